@@ -1,0 +1,91 @@
+# conifit: plain Makefile. Targets:
+#   make            build build/conifit (optimised, with debug info)
+#   make deps       install the Debian packages conifit needs (as root; otherwise prints the command)
+#   make example    set up, then fit a shipped table and write fits/ (the README's first command)
+#   make test       build and run the cmocka suite (the README's second command)
+#   make sanitize   the same suite under AddressSanitizer + UndefinedBehaviorSanitizer
+#   make bench      the benchmark report (optimised build, separate from the tests)
+#   make clean
+# WERROR=1 turns warnings into errors (CI sets it).
+
+CC      ?= cc
+PKGS    := nlopt gsl jansson
+TESTPKGS := cmocka
+DEBS    := build-essential pkg-config libnlopt-dev libgsl-dev libcmocka-dev libjansson-dev \
+           gnuplot-nox calculix-ccx
+BUILD   ?= build
+
+WARN    := -Wall -Wextra -Wpedantic -Wshadow -Wmissing-prototypes -Wstrict-prototypes
+ifeq ($(WERROR),1)
+WARN    += -Werror
+endif
+OPT     ?= -O2 -g
+CPPFLAGS += -D_DEFAULT_SOURCE -Isrc
+CFLAGS  += -std=c17 $(OPT) $(WARN) $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+LDLIBS  += $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lm -lpthread
+
+ifeq ($(SANITIZE),1)
+BUILD   := build/asan
+CFLAGS  += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+LDFLAGS += -fsanitize=address,undefined
+OPT     := -O1 -g
+endif
+
+# Library modules: every src/*.c but the command-line layer (main.c, cli*.c).
+CLI_SRC := src/main.c $(wildcard src/cli*.c)
+LIB_SRC := $(filter-out $(CLI_SRC),$(wildcard src/*.c))
+LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
+CLI_OBJ := $(CLI_SRC:src/%.c=$(BUILD)/obj/%.o)
+TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
+
+.PHONY: all deps example test sanitize bench clean check-deps
+
+all: check-deps $(BUILD)/conifit
+
+# Fails with the exact install command when a package is missing.
+check-deps:
+	@missing=""; for p in $(PKGS) $(TESTPKGS); do pkg-config --exists $$p 2>/dev/null || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+	  echo "conifit: missing libraries:$$missing. Install them with:" >&2; \
+	  echo "  apt-get update && apt-get install -y $(DEBS)   (or: make deps, as root)" >&2; exit 1; fi
+
+deps:
+	@missing=""; for d in $(DEBS); do dpkg -s $$d >/dev/null 2>&1 || missing="$$missing $$d"; done; \
+	if [ -z "$$missing" ]; then echo "conifit: all packages present"; \
+	elif [ "$$(id -u)" = 0 ]; then \
+	  echo "conifit: installing$$missing"; \
+	  export DEBIAN_FRONTEND=noninteractive; \
+	  apt-get update -qq && apt-get install -y -qq --no-install-recommends $$missing >/dev/null && \
+	  echo "conifit: installed$$missing"; \
+	else echo "conifit: missing packages. Run as root:" >&2; \
+	  echo "  apt-get update && apt-get install -y$$missing" >&2; exit 1; fi
+
+example: deps
+	@$(MAKE) --no-print-directory all
+	$(BUILD)/conifit info --D1 10 --D2 30 --n 4 --d 1 --G 80000 --H 40
+	$(BUILD)/conifit curve --D1 10 --D2 30 --n 4 --d 1 --G 80000 --H 40 --points 9
+
+$(BUILD)/obj/%.o: src/%.c $(wildcard src/*.h) | $(BUILD)/obj
+	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+
+$(BUILD)/conifit: $(LIB_OBJ) $(CLI_OBJ)
+	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS)
+
+# Each test links the library (and may see internals through -Isrc); the CLI tests run the binary.
+$(BUILD)/tests/%: tests/%.c tests/testutil.h $(LIB_OBJ) | $(BUILD)/tests
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) $(shell pkg-config --cflags $(TESTPKGS) 2>/dev/null) $< $(LIB_OBJ) -o $@ \
+	  $(LDFLAGS) $(LDLIBS) $(shell pkg-config --libs $(TESTPKGS) 2>/dev/null)
+
+$(BUILD)/obj $(BUILD)/tests:
+	mkdir -p $@
+
+test: check-deps $(BUILD)/conifit $(TESTS)
+	@fail=0; for t in $(TESTS); do \
+	  CONIFIT=$(BUILD)/conifit $$t || fail=1; done; \
+	if [ $$fail = 0 ]; then echo "conifit: all test programs passed"; else echo "conifit: TEST FAILURES" >&2; exit 1; fi
+
+sanitize:
+	@$(MAKE) --no-print-directory test SANITIZE=1
+
+clean:
+	rm -rf build

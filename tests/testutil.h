@@ -1,0 +1,87 @@
+/*
+** Helpers shared by the cmocka tests: running the conifit binary, temporary folders, and the
+** location of the published measurement tables (read from ../shared/datasets when present).
+*/
+#ifndef CF_TESTUTIL_H
+#define CF_TESTUTIL_H
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+#include <math.h>
+
+/* Fails unless |a - b| <= tol, printing both values to 17 digits (cmocka 1.1.5 has no double
+** comparison of its own). */
+#define assert_close(a, b, tol) tu_assert_close((a), (b), (tol), #a, __FILE__, __LINE__)
+static inline void tu_assert_close(double a, double b, double tol, const char *expr,
+                                   const char *file, int line)
+{
+    if (!(fabs(a - b) <= tol))
+    {
+        print_error("%s = %.17g, expected %.17g within %.3g (off by %.3g)\n", expr, a, b, tol,
+                    fabs(a - b));
+        _fail(file, line);
+    }
+}
+
+/* Path of the conifit binary under test (the Makefile sets CONIFIT). */
+static inline const char *tu_conifit(void)
+{
+    const char *p = getenv("CONIFIT");
+    return p ? p : "build/conifit";
+}
+
+/* Runs `conifit ARGS` through the shell with stdout and stderr captured into the given buffers
+** (each up to cap bytes, NUL-terminated); returns the exit status. */
+static inline int tu_run(char *out, size_t out_cap, char *errbuf, size_t err_cap, const char *fmt,
+                         ...)
+{
+    char args[4096], cmd[8192];
+    char outfile[] = "/tmp/conifit-test-out-XXXXXX", errfile[] = "/tmp/conifit-test-err-XXXXXX";
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(args, sizeof args, fmt, ap);
+    va_end(ap);
+    int fo = mkstemp(outfile), fe = mkstemp(errfile);
+    assert_true(fo >= 0 && fe >= 0);
+    snprintf(cmd, sizeof cmd, "%s %s >%s 2>%s </dev/null", tu_conifit(), args, outfile, errfile);
+    int st = system(cmd);
+    const char *files[2] = {outfile, errfile};
+    char *bufs[2] = {out, errbuf};
+    size_t caps[2] = {out_cap, err_cap};
+    for (int i = 0; i < 2; i++) {
+        if (!bufs[i])
+            continue;
+        FILE *f = fopen(files[i], "rb");
+        size_t n = f ? fread(bufs[i], 1, caps[i] - 1, f) : 0;
+        bufs[i][n] = '\0';
+        if (f)
+            fclose(f);
+    }
+    close(fo);
+    close(fe);
+    remove(outfile);
+    remove(errfile);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/* The folder of published tables, or NULL when it is absent (tests that need it then skip). */
+static inline const char *tu_datasets(void)
+{
+    static const char *dir = "../shared/datasets";
+    FILE *f = fopen("../shared/datasets/README.md", "r");
+    if (!f)
+        return NULL;
+    fclose(f);
+    return dir;
+}
+
+#endif
