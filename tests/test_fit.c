@@ -1,0 +1,462 @@
+/*
+** Tests of the fitter (src/fit.c) and the baselines (src/baseline.c): recovery of known springs
+** from synthetic tables (noiseless and noisy), constraints checked at every reported solution,
+** fixed parameters, determinism, and the published tables against an independent
+** three-parameter least-squares fit.
+*/
+#include <float.h>
+#include <math.h>
+
+#include "testutil.h"
+
+#include <gsl/gsl_blas.h>
+#include <gsl/gsl_multifit_nlinear.h>
+
+#include "baseline.h"
+#include "fit.h"
+#include "law.h"
+#include "measure.h"
+
+/* ---- synthetic tables ------------------------------------------------------------------------ */
+
+typedef struct table {
+    size_t n;
+    double x[400], y[400];
+} table;
+
+/* Box-Muller normal deviates from a fixed LCG, so the noisy tables are the same on every run. */
+static double normal(uint64_t *s)
+{
+    *s = *s * 6364136223846793005ull + 1442695040888963407ull;
+    double u1 = ((double)(*s >> 11) + 0.5) * 0x1.0p-53;
+    *s = *s * 6364136223846793005ull + 1442695040888963407ull;
+    double u2 = ((double)(*s >> 11) + 0.5) * 0x1.0p-53;
+    return sqrt(-2 * log(u1)) * cos(2 * M_PI * u2);
+}
+
+/* sigma = F(eps H)/H^2 at n strains evenly spaced up to frac of the solid strain; noise is a
+** relative standard deviation of the largest stress. */
+static void synth_pw(const cf_spring *p, size_t n, double frac, double noise, uint64_t seed,
+                     double pw, table *t)
+{
+    cf_law law;
+    cf_error err = {0};
+    if (cf_law_init(&law, p, &err) != CF_OK)
+        fail_msg("bad test spring: %s", err.msg);
+    double es = law.travel_mm / p->H_mm;
+    double smax = law.F_C_N / (p->H_mm * p->H_mm);
+    t->n = n;
+    for (size_t i = 0; i < n; i++) {
+        t->x[i] = frac * es * (1 - pow(1 - (double)i / (double)(n - 1), pw));
+        t->y[i] = cf_law_force(&law, CF_LAW_EXACT, t->x[i] * p->H_mm, NULL, NULL) /
+                  (p->H_mm * p->H_mm);
+        if (noise > 0)
+            t->y[i] += noise * smax * normal(&seed);
+    }
+}
+
+/* Strains evenly spaced. */
+static void synth(const cf_spring *p, size_t n, double frac, double noise, uint64_t seed,
+                  table *t)
+{
+    synth_pw(p, n, frac, noise, seed, 1.0, t);
+}
+
+static cf_fit_data data_of(const table *t)
+{
+    cf_fit_data d = {t->n, t->x, t->y, NULL, 0};
+    return d;
+}
+
+static void fit_ok(const cf_fit_data *d, const cf_fit_options *o, cf_spring_type type,
+                   cf_fit_result *r)
+{
+    cf_error err = {0};
+    if (cf_fit_run(d, o, type, r, &err) != CF_OK)
+        fail_msg("cf_fit_run failed: %s", err.msg);
+}
+
+/* The reported solution must satisfy its constraints, checked here from the parameters alone. */
+static void assert_constraints_hold(const cf_fit_result *r, const cf_fit_data *d,
+                                    const cf_fit_options *o)
+{
+    const cf_spring *p = &r->params;
+    cf_law law;
+    assert_int_equal(cf_law_init(&law, p, NULL), CF_OK);
+    assert_int_equal(law.type, r->type);
+    assert_true(p->D1_mm / p->d_mm >= 3 * (1 - 1e-9));
+    assert_true(p->D1_mm / p->d_mm <= o->index_max * (1 + 1e-9));
+    assert_true(p->n >= 2 * (1 - 1e-12));
+    assert_true(p->D2_mm >= p->D1_mm);
+    double xmax = 0;
+    for (size_t i = 0; i < d->count; i++)
+        xmax = fmax(xmax, fabs(d->x[i]));
+    double umax = d->force_displacement ? xmax : xmax * p->H_mm;
+    assert_true(law.travel_mm > umax);
+    if (r->type == CF_TELESCOPING)
+        assert_true((p->D2_mm - p->D1_mm) / 2 >= p->n * p->d_mm);
+    else
+        assert_true((p->D2_mm - p->D1_mm) / 2 < p->n * p->d_mm);
+    assert_true(r->feasible);
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        double v = ((const double *)p)[k];
+        if (o->fixed[k])
+            assert_close(v, o->fixed_value[k], 1e-12 * o->fixed_value[k]);
+    }
+}
+
+/* pw > 1 crowds the strains towards the end of the table (x = frac e_s (1 - (1 - t)^pw)). */
+static void assert_recovers(const cf_spring *truth, cf_spring_type type, double frac, double pw)
+{
+    table t;
+    synth_pw(truth, 120, frac, 0, 0, pw, &t);
+    cf_fit_data d = data_of(&t);
+    cf_fit_options o = cf_fit_default_options();
+    cf_fit_result r;
+    fit_ok(&d, &o, type, &r);
+    double id[3];
+    cf_fit_identifiable(truth, 0, id);
+    for (int k = 0; k < 3; k++)
+        assert_close(r.ident[k], id[k], 1e-6 * id[k]);
+    double smax = fabs(t.y[t.n - 1]);
+    assert_true(r.rmse <= 1e-12 * smax);
+    assert_constraints_hold(&r, &d, &o);
+}
+
+/* Telescoping spring D1 = 10, D2 = 30, n = 4, d = 1 (rho = 1/3). */
+static void fit_recovers_telescoping_spring_from_noiseless_table(void **state)
+{
+    (void)state;
+    cf_spring p = {10, 30, 4, 1, 80000, 40};
+    assert_recovers(&p, CF_TELESCOPING, 0.98, 1);
+}
+
+/* Non-telescoping spring D1 = 10, D2 = 14, n = 5, d = 1.5 (rho = 0.714). */
+static void fit_recovers_non_telescoping_spring_from_noiseless_table(void **state)
+{
+    (void)state;
+    cf_spring p = {10, 14, 5, 1.5, 80000, 30};
+    assert_recovers(&p, CF_NON_TELESCOPING, 0.99, 1);
+}
+
+/* Nearly cylindrical: rho = 0.999 (non-telescoping necessarily). Its nonlinear region is the
+** last 0.15 % of the travel, so the table runs to 99.89 % of it (inside the travel margin) with
+** the strains crowded towards the end. */
+static void fit_recovers_nearly_cylindrical_spring(void **state)
+{
+    (void)state;
+    cf_spring p = {9.99, 10, 6, 1.2, 80000, 25};
+    assert_recovers(&p, CF_NON_TELESCOPING, 0.9989, 6);
+}
+
+/* Strongly conical: rho = 0.05, telescoping. */
+static void fit_recovers_strongly_conical_spring(void **state)
+{
+    (void)state;
+    cf_spring p = {3, 60, 3, 0.5, 80000, 20};
+    assert_recovers(&p, CF_TELESCOPING, 0.97, 1);
+}
+
+/* Both types fit a table that only the non-telescoping geometry generated: the three quantities
+** are the same law, so the telescoping fit matches as well when rho is within its range. */
+static void both_types_fit_the_same_law_when_rho_allows(void **state)
+{
+    (void)state;
+    cf_spring p = {10, 30, 4, 1, 80000, 40};
+    table t;
+    synth(&p, 100, 0.95, 0, 0, &t);
+    cf_fit_data d = data_of(&t);
+    cf_fit_options o = cf_fit_default_options();
+    cf_fit_result r;
+    fit_ok(&d, &o, CF_NON_TELESCOPING, &r);
+    assert_close(r.ident[0], 1.0 / 3.0, 1e-6);
+    assert_true(r.rmse <= 1e-12 * t.y[t.n - 1]);
+    assert_constraints_hold(&r, &d, &o);
+}
+
+/* With noise the truth lies within 3 standard errors of the estimate. */
+static void noisy_fit_brackets_truth_within_three_standard_errors(void **state)
+{
+    (void)state;
+    const cf_spring springs[2] = {{10, 30, 4, 1, 80000, 40}, {10, 14, 5, 1.5, 80000, 30}};
+    const cf_spring_type types[2] = {CF_TELESCOPING, CF_NON_TELESCOPING};
+    for (int s = 0; s < 2; s++) {
+        table t;
+        synth(&springs[s], 200, 0.97, 0.002, 12345 + (uint64_t)s, &t);
+        cf_fit_data d = data_of(&t);
+        cf_fit_options o = cf_fit_default_options();
+        cf_fit_result r;
+        fit_ok(&d, &o, types[s], &r);
+        double id[3];
+        cf_fit_identifiable(&springs[s], 0, id);
+        for (int k = 0; k < 3; k++) {
+            assert_true(r.ident_se[k] > 0);
+            assert_true(r.ident_se[k] < 0.2 * id[k]); /* the uncertainty says something */
+            assert_close(r.ident[k], id[k], 3 * r.ident_se[k]);
+        }
+        assert_constraints_hold(&r, &d, &o);
+    }
+}
+
+/* A fixed parameter is honoured and the fit still reaches the law when the family allows it. */
+static void fixed_parameters_are_held_and_fit_still_exact(void **state)
+{
+    (void)state;
+    cf_spring p = {10, 30, 4, 1, 80000, 40};
+    table t;
+    synth(&p, 100, 0.95, 0, 0, &t);
+    cf_fit_data d = data_of(&t);
+    cf_fit_options o = cf_fit_default_options();
+    o.fixed[CF_P_H] = 1;
+    o.fixed_value[CF_P_H] = 5.0;
+    o.fixed[CF_P_G] = 1;
+    o.fixed_value[CF_P_G] = 10000.0;
+    cf_fit_result r;
+    fit_ok(&d, &o, CF_TELESCOPING, &r);
+    assert_close(r.params.H_mm, 5.0, 0);
+    assert_close(r.params.G_MPa, 10000.0, 0);
+    assert_true(r.rmse <= 1e-9 * t.y[t.n - 1]);
+    assert_constraints_hold(&r, &d, &o);
+}
+
+/* Every optimiser gives a feasible fit at rounding level on a noiseless table. */
+static void every_optimizer_reaches_the_law(void **state)
+{
+    (void)state;
+    cf_spring p = {10, 14, 5, 1.5, 80000, 30};
+    table t;
+    synth(&p, 80, 0.95, 0, 0, &t);
+    cf_fit_data d = data_of(&t);
+    for (int a = 0; a <= CF_OPT_MMA; a++) {
+        cf_fit_options o = cf_fit_default_options();
+        o.optimizer = (cf_fit_optimizer)a;
+        cf_fit_result r;
+        fit_ok(&d, &o, CF_NON_TELESCOPING, &r);
+        assert_true(r.rmse <= 1e-12 * t.y[t.n - 1]);
+        assert_constraints_hold(&r, &d, &o);
+    }
+}
+
+/* Same seed, same numbers (to the bit); the wall time is the only thing allowed to differ. */
+static void fits_are_deterministic_for_a_seed(void **state)
+{
+    (void)state;
+    cf_spring p = {10, 30, 4, 1, 80000, 40};
+    table t;
+    synth(&p, 100, 0.95, 0.01, 99, &t);
+    cf_fit_data d = data_of(&t);
+    cf_fit_options o = cf_fit_default_options();
+    cf_fit_result a, b;
+    fit_ok(&d, &o, CF_TELESCOPING, &a);
+    fit_ok(&d, &o, CF_TELESCOPING, &b);
+    assert_memory_equal(&a.params, &b.params, sizeof a.params);
+    assert_memory_equal(a.ident, b.ident, sizeof a.ident);
+    assert_memory_equal(a.ident_se, b.ident_se, sizeof a.ident_se);
+}
+
+/* Bad tables are refused with CF_E_DATA and a message naming the value. */
+static void bad_tables_are_refused(void **state)
+{
+    (void)state;
+    double x[5] = {0, 0.1, 0.2, 0.3, 0.4}, y[5] = {0, 1, 2, NAN, 4}, z[5] = {0};
+    cf_fit_options o = cf_fit_default_options();
+    cf_fit_result r;
+    cf_error err = {0};
+    cf_fit_data d = {5, x, y, NULL, 0};
+    assert_int_equal(cf_fit_run(&d, &o, CF_TELESCOPING, &r, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "point 4"));
+    d.y = z;
+    assert_int_equal(cf_fit_run(&d, &o, CF_TELESCOPING, &r, &err), CF_E_DATA);
+    d.count = 3;
+    d.y = x;
+    assert_int_equal(cf_fit_run(&d, &o, CF_TELESCOPING, &r, &err), CF_E_DATA);
+}
+
+/* A strain of 1 or more cannot be reached by any spring (s/H < 1): the fit is reported, marked
+** infeasible with the travel constraint named. */
+static void strain_beyond_any_spring_is_reported_infeasible(void **state)
+{
+    (void)state;
+    double x[6] = {0, 0.4, 0.8, 1.2, 1.6, 2.0}, y[6] = {0, 1, 2.2, 3.6, 5.2, 7};
+    cf_fit_data d = {6, x, y, NULL, 0};
+    cf_fit_options o = cf_fit_default_options();
+    cf_fit_result r;
+    fit_ok(&d, &o, CF_NON_TELESCOPING, &r);
+    assert_false(r.feasible);
+    assert_true(r.violated & CF_C_TRAVEL);
+    assert_true(isfinite(r.rmse));
+}
+
+/* ---- baselines ------------------------------------------------------------------------------- */
+
+/* Hand values: a linear table gives E exactly; a Duffing table its k1, k3; a Fung table A, B. */
+static void baselines_recover_their_own_laws(void **state)
+{
+    (void)state;
+    double x[20], yl[20], yd[20], yf[20];
+    for (int i = 0; i < 20; i++) {
+        x[i] = 0.01 * i;
+        yl[i] = 3.5 * x[i];
+        yd[i] = 2 * x[i] + 400 * x[i] * x[i] * x[i];
+        yf[i] = 0.2 * (exp(12 * x[i]) - 1);
+    }
+    cf_baseline b[CF_BASE_COUNT];
+    cf_fit_data d = {20, x, yl, NULL, 0};
+    cf_baseline_fit_all(&d, b);
+    assert_close(b[CF_BASE_LINEAR].coef[0], 3.5, 1e-12);
+    assert_true(b[CF_BASE_LINEAR].rmse < 1e-13);
+    d.y = yd;
+    cf_baseline_fit_all(&d, b);
+    assert_close(b[CF_BASE_DUFFING].coef[0], 2, 1e-9);
+    assert_close(b[CF_BASE_DUFFING].coef[1], 400, 1e-7);
+    d.y = yf;
+    cf_baseline_fit_all(&d, b);
+    assert_close(b[CF_BASE_FUNG].coef[0], 0.2, 1e-6);
+    assert_close(b[CF_BASE_FUNG].coef[1], 12, 1e-6);
+    /* AIC = n ln(RSS/n) + 2k by hand for the linear fit of the Fung table */
+    double rss = b[CF_BASE_LINEAR].rss;
+    assert_close(b[CF_BASE_LINEAR].aic, 20 * log(rss / 20) + 2, 1e-9);
+}
+
+/* ---- published tables: both types fit, and no worse than an independent careful fit ---------- */
+
+/* The independent fit: the same three-parameter law sigma = A F1(x/B; rho) written directly with
+** the exact evaluator, bounded by clamping, solved by GSL's LM from a dense deterministic set of
+** starts. */
+typedef struct ind_ctx {
+    const double *x, *y;
+    size_t n;
+    double rho_hi, b_lo, b_hi;
+} ind_ctx;
+
+static void ind_unpack(const ind_ctx *c, const gsl_vector *v, double *rho, double *B, double *A)
+{
+    *rho = fmin(fmax(gsl_vector_get(v, 0), 1e-3), c->rho_hi);
+    *B = fmin(fmax(gsl_vector_get(v, 1), c->b_lo), c->b_hi);
+    *A = fabs(gsl_vector_get(v, 2));
+}
+
+static double ind_model(double rho, double B, double A, double x)
+{
+    cf_spring p = {rho, 1, 2, 0.5, 256 * rho * rho * rho, 2}; /* travel 1, F_C 1 */
+    cf_law law;
+    if (cf_law_init(&law, &p, NULL) != CF_OK)
+        return NAN;
+    return A * cf_law_force(&law, CF_LAW_EXACT, x / B, NULL, NULL);
+}
+
+static int ind_f(const gsl_vector *v, void *params, gsl_vector *f)
+{
+    ind_ctx *c = params;
+    double rho, B, A;
+    ind_unpack(c, v, &rho, &B, &A);
+    for (size_t i = 0; i < c->n; i++)
+        gsl_vector_set(f, i, ind_model(rho, B, A, c->x[i]) - c->y[i]);
+    return GSL_SUCCESS;
+}
+
+static double independent_rmse(const double *x, const double *y, size_t n, double rho_hi,
+                               double b_lo, double b_hi)
+{
+    ind_ctx c = {x, y, n, rho_hi, b_lo, b_hi};
+    double ymax = 0;
+    for (size_t i = 0; i < n; i++)
+        ymax = fmax(ymax, fabs(y[i]));
+    double best = INFINITY;
+    gsl_multifit_nlinear_parameters fp = gsl_multifit_nlinear_default_parameters();
+    gsl_multifit_nlinear_workspace *w =
+        gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &fp, n, 3);
+    gsl_multifit_nlinear_fdf fdf = {ind_f, NULL, NULL, n, 3, &c, 0, 0, 0};
+    for (int i = 0; i < 12; i++)
+        for (int j = 0; j < 12; j++) {
+            double rho = 1e-3 + (rho_hi - 1e-3) * pow((i + 0.5) / 12.0, 2);
+            double B = b_lo + (b_hi - b_lo) * pow((j + 0.5) / 12.0, 3);
+            double v0[3] = {rho, B, ymax};
+            gsl_vector_view vv = gsl_vector_view_array(v0, 3);
+            if (gsl_multifit_nlinear_init(&vv.vector, &fdf, w) != GSL_SUCCESS)
+                continue;
+            int info;
+            gsl_multifit_nlinear_driver(200, 1e-12, 1e-12, 1e-12, NULL, NULL, &info, w);
+            gsl_vector *f = gsl_multifit_nlinear_residual(w);
+            double chi2;
+            gsl_blas_ddot(f, f, &chi2);
+            if (isfinite(chi2))
+                best = fmin(best, sqrt(chi2 / (double)n));
+        }
+    gsl_multifit_nlinear_free(w);
+    return best;
+}
+
+static void published_tables_fit_both_types_at_least_as_well_as_an_independent_fit(void **state)
+{
+    (void)state;
+    const char *dir = tu_datasets();
+    if (!dir)
+        skip();
+    static const char *files[] = {
+        "brain_coronaradiata_compression.csv", "brain_coronaradiata_tension.csv",
+        "brain_cortex_compression.csv",        "brain_cortex_shear.csv",
+        "brain_cortex_tension.csv",            "heart_myocardium_biaxial_1to1_fiber.csv",
+        "heart_myocardium_shear_fs.csv",       "muscle_compression_relaxation_crossfiber30.csv",
+        "muscle_compression_relaxation_fiber30.csv", "skin_porcine_stripbiaxial_x.csv",
+        "thrombus_pureshear_force_displacement.csv", "treloar1944_rubber_uniaxial.csv"};
+    for (size_t f = 0; f < sizeof files / sizeof files[0]; f++) {
+        char path[512];
+        snprintf(path, sizeof path, "%s/%s", dir, files[f]);
+        cf_measure m;
+        cf_error err = {0};
+        cf_measure_options mo = cf_measure_default_options();
+        if (strstr(files[f], "muscle")) {
+            mo.x_col = "strain";
+            mo.y_col = "stress";
+        }
+        if (cf_measure_load(path, &mo, &m, &err) != CF_OK)
+            fail_msg("%s: %s", files[f], err.msg);
+        cf_fit_data d = {m.count, m.x, m.y, m.w, m.kind == CF_MEASURE_FORCE_DISPLACEMENT};
+        double xmax = 0;
+        for (size_t i = 0; i < m.count; i++)
+            xmax = fmax(xmax, fabs(m.x[i]));
+        for (int t = 0; t < 2; t++) {
+            cf_fit_options o = cf_fit_default_options();
+            cf_fit_result r;
+            fit_ok(&d, &o, (cf_spring_type)t, &r);
+            assert_true(isfinite(r.rmse));
+            double need = xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
+            if (!d.force_displacement && need >= 1) {
+                /* no spring reaches this strain: reported, and flagged */
+                assert_false(r.feasible);
+                assert_true(r.violated & CF_C_TRAVEL);
+                continue;
+            }
+            assert_constraints_hold(&r, &d, &o);
+            double rho_hi = t == CF_TELESCOPING ? o.index_max / (o.index_max + 4) : 1.0;
+            double b_hi = d.force_displacement ? 1e3 * need : 1 - 1e-9;
+            double ref = independent_rmse(m.x, m.y, m.count, rho_hi, need, b_hi);
+            if (!(r.rmse <= ref * (1 + 1e-6)))
+                fail_msg("%s (%s): rmse %.17g worse than independent %.17g", files[f],
+                         cf_spring_type_name((cf_spring_type)t), r.rmse, ref);
+        }
+        cf_measure_free(&m);
+    }
+}
+
+int main(void)
+{
+    gsl_set_error_handler_off();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(fit_recovers_telescoping_spring_from_noiseless_table),
+        cmocka_unit_test(fit_recovers_non_telescoping_spring_from_noiseless_table),
+        cmocka_unit_test(fit_recovers_nearly_cylindrical_spring),
+        cmocka_unit_test(fit_recovers_strongly_conical_spring),
+        cmocka_unit_test(both_types_fit_the_same_law_when_rho_allows),
+        cmocka_unit_test(noisy_fit_brackets_truth_within_three_standard_errors),
+        cmocka_unit_test(fixed_parameters_are_held_and_fit_still_exact),
+        cmocka_unit_test(every_optimizer_reaches_the_law),
+        cmocka_unit_test(fits_are_deterministic_for_a_seed),
+        cmocka_unit_test(bad_tables_are_refused),
+        cmocka_unit_test(strain_beyond_any_spring_is_reported_infeasible),
+        cmocka_unit_test(baselines_recover_their_own_laws),
+        cmocka_unit_test(published_tables_fit_both_types_at_least_as_well_as_an_independent_fit),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
