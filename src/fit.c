@@ -11,7 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <stdio.h>
 
 #include <gsl/gsl_blas.h>
 #include <gsl/gsl_linalg.h>
@@ -820,7 +819,6 @@ cf_status cf_fit_run(const cf_fit_data *data, const cf_fit_options *opt, cf_spri
     double v[3] = {0.5, 0.5 * (c.b_lo + c.b_hi), 1.0}, se[3];
     stage_a(&c, v);
     stage_a_errors(&c, v, se);
-    if (getenv("CF_FIT_DEBUG")) fprintf(stderr, "A: rho %.17g B %.17g A %.17g obj %.6g\n", v[0], v[1], v[2], reduced_profile(&c, v[0], v[1], &(double){0}));
     /* Stage B: place a spring of the family. */
     for (int k = 0; k < CF_P_COUNT; k++) {
         if (opt->fixed[k])
@@ -839,7 +837,6 @@ cf_status cf_fit_run(const cf_fit_data *data, const cf_fit_options *opt, cf_spri
     nl_run(&c, NLOPT_LD_SLSQP, z_preference, 1, z, 2000);
     full_params(&c, z, p);
     double best_obj = objective6(&c, p);
-    if (getenv("CF_FIT_DEBUG")) fprintf(stderr, "B: %g %g %g %g %g %g obj %.6g\n", p[0],p[1],p[2],p[3],p[4],p[5], best_obj*c.ynorm);
     double best_p[CF_P_COUNT];
     memcpy(best_p, p, sizeof p);
     unsigned act, vio;
