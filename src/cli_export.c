@@ -22,7 +22,9 @@ static const char export_help[] =
     "  --format F   json | csv | calculix | abaqus | febio | lsdyna | sofa\n"
     "  --type T     telescoping | non-telescoping (default: the fit's better type)\n"
     "  -o FILE      output file (default stdout); written atomically\n"
-    "  --tol REL    relative tolerance of the table, 1e-9..0.1 (default 1e-4)\n"
+    "  --tol REL    relative tolerance of the table, 1e-9..0.1 (default 1e-4; for calculix\n"
+    "               the smallest of 1e-4, 2e-4, 5e-4, 1e-3, ... whose table fits CalculiX's\n"
+    "               200 rows)\n"
     "  --degree N   sofa: degree of the polynomial in strain, 1..15 (default 7)\n"
     "  --example    calculix/abaqus: a complete one-spring .inp instead of the *SPRING block\n\n"
     "FIT.json is a fit file (conifit fit -o) or an exported spring (--format json).\n";
@@ -32,7 +34,7 @@ int cf_cli_export(int argc, char **argv)
     cf_error err = {0};
     cf_export_options opt = cf_export_default_options();
     const char *fit_path = NULL, *type = NULL, *out_path = NULL;
-    int have_format = 0;
+    int have_format = 0, tol_given = 0;
     for (int i = 1; i < argc; i++) {
         const char *val;
         int m;
@@ -62,6 +64,7 @@ int cf_cli_export(int argc, char **argv)
         if ((m = cf_cli_match(argc, argv, &i, "--tol", &val, &err)) != 0) {
             if (m < 0 || cf_cli_parse_double("--tol", val, &opt.tol, &err) != CF_OK)
                 return cf_cli_usage_error("export", "%s", err.msg);
+            tol_given = 1;
             if (opt.tol < CF_EXPORT_TOL_MIN || opt.tol > CF_EXPORT_TOL_MAX)
                 return cf_cli_usage_error("export", "option --tol: %g is outside [%g, %g]",
                                           opt.tol, CF_EXPORT_TOL_MIN, CF_EXPORT_TOL_MAX);
@@ -96,6 +99,7 @@ int cf_cli_export(int argc, char **argv)
     if (cf_fitfile_load(fit_path, type, &fs, &err) != CF_OK)
         return cf_cli_fail(&err);
     opt.source = fit_path;
+    opt.auto_tol = !tol_given;
 
     char *buf = NULL;
     size_t len = 0;
@@ -139,6 +143,6 @@ int cf_cli_export(int argc, char **argv)
                 "conifit export: %s, %zu rows, max error %.3g relative (%.3g N), tol %g, "
                 "table ends at |u| = %.10g mm\n",
                 cf_export_format_name(opt.format), rep.rows, rep.max_err_rel, rep.max_err_N,
-                opt.tol, rep.u_end_mm);
+                rep.tol, rep.u_end_mm);
     return CF_EXIT_OK;
 }

@@ -18,7 +18,7 @@
 /* Rows are accepted when the interpolation error at the probes is within this fraction of the
 ** tolerance, so that the error between probes (checked afterwards on the dense grid) stays
 ** within the tolerance itself. */
-#define CF_EXPORT_SAFETY 0.5
+#define CF_EXPORT_SAFETY 0.8
 /* Points of each half of the independent check grid (uniform in u, and uniform in
 ** w = sqrt(1 - |u|/s), which crowds towards solid). */
 #define CF_EXPORT_CHECK_POINTS 20000
@@ -62,31 +62,66 @@ static double allowed_error(const cf_law *law, double tol, double F)
     return tol * fmax(fabs(F), CF_EXPORT_FLOOR * law->F_C_N);
 }
 
-/* Appends the rows of (a, b] on the compression side: b itself once linear interpolation between
-** a and b is within tolerance at the probes, otherwise both halves. */
-static int refine(const cf_law *law, double tol, double a, double Fa, double b, double Fb,
-                  double kb, rowbuf *rows)
+/* True when linear interpolation between the rows at a and b stays within the tolerance (times
+** the safety factor) at seven probes inside the interval. */
+static int interval_ok(const cf_law *law, double tol, double a, double Fa, double b, double Fb)
 {
-    static const double probes[3] = {0.25, 0.5, 0.75};
-    /* Intervals narrower than this are not split: their ends would differ by a few ulps. */
-    const double min_width = 64.0 * DBL_EPSILON * law->travel_mm;
-    int ok = 1;
-    if (b > law->u_T_mm && b - a > min_width) {
-        for (int i = 0; i < 3 && ok; i++) {
-            double x = a + probes[i] * (b - a);
-            double F = cf_law_force(law, CF_LAW_EXACT, x, NULL, NULL);
-            double lin = Fa + (Fb - Fa) * probes[i];
-            if (fabs(lin - F) > CF_EXPORT_SAFETY * allowed_error(law, tol, F))
-                ok = 0;
-        }
+    for (int i = 1; i < 8; i++) {
+        double f = i / 8.0;
+        double F = cf_law_force(law, CF_LAW_EXACT, a + f * (b - a), NULL, NULL);
+        if (fabs(Fa + (Fb - Fa) * f - F) > CF_EXPORT_SAFETY * allowed_error(law, tol, F))
+            return 0;
     }
-    if (ok)
-        return rowbuf_push(rows, b, Fb, kb);
-    double m = 0.5 * (a + b), km;
-    double Fm = cf_law_force(law, CF_LAW_EXACT, m, &km, NULL);
-    if (refine(law, tol, a, Fa, m, Fm, km, rows) != 0)
-        return -1;
-    return refine(law, tol, m, Fm, b, Fb, kb, rows);
+    return 1;
+}
+
+/* Appends the rows of (a, end] on the compression side, marching from a: each next row is the
+** farthest one (found by doubling, then bisection) whose interval still meets the tolerance.
+** This nearly equidistributes the error, so the row count stays close to the least possible. */
+static int march(const cf_law *law, double tol, double a, double end, rowbuf *rows)
+{
+    /* Intervals narrower than this are not refined: their ends would differ by a few ulps. */
+    const double min_width = 64.0 * DBL_EPSILON * law->travel_mm;
+    double Fa = cf_law_force(law, CF_LAW_EXACT, a, NULL, NULL);
+    double h = (end - a) / 64.0;
+    while (a < end) {
+        double good = 0.0, bad = 0.0;
+        double w = fmin(h, end - a);
+        /* grow while the interval is good, shrink while it is bad */
+        for (int it = 0; it < 200; it++) {
+            double b = (w >= end - a) ? end : a + w;
+            double Fb = cf_law_force(law, CF_LAW_EXACT, b, NULL, NULL);
+            if (w <= min_width || interval_ok(law, tol, a, Fa, b, Fb)) {
+                good = w;
+                if (b == end || bad != 0.0)
+                    break;
+                w *= 2.0;
+            } else {
+                bad = w;
+                if (good != 0.0)
+                    break;
+                w *= 0.5;
+            }
+        }
+        /* refine between the good and the bad width */
+        for (int it = 0; it < 12 && bad != 0.0 && a + good < end; it++) {
+            double m = 0.5 * (good + bad);
+            double Fb = cf_law_force(law, CF_LAW_EXACT, a + m, NULL, NULL);
+            if (interval_ok(law, tol, a, Fa, a + m, Fb))
+                good = m;
+            else
+                bad = m;
+        }
+        double b = (a + good >= end) ? end : a + good;
+        double kb;
+        double Fb = cf_law_force(law, CF_LAW_EXACT, b, &kb, NULL);
+        if (rowbuf_push(rows, b, Fb, kb) != 0)
+            return -1;
+        h = good;
+        a = b;
+        Fa = Fb;
+    }
+    return 0;
 }
 
 /* The i-th point (0 <= i < 2 CHECK_POINTS) of the dense check grid over [-u_end, u_end]. */
@@ -148,18 +183,15 @@ cf_status cf_export_table_build(const cf_law *law, double tol, cf_export_table *
     double k0;
     double F0 = cf_law_force(law, CF_LAW_EXACT, 0.0, &k0, NULL);
     bad |= rowbuf_push(&half, 0.0, F0, k0);
-    double a = 0.0, Fa = F0;
+    double a = 0.0;
     if (law->u_T_mm < u_end) { /* region 1 is linear: one interval */
         double kT;
         double FT = cf_law_force(law, CF_LAW_EXACT, law->u_T_mm, &kT, NULL);
         bad |= rowbuf_push(&half, law->u_T_mm, FT, kT);
         a = law->u_T_mm;
-        Fa = FT;
     }
-    double ke;
-    double Fe = cf_law_force(law, CF_LAW_EXACT, u_end, &ke, NULL);
     if (!bad)
-        bad |= refine(law, tol, a, Fa, u_end, Fe, ke, &half);
+        bad |= march(law, tol, a, u_end, &half);
     if (bad) {
         free(half.u), free(half.F), free(half.k);
         return cf_error_set(err, CF_E_INTERNAL, "out of memory building the export table");
@@ -532,8 +564,25 @@ cf_status cf_export_write(FILE *out, const cf_fitted_spring *fs, const cf_export
         st = write_json(out, fs, &law, opt, err);
         goto done;
     }
-    if ((st = cf_export_table_build(&law, opt->tol, &t, err)) != CF_OK)
-        goto done;
+    double tol = opt->tol;
+    for (int step = 0;; step++) {
+        if ((st = cf_export_table_build(&law, tol, &t, err)) != CF_OK)
+            goto done;
+        if (opt->format != CF_EXPORT_CALCULIX || t.rows <= CF_EXPORT_CALCULIX_MAX_ROWS)
+            break;
+        /* rows grow like tol^(-1/2): the tolerance that would fit, for the message */
+        double need = tol * pow((double)t.rows / CF_EXPORT_CALCULIX_MAX_ROWS, 2.0);
+        if (!opt->auto_tol || tol >= CF_EXPORT_TOL_MAX) {
+            st = cf_error_set(err, CF_E_DATA,
+                              "CalculiX reads at most %d (force, elongation) pairs per spring, "
+                              "but --tol %g needs %zu rows; use --tol %.2g or larger",
+                              CF_EXPORT_CALCULIX_MAX_ROWS, tol, t.rows, need * 1.2);
+            goto done;
+        }
+        cf_export_table_free(&t);
+        tol = fmin(CF_EXPORT_TOL_MAX, (step % 3 == 1) ? tol * 2.5 : tol * 2.0);
+    }
+    r.tol = tol;
     r.rows = t.rows;
     r.max_err_rel = t.max_err_rel;
     r.max_err_N = t.max_err_N;

@@ -37,6 +37,9 @@
 #define CF_EXPORT_TOL_DEFAULT 1e-4
 #define CF_EXPORT_TOL_MIN 1e-9
 #define CF_EXPORT_TOL_MAX 0.1
+/* CalculiX 2.20 keeps at most 200 (force, elongation) pairs of a nonlinear *SPRING and silently
+** ignores the rest (found by running ccx on longer tables), so its export refuses larger tables. */
+#define CF_EXPORT_CALCULIX_MAX_ROWS 200
 /* Default and largest degree of the SOFA polynomial. */
 #define CF_EXPORT_DEGREE_DEFAULT 7
 #define CF_EXPORT_DEGREE_MAX 15
@@ -96,6 +99,8 @@ typedef struct cf_export_options {
     int degree;          /* SOFA polynomial degree */
     int example;         /* calculix/abaqus: a complete one-spring .inp instead of the block */
     const char *source;  /* name of the fit file, for provenance ("" or NULL if none) */
+    int auto_tol;        /* calculix: loosen tol (x2, x2.5, x2 ...) until the table fits
+                         ** CF_EXPORT_CALCULIX_MAX_ROWS rows, instead of refusing */
 } cf_export_options;
 
 cf_export_options cf_export_default_options(void);
@@ -106,6 +111,7 @@ typedef struct cf_export_report {
     double max_err_rel;   /* achieved maximum error (table: relative, see above; sofa: / F_C) */
     double max_err_N;     /* the same in N */
     double u_end_mm;      /* last row of the table, mm */
+    double tol;           /* tolerance the table was built with */
 } cf_export_report;
 
 /* Writes the spring in the chosen format to out. Never writes NaN or Inf. */
