@@ -11,7 +11,7 @@
 #include "error.h"
 #include "law.h"
 
-#define CF_VERSION "0.1.0"
+#include "version.h"
 
 /* Each subcommand: parses its own arguments (argv[0] is the subcommand name) and returns an exit
 ** status (0, 2, 65, 66, 70, 73). */

@@ -13,7 +13,7 @@
 #include <gsl/gsl_multifit.h>
 #include <jansson.h>
 
-#include "cli.h" /* CF_VERSION only */
+#include "version.h"
 
 /* Rows are accepted when the interpolation error at the probes is within this fraction of the
 ** tolerance, so that the error between probes (checked afterwards on the dense grid) stays
