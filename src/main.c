@@ -20,6 +20,7 @@ static const command commands[] = {
     {"force", cf_cli_force, "force F(u) of one spring at one compression"},
     {"curve", cf_cli_curve, "CSV table of force and stiffness from full stretch to solid"},
     {"info", cf_cli_info, "derived quantities of a spring (type, travel, loads, k0, ...)"},
+    {"synth", cf_cli_synth, "write the stress-strain table of a spring (example data)"},
 };
 
 static void usage(FILE *out)
