@@ -216,8 +216,8 @@ int cf_cli_synth(int argc, char **argv)
     double E = a.strain_max > 0.0 ? a.strain_max : 0.95 * solid_strain;
     if (!(E < solid_strain)) {
         cf_law_free(&law);
-        return cf_cli_usage_error("synth", "option --strain-max: %.17g is not below the solid "
-                                  "strain %.17g of this spring", E, solid_strain);
+        return cf_cli_usage_error("synth", "option --strain-max: %.10g is not below the solid "
+                                  "strain %.10g of this spring", E, solid_strain);
     }
     if (law.index_c < 3.0)
         fprintf(stderr, "conifit synth: warning: spring index D1/d = %.6g < 3 is not a practical "
