@@ -541,11 +541,11 @@ static const unit_def *comment_unit_xy(const char *s, size_t n, int which,
                 char *w = tok + strlen(tok);
                 while (w > tok && !isspace((unsigned char)w[-1]))
                     w--;
+                while (*w == '[' || *w == '(')
+                    w++;
                 size_t wl = strlen(w);
-                if (wl >= 2 && (w[0] == '[' || w[0] == '(')) {
-                    memmove(w, w + 1, wl);
-                    w[wl - 2] = '\0';
-                }
+                while (wl > 0 && (w[wl - 1] == ']' || w[wl - 1] == ')' || w[wl - 1] == '.'))
+                    w[--wl] = '\0';
                 return wanted_unit(w, want, nwant);
             }
             j++;

@@ -371,6 +371,10 @@ static void units_stated_in_comments_are_honoured(void **state)
             NULL, &m);
     assert_string_equal(m.y_unit, "MPa");
     cf_measure_free(&m);
+    load_ok("# (x, y) = (strain, [kPa])\nstrain,stress\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n",
+            NULL, &m);
+    assert_string_equal(m.y_unit, "kPa");
+    cf_measure_free(&m);
     load_ok("# column 1 = displacement [mm], column 2 = force [mN]\ndisplacement,force\n"
             "0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n",
             NULL, &m);
