@@ -21,6 +21,7 @@ int cf_cli_info(int argc, char **argv);
 int cf_cli_fit(int argc, char **argv);
 int cf_cli_simulate(int argc, char **argv);
 int cf_cli_export(int argc, char **argv);
+int cf_cli_synth(int argc, char **argv);
 
 /* Prints "conifit: MESSAGE" on stderr for err and returns its exit status. */
 int cf_cli_fail(const cf_error *err);
