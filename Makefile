@@ -89,3 +89,15 @@ sanitize:
 
 clean:
 	rm -rf build
+
+# The benchmark program: optimised build of the library plus tests/bench/*.c; writes
+# tests/bench/REPORT.md and its plots. BENCH_ARGS=--quick for a short smoke run.
+BENCH_OBJ := $(LIB_SRC:src/%.c=build/bench/obj/%.o)
+build/bench/obj/%.o: src/%.c $(wildcard src/*.h) | build/bench/obj
+	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+build/bench/obj:
+	mkdir -p $@
+build/bench/conifit-bench: $(wildcard tests/bench/*.c) tests/bench/bench.h $(BENCH_OBJ)
+	$(CC) $(CPPFLAGS) -Itests/bench $(CFLAGS) $(wildcard tests/bench/*.c) $(BENCH_OBJ) -o $@ $(LDFLAGS) $(LDLIBS)
+bench: check-deps build/bench/conifit-bench $(BUILD)/conifit
+	build/bench/conifit-bench $(BENCH_ARGS) tests/bench

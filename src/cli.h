@@ -11,7 +11,7 @@
 #include "error.h"
 #include "law.h"
 
-#define CF_VERSION "0.1.0"
+#include "version.h"
 
 /* Each subcommand: parses its own arguments (argv[0] is the subcommand name) and returns an exit
 ** status (0, 2, 65, 66, 70, 73). */
@@ -21,6 +21,7 @@ int cf_cli_info(int argc, char **argv);
 int cf_cli_fit(int argc, char **argv);
 int cf_cli_simulate(int argc, char **argv);
 int cf_cli_export(int argc, char **argv);
+int cf_cli_synth(int argc, char **argv);
 
 /* Prints "conifit: MESSAGE" on stderr for err and returns its exit status. */
 int cf_cli_fail(const cf_error *err);

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "fitfile.h"
 
 static const char force_help[] =
     "usage: conifit force SPRING --u MM [--method M]\n"
@@ -30,6 +31,7 @@ static const char info_help[] =
 
 typedef struct law_args {
     cf_cli_spring spring;
+    const char *spring_file; /* --spring FILE.json[:TYPE], or NULL */
     cf_law_method method;
     long table;
     double u;
@@ -53,7 +55,17 @@ static int parse(const char *cmd, const char *help, const char *allowed, int arg
         if (cf_cli_is_help(argv[i])) {
             printf(help, 0.0);
             fputs(cf_cli_spring_help, stdout);
+            fputs("  --spring FILE.json[:TYPE]  instead of the six: the spring of a fit file or of\n"
+                  "             an exported spring (conifit export --format json); TYPE is\n"
+                  "             telescoping or non-telescoping (default: the better fit)\n",
+                  stdout);
             return CF_EXIT_OK;
+        }
+        if ((m = cf_cli_match(argc, argv, &i, "--spring", &val, &err)) != 0) {
+            if (m < 0)
+                return cf_cli_usage_error(cmd, "%s", err.msg);
+            a->spring_file = val;
+            continue;
         }
         if ((m = cf_cli_spring_option(&a->spring, argc, argv, &i, &err)) != 0) {
             if (m < 0)
@@ -86,7 +98,16 @@ static int parse(const char *cmd, const char *help, const char *allowed, int arg
         }
         return cf_cli_usage_error(cmd, "unknown argument '%s'", argv[i]);
     }
-    if (cf_cli_spring_complete(&a->spring, &err) != CF_OK)
+    if (a->spring_file) {
+        for (int k = 0; k < 6; k++)
+            if (a->spring.have[k])
+                return cf_cli_usage_error(cmd, "--spring replaces --D1 --D2 --n --d --G --H; "
+                                               "give one or the other");
+        cf_fitted_spring fs;
+        if (cf_fitfile_load_spec(a->spring_file, &fs, &err) != CF_OK)
+            return cf_cli_fail(&err);
+        a->spring.p = fs.params;
+    } else if (cf_cli_spring_complete(&a->spring, &err) != CF_OK)
         return cf_cli_usage_error(cmd, "%s", err.msg);
     if (strstr(allowed, "u") && !a->have_u)
         return cf_cli_usage_error(cmd, "missing option --u");

@@ -17,12 +17,22 @@
 **   }
 ** Only "fits[].type", "fits[].params" (and the provenance fields if present) are needed to read a
 ** spring back; everything else is report.
+**
+** The same reader takes a single exported spring (`conifit export --format json`), recognised by
+** its "schema" key:
+**   { "schema": "conifit-spring-1", "conifit_version": "0.1.0", "type": "telescoping",
+**     "params": { "D1_mm", "D2_mm", "n", "d_mm", "G_MPa", "H_mm" },
+**     "derived": { ... as above ... }, "units": { ... },
+**     "provenance": { "fit_file", "data_file", "rmse", "rmse_unit", "fit_version" } }
 */
 #ifndef CF_FITFILE_H
 #define CF_FITFILE_H
 
 #include "error.h"
 #include "law.h"
+
+/* The "schema" value of a single exported spring. */
+#define CF_SPRINGFILE_SCHEMA "conifit-spring-1"
 
 /* A spring read from a fit file, with what is known of where it came from. */
 typedef struct cf_fitted_spring {

@@ -21,6 +21,8 @@ static const command commands[] = {
     {"curve", cf_cli_curve, "CSV table of force and stiffness from full stretch to solid"},
     {"info", cf_cli_info, "derived quantities of a spring (type, travel, loads, k0, ...)"},
     {"fit", cf_cli_fit, "fit conical springs (both types) and baselines to measured tables"},
+    {"export", cf_cli_export, "write a fitted spring for CalculiX, Abaqus, FEBio, LS-DYNA, SOFA"},
+    {"synth", cf_cli_synth, "write the stress-strain table of a spring (example data)"},
 };
 
 static void usage(FILE *out)

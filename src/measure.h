@@ -25,8 +25,11 @@ typedef enum cf_measure_kind {
 } cf_measure_kind;
 
 typedef struct cf_measure_options {
-    const char *x_col;       /* column name of x, or NULL to take the first data column */
-    const char *y_col;       /* column name of y, or NULL to take the column after x */
+    const char *x_col;       /* column name of x (with or without its unit decoration), or NULL:
+                             ** the first column named strain/stretch/lambda/displacement/
+                             ** elongation/gamma/shear..., else the first column that is not y */
+    const char *y_col;       /* column name of y, or NULL: the first column named stress/force/
+                             ** load..., else the first remaining column */
     const char *stress_unit; /* "Pa", "kPa", "MPa", "GPa", "N/mm2", "mmHg"...; NULL: from header */
     const char *force_unit;  /* "N", "mN", "kN", "uN"; NULL: from header */
     const char *length_unit; /* "m", "mm", "um", "cm"; NULL: from header */
@@ -36,6 +39,24 @@ typedef struct cf_measure_options {
 /* Options with everything decided from the file. */
 cf_measure_options cf_measure_default_options(void);
 
+/* Fewest data rows a table must have (six design parameters). */
+#define CF_MEASURE_MIN_ROWS 6
+
+/* What a unit measures. */
+typedef enum cf_unit_class {
+    CF_UNIT_UNKNOWN = 0,
+    CF_UNIT_STRESS = 1, /* converted to MPa */
+    CF_UNIT_FORCE = 2,  /* converted to N */
+    CF_UNIT_LENGTH = 3, /* converted to mm */
+    CF_UNIT_TIME = 4,   /* converted to s */
+    CF_UNIT_STRAIN = 5  /* dimensionless: "-", "1" or "%" (converted to a plain fraction) */
+} cf_unit_class;
+
+/* Looks up a unit name (case-sensitive: "kPa", "MPa", "N/mm2", "mN", "um", "%", ...). Returns
+** CF_UNIT_UNKNOWN for a name it does not know; otherwise the class, and in *to_conifit (if not
+** NULL) the factor that converts a value in that unit to conifit's (MPa, N, mm, s, -). */
+cf_unit_class cf_measure_unit(const char *name, double *to_conifit);
+
 typedef struct cf_measure {
     cf_measure_kind kind;
     size_t count;          /* number of data rows */
@@ -44,7 +65,9 @@ typedef struct cf_measure {
     double *w;             /* weights (> 0; 1 when the file has no weight column), count values */
     double *t;             /* time [s] when the file has a time column, else NULL */
     double y_to_file;      /* multiply y by this to get the file's own unit (1000 for kPa) */
-    int compression;       /* 1 when the data lie at negative x (compression negative) */
+    int compression;       /* 1 when the data lie at negative x (compression negative): some
+                           ** x < 0 and none > 0 */
+    int x_from_stretch;    /* 1 when the x column held stretch, converted to strain = stretch - 1 */
     char path[1024];       /* the file as named by the caller */
     char x_column[64];     /* header name of the x column */
     char y_column[64];     /* header name of the y column */

@@ -1,0 +1,105 @@
+/*
+** conifit-bench: measures what accuracy costs in time at every stage of conifit and writes a
+** Markdown report with tables and gnuplot plots. Usage: conifit-bench [--quick] DIR
+** Every number in the report is measured by this program on the machine that runs it.
+*/
+#include "bench.h"
+
+#include <locale.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/utsname.h>
+#include <time.h>
+
+#include <gsl/gsl_errno.h>
+
+volatile double bench_sink;
+
+double bench_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+bench_stats bench_summarise(double *x, int count)
+{
+    bench_stats s = {0, 0, 0, count};
+    if (count <= 0)
+        return s;
+    qsort(x, (size_t)count, sizeof *x, cmp_double);
+    s.min = x[0];
+    s.max = x[count - 1];
+    s.median = (count % 2) ? x[count / 2] : 0.5 * (x[count / 2 - 1] + x[count / 2]);
+    return s;
+}
+
+FILE *bench_open_data(const bench_ctx *ctx, const char *name)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", ctx->dir, name);
+    return fopen(path, "w");
+}
+
+int bench_gnuplot(const bench_ctx *ctx, const char *script)
+{
+    char cmd[1200];
+    snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot", ctx->dir);
+    FILE *p = popen(cmd, "w");
+    if (!p)
+        return -1;
+    fputs(script, p);
+    return pclose(p) == 0 ? 0 : -1;
+}
+
+int main(int argc, char **argv)
+{
+    setlocale(LC_ALL, "C");
+    gsl_set_error_handler_off();
+    bench_ctx ctx = {0};
+    const char *dir = NULL;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--quick") == 0)
+            ctx.quick = 1;
+        else if (argv[i][0] == '-') {
+            fprintf(stderr, "usage: conifit-bench [--quick] DIR\n");
+            return 2;
+        } else
+            dir = argv[i];
+    }
+    if (!dir) {
+        fprintf(stderr, "usage: conifit-bench [--quick] DIR\n");
+        return 2;
+    }
+    ctx.dir = dir;
+    char path[1024], tmp[1100];
+    snprintf(path, sizeof path, "%s/REPORT.md", dir);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    ctx.md = fopen(tmp, "w");
+    if (!ctx.md) {
+        fprintf(stderr, "conifit-bench: cannot write %s\n", tmp);
+        return 73;
+    }
+    struct utsname un;
+    uname(&un);
+    fprintf(ctx.md, "# conifit benchmark report\n\n"
+                    "What accuracy costs in time, measured by `make bench` (tests/bench/). Every "
+                    "time is the median of repeated runs with the spread (min–max) beside it; "
+                    "one core, `-O2`. Machine: %s %s.\n\n",
+            un.sysname, un.machine);
+    double t0 = bench_now();
+    bench_section_law(&ctx);
+    fprintf(ctx.md, "\n---\nWhole benchmark run: %.0f s.\n", bench_now() - t0);
+    if (fclose(ctx.md) != 0 || rename(tmp, path) != 0) {
+        fprintf(stderr, "conifit-bench: cannot write %s\n", path);
+        return 73;
+    }
+    fprintf(stderr, "conifit-bench: wrote %s\n", path);
+    return 0;
+}

@@ -1,0 +1,144 @@
+/*
+** Tests of the fit-file reader (src/fitfile.c): a good fit file and an exported spring load with
+** their provenance; every malformed case is refused with a message naming its key and value.
+*/
+#include "testutil.h"
+
+#include "fitfile.h"
+
+static char dir[64];
+static char path[128];
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(dir, sizeof dir, "/tmp/conifit-fitfile-XXXXXX");
+    return mkdtemp(dir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static const char *write_file(const char *name, const char *text)
+{
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+    return path;
+}
+
+#define TEL "{\"type\":\"telescoping\",\"params\":{\"D1_mm\":10,\"D2_mm\":30,\"n\":4,\"d_mm\":1," \
+            "\"G_MPa\":80000,\"H_mm\":40},\"rmse\":0.5}"
+#define NON "{\"type\":\"non-telescoping\",\"params\":{\"D1_mm\":10,\"D2_mm\":20,\"n\":6,\"d_mm\":1," \
+            "\"G_MPa\":80000,\"H_mm\":40},\"rmse\":0.7}"
+#define HEAD "{\"conifit_version\":\"0.1.0\",\"data\":{\"file\":\"data/t.csv\",\"y_unit\":\"kPa\"},"
+
+static void good_file_loads_both_types_and_provenance(void **state)
+{
+    (void)state;
+    cf_fitted_spring fs;
+    cf_error err = {0};
+    const char *p = write_file("good.json", HEAD "\"fits\":[" TEL "," NON
+                                                 "],\"better_type\":\"non-telescoping\"}");
+    assert_int_equal(cf_fitfile_load(p, NULL, &fs, &err), CF_OK);
+    assert_int_equal(fs.type, CF_NON_TELESCOPING); /* the better type by default */
+    assert_close(fs.params.D2_mm, 20.0, 0.0);
+    assert_close(fs.rmse, 0.7, 0.0);
+    assert_string_equal(fs.data_file, "data/t.csv");
+    assert_string_equal(fs.y_unit, "kPa");
+    assert_string_equal(fs.version, "0.1.0");
+    assert_int_equal(cf_fitfile_load(p, "telescoping", &fs, &err), CF_OK);
+    assert_int_equal(fs.type, CF_TELESCOPING);
+    assert_close(fs.params.n, 4.0, 0.0);
+    char spec[256];
+    snprintf(spec, sizeof spec, "%s:telescoping", p);
+    assert_int_equal(cf_fitfile_load_spec(spec, &fs, &err), CF_OK);
+    assert_int_equal(fs.type, CF_TELESCOPING);
+}
+
+static void exported_spring_file_loads_and_checks_its_type(void **state)
+{
+    (void)state;
+    cf_fitted_spring fs;
+    cf_error err = {0};
+    const char *p = write_file(
+        "spring.json", "{\"schema\":\"conifit-spring-1\",\"conifit_version\":\"0.1.0\","
+                       "\"type\":\"telescoping\",\"params\":{\"D1_mm\":10,\"D2_mm\":30,\"n\":4,"
+                       "\"d_mm\":1,\"G_MPa\":80000,\"H_mm\":40},\"provenance\":{\"data_file\":"
+                       "\"data/t.csv\",\"rmse\":0.25,\"rmse_unit\":\"kPa\"}}");
+    assert_int_equal(cf_fitfile_load(p, NULL, &fs, &err), CF_OK);
+    assert_int_equal(fs.type, CF_TELESCOPING);
+    assert_close(fs.rmse, 0.25, 0.0);
+    assert_string_equal(fs.data_file, "data/t.csv");
+    assert_int_equal(cf_fitfile_load(p, "non-telescoping", &fs, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "non-telescoping"));
+}
+
+/* Each malformed file: its text, and two pieces the message must contain (key and value). */
+static void every_malformed_file_is_refused_naming_key_and_value(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *text, *type, *key, *value;
+    } cases[] = {
+        {"{\"fits\": [", NULL, "bad.json:1:", "not a valid fit file"},
+        {HEAD "\"better_type\":\"telescoping\"}", NULL, "'fits'", "missing"},
+        {HEAD "\"fits\":[]}", NULL, "'fits'", "non-empty"},
+        {HEAD "\"fits\":[" TEL "]}", "non-telescoping", "no fit of type", "'non-telescoping'"},
+        {HEAD "\"fits\":[" TEL "," NON "]}", NULL, "better_type", "several fits"},
+        {HEAD "\"fits\":[{\"type\":\"conical\",\"params\":{}}]}", NULL, "fits[0].type",
+         "'conical'"},
+        {HEAD "\"fits\":[{\"type\":\"telescoping\",\"params\":{\"D2_mm\":30,\"n\":4,\"d_mm\":1,"
+              "\"G_MPa\":80000,\"H_mm\":40}}]}",
+         NULL, "fits[0].params.D1_mm", "(missing)"},
+        {HEAD "\"fits\":[{\"type\":\"telescoping\",\"params\":{\"D1_mm\":10,\"D2_mm\":30,\"n\":"
+              "\"four\",\"d_mm\":1,\"G_MPa\":80000,\"H_mm\":40}}]}",
+         NULL, "fits[0].params.n", "\"four\""},
+        {HEAD "\"fits\":[{\"type\":\"telescoping\",\"params\":{\"D1_mm\":40,\"D2_mm\":30,\"n\":4,"
+              "\"d_mm\":1,\"G_MPa\":80000,\"H_mm\":40}}]}",
+         NULL, "D1_mm", "40"},
+        {HEAD "\"fits\":[{\"type\":\"telescoping\",\"params\":{\"D1_mm\":10,\"D2_mm\":20,\"n\":6,"
+              "\"d_mm\":1,\"G_MPa\":80000,\"H_mm\":40}}]}",
+         NULL, "fits[0] says type 'telescoping'", "non-telescoping"},
+        {"{\"schema\":\"conifit-spring-1\",\"type\":\"telescoping\",\"params\":{\"D1_mm\":10}}",
+         NULL, "spring.params.D2_mm", "(missing)"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        cf_fitted_spring fs;
+        cf_error err = {0};
+        const char *p = write_file("bad.json", cases[i].text);
+        cf_status st = cf_fitfile_load(p, cases[i].type, &fs, &err);
+        if (st != CF_E_DATA || !strstr(err.msg, cases[i].key) || !strstr(err.msg, cases[i].value))
+            fail_msg("case %zu: status %d, message '%s' lacks '%s' or '%s'", i, (int)st, err.msg,
+                     cases[i].key, cases[i].value);
+    }
+}
+
+static void missing_file_is_noinput(void **state)
+{
+    (void)state;
+    cf_fitted_spring fs;
+    cf_error err = {0};
+    char p[128];
+    snprintf(p, sizeof p, "%s/absent.json", dir);
+    assert_int_equal(cf_fitfile_load(p, NULL, &fs, &err), CF_E_NOINPUT);
+    assert_non_null(strstr(err.msg, "absent.json"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(good_file_loads_both_types_and_provenance),
+        cmocka_unit_test(exported_spring_file_loads_and_checks_its_type),
+        cmocka_unit_test(every_malformed_file_is_refused_naming_key_and_value),
+        cmocka_unit_test(missing_file_is_noinput),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
