@@ -16,6 +16,7 @@
 
 #include "baseline.h"
 #include "cli.h"
+#include "version.h"
 #include "fit.h"
 #include "measure.h"
 #include "plot.h"

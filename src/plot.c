@@ -65,7 +65,7 @@ static void write_script(FILE *g, const cf_fit_report *r, const cf_fit_data *d, 
         fprintf(g, "set terminal pngcairo size 900,800 enhanced font 'sans,11'\n");
     fprintf(g, "set output '%s'\n", out);
     const char *xl = r->force_displacement ? "displacement [mm]" : "strain [-]";
-    fprintf(g, "set multiplot layout 2,1 title \"%s\" noenhanced\n", r->data_file);
+    fprintf(g, "set multiplot\nset title \"%s\" noenhanced\n", r->data_file);
     fprintf(g, "set size 1,0.66\nset origin 0,0.34\nset grid\nset key top left box opaque\n");
     fprintf(g, "set xlabel '%s'\nset ylabel '%s [%s]' noenhanced\n", xl, r->y_column, r->y_unit);
     static const char *colors[2] = {"#d62728", "#1f77b4"};

@@ -301,7 +301,9 @@ char *cf_report_text(const cf_fit_report *r)
         double rb = r->fits[b].rmse * r->y_to_file, ro = r->fits[ot].rmse * r->y_to_file;
         fprintf(o, "\nBetter type: %s (RMSE %.4g %s against %.4g %s", cf_spring_type_name(r->fits[b].type),
                 rb, r->y_unit, ro, r->y_unit);
-        if (rb > 0 && ro > rb * (1 + 1e-9))
+        /* differences at rounding level (noiseless tables) are no difference */
+        double level = 1e-9 * r->ymax * r->y_to_file;
+        if (ro - rb > 1e-6 * ro + level)
             fprintf(o, ", %.3g times lower; AIC lower by %.2f)\n", ro / rb,
                     cf_report_fit_aic(r, ot) - cf_report_fit_aic(r, b));
         else
