@@ -365,12 +365,12 @@ int cf_cli_fit(int argc, char **argv)
         }
         if (a.nfiles > 1 && !a.quiet) {
             printf("Summary (RMSE in each table's unit):\n");
-            printf("  %-44s %-16s %-16s %-16s %s\n", "table", "telescoping", "non-telescoping",
+            printf("  %-50s %-16s %-16s %-16s %s\n", "table", "telescoping", "non-telescoping",
                    "best baseline", "better type");
             for (int i = 0; i < a.nfiles; i++) {
                 fit_job *j = &jobs[i];
                 if (j->st != CF_OK) {
-                    printf("  %-44s failed\n", j->file);
+                    printf("  %-50s failed\n", j->file);
                     continue;
                 }
                 char cell[2][32] = {"-", "-"};
@@ -386,8 +386,10 @@ int cf_cli_fit(int argc, char **argv)
                 snprintf(bcell, sizeof bcell, "%s %.4g", cf_baseline_name((cf_baseline_kind)bb),
                          j->rep.baselines[bb].rmse * j->rep.y_to_file);
                 int b = cf_report_better(&j->rep);
-                printf("  %-44s %-16s %-16s %-16s %s\n", j->file, cell[0], cell[1], bcell,
-                       b >= 0 ? cf_spring_type_name(j->rep.fits[b].type) : "none feasible");
+                printf("  %-50s %-16s %-16s %-16s %s\n", j->file, cell[0], cell[1], bcell,
+                       b < 0                          ? "none feasible"
+                       : cf_report_types_tie(&j->rep) ? "equal"
+                                                      : cf_spring_type_name(j->rep.fits[b].type));
             }
         }
     }

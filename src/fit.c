@@ -804,7 +804,7 @@ cf_status cf_fit_run(const cf_fit_data *data, const cf_fit_options *opt, cf_spri
     /* Stage A bounds. Telescoping needs n <= c (1 - rho)/(2 rho) with n >= 2 and c <= index_max,
     ** so rho <= index_max/(index_max + 4). */
     c.rho_lo = RHO_LO;
-    c.rho_hi = type == CF_TELESCOPING ? opt->index_max / (opt->index_max + 4) : 1.0;
+    c.rho_hi = type == CF_TELESCOPING ? opt->index_max / (opt->index_max + 4) * (1 - 1e-6) : 1.0;
     double need = c.xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
     if (c.fd) {
         c.travel_ok = 1;

@@ -24,6 +24,14 @@ int cf_report_better(const cf_fit_report *r)
     return best;
 }
 
+int cf_report_types_tie(const cf_fit_report *r)
+{
+    if (r->nfits != 2)
+        return 0;
+    double a = r->fits[0].rmse, b = r->fits[1].rmse;
+    return fabs(a - b) <= 1e-6 * fmax(a, b) + 1e-9 * r->ymax;
+}
+
 double cf_report_fit_aic(const cf_fit_report *r, int i)
 {
     double f = r->y_to_file;
@@ -133,7 +141,8 @@ static json_t *report_json(const cf_fit_report *r)
         int o = 1 - b;
         json_object_set_new(
             root, "comparison",
-            json_pack("{s:o, s:o}", "rmse_ratio_other_to_better",
+            json_pack("{s:b, s:o, s:o}", "tie", cf_report_types_tie(r),
+                      "rmse_ratio_other_to_better",
                       num(r->fits[b].rmse > 0 ? r->fits[o].rmse / r->fits[b].rmse : 1.0),
                       "aic_difference", num(cf_report_fit_aic(r, o) - cf_report_fit_aic(r, b))));
     }
@@ -301,9 +310,7 @@ char *cf_report_text(const cf_fit_report *r)
         double rb = r->fits[b].rmse * r->y_to_file, ro = r->fits[ot].rmse * r->y_to_file;
         fprintf(o, "\nBetter type: %s (RMSE %.4g %s against %.4g %s", cf_spring_type_name(r->fits[b].type),
                 rb, r->y_unit, ro, r->y_unit);
-        /* differences at rounding level (noiseless tables) are no difference */
-        double level = 1e-9 * r->ymax * r->y_to_file;
-        if (ro - rb > 1e-6 * ro + level)
+        if (!cf_report_types_tie(r))
             fprintf(o, ", %.3g times lower; AIC lower by %.2f)\n", ro / rb,
                     cf_report_fit_aic(r, ot) - cf_report_fit_aic(r, b));
         else

@@ -32,6 +32,10 @@ typedef struct cf_fit_report {
 /* Index of the better fit in r->fits: the feasible one with the lower RMSE (-1 if none). */
 int cf_report_better(const cf_fit_report *r);
 
+/* 1 when both types were fitted and their RMSEs differ by no more than 1e-6 relative (or by
+** rounding level, 1e-9 max|y|): the table does not tell the types apart. */
+int cf_report_types_tie(const cf_fit_report *r);
+
 /* AIC of fit i, with RSS in the file's unit (comparable with the baselines' AIC of the report). */
 double cf_report_fit_aic(const cf_fit_report *r, int i);
 double cf_report_baseline_aic(const cf_fit_report *r, int k);
