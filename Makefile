@@ -62,8 +62,8 @@ deps:
 
 example: deps
 	@$(MAKE) --no-print-directory all
-	$(BUILD)/conifit info --D1 10 --D2 30 --n 4 --d 1 --G 80000 --H 40
-	$(BUILD)/conifit curve --D1 10 --D2 30 --n 4 --d 1 --G 80000 --H 40 --points 9
+	@mkdir -p fits
+	$(BUILD)/conifit fit data/telescoping_noise1pct.csv -o fits/telescoping_noise1pct.json --plot fits/telescoping_noise1pct.png
 
 $(BUILD)/obj/%.o: src/%.c $(wildcard src/*.h) | $(BUILD)/obj
 	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@

@@ -231,6 +231,31 @@ static double reduced(const cf_law *canon, double A, double B, double x, double 
     return A * g;
 }
 
+/* The canonical law g(t) = F/F_C at t = u/s and its derivatives dg/dt and dg/drho, analytic:
+** region 1: g = h(rho) t, h = 4 rho^3/((1 + rho)(1 + rho^2));
+** region 2: g = y^3 with y^4 - 4 c y + 3 = 0, c = (1 - |t|)/rho + |t|, so dy/dc = y/(y^3 - c)
+** and dc/drho = -(1 - |t|)/rho^2; past solid g = +-1 with zero derivatives. */
+static double canon_eval(const cf_law *canon, double t, double *dg_dt, double *dg_drho)
+{
+    int flags = 0;
+    double k;
+    double g = cf_law_force(canon, CF_LAW_CLOSED_NEWTON, t, &k, &flags);
+    const double rho = canon->rho, a = fabs(t), sg = t < 0 ? -1.0 : 1.0;
+    *dg_dt = k;
+    if (flags & CF_LAW_SOLID) {
+        *dg_drho = 0;
+    } else if (flags & CF_LAW_LINEAR) {
+        double h = 4 * rho * rho * rho / ((1 + rho) * (1 + rho * rho));
+        *dg_drho = t * h * (3 / rho - 1 / (1 + rho) - 2 * rho / (1 + rho * rho));
+    } else {
+        double y = cbrt(fabs(g));
+        double c = (1 - a) / rho + a;
+        double den = y * y * y - c;
+        *dg_drho = den < 0 ? sg * 3 * y * y * (y / den) * (-(1 - a) / (rho * rho)) : 0.0;
+    }
+    return g;
+}
+
 /* Weighted objective of the reduced model with the load scale A solved in closed form. */
 static double reduced_profile(fit_ctx *c, double rho, double B, double *A_out)
 {
@@ -272,9 +297,37 @@ static int lm_f(const gsl_vector *th, void *params, gsl_vector *f)
     cf_law canon;
     if (!isfinite(A) || canon_law(rho, &canon) != CF_OK)
         return GSL_EDOM;
+    /* residuals scaled so that the zero model has |f| = 1: GSL's gradient test is absolute
+    ** below |f| = 1, which would stop early on tables in MPa of tissue (tiny numbers) */
+    const double sc = 1.0 / sqrt(c->ynorm);
     for (size_t i = 0; i < c->n; i++)
-        gsl_vector_set(f, i,
-                       c->sw[i] * (reduced(&canon, A, B, c->data->x[i], NULL) - c->data->y[i]));
+        gsl_vector_set(f, i, sc * c->sw[i] *
+                                 (reduced(&canon, A, B, c->data->x[i], NULL) - c->data->y[i]));
+    c->evals++;
+    return GSL_SUCCESS;
+}
+
+/* Analytic Jacobian of lm_f in the transformed variables. */
+static int lm_df(const gsl_vector *th, void *params, gsl_matrix *J)
+{
+    fit_ctx *c = params;
+    double rho, B, A;
+    unpack3(c, th, &rho, &B, &A);
+    cf_law canon;
+    if (!isfinite(A) || canon_law(rho, &canon) != CF_OK)
+        return GSL_EDOM;
+    const double s0 = sigmoid(gsl_vector_get(th, 0)), s1 = sigmoid(gsl_vector_get(th, 1));
+    const double drho = (c->rho_hi - c->rho_lo) * s0 * (1 - s0);
+    const double dB = (c->b_hi - c->b_lo) * s1 * (1 - s1);
+    const double sc = 1.0 / sqrt(c->ynorm);
+    for (size_t i = 0; i < c->n; i++) {
+        double t = c->data->x[i] / B, gt, gr;
+        double g = canon_eval(&canon, t, &gt, &gr);
+        double w = sc * c->sw[i];
+        gsl_matrix_set(J, i, 0, w * A * gr * drho);
+        gsl_matrix_set(J, i, 1, w * (-A * gt * t / B) * dB);
+        gsl_matrix_set(J, i, 2, w * A * g);
+    }
     c->evals++;
     return GSL_SUCCESS;
 }
@@ -293,7 +346,7 @@ static double lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3
     gsl_multifit_nlinear_fdf fdf;
     memset(&fdf, 0, sizeof fdf);
     fdf.f = lm_f;
-    fdf.df = NULL;
+    fdf.df = lm_df;
     fdf.n = c->n;
     fdf.p = p;
     fdf.params = c;
@@ -406,27 +459,24 @@ static double stage_a(fit_ctx *c, double best3[3])
     return best;
 }
 
-/* Standard errors of (rho, B, A) at a solution: s^2 (J^T J)^-1 with J of the weighted residuals;
-** columns d/dA and d/dB analytic (the law's own stiffness), d/drho by central differences. */
+/* Standard errors of (rho, B, A) at a solution: s^2 (J^T J)^-1 with the analytic Jacobian of the
+** weighted residuals (canon_eval). */
 static void stage_a_errors(fit_ctx *c, const double v[3], double se[3])
 {
     se[0] = se[1] = se[2] = -1;
     const double rho = v[0], B = v[1], A = v[2];
-    double h = 1e-6 * fmin(rho, 1.0);
-    double r_lo = rho - h, r_hi = fmin(rho + h, 1.0);
-    cf_law lc, lm, lp;
-    if (canon_law(rho, &lc) != CF_OK || canon_law(r_lo, &lm) != CF_OK ||
-        canon_law(r_hi, &lp) != CF_OK || c->n <= 3)
+    cf_law lc;
+    if (canon_law(rho, &lc) != CF_OK || c->n <= 3)
         return;
     gsl_matrix *JtJ = gsl_matrix_calloc(3, 3);
     if (!JtJ)
         return;
     double rss = 0;
     for (size_t i = 0; i < c->n; i++) {
-        double x = c->data->x[i], dB;
-        double m = reduced(&lc, A, B, x, &dB);
-        double row[3] = {(reduced(&lp, A, B, x, NULL) - reduced(&lm, A, B, x, NULL)) / (r_hi - r_lo),
-                         dB, m / A};
+        double x = c->data->x[i], gt, gr;
+        double g = canon_eval(&lc, x / B, &gt, &gr);
+        double m = A * g;
+        double row[3] = {A * gr, -A * gt * x / (B * B), g};
         double r = c->sw[i] * (m - c->data->y[i]);
         rss += r * r;
         for (int a = 0; a < 3; a++)
@@ -707,6 +757,34 @@ static void analytic_member(const fit_ctx *c, const double v[3], double *p)
         p[k] = c->opt->fixed[k] ? c->opt->fixed_value[k] : q[k];
 }
 
+/* SLSQP meets the equality constraints to its tolerance only; where D2, H and G are free they
+** are set from the identifiable quantities in closed form so that the spring reproduces them to
+** rounding. Kept only when the constraints still hold. */
+static void snap_to_family(fit_ctx *c, double *p, double *z)
+{
+    double q[CF_P_COUNT];
+    memcpy(q, p, sizeof q);
+    const double *v = c->target;
+    const int *fx = c->opt->fixed;
+    if (!fx[CF_P_D2])
+        q[CF_P_D2] = q[CF_P_D1] / v[0];
+    double Lmin = lmin_of(q, c->type);
+    if (!fx[CF_P_H])
+        q[CF_P_H] = c->fd ? Lmin + v[1] : Lmin / (1 - v[1]);
+    double s = q[CF_P_H] - Lmin;
+    if (!fx[CF_P_G] && s > 0) {
+        double FC = c->fd ? v[2] : v[2] * q[CF_P_H] * q[CF_P_H];
+        double D1 = q[CF_P_D1], d = q[CF_P_D];
+        q[CF_P_G] = 8 * q[CF_P_N] * D1 * D1 * D1 * FC / (d * d * d * d * s);
+    }
+    cf_spring sp = from_array(q);
+    if (!cf_fit_check(&sp, c->type, c->data, c->opt, NULL, NULL))
+        return;
+    memcpy(p, q, sizeof q);
+    for (int k = 0; k < c->nfree; k++)
+        z[k] = log(p[c->free_idx[k]]);
+}
+
 /* ---- the driver ------------------------------------------------------------------------------ */
 
 static cf_status check_data(const cf_fit_data *d, cf_error *err)
@@ -836,6 +914,7 @@ cf_status cf_fit_run(const cf_fit_data *data, const cf_fit_options *opt, cf_spri
         z[k] = log(p[c.free_idx[k]]);
     nl_run(&c, NLOPT_LD_SLSQP, z_preference, 1, z, 2000);
     full_params(&c, z, p);
+    snap_to_family(&c, p, z);
     double best_obj = objective6(&c, p);
     double best_p[CF_P_COUNT];
     memcpy(best_p, p, sizeof p);

@@ -72,8 +72,8 @@ static void write_script(FILE *g, const cf_fit_report *r, const cf_fit_data *d, 
     static const char *bcolors[CF_BASE_COUNT] = {"#7f7f7f", "#2ca02c", "#9467bd"};
     fprintf(g, "plot $DATA using 1:2 with points pt 7 ps 0.6 lc rgb 'black' title 'measured'");
     for (int k = 0; k < r->nfits; k++)
-        fprintf(g, ", $CURVES using 1:%d with lines lw 2 lc rgb '%s' title 'conical, %s'", 2 + k,
-                colors[k], cf_spring_type_name(r->fits[k].type));
+        fprintf(g, ", $CURVES using 1:%d with lines lw %d lc rgb '%s' title 'conical, %s'", 2 + k,
+                k == 0 ? 4 : 2, colors[k], cf_spring_type_name(r->fits[k].type));
     for (int k = 0; k < CF_BASE_COUNT; k++)
         fprintf(g, ", $CURVES using 1:%d with lines lw 1 dt 2 lc rgb '%s' title '%s'",
                 2 + r->nfits + k, bcolors[k], cf_baseline_name((cf_baseline_kind)k));
