@@ -12,7 +12,7 @@ static const char force_help[] =
     "usage: conifit force SPRING --u MM [--method M]\n"
     "Prints the force F(u) of a conical spring in newtons (%.17g) on one line.\n\n"
     "  --u MM       compression in mm (positive shortens the spring, negative stretches it)\n"
-    "  --method M   exact | closed | closed+newton | table (default closed+newton)\n"
+    "  --method M   exact | closed | closed+newton | table (default closed)\n"
     "  --table N    intervals of the table for --method table (default 256)\n\n";
 
 static const char curve_help[] =
@@ -21,7 +21,7 @@ static const char curve_help[] =
     "to solid (u = +travel), N points evenly spaced in u (default 201). At +-travel the\n"
     "spring is solid: the force is +-F_C and the stiffness is reported as 0.\n\n"
     "  --points N   number of rows, 2..10000000 (default 201)\n"
-    "  --method M   exact | closed | closed+newton | table (default closed+newton)\n"
+    "  --method M   exact | closed | closed+newton | table (default closed)\n"
     "  --table N    intervals of the table for --method table (default 256)\n\n";
 
 static const char info_help[] =
@@ -46,7 +46,7 @@ static int parse(const char *cmd, const char *help, const char *allowed, int arg
 {
     cf_error err = {0};
     memset(a, 0, sizeof *a);
-    a->method = CF_LAW_CLOSED_NEWTON;
+    a->method = CF_LAW_CLOSED;
     a->table = CF_LAW_TABLE_DEFAULT;
     a->points = 201;
     for (int i = 1; i < argc; i++) {
