@@ -20,6 +20,7 @@ static const command commands[] = {
     {"force", cf_cli_force, "force F(u) of one spring at one compression"},
     {"curve", cf_cli_curve, "CSV table of force and stiffness from full stretch to solid"},
     {"info", cf_cli_info, "derived quantities of a spring (type, travel, loads, k0, ...)"},
+    {"simulate", cf_cli_simulate, "run a scene on a mass-spring lattice of conical springs"},
 };
 
 static void usage(FILE *out)

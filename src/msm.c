@@ -53,6 +53,8 @@ typedef struct solver {
     double *Tx0, *kx, *Lprev; /* quasi-static extras per spring (NULL when static) */
     double *sigm;             /* Maxwell branch stress per spring, MPa (NULL when off) */
     double *tmp;              /* per-spring scratch */
+    gsl_spmatrix *C;          /* tangent, compressed columns, pattern built once */
+    int *map, *diag;          /* spring block -> C->data index; DOF -> its diagonal index */
     double load;              /* current drive value: strain or stress, MPa */
     int extras;               /* quasi-static extras active */
     cf_msm_stats *st;
@@ -70,6 +72,10 @@ static void solver_free(solver *s)
     free(s->Lprev);
     free(s->sigm);
     free(s->tmp);
+    free(s->map);
+    free(s->diag);
+    if (s->C)
+        gsl_spmatrix_free(s->C);
 }
 
 static int is_prescribed(const solver *s, size_t node, int axis)
@@ -194,15 +200,76 @@ static void add_entry(gsl_spmatrix *K, long i, long j, double v)
         gsl_spmatrix_set(K, (size_t)i, (size_t)j, v);
 }
 
+/* Index of entry (row, col) in the compressed-column matrix C, or -1 (rows within a column are
+** not sorted by GSL's compression; a column holds at most 81 entries). */
+static int ccs_index(const gsl_spmatrix *C, long row, long col)
+{
+    if (row < 0 || col < 0)
+        return -1;
+    for (int k = C->p[col]; k < C->p[col + 1]; k++)
+        if (C->i[k] == row)
+            return k;
+    return -1;
+}
+
+/* The sparsity pattern of the tangent, built once: for every spring the positions in C->data of
+** its four 3 x 3 blocks (ii, jj, ij, ji), so that assembly is a pass of additions. */
+static cf_status build_pattern(solver *s, cf_error *err)
+{
+    cf_lattice *lat = s->lat;
+    const size_t n = s->ndof;
+    gsl_spmatrix *K = gsl_spmatrix_alloc_nzmax(n ? n : 1, n ? n : 1, 40 * n + 16,
+                                               GSL_SPMATRIX_TRIPLET);
+    if (!K)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent matrix");
+    for (size_t q = 0; q < lat->ns; q++) {
+        uint32_t i = lat->si[q], j = lat->sj[q];
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++) {
+                long ia = s->eq[3 * i + a], ib = s->eq[3 * i + b];
+                long ja = s->eq[3 * j + a], jb = s->eq[3 * j + b];
+                add_entry(K, ia, ib, 1);
+                add_entry(K, ja, jb, 1);
+                add_entry(K, ia, jb, 1);
+                add_entry(K, ja, ib, 1);
+            }
+    }
+    for (size_t e = 0; e < n; e++)
+        add_entry(K, (long)e, (long)e, 1);
+    s->C = gsl_spmatrix_ccs(K);
+    gsl_spmatrix_free(K);
+    s->map = malloc((lat->ns ? lat->ns : 1) * 36 * sizeof(int));
+    s->diag = malloc((n ? n : 1) * sizeof(int));
+    if (!s->C || !s->map || !s->diag)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent matrix");
+    for (size_t q = 0; q < lat->ns; q++) {
+        uint32_t i = lat->si[q], j = lat->sj[q];
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++) {
+                long ia = s->eq[3 * i + a], ib = s->eq[3 * i + b];
+                long ja = s->eq[3 * j + a], jb = s->eq[3 * j + b];
+                int *m = s->map + q * 36 + a * 3 + b;
+                m[0] = ccs_index(s->C, ia, ib);
+                m[9] = ccs_index(s->C, ja, jb);
+                m[18] = ccs_index(s->C, ia, jb);
+                m[27] = ccs_index(s->C, ja, ib);
+            }
+    }
+    for (size_t e = 0; e < n; e++)
+        s->diag[e] = ccs_index(s->C, (long)e, (long)e);
+    return CF_OK;
+}
+
 /* Assembles the tangent K = -dR/dx at the state of the last residual(), solves K dx = R by GMRES
 ** with symmetric Jacobi scaling. */
 static cf_status newton_direction(solver *s, cf_error *err)
 {
     cf_lattice *lat = s->lat;
     const size_t n = s->ndof;
-    gsl_spmatrix *K = gsl_spmatrix_alloc_nzmax(n, n, 40 * n + 16, GSL_SPMATRIX_TRIPLET);
-    if (!K)
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent matrix");
+    if (!s->C && build_pattern(s, err) != CF_OK)
+        return CF_E_INTERNAL;
+    gsl_spmatrix *C = s->C;
+    memset(C->data, 0, (size_t)C->p[n] * sizeof(double));
     for (size_t q = 0; q < lat->ns; q++) {
         uint32_t i = lat->si[q], j = lat->sj[q];
         double L = lat->L_mm[q];
@@ -212,28 +279,26 @@ static cf_status newton_direction(solver *s, cf_error *err)
         if (s->extras)
             kt += s->kx[q];
         double g = lat->T_N[q] / L;
+        const int *m = s->map + q * 36;
         for (int a = 0; a < 3; a++)
             for (int b = 0; b < 3; b++) {
                 double B = (kt - g) * nv[a] * nv[b] + (a == b ? g : 0.0);
-                if (B == 0)
-                    continue;
-                long ia = s->eq[3 * i + a], ib = s->eq[3 * i + b];
-                long ja = s->eq[3 * j + a], jb = s->eq[3 * j + b];
-                add_entry(K, ia, ib, B);
-                add_entry(K, ja, jb, B);
-                add_entry(K, ia, jb, -B);
-                add_entry(K, ja, ib, -B);
+                int k = a * 3 + b;
+                if (m[k] >= 0)
+                    C->data[m[k]] += B;
+                if (m[k + 9] >= 0)
+                    C->data[m[k + 9]] += B;
+                if (m[k + 18] >= 0)
+                    C->data[m[k + 18]] -= B;
+                if (m[k + 27] >= 0)
+                    C->data[m[k + 27]] -= B;
             }
     }
     /* Symmetric Jacobi scaling: K' = D^-1 K D^-1 with D = sqrt|diag|. */
     for (size_t e = 0; e < n; e++) {
-        double d = gsl_spmatrix_get(K, e, e);
+        double d = C->data[s->diag[e]];
         s->D[e] = (d != 0 && isfinite(d)) ? sqrt(fabs(d)) : 1.0;
     }
-    gsl_spmatrix *C = gsl_spmatrix_ccs(K);
-    gsl_spmatrix_free(K);
-    if (!C)
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent matrix");
     for (size_t col = 0; col < n; col++)
         for (int k = C->p[col]; k < C->p[col + 1]; k++)
             C->data[k] /= s->D[C->i[k]] * s->D[col];
@@ -270,7 +335,6 @@ done:
     gsl_splinalg_itersolve_free(w);
     gsl_vector_free(b);
     gsl_vector_free(xv);
-    gsl_spmatrix_free(C);
     return st;
 }
 
