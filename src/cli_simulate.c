@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "atomic.h"
@@ -91,6 +92,7 @@ static cf_status plot(const cf_scene *sc, const char *csv, const char *png, cf_e
     int fd = mkstemp(tmp);
     if (fd < 0)
         return cf_error_set(err, CF_E_CANTWRITE, "%s: cannot create a temporary file", png);
+    fchmod(fd, 0644); /* an ordinary file, not mkstemp's private mode */
     close(fd);
     FILE *gp = popen("gnuplot", "w");
     if (!gp) {
