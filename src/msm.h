@@ -69,7 +69,7 @@ cf_msm_config cf_msm_default(void);
 typedef struct cf_msm_stats {
     size_t solves;             /* static / quasi-static Newton solves */
     size_t newton_iters;       /* Newton iterations in all */
-    size_t linear_iters;       /* GMRES iterations in all */
+    size_t linear_iters;       /* linear solves: dense LU solves plus GMRES restart cycles */
     size_t steps;              /* time steps taken */
     double dt_used_min_s;      /* smallest step used, s (0 for static runs) */
     double dt_stable_s;        /* stable explicit step at the start, s (0 if not explicit) */
