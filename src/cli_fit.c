@@ -435,8 +435,9 @@ int cf_cli_fit(int argc, char **argv)
                 if ((int)strlen(jobs[i].file) > wname)
                     wname = (int)strlen(jobs[i].file);
             printf("Summary (RMSE in each table's unit):\n");
-            printf("  %-*s %-18s %-18s %-22s %s\n", wname, "table", "telescoping",
-                   "non-telescoping", "best baseline", "better type");
+            printf("  %-*s %-18s %-18s %-22s %-16s%s\n", wname, "table", "telescoping",
+                   "non-telescoping", "best baseline", "better type",
+                   a.validate ? " lattice RMSE (better type)" : "");
             for (int i = 0; i < a.nfiles; i++) {
                 fit_job *j = &jobs[i];
                 if (j->st != CF_OK) {
@@ -456,10 +457,18 @@ int cf_cli_fit(int argc, char **argv)
                 snprintf(bcell, sizeof bcell, "%s %.4g %s", cf_baseline_name((cf_baseline_kind)bb),
                          j->rep.baselines[bb].rmse * j->rep.y_to_file, j->rep.y_unit);
                 int b = cf_report_better(&j->rep);
-                printf("  %-*s %-18s %-18s %-22s %s\n", wname, j->file, cell[0], cell[1], bcell,
+                char vcell[48] = "";
+                if (a.validate && b >= 0 && j->rep.val[b].done)
+                    snprintf(vcell, sizeof vcell, " %.4g %s",
+                             j->rep.val[b].rmse * j->rep.y_to_file, j->rep.y_unit);
+                else if (a.validate)
+                    snprintf(vcell, sizeof vcell, " skipped");
+                printf("  %-*s %-18s %-18s %-22s %-16s%s\n", wname, j->file, cell[0], cell[1],
+                       bcell,
                        b < 0                          ? "none feasible"
                        : cf_report_types_tie(&j->rep) ? "equal"
-                                                      : cf_spring_type_name(j->rep.fits[b].type));
+                                                      : cf_spring_type_name(j->rep.fits[b].type),
+                       vcell);
             }
         }
     }
