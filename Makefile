@@ -1,7 +1,8 @@
 # conifit: plain Makefile. Targets:
 #   make            build build/conifit (optimised, with debug info)
 #   make deps       install the Debian packages conifit needs (as root; otherwise prints the command)
-#   make example    set up, then fit a shipped table and write fits/ (the README's first command)
+#   make example    set up, then fit and validate a shipped table into fits/ (the README's first command)
+#   make fits       re-fit every table in data/ into fits/ (JSON and PNG), validated in the lattice
 #   make test       build and run the cmocka suite (the README's second command)
 #   make sanitize   the same suite under AddressSanitizer + UndefinedBehaviorSanitizer
 #   make bench      the benchmark report (optimised build, separate from the tests)
@@ -39,7 +40,7 @@ LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 CLI_OBJ := $(CLI_SRC:src/%.c=$(BUILD)/obj/%.o)
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 
-.PHONY: all deps example test sanitize bench clean check-deps figures
+.PHONY: all deps example test sanitize bench clean check-deps figures fits
 
 all: check-deps $(BUILD)/conifit
 
@@ -64,7 +65,10 @@ deps:
 example: deps
 	@$(MAKE) --no-print-directory all
 	@mkdir -p fits
-	$(BUILD)/conifit fit data/telescoping_noise1pct.csv -o fits/telescoping_noise1pct.json --plot fits/telescoping_noise1pct.png
+	$(BUILD)/conifit fit data/telescoping_noise1pct.csv --validate -o fits/telescoping_noise1pct.json --plot fits/telescoping_noise1pct.png
+
+fits: check-deps $(BUILD)/conifit
+	$(BUILD)/conifit fit data/*.csv --validate -o fits/ --plot fits/ -j 4
 
 $(BUILD)/obj/%.o: src/%.c $(wildcard src/*.h) | $(BUILD)/obj
 	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@

@@ -21,6 +21,8 @@
 #include "measure.h"
 #include "plot.h"
 #include "report.h"
+#include "scene.h"
+#include "validate.h"
 
 static const char fit_help[] =
     "usage: conifit fit FILE.csv... [-o OUT.json | -o DIR/] [options]\n"
@@ -35,6 +37,12 @@ static const char fit_help[] =
     "  --optimizer NAME        slsqp (default) | cobyla | mma: the constrained local optimiser\n"
     "  --seed S                seed of the global search (default 1); same seed, same result\n"
     "  --starts N              local starts of the global search (default 8)\n"
+    "  --validate [SCENE.json] run each fitted spring in the static uniaxial lattice (the scene's\n"
+    "                          lattice, or 3x3x3 cells with face and body diagonals) at the\n"
+    "                          table's strains and report the lattice's RMSE, R^2, max |error|\n"
+    "                          in the table's stress unit (stress-strain tables only)\n"
+    "  --through-msm [SCENE.json]  fit through the lattice: refine rho, s/H and F_C/H^2 so that\n"
+    "                          the lattice's curve matches the table (implies --validate; slower)\n"
     "  --plot FILE.png|.svg    draw data, fits, baselines and residuals with gnuplot\n"
     "                          (with several tables: a folder DIR/, one NAME.png per table)\n"
     "  --x-col NAME, --y-col NAME   columns to use in wider tables\n"
@@ -57,6 +65,10 @@ typedef struct fit_args {
     cf_measure_options mopt;
     long jobs;
     int quiet;
+    int validate;                /* --validate or --through-msm */
+    int through;                 /* --through-msm */
+    const char *scene;           /* the validation scene, or NULL for the default lattice */
+    cf_validate_setup vsetup;    /* the lattice the fits are validated in */
 } fit_args;
 
 typedef struct fit_job {
@@ -92,6 +104,30 @@ static void path_in_dir(char *dst, size_t cap, const char *dir, const char *file
              ext);
 }
 
+static int ends_with_json(const char *s)
+{
+    size_t n = strlen(s);
+    return n > 5 && strcmp(s + n - 5, ".json") == 0;
+}
+
+/* `--validate`, `--validate=SCENE.json`, `--validate SCENE.json` (the value is taken only when
+** it ends in .json, so a table may follow the flag); the same for --through-msm. 1 if consumed. */
+static int validate_option(int argc, char **argv, int *i, const char *name, fit_args *a)
+{
+    size_t n = strlen(name);
+    const char *arg = argv[*i];
+    if (strncmp(arg, name, n) != 0 || (arg[n] != '\0' && arg[n] != '='))
+        return 0;
+    a->validate = 1;
+    if (strcmp(name, "--through-msm") == 0)
+        a->through = 1;
+    if (arg[n] == '=')
+        a->scene = arg + n + 1;
+    else if (*i + 1 < argc && argv[*i + 1][0] != '-' && ends_with_json(argv[*i + 1]))
+        a->scene = argv[++*i];
+    return 1;
+}
+
 static int parse_args(int argc, char **argv, fit_args *a)
 {
     static const char *cmd = "fit";
@@ -101,6 +137,7 @@ static int parse_args(int argc, char **argv, fit_args *a)
     a->fopt = cf_fit_default_options();
     a->mopt = cf_measure_default_options();
     a->jobs = 1;
+    a->vsetup = cf_validate_default();
     a->files = calloc((size_t)argc, sizeof *a->files);
     if (!a->files)
         return CF_EXIT_SOFTWARE;
@@ -117,6 +154,9 @@ static int parse_args(int argc, char **argv, fit_args *a)
             if (m < 0)
                 BAD();
             a->out = v;
+        } else if (validate_option(argc, argv, &i, "--validate", a) ||
+                   validate_option(argc, argv, &i, "--through-msm", a)) {
+            continue;
         } else if (OPT("--plot")) {
             if (m < 0)
                 BAD();
@@ -252,6 +292,22 @@ static void run_job(fit_job *j)
         r->nfits++;
     }
     cf_baseline_fit_all(&d, r->baselines);
+    if (a->validate) {
+        r->validate = 1;
+        r->through_msm = a->through;
+        for (int k = 0; k < r->nfits; k++) {
+            cf_error verr = {0};
+            /* a table the lattice cannot run (force-displacement, past solid) is noted, not fatal */
+            if (cf_validate_run(&r->fits[k].params, &a->vsetup, &d, &r->val[k], &verr) != CF_OK ||
+                !a->through)
+                continue;
+            if (isatty(2))
+                fprintf(stderr, "conifit: %s: fitting the %s spring through the lattice...\n",
+                        j->file, cf_spring_type_name(r->fits[k].type));
+            cf_validate_through_msm(&d, &a->fopt, &a->vsetup, &r->fits[k], &r->val[k],
+                                    &r->thr[k], &verr);
+        }
+    }
     const char *inputs[257];
     int ni = 0;
     for (int i = 0; i < a->nfiles && ni < 256; i++)
@@ -323,6 +379,16 @@ int cf_cli_fit(int argc, char **argv)
         if (cf_measure_load(a.files[i], &a.mopt, &jobs[i].m, &err) != CF_OK)
             rc = cf_cli_fail(&err);
     }
+    if (rc < 0 && a.scene) {
+        cf_scene sc;
+        cf_error err = {0};
+        cf_status st = cf_scene_load(a.scene, &sc, &err);
+        if (st == CF_OK)
+            st = cf_validate_from_scene(&sc, a.scene, &a.vsetup, &err);
+        cf_scene_free(&sc);
+        if (st != CF_OK)
+            rc = cf_cli_fail(&err);
+    }
     if (rc < 0) {
         pool p = {jobs, a.nfiles, 0, PTHREAD_MUTEX_INITIALIZER};
         int nt = (int)(a.jobs < a.nfiles ? a.jobs : a.nfiles);
@@ -369,8 +435,9 @@ int cf_cli_fit(int argc, char **argv)
                 if ((int)strlen(jobs[i].file) > wname)
                     wname = (int)strlen(jobs[i].file);
             printf("Summary (RMSE in each table's unit):\n");
-            printf("  %-*s %-18s %-18s %-22s %s\n", wname, "table", "telescoping",
-                   "non-telescoping", "best baseline", "better type");
+            printf("  %-*s %-18s %-18s %-22s %-16s%s\n", wname, "table", "telescoping",
+                   "non-telescoping", "best baseline", "better type",
+                   a.validate ? " lattice RMSE (better type)" : "");
             for (int i = 0; i < a.nfiles; i++) {
                 fit_job *j = &jobs[i];
                 if (j->st != CF_OK) {
@@ -390,16 +457,26 @@ int cf_cli_fit(int argc, char **argv)
                 snprintf(bcell, sizeof bcell, "%s %.4g %s", cf_baseline_name((cf_baseline_kind)bb),
                          j->rep.baselines[bb].rmse * j->rep.y_to_file, j->rep.y_unit);
                 int b = cf_report_better(&j->rep);
-                printf("  %-*s %-18s %-18s %-22s %s\n", wname, j->file, cell[0], cell[1], bcell,
+                char vcell[48] = "";
+                if (a.validate && b >= 0 && j->rep.val[b].done)
+                    snprintf(vcell, sizeof vcell, " %.4g %s",
+                             j->rep.val[b].rmse * j->rep.y_to_file, j->rep.y_unit);
+                else if (a.validate)
+                    snprintf(vcell, sizeof vcell, " skipped");
+                printf("  %-*s %-18s %-18s %-22s %-16s%s\n", wname, j->file, cell[0], cell[1],
+                       bcell,
                        b < 0                          ? "none feasible"
                        : cf_report_types_tie(&j->rep) ? "equal"
-                                                      : cf_spring_type_name(j->rep.fits[b].type));
+                                                      : cf_spring_type_name(j->rep.fits[b].type),
+                       vcell);
             }
         }
     }
     for (int i = 0; i < a.nfiles; i++) {
         cf_measure_free(&jobs[i].m);
         free(jobs[i].text);
+        for (int k = 0; k < 2; k++)
+            cf_validation_free(&jobs[i].rep.val[k]);
     }
     free(jobs);
     free(a.files);

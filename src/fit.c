@@ -875,69 +875,117 @@ static void summarise(fit_ctx *c, const double *p, cf_fit_result *res)
                                  &res->violated);
 }
 
+/* Checks data and options and prepares the context shared by every stage (c->sw is malloc'd). */
+static cf_status ctx_setup(fit_ctx *c, const cf_fit_data *data, const cf_fit_options *opt,
+                           cf_spring_type type, cf_error *err)
+{
+    memset(c, 0, sizeof *c);
+    cf_status st = check_data(data, err);
+    if (st != CF_OK || (st = check_options(opt, err)) != CF_OK)
+        return st;
+    c->data = data;
+    c->opt = opt;
+    c->type = type;
+    c->fd = data->force_displacement;
+    c->n = data->count;
+    c->sw = malloc(sizeof(double) * c->n);
+    if (!c->sw)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", c->n);
+    double ymax = 0;
+    for (size_t i = 0; i < c->n; i++)
+        ymax = fmax(ymax, fabs(data->y[i]));
+    for (size_t i = 0; i < c->n; i++) {
+        double sc = opt->relative ? fmax(fabs(data->y[i]), REL_FLOOR * ymax) : 1.0;
+        c->sw[i] = sqrt(data->w ? data->w[i] : 1.0) / sc;
+        c->ynorm += (c->sw[i] * data->y[i]) * (c->sw[i] * data->y[i]);
+    }
+    c->xmax = data_xmax(data);
+    /* Stage A bounds. Telescoping needs n <= c (1 - rho)/(2 rho) with n >= 2 and c <= index_max,
+    ** so rho <= index_max/(index_max + 4). */
+    c->rho_lo = RHO_LO;
+    c->rho_hi = type == CF_TELESCOPING ? opt->index_max / (opt->index_max + 4) * (1 - 1e-6) : 1.0;
+    double need = c->xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
+    if (c->fd) {
+        c->travel_ok = 1;
+        c->b_lo = need;
+        c->b_hi = 1e3 * need;
+    } else {
+        c->travel_ok = need < 1 - 1e-9;
+        c->b_lo = c->travel_ok ? need : 1e-6;
+        c->b_hi = 1 - 1e-9;
+    }
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        if (opt->fixed[k])
+            c->base[k] = opt->fixed_value[k];
+        else
+            c->free_idx[c->nfree++] = k;
+    }
+    c->pref[0] = log(sqrt(3.0 * opt->index_max));
+    c->pref[1] = log(4.0);
+    c->pref[2] = log(opt->fixed[CF_P_H] ? opt->fixed_value[CF_P_H] : opt->H_preferred_mm);
+    return CF_OK;
+}
+
+/* Stage B: places a spring of the family with identifiable quantities v (p, z out). */
+static void place(fit_ctx *c, const double v[3], double *p, double *z)
+{
+    memcpy(c->target, v, sizeof c->target);
+    analytic_member(c, v, p);
+    for (int k = 0; k < c->nfree; k++)
+        z[k] = log(p[c->free_idx[k]]);
+    nl_run(c, NLOPT_LD_SLSQP, z_preference, 1, z, 2000);
+    full_params(c, z, p);
+    snap_to_family(c, p, z);
+}
+
+cf_status cf_fit_place(const cf_fit_data *data, const cf_fit_options *opt, cf_spring_type type,
+                       const double ident[3], cf_fit_result *res, cf_error *err)
+{
+    const double t0 = now_s();
+    fit_ctx c;
+    cf_status st = ctx_setup(&c, data, opt, type, err);
+    if (st != CF_OK) {
+        free(c.sw);
+        return st;
+    }
+    for (int k = 0; k < 3; k++)
+        if (!(ident[k] > 0) || !isfinite(ident[k])) {
+            free(c.sw);
+            return cf_error_set(err, CF_E_DATA, "identifiable quantity %d = %g must be positive",
+                                k, ident[k]);
+        }
+    double p[CF_P_COUNT], z[CF_P_COUNT];
+    place(&c, ident, p, z);
+    memset(res, 0, sizeof *res);
+    res->type = type;
+    summarise(&c, p, res);
+    for (int k = 0; k < 3; k++)
+        res->ident_se[k] = -1;
+    res->optimizer = "placement";
+    res->evaluations = c.evals;
+    free(c.sw);
+    res->wall_time_s = now_s() - t0;
+    return CF_OK;
+}
+
 cf_status cf_fit_run(const cf_fit_data *data, const cf_fit_options *opt, cf_spring_type type,
                      cf_fit_result *res, cf_error *err)
 {
     const double t0 = now_s();
     memset(res, 0, sizeof *res);
-    cf_status st = check_data(data, err);
-    if (st != CF_OK || (st = check_options(opt, err)) != CF_OK)
-        return st;
     fit_ctx c;
-    memset(&c, 0, sizeof c);
-    c.data = data;
-    c.opt = opt;
-    c.type = type;
-    c.fd = data->force_displacement;
-    c.n = data->count;
-    c.sw = malloc(sizeof(double) * c.n);
-    if (!c.sw)
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", c.n);
-    double ymax = 0;
-    for (size_t i = 0; i < c.n; i++)
-        ymax = fmax(ymax, fabs(data->y[i]));
-    for (size_t i = 0; i < c.n; i++) {
-        double sc = opt->relative ? fmax(fabs(data->y[i]), REL_FLOOR * ymax) : 1.0;
-        c.sw[i] = sqrt(data->w ? data->w[i] : 1.0) / sc;
-        c.ynorm += (c.sw[i] * data->y[i]) * (c.sw[i] * data->y[i]);
-    }
-    c.xmax = data_xmax(data);
-    /* Stage A bounds. Telescoping needs n <= c (1 - rho)/(2 rho) with n >= 2 and c <= index_max,
-    ** so rho <= index_max/(index_max + 4). */
-    c.rho_lo = RHO_LO;
-    c.rho_hi = type == CF_TELESCOPING ? opt->index_max / (opt->index_max + 4) * (1 - 1e-6) : 1.0;
-    double need = c.xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
-    if (c.fd) {
-        c.travel_ok = 1;
-        c.b_lo = need;
-        c.b_hi = 1e3 * need;
-    } else {
-        c.travel_ok = need < 1 - 1e-9;
-        c.b_lo = c.travel_ok ? need : 1e-6;
-        c.b_hi = 1 - 1e-9;
+    cf_status st = ctx_setup(&c, data, opt, type, err);
+    if (st != CF_OK) {
+        free(c.sw);
+        return st;
     }
     /* Stage A: the identifiable quantities and their errors. */
     double v[3] = {0.5, 0.5 * (c.b_lo + c.b_hi), 1.0}, se[3];
     stage_a(&c, v);
     stage_a_errors(&c, v, se);
     /* Stage B: place a spring of the family. */
-    for (int k = 0; k < CF_P_COUNT; k++) {
-        if (opt->fixed[k])
-            c.base[k] = opt->fixed_value[k];
-        else
-            c.free_idx[c.nfree++] = k;
-    }
-    c.pref[0] = log(sqrt(3.0 * opt->index_max));
-    c.pref[1] = log(4.0);
-    c.pref[2] = log(opt->fixed[CF_P_H] ? opt->fixed_value[CF_P_H] : opt->H_preferred_mm);
-    memcpy(c.target, v, sizeof v);
     double p[CF_P_COUNT], z[CF_P_COUNT];
-    analytic_member(&c, v, p);
-    for (int k = 0; k < c.nfree; k++)
-        z[k] = log(p[c.free_idx[k]]);
-    nl_run(&c, NLOPT_LD_SLSQP, z_preference, 1, z, 2000);
-    full_params(&c, z, p);
-    snap_to_family(&c, p, z);
+    place(&c, v, p, z);
     double best_obj = objective6(&c, p);
     double best_p[CF_P_COUNT];
     memcpy(best_p, p, sizeof p);

@@ -113,6 +113,13 @@ typedef struct cf_fit_result {
 cf_status cf_fit_run(const cf_fit_data *data, const cf_fit_options *opt, cf_spring_type type,
                      cf_fit_result *res, cf_error *err);
 
+/* Stage B alone: places one spring of the given type whose identifiable quantities are ident
+** (rho, solid strain or travel, stress or load scale; units as in cf_fit_result.ident), exactly as
+** cf_fit_run places its spring before the polish, and fills res (quality against data, feasibility;
+** ident_se = -1, optimizer "placement"). Used by the fit through the lattice (validate.h). */
+cf_status cf_fit_place(const cf_fit_data *data, const cf_fit_options *opt, cf_spring_type type,
+                       const double ident[3], cf_fit_result *res, cf_error *err);
+
 /* Evaluates the model (stress in MPa, or force in N) of spring p at x. */
 double cf_fit_model(const cf_law *law, int force_displacement, double x);
 

@@ -25,6 +25,25 @@ static int ends_with(const char *s, const char *suffix)
     return a >= b && strcasecmp(s + a - b, suffix) == 0;
 }
 
+/* x and the lattice stress (file's unit) of every data point, sorted by x. */
+static void lattice_block(FILE *g, const cf_fit_data *d, const double *stress_MPa, double u)
+{
+    size_t *ord = malloc(sizeof(size_t) * (d->count ? d->count : 1));
+    if (!ord)
+        return;
+    for (size_t i = 0; i < d->count; i++)
+        ord[i] = i;
+    for (size_t i = 1; i < d->count; i++) /* insertion sort: tables are short and nearly sorted */
+        for (size_t j = i; j > 0 && d->x[ord[j - 1]] > d->x[ord[j]]; j--) {
+            size_t t = ord[j];
+            ord[j] = ord[j - 1];
+            ord[j - 1] = t;
+        }
+    for (size_t i = 0; i < d->count; i++)
+        fprintf(g, "%.17g %.17g\n", d->x[ord[i]], stress_MPa[ord[i]] * u);
+    free(ord);
+}
+
 static void write_script(FILE *g, const cf_fit_report *r, const cf_fit_data *d, const char *out,
                          int svg)
 {
@@ -59,6 +78,16 @@ static void write_script(FILE *g, const cf_fit_report *r, const cf_fit_data *d, 
         fputc('\n', g);
     }
     fprintf(g, "EOD\n");
+    /* the lattice curve of each validated fit, at the table's strains in increasing order */
+    int nlat = 0;
+    if (r->validate)
+        for (int k = 0; k < r->nfits; k++)
+            if (r->val[k].done && r->val[k].count == d->count) {
+                fprintf(g, "$LATTICE%d << EOD\n", k);
+                lattice_block(g, d, r->val[k].stress_MPa, u);
+                fprintf(g, "EOD\n");
+                nlat++;
+            }
     if (svg)
         fprintf(g, "set terminal svg size 900,800 dynamic enhanced font 'sans,12'\n");
     else
@@ -77,6 +106,12 @@ static void write_script(FILE *g, const cf_fit_report *r, const cf_fit_data *d, 
     for (int k = 0; k < CF_BASE_COUNT; k++)
         fprintf(g, ", $CURVES using 1:%d with lines lw 1 dt 2 lc rgb '%s' title '%s'",
                 2 + r->nfits + k, bcolors[k], cf_baseline_name((cf_baseline_kind)k));
+    for (int k = 0; nlat > 0 && k < r->nfits; k++)
+        if (r->val[k].done && r->val[k].count == d->count)
+            fprintf(g, ", $LATTICE%d using 1:2 with linespoints lw 2 dt 4 pt 6 ps 0.5 lc rgb '%s' "
+                       "title 'lattice %dx%dx%d, %s'",
+                    k, colors[k], r->val[k].setup.cfg.lattice.nx, r->val[k].setup.cfg.lattice.ny,
+                    r->val[k].setup.cfg.lattice.nz, cf_spring_type_name(r->fits[k].type));
     fprintf(g, "\nset size 1,0.34\nset origin 0,0\nunset title\nset key off\n");
     fprintf(g, "set ylabel 'residual [%s]' noenhanced\n", r->y_unit);
     fprintf(g, "plot 0 with lines lc rgb 'black' notitle");

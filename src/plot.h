@@ -1,8 +1,9 @@
 /*
-** Plotting a fit through gnuplot: the measured points, both conical fits and the baselines on
-** top, the residuals of each model underneath (multiplot). gnuplot runs as a child process that
-** reads its script on stdin; it writes a temporary file beside the target, which is renamed into
-** place only when gnuplot succeeded, so a failed plot leaves no file. The program is `gnuplot`
+** Plotting a fit through gnuplot: the measured points, both conical fits, the baselines and (with
+** --validate) the lattice curve of each fit on top, the residuals of each model underneath
+** (multiplot). gnuplot runs as a child process that reads its script on stdin; it writes a
+** temporary file beside the target, which is renamed into place only when gnuplot succeeded, so a
+** failed plot leaves no file. The program is `gnuplot`
 ** on PATH, or the one named by the environment variable CONIFIT_GNUPLOT.
 */
 #ifndef CF_PLOT_H

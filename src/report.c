@@ -64,7 +64,7 @@ static json_t *value_se(double v, double se)
     return json_pack("{s:o, s:o}", "value", num(v), "stderr", se >= 0 ? num(se) : json_null());
 }
 
-static json_t *fit_json(const cf_fit_report *r, int i)
+static json_t *fit_json_core(const cf_fit_report *r, int i)
 {
     const cf_fit_result *f = &r->fits[i];
     const cf_law *L = &f->law;
@@ -96,6 +96,55 @@ static json_t *fit_json(const cf_fit_report *r, int i)
                      constraint_list(f->violated), "optimizer", f->optimizer, "evaluations",
                      (json_int_t)f->evaluations, "wall_time_s",
                      num(r->with_timing ? f->wall_time_s : 0.0));
+}
+
+static const char *diag_name(unsigned dg)
+{
+    switch (dg & (CF_DIAG_FACE | CF_DIAG_BODY)) {
+    case CF_DIAG_FACE: return "face";
+    case CF_DIAG_BODY: return "body";
+    case CF_DIAG_FACE | CF_DIAG_BODY: return "face+body";
+    default: return "none";
+    }
+}
+
+/* validation {rmse, r2, max_abs_error (file's unit), lattice {...}, wall_time_s} or {skipped} */
+static json_t *validation_json(const cf_fit_report *r, int i)
+{
+    const cf_validation *v = &r->val[i];
+    if (!v->done)
+        return json_pack("{s:s}", "skipped", v->note);
+    const cf_lattice_config *lc = &v->setup.cfg.lattice;
+    double u = r->y_to_file;
+    json_t *lat = json_pack("{s:i, s:i, s:i, s:s, s:o, s:s}", "nx", lc->nx, "ny", lc->ny, "nz",
+                            lc->nz, "diagonals", diag_name(lc->diagonals), "diagonal_weight",
+                            num(lc->diagonal_weight), "bottom",
+                            lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial");
+    return json_pack("{s:o, s:o, s:o, s:o, s:s, s:I, s:o}", "rmse", num(v->rmse * u), "r2",
+                     num(v->r2), "max_abs_error", num(v->max_abs_error * u), "lattice", lat,
+                     "law_method", cf_law_method_name(v->setup.method), "solves",
+                     (json_int_t)v->solves, "wall_time_s",
+                     num(r->with_timing ? v->wall_time_s : 0.0));
+}
+
+static json_t *through_json(const cf_fit_report *r, int i)
+{
+    const cf_through_msm *t = &r->thr[i];
+    double u = r->y_to_file;
+    return json_pack("{s:o, s:o, s:b, s:o, s:I}", "rmse_before", num(t->rmse_before * u),
+                     "rmse_after", num(t->rmse_after * u), "improved", t->improved,
+                     "wall_time_s", num(r->with_timing ? t->wall_time_s : 0.0), "evaluations",
+                     (json_int_t)t->evaluations);
+}
+
+static json_t *fit_json(const cf_fit_report *r, int i)
+{
+    json_t *o = fit_json_core(r, i);
+    if (o && r->validate)
+        json_object_set_new(o, "validation", validation_json(r, i));
+    if (o && r->through_msm && r->thr[i].done)
+        json_object_set_new(o, "through_msm", through_json(r, i));
+    return o;
 }
 
 static json_t *baseline_json(const cf_fit_report *r, int k)
@@ -233,6 +282,79 @@ static void ident_row(FILE *o, const cf_fit_report *r, const char *label, int k,
     fputc('\n', o);
 }
 
+/* One cell per fit from a printf format and a value (MPa values are converted by the caller). */
+static void cells(FILE *o, const cf_fit_report *r, const char *label, const char *const *text)
+{
+    fprintf(o, "  %-26s", label);
+    for (int i = 0; i < r->nfits; i++)
+        fprintf(o, " %-24s", text[i]);
+    fputc('\n', o);
+}
+
+/* The lattice validation (and the fit through the lattice) beside the single-spring quality. */
+static void validation_text(FILE *o, const cf_fit_report *r)
+{
+    int any = 0;
+    for (int i = 0; i < r->nfits; i++)
+        any |= r->val[i].done;
+    if (!any) {
+        fprintf(o, " validation in the lattice: skipped: %s\n", r->val[0].note);
+        return;
+    }
+    const cf_validate_setup *su = &r->val[0].setup;
+    for (int i = 0; i < r->nfits; i++)
+        if (r->val[i].done)
+            su = &r->val[i].setup;
+    const cf_lattice_config *lc = &su->cfg.lattice;
+    fprintf(o, " validation in the lattice (%d x %d x %d cells, diagonals %s, bottom %s, %s):\n",
+            lc->nx, lc->ny, lc->nz, diag_name(lc->diagonals),
+            lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial", cf_law_method_name(su->method));
+    char buf[4][2][64];
+    const char *t[2];
+    const double u = r->y_to_file;
+    for (int i = 0; i < r->nfits; i++) {
+        const cf_validation *v = &r->val[i];
+        if (!v->done) {
+            for (int k = 0; k < 4; k++)
+                snprintf(buf[k][i], sizeof buf[k][i], k ? "" : "skipped (see below)");
+            continue;
+        }
+        snprintf(buf[0][i], sizeof buf[0][i], "%.4g %s", v->rmse * u, r->y_unit);
+        snprintf(buf[1][i], sizeof buf[1][i], "%.4g %s", v->max_abs_error * u, r->y_unit);
+        snprintf(buf[2][i], sizeof buf[2][i], "%.6f", v->r2);
+        snprintf(buf[3][i], sizeof buf[3][i], "%.1f ms, %zu solves", 1e3 * v->wall_time_s,
+                 v->solves);
+    }
+    static const char *const labels[4] = {"lattice RMSE", "lattice max |error|", "lattice R^2",
+                                          "lattice time"};
+    for (int k = 0; k < 4; k++) {
+        for (int i = 0; i < r->nfits; i++)
+            t[i] = buf[k][i];
+        cells(o, r, labels[k], t);
+    }
+    if (r->through_msm) {
+        for (int i = 0; i < r->nfits; i++) {
+            const cf_through_msm *th = &r->thr[i];
+            if (th->done)
+                snprintf(buf[0][i], sizeof buf[0][i], "%.4g -> %.4g %s", th->rmse_before * u,
+                         th->rmse_after * u, r->y_unit);
+            else
+                snprintf(buf[0][i], sizeof buf[0][i], "not run");
+            snprintf(buf[1][i], sizeof buf[1][i], "%.2f s, %ld curves", th->wall_time_s,
+                     th->evaluations);
+            t[i] = buf[0][i];
+        }
+        cells(o, r, "through lattice: RMSE", t);
+        for (int i = 0; i < r->nfits; i++)
+            t[i] = buf[1][i];
+        cells(o, r, "through lattice: cost", t);
+    }
+    for (int i = 0; i < r->nfits; i++)
+        if (!r->val[i].done)
+            fprintf(o, "  (%s: validation skipped: %s)\n", cf_spring_type_name(r->fits[i].type),
+                    r->val[i].note);
+}
+
 char *cf_report_text(const cf_fit_report *r)
 {
     char *buf = NULL;
@@ -273,6 +395,8 @@ char *cf_report_text(const cf_fit_report *r)
     row(o, r, "max |error|", "%.4g %s", 11);
     row(o, r, "R^2", "%.6f", 12);
     row(o, r, "AIC (k = 3)", "%.2f", 13);
+    if (r->validate)
+        validation_text(o, r);
     fprintf(o, "  %-26s", "feasible");
     for (int i = 0; i < r->nfits; i++) {
         char cell[160] = "yes";

@@ -11,6 +11,7 @@
 #include "baseline.h"
 #include "error.h"
 #include "fit.h"
+#include "validate.h"
 
 /* One table and its fits, as the report sees it. Values of the fits are in conifit's units
 ** (MPa or N); y_to_file converts them to the file's own unit for display and JSON. */
@@ -27,6 +28,10 @@ typedef struct cf_fit_report {
     cf_fit_result fits[2];
     cf_baseline baselines[CF_BASE_COUNT];
     int with_timing;            /* 0: write wall_time_s as 0 (for reproducible files) */
+    int validate;               /* 1: each fit was run in the lattice (val[i]) */
+    cf_validation val[2];       /* lattice validation of fits[i] (MPa; not owned by the report) */
+    int through_msm;            /* 1: each fit was refined through the lattice (thr[i]) */
+    cf_through_msm thr[2];      /* what that cost and gained (MPa) */
 } cf_fit_report;
 
 /* Index of the better fit in r->fits: the feasible one with the lower RMSE (-1 if none). */
