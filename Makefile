@@ -5,6 +5,7 @@
 #   make test       build and run the cmocka suite (the README's second command)
 #   make sanitize   the same suite under AddressSanitizer + UndefinedBehaviorSanitizer
 #   make bench      the benchmark report (optimised build, separate from the tests)
+#   make figures    regenerate fits/figures/*.png (validation, hysteresis, creep) from data/scenes
 #   make clean
 # WERROR=1 turns warnings into errors (CI sets it).
 
@@ -38,7 +39,7 @@ LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 CLI_OBJ := $(CLI_SRC:src/%.c=$(BUILD)/obj/%.o)
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 
-.PHONY: all deps example test sanitize bench clean check-deps
+.PHONY: all deps example test sanitize bench clean check-deps figures
 
 all: check-deps $(BUILD)/conifit
 
@@ -83,6 +84,12 @@ test: check-deps $(BUILD)/conifit $(TESTS)
 	@fail=0; for t in $(TESTS); do \
 	  CONIFIT=$(BUILD)/conifit $$t || fail=1; done; \
 	if [ $$fail = 0 ]; then echo "conifit: all test programs passed"; else echo "conifit: TEST FAILURES" >&2; exit 1; fi
+
+figures: check-deps $(BUILD)/conifit
+	@mkdir -p fits/figures
+	$(BUILD)/conifit simulate data/scenes/uniaxial.json -o $(BUILD)/uniaxial.csv --plot fits/figures/validation.png
+	$(BUILD)/conifit simulate data/scenes/hysteresis.json -o $(BUILD)/hysteresis.csv --plot fits/figures/hysteresis.png
+	$(BUILD)/conifit simulate data/scenes/creep.json -o $(BUILD)/creep.csv --plot fits/figures/creep.png
 
 sanitize:
 	@$(MAKE) --no-print-directory test SANITIZE=1

@@ -364,13 +364,17 @@ int cf_cli_fit(int argc, char **argv)
                                 : "loosen --fix or --index-max");
         }
         if (a.nfiles > 1 && !a.quiet) {
+            int wname = 5;
+            for (int i = 0; i < a.nfiles; i++)
+                if ((int)strlen(jobs[i].file) > wname)
+                    wname = (int)strlen(jobs[i].file);
             printf("Summary (RMSE in each table's unit):\n");
-            printf("  %-50s %-16s %-16s %-16s %s\n", "table", "telescoping", "non-telescoping",
-                   "best baseline", "better type");
+            printf("  %-*s %-18s %-18s %-22s %s\n", wname, "table", "telescoping",
+                   "non-telescoping", "best baseline", "better type");
             for (int i = 0; i < a.nfiles; i++) {
                 fit_job *j = &jobs[i];
                 if (j->st != CF_OK) {
-                    printf("  %-50s failed\n", j->file);
+                    printf("  %-*s failed\n", wname, j->file);
                     continue;
                 }
                 char cell[2][32] = {"-", "-"};
@@ -383,10 +387,10 @@ int cf_cli_fit(int argc, char **argv)
                     if (j->rep.baselines[k].rmse < j->rep.baselines[bb].rmse)
                         bb = k;
                 char bcell[48];
-                snprintf(bcell, sizeof bcell, "%s %.4g", cf_baseline_name((cf_baseline_kind)bb),
-                         j->rep.baselines[bb].rmse * j->rep.y_to_file);
+                snprintf(bcell, sizeof bcell, "%s %.4g %s", cf_baseline_name((cf_baseline_kind)bb),
+                         j->rep.baselines[bb].rmse * j->rep.y_to_file, j->rep.y_unit);
                 int b = cf_report_better(&j->rep);
-                printf("  %-50s %-16s %-16s %-16s %s\n", j->file, cell[0], cell[1], bcell,
+                printf("  %-*s %-18s %-18s %-22s %s\n", wname, j->file, cell[0], cell[1], bcell,
                        b < 0                          ? "none feasible"
                        : cf_report_types_tie(&j->rep) ? "equal"
                                                       : cf_spring_type_name(j->rep.fits[b].type));

@@ -23,6 +23,7 @@ static const command commands[] = {
     {"fit", cf_cli_fit, "fit conical springs (both types) and baselines to measured tables"},
     {"export", cf_cli_export, "write a fitted spring for CalculiX, Abaqus, FEBio, LS-DYNA, SOFA"},
     {"synth", cf_cli_synth, "write the stress-strain table of a spring (example data)"},
+    {"simulate", cf_cli_simulate, "run a scene on a mass-spring lattice of conical springs"},
 };
 
 static void usage(FILE *out)

@@ -1,0 +1,320 @@
+/*
+** Tests of the mass-spring lattice and its solvers (src/lattice.c, src/msm.c): the axial lattice
+** against the single spring, equal and opposite spring forces, static against damped dynamics,
+** energy of the undamped symplectic integrator, creep, hysteresis against loading rate, and the
+** refusal of an unstable time step.
+*/
+#include "testutil.h"
+
+#include "lattice.h"
+#include "msm.h"
+
+/* A soft, strongly stiffening non-telescoping spring (solid strain 0.5, H = 10 mm). */
+static cf_law make_law(void)
+{
+    cf_spring p = {6, 15, 2.5, 2, 26, 10};
+    cf_law law;
+    cf_error err = {0};
+    if (cf_law_init(&law, &p, &err) != CF_OK)
+        fail_msg("spring refused: %s", err.msg);
+    return law;
+}
+
+static cf_msm_config small_config(int nx, int ny, int nz, unsigned diag)
+{
+    cf_msm_config c = cf_msm_default();
+    c.lattice.nx = nx;
+    c.lattice.ny = ny;
+    c.lattice.nz = nz;
+    c.lattice.diagonals = diag;
+    return c;
+}
+
+static void axial_only_lattice_reproduces_single_spring_curve(void **state)
+{
+    (void)state;
+    cf_law law = make_law();
+    cf_msm_config cfg = small_config(2, 3, 4, CF_DIAG_NONE);
+    /* Table convention: negative strain = compression; up to 96 % of the solid strain. */
+    double e[] = {-0.01, -0.1, -0.2, -0.3, -0.4, -0.45, -0.48, 0.05, 0.2, 0.4};
+    size_t n = sizeof e / sizeof e[0];
+    double s[10];
+    cf_error err = {0};
+    cf_msm_stats st;
+    cf_status rc = cf_msm_uniaxial(&law, CF_LAW_CLOSED_NEWTON, &cfg, e, n, s, &st, &err);
+    if (rc != CF_OK)
+        fail_msg("uniaxial: %s", err.msg);
+    for (size_t i = 0; i < n; i++) {
+        double H = law.p.H_mm;
+        double ref = -cf_law_force(&law, CF_LAW_EXACT, -e[i] * H, NULL, NULL) / (H * H);
+        assert_close(s[i], ref, 1e-9 * fabs(ref));
+    }
+}
+
+static void lattice_with_diagonals_is_stiffer_than_one_spring(void **state)
+{
+    (void)state;
+    cf_law law = make_law();
+    cf_msm_config cfg = small_config(3, 3, 3, CF_DIAG_FACE | CF_DIAG_BODY);
+    double e[] = {-0.1, -0.3};
+    double s[2];
+    cf_error err = {0};
+    assert_int_equal(cf_msm_uniaxial(&law, CF_LAW_CLOSED, &cfg, e, 2, s, NULL, &err), CF_OK);
+    for (int i = 0; i < 2; i++) {
+        double ref = -cf_law_force(&law, CF_LAW_EXACT, -e[i] * 10, NULL, NULL) / 100;
+        assert_true(s[i] < ref * 1.2); /* more negative: stiffer in compression */
+    }
+}
+
+static void every_spring_applies_equal_and_opposite_forces(void **state)
+{
+    (void)state;
+    cf_law law = make_law();
+    cf_lattice_config c = cf_lattice_default();
+    c.nx = 2;
+    c.ny = 3;
+    c.nz = 2;
+    cf_lattice lat;
+    cf_error err = {0};
+    assert_int_equal(cf_lattice_create(&lat, &law, CF_LAW_CLOSED_NEWTON, &c, &err), CF_OK);
+    srand(7);
+    for (size_t p = 0; p < lat.nn; p++) {
+        lat.x[p] += 1.5 * (rand() / (double)RAND_MAX - 0.5);
+        lat.y[p] += 1.5 * (rand() / (double)RAND_MAX - 0.5);
+        lat.z[p] += 1.5 * (rand() / (double)RAND_MAX - 0.5);
+    }
+    cf_lattice_forces(&lat);
+    /* Independent sum: each spring's tension along its axis, +T n on si, -T n on sj. */
+    double *gx = calloc(lat.nn, sizeof(double)), *gy = calloc(lat.nn, sizeof(double)),
+           *gz = calloc(lat.nn, sizeof(double));
+    double scale = 0;
+    for (size_t s = 0; s < lat.ns; s++) {
+        uint32_t i = lat.si[s], j = lat.sj[s];
+        double dx = lat.x[j] - lat.x[i], dy = lat.y[j] - lat.y[i], dz = lat.z[j] - lat.z[i];
+        double L = sqrt(dx * dx + dy * dy + dz * dz);
+        double F = cf_law_force(&law, CF_LAW_CLOSED_NEWTON, (lat.L0_mm[s] - L) * lat.a[s], NULL,
+                                NULL);
+        double T = -lat.w[s] * F;
+        scale = fmax(scale, fabs(T));
+        gx[i] += T * dx / L, gy[i] += T * dy / L, gz[i] += T * dz / L;
+        gx[j] -= T * dx / L, gy[j] -= T * dy / L, gz[j] -= T * dz / L;
+    }
+    assert_true(scale > 0);
+    double sum[3] = {0}, torque[3] = {0};
+    for (size_t p = 0; p < lat.nn; p++) {
+        assert_close(lat.fx[p], gx[p], 1e-12 * scale);
+        assert_close(lat.fy[p], gy[p], 1e-12 * scale);
+        assert_close(lat.fz[p], gz[p], 1e-12 * scale);
+        sum[0] += lat.fx[p], sum[1] += lat.fy[p], sum[2] += lat.fz[p];
+        torque[0] += lat.y[p] * lat.fz[p] - lat.z[p] * lat.fy[p];
+        torque[1] += lat.z[p] * lat.fx[p] - lat.x[p] * lat.fz[p];
+        torque[2] += lat.x[p] * lat.fy[p] - lat.y[p] * lat.fx[p];
+    }
+    for (int a = 0; a < 3; a++) {
+        assert_close(sum[a], 0, 1e-12 * scale * lat.ns);
+        assert_close(torque[a], 0, 1e-10 * scale * lat.ns);
+    }
+    free(gx);
+    free(gy);
+    free(gz);
+    cf_lattice_free(&lat);
+}
+
+/* Runs a held path (0 -> v over ramp_s, held to t_end) and returns the final sample. */
+static cf_msm_sample run_hold(const cf_law *law, const cf_msm_config *cfg,
+                              const cf_msm_effects *fx, cf_msm_drive drive, double v,
+                              double ramp_s, double t_end, size_t nsamples, cf_msm_sample *all,
+                              cf_msm_stats *st, cf_status want)
+{
+    cf_lattice lat;
+    cf_error err = {0};
+    assert_int_equal(cf_lattice_create(&lat, law, CF_LAW_CLOSED_NEWTON, &cfg->lattice, &err),
+                     CF_OK);
+    double t[3] = {0, ramp_s, t_end}, val[3] = {ramp_s > 0 ? 0 : v, v, v};
+    cf_msm_path path = {drive, 3, t, val};
+    double *ts = malloc(nsamples * sizeof(double));
+    cf_msm_sample *out = all ? all : calloc(nsamples, sizeof *out);
+    for (size_t k = 0; k < nsamples; k++)
+        ts[k] = t_end * (double)k / (double)(nsamples - 1);
+    cf_status rc = cf_msm_run(&lat, fx, cfg, &path, ts, nsamples, out, NULL, st, &err);
+    if (rc != want)
+        fail_msg("cf_msm_run returned %d (%s), expected %d", rc, err.msg, want);
+    cf_msm_sample last = out[nsamples - 1];
+    if (!all)
+        free(out);
+    free(ts);
+    cf_lattice_free(&lat);
+    return last;
+}
+
+static void static_solve_and_long_damped_dynamic_run_agree(void **state)
+{
+    (void)state;
+    cf_law law = make_law();
+    cf_msm_config cfg = small_config(2, 2, 2, CF_DIAG_FACE | CF_DIAG_BODY);
+    cfg.lattice.density_t_per_mm3 = 1e-6;
+    const double stress = 1.0e-3; /* 1 kPa */
+    cf_msm_stats st;
+    cf_msm_sample s0 = run_hold(&law, &cfg, NULL, CF_DRIVE_FORCE, stress, 0, 1, 2, NULL, &st,
+                                CF_OK);
+    cf_msm_effects fx = {0};
+    fx.inertia = 1;
+    fx.eta_MPa_s = 2e-3;
+    cf_msm_sample s1 = run_hold(&law, &cfg, &fx, CF_DRIVE_FORCE, stress, 0.5, 20, 21, NULL, &st,
+                                CF_OK);
+    assert_true(st.steps > 1000);
+    assert_true(s0.strain > 0.05);
+    assert_close(s1.strain, s0.strain, 1e-6 * s0.strain);
+}
+
+static void undamped_symplectic_run_keeps_energy_bounded(void **state)
+{
+    (void)state;
+    cf_law law = make_law();
+    cf_msm_config cfg = small_config(1, 1, 1, CF_DIAG_FACE | CF_DIAG_BODY);
+    cf_msm_effects fx = {0};
+    fx.inertia = 1;
+    /* A load applied at once: the lattice oscillates about its equilibrium forever. */
+    cf_lattice lat;
+    cf_error err = {0};
+    assert_int_equal(cf_lattice_create(&lat, &law, CF_LAW_CLOSED_NEWTON, &cfg.lattice, &err),
+                     CF_OK);
+    double dt = 0.25 * cf_msm_stable_step(&lat, &fx);
+    cf_lattice_free(&lat);
+    cfg.dt_s = dt;
+    /* Symplectic Euler conserves a nearby energy: the error oscillates with an amplitude of order
+    ** omega dt but does not grow. Compare 1e4 steps with 1e5 steps of the same run. */
+    cf_msm_stats s_short, s_long;
+    cf_msm_sample *all = calloc(101, sizeof *all);
+    run_hold(&law, &cfg, &fx, CF_DRIVE_FORCE, 2e-4, 0, 1e4 * dt, 101, all, &s_short, CF_OK);
+    run_hold(&law, &cfg, &fx, CF_DRIVE_FORCE, 2e-4, 0, 1e5 * dt, 101, all, &s_long, CF_OK);
+    assert_true(s_long.steps >= 100000);
+    double kmax = 0;
+    for (int k = 0; k < 101; k++)
+        kmax = fmax(kmax, all[k].kinetic_mJ);
+    assert_true(kmax > 0); /* it does oscillate */
+    assert_true(s_long.max_energy_drift < 0.1);
+    assert_true(s_long.max_energy_drift < 2 * s_short.max_energy_drift + 0.01);
+    free(all);
+}
+
+static void creep_strain_rises_monotonically_toward_static_value(void **state)
+{
+    (void)state;
+    cf_law law = make_law();
+    cf_msm_config cfg = small_config(2, 2, 2, CF_DIAG_FACE | CF_DIAG_BODY);
+    cfg.quasi_substeps = 4;
+    const double stress = 1.0e-3, tau = 5;
+    cf_msm_sample s0 = run_hold(&law, &cfg, NULL, CF_DRIVE_FORCE, stress, 0, 1, 2, NULL, NULL,
+                                CF_OK);
+    cf_msm_effects fx = {0};
+    fx.maxwell_E_MPa = 3e-3;
+    fx.maxwell_tau_s = tau;
+    size_t n = 121;
+    cf_msm_sample *all = calloc(n, sizeof *all);
+    run_hold(&law, &cfg, &fx, CF_DRIVE_FORCE, stress, 1, 1 + 40 * tau, n, all, NULL, CF_OK);
+    size_t k0 = 2; /* first sample after the ramp (t = 1 s) */
+    assert_true(all[k0].strain < 0.9 * s0.strain);
+    for (size_t k = k0 + 1; k < n; k++) {
+        assert_true(all[k].strain >= all[k - 1].strain);
+        assert_true(all[k].strain <= s0.strain * (1 + 1e-9));
+    }
+    assert_close(all[n - 1].strain, s0.strain, 1e-3 * s0.strain);
+    free(all);
+}
+
+/* Loop area (kPa) of one load-unload cycle to strain 0.2 of the given period with dashpots. */
+static double loop_area(const cf_law *law, double period)
+{
+    cf_msm_config cfg = small_config(1, 1, 2, CF_DIAG_FACE | CF_DIAG_BODY);
+    cfg.quasi_substeps = 2;
+    cf_lattice lat;
+    cf_error err = {0};
+    assert_int_equal(cf_lattice_create(&lat, law, CF_LAW_CLOSED_NEWTON, &cfg.lattice, &err),
+                     CF_OK);
+    cf_msm_effects fx = {0};
+    fx.eta_MPa_s = 5e-3;
+    double t[3] = {0, period / 2, period}, v[3] = {0, 0.2, 0};
+    cf_msm_path path = {CF_DRIVE_DISPLACEMENT, 3, t, v};
+    enum { N = 81 };
+    double ts[N];
+    cf_msm_sample s[N];
+    for (int k = 0; k < N; k++)
+        ts[k] = period * k / (N - 1);
+    cf_status rc = cf_msm_run(&lat, &fx, &cfg, &path, ts, N, s, NULL, NULL, &err);
+    if (rc != CF_OK)
+        fail_msg("cycle: %s", err.msg);
+    double A = 0;
+    for (int k = 1; k < N; k++)
+        A += 0.5 * (s[k].stress_MPa + s[k - 1].stress_MPa) * (s[k].strain - s[k - 1].strain);
+    cf_lattice_free(&lat);
+    return A * 1e3;
+}
+
+static void hysteresis_area_is_positive_and_vanishes_as_rate_goes_to_zero(void **state)
+{
+    (void)state;
+    cf_law law = make_law();
+    double a1 = loop_area(&law, 10), a2 = loop_area(&law, 100), a3 = loop_area(&law, 1000);
+    assert_true(a1 > 0 && a2 > 0 && a3 > 0);
+    /* Dashpot dissipation is proportional to the rate: ten times slower, ten times less. */
+    assert_true(a2 < 0.2 * a1);
+    assert_true(a3 < 0.2 * a2);
+    assert_true(a3 < 0.02 * a1);
+}
+
+static void unstable_time_step_is_refused(void **state)
+{
+    (void)state;
+    cf_law law = make_law();
+    cf_msm_config cfg = small_config(1, 1, 1, CF_DIAG_FACE);
+    cf_msm_effects fx = {0};
+    fx.inertia = 1;
+    cf_lattice lat;
+    cf_error err = {0};
+    assert_int_equal(cf_lattice_create(&lat, &law, CF_LAW_CLOSED_NEWTON, &cfg.lattice, &err),
+                     CF_OK);
+    double stable = cf_msm_stable_step(&lat, &fx);
+    assert_true(stable > 0 && isfinite(stable));
+    cfg.dt_s = 3 * stable;
+    double t[2] = {0, 1}, v[2] = {1e-3, 1e-3}, ts[2] = {0, 1};
+    cf_msm_path path = {CF_DRIVE_FORCE, 2, t, v};
+    cf_msm_sample s[2];
+    assert_int_equal(cf_msm_run(&lat, &fx, &cfg, &path, ts, 2, s, NULL, NULL, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "dt_s"));
+    cf_lattice_free(&lat);
+}
+
+static void lattice_masses_and_top_shares_add_up(void **state)
+{
+    (void)state;
+    cf_law law = make_law();
+    cf_lattice_config c = cf_lattice_default();
+    c.nx = 3, c.ny = 2, c.nz = 4;
+    cf_lattice lat;
+    assert_int_equal(cf_lattice_create(&lat, &law, CF_LAW_CLOSED, &c, NULL), CF_OK);
+    double m = 0, sh = 0;
+    for (size_t p = 0; p < lat.nn; p++)
+        m += lat.mass_t[p];
+    for (size_t t = 0; t < lat.ntop; t++)
+        sh += lat.top_share[t];
+    assert_close(m, c.density_t_per_mm3 * 24 * 1000, 1e-12 * m);
+    assert_close(sh, 6, 1e-12);
+    cf_lattice_free(&lat);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(axial_only_lattice_reproduces_single_spring_curve),
+        cmocka_unit_test(lattice_with_diagonals_is_stiffer_than_one_spring),
+        cmocka_unit_test(every_spring_applies_equal_and_opposite_forces),
+        cmocka_unit_test(lattice_masses_and_top_shares_add_up),
+        cmocka_unit_test(static_solve_and_long_damped_dynamic_run_agree),
+        cmocka_unit_test(undamped_symplectic_run_keeps_energy_bounded),
+        cmocka_unit_test(creep_strain_rises_monotonically_toward_static_value),
+        cmocka_unit_test(hysteresis_area_is_positive_and_vanishes_as_rate_goes_to_zero),
+        cmocka_unit_test(unstable_time_step_is_refused),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,196 @@
+/*
+** Tests of scene files (src/scene.c) and of `conifit simulate`: every bad scene is refused with a
+** message naming its key, nothing is written for a bad scene, a good scene runs, and the shipped
+** relaxation scene is compared with the published muscle relaxation table when it is present.
+*/
+#include "testutil.h"
+
+#include "scene.h"
+
+#define SPRING "\"spring\": {\"params\": {\"D1_mm\": 6, \"D2_mm\": 15, \"n\": 2.5, \"d_mm\": 2, " \
+               "\"G_MPa\": 26, \"H_mm\": 10}}"
+#define RAMP "\"protocol\": {\"kind\": \"ramp\", \"to_strain\": 0.2}"
+
+typedef struct bad_case {
+    const char *json;
+    cf_status status;
+    const char *must_name; /* text the message must contain */
+} bad_case;
+
+static void every_bad_scene_is_refused_naming_its_key(void **state)
+{
+    (void)state;
+    static const bad_case cases[] = {
+        {"{" SPRING ", " RAMP ", \"colour\": 1}", CF_E_DATA, "'colour'"},
+        {"{" SPRING ", " RAMP ", \"lattice\": {\"nx\": 0}}", CF_E_DATA, "'lattice.nx' = 0"},
+        {"{" SPRING ", " RAMP ", \"lattice\": {\"nx\": 2.5}}", CF_E_DATA, "'lattice.nx' = 2.5"},
+        {"{" SPRING ", " RAMP ", \"lattice\": {\"nq\": 2}}", CF_E_DATA, "'lattice.nq'"},
+        {"{" SPRING ", " RAMP ", \"lattice\": {\"diagonals\": \"all\"}}", CF_E_DATA,
+         "'lattice.diagonals' = 'all'"},
+        {"{" SPRING ", " RAMP ", \"lattice\": {\"bottom\": \"glued\"}}", CF_E_DATA,
+         "'lattice.bottom' = 'glued'"},
+        {"{" RAMP "}", CF_E_DATA, "'spring'"},
+        {"{" SPRING "}", CF_E_DATA, "'protocol'"},
+        {"{\"spring\": {\"params\": {\"D1_mm\": 6, \"D2_mm\": 15, \"n\": 2.5, \"d_mm\": 2, "
+         "\"G_MPa\": 26}}, " RAMP "}",
+         CF_E_DATA, "'spring.params.H_mm'"},
+        {"{\"spring\": {\"params\": {\"D1_mm\": 6, \"D2_mm\": 15, \"n\": 2.5, \"d_mm\": 2, "
+         "\"G_MPa\": -26, \"H_mm\": 10}}, " RAMP "}",
+         CF_E_DATA, "'spring.params.G_MPa' = -26"},
+        {"{\"spring\": {\"fit\": \"no/such/fit.json\"}, " RAMP "}", CF_E_NOINPUT, "'spring.fit'"},
+        {"{" SPRING ", \"protocol\": {\"kind\": \"ramp\", \"to_strain\": 0.6}}", CF_E_DATA,
+         "'protocol.to_strain' = 0.6"},
+        {"{" SPRING ", \"protocol\": {\"kind\": \"zigzag\", \"to_strain\": 0.2}}", CF_E_DATA,
+         "'protocol.kind' = 'zigzag'"},
+        {"{" SPRING ", \"protocol\": {\"kind\": \"cycles\", \"to_strain\": 0.2}}", CF_E_DATA,
+         "'protocol.period_s'"},
+        {"{" SPRING ", \"protocol\": {\"kind\": \"ramp\", \"to_strain\": 0.2, \"hold_s\": 3}}",
+         CF_E_DATA, "'protocol.hold_s'"},
+        {"{" SPRING ", \"protocol\": {\"kind\": \"hold\", \"to_strain\": 0.2, "
+         "\"to_stress_kPa\": 1, \"ramp_s\": 1, \"hold_s\": 1}}",
+         CF_E_DATA, "'protocol.to_strain'"},
+        {"{" SPRING ", " RAMP ", \"effects\": {\"viscosity\": {\"E_kPa\": 3}}}", CF_E_DATA,
+         "'effects.viscosity.tau_s'"},
+        {"{" SPRING ", " RAMP ", \"effects\": {\"damping\": {\"eta_kPa_s\": -1}}}", CF_E_DATA,
+         "'effects.damping.eta_kPa_s' = -1"},
+        {"{" SPRING ", " RAMP ", \"effects\": {\"inertia\": 1}}", CF_E_DATA, "'effects.inertia'"},
+        {"{" SPRING ", " RAMP ", \"effects\": {\"gravity\": true}}", CF_E_DATA,
+         "'effects.gravity'"},
+        {"{" SPRING ", " RAMP ", \"law_method\": \"guess\"}", CF_E_DATA, "'law_method' = 'guess'"},
+        {"{" SPRING ", " RAMP ", \"integrator\": {\"dt_s\": -1}}", CF_E_DATA,
+         "'integrator.dt_s' = -1"},
+        {"{" SPRING ", " RAMP ", \"density_t_per_mm3\": 0}", CF_E_DATA,
+         "'density_t_per_mm3' = 0"},
+        {"{" SPRING ", " RAMP, CF_E_DATA, "not valid JSON"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        cf_scene sc;
+        cf_error err = {0};
+        cf_status st = cf_scene_parse(cases[i].json, "s.json", &sc, &err);
+        if (st != cases[i].status || !strstr(err.msg, cases[i].must_name))
+            fail_msg("case %zu: status %d (want %d), message '%s' lacks \"%s\"", i, st,
+                     cases[i].status, err.msg, cases[i].must_name);
+        assert_null(sc.sample_t_s);
+    }
+}
+
+static void good_scene_builds_its_loading_path(void **state)
+{
+    (void)state;
+    cf_scene sc;
+    cf_error err = {0};
+    const char *json = "{" SPRING ", \"protocol\": {\"kind\": \"cycles\", \"to_stress_kPa\": 2, "
+                       "\"period_s\": 10, \"count\": 3}, \"samples_per_segment\": 5, "
+                       "\"effects\": {\"damping\": {\"eta_kPa_s\": 4}}}";
+    if (cf_scene_parse(json, "s.json", &sc, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    assert_int_equal(sc.drive, CF_DRIVE_FORCE);
+    assert_int_equal(sc.npath, 7);
+    assert_close(sc.path_t_s[6], 30, 0);
+    assert_close(sc.path_v[1], 2e-3, 1e-18); /* kPa -> MPa */
+    assert_close(sc.path_v[2], 0, 0);
+    assert_int_equal(sc.nsamples, 6 * 5 + 1);
+    assert_close(sc.effects.eta_MPa_s, 4e-3, 1e-18);
+    assert_int_equal(sc.cfg.lattice.nx, 3); /* default lattice */
+    cf_scene_free(&sc);
+}
+
+static void simulate_writes_nothing_for_a_bad_scene_and_a_csv_for_a_good_one(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-scene-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char bad[256], good[256], out[256], cmd[1024];
+    snprintf(bad, sizeof bad, "%s/bad.json", dir);
+    snprintf(good, sizeof good, "%s/good.json", dir);
+    snprintf(out, sizeof out, "%s/out.csv", dir);
+    FILE *f = fopen(bad, "w");
+    fprintf(f, "{" SPRING ", " RAMP ", \"lattice\": {\"nx\": -1}}");
+    fclose(f);
+    f = fopen(good, "w");
+    fprintf(f, "{" SPRING ", " RAMP ", \"lattice\": {\"nx\": 1, \"ny\": 1, \"nz\": 2}, "
+               "\"samples_per_segment\": 4}");
+    fclose(f);
+    char so[4096], se[4096];
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "simulate %s -o %s", bad, out), 65);
+    assert_non_null(strstr(se, "lattice.nx"));
+    assert_int_equal(access(out, F_OK), -1);
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "simulate %s/none.json -o %s", dir, out),
+                     66);
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "simulate %s", good), 2);
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "simulate %s -o %s", good, good), 73);
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "simulate %s -o %s", good, out), 0);
+    assert_non_null(strstr(so, "static equilibria"));
+    f = fopen(out, "r");
+    assert_non_null(f);
+    char line[512];
+    assert_non_null(fgets(line, sizeof line, f));
+    assert_string_equal(line, "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa\n");
+    int rows = 0;
+    double t, e = 0, s = 0, k, sp;
+    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf", &t, &e, &s, &k, &sp) == 5)
+        rows++;
+    fclose(f);
+    assert_int_equal(rows, 5);
+    assert_close(e, 0.2, 1e-12);
+    assert_true(s > sp && sp > 0); /* the diagonals stiffen the lattice */
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "simulate --help"), 0);
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
+/* The shipped relaxation scene against the published along-fibre relaxation table: the lattice's
+** Maxwell branch is one exponential, the muscle relaxes over several time scales, so the check is
+** on the peak and on the held end, within 15 %. */
+static void relaxation_scene_follows_published_muscle_relaxation(void **state)
+{
+    (void)state;
+    const char *ds = tu_datasets();
+    if (!ds) {
+        skip();
+        return;
+    }
+    char path[512];
+    snprintf(path, sizeof path, "%s/muscle_compression_relaxation_fiber30.csv", ds);
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    char line[512];
+    double peak = 0, end = 0, t, e, s;
+    while (fgets(line, sizeof line, f))
+        if (sscanf(line, "%lf,%lf,%lf", &t, &e, &s) == 3) {
+            peak = fmin(peak, s);
+            end = s;
+        }
+    fclose(f);
+    char dir[] = "/tmp/conifit-relax-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char out[256], so[4096], se[4096];
+    snprintf(out, sizeof out, "%s/r.csv", dir);
+    assert_int_equal(
+        tu_run(so, sizeof so, se, sizeof se, "simulate data/scenes/relaxation.json -o %s", out), 0);
+    double speak = 0, send = 0;
+    f = fopen(out, "r");
+    assert_non_null(fgets(line, sizeof line, f));
+    double k, sp;
+    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf", &t, &e, &s, &k, &sp) == 5) {
+        speak = fmax(speak, s);
+        send = s;
+    }
+    fclose(f);
+    remove(out);
+    rmdir(dir);
+    /* The table is compression negative; the simulation compression positive. */
+    assert_close(speak, -peak, 0.15 * -peak);
+    assert_close(send, -end, 0.15 * -end);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(every_bad_scene_is_refused_naming_its_key),
+        cmocka_unit_test(good_scene_builds_its_loading_path),
+        cmocka_unit_test(simulate_writes_nothing_for_a_bad_scene_and_a_csv_for_a_good_one),
+        cmocka_unit_test(relaxation_scene_follows_published_muscle_relaxation),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
