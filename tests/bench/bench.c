@@ -11,6 +11,7 @@
 #include <string.h>
 #include <sys/utsname.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <gsl/gsl_errno.h>
 
@@ -119,9 +120,26 @@ int main(int argc, char **argv)
                     "time is the median of repeated runs with the spread (min–max) beside it; "
                     "one core, `-O2`. Machine: %s %s.\n\n",
             un.sysname, un.machine);
+    /* other work on the machine shows in the load average; the report states it when present */
+    double load = -1;
+    FILE *la = fopen("/proc/loadavg", "r");
+    if (la) {
+        if (fscanf(la, "%lf", &load) != 1)
+            load = -1;
+        fclose(la);
+    }
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    if (load >= 0.5)
+        fprintf(ctx.md, "Noise: the 1-minute load average was %.2f on %ld cores when the run "
+                        "started (other work was running), which widens the spreads.\n\n",
+                load, cores);
     double t0 = bench_now();
+    bench_memory_fit_early(&ctx);
     bench_section_law(&ctx);
+    bench_section_lattice(&ctx);
+    bench_section_integrators(&ctx);
     bench_section_fit(&ctx);
+    bench_section_resolution(&ctx);
     bench_section_memory(&ctx);
     write_targets(&ctx);
     fprintf(ctx.md, "\n---\nWhole benchmark run: %.0f s.\n", bench_now() - t0);

@@ -36,6 +36,10 @@ typedef struct bench_ctx {
     int quick;             /* 1: fewer repeats and sizes (a smoke run) */
     bench_target targets[BENCH_MAX_TARGETS];
     int ntargets;
+    size_t largest_springs; /* springs of the largest lattice of section 2 */
+    int largest_cells;      /* its cells per edge */
+    double slope_closed;    /* growth exponent of the closed-form lattice step */
+    char *mem_fit;          /* section 6's fit-memory text, measured first (bench_memory_fit_early) */
 } bench_ctx;
 
 /* Records a target for the summary table; measured is printf-formatted. */
@@ -55,7 +59,11 @@ long bench_child_maxrss_kb(void (*fn)(void *), void *arg);
 extern volatile double bench_sink;
 
 void bench_section_law(bench_ctx *ctx);
+void bench_section_lattice(bench_ctx *ctx);
+void bench_section_integrators(bench_ctx *ctx);
 void bench_section_fit(bench_ctx *ctx);
+void bench_section_resolution(bench_ctx *ctx);
+void bench_memory_fit_early(bench_ctx *ctx);
 void bench_section_memory(bench_ctx *ctx);
 
 #endif
