@@ -6,10 +6,12 @@
 #include "bench.h"
 
 #include <locale.h>
+#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/utsname.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <gsl/gsl_errno.h>
 
@@ -58,6 +60,31 @@ int bench_gnuplot(const bench_ctx *ctx, const char *script)
     return pclose(p) == 0 ? 0 : -1;
 }
 
+void bench_target_add(bench_ctx *ctx, const char *name, int met, const char *fmt, ...)
+{
+    if (ctx->ntargets >= BENCH_MAX_TARGETS)
+        return;
+    bench_target *t = &ctx->targets[ctx->ntargets++];
+    snprintf(t->name, sizeof t->name, "%s", name);
+    t->met = met;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(t->measured, sizeof t->measured, fmt, ap);
+    va_end(ap);
+}
+
+/* The closing table: every target of the benchmark with its measured value. */
+static void write_targets(bench_ctx *ctx)
+{
+    fprintf(ctx->md, "## Targets\n\n| target | measured | verdict |\n|---|---|---|\n");
+    for (int i = 0; i < ctx->ntargets; i++) {
+        const bench_target *t = &ctx->targets[i];
+        fprintf(ctx->md, "| %s | %s | %s |\n", t->name, t->measured,
+                t->met > 0 ? "**met**" : t->met == 0 ? "**not met**" : "not measured");
+    }
+    fprintf(ctx->md, "\n");
+}
+
 int main(int argc, char **argv)
 {
     setlocale(LC_ALL, "C");
@@ -93,8 +120,28 @@ int main(int argc, char **argv)
                     "time is the median of repeated runs with the spread (min–max) beside it; "
                     "one core, `-O2`. Machine: %s %s.\n\n",
             un.sysname, un.machine);
+    /* other work on the machine shows in the load average; the report states it when present */
+    double load = -1;
+    FILE *la = fopen("/proc/loadavg", "r");
+    if (la) {
+        if (fscanf(la, "%lf", &load) != 1)
+            load = -1;
+        fclose(la);
+    }
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    if (load >= 0.5)
+        fprintf(ctx.md, "Noise: the 1-minute load average was %.2f on %ld cores when the run "
+                        "started (other work was running), which widens the spreads.\n\n",
+                load, cores);
     double t0 = bench_now();
+    bench_memory_fit_early(&ctx);
     bench_section_law(&ctx);
+    bench_section_lattice(&ctx);
+    bench_section_integrators(&ctx);
+    bench_section_fit(&ctx);
+    bench_section_resolution(&ctx);
+    bench_section_memory(&ctx);
+    write_targets(&ctx);
     fprintf(ctx.md, "\n---\nWhole benchmark run: %.0f s.\n", bench_now() - t0);
     if (fclose(ctx.md) != 0 || rename(tmp, path) != 0) {
         fprintf(stderr, "conifit-bench: cannot write %s\n", path);

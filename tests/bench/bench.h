@@ -21,11 +21,30 @@ typedef struct bench_stats {
 bench_stats bench_summarise(double *x, int count);
 
 /* Where the report and its plots go, and how to draw a plot. */
+/* One target of the issue with its measured value, for the summary at the end of the report. */
+typedef struct bench_target {
+    char name[160];
+    char measured[200];
+    int met; /* 1 met, 0 not met, -1 not measured */
+} bench_target;
+
+#define BENCH_MAX_TARGETS 16
+
 typedef struct bench_ctx {
     FILE *md;              /* the Markdown report */
     const char *dir;       /* folder of the report, plots and plot data */
     int quick;             /* 1: fewer repeats and sizes (a smoke run) */
+    bench_target targets[BENCH_MAX_TARGETS];
+    int ntargets;
+    size_t largest_springs; /* springs of the largest lattice of section 2 */
+    int largest_cells;      /* its cells per edge */
+    double slope_closed;    /* growth exponent of the closed-form lattice step */
+    char *mem_fit;          /* section 6's fit-memory text, measured first (bench_memory_fit_early) */
 } bench_ctx;
+
+/* Records a target for the summary table; measured is printf-formatted. */
+void bench_target_add(bench_ctx *ctx, const char *name, int met, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
 
 /* Runs gnuplot on script (with `set output` already naming a PNG in dir); returns 0 on success. */
 int bench_gnuplot(const bench_ctx *ctx, const char *script);
@@ -33,9 +52,18 @@ int bench_gnuplot(const bench_ctx *ctx, const char *script);
 /* Opens dir/name for writing plot data; NULL on failure. */
 FILE *bench_open_data(const bench_ctx *ctx, const char *name);
 
+/* Runs fn(arg) in a forked child; the child's peak resident set (ru_maxrss, KiB), -1 on failure. */
+long bench_child_maxrss_kb(void (*fn)(void *), void *arg);
+
 /* Sink that keeps the compiler from discarding benchmark work. */
 extern volatile double bench_sink;
 
 void bench_section_law(bench_ctx *ctx);
+void bench_section_lattice(bench_ctx *ctx);
+void bench_section_integrators(bench_ctx *ctx);
+void bench_section_fit(bench_ctx *ctx);
+void bench_section_resolution(bench_ctx *ctx);
+void bench_memory_fit_early(bench_ctx *ctx);
+void bench_section_memory(bench_ctx *ctx);
 
 #endif
