@@ -83,6 +83,7 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
     lat->cfg = *cfg;
     lat->law = law;
     lat->method = method;
+    lat->with_stiffness = 1;
     lat->H_mm = law->p.H_mm;
     lat->travel_mm = law->travel_mm;
     const double H = lat->H_mm;
@@ -240,7 +241,8 @@ double cf_lattice_forces(cf_lattice *lat)
         umax = au > umax ? au : umax;
     }
     /* 2: the law, one dispatch for all springs. */
-    cf_law_force_many(lat->law, lat->method, ns, lat->u_mm, lat->F_N, lat->k_N_per_mm);
+    cf_law_force_many(lat->law, lat->method, ns, lat->u_mm, lat->F_N,
+                      lat->with_stiffness ? lat->k_N_per_mm : NULL);
     /* 3: tensions and equal and opposite node forces. */
     memset(fx, 0, nn * sizeof(double));
     memset(fy, 0, nn * sizeof(double));

@@ -75,7 +75,9 @@ typedef struct cf_lattice {
     double *L_mm;           /* current length (kernel output), mm */
     double *u_mm;           /* law compression (L0 - L) a (kernel output), mm */
     double *F_N;            /* law force at u (kernel output), N, compression positive */
-    double *k_N_per_mm;     /* law stiffness at u (kernel output), N/mm */
+    double *k_N_per_mm;     /* law stiffness at u (kernel output when with_stiffness), N/mm */
+    int with_stiffness;     /* 1 (default): the kernel also evaluates k_N_per_mm (statics, stable
+                            ** step); 0: forces only, as an explicit step needs (cheaper) */
     double *T_N;            /* spring tension w (-F) + effects (kernel output), N */
     /* faces */
     size_t ntop;            /* nodes on the top face */
@@ -100,7 +102,8 @@ void cf_lattice_free(cf_lattice *lat);
 void cf_lattice_reset(cf_lattice *lat);
 
 /* The force kernel: from the current positions computes every spring's length, compression, law
-** force and stiffness and elastic tension (L_mm, u_mm, F_N, k_N_per_mm, T_N) and the node forces
+** force and (when lat->with_stiffness) stiffness and elastic tension (L_mm, u_mm, F_N, k_N_per_mm,
+** T_N) and the node forces
 ** fx, fy, fz (every spring adds equal and opposite forces along its axis to its two nodes).
 ** Returns the largest |u| / travel over all springs (>= 1 means some spring is at solid). */
 double cf_lattice_forces(cf_lattice *lat);

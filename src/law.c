@@ -358,6 +358,20 @@ static inline double table_y(const struct cf_law_table *t, double w, double *dyd
 
 /* ---- evaluation ------------------------------------------------------------------------------ */
 
+/* Region 2 from the table, for |u| = a in (u_T, s): F, and dF/du when k is not NULL
+** (dF/du = 3 F_C y^2 dy/dw dw/du with dw/du = -1/(2 s w)). */
+static inline double table_region2(const cf_law *law, double u, double a, double *k)
+{
+    const double w = sqrt((law->travel_mm - a) * law->inv_travel);
+    double dydw;
+    const double y = table_y(law->table, w, &dydw);
+    if (k) {
+        const double kk = -1.5 * law->F_C_N * law->inv_travel * y * y * dydw / w;
+        *k = (kk >= 0 && kk <= DBL_MAX) ? kk : 0.0;
+    }
+    return copysign(law->F_C_N * y * y * y, u);
+}
+
 static inline double law_eval(const cf_law *law, cf_law_method method, double u, double *k,
                               int *flags)
 {
@@ -382,16 +396,8 @@ static inline double law_eval(const cf_law *law, cf_law_method method, double u,
         region2_exact(law, delta, &y, &om);
         break;
     case CF_LAW_TABLE:
-        if (law->table) {
-            double dydw;
-            const double w = sqrt(v);
-            y = table_y(law->table, w, &dydw);
-            /* dF/du = 3 F_C y^2 dy/dw * dw/du, dw/du = -1/(2 s w) */
-            *k = -3.0 * law->F_C_N * y * y * dydw * law->inv_travel / (2.0 * w);
-            if (!(*k >= 0) || !isfinite(*k))
-                *k = 0.0;
-            return sign * law->F_C_N * y * y * y;
-        }
+        if (law->table)
+            return table_region2(law, u, a, k);
         region2_closed(delta, &y, &om, &e); /* no table built: closed form with Newton */
         region2_newton(delta, &y, &om, e);
         break;
@@ -423,6 +429,36 @@ double cf_law_force(const cf_law *law, cf_law_method method, double u_mm, double
     return F;
 }
 
+/* The table over many displacements: the hot loop of a lattice step, written out so that the
+** compiler sees one straight path and no stiffness work when none is asked for. */
+static inline double table_one(const cf_law *law, double u, double *k)
+{
+    const double a = fabs(u);
+    if (a <= law->u_T_mm) {
+        if (k)
+            *k = law->k0_N_per_mm;
+        return law->k0_N_per_mm * u;
+    }
+    if (!(a < law->travel_mm)) {
+        if (k)
+            *k = 0.0;
+        return isnan(u) ? 0.0 : copysign(law->F_C_N, u);
+    }
+    return table_region2(law, u, a, k);
+}
+
+static void table_many_k(const cf_law *law, size_t count, const double *u, double *F, double *k)
+{
+    for (size_t i = 0; i < count; i++)
+        F[i] = table_one(law, u[i], &k[i]);
+}
+
+static void table_many(const cf_law *law, size_t count, const double *u, double *F)
+{
+    for (size_t i = 0; i < count; i++)
+        F[i] = table_one(law, u[i], NULL);
+}
+
 void cf_law_force_many(const cf_law *law, cf_law_method method, size_t count, const double *u_mm,
                        double *F_N, double *k_N_per_mm)
 {
@@ -437,6 +473,13 @@ void cf_law_force_many(const cf_law *law, cf_law_method method, size_t count, co
         }
         break;
     case CF_LAW_TABLE:
+        if (law->table) {
+            if (k_N_per_mm)
+                table_many_k(law, count, u_mm, F_N, k_N_per_mm);
+            else
+                table_many(law, count, u_mm, F_N);
+            break;
+        }
         for (size_t i = 0; i < count; i++) {
             F_N[i] = law_eval(law, CF_LAW_TABLE, u_mm[i], &k, &fl);
             if (k_N_per_mm)

@@ -640,7 +640,9 @@ static void dyn_step(solver *s, dyn *d, double h, double v1, double rate)
     cf_lattice *lat = s->lat;
     const cf_msm_effects *fx = s->fx;
     const size_t ns = lat->ns, nn = lat->nn;
+    lat->with_stiffness = 0; /* an explicit step needs forces only */
     cf_lattice_forces(lat);
+    lat->with_stiffness = 1;
     double H2 = lat->H_mm * lat->H_mm;
     if (fx->eta_MPa_s > 0 || s->sigm) {
         /* Rate of change of every spring length. */
