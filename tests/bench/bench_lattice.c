@@ -28,7 +28,8 @@ static const lvariant lvars[] = {
 };
 #define NLV (sizeof lvars / sizeof lvars[0])
 
-/* The lattice kernel with F = k u in place of the law (same passes, same memory traffic). */
+/* The lattice kernel with F = k u in place of the law (same passes, same memory traffic; forces
+** only, as in an explicit step). */
 static void linear_forces(cf_lattice *lat, double k)
 {
     const size_t ns = lat->ns, nn = lat->nn;
@@ -36,7 +37,7 @@ static void linear_forces(cf_lattice *lat, double k)
     const double *restrict x = lat->x, *restrict y = lat->y, *restrict z = lat->z;
     const double *restrict L0 = lat->L0_mm, *restrict a = lat->a, *restrict w = lat->w;
     double *restrict L = lat->L_mm, *restrict u = lat->u_mm, *restrict T = lat->T_N;
-    double *restrict F = lat->F_N, *restrict K = lat->k_N_per_mm;
+    double *restrict F = lat->F_N;
     double *restrict fx = lat->fx, *restrict fy = lat->fy, *restrict fz = lat->fz;
     for (size_t s = 0; s < ns; s++) {
         double dx = x[sj[s]] - x[si[s]], dy = y[sj[s]] - y[si[s]], dz = z[sj[s]] - z[si[s]];
@@ -44,10 +45,8 @@ static void linear_forces(cf_lattice *lat, double k)
         L[s] = l;
         u[s] = (L0[s] - l) * a[s];
     }
-    for (size_t s = 0; s < ns; s++) {
+    for (size_t s = 0; s < ns; s++)
         F[s] = k * u[s];
-        K[s] = k;
-    }
     memset(fx, 0, nn * sizeof(double));
     memset(fy, 0, nn * sizeof(double));
     memset(fz, 0, nn * sizeof(double));
@@ -75,8 +74,10 @@ static void step(cf_lattice *lat, vel *v, int linear, double k, double h)
 {
     if (linear)
         linear_forces(lat, k);
-    else
+    else {
+        lat->with_stiffness = 0; /* an explicit step needs forces only */
         cf_lattice_forces(lat);
+    }
     for (size_t p = 0; p < lat->nn; p++) {
         const double im = h / lat->mass_t[p];
         const uint8_t f = lat->fix[p];
