@@ -138,9 +138,9 @@ static double logit(double p)
 double cf_fit_model(const cf_law *law, int force_displacement, double x)
 {
     if (force_displacement)
-        return cf_law_force(law, CF_LAW_CLOSED_NEWTON, x, NULL, NULL);
+        return cf_law_force(law, CF_LAW_CLOSED, x, NULL, NULL);
     const double H = law->p.H_mm;
-    return cf_law_force(law, CF_LAW_CLOSED_NEWTON, x * H, NULL, NULL) / (H * H);
+    return cf_law_force(law, CF_LAW_CLOSED, x * H, NULL, NULL) / (H * H);
 }
 
 /* Solid length of a spring of the given type (the type being fitted, not the one its geometry
@@ -225,7 +225,7 @@ static double reduced(const cf_law *canon, double A, double B, double x, double 
 {
     double k;
     double t = x / B;
-    double g = cf_law_force(canon, CF_LAW_CLOSED_NEWTON, t, &k, NULL);
+    double g = cf_law_force(canon, CF_LAW_CLOSED, t, &k, NULL);
     if (dB)
         *dB = -A * k * t / B;
     return A * g;
@@ -239,7 +239,7 @@ static double canon_eval(const cf_law *canon, double t, double *dg_dt, double *d
 {
     int flags = 0;
     double k;
-    double g = cf_law_force(canon, CF_LAW_CLOSED_NEWTON, t, &k, &flags);
+    double g = cf_law_force(canon, CF_LAW_CLOSED, t, &k, &flags);
     const double rho = canon->rho, a = fabs(t), sg = t < 0 ? -1.0 : 1.0;
     *dg_dt = k;
     if (flags & CF_LAW_SOLID) {

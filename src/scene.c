@@ -386,7 +386,7 @@ static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
     if ((st = only_keys(c, root, "", allowed)))
         return st;
     sc->cfg = cf_msm_default();
-    sc->method = CF_LAW_CLOSED_NEWTON;
+    sc->method = CF_LAW_CLOSED;
     sc->table_intervals = CF_LAW_TABLE_DEFAULT;
     json_t *sp, *lt, *pr, *ef, *in;
     if ((st = object(c, root, "spring", 1, &sp)) || (st = spring_section(c, sp, sc)))

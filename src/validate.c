@@ -36,7 +36,7 @@ cf_validate_setup cf_validate_default(void)
 {
     cf_validate_setup s;
     s.cfg = cf_msm_default();
-    s.method = CF_LAW_CLOSED_NEWTON;
+    s.method = CF_LAW_CLOSED;
     s.table_intervals = CF_LAW_TABLE_DEFAULT;
     return s;
 }
