@@ -336,6 +336,9 @@ static int lm_df(const gsl_vector *th, void *params, gsl_matrix *J)
 #define LM_MAX_ITER 300
 #define LM_STALL 8
 #define LM_STALL_REL 1e-9
+/* ... and once the residual is at rounding level (relative residual norm 1e-13): on a noiseless
+** table the sum of squares then only jitters, and no step can improve the fit. */
+#define LM_FLOOR_REL 1e-26
 
 static double lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3])
 {
@@ -363,7 +366,7 @@ static double lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3
         /* The driver loop, with one more stopping rule: an optimum on a bound of rho or of the
         ** length scale lies at infinity in the logit coordinates, where the step test never
         ** fires; stop once the sum of squares has stopped falling (LM_STALL iterations in a row
-        ** that lower it by less than LM_STALL_REL of itself). */
+        ** that lower it by less than LM_STALL_REL of itself) or reached rounding level. */
         gsl_vector *f = gsl_multifit_nlinear_residual(w);
         double prev;
         gsl_blas_ddot(f, f, &prev);
@@ -378,7 +381,7 @@ static double lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3
             gsl_blas_ddot(f, f, &cur);
             stall = (prev - cur <= LM_STALL_REL * prev) ? stall + 1 : 0;
             prev = cur;
-            if (stall >= LM_STALL)
+            if (stall >= LM_STALL || cur <= LM_FLOOR_REL) /* residuals are scaled by 1/sqrt(ynorm) */
                 break;
         }
         double chi2;
@@ -735,6 +738,8 @@ static void nl_run(fit_ctx *c, nlopt_algorithm alg, zfun obj, int equalities, do
         }
     nlopt_set_xtol_rel(o, c->opt->xtol_rel);
     nlopt_set_ftol_abs(o, 1e-16);
+    if (obj == z_objective) /* a fit at rounding level cannot be polished further */
+        nlopt_set_stopval(o, LM_FLOOR_REL);
     nlopt_set_maxeval(o, maxeval);
     double f;
     double zs[CF_P_COUNT];
