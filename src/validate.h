@@ -38,7 +38,7 @@ typedef struct cf_validate_setup {
 } cf_validate_setup;
 
 /* cf_msm_default() (3 x 3 x 3 cells, face and body diagonals, bottom axial) with the fitter's own
-** evaluator, CF_LAW_CLOSED_NEWTON. */
+** evaluator, CF_LAW_CLOSED. */
 cf_validate_setup cf_validate_default(void);
 
 /* The setup of a scene, which must be a static uniaxial one: protocol kind "ramp" under a
