@@ -5,7 +5,8 @@
 **
 ** What runs depends only on the effects asked for:
 **   no time effect          -> a sequence of static equilibria (Newton with the law's tangent,
-**                              GMRES on the sparse tangent, backtracking so that no spring is
+**                              banded LDL^T of the sparse tangent with dense LU and GMRES as
+**                              fallbacks, backtracking so that no spring is
 **                              driven to solid); no time stepping.
 **   damping and/or Maxwell,  -> implicit quasi-static steps (backward Euler for the dashpots, the
 **   no inertia                 exact exponential update for the Maxwell branches), each a Newton
@@ -69,7 +70,7 @@ cf_msm_config cf_msm_default(void);
 typedef struct cf_msm_stats {
     size_t solves;             /* static / quasi-static Newton solves */
     size_t newton_iters;       /* Newton iterations in all */
-    size_t linear_iters;       /* linear solves: dense LU solves plus GMRES restart cycles */
+    size_t linear_iters;       /* linear solves: banded or dense factorisations plus GMRES cycles */
     size_t steps;              /* time steps taken */
     double dt_used_min_s;      /* smallest step used, s (0 for static runs) */
     double dt_stable_s;        /* stable explicit step at the start, s (0 if not explicit) */

@@ -122,7 +122,7 @@ void bench_section_integrators(bench_ctx *ctx)
     }
     cf_msm_effects none = {0};
     run_out o = run(&law, &none, 0, NULL, repeats);
-    row(ctx->md, "static (Newton + GMRES)", "–", &o, 0);
+    row(ctx->md, "static (Newton, banded LDLT)", "–", &o, 0);
     cf_msm_effects qs = {0};
     qs.eta_MPa_s = ETA_MPA_S;
     static const double qdt[] = {RAMP_S / 10, RAMP_S / 50, RAMP_S / 250};

@@ -85,7 +85,7 @@ void bench_section_resolution(bench_ctx *ctx)
     const double k = m.y_to_file;
     fprintf(ctx->md,
             "The telescoping spring fitted to `%s` (%zu points, single-spring RMSE %.4g %s) is "
-            "run through the static uniaxial solve (`cf_msm_uniaxial`, Newton + GMRES, closed "
+            "run through the static uniaxial solve (`cf_msm_uniaxial`, Newton with a banded LDLT, closed "
             "form) at the table's strains on cubic lattices of n³ cells. Validation error: RMSE of "
             "the lattice curve against the table, and against the single spring's own curve "
             "(what the lattice adds). Time: one whole curve, ms, median of %d [min–max].\n\n"
