@@ -47,7 +47,7 @@ static void summary(const cf_scene *sc, const cf_msm_sample *s, size_t n, const 
                "sub-stepped\n",
                st->dt_stable_s, st->dt_used_min_s, st->steps, st->substepped);
     else
-        printf("solves: %zu, Newton iterations: %zu, linear solves (LU or GMRES cycles): %zu\n", st->solves,
+        printf("solves: %zu, Newton iterations: %zu, linear solves: %zu\n", st->solves,
                st->newton_iters, st->linear_iters);
     printf("largest spring compression: %.4g of travel\n", st->max_u_over_travel);
     if (sc->kind == CF_PROTO_CYCLES) {
