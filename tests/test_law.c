@@ -418,6 +418,37 @@ static void cli_force_prints_the_law_to_17_digits(void **state)
     assert_string_equal(out, "-1.25\n");
 }
 
+/* The command line at the hard corners: conifit force with --method exact and closed agrees with
+** the long-double reference to 1e-12 relative (u printed with %.17g, so it reaches the binary as
+** the same double). */
+static void cli_force_matches_reference_at_hard_cases(void **state)
+{
+    (void)state;
+    const char *methods[] = {"exact", "closed"};
+    for (size_t a = 0; a < sizeof rhos / sizeof rhos[0]; a++)
+        for (size_t c = 0; c < sizeof coils / sizeof coils[0]; c += 2) {
+            cf_law law;
+            init_ok(&law, scaled(rhos[a], coils[c], 1, 1));
+            const cf_spring *p = &law.p;
+            const double s = law.travel_mm, uT = law.u_T_mm;
+            const double us[] = {0.0, uT, nextafter(uT, 0), nextafter(uT, INFINITY),
+                                 s * (1 - 1e-15), s, 1.5 * s, -0.5 * (uT + s)};
+            for (size_t i = 0; i < sizeof us / sizeof us[0]; i++)
+                for (int m = 0; m < 2; m++) {
+                    char out[128], errb[256];
+                    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                                            "force --D1 %.17g --D2 %.17g --n %.17g --d %.17g "
+                                            "--G %.17g --H %.17g --u %.17g --method %s",
+                                            p->D1_mm, p->D2_mm, p->n, p->d_mm, p->G_MPa, p->H_mm,
+                                            us[i], methods[m]),
+                                     0);
+                    double F = strtod(out, NULL);
+                    double R = (double)reference_force(p, us[i]);
+                    assert_close(F, R, 1e-12 * fabs(R));
+                }
+        }
+}
+
 static void cli_bad_arguments_exit_2_with_a_message(void **state)
 {
     (void)state;
@@ -507,6 +538,7 @@ int main(void)
         cmocka_unit_test(invalid_parameters_are_refused_with_their_name),
         cmocka_unit_test(method_names_round_trip),
         cmocka_unit_test(cli_force_prints_the_law_to_17_digits),
+        cmocka_unit_test(cli_force_matches_reference_at_hard_cases),
         cmocka_unit_test(cli_bad_arguments_exit_2_with_a_message),
         cmocka_unit_test(cli_curve_spans_stretch_to_solid),
         cmocka_unit_test(cli_info_and_help_and_version),
