@@ -26,6 +26,14 @@ static const char simulate_help[] =
     "  --plot FILE.png     also plot the result with gnuplot\n";
 
 /* Area of the closed loop(s) in the stress-strain plane over samples [a, b], kPa = kJ/m^3. */
+/* Progress on a terminal: one line, rewritten after every sample. */
+static void show_progress(void *ctx, size_t done, size_t total, double t_s)
+{
+    (void)ctx;
+    fprintf(stderr, "\rconifit simulate: sample %zu of %zu (t = %.4g s)", done, total, t_s);
+    fflush(stderr);
+}
+
 static double loop_area(const cf_msm_sample *s, size_t a, size_t b)
 {
     double A = 0;
@@ -202,8 +210,15 @@ int cf_cli_simulate(int argc, char **argv)
     cf_msm_path path = cf_scene_path(&sc);
     cf_msm_stats st;
     size_t done = 0;
-    if (cf_msm_run(&lat, &sc.effects, &sc.cfg, &path, sc.sample_t_s, sc.nsamples, samples, &done,
-                   &st, &err) != CF_OK) {
+    if (isatty(STDERR_FILENO)) {
+        sc.cfg.progress = show_progress;
+        sc.cfg.progress_ctx = NULL;
+    }
+    cf_status run_st = cf_msm_run(&lat, &sc.effects, &sc.cfg, &path, sc.sample_t_s, sc.nsamples,
+                                  samples, &done, &st, &err);
+    if (sc.cfg.progress)
+        fputs("\r\033[K", stderr); /* clear the progress line */
+    if (run_st != CF_OK) {
         rc = cf_cli_fail(&err);
         goto end;
     }

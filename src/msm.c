@@ -44,6 +44,8 @@ cf_msm_config cf_msm_default(void)
     c.newton_max_iter = 50;
     c.dt_s = 0;
     c.quasi_substeps = 10;
+    c.progress = NULL;
+    c.progress_ctx = NULL;
     return c;
 }
 
@@ -940,6 +942,8 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
         }
         if (done)
             *done = k + 1;
+        if (cfg->progress)
+            cfg->progress(cfg->progress_ctx, k + 1, nsamples, tk);
     }
 end:
     free(d.vx);

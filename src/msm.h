@@ -61,6 +61,10 @@ typedef struct cf_msm_config {
     double dt_s;               /* time step, s: 0 = automatic (quasi-static: sample interval
                                   split in quasi_substeps; dynamic: 0.9 of the stable step) */
     int quasi_substeps;        /* implicit steps per sample interval when dt_s = 0 */
+    /* Called by cf_msm_run after every reported sample (done of total) when not NULL, so that a
+    ** caller can show progress; the library itself never prints. */
+    void (*progress)(void *ctx, size_t done, size_t total, double t_s);
+    void *progress_ctx;
 } cf_msm_config;
 
 /* 3 x 3 x 3 cells, face and body diagonals, bottom axial; Newton 1e-11, 50 iterations. */
