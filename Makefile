@@ -22,7 +22,7 @@ ifeq ($(WERROR),1)
 WARN    += -Werror
 endif
 OPT     ?= -O2 -g -fno-math-errno
-CPPFLAGS += -D_DEFAULT_SOURCE -Isrc
+CPPFLAGS += -D_DEFAULT_SOURCE -Isrc/include -Isrc
 CFLAGS  += -std=c17 $(OPT) $(WARN) $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 LDLIBS  += $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lm -lpthread
 
@@ -33,9 +33,11 @@ LDFLAGS += -fsanitize=address,undefined
 OPT     := -O1 -g
 endif
 
-# Library modules: every src/*.c but the command-line layer (main.c, cli*.c).
-CLI_SRC := src/main.c $(wildcard src/cli*.c)
-LIB_SRC := $(filter-out $(CLI_SRC),$(wildcard src/*.c))
+# Sources by layer (README, "Architecture"): src/LAYER/*.c. The library is every layer but cli/;
+# public headers live in src/include/conifit/, private ones beside their sources.
+HDRS    := $(wildcard src/include/conifit/*.h src/*/*.h)
+CLI_SRC := $(wildcard src/cli/*.c)
+LIB_SRC := $(filter-out $(CLI_SRC),$(wildcard src/*/*.c))
 LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 CLI_OBJ := $(CLI_SRC:src/%.c=$(BUILD)/obj/%.o)
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
@@ -70,7 +72,8 @@ example: deps
 fits: check-deps $(BUILD)/conifit
 	$(BUILD)/conifit fit data/*.csv --validate -o fits/ --plot fits/ -j 4
 
-$(BUILD)/obj/%.o: src/%.c $(wildcard src/*.h) | $(BUILD)/obj
+$(BUILD)/obj/%.o: src/%.c $(HDRS)
+	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
 
 $(BUILD)/conifit: $(LIB_OBJ) $(CLI_OBJ)
@@ -85,6 +88,7 @@ $(BUILD)/obj $(BUILD)/tests:
 	mkdir -p $@
 
 test: check-deps $(BUILD)/conifit $(TESTS)
+	@sh tests/check_layers.sh
 	@fail=0; for t in $(TESTS); do \
 	  CONIFIT=$(BUILD)/conifit $$t || fail=1; done; \
 	if [ $$fail = 0 ]; then echo "conifit: all test programs passed"; else echo "conifit: TEST FAILURES" >&2; exit 1; fi
@@ -104,10 +108,9 @@ clean:
 # The benchmark program: optimised build of the library plus tests/bench/*.c; writes
 # tests/bench/REPORT.md and its plots. BENCH_ARGS=--quick for a short smoke run.
 BENCH_OBJ := $(LIB_SRC:src/%.c=build/bench/obj/%.o)
-build/bench/obj/%.o: src/%.c $(wildcard src/*.h) | build/bench/obj
+build/bench/obj/%.o: src/%.c $(HDRS)
+	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
-build/bench/obj:
-	mkdir -p $@
 build/bench/conifit-bench: $(wildcard tests/bench/*.c) tests/bench/bench.h $(BENCH_OBJ)
 	$(CC) $(CPPFLAGS) -Itests/bench $(CFLAGS) $(wildcard tests/bench/*.c) $(BENCH_OBJ) -o $@ $(LDFLAGS) $(LDLIBS)
 bench: check-deps build/bench/conifit-bench $(BUILD)/conifit

@@ -8,7 +8,7 @@
 
 #include "testutil.h"
 
-#include "fitfile.h"
+#include "conifit/fitfile.h"
 
 static char out[1 << 16], errb[1 << 14];
 

@@ -1,5 +1,5 @@
 /*
-** Tests of the export (src/export.c, conifit export): adaptive tables against the law on a dense
+** Tests of the export (src/out/export.c, conifit export): adaptive tables against the law on a dense
 ** grid of their own, the FEBio, LS-DYNA and SOFA layouts and values, the JSON round trip through
 ** `conifit force --spring`, error handling, and the proof: CalculiX (ccx) run on the exported
 ** springs, its reaction forces matched against the law at every step.
@@ -8,9 +8,9 @@
 
 #include "testutil.h"
 
-#include "export.h"
-#include "fitfile.h"
-#include "law.h"
+#include "conifit/export.h"
+#include "conifit/fitfile.h"
+#include "conifit/law.h"
 
 /* ccx prints forces with 7 significant digits. */
 #define CCX_PRINT_REL 1e-6

@@ -1,5 +1,5 @@
 /*
-** Tests of the fitter (src/fit.c) and the baselines (src/baseline.c): recovery of known springs
+** Tests of the fitter (src/fit/fit.c) and the baselines (src/fit/baseline.c): recovery of known springs
 ** from synthetic tables (noiseless and noisy), constraints checked at every reported solution,
 ** fixed parameters, determinism, and the published tables against an independent
 ** three-parameter least-squares fit.
@@ -12,10 +12,10 @@
 #include <gsl/gsl_blas.h>
 #include <gsl/gsl_multifit_nlinear.h>
 
-#include "baseline.h"
-#include "fit.h"
-#include "law.h"
-#include "measure.h"
+#include "conifit/baseline.h"
+#include "conifit/fit.h"
+#include "conifit/law.h"
+#include "conifit/measure.h"
 
 /* ---- synthetic tables ------------------------------------------------------------------------ */
 

@@ -1,10 +1,10 @@
 /*
-** Tests of the fit-file reader (src/fitfile.c): a good fit file and an exported spring load with
+** Tests of the fit-file reader (src/io/fitfile.c): a good fit file and an exported spring load with
 ** their provenance; every malformed case is refused with a message naming its key and value.
 */
 #include "testutil.h"
 
-#include "fitfile.h"
+#include "conifit/fitfile.h"
 
 static char dir[64];
 static char path[128];

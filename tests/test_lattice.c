@@ -1,13 +1,13 @@
 /*
-** Tests of the mass-spring lattice and its solvers (src/lattice.c, src/msm.c): the axial lattice
+** Tests of the mass-spring lattice and its solvers (src/model/lattice.c, src/model/msm.c): the axial lattice
 ** against the single spring, equal and opposite spring forces, static against damped dynamics,
 ** energy of the undamped symplectic integrator, creep, hysteresis against loading rate, and the
 ** refusal of an unstable time step.
 */
 #include "testutil.h"
 
-#include "lattice.h"
-#include "msm.h"
+#include "conifit/lattice.h"
+#include "conifit/msm.h"
 
 /* A soft, strongly stiffening non-telescoping spring (solid strain 0.5, H = 10 mm). */
 static cf_law make_law(void)

@@ -1,5 +1,5 @@
 /*
-** Tests of the conical spring law (src/law.c): hand-computed values, the evaluators against an
+** Tests of the conical spring law (src/model/law.c): hand-computed values, the evaluators against an
 ** independent long-double evaluation over the hard corners of the domain, the invariants of the
 ** law, parameter checks, and the force/curve/info command line.
 */
@@ -8,7 +8,7 @@
 
 #include "testutil.h"
 
-#include "law.h"
+#include "conifit/law.h"
 
 /* Error bounds (relative to |F| unless said otherwise). */
 #define EXACT_TOL 1e-14   /* exact (Brent to the last bits) against the long-double reference */

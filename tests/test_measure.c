@@ -1,5 +1,5 @@
 /*
-** Tests of the measurement-table reader (src/measure.c) and of `conifit synth`: every accepted
+** Tests of the measurement-table reader (src/io/measure.c) and of `conifit synth`: every accepted
 ** variant of the CSV dialect and of unit spelling, every error of the catalogue with its status,
 ** line, column and offending text, the published tables in ../shared/datasets (when present), and
 ** the example tables shipped in data/ (re-synthesised from the command each one documents).
@@ -9,8 +9,8 @@
 
 #include "testutil.h"
 
-#include "law.h"
-#include "measure.h"
+#include "conifit/law.h"
+#include "conifit/measure.h"
 
 /* Relative tolerance for values that went through one unit conversion (a product of doubles). */
 #define CONV_TOL 1e-15

@@ -1,11 +1,11 @@
 /*
-** Tests of scene files (src/scene.c) and of `conifit simulate`: every bad scene is refused with a
+** Tests of scene files (src/io/scene.c) and of `conifit simulate`: every bad scene is refused with a
 ** message naming its key, nothing is written for a bad scene, a good scene runs, and the shipped
 ** relaxation scene is compared with the published muscle relaxation table when it is present.
 */
 #include "testutil.h"
 
-#include "scene.h"
+#include "conifit/scene.h"
 
 #define SPRING "\"spring\": {\"params\": {\"D1_mm\": 6, \"D2_mm\": 15, \"n\": 2.5, \"d_mm\": 2, " \
                "\"G_MPa\": 26, \"H_mm\": 10}}"

@@ -11,9 +11,9 @@
 
 #include "testutil.h"
 
-#include "measure.h"
-#include "msm.h"
-#include "validate.h"
+#include "conifit/measure.h"
+#include "conifit/msm.h"
+#include "conifit/validate.h"
 
 static char out[1 << 16], errb[1 << 14];
 

@@ -10,9 +10,9 @@
 #include <string.h>
 
 #include "bench.h"
-#include "fit.h"
-#include "measure.h"
-#include "validate.h"
+#include "conifit/fit.h"
+#include "conifit/measure.h"
+#include "conifit/validate.h"
 
 static const cf_fit_optimizer optimizers[] = {CF_OPT_SLSQP, CF_OPT_COBYLA, CF_OPT_MMA};
 #define NOPT 3

@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "bench.h"
-#include "lattice.h"
+#include "conifit/lattice.h"
 
 /* The spring behind data/telescoping.csv: solid strain 0.6, region 2 from strain 0.24. */
 static const cf_spring bench_spring = {8, 20, 2.5, 2, 100, 5};

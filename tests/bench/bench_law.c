@@ -6,7 +6,7 @@
 #include <stdlib.h>
 
 #include "bench.h"
-#include "law.h"
+#include "conifit/law.h"
 
 typedef struct variant {
     const char *name;

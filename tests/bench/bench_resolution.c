@@ -8,9 +8,9 @@
 #include <string.h>
 
 #include "bench.h"
-#include "fit.h"
-#include "measure.h"
-#include "msm.h"
+#include "conifit/fit.h"
+#include "conifit/measure.h"
+#include "conifit/msm.h"
 
 #define TABLE "data/telescoping_noise1pct.csv"
 

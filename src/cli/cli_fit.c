@@ -1,0 +1,484 @@
+/*
+** `conifit fit`: fit conical springs (both types by default) to one or more measured tables,
+** print a readable report, and write one JSON fit file (and optionally a plot) per table.
+** Several tables run in parallel with -j N (one thread per table at a time; the fitter keeps no
+** global state).
+*/
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "conifit/baseline.h"
+#include "cli/cli.h"
+#include "conifit/version.h"
+#include "conifit/fit.h"
+#include "conifit/measure.h"
+#include "out/plot.h"
+#include "conifit/report.h"
+#include "conifit/scene.h"
+#include "conifit/validate.h"
+
+static const char fit_help[] =
+    "usage: conifit fit FILE.csv... [-o OUT.json | -o DIR/] [options]\n"
+    "Fits the design parameters D1, D2, n, d [mm], G [MPa], H [mm] of a conical spring to a\n"
+    "measured stress-strain (or force-displacement) table, for each spring type, with linear,\n"
+    "Duffing and Fung baselines beside it. Prints a report; -o writes the JSON fit file.\n\n"
+    "  -o OUT.json | -o DIR/   fit file (one table) or folder (one NAME.json per table)\n"
+    "  --type T                telescoping | non-telescoping | both (default both)\n"
+    "  --fix NAME=VALUE        hold a parameter: D1, D2, d, H in mm, G in MPa, n (repeatable)\n"
+    "  --index-max C           largest spring index D1/d (default 12; the smallest is 3)\n"
+    "  --relative              residuals relative to |stress| instead of absolute\n"
+    "  --optimizer NAME        slsqp (default) | cobyla | mma: the constrained local optimiser\n"
+    "  --seed S                seed of the global search (default 1); same seed, same result\n"
+    "  --starts N              local starts of the global search (default 8)\n"
+    "  --validate [SCENE.json] run each fitted spring in the static uniaxial lattice (the scene's\n"
+    "                          lattice, or 3x3x3 cells with face and body diagonals) at the\n"
+    "                          table's strains and report the lattice's RMSE, R^2, max |error|\n"
+    "                          in the table's stress unit (stress-strain tables only)\n"
+    "  --through-msm [SCENE.json]  fit through the lattice: refine rho, s/H and F_C/H^2 so that\n"
+    "                          the lattice's curve matches the table (implies --validate; slower)\n"
+    "  --plot FILE.png|.svg    draw data, fits, baselines and residuals with gnuplot\n"
+    "                          (with several tables: a folder DIR/, one NAME.png per table)\n"
+    "  --x-col NAME, --y-col NAME   columns to use in wider tables\n"
+    "  --stress-unit U         unit of a stress column without one (Pa, kPa, MPa, ...)\n"
+    "  --force-unit U          unit of a force column without one (N, mN, ...)\n"
+    "  --length-unit U         unit of a displacement column without one (mm, m, ...)\n"
+    "  --stretch               the x column is stretch (strain = stretch - 1)\n"
+    "  -j N                    fit N tables at a time (default 1)\n"
+    "  --quiet                 no report on stdout (errors and warnings still on stderr)\n\n"
+    "Tables: a header row naming the columns, units in the names (stress_kPa, stress [kPa]),\n"
+    "'#' comments, ',' ';' or TAB delimiters, an optional weight column. Tension positive.\n";
+
+typedef struct fit_args {
+    const char **files;
+    int nfiles;
+    const char *out;
+    const char *plot;
+    int types; /* bit 0 telescoping, bit 1 non-telescoping */
+    cf_fit_options fopt;
+    cf_measure_options mopt;
+    long jobs;
+    int quiet;
+    int validate;                /* --validate or --through-msm */
+    int through;                 /* --through-msm */
+    const char *scene;           /* the validation scene, or NULL for the default lattice */
+    cf_validate_setup vsetup;    /* the lattice the fits are validated in */
+} fit_args;
+
+typedef struct fit_job {
+    const fit_args *args;
+    const char *file;
+    cf_measure m;
+    cf_fit_report rep;
+    char json_path[4096];
+    char plot_path[4096];
+    char *text;
+    cf_error err;
+    cf_status st;
+} fit_job;
+
+static int is_dir_target(const char *p)
+{
+    struct stat s;
+    size_t n = strlen(p);
+    return (n > 0 && p[n - 1] == '/') || (stat(p, &s) == 0 && S_ISDIR(s.st_mode));
+}
+
+/* DIR/BASENAME-without-extension.EXT */
+static void path_in_dir(char *dst, size_t cap, const char *dir, const char *file, const char *ext)
+{
+    const char *base = strrchr(file, '/');
+    base = base ? base + 1 : file;
+    size_t n = strlen(base);
+    const char *dot = strrchr(base, '.');
+    if (dot && dot != base)
+        n = (size_t)(dot - base);
+    size_t dl = strlen(dir);
+    snprintf(dst, cap, "%s%s%.*s%s", dir, (dl && dir[dl - 1] == '/') ? "" : "/", (int)n, base,
+             ext);
+}
+
+static int ends_with_json(const char *s)
+{
+    size_t n = strlen(s);
+    return n > 5 && strcmp(s + n - 5, ".json") == 0;
+}
+
+/* `--validate`, `--validate=SCENE.json`, `--validate SCENE.json` (the value is taken only when
+** it ends in .json, so a table may follow the flag); the same for --through-msm. 1 if consumed. */
+static int validate_option(int argc, char **argv, int *i, const char *name, fit_args *a)
+{
+    size_t n = strlen(name);
+    const char *arg = argv[*i];
+    if (strncmp(arg, name, n) != 0 || (arg[n] != '\0' && arg[n] != '='))
+        return 0;
+    a->validate = 1;
+    if (strcmp(name, "--through-msm") == 0)
+        a->through = 1;
+    if (arg[n] == '=')
+        a->scene = arg + n + 1;
+    else if (*i + 1 < argc && argv[*i + 1][0] != '-' && ends_with_json(argv[*i + 1]))
+        a->scene = argv[++*i];
+    return 1;
+}
+
+static int parse_args(int argc, char **argv, fit_args *a)
+{
+    static const char *cmd = "fit";
+    cf_error err = {0};
+    memset(a, 0, sizeof *a);
+    a->types = 3;
+    a->fopt = cf_fit_default_options();
+    a->mopt = cf_measure_default_options();
+    a->jobs = 1;
+    a->vsetup = cf_validate_default();
+    a->files = calloc((size_t)argc, sizeof *a->files);
+    if (!a->files)
+        return CF_EXIT_SOFTWARE;
+    for (int i = 1; i < argc; i++) {
+        const char *v;
+        int m;
+        if (cf_cli_is_help(argv[i])) {
+            fputs(fit_help, stdout);
+            return CF_EXIT_OK;
+        }
+#define OPT(name) ((m = cf_cli_match(argc, argv, &i, name, &v, &err)) != 0)
+#define BAD() return cf_cli_usage_error(cmd, "%s", err.msg)
+        if (OPT("-o")) {
+            if (m < 0)
+                BAD();
+            a->out = v;
+        } else if (validate_option(argc, argv, &i, "--validate", a) ||
+                   validate_option(argc, argv, &i, "--through-msm", a)) {
+            continue;
+        } else if (OPT("--plot")) {
+            if (m < 0)
+                BAD();
+            a->plot = v;
+        } else if (OPT("--type")) {
+            if (m < 0)
+                BAD();
+            if (strcmp(v, "both") == 0)
+                a->types = 3;
+            else if (strcmp(v, "telescoping") == 0)
+                a->types = 1;
+            else if (strcmp(v, "non-telescoping") == 0)
+                a->types = 2;
+            else
+                return cf_cli_usage_error(cmd, "--type '%s': expected telescoping, "
+                                               "non-telescoping or both", v);
+        } else if (OPT("--fix")) {
+            if (m < 0)
+                BAD();
+            char name[32];
+            const char *eq = strchr(v, '=');
+            int k;
+            double val;
+            if (!eq || (size_t)(eq - v) >= sizeof name)
+                return cf_cli_usage_error(cmd, "--fix '%s': expected NAME=VALUE", v);
+            snprintf(name, sizeof name, "%.*s", (int)(eq - v), v);
+            if (cf_fit_param_parse(name, &k, &err) != CF_OK ||
+                cf_cli_parse_double("--fix", eq + 1, &val, &err) != CF_OK)
+                BAD();
+            if (!(val > 0))
+                return cf_cli_usage_error(cmd, "--fix %s=%g: the value must be positive", name,
+                                          val);
+            a->fopt.fixed[k] = 1;
+            a->fopt.fixed_value[k] = val;
+        } else if (OPT("--index-max")) {
+            if (m < 0 || cf_cli_parse_double("--index-max", v, &a->fopt.index_max, &err))
+                BAD();
+            if (a->fopt.index_max < 3)
+                return cf_cli_usage_error(cmd, "--index-max %g: must be at least 3",
+                                          a->fopt.index_max);
+        } else if (strcmp(argv[i], "--relative") == 0) {
+            a->fopt.relative = 1;
+        } else if (OPT("--optimizer")) {
+            if (m < 0 || cf_fit_optimizer_parse(v, &a->fopt.optimizer, &err) != CF_OK)
+                BAD();
+        } else if (OPT("--seed")) {
+            long s;
+            if (m < 0 || cf_cli_parse_long("--seed", v, 0, 2147483647L, &s, &err))
+                BAD();
+            a->fopt.seed = (unsigned long)s;
+        } else if (OPT("--starts")) {
+            long s;
+            if (m < 0 || cf_cli_parse_long("--starts", v, 1, 10000, &s, &err))
+                BAD();
+            a->fopt.multistart = (int)s;
+        } else if (OPT("--x-col")) {
+            if (m < 0)
+                BAD();
+            a->mopt.x_col = v;
+        } else if (OPT("--y-col")) {
+            if (m < 0)
+                BAD();
+            a->mopt.y_col = v;
+        } else if (OPT("--stress-unit")) {
+            if (m < 0)
+                BAD();
+            a->mopt.stress_unit = v;
+        } else if (OPT("--force-unit")) {
+            if (m < 0)
+                BAD();
+            a->mopt.force_unit = v;
+        } else if (OPT("--length-unit")) {
+            if (m < 0)
+                BAD();
+            a->mopt.length_unit = v;
+        } else if (strcmp(argv[i], "--stretch") == 0) {
+            a->mopt.x_is_stretch = 1;
+        } else if (OPT("-j")) {
+            if (m < 0 || cf_cli_parse_long("-j", v, 1, 256, &a->jobs, &err))
+                BAD();
+        } else if (strcmp(argv[i], "--quiet") == 0) {
+            a->quiet = 1;
+        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
+            return cf_cli_usage_error(cmd, "unknown option '%s'", argv[i]);
+        } else {
+            a->files[a->nfiles++] = argv[i];
+        }
+#undef OPT
+#undef BAD
+    }
+    if (a->nfiles == 0)
+        return cf_cli_usage_error(cmd, "no table given");
+    if (a->nfiles > 1 && a->out && !is_dir_target(a->out))
+        return cf_cli_usage_error(cmd, "-o %s: with %d tables, -o must name a folder (DIR/)",
+                                  a->out, a->nfiles);
+    if (a->nfiles > 1 && a->plot && !is_dir_target(a->plot))
+        return cf_cli_usage_error(cmd, "--plot %s: with %d tables, --plot must name a folder",
+                                  a->plot, a->nfiles);
+    return -1;
+}
+
+/* Fits one loaded table and writes its outputs. */
+static void run_job(fit_job *j)
+{
+    const fit_args *a = j->args;
+    cf_measure *m = &j->m;
+    cf_fit_data d = {m->count, m->x, m->y, m->w, m->kind == CF_MEASURE_FORCE_DISPLACEMENT};
+    cf_fit_report *r = &j->rep;
+    memset(r, 0, sizeof *r);
+    r->version = CF_VERSION;
+    r->data_file = j->file;
+    r->x_column = m->x_column;
+    r->x_unit = m->x_unit;
+    r->y_column = m->y_column;
+    r->y_unit = m->y_unit;
+    r->force_displacement = d.force_displacement;
+    r->compression = m->compression;
+    r->points = m->count;
+    r->y_to_file = m->y_to_file;
+    r->with_timing = 1;
+    for (size_t i = 0; i < m->count; i++)
+        r->ymax = fmax(r->ymax, fabs(m->y[i]));
+    for (int t = 0; t < 2; t++) {
+        if (!(a->types & (1 << t)))
+            continue;
+        j->st = cf_fit_run(&d, &a->fopt, (cf_spring_type)t, &r->fits[r->nfits], &j->err);
+        if (j->st != CF_OK) {
+            char msg[CF_ERROR_MSG_LEN];
+            snprintf(msg, sizeof msg, "%s", j->err.msg);
+            cf_error_set(&j->err, j->st, "%s: %s", j->file, msg);
+            return;
+        }
+        r->nfits++;
+    }
+    cf_baseline_fit_all(&d, r->baselines);
+    if (a->validate) {
+        r->validate = 1;
+        r->through_msm = a->through;
+        for (int k = 0; k < r->nfits; k++) {
+            cf_error verr = {0};
+            /* a table the lattice cannot run (force-displacement, past solid) is noted, not fatal */
+            if (cf_validate_run(&r->fits[k].params, &a->vsetup, &d, &r->val[k], &verr) != CF_OK ||
+                !a->through)
+                continue;
+            if (isatty(2))
+                fprintf(stderr, "conifit: %s: fitting the %s spring through the lattice...\n",
+                        j->file, cf_spring_type_name(r->fits[k].type));
+            cf_validate_through_msm(&d, &a->fopt, &a->vsetup, &r->fits[k], &r->val[k],
+                                    &r->thr[k], &verr);
+        }
+    }
+    const char *inputs[257];
+    int ni = 0;
+    for (int i = 0; i < a->nfiles && ni < 256; i++)
+        inputs[ni++] = a->files[i];
+    inputs[ni] = NULL;
+    if (a->out) {
+        if (is_dir_target(a->out))
+            path_in_dir(j->json_path, sizeof j->json_path, a->out, j->file, ".json");
+        else
+            snprintf(j->json_path, sizeof j->json_path, "%s", a->out);
+        j->st = cf_report_json_write(r, j->json_path, inputs, &j->err);
+        if (j->st != CF_OK)
+            return;
+    }
+    if (a->plot) {
+        if (a->nfiles > 1 || is_dir_target(a->plot))
+            path_in_dir(j->plot_path, sizeof j->plot_path, a->plot, j->file, ".png");
+        else
+            snprintf(j->plot_path, sizeof j->plot_path, "%s", a->plot);
+        j->st = cf_plot_write(r, &d, j->plot_path, inputs, &j->err);
+        if (j->st != CF_OK)
+            return;
+    }
+    if (!a->quiet)
+        j->text = cf_report_text(r);
+}
+
+typedef struct pool {
+    fit_job *jobs;
+    int count;
+    int next;
+    pthread_mutex_t lock;
+} pool;
+
+static void *worker(void *arg)
+{
+    pool *p = arg;
+    for (;;) {
+        pthread_mutex_lock(&p->lock);
+        int k = p->next++;
+        pthread_mutex_unlock(&p->lock);
+        if (k >= p->count)
+            return NULL;
+        run_job(&p->jobs[k]);
+    }
+}
+
+int cf_cli_fit(int argc, char **argv)
+{
+    fit_args a;
+    int rc = parse_args(argc, argv, &a);
+    if (rc >= 0) {
+        free(a.files);
+        return rc;
+    }
+    /* a gnuplot that exits early must not kill us through SIGPIPE */
+    signal(SIGPIPE, SIG_IGN);
+    fit_job *jobs = calloc((size_t)a.nfiles, sizeof *jobs);
+    if (!jobs) {
+        free(a.files);
+        fprintf(stderr, "conifit: out of memory\n");
+        return CF_EXIT_SOFTWARE;
+    }
+    /* Read every table first: a bad one stops the run before anything is written. */
+    for (int i = 0; i < a.nfiles && rc < 0; i++) {
+        jobs[i].args = &a;
+        jobs[i].file = a.files[i];
+        cf_error err = {0};
+        if (cf_measure_load(a.files[i], &a.mopt, &jobs[i].m, &err) != CF_OK)
+            rc = cf_cli_fail(&err);
+    }
+    if (rc < 0 && a.scene) {
+        cf_scene sc;
+        cf_error err = {0};
+        cf_status st = cf_scene_load(a.scene, &sc, &err);
+        if (st == CF_OK)
+            st = cf_validate_from_scene(&sc, a.scene, &a.vsetup, &err);
+        cf_scene_free(&sc);
+        if (st != CF_OK)
+            rc = cf_cli_fail(&err);
+    }
+    if (rc < 0) {
+        pool p = {jobs, a.nfiles, 0, PTHREAD_MUTEX_INITIALIZER};
+        int nt = (int)(a.jobs < a.nfiles ? a.jobs : a.nfiles);
+        pthread_t th[256];
+        int started = 0;
+        for (int t = 1; t < nt; t++)
+            if (pthread_create(&th[started], NULL, worker, &p) == 0)
+                started++;
+        worker(&p);
+        for (int t = 0; t < started; t++)
+            pthread_join(th[t], NULL);
+        rc = CF_EXIT_OK;
+        for (int i = 0; i < a.nfiles; i++) {
+            fit_job *j = &jobs[i];
+            if (j->st != CF_OK) {
+                int e = cf_cli_fail(&j->err);
+                if (rc == CF_EXIT_OK)
+                    rc = e;
+                continue;
+            }
+            if (j->text) {
+                fputs(j->text, stdout);
+                if (j->json_path[0])
+                    printf("Fit file: %s\n", j->json_path);
+                if (j->plot_path[0])
+                    printf("Plot: %s\n", j->plot_path);
+                if (a.nfiles > 1)
+                    fputc('\n', stdout);
+            }
+            for (int k = 0; k < j->rep.nfits; k++)
+                if (!j->rep.fits[k].feasible)
+                    fprintf(stderr,
+                            "conifit: warning: %s: the %s fit violates its constraints "
+                            "(see 'feasible'); %s\n",
+                            j->file, cf_spring_type_name(j->rep.fits[k].type),
+                            (j->rep.fits[k].violated & CF_C_TRAVEL)
+                                ? "no spring reaches the largest strain of this table "
+                                  "(a solid strain is below 1)"
+                                : "loosen --fix or --index-max");
+        }
+        if (a.nfiles > 1 && !a.quiet) {
+            int wname = 5;
+            for (int i = 0; i < a.nfiles; i++)
+                if ((int)strlen(jobs[i].file) > wname)
+                    wname = (int)strlen(jobs[i].file);
+            printf("Summary (RMSE in each table's unit):\n");
+            printf("  %-*s %-18s %-18s %-22s %-16s%s\n", wname, "table", "telescoping",
+                   "non-telescoping", "best baseline", "better type",
+                   a.validate ? " lattice RMSE (better type)" : "");
+            for (int i = 0; i < a.nfiles; i++) {
+                fit_job *j = &jobs[i];
+                if (j->st != CF_OK) {
+                    printf("  %-*s failed\n", wname, j->file);
+                    continue;
+                }
+                char cell[2][32] = {"-", "-"};
+                for (int k = 0; k < j->rep.nfits; k++)
+                    snprintf(cell[j->rep.fits[k].type], sizeof cell[0], "%.4g %s%s",
+                             j->rep.fits[k].rmse * j->rep.y_to_file, j->rep.y_unit,
+                             j->rep.fits[k].feasible ? "" : " (!)");
+                int bb = 0;
+                for (int k = 1; k < CF_BASE_COUNT; k++)
+                    if (j->rep.baselines[k].rmse < j->rep.baselines[bb].rmse)
+                        bb = k;
+                char bcell[48];
+                snprintf(bcell, sizeof bcell, "%s %.4g %s", cf_baseline_name((cf_baseline_kind)bb),
+                         j->rep.baselines[bb].rmse * j->rep.y_to_file, j->rep.y_unit);
+                int b = cf_report_better(&j->rep);
+                char vcell[48] = "";
+                if (a.validate && b >= 0 && j->rep.val[b].done)
+                    snprintf(vcell, sizeof vcell, " %.4g %s",
+                             j->rep.val[b].rmse * j->rep.y_to_file, j->rep.y_unit);
+                else if (a.validate)
+                    snprintf(vcell, sizeof vcell, " skipped");
+                printf("  %-*s %-18s %-18s %-22s %-16s%s\n", wname, j->file, cell[0], cell[1],
+                       bcell,
+                       b < 0                          ? "none feasible"
+                       : cf_report_types_tie(&j->rep) ? "equal"
+                                                      : cf_spring_type_name(j->rep.fits[b].type),
+                       vcell);
+            }
+        }
+    }
+    for (int i = 0; i < a.nfiles; i++) {
+        cf_measure_free(&jobs[i].m);
+        free(jobs[i].text);
+        for (int k = 0; k < 2; k++)
+            cf_validation_free(&jobs[i].rep.val[k]);
+    }
+    free(jobs);
+    free(a.files);
+    return rc;
+}

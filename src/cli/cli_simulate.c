@@ -1,0 +1,251 @@
+/*
+** The `simulate` subcommand: runs a scene (scene.h) on the mass-spring lattice, writes the curve
+** as CSV, prints a summary (loop energy, residual strain, creep or relaxation end values) and
+** optionally plots it with gnuplot.
+*/
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "base/atomic.h"
+#include "cli/cli.h"
+#include "conifit/msm.h"
+#include "conifit/scene.h"
+
+static const char simulate_help[] =
+    "usage: conifit simulate SCENE.json -o OUT.csv [--plot OUT.png]\n"
+    "Runs the scene on a mass-spring lattice of conical springs and writes the CSV\n"
+    "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa (compression positive: strain\n"
+    "is the top face's shortening over the height, stress the top reaction over nx ny H^2, in kPa;\n"
+    "spring_stress_kPa is one spring's F(strain H)/H^2 at the same strain, for comparison).\n"
+    "A scene with no inertia, damping or viscosity is solved as static equilibria.\n\n"
+    "  -o, --output FILE   CSV to write (written to a temporary name, then renamed)\n"
+    "  --plot FILE.png     also plot the result with gnuplot\n";
+
+/* Area of the closed loop(s) in the stress-strain plane over samples [a, b], kPa = kJ/m^3. */
+/* Progress on a terminal: one line, rewritten after every sample. */
+static void show_progress(void *ctx, size_t done, size_t total, double t_s)
+{
+    (void)ctx;
+    fprintf(stderr, "\rconifit simulate: sample %zu of %zu (t = %.4g s)", done, total, t_s);
+    fflush(stderr);
+}
+
+static double loop_area(const cf_msm_sample *s, size_t a, size_t b)
+{
+    double A = 0;
+    for (size_t k = a + 1; k <= b; k++)
+        A += 0.5 * (s[k].stress_MPa + s[k - 1].stress_MPa) * (s[k].strain - s[k - 1].strain);
+    return A * 1e3;
+}
+
+static void summary(const cf_scene *sc, const cf_msm_sample *s, size_t n, const cf_msm_stats *st)
+{
+    const int timed = sc->effects.inertia || sc->effects.eta_MPa_s > 0 ||
+                      sc->effects.maxwell_E_MPa > 0;
+    printf("spring: %s; lattice %d x %d x %d cells; solver: %s\n", sc->spring_source,
+           sc->cfg.lattice.nx, sc->cfg.lattice.ny, sc->cfg.lattice.nz,
+           !timed ? "static equilibria"
+           : sc->effects.inertia ? "explicit symplectic Euler" : "implicit quasi-static steps");
+    if (sc->effects.inertia)
+        printf("time step: stable %.6g s, smallest used %.6g s, %zu steps, %zu intervals "
+               "sub-stepped\n",
+               st->dt_stable_s, st->dt_used_min_s, st->steps, st->substepped);
+    else
+        printf("solves: %zu, Newton iterations: %zu, linear solves: %zu\n", st->solves,
+               st->newton_iters, st->linear_iters);
+    printf("largest spring compression: %.4g of travel\n", st->max_u_over_travel);
+    if (sc->kind == CF_PROTO_CYCLES) {
+        size_t per = (n - 1) / (size_t)sc->cycles;
+        for (int c = 0; c < sc->cycles; c++) {
+            size_t a = (size_t)c * per, b = a + per;
+            printf("cycle %d: dissipated energy %.6g kJ/m^3 (= kPa), ", c + 1,
+                   loop_area(s, a, b));
+            if (sc->drive == CF_DRIVE_FORCE) {
+                printf("residual strain after unloading %.6g\n", s[b].strain);
+            } else {
+                /* Strain at which the unloading branch first carries no stress. */
+                double eu = s[b].strain;
+                for (size_t k = a + per / 2; k < b; k++)
+                    if (s[k].stress_MPa > 0 && s[k + 1].stress_MPa <= 0) {
+                        double f = s[k].stress_MPa / (s[k].stress_MPa - s[k + 1].stress_MPa);
+                        eu = s[k].strain + f * (s[k + 1].strain - s[k].strain);
+                        break;
+                    }
+                printf("residual strain after unloading (zero stress) %.6g\n", eu);
+            }
+        }
+    } else if (sc->kind == CF_PROTO_HOLD) {
+        size_t r = (n - 1) / 2; /* end of the ramp (two segments of equal sample counts) */
+        if (sc->drive == CF_DRIVE_FORCE)
+            printf("creep: strain %.6g at t = %.6g s (end of ramp), %.6g at t = %.6g s (end)\n",
+                   s[r].strain, s[r].t_s, s[n - 1].strain, s[n - 1].t_s);
+        else
+            printf("relaxation: stress %.6g kPa at t = %.6g s (end of ramp), %.6g kPa at "
+                   "t = %.6g s (end)\n",
+                   s[r].stress_MPa * 1e3, s[r].t_s, s[n - 1].stress_MPa * 1e3, s[n - 1].t_s);
+    } else {
+        printf("end: strain %.6g, stress %.6g kPa\n", s[n - 1].strain, s[n - 1].stress_MPa * 1e3);
+    }
+}
+
+/* Runs gnuplot on the CSV, writing a temporary PNG beside `png` and renaming it. */
+static cf_status plot(const cf_scene *sc, const char *csv, const char *png, cf_error *err)
+{
+    char tmp[4200];
+    snprintf(tmp, sizeof tmp, "%s.tmpXXXXXX", png);
+    int fd = mkstemp(tmp);
+    if (fd < 0)
+        return cf_error_set(err, CF_E_CANTWRITE, "%s: cannot create a temporary file", png);
+    fchmod(fd, 0644); /* an ordinary file, not mkstemp's private mode */
+    close(fd);
+    FILE *gp = popen("gnuplot", "w");
+    if (!gp) {
+        remove(tmp);
+        return cf_error_set(err, CF_E_CANTWRITE, "cannot run gnuplot for %s", png);
+    }
+    fprintf(gp, "set terminal pngcairo size 800,560 font ',11'\nset output '%s'\n"
+                "set datafile separator ','\nset key top left\nset grid\n", tmp);
+    if (sc->kind == CF_PROTO_HOLD) {
+        fprintf(gp, "set xlabel 'time (s)'\n");
+        if (sc->drive == CF_DRIVE_FORCE)
+            fprintf(gp, "set ylabel 'compressive strain'\nset title 'creep under a held load'\n"
+                        "plot '%s' every ::1 using 1:2 with lines lw 2 title 'lattice'\n", csv);
+        else
+            fprintf(gp, "set ylabel 'compressive stress (kPa)'\n"
+                        "set title 'relaxation under a held strain'\n"
+                        "plot '%s' every ::1 using 1:3 with lines lw 2 title 'lattice'\n", csv);
+    } else {
+        fprintf(gp, "set xlabel 'compressive strain'\nset ylabel 'compressive stress (kPa)'\n");
+        if (sc->kind == CF_PROTO_CYCLES)
+            fprintf(gp, "set title 'load-unload cycles'\n"
+                        "plot '%s' every ::1 using 2:3 with lines lw 2 title 'lattice'\n", csv);
+        else
+            fprintf(gp, "set title 'uniaxial: lattice against one spring'\n"
+                        "plot '%s' every ::1 using 2:3 with lines lw 2 title 'lattice', "
+                        "'' every ::1 using 2:5 with lines lw 2 dt 2 title 'single spring'\n",
+                    csv);
+    }
+    int rc = pclose(gp);
+    if (rc != 0) {
+        remove(tmp);
+        return cf_error_set(err, CF_E_CANTWRITE, "gnuplot failed (status %d) writing %s", rc, png);
+    }
+    if (rename(tmp, png) != 0) {
+        remove(tmp);
+        return cf_error_set(err, CF_E_CANTWRITE, "%s: cannot rename the plot into place", png);
+    }
+    return CF_OK;
+}
+
+int cf_cli_simulate(int argc, char **argv)
+{
+    const char *scene_path = NULL, *out = NULL, *png = NULL;
+    cf_error err = {0};
+    for (int i = 1; i < argc; i++) {
+        const char *val;
+        int m;
+        if (cf_cli_is_help(argv[i])) {
+            fputs(simulate_help, stdout);
+            return CF_EXIT_OK;
+        }
+        if (strcmp(argv[i], "-o") == 0) {
+            if (i + 1 >= argc)
+                return cf_cli_usage_error("simulate", "-o needs a file name");
+            out = argv[++i];
+            continue;
+        }
+        if ((m = cf_cli_match(argc, argv, &i, "--output", &val, &err)) != 0) {
+            if (m < 0)
+                return cf_cli_usage_error("simulate", "%s", err.msg);
+            out = val;
+            continue;
+        }
+        if ((m = cf_cli_match(argc, argv, &i, "--plot", &val, &err)) != 0) {
+            if (m < 0)
+                return cf_cli_usage_error("simulate", "%s", err.msg);
+            png = val;
+            continue;
+        }
+        if (argv[i][0] == '-' && argv[i][1] != '\0')
+            return cf_cli_usage_error("simulate", "unknown option '%s'", argv[i]);
+        if (scene_path)
+            return cf_cli_usage_error("simulate", "more than one scene ('%s' and '%s')",
+                                      scene_path, argv[i]);
+        scene_path = argv[i];
+    }
+    if (!scene_path)
+        return cf_cli_usage_error("simulate", "no scene file given");
+    if (!out)
+        return cf_cli_usage_error("simulate", "no output file given (-o OUT.csv)");
+
+    cf_scene sc;
+    if (cf_scene_load(scene_path, &sc, &err) != CF_OK)
+        return cf_cli_fail(&err);
+    cf_law law;
+    memset(&law, 0, sizeof law);
+    cf_lattice lat;
+    memset(&lat, 0, sizeof lat);
+    cf_msm_sample *samples = NULL;
+    cf_atomic a = {0};
+    int rc = CF_EXIT_OK;
+    if (cf_law_init(&law, &sc.spring, &err) != CF_OK) {
+        rc = cf_cli_fail(&err);
+        goto end;
+    }
+    if ((sc.method == CF_LAW_TABLE && cf_law_table_build(&law, sc.table_intervals, &err)) ||
+        cf_lattice_create(&lat, &law, sc.method, &sc.cfg.lattice, &err) != CF_OK) {
+        rc = cf_cli_fail(&err);
+        goto end;
+    }
+    samples = calloc(sc.nsamples, sizeof *samples);
+    if (!samples) {
+        cf_error_set(&err, CF_E_INTERNAL, "out of memory for %zu samples", sc.nsamples);
+        rc = cf_cli_fail(&err);
+        goto end;
+    }
+    cf_msm_path path = cf_scene_path(&sc);
+    cf_msm_stats st;
+    size_t done = 0;
+    if (isatty(STDERR_FILENO)) {
+        sc.cfg.progress = show_progress;
+        sc.cfg.progress_ctx = NULL;
+    }
+    cf_status run_st = cf_msm_run(&lat, &sc.effects, &sc.cfg, &path, sc.sample_t_s, sc.nsamples,
+                                  samples, &done, &st, &err);
+    if (sc.cfg.progress)
+        fputs("\r\033[K", stderr); /* clear the progress line */
+    if (run_st != CF_OK) {
+        rc = cf_cli_fail(&err);
+        goto end;
+    }
+    const char *inputs[] = {scene_path, NULL};
+    if (cf_atomic_open(&a, out, inputs, &err) != CF_OK) {
+        rc = cf_cli_fail(&err);
+        goto end;
+    }
+    fprintf(a.fp, "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa\n");
+    double H = law.p.H_mm;
+    for (size_t k = 0; k < sc.nsamples; k++) {
+        double f = cf_law_force(&law, sc.method, samples[k].strain * H, NULL, NULL) / (H * H);
+        fprintf(a.fp, "%.17g,%.17g,%.17g,%.17g,%.17g\n", samples[k].t_s, samples[k].strain,
+                samples[k].stress_MPa * 1e3, samples[k].kinetic_mJ, f * 1e3);
+    }
+    if (cf_atomic_commit(&a, &err) != CF_OK) {
+        rc = cf_cli_fail(&err);
+        goto end;
+    }
+    summary(&sc, samples, sc.nsamples, &st);
+    if (png && plot(&sc, out, png, &err) != CF_OK)
+        rc = cf_cli_fail(&err);
+end:
+    cf_atomic_abort(&a);
+    free(samples);
+    cf_lattice_free(&lat);
+    cf_law_free(&law);
+    cf_scene_free(&sc);
+    return rc;
+}

@@ -1,0 +1,1036 @@
+/*
+** The fitter: three identifiable quantities first (global grid + Levenberg-Marquardt, GSL), then
+** one spring of that family placed under the design constraints (NLopt SLSQP with equality
+** constraints), then a constrained local polish on the six design parameters (NLopt). See fit.h.
+*/
+#include "conifit/fit.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <gsl/gsl_blas.h>
+#include <gsl/gsl_linalg.h>
+#include <gsl/gsl_multifit_nlinear.h>
+#include <gsl/gsl_vector.h>
+#include <nlopt.h>
+
+/* Lowest diameter ratio searched: rho = 1e-3 is a spring whose largest coil is a thousand times
+** its smallest, far beyond any wound spring. */
+#define RHO_LO 1e-3
+/* Relative residuals divide by max(|y|, REL_FLOOR max|y|) so that the point at the origin
+** (y = 0) keeps a finite weight. */
+#define REL_FLOOR 1e-3
+/* Constraint tolerances (constraints are in log units, i.e. relative): a constraint counts as
+** violated beyond FEAS_TOL and active within ACTIVE_TOL of its limit. The optimisers see the
+** constraints shifted by SAFETY so that their solutions land on the feasible side. */
+#define FEAS_TOL 1e-9
+#define ACTIVE_TOL 1e-6
+#define SAFETY 1e-10
+/* Grid of the global stage: GRID x GRID cells over (rho, length scale). */
+#define GRID 28
+/* Objective value returned where the model cannot be evaluated (invalid spring). */
+#define HUGE_OBJ 1e30
+
+static const char *const param_names[CF_P_COUNT] = {"D1", "D2", "n", "d", "G", "H"};
+
+const char *cf_fit_param_name(int index)
+{
+    return (index >= 0 && index < CF_P_COUNT) ? param_names[index] : "?";
+}
+
+cf_status cf_fit_param_parse(const char *name, int *index, cf_error *err)
+{
+    static const char *const long_names[CF_P_COUNT] = {"D1_mm", "D2_mm", "n", "d_mm", "G_MPa",
+                                                       "H_mm"};
+    for (int i = 0; i < CF_P_COUNT; i++)
+        if (strcmp(name, param_names[i]) == 0 || strcmp(name, long_names[i]) == 0) {
+            *index = i;
+            return CF_OK;
+        }
+    return cf_error_set(err, CF_E_USAGE, "unknown parameter '%s' (expected D1, D2, n, d, G or H)",
+                        name);
+}
+
+const char *cf_fit_optimizer_name(cf_fit_optimizer o)
+{
+    switch (o) {
+    case CF_OPT_SLSQP: return "slsqp";
+    case CF_OPT_COBYLA: return "cobyla";
+    case CF_OPT_MMA: return "mma";
+    }
+    return "?";
+}
+
+cf_status cf_fit_optimizer_parse(const char *name, cf_fit_optimizer *o, cf_error *err)
+{
+    for (int i = 0; i <= CF_OPT_MMA; i++)
+        if (strcmp(name, cf_fit_optimizer_name((cf_fit_optimizer)i)) == 0) {
+            *o = (cf_fit_optimizer)i;
+            return CF_OK;
+        }
+    return cf_error_set(err, CF_E_USAGE, "unknown optimizer '%s' (expected slsqp, cobyla or mma)",
+                        name);
+}
+
+const char *cf_fit_constraint_name(unsigned bit)
+{
+    switch (bit) {
+    case CF_C_INDEX_MIN: return "index_min";
+    case CF_C_INDEX_MAX: return "index_max";
+    case CF_C_COILS: return "coils_min";
+    case CF_C_DIAMETERS: return "D2_ge_D1";
+    case CF_C_TRAVEL: return "travel";
+    case CF_C_TYPE: return "type";
+    case CF_C_BOUNDS: return "bounds";
+    }
+    return "?";
+}
+
+cf_fit_options cf_fit_default_options(void)
+{
+    cf_fit_options o;
+    memset(&o, 0, sizeof o);
+    /* Bounds wide enough for any tissue table in any unit (micrometre springs to metre springs,
+    ** moduli from foams to steel); the constraints, not the bounds, shape the fit. */
+    const double lo[CF_P_COUNT] = {1e-6, 1e-6, 2, 1e-7, 1e-15, 1e-6};
+    const double hi[CF_P_COUNT] = {1e6, 1e9, 1e7, 1e5, 1e15, 1e6};
+    memcpy(o.lower, lo, sizeof lo);
+    memcpy(o.upper, hi, sizeof hi);
+    o.index_max = CF_FIT_INDEX_MAX_DEFAULT;
+    o.optimizer = CF_OPT_SLSQP;
+    o.xtol_rel = 1e-12;
+    o.seed = 1;
+    o.multistart = 8;
+    o.H_preferred_mm = 10.0;
+    return o;
+}
+
+/* ---- small helpers --------------------------------------------------------------------------- */
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* splitmix64: a tiny deterministic generator, state local to one fit. */
+static double rng_uniform(uint64_t *state)
+{
+    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * 0x1.0p-53;
+}
+
+static double sigmoid(double t) { return 1.0 / (1.0 + exp(-t)); }
+static double logit(double p)
+{
+    p = fmin(fmax(p, 1e-15), 1 - 1e-15);
+    return log(p / (1 - p));
+}
+
+double cf_fit_model(const cf_law *law, int force_displacement, double x)
+{
+    if (force_displacement)
+        return cf_law_force(law, CF_LAW_CLOSED, x, NULL, NULL);
+    const double H = law->p.H_mm;
+    return cf_law_force(law, CF_LAW_CLOSED, x * H, NULL, NULL) / (H * H);
+}
+
+/* Solid length of a spring of the given type (the type being fitted, not the one its geometry
+** has; the type constraint makes the two agree). */
+static double lmin_of(const double *p, cf_spring_type type)
+{
+    return type == CF_TELESCOPING ? p[CF_P_D] : p[CF_P_N] * p[CF_P_D];
+}
+
+static void to_array(const cf_spring *s, double *p)
+{
+    p[CF_P_D1] = s->D1_mm;
+    p[CF_P_D2] = s->D2_mm;
+    p[CF_P_N] = s->n;
+    p[CF_P_D] = s->d_mm;
+    p[CF_P_G] = s->G_MPa;
+    p[CF_P_H] = s->H_mm;
+}
+
+static cf_spring from_array(const double *p)
+{
+    cf_spring s = {p[CF_P_D1], p[CF_P_D2], p[CF_P_N], p[CF_P_D], p[CF_P_G], p[CF_P_H]};
+    return s;
+}
+
+/* Identifiable quantities of a parameter array for a given type. */
+static void ident_of(const double *p, cf_spring_type type, int fd, double out[3])
+{
+    double s = p[CF_P_H] - lmin_of(p, type);
+    double D1 = p[CF_P_D1], d = p[CF_P_D];
+    double FC = p[CF_P_G] * d * d * d * d * s / (8 * p[CF_P_N] * D1 * D1 * D1);
+    out[0] = D1 / p[CF_P_D2];
+    out[1] = fd ? s : s / p[CF_P_H];
+    out[2] = fd ? FC : FC / (p[CF_P_H] * p[CF_P_H]);
+}
+
+void cf_fit_identifiable(const cf_spring *p, int force_displacement, double ident[3])
+{
+    double a[CF_P_COUNT];
+    to_array(p, a);
+    cf_law law;
+    cf_spring_type type = CF_NON_TELESCOPING;
+    if (cf_law_init(&law, p, NULL) == CF_OK)
+        type = law.type;
+    ident_of(a, type, force_displacement, ident);
+}
+
+/* ---- the data as the fit sees it ------------------------------------------------------------- */
+
+typedef struct fit_ctx {
+    const cf_fit_data *data;
+    const cf_fit_options *opt;
+    cf_spring_type type;
+    int fd;
+    size_t n;
+    double *sw;     /* sqrt(w_i)/scale_i: residual i is sw_i (model_i - y_i) */
+    double xmax;    /* largest |x|: strain [-] or displacement [mm] */
+    double ynorm;   /* sum of (sw_i y_i)^2: objective of the zero model */
+    int travel_ok;  /* 0 when no spring can reach xmax (strain >= 1) */
+    /* stage A bounds on (rho, length scale) */
+    double rho_lo, rho_hi, b_lo, b_hi;
+    long evals;
+    /* stage B/C: free parameters */
+    int nfree;
+    int free_idx[CF_P_COUNT];
+    double base[CF_P_COUNT]; /* values of the fixed parameters */
+    /* stage B targets */
+    double target[3];
+    double pref[3]; /* preferred log c, log n, log H */
+} fit_ctx;
+
+/* The canonical spring of diameter ratio rho with travel 1 mm and solid load 1 N:
+** D1 = rho, D2 = 1, n = 2, d = 0.5 (non-telescoping, L_min = 1), H = 2, G = 256 rho^3. */
+static cf_status canon_law(double rho, cf_law *law)
+{
+    cf_spring p = {rho, 1.0, 2.0, 0.5, 256.0 * rho * rho * rho, 2.0};
+    return cf_law_init(law, &p, NULL);
+}
+
+/* Reduced model value at x: A F_canon(x/B); *dB (if not NULL) receives d/dB. */
+static double reduced(const cf_law *canon, double A, double B, double x, double *dB)
+{
+    double k;
+    double t = x / B;
+    double g = cf_law_force(canon, CF_LAW_CLOSED, t, &k, NULL);
+    if (dB)
+        *dB = -A * k * t / B;
+    return A * g;
+}
+
+/* The canonical law g(t) = F/F_C at t = u/s and its derivatives dg/dt and dg/drho, analytic:
+** region 1: g = h(rho) t, h = 4 rho^3/((1 + rho)(1 + rho^2));
+** region 2: g = y^3 with y^4 - 4 c y + 3 = 0, c = (1 - |t|)/rho + |t|, so dy/dc = y/(y^3 - c)
+** and dc/drho = -(1 - |t|)/rho^2; past solid g = +-1 with zero derivatives. */
+static double canon_eval(const cf_law *canon, double t, double *dg_dt, double *dg_drho)
+{
+    int flags = 0;
+    double k;
+    double g = cf_law_force(canon, CF_LAW_CLOSED, t, &k, &flags);
+    const double rho = canon->rho, a = fabs(t), sg = t < 0 ? -1.0 : 1.0;
+    *dg_dt = k;
+    if (flags & CF_LAW_SOLID) {
+        *dg_drho = 0;
+    } else if (flags & CF_LAW_LINEAR) {
+        double h = 4 * rho * rho * rho / ((1 + rho) * (1 + rho * rho));
+        *dg_drho = t * h * (3 / rho - 1 / (1 + rho) - 2 * rho / (1 + rho * rho));
+    } else {
+        double y = cbrt(fabs(g));
+        double c = (1 - a) / rho + a;
+        double den = y * y * y - c;
+        *dg_drho = den < 0 ? sg * 3 * y * y * (y / den) * (-(1 - a) / (rho * rho)) : 0.0;
+    }
+    return g;
+}
+
+/* Weighted objective of the reduced model with the load scale A solved in closed form. */
+static double reduced_profile(fit_ctx *c, double rho, double B, double *A_out)
+{
+    cf_law canon;
+    if (canon_law(rho, &canon) != CF_OK)
+        return HUGE_OBJ;
+    double sgy = 0, sgg = 0, syy = 0;
+    for (size_t i = 0; i < c->n; i++) {
+        double g = c->sw[i] * reduced(&canon, 1.0, B, c->data->x[i], NULL);
+        double y = c->sw[i] * c->data->y[i];
+        sgy += g * y;
+        sgg += g * g;
+        syy += y * y;
+    }
+    c->evals++;
+    double A = sgg > 0 ? sgy / sgg : 0;
+    if (!(A > 0) || !isfinite(A)) {
+        *A_out = 1e-300;
+        return syy;
+    }
+    *A_out = A;
+    return fmax(syy - A * sgy, 0.0);
+}
+
+/* ---- stage A: Levenberg-Marquardt on the three identifiable quantities ----------------------- */
+
+static void unpack3(const fit_ctx *c, const gsl_vector *th, double *rho, double *B, double *A)
+{
+    *rho = c->rho_lo + (c->rho_hi - c->rho_lo) * sigmoid(gsl_vector_get(th, 0));
+    *B = c->b_lo + (c->b_hi - c->b_lo) * sigmoid(gsl_vector_get(th, 1));
+    *A = exp(gsl_vector_get(th, 2));
+}
+
+static int lm_f(const gsl_vector *th, void *params, gsl_vector *f)
+{
+    fit_ctx *c = params;
+    double rho, B, A;
+    unpack3(c, th, &rho, &B, &A);
+    cf_law canon;
+    if (!isfinite(A) || canon_law(rho, &canon) != CF_OK)
+        return GSL_EDOM;
+    /* residuals scaled so that the zero model has |f| = 1: GSL's gradient test is absolute
+    ** below |f| = 1, which would stop early on tables in MPa of tissue (tiny numbers) */
+    const double sc = 1.0 / sqrt(c->ynorm);
+    for (size_t i = 0; i < c->n; i++)
+        gsl_vector_set(f, i, sc * c->sw[i] *
+                                 (reduced(&canon, A, B, c->data->x[i], NULL) - c->data->y[i]));
+    c->evals++;
+    return GSL_SUCCESS;
+}
+
+/* Analytic Jacobian of lm_f in the transformed variables. */
+static int lm_df(const gsl_vector *th, void *params, gsl_matrix *J)
+{
+    fit_ctx *c = params;
+    double rho, B, A;
+    unpack3(c, th, &rho, &B, &A);
+    cf_law canon;
+    if (!isfinite(A) || canon_law(rho, &canon) != CF_OK)
+        return GSL_EDOM;
+    const double s0 = sigmoid(gsl_vector_get(th, 0)), s1 = sigmoid(gsl_vector_get(th, 1));
+    const double drho = (c->rho_hi - c->rho_lo) * s0 * (1 - s0);
+    const double dB = (c->b_hi - c->b_lo) * s1 * (1 - s1);
+    const double sc = 1.0 / sqrt(c->ynorm);
+    for (size_t i = 0; i < c->n; i++) {
+        double t = c->data->x[i] / B, gt, gr;
+        double g = canon_eval(&canon, t, &gt, &gr);
+        double w = sc * c->sw[i];
+        gsl_matrix_set(J, i, 0, w * A * gr * drho);
+        gsl_matrix_set(J, i, 1, w * (-A * gt * t / B) * dB);
+        gsl_matrix_set(J, i, 2, w * A * g);
+    }
+    c->evals++;
+    return GSL_SUCCESS;
+}
+
+/* Levenberg-Marquardt limits: iterations, and the stagnation rule (see lm_run). */
+#define LM_MAX_ITER 300
+#define LM_STALL 8
+#define LM_STALL_REL 1e-9
+/* ... and once the residual is at rounding level (relative residual norm 1e-13): on a noiseless
+** table the sum of squares then only jitters, and no step can improve the fit. */
+#define LM_FLOOR_REL 1e-26
+
+static double lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3])
+{
+    const size_t p = 3;
+    gsl_multifit_nlinear_parameters fp = gsl_multifit_nlinear_default_parameters();
+    fp.trs = gsl_multifit_nlinear_trs_lm;
+    fp.scale = gsl_multifit_nlinear_scale_more;
+    fp.fdtype = GSL_MULTIFIT_NLINEAR_CTRDIFF;
+    gsl_multifit_nlinear_workspace *w =
+        gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &fp, c->n, p);
+    if (!w)
+        return HUGE_OBJ;
+    gsl_multifit_nlinear_fdf fdf;
+    memset(&fdf, 0, sizeof fdf);
+    fdf.f = lm_f;
+    fdf.df = lm_df;
+    fdf.n = c->n;
+    fdf.p = p;
+    fdf.params = c;
+    double th0[3] = {logit((rho0 - c->rho_lo) / (c->rho_hi - c->rho_lo)),
+                     logit((B0 - c->b_lo) / (c->b_hi - c->b_lo)), log(A0)};
+    gsl_vector_view x0 = gsl_vector_view_array(th0, 3);
+    double best = HUGE_OBJ;
+    if (gsl_multifit_nlinear_init(&x0.vector, &fdf, w) == GSL_SUCCESS) {
+        /* The driver loop, with one more stopping rule: an optimum on a bound of rho or of the
+        ** length scale lies at infinity in the logit coordinates, where the step test never
+        ** fires; stop once the sum of squares has stopped falling (LM_STALL iterations in a row
+        ** that lower it by less than LM_STALL_REL of itself) or reached rounding level. */
+        gsl_vector *f = gsl_multifit_nlinear_residual(w);
+        double prev;
+        gsl_blas_ddot(f, f, &prev);
+        int stall = 0;
+        for (int it = 0; it < LM_MAX_ITER; it++) {
+            int info;
+            if (gsl_multifit_nlinear_iterate(w) != GSL_SUCCESS)
+                break;
+            if (gsl_multifit_nlinear_test(1e-15, 1e-15, 1e-15, &info, w) == GSL_SUCCESS)
+                break;
+            double cur;
+            gsl_blas_ddot(f, f, &cur);
+            stall = (prev - cur <= LM_STALL_REL * prev) ? stall + 1 : 0;
+            prev = cur;
+            if (stall >= LM_STALL || cur <= LM_FLOOR_REL) /* residuals are scaled by 1/sqrt(ynorm) */
+                break;
+        }
+        double chi2;
+        gsl_blas_ddot(f, f, &chi2);
+        if (isfinite(chi2)) {
+            unpack3(c, gsl_multifit_nlinear_position(w), &out[0], &out[1], &out[2]);
+            best = chi2;
+        }
+    }
+    gsl_multifit_nlinear_free(w);
+    return best;
+}
+
+/* The paper's two-point start: the maximum point gives the solid strain and the load scale,
+** the transition point (last point on the initial line within 5 %) gives rho = (F_T/F_C)^(1/3). */
+static void two_point_start(const fit_ctx *c, double *rho, double *B, double *A)
+{
+    const double *x = c->data->x, *y = c->data->y;
+    size_t imax = 0;
+    for (size_t i = 0; i < c->n; i++)
+        if (fabs(x[i]) > fabs(x[imax]))
+            imax = i;
+    /* initial slope from the points in the first tenth of the range */
+    double sxy = 0, sxx = 0;
+    for (size_t i = 0; i < c->n; i++)
+        if (fabs(x[i]) <= 0.1 * c->xmax) {
+            sxy += x[i] * y[i];
+            sxx += x[i] * x[i];
+        }
+    double k = sxx > 0 ? sxy / sxx : y[imax] / x[imax];
+    double yT = 0;
+    for (size_t i = 0; i < c->n; i++)
+        if (fabs(y[i] - k * x[i]) <= 0.05 * fabs(y[i]) && fabs(y[i]) > yT)
+            yT = fabs(y[i]);
+    double ymax = fabs(y[imax]);
+    double r = (yT > 0 && ymax > 0) ? cbrt(fmin(yT / ymax, 1.0)) : 0.5;
+    *rho = fmin(fmax(r, c->rho_lo + 1e-9 * (c->rho_hi - c->rho_lo)), c->rho_hi);
+    *B = fmin(fmax(c->travel_ok ? c->xmax * (1 + 2 * CF_FIT_TRAVEL_MARGIN) : 0.5 * c->b_hi,
+                   c->b_lo + 1e-6 * (c->b_hi - c->b_lo)),
+              c->b_hi - 1e-6 * (c->b_hi - c->b_lo));
+    *A = ymax > 0 ? ymax : 1.0;
+}
+
+typedef struct start {
+    double obj, rho, B;
+} start;
+
+static int cmp_start(const void *a, const void *b)
+{
+    double x = ((const start *)a)->obj, y = ((const start *)b)->obj;
+    return (x > y) - (x < y);
+}
+
+/* Global stage over (rho, B) with A in closed form, then LM from the best starts. */
+static double stage_a(fit_ctx *c, double best3[3])
+{
+    uint64_t rng = (uint64_t)c->opt->seed * 0x2545F4914F6CDD1Dull + 1;
+    start grid[GRID * GRID];
+    size_t k = 0;
+    for (int i = 0; i < GRID; i++) {
+        /* rho: half the grid log-spaced from RHO_LO, half approaching rho_hi geometrically
+        ** (resolves nearly cylindrical springs) */
+        double ti = (i + rng_uniform(&rng)) / GRID;
+        double rho = (i % 2 == 0)
+                         ? c->rho_lo * pow(c->rho_hi / c->rho_lo, ti)
+                         : c->rho_hi - (c->rho_hi - c->rho_lo) * pow(1e-7, ti);
+        for (int j = 0; j < GRID; j++) {
+            double tj = (j + rng_uniform(&rng)) / GRID;
+            double B = (j % 2 == 0) ? c->b_lo + (c->b_hi - c->b_lo) * tj * tj
+                                    : c->b_lo + (c->b_hi - c->b_lo) * pow(1e-7, 1 - tj);
+            double A;
+            grid[k].obj = reduced_profile(c, rho, B, &A);
+            grid[k].rho = rho;
+            grid[k].B = B;
+            k++;
+        }
+    }
+    qsort(grid, k, sizeof grid[0], cmp_start);
+    double best = HUGE_OBJ;
+    double r, B, A, out[3];
+    two_point_start(c, &r, &B, &A);
+    reduced_profile(c, r, B, &A);
+    best = lm_run(c, r, B, A, best3);
+    int used = 0;
+    for (size_t i = 0; i < k && used < c->opt->multistart; i++) {
+        /* skip starts that lie next to one already used */
+        int near = 0;
+        for (size_t j = 0; j < i && !near; j++)
+            near = fabs(grid[j].rho - grid[i].rho) < 0.02 && fabs(grid[j].B - grid[i].B) <
+                                                                  0.02 * (c->b_hi - c->b_lo);
+        if (near && i > 0)
+            continue;
+        used++;
+        reduced_profile(c, grid[i].rho, grid[i].B, &A);
+        double v = lm_run(c, grid[i].rho, grid[i].B, A, out);
+        if (v < best) {
+            best = v;
+            memcpy(best3, out, sizeof out);
+        }
+    }
+    return best;
+}
+
+/* Standard errors of (rho, B, A) at a solution: s^2 (J^T J)^-1 with the analytic Jacobian of the
+** weighted residuals (canon_eval). */
+static void stage_a_errors(fit_ctx *c, const double v[3], double se[3])
+{
+    se[0] = se[1] = se[2] = -1;
+    const double rho = v[0], B = v[1], A = v[2];
+    cf_law lc;
+    if (canon_law(rho, &lc) != CF_OK || c->n <= 3)
+        return;
+    gsl_matrix *JtJ = gsl_matrix_calloc(3, 3);
+    if (!JtJ)
+        return;
+    double rss = 0;
+    for (size_t i = 0; i < c->n; i++) {
+        double x = c->data->x[i], gt, gr;
+        double g = canon_eval(&lc, x / B, &gt, &gr);
+        double m = A * g;
+        double row[3] = {A * gr, -A * gt * x / (B * B), g};
+        double r = c->sw[i] * (m - c->data->y[i]);
+        rss += r * r;
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++)
+                *gsl_matrix_ptr(JtJ, a, b) += c->sw[i] * c->sw[i] * row[a] * row[b];
+    }
+    c->evals += 3;
+    /* scale to unit diagonal before inverting (the columns differ by orders of magnitude) */
+    double dsc[3];
+    int ok = 1;
+    for (int a = 0; a < 3; a++) {
+        dsc[a] = sqrt(gsl_matrix_get(JtJ, a, a));
+        ok = ok && dsc[a] > 0 && isfinite(dsc[a]);
+    }
+    if (ok) {
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++)
+                *gsl_matrix_ptr(JtJ, a, b) /= dsc[a] * dsc[b];
+        if (gsl_linalg_cholesky_decomp1(JtJ) == GSL_SUCCESS &&
+            gsl_linalg_cholesky_invert(JtJ) == GSL_SUCCESS) {
+            double s2 = rss / (double)(c->n - 3);
+            for (int a = 0; a < 3; a++) {
+                double var = s2 * gsl_matrix_get(JtJ, a, a) / (dsc[a] * dsc[a]);
+                se[a] = (var >= 0 && isfinite(var)) ? sqrt(var) : -1;
+            }
+        }
+    }
+    gsl_matrix_free(JtJ);
+}
+
+/* ---- constraints (shared by stages B, C and the check) --------------------------------------- */
+
+/* Constraint values g_k <= 0 when satisfied, in log (relative) units, for the bits in order
+** index_min, index_max, coils, diameters, travel, type. */
+static void constraint_values(const double *p, cf_spring_type type, double xmax, int fd,
+                              double index_max, double g[6])
+{
+    double c = p[CF_P_D1] / p[CF_P_D];
+    g[0] = log(3.0) - log(c);
+    g[1] = log(c) - log(index_max);
+    g[2] = log(2.0) - log(p[CF_P_N]);
+    g[3] = log(p[CF_P_D1]) - log(p[CF_P_D2]);
+    double s = p[CF_P_H] - lmin_of(p, type);
+    double umax = (fd ? xmax : xmax * p[CF_P_H]) * (1 + CF_FIT_TRAVEL_MARGIN);
+    g[4] = s > 0 ? log(umax) - log(s) : 50.0;
+    double step = (p[CF_P_D2] - p[CF_P_D1]) / 2, nd = p[CF_P_N] * p[CF_P_D];
+    g[5] = type == CF_TELESCOPING ? (nd - step) / p[CF_P_D2] : (step - nd) / p[CF_P_D2] + 1e-12;
+    for (int k = 0; k < 6; k++)
+        if (!isfinite(g[k]))
+            g[k] = 50.0;
+}
+
+static double data_xmax(const cf_fit_data *d)
+{
+    double m = 0;
+    for (size_t i = 0; i < d->count; i++)
+        m = fmax(m, fabs(d->x[i]));
+    return m;
+}
+
+int cf_fit_check(const cf_spring *sp, cf_spring_type type, const cf_fit_data *data,
+                 const cf_fit_options *opt, unsigned *active, unsigned *violated)
+{
+    double p[CF_P_COUNT], g[6];
+    to_array(sp, p);
+    unsigned act = 0, vio = 0;
+    constraint_values(p, type, data_xmax(data), data->force_displacement, opt->index_max, g);
+    for (int k = 0; k < 6; k++) {
+        if (g[k] > FEAS_TOL)
+            vio |= 1u << k;
+        if (g[k] > -ACTIVE_TOL)
+            act |= 1u << k;
+    }
+    /* the geometry must be of the type fitted, judged by the law itself */
+    cf_law law;
+    if (cf_law_init(&law, sp, NULL) != CF_OK || law.type != type)
+        vio |= CF_C_TYPE;
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        if (opt->fixed[k]) {
+            if (fabs(p[k] - opt->fixed_value[k]) > 1e-12 * fabs(opt->fixed_value[k]))
+                vio |= CF_C_BOUNDS;
+            continue;
+        }
+        if (p[k] < opt->lower[k] * (1 - 1e-12) || p[k] > opt->upper[k] * (1 + 1e-12))
+            vio |= CF_C_BOUNDS;
+        if (p[k] <= opt->lower[k] * (1 + ACTIVE_TOL) || p[k] >= opt->upper[k] * (1 - ACTIVE_TOL))
+            act |= CF_C_BOUNDS;
+    }
+    if (active)
+        *active = act;
+    if (violated)
+        *violated = vio;
+    return vio == 0;
+}
+
+/* ---- stages B and C: NLopt over the free design parameters (log variables) ------------------- */
+
+static void full_params(const fit_ctx *c, const double *z, double *p)
+{
+    memcpy(p, c->base, sizeof c->base);
+    for (int k = 0; k < c->nfree; k++)
+        p[c->free_idx[k]] = exp(z[k]);
+}
+
+/* Weighted objective of the six-parameter model, normalised by that of the zero model. */
+static double objective6(fit_ctx *c, const double *p)
+{
+    cf_spring s = from_array(p);
+    cf_law law;
+    if (cf_law_init(&law, &s, NULL) != CF_OK)
+        return HUGE_OBJ;
+    double sum = 0;
+    for (size_t i = 0; i < c->n; i++) {
+        double r = c->sw[i] * (cf_fit_model(&law, c->fd, c->data->x[i]) - c->data->y[i]);
+        sum += r * r;
+    }
+    c->evals++;
+    return isfinite(sum) ? sum / c->ynorm : HUGE_OBJ;
+}
+
+/* Central-difference gradient of a scalar function of z. */
+typedef double (*zfun)(fit_ctx *c, const double *z, int which);
+
+static void fd_grad(fit_ctx *c, zfun f, int which, const double *z, double *grad)
+{
+    double zz[CF_P_COUNT];
+    memcpy(zz, z, sizeof(double) * (size_t)c->nfree);
+    for (int k = 0; k < c->nfree; k++) {
+        double h = 1e-6 * fmax(1.0, fabs(z[k]));
+        zz[k] = z[k] + h;
+        double fp = f(c, zz, which);
+        zz[k] = z[k] - h;
+        double fm = f(c, zz, which);
+        zz[k] = z[k];
+        grad[k] = (fp - fm) / (2 * h);
+    }
+}
+
+static double z_objective(fit_ctx *c, const double *z, int which)
+{
+    (void)which;
+    double p[CF_P_COUNT];
+    full_params(c, z, p);
+    return objective6(c, p);
+}
+
+static double z_constraint(fit_ctx *c, const double *z, int which)
+{
+    double p[CF_P_COUNT], g[6];
+    full_params(c, z, p);
+    constraint_values(p, c->type, c->xmax, c->fd, c->opt->index_max, g);
+    return g[which] + SAFETY;
+}
+
+/* log(ident(p)) - log(target): the equality constraints of placement */
+static double z_equality(fit_ctx *c, const double *z, int which)
+{
+    double p[CF_P_COUNT], id[3];
+    full_params(c, z, p);
+    ident_of(p, c->type, c->fd, id);
+    double v = id[which] > 0 ? log(id[which]) - log(c->target[which]) : 50.0;
+    return isfinite(v) ? v : 50.0;
+}
+
+/* Preference of placement: a practical spring index, a handful of coils, the preferred H. */
+static double z_preference(fit_ctx *c, const double *z, int which)
+{
+    (void)which;
+    double p[CF_P_COUNT];
+    full_params(c, z, p);
+    double a = log(p[CF_P_D1] / p[CF_P_D]) - c->pref[0];
+    double b = log(p[CF_P_N]) - c->pref[1];
+    double h = log(p[CF_P_H]) - c->pref[2];
+    return a * a + b * b + h * h;
+}
+
+typedef struct nl_thunk {
+    fit_ctx *c;
+    zfun f;
+    int which;
+} nl_thunk;
+
+static double nl_func(unsigned n, const double *z, double *grad, void *data)
+{
+    (void)n;
+    nl_thunk *t = data;
+    if (grad)
+        fd_grad(t->c, t->f, t->which, z, grad);
+    return t->f(t->c, z, t->which);
+}
+
+static nlopt_algorithm algorithm_of(cf_fit_optimizer o)
+{
+    switch (o) {
+    case CF_OPT_COBYLA: return NLOPT_LN_COBYLA;
+    case CF_OPT_MMA: return NLOPT_LD_MMA;
+    case CF_OPT_SLSQP: break;
+    }
+    return NLOPT_LD_SLSQP;
+}
+
+/* Runs NLopt with the free variables z (in/out); objective `obj`, the six inequality constraints
+** (the travel one left out when it cannot be met), optionally the three placement equalities. */
+static void nl_run(fit_ctx *c, nlopt_algorithm alg, zfun obj, int equalities, double *z,
+                   int maxeval)
+{
+    unsigned nf = (unsigned)c->nfree;
+    if (nf == 0)
+        return;
+    nlopt_opt o = nlopt_create(alg, nf);
+    if (!o)
+        return;
+    double lb[CF_P_COUNT], ub[CF_P_COUNT];
+    for (int k = 0; k < c->nfree; k++) {
+        lb[k] = log(c->opt->lower[c->free_idx[k]]);
+        ub[k] = log(c->opt->upper[c->free_idx[k]]);
+        z[k] = fmin(fmax(z[k], lb[k]), ub[k]);
+    }
+    nlopt_set_lower_bounds(o, lb);
+    nlopt_set_upper_bounds(o, ub);
+    nl_thunk to = {c, obj, 0}, tc[6], te[3];
+    nlopt_set_min_objective(o, nl_func, &to);
+    for (int k = 0; k < 6; k++) {
+        tc[k] = (nl_thunk){c, z_constraint, k};
+        if (k == 4 && !c->travel_ok)
+            continue;
+        nlopt_add_inequality_constraint(o, nl_func, &tc[k], 0.0);
+    }
+    if (equalities)
+        for (int k = 0; k < 3; k++) {
+            te[k] = (nl_thunk){c, z_equality, k};
+            nlopt_add_equality_constraint(o, nl_func, &te[k], 1e-12);
+        }
+    nlopt_set_xtol_rel(o, c->opt->xtol_rel);
+    nlopt_set_ftol_abs(o, 1e-16);
+    if (obj == z_objective) /* a fit at rounding level cannot be polished further */
+        nlopt_set_stopval(o, LM_FLOOR_REL);
+    nlopt_set_maxeval(o, maxeval);
+    double f;
+    double zs[CF_P_COUNT];
+    memcpy(zs, z, sizeof(double) * nf);
+    nlopt_result r = nlopt_optimize(o, z, &f);
+    int bad = r < 0 && r != NLOPT_ROUNDOFF_LIMITED;
+    for (int k = 0; k < c->nfree; k++)
+        bad = bad || !isfinite(z[k]);
+    if (bad)
+        memcpy(z, zs, sizeof(double) * nf); /* keep the start rather than a broken point */
+    nlopt_destroy(o);
+}
+
+/* An analytic member of the family: preferred index (moved into the type's feasible range),
+** a few coils, the preferred free length, G from the load scale. Fixed values override. */
+static void analytic_member(const fit_ctx *c, const double v[3], double *p)
+{
+    const double rho = v[0], cmax = c->opt->index_max;
+    double cidx = exp(c->pref[0]), n = exp(c->pref[1]);
+    double lim = (1 - rho) / (2 * rho); /* telescoping <=> n <= c lim */
+    if (c->type == CF_TELESCOPING) {
+        if (cidx * lim < 2)
+            cidx = fmin(cmax, 2.0 / fmax(lim, 1e-300) * (1 + 1e-6));
+        n = fmax(2.0, fmin(n, cidx * lim * (1 - 1e-6)));
+    } else if (n <= cidx * lim) {
+        n = cidx * lim * 1.05 + 1e-3;
+    }
+    double H, s;
+    if (c->fd) {
+        s = v[1];
+        H = fmax(c->opt->H_preferred_mm, 2 * s);
+    } else {
+        H = c->opt->H_preferred_mm;
+        s = v[1] * H;
+    }
+    double Lmin = H - s;
+    double d = c->type == CF_TELESCOPING ? Lmin : Lmin / n;
+    double D1 = cidx * d, D2 = D1 / rho;
+    double FC = c->fd ? v[2] : v[2] * H * H;
+    double G = 8 * n * D1 * D1 * D1 * FC / (d * d * d * d * s);
+    const double q[CF_P_COUNT] = {D1, D2, n, d, G, H};
+    for (int k = 0; k < CF_P_COUNT; k++)
+        p[k] = c->opt->fixed[k] ? c->opt->fixed_value[k] : q[k];
+}
+
+/* SLSQP meets the equality constraints to its tolerance only; where D2, H and G are free they
+** are set from the identifiable quantities in closed form so that the spring reproduces them to
+** rounding. Kept only when the constraints still hold. */
+static void snap_to_family(fit_ctx *c, double *p, double *z)
+{
+    double q[CF_P_COUNT];
+    memcpy(q, p, sizeof q);
+    const double *v = c->target;
+    const int *fx = c->opt->fixed;
+    if (!fx[CF_P_D2])
+        q[CF_P_D2] = q[CF_P_D1] / v[0];
+    double Lmin = lmin_of(q, c->type);
+    if (!fx[CF_P_H])
+        q[CF_P_H] = c->fd ? Lmin + v[1] : Lmin / (1 - v[1]);
+    double s = q[CF_P_H] - Lmin;
+    if (!fx[CF_P_G] && s > 0) {
+        double FC = c->fd ? v[2] : v[2] * q[CF_P_H] * q[CF_P_H];
+        double D1 = q[CF_P_D1], d = q[CF_P_D];
+        q[CF_P_G] = 8 * q[CF_P_N] * D1 * D1 * D1 * FC / (d * d * d * d * s);
+    }
+    cf_spring sp = from_array(q);
+    if (!cf_fit_check(&sp, c->type, c->data, c->opt, NULL, NULL))
+        return;
+    memcpy(p, q, sizeof q);
+    for (int k = 0; k < c->nfree; k++)
+        z[k] = log(p[c->free_idx[k]]);
+}
+
+/* ---- the driver ------------------------------------------------------------------------------ */
+
+static cf_status check_data(const cf_fit_data *d, cf_error *err)
+{
+    if (d->count < 4)
+        return cf_error_set(err, CF_E_DATA, "%zu data points: a fit needs at least 4", d->count);
+    double ymax = 0, xmax = 0;
+    for (size_t i = 0; i < d->count; i++) {
+        if (!isfinite(d->x[i]) || !isfinite(d->y[i]))
+            return cf_error_set(err, CF_E_DATA, "data point %zu is not finite (%g, %g)", i + 1,
+                                d->x[i], d->y[i]);
+        if (d->w && !(d->w[i] > 0 && isfinite(d->w[i])))
+            return cf_error_set(err, CF_E_DATA, "weight of data point %zu is %g (must be > 0)",
+                                i + 1, d->w[i]);
+        ymax = fmax(ymax, fabs(d->y[i]));
+        xmax = fmax(xmax, fabs(d->x[i]));
+    }
+    if (!(ymax > 0) || !(xmax > 0))
+        return cf_error_set(err, CF_E_DATA, "every %s value is zero: nothing to fit",
+                            !(ymax > 0) ? "y" : "x");
+    return CF_OK;
+}
+
+static cf_status check_options(const cf_fit_options *o, cf_error *err)
+{
+    if (!(o->index_max >= 3) || !isfinite(o->index_max))
+        return cf_error_set(err, CF_E_USAGE, "index-max = %g: must be at least 3", o->index_max);
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        if (!(o->lower[k] > 0 && o->lower[k] <= o->upper[k] && isfinite(o->upper[k])))
+            return cf_error_set(err, CF_E_USAGE, "bounds of %s: %g .. %g are not 0 < lo <= hi",
+                                param_names[k], o->lower[k], o->upper[k]);
+        if (o->fixed[k] && !(o->fixed_value[k] > 0 && isfinite(o->fixed_value[k])))
+            return cf_error_set(err, CF_E_USAGE, "fixed %s = %g must be a positive number",
+                                param_names[k], o->fixed_value[k]);
+    }
+    if (o->fixed[CF_P_N] && o->fixed_value[CF_P_N] < 2)
+        return cf_error_set(err, CF_E_USAGE, "fixed n = %g: a conical spring needs n >= 2",
+                            o->fixed_value[CF_P_N]);
+    if (o->multistart < 1)
+        return cf_error_set(err, CF_E_USAGE, "multistart = %d must be >= 1", o->multistart);
+    return CF_OK;
+}
+
+static void summarise(fit_ctx *c, const double *p, cf_fit_result *res)
+{
+    res->params = from_array(p);
+    cf_law_init(&res->law, &res->params, NULL);
+    ident_of(p, c->type, c->fd, res->ident);
+    double rss = 0, mx = 0, ym = 0, syy = 0;
+    for (size_t i = 0; i < c->n; i++)
+        ym += c->data->y[i];
+    ym /= (double)c->n;
+    for (size_t i = 0; i < c->n; i++) {
+        double r = cf_fit_model(&res->law, c->fd, c->data->x[i]) - c->data->y[i];
+        rss += r * r;
+        mx = fmax(mx, fabs(r));
+        syy += (c->data->y[i] - ym) * (c->data->y[i] - ym);
+    }
+    res->rss = rss;
+    res->rmse = sqrt(rss / (double)c->n);
+    res->max_abs_error = mx;
+    res->r2 = syy > 0 ? 1 - rss / syy : 0;
+    res->objective = objective6(c, p) * c->ynorm;
+    res->feasible = cf_fit_check(&res->params, c->type, c->data, c->opt, &res->active,
+                                 &res->violated);
+}
+
+/* Checks data and options and prepares the context shared by every stage (c->sw is malloc'd). */
+static cf_status ctx_setup(fit_ctx *c, const cf_fit_data *data, const cf_fit_options *opt,
+                           cf_spring_type type, cf_error *err)
+{
+    memset(c, 0, sizeof *c);
+    cf_status st = check_data(data, err);
+    if (st != CF_OK || (st = check_options(opt, err)) != CF_OK)
+        return st;
+    c->data = data;
+    c->opt = opt;
+    c->type = type;
+    c->fd = data->force_displacement;
+    c->n = data->count;
+    c->sw = malloc(sizeof(double) * c->n);
+    if (!c->sw)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", c->n);
+    double ymax = 0;
+    for (size_t i = 0; i < c->n; i++)
+        ymax = fmax(ymax, fabs(data->y[i]));
+    for (size_t i = 0; i < c->n; i++) {
+        double sc = opt->relative ? fmax(fabs(data->y[i]), REL_FLOOR * ymax) : 1.0;
+        c->sw[i] = sqrt(data->w ? data->w[i] : 1.0) / sc;
+        c->ynorm += (c->sw[i] * data->y[i]) * (c->sw[i] * data->y[i]);
+    }
+    c->xmax = data_xmax(data);
+    /* Stage A bounds. Telescoping needs n <= c (1 - rho)/(2 rho) with n >= 2 and c <= index_max,
+    ** so rho <= index_max/(index_max + 4). */
+    c->rho_lo = RHO_LO;
+    c->rho_hi = type == CF_TELESCOPING ? opt->index_max / (opt->index_max + 4) * (1 - 1e-6) : 1.0;
+    double need = c->xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
+    if (c->fd) {
+        c->travel_ok = 1;
+        c->b_lo = need;
+        c->b_hi = 1e3 * need;
+    } else {
+        c->travel_ok = need < 1 - 1e-9;
+        c->b_lo = c->travel_ok ? need : 1e-6;
+        c->b_hi = 1 - 1e-9;
+    }
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        if (opt->fixed[k])
+            c->base[k] = opt->fixed_value[k];
+        else
+            c->free_idx[c->nfree++] = k;
+    }
+    c->pref[0] = log(sqrt(3.0 * opt->index_max));
+    c->pref[1] = log(4.0);
+    c->pref[2] = log(opt->fixed[CF_P_H] ? opt->fixed_value[CF_P_H] : opt->H_preferred_mm);
+    return CF_OK;
+}
+
+/* Stage B: places a spring of the family with identifiable quantities v (p, z out). */
+static void place(fit_ctx *c, const double v[3], double *p, double *z)
+{
+    memcpy(c->target, v, sizeof c->target);
+    analytic_member(c, v, p);
+    for (int k = 0; k < c->nfree; k++)
+        z[k] = log(p[c->free_idx[k]]);
+    nl_run(c, NLOPT_LD_SLSQP, z_preference, 1, z, 2000);
+    full_params(c, z, p);
+    snap_to_family(c, p, z);
+}
+
+cf_status cf_fit_place(const cf_fit_data *data, const cf_fit_options *opt, cf_spring_type type,
+                       const double ident[3], cf_fit_result *res, cf_error *err)
+{
+    const double t0 = now_s();
+    fit_ctx c;
+    cf_status st = ctx_setup(&c, data, opt, type, err);
+    if (st != CF_OK) {
+        free(c.sw);
+        return st;
+    }
+    for (int k = 0; k < 3; k++)
+        if (!(ident[k] > 0) || !isfinite(ident[k])) {
+            free(c.sw);
+            return cf_error_set(err, CF_E_DATA, "identifiable quantity %d = %g must be positive",
+                                k, ident[k]);
+        }
+    double p[CF_P_COUNT], z[CF_P_COUNT];
+    place(&c, ident, p, z);
+    memset(res, 0, sizeof *res);
+    res->type = type;
+    summarise(&c, p, res);
+    for (int k = 0; k < 3; k++)
+        res->ident_se[k] = -1;
+    res->optimizer = "placement";
+    res->evaluations = c.evals;
+    free(c.sw);
+    res->wall_time_s = now_s() - t0;
+    return CF_OK;
+}
+
+cf_status cf_fit_run(const cf_fit_data *data, const cf_fit_options *opt, cf_spring_type type,
+                     cf_fit_result *res, cf_error *err)
+{
+    const double t0 = now_s();
+    memset(res, 0, sizeof *res);
+    fit_ctx c;
+    cf_status st = ctx_setup(&c, data, opt, type, err);
+    if (st != CF_OK) {
+        free(c.sw);
+        return st;
+    }
+    /* Stage A: the identifiable quantities and their errors. */
+    double v[3] = {0.5, 0.5 * (c.b_lo + c.b_hi), 1.0}, se[3];
+    stage_a(&c, v);
+    stage_a_errors(&c, v, se);
+    /* Stage B: place a spring of the family. */
+    double p[CF_P_COUNT], z[CF_P_COUNT];
+    place(&c, v, p, z);
+    double best_obj = objective6(&c, p);
+    double best_p[CF_P_COUNT];
+    memcpy(best_p, p, sizeof p);
+    unsigned act, vio;
+    cf_spring sp = from_array(p);
+    int best_feas = cf_fit_check(&sp, type, data, opt, &act, &vio);
+    /* Stage C: local polish on the real objective; with fixed parameters the family may be out
+    ** of reach, so then also from seeded starts around the placement. */
+    uint64_t rng = (uint64_t)opt->seed * 0x9E3779B97F4A7C15ull + 7;
+    int starts = 1;
+    for (int k = 0; k < CF_P_COUNT; k++)
+        if (opt->fixed[k])
+            starts = opt->multistart;
+    for (int s = 0; s < starts; s++) {
+        double zz[CF_P_COUNT];
+        for (int k = 0; k < c.nfree; k++)
+            zz[k] = z[k] + (s == 0 ? 0.0 : 0.5 * (rng_uniform(&rng) - 0.5));
+        nl_run(&c, algorithm_of(opt->optimizer), z_objective, 0, zz, 3000);
+        double q[CF_P_COUNT];
+        full_params(&c, zz, q);
+        sp = from_array(q);
+        int feas = cf_fit_check(&sp, type, data, opt, &act, &vio);
+        double o = objective6(&c, q);
+        if ((feas && !best_feas) || (feas == best_feas && o < best_obj)) {
+            best_obj = o;
+            best_feas = feas;
+            memcpy(best_p, q, sizeof q);
+        }
+    }
+    res->type = type;
+    summarise(&c, best_p, res);
+    /* Standard errors belong to the identifiable quantities of stage A; when the reported
+    ** spring sits elsewhere (fixed parameters), recompute them there. */
+    if (fabs(res->ident[0] - v[0]) > 1e-6 * v[0] || fabs(res->ident[1] - v[1]) > 1e-6 * v[1] ||
+        fabs(res->ident[2] - v[2]) > 1e-6 * v[2])
+        stage_a_errors(&c, res->ident, se);
+    memcpy(res->ident_se, se, sizeof se);
+    res->optimizer = cf_fit_optimizer_name(opt->optimizer);
+    res->evaluations = c.evals;
+    free(c.sw);
+    res->wall_time_s = now_s() - t0;
+    return CF_OK;
+}

@@ -1,0 +1,143 @@
+/*
+** Fitting conical-spring design parameters (D1, D2, n, d, G, H) to a measured table.
+**
+** The law seen through a table depends on three combinations only (identifiability): the diameter
+** ratio rho = D1/D2, a length scale and a load scale. For a stress-strain table (sigma = F/H^2,
+** epsilon = u/H) those are the solid strain s/H and the stress scale F_C/H^2 (MPa); for a
+** force-displacement table the travel s (mm) and the solid load F_C (N). The fit therefore runs in
+** three stages:
+**   A. the three identifiable quantities: a global search over (rho, length scale) with the load
+**      scale solved in closed form (the model is linear in it), started also from the paper's
+**      two-point derivation (transition and maximum point, eqs. 11-17), then Levenberg-Marquardt
+**      (GSL) from the best starts; standard errors from the Jacobian (s^2 (J^T W J)^-1);
+**   B. placement: NLopt picks one spring of that family that meets the design constraints,
+**      honours fixed parameters and is closest (in log space) to a practical preferred design;
+**   C. polish: an NLopt local optimiser (COBYLA, SLSQP or MMA) on the weighted least-squares
+**      objective in the six design parameters under the nonlinear inequality constraints
+**      c = D1/d in [3, index_max], n >= 2, D2 >= D1, travel > largest |u| (with a margin), and the
+**      type condition (telescoping <=> (D2 - D1)/2 >= n d).
+** Every reported solution is checked against the constraints here, not taken from the optimiser.
+** Deterministic: the only randomness is a seeded generator in the result-local state.
+** Thread-safe: no globals; each call owns its state.
+*/
+#ifndef CF_FIT_H
+#define CF_FIT_H
+
+#include <stddef.h>
+
+#include "conifit/error.h"
+#include "conifit/law.h"
+
+/* Index of each design parameter in the arrays below, in the order D1, D2, n, d, G, H. */
+enum { CF_P_D1 = 0, CF_P_D2, CF_P_N, CF_P_D, CF_P_G, CF_P_H, CF_P_COUNT };
+
+/* Constraints, as bits of cf_fit_result.active / .violated. */
+enum {
+    CF_C_INDEX_MIN = 1 << 0, /* c = D1/d >= 3 */
+    CF_C_INDEX_MAX = 1 << 1, /* c <= index_max */
+    CF_C_COILS = 1 << 2,     /* n >= 2 */
+    CF_C_DIAMETERS = 1 << 3, /* D2 >= D1 */
+    CF_C_TRAVEL = 1 << 4,    /* travel > (1 + margin) largest |u| */
+    CF_C_TYPE = 1 << 5,      /* the geometry is of the type being fitted */
+    CF_C_BOUNDS = 1 << 6,    /* a parameter at (or beyond) its lower or upper bound */
+    CF_C_COUNT = 7
+};
+
+typedef enum cf_fit_optimizer {
+    CF_OPT_SLSQP = 0,  /* NLopt SLSQP, central-difference gradients */
+    CF_OPT_COBYLA = 1, /* NLopt COBYLA, derivative-free */
+    CF_OPT_MMA = 2     /* NLopt MMA, central-difference gradients */
+} cf_fit_optimizer;
+
+/* Relative travel margin: the largest measured |u| must stay this fraction of the travel short of
+** solid. Near solid the stiffness grows like (s - u)^(-1/2): a spring whose solid point sat on
+** the last data point would have an unbounded stiffness there. 1e-6 keeps the point clearly
+** inside (the law resolves s - u to rounding, ~1e-16 s) while allowing tables measured, or
+** synthesised, to within a few parts in 1e5 of solid. */
+#define CF_FIT_TRAVEL_MARGIN 1e-6
+
+/* Default upper spring index. Wound springs are practical for indices of about 4 to 12; above
+** that the coils tangle and buckle (the usual design handbooks give the same range). */
+#define CF_FIT_INDEX_MAX_DEFAULT 12.0
+
+typedef struct cf_fit_options {
+    int fixed[CF_P_COUNT];          /* 1: held at fixed_value */
+    double fixed_value[CF_P_COUNT]; /* mm, -, mm, MPa, mm as in cf_spring */
+    double lower[CF_P_COUNT];       /* bounds, same units */
+    double upper[CF_P_COUNT];
+    double index_max;               /* upper spring index, dimensionless (>= 3) */
+    int relative;                   /* 1: residuals relative to |y| (floor 1e-3 max|y|) */
+    cf_fit_optimizer optimizer;     /* local optimiser of stage C */
+    double xtol_rel;                /* relative tolerance on the parameters (NLopt, GSL) */
+    unsigned long seed;             /* seed of the global stage */
+    int multistart;                 /* number of local starts in stage A (>= 1) */
+    double H_preferred_mm;          /* free length preferred by placement when H is free, mm */
+} cf_fit_options;
+
+cf_fit_options cf_fit_default_options(void);
+
+/* The table to fit, in conifit's units: strain [-] and stress [MPa], or displacement [mm] and
+** force [N]. w may be NULL (all weights 1). Arrays are only read. */
+typedef struct cf_fit_data {
+    size_t count;
+    const double *x;
+    const double *y;
+    const double *w;
+    int force_displacement; /* 0: stress-strain, 1: force-displacement */
+} cf_fit_data;
+
+typedef struct cf_fit_result {
+    cf_spring_type type;
+    cf_spring params;      /* the reported spring */
+    cf_law law;            /* derived quantities of params (no table) */
+    double ident[3];       /* rho [-]; solid strain s/H [-] or travel s [mm]; F_C/H^2 [MPa] or
+                              F_C [N] */
+    double ident_se[3];    /* standard errors, same units; -1 when not determined */
+    double rss;            /* unweighted sum of squared residuals, (MPa or N)^2 */
+    double rmse;           /* root mean square residual, MPa or N */
+    double max_abs_error;  /* largest |residual|, MPa or N */
+    double r2;             /* coefficient of determination, dimensionless */
+    double objective;      /* weighted (relative) objective minimised */
+    int feasible;          /* 1 when every constraint holds at params (checked here) */
+    unsigned active;       /* CF_C_* bits of constraints at their limit (within 1e-6) */
+    unsigned violated;     /* CF_C_* bits of violated constraints */
+    const char *optimizer; /* name of the stage-C optimiser */
+    long evaluations;      /* evaluations of the model over the table, all stages */
+    double wall_time_s;    /* s */
+} cf_fit_result;
+
+/* Fits one spring type. CF_E_DATA for a table that cannot be fitted (fewer than 4 points, a
+** non-finite value, all y zero, a non-positive weight) or contradictory options (message names
+** them); CF_E_INTERNAL when memory runs out. A fit whose constraints cannot all be met (e.g. a
+** strain >= 1, which no spring reaches) is returned with feasible = 0 and the violated bits. */
+cf_status cf_fit_run(const cf_fit_data *data, const cf_fit_options *opt, cf_spring_type type,
+                     cf_fit_result *res, cf_error *err);
+
+/* Stage B alone: places one spring of the given type whose identifiable quantities are ident
+** (rho, solid strain or travel, stress or load scale; units as in cf_fit_result.ident), exactly as
+** cf_fit_run places its spring before the polish, and fills res (quality against data, feasibility;
+** ident_se = -1, optimizer "placement"). Used by the fit through the lattice (validate.h). */
+cf_status cf_fit_place(const cf_fit_data *data, const cf_fit_options *opt, cf_spring_type type,
+                       const double ident[3], cf_fit_result *res, cf_error *err);
+
+/* Evaluates the model (stress in MPa, or force in N) of spring p at x. */
+double cf_fit_model(const cf_law *law, int force_displacement, double x);
+
+/* Checks the constraints of options/type/data at p: fills *active and *violated (CF_C_* bits) and
+** returns 1 when feasible. */
+int cf_fit_check(const cf_spring *p, cf_spring_type type, const cf_fit_data *data,
+                 const cf_fit_options *opt, unsigned *active, unsigned *violated);
+
+/* The three identifiable quantities of spring p (see cf_fit_result.ident). */
+void cf_fit_identifiable(const cf_spring *p, int force_displacement, double ident[3]);
+
+/* Name of a constraint bit ("index_min", ...), and of an optimiser ("slsqp", ...). */
+const char *cf_fit_constraint_name(unsigned bit);
+const char *cf_fit_optimizer_name(cf_fit_optimizer o);
+cf_status cf_fit_optimizer_parse(const char *name, cf_fit_optimizer *o, cf_error *err);
+
+/* Parses a parameter name "D1", "D2", "n", "d", "G", "H" (also with unit suffix "D1_mm"). */
+cf_status cf_fit_param_parse(const char *name, int *index, cf_error *err);
+const char *cf_fit_param_name(int index);
+
+#endif

@@ -1,0 +1,61 @@
+/*
+** Reading fitted springs back from a conifit fit file (the JSON that `conifit fit -o` writes).
+**
+** Schema (all numbers finite; units in the key names):
+**   {
+**     "conifit_version": "0.1.0",
+**     "data": { "file": "data/x.csv", "points": 40, "x_column": "strain", "x_unit": "-",
+**               "y_column": "stress", "y_unit": "kPa", "kind": "stress-strain" | "force-displacement",
+**               "sign": "tension-positive" | "compression-negative" },
+**     "fits": [ { "type": "telescoping" | "non-telescoping",
+**                 "params":  { "D1_mm", "D2_mm", "n", "d_mm", "G_MPa", "H_mm" },
+**                 "derived": { "rho", "travel_mm", "solid_strain", "F_T_N", "F_C_N",
+**                              "k0_N_per_mm", "u_T_mm", "index_c", "L_min_mm", "L_max_mm" },
+**                 "rmse", "max_abs_error", "r2", ... } , ... ],
+**     "better_type": "telescoping" | "non-telescoping",
+**     ...
+**   }
+** Only "fits[].type", "fits[].params" (and the provenance fields if present) are needed to read a
+** spring back; everything else is report.
+**
+** The same reader takes a single exported spring (`conifit export --format json`), recognised by
+** its "schema" key:
+**   { "schema": "conifit-spring-1", "conifit_version": "0.1.0", "type": "telescoping",
+**     "params": { "D1_mm", "D2_mm", "n", "d_mm", "G_MPa", "H_mm" },
+**     "derived": { ... as above ... }, "units": { ... },
+**     "provenance": { "fit_file", "data_file", "rmse", "rmse_unit", "fit_version" } }
+*/
+#ifndef CF_FITFILE_H
+#define CF_FITFILE_H
+
+#include "conifit/error.h"
+#include "conifit/law.h"
+
+/* The "schema" value of a single exported spring. */
+#define CF_SPRINGFILE_SCHEMA "conifit-spring-1"
+
+/* A spring read from a fit file, with what is known of where it came from. */
+typedef struct cf_fitted_spring {
+    cf_spring params;
+    cf_spring_type type;
+    double rmse;                 /* fit RMSE in the data's stress (or force) unit; NAN if absent */
+    char data_file[512];         /* "" if absent */
+    char y_unit[32];             /* unit of rmse; "" if absent */
+    char version[32];            /* conifit version that wrote the file; "" if absent */
+} cf_fitted_spring;
+
+/* Loads the spring of the given type from the fit file at path; type_name NULL (or "") takes the
+** file's "better_type", or the only fit when there is one. Errors: CF_E_NOINPUT when the file
+** cannot be opened, CF_E_DATA when it is not JSON, lacks the type or a parameter, or holds a
+** non-finite or invalid value (the message names the file, the key and the value). */
+cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spring *out,
+                          cf_error *err);
+
+/* Splits "FILE.json:TYPE" into path and type (type NULL when there is no ":TYPE" suffix naming a
+** spring type) and loads it. */
+cf_status cf_fitfile_load_spec(const char *spec, cf_fitted_spring *out, cf_error *err);
+
+/* Parses "telescoping" / "non-telescoping"; CF_E_USAGE otherwise. */
+cf_status cf_spring_type_parse(const char *name, cf_spring_type *type, cf_error *err);
+
+#endif

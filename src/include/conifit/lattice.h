@@ -1,0 +1,122 @@
+/*
+** The mass-spring lattice: a regular block of nx x ny x nz cubic cells of edge H (the spring's free
+** length), point masses at the nodes, conical springs on the cell edges and optionally on the face
+** and body diagonals. It sees the spring law only through law.h (cf_law_force_many), and it is the
+** force kernel the solvers of msm.h call on every step.
+**
+** Units: mm, N, s and the mass unit that makes them consistent, the tonne (1 t = 1000 kg, so
+** 1 N = 1 t mm/s^2); a density of 1000 kg/m^3 is 1e-9 t/mm^3. Stresses are MPa (N/mm^2).
+** Axes: z is the loading axis; the bottom face is z = 0, the top face z = nz H.
+**
+** Spring weights. Each cell owns a quarter of each of its 12 edges (an edge is shared by up to four
+** cells), half of each of its 12 face diagonals (a face by up to two cells) and all of its 4 body
+** diagonals; a spring's weight w is the sum of the shares of the cells that contain it, and its
+** force is w times the law. So every layer of axial springs carries nx ny springs' worth of force
+** and a lattice of axial springs alone reproduces sigma = F/H^2 of one spring exactly.
+**
+** Diagonal springs use the same law in strain form: a diagonal of rest length L0 (sqrt 2 H or
+** sqrt 3 H) is evaluated at the compression u = (L0 - L) H/L0 and carries w * diagonal_weight
+** times that force. It is therefore the fitted material, stretched to the diagonal's length: it
+** reaches solid at the same strain as the edges (L_min = L0 L_min(H)/H, L_max = L0 L_max(H)/H,
+** paper eqs. 18-21 scaled), and one law object (one table) serves every spring.
+*/
+#ifndef CF_LATTICE_H
+#define CF_LATTICE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "conifit/error.h"
+#include "conifit/law.h"
+
+/* Which diagonals the lattice has (bit flags). */
+enum { CF_DIAG_NONE = 0, CF_DIAG_FACE = 1, CF_DIAG_BODY = 2 };
+
+typedef enum cf_bottom_bc {
+    CF_BOTTOM_AXIAL = 0,  /* bottom nodes held in z, free to slide laterally (lubricated platen) */
+    CF_BOTTOM_CLAMPED = 1 /* bottom nodes held in x, y and z */
+} cf_bottom_bc;
+
+typedef struct cf_lattice_config {
+    int nx, ny, nz;           /* cells along x, y and z (z = loading axis), each >= 1 */
+    unsigned diagonals;       /* CF_DIAG_FACE | CF_DIAG_BODY, or CF_DIAG_NONE */
+    double diagonal_weight;   /* force factor of the diagonal springs, dimensionless, >= 0 */
+    double density_t_per_mm3; /* mass density, tonne/mm^3 (1e-9 = 1000 kg/m^3), > 0 */
+    cf_bottom_bc bottom;      /* bottom-face boundary condition */
+} cf_lattice_config;
+
+/* 3 x 3 x 3 cells, face and body diagonals of weight 1, density 1e-9 t/mm^3, bottom axial. */
+cf_lattice_config cf_lattice_default(void);
+
+/* DOF fixity bits per node. */
+enum { CF_FIX_X = 1, CF_FIX_Y = 2, CF_FIX_Z = 4 };
+
+/* The lattice: nodes and springs as structures of arrays. Springs are ordered by their first
+** node, whose index runs x fastest, so a pass over the springs walks memory nearly in order. */
+typedef struct cf_lattice {
+    cf_lattice_config cfg;
+    const cf_law *law;      /* not owned */
+    cf_law_method method;   /* evaluator used by the kernel */
+    double H_mm;            /* cell edge = free length of the axial springs, mm */
+    double travel_mm;       /* law travel s (axial compression at solid), mm */
+    size_t nn;              /* number of nodes */
+    size_t ns;              /* number of springs */
+    /* nodes */
+    double *x, *y, *z;      /* positions, mm */
+    double *X, *Y, *Z;      /* reference positions, mm */
+    double *mass_t;         /* node masses, t */
+    double *fx, *fy, *fz;   /* forces on the nodes from the springs (output of the kernel), N */
+    uint8_t *fix;           /* CF_FIX_* bits (bottom face and rigid-body pins) */
+    /* springs */
+    uint32_t *si, *sj;      /* end nodes, si < sj */
+    double *L0_mm;          /* rest length, mm */
+    double *a;              /* H / L0: converts length change to the law's compression, - */
+    double *w;              /* force weight (cell shares x diagonal_weight), - */
+    double *L_mm;           /* current length (kernel output), mm */
+    double *u_mm;           /* law compression (L0 - L) a (kernel output), mm */
+    double *F_N;            /* law force at u (kernel output), N, compression positive */
+    double *k_N_per_mm;     /* law stiffness at u (kernel output when with_stiffness), N/mm */
+    int with_stiffness;     /* 1 (default): the kernel also evaluates k_N_per_mm (statics, stable
+                            ** step); 0: forces only, as an explicit step needs (cheaper) */
+    double *T_N;            /* spring tension w (-F) + effects (kernel output), N */
+    /* faces */
+    size_t ntop;            /* nodes on the top face */
+    uint32_t *top;          /* their indices */
+    double *top_share;      /* tributary share of the top area, in units of H^2 (sum nx ny) */
+    double area_mm2;        /* nx ny H^2, mm^2 */
+    double height_mm;       /* nz H, mm */
+    double m_min_t;         /* lightest node mass, t */
+    int max_degree;         /* most springs meeting at one node */
+} cf_lattice;
+
+/* Builds the lattice at its reference (undeformed) state. CF_E_DATA with a message naming the
+** field for a bad configuration, CF_E_INTERNAL when memory runs out. The law must outlive the
+** lattice; with CF_LAW_TABLE the caller builds the law's table first. */
+cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method method,
+                            const cf_lattice_config *cfg, cf_error *err);
+
+/* Releases the arrays. Safe on a zeroed lattice. */
+void cf_lattice_free(cf_lattice *lat);
+
+/* Puts every node back at its reference position. */
+void cf_lattice_reset(cf_lattice *lat);
+
+/* The force kernel: from the current positions computes every spring's length, compression, law
+** force and (when lat->with_stiffness) stiffness and elastic tension (L_mm, u_mm, F_N, k_N_per_mm,
+** T_N) and the node forces
+** fx, fy, fz (every spring adds equal and opposite forces along its axis to its two nodes).
+** Returns the largest |u| / travel over all springs (>= 1 means some spring is at solid). */
+double cf_lattice_forces(cf_lattice *lat);
+
+/* Adds to fx, fy, fz the forces of extra tensions Textra[s] (N, tension positive) along each
+** spring's current axis (uses L_mm from the last cf_lattice_forces) and adds them to T_N. */
+void cf_lattice_add_tensions(cf_lattice *lat, const double *Textra_N);
+
+/* Elastic energy stored in the springs at the current state, mJ = N mm (Gauss-Legendre quadrature
+** of the law over each spring's compression; accurate to about 1e-10 relative away from solid). */
+double cf_lattice_elastic_energy(const cf_lattice *lat);
+
+/* Mean z displacement of the top face (mm, compression positive) and nominal compressive strain. */
+double cf_lattice_top_strain(const cf_lattice *lat);
+
+#endif

@@ -1,0 +1,130 @@
+/*
+** The conical spring law: force and tangent stiffness of a constant-pitch conical compression
+** spring as a function of its compression u. A pure scalar kernel: it knows nothing of meshes,
+** fits or files.
+**
+** Law (derived from first principles in the README, "The law"; the paper's eqs. 3-12 encode it):
+**   travel to solid  s   = H - L_min,  L_min = d (telescoping) or n d (non-telescoping)
+**   telescoping      <=> (D2 - D1)/2 >= n d   (coils of successive radii fit inside each other)
+**   transition load  F_T = G d^4 s / (8 n D2^3),  solid load F_C = G d^4 s / (8 n D1^3)
+**   region 1 (|u| <= u_T): F = k0 u, k0 = G d^4 / (2 n (D1 + D2)(D1^2 + D2^2)),
+**                          u_T = s (1 + rho)(1 + rho^2) / 4, rho = D1/D2
+**   region 2 (u_T < |u| < s): F = F_C y^3 with y the root in [rho, 1] of y^4 - 4 c y + 3 = 0,
+**                          c = 1/rho - (u/s)(1/rho - 1)
+**   region 3 (|u| >= s): solid; the law reports F = +-F_C and the CF_LAW_SOLID flag.
+**   F(-u) = -F(u): stretching mirrors compression (paper eqs. 20-21, L_max = 2H - L_min).
+** References: Rodriguez E, Paredes M, Sartor M (2006), Analytical behavior law for a constant pitch
+** conical compression spring, J Mech Des 128:1352-1356; the conical-springs paper (eqs. 1-21).
+**
+** Units: lengths in mm, G in MPa = N/mm^2, forces in N, stiffness in N/mm.
+** Sign: u > 0 compresses (shortens) the spring, u < 0 stretches it; F has the sign of u.
+**
+** Evaluators (chosen per call, all behind cf_law_force):
+**   CF_LAW_EXACT   bracketed root finding (Brent) on the explicit deflection-of-load relation,
+**                  converged until the bracket stops shrinking: accurate to the last bits, slowest.
+**   CF_LAW_CLOSED  Ferrari's closed form of the quartic, written without cancellation near solid,
+**                  in the near-cylindrical limit and for strongly conical springs.
+**   CF_LAW_CLOSED_NEWTON  the closed form followed by one Newton step in the near-solid variable.
+**   CF_LAW_TABLE   a precomputed cubic Hermite table (see cf_law_table_build) on a grid uniform in
+**                  sqrt(1 - u/s), where the law is smooth; fastest, with a measured error bound.
+*/
+#ifndef CF_LAW_H
+#define CF_LAW_H
+
+#include <stddef.h>
+
+#include "conifit/error.h"
+
+/* The six design parameters of a conical spring. */
+typedef struct cf_spring {
+    double D1_mm; /* mean diameter of the smallest active coil, mm */
+    double D2_mm; /* mean diameter of the largest active coil, mm (D2 >= D1) */
+    double n;     /* number of active coils, dimensionless (n >= 2, real) */
+    double d_mm;  /* wire diameter, mm */
+    double G_MPa; /* shear modulus of the wire, MPa */
+    double H_mm;  /* free length, mm (rest length in the mass-spring model) */
+} cf_spring;
+
+typedef enum cf_spring_type {
+    CF_TELESCOPING = 0,     /* (D2 - D1)/2 >= n d, solid length d */
+    CF_NON_TELESCOPING = 1  /* (D2 - D1)/2 <  n d, solid length n d */
+} cf_spring_type;
+
+typedef enum cf_law_method {
+    CF_LAW_EXACT = 0,
+    CF_LAW_CLOSED = 1,
+    CF_LAW_CLOSED_NEWTON = 2,
+    CF_LAW_TABLE = 3
+} cf_law_method;
+
+/* Flags reported by an evaluation. */
+enum {
+    CF_LAW_LINEAR = 1, /* |u| <= u_T: region 1 */
+    CF_LAW_SOLID = 2   /* |u| >= travel: clamped at +-F_C, stiffness reported as 0 */
+};
+
+/* Default number of table intervals. Measured maximum force error of the table against exact at
+** this size: 1.5e-12 of |F| at rho = 0.5, 2.3e-10 at rho = 0.1, 3e-9 at rho = 0.03, and 6.5e-7 of
+** F_C at rho = 1e-3; the error falls as the fourth power of the size (tests/test_law.c checks
+** the bound, the benchmark reports the whole curve). */
+#define CF_LAW_TABLE_DEFAULT 256
+
+struct cf_law_table; /* opaque; built by cf_law_table_build */
+
+/* A spring prepared for evaluation: its parameters and every derived quantity. Plain data apart
+** from the optional table; build with cf_law_init, release with cf_law_free. */
+typedef struct cf_law {
+    cf_spring p;
+    cf_spring_type type;
+    double rho;          /* D1/D2, dimensionless, in (0, 1] */
+    double rho_inv_m1;   /* 1/rho - 1 = (D2 - D1)/D1, formed without cancellation */
+    double index_c;      /* spring index D1/d, dimensionless */
+    double L_min_mm;     /* solid length, mm */
+    double L_max_mm;     /* length at full stretch, 2H - L_min, mm */
+    double travel_mm;    /* s = H - L_min, mm */
+    double F_T_N;        /* transition load (end of region 1), N */
+    double F_C_N;        /* solid load, N */
+    double k0_N_per_mm;  /* stiffness of region 1, N/mm */
+    double u_T_mm;       /* compression at the transition, mm */
+    double inv_travel;   /* 1/s, 1/mm */
+    double k_scale;      /* 4 F_C (1/rho - 1)/s, N/mm: region-2 stiffness is k_scale y^4/(1-y^4) */
+    double w_T;          /* sqrt(1 - u_T/s): where region 2 starts in the table variable */
+    struct cf_law_table *table; /* NULL until cf_law_table_build */
+} cf_law;
+
+/* Validates p and fills law with the derived quantities (law->table = NULL). Refuses non-finite or
+** non-positive values, D1 > D2, n < 2 and a travel <= 0 with CF_E_DATA and a message naming the
+** parameter and its value. D1 == D2 (a cylindrical spring) is valid: linear up to solid. */
+cf_status cf_law_init(cf_law *law, const cf_spring *p, cf_error *err);
+
+/* Releases the table of law, if any. Safe on a zeroed law and on NULL. */
+void cf_law_free(cf_law *law);
+
+/* Builds (or rebuilds) the table used by CF_LAW_TABLE with `intervals` intervals (>= 2) over
+** region 2. CF_E_DATA for a bad size, CF_E_INTERNAL when memory runs out. */
+cf_status cf_law_table_build(cf_law *law, size_t intervals, cf_error *err);
+
+/* Force (N) at compression u (mm) with the chosen method; *k_N_per_mm (if not NULL) receives the
+** tangent stiffness dF/du >= 0 and *flags (if not NULL) CF_LAW_LINEAR / CF_LAW_SOLID. A non-finite
+** u is treated as solid with the sign of u (NaN as +0 force). CF_LAW_TABLE without a built table
+** falls back to CF_LAW_CLOSED_NEWTON. Never returns NaN or Inf for a law that cf_law_init accepted. */
+double cf_law_force(const cf_law *law, cf_law_method method, double u_mm, double *k_N_per_mm,
+                    int *flags);
+
+/* The same for count displacements at once: F[i] and (if k is not NULL) k[i] for u[i]. The method
+** is dispatched once, so the inner loop is the law alone. */
+void cf_law_force_many(const cf_law *law, cf_law_method method, size_t count, const double *u_mm,
+                       double *F_N, double *k_N_per_mm);
+
+/* Compression (mm, >= 0 for F >= 0) at which the spring carries force F (N): the explicit inverse
+** of the law, exact up to rounding; |F| >= F_C gives +-travel. */
+double cf_law_deflection(const cf_law *law, double F_N);
+
+/* "telescoping" or "non-telescoping". */
+const char *cf_spring_type_name(cf_spring_type type);
+
+/* Parses "exact", "closed", "closed+newton" or "table"; CF_E_USAGE for anything else. */
+cf_status cf_law_method_parse(const char *name, cf_law_method *method, cf_error *err);
+const char *cf_law_method_name(cf_law_method method);
+
+#endif

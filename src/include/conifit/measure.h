@@ -1,0 +1,89 @@
+/*
+** Reading measured tables: stress against strain (or stretch), or force against displacement,
+** from a CSV file with a header row, into the units conifit works in (MPa, N, mm, s).
+**
+** Accepted: '#' comment lines (anywhere, also before the header), CRLF or LF line ends, a UTF-8
+** byte-order mark, ',' ';' or TAB delimiters (detected from the header), double-quoted fields,
+** an optional `weight` column, an optional `time` column. Units come from the column name
+** (`stress_kPa`, `stress [kPa]`, `stress (kPa)`, `displacement_mm`, `force_N`) or from the options;
+** a bare `stress` column without a unit is an error unless opt->stress_unit gives one, except in
+** files whose '#' comments state the unit (e.g. "stress = ... [kPa]"), which the reader honours.
+** The x column is strain (engineering, dimensionless), stretch (converted to strain = stretch - 1),
+** or displacement (mm after conversion). Sign convention on input: tension positive; tables in
+** compression (negative values) are kept as they are and flagged in `compression`.
+*/
+#ifndef CF_MEASURE_H
+#define CF_MEASURE_H
+
+#include <stddef.h>
+
+#include "conifit/error.h"
+
+typedef enum cf_measure_kind {
+    CF_MEASURE_STRESS_STRAIN = 0,     /* x = engineering strain [-], y = stress [MPa] */
+    CF_MEASURE_FORCE_DISPLACEMENT = 1 /* x = displacement [mm], y = force [N] */
+} cf_measure_kind;
+
+typedef struct cf_measure_options {
+    const char *x_col;       /* column name of x (with or without its unit decoration), or NULL:
+                             ** the first column named strain/stretch/lambda/displacement/
+                             ** elongation/gamma/shear..., else the first column that is not y */
+    const char *y_col;       /* column name of y, or NULL: the first column named stress/force/
+                             ** load..., else the first remaining column */
+    const char *stress_unit; /* "Pa", "kPa", "MPa", "GPa", "N/mm2", "mmHg"...; NULL: from header */
+    const char *force_unit;  /* "N", "mN", "kN", "uN"; NULL: from header */
+    const char *length_unit; /* "m", "mm", "um", "cm"; NULL: from header */
+    int x_is_stretch;        /* -1: decide from the column name, 0: strain, 1: stretch */
+} cf_measure_options;
+
+/* Options with everything decided from the file. */
+cf_measure_options cf_measure_default_options(void);
+
+/* Fewest data rows a table must have (six design parameters). */
+#define CF_MEASURE_MIN_ROWS 6
+
+/* What a unit measures. */
+typedef enum cf_unit_class {
+    CF_UNIT_UNKNOWN = 0,
+    CF_UNIT_STRESS = 1, /* converted to MPa */
+    CF_UNIT_FORCE = 2,  /* converted to N */
+    CF_UNIT_LENGTH = 3, /* converted to mm */
+    CF_UNIT_TIME = 4,   /* converted to s */
+    CF_UNIT_STRAIN = 5  /* dimensionless: "-", "1" or "%" (converted to a plain fraction) */
+} cf_unit_class;
+
+/* Looks up a unit name (case-sensitive: "kPa", "MPa", "N/mm2", "mN", "um", "%", ...). Returns
+** CF_UNIT_UNKNOWN for a name it does not know; otherwise the class, and in *to_conifit (if not
+** NULL) the factor that converts a value in that unit to conifit's (MPa, N, mm, s, -). */
+cf_unit_class cf_measure_unit(const char *name, double *to_conifit);
+
+typedef struct cf_measure {
+    cf_measure_kind kind;
+    size_t count;          /* number of data rows */
+    double *x;             /* strain [-] or displacement [mm], count values */
+    double *y;             /* stress [MPa] or force [N], count values */
+    double *w;             /* weights (> 0; 1 when the file has no weight column), count values */
+    double *t;             /* time [s] when the file has a time column, else NULL */
+    double y_to_file;      /* multiply y by this to get the file's own unit (1000 for kPa) */
+    int compression;       /* 1 when the data lie at negative x (compression negative): some
+                           ** x < 0 and none > 0 */
+    int x_from_stretch;    /* 1 when the x column held stretch, converted to strain = stretch - 1 */
+    char path[1024];       /* the file as named by the caller */
+    char x_column[64];     /* header name of the x column */
+    char y_column[64];     /* header name of the y column */
+    char x_unit[16];       /* "-" for strain, "mm" for displacement after conversion */
+    char y_unit[16];       /* the file's own unit of y ("kPa", "mN", ...), used in reports */
+} cf_measure;
+
+/* Reads the table at path. Errors (nothing allocated is left behind):
+**   CF_E_NOINPUT  the file cannot be opened;
+**   CF_E_DATA     missing header, unknown unit, a column not found, a non-numeric or non-finite
+**                 cell, a short row, fewer than 6 data rows, an empty file, binary content, a
+**                 weight <= 0; the message reads "PATH:LINE:COLUMN: what is wrong ('value')". */
+cf_status cf_measure_load(const char *path, const cf_measure_options *opt, cf_measure *m,
+                          cf_error *err);
+
+/* Releases the arrays of m (safe on a zeroed struct). */
+void cf_measure_free(cf_measure *m);
+
+#endif

@@ -1,0 +1,116 @@
+/*
+** Solvers for the mass-spring lattice (lattice.h): static equilibria, quasi-static time stepping
+** with dashpots and Maxwell branches, and explicit symplectic dynamics with inertia; plus the
+** uniaxial curve used to validate a fitted spring.
+**
+** What runs depends only on the effects asked for:
+**   no time effect          -> a sequence of static equilibria (Newton with the law's tangent,
+**                              banded LDL^T of the sparse tangent with dense LU and GMRES as
+**                              fallbacks, backtracking so that no spring is
+**                              driven to solid); no time stepping.
+**   damping and/or Maxwell,  -> implicit quasi-static steps (backward Euler for the dashpots, the
+**   no inertia                 exact exponential update for the Maxwell branches), each a Newton
+**                              solve; unconditionally stable.
+**   inertia                 -> explicit symplectic Euler with the stable step computed from the
+**                              stiffest spring tangent and the lightest mass.
+** An effect that is off has no loop at all.
+**
+** Sign convention: strain and stress are compressive-positive here (u > 0 shortens). A tension-
+** positive table (compression negative) maps by changing the sign of both columns; that is what
+** cf_msm_uniaxial does for its caller.
+*/
+#ifndef CF_MSM_H
+#define CF_MSM_H
+
+#include <stddef.h>
+
+#include "conifit/error.h"
+#include "conifit/lattice.h"
+#include "conifit/law.h"
+
+/* Time-dependent effects; all zero = static. */
+typedef struct cf_msm_effects {
+    int inertia;               /* 1: solve the dynamics with node masses */
+    double eta_MPa_s;          /* dashpot beside every spring (paper eq. 14): sigma = eta d(eps)/dt,
+                                  MPa s; 0 = off */
+    double maxwell_E_MPa;      /* modulus of the Maxwell branch beside every spring, MPa; 0 = off */
+    double maxwell_tau_s;      /* relaxation time of the Maxwell branch, s */
+    double gravity_mm_per_s2;  /* acceleration along -z, mm/s^2 (9810 on earth); 0 = off */
+} cf_msm_effects;
+
+typedef enum cf_msm_drive {
+    CF_DRIVE_DISPLACEMENT = 0, /* the top face follows a prescribed compressive strain */
+    CF_DRIVE_FORCE = 1         /* the top face carries a prescribed compressive stress */
+} cf_msm_drive;
+
+/* A loading path: piecewise linear in time through (t_s[i], value[i]); value is the compressive
+** strain (-) for displacement drive, the compressive nominal stress (MPa) for force drive. Samples
+** are reported at every time in sample_t_s (increasing, inside the path). */
+typedef struct cf_msm_path {
+    cf_msm_drive drive;
+    size_t count;
+    const double *t_s;
+    const double *value;
+} cf_msm_path;
+
+/* Solver settings. */
+typedef struct cf_msm_config {
+    cf_lattice_config lattice;
+    double newton_rtol;        /* Newton: residual tolerance relative to the force scale, - */
+    int newton_max_iter;       /* Newton iterations per solve */
+    double dt_s;               /* time step, s: 0 = automatic (quasi-static: sample interval
+                                  split in quasi_substeps; dynamic: 0.9 of the stable step) */
+    int quasi_substeps;        /* implicit steps per sample interval when dt_s = 0 */
+    /* Called by cf_msm_run after every reported sample (done of total) when not NULL, so that a
+    ** caller can show progress; the library itself never prints. */
+    void (*progress)(void *ctx, size_t done, size_t total, double t_s);
+    void *progress_ctx;
+} cf_msm_config;
+
+/* 3 x 3 x 3 cells, face and body diagonals, bottom axial; Newton 1e-11, 50 iterations. */
+cf_msm_config cf_msm_default(void);
+
+/* What a run did. */
+typedef struct cf_msm_stats {
+    size_t solves;             /* static / quasi-static Newton solves */
+    size_t newton_iters;       /* Newton iterations in all */
+    size_t linear_iters;       /* linear solves: banded or dense factorisations plus GMRES cycles */
+    size_t steps;              /* time steps taken */
+    double dt_used_min_s;      /* smallest step used, s (0 for static runs) */
+    double dt_stable_s;        /* stable explicit step at the start, s (0 if not explicit) */
+    size_t substepped;         /* sample intervals where stiffening forced a smaller step */
+    double max_u_over_travel;  /* largest spring compression reached, in units of the travel */
+    double max_energy_drift;   /* explicit, no damping: max |E - E0| relative to the work done */
+} cf_msm_stats;
+
+/* One reported sample. */
+typedef struct cf_msm_sample {
+    double t_s;                /* time, s */
+    double strain;             /* compressive nominal strain of the top face, - */
+    double stress_MPa;         /* compressive nominal stress: top reaction / (nx ny H^2), MPa */
+    double kinetic_mJ;         /* kinetic energy, mJ = N mm (0 without inertia) */
+} cf_msm_sample;
+
+/* Runs the lattice along a path; fills out[k] for k < path sample count. Status CF_E_NOCONV when
+** a solve does not converge or a spring would have to pass solid (message: time and strain),
+** CF_E_DATA for an unstable requested step or an invalid path, CF_E_INTERNAL when energy or
+** positions become non-finite. On failure out holds the samples done so far, *done says how many. */
+cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fx, const cf_msm_config *cfg,
+                     const cf_msm_path *path, const double *sample_t_s, size_t nsamples,
+                     cf_msm_sample *out, size_t *done, cf_msm_stats *stats, cf_error *err);
+
+/* The static uniaxial curve of the lattice (cfg->lattice) built from law: the nominal stress at
+** each strain, in the table's own sign (negative strain = compression gives negative stress).
+** Strains are visited from 0 outwards, compression and tension separately, each solve starting
+** from the previous one. cfg may be NULL (cf_msm_default()); stats may be NULL. With
+** CF_LAW_TABLE the law's table must be built. */
+cf_status cf_msm_uniaxial(const cf_law *law, cf_law_method m, const cf_msm_config *cfg,
+                          const double *strain, size_t count, double *stress_MPa,
+                          cf_msm_stats *stats, cf_error *err);
+
+/* The explicit stable step (s) of the lattice at its current state for the given effects
+** (stiffest spring tangent, lightest mass, most springs at one node; the dashpots shorten it).
+** Calls cf_lattice_forces. */
+double cf_msm_stable_step(cf_lattice *lat, const cf_msm_effects *fx);
+
+#endif

@@ -1,0 +1,59 @@
+/*
+** What a fit reports: the readable terminal text and the JSON fit file (schema in fitfile.h,
+** extended with the identifiable quantities, quality measures and baselines). The JSON is written
+** atomically (atomic.h) with doubles to 17 significant digits and never a NaN or Inf.
+*/
+#ifndef CF_REPORT_H
+#define CF_REPORT_H
+
+#include <stddef.h>
+
+#include "conifit/baseline.h"
+#include "conifit/error.h"
+#include "conifit/fit.h"
+#include "conifit/validate.h"
+
+/* One table and its fits, as the report sees it. Values of the fits are in conifit's units
+** (MPa or N); y_to_file converts them to the file's own unit for display and JSON. */
+typedef struct cf_fit_report {
+    const char *version;        /* conifit version */
+    const char *data_file;      /* the table as named by the user */
+    const char *x_column, *x_unit, *y_column, *y_unit; /* header names and the file's units */
+    int force_displacement;     /* 0: stress-strain, 1: force-displacement */
+    int compression;            /* 1: the table is compression-negative */
+    size_t points;              /* number of data rows */
+    double y_to_file;           /* multiply MPa (or N) by this to get the file's unit */
+    double ymax;                /* largest |y| in MPa or N */
+    int nfits;                  /* 1 or 2 */
+    cf_fit_result fits[2];
+    cf_baseline baselines[CF_BASE_COUNT];
+    int with_timing;            /* 0: write wall_time_s as 0 (for reproducible files) */
+    int validate;               /* 1: each fit was run in the lattice (val[i]) */
+    cf_validation val[2];       /* lattice validation of fits[i] (MPa; not owned by the report) */
+    int through_msm;            /* 1: each fit was refined through the lattice (thr[i]) */
+    cf_through_msm thr[2];      /* what that cost and gained (MPa) */
+} cf_fit_report;
+
+/* Index of the better fit in r->fits: the feasible one with the lower RMSE (-1 if none). */
+int cf_report_better(const cf_fit_report *r);
+
+/* 1 when both types were fitted and their RMSEs differ by no more than 1e-6 relative (or by
+** rounding level, 1e-9 max|y|): the table does not tell the types apart. */
+int cf_report_types_tie(const cf_fit_report *r);
+
+/* AIC of fit i, with RSS in the file's unit (comparable with the baselines' AIC of the report). */
+double cf_report_fit_aic(const cf_fit_report *r, int i);
+double cf_report_baseline_aic(const cf_fit_report *r, int k);
+
+/* The JSON document as a string (malloc'd; caller frees). NULL when memory runs out. */
+char *cf_report_json_string(const cf_fit_report *r);
+
+/* Writes the JSON to path atomically; `inputs` (NULL-terminated, may be NULL) are refused as
+** targets. CF_E_CANTWRITE on failure (no file left behind). */
+cf_status cf_report_json_write(const cf_fit_report *r, const char *path,
+                               const char *const *inputs, cf_error *err);
+
+/* The readable report (malloc'd string; caller frees); NULL when memory runs out. */
+char *cf_report_text(const cf_fit_report *r);
+
+#endif

@@ -1,0 +1,53 @@
+/*
+** Scenes: a JSON file that says which spring, which lattice, which boundary conditions, which
+** loading protocol and which time-dependent effects a simulation uses (schema in the README,
+** section "Scenes"). Loading validates everything before anything is simulated: an unknown key,
+** a missing field, an impossible value or a missing fit file is refused with a message that names
+** the key and the value.
+*/
+#ifndef CF_SCENE_H
+#define CF_SCENE_H
+
+#include <stddef.h>
+
+#include "conifit/error.h"
+#include "conifit/law.h"
+#include "conifit/msm.h"
+
+typedef enum cf_protocol_kind {
+    CF_PROTO_RAMP = 0,   /* 0 -> target over duration_s */
+    CF_PROTO_CYCLES = 1, /* 0 -> target -> 0, count times, period_s each */
+    CF_PROTO_HOLD = 2    /* 0 -> target over ramp_s, then held for hold_s (creep or relaxation) */
+} cf_protocol_kind;
+
+typedef struct cf_scene {
+    cf_spring spring;           /* the spring of every lattice edge */
+    char spring_source[600];    /* "params" or the fit file (and type) it came from */
+    cf_law_method method;       /* law evaluator */
+    size_t table_intervals;     /* for CF_LAW_TABLE */
+    cf_msm_config cfg;          /* lattice and solver settings */
+    cf_msm_effects effects;     /* time-dependent effects */
+    cf_protocol_kind kind;
+    cf_msm_drive drive;         /* displacement (to_strain) or force (to_stress_kPa) */
+    double target;              /* compressive strain (-) or compressive stress (MPa) */
+    int cycles;                 /* number of load-unload cycles (CF_PROTO_CYCLES) */
+    size_t npath;               /* vertices of the loading path */
+    double *path_t_s, *path_v;  /* the path (value as in cf_msm_path) */
+    size_t nsamples;            /* reported samples */
+    double *sample_t_s;         /* their times, s */
+} cf_scene;
+
+/* Reads and validates the scene at path. CF_E_NOINPUT when it (or its fit file) cannot be read,
+** CF_E_DATA for anything invalid; the message names the file, the key and the value. */
+cf_status cf_scene_load(const char *path, cf_scene *sc, cf_error *err);
+
+/* The same from JSON text; `name` is used in messages. */
+cf_status cf_scene_parse(const char *json_text, const char *name, cf_scene *sc, cf_error *err);
+
+/* Releases the arrays of sc. Safe on a zeroed scene. */
+void cf_scene_free(cf_scene *sc);
+
+/* The loading path of the scene, for cf_msm_run. */
+cf_msm_path cf_scene_path(const cf_scene *sc);
+
+#endif

@@ -1,0 +1,94 @@
+/*
+** Validation of a fitted spring in the mass-spring lattice, and the fit through the lattice.
+**
+** A single spring reproduces its table by construction; a lattice of such springs with face and
+** body diagonals, boundary conditions and lateral freedom does not. cf_validate_run builds the
+** static uniaxial lattice (msm.h, cf_msm_uniaxial) from a fitted spring, drives it to every strain
+** of the table (the table's own sign: tension positive, compression negative) and measures how far
+** the lattice's nominal stress lies from the measured one (RMSE, R^2, max |error|).
+**
+** cf_validate_through_msm makes the lattice's curve the objective: starting from the ordinary fit
+** it optimises the three identifiable quantities (rho, solid strain s/H, stress scale F_C/H^2; the
+** lattice's stress depends on the design parameters only through them, as the single spring's
+** does) with NLopt BOBYQA (derivative-free, deterministic), then places the design parameters as
+** the ordinary fit does (cf_fit_place). The result is kept only when it lowers the validation
+** RMSE, so it never makes the validation worse.
+**
+** Stress-strain tables only: a force-displacement table is a single spring's curve, not a block
+** of tissue, and its free length H is not determined by the data, so there is no sound nominal
+** strain to drive the lattice with. Such tables are skipped with a note (CF_E_DATA here, which
+** the caller reports as a note rather than a failure).
+*/
+#ifndef CF_VALIDATE_H
+#define CF_VALIDATE_H
+
+#include <stddef.h>
+
+#include "conifit/error.h"
+#include "conifit/fit.h"
+#include "conifit/law.h"
+#include "conifit/msm.h"
+#include "conifit/scene.h"
+
+/* Where the lattice comes from. */
+typedef struct cf_validate_setup {
+    cf_msm_config cfg;          /* lattice and Newton settings */
+    cf_law_method method;       /* law evaluator in the lattice */
+    size_t table_intervals;     /* table size when method is CF_LAW_TABLE */
+} cf_validate_setup;
+
+/* cf_msm_default() (3 x 3 x 3 cells, face and body diagonals, bottom axial) with the fitter's own
+** evaluator, CF_LAW_CLOSED. */
+cf_validate_setup cf_validate_default(void);
+
+/* The setup of a scene, which must be a static uniaxial one: protocol kind "ramp" under a
+** displacement drive ('to_strain') and no time-dependent effect. The scene's spring is not used
+** (each fitted spring replaces it). CF_E_DATA naming the offending key otherwise. */
+cf_status cf_validate_from_scene(const cf_scene *sc, const char *name, cf_validate_setup *s,
+                                 cf_error *err);
+
+/* The outcome of one validation. */
+typedef struct cf_validation {
+    int done;                   /* 1: run; 0: skipped (see note) */
+    char note[CF_ERROR_MSG_LEN]; /* why it was skipped, empty when done */
+    cf_validate_setup setup;    /* the lattice it ran */
+    double rmse;                /* lattice stress against the table, MPa */
+    double max_abs_error;       /* largest |lattice - table|, MPa */
+    double r2;                  /* coefficient of determination of the lattice curve, - */
+    double wall_time_s;         /* s */
+    size_t solves;              /* static solves */
+    size_t newton_iters;        /* Newton iterations in all */
+    size_t count;               /* points of stress_MPa */
+    double *stress_MPa;         /* lattice stress at each table strain, MPa (owned; NULL if skipped) */
+} cf_validation;
+
+/* Runs the lattice made of spring p at the strains of d and fills v (v->stress_MPa malloc'd).
+** CF_E_DATA for a force-displacement table or a strain at or past the spring's solid strain,
+** CF_E_NOCONV when a static solve does not converge, CF_E_INTERNAL when memory runs out; on
+** failure v->done = 0 and v->note holds the message. */
+cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const cf_fit_data *d,
+                          cf_validation *v, cf_error *err);
+
+/* Releases v->stress_MPa. Safe on a zeroed validation. */
+void cf_validation_free(cf_validation *v);
+
+/* What the fit through the lattice did. */
+typedef struct cf_through_msm {
+    int done;                   /* 1: run */
+    int improved;               /* 1: the spring was replaced (the lattice fits better) */
+    double rmse_before;         /* validation RMSE of the ordinary fit, MPa */
+    double rmse_after;          /* validation RMSE of the reported spring, MPa */
+    double ident_before[3];     /* rho, s/H, F_C/H^2 [MPa] of the ordinary fit */
+    double ident_after[3];      /* the same after the lattice objective */
+    double wall_time_s;         /* s, the optimisation and the placement */
+    long evaluations;           /* lattice curves computed */
+} cf_through_msm;
+
+/* The fit through the lattice for one fitted spring res (in: the ordinary fit, with v its
+** validation, v->done = 1; out: the spring placed from the lattice-optimal identifiable quantities
+** and its validation, when that lowered the validation RMSE). Deterministic. */
+cf_status cf_validate_through_msm(const cf_fit_data *d, const cf_fit_options *opt,
+                                  const cf_validate_setup *s, cf_fit_result *res,
+                                  cf_validation *v, cf_through_msm *t, cf_error *err);
+
+#endif

@@ -1,0 +1,1182 @@
+/*
+** Reading measured tables (see measure.h): the CSV dialect, unit decorations in column names and
+** in '#' comments, conversion into MPa / N / mm / s, and one precise message for each way a table
+** can be wrong. Columns in messages count fields from 1.
+*/
+#include "conifit/measure.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+/* Largest file read (a measured table is far smaller; this only bounds the memory taken). */
+#define MAX_FILE_BYTES ((size_t)1 << 30)
+/* Longest column name kept (longer names are an error: they are not column names). */
+#define NAME_CAP 256
+
+cf_measure_options cf_measure_default_options(void)
+{
+    cf_measure_options o = {NULL, NULL, NULL, NULL, NULL, -1};
+    return o;
+}
+
+/* ---- units -------------------------------------------------------------------------------- */
+
+typedef struct unit_def {
+    const char *name;
+    cf_unit_class cls;
+    double to_conifit;
+    const char *canon; /* spelling used in reports */
+} unit_def;
+
+/* 1 mmHg = 133.322387415 Pa (conventional millimetre of mercury). */
+static const unit_def units[] = {
+    {"Pa", CF_UNIT_STRESS, 1e-6, "Pa"},
+    {"kPa", CF_UNIT_STRESS, 1e-3, "kPa"},
+    {"KPa", CF_UNIT_STRESS, 1e-3, "kPa"},
+    {"MPa", CF_UNIT_STRESS, 1.0, "MPa"},
+    {"GPa", CF_UNIT_STRESS, 1e3, "GPa"},
+    {"N/mm2", CF_UNIT_STRESS, 1.0, "N/mm2"},
+    {"N/mm^2", CF_UNIT_STRESS, 1.0, "N/mm2"},
+    {"N/mm\xc2\xb2", CF_UNIT_STRESS, 1.0, "N/mm2"},
+    {"N/m2", CF_UNIT_STRESS, 1e-6, "N/m2"},
+    {"N/m^2", CF_UNIT_STRESS, 1e-6, "N/m2"},
+    {"N/m\xc2\xb2", CF_UNIT_STRESS, 1e-6, "N/m2"},
+    {"mmHg", CF_UNIT_STRESS, 133.322387415e-6, "mmHg"},
+    {"N", CF_UNIT_FORCE, 1.0, "N"},
+    {"mN", CF_UNIT_FORCE, 1e-3, "mN"},
+    {"kN", CF_UNIT_FORCE, 1e3, "kN"},
+    {"uN", CF_UNIT_FORCE, 1e-6, "uN"},
+    {"\xc2\xb5N", CF_UNIT_FORCE, 1e-6, "uN"}, /* micro sign */
+    {"\xce\xbcN", CF_UNIT_FORCE, 1e-6, "uN"}, /* Greek mu */
+    {"m", CF_UNIT_LENGTH, 1e3, "m"},
+    {"cm", CF_UNIT_LENGTH, 10.0, "cm"},
+    {"mm", CF_UNIT_LENGTH, 1.0, "mm"},
+    {"um", CF_UNIT_LENGTH, 1e-3, "um"},
+    {"\xc2\xb5m", CF_UNIT_LENGTH, 1e-3, "um"},
+    {"\xce\xbcm", CF_UNIT_LENGTH, 1e-3, "um"},
+    {"s", CF_UNIT_TIME, 1.0, "s"},
+    {"ms", CF_UNIT_TIME, 1e-3, "ms"},
+    {"min", CF_UNIT_TIME, 60.0, "min"},
+    {"h", CF_UNIT_TIME, 3600.0, "h"},
+    {"-", CF_UNIT_STRAIN, 1.0, "-"},
+    {"1", CF_UNIT_STRAIN, 1.0, "-"},
+    {"%", CF_UNIT_STRAIN, 0.01, "%"},
+};
+
+static const unit_def *unit_find(const char *name)
+{
+    for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
+        if (strcmp(units[i].name, name) == 0)
+            return &units[i];
+    return NULL;
+}
+
+/* True when name equals a known unit up to letter case ("kpa", "n"): a unit written wrongly. */
+static int unit_like(const char *name)
+{
+    for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
+        if (strcasecmp(units[i].name, name) == 0)
+            return 1;
+    return 0;
+}
+
+cf_unit_class cf_measure_unit(const char *name, double *to_conifit)
+{
+    const unit_def *u = name ? unit_find(name) : NULL;
+    if (!u)
+        return CF_UNIT_UNKNOWN;
+    if (to_conifit)
+        *to_conifit = u->to_conifit;
+    return u->cls;
+}
+
+static const char unit_list[] =
+    "stress: Pa kPa MPa GPa N/mm2 N/m2 mmHg; force: N mN kN uN; length: m cm mm um; "
+    "time: s ms min h; strain: - %";
+
+/* ---- messages ----------------------------------------------------------------------------- */
+
+/* Copies text into out as a short printable quotation: control and non-ASCII bytes as \xNN,
+** long text cut with "...". */
+static void quote(char *out, size_t cap, const char *s, size_t n)
+{
+    size_t o = 0;
+    const size_t keep = 60;
+    for (size_t i = 0; i < n && o + 8 < cap; i++) {
+        unsigned char c = (unsigned char)s[i];
+        if (i == keep) {
+            o += (size_t)snprintf(out + o, cap - o, "...");
+            break;
+        }
+        if (c >= 0x20 && c < 0x7f)
+            out[o++] = (char)c;
+        else
+            o += (size_t)snprintf(out + o, cap - o, "\\x%02X", c);
+    }
+    out[o < cap ? o : cap - 1] = '\0';
+}
+
+/* CF_E_DATA with "PATH:LINE:COL: message". */
+static cf_status data_error(cf_error *err, const char *path, size_t line, size_t col,
+                            const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 5, 6)))
+#endif
+    ;
+static cf_status data_error(cf_error *err, const char *path, size_t line, size_t col,
+                            const char *fmt, ...)
+{
+    char msg[CF_ERROR_MSG_LEN];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return cf_error_set(err, CF_E_DATA, "%s:%zu:%zu: %s", path, line, col, msg);
+}
+
+/* ---- lines and fields --------------------------------------------------------------------- */
+
+typedef struct line_span {
+    const char *s;
+    size_t n;    /* without the line end (and without a CR before it) */
+    size_t line; /* 1-based */
+} line_span;
+
+/* The fields of one row, unquoted, each NUL-terminated inside buf. */
+typedef struct fields {
+    char *buf;
+    size_t buf_cap;
+    size_t *off;
+    size_t count, cap;
+} fields;
+
+static void fields_free(fields *f)
+{
+    free(f->buf);
+    free(f->off);
+    memset(f, 0, sizeof *f);
+}
+
+static int fields_reserve(fields *f, size_t text_len)
+{
+    if (f->buf_cap < text_len + 1) {
+        char *b = realloc(f->buf, text_len + 1);
+        if (!b)
+            return -1;
+        f->buf = b;
+        f->buf_cap = text_len + 1;
+    }
+    return 0;
+}
+
+static int fields_push(fields *f, size_t off)
+{
+    if (f->count == f->cap) {
+        size_t cap = f->cap ? 2 * f->cap : 16;
+        size_t *o = realloc(f->off, cap * sizeof *o);
+        if (!o)
+            return -1;
+        f->off = o;
+        f->cap = cap;
+    }
+    f->off[f->count++] = off;
+    return 0;
+}
+
+static const char *field(const fields *f, size_t i)
+{
+    return f->buf + f->off[i];
+}
+
+/* Length of the line's content: up to a '#' outside double quotes (a comment), trailing
+** blanks removed. */
+static size_t content_length(const char *s, size_t n)
+{
+    int q = 0;
+    size_t end = n;
+    for (size_t i = 0; i < n; i++) {
+        if (s[i] == '"')
+            q = !q;
+        else if (s[i] == '#' && !q) {
+            end = i;
+            break;
+        }
+    }
+    while (end > 0 && (s[end - 1] == ' ' || s[end - 1] == '\t'))
+        end--;
+    return end;
+}
+
+static int is_blank(char c, char delim)
+{
+    return c == ' ' || (c == '\t' && delim != '\t');
+}
+
+/* Splits s[0..n) at delim into f. Returns 0, or -1 on a quoting error (with *bad_col the field
+** and *why the reason), or -2 when memory runs out. */
+static int split(const char *s, size_t n, char delim, fields *f, size_t *bad_col,
+                 const char **why)
+{
+    f->count = 0;
+    if (fields_reserve(f, n) != 0)
+        return -2;
+    size_t i = 0, o = 0;
+    for (;;) {
+        while (i < n && is_blank(s[i], delim))
+            i++;
+        if (fields_push(f, o) != 0)
+            return -2;
+        if (i < n && s[i] == '"') {
+            i++;
+            for (;;) {
+                if (i >= n) {
+                    *bad_col = f->count;
+                    *why = "unterminated double quote";
+                    return -1;
+                }
+                if (s[i] == '"') {
+                    if (i + 1 < n && s[i + 1] == '"') {
+                        f->buf[o++] = '"';
+                        i += 2;
+                        continue;
+                    }
+                    i++;
+                    break;
+                }
+                f->buf[o++] = s[i++];
+            }
+            while (i < n && is_blank(s[i], delim))
+                i++;
+            if (i < n && s[i] != delim) {
+                *bad_col = f->count;
+                *why = "text after a closing double quote";
+                return -1;
+            }
+        } else {
+            size_t start = o;
+            while (i < n && s[i] != delim) {
+                if (s[i] == '"') {
+                    *bad_col = f->count;
+                    *why = "double quote inside an unquoted field";
+                    return -1;
+                }
+                f->buf[o++] = s[i++];
+            }
+            while (o > start && is_blank(f->buf[o - 1], delim))
+                o--;
+        }
+        f->buf[o++] = '\0';
+        if (i >= n)
+            return 0;
+        i++; /* the delimiter: another field follows, possibly empty */
+        if (fields_reserve(f, n + f->count + 1) != 0)
+            return -2;
+    }
+}
+
+/* Checks a line for bytes that do not belong in a text table: NUL, control characters other than
+** TAB, a CR that does not end the line, and malformed UTF-8. Returns the byte offset of the first
+** bad byte, or n when the line is text. */
+static size_t bad_byte(const unsigned char *s, size_t n)
+{
+    size_t i = 0;
+    while (i < n) {
+        unsigned char c = s[i];
+        if (c < 0x80) {
+            if ((c < 0x20 && c != '\t') || c == 0x7f)
+                return i;
+            i++;
+            continue;
+        }
+        size_t len;
+        uint32_t cp;
+        if (c >= 0xc2 && c <= 0xdf) {
+            len = 2;
+            cp = c & 0x1f;
+        } else if (c >= 0xe0 && c <= 0xef) {
+            len = 3;
+            cp = c & 0x0f;
+        } else if (c >= 0xf0 && c <= 0xf4) {
+            len = 4;
+            cp = c & 0x07;
+        } else
+            return i;
+        if (i + len > n)
+            return i;
+        for (size_t k = 1; k < len; k++) {
+            if ((s[i + k] & 0xc0) != 0x80)
+                return i;
+            cp = (cp << 6) | (s[i + k] & 0x3f);
+        }
+        if ((len == 3 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) ||
+            (len == 4 && (cp < 0x10000 || cp > 0x10ffff)) || (cp >= 0x80 && cp <= 0x9f))
+            return i;
+        i += len;
+    }
+    return n;
+}
+
+/* ---- numbers ------------------------------------------------------------------------------ */
+
+typedef enum num_result { NUM_OK, NUM_EMPTY, NUM_NOT_NUMBER, NUM_NOT_FINITE } num_result;
+
+/* Parses a cell as a finite decimal number ('.' decimal point; a single ',' is taken as the
+** decimal point when the delimiter is not a comma). */
+static num_result parse_number(const char *text, char delim, double *out)
+{
+    char tmp[128];
+    size_t n = strlen(text);
+    if (n == 0)
+        return NUM_EMPTY;
+    if (n >= sizeof tmp)
+        return NUM_NOT_NUMBER;
+    memcpy(tmp, text, n + 1);
+    const char *p = tmp;
+    if (*p == '+' || *p == '-')
+        p++;
+    if (strncasecmp(p, "nan", 3) == 0 || strncasecmp(p, "inf", 3) == 0)
+        return NUM_NOT_FINITE;
+    if (delim != ',') {
+        char *comma = strchr(tmp, ',');
+        if (comma && !strchr(tmp, '.') && !strchr(comma + 1, ','))
+            *comma = '.';
+    }
+    for (const char *c = p; *c; c++)
+        if (!isdigit((unsigned char)*c) && *c != '.' && *c != 'e' && *c != 'E' && *c != '+' &&
+            *c != '-')
+            return NUM_NOT_NUMBER;
+    char *end = NULL;
+    errno = 0;
+    double v = strtod(tmp, &end);
+    if (end == tmp || *end != '\0')
+        return NUM_NOT_NUMBER;
+    if (!isfinite(v) || (errno == ERANGE && fabs(v) > 1.0))
+        return NUM_NOT_FINITE;
+    *out = v;
+    return NUM_OK;
+}
+
+/* ---- column names ------------------------------------------------------------------------- */
+
+typedef struct column {
+    char name[NAME_CAP]; /* as in the header */
+    char base[NAME_CAP]; /* without the unit decoration */
+    char unit[NAME_CAP]; /* the decoration ("" when none) */
+} column;
+
+static void trim_copy(char *out, size_t cap, const char *s, size_t n)
+{
+    while (n > 0 && isspace((unsigned char)*s)) {
+        s++;
+        n--;
+    }
+    while (n > 0 && isspace((unsigned char)s[n - 1]))
+        n--;
+    if (n >= cap)
+        n = cap - 1;
+    memcpy(out, s, n);
+    out[n] = '\0';
+}
+
+/* Splits a header name into base and unit: "stress [kPa]", "stress (kPa)", "stress_kPa". A
+** suffix after the last '_' is a unit only when it is one (so "true_strain" stays a name) or
+** looks like one written in the wrong case ("stress_kpa", reported as an unknown unit). */
+static void column_parse(column *c, const char *name)
+{
+    snprintf(c->name, sizeof c->name, "%s", name);
+    size_t n = strlen(name);
+    c->unit[0] = '\0';
+    if (n > 0 && (name[n - 1] == ']' || name[n - 1] == ')')) {
+        char open = name[n - 1] == ']' ? '[' : '(';
+        const char *o = strrchr(name, open);
+        if (o && o > name) {
+            trim_copy(c->base, sizeof c->base, name, (size_t)(o - name));
+            trim_copy(c->unit, sizeof c->unit, o + 1, (size_t)(name + n - 1 - (o + 1)));
+            if (c->base[0])
+                return;
+        }
+    }
+    const char *us = strrchr(name, '_');
+    if (us && us > name && us[1] && (unit_find(us + 1) || unit_like(us + 1))) {
+        trim_copy(c->base, sizeof c->base, name, (size_t)(us - name));
+        snprintf(c->unit, sizeof c->unit, "%s", us + 1);
+        return;
+    }
+    trim_copy(c->base, sizeof c->base, name, n);
+    c->unit[0] = '\0';
+}
+
+static int starts_with_ci(const char *s, const char *prefix)
+{
+    return strncasecmp(s, prefix, strlen(prefix)) == 0;
+}
+
+static int contains_ci(const char *s, const char *word)
+{
+    size_t n = strlen(word);
+    for (; *s; s++)
+        if (strncasecmp(s, word, n) == 0)
+            return 1;
+    return 0;
+}
+
+static int is_x_name(const char *b)
+{
+    static const char *const p[] = {"strain", "stretch", "lambda", "displacement",
+                                    "elongation", "gamma", "shear"};
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++)
+        if (starts_with_ci(b, p[i]))
+            return 1;
+    return 0;
+}
+
+static cf_unit_class y_name_class(const char *b)
+{
+    if (starts_with_ci(b, "stress") || contains_ci(b, "stress"))
+        return CF_UNIT_STRESS;
+    if (starts_with_ci(b, "force") || starts_with_ci(b, "load") || contains_ci(b, "force"))
+        return CF_UNIT_FORCE;
+    return CF_UNIT_UNKNOWN;
+}
+
+static int is_y_name(const char *b)
+{
+    return starts_with_ci(b, "stress") || starts_with_ci(b, "force") || starts_with_ci(b, "load");
+}
+
+static int is_weight_name(const char *b)
+{
+    return strcasecmp(b, "weight") == 0 || strcasecmp(b, "weights") == 0;
+}
+
+static int is_time_name(const char *b)
+{
+    return strcasecmp(b, "time") == 0 || strcasecmp(b, "t") == 0;
+}
+
+static int is_stretch_name(const char *b)
+{
+    return starts_with_ci(b, "stretch") || starts_with_ci(b, "lambda");
+}
+
+/* ---- units stated in '#' comments --------------------------------------------------------- */
+
+static int word_char(char c)
+{
+    return isalnum((unsigned char)c) || c == '_';
+}
+
+/* Does u (a bracket's content or a bare word) name a unit of one of the wanted classes? */
+static const unit_def *wanted_unit(const char *u, const cf_unit_class *want, size_t nwant)
+{
+    const unit_def *d = unit_find(u);
+    for (size_t k = 0; d && k < nwant; k++)
+        if (d->cls == want[k])
+            return d;
+    return NULL;
+}
+
+/* Looks in one comment for the column name as a word followed, in the same clause (up to ',' or
+** ';' or an unmatched closing bracket), by a bracketed unit of a wanted class:
+** "stress = nominal stress [kPa]", "displacement [mm]". */
+static const unit_def *comment_unit_after_name(const char *s, size_t n, const char *name,
+                                               const cf_unit_class *want, size_t nwant)
+{
+    size_t len = strlen(name);
+    if (len == 0)
+        return NULL;
+    for (size_t i = 0; i + len <= n; i++) {
+        if (strncasecmp(s + i, name, len) != 0)
+            continue;
+        if ((i > 0 && word_char(s[i - 1])) || (i + len < n && word_char(s[i + len])))
+            continue;
+        for (size_t j = i + len; j < n; j++) {
+            char c = s[j];
+            if (c == ',' || c == ';' || c == ')' || c == ']')
+                break;
+            if (c == '[' || c == '(') {
+                char close = c == '[' ? ']' : ')';
+                const char *e = memchr(s + j + 1, close, n - j - 1);
+                if (!e)
+                    break;
+                char u[NAME_CAP];
+                trim_copy(u, sizeof u, s + j + 1, (size_t)(e - (s + j + 1)));
+                const unit_def *d = wanted_unit(u, want, nwant);
+                if (d)
+                    return d;
+                j = (size_t)(e - s);
+            }
+        }
+    }
+    return NULL;
+}
+
+/* "... (x, y): strain, MPa" or "(x, y) = mm, mN": units listed for x and y in that order. */
+static const unit_def *comment_unit_xy(const char *s, size_t n, int which,
+                                       const cf_unit_class *want, size_t nwant)
+{
+    static const char key[] = "(x, y)";
+    const size_t klen = sizeof key - 1;
+    for (size_t i = 0; i + klen <= n; i++) {
+        if (strncasecmp(s + i, key, klen) != 0)
+            continue;
+        size_t j = i + klen;
+        while (j < n && (s[j] == ' ' || s[j] == ':' || s[j] == '=' || s[j] == '\t'))
+            j++;
+        for (int k = 0; k <= which && j < n; k++) {
+            size_t start = j;
+            while (j < n && s[j] != ',' && s[j] != ';')
+                j++;
+            if (k == which) {
+                char tok[NAME_CAP];
+                trim_copy(tok, sizeof tok, s + start, j - start);
+                /* the token may be "kPa" or "stress kPa" or "[kPa]": try its last word */
+                char *w = tok + strlen(tok);
+                while (w > tok && !isspace((unsigned char)w[-1]))
+                    w--;
+                while (*w == '[' || *w == '(')
+                    w++;
+                size_t wl = strlen(w);
+                while (wl > 0 && (w[wl - 1] == ']' || w[wl - 1] == ')' || w[wl - 1] == '.'))
+                    w[--wl] = '\0';
+                return wanted_unit(w, want, nwant);
+            }
+            j++;
+        }
+    }
+    return NULL;
+}
+
+static const unit_def *comment_unit(const line_span *comments, size_t ncomments, const char *name,
+                                    int which, const cf_unit_class *want, size_t nwant)
+{
+    for (size_t i = 0; i < ncomments; i++) {
+        const unit_def *d =
+            comment_unit_after_name(comments[i].s, comments[i].n, name, want, nwant);
+        if (d)
+            return d;
+    }
+    for (size_t i = 0; i < ncomments; i++) {
+        const unit_def *d = comment_unit_xy(comments[i].s, comments[i].n, which, want, nwant);
+        if (d)
+            return d;
+    }
+    return NULL;
+}
+
+/* ---- the reader --------------------------------------------------------------------------- */
+
+typedef struct reader {
+    const char *path;
+    char *text;
+    size_t size;
+    line_span *lines; /* every line of the file */
+    size_t nlines;
+    line_span *comments; /* the '#' lines, without the '#' */
+    size_t ncomments;
+    column *cols;
+    size_t ncols;
+    fields f;
+    double *x, *y, *w, *t;
+    size_t count, cap;
+} reader;
+
+static void reader_free(reader *r)
+{
+    free(r->text);
+    free(r->lines);
+    free(r->comments);
+    free(r->cols);
+    fields_free(&r->f);
+    free(r->x);
+    free(r->y);
+    free(r->w);
+    free(r->t);
+}
+
+static cf_status out_of_memory(cf_error *err, const char *path)
+{
+    return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory reading the table", path);
+}
+
+static cf_status read_all(reader *r, cf_error *err)
+{
+    FILE *fp = fopen(r->path, "rb");
+    if (!fp)
+        return cf_error_set(err, CF_E_NOINPUT, "%s: cannot open: %s", r->path, strerror(errno));
+    size_t cap = 1 << 16;
+    r->text = malloc(cap);
+    if (!r->text) {
+        fclose(fp);
+        return out_of_memory(err, r->path);
+    }
+    for (;;) {
+        if (r->size == cap) {
+            if (cap >= MAX_FILE_BYTES) {
+                fclose(fp);
+                return cf_error_set(err, CF_E_DATA, "%s:1:1: file larger than %zu bytes: not a "
+                                    "measured table", r->path, MAX_FILE_BYTES);
+            }
+            char *t = realloc(r->text, 2 * cap);
+            if (!t) {
+                fclose(fp);
+                return out_of_memory(err, r->path);
+            }
+            r->text = t;
+            cap *= 2;
+        }
+        size_t got = fread(r->text + r->size, 1, cap - r->size, fp);
+        r->size += got;
+        if (got == 0)
+            break;
+    }
+    int bad = ferror(fp);
+    int saved = errno;
+    fclose(fp);
+    if (bad)
+        return cf_error_set(err, CF_E_NOINPUT, "%s: cannot read: %s", r->path,
+                            strerror(saved ? saved : EIO));
+    return CF_OK;
+}
+
+/* Cuts the text into lines (LF or CRLF), after a UTF-8 byte-order mark. */
+static cf_status cut_lines(reader *r, cf_error *err)
+{
+    const char *s = r->text, *end = r->text + r->size;
+    if (r->size >= 3 && memcmp(s, "\xEF\xBB\xBF", 3) == 0)
+        s += 3;
+    size_t cap = 0;
+    for (size_t line = 1; s < end; line++) {
+        const char *nl = memchr(s, '\n', (size_t)(end - s));
+        const char *e = nl ? nl : end;
+        size_t n = (size_t)(e - s);
+        if (n > 0 && s[n - 1] == '\r')
+            n--;
+        if (r->nlines == cap) {
+            cap = cap ? 2 * cap : 256;
+            line_span *l = realloc(r->lines, cap * sizeof *l);
+            if (!l)
+                return out_of_memory(err, r->path);
+            r->lines = l;
+        }
+        r->lines[r->nlines++] = (line_span){s, n, line};
+        s = nl ? nl + 1 : end;
+    }
+    return CF_OK;
+}
+
+static int is_comment_line(const line_span *l)
+{
+    size_t i = 0;
+    while (i < l->n && (l->s[i] == ' ' || l->s[i] == '\t'))
+        i++;
+    return i < l->n && l->s[i] == '#';
+}
+
+/* Checks every line for binary content and collects the comment lines. */
+static cf_status scan_text(reader *r, cf_error *err)
+{
+    r->comments = malloc((r->nlines ? r->nlines : 1) * sizeof *r->comments);
+    if (!r->comments)
+        return out_of_memory(err, r->path);
+    for (size_t i = 0; i < r->nlines; i++) {
+        const line_span *l = &r->lines[i];
+        size_t b = bad_byte((const unsigned char *)l->s, l->n);
+        if (b < l->n) {
+            char q[256];
+            quote(q, sizeof q, l->s, l->n);
+            unsigned char c = (unsigned char)l->s[b];
+            return data_error(err, r->path, l->line, b + 1,
+                              "%s: byte 0x%02X is not text (the column counts bytes here) ('%s')",
+                              c == '\r' ? "carriage return inside a line" : "binary content", c,
+                              q);
+        }
+        if (is_comment_line(l)) {
+            const char *h = memchr(l->s, '#', l->n);
+            r->comments[r->ncomments++] = (line_span){h + 1, l->n - (size_t)(h + 1 - l->s),
+                                                      l->line};
+        }
+    }
+    return CF_OK;
+}
+
+static char detect_delimiter(const char *s, size_t n)
+{
+    size_t comma = 0, semi = 0, tab = 0;
+    int q = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (s[i] == '"')
+            q = !q;
+        else if (!q && s[i] == ',')
+            comma++;
+        else if (!q && s[i] == ';')
+            semi++;
+        else if (!q && s[i] == '\t')
+            tab++;
+    }
+    if (tab > comma && tab > semi)
+        return '\t';
+    if (semi > comma)
+        return ';';
+    if (comma > 0)
+        return ',';
+    return 0;
+}
+
+static cf_status split_or_fail(reader *r, const line_span *l, size_t n, char delim,
+                               cf_error *err)
+{
+    size_t bad = 0;
+    const char *why = NULL;
+    int rc = split(l->s, n, delim, &r->f, &bad, &why);
+    if (rc == -2)
+        return out_of_memory(err, r->path);
+    if (rc == -1) {
+        char q[256];
+        quote(q, sizeof q, l->s, n);
+        return data_error(err, r->path, l->line, bad, "%s ('%s')", why, q);
+    }
+    return CF_OK;
+}
+
+static int push_row(reader *r, double x, double y, double w, double t)
+{
+    if (r->count == r->cap) {
+        size_t cap = r->cap ? 2 * r->cap : 64;
+        double *a[4] = {r->x, r->y, r->w, r->t};
+        for (int k = 0; k < 4; k++) {
+            double *p = realloc(a[k], cap * sizeof *p);
+            if (!p)
+                return -1;
+            a[k] = p;
+            if (k == 0)
+                r->x = p;
+            else if (k == 1)
+                r->y = p;
+            else if (k == 2)
+                r->w = p;
+            else
+                r->t = p;
+        }
+        r->cap = cap;
+    }
+    r->x[r->count] = x;
+    r->y[r->count] = y;
+    r->w[r->count] = w;
+    r->t[r->count] = t;
+    r->count++;
+    return 0;
+}
+
+/* Finds a column by name (the full header name or its base, case-insensitive). */
+static long find_column(const reader *r, const char *name)
+{
+    for (size_t i = 0; i < r->ncols; i++)
+        if (strcasecmp(r->cols[i].name, name) == 0)
+            return (long)i;
+    for (size_t i = 0; i < r->ncols; i++)
+        if (strcasecmp(r->cols[i].base, name) == 0)
+            return (long)i;
+    return -1;
+}
+
+static cf_status column_not_found(const reader *r, size_t header_line, const char *what,
+                                  const char *name, cf_error *err)
+{
+    char list[256];
+    size_t o = 0;
+    list[0] = '\0';
+    for (size_t i = 0; i < r->ncols && o + 4 < sizeof list; i++)
+        o += (size_t)snprintf(list + o, sizeof list - o, "%s%s", i ? ", " : "", r->cols[i].name);
+    char q[256];
+    quote(q, sizeof q, name, strlen(name));
+    return data_error(err, r->path, header_line, 1, "no %s column named '%s' (the header has: %s)",
+                      what, q, list);
+}
+
+/* Resolves the unit of column c: the option if given, else its decoration, else a '#' comment.
+** Returns CF_OK with *u NULL when no unit is stated anywhere. */
+static cf_status column_unit(const reader *r, size_t header_line, size_t ci, const char *option,
+                             const char *option_flag, int which, const cf_unit_class *want,
+                             size_t nwant, const unit_def **u, cf_error *err)
+{
+    const column *c = &r->cols[ci];
+    const char *text = option ? option : (c->unit[0] ? c->unit : NULL);
+    *u = NULL;
+    if (text) {
+        const unit_def *d = unit_find(text);
+        char q[256];
+        quote(q, sizeof q, text, strlen(text));
+        if (!d) {
+            if (option)
+                return cf_error_set(err, CF_E_DATA,
+                                    "%s: %s '%s': unknown unit (known units: %s)", r->path,
+                                    option_flag, q, unit_list);
+            return data_error(err, r->path, header_line, ci + 1,
+                              "column '%s': unknown unit '%s' (known units, case-sensitive: %s)",
+                              c->name, q, unit_list);
+        }
+        for (size_t k = 0; k < nwant; k++)
+            if (d->cls == want[k]) {
+                *u = d;
+                return CF_OK;
+            }
+        if (option)
+            return cf_error_set(err, CF_E_DATA, "%s: %s '%s' is not a unit for column '%s'",
+                                r->path, option_flag, q, c->name);
+        return data_error(err, r->path, header_line, ci + 1,
+                          "column '%s': unit '%s' does not fit this column ('%s')", c->name, q,
+                          c->name);
+    }
+    *u = comment_unit(r->comments, r->ncomments, c->base, which, want, nwant);
+    return CF_OK;
+}
+
+cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf_measure *m,
+                          cf_error *err)
+{
+    cf_measure_options opt = opt_in ? *opt_in : cf_measure_default_options();
+    reader r;
+    cf_status st;
+    memset(&r, 0, sizeof r);
+    memset(m, 0, sizeof *m);
+    if (!path)
+        return cf_error_set(err, CF_E_NOINPUT, "no input file named");
+    r.path = path;
+    if ((st = read_all(&r, err)) != CF_OK || (st = cut_lines(&r, err)) != CF_OK ||
+        (st = scan_text(&r, err)) != CF_OK)
+        goto fail;
+
+    /* The header: the first line with content. */
+    size_t hi = 0, hn = 0;
+    while (hi < r.nlines) {
+        if (!is_comment_line(&r.lines[hi]) &&
+            (hn = content_length(r.lines[hi].s, r.lines[hi].n)) > 0)
+            break;
+        hi++;
+    }
+    if (hi == r.nlines) {
+        if (r.size == 0)
+            st = data_error(err, path, 1, 1, "empty file: no header and no data (0 bytes)");
+        else
+            st = data_error(err, path, r.nlines ? r.lines[r.nlines - 1].line : 1, 1,
+                            "no header row and no data: only comments and blank lines (%zu "
+                            "bytes)", r.size);
+        goto fail;
+    }
+    const line_span *hl = &r.lines[hi];
+    const size_t header_line = hl->line;
+    char hq[256];
+    quote(hq, sizeof hq, hl->s, hn);
+    char delim = detect_delimiter(hl->s, hn);
+    if (!delim) {
+        st = data_error(err, path, header_line, 1,
+                        "the header has a single column; expected at least x and y separated by "
+                        "',' ';' or TAB ('%s')", hq);
+        goto fail;
+    }
+    if ((st = split_or_fail(&r, hl, hn, delim, err)) != CF_OK)
+        goto fail;
+    size_t ncols = r.f.count;
+    int trailing = 0;
+    if (ncols > 1 && field(&r.f, ncols - 1)[0] == '\0') {
+        trailing = 1; /* the header ends with a delimiter: so must every row */
+        ncols--;
+    }
+    r.cols = calloc(ncols, sizeof *r.cols);
+    if (!r.cols) {
+        st = out_of_memory(err, path);
+        goto fail;
+    }
+    r.ncols = ncols;
+    size_t numeric = 0;
+    for (size_t i = 0; i < ncols; i++) {
+        const char *name = field(&r.f, i);
+        double v;
+        if (name[0] == '\0') {
+            st = data_error(err, path, header_line, i + 1, "column %zu has no name ('%s')",
+                            i + 1, hq);
+            goto fail;
+        }
+        if (strlen(name) >= NAME_CAP) {
+            st = data_error(err, path, header_line, i + 1, "column name too long ('%.60s...')",
+                            name);
+            goto fail;
+        }
+        if (parse_number(name, delim, &v) == NUM_OK)
+            numeric++;
+        column_parse(&r.cols[i], name);
+    }
+    if (numeric == ncols) {
+        st = data_error(err, path, header_line, 1,
+                        "missing header: the first row holds numbers, not column names ('%s')",
+                        hq);
+        goto fail;
+    }
+
+    /* Which columns: x, y, weight, time. */
+    long xi = -1, yi = -1, wi = -1, ti = -1;
+    for (size_t i = 0; i < ncols; i++) {
+        if (wi < 0 && is_weight_name(r.cols[i].base))
+            wi = (long)i;
+        if (ti < 0 && is_time_name(r.cols[i].base))
+            ti = (long)i;
+    }
+    if (opt.x_col && (xi = find_column(&r, opt.x_col)) < 0) {
+        st = column_not_found(&r, header_line, "x", opt.x_col, err);
+        goto fail;
+    }
+    if (opt.y_col && (yi = find_column(&r, opt.y_col)) < 0) {
+        st = column_not_found(&r, header_line, "y", opt.y_col, err);
+        goto fail;
+    }
+    for (int pass = 0; pass < 2 && yi < 0; pass++)
+        for (size_t i = 0; i < ncols && yi < 0; i++)
+            if ((long)i != xi && (pass == 0 ? is_y_name(r.cols[i].base)
+                                            : y_name_class(r.cols[i].base) != CF_UNIT_UNKNOWN))
+                yi = (long)i;
+    for (size_t i = 0; i < ncols && xi < 0; i++)
+        if ((long)i != yi && is_x_name(r.cols[i].base))
+            xi = (long)i;
+    for (size_t i = 0; i < ncols && (xi < 0 || yi < 0); i++) {
+        if ((long)i == xi || (long)i == yi || (long)i == wi || (long)i == ti)
+            continue;
+        if (xi < 0)
+            xi = (long)i;
+        else
+            yi = (long)i;
+    }
+    if (xi < 0 || yi < 0 || xi == yi) {
+        st = data_error(err, path, header_line, 1,
+                        "cannot tell which columns are x and y; name them (strain, stress_kPa, "
+                        "...) or use --x-col/--y-col ('%s')", hq);
+        goto fail;
+    }
+    if (wi == xi || wi == yi)
+        wi = -1;
+    if (ti == xi || ti == yi)
+        ti = -1;
+
+    /* Units. y first: it decides between stress-strain and force-displacement. */
+    const column *xc = &r.cols[xi], *yc = &r.cols[yi];
+    cf_unit_class yname = y_name_class(yc->base);
+    const char *yopt = NULL, *yflag = "--stress-unit";
+    cf_unit_class ywant[2] = {CF_UNIT_STRESS, CF_UNIT_FORCE};
+    size_t nywant = 2;
+    if (yname == CF_UNIT_STRESS) {
+        yopt = opt.stress_unit;
+        nywant = 1;
+    } else if (yname == CF_UNIT_FORCE) {
+        yopt = opt.force_unit;
+        yflag = "--force-unit";
+        ywant[0] = CF_UNIT_FORCE;
+        nywant = 1;
+    } else if (opt.stress_unit) {
+        yopt = opt.stress_unit;
+    } else if (opt.force_unit) {
+        yopt = opt.force_unit;
+        yflag = "--force-unit";
+    }
+    const unit_def *yu = NULL, *xu = NULL, *tu = NULL;
+    if ((st = column_unit(&r, header_line, (size_t)yi, yopt, yflag, 1, ywant, nywant, &yu, err)))
+        goto fail;
+    if (!yu) {
+        const char *hint = yname == CF_UNIT_FORCE ? "force_N or force [mN], or give --force-unit"
+                                                  : "stress_kPa or stress [kPa], or give "
+                                                    "--stress-unit (or --force-unit for a force)";
+        st = data_error(err, path, header_line, (size_t)yi + 1,
+                        "column '%s' has no unit: name it like %s ('%s')", yc->name, hint,
+                        yc->name);
+        goto fail;
+    }
+    m->kind = yu->cls == CF_UNIT_STRESS ? CF_MEASURE_STRESS_STRAIN : CF_MEASURE_FORCE_DISPLACEMENT;
+    int stretch = opt.x_is_stretch == 1 || (opt.x_is_stretch < 0 && is_stretch_name(xc->base));
+    double xscale = 1.0;
+    if (m->kind == CF_MEASURE_STRESS_STRAIN) {
+        cf_unit_class xw[1] = {CF_UNIT_STRAIN};
+        if (xc->unit[0]) {
+            const unit_def *d = unit_find(xc->unit);
+            if (!d || d->cls != CF_UNIT_STRAIN) {
+                st = data_error(err, path, header_line, (size_t)xi + 1,
+                                "column '%s' has unit '%s' but y is a stress, so x must be a "
+                                "dimensionless strain or stretch ('-' or '%%') ('%s')",
+                                xc->name, xc->unit, xc->name);
+                goto fail;
+            }
+            xu = d;
+        } else
+            xu = comment_unit(r.comments, r.ncomments, xc->base, 0, xw, 1);
+        if (xu)
+            xscale = xu->to_conifit;
+        if (stretch && xscale != 1.0) {
+            st = data_error(err, path, header_line, (size_t)xi + 1,
+                            "stretch column '%s' cannot be in '%%' ('%s')", xc->name, xc->name);
+            goto fail;
+        }
+    } else {
+        cf_unit_class xw[1] = {CF_UNIT_LENGTH};
+        if (stretch) {
+            st = data_error(err, path, header_line, (size_t)xi + 1,
+                            "column '%s' is a stretch but y is a force; give a displacement "
+                            "column or a stress ('%s')", xc->name, xc->name);
+            goto fail;
+        }
+        if ((st = column_unit(&r, header_line, (size_t)xi, opt.length_unit, "--length-unit", 0,
+                              xw, 1, &xu, err)))
+            goto fail;
+        if (!xu) {
+            st = data_error(err, path, header_line, (size_t)xi + 1,
+                            "column '%s' has no length unit (y is a force): name it like "
+                            "displacement_mm, or give --length-unit ('%s')", xc->name, xc->name);
+            goto fail;
+        }
+        xscale = xu->to_conifit;
+    }
+    double tscale = 1.0;
+    if (ti >= 0) {
+        cf_unit_class tw[1] = {CF_UNIT_TIME};
+        if ((st = column_unit(&r, header_line, (size_t)ti, NULL, "", 2, tw, 1, &tu, err)))
+            goto fail;
+        if (tu)
+            tscale = tu->to_conifit;
+    }
+    const double yscale = yu->to_conifit;
+
+    /* Rows. */
+    size_t last_line = header_line;
+    for (size_t li = hi + 1; li < r.nlines; li++) {
+        const line_span *l = &r.lines[li];
+        if (is_comment_line(l))
+            continue;
+        size_t n = content_length(l->s, l->n);
+        if (n == 0)
+            continue;
+        if ((st = split_or_fail(&r, l, n, delim, err)) != CF_OK)
+            goto fail;
+        size_t nf = r.f.count, all_empty = 1;
+        for (size_t k = 0; k < nf; k++)
+            if (field(&r.f, k)[0])
+                all_empty = 0;
+        if (all_empty)
+            continue; /* a row of empty cells (",,,") counts as blank */
+        char q[256];
+        quote(q, sizeof q, l->s, n);
+        size_t want = ncols + (size_t)trailing;
+        if (nf < want) {
+            st = data_error(err, path, l->line, nf + 1,
+                            "short row: %zu fields where the header has %zu%s ('%s')", nf, want,
+                            trailing ? " (the header ends with a delimiter, so must every row)"
+                                     : "",
+                            q);
+            goto fail;
+        }
+        if (nf > want) {
+            char fq[128];
+            quote(fq, sizeof fq, field(&r.f, want), strlen(field(&r.f, want)));
+            st = data_error(err, path, l->line, want + 1,
+                            "long row: %zu fields where the header has %zu (extra '%s') ('%s')",
+                            nf, want, fq, q);
+            goto fail;
+        }
+        if (trailing && field(&r.f, ncols)[0]) {
+            st = data_error(err, path, l->line, ncols + 1,
+                            "a value in the unnamed last column (the header ends with a "
+                            "delimiter) ('%s')", field(&r.f, ncols));
+            goto fail;
+        }
+        long idx[4] = {xi, yi, wi, ti};
+        double v[4] = {0.0, 0.0, 1.0, 0.0};
+        for (int k = 0; k < 4; k++) {
+            if (idx[k] < 0)
+                continue;
+            const char *cell = field(&r.f, (size_t)idx[k]);
+            num_result nr = parse_number(cell, delim, &v[k]);
+            if (nr != NUM_OK) {
+                char cq[128];
+                quote(cq, sizeof cq, cell, strlen(cell));
+                const char *what = nr == NUM_EMPTY        ? "empty cell"
+                                   : nr == NUM_NOT_FINITE ? "not a finite number"
+                                                          : "not a number";
+                st = data_error(err, path, l->line, (size_t)idx[k] + 1, "column '%s': %s ('%s')",
+                                r.cols[idx[k]].name, what, cq);
+                goto fail;
+            }
+        }
+        if (wi >= 0 && !(v[2] > 0.0)) {
+            st = data_error(err, path, l->line, (size_t)wi + 1,
+                            "column '%s': a weight must be > 0 ('%s')", r.cols[wi].name,
+                            field(&r.f, (size_t)wi));
+            goto fail;
+        }
+        double x = stretch ? v[0] - 1.0 : v[0] * xscale;
+        double y = v[1] * yscale, t = v[3] * tscale;
+        if (!isfinite(x) || !isfinite(y) || !isfinite(t)) {
+            st = data_error(err, path, l->line, (size_t)xi + 1,
+                            "value out of range after unit conversion ('%s')", q);
+            goto fail;
+        }
+        if (push_row(&r, x, y, v[2], t) != 0) {
+            st = out_of_memory(err, path);
+            goto fail;
+        }
+        last_line = l->line;
+    }
+    if (r.count < CF_MEASURE_MIN_ROWS) {
+        st = data_error(err, path, last_line, 1,
+                        "only %zu data rows; a fit needs at least %d ('%zu rows')", r.count,
+                        CF_MEASURE_MIN_ROWS, r.count);
+        goto fail;
+    }
+
+    /* Hand over. */
+    int neg = 0, pos = 0;
+    for (size_t i = 0; i < r.count; i++) {
+        neg |= r.x[i] < 0.0;
+        pos |= r.x[i] > 0.0;
+    }
+    m->count = r.count;
+    m->x = r.x;
+    m->y = r.y;
+    m->w = r.w;
+    if (ti >= 0)
+        m->t = r.t;
+    else
+        free(r.t);
+    r.x = r.y = r.w = r.t = NULL;
+    m->y_to_file = 1.0 / yscale;
+    m->compression = neg && !pos;
+    m->x_from_stretch = stretch;
+    snprintf(m->path, sizeof m->path, "%s", path);
+    snprintf(m->x_column, sizeof m->x_column, "%.63s", xc->name);
+    snprintf(m->y_column, sizeof m->y_column, "%.63s", yc->name);
+    snprintf(m->x_unit, sizeof m->x_unit, "%s",
+             m->kind == CF_MEASURE_STRESS_STRAIN ? "-" : "mm");
+    snprintf(m->y_unit, sizeof m->y_unit, "%s", yu->canon);
+    reader_free(&r);
+    cf_error_clear(err);
+    return CF_OK;
+
+fail:
+    reader_free(&r);
+    memset(m, 0, sizeof *m);
+    return st;
+}
+
+void cf_measure_free(cf_measure *m)
+{
+    if (!m)
+        return;
+    free(m->x);
+    free(m->y);
+    free(m->w);
+    free(m->t);
+    m->x = m->y = m->w = m->t = NULL;
+    m->count = 0;
+}

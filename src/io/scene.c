@@ -1,0 +1,484 @@
+/*
+** Scene files (see scene.h and the README's "Scenes" section): JSON parsing with jansson, strict
+** key checking, and the conversion of a loading protocol into a piecewise-linear path and the
+** times at which samples are reported.
+*/
+#include "conifit/scene.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <jansson.h>
+
+#include "conifit/fitfile.h"
+
+/* Most cycles and samples a scene may ask for (keeps memory and run time bounded). */
+#define MAX_CYCLES 1000
+#define MAX_SAMPLES_PER_SEGMENT 100000
+
+typedef struct ctx {
+    const char *name;
+    cf_error *err;
+} ctx;
+
+/* Refuses keys of obj that are not in the NULL-terminated list. */
+static cf_status only_keys(ctx *c, json_t *obj, const char *where, const char *const *allowed)
+{
+    const char *key;
+    json_t *v;
+    json_object_foreach(obj, key, v)
+    {
+        int ok = 0;
+        for (size_t i = 0; allowed[i]; i++)
+            ok |= strcmp(key, allowed[i]) == 0;
+        if (!ok)
+            return cf_error_set(c->err, CF_E_DATA, "%s: unknown key '%s%s%s'", c->name, where,
+                                *where ? "." : "", key);
+    }
+    return CF_OK;
+}
+
+/* A number at obj[key]: required or default; checked finite and within [lo, hi] (or (lo, hi]
+** with open_lo). */
+static cf_status number(ctx *c, json_t *obj, const char *where, const char *key, int required,
+                        double dflt, double lo, int open_lo, double hi, double *out)
+{
+    json_t *v = obj ? json_object_get(obj, key) : NULL;
+    const char *dot = *where ? "." : "";
+    if (!v) {
+        if (required)
+            return cf_error_set(c->err, CF_E_DATA, "%s: missing key '%s%s%s'", c->name, where,
+                                dot, key);
+        *out = dflt;
+        return CF_OK;
+    }
+    if (!json_is_number(v))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s%s%s' must be a number", c->name,
+                            where, dot, key);
+    double x = json_number_value(v);
+    if (!isfinite(x) || (open_lo ? !(x > lo) : !(x >= lo)) || !(x <= hi))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s%s%s' = %g: must be %s %g and <= %g",
+                            c->name, where, dot, key, x, open_lo ? ">" : ">=", lo, hi);
+    *out = x;
+    return CF_OK;
+}
+
+static cf_status boolean(ctx *c, json_t *obj, const char *where, const char *key, int *out)
+{
+    json_t *v = obj ? json_object_get(obj, key) : NULL;
+    *out = 0;
+    if (!v)
+        return CF_OK;
+    if (!json_is_boolean(v))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.%s' must be true or false", c->name,
+                            where, key);
+    *out = json_is_true(v);
+    return CF_OK;
+}
+
+static cf_status object(ctx *c, json_t *root, const char *key, int required, json_t **out)
+{
+    json_t *v = json_object_get(root, key);
+    *out = NULL;
+    if (!v) {
+        if (required)
+            return cf_error_set(c->err, CF_E_DATA, "%s: missing key '%s'", c->name, key);
+        return CF_OK;
+    }
+    if (!json_is_object(v))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be an object", c->name, key);
+    *out = v;
+    return CF_OK;
+}
+
+static cf_status spring_section(ctx *c, json_t *sp, cf_scene *sc)
+{
+    static const char *const allowed[] = {"fit", "type", "params", NULL};
+    static const char *const pkeys[] = {"D1_mm", "D2_mm", "n", "d_mm", "G_MPa", "H_mm", NULL};
+    cf_status st = only_keys(c, sp, "spring", allowed);
+    if (st)
+        return st;
+    json_t *fit = json_object_get(sp, "fit"), *params = json_object_get(sp, "params");
+    json_t *type = json_object_get(sp, "type");
+    if ((fit != NULL) == (params != NULL))
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'spring' needs exactly one of 'spring.fit' or 'spring.params'",
+                            c->name);
+    if (type && !json_is_string(type))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'spring.type' must be a string", c->name);
+    if (fit) {
+        if (!json_is_string(fit))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key 'spring.fit' must be a file name",
+                                c->name);
+        const char *tn = type ? json_string_value(type) : NULL;
+        if (tn && cf_spring_type_parse(tn, &(cf_spring_type){0}, NULL) != CF_OK)
+            return cf_error_set(c->err, CF_E_DATA,
+                                "%s: key 'spring.type' = '%s': expected telescoping or "
+                                "non-telescoping",
+                                c->name, tn);
+        cf_fitted_spring fs;
+        cf_error ferr = {0};
+        st = cf_fitfile_load(json_string_value(fit), tn, &fs, &ferr);
+        if (st)
+            return cf_error_set(c->err, st, "%s: key 'spring.fit': %s", c->name, ferr.msg);
+        sc->spring = fs.params;
+        snprintf(sc->spring_source, sizeof sc->spring_source, "%s:%s", json_string_value(fit),
+                 cf_spring_type_name(fs.type));
+        return CF_OK;
+    }
+    if (type)
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'spring.type' only goes with 'spring.fit'", c->name);
+    if (!json_is_object(params))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'spring.params' must be an object",
+                            c->name);
+    if ((st = only_keys(c, params, "spring.params", pkeys)))
+        return st;
+    double *slot[6] = {&sc->spring.D1_mm, &sc->spring.D2_mm, &sc->spring.n,
+                       &sc->spring.d_mm,  &sc->spring.G_MPa, &sc->spring.H_mm};
+    for (int k = 0; k < 6; k++)
+        if ((st = number(c, params, "spring.params", pkeys[k], 1, 0, 0, 1, INFINITY, slot[k])))
+            return st;
+    cf_law law;
+    cf_error lerr = {0};
+    if (cf_law_init(&law, &sc->spring, &lerr) != CF_OK)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'spring.params': %s", c->name, lerr.msg);
+    snprintf(sc->spring_source, sizeof sc->spring_source, "params");
+    return CF_OK;
+}
+
+static cf_status lattice_section(ctx *c, json_t *lt, cf_scene *sc)
+{
+    static const char *const allowed[] = {"nx", "ny", "nz", "diagonals", "diagonal_weight",
+                                          "bottom", NULL};
+    cf_status st;
+    cf_lattice_config *L = &sc->cfg.lattice;
+    if (lt && (st = only_keys(c, lt, "lattice", allowed)))
+        return st;
+    const char *dn[3] = {"nx", "ny", "nz"};
+    int *dv[3] = {&L->nx, &L->ny, &L->nz};
+    for (int k = 0; k < 3; k++) {
+        double v;
+        if ((st = number(c, lt, "lattice", dn[k], 0, *dv[k], 1, 0, 1000, &v)))
+            return st;
+        if (v != floor(v))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key 'lattice.%s' = %g: must be a whole "
+                                "number", c->name, dn[k], v);
+        *dv[k] = (int)v;
+    }
+    if ((st = number(c, lt, "lattice", "diagonal_weight", 0, L->diagonal_weight, 0, 0, 1e6,
+                     &L->diagonal_weight)))
+        return st;
+    json_t *d = lt ? json_object_get(lt, "diagonals") : NULL;
+    if (d) {
+        const char *s = json_string_value(d);
+        if (s && strcmp(s, "none") == 0)
+            L->diagonals = CF_DIAG_NONE;
+        else if (s && strcmp(s, "face") == 0)
+            L->diagonals = CF_DIAG_FACE;
+        else if (s && strcmp(s, "body") == 0)
+            L->diagonals = CF_DIAG_BODY;
+        else if (s && strcmp(s, "face+body") == 0)
+            L->diagonals = CF_DIAG_FACE | CF_DIAG_BODY;
+        else
+            return cf_error_set(c->err, CF_E_DATA,
+                                "%s: key 'lattice.diagonals' = '%s': expected none, face, body or "
+                                "face+body",
+                                c->name, s ? s : "(not a string)");
+    }
+    json_t *b = lt ? json_object_get(lt, "bottom") : NULL;
+    if (b) {
+        const char *s = json_string_value(b);
+        if (s && strcmp(s, "axial") == 0)
+            L->bottom = CF_BOTTOM_AXIAL;
+        else if (s && strcmp(s, "clamped") == 0)
+            L->bottom = CF_BOTTOM_CLAMPED;
+        else
+            return cf_error_set(c->err, CF_E_DATA,
+                                "%s: key 'lattice.bottom' = '%s': expected axial or clamped",
+                                c->name, s ? s : "(not a string)");
+    }
+    return CF_OK;
+}
+
+static cf_status effects_section(ctx *c, json_t *ef, cf_scene *sc)
+{
+    static const char *const allowed[] = {"inertia", "damping", "viscosity", "gravity", NULL};
+    static const char *const dkeys[] = {"eta_kPa_s", NULL};
+    static const char *const vkeys[] = {"E_kPa", "tau_s", NULL};
+    cf_status st;
+    cf_msm_effects *e = &sc->effects;
+    memset(e, 0, sizeof *e);
+    if (!ef)
+        return CF_OK;
+    if ((st = only_keys(c, ef, "effects", allowed)))
+        return st;
+    if ((st = boolean(c, ef, "effects", "inertia", &e->inertia)))
+        return st;
+    int g = 0;
+    if ((st = boolean(c, ef, "effects", "gravity", &g)))
+        return st;
+    e->gravity_mm_per_s2 = g ? 9806.65 : 0.0;
+    json_t *dm = json_object_get(ef, "damping"), *vs = json_object_get(ef, "viscosity");
+    if (dm) {
+        if (!json_is_object(dm))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key 'effects.damping' must be an object "
+                                "{\"eta_kPa_s\": ...}", c->name);
+        double eta;
+        if ((st = only_keys(c, dm, "effects.damping", dkeys)) ||
+            (st = number(c, dm, "effects.damping", "eta_kPa_s", 1, 0, 0, 1, 1e12, &eta)))
+            return st;
+        e->eta_MPa_s = eta * 1e-3;
+    }
+    if (vs) {
+        if (!json_is_object(vs))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key 'effects.viscosity' must be an object "
+                                "{\"E_kPa\": ..., \"tau_s\": ...}", c->name);
+        double E, tau;
+        if ((st = only_keys(c, vs, "effects.viscosity", vkeys)) ||
+            (st = number(c, vs, "effects.viscosity", "E_kPa", 1, 0, 0, 1, 1e12, &E)) ||
+            (st = number(c, vs, "effects.viscosity", "tau_s", 1, 0, 0, 1, 1e12, &tau)))
+            return st;
+        e->maxwell_E_MPa = E * 1e-3;
+        e->maxwell_tau_s = tau;
+    }
+    if (g && !e->inertia)
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'effects.gravity' = true needs 'effects.inertia' = true "
+                            "(weight is carried by masses)",
+                            c->name);
+    return CF_OK;
+}
+
+static cf_status push(cf_scene *sc, size_t *cap, double t, double v)
+{
+    if (sc->npath == *cap) {
+        size_t nc = *cap ? 2 * *cap : 8;
+        double *a = realloc(sc->path_t_s, nc * sizeof(double));
+        if (!a)
+            return CF_E_INTERNAL;
+        sc->path_t_s = a;
+        double *b = realloc(sc->path_v, nc * sizeof(double));
+        if (!b)
+            return CF_E_INTERNAL;
+        sc->path_v = b;
+        *cap = nc;
+    }
+    sc->path_t_s[sc->npath] = t;
+    sc->path_v[sc->npath] = v;
+    sc->npath++;
+    return CF_OK;
+}
+
+static cf_status protocol_section(ctx *c, json_t *pr, cf_scene *sc, double samples_per_segment)
+{
+    static const char *const allowed[] = {"kind", "to_strain", "to_stress_kPa", "duration_s",
+                                          "period_s", "count", "ramp_s", "hold_s", NULL};
+    cf_status st;
+    if ((st = only_keys(c, pr, "protocol", allowed)))
+        return st;
+    const char *kind = json_string_value(json_object_get(pr, "kind"));
+    if (!kind)
+        return cf_error_set(c->err, CF_E_DATA, "%s: missing key 'protocol.kind' (ramp, cycles or "
+                            "hold)", c->name);
+    json_t *ts = json_object_get(pr, "to_strain"), *tf = json_object_get(pr, "to_stress_kPa");
+    if ((ts != NULL) == (tf != NULL))
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'protocol' needs exactly one of 'protocol.to_strain' "
+                            "(displacement drive) or 'protocol.to_stress_kPa' (force drive)",
+                            c->name);
+    double target;
+    if (ts) {
+        sc->drive = CF_DRIVE_DISPLACEMENT;
+        if ((st = number(c, pr, "protocol", "to_strain", 1, 0, -0.999, 0, 0.999, &target)))
+            return st;
+        /* A compressive strain at or past the spring's solid strain cannot be reached. */
+        cf_law law;
+        if (cf_law_init(&law, &sc->spring, NULL) == CF_OK &&
+            fabs(target) >= law.travel_mm / law.p.H_mm)
+            return cf_error_set(c->err, CF_E_DATA,
+                                "%s: key 'protocol.to_strain' = %g: at or beyond the spring's "
+                                "solid strain %.6g",
+                                c->name, target, law.travel_mm / law.p.H_mm);
+    } else {
+        sc->drive = CF_DRIVE_FORCE;
+        if ((st = number(c, pr, "protocol", "to_stress_kPa", 1, 0, -1e9, 0, 1e9, &target)))
+            return st;
+        target *= 1e-3;
+    }
+    sc->target = target;
+    size_t cap = 0;
+    double seg_t[3];
+    size_t nseg = 0;
+    if (strcmp(kind, "ramp") == 0) {
+        static const char *const ok[] = {"kind", "to_strain", "to_stress_kPa", "duration_s", NULL};
+        double dur;
+        if ((st = only_keys(c, pr, "protocol", ok)) ||
+            (st = number(c, pr, "protocol", "duration_s", 0, 1, 0, 1, 1e9, &dur)))
+            return st;
+        sc->kind = CF_PROTO_RAMP;
+        if (push(sc, &cap, 0, 0) || push(sc, &cap, dur, target))
+            goto oom;
+        (void)seg_t;
+        (void)nseg;
+    } else if (strcmp(kind, "cycles") == 0) {
+        static const char *const ok[] = {"kind", "to_strain", "to_stress_kPa", "period_s", "count",
+                                         NULL};
+        double period, count;
+        if ((st = only_keys(c, pr, "protocol", ok)) ||
+            (st = number(c, pr, "protocol", "period_s", 1, 0, 0, 1, 1e9, &period)) ||
+            (st = number(c, pr, "protocol", "count", 0, 1, 1, 0, MAX_CYCLES, &count)))
+            return st;
+        if (count != floor(count))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key 'protocol.count' = %g: must be a "
+                                "whole number", c->name, count);
+        sc->kind = CF_PROTO_CYCLES;
+        sc->cycles = (int)count;
+        if (push(sc, &cap, 0, 0))
+            goto oom;
+        for (int k = 0; k < sc->cycles; k++)
+            if (push(sc, &cap, (k + 0.5) * period, target) || push(sc, &cap, (k + 1) * period, 0))
+                goto oom;
+    } else if (strcmp(kind, "hold") == 0) {
+        static const char *const ok[] = {"kind", "to_strain", "to_stress_kPa", "ramp_s", "hold_s",
+                                         NULL};
+        double ramp, hold;
+        if ((st = only_keys(c, pr, "protocol", ok)) ||
+            (st = number(c, pr, "protocol", "ramp_s", 1, 0, 0, 1, 1e9, &ramp)) ||
+            (st = number(c, pr, "protocol", "hold_s", 1, 0, 0, 1, 1e9, &hold)))
+            return st;
+        sc->kind = CF_PROTO_HOLD;
+        if (push(sc, &cap, 0, 0) || push(sc, &cap, ramp, target) ||
+            push(sc, &cap, ramp + hold, target))
+            goto oom;
+    } else {
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'protocol.kind' = '%s': expected ramp, cycles or hold",
+                            c->name, kind);
+    }
+    /* Samples: every path segment split in samples_per_segment intervals. */
+    size_t per = (size_t)samples_per_segment;
+    sc->nsamples = (sc->npath - 1) * per + 1;
+    sc->sample_t_s = malloc(sc->nsamples * sizeof(double));
+    if (!sc->sample_t_s)
+        goto oom;
+    size_t k = 0;
+    sc->sample_t_s[k++] = sc->path_t_s[0];
+    for (size_t i = 1; i < sc->npath; i++)
+        for (size_t j = 1; j <= per; j++)
+            sc->sample_t_s[k++] = sc->path_t_s[i - 1] +
+                                  (sc->path_t_s[i] - sc->path_t_s[i - 1]) * (double)j / per;
+    return CF_OK;
+oom:
+    return cf_error_set(c->err, CF_E_INTERNAL, "out of memory for the loading path");
+}
+
+static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
+{
+    static const char *const allowed[] = {"spring", "lattice", "density_t_per_mm3", "protocol",
+                                          "effects", "integrator", "law_method", "table_intervals",
+                                          "samples_per_segment", "comment", NULL};
+    cf_status st;
+    if (!json_is_object(root))
+        return cf_error_set(c->err, CF_E_DATA, "%s: a scene must be a JSON object", c->name);
+    if ((st = only_keys(c, root, "", allowed)))
+        return st;
+    sc->cfg = cf_msm_default();
+    sc->method = CF_LAW_CLOSED;
+    sc->table_intervals = CF_LAW_TABLE_DEFAULT;
+    json_t *sp, *lt, *pr, *ef, *in;
+    if ((st = object(c, root, "spring", 1, &sp)) || (st = spring_section(c, sp, sc)))
+        return st;
+    if ((st = object(c, root, "lattice", 0, &lt)) || (st = lattice_section(c, lt, sc)))
+        return st;
+    if ((st = number(c, root, "", "density_t_per_mm3", 0, 1e-9, 0, 1, 1, 
+                     &sc->cfg.lattice.density_t_per_mm3)))
+        return st;
+    if ((st = object(c, root, "effects", 0, &ef)) || (st = effects_section(c, ef, sc)))
+        return st;
+    json_t *lm = json_object_get(root, "law_method");
+    if (lm) {
+        cf_error merr = {0};
+        if (!json_is_string(lm) || cf_law_method_parse(json_string_value(lm), &sc->method, &merr))
+            return cf_error_set(c->err, CF_E_DATA,
+                                "%s: key 'law_method' = '%s': expected exact, closed, "
+                                "closed+newton or table",
+                                c->name, json_is_string(lm) ? json_string_value(lm) : "?");
+    }
+    double ti;
+    if ((st = number(c, root, "", "table_intervals", 0, CF_LAW_TABLE_DEFAULT, 2, 0, 1e7, &ti)))
+        return st;
+    sc->table_intervals = (size_t)ti;
+    if ((st = object(c, root, "integrator", 0, &in)))
+        return st;
+    if (in) {
+        static const char *const ik[] = {"dt_s", "substeps", NULL};
+        double sub;
+        if ((st = only_keys(c, in, "integrator", ik)) ||
+            (st = number(c, in, "integrator", "dt_s", 0, 0, 0, 0, 1e6, &sc->cfg.dt_s)) ||
+            (st = number(c, in, "integrator", "substeps", 0, 10, 1, 0, 1e6, &sub)))
+            return st;
+        sc->cfg.quasi_substeps = (int)sub;
+    }
+    double per;
+    if ((st = number(c, root, "", "samples_per_segment", 0, 50, 1, 0, MAX_SAMPLES_PER_SEGMENT,
+                     &per)))
+        return st;
+    if ((st = object(c, root, "protocol", 1, &pr)) ||
+        (st = protocol_section(c, pr, sc, floor(per))))
+        return st;
+    return CF_OK;
+}
+
+void cf_scene_free(cf_scene *sc)
+{
+    if (!sc)
+        return;
+    free(sc->path_t_s);
+    free(sc->path_v);
+    free(sc->sample_t_s);
+    sc->path_t_s = sc->path_v = sc->sample_t_s = NULL;
+}
+
+static cf_status finish(ctx *c, json_t *root, json_error_t *jerr, cf_scene *sc)
+{
+    if (!root)
+        return cf_error_set(c->err, CF_E_DATA, "%s:%d:%d: not valid JSON: %s", c->name,
+                            jerr->line, jerr->column, jerr->text);
+    cf_status st = parse_root(c, root, sc);
+    json_decref(root);
+    if (st != CF_OK)
+        cf_scene_free(sc);
+    return st;
+}
+
+cf_status cf_scene_parse(const char *json_text, const char *name, cf_scene *sc, cf_error *err)
+{
+    memset(sc, 0, sizeof *sc);
+    ctx c = {name, err};
+    json_error_t jerr;
+    json_t *root = json_loads(json_text, JSON_REJECT_DUPLICATES, &jerr);
+    return finish(&c, root, &jerr, sc);
+}
+
+cf_status cf_scene_load(const char *path, cf_scene *sc, cf_error *err)
+{
+    memset(sc, 0, sizeof *sc);
+    ctx c = {path, err};
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return cf_error_set(err, CF_E_NOINPUT, "%s: cannot open scene: %s", path,
+                            strerror(errno));
+    json_error_t jerr;
+    json_t *root = json_loadf(f, JSON_REJECT_DUPLICATES, &jerr);
+    fclose(f);
+    return finish(&c, root, &jerr, sc);
+}
+
+cf_msm_path cf_scene_path(const cf_scene *sc)
+{
+    cf_msm_path p = {sc->drive, sc->npath, sc->path_t_s, sc->path_v};
+    return p;
+}

@@ -1,0 +1,329 @@
+/*
+** The mass-spring lattice (see lattice.h): construction of nodes, springs, weights, masses and
+** boundary fixities, and the force kernel the solvers call on every step.
+*/
+#include "conifit/lattice.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+cf_lattice_config cf_lattice_default(void)
+{
+    cf_lattice_config c;
+    c.nx = c.ny = c.nz = 3;
+    c.diagonals = CF_DIAG_FACE | CF_DIAG_BODY;
+    c.diagonal_weight = 1.0;
+    c.density_t_per_mm3 = 1e-9;
+    c.bottom = CF_BOTTOM_AXIAL;
+    return c;
+}
+
+/* Largest lattice accepted: keeps node indices in uint32 and memory bounded (about 2e7 springs). */
+#define CF_LATTICE_MAX_NODES 1500000.0
+
+void cf_lattice_free(cf_lattice *lat)
+{
+    if (!lat)
+        return;
+    double **d[] = {&lat->x, &lat->y, &lat->z, &lat->X, &lat->Y, &lat->Z, &lat->mass_t, &lat->fx,
+                    &lat->fy, &lat->fz, &lat->L0_mm, &lat->a, &lat->w, &lat->L_mm, &lat->u_mm,
+                    &lat->F_N, &lat->k_N_per_mm, &lat->T_N, &lat->top_share};
+    for (size_t i = 0; i < sizeof d / sizeof d[0]; i++) {
+        free(*d[i]);
+        *d[i] = NULL;
+    }
+    free(lat->fix);
+    free(lat->si);
+    free(lat->sj);
+    free(lat->top);
+    lat->fix = NULL;
+    lat->si = lat->sj = lat->top = NULL;
+}
+
+/* Number of cells along one axis that contain a segment from node index p with offset o
+** (o in {-1, 0, 1}) on an axis of n cells: an offset of 0 lies in cells p-1 and p, else in one. */
+static int cells_along(int p, int o, int n)
+{
+    if (o != 0) {
+        int c = o > 0 ? p : p - 1;
+        return (c >= 0 && c < n) ? 1 : 0;
+    }
+    return (p - 1 >= 0) + (p < n);
+}
+
+static size_t node_id(const cf_lattice_config *c, int i, int j, int k)
+{
+    return (size_t)i + (size_t)(c->nx + 1) * ((size_t)j + (size_t)(c->ny + 1) * (size_t)k);
+}
+
+cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method method,
+                            const cf_lattice_config *cfg, cf_error *err)
+{
+    memset(lat, 0, sizeof *lat);
+    const int dims[3] = {cfg->nx, cfg->ny, cfg->nz};
+    const char *names[3] = {"nx", "ny", "nz"};
+    for (int a = 0; a < 3; a++)
+        if (dims[a] < 1 || dims[a] > 10000)
+            return cf_error_set(err, CF_E_DATA, "lattice.%s = %d: must be between 1 and 10000",
+                                names[a], dims[a]);
+    if ((double)(cfg->nx + 1) * (cfg->ny + 1) * (cfg->nz + 1) > CF_LATTICE_MAX_NODES)
+        return cf_error_set(err, CF_E_DATA,
+                            "lattice %d x %d x %d cells: more than %.0f nodes", cfg->nx, cfg->ny,
+                            cfg->nz, CF_LATTICE_MAX_NODES);
+    if (!(cfg->density_t_per_mm3 > 0) || !isfinite(cfg->density_t_per_mm3))
+        return cf_error_set(err, CF_E_DATA, "density_t_per_mm3 = %g: must be finite and > 0",
+                            cfg->density_t_per_mm3);
+    if (!(cfg->diagonal_weight >= 0) || !isfinite(cfg->diagonal_weight))
+        return cf_error_set(err, CF_E_DATA, "lattice.diagonal_weight = %g: must be finite and >= 0",
+                            cfg->diagonal_weight);
+    if (cfg->diagonals & ~(unsigned)(CF_DIAG_FACE | CF_DIAG_BODY))
+        return cf_error_set(err, CF_E_DATA, "lattice.diagonals = %u: unknown flags",
+                            cfg->diagonals);
+    lat->cfg = *cfg;
+    lat->law = law;
+    lat->method = method;
+    lat->with_stiffness = 1;
+    lat->H_mm = law->p.H_mm;
+    lat->travel_mm = law->travel_mm;
+    const double H = lat->H_mm;
+
+    /* The 13 "positive" neighbour offsets (each unordered pair once). */
+    int off[13][3];
+    int noff = 0;
+    for (int dz = -1; dz <= 1; dz++)
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dx = -1; dx <= 1; dx++) {
+                int pos = dz > 0 || (dz == 0 && dy > 0) || (dz == 0 && dy == 0 && dx > 0);
+                if (!pos)
+                    continue;
+                int nz0 = (dx != 0) + (dy != 0) + (dz != 0);
+                if (nz0 == 2 && !(cfg->diagonals & CF_DIAG_FACE))
+                    continue;
+                if (nz0 == 3 && !(cfg->diagonals & CF_DIAG_BODY))
+                    continue;
+                if (nz0 > 1 && cfg->diagonal_weight == 0)
+                    continue;
+                off[noff][0] = dx;
+                off[noff][1] = dy;
+                off[noff][2] = dz;
+                noff++;
+            }
+
+    const size_t nn = (size_t)(cfg->nx + 1) * (cfg->ny + 1) * (cfg->nz + 1);
+    lat->nn = nn;
+    /* Upper bound on springs: noff per node. */
+    size_t cap = nn * (size_t)noff;
+    double **nd[] = {&lat->x, &lat->y, &lat->z, &lat->X, &lat->Y, &lat->Z,
+                     &lat->mass_t, &lat->fx, &lat->fy, &lat->fz};
+    for (size_t i = 0; i < sizeof nd / sizeof nd[0]; i++)
+        if (!(*nd[i] = calloc(nn, sizeof(double))))
+            goto oom;
+    double **sd[] = {&lat->L0_mm, &lat->a, &lat->w, &lat->L_mm, &lat->u_mm,
+                     &lat->F_N, &lat->k_N_per_mm, &lat->T_N};
+    for (size_t i = 0; i < sizeof sd / sizeof sd[0]; i++)
+        if (!(*sd[i] = calloc(cap ? cap : 1, sizeof(double))))
+            goto oom;
+    lat->fix = calloc(nn, 1);
+    lat->si = calloc(cap ? cap : 1, sizeof(uint32_t));
+    lat->sj = calloc(cap ? cap : 1, sizeof(uint32_t));
+    size_t ntop = (size_t)(cfg->nx + 1) * (cfg->ny + 1);
+    lat->top = calloc(ntop, sizeof(uint32_t));
+    lat->top_share = calloc(ntop, sizeof(double));
+    if (!lat->fix || !lat->si || !lat->sj || !lat->top || !lat->top_share)
+        goto oom;
+
+    const double cell_mass = cfg->density_t_per_mm3 * H * H * H;
+    int *degree = calloc(nn, sizeof(int));
+    if (!degree)
+        goto oom;
+    size_t ns = 0;
+    lat->m_min_t = INFINITY;
+    for (int k = 0; k <= cfg->nz; k++)
+        for (int j = 0; j <= cfg->ny; j++)
+            for (int i = 0; i <= cfg->nx; i++) {
+                size_t p = node_id(cfg, i, j, k);
+                lat->X[p] = lat->x[p] = i * H;
+                lat->Y[p] = lat->y[p] = j * H;
+                lat->Z[p] = lat->z[p] = k * H;
+                int cx = cells_along(i, 0, cfg->nx), cy = cells_along(j, 0, cfg->ny),
+                    cz = cells_along(k, 0, cfg->nz);
+                lat->mass_t[p] = cell_mass * cx * cy * cz / 8.0;
+                if (lat->mass_t[p] < lat->m_min_t)
+                    lat->m_min_t = lat->mass_t[p];
+                for (int o = 0; o < noff; o++) {
+                    int i2 = i + off[o][0], j2 = j + off[o][1], k2 = k + off[o][2];
+                    if (i2 < 0 || i2 > cfg->nx || j2 < 0 || j2 > cfg->ny || k2 < 0 ||
+                        k2 > cfg->nz)
+                        continue;
+                    int cells = cells_along(i, off[o][0], cfg->nx) *
+                                cells_along(j, off[o][1], cfg->ny) *
+                                cells_along(k, off[o][2], cfg->nz);
+                    if (cells == 0)
+                        continue;
+                    int zeros = (off[o][0] == 0) + (off[o][1] == 0) + (off[o][2] == 0);
+                    double share = cells / (double)(1 << zeros); /* 4, 2 or 1 cells share it */
+                    int nzc = 3 - zeros;
+                    double L0 = H * sqrt((double)nzc);
+                    size_t q = node_id(cfg, i2, j2, k2);
+                    lat->si[ns] = (uint32_t)(p < q ? p : q);
+                    lat->sj[ns] = (uint32_t)(p < q ? q : p);
+                    lat->L0_mm[ns] = L0;
+                    lat->a[ns] = H / L0;
+                    lat->w[ns] = share * (nzc > 1 ? cfg->diagonal_weight : 1.0);
+                    degree[p]++;
+                    degree[q]++;
+                    ns++;
+                }
+            }
+    lat->ns = ns;
+    lat->max_degree = 0;
+    for (size_t p = 0; p < nn; p++)
+        if (degree[p] > lat->max_degree)
+            lat->max_degree = degree[p];
+    free(degree);
+
+    /* Boundary: bottom face held in z (and x, y when clamped); with a sliding bottom, node (0,0,0)
+    ** is pinned in x and y and node (nx,0,0) in y, which removes the rigid lateral motions
+    ** without restraining the lateral expansion. */
+    for (int j = 0; j <= cfg->ny; j++)
+        for (int i = 0; i <= cfg->nx; i++) {
+            size_t p = node_id(cfg, i, j, 0);
+            lat->fix[p] = CF_FIX_Z;
+            if (cfg->bottom == CF_BOTTOM_CLAMPED)
+                lat->fix[p] |= CF_FIX_X | CF_FIX_Y;
+        }
+    if (cfg->bottom == CF_BOTTOM_AXIAL) {
+        lat->fix[node_id(cfg, 0, 0, 0)] |= CF_FIX_X | CF_FIX_Y;
+        lat->fix[node_id(cfg, cfg->nx, 0, 0)] |= CF_FIX_Y;
+    }
+    lat->ntop = ntop;
+    size_t t = 0;
+    for (int j = 0; j <= cfg->ny; j++)
+        for (int i = 0; i <= cfg->nx; i++) {
+            lat->top[t] = (uint32_t)node_id(cfg, i, j, cfg->nz);
+            lat->top_share[t] = cells_along(i, 0, cfg->nx) * cells_along(j, 0, cfg->ny) / 4.0;
+            t++;
+        }
+    lat->area_mm2 = (double)cfg->nx * cfg->ny * H * H;
+    lat->height_mm = cfg->nz * H;
+    return CF_OK;
+oom:
+    cf_lattice_free(lat);
+    return cf_error_set(err, CF_E_INTERNAL, "out of memory for a %d x %d x %d lattice", cfg->nx,
+                        cfg->ny, cfg->nz);
+}
+
+void cf_lattice_reset(cf_lattice *lat)
+{
+    memcpy(lat->x, lat->X, lat->nn * sizeof(double));
+    memcpy(lat->y, lat->Y, lat->nn * sizeof(double));
+    memcpy(lat->z, lat->Z, lat->nn * sizeof(double));
+}
+
+double cf_lattice_forces(cf_lattice *lat)
+{
+    const size_t ns = lat->ns, nn = lat->nn;
+    const uint32_t *restrict si = lat->si, *restrict sj = lat->sj;
+    const double *restrict x = lat->x, *restrict y = lat->y, *restrict z = lat->z;
+    const double *restrict L0 = lat->L0_mm, *restrict a = lat->a, *restrict w = lat->w;
+    double *restrict L = lat->L_mm, *restrict u = lat->u_mm, *restrict T = lat->T_N;
+    double *restrict fx = lat->fx, *restrict fy = lat->fy, *restrict fz = lat->fz;
+    const double *restrict F = lat->F_N;
+    double umax = 0;
+    /* 1: geometry (gathers, no branches). */
+    for (size_t s = 0; s < ns; s++) {
+        double dx = x[sj[s]] - x[si[s]], dy = y[sj[s]] - y[si[s]], dz = z[sj[s]] - z[si[s]];
+        double l = sqrt(dx * dx + dy * dy + dz * dz);
+        L[s] = l;
+        u[s] = (L0[s] - l) * a[s];
+        double au = fabs(u[s]);
+        umax = au > umax ? au : umax;
+    }
+    /* 2: the law, one dispatch for all springs. */
+    cf_law_force_many(lat->law, lat->method, ns, lat->u_mm, lat->F_N,
+                      lat->with_stiffness ? lat->k_N_per_mm : NULL);
+    /* 3: tensions and equal and opposite node forces. */
+    memset(fx, 0, nn * sizeof(double));
+    memset(fy, 0, nn * sizeof(double));
+    memset(fz, 0, nn * sizeof(double));
+    for (size_t s = 0; s < ns; s++) {
+        double t = -w[s] * F[s];
+        T[s] = t;
+        double g = t / L[s];
+        uint32_t i = si[s], j = sj[s];
+        double gx = g * (x[j] - x[i]), gy = g * (y[j] - y[i]), gz = g * (z[j] - z[i]);
+        fx[i] += gx;
+        fy[i] += gy;
+        fz[i] += gz;
+        fx[j] -= gx;
+        fy[j] -= gy;
+        fz[j] -= gz;
+    }
+    return umax / lat->travel_mm;
+}
+
+void cf_lattice_add_tensions(cf_lattice *lat, const double *Textra_N)
+{
+    const uint32_t *si = lat->si, *sj = lat->sj;
+    for (size_t s = 0; s < lat->ns; s++) {
+        uint32_t i = si[s], j = sj[s];
+        double g = Textra_N[s] / lat->L_mm[s];
+        double gx = g * (lat->x[j] - lat->x[i]), gy = g * (lat->y[j] - lat->y[i]),
+               gz = g * (lat->z[j] - lat->z[i]);
+        lat->fx[i] += gx;
+        lat->fy[i] += gy;
+        lat->fz[i] += gz;
+        lat->fx[j] -= gx;
+        lat->fy[j] -= gy;
+        lat->fz[j] -= gz;
+        lat->T_N[s] += Textra_N[s];
+    }
+}
+
+/* Work done compressing one unweighted spring of the law from 0 to u: int_0^u F(v) dv, N mm.
+** Region 1 exactly; the rest by 8-point Gauss-Legendre on [u_T, |u|] (the law is smooth there
+** apart from the square-root stiffening at solid). */
+static double law_work(const cf_law *law, cf_law_method m, double u)
+{
+    static const double gx[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
+                                 0.9602898564975363};
+    static const double gw[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
+                                 0.1012285362903763};
+    double au = fabs(u), uT = law->u_T_mm, s = law->travel_mm;
+    double e = 0.5 * law->k0_N_per_mm * fmin(au, uT) * fmin(au, uT);
+    if (au > uT) {
+        double hi = fmin(au, s), mid = 0.5 * (uT + hi), half = 0.5 * (hi - uT);
+        for (int q = 0; q < 4; q++)
+            e += half * gw[q] *
+                 (cf_law_force(law, m, mid + half * gx[q], NULL, NULL) +
+                  cf_law_force(law, m, mid - half * gx[q], NULL, NULL));
+        if (au > s)
+            e += law->F_C_N * (au - s);
+    }
+    return e;
+}
+
+double cf_lattice_elastic_energy(const cf_lattice *lat)
+{
+    double e = 0;
+    for (size_t s = 0; s < lat->ns; s++) {
+        double dx = lat->x[lat->sj[s]] - lat->x[lat->si[s]];
+        double dy = lat->y[lat->sj[s]] - lat->y[lat->si[s]];
+        double dz = lat->z[lat->sj[s]] - lat->z[lat->si[s]];
+        double u = (lat->L0_mm[s] - sqrt(dx * dx + dy * dy + dz * dz)) * lat->a[s];
+        e += lat->w[s] / lat->a[s] * law_work(lat->law, lat->method, u);
+    }
+    return e;
+}
+
+double cf_lattice_top_strain(const cf_lattice *lat)
+{
+    double sum = 0, wsum = 0;
+    for (size_t t = 0; t < lat->ntop; t++) {
+        uint32_t p = lat->top[t];
+        sum += lat->top_share[t] * (lat->Z[p] - lat->z[p]);
+        wsum += lat->top_share[t];
+    }
+    return sum / wsum / lat->height_mm;
+}

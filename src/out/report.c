@@ -1,0 +1,470 @@
+/*
+** Fit reports (see report.h): JSON through jansson, text through a memory stream.
+*/
+#include "conifit/report.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <jansson.h>
+
+#include "base/atomic.h"
+
+int cf_report_better(const cf_fit_report *r)
+{
+    int best = -1;
+    for (int i = 0; i < r->nfits; i++) {
+        if (!r->fits[i].feasible)
+            continue;
+        if (best < 0 || r->fits[i].rmse < r->fits[best].rmse)
+            best = i;
+    }
+    return best;
+}
+
+int cf_report_types_tie(const cf_fit_report *r)
+{
+    if (r->nfits != 2)
+        return 0;
+    double a = r->fits[0].rmse, b = r->fits[1].rmse;
+    return fabs(a - b) <= 1e-6 * fmax(a, b) + 1e-9 * r->ymax;
+}
+
+double cf_report_fit_aic(const cf_fit_report *r, int i)
+{
+    double f = r->y_to_file;
+    return cf_baseline_aic(r->points, r->fits[i].rss * f * f, 3, r->ymax * f);
+}
+
+double cf_report_baseline_aic(const cf_fit_report *r, int k)
+{
+    double f = r->y_to_file;
+    return cf_baseline_aic(r->points, r->baselines[k].rss * f * f, r->baselines[k].k, r->ymax * f);
+}
+
+/* A JSON number, or null for a value that is not finite (never written as NaN/Inf). */
+static json_t *num(double v)
+{
+    return isfinite(v) ? json_real(v) : json_null();
+}
+
+static json_t *constraint_list(unsigned bits)
+{
+    json_t *a = json_array();
+    for (int k = 0; k < CF_C_COUNT; k++)
+        if (bits & (1u << k))
+            json_array_append_new(a, json_string(cf_fit_constraint_name(1u << k)));
+    return a;
+}
+
+static json_t *value_se(double v, double se)
+{
+    return json_pack("{s:o, s:o}", "value", num(v), "stderr", se >= 0 ? num(se) : json_null());
+}
+
+static json_t *fit_json_core(const cf_fit_report *r, int i)
+{
+    const cf_fit_result *f = &r->fits[i];
+    const cf_law *L = &f->law;
+    const cf_spring *p = &f->params;
+    double u = r->y_to_file;
+    json_t *params = json_pack("{s:o, s:o, s:o, s:o, s:o, s:o}", "D1_mm", num(p->D1_mm), "D2_mm",
+                               num(p->D2_mm), "n", num(p->n), "d_mm", num(p->d_mm), "G_MPa",
+                               num(p->G_MPa), "H_mm", num(p->H_mm));
+    json_t *derived = json_pack(
+        "{s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o}", "rho", num(L->rho), "travel_mm",
+        num(L->travel_mm), "solid_strain", num(L->travel_mm / p->H_mm), "F_T_N", num(L->F_T_N),
+        "F_C_N", num(L->F_C_N), "k0_N_per_mm", num(L->k0_N_per_mm), "u_T_mm", num(L->u_T_mm),
+        "index_c", num(L->index_c), "L_min_mm", num(L->L_min_mm), "L_max_mm", num(L->L_max_mm));
+    json_t *ident;
+    if (r->force_displacement)
+        ident = json_pack("{s:o, s:o, s:o}", "rho", value_se(f->ident[0], f->ident_se[0]),
+                          "travel_mm", value_se(f->ident[1], f->ident_se[1]), "F_C_N",
+                          value_se(f->ident[2], f->ident_se[2]));
+    else
+        ident = json_pack("{s:o, s:o, s:o}", "rho", value_se(f->ident[0], f->ident_se[0]),
+                          "solid_strain", value_se(f->ident[1], f->ident_se[1]),
+                          "stress_scale_MPa", value_se(f->ident[2], f->ident_se[2]));
+    return json_pack("{s:s, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:b, s:o, s:o, s:s, s:I, s:o}",
+                     "type", cf_spring_type_name(f->type), "params", params, "derived", derived,
+                     "identifiable", ident, "rmse", num(f->rmse * u), "max_abs_error",
+                     num(f->max_abs_error * u), "r2", num(f->r2), "aic",
+                     num(cf_report_fit_aic(r, i)), "feasible", f->feasible, "active_constraints",
+                     constraint_list(f->active), "violated_constraints",
+                     constraint_list(f->violated), "optimizer", f->optimizer, "evaluations",
+                     (json_int_t)f->evaluations, "wall_time_s",
+                     num(r->with_timing ? f->wall_time_s : 0.0));
+}
+
+static const char *diag_name(unsigned dg)
+{
+    switch (dg & (CF_DIAG_FACE | CF_DIAG_BODY)) {
+    case CF_DIAG_FACE: return "face";
+    case CF_DIAG_BODY: return "body";
+    case CF_DIAG_FACE | CF_DIAG_BODY: return "face+body";
+    default: return "none";
+    }
+}
+
+/* validation {rmse, r2, max_abs_error (file's unit), lattice {...}, wall_time_s} or {skipped} */
+static json_t *validation_json(const cf_fit_report *r, int i)
+{
+    const cf_validation *v = &r->val[i];
+    if (!v->done)
+        return json_pack("{s:s}", "skipped", v->note);
+    const cf_lattice_config *lc = &v->setup.cfg.lattice;
+    double u = r->y_to_file;
+    json_t *lat = json_pack("{s:i, s:i, s:i, s:s, s:o, s:s}", "nx", lc->nx, "ny", lc->ny, "nz",
+                            lc->nz, "diagonals", diag_name(lc->diagonals), "diagonal_weight",
+                            num(lc->diagonal_weight), "bottom",
+                            lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial");
+    return json_pack("{s:o, s:o, s:o, s:o, s:s, s:I, s:o}", "rmse", num(v->rmse * u), "r2",
+                     num(v->r2), "max_abs_error", num(v->max_abs_error * u), "lattice", lat,
+                     "law_method", cf_law_method_name(v->setup.method), "solves",
+                     (json_int_t)v->solves, "wall_time_s",
+                     num(r->with_timing ? v->wall_time_s : 0.0));
+}
+
+static json_t *through_json(const cf_fit_report *r, int i)
+{
+    const cf_through_msm *t = &r->thr[i];
+    double u = r->y_to_file;
+    return json_pack("{s:o, s:o, s:b, s:o, s:I}", "rmse_before", num(t->rmse_before * u),
+                     "rmse_after", num(t->rmse_after * u), "improved", t->improved,
+                     "wall_time_s", num(r->with_timing ? t->wall_time_s : 0.0), "evaluations",
+                     (json_int_t)t->evaluations);
+}
+
+static json_t *fit_json(const cf_fit_report *r, int i)
+{
+    json_t *o = fit_json_core(r, i);
+    if (o && r->validate)
+        json_object_set_new(o, "validation", validation_json(r, i));
+    if (o && r->through_msm && r->thr[i].done)
+        json_object_set_new(o, "through_msm", through_json(r, i));
+    return o;
+}
+
+static json_t *baseline_json(const cf_fit_report *r, int k)
+{
+    const cf_baseline *b = &r->baselines[k];
+    double u = r->y_to_file;
+    json_t *coef;
+    /* coefficients in the file's y unit per unit x */
+    if (b->kind == CF_BASE_LINEAR)
+        coef = json_pack("{s:o}", "E", num(b->coef[0] * u));
+    else if (b->kind == CF_BASE_DUFFING)
+        coef = json_pack("{s:o, s:o}", "k1", num(b->coef[0] * u), "k3", num(b->coef[1] * u));
+    else
+        coef = json_pack("{s:o, s:o}", "A", num(b->coef[0] * u), "B", num(b->coef[1]));
+    return json_pack("{s:s, s:s, s:o, s:i, s:o, s:o}", "model", cf_baseline_name(b->kind),
+                     "formula",
+                     b->kind == CF_BASE_LINEAR    ? "y = E x"
+                     : b->kind == CF_BASE_DUFFING ? "y = k1 x + k3 x^3"
+                                                  : "y = A (exp(B x) - 1)",
+                     "coefficients", coef, "parameters", b->k, "rmse", num(b->rmse * u), "aic",
+                     num(cf_report_baseline_aic(r, k)));
+}
+
+static json_t *report_json(const cf_fit_report *r)
+{
+    json_t *data = json_pack(
+        "{s:s, s:I, s:s, s:s, s:s, s:s, s:s, s:s}", "file", r->data_file, "points",
+        (json_int_t)r->points, "x_column", r->x_column, "x_unit", r->x_unit, "y_column",
+        r->y_column, "y_unit", r->y_unit, "kind",
+        r->force_displacement ? "force-displacement" : "stress-strain", "sign",
+        r->compression ? "compression-negative" : "tension-positive");
+    json_t *fits = json_array(), *base = json_array();
+    for (int i = 0; i < r->nfits; i++)
+        json_array_append_new(fits, fit_json(r, i));
+    for (int k = 0; k < CF_BASE_COUNT; k++)
+        json_array_append_new(base, baseline_json(r, k));
+    json_t *root = json_pack("{s:s, s:o, s:o}", "conifit_version", r->version, "data", data,
+                             "fits", fits);
+    int b = cf_report_better(r);
+    json_object_set_new(root, "better_type",
+                        b >= 0 ? json_string(cf_spring_type_name(r->fits[b].type)) : json_null());
+    if (r->nfits == 2 && b >= 0) {
+        int o = 1 - b;
+        json_object_set_new(
+            root, "comparison",
+            json_pack("{s:b, s:o, s:o}", "tie", cf_report_types_tie(r),
+                      "rmse_ratio_other_to_better",
+                      num(r->fits[b].rmse > 0 ? r->fits[o].rmse / r->fits[b].rmse : 1.0),
+                      "aic_difference", num(cf_report_fit_aic(r, o) - cf_report_fit_aic(r, b))));
+    }
+    json_object_set_new(root, "baselines", base);
+    json_object_set_new(root, "identifiability",
+                        json_string("the law depends on the six design parameters only through "
+                                    "rho, the solid strain (travel) and the stress (load) scale; "
+                                    "params is one member of that family, chosen by the "
+                                    "constraints"));
+    return root;
+}
+
+char *cf_report_json_string(const cf_fit_report *r)
+{
+    json_t *root = report_json(r);
+    if (!root)
+        return NULL;
+    char *s = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
+    json_decref(root);
+    return s;
+}
+
+cf_status cf_report_json_write(const cf_fit_report *r, const char *path,
+                               const char *const *inputs, cf_error *err)
+{
+    char *s = cf_report_json_string(r);
+    if (!s)
+        return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory building the report", path);
+    cf_atomic a;
+    cf_status st = cf_atomic_open(&a, path, inputs, err);
+    if (st == CF_OK) {
+        fputs(s, a.fp);
+        fputc('\n', a.fp);
+        st = cf_atomic_commit(&a, err);
+    }
+    free(s);
+    return st;
+}
+
+/* ---- text ------------------------------------------------------------------------------------- */
+
+static void row(FILE *o, const cf_fit_report *r, const char *label, const char *fmt, int which)
+{
+    fprintf(o, "  %-26s", label);
+    for (int i = 0; i < r->nfits; i++) {
+        const cf_fit_result *f = &r->fits[i];
+        const cf_spring *p = &f->params;
+        char cell[64];
+        double u = r->y_to_file;
+        switch (which) {
+        case 0: snprintf(cell, sizeof cell, fmt, p->D1_mm); break;
+        case 1: snprintf(cell, sizeof cell, fmt, p->D2_mm); break;
+        case 2: snprintf(cell, sizeof cell, fmt, p->n); break;
+        case 3: snprintf(cell, sizeof cell, fmt, p->d_mm); break;
+        case 4: snprintf(cell, sizeof cell, fmt, p->G_MPa); break;
+        case 5: snprintf(cell, sizeof cell, fmt, p->H_mm); break;
+        case 6: snprintf(cell, sizeof cell, fmt, f->law.index_c); break;
+        case 7: snprintf(cell, sizeof cell, fmt, f->law.travel_mm); break;
+        case 8: snprintf(cell, sizeof cell, fmt, f->law.F_T_N); break;
+        case 9: snprintf(cell, sizeof cell, fmt, f->law.F_C_N); break;
+        case 10: snprintf(cell, sizeof cell, fmt, f->rmse * u, r->y_unit); break;
+        case 11: snprintf(cell, sizeof cell, fmt, f->max_abs_error * u, r->y_unit); break;
+        case 12: snprintf(cell, sizeof cell, fmt, f->r2); break;
+        case 13: snprintf(cell, sizeof cell, fmt, cf_report_fit_aic(r, i)); break;
+        case 14: snprintf(cell, sizeof cell, fmt, f->law.k0_N_per_mm); break;
+        default: cell[0] = '\0';
+        }
+        fprintf(o, " %-24s", cell);
+    }
+    fputc('\n', o);
+}
+
+static void ident_row(FILE *o, const cf_fit_report *r, const char *label, int k, double scale,
+                      const char *unit)
+{
+    fprintf(o, "  %-26s", label);
+    for (int i = 0; i < r->nfits; i++) {
+        char cell[64];
+        const cf_fit_result *f = &r->fits[i];
+        if (f->ident_se[k] >= 0)
+            snprintf(cell, sizeof cell, "%.6g ± %.2g%s%s", f->ident[k] * scale,
+                     f->ident_se[k] * scale, *unit ? " " : "", unit);
+        else
+            snprintf(cell, sizeof cell, "%.6g%s%s (± ?)", f->ident[k] * scale, *unit ? " " : "",
+                     unit);
+        fprintf(o, " %-24s", cell);
+    }
+    fputc('\n', o);
+}
+
+/* One cell per fit from a printf format and a value (MPa values are converted by the caller). */
+static void cells(FILE *o, const cf_fit_report *r, const char *label, const char *const *text)
+{
+    fprintf(o, "  %-26s", label);
+    for (int i = 0; i < r->nfits; i++)
+        fprintf(o, " %-24s", text[i]);
+    fputc('\n', o);
+}
+
+/* The lattice validation (and the fit through the lattice) beside the single-spring quality. */
+static void validation_text(FILE *o, const cf_fit_report *r)
+{
+    int any = 0;
+    for (int i = 0; i < r->nfits; i++)
+        any |= r->val[i].done;
+    if (!any) {
+        fprintf(o, " validation in the lattice: skipped: %s\n", r->val[0].note);
+        return;
+    }
+    const cf_validate_setup *su = &r->val[0].setup;
+    for (int i = 0; i < r->nfits; i++)
+        if (r->val[i].done)
+            su = &r->val[i].setup;
+    const cf_lattice_config *lc = &su->cfg.lattice;
+    fprintf(o, " validation in the lattice (%d x %d x %d cells, diagonals %s, bottom %s, %s):\n",
+            lc->nx, lc->ny, lc->nz, diag_name(lc->diagonals),
+            lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial", cf_law_method_name(su->method));
+    char buf[4][2][64];
+    const char *t[2];
+    const double u = r->y_to_file;
+    for (int i = 0; i < r->nfits; i++) {
+        const cf_validation *v = &r->val[i];
+        if (!v->done) {
+            for (int k = 0; k < 4; k++)
+                snprintf(buf[k][i], sizeof buf[k][i], k ? "" : "skipped (see below)");
+            continue;
+        }
+        snprintf(buf[0][i], sizeof buf[0][i], "%.4g %s", v->rmse * u, r->y_unit);
+        snprintf(buf[1][i], sizeof buf[1][i], "%.4g %s", v->max_abs_error * u, r->y_unit);
+        snprintf(buf[2][i], sizeof buf[2][i], "%.6f", v->r2);
+        snprintf(buf[3][i], sizeof buf[3][i], "%.1f ms, %zu solves", 1e3 * v->wall_time_s,
+                 v->solves);
+    }
+    static const char *const labels[4] = {"lattice RMSE", "lattice max |error|", "lattice R^2",
+                                          "lattice time"};
+    for (int k = 0; k < 4; k++) {
+        for (int i = 0; i < r->nfits; i++)
+            t[i] = buf[k][i];
+        cells(o, r, labels[k], t);
+    }
+    if (r->through_msm) {
+        for (int i = 0; i < r->nfits; i++) {
+            const cf_through_msm *th = &r->thr[i];
+            if (th->done)
+                snprintf(buf[0][i], sizeof buf[0][i], "%.4g -> %.4g %s", th->rmse_before * u,
+                         th->rmse_after * u, r->y_unit);
+            else
+                snprintf(buf[0][i], sizeof buf[0][i], "not run");
+            snprintf(buf[1][i], sizeof buf[1][i], "%.2f s, %ld curves", th->wall_time_s,
+                     th->evaluations);
+            t[i] = buf[0][i];
+        }
+        cells(o, r, "through lattice: RMSE", t);
+        for (int i = 0; i < r->nfits; i++)
+            t[i] = buf[1][i];
+        cells(o, r, "through lattice: cost", t);
+    }
+    for (int i = 0; i < r->nfits; i++)
+        if (!r->val[i].done)
+            fprintf(o, "  (%s: validation skipped: %s)\n", cf_spring_type_name(r->fits[i].type),
+                    r->val[i].note);
+}
+
+char *cf_report_text(const cf_fit_report *r)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *o = open_memstream(&buf, &len);
+    if (!o)
+        return NULL;
+    fprintf(o, "%s: %zu points, %s [%s] against %s [%s], %s\n\n", r->data_file, r->points,
+            r->x_column, r->x_unit, r->y_column, r->y_unit,
+            r->compression ? "compression negative" : "tension positive");
+    fprintf(o, "  %-26s", "");
+    for (int i = 0; i < r->nfits; i++)
+        fprintf(o, " %-24s", cf_spring_type_name(r->fits[i].type));
+    fputc('\n', o);
+    fprintf(o, " identifiable (determined by the data):\n");
+    ident_row(o, r, "rho = D1/D2", 0, 1, "");
+    if (r->force_displacement) {
+        ident_row(o, r, "travel s", 1, 1, "mm");
+        ident_row(o, r, "solid load F_C", 2, 1, "N");
+    } else {
+        ident_row(o, r, "solid strain s/H", 1, 1, "");
+        ident_row(o, r, "stress scale F_C/H^2", 2, r->y_to_file, r->y_unit);
+    }
+    fprintf(o, " one spring of that family (chosen by the constraints):\n");
+    row(o, r, "D1", "%.6g mm", 0);
+    row(o, r, "D2", "%.6g mm", 1);
+    row(o, r, "n", "%.6g", 2);
+    row(o, r, "d", "%.6g mm", 3);
+    row(o, r, "G", "%.6g MPa", 4);
+    row(o, r, "H", "%.6g mm", 5);
+    row(o, r, "spring index c = D1/d", "%.4g", 6);
+    row(o, r, "travel s", "%.6g mm", 7);
+    row(o, r, "F_T, F_C", "%.4g N", 8);
+    row(o, r, "", "%.4g N", 9);
+    row(o, r, "k0", "%.6g N/mm", 14);
+    fprintf(o, " quality:\n");
+    row(o, r, "RMSE", "%.4g %s", 10);
+    row(o, r, "max |error|", "%.4g %s", 11);
+    row(o, r, "R^2", "%.6f", 12);
+    row(o, r, "AIC (k = 3)", "%.2f", 13);
+    if (r->validate)
+        validation_text(o, r);
+    fprintf(o, "  %-26s", "feasible");
+    for (int i = 0; i < r->nfits; i++) {
+        char cell[160] = "yes";
+        if (!r->fits[i].feasible) {
+            snprintf(cell, sizeof cell, "NO:");
+            for (int k = 0; k < CF_C_COUNT; k++)
+                if (r->fits[i].violated & (1u << k))
+                    snprintf(cell + strlen(cell), sizeof cell - strlen(cell), " %s",
+                             cf_fit_constraint_name(1u << k));
+        }
+        fprintf(o, " %-24s", cell);
+    }
+    fputc('\n', o);
+    fprintf(o, "  %-26s", "active constraints");
+    for (int i = 0; i < r->nfits; i++) {
+        char cell[160] = "";
+        for (int k = 0; k < CF_C_COUNT; k++)
+            if (r->fits[i].active & (1u << k))
+                snprintf(cell + strlen(cell), sizeof cell - strlen(cell), "%s%s", *cell ? "," : "",
+                         cf_fit_constraint_name(1u << k));
+        fprintf(o, " %-24s", *cell ? cell : "none");
+    }
+    fputc('\n', o);
+    fprintf(o, "  %-26s", "optimizer, evaluations");
+    for (int i = 0; i < r->nfits; i++) {
+        char cell[64];
+        snprintf(cell, sizeof cell, "%s, %ld, %.1f ms", r->fits[i].optimizer,
+                 r->fits[i].evaluations, 1e3 * r->fits[i].wall_time_s);
+        fprintf(o, " %-24s", cell);
+    }
+    fputc('\n', o);
+    int b = cf_report_better(r);
+    if (r->nfits == 2 && b >= 0) {
+        int ot = 1 - b;
+        double rb = r->fits[b].rmse * r->y_to_file, ro = r->fits[ot].rmse * r->y_to_file;
+        fprintf(o, "\nBetter type: %s (RMSE %.4g %s against %.4g %s", cf_spring_type_name(r->fits[b].type),
+                rb, r->y_unit, ro, r->y_unit);
+        if (!cf_report_types_tie(r))
+            fprintf(o, ", %.3g times lower; AIC lower by %.2f)\n", ro / rb,
+                    cf_report_fit_aic(r, ot) - cf_report_fit_aic(r, b));
+        else
+            fprintf(o, "; the two types fit equally well)\n");
+    } else if (b < 0) {
+        fprintf(o, "\nNo feasible fit: no spring meets every constraint on this table (see "
+                   "'feasible' above).\n");
+    }
+    fprintf(o, "\nBaselines (plain least squares):\n");
+    for (int k = 0; k < CF_BASE_COUNT; k++) {
+        const cf_baseline *bl = &r->baselines[k];
+        char co[96];
+        double u = r->y_to_file;
+        if (bl->kind == CF_BASE_LINEAR)
+            snprintf(co, sizeof co, "E = %.4g %s", bl->coef[0] * u, r->y_unit);
+        else if (bl->kind == CF_BASE_DUFFING)
+            snprintf(co, sizeof co, "k1 = %.4g, k3 = %.4g %s", bl->coef[0] * u, bl->coef[1] * u,
+                     r->y_unit);
+        else
+            snprintf(co, sizeof co, "A = %.4g %s, B = %.4g", bl->coef[0] * u, r->y_unit,
+                     bl->coef[1]);
+        fprintf(o, "  %-8s %-36s RMSE %.4g %s   AIC %.2f (k = %d)\n", cf_baseline_name(bl->kind), co,
+                bl->rmse * u, r->y_unit, cf_report_baseline_aic(r, k), bl->k);
+    }
+    fprintf(o, "\nThe law seen through this table depends on the six design parameters only through "
+               "rho,\nthe %s and the %s. The six numbers above are one member of a family of "
+               "equally\ngood springs, chosen by the constraints (spring index, n >= 2, type, "
+               "bounds, fixed values).\n",
+            r->force_displacement ? "travel" : "solid strain",
+            r->force_displacement ? "solid load" : "stress scale");
+    fclose(o);
+    return buf;
+}
