@@ -255,6 +255,8 @@ static int parse_args(int argc, char **argv, fit_args *a)
     if (a->nfiles > 1 && a->plot && !is_dir_target(a->plot))
         return cf_cli_usage_error(cmd, "--plot %s: with %d tables, --plot must name a folder",
                                   a->plot, a->nfiles);
+    if (a->plot && !is_dir_target(a->plot) && cf_plot_check_name(a->plot, &err) != CF_OK)
+        return cf_cli_usage_error(cmd, "--plot %s: the file must end in .png or .svg", a->plot);
     return -1;
 }
 

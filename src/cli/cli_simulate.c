@@ -14,6 +14,7 @@
 #include "cli/cli.h"
 #include "conifit/msm.h"
 #include "conifit/scene.h"
+#include "out/plot.h"
 
 static const char simulate_help[] =
     "usage: conifit simulate SCENE.json -o OUT.csv [--plot OUT.png]\n"
@@ -23,7 +24,7 @@ static const char simulate_help[] =
     "spring_stress_kPa is one spring's F(strain H)/H^2 at the same strain, for comparison).\n"
     "A scene with no inertia, damping or viscosity is solved as static equilibria.\n\n"
     "  -o, --output FILE   CSV to write (written to a temporary name, then renamed)\n"
-    "  --plot FILE.png     also plot the result with gnuplot\n";
+    "  --plot FILE.png|.svg  also plot the result with gnuplot\n";
 
 /* Area of the closed loop(s) in the stress-strain plane over samples [a, b], kPa = kJ/m^3. */
 /* Progress on a terminal: one line, rewritten after every sample. */
@@ -92,55 +93,6 @@ static void summary(const cf_scene *sc, const cf_msm_sample *s, size_t n, const 
     }
 }
 
-/* Runs gnuplot on the CSV, writing a temporary PNG beside `png` and renaming it. */
-static cf_status plot(const cf_scene *sc, const char *csv, const char *png, cf_error *err)
-{
-    char tmp[4200];
-    snprintf(tmp, sizeof tmp, "%s.tmpXXXXXX", png);
-    int fd = mkstemp(tmp);
-    if (fd < 0)
-        return cf_error_set(err, CF_E_CANTWRITE, "%s: cannot create a temporary file", png);
-    fchmod(fd, 0644); /* an ordinary file, not mkstemp's private mode */
-    close(fd);
-    FILE *gp = popen("gnuplot", "w");
-    if (!gp) {
-        remove(tmp);
-        return cf_error_set(err, CF_E_CANTWRITE, "cannot run gnuplot for %s", png);
-    }
-    fprintf(gp, "set terminal pngcairo size 800,560 font ',11'\nset output '%s'\n"
-                "set datafile separator ','\nset key top left\nset grid\n", tmp);
-    if (sc->kind == CF_PROTO_HOLD) {
-        fprintf(gp, "set xlabel 'time (s)'\n");
-        if (sc->drive == CF_DRIVE_FORCE)
-            fprintf(gp, "set ylabel 'compressive strain'\nset title 'creep under a held load'\n"
-                        "plot '%s' every ::1 using 1:2 with lines lw 2 title 'lattice'\n", csv);
-        else
-            fprintf(gp, "set ylabel 'compressive stress (kPa)'\n"
-                        "set title 'relaxation under a held strain'\n"
-                        "plot '%s' every ::1 using 1:3 with lines lw 2 title 'lattice'\n", csv);
-    } else {
-        fprintf(gp, "set xlabel 'compressive strain'\nset ylabel 'compressive stress (kPa)'\n");
-        if (sc->kind == CF_PROTO_CYCLES)
-            fprintf(gp, "set title 'load-unload cycles'\n"
-                        "plot '%s' every ::1 using 2:3 with lines lw 2 title 'lattice'\n", csv);
-        else
-            fprintf(gp, "set title 'uniaxial: lattice against one spring'\n"
-                        "plot '%s' every ::1 using 2:3 with lines lw 2 title 'lattice', "
-                        "'' every ::1 using 2:5 with lines lw 2 dt 2 title 'single spring'\n",
-                    csv);
-    }
-    int rc = pclose(gp);
-    if (rc != 0) {
-        remove(tmp);
-        return cf_error_set(err, CF_E_CANTWRITE, "gnuplot failed (status %d) writing %s", rc, png);
-    }
-    if (rename(tmp, png) != 0) {
-        remove(tmp);
-        return cf_error_set(err, CF_E_CANTWRITE, "%s: cannot rename the plot into place", png);
-    }
-    return CF_OK;
-}
-
 int cf_cli_simulate(int argc, char **argv)
 {
     const char *scene_path = NULL, *out = NULL, *png = NULL;
@@ -181,6 +133,8 @@ int cf_cli_simulate(int argc, char **argv)
         return cf_cli_usage_error("simulate", "no scene file given");
     if (!out)
         return cf_cli_usage_error("simulate", "no output file given (-o OUT.csv)");
+    if (png && cf_plot_check_name(png, &err) != CF_OK)
+        return cf_cli_usage_error("simulate", "--plot %s: the file must end in .png or .svg", png);
 
     cf_scene sc;
     if (cf_scene_load(scene_path, &sc, &err) != CF_OK)
@@ -190,7 +144,8 @@ int cf_cli_simulate(int argc, char **argv)
     cf_lattice lat;
     memset(&lat, 0, sizeof lat);
     cf_msm_sample *samples = NULL;
-    cf_atomic a = {0};
+    cf_atomic a = {0}, pa = {0};
+    double *spring = NULL;
     int rc = CF_EXIT_OK;
     if (cf_law_init(&law, &sc.spring, &err) != CF_OK) {
         rc = cf_cli_fail(&err);
@@ -227,22 +182,34 @@ int cf_cli_simulate(int argc, char **argv)
         rc = cf_cli_fail(&err);
         goto end;
     }
-    fprintf(a.fp, "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa\n");
-    double H = law.p.H_mm;
-    for (size_t k = 0; k < sc.nsamples; k++) {
-        double f = cf_law_force(&law, sc.method, samples[k].strain * H, NULL, NULL) / (H * H);
-        fprintf(a.fp, "%.17g,%.17g,%.17g,%.17g,%.17g\n", samples[k].t_s, samples[k].strain,
-                samples[k].stress_MPa * 1e3, samples[k].kinetic_mJ, f * 1e3);
+    spring = malloc(sc.nsamples * sizeof *spring);
+    if (!spring) {
+        cf_error_set(&err, CF_E_INTERNAL, "out of memory for %zu samples", sc.nsamples);
+        rc = cf_cli_fail(&err);
+        goto end;
     }
-    if (cf_atomic_commit(&a, &err) != CF_OK) {
+    double H = law.p.H_mm;
+    for (size_t k = 0; k < sc.nsamples; k++)
+        spring[k] = cf_law_force(&law, sc.method, samples[k].strain * H, NULL, NULL) / (H * H);
+    fprintf(a.fp, "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa\n");
+    for (size_t k = 0; k < sc.nsamples; k++)
+        fprintf(a.fp, "%.17g,%.17g,%.17g,%.17g,%.17g\n", samples[k].t_s, samples[k].strain,
+                samples[k].stress_MPa * 1e3, samples[k].kinetic_mJ, spring[k] * 1e3);
+    if (png && cf_plot_simulation(&sc, samples, spring, sc.nsamples, png, inputs, &pa, &err) !=
+                   CF_OK) {
+        rc = cf_cli_fail(&err);
+        goto end;
+    }
+    /* both outputs exist as temporaries: put them in place together */
+    if (cf_atomic_commit(&a, &err) != CF_OK || (png && cf_atomic_commit(&pa, &err) != CF_OK)) {
         rc = cf_cli_fail(&err);
         goto end;
     }
     summary(&sc, samples, sc.nsamples, &st);
-    if (png && plot(&sc, out, png, &err) != CF_OK)
-        rc = cf_cli_fail(&err);
 end:
     cf_atomic_abort(&a);
+    cf_atomic_abort(&pa);
+    free(spring);
     free(samples);
     cf_lattice_free(&lat);
     cf_law_free(&law);

@@ -1,36 +1,28 @@
 /*
-** gnuplot plots of a fit (see plot.h). The data and the model curves go into the script as inline
-** data blocks, so gnuplot needs no other file.
+** conifit's figures (see plot.h), written as gnuplot scripts under the rule of gnuplot.h.
 */
 #include "out/plot.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
-#include <fcntl.h>
-#include <strings.h>
-#include <unistd.h>
 
-#include "base/atomic.h"
+#include "out/gnuplot.h"
 
 /* Points on each model curve. */
 #define CURVE_POINTS 400
 
-static int ends_with(const char *s, const char *suffix)
-{
-    size_t a = strlen(s), b = strlen(suffix);
-    return a >= b && strcasecmp(s + a - b, suffix) == 0;
-}
-
 /* x and the lattice stress (file's unit) of every data point, sorted by x. */
-static void lattice_block(FILE *g, const cf_fit_data *d, const double *stress_MPa, double u)
+static void lattice_block(cf_gp *g, const char *name, const cf_fit_data *d,
+                          const double *stress_MPa, double u)
 {
     size_t *ord = malloc(sizeof(size_t) * (d->count ? d->count : 1));
-    if (!ord)
+    if (!ord) {
+        cf_gp_block_begin(g, name);
+        cf_gp_block_end(g);
         return;
+    }
     for (size_t i = 0; i < d->count; i++)
         ord[i] = i;
     for (size_t i = 1; i < d->count; i++) /* insertion sort: tables are short and nearly sorted */
@@ -39,14 +31,24 @@ static void lattice_block(FILE *g, const cf_fit_data *d, const double *stress_MP
             ord[j] = ord[j - 1];
             ord[j - 1] = t;
         }
-    for (size_t i = 0; i < d->count; i++)
-        fprintf(g, "%.17g %.17g\n", d->x[ord[i]], stress_MPa[ord[i]] * u);
+    cf_gp_block_begin(g, name);
+    for (size_t i = 0; i < d->count; i++) {
+        double row[2] = {d->x[ord[i]], stress_MPa[ord[i]] * u};
+        cf_gp_block_row(g, 2, row);
+    }
+    cf_gp_block_end(g);
     free(ord);
 }
 
-static void write_script(FILE *g, const cf_fit_report *r, const cf_fit_data *d, const char *out,
-                         int svg)
+typedef struct fit_figure {
+    const cf_fit_report *r;
+    const cf_fit_data *d;
+} fit_figure;
+
+static void fit_script(cf_gp *g, const void *fig)
 {
+    const cf_fit_report *r = ((const fit_figure *)fig)->r;
+    const cf_fit_data *d = ((const fit_figure *)fig)->d;
     const double u = r->y_to_file;
     double xmin = 0, xmax = 0;
     for (size_t i = 0; i < d->count; i++) {
@@ -56,144 +58,187 @@ static void write_script(FILE *g, const cf_fit_report *r, const cf_fit_data *d, 
     cf_law laws[2];
     for (int i = 0; i < r->nfits; i++)
         laws[i] = r->fits[i].law;
+    double row[2 + 2 * (2 + CF_BASE_COUNT)];
     /* data: x, y, then the residual of each model (fits then baselines) */
-    fprintf(g, "$DATA << EOD\n");
+    cf_gp_block_begin(g, "DATA");
     for (size_t i = 0; i < d->count; i++) {
-        fprintf(g, "%.17g %.17g", d->x[i], d->y[i] * u);
+        size_t c = 0;
+        row[c++] = d->x[i];
+        row[c++] = d->y[i] * u;
         for (int k = 0; k < r->nfits; k++)
-            fprintf(g, " %.17g",
-                    (cf_fit_model(&laws[k], r->force_displacement, d->x[i]) - d->y[i]) * u);
+            row[c++] = (cf_fit_model(&laws[k], r->force_displacement, d->x[i]) - d->y[i]) * u;
         for (int k = 0; k < CF_BASE_COUNT; k++)
-            fprintf(g, " %.17g", (cf_baseline_eval(&r->baselines[k], d->x[i]) - d->y[i]) * u);
-        fputc('\n', g);
+            row[c++] = (cf_baseline_eval(&r->baselines[k], d->x[i]) - d->y[i]) * u;
+        cf_gp_block_row(g, c, row);
     }
-    fprintf(g, "EOD\n$CURVES << EOD\n");
+    cf_gp_block_end(g);
+    cf_gp_block_begin(g, "CURVES");
     for (int j = 0; j <= CURVE_POINTS; j++) {
+        size_t c = 0;
         double x = xmin + (xmax - xmin) * j / CURVE_POINTS;
-        fprintf(g, "%.17g", x);
+        row[c++] = x;
         for (int k = 0; k < r->nfits; k++)
-            fprintf(g, " %.17g", cf_fit_model(&laws[k], r->force_displacement, x) * u);
+            row[c++] = cf_fit_model(&laws[k], r->force_displacement, x) * u;
         for (int k = 0; k < CF_BASE_COUNT; k++)
-            fprintf(g, " %.17g", cf_baseline_eval(&r->baselines[k], x) * u);
-        fputc('\n', g);
+            row[c++] = cf_baseline_eval(&r->baselines[k], x) * u;
+        cf_gp_block_row(g, c, row);
     }
-    fprintf(g, "EOD\n");
+    cf_gp_block_end(g);
     /* the lattice curve of each validated fit, at the table's strains in increasing order */
-    int nlat = 0;
+    static const char *const lat_name[2] = {"LATTICE0", "LATTICE1"};
+    int lat[2] = {0, 0};
     if (r->validate)
         for (int k = 0; k < r->nfits; k++)
             if (r->val[k].done && r->val[k].count == d->count) {
-                fprintf(g, "$LATTICE%d << EOD\n", k);
-                lattice_block(g, d, r->val[k].stress_MPa, u);
-                fprintf(g, "EOD\n");
-                nlat++;
+                lattice_block(g, lat_name[k], d, r->val[k].stress_MPa, u);
+                lat[k] = 1;
             }
-    if (svg)
-        fprintf(g, "set terminal svg size 900,800 dynamic enhanced font 'sans,12'\n");
-    else
-        fprintf(g, "set terminal pngcairo size 900,800 enhanced font 'sans,11'\n");
-    fprintf(g, "set output '%s'\n", out);
-    const char *xl = r->force_displacement ? "displacement [mm]" : "strain [-]";
-    fprintf(g, "set multiplot\nset title \"%s\" noenhanced\n", r->data_file);
-    fprintf(g, "set size 1,0.66\nset origin 0,0.34\nset grid\nset key top left box opaque\n");
-    fprintf(g, "set xlabel '%s'\nset ylabel '%s [%s]' noenhanced\n", xl, r->y_column, r->y_unit);
+    cf_gp_cmd(g, "set multiplot");
+    cf_gp_cmd(g, "set title %q noenhanced", r->data_file);
+    cf_gp_cmd(g, "set size 1,0.66");
+    cf_gp_cmd(g, "set origin 0,0.34");
+    cf_gp_cmd(g, "set grid");
+    cf_gp_cmd(g, "set key top left box opaque");
+    cf_gp_cmd(g, "set xlabel %q", r->force_displacement ? "displacement [mm]" : "strain [-]");
+    char yl[400];
+    snprintf(yl, sizeof yl, "%s [%s]", r->y_column, r->y_unit);
+    cf_gp_cmd(g, "set ylabel %q noenhanced", yl);
     static const char *colors[2] = {"#d62728", "#1f77b4"};
     static const char *bcolors[CF_BASE_COUNT] = {"#7f7f7f", "#2ca02c", "#9467bd"};
-    fprintf(g, "plot $DATA using 1:2 with points pt 7 ps 0.6 lc rgb 'black' title 'measured'");
-    for (int k = 0; k < r->nfits; k++)
-        fprintf(g, ", $CURVES using 1:%d with lines lw %d lc rgb '%s' title 'conical, %s'", 2 + k,
-                k == 0 ? 4 : 2, colors[k], cf_spring_type_name(r->fits[k].type));
+    /* one plot command over several lines: each item ends in a backslash, an empty line ends it */
+    cf_gp_cmd(g, "plot $DATA using 1:2 with points pt 7 ps 0.6 lc rgb %q title %q \\", "black",
+              "measured");
+    for (int k = 0; k < r->nfits; k++) {
+        char t[64];
+        snprintf(t, sizeof t, "conical, %s", cf_spring_type_name(r->fits[k].type));
+        cf_gp_cmd(g, "  , $CURVES using 1:%d with lines lw %d lc rgb %q title %q \\", 2 + k,
+                  k == 0 ? 4 : 2, colors[k], t);
+    }
     for (int k = 0; k < CF_BASE_COUNT; k++)
-        fprintf(g, ", $CURVES using 1:%d with lines lw 1 dt 2 lc rgb '%s' title '%s'",
-                2 + r->nfits + k, bcolors[k], cf_baseline_name((cf_baseline_kind)k));
-    for (int k = 0; nlat > 0 && k < r->nfits; k++)
-        if (r->val[k].done && r->val[k].count == d->count)
-            fprintf(g, ", $LATTICE%d using 1:2 with linespoints lw 2 dt 4 pt 6 ps 0.5 lc rgb '%s' "
-                       "title 'lattice %dx%dx%d, %s'",
-                    k, colors[k], r->val[k].setup.cfg.lattice.nx, r->val[k].setup.cfg.lattice.ny,
-                    r->val[k].setup.cfg.lattice.nz, cf_spring_type_name(r->fits[k].type));
-    fprintf(g, "\nset size 1,0.34\nset origin 0,0\nunset title\nset key off\n");
-    fprintf(g, "set ylabel 'residual [%s]' noenhanced\n", r->y_unit);
-    fprintf(g, "plot 0 with lines lc rgb 'black' notitle");
+        cf_gp_cmd(g, "  , $CURVES using 1:%d with lines lw 1 dt 2 lc rgb %q title %q \\",
+                  2 + r->nfits + k, bcolors[k], cf_baseline_name((cf_baseline_kind)k));
     for (int k = 0; k < r->nfits; k++)
-        fprintf(g, ", $DATA using 1:%d with linespoints pt 7 ps 0.4 lc rgb '%s'", 3 + k, colors[k]);
+        if (lat[k]) {
+            char t[96];
+            snprintf(t, sizeof t, "lattice %dx%dx%d, %s", r->val[k].setup.cfg.lattice.nx,
+                     r->val[k].setup.cfg.lattice.ny, r->val[k].setup.cfg.lattice.nz,
+                     cf_spring_type_name(r->fits[k].type));
+            cf_gp_cmd(g, "  , $LATTICE%d using 1:2 with linespoints lw 2 dt 4 pt 6 ps 0.5 "
+                         "lc rgb %q title %q \\",
+                      k, colors[k], t);
+        }
+    cf_gp_cmd(g, "");
+    cf_gp_cmd(g, "set size 1,0.34");
+    cf_gp_cmd(g, "set origin 0,0");
+    cf_gp_cmd(g, "unset title");
+    cf_gp_cmd(g, "set key off");
+    char rl[96];
+    snprintf(rl, sizeof rl, "residual [%s]", r->y_unit);
+    cf_gp_cmd(g, "set ylabel %q noenhanced", rl);
+    cf_gp_cmd(g, "plot 0 with lines lc rgb %q notitle \\", "black");
+    for (int k = 0; k < r->nfits; k++)
+        cf_gp_cmd(g, "  , $DATA using 1:%d with linespoints pt 7 ps 0.4 lc rgb %q \\", 3 + k,
+                  colors[k]);
     for (int k = 0; k < CF_BASE_COUNT; k++)
-        fprintf(g, ", $DATA using 1:%d with lines dt 2 lc rgb '%s'", 3 + r->nfits + k, bcolors[k]);
-    fprintf(g, "\nunset multiplot\nset output\n");
+        cf_gp_cmd(g, "  , $DATA using 1:%d with lines dt 2 lc rgb %q \\", 3 + r->nfits + k,
+                  bcolors[k]);
+    cf_gp_cmd(g, "");
+    cf_gp_cmd(g, "unset multiplot");
+}
+
+/* A figure of width x height pixels: its script, drawn to a temporary file beside path. */
+static cf_status draw(void (*script)(cf_gp *, const void *), const void *fig, int width,
+                      int height, const char *path, const char *const *inputs, cf_atomic *out,
+                      cf_error *err)
+{
+    cf_gp g;
+    memset(out, 0, sizeof *out);
+    cf_gp_init(&g);
+    cf_gp_terminal(&g, path, width, height);
+    script(&g, fig);
+    cf_status st = cf_gp_render(&g, path, inputs, out, err);
+    cf_gp_free(&g);
+    return st;
+}
+
+cf_status cf_plot_check_name(const char *path, cf_error *err)
+{
+    return cf_gp_check_name(path, err);
+}
+
+cf_status cf_plot_fit(const cf_fit_report *r, const cf_fit_data *data, const char *path,
+                      const char *const *inputs, cf_atomic *out, cf_error *err)
+{
+    fit_figure f = {r, data};
+    return draw(fit_script, &f, 900, 800, path, inputs, out, err);
 }
 
 cf_status cf_plot_write(const cf_fit_report *r, const cf_fit_data *data, const char *path,
                         const char *const *inputs, cf_error *err)
 {
-    int svg = ends_with(path, ".svg");
-    if (!svg && !ends_with(path, ".png"))
-        return cf_error_set(err, CF_E_USAGE, "--plot %s: the file must end in .png or .svg", path);
-    if (strchr(path, '\'') || strchr(path, '\n'))
-        return cf_error_set(err, CF_E_USAGE, "--plot %s: quotes and newlines are not allowed",
-                            path);
-    /* reserve a temporary name beside the target (atomic.h), let gnuplot write it */
     cf_atomic a;
-    cf_status st = cf_atomic_open(&a, path, inputs, err);
-    if (st != CF_OK)
-        return st;
-    fclose(a.fp);
-    a.fp = NULL;
-    const char *prog = getenv("CONIFIT_GNUPLOT");
-    if (!prog || !*prog)
-        prog = "gnuplot";
-    int fds[2];
-    if (pipe(fds) != 0) {
-        cf_atomic_abort(&a);
-        return cf_error_set(err, CF_E_INTERNAL, "cannot start gnuplot: %s", strerror(errno));
+    cf_status st = cf_plot_fit(r, data, path, inputs, &a, err);
+    if (st == CF_OK)
+        st = cf_atomic_commit(&a, err);
+    return st;
+}
+
+typedef struct simulation_figure {
+    const cf_scene *sc;
+    const cf_msm_sample *s;
+    const double *spring_MPa;
+    size_t n;
+} simulation_figure;
+
+static void simulation_script(cf_gp *g, const void *fig)
+{
+    const simulation_figure *f = fig;
+    const cf_scene *sc = f->sc;
+    const cf_msm_sample *s = f->s;
+    const double *spring_MPa = f->spring_MPa;
+    size_t n = f->n;
+    /* columns: time [s], strain [-], stress [kPa], one spring's stress [kPa] */
+    cf_gp_block_begin(g, "SIM");
+    for (size_t k = 0; k < n; k++) {
+        double row[4] = {s[k].t_s, s[k].strain, s[k].stress_MPa * 1e3, spring_MPa[k] * 1e3};
+        cf_gp_block_row(g, 4, row);
     }
-    pid_t pid = fork();
-    if (pid < 0) {
-        close(fds[0]);
-        close(fds[1]);
-        cf_atomic_abort(&a);
-        return cf_error_set(err, CF_E_INTERNAL, "cannot start gnuplot: %s", strerror(errno));
-    }
-    if (pid == 0) {
-        dup2(fds[0], 0);
-        close(fds[0]);
-        close(fds[1]);
-        int null = open("/dev/null", O_WRONLY);
-        if (null >= 0) {
-            dup2(null, 1);
-            dup2(null, 2);
+    cf_gp_block_end(g);
+    cf_gp_cmd(g, "set key top left noenhanced");
+    cf_gp_cmd(g, "set grid");
+    /* the curve is named after the spring it ran (a scene's fit file, or "params") */
+    char lattice[700];
+    snprintf(lattice, sizeof lattice, "lattice (spring: %s)", sc->spring_source);
+    if (sc->kind == CF_PROTO_HOLD) {
+        cf_gp_cmd(g, "set xlabel %q", "time (s)");
+        if (sc->drive == CF_DRIVE_FORCE) {
+            cf_gp_cmd(g, "set ylabel %q", "compressive strain");
+            cf_gp_cmd(g, "set title %q", "creep under a held load");
+            cf_gp_cmd(g, "plot $SIM using 1:2 with lines lw 2 title %q", lattice);
+        } else {
+            cf_gp_cmd(g, "set ylabel %q", "compressive stress (kPa)");
+            cf_gp_cmd(g, "set title %q", "relaxation under a held strain");
+            cf_gp_cmd(g, "plot $SIM using 1:3 with lines lw 2 title %q", lattice);
         }
-        execlp(prog, prog, (char *)NULL);
-        _exit(127);
+        return;
     }
-    close(fds[0]);
-    FILE *g = fdopen(fds[1], "w");
-    if (g) {
-        write_script(g, r, data, a.tmp, svg);
-        fclose(g);
+    cf_gp_cmd(g, "set xlabel %q", "compressive strain");
+    cf_gp_cmd(g, "set ylabel %q", "compressive stress (kPa)");
+    if (sc->kind == CF_PROTO_CYCLES) {
+        cf_gp_cmd(g, "set title %q", "load-unload cycles");
+        cf_gp_cmd(g, "plot $SIM using 2:3 with lines lw 2 title %q", lattice);
     } else {
-        close(fds[1]);
+        cf_gp_cmd(g, "set title %q", "uniaxial: lattice against one spring");
+        cf_gp_cmd(g, "plot $SIM using 2:3 with lines lw 2 title %q, $SIM using 2:4 with lines "
+                     "lw 2 dt 2 title %q",
+                  lattice, "single spring");
     }
-    int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
-        ;
-    int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    if (code == 127) {
-        cf_atomic_abort(&a);
-        return cf_error_set(err, CF_E_INTERNAL,
-                            "cannot run '%s' to draw %s: install gnuplot (Debian package "
-                            "gnuplot-nox)",
-                            prog, path);
-    }
-    if (code != 0) {
-        cf_atomic_abort(&a);
-        return cf_error_set(err, CF_E_INTERNAL, "'%s' failed (status %d) drawing %s", prog, code,
-                            path);
-    }
-    if (rename(a.tmp, a.path) != 0) {
-        int e = errno;
-        cf_atomic_abort(&a);
-        return cf_error_set(err, CF_E_CANTWRITE, "%s: cannot write plot: %s", path, strerror(e));
-    }
-    a.tmp[0] = '\0';
-    return CF_OK;
+}
+
+cf_status cf_plot_simulation(const cf_scene *sc, const cf_msm_sample *s, const double *spring_MPa,
+                             size_t n, const char *path, const char *const *inputs,
+                             cf_atomic *out, cf_error *err)
+{
+    simulation_figure f = {sc, s, spring_MPa, n};
+    return draw(simulation_script, &f, 800, 560, path, inputs, out, err);
 }
