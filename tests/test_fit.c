@@ -62,13 +62,13 @@ static void synth(const cf_spring *p, size_t n, double frac, double noise, uint6
     synth_pw(p, n, frac, noise, seed, 1.0, t);
 }
 
-static cf_fit_data data_of(const table *t)
+static cf_table data_of(const table *t)
 {
-    cf_fit_data d = {t->n, t->x, t->y, NULL, 0};
+    cf_table d = {.count = t->n, .x = (double *)t->x, .y = (double *)t->y};
     return d;
 }
 
-static void fit_ok(const cf_fit_data *d, const cf_fit_options *o, cf_spring_type type,
+static void fit_ok(const cf_table *d, const cf_fit_options *o, cf_spring_type type,
                    cf_fit_result *r)
 {
     cf_error err = {0};
@@ -77,7 +77,7 @@ static void fit_ok(const cf_fit_data *d, const cf_fit_options *o, cf_spring_type
 }
 
 /* The reported solution must satisfy its constraints, checked here from the parameters alone. */
-static void assert_constraints_hold(const cf_fit_result *r, const cf_fit_data *d,
+static void assert_constraints_hold(const cf_fit_result *r, const cf_table *d,
                                     const cf_fit_options *o)
 {
     const cf_spring *p = &r->params;
@@ -91,7 +91,7 @@ static void assert_constraints_hold(const cf_fit_result *r, const cf_fit_data *d
     double xmax = 0;
     for (size_t i = 0; i < d->count; i++)
         xmax = fmax(xmax, fabs(d->x[i]));
-    double umax = d->force_displacement ? xmax : xmax * p->H_mm;
+    double umax = cf_table_is_force(d) ? xmax : xmax * p->H_mm;
     assert_true(law.travel_mm > umax);
     if (r->type == CF_TELESCOPING)
         assert_true((p->D2_mm - p->D1_mm) / 2 >= p->n * p->d_mm);
@@ -110,7 +110,7 @@ static void assert_recovers(const cf_spring *truth, cf_spring_type type, double 
 {
     table t;
     synth_pw(truth, 120, frac, 0, 0, pw, &t);
-    cf_fit_data d = data_of(&t);
+    cf_table d = data_of(&t);
     cf_fit_options o = cf_fit_default_options();
     cf_fit_result r;
     fit_ok(&d, &o, type, &r);
@@ -165,7 +165,7 @@ static void both_types_fit_the_same_law_when_rho_allows(void **state)
     cf_spring p = {10, 30, 4, 1, 80000, 40};
     table t;
     synth(&p, 100, 0.95, 0, 0, &t);
-    cf_fit_data d = data_of(&t);
+    cf_table d = data_of(&t);
     cf_fit_options o = cf_fit_default_options();
     cf_fit_result r;
     fit_ok(&d, &o, CF_NON_TELESCOPING, &r);
@@ -183,7 +183,7 @@ static void noisy_fit_brackets_truth_within_three_standard_errors(void **state)
     for (int s = 0; s < 2; s++) {
         table t;
         synth(&springs[s], 200, 0.97, 0.002, 12345 + (uint64_t)s, &t);
-        cf_fit_data d = data_of(&t);
+        cf_table d = data_of(&t);
         cf_fit_options o = cf_fit_default_options();
         cf_fit_result r;
         fit_ok(&d, &o, types[s], &r);
@@ -205,7 +205,7 @@ static void fixed_parameters_are_held_and_fit_still_exact(void **state)
     cf_spring p = {10, 30, 4, 1, 80000, 40};
     table t;
     synth(&p, 100, 0.95, 0, 0, &t);
-    cf_fit_data d = data_of(&t);
+    cf_table d = data_of(&t);
     cf_fit_options o = cf_fit_default_options();
     o.fixed[CF_P_H] = 1;
     o.fixed_value[CF_P_H] = 5.0;
@@ -226,7 +226,7 @@ static void every_optimizer_reaches_the_law(void **state)
     cf_spring p = {10, 14, 5, 1.5, 80000, 30};
     table t;
     synth(&p, 80, 0.95, 0, 0, &t);
-    cf_fit_data d = data_of(&t);
+    cf_table d = data_of(&t);
     for (int a = 0; a <= CF_OPT_MMA; a++) {
         cf_fit_options o = cf_fit_default_options();
         o.optimizer = (cf_fit_optimizer)a;
@@ -244,7 +244,7 @@ static void fits_are_deterministic_for_a_seed(void **state)
     cf_spring p = {10, 30, 4, 1, 80000, 40};
     table t;
     synth(&p, 100, 0.95, 0.01, 99, &t);
-    cf_fit_data d = data_of(&t);
+    cf_table d = data_of(&t);
     cf_fit_options o = cf_fit_default_options();
     cf_fit_result a, b;
     fit_ok(&d, &o, CF_TELESCOPING, &a);
@@ -262,7 +262,7 @@ static void bad_tables_are_refused(void **state)
     cf_fit_options o = cf_fit_default_options();
     cf_fit_result r;
     cf_error err = {0};
-    cf_fit_data d = {5, x, y, NULL, 0};
+    cf_table d = {.count = 5, .x = x, .y = y};
     assert_int_equal(cf_fit_run(&d, &o, CF_TELESCOPING, &r, &err), CF_E_DATA);
     assert_non_null(strstr(err.msg, "point 4"));
     d.y = z;
@@ -278,7 +278,7 @@ static void strain_beyond_any_spring_is_reported_infeasible(void **state)
 {
     (void)state;
     double x[6] = {0, 0.4, 0.8, 1.2, 1.6, 2.0}, y[6] = {0, 1, 2.2, 3.6, 5.2, 7};
-    cf_fit_data d = {6, x, y, NULL, 0};
+    cf_table d = {.count = 6, .x = x, .y = y};
     cf_fit_options o = cf_fit_default_options();
     cf_fit_result r;
     fit_ok(&d, &o, CF_NON_TELESCOPING, &r);
@@ -301,7 +301,7 @@ static void baselines_recover_their_own_laws(void **state)
         yf[i] = 0.2 * (exp(12 * x[i]) - 1);
     }
     cf_baseline b[CF_BASE_COUNT];
-    cf_fit_data d = {20, x, yl, NULL, 0};
+    cf_table d = {.count = 20, .x = x, .y = yl};
     cf_baseline_fit_all(&d, b);
     assert_close(b[CF_BASE_LINEAR].coef[0], 3.5, 1e-12);
     assert_true(b[CF_BASE_LINEAR].rmse < 1e-13);
@@ -403,7 +403,7 @@ static void published_tables_fit_both_types_at_least_as_well_as_an_independent_f
     for (size_t f = 0; f < sizeof files / sizeof files[0]; f++) {
         char path[512];
         snprintf(path, sizeof path, "%s/%s", dir, files[f]);
-        cf_measure m;
+        cf_table m;
         cf_error err = {0};
         cf_measure_options mo = cf_measure_default_options();
         if (strstr(files[f], "muscle")) {
@@ -412,7 +412,7 @@ static void published_tables_fit_both_types_at_least_as_well_as_an_independent_f
         }
         if (cf_measure_load(path, &mo, &m, &err) != CF_OK)
             fail_msg("%s: %s", files[f], err.msg);
-        cf_fit_data d = {m.count, m.x, m.y, m.w, m.kind == CF_MEASURE_FORCE_DISPLACEMENT};
+        cf_table d = m; /* the same arrays; m owns them */
         double xmax = 0;
         for (size_t i = 0; i < m.count; i++)
             xmax = fmax(xmax, fabs(m.x[i]));
@@ -422,7 +422,7 @@ static void published_tables_fit_both_types_at_least_as_well_as_an_independent_f
             fit_ok(&d, &o, (cf_spring_type)t, &r);
             assert_true(isfinite(r.rmse));
             double need = xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
-            if (!d.force_displacement && need >= 1) {
+            if (!cf_table_is_force(&d) && need >= 1) {
                 /* no spring reaches this strain: reported, and flagged */
                 assert_false(r.feasible);
                 assert_true(r.violated & CF_C_TRAVEL);
@@ -430,13 +430,13 @@ static void published_tables_fit_both_types_at_least_as_well_as_an_independent_f
             }
             assert_constraints_hold(&r, &d, &o);
             double rho_hi = t == CF_TELESCOPING ? o.index_max / (o.index_max + 4) : 1.0;
-            double b_hi = d.force_displacement ? 1e3 * need : 1 - 1e-9;
+            double b_hi = cf_table_is_force(&d) ? 1e3 * need : 1 - 1e-9;
             double ref = independent_rmse(m.x, m.y, m.count, rho_hi, need, b_hi);
             if (!(r.rmse <= ref * (1 + 1e-6)))
                 fail_msg("%s (%s): rmse %.17g worse than independent %.17g", files[f],
                          cf_spring_type_name((cf_spring_type)t), r.rmse, ref);
         }
-        cf_measure_free(&m);
+        cf_table_free(&m);
     }
 }
 

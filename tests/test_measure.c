@@ -52,7 +52,7 @@ static const char *write_text(const char *text)
     return write_bytes(text, (size_t)-1);
 }
 
-static void load_ok(const char *text, const cf_measure_options *opt, cf_measure *m)
+static void load_ok(const char *text, const cf_measure_options *opt, cf_table *m)
 {
     cf_error err = {0};
     const char *path = write_text(text);
@@ -67,7 +67,7 @@ static void expect_error_bytes(const char *text, size_t len, const cf_measure_op
                                cf_status status, int line, int col, const char *quoted)
 {
     cf_error err = {0};
-    cf_measure m;
+    cf_table m;
     const char *path = write_bytes(text, len);
     cf_status st = cf_measure_load(path, opt, &m, &err);
     if (st != status)
@@ -118,9 +118,9 @@ static void stress_units_are_read_from_every_decoration(void **state)
         {"strain,nominal_stress_kPa", 1e-3, "kPa"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        cf_measure m;
+        cf_table m;
         load_ok(with_header(cases[k].header), NULL, &m);
-        assert_int_equal(m.kind, CF_MEASURE_STRESS_STRAIN);
+        assert_int_equal(m.kind, CF_TABLE_STRESS_STRAIN);
         assert_int_equal(m.count, 6);
         assert_string_equal(m.y_unit, cases[k].unit);
         assert_string_equal(m.x_unit, "-");
@@ -131,7 +131,7 @@ static void stress_units_are_read_from_every_decoration(void **state)
         }
         assert_close(m.y_to_file * cases[k].to_mpa, 1.0, 1e-15);
         assert_null(m.t);
-        cf_measure_free(&m);
+        cf_table_free(&m);
     }
 }
 
@@ -149,71 +149,71 @@ static void force_and_length_units_make_a_force_displacement_table(void **state)
         {"displacement_m,force_kN", 1e3, 1e3, "kN"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        cf_measure m;
+        cf_table m;
         load_ok(with_header(cases[k].header), NULL, &m);
-        assert_int_equal(m.kind, CF_MEASURE_FORCE_DISPLACEMENT);
+        assert_int_equal(m.kind, CF_TABLE_FORCE_DISPLACEMENT);
         assert_string_equal(m.x_unit, "mm");
         assert_string_equal(m.y_unit, cases[k].yunit);
         assert_close(m.x[3], 0.3 * cases[k].x_to_mm, 1e-15 * cases[k].x_to_mm);
         assert_close(m.y[5], 5.0 * cases[k].y_to_n, 1e-15 * cases[k].y_to_n);
         assert_close(m.y_to_file * cases[k].y_to_n, 1.0, 1e-15);
-        cf_measure_free(&m);
+        cf_table_free(&m);
     }
 }
 
 static void options_override_and_supply_units(void **state)
 {
     (void)state;
-    cf_measure m;
+    cf_table m;
     cf_measure_options o = cf_measure_default_options();
     o.stress_unit = "MPa";
     load_ok(with_header("strain,stress_kPa"), &o, &m); /* the option wins over the name */
     assert_close(m.y[2], 2.0, 0.0);
     assert_string_equal(m.y_unit, "MPa");
-    cf_measure_free(&m);
+    cf_table_free(&m);
     o.stress_unit = "Pa";
     load_ok(with_header("strain,stress"), &o, &m);
     assert_close(m.y[4], 4e-6, 1e-21);
-    cf_measure_free(&m);
+    cf_table_free(&m);
     o = cf_measure_default_options();
     o.force_unit = "mN";
     o.length_unit = "um";
     load_ok(with_header("displacement,force"), &o, &m);
-    assert_int_equal(m.kind, CF_MEASURE_FORCE_DISPLACEMENT);
+    assert_int_equal(m.kind, CF_TABLE_FORCE_DISPLACEMENT);
     assert_close(m.x[5], 0.5e-3, 1e-18);
     assert_close(m.y[5], 5e-3, 1e-18);
-    cf_measure_free(&m);
+    cf_table_free(&m);
 }
 
 static void percent_strain_is_divided_by_100(void **state)
 {
     (void)state;
-    cf_measure m;
+    cf_table m;
     load_ok(with_header("strain_%,stress_kPa"), NULL, &m);
     assert_close(m.x[5], 0.005, 1e-18);
-    cf_measure_free(&m);
+    cf_table_free(&m);
 }
 
 static void semicolon_tab_and_decimal_comma_are_read(void **state)
 {
     (void)state;
-    cf_measure m;
+    cf_table m;
     load_ok("strain;stress_kPa\n0;0\n0.1;1\n0.2;2\n0.3;3\n0.4;4\n0.5;5\n", NULL, &m);
     assert_close(m.y[3], 3e-3, 1e-18);
-    cf_measure_free(&m);
+    cf_table_free(&m);
     load_ok("strain\tstress_kPa\n0\t0\n0.1\t1\n0.2\t2\n0.3\t3\n0.4\t4\n0.5\t5\n", NULL, &m);
     assert_close(m.x[4], 0.4, 0.0);
-    cf_measure_free(&m);
+    cf_table_free(&m);
     load_ok("strain;stress_kPa\n0;0\n0,1;1,5\n0,2;2\n0,3;3\n0,4;4\n0,5;5\n", NULL, &m);
     assert_close(m.x[1], 0.1, 0.0);
     assert_close(m.y[1], 1.5e-3, 1e-18);
-    cf_measure_free(&m);
+    cf_table_free(&m);
 }
 
 static void quoted_fields_with_escaped_quotes_are_read(void **state)
 {
     (void)state;
-    cf_measure m;
+    cf_table m;
     load_ok("\"note, free text\",\"strain\",\"stress [kPa]\"\n"
             "\"a \"\"quoted\"\" word\",\"0\",\"0\"\n"
             "\"x, y\",0.1,1\n,0.2,2\n\"\",0.3,3\n z ,0.4,4\n\"#not a comment\",0.5,5\n",
@@ -222,13 +222,13 @@ static void quoted_fields_with_escaped_quotes_are_read(void **state)
     assert_string_equal(m.x_column, "strain");
     assert_string_equal(m.y_column, "stress [kPa]");
     assert_close(m.y[5], 5e-3, 1e-18);
-    cf_measure_free(&m);
+    cf_table_free(&m);
 }
 
 static void bom_crlf_comments_and_blank_lines_are_skipped(void **state)
 {
     (void)state;
-    cf_measure m;
+    cf_table m;
     load_ok("\xEF\xBB\xBF# made by hand\r\n\r\n# units in the names\r\nstrain,stress_kPa\r\n"
             "0,0\r\n  # a comment between rows\r\n0.1,1 # after a value\r\n\r\n0.2,2\r\n"
             ",\r\n0.3,3\r\n0.4,4\r\n0.5,5",
@@ -236,16 +236,16 @@ static void bom_crlf_comments_and_blank_lines_are_skipped(void **state)
     assert_int_equal(m.count, 6);
     assert_close(m.x[1], 0.1, 0.0);
     assert_close(m.y[5], 5e-3, 1e-18);
-    cf_measure_free(&m);
+    cf_table_free(&m);
 }
 
 static void trailing_delimiter_is_accepted_when_every_line_has_it(void **state)
 {
     (void)state;
-    cf_measure m;
+    cf_table m;
     load_ok("strain,stress_kPa,\n0,0,\n0.1,1,\n0.2,2,\n0.3,3,\n0.4,4,\n0.5,5,\n", NULL, &m);
     assert_int_equal(m.count, 6);
-    cf_measure_free(&m);
+    cf_table_free(&m);
     /* only on the header: the rows are short */
     expect_error("strain,stress_kPa,\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n", NULL, 2, 3,
                  "0,0");
@@ -257,40 +257,40 @@ static void trailing_delimiter_is_accepted_when_every_line_has_it(void **state)
 static void weight_column_is_read(void **state)
 {
     (void)state;
-    cf_measure m;
+    cf_table m;
     load_ok("strain,stress_kPa,weight\n0,0,1\n0.1,1,2\n0.2,2,0.5\n0.3,3,1\n0.4,4,1\n0.5,5,3\n",
             NULL, &m);
     assert_close(m.w[1], 2.0, 0.0);
     assert_close(m.w[2], 0.5, 0.0);
     assert_close(m.w[5], 3.0, 0.0);
-    cf_measure_free(&m);
+    cf_table_free(&m);
 }
 
 static void stretch_is_converted_to_strain(void **state)
 {
     (void)state;
-    cf_measure m;
+    cf_table m;
     load_ok("stretch,stress_kPa\n1,0\n1.1,1\n1.2,2\n1.3,3\n0.9,-1\n0.8,-2\n", NULL, &m);
     assert_int_equal(m.x_from_stretch, 1);
     assert_close(m.x[0], 0.0, 0.0);
     assert_close(m.x[3], 0.3, 1e-15);
     assert_close(m.x[5], -0.2, 1e-15);
-    cf_measure_free(&m);
+    cf_table_free(&m);
     load_ok("lambda [-],stress_kPa\n1,0\n1.1,1\n1.2,2\n1.3,3\n1.4,4\n1.5,5\n", NULL, &m);
     assert_close(m.x[5], 0.5, 1e-15);
-    cf_measure_free(&m);
+    cf_table_free(&m);
     /* by option, on a column whose name says nothing */
     cf_measure_options o = cf_measure_default_options();
     o.x_is_stretch = 1;
     load_ok("a,stress_kPa\n1,0\n1.1,1\n1.2,2\n1.3,3\n1.4,4\n1.5,5\n", &o, &m);
     assert_close(m.x[2], 0.2, 1e-15);
-    cf_measure_free(&m);
+    cf_table_free(&m);
     /* and the option can say a column named stretch holds strain */
     o.x_is_stretch = 0;
     load_ok("stretch,stress_kPa\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n", &o, &m);
     assert_int_equal(m.x_from_stretch, 0);
     assert_close(m.x[2], 0.2, 0.0);
-    cf_measure_free(&m);
+    cf_table_free(&m);
 }
 
 static const char time_table[] =
@@ -300,7 +300,7 @@ static const char time_table[] =
 static void columns_are_chosen_by_name_in_a_wider_table(void **state)
 {
     (void)state;
-    cf_measure m;
+    cf_table m;
     load_ok(time_table, NULL, &m);
     assert_string_equal(m.x_column, "strain");
     assert_string_equal(m.y_column, "stress_kPa");
@@ -308,7 +308,7 @@ static void columns_are_chosen_by_name_in_a_wider_table(void **state)
     assert_close(m.t[4], 4.0, 0.0);
     assert_close(m.x[4], -0.03, 0.0);
     assert_int_equal(m.compression, 1);
-    cf_measure_free(&m);
+    cf_table_free(&m);
     /* by option: the base name or the whole header name */
     cf_measure_options o = cf_measure_default_options();
     o.x_col = "time";
@@ -322,66 +322,66 @@ static void columns_are_chosen_by_name_in_a_wider_table(void **state)
     assert_string_equal(m.x_column, "time");
     assert_close(m.x[5], 5.0, 0.0);
     assert_null(m.t);
-    cf_measure_free(&m);
+    cf_table_free(&m);
     o.x_col = "STRAIN";
     o.y_col = "stress_kPa";
     load_ok(time_table, &o, &m);
     assert_close(m.y[5], -2.2e-3, 1e-18);
-    cf_measure_free(&m);
+    cf_table_free(&m);
     /* without recognisable names, the first two columns */
     load_ok(with_header("a,b [kPa]"), NULL, &m);
     assert_string_equal(m.x_column, "a");
     assert_string_equal(m.y_column, "b [kPa]");
-    cf_measure_free(&m);
+    cf_table_free(&m);
     /* y named first, x second */
     load_ok(with_header("shear_stress [kPa],gamma"), NULL, &m);
     assert_string_equal(m.x_column, "gamma");
     assert_close(m.x[5], 5.0, 0.0);
-    cf_measure_free(&m);
+    cf_table_free(&m);
 }
 
 static void repeated_strains_are_kept_and_sign_is_reported(void **state)
 {
     (void)state;
-    cf_measure m;
+    cf_table m;
     load_ok("strain,stress_kPa\n0.1,1\n0.1,1.1\n0.2,2\n0.2,1.9\n0.1,0.9\n0,0\n", NULL, &m);
     assert_int_equal(m.count, 6);
     assert_close(m.x[1], 0.1, 0.0);
     assert_close(m.y[1], 1.1e-3, 1e-18);
     assert_int_equal(m.compression, 0);
-    cf_measure_free(&m);
+    cf_table_free(&m);
     load_ok("strain,stress_kPa\n0,0\n-0.1,-1\n-0.2,-2\n-0.3,-3\n-0.4,-4\n-0.5,-5\n", NULL, &m);
     assert_int_equal(m.compression, 1);
     assert_close(m.x[5], -0.5, 0.0); /* kept as it is */
     assert_close(m.y[5], -5e-3, 1e-18);
-    cf_measure_free(&m);
+    cf_table_free(&m);
 }
 
 static void units_stated_in_comments_are_honoured(void **state)
 {
     (void)state;
-    cf_measure m;
+    cf_table m;
     load_ok("# columns: strain = engineering (nominal) strain [-], stress = nominal stress [kPa]\n"
             "strain,stress\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n",
             NULL, &m);
     assert_string_equal(m.y_unit, "kPa");
     assert_close(m.y[5], 5e-3, 1e-18);
-    cf_measure_free(&m);
+    cf_table_free(&m);
     load_ok("# units (x, y): strain, MPa\nstrain,stress\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n",
             NULL, &m);
     assert_string_equal(m.y_unit, "MPa");
-    cf_measure_free(&m);
+    cf_table_free(&m);
     load_ok("# (x, y) = (strain, [kPa])\nstrain,stress\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n",
             NULL, &m);
     assert_string_equal(m.y_unit, "kPa");
-    cf_measure_free(&m);
+    cf_table_free(&m);
     load_ok("# column 1 = displacement [mm], column 2 = force [mN]\ndisplacement,force\n"
             "0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n",
             NULL, &m);
-    assert_int_equal(m.kind, CF_MEASURE_FORCE_DISPLACEMENT);
+    assert_int_equal(m.kind, CF_TABLE_FORCE_DISPLACEMENT);
     assert_string_equal(m.y_unit, "mN");
     assert_close(m.y[5], 5e-3, 1e-18);
-    cf_measure_free(&m);
+    cf_table_free(&m);
 }
 
 static void unit_lookup_knows_classes_and_factors(void **state)
@@ -490,15 +490,15 @@ static void missing_file_is_noinput(void **state)
 {
     (void)state;
     cf_error err = {0};
-    cf_measure m;
+    cf_table m;
     char path[512];
     snprintf(path, sizeof path, "%s/does-not-exist.csv", tmpdir);
     assert_int_equal(cf_measure_load(path, NULL, &m, &err), CF_E_NOINPUT);
     assert_non_null(strstr(err.msg, "does-not-exist.csv"));
     assert_null(m.x);
     assert_int_equal(cf_exit_code(err.status), 66);
-    cf_measure_free(&m); /* safe on the zeroed result */
-    cf_measure_free(NULL);
+    cf_table_free(&m); /* safe on the zeroed result */
+    cf_table_free(NULL);
 }
 
 /* ---- the published tables ------------------------------------------------------------------ */
@@ -513,36 +513,36 @@ static void all_published_tables_load_with_their_units(void **state)
     }
     static const struct {
         const char *file;
-        cf_measure_kind kind;
+        cf_table_kind kind;
         const char *yunit;
         size_t count;
         int compression, has_time;
         double last_x, last_y; /* in conifit units: strain or mm, MPa or N */
     } t[] = {
-        {"brain_cortex_compression.csv", CF_MEASURE_STRESS_STRAIN, "kPa", 17, 1, 0, -0.1,
+        {"brain_cortex_compression.csv", CF_TABLE_STRESS_STRAIN, "kPa", 17, 1, 0, -0.1,
          -1.1484e-3},
-        {"brain_cortex_tension.csv", CF_MEASURE_STRESS_STRAIN, "kPa", 17, 0, 0, 0.1, 0.4151e-3},
-        {"brain_cortex_shear.csv", CF_MEASURE_STRESS_STRAIN, "kPa", 17, 0, 0, 0.2, 0.5435e-3},
-        {"brain_coronaradiata_compression.csv", CF_MEASURE_STRESS_STRAIN, "kPa", 17, 1, 0, -0.1,
+        {"brain_cortex_tension.csv", CF_TABLE_STRESS_STRAIN, "kPa", 17, 0, 0, 0.1, 0.4151e-3},
+        {"brain_cortex_shear.csv", CF_TABLE_STRESS_STRAIN, "kPa", 17, 0, 0, 0.2, 0.5435e-3},
+        {"brain_coronaradiata_compression.csv", CF_TABLE_STRESS_STRAIN, "kPa", 17, 1, 0, -0.1,
          -0.7591e-3},
-        {"brain_coronaradiata_tension.csv", CF_MEASURE_STRESS_STRAIN, "kPa", 17, 0, 0, 0.1,
+        {"brain_coronaradiata_tension.csv", CF_TABLE_STRESS_STRAIN, "kPa", 17, 0, 0, 0.1,
          0.1582e-3},
-        {"treloar1944_rubber_uniaxial.csv", CF_MEASURE_STRESS_STRAIN, "MPa", 25, 0, 0, 6.69, 6.33},
-        {"heart_myocardium_shear_fs.csv", CF_MEASURE_STRESS_STRAIN, "kPa", 11, 0, 0, 0.5,
+        {"treloar1944_rubber_uniaxial.csv", CF_TABLE_STRESS_STRAIN, "MPa", 25, 0, 0, 6.69, 6.33},
+        {"heart_myocardium_shear_fs.csv", CF_TABLE_STRESS_STRAIN, "kPa", 11, 0, 0, 0.5,
          5.783e-3},
-        {"heart_myocardium_biaxial_1to1_fiber.csv", CF_MEASURE_STRESS_STRAIN, "kPa", 11, 0, 0, 0.1,
+        {"heart_myocardium_biaxial_1to1_fiber.csv", CF_TABLE_STRESS_STRAIN, "kPa", 11, 0, 0, 0.1,
          8.257e-3},
-        {"skin_porcine_stripbiaxial_x.csv", CF_MEASURE_STRESS_STRAIN, "MPa", 100, 0, 0, NAN, NAN},
-        {"thrombus_pureshear_force_displacement.csv", CF_MEASURE_FORCE_DISPLACEMENT, "mN", 1068, 0,
+        {"skin_porcine_stripbiaxial_x.csv", CF_TABLE_STRESS_STRAIN, "MPa", 100, 0, 0, NAN, NAN},
+        {"thrombus_pureshear_force_displacement.csv", CF_TABLE_FORCE_DISPLACEMENT, "mN", 1068, 0,
          0, 5.0025, 0.4766442},
-        {"muscle_compression_relaxation_fiber30.csv", CF_MEASURE_STRESS_STRAIN, "kPa", 50, 1, 1,
+        {"muscle_compression_relaxation_fiber30.csv", CF_TABLE_STRESS_STRAIN, "kPa", 50, 1, 1,
          NAN, NAN},
-        {"muscle_compression_relaxation_crossfiber30.csv", CF_MEASURE_STRESS_STRAIN, "kPa", 50, 1,
+        {"muscle_compression_relaxation_crossfiber30.csv", CF_TABLE_STRESS_STRAIN, "kPa", 50, 1,
          1, NAN, NAN},
     };
     for (size_t k = 0; k < sizeof t / sizeof t[0]; k++) {
         char path[512];
-        cf_measure m;
+        cf_table m;
         cf_error err = {0};
         snprintf(path, sizeof path, "%s/%s", dir, t[k].file);
         cf_status st = cf_measure_load(path, NULL, &m, &err);
@@ -553,7 +553,7 @@ static void all_published_tables_load_with_their_units(void **state)
         assert_int_equal(m.count, t[k].count);
         assert_int_equal(m.compression, t[k].compression);
         assert_int_equal(m.t != NULL, t[k].has_time);
-        if (t[k].kind == CF_MEASURE_STRESS_STRAIN)
+        if (t[k].kind == CF_TABLE_STRESS_STRAIN)
             assert_string_equal(m.x_column, "strain");
         if (!isnan(t[k].last_x)) {
             assert_close(m.x[m.count - 1], t[k].last_x, 1e-15);
@@ -561,7 +561,7 @@ static void all_published_tables_load_with_their_units(void **state)
         }
         for (size_t i = 0; i < m.count; i++)
             assert_true(isfinite(m.x[i]) && isfinite(m.y[i]) && m.w[i] == 1.0);
-        cf_measure_free(&m);
+        cf_table_free(&m);
     }
 }
 
@@ -586,7 +586,7 @@ static void synth_writes_the_law_in_kpa(void **state)
                     "synth --D1 8 --D2 20 --n 2.5 --d 2 --G 100 --H 5 --strain-max 0.5 "
                     "--points 11 -o %s", path);
     assert_int_equal(rc, 0);
-    cf_measure m;
+    cf_table m;
     cf_error err = {0};
     assert_int_equal(cf_measure_load(path, NULL, &m, &err), CF_OK);
     assert_int_equal(m.count, 11);
@@ -607,7 +607,7 @@ static void synth_writes_the_law_in_kpa(void **state)
         assert_close(m.y[i], F / 25.0, 1e-14 * F);
     }
     assert_close(m.x[10], 0.5, 0.0);
-    cf_measure_free(&m);
+    cf_table_free(&m);
     /* compression: the same table with both signs flipped */
     char cpath[512];
     snprintf(cpath, sizeof cpath, "%s/synth-comp.csv", tmpdir);
@@ -615,7 +615,7 @@ static void synth_writes_the_law_in_kpa(void **state)
                 "synth --D1 8 --D2 20 --n 2.5 --d 2 --G 100 --H 5 --strain-max 0.5 --points 11 "
                 "--compression -o %s", cpath);
     assert_int_equal(rc, 0);
-    cf_measure c, t;
+    cf_table c, t;
     assert_int_equal(cf_measure_load(cpath, NULL, &c, &err), CF_OK);
     assert_int_equal(cf_measure_load(path, NULL, &t, &err), CF_OK);
     assert_int_equal(c.compression, 1);
@@ -623,8 +623,8 @@ static void synth_writes_the_law_in_kpa(void **state)
         assert_close(c.x[i], -t.x[i], 0.0);
         assert_close(c.y[i], -t.y[i], 0.0);
     }
-    cf_measure_free(&c);
-    cf_measure_free(&t);
+    cf_table_free(&c);
+    cf_table_free(&t);
 }
 
 static void synth_noise_is_deterministic_and_of_the_asked_size(void **state)
@@ -643,7 +643,7 @@ static void synth_noise_is_deterministic_and_of_the_asked_size(void **state)
     assert_int_equal(tu_run(NULL, 0, NULL, 0, "synth %s --noise 0.01 --seed 8 -o %s", spring, c),
                      0);
     assert_int_equal(tu_run(NULL, 0, NULL, 0, "synth %s -o %s", spring, z), 0);
-    cf_measure ma, mb, mc, mz;
+    cf_table ma, mb, mc, mz;
     cf_error err = {0};
     assert_int_equal(cf_measure_load(a, NULL, &ma, &err), CF_OK);
     assert_int_equal(cf_measure_load(b, NULL, &mb, &err), CF_OK);
@@ -667,10 +667,10 @@ static void synth_noise_is_deterministic_and_of_the_asked_size(void **state)
     ** with overwhelming probability for any seed (and this seed is fixed) */
     assert_close(sd, 0.01, 0.0015);
     assert_close(mean, 0.0, 4 * 0.01 / sqrt(n));
-    cf_measure_free(&ma);
-    cf_measure_free(&mb);
-    cf_measure_free(&mc);
-    cf_measure_free(&mz);
+    cf_table_free(&ma);
+    cf_table_free(&mb);
+    cf_table_free(&mc);
+    cf_table_free(&mz);
 }
 
 static void synth_refuses_bad_requests_without_writing(void **state)
@@ -725,7 +725,7 @@ static void shipped_table_is_reproduced_by_its_documented_command(void **state)
         char path[512];
         snprintf(path, sizeof path, "%s/again-%zu.csv", tmpdir, k);
         assert_int_equal(tu_run(NULL, 0, err_buf, sizeof err_buf, "%s -o %s", args, path), 0);
-        cf_measure a, b;
+        cf_table a, b;
         cf_error err = {0};
         assert_int_equal(cf_measure_load(shipped[k], NULL, &a, &err), CF_OK);
         assert_int_equal(cf_measure_load(path, NULL, &b, &err), CF_OK);
@@ -735,8 +735,8 @@ static void shipped_table_is_reproduced_by_its_documented_command(void **state)
             assert_close(a.x[i], b.x[i], 1e-15);
             assert_close(a.y[i], b.y[i], 1e-13 * fabs(a.y[i]) + 1e-18);
         }
-        cf_measure_free(&a);
-        cf_measure_free(&b);
+        cf_table_free(&a);
+        cf_table_free(&b);
     }
 }
 
@@ -769,11 +769,11 @@ static void shipped_tables_come_from_valid_springs(void **state)
         assert_true(law.index_c >= 3.0);
         assert_true(p.n >= 2.0);
         types[law.type] = 1;
-        cf_measure m;
+        cf_table m;
         assert_int_equal(cf_measure_load(shipped[k], NULL, &m, &err), CF_OK);
         for (size_t i = 0; i < m.count; i++) /* inside the travel: never solid */
             assert_true(fabs(m.x[i]) < law.travel_mm / p.H_mm);
-        cf_measure_free(&m);
+        cf_table_free(&m);
     }
     assert_true(types[CF_TELESCOPING] && types[CF_NON_TELESCOPING]);
 }

@@ -94,7 +94,7 @@ static void validate_writes_keys_consistent_with_the_lattice(void **state)
                     num_at(p, "d_mm"),  num_at(p, "G_MPa"), num_at(p, "H_mm")};
     json_decref(root);
     cf_measure_options mo = cf_measure_default_options();
-    cf_measure m;
+    cf_table m;
     cf_error err = {0};
     assert_int_equal(cf_measure_load("data/telescoping_noise1pct.csv", &mo, &m, &err), CF_OK);
     cf_law law;
@@ -117,7 +117,7 @@ static void validate_writes_keys_consistent_with_the_lattice(void **state)
     /* the diagonals make the lattice stiffer than one spring: the error is not the fit's */
     assert_true(want > 0);
     free(s);
-    cf_measure_free(&m);
+    cf_table_free(&m);
     remove(json);
     rmdir(dir);
 }
@@ -140,11 +140,11 @@ static void axial_only_lattice_reproduces_the_fit_error(void **state)
     double ymax[2] = {0, 0};
     for (int t = 0; t < 2; t++) {
         cf_measure_options mo = cf_measure_default_options();
-        cf_measure m;
+        cf_table m;
         assert_int_equal(cf_measure_load(tables[t], &mo, &m, NULL), CF_OK);
         for (size_t i = 0; i < m.count; i++)
             ymax[t] = fmax(ymax[t], fabs(m.y[i]) * m.y_to_file);
-        cf_measure_free(&m);
+        cf_table_free(&m);
     }
     for (int t = 0; t < 2; t++) {
         int st = tu_run(out, sizeof out, errb, sizeof errb, "fit %s --validate %s -o %s --quiet",

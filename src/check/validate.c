@@ -12,18 +12,14 @@
 
 #include <nlopt.h>
 
-/* Relative residuals divide by max(|y|, REL_FLOOR max|y|), as the ordinary fit does (fit.h). */
-#define REL_FLOOR 1e-3
-/* Lowest diameter ratio searched, as in the ordinary fit. */
-#define RHO_LO 1e-3
+#include "fit/lsq.h"
+
 /* BOBYQA stops when a step changes every variable by less than this, relative. The validation
 ** error is reported to 4 digits; 1e-6 in the variables is far below what changes them. */
 #define XTOL_REL 1e-6
 /* Lattice curves allowed to the optimiser: each is a few milliseconds on the default 3 x 3 x 3
 ** lattice; BOBYQA on the two remaining variables typically converges in a few dozen. */
 #define MAX_CURVES 400
-/* Objective where the lattice cannot be run (a strain past solid, no convergence). */
-#define HUGE_OBJ 1e30
 
 static double now_s(void)
 {
@@ -84,7 +80,7 @@ void cf_validation_free(cf_validation *v)
 
 /* The lattice curve of spring p at the strains of d into out (count values). */
 static cf_status lattice_curve(const cf_spring *p, const cf_validate_setup *s,
-                               const cf_fit_data *d, double *out, cf_msm_stats *stats,
+                               const cf_table *d, double *out, cf_msm_stats *stats,
                                cf_error *err)
 {
     cf_law law;
@@ -98,7 +94,7 @@ static cf_status lattice_curve(const cf_spring *p, const cf_validate_setup *s,
     return st;
 }
 
-cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const cf_fit_data *d,
+cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const cf_table *d,
                           cf_validation *v, cf_error *err)
 {
     const double t0 = now_s();
@@ -106,7 +102,7 @@ cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const 
     v->setup = *s;
     cf_error e = {0};
     cf_status st = CF_OK;
-    if (d->force_displacement) {
+    if (cf_table_is_force(d)) {
         st = cf_error_set(&e, CF_E_DATA,
                           "validation needs a stress-strain table; a force-displacement table is "
                           "one spring's curve and does not determine the cell size H");
@@ -129,19 +125,10 @@ cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const 
         return st;
     }
     v->count = d->count;
-    double ym = 0, rss = 0, syy = 0, mx = 0;
-    for (size_t i = 0; i < d->count; i++)
-        ym += d->y[i];
-    ym /= (double)d->count;
-    for (size_t i = 0; i < d->count; i++) {
-        double r = v->stress_MPa[i] - d->y[i];
-        rss += r * r;
-        mx = fmax(mx, fabs(r));
-        syy += (d->y[i] - ym) * (d->y[i] - ym);
-    }
-    v->rmse = sqrt(rss / (double)d->count);
-    v->max_abs_error = mx;
-    v->r2 = syy > 0 ? 1 - rss / syy : 0;
+    cf_lsq_quality q = cf_lsq_quality_of(d, v->stress_MPa);
+    v->rmse = q.rmse;
+    v->max_abs_error = q.max_abs_error;
+    v->r2 = q.r2;
     v->done = 1;
     v->wall_time_s = now_s() - t0;
     return CF_OK;
@@ -157,12 +144,12 @@ static cf_spring member(double rho, double e, double A)
     const double H = 1.0, Lmin = H * (1 - e), s = H * e, n = 2.0, dw = Lmin / n;
     const double D2 = rho < 1 ? Lmin / (1 - rho) : Lmin, D1 = rho * D2;
     const double FC = A * H * H;
-    cf_spring p = {D1, D2, n, dw, 8 * n * D1 * D1 * D1 * FC / (dw * dw * dw * dw * s), H};
+    cf_spring p = {D1, D2, n, dw, cf_lsq_G_of_FC(FC, n, D1, dw, s), H};
     return p;
 }
 
 typedef struct tm_ctx {
-    const cf_fit_data *d;
+    const cf_table *d;
     const cf_validate_setup *s;
     double *sw;     /* residual weights */
     double ynorm;   /* weighted sum of y^2 */
@@ -180,7 +167,7 @@ static double tm_profile(tm_ctx *c, const double *z, double *A_out)
     c->evals++;
     *A_out = 0;
     if (lattice_curve(&p, c->s, c->d, c->curve, NULL, NULL) != CF_OK)
-        return HUGE_OBJ;
+        return CF_LSQ_HUGE_OBJ;
     double gy = 0, gg = 0;
     for (size_t i = 0; i < c->d->count; i++) {
         double w = c->sw[i] * c->sw[i];
@@ -189,14 +176,14 @@ static double tm_profile(tm_ctx *c, const double *z, double *A_out)
     }
     double A = gy / gg;
     if (!(A > 0) || !isfinite(A))
-        return HUGE_OBJ;
+        return CF_LSQ_HUGE_OBJ;
     double sum = 0;
     for (size_t i = 0; i < c->d->count; i++) {
         double r = c->sw[i] * (A * c->curve[i] - c->d->y[i]);
         sum += r * r;
     }
     *A_out = A;
-    return isfinite(sum) ? sum / c->ynorm : HUGE_OBJ;
+    return isfinite(sum) ? sum / c->ynorm : CF_LSQ_HUGE_OBJ;
 }
 
 static double tm_objective(unsigned nz, const double *z, double *grad, void *data)
@@ -207,7 +194,7 @@ static double tm_objective(unsigned nz, const double *z, double *grad, void *dat
     return tm_profile(data, z, &A);
 }
 
-cf_status cf_validate_through_msm(const cf_fit_data *d, const cf_fit_options *opt,
+cf_status cf_validate_through_msm(const cf_table *d, const cf_fit_options *opt,
                                   const cf_validate_setup *s, cf_fit_result *res,
                                   cf_validation *v, cf_through_msm *t, cf_error *err)
 {
@@ -227,21 +214,11 @@ cf_status cf_validate_through_msm(const cf_fit_data *d, const cf_fit_options *op
         free(c.curve);
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", d->count);
     }
-    double ymax = 0, xmax = 0;
-    for (size_t i = 0; i < d->count; i++) {
-        ymax = fmax(ymax, fabs(d->y[i]));
-        xmax = fmax(xmax, fabs(d->x[i]));
-    }
-    for (size_t i = 0; i < d->count; i++) {
-        double sc = opt->relative ? fmax(fabs(d->y[i]), REL_FLOOR * ymax) : 1.0;
-        c.sw[i] = sqrt(d->w ? d->w[i] : 1.0) / sc;
-        c.ynorm += (c.sw[i] * d->y[i]) * (c.sw[i] * d->y[i]);
-    }
+    const double xmax = cf_lsq_xmax(d);
+    c.ynorm = cf_lsq_weights(d, opt->relative, c.sw);
     const double *v0 = t->ident_before;
-    double rho_hi = res->type == CF_TELESCOPING
-                        ? opt->index_max / (opt->index_max + 4) * (1 - 1e-6)
-                        : 1.0;
-    double lb[2] = {log(RHO_LO), xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9)};
+    double rho_hi = cf_lsq_rho_hi(res->type, opt->index_max);
+    double lb[2] = {log(CF_LSQ_RHO_LO), xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9)};
     double ub[2] = {log(rho_hi), 1 - 1e-9};
     double z[2] = {log(v0[0]), v0[1]};
     cf_status st = CF_OK;

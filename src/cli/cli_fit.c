@@ -14,15 +14,10 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "conifit/baseline.h"
 #include "cli/cli.h"
-#include "conifit/version.h"
-#include "conifit/fit.h"
-#include "conifit/measure.h"
+#include "conifit/baseline.h"
+#include "conifit/pipeline.h"
 #include "out/plot.h"
-#include "conifit/report.h"
-#include "conifit/scene.h"
-#include "conifit/validate.h"
 
 static const char fit_help[] =
     "usage: conifit fit FILE.csv... [-o OUT.json | -o DIR/] [options]\n"
@@ -60,21 +55,17 @@ typedef struct fit_args {
     int nfiles;
     const char *out;
     const char *plot;
-    int types; /* bit 0 telescoping, bit 1 non-telescoping */
-    cf_fit_options fopt;
+    cf_pipeline_options popt;    /* types, fitter options, validation lattice */
     cf_measure_options mopt;
     long jobs;
     int quiet;
-    int validate;                /* --validate or --through-msm */
-    int through;                 /* --through-msm */
     const char *scene;           /* the validation scene, or NULL for the default lattice */
-    cf_validate_setup vsetup;    /* the lattice the fits are validated in */
 } fit_args;
 
 typedef struct fit_job {
     const fit_args *args;
     const char *file;
-    cf_measure m;
+    cf_table m;
     cf_fit_report rep;
     char json_path[4096];
     char plot_path[4096];
@@ -118,9 +109,9 @@ static int validate_option(int argc, char **argv, int *i, const char *name, fit_
     const char *arg = argv[*i];
     if (strncmp(arg, name, n) != 0 || (arg[n] != '\0' && arg[n] != '='))
         return 0;
-    a->validate = 1;
+    a->popt.validate = 1;
     if (strcmp(name, "--through-msm") == 0)
-        a->through = 1;
+        a->popt.through_msm = 1;
     if (arg[n] == '=')
         a->scene = arg + n + 1;
     else if (*i + 1 < argc && argv[*i + 1][0] != '-' && ends_with_json(argv[*i + 1]))
@@ -133,11 +124,9 @@ static int parse_args(int argc, char **argv, fit_args *a)
     static const char *cmd = "fit";
     cf_error err = {0};
     memset(a, 0, sizeof *a);
-    a->types = 3;
-    a->fopt = cf_fit_default_options();
+    a->popt = cf_pipeline_default_options();
     a->mopt = cf_measure_default_options();
     a->jobs = 1;
-    a->vsetup = cf_validate_default();
     a->files = calloc((size_t)argc, sizeof *a->files);
     if (!a->files)
         return CF_EXIT_SOFTWARE;
@@ -165,11 +154,11 @@ static int parse_args(int argc, char **argv, fit_args *a)
             if (m < 0)
                 BAD();
             if (strcmp(v, "both") == 0)
-                a->types = 3;
+                a->popt.types = CF_PIPELINE_BOTH;
             else if (strcmp(v, "telescoping") == 0)
-                a->types = 1;
+                a->popt.types = CF_PIPELINE_TELESCOPING;
             else if (strcmp(v, "non-telescoping") == 0)
-                a->types = 2;
+                a->popt.types = CF_PIPELINE_NON_TELESCOPING;
             else
                 return cf_cli_usage_error(cmd, "--type '%s': expected telescoping, "
                                                "non-telescoping or both", v);
@@ -183,35 +172,37 @@ static int parse_args(int argc, char **argv, fit_args *a)
             if (!eq || (size_t)(eq - v) >= sizeof name)
                 return cf_cli_usage_error(cmd, "--fix '%s': expected NAME=VALUE", v);
             snprintf(name, sizeof name, "%.*s", (int)(eq - v), v);
-            if (cf_fit_param_parse(name, &k, &err) != CF_OK ||
-                cf_cli_parse_double("--fix", eq + 1, &val, &err) != CF_OK)
+            if ((k = cf_spring_param_find(name)) < 0)
+                return cf_cli_usage_error(cmd, "--fix %s: unknown parameter '%s' (expected D1, "
+                                               "D2, n, d, G or H)", v, name);
+            if (cf_cli_parse_double("--fix", eq + 1, &val, &err) != CF_OK)
                 BAD();
             if (!(val > 0))
                 return cf_cli_usage_error(cmd, "--fix %s=%g: the value must be positive", name,
                                           val);
-            a->fopt.fixed[k] = 1;
-            a->fopt.fixed_value[k] = val;
+            a->popt.fit.fixed[k] = 1;
+            a->popt.fit.fixed_value[k] = val;
         } else if (OPT("--index-max")) {
-            if (m < 0 || cf_cli_parse_double("--index-max", v, &a->fopt.index_max, &err))
+            if (m < 0 || cf_cli_parse_double("--index-max", v, &a->popt.fit.index_max, &err))
                 BAD();
-            if (a->fopt.index_max < 3)
+            if (a->popt.fit.index_max < 3)
                 return cf_cli_usage_error(cmd, "--index-max %g: must be at least 3",
-                                          a->fopt.index_max);
+                                          a->popt.fit.index_max);
         } else if (strcmp(argv[i], "--relative") == 0) {
-            a->fopt.relative = 1;
+            a->popt.fit.relative = 1;
         } else if (OPT("--optimizer")) {
-            if (m < 0 || cf_fit_optimizer_parse(v, &a->fopt.optimizer, &err) != CF_OK)
+            if (m < 0 || cf_fit_optimizer_parse(v, &a->popt.fit.optimizer, &err) != CF_OK)
                 BAD();
         } else if (OPT("--seed")) {
             long s;
             if (m < 0 || cf_cli_parse_long("--seed", v, 0, 2147483647L, &s, &err))
                 BAD();
-            a->fopt.seed = (unsigned long)s;
+            a->popt.fit.seed = (unsigned long)s;
         } else if (OPT("--starts")) {
             long s;
             if (m < 0 || cf_cli_parse_long("--starts", v, 1, 10000, &s, &err))
                 BAD();
-            a->fopt.multistart = (int)s;
+            a->popt.fit.multistart = (int)s;
         } else if (OPT("--x-col")) {
             if (m < 0)
                 BAD();
@@ -260,56 +251,21 @@ static int parse_args(int argc, char **argv, fit_args *a)
     return -1;
 }
 
+/* Through-the-lattice work takes seconds: say so on a terminal. */
+static void show_progress(void *ctx, const char *table, const char *what)
+{
+    (void)ctx;
+    if (strstr(what, "through the lattice"))
+        fprintf(stderr, "conifit: %s: %s...\n", table, what);
+}
+
 /* Fits one loaded table and writes its outputs. */
 static void run_job(fit_job *j)
 {
     const fit_args *a = j->args;
-    cf_measure *m = &j->m;
-    cf_fit_data d = {m->count, m->x, m->y, m->w, m->kind == CF_MEASURE_FORCE_DISPLACEMENT};
-    cf_fit_report *r = &j->rep;
-    memset(r, 0, sizeof *r);
-    r->version = CF_VERSION;
-    r->data_file = j->file;
-    r->x_column = m->x_column;
-    r->x_unit = m->x_unit;
-    r->y_column = m->y_column;
-    r->y_unit = m->y_unit;
-    r->force_displacement = d.force_displacement;
-    r->compression = m->compression;
-    r->points = m->count;
-    r->y_to_file = m->y_to_file;
-    r->with_timing = 1;
-    for (size_t i = 0; i < m->count; i++)
-        r->ymax = fmax(r->ymax, fabs(m->y[i]));
-    for (int t = 0; t < 2; t++) {
-        if (!(a->types & (1 << t)))
-            continue;
-        j->st = cf_fit_run(&d, &a->fopt, (cf_spring_type)t, &r->fits[r->nfits], &j->err);
-        if (j->st != CF_OK) {
-            char msg[CF_ERROR_MSG_LEN];
-            snprintf(msg, sizeof msg, "%s", j->err.msg);
-            cf_error_set(&j->err, j->st, "%s: %s", j->file, msg);
-            return;
-        }
-        r->nfits++;
-    }
-    cf_baseline_fit_all(&d, r->baselines);
-    if (a->validate) {
-        r->validate = 1;
-        r->through_msm = a->through;
-        for (int k = 0; k < r->nfits; k++) {
-            cf_error verr = {0};
-            /* a table the lattice cannot run (force-displacement, past solid) is noted, not fatal */
-            if (cf_validate_run(&r->fits[k].params, &a->vsetup, &d, &r->val[k], &verr) != CF_OK ||
-                !a->through)
-                continue;
-            if (isatty(2))
-                fprintf(stderr, "conifit: %s: fitting the %s spring through the lattice...\n",
-                        j->file, cf_spring_type_name(r->fits[k].type));
-            cf_validate_through_msm(&d, &a->fopt, &a->vsetup, &r->fits[k], &r->val[k],
-                                    &r->thr[k], &verr);
-        }
-    }
+    j->st = cf_pipeline_fit(&j->m, &a->popt, &j->rep, &j->err);
+    if (j->st != CF_OK)
+        return;
     const char *inputs[257];
     int ni = 0;
     for (int i = 0; i < a->nfiles && ni < 256; i++)
@@ -320,21 +276,19 @@ static void run_job(fit_job *j)
             path_in_dir(j->json_path, sizeof j->json_path, a->out, j->file, ".json");
         else
             snprintf(j->json_path, sizeof j->json_path, "%s", a->out);
-        j->st = cf_report_json_write(r, j->json_path, inputs, &j->err);
-        if (j->st != CF_OK)
-            return;
     }
     if (a->plot) {
         if (a->nfiles > 1 || is_dir_target(a->plot))
             path_in_dir(j->plot_path, sizeof j->plot_path, a->plot, j->file, ".png");
         else
             snprintf(j->plot_path, sizeof j->plot_path, "%s", a->plot);
-        j->st = cf_plot_write(r, &d, j->plot_path, inputs, &j->err);
-        if (j->st != CF_OK)
-            return;
     }
+    j->st = cf_pipeline_write(&j->rep, a->out ? j->json_path : NULL,
+                              a->plot ? j->plot_path : NULL, inputs, &j->err);
+    if (j->st != CF_OK)
+        return;
     if (!a->quiet)
-        j->text = cf_report_text(r);
+        j->text = cf_report_text(&j->rep);
 }
 
 typedef struct pool {
@@ -382,15 +336,12 @@ int cf_cli_fit(int argc, char **argv)
             rc = cf_cli_fail(&err);
     }
     if (rc < 0 && a.scene) {
-        cf_scene sc;
         cf_error err = {0};
-        cf_status st = cf_scene_load(a.scene, &sc, &err);
-        if (st == CF_OK)
-            st = cf_validate_from_scene(&sc, a.scene, &a.vsetup, &err);
-        cf_scene_free(&sc);
-        if (st != CF_OK)
+        if (cf_pipeline_use_scene(&a.popt, a.scene, &err) != CF_OK)
             rc = cf_cli_fail(&err);
     }
+    if (isatty(STDERR_FILENO))
+        a.popt.progress = show_progress;
     if (rc < 0) {
         pool p = {jobs, a.nfiles, 0, PTHREAD_MUTEX_INITIALIZER};
         int nt = (int)(a.jobs < a.nfiles ? a.jobs : a.nfiles);
@@ -439,7 +390,7 @@ int cf_cli_fit(int argc, char **argv)
             printf("Summary (RMSE in each table's unit):\n");
             printf("  %-*s %-18s %-18s %-22s %-16s%s\n", wname, "table", "telescoping",
                    "non-telescoping", "best baseline", "better type",
-                   a.validate ? " lattice RMSE (better type)" : "");
+                   a.popt.validate ? " lattice RMSE (better type)" : "");
             for (int i = 0; i < a.nfiles; i++) {
                 fit_job *j = &jobs[i];
                 if (j->st != CF_OK) {
@@ -449,7 +400,7 @@ int cf_cli_fit(int argc, char **argv)
                 char cell[2][32] = {"-", "-"};
                 for (int k = 0; k < j->rep.nfits; k++)
                     snprintf(cell[j->rep.fits[k].type], sizeof cell[0], "%.4g %s%s",
-                             j->rep.fits[k].rmse * j->rep.y_to_file, j->rep.y_unit,
+                             j->rep.fits[k].rmse * j->m.y_to_file, j->m.y_unit,
                              j->rep.fits[k].feasible ? "" : " (!)");
                 int bb = 0;
                 for (int k = 1; k < CF_BASE_COUNT; k++)
@@ -457,13 +408,13 @@ int cf_cli_fit(int argc, char **argv)
                         bb = k;
                 char bcell[48];
                 snprintf(bcell, sizeof bcell, "%s %.4g %s", cf_baseline_name((cf_baseline_kind)bb),
-                         j->rep.baselines[bb].rmse * j->rep.y_to_file, j->rep.y_unit);
+                         j->rep.baselines[bb].rmse * j->m.y_to_file, j->m.y_unit);
                 int b = cf_report_better(&j->rep);
                 char vcell[48] = "";
-                if (a.validate && b >= 0 && j->rep.val[b].done)
+                if (a.popt.validate && b >= 0 && j->rep.val[b].done)
                     snprintf(vcell, sizeof vcell, " %.4g %s",
-                             j->rep.val[b].rmse * j->rep.y_to_file, j->rep.y_unit);
-                else if (a.validate)
+                             j->rep.val[b].rmse * j->m.y_to_file, j->m.y_unit);
+                else if (a.popt.validate)
                     snprintf(vcell, sizeof vcell, " skipped");
                 printf("  %-*s %-18s %-18s %-22s %-16s%s\n", wname, j->file, cell[0], cell[1],
                        bcell,
@@ -475,10 +426,9 @@ int cf_cli_fit(int argc, char **argv)
         }
     }
     for (int i = 0; i < a.nfiles; i++) {
-        cf_measure_free(&jobs[i].m);
+        cf_table_free(&jobs[i].m);
         free(jobs[i].text);
-        for (int k = 0; k < 2; k++)
-            cf_validation_free(&jobs[i].rep.val[k]);
+        cf_report_free(&jobs[i].rep);
     }
     free(jobs);
     free(a.files);

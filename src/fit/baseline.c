@@ -38,7 +38,7 @@ double cf_baseline_aic(size_t n, double rss, int k, double ymax)
 }
 
 /* RSS of Fung's law with A solved for the given B (A returned). */
-static double fung_profile(const cf_fit_data *d, double B, double *A)
+static double fung_profile(const cf_table *d, double B, double *A)
 {
     double sgy = 0, sgg = 0, syy = 0;
     for (size_t i = 0; i < d->count; i++) {
@@ -52,7 +52,7 @@ static double fung_profile(const cf_fit_data *d, double B, double *A)
     return isfinite(rss) ? fmax(rss, 0.0) : INFINITY;
 }
 
-static void finish(const cf_fit_data *d, cf_baseline *b, double ymax)
+static void finish(const cf_table *d, cf_baseline *b, double ymax)
 {
     double rss = 0;
     for (size_t i = 0; i < d->count; i++) {
@@ -64,7 +64,7 @@ static void finish(const cf_fit_data *d, cf_baseline *b, double ymax)
     b->aic = cf_baseline_aic(d->count, rss, b->k, ymax);
 }
 
-void cf_baseline_fit_all(const cf_fit_data *d, cf_baseline out[CF_BASE_COUNT])
+void cf_baseline_fit_all(const cf_table *d, cf_baseline out[CF_BASE_COUNT])
 {
     double xmax = 0, ymax = 0;
     double s2 = 0, s4 = 0, s6 = 0, sy1 = 0, sy3 = 0;

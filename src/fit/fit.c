@@ -18,12 +18,8 @@
 #include <gsl/gsl_vector.h>
 #include <nlopt.h>
 
-/* Lowest diameter ratio searched: rho = 1e-3 is a spring whose largest coil is a thousand times
-** its smallest, far beyond any wound spring. */
-#define RHO_LO 1e-3
-/* Relative residuals divide by max(|y|, REL_FLOOR max|y|) so that the point at the origin
-** (y = 0) keeps a finite weight. */
-#define REL_FLOOR 1e-3
+#include "fit/lsq.h"
+
 /* Constraint tolerances (constraints are in log units, i.e. relative): a constraint counts as
 ** violated beyond FEAS_TOL and active within ACTIVE_TOL of its limit. The optimisers see the
 ** constraints shifted by SAFETY so that their solutions land on the feasible side. */
@@ -32,28 +28,6 @@
 #define SAFETY 1e-10
 /* Grid of the global stage: GRID x GRID cells over (rho, length scale). */
 #define GRID 28
-/* Objective value returned where the model cannot be evaluated (invalid spring). */
-#define HUGE_OBJ 1e30
-
-static const char *const param_names[CF_P_COUNT] = {"D1", "D2", "n", "d", "G", "H"};
-
-const char *cf_fit_param_name(int index)
-{
-    return (index >= 0 && index < CF_P_COUNT) ? param_names[index] : "?";
-}
-
-cf_status cf_fit_param_parse(const char *name, int *index, cf_error *err)
-{
-    static const char *const long_names[CF_P_COUNT] = {"D1_mm", "D2_mm", "n", "d_mm", "G_MPa",
-                                                       "H_mm"};
-    for (int i = 0; i < CF_P_COUNT; i++)
-        if (strcmp(name, param_names[i]) == 0 || strcmp(name, long_names[i]) == 0) {
-            *index = i;
-            return CF_OK;
-        }
-    return cf_error_set(err, CF_E_USAGE, "unknown parameter '%s' (expected D1, D2, n, d, G or H)",
-                        name);
-}
 
 const char *cf_fit_optimizer_name(cf_fit_optimizer o)
 {
@@ -72,7 +46,7 @@ cf_status cf_fit_optimizer_parse(const char *name, cf_fit_optimizer *o, cf_error
             *o = (cf_fit_optimizer)i;
             return CF_OK;
         }
-    return cf_error_set(err, CF_E_USAGE, "unknown optimizer '%s' (expected slsqp, cobyla or mma)",
+    return cf_error_set(err, CF_E_DATA, "unknown optimizer '%s' (expected slsqp, cobyla or mma)",
                         name);
 }
 
@@ -94,12 +68,12 @@ cf_fit_options cf_fit_default_options(void)
 {
     cf_fit_options o;
     memset(&o, 0, sizeof o);
-    /* Bounds wide enough for any tissue table in any unit (micrometre springs to metre springs,
-    ** moduli from foams to steel); the constraints, not the bounds, shape the fit. */
-    const double lo[CF_P_COUNT] = {1e-6, 1e-6, 2, 1e-7, 1e-15, 1e-6};
-    const double hi[CF_P_COUNT] = {1e6, 1e9, 1e7, 1e5, 1e15, 1e6};
-    memcpy(o.lower, lo, sizeof lo);
-    memcpy(o.upper, hi, sizeof hi);
+    /* Bounds from the spring description (spring.h); the constraints, not the bounds, shape
+    ** the fit. */
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        o.lower[k] = cf_spring_param_info(k)->lower;
+        o.upper[k] = cf_spring_param_info(k)->upper;
+    }
     o.index_max = CF_FIT_INDEX_MAX_DEFAULT;
     o.optimizer = CF_OPT_SLSQP;
     o.xtol_rel = 1e-12;
@@ -191,12 +165,13 @@ void cf_fit_identifiable(const cf_spring *p, int force_displacement, double iden
 /* ---- the data as the fit sees it ------------------------------------------------------------- */
 
 typedef struct fit_ctx {
-    const cf_fit_data *data;
+    const cf_table *data;
     const cf_fit_options *opt;
     cf_spring_type type;
     int fd;
     size_t n;
     double *sw;     /* sqrt(w_i)/scale_i: residual i is sw_i (model_i - y_i) */
+    double *model;  /* scratch: the model at each point (same allocation as sw) */
     double xmax;    /* largest |x|: strain [-] or displacement [mm] */
     double ynorm;   /* sum of (sw_i y_i)^2: objective of the zero model */
     int travel_ok;  /* 0 when no spring can reach xmax (strain >= 1) */
@@ -261,7 +236,7 @@ static double reduced_profile(fit_ctx *c, double rho, double B, double *A_out)
 {
     cf_law canon;
     if (canon_law(rho, &canon) != CF_OK)
-        return HUGE_OBJ;
+        return CF_LSQ_HUGE_OBJ;
     double sgy = 0, sgg = 0, syy = 0;
     for (size_t i = 0; i < c->n; i++) {
         double g = c->sw[i] * reduced(&canon, 1.0, B, c->data->x[i], NULL);
@@ -350,7 +325,7 @@ static double lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3
     gsl_multifit_nlinear_workspace *w =
         gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &fp, c->n, p);
     if (!w)
-        return HUGE_OBJ;
+        return CF_LSQ_HUGE_OBJ;
     gsl_multifit_nlinear_fdf fdf;
     memset(&fdf, 0, sizeof fdf);
     fdf.f = lm_f;
@@ -361,7 +336,7 @@ static double lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3
     double th0[3] = {logit((rho0 - c->rho_lo) / (c->rho_hi - c->rho_lo)),
                      logit((B0 - c->b_lo) / (c->b_hi - c->b_lo)), log(A0)};
     gsl_vector_view x0 = gsl_vector_view_array(th0, 3);
-    double best = HUGE_OBJ;
+    double best = CF_LSQ_HUGE_OBJ;
     if (gsl_multifit_nlinear_init(&x0.vector, &fdf, w) == GSL_SUCCESS) {
         /* The driver loop, with one more stopping rule: an optimum on a bound of rho or of the
         ** length scale lies at infinity in the logit coordinates, where the step test never
@@ -442,7 +417,7 @@ static double stage_a(fit_ctx *c, double best3[3])
     start grid[GRID * GRID];
     size_t k = 0;
     for (int i = 0; i < GRID; i++) {
-        /* rho: half the grid log-spaced from RHO_LO, half approaching rho_hi geometrically
+        /* rho: half the grid log-spaced from CF_LSQ_RHO_LO, half approaching rho_hi geometrically
         ** (resolves nearly cylindrical springs) */
         double ti = (i + rng_uniform(&rng)) / GRID;
         double rho = (i % 2 == 0)
@@ -460,7 +435,7 @@ static double stage_a(fit_ctx *c, double best3[3])
         }
     }
     qsort(grid, k, sizeof grid[0], cmp_start);
-    double best = HUGE_OBJ;
+    double best = CF_LSQ_HUGE_OBJ;
     double r, B, A, out[3];
     two_point_start(c, &r, &B, &A);
     reduced_profile(c, r, B, &A);
@@ -555,21 +530,13 @@ static void constraint_values(const double *p, cf_spring_type type, double xmax,
             g[k] = 50.0;
 }
 
-static double data_xmax(const cf_fit_data *d)
-{
-    double m = 0;
-    for (size_t i = 0; i < d->count; i++)
-        m = fmax(m, fabs(d->x[i]));
-    return m;
-}
-
-int cf_fit_check(const cf_spring *sp, cf_spring_type type, const cf_fit_data *data,
+int cf_fit_check(const cf_spring *sp, cf_spring_type type, const cf_table *data,
                  const cf_fit_options *opt, unsigned *active, unsigned *violated)
 {
     double p[CF_P_COUNT], g[6];
     to_array(sp, p);
     unsigned act = 0, vio = 0;
-    constraint_values(p, type, data_xmax(data), data->force_displacement, opt->index_max, g);
+    constraint_values(p, type, cf_lsq_xmax(data), cf_table_is_force(data), opt->index_max, g);
     for (int k = 0; k < 6; k++) {
         if (g[k] > FEAS_TOL)
             vio |= 1u << k;
@@ -613,14 +580,14 @@ static double objective6(fit_ctx *c, const double *p)
     cf_spring s = from_array(p);
     cf_law law;
     if (cf_law_init(&law, &s, NULL) != CF_OK)
-        return HUGE_OBJ;
+        return CF_LSQ_HUGE_OBJ;
     double sum = 0;
     for (size_t i = 0; i < c->n; i++) {
         double r = c->sw[i] * (cf_fit_model(&law, c->fd, c->data->x[i]) - c->data->y[i]);
         sum += r * r;
     }
     c->evals++;
-    return isfinite(sum) ? sum / c->ynorm : HUGE_OBJ;
+    return isfinite(sum) ? sum / c->ynorm : CF_LSQ_HUGE_OBJ;
 }
 
 /* Central-difference gradient of a scalar function of z. */
@@ -779,7 +746,7 @@ static void analytic_member(const fit_ctx *c, const double v[3], double *p)
     double d = c->type == CF_TELESCOPING ? Lmin : Lmin / n;
     double D1 = cidx * d, D2 = D1 / rho;
     double FC = c->fd ? v[2] : v[2] * H * H;
-    double G = 8 * n * D1 * D1 * D1 * FC / (d * d * d * d * s);
+    double G = cf_lsq_G_of_FC(FC, n, D1, d, s);
     const double q[CF_P_COUNT] = {D1, D2, n, d, G, H};
     for (int k = 0; k < CF_P_COUNT; k++)
         p[k] = c->opt->fixed[k] ? c->opt->fixed_value[k] : q[k];
@@ -803,7 +770,7 @@ static void snap_to_family(fit_ctx *c, double *p, double *z)
     if (!fx[CF_P_G] && s > 0) {
         double FC = c->fd ? v[2] : v[2] * q[CF_P_H] * q[CF_P_H];
         double D1 = q[CF_P_D1], d = q[CF_P_D];
-        q[CF_P_G] = 8 * q[CF_P_N] * D1 * D1 * D1 * FC / (d * d * d * d * s);
+        q[CF_P_G] = cf_lsq_G_of_FC(FC, q[CF_P_N], D1, d, s);
     }
     cf_spring sp = from_array(q);
     if (!cf_fit_check(&sp, c->type, c->data, c->opt, NULL, NULL))
@@ -815,7 +782,7 @@ static void snap_to_family(fit_ctx *c, double *p, double *z)
 
 /* ---- the driver ------------------------------------------------------------------------------ */
 
-static cf_status check_data(const cf_fit_data *d, cf_error *err)
+static cf_status check_data(const cf_table *d, cf_error *err)
 {
     if (d->count < 4)
         return cf_error_set(err, CF_E_DATA, "%zu data points: a fit needs at least 4", d->count);
@@ -839,20 +806,20 @@ static cf_status check_data(const cf_fit_data *d, cf_error *err)
 static cf_status check_options(const cf_fit_options *o, cf_error *err)
 {
     if (!(o->index_max >= 3) || !isfinite(o->index_max))
-        return cf_error_set(err, CF_E_USAGE, "index-max = %g: must be at least 3", o->index_max);
+        return cf_error_set(err, CF_E_DATA, "index_max = %g: the largest spring index must be at least 3", o->index_max);
     for (int k = 0; k < CF_P_COUNT; k++) {
         if (!(o->lower[k] > 0 && o->lower[k] <= o->upper[k] && isfinite(o->upper[k])))
-            return cf_error_set(err, CF_E_USAGE, "bounds of %s: %g .. %g are not 0 < lo <= hi",
-                                param_names[k], o->lower[k], o->upper[k]);
+            return cf_error_set(err, CF_E_DATA, "bounds of %s: %g .. %g are not 0 < lo <= hi",
+                                cf_spring_param_info(k)->name, o->lower[k], o->upper[k]);
         if (o->fixed[k] && !(o->fixed_value[k] > 0 && isfinite(o->fixed_value[k])))
-            return cf_error_set(err, CF_E_USAGE, "fixed %s = %g must be a positive number",
-                                param_names[k], o->fixed_value[k]);
+            return cf_error_set(err, CF_E_DATA, "fixed %s = %g must be a positive number",
+                                cf_spring_param_info(k)->name, o->fixed_value[k]);
     }
     if (o->fixed[CF_P_N] && o->fixed_value[CF_P_N] < 2)
-        return cf_error_set(err, CF_E_USAGE, "fixed n = %g: a conical spring needs n >= 2",
+        return cf_error_set(err, CF_E_DATA, "fixed n = %g: a conical spring needs n >= 2",
                             o->fixed_value[CF_P_N]);
     if (o->multistart < 1)
-        return cf_error_set(err, CF_E_USAGE, "multistart = %d must be >= 1", o->multistart);
+        return cf_error_set(err, CF_E_DATA, "multistart = %d must be >= 1", o->multistart);
     return CF_OK;
 }
 
@@ -861,27 +828,20 @@ static void summarise(fit_ctx *c, const double *p, cf_fit_result *res)
     res->params = from_array(p);
     cf_law_init(&res->law, &res->params, NULL);
     ident_of(p, c->type, c->fd, res->ident);
-    double rss = 0, mx = 0, ym = 0, syy = 0;
     for (size_t i = 0; i < c->n; i++)
-        ym += c->data->y[i];
-    ym /= (double)c->n;
-    for (size_t i = 0; i < c->n; i++) {
-        double r = cf_fit_model(&res->law, c->fd, c->data->x[i]) - c->data->y[i];
-        rss += r * r;
-        mx = fmax(mx, fabs(r));
-        syy += (c->data->y[i] - ym) * (c->data->y[i] - ym);
-    }
-    res->rss = rss;
-    res->rmse = sqrt(rss / (double)c->n);
-    res->max_abs_error = mx;
-    res->r2 = syy > 0 ? 1 - rss / syy : 0;
+        c->model[i] = cf_fit_model(&res->law, c->fd, c->data->x[i]);
+    cf_lsq_quality q = cf_lsq_quality_of(c->data, c->model);
+    res->rss = q.rss;
+    res->rmse = q.rmse;
+    res->max_abs_error = q.max_abs_error;
+    res->r2 = q.r2;
     res->objective = objective6(c, p) * c->ynorm;
     res->feasible = cf_fit_check(&res->params, c->type, c->data, c->opt, &res->active,
                                  &res->violated);
 }
 
 /* Checks data and options and prepares the context shared by every stage (c->sw is malloc'd). */
-static cf_status ctx_setup(fit_ctx *c, const cf_fit_data *data, const cf_fit_options *opt,
+static cf_status ctx_setup(fit_ctx *c, const cf_table *data, const cf_fit_options *opt,
                            cf_spring_type type, cf_error *err)
 {
     memset(c, 0, sizeof *c);
@@ -891,24 +851,18 @@ static cf_status ctx_setup(fit_ctx *c, const cf_fit_data *data, const cf_fit_opt
     c->data = data;
     c->opt = opt;
     c->type = type;
-    c->fd = data->force_displacement;
+    c->fd = cf_table_is_force(data);
     c->n = data->count;
-    c->sw = malloc(sizeof(double) * c->n);
+    /* one block: the residual weights, then the model's values at the points (summarise) */
+    c->sw = malloc(2 * sizeof(double) * c->n);
     if (!c->sw)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", c->n);
-    double ymax = 0;
-    for (size_t i = 0; i < c->n; i++)
-        ymax = fmax(ymax, fabs(data->y[i]));
-    for (size_t i = 0; i < c->n; i++) {
-        double sc = opt->relative ? fmax(fabs(data->y[i]), REL_FLOOR * ymax) : 1.0;
-        c->sw[i] = sqrt(data->w ? data->w[i] : 1.0) / sc;
-        c->ynorm += (c->sw[i] * data->y[i]) * (c->sw[i] * data->y[i]);
-    }
-    c->xmax = data_xmax(data);
-    /* Stage A bounds. Telescoping needs n <= c (1 - rho)/(2 rho) with n >= 2 and c <= index_max,
-    ** so rho <= index_max/(index_max + 4). */
-    c->rho_lo = RHO_LO;
-    c->rho_hi = type == CF_TELESCOPING ? opt->index_max / (opt->index_max + 4) * (1 - 1e-6) : 1.0;
+    c->model = c->sw + c->n;
+    c->ynorm = cf_lsq_weights(data, opt->relative, c->sw);
+    c->xmax = cf_lsq_xmax(data);
+    /* Stage A bounds (rho_hi: lsq.h). */
+    c->rho_lo = CF_LSQ_RHO_LO;
+    c->rho_hi = cf_lsq_rho_hi(type, opt->index_max);
     double need = c->xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
     if (c->fd) {
         c->travel_ok = 1;
@@ -943,7 +897,7 @@ static void place(fit_ctx *c, const double v[3], double *p, double *z)
     snap_to_family(c, p, z);
 }
 
-cf_status cf_fit_place(const cf_fit_data *data, const cf_fit_options *opt, cf_spring_type type,
+cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                        const double ident[3], cf_fit_result *res, cf_error *err)
 {
     const double t0 = now_s();
@@ -973,7 +927,7 @@ cf_status cf_fit_place(const cf_fit_data *data, const cf_fit_options *opt, cf_sp
     return CF_OK;
 }
 
-cf_status cf_fit_run(const cf_fit_data *data, const cf_fit_options *opt, cf_spring_type type,
+cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                      cf_fit_result *res, cf_error *err)
 {
     const double t0 = now_s();

@@ -11,20 +11,8 @@
 
 #include <jansson.h>
 
-cf_status cf_spring_type_parse(const char *name, cf_spring_type *type, cf_error *err)
-{
-    if (name && strcmp(name, "telescoping") == 0) {
-        *type = CF_TELESCOPING;
-        return CF_OK;
-    }
-    if (name && strcmp(name, "non-telescoping") == 0) {
-        *type = CF_NON_TELESCOPING;
-        return CF_OK;
-    }
-    return cf_error_set(err, CF_E_USAGE,
-                        "unknown spring type '%s' (expected telescoping or non-telescoping)",
-                        name ? name : "(null)");
-}
+#include "base/atomic.h"
+#include "io/fitfile_json.h"
 
 static void copy_string(json_t *obj, const char *key, char *dst, size_t cap)
 {
@@ -35,7 +23,6 @@ static void copy_string(json_t *obj, const char *key, char *dst, size_t cap)
 cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spring *out,
                           cf_error *err)
 {
-    static const char *keys[6] = {"D1_mm", "D2_mm", "n", "d_mm", "G_MPa", "H_mm"};
     memset(out, 0, sizeof *out);
     out->rmse = NAN;
     FILE *f = fopen(path, "rb");
@@ -102,18 +89,17 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
         goto done;
     }
     json_t *params = json_object_get(fit, "params");
-    double *slot[6] = {&out->params.D1_mm, &out->params.D2_mm, &out->params.n,
-                       &out->params.d_mm,  &out->params.G_MPa, &out->params.H_mm};
-    for (int k = 0; k < 6; k++) {
-        json_t *v = json_object_get(params, keys[k]);
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        const char *key = cf_spring_param_info(k)->key;
+        json_t *v = json_object_get(params, key);
         if (!json_is_number(v) || !isfinite(json_number_value(v))) {
             char *text = v ? json_dumps(v, JSON_ENCODE_ANY) : NULL;
             st = cf_error_set(err, CF_E_DATA, "%s: %s.params.%s = %.40s is not a number", path,
-                              where, keys[k], text ? text : "(missing)");
+                              where, key, text ? text : "(missing)");
             free(text);
             goto done;
         }
-        *slot[k] = json_number_value(v);
+        cf_spring_set(&out->params, k, json_number_value(v));
     }
     cf_law law;
     cf_error lerr = {0};
@@ -158,4 +144,66 @@ cf_status cf_fitfile_load_spec(const char *spec, cf_fitted_spring *out, cf_error
         type = colon + 1;
     }
     return cf_fitfile_load(path, type, out, err);
+}
+
+/* ---- writing (fitfile_json.h) ----------------------------------------------------------------- */
+
+json_t *cf_json_number(double v)
+{
+    return isfinite(v) ? json_real(v) : json_null();
+}
+
+json_t *cf_fitfile_spring_json(const cf_law *law)
+{
+    const cf_spring *p = &law->p;
+    json_t *params = json_object();
+    for (int k = 0; params && k < CF_P_COUNT; k++)
+        json_object_set_new(params, cf_spring_param_info(k)->key,
+                            cf_json_number(cf_spring_get(p, k)));
+    json_t *derived = json_pack(
+        "{s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o}", "rho", cf_json_number(law->rho),
+        "travel_mm", cf_json_number(law->travel_mm), "solid_strain",
+        cf_json_number(law->travel_mm / p->H_mm), "F_T_N", cf_json_number(law->F_T_N), "F_C_N",
+        cf_json_number(law->F_C_N), "k0_N_per_mm", cf_json_number(law->k0_N_per_mm), "u_T_mm",
+        cf_json_number(law->u_T_mm), "index_c", cf_json_number(law->index_c), "L_min_mm",
+        cf_json_number(law->L_min_mm), "L_max_mm", cf_json_number(law->L_max_mm));
+    if (!params || !derived) {
+        json_decref(params);
+        json_decref(derived);
+        return NULL;
+    }
+    return json_pack("{s:s, s:o, s:o}", "type", cf_spring_type_name(law->type), "params", params,
+                     "derived", derived);
+}
+
+char *cf_fitfile_dumps(const json_t *root)
+{
+    char *s = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17) | JSON_PRESERVE_ORDER);
+    if (!s)
+        return NULL;
+    size_t n = strlen(s);
+    char *t = realloc(s, n + 2);
+    if (!t) {
+        free(s);
+        return NULL;
+    }
+    t[n] = '\n';
+    t[n + 1] = '\0';
+    return t;
+}
+
+cf_status cf_fitfile_write(const json_t *root, const char *path, const char *const *inputs,
+                           cf_error *err)
+{
+    char *s = cf_fitfile_dumps(root);
+    if (!s)
+        return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory writing the JSON", path);
+    cf_atomic a;
+    cf_status st = cf_atomic_open(&a, path, inputs, err);
+    if (st == CF_OK) {
+        fputs(s, a.fp);
+        st = cf_atomic_commit(&a, err);
+    }
+    free(s);
+    return st;
 }

@@ -839,7 +839,7 @@ static cf_status column_unit(const reader *r, size_t header_line, size_t ci, con
     return CF_OK;
 }
 
-cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf_measure *m,
+cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf_table *m,
                           cf_error *err)
 {
     cf_measure_options opt = opt_in ? *opt_in : cf_measure_default_options();
@@ -996,10 +996,10 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
                         yc->name);
         goto fail;
     }
-    m->kind = yu->cls == CF_UNIT_STRESS ? CF_MEASURE_STRESS_STRAIN : CF_MEASURE_FORCE_DISPLACEMENT;
+    m->kind = yu->cls == CF_UNIT_STRESS ? CF_TABLE_STRESS_STRAIN : CF_TABLE_FORCE_DISPLACEMENT;
     int stretch = opt.x_is_stretch == 1 || (opt.x_is_stretch < 0 && is_stretch_name(xc->base));
     double xscale = 1.0;
-    if (m->kind == CF_MEASURE_STRESS_STRAIN) {
+    if (m->kind == CF_TABLE_STRESS_STRAIN) {
         cf_unit_class xw[1] = {CF_UNIT_STRAIN};
         if (xc->unit[0]) {
             const unit_def *d = unit_find(xc->unit);
@@ -1157,7 +1157,7 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
     snprintf(m->x_column, sizeof m->x_column, "%.63s", xc->name);
     snprintf(m->y_column, sizeof m->y_column, "%.63s", yc->name);
     snprintf(m->x_unit, sizeof m->x_unit, "%s",
-             m->kind == CF_MEASURE_STRESS_STRAIN ? "-" : "mm");
+             m->kind == CF_TABLE_STRESS_STRAIN ? "-" : "mm");
     snprintf(m->y_unit, sizeof m->y_unit, "%s", yu->canon);
     reader_free(&r);
     cf_error_clear(err);
@@ -1169,7 +1169,7 @@ fail:
     return st;
 }
 
-void cf_measure_free(cf_measure *m)
+void cf_table_free(cf_table *m)
 {
     if (!m)
         return;
@@ -1179,4 +1179,45 @@ void cf_measure_free(cf_measure *m)
     free(m->t);
     m->x = m->y = m->w = m->t = NULL;
     m->count = 0;
+}
+
+int cf_table_is_force(const cf_table *m)
+{
+    return m->kind == CF_TABLE_FORCE_DISPLACEMENT;
+}
+
+cf_status cf_table_from_arrays(cf_table_kind kind, size_t count, const double *x, const double *y,
+                               const double *w, cf_table *m, cf_error *err)
+{
+    memset(m, 0, sizeof *m);
+    m->kind = kind;
+    size_t bytes = sizeof(double) * (count ? count : 1);
+    m->x = malloc(bytes);
+    m->y = malloc(bytes);
+    m->w = malloc(bytes);
+    if (!m->x || !m->y || !m->w) {
+        cf_table_free(m);
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for a table of %zu points", count);
+    }
+    for (size_t i = 0; i < count; i++) {
+        m->x[i] = x[i];
+        m->y[i] = y[i];
+        m->w[i] = w ? w[i] : 1.0;
+    }
+    m->count = count;
+    m->y_to_file = 1.0;
+    snprintf(m->path, sizeof m->path, "(table in memory)");
+    snprintf(m->x_column, sizeof m->x_column, "x");
+    snprintf(m->y_column, sizeof m->y_column, "y");
+    snprintf(m->x_unit, sizeof m->x_unit, "%s", kind == CF_TABLE_FORCE_DISPLACEMENT ? "mm" : "-");
+    snprintf(m->y_unit, sizeof m->y_unit, "%s", kind == CF_TABLE_FORCE_DISPLACEMENT ? "N" : "MPa");
+    for (size_t i = 0; i < count; i++)
+        if (x[i] > 0)
+            return CF_OK;
+    m->compression = count > 0;
+    for (size_t i = 0; i < count; i++)
+        if (x[i] < 0)
+            return CF_OK;
+    m->compression = 0;
+    return CF_OK;
 }

@@ -45,12 +45,11 @@ static cf_status check_positive(const char *name, double v, cf_error *err)
 
 cf_status cf_law_init(cf_law *law, const cf_spring *p, cf_error *err)
 {
-    static const char *names[6] = {"D1_mm", "D2_mm", "n", "d_mm", "G_MPa", "H_mm"};
-    const double vals[6] = {p->D1_mm, p->D2_mm, p->n, p->d_mm, p->G_MPa, p->H_mm};
     cf_status st;
     memset(law, 0, sizeof *law);
-    for (int i = 0; i < 6; i++)
-        if ((st = check_positive(names[i], vals[i], err)) != CF_OK)
+    for (int k = 0; k < CF_P_COUNT; k++)
+        if ((st = check_positive(cf_spring_param_info(k)->key, cf_spring_get(p, k), err)) !=
+            CF_OK)
             return st;
     if (p->D1_mm > p->D2_mm)
         return cf_error_set(err, CF_E_DATA,
@@ -115,11 +114,6 @@ void cf_law_free(cf_law *law)
     law->table = NULL;
 }
 
-const char *cf_spring_type_name(cf_spring_type type)
-{
-    return type == CF_TELESCOPING ? "telescoping" : "non-telescoping";
-}
-
 cf_status cf_law_method_parse(const char *name, cf_law_method *method, cf_error *err)
 {
     static const struct { const char *name; cf_law_method m; } map[] = {
@@ -130,7 +124,7 @@ cf_status cf_law_method_parse(const char *name, cf_law_method *method, cf_error 
             *method = map[i].m;
             return CF_OK;
         }
-    return cf_error_set(err, CF_E_USAGE,
+    return cf_error_set(err, CF_E_DATA,
                         "unknown method '%s' (expected exact, closed, closed+newton or table)",
                         name ? name : "(null)");
 }

@@ -14,6 +14,7 @@
 #include <jansson.h>
 
 #include "conifit/version.h"
+#include "io/fitfile_json.h"
 
 /* Rows are accepted when the interpolation error at the probes is within this fraction of the
 ** tolerance, so that the error between probes (checked afterwards on the dense grid) stays
@@ -322,7 +323,7 @@ cf_status cf_export_format_parse(const char *name, cf_export_format *format, cf_
             *format = (cf_export_format)i;
             return CF_OK;
         }
-    return cf_error_set(err, CF_E_USAGE,
+    return cf_error_set(err, CF_E_DATA,
                         "unknown export format '%s' (expected json, csv, calculix, abaqus, "
                         "febio, lsdyna or sofa)",
                         name ? name : "(null)");
@@ -354,12 +355,13 @@ static const char *src_name(const cf_export_options *opt)
 ** so that no "--" appears inside one). */
 static void params_line(FILE *out, const char *lead, const char *tail, const cf_law *law)
 {
-    const cf_spring *p = &law->p;
-    fprintf(out,
-            "%sspring (%s): D1 = %.17g mm, D2 = %.17g mm, n = %.17g, d = %.17g mm, "
-            "G = %.17g MPa, H = %.17g mm%s\n",
-            lead, cf_spring_type_name(law->type), p->D1_mm, p->D2_mm, p->n, p->d_mm, p->G_MPa,
-            p->H_mm, tail);
+    fprintf(out, "%sspring (%s):", lead, cf_spring_type_name(law->type));
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        const cf_spring_param *sp = cf_spring_param_info(k);
+        fprintf(out, "%s %s = %.17g%s%s", k ? "," : "", sp->name, cf_spring_get(&law->p, k),
+                strcmp(sp->unit, "-") ? " " : "", strcmp(sp->unit, "-") ? sp->unit : "");
+    }
+    fprintf(out, "%s\n", tail);
     fprintf(out, "%stravel s = %.17g mm, F_T = %.17g N, F_C = %.17g N, k0 = %.17g N/mm%s\n", lead,
             law->travel_mm, law->F_T_N, law->F_C_N, law->k0_N_per_mm, tail);
 }
@@ -381,31 +383,19 @@ static void table_comment(FILE *out, const char *lead, const char *tail,
 static cf_status write_json(FILE *out, const cf_fitted_spring *fs, const cf_law *law,
                             const cf_export_options *opt, cf_error *err)
 {
-    const cf_spring *p = &law->p;
-    json_t *root = json_object();
-    json_t *params = json_object(), *derived = json_object(), *units = json_object();
-    json_t *prov = json_object();
-    json_object_set_new(root, "schema", json_string(CF_SPRINGFILE_SCHEMA));
-    json_object_set_new(root, "conifit_version", json_string(CF_VERSION));
-    json_object_set_new(root, "type", json_string(cf_spring_type_name(law->type)));
-    json_object_set_new(params, "D1_mm", json_real(p->D1_mm));
-    json_object_set_new(params, "D2_mm", json_real(p->D2_mm));
-    json_object_set_new(params, "n", json_real(p->n));
-    json_object_set_new(params, "d_mm", json_real(p->d_mm));
-    json_object_set_new(params, "G_MPa", json_real(p->G_MPa));
-    json_object_set_new(params, "H_mm", json_real(p->H_mm));
-    json_object_set_new(root, "params", params);
-    json_object_set_new(derived, "rho", json_real(law->rho));
-    json_object_set_new(derived, "index_c", json_real(law->index_c));
-    json_object_set_new(derived, "L_min_mm", json_real(law->L_min_mm));
-    json_object_set_new(derived, "L_max_mm", json_real(law->L_max_mm));
-    json_object_set_new(derived, "travel_mm", json_real(law->travel_mm));
-    json_object_set_new(derived, "solid_strain", json_real(law->travel_mm / p->H_mm));
-    json_object_set_new(derived, "F_T_N", json_real(law->F_T_N));
-    json_object_set_new(derived, "F_C_N", json_real(law->F_C_N));
-    json_object_set_new(derived, "k0_N_per_mm", json_real(law->k0_N_per_mm));
-    json_object_set_new(derived, "u_T_mm", json_real(law->u_T_mm));
-    json_object_set_new(root, "derived", derived);
+    json_t *root = json_pack("{s:s, s:s}", "schema", CF_SPRINGFILE_SCHEMA, "conifit_version",
+                             CF_VERSION);
+    json_t *spring = cf_fitfile_spring_json(law);
+    json_t *units = json_object(), *prov = json_object();
+    if (!root || !spring || !units || !prov) {
+        json_decref(root);
+        json_decref(spring);
+        json_decref(units);
+        json_decref(prov);
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory building the JSON spring");
+    }
+    json_object_update(root, spring);
+    json_decref(spring);
     json_object_set_new(units, "length", json_string("mm"));
     json_object_set_new(units, "force", json_string("N"));
     json_object_set_new(units, "modulus", json_string("MPa"));
@@ -416,16 +406,19 @@ static cf_status write_json(FILE *out, const cf_fitted_spring *fs, const cf_law 
     json_object_set_new(prov, "fit_file", json_string(opt->source ? opt->source : ""));
     json_object_set_new(prov, "data_file", json_string(fs->data_file));
     if (isfinite(fs->rmse)) {
-        json_object_set_new(prov, "rmse", json_real(fs->rmse));
+        json_object_set_new(prov, "rmse", cf_json_number(fs->rmse));
         json_object_set_new(prov, "rmse_unit", json_string(fs->y_unit));
     }
     json_object_set_new(prov, "fit_version", json_string(fs->version));
     json_object_set_new(root, "provenance", prov);
-    int rc = json_dumpf(root, out, JSON_INDENT(2) | JSON_REAL_PRECISION(17) | JSON_PRESERVE_ORDER);
+    char *text = cf_fitfile_dumps(root);
     json_decref(root);
-    if (rc != 0)
+    if (!text)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory writing the JSON spring");
+    int rc = fputs(text, out);
+    free(text);
+    if (rc < 0)
         return cf_error_set(err, CF_E_CANTWRITE, "cannot write the JSON spring");
-    fputc('\n', out);
     return CF_OK;
 }
 

@@ -14,7 +14,7 @@
 #define CURVE_POINTS 400
 
 /* x and the lattice stress (file's unit) of every data point, sorted by x. */
-static void lattice_block(cf_gp *g, const char *name, const cf_fit_data *d,
+static void lattice_block(cf_gp *g, const char *name, const cf_table *d,
                           const double *stress_MPa, double u)
 {
     size_t *ord = malloc(sizeof(size_t) * (d->count ? d->count : 1));
@@ -40,16 +40,11 @@ static void lattice_block(cf_gp *g, const char *name, const cf_fit_data *d,
     free(ord);
 }
 
-typedef struct fit_figure {
-    const cf_fit_report *r;
-    const cf_fit_data *d;
-} fit_figure;
-
 static void fit_script(cf_gp *g, const void *fig)
 {
-    const cf_fit_report *r = ((const fit_figure *)fig)->r;
-    const cf_fit_data *d = ((const fit_figure *)fig)->d;
-    const double u = r->y_to_file;
+    const cf_fit_report *r = fig;
+    const cf_table *d = r->table;
+    const double u = d->y_to_file;
     double xmin = 0, xmax = 0;
     for (size_t i = 0; i < d->count; i++) {
         xmin = fmin(xmin, d->x[i]);
@@ -66,7 +61,7 @@ static void fit_script(cf_gp *g, const void *fig)
         row[c++] = d->x[i];
         row[c++] = d->y[i] * u;
         for (int k = 0; k < r->nfits; k++)
-            row[c++] = (cf_fit_model(&laws[k], r->force_displacement, d->x[i]) - d->y[i]) * u;
+            row[c++] = (cf_fit_model(&laws[k], cf_table_is_force(d), d->x[i]) - d->y[i]) * u;
         for (int k = 0; k < CF_BASE_COUNT; k++)
             row[c++] = (cf_baseline_eval(&r->baselines[k], d->x[i]) - d->y[i]) * u;
         cf_gp_block_row(g, c, row);
@@ -78,7 +73,7 @@ static void fit_script(cf_gp *g, const void *fig)
         double x = xmin + (xmax - xmin) * j / CURVE_POINTS;
         row[c++] = x;
         for (int k = 0; k < r->nfits; k++)
-            row[c++] = cf_fit_model(&laws[k], r->force_displacement, x) * u;
+            row[c++] = cf_fit_model(&laws[k], cf_table_is_force(d), x) * u;
         for (int k = 0; k < CF_BASE_COUNT; k++)
             row[c++] = cf_baseline_eval(&r->baselines[k], x) * u;
         cf_gp_block_row(g, c, row);
@@ -94,14 +89,14 @@ static void fit_script(cf_gp *g, const void *fig)
                 lat[k] = 1;
             }
     cf_gp_cmd(g, "set multiplot");
-    cf_gp_cmd(g, "set title %q noenhanced", r->data_file);
+    cf_gp_cmd(g, "set title %q noenhanced", d->path);
     cf_gp_cmd(g, "set size 1,0.66");
     cf_gp_cmd(g, "set origin 0,0.34");
     cf_gp_cmd(g, "set grid");
     cf_gp_cmd(g, "set key top left box opaque");
-    cf_gp_cmd(g, "set xlabel %q", r->force_displacement ? "displacement [mm]" : "strain [-]");
+    cf_gp_cmd(g, "set xlabel %q", cf_table_is_force(d) ? "displacement [mm]" : "strain [-]");
     char yl[400];
-    snprintf(yl, sizeof yl, "%s [%s]", r->y_column, r->y_unit);
+    snprintf(yl, sizeof yl, "%s [%s]", d->y_column, d->y_unit);
     cf_gp_cmd(g, "set ylabel %q noenhanced", yl);
     static const char *colors[2] = {"#d62728", "#1f77b4"};
     static const char *bcolors[CF_BASE_COUNT] = {"#7f7f7f", "#2ca02c", "#9467bd"};
@@ -133,7 +128,7 @@ static void fit_script(cf_gp *g, const void *fig)
     cf_gp_cmd(g, "unset title");
     cf_gp_cmd(g, "set key off");
     char rl[96];
-    snprintf(rl, sizeof rl, "residual [%s]", r->y_unit);
+    snprintf(rl, sizeof rl, "residual [%s]", d->y_unit);
     cf_gp_cmd(g, "set ylabel %q noenhanced", rl);
     cf_gp_cmd(g, "plot 0 with lines lc rgb %q notitle \\", "black");
     for (int k = 0; k < r->nfits; k++)
@@ -166,18 +161,17 @@ cf_status cf_plot_check_name(const char *path, cf_error *err)
     return cf_gp_check_name(path, err);
 }
 
-cf_status cf_plot_fit(const cf_fit_report *r, const cf_fit_data *data, const char *path,
-                      const char *const *inputs, cf_atomic *out, cf_error *err)
+cf_status cf_plot_fit(const cf_fit_report *r, const char *path, const char *const *inputs,
+                      cf_atomic *out, cf_error *err)
 {
-    fit_figure f = {r, data};
-    return draw(fit_script, &f, 900, 800, path, inputs, out, err);
+    return draw(fit_script, r, 900, 800, path, inputs, out, err);
 }
 
-cf_status cf_plot_write(const cf_fit_report *r, const cf_fit_data *data, const char *path,
-                        const char *const *inputs, cf_error *err)
+cf_status cf_plot_write(const cf_fit_report *r, const char *path, const char *const *inputs,
+                        cf_error *err)
 {
     cf_atomic a;
-    cf_status st = cf_plot_fit(r, data, path, inputs, &a, err);
+    cf_status st = cf_plot_fit(r, path, inputs, &a, err);
     if (st == CF_OK)
         st = cf_atomic_commit(&a, err);
     return st;

@@ -29,11 +29,11 @@ cf_status cf_plot_check_name(const char *path, cf_error *err);
 ** with its other outputs (cf_atomic_commit) or abort. CF_E_DATA for another extension,
 ** CF_E_INTERNAL when gnuplot is missing or fails (message says which), CF_E_CANTWRITE when the
 ** file cannot be written; `inputs` (NULL-terminated, may be NULL) are refused as targets. */
-cf_status cf_plot_fit(const cf_fit_report *r, const cf_fit_data *data, const char *path,
+cf_status cf_plot_fit(const cf_fit_report *r, const char *path,
                       const char *const *inputs, cf_atomic *out, cf_error *err);
 
 /* The same, committed at once. */
-cf_status cf_plot_write(const cf_fit_report *r, const cf_fit_data *data, const char *path,
+cf_status cf_plot_write(const cf_fit_report *r, const char *path,
                         const char *const *inputs, cf_error *err);
 
 /* Draws a simulation's samples (n of them; spring_MPa[k]: one spring's F(strain H)/H^2 at the

@@ -11,6 +11,15 @@
 #include <jansson.h>
 
 #include "base/atomic.h"
+#include "io/fitfile_json.h"
+
+void cf_report_free(cf_fit_report *r)
+{
+    if (!r)
+        return;
+    for (int i = 0; i < 2; i++)
+        cf_validation_free(&r->val[i]);
+}
 
 int cf_report_better(const cf_fit_report *r)
 {
@@ -34,21 +43,17 @@ int cf_report_types_tie(const cf_fit_report *r)
 
 double cf_report_fit_aic(const cf_fit_report *r, int i)
 {
-    double f = r->y_to_file;
-    return cf_baseline_aic(r->points, r->fits[i].rss * f * f, 3, r->ymax * f);
+    double f = r->table->y_to_file;
+    return cf_baseline_aic(r->table->count, r->fits[i].rss * f * f, 3, r->ymax * f);
 }
 
 double cf_report_baseline_aic(const cf_fit_report *r, int k)
 {
-    double f = r->y_to_file;
-    return cf_baseline_aic(r->points, r->baselines[k].rss * f * f, r->baselines[k].k, r->ymax * f);
+    double f = r->table->y_to_file;
+    return cf_baseline_aic(r->table->count, r->baselines[k].rss * f * f, r->baselines[k].k, r->ymax * f);
 }
 
-/* A JSON number, or null for a value that is not finite (never written as NaN/Inf). */
-static json_t *num(double v)
-{
-    return isfinite(v) ? json_real(v) : json_null();
-}
+#define num cf_json_number
 
 static json_t *constraint_list(unsigned bits)
 {
@@ -67,19 +72,9 @@ static json_t *value_se(double v, double se)
 static json_t *fit_json_core(const cf_fit_report *r, int i)
 {
     const cf_fit_result *f = &r->fits[i];
-    const cf_law *L = &f->law;
-    const cf_spring *p = &f->params;
-    double u = r->y_to_file;
-    json_t *params = json_pack("{s:o, s:o, s:o, s:o, s:o, s:o}", "D1_mm", num(p->D1_mm), "D2_mm",
-                               num(p->D2_mm), "n", num(p->n), "d_mm", num(p->d_mm), "G_MPa",
-                               num(p->G_MPa), "H_mm", num(p->H_mm));
-    json_t *derived = json_pack(
-        "{s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o}", "rho", num(L->rho), "travel_mm",
-        num(L->travel_mm), "solid_strain", num(L->travel_mm / p->H_mm), "F_T_N", num(L->F_T_N),
-        "F_C_N", num(L->F_C_N), "k0_N_per_mm", num(L->k0_N_per_mm), "u_T_mm", num(L->u_T_mm),
-        "index_c", num(L->index_c), "L_min_mm", num(L->L_min_mm), "L_max_mm", num(L->L_max_mm));
+    double u = r->table->y_to_file;
     json_t *ident;
-    if (r->force_displacement)
+    if (cf_table_is_force(r->table))
         ident = json_pack("{s:o, s:o, s:o}", "rho", value_se(f->ident[0], f->ident_se[0]),
                           "travel_mm", value_se(f->ident[1], f->ident_se[1]), "F_C_N",
                           value_se(f->ident[2], f->ident_se[2]));
@@ -87,15 +82,22 @@ static json_t *fit_json_core(const cf_fit_report *r, int i)
         ident = json_pack("{s:o, s:o, s:o}", "rho", value_se(f->ident[0], f->ident_se[0]),
                           "solid_strain", value_se(f->ident[1], f->ident_se[1]),
                           "stress_scale_MPa", value_se(f->ident[2], f->ident_se[2]));
-    return json_pack("{s:s, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:b, s:o, s:o, s:s, s:I, s:o}",
-                     "type", cf_spring_type_name(f->type), "params", params, "derived", derived,
-                     "identifiable", ident, "rmse", num(f->rmse * u), "max_abs_error",
-                     num(f->max_abs_error * u), "r2", num(f->r2), "aic",
-                     num(cf_report_fit_aic(r, i)), "feasible", f->feasible, "active_constraints",
-                     constraint_list(f->active), "violated_constraints",
-                     constraint_list(f->violated), "optimizer", f->optimizer, "evaluations",
-                     (json_int_t)f->evaluations, "wall_time_s",
-                     num(r->with_timing ? f->wall_time_s : 0.0));
+    json_t *o = cf_fitfile_spring_json(&f->law);
+    json_t *rest = json_pack(
+        "{s:o, s:o, s:o, s:o, s:o, s:b, s:o, s:o, s:s, s:I, s:o}", "identifiable", ident, "rmse",
+        num(f->rmse * u), "max_abs_error", num(f->max_abs_error * u), "r2", num(f->r2), "aic",
+        num(cf_report_fit_aic(r, i)), "feasible", f->feasible, "active_constraints",
+        constraint_list(f->active), "violated_constraints", constraint_list(f->violated),
+        "optimizer", f->optimizer, "evaluations", (json_int_t)f->evaluations, "wall_time_s",
+        num(r->with_timing ? f->wall_time_s : 0.0));
+    if (!o || !rest) {
+        json_decref(o);
+        json_decref(rest);
+        return NULL;
+    }
+    json_object_update(o, rest);
+    json_decref(rest);
+    return o;
 }
 
 static const char *diag_name(unsigned dg)
@@ -115,7 +117,7 @@ static json_t *validation_json(const cf_fit_report *r, int i)
     if (!v->done)
         return json_pack("{s:s}", "skipped", v->note);
     const cf_lattice_config *lc = &v->setup.cfg.lattice;
-    double u = r->y_to_file;
+    double u = r->table->y_to_file;
     json_t *lat = json_pack("{s:i, s:i, s:i, s:s, s:o, s:s}", "nx", lc->nx, "ny", lc->ny, "nz",
                             lc->nz, "diagonals", diag_name(lc->diagonals), "diagonal_weight",
                             num(lc->diagonal_weight), "bottom",
@@ -130,7 +132,7 @@ static json_t *validation_json(const cf_fit_report *r, int i)
 static json_t *through_json(const cf_fit_report *r, int i)
 {
     const cf_through_msm *t = &r->thr[i];
-    double u = r->y_to_file;
+    double u = r->table->y_to_file;
     return json_pack("{s:o, s:o, s:b, s:o, s:I}", "rmse_before", num(t->rmse_before * u),
                      "rmse_after", num(t->rmse_after * u), "improved", t->improved,
                      "wall_time_s", num(r->with_timing ? t->wall_time_s : 0.0), "evaluations",
@@ -150,7 +152,7 @@ static json_t *fit_json(const cf_fit_report *r, int i)
 static json_t *baseline_json(const cf_fit_report *r, int k)
 {
     const cf_baseline *b = &r->baselines[k];
-    double u = r->y_to_file;
+    double u = r->table->y_to_file;
     json_t *coef;
     /* coefficients in the file's y unit per unit x */
     if (b->kind == CF_BASE_LINEAR)
@@ -171,11 +173,11 @@ static json_t *baseline_json(const cf_fit_report *r, int k)
 static json_t *report_json(const cf_fit_report *r)
 {
     json_t *data = json_pack(
-        "{s:s, s:I, s:s, s:s, s:s, s:s, s:s, s:s}", "file", r->data_file, "points",
-        (json_int_t)r->points, "x_column", r->x_column, "x_unit", r->x_unit, "y_column",
-        r->y_column, "y_unit", r->y_unit, "kind",
-        r->force_displacement ? "force-displacement" : "stress-strain", "sign",
-        r->compression ? "compression-negative" : "tension-positive");
+        "{s:s, s:I, s:s, s:s, s:s, s:s, s:s, s:s}", "file", r->table->path, "points",
+        (json_int_t)r->table->count, "x_column", r->table->x_column, "x_unit", r->table->x_unit, "y_column",
+        r->table->y_column, "y_unit", r->table->y_unit, "kind",
+        cf_table_is_force(r->table) ? "force-displacement" : "stress-strain", "sign",
+        r->table->compression ? "compression-negative" : "tension-positive");
     json_t *fits = json_array(), *base = json_array();
     for (int i = 0; i < r->nfits; i++)
         json_array_append_new(fits, fit_json(r, i));
@@ -209,7 +211,7 @@ char *cf_report_json_string(const cf_fit_report *r)
     json_t *root = report_json(r);
     if (!root)
         return NULL;
-    char *s = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
+    char *s = cf_fitfile_dumps(root);
     json_decref(root);
     return s;
 }
@@ -217,17 +219,11 @@ char *cf_report_json_string(const cf_fit_report *r)
 cf_status cf_report_json_write(const cf_fit_report *r, const char *path,
                                const char *const *inputs, cf_error *err)
 {
-    char *s = cf_report_json_string(r);
-    if (!s)
+    json_t *root = report_json(r);
+    if (!root)
         return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory building the report", path);
-    cf_atomic a;
-    cf_status st = cf_atomic_open(&a, path, inputs, err);
-    if (st == CF_OK) {
-        fputs(s, a.fp);
-        fputc('\n', a.fp);
-        st = cf_atomic_commit(&a, err);
-    }
-    free(s);
+    cf_status st = cf_fitfile_write(root, path, inputs, err);
+    json_decref(root);
     return st;
 }
 
@@ -240,20 +236,16 @@ static void row(FILE *o, const cf_fit_report *r, const char *label, const char *
         const cf_fit_result *f = &r->fits[i];
         const cf_spring *p = &f->params;
         char cell[64];
-        double u = r->y_to_file;
+        double u = r->table->y_to_file;
         switch (which) {
-        case 0: snprintf(cell, sizeof cell, fmt, p->D1_mm); break;
-        case 1: snprintf(cell, sizeof cell, fmt, p->D2_mm); break;
-        case 2: snprintf(cell, sizeof cell, fmt, p->n); break;
-        case 3: snprintf(cell, sizeof cell, fmt, p->d_mm); break;
-        case 4: snprintf(cell, sizeof cell, fmt, p->G_MPa); break;
-        case 5: snprintf(cell, sizeof cell, fmt, p->H_mm); break;
+        case 0: case 1: case 2: case 3: case 4: case 5: /* the design parameters (spring.h) */
+            snprintf(cell, sizeof cell, fmt, cf_spring_get(p, which)); break;
         case 6: snprintf(cell, sizeof cell, fmt, f->law.index_c); break;
         case 7: snprintf(cell, sizeof cell, fmt, f->law.travel_mm); break;
         case 8: snprintf(cell, sizeof cell, fmt, f->law.F_T_N); break;
         case 9: snprintf(cell, sizeof cell, fmt, f->law.F_C_N); break;
-        case 10: snprintf(cell, sizeof cell, fmt, f->rmse * u, r->y_unit); break;
-        case 11: snprintf(cell, sizeof cell, fmt, f->max_abs_error * u, r->y_unit); break;
+        case 10: snprintf(cell, sizeof cell, fmt, f->rmse * u, r->table->y_unit); break;
+        case 11: snprintf(cell, sizeof cell, fmt, f->max_abs_error * u, r->table->y_unit); break;
         case 12: snprintf(cell, sizeof cell, fmt, f->r2); break;
         case 13: snprintf(cell, sizeof cell, fmt, cf_report_fit_aic(r, i)); break;
         case 14: snprintf(cell, sizeof cell, fmt, f->law.k0_N_per_mm); break;
@@ -311,7 +303,7 @@ static void validation_text(FILE *o, const cf_fit_report *r)
             lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial", cf_law_method_name(su->method));
     char buf[4][2][64];
     const char *t[2];
-    const double u = r->y_to_file;
+    const double u = r->table->y_to_file;
     for (int i = 0; i < r->nfits; i++) {
         const cf_validation *v = &r->val[i];
         if (!v->done) {
@@ -319,8 +311,8 @@ static void validation_text(FILE *o, const cf_fit_report *r)
                 snprintf(buf[k][i], sizeof buf[k][i], k ? "" : "skipped (see below)");
             continue;
         }
-        snprintf(buf[0][i], sizeof buf[0][i], "%.4g %s", v->rmse * u, r->y_unit);
-        snprintf(buf[1][i], sizeof buf[1][i], "%.4g %s", v->max_abs_error * u, r->y_unit);
+        snprintf(buf[0][i], sizeof buf[0][i], "%.4g %s", v->rmse * u, r->table->y_unit);
+        snprintf(buf[1][i], sizeof buf[1][i], "%.4g %s", v->max_abs_error * u, r->table->y_unit);
         snprintf(buf[2][i], sizeof buf[2][i], "%.6f", v->r2);
         snprintf(buf[3][i], sizeof buf[3][i], "%.1f ms, %zu solves", 1e3 * v->wall_time_s,
                  v->solves);
@@ -337,7 +329,7 @@ static void validation_text(FILE *o, const cf_fit_report *r)
             const cf_through_msm *th = &r->thr[i];
             if (th->done)
                 snprintf(buf[0][i], sizeof buf[0][i], "%.4g -> %.4g %s", th->rmse_before * u,
-                         th->rmse_after * u, r->y_unit);
+                         th->rmse_after * u, r->table->y_unit);
             else
                 snprintf(buf[0][i], sizeof buf[0][i], "not run");
             snprintf(buf[1][i], sizeof buf[1][i], "%.2f s, %ld curves", th->wall_time_s,
@@ -362,29 +354,30 @@ char *cf_report_text(const cf_fit_report *r)
     FILE *o = open_memstream(&buf, &len);
     if (!o)
         return NULL;
-    fprintf(o, "%s: %zu points, %s [%s] against %s [%s], %s\n\n", r->data_file, r->points,
-            r->x_column, r->x_unit, r->y_column, r->y_unit,
-            r->compression ? "compression negative" : "tension positive");
+    fprintf(o, "%s: %zu points, %s [%s] against %s [%s], %s\n\n", r->table->path, r->table->count,
+            r->table->x_column, r->table->x_unit, r->table->y_column, r->table->y_unit,
+            r->table->compression ? "compression negative" : "tension positive");
     fprintf(o, "  %-26s", "");
     for (int i = 0; i < r->nfits; i++)
         fprintf(o, " %-24s", cf_spring_type_name(r->fits[i].type));
     fputc('\n', o);
     fprintf(o, " identifiable (determined by the data):\n");
     ident_row(o, r, "rho = D1/D2", 0, 1, "");
-    if (r->force_displacement) {
+    if (cf_table_is_force(r->table)) {
         ident_row(o, r, "travel s", 1, 1, "mm");
         ident_row(o, r, "solid load F_C", 2, 1, "N");
     } else {
         ident_row(o, r, "solid strain s/H", 1, 1, "");
-        ident_row(o, r, "stress scale F_C/H^2", 2, r->y_to_file, r->y_unit);
+        ident_row(o, r, "stress scale F_C/H^2", 2, r->table->y_to_file, r->table->y_unit);
     }
     fprintf(o, " one spring of that family (chosen by the constraints):\n");
-    row(o, r, "D1", "%.6g mm", 0);
-    row(o, r, "D2", "%.6g mm", 1);
-    row(o, r, "n", "%.6g", 2);
-    row(o, r, "d", "%.6g mm", 3);
-    row(o, r, "G", "%.6g MPa", 4);
-    row(o, r, "H", "%.6g mm", 5);
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        const cf_spring_param *sp = cf_spring_param_info(k);
+        char fmt[32];
+        snprintf(fmt, sizeof fmt, "%%.6g%s%s", strcmp(sp->unit, "-") ? " " : "",
+                 strcmp(sp->unit, "-") ? sp->unit : "");
+        row(o, r, sp->name, fmt, k);
+    }
     row(o, r, "spring index c = D1/d", "%.4g", 6);
     row(o, r, "travel s", "%.6g mm", 7);
     row(o, r, "F_T, F_C", "%.4g N", 8);
@@ -431,9 +424,9 @@ char *cf_report_text(const cf_fit_report *r)
     int b = cf_report_better(r);
     if (r->nfits == 2 && b >= 0) {
         int ot = 1 - b;
-        double rb = r->fits[b].rmse * r->y_to_file, ro = r->fits[ot].rmse * r->y_to_file;
+        double rb = r->fits[b].rmse * r->table->y_to_file, ro = r->fits[ot].rmse * r->table->y_to_file;
         fprintf(o, "\nBetter type: %s (RMSE %.4g %s against %.4g %s", cf_spring_type_name(r->fits[b].type),
-                rb, r->y_unit, ro, r->y_unit);
+                rb, r->table->y_unit, ro, r->table->y_unit);
         if (!cf_report_types_tie(r))
             fprintf(o, ", %.3g times lower; AIC lower by %.2f)\n", ro / rb,
                     cf_report_fit_aic(r, ot) - cf_report_fit_aic(r, b));
@@ -447,24 +440,24 @@ char *cf_report_text(const cf_fit_report *r)
     for (int k = 0; k < CF_BASE_COUNT; k++) {
         const cf_baseline *bl = &r->baselines[k];
         char co[96];
-        double u = r->y_to_file;
+        double u = r->table->y_to_file;
         if (bl->kind == CF_BASE_LINEAR)
-            snprintf(co, sizeof co, "E = %.4g %s", bl->coef[0] * u, r->y_unit);
+            snprintf(co, sizeof co, "E = %.4g %s", bl->coef[0] * u, r->table->y_unit);
         else if (bl->kind == CF_BASE_DUFFING)
             snprintf(co, sizeof co, "k1 = %.4g, k3 = %.4g %s", bl->coef[0] * u, bl->coef[1] * u,
-                     r->y_unit);
+                     r->table->y_unit);
         else
-            snprintf(co, sizeof co, "A = %.4g %s, B = %.4g", bl->coef[0] * u, r->y_unit,
+            snprintf(co, sizeof co, "A = %.4g %s, B = %.4g", bl->coef[0] * u, r->table->y_unit,
                      bl->coef[1]);
         fprintf(o, "  %-8s %-36s RMSE %.4g %s   AIC %.2f (k = %d)\n", cf_baseline_name(bl->kind), co,
-                bl->rmse * u, r->y_unit, cf_report_baseline_aic(r, k), bl->k);
+                bl->rmse * u, r->table->y_unit, cf_report_baseline_aic(r, k), bl->k);
     }
     fprintf(o, "\nThe law seen through this table depends on the six design parameters only through "
                "rho,\nthe %s and the %s. The six numbers above are one member of a family of "
                "equally\ngood springs, chosen by the constraints (spring index, n >= 2, type, "
                "bounds, fixed values).\n",
-            r->force_displacement ? "travel" : "solid strain",
-            r->force_displacement ? "solid load" : "stress scale");
+            cf_table_is_force(r->table) ? "travel" : "solid strain",
+            cf_table_is_force(r->table) ? "solid load" : "stress scale");
     fclose(o);
     return buf;
 }

@@ -36,7 +36,7 @@ static int is_csv(const struct dirent *e)
 }
 
 /* Fits (data, opt, type) `repeats` times; the result comes from the last run. */
-static fit_cell time_fit(const cf_fit_data *d, const cf_fit_options *opt, cf_spring_type type,
+static fit_cell time_fit(const cf_table *d, const cf_fit_options *opt, cf_spring_type type,
                          double y_to_file, int repeats)
 {
     fit_cell c = {0};
@@ -87,7 +87,7 @@ static int bench_folder(bench_ctx *ctx, const char *dir, const char *label, int 
     for (int f = 0; f < n; f++) {
         char path[1024];
         snprintf(path, sizeof path, "%s/%s", dir, names[f]->d_name);
-        cf_measure m;
+        cf_table m;
         cf_error err = {0};
         cf_measure_options mo = cf_measure_default_options();
         if (cf_measure_load(path, &mo, &m, &err) != CF_OK) {
@@ -96,7 +96,7 @@ static int bench_folder(bench_ctx *ctx, const char *dir, const char *label, int 
             free(names[f]);
             continue;
         }
-        cf_fit_data d = {m.count, m.x, m.y, m.w, m.kind == CF_MEASURE_FORCE_DISPLACEMENT};
+        cf_table d = m; /* the same arrays; m owns them */
         fit_cell cell[NCFG][2];
         double best[2] = {INFINITY, INFINITY};
         for (int o = 0; o < NOPT; o++)
@@ -134,7 +134,7 @@ static int bench_folder(bench_ctx *ctx, const char *dir, const char *label, int 
             }
             fprintf(ctx->md, " %s |\n", m.y_unit);
         }
-        cf_measure_free(&m);
+        cf_table_free(&m);
         free(names[f]);
     }
     free(names);
@@ -165,7 +165,7 @@ static void synth_table(double *x, double *y, size_t n, double noise)
 static void through_lattice(bench_ctx *ctx)
 {
     const char *path = "data/telescoping_noise1pct.csv";
-    cf_measure m;
+    cf_table m;
     cf_error err = {0};
     cf_measure_options mo = cf_measure_default_options();
     fprintf(ctx->md, "**Single-spring fit against fit through the lattice** (`conifit fit "
@@ -178,7 +178,7 @@ static void through_lattice(bench_ctx *ctx)
         fprintf(ctx->md, "(not measured: %s)\n\n", err.msg);
         return;
     }
-    cf_fit_data d = {m.count, m.x, m.y, m.w, 0};
+    cf_table d = m; /* the same arrays; m owns them */
     cf_fit_options opt = cf_fit_default_options();
     fprintf(ctx->md, "| lattice | runs | fit RMSE (one spring) | validation RMSE, ordinary fit | "
                      "fit + validation, s | validation RMSE, through the lattice | through the "
@@ -223,7 +223,7 @@ static void through_lattice(bench_ctx *ctx)
                 evals);
     }
     fprintf(ctx->md, "\n");
-    cf_measure_free(&m);
+    cf_table_free(&m);
 }
 
 void bench_section_fit(bench_ctx *ctx)
@@ -242,7 +242,7 @@ void bench_section_fit(bench_ctx *ctx)
     double rm[2][2];
     for (int v = 0; v < 2; v++) {
         synth_table(x, y, NP, v ? 0.01 : 0.0);
-        cf_fit_data d = {NP, x, y, NULL, 0};
+        cf_table d = {.count = NP, .x = x, .y = y};
         cf_fit_options opt = cf_fit_default_options();
         double t[16];
         for (int r = 0; r < trepeats; r++) {

@@ -23,7 +23,7 @@ typedef struct res_row {
     char msg[CF_ERROR_MSG_LEN];
 } res_row;
 
-static res_row validate(const cf_law *law, const cf_measure *m, int n, unsigned diag,
+static res_row validate(const cf_law *law, const cf_table *m, int n, unsigned diag,
                         const double *single, int repeats)
 {
     res_row o;
@@ -65,18 +65,18 @@ void bench_section_resolution(bench_ctx *ctx)
 {
     const int repeats = ctx->quick ? 1 : 3;
     fprintf(ctx->md, "## 5. Lattice resolution: validation error against size and time\n\n");
-    cf_measure m;
+    cf_table m;
     cf_measure_options mo = cf_measure_default_options();
     if (cf_measure_load(TABLE, &mo, &m, NULL) != CF_OK) {
         fprintf(ctx->md, "(%s not found: section skipped)\n\n", TABLE);
         return;
     }
-    cf_fit_data d = {m.count, m.x, m.y, m.w, 0};
+    cf_table d = m; /* the same arrays; m owns them */
     cf_fit_options opt = cf_fit_default_options();
     cf_fit_result fit;
     if (cf_fit_run(&d, &opt, CF_TELESCOPING, &fit, NULL) != CF_OK) {
         fprintf(ctx->md, "(fit of %s failed: section skipped)\n\n", TABLE);
-        cf_measure_free(&m);
+        cf_table_free(&m);
         return;
     }
     double *single = malloc(m.count * sizeof *single);
@@ -142,5 +142,5 @@ void bench_section_resolution(bench_ctx *ctx)
         fprintf(ctx->md, "![lattice resolution](resolution.png)\n\n");
     free(single);
     cf_law_free(&fit.law);
-    cf_measure_free(&m);
+    cf_table_free(&m);
 }

@@ -28,7 +28,7 @@ typedef struct cf_baseline {
 } cf_baseline;
 
 /* Fits all baselines to the table (weights ignored: the comparison is on plain residuals). */
-void cf_baseline_fit_all(const cf_fit_data *data, cf_baseline out[CF_BASE_COUNT]);
+void cf_baseline_fit_all(const cf_table *data, cf_baseline out[CF_BASE_COUNT]);
 
 /* Value of a fitted baseline at x. */
 double cf_baseline_eval(const cf_baseline *b, double x);

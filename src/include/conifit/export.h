@@ -118,7 +118,7 @@ typedef struct cf_export_report {
 cf_status cf_export_write(FILE *out, const cf_fitted_spring *fs, const cf_export_options *opt,
                           cf_export_report *rep, cf_error *err);
 
-/* Parses json | csv | calculix | abaqus | febio | lsdyna | sofa; CF_E_USAGE otherwise. */
+/* Parses json | csv | calculix | abaqus | febio | lsdyna | sofa; CF_E_DATA otherwise. */
 cf_status cf_export_format_parse(const char *name, cf_export_format *format, cf_error *err);
 const char *cf_export_format_name(cf_export_format format);
 

@@ -27,9 +27,9 @@
 
 #include "conifit/error.h"
 #include "conifit/law.h"
+#include "conifit/measure.h"
 
-/* Index of each design parameter in the arrays below, in the order D1, D2, n, d, G, H. */
-enum { CF_P_D1 = 0, CF_P_D2, CF_P_N, CF_P_D, CF_P_G, CF_P_H, CF_P_COUNT };
+/* Arrays of design parameters below are indexed by CF_P_D1 ... CF_P_H (spring.h). */
 
 /* Constraints, as bits of cf_fit_result.active / .violated. */
 enum {
@@ -76,15 +76,8 @@ typedef struct cf_fit_options {
 
 cf_fit_options cf_fit_default_options(void);
 
-/* The table to fit, in conifit's units: strain [-] and stress [MPa], or displacement [mm] and
-** force [N]. w may be NULL (all weights 1). Arrays are only read. */
-typedef struct cf_fit_data {
-    size_t count;
-    const double *x;
-    const double *y;
-    const double *w;
-    int force_displacement; /* 0: stress-strain, 1: force-displacement */
-} cf_fit_data;
+/* The table to fit is a cf_table (measure.h) in conifit's units: strain [-] and stress [MPa], or
+** displacement [mm] and force [N]; its w may be NULL (all weights 1). It is only read. */
 
 typedef struct cf_fit_result {
     cf_spring_type type;
@@ -110,14 +103,14 @@ typedef struct cf_fit_result {
 ** non-finite value, all y zero, a non-positive weight) or contradictory options (message names
 ** them); CF_E_INTERNAL when memory runs out. A fit whose constraints cannot all be met (e.g. a
 ** strain >= 1, which no spring reaches) is returned with feasible = 0 and the violated bits. */
-cf_status cf_fit_run(const cf_fit_data *data, const cf_fit_options *opt, cf_spring_type type,
+cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                      cf_fit_result *res, cf_error *err);
 
 /* Stage B alone: places one spring of the given type whose identifiable quantities are ident
 ** (rho, solid strain or travel, stress or load scale; units as in cf_fit_result.ident), exactly as
 ** cf_fit_run places its spring before the polish, and fills res (quality against data, feasibility;
 ** ident_se = -1, optimizer "placement"). Used by the fit through the lattice (validate.h). */
-cf_status cf_fit_place(const cf_fit_data *data, const cf_fit_options *opt, cf_spring_type type,
+cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                        const double ident[3], cf_fit_result *res, cf_error *err);
 
 /* Evaluates the model (stress in MPa, or force in N) of spring p at x. */
@@ -125,7 +118,7 @@ double cf_fit_model(const cf_law *law, int force_displacement, double x);
 
 /* Checks the constraints of options/type/data at p: fills *active and *violated (CF_C_* bits) and
 ** returns 1 when feasible. */
-int cf_fit_check(const cf_spring *p, cf_spring_type type, const cf_fit_data *data,
+int cf_fit_check(const cf_spring *p, cf_spring_type type, const cf_table *data,
                  const cf_fit_options *opt, unsigned *active, unsigned *violated);
 
 /* The three identifiable quantities of spring p (see cf_fit_result.ident). */
@@ -135,9 +128,5 @@ void cf_fit_identifiable(const cf_spring *p, int force_displacement, double iden
 const char *cf_fit_constraint_name(unsigned bit);
 const char *cf_fit_optimizer_name(cf_fit_optimizer o);
 cf_status cf_fit_optimizer_parse(const char *name, cf_fit_optimizer *o, cf_error *err);
-
-/* Parses a parameter name "D1", "D2", "n", "d", "G", "H" (also with unit suffix "D1_mm"). */
-cf_status cf_fit_param_parse(const char *name, int *index, cf_error *err);
-const char *cf_fit_param_name(int index);
 
 #endif

@@ -55,7 +55,4 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
 ** spring type) and loads it. */
 cf_status cf_fitfile_load_spec(const char *spec, cf_fitted_spring *out, cf_error *err);
 
-/* Parses "telescoping" / "non-telescoping"; CF_E_USAGE otherwise. */
-cf_status cf_spring_type_parse(const char *name, cf_spring_type *type, cf_error *err);
-
 #endif

@@ -34,21 +34,7 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
-
-/* The six design parameters of a conical spring. */
-typedef struct cf_spring {
-    double D1_mm; /* mean diameter of the smallest active coil, mm */
-    double D2_mm; /* mean diameter of the largest active coil, mm (D2 >= D1) */
-    double n;     /* number of active coils, dimensionless (n >= 2, real) */
-    double d_mm;  /* wire diameter, mm */
-    double G_MPa; /* shear modulus of the wire, MPa */
-    double H_mm;  /* free length, mm (rest length in the mass-spring model) */
-} cf_spring;
-
-typedef enum cf_spring_type {
-    CF_TELESCOPING = 0,     /* (D2 - D1)/2 >= n d, solid length d */
-    CF_NON_TELESCOPING = 1  /* (D2 - D1)/2 <  n d, solid length n d */
-} cf_spring_type;
+#include "conifit/spring.h"
 
 typedef enum cf_law_method {
     CF_LAW_EXACT = 0,
@@ -120,10 +106,7 @@ void cf_law_force_many(const cf_law *law, cf_law_method method, size_t count, co
 ** of the law, exact up to rounding; |F| >= F_C gives +-travel. */
 double cf_law_deflection(const cf_law *law, double F_N);
 
-/* "telescoping" or "non-telescoping". */
-const char *cf_spring_type_name(cf_spring_type type);
-
-/* Parses "exact", "closed", "closed+newton" or "table"; CF_E_USAGE for anything else. */
+/* Parses "exact", "closed", "closed+newton" or "table"; CF_E_DATA for anything else. */
 cf_status cf_law_method_parse(const char *name, cf_law_method *method, cf_error *err);
 const char *cf_law_method_name(cf_law_method method);
 

@@ -19,10 +19,10 @@
 
 #include "conifit/error.h"
 
-typedef enum cf_measure_kind {
-    CF_MEASURE_STRESS_STRAIN = 0,     /* x = engineering strain [-], y = stress [MPa] */
-    CF_MEASURE_FORCE_DISPLACEMENT = 1 /* x = displacement [mm], y = force [N] */
-} cf_measure_kind;
+typedef enum cf_table_kind {
+    CF_TABLE_STRESS_STRAIN = 0,     /* x = engineering strain [-], y = stress [MPa] */
+    CF_TABLE_FORCE_DISPLACEMENT = 1 /* x = displacement [mm], y = force [N] */
+} cf_table_kind;
 
 typedef struct cf_measure_options {
     const char *x_col;       /* column name of x (with or without its unit decoration), or NULL:
@@ -57,8 +57,11 @@ typedef enum cf_unit_class {
 ** NULL) the factor that converts a value in that unit to conifit's (MPa, N, mm, s, -). */
 cf_unit_class cf_measure_unit(const char *name, double *to_conifit);
 
-typedef struct cf_measure {
-    cf_measure_kind kind;
+/* A measured table in conifit's units: the one type that goes from the reader through the fit,
+** the validation, the report and the plots. The reader fills every field; a table built in code
+** (cf_table_from_arrays) has kind, count, x, y, w, y_to_file = 1 and empty names. */
+typedef struct cf_table {
+    cf_table_kind kind;
     size_t count;          /* number of data rows */
     double *x;             /* strain [-] or displacement [mm], count values */
     double *y;             /* stress [MPa] or force [N], count values */
@@ -73,17 +76,26 @@ typedef struct cf_measure {
     char y_column[64];     /* header name of the y column */
     char x_unit[16];       /* "-" for strain, "mm" for displacement after conversion */
     char y_unit[16];       /* the file's own unit of y ("kPa", "mN", ...), used in reports */
-} cf_measure;
+} cf_table;
 
 /* Reads the table at path. Errors (nothing allocated is left behind):
 **   CF_E_NOINPUT  the file cannot be opened;
 **   CF_E_DATA     missing header, unknown unit, a column not found, a non-numeric or non-finite
 **                 cell, a short row, fewer than 6 data rows, an empty file, binary content, a
 **                 weight <= 0; the message reads "PATH:LINE:COLUMN: what is wrong ('value')". */
-cf_status cf_measure_load(const char *path, const cf_measure_options *opt, cf_measure *m,
+cf_status cf_measure_load(const char *path, const cf_measure_options *opt, cf_table *m,
                           cf_error *err);
 
+/* A table of count points copied from x, y and w (w NULL: every weight 1), for data made in
+** code (tests, benchmarks, other front ends): the units are conifit's, y_unit "MPa" or "N",
+** path and column names "x" and "y". CF_E_INTERNAL when memory runs out. */
+cf_status cf_table_from_arrays(cf_table_kind kind, size_t count, const double *x, const double *y,
+                               const double *w, cf_table *m, cf_error *err);
+
+/* 1 for a force-displacement table, 0 for stress-strain. */
+int cf_table_is_force(const cf_table *m);
+
 /* Releases the arrays of m (safe on a zeroed struct). */
-void cf_measure_free(cf_measure *m);
+void cf_table_free(cf_table *m);
 
 #endif

@@ -11,28 +11,28 @@
 #include "conifit/baseline.h"
 #include "conifit/error.h"
 #include "conifit/fit.h"
+#include "conifit/measure.h"
 #include "conifit/validate.h"
 
-/* One table and its fits, as the report sees it. Values of the fits are in conifit's units
-** (MPa or N); y_to_file converts them to the file's own unit for display and JSON. */
+/* One table and its fits, as the report sees it (cf_pipeline_fit fills it). Values of the fits
+** are in conifit's units (MPa or N); table->y_to_file converts them to the file's own unit for
+** display and JSON. */
 typedef struct cf_fit_report {
     const char *version;        /* conifit version */
-    const char *data_file;      /* the table as named by the user */
-    const char *x_column, *x_unit, *y_column, *y_unit; /* header names and the file's units */
-    int force_displacement;     /* 0: stress-strain, 1: force-displacement */
-    int compression;            /* 1: the table is compression-negative */
-    size_t points;              /* number of data rows */
-    double y_to_file;           /* multiply MPa (or N) by this to get the file's unit */
+    const cf_table *table;      /* the table fitted (not owned; outlives the report) */
     double ymax;                /* largest |y| in MPa or N */
     int nfits;                  /* 1 or 2 */
     cf_fit_result fits[2];
     cf_baseline baselines[CF_BASE_COUNT];
     int with_timing;            /* 0: write wall_time_s as 0 (for reproducible files) */
     int validate;               /* 1: each fit was run in the lattice (val[i]) */
-    cf_validation val[2];       /* lattice validation of fits[i] (MPa; not owned by the report) */
+    cf_validation val[2];       /* lattice validation of fits[i] (MPa; freed by cf_report_free) */
     int through_msm;            /* 1: each fit was refined through the lattice (thr[i]) */
     cf_through_msm thr[2];      /* what that cost and gained (MPa) */
 } cf_fit_report;
+
+/* Releases what the report owns (the validations' curves). Safe on a zeroed report. */
+void cf_report_free(cf_fit_report *r);
 
 /* Index of the better fit in r->fits: the feasible one with the lower RMSE (-1 if none). */
 int cf_report_better(const cf_fit_report *r);

@@ -66,7 +66,7 @@ typedef struct cf_validation {
 ** CF_E_DATA for a force-displacement table or a strain at or past the spring's solid strain,
 ** CF_E_NOCONV when a static solve does not converge, CF_E_INTERNAL when memory runs out; on
 ** failure v->done = 0 and v->note holds the message. */
-cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const cf_fit_data *d,
+cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const cf_table *d,
                           cf_validation *v, cf_error *err);
 
 /* Releases v->stress_MPa. Safe on a zeroed validation. */
@@ -87,7 +87,7 @@ typedef struct cf_through_msm {
 /* The fit through the lattice for one fitted spring res (in: the ordinary fit, with v its
 ** validation, v->done = 1; out: the spring placed from the lattice-optimal identifiable quantities
 ** and its validation, when that lowered the validation RMSE). Deterministic. */
-cf_status cf_validate_through_msm(const cf_fit_data *d, const cf_fit_options *opt,
+cf_status cf_validate_through_msm(const cf_table *d, const cf_fit_options *opt,
                                   const cf_validate_setup *s, cf_fit_result *res,
                                   cf_validation *v, cf_through_msm *t, cf_error *err);
 

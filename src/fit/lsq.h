@@ -1,0 +1,51 @@
+/*
+** Least-squares pieces shared by the fitter (fit.c), the baselines and the fit through the
+** lattice (check/validate.c), so that each is defined once: the residual weights and their floor,
+** the bounds of the diameter ratio searched, the quality measures, and the wire modulus that
+** gives a spring its solid load. Private to the library.
+*/
+#ifndef CF_FIT_LSQ_H
+#define CF_FIT_LSQ_H
+
+#include <stddef.h>
+
+#include "conifit/law.h"
+#include "conifit/measure.h"
+
+/* Relative residuals divide by max(|y|, CF_LSQ_REL_FLOOR max|y|) so that the point at the origin
+** (y = 0) keeps a finite weight. */
+#define CF_LSQ_REL_FLOOR 1e-3
+/* Lowest diameter ratio searched: rho = 1e-3 is a spring whose largest coil is a thousand times
+** its smallest, far beyond any wound spring. */
+#define CF_LSQ_RHO_LO 1e-3
+/* Objective value returned where the model cannot be evaluated (an invalid spring, a lattice
+** that does not converge). */
+#define CF_LSQ_HUGE_OBJ 1e30
+
+/* Fills sw[i] = sqrt(w_i) / scale_i (scale 1, or the floored |y_i| when relative) for the count
+** points of t and returns the weighted norm sum (sw_i y_i)^2. */
+double cf_lsq_weights(const cf_table *t, int relative, double *sw);
+
+/* Quality of a model's values against the table's y (unweighted). */
+typedef struct cf_lsq_quality {
+    double rss;           /* sum of squared residuals, (unit of y)^2 */
+    double rmse;          /* sqrt(rss / count), unit of y */
+    double max_abs_error; /* largest |model - y|, unit of y */
+    double r2;            /* 1 - rss / sum (y - mean y)^2; 0 when y is constant */
+} cf_lsq_quality;
+
+cf_lsq_quality cf_lsq_quality_of(const cf_table *t, const double *model);
+
+/* Largest diameter ratio of a spring type: telescoping needs n <= c (1 - rho)/(2 rho) with
+** n >= 2 and c <= index_max, so rho <= index_max/(index_max + 4) (less a hair); non-telescoping
+** reaches the cylinder, 1. */
+double cf_lsq_rho_hi(cf_spring_type type, double index_max);
+
+/* Largest |x| of the table. */
+double cf_lsq_xmax(const cf_table *t);
+
+/* The wire modulus G (MPa) that gives a spring of n coils, smallest coil D1, wire d and travel s
+** (mm) the solid load F_C (N): F_C = G d^4 s / (8 n D1^3). */
+double cf_lsq_G_of_FC(double F_C_N, double n, double D1_mm, double d_mm, double s_mm);
+
+#endif

@@ -1,0 +1,62 @@
+/*
+** The fitting pipeline as one library call: a table in, a report out.
+**
+**   cf_table (measure.h) --cf_fit_run, each type--> cf_fit_result
+**                        --cf_baseline_fit_all----> linear, Duffing, Fung
+**                        --cf_validate_run---------> lattice curve, RMSE, R^2 (optional)
+**                        --cf_validate_through_msm-> the fit through the lattice (optional)
+**   = cf_fit_report (report.h) --cf_pipeline_write--> fit file (JSON) and plot
+**
+** Every front end (the command line, the tests, the benchmark) goes through these calls, so the
+** path from a table to a fit file exists once. Thread-safe: no globals; one report per call.
+*/
+#ifndef CF_PIPELINE_H
+#define CF_PIPELINE_H
+
+#include "conifit/error.h"
+#include "conifit/fit.h"
+#include "conifit/measure.h"
+#include "conifit/report.h"
+#include "conifit/validate.h"
+
+/* Spring types to fit, as bits of cf_pipeline_options.types. */
+enum {
+    CF_PIPELINE_TELESCOPING = 1 << CF_TELESCOPING,
+    CF_PIPELINE_NON_TELESCOPING = 1 << CF_NON_TELESCOPING,
+    CF_PIPELINE_BOTH = CF_PIPELINE_TELESCOPING | CF_PIPELINE_NON_TELESCOPING
+};
+
+/* Called before each long step: `table` is the table's path, `what` says what starts ("fitting
+** the telescoping spring through the lattice"). The library itself never prints. */
+typedef void (*cf_pipeline_progress)(void *ctx, const char *table, const char *what);
+
+typedef struct cf_pipeline_options {
+    unsigned types;              /* CF_PIPELINE_* bits (default both) */
+    cf_fit_options fit;          /* the fitter's options (fit.h) */
+    int validate;                /* 1: run each fit in the lattice */
+    int through_msm;             /* 1: fit through the lattice (implies validate) */
+    cf_validate_setup lattice;   /* the lattice of the validation (validate.h) */
+    int with_timing;             /* 0: write wall times as 0 (reproducible fit files) */
+    cf_pipeline_progress progress; /* NULL: silent */
+    void *progress_ctx;
+} cf_pipeline_options;
+
+/* Both types, the fitter's defaults, no validation (default lattice ready), timing on. */
+cf_pipeline_options cf_pipeline_default_options(void);
+
+/* Replaces opt->lattice by the lattice of the static uniaxial scene at path (scene.h,
+** cf_validate_from_scene). CF_E_NOINPUT or CF_E_DATA naming the file and key. */
+cf_status cf_pipeline_use_scene(cf_pipeline_options *opt, const char *path, cf_error *err);
+
+/* Fits table t and fills r (r->table = t, which must outlive r; release r with cf_report_free).
+** A table the lattice cannot run (force-displacement) is validated as skipped, with a note, not
+** an error. Errors: those of cf_fit_run, prefixed with the table's path. */
+cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_fit_report *r,
+                          cf_error *err);
+
+/* Writes the report's fit file to json_path and its plot to plot_path (either NULL: not
+** written), each atomically; `inputs` (NULL-terminated, may be NULL) are refused as targets. */
+cf_status cf_pipeline_write(const cf_fit_report *r, const char *json_path, const char *plot_path,
+                            const char *const *inputs, cf_error *err);
+
+#endif

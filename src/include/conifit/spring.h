@@ -1,0 +1,58 @@
+/*
+** The conical spring as data: its six design parameters, its two types, and the one description
+** of each parameter (name, unit, JSON key, meaning, fit bounds) that every reader, writer, report,
+** export and command-line option works from. Adding a parameter or renaming a key is a change to
+** src/model/spring.c alone.
+*/
+#ifndef CF_SPRING_H
+#define CF_SPRING_H
+
+#include <stddef.h>
+
+#include "conifit/error.h"
+
+/* The six design parameters of a conical spring. */
+typedef struct cf_spring {
+    double D1_mm; /* mean diameter of the smallest active coil, mm */
+    double D2_mm; /* mean diameter of the largest active coil, mm (D2 >= D1) */
+    double n;     /* number of active coils, dimensionless (n >= 2, real) */
+    double d_mm;  /* wire diameter, mm */
+    double G_MPa; /* shear modulus of the wire, MPa */
+    double H_mm;  /* free length, mm (rest length in the mass-spring model) */
+} cf_spring;
+
+typedef enum cf_spring_type {
+    CF_TELESCOPING = 0,     /* (D2 - D1)/2 >= n d, solid length d */
+    CF_NON_TELESCOPING = 1  /* (D2 - D1)/2 <  n d, solid length n d */
+} cf_spring_type;
+
+/* Index of each design parameter, in the order D1, D2, n, d, G, H. */
+enum { CF_P_D1 = 0, CF_P_D2, CF_P_N, CF_P_D, CF_P_G, CF_P_H, CF_P_COUNT };
+
+/* What conifit knows of one design parameter. */
+typedef struct cf_spring_param {
+    const char *name;    /* "D1": in messages, reports and NAME=VALUE settings */
+    const char *unit;    /* "mm", "-" or "MPa" */
+    const char *key;     /* key in fit files, exported springs and scenes: "D1_mm" */
+    const char *meaning; /* "mean diameter of the smallest active coil" */
+    double lower, upper; /* default bounds of the fit, in unit: wide enough for any tissue table
+                         ** in any unit (micrometre to metre springs, foams to steel) */
+} cf_spring_param;
+
+/* The description of parameter k (0 <= k < CF_P_COUNT); NULL for another k. */
+const cf_spring_param *cf_spring_param_info(int k);
+
+/* Value of parameter k of p, and setting it. */
+double cf_spring_get(const cf_spring *p, int k);
+void cf_spring_set(cf_spring *p, int k, double value);
+
+/* Index of the parameter called name (its name "D1" or its key "D1_mm"), or -1. */
+int cf_spring_param_find(const char *name);
+
+/* "telescoping" or "non-telescoping". */
+const char *cf_spring_type_name(cf_spring_type type);
+
+/* Parses "telescoping" / "non-telescoping"; CF_E_DATA naming the value otherwise. */
+cf_status cf_spring_type_parse(const char *name, cf_spring_type *type, cf_error *err);
+
+#endif

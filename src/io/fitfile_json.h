@@ -1,0 +1,33 @@
+/*
+** The one writer of conifit's spring JSON (private to the library): the fit file of
+** `conifit fit -o` (out/report.c) and the single exported spring of `conifit export --format json`
+** (out/export.c) both build their spring objects and write their documents here, so that
+** cf_fitfile_load (fitfile.h) reads back exactly what was written.
+*/
+#ifndef CF_IO_FITFILE_JSON_H
+#define CF_IO_FITFILE_JSON_H
+
+#include <stdio.h>
+
+#include <jansson.h>
+
+#include "conifit/error.h"
+#include "conifit/law.h"
+
+/* A JSON number, or null for a value that is not finite (NaN and Inf never reach a file). */
+json_t *cf_json_number(double v);
+
+/* {"type", "params" {D1_mm ...}, "derived" {rho, travel_mm, ...}} of a spring prepared by
+** cf_law_init (keys from the spring description, spring.h). NULL when memory runs out. */
+json_t *cf_fitfile_spring_json(const cf_law *law);
+
+/* The document as text: two-space indent, doubles to 17 significant digits, a final newline.
+** malloc'd; NULL when memory runs out. */
+char *cf_fitfile_dumps(const json_t *root);
+
+/* Writes the document to path atomically (atomic.h); `inputs` (NULL-terminated, may be NULL) are
+** refused as targets. CF_E_CANTWRITE (or CF_E_INTERNAL when memory runs out) on failure. */
+cf_status cf_fitfile_write(const json_t *root, const char *path, const char *const *inputs,
+                           cf_error *err);
+
+#endif

@@ -1,0 +1,102 @@
+/*
+** The fitting pipeline (see pipeline.h).
+*/
+#include "conifit/pipeline.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "conifit/baseline.h"
+#include "conifit/scene.h"
+#include "conifit/version.h"
+#include "out/plot.h"
+
+cf_pipeline_options cf_pipeline_default_options(void)
+{
+    cf_pipeline_options o;
+    memset(&o, 0, sizeof o);
+    o.types = CF_PIPELINE_BOTH;
+    o.fit = cf_fit_default_options();
+    o.lattice = cf_validate_default();
+    o.with_timing = 1;
+    return o;
+}
+
+cf_status cf_pipeline_use_scene(cf_pipeline_options *opt, const char *path, cf_error *err)
+{
+    cf_scene sc;
+    cf_status st = cf_scene_load(path, &sc, err);
+    if (st != CF_OK)
+        return st;
+    st = cf_validate_from_scene(&sc, path, &opt->lattice, err);
+    cf_scene_free(&sc);
+    return st;
+}
+
+static void progress(const cf_pipeline_options *opt, const cf_table *t, const char *fmt,
+                     const char *arg)
+{
+    if (!opt->progress)
+        return;
+    char what[128];
+    snprintf(what, sizeof what, fmt, arg);
+    opt->progress(opt->progress_ctx, t->path, what);
+}
+
+/* Each fit in the lattice, and through it when asked. A fit the lattice cannot run keeps its
+** validation's note (report.c prints it) and is not an error. */
+static void validate_fits(const cf_table *t, const cf_pipeline_options *opt, cf_fit_report *r)
+{
+    r->validate = 1;
+    r->through_msm = opt->through_msm;
+    for (int k = 0; k < r->nfits; k++) {
+        cf_error verr = {0};
+        const char *type = cf_spring_type_name(r->fits[k].type);
+        progress(opt, t, "validating the %s spring in the lattice", type);
+        if (cf_validate_run(&r->fits[k].params, &opt->lattice, t, &r->val[k], &verr) != CF_OK ||
+            !opt->through_msm)
+            continue;
+        progress(opt, t, "fitting the %s spring through the lattice", type);
+        cf_validate_through_msm(t, &opt->fit, &opt->lattice, &r->fits[k], &r->val[k], &r->thr[k],
+                                &verr);
+    }
+}
+
+cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_fit_report *r,
+                          cf_error *err)
+{
+    memset(r, 0, sizeof *r);
+    r->version = CF_VERSION;
+    r->table = t;
+    r->with_timing = opt->with_timing;
+    for (size_t i = 0; i < t->count; i++)
+        r->ymax = fmax(r->ymax, fabs(t->y[i]));
+    for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING; ty++) {
+        if (!(opt->types & (1u << ty)))
+            continue;
+        progress(opt, t, "fitting the %s spring", cf_spring_type_name((cf_spring_type)ty));
+        cf_error e = {0};
+        cf_status st = cf_fit_run(t, &opt->fit, (cf_spring_type)ty, &r->fits[r->nfits], &e);
+        if (st != CF_OK)
+            return cf_error_set(err, st, "%s: %s", t->path, e.msg);
+        r->nfits++;
+    }
+    if (r->nfits == 0)
+        return cf_error_set(err, CF_E_DATA, "%s: no spring type chosen to fit", t->path);
+    cf_baseline_fit_all(t, r->baselines);
+    if (opt->validate || opt->through_msm)
+        validate_fits(t, opt, r);
+    return CF_OK;
+}
+
+cf_status cf_pipeline_write(const cf_fit_report *r, const char *json_path, const char *plot_path,
+                            const char *const *inputs, cf_error *err)
+{
+    cf_status st = CF_OK;
+    if (json_path)
+        st = cf_report_json_write(r, json_path, inputs, err);
+    if (st == CF_OK && plot_path)
+        st = cf_plot_write(r, plot_path, inputs, err);
+    return st;
+}

@@ -1,0 +1,179 @@
+/*
+** The pipeline (pipeline.h) and the spring description (spring.h):
+**  - golden: refitting every table of data/ through cf_pipeline_fit reproduces the committed
+**    fits/NAME.json (made by `make fits`) to a stated tolerance;
+**  - the JSON keys of the spring description are the ones written to a fit file and read back;
+**  - a table made in code goes through the same call.
+*/
+#include "testutil.h"
+
+#include <dirent.h>
+#include <glob.h>
+
+#include <jansson.h>
+
+#include "conifit/fitfile.h"
+#include "conifit/pipeline.h"
+#include "conifit/spring.h"
+
+/* Tolerance of the golden comparison, relative to the committed value. The fit is deterministic
+** for a given build (seeded, no threads inside a fit); another compiler or optimisation level may
+** change the last bits of each floating-point step, and the optimisers amplify that to about
+** 1e-10 relative on the design parameters. 1e-6 leaves room for that and still catches any change
+** in what is fitted. Quantities that are zero at rounding level (RMSE of a noiseless table) are
+** compared absolutely, to 1e-9 of the table's largest |stress|. */
+#define GOLDEN_REL 1e-6
+#define GOLDEN_ABS_OF_YMAX 1e-9
+
+static double jnum(json_t *o, const char *path)
+{
+    char buf[256];
+    snprintf(buf, sizeof buf, "%s", path);
+    json_t *cur = o;
+    for (char *tok = strtok(buf, "."); tok && cur; tok = strtok(NULL, "."))
+        cur = json_object_get(cur, tok);
+    if (!json_is_number(cur))
+        fail_msg("key %s missing or not a number", path);
+    return json_number_value(cur);
+}
+
+static void golden_close(const char *file, const char *what, double got, double want, double abs)
+{
+    double tol = fmax(GOLDEN_REL * fabs(want), abs);
+    if (!(fabs(got - want) <= tol))
+        fail_msg("%s: %s = %.17g, committed %.17g (tolerance %.3g)", file, what, got, want, tol);
+}
+
+/* One committed fit file against a fresh pipeline run on its table. */
+static void check_golden(const char *json_path)
+{
+    json_error_t jerr;
+    json_t *root = json_load_file(json_path, 0, &jerr);
+    if (!root)
+        fail_msg("%s: %s", json_path, jerr.text);
+    const char *table_path = json_string_value(json_object_get(json_object_get(root, "data"), "file"));
+    assert_non_null(table_path);
+    cf_table t;
+    cf_error err = {0};
+    cf_measure_options mo = cf_measure_default_options();
+    if (cf_measure_load(table_path, &mo, &t, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    cf_pipeline_options po = cf_pipeline_default_options();
+    json_t *fits = json_object_get(root, "fits");
+    json_t *first = json_array_get(fits, 0);
+    po.validate = json_object_get(first, "validation") != NULL;
+    cf_fit_report r;
+    if (cf_pipeline_fit(&t, &po, &r, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    assert_int_equal(r.nfits, (int)json_array_size(fits));
+    const double u = t.y_to_file, abs_y = GOLDEN_ABS_OF_YMAX * r.ymax * u;
+    for (int i = 0; i < r.nfits; i++) {
+        json_t *f = json_array_get(fits, (size_t)i);
+        const cf_fit_result *res = &r.fits[i];
+        assert_string_equal(json_string_value(json_object_get(f, "type")),
+                            cf_spring_type_name(res->type));
+        for (int k = 0; k < CF_P_COUNT; k++) {
+            char key[64];
+            snprintf(key, sizeof key, "params.%s", cf_spring_param_info(k)->key);
+            golden_close(json_path, key, cf_spring_get(&res->params, k), jnum(f, key), 0);
+        }
+        golden_close(json_path, "rmse", res->rmse * u, jnum(f, "rmse"), abs_y);
+        golden_close(json_path, "r2", res->r2, jnum(f, "r2"), 1e-12);
+        if (po.validate && r.val[i].done)
+            golden_close(json_path, "validation.rmse", r.val[i].rmse * u,
+                         jnum(f, "validation.rmse"), abs_y);
+    }
+    cf_report_free(&r);
+    cf_table_free(&t);
+    json_decref(root);
+}
+
+static void refitting_the_shipped_tables_reproduces_the_committed_fits(void **state)
+{
+    (void)state;
+    glob_t g;
+    assert_int_equal(glob("fits/*.json", 0, NULL, &g), 0);
+    assert_true(g.gl_pathc >= 7); /* one per table of data/ */
+    for (size_t i = 0; i < g.gl_pathc; i++)
+        check_golden(g.gl_pathv[i]);
+    globfree(&g);
+}
+
+/* The keys of the spring description are what the fit file holds and what the reader reads: a
+** spring written through the pipeline reads back bit for bit. */
+static void spring_description_keys_round_trip_through_a_fit_file(void **state)
+{
+    (void)state;
+    double x[12], y[12];
+    cf_spring p = {4, 10, 3, 0.5, 80000, 12};
+    cf_law law;
+    assert_int_equal(cf_law_init(&law, &p, NULL), CF_OK);
+    for (int i = 0; i < 12; i++) {
+        x[i] = 0.04 * i;
+        y[i] = cf_law_force(&law, CF_LAW_EXACT, x[i] * p.H_mm, NULL, NULL) / (p.H_mm * p.H_mm);
+    }
+    cf_table t;
+    assert_int_equal(cf_table_from_arrays(CF_TABLE_STRESS_STRAIN, 12, x, y, NULL, &t, NULL), CF_OK);
+    assert_string_equal(t.y_unit, "MPa");
+    assert_false(t.compression);
+    cf_pipeline_options po = cf_pipeline_default_options();
+    po.types = CF_PIPELINE_TELESCOPING;
+    cf_fit_report r;
+    cf_error err = {0};
+    assert_int_equal(cf_pipeline_fit(&t, &po, &r, &err), CF_OK);
+    assert_int_equal(r.nfits, 1);
+    assert_true(r.fits[0].rmse < 1e-9 * r.ymax);
+    char dir[] = "/tmp/conifit-pipeline-XXXXXX", path[300];
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/fit.json", dir);
+    assert_int_equal(cf_pipeline_write(&r, path, NULL, NULL, &err), CF_OK);
+    json_t *root = json_load_file(path, 0, NULL);
+    assert_non_null(root);
+    json_t *params = json_object_get(json_array_get(json_object_get(root, "fits"), 0), "params");
+    assert_int_equal(json_object_size(params), CF_P_COUNT);
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        const cf_spring_param *sp = cf_spring_param_info(k);
+        assert_true(json_is_number(json_object_get(params, sp->key)));
+        assert_int_equal(cf_spring_param_find(sp->key), k);
+        assert_int_equal(cf_spring_param_find(sp->name), k);
+    }
+    json_decref(root);
+    cf_fitted_spring fs;
+    assert_int_equal(cf_fitfile_load(path, NULL, &fs, &err), CF_OK);
+    for (int k = 0; k < CF_P_COUNT; k++)
+        assert_true(cf_spring_get(&fs.params, k) == cf_spring_get(&r.fits[0].params, k));
+    assert_int_equal(cf_spring_param_find("D3"), -1);
+    remove(path);
+    rmdir(dir);
+    cf_report_free(&r);
+    cf_table_free(&t);
+    cf_law_free(&law);
+}
+
+/* The library speaks of parameters and values, never of command-line flags or usage. */
+static void library_errors_are_data_errors_not_usage(void **state)
+{
+    (void)state;
+    cf_error err = {0};
+    cf_spring_type ty;
+    assert_int_equal(cf_spring_type_parse("conical", &ty, &err), CF_E_DATA);
+    assert_null(strstr(err.msg, "--"));
+    cf_fit_options o = cf_fit_default_options();
+    o.index_max = 2;
+    double x[6] = {0, 0.1, 0.2, 0.3, 0.4, 0.5}, y[6] = {0, 1, 2, 3, 5, 8};
+    cf_table t = {.count = 6, .x = x, .y = y};
+    cf_fit_result res;
+    assert_int_equal(cf_fit_run(&t, &o, CF_TELESCOPING, &res, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "index_max"));
+    assert_null(strstr(err.msg, "--"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(refitting_the_shipped_tables_reproduces_the_committed_fits),
+        cmocka_unit_test(spring_description_keys_round_trip_through_a_fit_file),
+        cmocka_unit_test(library_errors_are_data_errors_not_usage),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
