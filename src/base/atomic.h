@@ -1,7 +1,19 @@
 /*
-** Writing output files so that nothing is ever half-written: write to a temporary file in the
-** same folder, then rename it over the target. A failed or aborted write leaves no file at all,
-** and the target is refused when it is one of the run's input files.
+** Writing output files so that nothing is ever half-written and nothing but a regular file is
+** ever replaced.
+**
+** A file is written under a hidden temporary name in its own folder, `.NAME.conifit-PID-XXXXXX`,
+** and renamed over the target only when it is complete (and, for a command with several outputs,
+** only when all of them are: open them all, then commit them all). Rules:
+**   - the target must not be one of the run's inputs;
+**   - an existing target must be a regular file: a symbolic link, FIFO, character or block device,
+**     socket or folder is refused (conifit never writes into such a thing, nor replaces it);
+**   - a failed or aborted write leaves no file at all;
+**   - temporaries still open when the process is stopped by a signal are removed by
+**     cf_atomic_remove_temporaries (main calls it on SIGINT, SIGTERM, SIGHUP, SIGPIPE); those of a
+**     process killed outright (SIGKILL) stay hidden (dot names) and are swept by the next
+**     cf_atomic_open in the same folder, once no process of that PID is alive on this machine.
+** The list of live temporaries is the one process-wide state of the library; it is thread-safe.
 */
 #ifndef CF_ATOMIC_H
 #define CF_ATOMIC_H
@@ -11,22 +23,37 @@
 #include "conifit/error.h"
 
 typedef struct cf_atomic {
-    FILE *fp;          /* write here */
+    FILE *fp;          /* write here (NULL once the file is finished) */
     char path[4096];   /* final name */
-    char tmp[4112];    /* temporary name in the same folder */
+    char tmp[4200];    /* temporary name in the same folder ("" when none) */
+    int slot;          /* 1 + its entry in the list of live temporaries, 0 when none */
 } cf_atomic;
 
-/* Opens a temporary file beside path. CF_E_CANTWRITE (message names the path and the reason)
-** when it cannot be created. `inputs` (may be NULL) is a NULL-terminated list of input paths that
-** path must not be: writing over one of them is refused with CF_E_CANTWRITE. */
+/* Whether path may be written: CF_E_CANTWRITE (message names the path and the reason) when it is
+** one of `inputs` (NULL-terminated, may be NULL), exists and is not a regular file, or its folder
+** does not exist. Lets a command refuse a bad target before any work. */
+cf_status cf_atomic_check(const char *path, const char *const *inputs, cf_error *err);
+
+/* Checks path (cf_atomic_check) and opens a temporary file beside it. CF_E_CANTWRITE when it
+** cannot be created. */
 cf_status cf_atomic_open(cf_atomic *a, const char *path, const char *const *inputs, cf_error *err);
 
-/* Flushes, closes and renames the temporary file to its final name. On any failure the temporary
-** file is removed and CF_E_CANTWRITE returned. */
+/* Finishes the temporary file (flush, close), checking every write; the file is complete but not
+** in place, and no descriptor stays open. On failure the temporary is removed, CF_E_CANTWRITE. */
+cf_status cf_atomic_finish(cf_atomic *a, cf_error *err);
+
+/* Finishes the file if needed and renames it to its final name, after checking again that the
+** target is not (by now) something other than a regular file. On any failure the temporary file
+** is removed and CF_E_CANTWRITE returned. */
 cf_status cf_atomic_commit(cf_atomic *a, cf_error *err);
 
-/* Closes and removes the temporary file (safe to call twice, or after a commit). */
+/* Closes and removes the temporary file (safe to call twice, after a commit, or on a zeroed
+** cf_atomic). */
 void cf_atomic_abort(cf_atomic *a);
+
+/* Removes every temporary file still open in this process. Async-signal-safe: for a handler of a
+** fatal signal. */
+void cf_atomic_remove_temporaries(void);
 
 /* True when a and b name the same existing file (same device and inode). */
 int cf_same_file(const char *a, const char *b);

@@ -7,13 +7,13 @@
 #include <errno.h>
 #include <math.h>
 #include <pthread.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "base/atomic.h"
 #include "cli/cli.h"
 #include "conifit/baseline.h"
 #include "conifit/pipeline.h"
@@ -67,9 +67,11 @@ typedef struct fit_job {
     const char *file;
     cf_table m;
     cf_fit_report rep;
-    char json_path[4096];
+    char json_path[4096];        /* "" when not written */
     char plot_path[4096];
+    cf_atomic json_out, plot_out; /* both complete, put in place only when every job succeeded */
     char *text;
+    const char *const *inputs;   /* every input of the run: never an output */
     cf_error err;
     cf_status st;
 } fit_job;
@@ -266,25 +268,10 @@ static void run_job(fit_job *j)
     j->st = cf_pipeline_fit(&j->m, &a->popt, &j->rep, &j->err);
     if (j->st != CF_OK)
         return;
-    const char *inputs[257];
-    int ni = 0;
-    for (int i = 0; i < a->nfiles && ni < 256; i++)
-        inputs[ni++] = a->files[i];
-    inputs[ni] = NULL;
-    if (a->out) {
-        if (is_dir_target(a->out))
-            path_in_dir(j->json_path, sizeof j->json_path, a->out, j->file, ".json");
-        else
-            snprintf(j->json_path, sizeof j->json_path, "%s", a->out);
-    }
-    if (a->plot) {
-        if (a->nfiles > 1 || is_dir_target(a->plot))
-            path_in_dir(j->plot_path, sizeof j->plot_path, a->plot, j->file, ".png");
-        else
-            snprintf(j->plot_path, sizeof j->plot_path, "%s", a->plot);
-    }
-    j->st = cf_pipeline_write(&j->rep, a->out ? j->json_path : NULL,
-                              a->plot ? j->plot_path : NULL, inputs, &j->err);
+    /* both outputs as temporaries; cf_cli_fit puts them in place when every table succeeded */
+    j->st = cf_pipeline_prepare(&j->rep, j->json_path[0] ? j->json_path : NULL,
+                                j->plot_path[0] ? j->plot_path : NULL, j->inputs, &j->json_out,
+                                &j->plot_out, &j->err);
     if (j->st != CF_OK)
         return;
     if (!a->quiet)
@@ -311,6 +298,46 @@ static void *worker(void *arg)
     }
 }
 
+/* Names every output of the run before anything is read or fitted, and refuses the run when two
+** outputs share a name (two tables with one base name in a batch, -o and --plot alike) or an
+** output cannot be written (an input, a non-regular file, a missing folder). */
+static int plan_outputs(const fit_args *a, fit_job *jobs, const char *const *inputs)
+{
+    cf_error err = {0};
+    for (int i = 0; i < a->nfiles; i++) {
+        fit_job *j = &jobs[i];
+        j->inputs = inputs;
+        if (a->out && is_dir_target(a->out))
+            path_in_dir(j->json_path, sizeof j->json_path, a->out, a->files[i], ".json");
+        else if (a->out)
+            snprintf(j->json_path, sizeof j->json_path, "%s", a->out);
+        if (a->plot && (a->nfiles > 1 || is_dir_target(a->plot)))
+            path_in_dir(j->plot_path, sizeof j->plot_path, a->plot, a->files[i], ".png");
+        else if (a->plot)
+            snprintf(j->plot_path, sizeof j->plot_path, "%s", a->plot);
+        const char *mine[2] = {j->json_path, j->plot_path};
+        for (int k = 0; k < 2; k++) {
+            if (!mine[k][0])
+                continue;
+            if (cf_atomic_check(mine[k], inputs, &err) != CF_OK)
+                return cf_cli_fail(&err);
+            /* against every output named so far, this table's included */
+            for (int i2 = 0; i2 <= i; i2++)
+                for (int k2 = 0; k2 < 2; k2++) {
+                    const char *other = k2 == 0 ? jobs[i2].json_path : jobs[i2].plot_path;
+                    if ((i2 == i && k2 >= k) || !other[0] || strcmp(other, mine[k]) != 0)
+                        continue;
+                    if (i2 == i)
+                        return cf_cli_usage_error("fit", "-o and --plot both name %s", mine[k]);
+                    return cf_cli_usage_error("fit", "tables %s and %s would both be written "
+                                              "to %s; give them different names",
+                                              a->files[i2], a->files[i], mine[k]);
+                }
+        }
+    }
+    return -1;
+}
+
 int cf_cli_fit(int argc, char **argv)
 {
     fit_args a;
@@ -319,14 +346,24 @@ int cf_cli_fit(int argc, char **argv)
         free(a.files);
         return rc;
     }
-    /* a gnuplot that exits early must not kill us through SIGPIPE */
-    signal(SIGPIPE, SIG_IGN);
     fit_job *jobs = calloc((size_t)a.nfiles, sizeof *jobs);
     if (!jobs) {
         free(a.files);
         fprintf(stderr, "conifit: out of memory\n");
         return CF_EXIT_SOFTWARE;
     }
+    /* every input of the run, never to be an output */
+    const char **inputs = calloc((size_t)a.nfiles + 2, sizeof *inputs);
+    if (!inputs) {
+        free(jobs);
+        free(a.files);
+        fprintf(stderr, "conifit: out of memory\n");
+        return CF_EXIT_SOFTWARE;
+    }
+    for (int i = 0; i < a.nfiles; i++)
+        inputs[i] = a.files[i];
+    inputs[a.nfiles] = a.scene;
+    rc = plan_outputs(&a, jobs, inputs);
     /* Read every table first: a bad one stops the run before anything is written. */
     for (int i = 0; i < a.nfiles && rc < 0; i++) {
         jobs[i].args = &a;
@@ -353,6 +390,22 @@ int cf_cli_fit(int argc, char **argv)
         worker(&p);
         for (int t = 0; t < started; t++)
             pthread_join(th[t], NULL);
+        /* all outputs or none: they go in place only when every table succeeded */
+        int failed = 0;
+        for (int i = 0; i < a.nfiles; i++)
+            failed |= jobs[i].st != CF_OK;
+        for (int i = 0; i < a.nfiles && !failed; i++) {
+            fit_job *j = &jobs[i];
+            if ((j->json_path[0] && (j->st = cf_atomic_commit(&j->json_out, &j->err)) != CF_OK) ||
+                (j->plot_path[0] && (j->st = cf_atomic_commit(&j->plot_out, &j->err)) != CF_OK))
+                failed = 1;
+        }
+        for (int i = 0; i < a.nfiles; i++) {
+            cf_atomic_abort(&jobs[i].json_out);
+            cf_atomic_abort(&jobs[i].plot_out);
+            if (failed && jobs[i].st == CF_OK)
+                jobs[i].json_path[0] = jobs[i].plot_path[0] = '\0'; /* not written */
+        }
         rc = CF_EXIT_OK;
         for (int i = 0; i < a.nfiles; i++) {
             fit_job *j = &jobs[i];
@@ -382,6 +435,9 @@ int cf_cli_fit(int argc, char **argv)
                                   "(a solid strain is below 1)"
                                 : "loosen --fix or --index-max");
         }
+        if (failed && (a.out || a.plot))
+            fprintf(stderr, "conifit: no output file written (outputs are written only when "
+                            "every table succeeds)\n");
         if (a.nfiles > 1 && !a.quiet) {
             int wname = 5;
             for (int i = 0; i < a.nfiles; i++)
@@ -431,6 +487,7 @@ int cf_cli_fit(int argc, char **argv)
         cf_report_free(&jobs[i].rep);
     }
     free(jobs);
+    free(inputs);
     free(a.files);
     return rc;
 }

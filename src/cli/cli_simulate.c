@@ -137,8 +137,24 @@ int cf_cli_simulate(int argc, char **argv)
         return cf_cli_usage_error("simulate", "--plot %s: the file must end in .png or .svg", png);
 
     cf_scene sc;
+    if (png && strcmp(png, out) == 0)
+        return cf_cli_usage_error("simulate", "-o and --plot both name %s", out);
     if (cf_scene_load(scene_path, &sc, &err) != CF_OK)
         return cf_cli_fail(&err);
+    /* the inputs (the scene and the fit file it names) are never outputs; both outputs are
+    ** checked before the run, which may be long */
+    char fitfile[sizeof sc.spring_source];
+    snprintf(fitfile, sizeof fitfile, "%s", sc.spring_source);
+    char *colon = strrchr(fitfile, ':');
+    if (colon && strcmp(sc.spring_source, "params") != 0)
+        *colon = '\0';
+    const char *inputs[] = {scene_path, strcmp(sc.spring_source, "params") ? fitfile : NULL,
+                            NULL};
+    if (cf_atomic_check(out, inputs, &err) != CF_OK ||
+        (png && cf_atomic_check(png, inputs, &err) != CF_OK)) {
+        cf_scene_free(&sc);
+        return cf_cli_fail(&err);
+    }
     cf_law law;
     memset(&law, 0, sizeof law);
     cf_lattice lat;
@@ -177,7 +193,6 @@ int cf_cli_simulate(int argc, char **argv)
         rc = cf_cli_fail(&err);
         goto end;
     }
-    const char *inputs[] = {scene_path, NULL};
     if (cf_atomic_open(&a, out, inputs, &err) != CF_OK) {
         rc = cf_cli_fail(&err);
         goto end;

@@ -2,12 +2,15 @@
 ** conifit: conical-spring parameters for mass-spring soft-tissue models.
 ** The entry point: dispatches to a subcommand and owns the process-wide settings.
 */
+#include <errno.h>
 #include <locale.h>
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 
 #include <gsl/gsl_errno.h>
 
+#include "base/atomic.h"
 #include "cli/cli.h"
 
 typedef struct command {
@@ -37,12 +40,36 @@ static void usage(FILE *out)
                  "70 internal error, 73 cannot write output.\n");
 }
 
-int main(int argc, char **argv)
+/* A fatal signal while outputs are being written: remove their temporaries, then die of it. */
+static void on_signal(int sig)
 {
-    /* Numbers are read and written with '.' whatever the user's locale; GSL reports errors by
-    ** status, never by aborting. */
-    setlocale(LC_ALL, "C");
-    gsl_set_error_handler_off();
+    cf_atomic_remove_temporaries();
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+/* Everything a command printed must have reached standard output: a full disk or a closed pipe
+** is an output that cannot be written (73), never a silent success. */
+static int finish(int rc)
+{
+    int bad = ferror(stdout);
+    int e = bad ? EIO : 0;
+    if (fflush(stdout) != 0 && !bad) {
+        bad = 1;
+        e = errno;
+    }
+    if (fclose(stdout) != 0 && !bad) {
+        bad = 1;
+        e = errno;
+    }
+    if (!bad)
+        return rc;
+    fprintf(stderr, "conifit: cannot write standard output: %s\n", strerror(e));
+    return rc == CF_EXIT_OK ? CF_EXIT_CANTCREAT : rc;
+}
+
+static int run(int argc, char **argv)
+{
     if (argc < 2) {
         usage(stderr);
         return CF_EXIT_USAGE;
@@ -60,4 +87,22 @@ int main(int argc, char **argv)
             return commands[i].run(argc - 1, argv + 1);
     fprintf(stderr, "conifit: unknown command '%s' (see 'conifit --help')\n", argv[1]);
     return CF_EXIT_USAGE;
+}
+
+int main(int argc, char **argv)
+{
+    /* Numbers are read and written with '.' whatever the user's locale; GSL reports errors by
+    ** status, never by aborting. */
+    setlocale(LC_ALL, "C");
+    gsl_set_error_handler_off();
+    /* SIGPIPE (a reader of standard output went away) ends the run as usual, but cleanly */
+    static const int fatal[] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE};
+    for (size_t i = 0; i < sizeof fatal / sizeof fatal[0]; i++) {
+        struct sigaction sa;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = on_signal;
+        sigemptyset(&sa.sa_mask);
+        sigaction(fatal[i], &sa, NULL);
+    }
+    return finish(run(argc, argv));
 }

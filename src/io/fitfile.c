@@ -192,18 +192,28 @@ char *cf_fitfile_dumps(const json_t *root)
     return t;
 }
 
-cf_status cf_fitfile_write(const json_t *root, const char *path, const char *const *inputs,
-                           cf_error *err)
+cf_status cf_fitfile_prepare(const json_t *root, const char *path, const char *const *inputs,
+                             struct cf_atomic *out, cf_error *err)
 {
+    memset(out, 0, sizeof *out);
     char *s = cf_fitfile_dumps(root);
     if (!s)
         return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory writing the JSON", path);
-    cf_atomic a;
-    cf_status st = cf_atomic_open(&a, path, inputs, err);
+    cf_status st = cf_atomic_open(out, path, inputs, err);
     if (st == CF_OK) {
-        fputs(s, a.fp);
-        st = cf_atomic_commit(&a, err);
+        fputs(s, out->fp);
+        st = cf_atomic_finish(out, err);
     }
     free(s);
+    return st;
+}
+
+cf_status cf_fitfile_write(const json_t *root, const char *path, const char *const *inputs,
+                           cf_error *err)
+{
+    cf_atomic a;
+    cf_status st = cf_fitfile_prepare(root, path, inputs, &a, err);
+    if (st == CF_OK)
+        st = cf_atomic_commit(&a, err);
     return st;
 }

@@ -216,14 +216,25 @@ char *cf_report_json_string(const cf_fit_report *r)
     return s;
 }
 
-cf_status cf_report_json_write(const cf_fit_report *r, const char *path,
-                               const char *const *inputs, cf_error *err)
+cf_status cf_report_json_prepare(const cf_fit_report *r, const char *path,
+                                 const char *const *inputs, struct cf_atomic *out, cf_error *err)
 {
+    memset(out, 0, sizeof *out);
     json_t *root = report_json(r);
     if (!root)
         return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory building the report", path);
-    cf_status st = cf_fitfile_write(root, path, inputs, err);
+    cf_status st = cf_fitfile_prepare(root, path, inputs, out, err);
     json_decref(root);
+    return st;
+}
+
+cf_status cf_report_json_write(const cf_fit_report *r, const char *path,
+                               const char *const *inputs, cf_error *err)
+{
+    cf_atomic a;
+    cf_status st = cf_report_json_prepare(r, path, inputs, &a, err);
+    if (st == CF_OK)
+        st = cf_atomic_commit(&a, err);
     return st;
 }
 

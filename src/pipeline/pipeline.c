@@ -10,6 +10,7 @@
 #include "conifit/baseline.h"
 #include "conifit/scene.h"
 #include "conifit/version.h"
+#include "base/atomic.h"
 #include "out/plot.h"
 
 cf_pipeline_options cf_pipeline_default_options(void)
@@ -90,13 +91,38 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
     return CF_OK;
 }
 
+cf_status cf_pipeline_prepare(const cf_fit_report *r, const char *json_path,
+                              const char *plot_path, const char *const *inputs,
+                              struct cf_atomic *json_out, struct cf_atomic *plot_out,
+                              cf_error *err)
+{
+    memset(json_out, 0, sizeof *json_out);
+    memset(plot_out, 0, sizeof *plot_out);
+    cf_status st = CF_OK;
+    if (json_path)
+        st = cf_report_json_prepare(r, json_path, inputs, json_out, err);
+    if (st == CF_OK && plot_path) {
+        st = cf_plot_fit(r, plot_path, inputs, plot_out, err);
+        if (st == CF_OK)
+            st = cf_atomic_finish(plot_out, err);
+    }
+    if (st != CF_OK) {
+        cf_atomic_abort(json_out);
+        cf_atomic_abort(plot_out);
+    }
+    return st;
+}
+
 cf_status cf_pipeline_write(const cf_fit_report *r, const char *json_path, const char *plot_path,
                             const char *const *inputs, cf_error *err)
 {
-    cf_status st = CF_OK;
-    if (json_path)
-        st = cf_report_json_write(r, json_path, inputs, err);
+    cf_atomic a, b;
+    cf_status st = cf_pipeline_prepare(r, json_path, plot_path, inputs, &a, &b, err);
+    if (st == CF_OK && json_path)
+        st = cf_atomic_commit(&a, err);
     if (st == CF_OK && plot_path)
-        st = cf_plot_write(r, plot_path, inputs, err);
+        st = cf_atomic_commit(&b, err);
+    cf_atomic_abort(&a);
+    cf_atomic_abort(&b);
     return st;
 }

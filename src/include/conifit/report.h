@@ -48,6 +48,12 @@ double cf_report_baseline_aic(const cf_fit_report *r, int k);
 /* The JSON document as a string (malloc'd; caller frees). NULL when memory runs out. */
 char *cf_report_json_string(const cf_fit_report *r);
 
+/* Writes the JSON to a temporary file beside path, complete but not yet in place (base/atomic.h):
+** the caller commits it together with its other outputs, or aborts it. Errors as below. */
+struct cf_atomic;
+cf_status cf_report_json_prepare(const cf_fit_report *r, const char *path,
+                                 const char *const *inputs, struct cf_atomic *out, cf_error *err);
+
 /* Writes the JSON to path atomically; `inputs` (NULL-terminated, may be NULL) are refused as
 ** targets. CF_E_CANTWRITE on failure (no file left behind). */
 cf_status cf_report_json_write(const cf_fit_report *r, const char *path,
