@@ -20,13 +20,21 @@ static cf_law make_law(void)
     return law;
 }
 
-static cf_msm_config small_config(int nx, int ny, int nz, unsigned diag)
+/* Family weights (edge, face, body): edges alone, every family at full weight (the uncalibrated
+** lattice), and NULL for the default calibration (isotropic). */
+static const double W_EDGES[3] = {1, 0, 0};
+static const double W_ONES[3] = {1, 1, 1};
+
+static cf_msm_config small_config(int nx, int ny, int nz, const double *w)
 {
     cf_msm_config c = cf_msm_default();
     c.lattice.nx = nx;
     c.lattice.ny = ny;
     c.lattice.nz = nz;
-    c.lattice.diagonals = diag;
+    if (w) {
+        memcpy(c.lattice.weight, w, sizeof c.lattice.weight);
+        c.lattice.calibration = CF_CAL_CUSTOM;
+    }
     return c;
 }
 
@@ -34,7 +42,7 @@ static void axial_only_lattice_reproduces_single_spring_curve(void **state)
 {
     (void)state;
     cf_law law = make_law();
-    cf_msm_config cfg = small_config(2, 3, 4, CF_DIAG_NONE);
+    cf_msm_config cfg = small_config(2, 3, 4, W_EDGES);
     /* Table convention: negative strain = compression; up to 96 % of the solid strain. */
     double e[] = {-0.01, -0.1, -0.2, -0.3, -0.4, -0.45, -0.48, 0.05, 0.2, 0.4};
     size_t n = sizeof e / sizeof e[0];
@@ -51,19 +59,105 @@ static void axial_only_lattice_reproduces_single_spring_curve(void **state)
     }
 }
 
-static void lattice_with_diagonals_is_stiffer_than_one_spring(void **state)
+/* The isotropic calibration from the Cauchy-Born constants: isotropic (Zener ratio 1), nu = 1/4,
+** modulus k0/H; about 0.6085 for the edges and 0.2708 for each diagonal. The uncalibrated lattice
+** (every family at weight 1) is 2.248 times stiffer than its springs with nu = 0.317. */
+static void isotropic_calibration_has_the_law_modulus_and_nu_one_quarter(void **state)
+{
+    (void)state;
+    double w[3];
+    assert_int_equal(cf_calibration_weights(CF_CAL_ISOTROPIC, w, NULL), CF_OK);
+    assert_close(w[CF_FAMILY_EDGE], 0.6085, 1e-4);
+    assert_close(w[CF_FAMILY_FACE], 0.2708, 1e-4);
+    assert_close(w[CF_FAMILY_BODY], w[CF_FAMILY_FACE], 0);
+    /* k_e = k_f + 8 k_b / 3 with k_f = w_f / sqrt 2, k_b = w_b / sqrt 3 */
+    assert_close(w[0], w[1] / sqrt(2.0) + 8 * w[2] / (3 * sqrt(3.0)), 1e-15);
+    cf_cubic_moduli m = cf_cubic_moduli_of(w);
+    assert_close(m.E, 1, 1e-14);
+    assert_close(m.nu, 0.25, 1e-15);
+    assert_close(m.zener, 1, 1e-14);
+    assert_int_equal(cf_calibration_weights(CF_CAL_AXIAL, w, NULL), CF_OK);
+    m = cf_cubic_moduli_of(w);
+    assert_close(m.E, 1, 1e-14);
+    assert_close(w[0], w[1], 0);
+    double ones[3] = {1, 1, 1};
+    m = cf_cubic_moduli_of(ones);
+    assert_close(m.E, 2.248, 1e-3);
+    assert_close(m.nu, 0.317, 1e-3);
+    assert_int_equal(cf_calibration_weights(CF_CAL_FITTED, w, NULL), CF_E_DATA);
+    double bad[3] = {1, -0.5, 0};
+    cf_error err = {0};
+    assert_int_equal(cf_calibration_check(bad, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "lattice.weights.face = -0.5"));
+    double none[3] = {0, 0, 0};
+    assert_int_equal(cf_calibration_check(none, NULL), CF_E_DATA);
+}
+
+/* The full default lattice at a small strain: the nominal stress is (k0/H) strain to 1e-6 and the
+** sides move in by nu = 1/4 of the axial strain, for several lattice sizes. */
+static void default_lattice_modulus_is_k0_over_H_and_nu_one_quarter(void **state)
 {
     (void)state;
     cf_law law = make_law();
-    cf_msm_config cfg = small_config(3, 3, 3, CF_DIAG_FACE | CF_DIAG_BODY);
-    double e[] = {-0.1, -0.3};
-    double s[2];
-    cf_error err = {0};
-    assert_int_equal(cf_msm_uniaxial(&law, CF_LAW_CLOSED, &cfg, e, 2, s, NULL, &err), CF_OK);
-    for (int i = 0; i < 2; i++) {
-        double ref = -cf_law_force(&law, CF_LAW_EXACT, -e[i] * 10, NULL, NULL) / 100;
-        assert_true(s[i] < ref * 1.2); /* more negative: stiffer in compression */
+    const int sizes[3][3] = {{1, 1, 1}, {2, 3, 2}, {3, 3, 3}};
+    for (int z = 0; z < 3; z++) {
+        cf_msm_config cfg = small_config(sizes[z][0], sizes[z][1], sizes[z][2], NULL);
+        cf_lattice lat;
+        cf_error err = {0};
+        assert_int_equal(cf_lattice_create(&lat, &law, CF_LAW_CLOSED, &cfg.lattice, &err), CF_OK);
+        const double e = 1e-7; /* compressive */
+        double t[2] = {0, 1}, v[2] = {0, e}, ts[1] = {1};
+        cf_msm_path path = {CF_DRIVE_DISPLACEMENT, 2, t, v};
+        cf_msm_sample out[1];
+        cf_status rc = cf_msm_run(&lat, NULL, &cfg, &path, ts, 1, out, NULL, NULL, &err);
+        if (rc != CF_OK)
+            fail_msg("small strain: %s", err.msg);
+        double E = law.k0_N_per_mm / law.p.H_mm;
+        assert_close(out[0].stress_MPa / e, E, 1e-6 * E);
+        /* lateral strain of the corner column at x = nx H, y = 0 */
+        size_t corner = (size_t)cfg.lattice.nx; /* node (nx, 0, 0) */
+        double lateral = (lat.x[corner] - lat.X[corner]) / lat.X[corner];
+        assert_close(lateral / e, 0.25, 1e-6);
+        cf_lattice_free(&lat);
     }
+}
+
+/* Dashpots are scaled by the family weights: doubling every weight doubles the whole viscous
+** loop (elastic and dashpot forces alike), to rounding. */
+static void dashpots_scale_with_the_family_weights(void **state)
+{
+    (void)state;
+    cf_law law = make_law();
+    double s2[2][21];
+    for (int k = 0; k < 2; k++) {
+        cf_msm_config cfg = small_config(1, 1, 1, NULL);
+        for (int f = 0; f < 3; f++)
+            cfg.lattice.weight[f] *= k ? 2 : 1;
+        cfg.quasi_substeps = 2;
+        cf_lattice lat;
+        assert_int_equal(cf_lattice_create(&lat, &law, CF_LAW_CLOSED, &cfg.lattice, NULL), CF_OK);
+        cf_msm_effects fx = {0};
+        fx.eta_MPa_s = 5e-3;
+        fx.maxwell_E_MPa = 2e-3;
+        fx.maxwell_tau_s = 0.3;
+        double t[3] = {0, 1, 2}, v[3] = {0, 0.2, 0}, ts[21];
+        for (int i = 0; i < 21; i++)
+            ts[i] = 0.1 * i;
+        cf_msm_path path = {CF_DRIVE_DISPLACEMENT, 3, t, v};
+        cf_msm_sample out[21];
+        cf_error err = {0};
+        if (cf_msm_run(&lat, &fx, &cfg, &path, ts, 21, out, NULL, NULL, &err) != CF_OK)
+            fail_msg("cycle: %s", err.msg);
+        for (int i = 0; i < 21; i++)
+            s2[k][i] = out[i].stress_MPa;
+        cf_lattice_free(&lat);
+    }
+    double top = 0;
+    for (int i = 0; i < 21; i++)
+        top = fmax(top, fabs(s2[0][i]));
+    assert_true(top > 0);
+    for (int i = 0; i < 21; i++)
+        assert_close(s2[1][i], 2 * s2[0][i], 1e-9 * top);
 }
 
 static void every_spring_applies_equal_and_opposite_forces(void **state)
@@ -151,16 +245,16 @@ static void static_solve_and_long_damped_dynamic_run_agree(void **state)
 {
     (void)state;
     cf_law law = make_law();
-    cf_msm_config cfg = small_config(2, 2, 2, CF_DIAG_FACE | CF_DIAG_BODY);
+    cf_msm_config cfg = small_config(2, 2, 2, NULL);
     cfg.lattice.density_t_per_mm3 = 1e-6;
-    const double stress = 1.0e-3; /* 1 kPa */
+    const double stress = 0.2e-3; /* 0.2 kPa: well inside the stable range */
     cf_msm_stats st;
     cf_msm_sample s0 = run_hold(&law, &cfg, NULL, CF_DRIVE_FORCE, stress, 0, 1, 2, NULL, &st,
                                 CF_OK);
     cf_msm_effects fx = {0};
     fx.inertia = 1;
     fx.eta_MPa_s = 2e-3;
-    cf_msm_sample s1 = run_hold(&law, &cfg, &fx, CF_DRIVE_FORCE, stress, 0.5, 20, 21, NULL, &st,
+    cf_msm_sample s1 = run_hold(&law, &cfg, &fx, CF_DRIVE_FORCE, stress, 0.5, 40, 41, NULL, &st,
                                 CF_OK);
     assert_true(st.steps > 1000);
     assert_true(s0.strain > 0.05);
@@ -171,7 +265,7 @@ static void undamped_symplectic_run_keeps_energy_bounded(void **state)
 {
     (void)state;
     cf_law law = make_law();
-    cf_msm_config cfg = small_config(1, 1, 1, CF_DIAG_FACE | CF_DIAG_BODY);
+    cf_msm_config cfg = small_config(1, 1, 1, NULL);
     cf_msm_effects fx = {0};
     fx.inertia = 1;
     /* A load applied at once: the lattice oscillates about its equilibrium forever. */
@@ -202,9 +296,9 @@ static void creep_strain_rises_monotonically_toward_static_value(void **state)
 {
     (void)state;
     cf_law law = make_law();
-    cf_msm_config cfg = small_config(2, 2, 2, CF_DIAG_FACE | CF_DIAG_BODY);
+    cf_msm_config cfg = small_config(2, 2, 2, NULL);
     cfg.quasi_substeps = 4;
-    const double stress = 1.0e-3, tau = 5;
+    const double stress = 0.4e-3, tau = 5;
     cf_msm_sample s0 = run_hold(&law, &cfg, NULL, CF_DRIVE_FORCE, stress, 0, 1, 2, NULL, NULL,
                                 CF_OK);
     cf_msm_effects fx = {0};
@@ -226,7 +320,7 @@ static void creep_strain_rises_monotonically_toward_static_value(void **state)
 /* Loop area (kPa) of one load-unload cycle to strain 0.2 of the given period with dashpots. */
 static double loop_area(const cf_law *law, double period)
 {
-    cf_msm_config cfg = small_config(1, 1, 2, CF_DIAG_FACE | CF_DIAG_BODY);
+    cf_msm_config cfg = small_config(1, 1, 2, NULL);
     cfg.quasi_substeps = 2;
     cf_lattice lat;
     cf_error err = {0};
@@ -267,7 +361,7 @@ static void unstable_time_step_is_refused(void **state)
 {
     (void)state;
     cf_law law = make_law();
-    cf_msm_config cfg = small_config(1, 1, 1, CF_DIAG_FACE);
+    cf_msm_config cfg = small_config(1, 1, 1, W_ONES);
     cf_msm_effects fx = {0};
     fx.inertia = 1;
     cf_lattice lat;
@@ -307,7 +401,9 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(axial_only_lattice_reproduces_single_spring_curve),
-        cmocka_unit_test(lattice_with_diagonals_is_stiffer_than_one_spring),
+        cmocka_unit_test(isotropic_calibration_has_the_law_modulus_and_nu_one_quarter),
+        cmocka_unit_test(default_lattice_modulus_is_k0_over_H_and_nu_one_quarter),
+        cmocka_unit_test(dashpots_scale_with_the_family_weights),
         cmocka_unit_test(every_spring_applies_equal_and_opposite_forces),
         cmocka_unit_test(lattice_masses_and_top_shares_add_up),
         cmocka_unit_test(static_solve_and_long_damped_dynamic_run_agree),

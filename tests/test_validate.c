@@ -86,12 +86,18 @@ static void validate_writes_keys_consistent_with_the_lattice(void **state)
     assert_true(rmse >= 0 && mx >= rmse && r2 <= 1);
     json_t *lat = json_object_get(v, "lattice");
     assert_int_equal(json_integer_value(json_object_get(lat, "nx")), 3);
-    assert_string_equal(json_string_value(json_object_get(lat, "diagonals")), "face+body");
+    assert_string_equal(json_string_value(json_object_get(lat, "calibration")), "isotropic");
+    json_t *lw = json_object_get(lat, "weights");
+    assert_true(fabs(num_at(lw, "edge") - 0.6085) < 1e-4);
+    assert_true(fabs(num_at(lw, "face") - 0.2708) < 1e-4 && num_at(lw, "body") == num_at(lw, "face"));
+    assert_true(fabs(num_at(lat, "poisson_ratio") - 0.25) < 1e-12);
+    assert_true(fabs(num_at(lat, "modulus_ratio") - 1) < 1e-12);
     assert_string_equal(json_string_value(json_object_get(lat, "bottom")), "axial");
     /* recompute */
     json_t *p = json_object_get(f, "params");
     cf_spring sp = {num_at(p, "D1_mm"), num_at(p, "D2_mm"), num_at(p, "n"),
                     num_at(p, "d_mm"),  num_at(p, "G_MPa"), num_at(p, "H_mm")};
+    double fit_rmse = num_at(f, "rmse");
     json_decref(root);
     cf_measure_options mo = cf_measure_default_options();
     cf_table m;
@@ -114,8 +120,10 @@ static void validate_writes_keys_consistent_with_the_lattice(void **state)
     double want = sqrt(rss / (double)m.count);
     if (!close_rel(rmse, want, 1e-9) || !close_rel(mx, emax, 1e-9))
         fail_msg("written rmse %.17g max %.17g, recomputed %.17g %.17g", rmse, mx, want, emax);
-    /* the diagonals make the lattice stiffer than one spring: the error is not the fit's */
-    assert_true(want > 0);
+    /* the calibrated lattice is close to the law but not equal to it (its diagonals rotate and
+    ** strain less than the axis): a small multiple of the fit's error, not zero */
+    if (!(want > fit_rmse && want < 6 * fit_rmse))
+        fail_msg("lattice rmse %.6g against fit rmse %.6g", want, fit_rmse);
     free(s);
     cf_table_free(&m);
     remove(json);
@@ -157,9 +165,9 @@ static void axial_only_lattice_reproduces_the_fit_error(void **state)
             json_t *v = json_object_get(f, "validation");
             double a = num_at(f, "rmse"), b = num_at(v, "rmse");
             double ma = num_at(f, "max_abs_error"), mb = num_at(v, "max_abs_error");
-            assert_string_equal(
-                json_string_value(json_object_get(json_object_get(v, "lattice"), "diagonals")),
-                "none");
+            json_t *lw = json_object_get(json_object_get(v, "lattice"), "weights");
+            assert_true(num_at(lw, "edge") == 1 && num_at(lw, "face") == 0 &&
+                        num_at(lw, "body") == 0);
             json_decref(root);
             /* 1e-9 relative, with a floor at rounding level of the table (a noiseless table is
             ** fitted to ~1e-15 of its largest stress, where a relative test means nothing) */

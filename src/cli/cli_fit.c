@@ -33,7 +33,7 @@ static const char fit_help[] =
     "  --seed S                seed of the global search (default 1); same seed, same result\n"
     "  --starts N              local starts of the global search (default 8)\n"
     "  --validate [SCENE.json] run each fitted spring in the static uniaxial lattice (the scene's\n"
-    "                          lattice, or 3x3x3 cells with face and body diagonals) at the\n"
+    "                          lattice, or 3x3x3 cells calibrated isotropic) at the\n"
     "                          table's strains and report the lattice's RMSE, R^2, max |error|\n"
     "                          in the table's stress unit (stress-strain tables only)\n"
     "  --through-msm [SCENE.json]  fit through the lattice: refine rho, s/H and F_C/H^2 so that\n"

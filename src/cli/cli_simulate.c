@@ -47,8 +47,11 @@ static void summary(const cf_scene *sc, const cf_msm_sample *s, size_t n, const 
 {
     const int timed = sc->effects.inertia || sc->effects.eta_MPa_s > 0 ||
                       sc->effects.maxwell_E_MPa > 0;
-    printf("spring: %s; lattice %d x %d x %d cells; solver: %s\n", sc->spring_source,
-           sc->cfg.lattice.nx, sc->cfg.lattice.ny, sc->cfg.lattice.nz,
+    const cf_lattice_config *lc = &sc->cfg.lattice;
+    printf("spring: %s; lattice %d x %d x %d cells, calibration %s (weights edge %.4g, face "
+           "%.4g, body %.4g); solver: %s\n",
+           sc->spring_source, lc->nx, lc->ny, lc->nz, cf_calibration_name(lc->calibration),
+           lc->weight[CF_FAMILY_EDGE], lc->weight[CF_FAMILY_FACE], lc->weight[CF_FAMILY_BODY],
            !timed ? "static equilibria"
            : sc->effects.inertia ? "explicit symplectic Euler" : "implicit quasi-static steps");
     if (sc->effects.inertia)

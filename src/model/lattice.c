@@ -12,8 +12,8 @@ cf_lattice_config cf_lattice_default(void)
 {
     cf_lattice_config c;
     c.nx = c.ny = c.nz = 3;
-    c.diagonals = CF_DIAG_FACE | CF_DIAG_BODY;
-    c.diagonal_weight = 1.0;
+    c.calibration = CF_CAL_ISOTROPIC;
+    cf_calibration_weights(c.calibration, c.weight, NULL);
     c.density_t_per_mm3 = 1e-9;
     c.bottom = CF_BOTTOM_AXIAL;
     return c;
@@ -34,6 +34,8 @@ void cf_lattice_free(cf_lattice *lat)
         *d[i] = NULL;
     }
     free(lat->fix);
+    free(lat->family);
+    lat->family = NULL;
     free(lat->si);
     free(lat->sj);
     free(lat->top);
@@ -74,12 +76,9 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
     if (!(cfg->density_t_per_mm3 > 0) || !isfinite(cfg->density_t_per_mm3))
         return cf_error_set(err, CF_E_DATA, "density_t_per_mm3 = %g: must be finite and > 0",
                             cfg->density_t_per_mm3);
-    if (!(cfg->diagonal_weight >= 0) || !isfinite(cfg->diagonal_weight))
-        return cf_error_set(err, CF_E_DATA, "lattice.diagonal_weight = %g: must be finite and >= 0",
-                            cfg->diagonal_weight);
-    if (cfg->diagonals & ~(unsigned)(CF_DIAG_FACE | CF_DIAG_BODY))
-        return cf_error_set(err, CF_E_DATA, "lattice.diagonals = %u: unknown flags",
-                            cfg->diagonals);
+    cf_status wst = cf_calibration_check(cfg->weight, err);
+    if (wst != CF_OK)
+        return wst;
     lat->cfg = *cfg;
     lat->law = law;
     lat->method = method;
@@ -98,12 +97,8 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
                 if (!pos)
                     continue;
                 int nz0 = (dx != 0) + (dy != 0) + (dz != 0);
-                if (nz0 == 2 && !(cfg->diagonals & CF_DIAG_FACE))
-                    continue;
-                if (nz0 == 3 && !(cfg->diagonals & CF_DIAG_BODY))
-                    continue;
-                if (nz0 > 1 && cfg->diagonal_weight == 0)
-                    continue;
+                if (cfg->weight[nz0 - 1] == 0)
+                    continue; /* a family of weight 0 has no springs */
                 off[noff][0] = dx;
                 off[noff][1] = dy;
                 off[noff][2] = dz;
@@ -125,12 +120,13 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
         if (!(*sd[i] = calloc(cap ? cap : 1, sizeof(double))))
             goto oom;
     lat->fix = calloc(nn, 1);
+    lat->family = calloc(cap ? cap : 1, 1);
     lat->si = calloc(cap ? cap : 1, sizeof(uint32_t));
     lat->sj = calloc(cap ? cap : 1, sizeof(uint32_t));
     size_t ntop = (size_t)(cfg->nx + 1) * (cfg->ny + 1);
     lat->top = calloc(ntop, sizeof(uint32_t));
     lat->top_share = calloc(ntop, sizeof(double));
-    if (!lat->fix || !lat->si || !lat->sj || !lat->top || !lat->top_share)
+    if (!lat->fix || !lat->family || !lat->si || !lat->sj || !lat->top || !lat->top_share)
         goto oom;
 
     const double cell_mass = cfg->density_t_per_mm3 * H * H * H;
@@ -170,7 +166,8 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
                     lat->sj[ns] = (uint32_t)(p < q ? q : p);
                     lat->L0_mm[ns] = L0;
                     lat->a[ns] = H / L0;
-                    lat->w[ns] = share * (nzc > 1 ? cfg->diagonal_weight : 1.0);
+                    lat->w[ns] = share * cfg->weight[nzc - 1];
+                    lat->family[ns] = (uint8_t)(nzc - 1);
                     degree[p]++;
                     degree[q]++;
                     ns++;

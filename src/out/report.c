@@ -100,14 +100,11 @@ static json_t *fit_json_core(const cf_fit_report *r, int i)
     return o;
 }
 
-static const char *diag_name(unsigned dg)
+/* {edge, face, body} */
+static json_t *weights_json(const double w[CF_FAMILY_COUNT])
 {
-    switch (dg & (CF_DIAG_FACE | CF_DIAG_BODY)) {
-    case CF_DIAG_FACE: return "face";
-    case CF_DIAG_BODY: return "body";
-    case CF_DIAG_FACE | CF_DIAG_BODY: return "face+body";
-    default: return "none";
-    }
+    return json_pack("{s:o, s:o, s:o}", "edge", num(w[CF_FAMILY_EDGE]), "face",
+                     num(w[CF_FAMILY_FACE]), "body", num(w[CF_FAMILY_BODY]));
 }
 
 /* validation {rmse, r2, max_abs_error (file's unit), lattice {...}, wall_time_s} or {skipped} */
@@ -118,9 +115,12 @@ static json_t *validation_json(const cf_fit_report *r, int i)
         return json_pack("{s:s}", "skipped", v->note);
     const cf_lattice_config *lc = &v->setup.cfg.lattice;
     double u = r->table->y_to_file;
-    json_t *lat = json_pack("{s:i, s:i, s:i, s:s, s:o, s:s}", "nx", lc->nx, "ny", lc->ny, "nz",
-                            lc->nz, "diagonals", diag_name(lc->diagonals), "diagonal_weight",
-                            num(lc->diagonal_weight), "bottom",
+    cf_cubic_moduli cm = cf_cubic_moduli_of(lc->weight);
+    json_t *lat = json_pack("{s:i, s:i, s:i, s:s, s:o, s:o, s:o, s:s}", "nx", lc->nx, "ny",
+                            lc->ny, "nz", lc->nz, "calibration",
+                            cf_calibration_name(lc->calibration), "weights",
+                            weights_json(lc->weight), "modulus_ratio", num(cm.E), "poisson_ratio",
+                            num(cm.nu), "bottom",
                             lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial");
     return json_pack("{s:o, s:o, s:o, s:o, s:s, s:I, s:o}", "rmse", num(v->rmse * u), "r2",
                      num(v->r2), "max_abs_error", num(v->max_abs_error * u), "lattice", lat,
@@ -309,9 +309,14 @@ static void validation_text(FILE *o, const cf_fit_report *r)
         if (r->val[i].done)
             su = &r->val[i].setup;
     const cf_lattice_config *lc = &su->cfg.lattice;
-    fprintf(o, " validation in the lattice (%d x %d x %d cells, diagonals %s, bottom %s, %s):\n",
-            lc->nx, lc->ny, lc->nz, diag_name(lc->diagonals),
-            lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial", cf_law_method_name(su->method));
+    cf_cubic_moduli cm = cf_cubic_moduli_of(lc->weight);
+    fprintf(o,
+            " validation in the lattice (%d x %d x %d cells, calibration %s: weights edge %.4g, "
+            "face %.4g, body %.4g; small-strain modulus %.4g x k0/H, nu %.3f; bottom %s, %s):\n",
+            lc->nx, lc->ny, lc->nz, cf_calibration_name(lc->calibration),
+            lc->weight[CF_FAMILY_EDGE], lc->weight[CF_FAMILY_FACE], lc->weight[CF_FAMILY_BODY],
+            cm.E, cm.nu, lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial",
+            cf_law_method_name(su->method));
     char buf[4][2][64];
     const char *t[2];
     const double u = r->table->y_to_file;

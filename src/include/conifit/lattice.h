@@ -14,11 +14,18 @@
 ** force is w times the law. So every layer of axial springs carries nx ny springs' worth of force
 ** and a lattice of axial springs alone reproduces sigma = F/H^2 of one spring exactly.
 **
+** Spring families. The springs of each family (edges, face diagonals, body diagonals) carry the
+** law times the family's weight (calibration.h): the default calibration makes the lattice
+** isotropic at small strain (nu = 1/4) with the law's modulus k0/H. A family of weight 0 has no
+** springs at all. Dashpots and Maxwell branches (msm.h) are scaled by the same weights, so the
+** viscous response is calibrated with the elastic one.
+**
 ** Diagonal springs use the same law in strain form: a diagonal of rest length L0 (sqrt 2 H or
-** sqrt 3 H) is evaluated at the compression u = (L0 - L) H/L0 and carries w * diagonal_weight
-** times that force. It is therefore the fitted material, stretched to the diagonal's length: it
-** reaches solid at the same strain as the edges (L_min = L0 L_min(H)/H, L_max = L0 L_max(H)/H,
-** paper eqs. 18-21 scaled), and one law object (one table) serves every spring.
+** sqrt 3 H) is evaluated at the compression u = (L0 - L) H/L0 and carries its cell shares times
+** its family weight times that force. It is therefore the fitted material, stretched to the
+** diagonal's length: it reaches solid at the same strain as the edges (L_min = L0 L_min(H)/H,
+** L_max = L0 L_max(H)/H, paper eqs. 18-21 scaled), and one law object (one table) serves every
+** spring.
 */
 #ifndef CF_LATTICE_H
 #define CF_LATTICE_H
@@ -26,11 +33,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "conifit/calibration.h"
 #include "conifit/error.h"
 #include "conifit/law.h"
-
-/* Which diagonals the lattice has (bit flags). */
-enum { CF_DIAG_NONE = 0, CF_DIAG_FACE = 1, CF_DIAG_BODY = 2 };
 
 typedef enum cf_bottom_bc {
     CF_BOTTOM_AXIAL = 0,  /* bottom nodes held in z, free to slide laterally (lubricated platen) */
@@ -39,13 +44,14 @@ typedef enum cf_bottom_bc {
 
 typedef struct cf_lattice_config {
     int nx, ny, nz;           /* cells along x, y and z (z = loading axis), each >= 1 */
-    unsigned diagonals;       /* CF_DIAG_FACE | CF_DIAG_BODY, or CF_DIAG_NONE */
-    double diagonal_weight;   /* force factor of the diagonal springs, dimensionless, >= 0 */
+    double weight[CF_FAMILY_COUNT]; /* force factor of each family (CF_FAMILY_EDGE, _FACE,
+                              ** _BODY), dimensionless, >= 0; 0 = the family is absent */
+    cf_calibration calibration; /* where the weights came from (reported with them) */
     double density_t_per_mm3; /* mass density, tonne/mm^3 (1e-9 = 1000 kg/m^3), > 0 */
     cf_bottom_bc bottom;      /* bottom-face boundary condition */
 } cf_lattice_config;
 
-/* 3 x 3 x 3 cells, face and body diagonals of weight 1, density 1e-9 t/mm^3, bottom axial. */
+/* 3 x 3 x 3 cells, the isotropic calibration, density 1e-9 t/mm^3, bottom axial. */
 cf_lattice_config cf_lattice_default(void);
 
 /* DOF fixity bits per node. */
@@ -71,7 +77,8 @@ typedef struct cf_lattice {
     uint32_t *si, *sj;      /* end nodes, si < sj */
     double *L0_mm;          /* rest length, mm */
     double *a;              /* H / L0: converts length change to the law's compression, - */
-    double *w;              /* force weight (cell shares x diagonal_weight), - */
+    double *w;              /* force weight (cell shares x family weight), - */
+    uint8_t *family;        /* CF_FAMILY_* of each spring */
     double *L_mm;           /* current length (kernel output), mm */
     double *u_mm;           /* law compression (L0 - L) a (kernel output), mm */
     double *F_N;            /* law force at u (kernel output), N, compression positive */

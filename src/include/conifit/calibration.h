@@ -1,0 +1,74 @@
+/*
+** Calibration of the cubic mass-spring lattice: how much of the fitted law each spring family
+** carries, so that the lattice as a material behaves like the tissue the law was fitted to.
+**
+** A cubic cell of edge H holds, per cell, one spring along each of the 3 edge directions, one
+** along each of the 6 face-diagonal directions and one along each of the 4 body diagonals. Every
+** family evaluates the same law in strain form (a spring of rest length L0 at the compression
+** u = (L0 - L) H / L0) and carries it times its family weight w. The axial stiffness dF/dL of a
+** spring at small strain is therefore k_e = w_e k0 (edge), k_f = w_f k0 / sqrt 2 (face diagonal)
+** and k_b = w_b k0 / sqrt 3 (body diagonal), k0 the law's linear stiffness.
+**
+** Affine (Cauchy-Born) homogenisation of the cell gives the small-strain elastic constants
+**     C11 = (k_e + 2 k_f + 4 k_b / 3) / H,    C12 = C44 = (k_f + 4 k_b / 3) / H
+** (C12 = C44 is the Cauchy relation of central springs). The lattice is isotropic when
+** C11 - C12 = 2 C44, i.e. k_e = k_f + 8 k_b / 3, and then nu = 1/4 whatever the weights: the
+** best a lattice of central springs can do (Kot et al. 2015; Golec et al. 2020). Its Young's
+** modulus along a cube axis is E = (C11 - C12)(C11 + 2 C12) / (C11 + C12).
+**
+** Calibrations:
+**   isotropic  face and body weights equal, k_e = k_f + 8 k_b / 3 (isotropic, nu = 1/4), scaled
+**              so that E = k0 / H, the law's own small-strain modulus: about 0.6085 for the
+**              edges and 0.2708 for each diagonal. The default.
+**   axial      every family the same weight (the shape of the uncalibrated lattice), scaled so
+**              that E = k0 / H along the axes; nu = 0.317 and the lattice is anisotropic.
+**   fitted     weights found by a fit through the lattice (a joint fit of several test modes);
+**              they cannot be derived here.
+**   custom     weights given by hand.
+** References: San-Vicente, Aguinaga & Celiguieta 2012; Lloyd, Szekely & Harders 2007; Baudet et
+** al. 2009; Kot et al. 2015; Golec et al. 2020.
+*/
+#ifndef CF_CALIBRATION_H
+#define CF_CALIBRATION_H
+
+#include "conifit/error.h"
+
+/* The spring families of the cubic cell, as indices of a weight[3] array. */
+enum { CF_FAMILY_EDGE = 0, CF_FAMILY_FACE = 1, CF_FAMILY_BODY = 2, CF_FAMILY_COUNT = 3 };
+
+typedef enum cf_calibration {
+    CF_CAL_ISOTROPIC = 0,
+    CF_CAL_AXIAL = 1,
+    CF_CAL_FITTED = 2,
+    CF_CAL_CUSTOM = 3
+} cf_calibration;
+
+/* Small-strain elastic constants of the cubic lattice, in units of the law's k0 / H (so E = 1
+** means the lattice's modulus along an axis equals the single spring's). */
+typedef struct cf_cubic_moduli {
+    double C11, C12, C44; /* cubic elastic constants, k0/H */
+    double E;             /* Young's modulus along a cube axis, k0/H */
+    double nu;            /* Poisson's ratio for a load along a cube axis, - */
+    double zener;         /* anisotropy ratio 2 C44 / (C11 - C12); 1 when isotropic, - */
+} cf_cubic_moduli;
+
+/* The moduli of a lattice with family weights w (each finite and >= 0). */
+cf_cubic_moduli cf_cubic_moduli_of(const double w[CF_FAMILY_COUNT]);
+
+/* The family weights of calibration c (isotropic or axial, derived from the formulas above).
+** CF_E_DATA for fitted or custom, which carry their own weights. */
+cf_status cf_calibration_weights(cf_calibration c, double w[CF_FAMILY_COUNT], cf_error *err);
+
+/* Checks family weights: each finite and >= 0, and a lattice that carries load along every axis
+** (the edges or the diagonals not all zero). CF_E_DATA naming the family and value. */
+cf_status cf_calibration_check(const double w[CF_FAMILY_COUNT], cf_error *err);
+
+/* "isotropic", "axial", "fitted", "custom"; and the parser of the first three (the names a scene
+** may give). */
+const char *cf_calibration_name(cf_calibration c);
+cf_status cf_calibration_parse(const char *name, cf_calibration *c, cf_error *err);
+
+/* "edge", "face", "body". */
+const char *cf_family_name(int family);
+
+#endif
