@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include <jansson.h>
 
@@ -29,9 +30,19 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
     if (!f)
         return cf_error_set(err, CF_E_NOINPUT, "%s: cannot open fit file: %s", path,
                             strerror(errno));
+    struct stat fs;
+    if (fstat(fileno(f), &fs) == 0 && S_ISDIR(fs.st_mode)) {
+        fclose(f);
+        return cf_error_set(err, CF_E_NOINPUT, "%s: cannot read fit file: it is a folder", path);
+    }
     json_error_t jerr;
+    errno = 0;
     json_t *root = json_loadf(f, JSON_REJECT_DUPLICATES, &jerr);
+    int unreadable = ferror(f), e = errno;
     fclose(f);
+    if (!root && unreadable) /* a read error, not bad JSON */
+        return cf_error_set(err, CF_E_NOINPUT, "%s: cannot read fit file: %s", path,
+                            strerror(e ? e : EIO));
     if (!root)
         return cf_error_set(err, CF_E_DATA, "%s:%d:%d: not a valid fit file: %s", path, jerr.line,
                             jerr.column, jerr.text);

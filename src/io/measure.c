@@ -15,8 +15,6 @@
 #include <string.h>
 #include <strings.h>
 
-/* Largest file read (a measured table is far smaller; this only bounds the memory taken). */
-#define MAX_FILE_BYTES ((size_t)1 << 30)
 /* Longest column name kept (longer names are an error: they are not column names). */
 #define NAME_CAP 256
 
@@ -485,25 +483,32 @@ static const unit_def *wanted_unit(const char *u, const cf_unit_class *want, siz
 
 /* Looks in one comment for the column name as a word followed, in the same clause (up to ',' or
 ** ';' or an unmatched closing bracket), by a bracketed unit of a wanted class:
-** "stress = nominal stress [kPa]", "displacement [mm]". */
+** "stress = nominal stress [kPa]", "displacement [mm]". Linear in the comment's length: a scan
+** that fails resumes where it stopped (a later mention of the name in the same clause would see
+** only part of what this one saw), and a bracket is searched for its closing one no further than
+** the longest unit name. */
 static const unit_def *comment_unit_after_name(const char *s, size_t n, const char *name,
                                                const cf_unit_class *want, size_t nwant)
 {
     size_t len = strlen(name);
     if (len == 0)
         return NULL;
-    for (size_t i = 0; i + len <= n; i++) {
-        if (strncasecmp(s + i, name, len) != 0)
+    size_t i = 0;
+    while (i + len <= n) {
+        if ((i > 0 && word_char(s[i - 1])) || strncasecmp(s + i, name, len) != 0 ||
+            (i + len < n && word_char(s[i + len]))) {
+            i++;
             continue;
-        if ((i > 0 && word_char(s[i - 1])) || (i + len < n && word_char(s[i + len])))
-            continue;
-        for (size_t j = i + len; j < n; j++) {
+        }
+        size_t j = i + len;
+        for (; j < n; j++) {
             char c = s[j];
             if (c == ',' || c == ';' || c == ')' || c == ']')
                 break;
             if (c == '[' || c == '(') {
                 char close = c == '[' ? ']' : ')';
-                const char *e = memchr(s + j + 1, close, n - j - 1);
+                size_t room = n - j - 1 < NAME_CAP ? n - j - 1 : NAME_CAP;
+                const char *e = memchr(s + j + 1, close, room);
                 if (!e)
                     break;
                 char u[NAME_CAP];
@@ -514,6 +519,7 @@ static const unit_def *comment_unit_after_name(const char *s, size_t n, const ch
                 j = (size_t)(e - s);
             }
         }
+        i = j > i ? j : i + 1;
     }
     return NULL;
 }
@@ -618,19 +624,21 @@ static cf_status read_all(reader *r, cf_error *err)
         return out_of_memory(err, r->path);
     }
     for (;;) {
+        if (r->size > CF_MEASURE_MAX_BYTES) {
+            fclose(fp);
+            return cf_error_set(err, CF_E_DATA, "%s:1:1: file larger than %zu bytes (256 MiB): not "
+                                "a measured table", r->path, CF_MEASURE_MAX_BYTES);
+        }
         if (r->size == cap) {
-            if (cap >= MAX_FILE_BYTES) {
-                fclose(fp);
-                return cf_error_set(err, CF_E_DATA, "%s:1:1: file larger than %zu bytes: not a "
-                                    "measured table", r->path, MAX_FILE_BYTES);
-            }
-            char *t = realloc(r->text, 2 * cap);
+            /* one byte past the limit is enough to tell a file that is too large */
+            size_t ncap = 2 * cap < CF_MEASURE_MAX_BYTES + 1 ? 2 * cap : CF_MEASURE_MAX_BYTES + 1;
+            char *t = realloc(r->text, ncap);
             if (!t) {
                 fclose(fp);
                 return out_of_memory(err, r->path);
             }
             r->text = t;
-            cap *= 2;
+            cap = ncap;
         }
         size_t got = fread(r->text + r->size, 1, cap - r->size, fp);
         r->size += got;
@@ -659,6 +667,10 @@ static cf_status cut_lines(reader *r, cf_error *err)
         size_t n = (size_t)(e - s);
         if (n > 0 && s[n - 1] == '\r')
             n--;
+        if (r->nlines == CF_MEASURE_MAX_LINES)
+            return cf_error_set(err, CF_E_DATA, "%s:%zu:1: more than %d lines: not a measured "
+                                "table (at most %d data rows)", r->path, line,
+                                CF_MEASURE_MAX_LINES, CF_MEASURE_MAX_ROWS);
         if (r->nlines == cap) {
             cap = cap ? 2 * cap : 256;
             line_span *l = realloc(r->lines, cap * sizeof *l);
@@ -890,6 +902,12 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
         trailing = 1; /* the header ends with a delimiter: so must every row */
         ncols--;
     }
+    if (ncols > CF_MEASURE_MAX_COLUMNS) {
+        st = data_error(err, path, header_line, CF_MEASURE_MAX_COLUMNS + 1,
+                        "the header has %zu columns; a table may have at most %d ('%s')", ncols,
+                        CF_MEASURE_MAX_COLUMNS, hq);
+        goto fail;
+    }
     r.cols = calloc(ncols, sizeof *r.cols);
     if (!r.cols) {
         st = out_of_memory(err, path);
@@ -1120,6 +1138,12 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
         if (!isfinite(x) || !isfinite(y) || !isfinite(t)) {
             st = data_error(err, path, l->line, (size_t)xi + 1,
                             "value out of range after unit conversion ('%s')", q);
+            goto fail;
+        }
+        if (r.count == CF_MEASURE_MAX_ROWS) {
+            st = data_error(err, path, l->line, 1,
+                            "more than %d data rows: a table may have at most %d (thin it, or "
+                            "fit a part of it)", CF_MEASURE_MAX_ROWS, CF_MEASURE_MAX_ROWS);
             goto fail;
         }
         if (push_row(&r, x, y, v[2], t) != 0) {

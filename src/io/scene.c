@@ -9,6 +9,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include <jansson.h>
 
@@ -531,9 +532,19 @@ cf_status cf_scene_load(const char *path, cf_scene *sc, cf_error *err)
     if (!f)
         return cf_error_set(err, CF_E_NOINPUT, "%s: cannot open scene: %s", path,
                             strerror(errno));
+    struct stat fs;
+    if (fstat(fileno(f), &fs) == 0 && S_ISDIR(fs.st_mode)) {
+        fclose(f);
+        return cf_error_set(err, CF_E_NOINPUT, "%s: cannot read scene: it is a folder", path);
+    }
     json_error_t jerr;
+    errno = 0;
     json_t *root = json_loadf(f, JSON_REJECT_DUPLICATES, &jerr);
+    int unreadable = ferror(f), e = errno;
     fclose(f);
+    if (!root && unreadable) /* a read error, not bad JSON */
+        return cf_error_set(err, CF_E_NOINPUT, "%s: cannot read scene: %s", path,
+                            strerror(e ? e : EIO));
     return finish(&c, root, &jerr, sc);
 }
 

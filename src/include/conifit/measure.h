@@ -42,6 +42,13 @@ cf_measure_options cf_measure_default_options(void);
 /* Fewest data rows a table must have (six design parameters). */
 #define CF_MEASURE_MIN_ROWS 6
 
+/* Limits of a table: beyond them it is refused with a message naming the line (CF_E_DATA), so that
+** the memory and time a table takes are bounded by these and not only by what a file holds. */
+#define CF_MEASURE_MAX_ROWS 1000000           /* data rows */
+#define CF_MEASURE_MAX_COLUMNS 1000           /* columns of the header */
+#define CF_MEASURE_MAX_LINES 2000000          /* lines in all: rows, comments, blank lines */
+#define CF_MEASURE_MAX_BYTES ((size_t)256 << 20) /* file size, 256 MiB */
+
 /* What a unit measures. */
 typedef enum cf_unit_class {
     CF_UNIT_UNKNOWN = 0,
