@@ -14,7 +14,7 @@ CC      ?= cc
 PKGS    := nlopt gsl jansson
 TESTPKGS := cmocka
 DEBS    := build-essential pkg-config libnlopt-dev libgsl-dev libcmocka-dev libjansson-dev \
-           gnuplot-nox calculix-ccx
+           libsuitesparse-dev libopenblas0-serial gnuplot-nox calculix-ccx
 BUILD   ?= build
 
 WARN    := -Wall -Wextra -Wpedantic -Wshadow -Wmissing-prototypes -Wstrict-prototypes
@@ -23,8 +23,12 @@ WARN    += -Werror
 endif
 OPT     ?= -O2 -g -fno-math-errno
 CPPFLAGS += -D_DEFAULT_SOURCE -Isrc/include -Isrc
-CFLAGS  += -std=c17 $(OPT) $(WARN) $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
-LDLIBS  += $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lm -lpthread
+# SuiteSparse CHOLMOD (sparse Cholesky of the lattice tangent): newer releases ship CHOLMOD.pc;
+# Debian 12's libsuitesparse-dev has none and keeps its headers in include/suitesparse.
+SPARSE_CFLAGS := $(shell pkg-config --cflags CHOLMOD 2>/dev/null || echo -I/usr/include/suitesparse)
+SPARSE_LIBS   := $(shell pkg-config --libs CHOLMOD 2>/dev/null || echo -lcholmod)
+CFLAGS  += -std=c17 $(OPT) $(WARN) $(shell pkg-config --cflags $(PKGS) 2>/dev/null) $(SPARSE_CFLAGS)
+LDLIBS  += $(shell pkg-config --libs $(PKGS) 2>/dev/null) $(SPARSE_LIBS) -lm -lpthread
 
 ifeq ($(SANITIZE),1)
 BUILD   := build/asan
@@ -49,6 +53,7 @@ all: check-deps $(BUILD)/conifit
 # Fails with the exact install command when a package is missing.
 check-deps:
 	@missing=""; for p in $(PKGS) $(TESTPKGS); do pkg-config --exists $$p 2>/dev/null || missing="$$missing $$p"; done; \
+	printf '#include <cholmod.h>\n' | $(CC) $(SPARSE_CFLAGS) -E - >/dev/null 2>&1 || missing="$$missing cholmod"; \
 	if [ -n "$$missing" ]; then \
 	  echo "conifit: missing libraries:$$missing. Install them with:" >&2; \
 	  echo "  apt-get update && apt-get install -y $(DEBS)   (or: make deps, as root)" >&2; exit 1; fi

@@ -397,6 +397,61 @@ static void lattice_masses_and_top_shares_add_up(void **state)
     cf_lattice_free(&lat);
 }
 
+/* The static solver reports the inertia of its tangents: none negative while the compressed
+** lattice is stable, negative pivots once a column of cells can buckle sideways (deep compression
+** of the default lattice, where every family carries the full law); explicit dynamics factors
+** nothing and says so. */
+static void tangent_inertia_marks_the_loss_of_stability(void **state)
+{
+    (void)state;
+    cf_law law = make_law();
+    cf_msm_config cfg = small_config(3, 3, 3, CF_DIAG_FACE | CF_DIAG_BODY);
+    cf_lattice lat;
+    cf_error err = {0};
+    assert_int_equal(cf_lattice_create(&lat, &law, CF_LAW_CLOSED, &cfg.lattice, &err), CF_OK);
+    double t[2] = {0, 1}, v[2] = {0, 0.48};
+    cf_msm_path path = {CF_DRIVE_DISPLACEMENT, 2, t, v};
+    enum { N = 24 };
+    double ts[N];
+    cf_msm_sample out[N];
+    for (int i = 0; i < N; i++)
+        ts[i] = (i + 1) / (double)N;
+    size_t done = 0;
+    cf_msm_stats st;
+    if (cf_msm_run(&lat, NULL, &cfg, &path, ts, N, out, &done, &st, &err) != CF_OK)
+        fail_msg("static ramp: %s", err.msg);
+    assert_int_equal(done, N);
+    long first_unstable = -1;
+    for (int i = 0; i < N; i++) {
+        assert_true(out[i].neg_pivots >= 0);
+        if (out[i].strain <= 0.3)
+            assert_int_equal(out[i].neg_pivots, 0);
+        if (out[i].neg_pivots > 0 && first_unstable < 0)
+            first_unstable = i;
+        if (first_unstable >= 0) /* once unstable, deeper compression stays unstable */
+            assert_true(out[i].neg_pivots > 0);
+    }
+    assert_true(first_unstable > 0);
+    assert_true(out[N - 1].neg_pivots > 0);
+    assert_true(st.indefinite_tangents > 0);
+    assert_true(st.neg_pivots_max >= out[N - 1].neg_pivots);
+    cf_lattice_free(&lat);
+
+    /* explicit dynamics: no tangent, inertia unknown */
+    assert_int_equal(cf_lattice_create(&lat, &law, CF_LAW_CLOSED, &cfg.lattice, &err), CF_OK);
+    cf_msm_effects fx = {0};
+    fx.inertia = 1;
+    fx.eta_MPa_s = 1e-4;
+    double v2[2] = {0, 0.01};
+    cf_msm_path p2 = {CF_DRIVE_DISPLACEMENT, 2, t, v2};
+    double ts2[1] = {0.01};
+    cf_msm_sample o2[1];
+    if (cf_msm_run(&lat, &fx, &cfg, &p2, ts2, 1, o2, &done, &st, &err) != CF_OK)
+        fail_msg("dynamic run: %s", err.msg);
+    assert_int_equal(o2[0].neg_pivots, -1);
+    cf_lattice_free(&lat);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -411,6 +466,7 @@ int main(void)
         cmocka_unit_test(creep_strain_rises_monotonically_toward_static_value),
         cmocka_unit_test(hysteresis_area_is_positive_and_vanishes_as_rate_goes_to_zero),
         cmocka_unit_test(unstable_time_step_is_refused),
+        cmocka_unit_test(tangent_inertia_marks_the_loss_of_stability),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

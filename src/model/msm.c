@@ -4,6 +4,7 @@
 ** validation curve.
 */
 #include "conifit/msm.h"
+#include "model/sparse_chol.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -22,9 +23,10 @@
 #define GMRES_TOL 1e-13
 #define GMRES_MAX_RESTARTS 200
 #define GMRES_ACCEPT 1e-6
-/* Linear solves: banded LDL^T first (accepted when its relative residual is below BAND_ACCEPT,
-** and when the band fits in BAND_MAX_ENTRIES doubles), else dense LU up to DENSE_MAX_DOF free
-** DOFs (a 7x7x7 lattice has ~1500), else GMRES. */
+/* Linear solves: sparse Cholesky (CHOLMOD, L D L^T when the tangent is indefinite) first, accepted
+** when its relative residual is below BAND_ACCEPT; if it fails, banded LDL^T (when the band fits
+** in BAND_MAX_ENTRIES doubles), else dense LU up to DENSE_MAX_DOF free DOFs (a 7x7x7 lattice has
+** ~1500), else GMRES. */
 #define BAND_ACCEPT 1e-10
 #define BAND_MAX_ENTRIES 5e7
 #define DENSE_MAX_DOF 1200
@@ -67,6 +69,9 @@ typedef struct solver {
     int *map, *diag;          /* spring block -> C->data index; DOF -> its diagonal index */
     size_t band;              /* half-bandwidth of C (largest |row - col|) */
     gsl_matrix *AB;           /* banded LDL^T workspace, ndof x (band + 1); NULL until used */
+    cf_sparse_chol *chol;     /* sparse factorisation of C (pattern analysed once); NULL until used */
+    int chol_failed;          /* 1: the sparse factorisation could not be set up; not retried */
+    long neg_pivots;          /* negative pivots of the last factored tangent, -1 unknown */
     double load;              /* current drive value: strain or stress, MPa */
     int extras;               /* quasi-static extras active */
     cf_msm_stats *st;
@@ -90,6 +95,7 @@ static void solver_free(solver *s)
         gsl_spmatrix_free(s->C);
     if (s->AB)
         gsl_matrix_free(s->AB);
+    cf_sparse_chol_free(s->chol);
 }
 
 static int is_prescribed(const solver *s, size_t node, int axis)
@@ -112,6 +118,9 @@ static cf_status solver_init(solver *s, cf_lattice *lat, const cf_msm_effects *f
     s->cfg = cfg;
     s->drive = drive;
     s->st = st;
+    s->neg_pivots = -1;
+    if (st)
+        st->neg_pivots_max = -1;
     s->eq = malloc(3 * lat->nn * sizeof(long));
     s->xsave = malloc(3 * lat->nn * sizeof(double));
     s->tmp = calloc(lat->ns ? lat->ns : 1, sizeof(double));
@@ -282,6 +291,79 @@ static cf_status build_pattern(solver *s, cf_error *err)
     return CF_OK;
 }
 
+/* Adds the inertia of the tangent just solved (s->neg_pivots, -1 unknown) to the statistics. */
+static void note_inertia(solver *s)
+{
+    const long neg = s->neg_pivots;
+    if (!s->st || neg < 0)
+        return;
+    if (neg > 0)
+        s->st->indefinite_tangents++;
+    if (neg > s->st->neg_pivots_max)
+        s->st->neg_pivots_max = neg;
+}
+
+/* Sparse Cholesky of the scaled tangent (sparse_chol.h): the pattern is analysed once with a
+** fill-reducing ordering, so a factorisation costs far less than the band's n b^2 on lattices of
+** more than a few cells a side, and an indefinite tangent is factored as L D L^T with its negative
+** pivots counted. Accepted when the residual is small. Returns 1 when s->dx holds the update;
+** sets *fatal for an out-of-memory that no fallback would survive. */
+static int chol_direction(solver *s, int *fatal, cf_error *err)
+{
+    const size_t n = s->ndof;
+    gsl_spmatrix *C = s->C;
+    *fatal = 0;
+    if (s->chol_failed || n == 0)
+        return 0;
+    cf_error lerr = {0};
+    if (!s->chol && cf_sparse_chol_create(&s->chol, n, C->p, C->i, &lerr) != CF_OK) {
+        s->chol_failed = 1;
+        return 0;
+    }
+    cf_chol_info info;
+    cf_status st = cf_sparse_chol_factor(s->chol, C->data, &info, &lerr);
+    if (st == CF_E_INTERNAL) {
+        *fatal = 1;
+        cf_error_set(err, CF_E_INTERNAL, "%s", lerr.msg);
+        return 0;
+    }
+    if (st != CF_OK)
+        return 0;
+    double *rhs = malloc(2 * n * sizeof(double));
+    if (!rhs) {
+        *fatal = 1;
+        cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent solve");
+        return 0;
+    }
+    double *xv = rhs + n;
+    for (size_t e = 0; e < n; e++)
+        rhs[e] = s->R[e] / s->D[e];
+    int ok = cf_sparse_chol_solve(s->chol, rhs, xv, &lerr) == CF_OK;
+    if (ok) { /* residual check: || rhs - C x || against || rhs || */
+        gsl_vector_view xw = gsl_vector_view_array(xv, n);
+        gsl_vector *r = gsl_vector_alloc(n);
+        ok = r != NULL;
+        if (ok) {
+            for (size_t e = 0; e < n; e++)
+                gsl_vector_set(r, e, rhs[e]);
+            gsl_vector_const_view bw = gsl_vector_const_view_array(rhs, n);
+            ok = gsl_spblas_dgemv(CblasNoTrans, -1.0, C, &xw.vector, 1.0, r) == GSL_SUCCESS &&
+                 gsl_blas_dnrm2(r) <= BAND_ACCEPT * gsl_blas_dnrm2(&bw.vector);
+            gsl_vector_free(r);
+        }
+    }
+    for (size_t e = 0; ok && e < n; e++) {
+        double v = xv[e] / s->D[e];
+        ok = isfinite(v);
+        s->dx[e] = v;
+    }
+    free(rhs);
+    s->neg_pivots = info.neg_pivots; /* the inertia holds even when the solve is refused */
+    if (ok && s->st)
+        s->st->linear_iters++;
+    return ok;
+}
+
 /* The scaled tangent is symmetric and, with the nodes numbered layer by layer, banded (half-
 ** bandwidth about 3 (nx + 1)(ny + 1)): a banded LDL^T (GSL) costs n b^2 instead of n^3/3. It does
 ** not pivot, so the solve is accepted only when its residual is small; otherwise the caller falls
@@ -309,6 +391,9 @@ static int band_direction(solver *s)
         ok = gsl_linalg_ldlt_band_decomp(s->AB) == GSL_SUCCESS &&
              gsl_linalg_ldlt_band_solve(s->AB, rhs, xv) == GSL_SUCCESS;
     }
+    long neg = 0; /* the inertia from D, the first column of the decomposed band */
+    for (size_t e = 0; ok && e < n; e++)
+        neg += gsl_matrix_get(s->AB, e, 0) < 0;
     if (ok) { /* residual check: r = rhs - C x */
         gsl_vector_memcpy(r, rhs);
         ok = gsl_spblas_dgemv(CblasNoTrans, -1.0, C, xv, 1.0, r) == GSL_SUCCESS &&
@@ -319,8 +404,11 @@ static int band_direction(solver *s)
         ok = isfinite(v);
         s->dx[e] = v;
     }
-    if (ok && s->st)
-        s->st->linear_iters++;
+    if (ok) {
+        s->neg_pivots = neg;
+        if (s->st)
+            s->st->linear_iters++;
+    }
     gsl_vector_free(rhs);
     gsl_vector_free(xv);
     gsl_vector_free(r);
@@ -372,9 +460,10 @@ done:
     return st;
 }
 
-/* Assembles the tangent K = -dR/dx at the state of the last residual(), solves K dx = R (dense LU
-** for small systems, otherwise GMRES) with symmetric Jacobi scaling. */
-static cf_status newton_direction(solver *s, cf_error *err)
+/* Assembles the tangent K = -dR/dx at the state of the last residual(), solves K dx = R (sparse
+** Cholesky, else banded LDL^T, dense LU for small systems, GMRES) with symmetric Jacobi scaling
+** (a congruence: the inertia is that of K). */
+static cf_status tangent_solve(solver *s, cf_error *err)
 {
     cf_lattice *lat = s->lat;
     const size_t n = s->ndof;
@@ -414,6 +503,12 @@ static cf_status newton_direction(solver *s, cf_error *err)
     for (size_t col = 0; col < n; col++)
         for (int k = C->p[col]; k < C->p[col + 1]; k++)
             C->data[k] /= s->D[C->i[k]] * s->D[col];
+    int fatal = 0;
+    s->neg_pivots = -1;
+    if (chol_direction(s, &fatal, err))
+        return CF_OK;
+    if (fatal)
+        return CF_E_INTERNAL;
     if (band_direction(s))
         return CF_OK;
     if (n <= DENSE_MAX_DOF)
@@ -451,6 +546,13 @@ done:
     gsl_splinalg_itersolve_free(w);
     gsl_vector_free(b);
     gsl_vector_free(xv);
+    return st;
+}
+
+static cf_status newton_direction(solver *s, cf_error *err)
+{
+    cf_status st = tangent_solve(s, err);
+    note_inertia(s);
     return st;
 }
 
@@ -926,6 +1028,7 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
             }
         }
         out[k].kinetic_mJ = fx->inertia ? kinetic(lat, &d) : 0.0;
+        out[k].neg_pivots = fx->inertia ? -1 : s.neg_pivots;
         if (!isfinite(out[k].strain) || !isfinite(out[k].stress_MPa) ||
             !isfinite(out[k].kinetic_mJ)) {
             rc = cf_error_set(err, CF_E_INTERNAL,

@@ -74,7 +74,11 @@ cf_msm_config cf_msm_default(void);
 typedef struct cf_msm_stats {
     size_t solves;             /* static / quasi-static Newton solves */
     size_t newton_iters;       /* Newton iterations in all */
-    size_t linear_iters;       /* linear solves: banded or dense factorisations plus GMRES cycles */
+    size_t linear_iters;       /* linear solves: sparse, banded or dense factorisations plus
+                                  GMRES cycles */
+    size_t indefinite_tangents;/* factored tangents with negative pivots (unstable states) */
+    long neg_pivots_max;       /* most negative pivots of any factored tangent (0: every tangent
+                                  was positive definite); -1 if none had a known inertia */
     size_t steps;              /* time steps taken */
     double dt_used_min_s;      /* smallest step used, s (0 for static runs) */
     double dt_stable_s;        /* stable explicit step at the start, s (0 if not explicit) */
@@ -89,6 +93,10 @@ typedef struct cf_msm_sample {
     double strain;             /* compressive nominal strain of the top face, - */
     double stress_MPa;         /* compressive nominal stress: top reaction / (nx ny H^2), MPa */
     double kinetic_mJ;         /* kinetic energy, mJ = N mm (0 without inertia) */
+    long neg_pivots;           /* negative pivots (negative eigenvalues) of the tangent factored in
+                                  the last Newton iteration of this sample's solve: 0 a stable
+                                  equilibrium, > 0 an unstable one; -1 unknown (explicit dynamics,
+                                  or a solve that needed no factorisation and none came before) */
 } cf_msm_sample;
 
 /* Runs the lattice along a path; fills out[k] for k < path sample count. Status CF_E_NOCONV when

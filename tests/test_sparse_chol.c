@@ -1,0 +1,188 @@
+/*
+** Tests of the sparse factorisation with inertia (src/model/sparse_chol.c): the negative pivots of
+** shifted Laplacians against their known eigenvalues (a small one, factored simplicially, and a
+** 3-D one large enough for supernodes), the solution against the matrix, and a singular matrix.
+*/
+#include "testutil.h"
+
+#include "model/sparse_chol.h"
+
+/* A symmetric matrix in compressed columns with both triangles stored and the rows of every
+** column in descending order (CHOLMOD must not rely on sorted input). */
+typedef struct csc {
+    size_t n;
+    int *p, *i;
+    double *x;
+} csc;
+
+static void csc_free(csc *a)
+{
+    free(a->p);
+    free(a->i);
+    free(a->x);
+}
+
+/* The 7-point Laplacian of an N1 x N2 x N3 grid with Dirichlet ends, minus sigma I (N2 = N3 = 1
+** gives the 1-D tridiagonal one). */
+static csc laplacian(int N1, int N2, int N3, double sigma)
+{
+    csc a;
+    a.n = (size_t)N1 * N2 * N3;
+    a.p = calloc(a.n + 1, sizeof(int));
+    a.i = calloc(7 * a.n, sizeof(int));
+    a.x = calloc(7 * a.n, sizeof(double));
+    assert_non_null(a.p);
+    assert_non_null(a.i);
+    assert_non_null(a.x);
+    int k = 0;
+    for (int c = 0; c < N3; c++)
+        for (int b = 0; b < N2; b++)
+            for (int q = 0; q < N1; q++) {
+                int col = q + N1 * (b + N2 * c);
+                a.p[col] = k;
+                /* neighbours in descending order of index */
+                const int nb[6][3] = {{0, 0, 1}, {0, 1, 0}, {1, 0, 0},
+                                      {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
+                const double diag = 2.0 * (1 + (N2 > 1) + (N3 > 1)) - sigma;
+                for (int m = 0; m < 3; m++) {
+                    int q2 = q + nb[m][0], b2 = b + nb[m][1], c2 = c + nb[m][2];
+                    if (q2 < N1 && b2 < N2 && c2 < N3) {
+                        a.i[k] = q2 + N1 * (b2 + N2 * c2);
+                        a.x[k++] = -1.0;
+                    }
+                }
+                a.i[k] = col;
+                a.x[k++] = diag;
+                for (int m = 3; m < 6; m++) {
+                    int q2 = q + nb[m][0], b2 = b + nb[m][1], c2 = c + nb[m][2];
+                    if (q2 >= 0 && b2 >= 0 && c2 >= 0) {
+                        a.i[k] = q2 + N1 * (b2 + N2 * c2);
+                        a.x[k++] = -1.0;
+                    }
+                }
+            }
+    a.p[a.n] = k;
+    return a;
+}
+
+/* Eigenvalues of the Dirichlet Laplacian below sigma: sums of 2 - 2 cos(m pi/(N + 1)). */
+static long count_below(int N1, int N2, int N3, double sigma)
+{
+    long count = 0;
+    for (int i = 1; i <= N1; i++)
+        for (int j = 1; j <= (N2 > 1 ? N2 : 1); j++)
+            for (int l = 1; l <= (N3 > 1 ? N3 : 1); l++) {
+                double lam = 2 - 2 * cos(i * M_PI / (N1 + 1));
+                if (N2 > 1)
+                    lam += 2 - 2 * cos(j * M_PI / (N2 + 1));
+                if (N3 > 1)
+                    lam += 2 - 2 * cos(l * M_PI / (N3 + 1));
+                assert_true(fabs(lam - sigma) > 1e-7); /* the shift is not an eigenvalue */
+                count += lam < sigma;
+            }
+    return count;
+}
+
+/* Largest |A x - b| over |b| for the full symmetric matrix a. */
+static double residual(const csc *a, const double *x, const double *b)
+{
+    double *r = calloc(a->n, sizeof(double));
+    assert_non_null(r);
+    for (size_t c = 0; c < a->n; c++)
+        for (int k = a->p[c]; k < a->p[c + 1]; k++)
+            r[a->i[k]] += a->x[k] * x[c];
+    double worst = 0, bmax = 0;
+    for (size_t e = 0; e < a->n; e++) {
+        worst = fmax(worst, fabs(r[e] - b[e]));
+        bmax = fmax(bmax, fabs(b[e]));
+    }
+    free(r);
+    return worst / bmax;
+}
+
+static void check_inertia_and_solve(int N1, int N2, int N3, double sigma, int expect_ldlt)
+{
+    csc a = laplacian(N1, N2, N3, sigma);
+    cf_sparse_chol *ch = NULL;
+    cf_error err = {0};
+    assert_int_equal(cf_sparse_chol_create(&ch, a.n, a.p, a.i, &err), CF_OK);
+    cf_chol_info info;
+    cf_status st = cf_sparse_chol_factor(ch, a.x, &info, &err);
+    if (st != CF_OK)
+        fail_msg("factor %dx%dx%d sigma %g: %s", N1, N2, N3, sigma, err.msg);
+    long expect = count_below(N1, N2, N3, sigma);
+    if (info.neg_pivots != expect)
+        fail_msg("%dx%dx%d, sigma %g: %ld negative pivots, %ld eigenvalues below sigma", N1, N2,
+                 N3, sigma, info.neg_pivots, expect);
+    if (expect_ldlt >= 0)
+        assert_int_equal(info.ldlt, expect_ldlt);
+    assert_true(info.fill >= 1.0);
+    double *b = malloc(a.n * sizeof(double)), *x = malloc(a.n * sizeof(double));
+    assert_non_null(b);
+    assert_non_null(x);
+    for (size_t e = 0; e < a.n; e++)
+        b[e] = sin(0.37 * (double)e) + 0.5;
+    assert_int_equal(cf_sparse_chol_solve(ch, b, x, &err), CF_OK);
+    double r = residual(&a, x, b);
+    if (!(r < 1e-9))
+        fail_msg("%dx%dx%d sigma %g: relative residual %.3g", N1, N2, N3, sigma, r);
+    assert_true(cf_sparse_chol_peak_bytes(ch) > 0);
+    free(b);
+    free(x);
+    cf_sparse_chol_free(ch);
+    csc_free(&a);
+}
+
+static void positive_definite_matrix_has_no_negative_pivots(void **state)
+{
+    (void)state;
+    check_inertia_and_solve(200, 1, 1, 0.0, -1);
+    check_inertia_and_solve(20, 20, 20, 0.0, 0); /* supernodal LL^T */
+}
+
+static void shifted_laplacian_counts_its_eigenvalues_below_the_shift(void **state)
+{
+    (void)state;
+    /* shifts that fall between eigenvalues (none within 1e-6 of one) */
+    const double s1[] = {0.5, 1.3, 2.9, 3.7};
+    for (size_t k = 0; k < sizeof s1 / sizeof s1[0]; k++)
+        check_inertia_and_solve(200, 1, 1, s1[k], -1);
+    const double s3[] = {0.61, 2.05, 5.5, 9.1};
+    for (size_t k = 0; k < sizeof s3 / sizeof s3[0]; k++)
+        check_inertia_and_solve(20, 20, 20, s3[k], 1);
+}
+
+static void zero_pivot_is_reported_as_singular(void **state)
+{
+    (void)state;
+    /* diag(1, 2, 0, 3) */
+    int p[5] = {0, 1, 2, 3, 4}, i[4] = {0, 1, 2, 3};
+    double x[4] = {1, 2, 0, 3};
+    cf_sparse_chol *ch = NULL;
+    cf_error err = {0};
+    assert_int_equal(cf_sparse_chol_create(&ch, 4, p, i, &err), CF_OK);
+    cf_chol_info info;
+    assert_int_equal(cf_sparse_chol_factor(ch, x, &info, &err), CF_E_NOCONV);
+    assert_int_equal(info.singular, 1);
+    assert_int_equal(info.neg_pivots, -1);
+    assert_non_null(strstr(err.msg, "singular"));
+    double b[4] = {1, 1, 1, 1}, sol[4];
+    assert_int_equal(cf_sparse_chol_solve(ch, b, sol, &err), CF_E_INTERNAL);
+    /* the same object factors a regular matrix afterwards */
+    x[2] = -4;
+    assert_int_equal(cf_sparse_chol_factor(ch, x, &info, &err), CF_OK);
+    assert_int_equal(info.neg_pivots, 1);
+    assert_int_equal(cf_sparse_chol_solve(ch, b, sol, &err), CF_OK);
+    assert_close(sol[2], -0.25, 1e-15);
+    cf_sparse_chol_free(ch);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(positive_definite_matrix_has_no_negative_pivots),
+        cmocka_unit_test(shifted_laplacian_counts_its_eigenvalues_below_the_shift),
+        cmocka_unit_test(zero_pivot_is_reported_as_singular),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
