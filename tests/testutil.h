@@ -73,6 +73,16 @@ static inline int tu_run(char *out, size_t out_cap, char *errbuf, size_t err_cap
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+/* The twelve published tables of ../shared/datasets, by file name. */
+static const char *const tu_published_tables[] = {
+    "brain_coronaradiata_compression.csv", "brain_coronaradiata_tension.csv",
+    "brain_cortex_compression.csv",        "brain_cortex_shear.csv",
+    "brain_cortex_tension.csv",            "heart_myocardium_biaxial_1to1_fiber.csv",
+    "heart_myocardium_shear_fs.csv",       "muscle_compression_relaxation_crossfiber30.csv",
+    "muscle_compression_relaxation_fiber30.csv", "skin_porcine_stripbiaxial_x.csv",
+    "thrombus_pureshear_force_displacement.csv", "treloar1944_rubber_uniaxial.csv"};
+#define TU_PUBLISHED_COUNT (sizeof tu_published_tables / sizeof tu_published_tables[0])
+
 /* The folder of published tables, or NULL when it is absent (tests that need it then skip). */
 static inline const char *tu_datasets(void)
 {

@@ -28,6 +28,10 @@ static const char fit_help[] =
     "  --type T                telescoping | non-telescoping | both (default both)\n"
     "  --fix NAME=VALUE        hold a parameter: D1, D2, d, H in mm, G in MPa, n (repeatable)\n"
     "  --index-max C           largest spring index D1/d (default 12; the smallest is 3)\n"
+    "  --rho-min R             smallest diameter ratio D1/D2 (default 0.05)\n"
+    "  --n-max N               most active coils (default 30; the fewest is 2)\n"
+    "  --D2-max-H R            largest outer diameter in free lengths, D2/H (default 10)\n"
+    "  --G-max G               stiffest wire, shear modulus in MPa (default 80000, steel)\n"
     "  --relative              residuals relative to |stress| instead of absolute\n"
     "  --optimizer NAME        slsqp (default) | cobyla | mma: the constrained local optimiser\n"
     "  --seed S                seed of the global search (default 1); same seed, same result\n"
@@ -121,6 +125,44 @@ static int validate_option(int argc, char **argv, int *i, const char *name, fit_
     return 1;
 }
 
+/* The flag that widens a limit, by constraint bit. */
+static const char *limit_flag(unsigned bit)
+{
+    switch (bit) {
+    case CF_C_INDEX_MAX: return "--index-max";
+    case CF_C_RHO_MIN: return "--rho-min";
+    case CF_C_COILS_MAX: return "--n-max";
+    case CF_C_G_MAX: return "--G-max";
+    case CF_C_D2_H: return "--D2-max-H";
+    case CF_C_TRAVEL: return "nothing: no spring reaches the largest strain (a solid strain is "
+                             "below 1)";
+    case CF_C_TYPE: return "--rho-min, --index-max, --D2-max-H (a telescoping spring needs "
+                           "rho <= index_max/(index_max + 4))";
+    }
+    return "--fix";
+}
+
+/* Named warnings on stderr: a family that cannot be placed inside the limits, a law that goes
+** solid close past the data. */
+static void fit_warnings(const char *file, const cf_fit_report *r, const cf_fit_result *f)
+{
+    const char *type = cf_spring_type_name(f->type);
+    for (int b = 0; b < CF_C_COUNT; b++) {
+        unsigned bit = 1u << b;
+        if (f->violated & bit)
+            fprintf(stderr,
+                    "conifit: warning: %s: no %s spring of this table meets the limit %s "
+                    "(feasible: false); to widen it: %s\n",
+                    file, type, cf_fit_constraint_name(bit), limit_flag(bit));
+    }
+    if (f->feasible && f->solid_ratio < CF_FIT_SOLID_RATIO_WARN)
+        fprintf(stderr,
+                "conifit: warning: %s: the %s law goes solid at %s %.4g, %.3g times the table's "
+                "largest (below %.1f): it stiffens without bound just past the data\n",
+                file, type, cf_table_is_force(r->table) ? "displacement [mm]" : "strain", f->ident[1],
+                f->solid_ratio, CF_FIT_SOLID_RATIO_WARN);
+}
+
 static int parse_args(int argc, char **argv, fit_args *a)
 {
     static const char *cmd = "fit";
@@ -190,6 +232,30 @@ static int parse_args(int argc, char **argv, fit_args *a)
             if (a->popt.fit.index_max < 3)
                 return cf_cli_usage_error(cmd, "--index-max %g: must be at least 3",
                                           a->popt.fit.index_max);
+        } else if (OPT("--rho-min")) {
+            if (m < 0 || cf_cli_parse_double("--rho-min", v, &a->popt.fit.rho_min, &err))
+                BAD();
+            if (!(a->popt.fit.rho_min > 0 && a->popt.fit.rho_min < 1))
+                return cf_cli_usage_error(cmd, "--rho-min %g: a diameter ratio D1/D2 lies in (0, 1)",
+                                          a->popt.fit.rho_min);
+        } else if (OPT("--n-max")) {
+            if (m < 0 || cf_cli_parse_double("--n-max", v, &a->popt.fit.upper[CF_P_N], &err))
+                BAD();
+            if (!(a->popt.fit.upper[CF_P_N] >= 2))
+                return cf_cli_usage_error(cmd, "--n-max %g: a conical spring needs n >= 2",
+                                          a->popt.fit.upper[CF_P_N]);
+        } else if (OPT("--D2-max-H")) {
+            if (m < 0 || cf_cli_parse_double("--D2-max-H", v, &a->popt.fit.D2_over_H_max, &err))
+                BAD();
+            if (!(a->popt.fit.D2_over_H_max > 0))
+                return cf_cli_usage_error(cmd, "--D2-max-H %g: must be positive",
+                                          a->popt.fit.D2_over_H_max);
+        } else if (OPT("--G-max")) {
+            if (m < 0 || cf_cli_parse_double("--G-max", v, &a->popt.fit.upper[CF_P_G], &err))
+                BAD();
+            if (!(a->popt.fit.upper[CF_P_G] > a->popt.fit.lower[CF_P_G]))
+                return cf_cli_usage_error(cmd, "--G-max %g MPa: must be positive",
+                                          a->popt.fit.upper[CF_P_G]);
         } else if (strcmp(argv[i], "--relative") == 0) {
             a->popt.fit.relative = 1;
         } else if (OPT("--optimizer")) {
@@ -425,15 +491,7 @@ int cf_cli_fit(int argc, char **argv)
                     fputc('\n', stdout);
             }
             for (int k = 0; k < j->rep.nfits; k++)
-                if (!j->rep.fits[k].feasible)
-                    fprintf(stderr,
-                            "conifit: warning: %s: the %s fit violates its constraints "
-                            "(see 'feasible'); %s\n",
-                            j->file, cf_spring_type_name(j->rep.fits[k].type),
-                            (j->rep.fits[k].violated & CF_C_TRAVEL)
-                                ? "no spring reaches the largest strain of this table "
-                                  "(a solid strain is below 1)"
-                                : "loosen --fix or --index-max");
+                fit_warnings(j->file, &j->rep, &j->rep.fits[k]);
         }
         if (failed && (a.out || a.plot))
             fprintf(stderr, "conifit: no output file written (outputs are written only when "
@@ -475,7 +533,7 @@ int cf_cli_fit(int argc, char **argv)
                 printf("  %-*s %-18s %-18s %-22s %-16s%s\n", wname, j->file, cell[0], cell[1],
                        bcell,
                        b < 0                          ? "none feasible"
-                       : cf_report_types_tie(&j->rep) ? "equal"
+                       : cf_report_types_tie(&j->rep) ? "tie"
                                                       : cf_spring_type_name(j->rep.fits[b].type),
                        vcell);
             }

@@ -13,6 +13,8 @@
 #include <time.h>
 
 #include <gsl/gsl_blas.h>
+#include <gsl/gsl_cdf.h>
+#include <gsl/gsl_eigen.h>
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_multifit_nlinear.h>
 #include <gsl/gsl_vector.h>
@@ -60,6 +62,10 @@ const char *cf_fit_constraint_name(unsigned bit)
     case CF_C_TRAVEL: return "travel";
     case CF_C_TYPE: return "type";
     case CF_C_BOUNDS: return "bounds";
+    case CF_C_RHO_MIN: return "rho_min";
+    case CF_C_COILS_MAX: return "coils_max";
+    case CF_C_G_MAX: return "G_max";
+    case CF_C_D2_H: return "D2_max_H";
     }
     return "?";
 }
@@ -74,6 +80,10 @@ cf_fit_options cf_fit_default_options(void)
         o.lower[k] = cf_spring_param_info(k)->lower;
         o.upper[k] = cf_spring_param_info(k)->upper;
     }
+    o.upper[CF_P_N] = CF_FIT_COILS_MAX_DEFAULT;
+    o.upper[CF_P_G] = CF_FIT_G_MAX_DEFAULT;
+    o.rho_min = CF_FIT_RHO_MIN_DEFAULT;
+    o.D2_over_H_max = CF_FIT_D2_OVER_H_MAX_DEFAULT;
     o.index_max = CF_FIT_INDEX_MAX_DEFAULT;
     o.optimizer = CF_OPT_SLSQP;
     o.xtol_rel = 1e-12;
@@ -175,6 +185,8 @@ typedef struct fit_ctx {
     double xmax;    /* largest |x|: strain [-] or displacement [mm] */
     double ynorm;   /* sum of (sw_i y_i)^2: objective of the zero model */
     int travel_ok;  /* 0 when no spring can reach xmax (strain >= 1) */
+    int region;     /* 1: the type's placeable set of (rho, B, A) is known in closed form
+                    ** (stress-strain table, no fixed parameter; see region_at) */
     /* stage A bounds on (rho, length scale) */
     double rho_lo, rho_hi, b_lo, b_hi;
     long evals;
@@ -461,17 +473,24 @@ static double stage_a(fit_ctx *c, double best3[3])
 }
 
 /* Standard errors of (rho, B, A) at a solution: s^2 (J^T J)^-1 with the analytic Jacobian of the
-** weighted residuals (canon_eval). */
-static void stage_a_errors(fit_ctx *c, const double v[3], double se[3])
+** weighted residuals (canon_eval); the correlation matrix (NAN where not determined). Returns 1
+** when J^T J is numerically singular (then the errors stay -1). */
+static int stage_a_errors(fit_ctx *c, const double v[3], double se[3], double corr[3][3])
 {
     se[0] = se[1] = se[2] = -1;
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            corr[a][b] = NAN;
     const double rho = v[0], B = v[1], A = v[2];
     cf_law lc;
     if (canon_law(rho, &lc) != CF_OK || c->n <= 3)
-        return;
-    gsl_matrix *JtJ = gsl_matrix_calloc(3, 3);
-    if (!JtJ)
-        return;
+        return 0;
+    gsl_matrix *JtJ = gsl_matrix_calloc(3, 3), *E = gsl_matrix_alloc(3, 3);
+    gsl_vector *ev = gsl_vector_alloc(3);
+    gsl_eigen_symm_workspace *ew = gsl_eigen_symm_alloc(3);
+    int rank_def = 0;
+    if (!JtJ || !E || !ev || !ew)
+        goto done;
     double rss = 0;
     for (size_t i = 0; i < c->n; i++) {
         double x = c->data->x[i], gt, gr;
@@ -487,37 +506,68 @@ static void stage_a_errors(fit_ctx *c, const double v[3], double se[3])
     c->evals += 3;
     /* scale to unit diagonal before inverting (the columns differ by orders of magnitude) */
     double dsc[3];
-    int ok = 1;
     for (int a = 0; a < 3; a++) {
         dsc[a] = sqrt(gsl_matrix_get(JtJ, a, a));
-        ok = ok && dsc[a] > 0 && isfinite(dsc[a]);
-    }
-    if (ok) {
-        for (int a = 0; a < 3; a++)
-            for (int b = 0; b < 3; b++)
-                *gsl_matrix_ptr(JtJ, a, b) /= dsc[a] * dsc[b];
-        if (gsl_linalg_cholesky_decomp1(JtJ) == GSL_SUCCESS &&
-            gsl_linalg_cholesky_invert(JtJ) == GSL_SUCCESS) {
-            double s2 = rss / (double)(c->n - 3);
-            for (int a = 0; a < 3; a++) {
-                double var = s2 * gsl_matrix_get(JtJ, a, a) / (dsc[a] * dsc[a]);
-                se[a] = (var >= 0 && isfinite(var)) ? sqrt(var) : -1;
-            }
+        if (!(dsc[a] > 0 && isfinite(dsc[a]))) {
+            rank_def = 1;
+            goto done;
         }
     }
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            *gsl_matrix_ptr(JtJ, a, b) /= dsc[a] * dsc[b];
+    gsl_matrix_memcpy(E, JtJ);
+    if (gsl_eigen_symm(E, ev, ew) != GSL_SUCCESS) {
+        rank_def = 1;
+        goto done;
+    }
+    double emin = gsl_vector_min(ev), emax = gsl_vector_max(ev);
+    if (!(emin > 1e-10 * emax)) {
+        rank_def = 1;
+        goto done;
+    }
+    if (gsl_linalg_cholesky_decomp1(JtJ) == GSL_SUCCESS &&
+        gsl_linalg_cholesky_invert(JtJ) == GSL_SUCCESS) {
+        double s2 = rss / (double)(c->n - 3);
+        for (int a = 0; a < 3; a++) {
+            double var = s2 * gsl_matrix_get(JtJ, a, a) / (dsc[a] * dsc[a]);
+            se[a] = (var >= 0 && isfinite(var)) ? sqrt(var) : -1;
+        }
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++) {
+                double q = gsl_matrix_get(JtJ, a, b) /
+                           sqrt(gsl_matrix_get(JtJ, a, a) * gsl_matrix_get(JtJ, b, b));
+                corr[a][b] = isfinite(q) ? fmax(-1.0, fmin(1.0, q)) : NAN;
+            }
+    } else {
+        rank_def = 1;
+    }
+done:
+    gsl_eigen_symm_free(ew);
+    gsl_vector_free(ev);
+    gsl_matrix_free(E);
     gsl_matrix_free(JtJ);
+    return rank_def;
 }
 
 /* ---- constraints (shared by stages B, C and the check) --------------------------------------- */
 
-/* Constraint values g_k <= 0 when satisfied, in log (relative) units, for the bits in order
-** index_min, index_max, coils, diameters, travel, type. */
+/* Number of inequality constraints of the design, and the CF_C_* bit of each. */
+#define NCON 8
+/* rho_min is met within this relative tolerance, so that a table made from a spring at exactly
+** rho_min is fitted to rounding (its optimum then lies inside stage A's range, not on its edge). */
+#define RHO_MIN_TOL 1e-6
+static const unsigned con_bit[NCON] = {CF_C_INDEX_MIN, CF_C_INDEX_MAX, CF_C_COILS, CF_C_DIAMETERS,
+                                       CF_C_TRAVEL,    CF_C_TYPE,      CF_C_RHO_MIN, CF_C_D2_H};
+#define CON_TRAVEL 4
+
+/* Constraint values g_k <= 0 when satisfied, in log (relative) units, in the order of con_bit. */
 static void constraint_values(const double *p, cf_spring_type type, double xmax, int fd,
-                              double index_max, double g[6])
+                              const cf_fit_options *opt, double g[NCON])
 {
     double c = p[CF_P_D1] / p[CF_P_D];
     g[0] = log(3.0) - log(c);
-    g[1] = log(c) - log(index_max);
+    g[1] = log(c) - log(opt->index_max);
     g[2] = log(2.0) - log(p[CF_P_N]);
     g[3] = log(p[CF_P_D1]) - log(p[CF_P_D2]);
     double s = p[CF_P_H] - lmin_of(p, type);
@@ -525,7 +575,9 @@ static void constraint_values(const double *p, cf_spring_type type, double xmax,
     g[4] = s > 0 ? log(umax) - log(s) : 50.0;
     double step = (p[CF_P_D2] - p[CF_P_D1]) / 2, nd = p[CF_P_N] * p[CF_P_D];
     g[5] = type == CF_TELESCOPING ? (nd - step) / p[CF_P_D2] : (step - nd) / p[CF_P_D2] + 1e-12;
-    for (int k = 0; k < 6; k++)
+    g[6] = log(opt->rho_min * (1 - RHO_MIN_TOL)) - log(p[CF_P_D1] / p[CF_P_D2]);
+    g[7] = log(p[CF_P_D2]) - log(opt->D2_over_H_max * p[CF_P_H]);
+    for (int k = 0; k < NCON; k++)
         if (!isfinite(g[k]))
             g[k] = 50.0;
 }
@@ -533,15 +585,15 @@ static void constraint_values(const double *p, cf_spring_type type, double xmax,
 int cf_fit_check(const cf_spring *sp, cf_spring_type type, const cf_table *data,
                  const cf_fit_options *opt, unsigned *active, unsigned *violated)
 {
-    double p[CF_P_COUNT], g[6];
+    double p[CF_P_COUNT], g[NCON];
     to_array(sp, p);
     unsigned act = 0, vio = 0;
-    constraint_values(p, type, cf_lsq_xmax(data), cf_table_is_force(data), opt->index_max, g);
-    for (int k = 0; k < 6; k++) {
+    constraint_values(p, type, cf_lsq_xmax(data), cf_table_is_force(data), opt, g);
+    for (int k = 0; k < NCON; k++) {
         if (g[k] > FEAS_TOL)
-            vio |= 1u << k;
+            vio |= con_bit[k];
         if (g[k] > -ACTIVE_TOL)
-            act |= 1u << k;
+            act |= con_bit[k];
     }
     /* the geometry must be of the type fitted, judged by the law itself */
     cf_law law;
@@ -553,10 +605,16 @@ int cf_fit_check(const cf_spring *sp, cf_spring_type type, const cf_table *data,
                 vio |= CF_C_BOUNDS;
             continue;
         }
-        if (p[k] < opt->lower[k] * (1 - 1e-12) || p[k] > opt->upper[k] * (1 + 1e-12))
+        /* the upper bounds of n and G are named; the other bounds are the wide defaults */
+        unsigned ub = k == CF_P_N ? CF_C_COILS_MAX : k == CF_P_G ? CF_C_G_MAX : CF_C_BOUNDS;
+        if (p[k] < opt->lower[k] * (1 - 1e-12))
             vio |= CF_C_BOUNDS;
-        if (p[k] <= opt->lower[k] * (1 + ACTIVE_TOL) || p[k] >= opt->upper[k] * (1 - ACTIVE_TOL))
-            act |= CF_C_BOUNDS;
+        if (p[k] > opt->upper[k] * (1 + 1e-12))
+            vio |= ub;
+        if (p[k] <= opt->lower[k] * (1 + ACTIVE_TOL))
+            act |= k == CF_P_N ? CF_C_COILS : CF_C_BOUNDS;
+        if (p[k] >= opt->upper[k] * (1 - ACTIVE_TOL))
+            act |= ub;
     }
     if (active)
         *active = act;
@@ -618,9 +676,9 @@ static double z_objective(fit_ctx *c, const double *z, int which)
 
 static double z_constraint(fit_ctx *c, const double *z, int which)
 {
-    double p[CF_P_COUNT], g[6];
+    double p[CF_P_COUNT], g[NCON];
     full_params(c, z, p);
-    constraint_values(p, c->type, c->xmax, c->fd, c->opt->index_max, g);
+    constraint_values(p, c->type, c->xmax, c->fd, c->opt, g);
     return g[which] + SAFETY;
 }
 
@@ -690,11 +748,11 @@ static void nl_run(fit_ctx *c, nlopt_algorithm alg, zfun obj, int equalities, do
     }
     nlopt_set_lower_bounds(o, lb);
     nlopt_set_upper_bounds(o, ub);
-    nl_thunk to = {c, obj, 0}, tc[6], te[3];
+    nl_thunk to = {c, obj, 0}, tc[NCON], te[3];
     nlopt_set_min_objective(o, nl_func, &to);
-    for (int k = 0; k < 6; k++) {
+    for (int k = 0; k < NCON; k++) {
         tc[k] = (nl_thunk){c, z_constraint, k};
-        if (k == 4 && !c->travel_ok)
+        if (k == CON_TRAVEL && !c->travel_ok)
             continue;
         nlopt_add_inequality_constraint(o, nl_func, &tc[k], 0.0);
     }
@@ -780,6 +838,446 @@ static void snap_to_family(fit_ctx *c, double *p, double *z)
         z[k] = log(p[c->free_idx[k]]);
 }
 
+/* ---- the type's limits in the space of the identifiable quantities --------------------------- */
+
+/* For a stress-strain table with no fixed parameter the design limits reduce to closed-form
+** limits on (rho, B = s/H, A = F_C/H^2), because H is a pure scale. With c = D1/d:
+**   non-telescoping (d = (1 - B) H/n): G = 8 n^2 c^3 A/(B (1 - B)), D2/H = c (1 - B)/(n rho),
+**     type n > c (1 - rho)/(2 rho): every limit is easiest at c = 3, so the family can be placed
+**     iff n_lo = max(n_min, 3 (1 - rho)/(2 rho), 3 (1 - B)/(D2max rho)) <= n_max, and then carries
+**     at most A_max = G_max B (1 - B)/(8 * 27 n_lo^2);
+**   telescoping (d = (1 - B) H): G = 8 n c^3 A/(B (1 - B)), D2/H = c (1 - B)/rho, type
+**     n <= c (1 - rho)/(2 rho): easiest at n = n_min, so iff
+**     c_lo = max(3, 2 n_min rho/(1 - rho)) <= c_hi = min(index_max, D2max rho/(1 - B)), and then
+**     A_max = G_max B (1 - B)/(8 n_min c_lo^3).
+** margin <= 0 where the family can be placed (log units); lo_bit/hi_bit name the two limits that
+** meet at the edge. REGION_SAFETY keeps solutions that far inside, so that placement finds them. */
+#define REGION_SAFETY 1e-4
+
+typedef struct region {
+    double margin;
+    double A_max;
+    unsigned lo_bit, hi_bit;
+} region;
+
+static region region_at(const fit_ctx *c, double rho, double B)
+{
+    region r = {-1.0, INFINITY, 0, 0};
+    if (!c->region)
+        return r;
+    if (!(rho > 0 && rho < 1 && B > 0 && B < 1)) {
+        r.margin = 50;
+        return r;
+    }
+    const cf_fit_options *o = c->opt;
+    const double nmin = o->lower[CF_P_N], nmax = o->upper[CF_P_N], Gmax = o->upper[CF_P_G];
+    const double Dr = o->D2_over_H_max, cmin = 3.0, cmax = o->index_max;
+    if (c->type == CF_TELESCOPING) {
+        double c_type = 2 * nmin * rho / (1 - rho), c_D = Dr * rho / (1 - B);
+        double c_lo = fmax(cmin, c_type), c_hi = fmin(cmax, c_D);
+        r.lo_bit = c_type > cmin ? CF_C_TYPE : CF_C_INDEX_MIN;
+        r.hi_bit = c_D < cmax ? CF_C_D2_H : CF_C_INDEX_MAX;
+        r.margin = log(c_lo) - log(c_hi);
+        r.A_max = Gmax * B * (1 - B) / (8 * nmin * c_lo * c_lo * c_lo);
+    } else {
+        double n_type = cmin * (1 - rho) / (2 * rho) * (1 + 1e-6);
+        double n_D = cmin * (1 - B) / (Dr * rho);
+        double n_lo = fmax(nmin, fmax(n_type, n_D));
+        r.lo_bit = n_lo == nmin ? CF_C_COILS : n_lo == n_type ? CF_C_TYPE : CF_C_D2_H;
+        r.hi_bit = CF_C_COILS_MAX;
+        r.margin = log(n_lo) - log(nmax);
+        r.A_max = Gmax * B * (1 - B) / (8 * cmin * cmin * cmin * n_lo * n_lo);
+    }
+    r.A_max *= 1 - REGION_SAFETY;
+    double m_rho = log(o->rho_min * (1 - RHO_MIN_TOL)) - log(rho);
+    if (m_rho > r.margin) {
+        r.margin = m_rho;
+        r.lo_bit = CF_C_RHO_MIN;
+        r.hi_bit = 0;
+    }
+    if (!isfinite(r.margin))
+        r.margin = 50;
+    return r;
+}
+
+/* Weighted residual sum of squares of the reduced model at (rho, B) with the load scale A fixed
+** (A_fixed > 0) or solved in closed form and clamped to (0, A_max]; *A_out the scale used.
+** The sum is formed from the residuals themselves, not from the expanded square, so that it
+** stays exact on noiseless tables. */
+static double rss_at(fit_ctx *c, double rho, double B, double A_fixed, double A_max,
+                     double *A_out)
+{
+    cf_law canon;
+    *A_out = A_fixed;
+    if (!(B > 0) || canon_law(rho, &canon) != CF_OK)
+        return CF_LSQ_HUGE_OBJ;
+    double sgy = 0, sgg = 0;
+    for (size_t i = 0; i < c->n; i++) {
+        double g = c->sw[i] * reduced(&canon, 1.0, B, c->data->x[i], NULL);
+        c->model[i] = g;
+        sgy += g * c->sw[i] * c->data->y[i];
+        sgg += g * g;
+    }
+    double A = A_fixed;
+    if (!(A > 0)) {
+        A = sgg > 0 ? sgy / sgg : 0;
+        if (!(A > 0) || !isfinite(A))
+            A = 1e-300;
+        A = fmin(A, A_max);
+    }
+    double rss = 0;
+    for (size_t i = 0; i < c->n; i++) {
+        double r = A * c->model[i] - c->sw[i] * c->data->y[i];
+        rss += r * r;
+    }
+    c->evals++;
+    *A_out = A;
+    return isfinite(rss) ? rss : CF_LSQ_HUGE_OBJ;
+}
+
+/* A sub-problem over (log rho, B) with one quantity held (fixed = 0 rho, 1 B, 2 A; -1 none) and
+** the type's limits as constraints: the constrained fit (fixed = -1) and the profiles. */
+typedef struct sub {
+    fit_ctx *c;
+    int fixed;
+    double t;
+} sub;
+
+static void sub_point(const sub *q, const double *x, double *rho, double *B)
+{
+    int j = 0;
+    *rho = q->fixed == 0 ? q->t : exp(x[j++]);
+    *B = q->fixed == 1 ? q->t : x[j];
+}
+
+static double sub_f0(const sub *q, const double *x)
+{
+    double rho, B, A;
+    sub_point(q, x, &rho, &B);
+    region r = region_at(q->c, rho, B);
+    return rss_at(q->c, rho, B, q->fixed == 2 ? q->t : -1, r.A_max, &A);
+}
+
+static double sub_g0(const sub *q, const double *x);
+
+/* Central differences for the gradient-based optimiser (SLSQP). */
+static void sub_grad(const sub *q, double (*f)(const sub *, const double *), unsigned n,
+                     const double *x, double *grad)
+{
+    double xx[2];
+    memcpy(xx, x, sizeof(double) * n);
+    for (unsigned k = 0; k < n; k++) {
+        double h = 1e-7 * fmax(1.0, fabs(x[k]));
+        xx[k] = x[k] + h;
+        double fp = f(q, xx);
+        xx[k] = x[k] - h;
+        double fm = f(q, xx);
+        xx[k] = x[k];
+        grad[k] = (fp - fm) / (2 * h);
+    }
+}
+
+static double sub_f(unsigned n, const double *x, double *grad, void *data)
+{
+    const sub *q = data;
+    if (grad)
+        sub_grad(q, sub_f0, n, x, grad);
+    return sub_f0(q, x);
+}
+
+static double sub_g(unsigned n, const double *x, double *grad, void *data)
+{
+    const sub *q = data;
+    if (grad)
+        sub_grad(q, sub_g0, n, x, grad);
+    return sub_g0(q, x);
+}
+
+static double sub_g0(const sub *q, const double *x)
+{
+    double rho, B;
+    sub_point(q, x, &rho, &B);
+    region r = region_at(q->c, rho, B);
+    double g = r.margin + REGION_SAFETY;
+    if (q->fixed == 2 && isfinite(r.A_max))
+        g = fmax(g, log(q->t) - log(r.A_max));
+    return g;
+}
+
+/* Minimises the sub-problem from x (in/out); returns its RSS, CF_LSQ_HUGE_OBJ when no point meets the
+** limits. */
+static double sub_solve(fit_ctx *c, sub *q, double *x, nlopt_algorithm alg)
+{
+    unsigned nv = q->fixed < 0 ? 2u : q->fixed == 2 ? 2u : 1u;
+    double lb[2], ub[2];
+    unsigned j = 0;
+    if (q->fixed != 0) {
+        lb[j] = log(c->rho_lo);
+        ub[j] = log(c->rho_hi * (1 - 1e-12));
+        j++;
+    }
+    if (q->fixed != 1) {
+        lb[j] = c->b_lo;
+        ub[j] = c->b_hi;
+    }
+    for (unsigned k = 0; k < nv; k++)
+        x[k] = fmin(fmax(x[k], lb[k]), ub[k]);
+    nlopt_opt o = nlopt_create(alg, nv);
+    if (!o)
+        return CF_LSQ_HUGE_OBJ;
+    nlopt_set_lower_bounds(o, lb);
+    nlopt_set_upper_bounds(o, ub);
+    nlopt_set_min_objective(o, sub_f, q);
+    if (c->region)
+        nlopt_add_inequality_constraint(o, sub_g, q, 0.0);
+    nlopt_set_xtol_rel(o, 1e-9);
+    nlopt_set_maxeval(o, 300);
+    double f = CF_LSQ_HUGE_OBJ;
+    nlopt_result r = nlopt_optimize(o, x, &f);
+    nlopt_destroy(o);
+    if (r < 0 && r != NLOPT_ROUNDOFF_LIMITED)
+        f = sub_f0(q, x);
+    if (c->region && sub_g0(q, x) > 1e-9)
+        return CF_LSQ_HUGE_OBJ;
+    return f;
+}
+
+/* Stage A under the type's limits: used when the optimum over every spring lies outside them.
+** Seeded grid over (rho, B) as in stage_a, feasible points only, then COBYLA from the best. */
+static int stage_a_constrained(fit_ctx *c, double v[3])
+{
+    uint64_t rng = (uint64_t)c->opt->seed * 0x2545F4914F6CDD1Dull + 3;
+    start grid[GRID * GRID];
+    size_t k = 0;
+    sub q = {c, -1, 0};
+    for (int i = 0; i < GRID; i++) {
+        double ti = (i + rng_uniform(&rng)) / GRID;
+        double rho = c->rho_lo * pow(c->rho_hi / c->rho_lo, ti);
+        for (int j = 0; j < GRID; j++) {
+            double tj = (j + rng_uniform(&rng)) / GRID;
+            double B = c->b_lo + (c->b_hi - c->b_lo) * tj;
+            double x[2] = {log(rho), B};
+            if (sub_g0(&q, x) > 0)
+                continue;
+            grid[k].obj = sub_f0(&q, x);
+            grid[k].rho = rho;
+            grid[k].B = B;
+            k++;
+        }
+    }
+    if (k == 0)
+        return 0;
+    qsort(grid, k, sizeof grid[0], cmp_start);
+    double best = CF_LSQ_HUGE_OBJ, bx[2] = {0, 0};
+    for (size_t i = 0; i < k && (int)i < c->opt->multistart; i++) {
+        double x[2] = {log(grid[i].rho), grid[i].B};
+        double f = sub_solve(c, &q, x, NLOPT_LN_COBYLA);
+        double f2 = sub_solve(c, &q, x, NLOPT_LD_SLSQP);
+        f = fmin(f, f2);
+        if (f < best) {
+            best = f;
+            memcpy(bx, x, sizeof bx);
+        }
+    }
+    if (!(best < CF_LSQ_HUGE_OBJ))
+        return 0;
+    v[0] = exp(bx[0]);
+    v[1] = bx[1];
+    region r = region_at(c, v[0], v[1]);
+    rss_at(c, v[0], v[1], -1, r.A_max, &v[2]);
+    return 1;
+}
+
+/* Limits the quantities v sit on (CF_C_* bits): rho_min, the travel, the type's limits. */
+static unsigned held_at(const fit_ctx *c, const double v[3])
+{
+    unsigned h = 0;
+    if (v[0] <= fmax(c->rho_lo, c->opt->rho_min) * (1 + 1e-3))
+        h |= c->opt->rho_min > CF_LSQ_RHO_LO ? CF_C_RHO_MIN : CF_C_BOUNDS;
+    if (c->travel_ok && v[1] <= c->b_lo * (1 + 1e-5))
+        h |= CF_C_TRAVEL;
+    if (c->region) {
+        region r = region_at(c, v[0], v[1]);
+        if (r.margin > -10 * REGION_SAFETY)
+            h |= r.lo_bit | r.hi_bit;
+        if (v[2] >= r.A_max * (1 - 10 * REGION_SAFETY))
+            h |= CF_C_G_MAX;
+    } else if (c->rho_hi < 1 && v[0] >= c->rho_hi * (1 - 1e-4)) {
+        h |= CF_C_TYPE;
+    }
+    return h;
+}
+
+/* A member of the family v that meets every limit, for the placement to start from (stress-strain
+** tables without fixed parameters): the corner the limits leave open, then a grid over the spring
+** index and the coil count for the point closest to the preferred design. 0 when none is found. */
+static int region_member(fit_ctx *c, const double v[3], double *p)
+{
+    const double rho = v[0], B = v[1], H = c->opt->H_preferred_mm;
+    const double nmin = c->opt->lower[CF_P_N], nmax = c->opt->upper[CF_P_N];
+    const double cmax = c->opt->index_max;
+    double best = CF_LSQ_HUGE_OBJ;
+    int found = 0;
+    for (int i = -1; i <= 40; i++)
+        for (int j = 0; j <= 40; j++) {
+            double cidx, n;
+            if (i < 0) { /* the corner of region_at */
+                if (j > 0)
+                    break;
+                if (c->type == CF_TELESCOPING) {
+                    cidx = fmax(3.0, 2 * nmin * rho / (1 - rho)) * (1 + 1e-5);
+                    n = nmin * (1 + 1e-7);
+                } else {
+                    cidx = 3.0 * (1 + 1e-7);
+                    n = fmax(nmin, fmax(3.0 * (1 - rho) / (2 * rho) * (1 + 1e-6),
+                                        3.0 * (1 - B) / (c->opt->D2_over_H_max * rho))) *
+                        (1 + 1e-5);
+                }
+            } else {
+                cidx = 3.0 * pow(cmax / 3.0, i / 40.0);
+                n = nmin * pow(nmax / nmin, j / 40.0);
+            }
+            double s = B * H, Lmin = H - s;
+            double d = c->type == CF_TELESCOPING ? Lmin : Lmin / n;
+            double D1 = cidx * d, FC = v[2] * H * H;
+            double q[CF_P_COUNT] = {D1, D1 / rho, n, d, 8 * n * D1 * D1 * D1 * FC / (d * d * d * d * s),
+                                    H};
+            cf_spring sp = from_array(q);
+            if (!cf_fit_check(&sp, c->type, c->data, c->opt, NULL, NULL))
+                continue;
+            double a = log(cidx) - c->pref[0], b = log(n) - c->pref[1];
+            double score = a * a + b * b;
+            if (score < best) {
+                best = score;
+                memcpy(p, q, sizeof q);
+                found = 1;
+            }
+        }
+    return found;
+}
+
+/* ---- uncertainty: standard errors, correlation, profile-likelihood intervals ----------------- */
+
+/* F(0.95; 1, N - 3) times the residual variance (floored at rounding level): the rise of the
+** weighted RSS that the noise can explain, for one quantity. */
+static double rss_threshold(const fit_ctx *c, double rss)
+{
+    double dof = (double)c->n - 3;
+    double s2 = fmax(rss / dof, 1e-24 * c->ynorm / (double)c->n);
+    return gsl_cdf_fdist_Pinv(0.95, 1.0, dof) * s2;
+}
+
+/* The profile of quantity q->fixed at log value u: the RSS minimised over the other quantities
+** from xin; xin moves to the minimiser when the RSS is within limit. */
+static double profile_at(fit_ctx *c, sub *q, double u, double limit, double *xin)
+{
+    double x[2] = {xin[0], xin[1]};
+    q->t = exp(u);
+    double f = sub_solve(c, q, x, NLOPT_LN_COBYLA);
+    if (f <= limit)
+        memcpy(xin, x, sizeof x);
+    return f;
+}
+
+/* One end of the profile interval of quantity k (dir = -1 low, +1 high), in log units from the
+** value v[k]; res receives the end and the bit of the bound it reached. */
+static void profile_end(fit_ctx *c, int k, const double v[3], double limit, int dir, double h,
+                        cf_fit_result *res)
+{
+    /* the range of each quantity, in log units */
+    double lo[3] = {log(c->rho_lo), log(c->b_lo), -INFINITY};
+    double hi[3] = {log(c->rho_hi * (1 - 1e-12)), log(c->b_hi), INFINITY};
+    unsigned lo_bit[3] = {c->opt->rho_min > CF_LSQ_RHO_LO ? CF_C_RHO_MIN : CF_C_BOUNDS,
+                          c->travel_ok ? CF_C_TRAVEL : CF_C_BOUNDS, 0};
+    unsigned hi_bit[3] = {(c->type == CF_TELESCOPING && !c->region) ? CF_C_TYPE : CF_C_DIAMETERS,
+                          CF_C_BOUNDS, 0};
+    sub q = {c, k, 0};
+    double x0[2], xin[2];
+    int j = 0;
+    if (k != 0)
+        x0[j++] = log(v[0]);
+    if (k != 1)
+        x0[j] = v[1];
+    memcpy(xin, x0, sizeof x0);
+    double u_in = log(v[k]), u_out = NAN;
+    unsigned end_bit = 0;
+    int done = 0, infeasible = 0;
+    for (int it = 0; it < 60 && !done; it++, h *= 2) {
+        double u = u_in + dir * h;
+        int at_bound = 0;
+        if (dir < 0 && u <= lo[k]) {
+            u = lo[k];
+            at_bound = 1;
+        } else if (dir > 0 && u >= hi[k]) {
+            u = hi[k];
+            at_bound = 1;
+        }
+        double f = profile_at(c, &q, u, limit, xin);
+        if (f <= limit) {
+            u_in = u;
+            if (at_bound) {
+                end_bit = dir < 0 ? lo_bit[k] : hi_bit[k];
+                done = 1;
+            }
+        } else {
+            u_out = u;
+            infeasible = f >= CF_LSQ_HUGE_OBJ;
+            done = 2;
+        }
+    }
+    if (done == 2) {
+        for (int it = 0; it < 30 && fabs(u_out - u_in) > 1e-4 * fmax(1.0, fabs(u_in)); it++) {
+            double u = 0.5 * (u_in + u_out);
+            double f = profile_at(c, &q, u, limit, xin);
+            if (f <= limit) {
+                u_in = u;
+            } else {
+                u_out = u;
+                infeasible = f >= CF_LSQ_HUGE_OBJ;
+            }
+        }
+        if (infeasible) { /* the end is where the type's limits close, not the threshold */
+            double rho, B;
+            sub_point(&q, xin, &rho, &B);
+            region r = region_at(c, k == 0 ? exp(u_in) : rho, k == 1 ? exp(u_in) : B);
+            end_bit = k == 2 ? CF_C_G_MAX : r.lo_bit | r.hi_bit;
+        }
+    }
+    res->interval[k][dir < 0 ? 0 : 1] = exp(u_in);
+    res->interval_end[k][dir < 0 ? 0 : 1] = end_bit;
+}
+
+/* Standard errors s^2 (J^T W J)^-1 of (rho, B, A) at v, the correlation matrix, and whether the
+** Jacobian is numerically rank-deficient (smallest eigenvalue of the unit-diagonal J^T W J below
+** 1e-10 of the largest): then no standard error is given. */
+static void uncertainty(fit_ctx *c, cf_fit_result *res, unsigned held_a)
+{
+    const double *v = res->ident;
+    int rank_def = stage_a_errors(c, v, res->ident_se, res->corr);
+    res->held = held_a | held_at(c, v) | (c->fd || c->region ? 0u : res->active);
+    unsigned why = res->held | (rank_def ? CF_FIT_RANK_DEFICIENT : 0);
+    /* a Wald interval that would cross the range of a quantity is no interval either */
+    double lo[3] = {c->rho_lo, c->b_lo, 0}, hi[3] = {c->rho_hi, c->b_hi, INFINITY};
+    int need = why != 0;
+    for (int k = 0; k < 3; k++)
+        need = need || res->ident_se[k] < 0 || v[k] - 1.96 * res->ident_se[k] < lo[k] ||
+               v[k] + 1.96 * res->ident_se[k] > hi[k];
+    if (!need || c->n <= 3)
+        return;
+    region r = region_at(c, v[0], v[1]);
+    double A;
+    double rss0 = fmin(res->objective, rss_at(c, v[0], v[1], -1, r.A_max, &A));
+    double limit = rss0 + rss_threshold(c, rss0);
+    for (int k = 0; k < 3; k++) {
+        double h = res->ident_se[k] > 0 ? fmin(0.5 * res->ident_se[k] / v[k], 0.1) : 0.01;
+        h = fmax(h, 1e-4);
+        profile_end(c, k, v, limit, -1, h, res);
+        profile_end(c, k, v, limit, +1, h, res);
+        res->interval_ok[k] = 1;
+        res->interval_why[k] = why;
+    }
+}
+
 /* ---- the driver ------------------------------------------------------------------------------ */
 
 static cf_status check_data(const cf_table *d, cf_error *err)
@@ -815,6 +1313,16 @@ static cf_status check_options(const cf_fit_options *o, cf_error *err)
             return cf_error_set(err, CF_E_DATA, "fixed %s = %g must be a positive number",
                                 cf_spring_param_info(k)->name, o->fixed_value[k]);
     }
+    if (!(o->rho_min > 0 && o->rho_min < 1))
+        return cf_error_set(err, CF_E_DATA,
+                            "rho_min = %g: the smallest diameter ratio D1/D2 must lie in (0, 1)",
+                            o->rho_min);
+    if (!(o->D2_over_H_max > 0) || !isfinite(o->D2_over_H_max))
+        return cf_error_set(err, CF_E_DATA, "D2/H limit = %g must be a positive number",
+                            o->D2_over_H_max);
+    if (o->upper[CF_P_N] < 2)
+        return cf_error_set(err, CF_E_DATA, "upper bound of n = %g: a conical spring needs n >= 2",
+                            o->upper[CF_P_N]);
     if (o->fixed[CF_P_N] && o->fixed_value[CF_P_N] < 2)
         return cf_error_set(err, CF_E_DATA, "fixed n = %g: a conical spring needs n >= 2",
                             o->fixed_value[CF_P_N]);
@@ -838,6 +1346,11 @@ static void summarise(fit_ctx *c, const double *p, cf_fit_result *res)
     res->objective = objective6(c, p) * c->ynorm;
     res->feasible = cf_fit_check(&res->params, c->type, c->data, c->opt, &res->active,
                                  &res->violated);
+    res->objective_zero = c->ynorm;
+    res->solid_ratio = c->xmax > 0 ? res->ident[1] / c->xmax : INFINITY;
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            res->corr[a][b] = NAN;
 }
 
 /* Checks data and options and prepares the context shared by every stage (c->sw is malloc'd). */
@@ -853,16 +1366,30 @@ static cf_status ctx_setup(fit_ctx *c, const cf_table *data, const cf_fit_option
     c->type = type;
     c->fd = cf_table_is_force(data);
     c->n = data->count;
-    /* one block: the residual weights, then the model's values at the points (summarise) */
+    /* one block: the residual weights, then the model's values at the points (summarise, and
+    ** scratch for rss_at) */
     c->sw = malloc(2 * sizeof(double) * c->n);
     if (!c->sw)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", c->n);
     c->model = c->sw + c->n;
     c->ynorm = cf_lsq_weights(data, opt->relative, c->sw);
     c->xmax = cf_lsq_xmax(data);
-    /* Stage A bounds (rho_hi: lsq.h). */
-    c->rho_lo = CF_LSQ_RHO_LO;
-    c->rho_hi = cf_lsq_rho_hi(type, opt->index_max);
+    int nfixed = 0;
+    for (int k = 0; k < CF_P_COUNT; k++)
+        nfixed += opt->fixed[k] != 0;
+    c->region = !c->fd && nfixed == 0;
+    /* Stage A bounds. Both types search the same range of rho when the type's own limits are
+    ** known in closed form (they are then imposed as constraints, region_at), so that both report
+    ** the same quantities wherever neither type's limits bind; rho_min is one of those limits and
+    ** stage A searches a little below it, so that an optimum on rho_min lies inside its range.
+    ** Otherwise (lsq.h) telescoping stops at rho <= index_max/(index_max + 4). */
+    c->rho_lo = fmax(CF_LSQ_RHO_LO, opt->rho_min * (c->region ? 0.9 : 1 - RHO_MIN_TOL));
+    c->rho_hi = c->region ? 1.0 : cf_lsq_rho_hi(type, opt->index_max);
+    if (c->rho_hi <= c->rho_lo * (1 + 1e-9))
+        return cf_error_set(err, CF_E_DATA,
+                            "rho_min = %g leaves no diameter ratio a %s spring can have (at most "
+                            "%g with index_max = %g)",
+                            opt->rho_min, cf_spring_type_name(type), c->rho_hi, opt->index_max);
     double need = c->xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
     if (c->fd) {
         c->travel_ok = 1;
@@ -889,12 +1416,28 @@ static cf_status ctx_setup(fit_ctx *c, const cf_table *data, const cf_fit_option
 static void place(fit_ctx *c, const double v[3], double *p, double *z)
 {
     memcpy(c->target, v, sizeof c->target);
-    analytic_member(c, v, p);
+    if (!(c->region && region_member(c, v, p)))
+        analytic_member(c, v, p);
     for (int k = 0; k < c->nfree; k++)
         z[k] = log(p[c->free_idx[k]]);
+    double p0[CF_P_COUNT], z0[CF_P_COUNT];
+    memcpy(p0, p, sizeof p0);
+    memcpy(z0, z, sizeof z0);
+    cf_spring sp = from_array(p0);
+    int feas0 = cf_fit_check(&sp, c->type, c->data, c->opt, NULL, NULL);
     nl_run(c, NLOPT_LD_SLSQP, z_preference, 1, z, 2000);
     full_params(c, z, p);
     snap_to_family(c, p, z);
+    sp = from_array(p);
+    if (feas0 && !cf_fit_check(&sp, c->type, c->data, c->opt, NULL, NULL)) {
+        memcpy(p, p0, sizeof p0); /* keep the feasible start rather than a worse point */
+        memcpy(z, z0, sizeof z0);
+    }
+}
+
+static void ctx_free(fit_ctx *c)
+{
+    free(c->sw);
 }
 
 cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
@@ -904,12 +1447,12 @@ cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_sprin
     fit_ctx c;
     cf_status st = ctx_setup(&c, data, opt, type, err);
     if (st != CF_OK) {
-        free(c.sw);
+        ctx_free(&c);
         return st;
     }
     for (int k = 0; k < 3; k++)
         if (!(ident[k] > 0) || !isfinite(ident[k])) {
-            free(c.sw);
+            ctx_free(&c);
             return cf_error_set(err, CF_E_DATA, "identifiable quantity %d = %g must be positive",
                                 k, ident[k]);
         }
@@ -922,7 +1465,7 @@ cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_sprin
         res->ident_se[k] = -1;
     res->optimizer = "placement";
     res->evaluations = c.evals;
-    free(c.sw);
+    ctx_free(&c);
     res->wall_time_s = now_s() - t0;
     return CF_OK;
 }
@@ -935,13 +1478,23 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
     fit_ctx c;
     cf_status st = ctx_setup(&c, data, opt, type, err);
     if (st != CF_OK) {
-        free(c.sw);
+        ctx_free(&c);
         return st;
     }
-    /* Stage A: the identifiable quantities and their errors. */
-    double v[3] = {0.5, 0.5 * (c.b_lo + c.b_hi), 1.0}, se[3];
+    /* Stage A: the identifiable quantities, over every spring, then under the type's limits when
+    ** the optimum lies outside them. */
+    double v[3] = {0.5, 0.5 * (c.b_lo + c.b_hi), 1.0};
     stage_a(&c, v);
-    stage_a_errors(&c, v, se);
+    unsigned held_a = 0; /* the limits that keep the type from stage A's optimum */
+    if (c.region) {
+        region r = region_at(&c, v[0], v[1]);
+        int out = r.margin > 0, over = v[2] > r.A_max / (1 - REGION_SAFETY);
+        if (out || over) {
+            held_a = (out ? r.lo_bit | r.hi_bit : 0u) | (over ? (unsigned)CF_C_G_MAX : 0u);
+            if (stage_a_constrained(&c, v))
+                held_a |= held_at(&c, v);
+        }
+    }
     /* Stage B: place a spring of the family. */
     double p[CF_P_COUNT], z[CF_P_COUNT];
     place(&c, v, p, z);
@@ -976,15 +1529,38 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
     }
     res->type = type;
     summarise(&c, best_p, res);
-    /* Standard errors belong to the identifiable quantities of stage A; when the reported
-    ** spring sits elsewhere (fixed parameters), recompute them there. */
-    if (fabs(res->ident[0] - v[0]) > 1e-6 * v[0] || fabs(res->ident[1] - v[1]) > 1e-6 * v[1] ||
-        fabs(res->ident[2] - v[2]) > 1e-6 * v[2])
-        stage_a_errors(&c, res->ident, se);
-    memcpy(res->ident_se, se, sizeof se);
+    /* Errors, correlation and, where the data leave a quantity open, its profile interval: at
+    ** the reported spring's quantities. */
+    uncertainty(&c, res, held_a);
     res->optimizer = cf_fit_optimizer_name(opt->optimizer);
     res->evaluations = c.evals;
-    free(c.sw);
+    ctx_free(&c);
     res->wall_time_s = now_s() - t0;
     return CF_OK;
+}
+
+cf_fit_verdict cf_fit_compare(const cf_fit_result *a, const cf_fit_result *b, size_t points)
+{
+    cf_fit_verdict v = {0, -1, NAN, NAN, 0};
+    const cf_fit_result *f[2] = {a, b};
+    if (a->feasible && b->feasible)
+        v.better = b->objective < a->objective ? 1 : 0;
+    else if (a->feasible || b->feasible)
+        v.better = a->feasible ? 0 : 1;
+    else
+        return v;
+    const cf_fit_result *w = f[1 - v.better], *g = f[v.better];
+    if (!w->feasible) { /* no contest: the other type has no spring inside its limits */
+        v.held = w->violated;
+        return v;
+    }
+    double dof = points > 3 ? (double)points - 3 : 1;
+    double s2 = fmax(g->objective / dof, 1e-24 * g->objective_zero / (double)points);
+    v.delta_rss = w->objective - g->objective;
+    v.threshold = gsl_cdf_fdist_Pinv(0.95, 1.0, dof) * s2;
+    v.tie = v.delta_rss <= v.threshold;
+    v.held = w->held & ~g->held;
+    if (!v.held)
+        v.held = w->held;
+    return v;
 }

@@ -69,9 +69,11 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
                               "%s: key 'fits' is missing or not a non-empty array", path);
             goto done;
         }
+        int tie = 0; /* the types tie: the first feasible fit stands for both */
         if (!want && json_array_size(fits) > 1) {
             want = json_string_value(json_object_get(root, "better_type"));
-            if (!want) {
+            tie = !want && json_is_true(json_object_get(json_object_get(root, "comparison"), "tie"));
+            if (!want && !tie) {
                 st = cf_error_set(err, CF_E_DATA,
                                   "%s: several fits and no 'better_type'; name the type", path);
                 goto done;
@@ -81,7 +83,8 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
         json_array_foreach(fits, i, item)
         {
             const char *t = json_string_value(json_object_get(item, "type"));
-            if (!want || (t && strcmp(t, want) == 0)) {
+            if (tie ? json_is_true(json_object_get(item, "feasible"))
+                    : (!want || (t && strcmp(t, want) == 0))) {
                 fit = item;
                 break;
             }

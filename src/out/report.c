@@ -4,6 +4,7 @@
 #include "conifit/report.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,22 +24,14 @@ void cf_report_free(cf_fit_report *r)
 
 int cf_report_better(const cf_fit_report *r)
 {
-    int best = -1;
-    for (int i = 0; i < r->nfits; i++) {
-        if (!r->fits[i].feasible)
-            continue;
-        if (best < 0 || r->fits[i].rmse < r->fits[best].rmse)
-            best = i;
-    }
-    return best;
+    if (r->nfits == 2)
+        return cf_fit_compare(&r->fits[0], &r->fits[1], r->table->count).better;
+    return r->nfits == 1 && r->fits[0].feasible ? 0 : -1;
 }
 
 int cf_report_types_tie(const cf_fit_report *r)
 {
-    if (r->nfits != 2)
-        return 0;
-    double a = r->fits[0].rmse, b = r->fits[1].rmse;
-    return fabs(a - b) <= 1e-6 * fmax(a, b) + 1e-9 * r->ymax;
+    return r->nfits == 2 && cf_fit_compare(&r->fits[0], &r->fits[1], r->table->count).tie;
 }
 
 double cf_report_fit_aic(const cf_fit_report *r, int i)
@@ -64,24 +57,87 @@ static json_t *constraint_list(unsigned bits)
     return a;
 }
 
-static json_t *value_se(double v, double se)
+/* Appends to buf (capacity cap, *n used), never past its end. */
+static void app(char *buf, size_t cap, size_t *n, const char *fmt, ...)
 {
-    return json_pack("{s:o, s:o}", "value", num(v), "stderr", se >= 0 ? num(se) : json_null());
+    if (*n + 1 >= cap)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    int k = vsnprintf(buf + *n, cap - *n, fmt, ap);
+    va_end(ap);
+    if (k > 0)
+        *n = fmin(*n + (size_t)k, cap - 1);
 }
+
+/* Why a profile interval was computed and where its ends come from, in words. */
+static void interval_reason(const cf_fit_result *f, int k, char *buf, size_t cap)
+{
+    size_t n = 0;
+    buf[0] = '\0';
+    unsigned why = f->interval_why[k], lim = why & ~CF_FIT_RANK_DEFICIENT;
+    app(buf, cap, &n, "profile likelihood, 95 %% (F-test), because ");
+    if (why & CF_FIT_RANK_DEFICIENT)
+        app(buf, cap, &n, "the Jacobian is rank-deficient%s", lim ? " and " : "");
+    if (lim) {
+        app(buf, cap, &n, "the fit sits on");
+        for (int b = 0; b < CF_C_COUNT; b++)
+            if (lim & (1u << b))
+                app(buf, cap, &n, " %s", cf_fit_constraint_name(1u << b));
+    }
+    if (!why)
+        app(buf, cap, &n, "the standard error reaches past the quantity's range");
+    for (int e = 0; e < 2; e++) {
+        unsigned b = f->interval_end[k][e];
+        if (b)
+            app(buf, cap, &n, "; the %s end is the limit %s: the data do not bound it", 
+                e ? "upper" : "lower", cf_fit_constraint_name(b & (0u - b)));
+    }
+}
+
+/* {value, stderr, interval, interval_reason} in conifit's units (MPa, N, mm). */
+static json_t *ident_json(const cf_fit_result *f, int k)
+{
+    double se = f->ident_se[k];
+    json_t *o = json_pack("{s:o, s:o}", "value", num(f->ident[k]), "stderr",
+                          se >= 0 ? num(se) : json_null());
+    if (f->interval_ok[k]) {
+        char why[512];
+        interval_reason(f, k, why, sizeof why);
+        json_object_set_new(o, "interval",
+                            json_pack("[o, o]", num(f->interval[k][0]), num(f->interval[k][1])));
+        json_object_set_new(o, "interval_reason", json_string(why));
+    } else {
+        json_object_set_new(o, "interval", json_null());
+        json_object_set_new(o, "interval_reason", json_null());
+    }
+    return o;
+}
+
+static json_t *correlation_json(const cf_fit_result *f, const char *const names[3])
+{
+    json_t *m = json_array();
+    for (int a = 0; a < 3; a++) {
+        json_t *row = json_array();
+        for (int b = 0; b < 3; b++)
+            json_array_append_new(row, num(f->corr[a][b]));
+        json_array_append_new(m, row);
+    }
+    return json_pack("{s:[s, s, s], s:o}", "order", names[0], names[1], names[2], "matrix", m);
+}
+
 
 static json_t *fit_json_core(const cf_fit_report *r, int i)
 {
     const cf_fit_result *f = &r->fits[i];
     double u = r->table->y_to_file;
-    json_t *ident;
-    if (cf_table_is_force(r->table))
-        ident = json_pack("{s:o, s:o, s:o}", "rho", value_se(f->ident[0], f->ident_se[0]),
-                          "travel_mm", value_se(f->ident[1], f->ident_se[1]), "F_C_N",
-                          value_se(f->ident[2], f->ident_se[2]));
-    else
-        ident = json_pack("{s:o, s:o, s:o}", "rho", value_se(f->ident[0], f->ident_se[0]),
-                          "solid_strain", value_se(f->ident[1], f->ident_se[1]),
-                          "stress_scale_MPa", value_se(f->ident[2], f->ident_se[2]));
+    static const char *const ss_names[3] = {"rho", "solid_strain", "stress_scale_MPa"};
+    static const char *const fd_names[3] = {"rho", "travel_mm", "F_C_N"};
+    const int fd = cf_table_is_force(r->table);
+    const char *const *names = fd ? fd_names : ss_names;
+    json_t *ident = json_object();
+    for (int k = 0; k < 3; k++)
+        json_object_set_new(ident, names[k], ident_json(f, k));
     json_t *o = cf_fitfile_spring_json(&f->law);
     json_t *rest = json_pack(
         "{s:o, s:o, s:o, s:o, s:o, s:b, s:o, s:o, s:s, s:I, s:o}", "identifiable", ident, "rmse",
@@ -97,6 +153,16 @@ static json_t *fit_json_core(const cf_fit_report *r, int i)
     }
     json_object_update(o, rest);
     json_decref(rest);
+    /* the type fitted: an infeasible fit's geometry may be of the other type */
+    json_object_set_new(o, "type", json_string(cf_spring_type_name(f->type)));
+    json_object_set_new(o, "identifiable_correlation", correlation_json(f, names));
+    json_object_set_new(o, "held_by", constraint_list(f->held));
+    json_object_set_new(
+        o, "extrapolation",
+        json_pack("{s:o, s:o, s:o, s:b}", fd ? "travel_mm" : "solid_strain", num(f->ident[1]),
+                  fd ? "largest_displacement_mm" : "largest_strain",
+                  num(f->ident[1] / f->solid_ratio), "ratio", num(f->solid_ratio), "warning",
+                  f->solid_ratio < CF_FIT_SOLID_RATIO_WARN));
     return o;
 }
 
@@ -170,6 +236,63 @@ static json_t *baseline_json(const cf_fit_report *r, int k)
                      num(cf_report_baseline_aic(r, k)));
 }
 
+/* The one sentence that compares the two types (both fitted, at least one feasible). */
+static void verdict_text(const cf_fit_report *r, char *buf, size_t cap)
+{
+    size_t n = 0;
+    buf[0] = '\0';
+    cf_fit_verdict v = cf_fit_compare(&r->fits[0], &r->fits[1], r->table->count);
+    if (v.better < 0) {
+        app(buf, cap, &n, "no verdict: neither type has a spring inside its limits");
+        return;
+    }
+    const cf_fit_result *g = &r->fits[v.better], *w = &r->fits[1 - v.better];
+    double u = r->table->y_to_file;
+    if (!w->feasible) {
+        app(buf, cap, &n, "%s: the %s type has no spring inside its limits (violated:",
+            cf_spring_type_name(g->type), cf_spring_type_name(w->type));
+        for (int b = 0; b < CF_C_COUNT; b++)
+            if (w->violated & (1u << b))
+                app(buf, cap, &n, " %s", cf_fit_constraint_name(1u << b));
+        app(buf, cap, &n, ")");
+        return;
+    }
+    double base = g->objective > 0 ? g->objective : 1.0;
+    if (v.tie) {
+        app(buf, cap, &n,
+            "tie: the data do not tell the types apart (RMSE %.4g against %.4g %s; the residual "
+            "sum of squares differs by %.3g of the better one's, below the F-test threshold "
+            "%.3g at 95 %%)",
+            r->fits[0].rmse * u, r->fits[1].rmse * u, r->table->y_unit, v.delta_rss / base,
+            v.threshold / base);
+        return;
+    }
+    app(buf, cap, &n,
+        "%s (RMSE %.4g against %.4g %s; the residual sum of squares of %s is higher by %.3g of "
+        "the better one's, above the F-test threshold %.3g at 95 %%); ",
+        cf_spring_type_name(g->type), g->rmse * u, w->rmse * u, r->table->y_unit,
+        cf_spring_type_name(w->type), v.delta_rss / base, v.threshold / base);
+    if (v.held) {
+        app(buf, cap, &n, "%s is held back by", cf_spring_type_name(w->type));
+        for (int b = 0; b < CF_C_COUNT; b++)
+            if (v.held & (1u << b))
+                app(buf, cap, &n, " %s", cf_fit_constraint_name(1u << b));
+    } else {
+        app(buf, cap, &n, "no limit of %s is active: its optimiser stopped at a worse point",
+            cf_spring_type_name(w->type));
+    }
+}
+
+/* The limits every fit ran under. */
+static json_t *limits_json(const cf_fit_report *r)
+{
+    const cf_fit_options *o = &r->fit_options;
+    return json_pack("{s:o, s:o, s:o, s:o, s:o, s:o, s:o}", "rho_min", num(o->rho_min), "n_min",
+                     num(o->lower[CF_P_N]), "n_max", num(o->upper[CF_P_N]), "D2_over_H_max",
+                     num(o->D2_over_H_max), "G_max_MPa", num(o->upper[CF_P_G]), "index_min",
+                     num(3.0), "index_max", num(o->index_max));
+}
+
 static json_t *report_json(const cf_fit_report *r)
 {
     json_t *data = json_pack(
@@ -185,15 +308,23 @@ static json_t *report_json(const cf_fit_report *r)
         json_array_append_new(base, baseline_json(r, k));
     json_t *root = json_pack("{s:s, s:o, s:o}", "conifit_version", r->version, "data", data,
                              "fits", fits);
-    int b = cf_report_better(r);
-    json_object_set_new(root, "better_type",
-                        b >= 0 ? json_string(cf_spring_type_name(r->fits[b].type)) : json_null());
+    json_object_set_new(root, "limits", limits_json(r));
+    int b = cf_report_better(r), tie = cf_report_types_tie(r);
+    json_object_set_new(root, "better_type", b >= 0 && !tie
+                                                 ? json_string(cf_spring_type_name(r->fits[b].type))
+                                                 : json_null());
     if (r->nfits == 2 && b >= 0) {
         int o = 1 - b;
+        cf_fit_verdict v = cf_fit_compare(&r->fits[0], &r->fits[1], r->table->count);
+        char text[1024];
+        verdict_text(r, text, sizeof text);
         json_object_set_new(
             root, "comparison",
-            json_pack("{s:b, s:o, s:o}", "tie", cf_report_types_tie(r),
-                      "rmse_ratio_other_to_better",
+            json_pack("{s:b, s:s, s:s, s:o, s:o, s:o, s:o, s:o}", "tie", tie, "verdict", text,
+                      "test", "F(1, N - 3) at 95 % on the weighted residual sum of squares",
+                      "delta_weighted_rss", num(v.delta_rss), "threshold_weighted_rss",
+                      num(v.threshold), "held_back_by",
+                      constraint_list(tie ? 0u : v.held), "rmse_ratio_other_to_better",
                       num(r->fits[b].rmse > 0 ? r->fits[o].rmse / r->fits[b].rmse : 1.0),
                       "aic_difference", num(cf_report_fit_aic(r, o) - cf_report_fit_aic(r, b))));
     }
@@ -267,22 +398,41 @@ static void row(FILE *o, const cf_fit_report *r, const char *label, const char *
     fputc('\n', o);
 }
 
+/* value ± standard error, or value [low, high] (the profile interval, marked *) */
 static void ident_row(FILE *o, const cf_fit_report *r, const char *label, int k, double scale,
                       const char *unit)
 {
     fprintf(o, "  %-26s", label);
     for (int i = 0; i < r->nfits; i++) {
-        char cell[64];
+        char cell[96];
         const cf_fit_result *f = &r->fits[i];
-        if (f->ident_se[k] >= 0)
+        const char *sp = *unit ? " " : "";
+        if (f->interval_ok[k])
+            snprintf(cell, sizeof cell, "%.4g [%.3g, %.3g]*%s%s", f->ident[k] * scale,
+                     f->interval[k][0] * scale, f->interval[k][1] * scale, sp, unit);
+        else if (f->ident_se[k] >= 0)
             snprintf(cell, sizeof cell, "%.6g ± %.2g%s%s", f->ident[k] * scale,
-                     f->ident_se[k] * scale, *unit ? " " : "", unit);
-        else
-            snprintf(cell, sizeof cell, "%.6g%s%s (± ?)", f->ident[k] * scale, *unit ? " " : "",
-                     unit);
+                     f->ident_se[k] * scale, sp, unit);
+        else /* uncertainty() computes an interval wherever the error is undetermined */
+            snprintf(cell, sizeof cell, "%.6g%s%s (no error: placed, not fitted)",
+                     f->ident[k] * scale, sp, unit);
         fprintf(o, " %-24s", cell);
     }
     fputc('\n', o);
+}
+
+/* Below the table: what each starred interval means, per type and quantity. */
+static void interval_notes(FILE *o, const cf_fit_report *r, const char *const names[3])
+{
+    for (int i = 0; i < r->nfits; i++)
+        for (int k = 0; k < 3; k++) {
+            const cf_fit_result *f = &r->fits[i];
+            if (!f->interval_ok[k])
+                continue;
+            char why[512];
+            interval_reason(f, k, why, sizeof why);
+            fprintf(o, "  * %s, %s: %s\n", cf_spring_type_name(f->type), names[k], why);
+        }
 }
 
 /* One cell per fit from a printf format and a value (MPa values are converted by the caller). */
@@ -386,6 +536,30 @@ char *cf_report_text(const cf_fit_report *r)
         ident_row(o, r, "solid strain s/H", 1, 1, "");
         ident_row(o, r, "stress scale F_C/H^2", 2, r->table->y_to_file, r->table->y_unit);
     }
+    static const char *const ss_names[3] = {"rho", "solid strain", "stress scale"};
+    static const char *const fd_names[3] = {"rho", "travel", "solid load"};
+    interval_notes(o, r, cf_table_is_force(r->table) ? fd_names : ss_names);
+    fprintf(o, "  %-26s", "correlation rho-s, rho-A, s-A");
+    for (int i = 0; i < r->nfits; i++) {
+        char cell[64];
+        const cf_fit_result *f = &r->fits[i];
+        if (isfinite(f->corr[0][1]))
+            snprintf(cell, sizeof cell, "%.3f, %.3f, %.3f", f->corr[0][1], f->corr[0][2],
+                     f->corr[1][2]);
+        else
+            snprintf(cell, sizeof cell, "not determined");
+        fprintf(o, " %-24s", cell);
+    }
+    fputc('\n', o);
+    fprintf(o, "  %-26s", cf_table_is_force(r->table) ? "solid / largest |u|" : "solid / largest |strain|");
+    for (int i = 0; i < r->nfits; i++) {
+        char cell[64];
+        const cf_fit_result *f = &r->fits[i];
+        snprintf(cell, sizeof cell, "%.3g%s", f->solid_ratio,
+                 f->solid_ratio < CF_FIT_SOLID_RATIO_WARN ? " (close to solid!)" : "");
+        fprintf(o, " %-24s", cell);
+    }
+    fputc('\n', o);
     fprintf(o, " one spring of that family (chosen by the constraints):\n");
     for (int k = 0; k < CF_P_COUNT; k++) {
         const cf_spring_param *sp = cf_spring_param_info(k);
@@ -437,17 +611,26 @@ char *cf_report_text(const cf_fit_report *r)
         fprintf(o, " %-24s", cell);
     }
     fputc('\n', o);
+    fprintf(o, "  %-26s", "held by");
+    for (int i = 0; i < r->nfits; i++) {
+        char cell[160] = "";
+        size_t n = 0;
+        for (int k = 0; k < CF_C_COUNT; k++)
+            if (r->fits[i].held & (1u << k))
+                app(cell, sizeof cell, &n, "%s%s", n ? "," : "", cf_fit_constraint_name(1u << k));
+        fprintf(o, " %-24s", n ? cell : "nothing");
+    }
+    fputc('\n', o);
+    const cf_fit_options *fo = &r->fit_options;
+    fprintf(o, "  limits: rho >= %g, %g <= n <= %g, 3 <= D1/d <= %g, D2 <= %g H, G <= %g MPa "
+               "(flags --rho-min, --n-max, --index-max, --D2-max-H, --G-max)\n",
+            fo->rho_min, fo->lower[CF_P_N], fo->upper[CF_P_N], fo->index_max, fo->D2_over_H_max,
+            fo->upper[CF_P_G]);
     int b = cf_report_better(r);
     if (r->nfits == 2 && b >= 0) {
-        int ot = 1 - b;
-        double rb = r->fits[b].rmse * r->table->y_to_file, ro = r->fits[ot].rmse * r->table->y_to_file;
-        fprintf(o, "\nBetter type: %s (RMSE %.4g %s against %.4g %s", cf_spring_type_name(r->fits[b].type),
-                rb, r->table->y_unit, ro, r->table->y_unit);
-        if (!cf_report_types_tie(r))
-            fprintf(o, ", %.3g times lower; AIC lower by %.2f)\n", ro / rb,
-                    cf_report_fit_aic(r, ot) - cf_report_fit_aic(r, b));
-        else
-            fprintf(o, "; the two types fit equally well)\n");
+        char text[1024];
+        verdict_text(r, text, sizeof text);
+        fprintf(o, "\nType: %s\n", text);
     } else if (b < 0) {
         fprintf(o, "\nNo feasible fit: no spring meets every constraint on this table (see "
                    "'feasible' above).\n");

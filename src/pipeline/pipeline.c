@@ -71,6 +71,7 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
     r->version = CF_VERSION;
     r->table = t;
     r->with_timing = opt->with_timing;
+    r->fit_options = opt->fit;
     for (size_t i = 0; i < t->count; i++)
         r->ymax = fmax(r->ymax, fabs(t->y[i]));
     for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING; ty++) {

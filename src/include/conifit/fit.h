@@ -39,9 +39,26 @@ enum {
     CF_C_DIAMETERS = 1 << 3, /* D2 >= D1 */
     CF_C_TRAVEL = 1 << 4,    /* travel > (1 + margin) largest |u| */
     CF_C_TYPE = 1 << 5,      /* the geometry is of the type being fitted */
-    CF_C_BOUNDS = 1 << 6,    /* a parameter at (or beyond) its lower or upper bound */
-    CF_C_COUNT = 7
+    CF_C_BOUNDS = 1 << 6,    /* a parameter at (or beyond) one of its other bounds */
+    CF_C_RHO_MIN = 1 << 7,   /* rho = D1/D2 >= rho_min */
+    CF_C_COILS_MAX = 1 << 8, /* n <= upper[CF_P_N] */
+    CF_C_G_MAX = 1 << 9,     /* G <= upper[CF_P_G] */
+    CF_C_D2_H = 1 << 10,     /* D2 <= D2_over_H_max H */
+    CF_C_COUNT = 11
 };
+
+/* Default limits that keep a fitted spring one that could be wound and defended: a diameter ratio
+** of at least 1/20 (below it the largest coil dwarfs the smallest and the law's nonlinear region
+** is a vanishing sliver of the travel), at most 30 coils, an outer diameter of at most ten free
+** lengths, and a wire no stiffer in shear than steel (G = 80 GPa). */
+#define CF_FIT_RHO_MIN_DEFAULT 0.05
+#define CF_FIT_COILS_MAX_DEFAULT 30.0
+#define CF_FIT_D2_OVER_H_MAX_DEFAULT 10.0
+#define CF_FIT_G_MAX_DEFAULT 80000.0
+
+/* A fit whose law goes solid at less than this multiple of the table's largest strain is
+** extrapolating close to solid just past the data (reports warn). */
+#define CF_FIT_SOLID_RATIO_WARN 1.5
 
 typedef enum cf_fit_optimizer {
     CF_OPT_SLSQP = 0,  /* NLopt SLSQP, central-difference gradients */
@@ -63,9 +80,11 @@ typedef enum cf_fit_optimizer {
 typedef struct cf_fit_options {
     int fixed[CF_P_COUNT];          /* 1: held at fixed_value */
     double fixed_value[CF_P_COUNT]; /* mm, -, mm, MPa, mm as in cf_spring */
-    double lower[CF_P_COUNT];       /* bounds, same units */
+    double lower[CF_P_COUNT];       /* bounds, same units (upper n and G: CF_FIT_*_DEFAULT) */
     double upper[CF_P_COUNT];
     double index_max;               /* upper spring index, dimensionless (>= 3) */
+    double rho_min;                 /* smallest diameter ratio D1/D2 (0 < rho_min < 1) */
+    double D2_over_H_max;           /* largest D2/H, dimensionless (> 0) */
     int relative;                   /* 1: residuals relative to |y| (floor 1e-3 max|y|) */
     cf_fit_optimizer optimizer;     /* local optimiser of stage C */
     double xtol_rel;                /* relative tolerance on the parameters (NLopt, GSL) */
@@ -86,11 +105,26 @@ typedef struct cf_fit_result {
     double ident[3];       /* rho [-]; solid strain s/H [-] or travel s [mm]; F_C/H^2 [MPa] or
                               F_C [N] */
     double ident_se[3];    /* standard errors, same units; -1 when not determined */
+    /* Profile-likelihood interval of each identifiable quantity (95 %, F-test on the residual
+    ** sum of squares), computed when the quantity sits on a bound or limit of the type, or the
+    ** Jacobian is rank-deficient (then ident_se is -1); interval_ok[k] = 0 when not computed. */
+    int interval_ok[3];
+    double interval[3][2];
+    unsigned interval_end[3][2]; /* CF_C_* bit of the bound an end reached (0: the threshold) */
+    unsigned interval_why[3];    /* CF_C_* bits of the bounds the quantity sits on; with
+                                 ** CF_FIT_RANK_DEFICIENT when the Jacobian is */
+    double corr[3][3];     /* correlation of the three quantities; NAN where not determined */
+    unsigned held;         /* CF_C_* bits of the limits that hold the identifiable quantities
+                           ** away from the optimum of the law over every spring (the type's
+                           ** geometry and the design bounds, rho_min, the travel) */
+    double solid_ratio;    /* solid strain (travel) over the table's largest |strain|
+                           ** (|displacement|): how far the law is from solid at the data */
     double rss;            /* unweighted sum of squared residuals, (MPa or N)^2 */
     double rmse;           /* root mean square residual, MPa or N */
     double max_abs_error;  /* largest |residual|, MPa or N */
     double r2;             /* coefficient of determination, dimensionless */
-    double objective;      /* weighted (relative) objective minimised */
+    double objective;      /* weighted (relative) objective minimised: the weighted RSS */
+    double objective_zero; /* the same for the zero model (the data's weighted sum of squares) */
     int feasible;          /* 1 when every constraint holds at params (checked here) */
     unsigned active;       /* CF_C_* bits of constraints at their limit (within 1e-6) */
     unsigned violated;     /* CF_C_* bits of violated constraints */
@@ -98,6 +132,9 @@ typedef struct cf_fit_result {
     long evaluations;      /* evaluations of the model over the table, all stages */
     double wall_time_s;    /* s */
 } cf_fit_result;
+
+/* Extra bit in interval_why: the Jacobian of the three quantities is (numerically) singular. */
+#define CF_FIT_RANK_DEFICIENT (1u << 31)
 
 /* Fits one spring type. CF_E_DATA for a table that cannot be fitted (fewer than 4 points, a
 ** non-finite value, all y zero, a non-positive weight) or contradictory options (message names
@@ -112,6 +149,22 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
 ** ident_se = -1, optimizer "placement"). Used by the fit through the lattice (validate.h). */
 cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                        const double ident[3], cf_fit_result *res, cf_error *err);
+
+/* The verdict between two fits of one table (the two spring types). Both types are constrained
+** subsets of one three-parameter law, so the worse one is judged as the better one's law under an
+** extra constraint: an F-test with 1 and N - 3 degrees of freedom at 95 % on the weighted residual
+** sum of squares, s^2 = RSS_better/(N - 3) floored at rounding level (1e-12 of the data's scale).
+** tie = 1 when the difference is below the threshold; better = index (0 or 1) of the fit with
+** the lower objective among the feasible ones (-1 if none); held = the worse fit's held bits. */
+typedef struct cf_fit_verdict {
+    int tie;
+    int better;
+    double delta_rss;   /* weighted RSS of the worse minus the better (weighted units) */
+    double threshold;   /* F(0.95; 1, N - 3) s^2 */
+    unsigned held;      /* what held the worse fit back (CF_C_* bits) */
+} cf_fit_verdict;
+
+cf_fit_verdict cf_fit_compare(const cf_fit_result *a, const cf_fit_result *b, size_t points);
 
 /* Evaluates the model (stress in MPa, or force in N) of spring p at x. */
 double cf_fit_model(const cf_law *law, int force_displacement, double x);

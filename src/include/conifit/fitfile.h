@@ -12,7 +12,7 @@
 **                 "derived": { "rho", "travel_mm", "solid_strain", "F_T_N", "F_C_N",
 **                              "k0_N_per_mm", "u_T_mm", "index_c", "L_min_mm", "L_max_mm" },
 **                 "rmse", "max_abs_error", "r2", ... } , ... ],
-**     "better_type": "telescoping" | "non-telescoping",
+**     "better_type": "telescoping" | "non-telescoping" | null (the types tie),
 **     ...
 **   }
 ** Only "fits[].type", "fits[].params" (and the provenance fields if present) are needed to read a
@@ -45,7 +45,8 @@ typedef struct cf_fitted_spring {
 } cf_fitted_spring;
 
 /* Loads the spring of the given type from the fit file at path; type_name NULL (or "") takes the
-** file's "better_type", or the only fit when there is one. Errors: CF_E_NOINPUT when the file
+** file's "better_type", or the only fit when there is one; when the types tie ("better_type" null,
+** "comparison.tie" true), the first feasible fit. Errors: CF_E_NOINPUT when the file
 ** cannot be opened, CF_E_DATA when it is not JSON, lacks the type or a parameter, or holds a
 ** non-finite or invalid value (the message names the file, the key and the value). */
 cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spring *out,

@@ -20,6 +20,7 @@
 typedef struct cf_fit_report {
     const char *version;        /* conifit version */
     const cf_table *table;      /* the table fitted (not owned; outlives the report) */
+    cf_fit_options fit_options; /* the options the fits ran with (their limits are reported) */
     double ymax;                /* largest |y| in MPa or N */
     int nfits;                  /* 1 or 2 */
     cf_fit_result fits[2];
@@ -34,11 +35,12 @@ typedef struct cf_fit_report {
 /* Releases what the report owns (the validations' curves). Safe on a zeroed report. */
 void cf_report_free(cf_fit_report *r);
 
-/* Index of the better fit in r->fits: the feasible one with the lower RMSE (-1 if none). */
+/* Index of the better fit in r->fits: the feasible one with the lower objective (-1 if none);
+** on a tie (cf_report_types_tie) this is the one a command uses, never one the report names. */
 int cf_report_better(const cf_fit_report *r);
 
-/* 1 when both types were fitted and their RMSEs differ by no more than 1e-6 relative (or by
-** rounding level, 1e-9 max|y|): the table does not tell the types apart. */
+/* 1 when both types were fitted and the data cannot tell them apart (cf_fit_compare: F-test at
+** 95 % on the residual sum of squares, floored at rounding level). */
 int cf_report_types_tie(const cf_fit_report *r);
 
 /* AIC of fit i, with RSS in the file's unit (comparable with the baselines' AIC of the report). */
