@@ -4,6 +4,8 @@
 */
 #include "conifit/lattice.h"
 
+#include "conifit/cell.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -87,23 +89,15 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
     lat->travel_mm = law->travel_mm;
     const double H = lat->H_mm;
 
-    /* The 13 "positive" neighbour offsets (each unordered pair once). */
-    int off[13][3];
+    /* The spring directions of the cell (each unordered pair of neighbours once). */
+    int off[CF_CELL_DIRS][3];
     int noff = 0;
-    for (int dz = -1; dz <= 1; dz++)
-        for (int dy = -1; dy <= 1; dy++)
-            for (int dx = -1; dx <= 1; dx++) {
-                int pos = dz > 0 || (dz == 0 && dy > 0) || (dz == 0 && dy == 0 && dx > 0);
-                if (!pos)
-                    continue;
-                int nz0 = (dx != 0) + (dy != 0) + (dz != 0);
-                if (cfg->weight[nz0 - 1] == 0)
-                    continue; /* a family of weight 0 has no springs */
-                off[noff][0] = dx;
-                off[noff][1] = dy;
-                off[noff][2] = dz;
-                noff++;
-            }
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        int fam;
+        cf_cell_direction(d, off[noff], &fam);
+        if (cfg->weight[fam] != 0)
+            noff++; /* a family of weight 0 has no springs */
+    }
 
     const size_t nn = (size_t)(cfg->nx + 1) * (cfg->ny + 1) * (cfg->nz + 1);
     lat->nn = nn;

@@ -1,0 +1,106 @@
+/*
+** The homogenised cell: the stress of the cubic mass-spring lattice (lattice.h) under a homogeneous
+** deformation, from one cell (affine, Cauchy-Born), with the free stretches of a test mode solved
+** for zero stress. It costs microseconds per strain instead of a lattice solve.
+**
+** Why one cell is enough: under a homogeneous deformation every node of the lattice is a centre of
+** symmetry of its springs (interior forces cancel pair by pair), and a free side face is in
+** equilibrium exactly when the cell's nominal stress has no traction on it. So wherever the full
+** lattice's static solution is homogeneous (free sides, lubricated platens: bottom 'axial'), it
+** equals the cell's, for any number of cells (tests: 1e-9 relative).
+**
+** The cell of edge H holds one spring along each of 13 directions N (integer offsets: 3 edges,
+** 6 face diagonals, 4 body diagonals; reference vector X = H N, rest length L0 = H |N|). Under a
+** deformation gradient F a spring has length L = |F X|, stretch L/L0 and the law's compression
+** u = H (1 - L/L0) (the strain form of lattice.h); its tension is T = -w F_law(u) + extra (w its
+** family's weight, extra an optional viscous term). The nominal (first Piola-Kirchhoff) stress is
+**     P = (1/H^3) sum_d T_d (F X_d) (X_d)^T / L_d,        MPa, tension positive.
+**
+** Test modes (table strain e, tension positive; stretch 1 + e; loading axis as stated):
+**   uniaxial     F = diag(a, a, 1 + e), a free with P_xx = P_yy = 0 (free sides); stress P_zz
+**   shear        F = I + e (x along z): simple shear of amount e, other stretches held; stress P_xz
+**   planar       F = diag(1 + e, 1, c), c free with P_zz = 0 (pure shear); stress P_xx
+**   equibiaxial  F = diag(1 + e, 1 + e, c), c free with P_zz = 0; stress P_xx
+**   confined     F = diag(1, 1, 1 + e), lateral stretches held; stress P_zz
+** Only uniaxial is a mode of the full lattice (cf_msm_uniaxial); the others are the cell's.
+**
+** For time-dependent models the cell takes, per direction, an extra tension affine in the
+** spring's length, T_extra = T0 + k (L - Lref): a backward-Euler dashpot or the exponential update
+** of a Maxwell branch over one step has that form. A strain history is then a loop of
+** cf_cell_mode calls, updating the extra terms from the returned spring lengths. The weights of
+** calibration.h scale the extras as they scale the law (give them already weighted).
+*/
+#ifndef CF_CELL_H
+#define CF_CELL_H
+
+#include <stddef.h>
+
+#include "conifit/calibration.h"
+#include "conifit/error.h"
+#include "conifit/law.h"
+
+typedef enum cf_mode {
+    CF_MODE_UNIAXIAL = 0,
+    CF_MODE_SHEAR = 1,
+    CF_MODE_PLANAR = 2,
+    CF_MODE_EQUIBIAXIAL = 3,
+    CF_MODE_CONFINED = 4,
+    CF_MODE_COUNT = 5
+} cf_mode;
+
+/* "uniaxial", "shear", "planar", "equibiaxial", "confined"; the parser refuses anything else
+** with CF_E_DATA naming the value. */
+const char *cf_mode_name(cf_mode m);
+cf_status cf_mode_parse(const char *name, cf_mode *m, cf_error *err);
+
+/* Spring directions of the cell. */
+#define CF_CELL_DIRS 13
+
+/* Integer offset N[3] of direction d (0 <= d < CF_CELL_DIRS) and its family (CF_FAMILY_*). */
+void cf_cell_direction(int d, int N[3], int *family);
+
+typedef struct cf_cell {
+    const cf_law *law;               /* not owned; with CF_LAW_TABLE its table must be built */
+    cf_law_method method;            /* evaluator */
+    double weight[CF_FAMILY_COUNT];  /* family weights (calibration.h) */
+} cf_cell;
+
+/* Checks the weights (cf_calibration_check) and fills c. */
+cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
+                       const double weight[CF_FAMILY_COUNT], cf_error *err);
+
+/* Extra tension per direction, T = T0_N[d] + k_N_per_mm[d] (L - Lref_mm[d]), N (tension
+** positive), already multiplied by the family weight. */
+typedef struct cf_cell_extra {
+    double T0_N[CF_CELL_DIRS];
+    double k_N_per_mm[CF_CELL_DIRS];
+    double Lref_mm[CF_CELL_DIRS];
+} cf_cell_extra;
+
+/* The cell at one deformation. */
+typedef struct cf_cell_state {
+    double F[9];                     /* deformation gradient, row-major (F[3 i + j] = F_ij), - */
+    double L_mm[CF_CELL_DIRS];       /* spring lengths, mm */
+    double T_N[CF_CELL_DIRS];        /* spring tensions (law and extra, weighted), N */
+    double P_MPa[3][3];              /* nominal stress, MPa, tension positive */
+    double stress_MPa;               /* the mode's stress component (cf_cell_mode), MPa */
+    double free_stretch;             /* the solved free stretch (1 when the mode has none), - */
+    double max_u_over_travel;        /* largest |u| / travel over the springs, - */
+} cf_cell_state;
+
+/* The state at deformation gradient F (row-major, F[3 i + j] = F_ij; extra may be NULL). CF_E_DATA when a spring would reach
+** or pass solid (message: the direction and its stretch) or F is not finite. */
+cf_status cf_cell_stress(const cf_cell *c, const double F[9], const cf_cell_extra *extra,
+                         cf_cell_state *s, cf_error *err);
+
+/* The state of test mode m at table strain e (tension positive), the free stretch solved to
+** rounding (safeguarded Newton inside a bracket). CF_E_DATA when e is not finite or the mode
+** cannot reach it (a spring at solid), CF_E_NOCONV when no free stretch gives zero stress. */
+cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extra *extra,
+                       cf_cell_state *s, cf_error *err);
+
+/* The mode's stress (MPa, table sign) at each of count strains. Stops at the first failure. */
+cf_status cf_cell_curve(const cf_cell *c, cf_mode m, const double *strain, size_t count,
+                        double *stress_MPa, cf_error *err);
+
+#endif

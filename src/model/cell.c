@@ -1,0 +1,290 @@
+/*
+** The homogenised cell of the cubic lattice (see cell.h): nominal stress of one cell under a
+** homogeneous deformation, its tangent along the free stretch of a test mode, and the
+** safeguarded Newton solve of that stretch.
+*/
+#include "conifit/cell.h"
+
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+/* A spring closer to solid than this fraction of the travel is refused (the law's stiffness grows
+** like (s - u)^(-1/2) there, and the full lattice stops at the same margin). */
+#define SOLID_MARGIN (1.0 - 1e-9)
+/* Newton iterations for a free stretch. */
+#define MAX_ITER 100
+
+static const char *const mode_names[CF_MODE_COUNT] = {"uniaxial", "shear", "planar",
+                                                      "equibiaxial", "confined"};
+
+const char *cf_mode_name(cf_mode m)
+{
+    return (int)m >= 0 && m < CF_MODE_COUNT ? mode_names[m] : "?";
+}
+
+cf_status cf_mode_parse(const char *name, cf_mode *m, cf_error *err)
+{
+    for (int k = 0; name && k < CF_MODE_COUNT; k++)
+        if (strcmp(name, mode_names[k]) == 0) {
+            *m = (cf_mode)k;
+            return CF_OK;
+        }
+    return cf_error_set(err, CF_E_DATA,
+                        "mode '%s': expected uniaxial, shear, planar, equibiaxial or confined",
+                        name ? name : "(none)");
+}
+
+/* The 13 directions, each unordered pair of neighbours once, in the order of lattice.c. */
+void cf_cell_direction(int d, int N[3], int *family)
+{
+    int k = 0;
+    for (int dz = -1; dz <= 1; dz++)
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dx = -1; dx <= 1; dx++) {
+                int pos = dz > 0 || (dz == 0 && dy > 0) || (dz == 0 && dy == 0 && dx > 0);
+                if (!pos)
+                    continue;
+                if (k++ == d) {
+                    N[0] = dx, N[1] = dy, N[2] = dz;
+                    *family = (dx != 0) + (dy != 0) + (dz != 0) - 1;
+                    return;
+                }
+            }
+    N[0] = N[1] = N[2] = 0;
+    *family = CF_FAMILY_EDGE;
+}
+
+cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
+                       const double weight[CF_FAMILY_COUNT], cf_error *err)
+{
+    cf_status st = cf_calibration_check(weight, err);
+    if (st != CF_OK)
+        return st;
+    c->law = law;
+    c->method = method;
+    memcpy(c->weight, weight, sizeof c->weight);
+    return CF_OK;
+}
+
+/* The state at F, and dT/dL of every spring (N/mm) for the tangent. */
+static cf_status evaluate(const cf_cell *c, const double F[9], const cf_cell_extra *x,
+                          cf_cell_state *s, double kT[CF_CELL_DIRS], cf_error *err)
+{
+    const cf_law *law = c->law;
+    const double H = law->p.H_mm, H3 = H * H * H;
+    memset(s->P_MPa, 0, sizeof s->P_MPa);
+    memcpy(s->F, F, sizeof s->F);
+    s->max_u_over_travel = 0;
+    for (int i = 0; i < 9; i++)
+        if (!isfinite(F[i]))
+            return cf_error_set(err, CF_E_DATA, "deformation gradient F[%d][%d] = %g is not "
+                                "finite", i / 3, i % 3, F[i]);
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        int N[3], fam;
+        cf_cell_direction(d, N, &fam);
+        double X[3] = {H * N[0], H * N[1], H * N[2]}, xv[3];
+        for (int i = 0; i < 3; i++)
+            xv[i] = F[3 * i] * X[0] + F[3 * i + 1] * X[1] + F[3 * i + 2] * X[2];
+        double L = sqrt(xv[0] * xv[0] + xv[1] * xv[1] + xv[2] * xv[2]);
+        double L0 = H * sqrt((double)(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]));
+        double u = H * (L0 - L) / L0;
+        double r = fabs(u) / law->travel_mm;
+        s->max_u_over_travel = fmax(s->max_u_over_travel, r);
+        if (!(r < SOLID_MARGIN) || !(L > 0))
+            return cf_error_set(err, CF_E_DATA,
+                                "the cell's spring along (%d, %d, %d) reaches solid (stretch %.6g, "
+                                "solid at %.6g)",
+                                N[0], N[1], N[2], L / L0, 1 - copysign(law->travel_mm / H, u));
+        double k = 0;
+        double f = cf_law_force(law, c->method, u, &k, NULL);
+        double w = c->weight[fam];
+        double T = -w * f, dT = w * k * H / L0;
+        if (x) {
+            T += x->T0_N[d] + x->k_N_per_mm[d] * (L - x->Lref_mm[d]);
+            dT += x->k_N_per_mm[d];
+        }
+        s->L_mm[d] = L;
+        s->T_N[d] = T;
+        kT[d] = dT;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                s->P_MPa[i][j] += T * xv[i] * X[j] / (L * H3);
+    }
+    return CF_OK;
+}
+
+cf_status cf_cell_stress(const cf_cell *c, const double F[9], const cf_cell_extra *extra,
+                         cf_cell_state *s, cf_error *err)
+{
+    double kT[CF_CELL_DIRS];
+    s->stress_MPa = 0;
+    s->free_stretch = 1;
+    return evaluate(c, F, extra, s, kT, err);
+}
+
+/* dP[m][m] / dF[k][k] summed over the diagonal entries k whose bit is set in kmask, at state s:
+** dP_ij/dF_kl = (1/H^3) sum_d [(dT/dL - T/L) x_i X_j x_k X_l / L^2 + T delta_ik X_j X_l / L]. */
+static double tangent(const cf_cell *c, const cf_cell_state *s, const double kT[CF_CELL_DIRS],
+                      int m, unsigned kmask)
+{
+    const double H = c->law->p.H_mm, H3 = H * H * H;
+    double g = 0;
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        int N[3], fam;
+        cf_cell_direction(d, N, &fam);
+        double X[3] = {H * N[0], H * N[1], H * N[2]}, xv[3];
+        for (int i = 0; i < 3; i++)
+            xv[i] = s->F[3 * i] * X[0] + s->F[3 * i + 1] * X[1] + s->F[3 * i + 2] * X[2];
+        double L = s->L_mm[d], T = s->T_N[d];
+        for (int k = 0; k < 3; k++) {
+            if (!(kmask & (1u << k)))
+                continue;
+            g += (kT[d] - T / L) * xv[m] * X[m] * xv[k] * X[k] / (L * L * L * H3);
+            if (k == m)
+                g += T * X[m] * X[m] / (L * H3);
+        }
+    }
+    return g;
+}
+
+/* How mode m places F at strain e and free stretch a; which diagonal entries a sets (mask), which
+** diagonal stress it must zero (zero, or -1 for none) and which component is the stress read. */
+typedef struct mode_form {
+    unsigned free_mask;
+    int zero;
+    int si, sj;
+} mode_form;
+
+static mode_form form_of(cf_mode m)
+{
+    switch (m) {
+    case CF_MODE_UNIAXIAL: return (mode_form){3u, 0, 2, 2};
+    case CF_MODE_SHEAR: return (mode_form){0u, -1, 0, 2};
+    case CF_MODE_PLANAR: return (mode_form){4u, 2, 0, 0};
+    case CF_MODE_EQUIBIAXIAL: return (mode_form){4u, 2, 0, 0};
+    case CF_MODE_CONFINED: return (mode_form){0u, -1, 2, 2};
+    default: return (mode_form){0u, -1, 2, 2};
+    }
+}
+
+static void place(cf_mode m, double e, double a, double F[9])
+{
+    memset(F, 0, 9 * sizeof(double));
+    F[0] = F[4] = F[8] = 1;
+    switch (m) {
+    case CF_MODE_UNIAXIAL: F[0] = F[4] = a, F[8] = 1 + e; break;
+    case CF_MODE_SHEAR: F[2] = e; break;
+    case CF_MODE_PLANAR: F[0] = 1 + e, F[8] = a; break;
+    case CF_MODE_EQUIBIAXIAL: F[0] = F[4] = 1 + e, F[8] = a; break;
+    case CF_MODE_CONFINED: F[8] = 1 + e; break;
+    default: break;
+    }
+}
+
+/* First guess of the free stretch from the small-strain constants of the weights. */
+static double guess(const cf_cell *c, cf_mode m, double e)
+{
+    cf_cubic_moduli cm = cf_cubic_moduli_of(c->weight);
+    switch (m) {
+    case CF_MODE_UNIAXIAL: return 1 - cm.nu * e;
+    case CF_MODE_PLANAR: return 1 - cm.C12 / cm.C11 * e;
+    case CF_MODE_EQUIBIAXIAL: return 1 - 2 * cm.C12 / cm.C11 * e;
+    default: return 1;
+    }
+}
+
+cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extra *extra,
+                       cf_cell_state *s, cf_error *err)
+{
+    if ((int)m < 0 || m >= CF_MODE_COUNT)
+        return cf_error_set(err, CF_E_DATA, "mode %d: unknown", (int)m);
+    if (!isfinite(e) || !(e > -1))
+        return cf_error_set(err, CF_E_DATA, "%s strain %g: must be finite and > -1",
+                            cf_mode_name(m), e);
+    const mode_form fm = form_of(m);
+    double F[9], kT[CF_CELL_DIRS];
+    cf_status st;
+    if (fm.zero < 0) {
+        place(m, e, 1, F);
+        if ((st = evaluate(c, F, extra, s, kT, err)) != CF_OK)
+            return st;
+        s->free_stretch = 1;
+        s->stress_MPa = s->P_MPa[fm.si][fm.sj];
+        return CF_OK;
+    }
+    /* Safeguarded Newton on r(a) = P[zero][zero], increasing in a: a bracket [lo, hi] with
+    ** r(lo) < 0 < r(hi) is kept once known; a step that leaves it, or the domain, bisects. */
+    const cf_law *law = c->law;
+    const double sH = law->travel_mm / law->p.H_mm;
+    double lo = 1 - sH, hi = 1 + sH; /* the edge along a free axis reaches solid there */
+    int have_lo = 0, have_hi = 0;
+    double a = fmin(fmax(guess(c, m, e), lo + 1e-3 * sH), hi - 1e-3 * sH);
+    cf_error e1 = {0};
+    for (int it = 0; it < MAX_ITER; it++) {
+        place(m, e, a, F);
+        st = evaluate(c, F, extra, s, kT, &e1);
+        if (st != CF_OK) {
+            /* outside the domain: move halfway back toward the bracket's inside */
+            if (a > 1)
+                hi = a;
+            else
+                lo = a;
+            a = 0.5 * (lo + hi);
+            if (hi - lo <= 4 * DBL_EPSILON * hi)
+                break;
+            continue;
+        }
+        double r = s->P_MPa[fm.zero][fm.zero];
+        if (r == 0)
+            break;
+        if (r < 0)
+            lo = a, have_lo = 1;
+        else
+            hi = a, have_hi = 1;
+        double g = tangent(c, s, kT, fm.zero, fm.free_mask);
+        double an = a - r / g;
+        if (!(g > 0) || !(an > lo && an < hi)) {
+            if (have_lo && have_hi)
+                an = 0.5 * (lo + hi);
+            else /* expand toward the missing side */
+                an = r > 0 ? 0.5 * (lo + a) : 0.5 * (a + hi);
+        }
+        if (fabs(an - a) <= 2 * DBL_EPSILON * fabs(a)) {
+            a = an;
+            place(m, e, a, F);
+            if ((st = evaluate(c, F, extra, s, kT, &e1)) != CF_OK)
+                break;
+            s->free_stretch = a;
+            s->stress_MPa = s->P_MPa[fm.si][fm.sj];
+            return CF_OK;
+        }
+        a = an;
+    }
+    if (st == CF_OK && s->P_MPa[fm.zero][fm.zero] == 0) {
+        s->free_stretch = a;
+        s->stress_MPa = s->P_MPa[fm.si][fm.sj];
+        return CF_OK;
+    }
+    if (st != CF_OK && (have_lo || have_hi))
+        return cf_error_set(err, CF_E_DATA, "%s strain %g: %s", cf_mode_name(m), e, e1.msg);
+    if (st != CF_OK)
+        return cf_error_set(err, CF_E_DATA, "%s strain %g is beyond what the lattice reaches: %s",
+                            cf_mode_name(m), e, e1.msg);
+    return cf_error_set(err, CF_E_NOCONV,
+                        "%s strain %g: no free stretch gives zero lateral stress (last %.17g)",
+                        cf_mode_name(m), e, a);
+}
+
+cf_status cf_cell_curve(const cf_cell *c, cf_mode m, const double *strain, size_t count,
+                        double *stress_MPa, cf_error *err)
+{
+    cf_cell_state s;
+    for (size_t i = 0; i < count; i++) {
+        cf_status st = cf_cell_mode(c, m, strain[i], NULL, &s, err);
+        if (st != CF_OK)
+            return st;
+        stress_MPa[i] = s.stress_MPa;
+    }
+    return CF_OK;
+}

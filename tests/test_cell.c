@@ -1,0 +1,237 @@
+/*
+** Tests of the homogenised cell (src/model/cell.c): it equals the full lattice's static uniaxial
+** solution to 1e-9 for several cell counts and calibrations, in tension and compression; its
+** small-strain response in every mode is the one the Cauchy-Born constants predict; the stress is
+** frame-indifferent; the free stretch leaves no lateral stress; extra tensions enter as forces on
+** the faces; bad input is refused.
+*/
+#include "testutil.h"
+
+#include "conifit/cell.h"
+#include "conifit/msm.h"
+
+/* A soft, strongly stiffening non-telescoping spring (solid strain 0.5, H = 10 mm), and a
+** telescoping one with a deeper nonlinear range. */
+static cf_law law_of(int which)
+{
+    cf_spring a = {6, 15, 2.5, 2, 26, 10};
+    cf_spring b = {8, 20, 2.5, 1.2, 100, 5};
+    cf_law law;
+    cf_error err = {0};
+    if (cf_law_init(&law, which ? &b : &a, &err) != CF_OK)
+        fail_msg("spring refused: %s", err.msg);
+    return law;
+}
+
+/* The isotropic cell of law with evaluator m. */
+static cf_cell iso_cell(const cf_law *law, cf_law_method m)
+{
+    double w[3];
+    assert_int_equal(cf_calibration_weights(CF_CAL_ISOTROPIC, w, NULL), CF_OK);
+    cf_cell c;
+    assert_int_equal(cf_cell_init(&c, law, m, w, NULL), CF_OK);
+    return c;
+}
+
+static void cell_equals_the_full_lattice_in_uniaxial_tension_and_compression(void **state)
+{
+    (void)state;
+    const int sizes[4][3] = {{1, 1, 1}, {2, 3, 2}, {3, 3, 3}, {4, 2, 3}};
+    for (int which = 0; which < 2; which++) {
+        cf_law law = law_of(which);
+        double sH = law.travel_mm / law.p.H_mm;
+        /* up to 0.9 of the solid strain in tension, 0.6 in compression (inside the stable range
+        ** of the default lattice) */
+        double e[] = {-0.6 * sH, -0.45 * sH, -0.3 * sH, -0.1 * sH, -0.01 * sH,
+                      0.01 * sH,  0.2 * sH,  0.5 * sH,  0.75 * sH, 0.9 * sH};
+        const size_t n = sizeof e / sizeof e[0];
+        for (int cal = 0; cal < 3; cal++) {
+            double w[3] = {1, 0.5, 0.3};
+            if (cal < 2)
+                assert_int_equal(cf_calibration_weights(cal ? CF_CAL_AXIAL : CF_CAL_ISOTROPIC, w,
+                                                        NULL),
+                                 CF_OK);
+            cf_cell c;
+            assert_int_equal(cf_cell_init(&c, &law, CF_LAW_CLOSED, w, NULL), CF_OK);
+            double cell[10];
+            cf_error err = {0};
+            if (cf_cell_curve(&c, CF_MODE_UNIAXIAL, e, n, cell, &err) != CF_OK)
+                fail_msg("cell: %s", err.msg);
+            for (int z = 0; z < 4; z++) {
+                cf_msm_config cfg = cf_msm_default();
+                cfg.lattice.nx = sizes[z][0];
+                cfg.lattice.ny = sizes[z][1];
+                cfg.lattice.nz = sizes[z][2];
+                memcpy(cfg.lattice.weight, w, sizeof w);
+                double full[10];
+                if (cf_msm_uniaxial(&law, CF_LAW_CLOSED, &cfg, e, n, full, NULL, &err) != CF_OK)
+                    fail_msg("lattice %dx%dx%d: %s", sizes[z][0], sizes[z][1], sizes[z][2],
+                             err.msg);
+                for (size_t i = 0; i < n; i++)
+                    if (!(fabs(cell[i] - full[i]) <= 1e-9 * fabs(full[i])))
+                        fail_msg("spring %d, weights %g/%g/%g, %dx%dx%d cells, strain %g: cell "
+                                 "%.17g, lattice %.17g",
+                                 which, w[0], w[1], w[2], sizes[z][0], sizes[z][1], sizes[z][2],
+                                 e[i], cell[i], full[i]);
+            }
+        }
+    }
+}
+
+/* At a small strain each mode's stress is the Cauchy-Born prediction from C11, C12 = C44 (in
+** units of k0/H), and the uniaxial free stretch gives nu. */
+static void small_strain_response_of_every_mode_follows_the_elastic_constants(void **state)
+{
+    (void)state;
+    cf_law law = law_of(0);
+    const double E0 = law.k0_N_per_mm / law.p.H_mm;
+    double weights[2][3] = {{0, 0, 0}, {1, 0.5, 0.3}};
+    cf_calibration_weights(CF_CAL_ISOTROPIC, weights[0], NULL);
+    for (int k = 0; k < 2; k++) {
+        cf_cell c;
+        assert_int_equal(cf_cell_init(&c, &law, CF_LAW_EXACT, weights[k], NULL), CF_OK);
+        cf_cubic_moduli m = cf_cubic_moduli_of(weights[k]);
+        const double want[CF_MODE_COUNT] = {
+            m.E, m.C44, m.C11 - m.C12 * m.C12 / m.C11,
+            m.C11 + m.C12 - 2 * m.C12 * m.C12 / m.C11, m.C11};
+        const double e = 1e-7;
+        for (int md = 0; md < CF_MODE_COUNT; md++) {
+            cf_cell_state s;
+            cf_error err = {0};
+            if (cf_cell_mode(&c, (cf_mode)md, e, NULL, &s, &err) != CF_OK)
+                fail_msg("%s: %s", cf_mode_name((cf_mode)md), err.msg);
+            assert_close(s.stress_MPa / (e * E0), want[md], 1e-6 * want[md]);
+            if (md == CF_MODE_UNIAXIAL) {
+                assert_close((1 - s.free_stretch) / e, m.nu, 1e-6);
+                /* rounding: the springs' compressions are formed from lengths, ~1e-16 H */
+                assert_close(s.P_MPa[0][0], 0, 1e-14 * E0);
+                assert_close(s.P_MPa[1][1], 0, 1e-14 * E0);
+            }
+            if (md == CF_MODE_PLANAR || md == CF_MODE_EQUIBIAXIAL)
+                assert_close(s.P_MPa[2][2], 0, 1e-14 * E0);
+        }
+        if (k == 0)
+            assert_close(m.nu, 0.25, 1e-15);
+    }
+}
+
+/* Deep in the nonlinear range the free stretch still leaves no lateral stress, and the uniaxial
+** stress is continuous and increasing from compression to tension. */
+static void uniaxial_curve_is_monotonic_with_zero_lateral_stress(void **state)
+{
+    (void)state;
+    cf_law law = law_of(1);
+    cf_cell c = iso_cell(&law, CF_LAW_CLOSED);
+    double sH = law.travel_mm / law.p.H_mm, prev = -INFINITY;
+    for (int i = -95; i <= 95; i++) {
+        cf_cell_state s;
+        cf_error err = {0};
+        double e = 0.01 * i * sH;
+        if (cf_cell_mode(&c, CF_MODE_UNIAXIAL, e, NULL, &s, &err) != CF_OK)
+            fail_msg("strain %g: %s", e, err.msg);
+        assert_true(s.stress_MPa > prev);
+        prev = s.stress_MPa;
+        assert_true(fabs(s.P_MPa[0][0]) <= 1e-13 * (fabs(s.stress_MPa) + law.k0_N_per_mm / law.p.H_mm));
+        assert_true(s.max_u_over_travel < 1);
+    }
+}
+
+/* P(R U) = R P(U) for a rotation R: the stress of a rotated deformation is the rotated stress. */
+static void stress_is_frame_indifferent(void **state)
+{
+    (void)state;
+    cf_law law = law_of(0);
+    cf_cell c = iso_cell(&law, CF_LAW_EXACT);
+    double U[9] = {1.1, 0.05, 0.02, 0.05, 0.92, -0.03, 0.02, -0.03, 1.04};
+    double t = 0.7, R[9] = {cos(t), -sin(t), 0, sin(t), cos(t), 0, 0, 0, 1}, RU[9];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            RU[3 * i + j] = 0;
+            for (int k = 0; k < 3; k++)
+                RU[3 * i + j] += R[3 * i + k] * U[3 * k + j];
+        }
+    cf_cell_state a, b;
+    assert_int_equal(cf_cell_stress(&c, U, NULL, &a, NULL), CF_OK);
+    assert_int_equal(cf_cell_stress(&c, RU, NULL, &b, NULL), CF_OK);
+    double scale = 0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            scale = fmax(scale, fabs(a.P_MPa[i][j]));
+    assert_true(scale > 0);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            double r = 0;
+            for (int k = 0; k < 3; k++)
+                r += R[3 * i + k] * a.P_MPa[k][j];
+            assert_close(b.P_MPa[i][j], r, 1e-13 * scale);
+        }
+}
+
+/* An extra tension T0 on the z edge of the undeformed cell is a traction T0/H^2 on the top face;
+** an extra stiffness k on it adds k H / H^2 per unit confined strain (a dashpot's form). */
+static void extra_tensions_act_as_spring_forces(void **state)
+{
+    (void)state;
+    cf_law law = law_of(0);
+    const double H = law.p.H_mm;
+    cf_cell c = iso_cell(&law, CF_LAW_CLOSED);
+    int zedge = -1;
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        int N[3], f;
+        cf_cell_direction(d, N, &f);
+        if (N[0] == 0 && N[1] == 0 && N[2] == 1)
+            zedge = d;
+        assert_int_equal(f, abs(N[0]) + abs(N[1]) + abs(N[2]) - 1);
+    }
+    assert_true(zedge >= 0);
+    cf_cell_extra x;
+    memset(&x, 0, sizeof x);
+    for (int d = 0; d < CF_CELL_DIRS; d++)
+        x.Lref_mm[d] = H;
+    x.T0_N[zedge] = 0.01;
+    cf_cell_state s0, s1;
+    assert_int_equal(cf_cell_mode(&c, CF_MODE_CONFINED, 0, &x, &s1, NULL), CF_OK);
+    assert_close(s1.stress_MPa, 0.01 / (H * H), 1e-15);
+    x.T0_N[zedge] = 0;
+    x.k_N_per_mm[zedge] = 0.02;
+    const double e = 0.05;
+    assert_int_equal(cf_cell_mode(&c, CF_MODE_CONFINED, e, NULL, &s0, NULL), CF_OK);
+    assert_int_equal(cf_cell_mode(&c, CF_MODE_CONFINED, e, &x, &s1, NULL), CF_OK);
+    assert_close(s1.stress_MPa - s0.stress_MPa, 0.02 * e * H / (H * H), 1e-15);
+}
+
+static void bad_input_is_refused(void **state)
+{
+    (void)state;
+    cf_law law = law_of(0);
+    double w[3] = {1, -1, 0};
+    cf_cell c;
+    cf_error err = {0};
+    assert_int_equal(cf_cell_init(&c, &law, CF_LAW_CLOSED, w, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "lattice.weights.face"));
+    cf_calibration_weights(CF_CAL_ISOTROPIC, w, NULL);
+    assert_int_equal(cf_cell_init(&c, &law, CF_LAW_CLOSED, w, NULL), CF_OK);
+    cf_mode m;
+    assert_int_equal(cf_mode_parse("torsion", &m, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "'torsion'"));
+    assert_int_equal(cf_mode_parse("planar", &m, NULL), CF_OK);
+    assert_int_equal(m, CF_MODE_PLANAR);
+    cf_cell_state s;
+    /* past the solid strain 0.5 in compression, and a NaN */
+    assert_int_equal(cf_cell_mode(&c, CF_MODE_UNIAXIAL, -0.55, NULL, &s, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "solid"));
+    assert_int_equal(cf_cell_mode(&c, CF_MODE_SHEAR, NAN, NULL, &s, &err), CF_E_DATA);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(cell_equals_the_full_lattice_in_uniaxial_tension_and_compression),
+        cmocka_unit_test(small_strain_response_of_every_mode_follows_the_elastic_constants),
+        cmocka_unit_test(uniaxial_curve_is_monotonic_with_zero_lateral_stress),
+        cmocka_unit_test(stress_is_frame_indifferent),
+        cmocka_unit_test(extra_tensions_act_as_spring_forces),
+        cmocka_unit_test(bad_input_is_refused),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
