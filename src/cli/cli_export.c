@@ -1,8 +1,9 @@
 /*
-** The export subcommand: a fitted spring written for another simulator (see export.h).
-** The whole output is produced in memory first, so a failure never leaves partial output on
-** stdout or in the -o file.
+** The export subcommand: a fitted spring, or the whole calibrated lattice, written for another
+** simulator (see export.h). The whole output is produced in memory first, so a failure never
+** leaves partial output on stdout or in the -o file.
 */
+#include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,95 +12,171 @@
 #include "cli/cli.h"
 #include "conifit/export.h"
 #include "conifit/fitfile.h"
+#include "conifit/scene.h"
 
 static const char export_help[] =
-    "usage: conifit export FIT.json --format F [--type T] [-o FILE] [--tol REL] [--degree N]\n"
+    "usage: conifit export FIT.json --format F [--type T] [-o FILE] [--tol REL] [--range LO:HI]\n"
     "                      [--example]\n"
-    "Writes a fitted spring for another simulator. Tables are sampled adaptively so that linear\n"
-    "interpolation stays within --tol of the law (relative to the local force, floor 1e-3 F_C),\n"
-    "from full stretch to a hair before solid; the achieved maximum error and the row count are\n"
-    "printed on stderr. Units: mm, N, s, tonne (stated inside each file).\n\n"
-    "  --format F   json | csv | calculix | abaqus | febio | lsdyna | sofa\n"
-    "  --type T     telescoping | non-telescoping (default: the fit's better type)\n"
-    "  -o FILE      output file (default stdout); written atomically\n"
-    "  --tol REL    relative tolerance of the table, 1e-9..0.1 (default 1e-4; for calculix\n"
-    "               the smallest of 1e-4, 2e-4, 5e-4, 1e-3, ... whose table fits CalculiX's\n"
-    "               200 rows)\n"
-    "  --degree N   sofa: degree of the polynomial in strain, 1..15 (default 7)\n"
-    "  --example    calculix/abaqus: a complete one-spring .inp instead of the *SPRING block\n\n"
+    "       conifit export FIT.json --lattice [SCENE.json] --format F [--type T] [-o FILE]\n"
+    "                      [--tol REL]\n"
+    "Writes a fitted spring for another simulator as a force-displacement table within --tol\n"
+    "of F_C of the law (nodes placed where the interpolation error is, the achieved error\n"
+    "measured on an independent dense grid). With --lattice, writes the validation lattice\n"
+    "built from the spring (every spring family with its weight and its own table, boundary\n"
+    "conditions, the uniaxial loading of SCENE.json or, without it, 20 steps to half the solid\n"
+    "strain, and output requests) as a model that runs in the target as it is; conifit's own\n"
+    "reaction at every step is written in its header. Row count and error go to stderr.\n"
+    "Units: mm, N, s, tonne (stated inside each file).\n\n"
+    "  --format F       json | csv | calculix | abaqus | febio | lsdyna | sofa\n"
+    "  --type T         telescoping | non-telescoping (default: the fit's better type)\n"
+    "  -o, --output F   output file (default stdout); written atomically\n"
+    "  --tol REL        table tolerance as a fraction of F_C, 1e-9..0.1 (default 1e-4; for\n"
+    "                   calculix/abaqus, without --tol, the smallest of 1e-4, 2e-4, 5e-4, ...\n"
+    "                   whose table fits CalculiX's 200 pairs)\n"
+    "  --range LO:HI    compressions (mm, > 0 shortens) the table covers, LO <= 0 <= HI, e.g.\n"
+    "                   0:4.5 for compression only (default: full stretch to just before solid)\n"
+    "  --example        a complete one-spring model that runs as it is (every format but json\n"
+    "                   and csv; sofa always writes a scene)\n"
+    "  --lattice        the whole lattice model (see above)\n"
+    "  -q, --quiet      no summary on stderr\n\n"
     "FIT.json is a fit file (conifit fit -o) or an exported spring (--format json).\n";
+
+/* Parses "LO:HI" (mm). */
+static cf_status parse_range(const char *text, double *lo, double *hi, cf_error *err)
+{
+    const char *colon = text ? strchr(text, ':') : NULL;
+    if (!colon)
+        return cf_error_set(err, CF_E_USAGE, "option --range: '%s' is not LO:HI (mm)",
+                            text ? text : "");
+    char a[64];
+    size_t n = (size_t)(colon - text);
+    if (n == 0 || n >= sizeof a)
+        return cf_error_set(err, CF_E_USAGE, "option --range: '%s' is not LO:HI (mm)", text);
+    memcpy(a, text, n);
+    a[n] = '\0';
+    if (cf_cli_parse_double("--range", a, lo, err) != CF_OK ||
+        cf_cli_parse_double("--range", colon + 1, hi, err) != CF_OK)
+        return CF_E_USAGE;
+    if (*lo > 0.0 || *hi < 0.0 || !(*hi > *lo))
+        return cf_error_set(err, CF_E_USAGE,
+                            "option --range: %g:%g must have LO <= 0 <= HI and LO < HI (mm; the "
+                            "rest state u = 0 is always in the table)",
+                            *lo, *hi);
+    return CF_OK;
+}
 
 int cf_cli_export(int argc, char **argv)
 {
+    enum { OPT_FORMAT = 256, OPT_TYPE, OPT_TOL, OPT_RANGE, OPT_EXAMPLE, OPT_LATTICE };
+    static const struct option longopts[] = {
+        {"format", required_argument, NULL, OPT_FORMAT},
+        {"type", required_argument, NULL, OPT_TYPE},
+        {"output", required_argument, NULL, 'o'},
+        {"tol", required_argument, NULL, OPT_TOL},
+        {"range", required_argument, NULL, OPT_RANGE},
+        {"example", no_argument, NULL, OPT_EXAMPLE},
+        {"lattice", no_argument, NULL, OPT_LATTICE},
+        {"quiet", no_argument, NULL, 'q'},
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
     cf_error err = {0};
     cf_export_options opt = cf_export_default_options();
-    const char *fit_path = NULL, *type = NULL, *out_path = NULL;
-    int have_format = 0, tol_given = 0;
-    for (int i = 1; i < argc; i++) {
-        const char *val;
-        int m;
-        if (cf_cli_is_help(argv[i])) {
-            fputs(export_help, stdout);
-            return CF_EXIT_OK;
-        }
-        if ((m = cf_cli_match(argc, argv, &i, "--format", &val, &err)) != 0) {
-            if (m < 0 || cf_export_format_parse(val, &opt.format, &err) != CF_OK)
+    const char *type = NULL, *out_path = NULL;
+    int have_format = 0, tol_given = 0, lattice = 0, quiet = 0, c;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":o:qh", longopts, NULL)) != -1) {
+        switch (c) {
+        case OPT_FORMAT:
+            if (cf_export_format_parse(optarg, &opt.format, &err) != CF_OK)
                 return cf_cli_usage_error("export", "%s", err.msg);
             have_format = 1;
-            continue;
-        }
-        if ((m = cf_cli_match(argc, argv, &i, "--type", &val, &err)) != 0) {
+            break;
+        case OPT_TYPE: {
             cf_spring_type t;
-            if (m < 0 || cf_spring_type_parse(val, &t, &err) != CF_OK)
+            if (cf_spring_type_parse(optarg, &t, &err) != CF_OK)
                 return cf_cli_usage_error("export", "%s", err.msg);
-            type = val;
-            continue;
+            type = optarg;
+            break;
         }
-        if ((m = cf_cli_match(argc, argv, &i, "-o", &val, &err)) != 0) {
-            if (m < 0)
+        case 'o':
+            out_path = optarg;
+            break;
+        case OPT_TOL:
+            if (cf_cli_parse_double("--tol", optarg, &opt.tol, &err) != CF_OK)
                 return cf_cli_usage_error("export", "%s", err.msg);
-            out_path = val;
-            continue;
-        }
-        if ((m = cf_cli_match(argc, argv, &i, "--tol", &val, &err)) != 0) {
-            if (m < 0 || cf_cli_parse_double("--tol", val, &opt.tol, &err) != CF_OK)
-                return cf_cli_usage_error("export", "%s", err.msg);
-            tol_given = 1;
             if (opt.tol < CF_EXPORT_TOL_MIN || opt.tol > CF_EXPORT_TOL_MAX)
                 return cf_cli_usage_error("export", "option --tol: %g is outside [%g, %g]",
                                           opt.tol, CF_EXPORT_TOL_MIN, CF_EXPORT_TOL_MAX);
-            continue;
-        }
-        if ((m = cf_cli_match(argc, argv, &i, "--degree", &val, &err)) != 0) {
-            long d;
-            if (m < 0 || cf_cli_parse_long("--degree", val, 1, CF_EXPORT_DEGREE_MAX, &d, &err))
+            tol_given = 1;
+            break;
+        case OPT_RANGE:
+            if (parse_range(optarg, &opt.u_lo_mm, &opt.u_hi_mm, &err) != CF_OK)
                 return cf_cli_usage_error("export", "%s", err.msg);
-            opt.degree = (int)d;
-            continue;
-        }
-        if (strcmp(argv[i], "--example") == 0) {
+            opt.have_range = 1;
+            break;
+        case OPT_EXAMPLE:
             opt.example = 1;
-            continue;
+            break;
+        case OPT_LATTICE:
+            lattice = 1;
+            break;
+        case 'q':
+            quiet = 1;
+            break;
+        case 'h':
+            fputs(export_help, stdout);
+            return CF_EXIT_OK;
+        case ':':
+            return cf_cli_usage_error("export", "option %s needs a value", argv[optind - 1]);
+        default:
+            return cf_cli_usage_error("export", "unknown option '%s'", argv[optind - 1]);
         }
-        if (argv[i][0] == '-' && argv[i][1] != '\0')
-            return cf_cli_usage_error("export", "unknown option '%s'", argv[i]);
-        if (fit_path)
-            return cf_cli_usage_error("export", "more than one fit file ('%s' and '%s')",
-                                      fit_path, argv[i]);
-        fit_path = argv[i];
     }
-    if (!fit_path)
+    const int npos = argc - optind;
+    if (npos < 1)
         return cf_cli_usage_error("export", "missing the fit file");
+    if (npos > (lattice ? 2 : 1))
+        return cf_cli_usage_error("export", "unexpected argument '%s'", argv[optind + npos - 1]);
+    const char *fit_path = argv[optind];
+    const char *scene_path = npos == 2 ? argv[optind + 1] : NULL;
     if (!have_format)
         return cf_cli_usage_error("export", "missing option --format");
-    if (opt.example && opt.format != CF_EXPORT_CALCULIX && opt.format != CF_EXPORT_ABAQUS)
-        return cf_cli_usage_error("export", "--example is for --format calculix or abaqus");
+    if (opt.example && (opt.format == CF_EXPORT_JSON || opt.format == CF_EXPORT_CSV))
+        return cf_cli_usage_error("export", "--example needs a simulator format (calculix, "
+                                            "abaqus, febio, lsdyna or sofa): json and csv are "
+                                            "data, not models");
+    if (lattice && (opt.format == CF_EXPORT_JSON || opt.format == CF_EXPORT_CSV))
+        return cf_cli_usage_error("export", "--lattice needs a simulator format (calculix, "
+                                            "abaqus, febio, lsdyna or sofa)");
+    if (lattice && (opt.example || opt.have_range))
+        return cf_cli_usage_error("export", "--lattice takes neither --example nor --range (the "
+                                            "lattice's tables cover the whole travel)");
 
     cf_fitted_spring fs;
     if (cf_fitfile_load(fit_path, type, &fs, &err) != CF_OK)
         return cf_cli_fail(&err);
     opt.source = fit_path;
     opt.auto_tol = !tol_given;
+
+    cf_export_lattice lx;
+    if (lattice) {
+        if (scene_path) {
+            cf_scene sc;
+            if (cf_scene_load(scene_path, &sc, &err) != CF_OK)
+                return cf_cli_fail(&err);
+            cf_status st = cf_export_lattice_from_scene(&sc, scene_path, &lx, &err);
+            cf_scene_free(&sc);
+            if (st != CF_OK)
+                return cf_cli_fail(&err);
+        } else {
+            cf_law law;
+            if (cf_law_init(&law, &fs.params, &err) != CF_OK)
+                return cf_cli_fail(&err);
+            lx = cf_export_lattice_default(&law);
+            cf_law_free(&law);
+        }
+    }
 
     char *buf = NULL;
     size_t len = 0;
@@ -109,16 +186,17 @@ int cf_cli_export(int argc, char **argv)
         return cf_cli_fail(&err);
     }
     cf_export_report rep;
-    cf_status st = cf_export_write(mem, &fs, &opt, &rep, &err);
+    cf_status st = lattice ? cf_export_write_lattice(mem, &fs, &opt, &lx, &rep, &err)
+                           : cf_export_write(mem, &fs, &opt, &rep, &err);
     if (fclose(mem) != 0 && st == CF_OK)
         st = cf_error_set(&err, CF_E_INTERNAL, "out of memory");
     if (st != CF_OK) {
         free(buf);
         return cf_cli_fail(&err);
     }
-    if (out_path) {
+    if (out_path && strcmp(out_path, "-") != 0) {
         cf_atomic a;
-        const char *inputs[2] = {fit_path, NULL};
+        const char *inputs[3] = {fit_path, scene_path, NULL};
         if (cf_atomic_open(&a, out_path, inputs, &err) != CF_OK) {
             free(buf);
             return cf_cli_fail(&err);
@@ -134,15 +212,19 @@ int cf_cli_export(int argc, char **argv)
         return cf_cli_fail(&err);
     }
     free(buf);
-    if (opt.format == CF_EXPORT_SOFA)
+    if (quiet || opt.format == CF_EXPORT_JSON)
+        return CF_EXIT_OK;
+    if (lattice)
         fprintf(stderr,
-                "conifit export: sofa polynomial of degree %d, max error %.3g N (%.3g of F_C)\n",
-                opt.degree, rep.max_err_N, rep.max_err_rel);
-    else if (opt.format != CF_EXPORT_JSON)
+                "conifit export: %s lattice, %zu nodes, %zu springs in %zu groups, %zu load "
+                "steps; tables of %zu rows, max error %.3g of F_C (%.3g N), tol %g\n",
+                cf_export_format_name(opt.format), rep.nodes, rep.springs, rep.groups, rep.steps,
+                rep.rows, rep.max_err_rel, rep.max_err_N, rep.tol);
+    else
         fprintf(stderr,
-                "conifit export: %s, %zu rows, max error %.3g relative (%.3g N), tol %g, "
-                "table ends at |u| = %.10g mm\n",
+                "conifit export: %s, %zu rows, max error %.3g of F_C (%.3g N), tol %g, table "
+                "over u in [%.10g, %.10g] mm\n",
                 cf_export_format_name(opt.format), rep.rows, rep.max_err_rel, rep.max_err_N,
-                rep.tol, rep.u_end_mm);
+                rep.tol, rep.u_lo_mm, rep.u_hi_mm);
     return CF_EXIT_OK;
 }

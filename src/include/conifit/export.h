@@ -1,20 +1,19 @@
 /*
-** Export of a fitted conical spring to other simulators: the law sampled into an adaptive
-** force-displacement table (or fitted by a polynomial in strain), written in each target's own
-** conventions and units.
+** Export of a fitted conical spring, or of the whole calibrated lattice it was validated in, to
+** other simulators: the law as a force-displacement table, written in each target's own
+** conventions and units, either as a block to paste into a model or as a model that runs as it is.
 **
-** The table. Rows run from full stretch to just before solid, u in [-u_end, +u_end] (mm), with
-** rows always at 0, +-u_T and +-u_end. Rows are placed by bisection until linear interpolation
-** between two rows stays within the tolerance of the law, measured as
-**     |F_table(u) - F(u)| <= tol * max(|F(u)|, CF_EXPORT_FLOOR * F_C)
-** i.e. relative to the local force, with an absolute floor of tol * 1e-3 * F_C where the force
-** itself is tiny (around u = 0; region 1 is linear, so the table is exact there anyway).
-** Near solid the stiffness grows like (s - u)^(-1/2), so the table stops a hair before solid,
-** at u_end = the compression where the law carries F_C (1 - tol): past u_end, a simulator that
-** holds the last force constant is within tol * F_C of the law up to solid (where the law clamps
-** at F_C), and one that extrapolates the last slope behaves as a stiff solid stop.
-** The achieved error is measured afterwards on a dense grid independent of the rows (uniform in
-** u, and uniform in sqrt(1 - |u|/s), which crowds towards solid) with the exact evaluator.
+** The table (src/out/export_table.c). Rows run over a range of compressions u (mm), by default
+** from full stretch to just before solid, with rows always at 0, +-u_T and the two ends. The
+** tolerance is a fraction of the solid load: everywhere in the range
+**     |F_table(u) - F(u)| <= tol * F_C.
+** Nodes are placed by equidistributing the interpolation error (density ~ |F''|^(1/2)), interior
+** values are moved by half the local interpolation error (a best approximation rather than the
+** interpolant), and the achieved error is measured on a dense grid that knows nothing of the rows
+** (uniform in u, and uniform in sqrt(1 - |u|/s), which crowds towards solid). Near solid the
+** stiffness grows like (s - u)^(-1/2), so the full range stops at u_end, where the law carries
+** F_C (1 - tol): a simulator that holds the last force beyond it (CalculiX, FEBio CONSTANT) is
+** within tol F_C of the law up to solid.
 **
 ** Sign conventions: conifit's u > 0 compresses and F has the sign of u. CalculiX, Abaqus,
 ** FEBio, LS-DYNA and SOFA take tension positive, so their tables hold elongation = -u (mm) and
@@ -29,20 +28,19 @@
 #include "conifit/error.h"
 #include "conifit/fitfile.h"
 #include "conifit/law.h"
+#include "conifit/msm.h"
+#include "conifit/scene.h"
 
-/* Absolute floor of the table tolerance, as a fraction of F_C (see above). */
-#define CF_EXPORT_FLOOR 1e-3
-/* Default relative tolerance of the table, and the range accepted. Below 1e-9 the rows near
-** solid would have to be closer than the spacing of doubles allows. */
+/* Default tolerance of the table (fraction of F_C), and the range accepted. Below 1e-9 the rows
+** near solid would have to be closer than the spacing of doubles allows. */
 #define CF_EXPORT_TOL_DEFAULT 1e-4
 #define CF_EXPORT_TOL_MIN 1e-9
 #define CF_EXPORT_TOL_MAX 0.1
-/* CalculiX 2.20 keeps at most 200 (force, elongation) pairs of a nonlinear *SPRING and silently
-** ignores the rest (found by running ccx on longer tables), so its export refuses larger tables. */
+/* CalculiX copies a nonlinear spring's curve into a fixed local array of 200 (elongation, force)
+** pairs with the pair count stored right after it (plconloc(802) in ccx's materialdata_sp.f);
+** a longer table is read without a message and corrupts that count, which perturbs the whole
+** curve. Exports for CalculiX (and Abaqus, so that the same file runs in both) keep to 200. */
 #define CF_EXPORT_CALCULIX_MAX_ROWS 200
-/* Default and largest degree of the SOFA polynomial. */
-#define CF_EXPORT_DEGREE_DEFAULT 7
-#define CF_EXPORT_DEGREE_MAX 15
 
 typedef enum cf_export_format {
     CF_EXPORT_JSON = 0,
@@ -57,19 +55,28 @@ typedef enum cf_export_format {
 /* A force-displacement table of the law, rows ascending in u. */
 typedef struct cf_export_table {
     size_t rows;
-    double *u_mm;        /* compression of each row, mm (ascending, odd-symmetric) */
-    double *F_N;         /* force of the law at u, N */
+    double *u_mm;        /* compression of each row, mm (ascending) */
+    double *F_N;         /* force of the table at u, N (within tol F_C of the law) */
     double *k_N_per_mm;  /* tangent stiffness of the law at u, N/mm */
-    double tol;          /* requested relative tolerance */
-    double u_end_mm;     /* last row: where the law carries F_C (1 - tol), mm */
-    double max_err_rel;  /* achieved maximum of |F_table - F| / max(|F|, FLOOR F_C) */
-    double max_err_N;    /* |F_table - F| at that point, N */
+    double tol;          /* requested tolerance, fraction of F_C */
+    double u_lo_mm;      /* first row (<= 0: the largest stretch), mm */
+    double u_hi_mm;      /* last row (>= 0: the largest compression), mm */
+    double max_err_rel;  /* achieved maximum |F_table - F| / F_C over [u_lo, u_hi] */
+    double max_err_N;    /* the same in N */
     double max_err_u_mm; /* where it occurs, mm */
 } cf_export_table;
 
-/* Samples the law into t (see the top of this file). CF_E_DATA for a tolerance outside
-** [CF_EXPORT_TOL_MIN, CF_EXPORT_TOL_MAX], CF_E_INTERNAL when memory runs out. */
+/* Where the full-range table ends: the compression (mm) at which the law carries F_C (1 - tol). */
+double cf_export_table_end(const cf_law *law, double tol);
+
+/* Samples the law into t over [-u_end, u_end] (see the top of this file). CF_E_DATA for a
+** tolerance outside [CF_EXPORT_TOL_MIN, CF_EXPORT_TOL_MAX], CF_E_INTERNAL when memory runs out. */
 cf_status cf_export_table_build(const cf_law *law, double tol, cf_export_table *t, cf_error *err);
+
+/* The same over [u_lo, u_hi] (mm, u_lo <= 0 <= u_hi): CF_E_DATA naming the limit when the range
+** passes the end of the travel (|u| > u_end) or does not contain the rest state. */
+cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo_mm,
+                                      double u_hi_mm, cf_export_table *t, cf_error *err);
 
 /* Releases the rows of t; safe on a zeroed table. */
 void cf_export_table_free(cf_export_table *t);
@@ -77,29 +84,15 @@ void cf_export_table_free(cf_export_table *t);
 /* Linear interpolation of the table at u (mm), N; the end rows' forces outside the table. */
 double cf_export_table_eval(const cf_export_table *t, double u_mm);
 
-/* A least-squares polynomial in strain for SOFA: tension force (N) = sum_k a[k-1] L^k, k = 1..
-** degree, L = elongation / H = -u/H, fitted on a grid uniform in u over [-u_end, u_end]. */
-typedef struct cf_export_poly {
-    int degree;
-    double a_N[CF_EXPORT_DEGREE_MAX]; /* coefficient of L^(k), N, k = 1..degree */
-    double max_err_N;                 /* maximum |poly - law| on the check grid, N */
-    double max_err_rel_FC;            /* the same relative to F_C */
-} cf_export_poly;
-
-cf_status cf_export_poly_fit(const cf_law *law, const cf_export_table *t, int degree,
-                             cf_export_poly *poly, cf_error *err);
-
-/* The polynomial's tension force (N) at strain L (elongation / H). */
-double cf_export_poly_eval(const cf_export_poly *poly, double L);
-
 /* What to write. Build with cf_export_default_options, then change fields. */
 typedef struct cf_export_options {
     cf_export_format format;
-    double tol;          /* relative tolerance of the table */
-    int degree;          /* SOFA polynomial degree */
-    int example;         /* calculix/abaqus: a complete one-spring .inp instead of the block */
+    double tol;          /* tolerance of the table, fraction of F_C */
+    int have_range;      /* 1: the table covers [u_lo_mm, u_hi_mm] only */
+    double u_lo_mm, u_hi_mm; /* compression range of the table, mm (u_lo <= 0 <= u_hi) */
+    int example;         /* a complete one-spring model that runs as it is, instead of the block */
     const char *source;  /* name of the fit file, for provenance ("" or NULL if none) */
-    int auto_tol;        /* calculix: loosen tol (x2, x2.5, x2 ...) until the table fits
+    int auto_tol;        /* calculix/abaqus: loosen tol (x2, x2.5, x2 ...) until the table fits
                          ** CF_EXPORT_CALCULIX_MAX_ROWS rows, instead of refusing */
 } cf_export_options;
 
@@ -107,16 +100,56 @@ cf_export_options cf_export_default_options(void);
 
 /* What was written: row count and achieved error, for the user. */
 typedef struct cf_export_report {
-    size_t rows;          /* rows of the table written (0 for json) */
-    double max_err_rel;   /* achieved maximum error (table: relative, see above; sofa: / F_C) */
-    double max_err_N;     /* the same in N */
-    double u_end_mm;      /* last row of the table, mm */
+    size_t rows;          /* rows of the table written (largest of all groups for a lattice) */
+    double max_err_rel;   /* achieved maximum error, fraction of F_C */
+    double max_err_N;     /* the same in N (one spring, weight 1) */
+    double u_lo_mm, u_hi_mm; /* range of the table, mm */
     double tol;           /* tolerance the table was built with */
+    size_t groups;        /* lattice: spring groups (one table each) */
+    size_t springs;       /* lattice: springs */
+    size_t nodes;         /* lattice: nodes */
+    size_t steps;         /* lattice: load steps */
 } cf_export_report;
 
 /* Writes the spring in the chosen format to out. Never writes NaN or Inf. */
 cf_status cf_export_write(FILE *out, const cf_fitted_spring *fs, const cf_export_options *opt,
                           cf_export_report *rep, cf_error *err);
+
+/* Most load steps of a lattice export. */
+#define CF_EXPORT_MAX_STEPS 256
+
+/* The lattice to export and its loading: a static uniaxial compression (the validation's test),
+** reported at each strain of `strain` (compressive strain, -, > 0 shortens; increasing). */
+typedef struct cf_export_lattice {
+    cf_msm_config cfg;          /* lattice and Newton settings */
+    cf_law_method method;       /* evaluator of conifit's own reference run */
+    size_t nsteps;              /* load steps, <= CF_EXPORT_MAX_STEPS */
+    double strain[CF_EXPORT_MAX_STEPS]; /* compressive strain at the end of each step, - */
+} cf_export_lattice;
+/* Default loading: CF_EXPORT_DEFAULT_STEPS equal steps to this fraction of the solid strain. */
+#define CF_EXPORT_DEFAULT_STEPS 20
+#define CF_EXPORT_DEFAULT_STRAIN_FRACTION 0.5
+
+/* The validation's lattice (cf_validate_default) loaded in CF_EXPORT_DEFAULT_STEPS equal steps to
+** half the solid strain of law. */
+cf_export_lattice cf_export_lattice_default(const cf_law *law);
+
+/* The lattice and loading of a scene, which must be a static uniaxial compression: protocol
+** "ramp" under a displacement drive to a compressive strain, no time effect; the steps are the
+** scene's samples after t = 0. CF_E_DATA naming the key otherwise. */
+cf_status cf_export_lattice_from_scene(const cf_scene *sc, const char *name,
+                                       cf_export_lattice *lx, cf_error *err);
+
+/* Writes the lattice built from the fitted spring, every spring family (and each share of it at
+** the faces) as its own group with its weight and its own table, the boundary conditions, the
+** loading and the output requests, as a model that runs in the target (calculix, abaqus, febio,
+** lsdyna, sofa). conifit's own static run of the same lattice is done first: its top-face
+** reaction at every step is written into the file's header for comparison. CF_E_DATA when the
+** lattice cannot follow the loading (a solve fails, or a spring would pass the table's end),
+** with the largest strain that works. Never writes NaN or Inf. */
+cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
+                                  const cf_export_options *opt, const cf_export_lattice *lx,
+                                  cf_export_report *rep, cf_error *err);
 
 /* Parses json | csv | calculix | abaqus | febio | lsdyna | sofa; CF_E_DATA otherwise. */
 cf_status cf_export_format_parse(const char *name, cf_export_format *format, cf_error *err);

@@ -1,0 +1,276 @@
+/*
+** Export of the whole validation lattice (see export.h, cf_export_write_lattice): the lattice is
+** built from the fitted spring exactly as the validation builds it, run once by conifit's own
+** static solver along the loading (its top reaction at every step goes into the file, and a
+** loading it cannot follow is refused), and its springs are grouped by rest length and weight so
+** that each group carries one table: the law in strain form, u = -(L - L0) H/L0, times the
+** group's weight (the family's weight times the cell shares of a spring on a face or an edge).
+*/
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "conifit/export.h"
+#include "conifit/lattice.h"
+#include "conifit/validate.h"
+#include "out/export_model.h"
+
+/* Two springs belong to one group when their rest lengths and weights agree to this relative
+** difference (they are computed by the same formulas, so they agree to rounding). */
+#define GROUP_REL 1e-12
+
+cf_export_lattice cf_export_lattice_default(const cf_law *law)
+{
+    cf_export_lattice lx;
+    memset(&lx, 0, sizeof lx);
+    const cf_validate_setup v = cf_validate_default();
+    lx.cfg = v.cfg;
+    lx.method = v.method;
+    lx.nsteps = CF_EXPORT_DEFAULT_STEPS;
+    const double end = CF_EXPORT_DEFAULT_STRAIN_FRACTION * law->travel_mm / law->p.H_mm;
+    for (size_t k = 0; k < lx.nsteps; k++)
+        lx.strain[k] = end * (double)(k + 1) / (double)lx.nsteps;
+    return lx;
+}
+
+cf_status cf_export_lattice_from_scene(const cf_scene *sc, const char *name,
+                                       cf_export_lattice *lx, cf_error *err)
+{
+    memset(lx, 0, sizeof *lx);
+    cf_validate_setup v;
+    cf_status st = cf_validate_from_scene(sc, name, &v, err);
+    if (st != CF_OK)
+        return st;
+    lx->cfg = v.cfg;
+    lx->cfg.progress = NULL;
+    /* the reference run needs no table: the closed form is within 2.5e-15 of exact */
+    lx->method = v.method == CF_LAW_TABLE ? CF_LAW_CLOSED : v.method;
+    const cf_msm_path p = cf_scene_path(sc);
+    for (size_t k = 0; k < sc->nsamples; k++) {
+        const double t = sc->sample_t_s[k];
+        if (!(t > p.t_s[0]))
+            continue; /* the rest state is not a step */
+        double e = p.value[p.count - 1];
+        for (size_t i = 1; i < p.count; i++)
+            if (t <= p.t_s[i]) {
+                const double f = (t - p.t_s[i - 1]) / (p.t_s[i] - p.t_s[i - 1]);
+                e = p.value[i - 1] + f * (p.value[i] - p.value[i - 1]);
+                break;
+            }
+        if (lx->nsteps == CF_EXPORT_MAX_STEPS)
+            return cf_error_set(err, CF_E_DATA,
+                                "%s: %zu samples: a lattice export takes at most %d load steps "
+                                "(use fewer samples_per_segment)",
+                                name, sc->nsamples, CF_EXPORT_MAX_STEPS);
+        if (e == 0.0)
+            continue;
+        lx->strain[lx->nsteps++] = e;
+    }
+    if (lx->nsteps == 0)
+        return cf_error_set(err, CF_E_DATA, "%s: the loading never leaves the rest state", name);
+    return CF_OK;
+}
+
+/* Title of the lattice model. */
+static void lattice_title(char *buf, size_t cap, const cf_lattice_config *c)
+{
+    snprintf(buf, cap,
+             "lattice of %d x %d x %d cells (family weights: edge %.6g, face diagonal %.6g, body "
+             "diagonal %.6g), bottom %s, uniaxial compression along z",
+             c->nx, c->ny, c->nz, c->weight[CF_FAMILY_EDGE], c->weight[CF_FAMILY_FACE],
+             c->weight[CF_FAMILY_BODY],
+             c->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "held along z (sliding)");
+}
+
+static int same(double a, double b)
+{
+    return fabs(a - b) <= GROUP_REL * fmax(fabs(a), fabs(b));
+}
+
+/* Copies the lattice's nodes, springs and boundary into m and groups the springs. */
+static int model_of_lattice(cf_xmodel *m, const cf_lattice *lat)
+{
+    m->nn = lat->nn;
+    m->ns = lat->ns;
+    m->ntop = lat->ntop;
+    m->X = malloc(m->nn * sizeof *m->X);
+    m->Y = malloc(m->nn * sizeof *m->Y);
+    m->Z = malloc(m->nn * sizeof *m->Z);
+    m->fix = malloc(m->nn);
+    m->si = malloc(m->ns * sizeof *m->si);
+    m->sj = malloc(m->ns * sizeof *m->sj);
+    m->grp = malloc(m->ns * sizeof *m->grp);
+    m->top = malloc(m->ntop * sizeof *m->top);
+    m->g = calloc(m->ns, sizeof *m->g); /* at most one group per spring */
+    if (!m->X || !m->Y || !m->Z || !m->fix || !m->si || !m->sj || !m->grp || !m->top || !m->g)
+        return -1;
+    memcpy(m->X, lat->X, m->nn * sizeof *m->X);
+    memcpy(m->Y, lat->Y, m->nn * sizeof *m->Y);
+    memcpy(m->Z, lat->Z, m->nn * sizeof *m->Z);
+    memcpy(m->fix, lat->fix, m->nn);
+    memcpy(m->si, lat->si, m->ns * sizeof *m->si);
+    memcpy(m->sj, lat->sj, m->ns * sizeof *m->sj);
+    memcpy(m->top, lat->top, m->ntop * sizeof *m->top);
+    for (size_t s = 0; s < m->ns; s++) {
+        size_t g = 0;
+        while (g < m->ng && !(same(m->g[g].L0_mm, lat->L0_mm[s]) && same(m->g[g].weight, lat->w[s])))
+            g++;
+        if (g == m->ng) {
+            m->g[g].L0_mm = lat->L0_mm[s];
+            m->g[g].weight = lat->w[s];
+            m->ng++;
+        }
+        m->g[g].count++;
+        m->grp[s] = (uint32_t)g;
+    }
+    m->area_mm2 = lat->area_mm2;
+    m->height_mm = lat->height_mm;
+    /* the springs a horizontal plane through the middle of a layer of cells cuts */
+    const double zc = lat->H_mm * (floor(lat->cfg.nz / 2.0) + 0.5);
+    double cut = 0.0;
+    for (size_t s = 0; s < m->ns; s++) {
+        const double za = lat->Z[lat->si[s]], zb = lat->Z[lat->sj[s]];
+        if ((za - zc) * (zb - zc) < 0.0)
+            cut += lat->w[s] * fabs(zb - za) / lat->L0_mm[s];
+    }
+    m->reaction_tol_N = cut; /* times tol F_C by the caller */
+    return 0;
+}
+
+/* conifit's static run along the loading: compressive top reaction (N) at each step into ref_N
+** and the largest spring compression (mm). */
+static cf_status reference_run(const cf_law *law, const cf_export_lattice *lx, double area_mm2,
+                               double *ref_N, double *max_u_mm, cf_error *err)
+{
+    double strain[CF_EXPORT_MAX_STEPS], stress[CF_EXPORT_MAX_STEPS];
+    for (size_t k = 0; k < lx->nsteps; k++)
+        strain[k] = -lx->strain[k]; /* the table's sign: compression negative */
+    cf_msm_stats stats = {0};
+    cf_status st =
+        cf_msm_uniaxial(law, lx->method, &lx->cfg, strain, lx->nsteps, stress, &stats, err);
+    if (st != CF_OK)
+        return st;
+    for (size_t k = 0; k < lx->nsteps; k++)
+        ref_N[k] = -stress[k] * area_mm2;
+    *max_u_mm = stats.max_u_over_travel * law->travel_mm;
+    return CF_OK;
+}
+
+/* The largest number of leading steps (< n) that conifit's lattice follows, by bisection. */
+static size_t steps_that_work(const cf_law *law, const cf_export_lattice *lx, double area,
+                              double u_limit, size_t n)
+{
+    size_t lo = 0, hi = n; /* lo steps work, hi do not */
+    while (hi - lo > 1) {
+        size_t mid = (lo + hi) / 2;
+        cf_export_lattice part = *lx;
+        part.nsteps = mid;
+        double ref[CF_EXPORT_MAX_STEPS], umax;
+        cf_error e = {0};
+        if (reference_run(law, &part, area, ref, &umax, &e) == CF_OK && umax <= u_limit)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
+                                  const cf_export_options *opt, const cf_export_lattice *lx,
+                                  cf_export_report *rep, cf_error *err)
+{
+    cf_law law;
+    cf_lattice lat;
+    cf_export_table t = {0};
+    cf_xmodel m = {0};
+    cf_export_report r = {0};
+    char title[256];
+    memset(&lat, 0, sizeof lat);
+    if (lx->nsteps == 0 || lx->nsteps > CF_EXPORT_MAX_STEPS)
+        return cf_error_set(err, CF_E_DATA, "%zu load steps: a lattice export takes 1 to %d",
+                            lx->nsteps, CF_EXPORT_MAX_STEPS);
+    for (size_t k = 0; k < lx->nsteps; k++)
+        if (!isfinite(lx->strain[k]))
+            return cf_error_set(err, CF_E_DATA, "load step %zu: strain is not finite", k + 1);
+    cf_status st = cf_law_init(&law, &fs->params, err);
+    if (st != CF_OK)
+        return st;
+    if ((st = cf_export_table_for(&law, opt, &t, err)) != CF_OK)
+        goto done;
+    if ((st = cf_lattice_create(&lat, &law, lx->method, &lx->cfg.lattice, err)) != CF_OK)
+        goto done;
+    if (model_of_lattice(&m, &lat) != 0)
+        goto oom;
+    m.reaction_tol_N *= t.tol * law.F_C_N;
+    m.law = &law;
+    m.base = &t;
+    m.source = (opt->source && *opt->source) ? opt->source : "(none)";
+    lattice_title(title, sizeof title, &lx->cfg.lattice);
+    m.title = title;
+    m.nsteps = lx->nsteps;
+    m.dz_mm = malloc(m.nsteps * sizeof *m.dz_mm);
+    m.ref_N = malloc(m.nsteps * sizeof *m.ref_N);
+    m.strain = malloc(m.nsteps * sizeof *m.strain);
+    if (!m.dz_mm || !m.ref_N || !m.strain)
+        goto oom;
+    for (size_t k = 0; k < m.nsteps; k++) {
+        m.strain[k] = lx->strain[k];
+        m.dz_mm[k] = -lx->strain[k] * lat.height_mm;
+    }
+    double umax = 0.0;
+    cf_error run_err = {0};
+    st = reference_run(&law, lx, lat.area_mm2, m.ref_N, &umax, &run_err);
+    const double u_limit = fmin(t.u_hi_mm, -t.u_lo_mm);
+    if (st != CF_OK || umax > u_limit) {
+        const size_t ok = steps_that_work(&law, lx, lat.area_mm2, u_limit, lx->nsteps);
+        char works[160];
+        if (ok > 0)
+            snprintf(works, sizeof works, "the loading works up to strain %.6g (step %zu)",
+                     lx->strain[ok - 1], ok);
+        else
+            snprintf(works, sizeof works, "not even the first step (strain %.6g) works",
+                     lx->strain[0]);
+        if (st != CF_OK)
+            st = cf_error_set(err, CF_E_DATA,
+                              "the lattice cannot follow the loading to strain %.6g: %s; %s",
+                              lx->strain[lx->nsteps - 1], run_err.msg, works);
+        else
+            st = cf_error_set(err, CF_E_DATA,
+                              "at strain %.6g a spring of the lattice is compressed to %.6g mm, "
+                              "past the table's end at %.6g mm (solid at %.6g mm); %s",
+                              lx->strain[lx->nsteps - 1], umax, u_limit, law.travel_mm, works);
+        goto done;
+    }
+    for (size_t k = 0; k < m.nsteps; k++)
+        if (!isfinite(m.ref_N[k])) {
+            st = cf_error_set(err, CF_E_INTERNAL, "reference reaction at step %zu is not finite",
+                              k + 1);
+            goto done;
+        }
+    if (cf_xmodel_tables(&m) != 0 || cf_xmodel_write(out, &m, opt->format) != 0)
+        goto oom;
+    r.rows = t.rows;
+    r.tol = t.tol;
+    r.max_err_rel = t.max_err_rel;
+    r.max_err_N = t.max_err_N;
+    r.u_lo_mm = t.u_lo_mm;
+    r.u_hi_mm = t.u_hi_mm;
+    r.groups = m.ng;
+    r.springs = m.ns;
+    r.nodes = m.nn;
+    r.steps = m.nsteps;
+    if (ferror(out))
+        st = cf_error_set(err, CF_E_CANTWRITE, "cannot write the %s lattice export",
+                          cf_export_format_name(opt->format));
+    goto done;
+oom:
+    st = cf_error_set(err, CF_E_INTERNAL, "out of memory writing the lattice model");
+done:
+    if (rep)
+        *rep = r;
+    cf_xmodel_free(&m);
+    cf_lattice_free(&lat);
+    cf_export_table_free(&t);
+    cf_law_free(&law);
+    return st;
+}

@@ -1,0 +1,506 @@
+/*
+** Runnable models for other simulators (see export_model.h): one writer per target, each
+** writing nodes, one spring group per (rest length, weight) with its own table, the boundary
+** conditions, the load steps and the output requests in that code's own syntax.
+**
+** What each target reads, as checked against its documentation and source:
+** - CalculiX ccx: SPRINGA elements with *SPRING, NONLINEAR take (force, elongation) pairs; ccx
+**   holds the force constant past the last pair, and copies the curve into a fixed array of 200
+**   pairs (materialdata_sp.f, plconloc(802)), hence the 200-row limit. *NODE PRINT with TOTALS
+**   prints the summed reaction of a node set for every increment.
+** - Abaqus/Standard reads the same *SPRING layout (ccx took its input language from it).
+** - FEBio 4: discrete_material type "nonlinear spring" with measure "elongation" and a point
+**   curve (extend CONSTANT holds the last force), discrete sets in the Mesh section, "zero
+**   displacement" and "prescribed displacement" boundary conditions, a load controller.
+** - LS-DYNA: *MAT_SPRING_NONLINEAR_ELASTIC (MAT_S04) on *ELEMENT_DISCRETE; every *DEFINE_CURVE is
+**   resampled to LCINT equally spaced points, 100 unless the curve's own LCINT (field 8 of its
+**   first card, since 2015) or *CONTROL_SOLUTION says otherwise (LSTC FAQ "discretization of
+**   curves"); so each curve carries LCINT >= its rows.
+** - SOFA: PolynomialSpringsForceField evaluates force = sum a_k |L|^k with L = (l - l0)/l0, times
+**   +1 when stretched and, when compressed, -1 if compressible="1" and 0 otherwise
+**   (PolynomialSpringsForceField.inl, addForce). No SOFA spring component reads a table, but a
+**   piecewise-linear curve is a sum of such springs on the same two nodes: two compressible linear
+**   springs give any affine force A + B e, and one one-sided (compressible="0") linear spring of
+**   rest length l_j per interior row adds the change of slope there, (s_j - s_j-1)(l - l_j)+. The
+**   sum reproduces the table exactly in force. SOFA's tangent of a one-sided spring ignores
+**   whether it is engaged (ComputeJacobian uses the polynomial at |L| in both states), so an
+**   implicit solver sees the constant stiffness of all springs engaged, the last slope of the
+**   table: stable and right at equilibrium, slower to settle than the force alone would be.
+*/
+#include "out/export_model.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "conifit/lattice.h"
+#include "conifit/spring.h"
+#include "conifit/version.h"
+
+void cf_xmodel_free(cf_xmodel *m)
+{
+    if (!m)
+        return;
+    free(m->X), free(m->Y), free(m->Z), free(m->fix);
+    free(m->si), free(m->sj), free(m->grp), free(m->top);
+    free(m->dz_mm), free(m->ref_N), free(m->strain);
+    for (size_t g = 0; g < m->ng && m->g; g++)
+        free(m->g[g].e_mm), free(m->g[g].T_N);
+    free(m->g);
+    memset(m, 0, sizeof *m);
+}
+
+int cf_xmodel_tables(cf_xmodel *m)
+{
+    const cf_export_table *t = m->base;
+    const double H = m->law->p.H_mm;
+    for (size_t g = 0; g < m->ng; g++) {
+        cf_xgroup *G = &m->g[g];
+        G->rows = t->rows;
+        G->e_mm = malloc(t->rows * sizeof *G->e_mm);
+        G->T_N = malloc(t->rows * sizeof *G->T_N);
+        if (!G->e_mm || !G->T_N)
+            return -1;
+        /* ascending elongation: the table read from its compression end */
+        for (size_t i = 0; i < t->rows; i++) {
+            size_t r = t->rows - 1 - i;
+            G->e_mm[i] = -t->u_mm[r] * (G->L0_mm / H);
+            G->T_N[i] = -G->weight * t->F_N[r];
+            if (G->e_mm[i] == 0.0)
+                G->e_mm[i] = 0.0; /* no "-0" in files */
+            if (G->T_N[i] == 0.0)
+                G->T_N[i] = 0.0;
+        }
+    }
+    return 0;
+}
+
+/* ---- comments shared by the writers ---------------------------------------------------------- */
+
+void cf_export_comment_spring(FILE *out, const char *lead, const char *tail, const cf_law *law)
+{
+    fprintf(out, "%sspring (%s):", lead, cf_spring_type_name(law->type));
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        const cf_spring_param *sp = cf_spring_param_info(k);
+        fprintf(out, "%s %s = %.17g%s%s", k ? "," : "", sp->name, cf_spring_get(&law->p, k),
+                strcmp(sp->unit, "-") ? " " : "", strcmp(sp->unit, "-") ? sp->unit : "");
+    }
+    fprintf(out, "%s\n", tail);
+    fprintf(out, "%stravel s = %.17g mm, F_T = %.17g N, F_C = %.17g N, k0 = %.17g N/mm%s\n", lead,
+            law->travel_mm, law->F_T_N, law->F_C_N, law->k0_N_per_mm, tail);
+}
+
+void cf_export_comment_table(FILE *out, const char *lead, const char *tail,
+                             const cf_export_table *t, const cf_law *law)
+{
+    fprintf(out,
+            "%stable: %zu rows over u in [%.10g, %.10g] mm (compression positive); within %.3g "
+            "F_C of the law, achieved %.3g F_C (%.3g N at u = %.6g mm)%s\n",
+            lead, t->rows, t->u_lo_mm, t->u_hi_mm, t->tol, t->max_err_rel, t->max_err_N,
+            t->max_err_u_mm, tail);
+    fprintf(out,
+            "%sthe law is solid at |u| = %.17g mm (force F_C); past the table's ends a simulator "
+            "that holds the last force is within %.3g F_C of the law up to solid when the table "
+            "runs to its full range%s\n",
+            lead, law->travel_mm, t->tol, tail);
+}
+
+static void model_header(FILE *out, const char *lead, const char *tail, const cf_xmodel *m,
+                         const char *target, const char *how)
+{
+    fprintf(out, "%sconifit %s: %s for %s%s\n", lead, CF_VERSION, m->title, target, tail);
+    fprintf(out, "%srun: %s%s\n", lead, how, tail);
+    fprintf(out, "%sunits: mm, N, s, tonne (force in N, lengths in mm)%s\n", lead, tail);
+    fprintf(out,
+            "%ssign: tension positive; each spring table holds elongation L - L0 (mm) and "
+            "tension (N)%s\n",
+            lead, tail);
+    fprintf(out, "%ssource: %s%s\n", lead, (m->source && *m->source) ? m->source : "(none)",
+            tail);
+    cf_export_comment_spring(out, lead, tail, m->law);
+    cf_export_comment_table(out, lead, tail, m->base, m->law);
+    fprintf(out,
+            "%s%zu nodes, %zu springs in %zu groups; group k is the law at rest length L0 (in "
+            "strain form u = -(L - L0) H/L0) times its weight:%s\n",
+            lead, m->nn, m->ns, m->ng, tail);
+    for (size_t g = 0; g < m->ng; g++)
+        fprintf(out, "%s  group %zu: L0 = %.17g mm, weight = %.17g, %zu springs, %zu rows%s\n",
+                lead, g + 1, m->g[g].L0_mm, m->g[g].weight, m->g[g].count, m->g[g].rows, tail);
+    fprintf(out,
+            "%sloading: the %zu top nodes move along z together (x, y free unless fixed); at each "
+            "step, conifit's compressive top reaction (N) for comparison:%s\n",
+            lead, m->ntop, tail);
+    fprintf(out,
+            "%sreaction tolerance implied by the tables: %.6g N (tol F_C times the weights of "
+            "the springs a horizontal plane cuts, projected on z)%s\n",
+            lead, m->reaction_tol_N, tail);
+    for (size_t k = 0; k < m->nsteps; k++)
+        fprintf(out, "%s  step %zu: top z displacement %.17g mm (strain %.10g), conifit reaction "
+                     "%.17g N%s\n",
+                lead, k + 1, m->dz_mm[k], m->strain[k], m->ref_N[k], tail);
+}
+
+/* ---- CalculiX and Abaqus ---------------------------------------------------------------------- */
+
+/* Convergence: the residual force criterion R_n tightened from its default 0.005 of the mean force
+** so that the reaction is converged far below the table's tolerance; the other entries are the
+** defaults of the *CONTROLS, PARAMETERS=FIELD line. */
+static const char inp_controls[] = "1.e-9,1.e-6,0.01,,0.02,1.e-5,1.e-3,1.e-8\n";
+
+void cf_xmodel_write_inp(FILE *out, const cf_xmodel *m, int abaqus)
+{
+    const char *target = abaqus ? "Abaqus/Standard" : "CalculiX (ccx)";
+    model_header(out, "** ", "", m, target,
+                 abaqus ? "abaqus job=NAME (summed top reaction RF3 in NAME.dat per increment)"
+                        : "ccx -i NAME (summed top reaction in NAME.dat, 'total force' lines)");
+    fprintf(out, "*NODE, NSET=NALL\n");
+    for (size_t i = 0; i < m->nn; i++)
+        fprintf(out, "%zu, %.17g, %.17g, %.17g\n", i + 1, m->X[i], m->Y[i], m->Z[i]);
+    fprintf(out, "*NSET, NSET=NTOP\n");
+    for (size_t t = 0; t < m->ntop; t++)
+        fprintf(out, "%u%s", m->top[t] + 1, (t % 16 == 15 || t + 1 == m->ntop) ? "\n" : ", ");
+    for (size_t g = 0; g < m->ng; g++) {
+        fprintf(out, "*ELEMENT, TYPE=SPRINGA, ELSET=G%zu\n", g + 1);
+        for (size_t s = 0; s < m->ns; s++)
+            if (m->grp[s] == g)
+                fprintf(out, "%zu, %u, %u\n", s + 1, m->si[s] + 1, m->sj[s] + 1);
+        fprintf(out, "** group %zu: L0 = %.17g mm, weight %.17g; force (N), elongation (mm)\n",
+                g + 1, m->g[g].L0_mm, m->g[g].weight);
+        fprintf(out, "*SPRING, ELSET=G%zu, NONLINEAR\n\n", g + 1);
+        for (size_t i = 0; i < m->g[g].rows; i++)
+            fprintf(out, "%.17g, %.17g\n", m->g[g].T_N[i], m->g[g].e_mm[i]);
+    }
+    fprintf(out, "*BOUNDARY\n");
+    for (size_t i = 0; i < m->nn; i++)
+        for (int a = 0; a < 3; a++)
+            if (m->fix[i] & (1u << a))
+                fprintf(out, "%zu, %d, %d\n", i + 1, a + 1, a + 1);
+    for (size_t k = 0; k < m->nsteps; k++) {
+        fprintf(out, "*STEP, NLGEOM%s, INC=1000\n*STATIC\n1., 1.\n", abaqus ? "=YES" : "");
+        fprintf(out, "*CONTROLS, PARAMETERS=FIELD%s\n%s", abaqus ? ", FIELD=DISPLACEMENT" : "",
+                inp_controls);
+        fprintf(out, "*BOUNDARY\nNTOP, 3, 3, %.17g\n", m->dz_mm[k]);
+        fprintf(out, "*NODE PRINT, NSET=NTOP, TOTALS=ONLY\nRF\n*END STEP\n");
+    }
+}
+
+/* ---- FEBio 4 ---------------------------------------------------------------------------------- */
+
+/* The fixed-direction masks that occur, in a fixed order, with FEBio set names. */
+static const char *const mask_name[8] = {"", "fix_x", "fix_y", "fix_xy",
+                                         "fix_z", "fix_xz", "fix_yz", "fix_xyz"};
+
+void cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
+{
+    fprintf(out, "<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?>\n");
+    model_header(out, "<!-- ", " -->", m, "FEBio 4",
+                 "febio4 -i NAME.feb (summed top reaction: column sums of NAME_top_Rz.txt)");
+    fprintf(out, "<febio_spec version=\"4.0\">\n\t<Module type=\"solid\"/>\n");
+    fprintf(out, "\t<Control>\n\t\t<analysis>STATIC</analysis>\n\t\t<time_steps>%zu</time_steps>\n"
+                 "\t\t<step_size>1</step_size>\n\t\t<solver type=\"solid\">\n"
+                 "\t\t\t<max_refs>50</max_refs>\n\t\t\t<dtol>1e-9</dtol>\n"
+                 "\t\t\t<etol>1e-12</etol>\n\t\t\t<rtol>1e-12</rtol>\n"
+                 "\t\t\t<qn_method type=\"BFGS\">\n\t\t\t\t<max_ups>0</max_ups>\n"
+                 "\t\t\t</qn_method>\n\t\t</solver>\n\t</Control>\n",
+            m->nsteps);
+    fprintf(out, "\t<Mesh>\n\t\t<Nodes name=\"conifit_nodes\">\n");
+    for (size_t i = 0; i < m->nn; i++)
+        fprintf(out, "\t\t\t<node id=\"%zu\">%.17g,%.17g,%.17g</node>\n", i + 1, m->X[i], m->Y[i],
+                m->Z[i]);
+    fprintf(out, "\t\t</Nodes>\n");
+    for (unsigned mask = 1; mask < 8; mask++) {
+        size_t cnt = 0;
+        for (size_t i = 0; i < m->nn; i++)
+            cnt += (m->fix[i] & 7u) == mask;
+        if (!cnt)
+            continue;
+        fprintf(out, "\t\t<NodeSet name=\"%s\">", mask_name[mask]);
+        size_t w = 0;
+        for (size_t i = 0; i < m->nn; i++)
+            if ((m->fix[i] & 7u) == mask)
+                fprintf(out, "%s%zu", w++ ? "," : "", i + 1);
+        fprintf(out, "</NodeSet>\n");
+    }
+    fprintf(out, "\t\t<NodeSet name=\"top\">");
+    for (size_t t = 0; t < m->ntop; t++)
+        fprintf(out, "%s%u", t ? "," : "", m->top[t] + 1);
+    fprintf(out, "</NodeSet>\n");
+    for (size_t g = 0; g < m->ng; g++) {
+        fprintf(out, "\t\t<DiscreteSet name=\"G%zu\">\n", g + 1);
+        for (size_t s = 0; s < m->ns; s++)
+            if (m->grp[s] == g)
+                fprintf(out, "\t\t\t<delem>%u,%u</delem>\n", m->si[s] + 1, m->sj[s] + 1);
+        fprintf(out, "\t\t</DiscreteSet>\n");
+    }
+    fprintf(out, "\t</Mesh>\n\t<Boundary>\n");
+    for (unsigned mask = 1; mask < 8; mask++) {
+        size_t cnt = 0;
+        for (size_t i = 0; i < m->nn; i++)
+            cnt += (m->fix[i] & 7u) == mask;
+        if (!cnt)
+            continue;
+        fprintf(out, "\t\t<bc name=\"%s\" node_set=\"%s\" type=\"zero displacement\">\n"
+                     "\t\t\t<x_dof>%d</x_dof>\n\t\t\t<y_dof>%d</y_dof>\n\t\t\t<z_dof>%d</z_dof>\n"
+                     "\t\t</bc>\n",
+                mask_name[mask], mask_name[mask], !!(mask & 1u), !!(mask & 2u), !!(mask & 4u));
+    }
+    fprintf(out, "\t\t<bc name=\"drive\" node_set=\"top\" type=\"prescribed displacement\">\n"
+                 "\t\t\t<dof>z</dof>\n\t\t\t<value lc=\"1\">1</value>\n"
+                 "\t\t\t<relative>0</relative>\n\t\t</bc>\n\t</Boundary>\n");
+    fprintf(out, "\t<Discrete>\n");
+    for (size_t g = 0; g < m->ng; g++) {
+        fprintf(out, "\t\t<discrete_material id=\"%zu\" name=\"G%zu\" type=\"nonlinear spring\">\n"
+                     "\t\t\t<scale>1</scale>\n\t\t\t<measure>elongation</measure>\n"
+                     "\t\t\t<force type=\"point\">\n\t\t\t\t<interpolate>LINEAR</interpolate>\n"
+                     "\t\t\t\t<extend>CONSTANT</extend>\n\t\t\t\t<points>\n",
+                g + 1, g + 1);
+        for (size_t i = 0; i < m->g[g].rows; i++)
+            fprintf(out, "\t\t\t\t\t<pt>%.17g,%.17g</pt>\n", m->g[g].e_mm[i], m->g[g].T_N[i]);
+        fprintf(out, "\t\t\t\t</points>\n\t\t\t</force>\n\t\t</discrete_material>\n");
+    }
+    for (size_t g = 0; g < m->ng; g++)
+        fprintf(out, "\t\t<discrete dmat=\"%zu\" discrete_set=\"G%zu\"/>\n", g + 1, g + 1);
+    fprintf(out, "\t</Discrete>\n\t<LoadData>\n\t\t<load_controller id=\"1\" name=\"drive\" "
+                 "type=\"loadcurve\">\n\t\t\t<interpolate>LINEAR</interpolate>\n"
+                 "\t\t\t<points>\n\t\t\t\t<pt>0,0</pt>\n");
+    for (size_t k = 0; k < m->nsteps; k++)
+        fprintf(out, "\t\t\t\t<pt>%zu,%.17g</pt>\n", k + 1, m->dz_mm[k]);
+    fprintf(out, "\t\t\t</points>\n\t\t</load_controller>\n\t</LoadData>\n");
+    fprintf(out, "\t<Output>\n\t\t<logfile>\n\t\t\t<node_data data=\"Rz\" delim=\",\" "
+                 "file=\"NAME_top_Rz.txt\" node_set=\"top\"/>\n\t\t</logfile>\n\t</Output>\n");
+    fprintf(out, "</febio_spec>\n");
+}
+
+/* ---- LS-DYNA ---------------------------------------------------------------------------------- */
+
+/* LS-DYNA's translational constraint code of *NODE (TC) for a fixed-direction mask. */
+static int dyna_tc(unsigned mask)
+{
+    static const int tc[8] = {0, 1, 2, 4, 3, 6, 5, 7};
+    return tc[mask & 7u];
+}
+
+void cf_xmodel_write_lsdyna(FILE *out, const cf_xmodel *m)
+{
+    model_header(out, "$ ", "", m, "LS-DYNA (implicit static)",
+                 "ls-dyna i=NAME.k (top reaction: spcforc / bndout of the prescribed motion)");
+    fprintf(out, "*KEYWORD\n*TITLE\nconifit %s\n", m->title);
+    fprintf(out, "*CONTROL_TERMINATION\n$#  endtim\n%10.1f\n", (double)m->nsteps);
+    fprintf(out, "*CONTROL_IMPLICIT_GENERAL\n$#  imflag       dt0\n%10d%10.1f\n", 1, 1.0);
+    fprintf(out, "*CONTROL_IMPLICIT_SOLUTION\n$#  nsolvr    ilimit    maxref     dctol     ectol"
+                 "     rctol\n%10d%10d%10d%10.1e%10.1e%10.1e\n",
+            12, 11, 50, 1e-9, 1e-12, 1e-12);
+    fprintf(out, "*DATABASE_BNDOUT\n$#      dt\n%10.1f\n", 1.0);
+    fprintf(out, "*DATABASE_SPCFORC\n$#      dt\n%10.1f\n", 1.0);
+    fprintf(out, "*NODE\n$#   nid               x               y               z      tc      "
+                 "rc\n");
+    for (size_t i = 0; i < m->nn; i++)
+        fprintf(out, "%8zu%16.9e%16.9e%16.9e%8d%8d\n", i + 1, m->X[i], m->Y[i], m->Z[i],
+                dyna_tc(m->fix[i]), 7);
+    fprintf(out, "*SECTION_DISCRETE\n$#   secid       dro\n%10d%10d\n", 1, 0);
+    for (size_t g = 0; g < m->ng; g++) {
+        const cf_xgroup *G = &m->g[g];
+        fprintf(out, "$ group %zu: L0 = %.17g mm, weight %.17g\n", g + 1, G->L0_mm, G->weight);
+        fprintf(out, "*PART\ngroup %zu\n$#     pid     secid       mid\n%10zu%10d%10zu\n", g + 1,
+                g + 1, 1, g + 1);
+        fprintf(out, "*MAT_SPRING_NONLINEAR_ELASTIC\n$#     mid       lcd       lcr\n%10zu%10zu%10d\n",
+                g + 1, g + 1, 0);
+        fprintf(out, "*DEFINE_CURVE\n$#    lcid      sidr       sfa       sfo      offa      offo"
+                     "    dattyp     lcint\n");
+        fprintf(out, "%10zu%10d%10.1f%10.1f%10.1f%10.1f%10d%10zu\n", g + 1, 0, 1.0, 1.0, 0.0, 0.0,
+                0, G->rows);
+        fprintf(out, "$#                a1                  o1\n");
+        for (size_t i = 0; i < G->rows; i++)
+            fprintf(out, "%20.12e%20.12e\n", G->e_mm[i], G->T_N[i]);
+    }
+    fprintf(out, "*ELEMENT_DISCRETE\n$#   eid     pid      n1      n2\n");
+    for (size_t s = 0; s < m->ns; s++)
+        fprintf(out, "%8zu%8u%8u%8u\n", s + 1, m->grp[s] + 1, m->si[s] + 1, m->sj[s] + 1);
+    fprintf(out, "*SET_NODE_LIST\n$#     sid\n%10d\n", 1);
+    for (size_t t = 0; t < m->ntop; t++)
+        fprintf(out, "%10u%s", m->top[t] + 1, (t % 8 == 7 || t + 1 == m->ntop) ? "\n" : "");
+    const size_t lc_drive = m->ng + 1;
+    fprintf(out, "*BOUNDARY_PRESCRIBED_MOTION_SET\n$#    nsid       dof       vad      lcid        "
+                 "sf\n%10d%10d%10d%10zu%10.1f\n",
+            1, 3, 2, lc_drive, 1.0);
+    fprintf(out, "*DEFINE_CURVE\n$#    lcid      sidr       sfa       sfo      offa      offo    "
+                 "dattyp     lcint\n%10zu%10d%10.1f%10.1f%10.1f%10.1f%10d%10zu\n",
+            lc_drive, 0, 1.0, 1.0, 0.0, 0.0, 0, m->nsteps + 1);
+    fprintf(out, "%20.12e%20.12e\n", 0.0, 0.0);
+    for (size_t k = 0; k < m->nsteps; k++)
+        fprintf(out, "%20.12e%20.12e\n", (double)(k + 1), m->dz_mm[k]);
+    fprintf(out, "*END\n");
+}
+
+/* ---- SOFA ------------------------------------------------------------------------------------- */
+
+void cf_sofa_terms_free(cf_sofa_terms *s)
+{
+    if (!s)
+        return;
+    free(s->knot_mm), free(s->a_N);
+    memset(s, 0, sizeof *s);
+}
+
+int cf_sofa_terms_of(const cf_xgroup *g, cf_sofa_terms *s)
+{
+    memset(s, 0, sizeof *s);
+    const size_t R = g->rows;
+    if (R < 2)
+        return -1;
+    s->knot_mm = malloc(R * sizeof *s->knot_mm);
+    s->a_N = malloc(R * sizeof *s->a_N);
+    if (!s->knot_mm || !s->a_N) {
+        cf_sofa_terms_free(s);
+        return -1;
+    }
+    const double L0 = g->L0_mm;
+    double prev = (g->T_N[1] - g->T_N[0]) / (g->e_mm[1] - g->e_mm[0]);
+    /* affine part: the first segment, extended */
+    const double A = g->T_N[0] - prev * g->e_mm[0], B = prev;
+    s->a_half_N = A;
+    s->a_rest_N = B * L0 - 2.0 * A;
+    for (size_t j = 1; j + 1 < R; j++) {
+        const double slope = (g->T_N[j + 1] - g->T_N[j]) / (g->e_mm[j + 1] - g->e_mm[j]);
+        const double d = slope - prev;
+        prev = slope;
+        if (d == 0.0)
+            continue; /* no kink (the middle of region 1) */
+        const double knot = L0 + g->e_mm[j];
+        s->knot_mm[s->nknots] = knot;
+        s->a_N[s->nknots] = d * knot;
+        s->nknots++;
+    }
+    return 0;
+}
+
+/* One PolynomialSpringsForceField of degree-1 springs: `count` node pairs of group g, each with
+** rest length l0 and coefficient a. */
+static void sofa_field(FILE *out, const cf_xmodel *m, size_t g, const char *name, int compressible,
+                       double l0, double a)
+{
+    const size_t n = m->g[g].count;
+    fprintf(out, "\t\t<PolynomialSpringsForceField name=\"%s\" object1=\"@dofs\" object2=\"@dofs\" "
+                 "compressible=\"%d\" computeZeroLength=\"0\" firstObjectPoints=\"",
+            name, compressible);
+    size_t w = 0;
+    for (size_t s = 0; s < m->ns; s++)
+        if (m->grp[s] == g)
+            fprintf(out, "%s%u", w++ ? " " : "", m->si[s]);
+    fprintf(out, "\" secondObjectPoints=\"");
+    w = 0;
+    for (size_t s = 0; s < m->ns; s++)
+        if (m->grp[s] == g)
+            fprintf(out, "%s%u", w++ ? " " : "", m->sj[s]);
+    /* one degree and one coefficient per spring: SOFA applies the first polynomial to all (with a
+    ** warning on every step) when the lists are shorter than the springs */
+    fprintf(out, "\" polynomialDegree=\"");
+    for (size_t i = 0; i < n; i++)
+        fprintf(out, "%s1", i ? " " : "");
+    fprintf(out, "\" polynomialStiffness=\"");
+    for (size_t i = 0; i < n; i++)
+        fprintf(out, "%s%.17g", i ? " " : "", a);
+    fprintf(out, "\" zeroLength=\"%.17g\"/>\n", l0);
+}
+
+int cf_xmodel_write_sofa(FILE *out, const cf_xmodel *m)
+{
+    cf_sofa_terms *terms = calloc(m->ng ? m->ng : 1, sizeof *terms);
+    if (!terms)
+        return -1;
+    for (size_t g = 0; g < m->ng; g++)
+        if (cf_sofa_terms_of(&m->g[g], &terms[g]) != 0) {
+            for (size_t h = 0; h < g; h++)
+                cf_sofa_terms_free(&terms[h]);
+            free(terms);
+            return -1;
+        }
+    fprintf(out, "<?xml version=\"1.0\"?>\n");
+    model_header(out, "<!-- ", " -->", m, "SOFA (v24.06 or later)",
+                 "runSofa NAME.scn (top reaction: the force on the driven nodes)");
+    fprintf(out,
+            "<!-- each spring is a sum of degree-1 PolynomialSpringsForceField springs on its two "
+            "nodes: two compressible ones (compressible=1, rest lengths L0 and L0/2) give the "
+            "first segment of the table extended, one one-sided spring (compressible=0) per "
+            "interior row adds that row's change of slope; together they reproduce the table's "
+            "piecewise-linear force exactly. SOFA's tangent of a one-sided spring counts it as "
+            "engaged in both states, so implicit solvers see the table's last slope: equilibria "
+            "are right, settling is slower. Needs the double-precision template Vec3d. -->\n");
+    fprintf(out, "<Node name=\"root\" dt=\"1\" gravity=\"0 0 0\">\n");
+    fprintf(out, "\t<RequiredPlugin pluginName=\"Sofa.Component.StateContainer "
+                 "Sofa.Component.SolidMechanics.Spring Sofa.Component.Constraint.Projective "
+                 "Sofa.Component.ODESolver.Backward Sofa.Component.LinearSolver.Direct "
+                 "Sofa.Component.Mass\"/>\n");
+    fprintf(out, "\t<DefaultAnimationLoop/>\n\t<Node name=\"conifit\">\n");
+    fprintf(out, "\t\t<EulerImplicitSolver rayleighStiffness=\"0\" rayleighMass=\"0\"/>\n");
+    fprintf(out, "\t\t<SparseLDLSolver template=\"CompressedRowSparseMatrixMat3x3d\"/>\n");
+    fprintf(out, "\t\t<MechanicalObject name=\"dofs\" template=\"Vec3d\" position=\"");
+    for (size_t i = 0; i < m->nn; i++)
+        fprintf(out, "%s%.17g %.17g %.17g", i ? "  " : "", m->X[i], m->Y[i], m->Z[i]);
+    fprintf(out, "\"/>\n\t\t<UniformMass totalMass=\"1e-9\"/>\n");
+    for (unsigned mask = 1; mask < 8; mask++) {
+        size_t w = 0;
+        for (size_t i = 0; i < m->nn; i++)
+            if ((m->fix[i] & 7u) == mask) {
+                if (!w++)
+                    fprintf(out,
+                            "\t\t<PartialFixedProjectiveConstraint name=\"%s\" "
+                            "fixedDirections=\"%d %d %d\" indices=\"",
+                            mask_name[mask], !!(mask & 1u), !!(mask & 2u), !!(mask & 4u));
+                fprintf(out, "%s%zu", w > 1 ? " " : "", i);
+            }
+        if (w)
+            fprintf(out, "\"/>\n");
+    }
+    fprintf(out, "\t\t<PartialLinearMovementProjectiveConstraint name=\"drive\" "
+                 "movedDirections=\"0 0 1\" indices=\"");
+    for (size_t t = 0; t < m->ntop; t++)
+        fprintf(out, "%s%u", t ? " " : "", m->top[t]);
+    fprintf(out, "\" keyTimes=\"0");
+    for (size_t k = 0; k < m->nsteps; k++)
+        fprintf(out, " %zu", k + 1);
+    fprintf(out, "\" movements=\"0 0 0");
+    for (size_t k = 0; k < m->nsteps; k++)
+        fprintf(out, "  0 0 %.17g", m->dz_mm[k]);
+    fprintf(out, "\"/>\n");
+    for (size_t g = 0; g < m->ng; g++) {
+        const cf_sofa_terms s = terms[g];
+        char name[64];
+        fprintf(out, "\t\t<!-- group %zu: L0 = %.17g mm, weight %.17g, %zu one-sided springs -->\n",
+                g + 1, m->g[g].L0_mm, m->g[g].weight, s.nknots);
+        snprintf(name, sizeof name, "G%zu_rest", g + 1);
+        sofa_field(out, m, g, name, 1, m->g[g].L0_mm, s.a_rest_N);
+        snprintf(name, sizeof name, "G%zu_half", g + 1);
+        sofa_field(out, m, g, name, 1, 0.5 * m->g[g].L0_mm, s.a_half_N);
+        for (size_t j = 0; j < s.nknots; j++) {
+            snprintf(name, sizeof name, "G%zu_k%zu", g + 1, j + 1);
+            sofa_field(out, m, g, name, 0, s.knot_mm[j], s.a_N[j]);
+        }
+        cf_sofa_terms_free(&terms[g]);
+    }
+    free(terms);
+    fprintf(out, "\t</Node>\n</Node>\n");
+    return 0;
+}
+
+int cf_xmodel_write(FILE *out, const cf_xmodel *m, cf_export_format f)
+{
+    switch (f) {
+    case CF_EXPORT_CALCULIX:
+        cf_xmodel_write_inp(out, m, 0);
+        return 0;
+    case CF_EXPORT_ABAQUS:
+        cf_xmodel_write_inp(out, m, 1);
+        return 0;
+    case CF_EXPORT_FEBIO:
+        cf_xmodel_write_febio(out, m);
+        return 0;
+    case CF_EXPORT_LSDYNA:
+        cf_xmodel_write_lsdyna(out, m);
+        return 0;
+    case CF_EXPORT_SOFA:
+        return cf_xmodel_write_sofa(out, m);
+    default:
+        return -1;
+    }
+}

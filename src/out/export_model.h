@@ -1,0 +1,92 @@
+/*
+** A model to export (private to the export module): nodes with their fixed directions, springs in
+** groups that share one table, the top nodes that a prescribed displacement along z drives, the
+** load steps, and conifit's own reaction at each step. Built from one spring (the --example of
+** every format) or from the validation lattice, and written by one writer per target.
+*/
+#ifndef CF_OUT_EXPORT_MODEL_H
+#define CF_OUT_EXPORT_MODEL_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "conifit/export.h"
+#include "conifit/law.h"
+
+/* Springs of one rest length and one weight: their table in their own elongation and tension. */
+typedef struct cf_xgroup {
+    double L0_mm;       /* rest length, mm */
+    double weight;      /* force factor on the law, - */
+    size_t count;       /* springs in the group */
+    size_t rows;        /* rows of the table */
+    double *e_mm;       /* elongation L - L0 = -u L0/H, mm, ascending */
+    double *T_N;        /* tension = -weight F(u), N */
+} cf_xgroup;
+
+typedef struct cf_xmodel {
+    const char *title;      /* one line: what the model is */
+    const char *source;     /* fit file name, for provenance */
+    const cf_law *law;
+    const cf_export_table *base; /* the law's table (weight 1, rest length H) */
+    size_t nn;              /* nodes */
+    double *X, *Y, *Z;      /* reference positions, mm */
+    uint8_t *fix;           /* CF_FIX_X | CF_FIX_Y | CF_FIX_Z: held at zero displacement */
+    size_t ns;              /* springs */
+    uint32_t *si, *sj;      /* end nodes (0-based) */
+    uint32_t *grp;          /* group of each spring */
+    size_t ng;              /* groups */
+    cf_xgroup *g;
+    size_t ntop;            /* driven nodes: z displacement prescribed, x and y free unless fixed */
+    uint32_t *top;
+    size_t nsteps;          /* load steps */
+    double *dz_mm;          /* z displacement of the driven nodes at the end of each step, mm */
+    double *ref_N;          /* conifit's compressive top reaction at each step, N */
+    double *strain;         /* compressive nominal strain at each step, - */
+    double reaction_tol_N;  /* what the tables allow in the top reaction: tol F_C times the
+                            ** weights of the springs a horizontal plane cuts, projected on z */
+    double area_mm2;        /* loaded area (lattice: nx ny H^2), mm^2 */
+    double height_mm;       /* height along z, mm */
+} cf_xmodel;
+
+/* Releases what the model owns (its arrays and group tables). Safe on a zeroed model. */
+void cf_xmodel_free(cf_xmodel *m);
+
+/* Fills the group tables from m->base (each group's L0 and weight set). 0, or -1 out of memory. */
+int cf_xmodel_tables(cf_xmodel *m);
+
+/* Writes m in format f (calculix, abaqus, febio, lsdyna, sofa): 0, or -1 for another format or
+** when memory runs out. */
+int cf_xmodel_write(FILE *out, const cf_xmodel *m, cf_export_format f);
+
+/* The table of the law for opt: its range and tolerance, kept to CalculiX's 200 pairs for
+** calculix and abaqus (loosening the tolerance when opt->auto_tol, else CF_E_DATA naming the
+** tolerance that fits). */
+cf_status cf_export_table_for(const cf_law *law, const cf_export_options *opt,
+                              cf_export_table *t, cf_error *err);
+
+/* Writers of runnable models. */
+void cf_xmodel_write_inp(FILE *out, const cf_xmodel *m, int abaqus);
+void cf_xmodel_write_febio(FILE *out, const cf_xmodel *m);
+void cf_xmodel_write_lsdyna(FILE *out, const cf_xmodel *m);
+int cf_xmodel_write_sofa(FILE *out, const cf_xmodel *m); /* -1: out of memory */
+
+/* Writes a comment line with the spring's parameters, and the table's accuracy, each line
+** starting with lead and ending with tail. */
+void cf_export_comment_spring(FILE *out, const char *lead, const char *tail, const cf_law *law);
+void cf_export_comment_table(FILE *out, const char *lead, const char *tail,
+                             const cf_export_table *t, const cf_law *law);
+
+/* The SOFA form of one group's table: a linear part A + B e written as two compressible linear
+** springs, plus one one-sided spring per interior node (see export_model.c). */
+typedef struct cf_sofa_terms {
+    double a_rest_N;     /* coefficient of the compressible spring of rest length L0, N */
+    double a_half_N;     /* coefficient of the compressible spring of rest length L0/2, N */
+    size_t nknots;
+    double *knot_mm;     /* rest length of each one-sided spring, mm */
+    double *a_N;         /* its coefficient (force = a (l - knot)/knot while l >= knot), N */
+} cf_sofa_terms;
+int cf_sofa_terms_of(const cf_xgroup *g, cf_sofa_terms *s);
+void cf_sofa_terms_free(cf_sofa_terms *s);
+
+#endif

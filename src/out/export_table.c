@@ -1,0 +1,374 @@
+/*
+** The export table (see export.h): the law as a piecewise-linear force-displacement table whose
+** nodes are placed where the interpolation error is, checked afterwards on a grid that knows
+** nothing of the nodes.
+**
+** Placement. Linear interpolation over an interval of width h errs by about h^2 |F''| / 8, so the
+** nodes that make that error equal on every interval have a density proportional to |F''|^(1/2)
+** (de Boor, A Practical Guide to Splines, ch. III, on equidistributing the interpolation error).
+** Region 1 is linear (one interval, exact). In region 2 the law is written through
+** r = (F_C/F)^(1/3) in [1, 1/rho] (MODEL.md):
+**     u = s - A (r - 1)^2 (6 + 8q + 3q^2) / (4 (1 + q)^3),  q = r - 1,  A = s / (1/rho - 1)
+**     F'' = 64 F r^10 / (3 A^2 (r^4 - 1)^3)
+** and with r = 1 + t^2 the density sqrt(F''/F_C) |du/dt| becomes the smooth, bounded
+**     g(t) = 4 sqrt(3) r^(-1/2) / sqrt(4 + 6q + 4q^2 + q^3)
+** (A cancels: the row count depends on rho and the tolerance only). Nodes are equally spaced in
+** the running integral of g.
+**
+** Values. A table's values need not be samples of the law: moving each interior node towards the
+** concave side by half the interpolation error of its two intervals makes the error swing between
+** -e/2 and +e/2 instead of 0 and e, so the same tolerance needs about 1/sqrt(2) of the rows. The
+** rows at 0, +-u_T and the table's two ends stay on the law (region 1 stays exact, and a simulator
+** that holds the last force beyond the table starts from the law's value), and the intervals next
+** to the ends are halved so that they meet the same bound without the shift.
+**
+** The count is then settled by measurement: the maximum error on the check grid sets the next
+** count (error ~ count^-2) until it is within the tolerance.
+*/
+#include "conifit/export.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The placement aims at this fraction of the tolerance; the measured error decides. */
+#define TABLE_AIM 0.9
+/* Points of the running integral of g over region 2. */
+#define TABLE_QUAD 4096
+/* Points of each half of the check grid: uniform in u, and uniform in w = sqrt(1 - |u|/s), which
+** crowds towards solid where the intervals are short. */
+#define TABLE_CHECK 20000
+/* Placement rounds before giving up (each one corrects the count from the measured error). */
+#define TABLE_ROUNDS 12
+/* Probes per interval when measuring its interpolation error for the shift. */
+#define TABLE_PROBES 15
+
+/* ---- one half of the table (compression side, 0 <= u <= U) ----------------------------------- */
+
+typedef struct half {
+    size_t n;
+    double *u, *F;
+} half;
+
+/* The density g(t) of the top of this file. */
+static double density(double t)
+{
+    const double q = t * t, r = 1.0 + q;
+    return 4.0 * sqrt(3.0) / (sqrt(r) * sqrt(4.0 + q * (6.0 + q * (4.0 + q))));
+}
+
+/* Compression (mm) of the point of region 2 at r = 1 + t^2, written without cancellation near
+** solid. */
+static double u_of_t(const cf_law *law, double t)
+{
+    const double q = t * t, A = law->travel_mm / law->rho_inv_m1;
+    const double gap = A * q * q * (6.0 + q * (8.0 + 3.0 * q)) / (4.0 * (1.0 + q) * (1.0 + q) * (1.0 + q));
+    return law->travel_mm - gap;
+}
+
+/* t of the region-2 point at compression u (u_T < u < s). */
+static double t_of_u(const cf_law *law, double u)
+{
+    const double F = cf_law_force(law, CF_LAW_EXACT, u, NULL, NULL);
+    /* r - 1 = (F_C/F)^(1/3) - 1 from the force deficit, without cancellation near solid */
+    const double q = expm1(log1p((law->F_C_N - F) / F) / 3.0);
+    return sqrt(fmax(q, 0.0));
+}
+
+/* Fills h with the nodes of [0, U] for `intervals` region-2 intervals (before the halving of the
+** end intervals) and the law's values at them, shifted as described at the top. */
+static int half_place(const cf_law *law, double U, size_t intervals, half *h)
+{
+    free(h->u), free(h->F);
+    memset(h, 0, sizeof *h);
+    const int linear_only = !(U > law->u_T_mm) || !(law->rho_inv_m1 > 0.0);
+    const size_t cap = linear_only ? 2 : intervals + 5;
+    h->u = malloc(cap * sizeof *h->u);
+    h->F = malloc(cap * sizeof *h->F);
+    if (!h->u || !h->F)
+        return -1;
+    h->u[h->n++] = 0.0;
+    if (linear_only) {
+        h->u[h->n++] = U;
+    } else {
+        h->u[h->n++] = law->u_T_mm;
+        /* running integral of g from t_T (at u_T) down to t_U (at U) */
+        const double tT = sqrt(law->rho_inv_m1), tU = t_of_u(law, U);
+        double G[TABLE_QUAD + 1];
+        G[0] = 0.0;
+        const double dt = (tT - tU) / TABLE_QUAD;
+        for (int i = 1; i <= TABLE_QUAD; i++) { /* Simpson on each cell */
+            const double a = tT - (i - 1) * dt, b = tT - i * dt;
+            G[i] = G[i - 1] + dt / 6.0 * (density(a) + 4.0 * density(0.5 * (a + b)) + density(b));
+        }
+        /* nodes at equal steps of G; the first and last intervals halved */
+        const size_t N = intervals < 2 ? 2 : intervals;
+        size_t j = 0;
+        for (size_t k = 0; k <= 2 * N; k++) {
+            /* positions (in units of one interval): 0.5, 1, 2, ..., N-1, N-0.5, N */
+            double pos;
+            if (k == 0)
+                pos = 0.5;
+            else if (k <= N - 1)
+                pos = (double)k;
+            else if (k == N)
+                pos = (double)N - 0.5;
+            else
+                break;
+            const double target = pos / (double)N * G[TABLE_QUAD];
+            while (j < TABLE_QUAD - 1 && G[j + 1] < target)
+                j++;
+            const double f = (target - G[j]) / (G[j + 1] - G[j]);
+            const double t = tT - (j + f) * dt;
+            const double u = u_of_t(law, t);
+            if (u > h->u[h->n - 1] && u < U)
+                h->u[h->n++] = u;
+        }
+        h->u[h->n++] = U;
+    }
+    for (size_t i = 0; i < h->n; i++)
+        h->F[i] = cf_law_force(law, CF_LAW_EXACT, h->u[i], NULL, NULL);
+    /* shift the interior region-2 nodes by half the interpolation error of their intervals */
+    if (h->n > 4) {
+        double *e = malloc(h->n * sizeof *e);
+        if (!e)
+            return -1;
+        for (size_t i = 1; i + 1 < h->n; i++) { /* interval [u_i, u_i+1] */
+            double worst = 0.0;
+            for (int p = 1; p <= TABLE_PROBES; p++) {
+                const double f = p / (TABLE_PROBES + 1.0);
+                const double u = h->u[i] + f * (h->u[i + 1] - h->u[i]);
+                const double chord = h->F[i] + f * (h->F[i + 1] - h->F[i]);
+                worst = fmax(worst, chord - cf_law_force(law, CF_LAW_EXACT, u, NULL, NULL));
+            }
+            e[i] = worst;
+        }
+        for (size_t i = 2; i + 1 < h->n; i++) /* nodes strictly between u_T and U */
+            h->F[i] -= 0.25 * (e[i - 1] + e[i]);
+        free(e);
+    }
+    return 0;
+}
+
+/* ---- the whole table -------------------------------------------------------------------------- */
+
+double cf_export_table_eval(const cf_export_table *t, double u_mm)
+{
+    if (t->rows == 0)
+        return 0.0;
+    if (!(u_mm > t->u_mm[0]))
+        return t->F_N[0];
+    if (u_mm >= t->u_mm[t->rows - 1])
+        return t->F_N[t->rows - 1];
+    size_t lo = 0, hi = t->rows - 1; /* u[lo] < u <= u[hi] */
+    while (hi - lo > 1) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (t->u_mm[mid] < u_mm)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    const double f = (u_mm - t->u_mm[lo]) / (t->u_mm[hi] - t->u_mm[lo]);
+    return t->F_N[lo] + f * (t->F_N[hi] - t->F_N[lo]);
+}
+
+void cf_export_table_free(cf_export_table *t)
+{
+    if (!t)
+        return;
+    free(t->u_mm);
+    free(t->F_N);
+    free(t->k_N_per_mm);
+    memset(t, 0, sizeof *t);
+}
+
+double cf_export_table_end(const cf_law *law, double tol)
+{
+    return cf_law_deflection(law, law->F_C_N * (1.0 - tol));
+}
+
+/* The i-th point (0 <= i < 2 TABLE_CHECK) of the check grid over the half [0, U]. */
+static double check_point(const cf_law *law, double U, size_t i)
+{
+    const size_t N = TABLE_CHECK;
+    if (i < N)
+        return U * ((double)i + 0.5) / (double)N;
+    i -= N;
+    const double s = law->travel_mm;
+    const double w_end = sqrt(fmax(0.0, 1.0 - U / s));
+    const double w = w_end + (1.0 - w_end) * ((double)i + 0.5) / (double)N;
+    return fmin(s * (1.0 - w * w), U);
+}
+
+/* Largest |table - law| over the half [0, U] (sign = +1) or [-U, 0] (sign = -1), N. */
+static double half_error(const cf_law *law, const cf_export_table *t, double U, double sign,
+                         double *where)
+{
+    double worst = 0.0;
+    for (size_t i = 0; i < 2 * (size_t)TABLE_CHECK; i++) {
+        const double u = sign * check_point(law, U, i);
+        const double e = fabs(cf_export_table_eval(t, u) - cf_law_force(law, CF_LAW_EXACT, u, NULL,
+                                                                        NULL));
+        if (e > worst) {
+            worst = e;
+            *where = u;
+        }
+    }
+    return worst;
+}
+
+/* Joins the stretch half (mirrored) and the compression half into t. */
+static int join(const cf_law *law, const half *st, const half *co, cf_export_table *t)
+{
+    const size_t n = st->n + co->n - 1;
+    double *u = malloc(n * sizeof *u), *F = malloc(n * sizeof *F), *k = malloc(n * sizeof *k);
+    if (!u || !F || !k) {
+        free(u), free(F), free(k);
+        return -1;
+    }
+    size_t r = 0;
+    for (size_t i = st->n; i-- > 1;) {
+        u[r] = -st->u[i];
+        F[r++] = -st->F[i];
+    }
+    for (size_t i = 0; i < co->n; i++) {
+        u[r] = co->u[i];
+        F[r++] = co->F[i];
+    }
+    for (size_t i = 0; i < n; i++)
+        cf_law_force(law, CF_LAW_EXACT, u[i], &k[i], NULL);
+    free(t->u_mm), free(t->F_N), free(t->k_N_per_mm);
+    t->u_mm = u;
+    t->F_N = F;
+    t->k_N_per_mm = k;
+    t->rows = n;
+    return 0;
+}
+
+/* Places one half to the tolerance: returns its region-2 interval count, 0 on failure. */
+static size_t settle_half(const cf_law *law, double tol, double U, double sign, half *h,
+                          cf_export_table *scratch, double *err_N, double *where)
+{
+    const double goal = tol * law->F_C_N;
+    /* first guess from the integral of g: error per interval ~ (dG)^2 / 16 in units of F_C */
+    double G = 0.0;
+    if (U > law->u_T_mm && law->rho_inv_m1 > 0.0) {
+        const double tT = sqrt(law->rho_inv_m1), tU = t_of_u(law, U);
+        const int M = 512;
+        for (int i = 0; i < M; i++)
+            G += density(tT - (i + 0.5) * (tT - tU) / M) * (tT - tU) / M;
+    }
+    size_t N = (size_t)ceil(G / sqrt(16.0 * TABLE_AIM * tol)) + 1;
+    half empty = {0};
+    for (int round = 0; round < TABLE_ROUNDS; round++) {
+        if (half_place(law, U, N, h) != 0)
+            return 0;
+        /* a table with this half on its own side and a copy mirrored on the other */
+        const half *co = sign > 0 ? h : &empty, *st = sign > 0 ? &empty : h;
+        half one = {1, (double[]){0.0}, (double[]){0.0}};
+        if (join(law, st->n ? st : &one, co->n ? co : &one, scratch) != 0)
+            return 0;
+        *err_N = half_error(law, scratch, U, sign, where);
+        if (*err_N <= goal)
+            return N;
+        if (h->n <= 2) /* region 1 only: exact, cannot improve */
+            return N;
+        double next = N * sqrt(*err_N / (TABLE_AIM * goal));
+        N = (size_t)fmax((double)N + 1.0, ceil(next));
+    }
+    return N; /* the caller sees *err_N > goal */
+}
+
+cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo_mm,
+                                      double u_hi_mm, cf_export_table *t, cf_error *err)
+{
+    memset(t, 0, sizeof *t);
+    if (!isfinite(tol) || tol < CF_EXPORT_TOL_MIN || tol > CF_EXPORT_TOL_MAX)
+        return cf_error_set(err, CF_E_DATA, "tolerance %g is outside [%g, %g]", tol,
+                            CF_EXPORT_TOL_MIN, CF_EXPORT_TOL_MAX);
+    const double u_end = cf_export_table_end(law, tol);
+    if (!isfinite(u_lo_mm) || !isfinite(u_hi_mm) || u_lo_mm > 0.0 || u_hi_mm < 0.0 ||
+        !(u_hi_mm > u_lo_mm))
+        return cf_error_set(err, CF_E_DATA,
+                            "range [%g, %g] mm must contain the rest state u = 0 and be wider "
+                            "than a point",
+                            u_lo_mm, u_hi_mm);
+    if (u_hi_mm > u_end || -u_lo_mm > u_end)
+        return cf_error_set(err, CF_E_DATA,
+                            "range [%g, %g] mm passes the end of the spring's travel: the table "
+                            "reaches |u| <= %.10g mm (where the law carries F_C (1 - tol); solid "
+                            "at %.10g mm)",
+                            u_lo_mm, u_hi_mm, u_end, law->travel_mm);
+    half co = {0}, st = {0};
+    cf_export_table scratch = {0};
+    double eco = 0.0, est = 0.0, wco = 0.0, wst = 0.0;
+    cf_status status = CF_OK;
+    const double Uco = u_hi_mm, Ust = -u_lo_mm;
+    size_t Nco = 0, Nst = 0;
+    if (Uco > 0.0 && (Nco = settle_half(law, tol, Uco, +1.0, &co, &scratch, &eco, &wco)) == 0)
+        goto oom;
+    if (Ust > 0.0) {
+        if (Ust == Uco) { /* the law is odd: the stretch half mirrors the compression half */
+            st.n = co.n;
+            st.u = malloc(co.n * sizeof *st.u);
+            st.F = malloc(co.n * sizeof *st.F);
+            if (!st.u || !st.F)
+                goto oom;
+            memcpy(st.u, co.u, co.n * sizeof *st.u);
+            memcpy(st.F, co.F, co.n * sizeof *st.F);
+            est = eco;
+            wst = -wco;
+            Nst = Nco;
+        } else if ((Nst = settle_half(law, tol, Ust, -1.0, &st, &scratch, &est, &wst)) == 0) {
+            goto oom;
+        }
+    }
+    {
+        half one = {1, (double[]){0.0}, (double[]){0.0}};
+        if (join(law, st.n ? &st : &one, co.n ? &co : &one, t) != 0)
+            goto oom;
+    }
+    t->tol = tol;
+    t->u_lo_mm = u_lo_mm;
+    t->u_hi_mm = u_hi_mm;
+    /* the achieved error of the joined table, on the check grid of each side */
+    eco = Uco > 0.0 ? half_error(law, t, Uco, +1.0, &wco) : 0.0;
+    est = Ust > 0.0 ? half_error(law, t, Ust, -1.0, &wst) : 0.0;
+    t->max_err_N = fmax(eco, est);
+    t->max_err_u_mm = eco >= est ? wco : wst;
+    t->max_err_rel = t->max_err_N / law->F_C_N;
+    for (size_t i = 0; i < t->rows; i++)
+        if (!isfinite(t->u_mm[i]) || !isfinite(t->F_N[i]) || !isfinite(t->k_N_per_mm[i])) {
+            status = cf_error_set(err, CF_E_INTERNAL, "export table row %zu is not finite", i);
+            cf_export_table_free(t);
+            goto done;
+        }
+    if (t->max_err_rel > tol) {
+        status = cf_error_set(err, CF_E_INTERNAL,
+                              "export table of %zu rows misses the tolerance %g (achieved %.3g of "
+                              "F_C)",
+                              t->rows, tol, t->max_err_rel);
+        cf_export_table_free(t);
+    }
+    (void)Nst;
+    goto done;
+oom:
+    status = cf_error_set(err, CF_E_INTERNAL, "out of memory building the export table");
+    cf_export_table_free(t);
+done:
+    free(co.u), free(co.F), free(st.u), free(st.F);
+    cf_export_table_free(&scratch);
+    return status;
+}
+
+cf_status cf_export_table_build(const cf_law *law, double tol, cf_export_table *t, cf_error *err)
+{
+    if (!isfinite(tol) || tol < CF_EXPORT_TOL_MIN || tol > CF_EXPORT_TOL_MAX) {
+        memset(t, 0, sizeof *t);
+        return cf_error_set(err, CF_E_DATA, "tolerance %g is outside [%g, %g]", tol,
+                            CF_EXPORT_TOL_MIN, CF_EXPORT_TOL_MAX);
+    }
+    const double u_end = cf_export_table_end(law, tol);
+    return cf_export_table_build_range(law, tol, -u_end, u_end, t, err);
+}
