@@ -265,7 +265,10 @@ static void first_error_line(FILE *f, char *out, size_t cap)
                 last[o++] = *p;
         if (o > 0) {
             last[o] = '\0';
-            snprintf(out, cap, "%s", last);
+            if (o >= cap)
+                o = cap - 1;   /* cap > 0: the caller's buffer holds at least the terminator */
+            memcpy(out, last, o);
+            out[o] = '\0';
         }
     }
 }
