@@ -137,28 +137,46 @@ static int model_of_lattice(cf_xmodel *m, const cf_lattice *lat)
     return 0;
 }
 
-/* conifit's static run along the loading: compressive top reaction (N) at each step into ref_N
-** and the largest spring compression (mm). */
-static cf_status reference_run(const cf_law *law, const cf_export_lattice *lx, double area_mm2,
-                               double *ref_N, double *max_u_mm, cf_error *err)
+/* conifit's static run along the loading (the same solver as `conifit simulate`): compressive
+** top reaction (N) at each step into ref_N, the largest spring compression (mm), and the first
+** step whose equilibrium is unstable (negative pivots of the tangent; 0 when none is). */
+static cf_status reference_run(cf_lattice *lat, const cf_export_lattice *lx, double *ref_N,
+                               double *max_u_mm, size_t *unstable, long *pivots, cf_error *err)
 {
-    double strain[CF_EXPORT_MAX_STEPS], stress[CF_EXPORT_MAX_STEPS];
-    for (size_t k = 0; k < lx->nsteps; k++)
-        strain[k] = -lx->strain[k]; /* the table's sign: compression negative */
+    double t[CF_EXPORT_MAX_STEPS + 1], v[CF_EXPORT_MAX_STEPS + 1];
+    cf_msm_sample out[CF_EXPORT_MAX_STEPS];
+    t[0] = 0.0;
+    v[0] = 0.0;
+    for (size_t k = 0; k < lx->nsteps; k++) {
+        t[k + 1] = (double)(k + 1);
+        v[k + 1] = lx->strain[k];
+    }
+    const cf_msm_path path = {CF_DRIVE_DISPLACEMENT, lx->nsteps + 1, t, v};
+    const cf_msm_effects none = {0};
     cf_msm_stats stats = {0};
-    cf_status st =
-        cf_msm_uniaxial(law, lx->method, &lx->cfg, strain, lx->nsteps, stress, &stats, err);
+    size_t done = 0;
+    cf_lattice_reset(lat);
+    cf_status st = cf_msm_run(lat, &none, &lx->cfg, &path, t + 1, lx->nsteps, out, &done, &stats,
+                              err);
+    cf_lattice_reset(lat);
     if (st != CF_OK)
         return st;
-    for (size_t k = 0; k < lx->nsteps; k++)
-        ref_N[k] = -stress[k] * area_mm2;
-    *max_u_mm = stats.max_u_over_travel * law->travel_mm;
+    *unstable = 0;
+    for (size_t k = 0; k < lx->nsteps; k++) {
+        ref_N[k] = out[k].stress_MPa * lat->area_mm2;
+        if (!*unstable && out[k].neg_pivots > 0) {
+            *unstable = k + 1;
+            *pivots = out[k].neg_pivots;
+        }
+    }
+    *max_u_mm = stats.max_u_over_travel * lat->travel_mm;
     return CF_OK;
 }
 
-/* The largest number of leading steps (< n) that conifit's lattice follows, by bisection. */
-static size_t steps_that_work(const cf_law *law, const cf_export_lattice *lx, double area,
-                              double u_limit, size_t n)
+/* The largest number of leading steps (< n) that conifit's lattice follows stably and within the
+** tables, by bisection. */
+static size_t steps_that_work(cf_lattice *lat, const cf_export_lattice *lx, double u_limit,
+                              size_t n)
 {
     size_t lo = 0, hi = n; /* lo steps work, hi do not */
     while (hi - lo > 1) {
@@ -166,8 +184,11 @@ static size_t steps_that_work(const cf_law *law, const cf_export_lattice *lx, do
         cf_export_lattice part = *lx;
         part.nsteps = mid;
         double ref[CF_EXPORT_MAX_STEPS], umax;
+        size_t bad;
+        long piv;
         cf_error e = {0};
-        if (reference_run(law, &part, area, ref, &umax, &e) == CF_OK && umax <= u_limit)
+        if (reference_run(lat, &part, ref, &umax, &bad, &piv, &e) == CF_OK && umax <= u_limit &&
+            bad == 0)
             lo = mid;
         else
             hi = mid;
@@ -218,11 +239,13 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
         m.dz_mm[k] = -lx->strain[k] * lat.height_mm;
     }
     double umax = 0.0;
+    size_t unstable = 0;
+    long pivots = 0;
     cf_error run_err = {0};
-    st = reference_run(&law, lx, lat.area_mm2, m.ref_N, &umax, &run_err);
+    st = reference_run(&lat, lx, m.ref_N, &umax, &unstable, &pivots, &run_err);
     const double u_limit = fmin(t.u_hi_mm, -t.u_lo_mm);
-    if (st != CF_OK || umax > u_limit) {
-        const size_t ok = steps_that_work(&law, lx, lat.area_mm2, u_limit, lx->nsteps);
+    if (st != CF_OK || umax > u_limit || unstable) {
+        const size_t ok = steps_that_work(&lat, lx, u_limit, lx->nsteps);
         char works[160];
         if (ok > 0)
             snprintf(works, sizeof works, "the loading works up to strain %.6g (step %zu)",
@@ -234,11 +257,17 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
             st = cf_error_set(err, CF_E_DATA,
                               "the lattice cannot follow the loading to strain %.6g: %s; %s",
                               lx->strain[lx->nsteps - 1], run_err.msg, works);
+        else if (unstable)
+            st = cf_error_set(err, CF_E_DATA,
+                              "the lattice loses stability within the loading: at strain %.6g "
+                              "(step %zu) its tangent has %ld negative pivots, so a simulator "
+                              "would leave the homogeneous state there; %s",
+                              lx->strain[unstable - 1], unstable, pivots, works);
         else
             st = cf_error_set(err, CF_E_DATA,
-                              "at strain %.6g a spring of the lattice is compressed to %.6g mm, "
-                              "past the table's end at %.6g mm (solid at %.6g mm); %s",
-                              lx->strain[lx->nsteps - 1], umax, u_limit, law.travel_mm, works);
+                              "a spring of the lattice is compressed to %.6g mm, past the table's "
+                              "end at %.6g mm (solid at %.6g mm); %s",
+                              umax, u_limit, law.travel_mm, works);
         goto done;
     }
     for (size_t k = 0; k < m.nsteps; k++)
