@@ -1,11 +1,14 @@
 # conifit: plain Makefile. Targets:
 #   make            build build/conifit (optimised, with debug info)
 #   make deps       install the Debian packages conifit needs (as root; otherwise prints the command)
-#   make example    set up, then fit and validate a shipped table into fits/ (the README's first command)
+#   make example    set up, then fit and validate a shipped table into build/example/ (the README's
+#                   first command; as root it installs missing packages, otherwise it prints the
+#                   one apt-get line and stops)
 #   make fits       re-fit every table in data/ into fits/ (JSON and PNG), validated in the lattice
 #   make test       build and run the cmocka suite (the README's second command)
 #   make sanitize   the same suite under AddressSanitizer + UndefinedBehaviorSanitizer
-#   make bench      the benchmark report (optimised build, separate from the tests)
+#   make bench      the benchmark report into build/bench/report/ (optimised build, separate from
+#                   the tests); make bench-update copies it over the committed tests/bench/
 #   make figures    regenerate fits/figures/*.png (validation, hysteresis, creep) from data/scenes
 #   make clean
 # WERROR=1 turns warnings into errors (CI sets it).
@@ -46,7 +49,7 @@ LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 CLI_OBJ := $(CLI_SRC:src/%.c=$(BUILD)/obj/%.o)
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 
-.PHONY: all deps example test sanitize bench clean check-deps figures fits
+.PHONY: all deps example test sanitize bench bench-update clean check-deps figures fits
 
 all: check-deps $(BUILD)/conifit
 
@@ -71,8 +74,8 @@ deps:
 
 example: deps
 	@$(MAKE) --no-print-directory all
-	@mkdir -p fits
-	$(BUILD)/conifit fit data/telescoping_noise1pct.csv --validate -o fits/telescoping_noise1pct.json --plot fits/telescoping_noise1pct.png
+	@mkdir -p $(BUILD)/example
+	$(BUILD)/conifit fit data/telescoping_noise1pct.csv --validate -o $(BUILD)/example/telescoping_noise1pct.json --plot $(BUILD)/example/telescoping_noise1pct.png
 
 fits: check-deps $(BUILD)/conifit
 	$(BUILD)/conifit fit data/*.csv --validate -o fits/ --plot fits/ -j 4
@@ -111,12 +114,19 @@ clean:
 	rm -rf build
 
 # The benchmark program: optimised build of the library plus tests/bench/*.c; writes
-# tests/bench/REPORT.md and its plots. BENCH_ARGS=--quick for a short smoke run.
+# build/bench/report/REPORT.md and its plots (progress on a terminal). BENCH_ARGS=--quick for a
+# short smoke run. The committed report in tests/bench/ changes only through make bench-update.
 BENCH_OBJ := $(LIB_SRC:src/%.c=build/bench/obj/%.o)
 build/bench/obj/%.o: src/%.c $(HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
 build/bench/conifit-bench: $(wildcard tests/bench/*.c) tests/bench/bench.h $(BENCH_OBJ)
 	$(CC) $(CPPFLAGS) -Itests/bench $(CFLAGS) $(wildcard tests/bench/*.c) $(BENCH_OBJ) -o $@ $(LDFLAGS) $(LDLIBS)
+BENCH_OUT := build/bench/report
 bench: check-deps build/bench/conifit-bench $(BUILD)/conifit
-	build/bench/conifit-bench $(BENCH_ARGS) tests/bench
+	@mkdir -p $(BENCH_OUT)
+	build/bench/conifit-bench $(BENCH_ARGS) $(BENCH_OUT)
+	@echo "conifit: the report is $(BENCH_OUT)/REPORT.md; 'make bench-update' copies it (and its plots) over tests/bench/"
+bench-update:
+	@test -f $(BENCH_OUT)/REPORT.md || { echo "conifit: no report in $(BENCH_OUT): run make bench first" >&2; exit 1; }
+	cp $(BENCH_OUT)/REPORT.md $(BENCH_OUT)/*.png $(BENCH_OUT)/*.dat tests/bench/

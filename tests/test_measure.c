@@ -418,8 +418,8 @@ static void bad_tables_fail_with_line_column_and_value(void **state)
     expect_error(with_header("displacement_mm,stress_kPa"), NULL, 1, 1, "'displacement_mm'");
     /* a y column without any unit names the column and the flag */
     expect_error(with_header("strain,stress"), NULL, 1, 2, "'stress'");
-    expect_error(with_header("strain,stress"), NULL, 1, 2, "--stress-unit");
-    expect_error(with_header("displacement,force_N"), NULL, 1, 1, "--length-unit");
+    expect_error(with_header("strain,stress"), NULL, 1, 2, "option stress_unit");
+    expect_error(with_header("displacement,force_N"), NULL, 1, 1, "option length_unit");
     /* columns not found */
     cf_measure_options o = cf_measure_default_options();
     o.y_col = "load";
@@ -454,7 +454,11 @@ static void bad_tables_fail_with_line_column_and_value(void **state)
     expect_error("", NULL, 1, 1, "0 bytes");
     expect_error("# nothing here\n\n# at all\n", NULL, 3, 1, "bytes");
     /* a single column */
-    expect_error("strain stress\n0 0\n", NULL, 1, 1, "'strain stress'");
+    expect_error("strain_percent\n0\n1\n", NULL, 1, 1, "'strain_percent'");
+    /* blank-separated columns are read, so a missing unit is found in the second column */
+    expect_error("strain stress\n0 0\n", NULL, 1, 2, "'stress'");
+    /* a spreadsheet saved as such: told to save it as CSV */
+    expect_error("PK\003\004\024\000\006\000", NULL, 1, 1, "save the sheet as CSV");
     /* broken quoting */
     expect_error(with_header("strain,\"stress_kPa"), NULL, 1, 2, "unterminated");
     /* weights must be > 0 */
@@ -673,14 +677,37 @@ static void synth_noise_is_deterministic_and_of_the_asked_size(void **state)
     cf_table_free(&mz);
 }
 
+/* A .txt table whose columns are separated by blanks (and TABs mixed in) reads like its CSV
+** twin; a unit decoration "[kPa]" after a name stays with it. */
+static void blank_separated_tables_are_read(void **state)
+{
+    (void)state;
+    cf_table m;
+    load_ok("# specimen 2\nstrain   stress [kPa] weight\n0 0 1\n0.1  1.5 1\n0.2\t3 2\n"
+            "0.3 4.5 1 # a comment\n0.4 6 1\n  0.5 7.5 1\n",
+            NULL, &m);
+    assert_int_equal(m.count, 6);
+    assert_int_equal(m.kind, CF_TABLE_STRESS_STRAIN);
+    assert_string_equal(m.y_column, "stress [kPa]");
+    assert_string_equal(m.y_unit, "kPa");
+    assert_close(m.y[5], 7.5e-3, 1e-18);
+    assert_close(m.w[2], 2, 0);
+    cf_table_free(&m);
+    /* a short row is still a short row */
+    expect_error("strain stress_kPa\n0 0\n0.1\n0.2 2\n0.3 3\n0.4 4\n0.5 5\n0.6 6\n", NULL, 3, 2,
+                 "'0.1'");
+}
+
 static void synth_refuses_bad_requests_without_writing(void **state)
 {
     (void)state;
     char path[512];
     snprintf(path, sizeof path, "%s/never.csv", tmpdir);
     const char *sp = "--D1 8 --D2 20 --n 2.5 --d 2 --G 100 --H 5";
-    assert_int_equal(tu_run(NULL, 0, err_buf, sizeof err_buf, "synth %s", sp), 2);
-    assert_non_null(strstr(err_buf, "-o"));
+    assert_int_equal(tu_run(NULL, 0, err_buf, sizeof err_buf, "synth %s --points", sp), 2);
+    assert_non_null(strstr(err_buf, "--points"));
+    assert_int_equal(tu_run(NULL, 0, err_buf, sizeof err_buf, "synth %s --bogus", sp), 2);
+    assert_non_null(strstr(err_buf, "'--bogus'"));
     assert_int_equal(
         tu_run(NULL, 0, err_buf, sizeof err_buf, "synth %s --strain-max 0.6 -o %s", sp, path), 2);
     assert_non_null(strstr(err_buf, "0.6"));
@@ -796,6 +823,7 @@ int main(void)
         cmocka_unit_test(units_stated_in_comments_are_honoured),
         cmocka_unit_test(unit_lookup_knows_classes_and_factors),
         cmocka_unit_test(bad_tables_fail_with_line_column_and_value),
+        cmocka_unit_test(blank_separated_tables_are_read),
         cmocka_unit_test(binary_content_is_refused),
         cmocka_unit_test(missing_file_is_noinput),
         cmocka_unit_test(all_published_tables_load_with_their_units),

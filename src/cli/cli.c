@@ -3,15 +3,41 @@
 */
 #include "cli/cli.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+
+/* The library names a setting "option FIELD" (option stress_unit); the command line calls it
+** --stress-unit. Copies msg to out with every such name in its flag spelling. */
+static void flags_for_options(const char *msg, char *out, size_t cap)
+{
+    static const char key[] = "option ";
+    size_t o = 0;
+    while (*msg && o + 1 < cap) {
+        if (strncmp(msg, key, sizeof key - 1) == 0 && islower((unsigned char)msg[sizeof key - 1])) {
+            msg += sizeof key - 1;
+            if (o + 2 < cap) {
+                out[o++] = '-';
+                out[o++] = '-';
+            }
+            while ((islower((unsigned char)*msg) || *msg == '_') && o + 1 < cap)
+                out[o++] = *msg == '_' ? '-' : *msg, msg++;
+            continue;
+        }
+        out[o++] = *msg++;
+    }
+    out[o] = '\0';
+}
 
 int cf_cli_fail(const cf_error *err)
 {
-    fprintf(stderr, "conifit: %s\n", err->msg[0] ? err->msg : cf_strerror(err->status));
+    char msg[2 * CF_ERROR_MSG_LEN];
+    flags_for_options(err->msg[0] ? err->msg : cf_strerror(err->status), msg, sizeof msg);
+    fprintf(stderr, "conifit: %s\n", msg);
     return cf_exit_code(err->status);
 }
 
@@ -24,33 +50,6 @@ int cf_cli_usage_error(const char *cmd, const char *fmt, ...)
     va_end(ap);
     fprintf(stderr, " (see 'conifit %s --help')\n", cmd);
     return CF_EXIT_USAGE;
-}
-
-int cf_cli_is_help(const char *arg)
-{
-    return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;
-}
-
-int cf_cli_match(int argc, char **argv, int *i, const char *name, const char **value,
-                 cf_error *err)
-{
-    const char *arg = argv[*i];
-    size_t len = strlen(name);
-    if (strncmp(arg, name, len) != 0)
-        return 0;
-    if (arg[len] == '=') {
-        *value = arg + len + 1;
-        return 1;
-    }
-    if (arg[len] != '\0')
-        return 0;
-    if (*i + 1 >= argc) {
-        cf_error_set(err, CF_E_USAGE, "option %s needs a value", name);
-        return -1;
-    }
-    *i += 1;
-    *value = argv[*i];
-    return 1;
 }
 
 cf_status cf_cli_parse_double(const char *name, const char *text, double *out, cf_error *err)
@@ -82,39 +81,213 @@ cf_status cf_cli_parse_long(const char *name, const char *text, long lo, long hi
     return CF_OK;
 }
 
-static const char *const spring_flags[6] = {"--D1", "--D2", "--n", "--d", "--G", "--H"};
+/* ---- option parsing ------------------------------------------------------------------------- */
 
-const char cf_cli_spring_help[] =
-    "Spring (all six required):\n"
-    "  --D1 MM    mean diameter of the smallest active coil, mm\n"
-    "  --D2 MM    mean diameter of the largest active coil, mm (D2 >= D1)\n"
-    "  --n N      number of active coils (>= 2, may be fractional)\n"
-    "  --d MM     wire diameter, mm\n"
-    "  --G MPA    shear modulus of the wire, MPa (N/mm^2)\n"
-    "  --H MM     free length, mm\n";
+static const struct option common_opts[] = {
+    {"help", no_argument, NULL, 'h'},
+    {"output", required_argument, NULL, 'o'},
+    {"quiet", no_argument, NULL, 'q'},
+    {"progress", no_argument, NULL, CF_CLI_OPT_PROGRESS},
+    {"no-progress", no_argument, NULL, CF_CLI_OPT_NO_PROGRESS},
+};
+#define NCOMMON (sizeof common_opts / sizeof common_opts[0])
 
-int cf_cli_spring_option(cf_cli_spring *s, int argc, char **argv, int *i, cf_error *err)
+int cf_cli_parser_init(cf_cli_parser *p, const char *cmd, const char *help, int spring,
+                       int argc, char **argv, const char *shortopts,
+                       const struct option *longopts)
 {
-    double *slot[6] = {&s->p.D1_mm, &s->p.D2_mm, &s->p.n, &s->p.d_mm, &s->p.G_MPa, &s->p.H_mm};
-    for (int k = 0; k < 6; k++) {
-        const char *val;
-        int m = cf_cli_match(argc, argv, i, spring_flags[k], &val, err);
-        if (m < 0)
-            return -1;
-        if (m == 0)
-            continue;
-        if (cf_cli_parse_double(spring_flags[k], val, slot[k], err) != CF_OK)
-            return -1;
-        s->have[k] = 1;
-        return 1;
+    memset(p, 0, sizeof *p);
+    p->cmd = cmd;
+    p->help = help;
+    p->spring = spring;
+    p->argc = argc;
+    p->argv = argv;
+    p->progress = -1;
+    /* ':' first: a missing value is told apart from an unknown option */
+    snprintf(p->shortopts, sizeof p->shortopts, ":ho:q%s", shortopts ? shortopts : "");
+    size_t own = 0;
+    while (longopts && longopts[own].name)
+        own++;
+    size_t n = NCOMMON + (spring ? CF_P_COUNT : 0) + own;
+    p->longopts = calloc(n + 1, sizeof *p->longopts);
+    if (!p->longopts) {
+        fprintf(stderr, "conifit %s: out of memory\n", cmd);
+        return CF_EXIT_SOFTWARE;
     }
+    size_t k = 0;
+    for (size_t i = 0; i < NCOMMON; i++)
+        p->longopts[k++] = common_opts[i];
+    for (int i = 0; spring && i < CF_P_COUNT; i++)
+        p->longopts[k++] = (struct option){cf_spring_param_info(i)->name, required_argument, NULL,
+                                           CF_CLI_OPT_SPRING + i};
+    for (size_t i = 0; i < own; i++)
+        p->longopts[k++] = longopts[i];
+    optind = 0; /* a fresh scan (glibc re-initialises on 0) */
+    opterr = 0; /* messages are ours */
     return 0;
+}
+
+void cf_cli_parser_free(cf_cli_parser *p)
+{
+    free(p->longopts);
+    p->longopts = NULL;
+}
+
+/* The option getopt_long just refused, as the user wrote it. */
+static const char *offending(const cf_cli_parser *p, char *buf, size_t cap)
+{
+    if (optopt > 0 && optopt < 256) {
+        snprintf(buf, cap, "-%c", optopt);
+        return buf;
+    }
+    const char *a = (optind > 0 && optind <= p->argc) ? p->argv[optind - 1] : "?";
+    const char *eq = strchr(a, '=');
+    snprintf(buf, cap, "%.*s", eq ? (int)(eq - a) : (int)strlen(a), a);
+    return buf;
+}
+
+int cf_cli_next(cf_cli_parser *p)
+{
+    for (;;) {
+        int c = getopt_long(p->argc, p->argv, p->shortopts, p->longopts, NULL);
+        char buf[128];
+        switch (c) {
+        case -1:
+            return 0;
+        case 'h':
+            fputs(p->help, stdout);
+            if (p->spring)
+                cf_cli_spring_help(stdout);
+            cf_cli_common_help(stdout);
+            p->status = CF_EXIT_OK;
+            return -1;
+        case 'o':
+            p->output = optarg;
+            break;
+        case 'q':
+            p->quiet = 1;
+            break;
+        case CF_CLI_OPT_PROGRESS:
+            p->progress = 1;
+            break;
+        case CF_CLI_OPT_NO_PROGRESS:
+            p->progress = 0;
+            break;
+        case ':':
+            p->status = cf_cli_usage_error(p->cmd, "option %s needs a value",
+                                           offending(p, buf, sizeof buf));
+            return -1;
+        case '?':
+            p->status = cf_cli_usage_error(p->cmd, "unknown option '%s'",
+                                           offending(p, buf, sizeof buf));
+            return -1;
+        default:
+            return c;
+        }
+    }
+}
+
+int cf_cli_parse(cf_cli_parser *p, int (*take)(void *ctx, int c, const char *value), void *ctx)
+{
+    int c, rc = 0;
+    while ((c = cf_cli_next(p)) > 0 && (rc = take(ctx, c, optarg)) == 0)
+        ;
+    cf_cli_parser_free(p);
+    if (c < 0)
+        return p->status;
+    return rc ? rc : -1;
+}
+
+int cf_cli_progress(const cf_cli_parser *p)
+{
+    return p->progress < 0 ? isatty(STDERR_FILENO) : p->progress;
+}
+
+void cf_cli_common_help(FILE *out)
+{
+    fputs("  -q, --quiet             nothing but the result and errors (no report, notes or\n"
+          "                          summaries)\n"
+          "  --progress, --no-progress  progress lines on stderr (default: only when stderr is\n"
+          "                          a terminal)\n"
+          "  -h, --help              this help\n",
+          out);
+}
+
+/* ---- output ---------------------------------------------------------------------------------- */
+
+int cf_cli_is_stdio(const char *path)
+{
+    return path && strcmp(path, "-") == 0;
+}
+
+cf_status cf_cli_out_open(cf_cli_out *o, const char *path, const char *const *inputs,
+                          cf_error *err)
+{
+    memset(o, 0, sizeof *o);
+    if (!path || cf_cli_is_stdio(path)) {
+        o->fp = stdout;
+        o->to_stdout = 1;
+        return CF_OK;
+    }
+    cf_status st = cf_atomic_open(&o->a, path, inputs, err);
+    o->fp = o->a.fp;
+    return st;
+}
+
+cf_status cf_cli_out_close(cf_cli_out *o, cf_error *err)
+{
+    if (o->to_stdout) {
+        o->fp = NULL;
+        if (fflush(stdout) != 0 || ferror(stdout))
+            return cf_error_set(err, CF_E_CANTWRITE, "cannot write to standard output");
+        return CF_OK;
+    }
+    o->fp = NULL;
+    return cf_atomic_commit(&o->a, err);
+}
+
+void cf_cli_out_abort(cf_cli_out *o)
+{
+    if (!o->to_stdout)
+        cf_atomic_abort(&o->a);
+    o->fp = NULL;
+}
+
+/* ---- spring options -------------------------------------------------------------------------- */
+
+int cf_cli_spring_take(cf_cli_spring *s, int c, const char *text, cf_error *err)
+{
+    int k = c - CF_CLI_OPT_SPRING;
+    if (k < 0 || k >= CF_P_COUNT)
+        return 0;
+    char flag[16];
+    double v;
+    snprintf(flag, sizeof flag, "--%s", cf_spring_param_info(k)->name);
+    if (cf_cli_parse_double(flag, text, &v, err) != CF_OK)
+        return -1;
+    cf_spring_set(&s->p, k, v);
+    s->have[k] = 1;
+    return 1;
 }
 
 cf_status cf_cli_spring_complete(const cf_cli_spring *s, cf_error *err)
 {
-    for (int k = 0; k < 6; k++)
+    for (int k = 0; k < CF_P_COUNT; k++)
         if (!s->have[k])
-            return cf_error_set(err, CF_E_USAGE, "missing spring option %s", spring_flags[k]);
+            return cf_error_set(err, CF_E_USAGE, "missing spring option --%s",
+                                cf_spring_param_info(k)->name);
     return CF_OK;
+}
+
+void cf_cli_spring_help(FILE *out)
+{
+    fputs("Spring (all six required):\n", out);
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        const cf_spring_param *sp = cf_spring_param_info(k);
+        char flag[32];
+        snprintf(flag, sizeof flag, "--%s %s", sp->name,
+                 strcmp(sp->unit, "-") == 0 ? "N" : strcmp(sp->unit, "mm") == 0 ? "MM" : "MPA");
+        fprintf(out, "  %-12s %s%s%s\n", flag, sp->meaning, strcmp(sp->unit, "-") ? ", " : "",
+                strcmp(sp->unit, "-") ? sp->unit : "");
+    }
 }

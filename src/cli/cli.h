@@ -6,12 +6,14 @@
 #ifndef CF_CLI_H
 #define CF_CLI_H
 
+#include <getopt.h>
 #include <stdio.h>
 
 #include "conifit/error.h"
 #include "conifit/law.h"
 
 #include "conifit/version.h"
+#include "base/atomic.h"
 
 /* Each subcommand: parses its own arguments (argv[0] is the subcommand name) and returns an exit
 ** status (0, 2, 65, 66, 70, 73). */
@@ -33,12 +35,6 @@ int cf_cli_usage_error(const char *cmd, const char *fmt, ...)
 #endif
     ;
 
-/* Option scanning: `--name VALUE` or `--name=VALUE`. cf_cli_match returns 1 and sets *value when
-** argv[*i] is option `name` (advancing *i past a separate value), 0 when it is another argument,
-** and -1 when the option lacks its value (a message is in err). */
-int cf_cli_match(int argc, char **argv, int *i, const char *name, const char **value,
-                 cf_error *err);
-
 /* Parses a finite double for option `name`; CF_E_USAGE with a message naming the option. */
 cf_status cf_cli_parse_double(const char *name, const char *text, double *out, cf_error *err);
 
@@ -46,22 +42,96 @@ cf_status cf_cli_parse_double(const char *name, const char *text, double *out, c
 cf_status cf_cli_parse_long(const char *name, const char *text, long lo, long hi, long *out,
                             cf_error *err);
 
-/* True when argv[i] is -h or --help. */
-int cf_cli_is_help(const char *arg);
+/* ---- option parsing: getopt_long with the options every command shares ---------------------- */
 
-/* Spring arguments shared by force, curve and info: --D1 --D2 --n --d --G --H (all required). */
+/* Option codes of the shared long options without a short form, and of the spring options
+** (--D1 ... --H: CF_CLI_OPT_SPRING + CF_P_D1 ... CF_P_H). Commands number their own from
+** CF_CLI_OPT_OWN. */
+enum {
+    CF_CLI_OPT_PROGRESS = 1000,
+    CF_CLI_OPT_NO_PROGRESS,
+    CF_CLI_OPT_SPRING = 1100,
+    CF_CLI_OPT_OWN = 1200
+};
+
+/* Every command takes -h/--help, -o/--output FILE, -q/--quiet and --progress/--no-progress;
+** cf_cli_next handles them and returns the command's own options. */
+typedef struct cf_cli_parser {
+    const char *cmd;               /* "fit", for messages */
+    const char *help;              /* the command's help text */
+    int spring;                    /* 1: the command takes --D1 ... --H */
+    int argc;
+    char **argv;
+    char shortopts[64];
+    struct option *longopts;       /* shared + spring + the command's, malloc'd */
+    const char *output;            /* -o/--output (NULL if not given; "-" is standard output) */
+    int quiet;                     /* -q/--quiet */
+    int progress;                  /* --progress 1, --no-progress 0, -1 when not given */
+    int status;                    /* exit status once cf_cli_next returned -1 */
+} cf_cli_parser;
+
+/* Prepares parsing of argv (argv[0] is the command name). shortopts and longopts (terminated by
+** a zeroed entry; may be NULL) are the command's own. Returns 0, or an exit status (70) when
+** memory runs out. */
+int cf_cli_parser_init(cf_cli_parser *p, const char *cmd, const char *help, int spring,
+                       int argc, char **argv, const char *shortopts,
+                       const struct option *longopts);
+
+/* The next option of the command: its code (> 0; the value, if any, in optarg), 0 when the
+** options are done (the operands are argv[optind] ... argv[argc - 1]), or -1 when the command
+** stops with p->status: after --help (0) or a usage error (2, message printed). */
+int cf_cli_next(cf_cli_parser *p);
+
+/* Releases the parser. */
+void cf_cli_parser_free(cf_cli_parser *p);
+
+/* Runs cf_cli_next to the end, handing each of the command's options to take (which returns 0 to
+** go on, else an exit status), and frees the parser (its results stay readable). Returns -1 when
+** the command goes on (operands from argv[optind]), else the exit status. */
+int cf_cli_parse(cf_cli_parser *p, int (*take)(void *ctx, int c, const char *value), void *ctx);
+
+/* Progress on stderr: as asked, else when stderr is a terminal. */
+int cf_cli_progress(const cf_cli_parser *p);
+
+/* ---- output: a file written atomically, or standard output for "-" (or NULL) ---------------- */
+
+typedef struct cf_cli_out {
+    FILE *fp;          /* write here */
+    int to_stdout;     /* 1: fp is stdout */
+    cf_atomic a;       /* the file otherwise */
+} cf_cli_out;
+
+/* Opens path (NULL or "-": standard output). `inputs` as for cf_atomic_open. */
+cf_status cf_cli_out_open(cf_cli_out *o, const char *path, const char *const *inputs,
+                          cf_error *err);
+
+/* Commits the file (or flushes standard output); CF_E_CANTWRITE on failure. */
+cf_status cf_cli_out_close(cf_cli_out *o, cf_error *err);
+
+/* Drops an unfinished file (nothing for standard output). Safe after cf_cli_out_close. */
+void cf_cli_out_abort(cf_cli_out *o);
+
+/* 1 when path names standard input or output ("-"). */
+int cf_cli_is_stdio(const char *path);
+
+/* ---- the spring options --D1 --D2 --n --d --G --H (force, curve, info, synth) -------------- */
+
 typedef struct cf_cli_spring {
     cf_spring p;
-    int have[6];     /* which of D1, D2, n, d, G, H were given */
+    int have[CF_P_COUNT]; /* which of D1, D2, n, d, G, H were given */
 } cf_cli_spring;
 
-/* Tries argv[*i] as one of the spring options; returns 1 if consumed, 0 if not one, -1 on error. */
-int cf_cli_spring_option(cf_cli_spring *s, int argc, char **argv, int *i, cf_error *err);
+/* Takes option code c (CF_CLI_OPT_SPRING + k) with value text. Returns 1 when c is a spring
+** option it took, 0 when c is another option, -1 on a bad value (message in err). */
+int cf_cli_spring_take(cf_cli_spring *s, int c, const char *text, cf_error *err);
 
 /* After parsing: CF_E_USAGE naming the first missing spring option. */
 cf_status cf_cli_spring_complete(const cf_cli_spring *s, cf_error *err);
 
-/* Text describing the spring options, for --help. */
-extern const char cf_cli_spring_help[];
+/* Prints the spring options' help (from the spring description, spring.h). */
+void cf_cli_spring_help(FILE *out);
+
+/* Prints the help of -q, --progress and -h (each command's help states its own -o). */
+void cf_cli_common_help(FILE *out);
 
 #endif

@@ -3,7 +3,6 @@
 ** simulator (see export.h). The whole output is produced in memory first, so a failure never
 ** leaves partial output on stdout or in the -o file.
 */
-#include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,9 +26,10 @@ static const char export_help[] =
     "strain, and output requests) as a model that runs in the target as it is; conifit's own\n"
     "reaction at every step is written in its header. Row count and error go to stderr.\n"
     "Units: mm, N, s, tonne (stated inside each file).\n\n"
+    "  FIT.json         '-' reads the fit file from standard input\n"
     "  --format F       json | csv | calculix | abaqus | febio | lsdyna | sofa\n"
     "  --type T         telescoping | non-telescoping (default: the fit's better type)\n"
-    "  -o, --output F   output file (default stdout); written atomically\n"
+    "  -o, --output F   output file (default, or '-': standard output); written atomically\n"
     "  --tol REL        table tolerance as a fraction of F_C, 1e-9..0.1 (default 1e-4; for\n"
     "                   calculix/abaqus, without --tol, the smallest of 1e-4, 2e-4, 5e-4, ...\n"
     "                   whose table fits CalculiX's 200 pairs)\n"
@@ -37,8 +37,7 @@ static const char export_help[] =
     "                   0:4.5 for compression only (default: full stretch to just before solid)\n"
     "  --example        a complete one-spring model that runs as it is (every format but json\n"
     "                   and csv; sofa always writes a scene)\n"
-    "  --lattice        the whole lattice model (see above)\n"
-    "  -q, --quiet      no summary on stderr\n\n"
+    "  --lattice        the whole lattice model (see above)\n\n"
     "FIT.json is a fit file (conifit fit -o) or an exported spring (--format json).\n";
 
 /* Parses "LO:HI" (mm). */
@@ -65,74 +64,74 @@ static cf_status parse_range(const char *text, double *lo, double *hi, cf_error 
     return CF_OK;
 }
 
+enum { OPT_FORMAT = CF_CLI_OPT_OWN, OPT_TYPE, OPT_TOL, OPT_RANGE, OPT_EXAMPLE, OPT_LATTICE };
+
+typedef struct export_args {
+    cf_export_options opt;
+    const char *type;
+    int have_format, tol_given, lattice;
+} export_args;
+
+/* One option of export: 0 to go on, else an exit status. */
+static int export_option(void *ctx, int c, const char *value)
+{
+    export_args *a = ctx;
+    cf_error err = {0};
+    cf_spring_type t;
+    switch (c) {
+    case OPT_FORMAT:
+        if (cf_export_format_parse(value, &a->opt.format, &err) != CF_OK)
+            return cf_cli_usage_error("export", "option --format: %s", err.msg);
+        a->have_format = 1;
+        return 0;
+    case OPT_TYPE:
+        if (cf_spring_type_parse(value, &t, &err) != CF_OK)
+            return cf_cli_usage_error("export", "option --type: %s", err.msg);
+        a->type = value;
+        return 0;
+    case OPT_TOL:
+        if (cf_cli_parse_double("--tol", value, &a->opt.tol, &err) != CF_OK)
+            return cf_cli_usage_error("export", "%s", err.msg);
+        if (a->opt.tol < CF_EXPORT_TOL_MIN || a->opt.tol > CF_EXPORT_TOL_MAX)
+            return cf_cli_usage_error("export", "option --tol: %g is outside [%g, %g]",
+                                      a->opt.tol, CF_EXPORT_TOL_MIN, CF_EXPORT_TOL_MAX);
+        a->tol_given = 1;
+        return 0;
+    case OPT_RANGE:
+        if (parse_range(value, &a->opt.u_lo_mm, &a->opt.u_hi_mm, &err) != CF_OK)
+            return cf_cli_usage_error("export", "%s", err.msg);
+        a->opt.have_range = 1;
+        return 0;
+    case OPT_EXAMPLE:
+        a->opt.example = 1;
+        return 0;
+    case OPT_LATTICE:
+        a->lattice = 1;
+        return 0;
+    default:
+        return cf_cli_usage_error("export", "unexpected option");
+    }
+}
+
 int cf_cli_export(int argc, char **argv)
 {
-    enum { OPT_FORMAT = 256, OPT_TYPE, OPT_TOL, OPT_RANGE, OPT_EXAMPLE, OPT_LATTICE };
-    static const struct option longopts[] = {
-        {"format", required_argument, NULL, OPT_FORMAT},
-        {"type", required_argument, NULL, OPT_TYPE},
-        {"output", required_argument, NULL, 'o'},
-        {"tol", required_argument, NULL, OPT_TOL},
-        {"range", required_argument, NULL, OPT_RANGE},
-        {"example", no_argument, NULL, OPT_EXAMPLE},
-        {"lattice", no_argument, NULL, OPT_LATTICE},
-        {"quiet", no_argument, NULL, 'q'},
-        {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0}};
+    static const struct option own[] = {{"format", required_argument, NULL, OPT_FORMAT},
+                                        {"type", required_argument, NULL, OPT_TYPE},
+                                        {"tol", required_argument, NULL, OPT_TOL},
+                                        {"range", required_argument, NULL, OPT_RANGE},
+                                        {"example", no_argument, NULL, OPT_EXAMPLE},
+                                        {"lattice", no_argument, NULL, OPT_LATTICE},
+                                        {NULL, 0, NULL, 0}};
     cf_error err = {0};
-    cf_export_options opt = cf_export_default_options();
-    const char *type = NULL, *out_path = NULL;
-    int have_format = 0, tol_given = 0, lattice = 0, quiet = 0, c;
-    optind = 1;
-    opterr = 0;
-    while ((c = getopt_long(argc, argv, ":o:qh", longopts, NULL)) != -1) {
-        switch (c) {
-        case OPT_FORMAT:
-            if (cf_export_format_parse(optarg, &opt.format, &err) != CF_OK)
-                return cf_cli_usage_error("export", "%s", err.msg);
-            have_format = 1;
-            break;
-        case OPT_TYPE: {
-            cf_spring_type t;
-            if (cf_spring_type_parse(optarg, &t, &err) != CF_OK)
-                return cf_cli_usage_error("export", "%s", err.msg);
-            type = optarg;
-            break;
-        }
-        case 'o':
-            out_path = optarg;
-            break;
-        case OPT_TOL:
-            if (cf_cli_parse_double("--tol", optarg, &opt.tol, &err) != CF_OK)
-                return cf_cli_usage_error("export", "%s", err.msg);
-            if (opt.tol < CF_EXPORT_TOL_MIN || opt.tol > CF_EXPORT_TOL_MAX)
-                return cf_cli_usage_error("export", "option --tol: %g is outside [%g, %g]",
-                                          opt.tol, CF_EXPORT_TOL_MIN, CF_EXPORT_TOL_MAX);
-            tol_given = 1;
-            break;
-        case OPT_RANGE:
-            if (parse_range(optarg, &opt.u_lo_mm, &opt.u_hi_mm, &err) != CF_OK)
-                return cf_cli_usage_error("export", "%s", err.msg);
-            opt.have_range = 1;
-            break;
-        case OPT_EXAMPLE:
-            opt.example = 1;
-            break;
-        case OPT_LATTICE:
-            lattice = 1;
-            break;
-        case 'q':
-            quiet = 1;
-            break;
-        case 'h':
-            fputs(export_help, stdout);
-            return CF_EXIT_OK;
-        case ':':
-            return cf_cli_usage_error("export", "option %s needs a value", argv[optind - 1]);
-        default:
-            return cf_cli_usage_error("export", "unknown option '%s'", argv[optind - 1]);
-        }
-    }
+    export_args ea = {cf_export_default_options(), NULL, 0, 0, 0};
+    cf_cli_parser p;
+    int rc = cf_cli_parser_init(&p, "export", export_help, 0, argc, argv, "", own);
+    if (rc || (rc = cf_cli_parse(&p, export_option, &ea)) >= 0)
+        return rc;
+    cf_export_options opt = ea.opt;
+    const char *type = ea.type, *out_path = p.output;
+    const int have_format = ea.have_format, tol_given = ea.tol_given, lattice = ea.lattice,
+              quiet = p.quiet;
     const int npos = argc - optind;
     if (npos < 1)
         return cf_cli_usage_error("export", "missing the fit file");
@@ -156,7 +155,7 @@ int cf_cli_export(int argc, char **argv)
     cf_fitted_spring fs;
     if (cf_fitfile_load(fit_path, type, &fs, &err) != CF_OK)
         return cf_cli_fail(&err);
-    opt.source = fit_path;
+    opt.source = cf_cli_is_stdio(fit_path) ? "(standard input)" : fit_path;
     opt.auto_tol = !tol_given;
 
     cf_export_lattice lx;

@@ -20,11 +20,13 @@
 #include "out/plot.h"
 
 static const char fit_help[] =
-    "usage: conifit fit FILE.csv... [-o OUT.json | -o DIR/] [options]\n"
+    "usage: conifit fit TABLE... [-o OUT.json | -o DIR/ | -o -] [options]\n"
     "Fits the design parameters D1, D2, n, d [mm], G [MPa], H [mm] of a conical spring to a\n"
     "measured stress-strain (or force-displacement) table, for each spring type, with linear,\n"
     "Duffing and Fung baselines beside it. Prints a report; -o writes the JSON fit file.\n\n"
-    "  -o OUT.json | -o DIR/   fit file (one table) or folder (one NAME.json per table)\n"
+    "  TABLE                   .csv or .txt table; '-' reads one from standard input\n"
+    "  -o, --output OUT.json | DIR/ | -   fit file (one table), folder (one NAME.json per\n"
+    "                          table), or '-': the fit file on standard output (no report)\n"
     "  --type T                telescoping | non-telescoping | both (default both)\n"
     "  --fix NAME=VALUE        hold a parameter: D1, D2, d, H in mm, G in MPa, n (repeatable)\n"
     "  --index-max C           largest spring index D1/d (default 12; the smallest is 3)\n"
@@ -49,10 +51,10 @@ static const char fit_help[] =
     "  --force-unit U          unit of a force column without one (N, mN, ...)\n"
     "  --length-unit U         unit of a displacement column without one (mm, m, ...)\n"
     "  --stretch               the x column is stretch (strain = stretch - 1)\n"
-    "  -j N                    fit N tables at a time (default 1)\n"
-    "  --quiet                 no report on stdout (errors and warnings still on stderr)\n\n"
+    "  -j, --jobs N            fit N tables at a time (default 1)\n\n"
     "Tables: a header row naming the columns, units in the names (stress_kPa, stress [kPa]),\n"
-    "'#' comments, ',' ';' or TAB delimiters, an optional weight column. Tension positive.\n";
+    "'#' comments, ',' ';' TAB or blank-separated columns, an optional weight column. Tension\n"
+    "positive. A spreadsheet (.xlsx, .ods) must be saved as CSV first.\n";
 
 typedef struct fit_args {
     const char **files;
@@ -63,7 +65,10 @@ typedef struct fit_args {
     cf_measure_options mopt;
     long jobs;
     int quiet;
+    int progress;                /* progress lines on stderr */
     const char *scene;           /* the validation scene, or NULL for the default lattice */
+    int argc;                    /* the command line, for --validate SCENE.json */
+    char **argv;
 } fit_args;
 
 typedef struct fit_job {
@@ -90,6 +95,8 @@ static int is_dir_target(const char *p)
 /* DIR/BASENAME-without-extension.EXT */
 static void path_in_dir(char *dst, size_t cap, const char *dir, const char *file, const char *ext)
 {
+    if (strcmp(file, "-") == 0)
+        file = "stdin"; /* a table read from standard input */
     const char *base = strrchr(file, '/');
     base = base ? base + 1 : file;
     size_t n = strlen(base);
@@ -107,22 +114,74 @@ static int ends_with_json(const char *s)
     return n > 5 && strcmp(s + n - 5, ".json") == 0;
 }
 
-/* `--validate`, `--validate=SCENE.json`, `--validate SCENE.json` (the value is taken only when
-** it ends in .json, so a table may follow the flag); the same for --through-msm. 1 if consumed. */
-static int validate_option(int argc, char **argv, int *i, const char *name, fit_args *a)
+enum {
+    OPT_PLOT = CF_CLI_OPT_OWN,
+    OPT_TYPE,
+    OPT_FIX,
+    OPT_INDEX_MAX,
+    OPT_RELATIVE,
+    OPT_OPTIMIZER,
+    OPT_SEED,
+    OPT_STARTS,
+    OPT_VALIDATE,
+    OPT_THROUGH,
+    OPT_X_COL,
+    OPT_Y_COL,
+    OPT_STRESS_UNIT,
+    OPT_FORCE_UNIT,
+    OPT_LENGTH_UNIT,
+    OPT_STRETCH,
+    OPT_RHO_MIN,
+    OPT_N_MAX,
+    OPT_D2_MAX_H,
+    OPT_G_MAX
+};
+
+static const struct option fit_options[] = {
+    {"plot", required_argument, NULL, OPT_PLOT},
+    {"type", required_argument, NULL, OPT_TYPE},
+    {"fix", required_argument, NULL, OPT_FIX},
+    {"index-max", required_argument, NULL, OPT_INDEX_MAX},
+    {"relative", no_argument, NULL, OPT_RELATIVE},
+    {"optimizer", required_argument, NULL, OPT_OPTIMIZER},
+    {"seed", required_argument, NULL, OPT_SEED},
+    {"starts", required_argument, NULL, OPT_STARTS},
+    {"validate", optional_argument, NULL, OPT_VALIDATE},
+    {"through-msm", optional_argument, NULL, OPT_THROUGH},
+    {"x-col", required_argument, NULL, OPT_X_COL},
+    {"y-col", required_argument, NULL, OPT_Y_COL},
+    {"stress-unit", required_argument, NULL, OPT_STRESS_UNIT},
+    {"force-unit", required_argument, NULL, OPT_FORCE_UNIT},
+    {"length-unit", required_argument, NULL, OPT_LENGTH_UNIT},
+    {"stretch", no_argument, NULL, OPT_STRETCH},
+    {"rho-min", required_argument, NULL, OPT_RHO_MIN},
+    {"n-max", required_argument, NULL, OPT_N_MAX},
+    {"D2-max-H", required_argument, NULL, OPT_D2_MAX_H},
+    {"G-max", required_argument, NULL, OPT_G_MAX},
+    {"jobs", required_argument, NULL, 'j'},
+    {NULL, 0, NULL, 0}};
+
+/* --fix NAME=VALUE: 0, or the exit status of a usage error. */
+static int fix_option(const char *v, fit_args *a)
 {
-    size_t n = strlen(name);
-    const char *arg = argv[*i];
-    if (strncmp(arg, name, n) != 0 || (arg[n] != '\0' && arg[n] != '='))
-        return 0;
-    a->popt.validate = 1;
-    if (strcmp(name, "--through-msm") == 0)
-        a->popt.through_msm = 1;
-    if (arg[n] == '=')
-        a->scene = arg + n + 1;
-    else if (*i + 1 < argc && argv[*i + 1][0] != '-' && ends_with_json(argv[*i + 1]))
-        a->scene = argv[++*i];
-    return 1;
+    cf_error err = {0};
+    char name[32];
+    const char *eq = strchr(v, '=');
+    double val;
+    if (!eq || (size_t)(eq - v) >= sizeof name)
+        return cf_cli_usage_error("fit", "--fix '%s': expected NAME=VALUE", v);
+    snprintf(name, sizeof name, "%.*s", (int)(eq - v), v);
+    int k = cf_spring_param_find(name);
+    if (k < 0)
+        return cf_cli_usage_error("fit", "--fix %s: unknown parameter '%s' (expected D1, D2, n, "
+                                         "d, G or H)", v, name);
+    if (cf_cli_parse_double("--fix", eq + 1, &val, &err) != CF_OK)
+        return cf_cli_usage_error("fit", "%s", err.msg);
+    if (!(val > 0))
+        return cf_cli_usage_error("fit", "--fix %s=%g: the value must be positive", name, val);
+    a->popt.fit.fixed[k] = 1;
+    a->popt.fit.fixed_value[k] = val;
+    return 0;
 }
 
 /* The flag that widens a limit, by constraint bit. */
@@ -163,6 +222,104 @@ static void fit_warnings(const char *file, const cf_fit_report *r, const cf_fit_
                 f->solid_ratio, CF_FIT_SOLID_RATIO_WARN);
 }
 
+/* --validate[=SCENE.json] and --through-msm[=SCENE.json]; `--validate SCENE.json` takes the next
+** argument too when it ends in .json (a table never does), as earlier versions did. */
+static void validate_option(int c, const char *value, fit_args *a)
+{
+    a->popt.validate = 1;
+    if (c == OPT_THROUGH)
+        a->popt.through_msm = 1;
+    if (value)
+        a->scene = value;
+    else if (optind < a->argc && a->argv[optind][0] != '-' && ends_with_json(a->argv[optind]))
+        a->scene = a->argv[optind++];
+}
+
+/* One option of fit: 0 to go on, else an exit status. */
+static int fit_option(void *ctx, int c, const char *optval)
+{
+    fit_args *a = ctx;
+    cf_error err = {0};
+    cf_fit_options *fo = &a->popt.fit;
+    long n;
+    switch (c) {
+    case OPT_PLOT: a->plot = optval; return 0;
+    case OPT_TYPE:
+        if (strcmp(optval, "both") == 0)
+            a->popt.types = CF_PIPELINE_BOTH;
+        else if (strcmp(optval, "telescoping") == 0)
+            a->popt.types = CF_PIPELINE_TELESCOPING;
+        else if (strcmp(optval, "non-telescoping") == 0)
+            a->popt.types = CF_PIPELINE_NON_TELESCOPING;
+        else
+            return cf_cli_usage_error("fit", "--type '%s': expected telescoping, "
+                                             "non-telescoping or both", optval);
+        return 0;
+    case OPT_FIX: return fix_option(optval, a);
+    case OPT_INDEX_MAX:
+        if (cf_cli_parse_double("--index-max", optval, &fo->index_max, &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        if (fo->index_max < 3)
+            return cf_cli_usage_error("fit", "--index-max %g: must be at least 3", fo->index_max);
+        return 0;
+    case OPT_RHO_MIN:
+        if (cf_cli_parse_double("--rho-min", optval, &fo->rho_min, &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        if (!(fo->rho_min > 0 && fo->rho_min < 1))
+            return cf_cli_usage_error("fit", "--rho-min %g: a diameter ratio D1/D2 lies in (0, 1)",
+                                      fo->rho_min);
+        return 0;
+    case OPT_N_MAX:
+        if (cf_cli_parse_double("--n-max", optval, &fo->upper[CF_P_N], &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        if (!(fo->upper[CF_P_N] >= 2))
+            return cf_cli_usage_error("fit", "--n-max %g: a conical spring needs n >= 2",
+                                      fo->upper[CF_P_N]);
+        return 0;
+    case OPT_D2_MAX_H:
+        if (cf_cli_parse_double("--D2-max-H", optval, &fo->D2_over_H_max, &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        if (!(fo->D2_over_H_max > 0))
+            return cf_cli_usage_error("fit", "--D2-max-H %g: must be positive", fo->D2_over_H_max);
+        return 0;
+    case OPT_G_MAX:
+        if (cf_cli_parse_double("--G-max", optval, &fo->upper[CF_P_G], &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        if (!(fo->upper[CF_P_G] > fo->lower[CF_P_G]))
+            return cf_cli_usage_error("fit", "--G-max %g MPa: must be positive", fo->upper[CF_P_G]);
+        return 0;
+    case OPT_RELATIVE: fo->relative = 1; return 0;
+    case OPT_OPTIMIZER:
+        if (cf_fit_optimizer_parse(optval, &fo->optimizer, &err) != CF_OK)
+            return cf_cli_usage_error("fit", "option --optimizer: %s", err.msg);
+        return 0;
+    case OPT_SEED:
+        if (cf_cli_parse_long("--seed", optval, 0, 2147483647L, &n, &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        fo->seed = (unsigned long)n;
+        return 0;
+    case OPT_STARTS:
+        if (cf_cli_parse_long("--starts", optval, 1, 10000, &n, &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        fo->multistart = (int)n;
+        return 0;
+    case OPT_VALIDATE:
+    case OPT_THROUGH: validate_option(c, optval, a); return 0;
+    case OPT_X_COL: a->mopt.x_col = optval; return 0;
+    case OPT_Y_COL: a->mopt.y_col = optval; return 0;
+    case OPT_STRESS_UNIT: a->mopt.stress_unit = optval; return 0;
+    case OPT_FORCE_UNIT: a->mopt.force_unit = optval; return 0;
+    case OPT_LENGTH_UNIT: a->mopt.length_unit = optval; return 0;
+    case OPT_STRETCH: a->mopt.x_is_stretch = 1; return 0;
+    case 'j':
+        if (cf_cli_parse_long("-j", optval, 1, 256, &a->jobs, &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        return 0;
+    default: return cf_cli_usage_error("fit", "unexpected option");
+    }
+}
+
+/* The operands and the checks across options. -1 to go on, else an exit status. */
 static int parse_args(int argc, char **argv, fit_args *a)
 {
     static const char *cmd = "fit";
@@ -171,143 +328,29 @@ static int parse_args(int argc, char **argv, fit_args *a)
     a->popt = cf_pipeline_default_options();
     a->mopt = cf_measure_default_options();
     a->jobs = 1;
-    a->files = calloc((size_t)argc, sizeof *a->files);
-    if (!a->files)
-        return CF_EXIT_SOFTWARE;
-    for (int i = 1; i < argc; i++) {
-        const char *v;
-        int m;
-        if (cf_cli_is_help(argv[i])) {
-            fputs(fit_help, stdout);
-            return CF_EXIT_OK;
-        }
-#define OPT(name) ((m = cf_cli_match(argc, argv, &i, name, &v, &err)) != 0)
-#define BAD() return cf_cli_usage_error(cmd, "%s", err.msg)
-        if (OPT("-o")) {
-            if (m < 0)
-                BAD();
-            a->out = v;
-        } else if (validate_option(argc, argv, &i, "--validate", a) ||
-                   validate_option(argc, argv, &i, "--through-msm", a)) {
-            continue;
-        } else if (OPT("--plot")) {
-            if (m < 0)
-                BAD();
-            a->plot = v;
-        } else if (OPT("--type")) {
-            if (m < 0)
-                BAD();
-            if (strcmp(v, "both") == 0)
-                a->popt.types = CF_PIPELINE_BOTH;
-            else if (strcmp(v, "telescoping") == 0)
-                a->popt.types = CF_PIPELINE_TELESCOPING;
-            else if (strcmp(v, "non-telescoping") == 0)
-                a->popt.types = CF_PIPELINE_NON_TELESCOPING;
-            else
-                return cf_cli_usage_error(cmd, "--type '%s': expected telescoping, "
-                                               "non-telescoping or both", v);
-        } else if (OPT("--fix")) {
-            if (m < 0)
-                BAD();
-            char name[32];
-            const char *eq = strchr(v, '=');
-            int k;
-            double val;
-            if (!eq || (size_t)(eq - v) >= sizeof name)
-                return cf_cli_usage_error(cmd, "--fix '%s': expected NAME=VALUE", v);
-            snprintf(name, sizeof name, "%.*s", (int)(eq - v), v);
-            if ((k = cf_spring_param_find(name)) < 0)
-                return cf_cli_usage_error(cmd, "--fix %s: unknown parameter '%s' (expected D1, "
-                                               "D2, n, d, G or H)", v, name);
-            if (cf_cli_parse_double("--fix", eq + 1, &val, &err) != CF_OK)
-                BAD();
-            if (!(val > 0))
-                return cf_cli_usage_error(cmd, "--fix %s=%g: the value must be positive", name,
-                                          val);
-            a->popt.fit.fixed[k] = 1;
-            a->popt.fit.fixed_value[k] = val;
-        } else if (OPT("--index-max")) {
-            if (m < 0 || cf_cli_parse_double("--index-max", v, &a->popt.fit.index_max, &err))
-                BAD();
-            if (a->popt.fit.index_max < 3)
-                return cf_cli_usage_error(cmd, "--index-max %g: must be at least 3",
-                                          a->popt.fit.index_max);
-        } else if (OPT("--rho-min")) {
-            if (m < 0 || cf_cli_parse_double("--rho-min", v, &a->popt.fit.rho_min, &err))
-                BAD();
-            if (!(a->popt.fit.rho_min > 0 && a->popt.fit.rho_min < 1))
-                return cf_cli_usage_error(cmd, "--rho-min %g: a diameter ratio D1/D2 lies in (0, 1)",
-                                          a->popt.fit.rho_min);
-        } else if (OPT("--n-max")) {
-            if (m < 0 || cf_cli_parse_double("--n-max", v, &a->popt.fit.upper[CF_P_N], &err))
-                BAD();
-            if (!(a->popt.fit.upper[CF_P_N] >= 2))
-                return cf_cli_usage_error(cmd, "--n-max %g: a conical spring needs n >= 2",
-                                          a->popt.fit.upper[CF_P_N]);
-        } else if (OPT("--D2-max-H")) {
-            if (m < 0 || cf_cli_parse_double("--D2-max-H", v, &a->popt.fit.D2_over_H_max, &err))
-                BAD();
-            if (!(a->popt.fit.D2_over_H_max > 0))
-                return cf_cli_usage_error(cmd, "--D2-max-H %g: must be positive",
-                                          a->popt.fit.D2_over_H_max);
-        } else if (OPT("--G-max")) {
-            if (m < 0 || cf_cli_parse_double("--G-max", v, &a->popt.fit.upper[CF_P_G], &err))
-                BAD();
-            if (!(a->popt.fit.upper[CF_P_G] > a->popt.fit.lower[CF_P_G]))
-                return cf_cli_usage_error(cmd, "--G-max %g MPa: must be positive",
-                                          a->popt.fit.upper[CF_P_G]);
-        } else if (strcmp(argv[i], "--relative") == 0) {
-            a->popt.fit.relative = 1;
-        } else if (OPT("--optimizer")) {
-            if (m < 0 || cf_fit_optimizer_parse(v, &a->popt.fit.optimizer, &err) != CF_OK)
-                BAD();
-        } else if (OPT("--seed")) {
-            long s;
-            if (m < 0 || cf_cli_parse_long("--seed", v, 0, 2147483647L, &s, &err))
-                BAD();
-            a->popt.fit.seed = (unsigned long)s;
-        } else if (OPT("--starts")) {
-            long s;
-            if (m < 0 || cf_cli_parse_long("--starts", v, 1, 10000, &s, &err))
-                BAD();
-            a->popt.fit.multistart = (int)s;
-        } else if (OPT("--x-col")) {
-            if (m < 0)
-                BAD();
-            a->mopt.x_col = v;
-        } else if (OPT("--y-col")) {
-            if (m < 0)
-                BAD();
-            a->mopt.y_col = v;
-        } else if (OPT("--stress-unit")) {
-            if (m < 0)
-                BAD();
-            a->mopt.stress_unit = v;
-        } else if (OPT("--force-unit")) {
-            if (m < 0)
-                BAD();
-            a->mopt.force_unit = v;
-        } else if (OPT("--length-unit")) {
-            if (m < 0)
-                BAD();
-            a->mopt.length_unit = v;
-        } else if (strcmp(argv[i], "--stretch") == 0) {
-            a->mopt.x_is_stretch = 1;
-        } else if (OPT("-j")) {
-            if (m < 0 || cf_cli_parse_long("-j", v, 1, 256, &a->jobs, &err))
-                BAD();
-        } else if (strcmp(argv[i], "--quiet") == 0) {
-            a->quiet = 1;
-        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
-            return cf_cli_usage_error(cmd, "unknown option '%s'", argv[i]);
-        } else {
-            a->files[a->nfiles++] = argv[i];
-        }
-#undef OPT
-#undef BAD
-    }
+    cf_cli_parser p;
+    a->argc = argc;
+    a->argv = argv;
+    int rc = cf_cli_parser_init(&p, cmd, fit_help, 0, argc, argv, "j:", fit_options);
+    if (rc || (rc = cf_cli_parse(&p, fit_option, a)) >= 0)
+        return rc;
+    a->out = p.output;
+    a->quiet = p.quiet;
+    a->progress = cf_cli_progress(&p);
+    a->files = (const char **)argv + optind;
+    a->nfiles = argc - optind;
     if (a->nfiles == 0)
         return cf_cli_usage_error(cmd, "no table given");
+    for (int i = 0; i < a->nfiles; i++)
+        if (cf_cli_is_stdio(a->files[i]) && a->nfiles > 1)
+            return cf_cli_usage_error(cmd, "'-' (a table on standard input) must be the only "
+                                           "table");
+    if (cf_cli_is_stdio(a->out)) {
+        if (a->nfiles > 1)
+            return cf_cli_usage_error(cmd, "-o -: with %d tables, -o must name a folder (DIR/)",
+                                      a->nfiles);
+        a->quiet = 1; /* standard output holds the fit file */
+    }
     if (a->nfiles > 1 && a->out && !is_dir_target(a->out))
         return cf_cli_usage_error(cmd, "-o %s: with %d tables, -o must name a folder (DIR/)",
                                   a->out, a->nfiles);
@@ -373,7 +416,9 @@ static int plan_outputs(const fit_args *a, fit_job *jobs, const char *const *inp
     for (int i = 0; i < a->nfiles; i++) {
         fit_job *j = &jobs[i];
         j->inputs = inputs;
-        if (a->out && is_dir_target(a->out))
+        if (cf_cli_is_stdio(a->out))
+            ; /* the fit file goes to standard output, written by cf_cli_fit */
+        else if (a->out && is_dir_target(a->out))
             path_in_dir(j->json_path, sizeof j->json_path, a->out, a->files[i], ".json");
         else if (a->out)
             snprintf(j->json_path, sizeof j->json_path, "%s", a->out);
@@ -408,13 +453,10 @@ int cf_cli_fit(int argc, char **argv)
 {
     fit_args a;
     int rc = parse_args(argc, argv, &a);
-    if (rc >= 0) {
-        free(a.files);
+    if (rc >= 0)
         return rc;
-    }
     fit_job *jobs = calloc((size_t)a.nfiles, sizeof *jobs);
     if (!jobs) {
-        free(a.files);
         fprintf(stderr, "conifit: out of memory\n");
         return CF_EXIT_SOFTWARE;
     }
@@ -422,7 +464,6 @@ int cf_cli_fit(int argc, char **argv)
     const char **inputs = calloc((size_t)a.nfiles + 2, sizeof *inputs);
     if (!inputs) {
         free(jobs);
-        free(a.files);
         fprintf(stderr, "conifit: out of memory\n");
         return CF_EXIT_SOFTWARE;
     }
@@ -443,7 +484,7 @@ int cf_cli_fit(int argc, char **argv)
         if (cf_pipeline_use_scene(&a.popt, a.scene, &err) != CF_OK)
             rc = cf_cli_fail(&err);
     }
-    if (isatty(STDERR_FILENO))
+    if (a.progress)
         a.popt.progress = show_progress;
     if (rc < 0) {
         pool p = {jobs, a.nfiles, 0, PTHREAD_MUTEX_INITIALIZER};
@@ -480,6 +521,16 @@ int cf_cli_fit(int argc, char **argv)
                 if (rc == CF_EXIT_OK)
                     rc = e;
                 continue;
+            }
+            if (cf_cli_is_stdio(a.out)) {
+                char *json = cf_report_json_string(&j->rep);
+                if (!json || fputs(json, stdout) < 0 || fflush(stdout) != 0) {
+                    cf_error e = {0};
+                    cf_error_set(&e, json ? CF_E_CANTWRITE : CF_E_INTERNAL,
+                                 "cannot write the fit file to standard output");
+                    rc = cf_cli_fail(&e);
+                }
+                free(json);
             }
             if (j->text) {
                 fputs(j->text, stdout);
@@ -546,6 +597,5 @@ int cf_cli_fit(int argc, char **argv)
     }
     free(jobs);
     free(inputs);
-    free(a.files);
     return rc;
 }

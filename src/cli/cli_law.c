@@ -9,25 +9,35 @@
 #include "conifit/fitfile.h"
 
 static const char force_help[] =
-    "usage: conifit force SPRING --u MM [--method M]\n"
-    "Prints the force F(u) of a conical spring in newtons (%.17g) on one line.\n\n"
+    "usage: conifit force SPRING --u MM [--method M] [-o FILE]\n"
+    "Prints the force F(u) of a conical spring, in N, on one line (17 significant digits).\n\n"
     "  --u MM       compression in mm (positive shortens the spring, negative stretches it)\n"
     "  --method M   exact | closed | closed+newton | table (default closed)\n"
-    "  --table N    intervals of the table for --method table (default 256)\n\n";
+    "  --table N    intervals of the table for --method table (default 256)\n"
+    "  -o FILE      write the line to FILE (atomically) instead of standard output\n"
+    "  --spring FILE.json[:TYPE]  instead of the six: the spring of a fit file or of an\n"
+    "               exported spring (conifit export --format json); TYPE is telescoping or\n"
+    "               non-telescoping (default: the better fit)\n\n";
 
 static const char curve_help[] =
-    "usage: conifit curve SPRING [--points N] [--method M]\n"
+    "usage: conifit curve SPRING [--points N] [--method M] [-o FILE.csv]\n"
     "Prints the CSV table u_mm,force_N,stiffness_N_per_mm from full stretch (u = -travel)\n"
     "to solid (u = +travel), N points evenly spaced in u (default 201). At +-travel the\n"
     "spring is solid: the force is +-F_C and the stiffness is reported as 0.\n\n"
     "  --points N   number of rows, 2..10000000 (default 201)\n"
     "  --method M   exact | closed | closed+newton | table (default closed)\n"
-    "  --table N    intervals of the table for --method table (default 256)\n\n";
+    "  --table N    intervals of the table for --method table (default 256)\n"
+    "  -o FILE.csv  write the table to FILE.csv (atomically) instead of standard output\n"
+    "  --spring FILE.json[:TYPE]  instead of the six: the spring of a fit file or of an\n"
+    "               exported spring (conifit export --format json)\n\n";
 
 static const char info_help[] =
-    "usage: conifit info SPRING\n"
+    "usage: conifit info SPRING [-o FILE]\n"
     "Prints the derived quantities of a conical spring: type, solid and maximum length,\n"
-    "travel, transition and solid loads, linear stiffness, spring index and diameter ratio.\n\n";
+    "travel, transition and solid loads, linear stiffness, spring index and diameter ratio.\n\n"
+    "  -o FILE      write them to FILE (atomically) instead of standard output\n"
+    "  --spring FILE.json[:TYPE]  instead of the six: the spring of a fit file or of an\n"
+    "               exported spring (conifit export --format json)\n\n";
 
 typedef struct law_args {
     cf_cli_spring spring;
@@ -37,69 +47,72 @@ typedef struct law_args {
     double u;
     int have_u;
     long points;
+    const char *out;         /* -o, or NULL: standard output */
+    const char *cmd;         /* force, curve or info */
 } law_args;
+
+enum { OPT_SPRING = CF_CLI_OPT_OWN, OPT_U, OPT_POINTS, OPT_METHOD, OPT_TABLE };
+
+/* Takes one option of force/curve/info: 0 to go on, else an exit status (-1: not one of them). */
+static int law_option(void *ctx, int c, const char *optval)
+{
+    law_args *a = ctx;
+    const char *cmd = a->cmd;
+    cf_error err = {0};
+    int m = cf_cli_spring_take(&a->spring, c, optval, &err);
+    if (m != 0)
+        return m < 0 ? cf_cli_usage_error(cmd, "%s", err.msg) : 0;
+    switch (c) {
+    case OPT_SPRING:
+        a->spring_file = optval;
+        return 0;
+    case OPT_U:
+        a->have_u = 1;
+        return cf_cli_parse_double("--u", optval, &a->u, &err) ? cf_cli_usage_error(cmd, "%s", err.msg) : 0;
+    case OPT_POINTS:
+        return cf_cli_parse_long("--points", optval, 2, 10000000, &a->points, &err)
+                   ? cf_cli_usage_error(cmd, "%s", err.msg) : 0;
+    case OPT_METHOD:
+        return cf_law_method_parse(optval, &a->method, &err) ? cf_cli_usage_error(cmd, "option --method: %s", err.msg) : 0;
+    case OPT_TABLE:
+        return cf_cli_parse_long("--table", optval, 2, 1 << 26, &a->table, &err)
+                   ? cf_cli_usage_error(cmd, "%s", err.msg) : 0;
+    default:
+        return cf_cli_usage_error(cmd, "unexpected option");
+    }
+}
 
 /* Parses the options of force/curve/info; `allowed` lists the extra options ("u", "points",
 ** "method"). Returns -1 when the command should go on, else an exit status. */
 static int parse(const char *cmd, const char *help, const char *allowed, int argc, char **argv,
                  law_args *a)
 {
+    static const struct option all[] = {
+        {"spring", required_argument, NULL, OPT_SPRING}, {"u", required_argument, NULL, OPT_U},
+        {"points", required_argument, NULL, OPT_POINTS},
+        {"method", required_argument, NULL, OPT_METHOD},
+        {"table", required_argument, NULL, OPT_TABLE}, {NULL, 0, NULL, 0}};
+    struct option own[6];
+    int n = 0;
+    for (int i = 0; all[i].name; i++)
+        if (i == 0 || strstr(allowed, all[i].name) || (i == 4 && strstr(allowed, "method")))
+            own[n++] = all[i];
+    own[n] = (struct option){NULL, 0, NULL, 0};
     cf_error err = {0};
     memset(a, 0, sizeof *a);
     a->method = CF_LAW_CLOSED;
     a->table = CF_LAW_TABLE_DEFAULT;
     a->points = 201;
-    for (int i = 1; i < argc; i++) {
-        const char *val;
-        int m;
-        if (cf_cli_is_help(argv[i])) {
-            printf(help, 0.0);
-            fputs(cf_cli_spring_help, stdout);
-            fputs("  --spring FILE.json[:TYPE]  instead of the six: the spring of a fit file or of\n"
-                  "             an exported spring (conifit export --format json); TYPE is\n"
-                  "             telescoping or non-telescoping (default: the better fit)\n",
-                  stdout);
-            return CF_EXIT_OK;
-        }
-        if ((m = cf_cli_match(argc, argv, &i, "--spring", &val, &err)) != 0) {
-            if (m < 0)
-                return cf_cli_usage_error(cmd, "%s", err.msg);
-            a->spring_file = val;
-            continue;
-        }
-        if ((m = cf_cli_spring_option(&a->spring, argc, argv, &i, &err)) != 0) {
-            if (m < 0)
-                return cf_cli_usage_error(cmd, "%s", err.msg);
-            continue;
-        }
-        if (strstr(allowed, "u") && (m = cf_cli_match(argc, argv, &i, "--u", &val, &err)) != 0) {
-            if (m < 0 || cf_cli_parse_double("--u", val, &a->u, &err) != CF_OK)
-                return cf_cli_usage_error(cmd, "%s", err.msg);
-            a->have_u = 1;
-            continue;
-        }
-        if (strstr(allowed, "points") &&
-            (m = cf_cli_match(argc, argv, &i, "--points", &val, &err)) != 0) {
-            if (m < 0 || cf_cli_parse_long("--points", val, 2, 10000000, &a->points, &err))
-                return cf_cli_usage_error(cmd, "%s", err.msg);
-            continue;
-        }
-        if (strstr(allowed, "method") &&
-            (m = cf_cli_match(argc, argv, &i, "--method", &val, &err)) != 0) {
-            if (m < 0 || cf_law_method_parse(val, &a->method, &err) != CF_OK)
-                return cf_cli_usage_error(cmd, "%s", err.msg);
-            continue;
-        }
-        if (strstr(allowed, "method") &&
-            (m = cf_cli_match(argc, argv, &i, "--table", &val, &err)) != 0) {
-            if (m < 0 || cf_cli_parse_long("--table", val, 2, 1 << 26, &a->table, &err))
-                return cf_cli_usage_error(cmd, "%s", err.msg);
-            continue;
-        }
-        return cf_cli_usage_error(cmd, "unknown argument '%s'", argv[i]);
-    }
+    cf_cli_parser p;
+    a->cmd = cmd;
+    int rc = cf_cli_parser_init(&p, cmd, help, 1, argc, argv, "", own);
+    if (rc || (rc = cf_cli_parse(&p, law_option, a)) >= 0)
+        return rc;
+    a->out = p.output;
+    if (optind < argc)
+        return cf_cli_usage_error(cmd, "unexpected argument '%s'", argv[optind]);
     if (a->spring_file) {
-        for (int k = 0; k < 6; k++)
+        for (int k = 0; k < CF_P_COUNT; k++)
             if (a->spring.have[k])
                 return cf_cli_usage_error(cmd, "--spring replaces --D1 --D2 --n --d --G --H; "
                                                "give one or the other");
@@ -125,6 +138,25 @@ static int prepare(const law_args *a, cf_law *law)
     return -1;
 }
 
+/* The result goes to -o FILE (atomically) or standard output. -1 on success, else a status. */
+static int open_out(const law_args *a, cf_cli_out *out, cf_law *law)
+{
+    cf_error err = {0};
+    const char *inputs[2] = {a->spring_file, NULL};
+    if (cf_cli_out_open(out, a->out, inputs, &err) != CF_OK) {
+        cf_law_free(law);
+        return cf_cli_fail(&err);
+    }
+    return -1;
+}
+
+static int close_out(cf_cli_out *out, cf_law *law)
+{
+    cf_error err = {0};
+    cf_law_free(law);
+    return cf_cli_out_close(out, &err) == CF_OK ? CF_EXIT_OK : cf_cli_fail(&err);
+}
+
 int cf_cli_force(int argc, char **argv)
 {
     law_args a;
@@ -134,9 +166,13 @@ int cf_cli_force(int argc, char **argv)
         return rc;
     if ((rc = prepare(&a, &law)) >= 0)
         return rc;
-    printf("%.17g\n", cf_law_force(&law, a.method, a.u, NULL, NULL));
-    cf_law_free(&law);
-    return CF_EXIT_OK;
+    cf_cli_out out;
+    FILE *o = NULL;
+    if ((rc = open_out(&a, &out, &law)) >= 0)
+        return rc;
+    o = out.fp;
+    fprintf(o, "%.17g\n", cf_law_force(&law, a.method, a.u, NULL, NULL));
+    return close_out(&out, &law);
 }
 
 int cf_cli_curve(int argc, char **argv)
@@ -148,17 +184,21 @@ int cf_cli_curve(int argc, char **argv)
         return rc;
     if ((rc = prepare(&a, &law)) >= 0)
         return rc;
+    cf_cli_out out;
+    FILE *o = NULL;
+    if ((rc = open_out(&a, &out, &law)) >= 0)
+        return rc;
+    o = out.fp;
     const double s = law.travel_mm;
-    printf("u_mm,force_N,stiffness_N_per_mm\n");
+    fprintf(o, "u_mm,force_N,stiffness_N_per_mm\n");
     for (long i = 0; i < a.points; i++) {
         /* symmetric sampling: -s + 2 s i/(N-1), with the ends exact */
         double u = (i == a.points - 1) ? s : -s + 2.0 * s * (double)i / (double)(a.points - 1);
         double k;
         double F = cf_law_force(&law, a.method, u, &k, NULL);
-        printf("%.17g,%.17g,%.17g\n", u, F, k);
+        fprintf(o, "%.17g,%.17g,%.17g\n", u, F, k);
     }
-    cf_law_free(&law);
-    return fflush(stdout) == 0 ? CF_EXIT_OK : CF_EXIT_CANTCREAT;
+    return close_out(&out, &law);
 }
 
 int cf_cli_info(int argc, char **argv)
@@ -170,29 +210,33 @@ int cf_cli_info(int argc, char **argv)
         return rc;
     if ((rc = prepare(&a, &law)) >= 0)
         return rc;
+    cf_cli_out out;
+    FILE *o = NULL;
+    if ((rc = open_out(&a, &out, &law)) >= 0)
+        return rc;
+    o = out.fp;
     const cf_spring *p = &law.p;
-    printf("conical spring, %s\n", cf_spring_type_name(law.type));
-    printf("  %-34s %.10g mm\n", "D1 (smallest coil)", p->D1_mm);
-    printf("  %-34s %.10g mm\n", "D2 (largest coil)", p->D2_mm);
-    printf("  %-34s %.10g\n", "n (active coils)", p->n);
-    printf("  %-34s %.10g mm\n", "d (wire)", p->d_mm);
-    printf("  %-34s %.10g MPa\n", "G (shear modulus)", p->G_MPa);
-    printf("  %-34s %.10g mm\n", "H (free length)", p->H_mm);
-    printf("derived\n");
-    printf("  %-34s %s ((D2-D1)/2 = %.6g mm %s n d = %.6g mm)\n", "type",
+    fprintf(o, "conical spring, %s\n", cf_spring_type_name(law.type));
+    fprintf(o, "  %-34s %.10g mm\n", "D1 (smallest coil)", p->D1_mm);
+    fprintf(o, "  %-34s %.10g mm\n", "D2 (largest coil)", p->D2_mm);
+    fprintf(o, "  %-34s %.10g\n", "n (active coils)", p->n);
+    fprintf(o, "  %-34s %.10g mm\n", "d (wire)", p->d_mm);
+    fprintf(o, "  %-34s %.10g MPa\n", "G (shear modulus)", p->G_MPa);
+    fprintf(o, "  %-34s %.10g mm\n", "H (free length)", p->H_mm);
+    fprintf(o, "derived\n");
+    fprintf(o, "  %-34s %s ((D2-D1)/2 = %.6g mm %s n d = %.6g mm)\n", "type",
            cf_spring_type_name(law.type), 0.5 * (p->D2_mm - p->D1_mm),
            law.type == CF_TELESCOPING ? ">=" : "<", p->n * p->d_mm);
-    printf("  %-34s %.10g\n", "rho = D1/D2", law.rho);
-    printf("  %-34s %.10g\n", "spring index c = D1/d", law.index_c);
-    printf("  %-34s %.10g mm\n", "L_min (solid length)", law.L_min_mm);
-    printf("  %-34s %.10g mm\n", "L_max (full stretch)", law.L_max_mm);
-    printf("  %-34s %.10g mm\n", "travel s = H - L_min", law.travel_mm);
-    printf("  %-34s %.10g\n", "solid strain s/H", law.travel_mm / p->H_mm);
-    printf("  %-34s %.10g N/mm\n", "k0 (linear stiffness)", law.k0_N_per_mm);
-    printf("  %-34s %.10g mm\n", "u_T (end of linear region)", law.u_T_mm);
-    printf("  %-34s %.10g N\n", "F_T (transition load)", law.F_T_N);
-    printf("  %-34s %.10g N\n", "F_C (solid load)", law.F_C_N);
-    printf("  %-34s %.10g MPa\n", "F_C/H^2 (stress scale)", law.F_C_N / (p->H_mm * p->H_mm));
-    cf_law_free(&law);
-    return CF_EXIT_OK;
+    fprintf(o, "  %-34s %.10g\n", "rho = D1/D2", law.rho);
+    fprintf(o, "  %-34s %.10g\n", "spring index c = D1/d", law.index_c);
+    fprintf(o, "  %-34s %.10g mm\n", "L_min (solid length)", law.L_min_mm);
+    fprintf(o, "  %-34s %.10g mm\n", "L_max (full stretch)", law.L_max_mm);
+    fprintf(o, "  %-34s %.10g mm\n", "travel s = H - L_min", law.travel_mm);
+    fprintf(o, "  %-34s %.10g\n", "solid strain s/H", law.travel_mm / p->H_mm);
+    fprintf(o, "  %-34s %.10g N/mm\n", "k0 (linear stiffness)", law.k0_N_per_mm);
+    fprintf(o, "  %-34s %.10g mm\n", "u_T (end of linear region)", law.u_T_mm);
+    fprintf(o, "  %-34s %.10g N\n", "F_T (transition load)", law.F_T_N);
+    fprintf(o, "  %-34s %.10g N\n", "F_C (solid load)", law.F_C_N);
+    fprintf(o, "  %-34s %.10g MPa\n", "F_C/H^2 (stress scale)", law.F_C_N / (p->H_mm * p->H_mm));
+    return close_out(&out, &law);
 }

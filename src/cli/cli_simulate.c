@@ -17,13 +17,14 @@
 #include "out/plot.h"
 
 static const char simulate_help[] =
-    "usage: conifit simulate SCENE.json -o OUT.csv [--plot OUT.png]\n"
+    "usage: conifit simulate SCENE.json -o OUT.csv [--plot OUT.png|.svg] [-q]\n"
     "Runs the scene on a mass-spring lattice of conical springs and writes the CSV\n"
     "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa (compression positive: strain\n"
     "is the top face's shortening over the height, stress the top reaction over nx ny H^2, in kPa;\n"
     "spring_stress_kPa is one spring's F(strain H)/H^2 at the same strain, for comparison).\n"
     "A scene with no inertia, damping or viscosity is solved as static equilibria.\n\n"
-    "  -o, --output FILE   CSV to write (written to a temporary name, then renamed)\n"
+    "  -o, --output FILE   CSV to write (written to a temporary name, then renamed); '-'\n"
+    "                      writes it to standard output and the summary to stderr\n"
     "  --plot FILE.png|.svg  also plot the result with gnuplot\n";
 
 /* Area of the closed loop(s) in the stress-strain plane over samples [a, b], kPa = kJ/m^3. */
@@ -43,33 +44,33 @@ static double loop_area(const cf_msm_sample *s, size_t a, size_t b)
     return A * 1e3;
 }
 
-static void summary(const cf_scene *sc, const cf_msm_sample *s, size_t n, const cf_msm_stats *st)
+static void summary(FILE *o, const cf_scene *sc, const cf_msm_sample *s, size_t n, const cf_msm_stats *st)
 {
     const int timed = sc->effects.inertia || sc->effects.eta_MPa_s > 0 ||
                       sc->effects.maxwell_E_MPa > 0;
     const cf_lattice_config *lc = &sc->cfg.lattice;
-    printf("spring: %s; lattice %d x %d x %d cells, calibration %s (weights edge %.4g, face "
+    fprintf(o, "spring: %s; lattice %d x %d x %d cells, calibration %s (weights edge %.4g, face "
            "%.4g, body %.4g); solver: %s\n",
            sc->spring_source, lc->nx, lc->ny, lc->nz, cf_calibration_name(lc->calibration),
            lc->weight[CF_FAMILY_EDGE], lc->weight[CF_FAMILY_FACE], lc->weight[CF_FAMILY_BODY],
            !timed ? "static equilibria"
            : sc->effects.inertia ? "explicit symplectic Euler" : "implicit quasi-static steps");
     if (sc->effects.inertia)
-        printf("time step: stable %.6g s, smallest used %.6g s, %zu steps, %zu intervals "
+        fprintf(o, "time step: stable %.6g s, smallest used %.6g s, %zu steps, %zu intervals "
                "sub-stepped\n",
                st->dt_stable_s, st->dt_used_min_s, st->steps, st->substepped);
     else
-        printf("solves: %zu, Newton iterations: %zu, linear solves: %zu\n", st->solves,
+        fprintf(o, "solves: %zu, Newton iterations: %zu, linear solves: %zu\n", st->solves,
                st->newton_iters, st->linear_iters);
-    printf("largest spring compression: %.4g of travel\n", st->max_u_over_travel);
+    fprintf(o, "largest spring compression: %.4g of travel\n", st->max_u_over_travel);
     if (sc->kind == CF_PROTO_CYCLES) {
         size_t per = (n - 1) / (size_t)sc->cycles;
         for (int c = 0; c < sc->cycles; c++) {
             size_t a = (size_t)c * per, b = a + per;
-            printf("cycle %d: dissipated energy %.6g kJ/m^3 (= kPa), ", c + 1,
+            fprintf(o, "cycle %d: dissipated energy %.6g kJ/m^3 (= kPa), ", c + 1,
                    loop_area(s, a, b));
             if (sc->drive == CF_DRIVE_FORCE) {
-                printf("residual strain after unloading %.6g\n", s[b].strain);
+                fprintf(o, "residual strain after unloading %.6g\n", s[b].strain);
             } else {
                 /* Strain at which the unloading branch first carries no stress. */
                 double eu = s[b].strain;
@@ -79,63 +80,54 @@ static void summary(const cf_scene *sc, const cf_msm_sample *s, size_t n, const 
                         eu = s[k].strain + f * (s[k + 1].strain - s[k].strain);
                         break;
                     }
-                printf("residual strain after unloading (zero stress) %.6g\n", eu);
+                fprintf(o, "residual strain after unloading (zero stress) %.6g\n", eu);
             }
         }
     } else if (sc->kind == CF_PROTO_HOLD) {
         size_t r = (n - 1) / 2; /* end of the ramp (two segments of equal sample counts) */
         if (sc->drive == CF_DRIVE_FORCE)
-            printf("creep: strain %.6g at t = %.6g s (end of ramp), %.6g at t = %.6g s (end)\n",
+            fprintf(o, "creep: strain %.6g at t = %.6g s (end of ramp), %.6g at t = %.6g s (end)\n",
                    s[r].strain, s[r].t_s, s[n - 1].strain, s[n - 1].t_s);
         else
-            printf("relaxation: stress %.6g kPa at t = %.6g s (end of ramp), %.6g kPa at "
+            fprintf(o, "relaxation: stress %.6g kPa at t = %.6g s (end of ramp), %.6g kPa at "
                    "t = %.6g s (end)\n",
                    s[r].stress_MPa * 1e3, s[r].t_s, s[n - 1].stress_MPa * 1e3, s[n - 1].t_s);
     } else {
-        printf("end: strain %.6g, stress %.6g kPa\n", s[n - 1].strain, s[n - 1].stress_MPa * 1e3);
+        fprintf(o, "end: strain %.6g, stress %.6g kPa\n", s[n - 1].strain, s[n - 1].stress_MPa * 1e3);
     }
+}
+
+enum { OPT_PLOT = CF_CLI_OPT_OWN };
+
+/* --plot, the only option of simulate's own. */
+static int take_plot(void *ctx, int c, const char *value)
+{
+    (void)c;
+    *(const char **)ctx = value;
+    return 0;
 }
 
 int cf_cli_simulate(int argc, char **argv)
 {
+    static const struct option own[] = {{"plot", required_argument, NULL, OPT_PLOT},
+                                        {NULL, 0, NULL, 0}};
     const char *scene_path = NULL, *out = NULL, *png = NULL;
     cf_error err = {0};
-    for (int i = 1; i < argc; i++) {
-        const char *val;
-        int m;
-        if (cf_cli_is_help(argv[i])) {
-            fputs(simulate_help, stdout);
-            return CF_EXIT_OK;
-        }
-        if (strcmp(argv[i], "-o") == 0) {
-            if (i + 1 >= argc)
-                return cf_cli_usage_error("simulate", "-o needs a file name");
-            out = argv[++i];
-            continue;
-        }
-        if ((m = cf_cli_match(argc, argv, &i, "--output", &val, &err)) != 0) {
-            if (m < 0)
-                return cf_cli_usage_error("simulate", "%s", err.msg);
-            out = val;
-            continue;
-        }
-        if ((m = cf_cli_match(argc, argv, &i, "--plot", &val, &err)) != 0) {
-            if (m < 0)
-                return cf_cli_usage_error("simulate", "%s", err.msg);
-            png = val;
-            continue;
-        }
-        if (argv[i][0] == '-' && argv[i][1] != '\0')
-            return cf_cli_usage_error("simulate", "unknown option '%s'", argv[i]);
-        if (scene_path)
-            return cf_cli_usage_error("simulate", "more than one scene ('%s' and '%s')",
-                                      scene_path, argv[i]);
-        scene_path = argv[i];
-    }
-    if (!scene_path)
+    cf_cli_parser p;
+    int rc = cf_cli_parser_init(&p, "simulate", simulate_help, 0, argc, argv, "", own);
+    if (rc || (rc = cf_cli_parse(&p, take_plot, &png)) >= 0)
+        return rc;
+    out = p.output;
+    const int quiet = p.quiet, progress = cf_cli_progress(&p);
+    if (optind + 1 < argc)
+        return cf_cli_usage_error("simulate", "more than one scene ('%s' and '%s')",
+                                  argv[optind], argv[optind + 1]);
+    if (optind >= argc)
         return cf_cli_usage_error("simulate", "no scene file given");
+    scene_path = argv[optind];
     if (!out)
-        return cf_cli_usage_error("simulate", "no output file given (-o OUT.csv)");
+        return cf_cli_usage_error("simulate", "no output file given (-o OUT.csv, or -o - for "
+                                              "standard output)");
     if (png && cf_plot_check_name(png, &err) != CF_OK)
         return cf_cli_usage_error("simulate", "--plot %s: the file must end in .png or .svg", png);
 
@@ -153,7 +145,7 @@ int cf_cli_simulate(int argc, char **argv)
         *colon = '\0';
     const char *inputs[] = {scene_path, strcmp(sc.spring_source, "params") ? fitfile : NULL,
                             NULL};
-    if (cf_atomic_check(out, inputs, &err) != CF_OK ||
+    if ((!cf_cli_is_stdio(out) && cf_atomic_check(out, inputs, &err) != CF_OK) ||
         (png && cf_atomic_check(png, inputs, &err) != CF_OK)) {
         cf_scene_free(&sc);
         return cf_cli_fail(&err);
@@ -163,9 +155,10 @@ int cf_cli_simulate(int argc, char **argv)
     cf_lattice lat;
     memset(&lat, 0, sizeof lat);
     cf_msm_sample *samples = NULL;
-    cf_atomic a = {0}, pa = {0};
+    cf_cli_out a = {0};
+    cf_atomic pa = {0};
     double *spring = NULL;
-    int rc = CF_EXIT_OK;
+    rc = CF_EXIT_OK;
     if (cf_law_init(&law, &sc.spring, &err) != CF_OK) {
         rc = cf_cli_fail(&err);
         goto end;
@@ -184,7 +177,7 @@ int cf_cli_simulate(int argc, char **argv)
     cf_msm_path path = cf_scene_path(&sc);
     cf_msm_stats st;
     size_t done = 0;
-    if (isatty(STDERR_FILENO)) {
+    if (progress) {
         sc.cfg.progress = show_progress;
         sc.cfg.progress_ctx = NULL;
     }
@@ -196,7 +189,7 @@ int cf_cli_simulate(int argc, char **argv)
         rc = cf_cli_fail(&err);
         goto end;
     }
-    if (cf_atomic_open(&a, out, inputs, &err) != CF_OK) {
+    if (cf_cli_out_open(&a, out, inputs, &err) != CF_OK) {
         rc = cf_cli_fail(&err);
         goto end;
     }
@@ -219,13 +212,14 @@ int cf_cli_simulate(int argc, char **argv)
         goto end;
     }
     /* both outputs exist as temporaries: put them in place together */
-    if (cf_atomic_commit(&a, &err) != CF_OK || (png && cf_atomic_commit(&pa, &err) != CF_OK)) {
+    if (cf_cli_out_close(&a, &err) != CF_OK || (png && cf_atomic_commit(&pa, &err) != CF_OK)) {
         rc = cf_cli_fail(&err);
         goto end;
     }
-    summary(&sc, samples, sc.nsamples, &st);
+    if (!quiet)
+        summary(a.to_stdout ? stderr : stdout, &sc, samples, sc.nsamples, &st);
 end:
-    cf_atomic_abort(&a);
+    cf_cli_out_abort(&a);
     cf_atomic_abort(&pa);
     free(spring);
     free(samples);

@@ -12,13 +12,12 @@
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 
-#include "base/atomic.h"
 #include "cli/cli.h"
 #include "conifit/measure.h"
 
 static const char synth_help[] =
     "usage: conifit synth SPRING [--strain-max E] [--points N] [--noise REL] [--seed S]\n"
-    "                     [--stress-unit U] [--tension|--compression] -o FILE.csv\n"
+    "                     [--stress-unit U] [--tension|--compression] [-o FILE.csv]\n"
     "Writes the stress-strain table of a conical spring: stress = F/H^2, strain = u/H\n"
     "(one cubic cell of edge H), with '#' lines documenting the spring, its type, the\n"
     "derived quantities and the noise, then the header `strain,stress_kPa`.\n\n"
@@ -35,7 +34,7 @@ static const char synth_help[] =
     "  --stress-unit U  unit of the stress column: Pa, kPa (default), MPa, GPa, N/mm2, N/m2, mmHg\n"
     "  --tension        strain and stress positive (the default; tension positive)\n"
     "  --compression    strain and stress negative (compression, tension-positive convention)\n"
-    "  -o FILE          the table to write (written atomically; required)\n\n";
+    "  -o, --output FILE  the table to write (atomically); default, or '-': standard output\n\n";
 
 /* A number written with the fewest digits that read back to the same double. */
 static void print_shortest(FILE *fp, double v)
@@ -58,95 +57,104 @@ typedef struct synth_args {
     long seed;
     const char *stress_unit;
     int compression;
-    const char *out;
+    const char *out;   /* NULL or "-": standard output */
+    int quiet;
+    int have_sign;     /* --tension or --compression seen */
 } synth_args;
+
+enum {
+    OPT_STRAIN_MAX = CF_CLI_OPT_OWN,
+    OPT_POINTS,
+    OPT_SPACING,
+    OPT_NOISE,
+    OPT_SEED,
+    OPT_STRESS_UNIT,
+    OPT_TENSION,
+    OPT_COMPRESSION
+};
+
+/* One option of synth: 0 to go on, else an exit status. */
+static int synth_option(void *ctx, int c, const char *val)
+{
+    synth_args *a = ctx;
+    int *have_sign = &a->have_sign;
+    cf_error err = {0};
+    int m = cf_cli_spring_take(&a->spring, c, val, &err);
+    if (m != 0)
+        return m < 0 ? cf_cli_usage_error("synth", "%s", err.msg) : 0;
+    switch (c) {
+    case OPT_STRAIN_MAX:
+        if (cf_cli_parse_double("--strain-max", val, &a->strain_max, &err))
+            return cf_cli_usage_error("synth", "%s", err.msg);
+        if (!(a->strain_max > 0.0))
+            return cf_cli_usage_error("synth", "option --strain-max: '%s' must be > 0", val);
+        return 0;
+    case OPT_POINTS:
+        if (cf_cli_parse_long("--points", val, 2, 1000000, &a->points, &err))
+            return cf_cli_usage_error("synth", "%s", err.msg);
+        return 0;
+    case OPT_SPACING:
+        if (strcmp(val, "even") != 0 && strcmp(val, "solid") != 0)
+            return cf_cli_usage_error("synth", "option --spacing: '%s' is neither 'even' nor "
+                                      "'solid'", val);
+        a->solid_spacing = strcmp(val, "solid") == 0;
+        return 0;
+    case OPT_NOISE:
+        if (cf_cli_parse_double("--noise", val, &a->noise, &err))
+            return cf_cli_usage_error("synth", "%s", err.msg);
+        if (a->noise < 0.0)
+            return cf_cli_usage_error("synth", "option --noise: '%s' must be >= 0", val);
+        return 0;
+    case OPT_SEED:
+        if (cf_cli_parse_long("--seed", val, 0, 4294967295L, &a->seed, &err))
+            return cf_cli_usage_error("synth", "%s", err.msg);
+        return 0;
+    case OPT_STRESS_UNIT:
+        if (cf_measure_unit(val, NULL) != CF_UNIT_STRESS)
+            return cf_cli_usage_error("synth", "option --stress-unit: '%s' is not a stress "
+                                      "unit (Pa kPa MPa GPa N/mm2 N/m2 mmHg)", val);
+        a->stress_unit = val;
+        return 0;
+    case OPT_TENSION:
+    case OPT_COMPRESSION:
+        if (*have_sign && (c == OPT_COMPRESSION) != a->compression)
+            return cf_cli_usage_error("synth", "--tension and --compression exclude each other");
+        a->compression = c == OPT_COMPRESSION;
+        *have_sign = 1;
+        return 0;
+    default:
+        return cf_cli_usage_error("synth", "unexpected option");
+    }
+}
 
 /* Returns -1 to go on, else an exit status. */
 static int parse(int argc, char **argv, synth_args *a)
 {
+    static const struct option own[] = {
+        {"strain-max", required_argument, NULL, OPT_STRAIN_MAX},
+        {"points", required_argument, NULL, OPT_POINTS},
+        {"spacing", required_argument, NULL, OPT_SPACING},
+        {"noise", required_argument, NULL, OPT_NOISE},
+        {"seed", required_argument, NULL, OPT_SEED},
+        {"stress-unit", required_argument, NULL, OPT_STRESS_UNIT},
+        {"tension", no_argument, NULL, OPT_TENSION},
+        {"compression", no_argument, NULL, OPT_COMPRESSION},
+        {NULL, 0, NULL, 0}};
     cf_error err = {0};
     memset(a, 0, sizeof *a);
     a->points = 50;
     a->seed = 1;
     a->stress_unit = "kPa";
-    int have_sign = 0;
-    for (int i = 1; i < argc; i++) {
-        const char *val;
-        int m;
-        if (cf_cli_is_help(argv[i])) {
-            fputs(synth_help, stdout);
-            fputs(cf_cli_spring_help, stdout);
-            return CF_EXIT_OK;
-        }
-        if ((m = cf_cli_spring_option(&a->spring, argc, argv, &i, &err)) != 0) {
-            if (m < 0)
-                return cf_cli_usage_error("synth", "%s", err.msg);
-            continue;
-        }
-        if ((m = cf_cli_match(argc, argv, &i, "--strain-max", &val, &err)) != 0) {
-            if (m < 0 || cf_cli_parse_double("--strain-max", val, &a->strain_max, &err))
-                return cf_cli_usage_error("synth", "%s", err.msg);
-            if (!(a->strain_max > 0.0))
-                return cf_cli_usage_error("synth", "option --strain-max: '%s' must be > 0", val);
-            continue;
-        }
-        if ((m = cf_cli_match(argc, argv, &i, "--points", &val, &err)) != 0) {
-            if (m < 0 || cf_cli_parse_long("--points", val, 2, 1000000, &a->points, &err))
-                return cf_cli_usage_error("synth", "%s", err.msg);
-            continue;
-        }
-        if ((m = cf_cli_match(argc, argv, &i, "--spacing", &val, &err)) != 0) {
-            if (m < 0)
-                return cf_cli_usage_error("synth", "%s", err.msg);
-            if (strcmp(val, "even") != 0 && strcmp(val, "solid") != 0)
-                return cf_cli_usage_error("synth", "option --spacing: '%s' is neither 'even' nor "
-                                          "'solid'", val);
-            a->solid_spacing = strcmp(val, "solid") == 0;
-            continue;
-        }
-        if ((m = cf_cli_match(argc, argv, &i, "--noise", &val, &err)) != 0) {
-            if (m < 0 || cf_cli_parse_double("--noise", val, &a->noise, &err))
-                return cf_cli_usage_error("synth", "%s", err.msg);
-            if (a->noise < 0.0)
-                return cf_cli_usage_error("synth", "option --noise: '%s' must be >= 0", val);
-            continue;
-        }
-        if ((m = cf_cli_match(argc, argv, &i, "--seed", &val, &err)) != 0) {
-            if (m < 0 || cf_cli_parse_long("--seed", val, 0, 4294967295L, &a->seed, &err))
-                return cf_cli_usage_error("synth", "%s", err.msg);
-            continue;
-        }
-        if ((m = cf_cli_match(argc, argv, &i, "--stress-unit", &val, &err)) != 0) {
-            if (m < 0)
-                return cf_cli_usage_error("synth", "%s", err.msg);
-            if (cf_measure_unit(val, NULL) != CF_UNIT_STRESS)
-                return cf_cli_usage_error("synth", "option --stress-unit: '%s' is not a stress "
-                                          "unit (Pa kPa MPa GPa N/mm2 N/m2 mmHg)", val);
-            a->stress_unit = val;
-            continue;
-        }
-        if (strcmp(argv[i], "--tension") == 0 || strcmp(argv[i], "--compression") == 0) {
-            int c = strcmp(argv[i], "--compression") == 0;
-            if (have_sign && c != a->compression)
-                return cf_cli_usage_error("synth", "--tension and --compression exclude each "
-                                          "other");
-            a->compression = c;
-            have_sign = 1;
-            continue;
-        }
-        if ((m = cf_cli_match(argc, argv, &i, "-o", &val, &err)) != 0 ||
-            (m = cf_cli_match(argc, argv, &i, "--output", &val, &err)) != 0) {
-            if (m < 0)
-                return cf_cli_usage_error("synth", "%s", err.msg);
-            a->out = val;
-            continue;
-        }
-        return cf_cli_usage_error("synth", "unknown argument '%s'", argv[i]);
-    }
+    cf_cli_parser p;
+    int rc = cf_cli_parser_init(&p, "synth", synth_help, 1, argc, argv, "", own);
+    if (rc || (rc = cf_cli_parse(&p, synth_option, a)) >= 0)
+        return rc;
+    a->out = p.output;
+    a->quiet = p.quiet;
+    if (optind < argc)
+        return cf_cli_usage_error("synth", "unexpected argument '%s'", argv[optind]);
     if (cf_cli_spring_complete(&a->spring, &err) != CF_OK)
         return cf_cli_usage_error("synth", "%s", err.msg);
-    if (!a->out)
-        return cf_cli_usage_error("synth", "missing option -o FILE.csv");
     return -1;
 }
 
@@ -165,7 +173,7 @@ static void write_header(FILE *fp, const synth_args *a, const cf_law *law, doubl
             i++;
             continue;
         }
-        if (strncmp(argv[i], "-o=", 3) == 0 || strncmp(argv[i], "--output=", 9) == 0)
+        if (strncmp(argv[i], "-o", 2) == 0 || strncmp(argv[i], "--output=", 9) == 0)
             continue;
         fprintf(fp, " %s", argv[i]);
     }
@@ -219,7 +227,7 @@ int cf_cli_synth(int argc, char **argv)
         return cf_cli_usage_error("synth", "option --strain-max: %.10g is not below the solid "
                                   "strain %.10g of this spring", E, solid_strain);
     }
-    if (law.index_c < 3.0)
+    if (law.index_c < 3.0 && !a.quiet)
         fprintf(stderr, "conifit synth: warning: spring index D1/d = %.6g < 3 is not a practical "
                         "spring (the fitter requires >= 3)\n", law.index_c);
     double to_conifit = 1.0;
@@ -272,8 +280,8 @@ int cf_cli_synth(int argc, char **argv)
         return cf_cli_fail(&err);
     }
 
-    cf_atomic out;
-    if (cf_atomic_open(&out, a.out, NULL, &err) != CF_OK) {
+    cf_cli_out out;
+    if (cf_cli_out_open(&out, a.out, NULL, &err) != CF_OK) {
         free(strain);
         free(stress);
         cf_law_free(&law);
@@ -290,7 +298,7 @@ int cf_cli_synth(int argc, char **argv)
     free(strain);
     free(stress);
     cf_law_free(&law);
-    if (cf_atomic_commit(&out, &err) != CF_OK)
+    if (cf_cli_out_close(&out, &err) != CF_OK)
         return cf_cli_fail(&err);
     return CF_EXIT_OK;
 }

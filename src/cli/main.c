@@ -74,7 +74,7 @@ static int run(int argc, char **argv)
         usage(stderr);
         return CF_EXIT_USAGE;
     }
-    if (cf_cli_is_help(argv[1])) {
+    if (strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "--help") == 0) {
         usage(stdout);
         return CF_EXIT_OK;
     }

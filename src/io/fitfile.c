@@ -26,12 +26,13 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
 {
     memset(out, 0, sizeof *out);
     out->rmse = NAN;
-    FILE *f = fopen(path, "rb");
+    const int from_stdin = strcmp(path, "-") == 0; /* "-": standard input */
+    FILE *f = from_stdin ? stdin : fopen(path, "rb");
     if (!f)
         return cf_error_set(err, CF_E_NOINPUT, "%s: cannot open fit file: %s", path,
                             strerror(errno));
     struct stat fs;
-    if (fstat(fileno(f), &fs) == 0 && S_ISDIR(fs.st_mode)) {
+    if (!from_stdin && fstat(fileno(f), &fs) == 0 && S_ISDIR(fs.st_mode)) {
         fclose(f);
         return cf_error_set(err, CF_E_NOINPUT, "%s: cannot read fit file: it is a folder", path);
     }
@@ -39,7 +40,10 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
     errno = 0;
     json_t *root = json_loadf(f, JSON_REJECT_DUPLICATES, &jerr);
     int unreadable = ferror(f), e = errno;
-    fclose(f);
+    if (from_stdin)
+        path = "(standard input)";
+    else
+        fclose(f);
     if (!root && unreadable) /* a read error, not bad JSON */
         return cf_error_set(err, CF_E_NOINPUT, "%s: cannot read fit file: %s", path,
                             strerror(e ? e : EIO));

@@ -217,11 +217,61 @@ static int is_blank(char c, char delim)
     return c == ' ' || (c == '\t' && delim != '\t');
 }
 
+/* Splits a whitespace-separated line (delimiter ' ': runs of blanks and TABs) into f. A field
+** may be double-quoted (with "" for a quote inside); a field that starts with '[' or '(' belongs
+** to the one before it, so that "stress [kPa]" stays one column name. Returns as split(). */
+static int split_blanks(const char *s, size_t n, fields *f, size_t *bad_col, const char **why)
+{
+    f->count = 0;
+    if (fields_reserve(f, n) != 0)
+        return -2;
+    size_t i = 0, o = 0;
+    for (;;) {
+        while (i < n && (s[i] == ' ' || s[i] == '\t'))
+            i++;
+        if (i >= n)
+            return 0;
+        int joined = f->count > 0 && (s[i] == '[' || s[i] == '(');
+        if (joined)
+            f->buf[o - 1] = ' '; /* the previous field goes on: its NUL becomes a blank */
+        else if (fields_push(f, o) != 0)
+            return -2;
+        if (s[i] == '"') {
+            for (i++;; i++) {
+                if (i >= n) {
+                    *bad_col = f->count;
+                    *why = "unterminated double quote";
+                    return -1;
+                }
+                if (s[i] == '"' && i + 1 < n && s[i + 1] == '"')
+                    f->buf[o++] = s[i++];
+                else if (s[i] == '"')
+                    break;
+                else
+                    f->buf[o++] = s[i];
+            }
+            i++;
+        } else {
+            while (i < n && s[i] != ' ' && s[i] != '\t') {
+                if (s[i] == '"') {
+                    *bad_col = f->count;
+                    *why = "double quote inside an unquoted field";
+                    return -1;
+                }
+                f->buf[o++] = s[i++];
+            }
+        }
+        f->buf[o++] = '\0';
+    }
+}
+
 /* Splits s[0..n) at delim into f. Returns 0, or -1 on a quoting error (with *bad_col the field
 ** and *why the reason), or -2 when memory runs out. */
 static int split(const char *s, size_t n, char delim, fields *f, size_t *bad_col,
                  const char **why)
 {
+    if (delim == ' ')
+        return split_blanks(s, n, f, bad_col, why);
     f->count = 0;
     if (fields_reserve(f, n) != 0)
         return -2;
@@ -614,18 +664,23 @@ static cf_status out_of_memory(cf_error *err, const char *path)
 
 static cf_status read_all(reader *r, cf_error *err)
 {
-    FILE *fp = fopen(r->path, "rb");
+    const int from_stdin = strcmp(r->path, "-") == 0; /* "-": standard input */
+    FILE *fp = from_stdin ? stdin : fopen(r->path, "rb");
     if (!fp)
         return cf_error_set(err, CF_E_NOINPUT, "%s: cannot open: %s", r->path, strerror(errno));
+    if (from_stdin)
+        r->path = "(standard input)";
     size_t cap = 1 << 16;
     r->text = malloc(cap);
     if (!r->text) {
-        fclose(fp);
+        if (!from_stdin)
+            fclose(fp);
         return out_of_memory(err, r->path);
     }
     for (;;) {
         if (r->size > CF_MEASURE_MAX_BYTES) {
-            fclose(fp);
+            if (!from_stdin)
+                fclose(fp);
             return cf_error_set(err, CF_E_DATA, "%s:1:1: file larger than %zu bytes (256 MiB): not "
                                 "a measured table", r->path, CF_MEASURE_MAX_BYTES);
         }
@@ -634,7 +689,8 @@ static cf_status read_all(reader *r, cf_error *err)
             size_t ncap = 2 * cap < CF_MEASURE_MAX_BYTES + 1 ? 2 * cap : CF_MEASURE_MAX_BYTES + 1;
             char *t = realloc(r->text, ncap);
             if (!t) {
-                fclose(fp);
+                if (!from_stdin)
+                    fclose(fp);
                 return out_of_memory(err, r->path);
             }
             r->text = t;
@@ -647,11 +703,31 @@ static cf_status read_all(reader *r, cf_error *err)
     }
     int bad = ferror(fp);
     int saved = errno;
-    fclose(fp);
+    if (!from_stdin)
+        fclose(fp);
     if (bad)
         return cf_error_set(err, CF_E_NOINPUT, "%s: cannot read: %s", r->path,
                             strerror(saved ? saved : EIO));
     return CF_OK;
+}
+
+/* A spreadsheet is not a text table: say so, and what to do, instead of reporting its first
+** binary byte. .xlsx and .ods are ZIP containers ("PK\3\4"), .xls an OLE2 compound file. */
+static cf_status spreadsheet_check(const reader *r, cf_error *err)
+{
+    static const unsigned char zip[4] = {'P', 'K', 3, 4};
+    static const unsigned char ole[8] = {0xD0, 0xCF, 0x11, 0xE0, 0xA1, 0xB1, 0x1A, 0xE1};
+    const char *what = NULL;
+    if (r->size >= 4 && memcmp(r->text, zip, 4) == 0)
+        what = "a ZIP container, as .xlsx and .ods spreadsheets are";
+    else if (r->size >= 8 && memcmp(r->text, ole, 8) == 0)
+        what = "an OLE2 compound file, as .xls spreadsheets are";
+    if (!what)
+        return CF_OK;
+    return cf_error_set(err, CF_E_DATA,
+                        "%s:1:1: this file is %s, not a text table: save the sheet as CSV "
+                        "(comma-separated values) in the spreadsheet program and fit that file",
+                        r->path, what);
 }
 
 /* Cuts the text into lines (LF or CRLF), after a UTF-8 byte-order mark. */
@@ -739,7 +815,12 @@ static char detect_delimiter(const char *s, size_t n)
         return ';';
     if (comma > 0)
         return ',';
-    return 0;
+    /* none of them: columns separated by blanks (a .txt table), when there are two fields */
+    size_t nf = 0;
+    for (size_t i = 0; i < n; i++)
+        if (s[i] != ' ' && (i == 0 || s[i - 1] == ' ') && s[i] != '[' && s[i] != '(')
+            nf++;
+    return nf >= 2 ? ' ' : 0;
 }
 
 static cf_status split_or_fail(reader *r, const line_span *l, size_t n, char delim,
@@ -862,7 +943,10 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
     if (!path)
         return cf_error_set(err, CF_E_NOINPUT, "no input file named");
     r.path = path;
-    if ((st = read_all(&r, err)) != CF_OK || (st = cut_lines(&r, err)) != CF_OK ||
+    if ((st = read_all(&r, err)) != CF_OK)
+        goto fail;
+    path = r.path; /* "(standard input)" for "-" */
+    if ((st = spreadsheet_check(&r, err)) != CF_OK || (st = cut_lines(&r, err)) != CF_OK ||
         (st = scan_text(&r, err)) != CF_OK)
         goto fail;
 
@@ -891,7 +975,7 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
     if (!delim) {
         st = data_error(err, path, header_line, 1,
                         "the header has a single column; expected at least x and y separated by "
-                        "',' ';' or TAB ('%s')", hq);
+                        "',' ';' TAB or blanks ('%s')", hq);
         goto fail;
     }
     if ((st = split_or_fail(&r, hl, hn, delim, err)) != CF_OK)
@@ -974,7 +1058,7 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
     if (xi < 0 || yi < 0 || xi == yi) {
         st = data_error(err, path, header_line, 1,
                         "cannot tell which columns are x and y; name them (strain, stress_kPa, "
-                        "...) or use --x-col/--y-col ('%s')", hq);
+                        "...) or set option x_col and option y_col ('%s')", hq);
         goto fail;
     }
     if (wi == xi || wi == yi)
@@ -985,7 +1069,7 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
     /* Units. y first: it decides between stress-strain and force-displacement. */
     const column *xc = &r.cols[xi], *yc = &r.cols[yi];
     cf_unit_class yname = y_name_class(yc->base);
-    const char *yopt = NULL, *yflag = "--stress-unit";
+    const char *yopt = NULL, *yflag = "option stress_unit";
     cf_unit_class ywant[2] = {CF_UNIT_STRESS, CF_UNIT_FORCE};
     size_t nywant = 2;
     if (yname == CF_UNIT_STRESS) {
@@ -993,22 +1077,23 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
         nywant = 1;
     } else if (yname == CF_UNIT_FORCE) {
         yopt = opt.force_unit;
-        yflag = "--force-unit";
+        yflag = "option force_unit";
         ywant[0] = CF_UNIT_FORCE;
         nywant = 1;
     } else if (opt.stress_unit) {
         yopt = opt.stress_unit;
     } else if (opt.force_unit) {
         yopt = opt.force_unit;
-        yflag = "--force-unit";
+        yflag = "option force_unit";
     }
     const unit_def *yu = NULL, *xu = NULL, *tu = NULL;
     if ((st = column_unit(&r, header_line, (size_t)yi, yopt, yflag, 1, ywant, nywant, &yu, err)))
         goto fail;
     if (!yu) {
-        const char *hint = yname == CF_UNIT_FORCE ? "force_N or force [mN], or give --force-unit"
-                                                  : "stress_kPa or stress [kPa], or give "
-                                                    "--stress-unit (or --force-unit for a force)";
+        const char *hint = yname == CF_UNIT_FORCE ? "force_N or force [mN], or set option force_unit"
+                                                  : "stress_kPa or stress [kPa], or set "
+                                                    "option stress_unit (option force_unit for a "
+                                                    "force)";
         st = data_error(err, path, header_line, (size_t)yi + 1,
                         "column '%s' has no unit: name it like %s ('%s')", yc->name, hint,
                         yc->name);
@@ -1046,13 +1131,13 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
                             "column or a stress ('%s')", xc->name, xc->name);
             goto fail;
         }
-        if ((st = column_unit(&r, header_line, (size_t)xi, opt.length_unit, "--length-unit", 0,
+        if ((st = column_unit(&r, header_line, (size_t)xi, opt.length_unit, "option length_unit", 0,
                               xw, 1, &xu, err)))
             goto fail;
         if (!xu) {
             st = data_error(err, path, header_line, (size_t)xi + 1,
                             "column '%s' has no length unit (y is a force): name it like "
-                            "displacement_mm, or give --length-unit ('%s')", xc->name, xc->name);
+                            "displacement_mm, or set option length_unit ('%s')", xc->name, xc->name);
             goto fail;
         }
         xscale = xu->to_conifit;

@@ -1,6 +1,8 @@
 /*
 ** conifit-bench: measures what accuracy costs in time at every stage of conifit and writes a
-** Markdown report with tables and gnuplot plots. Usage: conifit-bench [--quick] DIR
+** Markdown report with tables and gnuplot plots.
+** Usage: conifit-bench [--quick] [--progress|--no-progress] DIR
+** (progress lines on stderr by default when stderr is a terminal).
 ** Every number in the report is measured by this program on the machine that runs it.
 */
 #include "bench.h"
@@ -91,17 +93,23 @@ int main(int argc, char **argv)
     gsl_set_error_handler_off();
     bench_ctx ctx = {0};
     const char *dir = NULL;
+    static const char usage[] = "usage: conifit-bench [--quick] [--progress|--no-progress] DIR\n";
+    int progress = isatty(STDERR_FILENO);
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--quick") == 0)
             ctx.quick = 1;
+        else if (strcmp(argv[i], "--progress") == 0)
+            progress = 1;
+        else if (strcmp(argv[i], "--no-progress") == 0)
+            progress = 0;
         else if (argv[i][0] == '-') {
-            fprintf(stderr, "usage: conifit-bench [--quick] DIR\n");
+            fputs(usage, stderr);
             return 2;
         } else
             dir = argv[i];
     }
     if (!dir) {
-        fprintf(stderr, "usage: conifit-bench [--quick] DIR\n");
+        fputs(usage, stderr);
         return 2;
     }
     ctx.dir = dir;
@@ -134,13 +142,23 @@ int main(int argc, char **argv)
                         "started (other work was running), which widens the spreads.\n\n",
                 load, cores);
     double t0 = bench_now();
-    bench_memory_fit_early(&ctx);
-    bench_section_law(&ctx);
-    bench_section_lattice(&ctx);
-    bench_section_integrators(&ctx);
-    bench_section_fit(&ctx);
-    bench_section_resolution(&ctx);
-    bench_section_memory(&ctx);
+    static const struct {
+        const char *what;
+        void (*run)(bench_ctx *);
+    } sections[] = {{"memory of a fit", bench_memory_fit_early},
+                    {"the force law", bench_section_law},
+                    {"the lattice step", bench_section_lattice},
+                    {"the integrators", bench_section_integrators},
+                    {"fitting", bench_section_fit},
+                    {"lattice resolution", bench_section_resolution},
+                    {"memory", bench_section_memory}};
+    const int nsec = (int)(sizeof sections / sizeof sections[0]);
+    for (int k = 0; k < nsec; k++) {
+        if (progress)
+            fprintf(stderr, "conifit-bench: [%d/%d] %s (%.0f s so far)\n", k + 1, nsec,
+                    sections[k].what, bench_now() - t0);
+        sections[k].run(&ctx);
+    }
     write_targets(&ctx);
     fprintf(ctx.md, "\n---\nWhole benchmark run: %.0f s.\n", bench_now() - t0);
     if (fclose(ctx.md) != 0 || rename(tmp, path) != 0) {

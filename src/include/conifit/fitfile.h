@@ -44,7 +44,8 @@ typedef struct cf_fitted_spring {
     char version[32];            /* conifit version that wrote the file; "" if absent */
 } cf_fitted_spring;
 
-/* Loads the spring of the given type from the fit file at path; type_name NULL (or "") takes the
+/* Loads the spring of the given type from the fit file at path ("-":
+** standard input); type_name NULL (or "") takes the
 ** file's "better_type", or the only fit when there is one; when the types tie ("better_type" null,
 ** "comparison.tie" true), the first feasible fit. Errors: CF_E_NOINPUT when the file
 ** cannot be opened, CF_E_DATA when it is not JSON, lacks the type or a parameter, or holds a

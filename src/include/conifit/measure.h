@@ -85,7 +85,10 @@ typedef struct cf_table {
     char y_unit[16];       /* the file's own unit of y ("kPa", "mN", ...), used in reports */
 } cf_table;
 
-/* Reads the table at path. Errors (nothing allocated is left behind):
+/* Reads the table at path ("-": standard input, named "(standard input)" in messages). Columns
+** are separated by ',' ';' TAB or, when the header has none of them, by blanks. A message that
+** points at a setting of opt names it "option FIELD" (option stress_unit, option x_col), which a
+** front end maps to its own spelling. Errors (nothing allocated is left behind):
 **   CF_E_NOINPUT  the file cannot be opened;
 **   CF_E_DATA     missing header, unknown unit, a column not found, a non-numeric or non-finite
 **                 cell, a short row, fewer than 6 data rows, an empty file, binary content, a
