@@ -8,6 +8,7 @@
 
 #include "conifit/lattice.h"
 #include "conifit/msm.h"
+#include "model/lattice_step.h"
 
 /* A soft, strongly stiffening non-telescoping spring (solid strain 0.5, H = 10 mm). */
 static cf_law make_law(void)
@@ -452,6 +453,103 @@ static void tangent_inertia_marks_the_loss_of_stability(void **state)
     cf_lattice_free(&lat);
 }
 
+/* The fused explicit step (lattice_step.h) against an independent sum with the exact law: node
+** forces of a jittered lattice whose springs span regions 1 and 2 in tension and compression, for
+** the closed form (vectorised lanes) and the table; the slab order used for threads gives the same
+** bits whether threads run or not; the node update moves free DOFs only and clears the forces. */
+static void fused_step_matches_independent_forces(void **state)
+{
+    (void)state;
+    cf_law law = make_law();
+    cf_error err = {0};
+    assert_int_equal(cf_law_table_build(&law, 4096, &err), CF_OK);
+    cf_lattice_config c = cf_lattice_default();
+    c.nx = 4;
+    c.ny = 3;
+    c.nz = 5;
+    const cf_law_method methods[3] = {CF_LAW_CLOSED, CF_LAW_TABLE, CF_LAW_EXACT};
+    for (int mi = 0; mi < 3; mi++) {
+        cf_lattice lat;
+        assert_int_equal(cf_lattice_create(&lat, &law, methods[mi], &c, &err), CF_OK);
+        srand(11);
+        for (size_t p = 0; p < lat.nn; p++) { /* compress to 0.3, jitter by up to 1.5 mm */
+            lat.x[p] += 1.5 * (rand() / (double)RAND_MAX - 0.5);
+            lat.y[p] += 1.5 * (rand() / (double)RAND_MAX - 0.5);
+            lat.z[p] = 0.7 * lat.Z[p] + 1.5 * (rand() / (double)RAND_MAX - 0.5);
+        }
+        double *g = calloc(3 * lat.nn, sizeof(double));
+        assert_non_null(g);
+        double scale = 0, umax = 0;
+        for (size_t q = 0; q < lat.ns; q++) {
+            uint32_t i = lat.si[q], j = lat.sj[q];
+            double d[3] = {lat.x[j] - lat.x[i], lat.y[j] - lat.y[i], lat.z[j] - lat.z[i]};
+            double L = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            double u = (lat.L0_mm[q] - L) * lat.a[q];
+            umax = fmax(umax, fabs(u));
+            double T = -lat.w[q] * cf_law_force(&law, CF_LAW_EXACT, u, NULL, NULL);
+            scale = fmax(scale, fabs(T));
+            for (int a = 0; a < 3; a++) {
+                g[3 * i + a] += T * d[a] / L;
+                g[3 * j + a] -= T * d[a] / L;
+            }
+        }
+        assert_true(umax > law.u_T_mm && umax < law.travel_mm); /* regions 1 and 2 both seen */
+        cf_lattice_stepper st;
+        assert_int_equal(cf_lattice_stepper_init(&st, &lat, NULL, &err), CF_OK);
+        memset(lat.fx, 0, lat.nn * sizeof(double));
+        memset(lat.fy, 0, lat.nn * sizeof(double));
+        memset(lat.fz, 0, lat.nn * sizeof(double));
+        assert_close(cf_lattice_stepper_forces(&st), umax / law.travel_mm, 1e-15);
+        /* the table's own error (4096 intervals, rho = 0.4) is far below 1e-10 of the force */
+        double tol = (methods[mi] == CF_LAW_TABLE ? 1e-10 : 1e-13) * scale;
+        double *f1 = malloc(3 * lat.nn * sizeof(double));
+        assert_non_null(f1);
+        for (size_t p = 0; p < lat.nn; p++) {
+            assert_close(lat.fx[p], g[3 * p], tol);
+            assert_close(lat.fy[p], g[3 * p + 1], tol);
+            assert_close(lat.fz[p], g[3 * p + 2], tol);
+            f1[3 * p] = lat.fx[p], f1[3 * p + 1] = lat.fy[p], f1[3 * p + 2] = lat.fz[p];
+        }
+        /* the threaded slab order: identical bits */
+        st.threads = 1;
+        memset(lat.fx, 0, lat.nn * sizeof(double));
+        memset(lat.fy, 0, lat.nn * sizeof(double));
+        memset(lat.fz, 0, lat.nn * sizeof(double));
+        cf_lattice_stepper_forces(&st);
+        for (size_t p = 0; p < lat.nn; p++)
+            assert_true(lat.fx[p] == f1[3 * p] && lat.fy[p] == f1[3 * p + 1] &&
+                        lat.fz[p] == f1[3 * p + 2]);
+        /* node update: v += h f/m, x += h v for free DOFs; prescribed ones keep v = 0 */
+        double *v[3];
+        for (int a = 0; a < 3; a++)
+            v[a] = calloc(lat.nn, sizeof(double));
+        double *x0 = malloc(3 * lat.nn * sizeof(double));
+        assert_non_null(x0);
+        for (size_t p = 0; p < lat.nn; p++)
+            x0[3 * p] = lat.x[p], x0[3 * p + 1] = lat.y[p], x0[3 * p + 2] = lat.z[p];
+        const double h = 1e-4;
+        cf_lattice_stepper_advance(&st, h, v[0], v[1], v[2]);
+        for (size_t p = 0; p < lat.nn; p++) {
+            double *xs[3] = {lat.x, lat.y, lat.z}, *fs[3] = {lat.fx, lat.fy, lat.fz};
+            for (int a = 0; a < 3; a++) {
+                int fixed = (lat.fix[p] >> a) & 1;
+                double vv = fixed ? 0.0 : h * f1[3 * p + a] / lat.mass_t[p];
+                assert_close(v[a][p], vv, 1e-14 * fabs(vv));
+                assert_close(xs[a][p], x0[3 * p + a] + h * vv, 1e-12);
+                assert_close(fs[a][p], 0.0, 0);
+            }
+        }
+        for (int a = 0; a < 3; a++)
+            free(v[a]);
+        free(x0);
+        free(f1);
+        free(g);
+        cf_lattice_stepper_free(&st);
+        cf_lattice_free(&lat);
+    }
+    cf_law_free(&law);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -460,6 +558,7 @@ int main(void)
         cmocka_unit_test(default_lattice_modulus_is_k0_over_H_and_nu_one_quarter),
         cmocka_unit_test(dashpots_scale_with_the_family_weights),
         cmocka_unit_test(every_spring_applies_equal_and_opposite_forces),
+        cmocka_unit_test(fused_step_matches_independent_forces),
         cmocka_unit_test(lattice_masses_and_top_shares_add_up),
         cmocka_unit_test(static_solve_and_long_damped_dynamic_run_agree),
         cmocka_unit_test(undamped_symplectic_run_keeps_energy_bounded),

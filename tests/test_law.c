@@ -178,6 +178,31 @@ static void check_method(const cf_law *law, cf_law_method m, double tol, int rel
     }
 }
 
+/* The same points through cf_law_force_many without stiffness: for the closed form and the table
+** that is the vectorised, branch-free path (law_simd.h), whose points of different regions share
+** one vector; it must keep the scalar evaluator's bound, and map NaN to 0 and +-Inf to +-F_C. */
+static void check_batch(const cf_law *law, cf_law_method m, double tol, int rel_to_FC)
+{
+    double u[1030], F[1030];
+    size_t np = probe_points(law, u, 1024);
+    u[np++] = NAN;
+    u[np++] = INFINITY;
+    u[np++] = -INFINITY;
+    cf_law_force_many(law, m, np, u, F, NULL);
+    assert_close(F[np - 3], 0.0, 0);
+    assert_close(F[np - 2], law->F_C_N, 0);
+    assert_close(F[np - 1], -law->F_C_N, 0);
+    for (size_t i = 0; i + 3 < np; i++) {
+        long double R = reference_force(&law->p, u[i]);
+        double scale = rel_to_FC ? law->F_C_N : fabs((double)R);
+        double errv = fabs(F[i] - (double)R);
+        if (!isfinite(F[i]) || (errv > tol * scale && errv > 0))
+            fail_msg("%s batch: rho=%.17g n=%g G=%g H=%g u=%.17g F=%.17g ref=%.17Lg rel=%.3g",
+                     cf_law_method_name(m), law->rho, law->p.n, law->p.G_MPa, law->p.H_mm, u[i],
+                     F[i], R, errv / scale);
+    }
+}
+
 static void closed_and_exact_match_reference_in_every_corner(void **state)
 {
     (void)state;
@@ -188,6 +213,7 @@ static void closed_and_exact_match_reference_in_every_corner(void **state)
                 init_ok(&law, scaled(rhos[a], coils[c], scales[b], scales[(b + 1) % 3]));
                 check_method(&law, CF_LAW_EXACT, EXACT_TOL, 0);
                 check_method(&law, CF_LAW_CLOSED, CLOSED_TOL, 0);
+                check_batch(&law, CF_LAW_CLOSED, CLOSED_TOL, 0);
                 check_method(&law, CF_LAW_CLOSED_NEWTON, CLOSED_TOL, 0);
             }
 }
@@ -201,8 +227,11 @@ static void table_error_is_within_its_stated_bound(void **state)
         init_ok(&law, scaled(rhos[a], 5, 1, 1));
         assert_int_equal(cf_law_table_build(&law, CF_LAW_TABLE_DEFAULT, &err), CF_OK);
         check_method(&law, CF_LAW_TABLE, TABLE_TOL_FC, 1);
-        if (rhos[a] >= 0.1)
+        check_batch(&law, CF_LAW_TABLE, TABLE_TOL_FC, 1);
+        if (rhos[a] >= 0.1) {
             check_method(&law, CF_LAW_TABLE, TABLE_TOL_256, 0);
+            check_batch(&law, CF_LAW_TABLE, TABLE_TOL_256, 0);
+        }
         cf_law_free(&law);
     }
 }

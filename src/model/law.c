@@ -10,6 +10,7 @@
 ** The stiffness is dF/du = k_scale y^4/(1 - y^4) with 1 - y^4 = e (4 - 6e + 4e^2 - e^3).
 */
 #include "conifit/law.h"
+#include "model/law_simd.h"
 
 #include <float.h>
 #include <math.h>
@@ -30,6 +31,8 @@ struct cf_law_table {
     double h;          /* w_max / intervals */
     double *y;         /* y at the nodes, intervals + 1 values */
     double *dy;        /* dy/dw at the nodes, times h (scaled for the Hermite basis) */
+    double *coef;      /* per interval, the Hermite cubic as y0 + q (m0 + q (a + q b)): y0, m0,
+                          a, b (4 intervals values; law_simd.h evaluates it) */
 };
 
 /* ---- parameter checks and derived quantities ---------------------------------------------- */
@@ -110,6 +113,7 @@ void cf_law_free(cf_law *law)
         return;
     free(law->table->y);
     free(law->table->dy);
+    free(law->table->coef);
     free(law->table);
     law->table = NULL;
 }
@@ -298,11 +302,13 @@ cf_status cf_law_table_build(cf_law *law, size_t intervals, cf_error *err)
     if (t) {
         t->y = malloc((intervals + 1) * sizeof *t->y);
         t->dy = malloc((intervals + 1) * sizeof *t->dy);
+        t->coef = malloc(4 * intervals * sizeof *t->coef);
     }
-    if (!t || !t->y || !t->dy) {
+    if (!t || !t->y || !t->dy || !t->coef) {
         if (t) {
             free(t->y);
             free(t->dy);
+            free(t->coef);
         }
         free(t);
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for a law table of %zu intervals",
@@ -329,6 +335,14 @@ cf_status cf_law_table_build(cf_law *law, size_t intervals, cf_error *err)
         t->dy[i] = dydw * t->h;
     }
     t->y[intervals] = law->rho; /* the transition, exactly */
+    for (size_t i = 0; i < intervals; i++) {
+        const double y0 = t->y[i], y1 = t->y[i + 1], m0 = t->dy[i], m1 = t->dy[i + 1];
+        double *k = t->coef + 4 * i;
+        k[0] = y0;
+        k[1] = m0;
+        k[2] = 3.0 * (y1 - y0) - 2.0 * m0 - m1;
+        k[3] = 2.0 * (y0 - y1) + m0 + m1;
+    }
     cf_law_free(law);
     law->table = t;
     return CF_OK;
@@ -342,10 +356,9 @@ static inline double table_y(const struct cf_law_table *t, double w, double *dyd
     if (i >= t->intervals)
         i = t->intervals - 1;
     const double q = x - (double)i;
-    const double y0 = t->y[i], y1 = t->y[i + 1], m0 = t->dy[i], m1 = t->dy[i + 1];
     /* cubic Hermite in q: p(q) = y0 + q (m0 + q (a + q b)) */
-    const double a = 3.0 * (y1 - y0) - 2.0 * m0 - m1;
-    const double b = 2.0 * (y0 - y1) + m0 + m1;
+    const double *k = t->coef + 4 * i;
+    const double y0 = k[0], m0 = k[1], a = k[2], b = k[3];
     *dydw = (m0 + q * (2.0 * a + 3.0 * q * b)) * t->inv_h;
     return y0 + q * (m0 + q * (a + q * b));
 }
@@ -445,9 +458,30 @@ static inline void law_many(const cf_law *law, cf_law_method method, size_t coun
             F[i] = law_eval(law, method, u[i], NULL, &fl);
 }
 
+void cf_law_lanes_init(const cf_law *law, cf_law_lanes *lanes)
+{
+    lanes->u_T = law->u_T_mm;
+    lanes->s = law->travel_mm;
+    lanes->inv_s = law->inv_travel;
+    lanes->k0 = law->k0_N_per_mm;
+    lanes->F_C = law->F_C_N;
+    lanes->rim1 = law->rho_inv_m1;
+    lanes->coef = law->table ? law->table->coef : NULL;
+    lanes->inv_h = law->table ? law->table->inv_h : 0.0;
+    lanes->xmax = law->table ? (double)(law->table->intervals - 1) : 0.0;
+}
+
 void cf_law_force_many(const cf_law *law, cf_law_method method, size_t count, const double *u_mm,
                        double *F_N, double *k_N_per_mm)
 {
+    if (!k_N_per_mm && (method == CF_LAW_CLOSED || (method == CF_LAW_TABLE && law->table))) {
+        /* forces alone: the vectorised lanes (law_simd.h) */
+        cf_law_lanes lanes;
+        cf_law_lanes_init(law, &lanes);
+        cf_law_force_lanes(&lanes, method == CF_LAW_TABLE ? CF_LANE_TABLE : CF_LANE_CLOSED,
+                           count, u_mm, F_N);
+        return;
+    }
     switch (method) { /* one branch per method so each loop body is specialised */
     case CF_LAW_EXACT:
         law_many(law, CF_LAW_EXACT, count, u_mm, F_N, k_N_per_mm);

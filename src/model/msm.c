@@ -4,6 +4,7 @@
 ** validation curve.
 */
 #include "conifit/msm.h"
+#include "model/lattice_step.h"
 #include "model/sparse_chol.h"
 
 #include <math.h>
@@ -800,6 +801,8 @@ double cf_msm_stable_step(cf_lattice *lat, const cf_msm_effects *fx)
 
 typedef struct dyn {
     double *vx, *vy, *vz, *Ld, *Tt;
+    int fused;                /* elastic springs only: the fused step of lattice_step.h */
+    cf_lattice_stepper step;  /* its state (when fused) */
 } dyn;
 
 /* One symplectic Euler step of length h ending at drive value v1 (rate for prescribed DOFs). */
@@ -808,6 +811,13 @@ static void dyn_step(solver *s, dyn *d, double h, double v1, double rate)
     cf_lattice *lat = s->lat;
     const cf_msm_effects *fx = s->fx;
     const size_t ns = lat->ns, nn = lat->nn;
+    if (d->fused) {
+        /* node forces are zero here (cleared by the last advance or before the interval) */
+        cf_lattice_stepper_forces(&d->step);
+        add_external(s);
+        cf_lattice_stepper_advance(&d->step, h, d->vx, d->vy, d->vz);
+        goto drive;
+    }
     lat->with_stiffness = 0; /* an explicit step needs forces only */
     cf_lattice_forces(lat);
     lat->with_stiffness = 1;
@@ -846,6 +856,7 @@ static void dyn_step(solver *s, dyn *d, double h, double v1, double rate)
             x[p] += h * va[p];
         }
     }
+drive:
     if (s->drive == CF_DRIVE_DISPLACEMENT) {
         place_top(lat, v1);
         for (size_t t = 0; t < lat->ntop; t++)
@@ -932,6 +943,11 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
             rc = cf_error_set(err, CF_E_INTERNAL, "out of memory for the dynamic state");
             goto end;
         }
+        d.fused = !(fx->eta_MPa_s > 0) && !s.sigm;
+        if (d.fused && (rc = cf_lattice_stepper_init(&d.step, lat, s.eq, err)) != CF_OK) {
+            d.fused = 0;
+            goto end;
+        }
     }
     s.load = 0;
     double t = nsamples ? fmin(sample_t_s[0], path->t_s[0]) : 0;
@@ -983,6 +999,11 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
                 double vb = path_value(path, tb);
                 double rate = (vb - path_value(path, tb - h)) / h;
                 s.load = vb;
+                if (m == 1 && d.fused) { /* the fused step adds onto zeroed node forces */
+                    memset(lat->fx, 0, lat->nn * sizeof(double));
+                    memset(lat->fy, 0, lat->nn * sizeof(double));
+                    memset(lat->fz, 0, lat->nn * sizeof(double));
+                }
                 dyn_step(&s, &d, h, vb, rate);
             }
             double um = cf_lattice_forces(lat);
@@ -1054,6 +1075,8 @@ end:
     free(d.vz);
     free(d.Ld);
     free(d.Tt);
+    if (d.fused)
+        cf_lattice_stepper_free(&d.step);
     solver_free(&s);
     return rc;
 }

@@ -1,0 +1,126 @@
+/*
+** The law as branch-free lane functions, for loops the compiler vectorises (`#pragma omp simd`):
+** every region is computed and the result selected, so a vector of displacements in different
+** regions takes one path. Forces only (an explicit step needs no stiffness); the scalar evaluators
+** of law.c keep the stiffness and the other methods.
+**
+** Closed form (region 2), with delta = (1/rho - 1)(s - |u|)/s and c = 1 + delta:
+**   t = cbrt(c^2 + sqrt(c^4 - 1)) from a division-free inverse cube root r = 1/t (an exponent-
+**   thirding start good to 3.4 %, two fourth-order steps, one Newton step on t), mu = (t - 1)^2 r,
+**   m = 2 + mu, Q = 2 sqrt2 c sqrt(m) + m^2, P = 12 (c^2 - 1 - mu/2) Q, and
+**   y = 6 sqrt(m) Q / ((m sqrt(m) + sqrt2 c)(sqrt2 sqrt(m) Q + sqrt(P))),   F = F_C y^3:
+** Ferrari's root of y^4 - 4 c y + 3 = 0 (law.c, region2_closed) with its divisions gathered into
+** one. All terms are positive, so y carries a relative error of a few ulps; t - 1 is formed by a
+** plain subtraction, which near solid loses relative digits of mu but only absolute ones of y
+** (measured against the long-double reference of tests/test_law.c: 2.4e-15 of |F| at worst over
+** every hard case). Costs three square roots and one division per lane.
+** Table: the cubic Hermite table of law.c, stored per interval as the coefficients of its
+** polynomial in the local coordinate (one cache line per lookup); the same values as law.c's.
+**
+** Private to the model layer.
+*/
+#ifndef CF_MODEL_LAW_SIMD_H
+#define CF_MODEL_LAW_SIMD_H
+
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "conifit/law.h"
+
+#if defined(__GNUC__)
+#define CF_LANE static inline __attribute__((always_inline))
+#else
+#define CF_LANE static inline
+#endif
+
+/* Runtime dispatch: each function so marked is compiled for baseline x86-64, x86-64-v3 (AVX2,
+** FMA) and x86-64-v4 (AVX-512), and the loader picks the widest the processor has. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__has_attribute)
+#if __has_attribute(target_clones) && !defined(__SANITIZE_ADDRESS__)
+#define CF_DISPATCH __attribute__((target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")))
+#endif
+#endif
+#ifndef CF_DISPATCH
+#define CF_DISPATCH
+#endif
+
+/* Everything a lane needs, copied by value into the loop (loads the compiler can hoist). */
+typedef struct cf_law_lanes {
+    double u_T, s, inv_s, k0, F_C, rim1; /* law.h: u_T_mm, travel_mm, inv_travel, k0, F_C, 1/rho-1 */
+    const double *coef; /* table: 4 coefficients per interval (NULL: no table) */
+    double inv_h;       /* table: intervals per unit of w */
+    double xmax;        /* table: intervals - 1, the last interval's index */
+} cf_law_lanes;
+
+/* Fills lanes from law; the table coefficients are those of law's table when it has one. */
+void cf_law_lanes_init(const cf_law *law, cf_law_lanes *lanes);
+
+/* The same force of one lane for either form: the caller has chosen it at compile time. */
+enum { CF_LANE_CLOSED = 0, CF_LANE_TABLE = 1 };
+
+/* Regions 1 and 3 around a region-2 value F2 computed for a = |u|; NaN gives 0. */
+CF_LANE double cf_lane_regions(const cf_law_lanes *c, double u, double a, double F2)
+{
+    const double F1 = c->k0 * a, F3 = c->F_C;
+    double F = a < c->s ? F2 : F3;
+    F = a <= c->u_T ? F1 : F;
+    F = copysign(F, u);
+    return u != u ? 0.0 : F;
+}
+
+CF_LANE double cf_lane_closed(const cf_law_lanes *c, double u)
+{
+    const double a = fabs(u);
+    const double sa = c->s - a;
+    const double delta = c->rim1 * ((sa > 0.0 ? sa : 0.0) * c->inv_s);
+    const double cc = 1.0 + delta;
+    const double dd = delta * (2.0 + delta); /* c^2 - 1 without cancellation */
+    const double X = cc * cc + sqrt(dd * (1.0 + cc * cc));
+    /* r = X^(-1/3): start from the exponent, then two steps of
+    ** r <- r (1 + e/3 + 2e^2/9 + 14e^3/81), e = 1 - X r^3 (fourth order, no division) */
+    uint64_t bits;
+    memcpy(&bits, &X, sizeof bits);
+    const int32_t hi = (int32_t)(bits >> 32);
+    const int32_t hr = (int32_t)0x553EF100 - (int32_t)((double)hi * (1.0 / 3.0));
+    bits = (uint64_t)(uint32_t)hr << 32;
+    double r;
+    memcpy(&r, &bits, sizeof r);
+    double e = 1.0 - X * (r * r * r);
+    r = r + r * e * ((1.0 / 3.0) + e * ((2.0 / 9.0) + e * (14.0 / 81.0)));
+    e = 1.0 - X * (r * r * r);
+    r = r + r * e * ((1.0 / 3.0) + e * ((2.0 / 9.0) + e * (14.0 / 81.0)));
+    double t = X * r * r;
+    t = t - (t * t * t - X) * (r * r) * (1.0 / 3.0); /* Newton on t^3 = X, 1/(3t^2) ~ r^2/3 */
+    const double tm1 = t - 1.0;
+    const double mu = tm1 * tm1 * r;
+    const double m = 2.0 + mu, rm = sqrt(m);
+    const double Q = 2.0 * M_SQRT2 * cc * rm + m * m;
+    const double P0 = 12.0 * (dd - 0.5 * mu) * Q;
+    const double P = P0 > 0.0 ? P0 : 0.0;
+    const double y = 6.0 * rm * Q / ((m * rm + M_SQRT2 * cc) * (M_SQRT2 * rm * Q + sqrt(P)));
+    return cf_lane_regions(c, u, a, c->F_C * y * y * y);
+}
+
+CF_LANE double cf_lane_table(const cf_law_lanes *c, double u)
+{
+    const double a = fabs(u);
+    const double sa = c->s - a;
+    const double w = sqrt((sa > 0.0 ? sa : 0.0) * c->inv_s);
+    double x = w * c->inv_h;
+    double xi = x < c->xmax ? x : c->xmax; /* NaN and region 1 land on the last interval */
+    xi = xi > 0.0 ? xi : 0.0;
+    const size_t i = (size_t)(int32_t)xi;
+    const double q = x - (double)i;
+    const double *k = c->coef + 4 * i;
+    const double y = k[0] + q * (k[1] + q * (k[2] + q * k[3]));
+    return cf_lane_regions(c, u, a, c->F_C * y * y * y);
+}
+
+/* Forces of count displacements with the closed form or the table (lanes->coef not NULL):
+** F[i] for u[i]. Vectorised, dispatched at run time. */
+void cf_law_force_lanes(const cf_law_lanes *lanes, int form, size_t count, const double *u,
+                        double *F);
+
+#endif
