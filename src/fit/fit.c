@@ -900,6 +900,21 @@ static region region_at(const fit_ctx *c, double rho, double B)
     return r;
 }
 
+double cf_fit_ident_limit(const cf_fit_options *opt, cf_spring_type type, double rho, double B,
+                          double *A_max)
+{
+    fit_ctx c;
+    memset(&c, 0, sizeof c);
+    c.opt = opt;
+    c.type = type;
+    c.region = 1;
+    for (int k = 0; k < CF_P_COUNT; k++)
+        c.region &= !opt->fixed[k];
+    region r = region_at(&c, rho, B);
+    *A_max = r.A_max;
+    return r.margin;
+}
+
 /* Weighted residual sum of squares of the reduced model at (rho, B) with the load scale A fixed
 ** (A_fixed > 0) or solved in closed form and clamped to (0, A_max]; *A_out the scale used.
 ** The sum is formed from the residuals themselves, not from the expanded square, so that it

@@ -20,7 +20,7 @@
 
 cf_measure_options cf_measure_default_options(void)
 {
-    cf_measure_options o = {NULL, NULL, NULL, NULL, NULL, -1};
+    cf_measure_options o = {NULL, NULL, NULL, NULL, NULL, -1, NULL};
     return o;
 }
 
@@ -625,6 +625,38 @@ static const unit_def *comment_unit(const line_span *comments, size_t ncomments,
             return d;
     }
     return NULL;
+}
+
+/* ---- the test mode stated in a '# mode: NAME' comment --------------------------------------- */
+
+/* Finds the comment "mode: NAME" (spaces allowed around the words; text after NAME ignored) and
+** parses NAME. Returns CF_OK with *found = 0 when no comment states a mode. */
+static cf_status comment_mode(const line_span *comments, size_t ncomments, const char *path,
+                              cf_mode *mode, int *found, cf_error *err)
+{
+    *found = 0;
+    for (size_t i = 0; i < ncomments; i++) {
+        const char *s = comments[i].s, *end = s + comments[i].n;
+        while (s < end && isspace((unsigned char)*s))
+            s++;
+        if ((size_t)(end - s) < 5 || strncmp(s, "mode:", 5) != 0)
+            continue;
+        s += 5;
+        while (s < end && isspace((unsigned char)*s))
+            s++;
+        const char *w = s;
+        while (s < end && !isspace((unsigned char)*s) && *s != ',' && *s != ';')
+            s++;
+        char name[32];
+        snprintf(name, sizeof name, "%.*s", (int)(s - w), w);
+        if (cf_mode_parse(name, mode, NULL) != CF_OK)
+            return data_error(err, path, comments[i].line, 1,
+                              "comment 'mode: %s': expected uniaxial, shear, planar, "
+                              "equibiaxial or confined ('%s')", name, name);
+        *found = 1;
+        return CF_OK;
+    }
+    return CF_OK;
 }
 
 /* ---- the reader --------------------------------------------------------------------------- */
@@ -1241,6 +1273,22 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
         st = data_error(err, path, last_line, 1,
                         "only %zu data rows; a fit needs at least %d ('%zu rows')", r.count,
                         CF_MEASURE_MIN_ROWS, r.count);
+        goto fail;
+    }
+
+    /* The test mode: the option wins over the file's comment. */
+    m->mode = CF_MODE_UNIAXIAL;
+    m->mode_stated = 0;
+    if (opt.mode) {
+        cf_error me = {0};
+        if (cf_mode_parse(opt.mode, &m->mode, &me) != CF_OK) {
+            st = cf_error_set(err, CF_E_DATA, "%s: --mode %s: expected uniaxial, shear, planar, "
+                              "equibiaxial or confined", path, opt.mode);
+            goto fail;
+        }
+        m->mode_stated = 1;
+    } else if ((st = comment_mode(r.comments, r.ncomments, path, &m->mode, &m->mode_stated,
+                                  err)) != CF_OK) {
         goto fail;
     }
 

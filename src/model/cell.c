@@ -35,24 +35,32 @@ cf_status cf_mode_parse(const char *name, cf_mode *m, cf_error *err)
                         name ? name : "(none)");
 }
 
-/* The 13 directions, each unordered pair of neighbours once, in the order of lattice.c. */
+/* The 13 directions, each unordered pair of neighbours once: offsets with dz > 0, or dz = 0 and
+** dy > 0, or dz = dy = 0 and dx > 0, in the order z, y, x from -1 to 1. */
+static const int dirs[CF_CELL_DIRS][3] = {
+    {1, 0, 0},
+    {-1, 1, 0},
+    {0, 1, 0},
+    {1, 1, 0},
+    {-1, -1, 1},
+    {0, -1, 1},
+    {1, -1, 1},
+    {-1, 0, 1},
+    {0, 0, 1},
+    {1, 0, 1},
+    {-1, 1, 1},
+    {0, 1, 1},
+    {1, 1, 1}};
+
 void cf_cell_direction(int d, int N[3], int *family)
 {
-    int k = 0;
-    for (int dz = -1; dz <= 1; dz++)
-        for (int dy = -1; dy <= 1; dy++)
-            for (int dx = -1; dx <= 1; dx++) {
-                int pos = dz > 0 || (dz == 0 && dy > 0) || (dz == 0 && dy == 0 && dx > 0);
-                if (!pos)
-                    continue;
-                if (k++ == d) {
-                    N[0] = dx, N[1] = dy, N[2] = dz;
-                    *family = (dx != 0) + (dy != 0) + (dz != 0) - 1;
-                    return;
-                }
-            }
-    N[0] = N[1] = N[2] = 0;
-    *family = CF_FAMILY_EDGE;
+    if (d < 0 || d >= CF_CELL_DIRS) {
+        N[0] = N[1] = N[2] = 0;
+        *family = CF_FAMILY_EDGE;
+        return;
+    }
+    N[0] = dirs[d][0], N[1] = dirs[d][1], N[2] = dirs[d][2];
+    *family = (N[0] != 0) + (N[1] != 0) + (N[2] != 0) - 1;
 }
 
 cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
@@ -140,7 +148,7 @@ static double tangent(const cf_cell *c, const cf_cell_state *s, const double kT[
         for (int k = 0; k < 3; k++) {
             if (!(kmask & (1u << k)))
                 continue;
-            g += (kT[d] - T / L) * xv[m] * X[m] * xv[k] * X[k] / (L * L * L * H3);
+            g += (kT[d] - T / L) * xv[m] * X[m] * xv[k] * X[k] / (L * L * H3);
             if (k == m)
                 g += T * X[m] * X[m] / (L * H3);
         }
@@ -221,7 +229,8 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
     int have_lo = 0, have_hi = 0;
     double a = fmin(fmax(guess(c, m, e), lo + 1e-3 * sH), hi - 1e-3 * sH);
     cf_error e1 = {0};
-    for (int it = 0; it < MAX_ITER; it++) {
+    int it;
+    for (it = 0; it < MAX_ITER; it++) {
         place(m, e, a, F);
         st = evaluate(c, F, extra, s, kT, &e1);
         if (st != CF_OK) {
@@ -236,8 +245,16 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
             continue;
         }
         double r = s->P_MPa[fm.zero][fm.zero];
-        if (r == 0)
-            break;
+        /* rounding level of that stress component: its largest term */
+        double rs = 0;
+        for (int d = 0; d < CF_CELL_DIRS; d++)
+            rs = fmax(rs, fabs(s->T_N[d]));
+        rs *= 8 * DBL_EPSILON / (law->p.H_mm * law->p.H_mm);
+        if (fabs(r) <= rs) {
+            s->free_stretch = a;
+            s->stress_MPa = s->P_MPa[fm.si][fm.sj];
+            return CF_OK;
+        }
         if (r < 0)
             lo = a, have_lo = 1;
         else
@@ -274,6 +291,22 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
     return cf_error_set(err, CF_E_NOCONV,
                         "%s strain %g: no free stretch gives zero lateral stress (last %.17g)",
                         cf_mode_name(m), e, a);
+}
+
+double cf_cell_spring_strain(cf_mode m, double e)
+{
+    double F[9], r = 0;
+    place(m, e, 1, F);
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        double X[3] = {dirs[d][0], dirs[d][1], dirs[d][2]}, L2 = 0, L02 = 0;
+        for (int i = 0; i < 3; i++) {
+            double xi = F[3 * i] * X[0] + F[3 * i + 1] * X[1] + F[3 * i + 2] * X[2];
+            L2 += xi * xi;
+            L02 += X[i] * X[i];
+        }
+        r = fmax(r, fabs(sqrt(L2 / L02) - 1));
+    }
+    return r;
 }
 
 cf_status cf_cell_curve(const cf_cell *c, cf_mode m, const double *strain, size_t count,

@@ -188,20 +188,25 @@ static json_t *validation_json(const cf_fit_report *r, int i)
                             weights_json(lc->weight), "modulus_ratio", num(cm.E), "poisson_ratio",
                             num(cm.nu), "bottom",
                             lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial");
-    return json_pack("{s:o, s:o, s:o, s:o, s:s, s:I, s:o}", "rmse", num(v->rmse * u), "r2",
-                     num(v->r2), "max_abs_error", num(v->max_abs_error * u), "lattice", lat,
-                     "law_method", cf_law_method_name(v->setup.method), "solves",
-                     (json_int_t)v->solves, "wall_time_s",
-                     num(r->with_timing ? v->wall_time_s : 0.0));
+    double fit_rmse = r->through_msm && r->thr[i].done ? r->thr[i].cell_rmse : r->fits[i].rmse;
+    return json_pack("{s:s, s:s, s:o, s:o, s:o, s:o, s:o, s:o, s:s, s:I, s:o}", "mode",
+                     cf_mode_name(v->mode), "model", v->by_cell ? "homogenised cell" :
+                     "full lattice", "fit_rmse", num(fit_rmse * u), "rmse", num(v->rmse * u),
+                     "law_difference_rmse", num(v->law_rmse * u), "r2", num(v->r2),
+                     "max_abs_error", num(v->max_abs_error * u), "lattice", lat, "law_method",
+                     cf_law_method_name(v->setup.method), "solves", (json_int_t)v->solves,
+                     "wall_time_s", num(r->with_timing ? v->wall_time_s : 0.0));
 }
 
 static json_t *through_json(const cf_fit_report *r, int i)
 {
     const cf_through_msm *t = &r->thr[i];
     double u = r->table->y_to_file;
-    return json_pack("{s:o, s:o, s:b, s:o, s:I}", "rmse_before", num(t->rmse_before * u),
-                     "rmse_after", num(t->rmse_after * u), "improved", t->improved,
-                     "wall_time_s", num(r->with_timing ? t->wall_time_s : 0.0), "evaluations",
+    return json_pack("{s:o, s:o, s:o, s:b, s:o, s:o, s:I}", "rmse_before",
+                     num(t->rmse_before * u), "cell_rmse", num(t->cell_rmse * u), "rmse_after",
+                     num(t->rmse_after * u), "improved", t->improved, "verification_max_abs",
+                     t->verified ? num(t->verify_max_abs * u) : json_null(), "wall_time_s",
+                     num(r->with_timing ? t->wall_time_s : 0.0), "evaluations",
                      (json_int_t)t->evaluations);
 }
 
@@ -467,25 +472,40 @@ static void validation_text(FILE *o, const cf_fit_report *r)
             lc->weight[CF_FAMILY_EDGE], lc->weight[CF_FAMILY_FACE], lc->weight[CF_FAMILY_BODY],
             cm.E, cm.nu, lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial",
             cf_law_method_name(su->method));
-    char buf[4][2][64];
+    const cf_validation *v0 = &r->val[0];
+    for (int i = 0; i < r->nfits; i++)
+        if (r->val[i].done)
+            v0 = &r->val[i];
+    fprintf(o, "  mode %s, %s; fit target: %s\n", cf_mode_name(v0->mode),
+            v0->by_cell ? "homogenised cell (the full lattice has no such boundary conditions)"
+                        : "full lattice",
+            r->through_msm ? "the lattice (through the homogenised cell)" : "the single spring");
+    enum { ROWS = 6 };
+    char buf[ROWS][2][64];
     const char *t[2];
     const double u = r->table->y_to_file;
+    const char *yu = r->table->y_unit;
     for (int i = 0; i < r->nfits; i++) {
         const cf_validation *v = &r->val[i];
         if (!v->done) {
-            for (int k = 0; k < 4; k++)
+            for (int k = 0; k < ROWS; k++)
                 snprintf(buf[k][i], sizeof buf[k][i], k ? "" : "skipped (see below)");
             continue;
         }
-        snprintf(buf[0][i], sizeof buf[0][i], "%.4g %s", v->rmse * u, r->table->y_unit);
-        snprintf(buf[1][i], sizeof buf[1][i], "%.4g %s", v->max_abs_error * u, r->table->y_unit);
-        snprintf(buf[2][i], sizeof buf[2][i], "%.6f", v->r2);
-        snprintf(buf[3][i], sizeof buf[3][i], "%.1f ms, %zu solves", 1e3 * v->wall_time_s,
+        const cf_through_msm *th = &r->thr[i];
+        double fr = r->through_msm && th->done ? th->cell_rmse : r->fits[i].rmse;
+        snprintf(buf[0][i], sizeof buf[0][i], "%.4g %s", fr * u, yu);
+        snprintf(buf[1][i], sizeof buf[1][i], "%.4g %s", v->rmse * u, yu);
+        snprintf(buf[2][i], sizeof buf[2][i], "%.4g %s", v->law_rmse * u, yu);
+        snprintf(buf[3][i], sizeof buf[3][i], "%.4g %s", v->max_abs_error * u, yu);
+        snprintf(buf[4][i], sizeof buf[4][i], "%.6f", v->r2);
+        snprintf(buf[5][i], sizeof buf[5][i], "%.1f ms, %zu solves", 1e3 * v->wall_time_s,
                  v->solves);
     }
-    static const char *const labels[4] = {"lattice RMSE", "lattice max |error|", "lattice R^2",
-                                          "lattice time"};
-    for (int k = 0; k < 4; k++) {
+    static const char *const labels[ROWS] = {"fit RMSE (its target)", "lattice RMSE",
+                                             "lattice vs law (RMSE)", "lattice max |error|",
+                                             "lattice R^2", "lattice time"};
+    for (int k = 0; k < ROWS; k++) {
         for (int i = 0; i < r->nfits; i++)
             t[i] = buf[k][i];
         cells(o, r, labels[k], t);
@@ -495,17 +515,24 @@ static void validation_text(FILE *o, const cf_fit_report *r)
             const cf_through_msm *th = &r->thr[i];
             if (th->done)
                 snprintf(buf[0][i], sizeof buf[0][i], "%.4g -> %.4g %s", th->rmse_before * u,
-                         th->rmse_after * u, r->table->y_unit);
+                         th->cell_rmse * u, yu);
             else
                 snprintf(buf[0][i], sizeof buf[0][i], "not run");
-            snprintf(buf[1][i], sizeof buf[1][i], "%.2f s, %ld curves", th->wall_time_s,
+            if (th->done && th->verified)
+                snprintf(buf[1][i], sizeof buf[1][i], "max |full - cell| %.3g %s",
+                         th->verify_max_abs * u, yu);
+            else
+                snprintf(buf[1][i], sizeof buf[1][i], "%s", th->done ? "cell only" : "");
+            snprintf(buf[2][i], sizeof buf[2][i], "%.3f s, %ld cell curves", th->wall_time_s,
                      th->evaluations);
-            t[i] = buf[0][i];
         }
-        cells(o, r, "through lattice: RMSE", t);
-        for (int i = 0; i < r->nfits; i++)
-            t[i] = buf[1][i];
-        cells(o, r, "through lattice: cost", t);
+        static const char *const tl[3] = {"through lattice: RMSE", "verified in full lattice",
+                                          "through lattice: cost"};
+        for (int k = 0; k < 3; k++) {
+            for (int i = 0; i < r->nfits; i++)
+                t[i] = buf[k][i];
+            cells(o, r, tl[k], t);
+        }
     }
     for (int i = 0; i < r->nfits; i++)
         if (!r->val[i].done)

@@ -45,19 +45,28 @@ static void progress(const cf_pipeline_options *opt, const cf_table *t, const ch
     opt->progress(opt->progress_ctx, t->path, what);
 }
 
-/* Each fit in the lattice, and through it when asked. A fit the lattice cannot run keeps its
-** validation's note (report.c prints it) and is not an error. */
+/* The target of table t: the option, or AUTO's choice by the table's mode. */
+static int through_lattice(const cf_table *t, const cf_pipeline_options *opt)
+{
+    if (opt->target == CF_TARGET_AUTO)
+        return !cf_table_is_force(t) && t->mode != CF_MODE_UNIAXIAL;
+    return opt->target == CF_TARGET_LATTICE;
+}
+
+/* Each fit in the lattice, or through it. A fit the lattice cannot run keeps its validation's
+** note (report.c prints it) and is not an error. */
 static void validate_fits(const cf_table *t, const cf_pipeline_options *opt, cf_fit_report *r)
 {
     r->validate = 1;
-    r->through_msm = opt->through_msm;
+    r->through_msm = through_lattice(t, opt);
     for (int k = 0; k < r->nfits; k++) {
         cf_error verr = {0};
         const char *type = cf_spring_type_name(r->fits[k].type);
-        progress(opt, t, "validating the %s spring in the lattice", type);
-        if (cf_validate_run(&r->fits[k].params, &opt->lattice, t, &r->val[k], &verr) != CF_OK ||
-            !opt->through_msm)
+        if (!r->through_msm) {
+            progress(opt, t, "validating the %s spring in the lattice", type);
+            cf_validate_run(&r->fits[k].params, &opt->lattice, t, &r->val[k], &verr);
             continue;
+        }
         progress(opt, t, "fitting the %s spring through the lattice", type);
         cf_validate_through_msm(t, &opt->fit, &opt->lattice, &r->fits[k], &r->val[k], &r->thr[k],
                                 &verr);
@@ -87,7 +96,7 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
     if (r->nfits == 0)
         return cf_error_set(err, CF_E_DATA, "%s: no spring type chosen to fit", t->path);
     cf_baseline_fit_all(t, r->baselines);
-    if (opt->validate || opt->through_msm)
+    if (opt->validate || through_lattice(t, opt))
         validate_fits(t, opt, r);
     return CF_OK;
 }

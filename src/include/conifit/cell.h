@@ -99,6 +99,12 @@ cf_status cf_cell_stress(const cf_cell *c, const double F[9], const cf_cell_extr
 cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extra *extra,
                        cf_cell_state *s, cf_error *err);
 
+/* The largest |L/L0 - 1| over the cell's springs at table strain e of mode m with the free
+** stretches held at 1: how far the springs travel (in strain) when the table reaches e. For
+** uniaxial, planar, equibiaxial and confined it is |e| (the loaded edge); for simple shear about
+** |e|/2 (a face diagonal). Lets a fit bound the springs' solid strain by what they reach. */
+double cf_cell_spring_strain(cf_mode m, double e);
+
 /* The mode's stress (MPa, table sign) at each of count strains. Stops at the first failure. */
 cf_status cf_cell_curve(const cf_cell *c, cf_mode m, const double *strain, size_t count,
                         double *stress_MPa, cf_error *err);

@@ -174,6 +174,14 @@ double cf_fit_model(const cf_law *law, int force_displacement, double x);
 int cf_fit_check(const cf_spring *p, cf_spring_type type, const cf_table *data,
                  const cf_fit_options *opt, unsigned *active, unsigned *violated);
 
+/* The type's design limits in the space of the identifiable quantities of a stress-strain table,
+** at rho and B = s/H: returns a margin (log units, <= 0 where a spring of the type can be placed
+** within the limits of opt) and in *A_max the largest stress scale F_C/H^2 (MPa) it can carry
+** there. With a fixed parameter no closed form exists: margin -1, *A_max = INFINITY. Used by the
+** fit through the lattice, which searches the same space. */
+double cf_fit_ident_limit(const cf_fit_options *opt, cf_spring_type type, double rho, double B,
+                          double *A_max);
+
 /* The three identifiable quantities of spring p (see cf_fit_result.ident). */
 void cf_fit_identifiable(const cf_spring *p, int force_displacement, double ident[3]);
 

@@ -17,6 +17,7 @@
 
 #include <stddef.h>
 
+#include "conifit/cell.h"
 #include "conifit/error.h"
 
 typedef enum cf_table_kind {
@@ -34,6 +35,8 @@ typedef struct cf_measure_options {
     const char *force_unit;  /* "N", "mN", "kN", "uN"; NULL: from header */
     const char *length_unit; /* "m", "mm", "um", "cm"; NULL: from header */
     int x_is_stretch;        /* -1: decide from the column name, 0: strain, 1: stretch */
+    const char *mode;        /* test mode ("uniaxial", "shear", ...), or NULL: from a '# mode:'
+                             ** comment of the file, else uniaxial */
 } cf_measure_options;
 
 /* Options with everything decided from the file. */
@@ -83,6 +86,9 @@ typedef struct cf_table {
     char y_column[64];     /* header name of the y column */
     char x_unit[16];       /* "-" for strain, "mm" for displacement after conversion */
     char y_unit[16];       /* the file's own unit of y ("kPa", "mN", ...), used in reports */
+    cf_mode mode;          /* test mode (cell.h): the option, else a '# mode: NAME' comment, else
+                           ** uniaxial */
+    int mode_stated;       /* 1 when the option or the file named the mode */
 } cf_table;
 
 /* Reads the table at path ("-": standard input, named "(standard input)" in messages). Columns

@@ -30,11 +30,20 @@ enum {
 ** the telescoping spring through the lattice"). The library itself never prints. */
 typedef void (*cf_pipeline_progress)(void *ctx, const char *table, const char *what);
 
+/* What the fit aims at. */
+typedef enum cf_pipeline_target {
+    CF_TARGET_AUTO = 0,    /* the spring for uniaxial tables, the lattice for the other modes (a
+                           ** single spring has no shear, planar, equibiaxial or confined form) */
+    CF_TARGET_SPRING = 1,  /* the single spring's curve F(eH)/H^2 */
+    CF_TARGET_LATTICE = 2  /* the lattice's curve in the table's mode (validate.h,
+                           ** cf_validate_through_msm), verified once in the full lattice */
+} cf_pipeline_target;
+
 typedef struct cf_pipeline_options {
     unsigned types;              /* CF_PIPELINE_* bits (default both) */
     cf_fit_options fit;          /* the fitter's options (fit.h) */
     int validate;                /* 1: run each fit in the lattice */
-    int through_msm;             /* 1: fit through the lattice (implies validate) */
+    cf_pipeline_target target;   /* CF_TARGET_LATTICE implies validate */
     cf_validate_setup lattice;   /* the lattice of the validation (validate.h) */
     int with_timing;             /* 0: write wall times as 0 (reproducible fit files) */
     cf_pipeline_progress progress; /* NULL: silent */

@@ -1,18 +1,19 @@
 /*
 ** Validation of a fitted spring in the mass-spring lattice, and the fit through the lattice.
 **
-** A single spring reproduces its table by construction; a lattice of such springs with face and
-** body diagonals, boundary conditions and lateral freedom does not. cf_validate_run builds the
-** static uniaxial lattice (msm.h, cf_msm_uniaxial) from a fitted spring, drives it to every strain
-** of the table (the table's own sign: tension positive, compression negative) and measures how far
-** the lattice's nominal stress lies from the measured one (RMSE, R^2, max |error|).
+** A single spring reproduces its table by construction; a lattice of such springs, with its
+** diagonals, boundary conditions and lateral freedom, does not. cf_validate_run drives the lattice
+** made of a fitted spring to every strain of the table (the table's own sign: tension positive)
+** in the table's test mode and measures how far its nominal stress lies from the measured one
+** (RMSE, R^2, max |error|) and from the law's own curve: a uniaxial table runs the full static
+** lattice (msm.h, cf_msm_uniaxial); the other modes (shear, planar, equibiaxial, confined) run the
+** homogenised cell (cell.h), which is the lattice under a homogeneous deformation.
 **
-** cf_validate_through_msm makes the lattice's curve the objective: starting from the ordinary fit
-** it optimises the three identifiable quantities (rho, solid strain s/H, stress scale F_C/H^2; the
-** lattice's stress depends on the design parameters only through them, as the single spring's
-** does) with NLopt BOBYQA (derivative-free, deterministic), then places the design parameters as
-** the ordinary fit does (cf_fit_place). The result is kept only when it lowers the validation
-** RMSE, so it never makes the validation worse.
+** cf_validate_through_msm makes the lattice's curve the objective (conifit fit --target lattice):
+** it optimises the three identifiable quantities (rho, solid strain s/H, stress scale F_C/H^2;
+** the lattice's stress depends on the design parameters only through them, as the single
+** spring's does) through the homogenised cell, places the design parameters as the ordinary fit
+** does (cf_fit_place), and verifies the result once in the full lattice.
 **
 ** Stress-strain tables only: a force-displacement table is a single spring's curve, not a block
 ** of tissue, and its free length H is not determined by the data, so there is no sound nominal
@@ -24,6 +25,7 @@
 
 #include <stddef.h>
 
+#include "conifit/cell.h"
 #include "conifit/error.h"
 #include "conifit/fit.h"
 #include "conifit/law.h"
@@ -58,6 +60,11 @@ typedef struct cf_validation {
     double wall_time_s;         /* s */
     size_t solves;              /* static solves */
     size_t newton_iters;        /* Newton iterations in all */
+    cf_mode mode;               /* the table's test mode */
+    int by_cell;                /* 1: run by the homogenised cell (a mode the full lattice has no
+                                ** boundary conditions for); 0: the full lattice */
+    double law_rmse;            /* RMSE of the lattice against the law's own curve F(eH)/H^2:
+                                ** what the lattice adds to the spring, MPa */
     size_t count;               /* points of stress_MPa */
     double *stress_MPa;         /* lattice stress at each table strain, MPa (owned; NULL if skipped) */
 } cf_validation;
@@ -76,17 +83,23 @@ void cf_validation_free(cf_validation *v);
 typedef struct cf_through_msm {
     int done;                   /* 1: run */
     int improved;               /* 1: the spring was replaced (the lattice fits better) */
-    double rmse_before;         /* validation RMSE of the ordinary fit, MPa */
-    double rmse_after;          /* validation RMSE of the reported spring, MPa */
+    double rmse_before;         /* RMSE of the ordinary fit in the lattice (homogenised cell), MPa */
+    double cell_rmse;           /* RMSE of the reported spring through the cell: the fit's, MPa */
+    double rmse_after;          /* validation RMSE of the reported spring (full lattice), MPa */
+    int verified;               /* 1: the full lattice ran (uniaxial); 0: the mode is the cell's */
+    double verify_max_abs;      /* largest |full lattice - cell| at the table's strains, MPa */
     double ident_before[3];     /* rho, s/H, F_C/H^2 [MPa] of the ordinary fit */
     double ident_after[3];      /* the same after the lattice objective */
     double wall_time_s;         /* s, the optimisation and the placement */
-    long evaluations;           /* lattice curves computed */
+    long evaluations;           /* cell curves computed */
 } cf_through_msm;
 
-/* The fit through the lattice for one fitted spring res (in: the ordinary fit, with v its
-** validation, v->done = 1; out: the spring placed from the lattice-optimal identifiable quantities
-** and its validation, when that lowered the validation RMSE). Deterministic. */
+/* The fit through the lattice for one fitted spring res (in: the ordinary fit; out: the spring
+** placed from the identifiable quantities that make the homogenised cell (cell.h) reproduce the
+** table in its mode, when that lowers the cell's RMSE). Local searches (NLopt BOBYQA over
+** log rho and s/H, the stress scale in closed form) from the ordinary fit and a coarse grid; the
+** reported spring is then validated once (v, freed and refilled here) in the validation lattice,
+** and t records the cell's fit RMSE against the full lattice's. Deterministic. */
 cf_status cf_validate_through_msm(const cf_table *d, const cf_fit_options *opt,
                                   const cf_validate_setup *s, cf_fit_result *res,
                                   cf_validation *v, cf_through_msm *t, cf_error *err);

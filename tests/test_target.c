@@ -1,0 +1,217 @@
+/*
+** Tests of the fit through the lattice (`conifit fit --target lattice`) and of test modes: on
+** noiseless tables made from known springs and reaching 95 % of the solid strain, in tension and
+** in compression, the full lattice of the reported spring lies within 1.5 % of the table's largest
+** stress (a single-spring fit validated in the same lattice does not); on the shipped noisy table
+** the lattice error is within 1.3 times the spring fit's own; the verification in the full lattice
+** agrees with the homogenised cell; a table's '# mode:' comment is read, --mode wins, a shear table
+** is fitted and validated in shear; bad modes are refused.
+*/
+#include "testutil.h"
+
+#include <jansson.h>
+
+#include "conifit/law.h"
+#include "conifit/cell.h"
+
+static char out[1 << 16], errb[1 << 14];
+
+static double num_at(json_t *obj, const char *key)
+{
+    json_t *v = json_object_get(obj, key);
+    if (!json_is_number(v))
+        fail_msg("key '%s' is missing or not a number", key);
+    return json_number_value(v);
+}
+
+/* Writes the table of spring p from 0 to frac of its solid strain (sign: +1 tension, -1
+** compression), 40 rows, optionally with a mode comment; returns the largest |stress| in kPa. */
+static double write_spring_table(const char *path, const cf_spring *p, double frac, int sign,
+                                 const char *mode)
+{
+    cf_law law;
+    assert_int_equal(cf_law_init(&law, p, NULL), CF_OK);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    if (mode)
+        fprintf(f, "# mode: %s\n", mode);
+    fprintf(f, "strain,stress_kPa\n");
+    double H = law.p.H_mm, smax = 0;
+    for (int i = 0; i <= 40; i++) {
+        double e = frac * law.travel_mm / H * i / 40;
+        double s = cf_law_force(&law, CF_LAW_EXACT, e * H, NULL, NULL) / (H * H) * 1e3;
+        fprintf(f, "%.17g,%.17g\n", sign * e, sign * s);
+        smax = fmax(smax, s);
+    }
+    fclose(f);
+    return smax;
+}
+
+/* Runs fit with the given target on table and returns (in kPa) the fit file's validation RMSE
+** of fits[0]; *fit_rmse the fit RMSE of its target. */
+static double lattice_rmse(const char *table, const char *json, const char *target,
+                           double *fit_rmse, double *verify)
+{
+    int st = tu_run(out, sizeof out, errb, sizeof errb,
+                    "fit %s --type non-telescoping --target %s --validate -o %s --quiet", table,
+                    target, json);
+    if (st != 0)
+        fail_msg("%s --target %s: exit %d: %s", table, target, st, errb);
+    json_error_t e;
+    json_t *root = json_load_file(json, 0, &e);
+    assert_non_null(root);
+    json_t *f = json_array_get(json_object_get(root, "fits"), 0);
+    json_t *v = json_object_get(f, "validation");
+    assert_string_equal(json_string_value(json_object_get(v, "model")), "full lattice");
+    double r = num_at(v, "rmse");
+    *fit_rmse = num_at(v, "fit_rmse");
+    json_t *t = json_object_get(f, "through_msm");
+    *verify = t ? num_at(t, "verification_max_abs") : -1;
+    json_decref(root);
+    return r;
+}
+
+static void lattice_target_reproduces_deep_known_spring_tables(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-target-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char table[256], json[256];
+    snprintf(table, sizeof table, "%s/t.csv", dir);
+    snprintf(json, sizeof json, "%s/t.json", dir);
+    const cf_spring springs[2] = {{6, 15, 2.5, 2, 26, 10}, {8, 20, 3, 1.5, 200, 6}};
+    for (int k = 0; k < 2; k++)
+        for (int sign = -1; sign <= 1; sign += 2) {
+            double smax = write_spring_table(table, &springs[k], 0.95, sign, NULL);
+            double fr_s, fr_l, ver_s, ver_l;
+            double spring = lattice_rmse(table, json, "spring", &fr_s, &ver_s);
+            double lattice = lattice_rmse(table, json, "lattice", &fr_l, &ver_l);
+            /* the single spring fits to rounding, but its lattice is several percent off */
+            assert_true(fr_s < 1e-9 * smax);
+            if (!(spring > 0.03 * smax))
+                fail_msg("spring %d sign %d: spring fit in the lattice %.4g kPa of %.4g", k, sign,
+                         spring, smax);
+            if (!(lattice <= 0.015 * smax))
+                fail_msg("spring %d sign %d: --target lattice leaves %.4g kPa (%.2f %% of %.4g)",
+                         k, sign, lattice, 100 * lattice / smax, smax);
+            /* the cell's fit error is the full lattice's, to the solver's tolerance */
+            assert_true(fabs(fr_l - lattice) <= 1e-6 * smax);
+            assert_true(ver_l >= 0 && ver_l <= 1e-8 * smax);
+        }
+    remove(table);
+    remove(json);
+    rmdir(dir);
+}
+
+static void lattice_target_on_the_shipped_noisy_table_is_near_the_spring_fit(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-target-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char json[256];
+    snprintf(json, sizeof json, "%s/n.json", dir);
+    double fr_s, fr_l, v_s, v_l;
+    const char *table = "data/telescoping_noise1pct.csv";
+    double spring = lattice_rmse(table, json, "spring", &fr_s, &v_s);
+    double lattice = lattice_rmse(table, json, "lattice", &fr_l, &v_l);
+    assert_true(v_s < 0); /* no fit through the lattice with --target spring */
+    if (!(lattice <= 1.3 * fr_s && lattice < spring))
+        fail_msg("lattice rmse %.4g kPa against the spring fit's %.4g (spring in the lattice "
+                 "%.4g)", lattice, fr_s, spring);
+    remove(json);
+    rmdir(dir);
+}
+
+/* A table made as the cell's simple-shear curve of a known spring is read as shear from its
+** comment, fitted through the lattice by default, validated by the homogenised cell, and the
+** JSON names the mode; --mode uniaxial makes it a uniaxial table again. */
+static void shear_table_is_fitted_and_validated_in_shear(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-target-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char table[256], json[256];
+    snprintf(table, sizeof table, "%s/shear.csv", dir);
+    snprintf(json, sizeof json, "%s/s.json", dir);
+    cf_spring p = {6, 15, 2.5, 2, 26, 10};
+    cf_law law;
+    assert_int_equal(cf_law_init(&law, &p, NULL), CF_OK);
+    double w[3];
+    cf_calibration_weights(CF_CAL_ISOTROPIC, w, NULL);
+    cf_cell c;
+    assert_int_equal(cf_cell_init(&c, &law, CF_LAW_EXACT, w, NULL), CF_OK);
+    FILE *f = fopen(table, "w");
+    assert_non_null(f);
+    fprintf(f, "# simple shear of a known lattice\n# mode: shear\nstrain,stress_kPa\n");
+    double smax = 0;
+    for (int i = 0; i <= 30; i++) {
+        cf_cell_state s;
+        double g = 0.6 * i / 30;
+        assert_int_equal(cf_cell_mode(&c, CF_MODE_SHEAR, g, NULL, &s, NULL), CF_OK);
+        fprintf(f, "%.17g,%.17g\n", g, s.stress_MPa * 1e3);
+        smax = fmax(smax, s.stress_MPa * 1e3);
+    }
+    fclose(f);
+    int st = tu_run(out, sizeof out, errb, sizeof errb,
+                    "fit %s --type non-telescoping -o %s", table, json);
+    if (st != 0)
+        fail_msg("exit %d: %s", st, errb);
+    assert_non_null(strstr(out, "mode shear"));
+    json_error_t e;
+    json_t *root = json_load_file(json, 0, &e);
+    assert_non_null(root);
+    json_t *fit = json_array_get(json_object_get(root, "fits"), 0);
+    json_t *v = json_object_get(fit, "validation");
+    assert_string_equal(json_string_value(json_object_get(v, "mode")), "shear");
+    assert_string_equal(json_string_value(json_object_get(v, "model")), "homogenised cell");
+    assert_non_null(json_object_get(fit, "through_msm"));
+    if (!(num_at(v, "rmse") <= 1e-3 * smax))
+        fail_msg("shear through the lattice: rmse %.4g kPa of %.4g", num_at(v, "rmse"), smax);
+    json_decref(root);
+    /* --mode wins over the comment */
+    st = tu_run(out, sizeof out, errb, sizeof errb,
+                "fit %s --type non-telescoping --mode uniaxial --validate -o %s", table, json);
+    if (st != 0)
+        fail_msg("exit %d: %s", st, errb);
+    assert_non_null(strstr(out, "mode uniaxial"));
+    remove(table);
+    remove(json);
+    rmdir(dir);
+}
+
+static void bad_modes_are_refused(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-target-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char table[256], json[256];
+    snprintf(table, sizeof table, "%s/bad.csv", dir);
+    snprintf(json, sizeof json, "%s/b.json", dir);
+    cf_spring p = {6, 15, 2.5, 2, 26, 10};
+    write_spring_table(table, &p, 0.5, 1, "torsion");
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb, "fit %s -o %s", table, json), 65);
+    assert_non_null(strstr(errb, "bad.csv:1:"));
+    assert_non_null(strstr(errb, "torsion"));
+    assert_int_equal(access(json, F_OK), -1);
+    write_spring_table(table, &p, 0.5, 1, NULL);
+    assert_int_equal(
+        tu_run(out, sizeof out, errb, sizeof errb, "fit %s --mode twist -o %s", table, json), 2);
+    assert_non_null(strstr(errb, "twist"));
+    assert_int_equal(
+        tu_run(out, sizeof out, errb, sizeof errb, "fit %s --target cell -o %s", table, json), 2);
+    assert_non_null(strstr(errb, "--target"));
+    assert_int_equal(access(json, F_OK), -1);
+    remove(table);
+    rmdir(dir);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(lattice_target_reproduces_deep_known_spring_tables),
+        cmocka_unit_test(lattice_target_on_the_shipped_noisy_table_is_near_the_spring_fit),
+        cmocka_unit_test(shear_table_is_fitted_and_validated_in_shear),
+        cmocka_unit_test(bad_modes_are_refused),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
