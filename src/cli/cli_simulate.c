@@ -12,6 +12,7 @@
 
 #include "base/atomic.h"
 #include "cli/cli.h"
+#include "conifit/budget.h"
 #include "conifit/msm.h"
 #include "conifit/scene.h"
 #include "out/plot.h"
@@ -25,7 +26,12 @@ static const char simulate_help[] =
     "A scene with no inertia, damping or viscosity is solved as static equilibria.\n\n"
     "  -o, --output FILE   CSV to write (written to a temporary name, then renamed); '-'\n"
     "                      writes it to standard output and the summary to stderr\n"
-    "  --plot FILE.png|.svg  also plot the result with gnuplot\n";
+    "  --plot FILE.png|.svg  also plot the result with gnuplot\n"
+    "  --max-memory SIZE   refuse a scene estimated to need more memory (bytes, or with a\n"
+    "                      K, M or G suffix; default 2G)\n"
+    "  --max-steps N       refuse a scene estimated to need more time steps or static\n"
+    "                      solves (default 1e7)\n"
+    "The estimates are made before anything runs; a refused scene exits 65 naming the key.\n";
 
 /* Area of the closed loop(s) in the stress-strain plane over samples [a, b], kPa = kJ/m^3. */
 /* Progress on a terminal: one line, rewritten after every sample. */
@@ -97,26 +103,67 @@ static void summary(FILE *o, const cf_scene *sc, const cf_msm_sample *s, size_t 
     }
 }
 
-enum { OPT_PLOT = CF_CLI_OPT_OWN };
+enum { OPT_PLOT = CF_CLI_OPT_OWN, OPT_MAX_MEMORY, OPT_MAX_STEPS };
 
-/* --plot, the only option of simulate's own. */
-static int take_plot(void *ctx, int c, const char *value)
+typedef struct sim_opts {
+    const char *png;
+    cf_budget budget;
+} sim_opts;
+
+/* A size in bytes with an optional K, M or G (binary) suffix; 0 when it is not one. */
+static double parse_size(const char *text)
 {
-    (void)c;
-    *(const char **)ctx = value;
+    char *end = NULL;
+    double v = strtod(text, &end);
+    double unit = 1;
+    if (end == text || !(v > 0))
+        return 0;
+    if (*end)
+        unit = end[1]        ? 0
+               : *end == 'K' ? 1024.0
+               : *end == 'M' ? 1048576.0
+               : *end == 'G' ? 1073741824.0
+                             : 0;
+    return isfinite(v * unit) ? v * unit : 0;
+}
+
+/* simulate's own options: --plot, --max-memory, --max-steps. */
+static int take_option(void *ctx, int c, const char *value)
+{
+    sim_opts *o = ctx;
+    cf_error err = {0};
+    if (c == OPT_PLOT) {
+        o->png = value;
+    } else if (c == OPT_MAX_MEMORY) {
+        if (!(o->budget.max_memory_bytes = parse_size(value)))
+            return cf_cli_usage_error("simulate", "--max-memory '%s': expected a size in bytes, "
+                                      "optionally with K, M or G", value);
+    } else if (c == OPT_MAX_STEPS) {
+        if (cf_cli_parse_double("--max-steps", value, &o->budget.max_steps, &err) != CF_OK)
+            return cf_cli_usage_error("simulate", "%s", err.msg);
+        if (!(o->budget.max_steps >= 1))
+            return cf_cli_usage_error("simulate", "--max-steps %g: must be at least 1",
+                                      o->budget.max_steps);
+    }
     return 0;
 }
 
 int cf_cli_simulate(int argc, char **argv)
 {
     static const struct option own[] = {{"plot", required_argument, NULL, OPT_PLOT},
+                                        {"max-memory", required_argument, NULL, OPT_MAX_MEMORY},
+                                        {"max-steps", required_argument, NULL, OPT_MAX_STEPS},
                                         {NULL, 0, NULL, 0}};
     const char *scene_path = NULL, *out = NULL, *png = NULL;
     cf_error err = {0};
+    cf_scene_cost cost;
+    sim_opts so = {NULL, cf_budget_default()};
     cf_cli_parser p;
     int rc = cf_cli_parser_init(&p, "simulate", simulate_help, 0, argc, argv, "", own);
-    if (rc || (rc = cf_cli_parse(&p, take_plot, &png)) >= 0)
+    if (rc || (rc = cf_cli_parse(&p, take_option, &so)) >= 0)
         return rc;
+    png = so.png;
+    cf_budget budget = so.budget;
     out = p.output;
     const int quiet = p.quiet, progress = cf_cli_progress(&p);
     if (optind + 1 < argc)
@@ -146,7 +193,8 @@ int cf_cli_simulate(int argc, char **argv)
     const char *inputs[] = {scene_path, strcmp(sc.spring_source, "params") ? fitfile : NULL,
                             NULL};
     if ((!cf_cli_is_stdio(out) && cf_atomic_check(out, inputs, &err) != CF_OK) ||
-        (png && cf_atomic_check(png, inputs, &err) != CF_OK)) {
+        (png && cf_atomic_check(png, inputs, &err) != CF_OK) ||
+        cf_budget_check_size(&sc, scene_path, &budget, &cost, &err) != CF_OK) {
         cf_scene_free(&sc);
         return cf_cli_fail(&err);
     }
@@ -164,7 +212,8 @@ int cf_cli_simulate(int argc, char **argv)
         goto end;
     }
     if ((sc.method == CF_LAW_TABLE && cf_law_table_build(&law, sc.table_intervals, &err)) ||
-        cf_lattice_create(&lat, &law, sc.method, &sc.cfg.lattice, &err) != CF_OK) {
+        cf_lattice_create(&lat, &law, sc.method, &sc.cfg.lattice, &err) != CF_OK ||
+        cf_budget_check_steps(&sc, scene_path, &lat, &budget, &cost, &err) != CF_OK) {
         rc = cf_cli_fail(&err);
         goto end;
     }

@@ -421,6 +421,12 @@ static cf_status protocol_section(ctx *c, json_t *pr, cf_scene *sc, double sampl
     }
     /* Samples: every path segment split in samples_per_segment intervals. */
     size_t per = (size_t)samples_per_segment;
+    if ((double)(sc->npath - 1) * (double)per + 1 > CF_SCENE_MAX_SAMPLES)
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'samples_per_segment' = %zu: %zu path segments would give "
+                            "%.3g samples, more than the %d a scene may have",
+                            c->name, per, sc->npath - 1, (double)(sc->npath - 1) * (double)per + 1,
+                            CF_SCENE_MAX_SAMPLES);
     sc->nsamples = (sc->npath - 1) * per + 1;
     sc->sample_t_s = malloc(sc->nsamples * sizeof(double));
     if (!sc->sample_t_s)

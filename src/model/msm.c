@@ -213,15 +213,27 @@ static double residual(solver *s, double *rnorm, double *fscale)
     return um;
 }
 
-static void add_entry(gsl_spmatrix *K, long i, long j, double v)
+/* Adds v to K(i, j) (nothing for a prescribed DOF); 0, or -1 when memory runs out. */
+static int add_entry(gsl_spmatrix *K, long i, long j, double v)
 {
     if (i < 0 || j < 0)
-        return;
+        return 0;
     double *ptr = gsl_spmatrix_ptr(K, (size_t)i, (size_t)j);
-    if (ptr)
+    if (ptr) {
         *ptr += v;
-    else
-        gsl_spmatrix_set(K, (size_t)i, (size_t)j, v);
+        return 0;
+    }
+    return gsl_spmatrix_set(K, (size_t)i, (size_t)j, v) == GSL_SUCCESS ? 0 : -1;
+}
+
+/* GSL's sparse allocators crash on their own failure path (they free a half-built matrix), so the
+** memory of a sparse matrix of nzmax entries (indices, values and the triplet tree) is tried
+** first: 1 when it can be had. */
+static int sparse_memory_available(size_t nzmax)
+{
+    void *p = malloc(nzmax * 64 + 4096);
+    free(p);
+    return p != NULL;
 }
 
 /* Index of entry (row, col) in the compressed-column matrix C, or -1 (rows within a column are
@@ -242,25 +254,28 @@ static cf_status build_pattern(solver *s, cf_error *err)
 {
     cf_lattice *lat = s->lat;
     const size_t n = s->ndof;
-    gsl_spmatrix *K = gsl_spmatrix_alloc_nzmax(n ? n : 1, n ? n : 1, 40 * n + 16,
-                                               GSL_SPMATRIX_TRIPLET);
+    /* a node couples with at most 26 neighbours and itself: 81 entries per row */
+    const size_t nzmax = 81 * n + 16;
+    gsl_spmatrix *K = sparse_memory_available(2 * nzmax)
+                          ? gsl_spmatrix_alloc_nzmax(n ? n : 1, n ? n : 1, nzmax,
+                                                     GSL_SPMATRIX_TRIPLET)
+                          : NULL;
     if (!K)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent matrix");
-    for (size_t q = 0; q < lat->ns; q++) {
+    int bad = 0;
+    for (size_t q = 0; q < lat->ns && !bad; q++) {
         uint32_t i = lat->si[q], j = lat->sj[q];
         for (int a = 0; a < 3; a++)
             for (int b = 0; b < 3; b++) {
                 long ia = s->eq[3 * i + a], ib = s->eq[3 * i + b];
                 long ja = s->eq[3 * j + a], jb = s->eq[3 * j + b];
-                add_entry(K, ia, ib, 1);
-                add_entry(K, ja, jb, 1);
-                add_entry(K, ia, jb, 1);
-                add_entry(K, ja, ib, 1);
+                bad |= add_entry(K, ia, ib, 1) | add_entry(K, ja, jb, 1) |
+                       add_entry(K, ia, jb, 1) | add_entry(K, ja, ib, 1);
             }
     }
-    for (size_t e = 0; e < n; e++)
-        add_entry(K, (long)e, (long)e, 1);
-    s->C = gsl_spmatrix_ccs(K);
+    for (size_t e = 0; e < n && !bad; e++)
+        bad |= add_entry(K, (long)e, (long)e, 1);
+    s->C = !bad && sparse_memory_available(K->nz) ? gsl_spmatrix_ccs(K) : NULL;
     gsl_spmatrix_free(K);
     s->map = malloc((lat->ns ? lat->ns : 1) * 36 * sizeof(int));
     s->diag = malloc((n ? n : 1) * sizeof(int));
@@ -602,8 +617,16 @@ static cf_status newton(solver *s, cf_error *err)
         if (s->st)
             s->st->newton_iters++;
         cf_error lerr = {0};
-        if (newton_direction(s, &lerr) != CF_OK)
+        if (newton_direction(s, &lerr) != CF_OK) {
+            if (lerr.status == CF_E_INTERNAL) { /* out of memory: not a matter of step size */
+                memcpy(lat->x, start, lat->nn * sizeof(double));
+                memcpy(lat->y, start + lat->nn, lat->nn * sizeof(double));
+                memcpy(lat->z, start + 2 * lat->nn, lat->nn * sizeof(double));
+                free(start);
+                return cf_error_set(err, CF_E_INTERNAL, "%s", lerr.msg);
+            }
             break;
+        }
         save_positions(s);
         double alpha = 1, rn0 = rn;
         int ok = 0;

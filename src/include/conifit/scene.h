@@ -37,6 +37,10 @@ typedef struct cf_scene {
     double *sample_t_s;         /* their times, s */
 } cf_scene;
 
+/* Most samples a scene may report (segments x samples_per_segment + 1); the memory and steps of
+** a scene are further bounded by its budget (budget.h). */
+#define CF_SCENE_MAX_SAMPLES 10000000
+
 /* Reads and validates the scene at path. CF_E_NOINPUT when it (or its fit file) cannot be read,
 ** CF_E_DATA for anything invalid; the message names the file, the key and the value. */
 cf_status cf_scene_load(const char *path, cf_scene *sc, cf_error *err);

@@ -1,0 +1,52 @@
+/*
+** What a scene will cost, estimated before anything runs: nodes, springs, samples, memory and
+** time steps (or static solves). A scene above the limits is refused with a message naming the
+** scene key that drives the estimate and the estimate itself, so that every accepted scene either
+** finishes or is refused before it starts. The limits are the defaults below or the caller's
+** (`conifit simulate --max-memory`, `--max-steps`).
+**
+** The estimates are of the present solvers: memory is the lattice, the samples and the largest
+** workspace of the linear solvers a static or implicit run may use (sparse tangent, banded factor,
+** dense LU or GMRES basis); steps are static solves (one per sample), implicit steps, or explicit
+** steps at the stable step of the unloaded lattice (stiffening springs can only add sub-steps).
+*/
+#ifndef CF_BUDGET_H
+#define CF_BUDGET_H
+
+#include <stddef.h>
+
+#include "conifit/error.h"
+#include "conifit/lattice.h"
+#include "conifit/scene.h"
+
+#define CF_BUDGET_MAX_MEMORY_DEFAULT (2.0 * 1024 * 1024 * 1024) /* bytes: 2 GiB */
+#define CF_BUDGET_MAX_STEPS_DEFAULT 1e7                         /* steps or solves */
+
+typedef struct cf_budget {
+    double max_memory_bytes;
+    double max_steps;
+} cf_budget;
+
+/* The default limits. */
+cf_budget cf_budget_default(void);
+
+typedef struct cf_scene_cost {
+    size_t nodes, springs, samples;
+    double memory_bytes;       /* estimate, bytes */
+    double steps;              /* estimate: explicit or implicit time steps, or static solves */
+    const char *steps_kind;    /* "explicit steps", "implicit steps" or "static solves" */
+} cf_scene_cost;
+
+/* `name` (the scene's file) starts each message. Nodes, springs, samples and memory of the scene, checked against the memory limit before the
+** lattice is built. CF_E_DATA naming the key (lattice.nx/ny/nz or samples_per_segment) and the
+** estimate when it is above. */
+cf_status cf_budget_check_size(const cf_scene *sc, const char *name, const cf_budget *b,
+                               cf_scene_cost *c, cf_error *err);
+
+/* The steps of the scene on its built lattice (for the explicit stable step), checked against
+** the step limit. CF_E_DATA naming the key (protocol duration, integrator.dt_s,
+** integrator.substeps or samples_per_segment) and the estimate when it is above. */
+cf_status cf_budget_check_steps(const cf_scene *sc, const char *name, cf_lattice *lat,
+                                const cf_budget *b, cf_scene_cost *c, cf_error *err);
+
+#endif

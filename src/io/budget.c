@@ -1,0 +1,118 @@
+/*
+** Cost estimates of a scene before it runs (see budget.h).
+*/
+#include "conifit/budget.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "conifit/calibration.h"
+
+/* Bytes per node and per spring of the lattice and the solver state (positions, reference
+** positions, forces, masses, velocities; spring ends, lengths, weights, tensions, law state), and
+** per sample (the sample, its time, the single-spring comparison). Rounded up from the arrays of
+** lattice.c and msm.c. */
+#define NODE_BYTES 160.0
+#define SPRING_BYTES 200.0
+#define SAMPLE_BYTES 64.0
+/* The static and implicit solvers (msm.c): the sparse tangent (81 entries a row at most, kept
+** twice while it is compressed), the banded factor when it fits in 5e7 entries, else a dense LU
+** up to 1200 unknowns, else a GMRES basis of 150 vectors. */
+#define TANGENT_ROW_BYTES (81.0 * 64.0)
+#define BAND_MAX_ENTRIES 5e7
+#define DENSE_MAX_DOF 1200.0
+#define GMRES_BASIS 150.0
+#define DT_SAFETY 0.9
+
+cf_budget cf_budget_default(void)
+{
+    cf_budget b = {CF_BUDGET_MAX_MEMORY_DEFAULT, CF_BUDGET_MAX_STEPS_DEFAULT};
+    return b;
+}
+
+static double mib(double bytes)
+{
+    return bytes / (1024.0 * 1024.0);
+}
+
+cf_status cf_budget_check_size(const cf_scene *sc, const char *name, const cf_budget *b,
+                               cf_scene_cost *c, cf_error *err)
+{
+    memset(c, 0, sizeof *c);
+    const cf_lattice_config *L = &sc->cfg.lattice;
+    const double nx = L->nx, ny = L->ny, nz = L->nz;
+    const double nodes = (nx + 1) * (ny + 1) * (nz + 1);
+    double springs = 0;
+    if (L->weight[CF_FAMILY_EDGE] > 0)
+        springs += nx * (ny + 1) * (nz + 1) + ny * (nx + 1) * (nz + 1) + nz * (nx + 1) * (ny + 1);
+    if (L->weight[CF_FAMILY_FACE] > 0)
+        springs += 2 * (nx * ny * (nz + 1) + ny * nz * (nx + 1) + nx * nz * (ny + 1));
+    if (L->weight[CF_FAMILY_BODY] > 0)
+        springs += 4 * nx * ny * nz;
+    c->nodes = (size_t)nodes;
+    c->springs = (size_t)springs;
+    c->samples = sc->nsamples;
+    const double dof = 3 * nodes;
+    double solver = 0;
+    if (!sc->effects.inertia) { /* static and implicit runs factor the tangent */
+        const double band = 3 * (nx + 1) * (ny + 1) + 3;
+        solver = dof * TANGENT_ROW_BYTES + springs * 36 * 4;
+        if (dof * (band + 1) <= BAND_MAX_ENTRIES)
+            solver += 8 * dof * (band + 1);
+        else if (dof <= DENSE_MAX_DOF)
+            solver += 8 * dof * dof;
+        else
+            solver += 8 * dof * (GMRES_BASIS + 4);
+    }
+    const double lattice = nodes * NODE_BYTES + springs * SPRING_BYTES;
+    const double samples = (double)sc->nsamples * SAMPLE_BYTES;
+    c->memory_bytes = lattice + solver + samples;
+    if (c->memory_bytes > b->max_memory_bytes) {
+        const char *key = samples > lattice + solver ? "samples_per_segment" : "lattice.nx/ny/nz";
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: key '%s': the scene needs about %.0f MiB (%.0f nodes, %.0f "
+                            "springs, %zu samples), above the limit of %.0f MiB (raise it with "
+                            "--max-memory)",
+                            name, key, mib(c->memory_bytes), nodes, springs, sc->nsamples,
+                            mib(b->max_memory_bytes));
+    }
+    return CF_OK;
+}
+
+cf_status cf_budget_check_steps(const cf_scene *sc, const char *name, cf_lattice *lat,
+                                const cf_budget *b, cf_scene_cost *c, cf_error *err)
+{
+    const cf_msm_effects *fx = &sc->effects;
+    const cf_msm_config *cfg = &sc->cfg;
+    const double duration = sc->npath ? sc->path_t_s[sc->npath - 1] - sc->path_t_s[0] : 0;
+    const char *key;
+    if (fx->inertia) {
+        double stable = DT_SAFETY * cf_msm_stable_step(lat, fx);
+        double dt = cfg->dt_s > 0 && cfg->dt_s < stable ? cfg->dt_s : stable;
+        c->steps = dt > 0 && isfinite(dt) ? duration / dt : INFINITY;
+        c->steps_kind = "explicit steps";
+        key = cfg->dt_s > 0 && cfg->dt_s < stable ? "integrator.dt_s"
+              : sc->kind == CF_PROTO_RAMP         ? "protocol.duration_s"
+              : sc->kind == CF_PROTO_CYCLES       ? "protocol.period_s"
+                                                  : "protocol.hold_s";
+    } else if (fx->eta_MPa_s > 0 || fx->maxwell_E_MPa > 0) {
+        c->steps_kind = "implicit steps";
+        if (cfg->dt_s > 0) {
+            c->steps = duration / cfg->dt_s + (double)sc->nsamples;
+            key = "integrator.dt_s";
+        } else {
+            c->steps = (double)sc->nsamples * (cfg->quasi_substeps > 0 ? cfg->quasi_substeps : 1);
+            key = cfg->quasi_substeps > 1 ? "integrator.substeps" : "samples_per_segment";
+        }
+    } else {
+        c->steps = (double)sc->nsamples;
+        c->steps_kind = "static solves";
+        key = "samples_per_segment";
+    }
+    if (!(c->steps <= b->max_steps))
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: key '%s': the scene needs about %.4g %s, above the limit of %.4g "
+                            "(raise it with --max-steps)",
+                            name, key, c->steps, c->steps_kind, b->max_steps);
+    return CF_OK;
+}

@@ -1,0 +1,166 @@
+/*
+** Scenes whose cost is out of proportion are refused before they start, naming the key and the
+** estimate (exit 65); the limits can be raised; and no shipped or test scene dies of a signal
+** when memory runs short (ulimit -v): it ends with 70 and a message, or succeeds.
+*/
+#include <sys/stat.h>
+
+#include "testutil.h"
+
+#include "conifit/budget.h"
+#include "conifit/scene.h"
+
+static char out[1 << 14], errb[1 << 14];
+static char dir[] = "/tmp/conifit-budget-XXXXXX";
+
+#define SPRING "\"spring\": {\"params\": {\"D1_mm\": 6, \"D2_mm\": 15, \"n\": 2.5, \"d_mm\": 2, " \
+               "\"G_MPa\": 26, \"H_mm\": 10}}"
+
+static int setup(void **state)
+{
+    (void)state;
+    return mkdtemp(dir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char cmd[256];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static void scene(const char *name, const char *body)
+{
+    char p[512];
+    snprintf(p, sizeof p, "%s/%s", dir, name);
+    FILE *f = fopen(p, "wb");
+    assert_non_null(f);
+    fprintf(f, "{" SPRING ", %s}\n", body);
+    assert_int_equal(fclose(f), 0);
+}
+
+static int exists(const char *name)
+{
+    char p[512];
+    struct stat s;
+    snprintf(p, sizeof p, "%s/%s", dir, name);
+    return stat(p, &s) == 0;
+}
+
+/* The scenes of the report that ran for days or took gigabytes: each refused with the key that
+** drives it, before anything is written. */
+static void costly_scenes_are_refused_naming_the_key(void **state)
+{
+    (void)state;
+    const struct {
+        const char *body, *key;
+    } cases[] = {
+        {"\"effects\": {\"inertia\": true}, \"protocol\": {\"kind\": \"ramp\", \"to_strain\": 0.1, "
+         "\"duration_s\": 1e9}",
+         "protocol.duration_s"},
+        {"\"lattice\": {\"nx\": 113, \"ny\": 113, \"nz\": 113}, \"protocol\": {\"kind\": \"ramp\", "
+         "\"to_strain\": 0.1}",
+         "lattice.nx/ny/nz"},
+        {"\"protocol\": {\"kind\": \"cycles\", \"to_strain\": 0.1, \"period_s\": 1, \"count\": "
+         "1000}, \"samples_per_segment\": 100000",
+         "samples_per_segment"},
+        {"\"effects\": {\"damping\": {\"eta_kPa_s\": 1}}, \"integrator\": {\"dt_s\": 1e-8}, "
+         "\"protocol\": {\"kind\": \"ramp\", \"to_strain\": 0.1}",
+         "integrator.dt_s"},
+        {"\"effects\": {\"damping\": {\"eta_kPa_s\": 1}}, \"integrator\": {\"substeps\": 1e6}, "
+         "\"protocol\": {\"kind\": \"ramp\", \"to_strain\": 0.1}",
+         "integrator.substeps"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        scene("costly.json", cases[i].body);
+        int st = tu_run(out, sizeof out, errb, sizeof errb, "simulate %s/costly.json -o %s/c.csv",
+                        dir, dir);
+        if (st != 65 || !strstr(errb, cases[i].key))
+            fail_msg("case %zu: exit %d, expected 65 naming '%s': %s", i, st, cases[i].key, errb);
+        assert_false(exists("c.csv"));
+    }
+}
+
+/* The limits are the caller's: the shipped uniaxial scene runs by default, and is refused under
+** a tighter step or memory limit. */
+static void limits_can_be_set(void **state)
+{
+    (void)state;
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "simulate data/scenes/uniaxial.json -o %s/u.csv", dir),
+                     0);
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "simulate data/scenes/uniaxial.json -o %s/u.csv --max-steps 10", dir),
+                     65);
+    assert_non_null(strstr(errb, "static solves"));
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "simulate data/scenes/uniaxial.json -o %s/u.csv --max-memory 64K",
+                            dir),
+                     65);
+    assert_non_null(strstr(errb, "lattice.nx/ny/nz"));
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "simulate data/scenes/uniaxial.json -o %s/u.csv --max-memory 12Q",
+                            dir),
+                     2);
+    /* the estimate itself: a 3 x 3 x 3 lattice with every family */
+    cf_scene sc;
+    cf_error err = {0};
+    assert_int_equal(cf_scene_load("data/scenes/uniaxial.json", &sc, &err), CF_OK);
+    cf_scene_cost c;
+    cf_budget b = cf_budget_default();
+    assert_int_equal(cf_budget_check_size(&sc, "uniaxial.json", &b, &c, &err), CF_OK);
+    cf_law law;
+    cf_lattice lat;
+    assert_int_equal(cf_law_init(&law, &sc.spring, &err), CF_OK);
+    assert_int_equal(cf_lattice_create(&lat, &law, sc.method, &sc.cfg.lattice, &err), CF_OK);
+    assert_int_equal(c.nodes, lat.nn);
+    assert_int_equal(c.springs, lat.ns);
+    assert_int_equal(c.springs, 144 + 216 + 108); /* edges, face diagonals, body diagonals */
+    assert_int_equal(cf_budget_check_steps(&sc, "uniaxial.json", &lat, &b, &c, &err), CF_OK);
+    assert_true(c.steps == (double)sc.nsamples);
+    cf_lattice_free(&lat);
+    cf_law_free(&law);
+    cf_scene_free(&sc);
+}
+
+/* Under a small address-space limit every scene ends with a status, never a signal. (Skipped
+** under AddressSanitizer, which reserves more address space than any such limit.) */
+static void memory_pressure_gives_a_status_not_a_crash(void **state)
+{
+    (void)state;
+    if (strstr(tu_conifit(), "asan"))
+        skip();
+    scene("big.json", "\"lattice\": {\"nx\": 40, \"ny\": 40, \"nz\": 40}, \"protocol\": "
+                      "{\"kind\": \"ramp\", \"to_strain\": 0.1}, \"samples_per_segment\": 2");
+    char big[512];
+    snprintf(big, sizeof big, "%s/big.json", dir);
+    const char *scenes[] = {"data/scenes/uniaxial.json", "data/scenes/hysteresis.json",
+                            "data/scenes/creep.json", "data/scenes/relaxation.json", big};
+    const long limits_kb[] = {60000, 200000, 1000000};
+    for (size_t i = 0; i < sizeof scenes / sizeof scenes[0]; i++)
+        for (size_t k = 0; k < sizeof limits_kb / sizeof limits_kb[0]; k++) {
+            if (i < 4 && k > 0)
+                continue; /* the shipped scenes are small: the tightest limit is the test */
+            char cmd[1024];
+            snprintf(cmd, sizeof cmd,
+                     "ulimit -v %ld; exec %s simulate %s -o %s/m.csv >/dev/null 2>%s/err",
+                     limits_kb[k], tu_conifit(), scenes[i], dir, dir);
+            int st = system(cmd);
+            int code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+            /* the shell reports a signal as 128 + its number */
+            if (code != 0 && code != 65 && code != 70)
+                fail_msg("%s under ulimit -v %ld: exit %d (a signal?)", scenes[i], limits_kb[k],
+                         code);
+        }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(costly_scenes_are_refused_naming_the_key),
+        cmocka_unit_test(limits_can_be_set),
+        cmocka_unit_test(memory_pressure_gives_a_status_not_a_crash),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
