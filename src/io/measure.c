@@ -1179,9 +1179,16 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
         cf_unit_class tw[1] = {CF_UNIT_TIME};
         if ((st = column_unit(&r, header_line, (size_t)ti, NULL, "", 2, tw, 1, &tu, err)))
             goto fail;
-        if (tu)
-            tscale = tu->to_conifit;
+        if (!tu) {
+            st = data_error(err, path, header_line, (size_t)ti + 1,
+                            "time column '%s' has no unit: name it like time_s or time [s] "
+                            "(s, ms, min, h)",
+                            r.cols[ti].name);
+            goto fail;
+        }
+        tscale = tu->to_conifit;
     }
+    double tprev = 0;
     const double yscale = yu->to_conifit;
 
     /* Rows. */
@@ -1263,6 +1270,14 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
                             "fit a part of it)", CF_MEASURE_MAX_ROWS, CF_MEASURE_MAX_ROWS);
             goto fail;
         }
+        if (ti >= 0 && r.count > 0 && !(t > tprev)) {
+            st = data_error(err, path, l->line, (size_t)ti + 1,
+                            "column '%s': time %.17g s does not increase (the row before has "
+                            "%.17g s) ('%s')",
+                            r.cols[ti].name, t, tprev, field(&r.f, (size_t)ti));
+            goto fail;
+        }
+        tprev = t;
         if (push_row(&r, x, y, v[2], t) != 0) {
             st = out_of_memory(err, path);
             goto fail;

@@ -39,6 +39,30 @@
 /* Safety factor on the explicit stable step. */
 #define DT_SAFETY 0.9
 
+cf_status cf_msm_prony_check(const cf_msm_effects *fx, cf_error *err)
+{
+    if (fx->prony_count < 0 || fx->prony_count > CF_PRONY_MAX)
+        return cf_error_set(err, CF_E_DATA, "%d Prony terms: at most %d", fx->prony_count,
+                            CF_PRONY_MAX);
+    double sum = 0;
+    for (int i = 0; i < fx->prony_count; i++) {
+        double g = fx->prony_g[i], tau = fx->prony_tau_s[i];
+        if (!(g >= 0) || !isfinite(g))
+            return cf_error_set(err, CF_E_DATA, "Prony term %d: g = %g must be finite and >= 0",
+                                i + 1, g);
+        if (!(tau > 0) || !isfinite(tau))
+            return cf_error_set(err, CF_E_DATA,
+                                "Prony term %d: tau_s = %g must be finite and > 0", i + 1, tau);
+        sum += g;
+    }
+    if (!(sum < 1))
+        return cf_error_set(err, CF_E_DATA,
+                            "Prony terms: the relative moduli sum to %.17g; the sum must be below "
+                            "1 (g_inf = 1 - sum g > 0)",
+                            sum);
+    return CF_OK;
+}
+
 cf_msm_config cf_msm_default(void)
 {
     cf_msm_config c;
@@ -65,6 +89,10 @@ typedef struct solver {
     double *xsave;            /* 3 nn positions for backtracking */
     double *Tx0, *kx, *Lprev; /* quasi-static extras per spring (NULL when static) */
     double *sigm;             /* Maxwell branch stress per spring, MPa (NULL when off) */
+    double *hq;               /* Prony branch forces, N per unit weight, compression positive:
+                                 branch i of spring q at hq[q * prony_count + i] (NULL when off) */
+    double *Fprev;            /* law force of every spring at the start of the step, N */
+    double qlv_scale;         /* step's law-force factor minus 1 (Prony terms; 0 when off) */
     double *tmp;              /* per-spring scratch */
     gsl_spmatrix *C;          /* tangent, compressed columns, pattern built once */
     int *map, *diag;          /* spring block -> C->data index; DOF -> its diagonal index */
@@ -89,6 +117,8 @@ static void solver_free(solver *s)
     free(s->kx);
     free(s->Lprev);
     free(s->sigm);
+    free(s->hq);
+    free(s->Fprev);
     free(s->tmp);
     free(s->map);
     free(s->diag);
@@ -137,7 +167,7 @@ static cf_status solver_init(solver *s, cf_lattice *lat, const cf_msm_effects *f
     s->dx = calloc(n ? n : 1, sizeof(double));
     if (!s->R || !s->D || !s->dx)
         goto oom;
-    if (fx && (fx->eta_MPa_s > 0 || fx->maxwell_E_MPa > 0)) {
+    if (fx && (fx->eta_MPa_s > 0 || fx->maxwell_E_MPa > 0 || fx->prony_count > 0)) {
         s->Tx0 = calloc(lat->ns, sizeof(double));
         s->kx = calloc(lat->ns, sizeof(double));
         s->Lprev = calloc(lat->ns, sizeof(double));
@@ -145,6 +175,10 @@ static cf_status solver_init(solver *s, cf_lattice *lat, const cf_msm_effects *f
             goto oom;
     }
     if (fx && fx->maxwell_E_MPa > 0 && !(s->sigm = calloc(lat->ns, sizeof(double))))
+        goto oom;
+    if (fx && fx->prony_count > 0 &&
+        (!(s->hq = calloc(lat->ns * (size_t)fx->prony_count, sizeof(double))) ||
+         !(s->Fprev = calloc(lat->ns, sizeof(double)))))
         goto oom;
     return CF_OK;
 oom:
@@ -193,7 +227,8 @@ static double residual(solver *s, double *rnorm, double *fscale)
     double um = cf_lattice_forces(lat);
     if (s->extras) {
         for (size_t q = 0; q < lat->ns; q++)
-            s->tmp[q] = s->Tx0[q] + s->kx[q] * (lat->L_mm[q] - s->Lprev[q]);
+            s->tmp[q] = s->Tx0[q] + s->kx[q] * (lat->L_mm[q] - s->Lprev[q]) -
+                        s->qlv_scale * lat->w[q] * lat->F_N[q];
         cf_lattice_add_tensions(lat, s->tmp);
     }
     add_external(s);
@@ -494,7 +529,7 @@ static cf_status tangent_solve(solver *s, cf_error *err)
                         (lat->z[j] - lat->z[i]) / L};
         double kt = lat->w[q] * lat->a[q] * lat->k_N_per_mm[q];
         if (s->extras)
-            kt += s->kx[q];
+            kt = kt * (1 + s->qlv_scale) + s->kx[q];
         double g = lat->T_N[q] / L;
         const int *m = s->map + q * 36;
         for (int a = 0; a < 3; a++)
@@ -754,12 +789,31 @@ static cf_status quasi_step(solver *s, double h, double v, cf_error *err)
         mcoef = fx->maxwell_E_MPa * fx->maxwell_tau_s * (-expm1(-h / fx->maxwell_tau_s)) / h;
     }
     double visc = fx->eta_MPa_s / h + mcoef; /* MPa per unit strain */
+    /* Prony terms: with F linear in time over the step, h_i(t + h) = e_i h_i(t) +
+    ** g_i b_i (F(t + h) - F(t)), e_i = exp(-h/tau_i), b_i = tau_i (1 - e_i)/h; so the spring
+    ** force w ((1 - sum g) F + sum h_i) at the end of the step is w (alpha F(t + h) + c) with
+    ** alpha = 1 - sum g_i (1 - b_i) and c = sum (e_i h_i - g_i b_i F(t)). */
+    const int np = fx->prony_count;
+    double pe[CF_PRONY_MAX], pb[CF_PRONY_MAX], alpha = 1;
+    for (int i = 0; i < np; i++) {
+        pe[i] = exp(-h / fx->prony_tau_s[i]);
+        pb[i] = -expm1(-h / fx->prony_tau_s[i]) * fx->prony_tau_s[i] / h;
+        alpha -= fx->prony_g[i] * (1 - pb[i]);
+    }
     cf_lattice_forces(lat); /* lengths at the start of the step */
     for (size_t q = 0; q < lat->ns; q++) {
         s->Lprev[q] = lat->L_mm[q];
         s->Tx0[q] = s->sigm ? lat->w[q] * H2 * s->sigm[q] * E1 : 0.0;
         s->kx[q] = lat->w[q] * H2 * visc / lat->L0_mm[q];
+        if (np > 0) {
+            double c = 0;
+            s->Fprev[q] = lat->F_N[q];
+            for (int i = 0; i < np; i++)
+                c += pe[i] * s->hq[q * np + i] - fx->prony_g[i] * pb[i] * lat->F_N[q];
+            s->Tx0[q] -= lat->w[q] * c;
+        }
     }
+    s->qlv_scale = alpha - 1;
     s->extras = 1;
     double v0 = s->load;
     s->load = v;
@@ -775,6 +829,10 @@ static cf_status quasi_step(solver *s, double h, double v, cf_error *err)
     if (s->sigm)
         for (size_t q = 0; q < lat->ns; q++)
             s->sigm[q] = s->sigm[q] * E1 + mcoef * (lat->L_mm[q] - s->Lprev[q]) / lat->L0_mm[q];
+    for (size_t q = 0; np > 0 && q < lat->ns; q++) /* F_N: the converged state */
+        for (int i = 0; i < np; i++)
+            s->hq[q * np + i] = pe[i] * s->hq[q * np + i] +
+                                fx->prony_g[i] * pb[i] * (lat->F_N[q] - s->Fprev[q]);
     if (s->st)
         s->st->steps++;
     return CF_OK;
@@ -951,7 +1009,12 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
     if (fx->maxwell_E_MPa > 0 && !(fx->maxwell_tau_s > 0 && isfinite(fx->maxwell_tau_s)))
         return cf_error_set(err, CF_E_DATA, "maxwell tau_s = %g: must be finite and > 0",
                             fx->maxwell_tau_s);
-    int timed = fx->inertia || fx->eta_MPa_s > 0 || fx->maxwell_E_MPa > 0;
+    if ((rc = cf_msm_prony_check(fx, err)) != CF_OK)
+        return rc;
+    if (fx->prony_count > 0 && fx->inertia)
+        return cf_error_set(err, CF_E_DATA, "Prony terms are solved quasi-statically: they do not "
+                            "combine with inertia");
+    int timed = fx->inertia || fx->eta_MPa_s > 0 || fx->maxwell_E_MPa > 0 || fx->prony_count > 0;
     solver s;
     if ((rc = solver_init(&s, lat, fx, cfg, path->drive, st, err)) != CF_OK)
         return rc;
@@ -999,7 +1062,16 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
                     n = (int)fmin(1e9, ceil((tk - t) / cfg->dt_s - 1e-9));
                 rc = quasi_advance(&s, path, t, tk, n > 0 ? n : 1, 0, err);
             } else if (k == 0) {
-                rc = static_to(&s, vk, err); /* the state at the first sample is at rest */
+                /* The state at the first sample is at rest: the Maxwell and Prony branches are
+                ** relaxed, so the springs carry g_inf times the law. */
+                if (fx->prony_count > 0) {
+                    double gsum = 0;
+                    for (int i = 0; i < fx->prony_count; i++)
+                        gsum += fx->prony_g[i];
+                    s.qlv_scale = -gsum;
+                    s.extras = 1;
+                }
+                rc = static_to(&s, vk, err);
             }
         } else if (tk > t) {
             double stab = DT_SAFETY * cf_msm_stable_step(lat, fx);

@@ -28,6 +28,9 @@
 #include "conifit/lattice.h"
 #include "conifit/law.h"
 
+/* Most Prony terms of a reduced relaxation function. */
+#define CF_PRONY_MAX 8
+
 /* Time-dependent effects; all zero = static. */
 typedef struct cf_msm_effects {
     int inertia;               /* 1: solve the dynamics with node masses */
@@ -36,7 +39,20 @@ typedef struct cf_msm_effects {
     double maxwell_E_MPa;      /* modulus of the Maxwell branch beside every spring, MPa; 0 = off */
     double maxwell_tau_s;      /* relaxation time of the Maxwell branch, s */
     double gravity_mm_per_s2;  /* acceleration along -z, mm/s^2 (9810 on earth); 0 = off */
+    /* Quasi-linear viscoelasticity (Fung): every spring's force is its law force convolved with
+    ** the reduced relaxation function G(t) = g_inf + sum g_i exp(-t/tau_i), g_inf = 1 - sum g_i,
+    ** i.e. the law is the instantaneous response and g_inf times the law the equilibrium one.
+    ** Each term is a Maxwell branch whose force h_i obeys dh_i/dt = g_i dF/dt - h_i/tau_i,
+    ** advanced by its exact recursive update over a step along which F varies linearly in time.
+    ** The state at the first sample is relaxed (h_i = 0). Quasi-static runs only (no inertia). */
+    int prony_count;                   /* number of terms, 0 = off, at most CF_PRONY_MAX */
+    double prony_g[CF_PRONY_MAX];      /* relative moduli g_i >= 0, sum < 1, - */
+    double prony_tau_s[CF_PRONY_MAX];  /* time constants tau_i > 0, s */
 } cf_msm_effects;
+
+/* Checks the Prony terms of fx (count within 0..CF_PRONY_MAX, g_i >= 0 and finite, sum g_i < 1,
+** tau_i > 0 and finite); CF_E_DATA naming the offending term otherwise. */
+cf_status cf_msm_prony_check(const cf_msm_effects *fx, cf_error *err);
 
 typedef enum cf_msm_drive {
     CF_DRIVE_DISPLACEMENT = 0, /* the top face follows a prescribed compressive strain */

@@ -1,0 +1,120 @@
+/*
+** Fitting the time-dependent model (viscomodel.h) to a measured time series: the conical law for
+** the elastic, instantaneous response (its three identifiable quantities rho, s/H, F_C/H^2) and a
+** Prony series of N Maxwell branches on every spring (g_i >= 0, sum g_i < 1, tau_i > 0), with
+** optionally a dashpot, fitted jointly to the stress along the measured strain history.
+**
+** How it fits:
+**   A. a global search on a cheap stand-in: the static lattice curve at unit stress scale on a
+**      grid of (rho, s/H), run through the Prony recursion at the measured times for every set
+**      of N time constants from a logarithmic grid spanning the series; for fixed rho, s/H and
+**      tau the stand-in is linear in the stress scale and in the g_i, which are solved by least
+**      squares (candidates that break g_i >= 0 or sum g_i < 1 are dropped);
+**   B. Levenberg-Marquardt (GSL, finite-difference Jacobian) on the model itself (the lattice
+**      driven by the measured history, with its exact recursive Prony update), from the best
+**      starts of A, in coordinates that keep every constraint (logit for rho and s/H inside
+**      their bounds, log tau, g_i = e^a_i / (1 + sum e^a_j)); the stress scale is solved in
+**      closed form at every evaluation (the stress is proportional to it, the dashpot being
+**      taken relative to it);
+**   C. standard errors from s^2 (J^T W J)^-1 with J the central-difference Jacobian of the model
+**      in the reported quantities (rho, s/H, F_C/H^2, g_i, tau_i, eta).
+** With nbranch = 0, N = 1..4 are fitted and the lowest AIC (n ln(RSS/n) + 2k) is kept.
+** Deterministic: no random numbers. Thread-safe: no globals.
+*/
+#ifndef CF_VISCOFIT_H
+#define CF_VISCOFIT_H
+
+#include <stddef.h>
+
+#include "conifit/error.h"
+#include "conifit/fit.h"
+#include "conifit/viscomodel.h"
+
+/* Branch counts tried when the choice is left to AIC. */
+#define CF_VISCO_AIC_MAX 4
+
+typedef struct cf_visco_fit_options {
+    int nbranch;            /* 1..CF_PRONY_MAX, or 0: choose 1..CF_VISCO_AIC_MAX by AIC */
+    int dashpot;            /* 1: fit a dashpot beside the springs as well */
+    int hold_elastic;       /* 1: rho, s/H, F_C/H^2 held at elastic[] (an earlier fit) */
+    double elastic[3];      /* rho [-], s/H [-], F_C/H^2 [MPa] */
+    int relative;           /* 1: residuals relative to |stress| (floor 1e-3 max|stress|) */
+    cf_visco_setup setup;   /* where the model is evaluated */
+} cf_visco_fit_options;
+
+cf_visco_fit_options cf_visco_fit_default_options(void);
+
+/* The measured series in conifit's units: time [s], strain [-] and stress [MPa], tension
+** positive (compression negative, as in the published relaxation tables). w may be NULL. */
+typedef struct cf_visco_data {
+    size_t count;
+    const double *t_s;
+    const double *x;
+    const double *y;
+    const double *w;
+} cf_visco_data;
+
+/* Checks that the series can be fitted: at least 6 points, finite values, time strictly
+** increasing, some change of strain, and a hold (an interval of constant nonzero strain) or a
+** reversal of the strain (cycles). CF_E_DATA with a message naming the point otherwise.
+** is_hold (may be NULL; count values) receives 1 for a point that ends an interval of constant
+** strain (the hold), 0 for the others (the ramps). */
+cf_status cf_visco_data_check(const cf_visco_data *d, unsigned char *is_hold, cf_error *err);
+
+/* The predicted response of the fitted tissue to two stated loads. */
+typedef struct cf_visco_predict {
+    int hysteresis_done;       /* 1 when computed; else note says why not */
+    double cycle_strain;       /* strain amplitude of the load-unload cycle, table's sign, - */
+    double cycle_period_s;     /* its period (load and unload at the series' ramp rate), s */
+    double loop_area_MPa;      /* energy dissipated in the cycle per unit volume, MPa = MJ/m^3 */
+    double loading_work_MPa;   /* work done on loading, MPa */
+    int creep_done;            /* 1 when computed */
+    double creep_stress_MPa;   /* held stress, table's sign (the series' final stress), MPa */
+    double creep_ramp_s;       /* time to apply it, s */
+    double creep_hold_s;       /* time held, s */
+    double creep_strain_ramp;  /* strain at the end of the ramp, table's sign */
+    double creep_strain_end;   /* strain at the end of the hold, table's sign */
+    char note[CF_ERROR_MSG_LEN];
+} cf_visco_predict;
+
+typedef struct cf_visco_fit {
+    cf_visco_params p;                  /* the fitted model (stress scale in MPa, eta in MPa s) */
+    double se_ident[3];                 /* standard errors of rho, s/H, F_C/H^2; -1: not
+                                           determined (or held) */
+    double se_g[CF_PRONY_MAX];          /* standard errors of g_i, -1 when not determined */
+    double se_tau_s[CF_PRONY_MAX];      /* of tau_i, s */
+    double se_eta_MPa_s;                /* of the dashpot, MPa s (-1 without one) */
+    int dashpot;                        /* 1 when a dashpot was fitted */
+    int held_elastic;                   /* 1 when the elastic quantities were held */
+    int chosen_by_aic;                  /* 1 when N was chosen by AIC */
+    double aic_by_n[CF_VISCO_AIC_MAX];  /* AIC of N = 1..4 when chosen by AIC (MPa^2 in RSS) */
+    size_t count, n_ramp, n_hold;       /* points in all, on ramps, in holds */
+    double rss;                         /* unweighted sum of squared residuals, MPa^2 */
+    double rmse, rmse_ramp, rmse_hold;  /* MPa; rmse_ramp/hold are -1 with no such point */
+    double max_abs_error;               /* MPa */
+    double r2;                          /* coefficient of determination, - */
+    double aic;                         /* n ln(RSS/n) + 2k, RSS in MPa^2 */
+    int k;                              /* fitted parameters */
+    double E_inst_MPa;                  /* small-strain instantaneous modulus of the lattice, MPa */
+    double E_eq_MPa;                    /* small-strain equilibrium modulus, g_inf E_inst, MPa */
+    double *model_MPa;                  /* the model at every point (owned), MPa */
+    unsigned char *is_hold;             /* 1 for a point of a hold (owned) */
+    cf_visco_predict pred;
+    long evaluations;                   /* model curves computed */
+    double wall_time_s;
+} cf_visco_fit;
+
+/* Fits the series. CF_E_DATA for a series cf_visco_data_check refuses or impossible options
+** (message names them), CF_E_NOCONV when no start could be evaluated, CF_E_INTERNAL when memory
+** runs out. res->model_MPa and res->is_hold are allocated; free with cf_visco_fit_free. */
+cf_status cf_visco_fit_run(const cf_visco_data *d, const cf_visco_fit_options *o,
+                           cf_visco_fit *res, cf_error *err);
+
+void cf_visco_fit_free(cf_visco_fit *r);
+
+/* The predicted hysteresis loop and creep of a fitted model for the series d (see
+** cf_visco_predict); called by cf_visco_fit_run. */
+void cf_visco_predictions(const cf_visco_params *p, const cf_visco_setup *s,
+                          const cf_visco_data *d, cf_visco_predict *out);
+
+#endif

@@ -1,0 +1,78 @@
+/*
+** The time-dependent model that conifit fits to a measured time series: the lattice of msm.h made
+** of one conical spring (its elastic, instantaneous response) with a Prony series of Maxwell
+** branches on every spring (quasi-linear viscoelasticity) and optionally a dashpot, driven by a
+** strain history (piecewise linear in time through the measured points) and sampled at the
+** measured times. It is the same machinery `conifit simulate` runs, so a scene built from the
+** fitted parameters and the same history reproduces the fitted curve.
+**
+** The nominal stress depends on the spring only through the identifiable quantities rho = D1/D2,
+** the solid strain s/H and the stress scale F_C/H^2: at a prescribed displacement every force of
+** the lattice (law and branches) is proportional to F_C, so the equilibrium does not depend on
+** it, except through the dashpot, which the model therefore takes relative to the stress scale.
+**
+** Sign: the series is read in the table's own sign (tension positive, compression negative) and
+** the stress returned in it.
+*/
+#ifndef CF_VISCOMODEL_H
+#define CF_VISCOMODEL_H
+
+#include <stddef.h>
+
+#include "conifit/error.h"
+#include "conifit/law.h"
+#include "conifit/msm.h"
+
+/* The parameters of the time-dependent model. */
+typedef struct cf_visco_params {
+    double rho;                       /* D1/D2, - */
+    double solid_strain;              /* s/H, - */
+    double stress_scale_MPa;          /* F_C/H^2, MPa */
+    int nbranch;                      /* Prony terms, 0..CF_PRONY_MAX */
+    double g[CF_PRONY_MAX];           /* relative moduli, - */
+    double tau_s[CF_PRONY_MAX];       /* time constants, s */
+    double eta_MPa_s;                 /* dashpot beside every spring, MPa s (0 = none) */
+} cf_visco_params;
+
+/* A strain history: count points, time strictly increasing, strain in the table's sign. */
+typedef struct cf_visco_series {
+    size_t count;
+    const double *t_s;
+    const double *strain;
+} cf_visco_series;
+
+/* Where the model is evaluated: the lattice configuration and solver settings (the sizes nx, ny,
+** nz are used as given; one cell suffices under the homogeneous deformation of an unconfined
+** compression) and the law evaluator. */
+typedef struct cf_visco_setup {
+    cf_msm_config cfg;
+    cf_law_method method;
+} cf_visco_setup;
+
+/* The default setup: the lattice of cf_msm_default() reduced to one cell (the same stress under
+** uniaxial loading with free sides), quasi_substeps implicit steps per measured interval (10),
+** law evaluator CF_LAW_CLOSED. */
+cf_visco_setup cf_visco_default(void);
+
+/* A spring of free length 1 mm with the given identifiable quantities (non-telescoping, n = 2);
+** the lattice's nominal stress depends on nothing else. */
+cf_spring cf_spring_member(double rho, double solid_strain, double stress_scale_MPa);
+
+/* The effects of p (Prony terms and dashpot) as msm.h takes them. */
+cf_msm_effects cf_visco_effects(const cf_visco_params *p);
+
+/* The model's stress (MPa, table's sign) at every point of the series. CF_E_DATA for invalid
+** parameters or series (message says which), CF_E_NOCONV when a lattice solve fails (e.g. a
+** spring would pass solid), CF_E_INTERNAL when memory runs out. stats may be NULL. */
+cf_status cf_visco_curve(const cf_visco_params *p, const cf_visco_setup *s,
+                         const cf_visco_series *series, double *stress_MPa, cf_msm_stats *stats,
+                         cf_error *err);
+
+/* A run of the same model along a loading path of msm.h (compressive-positive values: strain,
+** or stress in MPa for a force drive), sampled at sample_t_s; fills out (nsamples). Used for the
+** predicted hysteresis loop and creep. */
+cf_status cf_visco_run(const cf_visco_params *p, const cf_visco_setup *s, const cf_msm_path *path,
+                       const double *sample_t_s, size_t nsamples, cf_msm_sample *out,
+                       cf_error *err);
+
+#endif

@@ -1,0 +1,320 @@
+/*
+** Report, fit file and plot of a viscoelastic fit (see viscoreport.h).
+*/
+#include "conifit/viscoreport.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <jansson.h>
+
+#include "base/atomic.h"
+#include "out/plot.h"
+
+/* A JSON number, or null for a value that is not finite (never NaN/Inf). */
+static json_t *num(double v)
+{
+    return isfinite(v) ? json_real(v) : json_null();
+}
+
+/* A standard error, null when not determined (< 0). */
+static json_t *se_num(double se, double scale)
+{
+    return se >= 0 ? num(se * scale) : json_null();
+}
+
+static double g_inf(const cf_visco_params *p)
+{
+    double g = 1;
+    for (int i = 0; i < p->nbranch; i++)
+        g -= p->g[i];
+    return g;
+}
+
+static const char *diag_name(unsigned dg)
+{
+    switch (dg & (CF_DIAG_FACE | CF_DIAG_BODY)) {
+    case CF_DIAG_FACE: return "face";
+    case CF_DIAG_BODY: return "body";
+    case CF_DIAG_FACE | CF_DIAG_BODY: return "face+body";
+    default: return "none";
+    }
+}
+
+static json_t *constraints(unsigned bits)
+{
+    json_t *a = json_array();
+    for (int k = 0; k < CF_C_COUNT; k++)
+        if (bits & (1u << k))
+            json_array_append_new(a, json_string(cf_fit_constraint_name(1u << k)));
+    return a;
+}
+
+static json_t *predictions_json(const cf_visco_report *r)
+{
+    const cf_visco_predict *p = &r->fit->pred;
+    const double u = r->y_to_file;
+    json_t *h = p->hysteresis_done
+                    ? json_pack("{s:o, s:o, s:o, s:o, s:o}", "strain_amplitude",
+                                num(p->cycle_strain), "period_s", num(p->cycle_period_s),
+                                "loop_area_kPa", num(p->loop_area_MPa * 1e3), "loading_work_kPa",
+                                num(p->loading_work_MPa * 1e3), "dissipated_fraction",
+                                num(p->loading_work_MPa > 0 ? p->loop_area_MPa / p->loading_work_MPa
+                                                             : NAN))
+                    : json_pack("{s:s}", "skipped", p->note);
+    json_t *c = p->creep_done
+                    ? json_pack("{s:o, s:s, s:o, s:o, s:o, s:o, s:o}", "stress",
+                                num(p->creep_stress_MPa * u), "stress_unit", r->y_unit, "ramp_s",
+                                num(p->creep_ramp_s), "hold_s", num(p->creep_hold_s),
+                                "strain_end_of_ramp", num(p->creep_strain_ramp), "strain_end",
+                                num(p->creep_strain_end), "creep_strain",
+                                num(p->creep_strain_end - p->creep_strain_ramp))
+                    : json_pack("{s:s}", "skipped", p->note);
+    return json_pack("{s:o, s:o}", "hysteresis", h, "creep", c);
+}
+
+/* The viscoelastic part of one fit entry (the same for every placed spring). */
+static void visco_keys(const cf_visco_report *r, json_t *o)
+{
+    const cf_visco_fit *f = r->fit;
+    const double u = r->y_to_file;
+    json_t *prony = json_array();
+    for (int i = 0; i < f->p.nbranch; i++)
+        json_array_append_new(prony,
+                              json_pack("{s:o, s:o, s:o, s:o}", "g", num(f->p.g[i]), "tau_s",
+                                        num(f->p.tau_s[i]), "stderr_g", se_num(f->se_g[i], 1),
+                                        "stderr_tau_s", se_num(f->se_tau_s[i], 1)));
+    json_object_set_new(o, "rmse", num(f->rmse * u));
+    json_object_set_new(o, "rmse_ramp", f->rmse_ramp >= 0 ? num(f->rmse_ramp * u) : json_null());
+    json_object_set_new(o, "rmse_hold", f->rmse_hold >= 0 ? num(f->rmse_hold * u) : json_null());
+    json_object_set_new(o, "points_ramp", json_integer((json_int_t)f->n_ramp));
+    json_object_set_new(o, "points_hold", json_integer((json_int_t)f->n_hold));
+    json_object_set_new(o, "max_abs_error", num(f->max_abs_error * u));
+    json_object_set_new(o, "r2", num(f->r2));
+    /* AIC with RSS in the file's unit, k = fitted parameters */
+    double aic_shift = (double)f->count * log(u * u);
+    json_object_set_new(o, "aic", num(f->aic + aic_shift));
+    json_object_set_new(o, "parameters", json_integer(f->k));
+    json_object_set_new(o, "prony", prony);
+    json_object_set_new(o, "g_inf", num(g_inf(&f->p)));
+    json_object_set_new(o, "dashpot",
+                        f->dashpot ? json_pack("{s:o, s:o}", "eta_kPa_s",
+                                               num(f->p.eta_MPa_s * 1e3), "stderr_kPa_s",
+                                               se_num(f->se_eta_MPa_s, 1e3))
+                                   : json_null());
+    json_object_set_new(o, "instantaneous_modulus_kPa", num(f->E_inst_MPa * 1e3));
+    json_object_set_new(o, "equilibrium_modulus_kPa", num(f->E_eq_MPa * 1e3));
+    json_object_set_new(o, "branch_choice", json_string(f->chosen_by_aic ? "aic" : "given"));
+    if (f->chosen_by_aic) {
+        json_t *a = json_array();
+        for (int n = 0; n < CF_VISCO_AIC_MAX; n++)
+            if (f->aic_by_n[n] != 0)
+                json_array_append_new(a, json_pack("{s:i, s:o}", "branches", n + 1, "aic",
+                                                   num(f->aic_by_n[n] + aic_shift)));
+        json_object_set_new(o, "aic_by_branches", a);
+    }
+    json_object_set_new(o, "elastic_held", json_boolean(f->held_elastic));
+    json_object_set_new(o, "predictions", predictions_json(r));
+    json_object_set_new(o, "evaluations", json_integer((json_int_t)f->evaluations));
+    json_object_set_new(o, "wall_time_s", num(r->with_timing ? f->wall_time_s : 0.0));
+}
+
+static json_t *fit_json(const cf_visco_report *r, int i)
+{
+    const cf_fit_result *f = &r->placed[i];
+    const cf_spring *p = &f->params;
+    const cf_law *L = &f->law;
+    const cf_visco_fit *v = r->fit;
+    json_t *params = json_pack("{s:o, s:o, s:o, s:o, s:o, s:o}", "D1_mm", num(p->D1_mm), "D2_mm",
+                               num(p->D2_mm), "n", num(p->n), "d_mm", num(p->d_mm), "G_MPa",
+                               num(p->G_MPa), "H_mm", num(p->H_mm));
+    json_t *derived = json_pack(
+        "{s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o}", "rho", num(L->rho), "travel_mm",
+        num(L->travel_mm), "solid_strain", num(L->travel_mm / p->H_mm), "F_T_N", num(L->F_T_N),
+        "F_C_N", num(L->F_C_N), "k0_N_per_mm", num(L->k0_N_per_mm), "u_T_mm", num(L->u_T_mm),
+        "index_c", num(L->index_c), "L_min_mm", num(L->L_min_mm), "L_max_mm", num(L->L_max_mm));
+    json_t *ident = json_pack(
+        "{s:{s:o, s:o}, s:{s:o, s:o}, s:{s:o, s:o}}", "rho", "value", num(v->p.rho), "stderr",
+        se_num(v->se_ident[0], 1), "solid_strain", "value", num(v->p.solid_strain), "stderr",
+        se_num(v->se_ident[1], 1), "stress_scale_MPa", "value", num(v->p.stress_scale_MPa),
+        "stderr", se_num(v->se_ident[2], 1));
+    json_t *o = json_pack("{s:s, s:o, s:o, s:o, s:b, s:o, s:o}", "type",
+                          cf_spring_type_name(f->type), "params", params, "derived", derived,
+                          "identifiable", ident, "feasible", f->feasible, "active_constraints",
+                          constraints(f->active), "violated_constraints",
+                          constraints(f->violated));
+    if (o)
+        visco_keys(r, o);
+    return o;
+}
+
+static json_t *series_json(const cf_visco_report *r)
+{
+    const cf_visco_data *d = r->data;
+    json_t *t = json_array(), *x = json_array(), *y = json_array(), *m = json_array();
+    for (size_t k = 0; k < d->count; k++) {
+        json_array_append_new(t, num(d->t_s[k]));
+        json_array_append_new(x, num(d->x[k]));
+        json_array_append_new(y, num(d->y[k] * r->y_to_file));
+        json_array_append_new(m, num(r->fit->model_MPa[k] * r->y_to_file));
+    }
+    return json_pack("{s:o, s:o, s:o, s:o}", "time_s", t, "strain", x, "stress", y, "model", m);
+}
+
+static json_t *report_json(const cf_visco_report *r)
+{
+    const cf_lattice_config *lc = &r->setup->cfg.lattice;
+    json_t *data = json_pack("{s:s, s:I, s:s, s:s, s:s, s:s, s:s, s:s, s:s, s:s}", "file",
+                             r->data_file, "points", (json_int_t)r->data->count, "time_column",
+                             r->t_column, "time_unit", "s", "x_column", r->x_column, "x_unit", "-",
+                             "y_column", r->y_column, "y_unit", r->y_unit, "kind", "time-series",
+                             "sign", r->compression ? "compression-negative" : "tension-positive");
+    json_t *model = json_pack(
+        "{s:s, s:s, s:{s:i, s:i, s:i, s:s, s:o, s:s}, s:s, s:i}", "elastic",
+        "conical spring law: the instantaneous response", "viscous",
+        "Prony series on every spring (quasi-linear viscoelasticity): G(t) = g_inf + sum g_i "
+        "exp(-t/tau_i)",
+        "lattice", "nx", lc->nx, "ny", lc->ny, "nz", lc->nz, "diagonals",
+        diag_name(lc->diagonals), "diagonal_weight", num(lc->diagonal_weight), "bottom",
+        lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial", "law_method",
+        cf_law_method_name(r->setup->method), "substeps", r->setup->cfg.quasi_substeps);
+    json_t *fits = json_array();
+    int better = -1;
+    for (int i = 0; i < r->nplaced; i++) {
+        json_array_append_new(fits, fit_json(r, i));
+        if (better < 0 && r->placed[i].feasible)
+            better = i;
+    }
+    if (better < 0)
+        better = 0;
+    json_t *root = json_pack("{s:s, s:o, s:o, s:o, s:s, s:o, s:s}", "conifit_version",
+                             r->version, "data", data, "model", model, "fits", fits,
+                             "better_type", cf_spring_type_name(r->placed[better].type),
+                             "series", series_json(r), "identifiability",
+                             "the model depends on the six design parameters only through rho, "
+                             "the solid strain and the stress scale; every placed spring gives "
+                             "the same stress along the series");
+    return root;
+}
+
+char *cf_visco_report_json_string(const cf_visco_report *r)
+{
+    json_t *root = report_json(r);
+    if (!root)
+        return NULL;
+    char *s = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
+    json_decref(root);
+    return s;
+}
+
+cf_status cf_visco_report_json_write(const cf_visco_report *r, const char *path,
+                                     const char *const *inputs, cf_error *err)
+{
+    char *s = cf_visco_report_json_string(r);
+    if (!s)
+        return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory building the report", path);
+    cf_atomic a;
+    cf_status st = cf_atomic_open(&a, path, inputs, err);
+    if (st == CF_OK) {
+        fputs(s, a.fp);
+        fputc('\n', a.fp);
+        st = cf_atomic_commit(&a, err);
+    }
+    free(s);
+    return st;
+}
+
+/* ---- text ------------------------------------------------------------------------------------ */
+
+static void value_se_text(FILE *o, const char *label, double v, double se, double scale,
+                          const char *unit)
+{
+    fprintf(o, "  %-30s %.6g", label, v * scale);
+    if (se >= 0)
+        fprintf(o, " ± %.2g", se * scale);
+    else
+        fprintf(o, " (± ?)");
+    fprintf(o, "%s%s\n", *unit ? " " : "", unit);
+}
+
+char *cf_visco_report_text(const cf_visco_report *r)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *o = open_memstream(&buf, &len);
+    if (!o)
+        return NULL;
+    const cf_visco_fit *f = r->fit;
+    const double u = r->y_to_file;
+    const cf_lattice_config *lc = &r->setup->cfg.lattice;
+    fprintf(o, "%s: time series of %zu points (%s [s], %s [-], %s [%s]), %s\n", r->data_file,
+            r->data->count, r->t_column, r->x_column, r->y_column, r->y_unit,
+            r->compression ? "compression negative" : "tension positive");
+    fprintf(o, " viscoelastic fit: conical law (instantaneous) + %d Prony term%s%s, in the "
+               "lattice (%dx%dx%d cells, diagonals %s), driven by the measured strain history\n",
+            f->p.nbranch, f->p.nbranch == 1 ? "" : "s", f->dashpot ? " + dashpot" : "", lc->nx,
+            lc->ny, lc->nz, diag_name(lc->diagonals));
+    if (f->chosen_by_aic) {
+        fprintf(o, " branches chosen by AIC:");
+        for (int n = 0; n < CF_VISCO_AIC_MAX; n++)
+            if (f->aic_by_n[n] != 0)
+                fprintf(o, "  N=%d: %.2f", n + 1, f->aic_by_n[n] + (double)f->count * log(u * u));
+        fputc('\n', o);
+    }
+    fprintf(o, " elastic part%s:\n", f->held_elastic ? " (held from --elastic)" : "");
+    value_se_text(o, "rho = D1/D2", f->p.rho, f->se_ident[0], 1, "");
+    value_se_text(o, "solid strain s/H", f->p.solid_strain, f->se_ident[1], 1, "");
+    value_se_text(o, "stress scale F_C/H^2", f->p.stress_scale_MPa, f->se_ident[2], u, r->y_unit);
+    fprintf(o, " Prony series, G(t) = g_inf + sum g_i exp(-t/tau_i):\n");
+    for (int i = 0; i < f->p.nbranch; i++) {
+        char l[32];
+        snprintf(l, sizeof l, "g_%d", i + 1);
+        value_se_text(o, l, f->p.g[i], f->se_g[i], 1, "");
+        snprintf(l, sizeof l, "tau_%d", i + 1);
+        value_se_text(o, l, f->p.tau_s[i], f->se_tau_s[i], 1, "s");
+    }
+    fprintf(o, "  %-30s %.6g\n", "g_inf = 1 - sum g_i", g_inf(&f->p));
+    if (f->dashpot)
+        value_se_text(o, "dashpot eta", f->p.eta_MPa_s, f->se_eta_MPa_s, 1e3, "kPa s");
+    fprintf(o, "  %-30s %.4g kPa (instantaneous), %.4g kPa (equilibrium)\n",
+            "small-strain modulus", f->E_inst_MPa * 1e3, f->E_eq_MPa * 1e3);
+    fprintf(o, " quality:\n");
+    fprintf(o, "  %-30s %.4g %s (ramp %zu points: %.4g, hold %zu points: %.4g)\n", "RMSE",
+            f->rmse * u, r->y_unit, f->n_ramp, f->rmse_ramp >= 0 ? f->rmse_ramp * u : 0.0,
+            f->n_hold, f->rmse_hold >= 0 ? f->rmse_hold * u : 0.0);
+    fprintf(o, "  %-30s %.4g %s\n", "max |error|", f->max_abs_error * u, r->y_unit);
+    fprintf(o, "  %-30s %.6f\n", "R^2", f->r2);
+    fprintf(o, "  %-30s %.2f (k = %d)\n", "AIC", f->aic + (double)f->count * log(u * u), f->k);
+    fprintf(o, " predicted:\n");
+    const cf_visco_predict *p = &f->pred;
+    if (p->hysteresis_done)
+        fprintf(o, "  %-30s %.4g kPa (kJ/m^3) in a load-unload cycle to strain %.4g in %.4g s, "
+                   "%.1f %% of the loading work\n",
+                "hysteresis loop area", p->loop_area_MPa * 1e3, p->cycle_strain,
+                p->cycle_period_s,
+                p->loading_work_MPa > 0 ? 100 * p->loop_area_MPa / p->loading_work_MPa : 0.0);
+    if (p->creep_done)
+        fprintf(o, "  %-30s strain %.4g after the %.4g s ramp to %.4g %s, %.4g after %.4g s "
+                   "held (creep %.4g)\n",
+                "creep", p->creep_strain_ramp, p->creep_ramp_s, p->creep_stress_MPa * u,
+                r->y_unit, p->creep_strain_end, p->creep_hold_s,
+                p->creep_strain_end - p->creep_strain_ramp);
+    if (p->note[0])
+        fprintf(o, "  note: %s\n", p->note);
+    fprintf(o, " one spring of the family (the model depends only on rho, s/H, F_C/H^2):\n");
+    for (int i = 0; i < r->nplaced; i++) {
+        const cf_spring *s = &r->placed[i].params;
+        fprintf(o, "  %-30s D1 %.6g mm, D2 %.6g mm, n %.6g, d %.6g mm, G %.6g MPa, H %.6g mm%s\n",
+                cf_spring_type_name(r->placed[i].type), s->D1_mm, s->D2_mm, s->n, s->d_mm,
+                s->G_MPa, s->H_mm, r->placed[i].feasible ? "" : " (infeasible)");
+    }
+    fprintf(o, "  %-30s %ld model runs, %.2f s\n", "cost", f->evaluations,
+            r->with_timing ? f->wall_time_s : 0.0);
+    if (fclose(o) != 0) {
+        free(buf);
+        return NULL;
+    }
+    return buf;
+}
