@@ -294,7 +294,7 @@ static void stretch_is_converted_to_strain(void **state)
 }
 
 static const char time_table[] =
-    "time,strain,stress_kPa\n0,0,0\n1,-0.01,-1\n2,-0.02,-2\n3,-0.03,-3\n4,-0.03,-2.5\n"
+    "time_s,strain,stress_kPa\n0,0,0\n1,-0.01,-1\n2,-0.02,-2\n3,-0.03,-3\n4,-0.03,-2.5\n"
     "5,-0.03,-2.2\n";
 
 static void columns_are_chosen_by_name_in_a_wider_table(void **state)
@@ -316,13 +316,23 @@ static void columns_are_chosen_by_name_in_a_wider_table(void **state)
     o.length_unit = NULL;
     o.stress_unit = NULL;
     cf_error err = {0};
-    const char *path = write_text(time_table);
+    const char *path = write_text("time,strain,stress_kPa\n0,0,0\n1,-0.01,-1\n2,-0.02,-2\n"
+                                  "3,-0.03,-3\n4,-0.03,-2.5\n5,-0.03,-2.2\n");
     /* time as x with a stress: time has no strain unit, but seconds are not a strain */
     assert_int_equal(cf_measure_load(path, &o, &m, &err), CF_OK);
     assert_string_equal(m.x_column, "time");
     assert_close(m.x[5], 5.0, 0.0);
     assert_null(m.t);
     cf_table_free(&m);
+    /* a time column makes a time series: it needs a unit, and time must increase */
+    const char *bare = write_text("time,strain,stress_kPa\n0,0,0\n1,-0.01,-1\n2,-0.02,-2\n"
+                                  "3,-0.03,-3\n4,-0.03,-2.5\n5,-0.03,-2.2\n");
+    assert_int_equal(cf_measure_load(bare, NULL, &m, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, ":1:1: time column 'time' has no unit"));
+    const char *back = write_text("time_s,strain,stress_kPa\n0,0,0\n1,-0.01,-1\n2,-0.02,-2\n"
+                                  "3,-0.03,-3\n2.5,-0.03,-2.5\n5,-0.03,-2.2\n");
+    assert_int_equal(cf_measure_load(back, NULL, &m, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, ":6:1: column 'time_s': time 2.5 s does not increase"));
     o.x_col = "STRAIN";
     o.y_col = "stress_kPa";
     load_ok(time_table, &o, &m);

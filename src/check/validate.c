@@ -4,6 +4,8 @@
 */
 #include "conifit/validate.h"
 
+#include "conifit/viscomodel.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -163,17 +165,6 @@ cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const 
 
 /* ---- the fit through the lattice ------------------------------------------------------------ */
 
-/* A spring of free length 1 mm with the identifiable quantities rho, e = s/H and A = F_C/H^2:
-** non-telescoping with n = 2, d = L_min/2 and D2 = L_min/(1 - rho), so that (D2 - D1)/2 = L_min/2
-** stays below n d = L_min. The lattice's nominal stress depends on nothing else. */
-static cf_spring member(double rho, double e, double A)
-{
-    const double H = 1.0, Lmin = H * (1 - e), s = H * e, n = 2.0, dw = Lmin / n;
-    const double D2 = rho < 1 ? Lmin / (1 - rho) : Lmin, D1 = rho * D2;
-    const double FC = A * H * H;
-    cf_spring p = {D1, D2, n, dw, cf_lsq_G_of_FC(FC, n, D1, dw, s), H};
-    return p;
-}
 
 typedef struct tm_ctx {
     const cf_table *d;
@@ -192,7 +183,7 @@ typedef struct tm_ctx {
 ** and the best A is a weighted linear least-squares solution. *A_out receives it. */
 static double tm_profile(tm_ctx *c, const double *z, double *A_out)
 {
-    cf_spring p = member(exp(z[0]), z[1], 1.0);
+    cf_spring p = cf_spring_member(exp(z[0]), z[1], 1.0);
     c->evals++;
     *A_out = 0;
     /* the fitter's design limits in this space: where no spring can be placed, or the scale a

@@ -23,8 +23,8 @@ cf_spring cf_spring_member(double rho, double e, double A)
     ** L_min/2 stays below n d = L_min */
     const double H = 1.0, Lmin = H * (1 - e), s = H * e, n = 2.0, dw = Lmin / n;
     const double D2 = rho < 1 ? Lmin / (1 - rho) : Lmin, D1 = rho * D2;
-    const double FC = A * H * H;
-    cf_spring p = {D1, D2, n, dw, 8 * n * D1 * D1 * D1 * FC / (dw * dw * dw * dw * s), H};
+    const double FC = A * H * H, d2 = dw * dw;
+    cf_spring p = {D1, D2, n, dw, 8 * n * D1 * D1 * D1 * FC / (d2 * d2 * s), H};
     return p;
 }
 

@@ -11,12 +11,15 @@
 #include <jansson.h>
 
 #include "base/atomic.h"
-#include "out/plot.h"
+#include "io/fitfile_json.h"
+#include "out/gnuplot.h"
 
-/* A JSON number, or null for a value that is not finite (never NaN/Inf). */
-static json_t *num(double v)
+#define num cf_json_number
+
+void cf_visco_report_free(cf_visco_report *r)
 {
-    return isfinite(v) ? json_real(v) : json_null();
+    if (r)
+        cf_visco_fit_free(&r->fit);
 }
 
 /* A standard error, null when not determined (< 0). */
@@ -33,16 +36,6 @@ static double g_inf(const cf_visco_params *p)
     return g;
 }
 
-static const char *diag_name(unsigned dg)
-{
-    switch (dg & (CF_DIAG_FACE | CF_DIAG_BODY)) {
-    case CF_DIAG_FACE: return "face";
-    case CF_DIAG_BODY: return "body";
-    case CF_DIAG_FACE | CF_DIAG_BODY: return "face+body";
-    default: return "none";
-    }
-}
-
 static json_t *constraints(unsigned bits)
 {
     json_t *a = json_array();
@@ -54,8 +47,8 @@ static json_t *constraints(unsigned bits)
 
 static json_t *predictions_json(const cf_visco_report *r)
 {
-    const cf_visco_predict *p = &r->fit->pred;
-    const double u = r->y_to_file;
+    const cf_visco_predict *p = &r->fit.pred;
+    const double u = r->table->y_to_file;
     json_t *h = p->hysteresis_done
                     ? json_pack("{s:o, s:o, s:o, s:o, s:o}", "strain_amplitude",
                                 num(p->cycle_strain), "period_s", num(p->cycle_period_s),
@@ -66,7 +59,7 @@ static json_t *predictions_json(const cf_visco_report *r)
                     : json_pack("{s:s}", "skipped", p->note);
     json_t *c = p->creep_done
                     ? json_pack("{s:o, s:s, s:o, s:o, s:o, s:o, s:o}", "stress",
-                                num(p->creep_stress_MPa * u), "stress_unit", r->y_unit, "ramp_s",
+                                num(p->creep_stress_MPa * u), "stress_unit", r->table->y_unit, "ramp_s",
                                 num(p->creep_ramp_s), "hold_s", num(p->creep_hold_s),
                                 "strain_end_of_ramp", num(p->creep_strain_ramp), "strain_end",
                                 num(p->creep_strain_end), "creep_strain",
@@ -78,8 +71,8 @@ static json_t *predictions_json(const cf_visco_report *r)
 /* The viscoelastic part of one fit entry (the same for every placed spring). */
 static void visco_keys(const cf_visco_report *r, json_t *o)
 {
-    const cf_visco_fit *f = r->fit;
-    const double u = r->y_to_file;
+    const cf_visco_fit *f = &r->fit;
+    const double u = r->table->y_to_file;
     json_t *prony = json_array();
     for (int i = 0; i < f->p.nbranch; i++)
         json_array_append_new(prony,
@@ -124,62 +117,57 @@ static void visco_keys(const cf_visco_report *r, json_t *o)
 static json_t *fit_json(const cf_visco_report *r, int i)
 {
     const cf_fit_result *f = &r->placed[i];
-    const cf_spring *p = &f->params;
-    const cf_law *L = &f->law;
-    const cf_visco_fit *v = r->fit;
-    json_t *params = json_pack("{s:o, s:o, s:o, s:o, s:o, s:o}", "D1_mm", num(p->D1_mm), "D2_mm",
-                               num(p->D2_mm), "n", num(p->n), "d_mm", num(p->d_mm), "G_MPa",
-                               num(p->G_MPa), "H_mm", num(p->H_mm));
-    json_t *derived = json_pack(
-        "{s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o}", "rho", num(L->rho), "travel_mm",
-        num(L->travel_mm), "solid_strain", num(L->travel_mm / p->H_mm), "F_T_N", num(L->F_T_N),
-        "F_C_N", num(L->F_C_N), "k0_N_per_mm", num(L->k0_N_per_mm), "u_T_mm", num(L->u_T_mm),
-        "index_c", num(L->index_c), "L_min_mm", num(L->L_min_mm), "L_max_mm", num(L->L_max_mm));
-    json_t *ident = json_pack(
-        "{s:{s:o, s:o}, s:{s:o, s:o}, s:{s:o, s:o}}", "rho", "value", num(v->p.rho), "stderr",
-        se_num(v->se_ident[0], 1), "solid_strain", "value", num(v->p.solid_strain), "stderr",
-        se_num(v->se_ident[1], 1), "stress_scale_MPa", "value", num(v->p.stress_scale_MPa),
-        "stderr", se_num(v->se_ident[2], 1));
-    json_t *o = json_pack("{s:s, s:o, s:o, s:o, s:b, s:o, s:o}", "type",
-                          cf_spring_type_name(f->type), "params", params, "derived", derived,
-                          "identifiable", ident, "feasible", f->feasible, "active_constraints",
-                          constraints(f->active), "violated_constraints",
-                          constraints(f->violated));
-    if (o)
-        visco_keys(r, o);
+    const cf_visco_fit *v = &r->fit;
+    json_t *o = cf_fitfile_spring_json(&f->law);
+    json_t *rest = json_pack(
+        "{s:{s:{s:o, s:o}, s:{s:o, s:o}, s:{s:o, s:o}}, s:b, s:o, s:o}", "identifiable", "rho",
+        "value", num(v->p.rho), "stderr", se_num(v->se_ident[0], 1), "solid_strain", "value",
+        num(v->p.solid_strain), "stderr", se_num(v->se_ident[1], 1), "stress_scale_MPa", "value",
+        num(v->p.stress_scale_MPa), "stderr", se_num(v->se_ident[2], 1), "feasible", f->feasible,
+        "active_constraints", constraints(f->active), "violated_constraints",
+        constraints(f->violated));
+    if (!o || !rest || json_object_update(o, rest) != 0) {
+        json_decref(o);
+        json_decref(rest);
+        return NULL;
+    }
+    json_decref(rest);
+    visco_keys(r, o);
     return o;
 }
 
 static json_t *series_json(const cf_visco_report *r)
 {
-    const cf_visco_data *d = r->data;
+    const cf_table *d = r->table;
     json_t *t = json_array(), *x = json_array(), *y = json_array(), *m = json_array();
     for (size_t k = 0; k < d->count; k++) {
-        json_array_append_new(t, num(d->t_s[k]));
+        json_array_append_new(t, num(d->t[k]));
         json_array_append_new(x, num(d->x[k]));
-        json_array_append_new(y, num(d->y[k] * r->y_to_file));
-        json_array_append_new(m, num(r->fit->model_MPa[k] * r->y_to_file));
+        json_array_append_new(y, num(d->y[k] * d->y_to_file));
+        json_array_append_new(m, num(r->fit.model_MPa[k] * d->y_to_file));
     }
     return json_pack("{s:o, s:o, s:o, s:o}", "time_s", t, "strain", x, "stress", y, "model", m);
 }
 
 static json_t *report_json(const cf_visco_report *r)
 {
-    const cf_lattice_config *lc = &r->setup->cfg.lattice;
-    json_t *data = json_pack("{s:s, s:I, s:s, s:s, s:s, s:s, s:s, s:s, s:s, s:s}", "file",
-                             r->data_file, "points", (json_int_t)r->data->count, "time_column",
-                             r->t_column, "time_unit", "s", "x_column", r->x_column, "x_unit", "-",
-                             "y_column", r->y_column, "y_unit", r->y_unit, "kind", "time-series",
-                             "sign", r->compression ? "compression-negative" : "tension-positive");
+    const cf_lattice_config *lc = &r->setup.cfg.lattice;
+    const cf_table *tb = r->table;
+    json_t *data = json_pack("{s:s, s:I, s:s, s:s, s:s, s:s, s:s, s:s}", "file", tb->path,
+                             "points", (json_int_t)tb->count, "x_column", tb->x_column, "x_unit",
+                             "-", "y_column", tb->y_column, "y_unit", tb->y_unit, "kind",
+                             "time-series", "sign",
+                             tb->compression ? "compression-negative" : "tension-positive");
     json_t *model = json_pack(
-        "{s:s, s:s, s:{s:i, s:i, s:i, s:s, s:o, s:s}, s:s, s:i}", "elastic",
+        "{s:s, s:s, s:{s:i, s:i, s:i, s:s, s:{s:o, s:o, s:o}, s:s}, s:s, s:i}", "elastic",
         "conical spring law: the instantaneous response", "viscous",
         "Prony series on every spring (quasi-linear viscoelasticity): G(t) = g_inf + sum g_i "
         "exp(-t/tau_i)",
-        "lattice", "nx", lc->nx, "ny", lc->ny, "nz", lc->nz, "diagonals",
-        diag_name(lc->diagonals), "diagonal_weight", num(lc->diagonal_weight), "bottom",
-        lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial", "law_method",
-        cf_law_method_name(r->setup->method), "substeps", r->setup->cfg.quasi_substeps);
+        "lattice", "nx", lc->nx, "ny", lc->ny, "nz", lc->nz, "calibration",
+        cf_calibration_name(lc->calibration), "weights", "edge", num(lc->weight[CF_FAMILY_EDGE]),
+        "face", num(lc->weight[CF_FAMILY_FACE]), "body", num(lc->weight[CF_FAMILY_BODY]),
+        "bottom", lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial", "law_method",
+        cf_law_method_name(r->setup.method), "substeps", r->setup.cfg.quasi_substeps);
     json_t *fits = json_array();
     int better = -1;
     for (int i = 0; i < r->nplaced; i++) {
@@ -189,14 +177,13 @@ static json_t *report_json(const cf_visco_report *r)
     }
     if (better < 0)
         better = 0;
-    json_t *root = json_pack("{s:s, s:o, s:o, s:o, s:s, s:o, s:s}", "conifit_version",
-                             r->version, "data", data, "model", model, "fits", fits,
-                             "better_type", cf_spring_type_name(r->placed[better].type),
-                             "series", series_json(r), "identifiability",
-                             "the model depends on the six design parameters only through rho, "
-                             "the solid strain and the stress scale; every placed spring gives "
-                             "the same stress along the series");
-    return root;
+    return json_pack("{s:s, s:o, s:o, s:o, s:s, s:o, s:s}", "conifit_version", r->version,
+                     "data", data, "model", model, "fits", fits, "better_type",
+                     cf_spring_type_name(r->placed[better].type), "series", series_json(r),
+                     "identifiability",
+                     "the model depends on the six design parameters only through rho, the "
+                     "solid strain and the stress scale; every placed spring gives the same "
+                     "stress along the series");
 }
 
 char *cf_visco_report_json_string(const cf_visco_report *r)
@@ -204,25 +191,20 @@ char *cf_visco_report_json_string(const cf_visco_report *r)
     json_t *root = report_json(r);
     if (!root)
         return NULL;
-    char *s = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
+    char *s = cf_fitfile_dumps(root);
     json_decref(root);
     return s;
 }
 
-cf_status cf_visco_report_json_write(const cf_visco_report *r, const char *path,
-                                     const char *const *inputs, cf_error *err)
+cf_status cf_visco_report_json_prepare(const cf_visco_report *r, const char *path,
+                                       const char *const *inputs, struct cf_atomic *out,
+                                       cf_error *err)
 {
-    char *s = cf_visco_report_json_string(r);
-    if (!s)
+    json_t *root = report_json(r);
+    if (!root)
         return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory building the report", path);
-    cf_atomic a;
-    cf_status st = cf_atomic_open(&a, path, inputs, err);
-    if (st == CF_OK) {
-        fputs(s, a.fp);
-        fputc('\n', a.fp);
-        st = cf_atomic_commit(&a, err);
-    }
-    free(s);
+    cf_status st = cf_fitfile_prepare(root, path, inputs, out, err);
+    json_decref(root);
     return st;
 }
 
@@ -246,16 +228,16 @@ char *cf_visco_report_text(const cf_visco_report *r)
     FILE *o = open_memstream(&buf, &len);
     if (!o)
         return NULL;
-    const cf_visco_fit *f = r->fit;
-    const double u = r->y_to_file;
-    const cf_lattice_config *lc = &r->setup->cfg.lattice;
-    fprintf(o, "%s: time series of %zu points (%s [s], %s [-], %s [%s]), %s\n", r->data_file,
-            r->data->count, r->t_column, r->x_column, r->y_column, r->y_unit,
-            r->compression ? "compression negative" : "tension positive");
+    const cf_visco_fit *f = &r->fit;
+    const double u = r->table->y_to_file;
+    const cf_lattice_config *lc = &r->setup.cfg.lattice;
+    fprintf(o, "%s: time series of %zu points (%s [s], %s [-], %s [%s]), %s\n", r->table->path,
+            r->table->count, "time", r->table->x_column, r->table->y_column, r->table->y_unit,
+            r->table->compression ? "compression negative" : "tension positive");
     fprintf(o, " viscoelastic fit: conical law (instantaneous) + %d Prony term%s%s, in the "
-               "lattice (%dx%dx%d cells, diagonals %s), driven by the measured strain history\n",
+               "lattice (%dx%dx%d cells, calibration %s), driven by the measured strain history\n",
             f->p.nbranch, f->p.nbranch == 1 ? "" : "s", f->dashpot ? " + dashpot" : "", lc->nx,
-            lc->ny, lc->nz, diag_name(lc->diagonals));
+            lc->ny, lc->nz, cf_calibration_name(lc->calibration));
     if (f->chosen_by_aic) {
         fprintf(o, " branches chosen by AIC:");
         for (int n = 0; n < CF_VISCO_AIC_MAX; n++)
@@ -266,7 +248,7 @@ char *cf_visco_report_text(const cf_visco_report *r)
     fprintf(o, " elastic part%s:\n", f->held_elastic ? " (held from --elastic)" : "");
     value_se_text(o, "rho = D1/D2", f->p.rho, f->se_ident[0], 1, "");
     value_se_text(o, "solid strain s/H", f->p.solid_strain, f->se_ident[1], 1, "");
-    value_se_text(o, "stress scale F_C/H^2", f->p.stress_scale_MPa, f->se_ident[2], u, r->y_unit);
+    value_se_text(o, "stress scale F_C/H^2", f->p.stress_scale_MPa, f->se_ident[2], u, r->table->y_unit);
     fprintf(o, " Prony series, G(t) = g_inf + sum g_i exp(-t/tau_i):\n");
     for (int i = 0; i < f->p.nbranch; i++) {
         char l[32];
@@ -282,9 +264,9 @@ char *cf_visco_report_text(const cf_visco_report *r)
             "small-strain modulus", f->E_inst_MPa * 1e3, f->E_eq_MPa * 1e3);
     fprintf(o, " quality:\n");
     fprintf(o, "  %-30s %.4g %s (ramp %zu points: %.4g, hold %zu points: %.4g)\n", "RMSE",
-            f->rmse * u, r->y_unit, f->n_ramp, f->rmse_ramp >= 0 ? f->rmse_ramp * u : 0.0,
+            f->rmse * u, r->table->y_unit, f->n_ramp, f->rmse_ramp >= 0 ? f->rmse_ramp * u : 0.0,
             f->n_hold, f->rmse_hold >= 0 ? f->rmse_hold * u : 0.0);
-    fprintf(o, "  %-30s %.4g %s\n", "max |error|", f->max_abs_error * u, r->y_unit);
+    fprintf(o, "  %-30s %.4g %s\n", "max |error|", f->max_abs_error * u, r->table->y_unit);
     fprintf(o, "  %-30s %.6f\n", "R^2", f->r2);
     fprintf(o, "  %-30s %.2f (k = %d)\n", "AIC", f->aic + (double)f->count * log(u * u), f->k);
     fprintf(o, " predicted:\n");
@@ -299,7 +281,7 @@ char *cf_visco_report_text(const cf_visco_report *r)
         fprintf(o, "  %-30s strain %.4g after the %.4g s ramp to %.4g %s, %.4g after %.4g s "
                    "held (creep %.4g)\n",
                 "creep", p->creep_strain_ramp, p->creep_ramp_s, p->creep_stress_MPa * u,
-                r->y_unit, p->creep_strain_end, p->creep_hold_s,
+                r->table->y_unit, p->creep_strain_end, p->creep_hold_s,
                 p->creep_strain_end - p->creep_strain_ramp);
     if (p->note[0])
         fprintf(o, "  note: %s\n", p->note);
@@ -317,4 +299,66 @@ char *cf_visco_report_text(const cf_visco_report *r)
         return NULL;
     }
     return buf;
+}
+
+/* ---- plot ------------------------------------------------------------------------------------ */
+
+/* Left: stress against time (measured points, model line) over the residuals; right: stress
+** against strain (the loop of the series and the model's). */
+static void visco_script(cf_gp *g, const cf_visco_report *r)
+{
+    const cf_table *d = r->table;
+    const double u = r->table->y_to_file;
+    cf_gp_block_begin(g, "DATA");
+    for (size_t k = 0; k < d->count; k++) {
+        double row[5] = {d->t[k], d->x[k], d->y[k] * u, r->fit.model_MPa[k] * u,
+                         (r->fit.model_MPa[k] - d->y[k]) * u};
+        cf_gp_block_row(g, 5, row);
+    }
+    cf_gp_block_end(g);
+    char yl[96];
+    snprintf(yl, sizeof yl, "%s [%s]", r->table->y_column, r->table->y_unit);
+    char fl[160];
+    snprintf(fl, sizeof fl, "model: %d Prony term%s%s, RMSE %.3g %s", r->fit.p.nbranch,
+             r->fit.p.nbranch == 1 ? "" : "s", r->fit.dashpot ? " + dashpot" : "",
+             r->fit.rmse * u, r->table->y_unit);
+    cf_gp_cmd(g, "set multiplot title %q noenhanced", r->table->path);
+    cf_gp_cmd(g, "set grid");
+    cf_gp_cmd(g, "set key bottom right box opaque noenhanced");
+    cf_gp_cmd(g, "set size 0.55,0.62");
+    cf_gp_cmd(g, "set origin 0,0.33");
+    cf_gp_cmd(g, "set xlabel %q", "time [s]");
+    cf_gp_cmd(g, "set ylabel %q noenhanced", yl);
+    cf_gp_cmd(g, "plot $DATA using 1:3 with points pt 7 ps 0.7 lc rgb %q title %q, $DATA using "
+                 "1:4 with lines lw 2 lc rgb %q title %q",
+              "black", "measured", "#d62728", fl);
+    cf_gp_cmd(g, "set size 0.55,0.33");
+    cf_gp_cmd(g, "set origin 0,0");
+    cf_gp_cmd(g, "set key off");
+    cf_gp_cmd(g, "set ylabel %q noenhanced", "residual");
+    cf_gp_cmd(g, "plot 0 with lines lc rgb %q notitle, $DATA using 1:5 with linespoints pt 7 ps "
+                 "0.5 lc rgb %q notitle",
+              "black", "#d62728");
+    cf_gp_cmd(g, "set size 0.45,0.95");
+    cf_gp_cmd(g, "set origin 0.55,0");
+    cf_gp_cmd(g, "set key top left box opaque noenhanced");
+    cf_gp_cmd(g, "set xlabel %q", "strain [-]");
+    cf_gp_cmd(g, "set ylabel %q noenhanced", yl);
+    cf_gp_cmd(g, "plot $DATA using 2:3 with points pt 7 ps 0.7 lc rgb %q title %q, $DATA using "
+                 "2:4 with lines lw 2 lc rgb %q title %q",
+              "black", "measured", "#d62728", "model");
+    cf_gp_cmd(g, "unset multiplot");
+}
+
+cf_status cf_visco_plot(const cf_visco_report *r, const char *path, const char *const *inputs,
+                        struct cf_atomic *out, cf_error *err)
+{
+    cf_gp g;
+    memset(out, 0, sizeof *out);
+    cf_gp_init(&g);
+    cf_gp_terminal(&g, path, 1300, 700);
+    visco_script(&g, r);
+    cf_status st = cf_gp_render(&g, path, inputs, out, err);
+    cf_gp_free(&g);
+    return st;
 }

@@ -11,21 +11,21 @@
 
 #include "conifit/error.h"
 #include "conifit/fit.h"
+#include "conifit/measure.h"
 #include "conifit/viscofit.h"
 
 typedef struct cf_visco_report {
     const char *version;       /* conifit version */
-    const char *data_file;     /* the table as named by the user */
-    const char *t_column, *x_column, *y_column, *y_unit; /* header names, the file's stress unit */
-    double y_to_file;          /* multiply MPa by this for the file's unit */
-    int compression;           /* 1: the table is compression-negative */
-    const cf_visco_data *data; /* the series (conifit's units) */
-    const cf_visco_fit *fit;   /* the fit */
-    const cf_visco_setup *setup; /* where it was evaluated */
+    const cf_table *table;     /* the series (t not NULL; must outlive the report) */
+    cf_visco_setup setup;      /* where the model was evaluated */
+    cf_visco_fit fit;          /* the fit (owned: cf_visco_report_free) */
     int nplaced;               /* design springs placed from the identifiable quantities (1-2) */
     cf_fit_result placed[2];
     int with_timing;           /* 0: wall_time_s written as 0 (reproducible files) */
 } cf_visco_report;
+
+/* Releases what the report owns. Safe on a zeroed report. */
+void cf_visco_report_free(cf_visco_report *r);
 
 /* The readable report (malloc'd; NULL when memory runs out). */
 char *cf_visco_report_text(const cf_visco_report *r);
@@ -33,14 +33,17 @@ char *cf_visco_report_text(const cf_visco_report *r);
 /* The JSON fit file as a string (malloc'd; NULL when memory runs out). */
 char *cf_visco_report_json_string(const cf_visco_report *r);
 
-/* Writes the JSON atomically to path; inputs (NULL-terminated, may be NULL) are refused as
-** targets. CF_E_CANTWRITE on failure (nothing left behind). */
-cf_status cf_visco_report_json_write(const cf_visco_report *r, const char *path,
-                                     const char *const *inputs, cf_error *err);
+/* Writes the JSON to a temporary file beside path, complete but not in place (the caller commits
+** or aborts *out); inputs (NULL-terminated, may be NULL) are refused as targets. */
+struct cf_atomic;
+cf_status cf_visco_report_json_prepare(const cf_visco_report *r, const char *path,
+                                       const char *const *inputs, struct cf_atomic *out,
+                                       cf_error *err);
 
 /* Draws stress against time (data, model, residuals underneath) beside stress against strain,
-** with gnuplot, to a .png or .svg (errors as cf_plot_write). */
-cf_status cf_visco_plot_write(const cf_visco_report *r, const char *path,
-                              const char *const *inputs, cf_error *err);
+** with gnuplot, to a temporary .png or .svg beside path (as cf_plot_fit: the caller commits or
+** aborts *out). */
+cf_status cf_visco_plot(const cf_visco_report *r, const char *path, const char *const *inputs,
+                        struct cf_atomic *out, cf_error *err);
 
 #endif

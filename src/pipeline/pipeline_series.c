@@ -1,0 +1,67 @@
+/*
+** The pipeline of a time series (see pipeline_series.h).
+*/
+#include "conifit/pipeline_series.h"
+
+#include <string.h>
+
+#include "base/atomic.h"
+#include "conifit/version.h"
+
+cf_status cf_pipeline_fit_series(const cf_table *t, const cf_pipeline_options *opt,
+                                 const cf_visco_fit_options *vo, cf_visco_report *r,
+                                 cf_error *err)
+{
+    memset(r, 0, sizeof *r);
+    r->version = CF_VERSION;
+    r->table = t;
+    r->setup = vo->setup;
+    r->with_timing = opt->with_timing;
+    if (!t->t)
+        return cf_error_set(err, CF_E_DATA, "%s: not a time series (no time column)", t->path);
+    if (opt->progress)
+        opt->progress(opt->progress_ctx, t->path, "fitting the viscoelastic model along the series");
+    cf_visco_data d = {t->count, t->t, t->x, t->y, t->w};
+    cf_error e = {0};
+    cf_status st = cf_visco_fit_run(&d, vo, &r->fit, &e);
+    if (st != CF_OK)
+        return cf_error_set(err, st, "%s: %s", t->path, e.msg);
+    /* one spring of each type from the identifiable quantities, placed as the elastic fit does */
+    const double ident[3] = {r->fit.p.rho, r->fit.p.solid_strain, r->fit.p.stress_scale_MPa};
+    for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING; ty++) {
+        cf_error pe = {0};
+        if ((opt->types & (1u << ty)) &&
+            cf_fit_place(t, &opt->fit, (cf_spring_type)ty, ident, &r->placed[r->nplaced], &pe) ==
+                CF_OK)
+            r->nplaced++;
+    }
+    if (r->nplaced == 0) {
+        cf_visco_report_free(r);
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: no spring of the requested type has rho = %.6g, s/H = %.6g",
+                            t->path, ident[0], ident[1]);
+    }
+    return CF_OK;
+}
+
+cf_status cf_pipeline_series_prepare(const cf_visco_report *r, const char *json_path,
+                                     const char *plot_path, const char *const *inputs,
+                                     struct cf_atomic *json_out, struct cf_atomic *plot_out,
+                                     cf_error *err)
+{
+    memset(json_out, 0, sizeof *json_out);
+    memset(plot_out, 0, sizeof *plot_out);
+    cf_status st = CF_OK;
+    if (json_path)
+        st = cf_visco_report_json_prepare(r, json_path, inputs, json_out, err);
+    if (st == CF_OK && plot_path) {
+        st = cf_visco_plot(r, plot_path, inputs, plot_out, err);
+        if (st == CF_OK)
+            st = cf_atomic_finish(plot_out, err);
+    }
+    if (st != CF_OK) {
+        cf_atomic_abort(json_out);
+        cf_atomic_abort(plot_out);
+    }
+    return st;
+}

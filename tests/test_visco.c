@@ -1,0 +1,339 @@
+/*
+** Time-dependent tissue: Prony branches in the lattice (exact relaxation during a hold, no effect
+** when switched off, constraints), the model along a measured history (one cell = 27 cells under
+** uniaxial loading), the fit (recovery of known terms without and with noise, refusal of series
+** that cannot be fitted) and the command line on time series.
+*/
+#include "testutil.h"
+
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_rng.h>
+
+#include "conifit/msm.h"
+#include "conifit/viscofit.h"
+#include "conifit/viscomodel.h"
+
+/* A ramp to compressive strain 0.3 (table's sign: -0.3) in 30 s, then held to 330 s: 16 ramp
+** points, 20 hold points spaced geometrically (the protocol of the published muscle tables). */
+#define NS 36
+static void ramp_hold(double *t, double *x)
+{
+    for (int k = 0; k <= 15; k++) {
+        t[k] = 2.0 * k;
+        x[k] = -0.3 * t[k] / 30.0;
+    }
+    for (int k = 16; k < NS; k++) {
+        t[k] = 30 + 300 * pow((double)(k - 15) / (NS - 16), 2);
+        x[k] = -0.3;
+    }
+}
+
+static cf_visco_params known(void)
+{
+    cf_visco_params p;
+    memset(&p, 0, sizeof p);
+    p.rho = 0.3;
+    p.solid_strain = 0.5;
+    p.stress_scale_MPa = 0.01;
+    p.nbranch = 2;
+    p.g[0] = 0.35;
+    p.tau_s[0] = 3;
+    p.g[1] = 0.2;
+    p.tau_s[1] = 40;
+    return p;
+}
+
+/* During a hold the law force is constant, so every branch decays exactly as exp(-t/tau): in a
+** lattice of axial springs alone sigma(t) - g_inf sigma_e = (sigma(t_r) - g_inf sigma_e)
+** exp(-(t - t_r)/tau), to rounding. */
+static void test_hold_relaxes_exactly(void **state)
+{
+    (void)state;
+    cf_visco_params p = known();
+    p.nbranch = 1;
+    cf_visco_setup s = cf_visco_default();
+    s.cfg.lattice.weight[CF_FAMILY_EDGE] = 1; /* axial springs alone: the lattice is one spring */
+    s.cfg.lattice.weight[CF_FAMILY_FACE] = s.cfg.lattice.weight[CF_FAMILY_BODY] = 0;
+    double pt[3] = {0, 10, 100}, pv[3] = {0, 0.2, 0.2};
+    cf_msm_path path = {CF_DRIVE_DISPLACEMENT, 3, pt, pv};
+    double ts[5] = {0, 10, 20, 40, 100};
+    cf_msm_sample out[5];
+    cf_error err = {0};
+    assert_int_equal(cf_visco_run(&p, &s, &path, ts, 5, out, &err), CF_OK);
+    cf_spring sp = cf_spring_member(p.rho, p.solid_strain, p.stress_scale_MPa);
+    cf_law law;
+    assert_int_equal(cf_law_init(&law, &sp, &err), CF_OK);
+    double se = cf_law_force(&law, CF_LAW_EXACT, 0.2 * sp.H_mm, NULL, NULL) / (sp.H_mm * sp.H_mm);
+    double eq = (1 - p.g[0]) * se;
+    double d0 = out[1].stress_MPa - eq;
+    assert_true(d0 > 0.01 * se); /* the ramp left the branch loaded */
+    for (int k = 2; k < 5; k++)
+        assert_close((out[k].stress_MPa - eq) / d0, exp(-(ts[k] - 10) / p.tau_s[0]), 1e-9);
+    assert_close(out[0].stress_MPa, 0, 1e-15);
+}
+
+/* Prony terms with g = 0 change nothing: the run is the static curve. */
+static void test_zero_branches_are_elastic(void **state)
+{
+    (void)state;
+    cf_visco_params p = known();
+    p.g[0] = p.g[1] = 0;
+    cf_visco_setup s = cf_visco_default();
+    double t[NS], x[NS], y[NS], ys[NS];
+    ramp_hold(t, x);
+    cf_visco_series ser = {NS, t, x};
+    cf_error err = {0};
+    assert_int_equal(cf_visco_curve(&p, &s, &ser, y, NULL, &err), CF_OK);
+    cf_spring sp = cf_spring_member(p.rho, p.solid_strain, p.stress_scale_MPa);
+    cf_law law;
+    assert_int_equal(cf_law_init(&law, &sp, &err), CF_OK);
+    assert_int_equal(cf_msm_uniaxial(&law, s.method, &s.cfg, x, NS, ys, NULL, &err), CF_OK);
+    for (int k = 0; k < NS; k++)
+        assert_close(y[k], ys[k], 1e-10 * fabs(ys[NS - 1]));
+}
+
+static void test_prony_constraints(void **state)
+{
+    (void)state;
+    cf_msm_effects fx;
+    memset(&fx, 0, sizeof fx);
+    cf_error err = {0};
+    fx.prony_count = 2;
+    fx.prony_g[0] = 0.6;
+    fx.prony_g[1] = 0.4;
+    fx.prony_tau_s[0] = fx.prony_tau_s[1] = 1;
+    assert_int_equal(cf_msm_prony_check(&fx, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "below 1"));
+    fx.prony_g[1] = -0.1;
+    assert_int_equal(cf_msm_prony_check(&fx, &err), CF_E_DATA);
+    fx.prony_g[1] = 0.1;
+    fx.prony_tau_s[1] = 0;
+    assert_int_equal(cf_msm_prony_check(&fx, &err), CF_E_DATA);
+    fx.prony_tau_s[1] = 2;
+    assert_int_equal(cf_msm_prony_check(&fx, &err), CF_OK);
+    fx.prony_count = CF_PRONY_MAX + 1;
+    assert_int_equal(cf_msm_prony_check(&fx, &err), CF_E_DATA);
+}
+
+/* Uniaxial loading with free sides deforms the lattice homogeneously, so one cell gives the
+** stress of 27 along the whole history. */
+static void test_one_cell_is_the_block(void **state)
+{
+    (void)state;
+    cf_visco_params p = known();
+    cf_visco_setup s1 = cf_visco_default(), s3 = s1;
+    s3.cfg.lattice.nx = s3.cfg.lattice.ny = s3.cfg.lattice.nz = 3;
+    double t[NS], x[NS], y1[NS], y3[NS];
+    ramp_hold(t, x);
+    cf_visco_series ser = {NS, t, x};
+    cf_error err = {0};
+    assert_int_equal(cf_visco_curve(&p, &s1, &ser, y1, NULL, &err), CF_OK);
+    assert_int_equal(cf_visco_curve(&p, &s3, &ser, y3, NULL, &err), CF_OK);
+    for (int k = 0; k < NS; k++)
+        assert_close(y1[k], y3[k], 1e-8 * fabs(y3[15]));
+}
+
+static void assert_recovered(const cf_visco_fit *f, const cf_visco_params *p, double tol)
+{
+    assert_close(f->p.rho, p->rho, tol * p->rho);
+    assert_close(f->p.solid_strain, p->solid_strain, tol * p->solid_strain);
+    assert_close(f->p.stress_scale_MPa, p->stress_scale_MPa, tol * p->stress_scale_MPa);
+    assert_int_equal(f->p.nbranch, p->nbranch);
+    /* the fit may list the terms in another order: match by time constant */
+    for (int i = 0; i < p->nbranch; i++) {
+        int j = 0;
+        for (int k = 1; k < f->p.nbranch; k++)
+            if (fabs(log(f->p.tau_s[k] / p->tau_s[i])) < fabs(log(f->p.tau_s[j] / p->tau_s[i])))
+                j = k;
+        assert_close(f->p.g[j], p->g[i], tol * p->g[i]);
+        assert_close(f->p.tau_s[j], p->tau_s[i], tol * p->tau_s[i]);
+    }
+}
+
+/* A series made by the model from known terms is fitted back to 1e-6. */
+static void test_recover_noiseless(void **state)
+{
+    (void)state;
+    cf_visco_params p = known();
+    cf_visco_fit_options o = cf_visco_fit_default_options();
+    double t[NS], x[NS], y[NS];
+    ramp_hold(t, x);
+    cf_visco_series ser = {NS, t, x};
+    cf_error err = {0};
+    assert_int_equal(cf_visco_curve(&p, &o.setup, &ser, y, NULL, &err), CF_OK);
+    o.nbranch = 2;
+    cf_visco_data d = {NS, t, x, y, NULL};
+    cf_visco_fit f;
+    assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_OK);
+    assert_recovered(&f, &p, 1e-6);
+    assert_true(f.rmse < 1e-9 * p.stress_scale_MPa);
+    assert_int_equal(f.n_ramp, 16);
+    assert_int_equal(f.n_hold, NS - 16);
+    cf_visco_fit_free(&f);
+}
+
+/* With 0.5 % noise the terms are found within twice their reported standard errors. */
+static void test_recover_with_noise(void **state)
+{
+    (void)state;
+    cf_visco_params p = known();
+    cf_visco_fit_options o = cf_visco_fit_default_options();
+    double t[NS], x[NS], y[NS];
+    ramp_hold(t, x);
+    cf_visco_series ser = {NS, t, x};
+    cf_error err = {0};
+    assert_int_equal(cf_visco_curve(&p, &o.setup, &ser, y, NULL, &err), CF_OK);
+    double ymax = 0;
+    for (int k = 0; k < NS; k++)
+        ymax = fmax(ymax, fabs(y[k]));
+    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(r, 1);
+    for (int k = 1; k < NS; k++)
+        y[k] += gsl_ran_gaussian(r, 0.005 * ymax);
+    gsl_rng_free(r);
+    o.nbranch = 2;
+    cf_visco_data d = {NS, t, x, y, NULL};
+    cf_visco_fit f;
+    assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_OK);
+    for (int i = 0; i < 3; i++)
+        assert_true(f.se_ident[i] > 0);
+    assert_close(f.p.rho, p.rho, 2 * f.se_ident[0]);
+    assert_close(f.p.solid_strain, p.solid_strain, 2 * f.se_ident[1]);
+    assert_close(f.p.stress_scale_MPa, p.stress_scale_MPa, 2 * f.se_ident[2]);
+    for (int i = 0; i < 2; i++) {
+        int j = fabs(log(f.p.tau_s[0] / p.tau_s[i])) < fabs(log(f.p.tau_s[1] / p.tau_s[i])) ? 0 : 1;
+        assert_true(f.se_g[j] > 0 && f.se_tau_s[j] > 0);
+        assert_close(f.p.g[j], p.g[i], 2 * f.se_g[j]);
+        assert_close(f.p.tau_s[j], p.tau_s[i], 2 * f.se_tau_s[j]);
+    }
+    cf_visco_fit_free(&f);
+}
+
+static void test_series_refused(void **state)
+{
+    (void)state;
+    double t[NS], x[NS], y[NS];
+    ramp_hold(t, x);
+    for (int k = 0; k < NS; k++)
+        y[k] = x[k];
+    unsigned char hold[NS];
+    cf_error err = {0};
+    cf_visco_data d = {NS, t, x, y, NULL};
+    assert_int_equal(cf_visco_data_check(&d, hold, &err), CF_OK);
+    assert_int_equal(hold[15], 0);
+    assert_int_equal(hold[16], 1);
+    /* a single ramp: no hold, no reversal */
+    double xr[NS];
+    for (int k = 0; k < NS; k++)
+        xr[k] = -0.001 * k;
+    cf_visco_data dr = {NS, t, xr, y, NULL};
+    assert_int_equal(cf_visco_data_check(&dr, NULL, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "hold"));
+    /* no change of strain */
+    double x0[NS] = {0};
+    cf_visco_data d0 = {NS, t, x0, y, NULL};
+    assert_int_equal(cf_visco_data_check(&d0, NULL, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "never changes"));
+    /* time going backwards */
+    double tb[NS];
+    memcpy(tb, t, sizeof tb);
+    tb[20] = tb[19];
+    cf_visco_data db = {NS, tb, x, y, NULL};
+    assert_int_equal(cf_visco_data_check(&db, NULL, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "point 21"));
+    /* a held elastic fit whose solid strain is below the series' strain */
+    cf_visco_fit_options o = cf_visco_fit_default_options();
+    o.hold_elastic = 1;
+    o.elastic[0] = 0.3;
+    o.elastic[1] = 0.2;
+    o.elastic[2] = 0.01;
+    cf_visco_fit f;
+    assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_E_DATA);
+    assert_null(f.model_MPa);
+}
+
+/* Holding the elastic part recovers the Prony terms alone. */
+static void test_held_elastic(void **state)
+{
+    (void)state;
+    cf_visco_params p = known();
+    p.nbranch = 1;
+    cf_visco_fit_options o = cf_visco_fit_default_options();
+    double t[NS], x[NS], y[NS];
+    ramp_hold(t, x);
+    cf_visco_series ser = {NS, t, x};
+    cf_error err = {0};
+    assert_int_equal(cf_visco_curve(&p, &o.setup, &ser, y, NULL, &err), CF_OK);
+    o.nbranch = 1;
+    o.hold_elastic = 1;
+    o.elastic[0] = p.rho;
+    o.elastic[1] = p.solid_strain;
+    o.elastic[2] = p.stress_scale_MPa;
+    cf_visco_data d = {NS, t, x, y, NULL};
+    cf_visco_fit f;
+    assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_OK);
+    assert_int_equal(f.held_elastic, 1);
+    assert_int_equal(f.k, 2);
+    assert_true(f.p.rho == p.rho && f.p.stress_scale_MPa == p.stress_scale_MPa);
+    assert_close(f.p.g[0], p.g[0], 1e-6 * p.g[0]);
+    assert_close(f.p.tau_s[0], p.tau_s[0], 1e-6 * p.tau_s[0]);
+    assert_close(f.se_ident[0], -1, 0);
+    cf_visco_fit_free(&f);
+}
+
+/* The command line: a time series with a bad branch count or a time that goes back exits 65 and
+** writes nothing; --validate does not apply to a series. */
+static void test_cli_series_errors(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-visco-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char path[256], bad[256], out[256];
+    snprintf(path, sizeof path, "%s/series.csv", dir);
+    snprintf(bad, sizeof bad, "%s/back.csv", dir);
+    snprintf(out, sizeof out, "%s/fit.json", dir);
+    FILE *f = fopen(path, "w"), *g = fopen(bad, "w");
+    assert_true(f && g);
+    double t[NS], x[NS];
+    ramp_hold(t, x);
+    fprintf(f, "time_s,strain,stress_kPa\n");
+    fprintf(g, "time_s,strain,stress_kPa\n");
+    for (int k = 0; k < NS; k++) {
+        fprintf(f, "%.17g,%.17g,%.17g\n", t[k], x[k], 10 * x[k]);
+        fprintf(g, "%.17g,%.17g,%.17g\n", k == 20 ? t[18] : t[k], x[k], 10 * x[k]);
+    }
+    fclose(f);
+    fclose(g);
+    char so[4096], se[4096];
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "fit %s --branches 9 -o %s", path, out),
+                     65);
+    assert_non_null(strstr(se, "--branches"));
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "fit %s --branches 0 -o %s", path, out),
+                     65);
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "fit %s -o %s", bad, out), 65);
+    assert_non_null(strstr(se, ":22:1:"));
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "fit %s --validate -o %s", path, out),
+                     2);
+    assert_int_equal(access(out, F_OK), -1);
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "fit data/telescoping.csv --branches 2"),
+                     2);
+    unlink(path);
+    unlink(bad);
+    rmdir(dir);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_hold_relaxes_exactly),
+        cmocka_unit_test(test_zero_branches_are_elastic),
+        cmocka_unit_test(test_prony_constraints),
+        cmocka_unit_test(test_one_cell_is_the_block),
+        cmocka_unit_test(test_recover_noiseless),
+        cmocka_unit_test(test_recover_with_noise),
+        cmocka_unit_test(test_series_refused),
+        cmocka_unit_test(test_held_elastic),
+        cmocka_unit_test(test_cli_series_errors),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
