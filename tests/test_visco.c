@@ -115,13 +115,16 @@ static void test_prony_constraints(void **state)
     assert_int_equal(cf_msm_prony_check(&fx, &err), CF_E_DATA);
 }
 
-/* Uniaxial loading with free sides deforms the lattice homogeneously, so one cell gives the
-** stress of 27 along the whole history. */
-static void test_one_cell_is_the_block(void **state)
+/* Uniaxial loading with free sides deforms the lattice homogeneously, so the homogenised cell
+** gives the stress of a 27-cell lattice along the whole history, dashpot included. */
+static void test_cell_is_the_block(void **state)
 {
     (void)state;
     cf_visco_params p = known();
+    p.eta_MPa_s = 1e-3;
     cf_visco_setup s1 = cf_visco_default(), s3 = s1;
+    assert_int_equal(s1.cell, 1);
+    s3.cell = 0;
     s3.cfg.lattice.nx = s3.cfg.lattice.ny = s3.cfg.lattice.nz = 3;
     double t[NS], x[NS], y1[NS], y3[NS];
     ramp_hold(t, x);
@@ -131,6 +134,16 @@ static void test_one_cell_is_the_block(void **state)
     assert_int_equal(cf_visco_curve(&p, &s3, &ser, y3, NULL, &err), CF_OK);
     for (int k = 0; k < NS; k++)
         assert_close(y1[k], y3[k], 1e-8 * fabs(y3[15]));
+    /* and under a held stress (creep), driven by force */
+    double pt[3] = {0, 30, 330}, pv[3] = {0, 0.5 * fabs(y3[15]), 0.5 * fabs(y3[15])};
+    cf_msm_path path = {CF_DRIVE_FORCE, 3, pt, pv};
+    double ts[4] = {0, 30, 100, 330};
+    cf_msm_sample o1[4], o3[4];
+    assert_int_equal(cf_visco_run(&p, &s1, &path, ts, 4, o1, &err), CF_OK);
+    assert_int_equal(cf_visco_run(&p, &s3, &path, ts, 4, o3, &err), CF_OK);
+    assert_true(o3[3].strain > o3[1].strain * 1.05); /* it creeps */
+    for (int k = 0; k < 4; k++)
+        assert_close(o1[k].strain, o3[k].strain, 1e-8 * o3[3].strain);
 }
 
 static void assert_recovered(const cf_visco_fit *f, const cf_visco_params *p, double tol)
@@ -328,7 +341,7 @@ int main(void)
         cmocka_unit_test(test_hold_relaxes_exactly),
         cmocka_unit_test(test_zero_branches_are_elastic),
         cmocka_unit_test(test_prony_constraints),
-        cmocka_unit_test(test_one_cell_is_the_block),
+        cmocka_unit_test(test_cell_is_the_block),
         cmocka_unit_test(test_recover_noiseless),
         cmocka_unit_test(test_recover_with_noise),
         cmocka_unit_test(test_series_refused),

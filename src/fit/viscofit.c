@@ -15,7 +15,6 @@
 
 /* Bounds of rho and of the solid strain (the largest strain must stay CF_FIT_TRAVEL_MARGIN
 ** short of solid, as in the elastic fit). */
-#define RHO_LO 1e-3
 #define RHO_HI (1 - 1e-6)
 #define E_HI 0.999
 /* Relative residual floor (--relative), as in the elastic fit. */
@@ -58,6 +57,7 @@ cf_visco_fit_options cf_visco_fit_default_options(void)
     cf_visco_fit_options o;
     memset(&o, 0, sizeof o);
     o.setup = cf_visco_default();
+    o.rho_min = CF_FIT_RHO_MIN_DEFAULT;
     return o;
 }
 
@@ -119,6 +119,7 @@ typedef struct ctx {
     double ynorm;       /* weighted sum of y^2 */
     double ymax, xmax;
     double e_lo;        /* lower bound of s/H */
+    double rho_lo;      /* lower bound of rho (the fitter's rho_min) */
     double *m;          /* model curve scratch (n) */
     cf_visco_series series;
     long evals;
@@ -132,7 +133,7 @@ static cf_visco_params unpack(const ctx *c, const double *z)
     memset(&p, 0, sizeof p);
     size_t j = 0;
     if (c->free_el) {
-        p.rho = RHO_LO + (RHO_HI - RHO_LO) * expit(z[j++]);
+        p.rho = c->rho_lo + (RHO_HI - c->rho_lo) * expit(z[j++]);
         p.solid_strain = c->e_lo + (E_HI - c->e_lo) * expit(z[j++]);
         p.stress_scale_MPa = 1.0;
     } else {
@@ -157,7 +158,7 @@ static void pack(const ctx *c, const cf_visco_params *p, double *z)
 {
     size_t j = 0;
     if (c->free_el) {
-        z[j++] = logit((p->rho - RHO_LO) / (RHO_HI - RHO_LO));
+        z[j++] = logit((p->rho - c->rho_lo) / (RHO_HI - c->rho_lo));
         z[j++] = logit((p->solid_strain - c->e_lo) / (E_HI - c->e_lo));
     }
     double ginf = 1;
@@ -420,21 +421,26 @@ static void search_taus(ctx *c, const double *E, double *const *R, const double 
 ** that maps a spring's dashpot to the lattice's). */
 static int elastic_curve(ctx *c, double rho, double e, double A, double *E, double *lat_factor)
 {
+    cf_visco_params p;
+    memset(&p, 0, sizeof p);
+    p.rho = rho;
+    p.solid_strain = e;
+    p.stress_scale_MPa = A;
+    cf_error err = {0};
+    c->evals++;
+    if (cf_visco_elastic_curve(&p, &c->o->setup, c->d->x, c->n, E, &err) != CF_OK)
+        return 0;
+    if (!lat_factor)
+        return 1;
     cf_spring sp = cf_spring_member(rho, e, A);
     cf_law law;
-    cf_error err = {0};
-    if (cf_law_init(&law, &sp, &err) != CF_OK)
-        return 0;
-    int ok = cf_msm_uniaxial(&law, c->o->setup.method, &c->o->setup.cfg, c->d->x, c->n, E, NULL,
-                             &err) == CF_OK;
     double small = -1e-3 * e, s0 = 0;
-    if (ok && lat_factor)
-        ok = cf_msm_uniaxial(&law, c->o->setup.method, &c->o->setup.cfg, &small, 1, &s0, NULL,
-                             &err) == CF_OK &&
-             (*lat_factor = (s0 / small) / (law.k0_N_per_mm / sp.H_mm)) > 0;
+    if (cf_law_init(&law, &sp, &err) != CF_OK ||
+        cf_visco_elastic_curve(&p, &c->o->setup, &small, 1, &s0, &err) != CF_OK)
+        return 0;
+    *lat_factor = (s0 / small) / (law.k0_N_per_mm / sp.H_mm);
     cf_law_free(&law);
-    c->evals++;
-    return ok;
+    return *lat_factor > 0;
 }
 
 /* Stage A: the best starts for nb branches. */
@@ -470,7 +476,8 @@ static int stand_in(ctx *c, start *best, int nbest)
         for (int ie = 0; ie < ne; ie++) {
             double rho, e, A;
             if (c->free_el) {
-                rho = 0.02 * pow(0.98 / 0.02, (double)ir / (GRID_RHO - 1));
+                const double r0 = fmax(c->rho_lo * 1.001, 0.02);
+                rho = r0 * pow(0.98 / r0, (double)ir / (GRID_RHO - 1));
                 double f = (ie + 1.0) / (GRID_E + 1.0);
                 e = c->e_lo + (E_HI - c->e_lo) * f * f;
                 A = 1;
@@ -774,6 +781,7 @@ cf_status cf_visco_fit_run(const cf_visco_data *d, const cf_visco_fit_options *o
         c.xmax = fmax(c.xmax, fabs(d->x[k]));
     }
     c.e_lo = c.xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
+    c.rho_lo = o->rho_min > 0 && o->rho_min < RHO_HI ? o->rho_min : 1e-3;
     if (o->hold_elastic) {
         const double *el = o->elastic;
         if (!(el[0] > 0 && el[0] <= 1) || !(el[1] > c.xmax && el[1] < 1) || !(el[2] > 0) ||
@@ -878,18 +886,13 @@ cf_status cf_visco_fit_run(const cf_visco_data *d, const cf_visco_fit_options *o
         standard_errors(&c, &bestp, s2, res);
         /* small-strain moduli of the lattice */
         double Eel[1], small = -1e-3 * bestp.solid_strain;
-        cf_spring sp = cf_spring_member(bestp.rho, bestp.solid_strain, bestp.stress_scale_MPa);
-        cf_law law;
-        if (cf_law_init(&law, &sp, &e) == CF_OK &&
-            cf_msm_uniaxial(&law, o->setup.method, &o->setup.cfg, &small, 1, Eel, NULL, &e) ==
-                CF_OK) {
+        if (cf_visco_elastic_curve(&bestp, &o->setup, &small, 1, Eel, &e) == CF_OK) {
             double ginf = 1;
             for (int i = 0; i < bestp.nbranch; i++)
                 ginf -= bestp.g[i];
             res->E_inst_MPa = Eel[0] / small;
             res->E_eq_MPa = ginf * res->E_inst_MPa;
         }
-        cf_law_free(&law);
         cf_visco_predictions(&bestp, &o->setup, d, &res->pred);
     }
 out:

@@ -761,7 +761,7 @@ static double reported_stress(solver *s)
     return top_stress(s->lat);
 }
 
-static double path_value(const cf_msm_path *p, double t)
+double cf_msm_path_value(const cf_msm_path *p, double t)
 {
     if (t <= p->t_s[0])
         return p->value[0];
@@ -845,7 +845,7 @@ static cf_status quasi_advance(solver *s, const cf_msm_path *p, double t0, doubl
     double h = (t1 - t0) / n;
     for (int k = 1; k <= n; k++) {
         double ta = t0 + (k - 1) * h, tb = t0 + k * h;
-        cf_status st = quasi_step(s, h, path_value(p, tb), err);
+        cf_status st = quasi_step(s, h, cf_msm_path_value(p, tb), err);
         if (st == CF_E_NOCONV && depth < MAX_BISECT)
             st = quasi_advance(s, p, ta, tb, 2, depth + 1, err);
         if (st != CF_OK)
@@ -1046,13 +1046,13 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
                               cfg->dt_s, st->dt_stable_s);
             goto end;
         }
-        s.load = path_value(path, t);
+        s.load = cf_msm_path_value(path, t);
         if (path->drive == CF_DRIVE_DISPLACEMENT)
             place_top(lat, s.load);
     }
     double E0 = fx->inertia ? total_energy(&s, &d) : 0, Escale = 0, dE = 0;
     for (size_t k = 0; k < nsamples; k++) {
-        double tk = sample_t_s[k], vk = path_value(path, tk);
+        double tk = sample_t_s[k], vk = cf_msm_path_value(path, tk);
         if (!timed) {
             rc = static_to(&s, vk, err);
         } else if (!fx->inertia) {
@@ -1091,8 +1091,8 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
                 st->dt_used_min_s = h;
             for (double m = 1; m <= n; m++) {
                 double tb = t + m * h;
-                double vb = path_value(path, tb);
-                double rate = (vb - path_value(path, tb - h)) / h;
+                double vb = cf_msm_path_value(path, tb);
+                double rate = (vb - cf_msm_path_value(path, tb - h)) / h;
                 s.load = vb;
                 if (m == 1 && d.fused) { /* the fused step adds onto zeroed node forces */
                     memset(lat->fx, 0, lat->nn * sizeof(double));

@@ -8,11 +8,16 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "conifit/cell.h"
+
+/* Newton iterations on the cell's lateral stretch per step. */
+#define CELL_MAX_ITER 100
+
 cf_visco_setup cf_visco_default(void)
 {
     cf_visco_setup s;
+    s.cell = 1;
     s.cfg = cf_msm_default();
-    s.cfg.lattice.nx = s.cfg.lattice.ny = s.cfg.lattice.nz = 1;
     s.method = CF_LAW_CLOSED;
     return s;
 }
@@ -61,23 +66,240 @@ static cf_status check_params(const cf_visco_params *p, cf_error *err)
     return cf_msm_prony_check(&fx, err);
 }
 
-static cf_status run(const cf_visco_params *p, const cf_visco_setup *s, const cf_msm_path *path,
-                     const double *sample_t_s, size_t nsamples, cf_msm_sample *out,
-                     cf_msm_stats *stats, cf_error *err)
+
+/* The law of the model's spring (cf_spring_member) after checking p, with its table when s
+** asks for one. */
+static cf_status member_law(const cf_visco_params *p, const cf_visco_setup *s, cf_law *law,
+                            cf_error *err)
 {
     cf_status st = check_params(p, err);
     if (st != CF_OK)
         return st;
     cf_spring sp = cf_spring_member(p->rho, p->solid_strain, p->stress_scale_MPa);
-    cf_law law;
-    if ((st = cf_law_init(&law, &sp, err)) != CF_OK)
+    st = cf_law_init(law, &sp, err);
+    if (st == CF_OK && s->method == CF_LAW_TABLE &&
+        (st = cf_law_table_build(law, CF_LAW_TABLE_DEFAULT, err)) != CF_OK)
+        cf_law_free(law);
+    return st;
+}
+
+/* ---- the homogenised cell -------------------------------------------------------------------- */
+
+/* The state of the model in the cell: per direction the Prony branch forces (N per unit weight,
+** compression positive), the law force and length at the start of the step. */
+typedef struct cell_run {
+    cf_cell cell;
+    const cf_law *law;
+    cf_law_method method;
+    const cf_visco_params *p;
+    double H;                          /* cell edge, mm */
+    double L0[CF_CELL_DIRS], w[CF_CELL_DIRS], X[CF_CELL_DIRS][3];
+    double a;                          /* lateral stretch of the last state */
+    double h[CF_CELL_DIRS][CF_PRONY_MAX];
+    double Fprev[CF_CELL_DIRS], Lprev[CF_CELL_DIRS];
+    cf_cell_state st;                  /* the current state */
+} cell_run;
+
+/* One implicit step of length dt (0: the relaxed state at the start) to table strain e. The
+** spring tensions are exact at every trial (the Prony force w (alpha F(u) + c) and the dashpot
+** enter the cell as its affine extra term, re-linearised at the trial lengths), and the free
+** lateral stretch a of F = diag(a, a, 1 + e) is found by Newton on P_xx(a) = 0 with its exact
+** derivative. */
+static cf_status cell_step(cell_run *r, double dt, double e, cf_error *err)
+{
+    const cf_visco_params *p = r->p;
+    const int np = p->nbranch;
+    double pe[CF_PRONY_MAX], pb[CF_PRONY_MAX], alpha = 1, c[CF_CELL_DIRS];
+    for (int i = 0; i < np; i++) {
+        pe[i] = dt > 0 ? exp(-dt / p->tau_s[i]) : 0;
+        pb[i] = dt > 0 ? -expm1(-dt / p->tau_s[i]) * p->tau_s[i] / dt : 0;
+        alpha -= p->g[i] * (1 - pb[i]);
+    }
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        c[d] = 0;
+        for (int i = 0; i < np && dt > 0; i++)
+            c[d] += pe[i] * r->h[d][i] - p->g[i] * pb[i] * r->Fprev[d];
+    }
+    const double H = r->H, H3 = H * H * H, visc = dt > 0 ? p->eta_MPa_s / dt : 0;
+    const double lam = 1 + e, sH = r->law->travel_mm / H;
+    double a = r->a, lo = 1 - sH, hi = 1 + sH;
+    cf_cell_extra x;
+    for (int it = 0; it < CELL_MAX_ITER; it++) {
+        const double F[9] = {a, 0, 0, 0, a, 0, 0, 0, lam};
+        double kT[CF_CELL_DIRS], dL[CF_CELL_DIRS];
+        int ok = 1;
+        for (int d = 0; d < CF_CELL_DIRS && ok; d++) {
+            const double *X = r->X[d];
+            const double L = sqrt(a * a * (X[0] * X[0] + X[1] * X[1]) + lam * lam * X[2] * X[2]);
+            const double u = H * (1 - L / r->L0[d]);
+            ok = fabs(u) < r->law->travel_mm * (1 - 1e-9);
+            double k, f = cf_law_force(r->law, r->method, u, &k, NULL);
+            const double kd = r->w[d] * H * H * visc / r->L0[d]; /* dashpot, as msm.h */
+            x.T0_N[d] = -r->w[d] * ((alpha - 1) * f + c[d]) + kd * (L - r->Lprev[d]);
+            x.k_N_per_mm[d] = r->w[d] * (alpha - 1) * k * H / r->L0[d] + kd;
+            x.Lref_mm[d] = L;
+            kT[d] = r->w[d] * alpha * k * H / r->L0[d] + kd; /* dT/dL */
+            dL[d] = a * (X[0] * X[0] + X[1] * X[1]) / L;   /* dL/da */
+        }
+        cf_status st = ok ? cf_cell_stress(&r->cell, F, &x, &r->st, err) : CF_E_DATA;
+        if (st != CF_OK) { /* outside the springs' travel: back toward the last good stretch */
+            if (a > r->a)
+                hi = a;
+            else
+                lo = a;
+            a = 0.5 * (a + r->a);
+            if (hi - lo <= 1e-15)
+                break;
+            continue;
+        }
+        const double P = r->st.P_MPa[0][0];
+        double g = 0;
+        for (int d = 0; d < CF_CELL_DIRS; d++) {
+            const double *X = r->X[d], L = r->st.L_mm[d], T = r->st.T_N[d];
+            g += (kT[d] * dL[d] * a * X[0] * X[0] / L + T * X[0] * X[0] / L -
+                  T * a * X[0] * X[0] * dL[d] / (L * L)) / H3;
+        }
+        double an = a - P / g;
+        if (!(g > 0) || !(an > lo && an < hi))
+            an = P > 0 ? 0.5 * (lo + a) : 0.5 * (a + hi);
+        if (P > 0)
+            hi = a;
+        else
+            lo = a;
+        if (fabs(an - a) <= 4e-16 * a || P == 0) {
+            r->a = a;
+            r->st.free_stretch = a;
+            r->st.stress_MPa = r->st.P_MPa[2][2];
+            for (int d = 0; d < CF_CELL_DIRS; d++) {
+                double f = cf_law_force(r->law, r->method, H * (1 - r->st.L_mm[d] / r->L0[d]),
+                                        NULL, NULL);
+                for (int i = 0; i < np && dt > 0; i++)
+                    r->h[d][i] = pe[i] * r->h[d][i] + p->g[i] * pb[i] * (f - r->Fprev[d]);
+                r->Fprev[d] = f;
+                r->Lprev[d] = r->st.L_mm[d];
+            }
+            return CF_OK;
+        }
+        a = an;
+    }
+    return cf_error_set(err, CF_E_NOCONV,
+                        "the cell found no lateral stretch in equilibrium at strain %g", e);
+}
+
+/* A force-driven step: the table strain whose stress is the target (MPa, table sign), by the
+** secant method inside a bracket on a copy of the state. */
+static cf_status cell_step_force(cell_run *r, double dt, double target, double e0, cf_error *err)
+{
+    cell_run trial;
+    double lo = -r->law->travel_mm / r->H * (1 - 1e-9), hi = -lo;
+    double ea = e0, eb = e0 + (target >= 0 ? 1e-3 : -1e-3), fa, fb;
+    cf_status st;
+    trial = *r;
+    if ((st = cell_step(&trial, dt, ea, err)) != CF_OK)
         return st;
-    if (s->method == CF_LAW_TABLE && (st = cf_law_table_build(&law, CF_LAW_TABLE_DEFAULT, err))) {
-        cf_law_free(&law);
+    fa = trial.st.stress_MPa - target;
+    for (int it = 0; it < 100; it++) {
+        trial = *r;
+        eb = fmin(fmax(eb, lo), hi);
+        if ((st = cell_step(&trial, dt, eb, err)) != CF_OK) {
+            eb = 0.5 * (ea + eb);
+            continue;
+        }
+        fb = trial.st.stress_MPa - target;
+        if (fabs(fb) <= 1e-13 * fmax(fabs(target), 1e-300) || fabs(eb - ea) <= 1e-15) {
+            *r = trial;
+            return CF_OK;
+        }
+        double en = fb != fa ? eb - fb * (eb - ea) / (fb - fa) : eb + 1e-3;
+        ea = eb;
+        fa = fb;
+        eb = en;
+    }
+    return cf_error_set(err, CF_E_NOCONV, "the cell found no strain carrying %g MPa", target);
+}
+
+
+/* The model in the cell along a path, stepped as cf_msm_run steps it (quasi_substeps implicit
+** steps per sample interval, or steps of dt_s), samples as msm.h reports them (compressive
+** positive). */
+static cf_status cell_path(const cf_visco_params *p, const cf_visco_setup *s, const cf_law *law,
+                           const cf_msm_path *path, const double *ts, size_t ns,
+                           cf_msm_sample *out, cf_error *err)
+{
+    cell_run *r = calloc(1, sizeof *r);
+    if (!r)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the cell");
+    cf_status st = cf_cell_init(&r->cell, law, s->method, s->cfg.lattice.weight, err);
+    if (st != CF_OK) {
+        free(r);
         return st;
     }
+    r->law = law;
+    r->method = s->method;
+    r->p = p;
+    r->H = law->p.H_mm;
+    r->a = 1;
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        int N[3], fam;
+        cf_cell_direction(d, N, &fam);
+        r->L0[d] = r->H * sqrt((double)(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]));
+        for (int i = 0; i < 3; i++)
+            r->X[d][i] = r->H * N[i];
+        r->w[d] = s->cfg.lattice.weight[fam];
+        r->Lprev[d] = r->L0[d];
+    }
+    const int force = path->drive == CF_DRIVE_FORCE;
+    double t = ns ? fmin(ts[0], path->t_s[0]) : 0, e = 0;
+    for (size_t k = 0; k < ns && st == CF_OK; k++) {
+        const double tk = ts[k];
+        if (k == 0 || !(tk > t)) {
+            if (k == 0) { /* at rest: the branches relaxed */
+                double v = cf_msm_path_value(path, tk);
+                st = force ? cell_step_force(r, 0, -v, e, err) : cell_step(r, 0, -v, err);
+            }
+        } else {
+            int n = s->cfg.quasi_substeps > 0 ? s->cfg.quasi_substeps : 1;
+            if (s->cfg.dt_s > 0)
+                n = (int)fmin(1e9, ceil((tk - t) / s->cfg.dt_s - 1e-9));
+            if (n < 1)
+                n = 1;
+            const double h = (tk - t) / n;
+            for (int j = 1; j <= n && st == CF_OK; j++) {
+                double v = cf_msm_path_value(path, t + j * h);
+                st = force ? cell_step_force(r, h, -v, e, err) : cell_step(r, h, -v, err);
+                if (force && st == CF_OK)
+                    e = r->st.F[8] - 1; /* the next secant starts here */
+            }
+        }
+        if (force && st == CF_OK)
+            e = r->st.F[8] - 1;
+        t = tk;
+        if (st == CF_OK) {
+            out[k].t_s = tk;
+            out[k].strain = -(r->st.F[8] - 1);
+            out[k].stress_MPa = force ? cf_msm_path_value(path, tk) : -r->st.stress_MPa;
+            out[k].kinetic_mJ = 0;
+            if (!isfinite(out[k].strain) || !isfinite(out[k].stress_MPa))
+                st = cf_error_set(err, CF_E_INTERNAL, "the cell became non-finite at t = %g s",
+                                  tk);
+        }
+    }
+    free(r);
+    return st;
+}
+
+static cf_status run(const cf_visco_params *p, const cf_visco_setup *s, const cf_msm_path *path,
+                     const double *sample_t_s, size_t nsamples, cf_msm_sample *out,
+                     cf_msm_stats *stats, cf_error *err)
+{
+    cf_law law;
+    cf_status st = member_law(p, s, &law, err);
+    if (st != CF_OK)
+        return st;
     cf_lattice lat;
-    if ((st = cf_lattice_create(&lat, &law, s->method, &s->cfg.lattice, err)) == CF_OK) {
+    if (s->cell) {
+        st = cell_path(p, s, &law, path, sample_t_s, nsamples, out, err);
+    } else if ((st = cf_lattice_create(&lat, &law, s->method, &s->cfg.lattice, err)) == CF_OK) {
         cf_msm_effects fx = cf_visco_effects(p);
         cf_msm_config cfg = s->cfg;
         cfg.progress = NULL;
@@ -125,5 +347,24 @@ cf_status cf_visco_curve(const cf_visco_params *p, const cf_visco_setup *s,
         stress_MPa[k] = -out[k].stress_MPa;
     free(v);
     free(out);
+    return st;
+}
+
+cf_status cf_visco_elastic_curve(const cf_visco_params *p, const cf_visco_setup *s,
+                                 const double *strain, size_t count, double *stress_MPa,
+                                 cf_error *err)
+{
+    cf_law law;
+    cf_status st = member_law(p, s, &law, err);
+    if (st != CF_OK)
+        return st;
+    if (s->cell) {
+        cf_cell c;
+        if ((st = cf_cell_init(&c, &law, s->method, s->cfg.lattice.weight, err)) == CF_OK)
+            st = cf_cell_curve(&c, CF_MODE_UNIAXIAL, strain, count, stress_MPa, err);
+    } else {
+        st = cf_msm_uniaxial(&law, s->method, &s->cfg, strain, count, stress_MPa, NULL, err);
+    }
+    cf_law_free(&law);
     return st;
 }

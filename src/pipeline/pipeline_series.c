@@ -22,8 +22,10 @@ cf_status cf_pipeline_fit_series(const cf_table *t, const cf_pipeline_options *o
     if (opt->progress)
         opt->progress(opt->progress_ctx, t->path, "fitting the viscoelastic model along the series");
     cf_visco_data d = {t->count, t->t, t->x, t->y, t->w};
+    cf_visco_fit_options o = *vo;
+    o.rho_min = opt->fit.rho_min; /* the placement's limit is the fit's */
     cf_error e = {0};
-    cf_status st = cf_visco_fit_run(&d, vo, &r->fit, &e);
+    cf_status st = cf_visco_fit_run(&d, &o, &r->fit, &e);
     if (st != CF_OK)
         return cf_error_set(err, st, "%s: %s", t->path, e.msg);
     /* one spring of each type from the identifiable quantities, placed as the elastic fit does */

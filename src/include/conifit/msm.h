@@ -69,6 +69,9 @@ typedef struct cf_msm_path {
     const double *value;
 } cf_msm_path;
 
+/* The path's value at time t (linear between its points, held outside them). */
+double cf_msm_path_value(const cf_msm_path *p, double t);
+
 /* Solver settings. */
 typedef struct cf_msm_config {
     cf_lattice_config lattice;

@@ -39,6 +39,7 @@ typedef struct cf_visco_fit_options {
     int hold_elastic;       /* 1: rho, s/H, F_C/H^2 held at elastic[] (an earlier fit) */
     double elastic[3];      /* rho [-], s/H [-], F_C/H^2 [MPa] */
     int relative;           /* 1: residuals relative to |stress| (floor 1e-3 max|stress|) */
+    double rho_min;         /* smallest rho fitted (default the fitter's, 0.05) */
     cf_visco_setup setup;   /* where the model is evaluated */
 } cf_visco_fit_options;
 

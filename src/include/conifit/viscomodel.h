@@ -41,17 +41,20 @@ typedef struct cf_visco_series {
     const double *strain;
 } cf_visco_series;
 
-/* Where the model is evaluated: the lattice configuration and solver settings (the sizes nx, ny,
-** nz are used as given; one cell suffices under the homogeneous deformation of an unconfined
-** compression) and the law evaluator. */
+/* Where the model is evaluated. With `cell` (the default) the lattice's homogenised cell (cell.h)
+** in uniaxial loading with free sides: the lattice's stress wherever its deformation stays
+** homogeneous, at microseconds a step. Otherwise the full lattice of cfg.lattice (msm.h). Both
+** take quasi_substeps implicit steps per sample interval (cfg.dt_s = 0) with the same update, so
+** they agree to the solvers' tolerance; the cell cannot leave the homogeneous state, the lattice
+** can (a small lattice may buckle sideways while its branches relax). */
 typedef struct cf_visco_setup {
-    cf_msm_config cfg;
-    cf_law_method method;
+    int cell;                 /* 1: the homogenised cell (default); 0: the lattice */
+    cf_msm_config cfg;        /* lattice (weights for the cell) and solver settings */
+    cf_law_method method;     /* law evaluator */
 } cf_visco_setup;
 
-/* The default setup: the lattice of cf_msm_default() reduced to one cell (the same stress under
-** uniaxial loading with free sides), quasi_substeps implicit steps per measured interval (10),
-** law evaluator CF_LAW_CLOSED. */
+/* The default setup: the cell with the weights of cf_msm_default(), 10 implicit steps per
+** measured interval, law evaluator CF_LAW_CLOSED. */
 cf_visco_setup cf_visco_default(void);
 
 /* A spring of free length 1 mm with the given identifiable quantities (non-telescoping, n = 2);
@@ -67,6 +70,12 @@ cf_msm_effects cf_visco_effects(const cf_visco_params *p);
 cf_status cf_visco_curve(const cf_visco_params *p, const cf_visco_setup *s,
                          const cf_visco_series *series, double *stress_MPa, cf_msm_stats *stats,
                          cf_error *err);
+
+/* The static elastic (instantaneous) curve of the model at unit branch state: its stress (MPa,
+** table sign) at each strain, in the cell or the lattice as s says. */
+cf_status cf_visco_elastic_curve(const cf_visco_params *p, const cf_visco_setup *s,
+                                 const double *strain, size_t count, double *stress_MPa,
+                                 cf_error *err);
 
 /* A run of the same model along a loading path of msm.h (compressive-positive values: strain,
 ** or stress in MPa for a force drive), sampled at sample_t_s; fills out (nsamples). Used for the
