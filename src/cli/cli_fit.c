@@ -16,7 +16,9 @@
 #include "base/atomic.h"
 #include "cli/cli.h"
 #include "conifit/baseline.h"
+#include "conifit/fitfile.h"
 #include "conifit/pipeline.h"
+#include "conifit/pipeline_series.h"
 #include "out/plot.h"
 
 static const char fit_help[] =
@@ -56,7 +58,13 @@ static const char fit_help[] =
     "  --force-unit U          unit of a force column without one (N, mN, ...)\n"
     "  --length-unit U         unit of a displacement column without one (mm, m, ...)\n"
     "  --stretch               the x column is stretch (strain = stretch - 1)\n"
-    "  -j, --jobs N            fit N tables at a time (default 1)\n\n"
+    "  -j, --jobs N            fit N tables at a time (default 1)\n"
+    "Time series (a table with a time column such as time_s) are fitted with the time-dependent\n"
+    "model: the conical law plus a Prony series on every spring, in the lattice's homogenised\n"
+    "cell, driven by the measured strain history:\n"
+    "  --branches N            Prony terms, 1..8 (default: 1..4 chosen by AIC)\n"
+    "  --dashpot               fit a dashpot beside every spring as well\n"
+    "  --elastic FIT.json[:TYPE]  hold rho, s/H and F_C/H^2 at those of a fit file's spring\n\n"
     "Tables: a header row naming the columns, units in the names (stress_kPa, stress [kPa]),\n"
     "'#' comments, ',' ';' TAB or blank-separated columns, an optional weight column. Tension\n"
     "positive. A spreadsheet (.xlsx, .ods) must be saved as CSV first.\n";
@@ -74,6 +82,9 @@ typedef struct fit_args {
     const char *scene;           /* the validation scene, or NULL for the default lattice */
     int argc;                    /* the command line, for --validate SCENE.json */
     char **argv;
+    cf_visco_fit_options vopt;   /* time series: the viscoelastic fit */
+    const char *elastic;         /* --elastic FIT.json[:TYPE] */
+    int series_only;             /* an option for time series only was given */
 } fit_args;
 
 typedef struct fit_job {
@@ -81,6 +92,7 @@ typedef struct fit_job {
     const char *file;
     cf_table m;
     cf_fit_report rep;
+    cf_visco_report vrep;        /* a time series (m.t not NULL) */
     char json_path[4096];        /* "" when not written */
     char plot_path[4096];
     cf_atomic json_out, plot_out; /* both complete, put in place only when every job succeeded */
@@ -141,7 +153,10 @@ enum {
     OPT_RHO_MIN,
     OPT_N_MAX,
     OPT_D2_MAX_H,
-    OPT_G_MAX
+    OPT_G_MAX,
+    OPT_BRANCHES,
+    OPT_DASHPOT,
+    OPT_ELASTIC
 };
 
 static const struct option fit_options[] = {
@@ -167,6 +182,9 @@ static const struct option fit_options[] = {
     {"n-max", required_argument, NULL, OPT_N_MAX},
     {"D2-max-H", required_argument, NULL, OPT_D2_MAX_H},
     {"G-max", required_argument, NULL, OPT_G_MAX},
+    {"branches", required_argument, NULL, OPT_BRANCHES},
+    {"dashpot", no_argument, NULL, OPT_DASHPOT},
+    {"elastic", required_argument, NULL, OPT_ELASTIC},
     {"jobs", required_argument, NULL, 'j'},
     {NULL, 0, NULL, 0}};
 
@@ -335,6 +353,23 @@ static int fit_option(void *ctx, int c, const char *optval)
     case OPT_FORCE_UNIT: a->mopt.force_unit = optval; return 0;
     case OPT_LENGTH_UNIT: a->mopt.length_unit = optval; return 0;
     case OPT_STRETCH: a->mopt.x_is_stretch = 1; return 0;
+    case OPT_BRANCHES:
+        if (cf_cli_parse_long("--branches", optval, 1, CF_PRONY_MAX, &n, &err) != CF_OK) {
+            /* a branch count outside 1..8 is refused as bad data (65), as a bad table is */
+            fprintf(stderr, "conifit fit: %s\n", err.msg);
+            return CF_EXIT_DATAERR;
+        }
+        a->vopt.nbranch = (int)n;
+        a->series_only = 1;
+        return 0;
+    case OPT_DASHPOT:
+        a->vopt.dashpot = 1;
+        a->series_only = 1;
+        return 0;
+    case OPT_ELASTIC:
+        a->elastic = optval;
+        a->series_only = 1;
+        return 0;
     case 'j':
         if (cf_cli_parse_long("-j", optval, 1, 256, &a->jobs, &err))
             return cf_cli_usage_error("fit", "%s", err.msg);
@@ -351,6 +386,7 @@ static int parse_args(int argc, char **argv, fit_args *a)
     memset(a, 0, sizeof *a);
     a->popt = cf_pipeline_default_options();
     a->mopt = cf_measure_default_options();
+    a->vopt = cf_visco_fit_default_options();
     a->jobs = 1;
     cf_cli_parser p;
     a->argc = argc;
@@ -390,7 +426,7 @@ static int parse_args(int argc, char **argv, fit_args *a)
 static void show_progress(void *ctx, const char *table, const char *what)
 {
     (void)ctx;
-    if (strstr(what, "through the lattice"))
+    if (strstr(what, "through the lattice") || strstr(what, "viscoelastic"))
         fprintf(stderr, "conifit: %s: %s...\n", table, what);
 }
 
@@ -398,6 +434,16 @@ static void show_progress(void *ctx, const char *table, const char *what)
 static void run_job(fit_job *j)
 {
     const fit_args *a = j->args;
+    if (j->m.t) { /* a time series: the viscoelastic fit */
+        j->st = cf_pipeline_fit_series(&j->m, &a->popt, &a->vopt, &j->vrep, &j->err);
+        if (j->st == CF_OK)
+            j->st = cf_pipeline_series_prepare(&j->vrep, j->json_path[0] ? j->json_path : NULL,
+                                               j->plot_path[0] ? j->plot_path : NULL, j->inputs,
+                                               &j->json_out, &j->plot_out, &j->err);
+        if (j->st == CF_OK && !a->quiet)
+            j->text = cf_visco_report_text(&j->vrep);
+        return;
+    }
     j->st = cf_pipeline_fit(&j->m, &a->popt, &j->rep, &j->err);
     if (j->st != CF_OK)
         return;
@@ -485,7 +531,7 @@ int cf_cli_fit(int argc, char **argv)
         return CF_EXIT_SOFTWARE;
     }
     /* every input of the run, never to be an output */
-    const char **inputs = calloc((size_t)a.nfiles + 2, sizeof *inputs);
+    const char **inputs = calloc((size_t)a.nfiles + 3, sizeof *inputs);
     if (!inputs) {
         free(jobs);
         fprintf(stderr, "conifit: out of memory\n");
@@ -494,6 +540,7 @@ int cf_cli_fit(int argc, char **argv)
     for (int i = 0; i < a.nfiles; i++)
         inputs[i] = a.files[i];
     inputs[a.nfiles] = a.scene;
+    inputs[a.nfiles + (a.scene != NULL)] = a.elastic;
     rc = plan_outputs(&a, jobs, inputs);
     /* Read every table first: a bad one stops the run before anything is written. */
     for (int i = 0; i < a.nfiles && rc < 0; i++) {
@@ -507,6 +554,26 @@ int cf_cli_fit(int argc, char **argv)
         cf_error err = {0};
         if (cf_pipeline_use_scene(&a.popt, a.scene, &err) != CF_OK)
             rc = cf_cli_fail(&err);
+    }
+    int nseries = 0;
+    for (int i = 0; i < a.nfiles && rc < 0; i++)
+        nseries += jobs[i].m.t != NULL;
+    if (rc < 0 && nseries > 0 && (a.popt.validate || a.popt.through_msm))
+        rc = cf_cli_usage_error("fit", "--validate and --through-msm apply to stress-strain "
+                                       "tables; a time series is fitted through the lattice "
+                                       "already");
+    if (rc < 0 && nseries == 0 && a.series_only)
+        rc = cf_cli_usage_error("fit", "--branches, --dashpot and --elastic apply to time series "
+                                       "(a table with a time column) only");
+    if (rc < 0 && a.elastic) {
+        cf_fitted_spring fs;
+        cf_error err = {0};
+        if (cf_fitfile_load_spec(a.elastic, &fs, &err) != CF_OK) {
+            rc = cf_cli_fail(&err);
+        } else {
+            cf_fit_identifiable(&fs.params, 0, a.vopt.elastic);
+            a.vopt.hold_elastic = 1;
+        }
     }
     if (a.progress)
         a.popt.progress = show_progress;
@@ -586,6 +653,12 @@ int cf_cli_fit(int argc, char **argv)
                     printf("  %-*s failed\n", wname, j->file);
                     continue;
                 }
+                if (j->m.t) {
+                    printf("  %-*s time series: %d Prony term%s, RMSE %.4g %s\n", wname, j->file,
+                           j->vrep.fit.p.nbranch, j->vrep.fit.p.nbranch == 1 ? "" : "s",
+                           j->vrep.fit.rmse * j->m.y_to_file, j->m.y_unit);
+                    continue;
+                }
                 char cell[2][32] = {"-", "-"};
                 for (int k = 0; k < j->rep.nfits; k++)
                     snprintf(cell[j->rep.fits[k].type], sizeof cell[0], "%.4g %s%s",
@@ -618,6 +691,7 @@ int cf_cli_fit(int argc, char **argv)
         cf_table_free(&jobs[i].m);
         free(jobs[i].text);
         cf_report_free(&jobs[i].rep);
+        cf_visco_report_free(&jobs[i].vrep);
     }
     free(jobs);
     free(inputs);
