@@ -558,8 +558,8 @@ int cf_cli_fit(int argc, char **argv)
     int nseries = 0;
     for (int i = 0; i < a.nfiles && rc < 0; i++)
         nseries += jobs[i].m.t != NULL;
-    if (rc < 0 && nseries > 0 && (a.popt.validate || a.popt.through_msm))
-        rc = cf_cli_usage_error("fit", "--validate and --through-msm apply to stress-strain "
+    if (rc < 0 && nseries > 0 && (a.popt.validate || a.popt.target == CF_TARGET_LATTICE))
+        rc = cf_cli_usage_error("fit", "--validate and --target lattice apply to stress-strain "
                                        "tables; a time series is fitted through the lattice "
                                        "already");
     if (rc < 0 && nseries == 0 && a.series_only)
