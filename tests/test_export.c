@@ -754,6 +754,48 @@ static void calculix_runs_the_one_spring_example_and_matches_the_law(void **stat
     }
 }
 
+/* What the README says of CalculiX: past the last pair it holds the force constant. */
+static void calculix_holds_the_last_force_beyond_the_table(void **state)
+{
+    (void)state;
+    if (!have_ccx())
+        skip(); /* CI installs calculix-ccx (Makefile DEBS) */
+    cf_law law;
+    law_of(&law, &TEL);
+    char *block = export_to("hold.inp", "--format calculix --tol 1e-2");
+    double F[256], e[256];
+    const size_t n = inp_pairs(block, "*SPRING, ELSET=CONIFIT_SPRING, NONLINEAR", F, e, 256);
+    assert_true(n > 3 && n <= 256);
+    char path[160];
+    snprintf(path, sizeof path, "%s/hold_model.inp", dir);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f, "*NODE, NSET=NALL\n1, 0, 0, 0\n2, 0, 0, %.17g\n*NSET, NSET=NTOP\n2\n"
+               "*ELEMENT, TYPE=SPRINGA, ELSET=CONIFIT_SPRING\n1, 1, 2\n",
+            TEL.H_mm);
+    fputs(block, f);
+    fprintf(f, "*BOUNDARY\n1, 1, 3\n2, 1, 2\n");
+    /* compressed past the table's end (e[0]) towards solid, and stretched past its other end */
+    const double dz[2] = {0.5 * (e[0] - law.travel_mm), 0.5 * (e[n - 1] + law.travel_mm)};
+    for (int k = 0; k < 2; k++)
+        fprintf(f, "*STEP\n*STATIC\n*BOUNDARY\nNTOP, 3, 3, %.17g\n*NODE PRINT, NSET=NTOP, "
+                   "TOTALS=ONLY\nRF\n*END STEP\n",
+                dz[k]);
+    fclose(f);
+    run_ccx("hold_model");
+    snprintf(path, sizeof path, "%s/hold_model.dat", dir);
+    char *dat = slurp(path);
+    assert_non_null(dat);
+    double rz[4];
+    assert_int_equal(parse_totals(dat, rz, 4), 2);
+    /* the reaction is the end pair's force, not the law (which is at or near F_C there) and not
+    ** an extrapolated slope */
+    assert_close(rz[0], F[0], CCX_PRINT_REL * fabs(F[0]));
+    assert_close(rz[1], F[n - 1], CCX_PRINT_REL * fabs(F[n - 1]));
+    free(dat);
+    free(block);
+}
+
 /* ---- lattices --------------------------------------------------------------------------------- */
 
 /* A small static uniaxial scene built from the test's fit file. */
@@ -955,6 +997,17 @@ static void every_format_has_a_runnable_example(void **state)
         char *x = export_to(name, args);
         assert_non_null(strstr(x, must[f]));
         assert_non_null(strstr(x, "2 nodes, 1 springs in 1 groups"));
+        if (f == 2) { /* FEBio 4 builds the mesh when it reads MeshDomains: it must come first */
+            const char *order[] = {"</Mesh>", "<MeshDomains/>", "<Boundary>", "<Discrete>",
+                                   "<LoadData>", "<Output>"};
+            const char *at = x;
+            for (int k = 0; k < 6; k++) {
+                const char *hit = strstr(at, order[k]);
+                if (!hit)
+                    fail_msg("FEBio model lacks %s in order", order[k]);
+                at = hit;
+            }
+        }
         free(x);
     }
 }
@@ -1015,6 +1068,7 @@ int main(void)
         cmocka_unit_test(json_round_trips_through_force_spring),
         cmocka_unit_test(bad_input_gives_its_exit_status_the_number_that_works_and_no_output),
         cmocka_unit_test(calculix_runs_the_one_spring_example_and_matches_the_law),
+        cmocka_unit_test(calculix_holds_the_last_force_beyond_the_table),
         cmocka_unit_test(calculix_runs_the_lattice_and_matches_conifit_simulate_at_every_step),
         cmocka_unit_test(lattice_models_of_every_format_hold_the_law_in_every_group),
         cmocka_unit_test(every_format_has_a_runnable_example),

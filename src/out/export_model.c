@@ -10,8 +10,10 @@
 **   prints the summed reaction of a node set for every increment.
 ** - Abaqus/Standard reads the same *SPRING layout (ccx took its input language from it).
 ** - FEBio 4: discrete_material type "nonlinear spring" with measure "elongation" and a point
-**   curve (extend CONSTANT holds the last force), discrete sets in the Mesh section, "zero
-**   displacement" and "prescribed displacement" boundary conditions, a load controller.
+**   curve (extend CONSTANT holds the last force), discrete sets in the Mesh section resolved by
+**   name when the Discrete section is read (FEBioDiscreteSection25::Parse), after MeshDomains has
+**   built the mesh; "zero displacement" and "prescribed displacement" boundary conditions on
+**   named node sets, a load controller, a logfile of node data on a node set.
 ** - LS-DYNA: *MAT_SPRING_NONLINEAR_ELASTIC (MAT_S04) on *ELEMENT_DISCRETE; every *DEFINE_CURVE is
 **   resampled to LCINT equally spaced points, 100 unless the curve's own LCINT (field 8 of its
 **   first card, since 2015) or *CONTROL_SOLUTION says otherwise (LSTC FAQ "discretization of
@@ -232,7 +234,10 @@ void cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
                 fprintf(out, "\t\t\t<delem>%u,%u</delem>\n", m->si[s] + 1, m->sj[s] + 1);
         fprintf(out, "\t\t</DiscreteSet>\n");
     }
-    fprintf(out, "\t</Mesh>\n\t<Boundary>\n");
+    /* FEBio 4 builds the mesh (nodes, sets, degrees of freedom) when it reads MeshDomains
+    ** (FEBioMeshDomainsSection4::Parse), even an empty one; without it the discrete and node sets
+    ** named below are not found. */
+    fprintf(out, "\t</Mesh>\n\t<MeshDomains/>\n\t<Boundary>\n");
     for (unsigned mask = 1; mask < 8; mask++) {
         size_t cnt = 0;
         for (size_t i = 0; i < m->nn; i++)
