@@ -262,6 +262,59 @@ static void static_solve_and_long_damped_dynamic_run_agree(void **state)
     assert_close(s1.strain, s0.strain, 1e-6 * s0.strain);
 }
 
+/* The static scan's stability limit is real and not late: a slow, damped dynamic run of the same
+** lattice (nodes displaced by 1e-6 H so that a buckling mode can grow) follows the static curve up
+** to the limit, within the dashpots' overstress, and leaves it (collapses) past the limit. */
+static void stability_limit_is_confirmed_by_a_slow_damped_dynamic_run(void **state)
+{
+    (void)state;
+    cf_law law = make_law();
+    cf_msm_config cfg = small_config(2, 2, 2, NULL);
+    cfg.lattice.density_t_per_mm3 = 1e-6;
+    double limit, tension;
+    cf_error err = {0};
+    assert_int_equal(cf_msm_stability_limit(&law, CF_LAW_CLOSED, &cfg, -1, &limit, &err), CF_OK);
+    assert_int_equal(cf_msm_stability_limit(&law, CF_LAW_CLOSED, &cfg, 1, &tension, &err), CF_OK);
+    const double solid = law.travel_mm / law.p.H_mm;
+    assert_true(limit < -0.4 * solid && limit > -0.9 * solid); /* about 0.64 of solid */
+    assert_close(tension, 0, 0);                                /* stable in tension */
+    cf_lattice lat;
+    assert_int_equal(cf_lattice_create(&lat, &law, CF_LAW_CLOSED, &cfg.lattice, &err), CF_OK);
+    srand(3);
+    for (size_t q = 0; q < lat.nn; q++) {
+        lat.x[q] += 1e-6 * lat.H_mm * (rand() / (double)RAND_MAX - 0.5);
+        lat.y[q] += 1e-6 * lat.H_mm * (rand() / (double)RAND_MAX - 0.5);
+    }
+    cf_msm_effects fx = {0};
+    fx.inertia = 1;
+    fx.eta_MPa_s = 5e-4;
+    const double T = 80, emax = 0.9 * solid;
+    double t[2] = {0, T}, v[2] = {0, emax};
+    cf_msm_path path = {CF_DRIVE_DISPLACEMENT, 2, t, v};
+    enum { N = 91 };
+    double ts[N], strain[N], stat[N];
+    cf_msm_sample out[N];
+    for (int k = 0; k < N; k++)
+        ts[k] = T * k / (N - 1);
+    if (cf_msm_run(&lat, &fx, &cfg, &path, ts, N, out, NULL, NULL, &err) != CF_OK)
+        fail_msg("dynamic run: %s", err.msg);
+    for (int k = 0; k < N; k++)
+        strain[k] = -out[k].strain;
+    assert_int_equal(cf_msm_uniaxial(&law, CF_LAW_CLOSED, &cfg, strain, N, stat, NULL, &err),
+                     CF_OK);
+    const double over = fx.eta_MPa_s * emax / T; /* dashpot overstress, MPa */
+    int left = 0;
+    for (int k = 1; k < N; k++) {
+        double dyn = out[k].stress_MPa, st = -stat[k];
+        if (strain[k] > limit) /* before the limit (compression negative) */
+            assert_close(dyn, st, 2 * over + 1e-3 * st);
+        else if (dyn < 0.9 * st)
+            left = 1;
+    }
+    assert_true(left);
+    cf_lattice_free(&lat);
+}
+
 static void undamped_symplectic_run_keeps_energy_bounded(void **state)
 {
     (void)state;
@@ -561,6 +614,7 @@ int main(void)
         cmocka_unit_test(fused_step_matches_independent_forces),
         cmocka_unit_test(lattice_masses_and_top_shares_add_up),
         cmocka_unit_test(static_solve_and_long_damped_dynamic_run_agree),
+        cmocka_unit_test(stability_limit_is_confirmed_by_a_slow_damped_dynamic_run),
         cmocka_unit_test(undamped_symplectic_run_keeps_energy_bounded),
         cmocka_unit_test(creep_strain_rises_monotonically_toward_static_value),
         cmocka_unit_test(hysteresis_area_is_positive_and_vanishes_as_rate_goes_to_zero),

@@ -141,11 +141,14 @@ static void simulate_writes_nothing_for_a_bad_scene_and_a_csv_for_a_good_one(voi
     assert_non_null(f);
     char line[512];
     assert_non_null(fgets(line, sizeof line, f));
-    assert_string_equal(line, "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa\n");
-    int rows = 0;
+    assert_string_equal(line,
+                        "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,stable\n");
+    int rows = 0, stable;
     double t, e = 0, s = 0, k, sp;
-    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf", &t, &e, &s, &k, &sp) == 5)
+    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf,%d", &t, &e, &s, &k, &sp, &stable) == 6) {
         rows++;
+        assert_int_equal(stable, 1); /* 20 % compression: inside the stable range */
+    }
     fclose(f);
     assert_int_equal(rows, 5);
     assert_close(e, 0.2, 1e-12);
@@ -190,7 +193,7 @@ static void relaxation_scene_follows_published_muscle_relaxation(void **state)
     f = fopen(out, "r");
     assert_non_null(fgets(line, sizeof line, f));
     double k, sp;
-    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf", &t, &e, &s, &k, &sp) == 5) {
+    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf,%*d", &t, &e, &s, &k, &sp) == 5) {
         speak = fmax(speak, s);
         send = s;
     }

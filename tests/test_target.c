@@ -179,6 +179,45 @@ static void shear_table_is_fitted_and_validated_in_shear(void **state)
     rmdir(dir);
 }
 
+/* The validation states the lattice's stability limit: the shipped compression table reaches past
+** it (warning, stable_in_range false), the tension table does not (stable_to_strain null). */
+static void validation_reports_the_stability_limit(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-target-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char json[256];
+    snprintf(json, sizeof json, "%s/s.json", dir);
+    const char *tables[2] = {"data/telescoping_compression.csv", "data/telescoping.csv"};
+    for (int k = 0; k < 2; k++) {
+        int st = tu_run(out, sizeof out, errb, sizeof errb,
+                        "fit %s --type telescoping --validate -o %s", tables[k], json);
+        if (st != 0)
+            fail_msg("%s: exit %d: %s", tables[k], st, errb);
+        json_error_t e;
+        json_t *root = json_load_file(json, 0, &e);
+        assert_non_null(root);
+        json_t *v = json_object_get(json_array_get(json_object_get(root, "fits"), 0),
+                                    "validation");
+        json_t *lim = json_object_get(v, "stable_to_strain");
+        assert_non_null(lim);
+        if (k == 0) {
+            double x = json_number_value(lim);
+            assert_true(json_is_number(lim) && x < 0 && x > -0.6);
+            assert_true(json_is_false(json_object_get(v, "stable_in_range")));
+            assert_non_null(strstr(errb, "loses stability at strain"));
+            assert_non_null(strstr(out, "lattice stable"));
+        } else {
+            assert_true(json_is_null(lim));
+            assert_true(json_is_true(json_object_get(v, "stable_in_range")));
+            assert_null(strstr(errb, "loses stability"));
+        }
+        json_decref(root);
+    }
+    remove(json);
+    rmdir(dir);
+}
+
 static void bad_modes_are_refused(void **state)
 {
     (void)state;
@@ -211,6 +250,7 @@ int main(void)
         cmocka_unit_test(lattice_target_reproduces_deep_known_spring_tables),
         cmocka_unit_test(lattice_target_on_the_shipped_noisy_table_is_near_the_spring_fit),
         cmocka_unit_test(shear_table_is_fitted_and_validated_in_shear),
+        cmocka_unit_test(validation_reports_the_stability_limit),
         cmocka_unit_test(bad_modes_are_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -114,6 +114,30 @@ static cf_status model_curve(const cf_spring *p, const cf_validate_setup *s, con
     return st;
 }
 
+/* The stability limit of the full uniaxial lattice on the table's side (compression when the
+** table has any), and whether the table reaches past it. A failure leaves it unchecked. */
+static void stability(const cf_spring *p, const cf_validate_setup *s, const cf_table *d,
+                      cf_validation *v)
+{
+    double lo = 0, hi = 0;
+    for (size_t i = 0; i < d->count; i++) {
+        lo = fmin(lo, d->x[i]);
+        hi = fmax(hi, d->x[i]);
+    }
+    int side = lo < 0 ? -1 : 1;
+    cf_law law;
+    if (cf_law_init(&law, p, NULL) != CF_OK)
+        return;
+    if ((s->method != CF_LAW_TABLE || cf_law_table_build(&law, s->table_intervals, NULL) == CF_OK) &&
+        cf_msm_stability_limit(&law, s->method, &s->cfg, side, &v->stable_to_strain, NULL) ==
+            CF_OK) {
+        v->stability_checked = 1;
+        double reach = side < 0 ? lo : hi;
+        v->unstable_in_range = v->stable_to_strain != 0 && fabs(reach) > fabs(v->stable_to_strain);
+    }
+    cf_law_free(&law);
+}
+
 cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const cf_table *d,
                           cf_validation *v, cf_error *err)
 {
@@ -158,6 +182,8 @@ cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const 
         ss += (v->stress_MPa[i] - law[i]) * (v->stress_MPa[i] - law[i]);
     v->law_rmse = sqrt(ss / (double)d->count);
     free(law);
+    if (!v->by_cell)
+        stability(p, s, d, v);
     v->done = 1;
     v->wall_time_s = now_s() - t0;
     return CF_OK;

@@ -632,8 +632,16 @@ int cf_cli_fit(int argc, char **argv)
                 if (a.nfiles > 1)
                     fputc('\n', stdout);
             }
-            for (int k = 0; k < j->rep.nfits; k++)
+            for (int k = 0; k < j->rep.nfits; k++) {
                 fit_warnings(j->file, &j->rep, &j->rep.fits[k]);
+                const cf_validation *v = &j->rep.val[k];
+                if (j->rep.validate && v->done && v->unstable_in_range)
+                    fprintf(stderr,
+                            "conifit: warning: %s: the %s spring's lattice loses stability at "
+                            "strain %.4g, inside the table's range\n",
+                            j->file, cf_spring_type_name(j->rep.fits[k].type),
+                            v->stable_to_strain);
+            }
         }
         if (failed && (a.out || a.plot))
             fprintf(stderr, "conifit: no output file written (outputs are written only when "

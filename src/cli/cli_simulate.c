@@ -20,9 +20,11 @@
 static const char simulate_help[] =
     "usage: conifit simulate SCENE.json -o OUT.csv [--plot OUT.png|.svg] [-q]\n"
     "Runs the scene on a mass-spring lattice of conical springs and writes the CSV\n"
-    "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa (compression positive: strain\n"
-    "is the top face's shortening over the height, stress the top reaction over nx ny H^2, in kPa;\n"
-    "spring_stress_kPa is one spring's F(strain H)/H^2 at the same strain, for comparison).\n"
+    "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,stable (compression positive:\n"
+    "strain is the top face's shortening over the height, stress the top reaction over nx ny H^2,\n"
+    "in kPa; spring_stress_kPa is one spring's F(strain H)/H^2 at the same strain, for comparison;\n"
+    "stable is 1 up to the first sample whose tangent has a negative pivot and 0 from there on,\n"
+    "-1 in explicit dynamics, which factors no tangent).\n"
     "A scene with no inertia, damping or viscosity is solved as static equilibria.\n\n"
     "  -o, --output FILE   CSV to write (written to a temporary name, then renamed); '-'\n"
     "                      writes it to standard output and the summary to stderr\n"
@@ -32,6 +34,15 @@ static const char simulate_help[] =
     "  --max-steps N       refuse a scene estimated to need more time steps or static\n"
     "                      solves (default 1e7)\n"
     "The estimates are made before anything runs; a refused scene exits 65 naming the key.\n";
+
+/* Index of the first sample whose tangent had a negative pivot (n when none). */
+static size_t first_unstable(const cf_msm_sample *s, size_t n)
+{
+    for (size_t k = 0; k < n; k++)
+        if (s[k].neg_pivots > 0)
+            return k;
+    return n;
+}
 
 /* Area of the closed loop(s) in the stress-strain plane over samples [a, b], kPa = kJ/m^3. */
 /* Progress on a terminal: one line, rewritten after every sample. */
@@ -69,6 +80,14 @@ static void summary(FILE *o, const cf_scene *sc, const cf_msm_sample *s, size_t 
         fprintf(o, "solves: %zu, Newton iterations: %zu, linear solves: %zu\n", st->solves,
                st->newton_iters, st->linear_iters);
     fprintf(o, "largest spring compression: %.4g of travel\n", st->max_u_over_travel);
+    size_t lost = first_unstable(s, n);
+    if (lost < n)
+        fprintf(o, "lattice loses stability at strain %.6g (t = %.6g s): from there on the static "
+                "equilibrium is unstable (its tangent has %ld negative pivots; a column of cells "
+                "can buckle sideways), rows marked stable = 0\n",
+                s[lost].strain, s[lost].t_s, s[lost].neg_pivots);
+    else if (!sc->effects.inertia)
+        fprintf(o, "lattice stable at every sample (every factored tangent positive definite)\n");
     if (sc->kind == CF_PROTO_CYCLES) {
         size_t per = (n - 1) / (size_t)sc->cycles;
         for (int c = 0; c < sc->cycles; c++) {
@@ -251,10 +270,12 @@ int cf_cli_simulate(int argc, char **argv)
     double H = law.p.H_mm;
     for (size_t k = 0; k < sc.nsamples; k++)
         spring[k] = cf_law_force(&law, sc.method, samples[k].strain * H, NULL, NULL) / (H * H);
-    fprintf(a.fp, "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa\n");
+    fprintf(a.fp, "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,stable\n");
+    size_t lost = first_unstable(samples, sc.nsamples);
     for (size_t k = 0; k < sc.nsamples; k++)
-        fprintf(a.fp, "%.17g,%.17g,%.17g,%.17g,%.17g\n", samples[k].t_s, samples[k].strain,
-                samples[k].stress_MPa * 1e3, samples[k].kinetic_mJ, spring[k] * 1e3);
+        fprintf(a.fp, "%.17g,%.17g,%.17g,%.17g,%.17g,%d\n", samples[k].t_s, samples[k].strain,
+                samples[k].stress_MPa * 1e3, samples[k].kinetic_mJ, spring[k] * 1e3,
+                sc.effects.inertia ? -1 : k < lost);
     if (png && cf_plot_simulation(&sc, samples, spring, sc.nsamples, png, inputs, &pa, &err) !=
                    CF_OK) {
         rc = cf_cli_fail(&err);

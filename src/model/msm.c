@@ -36,6 +36,12 @@
 #define SOLID_MARGIN (1.0 - 1e-9)
 /* Bisections of a load increment (or time step) before a solve is declared non-converged. */
 #define MAX_BISECT 12
+/* Stability scan of the uniaxial lattice: steps up to STABILITY_REACH of the solid strain, then
+** bisections between the last stable strain and the first unstable one (resolution
+** REACH / STEPS / 2^BISECT of the solid strain, about 1e-5). */
+#define STABILITY_REACH 0.995
+#define STABILITY_STEPS 32
+#define STABILITY_BISECT 11
 /* Safety factor on the explicit stable step. */
 #define DT_SAFETY 0.9
 
@@ -1251,6 +1257,84 @@ cf_status cf_msm_uniaxial(const cf_law *law, cf_law_method m, const cf_msm_confi
                                   strain[i]);
     solver_free(&s);
     free(idx);
+    cf_lattice_free(&lat);
+    return rc;
+}
+
+/* ---- the stability limit of the uniaxial lattice --------------------------------------------- */
+
+/* Negative pivots of the tangent at the current state (a converged equilibrium): assembled and
+** factored once more, the update discarded. -1 when no factorisation reports its inertia. */
+static long inertia_here(solver *s)
+{
+    double rn, fs;
+    residual(s, &rn, &fs);
+    s->neg_pivots = -1;
+    cf_error e = {0};
+    (void)newton_direction(s, &e);
+    return s->neg_pivots;
+}
+
+cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_msm_config *cfgin,
+                                 int side, double *limit, cf_error *err)
+{
+    cf_msm_config cfg = cfgin ? *cfgin : cf_msm_default();
+    *limit = 0;
+    cf_lattice lat;
+    cf_status rc = cf_lattice_create(&lat, law, m, &cfg.lattice, err);
+    if (rc != CF_OK)
+        return rc;
+    cf_msm_stats st = {0};
+    solver s;
+    if ((rc = solver_init(&s, &lat, NULL, &cfg, CF_DRIVE_DISPLACEMENT, &st, err)) != CF_OK) {
+        cf_lattice_free(&lat);
+        return rc;
+    }
+    double *keep = malloc(3 * lat.nn * sizeof(double));
+    if (!keep) {
+        rc = cf_error_set(err, CF_E_INTERNAL, "out of memory");
+        goto done;
+    }
+    /* compressive-positive drive: a table strain of sign `side` is -side times it */
+    const double dir = side < 0 ? 1.0 : -1.0, top = STABILITY_REACH * lat.travel_mm / lat.H_mm;
+    double stable = 0;
+    s.load = 0;
+    for (int k = 1; k <= STABILITY_STEPS; k++) {
+        double e = top * k / STABILITY_STEPS;
+        memcpy(keep, lat.x, lat.nn * sizeof(double));
+        memcpy(keep + lat.nn, lat.y, lat.nn * sizeof(double));
+        memcpy(keep + 2 * lat.nn, lat.z, lat.nn * sizeof(double));
+        cf_error e1 = {0};
+        int lost = static_to(&s, dir * e, &e1) != CF_OK || inertia_here(&s) > 0;
+        if (!lost) {
+            stable = e;
+            continue;
+        }
+        /* Bisect between the last stable strain and this one, each solve from the stable state. */
+        double hi = e;
+        for (int b = 0; b < STABILITY_BISECT; b++) {
+            double mid = 0.5 * (stable + hi);
+            memcpy(lat.x, keep, lat.nn * sizeof(double));
+            memcpy(lat.y, keep + lat.nn, lat.nn * sizeof(double));
+            memcpy(lat.z, keep + 2 * lat.nn, lat.nn * sizeof(double));
+            s.load = dir * stable;
+            place_top(&lat, s.load);
+            cf_error e2 = {0};
+            if (static_to(&s, dir * mid, &e2) == CF_OK && inertia_here(&s) == 0) {
+                stable = mid;
+                memcpy(keep, lat.x, lat.nn * sizeof(double));
+                memcpy(keep + lat.nn, lat.y, lat.nn * sizeof(double));
+                memcpy(keep + 2 * lat.nn, lat.z, lat.nn * sizeof(double));
+            } else {
+                hi = mid;
+            }
+        }
+        *limit = -dir * 0.5 * (stable + hi);
+        break;
+    }
+done:
+    free(keep);
+    solver_free(&s);
     cf_lattice_free(&lat);
     return rc;
 }

@@ -189,13 +189,19 @@ static json_t *validation_json(const cf_fit_report *r, int i)
                             num(cm.nu), "bottom",
                             lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial");
     double fit_rmse = r->through_msm && r->thr[i].done ? r->thr[i].cell_rmse : r->fits[i].rmse;
-    return json_pack("{s:s, s:s, s:o, s:o, s:o, s:o, s:o, s:o, s:s, s:I, s:o}", "mode",
+    json_t *o = json_pack("{s:s, s:s, s:o, s:o, s:o, s:o, s:o, s:o, s:s, s:I, s:o}", "mode",
                      cf_mode_name(v->mode), "model", v->by_cell ? "homogenised cell" :
                      "full lattice", "fit_rmse", num(fit_rmse * u), "rmse", num(v->rmse * u),
                      "law_difference_rmse", num(v->law_rmse * u), "r2", num(v->r2),
                      "max_abs_error", num(v->max_abs_error * u), "lattice", lat, "law_method",
                      cf_law_method_name(v->setup.method), "solves", (json_int_t)v->solves,
                      "wall_time_s", num(r->with_timing ? v->wall_time_s : 0.0));
+    if (o && v->stability_checked) {
+        json_object_set_new(o, "stable_to_strain",
+                            v->stable_to_strain != 0 ? num(v->stable_to_strain) : json_null());
+        json_object_set_new(o, "stable_in_range", json_boolean(!v->unstable_in_range));
+    }
+    return o;
 }
 
 static json_t *through_json(const cf_fit_report *r, int i)
@@ -480,7 +486,7 @@ static void validation_text(FILE *o, const cf_fit_report *r)
             v0->by_cell ? "homogenised cell (the full lattice has no such boundary conditions)"
                         : "full lattice",
             r->through_msm ? "the lattice (through the homogenised cell)" : "the single spring");
-    enum { ROWS = 6 };
+    enum { ROWS = 7 };
     char buf[ROWS][2][64];
     const char *t[2];
     const double u = r->table->y_to_file;
@@ -501,15 +507,28 @@ static void validation_text(FILE *o, const cf_fit_report *r)
         snprintf(buf[4][i], sizeof buf[4][i], "%.6f", v->r2);
         snprintf(buf[5][i], sizeof buf[5][i], "%.1f ms, %zu solves", 1e3 * v->wall_time_s,
                  v->solves);
+        if (!v->stability_checked)
+            snprintf(buf[6][i], sizeof buf[6][i], "not checked");
+        else if (v->stable_to_strain == 0)
+            snprintf(buf[6][i], sizeof buf[6][i], "to solid");
+        else
+            snprintf(buf[6][i], sizeof buf[6][i], "to strain %.4g%s", v->stable_to_strain,
+                     v->unstable_in_range ? " (!)" : "");
     }
     static const char *const labels[ROWS] = {"fit RMSE (its target)", "lattice RMSE",
                                              "lattice vs law (RMSE)", "lattice max |error|",
-                                             "lattice R^2", "lattice time"};
+                                             "lattice R^2", "lattice time", "lattice stable"};
     for (int k = 0; k < ROWS; k++) {
         for (int i = 0; i < r->nfits; i++)
             t[i] = buf[k][i];
         cells(o, r, labels[k], t);
     }
+    for (int i = 0; i < r->nfits; i++)
+        if (r->val[i].done && r->val[i].unstable_in_range)
+            fprintf(o, "  (!) %s: the lattice loses stability at strain %.4g, inside the table's "
+                    "range: past it the static curve is an unstable equilibrium (a column of "
+                    "cells buckles sideways in a dynamic run)\n",
+                    cf_spring_type_name(r->fits[i].type), r->val[i].stable_to_strain);
     if (r->through_msm) {
         for (int i = 0; i < r->nfits; i++) {
             const cf_through_msm *th = &r->thr[i];

@@ -135,6 +135,15 @@ cf_status cf_msm_uniaxial(const cf_law *law, cf_law_method m, const cf_msm_confi
                           const double *strain, size_t count, double *stress_MPa,
                           cf_msm_stats *stats, cf_error *err);
 
+/* Where the static uniaxial lattice (cfg->lattice, cfg NULL: cf_msm_default()) built from law
+** first loses stability on one side (side < 0: compression, > 0: tension): the strain, in the
+** table's sign, at which the tangent of the homogeneous equilibrium first has a negative pivot
+** (a column of cells can buckle sideways; a dynamic run leaves the static curve there), found by
+** steps of 1/32 up to 0.995 of the solid strain and bisection to about 1e-5 of it. *limit = 0
+** when the lattice stays stable up to there. A static solve that fails counts as unstable. */
+cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_msm_config *cfg,
+                                 int side, double *limit, cf_error *err);
+
 /* The explicit stable step (s) of the lattice at its current state for the given effects
 ** (stiffest spring tangent, lightest mass, most springs at one node; the dashpots shorten it).
 ** Calls cf_lattice_forces. */

@@ -65,6 +65,11 @@ typedef struct cf_validation {
                                 ** boundary conditions for); 0: the full lattice */
     double law_rmse;            /* RMSE of the lattice against the law's own curve F(eH)/H^2:
                                 ** what the lattice adds to the spring, MPa */
+    int stability_checked;      /* 1: the static uniaxial lattice's stability limit was sought */
+    double stable_to_strain;    /* the strain (table sign) where the lattice first loses stability
+                                ** on the table's side (compression when the table has any), or 0
+                                ** when it stays stable up to 0.995 of the solid strain */
+    int unstable_in_range;      /* 1: the table reaches past stable_to_strain */
     size_t count;               /* points of stress_MPa */
     double *stress_MPa;         /* lattice stress at each table strain, MPa (owned; NULL if skipped) */
 } cf_validation;
