@@ -284,6 +284,12 @@ static size_t inp_pairs(const char *x, const char *after, double *F, double *e, 
     int used;
     double f, el;
     while (sscanf(b, "%lf, %lf\n%n", &f, &el, &used) == 2) {
+        /* both numbers carry a decimal point: ccx tells spring data from degrees of freedom by
+        ** whether the first line under *SPRING holds reals */
+        int dots = 0;
+        for (int k = 0; k < used; k++)
+            dots += b[k] == '.';
+        assert_int_equal(dots, 2);
         if (n < cap) {
             F[n] = f;
             e[n] = el;

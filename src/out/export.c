@@ -131,7 +131,7 @@ static void write_inp_block(FILE *out, const cf_law *law, const cf_export_table 
     fprintf(out, "** CalculiX holds the force of the last pair beyond the table (constant force)\n");
     fprintf(out, "*SPRING, ELSET=CONIFIT_SPRING, NONLINEAR\n\n");
     for (size_t i = t->rows; i-- > 0;)
-        fprintf(out, "%.17g, %.17g\n", -t->F_N[i], -t->u_mm[i]);
+        cf_export_inp_pair(out, -t->F_N[i], -t->u_mm[i]);
 }
 
 static void write_febio_block(FILE *out, const cf_law *law, const cf_export_table *t,

@@ -77,6 +77,41 @@ int cf_xmodel_tables(cf_xmodel *m)
     return 0;
 }
 
+/* A real for CalculiX/Abaqus input: at most 20 characters (ccx reads a number from a field of
+** 20 characters), always with a decimal point, with as many significant digits as fit (17, or 14
+** for a negative number with an exponent). */
+static void inp_real(char buf[32], double x)
+{
+    if (x == 0.0)
+        x = 0.0; /* no "-0" */
+    for (int p = 17; p >= 8; p--) {
+        char t[40];
+        snprintf(t, sizeof t, "%.*g", p, x);
+        char *e = strpbrk(t, "eE");
+        if (!strchr(t, '.')) { /* 40 -> 40.  1e-05 -> 1.e-05 */
+            char tail[40];
+            snprintf(tail, sizeof tail, "%s", e ? e : "");
+            if (e)
+                *e = '\0';
+            strcat(t, ".");
+            strcat(t, tail);
+        }
+        if (strlen(t) <= 20) {
+            memcpy(buf, t, strlen(t) + 1);
+            return;
+        }
+    }
+    snprintf(buf, 32, "%.8e", x);
+}
+
+void cf_export_inp_pair(FILE *out, double force_N, double elongation_mm)
+{
+    char a[32], b[32];
+    inp_real(a, force_N);
+    inp_real(b, elongation_mm);
+    fprintf(out, "%s, %s\n", a, b);
+}
+
 /* ---- comments shared by the writers ---------------------------------------------------------- */
 
 void cf_export_comment_spring(FILE *out, const char *lead, const char *tail, const cf_law *law)
@@ -156,8 +191,13 @@ void cf_xmodel_write_inp(FILE *out, const cf_xmodel *m, int abaqus)
                  abaqus ? "abaqus job=NAME (summed top reaction RF3 in NAME.dat per increment)"
                         : "ccx -i NAME (summed top reaction in NAME.dat, 'total force' lines)");
     fprintf(out, "*NODE, NSET=NALL\n");
-    for (size_t i = 0; i < m->nn; i++)
-        fprintf(out, "%zu, %.17g, %.17g, %.17g\n", i + 1, m->X[i], m->Y[i], m->Z[i]);
+    for (size_t i = 0; i < m->nn; i++) {
+        char x[32], y[32], z[32];
+        inp_real(x, m->X[i]);
+        inp_real(y, m->Y[i]);
+        inp_real(z, m->Z[i]);
+        fprintf(out, "%zu, %s, %s, %s\n", i + 1, x, y, z);
+    }
     fprintf(out, "*NSET, NSET=NTOP\n");
     for (size_t t = 0; t < m->ntop; t++)
         fprintf(out, "%u%s", m->top[t] + 1, (t % 16 == 15 || t + 1 == m->ntop) ? "\n" : ", ");
@@ -170,7 +210,7 @@ void cf_xmodel_write_inp(FILE *out, const cf_xmodel *m, int abaqus)
                 g + 1, m->g[g].L0_mm, m->g[g].weight);
         fprintf(out, "*SPRING, ELSET=G%zu, NONLINEAR\n\n", g + 1);
         for (size_t i = 0; i < m->g[g].rows; i++)
-            fprintf(out, "%.17g, %.17g\n", m->g[g].T_N[i], m->g[g].e_mm[i]);
+            cf_export_inp_pair(out, m->g[g].T_N[i], m->g[g].e_mm[i]);
     }
     fprintf(out, "*BOUNDARY\n");
     for (size_t i = 0; i < m->nn; i++)
@@ -181,7 +221,9 @@ void cf_xmodel_write_inp(FILE *out, const cf_xmodel *m, int abaqus)
         fprintf(out, "*STEP, NLGEOM%s, INC=1000\n*STATIC\n1., 1.\n", abaqus ? "=YES" : "");
         fprintf(out, "*CONTROLS, PARAMETERS=FIELD%s\n%s", abaqus ? ", FIELD=DISPLACEMENT" : "",
                 inp_controls);
-        fprintf(out, "*BOUNDARY\nNTOP, 3, 3, %.17g\n", m->dz_mm[k]);
+        char dz[32];
+        inp_real(dz, m->dz_mm[k]);
+        fprintf(out, "*BOUNDARY\nNTOP, 3, 3, %s\n", dz);
         fprintf(out, "*NODE PRINT, NSET=NTOP, TOTALS=ONLY\nRF\n*END STEP\n");
     }
 }

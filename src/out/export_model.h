@@ -71,6 +71,12 @@ void cf_xmodel_write_febio(FILE *out, const cf_xmodel *m);
 void cf_xmodel_write_lsdyna(FILE *out, const cf_xmodel *m);
 int cf_xmodel_write_sofa(FILE *out, const cf_xmodel *m); /* -1: out of memory */
 
+/* Writes one (force, elongation) pair of a *SPRING table, each number with a decimal point: ccx
+** decides from the first line under *SPRING whether it holds degrees of freedom (integers) or
+** spring data (reals), after deleting blank lines (ccx manual, *SPRING); each number fits the 20
+** characters ccx reads. */
+void cf_export_inp_pair(FILE *out, double force_N, double elongation_mm);
+
 /* Writes a comment line with the spring's parameters, and the table's accuracy, each line
 ** starting with lead and ending with tail. */
 void cf_export_comment_spring(FILE *out, const char *lead, const char *tail, const cf_law *law);
