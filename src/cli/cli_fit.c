@@ -51,8 +51,10 @@ static const char fit_help[] =
     "  --through-msm [SCENE.json]  the same as --target lattice [--validate SCENE.json]\n"
     "  --mode M                the table's test mode: uniaxial, shear, planar, equibiaxial or\n"
     "                          confined (wins over a '# mode:' comment; default uniaxial)\n"
-    "  --plot FILE.png|.svg    draw data, fits, baselines and residuals with gnuplot\n"
+    "  --plot FILE.png|.svg|.pdf  draw data, fits, baselines and residuals with gnuplot\n"
     "                          (with several tables: a folder DIR/, one NAME.png per table)\n"
+    "  --title TEXT            title of the plot (default: the table's file name without\n"
+    "                          folder and extension)\n"
     "  --x-col NAME, --y-col NAME   columns to use in wider tables\n"
     "  --stress-unit U         unit of a stress column without one (Pa, kPa, MPa, ...)\n"
     "  --force-unit U          unit of a force column without one (N, mN, ...)\n"
@@ -156,7 +158,8 @@ enum {
     OPT_G_MAX,
     OPT_BRANCHES,
     OPT_DASHPOT,
-    OPT_ELASTIC
+    OPT_ELASTIC,
+    OPT_TITLE
 };
 
 static const struct option fit_options[] = {
@@ -185,6 +188,7 @@ static const struct option fit_options[] = {
     {"branches", required_argument, NULL, OPT_BRANCHES},
     {"dashpot", no_argument, NULL, OPT_DASHPOT},
     {"elastic", required_argument, NULL, OPT_ELASTIC},
+    {"title", required_argument, NULL, OPT_TITLE},
     {"jobs", required_argument, NULL, 'j'},
     {NULL, 0, NULL, 0}};
 
@@ -271,6 +275,7 @@ static int fit_option(void *ctx, int c, const char *optval)
     long n;
     switch (c) {
     case OPT_PLOT: a->plot = optval; return 0;
+    case OPT_TITLE: a->popt.title = optval; return 0;
     case OPT_TYPE:
         if (strcmp(optval, "both") == 0)
             a->popt.types = CF_PIPELINE_BOTH;
@@ -418,7 +423,7 @@ static int parse_args(int argc, char **argv, fit_args *a)
         return cf_cli_usage_error(cmd, "--plot %s: with %d tables, --plot must name a folder",
                                   a->plot, a->nfiles);
     if (a->plot && !is_dir_target(a->plot) && cf_plot_check_name(a->plot, &err) != CF_OK)
-        return cf_cli_usage_error(cmd, "--plot %s: the file must end in .png or .svg", a->plot);
+        return cf_cli_usage_error(cmd, "--plot %s: the file must end in .png, .svg or .pdf", a->plot);
     return -1;
 }
 

@@ -18,7 +18,7 @@
 #include "out/plot.h"
 
 static const char simulate_help[] =
-    "usage: conifit simulate SCENE.json -o OUT.csv [--plot OUT.png|.svg] [-q]\n"
+    "usage: conifit simulate SCENE.json -o OUT.csv [--plot OUT.png|.svg|.pdf] [-q]\n"
     "Runs the scene on a mass-spring lattice of conical springs and writes the CSV\n"
     "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,stable (compression positive:\n"
     "strain is the top face's shortening over the height, stress the top reaction over nx ny H^2,\n"
@@ -28,7 +28,7 @@ static const char simulate_help[] =
     "A scene with no inertia, damping or viscosity is solved as static equilibria.\n\n"
     "  -o, --output FILE   CSV to write (written to a temporary name, then renamed); '-'\n"
     "                      writes it to standard output and the summary to stderr\n"
-    "  --plot FILE.png|.svg  also plot the result with gnuplot\n"
+    "  --plot FILE.png|.svg|.pdf  also plot the result with gnuplot\n"
     "  --max-memory SIZE   refuse a scene estimated to need more memory (bytes, or with a\n"
     "                      K, M or G suffix; default 2G)\n"
     "  --max-steps N       refuse a scene estimated to need more time steps or static\n"
@@ -195,7 +195,7 @@ int cf_cli_simulate(int argc, char **argv)
         return cf_cli_usage_error("simulate", "no output file given (-o OUT.csv, or -o - for "
                                               "standard output)");
     if (png && cf_plot_check_name(png, &err) != CF_OK)
-        return cf_cli_usage_error("simulate", "--plot %s: the file must end in .png or .svg", png);
+        return cf_cli_usage_error("simulate", "--plot %s: the file must end in .png, .svg or .pdf", png);
 
     cf_scene sc;
     if (png && strcmp(png, out) == 0)

@@ -27,9 +27,10 @@ static int ends_with_ci(const char *s, const char *suffix)
 
 cf_status cf_gp_check_name(const char *path, cf_error *err)
 {
-    if (path && (ends_with_ci(path, ".png") || ends_with_ci(path, ".svg")))
+    if (path && (ends_with_ci(path, ".png") || ends_with_ci(path, ".svg") ||
+                 ends_with_ci(path, ".pdf")))
         return CF_OK;
-    return cf_error_set(err, CF_E_DATA, "plot %s: the file must end in .png or .svg",
+    return cf_error_set(err, CF_E_DATA, "plot %s: the file must end in .png, .svg or .pdf",
                         path ? path : "(none)");
 }
 
@@ -188,8 +189,11 @@ void cf_gp_terminal(cf_gp *g, const char *path, int width, int height)
     else if (path && ends_with_ci(path, ".png"))
         cf_gp_cmd(g, "set terminal pngcairo size %d,%d enhanced font %q", width, height,
                   "sans,11");
+    else if (path && ends_with_ci(path, ".pdf")) /* vector, for papers: 140 pixels to the inch */
+        cf_gp_cmd(g, "set terminal pdfcairo size %gin,%gin enhanced font %q", width / 140.0,
+                  height / 140.0, "sans,8");
     else
-        invalid(g, CF_E_DATA, "the file must end in .png or .svg");
+        invalid(g, CF_E_DATA, "the file must end in .png, .svg or .pdf");
 }
 
 void cf_gp_block_begin(cf_gp *g, const char *name)

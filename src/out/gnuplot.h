@@ -32,7 +32,7 @@ typedef struct cf_gp {
     char msg[160];
 } cf_gp;
 
-/* CF_OK for a path conifit can draw to: .png (cairo PNG) or .svg (any case); CF_E_DATA naming the
+/* CF_OK for a path conifit can draw to: .png (cairo PNG), .svg or .pdf (cairo PDF) (any case); CF_E_DATA naming the
 ** path otherwise. */
 cf_status cf_gp_check_name(const char *path, cf_error *err);
 

@@ -13,55 +13,82 @@
 /* Points on each model curve. */
 #define CURVE_POINTS 400
 
-/* x and the lattice stress (file's unit) of every data point, sorted by x. */
+/* The figure of a fit, laid out for a paper: the model panel on top, the residual panel under
+** it, both with the same x axis and margins, each with its legend in the column to their right
+** (never over the data). Every curve differs from the others by its dash pattern, width or point
+** symbol as well as by its colour, so that the figure reads in greyscale. */
+
+/* Left and right edge of both panels, and where the legends start (fractions of the canvas). */
+#define PANEL_LEFT 0.09
+#define PANEL_RIGHT 0.66
+#define KEY_LEFT 0.68
+
+/* Line styles: 1-2 the conical fits, 3-5 the baselines, 6-7 the lattice curves. */
+static void styles(cf_gp *g)
+{
+    cf_gp_cmd(g, "set style line 1 dt 1 lw 3.5 lc rgb %q", "#b2182b");
+    cf_gp_cmd(g, "set style line 2 dt 2 lw 2.5 lc rgb %q", "#2166ac");
+    cf_gp_cmd(g, "set style line 3 dt 3 lw 2 lc rgb %q", "#525252");
+    cf_gp_cmd(g, "set style line 4 dt 4 lw 1.5 lc rgb %q", "#1b7837");
+    cf_gp_cmd(g, "set style line 5 dt 5 lw 1.5 lc rgb %q", "#762a83");
+    cf_gp_cmd(g, "set style line 6 dt 1 lw 1.5 pt 4 ps 0.9 lc rgb %q", "#d6604d");
+    cf_gp_cmd(g, "set style line 7 dt 2 lw 1.5 pt 8 ps 0.9 lc rgb %q", "#4393c3");
+}
+
+/* The table's name: its file name without folder and extension. */
+static void table_name(const cf_table *d, char *out, size_t cap)
+{
+    const char *base = strrchr(d->path, '/');
+    base = base ? base + 1 : d->path;
+    const char *dot = strrchr(base, '.');
+    int n = (dot && dot != base) ? (int)(dot - base) : (int)strlen(base);
+    snprintf(out, cap, "%.*s", n, base);
+}
+
+/* x, the lattice stress and its residual (file's unit) of every data point, sorted by x. */
 static void lattice_block(cf_gp *g, const char *name, const cf_table *d,
                           const double *stress_MPa, double u)
 {
     size_t *ord = malloc(sizeof(size_t) * (d->count ? d->count : 1));
-    if (!ord) {
-        cf_gp_block_begin(g, name);
-        cf_gp_block_end(g);
-        return;
-    }
-    for (size_t i = 0; i < d->count; i++)
-        ord[i] = i;
-    for (size_t i = 1; i < d->count; i++) /* insertion sort: tables are short and nearly sorted */
-        for (size_t j = i; j > 0 && d->x[ord[j - 1]] > d->x[ord[j]]; j--) {
-            size_t t = ord[j];
-            ord[j] = ord[j - 1];
-            ord[j - 1] = t;
-        }
     cf_gp_block_begin(g, name);
-    for (size_t i = 0; i < d->count; i++) {
-        double row[2] = {d->x[ord[i]], stress_MPa[ord[i]] * u};
-        cf_gp_block_row(g, 2, row);
+    if (ord) {
+        for (size_t i = 0; i < d->count; i++)
+            ord[i] = i;
+        for (size_t i = 1; i < d->count; i++) /* insertion sort: tables are short, nearly sorted */
+            for (size_t j = i; j > 0 && d->x[ord[j - 1]] > d->x[ord[j]]; j--) {
+                size_t t = ord[j];
+                ord[j] = ord[j - 1];
+                ord[j - 1] = t;
+            }
+        for (size_t i = 0; i < d->count; i++) {
+            size_t k = ord[i];
+            double row[3] = {d->x[k], stress_MPa[k] * u, (stress_MPa[k] - d->y[k]) * u};
+            cf_gp_block_row(g, 3, row);
+        }
     }
     cf_gp_block_end(g);
     free(ord);
 }
 
-static void fit_script(cf_gp *g, const void *fig)
+/* The data blocks: $DATA (x, y, the residual of each fit then of each baseline) and $CURVES (x,
+** each fit, each baseline) in the file's unit. */
+static void fit_blocks(cf_gp *g, const cf_fit_report *r)
 {
-    const cf_fit_report *r = fig;
     const cf_table *d = r->table;
     const double u = d->y_to_file;
-    double xmin = 0, xmax = 0;
+    const int fd = cf_table_is_force(d);
+    double xmin = 0, xmax = 0, row[2 + 2 * (2 + CF_BASE_COUNT)];
     for (size_t i = 0; i < d->count; i++) {
         xmin = fmin(xmin, d->x[i]);
         xmax = fmax(xmax, d->x[i]);
     }
-    cf_law laws[2];
-    for (int i = 0; i < r->nfits; i++)
-        laws[i] = r->fits[i].law;
-    double row[2 + 2 * (2 + CF_BASE_COUNT)];
-    /* data: x, y, then the residual of each model (fits then baselines) */
     cf_gp_block_begin(g, "DATA");
     for (size_t i = 0; i < d->count; i++) {
         size_t c = 0;
         row[c++] = d->x[i];
         row[c++] = d->y[i] * u;
         for (int k = 0; k < r->nfits; k++)
-            row[c++] = (cf_fit_model(&laws[k], cf_table_is_force(d), d->x[i]) - d->y[i]) * u;
+            row[c++] = (cf_fit_model(&r->fits[k].law, fd, d->x[i]) - d->y[i]) * u;
         for (int k = 0; k < CF_BASE_COUNT; k++)
             row[c++] = (cf_baseline_eval(&r->baselines[k], d->x[i]) - d->y[i]) * u;
         cf_gp_block_row(g, c, row);
@@ -73,71 +100,160 @@ static void fit_script(cf_gp *g, const void *fig)
         double x = xmin + (xmax - xmin) * j / CURVE_POINTS;
         row[c++] = x;
         for (int k = 0; k < r->nfits; k++)
-            row[c++] = cf_fit_model(&laws[k], cf_table_is_force(d), x) * u;
+            row[c++] = cf_fit_model(&r->fits[k].law, fd, x) * u;
         for (int k = 0; k < CF_BASE_COUNT; k++)
             row[c++] = cf_baseline_eval(&r->baselines[k], x) * u;
         cf_gp_block_row(g, c, row);
     }
     cf_gp_block_end(g);
-    /* the lattice curve of each validated fit, at the table's strains in increasing order */
-    static const char *const lat_name[2] = {"LATTICE0", "LATTICE1"};
-    int lat[2] = {0, 0};
-    if (r->validate)
-        for (int k = 0; k < r->nfits; k++)
-            if (r->val[k].done && r->val[k].count == d->count) {
-                lattice_block(g, lat_name[k], d, r->val[k].stress_MPa, u);
-                lat[k] = 1;
-            }
-    cf_gp_cmd(g, "set multiplot");
-    cf_gp_cmd(g, "set title %q noenhanced", d->path);
-    cf_gp_cmd(g, "set size 1,0.66");
-    cf_gp_cmd(g, "set origin 0,0.34");
-    cf_gp_cmd(g, "set grid");
-    cf_gp_cmd(g, "set key top left box opaque");
-    cf_gp_cmd(g, "set xlabel %q", cf_table_is_force(d) ? "displacement [mm]" : "strain [-]");
-    char yl[400];
-    snprintf(yl, sizeof yl, "%s [%s]", d->y_column, d->y_unit);
-    cf_gp_cmd(g, "set ylabel %q noenhanced", yl);
-    static const char *colors[2] = {"#d62728", "#1f77b4"};
-    static const char *bcolors[CF_BASE_COUNT] = {"#7f7f7f", "#2ca02c", "#9467bd"};
-    /* one plot command over several lines: each item ends in a backslash, an empty line ends it */
-    cf_gp_cmd(g, "plot $DATA using 1:2 with points pt 7 ps 0.6 lc rgb %q title %q \\", "black",
-              "measured");
+}
+
+/* Which curves a panel draws: the fits (both, or one when the types tie) and the lattices (both,
+** one when their curves coincide, or none). */
+typedef struct fit_curves {
+    int fit[2];       /* 1: draw fit k */
+    int lattice[2];   /* 1: draw the lattice curve of fit k */
+    int style[2];     /* line style of fit k (its lattice curve: style + 5) */
+    char fit_title[2][96];
+    char lattice_title[2][128];
+} fit_curves;
+
+/* Two curves that differ by less than this fraction of the largest |y| cannot be told apart in a
+** figure: they are drawn once, and the legend says so. */
+#define SAME_CURVE 2e-3
+
+static void choose_curves(const cf_fit_report *r, fit_curves *c)
+{
+    memset(c, 0, sizeof *c);
+    const cf_table *d = r->table;
+    const int fd = cf_table_is_force(d);
+    int keep = cf_report_better(r);
+    if (keep < 0)
+        keep = 0;
     for (int k = 0; k < r->nfits; k++) {
-        char t[64];
-        snprintf(t, sizeof t, "conical, %s", cf_spring_type_name(r->fits[k].type));
-        cf_gp_cmd(g, "  , $CURVES using 1:%d with lines lw %d lc rgb %q title %q \\", 2 + k,
-                  k == 0 ? 4 : 2, colors[k], t);
+        c->fit[k] = 1;
+        c->style[k] = 1 + (int)r->fits[k].type;
+        snprintf(c->fit_title[k], sizeof c->fit_title[k], "conical, %s",
+                 cf_spring_type_name(r->fits[k].type));
+        c->lattice[k] = r->validate && r->val[k].done && r->val[k].count == d->count;
+        const cf_lattice_config *lc = &r->val[k].setup.cfg.lattice;
+        snprintf(c->lattice_title[k], sizeof c->lattice_title[k], "lattice %dx%dx%d, %s", lc->nx,
+                 lc->ny, lc->nz, cf_spring_type_name(r->fits[k].type));
     }
-    for (int k = 0; k < CF_BASE_COUNT; k++)
-        cf_gp_cmd(g, "  , $CURVES using 1:%d with lines lw 1 dt 2 lc rgb %q title %q \\",
-                  2 + r->nfits + k, bcolors[k], cf_baseline_name((cf_baseline_kind)k));
-    for (int k = 0; k < r->nfits; k++)
-        if (lat[k]) {
-            char t[96];
-            snprintf(t, sizeof t, "lattice %dx%dx%d, %s", r->val[k].setup.cfg.lattice.nx,
-                     r->val[k].setup.cfg.lattice.ny, r->val[k].setup.cfg.lattice.nz,
-                     cf_spring_type_name(r->fits[k].type));
-            cf_gp_cmd(g, "  , $LATTICE%d using 1:2 with linespoints lw 2 dt 4 pt 6 ps 0.5 "
-                         "lc rgb %q title %q \\",
-                      k, colors[k], t);
+    if (r->nfits != 2)
+        return;
+    /* the two fits at the table's points and between them */
+    double diff = 0, xmin = 0, xmax = 0;
+    for (size_t i = 0; i < d->count; i++) {
+        xmin = fmin(xmin, d->x[i]);
+        xmax = fmax(xmax, d->x[i]);
+    }
+    for (int j = 0; j <= CURVE_POINTS; j++) {
+        double x = xmin + (xmax - xmin) * j / CURVE_POINTS;
+        diff = fmax(diff, fabs(cf_fit_model(&r->fits[0].law, fd, x) -
+                               cf_fit_model(&r->fits[1].law, fd, x)));
+    }
+    if (cf_report_types_tie(r) || diff <= SAME_CURVE * r->ymax) {
+        c->fit[1 - keep] = 0;
+        c->style[keep] = 1; /* one curve for both: the solid style */
+        if (cf_report_types_tie(r))
+            snprintf(c->fit_title[keep], sizeof c->fit_title[keep],
+                     "conical, both types (a tie)");
+        else
+            snprintf(c->fit_title[keep], sizeof c->fit_title[keep],
+                     "conical, both types (coincide)");
+    }
+    if (c->lattice[0] && c->lattice[1]) {
+        diff = 0;
+        for (size_t i = 0; i < d->count; i++)
+            diff = fmax(diff, fabs(r->val[0].stress_MPa[i] - r->val[1].stress_MPa[i]));
+        if (diff <= SAME_CURVE * r->ymax) {
+            c->lattice[1 - keep] = 0;
+            const cf_lattice_config *lc = &r->val[keep].setup.cfg.lattice;
+            snprintf(c->lattice_title[keep], sizeof c->lattice_title[keep],
+                     "lattice %dx%dx%d, both types (coincide)", lc->nx, lc->ny, lc->nz);
         }
-    cf_gp_cmd(g, "");
-    cf_gp_cmd(g, "set size 1,0.34");
-    cf_gp_cmd(g, "set origin 0,0");
-    cf_gp_cmd(g, "unset title");
-    cf_gp_cmd(g, "set key off");
-    char rl[96];
-    snprintf(rl, sizeof rl, "residual [%s]", d->y_unit);
-    cf_gp_cmd(g, "set ylabel %q noenhanced", rl);
-    cf_gp_cmd(g, "plot 0 with lines lc rgb %q notitle \\", "black");
+    }
+}
+
+/* One panel's plot command: the measured points (model panel only), the fits, the baselines and
+** the lattice curves, columns from $DATA/$CURVES (residual: $DATA's residual columns). */
+static void fit_panel(cf_gp *g, const cf_fit_report *r, const fit_curves *c, int residual)
+{
+    if (residual)
+        cf_gp_cmd(g, "plot 0 with lines lc rgb %q lw 1 notitle \\", "black");
+    else
+        cf_gp_cmd(g, "plot $DATA using 1:2 with points pt 7 ps 0.7 lc rgb %q title %q \\",
+                  "black", "measured");
     for (int k = 0; k < r->nfits; k++)
-        cf_gp_cmd(g, "  , $DATA using 1:%d with linespoints pt 7 ps 0.4 lc rgb %q \\", 3 + k,
-                  colors[k]);
-    for (int k = 0; k < CF_BASE_COUNT; k++)
-        cf_gp_cmd(g, "  , $DATA using 1:%d with lines dt 2 lc rgb %q \\", 3 + r->nfits + k,
-                  bcolors[k]);
+        if (c->fit[k]) {
+            if (residual)
+                cf_gp_cmd(g, "  , $DATA using 1:%d with lines ls %d title %q \\", 3 + k,
+                          c->style[k], c->fit_title[k]);
+            else
+                cf_gp_cmd(g, "  , $CURVES using 1:%d with lines ls %d title %q \\", 2 + k,
+                          c->style[k], c->fit_title[k]);
+        }
+    for (int k = 0; k < CF_BASE_COUNT; k++) {
+        const char *name = cf_baseline_name((cf_baseline_kind)k);
+        if (residual)
+            cf_gp_cmd(g, "  , $DATA using 1:%d with lines ls %d title %q \\", 3 + r->nfits + k,
+                      3 + k, name);
+        else
+            cf_gp_cmd(g, "  , $CURVES using 1:%d with lines ls %d title %q \\", 2 + r->nfits + k,
+                      3 + k, name);
+    }
+    for (int k = 0; k < r->nfits; k++)
+        if (c->lattice[k])
+            cf_gp_cmd(g, "  , $LATTICE%d using 1:%d with linespoints ls %d title %q \\", k,
+                      residual ? 3 : 2, 5 + c->style[k], c->lattice_title[k]);
     cf_gp_cmd(g, "");
+}
+
+static void fit_script(cf_gp *g, const void *fig)
+{
+    const cf_fit_report *r = fig;
+    const cf_table *d = r->table;
+    fit_blocks(g, r);
+    fit_curves c;
+    choose_curves(r, &c);
+    static const char *const lat_name[2] = {"LATTICE0", "LATTICE1"};
+    for (int k = 0; k < r->nfits; k++)
+        if (c.lattice[k])
+            lattice_block(g, lat_name[k], d, r->val[k].stress_MPa, d->y_to_file);
+    char title[300], label[400];
+    if (r->title)
+        snprintf(title, sizeof title, "%s", r->title);
+    else
+        table_name(d, title, sizeof title);
+    styles(g);
+    cf_gp_cmd(g, "set multiplot");
+    cf_gp_cmd(g, "set grid lc rgb %q", "#d9d9d9");
+    cf_gp_cmd(g, "set format x %q", "%g");
+    cf_gp_cmd(g, "set format y %q", "%g");
+    cf_gp_cmd(g, "set lmargin at screen %g", PANEL_LEFT);
+    cf_gp_cmd(g, "set rmargin at screen %g", PANEL_RIGHT);
+    cf_gp_cmd(g, "set xlabel %q", cf_table_is_force(d) ? "displacement [mm]" : "strain [-]");
+    /* the model panel */
+    cf_gp_cmd(g, "set title %q noenhanced", title);
+    cf_gp_cmd(g, "set tmargin at screen 0.93");
+    cf_gp_cmd(g, "set bmargin at screen 0.42");
+    cf_gp_cmd(g, "set key at screen %g,0.93 left top Left reverse noenhanced spacing 1.2 "
+                 "samplen 3.5 title %q",
+              KEY_LEFT, "model");
+    snprintf(label, sizeof label, "%s [%s]", d->y_column, d->y_unit);
+    cf_gp_cmd(g, "set ylabel %q noenhanced", label);
+    fit_panel(g, r, &c, 0);
+    /* the residual panel */
+    cf_gp_cmd(g, "unset title");
+    cf_gp_cmd(g, "set tmargin at screen 0.32");
+    cf_gp_cmd(g, "set bmargin at screen 0.07");
+    cf_gp_cmd(g, "set key at screen %g,0.32 left top Left reverse noenhanced spacing 1.2 "
+                 "samplen 3.5 title %q",
+              KEY_LEFT, "residual (model - measured)");
+    snprintf(label, sizeof label, "residual [%s]", d->y_unit);
+    cf_gp_cmd(g, "set ylabel %q noenhanced", label);
+    fit_panel(g, r, &c, 1);
     cf_gp_cmd(g, "unset multiplot");
 }
 
@@ -164,7 +280,7 @@ cf_status cf_plot_check_name(const char *path, cf_error *err)
 cf_status cf_plot_fit(const cf_fit_report *r, const char *path, const char *const *inputs,
                       cf_atomic *out, cf_error *err)
 {
-    return draw(fit_script, r, 900, 800, path, inputs, out, err);
+    return draw(fit_script, r, 1150, 820, path, inputs, out, err);
 }
 
 cf_status cf_plot_write(const cf_fit_report *r, const char *path, const char *const *inputs,
@@ -198,8 +314,13 @@ static void simulation_script(cf_gp *g, const void *fig)
         cf_gp_block_row(g, 4, row);
     }
     cf_gp_block_end(g);
-    cf_gp_cmd(g, "set key top left noenhanced");
-    cf_gp_cmd(g, "set grid");
+    /* the legend under the axes, never over the curve; styles that differ in greyscale */
+    cf_gp_cmd(g, "set key below noenhanced spacing 1.2 samplen 3.5");
+    cf_gp_cmd(g, "set bmargin 5");
+    cf_gp_cmd(g, "set grid lc rgb %q", "#d9d9d9");
+    cf_gp_cmd(g, "set format x %q", "%g");
+    cf_gp_cmd(g, "set format y %q", "%g");
+    styles(g);
     /* the curve is named after the spring it ran (a scene's fit file, or "params") */
     char lattice[700];
     snprintf(lattice, sizeof lattice, "lattice (spring: %s)", sc->spring_source);
@@ -208,11 +329,11 @@ static void simulation_script(cf_gp *g, const void *fig)
         if (sc->drive == CF_DRIVE_FORCE) {
             cf_gp_cmd(g, "set ylabel %q", "compressive strain");
             cf_gp_cmd(g, "set title %q", "creep under a held load");
-            cf_gp_cmd(g, "plot $SIM using 1:2 with lines lw 2 title %q", lattice);
+            cf_gp_cmd(g, "plot $SIM using 1:2 with lines ls 1 title %q", lattice);
         } else {
             cf_gp_cmd(g, "set ylabel %q", "compressive stress (kPa)");
             cf_gp_cmd(g, "set title %q", "relaxation under a held strain");
-            cf_gp_cmd(g, "plot $SIM using 1:3 with lines lw 2 title %q", lattice);
+            cf_gp_cmd(g, "plot $SIM using 1:3 with lines ls 1 title %q", lattice);
         }
         return;
     }
@@ -220,11 +341,11 @@ static void simulation_script(cf_gp *g, const void *fig)
     cf_gp_cmd(g, "set ylabel %q", "compressive stress (kPa)");
     if (sc->kind == CF_PROTO_CYCLES) {
         cf_gp_cmd(g, "set title %q", "load-unload cycles");
-        cf_gp_cmd(g, "plot $SIM using 2:3 with lines lw 2 title %q", lattice);
+        cf_gp_cmd(g, "plot $SIM using 2:3 with lines ls 1 title %q", lattice);
     } else {
         cf_gp_cmd(g, "set title %q", "uniaxial: lattice against one spring");
-        cf_gp_cmd(g, "plot $SIM using 2:3 with lines lw 2 title %q, $SIM using 2:4 with lines "
-                     "lw 2 dt 2 title %q",
+        cf_gp_cmd(g, "plot $SIM using 2:3 with lines ls 1 title %q, $SIM using 2:4 with lines "
+                     "ls 2 title %q",
                   lattice, "single spring");
     }
 }

@@ -20,12 +20,12 @@
 #include "conifit/report.h"
 #include "conifit/scene.h"
 
-/* CF_OK when path names a format conifit draws (.png or .svg, any case); CF_E_DATA otherwise. A
+/* CF_OK when path names a format conifit draws (.png, .svg or .pdf, any case); CF_E_DATA otherwise. A
 ** command checks this before any work, so that a misspelt name costs nothing. */
 cf_status cf_plot_check_name(const char *path, cf_error *err);
 
 /* Draws the report's table (x, y in conifit's units: strain or mm, MPa or N; shown in the file's
-** units) to path, a .png or .svg file, as a temporary file left in *out for the caller to commit
+** units) to path, a .png, .svg or .pdf file, as a temporary file left in *out for the caller to commit
 ** with its other outputs (cf_atomic_commit) or abort. CF_E_DATA for another extension,
 ** CF_E_INTERNAL when gnuplot is missing or fails (message says which), CF_E_CANTWRITE when the
 ** file cannot be written; `inputs` (NULL-terminated, may be NULL) are refused as targets. */

@@ -80,6 +80,7 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
     r->version = CF_VERSION;
     r->table = t;
     r->with_timing = opt->with_timing;
+    r->title = opt->title;
     r->fit_options = opt->fit;
     for (size_t i = 0; i < t->count; i++)
         r->ymax = fmax(r->ymax, fabs(t->y[i]));

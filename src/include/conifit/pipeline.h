@@ -46,6 +46,7 @@ typedef struct cf_pipeline_options {
     cf_pipeline_target target;   /* CF_TARGET_LATTICE implies validate */
     cf_validate_setup lattice;   /* the lattice of the validation (validate.h) */
     int with_timing;             /* 0: write wall times as 0 (reproducible fit files) */
+    const char *title;           /* the figure's title (NULL: the table's name; report.h) */
     cf_pipeline_progress progress; /* NULL: silent */
     void *progress_ctx;
 } cf_pipeline_options;

@@ -20,6 +20,8 @@
 typedef struct cf_fit_report {
     const char *version;        /* conifit version */
     const cf_table *table;      /* the table fitted (not owned; outlives the report) */
+    const char *title;          /* the figure's title; NULL: the table's name (its file name
+                                ** without folder and extension) */
     cf_fit_options fit_options; /* the options the fits ran with (their limits are reported) */
     double ymax;                /* largest |y| in MPa or N */
     int nfits;                  /* 1 or 2 */
