@@ -1034,6 +1034,15 @@ static void an_unstable_lattice_loading_is_refused_with_the_strain_that_works(
                             dir, dir, p),
                      65);
     assert_non_null(strstr(err, "loses stability"));
+    /* the limit it names is below the unstable step, and a loading just under it is accepted */
+    const char *lim = strstr(err, "stable up to strain ");
+    assert_non_null(lim);
+    const double limit = atof(lim + strlen("stable up to strain "));
+    assert_true(limit > 0 && limit < 0.9 * law.travel_mm / TEL.H_mm);
+    write_scene("latlim.json", 0.99 * limit, 6);
+    char largs[128];
+    snprintf(largs, sizeof largs, "--lattice %s/latlim.json --format calculix", dir);
+    free(export_to("latlim.inp", largs));
     assert_non_null(strstr(err, "negative pivots"));
     assert_non_null(strstr(err, "the loading works up to strain"));
     assert_int_equal(stat(p, &st), -1);

@@ -257,12 +257,21 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
             st = cf_error_set(err, CF_E_DATA,
                               "the lattice cannot follow the loading to strain %.6g: %s; %s",
                               lx->strain[lx->nsteps - 1], run_err.msg, works);
-        else if (unstable)
+        else if (unstable) {
+            /* where exactly: the first negative pivot along this side of the loading */
+            double limit = 0.0;
+            cf_error e2 = {0};
+            const int side = lx->strain[unstable - 1] > 0 ? -1 : +1;
+            char where[96] = "";
+            if (cf_msm_stability_limit(&law, lx->method, &lx->cfg, side, &limit, &e2) == CF_OK &&
+                limit != 0.0)
+                snprintf(where, sizeof where, " (stable up to strain %.6g)", fabs(limit));
             st = cf_error_set(err, CF_E_DATA,
-                              "the lattice loses stability within the loading: at strain %.6g "
+                              "the lattice loses stability within the loading%s: at strain %.6g "
                               "(step %zu) its tangent has %ld negative pivots, so a simulator "
                               "would leave the homogeneous state there; %s",
-                              lx->strain[unstable - 1], unstable, pivots, works);
+                              where, lx->strain[unstable - 1], unstable, pivots, works);
+        }
         else
             st = cf_error_set(err, CF_E_DATA,
                               "a spring of the lattice is compressed to %.6g mm, past the table's "
