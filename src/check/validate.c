@@ -180,7 +180,8 @@ cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const 
     double ss = 0;
     for (size_t i = 0; i < d->count; i++)
         ss += (v->stress_MPa[i] - law[i]) * (v->stress_MPa[i] - law[i]);
-    v->law_rmse = sqrt(ss / (double)d->count);
+    /* the law's own curve is a uniaxial one: in another mode there is nothing to compare */
+    v->law_rmse = d->mode == CF_MODE_UNIAXIAL ? sqrt(ss / (double)d->count) : NAN;
     free(law);
     if (!v->by_cell)
         stability(p, s, d, v);

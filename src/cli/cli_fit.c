@@ -17,6 +17,8 @@
 #include "cli/cli.h"
 #include "conifit/baseline.h"
 #include "conifit/fitfile.h"
+#include "conifit/joint.h"
+#include "conifit/jointreport.h"
 #include "conifit/pipeline.h"
 #include "conifit/pipeline_series.h"
 #include "out/plot.h"
@@ -49,6 +51,10 @@ static const char fit_help[] =
     "                          implies --validate) or the single spring's (default for uniaxial\n"
     "                          tables; the other modes default to lattice)\n"
     "  --through-msm [SCENE.json]  the same as --target lattice [--validate SCENE.json]\n"
+    "  --joint                 fit one lattice to every table at once, each in its own mode;\n"
+    "                          -o names one fit file, --plot one figure\n"
+    "  --calibration C         the lattice's family weights: isotropic (default), axial, or\n"
+    "                          fitted (with --joint: fitted with the springs)\n"
     "  --mode M                the table's test mode: uniaxial, shear, planar, equibiaxial or\n"
     "                          confined (wins over a '# mode:' comment; default uniaxial)\n"
     "  --plot FILE.png|.svg|.pdf  draw data, fits, baselines and residuals with gnuplot\n"
@@ -87,6 +93,8 @@ typedef struct fit_args {
     cf_visco_fit_options vopt;   /* time series: the viscoelastic fit */
     const char *elastic;         /* --elastic FIT.json[:TYPE] */
     int series_only;             /* an option for time series only was given */
+    int joint;                   /* --joint: one lattice for every table */
+    int calibration_given;       /* --calibration was given */
 } fit_args;
 
 typedef struct fit_job {
@@ -146,6 +154,8 @@ enum {
     OPT_THROUGH,
     OPT_TARGET,
     OPT_MODE,
+    OPT_JOINT,
+    OPT_CALIBRATION,
     OPT_X_COL,
     OPT_Y_COL,
     OPT_STRESS_UNIT,
@@ -175,6 +185,8 @@ static const struct option fit_options[] = {
     {"through-msm", optional_argument, NULL, OPT_THROUGH},
     {"target", required_argument, NULL, OPT_TARGET},
     {"mode", required_argument, NULL, OPT_MODE},
+    {"joint", no_argument, NULL, OPT_JOINT},
+    {"calibration", required_argument, NULL, OPT_CALIBRATION},
     {"x-col", required_argument, NULL, OPT_X_COL},
     {"y-col", required_argument, NULL, OPT_Y_COL},
     {"stress-unit", required_argument, NULL, OPT_STRESS_UNIT},
@@ -345,6 +357,16 @@ static int fit_option(void *ctx, int c, const char *optval)
         else
             return cf_cli_usage_error("fit", "--target '%s': expected lattice or spring", optval);
         return 0;
+    case OPT_JOINT: a->joint = 1; return 0;
+    case OPT_CALIBRATION: {
+        cf_lattice_config *lc = &a->popt.lattice.cfg.lattice;
+        if (cf_calibration_parse(optval, &lc->calibration, &err) != CF_OK)
+            return cf_cli_usage_error("fit", "--%s", err.msg);
+        if (lc->calibration != CF_CAL_FITTED)
+            cf_calibration_weights(lc->calibration, lc->weight, NULL);
+        a->calibration_given = 1;
+        return 0;
+    }
     case OPT_MODE: {
         cf_mode md;
         if (cf_mode_parse(optval, &md, &err) != CF_OK)
@@ -415,6 +437,24 @@ static int parse_args(int argc, char **argv, fit_args *a)
             return cf_cli_usage_error(cmd, "-o -: with %d tables, -o must name a folder (DIR/)",
                                       a->nfiles);
         a->quiet = 1; /* standard output holds the fit file */
+    }
+    if (a->joint && a->nfiles < 2)
+        return cf_cli_usage_error(cmd, "--joint fits several tables at once; give at least two");
+    if (a->calibration_given && a->popt.lattice.cfg.lattice.calibration == CF_CAL_FITTED &&
+        !a->joint)
+        return cf_cli_usage_error(cmd, "--calibration fitted: the family weights are fitted in a "
+                                       "joint fit of several modes (--joint)");
+    if (a->joint && a->out && (cf_cli_is_stdio(a->out) || is_dir_target(a->out)))
+        return cf_cli_usage_error(cmd, "--joint -o %s: a joint fit writes one fit file "
+                                       "(-o FILE.json)", a->out);
+    if (a->joint && a->plot && is_dir_target(a->plot))
+        return cf_cli_usage_error(cmd, "--joint --plot %s: a joint fit draws one figure "
+                                       "(--plot FILE.png)", a->plot);
+    if (a->joint) {
+        if (a->plot && cf_plot_check_name(a->plot, &err) != CF_OK)
+            return cf_cli_usage_error(cmd, "--plot %s: the file must end in .png or .svg",
+                                      a->plot);
+        return -1;
     }
     if (a->nfiles > 1 && a->out && !is_dir_target(a->out))
         return cf_cli_usage_error(cmd, "-o %s: with %d tables, -o must name a folder (DIR/)",
@@ -524,6 +564,61 @@ static int plan_outputs(const fit_args *a, fit_job *jobs, const char *const *inp
     return -1;
 }
 
+/* --joint: one lattice fitted to every table (joint.h), each spring type asked for. */
+static int run_joint(const fit_args *a, fit_job *jobs, const char *const *inputs)
+{
+    cf_error err = {0};
+    const char *outs[2] = {a->out, a->plot};
+    for (int k = 0; k < 2; k++)
+        if (outs[k] && cf_atomic_check(outs[k], inputs, &err) != CF_OK)
+            return cf_cli_fail(&err);
+    if (a->out && a->plot && strcmp(a->out, a->plot) == 0)
+        return cf_cli_usage_error("fit", "-o and --plot both name %s", a->out);
+    const cf_table *tabs[CF_JOINT_MAX];
+    if (a->nfiles > CF_JOINT_MAX)
+        return cf_cli_usage_error("fit", "--joint takes at most %d tables", CF_JOINT_MAX);
+    for (int i = 0; i < a->nfiles; i++)
+        tabs[i] = &jobs[i].m;
+    cf_joint_report r;
+    memset(&r, 0, sizeof r);
+    r.tables = tabs;
+    r.ntables = (size_t)a->nfiles;
+    r.with_timing = 1;
+    int rc = CF_EXIT_OK;
+    for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING && rc == CF_EXIT_OK; ty++) {
+        if (!(a->popt.types & (1u << ty)))
+            continue;
+        if (a->progress)
+            fprintf(stderr, "conifit fit: fitting the %s spring to %d tables jointly\n",
+                    cf_spring_type_name((cf_spring_type)ty), a->nfiles);
+        if (cf_joint_fit(tabs, r.ntables, &a->popt.fit, &a->popt.lattice, (cf_spring_type)ty,
+                         &r.fits[r.nfits], &err) != CF_OK)
+            rc = cf_cli_fail(&err);
+        else
+            r.nfits++;
+    }
+    cf_atomic jo, po;
+    if (rc == CF_EXIT_OK &&
+        cf_joint_prepare(&r, a->out, a->plot, inputs, &jo, &po, &err) != CF_OK)
+        rc = cf_cli_fail(&err);
+    if (rc == CF_EXIT_OK && ((a->out && cf_atomic_commit(&jo, &err) != CF_OK) ||
+                             (a->plot && cf_atomic_commit(&po, &err) != CF_OK)))
+        rc = cf_cli_fail(&err);
+    if (rc == CF_EXIT_OK && !a->quiet) {
+        char *text = cf_joint_text(&r);
+        if (text)
+            fputs(text, stdout);
+        free(text);
+        if (a->out)
+            printf("Fit file: %s\n", a->out);
+        if (a->plot)
+            printf("Plot: %s\n", a->plot);
+    }
+    for (int k = 0; k < r.nfits; k++)
+        cf_joint_free(&r.fits[k]);
+    return rc;
+}
+
 int cf_cli_fit(int argc, char **argv)
 {
     fit_args a;
@@ -546,7 +641,8 @@ int cf_cli_fit(int argc, char **argv)
         inputs[i] = a.files[i];
     inputs[a.nfiles] = a.scene;
     inputs[a.nfiles + (a.scene != NULL)] = a.elastic;
-    rc = plan_outputs(&a, jobs, inputs);
+    if (!a.joint)
+        rc = plan_outputs(&a, jobs, inputs);
     /* Read every table first: a bad one stops the run before anything is written. */
     for (int i = 0; i < a.nfiles && rc < 0; i++) {
         jobs[i].args = &a;
@@ -582,6 +678,10 @@ int cf_cli_fit(int argc, char **argv)
     }
     if (a.progress)
         a.popt.progress = show_progress;
+    if (rc < 0 && a.joint)
+        rc = nseries ? cf_cli_usage_error("fit", "--joint fits stress-strain tables; a time "
+                                                 "series is fitted on its own")
+                     : run_joint(&a, jobs, inputs);
     if (rc < 0) {
         pool p = {jobs, a.nfiles, 0, PTHREAD_MUTEX_INITIALIZER};
         int nt = (int)(a.jobs < a.nfiles ? a.jobs : a.nfiles);

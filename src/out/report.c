@@ -502,7 +502,10 @@ static void validation_text(FILE *o, const cf_fit_report *r)
         double fr = r->through_msm && th->done ? th->cell_rmse : r->fits[i].rmse;
         snprintf(buf[0][i], sizeof buf[0][i], "%.4g %s", fr * u, yu);
         snprintf(buf[1][i], sizeof buf[1][i], "%.4g %s", v->rmse * u, yu);
-        snprintf(buf[2][i], sizeof buf[2][i], "%.4g %s", v->law_rmse * u, yu);
+        if (isfinite(v->law_rmse))
+            snprintf(buf[2][i], sizeof buf[2][i], "%.4g %s", v->law_rmse * u, yu);
+        else
+            snprintf(buf[2][i], sizeof buf[2][i], "- (not uniaxial)");
         snprintf(buf[3][i], sizeof buf[3][i], "%.4g %s", v->max_abs_error * u, yu);
         snprintf(buf[4][i], sizeof buf[4][i], "%.6f", v->r2);
         snprintf(buf[5][i], sizeof buf[5][i], "%.1f ms, %zu solves", 1e3 * v->wall_time_s,

@@ -64,7 +64,8 @@ typedef struct cf_validation {
     int by_cell;                /* 1: run by the homogenised cell (a mode the full lattice has no
                                 ** boundary conditions for); 0: the full lattice */
     double law_rmse;            /* RMSE of the lattice against the law's own curve F(eH)/H^2:
-                                ** what the lattice adds to the spring, MPa */
+                                ** what the lattice adds to the spring, MPa; NaN for
+                                ** the other modes (the law's curve is a uniaxial one) */
     int stability_checked;      /* 1: the static uniaxial lattice's stability limit was sought */
     double stable_to_strain;    /* the strain (table sign) where the lattice first loses stability
                                 ** on the table's side (compression when the table has any), or 0

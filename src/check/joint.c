@@ -1,0 +1,281 @@
+/*
+** The joint fit of several tables through the lattice (see joint.h).
+*/
+#include "conifit/joint.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <nlopt.h>
+
+#include "conifit/cell.h"
+#include "conifit/msm.h"
+#include "fit/lsq.h"
+
+/* BOBYQA: relative step tolerance and curves per start (each a few tens of microseconds). */
+#define XTOL_REL 1e-7
+#define MAX_EVALS 600
+/* Diagonal-to-edge weight ratio searched when the weights are fitted. */
+#define Q_LO 0.02
+#define Q_HI 5.0
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+typedef struct jctx {
+    const cf_table *const *t;
+    size_t n;
+    const cf_fit_options *opt;
+    const cf_validate_setup *lat;
+    cf_spring_type type;
+    int fit_weights;
+    double weight[CF_FAMILY_COUNT]; /* the fixed weights (or the last tried) */
+    double *sw[CF_JOINT_MAX];       /* per-row residual weights 1/(s_k sqrt n_k) */
+    double *curve[CF_JOINT_MAX];    /* scratch: each table's cell curve at unit scale */
+    long evals;
+} jctx;
+
+/* Family weights of ratio q (face = body = q edge), scaled to the law's small-strain modulus. */
+static void weights_of(double q, double w[CF_FAMILY_COUNT])
+{
+    double u[CF_FAMILY_COUNT] = {1, q, q};
+    double E = cf_cubic_moduli_of(u).E;
+    for (int f = 0; f < CF_FAMILY_COUNT; f++)
+        w[f] = u[f] / E;
+}
+
+/* The spring of free length 1 with the identifiable quantities (rho, e, A) (as validate.c). */
+static cf_spring member(double rho, double e, double A)
+{
+    const double H = 1.0, Lmin = H * (1 - e), s = H * e, n = 2.0, dw = Lmin / n;
+    const double D2 = rho < 1 ? Lmin / (1 - rho) : Lmin, D1 = rho * D2;
+    cf_spring p = {D1, D2, n, dw, cf_lsq_G_of_FC(A * H * H, n, D1, dw, s), H};
+    return p;
+}
+
+/* Objective at z = (ln rho, s/H [, ln q]) with the stress scale in closed form; *A_out. */
+static double profile(jctx *c, const double *z, double *A_out)
+{
+    c->evals++;
+    *A_out = 0;
+    double rho = exp(z[0]), e = z[1], A_max;
+    if (cf_fit_ident_limit(c->opt, c->type, rho, e, &A_max) > 0)
+        return CF_LSQ_HUGE_OBJ;
+    if (c->fit_weights)
+        weights_of(exp(z[2]), c->weight);
+    cf_spring p = member(rho, e, 1.0);
+    cf_law law;
+    if (cf_law_init(&law, &p, NULL) != CF_OK)
+        return CF_LSQ_HUGE_OBJ;
+    cf_cell cell;
+    if (cf_cell_init(&cell, &law, c->lat->method == CF_LAW_TABLE ? CF_LAW_CLOSED : c->lat->method,
+                     c->weight, NULL) != CF_OK)
+        return CF_LSQ_HUGE_OBJ;
+    double gy = 0, gg = 0;
+    for (size_t k = 0; k < c->n; k++) {
+        const cf_table *t = c->t[k];
+        if (cf_cell_curve(&cell, t->mode, t->x, t->count, c->curve[k], NULL) != CF_OK)
+            return CF_LSQ_HUGE_OBJ;
+        for (size_t i = 0; i < t->count; i++) {
+            double w = c->sw[k][i] * c->sw[k][i];
+            gy += w * c->curve[k][i] * t->y[i];
+            gg += w * c->curve[k][i] * c->curve[k][i];
+        }
+    }
+    double A = fmin(gy / gg, A_max);
+    if (!(A > 0) || !isfinite(A))
+        return CF_LSQ_HUGE_OBJ;
+    double sum = 0;
+    for (size_t k = 0; k < c->n; k++)
+        for (size_t i = 0; i < c->t[k]->count; i++) {
+            double r = c->sw[k][i] * (A * c->curve[k][i] - c->t[k]->y[i]);
+            sum += r * r;
+        }
+    *A_out = A;
+    return isfinite(sum) ? sum : CF_LSQ_HUGE_OBJ;
+}
+
+static double objective(unsigned nz, const double *z, double *grad, void *data)
+{
+    (void)nz;
+    (void)grad;
+    double A;
+    return profile(data, z, &A);
+}
+
+void cf_joint_free(cf_joint_result *r)
+{
+    if (!r)
+        return;
+    for (size_t k = 0; k < CF_JOINT_MAX; k++) {
+        free(r->tab[k].lattice_MPa);
+        r->tab[k].lattice_MPa = NULL;
+    }
+}
+
+cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
+                       const cf_validate_setup *lat, cf_spring_type type, cf_joint_result *r,
+                       cf_error *err)
+{
+    const double t0 = now_s();
+    memset(r, 0, sizeof *r);
+    if (n < 2 || n > CF_JOINT_MAX)
+        return cf_error_set(err, CF_E_DATA, "a joint fit takes 2 to %d tables, not %zu",
+                            CF_JOINT_MAX, n);
+    for (size_t k = 0; k < n; k++)
+        if (cf_table_is_force(tables[k]))
+            return cf_error_set(err, CF_E_DATA,
+                                "%s: a joint fit needs stress-strain tables; a force-displacement "
+                                "table's lengths are its own, not strains one lattice shares",
+                                tables[k]->path);
+    jctx c;
+    memset(&c, 0, sizeof c);
+    c.t = tables;
+    c.n = n;
+    c.opt = opt;
+    c.lat = lat;
+    c.type = type;
+    c.fit_weights = lat->cfg.lattice.calibration == CF_CAL_FITTED;
+    memcpy(c.weight, lat->cfg.lattice.weight, sizeof c.weight);
+    cf_status st = CF_OK;
+    size_t total = 0;
+    for (size_t k = 0; k < n; k++)
+        total += tables[k]->count;
+    double *reach_x = malloc(total * sizeof(double)), *reach_y = malloc(total * sizeof(double));
+    if (!reach_x || !reach_y) {
+        st = cf_error_set(err, CF_E_INTERNAL, "out of memory");
+        goto out;
+    }
+    size_t m = 0;
+    for (size_t k = 0; k < n; k++) {
+        const cf_table *t = tables[k];
+        c.sw[k] = malloc(t->count * sizeof(double));
+        c.curve[k] = malloc(t->count * sizeof(double));
+        r->tab[k].lattice_MPa = malloc(t->count * sizeof(double));
+        if (!c.sw[k] || !c.curve[k] || !r->tab[k].lattice_MPa) {
+            st = cf_error_set(err, CF_E_INTERNAL, "out of memory");
+            goto out;
+        }
+        double ss = 0;
+        for (size_t i = 0; i < t->count; i++)
+            ss += t->y[i] * t->y[i];
+        double s = sqrt(ss / (double)t->count);
+        if (!(s > 0)) {
+            st = cf_error_set(err, CF_E_DATA, "%s: every stress is zero", t->path);
+            goto out;
+        }
+        r->tab[k].scale_MPa = s;
+        r->tab[k].mode = t->mode;
+        r->tab[k].points = t->count;
+        for (size_t i = 0; i < t->count; i++) {
+            c.sw[k][i] = sqrt((t->w ? t->w[i] : 1.0) / (double)t->count) / s;
+            reach_x[m] = copysign(cf_cell_spring_strain(t->mode, t->x[i]), t->x[i]);
+            reach_y[m++] = t->y[i];
+        }
+    }
+    r->ntables = n;
+    /* the springs' reach over every table bounds s/H and is what the placement must honour */
+    cf_table reach = *tables[0];
+    reach.count = total;
+    reach.x = reach_x;
+    reach.y = reach_y;
+    reach.w = NULL;
+    reach.t = NULL;
+    const double xmax = cf_lsq_xmax(&reach);
+    const int nz = c.fit_weights ? 3 : 2;
+    double lb[3] = {log(fmax(CF_LSQ_RHO_LO, opt->rho_min)),
+                    xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9), log(Q_LO)};
+    double ub[3] = {log(cf_lsq_rho_hi(type, opt->index_max)), 1 - 1e-9, log(Q_HI)};
+    if (!(lb[1] < ub[1])) {
+        st = cf_error_set(err, CF_E_DATA,
+                          "the springs must reach a strain of %g: no spring does", xmax);
+        goto out;
+    }
+    double best = CF_LSQ_HUGE_OBJ, zb[3] = {0, 0, 0};
+    const double grid_rho[3] = {0.1, 0.35, 0.7}, grid_e[3] = {0.1, 0.4, 0.8};
+    const double q_iso = 0.2708 / 0.6085, grid_q[2] = {q_iso, 1.0};
+    for (int gq = 0; gq < (c.fit_weights ? 2 : 1); gq++)
+        for (int g = 0; g < 9; g++) {
+            double z[3] = {log(grid_rho[g % 3]), lb[1] + grid_e[g / 3] * (ub[1] - lb[1]),
+                           log(grid_q[gq])};
+            for (int j = 0; j < nz; j++)
+                z[j] = fmin(fmax(z[j], lb[j]), ub[j]);
+            nlopt_opt o = nlopt_create(NLOPT_LN_BOBYQA, (unsigned)nz);
+            if (!o) {
+                st = cf_error_set(err, CF_E_INTERNAL, "cannot create the NLopt optimiser");
+                goto out;
+            }
+            double step[3] = {0.1, 0.05 * (ub[1] - lb[1]), 0.2}, f = CF_LSQ_HUGE_OBJ;
+            nlopt_set_lower_bounds(o, lb);
+            nlopt_set_upper_bounds(o, ub);
+            nlopt_set_min_objective(o, objective, &c);
+            nlopt_set_initial_step(o, step);
+            nlopt_set_xtol_rel(o, XTOL_REL);
+            nlopt_set_maxeval(o, MAX_EVALS);
+            nlopt_result res = nlopt_optimize(o, z, &f);
+            nlopt_destroy(o);
+            if ((res > 0 || res == NLOPT_ROUNDOFF_LIMITED) && f < best) {
+                best = f;
+                memcpy(zb, z, sizeof zb);
+            }
+        }
+    double A = 0;
+    if (!(best < CF_LSQ_HUGE_OBJ) || !(profile(&c, zb, &A) < CF_LSQ_HUGE_OBJ) || !(A > 0)) {
+        st = cf_error_set(err, CF_E_NOCONV, "the joint fit found no lattice that runs every table");
+        goto out;
+    }
+    r->objective = best;
+    r->ident[0] = exp(zb[0]), r->ident[1] = zb[1], r->ident[2] = A;
+    memcpy(r->weight, c.weight, sizeof r->weight);
+    r->calibration = lat->cfg.lattice.calibration;
+    if ((st = cf_fit_place(&reach, opt, type, r->ident, &r->fit, err)) != CF_OK)
+        goto out;
+    /* Each table in the lattice of the placed spring: the cell, and the full lattice when the
+    ** mode is uniaxial (the verification). */
+    cf_law law;
+    if ((st = cf_law_init(&law, &r->fit.params, err)) != CF_OK)
+        goto out;
+    cf_validate_setup full = *lat;
+    memcpy(full.cfg.lattice.weight, c.weight, sizeof c.weight);
+    cf_cell cell;
+    cf_cell_init(&cell, &law, CF_LAW_CLOSED, c.weight, NULL);
+    for (size_t k = 0; k < n && st == CF_OK; k++) {
+        const cf_table *t = tables[k];
+        cf_joint_table *jt = &r->tab[k];
+        if ((st = cf_cell_curve(&cell, t->mode, t->x, t->count, c.curve[k], err)) != CF_OK)
+            break;
+        jt->cell_rmse = cf_lsq_quality_of(t, c.curve[k]).rmse;
+        jt->by_cell = t->mode != CF_MODE_UNIAXIAL;
+        if (jt->by_cell)
+            memcpy(jt->lattice_MPa, c.curve[k], t->count * sizeof(double));
+        else if ((st = cf_msm_uniaxial(&law, CF_LAW_CLOSED, &full.cfg, t->x, t->count,
+                                       jt->lattice_MPa, NULL, err)) != CF_OK)
+            break;
+        jt->lattice_rmse = cf_lsq_quality_of(t, jt->lattice_MPa).rmse;
+        double ss = 0;
+        for (size_t i = 0; i < t->count; i++) {
+            double d = jt->lattice_MPa[i] - cf_fit_model(&law, 0, t->x[i]);
+            ss += d * d;
+        }
+        jt->law_rmse = t->mode == CF_MODE_UNIAXIAL ? sqrt(ss / (double)t->count) : NAN;
+    }
+    cf_law_free(&law);
+out:
+    for (size_t k = 0; k < n && k < CF_JOINT_MAX; k++) {
+        free(c.sw[k]);
+        free(c.curve[k]);
+    }
+    free(reach_x);
+    free(reach_y);
+    r->evaluations = c.evals;
+    r->wall_time_s = now_s() - t0;
+    if (st != CF_OK)
+        cf_joint_free(r);
+    return st;
+}

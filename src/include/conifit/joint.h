@@ -1,0 +1,64 @@
+/*
+** A joint fit through the lattice: several tables of one tissue, each in its own test mode
+** (uniaxial tension, compression, simple shear, ...), fitted by one lattice, i.e. one set of
+** identifiable quantities (rho, s/H, F_C/H^2) and, with the calibration `fitted`, the family
+** weights too (conifit fit A.csv B.csv C.csv --joint).
+**
+** Weighting: table k's residuals are divided by its RMS stress s_k = sqrt(mean y^2) and by
+** sqrt(n_k), so every table contributes its relative misfit once, whatever its stress scale and
+** its number of rows; the objective is sum_k (1/n_k) sum_i ((model_ki - y_ki)/s_k)^2. The stress
+** scale is solved in closed form for that weighting; (ln rho, s/H) and, when the weights are
+** fitted, ln q (q = diagonal weight / edge weight, face = body; the weights then rescaled so the
+** lattice's small-strain modulus is k0/H) by NLopt BOBYQA from a grid of starts, every curve
+** through the homogenised cell (cell.h). The spring is placed from the quantities as the ordinary
+** fit does, and each uniaxial table is then verified once in the full lattice.
+*/
+#ifndef CF_JOINT_H
+#define CF_JOINT_H
+
+#include <stddef.h>
+
+#include "conifit/calibration.h"
+#include "conifit/error.h"
+#include "conifit/fit.h"
+#include "conifit/measure.h"
+#include "conifit/validate.h"
+
+/* Most tables in one joint fit. */
+#define CF_JOINT_MAX 16
+
+typedef struct cf_joint_table {
+    cf_mode mode;
+    size_t points;
+    double scale_MPa;      /* the table's RMS stress s_k (its residual weight is 1/(s_k sqrt n_k)) */
+    double cell_rmse;      /* the fitted lattice (homogenised cell) against the table, MPa */
+    double lattice_rmse;   /* the full lattice (uniaxial tables; else the cell), MPa */
+    int by_cell;           /* 1: lattice_rmse is the cell's (a mode the full lattice lacks) */
+    double law_rmse;       /* the lattice against the law's own curve, MPa */
+    double *lattice_MPa;   /* the lattice's stress at each row (owned), MPa */
+} cf_joint_table;
+
+typedef struct cf_joint_result {
+    cf_fit_result fit;              /* the placed spring (quality fields against the first table) */
+    double ident[3];                /* rho, s/H, F_C/H^2 [MPa] the search found */
+    double weight[CF_FAMILY_COUNT]; /* the lattice's family weights */
+    cf_calibration calibration;     /* isotropic, axial or fitted */
+    size_t ntables;
+    cf_joint_table tab[CF_JOINT_MAX];
+    double objective;               /* the weighted objective at the optimum, - */
+    long evaluations;               /* cell curves computed */
+    double wall_time_s;
+} cf_joint_result;
+
+/* Fits the n tables jointly with spring type `type` in the lattice of `lat` (its calibration:
+** isotropic or axial as they are; CF_CAL_FITTED fits the weights). CF_E_DATA for fewer than two or
+** more than CF_JOINT_MAX tables, or a force-displacement table (its length scale is its own, not
+** a strain a lattice shares; the message names the file). */
+cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
+                       const cf_validate_setup *lat, cf_spring_type type, cf_joint_result *r,
+                       cf_error *err);
+
+/* Releases the per-table curves. Safe on a zeroed result. */
+void cf_joint_free(cf_joint_result *r);
+
+#endif

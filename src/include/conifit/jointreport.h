@@ -1,0 +1,39 @@
+/*
+** What a joint fit reports (joint.h): the readable text, the fit file (JSON: the spring of each
+** type in `fits[]` as in every fit file, so export and scenes read it, and `tables[]` with each
+** table's mode, points, RMSE of the fit and of the lattice) and the figure (every table with its
+** lattice curve, one panel per table).
+*/
+#ifndef CF_JOINTREPORT_H
+#define CF_JOINTREPORT_H
+
+#include <stddef.h>
+
+#include "conifit/error.h"
+#include "conifit/joint.h"
+#include "conifit/measure.h"
+
+struct cf_atomic;
+
+/* One joint fit per spring type over the same tables. */
+typedef struct cf_joint_report {
+    const cf_table *const *tables;
+    size_t ntables;
+    int nfits;
+    cf_joint_result fits[2];
+    int with_timing;            /* 0: wall times written as 0 */
+} cf_joint_report;
+
+/* Index of the better fit (lower weighted objective), -1 when none. */
+int cf_joint_better(const cf_joint_report *r);
+
+/* The readable report (malloc'd; NULL when memory runs out). */
+char *cf_joint_text(const cf_joint_report *r);
+
+/* The fit file and the figure as complete temporaries beside their targets (either path NULL:
+** not written); the caller commits them (cf_atomic_commit). On failure neither is left. */
+cf_status cf_joint_prepare(const cf_joint_report *r, const char *json_path, const char *plot_path,
+                           const char *const *inputs, struct cf_atomic *json_out,
+                           struct cf_atomic *plot_out, cf_error *err);
+
+#endif

@@ -1,0 +1,225 @@
+/*
+** Text, fit file and figure of a joint fit (see jointreport.h).
+*/
+#include "conifit/jointreport.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <jansson.h>
+
+#include "base/atomic.h"
+#include "conifit/version.h"
+#include "io/fitfile_json.h"
+#include "out/gnuplot.h"
+
+int cf_joint_better(const cf_joint_report *r)
+{
+    int b = -1;
+    for (int i = 0; i < r->nfits; i++)
+        if (b < 0 || r->fits[i].objective < r->fits[b].objective)
+            b = i;
+    return b;
+}
+
+static const char *weighting_text =
+    "each table's residuals divided by its RMS stress and by the square root of its number of "
+    "rows, so every table counts once whatever its stress scale and length";
+
+char *cf_joint_text(const cf_joint_report *r)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *o = open_memstream(&buf, &len);
+    if (!o)
+        return NULL;
+    fprintf(o, "Joint fit through the lattice of %zu tables (%s)\n", r->ntables, weighting_text);
+    for (int i = 0; i < r->nfits; i++) {
+        const cf_joint_result *j = &r->fits[i];
+        const cf_spring *p = &j->fit.params;
+        cf_cubic_moduli cm = cf_cubic_moduli_of(j->weight);
+        fprintf(o, "\n%s spring: D1 %.5g mm, D2 %.5g mm, n %.5g, d %.5g mm, G %.5g MPa, H %.5g mm"
+                   "%s\n",
+                cf_spring_type_name(j->fit.type), p->D1_mm, p->D2_mm, p->n, p->d_mm, p->G_MPa,
+                p->H_mm, j->fit.feasible ? "" : " (violates its constraints)");
+        fprintf(o, " lattice: rho %.4g, solid strain s/H %.4g, stress scale F_C/H^2 %.4g kPa; "
+                   "calibration %s (weights edge %.4g, face %.4g, body %.4g; nu %.3f)\n",
+                j->ident[0], j->ident[1], j->ident[2] * 1e3, cf_calibration_name(j->calibration),
+                j->weight[0], j->weight[1], j->weight[2], cm.nu);
+        fprintf(o, "  %-44s %-12s %6s %14s %14s %14s\n", "table", "mode", "points", "fit RMSE",
+                "lattice RMSE", "vs law");
+        for (size_t k = 0; k < r->ntables; k++) {
+            const cf_table *t = r->tables[k];
+            const cf_joint_table *jt = &j->tab[k];
+            double u = t->y_to_file;
+            char a[32], b[32], c[32];
+            snprintf(a, sizeof a, "%.4g %s", jt->cell_rmse * u, t->y_unit);
+            snprintf(b, sizeof b, "%.4g %s%s", jt->lattice_rmse * u, t->y_unit,
+                     jt->by_cell ? "*" : "");
+            if (isfinite(jt->law_rmse))
+                snprintf(c, sizeof c, "%.4g %s", jt->law_rmse * u, t->y_unit);
+            else
+                snprintf(c, sizeof c, "-");
+            fprintf(o, "  %-44s %-12s %6zu %14s %14s %14s\n", t->path, cf_mode_name(jt->mode),
+                    jt->points, a, b, c);
+        }
+        fprintf(o, "  (* homogenised cell: the full lattice has no such boundary conditions; "
+                   "%ld cell curves, %.3f s)\n",
+                j->evaluations, j->wall_time_s);
+    }
+    int b = cf_joint_better(r);
+    if (b >= 0)
+        fprintf(o, "\nBetter type: %s (lower weighted objective %.4g)\n",
+                cf_spring_type_name(r->fits[b].fit.type), r->fits[b].objective);
+    if (fclose(o) != 0) {
+        free(buf);
+        return NULL;
+    }
+    return buf;
+}
+
+static json_t *num(double v)
+{
+    return cf_json_number(v);
+}
+
+static json_t *joint_json(const cf_joint_report *r)
+{
+    json_t *root = json_object(), *fits = json_array(), *tabs = json_array();
+    if (!root || !fits || !tabs) {
+        json_decref(root);
+        json_decref(fits);
+        json_decref(tabs);
+        return NULL;
+    }
+    json_object_set_new(root, "conifit_version", json_string(CF_VERSION));
+    json_object_set_new(root, "joint", json_true());
+    json_object_set_new(root, "weighting", json_string(weighting_text));
+    for (int i = 0; i < r->nfits; i++) {
+        const cf_joint_result *j = &r->fits[i];
+        cf_law law;
+        if (cf_law_init(&law, &j->fit.params, NULL) != CF_OK)
+            continue;
+        json_t *f = cf_fitfile_spring_json(&law);
+        if (!f)
+            continue;
+        cf_cubic_moduli cm = cf_cubic_moduli_of(j->weight);
+        json_object_set_new(f, "identifiable",
+                            json_pack("{s:o, s:o, s:o}", "rho", num(j->ident[0]), "solid_strain",
+                                      num(j->ident[1]), "stress_scale_MPa", num(j->ident[2])));
+        json_object_set_new(
+            f, "lattice",
+            json_pack("{s:s, s:{s:o, s:o, s:o}, s:o, s:o}", "calibration",
+                      cf_calibration_name(j->calibration), "weights", "edge", num(j->weight[0]),
+                      "face", num(j->weight[1]), "body", num(j->weight[2]), "modulus_ratio",
+                      num(cm.E), "poisson_ratio", num(cm.nu)));
+        json_object_set_new(f, "feasible", json_boolean(j->fit.feasible));
+        json_object_set_new(f, "objective", num(j->objective));
+        json_object_set_new(f, "evaluations", json_integer(j->evaluations));
+        json_object_set_new(f, "wall_time_s", num(r->with_timing ? j->wall_time_s : 0.0));
+        json_t *per = json_array();
+        for (size_t k = 0; k < r->ntables; k++) {
+            const cf_table *t = r->tables[k];
+            const cf_joint_table *jt = &j->tab[k];
+            double u = t->y_to_file;
+            json_array_append_new(
+                per, json_pack("{s:s, s:s, s:I, s:s, s:o, s:o, s:o, s:s, s:o}", "file", t->path,
+                               "mode", cf_mode_name(jt->mode), "points", (json_int_t)jt->points,
+                               "unit", t->y_unit, "rmse", num(jt->cell_rmse * u), "lattice_rmse",
+                               num(jt->lattice_rmse * u), "law_difference_rmse",
+                               num(jt->law_rmse * u), "lattice_model",
+                               jt->by_cell ? "homogenised cell" : "full lattice", "scale",
+                               num(jt->scale_MPa * u)));
+        }
+        json_object_set_new(f, "tables", per);
+        json_array_append_new(fits, f);
+    }
+    int b = cf_joint_better(r);
+    json_object_set_new(root, "fits", fits);
+    json_object_set_new(root, "better_type",
+                        b >= 0 ? json_string(cf_spring_type_name(r->fits[b].fit.type))
+                               : json_null());
+    /* tables[]: the better type's numbers, one entry per table */
+    for (size_t k = 0; b >= 0 && k < r->ntables; k++) {
+        const cf_table *t = r->tables[k];
+        const cf_joint_table *jt = &r->fits[b].tab[k];
+        double u = t->y_to_file;
+        json_array_append_new(tabs, json_pack("{s:s, s:s, s:I, s:s, s:o, s:o}", "file", t->path,
+                                              "mode", cf_mode_name(jt->mode), "points",
+                                              (json_int_t)jt->points, "unit", t->y_unit, "rmse",
+                                              num(jt->cell_rmse * u), "lattice_rmse",
+                                              num(jt->lattice_rmse * u)));
+    }
+    json_object_set_new(root, "tables", tabs);
+    return root;
+}
+
+/* One panel per table: data (points) and the lattice of the better type (line). */
+static cf_status joint_plot(const cf_joint_report *r, const char *path,
+                            const char *const *inputs, cf_atomic *out, cf_error *err)
+{
+    int b = cf_joint_better(r);
+    if (b < 0)
+        return cf_error_set(err, CF_E_DATA, "no fit to plot");
+    cf_gp g;
+    cf_gp_init(&g);
+    int n = (int)r->ntables;
+    cf_gp_terminal(&g, path, 420 * n, 420);
+    for (int k = 0; k < n; k++) {
+        const cf_table *t = r->tables[k];
+        char name[16];
+        snprintf(name, sizeof name, "T%d", k);
+        cf_gp_block_begin(&g, name);
+        for (size_t i = 0; i < t->count; i++) {
+            double row[3] = {t->x[i], t->y[i] * t->y_to_file,
+                             r->fits[b].tab[k].lattice_MPa[i] * t->y_to_file};
+            cf_gp_block_row(&g, 3, row);
+        }
+        cf_gp_block_end(&g);
+    }
+    cf_gp_cmd(&g, "set multiplot layout 1,%d", n);
+    cf_gp_cmd(&g, "set grid");
+    for (int k = 0; k < n; k++) {
+        const cf_table *t = r->tables[k];
+        cf_gp_cmd(&g, t->compression ? "set key bottom right box opaque"
+                                     : "set key top left box opaque");
+        const char *base = strrchr(t->path, '/');
+        base = base ? base + 1 : t->path;
+        cf_gp_cmd(&g, "set title %q noenhanced", base);
+        cf_gp_cmd(&g, "set xlabel %q", t->mode == CF_MODE_SHEAR ? "amount of shear [-]"
+                                                                : "strain [-]");
+        cf_gp_cmd(&g, "set ylabel %q noenhanced", t->y_unit);
+        cf_gp_cmd(&g, "plot $T%d using 1:2 with points pt 7 ps 0.7 lc rgb %q title %q, "
+                      "$T%d using 1:3 with lines lw 2 lc rgb %q title %q",
+                  k, "black", "table", k, "#1f77b4", "one lattice, all tables");
+    }
+    cf_gp_cmd(&g, "unset multiplot");
+    cf_status st = cf_gp_render(&g, path, inputs, out, err);
+    cf_gp_free(&g);
+    return st;
+}
+
+cf_status cf_joint_prepare(const cf_joint_report *r, const char *json_path, const char *plot_path,
+                           const char *const *inputs, cf_atomic *json_out, cf_atomic *plot_out,
+                           cf_error *err)
+{
+    memset(json_out, 0, sizeof *json_out);
+    memset(plot_out, 0, sizeof *plot_out);
+    cf_status st = CF_OK;
+    if (json_path) {
+        json_t *root = joint_json(r);
+        if (!root)
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory for the fit file");
+        st = cf_fitfile_prepare(root, json_path, inputs, json_out, err);
+        json_decref(root);
+    }
+    if (st == CF_OK && plot_path)
+        st = joint_plot(r, plot_path, inputs, plot_out, err);
+    if (st != CF_OK) {
+        cf_atomic_abort(json_out);
+        cf_atomic_abort(plot_out);
+    }
+    return st;
+}
