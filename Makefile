@@ -20,7 +20,8 @@ DEBS    := build-essential pkg-config libnlopt-dev libgsl-dev libcmocka-dev libj
            libsuitesparse-dev libopenblas0-serial gnuplot-nox calculix-ccx
 BUILD   ?= build
 
-WARN    := -Wall -Wextra -Wpedantic -Wshadow -Wmissing-prototypes -Wstrict-prototypes
+WARN    := -Wall -Wextra -Wpedantic -Wshadow -Wmissing-prototypes -Wstrict-prototypes \
+           -Wno-overlength-strings
 ifeq ($(WERROR),1)
 WARN    += -Werror
 endif
