@@ -62,6 +62,10 @@ static const char fit_help[] =
     "  --force-unit U          unit of a force column without one (N, mN, ...)\n"
     "  --length-unit U         unit of a displacement column without one (mm, m, ...)\n"
     "  --stretch               the x column is stretch (strain = stretch - 1)\n"
+    "  --stress-measure M      nominal | cauchy: what the stress column holds (default: the\n"
+    "                          table's '# stress:' comment or column name, else nominal);\n"
+    "                          Cauchy stress is converted to nominal under incompressibility\n"
+    "  --strain-measure M      engineering | log | stretch (default: '# strain:' or the name)\n"
     "  -j, --jobs N            fit N tables at a time (default 1)\n"
     "Time series (a table with a time column such as time_s) are fitted with the time-dependent\n"
     "model: the conical law plus a Prony series on every spring, in the lattice's homogenised\n"
@@ -165,7 +169,9 @@ enum {
     OPT_BRANCHES,
     OPT_DASHPOT,
     OPT_ELASTIC,
-    OPT_TITLE
+    OPT_TITLE,
+    OPT_STRESS_MEASURE,
+    OPT_STRAIN_MEASURE
 };
 
 static const struct option fit_options[] = {
@@ -197,6 +203,8 @@ static const struct option fit_options[] = {
     {"dashpot", no_argument, NULL, OPT_DASHPOT},
     {"elastic", required_argument, NULL, OPT_ELASTIC},
     {"title", required_argument, NULL, OPT_TITLE},
+    {"stress-measure", required_argument, NULL, OPT_STRESS_MEASURE},
+    {"strain-measure", required_argument, NULL, OPT_STRAIN_MEASURE},
     {"jobs", required_argument, NULL, 'j'},
     {NULL, 0, NULL, 0}};
 
@@ -275,6 +283,28 @@ static void validate_option(int c, const char *value, fit_args *a)
 }
 
 /* One option of fit: 0 to go on, else an exit status. */
+/* --stress-measure, --strain-measure: a word the table reader knows (measure.h). */
+static int measure_option(int c, const char *optval, cf_measure_options *mo)
+{
+    int bad;
+    if (c == OPT_STRESS_MEASURE) {
+        cf_stress_measure v = CF_STRESS_NOMINAL;
+        bad = cf_stress_measure_parse(optval, &v) != 0;
+        mo->stress_measure = (int)v;
+    } else {
+        cf_strain_measure v = CF_STRAIN_ENGINEERING;
+        bad = cf_strain_measure_parse(optval, &v) != 0;
+        mo->strain_measure = (int)v;
+    }
+    if (!bad)
+        return 0;
+    return cf_cli_usage_error("fit", "%s '%s': expected %s",
+                              c == OPT_STRESS_MEASURE ? "--stress-measure" : "--strain-measure",
+                              optval,
+                              c == OPT_STRESS_MEASURE ? "nominal or cauchy"
+                                                      : "engineering, log or stretch");
+}
+
 static int fit_option(void *ctx, int c, const char *optval)
 {
     fit_args *a = ctx;
@@ -393,6 +423,8 @@ static int fit_option(void *ctx, int c, const char *optval)
         a->elastic = optval;
         a->series_only = 1;
         return 0;
+    case OPT_STRESS_MEASURE:
+    case OPT_STRAIN_MEASURE: return measure_option(c, optval, &a->mopt);
     case 'j':
         if (cf_cli_parse_long("-j", optval, 1, 256, &a->jobs, &err))
             return cf_cli_usage_error("fit", "%s", err.msg);

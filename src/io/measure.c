@@ -5,6 +5,8 @@
 */
 #include "conifit/measure.h"
 
+#include "io/measures.h"
+
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -20,7 +22,7 @@
 
 cf_measure_options cf_measure_default_options(void)
 {
-    cf_measure_options o = {NULL, NULL, NULL, NULL, NULL, -1, NULL};
+    cf_measure_options o = {NULL, NULL, NULL, NULL, NULL, -1, NULL, -1, -1};
     return o;
 }
 
@@ -466,19 +468,11 @@ static int starts_with_ci(const char *s, const char *prefix)
     return strncasecmp(s, prefix, strlen(prefix)) == 0;
 }
 
-static int contains_ci(const char *s, const char *word)
-{
-    size_t n = strlen(word);
-    for (; *s; s++)
-        if (strncasecmp(s, word, n) == 0)
-            return 1;
-    return 0;
-}
 
 static int is_x_name(const char *b)
 {
-    static const char *const p[] = {"strain", "stretch", "lambda", "displacement",
-                                    "elongation", "gamma", "shear"};
+    static const char *const p[] = {"strain", "stretch", "lambda", "displacement", "elongation",
+                                    "gamma", "shear", "log_strain", "true_strain", "hencky"};
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++)
         if (starts_with_ci(b, p[i]))
             return 1;
@@ -487,16 +481,17 @@ static int is_x_name(const char *b)
 
 static cf_unit_class y_name_class(const char *b)
 {
-    if (starts_with_ci(b, "stress") || contains_ci(b, "stress"))
+    if (cf_measures_contains_ci(b, "stress") || starts_with_ci(b, "cauchy"))
         return CF_UNIT_STRESS;
-    if (starts_with_ci(b, "force") || starts_with_ci(b, "load") || contains_ci(b, "force"))
+    if (starts_with_ci(b, "load") || cf_measures_contains_ci(b, "force"))
         return CF_UNIT_FORCE;
     return CF_UNIT_UNKNOWN;
 }
 
 static int is_y_name(const char *b)
 {
-    return starts_with_ci(b, "stress") || starts_with_ci(b, "force") || starts_with_ci(b, "load");
+    return starts_with_ci(b, "stress") || starts_with_ci(b, "force") || starts_with_ci(b, "load") ||
+           starts_with_ci(b, "cauchy") || starts_with_ci(b, "true_stress");
 }
 
 static int is_weight_name(const char *b)
@@ -509,10 +504,6 @@ static int is_time_name(const char *b)
     return strcasecmp(b, "time") == 0 || strcasecmp(b, "t") == 0;
 }
 
-static int is_stretch_name(const char *b)
-{
-    return starts_with_ci(b, "stretch") || starts_with_ci(b, "lambda");
-}
 
 /* ---- units stated in '#' comments --------------------------------------------------------- */
 
@@ -964,6 +955,73 @@ static cf_status column_unit(const reader *r, size_t header_line, size_t ci, con
     return CF_OK;
 }
 
+/* The stress and strain measures: the caller's options, the '# stress:' and '# strain:' comments
+** and the column names, reconciled (io/measures.h). */
+static cf_status decide_measures(const reader *r, const char *path, const cf_measure_options *opt,
+                                 const column *xc, const column *yc, cf_table_measures *out,
+                                 cf_error *err)
+{
+    static const char *const what[CF_DECL_KINDS] = {"stress measure", "strain measure"};
+    static const char *const expect[CF_DECL_KINDS] = {"nominal or cauchy",
+                                                      "engineering, log or stretch"};
+    cf_measures_said said[CF_DECL_KINDS];
+    for (int k = 0; k < CF_DECL_KINDS; k++)
+        said[k] = (cf_measures_said){-1, 0, -1};
+    for (size_t i = 0; i < r->ncomments; i++) {
+        int kind, v = -1;
+        char word[64];
+        if (!cf_measures_declaration(r->comments[i].s, r->comments[i].n, &kind, word,
+                                     sizeof word))
+            continue;
+        if (kind == CF_DECL_STRESS) {
+            cf_stress_measure x;
+            v = cf_stress_measure_parse(word, &x) == 0 ? (int)x : -1;
+        } else {
+            cf_strain_measure x;
+            v = cf_strain_measure_parse(word, &x) == 0 ? (int)x : -1;
+        }
+        if (v < 0)
+            return data_error(err, path, r->comments[i].line, 1, "unknown %s (expected %s) ('%s')",
+                              what[kind], expect[kind], word);
+        if (said[kind].declared >= 0 && said[kind].declared != v)
+            return data_error(err, path, r->comments[i].line, 1,
+                              "%s declared twice, differently (line %zu says otherwise) ('%s')",
+                              what[kind], said[kind].line, word);
+        said[kind].declared = v;
+        said[kind].line = r->comments[i].line;
+    }
+    said[CF_DECL_STRESS].column = cf_measures_stress_of_column(yc->base);
+    said[CF_DECL_STRAIN].column = cf_measures_strain_of_column(xc->base);
+    int strain_opt = opt->strain_measure >= 0   ? opt->strain_measure
+                     : opt->x_is_stretch == 1   ? CF_STRAIN_STRETCH
+                     : opt->x_is_stretch == 0   ? CF_STRAIN_ENGINEERING
+                                                : -1;
+    const int option[CF_DECL_KINDS] = {opt->stress_measure, strain_opt};
+    const char *col[CF_DECL_KINDS] = {yc->name, xc->name};
+    int value[CF_DECL_KINDS], over[CF_DECL_KINDS], filev[CF_DECL_KINDS];
+    cf_decl_source from[CF_DECL_KINDS];
+    size_t line[CF_DECL_KINDS];
+    for (int k = 0; k < CF_DECL_KINDS; k++) {
+        cf_status st = cf_measures_decide(path, col[k], what[k], cf_measures_names[k], option[k],
+                                          &said[k], 0, &value[k], &from[k], &line[k], &over[k],
+                                          &filev[k], err);
+        if (st != CF_OK)
+            return st;
+    }
+    memset(out, 0, sizeof *out);
+    out->stress = (cf_stress_measure)value[CF_DECL_STRESS];
+    out->strain = (cf_strain_measure)value[CF_DECL_STRAIN];
+    out->stress_from = from[CF_DECL_STRESS];
+    out->strain_from = from[CF_DECL_STRAIN];
+    out->stress_line = line[CF_DECL_STRESS];
+    out->strain_line = line[CF_DECL_STRAIN];
+    out->stress_overridden = over[CF_DECL_STRESS];
+    out->strain_overridden = over[CF_DECL_STRAIN];
+    out->stress_file = filev[CF_DECL_STRESS];
+    out->strain_file = filev[CF_DECL_STRAIN];
+    return CF_OK;
+}
+
 cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf_table *m,
                           cf_error *err)
 {
@@ -1132,7 +1190,10 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
         goto fail;
     }
     m->kind = yu->cls == CF_UNIT_STRESS ? CF_TABLE_STRESS_STRAIN : CF_TABLE_FORCE_DISPLACEMENT;
-    int stretch = opt.x_is_stretch == 1 || (opt.x_is_stretch < 0 && is_stretch_name(xc->base));
+    cf_table_measures meas;
+    if ((st = decide_measures(&r, path, &opt, xc, yc, &meas, err)))
+        goto fail;
+    int stretch = meas.strain == CF_STRAIN_STRETCH;
     double xscale = 1.0;
     if (m->kind == CF_TABLE_STRESS_STRAIN) {
         cf_unit_class xw[1] = {CF_UNIT_STRAIN};
@@ -1331,7 +1392,13 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
     snprintf(m->x_unit, sizeof m->x_unit, "%s",
              m->kind == CF_TABLE_STRESS_STRAIN ? "-" : "mm");
     snprintf(m->y_unit, sizeof m->y_unit, "%s", yu->canon);
+    m->measures = meas;
     reader_free(&r);
+    if ((st = cf_measures_convert(m, err)) != CF_OK) {
+        cf_table_free(m);
+        memset(m, 0, sizeof *m);
+        return st;
+    }
     cf_error_clear(err);
     return CF_OK;
 

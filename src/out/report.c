@@ -294,6 +294,64 @@ static void verdict_text(const cf_fit_report *r, char *buf, size_t cap)
     }
 }
 
+/* Where one measure came from, in words: "comment, line 12", "column name", "assumed", ... */
+static void source_text(char *buf, size_t cap, cf_decl_source from, size_t line, int overridden,
+                        const char *file_value)
+{
+    size_t n = 0;
+    buf[0] = '\0';
+    app(buf, cap, &n, "%s", cf_decl_source_name(from));
+    if (overridden)
+        app(buf, cap, &n, ", which wins over the table's '%s'", file_value);
+    if (line)
+        app(buf, cap, &n, "%sline %zu", overridden ? " on " : ", ", line);
+}
+
+/* The sources of a table's measures (stress, strain) and its mode. */
+static void sources_text(const cf_table *t, char src[3][128])
+{
+    const cf_table_measures *m = &t->measures;
+    source_text(src[0], sizeof src[0], m->stress_from, m->stress_line, m->stress_overridden,
+                cf_stress_measure_name((cf_stress_measure)m->stress_file));
+    source_text(src[1], sizeof src[1], m->strain_from, m->strain_line, m->strain_overridden,
+                cf_strain_measure_name((cf_strain_measure)m->strain_file));
+    snprintf(src[2], sizeof src[2], "%s", t->mode_stated ? "stated" : "assumed");
+}
+
+/* What was done to the stress and strain columns, in one sentence ("" when nothing). */
+static void conversion_text(const cf_table *t, char *buf, size_t cap)
+{
+    const cf_table_measures *m = &t->measures;
+    size_t n = 0;
+    buf[0] = '\0';
+    if (m->strain_converted)
+        app(buf, cap, &n, "%s", m->strain == CF_STRAIN_LOG
+                                    ? "log strain e converted to engineering strain exp(e) - 1"
+                                    : "stretch l converted to engineering strain l - 1");
+    if (m->stress_converted) {
+        app(buf, cap, &n, "%sCauchy stress converted to nominal ", n ? "; " : "");
+        if (t->mode == CF_MODE_SHEAR)
+            app(buf, cap, &n, "(simple shear: P12 = sigma12, the sheared face keeps its area)");
+        else if (t->mode == CF_MODE_CONFINED)
+            app(buf, cap, &n, "(confined: P = sigma, the lateral stretches are 1)");
+        else
+            app(buf, cap, &n, "P = sigma / (1 + strain), incompressible %s",
+                cf_mode_name(t->mode));
+    }
+}
+
+static json_t *measures_json(const cf_table *t)
+{
+    const cf_table_measures *m = &t->measures;
+    char src[3][128], conv[256];
+    sources_text(t, src);
+    conversion_text(t, conv, sizeof conv);
+    return json_pack("{s:s, s:s, s:s, s:s, s:s, s:s, s:o}", "stress", cf_stress_measure_name(m->stress),
+                     "stress_source", src[0], "strain", cf_strain_measure_name(m->strain),
+                     "strain_source", src[1], "mode", cf_mode_name(t->mode), "mode_source",
+                     src[2], "conversion", *conv ? json_string(conv) : json_null());
+}
+
 /* The limits every fit ran under. */
 static json_t *limits_json(const cf_fit_report *r)
 {
@@ -312,6 +370,8 @@ static json_t *report_json(const cf_fit_report *r)
         r->table->y_column, "y_unit", r->table->y_unit, "kind",
         cf_table_is_force(r->table) ? "force-displacement" : "stress-strain", "sign",
         r->table->compression ? "compression-negative" : "tension-positive");
+    if (!cf_table_is_force(r->table))
+        json_object_set_new(data, "measures", measures_json(r->table));
     json_t *fits = json_array(), *base = json_array();
     for (int i = 0; i < r->nfits; i++)
         json_array_append_new(fits, fit_json(r, i));
@@ -569,9 +629,21 @@ char *cf_report_text(const cf_fit_report *r)
     FILE *o = open_memstream(&buf, &len);
     if (!o)
         return NULL;
-    fprintf(o, "%s: %zu points, %s [%s] against %s [%s], %s\n\n", r->table->path, r->table->count,
+    fprintf(o, "%s: %zu points, %s [%s] against %s [%s], %s\n", r->table->path, r->table->count,
             r->table->x_column, r->table->x_unit, r->table->y_column, r->table->y_unit,
             r->table->compression ? "compression negative" : "tension positive");
+    if (!cf_table_is_force(r->table)) {
+        const cf_table_measures *m = &r->table->measures;
+        char src[3][128], conv[256];
+        sources_text(r->table, src);
+        conversion_text(r->table, conv, sizeof conv);
+        fprintf(o, " measures: stress %s (%s), strain %s (%s), mode %s (%s)\n",
+                cf_stress_measure_name(m->stress), src[0], cf_strain_measure_name(m->strain),
+                src[1], cf_mode_name(r->table->mode), src[2]);
+        if (*conv)
+            fprintf(o, " fitted as engineering strain and nominal stress: %s\n", conv);
+        fputc('\n', o);
+    }
     fprintf(o, "  %-26s", "");
     for (int i = 0; i < r->nfits; i++)
         fprintf(o, " %-24s", cf_spring_type_name(r->fits[i].type));

@@ -25,6 +25,55 @@ typedef enum cf_table_kind {
     CF_TABLE_FORCE_DISPLACEMENT = 1 /* x = displacement [mm], y = force [N] */
 } cf_table_kind;
 
+/* What the y column measures in a stress-strain table. Conversion: a Cauchy (true) stress sigma
+** becomes the nominal (first Piola-Kirchhoff) stress P the law models under incompressibility
+** (J = 1), for the table's test mode (cf_mode, cell.h): uniaxial, planar and equibiaxial
+** P = sigma / lambda along the loading axis (lambda = 1 + strain); simple shear P = sigma (the
+** shear face keeps its area); confined compression P = sigma (the lateral stretches are 1). */
+typedef enum cf_stress_measure {
+    CF_STRESS_NOMINAL = 0, /* force over undeformed area (first Piola-Kirchhoff) */
+    CF_STRESS_CAUCHY = 1   /* force over deformed area (true stress) */
+} cf_stress_measure;
+
+/* What the x column measures: engineering strain (stretch - 1, or the amount of shear), the
+** logarithmic (true, Hencky) strain ln(stretch), or the stretch itself. */
+typedef enum cf_strain_measure {
+    CF_STRAIN_ENGINEERING = 0,
+    CF_STRAIN_LOG = 1,
+    CF_STRAIN_STRETCH = 2
+} cf_strain_measure;
+
+/* Where a measure came from. */
+typedef enum cf_decl_source {
+    CF_DECL_ASSUMED = 0, /* nothing said: the default was assumed (and is reported as such) */
+    CF_DECL_COMMENT = 1, /* a '# stress:' or '# strain:' comment */
+    CF_DECL_COLUMN = 2,  /* the column's name (true_stress, cauchy, log_strain, lambda, ...) */
+    CF_DECL_OPTION = 3   /* the caller's option (it wins over the file; see *_overridden) */
+} cf_decl_source;
+
+/* The measures of a table as read and what was done with them. */
+typedef struct cf_table_measures {
+    cf_stress_measure stress;   /* as the file (or option) gives it, before conversion */
+    cf_strain_measure strain;
+    cf_decl_source stress_from, strain_from;
+    size_t stress_line, strain_line; /* the comment's line (CF_DECL_COMMENT), else 0 */
+    int stress_overridden;      /* 1: an option replaced a different declaration in the file, */
+    int strain_overridden;      /* which *_file then holds (its line in *_line when a comment) */
+    int stress_file, strain_file;
+    int stress_converted;       /* 1: y was converted from Cauchy to nominal */
+    int strain_converted;       /* 1: x was converted from log strain or stretch to engineering */
+} cf_table_measures;
+
+const char *cf_stress_measure_name(cf_stress_measure m); /* "nominal", "cauchy" */
+const char *cf_strain_measure_name(cf_strain_measure m); /* "engineering", "log", "stretch" */
+const char *cf_decl_source_name(cf_decl_source s);       /* "assumed", "comment", ... */
+
+/* Parse a measure word (case-insensitive; synonyms: true = cauchy, pk1/piola/engineering =
+** nominal for stress; true/hencky/logarithmic = log, lambda = stretch for strain). Return 0 and
+** set *m, or -1 for a word they do not know. */
+int cf_stress_measure_parse(const char *word, cf_stress_measure *m);
+int cf_strain_measure_parse(const char *word, cf_strain_measure *m);
+
 typedef struct cf_measure_options {
     const char *x_col;       /* column name of x (with or without its unit decoration), or NULL:
                              ** the first column named strain/stretch/lambda/displacement/
@@ -37,6 +86,9 @@ typedef struct cf_measure_options {
     int x_is_stretch;        /* -1: decide from the column name, 0: strain, 1: stretch */
     const char *mode;        /* test mode ("uniaxial", "shear", ...), or NULL: from a '# mode:'
                              ** comment of the file, else uniaxial */
+    int stress_measure;      /* -1: from the file (comment, column name; else nominal), or a
+                             ** cf_stress_measure that wins over the file */
+    int strain_measure;      /* -1: from the file, or a cf_strain_measure */
 } cf_measure_options;
 
 /* Options with everything decided from the file. */
@@ -89,6 +141,8 @@ typedef struct cf_table {
     cf_mode mode;          /* test mode (cell.h): the option, else a '# mode: NAME' comment, else
                            ** uniaxial */
     int mode_stated;       /* 1 when the option or the file named the mode */
+    cf_table_measures measures; /* stress and strain measures as read; x and y hold engineering
+                           ** strain and nominal stress after conversion */
 } cf_table;
 
 /* Reads the table at path ("-": standard input, named "(standard input)" in messages). Columns

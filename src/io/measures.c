@@ -1,0 +1,215 @@
+/*
+** Stress and strain measures and test modes of a table (measures.h). The conversions follow from
+** the deformation gradient of each test under incompressibility (J = 1): with F = diag(l1, l2, l3)
+** and the load along 1, the nominal stress is P = J sigma F^-T, so P11 = sigma11 / l1 whatever the
+** lateral stretches (uniaxial, planar, equibiaxial); simple shear F = I + gamma e1 (x) e2 leaves
+** the sheared face's area unchanged, P12 = sigma12; confined compression holds l2 = l3 = 1, so
+** J = l1 and P11 = sigma11. Log strain e gives the stretch exp(e), engineering strain exp(e) - 1.
+*/
+#include "io/measures.h"
+
+#include <ctype.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <strings.h>
+
+const char *const cf_measures_names[CF_DECL_KINDS][3] = {{"nominal", "cauchy"},
+                                                          {"engineering", "log", "stretch"}};
+
+const char *cf_stress_measure_name(cf_stress_measure m)
+{
+    return (unsigned)m < 2 ? cf_measures_names[CF_DECL_STRESS][m] : "?";
+}
+
+const char *cf_strain_measure_name(cf_strain_measure m)
+{
+    return (unsigned)m < 3 ? cf_measures_names[CF_DECL_STRAIN][m] : "?";
+}
+
+
+const char *cf_decl_source_name(cf_decl_source s)
+{
+    static const char *const n[] = {"assumed", "comment", "column name", "option"};
+    return (unsigned)s < 4 ? n[s] : "?";
+}
+
+typedef struct synonym {
+    const char *word;
+    int value;
+} synonym;
+
+static int lookup(const synonym *t, size_t n, const char *word)
+{
+    for (size_t i = 0; i < n; i++)
+        if (strcasecmp(word, t[i].word) == 0)
+            return t[i].value;
+    return -1;
+}
+
+int cf_stress_measure_parse(const char *word, cf_stress_measure *m)
+{
+    static const synonym t[] = {{"nominal", CF_STRESS_NOMINAL},
+                                {"engineering", CF_STRESS_NOMINAL},
+                                {"pk1", CF_STRESS_NOMINAL},
+                                {"piola", CF_STRESS_NOMINAL},
+                                {"first-piola-kirchhoff", CF_STRESS_NOMINAL},
+                                {"cauchy", CF_STRESS_CAUCHY},
+                                {"true", CF_STRESS_CAUCHY}};
+    int v = lookup(t, sizeof t / sizeof t[0], word);
+    if (v >= 0)
+        *m = (cf_stress_measure)v;
+    return v >= 0 ? 0 : -1;
+}
+
+int cf_strain_measure_parse(const char *word, cf_strain_measure *m)
+{
+    static const synonym t[] = {{"engineering", CF_STRAIN_ENGINEERING},
+                                {"nominal", CF_STRAIN_ENGINEERING},
+                                {"log", CF_STRAIN_LOG},
+                                {"logarithmic", CF_STRAIN_LOG},
+                                {"true", CF_STRAIN_LOG},
+                                {"hencky", CF_STRAIN_LOG},
+                                {"stretch", CF_STRAIN_STRETCH},
+                                {"lambda", CF_STRAIN_STRETCH}};
+    int v = lookup(t, sizeof t / sizeof t[0], word);
+    if (v >= 0)
+        *m = (cf_strain_measure)v;
+    return v >= 0 ? 0 : -1;
+}
+
+int cf_measures_declaration(const char *s, size_t n, int *kind, char *word, size_t cap)
+{
+    static const char *const keys[CF_DECL_KINDS] = {"stress:", "strain:"};
+    size_t i = 0;
+    while (i < n && (s[i] == ' ' || s[i] == '\t'))
+        i++;
+    for (int k = 0; k < CF_DECL_KINDS; k++) {
+        size_t kl = strlen(keys[k]);
+        if (n - i < kl || strncasecmp(s + i, keys[k], kl) != 0)
+            continue;
+        size_t j = i + kl;
+        while (j < n && (s[j] == ' ' || s[j] == '\t'))
+            j++;
+        size_t w = 0;
+        while (j < n && w + 1 < cap && (isalnum((unsigned char)s[j]) || s[j] == '-' || s[j] == '_'))
+            word[w++] = s[j++];
+        word[w] = '\0';
+        *kind = k;
+        return 1;
+    }
+    return 0;
+}
+
+int cf_measures_contains_ci(const char *s, const char *word)
+{
+    size_t n = strlen(word);
+    for (; *s; s++)
+        if (strncasecmp(s, word, n) == 0)
+            return 1;
+    return 0;
+}
+
+int cf_measures_stress_of_column(const char *name)
+{
+    static const char *const cauchy[] = {"cauchy", "true_stress", "true stress", "truestress"};
+    static const char *const nominal[] = {"nominal", "engineering", "pk1", "piola"};
+    for (int k = 0; k < 4; k++)
+        if (cf_measures_contains_ci(name, cauchy[k]))
+            return CF_STRESS_CAUCHY;
+    for (int k = 0; k < 4; k++)
+        if (cf_measures_contains_ci(name, nominal[k]))
+            return CF_STRESS_NOMINAL;
+    return -1;
+}
+
+int cf_measures_strain_of_column(const char *name)
+{
+    static const char *const logs[] = {"log", "true_strain", "true strain", "hencky"};
+    for (int k = 0; k < 4; k++)
+        if (cf_measures_contains_ci(name, logs[k]))
+            return CF_STRAIN_LOG;
+    if (strncasecmp(name, "stretch", 7) == 0 || strncasecmp(name, "lambda", 6) == 0)
+        return CF_STRAIN_STRETCH;
+    if (cf_measures_contains_ci(name, "engineering") || cf_measures_contains_ci(name, "nominal"))
+        return CF_STRAIN_ENGINEERING;
+    return -1;
+}
+
+cf_status cf_measures_decide(const char *path, const char *column, const char *what,
+                             const char *const *names, int option, const cf_measures_said *said,
+                             int fallback, int *value, cf_decl_source *from, size_t *line,
+                             int *overridden, int *file_value, cf_error *err)
+{
+    *line = said->declared >= 0 ? said->line : 0;
+    *overridden = 0;
+    if (said->declared >= 0 && said->column >= 0 && said->declared != said->column && option < 0)
+        return cf_error_set(err, CF_E_DATA,
+                            "%s:%zu: the %s is declared '%s' but column '%s' is named for '%s' "
+                            "(say which holds, or rename the column) ('%s')",
+                            path, said->line, what, names[said->declared], column,
+                            names[said->column], names[said->declared]);
+    int file = said->declared >= 0 ? said->declared : said->column;
+    *file_value = file;
+    if (option >= 0) {
+        *value = option;
+        *from = CF_DECL_OPTION;
+        *overridden = file >= 0 && file != option;
+        return CF_OK;
+    }
+    if (said->declared >= 0) {
+        *value = said->declared;
+        *from = CF_DECL_COMMENT;
+    } else if (said->column >= 0) {
+        *value = said->column;
+        *from = CF_DECL_COLUMN;
+    } else {
+        *value = fallback;
+        *from = CF_DECL_ASSUMED;
+    }
+    return CF_OK;
+}
+
+cf_status cf_measures_convert(cf_table *t, cf_error *err)
+{
+    cf_table_measures *m = &t->measures;
+    const int shear = t->mode == CF_MODE_SHEAR;
+    if (t->kind == CF_TABLE_FORCE_DISPLACEMENT) {
+        if (m->stress == CF_STRESS_CAUCHY)
+            return cf_error_set(err, CF_E_DATA,
+                                "%s: a Cauchy stress is declared, but the y column '%s' is a "
+                                "force: only a stress has a measure ('cauchy')",
+                                t->path, t->y_column);
+        if (m->strain == CF_STRAIN_LOG)
+            return cf_error_set(err, CF_E_DATA,
+                                "%s: a log strain is declared, but the x column '%s' is a "
+                                "displacement ('log')", t->path, t->x_column);
+        return CF_OK;
+    }
+    if (shear && m->strain != CF_STRAIN_ENGINEERING)
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: a simple-shear table is the amount of shear against the shear "
+                            "stress; a %s strain has no meaning there ('%s')",
+                            t->path, cf_strain_measure_name(m->strain),
+                            cf_strain_measure_name(m->strain));
+    if (m->strain == CF_STRAIN_LOG) {
+        for (size_t i = 0; i < t->count; i++)
+            t->x[i] = expm1(t->x[i]);
+        m->strain_converted = 1;
+    } else if (m->strain == CF_STRAIN_STRETCH) {
+        m->strain_converted = 1; /* the reader took stretch - 1 */
+    }
+    for (size_t i = 0; i < t->count; i++)
+        if (!(t->x[i] > -1) || !isfinite(t->x[i]))
+            return cf_error_set(err, CF_E_DATA,
+                                "%s: data row %zu: strain %g is a stretch of %g; a stretch must "
+                                "be positive ('%g')",
+                                t->path, i + 1, t->x[i], 1 + t->x[i], t->x[i]);
+    if (m->stress == CF_STRESS_CAUCHY) {
+        if (!shear && t->mode != CF_MODE_CONFINED)
+            for (size_t i = 0; i < t->count; i++)
+                t->y[i] /= 1 + t->x[i];
+        m->stress_converted = 1;
+    }
+    return CF_OK;
+}
