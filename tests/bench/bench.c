@@ -93,8 +93,9 @@ int main(int argc, char **argv)
     gsl_set_error_handler_off();
     bench_ctx ctx = {0};
     const char *dir = NULL;
-    static const char usage[] = "usage: conifit-bench [--quick] [--progress|--no-progress] DIR\n";
+    static const char usage[] = "usage: conifit-bench [--quick] [--progress|--no-progress] [--only WORD] DIR\n";
     int progress = isatty(STDERR_FILENO);
+    const char *only = NULL; /* --only WORD: the sections whose name contains WORD */
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--quick") == 0)
             ctx.quick = 1;
@@ -102,6 +103,8 @@ int main(int argc, char **argv)
             progress = 1;
         else if (strcmp(argv[i], "--no-progress") == 0)
             progress = 0;
+        else if (strcmp(argv[i], "--only") == 0 && i + 1 < argc)
+            only = argv[++i];
         else if (argv[i][0] == '-') {
             fputs(usage, stderr);
             return 2;
@@ -151,9 +154,12 @@ int main(int argc, char **argv)
                     {"the integrators", bench_section_integrators},
                     {"fitting", bench_section_fit},
                     {"lattice resolution", bench_section_resolution},
-                    {"memory", bench_section_memory}};
+                    {"memory", bench_section_memory},
+                    {"lattice calibration and the homogenised cell", bench_section_calibration}};
     const int nsec = (int)(sizeof sections / sizeof sections[0]);
     for (int k = 0; k < nsec; k++) {
+        if (only && !strstr(sections[k].what, only))
+            continue;
         if (progress)
             fprintf(stderr, "conifit-bench: [%d/%d] %s (%.0f s so far)\n", k + 1, nsec,
                     sections[k].what, bench_now() - t0);
