@@ -1,12 +1,17 @@
 /*
 ** Baseline fits (see baseline.h): the linear and Duffing laws are linear in their coefficients
-** and solved in closed form; Fung's law is linear in A for a fixed B, so B is found by a scan and
-** a golden-section refinement of the profile RSS(B).
+** and solved as linear least-squares problems (GSL, through the SVD of the design matrix, never
+** the squared normal equations); Fung's law is linear in A for a fixed B, so B is found by a scan
+** and a refinement of the profile RSS(B) with GSL's Brent minimiser.
 */
 #include "conifit/baseline.h"
 
 #include <float.h>
 #include <math.h>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_min.h>
+#include <gsl/gsl_multifit.h>
 
 const char *cf_baseline_name(cf_baseline_kind kind)
 {
@@ -64,30 +69,83 @@ static void finish(const cf_table *d, cf_baseline *b, double ymax)
     b->aic = cf_baseline_aic(d->count, rss, b->k, ymax);
 }
 
+/* Duffing's k1, k3: least squares on the design matrix [x, x^3]. 0 when GSL fails (out of memory,
+** a table without x). */
+static int duffing_fit(const cf_table *d, double coef[2])
+{
+    gsl_matrix *X = gsl_matrix_alloc(d->count, 2);
+    gsl_vector *y = gsl_vector_alloc(d->count), *c = gsl_vector_alloc(2);
+    gsl_matrix *cov = gsl_matrix_alloc(2, 2);
+    gsl_multifit_linear_workspace *w = gsl_multifit_linear_alloc(d->count, 2);
+    int ok = X && y && c && cov && w;
+    if (ok) {
+        for (size_t i = 0; i < d->count; i++) {
+            double x = d->x[i];
+            gsl_matrix_set(X, i, 0, x);
+            gsl_matrix_set(X, i, 1, x * x * x);
+            gsl_vector_set(y, i, d->y[i]);
+        }
+        double chisq;
+        ok = gsl_multifit_linear(X, y, c, cov, &chisq, w) == GSL_SUCCESS &&
+             isfinite(gsl_vector_get(c, 0)) && isfinite(gsl_vector_get(c, 1));
+        if (ok) {
+            coef[0] = gsl_vector_get(c, 0);
+            coef[1] = gsl_vector_get(c, 1);
+        }
+    }
+    if (w)
+        gsl_multifit_linear_free(w);
+    gsl_matrix_free(X);
+    gsl_matrix_free(cov);
+    gsl_vector_free(y);
+    gsl_vector_free(c);
+    return ok;
+}
+
+static double fung_rss(double B, void *data)
+{
+    double A;
+    return fung_profile(data, B, &A);
+}
+
+/* Refines the scan's best B in (lo, hi) with Brent's method on the profile RSS; returns B. */
+static double fung_refine(const cf_table *d, double B, double lo, double hi)
+{
+    gsl_function f = {fung_rss, (void *)d};
+    gsl_min_fminimizer *m = gsl_min_fminimizer_alloc(gsl_min_fminimizer_brent);
+    if (!m)
+        return B;
+    /* the scan's minimum lies strictly below its neighbours, as Brent's bracket needs */
+    if (gsl_min_fminimizer_set(m, &f, B, lo, hi) == GSL_SUCCESS) {
+        for (int it = 0; it < 200; it++) {
+            if (gsl_min_fminimizer_iterate(m) != GSL_SUCCESS)
+                break;
+            double a = gsl_min_fminimizer_x_lower(m), b = gsl_min_fminimizer_x_upper(m);
+            if (gsl_min_test_interval(a, b, 0, 1e-14) == GSL_SUCCESS)
+                break;
+        }
+        B = gsl_min_fminimizer_x_minimum(m);
+    }
+    gsl_min_fminimizer_free(m);
+    return B;
+}
+
 void cf_baseline_fit_all(const cf_table *d, cf_baseline out[CF_BASE_COUNT])
 {
-    double xmax = 0, ymax = 0;
-    double s2 = 0, s4 = 0, s6 = 0, sy1 = 0, sy3 = 0;
+    double xmax = 0, ymax = 0, s2 = 0, sy1 = 0;
     for (size_t i = 0; i < d->count; i++) {
-        double x = d->x[i], y = d->y[i], x2 = x * x;
+        double x = d->x[i], y = d->y[i];
         xmax = fmax(xmax, fabs(x));
         ymax = fmax(ymax, fabs(y));
-        s2 += x2;
-        s4 += x2 * x2;
-        s6 += x2 * x2 * x2;
+        s2 += x * x;
         sy1 += x * y;
-        sy3 += x2 * x * y;
     }
     cf_baseline *L = &out[CF_BASE_LINEAR], *D = &out[CF_BASE_DUFFING], *F = &out[CF_BASE_FUNG];
     *L = (cf_baseline){CF_BASE_LINEAR, 1, {s2 > 0 ? sy1 / s2 : 0, 0}, 0, 0, 0};
-    /* normal equations of (k1, k3): [s2 s4; s4 s6] k = [sy1; sy3] */
-    double det = s2 * s6 - s4 * s4;
     *D = (cf_baseline){CF_BASE_DUFFING, 2, {0, 0}, 0, 0, 0};
-    if (det > 1e-14 * s2 * s6) {
-        D->coef[0] = (sy1 * s6 - sy3 * s4) / det;
-        D->coef[1] = (s2 * sy3 - s4 * sy1) / det;
-    } else {
+    if (!duffing_fit(d, D->coef)) {
         D->coef[0] = L->coef[0];
+        D->coef[1] = 0;
     }
     /* Fung: scan B over +-50/xmax (exp(50) covers any stiffening a table shows), then refine */
     *F = (cf_baseline){CF_BASE_FUNG, 2, {0, 0}, 0, 0, 0};
@@ -104,26 +162,7 @@ void cf_baseline_fit_all(const cf_table *d, cf_baseline out[CF_BASE_COUNT])
             bestB = B;
         }
     }
-    double a = bestB - bmax / N, b = bestB + bmax / N;
-    const double g = 0.5 * (sqrt(5.0) - 1);
-    double c1 = b - g * (b - a), c2 = a + g * (b - a);
-    double f1 = fung_profile(d, c1, &A), f2 = fung_profile(d, c2, &A);
-    for (int it = 0; it < 200 && (b - a) > 1e-15 * fabs(b) + 1e-300; it++) {
-        if (f1 < f2) {
-            b = c2;
-            c2 = c1;
-            f2 = f1;
-            c1 = b - g * (b - a);
-            f1 = fung_profile(d, c1, &A);
-        } else {
-            a = c1;
-            c1 = c2;
-            f1 = f2;
-            c2 = a + g * (b - a);
-            f2 = fung_profile(d, c2, &A);
-        }
-    }
-    double Bf = 0.5 * (a + b);
+    double Bf = fung_refine(d, bestB, bestB - bmax / N, bestB + bmax / N);
     if (fung_profile(d, Bf, &A) > bestR)
         Bf = bestB;
     fung_profile(d, Bf, &A);

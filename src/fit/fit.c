@@ -17,6 +17,7 @@
 #include <gsl/gsl_eigen.h>
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_multifit_nlinear.h>
+#include <gsl/gsl_rng.h>
 #include <gsl/gsl_vector.h>
 #include <nlopt.h>
 
@@ -102,14 +103,20 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* splitmix64: a tiny deterministic generator, state local to one fit. */
-static double rng_uniform(uint64_t *state)
+/* The fit's random numbers: GSL's mt19937 (the generator conifit uses everywhere), one stream
+** per use, seeded from the fit's seed, local to one call (no shared state between threads). */
+static gsl_rng *seeded_rng(unsigned long seed, unsigned long stream)
 {
-    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return (double)(z >> 11) * 0x1.0p-53;
+    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+    if (r)
+        gsl_rng_set(r, seed * 4u + stream);
+    return r;
+}
+
+/* A uniform number in [0, 1); 0.5 (the cell's centre) when no generator could be made. */
+static double jitter(gsl_rng *r)
+{
+    return r ? gsl_rng_uniform(r) : 0.5;
 }
 
 static double sigmoid(double t) { return 1.0 / (1.0 + exp(-t)); }
@@ -425,18 +432,18 @@ static int cmp_start(const void *a, const void *b)
 /* Global stage over (rho, B) with A in closed form, then LM from the best starts. */
 static double stage_a(fit_ctx *c, double best3[3])
 {
-    uint64_t rng = (uint64_t)c->opt->seed * 0x2545F4914F6CDD1Dull + 1;
+    gsl_rng *rng = seeded_rng(c->opt->seed, 1);
     start grid[GRID * GRID];
     size_t k = 0;
     for (int i = 0; i < GRID; i++) {
         /* rho: half the grid log-spaced from CF_LSQ_RHO_LO, half approaching rho_hi geometrically
         ** (resolves nearly cylindrical springs) */
-        double ti = (i + rng_uniform(&rng)) / GRID;
+        double ti = (i + jitter(rng)) / GRID;
         double rho = (i % 2 == 0)
                          ? c->rho_lo * pow(c->rho_hi / c->rho_lo, ti)
                          : c->rho_hi - (c->rho_hi - c->rho_lo) * pow(1e-7, ti);
         for (int j = 0; j < GRID; j++) {
-            double tj = (j + rng_uniform(&rng)) / GRID;
+            double tj = (j + jitter(rng)) / GRID;
             double B = (j % 2 == 0) ? c->b_lo + (c->b_hi - c->b_lo) * tj * tj
                                     : c->b_lo + (c->b_hi - c->b_lo) * pow(1e-7, 1 - tj);
             double A;
@@ -446,6 +453,7 @@ static double stage_a(fit_ctx *c, double best3[3])
             k++;
         }
     }
+    gsl_rng_free(rng);
     qsort(grid, k, sizeof grid[0], cmp_start);
     double best = CF_LSQ_HUGE_OBJ;
     double r, B, A, out[3];
@@ -1061,15 +1069,15 @@ static double sub_solve(fit_ctx *c, sub *q, double *x, nlopt_algorithm alg)
 ** Seeded grid over (rho, B) as in stage_a, feasible points only, then COBYLA from the best. */
 static int stage_a_constrained(fit_ctx *c, double v[3])
 {
-    uint64_t rng = (uint64_t)c->opt->seed * 0x2545F4914F6CDD1Dull + 3;
+    gsl_rng *rng = seeded_rng(c->opt->seed, 3);
     start grid[GRID * GRID];
     size_t k = 0;
     sub q = {c, -1, 0};
     for (int i = 0; i < GRID; i++) {
-        double ti = (i + rng_uniform(&rng)) / GRID;
+        double ti = (i + jitter(rng)) / GRID;
         double rho = c->rho_lo * pow(c->rho_hi / c->rho_lo, ti);
         for (int j = 0; j < GRID; j++) {
-            double tj = (j + rng_uniform(&rng)) / GRID;
+            double tj = (j + jitter(rng)) / GRID;
             double B = c->b_lo + (c->b_hi - c->b_lo) * tj;
             double x[2] = {log(rho), B};
             if (sub_g0(&q, x) > 0)
@@ -1080,6 +1088,7 @@ static int stage_a_constrained(fit_ctx *c, double v[3])
             k++;
         }
     }
+    gsl_rng_free(rng);
     if (k == 0)
         return 0;
     qsort(grid, k, sizeof grid[0], cmp_start);
@@ -1521,7 +1530,7 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
     int best_feas = cf_fit_check(&sp, type, data, opt, &act, &vio);
     /* Stage C: local polish on the real objective; with fixed parameters the family may be out
     ** of reach, so then also from seeded starts around the placement. */
-    uint64_t rng = (uint64_t)opt->seed * 0x9E3779B97F4A7C15ull + 7;
+    gsl_rng *rng = seeded_rng(opt->seed, 2);
     int starts = 1;
     for (int k = 0; k < CF_P_COUNT; k++)
         if (opt->fixed[k])
@@ -1529,7 +1538,7 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
     for (int s = 0; s < starts; s++) {
         double zz[CF_P_COUNT];
         for (int k = 0; k < c.nfree; k++)
-            zz[k] = z[k] + (s == 0 ? 0.0 : 0.5 * (rng_uniform(&rng) - 0.5));
+            zz[k] = z[k] + (s == 0 ? 0.0 : 0.5 * (jitter(rng) - 0.5));
         nl_run(&c, algorithm_of(opt->optimizer), z_objective, 0, zz, 3000);
         double q[CF_P_COUNT];
         full_params(&c, zz, q);
@@ -1542,6 +1551,7 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
             memcpy(best_p, q, sizeof q);
         }
     }
+    gsl_rng_free(rng);
     res->type = type;
     summarise(&c, best_p, res);
     /* Errors, correlation and, where the data leave a quantity open, its profile interval: at

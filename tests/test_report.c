@@ -1,0 +1,149 @@
+/*
+** The report (out/report.c): the JSON fit file and the text, from a report the pipeline made.
+**  - the JSON holds the table's provenance and units, every number finite or null (a non-finite
+**    value is written as null, never as NaN or Inf), and reads back with the fit-file reader;
+**  - numbers in the file's own unit (kPa here), not conifit's MPa;
+**  - the text names both types, the identifiable quantities and the units;
+**  - a table that tells the types apart is reported with a better type, one that does not as a
+**    tie.
+*/
+#include "testutil.h"
+
+#include <jansson.h>
+
+#include "conifit/fitfile.h"
+#include "conifit/pipeline.h"
+
+/* A kPa stress-strain table of one spring's law (noise-free: both types fit it). */
+static void law_table(const cf_spring *p, int n, double emax, cf_table *t)
+{
+    cf_law law;
+    assert_int_equal(cf_law_init(&law, p, NULL), CF_OK);
+    double x[64], y[64];
+    for (int i = 0; i < n; i++) {
+        x[i] = emax * i / (n - 1);
+        y[i] = cf_law_force(&law, CF_LAW_EXACT, x[i] * p->H_mm, NULL, NULL) / (p->H_mm * p->H_mm);
+    }
+    assert_int_equal(cf_table_from_arrays(CF_TABLE_STRESS_STRAIN, (size_t)n, x, y, NULL, t, NULL),
+                     CF_OK);
+    /* as the reader would leave a kPa table */
+    t->y_to_file = 1000;
+    snprintf(t->y_unit, sizeof t->y_unit, "kPa");
+    snprintf(t->y_column, sizeof t->y_column, "stress_kPa");
+    snprintf(t->path, sizeof t->path, "spring.csv");
+    cf_law_free(&law);
+}
+
+static void json_holds_units_finite_numbers_and_reads_back(void **state)
+{
+    (void)state;
+    cf_spring p = {4, 10, 3, 0.5, 80000, 12};
+    cf_table t;
+    law_table(&p, 30, 0.5 * (12 - 0.5) / 12, &t);
+    cf_pipeline_options po = cf_pipeline_default_options();
+    cf_fit_report r;
+    cf_error err = {0};
+    assert_int_equal(cf_pipeline_fit(&t, &po, &r, &err), CF_OK);
+    assert_int_equal(r.nfits, 2);
+    /* a value no fit should hold: it must come out as null */
+    r.fits[1].max_abs_error = NAN;
+    char *s = cf_report_json_string(&r);
+    assert_non_null(s);
+    assert_null(strstr(s, "nan"));
+    assert_null(strstr(s, "NaN"));
+    assert_null(strstr(s, "inf"));
+    json_error_t je;
+    json_t *root = json_loads(s, JSON_REJECT_DUPLICATES, &je);
+    if (!root)
+        fail_msg("not JSON: %s", je.text);
+    json_t *data = json_object_get(root, "data");
+    assert_string_equal(json_string_value(json_object_get(data, "file")), "spring.csv");
+    assert_string_equal(json_string_value(json_object_get(data, "y_unit")), "kPa");
+    assert_int_equal(json_integer_value(json_object_get(data, "points")), 30);
+    json_t *f0 = json_array_get(json_object_get(root, "fits"), 0);
+    json_t *f1 = json_array_get(json_object_get(root, "fits"), 1);
+    assert_true(json_is_null(json_object_get(f1, "max_abs_error")));
+    /* RMSE in kPa: the fit's MPa value times 1000 */
+    assert_close(json_number_value(json_object_get(f0, "rmse")), r.fits[0].rmse * 1000,
+                 1e-12 * fmax(1.0, r.fits[0].rmse * 1000));
+    assert_int_equal(json_array_size(json_object_get(root, "baselines")), 3);
+    json_decref(root);
+    /* what is written reads back: the spring of the first fit, bit for bit */
+    char dir[] = "/tmp/conifit-report-XXXXXX", path[300];
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/r.json", dir);
+    assert_int_equal(cf_report_json_write(&r, path, NULL, &err), CF_OK);
+    cf_fitted_spring fs;
+    assert_int_equal(cf_fitfile_load(path, "telescoping", &fs, &err), CF_OK);
+    assert_true(fs.params.D1_mm == r.fits[0].params.D1_mm);
+    assert_true(fs.params.G_MPa == r.fits[0].params.G_MPa);
+    assert_string_equal(fs.y_unit, "kPa");
+    remove(path);
+    rmdir(dir);
+    free(s);
+    cf_report_free(&r);
+    cf_table_free(&t);
+}
+
+static void text_names_types_quantities_and_units(void **state)
+{
+    (void)state;
+    cf_spring p = {4, 10, 3, 0.5, 80000, 12};
+    cf_table t;
+    law_table(&p, 30, 0.5 * (12 - 0.5) / 12, &t);
+    cf_pipeline_options po = cf_pipeline_default_options();
+    cf_fit_report r;
+    assert_int_equal(cf_pipeline_fit(&t, &po, &r, NULL), CF_OK);
+    char *text = cf_report_text(&r);
+    assert_non_null(text);
+    const char *want[] = {"spring.csv", "telescoping", "non-telescoping", "rho = D1/D2",
+                          "solid strain s/H", "stress scale F_C/H^2", " mm", " MPa", " kPa",
+                          "RMSE", "Baselines", "duffing", "fung"};
+    for (size_t i = 0; i < sizeof want / sizeof want[0]; i++)
+        if (!strstr(text, want[i]))
+            fail_msg("the report text lacks '%s':\n%s", want[i], text);
+    /* the law of one spring is met by both types: reported as a tie, and so is the JSON */
+    assert_true(cf_report_types_tie(&r));
+    assert_non_null(strstr(text, "tie"));
+    free(text);
+    char *s = cf_report_json_string(&r);
+    json_t *root = json_loads(s, 0, NULL);
+    assert_true(json_is_true(json_object_get(json_object_get(root, "comparison"), "tie")));
+    json_decref(root);
+    free(s);
+    cf_report_free(&r);
+    cf_table_free(&t);
+}
+
+/* With one type only there is no comparison and the better fit is that one (if feasible). */
+static void one_type_has_no_comparison(void **state)
+{
+    (void)state;
+    cf_spring p = {4, 10, 3, 0.5, 80000, 12};
+    cf_table t;
+    law_table(&p, 30, 0.5 * (12 - 0.5) / 12, &t);
+    cf_pipeline_options po = cf_pipeline_default_options();
+    po.types = CF_PIPELINE_NON_TELESCOPING;
+    cf_fit_report r;
+    assert_int_equal(cf_pipeline_fit(&t, &po, &r, NULL), CF_OK);
+    assert_int_equal(r.nfits, 1);
+    assert_false(cf_report_types_tie(&r));
+    assert_int_equal(cf_report_better(&r), r.fits[0].feasible ? 0 : -1);
+    char *s = cf_report_json_string(&r);
+    json_t *root = json_loads(s, 0, NULL);
+    assert_null(json_object_get(root, "comparison"));
+    json_decref(root);
+    free(s);
+    cf_report_free(&r);
+    cf_table_free(&t);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(json_holds_units_finite_numbers_and_reads_back),
+        cmocka_unit_test(text_names_types_quantities_and_units),
+        cmocka_unit_test(one_type_has_no_comparison),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
