@@ -156,6 +156,8 @@ int cf_cli_next(cf_cli_parser *p)
             return 0;
         case 'h':
             fputs(p->help, stdout);
+            if (p->help_more)
+                fputs(p->help_more, stdout);
             if (p->spring)
                 cf_cli_spring_help(stdout);
             cf_cli_common_help(stdout);

@@ -59,6 +59,7 @@ enum {
 typedef struct cf_cli_parser {
     const char *cmd;               /* "fit", for messages */
     const char *help;              /* the command's help text */
+    const char *help_more;         /* printed after it when not NULL */
     int spring;                    /* 1: the command takes --D1 ... --H */
     int argc;
     char **argv;

@@ -66,7 +66,10 @@ static const char fit_help[] =
     "                          table's '# stress:' comment or column name, else nominal);\n"
     "                          Cauchy stress is converted to nominal under incompressibility\n"
     "  --strain-measure M      engineering | log | stretch (default: '# strain:' or the name)\n"
-    "  -j, --jobs N            fit N tables at a time (default 1)\n"
+    "  -j, --jobs N            fit N tables at a time (default 1)\n";
+
+/* The help's second part (C17 guarantees string literals of 4095 characters only). */
+static const char fit_help_series[] =
     "Time series (a table with a time column such as time_s) are fitted with the time-dependent\n"
     "model: the conical law plus a Prony series on every spring, in the lattice's homogenised\n"
     "cell, driven by the measured strain history:\n"
@@ -447,6 +450,7 @@ static int parse_args(int argc, char **argv, fit_args *a)
     a->argc = argc;
     a->argv = argv;
     int rc = cf_cli_parser_init(&p, cmd, fit_help, 0, argc, argv, "j:", fit_options);
+    p.help_more = fit_help_series;
     if (rc || (rc = cf_cli_parse(&p, fit_option, a)) >= 0)
         return rc;
     a->out = p.output;
