@@ -7,6 +7,7 @@
 #   make fits       re-fit every table in data/ into fits/ (JSON and PNG), validated in the lattice
 #   make test       build and run the cmocka suite (the README's second command)
 #   make sanitize   the same suite under AddressSanitizer + UndefinedBehaviorSanitizer
+#   make fuzz       libFuzzer (clang, ASan + UBSan) on each parser for FUZZ_SECONDS (default 60) s
 #   make bench      the benchmark report into build/bench/report/ (optimised build, separate from
 #                   the tests); make bench-update copies it over the committed tests/bench/
 #   make figures    regenerate fits/figures/*.png (validation, hysteresis, creep) from data/scenes
@@ -17,7 +18,7 @@ CC      ?= cc
 PKGS    := nlopt gsl jansson
 TESTPKGS := cmocka
 DEBS    := build-essential pkg-config libnlopt-dev libgsl-dev libcmocka-dev libjansson-dev \
-           libsuitesparse-dev libopenblas0-serial gnuplot-nox calculix-ccx
+           libsuitesparse-dev libopenblas0-serial gnuplot-nox calculix-ccx clang libclang-rt-dev
 BUILD   ?= build
 
 WARN    := -Wall -Wextra -Wpedantic -Wshadow -Wmissing-prototypes -Wstrict-prototypes \
@@ -50,7 +51,7 @@ LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 CLI_OBJ := $(CLI_SRC:src/%.c=$(BUILD)/obj/%.o)
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 
-.PHONY: all deps example test sanitize bench bench-update clean check-deps figures fits
+.PHONY: all deps example test sanitize fuzz bench bench-update clean check-deps figures fits
 
 all: check-deps $(BUILD)/conifit
 
@@ -96,8 +97,10 @@ $(BUILD)/tests/%: tests/%.c tests/testutil.h $(LIB_OBJ) | $(BUILD)/tests
 $(BUILD)/obj $(BUILD)/tests:
 	mkdir -p $@
 
-test: check-deps $(BUILD)/conifit $(TESTS)
+test: check-deps $(BUILD)/conifit $(TESTS) $(REPLAYS)
 	@sh tests/check_layers.sh
+	@$(foreach f,$(FUZZERS),CONIFIT_FUZZ_QUIET=1 $(BUILD)/fuzz-replay/$(f) $(FUZZ_SEEDS_$(f)) \
+	  tests/fuzz/regressions/$(f) || { echo "conifit: fuzz replay $(f) FAILED" >&2; exit 1; };)
 	@fail=0; for t in $(TESTS); do \
 	  CONIFIT=$(BUILD)/conifit $$t || fail=1; done; \
 	if [ $$fail = 0 ]; then echo "conifit: all test programs passed"; else echo "conifit: TEST FAILURES" >&2; exit 1; fi
@@ -110,6 +113,56 @@ figures: check-deps $(BUILD)/conifit
 
 sanitize:
 	@$(MAKE) --no-print-directory test SANITIZE=1
+
+# Fuzzing (tests/fuzz/README.md): one libFuzzer harness per parser, the library built again with
+# clang and ASan + UBSan; seed corpora from data/ and fits/. `make test` replays the seeds and the
+# saved crash inputs (tests/fuzz/regressions/NAME/) through the same harnesses, built with $(CC).
+FUZZERS      := table fitfile scene args
+FUZZ_SECONDS ?= 60
+FUZZ_CC      ?= clang
+FUZZ_CFLAGS  := -std=c17 -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined \
+                -fno-sanitize-recover=all $(shell pkg-config --cflags $(PKGS) 2>/dev/null) \
+                $(SPARSE_CFLAGS)
+FUZZ_LIBS    := $(shell pkg-config --libs $(PKGS) 2>/dev/null) $(SPARSE_LIBS) -lm -lpthread
+FUZZ_OBJ     := $(LIB_SRC:src/%.c=build/fuzz/obj/%.o) build/fuzz/obj/cli/cli.o
+REPLAYS      := $(FUZZERS:%=$(BUILD)/fuzz-replay/%)
+FUZZ_SEEDS_table   = data/*.csv
+FUZZ_SEEDS_fitfile = fits/*.json
+FUZZ_SEEDS_scene   = data/scenes/*.json
+FUZZ_SEEDS_args    = tests/fuzz/args
+
+$(BUILD)/fuzz-replay/%: tests/fuzz/replay.c tests/fuzz/fuzz_%.c tests/fuzz/fuzz.h $(LIB_OBJ) \
+                        $(BUILD)/obj/cli/cli.o
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) $(CFLAGS) tests/fuzz/replay.c tests/fuzz/fuzz_$*.c $(LIB_OBJ) \
+	  $(BUILD)/obj/cli/cli.o -o $@ $(LDFLAGS) $(LDLIBS)
+
+.SECONDARY: $(FUZZ_OBJ)
+build/fuzz/obj/%.o: src/%.c $(HDRS)
+	@mkdir -p $(dir $@)
+	$(FUZZ_CC) $(CPPFLAGS) $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link -c $< -o $@
+
+build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz.h $(FUZZ_OBJ)
+	$(FUZZ_CC) $(CPPFLAGS) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_OBJ) -o $@ $(FUZZ_LIBS)
+
+# Each fuzzer runs FUZZ_SECONDS on a working corpus in build/fuzz/corpus/NAME seeded from the
+# repository; a crash stops the run with its input in build/fuzz/crash-NAME-*: add it to
+# tests/fuzz/regressions/NAME/ once fixed.
+fuzz: check-deps $(FUZZERS:%=build/fuzz/fuzz_%)
+	@mkdir -p build/fuzz/corpus/table build/fuzz/corpus/fitfile build/fuzz/corpus/scene \
+	  build/fuzz/corpus/args
+	@cp $(FUZZ_SEEDS_table) build/fuzz/corpus/table/
+	@cp $(FUZZ_SEEDS_fitfile) build/fuzz/corpus/fitfile/
+	@cp $(FUZZ_SEEDS_scene) build/fuzz/corpus/scene/
+	@cp $(FUZZ_SEEDS_args)/* build/fuzz/corpus/args/
+	@for f in $(FUZZERS); do \
+	  echo "conifit: fuzzing $$f for $(FUZZ_SECONDS) s"; \
+	  build/fuzz/fuzz_$$f -max_total_time=$(FUZZ_SECONDS) -timeout=20 -rss_limit_mb=2048 -close_fd_mask=3 \
+	    -print_final_stats=1 -artifact_prefix=build/fuzz/crash-$$f- build/fuzz/corpus/$$f \
+	    $$(ls -d tests/fuzz/regressions/$$f 2>/dev/null) 2>build/fuzz/$$f.log \
+	    || { tail -n 40 build/fuzz/$$f.log >&2; echo "conifit: fuzzer $$f found a crash" >&2; exit 1; }; \
+	  grep -E "stat::number_of_executed_units|stat::peak_rss_mb" build/fuzz/$$f.log; \
+	done
 
 clean:
 	rm -rf build
