@@ -165,6 +165,50 @@ static void folders_are_missing_inputs(void **state)
     assert_int_equal(tu_run(NULL, 0, NULL, 0, "fit %s", dir), 66);
 }
 
+/* Finite values whose sums over the table would overflow are refused with line and column; names
+** cut to fit are cut between characters; a file name in another encoding is reported as valid
+** UTF-8, and its fit file is written (JSON with no NaN or Inf). */
+static void values_and_names(void **state)
+{
+    (void)state;
+    char path[512];
+    FILE *f = create("big.csv", path, sizeof path);
+    fputs("strain,stress_kPa\n0,0\n0.1,1\n0.2,2\n0.3,1e308\n0.4,4\n0.5,5\n0.6,6\n", f);
+    assert_int_equal(fclose(f), 0);
+    cf_table t;
+    cf_error err = {0};
+    assert_int_equal(cf_measure_load(path, NULL, &t, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "big.csv:5:2:"));
+
+    f = create("n\xff\xfe.csv", path, sizeof path);
+    fputs("strain,", f);
+    for (int k = 0; k < 40; k++)
+        fputs("\xcf\x83", f); /* a Greek sigma, two bytes */
+    fputs("stress [kPa]\n", f);
+    for (int k = 0; k < 8; k++)
+        fprintf(f, "%g,%g\n", k / 10.0, k * (1 + k / 10.0));
+    assert_int_equal(fclose(f), 0);
+    assert_int_equal(cf_measure_load(path, NULL, &t, &err), CF_OK);
+    size_t n = strlen(t.y_column);
+    assert_true(n > 0 && n < sizeof t.y_column && n % 2 == 0); /* whole characters only */
+    assert_non_null(strstr(t.path, "n??.csv"));
+    cf_table_free(&t);
+    char cmd[1200];
+    snprintf(cmd, sizeof cmd, "%s fit '%s' -q -o %s/u.json 2>/dev/null", tu_conifit(), path, dir);
+    assert_int_equal(WEXITSTATUS(system(cmd)), 0);
+    snprintf(cmd, sizeof cmd, "%s/u.json", dir);
+    f = fopen(cmd, "rb");
+    assert_non_null(f);
+    static char json[1 << 17];
+    size_t len = fread(json, 1, sizeof json - 1, f);
+    json[len] = '\0';
+    fclose(f);
+    assert_non_null(strstr(json, "n??.csv"));
+    assert_null(strstr(json, "nan"));
+    assert_null(strstr(json, "NaN"));
+    assert_null(strstr(json, "inf"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -173,6 +217,7 @@ int main(void)
         cmocka_unit_test(row_limit),
         cmocka_unit_test(line_and_size_limits),
         cmocka_unit_test(folders_are_missing_inputs),
+        cmocka_unit_test(values_and_names),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -373,6 +373,37 @@ static size_t bad_byte(const unsigned char *s, size_t n)
     return n;
 }
 
+/* Copies src into dst (cap bytes with the NUL) as valid UTF-8 without control characters, for
+** names that end up in reports and JSON: a byte that does not start a valid character (a file
+** name in another encoding) or is a control character becomes '?', and a name too long is cut at
+** a character boundary, never inside one. */
+static void utf8_copy(char *dst, size_t cap, const char *src)
+{
+    size_t o = 0, n = strlen(src), i = 0;
+    while (i < n && o + 1 < cap) {
+        const unsigned char *p = (const unsigned char *)src + i;
+        size_t len = 1;
+        if (*p >= 0x80) {
+            len = *p >= 0xf0 ? 4 : *p >= 0xe0 ? 3 : 2;
+            if (i + len > n || bad_byte(p, len) != len)
+                len = 0; /* not a valid character here */
+        } else if (*p < 0x20 || *p == 0x7f) {
+            len = 0;
+        }
+        if (len == 0) {
+            dst[o++] = '?';
+            i++;
+            continue;
+        }
+        if (o + len + 1 > cap)
+            break;
+        memcpy(dst + o, p, len);
+        o += len;
+        i += len;
+    }
+    dst[o] = '\0';
+}
+
 /* ---- numbers ------------------------------------------------------------------------------ */
 
 typedef enum num_result { NUM_OK, NUM_EMPTY, NUM_NOT_NUMBER, NUM_NOT_FINITE } num_result;
@@ -1325,6 +1356,20 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
                             "value out of range after unit conversion ('%s')", q);
             goto fail;
         }
+        /* finite, but so large that sums of squares over the table (RMSE, R^2, the fit's
+        ** objective) would overflow: refused, so that no derived number can be Inf or NaN */
+        if (fabs(x) > CF_MEASURE_MAX_VALUE || fabs(y) > CF_MEASURE_MAX_VALUE ||
+            fabs(v[2]) > CF_MEASURE_MAX_VALUE || fabs(t) > CF_MEASURE_MAX_VALUE) {
+            size_t col = fabs(x) > CF_MEASURE_MAX_VALUE   ? (size_t)xi
+                         : fabs(y) > CF_MEASURE_MAX_VALUE ? (size_t)yi
+                         : fabs(v[2]) > CF_MEASURE_MAX_VALUE ? (size_t)wi
+                                                             : (size_t)ti;
+            st = data_error(err, path, l->line, col + 1,
+                            "column '%s': magnitude above %g in conifit's units (MPa, N, mm, s): "
+                            "sums over the table would overflow ('%s')",
+                            r.cols[col].name, CF_MEASURE_MAX_VALUE, q);
+            goto fail;
+        }
         if (r.count == CF_MEASURE_MAX_ROWS) {
             st = data_error(err, path, l->line, 1,
                             "more than %d data rows: a table may have at most %d (thin it, or "
@@ -1386,9 +1431,9 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
     m->y_to_file = 1.0 / yscale;
     m->compression = neg && !pos;
     m->x_from_stretch = stretch;
-    snprintf(m->path, sizeof m->path, "%s", path);
-    snprintf(m->x_column, sizeof m->x_column, "%.63s", xc->name);
-    snprintf(m->y_column, sizeof m->y_column, "%.63s", yc->name);
+    utf8_copy(m->path, sizeof m->path, path);
+    utf8_copy(m->x_column, sizeof m->x_column, xc->name);
+    utf8_copy(m->y_column, sizeof m->y_column, yc->name);
     snprintf(m->x_unit, sizeof m->x_unit, "%s",
              m->kind == CF_TABLE_STRESS_STRAIN ? "-" : "mm");
     snprintf(m->y_unit, sizeof m->y_unit, "%s", yu->canon);

@@ -103,6 +103,7 @@ cf_measure_options cf_measure_default_options(void);
 #define CF_MEASURE_MAX_COLUMNS 1000           /* columns of the header */
 #define CF_MEASURE_MAX_LINES 2000000          /* lines in all: rows, comments, blank lines */
 #define CF_MEASURE_MAX_BYTES ((size_t)256 << 20) /* file size, 256 MiB */
+#define CF_MEASURE_MAX_VALUE 1e100                /* |value| in MPa, N, mm, s or a weight */
 
 /* What a unit measures. */
 typedef enum cf_unit_class {
