@@ -81,6 +81,11 @@ example: deps
 
 fits: check-deps $(BUILD)/conifit
 	$(BUILD)/conifit fit data/*.csv --validate -o fits/ --plot fits/ -j 4
+	@mkdir -p fits/series
+	$(BUILD)/conifit fit data/series/*.csv --branches 2 -o fits/series/ --plot fits/series/ -j 2
+	@if [ -d ../shared/datasets ]; then \
+	  $(BUILD)/conifit fit ../shared/datasets/muscle_compression_relaxation_*.csv -o fits/series/ --plot fits/series/ -j 2; \
+	else echo "conifit: ../shared/datasets absent: the muscle relaxation fits are not refreshed"; fi
 
 $(BUILD)/obj/%.o: src/%.c $(HDRS)
 	@mkdir -p $(@D)

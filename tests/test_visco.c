@@ -9,6 +9,9 @@
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 
+#include <jansson.h>
+
+#include "conifit/measure.h"
 #include "conifit/msm.h"
 #include "conifit/viscofit.h"
 #include "conifit/viscomodel.h"
@@ -163,6 +166,23 @@ static void assert_recovered(const cf_visco_fit *f, const cf_visco_params *p, do
     }
 }
 
+/* Every fitted quantity within twice its reported standard error of the truth. */
+static void assert_within_stderr(const cf_visco_fit *f, const cf_visco_params *p)
+{
+    for (int i = 0; i < 3; i++)
+        assert_true(f->se_ident[i] > 0);
+    assert_close(f->p.rho, p->rho, 2 * f->se_ident[0]);
+    assert_close(f->p.solid_strain, p->solid_strain, 2 * f->se_ident[1]);
+    assert_close(f->p.stress_scale_MPa, p->stress_scale_MPa, 2 * f->se_ident[2]);
+    for (int i = 0; i < 2; i++) {
+        int j = fabs(log(f->p.tau_s[0] / p->tau_s[i])) < fabs(log(f->p.tau_s[1] / p->tau_s[i])) ? 0
+                                                                                              : 1;
+        assert_true(f->se_g[j] > 0 && f->se_tau_s[j] > 0);
+        assert_close(f->p.g[j], p->g[i], 2 * f->se_g[j]);
+        assert_close(f->p.tau_s[j], p->tau_s[i], 2 * f->se_tau_s[j]);
+    }
+}
+
 /* A series made by the model from known terms is fitted back to 1e-6. */
 static void test_recover_noiseless(void **state)
 {
@@ -208,17 +228,7 @@ static void test_recover_with_noise(void **state)
     cf_visco_data d = {NS, t, x, y, NULL};
     cf_visco_fit f;
     assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_OK);
-    for (int i = 0; i < 3; i++)
-        assert_true(f.se_ident[i] > 0);
-    assert_close(f.p.rho, p.rho, 2 * f.se_ident[0]);
-    assert_close(f.p.solid_strain, p.solid_strain, 2 * f.se_ident[1]);
-    assert_close(f.p.stress_scale_MPa, p.stress_scale_MPa, 2 * f.se_ident[2]);
-    for (int i = 0; i < 2; i++) {
-        int j = fabs(log(f.p.tau_s[0] / p.tau_s[i])) < fabs(log(f.p.tau_s[1] / p.tau_s[i])) ? 0 : 1;
-        assert_true(f.se_g[j] > 0 && f.se_tau_s[j] > 0);
-        assert_close(f.p.g[j], p.g[i], 2 * f.se_g[j]);
-        assert_close(f.p.tau_s[j], p.tau_s[i], 2 * f.se_tau_s[j]);
-    }
+    assert_within_stderr(&f, &p);
     cf_visco_fit_free(&f);
 }
 
@@ -335,6 +345,121 @@ static void test_cli_series_errors(void **state)
     rmdir(dir);
 }
 
+/* The shipped synthetic series: made by the documented command, fitted back to its known terms
+** (1e-6 without noise; within twice the reported standard errors with 1 % noise). */
+static void fit_shipped(const char *path, cf_visco_fit *f)
+{
+    cf_table t;
+    cf_error err = {0};
+    assert_int_equal(cf_measure_load(path, NULL, &t, &err), CF_OK);
+    assert_non_null(t.t);
+    cf_visco_fit_options o = cf_visco_fit_default_options();
+    o.nbranch = 2;
+    cf_visco_data d = {t.count, t.t, t.x, t.y, NULL};
+    assert_int_equal(cf_visco_fit_run(&d, &o, f, &err), CF_OK);
+    cf_table_free(&t);
+}
+
+static cf_visco_params shipped_truth(void)
+{
+    cf_spring sp = {6, 15, 2.5, 2, 26, 10};
+    double id[3];
+    cf_fit_identifiable(&sp, 0, id);
+    cf_visco_params p = known();
+    p.rho = id[0];
+    p.solid_strain = id[1];
+    p.stress_scale_MPa = id[2];
+    return p;
+}
+
+static void test_shipped_synthetic_series(void **state)
+{
+    (void)state;
+    /* the documented command writes the shipped file, byte for byte */
+    char dir[] = "/tmp/conifit-visco-XXXXXX", out[256], so[4096], se[4096];
+    assert_non_null(mkdtemp(dir));
+    snprintf(out, sizeof out, "%s/s.csv", dir);
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se,
+                            "simulate data/scenes/synthetic_relaxation.json --table --noise 0.01 "
+                            "--seed 1 -o %s",
+                            out),
+                     0);
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "cmp -s %s data/series/synthetic_relaxation_noise1pct.csv", out);
+    assert_int_equal(system(cmd), 0);
+    unlink(out);
+    rmdir(dir);
+    cf_visco_params p = shipped_truth();
+    cf_visco_fit f;
+    fit_shipped("data/series/synthetic_relaxation.csv", &f);
+    assert_recovered(&f, &p, 1e-6);
+    cf_visco_fit_free(&f);
+    fit_shipped("data/series/synthetic_relaxation_noise1pct.csv", &f);
+    assert_within_stderr(&f, &p);
+    cf_visco_fit_free(&f);
+}
+
+/* conifit simulate, on a scene whose spring is the fit file and whose protocol is the series'
+** history, reproduces the fitted curve (27-cell lattice against the fit's cell: 1e-6). */
+static void test_simulate_reproduces_fit(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-visco-XXXXXX", fit[256], scene[256], csv[256];
+    char so[8192], se[4096];
+    assert_non_null(mkdtemp(dir));
+    snprintf(fit, sizeof fit, "%s/fit.json", dir);
+    snprintf(scene, sizeof scene, "%s/scene.json", dir);
+    snprintf(csv, sizeof csv, "%s/sim.csv", dir);
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se,
+                            "fit data/series/synthetic_relaxation_noise1pct.csv --branches 2 --dashpot "
+                            "-o %s",
+                            fit),
+                     0);
+    json_error_t je;
+    json_t *root = json_load_file(fit, 0, &je);
+    assert_non_null(root);
+    json_t *series = json_object_get(root, "series");
+    json_t *t = json_object_get(series, "time_s"), *x = json_object_get(series, "strain"),
+           *m = json_object_get(series, "model");
+    size_t n = json_array_size(t);
+    assert_true(n > 10 && json_array_size(m) == n);
+    /* the scene: the fit's spring (and Prony terms, dashpot) along the measured history */
+    json_t *ts = json_array(), *vs = json_array();
+    for (size_t k = 0; k < n; k++) {
+        json_array_append_new(ts, json_real(json_number_value(json_array_get(t, k))));
+        json_array_append_new(vs, json_real(-json_number_value(json_array_get(x, k))));
+    }
+    json_t *sc = json_pack("{s:{s:s}, s:{s:s, s:o, s:o}, s:i}", "spring", "fit", fit,
+                           "protocol", "kind", "history", "t_s", ts, "to_strain", vs,
+                           "samples_per_segment", 1);
+    assert_int_equal(json_dump_file(sc, scene, JSON_REAL_PRECISION(17)), 0);
+    json_decref(sc);
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "simulate %s -o %s", scene, csv), 0);
+    FILE *f = fopen(csv, "r");
+    assert_non_null(f);
+    char line[512];
+    assert_non_null(fgets(line, sizeof line, f)); /* header */
+    double peak = 0;
+    for (size_t k = 0; k < n; k++)
+        peak = fmax(peak, fabs(json_number_value(json_array_get(m, k))));
+    size_t k = 0;
+    while (fgets(line, sizeof line, f) && k < n) {
+        double tt, e, stress;
+        assert_int_equal(sscanf(line, "%lf,%lf,%lf", &tt, &e, &stress), 3);
+        assert_close(tt, json_number_value(json_array_get(t, k)), 1e-12);
+        /* simulate writes compression positive; the fit file keeps the table's sign */
+        assert_close(-stress, json_number_value(json_array_get(m, k)), 1e-6 * peak);
+        k++;
+    }
+    assert_int_equal(k, n);
+    fclose(f);
+    json_decref(root);
+    unlink(fit);
+    unlink(scene);
+    unlink(csv);
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -347,6 +472,8 @@ int main(void)
         cmocka_unit_test(test_series_refused),
         cmocka_unit_test(test_held_elastic),
         cmocka_unit_test(test_cli_series_errors),
+        cmocka_unit_test(test_shipped_synthetic_series),
+        cmocka_unit_test(test_simulate_reproduces_fit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -60,7 +60,7 @@ cf_status cf_validate_from_scene(const cf_scene *sc, const char *name, cf_valida
         return cf_error_set(err, CF_E_DATA,
                             "%s: key 'protocol.kind' = '%s': validation needs a static uniaxial "
                             "scene (kind 'ramp')",
-                            name, sc->kind == CF_PROTO_CYCLES ? "cycles" : "hold");
+                            name, sc->kind == CF_PROTO_CYCLES ? "cycles" : sc->kind == CF_PROTO_HOLD ? "hold" : "history");
     if (sc->drive != CF_DRIVE_DISPLACEMENT)
         return cf_error_set(err, CF_E_DATA,
                             "%s: key 'protocol.to_stress_kPa': validation drives the lattice by "

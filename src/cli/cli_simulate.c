@@ -17,6 +17,9 @@
 #include "conifit/scene.h"
 #include "out/plot.h"
 
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_rng.h>
+
 static const char simulate_help[] =
     "usage: conifit simulate SCENE.json -o OUT.csv [--plot OUT.png|.svg|.pdf] [-q]\n"
     "Runs the scene on a mass-spring lattice of conical springs and writes the CSV\n"
@@ -29,6 +32,11 @@ static const char simulate_help[] =
     "  -o, --output FILE   CSV to write (written to a temporary name, then renamed); '-'\n"
     "                      writes it to standard output and the summary to stderr\n"
     "  --plot FILE.png|.svg|.pdf  also plot the result with gnuplot\n"
+    "  --table             write a measurement table instead: time_s,strain,stress_kPa in the\n"
+    "                      published tables' sign (tension positive, compression negative),\n"
+    "                      '#' lines naming the scene; conifit fit reads it as a time series\n"
+    "  --noise REL         with --table: Gaussian noise on the stress, sd = REL x max |stress|\n"
+    "  --seed S            seed of the noise (GSL mt19937, default 1)\n"
     "  --max-memory SIZE   refuse a scene estimated to need more memory (bytes, or with a\n"
     "                      K, M or G suffix; default 2G)\n"
     "  --max-steps N       refuse a scene estimated to need more time steps or static\n"
@@ -64,7 +72,7 @@ static double loop_area(const cf_msm_sample *s, size_t a, size_t b)
 static void summary(FILE *o, const cf_scene *sc, const cf_msm_sample *s, size_t n, const cf_msm_stats *st)
 {
     const int timed = sc->effects.inertia || sc->effects.eta_MPa_s > 0 ||
-                      sc->effects.maxwell_E_MPa > 0;
+                      sc->effects.maxwell_E_MPa > 0 || sc->effects.prony_count > 0;
     const cf_lattice_config *lc = &sc->cfg.lattice;
     fprintf(o, "spring: %s; lattice %d x %d x %d cells, calibration %s (weights edge %.4g, face "
            "%.4g, body %.4g); solver: %s\n",
@@ -122,11 +130,14 @@ static void summary(FILE *o, const cf_scene *sc, const cf_msm_sample *s, size_t 
     }
 }
 
-enum { OPT_PLOT = CF_CLI_OPT_OWN, OPT_MAX_MEMORY, OPT_MAX_STEPS };
+enum { OPT_PLOT = CF_CLI_OPT_OWN, OPT_MAX_MEMORY, OPT_MAX_STEPS, OPT_TABLE, OPT_NOISE, OPT_SEED };
 
 typedef struct sim_opts {
     const char *png;
     cf_budget budget;
+    int table;      /* --table */
+    double noise;   /* --noise REL */
+    long seed;      /* --seed S */
 } sim_opts;
 
 /* A size in bytes with an optional K, M or G (binary) suffix; 0 when it is not one. */
@@ -153,6 +164,14 @@ static int take_option(void *ctx, int c, const char *value)
     cf_error err = {0};
     if (c == OPT_PLOT) {
         o->png = value;
+    } else if (c == OPT_TABLE) {
+        o->table = 1;
+    } else if (c == OPT_NOISE) {
+        if (cf_cli_parse_double("--noise", value, &o->noise, &err) != CF_OK || !(o->noise >= 0))
+            return cf_cli_usage_error("simulate", "--noise '%s': expected a number >= 0", value);
+    } else if (c == OPT_SEED) {
+        if (cf_cli_parse_long("--seed", value, 0, 2147483647L, &o->seed, &err) != CF_OK)
+            return cf_cli_usage_error("simulate", "%s", err.msg);
     } else if (c == OPT_MAX_MEMORY) {
         if (!(o->budget.max_memory_bytes = parse_size(value)))
             return cf_cli_usage_error("simulate", "--max-memory '%s': expected a size in bytes, "
@@ -172,11 +191,14 @@ int cf_cli_simulate(int argc, char **argv)
     static const struct option own[] = {{"plot", required_argument, NULL, OPT_PLOT},
                                         {"max-memory", required_argument, NULL, OPT_MAX_MEMORY},
                                         {"max-steps", required_argument, NULL, OPT_MAX_STEPS},
+                                        {"table", no_argument, NULL, OPT_TABLE},
+                                        {"noise", required_argument, NULL, OPT_NOISE},
+                                        {"seed", required_argument, NULL, OPT_SEED},
                                         {NULL, 0, NULL, 0}};
     const char *scene_path = NULL, *out = NULL, *png = NULL;
     cf_error err = {0};
     cf_scene_cost cost;
-    sim_opts so = {NULL, cf_budget_default()};
+    sim_opts so = {NULL, cf_budget_default(), 0, 0, 1};
     cf_cli_parser p;
     int rc = cf_cli_parser_init(&p, "simulate", simulate_help, 0, argc, argv, "", own);
     if (rc || (rc = cf_cli_parse(&p, take_option, &so)) >= 0)
@@ -270,12 +292,38 @@ int cf_cli_simulate(int argc, char **argv)
     double H = law.p.H_mm;
     for (size_t k = 0; k < sc.nsamples; k++)
         spring[k] = cf_law_force(&law, sc.method, samples[k].strain * H, NULL, NULL) / (H * H);
-    fprintf(a.fp, "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,stable\n");
-    size_t lost = first_unstable(samples, sc.nsamples);
-    for (size_t k = 0; k < sc.nsamples; k++)
-        fprintf(a.fp, "%.17g,%.17g,%.17g,%.17g,%.17g,%d\n", samples[k].t_s, samples[k].strain,
-                samples[k].stress_MPa * 1e3, samples[k].kinetic_mJ, spring[k] * 1e3,
-                sc.effects.inertia ? -1 : k < lost);
+    if (so.table) { /* a measurement table of the run, tension positive */
+        double smax = 0;
+        for (size_t k = 0; k < sc.nsamples; k++)
+            smax = fmax(smax, fabs(samples[k].stress_MPa * 1e3));
+        gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+        if (!rng) {
+            cf_error_set(&err, CF_E_INTERNAL, "out of memory for the noise generator");
+            rc = cf_cli_fail(&err);
+            goto end;
+        }
+        gsl_rng_set(rng, (unsigned long)so.seed);
+        fprintf(a.fp, "# conifit simulate --table: the lattice of a scene along its protocol\n");
+        fprintf(a.fp, "# noise: Gaussian, sd %.17g x max |stress| = %.17g kPa, seed %ld\n",
+                so.noise, so.noise * smax, so.seed);
+        fprintf(a.fp, "# mode: uniaxial\n# columns: time [s], engineering strain [-], nominal "
+                      "stress [kPa]; compression negative\n");
+        fprintf(a.fp, "time_s,strain,stress_kPa\n");
+        for (size_t k = 0; k < sc.nsamples; k++) {
+            double y = -samples[k].stress_MPa * 1e3;
+            if (so.noise > 0 && k > 0)
+                y += gsl_ran_gaussian(rng, so.noise * smax);
+            fprintf(a.fp, "%.17g,%.17g,%.17g\n", samples[k].t_s, -samples[k].strain, y);
+        }
+        gsl_rng_free(rng);
+    } else {
+        fprintf(a.fp, "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,stable\n");
+        size_t lost = first_unstable(samples, sc.nsamples);
+        for (size_t k = 0; k < sc.nsamples; k++)
+            fprintf(a.fp, "%.17g,%.17g,%.17g,%.17g,%.17g,%d\n", samples[k].t_s, samples[k].strain,
+                    samples[k].stress_MPa * 1e3, samples[k].kinetic_mJ, spring[k] * 1e3,
+                    sc.effects.inertia ? -1 : k < lost);
+    }
     if (png && cf_plot_simulation(&sc, samples, spring, sc.nsamples, png, inputs, &pa, &err) !=
                    CF_OK) {
         rc = cf_cli_fail(&err);

@@ -525,7 +525,12 @@ static void standard_errors(ctx *c, const cf_visco_params *p, double s2, cf_visc
     res->se_eta_MPa_s = -1;
     /* parameter list: rho, s/H, scale (free elastic), g_i, tau_i, eta */
     const int nb = p->nbranch;
-    const size_t k = (size_t)((c->free_el ? 3 : 0) + 2 * nb + (c->dash ? 1 : 0));
+    /* rho on its lower bound is set by the limit, not by the data: it is held here (its error
+    ** undetermined), or the others' errors would carry its freedom along the bound */
+    const int rho_held = !c->free_el || p->rho <= c->rho_lo * (1 + 1e-4);
+    res->rho_at_limit = c->free_el && rho_held;
+    const size_t k = (size_t)((c->free_el ? 3 : 0) - (c->free_el && rho_held) + 2 * nb +
+                              (c->dash ? 1 : 0));
     if (k == 0 || c->n <= k)
         return;
     gsl_matrix *J = gsl_matrix_alloc(c->n, k), *cov = gsl_matrix_alloc(k, k);
@@ -538,7 +543,7 @@ static void standard_errors(ctx *c, const cf_visco_params *p, double s2, cf_visc
         double *slot = NULL;
         cf_visco_params q = *p;
         if (which < 3) {
-            if (!c->free_el)
+            if (!c->free_el || (which == 0 && rho_held))
                 continue;
             slot = which == 0 ? &q.rho : which == 1 ? &q.solid_strain : &q.stress_scale_MPa;
         } else if (which < 3 + 2 * nb) {
@@ -579,7 +584,8 @@ static void standard_errors(ctx *c, const cf_visco_params *p, double s2, cf_visc
     if (ok && gsl_multifit_nlinear_covar(J, 1e-13, cov) == GSL_SUCCESS) {
         col = 0;
         for (int which = 0; which < 3 + 2 * nb + 1; which++) {
-            if ((which < 3 && !c->free_el) || (which == 3 + 2 * nb && !c->dash))
+            if ((which < 3 && !c->free_el) || (which == 0 && rho_held) ||
+                (which == 3 + 2 * nb && !c->dash))
                 continue;
             double var = s2 * gsl_matrix_get(cov, col, col);
             double se = var > 0 && isfinite(var) ? sqrt(var) : -1;

@@ -95,7 +95,7 @@ cf_status cf_budget_check_steps(const cf_scene *sc, const char *name, cf_lattice
               : sc->kind == CF_PROTO_RAMP         ? "protocol.duration_s"
               : sc->kind == CF_PROTO_CYCLES       ? "protocol.period_s"
                                                   : "protocol.hold_s";
-    } else if (fx->eta_MPa_s > 0 || fx->maxwell_E_MPa > 0) {
+    } else if (fx->eta_MPa_s > 0 || fx->maxwell_E_MPa > 0 || fx->prony_count > 0) {
         c->steps_kind = "implicit steps";
         if (cfg->dt_s > 0) {
             c->steps = duration / cfg->dt_s + (double)sc->nsamples;

@@ -21,6 +21,53 @@ static void copy_string(json_t *obj, const char *key, char *dst, size_t cap)
     snprintf(dst, cap, "%s", s ? s : "");
 }
 
+/* The Prony terms {"g", "tau_s"} and the dashpot {"eta_kPa_s"} of a viscoelastic fit, checked
+** as the lattice takes them (msm.h). */
+static cf_status read_visco(json_t *fit, const char *path, const char *where,
+                            cf_fitted_spring *out, cf_error *err)
+{
+    json_t *pr = json_object_get(fit, "prony");
+    out->viscoelastic = 0;
+    out->prony_count = 0;
+    out->eta_MPa_s = 0;
+    if (!pr)
+        return CF_OK;
+    if (!json_is_array(pr) || json_array_size(pr) > CF_PRONY_MAX)
+        return cf_error_set(err, CF_E_DATA, "%s: %s.prony must be a list of at most %d terms",
+                            path, where, CF_PRONY_MAX);
+    cf_msm_effects fx;
+    memset(&fx, 0, sizeof fx);
+    size_t i;
+    json_t *term;
+    json_array_foreach(pr, i, term)
+    {
+        json_t *g = json_object_get(term, "g"), *tau = json_object_get(term, "tau_s");
+        if (!json_is_number(g) || !json_is_number(tau))
+            return cf_error_set(err, CF_E_DATA, "%s: %s.prony[%zu] needs numbers 'g' and 'tau_s'",
+                                path, where, i);
+        fx.prony_g[i] = json_number_value(g);
+        fx.prony_tau_s[i] = json_number_value(tau);
+    }
+    fx.prony_count = (int)json_array_size(pr);
+    cf_error e = {0};
+    if (cf_msm_prony_check(&fx, &e) != CF_OK)
+        return cf_error_set(err, CF_E_DATA, "%s: %s.prony: %s", path, where, e.msg);
+    json_t *dp = json_object_get(fit, "dashpot"), *eta = json_object_get(dp, "eta_kPa_s");
+    if (dp && !json_is_null(dp)) {
+        if (!json_is_number(eta) || !(json_number_value(eta) >= 0) ||
+            !isfinite(json_number_value(eta)))
+            return cf_error_set(err, CF_E_DATA,
+                                "%s: %s.dashpot.eta_kPa_s must be a finite number >= 0", path,
+                                where);
+        out->eta_MPa_s = json_number_value(eta) * 1e-3;
+    }
+    out->viscoelastic = 1;
+    out->prony_count = fx.prony_count;
+    memcpy(out->prony_g, fx.prony_g, sizeof out->prony_g);
+    memcpy(out->prony_tau_s, fx.prony_tau_s, sizeof out->prony_tau_s);
+    return CF_OK;
+}
+
 cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spring *out,
                           cf_error *err)
 {
@@ -145,6 +192,8 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
         copy_string(data, "y_unit", out->y_unit, sizeof out->y_unit);
     }
     copy_string(root, "conifit_version", out->version, sizeof out->version);
+    if ((st = read_visco(fit, path, where, out, err)) != CF_OK)
+        goto done;
 done:
     json_decref(root);
     return st;

@@ -22,6 +22,8 @@
 typedef struct ctx {
     const char *name;
     cf_error *err;
+    cf_fitted_spring fit;  /* the spring's fit file, when it names one (its Prony terms) */
+    int from_fit;
 } ctx;
 
 /* Refuses keys of obj that are not in the NULL-terminated list. */
@@ -125,6 +127,8 @@ static cf_status spring_section(ctx *c, json_t *sp, cf_scene *sc)
         if (st)
             return cf_error_set(c->err, st, "%s: key 'spring.fit': %s", c->name, ferr.msg);
         sc->spring = fs.params;
+        c->fit = fs;
+        c->from_fit = 1;
         snprintf(sc->spring_source, sizeof sc->spring_source, "%s:%s", json_string_value(fit),
                  cf_spring_type_name(fs.type));
         return CF_OK;
@@ -264,14 +268,61 @@ static cf_status lattice_section(ctx *c, json_t *lt, cf_scene *sc)
     return CF_OK;
 }
 
+/* effects.viscosity.prony: [{"g": .., "tau_s": ..}, ...], alone (no E_kPa, tau_s beside it),
+** checked as the lattice takes it (g >= 0, sum g < 1, tau > 0, at most CF_PRONY_MAX). */
+static cf_status prony_list(ctx *c, json_t *vs, json_t *pr, cf_msm_effects *e)
+{
+    static const char *const tkeys[] = {"g", "tau_s", NULL};
+    if (json_object_get(vs, "E_kPa") || json_object_get(vs, "tau_s"))
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'effects.viscosity' takes either 'prony' or 'E_kPa' and "
+                            "'tau_s', not both",
+                            c->name);
+    if (!json_is_array(pr) || json_array_size(pr) < 1 || json_array_size(pr) > CF_PRONY_MAX)
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'effects.viscosity.prony' must be a list of 1 to %d terms "
+                            "{\"g\": .., \"tau_s\": ..}",
+                            c->name, CF_PRONY_MAX);
+    size_t i;
+    json_t *term;
+    cf_status st;
+    json_array_foreach(pr, i, term)
+    {
+        char where[64];
+        snprintf(where, sizeof where, "effects.viscosity.prony[%zu]", i);
+        if (!json_is_object(term))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be an object", c->name,
+                                where);
+        if ((st = only_keys(c, term, where, tkeys)) ||
+            (st = number(c, term, where, "g", 1, 0, 0, 0, 1, &e->prony_g[i])) ||
+            (st = number(c, term, where, "tau_s", 1, 0, 0, 1, 1e12, &e->prony_tau_s[i])))
+            return st;
+    }
+    e->prony_count = (int)json_array_size(pr);
+    cf_error pe = {0};
+    if (cf_msm_prony_check(e, &pe) != CF_OK)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'effects.viscosity.prony': %s", c->name,
+                            pe.msg);
+    return CF_OK;
+}
+
 static cf_status effects_section(ctx *c, json_t *ef, cf_scene *sc)
 {
     static const char *const allowed[] = {"inertia", "damping", "viscosity", "gravity", NULL};
     static const char *const dkeys[] = {"eta_kPa_s", NULL};
-    static const char *const vkeys[] = {"E_kPa", "tau_s", NULL};
+    static const char *const vkeys[] = {"E_kPa", "tau_s", "prony", NULL};
     cf_status st;
     cf_msm_effects *e = &sc->effects;
     memset(e, 0, sizeof *e);
+    /* A viscoelastic fit file brings its Prony terms and dashpot; the scene's own
+    ** effects.viscosity and effects.damping replace them. */
+    const int fit_visco = c->from_fit && c->fit.viscoelastic;
+    if (fit_visco) {
+        e->prony_count = c->fit.prony_count;
+        memcpy(e->prony_g, c->fit.prony_g, sizeof e->prony_g);
+        memcpy(e->prony_tau_s, c->fit.prony_tau_s, sizeof e->prony_tau_s);
+        e->eta_MPa_s = c->fit.eta_MPa_s;
+    }
     if (!ef)
         return CF_OK;
     if ((st = only_keys(c, ef, "effects", allowed)))
@@ -288,6 +339,7 @@ static cf_status effects_section(ctx *c, json_t *ef, cf_scene *sc)
             return cf_error_set(c->err, CF_E_DATA, "%s: key 'effects.damping' must be an object "
                                 "{\"eta_kPa_s\": ...}", c->name);
         double eta;
+        e->eta_MPa_s = 0;
         if ((st = only_keys(c, dm, "effects.damping", dkeys)) ||
             (st = number(c, dm, "effects.damping", "eta_kPa_s", 1, 0, 0, 1, 1e12, &eta)))
             return st;
@@ -298,13 +350,27 @@ static cf_status effects_section(ctx *c, json_t *ef, cf_scene *sc)
             return cf_error_set(c->err, CF_E_DATA, "%s: key 'effects.viscosity' must be an object "
                                 "{\"E_kPa\": ..., \"tau_s\": ...}", c->name);
         double E, tau;
-        if ((st = only_keys(c, vs, "effects.viscosity", vkeys)) ||
-            (st = number(c, vs, "effects.viscosity", "E_kPa", 1, 0, 0, 1, 1e12, &E)) ||
-            (st = number(c, vs, "effects.viscosity", "tau_s", 1, 0, 0, 1, 1e12, &tau)))
+        json_t *pr = json_object_get(vs, "prony");
+        e->prony_count = 0;
+        if ((st = only_keys(c, vs, "effects.viscosity", vkeys)))
             return st;
-        e->maxwell_E_MPa = E * 1e-3;
-        e->maxwell_tau_s = tau;
+        if (pr) {
+            if ((st = prony_list(c, vs, pr, e)))
+                return st;
+        } else {
+            if ((st = number(c, vs, "effects.viscosity", "E_kPa", 1, 0, 0, 1, 1e12, &E)) ||
+                (st = number(c, vs, "effects.viscosity", "tau_s", 1, 0, 0, 1, 1e12, &tau)))
+                return st;
+            e->maxwell_E_MPa = E * 1e-3;
+            e->maxwell_tau_s = tau;
+        }
     }
+    if (e->prony_count > 0 && e->inertia)
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: Prony terms (effects.viscosity.prony or a viscoelastic "
+                            "spring.fit) are solved quasi-statically: they do not combine with "
+                            "'effects.inertia' = true",
+                            c->name);
     if (g && !e->inertia)
         return cf_error_set(c->err, CF_E_DATA,
                             "%s: key 'effects.gravity' = true needs 'effects.inertia' = true "
@@ -333,17 +399,76 @@ static cf_status push(cf_scene *sc, size_t *cap, double t, double v)
     return CF_OK;
 }
 
+/* protocol "history": {"t_s": [...], "to_strain": [...]} (or "to_stress_kPa": [...]), the path
+** through those points (time increasing, compressive values, as for the other kinds): a measured
+** loading history, e.g. the series of a viscoelastic fit. */
+static cf_status history_protocol(ctx *c, json_t *pr, cf_scene *sc, size_t *cap)
+{
+    static const char *const ok[] = {"kind", "t_s", "to_strain", "to_stress_kPa", NULL};
+    cf_status st;
+    if ((st = only_keys(c, pr, "protocol", ok)))
+        return st;
+    json_t *t = json_object_get(pr, "t_s"), *vs = json_object_get(pr, "to_strain"),
+           *vf = json_object_get(pr, "to_stress_kPa");
+    json_t *v = vs ? vs : vf;
+    if ((vs != NULL) == (vf != NULL))
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'protocol' (history) needs exactly one of "
+                            "'protocol.to_strain' or 'protocol.to_stress_kPa' (lists)",
+                            c->name);
+    if (!json_is_array(t) || !json_is_array(v) || json_array_size(t) < 2 ||
+        json_array_size(t) != json_array_size(v) || json_array_size(t) > MAX_SAMPLES_PER_SEGMENT)
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: keys 'protocol.t_s' and 'protocol.%s' must be lists of the same "
+                            "length, 2 to %d values",
+                            c->name, vs ? "to_strain" : "to_stress_kPa", MAX_SAMPLES_PER_SEGMENT);
+    sc->kind = CF_PROTO_HISTORY;
+    sc->drive = vs ? CF_DRIVE_DISPLACEMENT : CF_DRIVE_FORCE;
+    cf_law law;
+    const double solid = cf_law_init(&law, &sc->spring, NULL) == CF_OK
+                             ? law.travel_mm / law.p.H_mm
+                             : 1.0;
+    sc->target = 0;
+    for (size_t i = 0; i < json_array_size(t); i++) {
+        json_t *ti = json_array_get(t, i), *vi = json_array_get(v, i);
+        double tv = json_number_value(ti), vv = json_number_value(vi);
+        if (!json_is_number(ti) || !isfinite(tv) || (i > 0 && !(tv > sc->path_t_s[i - 1])) ||
+            (i == 0 && tv < 0))
+            return cf_error_set(c->err, CF_E_DATA,
+                                "%s: key 'protocol.t_s[%zu]' = %g: times must be >= 0 and "
+                                "increase",
+                                c->name, i, tv);
+        if (!json_is_number(vi) || !isfinite(vv) || (vs && !(fabs(vv) < solid)))
+            return cf_error_set(c->err, CF_E_DATA,
+                                "%s: key 'protocol.%s[%zu]' = %g: %s", c->name,
+                                vs ? "to_strain" : "to_stress_kPa", i, vv,
+                                vs ? "a strain short of the spring's solid strain"
+                                   : "a finite stress");
+        if (push(sc, cap, tv, vs ? vv : vv * 1e-3))
+            return cf_error_set(c->err, CF_E_INTERNAL, "out of memory for the loading path");
+        if (fabs(sc->path_v[i]) > fabs(sc->target))
+            sc->target = sc->path_v[i];
+    }
+    return CF_OK;
+}
+
 static cf_status protocol_section(ctx *c, json_t *pr, cf_scene *sc, double samples_per_segment)
 {
     static const char *const allowed[] = {"kind", "to_strain", "to_stress_kPa", "duration_s",
-                                          "period_s", "count", "ramp_s", "hold_s", NULL};
+                                          "period_s", "count", "ramp_s", "hold_s", "t_s", NULL};
     cf_status st;
     if ((st = only_keys(c, pr, "protocol", allowed)))
         return st;
     const char *kind = json_string_value(json_object_get(pr, "kind"));
     if (!kind)
-        return cf_error_set(c->err, CF_E_DATA, "%s: missing key 'protocol.kind' (ramp, cycles or "
-                            "hold)", c->name);
+        return cf_error_set(c->err, CF_E_DATA, "%s: missing key 'protocol.kind' (ramp, cycles, "
+                            "hold or history)", c->name);
+    size_t cap = 0;
+    if (strcmp(kind, "history") == 0) {
+        if ((st = history_protocol(c, pr, sc, &cap)))
+            return st;
+        goto samples;
+    }
     json_t *ts = json_object_get(pr, "to_strain"), *tf = json_object_get(pr, "to_stress_kPa");
     if ((ts != NULL) == (tf != NULL))
         return cf_error_set(c->err, CF_E_DATA,
@@ -370,7 +495,6 @@ static cf_status protocol_section(ctx *c, json_t *pr, cf_scene *sc, double sampl
         target *= 1e-3;
     }
     sc->target = target;
-    size_t cap = 0;
     double seg_t[3];
     size_t nseg = 0;
     if (strcmp(kind, "ramp") == 0) {
@@ -416,9 +540,10 @@ static cf_status protocol_section(ctx *c, json_t *pr, cf_scene *sc, double sampl
             goto oom;
     } else {
         return cf_error_set(c->err, CF_E_DATA,
-                            "%s: key 'protocol.kind' = '%s': expected ramp, cycles or hold",
+                            "%s: key 'protocol.kind' = '%s': expected ramp, cycles, hold or history",
                             c->name, kind);
     }
+samples:;
     /* Samples: every path segment split in samples_per_segment intervals. */
     size_t per = (size_t)samples_per_segment;
     if ((double)(sc->npath - 1) * (double)per + 1 > CF_SCENE_MAX_SAMPLES)
@@ -524,7 +649,10 @@ static cf_status finish(ctx *c, json_t *root, json_error_t *jerr, cf_scene *sc)
 cf_status cf_scene_parse(const char *json_text, const char *name, cf_scene *sc, cf_error *err)
 {
     memset(sc, 0, sizeof *sc);
-    ctx c = {name, err};
+    ctx c;
+    memset(&c, 0, sizeof c);
+    c.name = name;
+    c.err = err;
     json_error_t jerr;
     json_t *root = json_loads(json_text, JSON_REJECT_DUPLICATES, &jerr);
     return finish(&c, root, &jerr, sc);
@@ -533,7 +661,10 @@ cf_status cf_scene_parse(const char *json_text, const char *name, cf_scene *sc, 
 cf_status cf_scene_load(const char *path, cf_scene *sc, cf_error *err)
 {
     memset(sc, 0, sizeof *sc);
-    ctx c = {path, err};
+    ctx c;
+    memset(&c, 0, sizeof c);
+    c.name = path;
+    c.err = err;
     FILE *f = fopen(path, "rb");
     if (!f)
         return cf_error_set(err, CF_E_NOINPUT, "%s: cannot open scene: %s", path,

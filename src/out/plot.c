@@ -324,15 +324,17 @@ static void simulation_script(cf_gp *g, const void *fig)
     /* the curve is named after the spring it ran (a scene's fit file, or "params") */
     char lattice[700];
     snprintf(lattice, sizeof lattice, "lattice (spring: %s)", sc->spring_source);
-    if (sc->kind == CF_PROTO_HOLD) {
+    if (sc->kind == CF_PROTO_HOLD || sc->kind == CF_PROTO_HISTORY) {
+        const int hist = sc->kind == CF_PROTO_HISTORY;
         cf_gp_cmd(g, "set xlabel %q", "time (s)");
         if (sc->drive == CF_DRIVE_FORCE) {
             cf_gp_cmd(g, "set ylabel %q", "compressive strain");
-            cf_gp_cmd(g, "set title %q", "creep under a held load");
+            cf_gp_cmd(g, "set title %q", hist ? "along a loading history" : "creep under a held load");
             cf_gp_cmd(g, "plot $SIM using 1:2 with lines ls 1 title %q", lattice);
         } else {
             cf_gp_cmd(g, "set ylabel %q", "compressive stress (kPa)");
-            cf_gp_cmd(g, "set title %q", "relaxation under a held strain");
+            cf_gp_cmd(g, "set title %q",
+                      hist ? "along a loading history" : "relaxation under a held strain");
             cf_gp_cmd(g, "plot $SIM using 1:3 with lines ls 1 title %q", lattice);
         }
         return;

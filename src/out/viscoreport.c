@@ -109,6 +109,7 @@ static void visco_keys(const cf_visco_report *r, json_t *o)
         json_object_set_new(o, "aic_by_branches", a);
     }
     json_object_set_new(o, "elastic_held", json_boolean(f->held_elastic));
+    json_object_set_new(o, "rho_at_limit", json_boolean(f->rho_at_limit));
     json_object_set_new(o, "predictions", predictions_json(r));
     json_object_set_new(o, "evaluations", json_integer((json_int_t)f->evaluations));
     json_object_set_new(o, "wall_time_s", num(r->with_timing ? f->wall_time_s : 0.0));
@@ -246,7 +247,8 @@ char *cf_visco_report_text(const cf_visco_report *r)
         fputc('\n', o);
     }
     fprintf(o, " elastic part%s:\n", f->held_elastic ? " (held from --elastic)" : "");
-    value_se_text(o, "rho = D1/D2", f->p.rho, f->se_ident[0], 1, "");
+    value_se_text(o, f->rho_at_limit ? "rho = D1/D2 (at --rho-min)" : "rho = D1/D2", f->p.rho,
+                  f->se_ident[0], 1, "");
     value_se_text(o, "solid strain s/H", f->p.solid_strain, f->se_ident[1], 1, "");
     value_se_text(o, "stress scale F_C/H^2", f->p.stress_scale_MPa, f->se_ident[2], u, r->table->y_unit);
     fprintf(o, " Prony series, G(t) = g_inf + sum g_i exp(-t/tau_i):\n");

@@ -3,10 +3,42 @@
 */
 #include "conifit/pipeline_series.h"
 
+#include <math.h>
 #include <string.h>
 
 #include "base/atomic.h"
 #include "conifit/version.h"
+
+/* The reported spring must carry the fitted model: a placement that the design limits pushed off
+** the fitted rho, s/H, F_C/H^2 is replaced by the spring of cf_spring_member scaled to the
+** preferred free length (all lengths scaled, G kept: the three quantities are unchanged), checked
+** against the same limits (so reported infeasible where they bind). 0 when no spring results. */
+static int exact_member(const cf_table *t, const cf_pipeline_options *opt, const double ident[3],
+                        cf_fit_result *f)
+{
+    double got[3];
+    cf_fit_identifiable(&f->params, 0, got);
+    int same = 1;
+    for (int k = 0; k < 3; k++)
+        same = same && fabs(got[k] - ident[k]) <= 1e-9 * fabs(ident[k]);
+    if (same)
+        return 1;
+    cf_spring p = cf_spring_member(ident[0], ident[1], ident[2]);
+    const double h = opt->fit.H_preferred_mm > 0 ? opt->fit.H_preferred_mm / p.H_mm : 10.0;
+    p.D1_mm *= h;
+    p.D2_mm *= h;
+    p.d_mm *= h;
+    p.H_mm *= h;
+    cf_error e = {0};
+    cf_law law;
+    if (cf_law_init(&law, &p, &e) != CF_OK)
+        return 0;
+    f->params = p;
+    f->law = law;
+    f->type = law.type;
+    f->feasible = cf_fit_check(&p, law.type, t, &opt->fit, &f->active, &f->violated);
+    return 1;
+}
 
 cf_status cf_pipeline_fit_series(const cf_table *t, const cf_pipeline_options *opt,
                                  const cf_visco_fit_options *vo, cf_visco_report *r,
@@ -34,8 +66,9 @@ cf_status cf_pipeline_fit_series(const cf_table *t, const cf_pipeline_options *o
         cf_error pe = {0};
         if ((opt->types & (1u << ty)) &&
             cf_fit_place(t, &opt->fit, (cf_spring_type)ty, ident, &r->placed[r->nplaced], &pe) ==
-                CF_OK)
-            r->nplaced++;
+                CF_OK && exact_member(t, opt, ident, &r->placed[r->nplaced]) &&
+            (r->nplaced == 0 || r->placed[0].type != r->placed[r->nplaced].type))
+            r->nplaced++; /* (two placements replaced by the same exact spring count once) */
     }
     if (r->nplaced == 0) {
         cf_visco_report_free(r);

@@ -30,6 +30,7 @@
 
 #include "conifit/error.h"
 #include "conifit/law.h"
+#include "conifit/msm.h"
 
 /* The "schema" value of a single exported spring. */
 #define CF_SPRINGFILE_SCHEMA "conifit-spring-1"
@@ -42,6 +43,11 @@ typedef struct cf_fitted_spring {
     char data_file[512];         /* "" if absent */
     char y_unit[32];             /* unit of rmse; "" if absent */
     char version[32];            /* conifit version that wrote the file; "" if absent */
+    /* A viscoelastic fit (of a time series) also carries its Prony terms and dashpot. */
+    int viscoelastic;            /* 1 when the fit has a "prony" list */
+    int prony_count;
+    double prony_g[CF_PRONY_MAX], prony_tau_s[CF_PRONY_MAX];
+    double eta_MPa_s;            /* dashpot, 0 when none */
 } cf_fitted_spring;
 
 /* Loads the spring of the given type from the fit file at path ("-":

@@ -17,7 +17,8 @@
 typedef enum cf_protocol_kind {
     CF_PROTO_RAMP = 0,   /* 0 -> target over duration_s */
     CF_PROTO_CYCLES = 1, /* 0 -> target -> 0, count times, period_s each */
-    CF_PROTO_HOLD = 2    /* 0 -> target over ramp_s, then held for hold_s (creep or relaxation) */
+    CF_PROTO_HOLD = 2,   /* 0 -> target over ramp_s, then held for hold_s (creep or relaxation) */
+    CF_PROTO_HISTORY = 3 /* through listed (time, value) points: a measured loading history */
 } cf_protocol_kind;
 
 typedef struct cf_scene {

@@ -87,6 +87,8 @@ typedef struct cf_visco_fit {
     double se_eta_MPa_s;                /* of the dashpot, MPa s (-1 without one) */
     int dashpot;                        /* 1 when a dashpot was fitted */
     int held_elastic;                   /* 1 when the elastic quantities were held */
+    int rho_at_limit;                   /* 1 when rho sits on its lower limit (rho_min): set by
+                                           the limit, its standard error undetermined */
     int chosen_by_aic;                  /* 1 when N was chosen by AIC */
     double aic_by_n[CF_VISCO_AIC_MAX];  /* AIC of N = 1..4 when chosen by AIC (MPa^2 in RSS) */
     size_t count, n_ramp, n_hold;       /* points in all, on ramps, in holds */
