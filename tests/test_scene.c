@@ -5,6 +5,7 @@
 */
 #include "testutil.h"
 
+#include "conifit/measure.h"
 #include "conifit/scene.h"
 
 #define SPRING "\"spring\": {\"params\": {\"D1_mm\": 6, \"D2_mm\": 15, \"n\": 2.5, \"d_mm\": 2, " \
@@ -173,16 +174,16 @@ static void relaxation_scene_follows_published_muscle_relaxation(void **state)
     }
     char path[512];
     snprintf(path, sizeof path, "%s/muscle_compression_relaxation_fiber30.csv", ds);
-    FILE *f = fopen(path, "r");
-    assert_non_null(f);
+    /* the table as conifit reads it: its Cauchy stress as nominal stress, kPa */
+    cf_table tb;
+    cf_error terr = {0};
+    assert_int_equal(cf_measure_load(path, NULL, &tb, &terr), CF_OK);
+    double peak = 0, end = 1e3 * tb.y[tb.count - 1], t, e, s;
+    for (size_t i = 0; i < tb.count; i++)
+        peak = fmin(peak, 1e3 * tb.y[i]);
+    cf_table_free(&tb);
     char line[512];
-    double peak = 0, end = 0, t, e, s;
-    while (fgets(line, sizeof line, f))
-        if (sscanf(line, "%lf,%lf,%lf", &t, &e, &s) == 3) {
-            peak = fmin(peak, s);
-            end = s;
-        }
-    fclose(f);
+    FILE *f;
     char dir[] = "/tmp/conifit-relax-XXXXXX";
     assert_non_null(mkdtemp(dir));
     char out[256], so[4096], se[4096];
@@ -190,19 +191,27 @@ static void relaxation_scene_follows_published_muscle_relaxation(void **state)
     assert_int_equal(
         tu_run(so, sizeof so, se, sizeof se, "simulate data/scenes/relaxation.json -o %s", out), 0);
     double speak = 0, send = 0;
+    int stable = 1, unstable_rows = 0;
     f = fopen(out, "r");
     assert_non_null(fgets(line, sizeof line, f));
     double k, sp;
-    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf,%*d", &t, &e, &s, &k, &sp) == 5) {
+    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf,%d", &t, &e, &s, &k, &sp, &stable) == 6) {
         speak = fmax(speak, s);
         send = s;
+        unstable_rows += stable == 0;
     }
     fclose(f);
     remove(out);
     rmdir(dir);
-    /* The table is compression negative; the simulation compression positive. */
-    assert_close(speak, -peak, 0.15 * -peak);
-    assert_close(send, -end, 0.15 * -end);
+    /* The table is compression negative; the simulation compression positive. The scene runs the
+    ** viscoelastic fit of this table (fits/series/): the peak within 5 %; the end within 5 % as
+    ** long as the lattice stays stable, and where it does not, simulate says so (rows marked
+    ** stable = 0) rather than pass off the buckled lattice's stress as the material's. */
+    assert_close(speak, -peak, 0.05 * -peak);
+    if (unstable_rows == 0)
+        assert_close(send, -end, 0.05 * -end);
+    else
+        assert_true(fabs(send + end) > 0.05 * -end);
 }
 
 int main(void)

@@ -235,6 +235,9 @@ char *cf_visco_report_text(const cf_visco_report *r)
     fprintf(o, "%s: time series of %zu points (%s [s], %s [-], %s [%s]), %s\n", r->table->path,
             r->table->count, "time", r->table->x_column, r->table->y_column, r->table->y_unit,
             r->table->compression ? "compression negative" : "tension positive");
+    if (r->table->measures.stress_converted)
+        fprintf(o, " (its Cauchy stress is fitted as nominal stress, converted under "
+                   "incompressibility; errors below are nominal)\n");
     fprintf(o, " viscoelastic fit: conical law (instantaneous) + %d Prony term%s%s, in the "
                "lattice (%dx%dx%d cells, calibration %s), driven by the measured strain history\n",
             f->p.nbranch, f->p.nbranch == 1 ? "" : "s", f->dashpot ? " + dashpot" : "", lc->nx,

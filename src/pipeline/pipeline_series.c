@@ -51,6 +51,11 @@ cf_status cf_pipeline_fit_series(const cf_table *t, const cf_pipeline_options *o
     r->with_timing = opt->with_timing;
     if (!t->t)
         return cf_error_set(err, CF_E_DATA, "%s: not a time series (no time column)", t->path);
+    if (t->mode != CF_MODE_UNIAXIAL)
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: the time-dependent model runs in uniaxial loading; this table "
+                            "is in mode '%s'",
+                            t->path, cf_mode_name(t->mode));
     if (opt->progress)
         opt->progress(opt->progress_ctx, t->path, "fitting the viscoelastic model along the series");
     cf_visco_data d = {t->count, t->t, t->x, t->y, t->w};

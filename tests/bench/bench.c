@@ -155,7 +155,8 @@ int main(int argc, char **argv)
                     {"fitting", bench_section_fit},
                     {"lattice resolution", bench_section_resolution},
                     {"memory", bench_section_memory},
-                    {"lattice calibration and the homogenised cell", bench_section_calibration}};
+                    {"lattice calibration and the homogenised cell", bench_section_calibration},
+                    {"viscoelastic fit", bench_section_visco}};
     const int nsec = (int)(sizeof sections / sizeof sections[0]);
     for (int k = 0; k < nsec; k++) {
         if (only && !strstr(sections[k].what, only))

@@ -66,5 +66,6 @@ void bench_section_resolution(bench_ctx *ctx);
 void bench_memory_fit_early(bench_ctx *ctx);
 void bench_section_memory(bench_ctx *ctx);
 void bench_section_calibration(bench_ctx *ctx);
+void bench_section_visco(bench_ctx *ctx);
 
 #endif
