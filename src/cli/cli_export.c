@@ -113,6 +113,9 @@ static int export_option(void *ctx, int c, const char *value)
     }
 }
 
+/* Why one long function: parse (export_option), check the combinations of options, load the
+** spring and the scene, write the whole output into memory, then to the file or standard output,
+** then the summary; a straight sequence in which each step can end the command with its status. */
 int cf_cli_export(int argc, char **argv)
 {
     static const struct option own[] = {{"format", required_argument, NULL, OPT_FORMAT},

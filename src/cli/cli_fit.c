@@ -285,7 +285,6 @@ static void validate_option(int c, const char *value, fit_args *a)
         a->scene = a->argv[optind++];
 }
 
-/* One option of fit: 0 to go on, else an exit status. */
 /* --stress-measure, --strain-measure: a word the table reader knows (measure.h). */
 static int measure_option(int c, const char *optval, cf_measure_options *mo)
 {
@@ -308,6 +307,8 @@ static int measure_option(int c, const char *optval, cf_measure_options *mo)
                                                       : "engineering, log or stretch");
 }
 
+/* One option of fit: 0 to go on, else an exit status. Long only because fit has many options:
+** one case per option, each a few lines of checking. */
 static int fit_option(void *ctx, int c, const char *optval)
 {
     fit_args *a = ctx;
@@ -651,6 +652,11 @@ static int run_joint(const fit_args *a, fit_job *jobs, const char *const *inputs
     return rc;
 }
 
+/* Why one long function: fit is read every table (a bad one stops the run before anything is
+** written), name every output, fit on N threads (worker, run_job), put the outputs in place only
+** when every table succeeded, then print reports, warnings and the batch summary; every step uses
+** the one job array and the all-or-nothing rule, and the library does the work of each step
+** (cf_measure_load, cf_pipeline_fit, cf_pipeline_prepare, cf_report_text). */
 int cf_cli_fit(int argc, char **argv)
 {
     fit_args a;

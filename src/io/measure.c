@@ -1053,6 +1053,11 @@ static cf_status decide_measures(const reader *r, const char *path, const cf_mea
     return CF_OK;
 }
 
+/* Why one long function: reading a table is one pass through six stages in order (the text, the
+** header, which columns, their units, the rows, the test mode; each marked by a comment below),
+** every stage reads what the previous ones decided (the delimiter, the column indices, the unit
+** factors) and every refusal must release everything through the one `fail:` exit, so that no
+** error path can leak or leave a half-filled table. The helpers above do each stage's detail. */
 cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf_table *m,
                           cf_error *err)
 {

@@ -61,6 +61,10 @@ static size_t node_id(const cf_lattice_config *c, int i, int j, int k)
     return (size_t)i + (size_t)(c->nx + 1) * ((size_t)j + (size_t)(c->ny + 1) * (size_t)k);
 }
 
+/* Why one long function: building the lattice is one sequence (check the configuration, place the
+** nodes, enumerate the springs of every family with their weights, set the boundary, allocate the
+** work arrays) over one set of arrays that cf_lattice_free releases on any failure; each stage is
+** marked by a comment below. */
 cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method method,
                             const cf_lattice_config *cfg, cf_error *err)
 {

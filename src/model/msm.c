@@ -998,6 +998,10 @@ static cf_status check_path(const cf_msm_path *p, const double *ts, size_t ns, c
     return CF_OK;
 }
 
+/* Why one long function: the run is one time loop whose solver is chosen once (static equilibria,
+** implicit quasi-static steps or explicit steps) and whose state (positions, velocities, Maxwell
+** strains, the sample cursor, the statistics) is shared by every branch; the branches' work is in
+** the helpers above, and what stays here is the bookkeeping that must see all of that state. */
 cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_config *cfg,
                      const cf_msm_path *path, const double *sample_t_s, size_t nsamples,
                      cf_msm_sample *out, size_t *done, cf_msm_stats *stats, cf_error *err)
