@@ -131,6 +131,8 @@ FUZZ_CFLAGS  := -std=c17 -g -O1 -fno-omit-frame-pointer -fsanitize=address,undef
 FUZZ_LIBS    := $(shell pkg-config --libs $(PKGS) 2>/dev/null) $(SPARSE_LIBS) -lm -lpthread
 FUZZ_OBJ     := $(LIB_SRC:src/%.c=build/fuzz/obj/%.o) build/fuzz/obj/cli/cli.o
 REPLAYS      := $(FUZZERS:%=$(BUILD)/fuzz-replay/%)
+# (named here, after the test rule read its prerequisites: make expands them on reading)
+test: $(REPLAYS)
 FUZZ_SEEDS_table   = data/*.csv
 FUZZ_SEEDS_fitfile = fits/*.json
 FUZZ_SEEDS_scene   = data/scenes/*.json
