@@ -214,6 +214,38 @@ static void relaxation_scene_follows_published_muscle_relaxation(void **state)
         assert_true(fabs(send + end) > 0.05 * -end);
 }
 
+/* A cycles scene with dashpots: the strain left at zero force is reported as such, and a
+** force-driven unload and hold shows that it recovers (no permanent set in an elastic lattice). */
+static void cycles_summary_separates_zero_force_strain_from_permanent_set(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-scene-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char scene[256], out[256], so[4096], se[4096];
+    snprintf(scene, sizeof scene, "%s/cyc.json", dir);
+    snprintf(out, sizeof out, "%s/cyc.csv", dir);
+    FILE *f = fopen(scene, "w");
+    assert_non_null(f);
+    fprintf(f, "{" SPRING ", \"lattice\": {\"nx\": 1, \"ny\": 1, \"nz\": 1}, \"protocol\": "
+               "{\"kind\": \"cycles\", \"to_strain\": 0.2, \"period_s\": 10, \"count\": 1}, "
+               "\"effects\": {\"damping\": {\"eta_kPa_s\": 5}}, \"samples_per_segment\": 20}");
+    fclose(f);
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "simulate %s -o %s", scene, out), 0);
+    assert_non_null(strstr(so, "strain where the unloading stress reaches zero"));
+    const char *r = strstr(so, "recovery (");
+    assert_non_null(r);
+    double e0, e1;
+    const char *p = strstr(r, "strain at zero force ");
+    assert_non_null(p);
+    assert_int_equal(sscanf(p, "strain at zero force %lf, after the hold %lf", &e0, &e1), 2);
+    assert_true(e0 > 1e-3);          /* the dashpots hold the lattice shortened at zero force */
+    assert_true(fabs(e1) < 1e-3 * e0); /* and it recovers */
+    assert_non_null(strstr(r, "no permanent set"));
+    remove(scene);
+    remove(out);
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -221,6 +253,7 @@ int main(void)
         cmocka_unit_test(good_scene_builds_its_loading_path),
         cmocka_unit_test(simulate_writes_nothing_for_a_bad_scene_and_a_csv_for_a_good_one),
         cmocka_unit_test(relaxation_scene_follows_published_muscle_relaxation),
+        cmocka_unit_test(cycles_summary_separates_zero_force_strain_from_permanent_set),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -43,6 +43,54 @@ static const char simulate_help[] =
     "                      solves (default 1e7)\n"
     "The estimates are made before anything runs; a refused scene exits 65 naming the key.\n";
 
+/* Strain left at zero force is not a permanent set: a viscous lattice creeps back. For a cycles
+** scene with dashpots or Maxwell branches (no inertia) this runs one force-driven cycle from the
+** virgin state to the scene's peak stress, unloads to zero force and holds it for ten periods (or
+** ten relaxation times, if longer), and prints the strain at zero force and at the end of the
+** hold. Returns the strain at the end of the hold (NAN when not run). */
+static double recovery(FILE *o, const cf_scene *sc, const cf_law *law, const cf_msm_sample *s,
+                       size_t n)
+{
+    if (sc->kind != CF_PROTO_CYCLES || sc->drive != CF_DRIVE_DISPLACEMENT || sc->effects.inertia ||
+        !(sc->effects.eta_MPa_s > 0 || sc->effects.maxwell_E_MPa > 0) || sc->npath < 3)
+        return NAN;
+    double peak = 0;
+    for (size_t k = 0; k < n; k++)
+        peak = fmax(peak, s[k].stress_MPa);
+    const double T = sc->path_t_s[2] - sc->path_t_s[0];
+    const double hold = 10 * fmax(T, sc->effects.maxwell_E_MPa > 0 ? sc->effects.maxwell_tau_s : 0);
+    double t[4] = {0, T / 2, T, T + hold}, v[4] = {0, peak, 0, 0};
+    cf_msm_path path = {CF_DRIVE_FORCE, 4, t, v};
+    enum { NS = 60 };
+    double ts[NS];
+    cf_msm_sample out[NS];
+    for (int k = 0; k < 20; k++)
+        ts[k] = T * (k + 1) / 20.0;
+    for (int k = 20; k < NS; k++)
+        ts[k] = T + hold * (k - 19) / (double)(NS - 20);
+    cf_lattice lat;
+    cf_error err = {0};
+    cf_msm_config cfg = sc->cfg;
+    cfg.progress = NULL;
+    if (cf_lattice_create(&lat, law, sc->method, &cfg.lattice, &err) != CF_OK)
+        return NAN;
+    cf_status st = cf_msm_run(&lat, &sc->effects, &cfg, &path, ts, NS, out, NULL, NULL, &err);
+    cf_lattice_free(&lat);
+    if (st != CF_OK) {
+        fprintf(o, "recovery test not run: %s\n", err.msg);
+        return NAN;
+    }
+    double e0 = out[19].strain, e1 = out[NS - 1].strain;
+    fprintf(o, "recovery (one force-driven cycle to the peak stress %.6g kPa, then zero force held "
+               "%.6g s): strain at zero force %.6g, after the hold %.6g: %s\n",
+            peak * 1e3, hold, e0, e1,
+            fabs(e1) <= 1e-3 * fabs(e0) + 1e-12
+                ? "no permanent set (the springs are elastic; the strain left at zero force is "
+                  "viscous and recovers)"
+                : "not recovered within the hold");
+    return e1;
+}
+
 /* Index of the first sample whose tangent had a negative pivot (n when none). */
 static size_t first_unstable(const cf_msm_sample *s, size_t n)
 {
@@ -103,7 +151,7 @@ static void summary(FILE *o, const cf_scene *sc, const cf_msm_sample *s, size_t 
             fprintf(o, "cycle %d: dissipated energy %.6g kJ/m^3 (= kPa), ", c + 1,
                    loop_area(s, a, b));
             if (sc->drive == CF_DRIVE_FORCE) {
-                fprintf(o, "residual strain after unloading %.6g\n", s[b].strain);
+                fprintf(o, "strain at zero force after unloading %.6g\n", s[b].strain);
             } else {
                 /* Strain at which the unloading branch first carries no stress. */
                 double eu = s[b].strain;
@@ -113,7 +161,7 @@ static void summary(FILE *o, const cf_scene *sc, const cf_msm_sample *s, size_t 
                         eu = s[k].strain + f * (s[k + 1].strain - s[k].strain);
                         break;
                     }
-                fprintf(o, "residual strain after unloading (zero stress) %.6g\n", eu);
+                fprintf(o, "strain where the unloading stress reaches zero %.6g\n", eu);
             }
         }
     } else if (sc->kind == CF_PROTO_HOLD) {
@@ -334,8 +382,10 @@ int cf_cli_simulate(int argc, char **argv)
         rc = cf_cli_fail(&err);
         goto end;
     }
-    if (!quiet)
+    if (!quiet) {
         summary(a.to_stdout ? stderr : stdout, &sc, samples, sc.nsamples, &st);
+        recovery(a.to_stdout ? stderr : stdout, &sc, &law, samples, sc.nsamples);
+    }
 end:
     cf_cli_out_abort(&a);
     cf_atomic_abort(&pa);
