@@ -115,6 +115,7 @@ figures: check-deps $(BUILD)/conifit
 	$(BUILD)/conifit simulate data/scenes/uniaxial.json -o $(BUILD)/uniaxial.csv --plot fits/figures/validation.png
 	$(BUILD)/conifit simulate data/scenes/hysteresis.json -o $(BUILD)/hysteresis.csv --plot fits/figures/hysteresis.png
 	$(BUILD)/conifit simulate data/scenes/creep.json -o $(BUILD)/creep.csv --plot fits/figures/creep.png
+	gnuplot fits/figures/type_regions.gp
 
 sanitize:
 	@$(MAKE) --no-print-directory test SANITIZE=1
