@@ -344,11 +344,12 @@ cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo
             cf_export_table_free(t);
             goto done;
         }
-    if (t->max_err_rel > tol) {
-        status = cf_error_set(err, CF_E_INTERNAL,
-                              "export table of %zu rows misses the tolerance %g (achieved %.3g of "
-                              "F_C)",
-                              t->rows, tol, t->max_err_rel);
+    if (t->max_err_rel > tol) { /* the spring, not the program: bad data (exit 65) */
+        status = cf_error_set(err, CF_E_DATA,
+                              "the spring (rho = %.4g) cannot be tabulated within the tolerance "
+                              "%g of F_C: %zu rows reach %.3g; loosen the tolerance to at least "
+                              "%.2g",
+                              law->rho, tol, t->rows, t->max_err_rel, t->max_err_rel);
         cf_export_table_free(t);
     }
     (void)Nst;

@@ -70,7 +70,8 @@ typedef struct cf_export_table {
 double cf_export_table_end(const cf_law *law, double tol);
 
 /* Samples the law into t over [-u_end, u_end] (see the top of this file). CF_E_DATA for a
-** tolerance outside [CF_EXPORT_TOL_MIN, CF_EXPORT_TOL_MAX], CF_E_INTERNAL when memory runs out. */
+** tolerance outside [CF_EXPORT_TOL_MIN, CF_EXPORT_TOL_MAX] or a spring whose table does not reach
+** the tolerance (the message gives the achieved error), CF_E_INTERNAL when memory runs out. */
 cf_status cf_export_table_build(const cf_law *law, double tol, cf_export_table *t, cf_error *err);
 
 /* The same over [u_lo, u_hi] (mm, u_lo <= 0 <= u_hi): CF_E_DATA naming the limit when the range
