@@ -18,7 +18,8 @@ CC      ?= cc
 PKGS    := nlopt gsl jansson
 TESTPKGS := cmocka
 DEBS    := build-essential pkg-config libnlopt-dev libgsl-dev libcmocka-dev libjansson-dev \
-           libsuitesparse-dev libopenblas0-serial gnuplot-nox calculix-ccx clang libclang-rt-dev
+           libsuitesparse-dev libmumps-seq-dev libopenblas0-serial gnuplot-nox calculix-ccx clang \
+           libclang-rt-dev
 BUILD   ?= build
 
 WARN    := -Wall -Wextra -Wpedantic -Wshadow -Wmissing-prototypes -Wstrict-prototypes \
@@ -31,7 +32,10 @@ CPPFLAGS += -D_DEFAULT_SOURCE -Isrc/include -Isrc
 # SuiteSparse CHOLMOD (sparse Cholesky of the lattice tangent): newer releases ship CHOLMOD.pc;
 # Debian 12's libsuitesparse-dev has none and keeps its headers in include/suitesparse.
 SPARSE_CFLAGS := $(shell pkg-config --cflags CHOLMOD 2>/dev/null || echo -I/usr/include/suitesparse)
-SPARSE_LIBS   := $(shell pkg-config --libs CHOLMOD 2>/dev/null || echo -lcholmod)
+# MUMPS (sequential build: L D L^T of indefinite tangents) likewise has no pkg-config file.
+SPARSE_CFLAGS += -I/usr/include/mumps_seq
+SPARSE_LIBS   := $(shell pkg-config --libs CHOLMOD 2>/dev/null || echo -lcholmod) \
+                 -ldmumps_seq -lmumps_common_seq -lmpiseq_seq -lpord_seq
 CFLAGS  += -std=c17 $(OPT) -fopenmp $(WARN) $(shell pkg-config --cflags $(PKGS) 2>/dev/null) $(SPARSE_CFLAGS)
 LDLIBS  += $(shell pkg-config --libs $(PKGS) 2>/dev/null) $(SPARSE_LIBS) -fopenmp -lm -lpthread
 
@@ -59,6 +63,7 @@ all: check-deps $(BUILD)/conifit
 check-deps:
 	@missing=""; for p in $(PKGS) $(TESTPKGS); do pkg-config --exists $$p 2>/dev/null || missing="$$missing $$p"; done; \
 	printf '#include <cholmod.h>\n' | $(CC) $(SPARSE_CFLAGS) -E - >/dev/null 2>&1 || missing="$$missing cholmod"; \
+	printf '#include <dmumps_c.h>\n' | $(CC) $(SPARSE_CFLAGS) -E - >/dev/null 2>&1 || missing="$$missing mumps"; \
 	if [ -n "$$missing" ]; then \
 	  echo "conifit: missing libraries:$$missing. Install them with:" >&2; \
 	  echo "  apt-get update && apt-get install -y $(DEBS)   (or: make deps, as root)" >&2; exit 1; fi

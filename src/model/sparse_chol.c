@@ -1,7 +1,11 @@
 /*
-** Sparse symmetric factorisation with inertia (see sparse_chol.h), on SuiteSparse CHOLMOD.
-** CHOLMOD user guide: cholmod_analyze, cholmod_factorize, cholmod_solve; Common->supernodal
-** selects supernodal LL^T or simplicial LDL^T, L->minor < n reports where a factorisation stopped.
+** Sparse symmetric factorisation with inertia (see sparse_chol.h).
+** Positive definite matrices: SuiteSparse CHOLMOD, supernodal LL^T (user guide: cholmod_analyze,
+** cholmod_factorize, cholmod_solve; L->minor < n reports where a factorisation stopped).
+** Indefinite ones: MUMPS, multifrontal L D L^T with 1x1 and 2x2 pivots for symmetric matrices
+** (SYM = 2), whose INFOG(12) is the number of negative pivots (MUMPS user guide, 5.x: JOB = 1
+** analysis, 2 factorisation, 3 solve; ICNTL(1-4) output streams; INFO(1) = -8/-9 workspace too
+** small, fixed by raising ICNTL(14); -10 numerically singular).
 */
 #include "model/sparse_chol.h"
 
@@ -10,33 +14,28 @@
 #include <string.h>
 
 #include <cholmod.h>
+#include <dmumps_c.h>
+
+#define MUMPS_USE_COMM_WORLD (-987654) /* the sequential library's stand-in communicator */
 
 struct cf_sparse_chol {
     cholmod_common cm;
     cholmod_sparse A;      /* a header over the caller's arrays (lower triangle used) */
-    cholmod_factor *LL;    /* supernodal (or simplicial, for small matrices) LL^T */
-    cholmod_factor *LD;    /* simplicial L D L^T, analysed when first needed */
-    cholmod_factor *last;  /* the factor the last successful factorisation left */
+    cholmod_factor *LL;    /* supernodal LL^T */
     size_t n;
     size_t lower_nnz;      /* entries of the lower triangle */
+    const int *colptr, *rowidx;
+    int last;              /* 0 none, 1 CHOLMOD, 2 MUMPS holds the last successful factorisation */
     int indefinite;        /* the last matrix was indefinite: start the next one with L D L^T */
+    /* MUMPS, set up at the first indefinite matrix */
+    int mumps_on;
+    DMUMPS_STRUC_C mu;
+    MUMPS_INT *irn, *jcn;  /* 1-based coordinates of the lower triangle */
+    double *mval;          /* its values, copied from the caller's array */
+    size_t *mpos;          /* position of each in the caller's value array */
+    double *rhs;           /* MUMPS solves in place */
+    size_t mumps_peak;     /* bytes MUMPS reported for its factors and workspace */
 };
-
-static void header(cholmod_sparse *A, size_t n, int *colptr, int *rowidx, double *values)
-{
-    memset(A, 0, sizeof *A);
-    A->nrow = A->ncol = n;
-    A->nzmax = (size_t)colptr[n];
-    A->p = colptr;
-    A->i = rowidx;
-    A->x = values;
-    A->stype = -1; /* symmetric, lower triangle stored (entries above are ignored) */
-    A->itype = CHOLMOD_INT;
-    A->xtype = CHOLMOD_REAL;
-    A->dtype = CHOLMOD_DOUBLE;
-    A->sorted = 0;
-    A->packed = 1;
-}
 
 cf_status cf_sparse_chol_create(cf_sparse_chol **out, size_t n, int *colptr, int *rowidx,
                                 cf_error *err)
@@ -51,18 +50,29 @@ cf_status cf_sparse_chol_create(cf_sparse_chol **out, size_t n, int *colptr, int
         free(ch);
         return cf_error_set(err, CF_E_INTERNAL, "CHOLMOD could not start");
     }
-    ch->cm.print = 0;            /* the library never prints */
+    ch->cm.print = 0; /* the library never prints */
     ch->cm.error_handler = NULL;
     ch->cm.quick_return_if_not_posdef = 1; /* stop at the first non-positive pivot */
+    ch->cm.supernodal = CHOLMOD_SUPERNODAL;
     ch->n = n;
+    ch->colptr = colptr;
+    ch->rowidx = rowidx;
     for (size_t c = 0; c < n; c++)
         for (int k = colptr[c]; k < colptr[c + 1]; k++)
             if ((size_t)rowidx[k] >= c)
                 ch->lower_nnz++;
-    header(&ch->A, n, colptr, rowidx, NULL);
-    ch->A.xtype = CHOLMOD_PATTERN; /* no values yet */
-    ch->cm.supernodal = CHOLMOD_AUTO; /* supernodal where it pays (more flops per entry) */
-    ch->LL = cholmod_analyze(&ch->A, &ch->cm);
+    cholmod_sparse *A = &ch->A;
+    A->nrow = A->ncol = n;
+    A->nzmax = (size_t)colptr[n];
+    A->p = colptr;
+    A->i = rowidx;
+    A->stype = -1; /* symmetric, lower triangle stored (entries above are ignored) */
+    A->itype = CHOLMOD_INT;
+    A->xtype = CHOLMOD_PATTERN; /* no values yet */
+    A->dtype = CHOLMOD_DOUBLE;
+    A->sorted = 0;
+    A->packed = 1;
+    ch->LL = cholmod_analyze(A, &ch->cm);
     if (!ch->LL || ch->cm.status < CHOLMOD_OK) {
         const int status = ch->cm.status;
         cf_sparse_chol_free(ch);
@@ -71,25 +81,99 @@ cf_status cf_sparse_chol_create(cf_sparse_chol **out, size_t n, int *colptr, int
                             "%d)",
                             n, status);
     }
-    ch->A.xtype = CHOLMOD_REAL;
+    A->xtype = CHOLMOD_REAL;
     *out = ch;
     return CF_OK;
 }
 
-/* Counts the negative entries of D in a simplicial LDL^T factor (D(j,j) is the first entry of
-** column j); returns -1 if a pivot is zero or not finite. */
-static long count_negative(const cholmod_factor *L)
+/* Analysis of the pattern for MUMPS (once). */
+static cf_status mumps_setup(cf_sparse_chol *ch, cf_error *err)
 {
-    const int *p = L->p;
-    const double *x = L->x;
-    long neg = 0;
-    for (size_t j = 0; j < L->n; j++) {
-        double d = x[p[j]];
-        if (!(d != 0) || !isfinite(d))
-            return -1;
-        neg += d < 0;
+    const size_t nz = ch->lower_nnz;
+    ch->irn = malloc(nz * sizeof *ch->irn);
+    ch->jcn = malloc(nz * sizeof *ch->jcn);
+    ch->mval = malloc(nz * sizeof *ch->mval);
+    ch->mpos = malloc(nz * sizeof *ch->mpos);
+    ch->rhs = malloc(ch->n * sizeof *ch->rhs);
+    if (!ch->irn || !ch->jcn || !ch->mval || !ch->mpos || !ch->rhs)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the indefinite factorisation");
+    size_t k = 0;
+    for (size_t c = 0; c < ch->n; c++)
+        for (int q = ch->colptr[c]; q < ch->colptr[c + 1]; q++)
+            if ((size_t)ch->rowidx[q] >= c) {
+                ch->irn[k] = (MUMPS_INT)ch->rowidx[q] + 1;
+                ch->jcn[k] = (MUMPS_INT)c + 1;
+                ch->mpos[k++] = (size_t)q;
+            }
+    DMUMPS_STRUC_C *mu = &ch->mu;
+    memset(mu, 0, sizeof *mu);
+    mu->job = -1;
+    mu->par = 1;
+    mu->sym = 2; /* general symmetric: pivots may be negative or 2x2 */
+    mu->comm_fortran = MUMPS_USE_COMM_WORLD;
+    dmumps_c(mu);
+    if (mu->info[0] < 0)
+        return cf_error_set(err, CF_E_INTERNAL, "MUMPS could not start (INFO(1) = %d)",
+                            (int)mu->info[0]);
+    ch->mumps_on = 1;
+    mu->icntl[0] = -1; /* no error, diagnostic or global output: the library never prints */
+    mu->icntl[1] = -1;
+    mu->icntl[2] = -1;
+    mu->icntl[3] = 0;
+    mu->icntl[6] = 7; /* ordering chosen by the analysis */
+    mu->n = (MUMPS_INT)ch->n;
+    mu->nnz = (MUMPS_INT8)nz;
+    mu->irn = ch->irn;
+    mu->jcn = ch->jcn;
+    mu->a = ch->mval;
+    mu->job = 1;
+    dmumps_c(mu);
+    if (mu->info[0] < 0)
+        return cf_error_set(err, CF_E_INTERNAL,
+                            "analysis of the indefinite tangent failed (%zu unknowns, MUMPS "
+                            "INFO(1) = %d)",
+                            ch->n, (int)mu->info[0]);
+    return CF_OK;
+}
+
+/* L D L^T by MUMPS; fills the inertia. */
+static cf_status mumps_factor(cf_sparse_chol *ch, const double *values, cf_chol_info *in,
+                              cf_error *err)
+{
+    cf_status st;
+    if (!ch->mumps_on && (st = mumps_setup(ch, err)) != CF_OK)
+        return st;
+    for (size_t k = 0; k < ch->lower_nnz; k++)
+        ch->mval[k] = values[ch->mpos[k]];
+    DMUMPS_STRUC_C *mu = &ch->mu;
+    for (int attempt = 0; attempt < 4; attempt++) {
+        mu->job = 2;
+        dmumps_c(mu);
+        if (mu->info[0] != -8 && mu->info[0] != -9)
+            break;
+        mu->icntl[13] = mu->icntl[13] > 0 ? 2 * mu->icntl[13] : 40; /* more workspace, % */
     }
-    return neg;
+    /* INFOG(22): megabytes MUMPS used in the factorisation */
+    const size_t mb = mu->infog[21] > 0 ? (size_t)mu->infog[21] : 0;
+    if (mb << 20 > ch->mumps_peak)
+        ch->mumps_peak = mb << 20;
+    if (mu->info[0] == -10 || mu->info[0] == -6) {
+        in->singular = 1;
+        return cf_error_set(err, CF_E_NOCONV, "the lattice tangent is singular (%zu unknowns)",
+                            ch->n);
+    }
+    if (mu->info[0] == -13 || mu->info[0] == -8 || mu->info[0] == -9)
+        return cf_error_set(err, CF_E_INTERNAL,
+                            "out of memory factoring the indefinite tangent (%zu unknowns)", ch->n);
+    if (mu->info[0] < 0)
+        return cf_error_set(err, CF_E_NOCONV,
+                            "factorisation of the indefinite tangent failed (%zu unknowns, MUMPS "
+                            "INFO(1) = %d)",
+                            ch->n, (int)mu->info[0]);
+    in->neg_pivots = (long)mu->infog[11];
+    in->fill = ch->lower_nnz ? (double)mu->infog[28] / (double)ch->lower_nnz : 0;
+    ch->last = 2;
+    return CF_OK;
 }
 
 cf_status cf_sparse_chol_factor(cf_sparse_chol *ch, double *values, cf_chol_info *info,
@@ -99,71 +183,50 @@ cf_status cf_sparse_chol_factor(cf_sparse_chol *ch, double *values, cf_chol_info
     cf_chol_info *in = info ? info : &local;
     memset(in, 0, sizeof *in);
     in->neg_pivots = -1;
-    ch->last = NULL;
-    ch->A.x = values;
-    /* Successive tangents of a solve change little: after an indefinite one, skip the LL^T that
-    ** would stop at its first negative pivot. */
-    if (ch->indefinite)
-        goto ldlt;
-    cholmod_factorize(&ch->A, ch->LL, &ch->cm);
-    if (ch->cm.status == CHOLMOD_OUT_OF_MEMORY)
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory factoring the tangent (%zu "
-                            "unknowns)", ch->n);
-    if (ch->cm.status == CHOLMOD_OK && ch->LL->minor == ch->n) {
-        /* A small matrix may have been analysed as simplicial L D L^T: its D has the inertia. */
-        in->neg_pivots = (ch->LL->is_super || ch->LL->is_ll) ? 0 : count_negative(ch->LL);
-        if (in->neg_pivots < 0) {
-            in->singular = 1;
-            return cf_error_set(err, CF_E_NOCONV,
-                                "the lattice tangent is singular or not finite (%zu unknowns)",
-                                ch->n);
-        }
-        in->ldlt = !(ch->LL->is_super || ch->LL->is_ll);
-        in->fill = ch->lower_nnz ? (double)(ch->cm.lnz) / (double)ch->lower_nnz : 0;
-        ch->last = ch->LL;
-        return CF_OK;
-    }
-    /* Not positive definite (or a NaN): L D L^T, which keeps going past negative pivots. */
-ldlt:
-    in->ldlt = 1;
-    if (!ch->LD) {
-        const int saved = ch->cm.supernodal;
-        ch->A.xtype = CHOLMOD_PATTERN;
-        ch->cm.supernodal = CHOLMOD_SIMPLICIAL;
-        ch->cm.final_ll = 0;
-        ch->LD = cholmod_analyze(&ch->A, &ch->cm);
-        ch->cm.supernodal = saved;
-        ch->A.xtype = CHOLMOD_REAL;
-        if (!ch->LD)
+    ch->last = 0;
+    for (size_t k = 0; k < (size_t)ch->colptr[ch->n]; k++)
+        if (!isfinite(values[k]))
+            return cf_error_set(err, CF_E_NOCONV, "the lattice tangent is not finite (%zu "
+                                "unknowns)", ch->n);
+    /* Successive tangents of a solve change little: after an indefinite one, go straight to the
+    ** L D L^T instead of an LL^T that would stop at its first negative pivot. */
+    if (!ch->indefinite) {
+        ch->A.x = values;
+        cholmod_factorize(&ch->A, ch->LL, &ch->cm);
+        if (ch->cm.status == CHOLMOD_OUT_OF_MEMORY)
             return cf_error_set(err, CF_E_INTERNAL,
-                                "out of memory analysing the indefinite tangent (%zu unknowns)",
-                                ch->n);
+                                "out of memory factoring the tangent (%zu unknowns)", ch->n);
+        if (ch->cm.status == CHOLMOD_OK && ch->LL->minor == ch->n) {
+            in->neg_pivots = 0;
+            in->fill = ch->lower_nnz ? ch->cm.lnz / (double)ch->lower_nnz : 0;
+            ch->last = 1;
+            return CF_OK;
+        }
     }
-    const int saved_quick = ch->cm.quick_return_if_not_posdef;
-    ch->cm.quick_return_if_not_posdef = 0;
-    cholmod_factorize(&ch->A, ch->LD, &ch->cm);
-    ch->cm.quick_return_if_not_posdef = saved_quick;
-    if (ch->cm.status == CHOLMOD_OUT_OF_MEMORY)
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory factoring the tangent (%zu "
-                            "unknowns)", ch->n);
-    long neg = (ch->LD->minor == ch->n && !ch->LD->is_ll) ? count_negative(ch->LD) : -1;
-    in->fill = ch->lower_nnz ? (double)(ch->cm.lnz) / (double)ch->lower_nnz : 0;
-    if (neg < 0) {
-        in->singular = 1;
-        return cf_error_set(err, CF_E_NOCONV,
-                            "the lattice tangent is singular or not finite (%zu unknowns, zero "
-                            "pivot at column %zu)",
-                            ch->n, (size_t)ch->LD->minor);
-    }
-    in->neg_pivots = neg;
-    ch->indefinite = neg > 0;
-    ch->last = ch->LD;
-    return CF_OK;
+    /* not positive definite: L D L^T, which keeps going past negative pivots */
+    in->ldlt = 1;
+    cf_status st = mumps_factor(ch, values, in, err);
+    if (st == CF_OK)
+        ch->indefinite = in->neg_pivots > 0;
+    return st;
 }
 
 cf_status cf_sparse_chol_solve(cf_sparse_chol *ch, const double *b, double *x, cf_error *err)
 {
-    if (!ch->last)
+    if (ch->last == 2) {
+        memcpy(ch->rhs, b, ch->n * sizeof(double));
+        ch->mu.rhs = ch->rhs;
+        ch->mu.nrhs = 1;
+        ch->mu.lrhs = (MUMPS_INT)ch->n;
+        ch->mu.job = 3;
+        dmumps_c(&ch->mu);
+        if (ch->mu.info[0] < 0)
+            return cf_error_set(err, CF_E_INTERNAL, "the indefinite solve failed (MUMPS INFO(1) "
+                                "= %d)", (int)ch->mu.info[0]);
+        memcpy(x, ch->rhs, ch->n * sizeof(double));
+        return CF_OK;
+    }
+    if (ch->last != 1)
         return cf_error_set(err, CF_E_INTERNAL, "sparse solve without a factorisation");
     cholmod_dense B;
     memset(&B, 0, sizeof B);
@@ -174,7 +237,7 @@ cf_status cf_sparse_chol_solve(cf_sparse_chol *ch, const double *b, double *x, c
     B.x = (void *)b; /* read only: CHOLMOD does not write the right-hand side */
     B.xtype = CHOLMOD_REAL;
     B.dtype = CHOLMOD_DOUBLE;
-    cholmod_dense *X = cholmod_solve(CHOLMOD_A, ch->last, &B, &ch->cm);
+    cholmod_dense *X = cholmod_solve(CHOLMOD_A, ch->LL, &B, &ch->cm);
     if (!X)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory in the sparse solve (%zu unknowns)",
                             ch->n);
@@ -185,7 +248,9 @@ cf_status cf_sparse_chol_solve(cf_sparse_chol *ch, const double *b, double *x, c
 
 size_t cf_sparse_chol_peak_bytes(const cf_sparse_chol *ch)
 {
-    return ch ? ch->cm.memory_usage : 0;
+    if (!ch)
+        return 0;
+    return ch->cm.memory_usage > ch->mumps_peak ? ch->cm.memory_usage : ch->mumps_peak;
 }
 
 void cf_sparse_chol_free(cf_sparse_chol *ch)
@@ -194,8 +259,15 @@ void cf_sparse_chol_free(cf_sparse_chol *ch)
         return;
     if (ch->LL)
         cholmod_free_factor(&ch->LL, &ch->cm);
-    if (ch->LD)
-        cholmod_free_factor(&ch->LD, &ch->cm);
     cholmod_finish(&ch->cm);
+    if (ch->mumps_on) {
+        ch->mu.job = -2;
+        dmumps_c(&ch->mu);
+    }
+    free(ch->irn);
+    free(ch->jcn);
+    free(ch->mval);
+    free(ch->mpos);
+    free(ch->rhs);
     free(ch);
 }

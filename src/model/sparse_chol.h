@@ -1,13 +1,15 @@
 /*
 ** Sparse symmetric factorisation of the lattice tangent (SuiteSparse CHOLMOD), with its inertia.
 **
-** The pattern is analysed once (fill-reducing ordering: CHOLMOD tries AMD and, when AMD leaves much
-** fill, METIS, and keeps the better); every numeric factorisation reuses it. A factorisation first
-** tries a supernodal Cholesky LL^T (BLAS-3 on dense supernodes, the fast path); a matrix that is
-** not positive definite makes it stop at the first non-positive pivot, and the matrix is then
-** factored as L D L^T (simplicial, no pivoting), whose D gives the inertia: by Sylvester's law the
-** number of negative entries of D is the number of negative eigenvalues of the matrix. That count
-** is what a static solver needs to tell a stable equilibrium (0) from an unstable one (> 0).
+** The pattern is analysed once (CHOLMOD's fill-reducing ordering: AMD, or METIS where AMD leaves
+** much fill); every numeric factorisation reuses it. A factorisation first tries CHOLMOD's
+** supernodal Cholesky LL^T (BLAS-3 on dense supernodes, the fast path); a matrix that is not
+** positive definite makes it stop at the first non-positive pivot, and the matrix is then factored
+** as L D L^T by MUMPS (multifrontal, BLAS-3, 1x1 and 2x2 pivots), whose count of negative pivots is
+** the inertia: by Sylvester's law, the number of negative eigenvalues of the matrix. That count is
+** what a static solver needs to tell a stable equilibrium (0) from an unstable one (> 0). CHOLMOD's
+** own L D L^T is simplicial only (no BLAS): measured on a 27 000-unknown 3-D Laplacian, 12 s per
+** factorisation against 1.3 s for MUMPS and 1.1 s for the supernodal LL^T.
 **
 ** Private to the model layer: msm.c is its only user.
 */
@@ -24,7 +26,8 @@ typedef struct cf_sparse_chol cf_sparse_chol; /* opaque */
 typedef struct cf_chol_info {
     long neg_pivots;   /* negative pivots = negative eigenvalues of the matrix (0: positive
                           definite); -1 when unknown (the factorisation failed) */
-    int ldlt;          /* 1: the LL^T stopped (not positive definite) and L D L^T was used */
+    int ldlt;          /* 1: the L D L^T (MUMPS) was used: the matrix is not positive definite, or
+                          the previous one was not */
     int singular;      /* 1: a zero pivot, the matrix is singular to working precision */
     double fill;       /* entries of the factor over entries of the lower triangle */
 } cf_chol_info;
