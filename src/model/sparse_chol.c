@@ -29,6 +29,7 @@ struct cf_sparse_chol {
     int indefinite;        /* the last matrix was indefinite: start the next one with L D L^T */
     /* MUMPS, set up at the first indefinite matrix */
     int mumps_on;
+    int mumps_failed;      /* its analysis failed: not retried */
     DMUMPS_STRUC_C mu;
     MUMPS_INT *irn, *jcn;  /* 1-based coordinates of the lower triangle */
     double *mval;          /* its values, copied from the caller's array */
@@ -86,8 +87,8 @@ cf_status cf_sparse_chol_create(cf_sparse_chol **out, size_t n, int *colptr, int
     return CF_OK;
 }
 
-/* Analysis of the pattern for MUMPS (once). */
-static cf_status mumps_setup(cf_sparse_chol *ch, cf_error *err)
+/* Analysis of the pattern for MUMPS (once), with the values of the first indefinite matrix. */
+static cf_status mumps_setup(cf_sparse_chol *ch, const double *values, cf_error *err)
 {
     const size_t nz = ch->lower_nnz;
     ch->irn = malloc(nz * sizeof *ch->irn);
@@ -103,6 +104,7 @@ static cf_status mumps_setup(cf_sparse_chol *ch, cf_error *err)
             if ((size_t)ch->rowidx[q] >= c) {
                 ch->irn[k] = (MUMPS_INT)ch->rowidx[q] + 1;
                 ch->jcn[k] = (MUMPS_INT)c + 1;
+                ch->mval[k] = values[q];
                 ch->mpos[k++] = (size_t)q;
             }
     DMUMPS_STRUC_C *mu = &ch->mu;
@@ -120,7 +122,9 @@ static cf_status mumps_setup(cf_sparse_chol *ch, cf_error *err)
     mu->icntl[1] = -1;
     mu->icntl[2] = -1;
     mu->icntl[3] = 0;
-    mu->icntl[6] = 7; /* ordering chosen by the analysis */
+    mu->icntl[5] = 0;  /* no column permutation: the pattern is symmetric with a full diagonal */
+    mu->icntl[6] = 7;  /* ordering chosen by the analysis */
+    mu->icntl[11] = 1; /* the usual symmetric ordering, no 2x2 compression from a matching */
     mu->n = (MUMPS_INT)ch->n;
     mu->nnz = (MUMPS_INT8)nz;
     mu->irn = ch->irn;
@@ -128,11 +132,13 @@ static cf_status mumps_setup(cf_sparse_chol *ch, cf_error *err)
     mu->a = ch->mval;
     mu->job = 1;
     dmumps_c(mu);
-    if (mu->info[0] < 0)
-        return cf_error_set(err, CF_E_INTERNAL,
+    if (mu->info[0] < 0) {
+        ch->mumps_failed = 1;
+        return cf_error_set(err, mu->info[0] == -7 ? CF_E_INTERNAL : CF_E_NOCONV,
                             "analysis of the indefinite tangent failed (%zu unknowns, MUMPS "
                             "INFO(1) = %d)",
                             ch->n, (int)mu->info[0]);
+    }
     return CF_OK;
 }
 
@@ -141,7 +147,9 @@ static cf_status mumps_factor(cf_sparse_chol *ch, const double *values, cf_chol_
                               cf_error *err)
 {
     cf_status st;
-    if (!ch->mumps_on && (st = mumps_setup(ch, err)) != CF_OK)
+    if (ch->mumps_failed)
+        return cf_error_set(err, CF_E_NOCONV, "no indefinite factorisation for this pattern");
+    if (!ch->mumps_on && (st = mumps_setup(ch, values, err)) != CF_OK)
         return st;
     for (size_t k = 0; k < ch->lower_nnz; k++)
         ch->mval[k] = values[ch->mpos[k]];
