@@ -77,6 +77,7 @@ cf_msm_config cf_msm_default(void)
     c.newton_max_iter = 50;
     c.dt_s = 0;
     c.quasi_substeps = 10;
+    c.banded_only = 0;
     c.progress = NULL;
     c.progress_ctx = NULL;
     return c;
@@ -562,7 +563,7 @@ static cf_status tangent_solve(solver *s, cf_error *err)
             C->data[k] /= s->D[C->i[k]] * s->D[col];
     int fatal = 0;
     s->neg_pivots = -1;
-    if (chol_direction(s, &fatal, err))
+    if (!s->cfg->banded_only && chol_direction(s, &fatal, err))
         return CF_OK;
     if (fatal)
         return CF_E_INTERNAL;

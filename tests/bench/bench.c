@@ -156,7 +156,8 @@ int main(int argc, char **argv)
                     {"lattice resolution", bench_section_resolution},
                     {"memory", bench_section_memory},
                     {"lattice calibration and the homogenised cell", bench_section_calibration},
-                    {"viscoelastic fit", bench_section_visco}};
+                    {"viscoelastic fit", bench_section_visco},
+                    {"statics at scale", bench_section_statics}};
     const int nsec = (int)(sizeof sections / sizeof sections[0]);
     for (int k = 0; k < nsec; k++) {
         if (only && !strstr(sections[k].what, only))

@@ -28,7 +28,7 @@ typedef struct bench_target {
     int met; /* 1 met, 0 not met, -1 not measured */
 } bench_target;
 
-#define BENCH_MAX_TARGETS 16
+#define BENCH_MAX_TARGETS 24
 
 typedef struct bench_ctx {
     FILE *md;              /* the Markdown report */
@@ -67,5 +67,6 @@ void bench_memory_fit_early(bench_ctx *ctx);
 void bench_section_memory(bench_ctx *ctx);
 void bench_section_calibration(bench_ctx *ctx);
 void bench_section_visco(bench_ctx *ctx);
+void bench_section_statics(bench_ctx *ctx);
 
 #endif

@@ -1,8 +1,9 @@
 /*
-** Benchmark section 2: one explicit step of the mass-spring lattice (force kernel plus the
-** symplectic update of the nodes) per spring, for a linear spring (the floor: the same kernel with
-** the law replaced by F = k u) and for the conical law with each evaluator, over lattices of about
-** 1e3 to 1e6 springs.
+** Benchmark section 2: one explicit step of the mass-spring lattice per spring: conifit's fused
+** step (lattice_step.h) with each evaluator, the unfused kernel it replaced, and a minimal
+** independent linear-spring step written here as the floor, over lattices of about 1e3 to 1e6
+** springs; springs per 1 ms at 1e4, 1e5 and 1e6; the machine's triad bandwidth and each kernel's
+** distance to the time its memory traffic needs; two threads at 1e6 springs.
 */
 #include <math.h>
 #include <stdlib.h>
@@ -10,6 +11,7 @@
 
 #include "bench.h"
 #include "conifit/lattice.h"
+#include "model/lattice_step.h"
 
 /* The spring behind data/telescoping.csv: solid strain 0.6, region 2 from strain 0.24. */
 static const cf_spring bench_spring = {8, 20, 2.5, 2, 100, 5};
@@ -17,83 +19,81 @@ static const cf_spring bench_spring = {8, 20, 2.5, 2, 100, 5};
 
 typedef struct lvariant {
     const char *name;
-    int linear;
+    int kind; /* 0 minimal linear kernel, 1 fused step, 2 previous unfused kernel */
     cf_law_method method;
 } lvariant;
 
 static const lvariant lvars[] = {
-    {"linear (floor)", 1, CF_LAW_CLOSED}, {"exact", 0, CF_LAW_EXACT},
-    {"closed", 0, CF_LAW_CLOSED},         {"closed+newton", 0, CF_LAW_CLOSED_NEWTON},
-    {"table 256", 0, CF_LAW_TABLE},
+    {"linear, minimal kernel (floor)", 0, CF_LAW_CLOSED},
+    {"exact", 1, CF_LAW_EXACT},
+    {"closed", 1, CF_LAW_CLOSED},
+    {"closed+newton", 1, CF_LAW_CLOSED_NEWTON},
+    {"table 256", 1, CF_LAW_TABLE},
+    {"closed, unfused kernel", 2, CF_LAW_CLOSED},
 };
 #define NLV (sizeof lvars / sizeof lvars[0])
+#define V_LIN 0
+#define V_CLOSED 2
+#define V_TABLE 4
+#define V_UNFUSED 5
 
-/* The lattice kernel with F = k u in place of the law (same passes, same memory traffic; forces
-** only, as in an explicit step). */
-static void linear_forces(cf_lattice *lat, double k)
+/* The floor: a minimal linear-spring step written here, independent of conifit's kernels. One
+** pass over the springs (gather, length, F = k (L0 - L) a, scatter), one over the nodes
+** (symplectic Euler, forces cleared). Same arrays, same order, no law. */
+static void linear_step(cf_lattice *lat, const double *const im[3], double *const v[3], double k,
+                        double h)
 {
-    const size_t ns = lat->ns, nn = lat->nn;
     const uint32_t *restrict si = lat->si, *restrict sj = lat->sj;
-    const double *restrict x = lat->x, *restrict y = lat->y, *restrict z = lat->z;
-    const double *restrict L0 = lat->L0_mm, *restrict a = lat->a, *restrict w = lat->w;
-    double *restrict L = lat->L_mm, *restrict u = lat->u_mm, *restrict T = lat->T_N;
-    double *restrict F = lat->F_N;
-    double *restrict fx = lat->fx, *restrict fy = lat->fy, *restrict fz = lat->fz;
-    for (size_t s = 0; s < ns; s++) {
-        double dx = x[sj[s]] - x[si[s]], dy = y[sj[s]] - y[si[s]], dz = z[sj[s]] - z[si[s]];
-        double l = sqrt(dx * dx + dy * dy + dz * dz);
-        L[s] = l;
-        u[s] = (L0[s] - l) * a[s];
+    double *const xs[3] = {lat->x, lat->y, lat->z};
+    double *const fs[3] = {lat->fx, lat->fy, lat->fz};
+    for (size_t s = 0; s < lat->ns; s++) {
+        const uint32_t i = si[s], j = sj[s];
+        const double dx = xs[0][j] - xs[0][i], dy = xs[1][j] - xs[1][i], dz = xs[2][j] - xs[2][i];
+        const double L = sqrt(dx * dx + dy * dy + dz * dz);
+        const double g = -lat->w[s] * k * (lat->L0_mm[s] - L) * lat->a[s] / L;
+        fs[0][i] += g * dx, fs[1][i] += g * dy, fs[2][i] += g * dz;
+        fs[0][j] -= g * dx, fs[1][j] -= g * dy, fs[2][j] -= g * dz;
     }
-    for (size_t s = 0; s < ns; s++)
-        F[s] = k * u[s];
-    memset(fx, 0, nn * sizeof(double));
-    memset(fy, 0, nn * sizeof(double));
-    memset(fz, 0, nn * sizeof(double));
-    for (size_t s = 0; s < ns; s++) {
-        double t = -w[s] * F[s];
-        T[s] = t;
-        double g = t / L[s];
-        uint32_t i = si[s], j = sj[s];
-        double gx = g * (x[j] - x[i]), gy = g * (y[j] - y[i]), gz = g * (z[j] - z[i]);
-        fx[i] += gx;
-        fy[i] += gy;
-        fz[i] += gz;
-        fx[j] -= gx;
-        fy[j] -= gy;
-        fz[j] -= gz;
-    }
+    for (int a = 0; a < 3; a++)
+        for (size_t p = 0; p < lat->nn; p++) {
+            v[a][p] += h * fs[a][p] * im[a][p];
+            xs[a][p] += h * v[a][p];
+            fs[a][p] = 0;
+        }
 }
 
-typedef struct vel {
-    double *vx, *vy, *vz;
-} vel;
-
-/* One symplectic Euler step: forces, then v += h f/m and x += h v on the free degrees. */
-static void step(cf_lattice *lat, vel *v, int linear, double k, double h)
+/* The kernel conifit used before the fused step: cf_lattice_forces (three passes with per-spring
+** outputs) and a separate node update. */
+static void unfused_step(cf_lattice *lat, const double *const im[3], double *const v[3], double h)
 {
-    if (linear)
-        linear_forces(lat, k);
-    else {
-        lat->with_stiffness = 0; /* an explicit step needs forces only */
-        cf_lattice_forces(lat);
-    }
-    for (size_t p = 0; p < lat->nn; p++) {
-        const double im = h / lat->mass_t[p];
-        const uint8_t f = lat->fix[p];
-        if (!(f & CF_FIX_X)) {
-            v->vx[p] += im * lat->fx[p];
-            lat->x[p] += h * v->vx[p];
+    lat->with_stiffness = 0;
+    cf_lattice_forces(lat);
+    double *const xs[3] = {lat->x, lat->y, lat->z};
+    double *const fs[3] = {lat->fx, lat->fy, lat->fz};
+    for (int a = 0; a < 3; a++)
+        for (size_t p = 0; p < lat->nn; p++) {
+            v[a][p] += h * fs[a][p] * im[a][p];
+            xs[a][p] += h * v[a][p];
         }
-        if (!(f & CF_FIX_Y)) {
-            v->vy[p] += im * lat->fy[p];
-            lat->y[p] += h * v->vy[p];
-        }
-        if (!(f & CF_FIX_Z)) {
-            v->vz[p] += im * lat->fz[p];
-            lat->z[p] += h * v->vz[p];
-        }
-    }
+}
+
+typedef struct runner {
+    cf_lattice *lat;
+    cf_lattice_stepper *st;
+    double *v[3];
+    double k;
+} runner;
+
+static void one_step(runner *r, int kind, double h)
+{
+    const double *const im[3] = {r->st->inv_mass[0], r->st->inv_mass[1], r->st->inv_mass[2]};
+    if (kind == 0)
+        linear_step(r->lat, im, r->v, r->k, h);
+    else if (kind == 1) {
+        cf_lattice_stepper_forces(r->st);
+        cf_lattice_stepper_advance(r->st, h, r->v[0], r->v[1], r->v[2]);
+    } else
+        unfused_step(r->lat, im, r->v, h);
 }
 
 /* Every coordinate scaled by (1 - STATE_STRAIN) about the origin, with a small seeded jitter, so
@@ -112,9 +112,62 @@ static void deform(cf_lattice *lat)
     }
 }
 
+/* Median ns per spring per step of one variant on one lattice (each sample lasts sample_s). */
+static bench_stats time_variant(runner *r, int kind, int repeats, double sample_s)
+{
+    cf_lattice *lat = r->lat;
+    deform(lat);
+    for (int a = 0; a < 3; a++)
+        memset(r->v[a], 0, lat->nn * sizeof(double));
+    memset(lat->fx, 0, lat->nn * sizeof(double));
+    memset(lat->fy, 0, lat->nn * sizeof(double));
+    memset(lat->fz, 0, lat->nn * sizeof(double));
+    const double h = 1e-12; /* the state stays where deform() put it */
+    double t0 = bench_now();
+    one_step(r, kind, h);
+    double one = bench_now() - t0;
+    long nstep = (long)(sample_s / fmax(one, 1e-9)) + 1;
+    double t[16];
+    for (int q = 0; q < repeats; q++) {
+        t0 = bench_now();
+        for (long i = 0; i < nstep; i++)
+            one_step(r, kind, h);
+        t[q] = (bench_now() - t0) / (double)nstep / (double)lat->ns * 1e9;
+    }
+    bench_sink += lat->x[lat->nn / 2];
+    return bench_summarise(t, repeats);
+}
+
+/* STREAM-like triad a = b + s c over three arrays far larger than the caches: bytes per second
+** counting 24 bytes per element (two reads, one write; the write-allocate read not counted). */
+static double triad_bandwidth(int repeats, bench_stats *out)
+{
+    const size_t n = (size_t)1 << 22; /* 32 MiB per array */
+    double *a = malloc(n * sizeof(double)), *b = malloc(n * sizeof(double)),
+           *c = malloc(n * sizeof(double));
+    if (!a || !b || !c) {
+        free(a), free(b), free(c);
+        return 0;
+    }
+    for (size_t i = 0; i < n; i++)
+        a[i] = 0, b[i] = (double)i, c[i] = 1.0 / (double)(i + 1);
+    double t[16];
+    for (int q = 0; q < repeats; q++) {
+        double t0 = bench_now();
+        const double sc = 1.0 + 1e-3 * q;
+        for (size_t i = 0; i < n; i++)
+            a[i] = b[i] + sc * c[i];
+        t[q] = 24.0 * (double)n / (bench_now() - t0) * 1e-9; /* GB/s */
+    }
+    bench_sink += a[n / 3];
+    free(a), free(b), free(c);
+    *out = bench_summarise(t, repeats);
+    return out->median;
+}
+
 void bench_section_lattice(bench_ctx *ctx)
 {
-    static const int full[] = {4, 6, 9, 13, 19, 28, 42};
+    static const int full[] = {4, 6, 9, 13, 19, 28, 43};
     static const int quick[] = {4, 9, 19};
     const int *sizes = ctx->quick ? quick : full;
     const int nsz = ctx->quick ? 3 : 7;
@@ -125,63 +178,61 @@ void bench_section_lattice(bench_ctx *ctx)
     cf_law_table_build(&law, 256, NULL);
     double per[7][NLV]; /* ns per spring per step (median) */
     bench_stats st[7][NLV];
-    size_t nsprings[7];
-    int ref = 0; /* index of the size nearest 1e5 springs */
+    size_t nsprings[7] = {0}, nnodes[7] = {0};
+    bench_stats thr1 = {0}, thr2 = {0};
+    int have_thr = 0;
     for (int z = 0; z < nsz; z++) {
         cf_lattice lat;
         cf_lattice_config cfg = cf_lattice_default();
         cfg.nx = cfg.ny = cfg.nz = sizes[z];
-        if (cf_lattice_create(&lat, &law, CF_LAW_CLOSED, &cfg, NULL) != CF_OK) {
-            nsprings[z] = 0;
+        if (cf_lattice_create(&lat, &law, CF_LAW_CLOSED, &cfg, NULL) != CF_OK)
             continue;
-        }
         nsprings[z] = lat.ns;
-        if (fabs(log((double)lat.ns / 1e5)) < fabs(log((double)nsprings[ref] / 1e5)))
-            ref = z;
+        nnodes[z] = lat.nn;
         ctx->largest_springs = lat.ns;
         ctx->largest_cells = sizes[z];
-        vel v = {calloc(lat.nn, sizeof(double)), calloc(lat.nn, sizeof(double)),
-                 calloc(lat.nn, sizeof(double))};
+        runner r = {&lat, NULL, {calloc(lat.nn, sizeof(double)), calloc(lat.nn, sizeof(double)),
+                                 calloc(lat.nn, sizeof(double))},
+                    law.k0_N_per_mm};
         for (size_t e = 0; e < NLV; e++) {
             lat.method = lvars[e].method;
-            deform(&lat);
-            memset(v.vx, 0, lat.nn * sizeof(double));
-            memset(v.vy, 0, lat.nn * sizeof(double));
-            memset(v.vz, 0, lat.nn * sizeof(double));
-            /* a step of 1e-12 s: the state stays where deform() put it */
-            const double h = 1e-12;
-            double t0 = bench_now();
-            step(&lat, &v, lvars[e].linear, law.k0_N_per_mm, h);
-            double one = bench_now() - t0;
-            long nstep = (long)(sample_s / fmax(one, 1e-9)) + 1;
-            double t[16];
-            for (int r = 0; r < repeats; r++) {
-                t0 = bench_now();
-                for (long i = 0; i < nstep; i++)
-                    step(&lat, &v, lvars[e].linear, law.k0_N_per_mm, h);
-                t[r] = (bench_now() - t0) / (double)nstep / (double)lat.ns * 1e9;
-            }
-            bench_sink += lat.fz[lat.nn / 2];
-            st[z][e] = bench_summarise(t, repeats);
+            cf_lattice_stepper stp;
+            if (cf_lattice_stepper_init(&stp, &lat, NULL, NULL) != CF_OK)
+                continue;
+            stp.threads = 0; /* one core */
+            r.st = &stp;
+            st[z][e] = time_variant(&r, lvars[e].kind, repeats, sample_s);
             per[z][e] = st[z][e].median;
+            if (e == V_CLOSED && lat.ns >= CF_STEP_THREADS_MIN) {
+                thr1 = st[z][e];
+                stp.threads = 1;
+                thr2 = time_variant(&r, 1, repeats, sample_s);
+                have_thr = 1;
+            }
+            cf_lattice_stepper_free(&stp);
         }
-        free(v.vx);
-        free(v.vy);
-        free(v.vz);
+        for (int a = 0; a < 3; a++)
+            free(r.v[a]);
         cf_lattice_free(&lat);
     }
     cf_law_free(&law);
 
     fprintf(ctx->md,
             "## 2. Lattice step: time per spring\n\n"
-            "One explicit step = the force kernel `cf_lattice_forces` (lengths, law, tensions, node "
-            "forces) plus the symplectic Euler update of every free node. Cubic lattices of n³ "
-            "cells with face and body diagonals (the default), the spring of "
-            "`data/telescoping.csv`, every node moved to a compression of %.2f (± 0.5 %% of H "
-            "jitter) so that every spring is in region 2. The linear floor is the same kernel "
-            "with the law replaced by F = k u. ns per spring per step, median of %d samples "
-            "[min–max]; each sample runs enough steps to last %.0f ms.\n\n",
-            STATE_STRAIN, repeats, sample_s * 1e3);
+            "One explicit step: every spring's force into the node forces, then the symplectic "
+            "Euler update of every free node (which also clears the forces). conifit's step is "
+            "the fused one (`model/lattice_step.c`: blocks of %d springs gathered, their "
+            "lengths and forces computed in one vectorised loop, scattered; closed form and table "
+            "through the branch-free lanes of `model/law_simd.h`, exact and closed+newton "
+            "through the scalar law per block); \"closed, unfused kernel\" is the kernel it "
+            "replaced (`cf_lattice_forces`: three passes with per-spring outputs). The floor is a "
+            "minimal linear-spring step written in the benchmark (one pass over the springs with "
+            "F = k u, one over the nodes), independent of conifit's code. Cubic lattices of n³ "
+            "cells with face and body diagonals, the spring of `data/telescoping.csv`, every node "
+            "moved to a compression of %.2f (± 0.5 %% of H jitter) so that every spring is in "
+            "region 2. One core; ns per spring per step, median of %d samples [min–max]; each "
+            "sample runs enough steps to last %.0f ms.\n\n",
+            CF_STEP_BLOCK, STATE_STRAIN, repeats, sample_s * 1e3);
     fprintf(ctx->md, "| n | springs |");
     for (size_t e = 0; e < NLV; e++)
         fprintf(ctx->md, " %s |", lvars[e].name);
@@ -196,7 +247,8 @@ void bench_section_lattice(bench_ctx *ctx)
         fprintf(ctx->md, "| %d | %zu |", sizes[z], nsprings[z]);
         for (size_t e = 0; e < NLV; e++)
             fprintf(ctx->md, " %.2f [%.2f–%.2f] |", st[z][e].median, st[z][e].min, st[z][e].max);
-        fprintf(ctx->md, " %.2f | %.2f |\n", per[z][2] / per[z][0], per[z][4] / per[z][0]);
+        fprintf(ctx->md, " %.2f | %.2f |\n", per[z][V_CLOSED] / per[z][V_LIN],
+                per[z][V_TABLE] / per[z][V_LIN]);
         if (dat) {
             fprintf(dat, "%zu", nsprings[z]);
             for (size_t e = 0; e < NLV; e++)
@@ -206,71 +258,130 @@ void bench_section_lattice(bench_ctx *ctx)
     }
     if (dat)
         fclose(dat);
-    /* growth: least-squares slope of log(step time) against log(springs) */
-    fprintf(ctx->md,
-            "\n**Growth.** Least-squares slope of log(time per step) against log(springs) "
-            "(1 = linear growth), and the largest lattice that keeps a 1 kHz step on one core: "
-            "the largest measured size whose step fits in 1 ms, and 1 ms divided by the time per "
-            "spring measured at the largest size (cache misses included).\n\n"
-            "| evaluator | slope | per-spring time, smallest → largest, ns | largest measured "
-            "size within 1 ms | springs per 1 ms step (at the largest size) |\n"
-            "|---|---|---|---|---|\n");
+
+    /* springs per 1 ms step at the sizes nearest 1e4, 1e5 and 1e6 springs */
+    const double want[3] = {1e4, 1e5, 1e6};
+    int at[3] = {0, 0, 0};
+    for (int q = 0; q < 3; q++)
+        for (int z = 0; z < nsz; z++)
+            if (nsprings[z] && fabs(log((double)nsprings[z] / want[q])) <
+                                   fabs(log((double)nsprings[at[q]] / want[q])))
+                at[q] = z;
+    fprintf(ctx->md, "\n**Springs per 1 ms step** (one core: 1 ms divided by the time per spring "
+                     "measured at that size):\n\n| lattice | springs |");
+    for (size_t e = 0; e < NLV; e++)
+        fprintf(ctx->md, " %s |", lvars[e].name);
+    fprintf(ctx->md, "\n|---|---|");
+    for (size_t e = 0; e < NLV; e++)
+        fprintf(ctx->md, "---|");
+    fprintf(ctx->md, "\n");
+    for (int q = 0; q < 3; q++) {
+        if (q > 0 && at[q] == at[q - 1])
+            continue;
+        int z = at[q];
+        fprintf(ctx->md, "| %d³ (~%.0e) | %zu |", sizes[z], want[q], nsprings[z]);
+        for (size_t e = 0; e < NLV; e++)
+            fprintf(ctx->md, " %.3g |", 1e6 / per[z][e]);
+        fprintf(ctx->md, "\n");
+    }
+
+    /* growth */
+    fprintf(ctx->md, "\n**Growth.** Least-squares slope of log(time per step) against "
+                     "log(springs) (1 = linear growth).\n\n| variant | slope | per-spring time, "
+                     "smallest → largest, ns |\n|---|---|---|\n");
     int last = nsz - 1;
     while (last > 0 && !nsprings[last])
         last--;
     for (size_t e = 0; e < NLV; e++) {
         double sx = 0, sy = 0, sxx = 0, sxy = 0;
         int m = 0;
-        size_t fits = 0;
         for (int z = 0; z < nsz; z++) {
             if (!nsprings[z])
                 continue;
-            double lx = log((double)nsprings[z]);
-            double ly = log(per[z][e] * (double)nsprings[z]);
-            sx += lx;
-            sy += ly;
-            sxx += lx * lx;
-            sxy += lx * ly;
+            double lx = log((double)nsprings[z]), ly = log(per[z][e] * (double)nsprings[z]);
+            sx += lx, sy += ly, sxx += lx * lx, sxy += lx * ly;
             m++;
-            if (per[z][e] * (double)nsprings[z] <= 1e6)
-                fits = nsprings[z];
         }
         double slope = (m * sxy - sx * sy) / (m * sxx - sx * sx);
-        fprintf(ctx->md, "| %s | %.3f | %.2f → %.2f | %zu | %.3g |\n", lvars[e].name, slope,
-                per[0][e], per[last][e], fits, 1e6 / per[last][e]);
-        if (e == 2)
+        fprintf(ctx->md, "| %s | %.3f | %.2f → %.2f |\n", lvars[e].name, slope, per[0][e],
+                per[last][e]);
+        if (e == V_CLOSED)
             ctx->slope_closed = slope;
     }
-    const double closed_ms = per[ref][2] * 1e5 * 1e-6; /* ms for 1e5 springs at the ref size */
-    const double springs_per_ms = 1e6 / per[ref][2];
-    const double rc = per[ref][2] / per[ref][0], rt = per[ref][4] / per[ref][0];
+
+    /* bandwidth floor at the largest size */
+    bench_stats bw;
+    const double gbs = triad_bandwidth(repeats, &bw);
+    const double nodes_per_spring = (double)nnodes[last] / (double)nsprings[last];
+    /* bytes that must cross the memory bus per spring and step when nothing stays in cache:
+    ** fused: si, sj (8) + L0, a, w (24) per spring; per node and axis the position, velocity and
+    ** force read and written (3 x 16) and the inverse mass (8). Minimal linear: the same with one
+    ** mass per node. Unfused: si, sj, L0, a read and L, u written (40), u read and F written (16),
+    ** w, F, L, si, sj read and T written (40); per node the forces cleared (24), gathered into
+    ** (48) and read (24), positions and velocities read and written (96), the mass (8). */
+    const double bytes[NLV] = {32 + 152 * nodes_per_spring, 32 + 168 * nodes_per_spring,
+                               32 + 168 * nodes_per_spring, 32 + 168 * nodes_per_spring,
+                               32 + 168 * nodes_per_spring, 96 + 200 * nodes_per_spring};
     fprintf(ctx->md,
-            "\n**Targets** (at n = %d, %zu springs, the size nearest 1e5). 1e5 conical springs "
+            "\n**Bandwidth floor.** Triad a = b + s·c over three 32 MiB arrays (far beyond the "
+            "caches), counting 24 bytes per element: %.1f GB/s [%.1f–%.1f], median of %d. At "
+            "the largest lattice (%zu springs, %zu nodes, %.0f MB of spring and node data) each "
+            "kernel must move at least the bytes below per spring and step (spring arrays once, "
+            "node arrays once, as if nothing stayed in cache; the layout in the source of this "
+            "section); the floor is that traffic at the triad bandwidth.\n\n"
+            "| variant | bytes per spring | floor, ns per spring | measured, ns per spring | "
+            "measured / floor |\n|---|---|---|---|---|\n",
+            gbs, bw.min, bw.max, repeats, nsprings[last], nnodes[last],
+            (32.0 * (double)nsprings[last] + 104.0 * (double)nnodes[last]) * 1e-6);
+    for (size_t e = 0; e < NLV; e++) {
+        double floor_ns = gbs > 0 ? bytes[e] / gbs : 0;
+        fprintf(ctx->md, "| %s | %.0f | %.2f | %.2f | %.1f |\n", lvars[e].name, bytes[e],
+                floor_ns, per[last][e], floor_ns > 0 ? per[last][e] / floor_ns : 0);
+    }
+    if (have_thr)
+        fprintf(ctx->md,
+                "\n**Threads** (OpenMP, lattices of %d springs and more): the closed-form fused "
+                "step at %zu springs, %.2f ns per spring on one thread [%.2f–%.2f], %.2f on two "
+                "[%.2f–%.2f]: %.2f× with two threads, on a machine whose two cores were shared "
+                "with other work while this ran (the load average above).\n\n",
+                CF_STEP_THREADS_MIN, nsprings[last], thr1.median, thr1.min, thr1.max, thr2.median,
+                thr2.min, thr2.max, thr1.median / thr2.median);
+    else
+        fprintf(ctx->md, "\n");
+
+    /* targets at the size nearest 1e5 springs */
+    const int ref = at[1];
+    const double springs_per_ms = 1e6 / per[ref][V_CLOSED];
+    const double rc = per[ref][V_CLOSED] / per[ref][V_LIN], rt = per[ref][V_TABLE] / per[ref][V_LIN];
+    fprintf(ctx->md,
+            "**Targets** (at n = %d, %zu springs, the size nearest 1e5). 1e5 conical springs "
             "per 1 ms step on one core: %s (closed: %.0f springs per ms, i.e. %.2f ms for 1e5; "
             "table: %.0f per ms). Closed ≤ 2× linear: %s (%.2f×). Table ≤ 1.3× linear: %s "
             "(%.2f×).\n\n",
             sizes[ref], nsprings[ref], springs_per_ms >= 1e5 ? "**met**" : "**not met**",
-            springs_per_ms, closed_ms, 1e6 / per[ref][4], rc <= 2 ? "**met**" : "**not met**", rc,
-            rt <= 1.3 ? "**met**" : "**not met**", rt);
+            springs_per_ms, per[ref][V_CLOSED] * 0.1, 1e6 / per[ref][V_TABLE],
+            rc <= 2 ? "**met**" : "**not met**", rc, rt <= 1.3 ? "**met**" : "**not met**", rt);
     bench_target_add(ctx, "lattice step grows linearly with the springs (slope 1 ± 0.1)",
-                     fabs(ctx->slope_closed - 1) <= 0.1, "slope %.3f (closed form, %zu to %zu springs)",
-                     ctx->slope_closed, nsprings[0], nsprings[last]);
+                     fabs(ctx->slope_closed - 1) <= 0.1,
+                     "slope %.3f (closed form, %zu to %zu springs)", ctx->slope_closed,
+                     nsprings[0], nsprings[last]);
     bench_target_add(ctx, "1e5 conical springs per 1 ms lattice step on one core (closed form)",
                      springs_per_ms >= 1e5, "%.3g springs per ms (%zu-spring lattice)",
                      springs_per_ms, nsprings[ref]);
-    bench_target_add(ctx, "lattice step with the closed form ≤ 2× the linear-spring lattice",
-                     rc <= 2, "%.2f× (%.2f against %.2f ns per spring)", rc, per[ref][2],
-                     per[ref][0]);
-    bench_target_add(ctx, "lattice step with the table ≤ 1.3× the linear-spring lattice", rt <= 1.3,
-                     "%.2f× (%.2f against %.2f ns per spring)", rt, per[ref][4], per[ref][0]);
+    bench_target_add(ctx, "lattice step with the closed form ≤ 2× the linear-spring step", rc <= 2,
+                     "%.2f× (%.2f against %.2f ns per spring)", rc, per[ref][V_CLOSED],
+                     per[ref][V_LIN]);
+    bench_target_add(ctx, "lattice step with the table ≤ 1.3× the linear-spring step", rt <= 1.3,
+                     "%.2f× (%.2f against %.2f ns per spring)", rt, per[ref][V_TABLE],
+                     per[ref][V_LIN]);
     if (bench_gnuplot(ctx, "set terminal pngcairo size 800,500\n"
                            "set output 'lattice_step.png'\n"
                            "set logscale xy\nset grid\nset key outside right\n"
                            "set xlabel 'springs in the lattice'\n"
                            "set ylabel 'time per spring per step [ns]'\n"
                            "set title 'Lattice step: time per spring (flat = linear growth)'\n"
-                           "plot for [c=2:6] 'lattice_step.dat' using 1:c with linespoints "
-                           "pt 7 title word('linear exact closed closed+newton table256', c-1)\n") ==
-        0)
+                           "plot for [c=2:7] 'lattice_step.dat' using 1:c with linespoints "
+                           "pt 7 title word('linear exact closed closed+newton table256 "
+                           "closed-unfused', c-1)\n") == 0)
         fprintf(ctx->md, "![lattice step: time per spring](lattice_step.png)\n\n");
 }

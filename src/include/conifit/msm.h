@@ -80,6 +80,8 @@ typedef struct cf_msm_config {
     double dt_s;               /* time step, s: 0 = automatic (quasi-static: sample interval
                                   split in quasi_substeps; dynamic: 0.9 of the stable step) */
     int quasi_substeps;        /* implicit steps per sample interval when dt_s = 0 */
+    int banded_only;           /* 1: solve tangents with the banded LDL^T (and its fallbacks)
+                                  instead of the sparse Cholesky, for comparisons; default 0 */
     /* Called by cf_msm_run after every reported sample (done of total) when not NULL, so that a
     ** caller can show progress; the library itself never prints. */
     void (*progress)(void *ctx, size_t done, size_t total, double t_s);
