@@ -99,7 +99,10 @@ static cf_status object(ctx *c, json_t *root, const char *key, int required, jso
 static cf_status spring_section(ctx *c, json_t *sp, cf_scene *sc)
 {
     static const char *const allowed[] = {"fit", "type", "params", NULL};
-    static const char *const pkeys[] = {"D1_mm", "D2_mm", "n", "d_mm", "G_MPa", "H_mm", NULL};
+    const char *pkeys[CF_P_COUNT + 1]; /* the keys of the spring description (spring.h) */
+    for (int k = 0; k < CF_P_COUNT; k++)
+        pkeys[k] = cf_spring_param_info(k)->key;
+    pkeys[CF_P_COUNT] = NULL;
     cf_status st = only_keys(c, sp, "spring", allowed);
     if (st)
         return st;
@@ -141,11 +144,12 @@ static cf_status spring_section(ctx *c, json_t *sp, cf_scene *sc)
                             c->name);
     if ((st = only_keys(c, params, "spring.params", pkeys)))
         return st;
-    double *slot[6] = {&sc->spring.D1_mm, &sc->spring.D2_mm, &sc->spring.n,
-                       &sc->spring.d_mm,  &sc->spring.G_MPa, &sc->spring.H_mm};
-    for (int k = 0; k < 6; k++)
-        if ((st = number(c, params, "spring.params", pkeys[k], 1, 0, 0, 1, INFINITY, slot[k])))
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        double v;
+        if ((st = number(c, params, "spring.params", pkeys[k], 1, 0, 0, 1, INFINITY, &v)))
             return st;
+        cf_spring_set(&sc->spring, k, v);
+    }
     cf_law law;
     cf_error lerr = {0};
     if (cf_law_init(&law, &sc->spring, &lerr) != CF_OK)
