@@ -149,6 +149,7 @@ int main(int argc, char **argv)
         const char *what;
         void (*run)(bench_ctx *);
     } sections[] = {{"memory of a fit", bench_memory_fit_early},
+                    {"statics at scale (measured first: it forks)", bench_statics_early},
                     {"the force law", bench_section_law},
                     {"the lattice step", bench_section_lattice},
                     {"the integrators", bench_section_integrators},
