@@ -29,7 +29,6 @@
 ** in BAND_MAX_ENTRIES doubles), else dense LU up to DENSE_MAX_DOF free DOFs (a 7x7x7 lattice has
 ** ~1500), else GMRES. */
 #define BAND_ACCEPT 1e-10
-#define SPARSE_MIN_DOF 600
 #define BAND_MAX_ENTRIES 5e7
 #define DENSE_MAX_DOF 1200
 /* A spring may come this close to solid (fraction of the travel) in a Newton step; beyond it the
@@ -564,10 +563,6 @@ static cf_status tangent_solve(solver *s, cf_error *err)
             C->data[k] /= s->D[C->i[k]] * s->D[col];
     int fatal = 0;
     s->neg_pivots = -1;
-    /* the band first on small lattices, where it is faster (benchmark section 9: 3^3 and 4^3
-    ** cells), the sparse Cholesky from SPARSE_MIN_DOF unknowns on (6^3 cells: 0.58 s against 0.88) */
-    if (n < SPARSE_MIN_DOF && !s->cfg->banded_only && band_direction(s))
-        return CF_OK;
     if (!s->cfg->banded_only && chol_direction(s, &fatal, err))
         return CF_OK;
     if (fatal)
