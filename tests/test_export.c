@@ -888,12 +888,14 @@ static void lattice_models_of_every_format_hold_the_law_in_every_group(void **st
     cf_law law;
     law_of(&law, &TEL);
     write_scene("latf.json", 0.3 * law.travel_mm / TEL.H_mm, 4);
-    const char *formats[5] = {"calculix", "abaqus", "febio", "lsdyna", "sofa"};
-    for (int f = 0; f < 5; f++) {
+    for (int f = 0; f < CF_EXPORT_FORMAT_COUNT; f++) {
+        const cf_export_format_info *fi = cf_export_format_get((cf_export_format)f);
+        if (!fi->model)
+            continue;
         char args[160], name[32];
         snprintf(args, sizeof args, "--lattice %s/latf.json --format %s --tol 1e-3", dir,
-                 formats[f]);
-        snprintf(name, sizeof name, "latf.%s", formats[f]);
+                 fi->name);
+        snprintf(name, sizeof name, "latf.%s", fi->name);
         char *x = export_to(name, args);
         /* groups from the header */
         double L0[16], w[16];
@@ -919,11 +921,11 @@ static void lattice_models_of_every_format_hold_the_law_in_every_group(void **st
         while (g < ng) {
             double e[512], T[512];
             size_t n = 0;
-            if (f <= 1) { /* *SPRING blocks: force, elongation */
+            if (f == CF_EXPORT_CALCULIX || f == CF_EXPORT_ABAQUS) { /* force, elongation */
                 char key[48];
                 snprintf(key, sizeof key, "*SPRING, ELSET=G%zu, NONLINEAR", g + 1);
                 n = inp_pairs(x, key, T, e, 512);
-            } else if (f == 2) { /* FEBio: <pt>e,T</pt> inside each discrete_material */
+            } else if (f == CF_EXPORT_FEBIO) { /* <pt>e,T</pt> inside each discrete_material */
                 char key[64];
                 snprintf(key, sizeof key, "name=\"G%zu\" type=\"nonlinear spring\"", g + 1);
                 p = strstr(x, key);
@@ -934,7 +936,7 @@ static void lattice_models_of_every_format_hold_the_law_in_every_group(void **st
                     assert_int_equal(sscanf(q, "<pt>%lf,%lf</pt>", &e[n], &T[n]), 2);
                     n++;
                 }
-            } else if (f == 3) { /* LS-DYNA: the curve after the group's LCINT card */
+            } else if (f == CF_EXPORT_LSDYNA) { /* the curve after the group's LCINT card */
                 char key[32];
                 snprintf(key, sizeof key, "$ group %zu:", g + 1);
                 p = strstr(x, key);
@@ -952,7 +954,7 @@ static void lattice_models_of_every_format_hold_the_law_in_every_group(void **st
                     p = strchr(p, '\n') + 1;
                 }
                 assert_true(lcint >= (double)n);
-            } else { /* SOFA: the force of the group's summed springs */
+            } else if (f == CF_EXPORT_SOFA) { /* the force of the group's summed springs */
                 static sofa_field sf[8192];
                 const size_t nf = sofa_fields(x, sf, 8192);
                 assert_true(nf < 8192);
@@ -973,13 +975,15 @@ static void lattice_models_of_every_format_hold_the_law_in_every_group(void **st
                             sum += sofa_force(L0[g] + e[n], sf[k].l0, sf[k].a, sf[k].compressible);
                     T[n++] = sum;
                 }
+            } else {
+                fail_msg("format %s writes models, but this test cannot read them back", fi->name);
             }
             assert_true(n > 10);
             for (size_t i = 0; i < n; i++) {
                 const double want = -w[g] * cf_law_force(&law, CF_LAW_EXACT, -e[i] * TEL.H_mm / L0[g],
                                                          NULL, NULL);
                 if (!(fabs(T[i] - want) <= 1.01e-3 * w[g] * law.F_C_N))
-                    fail_msg("%s group %zu: %g N at elongation %g mm, law %g N", formats[f], g + 1,
+                    fail_msg("%s group %zu: %g N at elongation %g mm, law %g N", fi->name, g + 1,
                              T[i], e[i], want);
                 checked++;
             }
@@ -990,20 +994,43 @@ static void lattice_models_of_every_format_hold_the_law_in_every_group(void **st
     }
 }
 
+/* What the one-spring model of each format must hold: its loading. */
+static const char *example_must(cf_export_format f)
+{
+    switch (f) {
+    case CF_EXPORT_CALCULIX:
+        return "*STEP";
+    case CF_EXPORT_ABAQUS:
+        return "*STEP, NLGEOM=YES";
+    case CF_EXPORT_FEBIO:
+        return "type=\"prescribed displacement\"";
+    case CF_EXPORT_LSDYNA:
+        return "*BOUNDARY_PRESCRIBED_MOTION_SET";
+    case CF_EXPORT_SOFA:
+        return "PartialLinearMovementProjective";
+    default:
+        return NULL;
+    }
+}
+
 static void every_format_has_a_runnable_example(void **state)
 {
     (void)state;
-    const char *formats[5] = {"calculix", "abaqus", "febio", "lsdyna", "sofa"};
-    const char *must[5] = {"*STEP", "*STEP, NLGEOM=YES", "type=\"prescribed displacement\"",
-                           "*BOUNDARY_PRESCRIBED_MOTION_SET", "PartialLinearMovementProjective"};
-    for (int f = 0; f < 5; f++) {
+    for (int f = 0; f < CF_EXPORT_FORMAT_COUNT; f++) {
+        const cf_export_format_info *fi = cf_export_format_get((cf_export_format)f);
+        if (!fi->model)
+            continue;
+        const char *must = example_must(fi->format);
+        if (!must)
+            fail_msg("format %s writes models, but this test does not know their loading",
+                     fi->name);
         char args[64], name[32];
-        snprintf(args, sizeof args, "--format %s --example --tol 1e-3", formats[f]);
-        snprintf(name, sizeof name, "ex.%s", formats[f]);
+        snprintf(args, sizeof args, "--format %s --example --tol 1e-3", fi->name);
+        snprintf(name, sizeof name, "ex.%s", fi->name);
         char *x = export_to(name, args);
-        assert_non_null(strstr(x, must[f]));
+        assert_non_null(strstr(x, must));
         assert_non_null(strstr(x, "2 nodes, 1 springs in 1 groups"));
-        if (f == 2) { /* FEBio 4 builds the mesh when it reads MeshDomains: it must come first */
+        if (f == CF_EXPORT_FEBIO) { /* FEBio 4 builds the mesh on reading MeshDomains: first */
             const char *order[] = {"</Mesh>", "<MeshDomains/>", "<Boundary>", "<Discrete>",
                                    "<LoadData>", "<Output>"};
             const char *at = x;
@@ -1016,6 +1043,92 @@ static void every_format_has_a_runnable_example(void **state)
         }
         free(x);
     }
+}
+
+/* ---- the registry of formats ------------------------------------------------------------------ */
+
+/* Every entry names itself, parses back, and stands in the command's help with its extension and
+** description; an unknown name is refused with the list of all of them. */
+static void the_format_registry_is_whole_and_drives_the_help(void **state)
+{
+    (void)state;
+    char help[16384], err[1024];
+    assert_int_equal(tu_run(help, sizeof help, err, sizeof err, "export --help"), 0);
+    cf_error e = {0};
+    cf_export_format g;
+    assert_int_equal(cf_export_format_parse("vtk", &g, &e), CF_E_DATA);
+    for (int f = 0; f < CF_EXPORT_FORMAT_COUNT; f++) {
+        const cf_export_format_info *fi = cf_export_format_get((cf_export_format)f);
+        assert_non_null(fi);
+        assert_int_equal(fi->format, f);
+        assert_true(fi->name[0] != '\0' && fi->extension[0] == '.' && fi->extension[1] != '\0');
+        assert_true(fi->description[0] != '\0' && !strchr(fi->description, '\n'));
+        assert_true(strlen(fi->description) <= 72); /* one line of the help */
+        assert_string_equal(cf_export_format_name((cf_export_format)f), fi->name);
+        cf_error e2 = {0};
+        assert_int_equal(cf_export_format_parse(fi->name, &g, &e2), CF_OK);
+        assert_int_equal(g, f);
+        for (int k = 0; k < f; k++)
+            assert_string_not_equal(cf_export_format_get((cf_export_format)k)->name, fi->name);
+        assert_non_null(strstr(e.msg, fi->name));
+        char line[256];
+        snprintf(line, sizeof line, "  %-9s %-6s %-7s %s\n", fi->name, fi->extension,
+                 fi->model ? "yes" : "no", fi->description);
+        if (!strstr(help, line))
+            fail_msg("export --help lacks the line '%s'", line);
+    }
+    assert_null(cf_export_format_get(CF_EXPORT_FORMAT_COUNT));
+    assert_string_equal(cf_export_format_name(CF_EXPORT_FORMAT_COUNT), "?");
+    char list[256];
+    assert_string_equal(cf_export_format_list(list, sizeof list, 1),
+                        "calculix, abaqus, febio, lsdyna or sofa");
+    assert_string_equal(cf_export_format_list(list, 8, 0), "json, c"); /* truncated, terminated */
+}
+
+/* Without --format, the extension of -o names the format when exactly one format has it. */
+static void the_output_extension_names_the_format(void **state)
+{
+    (void)state;
+    cf_export_format g = CF_EXPORT_JSON;
+    cf_error e = {0};
+    assert_int_equal(cf_export_format_of_path("out/a.b/s.FEB", &g, &e), CF_OK);
+    assert_int_equal(g, CF_EXPORT_FEBIO);
+    assert_int_equal(cf_export_format_of_path("s.inp", &g, &e), CF_E_DATA);
+    assert_non_null(strstr(e.msg, "calculix or abaqus"));
+    assert_int_equal(cf_export_format_of_path("a.k/s", &g, &e), CF_E_DATA);
+    assert_int_equal(cf_export_format_of_path("s.txt", &g, &e), CF_E_DATA);
+    char *x = export_to("byname.feb", "--tol 1e-3");
+    assert_non_null(strstr(x, "<febio_spec version=\"4.0\">"));
+    free(x);
+    char err[1024], p[160];
+    struct stat st;
+    snprintf(p, sizeof p, "%s/which.inp", dir);
+    assert_int_equal(tu_run(NULL, 0, err, sizeof err, "export %s/fit.json -o %s", dir, p), 2);
+    assert_non_null(strstr(err, "calculix or abaqus"));
+    assert_int_equal(stat(p, &st), -1);
+    /* a format that writes data only is refused for a model, naming those that write models */
+    assert_int_equal(tu_run(NULL, 0, err, sizeof err, "export %s/fit.json --format json --lattice",
+                            dir),
+                     2);
+    assert_non_null(strstr(err, "calculix, abaqus, febio, lsdyna or sofa"));
+    /* and the library refuses it too */
+    cf_fitted_spring fs;
+    char fit[96];
+    snprintf(fit, sizeof fit, "%s/fit.json", dir);
+    assert_int_equal(cf_fitfile_load(fit, NULL, &fs, &e), CF_OK);
+    cf_export_options opt = cf_export_default_options();
+    opt.format = CF_EXPORT_CSV;
+    opt.example = 1;
+    FILE *devnull = fopen("/dev/null", "w");
+    assert_non_null(devnull);
+    assert_int_equal(cf_export_write(devnull, &fs, &opt, NULL, &e), CF_E_DATA);
+    opt.example = 0;
+    cf_law law;
+    law_of(&law, &TEL);
+    const cf_export_lattice lx = cf_export_lattice_default(&law);
+    assert_int_equal(cf_export_write_lattice(devnull, &fs, &opt, &lx, NULL, &e), CF_E_DATA);
+    assert_non_null(strstr(e.msg, "csv"));
+    fclose(devnull);
 }
 
 static void an_unstable_lattice_loading_is_refused_with_the_strain_that_works(
@@ -1087,6 +1200,8 @@ int main(void)
         cmocka_unit_test(calculix_runs_the_lattice_and_matches_conifit_simulate_at_every_step),
         cmocka_unit_test(lattice_models_of_every_format_hold_the_law_in_every_group),
         cmocka_unit_test(every_format_has_a_runnable_example),
+        cmocka_unit_test(the_format_registry_is_whole_and_drives_the_help),
+        cmocka_unit_test(the_output_extension_names_the_format),
         cmocka_unit_test(an_unstable_lattice_loading_is_refused_with_the_strain_that_works),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

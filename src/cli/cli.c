@@ -158,6 +158,8 @@ int cf_cli_next(cf_cli_parser *p)
             fputs(p->help, stdout);
             if (p->help_more)
                 fputs(p->help_more, stdout);
+            if (p->help_extra)
+                p->help_extra(stdout);
             if (p->spring)
                 cf_cli_spring_help(stdout);
             cf_cli_common_help(stdout);

@@ -60,6 +60,7 @@ typedef struct cf_cli_parser {
     const char *cmd;               /* "fit", for messages */
     const char *help;              /* the command's help text */
     const char *help_more;         /* printed after it when not NULL */
+    void (*help_extra)(FILE *out); /* then called when not NULL (help built from the library) */
     int spring;                    /* 1: the command takes --D1 ... --H */
     int argc;
     char **argv;

@@ -27,18 +27,32 @@ static const char export_help[] =
     "reaction at every step is written in its header. Row count and error go to stderr.\n"
     "Units: mm, N, s, tonne (stated inside each file).\n\n"
     "  FIT.json         '-' reads the fit file from standard input\n"
-    "  --format F       json | csv | calculix | abaqus | febio | lsdyna | sofa\n"
+    "  --format F       one of the formats below (default: the format -o's extension names)\n"
     "  --type T         telescoping | non-telescoping (default: the fit's better type)\n"
     "  -o, --output F   output file (default, or '-': standard output); written atomically\n"
     "  --tol REL        table tolerance as a fraction of F_C, 1e-9..0.1 (default 1e-4; for\n"
-    "                   calculix/abaqus, without --tol, the smallest of 1e-4, 2e-4, 5e-4, ...\n"
-    "                   whose table fits CalculiX's 200 pairs)\n"
+    "                   formats whose target reads a limited table, without --tol, the\n"
+    "                   smallest of 1e-4, 2e-4, 5e-4, ... whose table fits (CalculiX: 200 pairs))\n"
     "  --range LO:HI    compressions (mm, > 0 shortens) the table covers, LO <= 0 <= HI, e.g.\n"
     "                   0:4.5 for compression only (default: full stretch to just before solid)\n"
-    "  --example        a complete one-spring model that runs as it is (every format but json\n"
-    "                   and csv; sofa always writes a scene)\n"
+    "  --example        a complete one-spring model that runs as it is (formats with models;\n"
+    "                   sofa always writes a scene)\n"
     "  --lattice        the whole lattice model (see above)\n\n"
     "FIT.json is a fit file (conifit fit -o) or an exported spring (--format json).\n";
+
+/* The formats, from the export module's registry. */
+static void formats_help(FILE *out)
+{
+    fputs("\nFormats (--format; models: also --example and --lattice):\n"
+          "  name      file   models  what the block is\n",
+          out);
+    for (int f = 0; f < CF_EXPORT_FORMAT_COUNT; f++) {
+        const cf_export_format_info *fi = cf_export_format_get((cf_export_format)f);
+        fprintf(out, "  %-9s %-6s %-7s %s\n", fi->name, fi->extension, fi->model ? "yes" : "no",
+                fi->description);
+    }
+    fputc('\n', out);
+}
 
 /* Parses "LO:HI" (mm). */
 static cf_status parse_range(const char *text, double *lo, double *hi, cf_error *err)
@@ -129,6 +143,7 @@ int cf_cli_export(int argc, char **argv)
     export_args ea = {cf_export_default_options(), NULL, 0, 0, 0};
     cf_cli_parser p;
     int rc = cf_cli_parser_init(&p, "export", export_help, 0, argc, argv, "", own);
+    p.help_extra = formats_help;
     if (rc || (rc = cf_cli_parse(&p, export_option, &ea)) >= 0)
         return rc;
     cf_export_options opt = ea.opt;
@@ -142,15 +157,19 @@ int cf_cli_export(int argc, char **argv)
         return cf_cli_usage_error("export", "unexpected argument '%s'", argv[optind + npos - 1]);
     const char *fit_path = argv[optind];
     const char *scene_path = npos == 2 ? argv[optind + 1] : NULL;
-    if (!have_format)
-        return cf_cli_usage_error("export", "missing option --format");
-    if (opt.example && (opt.format == CF_EXPORT_JSON || opt.format == CF_EXPORT_CSV))
-        return cf_cli_usage_error("export", "--example needs a simulator format (calculix, "
-                                            "abaqus, febio, lsdyna or sofa): json and csv are "
-                                            "data, not models");
-    if (lattice && (opt.format == CF_EXPORT_JSON || opt.format == CF_EXPORT_CSV))
-        return cf_cli_usage_error("export", "--lattice needs a simulator format (calculix, "
-                                            "abaqus, febio, lsdyna or sofa)");
+    if (!have_format) {
+        if (!out_path || cf_cli_is_stdio(out_path))
+            return cf_cli_usage_error("export", "missing option --format");
+        if (cf_export_format_of_path(out_path, &opt.format, &err) != CF_OK)
+            return cf_cli_usage_error("export", "missing option --format: %s", err.msg);
+    }
+    const cf_export_format_info *fi = cf_export_format_get(opt.format);
+    char models[128];
+    if ((opt.example || lattice) && !fi->model)
+        return cf_cli_usage_error("export", "%s needs a simulator format (%s): %s is data, not "
+                                            "a model",
+                                  opt.example ? "--example" : "--lattice",
+                                  cf_export_format_list(models, sizeof models, 1), fi->name);
     if (lattice && (opt.example || opt.have_range))
         return cf_cli_usage_error("export", "--lattice takes neither --example nor --range (the "
                                             "lattice's tables cover the whole travel)");
@@ -214,19 +233,19 @@ int cf_cli_export(int argc, char **argv)
         return cf_cli_fail(&err);
     }
     free(buf);
-    if (quiet || opt.format == CF_EXPORT_JSON)
+    if (quiet || !fi->table)
         return CF_EXIT_OK;
     if (lattice)
         fprintf(stderr,
                 "conifit export: %s lattice, %zu nodes, %zu springs in %zu groups, %zu load "
                 "steps; tables of %zu rows, max error %.3g of F_C (%.3g N), tol %g\n",
-                cf_export_format_name(opt.format), rep.nodes, rep.springs, rep.groups, rep.steps,
+                fi->name, rep.nodes, rep.springs, rep.groups, rep.steps,
                 rep.rows, rep.max_err_rel, rep.max_err_N, rep.tol);
     else
         fprintf(stderr,
                 "conifit export: %s, %zu rows, max error %.3g of F_C (%.3g N), tol %g, table "
                 "over u in [%.10g, %.10g] mm\n",
-                cf_export_format_name(opt.format), rep.rows, rep.max_err_rel, rep.max_err_N,
+                fi->name, rep.rows, rep.max_err_rel, rep.max_err_N,
                 rep.tol, rep.u_lo_mm, rep.u_hi_mm);
     return CF_EXIT_OK;
 }

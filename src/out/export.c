@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include <jansson.h>
 
@@ -15,30 +16,6 @@
 #include "conifit/version.h"
 #include "io/fitfile_json.h"
 #include "out/export_model.h"
-
-/* ---- formats ---------------------------------------------------------------------------------- */
-
-static const char *const format_names[] = {"json",  "csv",    "calculix", "abaqus",
-                                           "febio", "lsdyna", "sofa"};
-
-cf_status cf_export_format_parse(const char *name, cf_export_format *format, cf_error *err)
-{
-    for (size_t i = 0; i < sizeof format_names / sizeof format_names[0]; i++)
-        if (name && strcmp(name, format_names[i]) == 0) {
-            *format = (cf_export_format)i;
-            return CF_OK;
-        }
-    return cf_error_set(err, CF_E_DATA,
-                        "unknown export format '%s' (expected json, csv, calculix, abaqus, "
-                        "febio, lsdyna or sofa)",
-                        name ? name : "(null)");
-}
-
-const char *cf_export_format_name(cf_export_format format)
-{
-    size_t i = (size_t)format;
-    return i < sizeof format_names / sizeof format_names[0] ? format_names[i] : "?";
-}
 
 cf_export_options cf_export_default_options(void)
 {
@@ -68,12 +45,22 @@ static void block_header(FILE *out, const char *lead, const char *tail, const ch
     cf_export_comment_table(out, lead, tail, t, law);
 }
 
-static cf_status write_json(FILE *out, const cf_fitted_spring *fs, const cf_law *law,
-                            const cf_export_options *opt, cf_error *err)
+/* What a block writer writes from: the fitted spring, its law, the table of the law (none for
+** formats without a table) and the options. */
+typedef struct block_job {
+    const cf_fitted_spring *fs;
+    const cf_law *law;
+    const cf_export_table *t;
+    const cf_export_options *opt;
+} block_job;
+
+static cf_status write_json(FILE *out, const block_job *j, cf_error *err)
 {
+    const cf_fitted_spring *fs = j->fs;
+    const cf_export_options *opt = j->opt;
     json_t *root = json_pack("{s:s, s:s}", "schema", CF_SPRINGFILE_SCHEMA, "conifit_version",
                              CF_VERSION);
-    json_t *spring = cf_fitfile_spring_json(law);
+    json_t *spring = cf_fitfile_spring_json(j->law);
     json_t *units = json_object(), *prov = json_object();
     if (!root || !spring || !units || !prov) {
         json_decref(root);
@@ -111,35 +98,50 @@ static cf_status write_json(FILE *out, const cf_fitted_spring *fs, const cf_law 
 }
 
 
-static void write_csv(FILE *out, const cf_export_table *t)
+static cf_status write_csv(FILE *out, const block_job *j, cf_error *err)
 {
+    (void)err;
+    const cf_export_table *t = j->t;
     fprintf(out, "u_mm,force_N,stiffness_N_per_mm\n");
     for (size_t i = 0; i < t->rows; i++)
         fprintf(out, "%.17g,%.17g,%.17g\n", t->u_mm[i], t->F_N[i], t->k_N_per_mm[i]);
+    return CF_OK;
 }
 
 /* CalculiX and Abaqus share the *SPRING layout: force first, then elongation, ascending in
 ** elongation; tension positive, so each row is (-F(u), -u) read from the top of the table. */
-static void write_inp_block(FILE *out, const cf_law *law, const cf_export_table *t,
-                            const cf_export_options *opt)
+static void write_inp_block(FILE *out, const block_job *j, const char *what)
 {
-    block_header(out, "** ", "",
-                 opt->format == CF_EXPORT_ABAQUS
-                     ? "conical spring as a nonlinear Abaqus SPRINGA table"
-                     : "conical spring as a nonlinear CalculiX SPRINGA table",
-                 law, t, opt);
+    const cf_export_table *t = j->t;
+    block_header(out, "** ", "", what, j->law, t, j->opt);
     fprintf(out, "** CalculiX holds the force of the last pair beyond the table (constant force)\n");
     fprintf(out, "*SPRING, ELSET=CONIFIT_SPRING, NONLINEAR\n\n");
     for (size_t i = t->rows; i-- > 0;)
         cf_export_inp_pair(out, -t->F_N[i], -t->u_mm[i]);
 }
 
-static void write_febio_block(FILE *out, const cf_law *law, const cf_export_table *t,
-                              const cf_export_options *opt)
+static cf_status write_calculix(FILE *out, const block_job *j, cf_error *err)
 {
+    (void)err;
+    write_inp_block(out, j, "conical spring as a nonlinear CalculiX SPRINGA table");
+    return CF_OK;
+}
+
+static cf_status write_abaqus(FILE *out, const block_job *j, cf_error *err)
+{
+    (void)err;
+    write_inp_block(out, j, "conical spring as a nonlinear Abaqus SPRINGA table");
+    return CF_OK;
+}
+
+static cf_status write_febio(FILE *out, const block_job *j, cf_error *err)
+{
+    (void)err;
+    const cf_law *law = j->law;
+    const cf_export_table *t = j->t;
     fprintf(out, "<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?>\n");
     block_header(out, "<!-- ", " -->", "conical spring for FEBio 4 as a nonlinear spring", law, t,
-                 opt);
+                 j->opt);
     fprintf(out, "<!-- beyond the table the force is held constant (extend CONSTANT); for a "
                  "model that runs as it is use the example or the lattice export -->\n");
     fprintf(out, "<febio_spec version=\"4.0\">\n");
@@ -158,17 +160,19 @@ static void write_febio_block(FILE *out, const cf_law *law, const cf_export_tabl
     fprintf(out, "\t\t\t\t</points>\n\t\t\t</force>\n\t\t</discrete_material>\n");
     fprintf(out, "\t\t<discrete dmat=\"1\" discrete_set=\"conifit_springs\"/>\n");
     fprintf(out, "\t</Discrete>\n</febio_spec>\n");
+    return CF_OK;
 }
 
 /* LS-DYNA keyword cards: 10-character fields; the curve's points in two 20-character fields.
 ** LCINT (field 8 of the curve's first card) is the row count: LS-DYNA otherwise resamples the
 ** curve to 100 equally spaced points. */
-static void write_lsdyna_block(FILE *out, const cf_law *law, const cf_export_table *t,
-                               const cf_export_options *opt)
+static cf_status write_lsdyna(FILE *out, const block_job *j, cf_error *err)
 {
+    (void)err;
+    const cf_export_table *t = j->t;
     block_header(out, "$ ", "",
-                 "conical spring for LS-DYNA as *MAT_SPRING_NONLINEAR_ELASTIC (MAT_S04)", law, t,
-                 opt);
+                 "conical spring for LS-DYNA as *MAT_SPRING_NONLINEAR_ELASTIC (MAT_S04)", j->law,
+                 t, j->opt);
     fprintf(out, "$ LCINT = rows, so that LS-DYNA does not resample the curve to 100 points\n");
     fprintf(out, "*KEYWORD\n*MAT_SPRING_NONLINEAR_ELASTIC\n");
     fprintf(out, "$#     mid       lcd       lcr\n");
@@ -181,6 +185,123 @@ static void write_lsdyna_block(FILE *out, const cf_law *law, const cf_export_tab
     for (size_t i = t->rows; i-- > 0;)
         fprintf(out, "%20.12e%20.12e\n", -t->u_mm[i], -t->F_N[i]);
     fprintf(out, "*END\n");
+    return CF_OK;
+}
+
+/* ---- the registry of formats ------------------------------------------------------------------ */
+
+/* One format: what callers see, the writer of its block (NULL: the block is the one-spring model)
+** and the writer of its models (NULL: no models), and, for a format whose target reads tables of at
+** most info.max_rows rows, whose limit that is (for the message). */
+typedef struct format_def {
+    cf_export_format_info info;
+    cf_status (*block)(FILE *out, const block_job *j, cf_error *err);
+    int (*model)(FILE *out, const cf_xmodel *m);
+    const char *limited_by;
+} format_def;
+
+/* Indexed by cf_export_format; each entry: {format, name, extension, description, model, table,
+** max_rows}, block writer, model writer, limited_by. */
+static const format_def formats[CF_EXPORT_FORMAT_COUNT] = {
+    [CF_EXPORT_JSON] = {{CF_EXPORT_JSON, "json", ".json",
+      "the spring itself (schema " CF_SPRINGFILE_SCHEMA "), for any tool", 0, 0, 0},
+     write_json, NULL, NULL},
+    [CF_EXPORT_CSV] = {{CF_EXPORT_CSV, "csv", ".csv",
+      "the law's table: u_mm,force_N,stiffness_N_per_mm, for any tool", 0, 1, 0},
+     write_csv, NULL, NULL},
+    [CF_EXPORT_CALCULIX] = {{CF_EXPORT_CALCULIX, "calculix", ".inp",
+      "CalculiX ccx 2.20+: a *SPRING table for SPRINGA elements", 1, 1,
+      CF_EXPORT_CALCULIX_MAX_ROWS},
+     write_calculix, cf_xmodel_write_calculix, "CalculiX"},
+    [CF_EXPORT_ABAQUS] = {{CF_EXPORT_ABAQUS, "abaqus", ".inp",
+      "Abaqus/Standard: the same *SPRING table (kept to CalculiX's 200 rows)", 1, 1,
+      CF_EXPORT_CALCULIX_MAX_ROWS},
+     write_abaqus, cf_xmodel_write_abaqus, "CalculiX"},
+    [CF_EXPORT_FEBIO] = {{CF_EXPORT_FEBIO, "febio", ".feb",
+      "FEBio 4: a nonlinear-spring discrete material", 1, 1, 0},
+     write_febio, cf_xmodel_write_febio, NULL},
+    [CF_EXPORT_LSDYNA] = {{CF_EXPORT_LSDYNA, "lsdyna", ".k",
+      "LS-DYNA: *MAT_SPRING_NONLINEAR_ELASTIC with its *DEFINE_CURVE", 1, 1, 0},
+     write_lsdyna, cf_xmodel_write_lsdyna, NULL},
+    [CF_EXPORT_SOFA] = {{CF_EXPORT_SOFA, "sofa", ".scn",
+      "SOFA v24.06+: always a scene (springs as sums of polynomial springs)", 1, 1, 0},
+     NULL, cf_xmodel_write_sofa, NULL},
+};
+
+static const format_def *format_def_of(cf_export_format f)
+{
+    return (unsigned)f < CF_EXPORT_FORMAT_COUNT ? &formats[f] : NULL;
+}
+
+const cf_export_format_info *cf_export_format_get(cf_export_format format)
+{
+    const format_def *d = format_def_of(format);
+    return d ? &d->info : NULL;
+}
+
+const char *cf_export_format_name(cf_export_format format)
+{
+    const format_def *d = format_def_of(format);
+    return d ? d->info.name : "?";
+}
+
+const char *cf_export_format_list(char *buf, size_t cap, int models_only)
+{
+    size_t n = 0, k = 0, len = 0;
+    for (size_t i = 0; i < CF_EXPORT_FORMAT_COUNT; i++)
+        n += !models_only || formats[i].info.model;
+    if (cap)
+        buf[0] = '\0';
+    for (size_t i = 0; i < CF_EXPORT_FORMAT_COUNT && len < cap; i++) {
+        if (models_only && !formats[i].info.model)
+            continue;
+        const char *sep = k == 0 ? "" : k + 1 == n ? " or " : ", ";
+        int w = snprintf(buf + len, cap - len, "%s%s", sep, formats[i].info.name);
+        len += w > 0 ? (size_t)w : 0;
+        k++;
+    }
+    return buf;
+}
+
+cf_status cf_export_format_parse(const char *name, cf_export_format *format, cf_error *err)
+{
+    for (size_t i = 0; i < CF_EXPORT_FORMAT_COUNT; i++)
+        if (name && strcmp(name, formats[i].info.name) == 0) {
+            *format = formats[i].info.format;
+            return CF_OK;
+        }
+    char list[256];
+    return cf_error_set(err, CF_E_DATA, "unknown export format '%s' (expected %s)",
+                        name ? name : "(null)", cf_export_format_list(list, sizeof list, 0));
+}
+
+cf_status cf_export_format_of_path(const char *path, cf_export_format *format, cf_error *err)
+{
+    const char *dot = path ? strrchr(path, '.') : NULL;
+    const char *slash = path ? strrchr(path, '/') : NULL;
+    size_t found = 0;
+    char names[256] = "";
+    if (dot && (!slash || dot > slash))
+        for (size_t i = 0; i < CF_EXPORT_FORMAT_COUNT; i++)
+            if (strcasecmp(dot, formats[i].info.extension) == 0) {
+                if (found++ == 0)
+                    *format = formats[i].info.format;
+                const size_t len = strlen(names);
+                snprintf(names + len, sizeof names - len, "%s%s", len ? " or " : "",
+                         formats[i].info.name);
+            }
+    if (found == 1)
+        return CF_OK;
+    if (found > 1)
+        return cf_error_set(err, CF_E_DATA, "'%s' could be %s: name the format", path, names);
+    return cf_error_set(err, CF_E_DATA, "no export format writes files named like '%s'",
+                        path ? path : "(null)");
+}
+
+int cf_xmodel_write(FILE *out, const cf_xmodel *m, cf_export_format f)
+{
+    const format_def *d = format_def_of(f);
+    return d && d->model ? d->model(out, m) : -1;
 }
 
 /* ---- the table of a format -------------------------------------------------------------------- */
@@ -190,7 +311,8 @@ static void write_lsdyna_block(FILE *out, const cf_law *law, const cf_export_tab
 cf_status cf_export_table_for(const cf_law *law, const cf_export_options *opt,
                               cf_export_table *t, cf_error *err)
 {
-    const int capped = opt->format == CF_EXPORT_CALCULIX || opt->format == CF_EXPORT_ABAQUS;
+    const format_def *d = format_def_of(opt->format);
+    const size_t max_rows = d ? d->info.max_rows : 0;
     double tol = opt->tol;
     for (int step = 0;; step++) {
         cf_status st;
@@ -200,13 +322,13 @@ cf_status cf_export_table_for(const cf_law *law, const cf_export_options *opt,
             st = cf_export_table_build(law, tol, t, err);
         if (st != CF_OK)
             return st;
-        if (!capped || t->rows <= CF_EXPORT_CALCULIX_MAX_ROWS)
+        if (!max_rows || t->rows <= max_rows)
             return CF_OK;
         const size_t rows = t->rows;
         cf_export_table_free(t);
         if (!opt->auto_tol || tol >= CF_EXPORT_TOL_MAX) {
             /* rows grow like tol^(-1/2): find the tolerance that fits, to report it */
-            double need = tol * pow((double)rows / CF_EXPORT_CALCULIX_MAX_ROWS, 2.0);
+            double need = tol * pow((double)rows / (double)max_rows, 2.0);
             for (int k = 0; k < 20 && need <= CF_EXPORT_TOL_MAX; k++, need *= 1.1) {
                 cf_export_table probe;
                 cf_error e2 = {0};
@@ -215,20 +337,32 @@ cf_status cf_export_table_for(const cf_law *law, const cf_export_options *opt,
                         ? cf_export_table_build_range(law, need, opt->u_lo_mm, opt->u_hi_mm,
                                                       &probe, &e2)
                         : cf_export_table_build(law, need, &probe, &e2);
-                const int fits = s2 == CF_OK && probe.rows <= CF_EXPORT_CALCULIX_MAX_ROWS;
+                const int fits = s2 == CF_OK && probe.rows <= max_rows;
                 cf_export_table_free(&probe);
                 if (fits)
                     break;
             }
             return cf_error_set(err, CF_E_DATA,
-                                "CalculiX reads at most %d (force, elongation) pairs per spring, "
+                                "%s reads at most %zu (force, elongation) pairs per spring, "
                                 "but tolerance %g of F_C needs %zu rows for this spring (rho = "
                                 "%.4g); tolerance %.2g fits%s",
-                                CF_EXPORT_CALCULIX_MAX_ROWS, tol, rows, law->rho, need,
+                                d->limited_by, max_rows, tol, rows, law->rho, need,
                                 opt->have_range ? "" : ", or a narrower range");
         }
         tol = fmin(CF_EXPORT_TOL_MAX, (step % 3 == 1) ? tol * 2.5 : tol * 2.0);
     }
+}
+
+cf_export_report cf_export_report_of_table(const cf_export_table *t)
+{
+    cf_export_report r = {0};
+    r.rows = t->rows;
+    r.tol = t->tol;
+    r.max_err_rel = t->max_err_rel;
+    r.max_err_N = t->max_err_N;
+    r.u_lo_mm = t->u_lo_mm;
+    r.u_hi_mm = t->u_hi_mm;
+    return r;
 }
 
 /* ---- models ----------------------------------------------------------------------------------- */
@@ -283,6 +417,11 @@ static int single_model(cf_xmodel *m, const cf_law *law, const cf_export_table *
 cf_status cf_export_write(FILE *out, const cf_fitted_spring *fs, const cf_export_options *opt,
                           cf_export_report *rep, cf_error *err)
 {
+    const format_def *d = format_def_of(opt->format);
+    if (!d)
+        return cf_error_set(err, CF_E_INTERNAL, "unknown export format %d", (int)opt->format);
+    if (opt->example && !d->model)
+        return cf_error_set(err, CF_E_DATA, "format %s writes no model", d->info.name);
     cf_law law;
     cf_export_table t = {0};
     cf_export_report r = {0};
@@ -290,41 +429,26 @@ cf_status cf_export_write(FILE *out, const cf_fitted_spring *fs, const cf_export
     cf_status st = cf_law_init(&law, &fs->params, err);
     if (st != CF_OK)
         return st;
-    if (opt->format == CF_EXPORT_JSON) {
-        st = write_json(out, fs, &law, opt, err);
-        goto done;
+    if (d->info.table) {
+        if ((st = cf_export_table_for(&law, opt, &t, err)) != CF_OK)
+            goto done;
+        r = cf_export_report_of_table(&t);
     }
-    if ((st = cf_export_table_for(&law, opt, &t, err)) != CF_OK)
-        goto done;
-    r.tol = t.tol;
-    r.rows = t.rows;
-    r.max_err_rel = t.max_err_rel;
-    r.max_err_N = t.max_err_N;
-    r.u_lo_mm = t.u_lo_mm;
-    r.u_hi_mm = t.u_hi_mm;
-    if (opt->format == CF_EXPORT_CSV) {
-        write_csv(out, &t);
-    } else if (opt->example || opt->format == CF_EXPORT_SOFA) {
+    if (d->block && !opt->example) {
+        const block_job j = {fs, &law, &t, opt};
+        if ((st = d->block(out, &j, err)) != CF_OK)
+            goto done;
+    } else {
         m.law = &law;
         m.base = &t;
         m.source = src_name(opt);
-        if (single_model(&m, &law, &t) != 0 || cf_xmodel_write(out, &m, opt->format) != 0) {
+        if (single_model(&m, &law, &t) != 0 || d->model(out, &m) != 0) {
             st = cf_error_set(err, CF_E_INTERNAL, "out of memory writing the model");
             goto done;
         }
-    } else if (opt->format == CF_EXPORT_CALCULIX || opt->format == CF_EXPORT_ABAQUS) {
-        write_inp_block(out, &law, &t, opt);
-    } else if (opt->format == CF_EXPORT_FEBIO) {
-        write_febio_block(out, &law, &t, opt);
-    } else if (opt->format == CF_EXPORT_LSDYNA) {
-        write_lsdyna_block(out, &law, &t, opt);
-    } else {
-        st = cf_error_set(err, CF_E_INTERNAL, "unknown export format %d", (int)opt->format);
-        goto done;
     }
     if (ferror(out))
-        st = cf_error_set(err, CF_E_CANTWRITE, "cannot write the %s export",
-                          cf_export_format_name(opt->format));
+        st = cf_error_set(err, CF_E_CANTWRITE, "cannot write the %s export", d->info.name);
 done:
     if (rep)
         *rep = r;

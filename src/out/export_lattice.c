@@ -207,6 +207,10 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
     cf_export_report r = {0};
     char title[256];
     memset(&lat, 0, sizeof lat);
+    const cf_export_format_info *fi = cf_export_format_get(opt->format);
+    if (!fi || !fi->model)
+        return cf_error_set(err, CF_E_DATA, "format %s writes no model",
+                            cf_export_format_name(opt->format));
     if (lx->nsteps == 0 || lx->nsteps > CF_EXPORT_MAX_STEPS)
         return cf_error_set(err, CF_E_DATA, "%zu load steps: a lattice export takes 1 to %d",
                             lx->nsteps, CF_EXPORT_MAX_STEPS);
@@ -287,12 +291,7 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
         }
     if (cf_xmodel_tables(&m) != 0 || cf_xmodel_write(out, &m, opt->format) != 0)
         goto oom;
-    r.rows = t.rows;
-    r.tol = t.tol;
-    r.max_err_rel = t.max_err_rel;
-    r.max_err_N = t.max_err_N;
-    r.u_lo_mm = t.u_lo_mm;
-    r.u_hi_mm = t.u_hi_mm;
+    r = cf_export_report_of_table(&t);
     r.groups = m.ng;
     r.springs = m.ns;
     r.nodes = m.nn;

@@ -184,7 +184,7 @@ static void model_header(FILE *out, const char *lead, const char *tail, const cf
 ** defaults of the *CONTROLS, PARAMETERS=FIELD line. */
 static const char inp_controls[] = "1.e-9,1.e-6,0.01,,0.02,1.e-5,1.e-3,1.e-8\n";
 
-void cf_xmodel_write_inp(FILE *out, const cf_xmodel *m, int abaqus)
+static void write_inp(FILE *out, const cf_xmodel *m, int abaqus)
 {
     const char *target = abaqus ? "Abaqus/Standard" : "CalculiX (ccx)";
     model_header(out, "** ", "", m, target,
@@ -228,13 +228,25 @@ void cf_xmodel_write_inp(FILE *out, const cf_xmodel *m, int abaqus)
     }
 }
 
+int cf_xmodel_write_calculix(FILE *out, const cf_xmodel *m)
+{
+    write_inp(out, m, 0);
+    return 0;
+}
+
+int cf_xmodel_write_abaqus(FILE *out, const cf_xmodel *m)
+{
+    write_inp(out, m, 1);
+    return 0;
+}
+
 /* ---- FEBio 4 ---------------------------------------------------------------------------------- */
 
 /* The fixed-direction masks that occur, in a fixed order, with FEBio set names. */
 static const char *const mask_name[8] = {"", "fix_x", "fix_y", "fix_xy",
                                          "fix_z", "fix_xz", "fix_yz", "fix_xyz"};
 
-void cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
+int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
 {
     fprintf(out, "<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?>\n");
     model_header(out, "<!-- ", " -->", m, "FEBio 4",
@@ -316,6 +328,7 @@ void cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
     fprintf(out, "\t<Output>\n\t\t<logfile>\n\t\t\t<node_data data=\"Rz\" delim=\",\" "
                  "file=\"NAME_top_Rz.txt\" node_set=\"top\"/>\n\t\t</logfile>\n\t</Output>\n");
     fprintf(out, "</febio_spec>\n");
+    return 0;
 }
 
 /* ---- LS-DYNA ---------------------------------------------------------------------------------- */
@@ -327,7 +340,7 @@ static int dyna_tc(unsigned mask)
     return tc[mask & 7u];
 }
 
-void cf_xmodel_write_lsdyna(FILE *out, const cf_xmodel *m)
+int cf_xmodel_write_lsdyna(FILE *out, const cf_xmodel *m)
 {
     model_header(out, "$ ", "", m, "LS-DYNA (implicit static)",
                  "ls-dyna i=NAME.k (top reaction: spcforc / bndout of the prescribed motion)");
@@ -377,6 +390,7 @@ void cf_xmodel_write_lsdyna(FILE *out, const cf_xmodel *m)
     for (size_t k = 0; k < m->nsteps; k++)
         fprintf(out, "%20.12e%20.12e\n", (double)(k + 1), m->dz_mm[k]);
     fprintf(out, "*END\n");
+    return 0;
 }
 
 /* ---- SOFA ------------------------------------------------------------------------------------- */
@@ -528,26 +542,4 @@ int cf_xmodel_write_sofa(FILE *out, const cf_xmodel *m)
     free(terms);
     fprintf(out, "\t</Node>\n</Node>\n");
     return 0;
-}
-
-int cf_xmodel_write(FILE *out, const cf_xmodel *m, cf_export_format f)
-{
-    switch (f) {
-    case CF_EXPORT_CALCULIX:
-        cf_xmodel_write_inp(out, m, 0);
-        return 0;
-    case CF_EXPORT_ABAQUS:
-        cf_xmodel_write_inp(out, m, 1);
-        return 0;
-    case CF_EXPORT_FEBIO:
-        cf_xmodel_write_febio(out, m);
-        return 0;
-    case CF_EXPORT_LSDYNA:
-        cf_xmodel_write_lsdyna(out, m);
-        return 0;
-    case CF_EXPORT_SOFA:
-        return cf_xmodel_write_sofa(out, m);
-    default:
-        return -1;
-    }
 }

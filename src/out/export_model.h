@@ -55,8 +55,8 @@ void cf_xmodel_free(cf_xmodel *m);
 /* Fills the group tables from m->base (each group's L0 and weight set). 0, or -1 out of memory. */
 int cf_xmodel_tables(cf_xmodel *m);
 
-/* Writes m in format f (calculix, abaqus, febio, lsdyna, sofa): 0, or -1 for another format or
-** when memory runs out. */
+/* Writes m in format f through the format's model writer (export.c's registry): 0, or -1 for a
+** format without models or when memory runs out. */
 int cf_xmodel_write(FILE *out, const cf_xmodel *m, cf_export_format f);
 
 /* The table of the law for opt: its range and tolerance, kept to CalculiX's 200 pairs for
@@ -65,11 +65,15 @@ int cf_xmodel_write(FILE *out, const cf_xmodel *m, cf_export_format f);
 cf_status cf_export_table_for(const cf_law *law, const cf_export_options *opt,
                               cf_export_table *t, cf_error *err);
 
-/* Writers of runnable models. */
-void cf_xmodel_write_inp(FILE *out, const cf_xmodel *m, int abaqus);
-void cf_xmodel_write_febio(FILE *out, const cf_xmodel *m);
-void cf_xmodel_write_lsdyna(FILE *out, const cf_xmodel *m);
-int cf_xmodel_write_sofa(FILE *out, const cf_xmodel *m); /* -1: out of memory */
+/* The report of a table: its rows, tolerance, achieved error and range (the rest zero). */
+cf_export_report cf_export_report_of_table(const cf_export_table *t);
+
+/* The writers of runnable models, one per target: 0, or -1 when memory runs out. */
+int cf_xmodel_write_calculix(FILE *out, const cf_xmodel *m);
+int cf_xmodel_write_abaqus(FILE *out, const cf_xmodel *m);
+int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m);
+int cf_xmodel_write_lsdyna(FILE *out, const cf_xmodel *m);
+int cf_xmodel_write_sofa(FILE *out, const cf_xmodel *m);
 
 /* Writes one (force, elongation) pair of a *SPRING table, each number with a decimal point: ccx
 ** decides from the first line under *SPRING whether it holds degrees of freedom (integers) or

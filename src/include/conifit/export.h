@@ -42,6 +42,9 @@
 ** curve. Exports for CalculiX (and Abaqus, so that the same file runs in both) keep to 200. */
 #define CF_EXPORT_CALCULIX_MAX_ROWS 200
 
+/* The export formats. What each is and what writes it is held in one registry (src/out/export.c):
+** a new format is a value here and an entry there; the command line builds its help, its
+** --format check and its messages from the registry. */
 typedef enum cf_export_format {
     CF_EXPORT_JSON = 0,
     CF_EXPORT_CSV,
@@ -49,8 +52,37 @@ typedef enum cf_export_format {
     CF_EXPORT_ABAQUS,
     CF_EXPORT_FEBIO,
     CF_EXPORT_LSDYNA,
-    CF_EXPORT_SOFA
+    CF_EXPORT_SOFA,
+    CF_EXPORT_FORMAT_COUNT
 } cf_export_format;
+
+/* One entry of the registry, as callers see it. */
+typedef struct cf_export_format_info {
+    cf_export_format format;
+    const char *name;        /* the value of --format: "calculix" */
+    const char *extension;   /* the usual file name ending, with its dot: ".inp" */
+    const char *description; /* one line: the target and what the block is */
+    int model;               /* 1: writes runnable models (one spring, or the lattice) */
+    int table;               /* 1: writes the law as a table (json writes the spring itself) */
+    size_t max_rows;         /* most rows the target reads in one table, 0 for no limit */
+} cf_export_format_info;
+
+/* The entry of a format, NULL for a value outside the enum. Formats run 0 .. COUNT - 1. */
+const cf_export_format_info *cf_export_format_get(cf_export_format format);
+
+/* Parses a format name; CF_E_DATA naming every format otherwise. */
+cf_status cf_export_format_parse(const char *name, cf_export_format *format, cf_error *err);
+
+/* The format whose extension ends path: CF_OK with *format; CF_E_DATA when none does, or when
+** several share it (the message names them). */
+cf_status cf_export_format_of_path(const char *path, cf_export_format *format, cf_error *err);
+
+/* The name of a format ("?" outside the enum). */
+const char *cf_export_format_name(cf_export_format format);
+
+/* Writes the names of the formats (all, or only those that write models) into buf as an English
+** list, "a, b or c"; returns buf (truncated to cap). */
+const char *cf_export_format_list(char *buf, size_t cap, int models_only);
 
 /* A force-displacement table of the law, rows ascending in u. */
 typedef struct cf_export_table {
@@ -151,9 +183,5 @@ cf_status cf_export_lattice_from_scene(const cf_scene *sc, const char *name,
 cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
                                   const cf_export_options *opt, const cf_export_lattice *lx,
                                   cf_export_report *rep, cf_error *err);
-
-/* Parses json | csv | calculix | abaqus | febio | lsdyna | sofa; CF_E_DATA otherwise. */
-cf_status cf_export_format_parse(const char *name, cf_export_format *format, cf_error *err);
-const char *cf_export_format_name(cf_export_format format);
 
 #endif
