@@ -75,21 +75,6 @@ static double tension(const cf_law *law, double e)
     return -cf_law_force(law, CF_LAW_EXACT, -e, NULL, NULL);
 }
 
-static char *slurp(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *buf = malloc((size_t)n + 1);
-    size_t got = fread(buf, 1, (size_t)n, f);
-    buf[got] = '\0';
-    fclose(f);
-    return buf;
-}
-
 /* Runs `conifit export FIT ARGS -o DIR/name` and returns the file's text (caller frees). */
 static char *export_file(const char *fit, const char *name, const char *args)
 {
@@ -99,7 +84,7 @@ static char *export_file(const char *fit, const char *name, const char *args)
         fail_msg("conifit export %s %s exited %d: %s", fit, args, rc, err);
     char p[160];
     snprintf(p, sizeof p, "%s/%s", dir, name);
-    char *text = slurp(p);
+    char *text = tu_slurp(p);
     assert_non_null(text);
     return text;
 }
@@ -739,7 +724,7 @@ static void calculix_runs_the_one_spring_example_and_matches_the_law(void **stat
         assert_int_equal(n, 6);
         char p[160];
         snprintf(p, sizeof p, "%s/%s.dat", dir, job);
-        char *dat = slurp(p);
+        char *dat = tu_slurp(p);
         assert_non_null(dat);
         assert_int_equal(parse_totals(dat, rz, 16), n);
         const double tol = header_reaction_tol(x);
@@ -790,7 +775,7 @@ static void calculix_holds_the_last_force_beyond_the_table(void **state)
     fclose(f);
     run_ccx("hold_model");
     snprintf(path, sizeof path, "%s/hold_model.dat", dir);
-    char *dat = slurp(path);
+    char *dat = tu_slurp(path);
     assert_non_null(dat);
     double rz[4];
     assert_int_equal(parse_totals(dat, rz, 4), 2);
@@ -840,7 +825,7 @@ static void calculix_runs_the_lattice_and_matches_conifit_simulate_at_every_step
                      0);
     char p[160];
     snprintf(p, sizeof p, "%s/lat.csv", dir);
-    char *csv = slurp(p);
+    char *csv = tu_slurp(p);
     assert_non_null(csv);
     double strain[64], stress_kPa[64];
     int ns = 0;
@@ -854,7 +839,7 @@ static void calculix_runs_the_lattice_and_matches_conifit_simulate_at_every_step
     }
     assert_int_equal(ns, 12);
     snprintf(p, sizeof p, "%s/lat.dat", dir);
-    char *dat = slurp(p);
+    char *dat = tu_slurp(p);
     assert_non_null(dat);
     double rz[64], dz[64], ref[64];
     assert_int_equal(parse_totals(dat, rz, 64), ns);

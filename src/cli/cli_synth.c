@@ -178,8 +178,10 @@ static void write_header(FILE *fp, const synth_args *a, const cf_law *law, doubl
         fprintf(fp, " %s", argv[i]);
     }
     fprintf(fp, "\n");
-    fprintf(fp, "# spring: D1_mm=%.17g D2_mm=%.17g n=%.17g d_mm=%.17g G_MPa=%.17g H_mm=%.17g\n",
-            p->D1_mm, p->D2_mm, p->n, p->d_mm, p->G_MPa, p->H_mm);
+    fprintf(fp, "# spring:");
+    for (int k = 0; k < CF_P_COUNT; k++)
+        fprintf(fp, " %s=%.17g", cf_spring_param_info(k)->key, cf_spring_get(p, k));
+    fprintf(fp, "\n");
     fprintf(fp, "# type: %s ((D2 - D1)/2 = %.10g mm %s n d = %.10g mm)\n",
             cf_spring_type_name(law->type), 0.5 * (p->D2_mm - p->D1_mm),
             law->type == CF_TELESCOPING ? ">=" : "<", p->n * p->d_mm);

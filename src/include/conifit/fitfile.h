@@ -8,20 +8,22 @@
 **               "y_column": "stress", "y_unit": "kPa", "kind": "stress-strain" | "force-displacement",
 **               "sign": "tension-positive" | "compression-negative" },
 **     "fits": [ { "type": "telescoping" | "non-telescoping",
-**                 "params":  { "D1_mm", "D2_mm", "n", "d_mm", "G_MPa", "H_mm" },
+**                 "params":  { one number per design parameter, under its key },
 **                 "derived": { "rho", "travel_mm", "solid_strain", "F_T_N", "F_C_N",
 **                              "k0_N_per_mm", "u_T_mm", "index_c", "L_min_mm", "L_max_mm" },
 **                 "rmse", "max_abs_error", "r2", ... } , ... ],
 **     "better_type": "telescoping" | "non-telescoping" | null (the types tie),
 **     ...
 **   }
+** The keys of "params" are those of the spring's field table (cf_spring_param_info, spring.h), in
+** its order; `tests/test_spring.c` checks the README's lists of them against it.
 ** Only "fits[].type", "fits[].params" (and the provenance fields if present) are needed to read a
 ** spring back; everything else is report.
 **
 ** The same reader takes a single exported spring (`conifit export --format json`), recognised by
 ** its "schema" key:
 **   { "schema": "conifit-spring-1", "conifit_version": "0.1.0", "type": "telescoping",
-**     "params": { "D1_mm", "D2_mm", "n", "d_mm", "G_MPa", "H_mm" },
+**     "params": { ... as above ... },
 **     "derived": { ... as above ... }, "units": { ... },
 **     "provenance": { "fit_file", "data_file", "rmse", "rmse_unit", "fit_version" } }
 */

@@ -1,0 +1,112 @@
+/*
+** Tests of the spring's field table (src/model/spring.c), the one description of the design
+** parameters that every reader, writer, report, export and option works from:
+**  - the table is whole: names, units, keys and meanings present and unique, bounds ordered,
+**    lookup by name and by key, get and set touching their own field only;
+**  - the README's lists of the JSON keys (the fit file's "params", the scene and the exported
+**    spring) are the table's keys in its order, so that renaming a key in the table and not in
+**    the documentation fails here.
+*/
+#include "testutil.h"
+
+#include "conifit/spring.h"
+
+static void the_field_table_is_whole_and_found_by_name_and_key(void **state)
+{
+    (void)state;
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        const cf_spring_param *sp = cf_spring_param_info(k);
+        assert_non_null(sp);
+        assert_true(sp->name[0] && sp->unit[0] && sp->key[0] && sp->meaning[0]);
+        assert_true(isfinite(sp->lower) && isfinite(sp->upper) && sp->lower > 0 &&
+                    sp->lower < sp->upper);
+        assert_int_equal(cf_spring_param_find(sp->name), k);
+        assert_int_equal(cf_spring_param_find(sp->key), k);
+        for (int j = 0; j < k; j++) {
+            assert_string_not_equal(cf_spring_param_info(j)->name, sp->name);
+            assert_string_not_equal(cf_spring_param_info(j)->key, sp->key);
+        }
+        /* set and get reach field k alone */
+        cf_spring p;
+        memset(&p, 0, sizeof p);
+        cf_spring_set(&p, k, 1.5 + k);
+        for (int j = 0; j < CF_P_COUNT; j++)
+            assert_close(cf_spring_get(&p, j), j == k ? 1.5 + k : 0.0, 0.0);
+    }
+    assert_null(cf_spring_param_info(-1));
+    assert_null(cf_spring_param_info(CF_P_COUNT));
+    assert_int_equal(cf_spring_param_find("D3"), -1);
+    assert_int_equal(cf_spring_param_find(NULL), -1);
+    /* the struct's fields are the table's, in its order */
+    const cf_spring s = {1, 2, 3, 4, 5, 6};
+    for (int k = 0; k < CF_P_COUNT; k++)
+        assert_close(cf_spring_get(&s, k), k + 1.0, 0.0);
+}
+
+/* Checks the keys of one list, from `from` to the closing brace: each key stands between two
+** `quote` characters; in a JSON object (json = 1) only the names before a ':' count. */
+static void check_list(const char *from, char quote, int json)
+{
+    const char *end = strchr(from, '}');
+    assert_non_null(end);
+    int k = 0;
+    const char *p = from;
+    while ((p = memchr(p, quote, (size_t)(end - p))) != NULL) {
+        const char *q = memchr(p + 1, quote, (size_t)(end - p - 1));
+        assert_non_null(q);
+        const char *after = q + 1;
+        while (*after == ' ')
+            after++;
+        if (!json || *after == ':') {
+            if (k >= CF_P_COUNT)
+                fail_msg("README: a params list has more than %d keys: '%.*s'", CF_P_COUNT,
+                         (int)(end - from), from);
+            const char *want = cf_spring_param_info(k)->key;
+            if (strlen(want) != (size_t)(q - p - 1) || strncmp(p + 1, want, strlen(want)) != 0)
+                fail_msg("README: key %d of a params list is '%.*s', the field table's is '%s' "
+                         "(src/model/spring.c); list: '%.*s'",
+                         k + 1, (int)(q - p - 1), p + 1, want, (int)(end - from), from);
+            k++;
+        }
+        p = q + 1;
+    }
+    if (k != CF_P_COUNT)
+        fail_msg("README: a params list has %d keys, the field table %d: '%.*s'", k, CF_P_COUNT,
+                 (int)(end - from), from);
+}
+
+static void the_readme_lists_the_keys_of_the_field_table(void **state)
+{
+    (void)state;
+    char *readme = tu_slurp("README.md");
+    if (!readme)
+        fail_msg("README.md not found (the tests run from the repository's top level)");
+    int lists = 0;
+    /* JSON examples: "params": { "KEY": value, ... } */
+    for (const char *p = strstr(readme, "\"params\""); p; p = strstr(p + 1, "\"params\"")) {
+        const char *q = p + strlen("\"params\"");
+        while (*q == ' ' || *q == ':')
+            q++;
+        if (*q != '{' || strncmp(q, "{...}", 5) == 0) /* "{...}": a placeholder, no list */
+            continue;
+        check_list(q, '"', 1);
+        lists++;
+    }
+    /* prose: `params` {`KEY`, ...} */
+    for (const char *p = strstr(readme, "`params` {"); p; p = strstr(p + 1, "`params` {")) {
+        check_list(p + strlen("`params` "), '`', 0);
+        lists++;
+    }
+    /* the fit file, the scene and the exported spring: at least these three lists */
+    assert_true(lists >= 3);
+    free(readme);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(the_field_table_is_whole_and_found_by_name_and_key),
+        cmocka_unit_test(the_readme_lists_the_keys_of_the_field_table),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
