@@ -27,7 +27,9 @@ WARN    := -Wall -Wextra -Wpedantic -Wshadow -Wmissing-prototypes -Wstrict-proto
 ifeq ($(WERROR),1)
 WARN    += -Werror
 endif
-OPT     ?= -O2 -g -fno-math-errno
+# -fno-trapping-math: no code tests floating-point exception flags, and it lets the vectoriser
+# compute both sides of a selection (the law's lanes, model/law_simd.h); results are unchanged.
+OPT     ?= -O2 -g -fno-math-errno -fno-trapping-math
 CPPFLAGS += -D_DEFAULT_SOURCE -Isrc/include -Isrc
 # SuiteSparse CHOLMOD (sparse Cholesky of the lattice tangent): newer releases ship CHOLMOD.pc;
 # Debian 12's libsuitesparse-dev has none and keeps its headers in include/suitesparse.

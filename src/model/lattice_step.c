@@ -56,8 +56,9 @@ void cf_lattice_stepper_free(cf_lattice_stepper *st)
     memset(st, 0, sizeof *st);
 }
 
-/* Springs [q0, q1) in blocks: gather, geometry and law (vectorised), scatter. form is a constant
-** in every call site, so each copy is specialised. */
+/* Springs [q0, q1) in blocks: gather and geometry, the law, tensions (each a vectorised loop over
+** the block, so no lane's work hides behind a branch), then the scatter. form is a constant in every
+** call site, so each copy is specialised. */
 static inline __attribute__((always_inline)) double
 springs_range(const cf_lattice *lat, const cf_law_lanes *lanes, int form, size_t q0, size_t q1)
 {
@@ -66,49 +67,53 @@ springs_range(const cf_lattice *lat, const cf_law_lanes *lanes, int form, size_t
     const double *restrict L0 = lat->L0_mm, *restrict A = lat->a, *restrict W = lat->w;
     double *restrict fx = lat->fx, *restrict fy = lat->fy, *restrict fz = lat->fz;
     const cf_law_lanes c = *lanes;
-    double dx[CF_STEP_BLOCK], dy[CF_STEP_BLOCK], dz[CF_STEP_BLOCK], g[CF_STEP_BLOCK];
+    double dx[CF_STEP_BLOCK], dy[CF_STEP_BLOCK], dz[CF_STEP_BLOCK], L[CF_STEP_BLOCK],
+        u[CF_STEP_BLOCK], F[CF_STEP_BLOCK];
     double umax = 0;
     for (size_t b = q0; b < q1; b += CF_STEP_BLOCK) {
         const size_t m = q1 - b < CF_STEP_BLOCK ? q1 - b : CF_STEP_BLOCK;
         const uint32_t *restrict bi = si + b, *restrict bj = sj + b;
+        const double *restrict bL0 = L0 + b, *restrict bA = A + b, *restrict bW = W + b;
 #pragma omp simd
         for (size_t k = 0; k < m; k++) {
-            dx[k] = x[bj[k]] - x[bi[k]];
-            dy[k] = y[bj[k]] - y[bi[k]];
-            dz[k] = z[bj[k]] - z[bi[k]];
+            const double ex = x[bj[k]] - x[bi[k]], ey = y[bj[k]] - y[bi[k]],
+                         ez = z[bj[k]] - z[bi[k]];
+            dx[k] = ex, dy[k] = ey, dz[k] = ez;
+            const double d2 = ex * ex + ey * ey + ez * ez;
+            L[k] = sqrt(d2);
+            u[k] = (bL0[k] - L[k]) * bA[k];
         }
-        if (form >= 0) {
 #pragma omp simd reduction(max : umax)
-            for (size_t k = 0; k < m; k++) {
-                const double L = sqrt(dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]);
-                const double u = (L0[b + k] - L) * A[b + k];
-                const double au = fabs(u);
-                umax = au > umax ? au : umax;
-                const double F = form == CF_LANE_TABLE ? cf_lane_table(&c, u) : cf_lane_closed(&c, u);
-                g[k] = -W[b + k] * F / L;
-            }
-        } else { /* the scalar law: lengths, then one batch call, then tensions */
-            double L[CF_STEP_BLOCK], u[CF_STEP_BLOCK], F[CF_STEP_BLOCK];
-            for (size_t k = 0; k < m; k++) {
-                L[k] = sqrt(dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]);
-                u[k] = (L0[b + k] - L[k]) * A[b + k];
-                const double au = fabs(u[k]);
-                umax = au > umax ? au : umax;
-            }
-            cf_law_force_many(lat->law, lat->method, m, u, F, NULL);
-            for (size_t k = 0; k < m; k++)
-                g[k] = -W[b + k] * F[k] / L[k];
+        for (size_t k = 0; k < m; k++) {
+            const double au = fabs(u[k]);
+            umax = au > umax ? au : umax;
         }
+        if (form == CF_LANE_TABLE)
+            cf_lanes_table(&c, m, u, F);
+        else if (form == CF_LANE_CLOSED)
+            cf_lanes_closed(&c, m, u, F);
+        else /* the scalar law */
+            cf_law_force_many(lat->law, lat->method, m, u, F, NULL);
+#pragma omp simd
+        for (size_t k = 0; k < m; k++) {
+            const double gk = -bW[k] * F[k] / L[k];
+            dx[k] *= gk, dy[k] *= gk, dz[k] *= gk;
+        }
+        /* the scatter: a node's run of springs (they are sorted by first node) is summed in
+        ** registers and stored once, not read back from the store it just made */
+        uint32_t ci = bi[0];
+        double ax = 0, ay = 0, az = 0;
         for (size_t k = 0; k < m; k++) {
             const uint32_t i = bi[k], j = bj[k];
-            const double gx = g[k] * dx[k], gy = g[k] * dy[k], gz = g[k] * dz[k];
-            fx[i] += gx;
-            fy[i] += gy;
-            fz[i] += gz;
-            fx[j] -= gx;
-            fy[j] -= gy;
-            fz[j] -= gz;
+            if (i != ci) {
+                fx[ci] += ax, fy[ci] += ay, fz[ci] += az;
+                ax = ay = az = 0;
+                ci = i;
+            }
+            ax += dx[k], ay += dy[k], az += dz[k];
+            fx[j] -= dx[k], fy[j] -= dy[k], fz[j] -= dz[k];
         }
+        fx[ci] += ax, fy[ci] += ay, fz[ci] += az;
     }
     return umax;
 }

@@ -1,9 +1,11 @@
 /*
 ** The explicit step of the lattice in two fused passes, for runs where every step counts (haptic
 ** rates, large lattices):
-**   springs: in blocks of CF_STEP_BLOCK springs, gather the end positions, then lengths,
-**            compressions, law forces and tensions in one vectorised loop (law_simd.h), then
-**            scatter the equal and opposite forces into the node forces;
+**   springs: in blocks of CF_STEP_BLOCK springs, vectorised loops over the block gather the end
+**            positions and form lengths and compressions, evaluate the law (law_simd.h) and the
+**            tension vectors; then a scalar loop scatters the equal and opposite forces into the
+**            node forces, summing each first node's run of springs in registers (a sum through
+**            memory would wait on its own store at every spring);
 **   nodes:   symplectic Euler (v += h f/m, x += h v) and the node forces reset for the next step.
 ** Springs are visited in their storage order, which is by first node, so the gathers and scatters
 ** of a block fall on a few layers of nodes that stay in cache. Per spring the pass reads the two

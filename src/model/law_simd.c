@@ -9,13 +9,8 @@ void cf_law_force_lanes(const cf_law_lanes *lanes, int form, size_t count, const
                         double *F)
 {
     const cf_law_lanes c = *lanes; /* by value: its loads leave the loop */
-    if (form == CF_LANE_TABLE && c.coef) {
-#pragma omp simd
-        for (size_t i = 0; i < count; i++)
-            F[i] = cf_lane_table(&c, u[i]);
-    } else {
-#pragma omp simd
-        for (size_t i = 0; i < count; i++)
-            F[i] = cf_lane_closed(&c, u[i]);
-    }
+    if (form == CF_LANE_TABLE && c.coef)
+        cf_lanes_table(&c, count, u, F);
+    else
+        cf_lanes_closed(&c, count, u, F);
 }

@@ -17,6 +17,12 @@
 ** Table: the cubic Hermite table of law.c, stored per interval as the coefficients of its
 ** polynomial in the local coordinate (one cache line per lookup); the same values as law.c's.
 **
+** Vectorisation: every loop over lanes must if-convert, so no lane's work may sit behind a
+** condition the compiler keeps as a branch (a table lookup inside the region selection, a clamp it
+** specialises): the table's lookup is a loop of its own, and the build passes -fno-trapping-math
+** so that both sides of a selection may be computed. Each clone (baseline SSE2, AVX2, AVX-512)
+** vectorises; they compute the same operations, so they give the same bits.
+**
 ** Private to the model layer.
 */
 #ifndef CF_MODEL_LAW_SIMD_H
@@ -103,19 +109,51 @@ CF_LANE double cf_lane_closed(const cf_law_lanes *c, double u)
     return cf_lane_regions(c, u, a, c->F_C * y * y * y);
 }
 
-CF_LANE double cf_lane_table(const cf_law_lanes *c, double u)
+/* Region 2's y from the table, for every lane whatever its region (the caller selects): the
+** interval index is clamped into the table, so the four coefficient loads are always in bounds
+** and need no mask. */
+CF_LANE double cf_lane_table_y(const cf_law_lanes *c, double u)
 {
-    const double a = fabs(u);
-    const double sa = c->s - a;
+    const double sa = c->s - fabs(u);
     const double w = sqrt((sa > 0.0 ? sa : 0.0) * c->inv_s);
-    double x = w * c->inv_h;
-    double xi = x < c->xmax ? x : c->xmax; /* NaN and region 1 land on the last interval */
-    xi = xi > 0.0 ? xi : 0.0;
-    const size_t i = (size_t)(int32_t)xi;
+    const double x = w * c->inv_h;
+    /* x >= 0 (or NaN); NaN and region 1 land on the last interval */
+    const double xi = x < c->xmax ? x : c->xmax;
+    const int32_t i = (int32_t)xi;
     const double q = x - (double)i;
-    const double *k = c->coef + 4 * i;
-    const double y = k[0] + q * (k[1] + q * (k[2] + q * k[3]));
-    return cf_lane_regions(c, u, a, c->F_C * y * y * y);
+    const double *k = c->coef;
+    const int32_t j = 4 * i;
+    return k[j] + q * (k[j + 1] + q * (k[j + 2] + q * k[j + 3]));
+}
+
+/* Forces F[k] of count displacements u[k] (F may be u), each form a few vectorised loops over
+** chunks: the table's y of every lane first, stored, then the regions; a lookup inside the
+** region selection would be a conditional load, which the compiler does not vectorise. */
+#define CF_LANE_CHUNK 256
+
+CF_LANE void cf_lanes_closed(const cf_law_lanes *c, size_t count, const double *u, double *F)
+{
+#pragma omp simd
+    for (size_t k = 0; k < count; k++)
+        F[k] = cf_lane_closed(c, u[k]);
+}
+
+CF_LANE void cf_lanes_table(const cf_law_lanes *c, size_t count, const double *u, double *F)
+{
+    double yv[CF_LANE_CHUNK];
+    for (size_t b = 0; b < count; b += CF_LANE_CHUNK) {
+        const size_t m = count - b < CF_LANE_CHUNK ? count - b : CF_LANE_CHUNK;
+        const double *ub = u + b;
+        double *Fb = F + b;
+#pragma omp simd
+        for (size_t k = 0; k < m; k++)
+            yv[k] = cf_lane_table_y(c, ub[k]);
+#pragma omp simd
+        for (size_t k = 0; k < m; k++) {
+            const double yk = yv[k];
+            Fb[k] = cf_lane_regions(c, ub[k], fabs(ub[k]), c->F_C * yk * yk * yk);
+        }
+    }
 }
 
 /* Forces of count displacements with the closed form or the table (lanes->coef not NULL):
