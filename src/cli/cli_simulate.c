@@ -1,7 +1,7 @@
 /*
 ** The `simulate` subcommand: runs a scene (scene.h) on the mass-spring lattice, writes the curve
-** as CSV, prints a summary (loop energy, residual strain, creep or relaxation end values) and
-** optionally plots it with gnuplot.
+** as CSV, prints a summary (loop energy, residual strain and the recovery test from hysteresis.h,
+** creep or relaxation end values) and optionally plots it with gnuplot.
 */
 #include <math.h>
 #include <stdio.h>
@@ -13,6 +13,7 @@
 #include "base/atomic.h"
 #include "cli/cli.h"
 #include "conifit/budget.h"
+#include "conifit/hysteresis.h"
 #include "conifit/msm.h"
 #include "conifit/scene.h"
 #include "out/plot.h"
@@ -43,78 +44,32 @@ static const char simulate_help[] =
     "                      solves (default 1e7)\n"
     "The estimates are made before anything runs; a refused scene exits 65 naming the key.\n";
 
-/* Strain left at zero force is not a permanent set: a viscous lattice creeps back. For a cycles
-** scene with dashpots or Maxwell branches (no inertia) this runs one force-driven cycle from the
-** virgin state to the scene's peak stress, unloads to zero force and holds it for ten periods (or
-** ten relaxation times, if longer), and prints the strain at zero force and at the end of the
-** hold. Returns the strain at the end of the hold (NAN when not run). */
-static double recovery(FILE *o, const cf_scene *sc, const cf_law *law, const cf_msm_sample *s,
-                       size_t n)
+/* The recovery test (hysteresis.h), printed: whether the strain left at zero force recovers. */
+static void recovery(FILE *o, const cf_scene *sc, const cf_law *law, const cf_msm_sample *s,
+                     size_t n)
 {
-    if (sc->kind != CF_PROTO_CYCLES || sc->drive != CF_DRIVE_DISPLACEMENT || sc->effects.inertia ||
-        !(sc->effects.eta_MPa_s > 0 || sc->effects.maxwell_E_MPa > 0) || sc->npath < 3)
-        return NAN;
-    double peak = 0;
-    for (size_t k = 0; k < n; k++)
-        peak = fmax(peak, s[k].stress_MPa);
-    const double T = sc->path_t_s[2] - sc->path_t_s[0];
-    const double hold = 10 * fmax(T, sc->effects.maxwell_E_MPa > 0 ? sc->effects.maxwell_tau_s : 0);
-    double t[4] = {0, T / 2, T, T + hold}, v[4] = {0, peak, 0, 0};
-    cf_msm_path path = {CF_DRIVE_FORCE, 4, t, v};
-    enum { NS = 60 };
-    double ts[NS];
-    cf_msm_sample out[NS];
-    for (int k = 0; k < 20; k++)
-        ts[k] = T * (k + 1) / 20.0;
-    for (int k = 20; k < NS; k++)
-        ts[k] = T + hold * (k - 19) / (double)(NS - 20);
-    cf_lattice lat;
+    cf_hysteresis_recovery r;
     cf_error err = {0};
-    cf_msm_config cfg = sc->cfg;
-    cfg.progress = NULL;
-    if (cf_lattice_create(&lat, law, sc->method, &cfg.lattice, &err) != CF_OK)
-        return NAN;
-    cf_status st = cf_msm_run(&lat, &sc->effects, &cfg, &path, ts, NS, out, NULL, NULL, &err);
-    cf_lattice_free(&lat);
-    if (st != CF_OK) {
+    if (cf_hysteresis_recovery_test(sc, law, s, n, &r, &err) != CF_OK) {
         fprintf(o, "recovery test not run: %s\n", err.msg);
-        return NAN;
+        return;
     }
-    double e0 = out[19].strain, e1 = out[NS - 1].strain;
+    if (!r.ran)
+        return;
     fprintf(o, "recovery (one force-driven cycle to the peak stress %.6g kPa, then zero force held "
                "%.6g s): strain at zero force %.6g, after the hold %.6g: %s\n",
-            peak * 1e3, hold, e0, e1,
-            fabs(e1) <= 1e-3 * fabs(e0) + 1e-12
-                ? "no permanent set (the springs are elastic; the strain left at zero force is "
-                  "viscous and recovers)"
-                : "not recovered within the hold");
-    return e1;
+            r.peak_MPa * 1e3, r.hold_s, r.zero_strain, r.end_strain,
+            r.recovered ? "no permanent set (the springs are elastic; the strain left at zero "
+                          "force is viscous and recovers)"
+                        : "not recovered within the hold");
 }
 
-/* Index of the first sample whose tangent had a negative pivot (n when none). */
-static size_t first_unstable(const cf_msm_sample *s, size_t n)
-{
-    for (size_t k = 0; k < n; k++)
-        if (s[k].neg_pivots > 0)
-            return k;
-    return n;
-}
-
-/* Area of the closed loop(s) in the stress-strain plane over samples [a, b], kPa = kJ/m^3. */
 /* Progress on a terminal: one line, rewritten after every sample. */
 static void show_progress(void *ctx, size_t done, size_t total, double t_s)
 {
     (void)ctx;
     fprintf(stderr, "\rconifit simulate: sample %zu of %zu (t = %.4g s)", done, total, t_s);
     fflush(stderr);
-}
-
-static double loop_area(const cf_msm_sample *s, size_t a, size_t b)
-{
-    double A = 0;
-    for (size_t k = a + 1; k <= b; k++)
-        A += 0.5 * (s[k].stress_MPa + s[k - 1].stress_MPa) * (s[k].strain - s[k - 1].strain);
-    return A * 1e3;
 }
 
 static void summary(FILE *o, const cf_scene *sc, const cf_msm_sample *s, size_t n, const cf_msm_stats *st)
@@ -136,7 +91,7 @@ static void summary(FILE *o, const cf_scene *sc, const cf_msm_sample *s, size_t 
         fprintf(o, "solves: %zu, Newton iterations: %zu, linear solves: %zu\n", st->solves,
                st->newton_iters, st->linear_iters);
     fprintf(o, "largest spring compression: %.4g of travel\n", st->max_u_over_travel);
-    size_t lost = first_unstable(s, n);
+    size_t lost = cf_hysteresis_first_unstable(s, n);
     if (lost < n)
         fprintf(o, "lattice loses stability at strain %.6g (t = %.6g s): from there on the static "
                 "equilibrium is unstable (its tangent has %ld negative pivots; a column of cells "
@@ -145,24 +100,13 @@ static void summary(FILE *o, const cf_scene *sc, const cf_msm_sample *s, size_t 
     else if (!sc->effects.inertia)
         fprintf(o, "lattice stable at every sample (every factored tangent positive definite)\n");
     if (sc->kind == CF_PROTO_CYCLES) {
-        size_t per = (n - 1) / (size_t)sc->cycles;
         for (int c = 0; c < sc->cycles; c++) {
-            size_t a = (size_t)c * per, b = a + per;
-            fprintf(o, "cycle %d: dissipated energy %.6g kJ/m^3 (= kPa), ", c + 1,
-                   loop_area(s, a, b));
-            if (sc->drive == CF_DRIVE_FORCE) {
-                fprintf(o, "strain at zero force after unloading %.6g\n", s[b].strain);
-            } else {
-                /* Strain at which the unloading branch first carries no stress. */
-                double eu = s[b].strain;
-                for (size_t k = a + per / 2; k < b; k++)
-                    if (s[k].stress_MPa > 0 && s[k + 1].stress_MPa <= 0) {
-                        double f = s[k].stress_MPa / (s[k].stress_MPa - s[k + 1].stress_MPa);
-                        eu = s[k].strain + f * (s[k + 1].strain - s[k].strain);
-                        break;
-                    }
-                fprintf(o, "strain where the unloading stress reaches zero %.6g\n", eu);
-            }
+            const cf_hysteresis_cycle cy = cf_hysteresis_cycle_of(sc, s, n, c);
+            fprintf(o, "cycle %d: dissipated energy %.6g kJ/m^3 (= kPa), %s %.6g\n", c + 1,
+                    cy.energy_kPa,
+                    sc->drive == CF_DRIVE_FORCE ? "strain at zero force after unloading"
+                                                : "strain where the unloading stress reaches zero",
+                    cy.zero_strain);
         }
     } else if (sc->kind == CF_PROTO_HOLD) {
         size_t r = (n - 1) / 2; /* end of the ramp (two segments of equal sample counts) */
@@ -366,7 +310,7 @@ int cf_cli_simulate(int argc, char **argv)
         gsl_rng_free(rng);
     } else {
         fprintf(a.fp, "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,stable\n");
-        size_t lost = first_unstable(samples, sc.nsamples);
+        size_t lost = cf_hysteresis_first_unstable(samples, sc.nsamples);
         for (size_t k = 0; k < sc.nsamples; k++)
             fprintf(a.fp, "%.17g,%.17g,%.17g,%.17g,%.17g,%d\n", samples[k].t_s, samples[k].strain,
                     samples[k].stress_MPa * 1e3, samples[k].kinetic_mJ, spring[k] * 1e3,
