@@ -157,66 +157,58 @@ static int close_out(cf_cli_out *out, cf_law *law)
     return cf_cli_out_close(out, &err) == CF_OK ? CF_EXIT_OK : cf_cli_fail(&err);
 }
 
-int cf_cli_force(int argc, char **argv)
+/* force, curve and info: parse (the options in `takes` beside the spring's), prepare the law,
+** open the output, write the command's result with body, close. Returns the exit status. */
+static int run(const char *cmd, const char *help, const char *takes, int argc, char **argv,
+               void (*body)(FILE *o, const law_args *a, const cf_law *law))
 {
     law_args a;
     cf_law law;
-    int rc = parse("force", force_help, "u method", argc, argv, &a);
+    cf_cli_out out;
+    int rc = parse(cmd, help, takes, argc, argv, &a);
     if (rc >= 0)
         return rc;
     if ((rc = prepare(&a, &law)) >= 0)
         return rc;
-    cf_cli_out out;
-    FILE *o = NULL;
     if ((rc = open_out(&a, &out, &law)) >= 0)
         return rc;
-    o = out.fp;
-    fprintf(o, "%.17g\n", cf_law_force(&law, a.method, a.u, NULL, NULL));
+    body(out.fp, &a, &law);
     return close_out(&out, &law);
+}
+
+static void force_body(FILE *o, const law_args *a, const cf_law *law)
+{
+    fprintf(o, "%.17g\n", cf_law_force(law, a->method, a->u, NULL, NULL));
+}
+
+int cf_cli_force(int argc, char **argv)
+{
+    return run("force", force_help, "u method", argc, argv, force_body);
+}
+
+static void curve_body(FILE *o, const law_args *a, const cf_law *law)
+{
+    const double s = law->travel_mm;
+    fprintf(o, "u_mm,force_N,stiffness_N_per_mm\n");
+    for (long i = 0; i < a->points; i++) {
+        /* symmetric sampling: -s + 2 s i/(N-1), with the ends exact */
+        double u = (i == a->points - 1) ? s : -s + 2.0 * s * (double)i / (double)(a->points - 1);
+        double k;
+        double F = cf_law_force(law, a->method, u, &k, NULL);
+        fprintf(o, "%.17g,%.17g,%.17g\n", u, F, k);
+    }
 }
 
 int cf_cli_curve(int argc, char **argv)
 {
-    law_args a;
-    cf_law law;
-    int rc = parse("curve", curve_help, "points method", argc, argv, &a);
-    if (rc >= 0)
-        return rc;
-    if ((rc = prepare(&a, &law)) >= 0)
-        return rc;
-    cf_cli_out out;
-    FILE *o = NULL;
-    if ((rc = open_out(&a, &out, &law)) >= 0)
-        return rc;
-    o = out.fp;
-    const double s = law.travel_mm;
-    fprintf(o, "u_mm,force_N,stiffness_N_per_mm\n");
-    for (long i = 0; i < a.points; i++) {
-        /* symmetric sampling: -s + 2 s i/(N-1), with the ends exact */
-        double u = (i == a.points - 1) ? s : -s + 2.0 * s * (double)i / (double)(a.points - 1);
-        double k;
-        double F = cf_law_force(&law, a.method, u, &k, NULL);
-        fprintf(o, "%.17g,%.17g,%.17g\n", u, F, k);
-    }
-    return close_out(&out, &law);
+    return run("curve", curve_help, "points method", argc, argv, curve_body);
 }
 
-int cf_cli_info(int argc, char **argv)
+static void info_body(FILE *o, const law_args *a, const cf_law *law)
 {
-    law_args a;
-    cf_law law;
-    int rc = parse("info", info_help, "", argc, argv, &a);
-    if (rc >= 0)
-        return rc;
-    if ((rc = prepare(&a, &law)) >= 0)
-        return rc;
-    cf_cli_out out;
-    FILE *o = NULL;
-    if ((rc = open_out(&a, &out, &law)) >= 0)
-        return rc;
-    o = out.fp;
-    const cf_spring *p = &law.p;
-    fprintf(o, "conical spring, %s\n", cf_spring_type_name(law.type));
+    (void)a;
+    const cf_spring *p = &law->p;
+    fprintf(o, "conical spring, %s\n", cf_spring_type_name(law->type));
     fprintf(o, "  %-34s %.10g mm\n", "D1 (smallest coil)", p->D1_mm);
     fprintf(o, "  %-34s %.10g mm\n", "D2 (largest coil)", p->D2_mm);
     fprintf(o, "  %-34s %.10g\n", "n (active coils)", p->n);
@@ -225,18 +217,22 @@ int cf_cli_info(int argc, char **argv)
     fprintf(o, "  %-34s %.10g mm\n", "H (free length)", p->H_mm);
     fprintf(o, "derived\n");
     fprintf(o, "  %-34s %s ((D2-D1)/2 = %.6g mm %s n d = %.6g mm)\n", "type",
-           cf_spring_type_name(law.type), 0.5 * (p->D2_mm - p->D1_mm),
-           law.type == CF_TELESCOPING ? ">=" : "<", p->n * p->d_mm);
-    fprintf(o, "  %-34s %.10g\n", "rho = D1/D2", law.rho);
-    fprintf(o, "  %-34s %.10g\n", "spring index c = D1/d", law.index_c);
-    fprintf(o, "  %-34s %.10g mm\n", "L_min (solid length)", law.L_min_mm);
-    fprintf(o, "  %-34s %.10g mm\n", "L_max (full stretch)", law.L_max_mm);
-    fprintf(o, "  %-34s %.10g mm\n", "travel s = H - L_min", law.travel_mm);
-    fprintf(o, "  %-34s %.10g\n", "solid strain s/H", law.travel_mm / p->H_mm);
-    fprintf(o, "  %-34s %.10g N/mm\n", "k0 (linear stiffness)", law.k0_N_per_mm);
-    fprintf(o, "  %-34s %.10g mm\n", "u_T (end of linear region)", law.u_T_mm);
-    fprintf(o, "  %-34s %.10g N\n", "F_T (transition load)", law.F_T_N);
-    fprintf(o, "  %-34s %.10g N\n", "F_C (solid load)", law.F_C_N);
-    fprintf(o, "  %-34s %.10g MPa\n", "F_C/H^2 (stress scale)", law.F_C_N / (p->H_mm * p->H_mm));
-    return close_out(&out, &law);
+           cf_spring_type_name(law->type), 0.5 * (p->D2_mm - p->D1_mm),
+           law->type == CF_TELESCOPING ? ">=" : "<", p->n * p->d_mm);
+    fprintf(o, "  %-34s %.10g\n", "rho = D1/D2", law->rho);
+    fprintf(o, "  %-34s %.10g\n", "spring index c = D1/d", law->index_c);
+    fprintf(o, "  %-34s %.10g mm\n", "L_min (solid length)", law->L_min_mm);
+    fprintf(o, "  %-34s %.10g mm\n", "L_max (full stretch)", law->L_max_mm);
+    fprintf(o, "  %-34s %.10g mm\n", "travel s = H - L_min", law->travel_mm);
+    fprintf(o, "  %-34s %.10g\n", "solid strain s/H", law->travel_mm / p->H_mm);
+    fprintf(o, "  %-34s %.10g N/mm\n", "k0 (linear stiffness)", law->k0_N_per_mm);
+    fprintf(o, "  %-34s %.10g mm\n", "u_T (end of linear region)", law->u_T_mm);
+    fprintf(o, "  %-34s %.10g N\n", "F_T (transition load)", law->F_T_N);
+    fprintf(o, "  %-34s %.10g N\n", "F_C (solid load)", law->F_C_N);
+    fprintf(o, "  %-34s %.10g MPa\n", "F_C/H^2 (stress scale)", law->F_C_N / (p->H_mm * p->H_mm));
+}
+
+int cf_cli_info(int argc, char **argv)
+{
+    return run("info", info_help, "", argc, argv, info_body);
 }

@@ -12,6 +12,7 @@
 #include "conifit/version.h"
 #include "base/atomic.h"
 #include "out/plot.h"
+#include "pipeline/outputs.h"
 
 cf_pipeline_options cf_pipeline_default_options(void)
 {
@@ -109,14 +110,17 @@ cf_status cf_pipeline_prepare(const cf_fit_report *r, const char *json_path,
 {
     memset(json_out, 0, sizeof *json_out);
     memset(plot_out, 0, sizeof *plot_out);
-    cf_status st = CF_OK;
-    if (json_path)
-        st = cf_report_json_prepare(r, json_path, inputs, json_out, err);
-    if (st == CF_OK && plot_path) {
+    cf_status st = json_path ? cf_report_json_prepare(r, json_path, inputs, json_out, err) : CF_OK;
+    if (st == CF_OK && plot_path)
         st = cf_plot_fit(r, plot_path, inputs, plot_out, err);
-        if (st == CF_OK)
-            st = cf_atomic_finish(plot_out, err);
-    }
+    return cf_pipeline_outputs_end(st, plot_path, json_out, plot_out, err);
+}
+
+cf_status cf_pipeline_outputs_end(cf_status st, const char *plot_path, cf_atomic *json_out,
+                                  cf_atomic *plot_out, cf_error *err)
+{
+    if (st == CF_OK && plot_path)
+        st = cf_atomic_finish(plot_out, err);
     if (st != CF_OK) {
         cf_atomic_abort(json_out);
         cf_atomic_abort(plot_out);

@@ -8,6 +8,7 @@
 
 #include "base/atomic.h"
 #include "conifit/version.h"
+#include "pipeline/outputs.h"
 
 /* The reported spring must carry the fitted model: a placement that the design limits pushed off
 ** the fitted rho, s/H, F_C/H^2 is replaced by the spring of cf_spring_member scaled to the
@@ -91,17 +92,9 @@ cf_status cf_pipeline_series_prepare(const cf_visco_report *r, const char *json_
 {
     memset(json_out, 0, sizeof *json_out);
     memset(plot_out, 0, sizeof *plot_out);
-    cf_status st = CF_OK;
-    if (json_path)
-        st = cf_visco_report_json_prepare(r, json_path, inputs, json_out, err);
-    if (st == CF_OK && plot_path) {
+    cf_status st =
+        json_path ? cf_visco_report_json_prepare(r, json_path, inputs, json_out, err) : CF_OK;
+    if (st == CF_OK && plot_path)
         st = cf_visco_plot(r, plot_path, inputs, plot_out, err);
-        if (st == CF_OK)
-            st = cf_atomic_finish(plot_out, err);
-    }
-    if (st != CF_OK) {
-        cf_atomic_abort(json_out);
-        cf_atomic_abort(plot_out);
-    }
-    return st;
+    return cf_pipeline_outputs_end(st, plot_path, json_out, plot_out, err);
 }
