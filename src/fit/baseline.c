@@ -13,6 +13,8 @@
 #include <gsl/gsl_min.h>
 #include <gsl/gsl_multifit.h>
 
+#include "fit/subsample.h"
+
 const char *cf_baseline_name(cf_baseline_kind kind)
 {
     switch (kind) {
@@ -42,15 +44,16 @@ double cf_baseline_aic(size_t n, double rss, int k, double ymax)
     return (double)n * log(r / (double)n) + 2.0 * k;
 }
 
-/* RSS of Fung's law with A solved for the given B (A returned). */
-static double fung_profile(const cf_table *d, double B, double *A)
+/* RSS of Fung's law with A solved for the given B (A returned); weighted by d->w when weighted
+** (the subsample of a long table, whose weights stand for the rows of each bin). */
+static double fung_profile(const cf_table *d, int weighted, double B, double *A)
 {
     double sgy = 0, sgg = 0, syy = 0;
     for (size_t i = 0; i < d->count; i++) {
-        double g = expm1(B * d->x[i]);
-        sgy += g * d->y[i];
-        sgg += g * g;
-        syy += d->y[i] * d->y[i];
+        double g = expm1(B * d->x[i]), w = weighted ? d->w[i] : 1.0;
+        sgy += w * g * d->y[i];
+        sgg += w * g * g;
+        syy += w * d->y[i] * d->y[i];
     }
     *A = (sgg > 0 && isfinite(sgg)) ? sgy / sgg : 0;
     double rss = syy - *A * sgy;
@@ -105,7 +108,7 @@ static int duffing_fit(const cf_table *d, double coef[2])
 static double fung_rss(double B, void *data)
 {
     double A;
-    return fung_profile(data, B, &A);
+    return fung_profile(data, 0, B, &A);
 }
 
 /* Refines the scan's best B in (lo, hi) with Brent's method on the profile RSS; returns B. */
@@ -147,25 +150,46 @@ void cf_baseline_fit_all(const cf_table *d, cf_baseline out[CF_BASE_COUNT])
         D->coef[0] = L->coef[0];
         D->coef[1] = 0;
     }
-    /* Fung: scan B over +-50/xmax (exp(50) covers any stiffening a table shows), then refine */
+    /* Fung: scan B over +-50/xmax (exp(50) covers any stiffening a table shows), then refine. A
+    ** long table is scanned on its subsample (subsample.h), then on every row from the best
+    ** point of the scan to the nearest minimum along the scan's grid. */
     *F = (cf_baseline){CF_BASE_FUNG, 2, {0, 0}, 0, 0, 0};
     double bmax = xmax > 0 ? 50.0 / xmax : 1.0;
-    double bestB = bmax / 400, bestR = INFINITY, A;
+    double bestR = INFINITY, A;
     const int N = 400;
+    int ib = 1;
+    cf_table sub;
+    const cf_table *scan = d;
+    if (d->count > CF_FIT_SUBSAMPLE_ABOVE && cf_subsample(d, CF_SUBSAMPLE_ROWS, &sub, NULL) == CF_OK)
+        scan = &sub;
     for (int i = -N; i <= N; i++) {
         if (i == 0)
             continue;
-        double B = bmax * (double)i / N;
-        double r = fung_profile(d, B, &A);
+        double r = fung_profile(scan, scan != d, bmax * (double)i / N, &A);
         if (r < bestR) {
             bestR = r;
-            bestB = B;
+            ib = i;
         }
     }
+    if (scan != d) {
+        cf_table_free(&sub);
+        bestR = fung_profile(d, 0, bmax * (double)ib / N, &A);
+        for (int dir = -1; dir <= 1; dir += 2)
+            for (;;) {
+                int j = ib + dir == 0 ? ib + 2 * dir : ib + dir;
+                double r = j >= -N && j <= N ? fung_profile(d, 0, bmax * (double)j / N, &A)
+                                             : INFINITY;
+                if (!(r < bestR))
+                    break;
+                bestR = r;
+                ib = j;
+            }
+    }
+    double bestB = bmax * (double)ib / N;
     double Bf = fung_refine(d, bestB, bestB - bmax / N, bestB + bmax / N);
-    if (fung_profile(d, Bf, &A) > bestR)
+    if (fung_profile(d, 0, Bf, &A) > bestR)
         Bf = bestB;
-    fung_profile(d, Bf, &A);
+    fung_profile(d, 0, Bf, &A);
     F->coef[0] = A;
     F->coef[1] = Bf;
     finish(d, L, ymax);

@@ -13,7 +13,6 @@
 #include <time.h>
 
 #include <gsl/gsl_blas.h>
-#include <gsl/gsl_cdf.h>
 #include <gsl/gsl_eigen.h>
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_multifit_nlinear.h>
@@ -22,6 +21,7 @@
 #include <nlopt.h>
 
 #include "fit/lsq.h"
+#include "fit/subsample.h"
 
 /* Constraint tolerances (constraints are in log units, i.e. relative): a constraint counts as
 ** violated beyond FEAS_TOL and active within ACTIVE_TOL of its limit. The optimisers see the
@@ -91,6 +91,7 @@ cf_fit_options cf_fit_default_options(void)
     o.seed = 1;
     o.multistart = 8;
     o.H_preferred_mm = 10.0;
+    o.subsample_above = CF_FIT_SUBSAMPLE_ABOVE;
     return o;
 }
 
@@ -423,14 +424,37 @@ typedef struct start {
     double obj, rho, B;
 } start;
 
+/* A result of stage A's Levenberg-Marquardt runs (at most 1 + multistart of them are kept). */
+typedef struct start4 {
+    double obj, v[3];
+} start4;
+#define STAGE_A_RUNS 64
+
+static void record(start4 *found, int *nfound, double obj, const double v[3])
+{
+    if (found && obj < CF_LSQ_HUGE_OBJ && *nfound < STAGE_A_RUNS) {
+        found[*nfound].obj = obj;
+        memcpy(found[*nfound].v, v, sizeof found[0].v);
+        (*nfound)++;
+    }
+}
+
+static int cmp_start4(const void *a, const void *b)
+{
+    double x = ((const start4 *)a)->obj, y = ((const start4 *)b)->obj;
+    return (x > y) - (x < y);
+}
+
 static int cmp_start(const void *a, const void *b)
 {
     double x = ((const start *)a)->obj, y = ((const start *)b)->obj;
     return (x > y) - (x < y);
 }
 
-/* Global stage over (rho, B) with A in closed form, then LM from the best starts. */
-static double stage_a(fit_ctx *c, double best3[3])
+/* Global stage over (rho, B) with A in closed form, then LM from the best starts. Each LM
+** result (objective, rho, B, A) goes to found[] when found is not NULL (at most
+** STAGE_A_RUNS, counted in *nfound). */
+static double stage_a(fit_ctx *c, double best3[3], start4 *found, int *nfound)
 {
     gsl_rng *rng = seeded_rng(c->opt->seed, 1);
     start grid[GRID * GRID];
@@ -460,6 +484,7 @@ static double stage_a(fit_ctx *c, double best3[3])
     two_point_start(c, &r, &B, &A);
     reduced_profile(c, r, B, &A);
     best = lm_run(c, r, B, A, best3);
+    record(found, nfound, best, best3);
     int used = 0;
     for (size_t i = 0; i < k && used < c->opt->multistart; i++) {
         /* skip starts that lie next to one already used */
@@ -472,6 +497,7 @@ static double stage_a(fit_ctx *c, double best3[3])
         used++;
         reduced_profile(c, grid[i].rho, grid[i].B, &A);
         double v = lm_run(c, grid[i].rho, grid[i].B, A, out);
+        record(found, nfound, v, out);
         if (v < best) {
             best = v;
             memcpy(best3, out, sizeof out);
@@ -590,13 +616,14 @@ static void constraint_values(const double *p, cf_spring_type type, double xmax,
             g[k] = 50.0;
 }
 
-int cf_fit_check(const cf_spring *sp, cf_spring_type type, const cf_table *data,
-                 const cf_fit_options *opt, unsigned *active, unsigned *violated)
+/* cf_fit_check for a table whose largest |x| is xmax (fd: force-displacement). */
+static int check_spring(const cf_spring *sp, cf_spring_type type, double xmax, int fd,
+                        const cf_fit_options *opt, unsigned *active, unsigned *violated)
 {
     double p[CF_P_COUNT], g[NCON];
     to_array(sp, p);
     unsigned act = 0, vio = 0;
-    constraint_values(p, type, cf_lsq_xmax(data), cf_table_is_force(data), opt, g);
+    constraint_values(p, type, xmax, fd, opt, g);
     for (int k = 0; k < NCON; k++) {
         if (g[k] > FEAS_TOL)
             vio |= con_bit[k];
@@ -629,6 +656,19 @@ int cf_fit_check(const cf_spring *sp, cf_spring_type type, const cf_table *data,
     if (violated)
         *violated = vio;
     return vio == 0;
+}
+
+int cf_fit_check(const cf_spring *sp, cf_spring_type type, const cf_table *data,
+                 const cf_fit_options *opt, unsigned *active, unsigned *violated)
+{
+    return check_spring(sp, type, cf_lsq_xmax(data), cf_table_is_force(data), opt, active,
+                        violated);
+}
+
+/* The check at the fit's own table, without a pass over it. */
+static int check_at(const fit_ctx *c, const cf_spring *sp, unsigned *active, unsigned *violated)
+{
+    return check_spring(sp, c->type, c->xmax, c->fd, c->opt, active, violated);
 }
 
 /* ---- stages B and C: NLopt over the free design parameters (log variables) ------------------- */
@@ -839,7 +879,7 @@ static void snap_to_family(fit_ctx *c, double *p, double *z)
         q[CF_P_G] = cf_lsq_G_of_FC(FC, q[CF_P_N], D1, d, s);
     }
     cf_spring sp = from_array(q);
-    if (!cf_fit_check(&sp, c->type, c->data, c->opt, NULL, NULL))
+    if (!check_at(c, &sp, NULL, NULL))
         return;
     memcpy(p, q, sizeof q);
     for (int k = 0; k < c->nfree; k++)
@@ -1112,6 +1152,56 @@ static int stage_a_constrained(fit_ctx *c, double v[3])
     return 1;
 }
 
+/* ---- a long table: the global stages on its subsample, then a polish on every row ------------ */
+
+/* Stage A's optima on the subsample polished by Levenberg-Marquardt on every row: the best one,
+** and up to POLISH_RUNS - 1 others, distinct from it, that the F-test on the subsample cannot tell
+** from it (a table that leaves the quantities open has a valley of optima of nearly equal depth,
+** and the deepest on every row may lie elsewhere in it); v receives the best on every row. */
+#define POLISH_RUNS 3
+static void stage_a_polish(fit_ctx *c, start4 *found, int nfound, double v[3])
+{
+    qsort(found, (size_t)nfound, sizeof found[0], cmp_start4);
+    const double er = 1e-12 * (c->rho_hi - c->rho_lo), eb = 1e-12 * (c->b_hi - c->b_lo);
+    const double dof = (double)c->n - 3, within = nfound > 0 ? found[0].obj * (1 + cf_lsq_f95(dof) / dof) : 0;
+    double best = CF_LSQ_HUGE_OBJ;
+    int done = 0;
+    for (int i = 0; i < nfound && done < POLISH_RUNS && (i == 0 || found[i].obj <= within); i++) {
+        const double *u = found[i].v;
+        int same = 0;
+        for (int j = 0; j < i && !same; j++)
+            same = fabs(found[j].v[0] - u[0]) <= 1e-3 * u[0] &&
+                   fabs(found[j].v[1] - u[1]) <= 1e-3 * u[1];
+        if (same || !(u[2] > 0 && isfinite(u[2])))
+            continue;
+        done++;
+        double rho = fmin(fmax(u[0], c->rho_lo + er), c->rho_hi - er);
+        double B = fmin(fmax(u[1], c->b_lo + eb), c->b_hi - eb), out[3];
+        double f = lm_run(c, rho, B, u[2], out);
+        if (f < best) {
+            best = f;
+            memcpy(v, out, sizeof out);
+        }
+    }
+}
+
+/* The constrained optimum v (found on the subsample) polished on every row, as stage_a_constrained
+** polishes each of its starts; v keeps its value when the polish finds no better point. */
+static void stage_a_constrained_polish(fit_ctx *c, double v[3])
+{
+    sub q = {c, -1, 0};
+    double x0[2] = {log(v[0]), v[1]}, x[2] = {x0[0], x0[1]};
+    double f0 = sub_g0(&q, x0) <= 1e-9 ? sub_f0(&q, x0) : CF_LSQ_HUGE_OBJ;
+    double f = sub_solve(c, &q, x, NLOPT_LN_COBYLA);
+    f = fmin(f, sub_solve(c, &q, x, NLOPT_LD_SLSQP));
+    if (f > f0 || !(f < CF_LSQ_HUGE_OBJ))
+        memcpy(x, x0, sizeof x);
+    v[0] = exp(x[0]);
+    v[1] = x[1];
+    region r = region_at(c, v[0], v[1]);
+    rss_at(c, v[0], v[1], -1, r.A_max, &v[2]);
+}
+
 /* Limits the quantities v sit on (CF_C_* bits): rho_min, the travel, the type's limits. */
 static unsigned held_at(const fit_ctx *c, const double v[3])
 {
@@ -1167,7 +1257,7 @@ static int region_member(fit_ctx *c, const double v[3], double *p)
             double q[CF_P_COUNT] = {D1, D1 / rho, n, d, 8 * n * D1 * D1 * D1 * FC / (d * d * d * d * s),
                                     H};
             cf_spring sp = from_array(q);
-            if (!cf_fit_check(&sp, c->type, c->data, c->opt, NULL, NULL))
+            if (!check_at(c, &sp, NULL, NULL))
                 continue;
             double a = log(cidx) - c->pref[0], b = log(n) - c->pref[1];
             double score = a * a + b * b;
@@ -1188,7 +1278,7 @@ static double rss_threshold(const fit_ctx *c, double rss)
 {
     double dof = (double)c->n - 3;
     double s2 = fmax(rss / dof, 1e-24 * c->ynorm / (double)c->n);
-    return gsl_cdf_fdist_Pinv(0.95, 1.0, dof) * s2;
+    return cf_lsq_f95(dof) * s2;
 }
 
 /* The profile of quantity q->fixed at log value u: the RSS minimised over the other quantities
@@ -1274,7 +1364,7 @@ static void profile_end(fit_ctx *c, int k, const double v[3], double limit, int 
 /* Standard errors s^2 (J^T W J)^-1 of (rho, B, A) at v, the correlation matrix, and whether the
 ** Jacobian is numerically rank-deficient (smallest eigenvalue of the unit-diagonal J^T W J below
 ** 1e-10 of the largest): then no standard error is given. */
-static void uncertainty(fit_ctx *c, cf_fit_result *res, unsigned held_a)
+static void uncertainty(fit_ctx *c, fit_ctx *g, cf_fit_result *res, unsigned held_a)
 {
     const double *v = res->ident;
     int rank_def = stage_a_errors(c, v, res->ident_se, res->corr);
@@ -1290,13 +1380,14 @@ static void uncertainty(fit_ctx *c, cf_fit_result *res, unsigned held_a)
         return;
     region r = region_at(c, v[0], v[1]);
     double A;
-    double rss0 = fmin(res->objective, rss_at(c, v[0], v[1], -1, r.A_max, &A));
+    double rss0 = g == c ? fmin(res->objective, rss_at(c, v[0], v[1], -1, r.A_max, &A))
+                         : rss_at(g, v[0], v[1], -1, r.A_max, &A);
     double limit = rss0 + rss_threshold(c, rss0);
     for (int k = 0; k < 3; k++) {
         double h = res->ident_se[k] > 0 ? fmin(0.5 * res->ident_se[k] / v[k], 0.1) : 0.01;
         h = fmax(h, 1e-4);
-        profile_end(c, k, v, limit, -1, h, res);
-        profile_end(c, k, v, limit, +1, h, res);
+        profile_end(g, k, v, limit, -1, h, res);
+        profile_end(g, k, v, limit, +1, h, res);
         res->interval_ok[k] = 1;
         res->interval_why[k] = why;
     }
@@ -1368,8 +1459,7 @@ static void summarise(fit_ctx *c, const double *p, cf_fit_result *res)
     res->max_abs_error = q.max_abs_error;
     res->r2 = q.r2;
     res->objective = objective6(c, p) * c->ynorm;
-    res->feasible = cf_fit_check(&res->params, c->type, c->data, c->opt, &res->active,
-                                 &res->violated);
+    res->feasible = check_at(c, &res->params, &res->active, &res->violated);
     res->objective_zero = c->ynorm;
     res->solid_ratio = c->xmax > 0 ? res->ident[1] / c->xmax : INFINITY;
     for (int a = 0; a < 3; a++)
@@ -1448,12 +1538,12 @@ static void place(fit_ctx *c, const double v[3], double *p, double *z)
     memcpy(p0, p, sizeof p0);
     memcpy(z0, z, sizeof z0);
     cf_spring sp = from_array(p0);
-    int feas0 = cf_fit_check(&sp, c->type, c->data, c->opt, NULL, NULL);
+    int feas0 = check_at(c, &sp, NULL, NULL);
     nl_run(c, NLOPT_LD_SLSQP, z_preference, 1, z, 2000);
     full_params(c, z, p);
     snap_to_family(c, p, z);
     sp = from_array(p);
-    if (feas0 && !cf_fit_check(&sp, c->type, c->data, c->opt, NULL, NULL)) {
+    if (feas0 && !check_at(c, &sp, NULL, NULL)) {
         memcpy(p, p0, sizeof p0); /* keep the feasible start rather than a worse point */
         memcpy(z, z0, sizeof z0);
     }
@@ -1488,7 +1578,7 @@ cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_sprin
     for (int k = 0; k < 3; k++)
         res->ident_se[k] = -1;
     res->optimizer = "placement";
-    res->evaluations = c.evals;
+    res->evaluations = res->evaluations_full = c.evals;
     ctx_free(&c);
     res->wall_time_s = now_s() - t0;
     return CF_OK;
@@ -1499,24 +1589,41 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
 {
     const double t0 = now_s();
     memset(res, 0, sizeof *res);
-    fit_ctx c;
+    fit_ctx c, sc;
+    memset(&sc, 0, sizeof sc);
+    cf_table subt;
+    memset(&subt, 0, sizeof subt);
     cf_status st = ctx_setup(&c, data, opt, type, err);
+    /* A long table: the global searches see its subsample (g), the polish every row (c). */
+    const int long_table = st == CF_OK && opt->subsample_above > 0 && c.n > opt->subsample_above;
+    if (long_table && (st = cf_subsample(data, CF_SUBSAMPLE_ROWS, &subt, err)) == CF_OK)
+        st = ctx_setup(&sc, &subt, opt, type, err);
     if (st != CF_OK) {
         ctx_free(&c);
+        ctx_free(&sc);
+        cf_table_free(&subt);
         return st;
     }
+    fit_ctx *g = long_table ? &sc : &c;
     /* Stage A: the identifiable quantities, over every spring, then under the type's limits when
     ** the optimum lies outside them. */
     double v[3] = {0.5, 0.5 * (c.b_lo + c.b_hi), 1.0};
-    stage_a(&c, v);
+    start4 found[STAGE_A_RUNS];
+    int nfound = 0;
+    stage_a(g, v, long_table ? found : NULL, &nfound);
+    if (long_table)
+        stage_a_polish(&c, found, nfound, v);
     unsigned held_a = 0; /* the limits that keep the type from stage A's optimum */
     if (c.region) {
         region r = region_at(&c, v[0], v[1]);
         int out = r.margin > 0, over = v[2] > r.A_max / (1 - REGION_SAFETY);
         if (out || over) {
             held_a = (out ? r.lo_bit | r.hi_bit : 0u) | (over ? (unsigned)CF_C_G_MAX : 0u);
-            if (stage_a_constrained(&c, v))
+            if (stage_a_constrained(g, v)) {
+                if (long_table)
+                    stage_a_constrained_polish(&c, v);
                 held_a |= held_at(&c, v);
+            }
         }
     }
     /* Stage B: place a spring of the family. */
@@ -1527,23 +1634,52 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
     memcpy(best_p, p, sizeof p);
     unsigned act, vio;
     cf_spring sp = from_array(p);
-    int best_feas = cf_fit_check(&sp, type, data, opt, &act, &vio);
+    int best_feas = check_at(&c, &sp, &act, &vio);
     /* Stage C: local polish on the real objective; with fixed parameters the family may be out
-    ** of reach, so then also from seeded starts around the placement. */
+    ** of reach, so then also from seeded starts around the placement. A long table polishes its
+    ** starts on the subsample and the best of them on every row; without fixed parameters on a
+    ** stress-strain table (c.region) the six parameters reach the model only through the three
+    ** quantities that stage A fitted on every row, so the polish there can move the objective by
+    ** rounding only (1e-14 of it on the shipped tables) and a long table skips its full pass. */
     gsl_rng *rng = seeded_rng(opt->seed, 2);
     int starts = 1;
     for (int k = 0; k < CF_P_COUNT; k++)
         if (opt->fixed[k])
             starts = opt->multistart;
+    const nlopt_algorithm alg = algorithm_of(opt->optimizer);
+    double cand_z[CF_P_COUNT], cand_obj = CF_LSQ_HUGE_OBJ;
+    int cand_feas = 0, have_cand = 0;
     for (int s = 0; s < starts; s++) {
         double zz[CF_P_COUNT];
         for (int k = 0; k < c.nfree; k++)
             zz[k] = z[k] + (s == 0 ? 0.0 : 0.5 * (jitter(rng) - 0.5));
-        nl_run(&c, algorithm_of(opt->optimizer), z_objective, 0, zz, 3000);
+        nl_run(g, alg, z_objective, 0, zz, 3000);
         double q[CF_P_COUNT];
         full_params(&c, zz, q);
         sp = from_array(q);
-        int feas = cf_fit_check(&sp, type, data, opt, &act, &vio);
+        int feas = check_at(&c, &sp, &act, &vio);
+        double o = objective6(g, q);
+        if (long_table) {
+            if (!have_cand || (feas && !cand_feas) || (feas == cand_feas && o < cand_obj)) {
+                have_cand = 1;
+                cand_obj = o;
+                cand_feas = feas;
+                memcpy(cand_z, zz, sizeof zz);
+            }
+        } else if ((feas && !best_feas) || (feas == best_feas && o < best_obj)) {
+            best_obj = o;
+            best_feas = feas;
+            memcpy(best_p, q, sizeof q);
+        }
+    }
+    gsl_rng_free(rng);
+    if (have_cand) {
+        if (!c.region || held_a)
+            nl_run(&c, alg, z_objective, 0, cand_z, 3000);
+        double q[CF_P_COUNT];
+        full_params(&c, cand_z, q);
+        sp = from_array(q);
+        int feas = check_at(&c, &sp, &act, &vio);
         double o = objective6(&c, q);
         if ((feas && !best_feas) || (feas == best_feas && o < best_obj)) {
             best_obj = o;
@@ -1551,15 +1687,17 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
             memcpy(best_p, q, sizeof q);
         }
     }
-    gsl_rng_free(rng);
     res->type = type;
     summarise(&c, best_p, res);
     /* Errors, correlation and, where the data leave a quantity open, its profile interval: at
     ** the reported spring's quantities. */
-    uncertainty(&c, res, held_a);
+    uncertainty(&c, g, res, held_a);
     res->optimizer = cf_fit_optimizer_name(opt->optimizer);
-    res->evaluations = c.evals;
+    res->evaluations = c.evals + sc.evals;
+    res->evaluations_full = c.evals;
     ctx_free(&c);
+    ctx_free(&sc);
+    cf_table_free(&subt);
     res->wall_time_s = now_s() - t0;
     return CF_OK;
 }
@@ -1582,7 +1720,7 @@ cf_fit_verdict cf_fit_compare(const cf_fit_result *a, const cf_fit_result *b, si
     double dof = points > 3 ? (double)points - 3 : 1;
     double s2 = fmax(g->objective / dof, 1e-24 * g->objective_zero / (double)points);
     v.delta_rss = w->objective - g->objective;
-    v.threshold = gsl_cdf_fdist_Pinv(0.95, 1.0, dof) * s2;
+    v.threshold = cf_lsq_f95(dof) * s2;
     v.tie = v.delta_rss <= v.threshold;
     v.held = w->held & ~g->held;
     if (!v.held)

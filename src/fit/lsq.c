@@ -5,6 +5,8 @@
 
 #include <math.h>
 
+#include <gsl/gsl_cdf.h>
+
 double cf_lsq_weights(const cf_table *t, int relative, double *sw)
 {
     double ymax = 0, norm = 0;
@@ -55,4 +57,13 @@ double cf_lsq_G_of_FC(double F_C_N, double n, double D1_mm, double d_mm, double 
 {
     const double d2 = d_mm * d_mm;
     return 8 * n * D1_mm * D1_mm * D1_mm * F_C_N / (d2 * d2 * s_mm);
+}
+
+double cf_lsq_f95(double dof)
+{
+    double f = gsl_cdf_fdist_Pinv(0.95, 1.0, dof);
+    if (isfinite(f) && f > 0)
+        return f;
+    double t = gsl_cdf_tdist_Pinv(0.975, dof);
+    return t * t;
 }

@@ -41,6 +41,11 @@ cf_lsq_quality cf_lsq_quality_of(const cf_table *t, const double *model);
 ** reaches the cylinder, 1. */
 double cf_lsq_rho_hi(cf_spring_type type, double index_max);
 
+/* F(0.95; 1, dof), the 95 % quantile of the F distribution with 1 and dof degrees of freedom:
+** GSL's inverse where it converges, else the square of Student's t(0.975; dof), which it equals
+** (GSL 2.7's gsl_cdf_fdist_Pinv fails for some large dof, e.g. 4997 and 1e5, and returns NaN). */
+double cf_lsq_f95(double dof);
+
 /* Largest |x| of the table. */
 double cf_lsq_xmax(const cf_table *t);
 

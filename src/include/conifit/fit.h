@@ -91,7 +91,15 @@ typedef struct cf_fit_options {
     unsigned long seed;             /* seed of the global stage */
     int multistart;                 /* number of local starts in stage A (>= 1) */
     double H_preferred_mm;          /* free length preferred by placement when H is free, mm */
+    size_t subsample_above;         /* a table of more rows than this runs the global searches
+                                    ** (stage A's grid and starts, the constrained grid) on a
+                                    ** deterministic subsample of 1000 rows evenly along x, then
+                                    ** polishes on every row; 0: never (default
+                                    ** CF_FIT_SUBSAMPLE_ABOVE; the baselines use the same) */
 } cf_fit_options;
+
+/* Tables up to this many rows are searched on every row (every shipped and published table). */
+#define CF_FIT_SUBSAMPLE_ABOVE 2000
 
 cf_fit_options cf_fit_default_options(void);
 
@@ -129,7 +137,10 @@ typedef struct cf_fit_result {
     unsigned active;       /* CF_C_* bits of constraints at their limit (within 1e-6) */
     unsigned violated;     /* CF_C_* bits of violated constraints */
     const char *optimizer; /* name of the stage-C optimiser */
-    long evaluations;      /* evaluations of the model over the table, all stages */
+    long evaluations;      /* evaluations of the model over the table (or its subsample), all
+                           ** stages */
+    long evaluations_full; /* those over every row of the table (the rest ran on the subsample
+                           ** of a long table: cf_fit_options.subsample_above) */
     double wall_time_s;    /* s */
 } cf_fit_result;
 
