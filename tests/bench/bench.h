@@ -69,5 +69,6 @@ void bench_section_calibration(bench_ctx *ctx);
 void bench_section_visco(bench_ctx *ctx);
 void bench_section_statics(bench_ctx *ctx);
 void bench_statics_early(bench_ctx *ctx);
+void bench_section_longfit(bench_ctx *ctx);
 
 #endif
