@@ -75,7 +75,10 @@ static const char fit_help_series[] =
     "cell, driven by the measured strain history:\n"
     "  --branches N            Prony terms, 1..8 (default: 1..4 chosen by AIC)\n"
     "  --dashpot               fit a dashpot beside every spring as well\n"
-    "  --elastic FIT.json[:TYPE]  hold rho, s/H and F_C/H^2 at those of a fit file's spring\n\n"
+    "  --elastic FIT.json[:TYPE]  hold rho, s/H and F_C/H^2 at those of a fit file's spring\n"
+    "  --calibration C         the lattice's weights: axial (default for a series) or isotropic\n"
+    "The fitted spring stays within the design limits (--rho-min, --index-max, ...) and its\n"
+    "lattice stable up to the series' largest strain.\n\n"
     "Tables: a header row naming the columns, units in the names (stress_kPa, stress [kPa]),\n"
     "'#' comments, ',' ';' TAB or blank-separated columns, an optional weight column. Tension\n"
     "positive. A spreadsheet (.xlsx, .ods) must be saved as CSV first.\n";
@@ -454,6 +457,12 @@ static int parse_args(int argc, char **argv, fit_args *a)
     p.help_more = fit_help_series;
     if (rc || (rc = cf_cli_parse(&p, fit_option, a)) >= 0)
         return rc;
+    if (a->calibration_given && a->popt.lattice.cfg.lattice.calibration != CF_CAL_FITTED) {
+        /* a time series is fitted in the lattice of the calibration asked for */
+        a->vopt.setup.cfg.lattice.calibration = a->popt.lattice.cfg.lattice.calibration;
+        memcpy(a->vopt.setup.cfg.lattice.weight, a->popt.lattice.cfg.lattice.weight,
+               sizeof a->vopt.setup.cfg.lattice.weight);
+    }
     a->out = p.output;
     a->quiet = p.quiet;
     a->progress = cf_cli_progress(&p);

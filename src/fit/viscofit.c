@@ -9,9 +9,13 @@
 #include <time.h>
 
 #include <gsl/gsl_blas.h>
+#include <gsl/gsl_linalg.h>
 #include <gsl/gsl_matrix.h>
 #include <gsl/gsl_multifit_nlinear.h>
 #include <gsl/gsl_vector.h>
+
+#include "conifit/msm.h"
+#include "fit/viscolimits.h"
 
 /* Bounds of rho and of the solid strain (the largest strain must stay CF_FIT_TRAVEL_MARGIN
 ** short of solid, as in the elastic fit). */
@@ -57,7 +61,13 @@ cf_visco_fit_options cf_visco_fit_default_options(void)
     cf_visco_fit_options o;
     memset(&o, 0, sizeof o);
     o.setup = cf_visco_default();
+    /* the axial calibration: its diagonals carry as much as its edges, which keeps the lattice
+    ** stable further in compression than the isotropic one (README) */
+    o.setup.cfg.lattice.calibration = CF_CAL_AXIAL;
+    cf_calibration_weights(CF_CAL_AXIAL, o.setup.cfg.lattice.weight, NULL);
     o.rho_min = CF_FIT_RHO_MIN_DEFAULT;
+    o.stable_cells = 1;
+    o.limit_types = (1u << CF_TELESCOPING) | (1u << CF_NON_TELESCOPING);
     return o;
 }
 
@@ -118,12 +128,19 @@ typedef struct ctx {
     double *sw;         /* residual weights */
     double ynorm;       /* weighted sum of y^2 */
     double ymax, xmax;
-    double e_lo;        /* lower bound of s/H */
+    double e_lo;        /* lower bound of s/H (the travel margin; stability: see lim) */
     double rho_lo;      /* lower bound of rho (the fitter's rho_min) */
+    cf_visco_limits lim;/* design cap of the scale and stability bound of s/H */
     double *m;          /* model curve scratch (n) */
     cf_visco_series series;
     long evals;
 } ctx;
+
+/* The smallest s/H allowed at rho: above the travel margin and the lattice's stability bound. */
+static double solid_lo(const ctx *c, double rho)
+{
+    return cf_visco_limits_solid_min(&c->lim, rho);
+}
 
 /* LM coordinates -> model parameters; the stress scale is 1 (profiled) or the held one, the
 ** dashpot relative to it. */
@@ -134,7 +151,8 @@ static cf_visco_params unpack(const ctx *c, const double *z)
     size_t j = 0;
     if (c->free_el) {
         p.rho = c->rho_lo + (RHO_HI - c->rho_lo) * expit(z[j++]);
-        p.solid_strain = c->e_lo + (E_HI - c->e_lo) * expit(z[j++]);
+        const double lo = solid_lo(c, p.rho);
+        p.solid_strain = lo + (E_HI - lo) * expit(z[j++]);
         p.stress_scale_MPa = 1.0;
     } else {
         p.rho = c->o->elastic[0];
@@ -158,8 +176,9 @@ static void pack(const ctx *c, const cf_visco_params *p, double *z)
 {
     size_t j = 0;
     if (c->free_el) {
+        const double lo = solid_lo(c, p->rho);
         z[j++] = logit((p->rho - c->rho_lo) / (RHO_HI - c->rho_lo));
-        z[j++] = logit((p->solid_strain - c->e_lo) / (E_HI - c->e_lo));
+        z[j++] = logit((p->solid_strain - lo) / (E_HI - lo));
     }
     double ginf = 1;
     for (int i = 0; i < c->nb; i++)
@@ -181,11 +200,13 @@ static int curve(ctx *c, const cf_visco_params *p)
     return cf_visco_curve(p, &c->o->setup, &c->series, c->m, NULL, &e) == CF_OK;
 }
 
-/* The best stress scale for the curve in c->m (weighted least squares), or the held one. */
-static double profile_scale(const ctx *c)
+/* The best stress scale for the curve in c->m at unit scale (weighted least squares), capped at
+** the largest a spring within the design limits carries at (rho, s/H); 1 for a held scale (the
+** curve already carries it). 0 when no positive scale fits. */
+static double profile_scale(const ctx *c, double rho, double B)
 {
     if (!c->free_el)
-        return 1.0; /* the curve already carries the held scale */
+        return 1.0;
     double gy = 0, gg = 0;
     for (size_t k = 0; k < c->n; k++) {
         double w = c->sw[k] * c->sw[k];
@@ -193,6 +214,7 @@ static double profile_scale(const ctx *c)
         gg += w * c->m[k] * c->m[k];
     }
     double A = gg > 0 ? gy / gg : 0;
+    A = fmin(A, cf_visco_limits_scale_max(&c->lim, rho, B));
     return isfinite(A) && A > 0 ? A : 0;
 }
 
@@ -201,7 +223,7 @@ static int lm_f(const gsl_vector *zv, void *data, gsl_vector *f)
     ctx *c = data;
     cf_visco_params p = unpack(c, zv->data);
     double A = 0;
-    int ok = curve(c, &p) && (A = profile_scale(c)) > 0;
+    int ok = curve(c, &p) && (A = profile_scale(c, p.rho, p.solid_strain)) > 0;
     const double s = 1 / sqrt(c->ynorm);
     for (size_t k = 0; k < c->n; k++) {
         double r = ok ? c->sw[k] * (A * c->m[k] - c->d->y[k])
@@ -209,6 +231,28 @@ static int lm_f(const gsl_vector *zv, void *data, gsl_vector *f)
         gsl_vector_set(f, k, isfinite(r) ? r * s : 1e10);
     }
     return GSL_SUCCESS;
+}
+
+/* GSL's iterations on the workspace until convergence, a stall or the iteration limit. */
+static void lm_iterate(gsl_multifit_nlinear_workspace *w)
+{
+    gsl_vector *f = gsl_multifit_nlinear_residual(w);
+    double prev;
+    gsl_blas_ddot(f, f, &prev);
+    int stall = 0;
+    for (int it = 0; it < LM_MAX_ITER; it++) {
+        int info;
+        if (gsl_multifit_nlinear_iterate(w) != GSL_SUCCESS)
+            break;
+        if (gsl_multifit_nlinear_test(1e-14, 1e-14, 0, &info, w) == GSL_SUCCESS)
+            break;
+        double cur;
+        gsl_blas_ddot(f, f, &cur);
+        stall = (prev - cur <= LM_STALL_REL * prev) ? stall + 1 : 0;
+        prev = cur;
+        if (stall >= LM_STALL || cur <= LM_FLOOR_REL)
+            break;
+    }
 }
 
 /* Levenberg-Marquardt from z (in place); returns the scaled sum of squares. */
@@ -232,23 +276,8 @@ static double lm_run(ctx *c, double *z)
     gsl_vector_view x0 = gsl_vector_view_array(z, c->np);
     double best = HUGE_VAL;
     if (gsl_multifit_nlinear_init(&x0.vector, &fdf, w) == GSL_SUCCESS) {
+        lm_iterate(w);
         gsl_vector *f = gsl_multifit_nlinear_residual(w);
-        double prev;
-        gsl_blas_ddot(f, f, &prev);
-        int stall = 0;
-        for (int it = 0; it < LM_MAX_ITER; it++) {
-            int info;
-            if (gsl_multifit_nlinear_iterate(w) != GSL_SUCCESS)
-                break;
-            if (gsl_multifit_nlinear_test(1e-14, 1e-14, 0, &info, w) == GSL_SUCCESS)
-                break;
-            double cur;
-            gsl_blas_ddot(f, f, &cur);
-            stall = (prev - cur <= LM_STALL_REL * prev) ? stall + 1 : 0;
-            prev = cur;
-            if (stall >= LM_STALL || cur <= LM_FLOOR_REL)
-                break;
-        }
         gsl_blas_ddot(f, f, &best);
         memcpy(z, gsl_multifit_nlinear_position(w)->data, c->np * sizeof(double));
         if (!isfinite(best))
@@ -259,44 +288,6 @@ static double lm_run(ctx *c, double *z)
 }
 
 /* ---- stage A: the stand-in search ------------------------------------------------------------ */
-
-/* Solves the m x m system G a = b (Gaussian elimination with partial pivoting); 0 if singular. */
-static int small_solve(int m, double *G, double *b, double *a)
-{
-    for (int i = 0; i < m; i++) {
-        int piv = i;
-        for (int r = i + 1; r < m; r++)
-            if (fabs(G[r * m + i]) > fabs(G[piv * m + i]))
-                piv = r;
-        if (!(fabs(G[piv * m + i]) > 1e-300))
-            return 0;
-        if (piv != i) {
-            for (int k = 0; k < m; k++) {
-                double t = G[i * m + k];
-                G[i * m + k] = G[piv * m + k];
-                G[piv * m + k] = t;
-            }
-            double t = b[i];
-            b[i] = b[piv];
-            b[piv] = t;
-        }
-        for (int r = i + 1; r < m; r++) {
-            double f = G[r * m + i] / G[i * m + i];
-            for (int k = i; k < m; k++)
-                G[r * m + k] -= f * G[i * m + k];
-            b[r] -= f * b[i];
-        }
-    }
-    for (int i = m - 1; i >= 0; i--) {
-        double s = b[i];
-        for (int k = i + 1; k < m; k++)
-            s -= G[i * m + k] * a[k];
-        a[i] = s / G[i * m + i];
-        if (!isfinite(a[i]))
-            return 0;
-    }
-    return 1;
-}
 
 typedef struct start {
     double obj;
@@ -325,84 +316,153 @@ static void keep_start(start *best, int nbest, double obj, const cf_visco_params
     best[pos].p = *p;
 }
 
-/* For one elastic curve E (unit or held scale) and the Prony responses R[t][k] of every grid time
-** constant, tries every set of nb time constants and keeps the best feasible ones in best. */
-static void search_taus(ctx *c, const double *E, double *const *R, const double *taus,
-                        const double *rate, double rate_factor, const cf_visco_params *el,
-                        start *best, int nbest)
+/* The stand-in at one grid point (rho, s/H) for one set of time constants: the elastic curve E
+** (at unit scale, or at the held scale) and the responses of the chosen branches. The stress is
+**     A E + sum_i (A g_i) (R_i - E) + c_d rate,
+** linear in the unknowns A (unless held or capped), A g_i and the dashpot's c_d. */
+typedef struct standin {
+    const double *E, *rate;
+    const double *basis[2 + CF_PRONY_MAX];
+    double A_fixed;     /* > 0: the scale is held there (a held fit, or the design cap) */
+    gsl_matrix *X;      /* weighted design, n x (2 + CF_PRONY_MAX) */
+    gsl_vector *y, *tau, *a, *res;
+} standin;
+
+/* Weighted linear least squares of the stand-in by Householder QR (GSL): the coefficients in
+** a[] in the order of the basis (A first when free). 0 when the design is rank deficient. */
+static int standin_solve(const ctx *c, standin *s, int m, double *a)
 {
-    const int nb = c->nb, held = !c->free_el;
-    const int m = (held ? 0 : 1) + nb + c->dash; /* unknowns: A, A g_i, dashpot */
+    const size_t n = c->n;
+    gsl_matrix_view X = gsl_matrix_submatrix(s->X, 0, 0, n, (size_t)m);
+    gsl_vector_view tau = gsl_vector_subvector(s->tau, 0, (size_t)m);
+    gsl_vector_view av = gsl_vector_subvector(s->a, 0, (size_t)m);
+    const int held = s->A_fixed > 0;
+    const int off = held ? 0 : 1;
+    if ((size_t)m > n)
+        return 0;
+    for (size_t k = 0; k < n; k++) {
+        gsl_vector_set(s->y, k, c->sw[k] * (c->d->y[k] - (held ? s->A_fixed * s->E[k] : 0.0)));
+        for (int i = 0; i < m; i++) {
+            const double *b = i < off ? s->E : s->basis[i - off];
+            gsl_matrix_set(&X.matrix, k, (size_t)i, c->sw[k] * b[k]);
+        }
+    }
+    if (gsl_linalg_QR_decomp(&X.matrix, &tau.vector) != GSL_SUCCESS)
+        return 0;
+    double dmax = 0, dmin = HUGE_VAL;
+    for (int i = 0; i < m; i++) {
+        double r = fabs(gsl_matrix_get(&X.matrix, (size_t)i, (size_t)i));
+        dmax = fmax(dmax, r);
+        dmin = fmin(dmin, r);
+    }
+    if (!(dmin > 1e-13 * dmax))
+        return 0;
+    if (gsl_linalg_QR_lssolve(&X.matrix, &tau.vector, s->y, &av.vector, s->res) != GSL_SUCCESS)
+        return 0;
+    for (int i = 0; i < m; i++)
+        if (!isfinite(a[i] = gsl_vector_get(&av.vector, (size_t)i)))
+            return 0;
+    return 1;
+}
+
+/* The parameters of a stand-in solution, or 0 when they break g_i >= 0, sum g_i < 1, c_d > 0. */
+static int standin_params(const ctx *c, const standin *s, const double *a, const int *idx,
+                          const double *taus, double rate_factor, cf_visco_params *p)
+{
+    const int held = s->A_fixed > 0, off = held ? 0 : 1;
+    const double A = held ? s->A_fixed : a[0];
+    if (!(A > 0))
+        return 0;
+    double gs = 0;
+    p->nbranch = c->nb;
+    for (int i = 0; i < c->nb; i++) {
+        p->g[i] = a[off + i] / A;
+        p->tau_s[i] = taus[idx[i]];
+        if (!(p->g[i] >= 0))
+            return 0;
+        gs += p->g[i];
+    }
+    if (!(gs < 1 - 1e-9))
+        return 0;
+    if (c->dash) {
+        double cd = a[off + c->nb];
+        if (!(cd > 0))
+            return 0;
+        p->eta_MPa_s = cd * rate_factor; /* MPa s */
+    }
+    p->stress_scale_MPa *= A;
+    return 1;
+}
+
+/* The weighted, scaled sum of squares of the stand-in solution a. */
+static double standin_obj(const ctx *c, const standin *s, int m, const double *a)
+{
+    const int held = s->A_fixed > 0, off = held ? 0 : 1;
+    double sum = 0;
+    for (size_t k = 0; k < c->n; k++) {
+        double model = held ? s->A_fixed * s->E[k] : 0.0;
+        for (int i = 0; i < m; i++)
+            model += a[i] * (i < off ? s->E[k] : s->basis[i - off][k]);
+        double r = c->sw[k] * (model - c->d->y[k]);
+        sum += r * r;
+    }
+    return sum / c->ynorm;
+}
+
+/* One combination of time constants (indices idx into taus): solved, the scale capped at A_max
+** (then solved again with the scale held there), kept in best when feasible. */
+static void standin_combo(ctx *c, standin *s, double *const *R, const int *idx,
+                          const double *taus, double rate_factor, double A_max,
+                          const cf_visco_params *el, double *tmp, start *best, int nbest)
+{
+    const int nb = c->nb;
+    for (int i = 0; i < nb; i++) {
+        double *b = tmp + (size_t)i * c->n;
+        for (size_t k = 0; k < c->n; k++)
+            b[k] = R[idx[i]][k] - s->E[k];
+        s->basis[i] = b;
+    }
+    if (c->dash)
+        s->basis[nb] = s->rate;
+    const double A_held = c->free_el ? 0.0 : 1.0; /* a held curve carries its scale */
+    double a[2 + CF_PRONY_MAX];
+    s->A_fixed = A_held;
+    int m = (s->A_fixed > 0 ? 0 : 1) + nb + c->dash;
+    if (!standin_solve(c, s, m, a))
+        return;
+    if (s->A_fixed == 0 && a[0] > A_max) { /* past the design cap: the scale held there */
+        s->A_fixed = A_max;
+        m = nb + c->dash;
+        if (!(A_max > 0) || !standin_solve(c, s, m, a))
+            return;
+    }
+    cf_visco_params p = *el;
+    if (standin_params(c, s, a, idx, taus, rate_factor, &p))
+        keep_start(best, nbest, standin_obj(c, s, m, a), &p);
+}
+
+/* For one elastic curve E and the Prony responses R[t][k] of every grid time constant, tries
+** every set of nb time constants and keeps the best feasible ones in best. */
+static void search_taus(ctx *c, const double *E, double *const *R, const double *taus,
+                        const double *rate, double rate_factor, double A_max,
+                        const cf_visco_params *el, start *best, int nbest)
+{
+    const int nb = c->nb;
+    standin s;
+    memset(&s, 0, sizeof s);
+    s.E = E;
+    s.rate = rate;
+    s.X = gsl_matrix_alloc(c->n, 2 + CF_PRONY_MAX);
+    s.y = gsl_vector_alloc(c->n);
+    s.res = gsl_vector_alloc(c->n);
+    s.tau = gsl_vector_alloc(2 + CF_PRONY_MAX);
+    s.a = gsl_vector_alloc(2 + CF_PRONY_MAX);
+    double *tmp = malloc((size_t)(nb + 1) * c->n * sizeof(double));
     int idx[CF_PRONY_MAX];
     for (int i = 0; i < nb; i++)
         idx[i] = i;
-    const double *basis[2 + CF_PRONY_MAX];
-    double *tmp = malloc((size_t)(nb + 1) * c->n * sizeof(double));
-    if (!tmp)
-        return;
-    for (;;) {
-        /* basis: E (when the scale is free), R_i - E (coefficient A g_i), the rate */
-        int nbas = 0;
-        if (!held)
-            basis[nbas++] = E;
-        for (int i = 0; i < nb; i++) {
-            double *b = tmp + (size_t)i * c->n;
-            for (size_t k = 0; k < c->n; k++)
-                b[k] = R[idx[i]][k] - E[k];
-            basis[nbas++] = b;
-        }
-        if (c->dash)
-            basis[nbas++] = rate;
-        double G[(2 + CF_PRONY_MAX) * (2 + CF_PRONY_MAX)], rhs[2 + CF_PRONY_MAX],
-            a[2 + CF_PRONY_MAX];
-        for (int i = 0; i < m; i++) {
-            rhs[i] = 0;
-            for (int j = 0; j < m; j++)
-                G[i * m + j] = 0;
-        }
-        for (size_t k = 0; k < c->n; k++) {
-            double w = c->sw[k] * c->sw[k];
-            double yk = c->d->y[k] - (held ? E[k] : 0.0);
-            for (int i = 0; i < m; i++) {
-                rhs[i] += w * basis[i][k] * yk;
-                for (int j = 0; j <= i; j++)
-                    G[i * m + j] += w * basis[i][k] * basis[j][k];
-            }
-        }
-        for (int i = 0; i < m; i++)
-            for (int j = i + 1; j < m; j++)
-                G[i * m + j] = G[j * m + i];
-        if (small_solve(m, G, rhs, a)) {
-            double A = held ? 1.0 : a[0], gs = 0;
-            int ok = A > 0;
-            cf_visco_params p = *el;
-            p.nbranch = nb;
-            for (int i = 0; i < nb && ok; i++) {
-                p.g[i] = a[(held ? 0 : 1) + i] / A;
-                p.tau_s[i] = taus[idx[i]];
-                ok = p.g[i] >= 0;
-                gs += p.g[i];
-            }
-            ok = ok && gs < 1 - 1e-9;
-            if (c->dash) {
-                double cd = a[m - 1];
-                ok = ok && cd > 0;
-                p.eta_MPa_s = cd * rate_factor; /* MPa s */
-            }
-            if (ok) {
-                double sum = 0;
-                for (size_t k = 0; k < c->n; k++) {
-                    double model = held ? E[k] : 0.0;
-                    for (int i = 0; i < m; i++)
-                        model += a[i] * basis[i][k];
-                    double r = c->sw[k] * (model - c->d->y[k]);
-                    sum += r * r;
-                }
-                if (!held)
-                    p.stress_scale_MPa *= A;
-                keep_start(best, nbest, sum / c->ynorm, &p);
-            }
-        }
+    while (tmp && s.X && s.y && s.res && s.tau && s.a) {
+        standin_combo(c, &s, R, idx, taus, rate_factor, A_max, el, tmp, best, nbest);
         /* next combination of nb indices out of GRID_TAU, increasing */
         int i = nb - 1;
         while (i >= 0 && idx[i] == GRID_TAU - nb + i)
@@ -414,6 +474,11 @@ static void search_taus(ctx *c, const double *E, double *const *R, const double 
             idx[j] = idx[j - 1] + 1;
     }
     free(tmp);
+    gsl_matrix_free(s.X);
+    gsl_vector_free(s.y);
+    gsl_vector_free(s.res);
+    gsl_vector_free(s.tau);
+    gsl_vector_free(s.a);
 }
 
 /* Static lattice stress (table's sign) of the model's elastic part at every strain of the
@@ -430,17 +495,48 @@ static int elastic_curve(ctx *c, double rho, double e, double A, double *E, doub
     c->evals++;
     if (cf_visco_elastic_curve(&p, &c->o->setup, c->d->x, c->n, E, &err) != CF_OK)
         return 0;
-    if (!lat_factor)
-        return 1;
     cf_spring sp = cf_spring_member(rho, e, A);
     cf_law law;
     double small = -1e-3 * e, s0 = 0;
-    if (cf_law_init(&law, &sp, &err) != CF_OK ||
-        cf_visco_elastic_curve(&p, &c->o->setup, &small, 1, &s0, &err) != CF_OK)
+    if (cf_law_init(&law, &sp, &err) != CF_OK)
         return 0;
+    int ok = cf_visco_elastic_curve(&p, &c->o->setup, &small, 1, &s0, &err) == CF_OK;
     *lat_factor = (s0 / small) / (law.k0_N_per_mm / sp.H_mm);
     cf_law_free(&law);
-    return *lat_factor > 0;
+    return ok && *lat_factor > 0;
+}
+
+/* Prony responses per unit g of the curve E at every grid time constant:
+** h_k = e h_(k-1) + b (E_k - E_(k-1)), relaxed start. */
+static void grid_responses(const ctx *c, const double *E, const double *taus, double *const *R)
+{
+    const double *t = c->d->t_s;
+    for (int i = 0; i < GRID_TAU; i++) {
+        R[i][0] = 0;
+        for (size_t k = 1; k < c->n; k++) {
+            double h = t[k] - t[k - 1];
+            double ex = exp(-h / taus[i]), b = -expm1(-h / taus[i]) * taus[i] / h;
+            R[i][k] = ex * R[i][k - 1] + b * (E[k] - E[k - 1]);
+        }
+    }
+}
+
+/* The grid point (ir, ie) of the stand-in: rho spaced logarithmically from the lower limit, s/H
+** quadratically from the smallest allowed at that rho; the held values when held. */
+static void grid_point(const ctx *c, int ir, int ie, cf_visco_params *el)
+{
+    memset(el, 0, sizeof *el);
+    if (!c->free_el) {
+        el->rho = c->o->elastic[0];
+        el->solid_strain = c->o->elastic[1];
+        el->stress_scale_MPa = c->o->elastic[2];
+        return;
+    }
+    const double r0 = fmax(c->rho_lo * 1.001, 0.02);
+    el->rho = r0 * pow(0.98 / r0, (double)ir / (GRID_RHO - 1));
+    const double lo = solid_lo(c, el->rho), f = (ie + 1.0) / (GRID_E + 1.0);
+    el->solid_strain = lo + (E_HI - lo) * f * f;
+    el->stress_scale_MPa = 1;
 }
 
 /* Stage A: the best starts for nb branches. */
@@ -450,61 +546,32 @@ static int stand_in(ctx *c, start *best, int nbest)
         best[i].obj = HUGE_VAL;
     const size_t n = c->n;
     const double *t = c->d->t_s;
-    double dtmin = HUGE_VAL;
+    double dtmin = HUGE_VAL, taus[GRID_TAU];
     for (size_t k = 1; k < n; k++)
         dtmin = fmin(dtmin, t[k] - t[k - 1]);
-    const double span = t[n - 1] - t[0];
-    double taus[GRID_TAU];
-    const double tlo = 0.5 * dtmin, thi = 2 * span;
+    const double tlo = 0.5 * dtmin, thi = 2 * (t[n - 1] - t[0]);
     for (int i = 0; i < GRID_TAU; i++)
         taus[i] = tlo * pow(thi / tlo, (double)i / (GRID_TAU - 1));
     double *E = malloc(n * sizeof(double)), *rate = calloc(n, sizeof(double));
-    double *Rbuf = malloc((size_t)GRID_TAU * n * sizeof(double));
-    double *R[GRID_TAU];
-    if (!E || !rate || !Rbuf) {
-        free(E);
-        free(rate);
-        free(Rbuf);
-        return 0;
-    }
-    for (int i = 0; i < GRID_TAU; i++)
+    double *Rbuf = malloc((size_t)GRID_TAU * n * sizeof(double)), *R[GRID_TAU];
+    for (int i = 0; Rbuf && i < GRID_TAU; i++)
         R[i] = Rbuf + (size_t)i * n;
-    for (size_t k = 1; k < n; k++)
+    for (size_t k = 1; rate && k < n; k++)
         rate[k] = (c->d->x[k] - c->d->x[k - 1]) / (t[k] - t[k - 1]);
-    int nrho = c->free_el ? GRID_RHO : 1, ne = c->free_el ? GRID_E : 1;
-    for (int ir = 0; ir < nrho; ir++)
+    const int nrho = c->free_el ? GRID_RHO : 1, ne = c->free_el ? GRID_E : 1;
+    for (int ir = 0; E && rate && Rbuf && ir < nrho; ir++)
         for (int ie = 0; ie < ne; ie++) {
-            double rho, e, A;
-            if (c->free_el) {
-                const double r0 = fmax(c->rho_lo * 1.001, 0.02);
-                rho = r0 * pow(0.98 / r0, (double)ir / (GRID_RHO - 1));
-                double f = (ie + 1.0) / (GRID_E + 1.0);
-                e = c->e_lo + (E_HI - c->e_lo) * f * f;
-                A = 1;
-            } else {
-                rho = c->o->elastic[0];
-                e = c->o->elastic[1];
-                A = c->o->elastic[2];
-            }
-            double fac = 1;
-            if (!elastic_curve(c, rho, e, A, E, &fac))
-                continue;
-            /* Prony responses per unit g: h_k = e h_(k-1) + b (E_k - E_(k-1)), relaxed start */
-            for (int i = 0; i < GRID_TAU; i++) {
-                R[i][0] = 0;
-                for (size_t k = 1; k < n; k++) {
-                    double h = t[k] - t[k - 1];
-                    double ex = exp(-h / taus[i]), b = -expm1(-h / taus[i]) * taus[i] / h;
-                    R[i][k] = ex * R[i][k - 1] + b * (E[k] - E[k - 1]);
-                }
-            }
             cf_visco_params el;
-            memset(&el, 0, sizeof el);
-            el.rho = rho;
-            el.solid_strain = e;
-            el.stress_scale_MPa = A;
+            grid_point(c, ir, ie, &el);
+            double fac = 1;
+            if (!elastic_curve(c, el.rho, el.solid_strain, el.stress_scale_MPa, E, &fac))
+                continue;
+            grid_responses(c, E, taus, R);
+            const double A_max = c->free_el
+                                     ? cf_visco_limits_scale_max(&c->lim, el.rho, el.solid_strain)
+                                     : INFINITY;
             /* a dashpot eta beside every spring adds about eta * fac * rate to the stress */
-            search_taus(c, E, R, taus, rate, 1 / fac, &el, best, nbest);
+            search_taus(c, E, R, taus, rate, 1 / fac, A_max, &el, best, nbest);
         }
     free(E);
     free(rate);
@@ -514,102 +581,130 @@ static int stand_in(ctx *c, start *best, int nbest)
 
 /* ---- standard errors ------------------------------------------------------------------------- */
 
+/* Quantities of the covariance, in the order rho, s/H, F_C/H^2, (g_i, tau_i) per branch, eta:
+** the slot of quantity `which` in q, or NULL when it is not fitted or held at a limit. */
+static double *se_slot(const ctx *c, const int held[3], int which, cf_visco_params *q)
+{
+    const int nb = q->nbranch;
+    if (which < 3) {
+        if (!c->free_el || held[which])
+            return NULL;
+        return which == 0 ? &q->rho : which == 1 ? &q->solid_strain : &q->stress_scale_MPa;
+    }
+    if (which < 3 + 2 * nb) {
+        int i = (which - 3) / 2;
+        return (which - 3) % 2 == 0 ? &q->g[i] : &q->tau_s[i];
+    }
+    return c->dash ? &q->eta_MPa_s : NULL;
+}
+
+/* One column of the Jacobian: the weighted central difference of the model in quantity `which`,
+** its steps kept inside the quantity's domain. 0 when the model cannot be evaluated. */
+static int se_column(ctx *c, const cf_visco_params *p, const int held[3], int which,
+                     gsl_matrix *J, size_t col, double *mp, double *mm)
+{
+    cf_visco_params q = *p;
+    double *slot = se_slot(c, held, which, &q);
+    const double v = *slot;
+    const int is_g = which >= 3 && which < 3 + 2 * p->nbranch && (which - 3) % 2 == 0;
+    double h = SE_STEP * fmax(fabs(v), is_g ? 1e-2 : 1e-300);
+    double hp = h, hm = h;
+    if (which == 0) { /* keep rho inside (0, 1] */
+        hp = fmin(h, 1 - v);
+        hm = fmin(h, 0.5 * v);
+    } else if (which == 1) { /* s/H inside (largest strain, 1) */
+        hm = fmin(h, 0.5 * (v - c->xmax));
+        hp = fmin(h, 0.5 * (1 - v));
+    } else if (is_g) {
+        hm = fmin(h, v); /* g >= 0 */
+    }
+    if (!(hp > 0) && !(hm > 0))
+        return 0;
+    cf_error e = {0};
+    *slot = v + hp;
+    int ok = cf_visco_curve(&q, &c->o->setup, &c->series, mp, NULL, &e) == CF_OK;
+    *slot = v - hm;
+    ok = ok && cf_visco_curve(&q, &c->o->setup, &c->series, mm, NULL, &e) == CF_OK;
+    c->evals += 2;
+    for (size_t r = 0; ok && r < c->n; r++)
+        gsl_matrix_set(J, r, col, c->sw[r] * (mp[r] - mm[r]) / (hp + hm));
+    return ok;
+}
+
+/* Stores the standard error se of quantity `which` in res. */
+static void se_store(int which, int nb, double se, cf_visco_fit *res)
+{
+    if (which < 3)
+        res->se_ident[which] = se;
+    else if (which < 3 + 2 * nb)
+        *((which - 3) % 2 == 0 ? &res->se_g[(which - 3) / 2] : &res->se_tau_s[(which - 3) / 2]) =
+            se;
+    else
+        res->se_eta_MPa_s = se;
+}
+
 /* Central-difference Jacobian of the weighted model in the reported quantities at p, and the
-** covariance s^2 (J^T J)^-1. Fills the standard errors of res. */
-static void standard_errors(ctx *c, const cf_visco_params *p, double s2, cf_visco_fit *res)
+** covariance s^2 (J^T W J)^-1. A quantity on a limit (held[]: rho on rho_min, s/H on the
+** stability bound, the scale on the design cap) is set by the limit, not by the data: it is held
+** here (its error undetermined), or the others' errors would carry its freedom along the limit. */
+static void standard_errors(ctx *c, const cf_visco_params *p, const int held[3], double s2,
+                            cf_visco_fit *res)
 {
     for (int i = 0; i < 3; i++)
         res->se_ident[i] = -1;
     for (int i = 0; i < CF_PRONY_MAX; i++)
         res->se_g[i] = res->se_tau_s[i] = -1;
     res->se_eta_MPa_s = -1;
-    /* parameter list: rho, s/H, scale (free elastic), g_i, tau_i, eta */
-    const int nb = p->nbranch;
-    /* rho on its lower bound is set by the limit, not by the data: it is held here (its error
-    ** undetermined), or the others' errors would carry its freedom along the bound */
-    const int rho_held = !c->free_el || p->rho <= c->rho_lo * (1 + 1e-4);
-    res->rho_at_limit = c->free_el && rho_held;
-    const size_t k = (size_t)((c->free_el ? 3 : 0) - (c->free_el && rho_held) + 2 * nb +
-                              (c->dash ? 1 : 0));
+    const int nq = 3 + 2 * p->nbranch + 1;
+    cf_visco_params q = *p;
+    size_t k = 0;
+    for (int which = 0; which < nq; which++)
+        k += se_slot(c, held, which, &q) != NULL;
     if (k == 0 || c->n <= k)
         return;
     gsl_matrix *J = gsl_matrix_alloc(c->n, k), *cov = gsl_matrix_alloc(k, k);
     double *mp = malloc(c->n * sizeof(double)), *mm = malloc(c->n * sizeof(double));
-    if (!J || !cov || !mp || !mm)
-        goto out;
+    int ok = J && cov && mp && mm;
     size_t col = 0;
-    int ok = 1;
-    for (int which = 0; ok && which < 3 + 2 * nb + 1; which++) {
-        double *slot = NULL;
-        cf_visco_params q = *p;
-        if (which < 3) {
-            if (!c->free_el || (which == 0 && rho_held))
-                continue;
-            slot = which == 0 ? &q.rho : which == 1 ? &q.solid_strain : &q.stress_scale_MPa;
-        } else if (which < 3 + 2 * nb) {
-            int i = (which - 3) / 2;
-            slot = (which - 3) % 2 == 0 ? &q.g[i] : &q.tau_s[i];
-        } else {
-            if (!c->dash)
-                continue;
-            slot = &q.eta_MPa_s;
-        }
-        const double v = *slot;
-        const int is_g = which >= 3 && which < 3 + 2 * nb && (which - 3) % 2 == 0;
-        double h = SE_STEP * fmax(fabs(v), is_g ? 1e-2 : 1e-300);
-        double hp = h, hm = h;
-        if (which == 0) { /* keep rho inside (0, 1] */
-            hp = fmin(h, 1 - v);
-            hm = fmin(h, 0.5 * v);
-        } else if (which == 1) { /* s/H inside (largest strain, 1) */
-            hm = fmin(h, 0.5 * (v - c->xmax));
-            hp = fmin(h, 0.5 * (1 - v));
-        } else if (is_g) {
-            hm = fmin(h, v); /* g >= 0 */
-        }
-        if (!(hp > 0) && !(hm > 0)) {
-            ok = 0;
-            break;
-        }
-        cf_error e = {0};
-        *slot = v + hp;
-        ok = cf_visco_curve(&q, &c->o->setup, &c->series, mp, NULL, &e) == CF_OK;
-        *slot = v - hm;
-        ok = ok && cf_visco_curve(&q, &c->o->setup, &c->series, mm, NULL, &e) == CF_OK;
-        c->evals += 2;
-        for (size_t r = 0; ok && r < c->n; r++)
-            gsl_matrix_set(J, r, col, c->sw[r] * (mp[r] - mm[r]) / (hp + hm));
-        col++;
-    }
+    for (int which = 0; ok && which < nq; which++)
+        if (se_slot(c, held, which, &q))
+            ok = se_column(c, p, held, which, J, col++, mp, mm);
     if (ok && gsl_multifit_nlinear_covar(J, 1e-13, cov) == GSL_SUCCESS) {
         col = 0;
-        for (int which = 0; which < 3 + 2 * nb + 1; which++) {
-            if ((which < 3 && !c->free_el) || (which == 0 && rho_held) ||
-                (which == 3 + 2 * nb && !c->dash))
+        for (int which = 0; which < nq; which++) {
+            if (!se_slot(c, held, which, &q))
                 continue;
             double var = s2 * gsl_matrix_get(cov, col, col);
-            double se = var > 0 && isfinite(var) ? sqrt(var) : -1;
-            if (which < 3)
-                res->se_ident[which] = se;
-            else if (which < 3 + 2 * nb) {
-                int i = (which - 3) / 2;
-                if ((which - 3) % 2 == 0)
-                    res->se_g[i] = se;
-                else
-                    res->se_tau_s[i] = se;
-            } else
-                res->se_eta_MPa_s = se;
+            se_store(which, p->nbranch, var > 0 && isfinite(var) ? sqrt(var) : -1, res);
             col++;
         }
     }
-out:
-    gsl_matrix_free(J);
-    gsl_matrix_free(cov);
+    if (J)
+        gsl_matrix_free(J);
+    if (cov)
+        gsl_matrix_free(cov);
     free(mp);
     free(mm);
 }
 
 /* ---- one branch count ------------------------------------------------------------------------ */
+
+/* The start when the stand-in found none: equal branches spread over the series. */
+static void default_start(const ctx *c, int nb, start *s)
+{
+    s->obj = 1;
+    memset(&s->p, 0, sizeof s->p);
+    s->p.rho = c->free_el ? 0.3 : c->o->elastic[0];
+    s->p.solid_strain = c->free_el ? 0.5 * (solid_lo(c, 0.3) + E_HI) : c->o->elastic[1];
+    s->p.stress_scale_MPa = c->free_el ? 1 : c->o->elastic[2];
+    s->p.nbranch = nb;
+    double span = c->d->t_s[c->n - 1] - c->d->t_s[0];
+    for (int i = 0; i < nb; i++) {
+        s->p.g[i] = 0.5 / nb;
+        s->p.tau_s[i] = span * pow(10, -(double)(nb - i));
+    }
+    s->p.eta_MPa_s = c->dash ? 1e-3 : 0;
+}
 
 /* Fits nb branches; fills p (actual scale and dashpot) and returns the weighted scaled sum of
 ** squares (HUGE_VAL when nothing could be evaluated). */
@@ -618,29 +713,11 @@ static double fit_nb(ctx *c, int nb, cf_visco_params *pout)
     c->nb = nb;
     c->np = (size_t)((c->free_el ? 2 : 0) + 2 * nb + (c->dash ? 1 : 0));
     start best[LM_STARTS];
-    if (!stand_in(c, best, LM_STARTS)) {
-        /* no feasible stand-in: equal branches spread over the series */
-        best[0].obj = 1;
-        memset(&best[0].p, 0, sizeof best[0].p);
-        best[0].p.rho = c->free_el ? 0.3 : c->o->elastic[0];
-        best[0].p.solid_strain = c->free_el ? 0.5 * (c->e_lo + E_HI) : c->o->elastic[1];
-        best[0].p.stress_scale_MPa = c->free_el ? 1 : c->o->elastic[2];
-        best[0].p.nbranch = nb;
-        double span = c->d->t_s[c->n - 1] - c->d->t_s[0];
-        for (int i = 0; i < nb; i++) {
-            best[0].p.g[i] = 0.5 / nb;
-            best[0].p.tau_s[i] = span * pow(10, -(double)(nb - i));
-        }
-        best[0].p.eta_MPa_s = c->dash ? 1e-3 : 0;
-    }
+    if (!stand_in(c, best, LM_STARTS))
+        default_start(c, nb, &best[0]);
     double bestobj = HUGE_VAL;
     double *z = malloc(c->np * sizeof(double)), *zbest = malloc(c->np * sizeof(double));
-    if (!z || !zbest) {
-        free(z);
-        free(zbest);
-        return HUGE_VAL;
-    }
-    for (int s = 0; s < LM_STARTS; s++) {
+    for (int s = 0; z && zbest && s < LM_STARTS; s++) {
         if (!(best[s].obj < HUGE_VAL))
             continue;
         cf_visco_params p0 = best[s].p;
@@ -656,7 +733,7 @@ static double fit_nb(ctx *c, int nb, cf_visco_params *pout)
     if (bestobj < HUGE_VAL) {
         cf_visco_params p = unpack(c, zbest);
         if (c->free_el && curve(c, &p)) {
-            double A = profile_scale(c);
+            double A = profile_scale(c, p.rho, p.solid_strain);
             p.stress_scale_MPa = A;
             p.eta_MPa_s *= A;
         }
@@ -668,6 +745,64 @@ static double fit_nb(ctx *c, int nb, cf_visco_params *pout)
 }
 
 /* ---- predictions ----------------------------------------------------------------------------- */
+
+enum { PRED_PER = 200 }; /* samples per half of a predicted history */
+
+/* One load-unload cycle to the series' largest strain at its loading rate: loop area and loading
+** work. */
+static void predict_cycle(const cf_visco_params *p, const cf_visco_setup *s, double xpeak,
+                          double tload, cf_visco_predict *out)
+{
+    double ts[2 * PRED_PER + 1];
+    cf_msm_sample smp[2 * PRED_PER + 1];
+    cf_error e = {0};
+    double pt[3] = {0, tload, 2 * tload}, pv[3] = {0, fabs(xpeak), 0};
+    cf_msm_path path = {CF_DRIVE_DISPLACEMENT, 3, pt, pv};
+    for (int k = 0; k <= 2 * PRED_PER; k++)
+        ts[k] = 2 * tload * k / (2.0 * PRED_PER);
+    if (cf_visco_run(p, s, &path, ts, 2 * PRED_PER + 1, smp, &e) != CF_OK) {
+        snprintf(out->note, sizeof out->note, "hysteresis: %.480s", e.msg);
+        return;
+    }
+    double area = 0, work = 0;
+    for (int k = 1; k <= 2 * PRED_PER; k++) {
+        double dA = 0.5 * (smp[k].stress_MPa + smp[k - 1].stress_MPa) *
+                    (smp[k].strain - smp[k - 1].strain);
+        area += dA;
+        if (k <= PRED_PER)
+            work += dA;
+    }
+    out->hysteresis_done = 1;
+    out->cycle_strain = xpeak;
+    out->cycle_period_s = 2 * tload;
+    out->loop_area_MPa = area;
+    out->loading_work_MPa = work;
+}
+
+/* Creep under the stress sc (MPa, magnitude) applied in tload and held for thold; sgn is the
+** table's sign of the loading. */
+static void predict_creep(const cf_visco_params *p, const cf_visco_setup *s, double sc,
+                          double sgn, double tload, double thold, cf_visco_predict *out)
+{
+    double ts[2 * PRED_PER + 1];
+    cf_msm_sample smp[2 * PRED_PER + 1];
+    double pt[3] = {0, tload, tload + thold}, pv[3] = {0, sc, sc};
+    cf_msm_path path = {CF_DRIVE_FORCE, 3, pt, pv};
+    for (int k = 0; k <= 2 * PRED_PER; k++)
+        ts[k] = k <= PRED_PER ? tload * k / PRED_PER : tload + thold * (k - PRED_PER) / PRED_PER;
+    cf_error ce = {0};
+    if (sc > 0 && cf_visco_run(p, s, &path, ts, 2 * PRED_PER + 1, smp, &ce) == CF_OK) {
+        out->creep_done = 1;
+        out->creep_stress_MPa = sgn * sc;
+        out->creep_ramp_s = tload;
+        out->creep_hold_s = thold;
+        out->creep_strain_ramp = sgn * smp[PRED_PER].strain;
+        out->creep_strain_end = sgn * smp[2 * PRED_PER].strain;
+    } else if (!out->note[0]) {
+        snprintf(out->note, sizeof out->note, "creep: %.480s",
+                 sc > 0 ? ce.msg : "the series ends at zero stress");
+    }
+}
 
 void cf_visco_predictions(const cf_visco_params *p, const cf_visco_setup *s,
                           const cf_visco_data *d, cf_visco_predict *out)
@@ -689,55 +824,8 @@ void cf_visco_predictions(const cf_visco_params *p, const cf_visco_setup *s,
         tload = 1;
     if (!(thold > 0))
         thold = tload;
-    const double sgn = d->x[kp] < 0 ? -1.0 : 1.0; /* table's sign of the loading */
-    enum { PER = 200 };
-    double ts[2 * PER + 1];
-    cf_msm_sample smp[2 * PER + 1];
-    cf_error e = {0};
-    /* one load-unload cycle to the largest strain at the series' loading rate */
-    {
-        double pt[3] = {0, tload, 2 * tload}, pv[3] = {0, fabs(d->x[kp]), 0};
-        cf_msm_path path = {CF_DRIVE_DISPLACEMENT, 3, pt, pv};
-        for (int k = 0; k <= 2 * PER; k++)
-            ts[k] = 2 * tload * k / (2.0 * PER);
-        if (cf_visco_run(p, s, &path, ts, 2 * PER + 1, smp, &e) == CF_OK) {
-            double area = 0, work = 0;
-            for (int k = 1; k <= 2 * PER; k++) {
-                double dA = 0.5 * (smp[k].stress_MPa + smp[k - 1].stress_MPa) *
-                            (smp[k].strain - smp[k - 1].strain);
-                area += dA;
-                if (k <= PER)
-                    work += dA;
-            }
-            out->hysteresis_done = 1;
-            out->cycle_strain = d->x[kp];
-            out->cycle_period_s = 2 * tload;
-            out->loop_area_MPa = area;
-            out->loading_work_MPa = work;
-        } else {
-            snprintf(out->note, sizeof out->note, "hysteresis: %.480s", e.msg);
-        }
-    }
-    /* creep under the series' final stress, applied in the loading time and held */
-    {
-        double sc = fabs(d->y[n - 1]);
-        double pt[3] = {0, tload, tload + thold}, pv[3] = {0, sc, sc};
-        cf_msm_path path = {CF_DRIVE_FORCE, 3, pt, pv};
-        for (int k = 0; k <= 2 * PER; k++)
-            ts[k] = k <= PER ? tload * k / PER : tload + thold * (k - PER) / PER;
-        cf_error ce = {0};
-        if (sc > 0 && cf_visco_run(p, s, &path, ts, 2 * PER + 1, smp, &ce) == CF_OK) {
-            out->creep_done = 1;
-            out->creep_stress_MPa = sgn * sc;
-            out->creep_ramp_s = tload;
-            out->creep_hold_s = thold;
-            out->creep_strain_ramp = sgn * smp[PER].strain;
-            out->creep_strain_end = sgn * smp[2 * PER].strain;
-        } else if (!out->note[0]) {
-            snprintf(out->note, sizeof out->note, "creep: %.480s",
-                     sc > 0 ? ce.msg : "the series ends at zero stress");
-        }
-    }
+    predict_cycle(p, s, d->x[kp], tload, out);
+    predict_creep(p, s, fabs(d->y[n - 1]), d->x[kp] < 0 ? -1.0 : 1.0, tload, thold, out);
 }
 
 /* ---- the fit --------------------------------------------------------------------------------- */
@@ -750,6 +838,182 @@ void cf_visco_fit_free(cf_visco_fit *r)
     free(r->is_hold);
     r->model_MPa = NULL;
     r->is_hold = NULL;
+}
+
+/* Checks the options against the series and fills the fit state (weights, bounds, limits). */
+static cf_status fit_setup(ctx *c, const cf_visco_data *d, const cf_visco_fit_options *o,
+                           cf_error *err)
+{
+    const size_t n = d->count;
+    memset(c, 0, sizeof *c);
+    c->d = d;
+    c->o = o;
+    c->n = n;
+    c->free_el = !o->hold_elastic;
+    c->dash = o->dashpot != 0;
+    c->series.count = n;
+    c->series.t_s = d->t_s;
+    c->series.strain = d->x;
+    for (size_t k = 0; k < n; k++) {
+        c->ymax = fmax(c->ymax, fabs(d->y[k]));
+        c->xmax = fmax(c->xmax, fabs(d->x[k]));
+    }
+    c->e_lo = c->xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
+    c->rho_lo = o->rho_min > 0 && o->rho_min < RHO_HI ? o->rho_min : 1e-3;
+    const double *el = o->elastic;
+    if (o->hold_elastic && (!(el[0] > 0 && el[0] <= 1) || !(el[1] > c->xmax && el[1] < 1) ||
+                            !(el[2] > 0) || !isfinite(el[2])))
+        return cf_error_set(err, CF_E_DATA,
+                            "the held elastic fit (rho %g, s/H %g, F_C/H^2 %g MPa) cannot carry "
+                            "this series: its solid strain must exceed the largest strain %g",
+                            el[0], el[1], el[2], c->xmax);
+    if (!(c->e_lo < E_HI))
+        return cf_error_set(err, CF_E_DATA, "largest strain %g: no conical spring reaches it",
+                            c->xmax);
+    c->sw = malloc(n * sizeof(double));
+    c->m = malloc(n * sizeof(double));
+    if (!c->sw || !c->m)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", n);
+    for (size_t k = 0; k < n; k++) {
+        double sc = o->relative ? fmax(fabs(d->y[k]), REL_FLOOR * c->ymax) : 1.0;
+        c->sw[k] = sqrt(d->w ? d->w[k] : 1.0) / sc;
+        c->ynorm += (c->sw[k] * d->y[k]) * (c->sw[k] * d->y[k]);
+    }
+    if (!(c->ynorm > 0))
+        return cf_error_set(err, CF_E_DATA, "every stress of the series is zero");
+    cf_visco_limits_init(&c->lim, o->limits, o->limit_types, c->free_el ? o->stable_cells : 0,
+                         &o->setup, c->xmax, c->rho_lo, RHO_HI, c->e_lo, E_HI);
+    if (c->lim.unstable_everywhere)
+        return cf_error_set(err, CF_E_DATA,
+                            "no conical spring (rho %g to 1, solid strain to %g) gives a lattice "
+                            "of %d^3 cells that stays stable to the series' largest strain %g",
+                            c->rho_lo, E_HI, o->stable_cells, c->xmax);
+    return CF_OK;
+}
+
+/* Fits the branch counts asked for (or 1..CF_VISCO_AIC_MAX) and keeps the lowest AIC in *best. */
+static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf_error *err)
+{
+    const cf_visco_fit_options *o = c->o;
+    const int nlo = o->nbranch ? o->nbranch : 1, nhi = o->nbranch ? o->nbranch : CF_VISCO_AIC_MAX;
+    double best_aic = HUGE_VAL;
+    memset(best, 0, sizeof *best);
+    res->chosen_by_aic = o->nbranch == 0;
+    for (int nb = nlo; nb <= nhi; nb++) {
+        cf_visco_params p;
+        if (!(fit_nb(c, nb, &p) < HUGE_VAL) || !curve(c, &p))
+            continue;
+        double rss = 0;
+        for (size_t k = 0; k < c->n; k++)
+            rss += (c->m[k] - c->d->y[k]) * (c->m[k] - c->d->y[k]);
+        int kpar = (c->free_el ? 3 : 0) + 2 * nb + c->dash;
+        double aic = (double)c->n * log(fmax(rss, 1e-300) / (double)c->n) + 2.0 * kpar;
+        if (nb - 1 < CF_VISCO_AIC_MAX)
+            res->aic_by_n[nb - 1] = aic;
+        if (aic < best_aic) {
+            best_aic = aic;
+            *best = p;
+        }
+    }
+    if (!(best_aic < HUGE_VAL))
+        return cf_error_set(err, CF_E_NOCONV,
+                            "no viscoelastic model could be evaluated along this series");
+    return CF_OK;
+}
+
+/* The quality of the model curve in res->model_MPa: RSS, RMSE overall, on ramps and in holds,
+** R^2, AIC; returns the weighted RSS. */
+static double fit_quality(const ctx *c, cf_visco_fit *res)
+{
+    const cf_visco_data *d = c->d;
+    const size_t n = c->n;
+    double ssr = 0, ssh = 0, mean = 0, sst = 0, wrss = 0;
+    for (size_t k = 0; k < n; k++)
+        mean += d->y[k] / (double)n;
+    for (size_t k = 0; k < n; k++) {
+        double r = res->model_MPa[k] - d->y[k];
+        res->rss += r * r;
+        wrss += (c->sw[k] * r) * (c->sw[k] * r);
+        sst += (d->y[k] - mean) * (d->y[k] - mean);
+        res->max_abs_error = fmax(res->max_abs_error, fabs(r));
+        if (res->is_hold[k]) {
+            ssh += r * r;
+            res->n_hold++;
+        } else {
+            ssr += r * r;
+            res->n_ramp++;
+        }
+    }
+    res->rmse = sqrt(res->rss / (double)n);
+    res->rmse_ramp = res->n_ramp ? sqrt(ssr / (double)res->n_ramp) : -1;
+    res->rmse_hold = res->n_hold ? sqrt(ssh / (double)res->n_hold) : -1;
+    res->r2 = sst > 0 ? 1 - res->rss / sst : 0;
+    res->aic = (double)n * log(fmax(res->rss, 1e-300) / (double)n) + 2.0 * res->k;
+    return wrss;
+}
+
+/* Which limits the fitted elastic quantities sit on, and where the elastic lattice of the fitted
+** spring loses stability. */
+static void fit_limits(const ctx *c, const cf_visco_params *p, cf_visco_fit *res, int held[3])
+{
+    held[0] = held[1] = held[2] = 0;
+    res->stable_to_strain = 0;
+    if (!c->free_el)
+        return;
+    held[0] = res->rho_at_limit = p->rho <= c->rho_lo * (1 + 1e-4);
+    held[1] = res->at_stability_limit =
+        c->lim.cells > 0 && solid_lo(c, p->rho) > c->e_lo &&
+        p->solid_strain <= solid_lo(c, p->rho) * (1 + 1e-6);
+    held[2] = res->at_design_limit =
+        p->stress_scale_MPa >=
+        cf_visco_limits_scale_max(&c->lim, p->rho, p->solid_strain) * (1 - 1e-9);
+    if (c->lim.cells <= 0)
+        return;
+    cf_spring sp = cf_spring_member(p->rho, p->solid_strain, p->stress_scale_MPa);
+    cf_law law;
+    cf_error e = {0};
+    cf_msm_config cfg = c->o->setup.cfg;
+    cfg.lattice.nx = cfg.lattice.ny = cfg.lattice.nz = c->lim.cells;
+    double lim = 0;
+    if (cf_law_init(&law, &sp, &e) == CF_OK) {
+        if (cf_msm_stability_limit(&law, c->o->setup.method, &cfg, -1, &lim, &e) == CF_OK)
+            res->stable_to_strain = lim;
+        cf_law_free(&law);
+    }
+}
+
+/* The reported model: its curve, quality, standard errors, moduli and predictions. */
+static cf_status fit_report(ctx *c, const cf_visco_params *bestp, cf_visco_fit *res,
+                            cf_error *err)
+{
+    const cf_visco_fit_options *o = c->o;
+    cf_error e = {0};
+    cf_status st;
+    c->nb = bestp->nbranch;
+    if ((st = cf_visco_curve(bestp, &o->setup, &c->series, res->model_MPa, NULL, &e)) != CF_OK)
+        return cf_error_set(err, st, "%s", e.msg);
+    c->evals++;
+    res->p = *bestp;
+    res->dashpot = c->dash;
+    res->held_elastic = !c->free_el;
+    res->count = c->n;
+    res->k = (c->free_el ? 3 : 0) + 2 * bestp->nbranch + c->dash;
+    double wrss = fit_quality(c, res);
+    double s2 = (double)c->n > res->k ? wrss / ((double)c->n - res->k) : 0;
+    int held[3];
+    fit_limits(c, bestp, res, held);
+    standard_errors(c, bestp, held, s2, res);
+    /* small-strain moduli of the lattice */
+    double Eel[1], small = -1e-3 * bestp->solid_strain;
+    if (cf_visco_elastic_curve(bestp, &o->setup, &small, 1, Eel, &e) == CF_OK) {
+        double ginf = 1;
+        for (int i = 0; i < bestp->nbranch; i++)
+            ginf -= bestp->g[i];
+        res->E_inst_MPa = Eel[0] / small;
+        res->E_eq_MPa = ginf * res->E_inst_MPa;
+    }
+    cf_visco_predictions(bestp, &o->setup, c->d, &res->pred);
+    return CF_OK;
 }
 
 cf_status cf_visco_fit_run(const cf_visco_data *d, const cf_visco_fit_options *o,
@@ -773,139 +1037,14 @@ cf_status cf_visco_fit_run(const cf_visco_data *d, const cf_visco_fit_options *o
         return st;
     }
     ctx c;
-    memset(&c, 0, sizeof c);
-    c.d = d;
-    c.o = o;
-    c.n = n;
-    c.free_el = !o->hold_elastic;
-    c.dash = o->dashpot != 0;
-    c.series.count = n;
-    c.series.t_s = d->t_s;
-    c.series.strain = d->x;
-    for (size_t k = 0; k < n; k++) {
-        c.ymax = fmax(c.ymax, fabs(d->y[k]));
-        c.xmax = fmax(c.xmax, fabs(d->x[k]));
-    }
-    c.e_lo = c.xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
-    c.rho_lo = o->rho_min > 0 && o->rho_min < RHO_HI ? o->rho_min : 1e-3;
-    if (o->hold_elastic) {
-        const double *el = o->elastic;
-        if (!(el[0] > 0 && el[0] <= 1) || !(el[1] > c.xmax && el[1] < 1) || !(el[2] > 0) ||
-            !isfinite(el[2])) {
-            cf_visco_fit_free(res);
-            return cf_error_set(err, CF_E_DATA,
-                                "the held elastic fit (rho %g, s/H %g, F_C/H^2 %g MPa) cannot "
-                                "carry this series: its solid strain must exceed the largest "
-                                "strain %g",
-                                el[0], el[1], el[2], c.xmax);
-        }
-    }
-    if (!(c.e_lo < E_HI)) {
-        cf_visco_fit_free(res);
-        return cf_error_set(err, CF_E_DATA,
-                            "largest strain %g: no conical spring reaches it", c.xmax);
-    }
-    c.sw = malloc(n * sizeof(double));
-    c.m = malloc(n * sizeof(double));
-    if (!c.sw || !c.m) {
-        st = cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", n);
-        goto out;
-    }
-    for (size_t k = 0; k < n; k++) {
-        double sc = o->relative ? fmax(fabs(d->y[k]), REL_FLOOR * c.ymax) : 1.0;
-        c.sw[k] = sqrt(d->w ? d->w[k] : 1.0) / sc;
-        c.ynorm += (c.sw[k] * d->y[k]) * (c.sw[k] * d->y[k]);
-    }
-    if (!(c.ynorm > 0)) {
-        st = cf_error_set(err, CF_E_DATA, "every stress of the series is zero");
-        goto out;
-    }
-    /* Branch counts: the one asked for, or 1..4 by AIC. */
-    int nlo = o->nbranch ? o->nbranch : 1, nhi = o->nbranch ? o->nbranch : CF_VISCO_AIC_MAX;
-    double best_aic = HUGE_VAL;
     cf_visco_params bestp;
-    memset(&bestp, 0, sizeof bestp);
-    res->chosen_by_aic = o->nbranch == 0;
-    for (int nb = nlo; nb <= nhi; nb++) {
-        cf_visco_params p;
-        if (!(fit_nb(&c, nb, &p) < HUGE_VAL))
-            continue;
-        cf_error e = {0};
-        if (cf_visco_curve(&p, &o->setup, &c.series, c.m, NULL, &e) != CF_OK)
-            continue;
-        c.evals++;
-        double rss = 0;
-        for (size_t k = 0; k < n; k++)
-            rss += (c.m[k] - d->y[k]) * (c.m[k] - d->y[k]);
-        int kpar = (c.free_el ? 3 : 0) + 2 * nb + c.dash;
-        double aic = (double)n * log(fmax(rss, 1e-300) / (double)n) + 2.0 * kpar;
-        if (nb - 1 < CF_VISCO_AIC_MAX)
-            res->aic_by_n[nb - 1] = aic;
-        if (aic < best_aic) {
-            best_aic = aic;
-            bestp = p;
-        }
-    }
-    if (!(best_aic < HUGE_VAL)) {
-        st = cf_error_set(err, CF_E_NOCONV,
-                          "no viscoelastic model could be evaluated along this series");
-        goto out;
-    }
-    /* The reported model, its curve and its quality. */
-    {
-        cf_error e = {0};
-        c.nb = bestp.nbranch;
-        if ((st = cf_visco_curve(&bestp, &o->setup, &c.series, res->model_MPa, NULL, &e)) !=
-            CF_OK) {
-            st = cf_error_set(err, st, "%s", e.msg);
-            goto out;
-        }
-        c.evals++;
-        res->p = bestp;
-        res->dashpot = c.dash;
-        res->held_elastic = !c.free_el;
-        res->count = n;
-        res->k = (c.free_el ? 3 : 0) + 2 * bestp.nbranch + c.dash;
-        double ssr = 0, ssh = 0, mean = 0, sst = 0, wrss = 0;
-        for (size_t k = 0; k < n; k++)
-            mean += d->y[k] / (double)n;
-        for (size_t k = 0; k < n; k++) {
-            double r = res->model_MPa[k] - d->y[k];
-            res->rss += r * r;
-            wrss += (c.sw[k] * r) * (c.sw[k] * r);
-            sst += (d->y[k] - mean) * (d->y[k] - mean);
-            res->max_abs_error = fmax(res->max_abs_error, fabs(r));
-            if (res->is_hold[k]) {
-                ssh += r * r;
-                res->n_hold++;
-            } else {
-                ssr += r * r;
-                res->n_ramp++;
-            }
-        }
-        res->rmse = sqrt(res->rss / (double)n);
-        res->rmse_ramp = res->n_ramp ? sqrt(ssr / (double)res->n_ramp) : -1;
-        res->rmse_hold = res->n_hold ? sqrt(ssh / (double)res->n_hold) : -1;
-        res->r2 = sst > 0 ? 1 - res->rss / sst : 0;
-        res->aic = (double)n * log(fmax(res->rss, 1e-300) / (double)n) + 2.0 * res->k;
-        double s2 = (double)n > res->k ? wrss / ((double)n - res->k) : 0;
-        standard_errors(&c, &bestp, s2, res);
-        /* small-strain moduli of the lattice */
-        double Eel[1], small = -1e-3 * bestp.solid_strain;
-        if (cf_visco_elastic_curve(&bestp, &o->setup, &small, 1, Eel, &e) == CF_OK) {
-            double ginf = 1;
-            for (int i = 0; i < bestp.nbranch; i++)
-                ginf -= bestp.g[i];
-            res->E_inst_MPa = Eel[0] / small;
-            res->E_eq_MPa = ginf * res->E_inst_MPa;
-        }
-        cf_visco_predictions(&bestp, &o->setup, d, &res->pred);
-    }
-out:
+    if ((st = fit_setup(&c, d, o, err)) == CF_OK && (st = fit_counts(&c, res, &bestp, err)) == CF_OK)
+        st = fit_report(&c, &bestp, res, err);
     res->evaluations = c.evals;
     res->wall_time_s = now_s() - t0;
     free(c.sw);
     free(c.m);
+    cf_visco_limits_free(&c.lim);
     if (st != CF_OK)
         cf_visco_fit_free(res);
     return st;

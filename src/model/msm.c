@@ -1280,21 +1280,29 @@ static long inertia_here(solver *s)
     return s->neg_pivots;
 }
 
+/* The static lattice of cfg built from law and its displacement-driven solver (no effects). */
+static cf_status static_open(const cf_law *law, cf_law_method m, const cf_msm_config *cfg,
+                             cf_lattice *lat, solver *s, cf_msm_stats *st, cf_error *err)
+{
+    cf_status rc = cf_lattice_create(lat, law, m, &cfg->lattice, err);
+    if (rc != CF_OK)
+        return rc;
+    if ((rc = solver_init(s, lat, NULL, cfg, CF_DRIVE_DISPLACEMENT, st, err)) != CF_OK)
+        cf_lattice_free(lat);
+    return rc;
+}
+
 cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_msm_config *cfgin,
                                  int side, double *limit, cf_error *err)
 {
     cf_msm_config cfg = cfgin ? *cfgin : cf_msm_default();
     *limit = 0;
     cf_lattice lat;
-    cf_status rc = cf_lattice_create(&lat, law, m, &cfg.lattice, err);
-    if (rc != CF_OK)
-        return rc;
     cf_msm_stats st = {0};
     solver s;
-    if ((rc = solver_init(&s, &lat, NULL, &cfg, CF_DRIVE_DISPLACEMENT, &st, err)) != CF_OK) {
-        cf_lattice_free(&lat);
+    cf_status rc = static_open(law, m, &cfg, &lat, &s, &st, err);
+    if (rc != CF_OK)
         return rc;
-    }
     double *keep = malloc(3 * lat.nn * sizeof(double));
     if (!keep) {
         rc = cf_error_set(err, CF_E_INTERNAL, "out of memory");
@@ -1339,6 +1347,63 @@ cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_ms
     }
 done:
     free(keep);
+    solver_free(&s);
+    cf_lattice_free(&lat);
+    return rc;
+}
+
+/* ---- stability of a homogeneous state -------------------------------------------------------- */
+
+cf_status cf_msm_homogeneous_inertia(const cf_law *law, cf_law_method m, const cf_msm_config *cfgin,
+                                     double strain, double lateral, long *neg, cf_error *err)
+{
+    cf_msm_config cfg = cfgin ? *cfgin : cf_msm_default();
+    /* the banded LDL^T (GSL): its D gives the inertia, and unlike the sparse factorisations it
+    ** may run on any thread (MUMPS may not) */
+    cfg.banded_only = 1;
+    *neg = -1;
+    if (!isfinite(strain) || !isfinite(lateral) || !(lateral > 0))
+        return cf_error_set(err, CF_E_DATA, "strain %g, lateral stretch %g: not a deformation",
+                            strain, lateral);
+    if (cfg.lattice.bottom != CF_BOTTOM_AXIAL)
+        return cf_error_set(err, CF_E_DATA, "a clamped bottom holds the lattice's base: its "
+                            "uniaxial state is never homogeneous");
+    cf_lattice lat;
+    cf_msm_stats st = {0};
+    solver s;
+    cf_status rc = static_open(law, m, &cfg, &lat, &s, &st, err);
+    if (rc != CF_OK)
+        return rc;
+    /* F = diag(a, a, 1 + strain) about the pinned corner (the origin) */
+    for (size_t p = 0; p < lat.nn; p++) {
+        lat.x[p] = lateral * lat.X[p];
+        lat.y[p] = lateral * lat.Y[p];
+        lat.z[p] = (1 + strain) * lat.Z[p];
+    }
+    s.load = -strain;
+    double rn, fs;
+    double um = residual(&s, &rn, &fs);
+    if (!(um < 1))
+        rc = cf_error_set(err, CF_E_DATA, "strain %g: a spring of the lattice passes solid",
+                          strain);
+    else if (!(rn <= 1e-7 * fs))
+        rc = cf_error_set(err, CF_E_DATA,
+                          "strain %g, lateral stretch %.17g: not an equilibrium of this lattice "
+                          "(residual %.3g of the largest tension; a clamped bottom is never "
+                          "homogeneous)",
+                          strain, lateral, rn / fs);
+    else {
+        /* a right-hand side of ones, whose solution is discarded, so that the factorisation's
+        ** residual check means something at an equilibrium (R = 0) */
+        for (size_t k = 0; k < s.ndof; k++)
+            s.R[k] = 1.0;
+        cf_error e = {0};
+        (void)newton_direction(&s, &e);
+        *neg = s.neg_pivots;
+        if (*neg < 0)
+            rc = cf_error_set(err, CF_E_NOCONV, "strain %g: no factorisation of the tangent "
+                              "reported its inertia", strain);
+    }
     solver_free(&s);
     cf_lattice_free(&lat);
     return rc;

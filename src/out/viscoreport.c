@@ -110,6 +110,10 @@ static void visco_keys(const cf_visco_report *r, json_t *o)
     }
     json_object_set_new(o, "elastic_held", json_boolean(f->held_elastic));
     json_object_set_new(o, "rho_at_limit", json_boolean(f->rho_at_limit));
+    json_object_set_new(o, "solid_strain_at_stability_limit", json_boolean(f->at_stability_limit));
+    json_object_set_new(o, "stress_scale_at_design_limit", json_boolean(f->at_design_limit));
+    json_object_set_new(o, "stable_to_strain",
+                        f->stable_to_strain != 0 ? num(f->stable_to_strain) : json_null());
     json_object_set_new(o, "predictions", predictions_json(r));
     json_object_set_new(o, "evaluations", json_integer((json_int_t)f->evaluations));
     json_object_set_new(o, "wall_time_s", num(r->with_timing ? f->wall_time_s : 0.0));
@@ -252,8 +256,14 @@ char *cf_visco_report_text(const cf_visco_report *r)
     fprintf(o, " elastic part%s:\n", f->held_elastic ? " (held from --elastic)" : "");
     value_se_text(o, f->rho_at_limit ? "rho = D1/D2 (at --rho-min)" : "rho = D1/D2", f->p.rho,
                   f->se_ident[0], 1, "");
-    value_se_text(o, "solid strain s/H", f->p.solid_strain, f->se_ident[1], 1, "");
-    value_se_text(o, "stress scale F_C/H^2", f->p.stress_scale_MPa, f->se_ident[2], u, r->table->y_unit);
+    value_se_text(o, f->at_stability_limit ? "solid strain s/H (at the stability limit)"
+                                           : "solid strain s/H",
+                  f->p.solid_strain, f->se_ident[1], 1, "");
+    value_se_text(o, f->at_design_limit ? "F_C/H^2 (at the design limit)" : "stress scale F_C/H^2",
+                  f->p.stress_scale_MPa, f->se_ident[2], u, r->table->y_unit);
+    if (f->stable_to_strain != 0)
+        fprintf(o, "  elastic lattice stable to strain %.4g (one cell; larger lattices further)\n",
+                f->stable_to_strain);
     fprintf(o, " Prony series, G(t) = g_inf + sum g_i exp(-t/tau_i):\n");
     for (int i = 0; i < f->p.nbranch; i++) {
         char l[32];

@@ -61,7 +61,9 @@ cf_status cf_pipeline_fit_series(const cf_table *t, const cf_pipeline_options *o
         opt->progress(opt->progress_ctx, t->path, "fitting the viscoelastic model along the series");
     cf_visco_data d = {t->count, t->t, t->x, t->y, t->w};
     cf_visco_fit_options o = *vo;
-    o.rho_min = opt->fit.rho_min; /* the placement's limit is the fit's */
+    o.rho_min = opt->fit.rho_min; /* the placement's limits are the fit's */
+    o.limits = &opt->fit;
+    o.limit_types = opt->types;
     cf_error e = {0};
     cf_status st = cf_visco_fit_run(&d, &o, &r->fit, &e);
     if (st != CF_OK)

@@ -146,6 +146,16 @@ cf_status cf_msm_uniaxial(const cf_law *law, cf_law_method m, const cf_msm_confi
 cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_msm_config *cfg,
                                  int side, double *limit, cf_error *err);
 
+/* Negative pivots (*neg) of the tangent of the static lattice (cfg->lattice, cfg NULL:
+** cf_msm_default()) built from law, at the homogeneous uniaxial state of table strain `strain`
+** (negative = compression) with lateral stretch `lateral`, F = diag(lateral, lateral, 1 + strain):
+** the state the homogenised cell (cell.h) gives, which is the lattice's equilibrium for a bottom
+** 'axial' (CF_E_DATA for a clamped bottom, or when the residual is not at rounding level).
+** 0: a stable equilibrium; > 0: a column of cells can leave it. No Newton solve: one
+** assembly and banded L D L^T factorisation of the tangent (safe on any thread). */
+cf_status cf_msm_homogeneous_inertia(const cf_law *law, cf_law_method m, const cf_msm_config *cfg,
+                                     double strain, double lateral, long *neg, cf_error *err);
+
 /* The explicit stable step (s) of the lattice at its current state for the given effects
 ** (stiffest spring tangent, lightest mass, most springs at one node; the dashpots shorten it).
 ** Calls cf_lattice_forces. */

@@ -40,6 +40,17 @@ typedef struct cf_visco_fit_options {
     double elastic[3];      /* rho [-], s/H [-], F_C/H^2 [MPa] */
     int relative;           /* 1: residuals relative to |stress| (floor 1e-3 max|stress|) */
     double rho_min;         /* smallest rho fitted (default the fitter's, 0.05) */
+    /* Design limits (fit.h): when not NULL, rho, s/H and F_C/H^2 stay where a spring of one of
+    ** the types in limit_types (bits 1 << CF_TELESCOPING, 1 << CF_NON_TELESCOPING) can be
+    ** placed within them (cf_fit_ident_limit): the stress scale is capped at the largest such a
+    ** spring carries. NULL: no cap (the spring may then be one no one could build). */
+    const cf_fit_options *limits;
+    unsigned limit_types;
+    /* Stability: when > 0, the static lattice of stable_cells^3 cells (the weights of setup)
+    ** built from the fitted spring must stay stable (no negative pivot of its tangent) up to
+    ** the series' largest strain, so that every lattice `simulate` runs of it follows the fit
+    ** (the one-cell lattice loses stability first: 1 is the default and the safe choice). */
+    int stable_cells;
     cf_visco_setup setup;   /* where the model is evaluated */
 } cf_visco_fit_options;
 
@@ -89,6 +100,13 @@ typedef struct cf_visco_fit {
     int held_elastic;                   /* 1 when the elastic quantities were held */
     int rho_at_limit;                   /* 1 when rho sits on its lower limit (rho_min): set by
                                            the limit, its standard error undetermined */
+    int at_stability_limit;             /* 1 when s/H sits on the smallest value that keeps the
+                                           lattice stable over the series */
+    int at_design_limit;                /* 1 when F_C/H^2 sits on the largest value a spring
+                                           within the design limits carries */
+    double stable_to_strain;            /* where the elastic lattice of stable_cells^3 cells of
+                                           the fitted spring loses stability, table's sign;
+                                           0 when stable to 0.995 of solid or not checked */
     int chosen_by_aic;                  /* 1 when N was chosen by AIC */
     double aic_by_n[CF_VISCO_AIC_MAX];  /* AIC of N = 1..4 when chosen by AIC (MPa^2 in RSS) */
     size_t count, n_ramp, n_hold;       /* points in all, on ramps, in holds */
