@@ -1053,125 +1053,120 @@ static cf_status decide_measures(const reader *r, const char *path, const cf_mea
     return CF_OK;
 }
 
-/* Why one long function: reading a table is one pass through six stages in order (the text, the
-** header, which columns, their units, the rows, the test mode; each marked by a comment below),
-** every stage reads what the previous ones decided (the delimiter, the column indices, the unit
-** factors) and every refusal must release everything through the one `fail:` exit, so that no
-** error path can leak or leave a half-filled table. The helpers above do each stage's detail. */
-cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf_table *m,
-                          cf_error *err)
-{
-    cf_measure_options opt = opt_in ? *opt_in : cf_measure_default_options();
-    reader r;
-    cf_status st;
-    memset(&r, 0, sizeof r);
-    memset(m, 0, sizeof *m);
-    if (!path)
-        return cf_error_set(err, CF_E_NOINPUT, "no input file named");
-    r.path = path;
-    if ((st = read_all(&r, err)) != CF_OK)
-        goto fail;
-    path = r.path; /* "(standard input)" for "-" */
-    if ((st = spreadsheet_check(&r, err)) != CF_OK || (st = cut_lines(&r, err)) != CF_OK ||
-        (st = scan_text(&r, err)) != CF_OK)
-        goto fail;
+/* What the header decided, for the stages after it: where it is, its delimiter, its columns and
+** which of them are x, y, the weight and the time (-1: none). */
+typedef struct layout {
+    size_t hi, hn;         /* index of the header in r->lines, its content length */
+    size_t header_line;    /* its line number */
+    char hq[256];          /* the header quoted, for messages */
+    char delim;
+    size_t ncols;
+    int trailing;          /* the header ends with a delimiter: so must every row */
+    long xi, yi, wi, ti;
+} layout;
 
-    /* The header: the first line with content. */
-    size_t hi = 0, hn = 0;
-    while (hi < r.nlines) {
-        if (!is_comment_line(&r.lines[hi]) &&
-            (hn = content_length(r.lines[hi].s, r.lines[hi].n)) > 0)
+/* The units decided: the y unit, the measures, and the factors to conifit's units. */
+typedef struct scaling {
+    const unit_def *yu;
+    cf_table_measures meas;
+    int stretch;           /* x is a stretch: strain = x - 1 */
+    double xscale, yscale, tscale;
+} scaling;
+
+/* The header: the first line with content. */
+static cf_status find_header(const reader *r, layout *h, cf_error *err)
+{
+    const char *path = r->path;
+    h->hi = 0;
+    h->hn = 0;
+    while (h->hi < r->nlines) {
+        if (!is_comment_line(&r->lines[h->hi]) &&
+            (h->hn = content_length(r->lines[h->hi].s, r->lines[h->hi].n)) > 0)
             break;
-        hi++;
+        h->hi++;
     }
-    if (hi == r.nlines) {
-        if (r.size == 0)
-            st = data_error(err, path, 1, 1, "empty file: no header and no data (0 bytes)");
-        else
-            st = data_error(err, path, r.nlines ? r.lines[r.nlines - 1].line : 1, 1,
-                            "no header row and no data: only comments and blank lines (%zu "
-                            "bytes)", r.size);
-        goto fail;
-    }
-    const line_span *hl = &r.lines[hi];
-    const size_t header_line = hl->line;
-    char hq[256];
-    quote(hq, sizeof hq, hl->s, hn);
-    char delim = detect_delimiter(hl->s, hn);
-    if (!delim) {
-        st = data_error(err, path, header_line, 1,
-                        "the header has a single column; expected at least x and y separated by "
-                        "',' ';' TAB or blanks ('%s')", hq);
-        goto fail;
-    }
-    if ((st = split_or_fail(&r, hl, hn, delim, err)) != CF_OK)
-        goto fail;
-    size_t ncols = r.f.count;
-    int trailing = 0;
-    if (ncols > 1 && field(&r.f, ncols - 1)[0] == '\0') {
-        trailing = 1; /* the header ends with a delimiter: so must every row */
+    if (h->hi < r->nlines)
+        return CF_OK;
+    if (r->size == 0)
+        return data_error(err, path, 1, 1, "empty file: no header and no data (0 bytes)");
+    return data_error(err, path, r->nlines ? r->lines[r->nlines - 1].line : 1, 1,
+                      "no header row and no data: only comments and blank lines (%zu bytes)",
+                      r->size);
+}
+
+/* The header's delimiter and column names (r->cols). */
+static cf_status read_header(reader *r, layout *h, cf_error *err)
+{
+    const char *path = r->path;
+    const line_span *hl = &r->lines[h->hi];
+    h->header_line = hl->line;
+    quote(h->hq, sizeof h->hq, hl->s, h->hn);
+    h->delim = detect_delimiter(hl->s, h->hn);
+    if (!h->delim)
+        return data_error(err, path, h->header_line, 1,
+                          "the header has a single column; expected at least x and y separated "
+                          "by ',' ';' TAB or blanks ('%s')", h->hq);
+    cf_status st = split_or_fail(r, hl, h->hn, h->delim, err);
+    if (st != CF_OK)
+        return st;
+    size_t ncols = r->f.count;
+    h->trailing = 0;
+    if (ncols > 1 && field(&r->f, ncols - 1)[0] == '\0') {
+        h->trailing = 1;
         ncols--;
     }
-    if (ncols > CF_MEASURE_MAX_COLUMNS) {
-        st = data_error(err, path, header_line, CF_MEASURE_MAX_COLUMNS + 1,
-                        "the header has %zu columns; a table may have at most %d ('%s')", ncols,
-                        CF_MEASURE_MAX_COLUMNS, hq);
-        goto fail;
-    }
-    r.cols = calloc(ncols, sizeof *r.cols);
-    if (!r.cols) {
-        st = out_of_memory(err, path);
-        goto fail;
-    }
-    r.ncols = ncols;
+    if (ncols > CF_MEASURE_MAX_COLUMNS)
+        return data_error(err, path, h->header_line, CF_MEASURE_MAX_COLUMNS + 1,
+                          "the header has %zu columns; a table may have at most %d ('%s')", ncols,
+                          CF_MEASURE_MAX_COLUMNS, h->hq);
+    r->cols = calloc(ncols, sizeof *r->cols);
+    if (!r->cols)
+        return out_of_memory(err, path);
+    r->ncols = h->ncols = ncols;
     size_t numeric = 0;
     for (size_t i = 0; i < ncols; i++) {
-        const char *name = field(&r.f, i);
+        const char *name = field(&r->f, i);
         double v;
-        if (name[0] == '\0') {
-            st = data_error(err, path, header_line, i + 1, "column %zu has no name ('%s')",
-                            i + 1, hq);
-            goto fail;
-        }
-        if (strlen(name) >= NAME_CAP) {
-            st = data_error(err, path, header_line, i + 1, "column name too long ('%.60s...')",
-                            name);
-            goto fail;
-        }
-        if (parse_number(name, delim, &v) == NUM_OK)
+        if (name[0] == '\0')
+            return data_error(err, path, h->header_line, i + 1, "column %zu has no name ('%s')",
+                              i + 1, h->hq);
+        if (strlen(name) >= NAME_CAP)
+            return data_error(err, path, h->header_line, i + 1,
+                              "column name too long ('%.60s...')", name);
+        if (parse_number(name, h->delim, &v) == NUM_OK)
             numeric++;
-        column_parse(&r.cols[i], name);
+        column_parse(&r->cols[i], name);
     }
-    if (numeric == ncols) {
-        st = data_error(err, path, header_line, 1,
-                        "missing header: the first row holds numbers, not column names ('%s')",
-                        hq);
-        goto fail;
-    }
+    if (numeric == ncols)
+        return data_error(err, path, h->header_line, 1,
+                          "missing header: the first row holds numbers, not column names ('%s')",
+                          h->hq);
+    return CF_OK;
+}
 
-    /* Which columns: x, y, weight, time. */
+/* Which columns: x, y, weight, time (the options name x and y, else their names tell). */
+static cf_status choose_columns(const reader *r, const cf_measure_options *opt, layout *h,
+                                cf_error *err)
+{
+    const size_t ncols = h->ncols;
     long xi = -1, yi = -1, wi = -1, ti = -1;
     for (size_t i = 0; i < ncols; i++) {
-        if (wi < 0 && is_weight_name(r.cols[i].base))
+        if (wi < 0 && is_weight_name(r->cols[i].base))
             wi = (long)i;
-        if (ti < 0 && is_time_name(r.cols[i].base))
+        if (ti < 0 && is_time_name(r->cols[i].base))
             ti = (long)i;
     }
-    if (opt.x_col && (xi = find_column(&r, opt.x_col)) < 0) {
-        st = column_not_found(&r, header_line, "x", opt.x_col, err);
-        goto fail;
-    }
-    if (opt.y_col && (yi = find_column(&r, opt.y_col)) < 0) {
-        st = column_not_found(&r, header_line, "y", opt.y_col, err);
-        goto fail;
-    }
+    if (opt->x_col && (xi = find_column(r, opt->x_col)) < 0)
+        return column_not_found(r, h->header_line, "x", opt->x_col, err);
+    if (opt->y_col && (yi = find_column(r, opt->y_col)) < 0)
+        return column_not_found(r, h->header_line, "y", opt->y_col, err);
     for (int pass = 0; pass < 2 && yi < 0; pass++)
         for (size_t i = 0; i < ncols && yi < 0; i++)
-            if ((long)i != xi && (pass == 0 ? is_y_name(r.cols[i].base)
-                                            : y_name_class(r.cols[i].base) != CF_UNIT_UNKNOWN))
+            if ((long)i != xi && (pass == 0 ? is_y_name(r->cols[i].base)
+                                            : y_name_class(r->cols[i].base) != CF_UNIT_UNKNOWN))
                 yi = (long)i;
     for (size_t i = 0; i < ncols && xi < 0; i++)
-        if ((long)i != yi && is_x_name(r.cols[i].base))
+        if ((long)i != yi && is_x_name(r->cols[i].base))
             xi = (long)i;
     for (size_t i = 0; i < ncols && (xi < 0 || yi < 0); i++) {
         if ((long)i == xi || (long)i == yi || (long)i == wi || (long)i == ti)
@@ -1181,268 +1176,345 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
         else
             yi = (long)i;
     }
-    if (xi < 0 || yi < 0 || xi == yi) {
-        st = data_error(err, path, header_line, 1,
-                        "cannot tell which columns are x and y; name them (strain, stress_kPa, "
-                        "...) or set option x_col and option y_col ('%s')", hq);
-        goto fail;
-    }
-    if (wi == xi || wi == yi)
-        wi = -1;
-    if (ti == xi || ti == yi)
-        ti = -1;
+    if (xi < 0 || yi < 0 || xi == yi)
+        return data_error(err, r->path, h->header_line, 1,
+                          "cannot tell which columns are x and y; name them (strain, stress_kPa, "
+                          "...) or set option x_col and option y_col ('%s')", h->hq);
+    h->xi = xi;
+    h->yi = yi;
+    h->wi = wi == xi || wi == yi ? -1 : wi;
+    h->ti = ti == xi || ti == yi ? -1 : ti;
+    return CF_OK;
+}
 
-    /* Units. y first: it decides between stress-strain and force-displacement. */
-    const column *xc = &r.cols[xi], *yc = &r.cols[yi];
+/* The unit of y, which decides between stress-strain and force-displacement (m->kind). */
+static cf_status y_unit(const reader *r, const cf_measure_options *opt, const layout *h,
+                        cf_table *m, scaling *u, cf_error *err)
+{
+    const column *yc = &r->cols[h->yi];
     cf_unit_class yname = y_name_class(yc->base);
     const char *yopt = NULL, *yflag = "option stress_unit";
     cf_unit_class ywant[2] = {CF_UNIT_STRESS, CF_UNIT_FORCE};
     size_t nywant = 2;
     if (yname == CF_UNIT_STRESS) {
-        yopt = opt.stress_unit;
+        yopt = opt->stress_unit;
         nywant = 1;
     } else if (yname == CF_UNIT_FORCE) {
-        yopt = opt.force_unit;
+        yopt = opt->force_unit;
         yflag = "option force_unit";
         ywant[0] = CF_UNIT_FORCE;
         nywant = 1;
-    } else if (opt.stress_unit) {
-        yopt = opt.stress_unit;
-    } else if (opt.force_unit) {
-        yopt = opt.force_unit;
+    } else if (opt->stress_unit) {
+        yopt = opt->stress_unit;
+    } else if (opt->force_unit) {
+        yopt = opt->force_unit;
         yflag = "option force_unit";
     }
-    const unit_def *yu = NULL, *xu = NULL, *tu = NULL;
-    if ((st = column_unit(&r, header_line, (size_t)yi, yopt, yflag, 1, ywant, nywant, &yu, err)))
-        goto fail;
-    if (!yu) {
+    cf_status st = column_unit(r, h->header_line, (size_t)h->yi, yopt, yflag, 1, ywant, nywant,
+                               &u->yu, err);
+    if (st)
+        return st;
+    if (!u->yu) {
         const char *hint = yname == CF_UNIT_FORCE ? "force_N or force [mN], or set option force_unit"
                                                   : "stress_kPa or stress [kPa], or set "
                                                     "option stress_unit (option force_unit for a "
                                                     "force)";
-        st = data_error(err, path, header_line, (size_t)yi + 1,
-                        "column '%s' has no unit: name it like %s ('%s')", yc->name, hint,
-                        yc->name);
-        goto fail;
+        return data_error(err, r->path, h->header_line, (size_t)h->yi + 1,
+                          "column '%s' has no unit: name it like %s ('%s')", yc->name, hint,
+                          yc->name);
     }
-    m->kind = yu->cls == CF_UNIT_STRESS ? CF_TABLE_STRESS_STRAIN : CF_TABLE_FORCE_DISPLACEMENT;
-    cf_table_measures meas;
-    if ((st = decide_measures(&r, path, &opt, xc, yc, &meas, err)))
-        goto fail;
-    int stretch = meas.strain == CF_STRAIN_STRETCH;
-    double xscale = 1.0;
+    m->kind =
+        u->yu->cls == CF_UNIT_STRESS ? CF_TABLE_STRESS_STRAIN : CF_TABLE_FORCE_DISPLACEMENT;
+    u->yscale = u->yu->to_conifit;
+    return CF_OK;
+}
+
+/* The unit of x: a strain or stretch against a stress, a length against a force. */
+static cf_status x_unit(const reader *r, const cf_measure_options *opt, const layout *h,
+                        const cf_table *m, scaling *u, cf_error *err)
+{
+    const char *path = r->path;
+    const column *xc = &r->cols[h->xi];
+    const unit_def *xu = NULL;
+    u->xscale = 1.0;
     if (m->kind == CF_TABLE_STRESS_STRAIN) {
         cf_unit_class xw[1] = {CF_UNIT_STRAIN};
         if (xc->unit[0]) {
             const unit_def *d = unit_find(xc->unit);
-            if (!d || d->cls != CF_UNIT_STRAIN) {
-                st = data_error(err, path, header_line, (size_t)xi + 1,
-                                "column '%s' has unit '%s' but y is a stress, so x must be a "
-                                "dimensionless strain or stretch ('-' or '%%') ('%s')",
-                                xc->name, xc->unit, xc->name);
-                goto fail;
-            }
+            if (!d || d->cls != CF_UNIT_STRAIN)
+                return data_error(err, path, h->header_line, (size_t)h->xi + 1,
+                                  "column '%s' has unit '%s' but y is a stress, so x must be a "
+                                  "dimensionless strain or stretch ('-' or '%%') ('%s')",
+                                  xc->name, xc->unit, xc->name);
             xu = d;
         } else
-            xu = comment_unit(r.comments, r.ncomments, xc->base, 0, xw, 1);
+            xu = comment_unit(r->comments, r->ncomments, xc->base, 0, xw, 1);
         if (xu)
-            xscale = xu->to_conifit;
-        if (stretch && xscale != 1.0) {
-            st = data_error(err, path, header_line, (size_t)xi + 1,
-                            "stretch column '%s' cannot be in '%%' ('%s')", xc->name, xc->name);
-            goto fail;
-        }
-    } else {
-        cf_unit_class xw[1] = {CF_UNIT_LENGTH};
-        if (stretch) {
-            st = data_error(err, path, header_line, (size_t)xi + 1,
-                            "column '%s' is a stretch but y is a force; give a displacement "
-                            "column or a stress ('%s')", xc->name, xc->name);
-            goto fail;
-        }
-        if ((st = column_unit(&r, header_line, (size_t)xi, opt.length_unit, "option length_unit", 0,
-                              xw, 1, &xu, err)))
-            goto fail;
-        if (!xu) {
-            st = data_error(err, path, header_line, (size_t)xi + 1,
-                            "column '%s' has no length unit (y is a force): name it like "
-                            "displacement_mm, or set option length_unit ('%s')", xc->name, xc->name);
-            goto fail;
-        }
-        xscale = xu->to_conifit;
+            u->xscale = xu->to_conifit;
+        if (u->stretch && u->xscale != 1.0)
+            return data_error(err, path, h->header_line, (size_t)h->xi + 1,
+                              "stretch column '%s' cannot be in '%%' ('%s')", xc->name, xc->name);
+        return CF_OK;
     }
-    double tscale = 1.0;
-    if (ti >= 0) {
-        cf_unit_class tw[1] = {CF_UNIT_TIME};
-        if ((st = column_unit(&r, header_line, (size_t)ti, NULL, "", 2, tw, 1, &tu, err)))
-            goto fail;
-        if (!tu) {
-            st = data_error(err, path, header_line, (size_t)ti + 1,
-                            "time column '%s' has no unit: name it like time_s or time [s] "
-                            "(s, ms, min, h)",
-                            r.cols[ti].name);
-            goto fail;
-        }
-        tscale = tu->to_conifit;
-    }
-    double tprev = 0;
-    const double yscale = yu->to_conifit;
+    cf_unit_class xw[1] = {CF_UNIT_LENGTH};
+    if (u->stretch)
+        return data_error(err, path, h->header_line, (size_t)h->xi + 1,
+                          "column '%s' is a stretch but y is a force; give a displacement "
+                          "column or a stress ('%s')", xc->name, xc->name);
+    cf_status st = column_unit(r, h->header_line, (size_t)h->xi, opt->length_unit,
+                               "option length_unit", 0, xw, 1, &xu, err);
+    if (st)
+        return st;
+    if (!xu)
+        return data_error(err, path, h->header_line, (size_t)h->xi + 1,
+                          "column '%s' has no length unit (y is a force): name it like "
+                          "displacement_mm, or set option length_unit ('%s')", xc->name, xc->name);
+    u->xscale = xu->to_conifit;
+    return CF_OK;
+}
 
-    /* Rows. */
-    size_t last_line = header_line;
-    for (size_t li = hi + 1; li < r.nlines; li++) {
-        const line_span *l = &r.lines[li];
+/* The unit of the time column, if there is one. */
+static cf_status t_unit(const reader *r, const layout *h, scaling *u, cf_error *err)
+{
+    u->tscale = 1.0;
+    if (h->ti < 0)
+        return CF_OK;
+    const unit_def *tu = NULL;
+    cf_unit_class tw[1] = {CF_UNIT_TIME};
+    cf_status st = column_unit(r, h->header_line, (size_t)h->ti, NULL, "", 2, tw, 1, &tu, err);
+    if (st)
+        return st;
+    if (!tu)
+        return data_error(err, r->path, h->header_line, (size_t)h->ti + 1,
+                          "time column '%s' has no unit: name it like time_s or time [s] "
+                          "(s, ms, min, h)",
+                          r->cols[h->ti].name);
+    u->tscale = tu->to_conifit;
+    return CF_OK;
+}
+
+/* Units: y first (it decides the kind of table), the measures, then x and the time. */
+static cf_status decide_units(const reader *r, const cf_measure_options *opt, const layout *h,
+                              cf_table *m, scaling *u, cf_error *err)
+{
+    cf_status st = y_unit(r, opt, h, m, u, err);
+    if (st == CF_OK)
+        st = decide_measures(r, r->path, opt, &r->cols[h->xi], &r->cols[h->yi], &u->meas, err);
+    if (st != CF_OK)
+        return st;
+    u->stretch = u->meas.strain == CF_STRAIN_STRETCH;
+    if ((st = x_unit(r, opt, h, m, u, err)) != CF_OK)
+        return st;
+    return t_unit(r, h, u, err);
+}
+
+/* The field count of a row (split into r->f) against the header's. */
+static cf_status check_row_width(const reader *r, const line_span *l, const layout *h,
+                                 const char *q, cf_error *err)
+{
+    const size_t nf = r->f.count, want = h->ncols + (size_t)h->trailing;
+    if (nf < want)
+        return data_error(err, r->path, l->line, nf + 1,
+                          "short row: %zu fields where the header has %zu%s ('%s')", nf, want,
+                          h->trailing ? " (the header ends with a delimiter, so must every row)"
+                                      : "",
+                          q);
+    if (nf > want) {
+        char fq[128];
+        quote(fq, sizeof fq, field(&r->f, want), strlen(field(&r->f, want)));
+        return data_error(err, r->path, l->line, want + 1,
+                          "long row: %zu fields where the header has %zu (extra '%s') ('%s')", nf,
+                          want, fq, q);
+    }
+    if (h->trailing && field(&r->f, h->ncols)[0])
+        return data_error(err, r->path, l->line, h->ncols + 1,
+                          "a value in the unnamed last column (the header ends with a "
+                          "delimiter) ('%s')", field(&r->f, h->ncols));
+    return CF_OK;
+}
+
+/* The x, y, weight and time cells of a row (split into r->f) as numbers, v[4]. */
+static cf_status row_numbers(const reader *r, const line_span *l, const layout *h, double v[4],
+                             cf_error *err)
+{
+    const long idx[4] = {h->xi, h->yi, h->wi, h->ti};
+    for (int k = 0; k < 4; k++) {
+        if (idx[k] < 0)
+            continue;
+        const char *cell = field(&r->f, (size_t)idx[k]);
+        num_result nr = parse_number(cell, h->delim, &v[k]);
+        if (nr != NUM_OK) {
+            char cq[128];
+            quote(cq, sizeof cq, cell, strlen(cell));
+            const char *what = nr == NUM_EMPTY        ? "empty cell"
+                               : nr == NUM_NOT_FINITE ? "not a finite number"
+                                                      : "not a number";
+            return data_error(err, r->path, l->line, (size_t)idx[k] + 1, "column '%s': %s ('%s')",
+                              r->cols[idx[k]].name, what, cq);
+        }
+    }
+    if (h->wi >= 0 && !(v[2] > 0.0))
+        return data_error(err, r->path, l->line, (size_t)h->wi + 1,
+                          "column '%s': a weight must be > 0 ('%s')", r->cols[h->wi].name,
+                          field(&r->f, (size_t)h->wi));
+    return CF_OK;
+}
+
+/* One data row (line l, n characters of content): checked, converted and appended. *skip = 1
+** for a row of empty cells, which counts as blank. *tprev is the time of the row before. */
+static cf_status read_row(reader *r, const line_span *l, size_t n, const layout *h,
+                          const scaling *u, double *tprev, int *skip, cf_error *err)
+{
+    const char *path = r->path;
+    cf_status st = split_or_fail(r, l, n, h->delim, err);
+    if (st != CF_OK)
+        return st;
+    *skip = 1;
+    for (size_t k = 0; k < r->f.count; k++)
+        if (field(&r->f, k)[0])
+            *skip = 0;
+    if (*skip)
+        return CF_OK;
+    char q[256];
+    quote(q, sizeof q, l->s, n);
+    double v[4] = {0.0, 0.0, 1.0, 0.0};
+    if ((st = check_row_width(r, l, h, q, err)) != CF_OK ||
+        (st = row_numbers(r, l, h, v, err)) != CF_OK)
+        return st;
+    double x = u->stretch ? v[0] - 1.0 : v[0] * u->xscale;
+    double y = v[1] * u->yscale, t = v[3] * u->tscale;
+    if (!isfinite(x) || !isfinite(y) || !isfinite(t))
+        return data_error(err, path, l->line, (size_t)h->xi + 1,
+                          "value out of range after unit conversion ('%s')", q);
+    /* finite, but so large that sums of squares over the table (RMSE, R^2, the fit's
+    ** objective) would overflow: refused, so that no derived number can be Inf or NaN */
+    if (fabs(x) > CF_MEASURE_MAX_VALUE || fabs(y) > CF_MEASURE_MAX_VALUE ||
+        fabs(v[2]) > CF_MEASURE_MAX_VALUE || fabs(t) > CF_MEASURE_MAX_VALUE) {
+        size_t col = fabs(x) > CF_MEASURE_MAX_VALUE      ? (size_t)h->xi
+                     : fabs(y) > CF_MEASURE_MAX_VALUE    ? (size_t)h->yi
+                     : fabs(v[2]) > CF_MEASURE_MAX_VALUE ? (size_t)h->wi
+                                                         : (size_t)h->ti;
+        return data_error(err, path, l->line, col + 1,
+                          "column '%s': magnitude above %g in conifit's units (MPa, N, mm, s): "
+                          "sums over the table would overflow ('%s')",
+                          r->cols[col].name, CF_MEASURE_MAX_VALUE, q);
+    }
+    if (r->count == CF_MEASURE_MAX_ROWS)
+        return data_error(err, path, l->line, 1,
+                          "more than %d data rows: a table may have at most %d (thin it, or "
+                          "fit a part of it)", CF_MEASURE_MAX_ROWS, CF_MEASURE_MAX_ROWS);
+    if (h->ti >= 0 && r->count > 0 && !(t > *tprev))
+        return data_error(err, path, l->line, (size_t)h->ti + 1,
+                          "column '%s': time %.17g s does not increase (the row before has "
+                          "%.17g s) ('%s')",
+                          r->cols[h->ti].name, t, *tprev, field(&r->f, (size_t)h->ti));
+    *tprev = t;
+    if (push_row(r, x, y, v[2], t) != 0)
+        return out_of_memory(err, path);
+    return CF_OK;
+}
+
+/* Rows: every line after the header that is not a comment or blank. */
+static cf_status read_rows(reader *r, const layout *h, const scaling *u, cf_error *err)
+{
+    size_t last_line = h->header_line;
+    double tprev = 0;
+    for (size_t li = h->hi + 1; li < r->nlines; li++) {
+        const line_span *l = &r->lines[li];
         if (is_comment_line(l))
             continue;
         size_t n = content_length(l->s, l->n);
         if (n == 0)
             continue;
-        if ((st = split_or_fail(&r, l, n, delim, err)) != CF_OK)
-            goto fail;
-        size_t nf = r.f.count, all_empty = 1;
-        for (size_t k = 0; k < nf; k++)
-            if (field(&r.f, k)[0])
-                all_empty = 0;
-        if (all_empty)
-            continue; /* a row of empty cells (",,,") counts as blank */
-        char q[256];
-        quote(q, sizeof q, l->s, n);
-        size_t want = ncols + (size_t)trailing;
-        if (nf < want) {
-            st = data_error(err, path, l->line, nf + 1,
-                            "short row: %zu fields where the header has %zu%s ('%s')", nf, want,
-                            trailing ? " (the header ends with a delimiter, so must every row)"
-                                     : "",
-                            q);
-            goto fail;
-        }
-        if (nf > want) {
-            char fq[128];
-            quote(fq, sizeof fq, field(&r.f, want), strlen(field(&r.f, want)));
-            st = data_error(err, path, l->line, want + 1,
-                            "long row: %zu fields where the header has %zu (extra '%s') ('%s')",
-                            nf, want, fq, q);
-            goto fail;
-        }
-        if (trailing && field(&r.f, ncols)[0]) {
-            st = data_error(err, path, l->line, ncols + 1,
-                            "a value in the unnamed last column (the header ends with a "
-                            "delimiter) ('%s')", field(&r.f, ncols));
-            goto fail;
-        }
-        long idx[4] = {xi, yi, wi, ti};
-        double v[4] = {0.0, 0.0, 1.0, 0.0};
-        for (int k = 0; k < 4; k++) {
-            if (idx[k] < 0)
-                continue;
-            const char *cell = field(&r.f, (size_t)idx[k]);
-            num_result nr = parse_number(cell, delim, &v[k]);
-            if (nr != NUM_OK) {
-                char cq[128];
-                quote(cq, sizeof cq, cell, strlen(cell));
-                const char *what = nr == NUM_EMPTY        ? "empty cell"
-                                   : nr == NUM_NOT_FINITE ? "not a finite number"
-                                                          : "not a number";
-                st = data_error(err, path, l->line, (size_t)idx[k] + 1, "column '%s': %s ('%s')",
-                                r.cols[idx[k]].name, what, cq);
-                goto fail;
-            }
-        }
-        if (wi >= 0 && !(v[2] > 0.0)) {
-            st = data_error(err, path, l->line, (size_t)wi + 1,
-                            "column '%s': a weight must be > 0 ('%s')", r.cols[wi].name,
-                            field(&r.f, (size_t)wi));
-            goto fail;
-        }
-        double x = stretch ? v[0] - 1.0 : v[0] * xscale;
-        double y = v[1] * yscale, t = v[3] * tscale;
-        if (!isfinite(x) || !isfinite(y) || !isfinite(t)) {
-            st = data_error(err, path, l->line, (size_t)xi + 1,
-                            "value out of range after unit conversion ('%s')", q);
-            goto fail;
-        }
-        /* finite, but so large that sums of squares over the table (RMSE, R^2, the fit's
-        ** objective) would overflow: refused, so that no derived number can be Inf or NaN */
-        if (fabs(x) > CF_MEASURE_MAX_VALUE || fabs(y) > CF_MEASURE_MAX_VALUE ||
-            fabs(v[2]) > CF_MEASURE_MAX_VALUE || fabs(t) > CF_MEASURE_MAX_VALUE) {
-            size_t col = fabs(x) > CF_MEASURE_MAX_VALUE   ? (size_t)xi
-                         : fabs(y) > CF_MEASURE_MAX_VALUE ? (size_t)yi
-                         : fabs(v[2]) > CF_MEASURE_MAX_VALUE ? (size_t)wi
-                                                             : (size_t)ti;
-            st = data_error(err, path, l->line, col + 1,
-                            "column '%s': magnitude above %g in conifit's units (MPa, N, mm, s): "
-                            "sums over the table would overflow ('%s')",
-                            r.cols[col].name, CF_MEASURE_MAX_VALUE, q);
-            goto fail;
-        }
-        if (r.count == CF_MEASURE_MAX_ROWS) {
-            st = data_error(err, path, l->line, 1,
-                            "more than %d data rows: a table may have at most %d (thin it, or "
-                            "fit a part of it)", CF_MEASURE_MAX_ROWS, CF_MEASURE_MAX_ROWS);
-            goto fail;
-        }
-        if (ti >= 0 && r.count > 0 && !(t > tprev)) {
-            st = data_error(err, path, l->line, (size_t)ti + 1,
-                            "column '%s': time %.17g s does not increase (the row before has "
-                            "%.17g s) ('%s')",
-                            r.cols[ti].name, t, tprev, field(&r.f, (size_t)ti));
-            goto fail;
-        }
-        tprev = t;
-        if (push_row(&r, x, y, v[2], t) != 0) {
-            st = out_of_memory(err, path);
-            goto fail;
-        }
-        last_line = l->line;
+        int skip = 0;
+        cf_status st = read_row(r, l, n, h, u, &tprev, &skip, err);
+        if (st != CF_OK)
+            return st;
+        if (!skip)
+            last_line = l->line;
     }
-    if (r.count < CF_MEASURE_MIN_ROWS) {
-        st = data_error(err, path, last_line, 1,
-                        "only %zu data rows; a fit needs at least %d ('%zu rows')", r.count,
-                        CF_MEASURE_MIN_ROWS, r.count);
-        goto fail;
-    }
+    if (r->count < CF_MEASURE_MIN_ROWS)
+        return data_error(err, r->path, last_line, 1,
+                          "only %zu data rows; a fit needs at least %d ('%zu rows')", r->count,
+                          CF_MEASURE_MIN_ROWS, r->count);
+    return CF_OK;
+}
 
-    /* The test mode: the option wins over the file's comment. */
+/* The test mode: the option wins over the file's comment. */
+static cf_status decide_mode(const reader *r, const cf_measure_options *opt, cf_table *m,
+                             cf_error *err)
+{
     m->mode = CF_MODE_UNIAXIAL;
     m->mode_stated = 0;
-    if (opt.mode) {
-        cf_error me = {0};
-        if (cf_mode_parse(opt.mode, &m->mode, &me) != CF_OK) {
-            st = cf_error_set(err, CF_E_DATA, "%s: --mode %s: expected uniaxial, shear, planar, "
-                              "equibiaxial or confined", path, opt.mode);
-            goto fail;
-        }
-        m->mode_stated = 1;
-    } else if ((st = comment_mode(r.comments, r.ncomments, path, &m->mode, &m->mode_stated,
-                                  err)) != CF_OK) {
-        goto fail;
-    }
+    if (!opt->mode)
+        return comment_mode(r->comments, r->ncomments, r->path, &m->mode, &m->mode_stated, err);
+    cf_error me = {0};
+    if (cf_mode_parse(opt->mode, &m->mode, &me) != CF_OK)
+        return cf_error_set(err, CF_E_DATA, "%s: --mode %s: expected uniaxial, shear, planar, "
+                            "equibiaxial or confined", r->path, opt->mode);
+    m->mode_stated = 1;
+    return CF_OK;
+}
 
-    /* Hand over. */
+/* Hands the rows and what is known of them over to m (the reader keeps no rows). */
+static void hand_over(reader *r, const layout *h, const scaling *u, cf_table *m)
+{
     int neg = 0, pos = 0;
-    for (size_t i = 0; i < r.count; i++) {
-        neg |= r.x[i] < 0.0;
-        pos |= r.x[i] > 0.0;
+    for (size_t i = 0; i < r->count; i++) {
+        neg |= r->x[i] < 0.0;
+        pos |= r->x[i] > 0.0;
     }
-    m->count = r.count;
-    m->x = r.x;
-    m->y = r.y;
-    m->w = r.w;
-    if (ti >= 0)
-        m->t = r.t;
+    m->count = r->count;
+    m->x = r->x;
+    m->y = r->y;
+    m->w = r->w;
+    if (h->ti >= 0)
+        m->t = r->t;
     else
-        free(r.t);
-    r.x = r.y = r.w = r.t = NULL;
-    m->y_to_file = 1.0 / yscale;
+        free(r->t);
+    r->x = r->y = r->w = r->t = NULL;
+    m->y_to_file = 1.0 / u->yscale;
     m->compression = neg && !pos;
-    m->x_from_stretch = stretch;
-    utf8_copy(m->path, sizeof m->path, path);
-    utf8_copy(m->x_column, sizeof m->x_column, xc->name);
-    utf8_copy(m->y_column, sizeof m->y_column, yc->name);
+    m->x_from_stretch = u->stretch;
+    utf8_copy(m->path, sizeof m->path, r->path);
+    utf8_copy(m->x_column, sizeof m->x_column, r->cols[h->xi].name);
+    utf8_copy(m->y_column, sizeof m->y_column, r->cols[h->yi].name);
     snprintf(m->x_unit, sizeof m->x_unit, "%s",
              m->kind == CF_TABLE_STRESS_STRAIN ? "-" : "mm");
-    snprintf(m->y_unit, sizeof m->y_unit, "%s", yu->canon);
-    m->measures = meas;
+    snprintf(m->y_unit, sizeof m->y_unit, "%s", u->yu->canon);
+    m->measures = u->meas;
+}
+
+/* Reading a table is one pass through its stages in order: the text, the header, which columns,
+** their units, the rows, the test mode; every stage reads what the ones before decided (in the
+** reader, the layout and the scaling), and every refusal releases everything at one exit, so no
+** error path can leak or leave a half-filled table. */
+cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf_table *m,
+                          cf_error *err)
+{
+    cf_measure_options opt = opt_in ? *opt_in : cf_measure_default_options();
+    reader r;
+    layout h;
+    scaling u;
+    memset(&r, 0, sizeof r);
+    memset(&h, 0, sizeof h);
+    memset(&u, 0, sizeof u);
+    memset(m, 0, sizeof *m);
+    if (!path)
+        return cf_error_set(err, CF_E_NOINPUT, "no input file named");
+    r.path = path; /* read_all names standard input "(standard input)" */
+    cf_status st;
+    if ((st = read_all(&r, err)) != CF_OK || (st = spreadsheet_check(&r, err)) != CF_OK ||
+        (st = cut_lines(&r, err)) != CF_OK || (st = scan_text(&r, err)) != CF_OK ||
+        (st = find_header(&r, &h, err)) != CF_OK || (st = read_header(&r, &h, err)) != CF_OK ||
+        (st = choose_columns(&r, &opt, &h, err)) != CF_OK ||
+        (st = decide_units(&r, &opt, &h, m, &u, err)) != CF_OK ||
+        (st = read_rows(&r, &h, &u, err)) != CF_OK || (st = decide_mode(&r, &opt, m, err)) != CF_OK) {
+        reader_free(&r);
+        memset(m, 0, sizeof *m);
+        return st;
+    }
+    hand_over(&r, &h, &u, m);
     reader_free(&r);
     if ((st = cf_measures_convert(m, err)) != CF_OK) {
         cf_table_free(m);
@@ -1451,11 +1523,6 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
     }
     cf_error_clear(err);
     return CF_OK;
-
-fail:
-    reader_free(&r);
-    memset(m, 0, sizeof *m);
-    return st;
 }
 
 void cf_table_free(cf_table *m)
