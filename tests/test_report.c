@@ -1,7 +1,9 @@
 /*
 ** The report (out/report.c): the JSON fit file and the text, from a report the pipeline made.
-**  - the JSON holds the table's provenance and units, every number finite or null (a non-finite
-**    value is written as null, never as NaN or Inf), and reads back with the fit-file reader;
+**  - the JSON holds the table's provenance and units, every number finite and no null (a value
+**    that is not determined is left out, with a reason beside it; a document that would hold a
+**    non-finite number is not written, and the error names its key), and reads back with the
+**    fit-file reader;
 **  - numbers in the file's own unit (kPa here), not conifit's MPa;
 **  - the text names both types, the identifiable quantities and the units;
 **  - a table that tells the types apart is reported with a better type, one that does not as a
@@ -45,13 +47,12 @@ static void json_holds_units_finite_numbers_and_reads_back(void **state)
     cf_error err = {0};
     assert_int_equal(cf_pipeline_fit(&t, &po, &r, &err), CF_OK);
     assert_int_equal(r.nfits, 2);
-    /* a value no fit should hold: it must come out as null */
-    r.fits[1].max_abs_error = NAN;
     char *s = cf_report_json_string(&r);
     assert_non_null(s);
     assert_null(strstr(s, "nan"));
     assert_null(strstr(s, "NaN"));
     assert_null(strstr(s, "inf"));
+    assert_null(strstr(s, "null"));
     json_error_t je;
     json_t *root = json_loads(s, JSON_REJECT_DUPLICATES, &je);
     if (!root)
@@ -62,7 +63,7 @@ static void json_holds_units_finite_numbers_and_reads_back(void **state)
     assert_int_equal(json_integer_value(json_object_get(data, "points")), 30);
     json_t *f0 = json_array_get(json_object_get(root, "fits"), 0);
     json_t *f1 = json_array_get(json_object_get(root, "fits"), 1);
-    assert_true(json_is_null(json_object_get(f1, "max_abs_error")));
+    assert_true(json_is_number(json_object_get(f1, "max_abs_error")));
     /* RMSE in kPa: the fit's MPa value times 1000 */
     assert_close(json_number_value(json_object_get(f0, "rmse")), r.fits[0].rmse * 1000,
                  1e-12 * fmax(1.0, r.fits[0].rmse * 1000));
@@ -79,6 +80,13 @@ static void json_holds_units_finite_numbers_and_reads_back(void **state)
     assert_true(fs.params.G_MPa == r.fits[0].params.G_MPa);
     assert_string_equal(fs.y_unit, "kPa");
     remove(path);
+    /* a value no fit should hold: the document is refused, naming the key, and nothing written */
+    r.fits[1].max_abs_error = NAN;
+    assert_null(cf_report_json_string(&r));
+    cf_error e2 = {0};
+    assert_int_equal(cf_report_json_write(&r, path, NULL, &e2), CF_E_INTERNAL);
+    assert_non_null(strstr(e2.msg, "fits[1].max_abs_error"));
+    assert_int_equal(access(path, F_OK), -1);
     rmdir(dir);
     free(s);
     cf_report_free(&r);

@@ -243,8 +243,46 @@ json_t *cf_fitfile_spring_json(const cf_law *law)
                      "derived", derived);
 }
 
+/* Depth-first search for a null in v; path (capacity cap) receives its key path ("fits[0].rmse").
+** 1 when one is found. */
+static int find_null(const json_t *v, char *path, size_t cap, size_t used)
+{
+    if (json_is_null(v))
+        return 1;
+    if (json_is_object(v)) {
+        const char *key;
+        json_t *item;
+        json_object_foreach((json_t *)v, key, item) {
+            int n = snprintf(path + used, cap - used, "%s%s", used ? "." : "", key);
+            size_t u = n > 0 && (size_t)n < cap - used ? used + (size_t)n : cap - 1;
+            if (find_null(item, path, cap, u))
+                return 1;
+        }
+    } else if (json_is_array(v)) {
+        for (size_t i = 0; i < json_array_size(v); i++) {
+            int n = snprintf(path + used, cap - used, "[%zu]", i);
+            size_t u = n > 0 && (size_t)n < cap - used ? used + (size_t)n : cap - 1;
+            if (find_null(json_array_get(v, i), path, cap, u))
+                return 1;
+        }
+    }
+    path[used] = '\0';
+    return 0;
+}
+
+int cf_json_find_null(const json_t *root, char *path, size_t cap)
+{
+    if (cap == 0)
+        return json_is_null(root);
+    path[0] = '\0';
+    return find_null(root, path, cap, 0);
+}
+
 char *cf_fitfile_dumps(const json_t *root)
 {
+    char where[256];
+    if (cf_json_find_null(root, where, sizeof where))
+        return NULL;
     char *s = json_dumps(root, JSON_INDENT(2) | JSON_REAL_PRECISION(17) | JSON_PRESERVE_ORDER);
     if (!s)
         return NULL;
@@ -263,6 +301,11 @@ cf_status cf_fitfile_prepare(const json_t *root, const char *path, const char *c
                              struct cf_atomic *out, cf_error *err)
 {
     memset(out, 0, sizeof *out);
+    char where[256];
+    if (cf_json_find_null(root, where, sizeof where))
+        return cf_error_set(err, CF_E_INTERNAL,
+                            "%s: the value of '%s' is not a finite number; nothing written", path,
+                            where);
     char *s = cf_fitfile_dumps(root);
     if (!s)
         return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory writing the JSON", path);

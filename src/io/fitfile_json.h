@@ -14,15 +14,21 @@
 #include "conifit/error.h"
 #include "conifit/law.h"
 
-/* A JSON number, or null for a value that is not finite (NaN and Inf never reach a file). */
+/* A JSON number, or null for a value that is not finite; a document holding a null is never
+** written (cf_fitfile_dumps and cf_fitfile_prepare refuse it), so NaN and Inf never reach a file:
+** a key without a value is left out, with a reason beside it. */
 json_t *cf_json_number(double v);
+
+/* 1 when the document holds a null anywhere; path (capacity cap) then names its key
+** ("fits[0].identifiable.rho.stderr"). */
+int cf_json_find_null(const json_t *root, char *path, size_t cap);
 
 /* {"type", "params" {D1_mm ...}, "derived" {rho, travel_mm, ...}} of a spring prepared by
 ** cf_law_init (keys from the spring description, spring.h). NULL when memory runs out. */
 json_t *cf_fitfile_spring_json(const cf_law *law);
 
 /* The document as text: two-space indent, doubles to 17 significant digits, a final newline.
-** malloc'd; NULL when memory runs out. */
+** malloc'd; NULL when memory runs out or the document holds a null (cf_json_find_null). */
 char *cf_fitfile_dumps(const json_t *root);
 
 /* Writes the document to a temporary file beside path, complete but not in place: the caller

@@ -124,23 +124,25 @@ static json_t *joint_json(const cf_joint_report *r)
             const cf_table *t = r->tables[k];
             const cf_joint_table *jt = &j->tab[k];
             double u = t->y_to_file;
-            json_array_append_new(
-                per, json_pack("{s:s, s:s, s:I, s:s, s:o, s:o, s:o, s:s, s:o}", "file", t->path,
-                               "mode", cf_mode_name(jt->mode), "points", (json_int_t)jt->points,
-                               "unit", t->y_unit, "rmse", num(jt->cell_rmse * u), "lattice_rmse",
-                               num(jt->lattice_rmse * u), "law_difference_rmse",
-                               num(jt->law_rmse * u), "lattice_model",
-                               jt->by_cell ? "homogenised cell" : "full lattice", "scale",
-                               num(jt->scale_MPa * u)));
+            json_t *e = json_pack("{s:s, s:s, s:I, s:s, s:o, s:o, s:s, s:o}", "file", t->path,
+                                  "mode", cf_mode_name(jt->mode), "points",
+                                  (json_int_t)jt->points, "unit", t->y_unit, "rmse",
+                                  num(jt->cell_rmse * u), "lattice_rmse",
+                                  num(jt->lattice_rmse * u), "lattice_model",
+                                  jt->by_cell ? "homogenised cell" : "full lattice", "scale",
+                                  num(jt->scale_MPa * u));
+            if (e && isfinite(jt->law_rmse)) /* uniaxial tables only */
+                json_object_set_new(e, "law_difference_rmse", num(jt->law_rmse * u));
+            json_array_append_new(per, e);
         }
         json_object_set_new(f, "tables", per);
         json_array_append_new(fits, f);
     }
     int b = cf_joint_better(r);
     json_object_set_new(root, "fits", fits);
-    json_object_set_new(root, "better_type",
-                        b >= 0 ? json_string(cf_spring_type_name(r->fits[b].fit.type))
-                               : json_null());
+    if (b >= 0) /* absent when neither type has a spring inside its limits */
+        json_object_set_new(root, "better_type",
+                            json_string(cf_spring_type_name(r->fits[b].fit.type)));
     /* tables[]: the better type's numbers, one entry per table */
     for (size_t k = 0; b >= 0 && k < r->ntables; k++) {
         const cf_table *t = r->tables[k];

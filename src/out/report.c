@@ -95,27 +95,55 @@ static void interval_reason(const cf_fit_result *f, int k, char *buf, size_t cap
     }
 }
 
-/* {value, stderr, interval, interval_reason} in conifit's units (MPa, N, mm). */
+/* Why a fit has no standard errors (and no correlation matrix), in words. */
+static const char *stderr_reason(const cf_fit_result *f)
+{
+    if (strcmp(f->optimizer, "placement") == 0)
+        return "not computed: the spring is placed from the quantities of the fit through the "
+               "lattice";
+    for (int k = 0; k < 3; k++)
+        if (f->interval_ok[k] && (f->interval_why[k] & CF_FIT_RANK_DEFICIENT))
+            return "not determined: the Jacobian of the three quantities is numerically "
+                   "rank-deficient (see interval)";
+    return "not determined: the linearised covariance s^2 (J^T W J)^-1 could not be formed";
+}
+
+/* {value, stderr | stderr_reason, [interval, interval_reason]} in conifit's units (MPa, N, mm):
+** a key is present only with a value, never null. */
 static json_t *ident_json(const cf_fit_result *f, int k)
 {
     double se = f->ident_se[k];
-    json_t *o = json_pack("{s:o, s:o}", "value", num(f->ident[k]), "stderr",
-                          se >= 0 ? num(se) : json_null());
+    json_t *o = json_pack("{s:o}", "value", num(f->ident[k]));
+    if (!o)
+        return NULL;
+    if (se >= 0)
+        json_object_set_new(o, "stderr", num(se));
+    else
+        json_object_set_new(o, "stderr_reason", json_string(stderr_reason(f)));
     if (f->interval_ok[k]) {
         char why[512];
         interval_reason(f, k, why, sizeof why);
         json_object_set_new(o, "interval",
                             json_pack("[o, o]", num(f->interval[k][0]), num(f->interval[k][1])));
         json_object_set_new(o, "interval_reason", json_string(why));
-    } else {
-        json_object_set_new(o, "interval", json_null());
-        json_object_set_new(o, "interval_reason", json_null());
     }
     return o;
 }
 
+/* {order, matrix} when every correlation is determined, else {order, reason}. */
 static json_t *correlation_json(const cf_fit_result *f, const char *const names[3])
 {
+    json_t *o = json_pack("{s:[s, s, s]}", "order", names[0], names[1], names[2]);
+    int ok = 1;
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            ok = ok && isfinite(f->corr[a][b]);
+    if (!o)
+        return NULL;
+    if (!ok) {
+        json_object_set_new(o, "reason", json_string(stderr_reason(f)));
+        return o;
+    }
     json_t *m = json_array();
     for (int a = 0; a < 3; a++) {
         json_t *row = json_array();
@@ -123,7 +151,8 @@ static json_t *correlation_json(const cf_fit_result *f, const char *const names[
             json_array_append_new(row, num(f->corr[a][b]));
         json_array_append_new(m, row);
     }
-    return json_pack("{s:[s, s, s], s:o}", "order", names[0], names[1], names[2], "matrix", m);
+    json_object_set_new(o, "matrix", m);
+    return o;
 }
 
 
@@ -189,16 +218,18 @@ static json_t *validation_json(const cf_fit_report *r, int i)
                             num(cm.nu), "bottom",
                             lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial");
     double fit_rmse = r->through_msm && r->thr[i].done ? r->thr[i].cell_rmse : r->fits[i].rmse;
-    json_t *o = json_pack("{s:s, s:s, s:o, s:o, s:o, s:o, s:o, s:o, s:s, s:I, s:o}", "mode",
+    json_t *o = json_pack("{s:s, s:s, s:o, s:o, s:o, s:o, s:o, s:s, s:I, s:o}", "mode",
                      cf_mode_name(v->mode), "model", v->by_cell ? "homogenised cell" :
                      "full lattice", "fit_rmse", num(fit_rmse * u), "rmse", num(v->rmse * u),
-                     "law_difference_rmse", num(v->law_rmse * u), "r2", num(v->r2),
+                     "r2", num(v->r2),
                      "max_abs_error", num(v->max_abs_error * u), "lattice", lat, "law_method",
                      cf_law_method_name(v->setup.method), "solves", (json_int_t)v->solves,
                      "wall_time_s", num(r->with_timing ? v->wall_time_s : 0.0));
+    if (o && isfinite(v->law_rmse)) /* uniaxial tables only: the law's own curve is uniaxial */
+        json_object_set_new(o, "law_difference_rmse", num(v->law_rmse * u));
     if (o && v->stability_checked) {
-        json_object_set_new(o, "stable_to_strain",
-                            v->stable_to_strain != 0 ? num(v->stable_to_strain) : json_null());
+        if (v->stable_to_strain != 0) /* absent: stable over the whole range checked */
+            json_object_set_new(o, "stable_to_strain", num(v->stable_to_strain));
         json_object_set_new(o, "stable_in_range", json_boolean(!v->unstable_in_range));
     }
     return o;
@@ -208,12 +239,15 @@ static json_t *through_json(const cf_fit_report *r, int i)
 {
     const cf_through_msm *t = &r->thr[i];
     double u = r->table->y_to_file;
-    return json_pack("{s:o, s:o, s:o, s:b, s:o, s:o, s:I}", "rmse_before",
-                     num(t->rmse_before * u), "cell_rmse", num(t->cell_rmse * u), "rmse_after",
-                     num(t->rmse_after * u), "improved", t->improved, "verification_max_abs",
-                     t->verified ? num(t->verify_max_abs * u) : json_null(), "wall_time_s",
-                     num(r->with_timing ? t->wall_time_s : 0.0), "evaluations",
-                     (json_int_t)t->evaluations);
+    json_t *o = json_pack("{s:o, s:o, s:o, s:b, s:b, s:o, s:I}", "rmse_before",
+                          num(t->rmse_before * u), "cell_rmse", num(t->cell_rmse * u),
+                          "rmse_after", num(t->rmse_after * u), "improved", t->improved,
+                          "verified", t->verified, "wall_time_s",
+                          num(r->with_timing ? t->wall_time_s : 0.0), "evaluations",
+                          (json_int_t)t->evaluations);
+    if (o && t->verified)
+        json_object_set_new(o, "verification_max_abs", num(t->verify_max_abs * u));
+    return o;
 }
 
 static json_t *fit_json(const cf_fit_report *r, int i)
@@ -346,10 +380,13 @@ static json_t *measures_json(const cf_table *t)
     char src[3][128], conv[256];
     sources_text(t, src);
     conversion_text(t, conv, sizeof conv);
-    return json_pack("{s:s, s:s, s:s, s:s, s:s, s:s, s:o}", "stress", cf_stress_measure_name(m->stress),
-                     "stress_source", src[0], "strain", cf_strain_measure_name(m->strain),
-                     "strain_source", src[1], "mode", cf_mode_name(t->mode), "mode_source",
-                     src[2], "conversion", *conv ? json_string(conv) : json_null());
+    json_t *o = json_pack("{s:s, s:s, s:s, s:s, s:s, s:s}", "stress",
+                          cf_stress_measure_name(m->stress), "stress_source", src[0], "strain",
+                          cf_strain_measure_name(m->strain), "strain_source", src[1], "mode",
+                          cf_mode_name(t->mode), "mode_source", src[2]);
+    if (o && *conv) /* absent: the columns were taken as they are */
+        json_object_set_new(o, "conversion", json_string(conv));
+    return o;
 }
 
 /* The limits every fit ran under. */
@@ -381,23 +418,27 @@ static json_t *report_json(const cf_fit_report *r)
                              "fits", fits);
     json_object_set_new(root, "limits", limits_json(r));
     int b = cf_report_better(r), tie = cf_report_types_tie(r);
-    json_object_set_new(root, "better_type", b >= 0 && !tie
-                                                 ? json_string(cf_spring_type_name(r->fits[b].type))
-                                                 : json_null());
+    if (b >= 0 && !tie) /* absent on a tie (comparison.tie) or when no type has a spring */
+        json_object_set_new(root, "better_type", json_string(cf_spring_type_name(r->fits[b].type)));
     if (r->nfits == 2 && b >= 0) {
         int o = 1 - b;
         cf_fit_verdict v = cf_fit_compare(&r->fits[0], &r->fits[1], r->table->count);
         char text[1024];
         verdict_text(r, text, sizeof text);
-        json_object_set_new(
-            root, "comparison",
-            json_pack("{s:b, s:s, s:s, s:o, s:o, s:o, s:o, s:o}", "tie", tie, "verdict", text,
-                      "test", "F(1, N - 3) at 95 % on the weighted residual sum of squares",
-                      "delta_weighted_rss", num(v.delta_rss), "threshold_weighted_rss",
-                      num(v.threshold), "held_back_by",
-                      constraint_list(tie ? 0u : v.held), "rmse_ratio_other_to_better",
-                      num(r->fits[b].rmse > 0 ? r->fits[o].rmse / r->fits[b].rmse : 1.0),
-                      "aic_difference", num(cf_report_fit_aic(r, o) - cf_report_fit_aic(r, b))));
+        json_t *c = json_pack("{s:b, s:s, s:s, s:o, s:o, s:o}", "tie", tie, "verdict", text,
+                              "test", "F(1, N - 3) at 95 % on the weighted residual sum of squares",
+                              "held_back_by", constraint_list(tie ? 0u : v.held),
+                              "rmse_ratio_other_to_better",
+                              num(r->fits[b].rmse > 0 ? r->fits[o].rmse / r->fits[b].rmse : 1.0),
+                              "aic_difference",
+                              num(cf_report_fit_aic(r, o) - cf_report_fit_aic(r, b)));
+        /* the test's numbers, absent when the other type has no spring inside its limits (no
+        ** contest: the verdict says so) */
+        if (c && isfinite(v.delta_rss) && isfinite(v.threshold)) {
+            json_object_set_new(c, "delta_weighted_rss", num(v.delta_rss));
+            json_object_set_new(c, "threshold_weighted_rss", num(v.threshold));
+        }
+        json_object_set_new(root, "comparison", c);
     }
     json_object_set_new(root, "baselines", base);
     json_object_set_new(root, "identifiability",
