@@ -29,11 +29,16 @@
 ** in BAND_MAX_ENTRIES doubles), else dense LU up to DENSE_MAX_DOF free DOFs (a 7x7x7 lattice has
 ** ~1500), else GMRES. */
 #define BAND_ACCEPT 1e-10
+#define CHOL_REFINE 2
 #define BAND_MAX_ENTRIES 5e7
 #define DENSE_MAX_DOF 1200
 /* A spring may come this close to solid (fraction of the travel) in a Newton step; beyond it the
 ** step is shortened. Past it the law's stiffness grows like (s - u)^(-1/2) and Newton stalls. */
 #define SOLID_MARGIN (1.0 - 1e-9)
+/* Chord iterations (the uniaxial curve): a direction from the last factored tangent is kept while
+** each step cuts the residual at least by CHORD_RATE without shortening; otherwise the next
+** direction refactors. */
+#define CHORD_RATE 0.25
 /* Bisections of a load increment (or time step) before a solve is declared non-converged. */
 #define MAX_BISECT 12
 /* Stability scan of the uniaxial lattice: steps up to STABILITY_REACH of the solid strain, then
@@ -108,6 +113,9 @@ typedef struct solver {
     cf_sparse_chol *chol;     /* sparse factorisation of C (pattern analysed once); NULL until used */
     int chol_failed;          /* 1: the sparse factorisation could not be set up; not retried */
     long neg_pivots;          /* negative pivots of the last factored tangent, -1 unknown */
+    int chord;                /* reuse factorisations across iterations and load steps (below) */
+    int chol_ready;           /* s->chol holds the factors of C, scaled by s->D, for a chord step */
+    int refactor;             /* the next direction needs a fresh tangent */
     double load;              /* current drive value: strain or stress, MPa */
     int extras;               /* quasi-static extras active */
     cf_msm_stats *st;
@@ -366,11 +374,14 @@ static void note_inertia(solver *s)
 ** more than a few cells a side, and an indefinite tangent is factored as L D L^T with its negative
 ** pivots counted. Accepted when the residual is small. Returns 1 when s->dx holds the update;
 ** sets *fatal for an out-of-memory that no fallback would survive. */
+static int chol_solve(solver *s, int *fatal, cf_error *err);
+
 static int chol_direction(solver *s, int *fatal, cf_error *err)
 {
     const size_t n = s->ndof;
     gsl_spmatrix *C = s->C;
     *fatal = 0;
+    s->chol_ready = 0;
     if (s->chol_failed || n == 0)
         return 0;
     cf_error lerr = {0};
@@ -387,28 +398,44 @@ static int chol_direction(solver *s, int *fatal, cf_error *err)
     }
     if (st != CF_OK)
         return 0;
-    double *rhs = malloc(2 * n * sizeof(double));
+    s->neg_pivots = info.neg_pivots; /* the inertia holds even when the solve is refused */
+    int ok = chol_solve(s, fatal, err);
+    s->chol_ready = ok;
+    if (ok && s->st)
+        s->st->linear_iters++;
+    return ok;
+}
+
+/* The update from the factors in s->chol (of C as it was factored, scaled by s->D): solved,
+** accepted when its residual against C is small. Returns 1 when s->dx holds it. */
+static int chol_solve(solver *s, int *fatal, cf_error *err)
+{
+    const size_t n = s->ndof;
+    gsl_spmatrix *C = s->C;
+    cf_error lerr = {0};
+    double *rhs = malloc(4 * n * sizeof(double));
     if (!rhs) {
         *fatal = 1;
         cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent solve");
         return 0;
     }
-    double *xv = rhs + n;
+    double *xv = rhs + n, *r = rhs + 2 * n, *dv = rhs + 3 * n;
     for (size_t e = 0; e < n; e++)
         rhs[e] = s->R[e] / s->D[e];
     int ok = cf_sparse_chol_solve(s->chol, rhs, xv, &lerr) == CF_OK;
-    if (ok) { /* residual check: || rhs - C x || against || rhs || */
-        gsl_vector_view xw = gsl_vector_view_array(xv, n);
-        gsl_vector *r = gsl_vector_alloc(n);
-        ok = r != NULL;
-        if (ok) {
-            for (size_t e = 0; e < n; e++)
-                gsl_vector_set(r, e, rhs[e]);
-            gsl_vector_const_view bw = gsl_vector_const_view_array(rhs, n);
-            ok = gsl_spblas_dgemv(CblasNoTrans, -1.0, C, &xw.vector, 1.0, r) == GSL_SUCCESS &&
-                 gsl_blas_dnrm2(r) <= BAND_ACCEPT * gsl_blas_dnrm2(&bw.vector);
-            gsl_vector_free(r);
-        }
+    /* residual check, || rhs - C x || against || rhs ||, with up to CHOL_REFINE steps of
+    ** iterative refinement (an indefinite tangent near a singular one may need them) */
+    gsl_vector_view xw = gsl_vector_view_array(xv, n), rw = gsl_vector_view_array(r, n);
+    gsl_vector_const_view bw = gsl_vector_const_view_array(rhs, n);
+    const double bn = gsl_blas_dnrm2(&bw.vector);
+    for (int k = 0; ok; k++) {
+        memcpy(r, rhs, n * sizeof(double));
+        ok = gsl_spblas_dgemv(CblasNoTrans, -1.0, C, &xw.vector, 1.0, &rw.vector) == GSL_SUCCESS;
+        if (!ok || gsl_blas_dnrm2(&rw.vector) <= BAND_ACCEPT * bn)
+            break;
+        ok = k < CHOL_REFINE && cf_sparse_chol_solve(s->chol, r, dv, &lerr) == CF_OK;
+        for (size_t e = 0; ok && e < n; e++)
+            xv[e] += dv[e];
     }
     for (size_t e = 0; ok && e < n; e++) {
         double v = xv[e] / s->D[e];
@@ -416,9 +443,6 @@ static int chol_direction(solver *s, int *fatal, cf_error *err)
         s->dx[e] = v;
     }
     free(rhs);
-    s->neg_pivots = info.neg_pivots; /* the inertia holds even when the solve is refused */
-    if (ok && s->st)
-        s->st->linear_iters++;
     return ok;
 }
 
@@ -565,6 +589,7 @@ static cf_status tangent_solve(solver *s, cf_error *err)
     s->neg_pivots = -1;
     if (!s->cfg->banded_only && chol_direction(s, &fatal, err))
         return CF_OK;
+
     if (fatal)
         return CF_E_INTERNAL;
     if (band_direction(s))
@@ -659,7 +684,24 @@ static cf_status newton(solver *s, cf_error *err)
         if (s->st)
             s->st->newton_iters++;
         cf_error lerr = {0};
-        if (newton_direction(s, &lerr) != CF_OK) {
+        /* a chord step: the last factored tangent, while it still converges fast */
+        const int chord = s->chord && s->chol_ready && !s->refactor;
+        if (chord) {
+            int fatal = 0;
+            if (!chol_solve(s, &fatal, &lerr)) {
+                if (fatal) {
+                    memcpy(lat->x, start, lat->nn * sizeof(double));
+                    memcpy(lat->y, start + lat->nn, lat->nn * sizeof(double));
+                    memcpy(lat->z, start + 2 * lat->nn, lat->nn * sizeof(double));
+                    free(start);
+                    return cf_error_set(err, CF_E_INTERNAL, "%s", lerr.msg);
+                }
+                s->refactor = 1;
+                continue;
+            }
+            if (s->st)
+                s->st->chord_iters++;
+        } else if (newton_direction(s, &lerr) != CF_OK) {
             if (lerr.status == CF_E_INTERNAL) { /* out of memory: not a matter of step size */
                 memcpy(lat->x, start, lat->nn * sizeof(double));
                 memcpy(lat->y, start + lat->nn, lat->nn * sizeof(double));
@@ -668,7 +710,8 @@ static cf_status newton(solver *s, cf_error *err)
                 return cf_error_set(err, CF_E_INTERNAL, "%s", lerr.msg);
             }
             break;
-        }
+        } else
+            s->refactor = 0;
         save_positions(s);
         double alpha = 1, rn0 = rn;
         int ok = 0;
@@ -688,8 +731,14 @@ static cf_status newton(solver *s, cf_error *err)
         }
         if (!ok) {
             restore_positions(s);
-            break;
+            if (!chord)
+                break;
+            um = residual(s, &rn, &fs); /* a stale tangent: try again with a fresh one */
+            s->refactor = 1;
+            continue;
         }
+        if (chord && (alpha < 1 || rn > CHORD_RATE * rn0))
+            s->refactor = 1;
     }
     if (s->st && um > s->st->max_u_over_travel && st == CF_OK)
         s->st->max_u_over_travel = um;
@@ -1231,10 +1280,12 @@ cf_status cf_msm_uniaxial(const cf_law *law, cf_law_method m, const cf_msm_confi
         cf_lattice_free(&lat);
         return rc;
     }
+    s.chord = 1; /* only the curve is reported, not the inertia of each state */
     /* Two passes from the reference state: compression (table strain < 0), then tension. */
     for (int pass = 0; pass < 2 && rc == CF_OK; pass++) {
         cf_lattice_reset(&lat);
         s.load = 0;
+        s.refactor = 1;
         for (size_t r = 0; r < count && rc == CF_OK; r++) {
             size_t i = idx[r].i;
             double e = -strain[i]; /* compressive-positive */
