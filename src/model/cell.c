@@ -71,6 +71,8 @@ cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
         return st;
     c->law = law;
     c->method = method;
+    c->law_scale = 1.0;
+    c->stretch_hint = 0.0;
     memcpy(c->weight, weight, sizeof c->weight);
     return CF_OK;
 }
@@ -106,7 +108,7 @@ static cf_status evaluate(const cf_cell *c, const double F[9], const cf_cell_ext
                                 N[0], N[1], N[2], L / L0, 1 - copysign(law->travel_mm / H, u));
         double k = 0;
         double f = cf_law_force(law, c->method, u, &k, NULL);
-        double w = c->weight[fam];
+        double w = c->weight[fam] * c->law_scale;
         double T = -w * f, dT = w * k * H / L0;
         if (x) {
             T += x->T0_N[d] + x->k_N_per_mm[d] * (L - x->Lref_mm[d]);
@@ -227,7 +229,8 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
     const double sH = law->travel_mm / law->p.H_mm;
     double lo = 1 - sH, hi = 1 + sH; /* the edge along a free axis reaches solid there */
     int have_lo = 0, have_hi = 0;
-    double a = fmin(fmax(guess(c, m, e), lo + 1e-3 * sH), hi - 1e-3 * sH);
+    double a = c->stretch_hint > 0 ? c->stretch_hint : guess(c, m, e);
+    a = fmin(fmax(a, lo + 1e-3 * sH), hi - 1e-3 * sH);
     cf_error e1 = {0};
     int it;
     for (it = 0; it < MAX_ITER; it++) {

@@ -10,9 +10,6 @@
 
 #include "conifit/cell.h"
 
-/* Newton iterations on the cell's lateral stretch per step. */
-#define CELL_MAX_ITER 100
-
 cf_visco_setup cf_visco_default(void)
 {
     cf_visco_setup s;
@@ -93,97 +90,53 @@ typedef struct cell_run {
     cf_law_method method;
     const cf_visco_params *p;
     double H;                          /* cell edge, mm */
-    double L0[CF_CELL_DIRS], w[CF_CELL_DIRS], X[CF_CELL_DIRS][3];
-    double a;                          /* lateral stretch of the last state */
+    double L0[CF_CELL_DIRS], w[CF_CELL_DIRS];
     double h[CF_CELL_DIRS][CF_PRONY_MAX];
     double Fprev[CF_CELL_DIRS], Lprev[CF_CELL_DIRS];
     cf_cell_state st;                  /* the current state */
 } cell_run;
 
-/* One implicit step of length dt (0: the relaxed state at the start) to table strain e. The
-** spring tensions are exact at every trial (the Prony force w (alpha F(u) + c) and the dashpot
-** enter the cell as its affine extra term, re-linearised at the trial lengths), and the free
-** lateral stretch a of F = diag(a, a, 1 + e) is found by Newton on P_xx(a) = 0 with its exact
-** derivative. */
+/* One implicit step of length dt (0: the relaxed state at the start) to table strain e. Over the
+** step every spring's tension is w (alpha F(u) + c) plus its dashpot, alpha = 1 - sum g_i (1 - b_i)
+** and c from the branches' state (the exact recursive update for a law force linear in time along
+** the step): the law scaled by alpha and a term affine in the spring's length, which is what the
+** cell takes (cf_cell.law_scale and cf_cell_extra), so the cell's own solve of its free lateral
+** stretch (cf_cell_mode) gives the step's equilibrium exactly. */
 static cf_status cell_step(cell_run *r, double dt, double e, cf_error *err)
 {
     const cf_visco_params *p = r->p;
     const int np = p->nbranch;
-    double pe[CF_PRONY_MAX], pb[CF_PRONY_MAX], alpha = 1, c[CF_CELL_DIRS];
+    double pe[CF_PRONY_MAX], pb[CF_PRONY_MAX], alpha = 1;
     for (int i = 0; i < np; i++) {
         pe[i] = dt > 0 ? exp(-dt / p->tau_s[i]) : 0;
         pb[i] = dt > 0 ? -expm1(-dt / p->tau_s[i]) * p->tau_s[i] / dt : 0;
         alpha -= p->g[i] * (1 - pb[i]);
     }
-    for (int d = 0; d < CF_CELL_DIRS; d++) {
-        c[d] = 0;
-        for (int i = 0; i < np && dt > 0; i++)
-            c[d] += pe[i] * r->h[d][i] - p->g[i] * pb[i] * r->Fprev[d];
-    }
-    const double H = r->H, H3 = H * H * H, visc = dt > 0 ? p->eta_MPa_s / dt : 0;
-    const double lam = 1 + e, sH = r->law->travel_mm / H;
-    double a = r->a, lo = 1 - sH, hi = 1 + sH;
+    const double H = r->H, visc = dt > 0 ? p->eta_MPa_s / dt : 0;
     cf_cell_extra x;
-    for (int it = 0; it < CELL_MAX_ITER; it++) {
-        const double F[9] = {a, 0, 0, 0, a, 0, 0, 0, lam};
-        double kT[CF_CELL_DIRS], dL[CF_CELL_DIRS];
-        int ok = 1;
-        for (int d = 0; d < CF_CELL_DIRS && ok; d++) {
-            const double *X = r->X[d];
-            const double L = sqrt(a * a * (X[0] * X[0] + X[1] * X[1]) + lam * lam * X[2] * X[2]);
-            const double u = H * (1 - L / r->L0[d]);
-            ok = fabs(u) < r->law->travel_mm * (1 - 1e-9);
-            double k, f = cf_law_force(r->law, r->method, u, &k, NULL);
-            const double kd = r->w[d] * H * H * visc / r->L0[d]; /* dashpot, as msm.h */
-            x.T0_N[d] = -r->w[d] * ((alpha - 1) * f + c[d]) + kd * (L - r->Lprev[d]);
-            x.k_N_per_mm[d] = r->w[d] * (alpha - 1) * k * H / r->L0[d] + kd;
-            x.Lref_mm[d] = L;
-            kT[d] = r->w[d] * alpha * k * H / r->L0[d] + kd; /* dT/dL */
-            dL[d] = a * (X[0] * X[0] + X[1] * X[1]) / L;   /* dL/da */
-        }
-        cf_status st = ok ? cf_cell_stress(&r->cell, F, &x, &r->st, err) : CF_E_DATA;
-        if (st != CF_OK) { /* outside the springs' travel: back toward the last good stretch */
-            if (a > r->a)
-                hi = a;
-            else
-                lo = a;
-            a = 0.5 * (a + r->a);
-            if (hi - lo <= 1e-15)
-                break;
-            continue;
-        }
-        const double P = r->st.P_MPa[0][0];
-        double g = 0;
-        for (int d = 0; d < CF_CELL_DIRS; d++) {
-            const double *X = r->X[d], L = r->st.L_mm[d], T = r->st.T_N[d];
-            g += (kT[d] * dL[d] * a * X[0] * X[0] / L + T * X[0] * X[0] / L -
-                  T * a * X[0] * X[0] * dL[d] / (L * L)) / H3;
-        }
-        double an = a - P / g;
-        if (!(g > 0) || !(an > lo && an < hi))
-            an = P > 0 ? 0.5 * (lo + a) : 0.5 * (a + hi);
-        if (P > 0)
-            hi = a;
-        else
-            lo = a;
-        if (fabs(an - a) <= 4e-16 * a || P == 0) {
-            r->a = a;
-            r->st.free_stretch = a;
-            r->st.stress_MPa = r->st.P_MPa[2][2];
-            for (int d = 0; d < CF_CELL_DIRS; d++) {
-                double f = cf_law_force(r->law, r->method, H * (1 - r->st.L_mm[d] / r->L0[d]),
-                                        NULL, NULL);
-                for (int i = 0; i < np && dt > 0; i++)
-                    r->h[d][i] = pe[i] * r->h[d][i] + p->g[i] * pb[i] * (f - r->Fprev[d]);
-                r->Fprev[d] = f;
-                r->Lprev[d] = r->st.L_mm[d];
-            }
-            return CF_OK;
-        }
-        a = an;
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        double c = 0;
+        for (int i = 0; i < np && dt > 0; i++)
+            c += pe[i] * r->h[d][i] - p->g[i] * pb[i] * r->Fprev[d];
+        x.T0_N[d] = -r->w[d] * c;                                    /* branches, tension + */
+        x.k_N_per_mm[d] = r->w[d] * H * H * visc / r->L0[d];         /* dashpot, as msm.h */
+        x.Lref_mm[d] = r->Lprev[d];
     }
-    return cf_error_set(err, CF_E_NOCONV,
-                        "the cell found no lateral stretch in equilibrium at strain %g", e);
+    r->cell.law_scale = dt > 0 ? alpha : 1.0;
+    cf_status st = cf_cell_mode(&r->cell, CF_MODE_UNIAXIAL, e, &x, &r->st, err);
+    r->cell.law_scale = 1.0;
+    if (st == CF_OK)
+        r->cell.stretch_hint = r->st.free_stretch; /* the next step starts here */
+    if (st != CF_OK)
+        return st;
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        double f = cf_law_force(r->law, r->method, H * (1 - r->st.L_mm[d] / r->L0[d]), NULL, NULL);
+        for (int i = 0; i < np && dt > 0; i++)
+            r->h[d][i] = pe[i] * r->h[d][i] + p->g[i] * pb[i] * (f - r->Fprev[d]);
+        r->Fprev[d] = f;
+        r->Lprev[d] = r->st.L_mm[d];
+    }
+    return CF_OK;
 }
 
 /* A force-driven step: the table strain whose stress is the target (MPa, table sign), by the
@@ -238,13 +191,10 @@ static cf_status cell_path(const cf_visco_params *p, const cf_visco_setup *s, co
     r->method = s->method;
     r->p = p;
     r->H = law->p.H_mm;
-    r->a = 1;
     for (int d = 0; d < CF_CELL_DIRS; d++) {
         int N[3], fam;
         cf_cell_direction(d, N, &fam);
         r->L0[d] = r->H * sqrt((double)(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]));
-        for (int i = 0; i < 3; i++)
-            r->X[d][i] = r->H * N[i];
         r->w[d] = s->cfg.lattice.weight[fam];
         r->Lprev[d] = r->L0[d];
     }
