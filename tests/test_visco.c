@@ -12,6 +12,7 @@
 #include <jansson.h>
 
 #include "conifit/cell.h"
+#include "conifit/fitfile.h"
 #include "conifit/measure.h"
 #include "conifit/msm.h"
 #include "conifit/viscofit.h"
@@ -566,6 +567,50 @@ static void test_shipped_muscle_fits(void **state)
     }
 }
 
+/* A viscoelastic fit's Prony terms go with its spring: the JSON spring carries them under the
+** fit file's keys and reads back through cf_fitfile_load; the CSV table and the simulator blocks
+** state them in comment lines (their spring elements have no place for them). */
+static void test_export_prony(void **state)
+{
+    (void)state;
+    const char *fit = "fits/series/muscle_compression_relaxation_fiber30.json";
+    cf_fitted_spring fs, back;
+    cf_error err = {0};
+    assert_int_equal(cf_fitfile_load(fit, NULL, &fs, &err), CF_OK);
+    assert_int_equal(fs.viscoelastic, 1);
+    assert_true(fs.prony_count >= 1);
+    char dir[] = "/tmp/conifit-visco-XXXXXX", out[256], so[8192], se[4096];
+    assert_non_null(mkdtemp(dir));
+    snprintf(out, sizeof out, "%s/spring.json", dir);
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "export %s --format json -o %s", fit,
+                            out),
+                     0);
+    assert_int_equal(cf_fitfile_load(out, NULL, &back, &err), CF_OK);
+    assert_int_equal(back.viscoelastic, 1);
+    assert_int_equal(back.prony_count, fs.prony_count);
+    for (int i = 0; i < fs.prony_count; i++) {
+        assert_true(back.prony_g[i] == fs.prony_g[i]);
+        assert_true(back.prony_tau_s[i] == fs.prony_tau_s[i]);
+    }
+    assert_true(back.eta_MPa_s == fs.eta_MPa_s);
+    unlink(out);
+    rmdir(dir);
+    static const char *const formats[] = {"csv", "calculix", "abaqus", "febio", "lsdyna"};
+    for (int k = 0; k < 5; k++) {
+        assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "export %s --format %s -q", fit,
+                                formats[k]),
+                         0);
+        char want[96];
+        snprintf(want, sizeof want, "prony term 1: g = %.17g, tau_s = %.17g", fs.prony_g[0],
+                 fs.prony_tau_s[0]);
+        assert_non_null(strstr(so, want));
+    }
+    /* an elastic fit's exports say nothing of Prony terms */
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "export fits/telescoping.json --format csv"),
+                     0);
+    assert_null(strstr(so, "prony"));
+}
+
 /* The stability of a homogeneous state, from one factorisation at the cell's lateral stretch,
 ** agrees with the scan of the static lattice (cf_msm_stability_limit) on both sides of its
 ** limit. */
@@ -625,6 +670,7 @@ int main(void)
         cmocka_unit_test(test_simulate_reproduces_fit),
         cmocka_unit_test(test_shipped_muscle_fits),
         cmocka_unit_test(test_homogeneous_inertia),
+        cmocka_unit_test(test_export_prony),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

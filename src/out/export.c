@@ -31,6 +31,28 @@ static const char *src_name(const cf_export_options *opt)
     return (opt->source && *opt->source) ? opt->source : "(none)";
 }
 
+/* The Prony terms and dashpot of a viscoelastic fit, as comment lines: the time-dependent part of
+** the tissue that the simulator formats' spring elements have no place for (README, export). */
+static void prony_comment(FILE *out, const char *lead, const char *tail,
+                          const cf_fitted_spring *fs, const char *why)
+{
+    if (!fs || !fs->viscoelastic)
+        return;
+    double ginf = 1;
+    for (int i = 0; i < fs->prony_count; i++)
+        ginf -= fs->prony_g[i];
+    fprintf(out, "%sviscoelastic fit: quasi-linear viscoelasticity on every spring, force = the law "
+                 "convolved with G(t) = g_inf + sum g_i exp(-t/tau_i), g_inf = %.17g%s\n",
+            lead, ginf, tail);
+    for (int i = 0; i < fs->prony_count; i++)
+        fprintf(out, "%sprony term %d: g = %.17g, tau_s = %.17g%s\n", lead, i + 1, fs->prony_g[i],
+                fs->prony_tau_s[i], tail);
+    if (fs->eta_MPa_s > 0)
+        fprintf(out, "%sdashpot beside every spring: eta = %.17g kPa s%s\n", lead,
+                fs->eta_MPa_s * 1e3, tail);
+    fprintf(out, "%s%s%s\n", lead, why, tail);
+}
+
 /* Comment lines shared by the blocks: what, units, sign, source, spring and table. */
 static void block_header(FILE *out, const char *lead, const char *tail, const char *what,
                          const cf_law *law, const cf_export_table *t,
@@ -86,6 +108,23 @@ static cf_status write_json(FILE *out, const block_job *j, cf_error *err)
     }
     json_object_set_new(prov, "fit_version", json_string(fs->version));
     json_object_set_new(root, "provenance", prov);
+    if (fs->viscoelastic) { /* the keys of the fit file, which cf_fitfile_load reads back */
+        json_t *pr = json_array();
+        double ginf = 1;
+        for (int i = 0; pr && i < fs->prony_count; i++) {
+            json_array_append_new(pr, json_pack("{s:o, s:o}", "g", cf_json_number(fs->prony_g[i]),
+                                                "tau_s", cf_json_number(fs->prony_tau_s[i])));
+            ginf -= fs->prony_g[i];
+        }
+        json_object_set_new(root, "prony", pr);
+        json_object_set_new(root, "g_inf", cf_json_number(ginf));
+        if (fs->eta_MPa_s > 0)
+            json_object_set_new(root, "dashpot",
+                                json_pack("{s:o}", "eta_kPa_s", cf_json_number(fs->eta_MPa_s * 1e3)));
+        json_object_set_new(root, "viscoelasticity",
+                            json_string("quasi-linear (Fung): the spring's force is its law "
+                                        "convolved with G(t) = g_inf + sum g_i exp(-t/tau_i)"));
+    }
     char *text = cf_fitfile_dumps(root);
     json_decref(root);
     if (!text)
@@ -102,6 +141,9 @@ static cf_status write_csv(FILE *out, const block_job *j, cf_error *err)
 {
     (void)err;
     const cf_export_table *t = j->t;
+    prony_comment(out, "# ", "", j->fs,
+                  "the table below is the instantaneous (elastic) law; G(t) scales its response "
+                  "in time");
     fprintf(out, "u_mm,force_N,stiffness_N_per_mm\n");
     for (size_t i = 0; i < t->rows; i++)
         fprintf(out, "%.17g,%.17g,%.17g\n", t->u_mm[i], t->F_N[i], t->k_N_per_mm[i]);
@@ -114,6 +156,9 @@ static void write_inp_block(FILE *out, const block_job *j, const char *what)
 {
     const cf_export_table *t = j->t;
     block_header(out, "** ", "", what, j->law, t, j->opt);
+    prony_comment(out, "** ", "", j->fs,
+                  "not written as keywords: *VISCOELASTIC, TIME=PRONY belongs to a *MATERIAL of "
+                  "continuum elements; SPRINGA elements take *SPRING alone, elastic");
     fprintf(out, "** CalculiX holds the force of the last pair beyond the table (constant force)\n");
     fprintf(out, "*SPRING, ELSET=CONIFIT_SPRING, NONLINEAR\n\n");
     for (size_t i = t->rows; i-- > 0;)
@@ -142,6 +187,9 @@ static cf_status write_febio(FILE *out, const block_job *j, cf_error *err)
     fprintf(out, "<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?>\n");
     block_header(out, "<!-- ", " -->", "conical spring for FEBio 4 as a nonlinear spring", law, t,
                  j->opt);
+    prony_comment(out, "<!-- ", " -->", j->fs,
+                  "not written as material: FEBio's viscoelastic material (g1..g6, t1..t6) wraps a "
+                  "solid's elastic material; a discrete nonlinear spring has no relaxation");
     fprintf(out, "<!-- beyond the table the force is held constant (extend CONSTANT); for a "
                  "model that runs as it is use the example or the lattice export -->\n");
     fprintf(out, "<febio_spec version=\"4.0\">\n");
@@ -173,6 +221,9 @@ static cf_status write_lsdyna(FILE *out, const block_job *j, cf_error *err)
     block_header(out, "$ ", "",
                  "conical spring for LS-DYNA as *MAT_SPRING_NONLINEAR_ELASTIC (MAT_S04)", j->law,
                  t, j->opt);
+    prony_comment(out, "$ ", "", j->fs,
+                  "not written as cards: the viscoelastic materials with G_i, BETA_i are for "
+                  "solids; *MAT_SPRING_MAXWELL holds one linear term, not a series on a curve");
     fprintf(out, "$ LCINT = rows, so that LS-DYNA does not resample the curve to 100 points\n");
     fprintf(out, "*KEYWORD\n*MAT_SPRING_NONLINEAR_ELASTIC\n");
     fprintf(out, "$#     mid       lcd       lcr\n");
