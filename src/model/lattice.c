@@ -63,14 +63,9 @@ static size_t node_id(const cf_lattice_config *c, int i, int j, int k)
     return (size_t)i + (size_t)(c->nx + 1) * ((size_t)j + (size_t)(c->ny + 1) * (size_t)k);
 }
 
-/* Why one long function: building the lattice is one sequence (check the configuration, place the
-** nodes, enumerate the springs of every family with their weights, set the boundary, allocate the
-** work arrays) over one set of arrays that cf_lattice_free releases on any failure; each stage is
-** marked by a comment below. */
-cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method method,
-                            const cf_lattice_config *cfg, cf_error *err)
+/* The configuration is one a lattice can be built from: CF_E_DATA naming what is not. */
+static cf_status check_config(const cf_lattice_config *cfg, cf_error *err)
 {
-    memset(lat, 0, sizeof *lat);
     const int dims[3] = {cfg->nx, cfg->ny, cfg->nz};
     const char *names[3] = {"nx", "ny", "nz"};
     for (int a = 0; a < 3; a++)
@@ -84,56 +79,77 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
     if (!(cfg->density_t_per_mm3 > 0) || !isfinite(cfg->density_t_per_mm3))
         return cf_error_set(err, CF_E_DATA, "density_t_per_mm3 = %g: must be finite and > 0",
                             cfg->density_t_per_mm3);
-    cf_status wst = cf_calibration_check(cfg->weight, err);
-    if (wst != CF_OK)
-        return wst;
-    lat->cfg = *cfg;
-    lat->law = law;
-    lat->method = method;
-    lat->with_stiffness = 1;
-    lat->H_mm = law->p.H_mm;
-    lat->travel_mm = law->travel_mm;
-    const double H = lat->H_mm;
+    return cf_calibration_check(cfg->weight, err);
+}
 
-    /* The spring directions of the cell (each unordered pair of neighbours once). */
-    int off[CF_CELL_DIRS][3];
-    int noff = 0;
-    for (int d = 0; d < CF_CELL_DIRS; d++) {
-        int fam;
-        cf_cell_direction(d, off[noff], &fam);
-        if (cfg->weight[fam] != 0)
-            noff++; /* a family of weight 0 has no springs */
-    }
-
-    const size_t nn = (size_t)(cfg->nx + 1) * (cfg->ny + 1) * (cfg->nz + 1);
-    lat->nn = nn;
-    /* Upper bound on springs: noff per node. */
-    size_t cap = nn * (size_t)noff;
+/* The arrays of nn nodes, at most cap springs and ntop top nodes, zeroed: 0, or -1 when memory
+** runs out (what was allocated is left for cf_lattice_free). */
+static int lattice_alloc(cf_lattice *lat, size_t nn, size_t cap, size_t ntop)
+{
     double **nd[] = {&lat->x, &lat->y, &lat->z, &lat->X, &lat->Y, &lat->Z,
                      &lat->mass_t, &lat->fx, &lat->fy, &lat->fz};
     for (size_t i = 0; i < sizeof nd / sizeof nd[0]; i++)
         if (!(*nd[i] = calloc(nn, sizeof(double))))
-            goto oom;
+            return -1;
     double **sd[] = {&lat->L0_mm, &lat->a, &lat->w, &lat->L_mm, &lat->u_mm,
                      &lat->F_N, &lat->k_N_per_mm, &lat->T_N};
     for (size_t i = 0; i < sizeof sd / sizeof sd[0]; i++)
         if (!(*sd[i] = calloc(cap ? cap : 1, sizeof(double))))
-            goto oom;
+            return -1;
     lat->fix = calloc(nn, 1);
     lat->family = calloc(cap ? cap : 1, 1);
     lat->si = calloc(cap ? cap : 1, sizeof(uint32_t));
     lat->sj = calloc(cap ? cap : 1, sizeof(uint32_t));
-    size_t ntop = (size_t)(cfg->nx + 1) * (cfg->ny + 1);
     lat->top = calloc(ntop, sizeof(uint32_t));
     lat->top_share = calloc(ntop, sizeof(double));
-    if (!lat->fix || !lat->family || !lat->si || !lat->sj || !lat->top || !lat->top_share)
-        goto oom;
+    return lat->fix && lat->family && lat->si && lat->sj && lat->top && lat->top_share ? 0 : -1;
+}
 
+/* The springs from node (i, j, k) along the noff cell directions off, each with its rest length
+** and its weight (the family's, times the share of the cells that hold it); appended at
+** lat->ns, counted in degree. */
+static void add_springs(cf_lattice *lat, const int (*off)[3], int noff, int i, int j, int k,
+                        int *degree)
+{
+    const cf_lattice_config *cfg = &lat->cfg;
+    const double H = lat->H_mm;
+    const size_t p = node_id(cfg, i, j, k);
+    for (int o = 0; o < noff; o++) {
+        int i2 = i + off[o][0], j2 = j + off[o][1], k2 = k + off[o][2];
+        if (i2 < 0 || i2 > cfg->nx || j2 < 0 || j2 > cfg->ny || k2 < 0 || k2 > cfg->nz)
+            continue;
+        int cells = cells_along(i, off[o][0], cfg->nx) * cells_along(j, off[o][1], cfg->ny) *
+                    cells_along(k, off[o][2], cfg->nz);
+        if (cells == 0)
+            continue;
+        int zeros = (off[o][0] == 0) + (off[o][1] == 0) + (off[o][2] == 0);
+        double share = cells / (double)(1 << zeros); /* 4, 2 or 1 cells share it */
+        int nzc = 3 - zeros;
+        double L0 = H * sqrt((double)nzc);
+        size_t q = node_id(cfg, i2, j2, k2), ns = lat->ns;
+        lat->si[ns] = (uint32_t)(p < q ? p : q);
+        lat->sj[ns] = (uint32_t)(p < q ? q : p);
+        lat->L0_mm[ns] = L0;
+        lat->a[ns] = H / L0;
+        lat->w[ns] = share * cfg->weight[nzc - 1];
+        lat->family[ns] = (uint8_t)(nzc - 1);
+        degree[p]++;
+        degree[q]++;
+        lat->ns = ns + 1;
+    }
+}
+
+/* Every node at its place with its share of the cells' mass, and the springs from it. 0, or -1
+** when memory runs out. */
+static int place_nodes(cf_lattice *lat, const int (*off)[3], int noff)
+{
+    const cf_lattice_config *cfg = &lat->cfg;
+    const double H = lat->H_mm;
     const double cell_mass = cfg->density_t_per_mm3 * H * H * H;
-    int *degree = calloc(nn, sizeof(int));
+    int *degree = calloc(lat->nn, sizeof(int));
     if (!degree)
-        goto oom;
-    size_t ns = 0;
+        return -1;
+    lat->ns = 0;
     lat->m_min_t = INFINITY;
     for (int k = 0; k <= cfg->nz; k++)
         for (int j = 0; j <= cfg->ny; j++)
@@ -147,42 +163,22 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
                 lat->mass_t[p] = cell_mass * cx * cy * cz / 8.0;
                 if (lat->mass_t[p] < lat->m_min_t)
                     lat->m_min_t = lat->mass_t[p];
-                for (int o = 0; o < noff; o++) {
-                    int i2 = i + off[o][0], j2 = j + off[o][1], k2 = k + off[o][2];
-                    if (i2 < 0 || i2 > cfg->nx || j2 < 0 || j2 > cfg->ny || k2 < 0 ||
-                        k2 > cfg->nz)
-                        continue;
-                    int cells = cells_along(i, off[o][0], cfg->nx) *
-                                cells_along(j, off[o][1], cfg->ny) *
-                                cells_along(k, off[o][2], cfg->nz);
-                    if (cells == 0)
-                        continue;
-                    int zeros = (off[o][0] == 0) + (off[o][1] == 0) + (off[o][2] == 0);
-                    double share = cells / (double)(1 << zeros); /* 4, 2 or 1 cells share it */
-                    int nzc = 3 - zeros;
-                    double L0 = H * sqrt((double)nzc);
-                    size_t q = node_id(cfg, i2, j2, k2);
-                    lat->si[ns] = (uint32_t)(p < q ? p : q);
-                    lat->sj[ns] = (uint32_t)(p < q ? q : p);
-                    lat->L0_mm[ns] = L0;
-                    lat->a[ns] = H / L0;
-                    lat->w[ns] = share * cfg->weight[nzc - 1];
-                    lat->family[ns] = (uint8_t)(nzc - 1);
-                    degree[p]++;
-                    degree[q]++;
-                    ns++;
-                }
+                add_springs(lat, off, noff, i, j, k, degree);
             }
-    lat->ns = ns;
     lat->max_degree = 0;
-    for (size_t p = 0; p < nn; p++)
+    for (size_t p = 0; p < lat->nn; p++)
         if (degree[p] > lat->max_degree)
             lat->max_degree = degree[p];
     free(degree);
+    return 0;
+}
 
-    /* Boundary: bottom face held in z (and x, y when clamped); with a sliding bottom, node (0,0,0)
-    ** is pinned in x and y and node (nx,0,0) in y, which removes the rigid lateral motions
-    ** without restraining the lateral expansion. */
+/* Boundary: bottom face held in z (and x, y when clamped); with a sliding bottom, node (0,0,0)
+** is pinned in x and y and node (nx,0,0) in y, which removes the rigid lateral motions without
+** restraining the lateral expansion. The top nodes, with their shares of the top face. */
+static void set_boundary(cf_lattice *lat)
+{
+    const cf_lattice_config *cfg = &lat->cfg;
     for (int j = 0; j <= cfg->ny; j++)
         for (int i = 0; i <= cfg->nx; i++) {
             size_t p = node_id(cfg, i, j, 0);
@@ -194,7 +190,6 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
         lat->fix[node_id(cfg, 0, 0, 0)] |= CF_FIX_X | CF_FIX_Y;
         lat->fix[node_id(cfg, cfg->nx, 0, 0)] |= CF_FIX_Y;
     }
-    lat->ntop = ntop;
     size_t t = 0;
     for (int j = 0; j <= cfg->ny; j++)
         for (int i = 0; i <= cfg->nx; i++) {
@@ -202,13 +197,44 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
             lat->top_share[t] = cells_along(i, 0, cfg->nx) * cells_along(j, 0, cfg->ny) / 4.0;
             t++;
         }
-    lat->area_mm2 = (double)cfg->nx * cfg->ny * H * H;
-    lat->height_mm = cfg->nz * H;
+}
+
+cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method method,
+                            const cf_lattice_config *cfg, cf_error *err)
+{
+    memset(lat, 0, sizeof *lat);
+    cf_status st = check_config(cfg, err);
+    if (st != CF_OK)
+        return st;
+    lat->cfg = *cfg;
+    lat->law = law;
+    lat->method = method;
+    lat->with_stiffness = 1;
+    lat->H_mm = law->p.H_mm;
+    lat->travel_mm = law->travel_mm;
+
+    /* The spring directions of the cell (each unordered pair of neighbours once). */
+    int off[CF_CELL_DIRS][3];
+    int noff = 0;
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        int fam;
+        cf_cell_direction(d, off[noff], &fam);
+        if (cfg->weight[fam] != 0)
+            noff++; /* a family of weight 0 has no springs */
+    }
+    lat->nn = (size_t)(cfg->nx + 1) * (cfg->ny + 1) * (cfg->nz + 1);
+    lat->ntop = (size_t)(cfg->nx + 1) * (cfg->ny + 1);
+    /* at most noff springs per node */
+    if (lattice_alloc(lat, lat->nn, lat->nn * (size_t)noff, lat->ntop) != 0 ||
+        place_nodes(lat, (const int (*)[3])off, noff) != 0) {
+        cf_lattice_free(lat);
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for a %d x %d x %d lattice",
+                            cfg->nx, cfg->ny, cfg->nz);
+    }
+    set_boundary(lat);
+    lat->area_mm2 = (double)cfg->nx * cfg->ny * lat->H_mm * lat->H_mm;
+    lat->height_mm = cfg->nz * lat->H_mm;
     return CF_OK;
-oom:
-    cf_lattice_free(lat);
-    return cf_error_set(err, CF_E_INTERNAL, "out of memory for a %d x %d x %d lattice", cfg->nx,
-                        cfg->ny, cfg->nz);
 }
 
 void cf_lattice_reset(cf_lattice *lat)

@@ -1048,21 +1048,10 @@ static cf_status check_path(const cf_msm_path *p, const double *ts, size_t ns, c
     return CF_OK;
 }
 
-/* Why one long function: the run is one time loop whose solver is chosen once (static equilibria,
-** implicit quasi-static steps or explicit steps) and whose state (positions, velocities, Maxwell
-** strains, the sample cursor, the statistics) is shared by every branch; the branches' work is in
-** the helpers above, and what stays here is the bookkeeping that must see all of that state. */
-cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_config *cfg,
-                     const cf_msm_path *path, const double *sample_t_s, size_t nsamples,
-                     cf_msm_sample *out, size_t *done, cf_msm_stats *stats, cf_error *err)
+/* The run's effects and path are ones it can follow: CF_E_DATA naming what is not. */
+static cf_status check_run(const cf_msm_effects *fx, const cf_msm_path *path,
+                           const double *sample_t_s, size_t nsamples, cf_error *err)
 {
-    cf_msm_effects none = {0};
-    const cf_msm_effects *fx = fxin ? fxin : &none;
-    cf_msm_stats local = {0};
-    cf_msm_stats *st = stats ? stats : &local;
-    memset(st, 0, sizeof *st);
-    if (done)
-        *done = 0;
     cf_status rc = check_path(path, sample_t_s, nsamples, err);
     if (rc != CF_OK)
         return rc;
@@ -1074,27 +1063,165 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
     if (fx->prony_count > 0 && fx->inertia)
         return cf_error_set(err, CF_E_DATA, "Prony terms are solved quasi-statically: they do not "
                             "combine with inertia");
-    int timed = fx->inertia || fx->eta_MPa_s > 0 || fx->maxwell_E_MPa > 0 || fx->prony_count > 0;
+    return CF_OK;
+}
+
+static void dyn_free(dyn *d)
+{
+    free(d->vx);
+    free(d->vy);
+    free(d->vz);
+    free(d->Ld);
+    free(d->Tt);
+    if (d->fused)
+        cf_lattice_stepper_free(&d->step);
+}
+
+/* The dynamic state (velocities at rest) of an explicit run; the fused step when the springs are
+** elastic only. */
+static cf_status dyn_init(dyn *d, solver *s, cf_error *err)
+{
+    cf_lattice *lat = s->lat;
+    d->vx = calloc(lat->nn, sizeof(double));
+    d->vy = calloc(lat->nn, sizeof(double));
+    d->vz = calloc(lat->nn, sizeof(double));
+    d->Ld = calloc(lat->ns ? lat->ns : 1, sizeof(double));
+    d->Tt = calloc(lat->ns ? lat->ns : 1, sizeof(double));
+    if (!d->vx || !d->vy || !d->vz || !d->Ld || !d->Tt)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the dynamic state");
+    d->fused = !(s->fx->eta_MPa_s > 0) && !s->sigm;
+    cf_status rc = CF_OK;
+    if (d->fused && (rc = cf_lattice_stepper_init(&d->step, lat, s->eq, err)) != CF_OK)
+        d->fused = 0;
+    return rc;
+}
+
+/* Explicit steps from t to tk, each within the stable step (and cfg->dt_s when set). */
+static cf_status explicit_interval(solver *s, dyn *d, const cf_msm_path *path, double t,
+                                   double tk, cf_msm_stats *st, cf_error *err)
+{
+    cf_lattice *lat = s->lat;
+    const cf_msm_effects *fx = s->fx;
+    double stab = DT_SAFETY * cf_msm_stable_step(lat, fx);
+    double want = s->cfg->dt_s > 0 ? s->cfg->dt_s : stab;
+    if (want > stab) {
+        want = stab;
+        st->substepped++;
+    }
+    double n = ceil((tk - t) / want - 1e-9);
+    if (n > 1e12)
+        return cf_error_set(err, CF_E_DATA, "stable step %.3g s is too small for %.3g s", want,
+                            tk - t);
+    double h = (tk - t) / n;
+    if (st->dt_used_min_s == 0 || h < st->dt_used_min_s)
+        st->dt_used_min_s = h;
+    for (double m = 1; m <= n; m++) {
+        double tb = t + m * h;
+        double vb = cf_msm_path_value(path, tb);
+        double rate = (vb - cf_msm_path_value(path, tb - h)) / h;
+        s->load = vb;
+        if (m == 1 && d->fused) { /* the fused step adds onto zeroed node forces */
+            memset(lat->fx, 0, lat->nn * sizeof(double));
+            memset(lat->fy, 0, lat->nn * sizeof(double));
+            memset(lat->fz, 0, lat->nn * sizeof(double));
+        }
+        dyn_step(s, d, h, vb, rate);
+    }
+    double um = cf_lattice_forces(lat);
+    st->max_u_over_travel = fmax(st->max_u_over_travel, um);
+    if (um >= 1)
+        return cf_error_set(err, CF_E_NOCONV,
+                            "a spring reached solid length at t = %.6g s (strain %.6g): the load "
+                            "is more than the lattice can carry",
+                            tk, cf_lattice_top_strain(lat));
+    return CF_OK;
+}
+
+/* From time t to sample k at tk, drive value vk: a static equilibrium, implicit quasi-static
+** steps, or explicit steps, as the effects ask. */
+static cf_status advance_to(solver *s, dyn *d, const cf_msm_path *path, double t, double tk,
+                            double vk, size_t k, cf_msm_stats *st, cf_error *err)
+{
+    const cf_msm_effects *fx = s->fx;
+    const int timed = fx->inertia || fx->eta_MPa_s > 0 || fx->maxwell_E_MPa > 0 ||
+                      fx->prony_count > 0;
+    if (!timed)
+        return static_to(s, vk, err);
+    if (fx->inertia)
+        return tk > t ? explicit_interval(s, d, path, t, tk, st, err) : CF_OK;
+    if (tk > t) {
+        int n = s->cfg->quasi_substeps > 0 ? s->cfg->quasi_substeps : 1;
+        if (s->cfg->dt_s > 0)
+            n = (int)fmin(1e9, ceil((tk - t) / s->cfg->dt_s - 1e-9));
+        return quasi_advance(s, path, t, tk, n > 0 ? n : 1, 0, err);
+    }
+    if (k > 0)
+        return CF_OK;
+    /* The state at the first sample is at rest: the Maxwell and Prony branches are relaxed, so
+    ** the springs carry g_inf times the law. */
+    if (fx->prony_count > 0) {
+        double gsum = 0;
+        for (int i = 0; i < fx->prony_count; i++)
+            gsum += fx->prony_g[i];
+        s->qlv_scale = -gsum;
+        s->extras = 1;
+    }
+    return static_to(s, vk, err);
+}
+
+/* The compressive stress at the top of the current state (drive value vk). */
+static double sample_stress(solver *s, dyn *d, const cf_msm_path *path, double vk)
+{
+    cf_lattice *lat = s->lat;
+    const cf_msm_effects *fx = s->fx;
+    if (fx->inertia && (fx->eta_MPa_s > 0 || s->sigm) && path->drive == CF_DRIVE_DISPLACEMENT) {
+        /* Reaction including the dashpots at the current velocities. */
+        cf_lattice_forces(lat);
+        double H2 = lat->H_mm * lat->H_mm;
+        for (size_t q = 0; q < lat->ns; q++) {
+            uint32_t i = lat->si[q], j = lat->sj[q];
+            d->Ld[q] = ((lat->x[j] - lat->x[i]) * (d->vx[j] - d->vx[i]) +
+                        (lat->y[j] - lat->y[i]) * (d->vy[j] - d->vy[i]) +
+                        (lat->z[j] - lat->z[i]) * (d->vz[j] - d->vz[i])) /
+                       lat->L_mm[q];
+            d->Tt[q] = lat->w[q] * H2 * fx->eta_MPa_s / lat->L0_mm[q] * d->Ld[q] +
+                       (s->sigm ? lat->w[q] * H2 * s->sigm[q] : 0.0);
+        }
+        cf_lattice_add_tensions(lat, d->Tt);
+        add_external(s);
+        return path->drive == CF_DRIVE_FORCE ? vk : top_stress(lat);
+    }
+    if (s->extras) {
+        /* Quasi-static: the reaction of the last step includes its viscous forces. */
+        double rn, fsc;
+        residual(s, &rn, &fsc);
+        return path->drive == CF_DRIVE_FORCE ? vk : top_stress(lat);
+    }
+    return reported_stress(s);
+}
+
+/* The run is one time loop: each sample is reached (advance_to), reported (sample_stress) and
+** checked finite; the solver is set up once for the effects asked for. */
+cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_config *cfg,
+                     const cf_msm_path *path, const double *sample_t_s, size_t nsamples,
+                     cf_msm_sample *out, size_t *done, cf_msm_stats *stats, cf_error *err)
+{
+    cf_msm_effects none = {0};
+    const cf_msm_effects *fx = fxin ? fxin : &none;
+    cf_msm_stats local = {0};
+    cf_msm_stats *st = stats ? stats : &local;
+    memset(st, 0, sizeof *st);
+    if (done)
+        *done = 0;
+    cf_status rc = check_run(fx, path, sample_t_s, nsamples, err);
+    if (rc != CF_OK)
+        return rc;
     solver s;
     if ((rc = solver_init(&s, lat, fx, cfg, path->drive, st, err)) != CF_OK)
         return rc;
     dyn d = {0};
-    if (fx->inertia) {
-        d.vx = calloc(lat->nn, sizeof(double));
-        d.vy = calloc(lat->nn, sizeof(double));
-        d.vz = calloc(lat->nn, sizeof(double));
-        d.Ld = calloc(lat->ns ? lat->ns : 1, sizeof(double));
-        d.Tt = calloc(lat->ns ? lat->ns : 1, sizeof(double));
-        if (!d.vx || !d.vy || !d.vz || !d.Ld || !d.Tt) {
-            rc = cf_error_set(err, CF_E_INTERNAL, "out of memory for the dynamic state");
-            goto end;
-        }
-        d.fused = !(fx->eta_MPa_s > 0) && !s.sigm;
-        if (d.fused && (rc = cf_lattice_stepper_init(&d.step, lat, s.eq, err)) != CF_OK) {
-            d.fused = 0;
-            goto end;
-        }
-    }
+    if (fx->inertia && (rc = dyn_init(&d, &s, err)) != CF_OK)
+        goto end;
     s.load = 0;
     double t = nsamples ? fmin(sample_t_s[0], path->t_s[0]) : 0;
     if (fx->inertia) {
@@ -1113,96 +1240,13 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
     double E0 = fx->inertia ? total_energy(&s, &d) : 0, Escale = 0, dE = 0;
     for (size_t k = 0; k < nsamples; k++) {
         double tk = sample_t_s[k], vk = cf_msm_path_value(path, tk);
-        if (!timed) {
-            rc = static_to(&s, vk, err);
-        } else if (!fx->inertia) {
-            if (tk > t) {
-                int n = cfg->quasi_substeps > 0 ? cfg->quasi_substeps : 1;
-                if (cfg->dt_s > 0)
-                    n = (int)fmin(1e9, ceil((tk - t) / cfg->dt_s - 1e-9));
-                rc = quasi_advance(&s, path, t, tk, n > 0 ? n : 1, 0, err);
-            } else if (k == 0) {
-                /* The state at the first sample is at rest: the Maxwell and Prony branches are
-                ** relaxed, so the springs carry g_inf times the law. */
-                if (fx->prony_count > 0) {
-                    double gsum = 0;
-                    for (int i = 0; i < fx->prony_count; i++)
-                        gsum += fx->prony_g[i];
-                    s.qlv_scale = -gsum;
-                    s.extras = 1;
-                }
-                rc = static_to(&s, vk, err);
-            }
-        } else if (tk > t) {
-            double stab = DT_SAFETY * cf_msm_stable_step(lat, fx);
-            double want = cfg->dt_s > 0 ? cfg->dt_s : stab;
-            if (want > stab) {
-                want = stab;
-                st->substepped++;
-            }
-            double n = ceil((tk - t) / want - 1e-9);
-            if (n > 1e12) {
-                rc = cf_error_set(err, CF_E_DATA, "stable step %.3g s is too small for %.3g s",
-                                  want, tk - t);
-                goto end;
-            }
-            double h = (tk - t) / n;
-            if (st->dt_used_min_s == 0 || h < st->dt_used_min_s)
-                st->dt_used_min_s = h;
-            for (double m = 1; m <= n; m++) {
-                double tb = t + m * h;
-                double vb = cf_msm_path_value(path, tb);
-                double rate = (vb - cf_msm_path_value(path, tb - h)) / h;
-                s.load = vb;
-                if (m == 1 && d.fused) { /* the fused step adds onto zeroed node forces */
-                    memset(lat->fx, 0, lat->nn * sizeof(double));
-                    memset(lat->fy, 0, lat->nn * sizeof(double));
-                    memset(lat->fz, 0, lat->nn * sizeof(double));
-                }
-                dyn_step(&s, &d, h, vb, rate);
-            }
-            double um = cf_lattice_forces(lat);
-            st->max_u_over_travel = fmax(st->max_u_over_travel, um);
-            if (um >= 1) {
-                rc = cf_error_set(err, CF_E_NOCONV,
-                                  "a spring reached solid length at t = %.6g s (strain %.6g): the "
-                                  "load is more than the lattice can carry",
-                                  tk, cf_lattice_top_strain(lat));
-                goto end;
-            }
-        }
-        if (rc != CF_OK)
+        if ((rc = advance_to(&s, &d, path, t, tk, vk, k, st, err)) != CF_OK)
             goto end;
         t = tk;
         s.load = vk;
         out[k].t_s = tk;
         out[k].strain = cf_lattice_top_strain(lat);
-        if (fx->inertia && (fx->eta_MPa_s > 0 || s.sigm) && path->drive == CF_DRIVE_DISPLACEMENT) {
-            /* Reaction including the dashpots at the current velocities. */
-            cf_lattice_forces(lat);
-            double H2 = lat->H_mm * lat->H_mm;
-            for (size_t q = 0; q < lat->ns; q++) {
-                uint32_t i = lat->si[q], j = lat->sj[q];
-                d.Ld[q] = ((lat->x[j] - lat->x[i]) * (d.vx[j] - d.vx[i]) +
-                           (lat->y[j] - lat->y[i]) * (d.vy[j] - d.vy[i]) +
-                           (lat->z[j] - lat->z[i]) * (d.vz[j] - d.vz[i])) /
-                          lat->L_mm[q];
-                d.Tt[q] = lat->w[q] * H2 * fx->eta_MPa_s / lat->L0_mm[q] * d.Ld[q] +
-                          (s.sigm ? lat->w[q] * H2 * s.sigm[q] : 0.0);
-            }
-            cf_lattice_add_tensions(lat, d.Tt);
-            add_external(&s);
-            out[k].stress_MPa = path->drive == CF_DRIVE_FORCE ? vk : top_stress(lat);
-        } else {
-            if (s.extras) {
-                /* Quasi-static: the reaction of the last step includes its viscous forces. */
-                double rn, fsc;
-                residual(&s, &rn, &fsc);
-                out[k].stress_MPa = path->drive == CF_DRIVE_FORCE ? vk : top_stress(lat);
-            } else {
-                out[k].stress_MPa = reported_stress(&s);
-            }
-        }
+        out[k].stress_MPa = sample_stress(&s, &d, path, vk);
         out[k].kinetic_mJ = fx->inertia ? kinetic(lat, &d) : 0.0;
         out[k].neg_pivots = fx->inertia ? -1 : s.neg_pivots;
         if (!isfinite(out[k].strain) || !isfinite(out[k].stress_MPa) ||
@@ -1225,13 +1269,7 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
             cfg->progress(cfg->progress_ctx, k + 1, nsamples, tk);
     }
 end:
-    free(d.vx);
-    free(d.vy);
-    free(d.vz);
-    free(d.Ld);
-    free(d.Tt);
-    if (d.fused)
-        cf_lattice_stepper_free(&d.step);
+    dyn_free(&d);
     solver_free(&s);
     return rc;
 }
