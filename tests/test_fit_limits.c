@@ -289,7 +289,7 @@ static void limit_flags_are_checked_and_named(void **state)
                      0);
     assert_non_null(strstr(errb, "no telescoping spring of this table meets the limit"));
     /* widened limits are honoured */
-    root = fit_json("data/strongly_conical.csv --rho-min 0.01 --G-max 1e9 --n-max 100 --quiet");
+    root = fit_json("data/strongly_conical.csv --rho-min 0.01 --G-max 1e6 --n-max 100 --quiet");
     json_t *lim = json_object_get(root, "limits");
     assert_close(json_real_value(json_object_get(lim, "rho_min")), 0.01, 0);
     assert_close(json_real_value(json_object_get(lim, "n_max")), 100, 0);

@@ -33,11 +33,13 @@ static const char fit_help[] =
     "                          table), or '-': the fit file on standard output (no report)\n"
     "  --type T                telescoping | non-telescoping | both (default both)\n"
     "  --fix NAME=VALUE        hold a parameter: D1, D2, d, H in mm, G in MPa, n (repeatable)\n"
-    "  --index-max C           largest spring index D1/d (default 12; the smallest is 3)\n"
-    "  --rho-min R             smallest diameter ratio D1/D2 (default 0.05)\n"
-    "  --n-max N               most active coils (default 30; the fewest is 2)\n"
-    "  --D2-max-H R            largest outer diameter in free lengths, D2/H (default 10)\n"
-    "  --G-max G               stiffest wire, shear modulus in MPa (default 80000, steel)\n"
+    "  --index-max C           largest spring index D1/d, 3..50 (default 12; the smallest is 3)\n"
+    "  --rho-min R             smallest diameter ratio D1/D2, 0.001..1 (default 0.05)\n"
+    "  --n-max N               most active coils, 2..1000 (default 30; the fewest is 2)\n"
+    "  --D2-max-H R            largest outer diameter in free lengths, D2/H, up to 1000\n"
+    "                          (default 10)\n"
+    "  --G-max G               stiffest wire, shear modulus in MPa, up to 1e6 (default 80000,\n"
+    "                          steel)\n"
     "  --relative              residuals relative to |stress| instead of absolute\n"
     "  --optimizer NAME        slsqp (default) | cobyla | mma: the constrained local optimiser\n"
     "  --seed S                seed of the global search (default 1); same seed, same result\n"
@@ -336,34 +338,39 @@ static int fit_option(void *ctx, int c, const char *optval)
     case OPT_INDEX_MAX:
         if (cf_cli_parse_double("--index-max", optval, &fo->index_max, &err))
             return cf_cli_usage_error("fit", "%s", err.msg);
-        if (fo->index_max < 3)
-            return cf_cli_usage_error("fit", "--index-max %g: must be at least 3", fo->index_max);
+        if (!(fo->index_max >= 3 && fo->index_max <= CF_FIT_INDEX_MAX_LIMIT))
+            return cf_cli_usage_error("fit", "--index-max %g: a spring index D1/d lies in [3, %g]",
+                                      fo->index_max, CF_FIT_INDEX_MAX_LIMIT);
         return 0;
     case OPT_RHO_MIN:
         if (cf_cli_parse_double("--rho-min", optval, &fo->rho_min, &err))
             return cf_cli_usage_error("fit", "%s", err.msg);
-        if (!(fo->rho_min > 0 && fo->rho_min < 1))
-            return cf_cli_usage_error("fit", "--rho-min %g: a diameter ratio D1/D2 lies in (0, 1)",
-                                      fo->rho_min);
+        if (!(fo->rho_min >= CF_FIT_RHO_MIN_LIMIT && fo->rho_min < 1))
+            return cf_cli_usage_error("fit", "--rho-min %g: a diameter ratio D1/D2 the fit "
+                                             "searches lies in [%g, 1)",
+                                      fo->rho_min, CF_FIT_RHO_MIN_LIMIT);
         return 0;
     case OPT_N_MAX:
         if (cf_cli_parse_double("--n-max", optval, &fo->upper[CF_P_N], &err))
             return cf_cli_usage_error("fit", "%s", err.msg);
-        if (!(fo->upper[CF_P_N] >= 2))
-            return cf_cli_usage_error("fit", "--n-max %g: a conical spring needs n >= 2",
-                                      fo->upper[CF_P_N]);
+        if (!(fo->upper[CF_P_N] >= 2 && fo->upper[CF_P_N] <= CF_FIT_COILS_MAX_LIMIT))
+            return cf_cli_usage_error("fit", "--n-max %g: a conical spring has 2 to %g coils",
+                                      fo->upper[CF_P_N], CF_FIT_COILS_MAX_LIMIT);
         return 0;
     case OPT_D2_MAX_H:
         if (cf_cli_parse_double("--D2-max-H", optval, &fo->D2_over_H_max, &err))
             return cf_cli_usage_error("fit", "%s", err.msg);
-        if (!(fo->D2_over_H_max > 0))
-            return cf_cli_usage_error("fit", "--D2-max-H %g: must be positive", fo->D2_over_H_max);
+        if (!(fo->D2_over_H_max > 0 && fo->D2_over_H_max <= CF_FIT_D2_OVER_H_MAX_LIMIT))
+            return cf_cli_usage_error("fit", "--D2-max-H %g: must lie in (0, %g]",
+                                      fo->D2_over_H_max, CF_FIT_D2_OVER_H_MAX_LIMIT);
         return 0;
     case OPT_G_MAX:
         if (cf_cli_parse_double("--G-max", optval, &fo->upper[CF_P_G], &err))
             return cf_cli_usage_error("fit", "%s", err.msg);
-        if (!(fo->upper[CF_P_G] > fo->lower[CF_P_G]))
-            return cf_cli_usage_error("fit", "--G-max %g MPa: must be positive", fo->upper[CF_P_G]);
+        if (!(fo->upper[CF_P_G] > fo->lower[CF_P_G] && fo->upper[CF_P_G] <= CF_FIT_G_MAX_LIMIT))
+            return cf_cli_usage_error("fit", "--G-max %g MPa: must lie in (0, %g] MPa (no wire "
+                                             "is stiffer in shear)",
+                                      fo->upper[CF_P_G], CF_FIT_G_MAX_LIMIT);
         return 0;
     case OPT_RELATIVE: fo->relative = 1; return 0;
     case OPT_OPTIMIZER:

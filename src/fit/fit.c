@@ -1418,8 +1418,22 @@ static cf_status check_data(const cf_table *d, cf_error *err)
 
 static cf_status check_options(const cf_fit_options *o, cf_error *err)
 {
-    if (!(o->index_max >= 3) || !isfinite(o->index_max))
-        return cf_error_set(err, CF_E_DATA, "index_max = %g: the largest spring index must be at least 3", o->index_max);
+    if (!(o->index_max >= 3 && o->index_max <= CF_FIT_INDEX_MAX_LIMIT))
+        return cf_error_set(err, CF_E_DATA,
+                            "index_max = %g: the largest spring index must lie in [3, %g]",
+                            o->index_max, CF_FIT_INDEX_MAX_LIMIT);
+    if (!(o->rho_min >= CF_FIT_RHO_MIN_LIMIT))
+        return cf_error_set(err, CF_E_DATA, "rho_min = %g: at least %g", o->rho_min,
+                            CF_FIT_RHO_MIN_LIMIT);
+    if (!(o->upper[CF_P_N] <= CF_FIT_COILS_MAX_LIMIT))
+        return cf_error_set(err, CF_E_DATA, "upper bound of n = %g: at most %g coils",
+                            o->upper[CF_P_N], CF_FIT_COILS_MAX_LIMIT);
+    if (!(o->upper[CF_P_G] <= CF_FIT_G_MAX_LIMIT))
+        return cf_error_set(err, CF_E_DATA, "upper bound of G = %g MPa: at most %g MPa",
+                            o->upper[CF_P_G], CF_FIT_G_MAX_LIMIT);
+    if (!(o->D2_over_H_max <= CF_FIT_D2_OVER_H_MAX_LIMIT))
+        return cf_error_set(err, CF_E_DATA, "D2/H limit = %g: at most %g", o->D2_over_H_max,
+                            CF_FIT_D2_OVER_H_MAX_LIMIT);
     for (int k = 0; k < CF_P_COUNT; k++) {
         if (!(o->lower[k] > 0 && o->lower[k] <= o->upper[k] && isfinite(o->upper[k])))
             return cf_error_set(err, CF_E_DATA, "bounds of %s: %g .. %g are not 0 < lo <= hi",

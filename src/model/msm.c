@@ -670,9 +670,19 @@ static cf_status newton(solver *s, cf_error *err)
         s->st->solves++;
     double rn, fs;
     double um = residual(s, &rn, &fs);
-    /* Floor of the force scale: a small fraction of the solid load, so that an unloaded lattice
-    ** is converged at once. */
-    const double floor_f = 1e-12 * lat->law->F_C_N;
+    /* Floor of the force scale: a small fraction of the solid load times the largest spring
+    ** weight (forces scale with it, and so does their rounding), so that an unloaded lattice is
+    ** converged at once whatever its weights (a diagonal weight of 1e4 left 7e-13 N of rounding
+    ** against a floor of 1e-12 F_C). */
+    double wmax = 1, dash = 0;
+    for (size_t q = 0; q < lat->ns; q++)
+        wmax = fmax(wmax, lat->w[q]);
+    /* ... and, in an implicit step with dashpots or Maxwell branches, above the rounding of their
+    ** forces kx (L - Lprev), kx L being the scale of its terms (kx grows as 1/dt: 1000 substeps of
+    ** a 1 s ramp left 1.9e-8 N of it) */
+    for (size_t q = 0; s->extras && s->kx && q < lat->ns; q++)
+        dash = fmax(dash, s->kx[q] * lat->L_mm[q]);
+    const double floor_f = 1e-12 * lat->law->F_C_N * wmax + 1e-13 * dash;
     cf_status st = CF_E_NOCONV;
     for (int it = 0; it <= s->cfg->newton_max_iter; it++) {
         if (um < SOLID_MARGIN && rn <= s->cfg->newton_rtol * fs + floor_f) {

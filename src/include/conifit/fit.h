@@ -56,6 +56,18 @@ enum {
 #define CF_FIT_D2_OVER_H_MAX_DEFAULT 10.0
 #define CF_FIT_G_MAX_DEFAULT 80000.0
 
+/* The widest limits a fit takes (cf_fit_run refuses wider ones as bad options, naming them): a
+** spring index of at most 50 (handbooks stop near 25; above it a coil does not hold its shape), at
+** most 1000 coils, a wire at most 1e6 MPa stiff in shear (tungsten carbide, the stiffest wire
+** material, is about 2.7e5 MPa), an outer diameter of at most 1000 free lengths, and a diameter
+** ratio of at least CF_LSQ_RHO_LO = 1e-3, the smallest the search reaches. Within them the fitted
+** springs stay inside their limits and the limits inside the parameter bounds of spring.h. */
+#define CF_FIT_INDEX_MAX_LIMIT 50.0
+#define CF_FIT_COILS_MAX_LIMIT 1000.0
+#define CF_FIT_G_MAX_LIMIT 1e6
+#define CF_FIT_D2_OVER_H_MAX_LIMIT 1000.0
+#define CF_FIT_RHO_MIN_LIMIT 1e-3
+
 /* A fit whose law goes solid at less than this multiple of the table's largest strain is
 ** extrapolating close to solid just past the data (reports warn). */
 #define CF_FIT_SOLID_RATIO_WARN 1.5
