@@ -127,10 +127,16 @@ static int export_option(void *ctx, int c, const char *value)
     }
 }
 
-/* Why one long function: parse (export_option), check the combinations of options, load the
-** spring and the scene, write the whole output into memory, then to the file or standard output,
-** then the summary; a straight sequence in which each step can end the command with its status. */
-int cf_cli_export(int argc, char **argv)
+/* What the command line asked for. */
+typedef struct export_request {
+    export_args ea;
+    const char *out_path, *fit_path, *scene_path;
+    int quiet;
+} export_request;
+
+/* Parses the arguments into q and checks their combinations (the format from -o's extension
+** when not given). -1 to go on, else an exit status. */
+static int parse_request(int argc, char **argv, export_request *q)
 {
     static const struct option own[] = {{"format", required_argument, NULL, OPT_FORMAT},
                                         {"type", required_argument, NULL, OPT_TYPE},
@@ -140,112 +146,144 @@ int cf_cli_export(int argc, char **argv)
                                         {"lattice", no_argument, NULL, OPT_LATTICE},
                                         {NULL, 0, NULL, 0}};
     cf_error err = {0};
-    export_args ea = {cf_export_default_options(), NULL, 0, 0, 0};
+    export_args *ea = &q->ea;
+    *ea = (export_args){cf_export_default_options(), NULL, 0, 0, 0};
     cf_cli_parser p;
     int rc = cf_cli_parser_init(&p, "export", export_help, 0, argc, argv, "", own);
     p.help_extra = formats_help;
-    if (rc || (rc = cf_cli_parse(&p, export_option, &ea)) >= 0)
+    if (rc || (rc = cf_cli_parse(&p, export_option, ea)) >= 0)
         return rc;
-    cf_export_options opt = ea.opt;
-    const char *type = ea.type, *out_path = p.output;
-    const int have_format = ea.have_format, tol_given = ea.tol_given, lattice = ea.lattice,
-              quiet = p.quiet;
+    q->out_path = p.output;
+    q->quiet = p.quiet;
     const int npos = argc - optind;
     if (npos < 1)
         return cf_cli_usage_error("export", "missing the fit file");
-    if (npos > (lattice ? 2 : 1))
+    if (npos > (ea->lattice ? 2 : 1))
         return cf_cli_usage_error("export", "unexpected argument '%s'", argv[optind + npos - 1]);
-    const char *fit_path = argv[optind];
-    const char *scene_path = npos == 2 ? argv[optind + 1] : NULL;
-    if (!have_format) {
-        if (!out_path || cf_cli_is_stdio(out_path))
+    q->fit_path = argv[optind];
+    q->scene_path = npos == 2 ? argv[optind + 1] : NULL;
+    if (!ea->have_format) {
+        if (!q->out_path || cf_cli_is_stdio(q->out_path))
             return cf_cli_usage_error("export", "missing option --format");
-        if (cf_export_format_of_path(out_path, &opt.format, &err) != CF_OK)
+        if (cf_export_format_of_path(q->out_path, &ea->opt.format, &err) != CF_OK)
             return cf_cli_usage_error("export", "missing option --format: %s", err.msg);
     }
-    const cf_export_format_info *fi = cf_export_format_get(opt.format);
+    const cf_export_format_info *fi = cf_export_format_get(ea->opt.format);
     char models[128];
-    if ((opt.example || lattice) && !fi->model)
+    if ((ea->opt.example || ea->lattice) && !fi->model)
         return cf_cli_usage_error("export", "%s needs a simulator format (%s): %s is data, not "
                                             "a model",
-                                  opt.example ? "--example" : "--lattice",
+                                  ea->opt.example ? "--example" : "--lattice",
                                   cf_export_format_list(models, sizeof models, 1), fi->name);
-    if (lattice && (opt.example || opt.have_range))
+    if (ea->lattice && (ea->opt.example || ea->opt.have_range))
         return cf_cli_usage_error("export", "--lattice takes neither --example nor --range (the "
                                             "lattice's tables cover the whole travel)");
+    return -1;
+}
 
-    cf_fitted_spring fs;
-    if (cf_fitfile_load(fit_path, type, &fs, &err) != CF_OK)
-        return cf_cli_fail(&err);
-    opt.source = cf_cli_is_stdio(fit_path) ? "(standard input)" : fit_path;
-    opt.auto_tol = !tol_given;
-
-    cf_export_lattice lx;
-    if (lattice) {
-        if (scene_path) {
-            cf_scene sc;
-            if (cf_scene_load(scene_path, &sc, &err) != CF_OK)
-                return cf_cli_fail(&err);
-            cf_status st = cf_export_lattice_from_scene(&sc, scene_path, &lx, &err);
-            cf_scene_free(&sc);
-            if (st != CF_OK)
-                return cf_cli_fail(&err);
-        } else {
-            cf_law law;
-            if (cf_law_init(&law, &fs.params, &err) != CF_OK)
-                return cf_cli_fail(&err);
-            lx = cf_export_lattice_default(&law);
-            cf_law_free(&law);
-        }
+/* The lattice to export: the scene's, or the validation's default for the spring. */
+static cf_status lattice_of(const char *scene_path, const cf_fitted_spring *fs,
+                            cf_export_lattice *lx, cf_error *err)
+{
+    cf_status st;
+    if (scene_path) {
+        cf_scene sc;
+        if ((st = cf_scene_load(scene_path, &sc, err)) != CF_OK)
+            return st;
+        st = cf_export_lattice_from_scene(&sc, scene_path, lx, err);
+        cf_scene_free(&sc);
+        return st;
     }
+    cf_law law;
+    if ((st = cf_law_init(&law, &fs->params, err)) != CF_OK)
+        return st;
+    *lx = cf_export_lattice_default(&law);
+    cf_law_free(&law);
+    return CF_OK;
+}
 
-    char *buf = NULL;
-    size_t len = 0;
-    FILE *mem = open_memstream(&buf, &len);
-    if (!mem) {
-        cf_error_set(&err, CF_E_INTERNAL, "out of memory");
-        return cf_cli_fail(&err);
-    }
-    cf_export_report rep;
-    cf_status st = lattice ? cf_export_write_lattice(mem, &fs, &opt, &lx, &rep, &err)
-                           : cf_export_write(mem, &fs, &opt, &rep, &err);
+/* The whole export in memory (*buf, *len; the caller frees *buf), so that a failure never leaves
+** partial output. */
+static cf_status render(const export_request *q, const cf_fitted_spring *fs,
+                        const cf_export_options *opt, const cf_export_lattice *lx,
+                        cf_export_report *rep, char **buf, size_t *len, cf_error *err)
+{
+    *buf = NULL;
+    *len = 0;
+    FILE *mem = open_memstream(buf, len);
+    if (!mem)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory");
+    cf_status st = q->ea.lattice ? cf_export_write_lattice(mem, fs, opt, lx, rep, err)
+                                 : cf_export_write(mem, fs, opt, rep, err);
     if (fclose(mem) != 0 && st == CF_OK)
-        st = cf_error_set(&err, CF_E_INTERNAL, "out of memory");
-    if (st != CF_OK) {
-        free(buf);
-        return cf_cli_fail(&err);
-    }
-    if (out_path && strcmp(out_path, "-") != 0) {
+        st = cf_error_set(err, CF_E_INTERNAL, "out of memory");
+    return st;
+}
+
+/* buf to the -o file (atomically) or to standard output. */
+static cf_status emit(const export_request *q, const char *buf, size_t len, cf_error *err)
+{
+    if (q->out_path && strcmp(q->out_path, "-") != 0) {
         cf_atomic a;
-        const char *inputs[3] = {fit_path, scene_path, NULL};
-        if (cf_atomic_open(&a, out_path, inputs, &err) != CF_OK) {
-            free(buf);
-            return cf_cli_fail(&err);
-        }
+        const char *inputs[3] = {q->fit_path, q->scene_path, NULL};
+        cf_status st = cf_atomic_open(&a, q->out_path, inputs, err);
+        if (st != CF_OK)
+            return st;
         fwrite(buf, 1, len, a.fp);
-        if (cf_atomic_commit(&a, &err) != CF_OK) {
-            free(buf);
-            return cf_cli_fail(&err);
-        }
-    } else if (fwrite(buf, 1, len, stdout) != len || fflush(stdout) != 0) {
-        free(buf);
-        cf_error_set(&err, CF_E_CANTWRITE, "cannot write to standard output");
-        return cf_cli_fail(&err);
+        return cf_atomic_commit(&a, err);
     }
-    free(buf);
-    if (quiet || !fi->table)
-        return CF_EXIT_OK;
+    if (fwrite(buf, 1, len, stdout) != len || fflush(stdout) != 0)
+        return cf_error_set(err, CF_E_CANTWRITE, "cannot write to standard output");
+    return CF_OK;
+}
+
+/* Rows and achieved error (and the lattice's size) on stderr. */
+static void print_summary(const cf_export_format_info *fi, int lattice,
+                          const cf_export_report *rep)
+{
     if (lattice)
         fprintf(stderr,
                 "conifit export: %s lattice, %zu nodes, %zu springs in %zu groups, %zu load "
                 "steps; tables of %zu rows, max error %.3g of F_C (%.3g N), tol %g\n",
-                fi->name, rep.nodes, rep.springs, rep.groups, rep.steps,
-                rep.rows, rep.max_err_rel, rep.max_err_N, rep.tol);
+                fi->name, rep->nodes, rep->springs, rep->groups, rep->steps, rep->rows,
+                rep->max_err_rel, rep->max_err_N, rep->tol);
     else
         fprintf(stderr,
                 "conifit export: %s, %zu rows, max error %.3g of F_C (%.3g N), tol %g, table "
                 "over u in [%.10g, %.10g] mm\n",
-                fi->name, rep.rows, rep.max_err_rel, rep.max_err_N,
-                rep.tol, rep.u_lo_mm, rep.u_hi_mm);
+                fi->name, rep->rows, rep->max_err_rel, rep->max_err_N, rep->tol, rep->u_lo_mm,
+                rep->u_hi_mm);
+}
+
+/* export: parse, load the spring (and the lattice), render the whole output in memory, write it,
+** then the summary. */
+int cf_cli_export(int argc, char **argv)
+{
+    export_request q;
+    int rc = parse_request(argc, argv, &q);
+    if (rc >= 0)
+        return rc;
+    cf_error err = {0};
+    cf_export_options opt = q.ea.opt;
+    cf_fitted_spring fs;
+    if (cf_fitfile_load(q.fit_path, q.ea.type, &fs, &err) != CF_OK)
+        return cf_cli_fail(&err);
+    opt.source = cf_cli_is_stdio(q.fit_path) ? "(standard input)" : q.fit_path;
+    opt.auto_tol = !q.ea.tol_given;
+    cf_export_lattice lx;
+    if (q.ea.lattice && lattice_of(q.scene_path, &fs, &lx, &err) != CF_OK)
+        return cf_cli_fail(&err);
+    char *buf;
+    size_t len;
+    cf_export_report rep;
+    if (render(&q, &fs, &opt, &lx, &rep, &buf, &len, &err) != CF_OK ||
+        emit(&q, buf, len, &err) != CF_OK) {
+        free(buf);
+        return cf_cli_fail(&err);
+    }
+    free(buf);
+    const cf_export_format_info *fi = cf_export_format_get(opt.format);
+    if (!q.quiet && fi->table)
+        print_summary(fi, q.ea.lattice, &rep);
     return CF_EXIT_OK;
 }

@@ -668,11 +668,199 @@ static int run_joint(const fit_args *a, fit_job *jobs, const char *const *inputs
     return rc;
 }
 
-/* Why one long function: fit is read every table (a bad one stops the run before anything is
-** written), name every output, fit on N threads (worker, run_job), put the outputs in place only
-** when every table succeeded, then print reports, warnings and the batch summary; every step uses
-** the one job array and the all-or-nothing rule, and the library does the work of each step
-** (cf_measure_load, cf_pipeline_fit, cf_pipeline_prepare, cf_report_text). */
+/* Reads every table (a bad one stops the run before anything is written), the scene, and the
+** elastic fit a series is held to, and checks the options against what was read. -1 to go on,
+** else an exit status. */
+static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
+{
+    int rc = -1;
+    for (int i = 0; i < a->nfiles && rc < 0; i++) {
+        jobs[i].args = a;
+        jobs[i].file = a->files[i];
+        cf_error err = {0};
+        if (cf_measure_load(a->files[i], &a->mopt, &jobs[i].m, &err) != CF_OK)
+            rc = cf_cli_fail(&err);
+    }
+    if (rc < 0 && a->scene) {
+        cf_error err = {0};
+        if (cf_pipeline_use_scene(&a->popt, a->scene, &err) != CF_OK)
+            rc = cf_cli_fail(&err);
+    }
+    *nseries = 0;
+    for (int i = 0; i < a->nfiles && rc < 0; i++)
+        *nseries += jobs[i].m.t != NULL;
+    if (rc < 0 && *nseries > 0 && (a->popt.validate || a->popt.target == CF_TARGET_LATTICE))
+        rc = cf_cli_usage_error("fit", "--validate and --target lattice apply to stress-strain "
+                                       "tables; a time series is fitted through the lattice "
+                                       "already");
+    if (rc < 0 && *nseries == 0 && a->series_only)
+        rc = cf_cli_usage_error("fit", "--branches, --dashpot and --elastic apply to time series "
+                                       "(a table with a time column) only");
+    if (rc < 0 && a->elastic) {
+        cf_fitted_spring fs;
+        cf_error err = {0};
+        if (cf_fitfile_load_spec(a->elastic, &fs, &err) != CF_OK) {
+            rc = cf_cli_fail(&err);
+        } else {
+            cf_fit_identifiable(&fs.params, 0, a->vopt.elastic);
+            a->vopt.hold_elastic = 1;
+        }
+    }
+    return rc;
+}
+
+/* Fits every job on up to a->jobs threads. */
+static void run_pool(const fit_args *a, fit_job *jobs)
+{
+    pool p = {jobs, a->nfiles, 0, PTHREAD_MUTEX_INITIALIZER};
+    int nt = (int)(a->jobs < a->nfiles ? a->jobs : a->nfiles);
+    pthread_t th[256];
+    int started = 0;
+    for (int t = 1; t < nt; t++)
+        if (pthread_create(&th[started], NULL, worker, &p) == 0)
+            started++;
+    worker(&p);
+    for (int t = 0; t < started; t++)
+        pthread_join(th[t], NULL);
+}
+
+/* All outputs or none: they go in place only when every table succeeded. Returns 1 when none
+** was put in place because a job failed. */
+static int commit_outputs(const fit_args *a, fit_job *jobs)
+{
+    int failed = 0;
+    for (int i = 0; i < a->nfiles; i++)
+        failed |= jobs[i].st != CF_OK;
+    for (int i = 0; i < a->nfiles && !failed; i++) {
+        fit_job *j = &jobs[i];
+        if ((j->json_path[0] && (j->st = cf_atomic_commit(&j->json_out, &j->err)) != CF_OK) ||
+            (j->plot_path[0] && (j->st = cf_atomic_commit(&j->plot_out, &j->err)) != CF_OK))
+            failed = 1;
+    }
+    for (int i = 0; i < a->nfiles; i++) {
+        cf_atomic_abort(&jobs[i].json_out);
+        cf_atomic_abort(&jobs[i].plot_out);
+        if (failed && jobs[i].st == CF_OK)
+            jobs[i].json_path[0] = jobs[i].plot_path[0] = '\0'; /* not written */
+    }
+    return failed;
+}
+
+/* What one job prints: its error, or the fit file on standard output (-o -), its report, where
+** its files went, and its warnings. Returns its exit status. */
+static int report_job(const fit_args *a, fit_job *j)
+{
+    if (j->st != CF_OK)
+        return cf_cli_fail(&j->err);
+    int rc = CF_EXIT_OK;
+    if (cf_cli_is_stdio(a->out)) {
+        char *json = cf_report_json_string(&j->rep);
+        if (!json || fputs(json, stdout) < 0 || fflush(stdout) != 0) {
+            cf_error e = {0};
+            cf_error_set(&e, json ? CF_E_CANTWRITE : CF_E_INTERNAL,
+                         "cannot write the fit file to standard output");
+            rc = cf_cli_fail(&e);
+        }
+        free(json);
+    }
+    if (j->text) {
+        fputs(j->text, stdout);
+        if (j->json_path[0])
+            printf("Fit file: %s\n", j->json_path);
+        if (j->plot_path[0])
+            printf("Plot: %s\n", j->plot_path);
+        if (a->nfiles > 1)
+            fputc('\n', stdout);
+    }
+    for (int k = 0; k < j->rep.nfits; k++) {
+        fit_warnings(j->file, &j->rep, &j->rep.fits[k]);
+        const cf_validation *v = &j->rep.val[k];
+        if (j->rep.validate && v->done && v->unstable_in_range)
+            fprintf(stderr,
+                    "conifit: warning: %s: the %s spring's lattice loses stability at strain "
+                    "%.4g, inside the table's range\n",
+                    j->file, cf_spring_type_name(j->rep.fits[k].type), v->stable_to_strain);
+    }
+    return rc;
+}
+
+/* One row of the summary of several tables. */
+static void summary_row(const fit_args *a, const fit_job *j, int wname)
+{
+    if (j->st != CF_OK) {
+        printf("  %-*s failed\n", wname, j->file);
+        return;
+    }
+    if (j->m.t) {
+        printf("  %-*s time series: %d Prony term%s, RMSE %.4g %s\n", wname, j->file,
+               j->vrep.fit.p.nbranch, j->vrep.fit.p.nbranch == 1 ? "" : "s",
+               j->vrep.fit.rmse * j->m.y_to_file, j->m.y_unit);
+        return;
+    }
+    char cell[2][32] = {"-", "-"};
+    for (int k = 0; k < j->rep.nfits; k++)
+        snprintf(cell[j->rep.fits[k].type], sizeof cell[0], "%.4g %s%s",
+                 j->rep.fits[k].rmse * j->m.y_to_file, j->m.y_unit,
+                 j->rep.fits[k].feasible ? "" : " (!)");
+    int bb = 0;
+    for (int k = 1; k < CF_BASE_COUNT; k++)
+        if (j->rep.baselines[k].rmse < j->rep.baselines[bb].rmse)
+            bb = k;
+    char bcell[48];
+    snprintf(bcell, sizeof bcell, "%s %.4g %s", cf_baseline_name((cf_baseline_kind)bb),
+             j->rep.baselines[bb].rmse * j->m.y_to_file, j->m.y_unit);
+    int b = cf_report_better(&j->rep);
+    char vcell[48] = "";
+    if (a->popt.validate && b >= 0 && j->rep.val[b].done)
+        snprintf(vcell, sizeof vcell, " %.4g %s", j->rep.val[b].rmse * j->m.y_to_file,
+                 j->m.y_unit);
+    else if (a->popt.validate)
+        snprintf(vcell, sizeof vcell, " skipped");
+    printf("  %-*s %-18s %-18s %-22s %-16s%s\n", wname, j->file, cell[0], cell[1], bcell,
+           b < 0                          ? "none feasible"
+           : cf_report_types_tie(&j->rep) ? "tie"
+                                          : cf_spring_type_name(j->rep.fits[b].type),
+           vcell);
+}
+
+/* The summary of several tables: one row each. */
+static void print_summary(const fit_args *a, const fit_job *jobs)
+{
+    int wname = 5;
+    for (int i = 0; i < a->nfiles; i++)
+        if ((int)strlen(jobs[i].file) > wname)
+            wname = (int)strlen(jobs[i].file);
+    printf("Summary (RMSE in each table's unit):\n");
+    printf("  %-*s %-18s %-18s %-22s %-16s%s\n", wname, "table", "telescoping", "non-telescoping",
+           "best baseline", "better type", a->popt.validate ? " lattice RMSE (better type)" : "");
+    for (int i = 0; i < a->nfiles; i++)
+        summary_row(a, &jobs[i], wname);
+}
+
+/* Fits the jobs, puts their outputs in place (all or none), prints each report and the summary.
+** Returns the exit status: the first failure's, else 0. */
+static int fit_all(const fit_args *a, fit_job *jobs)
+{
+    run_pool(a, jobs);
+    const int failed = commit_outputs(a, jobs);
+    int rc = CF_EXIT_OK;
+    for (int i = 0; i < a->nfiles; i++) {
+        const int e = report_job(a, &jobs[i]);
+        if (jobs[i].st != CF_OK) /* the first failed table's status stands */
+            rc = rc == CF_EXIT_OK ? e : rc;
+        else if (e != CF_EXIT_OK) /* a fit file that standard output refused */
+            rc = e;
+    }
+    if (failed && (a->out || a->plot))
+        fprintf(stderr, "conifit: no output file written (outputs are written only when every "
+                        "table succeeds)\n");
+    if (a->nfiles > 1 && !a->quiet)
+        print_summary(a, jobs);
+    return rc;
+}
+
+/* fit: parse, name every output, read every input, then fit them all (fit_all) or jointly
+** (run_joint). */
 int cf_cli_fit(int argc, char **argv)
 {
     fit_args a;
@@ -680,14 +868,11 @@ int cf_cli_fit(int argc, char **argv)
     if (rc >= 0)
         return rc;
     fit_job *jobs = calloc((size_t)a.nfiles, sizeof *jobs);
-    if (!jobs) {
-        fprintf(stderr, "conifit: out of memory\n");
-        return CF_EXIT_SOFTWARE;
-    }
     /* every input of the run, never to be an output */
     const char **inputs = calloc((size_t)a.nfiles + 3, sizeof *inputs);
-    if (!inputs) {
+    if (!jobs || !inputs) {
         free(jobs);
+        free(inputs);
         fprintf(stderr, "conifit: out of memory\n");
         return CF_EXIT_SOFTWARE;
     }
@@ -697,163 +882,17 @@ int cf_cli_fit(int argc, char **argv)
     inputs[a.nfiles + (a.scene != NULL)] = a.elastic;
     if (!a.joint)
         rc = plan_outputs(&a, jobs, inputs);
-    /* Read every table first: a bad one stops the run before anything is written. */
-    for (int i = 0; i < a.nfiles && rc < 0; i++) {
-        jobs[i].args = &a;
-        jobs[i].file = a.files[i];
-        cf_error err = {0};
-        if (cf_measure_load(a.files[i], &a.mopt, &jobs[i].m, &err) != CF_OK)
-            rc = cf_cli_fail(&err);
-    }
-    if (rc < 0 && a.scene) {
-        cf_error err = {0};
-        if (cf_pipeline_use_scene(&a.popt, a.scene, &err) != CF_OK)
-            rc = cf_cli_fail(&err);
-    }
     int nseries = 0;
-    for (int i = 0; i < a.nfiles && rc < 0; i++)
-        nseries += jobs[i].m.t != NULL;
-    if (rc < 0 && nseries > 0 && (a.popt.validate || a.popt.target == CF_TARGET_LATTICE))
-        rc = cf_cli_usage_error("fit", "--validate and --target lattice apply to stress-strain "
-                                       "tables; a time series is fitted through the lattice "
-                                       "already");
-    if (rc < 0 && nseries == 0 && a.series_only)
-        rc = cf_cli_usage_error("fit", "--branches, --dashpot and --elastic apply to time series "
-                                       "(a table with a time column) only");
-    if (rc < 0 && a.elastic) {
-        cf_fitted_spring fs;
-        cf_error err = {0};
-        if (cf_fitfile_load_spec(a.elastic, &fs, &err) != CF_OK) {
-            rc = cf_cli_fail(&err);
-        } else {
-            cf_fit_identifiable(&fs.params, 0, a.vopt.elastic);
-            a.vopt.hold_elastic = 1;
-        }
-    }
+    if (rc < 0)
+        rc = load_inputs(&a, jobs, &nseries);
     if (a.progress)
         a.popt.progress = show_progress;
     if (rc < 0 && a.joint)
         rc = nseries ? cf_cli_usage_error("fit", "--joint fits stress-strain tables; a time "
                                                  "series is fitted on its own")
                      : run_joint(&a, jobs, inputs);
-    if (rc < 0) {
-        pool p = {jobs, a.nfiles, 0, PTHREAD_MUTEX_INITIALIZER};
-        int nt = (int)(a.jobs < a.nfiles ? a.jobs : a.nfiles);
-        pthread_t th[256];
-        int started = 0;
-        for (int t = 1; t < nt; t++)
-            if (pthread_create(&th[started], NULL, worker, &p) == 0)
-                started++;
-        worker(&p);
-        for (int t = 0; t < started; t++)
-            pthread_join(th[t], NULL);
-        /* all outputs or none: they go in place only when every table succeeded */
-        int failed = 0;
-        for (int i = 0; i < a.nfiles; i++)
-            failed |= jobs[i].st != CF_OK;
-        for (int i = 0; i < a.nfiles && !failed; i++) {
-            fit_job *j = &jobs[i];
-            if ((j->json_path[0] && (j->st = cf_atomic_commit(&j->json_out, &j->err)) != CF_OK) ||
-                (j->plot_path[0] && (j->st = cf_atomic_commit(&j->plot_out, &j->err)) != CF_OK))
-                failed = 1;
-        }
-        for (int i = 0; i < a.nfiles; i++) {
-            cf_atomic_abort(&jobs[i].json_out);
-            cf_atomic_abort(&jobs[i].plot_out);
-            if (failed && jobs[i].st == CF_OK)
-                jobs[i].json_path[0] = jobs[i].plot_path[0] = '\0'; /* not written */
-        }
-        rc = CF_EXIT_OK;
-        for (int i = 0; i < a.nfiles; i++) {
-            fit_job *j = &jobs[i];
-            if (j->st != CF_OK) {
-                int e = cf_cli_fail(&j->err);
-                if (rc == CF_EXIT_OK)
-                    rc = e;
-                continue;
-            }
-            if (cf_cli_is_stdio(a.out)) {
-                char *json = cf_report_json_string(&j->rep);
-                if (!json || fputs(json, stdout) < 0 || fflush(stdout) != 0) {
-                    cf_error e = {0};
-                    cf_error_set(&e, json ? CF_E_CANTWRITE : CF_E_INTERNAL,
-                                 "cannot write the fit file to standard output");
-                    rc = cf_cli_fail(&e);
-                }
-                free(json);
-            }
-            if (j->text) {
-                fputs(j->text, stdout);
-                if (j->json_path[0])
-                    printf("Fit file: %s\n", j->json_path);
-                if (j->plot_path[0])
-                    printf("Plot: %s\n", j->plot_path);
-                if (a.nfiles > 1)
-                    fputc('\n', stdout);
-            }
-            for (int k = 0; k < j->rep.nfits; k++) {
-                fit_warnings(j->file, &j->rep, &j->rep.fits[k]);
-                const cf_validation *v = &j->rep.val[k];
-                if (j->rep.validate && v->done && v->unstable_in_range)
-                    fprintf(stderr,
-                            "conifit: warning: %s: the %s spring's lattice loses stability at "
-                            "strain %.4g, inside the table's range\n",
-                            j->file, cf_spring_type_name(j->rep.fits[k].type),
-                            v->stable_to_strain);
-            }
-        }
-        if (failed && (a.out || a.plot))
-            fprintf(stderr, "conifit: no output file written (outputs are written only when "
-                            "every table succeeds)\n");
-        if (a.nfiles > 1 && !a.quiet) {
-            int wname = 5;
-            for (int i = 0; i < a.nfiles; i++)
-                if ((int)strlen(jobs[i].file) > wname)
-                    wname = (int)strlen(jobs[i].file);
-            printf("Summary (RMSE in each table's unit):\n");
-            printf("  %-*s %-18s %-18s %-22s %-16s%s\n", wname, "table", "telescoping",
-                   "non-telescoping", "best baseline", "better type",
-                   a.popt.validate ? " lattice RMSE (better type)" : "");
-            for (int i = 0; i < a.nfiles; i++) {
-                fit_job *j = &jobs[i];
-                if (j->st != CF_OK) {
-                    printf("  %-*s failed\n", wname, j->file);
-                    continue;
-                }
-                if (j->m.t) {
-                    printf("  %-*s time series: %d Prony term%s, RMSE %.4g %s\n", wname, j->file,
-                           j->vrep.fit.p.nbranch, j->vrep.fit.p.nbranch == 1 ? "" : "s",
-                           j->vrep.fit.rmse * j->m.y_to_file, j->m.y_unit);
-                    continue;
-                }
-                char cell[2][32] = {"-", "-"};
-                for (int k = 0; k < j->rep.nfits; k++)
-                    snprintf(cell[j->rep.fits[k].type], sizeof cell[0], "%.4g %s%s",
-                             j->rep.fits[k].rmse * j->m.y_to_file, j->m.y_unit,
-                             j->rep.fits[k].feasible ? "" : " (!)");
-                int bb = 0;
-                for (int k = 1; k < CF_BASE_COUNT; k++)
-                    if (j->rep.baselines[k].rmse < j->rep.baselines[bb].rmse)
-                        bb = k;
-                char bcell[48];
-                snprintf(bcell, sizeof bcell, "%s %.4g %s", cf_baseline_name((cf_baseline_kind)bb),
-                         j->rep.baselines[bb].rmse * j->m.y_to_file, j->m.y_unit);
-                int b = cf_report_better(&j->rep);
-                char vcell[48] = "";
-                if (a.popt.validate && b >= 0 && j->rep.val[b].done)
-                    snprintf(vcell, sizeof vcell, " %.4g %s",
-                             j->rep.val[b].rmse * j->m.y_to_file, j->m.y_unit);
-                else if (a.popt.validate)
-                    snprintf(vcell, sizeof vcell, " skipped");
-                printf("  %-*s %-18s %-18s %-22s %-16s%s\n", wname, j->file, cell[0], cell[1],
-                       bcell,
-                       b < 0                          ? "none feasible"
-                       : cf_report_types_tie(&j->rep) ? "tie"
-                                                      : cf_spring_type_name(j->rep.fits[b].type),
-                       vcell);
-            }
-        }
-    }
+    if (rc < 0)
+        rc = fit_all(&a, jobs);
     for (int i = 0; i < a.nfiles; i++) {
         cf_table_free(&jobs[i].m);
         free(jobs[i].text);

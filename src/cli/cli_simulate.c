@@ -178,7 +178,15 @@ static int take_option(void *ctx, int c, const char *value)
     return 0;
 }
 
-int cf_cli_simulate(int argc, char **argv)
+/* What the command line asked for. */
+typedef struct sim_request {
+    sim_opts so;
+    const char *scene_path, *out;
+    int quiet, progress;
+} sim_request;
+
+/* Parses the arguments into q. -1 to go on, else an exit status. */
+static int parse_request(int argc, char **argv, sim_request *q)
 {
     static const struct option own[] = {{"plot", required_argument, NULL, OPT_PLOT},
                                         {"max-memory", required_argument, NULL, OPT_MAX_MEMORY},
@@ -187,47 +195,134 @@ int cf_cli_simulate(int argc, char **argv)
                                         {"noise", required_argument, NULL, OPT_NOISE},
                                         {"seed", required_argument, NULL, OPT_SEED},
                                         {NULL, 0, NULL, 0}};
-    const char *scene_path = NULL, *out = NULL, *png = NULL;
     cf_error err = {0};
-    cf_scene_cost cost;
-    sim_opts so = {NULL, cf_budget_default(), 0, 0, 1};
+    q->so = (sim_opts){NULL, cf_budget_default(), 0, 0, 1};
     cf_cli_parser p;
     int rc = cf_cli_parser_init(&p, "simulate", simulate_help, 0, argc, argv, "", own);
-    if (rc || (rc = cf_cli_parse(&p, take_option, &so)) >= 0)
+    if (rc || (rc = cf_cli_parse(&p, take_option, &q->so)) >= 0)
         return rc;
-    png = so.png;
-    cf_budget budget = so.budget;
-    out = p.output;
-    const int quiet = p.quiet, progress = cf_cli_progress(&p);
+    const char *png = q->so.png;
+    q->out = p.output;
+    q->quiet = p.quiet;
+    q->progress = cf_cli_progress(&p);
     if (optind + 1 < argc)
         return cf_cli_usage_error("simulate", "more than one scene ('%s' and '%s')",
                                   argv[optind], argv[optind + 1]);
     if (optind >= argc)
         return cf_cli_usage_error("simulate", "no scene file given");
-    scene_path = argv[optind];
-    if (!out)
+    q->scene_path = argv[optind];
+    if (!q->out)
         return cf_cli_usage_error("simulate", "no output file given (-o OUT.csv, or -o - for "
                                               "standard output)");
     if (png && cf_plot_check_name(png, &err) != CF_OK)
         return cf_cli_usage_error("simulate", "--plot %s: the file must end in .png, .svg or .pdf", png);
+    if (png && strcmp(png, q->out) == 0)
+        return cf_cli_usage_error("simulate", "-o and --plot both name %s", q->out);
+    return -1;
+}
 
-    cf_scene sc;
-    if (png && strcmp(png, out) == 0)
-        return cf_cli_usage_error("simulate", "-o and --plot both name %s", out);
-    if (cf_scene_load(scene_path, &sc, &err) != CF_OK)
-        return cf_cli_fail(&err);
-    /* the inputs (the scene and the fit file it names) are never outputs; both outputs are
-    ** checked before the run, which may be long */
-    char fitfile[sizeof sc.spring_source];
-    snprintf(fitfile, sizeof fitfile, "%s", sc.spring_source);
+/* The lattice of the scene, run along its path into samples (allocated here, sc->nsamples). */
+static cf_status run_scene(cf_scene *sc, const sim_request *q, cf_budget *budget,
+                           cf_scene_cost *cost, cf_law *law, cf_lattice *lat,
+                           cf_msm_sample **samples, cf_msm_stats *st, cf_error *err)
+{
+    cf_status s;
+    if ((s = cf_law_init(law, &sc->spring, err)) != CF_OK)
+        return s;
+    if ((sc->method == CF_LAW_TABLE &&
+         (s = cf_law_table_build(law, sc->table_intervals, err)) != CF_OK) ||
+        (s = cf_lattice_create(lat, law, sc->method, &sc->cfg.lattice, err)) != CF_OK ||
+        (s = cf_budget_check_steps(sc, q->scene_path, lat, budget, cost, err)) != CF_OK)
+        return s;
+    *samples = calloc(sc->nsamples, sizeof **samples);
+    if (!*samples)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu samples", sc->nsamples);
+    cf_msm_path path = cf_scene_path(sc);
+    size_t done = 0;
+    if (q->progress) {
+        sc->cfg.progress = show_progress;
+        sc->cfg.progress_ctx = NULL;
+    }
+    s = cf_msm_run(lat, &sc->effects, &sc->cfg, &path, sc->sample_t_s, sc->nsamples, *samples,
+                   &done, st, err);
+    if (sc->cfg.progress)
+        fputs("\r\033[K", stderr); /* clear the progress line */
+    return s;
+}
+
+/* --table: a measurement table of the run, tension positive, with the noise asked for. */
+static cf_status write_table(FILE *o, const cf_msm_sample *s, size_t n, const sim_opts *so,
+                             cf_error *err)
+{
+    double smax = 0;
+    for (size_t k = 0; k < n; k++)
+        smax = fmax(smax, fabs(s[k].stress_MPa * 1e3));
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    if (!rng)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the noise generator");
+    gsl_rng_set(rng, (unsigned long)so->seed);
+    fprintf(o, "# conifit simulate --table: the lattice of a scene along its protocol\n");
+    fprintf(o, "# noise: Gaussian, sd %.17g x max |stress| = %.17g kPa, seed %ld\n", so->noise,
+            so->noise * smax, so->seed);
+    fprintf(o, "# mode: uniaxial\n# columns: time [s], engineering strain [-], nominal "
+               "stress [kPa]; compression negative\n");
+    fprintf(o, "time_s,strain,stress_kPa\n");
+    for (size_t k = 0; k < n; k++) {
+        double y = -s[k].stress_MPa * 1e3;
+        if (so->noise > 0 && k > 0)
+            y += gsl_ran_gaussian(rng, so->noise * smax);
+        fprintf(o, "%.17g,%.17g,%.17g\n", s[k].t_s, -s[k].strain, y);
+    }
+    gsl_rng_free(rng);
+    return CF_OK;
+}
+
+/* The run's curve, with one spring's stress at the same strain (spring, MPa) beside it. */
+static void write_curve(FILE *o, const cf_scene *sc, const cf_msm_sample *s, const double *spring)
+{
+    fprintf(o, "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,stable\n");
+    size_t lost = cf_hysteresis_first_unstable(s, sc->nsamples);
+    for (size_t k = 0; k < sc->nsamples; k++)
+        fprintf(o, "%.17g,%.17g,%.17g,%.17g,%.17g,%d\n", s[k].t_s, s[k].strain,
+                s[k].stress_MPa * 1e3, s[k].kinetic_mJ, spring[k] * 1e3,
+                sc->effects.inertia ? -1 : k < lost);
+}
+
+/* The inputs of a run, never to be outputs: the scene and the fit file it names (its name into
+** fitfile, sizeof sc->spring_source), NULL-terminated. */
+static void scene_inputs(const cf_scene *sc, const char *scene_path, char *fitfile,
+                         const char *inputs[3])
+{
+    snprintf(fitfile, sizeof sc->spring_source, "%s", sc->spring_source);
     char *colon = strrchr(fitfile, ':');
-    if (colon && strcmp(sc.spring_source, "params") != 0)
+    if (colon && strcmp(sc->spring_source, "params") != 0)
         *colon = '\0';
-    const char *inputs[] = {scene_path, strcmp(sc.spring_source, "params") ? fitfile : NULL,
-                            NULL};
+    inputs[0] = scene_path;
+    inputs[1] = strcmp(sc->spring_source, "params") ? fitfile : NULL;
+    inputs[2] = NULL;
+}
+
+/* Loads the scene, checks both outputs and the budget before the run (which may be long), runs
+** it, writes the CSV (and the plot) atomically, and prints the summary. */
+int cf_cli_simulate(int argc, char **argv)
+{
+    sim_request q;
+    int rc = parse_request(argc, argv, &q);
+    if (rc >= 0)
+        return rc;
+    const char *png = q.so.png, *out = q.out;
+    cf_budget budget = q.so.budget;
+    cf_scene_cost cost;
+    cf_error err = {0};
+    cf_scene sc;
+    if (cf_scene_load(q.scene_path, &sc, &err) != CF_OK)
+        return cf_cli_fail(&err);
+    char fitfile[sizeof sc.spring_source];
+    const char *inputs[3];
+    scene_inputs(&sc, q.scene_path, fitfile, inputs);
     if ((!cf_cli_is_stdio(out) && cf_atomic_check(out, inputs, &err) != CF_OK) ||
         (png && cf_atomic_check(png, inputs, &err) != CF_OK) ||
-        cf_budget_check_size(&sc, scene_path, &budget, &cost, &err) != CF_OK) {
+        cf_budget_check_size(&sc, q.scene_path, &budget, &cost, &err) != CF_OK) {
         cf_scene_free(&sc);
         return cf_cli_fail(&err);
     }
@@ -236,42 +331,13 @@ int cf_cli_simulate(int argc, char **argv)
     cf_lattice lat;
     memset(&lat, 0, sizeof lat);
     cf_msm_sample *samples = NULL;
+    cf_msm_stats st;
     cf_cli_out a = {0};
     cf_atomic pa = {0};
     double *spring = NULL;
     rc = CF_EXIT_OK;
-    if (cf_law_init(&law, &sc.spring, &err) != CF_OK) {
-        rc = cf_cli_fail(&err);
-        goto end;
-    }
-    if ((sc.method == CF_LAW_TABLE && cf_law_table_build(&law, sc.table_intervals, &err)) ||
-        cf_lattice_create(&lat, &law, sc.method, &sc.cfg.lattice, &err) != CF_OK ||
-        cf_budget_check_steps(&sc, scene_path, &lat, &budget, &cost, &err) != CF_OK) {
-        rc = cf_cli_fail(&err);
-        goto end;
-    }
-    samples = calloc(sc.nsamples, sizeof *samples);
-    if (!samples) {
-        cf_error_set(&err, CF_E_INTERNAL, "out of memory for %zu samples", sc.nsamples);
-        rc = cf_cli_fail(&err);
-        goto end;
-    }
-    cf_msm_path path = cf_scene_path(&sc);
-    cf_msm_stats st;
-    size_t done = 0;
-    if (progress) {
-        sc.cfg.progress = show_progress;
-        sc.cfg.progress_ctx = NULL;
-    }
-    cf_status run_st = cf_msm_run(&lat, &sc.effects, &sc.cfg, &path, sc.sample_t_s, sc.nsamples,
-                                  samples, &done, &st, &err);
-    if (sc.cfg.progress)
-        fputs("\r\033[K", stderr); /* clear the progress line */
-    if (run_st != CF_OK) {
-        rc = cf_cli_fail(&err);
-        goto end;
-    }
-    if (cf_cli_out_open(&a, out, inputs, &err) != CF_OK) {
+    if (run_scene(&sc, &q, &budget, &cost, &law, &lat, &samples, &st, &err) != CF_OK ||
+        cf_cli_out_open(&a, out, inputs, &err) != CF_OK) {
         rc = cf_cli_fail(&err);
         goto end;
     }
@@ -284,49 +350,22 @@ int cf_cli_simulate(int argc, char **argv)
     double H = law.p.H_mm;
     for (size_t k = 0; k < sc.nsamples; k++)
         spring[k] = cf_law_force(&law, sc.method, samples[k].strain * H, NULL, NULL) / (H * H);
-    if (so.table) { /* a measurement table of the run, tension positive */
-        double smax = 0;
-        for (size_t k = 0; k < sc.nsamples; k++)
-            smax = fmax(smax, fabs(samples[k].stress_MPa * 1e3));
-        gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
-        if (!rng) {
-            cf_error_set(&err, CF_E_INTERNAL, "out of memory for the noise generator");
+    if (q.so.table) {
+        if (write_table(a.fp, samples, sc.nsamples, &q.so, &err) != CF_OK) {
             rc = cf_cli_fail(&err);
             goto end;
         }
-        gsl_rng_set(rng, (unsigned long)so.seed);
-        fprintf(a.fp, "# conifit simulate --table: the lattice of a scene along its protocol\n");
-        fprintf(a.fp, "# noise: Gaussian, sd %.17g x max |stress| = %.17g kPa, seed %ld\n",
-                so.noise, so.noise * smax, so.seed);
-        fprintf(a.fp, "# mode: uniaxial\n# columns: time [s], engineering strain [-], nominal "
-                      "stress [kPa]; compression negative\n");
-        fprintf(a.fp, "time_s,strain,stress_kPa\n");
-        for (size_t k = 0; k < sc.nsamples; k++) {
-            double y = -samples[k].stress_MPa * 1e3;
-            if (so.noise > 0 && k > 0)
-                y += gsl_ran_gaussian(rng, so.noise * smax);
-            fprintf(a.fp, "%.17g,%.17g,%.17g\n", samples[k].t_s, -samples[k].strain, y);
-        }
-        gsl_rng_free(rng);
     } else {
-        fprintf(a.fp, "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,stable\n");
-        size_t lost = cf_hysteresis_first_unstable(samples, sc.nsamples);
-        for (size_t k = 0; k < sc.nsamples; k++)
-            fprintf(a.fp, "%.17g,%.17g,%.17g,%.17g,%.17g,%d\n", samples[k].t_s, samples[k].strain,
-                    samples[k].stress_MPa * 1e3, samples[k].kinetic_mJ, spring[k] * 1e3,
-                    sc.effects.inertia ? -1 : k < lost);
-    }
-    if (png && cf_plot_simulation(&sc, samples, spring, sc.nsamples, png, inputs, &pa, &err) !=
-                   CF_OK) {
-        rc = cf_cli_fail(&err);
-        goto end;
+        write_curve(a.fp, &sc, samples, spring);
     }
     /* both outputs exist as temporaries: put them in place together */
-    if (cf_cli_out_close(&a, &err) != CF_OK || (png && cf_atomic_commit(&pa, &err) != CF_OK)) {
+    if ((png && cf_plot_simulation(&sc, samples, spring, sc.nsamples, png, inputs, &pa, &err) !=
+                    CF_OK) ||
+        cf_cli_out_close(&a, &err) != CF_OK || (png && cf_atomic_commit(&pa, &err) != CF_OK)) {
         rc = cf_cli_fail(&err);
         goto end;
     }
-    if (!quiet) {
+    if (!q.quiet) {
         summary(a.to_stdout ? stderr : stdout, &sc, samples, sc.nsamples, &st);
         recovery(a.to_stdout ? stderr : stdout, &sc, &law, samples, sc.nsamples);
     }
