@@ -456,29 +456,17 @@ static cf_status history_protocol(ctx *c, json_t *pr, cf_scene *sc, size_t *cap)
     return CF_OK;
 }
 
-static cf_status protocol_section(ctx *c, json_t *pr, cf_scene *sc, double samples_per_segment)
+/* The drive and target of a ramp, cycles or hold protocol: exactly one of to_strain (a strain
+** short of the spring's solid strain) or to_stress_kPa; sc->drive and sc->target (MPa). */
+static cf_status protocol_target(ctx *c, json_t *pr, cf_scene *sc)
 {
-    static const char *const allowed[] = {"kind", "to_strain", "to_stress_kPa", "duration_s",
-                                          "period_s", "count", "ramp_s", "hold_s", "t_s", NULL};
-    cf_status st;
-    if ((st = only_keys(c, pr, "protocol", allowed)))
-        return st;
-    const char *kind = json_string_value(json_object_get(pr, "kind"));
-    if (!kind)
-        return cf_error_set(c->err, CF_E_DATA, "%s: missing key 'protocol.kind' (ramp, cycles, "
-                            "hold or history)", c->name);
-    size_t cap = 0;
-    if (strcmp(kind, "history") == 0) {
-        if ((st = history_protocol(c, pr, sc, &cap)))
-            return st;
-        goto samples;
-    }
     json_t *ts = json_object_get(pr, "to_strain"), *tf = json_object_get(pr, "to_stress_kPa");
     if ((ts != NULL) == (tf != NULL))
         return cf_error_set(c->err, CF_E_DATA,
                             "%s: key 'protocol' needs exactly one of 'protocol.to_strain' "
                             "(displacement drive) or 'protocol.to_stress_kPa' (force drive)",
                             c->name);
+    cf_status st;
     double target;
     if (ts) {
         sc->drive = CF_DRIVE_DISPLACEMENT;
@@ -499,56 +487,74 @@ static cf_status protocol_section(ctx *c, json_t *pr, cf_scene *sc, double sampl
         target *= 1e-3;
     }
     sc->target = target;
-    double seg_t[3];
-    size_t nseg = 0;
-    if (strcmp(kind, "ramp") == 0) {
-        static const char *const ok[] = {"kind", "to_strain", "to_stress_kPa", "duration_s", NULL};
-        double dur;
-        if ((st = only_keys(c, pr, "protocol", ok)) ||
-            (st = number(c, pr, "protocol", "duration_s", 0, 1, 0, 1, 1e9, &dur)))
-            return st;
-        sc->kind = CF_PROTO_RAMP;
-        if (push(sc, &cap, 0, 0) || push(sc, &cap, dur, target))
-            goto oom;
-        (void)seg_t;
-        (void)nseg;
-    } else if (strcmp(kind, "cycles") == 0) {
-        static const char *const ok[] = {"kind", "to_strain", "to_stress_kPa", "period_s", "count",
-                                         NULL};
-        double period, count;
-        if ((st = only_keys(c, pr, "protocol", ok)) ||
-            (st = number(c, pr, "protocol", "period_s", 1, 0, 0, 1, 1e9, &period)) ||
-            (st = number(c, pr, "protocol", "count", 0, 1, 1, 0, MAX_CYCLES, &count)))
-            return st;
-        if (count != floor(count))
-            return cf_error_set(c->err, CF_E_DATA, "%s: key 'protocol.count' = %g: must be a "
-                                "whole number", c->name, count);
-        sc->kind = CF_PROTO_CYCLES;
-        sc->cycles = (int)count;
-        if (push(sc, &cap, 0, 0))
-            goto oom;
-        for (int k = 0; k < sc->cycles; k++)
-            if (push(sc, &cap, (k + 0.5) * period, target) || push(sc, &cap, (k + 1) * period, 0))
-                goto oom;
-    } else if (strcmp(kind, "hold") == 0) {
-        static const char *const ok[] = {"kind", "to_strain", "to_stress_kPa", "ramp_s", "hold_s",
-                                         NULL};
-        double ramp, hold;
-        if ((st = only_keys(c, pr, "protocol", ok)) ||
-            (st = number(c, pr, "protocol", "ramp_s", 1, 0, 0, 1, 1e9, &ramp)) ||
-            (st = number(c, pr, "protocol", "hold_s", 1, 0, 0, 1, 1e9, &hold)))
-            return st;
-        sc->kind = CF_PROTO_HOLD;
-        if (push(sc, &cap, 0, 0) || push(sc, &cap, ramp, target) ||
-            push(sc, &cap, ramp + hold, target))
-            goto oom;
-    } else {
-        return cf_error_set(c->err, CF_E_DATA,
-                            "%s: key 'protocol.kind' = '%s': expected ramp, cycles, hold or history",
-                            c->name, kind);
-    }
-samples:;
-    /* Samples: every path segment split in samples_per_segment intervals. */
+    return CF_OK;
+}
+
+static cf_status path_oom(ctx *c)
+{
+    return cf_error_set(c->err, CF_E_INTERNAL, "out of memory for the loading path");
+}
+
+/* ramp: from rest to the target in duration_s. */
+static cf_status ramp_protocol(ctx *c, json_t *pr, cf_scene *sc, size_t *cap)
+{
+    static const char *const ok[] = {"kind", "to_strain", "to_stress_kPa", "duration_s", NULL};
+    double dur;
+    cf_status st;
+    if ((st = only_keys(c, pr, "protocol", ok)) ||
+        (st = number(c, pr, "protocol", "duration_s", 0, 1, 0, 1, 1e9, &dur)))
+        return st;
+    sc->kind = CF_PROTO_RAMP;
+    if (push(sc, cap, 0, 0) || push(sc, cap, dur, sc->target))
+        return path_oom(c);
+    return CF_OK;
+}
+
+/* cycles: count load-unload cycles of period_s, each to the target and back to rest. */
+static cf_status cycles_protocol(ctx *c, json_t *pr, cf_scene *sc, size_t *cap)
+{
+    static const char *const ok[] = {"kind", "to_strain", "to_stress_kPa", "period_s", "count",
+                                     NULL};
+    double period, count;
+    cf_status st;
+    if ((st = only_keys(c, pr, "protocol", ok)) ||
+        (st = number(c, pr, "protocol", "period_s", 1, 0, 0, 1, 1e9, &period)) ||
+        (st = number(c, pr, "protocol", "count", 0, 1, 1, 0, MAX_CYCLES, &count)))
+        return st;
+    if (count != floor(count))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'protocol.count' = %g: must be a "
+                            "whole number", c->name, count);
+    sc->kind = CF_PROTO_CYCLES;
+    sc->cycles = (int)count;
+    if (push(sc, cap, 0, 0))
+        return path_oom(c);
+    for (int k = 0; k < sc->cycles; k++)
+        if (push(sc, cap, (k + 0.5) * period, sc->target) || push(sc, cap, (k + 1) * period, 0))
+            return path_oom(c);
+    return CF_OK;
+}
+
+/* hold: a ramp to the target in ramp_s, then the target held for hold_s. */
+static cf_status hold_protocol(ctx *c, json_t *pr, cf_scene *sc, size_t *cap)
+{
+    static const char *const ok[] = {"kind", "to_strain", "to_stress_kPa", "ramp_s", "hold_s",
+                                     NULL};
+    double ramp, hold;
+    cf_status st;
+    if ((st = only_keys(c, pr, "protocol", ok)) ||
+        (st = number(c, pr, "protocol", "ramp_s", 1, 0, 0, 1, 1e9, &ramp)) ||
+        (st = number(c, pr, "protocol", "hold_s", 1, 0, 0, 1, 1e9, &hold)))
+        return st;
+    sc->kind = CF_PROTO_HOLD;
+    if (push(sc, cap, 0, 0) || push(sc, cap, ramp, sc->target) ||
+        push(sc, cap, ramp + hold, sc->target))
+        return path_oom(c);
+    return CF_OK;
+}
+
+/* Samples: every path segment split in samples_per_segment intervals. */
+static cf_status path_samples(ctx *c, cf_scene *sc, double samples_per_segment)
+{
     size_t per = (size_t)samples_per_segment;
     if ((double)(sc->npath - 1) * (double)per + 1 > CF_SCENE_MAX_SAMPLES)
         return cf_error_set(c->err, CF_E_DATA,
@@ -559,7 +565,7 @@ samples:;
     sc->nsamples = (sc->npath - 1) * per + 1;
     sc->sample_t_s = malloc(sc->nsamples * sizeof(double));
     if (!sc->sample_t_s)
-        goto oom;
+        return path_oom(c);
     size_t k = 0;
     sc->sample_t_s[k++] = sc->path_t_s[0];
     for (size_t i = 1; i < sc->npath; i++)
@@ -567,8 +573,37 @@ samples:;
             sc->sample_t_s[k++] = sc->path_t_s[i - 1] +
                                   (sc->path_t_s[i] - sc->path_t_s[i - 1]) * (double)j / per;
     return CF_OK;
-oom:
-    return cf_error_set(c->err, CF_E_INTERNAL, "out of memory for the loading path");
+}
+
+/* The protocol: its kind's path (history, or ramp, cycles or hold to a target), then the
+** samples along it. */
+static cf_status protocol_section(ctx *c, json_t *pr, cf_scene *sc, double samples_per_segment)
+{
+    static const char *const allowed[] = {"kind", "to_strain", "to_stress_kPa", "duration_s",
+                                          "period_s", "count", "ramp_s", "hold_s", "t_s", NULL};
+    cf_status st;
+    if ((st = only_keys(c, pr, "protocol", allowed)))
+        return st;
+    const char *kind = json_string_value(json_object_get(pr, "kind"));
+    if (!kind)
+        return cf_error_set(c->err, CF_E_DATA, "%s: missing key 'protocol.kind' (ramp, cycles, "
+                            "hold or history)", c->name);
+    size_t cap = 0;
+    if (strcmp(kind, "history") == 0)
+        st = history_protocol(c, pr, sc, &cap);
+    else if ((st = protocol_target(c, pr, sc)) != CF_OK)
+        return st;
+    else if (strcmp(kind, "ramp") == 0)
+        st = ramp_protocol(c, pr, sc, &cap);
+    else if (strcmp(kind, "cycles") == 0)
+        st = cycles_protocol(c, pr, sc, &cap);
+    else if (strcmp(kind, "hold") == 0)
+        st = hold_protocol(c, pr, sc, &cap);
+    else
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'protocol.kind' = '%s': expected ramp, cycles, hold or history",
+                            c->name, kind);
+    return st != CF_OK ? st : path_samples(c, sc, samples_per_segment);
 }
 
 static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)

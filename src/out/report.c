@@ -556,20 +556,17 @@ static void cells(FILE *o, const cf_fit_report *r, const char *label, const char
     fputc('\n', o);
 }
 
-/* The lattice validation (and the fit through the lattice) beside the single-spring quality. */
-static void validation_text(FILE *o, const cf_fit_report *r)
+/* The lattice the validation ran (the setup of a fit it was done for), its moduli, the test mode
+** and what the fit targeted. */
+static void validation_header(FILE *o, const cf_fit_report *r)
 {
-    int any = 0;
-    for (int i = 0; i < r->nfits; i++)
-        any |= r->val[i].done;
-    if (!any) {
-        fprintf(o, " validation in the lattice: skipped: %s\n", r->val[0].note);
-        return;
-    }
     const cf_validate_setup *su = &r->val[0].setup;
+    const cf_validation *v0 = &r->val[0];
     for (int i = 0; i < r->nfits; i++)
-        if (r->val[i].done)
+        if (r->val[i].done) {
             su = &r->val[i].setup;
+            v0 = &r->val[i];
+        }
     const cf_lattice_config *lc = &su->cfg.lattice;
     cf_cubic_moduli cm = cf_cubic_moduli_of(lc->weight);
     fprintf(o,
@@ -579,17 +576,29 @@ static void validation_text(FILE *o, const cf_fit_report *r)
             lc->weight[CF_FAMILY_EDGE], lc->weight[CF_FAMILY_FACE], lc->weight[CF_FAMILY_BODY],
             cm.E, cm.nu, lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial",
             cf_law_method_name(su->method));
-    const cf_validation *v0 = &r->val[0];
-    for (int i = 0; i < r->nfits; i++)
-        if (r->val[i].done)
-            v0 = &r->val[i];
     fprintf(o, "  mode %s, %s; fit target: %s\n", cf_mode_name(v0->mode),
             v0->by_cell ? "homogenised cell (the full lattice has no such boundary conditions)"
                         : "full lattice",
             r->through_msm ? "the lattice (through the homogenised cell)" : "the single spring");
+}
+
+/* Prints rows k < nrows of buf (one cell per fit) under their labels. */
+static void cell_rows(FILE *o, const cf_fit_report *r, char (*buf)[2][64], int nrows,
+                      const char *const *labels)
+{
+    const char *t[2];
+    for (int k = 0; k < nrows; k++) {
+        for (int i = 0; i < r->nfits; i++)
+            t[i] = buf[k][i];
+        cells(o, r, labels[k], t);
+    }
+}
+
+/* The validation's numbers, one column per fit. */
+static void validation_rows(FILE *o, const cf_fit_report *r)
+{
     enum { ROWS = 7 };
     char buf[ROWS][2][64];
-    const char *t[2];
     const double u = r->table->y_to_file;
     const char *yu = r->table->y_unit;
     for (int i = 0; i < r->nfits; i++) {
@@ -622,73 +631,84 @@ static void validation_text(FILE *o, const cf_fit_report *r)
     static const char *const labels[ROWS] = {"fit RMSE (its target)", "lattice RMSE",
                                              "lattice vs law (RMSE)", "lattice max |error|",
                                              "lattice R^2", "lattice time", "lattice stable"};
-    for (int k = 0; k < ROWS; k++) {
-        for (int i = 0; i < r->nfits; i++)
-            t[i] = buf[k][i];
-        cells(o, r, labels[k], t);
+    cell_rows(o, r, buf, ROWS, labels);
+}
+
+/* The fit through the lattice: its RMSE before and after, its check in the full lattice, cost. */
+static void through_rows(FILE *o, const cf_fit_report *r)
+{
+    char buf[3][2][64];
+    const double u = r->table->y_to_file;
+    const char *yu = r->table->y_unit;
+    for (int i = 0; i < r->nfits; i++) {
+        const cf_through_msm *th = &r->thr[i];
+        if (th->done)
+            snprintf(buf[0][i], sizeof buf[0][i], "%.4g -> %.4g %s", th->rmse_before * u,
+                     th->cell_rmse * u, yu);
+        else
+            snprintf(buf[0][i], sizeof buf[0][i], "not run");
+        if (th->done && th->verified)
+            snprintf(buf[1][i], sizeof buf[1][i], "max |full - cell| %.3g %s",
+                     th->verify_max_abs * u, yu);
+        else
+            snprintf(buf[1][i], sizeof buf[1][i], "%s", th->done ? "cell only" : "");
+        snprintf(buf[2][i], sizeof buf[2][i], "%.3f s, %ld cell curves", th->wall_time_s,
+                 th->evaluations);
     }
+    static const char *const tl[3] = {"through lattice: RMSE", "verified in full lattice",
+                                      "through lattice: cost"};
+    cell_rows(o, r, buf, 3, tl);
+}
+
+/* The lattice validation (and the fit through the lattice) beside the single-spring quality. */
+static void validation_text(FILE *o, const cf_fit_report *r)
+{
+    int any = 0;
+    for (int i = 0; i < r->nfits; i++)
+        any |= r->val[i].done;
+    if (!any) {
+        fprintf(o, " validation in the lattice: skipped: %s\n", r->val[0].note);
+        return;
+    }
+    validation_header(o, r);
+    validation_rows(o, r);
     for (int i = 0; i < r->nfits; i++)
         if (r->val[i].done && r->val[i].unstable_in_range)
             fprintf(o, "  (!) %s: the lattice loses stability at strain %.4g, inside the table's "
                     "range: past it the static curve is an unstable equilibrium (a column of "
                     "cells buckles sideways in a dynamic run)\n",
                     cf_spring_type_name(r->fits[i].type), r->val[i].stable_to_strain);
-    if (r->through_msm) {
-        for (int i = 0; i < r->nfits; i++) {
-            const cf_through_msm *th = &r->thr[i];
-            if (th->done)
-                snprintf(buf[0][i], sizeof buf[0][i], "%.4g -> %.4g %s", th->rmse_before * u,
-                         th->cell_rmse * u, yu);
-            else
-                snprintf(buf[0][i], sizeof buf[0][i], "not run");
-            if (th->done && th->verified)
-                snprintf(buf[1][i], sizeof buf[1][i], "max |full - cell| %.3g %s",
-                         th->verify_max_abs * u, yu);
-            else
-                snprintf(buf[1][i], sizeof buf[1][i], "%s", th->done ? "cell only" : "");
-            snprintf(buf[2][i], sizeof buf[2][i], "%.3f s, %ld cell curves", th->wall_time_s,
-                     th->evaluations);
-        }
-        static const char *const tl[3] = {"through lattice: RMSE", "verified in full lattice",
-                                          "through lattice: cost"};
-        for (int k = 0; k < 3; k++) {
-            for (int i = 0; i < r->nfits; i++)
-                t[i] = buf[k][i];
-            cells(o, r, tl[k], t);
-        }
-    }
+    if (r->through_msm)
+        through_rows(o, r);
     for (int i = 0; i < r->nfits; i++)
         if (!r->val[i].done)
             fprintf(o, "  (%s: validation skipped: %s)\n", cf_spring_type_name(r->fits[i].type),
                     r->val[i].note);
 }
 
-char *cf_report_text(const cf_fit_report *r)
+/* The table: its size, columns, sign, and (stress-strain) its measures and their conversion. */
+static void table_text(FILE *o, const cf_fit_report *r)
 {
-    char *buf = NULL;
-    size_t len = 0;
-    FILE *o = open_memstream(&buf, &len);
-    if (!o)
-        return NULL;
     fprintf(o, "%s: %zu points, %s [%s] against %s [%s], %s\n", r->table->path, r->table->count,
             r->table->x_column, r->table->x_unit, r->table->y_column, r->table->y_unit,
             r->table->compression ? "compression negative" : "tension positive");
-    if (!cf_table_is_force(r->table)) {
-        const cf_table_measures *m = &r->table->measures;
-        char src[3][128], conv[256];
-        sources_text(r->table, src);
-        conversion_text(r->table, conv, sizeof conv);
-        fprintf(o, " measures: stress %s (%s), strain %s (%s), mode %s (%s)\n",
-                cf_stress_measure_name(m->stress), src[0], cf_strain_measure_name(m->strain),
-                src[1], cf_mode_name(r->table->mode), src[2]);
-        if (*conv)
-            fprintf(o, " fitted as engineering strain and nominal stress: %s\n", conv);
-        fputc('\n', o);
-    }
-    fprintf(o, "  %-26s", "");
-    for (int i = 0; i < r->nfits; i++)
-        fprintf(o, " %-24s", cf_spring_type_name(r->fits[i].type));
+    if (cf_table_is_force(r->table))
+        return;
+    const cf_table_measures *m = &r->table->measures;
+    char src[3][128], conv[256];
+    sources_text(r->table, src);
+    conversion_text(r->table, conv, sizeof conv);
+    fprintf(o, " measures: stress %s (%s), strain %s (%s), mode %s (%s)\n",
+            cf_stress_measure_name(m->stress), src[0], cf_strain_measure_name(m->strain), src[1],
+            cf_mode_name(r->table->mode), src[2]);
+    if (*conv)
+        fprintf(o, " fitted as engineering strain and nominal stress: %s\n", conv);
     fputc('\n', o);
+}
+
+/* The three quantities the data determine, their intervals, correlations and distance to solid. */
+static void identifiable_text(FILE *o, const cf_fit_report *r)
+{
     fprintf(o, " identifiable (determined by the data):\n");
     ident_row(o, r, "rho = D1/D2", 0, 1, "");
     if (cf_table_is_force(r->table)) {
@@ -722,6 +742,12 @@ char *cf_report_text(const cf_fit_report *r)
         fprintf(o, " %-24s", cell);
     }
     fputc('\n', o);
+}
+
+/* One spring of the family (the field table's parameters and what follows from them), and the
+** fit's quality. */
+static void spring_text(FILE *o, const cf_fit_report *r)
+{
     fprintf(o, " one spring of that family (chosen by the constraints):\n");
     for (int k = 0; k < CF_P_COUNT; k++) {
         const cf_spring_param *sp = cf_spring_param_info(k);
@@ -740,8 +766,31 @@ char *cf_report_text(const cf_fit_report *r)
     row(o, r, "max |error|", "%.4g %s", 11);
     row(o, r, "R^2", "%.6f", 12);
     row(o, r, "AIC (k = 3)", "%.2f", 13);
-    if (r->validate)
-        validation_text(o, r);
+}
+
+/* One row of constraint names per fit: those of its active (which = 0) or holding (1) mask,
+** joined by commas, or `none` when there are none. */
+static void constraint_row(FILE *o, const cf_fit_report *r, const char *label, int which,
+                           const char *none)
+{
+    fprintf(o, "  %-26s", label);
+    for (int i = 0; i < r->nfits; i++) {
+        const cf_fit_result *f = &r->fits[i];
+        const unsigned mask = which == 0 ? f->active : f->held;
+        char cell[160] = "";
+        size_t n = 0;
+        for (int k = 0; k < CF_C_COUNT; k++)
+            if (mask & (1u << k))
+                app(cell, sizeof cell, &n, "%s%s", n ? "," : "", cf_fit_constraint_name(1u << k));
+        fprintf(o, " %-24s", n ? cell : none);
+    }
+    fputc('\n', o);
+}
+
+/* Feasibility, the constraints that are active and that hold the spring, the optimiser's cost,
+** and the limits the fit ran under. */
+static void constraints_text(FILE *o, const cf_fit_report *r)
+{
     fprintf(o, "  %-26s", "feasible");
     for (int i = 0; i < r->nfits; i++) {
         char cell[160] = "yes";
@@ -755,16 +804,7 @@ char *cf_report_text(const cf_fit_report *r)
         fprintf(o, " %-24s", cell);
     }
     fputc('\n', o);
-    fprintf(o, "  %-26s", "active constraints");
-    for (int i = 0; i < r->nfits; i++) {
-        char cell[160] = "";
-        for (int k = 0; k < CF_C_COUNT; k++)
-            if (r->fits[i].active & (1u << k))
-                snprintf(cell + strlen(cell), sizeof cell - strlen(cell), "%s%s", *cell ? "," : "",
-                         cf_fit_constraint_name(1u << k));
-        fprintf(o, " %-24s", *cell ? cell : "none");
-    }
-    fputc('\n', o);
+    constraint_row(o, r, "active constraints", 0, "none");
     fprintf(o, "  %-26s", "optimizer, evaluations");
     for (int i = 0; i < r->nfits; i++) {
         char cell[64];
@@ -773,21 +813,17 @@ char *cf_report_text(const cf_fit_report *r)
         fprintf(o, " %-24s", cell);
     }
     fputc('\n', o);
-    fprintf(o, "  %-26s", "held by");
-    for (int i = 0; i < r->nfits; i++) {
-        char cell[160] = "";
-        size_t n = 0;
-        for (int k = 0; k < CF_C_COUNT; k++)
-            if (r->fits[i].held & (1u << k))
-                app(cell, sizeof cell, &n, "%s%s", n ? "," : "", cf_fit_constraint_name(1u << k));
-        fprintf(o, " %-24s", n ? cell : "nothing");
-    }
-    fputc('\n', o);
+    constraint_row(o, r, "held by", 1, "nothing");
     const cf_fit_options *fo = &r->fit_options;
     fprintf(o, "  limits: rho >= %g, %g <= n <= %g, 3 <= D1/d <= %g, D2 <= %g H, G <= %g MPa "
                "(flags --rho-min, --n-max, --index-max, --D2-max-H, --G-max)\n",
             fo->rho_min, fo->lower[CF_P_N], fo->upper[CF_P_N], fo->index_max, fo->D2_over_H_max,
             fo->upper[CF_P_G]);
+}
+
+/* The verdict on the type, the baselines, and what the six numbers mean. */
+static void verdict_and_baselines(FILE *o, const cf_fit_report *r)
+{
     int b = cf_report_better(r);
     if (r->nfits == 2 && b >= 0) {
         char text[1024];
@@ -819,6 +855,26 @@ char *cf_report_text(const cf_fit_report *r)
                "bounds, fixed values).\n",
             cf_table_is_force(r->table) ? "travel" : "solid strain",
             cf_table_is_force(r->table) ? "solid load" : "stress scale");
+}
+
+char *cf_report_text(const cf_fit_report *r)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *o = open_memstream(&buf, &len);
+    if (!o)
+        return NULL;
+    table_text(o, r);
+    fprintf(o, "  %-26s", "");
+    for (int i = 0; i < r->nfits; i++)
+        fprintf(o, " %-24s", cf_spring_type_name(r->fits[i].type));
+    fputc('\n', o);
+    identifiable_text(o, r);
+    spring_text(o, r);
+    if (r->validate)
+        validation_text(o, r);
+    constraints_text(o, r);
+    verdict_and_baselines(o, r);
     fclose(o);
     return buf;
 }
