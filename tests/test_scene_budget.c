@@ -124,6 +124,46 @@ static void limits_can_be_set(void **state)
     cf_scene_free(&sc);
 }
 
+/* fit --validate SCENE takes the same budget as simulate: a validation lattice of 113^3 cells
+** (about 33 GiB, which it used to try to build) is refused before any fit with the key and the
+** estimate, a tighter --max-memory refuses the shipped scene, and --max-steps bounds the static
+** solves of the validation (a solve per row and type, and the stability scan); nothing is
+** written. Without --validate the budget does not apply. */
+static void fit_validate_takes_the_scene_budget(void **state)
+{
+    (void)state;
+    scene("big.json", "\"lattice\": {\"nx\": 113, \"ny\": 113, \"nz\": 113}, \"protocol\": "
+                      "{\"kind\": \"ramp\", \"to_strain\": 0.1}");
+    int st = tu_run(out, sizeof out, errb, sizeof errb,
+                    "fit data/telescoping.csv --validate %s/big.json -o %s/f.json", dir, dir);
+    if (st != 65 || !strstr(errb, "lattice.nx/ny/nz") || !strstr(errb, "MiB"))
+        fail_msg("113^3 validation lattice: exit %d, expected 65 naming the key: %s", st, errb);
+    assert_false(exists("f.json"));
+    st = tu_run(out, sizeof out, errb, sizeof errb,
+                "fit data/telescoping.csv --validate data/scenes/uniaxial.json --max-memory 64K "
+                "-o %s/f.json",
+                dir);
+    assert_int_equal(st, 65);
+    assert_non_null(strstr(errb, "lattice.nx/ny/nz"));
+    assert_false(exists("f.json"));
+    st = tu_run(out, sizeof out, errb, sizeof errb,
+                "fit data/telescoping.csv --validate --max-steps 100 -o %s/f.json", dir);
+    if (st != 65 || !strstr(errb, "static solves") || !strstr(errb, "--max-steps"))
+        fail_msg("--max-steps 100: exit %d, expected 65 naming the solves: %s", st, errb);
+    assert_false(exists("f.json"));
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "fit data/telescoping.csv --validate --max-memory 12Q -q"),
+                     2);
+    /* within the budget, and without --validate, it runs */
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "fit data/telescoping.csv --validate --max-steps 1000 -o %s/f.json",
+                            dir),
+                     0);
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "fit data/telescoping.csv --max-steps 100 -q"),
+                     0);
+}
+
 /* Under a small address-space limit every scene ends with a status, never a signal. (Skipped
 ** under AddressSanitizer, which reserves more address space than any such limit.) */
 static void memory_pressure_gives_a_status_not_a_crash(void **state)
@@ -173,6 +213,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(costly_scenes_are_refused_naming_the_key),
         cmocka_unit_test(limits_can_be_set),
+        cmocka_unit_test(fit_validate_takes_the_scene_budget),
         cmocka_unit_test(memory_pressure_gives_a_status_not_a_crash),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -52,6 +52,23 @@ int cf_cli_usage_error(const char *cmd, const char *fmt, ...)
     return CF_EXIT_USAGE;
 }
 
+/* A size in bytes with an optional K, M or G (binary) suffix; 0 when it is not one. */
+double cf_cli_parse_size(const char *text)
+{
+    char *end = NULL;
+    double v = strtod(text, &end);
+    double unit = 1;
+    if (end == text || !(v > 0))
+        return 0;
+    if (*end)
+        unit = end[1]        ? 0
+               : *end == 'K' ? 1024.0
+               : *end == 'M' ? 1048576.0
+               : *end == 'G' ? 1073741824.0
+                             : 0;
+    return isfinite(v * unit) ? v * unit : 0;
+}
+
 cf_status cf_cli_parse_double(const char *name, const char *text, double *out, cf_error *err)
 {
     char *end = NULL;

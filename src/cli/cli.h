@@ -38,6 +38,9 @@ int cf_cli_usage_error(const char *cmd, const char *fmt, ...)
 /* Parses a finite double for option `name`; CF_E_USAGE with a message naming the option. */
 cf_status cf_cli_parse_double(const char *name, const char *text, double *out, cf_error *err);
 
+/* A size in bytes with an optional K, M or G (binary) suffix; 0 when it is not one. */
+double cf_cli_parse_size(const char *text);
+
 /* Parses a whole number in [lo, hi] for option `name`. */
 cf_status cf_cli_parse_long(const char *name, const char *text, long lo, long hi, long *out,
                             cf_error *err);

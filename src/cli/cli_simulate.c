@@ -132,23 +132,6 @@ typedef struct sim_opts {
     long seed;      /* --seed S */
 } sim_opts;
 
-/* A size in bytes with an optional K, M or G (binary) suffix; 0 when it is not one. */
-static double parse_size(const char *text)
-{
-    char *end = NULL;
-    double v = strtod(text, &end);
-    double unit = 1;
-    if (end == text || !(v > 0))
-        return 0;
-    if (*end)
-        unit = end[1]        ? 0
-               : *end == 'K' ? 1024.0
-               : *end == 'M' ? 1048576.0
-               : *end == 'G' ? 1073741824.0
-                             : 0;
-    return isfinite(v * unit) ? v * unit : 0;
-}
-
 /* simulate's own options: --plot, --max-memory, --max-steps. */
 static int take_option(void *ctx, int c, const char *value)
 {
@@ -165,7 +148,7 @@ static int take_option(void *ctx, int c, const char *value)
         if (cf_cli_parse_long("--seed", value, 0, 2147483647L, &o->seed, &err) != CF_OK)
             return cf_cli_usage_error("simulate", "%s", err.msg);
     } else if (c == OPT_MAX_MEMORY) {
-        if (!(o->budget.max_memory_bytes = parse_size(value)))
+        if (!(o->budget.max_memory_bytes = cf_cli_parse_size(value)))
             return cf_cli_usage_error("simulate", "--max-memory '%s': expected a size in bytes, "
                                       "optionally with K, M or G", value);
     } else if (c == OPT_MAX_STEPS) {

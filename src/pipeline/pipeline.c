@@ -21,6 +21,7 @@ cf_pipeline_options cf_pipeline_default_options(void)
     o.types = CF_PIPELINE_BOTH;
     o.fit = cf_fit_default_options();
     o.lattice = cf_validate_default();
+    o.budget = cf_budget_default();
     o.with_timing = 1;
     return o;
 }
@@ -31,7 +32,10 @@ cf_status cf_pipeline_use_scene(cf_pipeline_options *opt, const char *path, cf_e
     cf_status st = cf_scene_load(path, &sc, err);
     if (st != CF_OK)
         return st;
-    st = cf_validate_from_scene(&sc, path, &opt->lattice, err);
+    cf_scene_cost cost;
+    st = cf_budget_check_size(&sc, path, &opt->budget, &cost, err);
+    if (st == CF_OK)
+        st = cf_validate_from_scene(&sc, path, &opt->lattice, err);
     cf_scene_free(&sc);
     return st;
 }
@@ -53,6 +57,9 @@ static int through_lattice(const cf_table *t, const cf_pipeline_options *opt)
         return !cf_table_is_force(t) && t->mode != CF_MODE_UNIAXIAL;
     return opt->target == CF_TARGET_LATTICE;
 }
+
+/* Static solves of a validation's stability scan, at most (32 steps and the bisection). */
+#define VALIDATE_SCAN_SOLVES 64
 
 /* Each fit in the lattice, or through it. A fit the lattice cannot run keeps its validation's
 ** note (report.c prints it) and is not an error. */
@@ -85,6 +92,20 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
     r->fit_options = opt->fit;
     for (size_t i = 0; i < t->count; i++)
         r->ymax = fmax(r->ymax, fabs(t->y[i]));
+    if ((opt->validate || through_lattice(t, opt)) && !cf_table_is_force(t)) {
+        /* a static solve per row and type in the validation lattice, and its stability scan */
+        int types = !!(opt->types & (1u << CF_TELESCOPING)) +
+                    !!(opt->types & (1u << CF_NON_TELESCOPING));
+        double solves = (double)types * ((double)t->count + VALIDATE_SCAN_SOLVES);
+        const cf_lattice_config *lc = &opt->lattice.cfg.lattice;
+        if (solves > opt->budget.max_steps)
+            return cf_error_set(err, CF_E_DATA,
+                                "%s: the validation needs about %.3g static solves of the "
+                                "%dx%dx%d lattice (%zu rows, %d types and the stability scan), "
+                                "above the limit of %g (raise it with --max-steps)",
+                                t->path, solves, lc->nx, lc->ny, lc->nz, t->count, types,
+                                opt->budget.max_steps);
+    }
     for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING; ty++) {
         if (!(opt->types & (1u << ty)))
             continue;

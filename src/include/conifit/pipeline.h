@@ -13,6 +13,7 @@
 #ifndef CF_PIPELINE_H
 #define CF_PIPELINE_H
 
+#include "conifit/budget.h"
 #include "conifit/error.h"
 #include "conifit/fit.h"
 #include "conifit/measure.h"
@@ -45,6 +46,8 @@ typedef struct cf_pipeline_options {
     int validate;                /* 1: run each fit in the lattice */
     cf_pipeline_target target;   /* CF_TARGET_LATTICE implies validate */
     cf_validate_setup lattice;   /* the lattice of the validation (validate.h) */
+    cf_budget budget;            /* limits of the validation's memory and static solves (budget.h,
+                                 ** as for a scene; default cf_budget_default) */
     int with_timing;             /* 0: write wall times as 0 (reproducible fit files) */
     const char *title;           /* the figure's title (NULL: the table's name; report.h) */
     cf_pipeline_progress progress; /* NULL: silent */
@@ -55,12 +58,14 @@ typedef struct cf_pipeline_options {
 cf_pipeline_options cf_pipeline_default_options(void);
 
 /* Replaces opt->lattice by the lattice of the static uniaxial scene at path (scene.h,
-** cf_validate_from_scene). CF_E_NOINPUT or CF_E_DATA naming the file and key. */
+** cf_validate_from_scene), whose size must fit opt->budget (cf_budget_check_size). CF_E_NOINPUT
+** or CF_E_DATA naming the file and key (and the estimate, for a scene above the budget). */
 cf_status cf_pipeline_use_scene(cf_pipeline_options *opt, const char *path, cf_error *err);
 
 /* Fits table t and fills r (r->table = t, which must outlive r; release r with cf_report_free).
 ** A table the lattice cannot run (force-displacement) is validated as skipped, with a note, not
-** an error. Errors: those of cf_fit_run, prefixed with the table's path. */
+** an error. Errors: those of cf_fit_run, prefixed with the table's path; CF_E_DATA before any
+** fit when the validation would need more static solves than opt->budget allows. */
 cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_fit_report *r,
                           cf_error *err);
 
