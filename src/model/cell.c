@@ -204,6 +204,47 @@ static double guess(const cf_cell *c, cf_mode m, double e)
     }
 }
 
+/* The state once its free stretch a is found: the stress of the mode's loaded component. */
+static cf_status settled(cf_cell_state *s, const mode_form *fm, double a)
+{
+    s->free_stretch = a;
+    s->stress_MPa = s->P_MPa[fm->si][fm->sj];
+    return CF_OK;
+}
+
+/* The rounding level of the lateral stress of state s: its largest term, MPa. */
+static double lateral_rounding(const cf_cell *c, const cf_cell_state *s)
+{
+    double rs = 0;
+    for (int d = 0; d < CF_CELL_DIRS; d++)
+        rs = fmax(rs, fabs(s->T_N[d]));
+    return rs * (8 * DBL_EPSILON / (c->law->p.H_mm * c->law->p.H_mm));
+}
+
+/* What the search for the free stretch knows: r(lo) < 0 < r(hi) once have_lo and have_hi. */
+typedef struct bracket {
+    double lo, hi;
+    int have_lo, have_hi;
+} bracket;
+
+/* The stretch after a, where the lateral stress is r and its slope g: Newton's step while it
+** stays inside the bracket, else bisection, or a move toward the side not yet bracketed. */
+static double next_stretch(bracket *b, double a, double r, double g)
+{
+    if (r < 0)
+        b->lo = a, b->have_lo = 1;
+    else
+        b->hi = a, b->have_hi = 1;
+    double an = a - r / g;
+    if (!(g > 0) || !(an > b->lo && an < b->hi)) {
+        if (b->have_lo && b->have_hi)
+            an = 0.5 * (b->lo + b->hi);
+        else /* expand toward the missing side */
+            an = r > 0 ? 0.5 * (b->lo + a) : 0.5 * (a + b->hi);
+    }
+    return an;
+}
+
 cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extra *extra,
                        cf_cell_state *s, cf_error *err)
 {
@@ -219,74 +260,45 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
         place(m, e, 1, F);
         if ((st = evaluate(c, F, extra, s, kT, err)) != CF_OK)
             return st;
-        s->free_stretch = 1;
-        s->stress_MPa = s->P_MPa[fm.si][fm.sj];
-        return CF_OK;
+        return settled(s, &fm, 1);
     }
     /* Safeguarded Newton on r(a) = P[zero][zero], increasing in a: a bracket [lo, hi] with
     ** r(lo) < 0 < r(hi) is kept once known; a step that leaves it, or the domain, bisects. */
-    const cf_law *law = c->law;
-    const double sH = law->travel_mm / law->p.H_mm;
-    double lo = 1 - sH, hi = 1 + sH; /* the edge along a free axis reaches solid there */
-    int have_lo = 0, have_hi = 0;
+    const double sH = c->law->travel_mm / c->law->p.H_mm;
+    bracket b = {1 - sH, 1 + sH, 0, 0}; /* the edge along a free axis reaches solid there */
     double a = c->stretch_hint > 0 ? c->stretch_hint : guess(c, m, e);
-    a = fmin(fmax(a, lo + 1e-3 * sH), hi - 1e-3 * sH);
+    a = fmin(fmax(a, b.lo + 1e-3 * sH), b.hi - 1e-3 * sH);
     cf_error e1 = {0};
-    int it;
-    for (it = 0; it < MAX_ITER; it++) {
+    for (int it = 0; it < MAX_ITER; it++) {
         place(m, e, a, F);
         st = evaluate(c, F, extra, s, kT, &e1);
         if (st != CF_OK) {
             /* outside the domain: move halfway back toward the bracket's inside */
             if (a > 1)
-                hi = a;
+                b.hi = a;
             else
-                lo = a;
-            a = 0.5 * (lo + hi);
-            if (hi - lo <= 4 * DBL_EPSILON * hi)
+                b.lo = a;
+            a = 0.5 * (b.lo + b.hi);
+            if (b.hi - b.lo <= 4 * DBL_EPSILON * b.hi)
                 break;
             continue;
         }
         double r = s->P_MPa[fm.zero][fm.zero];
-        /* rounding level of that stress component: its largest term */
-        double rs = 0;
-        for (int d = 0; d < CF_CELL_DIRS; d++)
-            rs = fmax(rs, fabs(s->T_N[d]));
-        rs *= 8 * DBL_EPSILON / (law->p.H_mm * law->p.H_mm);
-        if (fabs(r) <= rs) {
-            s->free_stretch = a;
-            s->stress_MPa = s->P_MPa[fm.si][fm.sj];
-            return CF_OK;
-        }
-        if (r < 0)
-            lo = a, have_lo = 1;
-        else
-            hi = a, have_hi = 1;
-        double g = tangent(c, s, kT, fm.zero, fm.free_mask);
-        double an = a - r / g;
-        if (!(g > 0) || !(an > lo && an < hi)) {
-            if (have_lo && have_hi)
-                an = 0.5 * (lo + hi);
-            else /* expand toward the missing side */
-                an = r > 0 ? 0.5 * (lo + a) : 0.5 * (a + hi);
-        }
+        if (fabs(r) <= lateral_rounding(c, s))
+            return settled(s, &fm, a);
+        double an = next_stretch(&b, a, r, tangent(c, s, kT, fm.zero, fm.free_mask));
         if (fabs(an - a) <= 2 * DBL_EPSILON * fabs(a)) {
             a = an;
             place(m, e, a, F);
             if ((st = evaluate(c, F, extra, s, kT, &e1)) != CF_OK)
                 break;
-            s->free_stretch = a;
-            s->stress_MPa = s->P_MPa[fm.si][fm.sj];
-            return CF_OK;
+            return settled(s, &fm, a);
         }
         a = an;
     }
-    if (st == CF_OK && s->P_MPa[fm.zero][fm.zero] == 0) {
-        s->free_stretch = a;
-        s->stress_MPa = s->P_MPa[fm.si][fm.sj];
-        return CF_OK;
-    }
-    if (st != CF_OK && (have_lo || have_hi))
+    if (st == CF_OK && s->P_MPa[fm.zero][fm.zero] == 0)
+        return settled(s, &fm, a);
+    if (st != CF_OK && (b.have_lo || b.have_hi))
         return cf_error_set(err, CF_E_DATA, "%s strain %g: %s", cf_mode_name(m), e, e1.msg);
     if (st != CF_OK)
         return cf_error_set(err, CF_E_DATA, "%s strain %g is beyond what the lattice reaches: %s",

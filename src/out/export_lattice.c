@@ -196,6 +196,91 @@ static size_t steps_that_work(cf_lattice *lat, const cf_export_lattice *lx, doub
     return lo;
 }
 
+/* The format writes models and the loading has 1 to CF_EXPORT_MAX_STEPS finite steps. */
+static cf_status check_loading(const cf_export_options *opt, const cf_export_lattice *lx,
+                               cf_error *err)
+{
+    const cf_export_format_info *fi = cf_export_format_get(opt->format);
+    if (!fi || !fi->model)
+        return cf_error_set(err, CF_E_DATA, "format %s writes no model",
+                            cf_export_format_name(opt->format));
+    if (lx->nsteps == 0 || lx->nsteps > CF_EXPORT_MAX_STEPS)
+        return cf_error_set(err, CF_E_DATA, "%zu load steps: a lattice export takes 1 to %d",
+                            lx->nsteps, CF_EXPORT_MAX_STEPS);
+    for (size_t k = 0; k < lx->nsteps; k++)
+        if (!isfinite(lx->strain[k]))
+            return cf_error_set(err, CF_E_DATA, "load step %zu: strain is not finite", k + 1);
+    return CF_OK;
+}
+
+/* The model of the lattice built from law with table t, loaded along lx (its title into title,
+** cap bytes). 0, or -1 when memory runs out. */
+static int lattice_model(cf_xmodel *m, const cf_lattice *lat, const cf_law *law,
+                         const cf_export_table *t, const cf_export_lattice *lx,
+                         const cf_export_options *opt, char *title, size_t cap)
+{
+    if (model_of_lattice(m, lat) != 0)
+        return -1;
+    m->reaction_tol_N *= t->tol * law->F_C_N;
+    m->law = law;
+    m->base = t;
+    m->source = (opt->source && *opt->source) ? opt->source : "(none)";
+    lattice_title(title, cap, &lx->cfg.lattice);
+    m->title = title;
+    m->nsteps = lx->nsteps;
+    m->dz_mm = malloc(m->nsteps * sizeof *m->dz_mm);
+    m->ref_N = malloc(m->nsteps * sizeof *m->ref_N);
+    m->strain = malloc(m->nsteps * sizeof *m->strain);
+    if (!m->dz_mm || !m->ref_N || !m->strain)
+        return -1;
+    for (size_t k = 0; k < m->nsteps; k++) {
+        m->strain[k] = lx->strain[k];
+        m->dz_mm[k] = -lx->strain[k] * lat->height_mm;
+    }
+    return 0;
+}
+
+/* Why the lattice cannot follow the loading (the reference run failed with run_err, was
+** unstable from step `unstable` with `pivots` negative pivots, or compressed a spring to umax
+** past u_limit), with the largest strain that works: CF_E_DATA. */
+static cf_status refuse_loading(cf_lattice *lat, const cf_law *law, const cf_export_lattice *lx,
+                                cf_status run_st, const cf_error *run_err, double umax,
+                                double u_limit, size_t unstable, long pivots, cf_error *err)
+{
+    const size_t ok = steps_that_work(lat, lx, u_limit, lx->nsteps);
+    char works[160];
+    if (ok > 0)
+        snprintf(works, sizeof works, "the loading works up to strain %.6g (step %zu)",
+                 lx->strain[ok - 1], ok);
+    else
+        snprintf(works, sizeof works, "not even the first step (strain %.6g) works",
+                 lx->strain[0]);
+    if (run_st != CF_OK)
+        return cf_error_set(err, CF_E_DATA,
+                            "the lattice cannot follow the loading to strain %.6g: %s; %s",
+                            lx->strain[lx->nsteps - 1], run_err->msg, works);
+    if (!unstable)
+        return cf_error_set(err, CF_E_DATA,
+                            "a spring of the lattice is compressed to %.6g mm, past the table's "
+                            "end at %.6g mm (solid at %.6g mm); %s",
+                            umax, u_limit, law->travel_mm, works);
+    /* where exactly: the first negative pivot along this side of the loading */
+    double limit = 0.0;
+    cf_error e2 = {0};
+    const int side = lx->strain[unstable - 1] > 0 ? -1 : +1;
+    char where[96] = "";
+    if (cf_msm_stability_limit(law, lx->method, &lx->cfg, side, &limit, &e2) == CF_OK &&
+        limit != 0.0)
+        snprintf(where, sizeof where, " (stable up to strain %.6g)", fabs(limit));
+    return cf_error_set(err, CF_E_DATA,
+                        "the lattice loses stability within the loading%s: at strain %.6g "
+                        "(step %zu) its tangent has %ld negative pivots, so a simulator "
+                        "would leave the homogeneous state there; %s",
+                        where, lx->strain[unstable - 1], unstable, pivots, works);
+}
+
+/* Builds the table and the lattice, runs conifit's reference along the loading (refusing a
+** loading the lattice cannot follow), then writes the model. */
 cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
                                   const cf_export_options *opt, const cf_export_lattice *lx,
                                   cf_export_report *rep, cf_error *err)
@@ -207,41 +292,14 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
     cf_export_report r = {0};
     char title[256];
     memset(&lat, 0, sizeof lat);
-    const cf_export_format_info *fi = cf_export_format_get(opt->format);
-    if (!fi || !fi->model)
-        return cf_error_set(err, CF_E_DATA, "format %s writes no model",
-                            cf_export_format_name(opt->format));
-    if (lx->nsteps == 0 || lx->nsteps > CF_EXPORT_MAX_STEPS)
-        return cf_error_set(err, CF_E_DATA, "%zu load steps: a lattice export takes 1 to %d",
-                            lx->nsteps, CF_EXPORT_MAX_STEPS);
-    for (size_t k = 0; k < lx->nsteps; k++)
-        if (!isfinite(lx->strain[k]))
-            return cf_error_set(err, CF_E_DATA, "load step %zu: strain is not finite", k + 1);
-    cf_status st = cf_law_init(&law, &fs->params, err);
-    if (st != CF_OK)
+    cf_status st = check_loading(opt, lx, err);
+    if (st != CF_OK || (st = cf_law_init(&law, &fs->params, err)) != CF_OK)
         return st;
-    if ((st = cf_export_table_for(&law, opt, &t, err)) != CF_OK)
+    if ((st = cf_export_table_for(&law, opt, &t, err)) != CF_OK ||
+        (st = cf_lattice_create(&lat, &law, lx->method, &lx->cfg.lattice, err)) != CF_OK)
         goto done;
-    if ((st = cf_lattice_create(&lat, &law, lx->method, &lx->cfg.lattice, err)) != CF_OK)
-        goto done;
-    if (model_of_lattice(&m, &lat) != 0)
+    if (lattice_model(&m, &lat, &law, &t, lx, opt, title, sizeof title) != 0)
         goto oom;
-    m.reaction_tol_N *= t.tol * law.F_C_N;
-    m.law = &law;
-    m.base = &t;
-    m.source = (opt->source && *opt->source) ? opt->source : "(none)";
-    lattice_title(title, sizeof title, &lx->cfg.lattice);
-    m.title = title;
-    m.nsteps = lx->nsteps;
-    m.dz_mm = malloc(m.nsteps * sizeof *m.dz_mm);
-    m.ref_N = malloc(m.nsteps * sizeof *m.ref_N);
-    m.strain = malloc(m.nsteps * sizeof *m.strain);
-    if (!m.dz_mm || !m.ref_N || !m.strain)
-        goto oom;
-    for (size_t k = 0; k < m.nsteps; k++) {
-        m.strain[k] = lx->strain[k];
-        m.dz_mm[k] = -lx->strain[k] * lat.height_mm;
-    }
     double umax = 0.0;
     size_t unstable = 0;
     long pivots = 0;
@@ -249,38 +307,7 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
     st = reference_run(&lat, lx, m.ref_N, &umax, &unstable, &pivots, &run_err);
     const double u_limit = fmin(t.u_hi_mm, -t.u_lo_mm);
     if (st != CF_OK || umax > u_limit || unstable) {
-        const size_t ok = steps_that_work(&lat, lx, u_limit, lx->nsteps);
-        char works[160];
-        if (ok > 0)
-            snprintf(works, sizeof works, "the loading works up to strain %.6g (step %zu)",
-                     lx->strain[ok - 1], ok);
-        else
-            snprintf(works, sizeof works, "not even the first step (strain %.6g) works",
-                     lx->strain[0]);
-        if (st != CF_OK)
-            st = cf_error_set(err, CF_E_DATA,
-                              "the lattice cannot follow the loading to strain %.6g: %s; %s",
-                              lx->strain[lx->nsteps - 1], run_err.msg, works);
-        else if (unstable) {
-            /* where exactly: the first negative pivot along this side of the loading */
-            double limit = 0.0;
-            cf_error e2 = {0};
-            const int side = lx->strain[unstable - 1] > 0 ? -1 : +1;
-            char where[96] = "";
-            if (cf_msm_stability_limit(&law, lx->method, &lx->cfg, side, &limit, &e2) == CF_OK &&
-                limit != 0.0)
-                snprintf(where, sizeof where, " (stable up to strain %.6g)", fabs(limit));
-            st = cf_error_set(err, CF_E_DATA,
-                              "the lattice loses stability within the loading%s: at strain %.6g "
-                              "(step %zu) its tangent has %ld negative pivots, so a simulator "
-                              "would leave the homogeneous state there; %s",
-                              where, lx->strain[unstable - 1], unstable, pivots, works);
-        }
-        else
-            st = cf_error_set(err, CF_E_DATA,
-                              "a spring of the lattice is compressed to %.6g mm, past the table's "
-                              "end at %.6g mm (solid at %.6g mm); %s",
-                              umax, u_limit, law.travel_mm, works);
+        st = refuse_loading(&lat, &law, lx, st, &run_err, umax, u_limit, unstable, pivots, err);
         goto done;
     }
     for (size_t k = 0; k < m.nsteps; k++)
