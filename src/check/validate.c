@@ -116,8 +116,8 @@ static cf_status model_curve(const cf_spring *p, const cf_validate_setup *s, con
 
 /* The stability limit of the full uniaxial lattice on the table's side (compression when the
 ** table has any), and whether the table reaches past it. A failure leaves it unchecked. */
-static void stability(const cf_spring *p, const cf_validate_setup *s, const cf_table *d,
-                      cf_validation *v)
+static cf_status stability(const cf_spring *p, const cf_validate_setup *s, const cf_table *d,
+                           cf_validation *v, cf_error *err)
 {
     double lo = 0, hi = 0;
     for (size_t i = 0; i < d->count; i++) {
@@ -127,15 +127,22 @@ static void stability(const cf_spring *p, const cf_validate_setup *s, const cf_t
     int side = lo < 0 ? -1 : 1;
     cf_law law;
     if (cf_law_init(&law, p, NULL) != CF_OK)
-        return;
-    if ((s->method != CF_LAW_TABLE || cf_law_table_build(&law, s->table_intervals, NULL) == CF_OK) &&
-        cf_msm_stability_limit(&law, s->method, &s->cfg, side, &v->stable_to_strain, NULL) ==
+        return CF_OK;
+    cf_error e = {0};
+    cf_status st = CF_OK;
+    if ((s->method != CF_LAW_TABLE || cf_law_table_build(&law, s->table_intervals, &e) == CF_OK) &&
+        (st = cf_msm_stability_limit(&law, s->method, &s->cfg, side, &v->stable_to_strain, &e)) ==
             CF_OK) {
         v->stability_checked = 1;
         double reach = side < 0 ? lo : hi;
         v->unstable_in_range = v->stable_to_strain != 0 && fabs(reach) > fabs(v->stable_to_strain);
     }
     cf_law_free(&law);
+    /* a scan that could not run leaves the stability unchecked; one that ran out of memory is an
+    ** error, not a finding */
+    if (e.status == CF_E_INTERNAL || st == CF_E_INTERNAL)
+        return cf_error_set(err, CF_E_INTERNAL, "%s", e.msg);
+    return CF_OK;
 }
 
 cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const cf_table *d,
@@ -183,8 +190,14 @@ cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const 
     /* the law's own curve is a uniaxial one: in another mode there is nothing to compare */
     v->law_rmse = d->mode == CF_MODE_UNIAXIAL ? sqrt(ss / (double)d->count) : NAN;
     free(law);
-    if (!v->by_cell)
-        stability(p, s, d, v);
+    if (!v->by_cell && (st = stability(p, s, d, v, &e)) != CF_OK) {
+        cf_validation_free(v);
+        snprintf(v->note, sizeof v->note, "%s", e.msg);
+        v->wall_time_s = now_s() - t0;
+        if (err)
+            *err = e;
+        return st;
+    }
     v->done = 1;
     v->wall_time_s = now_s() - t0;
     return CF_OK;

@@ -1,8 +1,8 @@
 /*
 ** Baseline fits (see baseline.h): the linear and Duffing laws are linear in their coefficients
-** and solved as linear least-squares problems (GSL, through the SVD of the design matrix, never
-** the squared normal equations); Fung's law is linear in A for a fixed B, so B is found by a scan
-** and a refinement of the profile RSS(B) with GSL's Brent minimiser.
+** and solved as linear least-squares problems (GSL, through the QR factorisation of the design
+** matrix, never the squared normal equations); Fung's law is linear in A for a fixed B, so B is
+** found by a scan and a refinement of the profile RSS(B) with GSL's Brent minimiser.
 */
 #include "conifit/baseline.h"
 
@@ -11,7 +11,7 @@
 
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_min.h>
-#include <gsl/gsl_multifit.h>
+#include <gsl/gsl_linalg.h>
 
 #include "fit/subsample.h"
 
@@ -72,15 +72,17 @@ static void finish(const cf_table *d, cf_baseline *b, double ymax)
     b->aic = cf_baseline_aic(d->count, rss, b->k, ymax);
 }
 
-/* Duffing's k1, k3: least squares on the design matrix [x, x^3]. 0 when GSL fails (out of memory,
-** a table without x). */
+/* Duffing's k1, k3: least squares on the design matrix [x, x^3] by its QR factorisation (GSL's
+** Householder QR, never the squared normal equations), in workspaces allocated here and checked:
+** gsl_multifit_linear allocates inside its SVD without checking and crashes when memory runs
+** out. 0 when the matrix is singular (a table without x), -1 when memory runs out. */
 static int duffing_fit(const cf_table *d, double coef[2])
 {
     gsl_matrix *X = gsl_matrix_alloc(d->count, 2);
-    gsl_vector *y = gsl_vector_alloc(d->count), *c = gsl_vector_alloc(2);
-    gsl_matrix *cov = gsl_matrix_alloc(2, 2);
-    gsl_multifit_linear_workspace *w = gsl_multifit_linear_alloc(d->count, 2);
-    int ok = X && y && c && cov && w;
+    gsl_vector *y = gsl_vector_alloc(d->count), *r = gsl_vector_alloc(d->count);
+    gsl_vector *c = gsl_vector_alloc(2), *tau = gsl_vector_alloc(2);
+    int ok = X && y && r && c && tau;
+    int oom = !ok;
     if (ok) {
         for (size_t i = 0; i < d->count; i++) {
             double x = d->x[i];
@@ -88,21 +90,21 @@ static int duffing_fit(const cf_table *d, double coef[2])
             gsl_matrix_set(X, i, 1, x * x * x);
             gsl_vector_set(y, i, d->y[i]);
         }
-        double chisq;
-        ok = gsl_multifit_linear(X, y, c, cov, &chisq, w) == GSL_SUCCESS &&
+        ok = gsl_linalg_QR_decomp(X, tau) == GSL_SUCCESS &&
+             fabs(gsl_matrix_get(X, 1, 1)) > 1e-14 * fabs(gsl_matrix_get(X, 0, 0)) &&
+             gsl_linalg_QR_lssolve(X, tau, y, c, r) == GSL_SUCCESS &&
              isfinite(gsl_vector_get(c, 0)) && isfinite(gsl_vector_get(c, 1));
         if (ok) {
             coef[0] = gsl_vector_get(c, 0);
             coef[1] = gsl_vector_get(c, 1);
         }
     }
-    if (w)
-        gsl_multifit_linear_free(w);
     gsl_matrix_free(X);
-    gsl_matrix_free(cov);
     gsl_vector_free(y);
+    gsl_vector_free(r);
     gsl_vector_free(c);
-    return ok;
+    gsl_vector_free(tau);
+    return oom ? -1 : ok;
 }
 
 static double fung_rss(double B, void *data)
@@ -111,13 +113,16 @@ static double fung_rss(double B, void *data)
     return fung_profile(data, 0, B, &A);
 }
 
-/* Refines the scan's best B in (lo, hi) with Brent's method on the profile RSS; returns B. */
-static double fung_refine(const cf_table *d, double B, double lo, double hi)
+/* Refines the scan's best B in (lo, hi) with Brent's method on the profile RSS; returns B
+** (*oom = 1 when the minimiser cannot be allocated). */
+static double fung_refine(const cf_table *d, double B, double lo, double hi, int *oom)
 {
     gsl_function f = {fung_rss, (void *)d};
     gsl_min_fminimizer *m = gsl_min_fminimizer_alloc(gsl_min_fminimizer_brent);
-    if (!m)
+    if (!m) {
+        *oom = 1;
         return B;
+    }
     /* the scan's minimum lies strictly below its neighbours, as Brent's bracket needs */
     if (gsl_min_fminimizer_set(m, &f, B, lo, hi) == GSL_SUCCESS) {
         for (int it = 0; it < 200; it++) {
@@ -133,7 +138,7 @@ static double fung_refine(const cf_table *d, double B, double lo, double hi)
     return B;
 }
 
-void cf_baseline_fit_all(const cf_table *d, cf_baseline out[CF_BASE_COUNT])
+cf_status cf_baseline_fit_all(const cf_table *d, cf_baseline out[CF_BASE_COUNT], cf_error *err)
 {
     double xmax = 0, ymax = 0, s2 = 0, sy1 = 0;
     for (size_t i = 0; i < d->count; i++) {
@@ -146,7 +151,8 @@ void cf_baseline_fit_all(const cf_table *d, cf_baseline out[CF_BASE_COUNT])
     cf_baseline *L = &out[CF_BASE_LINEAR], *D = &out[CF_BASE_DUFFING], *F = &out[CF_BASE_FUNG];
     *L = (cf_baseline){CF_BASE_LINEAR, 1, {s2 > 0 ? sy1 / s2 : 0, 0}, 0, 0, 0};
     *D = (cf_baseline){CF_BASE_DUFFING, 2, {0, 0}, 0, 0, 0};
-    if (!duffing_fit(d, D->coef)) {
+    int du = duffing_fit(d, D->coef), oom = du < 0;
+    if (du <= 0) {
         D->coef[0] = L->coef[0];
         D->coef[1] = 0;
     }
@@ -160,8 +166,11 @@ void cf_baseline_fit_all(const cf_table *d, cf_baseline out[CF_BASE_COUNT])
     int ib = 1;
     cf_table sub;
     const cf_table *scan = d;
-    if (d->count > CF_FIT_SUBSAMPLE_ABOVE && cf_subsample(d, CF_SUBSAMPLE_ROWS, &sub, NULL) == CF_OK)
+    if (d->count > CF_FIT_SUBSAMPLE_ABOVE) {
+        if (cf_subsample(d, CF_SUBSAMPLE_ROWS, &sub, NULL) != CF_OK)
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory fitting the baselines");
         scan = &sub;
+    }
     for (int i = -N; i <= N; i++) {
         if (i == 0)
             continue;
@@ -186,7 +195,7 @@ void cf_baseline_fit_all(const cf_table *d, cf_baseline out[CF_BASE_COUNT])
             }
     }
     double bestB = bmax * (double)ib / N;
-    double Bf = fung_refine(d, bestB, bestB - bmax / N, bestB + bmax / N);
+    double Bf = fung_refine(d, bestB, bestB - bmax / N, bestB + bmax / N, &oom);
     if (fung_profile(d, 0, Bf, &A) > bestR)
         Bf = bestB;
     fung_profile(d, 0, Bf, &A);
@@ -195,4 +204,8 @@ void cf_baseline_fit_all(const cf_table *d, cf_baseline out[CF_BASE_COUNT])
     finish(d, L, ymax);
     finish(d, D, ymax);
     finish(d, F, ymax);
+    if (oom)
+        return cf_error_set(err, CF_E_INTERNAL,
+                            "out of memory in the baselines' solvers (GSL)");
+    return CF_OK;
 }

@@ -14,6 +14,7 @@
 
 #include <gsl/gsl_blas.h>
 #include <gsl/gsl_eigen.h>
+#include <gsl/gsl_errno.h>
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_multifit_nlinear.h>
 #include <gsl/gsl_rng.h>
@@ -205,6 +206,7 @@ typedef struct fit_ctx {
     /* stage B targets */
     double target[3];
     double pref[3]; /* preferred log c, log n, log H */
+    int oom;        /* 1 when an allocation of GSL or NLopt failed: the fit ends with an error */
 } fit_ctx;
 
 /* The canonical spring of diameter ratio rho with travel 1 mm and solid load 1 N:
@@ -344,8 +346,10 @@ static double lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3
     fp.fdtype = GSL_MULTIFIT_NLINEAR_CTRDIFF;
     gsl_multifit_nlinear_workspace *w =
         gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &fp, c->n, p);
-    if (!w)
+    if (!w) {
+        c->oom = 1;
         return CF_LSQ_HUGE_OBJ;
+    }
     gsl_multifit_nlinear_fdf fdf;
     memset(&fdf, 0, sizeof fdf);
     fdf.f = lm_f;
@@ -357,7 +361,10 @@ static double lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3
                      logit((B0 - c->b_lo) / (c->b_hi - c->b_lo)), log(A0)};
     gsl_vector_view x0 = gsl_vector_view_array(th0, 3);
     double best = CF_LSQ_HUGE_OBJ;
-    if (gsl_multifit_nlinear_init(&x0.vector, &fdf, w) == GSL_SUCCESS) {
+    int ist = gsl_multifit_nlinear_init(&x0.vector, &fdf, w);
+    if (ist == GSL_ENOMEM)
+        c->oom = 1;
+    if (ist == GSL_SUCCESS) {
         /* The driver loop, with one more stopping rule: an optimum on a bound of rho or of the
         ** length scale lies at infinity in the logit coordinates, where the step test never
         ** fires; stop once the sum of squares has stopped falling (LM_STALL iterations in a row
@@ -368,7 +375,10 @@ static double lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3
         int stall = 0;
         for (int it = 0; it < LM_MAX_ITER; it++) {
             int info;
-            if (gsl_multifit_nlinear_iterate(w) != GSL_SUCCESS)
+            int is = gsl_multifit_nlinear_iterate(w);
+            if (is == GSL_ENOMEM)
+                c->oom = 1;
+            if (is != GSL_SUCCESS)
                 break;
             if (gsl_multifit_nlinear_test(1e-15, 1e-15, 1e-15, &info, w) == GSL_SUCCESS)
                 break;
@@ -457,6 +467,7 @@ static int cmp_start(const void *a, const void *b)
 static double stage_a(fit_ctx *c, double best3[3], start4 *found, int *nfound)
 {
     gsl_rng *rng = seeded_rng(c->opt->seed, 1);
+    c->oom |= !rng;
     start grid[GRID * GRID];
     size_t k = 0;
     for (int i = 0; i < GRID; i++) {
@@ -523,8 +534,10 @@ static int stage_a_errors(fit_ctx *c, const double v[3], double se[3], double co
     gsl_vector *ev = gsl_vector_alloc(3);
     gsl_eigen_symm_workspace *ew = gsl_eigen_symm_alloc(3);
     int rank_def = 0;
-    if (!JtJ || !E || !ev || !ew)
+    if (!JtJ || !E || !ev || !ew) {
+        c->oom = 1;
         goto done;
+    }
     double rss = 0;
     for (size_t i = 0; i < c->n; i++) {
         double x = c->data->x[i], gt, gr;
@@ -786,29 +799,37 @@ static void nl_run(fit_ctx *c, nlopt_algorithm alg, zfun obj, int equalities, do
     if (nf == 0)
         return;
     nlopt_opt o = nlopt_create(alg, nf);
-    if (!o)
+    if (!o) {
+        c->oom = 1;
         return;
+    }
     double lb[CF_P_COUNT], ub[CF_P_COUNT];
     for (int k = 0; k < c->nfree; k++) {
         lb[k] = log(c->opt->lower[c->free_idx[k]]);
         ub[k] = log(c->opt->upper[c->free_idx[k]]);
         z[k] = fmin(fmax(z[k], lb[k]), ub[k]);
     }
-    nlopt_set_lower_bounds(o, lb);
-    nlopt_set_upper_bounds(o, ub);
+    int set_oom = nlopt_set_lower_bounds(o, lb) == NLOPT_OUT_OF_MEMORY;
+    set_oom |= nlopt_set_upper_bounds(o, ub) == NLOPT_OUT_OF_MEMORY;
     nl_thunk to = {c, obj, 0}, tc[NCON], te[3];
-    nlopt_set_min_objective(o, nl_func, &to);
+    set_oom |= nlopt_set_min_objective(o, nl_func, &to) == NLOPT_OUT_OF_MEMORY;
     for (int k = 0; k < NCON; k++) {
         tc[k] = (nl_thunk){c, z_constraint, k};
         if (k == CON_TRAVEL && !c->travel_ok)
             continue;
-        nlopt_add_inequality_constraint(o, nl_func, &tc[k], 0.0);
+        set_oom |= nlopt_add_inequality_constraint(o, nl_func, &tc[k], 0.0) == NLOPT_OUT_OF_MEMORY;
     }
     if (equalities)
         for (int k = 0; k < 3; k++) {
             te[k] = (nl_thunk){c, z_equality, k};
-            nlopt_add_equality_constraint(o, nl_func, &te[k], 1e-12);
+            set_oom |=
+                nlopt_add_equality_constraint(o, nl_func, &te[k], 1e-12) == NLOPT_OUT_OF_MEMORY;
         }
+    if (set_oom) {
+        c->oom = 1;
+        nlopt_destroy(o);
+        return;
+    }
     nlopt_set_xtol_rel(o, c->opt->xtol_rel);
     nlopt_set_ftol_abs(o, 1e-16);
     if (obj == z_objective) /* a fit at rounding level cannot be polished further */
@@ -818,6 +839,7 @@ static void nl_run(fit_ctx *c, nlopt_algorithm alg, zfun obj, int equalities, do
     double zs[CF_P_COUNT];
     memcpy(zs, z, sizeof(double) * nf);
     nlopt_result r = nlopt_optimize(o, z, &f);
+    c->oom |= r == NLOPT_OUT_OF_MEMORY;
     int bad = r < 0 && r != NLOPT_ROUNDOFF_LIMITED;
     for (int k = 0; k < c->nfree; k++)
         bad = bad || !isfinite(z[k]);
@@ -1086,17 +1108,25 @@ static double sub_solve(fit_ctx *c, sub *q, double *x, nlopt_algorithm alg)
     for (unsigned k = 0; k < nv; k++)
         x[k] = fmin(fmax(x[k], lb[k]), ub[k]);
     nlopt_opt o = nlopt_create(alg, nv);
-    if (!o)
+    if (!o) {
+        c->oom = 1;
         return CF_LSQ_HUGE_OBJ;
-    nlopt_set_lower_bounds(o, lb);
-    nlopt_set_upper_bounds(o, ub);
-    nlopt_set_min_objective(o, sub_f, q);
+    }
+    int set_oom = nlopt_set_lower_bounds(o, lb) == NLOPT_OUT_OF_MEMORY;
+    set_oom |= nlopt_set_upper_bounds(o, ub) == NLOPT_OUT_OF_MEMORY;
+    set_oom |= nlopt_set_min_objective(o, sub_f, q) == NLOPT_OUT_OF_MEMORY;
     if (c->region)
-        nlopt_add_inequality_constraint(o, sub_g, q, 0.0);
+        set_oom |= nlopt_add_inequality_constraint(o, sub_g, q, 0.0) == NLOPT_OUT_OF_MEMORY;
+    if (set_oom) {
+        c->oom = 1;
+        nlopt_destroy(o);
+        return CF_LSQ_HUGE_OBJ;
+    }
     nlopt_set_xtol_rel(o, 1e-9);
     nlopt_set_maxeval(o, 300);
     double f = CF_LSQ_HUGE_OBJ;
     nlopt_result r = nlopt_optimize(o, x, &f);
+    c->oom |= r == NLOPT_OUT_OF_MEMORY;
     nlopt_destroy(o);
     if (r < 0 && r != NLOPT_ROUNDOFF_LIMITED)
         f = sub_f0(q, x);
@@ -1110,6 +1140,7 @@ static double sub_solve(fit_ctx *c, sub *q, double *x, nlopt_algorithm alg)
 static int stage_a_constrained(fit_ctx *c, double v[3])
 {
     gsl_rng *rng = seeded_rng(c->opt->seed, 3);
+    c->oom |= !rng;
     start grid[GRID * GRID];
     size_t k = 0;
     sub q = {c, -1, 0};
@@ -1593,7 +1624,12 @@ cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_sprin
         res->ident_se[k] = -1;
     res->optimizer = "placement";
     res->evaluations = res->evaluations_full = c.evals;
+    const int oom = c.oom;
     ctx_free(&c);
+    if (oom)
+        return cf_error_set(err, CF_E_INTERNAL,
+                            "out of memory in the %s placement's solver (NLopt)",
+                            cf_spring_type_name(type));
     res->wall_time_s = now_s() - t0;
     return CF_OK;
 }
@@ -1656,6 +1692,7 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
     ** quantities that stage A fitted on every row, so the polish there can move the objective by
     ** rounding only (1e-14 of it on the shipped tables) and a long table skips its full pass. */
     gsl_rng *rng = seeded_rng(opt->seed, 2);
+    c.oom |= !rng;
     int starts = 1;
     for (int k = 0; k < CF_P_COUNT; k++)
         if (opt->fixed[k])
@@ -1709,10 +1746,15 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
     res->optimizer = cf_fit_optimizer_name(opt->optimizer);
     res->evaluations = c.evals + sc.evals;
     res->evaluations_full = c.evals;
+    const int oom = c.oom || sc.oom;
     ctx_free(&c);
     ctx_free(&sc);
     cf_table_free(&subt);
     res->wall_time_s = now_s() - t0;
+    if (oom) /* a stage ran short: its result is not the fit's */
+        return cf_error_set(err, CF_E_INTERNAL,
+                            "out of memory in the %s fit's solvers (GSL, NLopt)",
+                            cf_spring_type_name(type));
     return CF_OK;
 }
 

@@ -263,29 +263,6 @@ static double residual(solver *s, double *rnorm, double *fscale)
     return um;
 }
 
-/* Adds v to K(i, j) (nothing for a prescribed DOF); 0, or -1 when memory runs out. */
-static int add_entry(gsl_spmatrix *K, long i, long j, double v)
-{
-    if (i < 0 || j < 0)
-        return 0;
-    double *ptr = gsl_spmatrix_ptr(K, (size_t)i, (size_t)j);
-    if (ptr) {
-        *ptr += v;
-        return 0;
-    }
-    return gsl_spmatrix_set(K, (size_t)i, (size_t)j, v) == GSL_SUCCESS ? 0 : -1;
-}
-
-/* GSL's sparse allocators crash on their own failure path (they free a half-built matrix), so the
-** memory of a sparse matrix of nzmax entries (indices, values and the triplet tree) is tried
-** first: 1 when it can be had. */
-static int sparse_memory_available(size_t nzmax)
-{
-    void *p = malloc(nzmax * 64 + 4096);
-    free(p);
-    return p != NULL;
-}
-
 /* Index of entry (row, col) in the compressed-column matrix C, or -1 (rows within a column are
 ** not sorted by GSL's compression; a column holds at most 81 entries). */
 static int ccs_index(const gsl_spmatrix *C, long row, long col)
@@ -304,29 +281,91 @@ static cf_status build_pattern(solver *s, cf_error *err)
 {
     cf_lattice *lat = s->lat;
     const size_t n = s->ndof;
-    /* a node couples with at most 26 neighbours and itself: 81 entries per row */
-    const size_t nzmax = 81 * n + 16;
-    gsl_spmatrix *K = sparse_memory_available(2 * nzmax)
-                          ? gsl_spmatrix_alloc_nzmax(n ? n : 1, n ? n : 1, nzmax,
-                                                     GSL_SPMATRIX_TRIPLET)
-                          : NULL;
-    if (!K)
+    /* The pattern by hand: each node couples with itself and the nodes it shares a spring with
+    ** (at most 26), a 3 x 3 block each. GSL's triplet tree and its compression are not used: they
+    ** crash on their own allocation failures (gsl_spmatrix_set, gsl_spmatrix_ccs); a compressed
+    ** matrix allocated directly fails cleanly. */
+    enum { MAXADJ = 27 };
+    const size_t nn = lat->nn;
+    uint32_t *adj = malloc((nn ? nn : 1) * MAXADJ * sizeof(uint32_t));
+    unsigned char *deg = calloc(nn ? nn : 1, 1);
+    int *colp = malloc((n + 1) * sizeof(int));
+    if (!adj || !deg || !colp) {
+        free(adj);
+        free(deg);
+        free(colp);
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent matrix");
+    }
+    for (size_t p = 0; p < nn; p++) {
+        adj[p * MAXADJ] = (uint32_t)p;
+        deg[p] = 1;
+    }
     int bad = 0;
     for (size_t q = 0; q < lat->ns && !bad; q++) {
-        uint32_t i = lat->si[q], j = lat->sj[q];
-        for (int a = 0; a < 3; a++)
-            for (int b = 0; b < 3; b++) {
-                long ia = s->eq[3 * i + a], ib = s->eq[3 * i + b];
-                long ja = s->eq[3 * j + a], jb = s->eq[3 * j + b];
-                bad |= add_entry(K, ia, ib, 1) | add_entry(K, ja, jb, 1) |
-                       add_entry(K, ia, jb, 1) | add_entry(K, ja, ib, 1);
+        uint32_t ends[2] = {lat->si[q], lat->sj[q]};
+        for (int e = 0; e < 2; e++) {
+            uint32_t a = ends[e], b = ends[1 - e];
+            int have = 0;
+            for (int k = 0; k < deg[a] && !have; k++)
+                have = adj[a * MAXADJ + k] == b;
+            if (!have) {
+                if (deg[a] == MAXADJ) {
+                    bad = 1;
+                    break;
+                }
+                adj[a * MAXADJ + deg[a]++] = b;
             }
+        }
     }
-    for (size_t e = 0; e < n && !bad; e++)
-        bad |= add_entry(K, (long)e, (long)e, 1);
-    s->C = !bad && sparse_memory_available(K->nz) ? gsl_spmatrix_ccs(K) : NULL;
-    gsl_spmatrix_free(K);
+    /* the column of free DOF e = eq[3 p + a] holds the free DOFs of the nodes adjacent to p */
+    size_t nnz = 0;
+    for (size_t e = 0; e <= n; e++)
+        colp[e] = 0;
+    for (size_t p = 0; p < nn && !bad; p++) {
+        size_t rows = 0;
+        for (int k = 0; k < deg[p]; k++)
+            for (int b = 0; b < 3; b++)
+                rows += s->eq[3 * (size_t)adj[p * MAXADJ + k] + b] >= 0;
+        for (int a = 0; a < 3; a++)
+            if (s->eq[3 * p + a] >= 0)
+                colp[s->eq[3 * p + a] + 1] = (int)rows;
+    }
+    for (size_t e = 0; e < n; e++)
+        colp[e + 1] += colp[e];
+    nnz = (size_t)colp[n];
+    gsl_spmatrix *C = bad ? NULL
+                          : gsl_spmatrix_alloc_nzmax(n ? n : 1, n ? n : 1, nnz ? nnz : 1,
+                                                     GSL_SPMATRIX_CSC);
+    if (C) {
+        for (size_t e = 0; e <= n; e++)
+            C->p[e] = colp[e];
+        for (size_t p = 0; p < nn; p++)
+            for (int a = 0; a < 3; a++) {
+                long col = s->eq[3 * p + a];
+                if (col < 0)
+                    continue;
+                int at = colp[col];
+                for (int k = 0; k < deg[p]; k++)
+                    for (int b = 0; b < 3; b++) {
+                        long row = s->eq[3 * (size_t)adj[p * MAXADJ + k] + b];
+                        if (row >= 0)
+                            C->i[at++] = (int)row;
+                    }
+                /* rows in increasing order within the column (at most 81: insertion sort) */
+                for (int x = colp[col] + 1; x < at; x++) {
+                    int v = C->i[x], y = x - 1;
+                    for (; y >= colp[col] && C->i[y] > v; y--)
+                        C->i[y + 1] = C->i[y];
+                    C->i[y + 1] = v;
+                }
+            }
+        memset(C->data, 0, (nnz ? nnz : 1) * sizeof(double));
+        C->nz = nnz;
+    }
+    free(adj);
+    free(deg);
+    free(colp);
+    s->C = C;
     s->map = malloc((lat->ns ? lat->ns : 1) * 36 * sizeof(int));
     s->diag = malloc((n ? n : 1) * sizeof(int));
     if (!s->C || !s->map || !s->diag)
@@ -1368,14 +1407,16 @@ cf_status cf_msm_uniaxial(const cf_law *law, cf_law_method m, const cf_msm_confi
 /* ---- the stability limit of the uniaxial lattice --------------------------------------------- */
 
 /* Negative pivots of the tangent at the current state (a converged equilibrium): assembled and
-** factored once more, the update discarded. -1 when no factorisation reports its inertia. */
-static long inertia_here(solver *s)
+** factored once more, the update discarded. -1 when no factorisation reports its inertia; *oom
+** set when memory ran out (then the count means nothing). */
+static long inertia_here(solver *s, int *oom)
 {
     double rn, fs;
     residual(s, &rn, &fs);
     s->neg_pivots = -1;
     cf_error e = {0};
-    (void)newton_direction(s, &e);
+    if (newton_direction(s, &e) == CF_E_INTERNAL || e.status == CF_E_INTERNAL)
+        *oom = 1;
     return s->neg_pivots;
 }
 
@@ -1417,7 +1458,12 @@ cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_ms
         memcpy(keep + lat.nn, lat.y, lat.nn * sizeof(double));
         memcpy(keep + 2 * lat.nn, lat.z, lat.nn * sizeof(double));
         cf_error e1 = {0};
-        int lost = static_to(&s, dir * e, &e1) != CF_OK || inertia_here(&s) > 0;
+        int oom = 0;
+        int lost = static_to(&s, dir * e, &e1) != CF_OK || inertia_here(&s, &oom) > 0;
+        if (oom || e1.status == CF_E_INTERNAL) { /* not a loss of stability: memory */
+            rc = cf_error_set(err, CF_E_INTERNAL, "out of memory in the stability scan");
+            goto done;
+        }
         if (!lost) {
             stable = e;
             continue;
@@ -1432,7 +1478,12 @@ cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_ms
             s.load = dir * stable;
             place_top(&lat, s.load);
             cf_error e2 = {0};
-            if (static_to(&s, dir * mid, &e2) == CF_OK && inertia_here(&s) == 0) {
+            int ok2 = static_to(&s, dir * mid, &e2) == CF_OK && inertia_here(&s, &oom) == 0;
+            if (oom || e2.status == CF_E_INTERNAL) {
+                rc = cf_error_set(err, CF_E_INTERNAL, "out of memory in the stability scan");
+                goto done;
+            }
+            if (ok2) {
                 stable = mid;
                 memcpy(keep, lat.x, lat.nn * sizeof(double));
                 memcpy(keep + lat.nn, lat.y, lat.nn * sizeof(double));

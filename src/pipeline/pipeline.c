@@ -62,8 +62,9 @@ static int through_lattice(const cf_table *t, const cf_pipeline_options *opt)
 #define VALIDATE_SCAN_SOLVES 64
 
 /* Each fit in the lattice, or through it. A fit the lattice cannot run keeps its validation's
-** note (report.c prints it) and is not an error. */
-static void validate_fits(const cf_table *t, const cf_pipeline_options *opt, cf_fit_report *r)
+** note (report.c prints it) and is not an error; running out of memory is (CF_E_INTERNAL). */
+static cf_status validate_fits(const cf_table *t, const cf_pipeline_options *opt,
+                               cf_fit_report *r, cf_error *err)
 {
     r->validate = 1;
     r->through_msm = through_lattice(t, opt);
@@ -73,12 +74,15 @@ static void validate_fits(const cf_table *t, const cf_pipeline_options *opt, cf_
         if (!r->through_msm) {
             progress(opt, t, "validating the %s spring in the lattice", type);
             cf_validate_run(&r->fits[k].params, &opt->lattice, t, &r->val[k], &verr);
-            continue;
+        } else {
+            progress(opt, t, "fitting the %s spring through the lattice", type);
+            cf_validate_through_msm(t, &opt->fit, &opt->lattice, &r->fits[k], &r->val[k],
+                                    &r->thr[k], &verr);
         }
-        progress(opt, t, "fitting the %s spring through the lattice", type);
-        cf_validate_through_msm(t, &opt->fit, &opt->lattice, &r->fits[k], &r->val[k], &r->thr[k],
-                                &verr);
+        if (verr.status == CF_E_INTERNAL)
+            return cf_error_set(err, CF_E_INTERNAL, "%s: %s", t->path, verr.msg);
     }
+    return CF_OK;
 }
 
 cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_fit_report *r,
@@ -118,9 +122,11 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
     }
     if (r->nfits == 0)
         return cf_error_set(err, CF_E_DATA, "%s: no spring type chosen to fit", t->path);
-    cf_baseline_fit_all(t, r->baselines);
+    cf_error be = {0};
+    if (cf_baseline_fit_all(t, r->baselines, &be) != CF_OK)
+        return cf_error_set(err, be.status, "%s: %s", t->path, be.msg);
     if (opt->validate || through_lattice(t, opt))
-        validate_fits(t, opt, r);
+        return validate_fits(t, opt, r, err);
     return CF_OK;
 }
 

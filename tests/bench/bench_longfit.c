@@ -94,7 +94,7 @@ static int run_once(const char *path, size_t subsample_above, long_run *out)
     }
     cf_baseline b[CF_BASE_COUNT];
     if (ok)
-        cf_baseline_fit_all(&t, b);
+        ok = cf_baseline_fit_all(&t, b, NULL) == CF_OK;
     out->read_s = t1 - t0;
     out->fit_s = bench_now() - t1;
     out->fit_cpu_s = cpu_now() - c1;

@@ -27,8 +27,9 @@ typedef struct cf_baseline {
     double aic;      /* dimensionless (with RSS in MPa^2 or N^2) */
 } cf_baseline;
 
-/* Fits all baselines to the table (weights ignored: the comparison is on plain residuals). */
-void cf_baseline_fit_all(const cf_table *data, cf_baseline out[CF_BASE_COUNT]);
+/* Fits all baselines to the table (weights ignored: the comparison is on plain residuals).
+** CF_E_INTERNAL when an allocation of GSL fails (out is then incomplete). */
+cf_status cf_baseline_fit_all(const cf_table *data, cf_baseline out[CF_BASE_COUNT], cf_error *err);
 
 /* Value of a fitted baseline at x. */
 double cf_baseline_eval(const cf_baseline *b, double x);
