@@ -102,11 +102,27 @@ static void the_readme_lists_the_keys_of_the_field_table(void **state)
     free(readme);
 }
 
+/* The parameters as text come from the table too, in both styles, and never overrun. */
+static void the_spring_as_text_follows_the_table(void **state)
+{
+    (void)state;
+    const cf_spring p = {10, 30, 4, 1, 80000, 40.5};
+    char buf[160];
+    assert_string_equal(cf_spring_text(&p, 6, 0, buf, sizeof buf),
+                        "D1 10 mm, D2 30 mm, n 4, d 1 mm, G 80000 MPa, H 40.5 mm");
+    assert_string_equal(cf_spring_text(&p, 2, 1, buf, sizeof buf),
+                        "D1=10 D2=30 n=4 d=1 G=8e+04 H=40");
+    char small[12];
+    memset(small, 'x', sizeof small);
+    assert_string_equal(cf_spring_text(&p, 6, 0, small, sizeof small), "D1 10 mm, D");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(the_field_table_is_whole_and_found_by_name_and_key),
         cmocka_unit_test(the_readme_lists_the_keys_of_the_field_table),
+        cmocka_unit_test(the_spring_as_text_follows_the_table),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

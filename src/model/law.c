@@ -97,13 +97,13 @@ cf_status cf_law_init(cf_law *law, const cf_spring *p, cf_error *err)
     const double derived[] = {law->rho,   law->rho_inv_m1,  law->index_c,    law->L_max_mm,
                               law->F_C_N, law->F_T_N,       law->k0_N_per_mm, law->u_T_mm,
                               law->inv_travel, law->k_scale, law->w_T};
+    char sp[160];
     for (size_t i = 0; i < sizeof derived / sizeof derived[0]; i++)
         if (!isfinite(derived[i]) || (i != 1 && i != 9 && i != 10 && derived[i] <= 0))
             return cf_error_set(err, CF_E_DATA,
-                                "spring D1=%g D2=%g n=%g d=%g G=%g H=%g is outside the range "
-                                "where its loads can be represented (derived value %zu = %g)",
-                                p->D1_mm, p->D2_mm, p->n, p->d_mm, p->G_MPa, p->H_mm, i,
-                                derived[i]);
+                                "spring %s is outside the range where its loads can be "
+                                "represented (derived value %zu = %g)",
+                                cf_spring_text(p, 6, 1, sp, sizeof sp), i, derived[i]);
     return CF_OK;
 }
 

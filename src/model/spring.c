@@ -3,6 +3,7 @@
 */
 #include "conifit/spring.h"
 
+#include <stdio.h>
 #include <string.h>
 
 static const cf_spring_param params[CF_P_COUNT] = {
@@ -43,6 +44,22 @@ void cf_spring_set(cf_spring *p, int k, double value)
     case CF_P_H: p->H_mm = value; break;
     default: break;
     }
+}
+
+const char *cf_spring_text(const cf_spring *p, int digits, int assign, char *buf, size_t cap)
+{
+    size_t n = 0;
+    if (cap)
+        buf[0] = '\0';
+    for (int k = 0; k < CF_P_COUNT && n < cap; k++) {
+        const cf_spring_param *sp = &params[k];
+        const int unit = !assign && strcmp(sp->unit, "-") != 0;
+        int w = snprintf(buf + n, cap - n, "%s%s%s%.*g%s%s", k ? (assign ? " " : ", ") : "",
+                         sp->name, assign ? "=" : " ", digits, cf_spring_get(p, k),
+                         unit ? " " : "", unit ? sp->unit : "");
+        n += w > 0 ? (size_t)w : 0;
+    }
+    return buf;
 }
 
 int cf_spring_param_find(const char *name)

@@ -40,10 +40,10 @@ char *cf_joint_text(const cf_joint_report *r)
         const cf_joint_result *j = &r->fits[i];
         const cf_spring *p = &j->fit.params;
         cf_cubic_moduli cm = cf_cubic_moduli_of(j->weight);
-        fprintf(o, "\n%s spring: D1 %.5g mm, D2 %.5g mm, n %.5g, d %.5g mm, G %.5g MPa, H %.5g mm"
-                   "%s\n",
-                cf_spring_type_name(j->fit.type), p->D1_mm, p->D2_mm, p->n, p->d_mm, p->G_MPa,
-                p->H_mm, j->fit.feasible ? "" : " (violates its constraints)");
+        char sp[160];
+        fprintf(o, "\n%s spring: %s%s\n", cf_spring_type_name(j->fit.type),
+                cf_spring_text(p, 5, 0, sp, sizeof sp),
+                j->fit.feasible ? "" : " (violates its constraints)");
         fprintf(o, " lattice: rho %.4g, solid strain s/H %.4g, stress scale F_C/H^2 %.4g kPa; "
                    "calibration %s (weights edge %.4g, face %.4g, body %.4g; nu %.3f)\n",
                 j->ident[0], j->ident[1], j->ident[2] * 1e3, cf_calibration_name(j->calibration),

@@ -302,10 +302,10 @@ char *cf_visco_report_text(const cf_visco_report *r)
         fprintf(o, "  note: %s\n", p->note);
     fprintf(o, " one spring of the family (the model depends only on rho, s/H, F_C/H^2):\n");
     for (int i = 0; i < r->nplaced; i++) {
-        const cf_spring *s = &r->placed[i].params;
-        fprintf(o, "  %-30s D1 %.6g mm, D2 %.6g mm, n %.6g, d %.6g mm, G %.6g MPa, H %.6g mm%s\n",
-                cf_spring_type_name(r->placed[i].type), s->D1_mm, s->D2_mm, s->n, s->d_mm,
-                s->G_MPa, s->H_mm, r->placed[i].feasible ? "" : " (infeasible)");
+        char sp[160];
+        fprintf(o, "  %-30s %s%s\n", cf_spring_type_name(r->placed[i].type),
+                cf_spring_text(&r->placed[i].params, 6, 0, sp, sizeof sp),
+                r->placed[i].feasible ? "" : " (infeasible)");
     }
     fprintf(o, "  %-30s %ld model runs, %.2f s\n", "cost", f->evaluations,
             r->with_timing ? f->wall_time_s : 0.0);

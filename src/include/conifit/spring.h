@@ -46,6 +46,11 @@ const cf_spring_param *cf_spring_param_info(int k);
 double cf_spring_get(const cf_spring *p, int k);
 void cf_spring_set(cf_spring *p, int k, double value);
 
+/* The six parameters as text, from the field table, into buf (cap bytes; returns buf), each value
+** with `digits` significant digits: "D1 10 mm, D2 30 mm, n 4, d 1 mm, G 8e+04 MPa, H 40 mm", or
+** with assign = 1 "D1=10 D2=30 n=4 d=1 G=8e+04 H=40" (no units). */
+const char *cf_spring_text(const cf_spring *p, int digits, int assign, char *buf, size_t cap);
+
 /* Index of the parameter called name (its name "D1" or its key "D1_mm"), or -1. */
 int cf_spring_param_find(const char *name);
 
