@@ -4,8 +4,8 @@
 ** better type of a tie, a stability limit never reached) is left out with a reason beside it, and
 ** a document that would hold a non-finite number is refused (tests/test_report.c). This test scans
 ** the committed fit files (every .json in fits/) and what the commands that write JSON or a report
-** write on the shipped tables: fit (with --validate, --target lattice, --joint, -o -), export
-** --format json, and their text on standard output and standard error.
+** write on the shipped tables: fit (with --validate, --target lattice, --joint, a time series,
+** -o -), export --format json, and their text on standard output and standard error.
 */
 #include <ctype.h>
 #include <dirent.h>
@@ -108,6 +108,7 @@ static void committed_fit_files_hold_no_null(void **state)
 {
     (void)state;
     assert_true(scan_dir("fits") >= 7);
+    assert_true(scan_dir("fits/series") >= 2); /* the viscoelastic fits */
 }
 
 /* The shipped tables through fit, with the lattice validation, with standard errors that are and
@@ -137,27 +138,24 @@ static void fit_outputs_hold_no_null(void **state)
         assert_clean_json_text("export --format json", out);
         remove(path);
     }
-    /* the fit through the lattice (placement: no standard errors, their reason instead) */
-    snprintf(path, sizeof path, "%s/target.json", dir);
-    int st = tu_run(out, sizeof out, errb, sizeof errb,
-                    "fit data/telescoping.csv --target lattice -o %s", path);
-    if (st != 0)
-        fail_msg("--target lattice: exit %d: %s", st, errb);
-    assert_no_bad_words("fit --target lattice", out);
-    assert_clean_json_file(path);
-    remove(path);
-    /* one lattice for two tables */
-    snprintf(path, sizeof path, "%s/joint.json", dir);
-    st = tu_run(out, sizeof out, errb, sizeof errb,
-                "fit --joint data/telescoping.csv data/telescoping_compression.csv -o %s", path);
-    if (st != 0)
-        fail_msg("--joint: exit %d: %s", st, errb);
-    assert_no_bad_words("fit --joint", out);
-    assert_clean_json_file(path);
-    remove(path);
+    /* the fit through the lattice (placement: no standard errors, their reason instead), one
+    ** lattice for two tables, and a viscoelastic fit of a time series (a writer of its own) */
+    static const char *const runs[] = {
+        "fit data/telescoping.csv --target lattice -o",
+        "fit --joint data/telescoping.csv data/telescoping_compression.csv -o",
+        "fit data/series/synthetic_relaxation.csv -o"};
+    for (size_t k = 0; k < sizeof runs / sizeof runs[0]; k++) {
+        snprintf(path, sizeof path, "%s/run%zu.json", dir, k);
+        int sk = tu_run(out, sizeof out, errb, sizeof errb, "%s %s", runs[k], path);
+        if (sk != 0)
+            fail_msg("%s: exit %d: %s", runs[k], sk, errb);
+        assert_no_bad_words(runs[k], out);
+        assert_clean_json_file(path);
+        remove(path);
+    }
     /* the fit file on standard output */
-    st = tu_run(out, sizeof out, errb, sizeof errb, "fit data/strongly_conical.csv -o -");
-    assert_int_equal(st, 0);
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb, "fit data/strongly_conical.csv -o -"),
+                     0);
     assert_clean_json_text("fit -o -", out);
     rmdir(dir);
 }

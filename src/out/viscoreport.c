@@ -22,10 +22,20 @@ void cf_visco_report_free(cf_visco_report *r)
         cf_visco_fit_free(&r->fit);
 }
 
-/* A standard error, null when not determined (< 0). */
-static json_t *se_num(double se, double scale)
+/* Sets o[key] to a standard error times scale, or, when it is not determined (< 0), leaves the
+** key out and sets o[key_reason] instead: a fit file holds no null (fitfile_json.h). */
+static void set_se(json_t *o, const char *key, double se, double scale)
 {
-    return se >= 0 ? num(se * scale) : json_null();
+    if (!o)
+        return;
+    if (se >= 0) {
+        json_object_set_new(o, key, num(se * scale));
+        return;
+    }
+    char rk[64];
+    snprintf(rk, sizeof rk, "%s_reason", key);
+    json_object_set_new(o, rk, json_string("not determined: the quantity sits on a limit or the "
+                                           "Jacobian of the fit is numerically rank-deficient"));
 }
 
 static double g_inf(const cf_visco_params *p)
@@ -74,14 +84,17 @@ static void visco_keys(const cf_visco_report *r, json_t *o)
     const cf_visco_fit *f = &r->fit;
     const double u = r->table->y_to_file;
     json_t *prony = json_array();
-    for (int i = 0; i < f->p.nbranch; i++)
-        json_array_append_new(prony,
-                              json_pack("{s:o, s:o, s:o, s:o}", "g", num(f->p.g[i]), "tau_s",
-                                        num(f->p.tau_s[i]), "stderr_g", se_num(f->se_g[i], 1),
-                                        "stderr_tau_s", se_num(f->se_tau_s[i], 1)));
+    for (int i = 0; i < f->p.nbranch; i++) {
+        json_t *e = json_pack("{s:o, s:o}", "g", num(f->p.g[i]), "tau_s", num(f->p.tau_s[i]));
+        set_se(e, "stderr_g", f->se_g[i], 1);
+        set_se(e, "stderr_tau_s", f->se_tau_s[i], 1);
+        json_array_append_new(prony, e);
+    }
     json_object_set_new(o, "rmse", num(f->rmse * u));
-    json_object_set_new(o, "rmse_ramp", f->rmse_ramp >= 0 ? num(f->rmse_ramp * u) : json_null());
-    json_object_set_new(o, "rmse_hold", f->rmse_hold >= 0 ? num(f->rmse_hold * u) : json_null());
+    if (f->rmse_ramp >= 0) /* absent without a point on the ramp */
+        json_object_set_new(o, "rmse_ramp", num(f->rmse_ramp * u));
+    if (f->rmse_hold >= 0) /* absent without a point in the hold */
+        json_object_set_new(o, "rmse_hold", num(f->rmse_hold * u));
     json_object_set_new(o, "points_ramp", json_integer((json_int_t)f->n_ramp));
     json_object_set_new(o, "points_hold", json_integer((json_int_t)f->n_hold));
     json_object_set_new(o, "max_abs_error", num(f->max_abs_error * u));
@@ -92,11 +105,11 @@ static void visco_keys(const cf_visco_report *r, json_t *o)
     json_object_set_new(o, "parameters", json_integer(f->k));
     json_object_set_new(o, "prony", prony);
     json_object_set_new(o, "g_inf", num(g_inf(&f->p)));
-    json_object_set_new(o, "dashpot",
-                        f->dashpot ? json_pack("{s:o, s:o}", "eta_kPa_s",
-                                               num(f->p.eta_MPa_s * 1e3), "stderr_kPa_s",
-                                               se_num(f->se_eta_MPa_s, 1e3))
-                                   : json_null());
+    if (f->dashpot) { /* absent without one */
+        json_t *dp = json_pack("{s:o}", "eta_kPa_s", num(f->p.eta_MPa_s * 1e3));
+        set_se(dp, "stderr_kPa_s", f->se_eta_MPa_s, 1e3);
+        json_object_set_new(o, "dashpot", dp);
+    }
     json_object_set_new(o, "instantaneous_modulus_kPa", num(f->E_inst_MPa * 1e3));
     json_object_set_new(o, "equilibrium_modulus_kPa", num(f->E_eq_MPa * 1e3));
     json_object_set_new(o, "branch_choice", json_string(f->chosen_by_aic ? "aic" : "given"));
@@ -112,8 +125,8 @@ static void visco_keys(const cf_visco_report *r, json_t *o)
     json_object_set_new(o, "rho_at_limit", json_boolean(f->rho_at_limit));
     json_object_set_new(o, "solid_strain_at_stability_limit", json_boolean(f->at_stability_limit));
     json_object_set_new(o, "stress_scale_at_design_limit", json_boolean(f->at_design_limit));
-    json_object_set_new(o, "stable_to_strain",
-                        f->stable_to_strain != 0 ? num(f->stable_to_strain) : json_null());
+    if (f->stable_to_strain != 0) /* absent: stable over the range scanned */
+        json_object_set_new(o, "stable_to_strain", num(f->stable_to_strain));
     json_object_set_new(o, "predictions", predictions_json(r));
     json_object_set_new(o, "evaluations", json_integer((json_int_t)f->evaluations));
     json_object_set_new(o, "wall_time_s", num(r->with_timing ? f->wall_time_s : 0.0));
@@ -124,13 +137,15 @@ static json_t *fit_json(const cf_visco_report *r, int i)
     const cf_fit_result *f = &r->placed[i];
     const cf_visco_fit *v = &r->fit;
     json_t *o = cf_fitfile_spring_json(&f->law);
-    json_t *rest = json_pack(
-        "{s:{s:{s:o, s:o}, s:{s:o, s:o}, s:{s:o, s:o}}, s:b, s:o, s:o}", "identifiable", "rho",
-        "value", num(v->p.rho), "stderr", se_num(v->se_ident[0], 1), "solid_strain", "value",
-        num(v->p.solid_strain), "stderr", se_num(v->se_ident[1], 1), "stress_scale_MPa", "value",
-        num(v->p.stress_scale_MPa), "stderr", se_num(v->se_ident[2], 1), "feasible", f->feasible,
-        "active_constraints", constraints(f->active), "violated_constraints",
-        constraints(f->violated));
+    json_t *id = json_pack("{s:{s:o}, s:{s:o}, s:{s:o}}", "rho", "value", num(v->p.rho),
+                           "solid_strain", "value", num(v->p.solid_strain), "stress_scale_MPa",
+                           "value", num(v->p.stress_scale_MPa));
+    set_se(json_object_get(id, "rho"), "stderr", v->se_ident[0], 1);
+    set_se(json_object_get(id, "solid_strain"), "stderr", v->se_ident[1], 1);
+    set_se(json_object_get(id, "stress_scale_MPa"), "stderr", v->se_ident[2], 1);
+    json_t *rest = json_pack("{s:o, s:b, s:o, s:o}", "identifiable", id, "feasible", f->feasible,
+                             "active_constraints", constraints(f->active), "violated_constraints",
+                             constraints(f->violated));
     if (!o || !rest || json_object_update(o, rest) != 0) {
         json_decref(o);
         json_decref(rest);
