@@ -288,6 +288,9 @@ static double bobyqa(tm_ctx *c, double *z, const double *lb, const double *ub)
     return f;
 }
 
+/* The fit through the lattice: the springs' reach, the starts, the search on the homogenised
+** cell, the placement and the verification in the full lattice, as marked below. Kept as one
+** function (~100 lines) because the stages share the cell's setup and the result. */
 cf_status cf_validate_through_msm(const cf_table *d, const cf_fit_options *opt,
                                   const cf_validate_setup *s, cf_fit_result *res,
                                   cf_validation *v, cf_through_msm *t, cf_error *err)

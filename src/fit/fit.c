@@ -1634,6 +1634,10 @@ cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_sprin
     return CF_OK;
 }
 
+/* The fit of one spring type: stage A (the identifiable quantities), B (placement of a spring),
+** C (polish on the real objective) and the errors, as marked below. Kept as one function (~120
+** lines) because the stages hand the same working point, subsample and result along; A, B and
+** the errors are calls of their own, C's loop over starts keeps the best candidate inline. */
 cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                      cf_fit_result *res, cf_error *err)
 {
