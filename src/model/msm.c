@@ -583,7 +583,8 @@ done:
 
 /* Assembles the tangent K = -dR/dx at the state of the last residual(), solves K dx = R (sparse
 ** Cholesky, else banded LDL^T, dense LU for small systems, GMRES) with symmetric Jacobi scaling
-** (a congruence: the inertia is that of K). */
+** (a congruence: the inertia is that of K). Kept as one function (~85 lines): assembly, scaling,
+** the solver cascade and the acceptance test share the scaled system and its workspaces. */
 static cf_status tangent_solve(solver *s, cf_error *err)
 {
     cf_lattice *lat = s->lat;
@@ -695,7 +696,9 @@ static void restore_positions(solver *s)
 }
 
 /* Newton from the current positions (prescribed DOFs already placed). On failure the positions
-** are put back where they started. */
+** are put back where they started. Kept as one function (~105 lines): the force floor, the choice
+** between a chord step and a fresh tangent, the line search and the retry with a fresh tangent all
+** read and update the same iteration state (residual norms, the factorisation's age). */
 static cf_status newton(solver *s, cf_error *err)
 {
     cf_lattice *lat = s->lat;
