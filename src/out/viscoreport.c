@@ -60,13 +60,15 @@ static json_t *predictions_json(const cf_visco_report *r)
     const cf_visco_predict *p = &r->fit.pred;
     const double u = r->table->y_to_file;
     json_t *h = p->hysteresis_done
-                    ? json_pack("{s:o, s:o, s:o, s:o, s:o}", "strain_amplitude",
-                                num(p->cycle_strain), "period_s", num(p->cycle_period_s),
-                                "loop_area_kPa", num(p->loop_area_MPa * 1e3), "loading_work_kPa",
-                                num(p->loading_work_MPa * 1e3), "dissipated_fraction",
-                                num(p->loading_work_MPa > 0 ? p->loop_area_MPa / p->loading_work_MPa
-                                                             : NAN))
+                    ? json_pack("{s:o, s:o, s:o, s:o}", "strain_amplitude", num(p->cycle_strain),
+                                "period_s", num(p->cycle_period_s), "loop_area_kPa",
+                                num(p->loop_area_MPa * 1e3), "loading_work_kPa",
+                                num(p->loading_work_MPa * 1e3))
                     : json_pack("{s:s}", "skipped", p->note);
+    /* a fraction only of a cycle that did work: absent, never NaN (which the writer refuses) */
+    if (h && p->hysteresis_done && p->loading_work_MPa > 0)
+        json_object_set_new(h, "dissipated_fraction",
+                            num(p->loop_area_MPa / p->loading_work_MPa));
     json_t *c = p->creep_done
                     ? json_pack("{s:o, s:s, s:o, s:o, s:o, s:o, s:o}", "stress",
                                 num(p->creep_stress_MPa * u), "stress_unit", r->table->y_unit, "ramp_s",
