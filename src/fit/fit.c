@@ -329,7 +329,7 @@ static int lm_df(const gsl_vector *th, void *params, gsl_matrix *J)
     return GSL_SUCCESS;
 }
 
-/* Levenberg-Marquardt limits: iterations, and the stagnation rule (see lm_run). */
+/* Levenberg-Marquardt limits: iterations, and the stagnation rule (cf_lsq_lm_stop). */
 #define LM_MAX_ITER 300
 #define LM_STALL 8
 #define LM_STALL_REL 1e-9
@@ -365,30 +365,13 @@ static double lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3
     if (ist == GSL_ENOMEM)
         c->oom = 1;
     if (ist == GSL_SUCCESS) {
-        /* The driver loop, with one more stopping rule: an optimum on a bound of rho or of the
-        ** length scale lies at infinity in the logit coordinates, where the step test never
-        ** fires; stop once the sum of squares has stopped falling (LM_STALL iterations in a row
-        ** that lower it by less than LM_STALL_REL of itself) or reached rounding level. */
+        /* an optimum on a bound of rho or of the length scale lies at infinity in the logit
+        ** coordinates: the stall rule stops there (residuals are scaled by 1/sqrt(ynorm)) */
+        static const cf_lsq_lm_stop stop = {LM_MAX_ITER, 1e-15, 1e-15, 1e-15,
+                                            LM_STALL,    LM_STALL_REL, LM_FLOOR_REL};
+        if (cf_lsq_lm_iterate(w, &stop) != 0)
+            c->oom = 1;
         gsl_vector *f = gsl_multifit_nlinear_residual(w);
-        double prev;
-        gsl_blas_ddot(f, f, &prev);
-        int stall = 0;
-        for (int it = 0; it < LM_MAX_ITER; it++) {
-            int info;
-            int is = gsl_multifit_nlinear_iterate(w);
-            if (is == GSL_ENOMEM)
-                c->oom = 1;
-            if (is != GSL_SUCCESS)
-                break;
-            if (gsl_multifit_nlinear_test(1e-15, 1e-15, 1e-15, &info, w) == GSL_SUCCESS)
-                break;
-            double cur;
-            gsl_blas_ddot(f, f, &cur);
-            stall = (prev - cur <= LM_STALL_REL * prev) ? stall + 1 : 0;
-            prev = cur;
-            if (stall >= LM_STALL || cur <= LM_FLOOR_REL) /* residuals are scaled by 1/sqrt(ynorm) */
-                break;
-        }
         double chi2;
         gsl_blas_ddot(f, f, &chi2);
         if (isfinite(chi2)) {

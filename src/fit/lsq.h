@@ -12,6 +12,8 @@
 #include "conifit/law.h"
 #include "conifit/measure.h"
 
+#include <gsl/gsl_multifit_nlinear.h>
+
 /* Relative residuals divide by max(|y|, CF_LSQ_REL_FLOOR max|y|) so that the point at the origin
 ** (y = 0) keeps a finite weight. */
 #define CF_LSQ_REL_FLOOR 1e-3
@@ -52,5 +54,21 @@ double cf_lsq_xmax(const cf_table *t);
 /* The wire modulus G (MPa) that gives a spring of n coils, smallest coil D1, wire d and travel s
 ** (mm) the solid load F_C (N): F_C = G d^4 s / (8 n D1^3). */
 double cf_lsq_G_of_FC(double F_C_N, double n, double D1_mm, double d_mm, double s_mm);
+
+/* When GSL's Levenberg-Marquardt iterations stop: its own test (xtol, gtol, ftol), the iteration
+** limit, and two more rules. An optimum on a bound of a logit coordinate lies at infinity, where
+** the step test never fires: stop once the sum of squares has fallen by less than stall_rel of
+** itself in `stall` iterations in a row, or once it is below `floor` (rounding level). */
+typedef struct cf_lsq_lm_stop {
+    int max_iter;
+    double xtol, gtol, ftol;
+    int stall;
+    double stall_rel;
+    double floor;
+} cf_lsq_lm_stop;
+
+/* Iterates an initialised workspace until a rule of stop fires or an iteration fails. Returns 0,
+** or -1 when an iteration ran out of memory (the position is then the last good one). */
+int cf_lsq_lm_iterate(gsl_multifit_nlinear_workspace *w, const cf_lsq_lm_stop *stop);
 
 #endif

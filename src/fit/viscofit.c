@@ -15,6 +15,7 @@
 #include <gsl/gsl_vector.h>
 
 #include "conifit/msm.h"
+#include "fit/lsq.h"
 #include "fit/viscolimits.h"
 
 /* Bounds of rho and of the solid strain (the largest strain must stay CF_FIT_TRAVEL_MARGIN
@@ -233,28 +234,6 @@ static int lm_f(const gsl_vector *zv, void *data, gsl_vector *f)
     return GSL_SUCCESS;
 }
 
-/* GSL's iterations on the workspace until convergence, a stall or the iteration limit. */
-static void lm_iterate(gsl_multifit_nlinear_workspace *w)
-{
-    gsl_vector *f = gsl_multifit_nlinear_residual(w);
-    double prev;
-    gsl_blas_ddot(f, f, &prev);
-    int stall = 0;
-    for (int it = 0; it < LM_MAX_ITER; it++) {
-        int info;
-        if (gsl_multifit_nlinear_iterate(w) != GSL_SUCCESS)
-            break;
-        if (gsl_multifit_nlinear_test(1e-14, 1e-14, 0, &info, w) == GSL_SUCCESS)
-            break;
-        double cur;
-        gsl_blas_ddot(f, f, &cur);
-        stall = (prev - cur <= LM_STALL_REL * prev) ? stall + 1 : 0;
-        prev = cur;
-        if (stall >= LM_STALL || cur <= LM_FLOOR_REL)
-            break;
-    }
-}
-
 /* Levenberg-Marquardt from z (in place); returns the scaled sum of squares. */
 static double lm_run(ctx *c, double *z)
 {
@@ -276,9 +255,11 @@ static double lm_run(ctx *c, double *z)
     gsl_vector_view x0 = gsl_vector_view_array(z, c->np);
     double best = HUGE_VAL;
     if (gsl_multifit_nlinear_init(&x0.vector, &fdf, w) == GSL_SUCCESS) {
-        lm_iterate(w);
+        static const cf_lsq_lm_stop stop = {LM_MAX_ITER, 1e-14, 1e-14, 0,
+                                            LM_STALL,    LM_STALL_REL, LM_FLOOR_REL};
         gsl_vector *f = gsl_multifit_nlinear_residual(w);
-        gsl_blas_ddot(f, f, &best);
+        if (cf_lsq_lm_iterate(w, &stop) == 0) /* out of memory: the start is lost */
+            gsl_blas_ddot(f, f, &best);
         memcpy(z, gsl_multifit_nlinear_position(w)->data, c->np * sizeof(double));
         if (!isfinite(best))
             best = HUGE_VAL;
