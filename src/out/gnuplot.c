@@ -277,8 +277,9 @@ static void first_error_line(FILE *f, char *out, size_t cap)
     }
 }
 
-/* Runs gnuplot on the finished script: store it in a temporary file, fork and exec gnuplot (no
-** shell) with its output into the atomic target, wait, read its error stream. Kept as one
+/* Runs gnuplot on the finished script: store it in a temporary file, start gnuplot by
+** posix_spawnp with a fixed argument vector (no shell; the script on its standard input, its
+** output into the atomic target), wait, read its error stream. Kept as one
 ** function (~85 lines) because every step owns a resource that each later failure must release. */
 cf_status cf_gp_render(cf_gp *g, const char *path, const char *const *inputs, cf_atomic *out,
                        cf_error *err)
@@ -311,15 +312,20 @@ cf_status cf_gp_render(cf_gp *g, const char *path, const char *const *inputs, cf
     if (!prog || !*prog)
         prog = "gnuplot";
     posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_adddup2(&fa, fileno(script), 0);
-    posix_spawn_file_actions_adddup2(&fa, fileno(out->fp), 1);
-    posix_spawn_file_actions_adddup2(&fa, fileno(errors), 2);
     char *argv[] = {(char *)prog, NULL};
     pid_t pid;
     fflush(out->fp);
-    int rc = posix_spawnp(&pid, prog, &fa, NULL, argv, environ);
-    posix_spawn_file_actions_destroy(&fa);
+    int rc = posix_spawn_file_actions_init(&fa);
+    if (rc == 0) {
+        rc = posix_spawn_file_actions_adddup2(&fa, fileno(script), 0);
+        if (rc == 0)
+            rc = posix_spawn_file_actions_adddup2(&fa, fileno(out->fp), 1);
+        if (rc == 0)
+            rc = posix_spawn_file_actions_adddup2(&fa, fileno(errors), 2);
+        if (rc == 0)
+            rc = posix_spawnp(&pid, prog, &fa, NULL, argv, environ);
+        posix_spawn_file_actions_destroy(&fa);
+    }
     fclose(script);
     if (rc != 0) {
         fclose(errors);
