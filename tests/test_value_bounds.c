@@ -139,8 +139,8 @@ static void scene(const char *path, const char *lattice, const char *extra)
 }
 
 /* Scene keys at their bounds are solved (a diagonal weight of 1e4 to 1e6, a thousand implicit
-** substeps of a dashpot lattice: both ended with exit 70 at the first steps, their force rounding
-** above the Newton floor); beyond them, or where the solver cannot meet them, refused up front with
+** substeps of a dashpot lattice, a step of 1e-4 s in a long row of cells: each ended with exit 70,
+** its force rounding above the Newton floor); beyond them, or where the solver cannot meet them, refused up front with
 ** the key (exit 65). */
 static void scene_values_are_solved_or_refused_with_their_key(void **state)
 {
@@ -167,6 +167,21 @@ static void scene_values_are_solved_or_refused_with_their_key(void **state)
     int st = tu_run(out, sizeof out, errb, sizeof errb, "simulate %s -o %s -q", sc, csv);
     if (st != 0)
         fail_msg("1000 substeps: exit %d: %s", st, errb);
+    /* dt_s = 1e-4 s in a row of 1000 cells, through a held strain: the dashpots' forces
+    ** kx (L - Lprev) are rounded to kx times the ulp of coordinates up to 1e4 mm, not of the 10 mm
+    ** springs, and the Newton floor taken from kx L left the hold's first step stalled at 1.9 times
+    ** it ("equilibrium not found", exit 70, after halving the step down to nothing) */
+    FILE *f = fopen(sc, "w");
+    assert_non_null(f);
+    fprintf(f, "{\"spring\": {\"params\": {\"D1_mm\": 6, \"D2_mm\": 15, \"n\": 2.5, \"d_mm\": 2, "
+               "\"G_MPa\": 26, \"H_mm\": 10}},\n \"lattice\": {\"nx\": 1000, \"ny\": 1, \"nz\": 1},\n"
+               " \"protocol\": {\"kind\": \"hold\", \"to_strain\": 0.3, \"ramp_s\": 5e-4, "
+               "\"hold_s\": 2e-4},\n \"effects\": {\"damping\": {\"eta_kPa_s\": 5}},"
+               " \"integrator\": {\"dt_s\": 1e-4}, \"samples_per_segment\": 5}\n");
+    fclose(f);
+    st = tu_run(out, sizeof out, errb, sizeof errb, "simulate %s -o %s -q", sc, csv);
+    if (st != 0)
+        fail_msg("dt_s 1e-4 in a row of 1000 cells: exit %d: %s", st, errb);
     /* a million: beyond the step budget, refused before anything runs */
     scene(sc, "", ",\n \"effects\": {\"damping\": {\"eta_kPa_s\": 5}},"
                   " \"integrator\": {\"substeps\": 1000000}");

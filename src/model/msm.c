@@ -720,10 +720,17 @@ static cf_status newton(solver *s, cf_error *err)
     for (size_t q = 0; q < lat->ns; q++)
         wmax = fmax(wmax, lat->w[q]);
     /* ... and, in an implicit step with dashpots or Maxwell branches, above the rounding of their
-    ** forces kx (L - Lprev), kx L being the scale of its terms (kx grows as 1/dt: 1000 substeps of
-    ** a 1 s ramp left 1.9e-8 N of it) */
-    for (size_t q = 0; s->extras && s->kx && q < lat->ns; q++)
-        dash = fmax(dash, s->kx[q] * lat->L_mm[q]);
+    ** forces kx (L - Lprev) (kx grows as 1/dt: 1000 substeps of a 1 s ramp left 1.9e-8 N of it).
+    ** A length is known only to the rounding of the coordinates it is formed from, eps times the
+    ** largest |coordinate| of the lattice, not of the length: so the scale of those terms is kx
+    ** times that coordinate (a row of 1000 cells stalled at 1.9 times a floor taken from kx L). */
+    if (s->extras && s->kx) {
+        double xmax = 0;
+        for (size_t p = 0; p < lat->nn; p++)
+            xmax = fmax(xmax, fmax(fabs(lat->x[p]), fmax(fabs(lat->y[p]), fabs(lat->z[p]))));
+        for (size_t q = 0; q < lat->ns; q++)
+            dash = fmax(dash, s->kx[q] * fmax(lat->L_mm[q], xmax));
+    }
     const double floor_f = 1e-12 * lat->law->F_C_N * wmax + 1e-13 * dash;
     cf_status st = CF_E_NOCONV;
     for (int it = 0; it <= s->cfg->newton_max_iter; it++) {
