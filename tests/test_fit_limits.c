@@ -19,6 +19,8 @@
 
 static char out[1 << 16], errb[1 << 14];
 
+static json_t *fit_json(const char *args);
+
 /* A noiseless stress-strain table of spring p, strains 0 .. frac * solid strain. */
 static void table_of(const cf_spring *p, double frac, size_t n, double *x, double *y)
 {
@@ -77,6 +79,83 @@ static void absurd_spring_is_fitted_inside_the_limits_with_profile_intervals(voi
         assert_true(r.interval_ok[0]);
     }
     cf_table_free(&d);
+}
+
+/* A precise table whose spring sits on rho_min (rho = 0.05, noise 1e-6 of the peak): every
+** quantity's profile interval has width and holds its value, rho's lower end is the limit and says
+** so. The profiles kept the searches' 1e-4 margin inside the limits, which the polish had used up,
+** and stopped their ends at 1e-4 in log units: every interval was [value, value]. On every row and
+** on a subsample (the long-table path) alike, and in the fit file and the report. */
+static void intervals_at_rho_min_have_width_and_name_the_limit(void **state)
+{
+    (void)state;
+    cf_spring truth = {2, 40, 4, 0.2, 80000, 40}; /* rho = 0.05 exactly, telescoping */
+    enum { N = 100 };
+    double x[N], y[N], ymax = 0;
+    table_of(&truth, 0.95, N, x, y);
+    for (size_t i = 0; i < N; i++)
+        ymax = fmax(ymax, fabs(y[i]));
+    for (size_t i = 1; i < N; i++) /* deterministic, zero-mean, 1e-6 of the peak */
+        y[i] += 1e-6 * ymax * sin(12.9898 * (double)i) * 1.7;
+    cf_table d;
+    cf_error terr = {0};
+    assert_int_equal(cf_table_from_arrays(CF_TABLE_STRESS_STRAIN, N, x, y, NULL, &d, &terr), CF_OK);
+    for (int pass = 0; pass < 2; pass++) {
+        cf_fit_options o = cf_fit_default_options();
+        if (pass == 1)
+            o.subsample_above = N / 2; /* profiles on the subsample, polish on every row */
+        cf_fit_result r;
+        cf_error err = {0};
+        assert_int_equal(cf_fit_run(&d, &o, CF_TELESCOPING, &r, &err), CF_OK);
+        assert_true(r.held & CF_C_RHO_MIN);
+        for (int k = 0; k < 3; k++) {
+            assert_true(r.interval_ok[k]);
+            const double lo = r.interval[k][0], hi = r.interval[k][1], v = r.ident[k];
+            if (!(lo <= v && v <= hi && hi - lo > 1e-7 * v))
+                fail_msg("pass %d, quantity %d: %.17g [%.17g, %.17g]", pass, k, v, lo, hi);
+            if (k > 0 && !(lo < v && v < hi))
+                fail_msg("pass %d, quantity %d: an end at the value: %.17g [%.17g, %.17g]", pass,
+                         k, v, lo, hi);
+        }
+        assert_int_equal(r.interval_end[0][0], CF_C_RHO_MIN);
+        assert_true(r.interval[0][0] <= o.rho_min && r.interval[0][1] > r.ident[0]);
+        assert_int_equal(r.interval_end[0][1], 0);
+    }
+    cf_table_free(&d);
+    /* through the program: the key that names the limit, and a report that shows the width */
+    char dir[] = "/tmp/conifit-limits-XXXXXX", csv[300];
+    assert_non_null(mkdtemp(dir));
+    snprintf(csv, sizeof csv, "%s/t.csv", dir);
+    FILE *f = fopen(csv, "w");
+    assert_non_null(f);
+    fprintf(f, "strain,stress_MPa\n");
+    for (size_t i = 0; i < N; i++)
+        fprintf(f, "%.17g,%.17g\n", x[i], y[i]);
+    fclose(f);
+    char args[400];
+    snprintf(args, sizeof args, "%s --type telescoping", csv);
+    json_t *root = fit_json(args);
+    json_t *rho = json_object_get(
+        json_object_get(json_array_get(json_object_get(root, "fits"), 0), "identifiable"), "rho");
+    json_t *lim = json_object_get(rho, "interval_limit");
+    assert_non_null(lim);
+    assert_string_equal(json_string_value(json_object_get(lim, "lower")), "rho_min");
+    assert_null(json_object_get(lim, "upper"));
+    assert_null(json_object_get(json_object_get(
+                                    json_object_get(json_array_get(json_object_get(root, "fits"), 0),
+                                                    "identifiable"),
+                                    "solid_strain"),
+                                "interval_limit"));
+    json_decref(root);
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb, "fit %s", args), 0);
+    const char *row = strstr(out, "solid strain s/H");
+    assert_non_null(row);
+    double v, lo, hi;
+    if (sscanf(row + strlen("solid strain s/H"), " %lf [%lf, %lf]", &v, &lo, &hi) != 3 ||
+        !(lo < v && v < hi))
+        fail_msg("the report's interval does not show its width: %.80s", row);
+    remove(csv);
+    rmdir(dir);
 }
 
 /* Wherever no limit binds, both types report the same identifiable quantities (one law). */
@@ -330,6 +409,7 @@ int main(void)
     gsl_set_error_handler_off();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(absurd_spring_is_fitted_inside_the_limits_with_profile_intervals),
+        cmocka_unit_test(intervals_at_rho_min_have_width_and_name_the_limit),
         cmocka_unit_test(both_types_agree_where_no_limit_binds),
         cmocka_unit_test(verdict_names_a_winner_only_beyond_the_noise),
         cmocka_unit_test(tie_and_winner_through_the_program),

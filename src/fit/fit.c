@@ -196,6 +196,8 @@ typedef struct fit_ctx {
     int travel_ok;  /* 0 when no spring can reach xmax (strain >= 1) */
     int region;     /* 1: the type's placeable set of (rho, B, A) is known in closed form
                     ** (stress-strain table, no fixed parameter; see region_at) */
+    double inside;  /* how far inside those limits (log units) a sub-problem's points keep:
+                    ** REGION_SAFETY for the searches, less for the profiles (uncertainty) */
     /* stage A bounds on (rho, length scale) */
     double rho_lo, rho_hi, b_lo, b_hi;
     long evals;
@@ -941,7 +943,7 @@ static region region_at(const fit_ctx *c, double rho, double B)
         r.margin = log(n_lo) - log(nmax);
         r.A_max = Gmax * B * (1 - B) / (8 * cmin * cmin * cmin * n_lo * n_lo);
     }
-    r.A_max *= 1 - REGION_SAFETY;
+    r.A_max *= 1 - c->inside;
     double m_rho = log(o->rho_min * (1 - RHO_MIN_TOL)) - log(rho);
     if (m_rho > r.margin) {
         r.margin = m_rho;
@@ -961,6 +963,7 @@ double cf_fit_ident_limit(const cf_fit_options *opt, cf_spring_type type, double
     c.opt = opt;
     c.type = type;
     c.region = 1;
+    c.inside = REGION_SAFETY;
     for (int k = 0; k < CF_P_COUNT; k++)
         c.region &= !opt->fixed[k];
     region r = region_at(&c, rho, B);
@@ -1066,7 +1069,7 @@ static double sub_g0(const sub *q, const double *x)
     double rho, B;
     sub_point(q, x, &rho, &B);
     region r = region_at(q->c, rho, B);
-    double g = r.margin + REGION_SAFETY;
+    double g = r.margin + q->c->inside;
     if (q->fixed == 2 && isfinite(r.A_max))
         g = fmax(g, log(q->t) - log(r.A_max));
     return g;
@@ -1354,7 +1357,14 @@ static void profile_end(fit_ctx *c, int k, const double v[3], double limit, int 
         }
     }
     if (done == 2) {
-        for (int it = 0; it < 30 && fabs(u_out - u_in) > 1e-4 * fmax(1.0, fabs(u_in)); it++) {
+        /* to 1e-4 in log units (times |log v|) or 1 % of the end's distance from the value,
+        ** whichever is finer: the first alone returned the value itself for every interval
+        ** narrower than that (a precise table, a long one, collapsed to [value, value]) */
+        const double u0 = log(v[k]);
+        for (int it = 0; it < 60 && fabs(u_out - u_in) > fmax(fmin(1e-4 * fmax(1.0, fabs(u_in)),
+                                                                   1e-2 * fabs(u_out - u0)),
+                                                              1e-15);
+             it++) {
             double u = 0.5 * (u_in + u_out);
             double f = profile_at(c, &q, u, limit, xin);
             if (f <= limit) {
@@ -1371,7 +1381,8 @@ static void profile_end(fit_ctx *c, int k, const double v[3], double limit, int 
             end_bit = k == 2 ? CF_C_G_MAX : r.lo_bit | r.hi_bit;
         }
     }
-    res->interval[k][dir < 0 ? 0 : 1] = exp(u_in);
+    /* exp(log(v)) may differ from v in the last bit: the interval always holds the value */
+    res->interval[k][dir < 0 ? 0 : 1] = dir < 0 ? fmin(exp(u_in), v[k]) : fmax(exp(u_in), v[k]);
     res->interval_end[k][dir < 0 ? 0 : 1] = end_bit;
 }
 
@@ -1392,19 +1403,27 @@ static void uncertainty(fit_ctx *c, fit_ctx *g, cf_fit_result *res, unsigned hel
                v[k] + 1.96 * res->ident_se[k] > hi[k];
     if (!need || c->n <= 3)
         return;
+    /* The profiles run up to the limits themselves: the searches' REGION_SAFETY is for the
+    ** placement, and a polish that ends on a limit (rho on rho_min, A on G_max) uses it up, which
+    ** left no admissible point near the fit and every interval at [value, value]. A reported
+    ** point past a limit by rounding is admitted; one past it by more stays outside. */
     region r = region_at(c, v[0], v[1]);
+    const double room = fmin(-r.margin, log(r.A_max / (1 - REGION_SAFETY)) - log(v[2]));
+    g->inside = fmax(fmin(0.0, room), -1e-9);
+    r = region_at(g, v[0], v[1]);
     double A;
     double rss0 = g == c ? fmin(res->objective, rss_at(c, v[0], v[1], -1, r.A_max, &A))
                          : rss_at(g, v[0], v[1], -1, r.A_max, &A);
     double limit = rss0 + rss_threshold(c, rss0);
     for (int k = 0; k < 3; k++) {
         double h = res->ident_se[k] > 0 ? fmin(0.5 * res->ident_se[k] / v[k], 0.1) : 0.01;
-        h = fmax(h, 1e-4);
+        h = fmax(h, 1e-13);
         profile_end(g, k, v, limit, -1, h, res);
         profile_end(g, k, v, limit, +1, h, res);
         res->interval_ok[k] = 1;
         res->interval_why[k] = why;
     }
+    g->inside = REGION_SAFETY;
 }
 
 /* ---- the driver ------------------------------------------------------------------------------ */
@@ -1506,6 +1525,7 @@ static cf_status ctx_setup(fit_ctx *c, const cf_table *data, const cf_fit_option
     c->data = data;
     c->opt = opt;
     c->type = type;
+    c->inside = REGION_SAFETY;
     c->fd = cf_table_is_force(data);
     c->n = data->count;
     /* one block: the residual weights, then the model's values at the points (summarise, and

@@ -126,6 +126,18 @@ static json_t *ident_json(const cf_fit_result *f, int k)
         json_object_set_new(o, "interval",
                             json_pack("[o, o]", num(f->interval[k][0]), num(f->interval[k][1])));
         json_object_set_new(o, "interval_reason", json_string(why));
+        /* an end that is a limit, not the data's: the interval is one-sided there */
+        json_t *lim = json_object();
+        for (int e = 0; e < 2; e++) {
+            unsigned b = f->interval_end[k][e];
+            if (b && lim)
+                json_object_set_new(lim, e ? "upper" : "lower",
+                                    json_string(cf_fit_constraint_name(b & (0u - b))));
+        }
+        if (lim && json_object_size(lim) > 0)
+            json_object_set_new(o, "interval_limit", lim);
+        else
+            json_decref(lim);
     }
     return o;
 }
@@ -510,6 +522,21 @@ static void row(FILE *o, const cf_fit_report *r, const char *label, const char *
     fputc('\n', o);
 }
 
+/* Significant digits that tell the ends of the interval [lo, hi] from the value v: 3, or more
+** when an end lies closer to v than 3 digits show (a precise or long table), at most 17. */
+static int interval_digits(double v, double lo, double hi)
+{
+    double w = INFINITY;
+    if (v - lo > 0)
+        w = v - lo;
+    if (hi - v > 0)
+        w = fmin(w, hi - v);
+    if (!(v != 0) || !isfinite(w))
+        return 3;
+    double d = floor(log10(fabs(v))) - floor(log10(w)) + 1;
+    return (int)fmin(17, fmax(3, d));
+}
+
 /* value ± standard error, or value [low, high] (the profile interval, marked *) */
 static void ident_row(FILE *o, const cf_fit_report *r, const char *label, int k, double scale,
                       const char *unit)
@@ -519,9 +546,13 @@ static void ident_row(FILE *o, const cf_fit_report *r, const char *label, int k,
         char cell[96];
         const cf_fit_result *f = &r->fits[i];
         const char *sp = *unit ? " " : "";
-        if (f->interval_ok[k])
-            snprintf(cell, sizeof cell, "%.4g [%.3g, %.3g]*%s%s", f->ident[k] * scale,
-                     f->interval[k][0] * scale, f->interval[k][1] * scale, sp, unit);
+        if (f->interval_ok[k]) {
+            const double v = f->ident[k] * scale, lo = f->interval[k][0] * scale,
+                         hi = f->interval[k][1] * scale;
+            const int dg = interval_digits(v, lo, hi);
+            snprintf(cell, sizeof cell, "%.*g [%.*g, %.*g]*%s%s", dg > 4 ? dg : 4, v, dg, lo, dg,
+                     hi, sp, unit);
+        }
         else if (f->ident_se[k] >= 0)
             snprintf(cell, sizeof cell, "%.6g ± %.2g%s%s", f->ident[k] * scale,
                      f->ident_se[k] * scale, sp, unit);
