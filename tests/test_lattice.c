@@ -603,6 +603,69 @@ static void fused_step_matches_independent_forces(void **state)
     cf_law_free(&law);
 }
 
+/* The stencil step (lattice_step.h) gives the forces of the edge-list kernel cf_lattice_forces to
+** rounding: jittered lattices in tension and compression (regions 1 and 2), non-cubic and 1 x 1 x 1,
+** every family weight including families of weight 0, with the closed form, the table and the
+** scalar law; the largest compression is the same; bottom-face and pinned DOFs change nothing in
+** the forces (they act in the node update only). */
+static void stencil_step_equals_edge_list_kernel(void **state)
+{
+    (void)state;
+    cf_law law = make_law();
+    cf_error err = {0};
+    assert_int_equal(cf_law_table_build(&law, 1024, &err), CF_OK);
+    static const int dims[][3] = {{1, 1, 1}, {4, 3, 5}, {2, 6, 1}, {7, 1, 3}, {1, 2, 2}};
+    static const double weights[][CF_FAMILY_COUNT] = {
+        {1, 1, 1}, {0.7, 0, 0}, {0, 1.3, 0}, {0, 0, 0.6}, {0.5, 0, 2}, {0, 0.25, 1}, {2, 0.4, 0}};
+    const cf_law_method methods[3] = {CF_LAW_CLOSED, CF_LAW_TABLE, CF_LAW_EXACT};
+    int compared = 0;
+    for (size_t di = 0; di < sizeof dims / sizeof dims[0]; di++)
+        for (size_t wi = 0; wi < sizeof weights / sizeof weights[0]; wi++)
+            for (int mi = 0; mi < 3; mi++) {
+                cf_lattice_config c = cf_lattice_default();
+                c.nx = dims[di][0], c.ny = dims[di][1], c.nz = dims[di][2];
+                memcpy(c.weight, weights[wi], sizeof c.weight);
+                c.calibration = CF_CAL_CUSTOM;
+                c.bottom = (di & 1) ? CF_BOTTOM_CLAMPED : CF_BOTTOM_AXIAL;
+                cf_lattice lat;
+                assert_int_equal(cf_lattice_create(&lat, &law, methods[mi], &c, &err), CF_OK);
+                srand((unsigned)(100 * di + 10 * wi + mi));
+                const double squeeze = (wi & 1) ? 1.15 : 0.72; /* tension or compression */
+                for (size_t p = 0; p < lat.nn; p++) {
+                    lat.x[p] += 1.2 * (rand() / (double)RAND_MAX - 0.5);
+                    lat.y[p] += 1.2 * (rand() / (double)RAND_MAX - 0.5);
+                    lat.z[p] = squeeze * lat.Z[p] + 1.2 * (rand() / (double)RAND_MAX - 0.5);
+                }
+                lat.with_stiffness = 0;
+                const double um_edges = cf_lattice_forces(&lat);
+                double *g = malloc(3 * lat.nn * sizeof(double));
+                assert_non_null(g);
+                double scale = 0;
+                for (size_t p = 0; p < lat.nn; p++) {
+                    g[3 * p] = lat.fx[p], g[3 * p + 1] = lat.fy[p], g[3 * p + 2] = lat.fz[p];
+                    scale = fmax(scale, fmax(fabs(lat.fx[p]), fmax(fabs(lat.fy[p]), fabs(lat.fz[p]))));
+                }
+                assert_true(scale > 0);
+                cf_lattice_stepper st;
+                assert_int_equal(cf_lattice_stepper_init(&st, &lat, NULL, &err), CF_OK);
+                memset(lat.fx, 0, lat.nn * sizeof(double));
+                memset(lat.fy, 0, lat.nn * sizeof(double));
+                memset(lat.fz, 0, lat.nn * sizeof(double));
+                assert_close(cf_lattice_stepper_forces(&st), um_edges, 1e-15);
+                for (size_t p = 0; p < lat.nn; p++) {
+                    assert_close(lat.fx[p], g[3 * p], 1e-12 * scale);
+                    assert_close(lat.fy[p], g[3 * p + 1], 1e-12 * scale);
+                    assert_close(lat.fz[p], g[3 * p + 2], 1e-12 * scale);
+                }
+                compared++;
+                free(g);
+                cf_lattice_stepper_free(&st);
+                cf_lattice_free(&lat);
+            }
+    assert_int_equal(compared, 5 * 7 * 3);
+    cf_law_free(&law);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -612,6 +675,7 @@ int main(void)
         cmocka_unit_test(dashpots_scale_with_the_family_weights),
         cmocka_unit_test(every_spring_applies_equal_and_opposite_forces),
         cmocka_unit_test(fused_step_matches_independent_forces),
+        cmocka_unit_test(stencil_step_equals_edge_list_kernel),
         cmocka_unit_test(lattice_masses_and_top_shares_add_up),
         cmocka_unit_test(static_solve_and_long_damped_dynamic_run_agree),
         cmocka_unit_test(stability_limit_is_confirmed_by_a_slow_damped_dynamic_run),

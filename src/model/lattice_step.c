@@ -1,10 +1,10 @@
 /*
-** The fused explicit step of the lattice (see lattice_step.h).
+** The explicit step of the lattice as a stencil over its regular grid (see lattice_step.h).
 **
-** Multiply-adds are contracted here (fused multiply-add in the clones whose processors have it:
-** about 10 % off the closed-form step), so the step's last bits depend on the clone the
-** processor runs; on one machine they are always the same. The law's batch evaluation
-** (law_simd.c) keeps separate roundings: its bits are those of every clone.
+** Multiply-adds are contracted here (fused multiply-add in the clones whose processors have it),
+** so the step's last bits depend on the clone the processor runs; on one machine they are always
+** the same. The law's batch evaluation (law_simd.c) keeps separate roundings: its bits are those
+** of every clone.
 */
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC optimize("fp-contract=fast")
@@ -14,6 +14,16 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* Share of the cells holding a segment along one axis from node index p with offset o on an axis
+** of n cells, as lattice.c counts it (a cell's edge is shared by up to 4 cells, a face by 2): 1
+** across the axis, along it 1/2 on the boundary and 1 inside; 0 when the far end is outside. */
+static double axis_share(int p, int o, int n)
+{
+    if (o != 0)
+        return p + o >= 0 && p + o <= n ? 1.0 : 0.0;
+    return p == 0 || p == n ? 0.5 : 1.0;
+}
 
 cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const long *eq,
                                   cf_error *err)
@@ -27,24 +37,34 @@ cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const
         st->form = CF_LANE_TABLE;
     else
         st->form = -1;
-    const size_t layer = (size_t)(lat->cfg.nx + 1) * (size_t)(lat->cfg.ny + 1);
-    const size_t nlayers = (size_t)lat->cfg.nz + 1;
-    st->slab = malloc((nlayers + 1) * sizeof *st->slab);
+    const cf_lattice_config *cfg = &lat->cfg;
+    const int nx = cfg->nx, ny = cfg->ny, nz = cfg->nz;
+    st->layer = (size_t)(nx + 1) * (size_t)(ny + 1);
+    st->nslab = (size_t)nz + 1;
     for (int a = 0; a < 3; a++)
         st->inv_mass[a] = malloc((lat->nn ? lat->nn : 1) * sizeof(double));
-    if (!st->slab || !st->inv_mass[0] || !st->inv_mass[1] || !st->inv_mass[2]) {
-        cf_lattice_stepper_free(st);
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the explicit step");
+    if (!st->inv_mass[0] || !st->inv_mass[1] || !st->inv_mass[2])
+        goto oom;
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        int off[3], fam;
+        cf_cell_direction(d, off, &fam);
+        if (cfg->weight[fam] == 0)
+            continue; /* a family of weight 0 has no springs (lattice.c) */
+        cf_step_dir *sd = &st->dir[st->ndir++];
+        sd->di = off[0], sd->dj = off[1], sd->dk = off[2];
+        sd->D = (size_t)((long)off[0] + (long)(nx + 1) * ((long)off[1] + (long)(ny + 1) * off[2]));
+        const int nzc = (off[0] != 0) + (off[1] != 0) + (off[2] != 0);
+        sd->L0 = lat->H_mm * sqrt((double)nzc); /* as lattice.c forms them */
+        sd->a = lat->H_mm / sd->L0;
+        sd->wk[0] = 1.0;
+        sd->wk[1] = off[2] != 0 ? 1.0 : 0.5;
+        if (!(sd->wl = malloc(st->layer * sizeof(double))))
+            goto oom;
+        for (int j = 0; j <= ny; j++)
+            for (int i = 0; i <= nx; i++)
+                sd->wl[(size_t)i + (size_t)(nx + 1) * (size_t)j] =
+                    cfg->weight[fam] * axis_share(i, off[0], nx) * axis_share(j, off[1], ny);
     }
-    /* slab k: the springs whose first node lies in layer k (springs are sorted by first node) */
-    size_t q = 0;
-    for (size_t k = 0; k < nlayers; k++) {
-        st->slab[k] = q;
-        while (q < lat->ns && lat->si[q] / layer == k)
-            q++;
-    }
-    st->slab[nlayers] = lat->ns;
-    st->nslab = nlayers;
     for (size_t p = 0; p < lat->nn; p++)
         for (int a = 0; a < 3; a++) {
             int prescribed = eq ? eq[3 * p + a] < 0 : (lat->fix[p] >> a) & 1;
@@ -52,76 +72,103 @@ cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const
         }
     st->threads = lat->ns >= CF_STEP_THREADS_MIN;
     return CF_OK;
+oom:
+    cf_lattice_stepper_free(st);
+    return cf_error_set(err, CF_E_INTERNAL, "out of memory for the explicit step");
 }
 
 void cf_lattice_stepper_free(cf_lattice_stepper *st)
 {
     if (!st)
         return;
-    free(st->slab);
+    for (int d = 0; d < CF_CELL_DIRS; d++)
+        free(st->dir[d].wl);
     for (int a = 0; a < 3; a++)
         free(st->inv_mass[a]);
     memset(st, 0, sizeof *st);
 }
 
-/* Springs [q0, q1) in blocks: gather and geometry, the law, tensions (each a vectorised loop over
-** the block, so no lane's work hides behind a branch), then the scatter. form is a constant in every
-** call site, so each copy is specialised. */
+/* The springs of direction sd from the first nodes [p0, p0 + n) of one layer (n <= CF_STEP_BLOCK;
+** W: their weights): geometry, the law, tensions added at p and subtracted at p + D, each a
+** vectorised loop over contiguous nodes. form is a constant in every call site, so each copy is
+** specialised. Returns the largest |u| of the real springs. */
 static inline __attribute__((always_inline)) double
-springs_range(const cf_lattice *lat, const cf_law_lanes *lanes, int form, size_t q0, size_t q1)
+run_dir(const cf_lattice *lat, const cf_law_lanes *c, int form, const cf_step_dir *sd, double wk,
+        size_t p0, size_t n, const double *restrict W)
 {
-    const uint32_t *restrict si = lat->si, *restrict sj = lat->sj;
-    const double *restrict x = lat->x, *restrict y = lat->y, *restrict z = lat->z;
-    const double *restrict L0 = lat->L0_mm, *restrict A = lat->a, *restrict W = lat->w;
-    double *restrict fx = lat->fx, *restrict fy = lat->fy, *restrict fz = lat->fz;
-    const cf_law_lanes c = *lanes;
+    const size_t D = sd->D;
+    const double L0 = sd->L0, A = sd->a;
+    const double *restrict xa = lat->x + p0, *restrict ya = lat->y + p0, *restrict za = lat->z + p0;
+    const double *restrict xb = xa + D, *restrict yb = ya + D, *restrict zb = za + D;
     double dx[CF_STEP_BLOCK], dy[CF_STEP_BLOCK], dz[CF_STEP_BLOCK], L[CF_STEP_BLOCK],
         u[CF_STEP_BLOCK], F[CF_STEP_BLOCK];
     double umax = 0;
-    for (size_t b = q0; b < q1; b += CF_STEP_BLOCK) {
-        const size_t m = q1 - b < CF_STEP_BLOCK ? q1 - b : CF_STEP_BLOCK;
-        const uint32_t *restrict bi = si + b, *restrict bj = sj + b;
-        const double *restrict bL0 = L0 + b, *restrict bA = A + b, *restrict bW = W + b;
-#pragma omp simd
-        for (size_t k = 0; k < m; k++) {
-            const double ex = x[bj[k]] - x[bi[k]], ey = y[bj[k]] - y[bi[k]],
-                         ez = z[bj[k]] - z[bi[k]];
-            dx[k] = ex, dy[k] = ey, dz[k] = ez;
-            const double d2 = ex * ex + ey * ey + ez * ez;
-            L[k] = sqrt(d2);
-            u[k] = (bL0[k] - L[k]) * bA[k];
-        }
 #pragma omp simd reduction(max : umax)
-        for (size_t k = 0; k < m; k++) {
-            const double au = fabs(u[k]);
-            umax = au > umax ? au : umax;
-        }
-        if (form == CF_LANE_TABLE)
-            cf_lanes_table(&c, m, u, F);
-        else if (form == CF_LANE_CLOSED)
-            cf_lanes_closed(&c, m, u, F);
-        else /* the scalar law */
-            cf_law_force_many(lat->law, lat->method, m, u, F, NULL);
+    for (size_t k = 0; k < n; k++) {
+        const double ex = xb[k] - xa[k], ey = yb[k] - ya[k], ez = zb[k] - za[k];
+        dx[k] = ex, dy[k] = ey, dz[k] = ez;
+        const double l = sqrt(ex * ex + ey * ey + ez * ez);
+        L[k] = l;
+        const double uk = (L0 - l) * A;
+        u[k] = uk;
+        const double au = W[k] != 0.0 ? fabs(uk) : 0.0; /* a wrapped pair is no spring */
+        umax = au > umax ? au : umax;
+    }
+    if (form == CF_LANE_TABLE)
+        cf_lanes_table(c, n, u, F);
+    else if (form == CF_LANE_CLOSED)
+        cf_lanes_closed(c, n, u, F);
+    else /* the scalar law */
+        cf_law_force_many(lat->law, lat->method, n, u, F, NULL);
+    /* the forces at p, then at p + D: two loops, since the runs overlap when D < n (each pointer
+    ** is restrict in its own loop only) */
+    {
+        double *restrict fx = lat->fx + p0, *restrict fy = lat->fy + p0, *restrict fz = lat->fz + p0;
 #pragma omp simd
-        for (size_t k = 0; k < m; k++) {
-            const double gk = -bW[k] * F[k] / L[k];
-            dx[k] *= gk, dy[k] *= gk, dz[k] *= gk;
+        for (size_t k = 0; k < n; k++) {
+            const double gk = W[k] != 0.0 ? -(wk * W[k]) * F[k] / L[k] : 0.0;
+            const double tx = dx[k] * gk, ty = dy[k] * gk, tz = dz[k] * gk;
+            dx[k] = tx, dy[k] = ty, dz[k] = tz;
+            fx[k] += tx, fy[k] += ty, fz[k] += tz;
         }
-        /* the scatter: a node's run of springs (they are sorted by first node) is summed in
-        ** registers and stored once, not read back from the store it just made */
-        uint32_t ci = bi[0];
-        double ax = 0, ay = 0, az = 0;
-        for (size_t k = 0; k < m; k++) {
-            const uint32_t i = bi[k], j = bj[k];
-            if (i != ci) {
-                fx[ci] += ax, fy[ci] += ay, fz[ci] += az;
-                ax = ay = az = 0;
-                ci = i;
-            }
-            ax += dx[k], ay += dy[k], az += dz[k];
-            fx[j] -= dx[k], fy[j] -= dy[k], fz[j] -= dz[k];
+    }
+    {
+        double *restrict fx = lat->fx + p0 + D, *restrict fy = lat->fy + p0 + D,
+                         *restrict fz = lat->fz + p0 + D;
+#pragma omp simd
+        for (size_t k = 0; k < n; k++)
+            fx[k] -= dx[k], fy[k] -= dy[k], fz[k] -= dz[k];
+    }
+    return umax;
+}
+
+/* Every spring whose first node lies in layer k, in chunks of CF_STEP_BLOCK nodes; per chunk every
+** direction, so the chunk's nodes stay in cache across the directions. */
+static inline __attribute__((always_inline)) double
+layer_springs(const cf_lattice_stepper *st, int form, size_t k)
+{
+    const cf_lattice *lat = st->lat;
+    const cf_law_lanes c = st->lanes;
+    const int nx = lat->cfg.nx, ny = lat->cfg.ny, nz = lat->cfg.nz;
+    const size_t row = (size_t)nx + 1, base = k * st->layer;
+    const int edge = k == 0 || k == (size_t)nz;
+    double umax = 0;
+    for (size_t c0 = 0; c0 < st->layer; c0 += CF_STEP_BLOCK) {
+        const size_t c1 = st->layer - c0 < CF_STEP_BLOCK ? st->layer : c0 + CF_STEP_BLOCK;
+        for (int d = 0; d < st->ndir; d++) {
+            const cf_step_dir *sd = &st->dir[d];
+            if (sd->dk > 0 && k == (size_t)nz)
+                continue;
+            /* the first nodes of this direction's springs in the layer: one flat run */
+            const size_t f0 = (size_t)(sd->di < 0) + row * (size_t)(sd->dj < 0);
+            const size_t f1 = (size_t)(nx - (sd->di > 0)) + row * (size_t)(ny - (sd->dj > 0)) + 1;
+            const size_t a = c0 > f0 ? c0 : f0, b = c1 < f1 ? c1 : f1;
+            if (a >= b)
+                continue;
+            const double um =
+                run_dir(lat, &c, form, sd, sd->wk[edge], base + a, b - a, sd->wl + a);
+            umax = um > umax ? um : umax;
         }
-        fx[ci] += ax, fy[ci] += ay, fz[ci] += az;
     }
     return umax;
 }
@@ -132,7 +179,7 @@ static double slabs_closed(const cf_lattice_stepper *st, size_t parity)
     double umax = 0;
 #pragma omp parallel for schedule(static) reduction(max : umax) if (st->threads)
     for (size_t k = parity; k < st->nslab; k += 2) {
-        double um = springs_range(st->lat, &st->lanes, CF_LANE_CLOSED, st->slab[k], st->slab[k + 1]);
+        double um = layer_springs(st, CF_LANE_CLOSED, k);
         umax = um > umax ? um : umax;
     }
     return umax;
@@ -144,7 +191,7 @@ static double slabs_table(const cf_lattice_stepper *st, size_t parity)
     double umax = 0;
 #pragma omp parallel for schedule(static) reduction(max : umax) if (st->threads)
     for (size_t k = parity; k < st->nslab; k += 2) {
-        double um = springs_range(st->lat, &st->lanes, CF_LANE_TABLE, st->slab[k], st->slab[k + 1]);
+        double um = layer_springs(st, CF_LANE_TABLE, k);
         umax = um > umax ? um : umax;
     }
     return umax;
@@ -155,7 +202,7 @@ static double slabs_scalar(const cf_lattice_stepper *st, size_t parity)
     double umax = 0;
 #pragma omp parallel for schedule(static) reduction(max : umax) if (st->threads)
     for (size_t k = parity; k < st->nslab; k += 2) {
-        double um = springs_range(st->lat, &st->lanes, -1, st->slab[k], st->slab[k + 1]);
+        double um = layer_springs(st, -1, k);
         umax = um > umax ? um : umax;
     }
     return umax;

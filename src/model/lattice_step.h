@@ -1,21 +1,30 @@
 /*
-** The explicit step of the lattice in two fused passes, for runs where every step counts (haptic
-** rates, large lattices):
-**   springs: in blocks of CF_STEP_BLOCK springs, vectorised loops over the block gather the end
-**            positions and form lengths and compressions, evaluate the law (law_simd.h) and the
-**            tension vectors; then a scalar loop scatters the equal and opposite forces into the
-**            node forces, summing each first node's run of springs in registers (a sum through
-**            memory would wait on its own store at every spring);
+** The explicit step of the lattice as a stencil, for runs where every step counts (haptic rates,
+** large lattices). conifit's lattices are regular (lattice.h): node (i, j, k) is
+** p = i + (nx + 1) (j + (ny + 1) k), and the springs of one cell direction (13 of them: 3 edges,
+** 6 face diagonals, 4 body diagonals) join p to p + D with one flat offset D, one rest length and
+** one H/L0. So the step needs no node indices and no per-spring constants:
+**   springs: layer by layer, in chunks of CF_STEP_BLOCK nodes, and per direction: contiguous
+**            loads of the positions at p and p + D, lengths and compressions, the law (law_simd.h)
+**            and the tension vectors, then two contiguous loops that add them to the forces at p
+**            and subtract them at p + D (no two lanes of a loop touch the same node). A spring's
+**            weight (family weight times the share of the cells holding it) depends only on
+**            whether it lies on the boundary: one table per direction over the nodes of a layer,
+**            times a factor per layer. A flat run of one direction also passes the pairs that
+**            wrap from the end of a row (or a layer's last row) to the start of the next: they are
+**            not springs, have weight 0 in that table and are masked out of the forces and of the
+**            largest compression;
 **   nodes:   symplectic Euler (v += h f/m, x += h v) and the node forces reset for the next step.
-** Springs are visited in their storage order, which is by first node, so the gathers and scatters
-** of a block fall on a few layers of nodes that stay in cache. Per spring the pass reads the two
-** node indices and three constants (L0, H/L0, weight), 40 bytes, and writes nothing.
+** Per spring the pass reads about 12 bytes (positions and forces of nodes in cache, the weight
+** table of the layer), against about 46 for a pass over an edge list.
 **
-** Threads: the springs are grouped in slabs, one per layer of first nodes; a spring of slab k
-** touches nodes of layers k and k + 1 only, so the even slabs can run in parallel, then the odd
-** ones. The order of the sums does not depend on the number of threads (same results with one
-** thread or many). Threads start only from CF_STEP_THREADS_MIN springs, below which they cost
-** more than they save.
+** The forces are those of cf_lattice_forces (the edge-list kernel the statics and the viscous
+** dynamics use) up to the order of the sums, i.e. to rounding.
+**
+** Threads: a slab is a layer of first nodes; a spring of slab k touches nodes of layers k and
+** k + 1 only, so the even slabs can run in parallel, then the odd ones. The order of the sums does
+** not depend on the number of threads (same results with one thread or many). Threads start only
+** from CF_STEP_THREADS_MIN springs, below which they cost more than they save.
 **
 ** Private to the model layer (msm.c's explicit dynamics; the benchmark).
 */
@@ -24,6 +33,7 @@
 
 #include <stddef.h>
 
+#include "conifit/cell.h"
 #include "conifit/error.h"
 #include "conifit/lattice.h"
 #include "model/law_simd.h"
@@ -31,12 +41,23 @@
 #define CF_STEP_BLOCK 256
 #define CF_STEP_THREADS_MIN 1000000
 
+/* One cell direction of the stencil. */
+typedef struct cf_step_dir {
+    size_t D;            /* flat offset of the second node, > 0 */
+    int di, dj, dk;      /* the offset in cells */
+    double L0, a;        /* rest length, mm, and H/L0 */
+    double wk[2];        /* layer factor: [0] inner layers, [1] the bottom and top layers */
+    double *wl;          /* weight over the first nodes of a layer (0: no spring there) */
+} cf_step_dir;
+
 typedef struct cf_lattice_stepper {
     cf_lattice *lat;       /* not owned */
     cf_law_lanes lanes;
     int form;              /* CF_LANE_CLOSED, CF_LANE_TABLE, or -1: the scalar law per block */
-    size_t nslab;          /* slabs (layers of first nodes) */
-    size_t *slab;          /* nslab + 1 spring indices: slab k is [slab[k], slab[k + 1]) */
+    int ndir;              /* directions with springs (families of weight > 0) */
+    cf_step_dir dir[CF_CELL_DIRS];
+    size_t layer;          /* nodes per layer, (nx + 1)(ny + 1) */
+    size_t nslab;          /* slabs (layers of first nodes), nz + 1 */
     double *inv_mass[3];   /* per axis: 1/m for a free DOF, 0 for a prescribed one */
     int threads;           /* 1: the lattice is large enough for threads */
 } cf_lattice_stepper;
