@@ -284,23 +284,33 @@ static void test_series_refused(void **state)
     assert_null(f.model_MPa);
 }
 
+/* The ramp-and-hold series of the one-branch model p into t, x, y, and options that hold p's
+** elastic part and fit one branch. */
+static void held_series(const cf_visco_params *p, cf_visco_fit_options *o, double *t, double *x,
+                        double *y)
+{
+    *o = cf_visco_fit_default_options();
+    ramp_hold(t, x);
+    cf_visco_series ser = {NS, t, x};
+    cf_error err = {0};
+    assert_int_equal(cf_visco_curve(p, &o->setup, &ser, y, NULL, &err), CF_OK);
+    o->nbranch = 1;
+    o->hold_elastic = 1;
+    o->elastic[0] = p->rho;
+    o->elastic[1] = p->solid_strain;
+    o->elastic[2] = p->stress_scale_MPa;
+}
+
 /* Holding the elastic part recovers the Prony terms alone. */
 static void test_held_elastic(void **state)
 {
     (void)state;
     cf_visco_params p = known();
     p.nbranch = 1;
-    cf_visco_fit_options o = cf_visco_fit_default_options();
+    cf_visco_fit_options o;
     double t[NS], x[NS], y[NS];
-    ramp_hold(t, x);
-    cf_visco_series ser = {NS, t, x};
     cf_error err = {0};
-    assert_int_equal(cf_visco_curve(&p, &o.setup, &ser, y, NULL, &err), CF_OK);
-    o.nbranch = 1;
-    o.hold_elastic = 1;
-    o.elastic[0] = p.rho;
-    o.elastic[1] = p.solid_strain;
-    o.elastic[2] = p.stress_scale_MPa;
+    held_series(&p, &o, t, x, y);
     cf_visco_data d = {NS, t, x, y, NULL};
     cf_visco_fit f;
     assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_OK);
@@ -310,7 +320,91 @@ static void test_held_elastic(void **state)
     assert_close(f.p.g[0], p.g[0], 1e-6 * p.g[0]);
     assert_close(f.p.tau_s[0], p.tau_s[0], 1e-6 * p.tau_s[0]);
     assert_close(f.se_ident[0], -1, 0);
+    /* the held spring's lattice is checked as a fitted one: stable beyond the series */
+    assert_true(f.stable_to_strain == 0 || f.stable_to_strain < -0.3);
     cf_visco_fit_free(&f);
+}
+
+/* A held elastic fit whose lattice buckles within the series is refused, naming the strain where
+** it loses stability (from the library and from the command line, nothing written); the same
+** spring with the check switched off is fitted. */
+static void test_held_elastic_unstable(void **state)
+{
+    (void)state;
+    cf_visco_params p = known();
+    p.rho = 0.1;
+    p.solid_strain = 0.35; /* the one-cell lattice needs s/H >= 0.49 at rho 0.1 to reach 0.30 */
+    p.nbranch = 1;
+    cf_visco_fit_options o;
+    double t[NS], x[NS], y[NS];
+    cf_error err = {0};
+    held_series(&p, &o, t, x, y);
+    cf_visco_data d = {NS, t, x, y, NULL};
+    cf_visco_fit f;
+    assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_E_DATA);
+    assert_null(f.model_MPa);
+    const char *at = strstr(err.msg, "loses stability at strain ");
+    assert_non_null(at);
+    double lim = atof(at + strlen("loses stability at strain "));
+    assert_true(lim < 0 && lim > -0.3);
+    /* the scan agrees with the one-factorisation check on both sides of that strain */
+    cf_spring sp = cf_spring_member(p.rho, p.solid_strain, 1.0);
+    cf_law law;
+    assert_int_equal(cf_law_init(&law, &sp, &err), CF_OK);
+    cf_msm_config cfg = o.setup.cfg;
+    cfg.lattice.nx = cfg.lattice.ny = cfg.lattice.nz = 1;
+    cf_cell cell;
+    assert_int_equal(cf_cell_init(&cell, &law, o.setup.method, cfg.lattice.weight, &err), CF_OK);
+    for (int side = 0; side < 2; side++) {
+        cf_cell_state cs;
+        long neg = -1;
+        double e = lim * (side ? 1.01 : 0.99);
+        assert_int_equal(cf_cell_mode(&cell, CF_MODE_UNIAXIAL, e, NULL, &cs, &err), CF_OK);
+        cf_status st = cf_msm_homogeneous_inertia(&law, o.setup.method, &cfg, e, cs.free_stretch,
+                                                  &neg, &err);
+        assert_true(side ? st != CF_OK || neg > 0 : st == CF_OK && neg == 0);
+    }
+    cf_law_free(&law);
+    o.stable_cells = 0;
+    assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_OK);
+    assert_close(f.p.g[0], p.g[0], 1e-6 * p.g[0]);
+    assert_close(f.stable_to_strain, 0, 0); /* not checked */
+    cf_visco_fit_free(&f);
+
+    /* the command line: --elastic with a fit file of that spring */
+    char dir[] = "/tmp/conifit-visco-XXXXXX", series[256], spring[256], out[256];
+    assert_non_null(mkdtemp(dir));
+    snprintf(series, sizeof series, "%s/series.csv", dir);
+    snprintf(spring, sizeof spring, "%s/spring.json", dir);
+    snprintf(out, sizeof out, "%s/fit.json", dir);
+    FILE *fs = fopen(series, "w");
+    assert_non_null(fs);
+    fprintf(fs, "time_s,strain,stress_kPa\n");
+    for (int k = 0; k < NS; k++)
+        fprintf(fs, "%.17g,%.17g,%.17g\n", t[k], x[k], 1e3 * y[k]);
+    fclose(fs);
+    sp = cf_spring_member(p.rho, p.solid_strain, p.stress_scale_MPa);
+    assert_int_equal(cf_law_init(&law, &sp, &err), CF_OK);
+    json_t *params = json_object(), *item = json_object(), *root = json_object();
+    for (int k = 0; k < CF_P_COUNT; k++)
+        json_object_set_new(params, cf_spring_param_info(k)->key,
+                            json_real(cf_spring_get(&sp, k)));
+    json_object_set_new(item, "type", json_string(cf_spring_type_name(law.type)));
+    json_object_set_new(item, "params", params);
+    json_object_set_new(root, "fits", json_pack("[o]", item));
+    assert_int_equal(json_dump_file(root, spring, 0), 0);
+    json_decref(root);
+    cf_law_free(&law);
+    char so[4096], se[4096];
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "fit %s --elastic %s --branches 1 -o %s",
+                            series, spring, out),
+                     65);
+    assert_non_null(strstr(se, "loses stability at strain"));
+    assert_non_null(strstr(se, "--elastic"));
+    assert_int_equal(access(out, F_OK), -1);
+    unlink(series);
+    unlink(spring);
+    rmdir(dir);
 }
 
 /* The command line: a time series with a bad branch count or a time that goes back exits 65 and
@@ -664,6 +758,7 @@ int main(void)
         cmocka_unit_test(test_recover_with_noise),
         cmocka_unit_test(test_series_refused),
         cmocka_unit_test(test_held_elastic),
+        cmocka_unit_test(test_held_elastic_unstable),
         cmocka_unit_test(test_cli_series_errors),
         cmocka_unit_test(test_shipped_synthetic_series),
         cmocka_unit_test(test_stderr_coverage),

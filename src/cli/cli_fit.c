@@ -82,7 +82,8 @@ static const char fit_help_series[] =
     "  --elastic FIT.json[:TYPE]  hold rho, s/H and F_C/H^2 at those of a fit file's spring\n"
     "  --calibration C         the lattice's weights: axial (default for a series) or isotropic\n"
     "The fitted spring stays within the design limits (--rho-min, --index-max, ...) and its\n"
-    "lattice stable up to the series' largest strain.\n\n"
+    "lattice stable up to the series' largest strain (a held --elastic spring whose lattice\n"
+    "would buckle within the series is refused).\n\n"
     "Tables: a header row naming the columns, units in the names (stress_kPa, stress [kPa]),\n"
     "'#' comments, ',' ';' TAB or blank-separated columns, an optional weight column. Tension\n"
     "positive. A spreadsheet (.xlsx, .ods) must be saved as CSV first.\n";

@@ -821,6 +821,25 @@ void cf_visco_fit_free(cf_visco_fit *r)
     r->is_hold = NULL;
 }
 
+/* Where the static elastic lattice of stable_cells^3 cells of the spring (rho, s/H, F_C/H^2)
+** first loses stability in compression (table's sign), by the scan of cf_msm_stability_limit; 0
+** when it stays stable to 0.995 of solid or cannot be scanned. */
+static double stability_limit(const ctx *c, double rho, double B, double A)
+{
+    cf_spring sp = cf_spring_member(rho, B, A);
+    cf_law law;
+    cf_error e = {0};
+    cf_msm_config cfg = c->o->setup.cfg;
+    cfg.lattice.nx = cfg.lattice.ny = cfg.lattice.nz = c->o->stable_cells;
+    double lim = 0;
+    if (cf_law_init(&law, &sp, &e) != CF_OK)
+        return 0;
+    if (cf_msm_stability_limit(&law, c->o->setup.method, &cfg, -1, &lim, &e) != CF_OK)
+        lim = 0;
+    cf_law_free(&law);
+    return lim;
+}
+
 /* Checks the options against the series and fills the fit state (weights, bounds, limits). */
 static cf_status fit_setup(ctx *c, const cf_visco_data *d, const cf_visco_fit_options *o,
                            cf_error *err)
@@ -869,6 +888,24 @@ static cf_status fit_setup(ctx *c, const cf_visco_data *d, const cf_visco_fit_op
                             "no conical spring (rho %g to 1, solid strain to %g) gives a lattice "
                             "of %d^3 cells that stays stable to the series' largest strain %g",
                             c->rho_lo, E_HI, o->stable_cells, c->xmax);
+    if (o->hold_elastic && o->stable_cells > 0) {
+        /* the held spring is not fitted, so its lattice is checked as the fitted one is kept:
+        ** stable at the series' largest strain, or refused */
+        cf_visco_limits held = c->lim;
+        held.cells = o->stable_cells;
+        if (!cf_visco_limits_stable(&held, el[0], el[1])) {
+            double at = stability_limit(c, el[0], el[1], el[2]);
+            char where[96] = "is not stable at that strain";
+            if (at != 0)
+                snprintf(where, sizeof where, "loses stability at strain %.6g", at);
+            return cf_error_set(err, CF_E_DATA,
+                                "the held elastic fit (rho %g, s/H %g, F_C/H^2 %g MPa): the "
+                                "lattice of %d^3 cells of its spring %s, within the series' "
+                                "largest strain %g (held there it buckles); fit the elastic "
+                                "part with the series instead (without --elastic)",
+                                el[0], el[1], el[2], o->stable_cells, where, -c->xmax);
+        }
+    }
     return CF_OK;
 }
 
@@ -934,11 +971,13 @@ static double fit_quality(const ctx *c, cf_visco_fit *res)
 }
 
 /* Which limits the fitted elastic quantities sit on, and where the elastic lattice of the fitted
-** spring loses stability. */
+** (or held) spring loses stability. */
 static void fit_limits(const ctx *c, const cf_visco_params *p, cf_visco_fit *res, int held[3])
 {
     held[0] = held[1] = held[2] = 0;
     res->stable_to_strain = 0;
+    if (c->o->stable_cells > 0)
+        res->stable_to_strain = stability_limit(c, p->rho, p->solid_strain, p->stress_scale_MPa);
     if (!c->free_el)
         return;
     held[0] = res->rho_at_limit = p->rho <= c->rho_lo * (1 + 1e-4);
@@ -948,19 +987,6 @@ static void fit_limits(const ctx *c, const cf_visco_params *p, cf_visco_fit *res
     held[2] = res->at_design_limit =
         p->stress_scale_MPa >=
         cf_visco_limits_scale_max(&c->lim, p->rho, p->solid_strain) * (1 - 1e-9);
-    if (c->lim.cells <= 0)
-        return;
-    cf_spring sp = cf_spring_member(p->rho, p->solid_strain, p->stress_scale_MPa);
-    cf_law law;
-    cf_error e = {0};
-    cf_msm_config cfg = c->o->setup.cfg;
-    cfg.lattice.nx = cfg.lattice.ny = cfg.lattice.nz = c->lim.cells;
-    double lim = 0;
-    if (cf_law_init(&law, &sp, &e) == CF_OK) {
-        if (cf_msm_stability_limit(&law, c->o->setup.method, &cfg, -1, &lim, &e) == CF_OK)
-            res->stable_to_strain = lim;
-        cf_law_free(&law);
-    }
 }
 
 /* The reported model: its curve, quality, standard errors, moduli and predictions. */

@@ -49,7 +49,9 @@ typedef struct cf_visco_fit_options {
     /* Stability: when > 0, the static lattice of stable_cells^3 cells (the weights of setup)
     ** built from the fitted spring must stay stable (no negative pivot of its tangent) up to
     ** the series' largest strain, so that every lattice `simulate` runs of it follows the fit
-    ** (the one-cell lattice loses stability first: 1 is the default and the safe choice). */
+    ** (the one-cell lattice loses stability first: 1 is the default and the safe choice). A
+    ** held spring (hold_elastic) is checked alike: CF_E_DATA when its lattice is not stable
+    ** there. */
     int stable_cells;
     cf_visco_setup setup;   /* where the model is evaluated */
 } cf_visco_fit_options;
@@ -105,7 +107,8 @@ typedef struct cf_visco_fit {
     int at_design_limit;                /* 1 when F_C/H^2 sits on the largest value a spring
                                            within the design limits carries */
     double stable_to_strain;            /* where the elastic lattice of stable_cells^3 cells of
-                                           the fitted spring loses stability, table's sign;
+                                           the fitted or held spring loses stability, table's
+                                           sign;
                                            0 when stable to 0.995 of solid or not checked */
     int chosen_by_aic;                  /* 1 when N was chosen by AIC */
     double aic_by_n[CF_VISCO_AIC_MAX];  /* AIC of N = 1..4 when chosen by AIC (MPa^2 in RSS) */
