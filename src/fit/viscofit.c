@@ -129,6 +129,7 @@ typedef struct ctx {
     double *sw;         /* residual weights */
     double ynorm;       /* weighted sum of y^2 */
     double ymax, xmax;
+    double xlo, xhi;    /* most compressive (<= 0) and most tensile (>= 0) strain */
     double e_lo;        /* lower bound of s/H (the travel margin; stability: see lim) */
     double rho_lo;      /* lower bound of rho (the fitter's rho_min) */
     cf_visco_limits lim;/* design cap of the scale and stability bound of s/H */
@@ -822,8 +823,9 @@ void cf_visco_fit_free(cf_visco_fit *r)
 }
 
 /* Where the static elastic lattice of stable_cells^3 cells of the spring (rho, s/H, F_C/H^2)
-** first loses stability in compression (table's sign), by the scan of cf_msm_stability_limit; 0
-** when it stays stable to 0.995 of solid or cannot be scanned. */
+** first loses stability (table's sign), by the scan of cf_msm_stability_limit on each side the
+** series reaches: a side where it does so within the series first, else the side of the
+** series' largest strain. 0 when it stays stable to 0.995 of solid or cannot be scanned. */
 static double stability_limit(const ctx *c, double rho, double B, double A)
 {
     cf_spring sp = cf_spring_member(rho, B, A);
@@ -831,13 +833,20 @@ static double stability_limit(const ctx *c, double rho, double B, double A)
     cf_error e = {0};
     cf_msm_config cfg = c->o->setup.cfg;
     cfg.lattice.nx = cfg.lattice.ny = cfg.lattice.nz = c->o->stable_cells;
-    double lim = 0;
     if (cf_law_init(&law, &sp, &e) != CF_OK)
         return 0;
-    if (cf_msm_stability_limit(&law, c->o->setup.method, &cfg, -1, &lim, &e) != CF_OK)
-        lim = 0;
+    const double reach[2] = {c->xlo, c->xhi};
+    double lim[2] = {0, 0};
+    for (int side = 0; side < 2; side++)
+        if (reach[side] == 0 ||
+            cf_msm_stability_limit(&law, c->o->setup.method, &cfg, side ? 1 : -1, &lim[side],
+                                   &e) != CF_OK)
+            lim[side] = 0;
     cf_law_free(&law);
-    return lim;
+    for (int side = 0; side < 2; side++)
+        if (lim[side] != 0 && fabs(lim[side]) <= fabs(reach[side]))
+            return lim[side];
+    return lim[-c->xlo >= c->xhi ? 0 : 1];
 }
 
 /* Checks the options against the series and fills the fit state (weights, bounds, limits). */
@@ -857,6 +866,8 @@ static cf_status fit_setup(ctx *c, const cf_visco_data *d, const cf_visco_fit_op
     for (size_t k = 0; k < n; k++) {
         c->ymax = fmax(c->ymax, fabs(d->y[k]));
         c->xmax = fmax(c->xmax, fabs(d->x[k]));
+        c->xlo = fmin(c->xlo, d->x[k]);
+        c->xhi = fmax(c->xhi, d->x[k]);
     }
     c->e_lo = c->xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
     c->rho_lo = o->rho_min > 0 && o->rho_min < RHO_HI ? o->rho_min : 1e-3;
@@ -882,7 +893,7 @@ static cf_status fit_setup(ctx *c, const cf_visco_data *d, const cf_visco_fit_op
     if (!(c->ynorm > 0))
         return cf_error_set(err, CF_E_DATA, "every stress of the series is zero");
     cf_visco_limits_init(&c->lim, o->limits, o->limit_types, c->free_el ? o->stable_cells : 0,
-                         &o->setup, c->xmax, c->rho_lo, RHO_HI, c->e_lo, E_HI);
+                         &o->setup, c->xlo, c->xhi, c->rho_lo, RHO_HI, c->e_lo, E_HI);
     if (c->lim.unstable_everywhere)
         return cf_error_set(err, CF_E_DATA,
                             "no conical spring (rho %g to 1, solid strain to %g) gives a lattice "
@@ -901,9 +912,9 @@ static cf_status fit_setup(ctx *c, const cf_visco_data *d, const cf_visco_fit_op
             return cf_error_set(err, CF_E_DATA,
                                 "the held elastic fit (rho %g, s/H %g, F_C/H^2 %g MPa): the "
                                 "lattice of %d^3 cells of its spring %s, within the series' "
-                                "largest strain %g (held there it buckles); fit the elastic "
+                                "strains %g to %g (held there it buckles); fit the elastic "
                                 "part with the series instead (without --elastic)",
-                                el[0], el[1], el[2], o->stable_cells, where, -c->xmax);
+                                el[0], el[1], el[2], o->stable_cells, where, c->xlo, c->xhi);
         }
     }
     return CF_OK;

@@ -27,20 +27,25 @@ int cf_visco_limits_stable(const cf_visco_limits *l, double rho, double B)
     if (cf_law_init(&law, &sp, &e) != CF_OK)
         return 0;
     cf_cell cell;
-    cf_cell_state s;
     cf_msm_config cfg = l->setup.cfg;
     cfg.lattice.nx = cfg.lattice.ny = cfg.lattice.nz = l->cells;
-    long neg = -1;
-    int ok = cf_cell_init(&cell, &law, l->setup.method, cfg.lattice.weight, &e) == CF_OK &&
-             cf_cell_mode(&cell, CF_MODE_UNIAXIAL, -l->xmax, NULL, &s, &e) == CF_OK &&
-             cf_msm_homogeneous_inertia(&law, l->setup.method, &cfg, -l->xmax, s.free_stretch,
+    int ok = cf_cell_init(&cell, &law, l->setup.method, cfg.lattice.weight, &e) == CF_OK;
+    const double at[2] = {l->xlo, l->xhi};
+    for (int side = 0; ok && side < 2; side++) {
+        if (at[side] == 0)
+            continue;
+        cf_cell_state s;
+        long neg = -1;
+        ok = cf_cell_mode(&cell, CF_MODE_UNIAXIAL, at[side], NULL, &s, &e) == CF_OK &&
+             cf_msm_homogeneous_inertia(&law, l->setup.method, &cfg, at[side], s.free_stretch,
                                         &neg, &e) == CF_OK &&
              neg == 0;
+    }
     cf_law_free(&law);
     return ok;
 }
 
-/* The smallest s/H in [e_lo, e_hi] at which the lattice is stable at -xmax (bisection; the
+/* The smallest s/H in [e_lo, e_hi] at which the lattice is stable at xlo and xhi (bisection; the
 ** lattice is stable for every larger s/H), e_hi when none is. */
 static double stable_bound(const cf_visco_limits *l, double rho)
 {
@@ -60,15 +65,16 @@ static double stable_bound(const cf_visco_limits *l, double rho)
 }
 
 void cf_visco_limits_init(cf_visco_limits *l, const cf_fit_options *design, unsigned types,
-                          int cells, const cf_visco_setup *setup, double xmax, double rho_lo,
-                          double rho_hi, double e_lo, double e_hi)
+                          int cells, const cf_visco_setup *setup, double xlo, double xhi,
+                          double rho_lo, double rho_hi, double e_lo, double e_hi)
 {
     memset(l, 0, sizeof *l);
     l->design = design;
     l->types = types;
     l->cells = cells;
     l->setup = *setup;
-    l->xmax = xmax;
+    l->xlo = fmin(xlo, 0.0);
+    l->xhi = fmax(xhi, 0.0);
     l->e_lo = e_lo;
     l->e_hi = e_hi;
     l->unstable_everywhere = cells > 0;
