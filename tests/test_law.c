@@ -539,6 +539,22 @@ static void cli_info_and_help_and_version(void **state)
     assert_non_null(strstr(out, "telescoping"));
     assert_non_null(strstr(out, "97.5 N"));
     assert_non_null(strstr(out, "0.25 N/mm"));
+    /* the design parameters as the spring's field table names and describes them, with units */
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        const cf_spring_param *sp = cf_spring_param_info(k);
+        char want[160];
+        const int bare = strcmp(sp->unit, "-") == 0;
+        snprintf(want, sizeof want, "\n  %-4s %.10g%s%s", sp->name,
+                 (double[]){10, 30, 4, 1, 80000, 40}[k], bare ? "" : " ", bare ? "" : sp->unit);
+        const char *line = strstr(out, want);
+        if (!line)
+            fail_msg("info: no line '%s' in:\n%s", want + 1, out);
+        const char *end = strchr(line + 1, '\n');
+        assert_non_null(end);
+        const char *meaning = strstr(line, sp->meaning);
+        if (!meaning || meaning > end)
+            fail_msg("info: the line of %s does not say '%s'", sp->name, sp->meaning);
+    }
     const char *cmds[] = {"force", "curve", "info"};
     for (int i = 0; i < 3; i++) {
         assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb, "%s --help", cmds[i]), 0);

@@ -209,12 +209,16 @@ static void info_body(FILE *o, const law_args *a, const cf_law *law)
     (void)a;
     const cf_spring *p = &law->p;
     fprintf(o, "conical spring, %s\n", cf_spring_type_name(law->type));
-    fprintf(o, "  %-34s %.10g mm\n", "D1 (smallest coil)", p->D1_mm);
-    fprintf(o, "  %-34s %.10g mm\n", "D2 (largest coil)", p->D2_mm);
-    fprintf(o, "  %-34s %.10g\n", "n (active coils)", p->n);
-    fprintf(o, "  %-34s %.10g mm\n", "d (wire)", p->d_mm);
-    fprintf(o, "  %-34s %.10g MPa\n", "G (shear modulus)", p->G_MPa);
-    fprintf(o, "  %-34s %.10g mm\n", "H (free length)", p->H_mm);
+    /* the design parameters: name, unit and meaning from the spring's field table (a
+    ** dimensionless one, unit "-", is printed bare) */
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        const cf_spring_param *sp = cf_spring_param_info(k);
+        const int bare = strcmp(sp->unit, "-") == 0;
+        char value[64];
+        snprintf(value, sizeof value, "%.10g%s%s", cf_spring_get(p, k), bare ? "" : " ",
+                 bare ? "" : sp->unit);
+        fprintf(o, "  %-4s %-29s %s\n", sp->name, value, sp->meaning);
+    }
     fprintf(o, "derived\n");
     fprintf(o, "  %-34s %s ((D2-D1)/2 = %.6g mm %s n d = %.6g mm)\n", "type",
            cf_spring_type_name(law->type), 0.5 * (p->D2_mm - p->D1_mm),
