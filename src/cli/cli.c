@@ -76,9 +76,16 @@ cf_status cf_cli_parse_double(const char *name, const char *text, double *out, c
     double v = strtod(text, &end);
     if (end == text || *end != '\0')
         return cf_error_set(err, CF_E_USAGE, "option %s: '%s' is not a number", name, text);
-    if (!isfinite(v) || errno == ERANGE)
+    /* ERANGE is also an underflow: a subnormal such as 5e-324 is a finite number (it was
+    ** refused as "not finite"); only a value that rounds to 0 from a nonzero one is refused */
+    if (!isfinite(v) || (errno == ERANGE && fabs(v) > 1.0))
         return cf_error_set(err, CF_E_USAGE, "option %s: '%s' is not a finite number", name,
                             text);
+    if (errno == ERANGE && v == 0)
+        return cf_error_set(err, CF_E_USAGE,
+                            "option %s: '%s' is below the smallest number a double holds "
+                            "(about 4.9e-324)",
+                            name, text);
     *out = v;
     return CF_OK;
 }
