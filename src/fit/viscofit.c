@@ -136,6 +136,8 @@ typedef struct ctx {
     double *m;          /* model curve scratch (n) */
     cf_visco_series series;
     long evals;
+    int oom;            /* 1 when an allocation failed in a solver or a model curve: the fit
+                        ** ends with an error instead of going on without that start or point */
 } ctx;
 
 /* The smallest s/H allowed at rho: above the travel margin and the lattice's stability bound. */
@@ -199,7 +201,10 @@ static int curve(ctx *c, const cf_visco_params *p)
 {
     cf_error e = {0};
     c->evals++;
-    return cf_visco_curve(p, &c->o->setup, &c->series, c->m, NULL, &e) == CF_OK;
+    cf_status st = cf_visco_curve(p, &c->o->setup, &c->series, c->m, NULL, &e);
+    if (st == CF_E_INTERNAL && strstr(e.msg, "out of memory"))
+        c->oom = 1; /* not a bad point: the curve was never computed */
+    return st == CF_OK;
 }
 
 /* The best stress scale for the curve in c->m at unit scale (weighted least squares), capped at
@@ -244,8 +249,10 @@ static double lm_run(ctx *c, double *z)
     fp.h_df = 1e-7;
     gsl_multifit_nlinear_workspace *w =
         gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &fp, c->n, c->np);
-    if (!w)
+    if (!w) {
+        c->oom = 1;
         return HUGE_VAL;
+    }
     gsl_multifit_nlinear_fdf fdf;
     memset(&fdf, 0, sizeof fdf);
     fdf.f = lm_f;
@@ -259,8 +266,10 @@ static double lm_run(ctx *c, double *z)
         static const cf_lsq_lm_stop stop = {LM_MAX_ITER, 1e-14, 1e-14, 0,
                                             LM_STALL,    LM_STALL_REL, LM_FLOOR_REL};
         gsl_vector *f = gsl_multifit_nlinear_residual(w);
-        if (cf_lsq_lm_iterate(w, &stop) == 0) /* out of memory: the start is lost */
+        if (cf_lsq_lm_iterate(w, &stop) == 0)
             gsl_blas_ddot(f, f, &best);
+        else
+            c->oom = 1;
         memcpy(z, gsl_multifit_nlinear_position(w)->data, c->np * sizeof(double));
         if (!isfinite(best))
             best = HUGE_VAL;
@@ -699,7 +708,8 @@ static double fit_nb(ctx *c, int nb, cf_visco_params *pout)
         default_start(c, nb, &best[0]);
     double bestobj = HUGE_VAL;
     double *z = malloc(c->np * sizeof(double)), *zbest = malloc(c->np * sizeof(double));
-    for (int s = 0; z && zbest && s < LM_STARTS; s++) {
+    c->oom |= !z || !zbest;
+    for (int s = 0; z && zbest && !c->oom && s < LM_STARTS; s++) {
         if (!(best[s].obj < HUGE_VAL))
             continue;
         cf_visco_params p0 = best[s].p;
@@ -930,7 +940,13 @@ static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf
     res->chosen_by_aic = o->nbranch == 0;
     for (int nb = nlo; nb <= nhi; nb++) {
         cf_visco_params p;
-        if (!(fit_nb(c, nb, &p) < HUGE_VAL) || !curve(c, &p))
+        const int ok = fit_nb(c, nb, &p) < HUGE_VAL && curve(c, &p);
+        if (c->oom)
+            return cf_error_set(err, CF_E_INTERNAL,
+                                "out of memory in the viscoelastic fit of %d Prony term%s (the "
+                                "Levenberg-Marquardt iteration or a model curve)",
+                                nb, nb == 1 ? "" : "s");
+        if (!ok)
             continue;
         double rss = 0;
         for (size_t k = 0; k < c->n; k++)
@@ -1058,6 +1074,9 @@ cf_status cf_visco_fit_run(const cf_visco_data *d, const cf_visco_fit_options *o
     cf_visco_params bestp;
     if ((st = fit_setup(&c, d, o, err)) == CF_OK && (st = fit_counts(&c, res, &bestp, err)) == CF_OK)
         st = fit_report(&c, &bestp, res, err);
+    if (st == CF_OK && c.oom)
+        st = cf_error_set(err, CF_E_INTERNAL,
+                          "out of memory in the viscoelastic fit's errors and predictions");
     res->evaluations = c.evals;
     res->wall_time_s = now_s() - t0;
     free(c.sw);

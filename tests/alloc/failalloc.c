@@ -4,9 +4,14 @@
 ** lies in libgsl* or libnlopt*) and makes the one numbered CF_FAIL_ALLOC_AT fail (malloc, calloc
 ** and realloc return NULL), as a full memory would. With CF_FAIL_ALLOC_REPORT=FILE it writes the
 ** number of such allocations to FILE at exit. Every other allocation passes through.
+**
+** CF_FAIL_ALLOC_WITHIN=START:SIZE (hexadecimal offsets of a function in the program, as `nm -S`
+** prints them) counts instead every allocation, whoever makes it (the program, GSL, NLopt), made
+** while that function is on the stack: the allocations of one loop and of what it calls.
 */
 #define _GNU_SOURCE
 #include <dlfcn.h>
+#include <execinfo.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,6 +22,8 @@ static void *(*real_calloc)(size_t, size_t);
 static void *(*real_realloc)(void *, size_t);
 static void (*real_free)(void *);
 static long fail_at = -1, counted;
+static uintptr_t within_lo, within_hi; /* CF_FAIL_ALLOC_WITHIN, offsets in the program */
+static int within_set, in_backtrace;
 static int ready, starting;
 /* dlsym itself may allocate before the real functions are known: served from here */
 static _Alignas(16) char boot[8192];
@@ -33,6 +40,15 @@ static void start(void)
     real_free = (void (*)(void *))dlsym(RTLD_NEXT, "free");
     const char *s = getenv("CF_FAIL_ALLOC_AT");
     fail_at = s ? atol(s) : -1;
+    const char *w = getenv("CF_FAIL_ALLOC_WITHIN");
+    char *colon = NULL;
+    if (w) {
+        within_lo = (uintptr_t)strtoull(w, &colon, 16);
+        if (colon && *colon == ':') {
+            within_hi = within_lo + (uintptr_t)strtoull(colon + 1, NULL, 16);
+            within_set = within_hi > within_lo;
+        }
+    }
     starting = 0;
     ready = 1;
 }
@@ -52,11 +68,34 @@ static int in_boot(const void *p)
     return (const char *)p >= boot && (const char *)p < boot + sizeof boot;
 }
 
+/* 1 when the function of CF_FAIL_ALLOC_WITHIN is on the stack. */
+static int inside_within(void)
+{
+    if (in_backtrace) /* backtrace itself may allocate the first time */
+        return 0;
+    in_backtrace = 1;
+    void *frames[64];
+    int n = backtrace(frames, 64), hit = 0;
+    for (int i = 0; i < n && !hit; i++) {
+        Dl_info info;
+        if (!dladdr(frames[i], &info) || !info.dli_fname || strstr(info.dli_fname, ".so"))
+            continue;
+        uintptr_t off = (uintptr_t)frames[i] - (uintptr_t)info.dli_fbase;
+        hit = off >= within_lo && off < within_hi;
+    }
+    in_backtrace = 0;
+    return hit;
+}
+
 /* 1 when this allocation, made from code at ret, is the one to fail. */
 static int fails(void *ret)
 {
     Dl_info info;
-    if (!ready || !dladdr(ret, &info) || !info.dli_fname)
+    if (!ready)
+        return 0;
+    if (within_set)
+        return inside_within() && ++counted == fail_at;
+    if (!dladdr(ret, &info) || !info.dli_fname)
         return 0;
     if (!strstr(info.dli_fname, "libgsl") && !strstr(info.dli_fname, "libnlopt"))
         return 0;
