@@ -9,6 +9,7 @@
 #include "testutil.h"
 
 #include "conifit/law.h"
+#include "model/law_simd.h"
 
 /* Error bounds (relative to |F| unless said otherwise). */
 #define EXACT_TOL 1e-14   /* exact (Brent to the last bits) against the long-double reference */
@@ -566,6 +567,26 @@ static void cli_info_and_help_and_version(void **state)
     assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb, ""), 2);
 }
 
+/* The lanes' square roots without a square-root instruction (law_simd.h): 1/sqrt(x) and
+** x / sqrt(x) within 4e-16 of the long-double values over the normal range, and 0 maps to a
+** finite value whose product with 0 is 0. */
+static void lane_rsqrt_is_accurate_over_the_normal_range(void **state)
+{
+    (void)state;
+    double worst = 0;
+    for (int k = -30000; k <= 30000; k++) {
+        const double x = exp(0.0235 * k) * (1.0 + 1e-3 * (k % 7)); /* 1e-306 to 1e306 */
+        const double r = cf_lane_rsqrt(x);
+        const long double ref = 1.0L / sqrtl((long double)x);
+        worst = fmax(worst, (double)fabsl((r - ref) / ref));
+        worst = fmax(worst, (double)fabsl((x * r - (long double)x * ref) / ((long double)x * ref)));
+    }
+    assert_true(worst < 4e-16);
+    const double r0 = cf_lane_rsqrt(0.0);
+    assert_true(isfinite(r0));
+    assert_true(0.0 * r0 == 0.0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -584,6 +605,7 @@ int main(void)
         cmocka_unit_test(method_names_round_trip),
         cmocka_unit_test(cli_force_prints_the_law_to_17_digits),
         cmocka_unit_test(cli_force_matches_reference_at_hard_cases),
+        cmocka_unit_test(lane_rsqrt_is_accurate_over_the_normal_range),
         cmocka_unit_test(cli_bad_arguments_exit_2_with_a_message),
         cmocka_unit_test(cli_curve_spans_stretch_to_solid),
         cmocka_unit_test(cli_info_and_help_and_version),

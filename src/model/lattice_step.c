@@ -100,16 +100,17 @@ run_dir(const cf_lattice *lat, const cf_law_lanes *c, int form, const cf_step_di
     const double L0 = sd->L0, A = sd->a;
     const double *restrict xa = lat->x + p0, *restrict ya = lat->y + p0, *restrict za = lat->z + p0;
     const double *restrict xb = xa + D, *restrict yb = ya + D, *restrict zb = za + D;
-    double dx[CF_STEP_BLOCK], dy[CF_STEP_BLOCK], dz[CF_STEP_BLOCK], L[CF_STEP_BLOCK],
+    double dx[CF_STEP_BLOCK], dy[CF_STEP_BLOCK], dz[CF_STEP_BLOCK], iL[CF_STEP_BLOCK],
         u[CF_STEP_BLOCK], F[CF_STEP_BLOCK];
     double umax = 0;
 #pragma omp simd reduction(max : umax)
     for (size_t k = 0; k < n; k++) {
         const double ex = xb[k] - xa[k], ey = yb[k] - ya[k], ez = zb[k] - za[k];
         dx[k] = ex, dy[k] = ey, dz[k] = ez;
-        const double l = sqrt(ex * ex + ey * ey + ez * ez);
-        L[k] = l;
-        const double uk = (L0 - l) * A;
+        const double d2 = ex * ex + ey * ey + ez * ez;
+        const double il = cf_lane_rsqrt(d2); /* the length and its inverse, no division */
+        iL[k] = il;
+        const double uk = (L0 - d2 * il) * A;
         u[k] = uk;
         const double au = W[k] != 0.0 ? fabs(uk) : 0.0; /* a wrapped pair is no spring */
         umax = au > umax ? au : umax;
@@ -126,7 +127,7 @@ run_dir(const cf_lattice *lat, const cf_law_lanes *c, int form, const cf_step_di
         double *restrict fx = lat->fx + p0, *restrict fy = lat->fy + p0, *restrict fz = lat->fz + p0;
 #pragma omp simd
         for (size_t k = 0; k < n; k++) {
-            const double gk = W[k] != 0.0 ? -(wk * W[k]) * F[k] / L[k] : 0.0;
+            const double gk = W[k] != 0.0 ? -(wk * W[k]) * F[k] * iL[k] : 0.0;
             const double tx = dx[k] * gk, ty = dy[k] * gk, tz = dz[k] * gk;
             dx[k] = tx, dy[k] = ty, dz[k] = tz;
             fx[k] += tx, fy[k] += ty, fz[k] += tz;
