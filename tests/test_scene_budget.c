@@ -7,6 +7,8 @@
 
 #include "testutil.h"
 
+#include <math.h>
+
 #include "conifit/budget.h"
 #include "conifit/scene.h"
 
@@ -164,6 +166,112 @@ static void fit_validate_takes_the_scene_budget(void **state)
                      0);
 }
 
+/* The steps' work on the scene's lattice (budget.h): 1e4 implicit substeps of a dashpot 3^3
+** lattice passed the step limit (5e5 steps) and ran for more than 5 minutes; they are refused
+** naming the key and the substeps that fit, which the budget then accepts. The same explicit
+** protocol costs in proportion to the springs; the shipped scenes pass. */
+static void work_counts_the_lattice_and_its_solves(void **state)
+{
+    (void)state;
+    scene("sub.json", "\"effects\": {\"damping\": {\"eta_kPa_s\": 5}}, \"integrator\": "
+                      "{\"substeps\": 10000}, \"protocol\": {\"kind\": \"ramp\", \"to_strain\": 0.1}");
+    int st = tu_run(out, sizeof out, errb, sizeof errb, "simulate %s/sub.json -o %s/c.csv", dir,
+                    dir);
+    const char *fits = strstr(errb, "at most ");
+    if (st != 65 || !strstr(errb, "integrator.substeps") || !strstr(errb, "spring-steps") ||
+        !strstr(errb, "--max-work") || !fits)
+        fail_msg("1e4 substeps of a 3^3 dashpot lattice: exit %d, expected 65 naming the key, "
+                 "the work and what fits: %s",
+                 st, errb);
+    assert_false(exists("c.csv"));
+    const long fit = atol(fits + strlen("at most "));
+    assert_true(fit >= 100 && fit < 10000);
+    /* the number that fits does, and one more does not (the library's check, nothing runs) */
+    char p[512];
+    snprintf(p, sizeof p, "%s/sub.json", dir);
+    cf_scene sc;
+    cf_error err = {0};
+    assert_int_equal(cf_scene_load(p, &sc, &err), CF_OK);
+    cf_law law;
+    cf_lattice lat;
+    assert_int_equal(cf_law_init(&law, &sc.spring, &err), CF_OK);
+    assert_int_equal(cf_lattice_create(&lat, &law, sc.method, &sc.cfg.lattice, &err), CF_OK);
+    cf_budget b = cf_budget_default();
+    cf_scene_cost c;
+    sc.cfg.quasi_substeps = (int)fit;
+    if (cf_budget_check_steps(&sc, "sub.json", &lat, &b, &c, &err) != CF_OK)
+        fail_msg("%ld substeps, said to fit: %s", fit, err.msg);
+    sc.cfg.quasi_substeps = (int)fit + 1;
+    assert_int_equal(cf_budget_check_steps(&sc, "sub.json", &lat, &b, &c, &err), CF_E_DATA);
+    /* a solve costs more on a larger lattice: the same scene at 6^3 fits fewer substeps */
+    const double w3 = c.work_per_step;
+    cf_lattice_free(&lat);
+    sc.cfg.lattice.nx = sc.cfg.lattice.ny = sc.cfg.lattice.nz = 6;
+    assert_int_equal(cf_lattice_create(&lat, &law, sc.method, &sc.cfg.lattice, &err), CF_OK);
+    sc.cfg.quasi_substeps = 1;
+    assert_int_equal(cf_budget_check_steps(&sc, "sub.json", &lat, &b, &c, &err), CF_OK);
+    assert_close(c.work_per_step / w3, pow(3.0 * 343 / (3.0 * 64), 1.5), 1e-12);
+    cf_lattice_free(&lat);
+    cf_law_free(&law);
+    cf_scene_free(&sc);
+    /* explicit steps cost one per spring: the same protocol on 2^3 and on 6^3 cells */
+    double work[2];
+    for (int k = 0; k < 2; k++) {
+        char body[400];
+        snprintf(body, sizeof body,
+                 "\"lattice\": {\"nx\": %d, \"ny\": %d, \"nz\": %d}, \"effects\": {\"inertia\": "
+                 "true}, \"integrator\": {\"dt_s\": 1e-7}, \"protocol\": {\"kind\": \"ramp\", "
+                 "\"to_strain\": 0.1, \"duration_s\": 0.01}",
+                 k ? 6 : 2, k ? 6 : 2, k ? 6 : 2);
+        scene("ex.json", body);
+        snprintf(p, sizeof p, "%s/ex.json", dir);
+        assert_int_equal(cf_scene_load(p, &sc, &err), CF_OK);
+        assert_int_equal(cf_law_init(&law, &sc.spring, &err), CF_OK);
+        assert_int_equal(cf_lattice_create(&lat, &law, sc.method, &sc.cfg.lattice, &err), CF_OK);
+        assert_int_equal(cf_budget_check_steps(&sc, "ex.json", &lat, &b, &c, &err), CF_OK);
+        assert_close(c.work, c.steps * (double)lat.ns, 1e-9 * c.work);
+        work[k] = c.work;
+        if (k == 1) { /* a limit between the two: the small lattice fits, the large does not */
+            b.max_work = 0.5 * (work[0] + work[1]);
+            assert_int_equal(cf_budget_check_steps(&sc, "ex.json", &lat, &b, &c, &err),
+                             CF_E_DATA);
+            assert_non_null(strstr(err.msg, "integrator.dt_s"));
+            assert_non_null(strstr(err.msg, "at least"));
+        }
+        cf_lattice_free(&lat);
+        cf_law_free(&law);
+        cf_scene_free(&sc);
+    }
+    assert_true(work[1] > 10 * work[0]);
+    /* the shipped scenes are within the default budget */
+    b = cf_budget_default();
+    static const char *const shipped[] = {"data/scenes/uniaxial.json", "data/scenes/hysteresis.json",
+                                          "data/scenes/creep.json", "data/scenes/relaxation.json",
+                                          "data/scenes/synthetic_relaxation.json"};
+    for (size_t i = 0; i < sizeof shipped / sizeof shipped[0]; i++) {
+        assert_int_equal(cf_scene_load(shipped[i], &sc, &err), CF_OK);
+        assert_int_equal(cf_law_init(&law, &sc.spring, &err), CF_OK);
+        assert_int_equal(cf_lattice_create(&lat, &law, sc.method, &sc.cfg.lattice, &err), CF_OK);
+        if (cf_budget_check_steps(&sc, shipped[i], &lat, &b, &c, &err) != CF_OK)
+            fail_msg("%s: %s", shipped[i], err.msg);
+        cf_lattice_free(&lat);
+        cf_law_free(&law);
+        cf_scene_free(&sc);
+    }
+    /* and the limit is the caller's */
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "simulate data/scenes/uniaxial.json -o %s/u.csv --max-work 1000", dir),
+                     65);
+    assert_non_null(strstr(errb, "spring-steps"));
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "fit data/telescoping.csv --validate --max-work 1e6 -q"),
+                     65);
+    assert_non_null(strstr(errb, "rows would fit"));
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "simulate data/scenes/uniaxial.json -o %s/u.csv --max-work 0", dir),
+                     2);
+}
+
 /* Under a small address-space limit every scene ends with a status, never a signal. (Skipped
 ** under AddressSanitizer, which reserves more address space than any such limit.) */
 static void memory_pressure_gives_a_status_not_a_crash(void **state)
@@ -214,6 +322,7 @@ int main(void)
         cmocka_unit_test(costly_scenes_are_refused_naming_the_key),
         cmocka_unit_test(limits_can_be_set),
         cmocka_unit_test(fit_validate_takes_the_scene_budget),
+        cmocka_unit_test(work_counts_the_lattice_and_its_solves),
         cmocka_unit_test(memory_pressure_gives_a_status_not_a_crash),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -90,6 +90,23 @@ cf_status cf_cli_parse_double(const char *name, const char *text, double *out, c
     return CF_OK;
 }
 
+int cf_cli_budget_option(const char *cmd, const char *flag, const char *value, cf_budget *b)
+{
+    cf_error err = {0};
+    if (strcmp(flag, "--max-memory") == 0) {
+        if (!(b->max_memory_bytes = cf_cli_parse_size(value)))
+            return cf_cli_usage_error(cmd, "--max-memory '%s': expected a size in bytes, "
+                                           "optionally with K, M or G", value);
+        return 0;
+    }
+    double *v = strcmp(flag, "--max-steps") == 0 ? &b->max_steps : &b->max_work;
+    if (cf_cli_parse_double(flag, value, v, &err) != CF_OK)
+        return cf_cli_usage_error(cmd, "%s", err.msg);
+    if (!(*v >= 1))
+        return cf_cli_usage_error(cmd, "%s %g: must be at least 1", flag, *v);
+    return 0;
+}
+
 cf_status cf_cli_parse_long(const char *name, const char *text, long lo, long hi, long *out,
                             cf_error *err)
 {

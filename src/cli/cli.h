@@ -9,6 +9,7 @@
 #include <getopt.h>
 #include <stdio.h>
 
+#include "conifit/budget.h"
 #include "conifit/error.h"
 #include "conifit/law.h"
 
@@ -40,6 +41,10 @@ cf_status cf_cli_parse_double(const char *name, const char *text, double *out, c
 
 /* A size in bytes with an optional K, M or G (binary) suffix; 0 when it is not one. */
 double cf_cli_parse_size(const char *text);
+
+/* The budget options shared by simulate and fit: --max-memory SIZE, --max-steps N, --max-work N
+** (flag names one of them) into b. 0 when taken, else the usage exit status (message printed). */
+int cf_cli_budget_option(const char *cmd, const char *flag, const char *value, cf_budget *b);
 
 /* Parses a whole number in [lo, hi] for option `name`. */
 cf_status cf_cli_parse_long(const char *name, const char *text, long lo, long hi, long *out,

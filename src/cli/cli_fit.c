@@ -51,8 +51,9 @@ static const char fit_help[] =
     "  --target lattice|spring fit the lattice's curve in the table's mode (implies --validate)\n"
     "                          or the spring's (default for uniaxial tables)\n"
     "  --through-msm [SCENE.json]  --target lattice [--validate SCENE.json]\n"
-    "  --max-memory SIZE, --max-steps N  the validation's budget, as for simulate (defaults\n"
-    "                          2G and 1e7 static solves): a larger lattice or table is refused\n"
+    "  --max-memory SIZE, --max-steps N, --max-work N  the validation's budget, as for\n"
+    "                          simulate (defaults 2G, 1e7 static solves and 1e10 spring-steps\n"
+    "                          of work): a larger lattice or table is refused\n"
     "  --joint                 one lattice for every table, each in its own mode\n"
     "  --calibration C         isotropic (default), axial, or fitted (with --joint)\n"
     "  --mode M                the table's test mode: uniaxial, shear, planar, equibiaxial or\n"
@@ -184,13 +185,15 @@ enum {
     OPT_STRESS_MEASURE,
     OPT_STRAIN_MEASURE,
     OPT_MAX_MEMORY,
-    OPT_MAX_STEPS
+    OPT_MAX_STEPS,
+    OPT_MAX_WORK
 };
 
 static const struct option fit_options[] = {
     {"plot", required_argument, NULL, OPT_PLOT},
     {"max-memory", required_argument, NULL, OPT_MAX_MEMORY},
     {"max-steps", required_argument, NULL, OPT_MAX_STEPS},
+    {"max-work", required_argument, NULL, OPT_MAX_WORK},
     {"type", required_argument, NULL, OPT_TYPE},
     {"fix", required_argument, NULL, OPT_FIX},
     {"index-max", required_argument, NULL, OPT_INDEX_MAX},
@@ -381,17 +384,11 @@ static int fit_option(void *ctx, int c, const char *optval)
         return 0;
     case OPT_RELATIVE: fo->relative = 1; return 0;
     case OPT_MAX_MEMORY:
-        if (!(a->popt.budget.max_memory_bytes = cf_cli_parse_size(optval)))
-            return cf_cli_usage_error("fit", "--max-memory '%s': expected a size in bytes, "
-                                             "optionally with K, M or G", optval);
-        return 0;
+        return cf_cli_budget_option("fit", "--max-memory", optval, &a->popt.budget);
     case OPT_MAX_STEPS:
-        if (cf_cli_parse_double("--max-steps", optval, &a->popt.budget.max_steps, &err))
-            return cf_cli_usage_error("fit", "%s", err.msg);
-        if (!(a->popt.budget.max_steps >= 1))
-            return cf_cli_usage_error("fit", "--max-steps %g: must be at least 1",
-                                      a->popt.budget.max_steps);
-        return 0;
+        return cf_cli_budget_option("fit", "--max-steps", optval, &a->popt.budget);
+    case OPT_MAX_WORK:
+        return cf_cli_budget_option("fit", "--max-work", optval, &a->popt.budget);
     case OPT_OPTIMIZER:
         if (cf_fit_optimizer_parse(optval, &fo->optimizer, &err) != CF_OK)
             return cf_cli_usage_error("fit", "option --optimizer: %s", err.msg);

@@ -4,6 +4,7 @@
 #include "conifit/budget.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "conifit/calibration.h"
@@ -26,8 +27,36 @@
 
 cf_budget cf_budget_default(void)
 {
-    cf_budget b = {CF_BUDGET_MAX_MEMORY_DEFAULT, CF_BUDGET_MAX_STEPS_DEFAULT};
+    cf_budget b = {CF_BUDGET_MAX_MEMORY_DEFAULT, CF_BUDGET_MAX_STEPS_DEFAULT,
+                   CF_BUDGET_MAX_WORK_DEFAULT};
     return b;
+}
+
+double cf_budget_solve_work(double unknowns)
+{
+    return CF_BUDGET_SOLVE_WORK_3 * pow(fmax(unknowns, 1.0) / 192.0, 1.5);
+}
+
+/* The work of the scene against the limit: CF_E_DATA naming the key, the estimate and what of
+** that key would fit. `fit` is the key's value that would fit, `fit_what` how to read it. */
+static cf_status check_work(const char *name, const char *key, const cf_scene_cost *c,
+                            const cf_lattice *lat, const cf_budget *b, double fit,
+                            const char *fit_what, cf_error *err)
+{
+    if (c->work <= b->max_work)
+        return CF_OK;
+    char fits[160];
+    if (fit > 0 && isfinite(fit))
+        snprintf(fits, sizeof fits, "%s %.4g would fit", fit_what, fit);
+    else
+        snprintf(fits, sizeof fits, "not even one step or sample fits this lattice: reduce "
+                                    "'lattice.nx/ny/nz'");
+    return cf_error_set(err, CF_E_DATA,
+                        "%s: key '%s': the scene needs about %.3g spring-steps of work (%.4g %s "
+                        "of a %dx%dx%d lattice, %.3g each), above the limit of %.3g (about 2 to "
+                        "6 minutes of one core; raise it with --max-work); %s",
+                        name, key, c->work, c->steps, c->steps_kind, lat->cfg.nx, lat->cfg.ny, lat->cfg.nz,
+                        c->work_per_step, b->max_work, fits);
 }
 
 static double mib(double bytes)
@@ -86,6 +115,10 @@ cf_status cf_budget_check_steps(const cf_scene *sc, const char *name, cf_lattice
     const cf_msm_config *cfg = &sc->cfg;
     const double duration = sc->npath ? sc->path_t_s[sc->npath - 1] - sc->path_t_s[0] : 0;
     const char *key;
+    /* what one step costs on this lattice: a pass over the springs, or a solve */
+    const double solve = cf_budget_solve_work(3.0 * (double)lat->nn);
+    double fit = 0;
+    const char *fit_what = "";
     if (fx->inertia) {
         double stable = DT_SAFETY * cf_msm_stable_step(lat, fx);
         double dt = cfg->dt_s > 0 && cfg->dt_s < stable ? cfg->dt_s : stable;
@@ -95,24 +128,44 @@ cf_status cf_budget_check_steps(const cf_scene *sc, const char *name, cf_lattice
               : sc->kind == CF_PROTO_RAMP         ? "protocol.duration_s"
               : sc->kind == CF_PROTO_CYCLES       ? "protocol.period_s"
                                                   : "protocol.hold_s";
+        c->work_per_step = (double)lat->ns;
+        const double share = b->max_work / (c->steps * c->work_per_step);
+        if (cfg->dt_s > 0 && cfg->dt_s < stable) {
+            fit = cfg->dt_s / share;
+            fit_what = "a step dt_s [s] of at least";
+        } else {
+            fit = duration * share;
+            fit_what = "a protocol lasting [s] at most";
+        }
     } else if (fx->eta_MPa_s > 0 || fx->maxwell_E_MPa > 0 || fx->prony_count > 0) {
         c->steps_kind = "implicit steps";
+        c->work_per_step = solve;
+        const double can = b->max_work / solve; /* steps that fit */
         if (cfg->dt_s > 0) {
             c->steps = duration / cfg->dt_s + (double)sc->nsamples;
             key = "integrator.dt_s";
+            fit = can > (double)sc->nsamples ? duration / (can - (double)sc->nsamples) : 0;
+            fit_what = "a step dt_s [s] of at least";
         } else {
             c->steps = (double)sc->nsamples * (cfg->quasi_substeps > 0 ? cfg->quasi_substeps : 1);
             key = cfg->quasi_substeps > 1 ? "integrator.substeps" : "samples_per_segment";
+            fit = cfg->quasi_substeps > 1 ? floor(can / (double)sc->nsamples) : floor(can);
+            fit_what = cfg->quasi_substeps > 1 ? "substeps per sample interval: at most"
+                                               : "samples in all: at most";
         }
     } else {
         c->steps = (double)sc->nsamples;
         c->steps_kind = "static solves";
         key = "samples_per_segment";
+        c->work_per_step = solve;
+        fit = floor(b->max_work / solve);
+        fit_what = "samples in all: at most";
     }
+    c->work = c->steps * c->work_per_step;
     if (!(c->steps <= b->max_steps))
         return cf_error_set(err, CF_E_DATA,
                             "%s: key '%s': the scene needs about %.4g %s, above the limit of %.4g "
                             "(raise it with --max-steps)",
                             name, key, c->steps, c->steps_kind, b->max_steps);
-    return CF_OK;
+    return check_work(name, key, c, lat, b, fit, fit_what, err);
 }

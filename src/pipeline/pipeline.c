@@ -109,6 +109,19 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
                                 "above the limit of %g (raise it with --max-steps)",
                                 t->path, solves, lc->nx, lc->ny, lc->nz, t->count, types,
                                 opt->budget.max_steps);
+        /* and what they cost on that lattice (budget.h) */
+        const double each = cf_budget_solve_work(
+            3.0 * (lc->nx + 1.0) * (lc->ny + 1.0) * (lc->nz + 1.0));
+        if (solves * each > opt->budget.max_work)
+            return cf_error_set(err, CF_E_DATA,
+                                "%s: the validation needs about %.3g spring-steps of work (%.3g "
+                                "static solves of the %dx%dx%d lattice, %.3g each), above the "
+                                "limit of %.3g (raise it with --max-work); at most %.0f rows "
+                                "would fit",
+                                t->path, solves * each, solves, lc->nx, lc->ny, lc->nz, each,
+                                opt->budget.max_work,
+                                fmax(0.0, floor(opt->budget.max_work / each / types) -
+                                              VALIDATE_SCAN_SOLVES));
     }
     for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING; ty++) {
         if (!(opt->types & (1u << ty)))

@@ -20,7 +20,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     cf_scene sc;
     cf_error err = {0};
     if (cf_scene_parse(text, "fuzz.json", &sc, &err) == CF_OK) {
-        cf_budget b = {64.0 * 1024 * 1024, 1e5};
+        cf_budget b = {64.0 * 1024 * 1024, 1e5, 1e8};
         cf_scene_cost c;
         cf_law law;
         if (cf_budget_check_size(&sc, "fuzz.json", &b, &c, &err) == CF_OK &&
