@@ -47,15 +47,11 @@ void cf_lattice_free(cf_lattice *lat)
     lat->si = lat->sj = lat->top = NULL;
 }
 
-/* Number of cells along one axis that contain a segment from node index p with offset o
-** (o in {-1, 0, 1}) on an axis of n cells: an offset of 0 lies in cells p-1 and p, else in one. */
-static int cells_along(int p, int o, int n)
+double cf_lattice_axis_share(int p, int o, int n)
 {
-    if (o != 0) {
-        int c = o > 0 ? p : p - 1;
-        return (c >= 0 && c < n) ? 1 : 0;
-    }
-    return (p - 1 >= 0) + (p < n);
+    if (o != 0)
+        return p + o >= 0 && p + o <= n ? 1.0 : 0.0;
+    return p == 0 || p == n ? 0.5 : 1.0;
 }
 
 static size_t node_id(const cf_lattice_config *c, int i, int j, int k)
@@ -118,13 +114,10 @@ static void add_springs(cf_lattice *lat, const int (*off)[3], int noff, int i, i
         int i2 = i + off[o][0], j2 = j + off[o][1], k2 = k + off[o][2];
         if (i2 < 0 || i2 > cfg->nx || j2 < 0 || j2 > cfg->ny || k2 < 0 || k2 > cfg->nz)
             continue;
-        int cells = cells_along(i, off[o][0], cfg->nx) * cells_along(j, off[o][1], cfg->ny) *
-                    cells_along(k, off[o][2], cfg->nz);
-        if (cells == 0)
-            continue;
-        int zeros = (off[o][0] == 0) + (off[o][1] == 0) + (off[o][2] == 0);
-        double share = cells / (double)(1 << zeros); /* 4, 2 or 1 cells share it */
-        int nzc = 3 - zeros;
+        double share = cf_lattice_axis_share(i, off[o][0], cfg->nx) *
+                       cf_lattice_axis_share(j, off[o][1], cfg->ny) *
+                       cf_lattice_axis_share(k, off[o][2], cfg->nz); /* 1/4, 1/2 or 1 */
+        int nzc = (off[o][0] != 0) + (off[o][1] != 0) + (off[o][2] != 0);
         double L0 = H * sqrt((double)nzc);
         size_t q = node_id(cfg, i2, j2, k2), ns = lat->ns;
         lat->si[ns] = (uint32_t)(p < q ? p : q);
@@ -158,9 +151,10 @@ static int place_nodes(cf_lattice *lat, const int (*off)[3], int noff)
                 lat->X[p] = lat->x[p] = i * H;
                 lat->Y[p] = lat->y[p] = j * H;
                 lat->Z[p] = lat->z[p] = k * H;
-                int cx = cells_along(i, 0, cfg->nx), cy = cells_along(j, 0, cfg->ny),
-                    cz = cells_along(k, 0, cfg->nz);
-                lat->mass_t[p] = cell_mass * cx * cy * cz / 8.0;
+                /* the node's share of the 1 to 8 cells around it */
+                lat->mass_t[p] = cell_mass * cf_lattice_axis_share(i, 0, cfg->nx) *
+                                 cf_lattice_axis_share(j, 0, cfg->ny) *
+                                 cf_lattice_axis_share(k, 0, cfg->nz);
                 if (lat->mass_t[p] < lat->m_min_t)
                     lat->m_min_t = lat->mass_t[p];
                 add_springs(lat, off, noff, i, j, k, degree);
@@ -194,7 +188,8 @@ static void set_boundary(cf_lattice *lat)
     for (int j = 0; j <= cfg->ny; j++)
         for (int i = 0; i <= cfg->nx; i++) {
             lat->top[t] = (uint32_t)node_id(cfg, i, j, cfg->nz);
-            lat->top_share[t] = cells_along(i, 0, cfg->nx) * cells_along(j, 0, cfg->ny) / 4.0;
+            lat->top_share[t] =
+                cf_lattice_axis_share(i, 0, cfg->nx) * cf_lattice_axis_share(j, 0, cfg->ny);
             t++;
         }
 }

@@ -15,16 +15,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Share of the cells holding a segment along one axis from node index p with offset o on an axis
-** of n cells, as lattice.c counts it (a cell's edge is shared by up to 4 cells, a face by 2): 1
-** across the axis, along it 1/2 on the boundary and 1 inside; 0 when the far end is outside. */
-static double axis_share(int p, int o, int n)
-{
-    if (o != 0)
-        return p + o >= 0 && p + o <= n ? 1.0 : 0.0;
-    return p == 0 || p == n ? 0.5 : 1.0;
-}
-
 cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const long *eq,
                                   cf_error *err)
 {
@@ -57,13 +47,14 @@ cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const
         sd->L0 = lat->H_mm * sqrt((double)nzc); /* as lattice.c forms them */
         sd->a = lat->H_mm / sd->L0;
         sd->wk[0] = 1.0;
-        sd->wk[1] = off[2] != 0 ? 1.0 : 0.5;
+        sd->wk[1] = cf_lattice_axis_share(0, off[2], nz); /* bottom and top layers */
         if (!(sd->wl = malloc(st->layer * sizeof(double))))
             goto oom;
         for (int j = 0; j <= ny; j++)
             for (int i = 0; i <= nx; i++)
                 sd->wl[(size_t)i + (size_t)(nx + 1) * (size_t)j] =
-                    cfg->weight[fam] * axis_share(i, off[0], nx) * axis_share(j, off[1], ny);
+                    cfg->weight[fam] * cf_lattice_axis_share(i, off[0], nx) *
+                    cf_lattice_axis_share(j, off[1], ny);
     }
     for (size_t p = 0; p < lat->nn; p++)
         for (int a = 0; a < 3; a++) {

@@ -108,6 +108,13 @@ void cf_lattice_free(cf_lattice *lat);
 /* Puts every node back at its reference position. */
 void cf_lattice_reset(cf_lattice *lat);
 
+/* The share, along one axis of n cells, of the cells holding a segment from node index p with
+** offset o (-1, 0 or 1): across the axis (o != 0) 1, or 0 when the far end is outside; along it
+** (o == 0) 1/2 on the boundary and 1 inside, since there two cells hold it. A spring's weight is
+** its family's times the product over the three axes, a node's mass the cell mass times the
+** product with o = 0 (the explicit step's stencil forms its weights from it too). */
+double cf_lattice_axis_share(int p, int o, int n);
+
 /* The force kernel: from the current positions computes every spring's length, compression, law
 ** force and (when lat->with_stiffness) stiffness and elastic tension (L_mm, u_mm, F_N, k_N_per_mm,
 ** T_N) and the node forces
