@@ -666,6 +666,38 @@ static void stencil_step_equals_edge_list_kernel(void **state)
     cf_law_free(&law);
 }
 
+/* The explicit step evaluates the spring's polynomial (law_simd.h) for the closed form and the
+** table wherever it fits within CF_POLY_TOL, and keeps the closed form and the table of a spring
+** too conical for it; exact runs the scalar law. */
+static void stencil_step_runs_the_polynomial_where_it_fits(void **state)
+{
+    (void)state;
+    static const cf_spring springs[] = {{6, 15, 2.5, 2, 26, 10}, {1.5, 30, 2.5, 0.3, 26, 10}};
+    const cf_law_method methods[3] = {CF_LAW_CLOSED, CF_LAW_TABLE, CF_LAW_EXACT};
+    for (int si = 0; si < 2; si++)
+        for (int mi = 0; mi < 3; mi++) {
+            cf_law law;
+            cf_error err = {0};
+            assert_int_equal(cf_law_init(&law, &springs[si], &err), CF_OK);
+            assert_int_equal(cf_law_table_build(&law, 256, &err), CF_OK);
+            cf_lattice_config c = cf_lattice_default();
+            cf_lattice lat;
+            assert_int_equal(cf_lattice_create(&lat, &law, methods[mi], &c, &err), CF_OK);
+            cf_lattice_stepper st;
+            assert_int_equal(cf_lattice_stepper_init(&st, &lat, NULL, &err), CF_OK);
+            const int expect = mi == 2    ? -1
+                               : si == 0 ? CF_LANE_POLY
+                               : mi == 0 ? CF_LANE_CLOSED
+                                         : CF_LANE_TABLE;
+            assert_int_equal(st.form, expect);
+            if (expect == CF_LANE_POLY)
+                assert_true(st.poly_error <= CF_POLY_TOL);
+            cf_lattice_stepper_free(&st);
+            cf_lattice_free(&lat);
+            cf_law_free(&law);
+        }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -676,6 +708,7 @@ int main(void)
         cmocka_unit_test(every_spring_applies_equal_and_opposite_forces),
         cmocka_unit_test(fused_step_matches_independent_forces),
         cmocka_unit_test(stencil_step_equals_edge_list_kernel),
+        cmocka_unit_test(stencil_step_runs_the_polynomial_where_it_fits),
         cmocka_unit_test(lattice_masses_and_top_shares_add_up),
         cmocka_unit_test(static_solve_and_long_damped_dynamic_run_agree),
         cmocka_unit_test(stability_limit_is_confirmed_by_a_slow_damped_dynamic_run),

@@ -219,6 +219,51 @@ static void closed_and_exact_match_reference_in_every_corner(void **state)
             }
 }
 
+/* The polynomial of region 2 (law_poly.c, law_simd.h): fitted wherever one polynomial of its degree
+** reaches CF_POLY_TOL (rho down to 0.2 in this list; refused at 0.1 and 1e-3, where the caller keeps
+** the closed form), and then within the closed form's 1e-12 of the long-double reference at every
+** hard case, through the dispatched batch (NaN to 0, +-Inf to +-F_C). */
+static void polynomial_form_matches_reference_where_it_fits(void **state)
+{
+    (void)state;
+    int fitted = 0;
+    for (size_t a = 0; a < sizeof rhos / sizeof rhos[0]; a++)
+        for (size_t b = 0; b < sizeof scales / sizeof scales[0]; b++)
+            for (size_t c = 0; c < sizeof coils / sizeof coils[0]; c++) {
+                cf_law law;
+                init_ok(&law, scaled(rhos[a], coils[c], scales[b], scales[(b + 1) % 3]));
+                cf_law_lanes lanes;
+                cf_law_lanes_init(&law, &lanes);
+                double worst;
+                const int ok = cf_law_lanes_fit_poly(&law, &lanes, &worst);
+                assert_int_equal(ok, rhos[a] >= 0.2);
+                assert_int_equal(lanes.poly_fit, ok);
+                if (!ok) {
+                    assert_true(!(worst <= CF_POLY_TOL));
+                    continue;
+                }
+                assert_true(worst <= CF_POLY_TOL);
+                fitted++;
+                double u[1030], F[1030];
+                size_t np = probe_points(&law, u, 1024);
+                u[np++] = NAN;
+                u[np++] = INFINITY;
+                u[np++] = -INFINITY;
+                cf_law_force_lanes(&lanes, CF_LANE_POLY, np, u, F);
+                assert_close(F[np - 3], 0.0, 0);
+                assert_close(F[np - 2], law.F_C_N, 0);
+                assert_close(F[np - 1], -law.F_C_N, 0);
+                for (size_t i = 0; i + 3 < np; i++) {
+                    const long double R = reference_force(&law.p, u[i]);
+                    const double errv = fabs(F[i] - (double)R);
+                    if (!isfinite(F[i]) || (errv > CLOSED_TOL * fabs((double)R) && errv > 0))
+                        fail_msg("polynomial: rho=%.17g n=%g G=%g H=%g u=%.17g F=%.17g ref=%.17Lg",
+                                 law.rho, law.p.n, law.p.G_MPa, law.p.H_mm, u[i], F[i], R);
+                }
+            }
+    assert_int_equal(fitted, 4 * 3 * 3);
+}
+
 static void table_error_is_within_its_stated_bound(void **state)
 {
     (void)state;
@@ -591,6 +636,7 @@ int main(void)
         cmocka_unit_test(telescoping_spring_matches_hand_values),
         cmocka_unit_test(non_telescoping_spring_matches_hand_values),
         cmocka_unit_test(closed_and_exact_match_reference_in_every_corner),
+        cmocka_unit_test(polynomial_form_matches_reference_where_it_fits),
         cmocka_unit_test(table_error_is_within_its_stated_bound),
         cmocka_unit_test(table_error_falls_with_table_size),
         cmocka_unit_test(law_is_odd_increasing_and_c1_at_transition),

@@ -27,6 +27,10 @@ cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const
         st->form = CF_LANE_TABLE;
     else
         st->form = -1;
+    /* closed form and table: the spring's polynomial when it is within CF_POLY_TOL of the closed
+    ** form (more accurate than the table, cheaper than both) */
+    if (st->form >= 0 && cf_law_lanes_fit_poly(lat->law, &st->lanes, &st->poly_error))
+        st->form = CF_LANE_POLY;
     const cf_lattice_config *cfg = &lat->cfg;
     const int nx = cfg->nx, ny = cfg->ny, nz = cfg->nz;
     st->layer = (size_t)(nx + 1) * (size_t)(ny + 1);
@@ -106,7 +110,9 @@ run_dir(const cf_lattice *lat, const cf_law_lanes *c, int form, const cf_step_di
         const double au = W[k] != 0.0 ? fabs(uk) : 0.0; /* a wrapped pair is no spring */
         umax = au > umax ? au : umax;
     }
-    if (form == CF_LANE_TABLE)
+    if (form == CF_LANE_POLY)
+        cf_lanes_poly(c, n, u, F);
+    else if (form == CF_LANE_TABLE)
         cf_lanes_table(c, n, u, F);
     else if (form == CF_LANE_CLOSED)
         cf_lanes_closed(c, n, u, F);
@@ -165,48 +171,32 @@ layer_springs(const cf_lattice_stepper *st, int form, size_t k)
     return umax;
 }
 
-CF_DISPATCH
-static double slabs_closed(const cf_lattice_stepper *st, size_t parity)
-{
-    double umax = 0;
-#pragma omp parallel for schedule(static) reduction(max : umax) if (st->threads)
-    for (size_t k = parity; k < st->nslab; k += 2) {
-        double um = layer_springs(st, CF_LANE_CLOSED, k);
-        umax = um > umax ? um : umax;
+/* The slabs of one parity with the law's form fixed at compile time, one copy per form and
+** instruction set. */
+#define CF_SLABS(name, form_)                                                                      \
+    static double name(const cf_lattice_stepper *st, size_t parity)                                \
+    {                                                                                              \
+        double umax = 0;                                                                           \
+        _Pragma("omp parallel for schedule(static) reduction(max : umax) if (st->threads)")       \
+        for (size_t k = parity; k < st->nslab; k += 2) {                                           \
+            double um = layer_springs(st, form_, k);                                               \
+            umax = um > umax ? um : umax;                                                          \
+        }                                                                                          \
+        return umax;                                                                               \
     }
-    return umax;
-}
-
-CF_DISPATCH
-static double slabs_table(const cf_lattice_stepper *st, size_t parity)
-{
-    double umax = 0;
-#pragma omp parallel for schedule(static) reduction(max : umax) if (st->threads)
-    for (size_t k = parity; k < st->nslab; k += 2) {
-        double um = layer_springs(st, CF_LANE_TABLE, k);
-        umax = um > umax ? um : umax;
-    }
-    return umax;
-}
-
-static double slabs_scalar(const cf_lattice_stepper *st, size_t parity)
-{
-    double umax = 0;
-#pragma omp parallel for schedule(static) reduction(max : umax) if (st->threads)
-    for (size_t k = parity; k < st->nslab; k += 2) {
-        double um = layer_springs(st, -1, k);
-        umax = um > umax ? um : umax;
-    }
-    return umax;
-}
+CF_DISPATCH CF_SLABS(slabs_closed, CF_LANE_CLOSED)
+CF_DISPATCH CF_SLABS(slabs_table, CF_LANE_TABLE)
+CF_DISPATCH CF_SLABS(slabs_poly, CF_LANE_POLY)
+CF_SLABS(slabs_scalar, -1)
 
 double cf_lattice_stepper_forces(cf_lattice_stepper *st)
 {
     double umax = 0;
     for (size_t parity = 0; parity < 2; parity++) { /* even slabs, then odd: no shared node */
-        double um = st->form == CF_LANE_CLOSED  ? slabs_closed(st, parity)
-                    : st->form == CF_LANE_TABLE ? slabs_table(st, parity)
-                                                : slabs_scalar(st, parity);
+        double um = st->form == CF_LANE_POLY     ? slabs_poly(st, parity)
+                    : st->form == CF_LANE_CLOSED ? slabs_closed(st, parity)
+                    : st->form == CF_LANE_TABLE  ? slabs_table(st, parity)
+                                                 : slabs_scalar(st, parity);
         umax = um > umax ? um : umax;
     }
     return umax / st->lat->travel_mm;

@@ -53,7 +53,9 @@ typedef struct cf_step_dir {
 typedef struct cf_lattice_stepper {
     cf_lattice *lat;       /* not owned */
     cf_law_lanes lanes;
-    int form;              /* CF_LANE_CLOSED, CF_LANE_TABLE, or -1: the scalar law per block */
+    int form;              /* CF_LANE_POLY, CF_LANE_CLOSED, CF_LANE_TABLE, or -1: the scalar law
+                              per block */
+    double poly_error;     /* the polynomial's measured error (law_simd.h), NaN when not fitted */
     int ndir;              /* directions with springs (families of weight > 0) */
     cf_step_dir dir[CF_CELL_DIRS];
     size_t layer;          /* nodes per layer, (nx + 1)(ny + 1) */

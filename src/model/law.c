@@ -195,7 +195,7 @@ static double brent_solve(double (*f)(double, void *), double target, double lo,
     return root;
 }
 
-static void region2_exact(const cf_law *law, double delta, double *y, double *om)
+static void region2_exact(const cf_law *law, double delta, double *y, double *om, double *e_out)
 {
     if (delta <= CF_DELTA_SWITCH) {
         const double e_max = fmin(0.5, law->p.D2_mm > law->p.D1_mm
@@ -204,11 +204,20 @@ static void region2_exact(const cf_law *law, double delta, double *y, double *om
         double e = brent_solve(e_residual, delta, 0.0, e_max);
         *y = 1.0 - e;
         *om = one_minus_y4_e(e);
+        *e_out = e;
     } else {
         double yy = brent_solve(y_residual, 1.0 + delta, law->rho, 0.5);
         *y = yy;
         *om = 1.0 - yy * yy * yy * yy;
+        *e_out = 1.0 - yy;
     }
+}
+
+double cf_law_region2_e(const cf_law *law, double delta)
+{
+    double y, om, e;
+    region2_exact(law, delta, &y, &om, &e);
+    return e;
 }
 
 /* Cube root of x > 0 without libm's cbrt (which costs about twice as much here): an exponent-
@@ -323,12 +332,12 @@ cf_status cf_law_table_build(cf_law *law, size_t intervals, cf_error *err)
         /* grid node w_i; delta = r w^2; dy/dw = dy/ddelta * 2 r w with
         ** dy/ddelta = -de/ddelta = -4 y^2 / (3 (1 - y^4)) */
         const double w = (i == intervals) ? law->w_T : t->h * (double)i;
-        double y = 1, om = 0, dydw;
+        double y = 1, om = 0, e, dydw;
         if (i == 0 || r == 0) {
             /* limit at solid: e ~ sqrt(2 delta / 3) = sqrt(2 r / 3) w */
             dydw = -sqrt(2.0 * r / 3.0);
         } else {
-            region2_exact(law, r * w * w, &y, &om);
+            region2_exact(law, r * w * w, &y, &om, &e);
             dydw = -8.0 * r * w * y * y / (3.0 * om);
         }
         t->y[i] = y;
@@ -412,7 +421,7 @@ static CF_ALWAYS_INLINE double law_eval(const cf_law *law, cf_law_method method,
     double y, om, e;
     switch (method) {
     case CF_LAW_EXACT:
-        region2_exact(law, delta, &y, &om);
+        region2_exact(law, delta, &y, &om, &e);
         break;
     case CF_LAW_TABLE: /* no table built: closed form with Newton */
     case CF_LAW_CLOSED_NEWTON:
@@ -460,6 +469,7 @@ static inline void law_many(const cf_law *law, cf_law_method method, size_t coun
 
 void cf_law_lanes_init(const cf_law *law, cf_law_lanes *lanes)
 {
+    memset(lanes, 0, sizeof *lanes);
     lanes->u_T = law->u_T_mm;
     lanes->s = law->travel_mm;
     lanes->inv_s = law->inv_travel;

@@ -17,6 +17,16 @@
 ** from cf_lane_rsqrt (multiplies and adds, no square-root instruction).
 ** Table: the cubic Hermite table of law.c, stored per interval as the coefficients of its
 ** polynomial in the local coordinate (one cache line per lookup); the same values as law.c's.
+** Polynomial (one spring, many evaluations: the lattice's explicit step): region 2 as a function
+** of w = sqrt((s - |u|)/s) alone, fitted for one spring by law_poly.c. With e = 1 - y = w P and
+** r = 1/rho - 1, the quartic divided by w^2 reads
+**   h(P) = P^2 (6 - 4e + e^2) - 4 r (1 - e) = 0,   regular at w = 0 (P(0) = sqrt(2r/3)),
+** and P(w) is analytic on [0, w_T] (its singularities lie where c^4 = 1, delta = -2 or -1 +- i,
+** off the real axis). Two polynomials of degree CF_POLY_DEGREE in w, from Chebyshev interpolation
+** of the exact solution: P0(w) ~ P and K(w) ~ 1/h'(P); then one division-free Newton step
+** P1 = P0 - h(P0) K, whose error is about the product of the two fits' errors, and y = 1 - w P1.
+** No lookup, no division, one square root: every lane runs the same few multiply-adds. The fit
+** is kept only where it is measured within CF_POLY_TOL of the closed form (law_poly.c).
 **
 ** Vectorisation: every loop over lanes must if-convert, so no lane's work may sit behind a
 ** condition the compiler keeps as a branch (a table lookup inside the region selection, a clamp it
@@ -53,19 +63,38 @@
 #define CF_DISPATCH
 #endif
 
+#define CF_POLY_DEGREE 12
+#define CF_POLY_TOL 1e-13 /* largest relative error of F, against the closed form, for a fit */
+
 /* Everything a lane needs, copied by value into the loop (loads the compiler can hoist). */
 typedef struct cf_law_lanes {
     double u_T, s, inv_s, k0, F_C, rim1; /* law.h: u_T_mm, travel_mm, inv_travel, k0, F_C, 1/rho-1 */
     const double *coef; /* table: 4 coefficients per interval (NULL: no table) */
     double inv_h;       /* table: intervals per unit of w */
     double xmax;        /* table: intervals - 1, the last interval's index */
+    /* polynomial (poly_fit set by cf_law_lanes_fit_poly): w is clamped to w_T and mapped to
+    ** x = w px_a - 1 in [-1, 1]; pa and pb are P0 and K in powers of x */
+    int poly_fit;
+    double w_T, px_a, r4; /* w_T, 2/w_T, 4 (1/rho - 1) */
+    double pa[CF_POLY_DEGREE + 1], pb[CF_POLY_DEGREE + 1];
 } cf_law_lanes;
 
-/* Fills lanes from law; the table coefficients are those of law's table when it has one. */
+/* Fills lanes from law; the table coefficients are those of law's table when it has one. No
+** polynomial (poly_fit = 0). */
 void cf_law_lanes_init(const cf_law *law, cf_law_lanes *lanes);
 
-/* The same force of one lane for either form: the caller has chosen it at compile time. */
-enum { CF_LANE_CLOSED = 0, CF_LANE_TABLE = 1 };
+/* Fits the polynomial of region 2 to law (law_poly.c) and measures it against the closed form
+** over region 2; keeps it (poly_fit = 1) when its largest relative error of F is within
+** CF_POLY_TOL, and returns 1 then, else 0 (the spring is too conical for one polynomial of this
+** degree: about rho < 0.2, or has no region 2). *worst (may be NULL) receives the measured error,
+** or NAN when nothing was fitted. */
+int cf_law_lanes_fit_poly(const cf_law *law, cf_law_lanes *lanes, double *worst);
+
+/* e = 1 - y of region 2 at delta >= 0 from the exact solver (law.c). */
+double cf_law_region2_e(const cf_law *law, double delta);
+
+/* The same force of one lane for any form: the caller has chosen it at compile time. */
+enum { CF_LANE_CLOSED = 0, CF_LANE_TABLE = 1, CF_LANE_POLY = 2 };
 
 /* Regions 1 and 3 around a region-2 value F2 computed for a = |u|; NaN gives 0. */
 CF_LANE double cf_lane_regions(const cf_law_lanes *c, double u, double a, double F2)
@@ -147,6 +176,27 @@ CF_LANE double cf_lane_table_y(const cf_law_lanes *c, double u)
     return k[j] + q * (k[j + 1] + q * (k[j + 2] + q * k[j + 3]));
 }
 
+/* Region 2 from the fitted polynomial, for every lane (the caller selects the region). */
+CF_LANE double cf_lane_poly(const cf_law_lanes *c, double u)
+{
+    const double a = fabs(u), sa = c->s - a;
+    double w = sqrt((sa > 0.0 ? sa : 0.0) * c->inv_s);
+    w = w < c->w_T ? w : c->w_T; /* region 1 maps to the fit's end; NaN to 0 */
+    const double x = w * c->px_a - 1.0;
+    double P = c->pa[CF_POLY_DEGREE], K = c->pb[CF_POLY_DEGREE];
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC unroll 32
+#endif
+    for (int j = CF_POLY_DEGREE - 1; j >= 0; j--) {
+        P = P * x + c->pa[j];
+        K = K * x + c->pb[j];
+    }
+    const double e = w * P;
+    const double h = P * P * (6.0 + e * (-4.0 + e)) - c->r4 * (1.0 - e);
+    const double y = 1.0 - w * (P - h * K);
+    return cf_lane_regions(c, u, a, c->F_C * y * y * y);
+}
+
 /* Forces F[k] of count displacements u[k] (F may be u), each form a few vectorised loops over
 ** chunks: the table's y of every lane first, stored, then the regions; a lookup inside the
 ** region selection would be a conditional load, which the compiler does not vectorise. */
@@ -157,6 +207,13 @@ CF_LANE void cf_lanes_closed(const cf_law_lanes *c, size_t count, const double *
 #pragma omp simd
     for (size_t k = 0; k < count; k++)
         F[k] = cf_lane_closed(c, u[k]);
+}
+
+CF_LANE void cf_lanes_poly(const cf_law_lanes *c, size_t count, const double *u, double *F)
+{
+#pragma omp simd
+    for (size_t k = 0; k < count; k++)
+        F[k] = cf_lane_poly(c, u[k]);
 }
 
 CF_LANE void cf_lanes_table(const cf_law_lanes *c, size_t count, const double *u, double *F)
@@ -177,8 +234,9 @@ CF_LANE void cf_lanes_table(const cf_law_lanes *c, size_t count, const double *u
     }
 }
 
-/* Forces of count displacements with the closed form or the table (lanes->coef not NULL):
-** F[i] for u[i]. Vectorised, dispatched at run time. */
+/* Forces of count displacements with the closed form, the table (lanes->coef not NULL) or the
+** polynomial (lanes->poly_fit): F[i] for u[i]. Vectorised, dispatched at run time. A form whose
+** data lanes lacks runs the closed form. */
 void cf_law_force_lanes(const cf_law_lanes *lanes, int form, size_t count, const double *u,
                         double *F);
 
