@@ -110,12 +110,17 @@ run_dir(const cf_lattice *lat, const cf_law_lanes *c, int form, const cf_step_di
         const double au = W[k] != 0.0 ? fabs(uk) : 0.0; /* a wrapped pair is no spring */
         umax = au > umax ? au : umax;
     }
+    /* the vector lanes' law over a whole number of 8 lanes: a short run (a small lattice's
+    ** layer) would otherwise spend most of its time in the scalar remainder of the loop */
+    const size_t n8 = (n + 7) & ~(size_t)7;
+    for (size_t k = n; k < n8; k++)
+        u[k] = 0.0;
     if (form == CF_LANE_POLY)
-        cf_lanes_poly(c, n, u, F);
+        cf_lanes_poly(c, n8, u, F);
     else if (form == CF_LANE_TABLE)
-        cf_lanes_table(c, n, u, F);
+        cf_lanes_table(c, n8, u, F);
     else if (form == CF_LANE_CLOSED)
-        cf_lanes_closed(c, n, u, F);
+        cf_lanes_closed(c, n8, u, F);
     else /* the scalar law */
         cf_law_force_many(lat->law, lat->method, n, u, F, NULL);
     /* the forces at p, then at p + D: two loops, since the runs overlap when D < n (each pointer
