@@ -219,49 +219,67 @@ static void closed_and_exact_match_reference_in_every_corner(void **state)
             }
 }
 
-/* The polynomial of region 2 (law_poly.c, law_simd.h): fitted wherever one polynomial of its degree
-** reaches CF_POLY_TOL (rho down to 0.2 in this list; refused at 0.1 and 1e-3, where the caller keeps
-** the closed form), and then within the closed form's 1e-12 of the long-double reference at every
-** hard case, through the dispatched batch (NaN to 0, +-Inf to +-F_C). */
+/* The polynomial of region 2 of law, fitted: within the closed form's 1e-12 of the long-double
+** reference at every hard case, through the dispatched batch (NaN to 0, +-Inf to +-F_C). Returns
+** the degree it took. */
+static int check_poly(const cf_law *law)
+{
+    cf_law_lanes lanes;
+    cf_law_lanes_init(law, &lanes);
+    double worst;
+    assert_int_equal(cf_law_lanes_fit_poly(law, &lanes, &worst), 1);
+    assert_int_equal(lanes.poly_fit, 1);
+    assert_true(worst <= CF_POLY_TOL);
+    double u[1030], F[1030];
+    size_t np = probe_points(law, u, 1024);
+    u[np++] = NAN;
+    u[np++] = INFINITY;
+    u[np++] = -INFINITY;
+    cf_law_force_lanes(&lanes, CF_LANE_POLY, np, u, F);
+    assert_close(F[np - 3], 0.0, 0);
+    assert_close(F[np - 2], law->F_C_N, 0);
+    assert_close(F[np - 1], -law->F_C_N, 0);
+    for (size_t i = 0; i + 3 < np; i++) {
+        const long double R = reference_force(&law->p, u[i]);
+        const double errv = fabs(F[i] - (double)R);
+        if (!isfinite(F[i]) || (errv > CLOSED_TOL * fabs((double)R) && errv > 0))
+            fail_msg("polynomial of degree %d: rho=%.17g n=%g G=%g H=%g u=%.17g F=%.17g "
+                     "ref=%.17Lg",
+                     lanes.poly_degree, law->rho, law->p.n, law->p.G_MPa, law->p.H_mm, u[i], F[i],
+                     R);
+    }
+    return lanes.poly_degree;
+}
+
+/* The polynomial of region 2 (law_poly.c, law_simd.h): of the low degree down to rho = 0.5 in this
+** list, of the high degree at rho = 0.25 and 0.2, refused at 0.1 and 1e-3 (the caller keeps the
+** closed form), and where fitted within the closed form's bound at every hard case. */
 static void polynomial_form_matches_reference_where_it_fits(void **state)
 {
     (void)state;
-    int fitted = 0;
     for (size_t a = 0; a < sizeof rhos / sizeof rhos[0]; a++)
         for (size_t b = 0; b < sizeof scales / sizeof scales[0]; b++)
             for (size_t c = 0; c < sizeof coils / sizeof coils[0]; c++) {
                 cf_law law;
                 init_ok(&law, scaled(rhos[a], coils[c], scales[b], scales[(b + 1) % 3]));
+                if (rhos[a] >= 0.5) {
+                    assert_int_equal(check_poly(&law), CF_POLY_DEGREE_LOW);
+                    continue;
+                }
                 cf_law_lanes lanes;
                 cf_law_lanes_init(&law, &lanes);
                 double worst;
-                const int ok = cf_law_lanes_fit_poly(&law, &lanes, &worst);
-                assert_int_equal(ok, rhos[a] >= 0.2);
-                assert_int_equal(lanes.poly_fit, ok);
-                if (!ok) {
-                    assert_true(!(worst <= CF_POLY_TOL));
-                    continue;
-                }
-                assert_true(worst <= CF_POLY_TOL);
-                fitted++;
-                double u[1030], F[1030];
-                size_t np = probe_points(&law, u, 1024);
-                u[np++] = NAN;
-                u[np++] = INFINITY;
-                u[np++] = -INFINITY;
-                cf_law_force_lanes(&lanes, CF_LANE_POLY, np, u, F);
-                assert_close(F[np - 3], 0.0, 0);
-                assert_close(F[np - 2], law.F_C_N, 0);
-                assert_close(F[np - 1], -law.F_C_N, 0);
-                for (size_t i = 0; i + 3 < np; i++) {
-                    const long double R = reference_force(&law.p, u[i]);
-                    const double errv = fabs(F[i] - (double)R);
-                    if (!isfinite(F[i]) || (errv > CLOSED_TOL * fabs((double)R) && errv > 0))
-                        fail_msg("polynomial: rho=%.17g n=%g G=%g H=%g u=%.17g F=%.17g ref=%.17Lg",
-                                 law.rho, law.p.n, law.p.G_MPa, law.p.H_mm, u[i], F[i], R);
-                }
+                assert_int_equal(cf_law_lanes_fit_poly(&law, &lanes, &worst), 0);
+                assert_int_equal(lanes.poly_fit, 0);
+                assert_true(!(worst <= CF_POLY_TOL));
             }
-    assert_int_equal(fitted, 4 * 3 * 3);
+    static const double more[] = {0.25, 0.2};
+    for (size_t a = 0; a < 2; a++)
+        for (size_t c = 0; c < sizeof coils / sizeof coils[0]; c++) {
+            cf_law law;
+            init_ok(&law, scaled(more[a], coils[c], 1, 1));
+            assert_int_equal(check_poly(&law), CF_POLY_DEGREE);
+        }
 }
 
 static void table_error_is_within_its_stated_bound(void **state)

@@ -1,51 +1,55 @@
 /*
 ** The polynomial form of region 2 for one spring (law_simd.h says what a lane computes with it):
-** Chebyshev interpolation of P(w) = e/w and K(w) = 1/h'(P(w)) on [0, w_T] at CF_POLY_DEGREE + 1
-** Chebyshev points from the exact solver, turned into powers of x = 2w/w_T - 1, then measured
-** against the closed form (closed+newton, within 2e-15 of exact) over region 2.
+** Chebyshev interpolation of P(w) = e/w and K(w) = 1/h'(P(w)) on [0, w_T] at degree + 1 Chebyshev
+** points from the exact solver, turned into powers of x = 2w/w_T - 1, then measured against the
+** closed form (closed+newton, within 2e-15 of exact) over region 2; degree 8 first, 12 where 8
+** falls short (degree 8 spares 8 multiply-adds per spring, measured 9 % of the whole step).
 **
 ** Why it converges: P is analytic wherever the quartic's root is simple, i.e. away from c^4 = 1;
 ** in z = sqrt(1/rho - 1) w those points lie 1.19 from the origin at +-67.5 degrees and at +-1.41i,
 ** so over [0, z_T] the Chebyshev coefficients fall geometrically, fast while z_T (which grows as
-** rho falls: 0.73 at rho = 0.5, 1.66 at 0.2, 27 at 1e-3) stays near 1. Measured in double for
-** degree 12 (F after the Newton step): 1e-15 at rho = 0.4, 2e-14 at 0.2, 2e-11 at 0.1; a fit
-** above CF_POLY_TOL is refused and the caller keeps the closed form.
+** rho falls: 0.73 at rho = 0.5, 1.66 at 0.2, 27 at 1e-3) stays near 1. Measured in double (F
+** after the Newton step): degree 8, 1.4e-15 at rho = 0.5, 8e-15 at 0.4, 2e-10 at 0.2; degree 12,
+** 1e-15 at 0.4, 2e-14 at 0.2, 2e-11 at 0.1; a fit above CF_POLY_TOL is refused and the caller
+** keeps the closed form.
 */
 #include "model/law_simd.h"
 
 #include <math.h>
 #include <string.h>
 
-#define N_TERMS (CF_POLY_DEGREE + 1)
+#define MAX_TERMS (CF_POLY_DEGREE + 1)
 #define CHECK_POINTS 2048 /* per sweep: uniform in w, then uniform in u */
 
-/* Chebyshev interpolant of the values f at the points cos(pi (j + 1/2)/N) as powers of x. */
-static void cheb_to_powers(const long double *f, double *out)
+/* Chebyshev interpolant of the terms values f at the points cos(pi (j + 1/2)/terms) as powers
+** of x. */
+static void cheb_to_powers(const long double *f, int terms, double *out)
 {
-    long double c[N_TERMS], m[N_TERMS] = {0}, t0[N_TERMS] = {0}, t1[N_TERMS] = {0}, t2[N_TERMS];
+    long double c[MAX_TERMS], m[MAX_TERMS] = {0}, t0[MAX_TERMS] = {0}, t1[MAX_TERMS] = {0},
+                              t2[MAX_TERMS];
     const long double pi = 3.141592653589793238462643383279502884L;
-    for (int k = 0; k < N_TERMS; k++) {
+    for (int k = 0; k < terms; k++) {
         long double sum = 0;
-        for (int j = 0; j < N_TERMS; j++)
-            sum += f[j] * cosl(pi * k * (j + 0.5L) / N_TERMS);
-        c[k] = sum * 2 / N_TERMS;
+        for (int j = 0; j < terms; j++)
+            sum += f[j] * cosl(pi * k * (j + 0.5L) / terms);
+        c[k] = sum * 2 / terms;
     }
     c[0] /= 2;
     t0[0] = 1; /* T_0 and T_1 as powers of x, then T_{k+1} = 2x T_k - T_{k-1} */
     t1[1] = 1;
     m[0] = c[0];
-    for (int i = 0; i < N_TERMS; i++)
+    for (int i = 0; i < terms; i++)
         m[i] += c[1] * t1[i];
-    for (int k = 2; k < N_TERMS; k++) {
-        for (int i = 0; i < N_TERMS; i++)
+    for (int k = 2; k < terms; k++) {
+        for (int i = 0; i < terms; i++)
             t2[i] = (i ? 2 * t1[i - 1] : 0) - t0[i];
-        for (int i = 0; i < N_TERMS; i++) {
+        for (int i = 0; i < terms; i++) {
             m[i] += c[k] * t2[i];
             t0[i] = t1[i];
             t1[i] = t2[i];
         }
     }
-    for (int i = 0; i < N_TERMS; i++)
+    for (int i = 0; i < terms; i++)
         out[i] = (double)m[i];
 }
 
@@ -67,25 +71,25 @@ static double worst_error(const cf_law *law, const cf_law_lanes *lanes, const do
     return worst;
 }
 
-int cf_law_lanes_fit_poly(const cf_law *law, cf_law_lanes *lanes, double *worst)
+/* Fits degree deg and measures it; 1 when it is kept. */
+static int fit_degree(const cf_law *law, cf_law_lanes *lanes, int deg, double *worst)
 {
     const double W = law->w_T, r = law->rho_inv_m1, s = law->travel_mm;
-    lanes->poly_fit = 0;
-    if (worst)
-        *worst = NAN;
-    if (!(W > 0) || !(r > 0) || !(law->u_T_mm < s))
-        return 0; /* no region 2 */
-    long double Pv[N_TERMS], Kv[N_TERMS];
+    const int terms = deg + 1;
+    long double Pv[MAX_TERMS], Kv[MAX_TERMS];
     const long double pi = 3.141592653589793238462643383279502884L;
-    for (int j = 0; j < N_TERMS; j++) {
-        const long double x = cosl(pi * (j + 0.5L) / N_TERMS);
+    for (int j = 0; j < terms; j++) {
+        const long double x = cosl(pi * (j + 0.5L) / terms);
         const double w = (double)((x + 1) * 0.5L * W);
         const long double P = (long double)cf_law_region2_e(law, r * w * w) / w;
         Pv[j] = P;
         Kv[j] = 1 / (12 * P - 12 * w * P * P + 4 * (long double)w * w * P * P * P + 4 * r * w);
     }
-    cheb_to_powers(Pv, lanes->pa);
-    cheb_to_powers(Kv, lanes->pb);
+    memset(lanes->pa, 0, sizeof lanes->pa);
+    memset(lanes->pb, 0, sizeof lanes->pb);
+    cheb_to_powers(Pv, terms, lanes->pa);
+    cheb_to_powers(Kv, terms, lanes->pb);
+    lanes->poly_degree = deg;
     lanes->w_T = W;
     lanes->px_a = 2.0 / W;
     lanes->r4 = 4.0 * r;
@@ -101,11 +105,22 @@ int cf_law_lanes_fit_poly(const cf_law *law, cf_law_lanes *lanes, double *worst)
         const double e = worst_error(law, lanes, u, CHECK_POINTS, F);
         err = e > err || e != e ? e : err;
     }
-    if (worst)
-        *worst = err;
+    *worst = err;
     if (!(err <= CF_POLY_TOL)) {
         lanes->poly_fit = 0;
         return 0;
     }
     return 1;
+}
+
+int cf_law_lanes_fit_poly(const cf_law *law, cf_law_lanes *lanes, double *worst)
+{
+    double err = NAN;
+    lanes->poly_fit = 0;
+    const int ok = law->w_T > 0 && law->rho_inv_m1 > 0 && law->u_T_mm < law->travel_mm &&
+                   (fit_degree(law, lanes, CF_POLY_DEGREE_LOW, &err) ||
+                    fit_degree(law, lanes, CF_POLY_DEGREE, &err));
+    if (worst)
+        *worst = err;
+    return ok;
 }

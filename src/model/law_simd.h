@@ -22,8 +22,9 @@
 ** r = 1/rho - 1, the quartic divided by w^2 reads
 **   h(P) = P^2 (6 - 4e + e^2) - 4 r (1 - e) = 0,   regular at w = 0 (P(0) = sqrt(2r/3)),
 ** and P(w) is analytic on [0, w_T] (its singularities lie where c^4 = 1, delta = -2 or -1 +- i,
-** off the real axis). Two polynomials of degree CF_POLY_DEGREE in w, from Chebyshev interpolation
-** of the exact solution: P0(w) ~ P and K(w) ~ 1/h'(P); then one division-free Newton step
+** off the real axis). Two polynomials of degree CF_POLY_DEGREE_LOW or, where that is not enough,
+** CF_POLY_DEGREE, in w, from Chebyshev interpolation of the exact solution: P0(w) ~ P and
+** K(w) ~ 1/h'(P); then one division-free Newton step
 ** P1 = P0 - h(P0) K, whose error is about the product of the two fits' errors, and y = 1 - w P1.
 ** No lookup, no division, one square root: every lane runs the same few multiply-adds. The fit
 ** is kept only where it is measured within CF_POLY_TOL of the closed form (law_poly.c).
@@ -63,7 +64,8 @@
 #define CF_DISPATCH
 #endif
 
-#define CF_POLY_DEGREE 12
+#define CF_POLY_DEGREE 12    /* the largest degree */
+#define CF_POLY_DEGREE_LOW 8 /* the degree tried first (rho down to about 0.4) */
 #define CF_POLY_TOL 1e-13 /* largest relative error of F, against the closed form, for a fit */
 
 /* Everything a lane needs, copied by value into the loop (loads the compiler can hoist). */
@@ -73,8 +75,8 @@ typedef struct cf_law_lanes {
     double inv_h;       /* table: intervals per unit of w */
     double xmax;        /* table: intervals - 1, the last interval's index */
     /* polynomial (poly_fit set by cf_law_lanes_fit_poly): w is clamped to w_T and mapped to
-    ** x = w px_a - 1 in [-1, 1]; pa and pb are P0 and K in powers of x */
-    int poly_fit;
+    ** x = w px_a - 1 in [-1, 1]; pa and pb are P0 and K in powers of x, of degree poly_degree */
+    int poly_fit, poly_degree;
     double w_T, px_a, r4; /* w_T, 2/w_T, 4 (1/rho - 1) */
     double pa[CF_POLY_DEGREE + 1], pb[CF_POLY_DEGREE + 1];
 } cf_law_lanes;
@@ -83,11 +85,12 @@ typedef struct cf_law_lanes {
 ** polynomial (poly_fit = 0). */
 void cf_law_lanes_init(const cf_law *law, cf_law_lanes *lanes);
 
-/* Fits the polynomial of region 2 to law (law_poly.c) and measures it against the closed form
-** over region 2; keeps it (poly_fit = 1) when its largest relative error of F is within
-** CF_POLY_TOL, and returns 1 then, else 0 (the spring is too conical for one polynomial of this
-** degree: about rho < 0.2, or has no region 2). *worst (may be NULL) receives the measured error,
-** or NAN when nothing was fitted. */
+/* Fits the polynomial of region 2 to law (law_poly.c), of degree CF_POLY_DEGREE_LOW, else
+** CF_POLY_DEGREE, and measures it against the closed form over region 2; keeps the first whose
+** largest relative error of F is within CF_POLY_TOL (poly_fit = 1, poly_degree) and returns 1,
+** else 0 (the spring is too conical for one polynomial of these degrees: about rho < 0.2, or has
+** no region 2). *worst (may be NULL) receives the measured error of the last degree tried, or NAN
+** when nothing was fitted. */
 int cf_law_lanes_fit_poly(const cf_law *law, cf_law_lanes *lanes, double *worst);
 
 /* e = 1 - y of region 2 at delta >= 0 from the exact solver (law.c). */
@@ -176,18 +179,19 @@ CF_LANE double cf_lane_table_y(const cf_law_lanes *c, double u)
     return k[j] + q * (k[j + 1] + q * (k[j + 2] + q * k[j + 3]));
 }
 
-/* Region 2 from the fitted polynomial, for every lane (the caller selects the region). */
-CF_LANE double cf_lane_poly(const cf_law_lanes *c, double u)
+/* The force from the fitted polynomial of degree deg (a constant where it is inlined; it must be
+** c->poly_degree), for every lane (the caller selects the region). */
+CF_LANE double cf_lane_poly(const cf_law_lanes *c, double u, int deg)
 {
     const double a = fabs(u), sa = c->s - a;
     double w = sqrt((sa > 0.0 ? sa : 0.0) * c->inv_s);
     w = w < c->w_T ? w : c->w_T; /* region 1 maps to the fit's end; NaN to 0 */
     const double x = w * c->px_a - 1.0;
-    double P = c->pa[CF_POLY_DEGREE], K = c->pb[CF_POLY_DEGREE];
+    double P = c->pa[deg], K = c->pb[deg];
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC unroll 32
 #endif
-    for (int j = CF_POLY_DEGREE - 1; j >= 0; j--) {
+    for (int j = deg - 1; j >= 0; j--) {
         P = P * x + c->pa[j];
         K = K * x + c->pb[j];
     }
@@ -211,9 +215,15 @@ CF_LANE void cf_lanes_closed(const cf_law_lanes *c, size_t count, const double *
 
 CF_LANE void cf_lanes_poly(const cf_law_lanes *c, size_t count, const double *u, double *F)
 {
+    if (c->poly_degree == CF_POLY_DEGREE_LOW) {
 #pragma omp simd
-    for (size_t k = 0; k < count; k++)
-        F[k] = cf_lane_poly(c, u[k]);
+        for (size_t k = 0; k < count; k++)
+            F[k] = cf_lane_poly(c, u[k], CF_POLY_DEGREE_LOW);
+    } else {
+#pragma omp simd
+        for (size_t k = 0; k < count; k++)
+            F[k] = cf_lane_poly(c, u[k], CF_POLY_DEGREE);
+    }
 }
 
 CF_LANE void cf_lanes_table(const cf_law_lanes *c, size_t count, const double *u, double *F)
