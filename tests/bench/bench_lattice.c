@@ -23,16 +23,19 @@ typedef struct lvariant {
     int kind; /* 0 minimal linear edge-list kernel, 1 conifit's step, 2 edge-list kernel
               ** cf_lattice_forces, 3 minimal linear stencil kernel */
     cf_law_method method;
+    int lanes; /* conifit's step: the lanes' form it is held to (-2: the one it chooses) */
 } lvariant;
 
 static const lvariant lvars[] = {
-    {"linear, minimal stencil kernel", 3, CF_LAW_CLOSED},
-    {"linear, minimal edge-list kernel", 0, CF_LAW_CLOSED},
-    {"exact", 1, CF_LAW_EXACT},
-    {"closed", 1, CF_LAW_CLOSED},
-    {"closed+newton", 1, CF_LAW_CLOSED_NEWTON},
-    {"table 256", 1, CF_LAW_TABLE},
-    {"closed, edge-list kernel", 2, CF_LAW_CLOSED},
+    {"linear, minimal stencil kernel", 3, CF_LAW_CLOSED, -2},
+    {"linear, minimal edge-list kernel", 0, CF_LAW_CLOSED, -2},
+    {"exact", 1, CF_LAW_EXACT, -2},
+    {"closed", 1, CF_LAW_CLOSED, -2},
+    {"closed+newton", 1, CF_LAW_CLOSED_NEWTON, -2},
+    {"table 256", 1, CF_LAW_TABLE, -2},
+    {"closed, edge-list kernel", 2, CF_LAW_CLOSED, -2},
+    {"closed form lanes (no polynomial)", 1, CF_LAW_CLOSED, CF_LANE_CLOSED},
+    {"table lanes (no polynomial)", 1, CF_LAW_TABLE, CF_LANE_TABLE},
 };
 #define NLV (sizeof lvars / sizeof lvars[0])
 #define V_LIN 0
@@ -365,6 +368,8 @@ void bench_section_lattice(bench_ctx *ctx)
     bench_stats thr1 = {0}, thr2 = {0};
     int have_thr = 0;
     double lin_differ = 0; /* the two linear kernels' forces, largest relative difference */
+    double poly_error = NAN; /* the polynomial's error measured by the closed form's stepper */
+    int poly_degree = 0;
     for (int z = 0; z < nsz; z++) {
         cf_lattice lat;
         cf_lattice_config cfg = cf_lattice_default();
@@ -394,8 +399,12 @@ void bench_section_lattice(bench_ctx *ctx)
             lat.method = lvars[e].method;
             have[e] = cf_lattice_stepper_init(&stp[e], &lat, NULL, NULL) == CF_OK;
             stp[e].threads = 0; /* one core */
+            if (have[e] && lvars[e].lanes != -2)
+                stp[e].form = lvars[e].lanes;
         }
         if (have[V_CLOSED]) {
+            poly_error = stp[V_CLOSED].poly_error;
+            poly_degree = stp[V_CLOSED].lanes.poly_degree;
             r.st = &stp[V_CLOSED];
             lin_differ = fmax(lin_differ, linear_kernels_differ(&r));
         }
@@ -441,7 +450,12 @@ void bench_section_lattice(bench_ctx *ctx)
             "constants; closed form and table through the branch-free lanes of "
             "`model/law_simd.h`, vectorised in every clone, the step with fused multiply-adds "
             "where the processor has them; exact and closed+newton through the scalar law per "
-            "chunk). \"closed, edge-list kernel\" is `cf_lattice_forces` (three passes over "
+            "chunk). For this spring (ρ = 0.4) \"closed\" and \"table 256\" both run the "
+            "spring's polynomial (`model/law_poly.c`: degree %d in √(1−|u|/s) and one "
+            "division-free Newton step, measured within %.1e of the closed form when the step "
+            "starts); \"closed form lanes\" and \"table lanes\" hold the step to the lanes it "
+            "runs for springs the polynomial does not fit (the closed form with its cube root and "
+            "division; the Hermite table's lookups). \"closed, edge-list kernel\" is `cf_lattice_forces` (three passes over "
             "the springs' node indices and constants, with per-spring outputs), which the statics "
             "and the viscous dynamics use. Two minimal linear-spring steps (F = k u) are written in "
             "the benchmark, independent of conifit's code: a stencil kernel of the same structure "
@@ -454,7 +468,8 @@ void bench_section_lattice(bench_ctx *ctx)
             "median of %d samples [min–max], taken round-robin over the variants, in CPU time of "
             "the thread (on this shared machine the wall time of a single-threaded kernel also "
             "counts its waits for a core); each sample runs enough steps to last %.0f ms.\n\n",
-            CF_STEP_BLOCK, lin_differ, STATE_STRAIN, repeats, sample_s * 1e3);
+            CF_STEP_BLOCK, poly_degree, poly_error, lin_differ, STATE_STRAIN, repeats,
+            sample_s * 1e3);
     fprintf(ctx->md, "| n | springs |");
     for (size_t e = 0; e < NLV; e++)
         fprintf(ctx->md, " %s |", lvars[e].name);
@@ -548,7 +563,8 @@ void bench_section_lattice(bench_ctx *ctx)
     const double bytes[NLV] = {152 * nodes_per_spring,      32 + 152 * nodes_per_spring,
                                168 * nodes_per_spring,      168 * nodes_per_spring,
                                168 * nodes_per_spring,      168 * nodes_per_spring,
-                               96 + 200 * nodes_per_spring};
+                               96 + 200 * nodes_per_spring, 168 * nodes_per_spring,
+                               168 * nodes_per_spring};
     fprintf(ctx->md,
             "\n**Bandwidth floor.** Triad a = b + s·c over three 32 MiB arrays (far beyond the "
             "caches), counting 24 bytes per element: %.1f GB/s [%.1f–%.1f], median of %d. At "
@@ -613,8 +629,9 @@ void bench_section_lattice(bench_ctx *ctx)
                            "set xlabel 'springs in the lattice'\n"
                            "set ylabel 'time per spring per step [ns]'\n"
                            "set title 'Lattice step: time per spring (flat = linear growth)'\n"
-                           "plot for [c=2:8] 'lattice_step.dat' using 1:c with linespoints "
+                           "plot for [c=2:10] 'lattice_step.dat' using 1:c with linespoints "
                            "pt 7 title word('linear-stencil linear-edge-list exact closed "
-                           "closed+newton table256 closed-edge-list', c-1)\n") == 0)
+                           "closed+newton table256 closed-edge-list closed-no-polynomial "
+                           "table-no-polynomial', c-1)\n") == 0)
         fprintf(ctx->md, "![lattice step: time per spring](lattice_step.png)\n\n");
 }
