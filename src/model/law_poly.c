@@ -25,7 +25,7 @@
 ** of x. */
 static void cheb_to_powers(const long double *f, int terms, double *out)
 {
-    long double c[MAX_TERMS], m[MAX_TERMS] = {0}, t0[MAX_TERMS] = {0}, t1[MAX_TERMS] = {0},
+    long double c[MAX_TERMS] = {0}, m[MAX_TERMS] = {0}, t0[MAX_TERMS] = {0}, t1[MAX_TERMS] = {0},
                               t2[MAX_TERMS];
     const long double pi = 3.141592653589793238462643383279502884L;
     for (int k = 0; k < terms; k++) {
