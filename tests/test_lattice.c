@@ -667,14 +667,16 @@ static void stencil_step_equals_edge_list_kernel(void **state)
 }
 
 /* The explicit step evaluates the spring's polynomial (law_simd.h) for the closed form and the
-** table wherever it fits within CF_POLY_TOL, and keeps the closed form and the table of a spring
-** too conical for it; exact runs the scalar law. */
+** table wherever it fits within CF_POLY_TOL (rho = 0.4 and, in two pieces, 0.05 here), and keeps
+** the closed form and the table of a spring too conical for it (rho = 0.005); exact runs the
+** scalar law. */
 static void stencil_step_runs_the_polynomial_where_it_fits(void **state)
 {
     (void)state;
-    static const cf_spring springs[] = {{6, 15, 2.5, 2, 26, 10}, {1.5, 30, 2.5, 0.3, 26, 10}};
+    static const cf_spring springs[] = {
+        {6, 15, 2.5, 2, 26, 10}, {0.15, 30, 2.5, 0.03, 26, 10}, {1.5, 30, 2.5, 0.3, 26, 10}};
     const cf_law_method methods[3] = {CF_LAW_CLOSED, CF_LAW_TABLE, CF_LAW_EXACT};
-    for (int si = 0; si < 2; si++)
+    for (int si = 0; si < 3; si++)
         for (int mi = 0; mi < 3; mi++) {
             cf_law law;
             cf_error err = {0};
@@ -686,12 +688,14 @@ static void stencil_step_runs_the_polynomial_where_it_fits(void **state)
             cf_lattice_stepper st;
             assert_int_equal(cf_lattice_stepper_init(&st, &lat, NULL, &err), CF_OK);
             const int expect = mi == 2    ? -1
-                               : si == 0 ? CF_LANE_POLY
+                               : si != 1 ? CF_LANE_POLY
                                : mi == 0 ? CF_LANE_CLOSED
                                          : CF_LANE_TABLE;
             assert_int_equal(st.form, expect);
-            if (expect == CF_LANE_POLY)
+            if (expect == CF_LANE_POLY) {
                 assert_true(st.poly_error <= CF_POLY_TOL);
+                assert_int_equal(st.lanes.poly_pieces, si == 2 ? 2 : 1);
+            }
             cf_lattice_stepper_free(&st);
             cf_lattice_free(&lat);
             cf_law_free(&law);

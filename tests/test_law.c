@@ -221,7 +221,7 @@ static void closed_and_exact_match_reference_in_every_corner(void **state)
 
 /* The polynomial of region 2 of law, fitted: within the closed form's 1e-12 of the long-double
 ** reference at every hard case, through the dispatched batch (NaN to 0, +-Inf to +-F_C). Returns
-** the degree it took. */
+** its degree, times 10 for two pieces. */
 static int check_poly(const cf_law *law)
 {
     cf_law_lanes lanes;
@@ -248,12 +248,13 @@ static int check_poly(const cf_law *law)
                      lanes.poly_degree, law->rho, law->p.n, law->p.G_MPa, law->p.H_mm, u[i], F[i],
                      R);
     }
-    return lanes.poly_degree;
+    return lanes.poly_degree * (lanes.poly_pieces == 2 ? 10 : 1);
 }
 
 /* The polynomial of region 2 (law_poly.c, law_simd.h): of the low degree down to rho = 0.5 in this
-** list, of the high degree at rho = 0.25 and 0.2, refused at 0.1 and 1e-3 (the caller keeps the
-** closed form), and where fitted within the closed form's bound at every hard case. */
+** list, of the high degree at rho = 0.25 and 0.2, in two pieces at 0.1, 0.05 and 0.03, refused at
+** 0.02 and 1e-3 (the caller keeps the closed form), and where fitted within the closed form's
+** bound at every hard case. */
 static void polynomial_form_matches_reference_where_it_fits(void **state)
 {
     (void)state;
@@ -266,6 +267,10 @@ static void polynomial_form_matches_reference_where_it_fits(void **state)
                     assert_int_equal(check_poly(&law), CF_POLY_DEGREE_LOW);
                     continue;
                 }
+                if (rhos[a] >= 0.1) {
+                    assert_int_equal(check_poly(&law), 10 * CF_POLY_DEGREE);
+                    continue;
+                }
                 cf_law_lanes lanes;
                 cf_law_lanes_init(&law, &lanes);
                 double worst;
@@ -273,12 +278,20 @@ static void polynomial_form_matches_reference_where_it_fits(void **state)
                 assert_int_equal(lanes.poly_fit, 0);
                 assert_true(!(worst <= CF_POLY_TOL));
             }
-    static const double more[] = {0.25, 0.2};
-    for (size_t a = 0; a < 2; a++)
+    static const double more[] = {0.25, 0.2, 0.05, 0.03, 0.02};
+    for (size_t a = 0; a < sizeof more / sizeof more[0]; a++)
         for (size_t c = 0; c < sizeof coils / sizeof coils[0]; c++) {
             cf_law law;
             init_ok(&law, scaled(more[a], coils[c], 1, 1));
-            assert_int_equal(check_poly(&law), CF_POLY_DEGREE);
+            if (more[a] >= 0.2)
+                assert_int_equal(check_poly(&law), CF_POLY_DEGREE);
+            else if (more[a] >= 0.03)
+                assert_int_equal(check_poly(&law), 10 * CF_POLY_DEGREE);
+            else {
+                cf_law_lanes lanes;
+                cf_law_lanes_init(&law, &lanes);
+                assert_int_equal(cf_law_lanes_fit_poly(&law, &lanes, NULL), 0);
+            }
         }
 }
 

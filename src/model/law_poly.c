@@ -10,8 +10,9 @@
 ** so over [0, z_T] the Chebyshev coefficients fall geometrically, fast while z_T (which grows as
 ** rho falls: 0.73 at rho = 0.5, 1.66 at 0.2, 27 at 1e-3) stays near 1. Measured in double (F
 ** after the Newton step): degree 8, 1.4e-15 at rho = 0.5, 8e-15 at 0.4, 2e-10 at 0.2; degree 12,
-** 1e-15 at 0.4, 2e-14 at 0.2, 2e-11 at 0.1; a fit above CF_POLY_TOL is refused and the caller
-** keeps the closed form.
+** 1e-15 at 0.4, 2e-14 at 0.2, 2e-11 at 0.1; two pieces of degree 12, 5e-15 at 0.1, 9e-15 at
+** 0.05, 8e-13 at 0.02 (pieces of equal width: 3e-13 at 0.05). A fit above CF_POLY_TOL is refused
+** and the caller keeps the closed form.
 */
 #include "model/law_simd.h"
 
@@ -71,28 +72,41 @@ static double worst_error(const cf_law *law, const cf_law_lanes *lanes, const do
     return worst;
 }
 
-/* Fits degree deg and measures it; 1 when it is kept. */
-static int fit_degree(const cf_law *law, cf_law_lanes *lanes, int deg, double *worst)
+/* Interpolates P and K of degree deg on [w0, w1] into piece q. */
+static void fit_piece(const cf_law *law, cf_law_lanes *lanes, int q, double w0, double w1, int deg)
 {
-    const double W = law->w_T, r = law->rho_inv_m1, s = law->travel_mm;
+    const double r = law->rho_inv_m1;
     const int terms = deg + 1;
     long double Pv[MAX_TERMS], Kv[MAX_TERMS];
     const long double pi = 3.141592653589793238462643383279502884L;
     for (int j = 0; j < terms; j++) {
         const long double x = cosl(pi * (j + 0.5L) / terms);
-        const double w = (double)((x + 1) * 0.5L * W);
+        const double w = (double)(w0 + (x + 1) * 0.5L * (w1 - w0));
         const long double P = (long double)cf_law_region2_e(law, r * w * w) / w;
         Pv[j] = P;
         Kv[j] = 1 / (12 * P - 12 * w * P * P + 4 * (long double)w * w * P * P * P + 4 * r * w);
     }
-    memset(lanes->pa, 0, sizeof lanes->pa);
-    memset(lanes->pb, 0, sizeof lanes->pb);
-    cheb_to_powers(Pv, terms, lanes->pa);
-    cheb_to_powers(Kv, terms, lanes->pb);
+    memset(lanes->pa[q], 0, sizeof lanes->pa[q]);
+    memset(lanes->pb[q], 0, sizeof lanes->pb[q]);
+    cheb_to_powers(Pv, terms, lanes->pa[q]);
+    cheb_to_powers(Kv, terms, lanes->pb[q]);
+    lanes->px_a[q] = 2.0 / (w1 - w0);
+    lanes->px_b[q] = -1.0 - 2.0 * w0 / (w1 - w0);
+}
+
+/* Fits deg in pieces pieces (the second from W 2^-1.5: the coefficients of P fall slowest near
+** w = 0, where its singularities are nearest) and measures it; 1 when it is kept. */
+static int fit_degree(const cf_law *law, cf_law_lanes *lanes, int deg, int pieces, double *worst)
+{
+    const double W = law->w_T, s = law->travel_mm;
     lanes->poly_degree = deg;
+    lanes->poly_pieces = pieces;
     lanes->w_T = W;
-    lanes->px_a = 2.0 / W;
-    lanes->r4 = 4.0 * r;
+    lanes->w_split = pieces == 2 ? W * 0.35355339059327373 : W;
+    lanes->r4 = 4.0 * law->rho_inv_m1;
+    fit_piece(law, lanes, 0, 0.0, lanes->w_split, deg);
+    if (pieces == 2)
+        fit_piece(law, lanes, 1, lanes->w_split, W, deg);
     lanes->poly_fit = 1;
 
     double u[CHECK_POINTS], F[CHECK_POINTS], err = 0;
@@ -118,8 +132,9 @@ int cf_law_lanes_fit_poly(const cf_law *law, cf_law_lanes *lanes, double *worst)
     double err = NAN;
     lanes->poly_fit = 0;
     const int ok = law->w_T > 0 && law->rho_inv_m1 > 0 && law->u_T_mm < law->travel_mm &&
-                   (fit_degree(law, lanes, CF_POLY_DEGREE_LOW, &err) ||
-                    fit_degree(law, lanes, CF_POLY_DEGREE, &err));
+                   (fit_degree(law, lanes, CF_POLY_DEGREE_LOW, 1, &err) ||
+                    fit_degree(law, lanes, CF_POLY_DEGREE, 1, &err) ||
+                    fit_degree(law, lanes, CF_POLY_DEGREE, 2, &err));
     if (worst)
         *worst = err;
     return ok;

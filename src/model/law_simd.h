@@ -24,7 +24,9 @@
 ** and P(w) is analytic on [0, w_T] (its singularities lie where c^4 = 1, delta = -2 or -1 +- i,
 ** off the real axis). Two polynomials of degree CF_POLY_DEGREE_LOW or, where that is not enough,
 ** CF_POLY_DEGREE, in w, from Chebyshev interpolation of the exact solution: P0(w) ~ P and
-** K(w) ~ 1/h'(P); then one division-free Newton step
+** K(w) ~ 1/h'(P) (for a strongly conical spring, whose w_T lies far out relative to those
+** singularities, two pieces of degree CF_POLY_DEGREE split at w_split, the piece of each lane
+** chosen by selection); then one division-free Newton step
 ** P1 = P0 - h(P0) K, whose error is about the product of the two fits' errors, and y = 1 - w P1.
 ** No lookup, no division, one square root: every lane runs the same few multiply-adds. The fit
 ** is kept only where it is measured within CF_POLY_TOL of the closed form (law_poly.c).
@@ -74,23 +76,25 @@ typedef struct cf_law_lanes {
     const double *coef; /* table: 4 coefficients per interval (NULL: no table) */
     double inv_h;       /* table: intervals per unit of w */
     double xmax;        /* table: intervals - 1, the last interval's index */
-    /* polynomial (poly_fit set by cf_law_lanes_fit_poly): w is clamped to w_T and mapped to
-    ** x = w px_a - 1 in [-1, 1]; pa and pb are P0 and K in powers of x, of degree poly_degree */
-    int poly_fit, poly_degree;
-    double w_T, px_a, r4; /* w_T, 2/w_T, 4 (1/rho - 1) */
-    double pa[CF_POLY_DEGREE + 1], pb[CF_POLY_DEGREE + 1];
+    /* polynomial (poly_fit set by cf_law_lanes_fit_poly): w is clamped to w_T; piece q (0, or 1
+    ** above w_split when there are two) maps it to x = w px_a[q] + px_b[q] in [-1, 1], where
+    ** pa[q] and pb[q] are P0 and K in powers of x, of degree poly_degree */
+    int poly_fit, poly_degree, poly_pieces;
+    double w_T, w_split, r4; /* w_T, the pieces' boundary, 4 (1/rho - 1) */
+    double px_a[2], px_b[2];
+    double pa[2][CF_POLY_DEGREE + 1], pb[2][CF_POLY_DEGREE + 1];
 } cf_law_lanes;
 
 /* Fills lanes from law; the table coefficients are those of law's table when it has one. No
 ** polynomial (poly_fit = 0). */
 void cf_law_lanes_init(const cf_law *law, cf_law_lanes *lanes);
 
-/* Fits the polynomial of region 2 to law (law_poly.c), of degree CF_POLY_DEGREE_LOW, else
-** CF_POLY_DEGREE, and measures it against the closed form over region 2; keeps the first whose
-** largest relative error of F is within CF_POLY_TOL (poly_fit = 1, poly_degree) and returns 1,
-** else 0 (the spring is too conical for one polynomial of these degrees: about rho < 0.2, or has
-** no region 2). *worst (may be NULL) receives the measured error of the last degree tried, or NAN
-** when nothing was fitted. */
+/* Fits the polynomial of region 2 to law (law_poly.c): one piece of degree CF_POLY_DEGREE_LOW,
+** else of CF_POLY_DEGREE, else two pieces of CF_POLY_DEGREE, each measured against the closed form
+** over region 2; keeps the first whose largest relative error of F is within CF_POLY_TOL
+** (poly_fit = 1, poly_degree, poly_pieces) and returns 1, else 0 (the spring is too conical even
+** for two pieces: about rho < 0.05, or has no region 2). *worst (may be NULL) receives the measured
+** error of the last fit tried, or NAN when nothing was fitted. */
 int cf_law_lanes_fit_poly(const cf_law *law, cf_law_lanes *lanes, double *worst);
 
 /* e = 1 - y of region 2 at delta >= 0 from the exact solver (law.c). */
@@ -179,21 +183,23 @@ CF_LANE double cf_lane_table_y(const cf_law_lanes *c, double u)
     return k[j] + q * (k[j + 1] + q * (k[j + 2] + q * k[j + 3]));
 }
 
-/* The force from the fitted polynomial of degree deg (a constant where it is inlined; it must be
-** c->poly_degree), for every lane (the caller selects the region). */
-CF_LANE double cf_lane_poly(const cf_law_lanes *c, double u, int deg)
+/* The force from the fitted polynomial of degree deg in pieces pieces (constants where it is
+** inlined; they must be c->poly_degree and c->poly_pieces), for every lane (the caller selects
+** the region). */
+CF_LANE double cf_lane_poly(const cf_law_lanes *c, double u, int deg, int pieces)
 {
     const double a = fabs(u), sa = c->s - a;
     double w = sqrt((sa > 0.0 ? sa : 0.0) * c->inv_s);
     w = w < c->w_T ? w : c->w_T; /* region 1 maps to the fit's end; NaN to 0 */
-    const double x = w * c->px_a - 1.0;
-    double P = c->pa[deg], K = c->pb[deg];
+    const int q = pieces == 2 && w > c->w_split;
+    const double x = w * (q ? c->px_a[1] : c->px_a[0]) + (q ? c->px_b[1] : c->px_b[0]);
+    double P = q ? c->pa[1][deg] : c->pa[0][deg], K = q ? c->pb[1][deg] : c->pb[0][deg];
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC unroll 32
 #endif
     for (int j = deg - 1; j >= 0; j--) {
-        P = P * x + c->pa[j];
-        K = K * x + c->pb[j];
+        P = P * x + (q ? c->pa[1][j] : c->pa[0][j]);
+        K = K * x + (q ? c->pb[1][j] : c->pb[0][j]);
     }
     const double e = w * P;
     const double h = P * P * (6.0 + e * (-4.0 + e)) - c->r4 * (1.0 - e);
@@ -215,14 +221,18 @@ CF_LANE void cf_lanes_closed(const cf_law_lanes *c, size_t count, const double *
 
 CF_LANE void cf_lanes_poly(const cf_law_lanes *c, size_t count, const double *u, double *F)
 {
-    if (c->poly_degree == CF_POLY_DEGREE_LOW) {
+    if (c->poly_pieces == 2) {
 #pragma omp simd
         for (size_t k = 0; k < count; k++)
-            F[k] = cf_lane_poly(c, u[k], CF_POLY_DEGREE_LOW);
+            F[k] = cf_lane_poly(c, u[k], CF_POLY_DEGREE, 2);
+    } else if (c->poly_degree == CF_POLY_DEGREE_LOW) {
+#pragma omp simd
+        for (size_t k = 0; k < count; k++)
+            F[k] = cf_lane_poly(c, u[k], CF_POLY_DEGREE_LOW, 1);
     } else {
 #pragma omp simd
         for (size_t k = 0; k < count; k++)
-            F[k] = cf_lane_poly(c, u[k], CF_POLY_DEGREE);
+            F[k] = cf_lane_poly(c, u[k], CF_POLY_DEGREE, 1);
     }
 }
 
