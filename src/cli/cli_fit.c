@@ -80,6 +80,9 @@ static const char fit_help_series[] =
     "cell, driven by the measured strain history:\n"
     "  --branches N            Prony terms, 1..8 (default: 1..4 chosen by AIC)\n"
     "  --dashpot               fit a dashpot beside every spring as well\n"
+    "  --relaxation R          qlv (default): relative moduli g_i constant (quasi-linear);\n"
+    "                          strain: g_i + g_per_strain_i |strain| at a spring's strain;\n"
+    "                          auto: both, the lower AIC kept\n"
     "  --elastic FIT.json[:TYPE]  hold rho, s/H and F_C/H^2 at those of a fit file's spring\n"
     "  --calibration C         the lattice's weights: axial (default for a series) or isotropic\n"
     "The fitted spring stays within the design limits (--rho-min, --index-max, ...) and its\n"
@@ -180,6 +183,7 @@ enum {
     OPT_G_MAX,
     OPT_BRANCHES,
     OPT_DASHPOT,
+    OPT_RELAXATION,
     OPT_ELASTIC,
     OPT_TITLE,
     OPT_STRESS_MEASURE,
@@ -219,6 +223,7 @@ static const struct option fit_options[] = {
     {"G-max", required_argument, NULL, OPT_G_MAX},
     {"branches", required_argument, NULL, OPT_BRANCHES},
     {"dashpot", no_argument, NULL, OPT_DASHPOT},
+    {"relaxation", required_argument, NULL, OPT_RELAXATION},
     {"elastic", required_argument, NULL, OPT_ELASTIC},
     {"title", required_argument, NULL, OPT_TITLE},
     {"stress-measure", required_argument, NULL, OPT_STRESS_MEASURE},
@@ -447,6 +452,18 @@ static int fit_option(void *ctx, int c, const char *optval)
         return 0;
     case OPT_DASHPOT:
         a->vopt.dashpot = 1;
+        a->series_only = 1;
+        return 0;
+    case OPT_RELAXATION:
+        if (strcmp(optval, "auto") == 0)
+            a->vopt.relaxation = CF_RELAX_AUTO;
+        else if (strcmp(optval, "qlv") == 0)
+            a->vopt.relaxation = CF_RELAX_QLV;
+        else if (strcmp(optval, "strain") == 0)
+            a->vopt.relaxation = CF_RELAX_STRAIN;
+        else
+            return cf_cli_usage_error("fit", "--relaxation '%s': expected auto, qlv or strain",
+                                      optval);
         a->series_only = 1;
         return 0;
     case OPT_ELASTIC:
@@ -710,7 +727,8 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
                                        "tables; a time series is fitted through the lattice "
                                        "already");
     if (rc < 0 && *nseries == 0 && a->series_only)
-        rc = cf_cli_usage_error("fit", "--branches, --dashpot and --elastic apply to time series "
+        rc = cf_cli_usage_error("fit", "--branches, --dashpot, --relaxation and --elastic apply to time "
+                                       "series "
                                        "(a table with a time column) only");
     if (rc < 0 && a->elastic) {
         cf_fitted_spring fs;

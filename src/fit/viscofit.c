@@ -4,6 +4,7 @@
 #include "conifit/viscofit.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -30,6 +31,7 @@
 #define GRID_TAU 12
 /* Starts of the Levenberg-Marquardt stage per branch count, and its limits. */
 #define LM_STARTS 2
+#define LM_STARTS_STRAIN 6
 #define LM_MAX_ITER 150
 #define LM_STALL 6
 #define LM_STALL_REL 1e-10
@@ -125,6 +127,7 @@ typedef struct ctx {
     int nb;             /* branches */
     int free_el;        /* 1: rho and s/H are fitted (and the scale profiled) */
     int dash;           /* 1: dashpot fitted */
+    int gs;             /* 1: growth of the relative moduli with strain (k_i) fitted */
     size_t np;          /* LM parameters */
     double *sw;         /* residual weights */
     double ynorm;       /* weighted sum of y^2 */
@@ -164,14 +167,21 @@ static cf_visco_params unpack(const ctx *c, const double *z)
         p.stress_scale_MPa = c->o->elastic[2];
     }
     p.nbranch = c->nb;
-    double sum = 1, ea[CF_PRONY_MAX];
+    /* the moduli at zero strain (g_i) and, with strain dependence, at the series' largest
+    ** strain (g_i + k_i x_max) are shares of two softmaxes: >= 0 and summing below 1 at every
+    ** strain the series reaches (they are linear in |strain|) */
+    double sum = 1, sumb = 1, ea[CF_PRONY_MAX], eb[CF_PRONY_MAX];
     for (int i = 0; i < c->nb; i++) {
         p.tau_s[i] = exp(z[j++]);
         ea[i] = exp(fmax(z[j++], A_LO));
+        eb[i] = c->gs ? exp(fmax(z[j++], A_LO)) : 0.0;
         sum += ea[i];
+        sumb += eb[i];
     }
-    for (int i = 0; i < c->nb; i++)
+    for (int i = 0; i < c->nb; i++) {
         p.g[i] = ea[i] / sum;
+        p.k[i] = c->gs ? (eb[i] / sumb - p.g[i]) / c->xmax : 0.0;
+    }
     p.eta_MPa_s = c->dash ? exp(z[j++]) * p.stress_scale_MPa : 0.0;
     return p;
 }
@@ -184,13 +194,19 @@ static void pack(const ctx *c, const cf_visco_params *p, double *z)
         z[j++] = logit((p->rho - c->rho_lo) / (RHO_HI - c->rho_lo));
         z[j++] = logit((p->solid_strain - lo) / (E_HI - lo));
     }
-    double ginf = 1;
-    for (int i = 0; i < c->nb; i++)
+    double ginf = 1, ginfb = 1, gb[CF_PRONY_MAX];
+    for (int i = 0; i < c->nb; i++) {
         ginf -= p->g[i];
+        gb[i] = c->gs ? p->g[i] + p->k[i] * c->xmax : 0.0;
+        ginfb -= gb[i];
+    }
     ginf = fmax(ginf, 1e-12);
+    ginfb = fmax(ginfb, 1e-12);
     for (int i = 0; i < c->nb; i++) {
         z[j++] = log(p->tau_s[i]);
         z[j++] = p->g[i] > 0 ? fmax(log(p->g[i] / ginf), A_LO) : A_LO;
+        if (c->gs)
+            z[j++] = gb[i] > 0 ? fmax(log(gb[i] / ginfb), A_LO) : A_LO;
     }
     if (c->dash)
         z[j++] = log(fmax(p->eta_MPa_s / p->stress_scale_MPa, 1e-300));
@@ -310,14 +326,106 @@ static void keep_start(start *best, int nbest, double obj, const cf_visco_params
 /* The stand-in at one grid point (rho, s/H) for one set of time constants: the elastic curve E
 ** (at unit scale, or at the held scale) and the responses of the chosen branches. The stress is
 **     A E + sum_i (A g_i) (R_i - E) + c_d rate,
-** linear in the unknowns A (unless held or capped), A g_i and the dashpot's c_d. */
+** with R_i branch i's response to E, linear in the unknowns A (unless held or capped), A g_i and
+** the dashpot's c_d. With relaxation depending on strain, g_i (1 - |x|/x_max) + g'_i |x|/x_max
+** (its values at zero and at the largest strain) takes the place of g_i: the unknowns are A g_i
+** and A g'_i, all >= 0 (non-negative least squares), with S_i the response to |x| E. */
 typedef struct standin {
     const double *E, *rate;
-    const double *basis[2 + CF_PRONY_MAX];
+    const double *xE; /* |x| E (NULL: quasi-linear) */
+    const double *basis[2 + 2 * CF_PRONY_MAX];
     double A_fixed;     /* > 0: the scale is held there (a held fit, or the design cap) */
-    gsl_matrix *X;      /* weighted design, n x (2 + CF_PRONY_MAX) */
+    gsl_matrix *X;      /* weighted design, n x (2 + 2 CF_PRONY_MAX) */
     gsl_vector *y, *tau, *a, *res;
 } standin;
+
+/* Non-negative least squares min |X a - y|, a >= 0 (Lawson and Hanson's active-set method, the
+** subproblems on the free columns by Householder QR): for the stand-in with relaxation growing
+** with strain, whose unconstrained solutions mostly cancel terms of opposite sign. X is n x m
+** (m <= 2 + 2 CF_PRONY_MAX), not changed; 0 when a subproblem is rank deficient. */
+static int nnls(const gsl_matrix *X, const gsl_vector *y, double *a)
+{
+    enum { MMAX = 2 + 2 * CF_PRONY_MAX };
+    const size_t n = X->size1, m = X->size2;
+    int in[MMAX] = {0};
+    double w[MMAX], z[MMAX], r_buf[1];
+    (void)r_buf;
+    gsl_matrix *Q = gsl_matrix_alloc(n, m);
+    gsl_vector *tau = gsl_vector_alloc(m), *sol = gsl_vector_alloc(m), *res = gsl_vector_alloc(n);
+    int ok = Q && tau && sol && res;
+    for (size_t j = 0; j < m; j++)
+        a[j] = 0;
+    /* solves the least squares on the free columns into z (0 elsewhere) */
+#define NNLS_SUB()                                                                                 \
+    do {                                                                                           \
+        size_t np_ = 0, map_[MMAX];                                                                \
+        for (size_t j = 0; j < m; j++)                                                             \
+            if (in[j])                                                                             \
+                map_[np_++] = j;                                                                   \
+        gsl_matrix_view Qv = gsl_matrix_submatrix(Q, 0, 0, n, np_);                                \
+        for (size_t k = 0; k < np_; k++)                                                           \
+            for (size_t i = 0; i < n; i++)                                                         \
+                gsl_matrix_set(&Qv.matrix, i, k, gsl_matrix_get(X, i, map_[k]));                   \
+        gsl_vector_view tv = gsl_vector_subvector(tau, 0, np_), sv = gsl_vector_subvector(sol, 0, np_); \
+        ok = gsl_linalg_QR_decomp(&Qv.matrix, &tv.vector) == GSL_SUCCESS &&                        \
+             gsl_linalg_QR_lssolve(&Qv.matrix, &tv.vector, y, &sv.vector, res) == GSL_SUCCESS;     \
+        for (size_t j = 0; j < m; j++)                                                             \
+            z[j] = 0;                                                                              \
+        for (size_t k = 0; ok && k < np_; k++)                                                     \
+            ok = isfinite(z[map_[k]] = gsl_vector_get(sol, k));                                    \
+    } while (0)
+    for (int outer = 0; ok && outer < 3 * (int)m; outer++) {
+        /* gradient w = X^T (y - X a) */
+        size_t jmax = m;
+        for (size_t j = 0; j < m; j++) {
+            double g = 0;
+            for (size_t i = 0; i < n; i++) {
+                double r = gsl_vector_get(y, i);
+                for (size_t k = 0; k < m; k++)
+                    if (a[k] != 0)
+                        r -= gsl_matrix_get(X, i, k) * a[k];
+                g += gsl_matrix_get(X, i, j) * r;
+            }
+            w[j] = g;
+            if (!in[j] && g > 1e-12 && (jmax == m || g > w[jmax]))
+                jmax = j;
+        }
+        if (jmax == m)
+            break;
+        in[jmax] = 1;
+        for (int inner = 0; ok && inner < 3 * (int)m; inner++) {
+            NNLS_SUB();
+            if (!ok)
+                break;
+            double alpha = 2;
+            for (size_t j = 0; j < m; j++)
+                if (in[j] && z[j] <= 0)
+                    alpha = fmin(alpha, a[j] / (a[j] - z[j]));
+            if (alpha > 1) { /* all free coefficients positive */
+                for (size_t j = 0; j < m; j++)
+                    a[j] = z[j];
+                break;
+            }
+            for (size_t j = 0; j < m; j++) {
+                a[j] += alpha * (z[j] - a[j]);
+                if (in[j] && a[j] <= 1e-300) {
+                    in[j] = 0;
+                    a[j] = 0;
+                }
+            }
+        }
+    }
+#undef NNLS_SUB
+    if (Q)
+        gsl_matrix_free(Q);
+    if (tau)
+        gsl_vector_free(tau);
+    if (sol)
+        gsl_vector_free(sol);
+    if (res)
+        gsl_vector_free(res);
+    return ok;
+}
 
 /* Weighted linear least squares of the stand-in by Householder QR (GSL): the coefficients in
 ** a[] in the order of the basis (A first when free). 0 when the design is rank deficient. */
@@ -338,6 +446,8 @@ static int standin_solve(const ctx *c, standin *s, int m, double *a)
             gsl_matrix_set(&X.matrix, k, (size_t)i, c->sw[k] * b[k]);
         }
     }
+    if (s->xE) /* relaxation growing with strain: every coefficient >= 0 */
+        return nnls(&X.matrix, s->y, a);
     if (gsl_linalg_QR_decomp(&X.matrix, &tau.vector) != GSL_SUCCESS)
         return 0;
     double dmax = 0, dmin = HUGE_VAL;
@@ -364,19 +474,22 @@ static int standin_params(const ctx *c, const standin *s, const double *a, const
     const double A = held ? s->A_fixed : a[0];
     if (!(A > 0))
         return 0;
-    double gs = 0;
+    double gs = 0, gs1 = 0;
     p->nbranch = c->nb;
     for (int i = 0; i < c->nb; i++) {
+        const double g1 = c->gs ? a[off + c->nb + i] / A : 0.0; /* at the largest strain */
         p->g[i] = a[off + i] / A;
+        p->k[i] = c->gs ? (g1 - p->g[i]) / c->xmax : 0.0;
         p->tau_s[i] = taus[idx[i]];
-        if (!(p->g[i] >= 0))
+        if (!(p->g[i] >= 0) || !(g1 >= 0))
             return 0;
         gs += p->g[i];
+        gs1 += g1;
     }
-    if (!(gs < 1 - 1e-9))
+    if (!(gs < 1 - 1e-9) || !(gs1 < 1 - 1e-9))
         return 0;
     if (c->dash) {
-        double cd = a[off + c->nb];
+        double cd = a[off + c->nb * (1 + c->gs)];
         if (!(cd > 0))
             return 0;
         p->eta_MPa_s = cd * rate_factor; /* MPa s */
@@ -402,7 +515,7 @@ static double standin_obj(const ctx *c, const standin *s, int m, const double *a
 
 /* One combination of time constants (indices idx into taus): solved, the scale capped at A_max
 ** (then solved again with the scale held there), kept in best when feasible. */
-static void standin_combo(ctx *c, standin *s, double *const *R, const int *idx,
+static void standin_combo(ctx *c, standin *s, double *const *R, double *const *S, const int *idx,
                           const double *taus, double rate_factor, double A_max,
                           const cf_visco_params *el, double *tmp, start *best, int nbest)
 {
@@ -413,17 +526,25 @@ static void standin_combo(ctx *c, standin *s, double *const *R, const int *idx,
             b[k] = R[idx[i]][k] - s->E[k];
         s->basis[i] = b;
     }
+    for (int i = 0; c->gs && i < nb; i++) {
+        double *b0 = tmp + (size_t)i * c->n, *b1 = tmp + (size_t)(nb + i) * c->n;
+        for (size_t k = 0; k < c->n; k++) {
+            b1[k] = (S[idx[i]][k] - s->xE[k]) / c->xmax;
+            b0[k] -= b1[k];
+        }
+        s->basis[nb + i] = b1;
+    }
     if (c->dash)
-        s->basis[nb] = s->rate;
+        s->basis[nb * (1 + c->gs)] = s->rate;
     const double A_held = c->free_el ? 0.0 : 1.0; /* a held curve carries its scale */
-    double a[2 + CF_PRONY_MAX];
+    double a[2 + 2 * CF_PRONY_MAX];
     s->A_fixed = A_held;
-    int m = (s->A_fixed > 0 ? 0 : 1) + nb + c->dash;
+    int m = (s->A_fixed > 0 ? 0 : 1) + nb * (1 + c->gs) + c->dash;
     if (!standin_solve(c, s, m, a))
         return;
     if (s->A_fixed == 0 && a[0] > A_max) { /* past the design cap: the scale held there */
         s->A_fixed = A_max;
-        m = nb + c->dash;
+        m = nb * (1 + c->gs) + c->dash;
         if (!(A_max > 0) || !standin_solve(c, s, m, a))
             return;
     }
@@ -434,26 +555,28 @@ static void standin_combo(ctx *c, standin *s, double *const *R, const int *idx,
 
 /* For one elastic curve E and the Prony responses R[t][k] of every grid time constant, tries
 ** every set of nb time constants and keeps the best feasible ones in best. */
-static void search_taus(ctx *c, const double *E, double *const *R, const double *taus,
-                        const double *rate, double rate_factor, double A_max,
-                        const cf_visco_params *el, start *best, int nbest)
+static void search_taus(ctx *c, const double *E, const double *xE, double *const *R,
+                        double *const *S, const double *taus, const double *rate,
+                        double rate_factor, double A_max, const cf_visco_params *el, start *best,
+                        int nbest)
 {
     const int nb = c->nb;
     standin s;
     memset(&s, 0, sizeof s);
     s.E = E;
+    s.xE = xE;
     s.rate = rate;
-    s.X = gsl_matrix_alloc(c->n, 2 + CF_PRONY_MAX);
+    s.X = gsl_matrix_alloc(c->n, 2 + 2 * CF_PRONY_MAX);
     s.y = gsl_vector_alloc(c->n);
     s.res = gsl_vector_alloc(c->n);
-    s.tau = gsl_vector_alloc(2 + CF_PRONY_MAX);
-    s.a = gsl_vector_alloc(2 + CF_PRONY_MAX);
-    double *tmp = malloc((size_t)(nb + 1) * c->n * sizeof(double));
+    s.tau = gsl_vector_alloc(2 + 2 * CF_PRONY_MAX);
+    s.a = gsl_vector_alloc(2 + 2 * CF_PRONY_MAX);
+    double *tmp = malloc((size_t)(2 * nb + 1) * c->n * sizeof(double));
     int idx[CF_PRONY_MAX];
     for (int i = 0; i < nb; i++)
         idx[i] = i;
     while (tmp && s.X && s.y && s.res && s.tau && s.a) {
-        standin_combo(c, &s, R, idx, taus, rate_factor, A_max, el, tmp, best, nbest);
+        standin_combo(c, &s, R, S, idx, taus, rate_factor, A_max, el, tmp, best, nbest);
         /* next combination of nb indices out of GRID_TAU, increasing */
         int i = nb - 1;
         while (i >= 0 && idx[i] == GRID_TAU - nb + i)
@@ -544,13 +667,16 @@ static int stand_in(ctx *c, start *best, int nbest)
     for (int i = 0; i < GRID_TAU; i++)
         taus[i] = tlo * pow(thi / tlo, (double)i / (GRID_TAU - 1));
     double *E = malloc(n * sizeof(double)), *rate = calloc(n, sizeof(double));
-    double *Rbuf = malloc((size_t)GRID_TAU * n * sizeof(double)), *R[GRID_TAU];
-    for (int i = 0; Rbuf && i < GRID_TAU; i++)
+    double *xE = malloc(n * sizeof(double));
+    double *Rbuf = malloc((size_t)GRID_TAU * 2 * n * sizeof(double)), *R[GRID_TAU], *S[GRID_TAU];
+    for (int i = 0; Rbuf && i < GRID_TAU; i++) {
         R[i] = Rbuf + (size_t)i * n;
+        S[i] = Rbuf + (size_t)(GRID_TAU + i) * n;
+    }
     for (size_t k = 1; rate && k < n; k++)
         rate[k] = (c->d->x[k] - c->d->x[k - 1]) / (t[k] - t[k - 1]);
     const int nrho = c->free_el ? GRID_RHO : 1, ne = c->free_el ? GRID_E : 1;
-    for (int ir = 0; E && rate && Rbuf && ir < nrho; ir++)
+    for (int ir = 0; E && xE && rate && Rbuf && ir < nrho; ir++)
         for (int ie = 0; ie < ne; ie++) {
             cf_visco_params el;
             grid_point(c, ir, ie, &el);
@@ -558,13 +684,20 @@ static int stand_in(ctx *c, start *best, int nbest)
             if (!elastic_curve(c, el.rho, el.solid_strain, el.stress_scale_MPa, E, &fac))
                 continue;
             grid_responses(c, E, taus, R);
+            if (c->gs) {
+                for (size_t k = 0; k < n; k++)
+                    xE[k] = fabs(c->d->x[k]) * E[k];
+                grid_responses(c, xE, taus, S);
+            }
             const double A_max = c->free_el
                                      ? cf_visco_limits_scale_max(&c->lim, el.rho, el.solid_strain)
                                      : INFINITY;
             /* a dashpot eta beside every spring adds about eta * fac * rate to the stress */
-            search_taus(c, E, R, taus, rate, 1 / fac, A_max, &el, best, nbest);
+            search_taus(c, E, c->gs ? xE : NULL, R, S, taus, rate, 1 / fac, A_max, &el, best,
+                        nbest);
         }
     free(E);
+    free(xE);
     free(rate);
     free(Rbuf);
     return best[0].obj < HUGE_VAL;
@@ -586,7 +719,9 @@ static double *se_slot(const ctx *c, const int held[3], int which, cf_visco_para
         int i = (which - 3) / 2;
         return (which - 3) % 2 == 0 ? &q->g[i] : &q->tau_s[i];
     }
-    return c->dash ? &q->eta_MPa_s : NULL;
+    if (which == 3 + 2 * nb)
+        return c->dash ? &q->eta_MPa_s : NULL;
+    return c->gs ? &q->k[which - 4 - 2 * nb] : NULL;
 }
 
 /* One column of the Jacobian: the weighted central difference of the model in quantity `which`,
@@ -630,8 +765,10 @@ static void se_store(int which, int nb, double se, cf_visco_fit *res)
     else if (which < 3 + 2 * nb)
         *((which - 3) % 2 == 0 ? &res->se_g[(which - 3) / 2] : &res->se_tau_s[(which - 3) / 2]) =
             se;
-    else
+    else if (which == 3 + 2 * nb)
         res->se_eta_MPa_s = se;
+    else
+        res->se_k[which - 4 - 2 * nb] = se;
 }
 
 /* Central-difference Jacobian of the weighted model in the reported quantities at p, and the
@@ -644,9 +781,9 @@ static void standard_errors(ctx *c, const cf_visco_params *p, const int held[3],
     for (int i = 0; i < 3; i++)
         res->se_ident[i] = -1;
     for (int i = 0; i < CF_PRONY_MAX; i++)
-        res->se_g[i] = res->se_tau_s[i] = -1;
+        res->se_g[i] = res->se_tau_s[i] = res->se_k[i] = -1;
     res->se_eta_MPa_s = -1;
-    const int nq = 3 + 2 * p->nbranch + 1;
+    const int nq = 3 + 2 * p->nbranch + 1 + (c->gs ? p->nbranch : 0);
     cf_visco_params q = *p;
     size_t k = 0;
     for (int which = 0; which < nq; which++)
@@ -702,14 +839,16 @@ static void default_start(const ctx *c, int nb, start *s)
 static double fit_nb(ctx *c, int nb, cf_visco_params *pout)
 {
     c->nb = nb;
-    c->np = (size_t)((c->free_el ? 2 : 0) + 2 * nb + (c->dash ? 1 : 0));
-    start best[LM_STARTS];
-    if (!stand_in(c, best, LM_STARTS))
+    c->np = (size_t)((c->free_el ? 2 : 0) + (2 + c->gs) * nb + (c->dash ? 1 : 0));
+    /* relaxation depending on strain trades more freely against the elastic curve: more starts */
+    const int nstarts = c->gs ? LM_STARTS_STRAIN : LM_STARTS;
+    start best[LM_STARTS_STRAIN];
+    if (!stand_in(c, best, nstarts))
         default_start(c, nb, &best[0]);
     double bestobj = HUGE_VAL;
     double *z = malloc(c->np * sizeof(double)), *zbest = malloc(c->np * sizeof(double));
     c->oom |= !z || !zbest;
-    for (int s = 0; z && zbest && !c->oom && s < LM_STARTS; s++) {
+    for (int s = 0; z && zbest && !c->oom && s < nstarts; s++) {
         if (!(best[s].obj < HUGE_VAL))
             continue;
         cf_visco_params p0 = best[s].p;
@@ -938,7 +1077,11 @@ static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf
     double best_aic = HUGE_VAL;
     memset(best, 0, sizeof *best);
     res->chosen_by_aic = o->nbranch == 0;
-    for (int nb = nlo; nb <= nhi; nb++) {
+    /* quasi-linear, strain-dependent or both (the lower AIC kept) */
+    const int gslo = o->relaxation == CF_RELAX_STRAIN, gshi = o->relaxation != CF_RELAX_QLV;
+    for (int v = 0; v < (nhi - nlo + 1) * (gshi - gslo + 1); v++) {
+        const int nb = nlo + v / (gshi - gslo + 1);
+        c->gs = gslo + v % (gshi - gslo + 1);
         cf_visco_params p;
         const int ok = fit_nb(c, nb, &p) < HUGE_VAL && curve(c, &p);
         if (c->oom)
@@ -951,10 +1094,10 @@ static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf
         double rss = 0;
         for (size_t k = 0; k < c->n; k++)
             rss += (c->m[k] - c->d->y[k]) * (c->m[k] - c->d->y[k]);
-        int kpar = (c->free_el ? 3 : 0) + 2 * nb + c->dash;
+        int kpar = (c->free_el ? 3 : 0) + (2 + c->gs) * nb + c->dash;
         double aic = (double)c->n * log(fmax(rss, 1e-300) / (double)c->n) + 2.0 * kpar;
-        if (nb - 1 < CF_VISCO_AIC_MAX)
-            res->aic_by_n[nb - 1] = aic;
+        if (nb - 1 < CF_VISCO_AIC_MAX && (c->gs == gslo || !(res->aic_by_n[nb - 1] <= aic)))
+            res->aic_by_n[nb - 1] = aic; /* the better of the two relaxations at this N */
         if (aic < best_aic) {
             best_aic = aic;
             *best = p;
@@ -1031,7 +1174,11 @@ static cf_status fit_report(ctx *c, const cf_visco_params *bestp, cf_visco_fit *
     res->dashpot = c->dash;
     res->held_elastic = !c->free_el;
     res->count = c->n;
-    res->k = (c->free_el ? 3 : 0) + 2 * bestp->nbranch + c->dash;
+    c->gs = 0;
+    for (int i = 0; i < bestp->nbranch; i++)
+        c->gs |= bestp->k[i] != 0;
+    res->strain_relaxation = c->gs;
+    res->k = (c->free_el ? 3 : 0) + (2 + c->gs) * bestp->nbranch + c->dash;
     double wrss = fit_quality(c, res);
     double s2 = (double)c->n > res->k ? wrss / ((double)c->n - res->k) : 0;
     int held[3];

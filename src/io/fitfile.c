@@ -42,11 +42,16 @@ static cf_status read_visco(json_t *fit, const char *path, const char *where,
     json_array_foreach(pr, i, term)
     {
         json_t *g = json_object_get(term, "g"), *tau = json_object_get(term, "tau_s");
+        json_t *k = json_object_get(term, "g_per_strain");
         if (!json_is_number(g) || !json_is_number(tau))
             return cf_error_set(err, CF_E_DATA, "%s: %s.prony[%zu] needs numbers 'g' and 'tau_s'",
                                 path, where, i);
+        if (k && !json_is_number(k))
+            return cf_error_set(err, CF_E_DATA, "%s: %s.prony[%zu].g_per_strain must be a number",
+                                path, where, i);
         fx.prony_g[i] = json_number_value(g);
         fx.prony_tau_s[i] = json_number_value(tau);
+        fx.prony_k[i] = k ? json_number_value(k) : 0.0;
     }
     fx.prony_count = (int)json_array_size(pr);
     cf_error e = {0};
@@ -65,6 +70,7 @@ static cf_status read_visco(json_t *fit, const char *path, const char *where,
     out->prony_count = fx.prony_count;
     memcpy(out->prony_g, fx.prony_g, sizeof out->prony_g);
     memcpy(out->prony_tau_s, fx.prony_tau_s, sizeof out->prony_tau_s);
+    memcpy(out->prony_k, fx.prony_k, sizeof out->prony_k);
     return CF_OK;
 }
 

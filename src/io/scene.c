@@ -272,11 +272,12 @@ static cf_status lattice_section(ctx *c, json_t *lt, cf_scene *sc)
     return CF_OK;
 }
 
-/* effects.viscosity.prony: [{"g": .., "tau_s": ..}, ...], alone (no E_kPa, tau_s beside it),
+/* effects.viscosity.prony: [{"g": .., "tau_s": .., "g_per_strain": ..}, ...] (g_per_strain
+** optional, 0: quasi-linear), alone (no E_kPa, tau_s beside it),
 ** checked as the lattice takes it (g >= 0, sum g < 1, tau > 0, at most CF_PRONY_MAX). */
 static cf_status prony_list(ctx *c, json_t *vs, json_t *pr, cf_msm_effects *e)
 {
-    static const char *const tkeys[] = {"g", "tau_s", NULL};
+    static const char *const tkeys[] = {"g", "tau_s", "g_per_strain", NULL};
     if (json_object_get(vs, "E_kPa") || json_object_get(vs, "tau_s"))
         return cf_error_set(c->err, CF_E_DATA,
                             "%s: key 'effects.viscosity' takes either 'prony' or 'E_kPa' and "
@@ -299,7 +300,8 @@ static cf_status prony_list(ctx *c, json_t *vs, json_t *pr, cf_msm_effects *e)
                                 where);
         if ((st = only_keys(c, term, where, tkeys)) ||
             (st = number(c, term, where, "g", 1, 0, 0, 0, 1, &e->prony_g[i])) ||
-            (st = number(c, term, where, "tau_s", 1, 0, 0, 1, 1e12, &e->prony_tau_s[i])))
+            (st = number(c, term, where, "tau_s", 1, 0, 0, 1, 1e12, &e->prony_tau_s[i])) ||
+            (st = number(c, term, where, "g_per_strain", 0, 0, -1e6, 0, 1e6, &e->prony_k[i])))
             return st;
     }
     e->prony_count = (int)json_array_size(pr);
@@ -325,6 +327,7 @@ static cf_status effects_section(ctx *c, json_t *ef, cf_scene *sc)
         e->prony_count = c->fit.prony_count;
         memcpy(e->prony_g, c->fit.prony_g, sizeof e->prony_g);
         memcpy(e->prony_tau_s, c->fit.prony_tau_s, sizeof e->prony_tau_s);
+        memcpy(e->prony_k, c->fit.prony_k, sizeof e->prony_k);
         e->eta_MPa_s = c->fit.eta_MPa_s;
     }
     if (!ef)

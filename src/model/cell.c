@@ -72,6 +72,7 @@ cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
     c->law = law;
     c->method = method;
     c->law_scale = 1.0;
+    c->law_scale_strain = 0.0;
     c->stretch_hint = 0.0;
     memcpy(c->weight, weight, sizeof c->weight);
     return CF_OK;
@@ -108,8 +109,16 @@ static cf_status evaluate(const cf_cell *c, const double F[9], const cf_cell_ext
                                 N[0], N[1], N[2], L / L0, 1 - copysign(law->travel_mm / H, u));
         double k = 0;
         double f = cf_law_force(law, c->method, u, &k, NULL);
-        double w = c->weight[fam] * c->law_scale;
-        double T = -w * f, dT = w * k * H / L0;
+        double w = c->weight[fam] * c->law_scale, T, dT;
+        if (c->law_scale_strain != 0) { /* factor law_scale + law_scale_strain |u| / H */
+            const double phi = c->law_scale + c->law_scale_strain * fabs(u) / H;
+            const double dphi = c->law_scale_strain * copysign(1.0, u) / H; /* d phi / du */
+            T = -c->weight[fam] * phi * f;
+            dT = c->weight[fam] * (phi * k + dphi * f) * H / L0;
+        } else {
+            T = -w * f;
+            dT = w * k * H / L0;
+        }
         if (x) {
             T += x->T0_N[d] + x->k_N_per_mm[d] * (L - x->Lref_mm[d]);
             dT += x->k_N_per_mm[d];

@@ -71,6 +71,10 @@ cf_status cf_msm_prony_check(const cf_msm_effects *fx, cf_error *err)
                             "Prony terms: the relative moduli sum to %.17g; the sum must be below "
                             "1 (g_inf = 1 - sum g > 0)",
                             sum);
+    for (int i = 0; i < fx->prony_count; i++)
+        if (!isfinite(fx->prony_k[i]))
+            return cf_error_set(err, CF_E_DATA, "Prony term %d: g_per_strain = %g must be finite",
+                                i + 1, fx->prony_k[i]);
     return CF_OK;
 }
 
@@ -105,6 +109,7 @@ typedef struct solver {
                                  branch i of spring q at hq[q * prony_count + i] (NULL when off) */
     double *Fprev;            /* law force of every spring at the start of the step, N */
     double qlv_scale;         /* step's law-force factor minus 1 (Prony terms; 0 when off) */
+    double qlv_slope;         /* its growth per unit |strain| of the spring (0: quasi-linear) */
     double *tmp;              /* per-spring scratch */
     gsl_spmatrix *C;          /* tangent, compressed columns, pattern built once */
     int *map, *diag;          /* spring block -> C->data index; DOF -> its diagonal index */
@@ -120,6 +125,27 @@ typedef struct solver {
     int extras;               /* quasi-static extras active */
     cf_msm_stats *st;
 } solver;
+
+/* The step's law-force factor minus 1 on spring q at its current strain (qlv_scale + qlv_slope
+** |u| / H), and its derivative with respect to the law compression u. */
+static inline double qlv_factor(const solver *s, size_t q, double *d_du)
+{
+    const cf_lattice *lat = s->lat;
+    if (s->qlv_slope == 0) {
+        if (d_du)
+            *d_du = 0;
+        return s->qlv_scale;
+    }
+    if (d_du)
+        *d_du = s->qlv_slope * copysign(1.0, lat->u_mm[q]) / lat->H_mm;
+    return s->qlv_scale + s->qlv_slope * fabs(lat->u_mm[q]) / lat->H_mm;
+}
+
+/* Prony term i's relative modulus at a spring's |strain| e: g_i + k_i e. */
+static inline double prony_g_at(const cf_msm_effects *fx, int i, double abs_e)
+{
+    return fx->prony_k[i] != 0 ? fx->prony_g[i] + fx->prony_k[i] * abs_e : fx->prony_g[i];
+}
 
 static void solver_free(solver *s)
 {
@@ -243,7 +269,7 @@ static double residual(solver *s, double *rnorm, double *fscale)
     if (s->extras) {
         for (size_t q = 0; q < lat->ns; q++)
             s->tmp[q] = s->Tx0[q] + s->kx[q] * (lat->L_mm[q] - s->Lprev[q]) -
-                        s->qlv_scale * lat->w[q] * lat->F_N[q];
+                        qlv_factor(s, q, NULL) * lat->w[q] * lat->F_N[q];
         cf_lattice_add_tensions(lat, s->tmp);
     }
     add_external(s);
@@ -599,8 +625,10 @@ static cf_status tangent_solve(solver *s, cf_error *err)
         double nv[3] = {(lat->x[j] - lat->x[i]) / L, (lat->y[j] - lat->y[i]) / L,
                         (lat->z[j] - lat->z[i]) / L};
         double kt = lat->w[q] * lat->a[q] * lat->k_N_per_mm[q];
-        if (s->extras)
-            kt = kt * (1 + s->qlv_scale) + s->kx[q];
+        if (s->extras) {
+            double dq, qf = qlv_factor(s, q, &dq);
+            kt = kt * (1 + qf) + s->kx[q] + dq * lat->w[q] * lat->a[q] * lat->F_N[q];
+        }
         double g = lat->T_N[q] / L;
         const int *m = s->map + q * 36;
         for (int a = 0; a < 3; a++)
@@ -891,6 +919,40 @@ double cf_msm_path_value(const cf_msm_path *p, double t)
 
 /* ---- quasi-static viscous steps ------------------------------------------------------------- */
 
+cf_status cf_msm_prony_at_strain(const cf_msm_effects *fx, double e, cf_error *err)
+{
+    double sum = 0;
+    for (int i = 0; i < fx->prony_count; i++) {
+        const double g = prony_g_at(fx, i, e);
+        if (!(g >= 0))
+            return cf_error_set(err, CF_E_DATA,
+                                "Prony term %d: at strain %.6g of a spring its relative modulus "
+                                "g + g_per_strain |strain| is %.6g; it must stay >= 0",
+                                i + 1, e, g);
+        sum += g;
+    }
+    if (!(sum < 1))
+        return cf_error_set(err, CF_E_DATA,
+                            "Prony terms: at strain %.6g of a spring the relative moduli sum to "
+                            "%.6g (g + g_per_strain |strain|); the sum must stay below 1",
+                            e, sum);
+    return CF_OK;
+}
+
+/* With relaxation that depends on strain, every spring's moduli at the converged state: past their
+** bounds the relaxed spring would push back the wrong way. */
+static cf_status relaxed_share_check(const solver *s, cf_error *err)
+{
+    const cf_msm_effects *fx = s->fx;
+    int any = 0;
+    for (int i = 0; fx && i < fx->prony_count; i++)
+        any |= fx->prony_k[i] != 0;
+    cf_status st = CF_OK;
+    for (size_t q = 0; any && st == CF_OK && q < s->lat->ns; q++)
+        st = cf_msm_prony_at_strain(fx, fabs(s->lat->u_mm[q]) / s->lat->H_mm, err);
+    return st;
+}
+
 /* One implicit step of length h to drive value v: dashpots by backward Euler, Maxwell branches by
 ** their exact exponential update at a constant strain rate over the step. */
 static cf_status quasi_step(solver *s, double h, double v, cf_error *err)
@@ -909,11 +971,12 @@ static cf_status quasi_step(solver *s, double h, double v, cf_error *err)
     ** force w ((1 - sum g) F + sum h_i) at the end of the step is w (alpha F(t + h) + c) with
     ** alpha = 1 - sum g_i (1 - b_i) and c = sum (e_i h_i - g_i b_i F(t)). */
     const int np = fx->prony_count;
-    double pe[CF_PRONY_MAX], pb[CF_PRONY_MAX], alpha = 1;
+    double pe[CF_PRONY_MAX], pb[CF_PRONY_MAX], alpha = 1, slope = 0;
     for (int i = 0; i < np; i++) {
         pe[i] = exp(-h / fx->prony_tau_s[i]);
         pb[i] = -expm1(-h / fx->prony_tau_s[i]) * fx->prony_tau_s[i] / h;
         alpha -= fx->prony_g[i] * (1 - pb[i]);
+        slope -= fx->prony_k[i] * (1 - pb[i]);
     }
     cf_lattice_forces(lat); /* lengths at the start of the step */
     for (size_t q = 0; q < lat->ns; q++) {
@@ -922,13 +985,15 @@ static cf_status quasi_step(solver *s, double h, double v, cf_error *err)
         s->kx[q] = lat->w[q] * H2 * visc / lat->L0_mm[q];
         if (np > 0) {
             double c = 0;
+            const double e = fabs(lat->u_mm[q]) / lat->H_mm;
             s->Fprev[q] = lat->F_N[q];
             for (int i = 0; i < np; i++)
-                c += pe[i] * s->hq[q * np + i] - fx->prony_g[i] * pb[i] * lat->F_N[q];
+                c += pe[i] * s->hq[q * np + i] - prony_g_at(fx, i, e) * pb[i] * lat->F_N[q];
             s->Tx0[q] -= lat->w[q] * c;
         }
     }
     s->qlv_scale = alpha - 1;
+    s->qlv_slope = slope;
     s->extras = 1;
     double v0 = s->load;
     s->load = v;
@@ -941,13 +1006,23 @@ static cf_status quasi_step(solver *s, double h, double v, cf_error *err)
             place_top(lat, v0);
         return st;
     }
+    if ((st = relaxed_share_check(s, err)) != CF_OK)
+        return st;
     if (s->sigm)
         for (size_t q = 0; q < lat->ns; q++)
             s->sigm[q] = s->sigm[q] * E1 + mcoef * (lat->L_mm[q] - s->Lprev[q]) / lat->L0_mm[q];
-    for (size_t q = 0; np > 0 && q < lat->ns; q++) /* F_N: the converged state */
+    for (size_t q = 0; np > 0 && q < lat->ns; q++) { /* F_N: the converged state */
+        /* |strain| at the start of the step, from its length there */
+        const double e0 = fabs((lat->L0_mm[q] - s->Lprev[q]) * lat->a[q]) / lat->H_mm;
+        const double e1 = fabs(lat->u_mm[q]) / lat->H_mm;
         for (int i = 0; i < np; i++)
-            s->hq[q * np + i] = pe[i] * s->hq[q * np + i] +
-                                fx->prony_g[i] * pb[i] * (lat->F_N[q] - s->Fprev[q]);
+            s->hq[q * np + i] =
+                pe[i] * s->hq[q * np + i] +
+                (fx->prony_k[i] == 0
+                     ? fx->prony_g[i] * pb[i] * (lat->F_N[q] - s->Fprev[q])
+                     : pb[i] * (prony_g_at(fx, i, e1) * lat->F_N[q] -
+                                prony_g_at(fx, i, e0) * s->Fprev[q]));
+    }
     if (s->st)
         s->st->steps++;
     return CF_OK;
@@ -1222,10 +1297,15 @@ static cf_status advance_to(solver *s, dyn *d, const cf_msm_path *path, double t
         double gsum = 0;
         for (int i = 0; i < fx->prony_count; i++)
             gsum += fx->prony_g[i];
+        double ksum = 0;
+        for (int i = 0; i < fx->prony_count; i++)
+            ksum += fx->prony_k[i];
         s->qlv_scale = -gsum;
+        s->qlv_slope = -ksum;
         s->extras = 1;
     }
-    return static_to(s, vk, err);
+    cf_status rc = static_to(s, vk, err);
+    return rc == CF_OK ? relaxed_share_check(s, err) : rc;
 }
 
 /* The compressive stress at the top of the current state (drive value vk). */

@@ -39,6 +39,7 @@ cf_msm_effects cf_visco_effects(const cf_visco_params *p)
     for (int i = 0; i < p->nbranch && i < CF_PRONY_MAX; i++) {
         fx.prony_g[i] = p->g[i];
         fx.prony_tau_s[i] = p->tau_s[i];
+        fx.prony_k[i] = p->k[i];
     }
     return fx;
 }
@@ -94,11 +95,13 @@ typedef struct cell_run {
     double h[CF_CELL_DIRS][CF_PRONY_MAX];
     double Fprev[CF_CELL_DIRS], Lprev[CF_CELL_DIRS];
     cf_cell_state st;                  /* the current state */
+    int strain_moduli;                 /* 1 when a Prony modulus changes with strain */
 } cell_run;
 
 /* One implicit step of length dt (0: the relaxed state at the start) to table strain e. Over the
 ** step every spring's tension is w (alpha F(u) + c) plus its dashpot, alpha = 1 - sum g_i (1 - b_i)
-** and c from the branches' state (the exact recursive update for a law force linear in time along
+** - |e| sum k_i (1 - b_i) at the spring's strain e (relaxation growing with strain, msm.h), and c
+** from the branches' state (the exact recursive update for a law force linear in time along
 ** the step): the law scaled by alpha and a term affine in the spring's length, which is what the
 ** cell takes (cf_cell.law_scale and cf_cell_extra), so the cell's own solve of its free lateral
 ** stretch (cf_cell_mode) gives the step's equilibrium exactly. */
@@ -106,33 +109,49 @@ static cf_status cell_step(cell_run *r, double dt, double e, cf_error *err)
 {
     const cf_visco_params *p = r->p;
     const int np = p->nbranch;
-    double pe[CF_PRONY_MAX], pb[CF_PRONY_MAX], alpha = 1;
+    double pe[CF_PRONY_MAX], pb[CF_PRONY_MAX], alpha = 1, slope = 0;
     for (int i = 0; i < np; i++) {
         pe[i] = dt > 0 ? exp(-dt / p->tau_s[i]) : 0;
         pb[i] = dt > 0 ? -expm1(-dt / p->tau_s[i]) * p->tau_s[i] / dt : 0;
         alpha -= p->g[i] * (1 - pb[i]);
+        slope -= p->k[i] * (1 - pb[i]);
     }
     const double H = r->H, visc = dt > 0 ? p->eta_MPa_s / dt : 0;
     cf_cell_extra x;
+    double e0[CF_CELL_DIRS]; /* each spring's |strain| at the start of the step */
     for (int d = 0; d < CF_CELL_DIRS; d++) {
         double c = 0;
+        e0[d] = fabs(1 - r->Lprev[d] / r->L0[d]);
         for (int i = 0; i < np && dt > 0; i++)
-            c += pe[i] * r->h[d][i] - p->g[i] * pb[i] * r->Fprev[d];
+            c += pe[i] * r->h[d][i] - (p->g[i] + p->k[i] * e0[d]) * pb[i] * r->Fprev[d];
         x.T0_N[d] = -r->w[d] * c;                                    /* branches, tension + */
         x.k_N_per_mm[d] = r->w[d] * H * H * visc / r->L0[d];         /* dashpot, as msm.h */
         x.Lref_mm[d] = r->Lprev[d];
     }
     r->cell.law_scale = dt > 0 ? alpha : 1.0;
+    r->cell.law_scale_strain = dt > 0 ? slope : 0.0;
     cf_status st = cf_cell_mode(&r->cell, CF_MODE_UNIAXIAL, e, &x, &r->st, err);
     r->cell.law_scale = 1.0;
+    r->cell.law_scale_strain = 0.0;
     if (st == CF_OK)
         r->cell.stretch_hint = r->st.free_stretch; /* the next step starts here */
     if (st != CF_OK)
         return st;
+    if (r->strain_moduli) { /* the moduli where the springs went (msm.h) */
+        const cf_msm_effects fx = cf_visco_effects(p);
+        for (int d = 0; d < CF_CELL_DIRS && st == CF_OK; d++)
+            st = cf_msm_prony_at_strain(&fx, fabs(1 - r->st.L_mm[d] / r->L0[d]), err);
+        if (st != CF_OK)
+            return st;
+    }
     for (int d = 0; d < CF_CELL_DIRS; d++) {
-        double f = cf_law_force(r->law, r->method, H * (1 - r->st.L_mm[d] / r->L0[d]), NULL, NULL);
+        const double u = H * (1 - r->st.L_mm[d] / r->L0[d]), e1 = fabs(u) / H;
+        double f = cf_law_force(r->law, r->method, u, NULL, NULL);
         for (int i = 0; i < np && dt > 0; i++)
-            r->h[d][i] = pe[i] * r->h[d][i] + p->g[i] * pb[i] * (f - r->Fprev[d]);
+            r->h[d][i] = pe[i] * r->h[d][i] +
+                         (p->k[i] == 0 ? p->g[i] * pb[i] * (f - r->Fprev[d])
+                                       : pb[i] * ((p->g[i] + p->k[i] * e1) * f -
+                                                  (p->g[i] + p->k[i] * e0[d]) * r->Fprev[d]));
         r->Fprev[d] = f;
         r->Lprev[d] = r->st.L_mm[d];
     }
@@ -191,6 +210,8 @@ static cf_status cell_path(const cf_visco_params *p, const cf_visco_setup *s, co
     r->method = s->method;
     r->p = p;
     r->H = law->p.H_mm;
+    for (int i = 0; i < p->nbranch; i++)
+        r->strain_moduli |= p->k[i] != 0;
     for (int d = 0; d < CF_CELL_DIRS; d++) {
         int N[3], fam;
         cf_cell_direction(d, N, &fam);

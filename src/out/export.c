@@ -41,12 +41,21 @@ static void prony_comment(FILE *out, const char *lead, const char *tail,
     double ginf = 1;
     for (int i = 0; i < fs->prony_count; i++)
         ginf -= fs->prony_g[i];
-    fprintf(out, "%sviscoelastic fit: quasi-linear viscoelasticity on every spring, force = the law "
-                 "convolved with G(t) = g_inf + sum g_i exp(-t/tau_i), g_inf = %.17g%s\n",
-            lead, ginf, tail);
+    int strain = 0;
     for (int i = 0; i < fs->prony_count; i++)
-        fprintf(out, "%sprony term %d: g = %.17g, tau_s = %.17g%s\n", lead, i + 1, fs->prony_g[i],
-                fs->prony_tau_s[i], tail);
+        strain |= fs->prony_k[i] != 0;
+    fprintf(out, "%sviscoelastic fit: %s on every spring, force = the law convolved with G(t) = "
+                 "g_inf + sum g_i exp(-t/tau_i), g_inf = %.17g%s%s\n",
+            lead, strain ? "relaxation depending on strain" : "quasi-linear viscoelasticity", ginf,
+            strain ? " at zero strain" : "", tail);
+    for (int i = 0; i < fs->prony_count; i++) {
+        fprintf(out, "%sprony term %d: g = %.17g, tau_s = %.17g", lead, i + 1, fs->prony_g[i],
+                fs->prony_tau_s[i]);
+        if (fs->prony_k[i] != 0) /* relaxation depending on strain */
+            fprintf(out, ", g_per_strain = %.17g (g at strain e: g + g_per_strain |e|)",
+                    fs->prony_k[i]);
+        fprintf(out, "%s\n", tail);
+    }
     if (fs->eta_MPa_s > 0)
         fprintf(out, "%sdashpot beside every spring: eta = %.17g kPa s%s\n", lead,
                 fs->eta_MPa_s * 1e3, tail);
@@ -112,8 +121,11 @@ static cf_status write_json(FILE *out, const block_job *j, cf_error *err)
         json_t *pr = json_array();
         double ginf = 1;
         for (int i = 0; pr && i < fs->prony_count; i++) {
-            json_array_append_new(pr, json_pack("{s:o, s:o}", "g", cf_json_number(fs->prony_g[i]),
-                                                "tau_s", cf_json_number(fs->prony_tau_s[i])));
+            json_t *t = json_pack("{s:o, s:o}", "g", cf_json_number(fs->prony_g[i]), "tau_s",
+                                  cf_json_number(fs->prony_tau_s[i]));
+            if (t && fs->prony_k[i] != 0)
+                json_object_set_new(t, "g_per_strain", cf_json_number(fs->prony_k[i]));
+            json_array_append_new(pr, t);
             ginf -= fs->prony_g[i];
         }
         json_object_set_new(root, "prony", pr);
@@ -121,9 +133,16 @@ static cf_status write_json(FILE *out, const block_job *j, cf_error *err)
         if (fs->eta_MPa_s > 0)
             json_object_set_new(root, "dashpot",
                                 json_pack("{s:o}", "eta_kPa_s", cf_json_number(fs->eta_MPa_s * 1e3)));
-        json_object_set_new(root, "viscoelasticity",
-                            json_string("quasi-linear (Fung): the spring's force is its law "
-                                        "convolved with G(t) = g_inf + sum g_i exp(-t/tau_i)"));
+        int strain = 0;
+        for (int i = 0; i < fs->prony_count; i++)
+            strain |= fs->prony_k[i] != 0;
+        json_object_set_new(
+            root, "viscoelasticity",
+            json_string(strain ? "relaxation depending on strain: term i's modulus at the "
+                                 "spring's strain e is g + g_per_strain |e|, its branch relaxing "
+                                 "that share of the law force"
+                               : "quasi-linear (Fung): the spring's force is its law convolved "
+                                 "with G(t) = g_inf + sum g_i exp(-t/tau_i)"));
     }
     char *text = cf_fitfile_dumps(root);
     json_decref(root);

@@ -90,6 +90,10 @@ static void visco_keys(const cf_visco_report *r, json_t *o)
         json_t *e = json_pack("{s:o, s:o}", "g", num(f->p.g[i]), "tau_s", num(f->p.tau_s[i]));
         set_se(e, "stderr_g", f->se_g[i], 1);
         set_se(e, "stderr_tau_s", f->se_tau_s[i], 1);
+        if (f->strain_relaxation) { /* absent: quasi-linear */
+            json_object_set_new(e, "g_per_strain", num(f->p.k[i]));
+            set_se(e, "stderr_g_per_strain", f->se_k[i], 1);
+        }
         json_array_append_new(prony, e);
     }
     json_object_set_new(o, "rmse", num(f->rmse * u));
@@ -107,6 +111,7 @@ static void visco_keys(const cf_visco_report *r, json_t *o)
     json_object_set_new(o, "parameters", json_integer(f->k));
     json_object_set_new(o, "prony", prony);
     json_object_set_new(o, "g_inf", num(g_inf(&f->p)));
+    json_object_set_new(o, "relaxation", json_string(f->strain_relaxation ? "strain" : "qlv"));
     if (f->dashpot) { /* absent without one */
         json_t *dp = json_pack("{s:o}", "eta_kPa_s", num(f->p.eta_MPa_s * 1e3));
         set_se(dp, "stderr_kPa_s", f->se_eta_MPa_s, 1e3);
@@ -183,8 +188,12 @@ static json_t *report_json(const cf_visco_report *r)
     json_t *model = json_pack(
         "{s:s, s:s, s:{s:i, s:i, s:i, s:s, s:{s:o, s:o, s:o}, s:s}, s:s, s:i}", "elastic",
         "conical spring law: the instantaneous response", "viscous",
-        "Prony series on every spring (quasi-linear viscoelasticity): G(t) = g_inf + sum g_i "
-        "exp(-t/tau_i)",
+        r->fit.strain_relaxation
+            ? "Prony series on every spring, relaxation depending on strain: g_i(e) = g_i + "
+              "g_per_strain_i |e| at the spring's strain e, each branch relaxing g_i(e) times the "
+              "law force"
+            : "Prony series on every spring (quasi-linear viscoelasticity): G(t) = g_inf + sum g_i "
+              "exp(-t/tau_i)",
         "lattice", "nx", lc->nx, "ny", lc->ny, "nz", lc->nz, "calibration",
         cf_calibration_name(lc->calibration), "weights", "edge", num(lc->weight[CF_FAMILY_EDGE]),
         "face", num(lc->weight[CF_FAMILY_FACE]), "body", num(lc->weight[CF_FAMILY_BODY]),
@@ -291,7 +300,14 @@ char *cf_visco_report_text(const cf_visco_report *r)
         value_se_text(o, l, f->p.g[i], f->se_g[i], 1, "");
         snprintf(l, sizeof l, "tau_%d", i + 1);
         value_se_text(o, l, f->p.tau_s[i], f->se_tau_s[i], 1, "s");
+        if (f->strain_relaxation) {
+            snprintf(l, sizeof l, "g_%d per unit |strain|", i + 1);
+            value_se_text(o, l, f->p.k[i], f->se_k[i], 1, "");
+        }
     }
+    if (f->strain_relaxation)
+        fprintf(o, "  (relaxation depends on strain: g_i + g_per_strain_i |strain| at a spring's "
+                   "strain)\n");
     fprintf(o, "  %-30s %.6g\n", "g_inf = 1 - sum g_i", g_inf(&f->p));
     if (f->dashpot)
         value_se_text(o, "dashpot eta", f->p.eta_MPa_s, f->se_eta_MPa_s, 1e3, "kPa s");

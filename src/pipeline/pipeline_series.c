@@ -68,15 +68,19 @@ cf_status cf_pipeline_fit_series(const cf_table *t, const cf_pipeline_options *o
     cf_status st = cf_visco_fit_run(&d, &o, &r->fit, &e);
     if (st != CF_OK)
         return cf_error_set(err, st, "%s: %s", t->path, e.msg);
-    /* one spring of each type from the identifiable quantities, placed as the elastic fit does */
+    /* one spring of each type from the identifiable quantities, placed as the elastic fit does;
+    ** a placement replaced by the exact member keeps its slot only if the member is of its type
+    ** (the member is non-telescoping: a telescoping placement the limits pushed off the fitted
+    ** quantities is dropped, not reported as a non-telescoping spring in place of the
+    ** non-telescoping placement) */
     const double ident[3] = {r->fit.p.rho, r->fit.p.solid_strain, r->fit.p.stress_scale_MPa};
     for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING; ty++) {
         cf_error pe = {0};
         if ((opt->types & (1u << ty)) &&
             cf_fit_place(t, &opt->fit, (cf_spring_type)ty, ident, &r->placed[r->nplaced], &pe) ==
                 CF_OK && exact_member(t, opt, ident, &r->placed[r->nplaced]) &&
-            (r->nplaced == 0 || r->placed[0].type != r->placed[r->nplaced].type))
-            r->nplaced++; /* (two placements replaced by the same exact spring count once) */
+            r->placed[r->nplaced].type == (cf_spring_type)ty)
+            r->nplaced++;
     }
     if (r->nplaced == 0) {
         cf_visco_report_free(r);

@@ -66,12 +66,15 @@ typedef struct cf_cell {
     double law_scale;                /* factor on every law force and tangent (1 by cf_cell_init):
                                      ** an implicit step of quasi-linear viscoelasticity scales the
                                      ** law by 1 - sum g_i (1 - b_i) and adds an affine extra */
+    double law_scale_strain;         /* its growth with strain (0 by cf_cell_init): the factor on
+                                     ** a spring at law compression u is law_scale +
+                                     ** law_scale_strain |u| / H (relaxation that grows with strain) */
     double stretch_hint;             /* first guess of a mode's free stretch (0 by cf_cell_init:
                                      ** from the small-strain constants); a history passes the
                                      ** last step's */
 } cf_cell;
 
-/* Checks the weights (cf_calibration_check) and fills c (law_scale 1, stretch_hint 0). */
+/* Checks the weights (cf_calibration_check) and fills c (law_scale 1, law_scale_strain 0, stretch_hint 0). */
 cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
                        const double weight[CF_FAMILY_COUNT], cf_error *err);
 

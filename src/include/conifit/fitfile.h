@@ -49,6 +49,8 @@ typedef struct cf_fitted_spring {
     int viscoelastic;            /* 1 when the fit has a "prony" list */
     int prony_count;
     double prony_g[CF_PRONY_MAX], prony_tau_s[CF_PRONY_MAX];
+    double prony_k[CF_PRONY_MAX]; /* change of g_i per unit |strain| ("g_per_strain"; 0 when
+                                  ** absent: quasi-linear) */
     double eta_MPa_s;            /* dashpot, 0 when none */
 } cf_fitted_spring;
 

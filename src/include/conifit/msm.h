@@ -48,11 +48,22 @@ typedef struct cf_msm_effects {
     int prony_count;                   /* number of terms, 0 = off, at most CF_PRONY_MAX */
     double prony_g[CF_PRONY_MAX];      /* relative moduli g_i >= 0, sum < 1, - */
     double prony_tau_s[CF_PRONY_MAX];  /* time constants tau_i > 0, s */
+    /* Relaxation that grows with strain (all 0 = quasi-linear): term i's relative modulus at the
+    ** spring's strain e = u / H (law compression over free length) is g_i + prony_k[i] |e|, and
+    ** its branch relaxes that share of the law force: dh_i/dt = d((g_i + k_i |e|) F)/dt -
+    ** h_i/tau_i. The equilibrium response is (1 - sum (g_i + k_i |e|)) F, which must stay
+    ** positive wherever a spring goes (a run that takes a spring past it fails with CF_E_DATA). */
+    double prony_k[CF_PRONY_MAX];      /* growth of g_i per unit strain, >= 0, - */
 } cf_msm_effects;
 
 /* Checks the Prony terms of fx (count within 0..CF_PRONY_MAX, g_i >= 0 and finite, sum g_i < 1,
-** tau_i > 0 and finite); CF_E_DATA naming the offending term otherwise. */
+** tau_i > 0 and finite, prony_k[i] >= 0 and finite); CF_E_DATA naming the offending term
+** otherwise. */
 cf_status cf_msm_prony_check(const cf_msm_effects *fx, cf_error *err);
+
+/* Checks the relative moduli of fx's Prony terms at a spring's |strain| e (g_i + k_i e each >= 0,
+** their sum below 1); CF_E_DATA naming the term and the strain otherwise. */
+cf_status cf_msm_prony_at_strain(const cf_msm_effects *fx, double e, cf_error *err);
 
 typedef enum cf_msm_drive {
     CF_DRIVE_DISPLACEMENT = 0, /* the top face follows a prescribed compressive strain */

@@ -33,9 +33,18 @@
 /* Branch counts tried when the choice is left to AIC. */
 #define CF_VISCO_AIC_MAX 4
 
+/* How the relative moduli may depend on strain (viscomodel.h k). */
+typedef enum cf_visco_relaxation {
+    CF_RELAX_QLV = 0,    /* quasi-linear: k_i = 0 (default) */
+    CF_RELAX_STRAIN = 1, /* g_i + k_i |strain|, linear in |strain| between the moduli at zero and
+                         ** at the series' largest strain, both fitted (each >= 0, sums < 1) */
+    CF_RELAX_AUTO = 2    /* both fitted, the lower AIC kept */
+} cf_visco_relaxation;
+
 typedef struct cf_visco_fit_options {
     int nbranch;            /* 1..CF_PRONY_MAX, or 0: choose 1..CF_VISCO_AIC_MAX by AIC */
     int dashpot;            /* 1: fit a dashpot beside the springs as well */
+    cf_visco_relaxation relaxation; /* quasi-linear (default), depending on strain, or by AIC */
     int hold_elastic;       /* 1: rho, s/H, F_C/H^2 held at elastic[] (an earlier fit) */
     double elastic[3];      /* rho [-], s/H [-], F_C/H^2 [MPa] */
     int relative;           /* 1: residuals relative to |stress| (floor 1e-3 max|stress|) */
@@ -98,6 +107,9 @@ typedef struct cf_visco_fit {
     double se_g[CF_PRONY_MAX];          /* standard errors of g_i, -1 when not determined */
     double se_tau_s[CF_PRONY_MAX];      /* of tau_i, s */
     double se_eta_MPa_s;                /* of the dashpot, MPa s (-1 without one) */
+    double se_k[CF_PRONY_MAX];          /* of k_i (relaxation growing with strain), -1 when not
+                                           fitted or not determined */
+    int strain_relaxation;              /* 1 when the k_i were fitted */
     int dashpot;                        /* 1 when a dashpot was fitted */
     int held_elastic;                   /* 1 when the elastic quantities were held */
     int rho_at_limit;                   /* 1 when rho sits on its lower limit (rho_min): set by

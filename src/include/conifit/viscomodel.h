@@ -31,6 +31,8 @@ typedef struct cf_visco_params {
     int nbranch;                      /* Prony terms, 0..CF_PRONY_MAX */
     double g[CF_PRONY_MAX];           /* relative moduli, - */
     double tau_s[CF_PRONY_MAX];       /* time constants, s */
+    double k[CF_PRONY_MAX];           /* growth of g_i per unit |strain| of a spring (msm.h
+                                      ** prony_k), - ; all 0: quasi-linear */
     double eta_MPa_s;                 /* dashpot beside every spring, MPa s (0 = none) */
 } cf_visco_params;
 
