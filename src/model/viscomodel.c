@@ -128,8 +128,10 @@ static cf_status cell_step(cell_run *r, double dt, double e, cf_error *err)
         x.k_N_per_mm[d] = r->w[d] * H * H * visc / r->L0[d];         /* dashpot, as msm.h */
         x.Lref_mm[d] = r->Lprev[d];
     }
-    r->cell.law_scale = dt > 0 ? alpha : 1.0;
-    r->cell.law_scale_strain = dt > 0 ? slope : 0.0;
+    /* dt = 0 (the first sample): e_i = b_i = 0, so alpha = g_inf and the branches hold nothing,
+    ** the relaxed state the lattice starts from (msm.h) */
+    r->cell.law_scale = alpha;
+    r->cell.law_scale_strain = slope;
     cf_status st = cf_cell_mode(&r->cell, CF_MODE_UNIAXIAL, e, &x, &r->st, err);
     r->cell.law_scale = 1.0;
     r->cell.law_scale_strain = 0.0;
