@@ -339,74 +339,79 @@ typedef struct standin {
     gsl_vector *y, *tau, *a, *res;
 } standin;
 
+enum { NNLS_MAX = 2 + 2 * CF_PRONY_MAX }; /* columns of the stand-in's design */
+
+/* Least squares of y on the columns of X marked in[] (Householder QR in Q, tau, sol, res), into z
+** (0 on the other columns); 0 when it fails or gives a non-finite value. */
+static int nnls_free_columns(const gsl_matrix *X, const gsl_vector *y, const int *in, gsl_matrix *Q,
+                             gsl_vector *tau, gsl_vector *sol, gsl_vector *res, double *z)
+{
+    const size_t n = X->size1, m = X->size2;
+    size_t nf = 0, map[NNLS_MAX];
+    for (size_t j = 0; j < m; j++) {
+        z[j] = 0;
+        if (in[j])
+            map[nf++] = j;
+    }
+    gsl_matrix_view Qv = gsl_matrix_submatrix(Q, 0, 0, n, nf);
+    for (size_t k = 0; k < nf; k++) {
+        gsl_vector_const_view col = gsl_matrix_const_column(X, map[k]);
+        gsl_matrix_set_col(&Qv.matrix, k, &col.vector);
+    }
+    gsl_vector_view tv = gsl_vector_subvector(tau, 0, nf), sv = gsl_vector_subvector(sol, 0, nf);
+    if (gsl_linalg_QR_decomp(&Qv.matrix, &tv.vector) != GSL_SUCCESS ||
+        gsl_linalg_QR_lssolve(&Qv.matrix, &tv.vector, y, &sv.vector, res) != GSL_SUCCESS)
+        return 0;
+    for (size_t k = 0; k < nf; k++)
+        if (!isfinite(z[map[k]] = gsl_vector_get(sol, k)))
+            return 0;
+    return 1;
+}
+
 /* Non-negative least squares min |X a - y|, a >= 0 (Lawson and Hanson's active-set method, the
-** subproblems on the free columns by Householder QR): for the stand-in with relaxation growing
-** with strain, whose unconstrained solutions mostly cancel terms of opposite sign. X is n x m
-** (m <= 2 + 2 CF_PRONY_MAX), not changed; 0 when a subproblem is rank deficient. */
+** subproblems on the free columns by Householder QR): for the stand-in with relaxation depending
+** on strain, whose unconstrained solutions mostly cancel terms of opposite sign. X is n x m
+** (m <= NNLS_MAX), not changed; 0 when a subproblem fails. */
 static int nnls(const gsl_matrix *X, const gsl_vector *y, double *a)
 {
-    enum { MMAX = 2 + 2 * CF_PRONY_MAX };
     const size_t n = X->size1, m = X->size2;
-    int in[MMAX] = {0};
-    double w[MMAX], z[MMAX], r_buf[1];
-    (void)r_buf;
+    int in[NNLS_MAX] = {0};
+    double w[NNLS_MAX], z[NNLS_MAX];
     gsl_matrix *Q = gsl_matrix_alloc(n, m);
     gsl_vector *tau = gsl_vector_alloc(m), *sol = gsl_vector_alloc(m), *res = gsl_vector_alloc(n);
     int ok = Q && tau && sol && res;
     for (size_t j = 0; j < m; j++)
         a[j] = 0;
-    /* solves the least squares on the free columns into z (0 elsewhere) */
-#define NNLS_SUB()                                                                                 \
-    do {                                                                                           \
-        size_t np_ = 0, map_[MMAX];                                                                \
-        for (size_t j = 0; j < m; j++)                                                             \
-            if (in[j])                                                                             \
-                map_[np_++] = j;                                                                   \
-        gsl_matrix_view Qv = gsl_matrix_submatrix(Q, 0, 0, n, np_);                                \
-        for (size_t k = 0; k < np_; k++)                                                           \
-            for (size_t i = 0; i < n; i++)                                                         \
-                gsl_matrix_set(&Qv.matrix, i, k, gsl_matrix_get(X, i, map_[k]));                   \
-        gsl_vector_view tv = gsl_vector_subvector(tau, 0, np_), sv = gsl_vector_subvector(sol, 0, np_); \
-        ok = gsl_linalg_QR_decomp(&Qv.matrix, &tv.vector) == GSL_SUCCESS &&                        \
-             gsl_linalg_QR_lssolve(&Qv.matrix, &tv.vector, y, &sv.vector, res) == GSL_SUCCESS;     \
-        for (size_t j = 0; j < m; j++)                                                             \
-            z[j] = 0;                                                                              \
-        for (size_t k = 0; ok && k < np_; k++)                                                     \
-            ok = isfinite(z[map_[k]] = gsl_vector_get(sol, k));                                    \
-    } while (0)
     for (int outer = 0; ok && outer < 3 * (int)m; outer++) {
-        /* gradient w = X^T (y - X a) */
+        /* the gradient w = X^T (y - X a), from the residual formed once */
+        gsl_vector_memcpy(res, y);
+        for (size_t k = 0; k < m; k++)
+            if (a[k] != 0) {
+                gsl_vector_const_view col = gsl_matrix_const_column(X, k);
+                gsl_blas_daxpy(-a[k], &col.vector, res);
+            }
         size_t jmax = m;
         for (size_t j = 0; j < m; j++) {
-            double g = 0;
-            for (size_t i = 0; i < n; i++) {
-                double r = gsl_vector_get(y, i);
-                for (size_t k = 0; k < m; k++)
-                    if (a[k] != 0)
-                        r -= gsl_matrix_get(X, i, k) * a[k];
-                g += gsl_matrix_get(X, i, j) * r;
-            }
-            w[j] = g;
-            if (!in[j] && g > 1e-12 && (jmax == m || g > w[jmax]))
+            gsl_vector_const_view col = gsl_matrix_const_column(X, j);
+            gsl_blas_ddot(&col.vector, res, &w[j]);
+            if (!in[j] && w[j] > 1e-12 && (jmax == m || w[j] > w[jmax]))
                 jmax = j;
         }
         if (jmax == m)
             break;
         in[jmax] = 1;
         for (int inner = 0; ok && inner < 3 * (int)m; inner++) {
-            NNLS_SUB();
-            if (!ok)
+            if (!(ok = nnls_free_columns(X, y, in, Q, tau, sol, res, z)))
                 break;
             double alpha = 2;
             for (size_t j = 0; j < m; j++)
                 if (in[j] && z[j] <= 0)
                     alpha = fmin(alpha, a[j] / (a[j] - z[j]));
-            if (alpha > 1) { /* all free coefficients positive */
-                for (size_t j = 0; j < m; j++)
-                    a[j] = z[j];
+            if (alpha > 1) { /* every free coefficient positive */
+                memcpy(a, z, m * sizeof(double));
                 break;
             }
-            for (size_t j = 0; j < m; j++) {
+            for (size_t j = 0; j < m; j++) { /* back to the boundary, dropping what reached it */
                 a[j] += alpha * (z[j] - a[j]);
                 if (in[j] && a[j] <= 1e-300) {
                     in[j] = 0;
@@ -415,7 +420,6 @@ static int nnls(const gsl_matrix *X, const gsl_vector *y, double *a)
             }
         }
     }
-#undef NNLS_SUB
     if (Q)
         gsl_matrix_free(Q);
     if (tau)
