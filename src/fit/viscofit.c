@@ -1178,9 +1178,8 @@ static cf_status fit_report(ctx *c, const cf_visco_params *bestp, cf_visco_fit *
     res->dashpot = c->dash;
     res->held_elastic = !c->free_el;
     res->count = c->n;
-    c->gs = 0;
-    for (int i = 0; i < bestp->nbranch; i++)
-        c->gs |= bestp->k[i] != 0;
+    const cf_msm_effects fx = cf_visco_effects(bestp);
+    c->gs = cf_msm_prony_depends_on_strain(&fx);
     res->strain_relaxation = c->gs;
     res->k = (c->free_el ? 3 : 0) + (2 + c->gs) * bestp->nbranch + c->dash;
     double wrss = fit_quality(c, res);

@@ -919,6 +919,14 @@ double cf_msm_path_value(const cf_msm_path *p, double t)
 
 /* ---- quasi-static viscous steps ------------------------------------------------------------- */
 
+int cf_msm_prony_depends_on_strain(const cf_msm_effects *fx)
+{
+    for (int i = 0; i < fx->prony_count; i++)
+        if (fx->prony_k[i] != 0)
+            return 1;
+    return 0;
+}
+
 cf_status cf_msm_prony_at_strain(const cf_msm_effects *fx, double e, cf_error *err)
 {
     double sum = 0;
@@ -944,9 +952,7 @@ cf_status cf_msm_prony_at_strain(const cf_msm_effects *fx, double e, cf_error *e
 static cf_status relaxed_share_check(const solver *s, cf_error *err)
 {
     const cf_msm_effects *fx = s->fx;
-    int any = 0;
-    for (int i = 0; fx && i < fx->prony_count; i++)
-        any |= fx->prony_k[i] != 0;
+    const int any = fx && cf_msm_prony_depends_on_strain(fx);
     cf_status st = CF_OK;
     for (size_t q = 0; any && st == CF_OK && q < s->lat->ns; q++)
         st = cf_msm_prony_at_strain(fx, fabs(s->lat->u_mm[q]) / s->lat->H_mm, err);

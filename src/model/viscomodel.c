@@ -212,8 +212,8 @@ static cf_status cell_path(const cf_visco_params *p, const cf_visco_setup *s, co
     r->method = s->method;
     r->p = p;
     r->H = law->p.H_mm;
-    for (int i = 0; i < p->nbranch; i++)
-        r->strain_moduli |= p->k[i] != 0;
+    const cf_msm_effects fx = cf_visco_effects(p);
+    r->strain_moduli = cf_msm_prony_depends_on_strain(&fx);
     for (int d = 0; d < CF_CELL_DIRS; d++) {
         int N[3], fam;
         cf_cell_direction(d, N, &fam);

@@ -31,6 +31,15 @@ static const char *src_name(const cf_export_options *opt)
     return (opt->source && *opt->source) ? opt->source : "(none)";
 }
 
+/* 1 when a Prony term of the fit changes with strain (g_per_strain). */
+static int strain_moduli(const cf_fitted_spring *fs)
+{
+    for (int i = 0; i < fs->prony_count; i++)
+        if (fs->prony_k[i] != 0)
+            return 1;
+    return 0;
+}
+
 /* The Prony terms and dashpot of a viscoelastic fit, as comment lines: the time-dependent part of
 ** the tissue that the simulator formats' spring elements have no place for (README, export). */
 static void prony_comment(FILE *out, const char *lead, const char *tail,
@@ -41,9 +50,7 @@ static void prony_comment(FILE *out, const char *lead, const char *tail,
     double ginf = 1;
     for (int i = 0; i < fs->prony_count; i++)
         ginf -= fs->prony_g[i];
-    int strain = 0;
-    for (int i = 0; i < fs->prony_count; i++)
-        strain |= fs->prony_k[i] != 0;
+    const int strain = strain_moduli(fs);
     fprintf(out, "%sviscoelastic fit: %s on every spring, force = the law convolved with G(t) = "
                  "g_inf + sum g_i exp(-t/tau_i), g_inf = %.17g%s%s\n",
             lead, strain ? "relaxation depending on strain" : "quasi-linear viscoelasticity", ginf,
@@ -133,9 +140,7 @@ static cf_status write_json(FILE *out, const block_job *j, cf_error *err)
         if (fs->eta_MPa_s > 0)
             json_object_set_new(root, "dashpot",
                                 json_pack("{s:o}", "eta_kPa_s", cf_json_number(fs->eta_MPa_s * 1e3)));
-        int strain = 0;
-        for (int i = 0; i < fs->prony_count; i++)
-            strain |= fs->prony_k[i] != 0;
+        const int strain = strain_moduli(fs);
         json_object_set_new(
             root, "viscoelasticity",
             json_string(strain ? "relaxation depending on strain: term i's modulus at the "

@@ -61,6 +61,9 @@ typedef struct cf_msm_effects {
 ** otherwise. */
 cf_status cf_msm_prony_check(const cf_msm_effects *fx, cf_error *err);
 
+/* 1 when a Prony term of fx changes with strain (some prony_k[i] != 0), 0 when quasi-linear. */
+int cf_msm_prony_depends_on_strain(const cf_msm_effects *fx);
+
 /* Checks the relative moduli of fx's Prony terms at a spring's |strain| e (g_i + k_i e each >= 0,
 ** their sum below 1); CF_E_DATA naming the term and the strain otherwise. */
 cf_status cf_msm_prony_at_strain(const cf_msm_effects *fx, double e, cf_error *err);
