@@ -179,17 +179,12 @@ static void check_method(const cf_law *law, cf_law_method m, double tol, int rel
     }
 }
 
-/* The same points through cf_law_force_many without stiffness: for the closed form and the table
-** that is the vectorised, branch-free path (law_simd.h), whose points of different regions share
-** one vector; it must keep the scalar evaluator's bound, and map NaN to 0 and +-Inf to +-F_C. */
-static void check_batch(const cf_law *law, cf_law_method m, double tol, int rel_to_FC)
+/* Forces F at the probe points u of law followed by NaN, +Inf and -Inf (np in all), as a batch
+** evaluator gives them: NaN to 0, +-Inf to +-F_C, every point within tol of the long-double
+** reference (relative to F_C or to the force itself). what names the evaluator in a failure. */
+static void check_batch_values(const cf_law *law, const double *u, const double *F, size_t np,
+                               double tol, int rel_to_FC, const char *what)
 {
-    double u[1030], F[1030];
-    size_t np = probe_points(law, u, 1024);
-    u[np++] = NAN;
-    u[np++] = INFINITY;
-    u[np++] = -INFINITY;
-    cf_law_force_many(law, m, np, u, F, NULL);
     assert_close(F[np - 3], 0.0, 0);
     assert_close(F[np - 2], law->F_C_N, 0);
     assert_close(F[np - 1], -law->F_C_N, 0);
@@ -198,10 +193,32 @@ static void check_batch(const cf_law *law, cf_law_method m, double tol, int rel_
         double scale = rel_to_FC ? law->F_C_N : fabs((double)R);
         double errv = fabs(F[i] - (double)R);
         if (!isfinite(F[i]) || (errv > tol * scale && errv > 0))
-            fail_msg("%s batch: rho=%.17g n=%g G=%g H=%g u=%.17g F=%.17g ref=%.17Lg rel=%.3g",
-                     cf_law_method_name(m), law->rho, law->p.n, law->p.G_MPa, law->p.H_mm, u[i],
-                     F[i], R, errv / scale);
+            fail_msg("%s: rho=%.17g n=%g G=%g H=%g u=%.17g F=%.17g ref=%.17Lg rel=%.3g", what,
+                     law->rho, law->p.n, law->p.G_MPa, law->p.H_mm, u[i], F[i], R, errv / scale);
     }
+}
+
+/* The probe points of law and the three non-finite ones; returns their count. */
+static size_t batch_points(const cf_law *law, double *u)
+{
+    size_t np = probe_points(law, u, 1024);
+    u[np++] = NAN;
+    u[np++] = INFINITY;
+    u[np++] = -INFINITY;
+    return np;
+}
+
+/* The same points through cf_law_force_many without stiffness: for the closed form and the table
+** that is the vectorised, branch-free path (law_simd.h), whose points of different regions share
+** one vector; it must keep the scalar evaluator's bound, and map NaN to 0 and +-Inf to +-F_C. */
+static void check_batch(const cf_law *law, cf_law_method m, double tol, int rel_to_FC)
+{
+    double u[1030], F[1030];
+    const size_t np = batch_points(law, u);
+    cf_law_force_many(law, m, np, u, F, NULL);
+    char what[64];
+    snprintf(what, sizeof what, "%s batch", cf_law_method_name(m));
+    check_batch_values(law, u, F, np, tol, rel_to_FC, what);
 }
 
 static void closed_and_exact_match_reference_in_every_corner(void **state)
@@ -231,23 +248,11 @@ static int check_poly(const cf_law *law)
     assert_int_equal(lanes.poly_fit, 1);
     assert_true(worst <= CF_POLY_TOL);
     double u[1030], F[1030];
-    size_t np = probe_points(law, u, 1024);
-    u[np++] = NAN;
-    u[np++] = INFINITY;
-    u[np++] = -INFINITY;
+    const size_t np = batch_points(law, u);
     cf_law_force_lanes(&lanes, CF_LANE_POLY, np, u, F);
-    assert_close(F[np - 3], 0.0, 0);
-    assert_close(F[np - 2], law->F_C_N, 0);
-    assert_close(F[np - 1], -law->F_C_N, 0);
-    for (size_t i = 0; i + 3 < np; i++) {
-        const long double R = reference_force(&law->p, u[i]);
-        const double errv = fabs(F[i] - (double)R);
-        if (!isfinite(F[i]) || (errv > CLOSED_TOL * fabs((double)R) && errv > 0))
-            fail_msg("polynomial of degree %d: rho=%.17g n=%g G=%g H=%g u=%.17g F=%.17g "
-                     "ref=%.17Lg",
-                     lanes.poly_degree, law->rho, law->p.n, law->p.G_MPa, law->p.H_mm, u[i], F[i],
-                     R);
-    }
+    char what[64];
+    snprintf(what, sizeof what, "polynomial of degree %d", lanes.poly_degree);
+    check_batch_values(law, u, F, np, CLOSED_TOL, 0, what);
     return lanes.poly_degree * (lanes.poly_pieces == 2 ? 10 : 1);
 }
 

@@ -33,6 +33,17 @@ static void ramp_hold(double *t, double *x)
     }
 }
 
+/* The ramp and hold of the model p evaluated as setup s says: times t, strains x, stresses y
+** (MPa, table sign), NS points each. */
+static void synth_series(const cf_visco_params *p, const cf_visco_setup *s, double *t, double *x,
+                         double *y)
+{
+    ramp_hold(t, x);
+    cf_visco_series ser = {NS, t, x};
+    cf_error err = {0};
+    assert_int_equal(cf_visco_curve(p, s, &ser, y, NULL, &err), CF_OK);
+}
+
 static cf_visco_params known(void)
 {
     cf_visco_params p;
@@ -237,10 +248,8 @@ static void test_recover_noiseless(void **state)
     cf_visco_params p = known();
     cf_visco_fit_options o = cf_visco_fit_default_options();
     double t[NS], x[NS], y[NS];
-    ramp_hold(t, x);
-    cf_visco_series ser = {NS, t, x};
+    synth_series(&p, &o.setup, t, x, y);
     cf_error err = {0};
-    assert_int_equal(cf_visco_curve(&p, &o.setup, &ser, y, NULL, &err), CF_OK);
     o.nbranch = 2;
     cf_visco_data d = {NS, t, x, y, NULL};
     cf_visco_fit f;
@@ -259,10 +268,8 @@ static void test_recover_with_noise(void **state)
     cf_visco_params p = known();
     cf_visco_fit_options o = cf_visco_fit_default_options();
     double t[NS], x[NS], y[NS];
-    ramp_hold(t, x);
-    cf_visco_series ser = {NS, t, x};
+    synth_series(&p, &o.setup, t, x, y);
     cf_error err = {0};
-    assert_int_equal(cf_visco_curve(&p, &o.setup, &ser, y, NULL, &err), CF_OK);
     double ymax = 0;
     for (int k = 0; k < NS; k++)
         ymax = fmax(ymax, fabs(y[k]));
@@ -322,10 +329,8 @@ static void test_strain_relaxation_recovered(void **state)
     p.k[1] = 0.5;
     cf_visco_fit_options o = cf_visco_fit_default_options();
     double t[NS], x[NS], y[NS];
-    ramp_hold(t, x);
-    cf_visco_series ser = {NS, t, x};
+    synth_series(&p, &o.setup, t, x, y);
     cf_error err = {0};
-    assert_int_equal(cf_visco_curve(&p, &o.setup, &ser, y, NULL, &err), CF_OK);
     o.nbranch = 2;
     o.relaxation = CF_RELAX_STRAIN;
     cf_visco_data d = {NS, t, x, y, NULL};
