@@ -39,6 +39,8 @@
 #include "model/law_simd.h"
 
 #define CF_STEP_BLOCK 256
+/* the law runs over whole vectors of 8 lanes, padded within the block (lattice_step.c) */
+_Static_assert(CF_STEP_BLOCK % 8 == 0, "CF_STEP_BLOCK must be a multiple of 8");
 #define CF_STEP_THREADS_MIN 1000000
 
 /* One cell direction of the stencil. */
