@@ -195,7 +195,8 @@ static void visco_fit_lm_loop_survives_allocation_failures(void **state)
         fail_msg("cf_lsq_lm_iterate not found by '%s'", cmd);
     snprintf(within, sizeof within, "CF_FAIL_ALLOC_WITHIN=%s:%s ", start, size);
     char args[800];
-    snprintf(args, sizeof args, "fit data/series/synthetic_relaxation.csv --branches 1 -q -o %s/out",
+    snprintf(args, sizeof args,
+             "fit data/series/synthetic_relaxation.csv --branches 1 --relaxation qlv -q -o %s/out",
              dir);
     inject(args, 1, 100000, 67, 1);
     within[0] = '\0';

@@ -161,9 +161,10 @@ static void simulate_writes_nothing_for_a_bad_scene_and_a_csv_for_a_good_one(voi
     assert_int_equal(system(cmd), 0);
 }
 
-/* The shipped relaxation scene against the published along-fibre relaxation table: the lattice's
-** Maxwell branch is one exponential, the muscle relaxes over several time scales, so the check is
-** on the peak and on the held end, within 15 %. */
+/* The shipped relaxation scene against the published along-fibre relaxation table, through the
+** viscoelastic fit the scene takes its spring and terms from: the peak within 5 %, and the whole
+** series (the scene's stress interpolated at the table's times) within a third of the error of the
+** hand-tuned scene the fit replaced (0.35 kPa). */
 static void relaxation_scene_follows_published_muscle_relaxation(void **state)
 {
     (void)state;
@@ -178,10 +179,10 @@ static void relaxation_scene_follows_published_muscle_relaxation(void **state)
     cf_table tb;
     cf_error terr = {0};
     assert_int_equal(cf_measure_load(path, NULL, &tb, &terr), CF_OK);
+    assert_non_null(tb.t);
     double peak = 0, end = 1e3 * tb.y[tb.count - 1], t, e, s;
     for (size_t i = 0; i < tb.count; i++)
         peak = fmin(peak, 1e3 * tb.y[i]);
-    cf_table_free(&tb);
     char line[512];
     FILE *f;
     char dir[] = "/tmp/conifit-relax-XXXXXX";
@@ -190,8 +191,9 @@ static void relaxation_scene_follows_published_muscle_relaxation(void **state)
     snprintf(out, sizeof out, "%s/r.csv", dir);
     assert_int_equal(
         tu_run(so, sizeof so, se, sizeof se, "simulate data/scenes/relaxation.json -o %s", out), 0);
-    double speak = 0, send = 0;
+    double speak = 0, send = 0, tprev = 0, sprev = 0, ss = 0;
     int stable = 1, unstable_rows = 0;
+    size_t row = 0, at = 0;
     f = fopen(out, "r");
     assert_non_null(fgets(line, sizeof line, f));
     double k, sp;
@@ -199,19 +201,35 @@ static void relaxation_scene_follows_published_muscle_relaxation(void **state)
         speak = fmax(speak, s);
         send = s;
         unstable_rows += stable == 0;
+        /* the table's rows between the last sample and this one (the scene starts at t = 0) */
+        for (; at < tb.count && tb.t[at] <= t; at++) {
+            double si = row && t > tprev ? sprev + (s - sprev) * (tb.t[at] - tprev) / (t - tprev) : s;
+            ss += (si + 1e3 * tb.y[at]) * (si + 1e3 * tb.y[at]);
+        }
+        tprev = t;
+        sprev = s;
+        row++;
     }
     fclose(f);
+    /* the table's last row, 0.16 s after the scene's end, against the scene's last sample */
+    for (; at < tb.count && tb.t[at] <= tprev + 1; at++)
+        ss += (send + 1e3 * tb.y[at]) * (send + 1e3 * tb.y[at]);
+    const size_t compared = at, count = tb.count;
+    cf_table_free(&tb);
     remove(out);
     rmdir(dir);
-    /* The table is compression negative; the simulation compression positive. The scene runs the
-    ** viscoelastic fit of this table (fits/series/): the peak within 5 %; the end within 5 % as
-    ** long as the lattice stays stable, and where it does not, simulate says so (rows marked
-    ** stable = 0) rather than pass off the buckled lattice's stress as the material's. */
+    /* The table is compression negative; the simulation compression positive. The fit keeps its
+    ** lattice stable over the series, so every row is (a buckled lattice's stress is not the
+    ** material's). The held end is not checked on its own: two terms trade the last minute of
+    ** the hold (the table still relaxing at 330 s) for the ramp. */
     assert_close(speak, -peak, 0.05 * -peak);
-    if (unstable_rows == 0)
-        assert_close(send, -end, 0.05 * -end);
-    else
-        assert_true(fabs(send + end) > 0.05 * -end);
+    assert_int_equal(unstable_rows, 0);
+    assert_int_equal(compared, count); /* the scene covers the table */
+    const double rmse = sqrt(ss / (double)count);
+    print_message("relaxation scene: peak %.4g kPa (table %.4g), end %.4g (table %.4g), RMSE over "
+                  "the table %.4g kPa\n",
+                  speak, -peak, send, -end, rmse);
+    assert_true(rmse <= 0.35 / 3);
 }
 
 /* A cycles scene with dashpots: the strain left at zero force is reported as such, and a

@@ -80,9 +80,10 @@ static const char fit_help_series[] =
     "cell, driven by the measured strain history:\n"
     "  --branches N            Prony terms, 1..8 (default: 1..4 chosen by AIC)\n"
     "  --dashpot               fit a dashpot beside every spring as well\n"
-    "  --relaxation R          qlv (default): relative moduli g_i constant (quasi-linear);\n"
+    "  --relaxation R          qlv: relative moduli g_i constant (quasi-linear);\n"
     "                          strain: g_i + g_per_strain_i |strain| at a spring's strain;\n"
-    "                          auto: both, the lower AIC kept\n"
+    "                          auto (default): both; kept is the lowest AIC among the\n"
+    "                          candidates whose terms the series determines\n"
     "  --elastic FIT.json[:TYPE]  hold rho, s/H and F_C/H^2 at those of a fit file's spring\n"
     "  --calibration C         the lattice's weights: axial (default for a series) or isotropic\n"
     "The fitted spring stays within the design limits (--rho-min, --index-max, ...) and its\n"
@@ -489,6 +490,7 @@ static int parse_args(int argc, char **argv, fit_args *a)
     a->popt = cf_pipeline_default_options();
     a->mopt = cf_measure_default_options();
     a->vopt = cf_visco_fit_default_options();
+    a->vopt.relaxation = CF_RELAX_AUTO;
     a->jobs = 1;
     cf_cli_parser p;
     a->argc = argc;

@@ -752,9 +752,13 @@ static int se_column(ctx *c, const cf_visco_params *p, const int held[3], int wh
         return 0;
     cf_error e = {0};
     *slot = v + hp;
-    int ok = cf_visco_curve(&q, &c->o->setup, &c->series, mp, NULL, &e) == CF_OK;
+    cf_status st = cf_visco_curve(&q, &c->o->setup, &c->series, mp, NULL, &e);
     *slot = v - hm;
-    ok = ok && cf_visco_curve(&q, &c->o->setup, &c->series, mm, NULL, &e) == CF_OK;
+    if (st == CF_OK)
+        st = cf_visco_curve(&q, &c->o->setup, &c->series, mm, NULL, &e);
+    if (st == CF_E_INTERNAL && strstr(e.msg, "out of memory"))
+        c->oom = 1; /* not an undetermined error: the column was never computed */
+    const int ok = st == CF_OK;
     c->evals += 2;
     for (size_t r = 0; ok && r < c->n; r++)
         gsl_matrix_set(J, r, col, c->sw[r] * (mp[r] - mm[r]) / (hp + hm));
@@ -797,11 +801,14 @@ static void standard_errors(ctx *c, const cf_visco_params *p, const int held[3],
     gsl_matrix *J = gsl_matrix_alloc(c->n, k), *cov = gsl_matrix_alloc(k, k);
     double *mp = malloc(c->n * sizeof(double)), *mm = malloc(c->n * sizeof(double));
     int ok = J && cov && mp && mm;
+    c->oom |= !ok;
     size_t col = 0;
     for (int which = 0; ok && which < nq; which++)
         if (se_slot(c, held, which, &q))
             ok = se_column(c, p, held, which, J, col++, mp, mm);
-    if (ok && gsl_multifit_nlinear_covar(J, 1e-13, cov) == GSL_SUCCESS) {
+    const int cs = ok ? gsl_multifit_nlinear_covar(J, 1e-13, cov) : GSL_FAILURE;
+    c->oom |= cs == GSL_ENOMEM;
+    if (cs == GSL_SUCCESS) {
         col = 0;
         for (int which = 0; which < nq; which++) {
             if (!se_slot(c, held, which, &q))
@@ -1073,15 +1080,68 @@ static cf_status fit_setup(ctx *c, const cf_visco_data *d, const cf_visco_fit_op
     return CF_OK;
 }
 
-/* Fits the branch counts asked for (or 1..CF_VISCO_AIC_MAX) and keeps the lowest AIC in *best. */
+/* Which limits the fitted elastic quantities sit on (rho_min, the stability bound of s/H, the
+** design cap of F_C/H^2): held there, their standard errors are not determined. */
+static void limits_held(const ctx *c, const cf_visco_params *p, int held[3])
+{
+    held[0] = held[1] = held[2] = 0;
+    if (!c->free_el)
+        return;
+    held[0] = p->rho <= c->rho_lo * (1 + 1e-4);
+    held[1] = c->lim.cells > 0 && solid_lo(c, p->rho) > c->e_lo &&
+              p->solid_strain <= solid_lo(c, p->rho) * (1 + 1e-6);
+    held[2] = p->stress_scale_MPa >=
+              cf_visco_limits_scale_max(&c->lim, p->rho, p->solid_strain) * (1 - 1e-9);
+}
+
+/* The limits of the fitted elastic quantities, and where the elastic lattice of the fitted (or
+** held) spring loses stability. */
+static void fit_limits(const ctx *c, const cf_visco_params *p, cf_visco_fit *res, int held[3])
+{
+    res->stable_to_strain = 0;
+    if (c->o->stable_cells > 0)
+        res->stable_to_strain = stability_limit(c, p->rho, p->solid_strain, p->stress_scale_MPa);
+    limits_held(c, p, held);
+    res->rho_at_limit = held[0];
+    res->at_stability_limit = held[1];
+    res->at_design_limit = held[2];
+}
+
+/* Whether the data determine every time-dependent quantity of candidate p: each g_i, tau_i (and
+** k_i, and the dashpot when fitted) has a standard error (the covariance's diagonal, scaled by 1
+** so that a noiseless series counts too). A term the series cannot pin down (tau_i -> 0, a g_i of
+** 0 with its tau_i free, two terms trading one for the other) makes the Jacobian rank-deficient;
+** AIC assumes a regular model and would reward such a fit's extra parameters. */
+static int prony_identified(ctx *c, const cf_visco_params *p)
+{
+    int held[3];
+    cf_visco_fit se;
+    memset(&se, 0, sizeof se);
+    limits_held(c, p, held);
+    standard_errors(c, p, held, 1.0, &se);
+    int ok = !c->dash || se.se_eta_MPa_s > 0;
+    for (int i = 0; i < p->nbranch; i++)
+        ok = ok && se.se_g[i] > 0 && se.se_tau_s[i] > 0 && (!c->gs || se.se_k[i] > 0);
+    return ok;
+}
+
+/* Candidate a is preferred to b: determined terms first, then the lower AIC. */
+static int preferred(int ident_a, double aic_a, int ident_b, double aic_b)
+{
+    return ident_a != ident_b ? ident_a > ident_b : aic_a < aic_b;
+}
+
+/* Fits the branch counts asked for (or 1..CF_VISCO_AIC_MAX), quasi-linear, depending on strain or
+** both, and keeps in *best the candidate whose terms the data determine with the lowest AIC (the
+** lowest AIC of all when none is determined); every candidate's AIC in res->by_n. */
 static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf_error *err)
 {
     const cf_visco_fit_options *o = c->o;
     const int nlo = o->nbranch ? o->nbranch : 1, nhi = o->nbranch ? o->nbranch : CF_VISCO_AIC_MAX;
     double best_aic = HUGE_VAL;
+    int best_ident = 0;
     memset(best, 0, sizeof *best);
-    res->chosen_by_aic = o->nbranch == 0;
-    /* quasi-linear, strain-dependent or both (the lower AIC kept) */
+    res->chosen_by_aic = o->nbranch == 0 || o->relaxation == CF_RELAX_AUTO;
     const int gslo = o->relaxation == CF_RELAX_STRAIN, gshi = o->relaxation != CF_RELAX_QLV;
     for (int v = 0; v < (nhi - nlo + 1) * (gshi - gslo + 1); v++) {
         const int nb = nlo + v / (gshi - gslo + 1);
@@ -1100,16 +1160,24 @@ static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf
             rss += (c->m[k] - c->d->y[k]) * (c->m[k] - c->d->y[k]);
         int kpar = (c->free_el ? 3 : 0) + (2 + c->gs) * nb + c->dash;
         double aic = (double)c->n * log(fmax(rss, 1e-300) / (double)c->n) + 2.0 * kpar;
-        if (nb - 1 < CF_VISCO_AIC_MAX && (c->gs == gslo || !(res->aic_by_n[nb - 1] <= aic)))
-            res->aic_by_n[nb - 1] = aic; /* the better of the two relaxations at this N */
-        if (aic < best_aic) {
+        const int ident = prony_identified(c, &p);
+        if (c->oom)
+            return cf_error_set(err, CF_E_INTERNAL,
+                                "out of memory in the standard errors of the fit of %d Prony "
+                                "term%s",
+                                nb, nb == 1 ? "" : "s");
+        if (nb - 1 < CF_VISCO_AIC_MAX)
+            res->by_n[nb - 1][c->gs] = (cf_visco_candidate){1, aic, ident};
+        if (best_aic == HUGE_VAL || preferred(ident, aic, best_ident, best_aic)) {
             best_aic = aic;
+            best_ident = ident;
             *best = p;
         }
     }
     if (!(best_aic < HUGE_VAL))
         return cf_error_set(err, CF_E_NOCONV,
                             "no viscoelastic model could be evaluated along this series");
+    res->identified = best_ident;
     return CF_OK;
 }
 
@@ -1144,25 +1212,6 @@ static double fit_quality(const ctx *c, cf_visco_fit *res)
     return wrss;
 }
 
-/* Which limits the fitted elastic quantities sit on, and where the elastic lattice of the fitted
-** (or held) spring loses stability. */
-static void fit_limits(const ctx *c, const cf_visco_params *p, cf_visco_fit *res, int held[3])
-{
-    held[0] = held[1] = held[2] = 0;
-    res->stable_to_strain = 0;
-    if (c->o->stable_cells > 0)
-        res->stable_to_strain = stability_limit(c, p->rho, p->solid_strain, p->stress_scale_MPa);
-    if (!c->free_el)
-        return;
-    held[0] = res->rho_at_limit = p->rho <= c->rho_lo * (1 + 1e-4);
-    held[1] = res->at_stability_limit =
-        c->lim.cells > 0 && solid_lo(c, p->rho) > c->e_lo &&
-        p->solid_strain <= solid_lo(c, p->rho) * (1 + 1e-6);
-    held[2] = res->at_design_limit =
-        p->stress_scale_MPa >=
-        cf_visco_limits_scale_max(&c->lim, p->rho, p->solid_strain) * (1 - 1e-9);
-}
-
 /* The reported model: its curve, quality, standard errors, moduli and predictions. */
 static cf_status fit_report(ctx *c, const cf_visco_params *bestp, cf_visco_fit *res,
                             cf_error *err)
@@ -1187,6 +1236,9 @@ static cf_status fit_report(ctx *c, const cf_visco_params *bestp, cf_visco_fit *
     int held[3];
     fit_limits(c, bestp, res, held);
     standard_errors(c, bestp, held, s2, res);
+    if (c->oom)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory in the standard errors of the "
+                                                "viscoelastic fit");
     /* small-strain moduli of the lattice */
     double Eel[1], small = -1e-3 * bestp->solid_strain;
     if (cf_visco_elastic_curve(bestp, &o->setup, &small, 1, Eel, &e) == CF_OK) {

@@ -123,11 +123,17 @@ static void visco_keys(const cf_visco_report *r, json_t *o)
     if (f->chosen_by_aic) {
         json_t *a = json_array();
         for (int n = 0; n < CF_VISCO_AIC_MAX; n++)
-            if (f->aic_by_n[n] != 0)
-                json_array_append_new(a, json_pack("{s:i, s:o}", "branches", n + 1, "aic",
-                                                   num(f->aic_by_n[n] + aic_shift)));
+            for (int gs = 0; gs < 2; gs++) {
+                const cf_visco_candidate *cd = &f->by_n[n][gs];
+                if (cd->fitted)
+                    json_array_append_new(
+                        a, json_pack("{s:i, s:s, s:o, s:b}", "branches", n + 1, "relaxation",
+                                     gs ? "strain" : "qlv", "aic", num(cd->aic + aic_shift),
+                                     "determined", cd->identified));
+            }
         json_object_set_new(o, "aic_by_branches", a);
     }
+    json_object_set_new(o, "terms_determined", json_boolean(f->identified));
     json_object_set_new(o, "elastic_held", json_boolean(f->held_elastic));
     json_object_set_new(o, "rho_at_limit", json_boolean(f->rho_at_limit));
     json_object_set_new(o, "solid_strain_at_stability_limit", json_boolean(f->at_stability_limit));
@@ -276,12 +282,28 @@ char *cf_visco_report_text(const cf_visco_report *r)
             f->p.nbranch, f->p.nbranch == 1 ? "" : "s", f->dashpot ? " + dashpot" : "", lc->nx,
             lc->ny, lc->nz, cf_calibration_name(lc->calibration));
     if (f->chosen_by_aic) {
-        fprintf(o, " branches chosen by AIC:");
-        for (int n = 0; n < CF_VISCO_AIC_MAX; n++)
-            if (f->aic_by_n[n] != 0)
-                fprintf(o, "  N=%d: %.2f", n + 1, f->aic_by_n[n] + (double)f->count * log(u * u));
-        fputc('\n', o);
+        fprintf(o, " chosen: the lowest AIC among the candidates whose terms the series "
+                   "determines\n");
+        for (int n = 0; n < CF_VISCO_AIC_MAX; n++) {
+            const char *sep = "";
+            for (int gs = 0; gs < 2; gs++) {
+                const cf_visco_candidate *cd = &f->by_n[n][gs];
+                if (!cd->fitted)
+                    continue;
+                if (!*sep)
+                    fprintf(o, "  AIC with %d term%s:", n + 1, n ? "s" : "");
+                fprintf(o, "%s %s %.2f%s", sep, gs ? "strain" : "qlv",
+                        cd->aic + (double)f->count * log(u * u),
+                        cd->identified ? "" : " (terms undetermined)");
+                sep = ",";
+            }
+            if (*sep)
+                fputc('\n', o);
+        }
     }
+    if (!f->identified)
+        fprintf(o, " warning: the series does not determine every time-dependent quantity of "
+                   "this model (the '?' below); fewer terms (--branches) or --relaxation qlv\n");
     fprintf(o, " elastic part%s:\n", f->held_elastic ? " (held from --elastic)" : "");
     value_se_text(o, f->rho_at_limit ? "rho = D1/D2 (at --rho-min)" : "rho = D1/D2", f->p.rho,
                   f->se_ident[0], 1, "");

@@ -35,10 +35,10 @@
 
 /* How the relative moduli may depend on strain (viscomodel.h k). */
 typedef enum cf_visco_relaxation {
-    CF_RELAX_QLV = 0,    /* quasi-linear: k_i = 0 (default) */
+    CF_RELAX_QLV = 0,    /* quasi-linear: k_i = 0 (the library's default; the command's is auto) */
     CF_RELAX_STRAIN = 1, /* g_i + k_i |strain|, linear in |strain| between the moduli at zero and
                          ** at the series' largest strain, both fitted (each >= 0, sums < 1) */
-    CF_RELAX_AUTO = 2    /* both fitted, the lower AIC kept */
+    CF_RELAX_AUTO = 2    /* both fitted; kept: determined terms first, then the lower AIC */
 } cf_visco_relaxation;
 
 typedef struct cf_visco_fit_options {
@@ -100,6 +100,14 @@ typedef struct cf_visco_predict {
     char note[CF_ERROR_MSG_LEN];
 } cf_visco_predict;
 
+/* One candidate of the choice by AIC: among candidates, those whose time-dependent quantities
+** the data determine come first, then the lower AIC. */
+typedef struct cf_visco_candidate {
+    int fitted;            /* 0: not fitted (N not tried, or no model could be evaluated) */
+    double aic;            /* n ln(RSS/n) + 2k, RSS in MPa^2 */
+    int identified;        /* 1 when every g_i, tau_i (k_i, dashpot) has a standard error */
+} cf_visco_candidate;
+
 typedef struct cf_visco_fit {
     cf_visco_params p;                  /* the fitted model (stress scale in MPa, eta in MPa s) */
     double se_ident[3];                 /* standard errors of rho, s/H, F_C/H^2; -1: not
@@ -122,8 +130,12 @@ typedef struct cf_visco_fit {
                                            the fitted or held spring loses stability, table's
                                            sign;
                                            0 when stable to 0.995 of solid or not checked */
-    int chosen_by_aic;                  /* 1 when N was chosen by AIC */
-    double aic_by_n[CF_VISCO_AIC_MAX];  /* AIC of N = 1..4 when chosen by AIC (MPa^2 in RSS) */
+    int chosen_by_aic;                  /* 1 when N or the relaxation was chosen by AIC */
+    int identified;                     /* 1 when the data determine every time-dependent
+                                           quantity of the model (each has a standard error) */
+    cf_visco_candidate by_n[CF_VISCO_AIC_MAX][2]; /* when chosen by AIC: the candidates of
+                                                     N = 1..4 terms, quasi-linear [0] and
+                                                     depending on strain [1] */
     size_t count, n_ramp, n_hold;       /* points in all, on ramps, in holds */
     double rss;                         /* unweighted sum of squared residuals, MPa^2 */
     double rmse, rmse_ramp, rmse_hold;  /* MPa; rmse_ramp/hold are -1 with no such point */
