@@ -203,7 +203,9 @@ static void relaxation_scene_follows_published_muscle_relaxation(void **state)
         unstable_rows += stable == 0;
         /* the table's rows between the last sample and this one (the scene starts at t = 0) */
         for (; at < tb.count && tb.t[at] <= t; at++) {
-            double si = row && t > tprev ? sprev + (s - sprev) * (tb.t[at] - tprev) / (t - tprev) : s;
+            double si = s;
+            if (row && t > tprev)
+                si = sprev + (s - sprev) * (tb.t[at] - tprev) / (t - tprev);
             ss += (si + 1e3 * tb.y[at]) * (si + 1e3 * tb.y[at]);
         }
         tprev = t;

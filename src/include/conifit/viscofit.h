@@ -44,7 +44,8 @@ typedef enum cf_visco_relaxation {
 typedef struct cf_visco_fit_options {
     int nbranch;            /* 1..CF_PRONY_MAX, or 0: choose 1..CF_VISCO_AIC_MAX by AIC */
     int dashpot;            /* 1: fit a dashpot beside the springs as well */
-    cf_visco_relaxation relaxation; /* quasi-linear (default), depending on strain, or by AIC */
+    cf_visco_relaxation relaxation; /* quasi-linear (the zero value), depending on strain, or
+                                    ** both with the choice (the command's default) */
     int hold_elastic;       /* 1: rho, s/H, F_C/H^2 held at elastic[] (an earlier fit) */
     double elastic[3];      /* rho [-], s/H [-], F_C/H^2 [MPa] */
     int relative;           /* 1: residuals relative to |stress| (floor 1e-3 max|stress|) */
