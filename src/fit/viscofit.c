@@ -128,6 +128,7 @@ typedef struct ctx {
     int free_el;        /* 1: rho and s/H are fitted (and the scale profiled) */
     int dash;           /* 1: dashpot fitted */
     int gs;             /* 1: growth of the relative moduli with strain (k_i) fitted */
+    unsigned smask;     /* with gs: bit i set when term i's k_i is fitted (else held at 0) */
     size_t np;          /* LM parameters */
     double *sw;         /* residual weights */
     double ynorm;       /* weighted sum of y^2 */
@@ -149,6 +150,21 @@ static double solid_lo(const ctx *c, double rho)
     return cf_visco_limits_solid_min(&c->lim, rho);
 }
 
+/* 1 when term i's relative modulus is fitted as changing with strain. */
+static int strain_term(const ctx *c, int i)
+{
+    return c->gs && (c->smask >> i & 1u);
+}
+
+/* The k_i fitted. */
+static int strain_terms(const ctx *c)
+{
+    int m = 0;
+    for (int i = 0; i < c->nb; i++)
+        m += strain_term(c, i);
+    return m;
+}
+
 /* LM coordinates -> model parameters; the stress scale is 1 (profiled) or the held one, the
 ** dashpot relative to it. */
 static cf_visco_params unpack(const ctx *c, const double *z)
@@ -167,21 +183,26 @@ static cf_visco_params unpack(const ctx *c, const double *z)
         p.stress_scale_MPa = c->o->elastic[2];
     }
     p.nbranch = c->nb;
-    /* the moduli at zero strain (g_i) and, with strain dependence, at the series' largest
-    ** strain (g_i + k_i x_max) are shares of two softmaxes: >= 0 and summing below 1 at every
-    ** strain the series reaches (they are linear in |strain|) */
+    /* the moduli at zero strain (g_i) are shares of a softmax: >= 0 and summing below 1; the
+    ** terms changing with strain share at the series' largest strain (g_i + k_i x_max) what the
+    ** constant terms leave there, by a second softmax: linear in |strain|, every modulus stays
+    ** >= 0 and their sum below 1 at every strain the series reaches */
     double sum = 1, sumb = 1, ea[CF_PRONY_MAX], eb[CF_PRONY_MAX];
     for (int i = 0; i < c->nb; i++) {
         p.tau_s[i] = exp(z[j++]);
         ea[i] = exp(fmax(z[j++], A_LO));
-        eb[i] = c->gs ? exp(fmax(z[j++], A_LO)) : 0.0;
+        eb[i] = strain_term(c, i) ? exp(fmax(z[j++], A_LO)) : 0.0;
         sum += ea[i];
         sumb += eb[i];
     }
+    double left = 1; /* what the constant terms leave at the largest strain */
     for (int i = 0; i < c->nb; i++) {
         p.g[i] = ea[i] / sum;
-        p.k[i] = c->gs ? (eb[i] / sumb - p.g[i]) / c->xmax : 0.0;
+        if (!strain_term(c, i))
+            left -= p.g[i];
     }
+    for (int i = 0; i < c->nb; i++)
+        p.k[i] = strain_term(c, i) ? (left * eb[i] / sumb - p.g[i]) / c->xmax : 0.0;
     p.eta_MPa_s = c->dash ? exp(z[j++]) * p.stress_scale_MPa : 0.0;
     return p;
 }
@@ -194,19 +215,24 @@ static void pack(const ctx *c, const cf_visco_params *p, double *z)
         z[j++] = logit((p->rho - c->rho_lo) / (RHO_HI - c->rho_lo));
         z[j++] = logit((p->solid_strain - lo) / (E_HI - lo));
     }
-    double ginf = 1, ginfb = 1, gb[CF_PRONY_MAX];
+    double ginf = 1, left = 1, gb[CF_PRONY_MAX];
     for (int i = 0; i < c->nb; i++) {
         ginf -= p->g[i];
-        gb[i] = c->gs ? p->g[i] + p->k[i] * c->xmax : 0.0;
-        ginfb -= gb[i];
+        gb[i] = strain_term(c, i) ? p->g[i] + p->k[i] * c->xmax : 0.0;
+        if (!strain_term(c, i))
+            left -= p->g[i];
     }
+    left = fmax(left, 1e-12);
+    double ginfb = 1;
+    for (int i = 0; i < c->nb; i++)
+        ginfb -= gb[i] / left;
     ginf = fmax(ginf, 1e-12);
     ginfb = fmax(ginfb, 1e-12);
     for (int i = 0; i < c->nb; i++) {
         z[j++] = log(p->tau_s[i]);
         z[j++] = p->g[i] > 0 ? fmax(log(p->g[i] / ginf), A_LO) : A_LO;
-        if (c->gs)
-            z[j++] = gb[i] > 0 ? fmax(log(gb[i] / ginfb), A_LO) : A_LO;
+        if (strain_term(c, i))
+            z[j++] = gb[i] > 0 ? fmax(log(gb[i] / left / ginfb), A_LO) : A_LO;
     }
     if (c->dash)
         z[j++] = log(fmax(p->eta_MPa_s / p->stress_scale_MPa, 1e-300));
@@ -725,7 +751,7 @@ static double *se_slot(const ctx *c, const int held[3], int which, cf_visco_para
     }
     if (which == 3 + 2 * nb)
         return c->dash ? &q->eta_MPa_s : NULL;
-    return c->gs ? &q->k[which - 4 - 2 * nb] : NULL;
+    return strain_term(c, which - 4 - 2 * nb) ? &q->k[which - 4 - 2 * nb] : NULL;
 }
 
 /* One column of the Jacobian: the weighted central difference of the model in quantity `which`,
@@ -745,8 +771,24 @@ static int se_column(ctx *c, const cf_visco_params *p, const int held[3], int wh
     } else if (which == 1) { /* s/H inside (largest strain, 1) */
         hm = fmin(h, 0.5 * (v - c->xmax));
         hp = fmin(h, 0.5 * (1 - v));
-    } else if (is_g) {
-        hm = fmin(h, v); /* g >= 0 */
+    } else if (which >= 3 && (is_g || which > 3 + 2 * p->nbranch)) {
+        /* a relative modulus or its slope: every g_i(x) >= 0 and their sum below 1 at x = 0 and
+        ** at the largest strain x_max (one-sided next to a limit, as the fit may sit on it) */
+        const int i = is_g ? (which - 3) / 2 : which - 4 - 2 * p->nbranch;
+        double sum0 = 0, sum1 = 0;
+        for (int j = 0; j < p->nbranch; j++) {
+            sum0 += p->g[j];
+            sum1 += p->g[j] + p->k[j] * c->xmax;
+        }
+        const double room0 = fmax(1 - sum0, 0), room1 = fmax(1 - sum1, 0);
+        const double g1 = fmax(p->g[i] + p->k[i] * c->xmax, 0);
+        if (is_g) {
+            hp = fmin(h, 0.5 * fmin(room0, room1));
+            hm = fmin(h, fmin(v, g1));
+        } else {
+            hp = fmin(h, 0.5 * room1 / c->xmax);
+            hm = fmin(h, g1 / c->xmax);
+        }
     }
     if (!(hp > 0) && !(hm > 0))
         return 0;
@@ -789,7 +831,7 @@ static void standard_errors(ctx *c, const cf_visco_params *p, const int held[3],
     for (int i = 0; i < 3; i++)
         res->se_ident[i] = -1;
     for (int i = 0; i < CF_PRONY_MAX; i++)
-        res->se_g[i] = res->se_tau_s[i] = res->se_k[i] = -1;
+        res->se_g[i] = res->se_tau_s[i] = res->se_k[i] = res->se_g_max[i] = -1;
     res->se_eta_MPa_s = -1;
     const int nq = 3 + 2 * p->nbranch + 1 + (c->gs ? p->nbranch : 0);
     cf_visco_params q = *p;
@@ -809,13 +851,28 @@ static void standard_errors(ctx *c, const cf_visco_params *p, const int held[3],
     const int cs = ok ? gsl_multifit_nlinear_covar(J, 1e-13, cov) : GSL_FAILURE;
     c->oom |= cs == GSL_ENOMEM;
     if (cs == GSL_SUCCESS) {
+        int colof[3 + 3 * CF_PRONY_MAX + 1];
         col = 0;
         for (int which = 0; which < nq; which++) {
+            colof[which] = -1;
             if (!se_slot(c, held, which, &q))
                 continue;
             double var = s2 * gsl_matrix_get(cov, col, col);
             se_store(which, p->nbranch, var > 0 && isfinite(var) ? sqrt(var) : -1, res);
-            col++;
+            colof[which] = (int)col++;
+        }
+        /* each term's modulus at the largest strain, g_i + k_i x_max: its variance with the
+        ** covariance of g_i and k_i */
+        for (int i = 0; i < p->nbranch; i++) {
+            const int cg = colof[3 + 2 * i], ck = c->gs ? colof[4 + 2 * p->nbranch + i] : -1;
+            if (cg < 0 || ck < 0) {
+                res->se_g_max[i] = cg < 0 ? -1 : res->se_g[i];
+                continue;
+            }
+            const double x = c->xmax;
+            double var = s2 * (gsl_matrix_get(cov, cg, cg) + x * x * gsl_matrix_get(cov, ck, ck) +
+                               2 * x * gsl_matrix_get(cov, cg, ck));
+            res->se_g_max[i] = var > 0 && isfinite(var) ? sqrt(var) : -1;
         }
     }
     if (J)
@@ -845,21 +902,25 @@ static void default_start(const ctx *c, int nb, start *s)
     s->p.eta_MPa_s = c->dash ? 1e-3 : 0;
 }
 
-/* Fits nb branches; fills p (actual scale and dashpot) and returns the weighted scaled sum of
-** squares (HUGE_VAL when nothing could be evaluated). */
-static double fit_nb(ctx *c, int nb, cf_visco_params *pout)
+/* Fits nb branches from the stand-in's starts and, when given, from `from` as well; fills p
+** (actual scale and dashpot) and returns the weighted scaled sum of squares (HUGE_VAL when
+** nothing could be evaluated). */
+static double fit_nb(ctx *c, int nb, const cf_visco_params *from, cf_visco_params *pout)
 {
     c->nb = nb;
-    c->np = (size_t)((c->free_el ? 2 : 0) + (2 + c->gs) * nb + (c->dash ? 1 : 0));
+    c->np = (size_t)((c->free_el ? 2 : 0) + 2 * nb + strain_terms(c) + (c->dash ? 1 : 0));
     /* relaxation depending on strain trades more freely against the elastic curve: more starts */
     const int nstarts = c->gs ? LM_STARTS_STRAIN : LM_STARTS;
-    start best[LM_STARTS_STRAIN];
-    if (!stand_in(c, best, nstarts))
-        default_start(c, nb, &best[0]);
+    start best[LM_STARTS_STRAIN + 1];
+    if (!stand_in(c, best + 1, nstarts))
+        default_start(c, nb, &best[1]);
+    best[0].obj = from ? 0.0 : HUGE_VAL;
+    if (from)
+        best[0].p = *from;
     double bestobj = HUGE_VAL;
     double *z = malloc(c->np * sizeof(double)), *zbest = malloc(c->np * sizeof(double));
     c->oom |= !z || !zbest;
-    for (int s = 0; z && zbest && !c->oom && s < nstarts; s++) {
+    for (int s = 0; z && zbest && !c->oom && s <= nstarts; s++) {
         if (!(best[s].obj < HUGE_VAL))
             continue;
         cf_visco_params p0 = best[s].p;
@@ -1107,21 +1168,38 @@ static void fit_limits(const ctx *c, const cf_visco_params *p, cf_visco_fit *res
     res->at_design_limit = held[2];
 }
 
-/* Whether the data determine every time-dependent quantity of candidate p: each g_i, tau_i (and
-** k_i, and the dashpot when fitted) has a standard error (the covariance's diagonal, scaled by 1
-** so that a noiseless series counts too). A term the series cannot pin down (tau_i -> 0, a g_i of
-** 0 with its tau_i free, two terms trading one for the other) makes the Jacobian rank-deficient;
-** AIC assumes a regular model and would reward such a fit's extra parameters. */
-static int prony_identified(ctx *c, const cf_visco_params *p)
+/* 1 when a positive quantity v is larger than its standard error se (se > 0: determined). */
+static int resolved(double v, double se)
+{
+    return se > 0 && se < v;
+}
+
+/* Whether the series determines the time-dependent quantities of candidate p, whose weighted
+** residual variance is s2: the Jacobian has full rank in them, and each tau_i, each term's
+** relative modulus at the largest strain (g_i + k_i x_max), each fitted k_i (its size) and the
+** dashpot is larger than its standard error. A term the series cannot pin down (tau_i -> 0 or
+** far past the series, a g_i of 0 with its tau_i free, two terms trading one for the other)
+** fails it; AIC assumes a regular model and would reward such a fit's extra parameters. The
+** errors are computed at s2 = 1 and scaled, so that a noiseless series (s2 -> 0) passes.
+** *loose gets the terms whose k_i is fitted but not larger than its error. */
+static int prony_identified(ctx *c, const cf_visco_params *p, double s2, unsigned *loose)
 {
     int held[3];
     cf_visco_fit se;
     memset(&se, 0, sizeof se);
     limits_held(c, p, held);
     standard_errors(c, p, held, 1.0, &se);
-    int ok = !c->dash || se.se_eta_MPa_s > 0;
-    for (int i = 0; i < p->nbranch; i++)
-        ok = ok && se.se_g[i] > 0 && se.se_tau_s[i] > 0 && (!c->gs || se.se_k[i] > 0);
+    const double s = sqrt(s2);
+    *loose = 0;
+    int ok = !c->dash || resolved(p->eta_MPa_s, s * se.se_eta_MPa_s);
+    for (int i = 0; i < p->nbranch; i++) {
+        ok = ok && resolved(p->tau_s[i], s * se.se_tau_s[i]) &&
+             resolved(p->g[i] + p->k[i] * c->xmax, s * se.se_g_max[i]);
+        if (strain_term(c, i) && !resolved(fabs(p->k[i]), s * se.se_k[i])) {
+            ok = 0;
+            *loose |= 1u << i;
+        }
+    }
     return ok;
 }
 
@@ -1131,46 +1209,88 @@ static int preferred(int ident_a, double aic_a, int ident_b, double aic_b)
     return ident_a != ident_b ? ident_a > ident_b : aic_a < aic_b;
 }
 
+/* One candidate: nb terms with c->gs and c->smask, started also from `from` when given. 1 when
+** fitted (its AIC, whether the series determines it and its loose k_i in *aic, *ident, *loose),
+** 0 when no model could be evaluated, -1 when memory ran out. */
+static int candidate(ctx *c, int nb, const cf_visco_params *from, cf_visco_params *p, double *aic,
+                     int *ident, unsigned *loose)
+{
+    if (!(fit_nb(c, nb, from, p) < HUGE_VAL) || !curve(c, p))
+        return c->oom ? -1 : 0;
+    double rss = 0, wrss = 0;
+    for (size_t k = 0; k < c->n; k++) {
+        const double r = c->m[k] - c->d->y[k];
+        rss += r * r;
+        wrss += c->sw[k] * c->sw[k] * r * r;
+    }
+    const int kpar = (c->free_el ? 3 : 0) + 2 * nb + strain_terms(c) + c->dash;
+    *aic = (double)c->n * log(fmax(rss, 1e-300) / (double)c->n) + 2.0 * kpar;
+    const double s2 = (double)c->n > kpar ? wrss / ((double)c->n - kpar) : 0;
+    *ident = prony_identified(c, p, s2, loose);
+    return c->oom ? -1 : 1;
+}
+
 /* Fits the branch counts asked for (or 1..CF_VISCO_AIC_MAX), quasi-linear, depending on strain or
 ** both, and keeps in *best the candidate whose terms the data determine with the lowest AIC (the
-** lowest AIC of all when none is determined); every candidate's AIC in res->by_n. */
+** lowest AIC of all when none is determined); every candidate's AIC in res->by_n. A candidate
+** depending on strain whose k_i are not all determined is fitted again with those terms constant
+** in strain (backward elimination, while some terms stay strain-dependent), and the preferred of
+** the two kept. c->gs and c->smask are left at the kept candidate's. */
 static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf_error *err)
 {
     const cf_visco_fit_options *o = c->o;
     const int nlo = o->nbranch ? o->nbranch : 1, nhi = o->nbranch ? o->nbranch : CF_VISCO_AIC_MAX;
     double best_aic = HUGE_VAL;
-    int best_ident = 0;
+    int best_ident = 0, best_gs = 0;
+    unsigned best_mask = 0;
     memset(best, 0, sizeof *best);
     res->chosen_by_aic = o->nbranch == 0 || o->relaxation == CF_RELAX_AUTO;
     const int gslo = o->relaxation == CF_RELAX_STRAIN, gshi = o->relaxation != CF_RELAX_QLV;
     for (int v = 0; v < (nhi - nlo + 1) * (gshi - gslo + 1); v++) {
         const int nb = nlo + v / (gshi - gslo + 1);
         c->gs = gslo + v % (gshi - gslo + 1);
-        cf_visco_params p;
-        const int ok = fit_nb(c, nb, &p) < HUGE_VAL && curve(c, &p);
-        if (c->oom)
-            return cf_error_set(err, CF_E_INTERNAL,
-                                "out of memory in the viscoelastic fit of %d Prony term%s (the "
-                                "Levenberg-Marquardt iteration or a model curve)",
-                                nb, nb == 1 ? "" : "s");
-        if (!ok)
+        c->smask = (1u << nb) - 1;
+        cf_visco_params p, q;
+        double aic = HUGE_VAL, aq;
+        int ident = 0, iq, fitted = 0, st;
+        unsigned lq, mask = c->smask;
+        cf_visco_params from;
+        const cf_visco_params *fp = NULL;
+        while ((st = candidate(c, nb, fp, &q, &aq, &iq, &lq)) != 0) {
+            if (st < 0)
+                return cf_error_set(err, CF_E_INTERNAL,
+                                    "out of memory in the viscoelastic fit of %d Prony term%s",
+                                    nb, nb == 1 ? "" : "s");
+            if (!fitted || preferred(iq, aq, ident, aic)) {
+                p = q;
+                aic = aq;
+                ident = iq;
+                mask = c->smask;
+            }
+            fitted = 1;
+            /* again without the loose k_i, while some stay */
+            if (iq || !lq || (c->smask & ~lq) == 0 || c->smask != mask)
+                break;
+            c->smask &= ~lq;
+            from = q; /* the loose terms held at their modulus halfway along the strain */
+            for (int i = 0; i < nb; i++)
+                if (lq >> i & 1u) {
+                    from.g[i] += 0.5 * from.k[i] * c->xmax;
+                    from.k[i] = 0;
+                }
+            fp = &from;
+        }
+        if (!fitted)
             continue;
-        double rss = 0;
-        for (size_t k = 0; k < c->n; k++)
-            rss += (c->m[k] - c->d->y[k]) * (c->m[k] - c->d->y[k]);
-        int kpar = (c->free_el ? 3 : 0) + (2 + c->gs) * nb + c->dash;
-        double aic = (double)c->n * log(fmax(rss, 1e-300) / (double)c->n) + 2.0 * kpar;
-        const int ident = prony_identified(c, &p);
-        if (c->oom)
-            return cf_error_set(err, CF_E_INTERNAL,
-                                "out of memory in the standard errors of the fit of %d Prony "
-                                "term%s",
-                                nb, nb == 1 ? "" : "s");
+        c->smask = mask;
         if (nb - 1 < CF_VISCO_AIC_MAX)
-            res->by_n[nb - 1][c->gs] = (cf_visco_candidate){1, aic, ident};
+            res->by_n[nb - 1][c->gs] =
+                (cf_visco_candidate){1, aic, ident, c->gs ? strain_terms(c) : 0};
         if (best_aic == HUGE_VAL || preferred(ident, aic, best_ident, best_aic)) {
             best_aic = aic;
             best_ident = ident;
+            best_gs = c->gs;
+            best_mask = c->smask;
             *best = p;
         }
     }
@@ -1178,6 +1298,9 @@ static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf
         return cf_error_set(err, CF_E_NOCONV,
                             "no viscoelastic model could be evaluated along this series");
     res->identified = best_ident;
+    c->gs = best_gs;
+    c->smask = best_mask;
+    c->nb = best->nbranch;
     return CF_OK;
 }
 
@@ -1227,10 +1350,10 @@ static cf_status fit_report(ctx *c, const cf_visco_params *bestp, cf_visco_fit *
     res->dashpot = c->dash;
     res->held_elastic = !c->free_el;
     res->count = c->n;
-    const cf_msm_effects fx = cf_visco_effects(bestp);
-    c->gs = cf_msm_prony_depends_on_strain(&fx);
-    res->strain_relaxation = c->gs;
-    res->k = (c->free_el ? 3 : 0) + (2 + c->gs) * bestp->nbranch + c->dash;
+    res->strain_relaxation = c->gs; /* and c->smask: those of the kept candidate */
+    res->strain_mask = c->gs ? c->smask & ((1u << bestp->nbranch) - 1) : 0;
+    res->x_max = c->xmax;
+    res->k = (c->free_el ? 3 : 0) + 2 * bestp->nbranch + strain_terms(c) + c->dash;
     double wrss = fit_quality(c, res);
     double s2 = (double)c->n > res->k ? wrss / ((double)c->n - res->k) : 0;
     int held[3];

@@ -1542,6 +1542,15 @@ int cf_table_is_force(const cf_table *m)
     return m->kind == CF_TABLE_FORCE_DISPLACEMENT;
 }
 
+void cf_table_name(const cf_table *m, char *out, size_t cap)
+{
+    const char *base = strrchr(m->path, '/');
+    base = base ? base + 1 : m->path;
+    const char *dot = strrchr(base, '.');
+    int n = (dot && dot != base) ? (int)(dot - base) : (int)strlen(base);
+    snprintf(out, cap, "%.*s", n, base);
+}
+
 cf_status cf_table_from_arrays(cf_table_kind kind, size_t count, const double *x, const double *y,
                                const double *w, cf_table *m, cf_error *err)
 {

@@ -35,16 +35,6 @@ static void styles(cf_gp *g)
     cf_gp_cmd(g, "set style line 7 dt 2 lw 1.5 pt 8 ps 0.9 lc rgb %q", "#4393c3");
 }
 
-/* The table's name: its file name without folder and extension. */
-static void table_name(const cf_table *d, char *out, size_t cap)
-{
-    const char *base = strrchr(d->path, '/');
-    base = base ? base + 1 : d->path;
-    const char *dot = strrchr(base, '.');
-    int n = (dot && dot != base) ? (int)(dot - base) : (int)strlen(base);
-    snprintf(out, cap, "%.*s", n, base);
-}
-
 /* x, the lattice stress and its residual (file's unit) of every data point, sorted by x. */
 static void lattice_block(cf_gp *g, const char *name, const cf_table *d,
                           const double *stress_MPa, double u)
@@ -225,7 +215,7 @@ static void fit_script(cf_gp *g, const void *fig)
     if (r->title)
         snprintf(title, sizeof title, "%s", r->title);
     else
-        table_name(d, title, sizeof title);
+        cf_table_name(d, title, sizeof title);
     styles(g);
     cf_gp_cmd(g, "set multiplot");
     cf_gp_cmd(g, "set grid lc rgb %q", "#d9d9d9");

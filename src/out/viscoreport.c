@@ -38,12 +38,18 @@ static void set_se(json_t *o, const char *key, double se, double scale)
                                            "Jacobian of the fit is numerically rank-deficient"));
 }
 
-static double g_inf(const cf_visco_params *p)
+/* The long-time relative modulus 1 - sum g_i(x) at |strain| x. */
+static double g_inf_at(const cf_visco_params *p, double x)
 {
     double g = 1;
     for (int i = 0; i < p->nbranch; i++)
-        g -= p->g[i];
+        g -= p->g[i] + p->k[i] * x;
     return g;
+}
+
+static double g_inf(const cf_visco_params *p)
+{
+    return g_inf_at(p, 0);
 }
 
 static json_t *constraints(unsigned bits)
@@ -90,7 +96,7 @@ static void visco_keys(const cf_visco_report *r, json_t *o)
         json_t *e = json_pack("{s:o, s:o}", "g", num(f->p.g[i]), "tau_s", num(f->p.tau_s[i]));
         set_se(e, "stderr_g", f->se_g[i], 1);
         set_se(e, "stderr_tau_s", f->se_tau_s[i], 1);
-        if (f->strain_relaxation) { /* absent: quasi-linear */
+        if (f->strain_mask >> i & 1u) { /* absent: constant in strain */
             json_object_set_new(e, "g_per_strain", num(f->p.k[i]));
             set_se(e, "stderr_g_per_strain", f->se_k[i], 1);
         }
@@ -111,6 +117,10 @@ static void visco_keys(const cf_visco_report *r, json_t *o)
     json_object_set_new(o, "parameters", json_integer(f->k));
     json_object_set_new(o, "prony", prony);
     json_object_set_new(o, "g_inf", num(g_inf(&f->p)));
+    if (f->strain_relaxation) { /* absent: quasi-linear, g_inf the same at every strain */
+        json_object_set_new(o, "largest_strain", num(f->x_max));
+        json_object_set_new(o, "g_inf_at_largest_strain", num(g_inf_at(&f->p, f->x_max)));
+    }
     json_object_set_new(o, "relaxation", json_string(f->strain_relaxation ? "strain" : "qlv"));
     if (f->dashpot) { /* absent without one */
         json_t *dp = json_pack("{s:o}", "eta_kPa_s", num(f->p.eta_MPa_s * 1e3));
@@ -127,9 +137,10 @@ static void visco_keys(const cf_visco_report *r, json_t *o)
                 const cf_visco_candidate *cd = &f->by_n[n][gs];
                 if (cd->fitted)
                     json_array_append_new(
-                        a, json_pack("{s:i, s:s, s:o, s:b}", "branches", n + 1, "relaxation",
-                                     gs ? "strain" : "qlv", "aic", num(cd->aic + aic_shift),
-                                     "determined", cd->identified));
+                        a, json_pack("{s:i, s:s, s:i, s:o, s:b}", "branches", n + 1,
+                                     "relaxation", gs ? "strain" : "qlv",
+                                     "terms_depending_on_strain", cd->strain_terms, "aic",
+                                     num(cd->aic + aic_shift), "determined", cd->identified));
             }
         json_object_set_new(o, "aic_by_branches", a);
     }
@@ -283,7 +294,8 @@ char *cf_visco_report_text(const cf_visco_report *r)
             lc->ny, lc->nz, cf_calibration_name(lc->calibration));
     if (f->chosen_by_aic) {
         fprintf(o, " chosen: the lowest AIC among the candidates whose terms the series "
-                   "determines\n");
+                   "determines (each time constant, modulus and strain slope larger than its "
+                   "standard error)\n");
         for (int n = 0; n < CF_VISCO_AIC_MAX; n++) {
             const char *sep = "";
             for (int gs = 0; gs < 2; gs++) {
@@ -292,8 +304,11 @@ char *cf_visco_report_text(const cf_visco_report *r)
                     continue;
                 if (!*sep)
                     fprintf(o, "  AIC with %d term%s:", n + 1, n ? "s" : "");
-                fprintf(o, "%s %s %.2f%s", sep, gs ? "strain" : "qlv",
-                        cd->aic + (double)f->count * log(u * u),
+                char what[48] = "qlv";
+                if (gs)
+                    snprintf(what, sizeof what, cd->strain_terms <= n ? "strain (%d of them)" : "strain",
+                             cd->strain_terms);
+                fprintf(o, "%s %s %.2f%s", sep, what, cd->aic + (double)f->count * log(u * u),
                         cd->identified ? "" : " (terms undetermined)");
                 sep = ",";
             }
@@ -303,7 +318,8 @@ char *cf_visco_report_text(const cf_visco_report *r)
     }
     if (!f->identified)
         fprintf(o, " warning: the series does not determine every time-dependent quantity of "
-                   "this model (the '?' below); fewer terms (--branches) or --relaxation qlv\n");
+                   "this model (a standard error as large as its value, or '?' below); fewer "
+                   "terms (--branches) or --relaxation qlv\n");
     fprintf(o, " elastic part%s:\n", f->held_elastic ? " (held from --elastic)" : "");
     value_se_text(o, f->rho_at_limit ? "rho = D1/D2 (at --rho-min)" : "rho = D1/D2", f->p.rho,
                   f->se_ident[0], 1, "");
@@ -322,15 +338,20 @@ char *cf_visco_report_text(const cf_visco_report *r)
         value_se_text(o, l, f->p.g[i], f->se_g[i], 1, "");
         snprintf(l, sizeof l, "tau_%d", i + 1);
         value_se_text(o, l, f->p.tau_s[i], f->se_tau_s[i], 1, "s");
-        if (f->strain_relaxation) {
-            snprintf(l, sizeof l, "g_%d per unit |strain|", i + 1);
+        snprintf(l, sizeof l, "g_%d per unit |strain|", i + 1);
+        if (f->strain_mask >> i & 1u)
             value_se_text(o, l, f->p.k[i], f->se_k[i], 1, "");
-        }
+        else if (f->strain_relaxation)
+            fprintf(o, "  %-30s 0 (held: this term's change with strain was not determined)\n", l);
     }
     if (f->strain_relaxation)
         fprintf(o, "  (relaxation depends on strain: g_i + g_per_strain_i |strain| at a spring's "
                    "strain)\n");
-    fprintf(o, "  %-30s %.6g\n", "g_inf = 1 - sum g_i", g_inf(&f->p));
+    fprintf(o, "  %-30s %.6g%s\n", "g_inf = 1 - sum g_i", g_inf(&f->p),
+            f->strain_relaxation ? " (at zero strain)" : "");
+    if (f->strain_relaxation)
+        fprintf(o, "  %-30s %.6g (at |strain| %.4g, the series' largest)\n", "g_inf(strain)",
+                g_inf_at(&f->p, f->x_max), f->x_max);
     if (f->dashpot)
         value_se_text(o, "dashpot eta", f->p.eta_MPa_s, f->se_eta_MPa_s, 1e3, "kPa s");
     fprintf(o, "  %-30s %.4g kPa (instantaneous), %.4g kPa (equilibrium)\n",
@@ -395,7 +416,13 @@ static void visco_script(cf_gp *g, const cf_visco_report *r)
     snprintf(fl, sizeof fl, "model: %d Prony term%s%s, RMSE %.3g %s", r->fit.p.nbranch,
              r->fit.p.nbranch == 1 ? "" : "s", r->fit.dashpot ? " + dashpot" : "",
              r->fit.rmse * u, r->table->y_unit);
-    cf_gp_cmd(g, "set multiplot title %q noenhanced", r->table->path);
+    char title[300];
+    if (r->title) {
+        snprintf(title, sizeof title, "%s", r->title);
+    } else {
+        cf_table_name(r->table, title, sizeof title);
+    }
+    cf_gp_cmd(g, "set multiplot title %q noenhanced", title);
     cf_gp_cmd(g, "set grid");
     cf_gp_cmd(g, "set key bottom right box opaque noenhanced");
     cf_gp_cmd(g, "set size 0.55,0.62");

@@ -50,6 +50,7 @@ cf_status cf_pipeline_fit_series(const cf_table *t, const cf_pipeline_options *o
     r->table = t;
     r->setup = vo->setup;
     r->with_timing = opt->with_timing;
+    r->title = opt->title;
     if (!t->t)
         return cf_error_set(err, CF_E_DATA, "%s: not a time series (no time column)", t->path);
     if (t->mode != CF_MODE_UNIAXIAL)

@@ -166,6 +166,10 @@ cf_status cf_table_from_arrays(cf_table_kind kind, size_t count, const double *x
 /* 1 for a force-displacement table, 0 for stress-strain. */
 int cf_table_is_force(const cf_table *m);
 
+/* The table's file name without folder and extension into out (cap bytes, cut to fit): the
+** default title of its plots. */
+void cf_table_name(const cf_table *m, char *out, size_t cap);
+
 /* Releases the arrays of m (safe on a zeroed struct). */
 void cf_table_free(cf_table *m);
 

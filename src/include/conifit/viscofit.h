@@ -106,7 +106,9 @@ typedef struct cf_visco_predict {
 typedef struct cf_visco_candidate {
     int fitted;            /* 0: not fitted (N not tried, or no model could be evaluated) */
     double aic;            /* n ln(RSS/n) + 2k, RSS in MPa^2 */
-    int identified;        /* 1 when every g_i, tau_i (k_i, dashpot) has a standard error */
+    int identified;        /* 1 when the series determines its time-dependent quantities (see
+                              cf_visco_fit.identified) */
+    int strain_terms;      /* terms whose relative modulus changes with strain (fitted k_i) */
 } cf_visco_candidate;
 
 typedef struct cf_visco_fit {
@@ -118,7 +120,12 @@ typedef struct cf_visco_fit {
     double se_eta_MPa_s;                /* of the dashpot, MPa s (-1 without one) */
     double se_k[CF_PRONY_MAX];          /* of k_i (relaxation growing with strain), -1 when not
                                            fitted or not determined */
-    int strain_relaxation;              /* 1 when the k_i were fitted */
+    double se_g_max[CF_PRONY_MAX];      /* of g_i + k_i x_max, the relative modulus at the
+                                           series' largest strain x_max (se_g[i] for a term
+                                           constant in strain), -1 when not determined */
+    int strain_relaxation;              /* 1 when k_i were fitted */
+    unsigned strain_mask;               /* bit i set when term i's k_i was fitted (with
+                                           strain_relaxation; the others' are held at 0) */
     int dashpot;                        /* 1 when a dashpot was fitted */
     int held_elastic;                   /* 1 when the elastic quantities were held */
     int rho_at_limit;                   /* 1 when rho sits on its lower limit (rho_min): set by
@@ -133,7 +140,9 @@ typedef struct cf_visco_fit {
                                            0 when stable to 0.995 of solid or not checked */
     int chosen_by_aic;                  /* 1 when N or the relaxation was chosen by AIC */
     int identified;                     /* 1 when the data determine every time-dependent
-                                           quantity of the model (each has a standard error) */
+                                           quantity of the model: each tau_i, each term's
+                                           modulus at the largest strain, each fitted k_i and
+                                           the dashpot is larger than its standard error */
     cf_visco_candidate by_n[CF_VISCO_AIC_MAX][2]; /* when chosen by AIC: the candidates of
                                                      N = 1..4 terms, quasi-linear [0] and
                                                      depending on strain [1] */
@@ -144,6 +153,7 @@ typedef struct cf_visco_fit {
     double r2;                          /* coefficient of determination, - */
     double aic;                         /* n ln(RSS/n) + 2k, RSS in MPa^2 */
     int k;                              /* fitted parameters */
+    double x_max;                       /* the series' largest |strain|, - */
     double E_inst_MPa;                  /* small-strain instantaneous modulus of the lattice, MPa */
     double E_eq_MPa;                    /* small-strain equilibrium modulus, g_inf E_inst, MPa */
     double *model_MPa;                  /* the model at every point (owned), MPa */

@@ -22,6 +22,8 @@ typedef struct cf_visco_report {
     int nplaced;               /* design springs placed from the identifiable quantities (1-2) */
     cf_fit_result placed[2];
     int with_timing;           /* 0: wall_time_s written as 0 (reproducible files) */
+    const char *title;         /* of the plot; NULL: the table's file name without folder and
+                                  extension */
 } cf_visco_report;
 
 /* Releases what the report owns. Safe on a zeroed report. */
