@@ -435,7 +435,9 @@ static void visco_script(cf_gp *g, const cf_visco_report *r)
     cf_gp_cmd(g, "set size 0.55,0.33");
     cf_gp_cmd(g, "set origin 0,0");
     cf_gp_cmd(g, "set key off");
-    cf_gp_cmd(g, "set ylabel %q noenhanced", "residual");
+    char rl[96];
+    snprintf(rl, sizeof rl, "residual [%s]", r->table->y_unit);
+    cf_gp_cmd(g, "set ylabel %q noenhanced", rl);
     cf_gp_cmd(g, "plot 0 with lines lc rgb %q notitle, $DATA using 1:5 with linespoints pt 7 ps "
                  "0.5 lc rgb %q notitle",
               "black", "#d62728");
