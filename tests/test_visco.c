@@ -532,7 +532,8 @@ static void test_held_elastic_unstable(void **state)
 }
 
 /* The command line: a time series with a bad branch count or a time that goes back exits 65 and
-** writes nothing; --validate does not apply to a series. */
+** writes nothing; --validate does not apply to a series alone, and in a batch with a
+** stress-strain table it applies to that table. */
 static void test_cli_series_errors(void **state)
 {
     (void)state;
@@ -567,6 +568,23 @@ static void test_cli_series_errors(void **state)
     assert_int_equal(access(out, F_OK), -1);
     assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "fit data/telescoping.csv --branches 2"),
                      2);
+    /* in a batch with a stress-strain table each option applies to the tables it concerns:
+    ** --validate to the table, --branches and --relaxation to the series */
+    char odir[300], fits[2][320];
+    snprintf(odir, sizeof odir, "%s/", dir);
+    snprintf(fits[0], sizeof fits[0], "%s/series.json", dir);
+    snprintf(fits[1], sizeof fits[1], "%s/telescoping.json", dir);
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se,
+                            "fit %s data/telescoping.csv --validate --branches 1 --relaxation qlv "
+                            "-o %s",
+                            path, odir),
+                     0);
+    assert_non_null(strstr(so, "validation in the lattice"));
+    assert_non_null(strstr(so, "1 Prony term"));
+    for (int k = 0; k < 2; k++) {
+        assert_int_equal(access(fits[k], F_OK), 0);
+        unlink(fits[k]);
+    }
     unlink(path);
     unlink(bad);
     rmdir(dir);

@@ -724,7 +724,10 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
     *nseries = 0;
     for (int i = 0; i < a->nfiles && rc < 0; i++)
         *nseries += jobs[i].m.t != NULL;
-    if (rc < 0 && *nseries > 0 && (a->popt.validate || a->popt.target == CF_TARGET_LATTICE))
+    /* as the series' options in a batch with stress-strain tables, these apply to the tables
+    ** they concern; refused when no table is one */
+    if (rc < 0 && *nseries == a->nfiles &&
+        (a->popt.validate || a->popt.target == CF_TARGET_LATTICE))
         rc = cf_cli_usage_error("fit", "--validate and --target lattice apply to stress-strain "
                                        "tables; a time series is fitted through the lattice "
                                        "already");
