@@ -14,7 +14,7 @@
 #include "out/gnuplot.h"
 
 static char scratch[] = "/tmp/conifit-inject-XXXXXX";
-static char conifit_abs[PATH_MAX], table_abs[PATH_MAX];
+static char conifit_abs[PATH_MAX], table_abs[PATH_MAX], series_abs[PATH_MAX];
 
 /* The payloads: each breaks out of a gnuplot string its own way and creates the marker. */
 typedef struct payload {
@@ -118,7 +118,8 @@ static int setup(void **state)
     (void)state;
     if (!mkdtemp(scratch))
         return -1;
-    if (!realpath(tu_conifit(), conifit_abs) || !realpath("data/telescoping.csv", table_abs))
+    if (!realpath(tu_conifit(), conifit_abs) || !realpath("data/telescoping.csv", table_abs) ||
+        !realpath("data/series/synthetic_relaxation.csv", series_abs))
         return -1;
     return 0;
 }
@@ -274,6 +275,48 @@ static void fit_file_names(void **state)
     }
 }
 
+/* conifit fit --plot of a time series (its own figure: stress against time and strain) with
+** payloads in the file name (the default title), the column names (axis labels) and --title. */
+static void fit_series_names(void **state)
+{
+    (void)state;
+    if (!have_gnuplot())
+        skip();
+    FILE *f = fopen(series_abs, "rb");
+    assert_non_null(f);
+    static char text[1 << 16], out[1 << 16];
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = '\0';
+    const char *hdr = "time_s,strain,stress_kPa\n";
+    char *h = strstr(text, hdr);
+    assert_non_null(h);
+    for (size_t k = 0; k < NPAYLOADS; k++) {
+        if (k == 1 || k == 3) /* a double quote or newline cannot stand unquoted in a CSV name */
+            continue;
+        char marker[32], p[256], name[300], png[300];
+        snprintf(marker, sizeof marker, "PWNED%zu", k);
+        make_payload(p, sizeof p, k, marker);
+        snprintf(name, sizeof name, "s%s.csv", p);
+        snprintf(png, sizeof png, "s%zu.png", k);
+        snprintf(out, sizeof out, "%.*stime_s,strain %s,stress %s [kPa]\n%s", (int)(h - text),
+                 text, p, p, h + strlen(hdr));
+        write_in_scratch(name, out);
+        char *argv[] = {conifit_abs, "fit",   name, "--branches", "1", "--relaxation", "qlv",
+                        "--plot",    png,     "--quiet", NULL};
+        int rc = run(NULL, argv);
+        if (rc != 0)
+            fail_msg("%s in a series' names: exit %d: %s", payloads[k].name, rc, last_stderr());
+        assert_true(exists_in_scratch(png));
+        char *argv2[] = {conifit_abs, "fit",   name, "--branches", "1", "--relaxation", "qlv",
+                         "--title",   p,       "--plot", png,      "--quiet", NULL};
+        rc = run(NULL, argv2);
+        if (rc != 0)
+            fail_msg("%s in a series' title: exit %d: %s", payloads[k].name, rc, last_stderr());
+        no_marker_left(payloads[k].name);
+    }
+}
+
 /* conifit simulate --plot with payloads in the output names, the scene's file name and the fit
 ** file the scene names (shown in the figure's key). */
 static void simulate_names(void **state)
@@ -372,6 +415,7 @@ int main(void)
         cmocka_unit_test(escaping_rule),
         cmocka_unit_test(fit_column_names_comments_units),
         cmocka_unit_test(fit_file_names),
+        cmocka_unit_test(fit_series_names),
         cmocka_unit_test(simulate_names),
         cmocka_unit_test(script_holds_no_live_text),
     };
