@@ -93,14 +93,22 @@ static const char *last_stderr(void)
 }
 
 /* The shipped table with its header line replaced. */
-static void table_with_header(const char *name, const char *header, const char *comment)
+/* The whole of a shipped file (at most 64 KiB) in a static buffer. */
+static char *shipped_text(const char *path)
 {
-    FILE *f = fopen(table_abs, "rb");
+    static char text[1 << 16];
+    FILE *f = fopen(path, "rb");
     assert_non_null(f);
-    static char text[1 << 16], out[1 << 16];
     size_t n = fread(text, 1, sizeof text - 1, f);
     fclose(f);
     text[n] = '\0';
+    return text;
+}
+
+static void table_with_header(const char *name, const char *header, const char *comment)
+{
+    static char out[1 << 16];
+    char *text = shipped_text(table_abs);
     char *h = strstr(text, "\nstrain,stress_kPa\n");
     assert_non_null(h);
     snprintf(out, sizeof out, "%s%.*s\n%s\n%s", comment ? comment : "", (int)(h - text), text,
@@ -282,12 +290,8 @@ static void fit_series_names(void **state)
     (void)state;
     if (!have_gnuplot())
         skip();
-    FILE *f = fopen(series_abs, "rb");
-    assert_non_null(f);
-    static char text[1 << 16], out[1 << 16];
-    size_t n = fread(text, 1, sizeof text - 1, f);
-    fclose(f);
-    text[n] = '\0';
+    static char out[1 << 16];
+    const char *text = shipped_text(series_abs);
     const char *hdr = "time_s,strain,stress_kPa\n";
     char *h = strstr(text, hdr);
     assert_non_null(h);
