@@ -5,7 +5,9 @@
 #                   first command; as root it installs missing packages, otherwise it prints the
 #                   one apt-get line and stops)
 #   make fits       re-fit every table in data/ into fits/ (JSON and PNG), validated in the lattice
-#   make test       build and run the cmocka suite (the README's second command)
+#   make test       build and run the cmocka suite (the README's second command), once for each
+#                   copy of the vector code the processor can run (AVX-512, AVX2, SSE2: the
+#                   environment variable CONIFIT_SIMD selects it); SIMD="sse2" runs only the ones named
 #   make sanitize   the same suite under AddressSanitizer + UndefinedBehaviorSanitizer
 #   make fuzz       libFuzzer (clang, ASan + UBSan) on each parser for FUZZ_SECONDS (default 60) s
 #   make bench      the benchmark report into build/bench/report/ (optimised build, separate from
@@ -21,6 +23,7 @@ DEBS    := build-essential pkg-config libnlopt-dev libgsl-dev libcmocka-dev libj
            libsuitesparse-dev libmumps-seq-dev libopenblas0-serial gnuplot-nox calculix-ccx clang \
            libclang-rt-dev
 BUILD   ?= build
+SIMD    ?=
 
 WARN    := -Wall -Wextra -Wpedantic -Wshadow -Wmissing-prototypes -Wstrict-prototypes \
            -Wno-overlength-strings
@@ -113,9 +116,15 @@ test: check-deps $(BUILD)/conifit $(TESTS) $(REPLAYS)
 	@sh tests/check_layers.sh
 	@$(foreach f,$(FUZZERS),CONIFIT_FUZZ_QUIET=1 $(BUILD)/fuzz-replay/$(f) $(FUZZ_SEEDS_$(f)) \
 	  tests/fuzz/regressions/$(f) || { echo "conifit: fuzz replay $(f) FAILED" >&2; exit 1; };)
-	@fail=0; for t in $(TESTS); do \
-	  CONIFIT=$(BUILD)/conifit $$t || fail=1; done; \
-	if [ $$fail = 0 ]; then echo "conifit: all test programs passed"; else echo "conifit: TEST FAILURES" >&2; exit 1; fi
+	@levels="$(SIMD)"; if [ -z "$$levels" ]; then \
+	  case $$(CONIFIT_SIMD= $(BUILD)/conifit --version) in \
+	    *"processor: avx512"*) levels="avx512 avx2 sse2" ;; \
+	    *"processor: avx2"*) levels="avx2 sse2" ;; \
+	    *) levels=sse2 ;; esac; fi; \
+	fail=0; for l in $$levels; do \
+	  echo "conifit: test programs with the $$l copies of the vector code"; \
+	  for t in $(TESTS); do CONIFIT_SIMD=$$l CONIFIT=$(BUILD)/conifit $$t || fail=1; done; done; \
+	if [ $$fail = 0 ]; then echo "conifit: all test programs passed ($$levels)"; else echo "conifit: TEST FAILURES" >&2; exit 1; fi
 
 figures: check-deps $(BUILD)/conifit
 	@mkdir -p fits/figures

@@ -625,7 +625,11 @@ static cf_visco_params shipped_truth(void)
 static void test_shipped_synthetic_series(void **state)
 {
     (void)state;
-    /* the documented command writes the shipped file, byte for byte */
+    /* The documented command writes the shipped file: the same text and noise, and the same
+    ** numbers up to rounding, which depends on the processor (the vector copy in use and the C
+    ** library's own per-processor math functions): an AVX2-only processor gave numbers up to
+    ** 1.6e-15 relative apart. 1e-12 relative leaves room for that and is still ten billion times
+    ** finer than the 1 % noise, so any change to the series fails. */
     char dir[] = "/tmp/conifit-visco-XXXXXX", out[256], so[4096], se[4096];
     assert_non_null(mkdtemp(dir));
     snprintf(out, sizeof out, "%s/s.csv", dir);
@@ -634,9 +638,7 @@ static void test_shipped_synthetic_series(void **state)
                             "--seed 1 -o %s",
                             out),
                      0);
-    char cmd[600];
-    snprintf(cmd, sizeof cmd, "cmp -s %s data/series/synthetic_relaxation_noise1pct.csv", out);
-    assert_int_equal(system(cmd), 0);
+    assert_text_close(out, "data/series/synthetic_relaxation_noise1pct.csv", 1e-12);
     unlink(out);
     rmdir(dir);
     cf_visco_params p = shipped_truth();

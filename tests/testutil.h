@@ -73,6 +73,55 @@ static inline int tu_run(char *out, size_t out_cap, char *errbuf, size_t err_cap
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+/* Fails unless the text files a and b hold the same lines with the same words, where a word that
+** reads as a number (strtod, whole word) need only agree with its counterpart to rel relatively
+** (|x - y| <= rel * max(|x|, |y|)). For outputs whose numbers pass through the vector copies of the
+** law or the lattice (conifit/law.h, cf_simd_level), which round differently from one another. */
+#define assert_text_close(a, b, rel) tu_assert_text_close((a), (b), (rel), __FILE__, __LINE__)
+static inline void tu_assert_text_close(const char *a, const char *b, double rel, const char *file,
+                                        int line)
+{
+    FILE *fa = fopen(a, "r"), *fb = fopen(b, "r");
+    if (!fa || !fb) {
+        print_error("cannot open %s or %s\n", a, b);
+        _fail(file, line);
+    }
+    char la[4096], lb[4096];
+    int lineno = 0, bad = 0;
+    for (;;) {
+        char *ra = fgets(la, sizeof la, fa), *rb = fgets(lb, sizeof lb, fb);
+        lineno++;
+        if (!ra || !rb) {
+            bad = ra != rb; /* one file ends before the other */
+            break;
+        }
+        const char *pa = la, *pb = lb;
+        while (!bad && (*pa || *pb)) {
+            char *ea, *eb;
+            double x = strtod(pa, &ea), y = strtod(pb, &eb);
+            if (ea != pa && eb != pb) { /* numbers on both sides */
+                const double m = fabs(x) > fabs(y) ? fabs(x) : fabs(y);
+                bad = !(fabs(x - y) <= rel * m);
+                pa = ea;
+                pb = eb;
+            } else {
+                bad = *pa != *pb;
+                pa += *pa != 0;
+                pb += *pb != 0;
+            }
+        }
+        if (bad)
+            break;
+    }
+    fclose(fa);
+    fclose(fb);
+    if (bad) {
+        print_error("%s and %s differ at line %d beyond %.3g relative:\n  %s  %s", a, b, lineno,
+                    rel, la, lb);
+        _fail(file, line);
+    }
+}
+
 /* The twelve published tables of ../shared/datasets, by file name. */
 static const char *const tu_published_tables[] = {
     "brain_coronaradiata_compression.csv", "brain_coronaradiata_tension.csv",

@@ -6,12 +6,14 @@
 #include <locale.h>
 #include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <gsl/gsl_errno.h>
 
 #include "base/atomic.h"
 #include "cli/cli.h"
+#include "conifit/law.h"
 
 typedef struct command {
     const char *name;
@@ -78,8 +80,14 @@ static int run(int argc, char **argv)
         usage(stdout);
         return CF_EXIT_OK;
     }
+    const char *simd = getenv("CONIFIT_SIMD");
+    if (simd && *simd && cf_simd_parse(simd) < 0) {
+        fprintf(stderr, "conifit: environment variable CONIFIT_SIMD is not sse2, avx2 or avx512\n");
+        return CF_EXIT_USAGE;
+    }
     if (strcmp(argv[1], "--version") == 0) {
-        printf("conifit %s\n", CF_VERSION);
+        printf("conifit %s\nvector instructions: %s (processor: %s)\n", CF_VERSION,
+               cf_simd_name(cf_simd_level()), cf_simd_name(cf_simd_level_supported()));
         return CF_EXIT_OK;
     }
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)

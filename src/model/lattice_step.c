@@ -177,9 +177,9 @@ layer_springs(const cf_lattice_stepper *st, int form, size_t k)
 }
 
 /* The slabs of one parity with the law's form fixed at compile time, one copy per form and
-** instruction set. */
-#define CF_SLABS(name, form_)                                                                      \
-    static double name(const cf_lattice_stepper *st, size_t parity)                                \
+** instruction set (law_simd.h). */
+#define CF_SLABS(attr, sfx, name, form_)                                                           \
+    attr static double name##sfx(const cf_lattice_stepper *st, size_t parity)                      \
     {                                                                                              \
         double umax = 0;                                                                           \
         _Pragma("omp parallel for schedule(static) reduction(max : umax) if (st->threads)")       \
@@ -189,41 +189,48 @@ layer_springs(const cf_lattice_stepper *st, int form, size_t k)
         }                                                                                          \
         return umax;                                                                               \
     }
-CF_DISPATCH CF_SLABS(slabs_closed, CF_LANE_CLOSED)
-CF_DISPATCH CF_SLABS(slabs_table, CF_LANE_TABLE)
-CF_DISPATCH CF_SLABS(slabs_poly, CF_LANE_POLY)
-CF_SLABS(slabs_scalar, -1)
+CF_SIMD_COPIES(CF_SLABS, slabs_closed, CF_LANE_CLOSED)
+CF_SIMD_COPIES(CF_SLABS, slabs_table, CF_LANE_TABLE)
+CF_SIMD_COPIES(CF_SLABS, slabs_poly, CF_LANE_POLY)
+CF_SLABS(, , slabs_scalar, -1)
 
 double cf_lattice_stepper_forces(cf_lattice_stepper *st)
 {
     double umax = 0;
     for (size_t parity = 0; parity < 2; parity++) { /* even slabs, then odd: no shared node */
-        double um = st->form == CF_LANE_POLY     ? slabs_poly(st, parity)
-                    : st->form == CF_LANE_CLOSED ? slabs_closed(st, parity)
-                    : st->form == CF_LANE_TABLE  ? slabs_table(st, parity)
+        double um = st->form == CF_LANE_POLY     ? CF_SIMD_CALL(slabs_poly, (st, parity))
+                    : st->form == CF_LANE_CLOSED ? CF_SIMD_CALL(slabs_closed, (st, parity))
+                    : st->form == CF_LANE_TABLE  ? CF_SIMD_CALL(slabs_table, (st, parity))
                                                  : slabs_scalar(st, parity);
         umax = um > umax ? um : umax;
     }
     return umax / st->lat->travel_mm;
 }
 
-CF_DISPATCH
+#define STEPPER_ADVANCE(attr, sfx, unused)                                                         \
+    attr static void advance##sfx(cf_lattice_stepper *st, double h, double *vx, double *vy,         \
+                                  double *vz)                                                      \
+    {                                                                                              \
+        cf_lattice *lat = st->lat;                                                                 \
+        double *const xs[3] = {lat->x, lat->y, lat->z};                                            \
+        double *const fs[3] = {lat->fx, lat->fy, lat->fz};                                         \
+        double *const vs[3] = {vx, vy, vz};                                                        \
+        const long nn = (long)lat->nn;                                                             \
+        for (int a = 0; a < 3; a++) {                                                              \
+            double *restrict x = xs[a], *restrict f = fs[a], *restrict v = vs[a];                  \
+            const double *restrict im = st->inv_mass[a];                                           \
+            _Pragma("omp parallel for simd schedule(static) if (st->threads)")                    \
+            for (long p = 0; p < nn; p++) {                                                        \
+                v[p] += h * f[p] * im[p];                                                          \
+                x[p] += h * v[p];                                                                  \
+                f[p] = 0.0;                                                                        \
+            }                                                                                      \
+        }                                                                                          \
+    }
+CF_SIMD_COPIES(STEPPER_ADVANCE, 0)
+
 void cf_lattice_stepper_advance(cf_lattice_stepper *st, double h, double *vx, double *vy,
                                 double *vz)
 {
-    cf_lattice *lat = st->lat;
-    double *const xs[3] = {lat->x, lat->y, lat->z};
-    double *const fs[3] = {lat->fx, lat->fy, lat->fz};
-    double *const vs[3] = {vx, vy, vz};
-    const long nn = (long)lat->nn;
-    for (int a = 0; a < 3; a++) {
-        double *restrict x = xs[a], *restrict f = fs[a], *restrict v = vs[a];
-        const double *restrict im = st->inv_mass[a];
-#pragma omp parallel for simd schedule(static) if (st->threads)
-        for (long p = 0; p < nn; p++) {
-            v[p] += h * f[p] * im[p];
-            x[p] += h * v[p];
-            f[p] = 0.0;
-        }
-    }
+    CF_SIMD_CALL(advance, (st, h, vx, vy, vz));
 }

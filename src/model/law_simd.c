@@ -4,15 +4,66 @@
 */
 #include "model/law_simd.h"
 
-CF_DISPATCH
+#include <stdatomic.h>
+#include <stdlib.h>
+
+static const char *const simd_names[] = {"sse2", "avx2", "avx512"};
+
+int cf_simd_parse(const char *name)
+{
+    for (int i = 0; name && i < (int)(sizeof simd_names / sizeof simd_names[0]); i++)
+        if (strcmp(name, simd_names[i]) == 0)
+            return i;
+    return -1;
+}
+
+const char *cf_simd_name(cf_simd level)
+{
+    return level >= CF_SIMD_SSE2 && level <= CF_SIMD_AVX512 ? simd_names[level] : "unknown";
+}
+
+cf_simd cf_simd_level_supported(void)
+{
+#if CF_SIMD_MULTI
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("x86-64-v4"))
+        return CF_SIMD_AVX512;
+    if (__builtin_cpu_supports("x86-64-v3"))
+        return CF_SIMD_AVX2;
+#endif
+    return CF_SIMD_SSE2;
+}
+
+cf_simd cf_simd_level(void)
+{
+    static atomic_int cached = -1; /* each thread that finds it unset computes the same value */
+    int level = atomic_load_explicit(&cached, memory_order_relaxed);
+    if (level < 0) {
+        level = (int)cf_simd_level_supported();
+        const int limit = cf_simd_parse(getenv("CONIFIT_SIMD"));
+        if (limit >= 0 && limit < level)
+            level = limit;
+        atomic_store_explicit(&cached, level, memory_order_relaxed);
+    }
+    return (cf_simd)level;
+}
+
+#define LAW_FORCE_LANES(attr, sfx, unused)                                                         \
+    attr static void force_lanes##sfx(const cf_law_lanes *lanes, int form, size_t count,            \
+                                      const double *u, double *F)                                  \
+    {                                                                                              \
+        const cf_law_lanes c = *lanes; /* by value: its loads leave the loop */                    \
+        if (form == CF_LANE_TABLE && c.coef)                                                       \
+            cf_lanes_table(&c, count, u, F);                                                       \
+        else if (form == CF_LANE_POLY && c.poly_fit)                                               \
+            cf_lanes_poly(&c, count, u, F);                                                        \
+        else                                                                                       \
+            cf_lanes_closed(&c, count, u, F);                                                      \
+    }
+CF_SIMD_COPIES(LAW_FORCE_LANES, 0)
+
 void cf_law_force_lanes(const cf_law_lanes *lanes, int form, size_t count, const double *u,
                         double *F)
 {
-    const cf_law_lanes c = *lanes; /* by value: its loads leave the loop */
-    if (form == CF_LANE_TABLE && c.coef)
-        cf_lanes_table(&c, count, u, F);
-    else if (form == CF_LANE_POLY && c.poly_fit)
-        cf_lanes_poly(&c, count, u, F);
-    else
-        cf_lanes_closed(&c, count, u, F);
+    CF_SIMD_CALL(force_lanes, (lanes, form, count, u, F));
 }

@@ -34,8 +34,8 @@
 ** Vectorisation: every loop over lanes must if-convert, so no lane's work may sit behind a
 ** condition the compiler keeps as a branch (a table lookup inside the region selection, a clamp it
 ** specialises): the table's lookup is a loop of its own, and the build passes -fno-trapping-math
-** so that both sides of a selection may be computed. Each clone (baseline SSE2, AVX2, AVX-512)
-** vectorises; they compute the same operations, so they give the same bits.
+** so that both sides of a selection may be computed. Each copy (baseline SSE2, AVX2, AVX-512)
+** vectorises, at its own width.
 **
 ** Private to the model layer.
 */
@@ -55,15 +55,30 @@
 #define CF_LANE static inline
 #endif
 
-/* Runtime dispatch: each function so marked is compiled for baseline x86-64, x86-64-v3 (AVX2,
-** FMA) and x86-64-v4 (AVX-512), and the loader picks the widest the processor has. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__has_attribute)
-#if __has_attribute(target_clones) && !defined(__SANITIZE_ADDRESS__)
-#define CF_DISPATCH __attribute__((target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")))
-#endif
-#endif
-#ifndef CF_DISPATCH
-#define CF_DISPATCH
+/* Run-time dispatch. A function is written once as a macro DEF(attr, sfx, ...) that defines
+** `attr static ... name##sfx(...)`; CF_SIMD_COPIES(DEF, ...) expands it for baseline x86-64 (SSE2,
+** suffix _v1), x86-64-v3 (AVX2, FMA; _v3) and x86-64-v4 (AVX-512; _v4), and CF_SIMD_CALL(name, args)
+** calls the widest copy that the processor has and that the environment variable CONIFIT_SIMD
+** allows (cf_simd_level, conifit/law.h): so the tests run every copy on a machine that has it, not
+** only the widest. A copy is a whole function, its OpenMP regions included, so the threads of a
+** parallel loop run the same instruction set as the copy. Elsewhere (clang, other processors, the
+** sanitizer build) one baseline copy. The copies evaluate the same expressions, but their widths
+** differ, and so may the vector libraries they call and the order of a reduction: they agree to a
+** few ulps, not bit for bit. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
+#define CF_SIMD_MULTI 1
+#define CF_SIMD_COPIES(DEF, ...)                                                                   \
+    DEF(, _v1, __VA_ARGS__)                                                                        \
+    DEF(__attribute__((target("arch=x86-64-v3"))), _v3, __VA_ARGS__)                               \
+    DEF(__attribute__((target("arch=x86-64-v4"))), _v4, __VA_ARGS__)
+#define CF_SIMD_CALL(name, args)                                                                   \
+    (cf_simd_level() >= CF_SIMD_AVX512 ? name##_v4 args                                            \
+     : cf_simd_level() >= CF_SIMD_AVX2 ? name##_v3 args                                            \
+                                       : name##_v1 args)
+#else
+#define CF_SIMD_MULTI 0
+#define CF_SIMD_COPIES(DEF, ...) DEF(, _v1, __VA_ARGS__)
+#define CF_SIMD_CALL(name, args) (name##_v1 args)
 #endif
 
 #define CF_POLY_DEGREE 12    /* the largest degree */
