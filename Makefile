@@ -53,12 +53,13 @@ endif
 
 # Sources by layer (README, "Architecture"): src/LAYER/*.c. The library is every layer but cli/;
 # public headers live in src/include/conifit/, private ones beside their sources.
-HDRS    := $(wildcard src/include/conifit/*.h src/*/*.h)
 CLI_SRC := $(wildcard src/cli/*.c)
 LIB_SRC := $(filter-out $(CLI_SRC),$(wildcard src/*/*.c))
 LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 CLI_OBJ := $(CLI_SRC:src/%.c=$(BUILD)/obj/%.o)
-TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
+# Tests by what they test: unit/ one module each, cli/ the command's behaviour, props/ properties
+# across modules (fuzz/ and bench/ have their own targets).
+TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/*/test_*.c))
 
 .PHONY: all deps example test sanitize fuzz bench bench-update clean check-deps figures fits
 
@@ -97,20 +98,22 @@ fits: check-deps $(BUILD)/conifit
 	  $(BUILD)/conifit fit ../shared/datasets/muscle_compression_relaxation_*.csv -o fits/series/ --plot fits/series/ -j 2; \
 	else echo "conifit: ../shared/datasets absent: the muscle relaxation fits are not refreshed"; fi
 
-$(BUILD)/obj/%.o: src/%.c $(HDRS)
+$(BUILD)/obj/%.o: src/%.c
 	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+	$(CC) $(CPPFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
 
 $(BUILD)/conifit: $(LIB_OBJ) $(CLI_OBJ)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS)
 
 # Each test links the library (and may see internals through -Isrc); the CLI tests run the binary.
-$(BUILD)/tests/%: tests/%.c tests/testutil.h $(LIB_OBJ) | $(BUILD)/tests
-	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) $(shell pkg-config --cflags $(TESTPKGS) 2>/dev/null) $< $(LIB_OBJ) -o $@ \
+$(BUILD)/tests/%: tests/%.c $(LIB_OBJ)
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -MMD -MP -MF $@.d $(shell pkg-config --cflags $(TESTPKGS) 2>/dev/null) $< $(LIB_OBJ) -o $@ \
 	  $(LDFLAGS) $(LDLIBS) $(shell pkg-config --libs $(TESTPKGS) 2>/dev/null)
 
-$(BUILD)/obj $(BUILD)/tests:
-	mkdir -p $@
+# Header dependencies, as the compiler found them (-MMD -MP): a header edit rebuilds its dependants.
+-include $(wildcard $(BUILD)/obj/*/*.d $(BUILD)/tests/*/*.d build/fuzz/obj/*/*.d \
+                    build/bench/obj/*/*.d)
 
 test: check-deps $(BUILD)/conifit $(TESTS) $(REPLAYS)
 	@sh tests/check_layers.sh
@@ -162,9 +165,9 @@ $(BUILD)/fuzz-replay/%: tests/fuzz/replay.c tests/fuzz/fuzz_%.c tests/fuzz/fuzz.
 	  $(BUILD)/obj/cli/cli.o -o $@ $(LDFLAGS) $(LDLIBS)
 
 .SECONDARY: $(FUZZ_OBJ)
-build/fuzz/obj/%.o: src/%.c $(HDRS)
+build/fuzz/obj/%.o: src/%.c
 	@mkdir -p $(dir $@)
-	$(FUZZ_CC) $(CPPFLAGS) $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link -c $< -o $@
+	$(FUZZ_CC) $(CPPFLAGS) $(FUZZ_CFLAGS) -MMD -MP -fsanitize=fuzzer-no-link -c $< -o $@
 
 build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz.h $(FUZZ_OBJ)
 	$(FUZZ_CC) $(CPPFLAGS) $(FUZZ_CFLAGS) -fsanitize=fuzzer $< $(FUZZ_OBJ) -o $@ $(FUZZ_LIBS)
@@ -195,9 +198,9 @@ clean:
 # build/bench/report/REPORT.md and its plots (progress on a terminal). BENCH_ARGS=--quick for a
 # short smoke run. The committed report in tests/bench/ changes only through make bench-update.
 BENCH_OBJ := $(LIB_SRC:src/%.c=build/bench/obj/%.o)
-build/bench/obj/%.o: src/%.c $(HDRS)
+build/bench/obj/%.o: src/%.c
 	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+	$(CC) $(CPPFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
 build/bench/conifit-bench: $(wildcard tests/bench/*.c) tests/bench/bench.h $(BENCH_OBJ)
 	$(CC) $(CPPFLAGS) -Itests/bench $(CFLAGS) $(wildcard tests/bench/*.c) $(BENCH_OBJ) -o $@ $(LDFLAGS) $(LDLIBS)
 BENCH_OUT := build/bench/report

@@ -21,7 +21,7 @@
 #include "conifit/jointreport.h"
 #include "conifit/pipeline.h"
 #include "conifit/pipeline_series.h"
-#include "out/plot.h"
+#include "report/plot.h"
 
 static const char fit_help[] =
     "usage: conifit fit TABLE... [-o OUT.json | -o DIR/ | -o -] [options]\n"

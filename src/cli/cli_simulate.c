@@ -16,7 +16,7 @@
 #include "conifit/hysteresis.h"
 #include "conifit/msm.h"
 #include "conifit/scene.h"
-#include "out/plot.h"
+#include "report/plot.h"
 
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>

@@ -1,7 +1,7 @@
 /*
 ** The one writer of conifit's spring JSON (private to the library): the fit file of
-** `conifit fit -o` (out/report.c) and the single exported spring of `conifit export --format json`
-** (out/export.c) both build their spring objects and write their documents here, so that
+** `conifit fit -o` (report/report.c) and the single exported spring of `conifit export --format json`
+** (report/export.c) both build their spring objects and write their documents here, so that
 ** cf_fitfile_load (fitfile.h) reads back exactly what was written.
 */
 #ifndef CF_IO_FITFILE_JSON_H

@@ -12,7 +12,7 @@
 ** Ferrari's root of y^4 - 4 c y + 3 = 0 (law.c, region2_closed) with its divisions gathered into
 ** one. All terms are positive, so y carries a relative error of a few ulps; t - 1 is formed by a
 ** plain subtraction, which near solid loses relative digits of mu but only absolute ones of y
-** (measured against the long-double reference of tests/test_law.c: 2.4e-15 of |F| at worst over
+** (measured against the long-double reference of tests/unit/test_law.c: 2.4e-15 of |F| at worst over
 ** every hard case). Costs one division per lane; its three square roots are x times 1/sqrt(x)
 ** from cf_lane_rsqrt (multiplies and adds, no square-root instruction).
 ** Table: the cubic Hermite table of law.c, stored per interval as the coefficients of its

@@ -11,7 +11,7 @@
 #include "conifit/scene.h"
 #include "conifit/version.h"
 #include "base/atomic.h"
-#include "out/plot.h"
+#include "report/plot.h"
 #include "pipeline/outputs.h"
 
 cf_pipeline_options cf_pipeline_default_options(void)

@@ -1,5 +1,5 @@
 /*
-** An allocation-failure injector for tests/test_alloc_failure.c, loaded with LD_PRELOAD into the
+** An allocation-failure injector for tests/props/test_alloc_failure.c, loaded with LD_PRELOAD into the
 ** conifit program: it counts the allocations made from inside GSL and NLopt (the caller's code
 ** lies in libgsl* or libnlopt*) and makes the one numbered CF_FAIL_ALLOC_AT fail (malloc, calloc
 ** and realloc return NULL), as a full memory would. With CF_FAIL_ALLOC_REPORT=FILE it writes the

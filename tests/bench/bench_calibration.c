@@ -165,5 +165,5 @@ void bench_section_calibration(bench_ctx *ctx)
     }
     fprintf(ctx->md, "\n");
     bench_target_add(ctx, "homogenised cell = full lattice (1e-9)", 1,
-                     "tests/test_cell.c, four sizes, three calibrations");
+                     "tests/unit/test_cell.c, four sizes, three calibrations");
 }

@@ -3,7 +3,7 @@
 ** other simulators: the law as a force-displacement table, written in each target's own
 ** conventions and units, either as a block to paste into a model or as a model that runs as it is.
 **
-** The table (src/out/export_table.c). Rows run over a range of compressions u (mm), by default
+** The table (src/report/export_table.c). Rows run over a range of compressions u (mm), by default
 ** from full stretch to just before solid, with rows always at 0, +-u_T and the two ends. The
 ** tolerance is a fraction of the solid load: everywhere in the range
 **     |F_table(u) - F(u)| <= tol * F_C.
@@ -42,7 +42,7 @@
 ** curve. Exports for CalculiX (and Abaqus, so that the same file runs in both) keep to 200. */
 #define CF_EXPORT_CALCULIX_MAX_ROWS 200
 
-/* The export formats. What each is and what writes it is held in one registry (src/out/export.c):
+/* The export formats. What each is and what writes it is held in one registry (src/report/export.c):
 ** a new format is a value here and an entry there; the command line builds its help, its
 ** --format check and its messages from the registry. */
 typedef enum cf_export_format {

@@ -51,7 +51,7 @@ enum {
 
 /* Default number of table intervals. Measured maximum force error of the table against exact at
 ** this size: 1.5e-12 of |F| at rho = 0.5, 2.3e-10 at rho = 0.1, 3e-9 at rho = 0.03, and 6.5e-7 of
-** F_C at rho = 1e-3; the error falls as the fourth power of the size (tests/test_law.c checks
+** F_C at rho = 1e-3; the error falls as the fourth power of the size (tests/unit/test_law.c checks
 ** the bound, the benchmark reports the whole curve). */
 #define CF_LAW_TABLE_DEFAULT 256
 

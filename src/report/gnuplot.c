@@ -1,7 +1,7 @@
 /*
 ** Building gnuplot scripts under one rule and running gnuplot (see gnuplot.h).
 */
-#include "out/gnuplot.h"
+#include "report/gnuplot.h"
 
 #include <ctype.h>
 #include <errno.h>

@@ -2,7 +2,7 @@
 ** No null, NaN or Inf in any JSON or text conifit writes: a value that is not determined (a
 ** standard error of a quantity the data leave open, a correlation, an interval not computed, the
 ** better type of a tie, a stability limit never reached) is left out with a reason beside it, and
-** a document that would hold a non-finite number is refused (tests/test_report.c). This test scans
+** a document that would hold a non-finite number is refused (tests/unit/test_report.c). This test scans
 ** the committed fit files (every .json in fits/) and what the commands that write JSON or a report
 ** write on the shipped tables: fit (with --validate, --target lattice, --joint, a time series,
 ** -o -), export --format json, and their text on standard output and standard error.

@@ -13,7 +13,7 @@
 #include "base/atomic.h"
 #include "conifit/version.h"
 #include "io/fitfile_json.h"
-#include "out/gnuplot.h"
+#include "report/gnuplot.h"
 
 int cf_joint_better(const cf_joint_report *r)
 {

@@ -1,14 +1,14 @@
 /*
 ** conifit's figures (see plot.h), written as gnuplot scripts under the rule of gnuplot.h.
 */
-#include "out/plot.h"
+#include "report/plot.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "out/gnuplot.h"
+#include "report/gnuplot.h"
 
 /* Points on each model curve. */
 #define CURVE_POINTS 400

@@ -12,7 +12,7 @@
 
 #include "base/atomic.h"
 #include "io/fitfile_json.h"
-#include "out/gnuplot.h"
+#include "report/gnuplot.h"
 
 #define num cf_json_number
 

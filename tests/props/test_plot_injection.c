@@ -11,7 +11,7 @@
 
 #include "testutil.h"
 
-#include "out/gnuplot.h"
+#include "report/gnuplot.h"
 
 static char scratch[] = "/tmp/conifit-inject-XXXXXX";
 static char conifit_abs[PATH_MAX], table_abs[PATH_MAX], series_abs[PATH_MAX];

@@ -15,7 +15,7 @@
 #include "conifit/lattice.h"
 #include "conifit/version.h"
 #include "io/fitfile_json.h"
-#include "out/export_model.h"
+#include "report/export_model.h"
 
 cf_export_options cf_export_default_options(void)
 {

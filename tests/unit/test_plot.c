@@ -1,5 +1,5 @@
 /*
-** The figures (out/plot.c): PNG, SVG and PDF are written (recognised by their first bytes); the
+** The figures (report/plot.c): PNG, SVG and PDF are written (recognised by their first bytes); the
 ** SVG, which is text, shows what the figure holds: the title (the table's name, or the one asked
 ** for), one curve for two types that tie, the legends of both panels, the lattice residual, and
 ** the simulation figures' legend. Skipped cleanly when gnuplot is not installed.
@@ -11,7 +11,7 @@
 #include "conifit/msm.h"
 #include "conifit/pipeline.h"
 #include "conifit/scene.h"
-#include "out/plot.h"
+#include "report/plot.h"
 
 static char dir[] = "/tmp/conifit-plot-XXXXXX";
 
