@@ -10,6 +10,7 @@
 #include "model/sparse_chol.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,6 +18,20 @@
 #include <dmumps_c.h>
 
 #define MUMPS_USE_COMM_WORLD (-987654) /* the sequential library's stand-in communicator */
+
+/* MUMPS keeps state of its own between the calls of one job in Fortran module variables (its load
+** balancing, DMUMPS_LOAD), shared by every instance in the process: two tables fitted on two
+** threads (`conifit fit -j 2 --validate`) crashed inside dmumps_load_update about one run in three.
+** Every call into MUMPS therefore holds one process-wide lock; CHOLMOD keeps its state in its
+** cholmod_common and runs unlocked. */
+static pthread_mutex_t mumps_lock = PTHREAD_MUTEX_INITIALIZER;
+
+static void mumps_call(DMUMPS_STRUC_C *mu)
+{
+    pthread_mutex_lock(&mumps_lock);
+    dmumps_c(mu);
+    pthread_mutex_unlock(&mumps_lock);
+}
 
 struct cf_sparse_chol {
     cholmod_common cm;
@@ -113,7 +128,7 @@ static cf_status mumps_setup(cf_sparse_chol *ch, const double *values, cf_error 
     mu->par = 1;
     mu->sym = 2; /* general symmetric: pivots may be negative or 2x2 */
     mu->comm_fortran = MUMPS_USE_COMM_WORLD;
-    dmumps_c(mu);
+    mumps_call(mu);
     if (mu->info[0] < 0)
         return cf_error_set(err, CF_E_INTERNAL, "MUMPS could not start (INFO(1) = %d)",
                             (int)mu->info[0]);
@@ -133,7 +148,7 @@ static cf_status mumps_setup(cf_sparse_chol *ch, const double *values, cf_error 
     mu->jcn = ch->jcn;
     mu->a = ch->mval;
     mu->job = 1;
-    dmumps_c(mu);
+    mumps_call(mu);
     if (mu->info[0] < 0) {
         ch->mumps_failed = 1;
         return cf_error_set(err, mu->info[0] == -7 ? CF_E_INTERNAL : CF_E_NOCONV,
@@ -158,7 +173,7 @@ static cf_status mumps_factor(cf_sparse_chol *ch, const double *values, cf_chol_
     DMUMPS_STRUC_C *mu = &ch->mu;
     for (int attempt = 0; attempt < 4; attempt++) {
         mu->job = 2;
-        dmumps_c(mu);
+        mumps_call(mu);
         if (mu->info[0] != -8 && mu->info[0] != -9)
             break;
         mu->icntl[13] = mu->icntl[13] > 0 ? 2 * mu->icntl[13] : 40; /* more workspace, % */
@@ -229,7 +244,7 @@ cf_status cf_sparse_chol_solve(cf_sparse_chol *ch, const double *b, double *x, c
         ch->mu.nrhs = 1;
         ch->mu.lrhs = (MUMPS_INT)ch->n;
         ch->mu.job = 3;
-        dmumps_c(&ch->mu);
+        mumps_call(&ch->mu);
         if (ch->mu.info[0] < 0)
             return cf_error_set(err, CF_E_INTERNAL, "the indefinite solve failed (MUMPS INFO(1) "
                                 "= %d)", (int)ch->mu.info[0]);
@@ -272,7 +287,7 @@ void cf_sparse_chol_free(cf_sparse_chol *ch)
     cholmod_finish(&ch->cm);
     if (ch->mumps_on) {
         ch->mu.job = -2;
-        dmumps_c(&ch->mu);
+        mumps_call(&ch->mu);
     }
     free(ch->irn);
     free(ch->jcn);

@@ -1,9 +1,12 @@
 /*
 ** Tests of the sparse factorisation with inertia (src/model/sparse_chol.c): the negative pivots of
 ** shifted Laplacians against their known eigenvalues (a small one, factored simplicially, and a
-** 3-D one large enough for supernodes), the solution against the matrix, and a singular matrix.
+** 3-D one large enough for supernodes), the solution against the matrix, a singular matrix, and
+** indefinite matrices factored on several threads at once.
 */
 #include "testutil.h"
+
+#include <pthread.h>
 
 #include "model/sparse_chol.h"
 
@@ -177,12 +180,61 @@ static void zero_pivot_is_reported_as_singular(void **state)
     cf_sparse_chol_free(ch);
 }
 
+/* Indefinite factorisations on several threads at once, as fits of several tables do: MUMPS keeps
+** module state shared by its instances, which crashed such runs before every call took a lock.
+** Checked inside the threads without cmocka (its failures jump), counted for the main thread. */
+enum { CONCURRENT_THREADS = 4, CONCURRENT_ROUNDS = 25 };
+
+static void *factor_repeatedly(void *arg)
+{
+    const csc *a = arg;
+    const long expect = count_below(10, 10, 10, 2.05);
+    long bad = 0;
+    double *b = malloc(a->n * sizeof(double)), *x = malloc(a->n * sizeof(double));
+    for (size_t e = 0; b && e < a->n; e++)
+        b[e] = cos(0.11 * (double)e);
+    for (int r = 0; r < CONCURRENT_ROUNDS; r++) {
+        cf_sparse_chol *ch = NULL;
+        cf_error err = {0};
+        cf_chol_info info;
+        if (!b || !x || cf_sparse_chol_create(&ch, a->n, a->p, a->i, &err) != CF_OK) {
+            bad++;
+            break;
+        }
+        bad += cf_sparse_chol_factor(ch, a->x, &info, &err) != CF_OK ||
+               info.neg_pivots != expect || !info.ldlt ||
+               cf_sparse_chol_solve(ch, b, x, &err) != CF_OK || !(residual(a, x, b) < 1e-9);
+        cf_sparse_chol_free(ch);
+    }
+    free(b);
+    free(x);
+    return (void *)(intptr_t)bad;
+}
+
+static void indefinite_factorisations_on_several_threads(void **state)
+{
+    (void)state;
+    csc a = laplacian(10, 10, 10, 2.05); /* read only: shared by the threads */
+    pthread_t th[CONCURRENT_THREADS];
+    for (int t = 0; t < CONCURRENT_THREADS; t++)
+        assert_int_equal(pthread_create(&th[t], NULL, factor_repeatedly, &a), 0);
+    long bad = 0;
+    for (int t = 0; t < CONCURRENT_THREADS; t++) {
+        void *ret;
+        assert_int_equal(pthread_join(th[t], &ret), 0);
+        bad += (long)(intptr_t)ret;
+    }
+    assert_int_equal(bad, 0);
+    csc_free(&a);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(positive_definite_matrix_has_no_negative_pivots),
         cmocka_unit_test(shifted_laplacian_counts_its_eigenvalues_below_the_shift),
         cmocka_unit_test(zero_pivot_is_reported_as_singular),
+        cmocka_unit_test(indefinite_factorisations_on_several_threads),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
