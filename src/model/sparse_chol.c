@@ -19,18 +19,21 @@
 
 #define MUMPS_USE_COMM_WORLD (-987654) /* the sequential library's stand-in communicator */
 
-/* MUMPS keeps state of its own between the calls of one job in Fortran module variables (its load
-** balancing, DMUMPS_LOAD), shared by every instance in the process: two tables fitted on two
-** threads (`conifit fit -j 2 --validate`) crashed inside dmumps_load_update about one run in three.
-** Every call into MUMPS therefore holds one process-wide lock; CHOLMOD keeps its state in its
-** cholmod_common and runs unlocked. */
-static pthread_mutex_t mumps_lock = PTHREAD_MUTEX_INITIALIZER;
+/* Neither library may run on two threads at once in one process. MUMPS keeps state of its own
+** between the calls of one job in Fortran module variables (its load balancing, DMUMPS_LOAD) shared
+** by every instance: two tables fitted on two threads (`conifit fit -j 2 --validate`) crashed
+** inside dmumps_load_update about one run in three. CHOLMOD's supernodal factorisation goes
+** through the BLAS, and with it unlocked the same batch gave validation errors that changed in
+** their last digits from run to run (seven tables, three runs, three different results; with the
+** lock, the same bits every time, as with one thread). So every call into either holds one
+** process-wide lock: threads still fit in parallel, their factorisations take turns. */
+static pthread_mutex_t sparse_lock = PTHREAD_MUTEX_INITIALIZER;
 
 static void mumps_call(DMUMPS_STRUC_C *mu)
 {
-    pthread_mutex_lock(&mumps_lock);
+    pthread_mutex_lock(&sparse_lock);
     dmumps_c(mu);
-    pthread_mutex_unlock(&mumps_lock);
+    pthread_mutex_unlock(&sparse_lock);
 }
 
 struct cf_sparse_chol {
@@ -217,7 +220,9 @@ cf_status cf_sparse_chol_factor(cf_sparse_chol *ch, double *values, cf_chol_info
     ** L D L^T instead of an LL^T that would stop at its first negative pivot. */
     if (!ch->indefinite) {
         ch->A.x = values;
+        pthread_mutex_lock(&sparse_lock);
         cholmod_factorize(&ch->A, ch->LL, &ch->cm);
+        pthread_mutex_unlock(&sparse_lock);
         if (ch->cm.status == CHOLMOD_OUT_OF_MEMORY)
             return cf_error_set(err, CF_E_INTERNAL,
                                 "out of memory factoring the tangent (%zu unknowns)", ch->n);
@@ -262,7 +267,9 @@ cf_status cf_sparse_chol_solve(cf_sparse_chol *ch, const double *b, double *x, c
     B.x = (void *)b; /* read only: CHOLMOD does not write the right-hand side */
     B.xtype = CHOLMOD_REAL;
     B.dtype = CHOLMOD_DOUBLE;
+    pthread_mutex_lock(&sparse_lock);
     cholmod_dense *X = cholmod_solve(CHOLMOD_A, ch->LL, &B, &ch->cm);
+    pthread_mutex_unlock(&sparse_lock);
     if (!X)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory in the sparse solve (%zu unknowns)",
                             ch->n);
