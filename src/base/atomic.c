@@ -1,7 +1,7 @@
 /*
 ** Atomic output files (see atomic.h).
 */
-#define _GNU_SOURCE /* mkostemp, O_CLOEXEC */
+#define _GNU_SOURCE /* O_CLOEXEC, O_NOFOLLOW */
 #include "base/atomic.h"
 
 #include <dirent.h>
@@ -10,8 +10,10 @@
 #include <pthread.h>
 #include <signal.h>
 #include <stdatomic.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/random.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -89,6 +91,10 @@ static cf_status regular_or_absent(const char *path, cf_error *err)
                             "%s: is %s; conifit writes only regular files and will not replace "
                             "it",
                             path, kind_of(s.st_mode));
+    if ((s.st_mode & 0222) == 0)
+        return cf_error_set(err, CF_E_CANTWRITE,
+                            "%s: is write-protected (mode %04o); conifit will not replace it",
+                            path, (unsigned)(s.st_mode & 07777));
     return CF_OK;
 }
 
@@ -130,7 +136,50 @@ cf_status cf_atomic_check(const char *path, const char *const *inputs, cf_error 
     return CF_OK;
 }
 
-/* Is name ".ANYTHING.conifit-PID-XXXXXX"? Then *pid is its PID. */
+/* This machine's PID space, as 16 hex digits: a hash of the host name, the kernel's boot id and the
+** PID namespace (device and inode of /proc/self/ns/pid). Two runs with the same tag see the same
+** processes under the same PIDs, so one may judge whether the other is alive; a run in another
+** container or on another host sharing the folder has another tag. Computed once. */
+static char host_tag[17];
+static pthread_once_t host_tag_once = PTHREAD_ONCE_INIT;
+
+static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *b = data;
+    for (size_t i = 0; i < n; i++)
+        h = (h ^ b[i]) * 0x100000001b3ULL;
+    return h;
+}
+
+static void host_tag_init(void)
+{
+    uint64_t h = 0xcbf29ce484222325ULL;
+    char buf[256] = {0};
+    if (gethostname(buf, sizeof buf - 1) == 0)
+        h = fnv1a(h, buf, strlen(buf));
+    int fd = open("/proc/sys/kernel/random/boot_id", O_RDONLY | O_CLOEXEC);
+    if (fd >= 0) {
+        ssize_t n = read(fd, buf, sizeof buf);
+        if (n > 0)
+            h = fnv1a(h, buf, (size_t)n);
+        close(fd);
+    }
+    struct stat s;
+    if (stat("/proc/self/ns/pid", &s) == 0) {
+        h = fnv1a(h, &s.st_dev, sizeof s.st_dev);
+        h = fnv1a(h, &s.st_ino, sizeof s.st_ino);
+    }
+    snprintf(host_tag, sizeof host_tag, "%016llx", (unsigned long long)h);
+}
+
+static const char *tag_of_host(void)
+{
+    pthread_once(&host_tag_once, host_tag_init);
+    return host_tag;
+}
+
+/* Is name ".ANYTHING.conifit-TAG-PID-XXXXXX" with this machine's TAG? Then *pid is its PID.
+** Temporaries of other PID spaces (and of the older form without a tag) are never judged. */
 static int temporary_name(const char *name, long *pid)
 {
     if (name[0] != '.')
@@ -140,17 +189,22 @@ static int temporary_name(const char *name, long *pid)
         tag = p;
     if (!tag || tag == name)
         return 0;
+    const char *mine = tag_of_host();
+    const size_t tl = strlen(mine);
+    if (strncmp(tag + 9, mine, tl) != 0 || tag[9 + tl] != '-')
+        return 0;
+    const char *digits = tag + 9 + tl + 1;
     char *end;
     errno = 0;
-    long v = strtol(tag + 9, &end, 10);
-    if (errno || end == tag + 9 || v <= 0 || *end != '-' || strlen(end + 1) != 6)
+    long v = strtol(digits, &end, 10);
+    if (errno || end == digits || v <= 0 || *end != '-' || strlen(end + 1) != 6)
         return 0;
     *pid = v;
     return 1;
 }
 
-/* Removes the temporaries that processes no longer alive left in dir (killed before they could
-** clean up). */
+/* Removes the temporaries that processes of this PID space no longer alive left in dir (killed
+** before they could clean up). */
 static void sweep(const char *dir)
 {
     DIR *d = opendir(dir);
@@ -171,6 +225,31 @@ static void sweep(const char *dir)
     closedir(d);
 }
 
+/* Creates the file named by tmpl, whose last six characters are replaced by random letters and
+** digits until the name is new, with mode 0666 less the umask (as any new file of the user's);
+** the descriptor, or -1 with errno. */
+static int create_temporary(char *tmpl)
+{
+    static const char letters[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789";
+    const size_t n = strlen(tmpl);
+    if (n < 6) {
+        errno = EINVAL;
+        return -1;
+    }
+    for (int attempt = 0; attempt < 100; attempt++) {
+        unsigned char r[6];
+        if (getrandom(r, sizeof r, 0) != (ssize_t)sizeof r)
+            return -1;
+        for (int i = 0; i < 6; i++)
+            tmpl[n - 6 + i] = letters[r[i] % (sizeof letters - 1)];
+        int fd = open(tmpl, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0666);
+        if (fd >= 0 || errno != EEXIST)
+            return fd;
+    }
+    errno = EEXIST;
+    return -1;
+}
+
 cf_status cf_atomic_open(cf_atomic *a, const char *path, const char *const *inputs, cf_error *err)
 {
     memset(a, 0, sizeof *a);
@@ -182,9 +261,9 @@ cf_status cf_atomic_open(cf_atomic *a, const char *path, const char *const *inpu
     size_t base = split_dir(path, dir, sizeof dir);
     sweep(dir);
     /* the base name is shortened so that the temporary name stays within NAME_MAX */
-    snprintf(a->tmp, sizeof a->tmp, "%.*s.%.200s.conifit-%ld-XXXXXX", (int)base, path,
-             path + base, (long)getpid());
-    int fd = mkostemp(a->tmp, O_CLOEXEC);
+    snprintf(a->tmp, sizeof a->tmp, "%.*s.%.200s.conifit-%s-%ld-XXXXXX", (int)base, path,
+             path + base, tag_of_host(), (long)getpid());
+    int fd = create_temporary(a->tmp);
     if (fd < 0) {
         int e = errno;
         a->tmp[0] = '\0';
@@ -192,9 +271,11 @@ cf_status cf_atomic_open(cf_atomic *a, const char *path, const char *const *inpu
                             strerror(e));
     }
     a->slot = live_add(a->tmp);
-    /* an ordinary file's mode (not mkstemp's private one), or the mode of the file it replaces */
+    /* a new file has the umask's permissions (create_temporary); one that replaces a file takes
+    ** that file's permissions, without set-user-ID, set-group-ID or sticky bits */
     struct stat s;
-    fchmod(fd, stat(path, &s) == 0 ? (s.st_mode & 07777) : 0644);
+    if (stat(path, &s) == 0)
+        fchmod(fd, s.st_mode & 0777);
     a->fp = fdopen(fd, "wb");
     if (!a->fp) {
         int e = errno;

@@ -2,17 +2,22 @@
 ** Writing output files so that nothing is ever half-written and nothing but a regular file is
 ** ever replaced.
 **
-** A file is written under a hidden temporary name in its own folder, `.NAME.conifit-PID-XXXXXX`,
+** A file is written under a hidden temporary name in its own folder, `.NAME.conifit-TAG-PID-XXXXXX`,
 ** and renamed over the target only when it is complete (and, for a command with several outputs,
 ** only when all of them are: open them all, then commit them all). Rules:
 **   - the target must not be one of the run's inputs;
-**   - an existing target must be a regular file: a symbolic link, FIFO, character or block device,
-**     socket or folder is refused (conifit never writes into such a thing, nor replaces it);
+**   - an existing target must be a regular file that is not write-protected (no write permission
+**     for anyone): a symbolic link, FIFO, character or block device, socket or folder is refused
+**     (conifit never writes into such a thing, nor replaces it);
+**   - a new file gets 0666 less the umask; a replaced file keeps its permissions but never a
+**     set-user-ID, set-group-ID or sticky bit;
 **   - a failed or aborted write leaves no file at all;
 **   - temporaries still open when the process is stopped by a signal are removed by
 **     cf_atomic_remove_temporaries (main calls it on SIGINT, SIGTERM, SIGHUP, SIGPIPE); those of a
 **     process killed outright (SIGKILL) stay hidden (dot names) and are swept by the next
-**     cf_atomic_open in the same folder, once no process of that PID is alive on this machine.
+**     cf_atomic_open in the same folder, once no process of that PID is alive. TAG names the PID
+**     space (host, boot and PID namespace): only temporaries of this one are judged, so a run in
+**     another container or on another host sharing the folder is never swept while it writes.
 ** The list of live temporaries is the one process-wide state of the library; it is thread-safe.
 */
 #ifndef CF_ATOMIC_H
@@ -30,8 +35,9 @@ typedef struct cf_atomic {
 } cf_atomic;
 
 /* Whether path may be written: CF_E_CANTWRITE (message names the path and the reason) when it is
-** one of `inputs` (NULL-terminated, may be NULL), exists and is not a regular file, or its folder
-** does not exist. Lets a command refuse a bad target before any work. */
+** one of `inputs` (NULL-terminated, may be NULL), exists and is not a regular file or is
+** write-protected, or its folder does not exist. Lets a command refuse a bad target before any
+** work. */
 cf_status cf_atomic_check(const char *path, const char *const *inputs, cf_error *err);
 
 /* Checks path (cf_atomic_check) and opens a temporary file beside it. CF_E_CANTWRITE when it

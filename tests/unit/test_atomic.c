@@ -1,0 +1,169 @@
+/*
+** Tests of the atomic output files (src/base/atomic.c): the permissions of what they write (the
+** umask for a new file, no special bits on a replaced one), write-protected targets refused and
+** left alone, and the sweep of dead runs' temporaries, which judges only temporaries of its own
+** PID space.
+*/
+#include "testutil.h"
+
+#include <dirent.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+
+#include "base/atomic.h"
+
+/* Writes text to path through cf_atomic; the status of the commit (or of the open). */
+static cf_status write_atomic(const char *path, const char *text, cf_error *err)
+{
+    cf_atomic a;
+    cf_status st = cf_atomic_open(&a, path, NULL, err);
+    if (st != CF_OK)
+        return st;
+    fputs(text, a.fp);
+    return cf_atomic_commit(&a, err);
+}
+
+static mode_t mode_of(const char *path)
+{
+    struct stat s;
+    assert_int_equal(stat(path, &s), 0);
+    return s.st_mode & 07777;
+}
+
+static void new_file_has_the_umask_permissions(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-atomic-XXXXXX", path[300];
+    assert_non_null(mkdtemp(dir));
+    const mode_t masks[] = {027, 077, 0};
+    for (size_t k = 0; k < sizeof masks / sizeof masks[0]; k++) {
+        snprintf(path, sizeof path, "%s/new%zu.csv", dir, k);
+        mode_t old = umask(masks[k]);
+        cf_error err = {0};
+        cf_status st = write_atomic(path, "x\n", &err);
+        umask(old);
+        assert_int_equal(st, CF_OK);
+        assert_int_equal(mode_of(path), 0666 & ~masks[k]);
+        unlink(path);
+    }
+    rmdir(dir);
+}
+
+static void replaced_file_keeps_its_permissions_without_special_bits(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-atomic-XXXXXX", path[300];
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/old.csv", dir);
+    cf_error err = {0};
+    assert_int_equal(write_atomic(path, "old\n", &err), CF_OK);
+    assert_int_equal(chmod(path, 06751), 0);
+    assert_int_equal(mode_of(path), 06751);
+    assert_int_equal(write_atomic(path, "new\n", &err), CF_OK);
+    assert_int_equal(mode_of(path), 0751);
+    char *text = tu_slurp(path);
+    assert_string_equal(text, "new\n");
+    free(text);
+    unlink(path);
+    rmdir(dir);
+}
+
+static void write_protected_target_is_refused_and_kept(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-atomic-XXXXXX", path[300];
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/kept.csv", dir);
+    cf_error err = {0};
+    assert_int_equal(write_atomic(path, "kept\n", &err), CF_OK);
+    assert_int_equal(chmod(path, 0444), 0);
+    assert_int_equal(write_atomic(path, "lost\n", &err), CF_E_CANTWRITE);
+    assert_non_null(strstr(err.msg, "write-protected"));
+    assert_non_null(strstr(err.msg, "kept.csv"));
+    char *text = tu_slurp(path);
+    assert_string_equal(text, "kept\n");
+    free(text);
+    /* nothing left behind: the folder holds the one file */
+    DIR *d = opendir(dir);
+    assert_non_null(d);
+    int n = 0;
+    for (struct dirent *e; (e = readdir(d)) != NULL;)
+        n += strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
+    closedir(d);
+    assert_int_equal(n, 1);
+    unlink(path);
+    rmdir(dir);
+}
+
+static int exists_in(const char *dir, const char *name)
+{
+    char p[600];
+    snprintf(p, sizeof p, "%s/%s", dir, name);
+    return access(p, F_OK) == 0;
+}
+
+static void touch_in(const char *dir, const char *name)
+{
+    char p[600];
+    snprintf(p, sizeof p, "%s/%s", dir, name);
+    FILE *f = fopen(p, "w");
+    assert_non_null(f);
+    fclose(f);
+}
+
+static void sweep_removes_only_dead_temporaries_of_its_own_pid_space(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-atomic-XXXXXX", path[300];
+    assert_non_null(mkdtemp(dir));
+    /* this run's tag, from the name of one of its temporaries */
+    snprintf(path, sizeof path, "%s/probe.csv", dir);
+    cf_atomic a;
+    cf_error err = {0};
+    assert_int_equal(cf_atomic_open(&a, path, NULL, &err), CF_OK);
+    const char *t = strstr(a.tmp, ".conifit-");
+    assert_non_null(t);
+    char tag[64];
+    assert_int_equal(sscanf(t + 9, "%63[0-9a-f]", tag), 1);
+    assert_int_equal(strlen(tag), 16);
+    cf_atomic_abort(&a);
+    /* a PID that was this PID space's and is dead now */
+    pid_t child = fork();
+    assert_true(child >= 0);
+    if (child == 0)
+        _exit(0);
+    assert_int_equal(waitpid(child, NULL, 0), child);
+    char dead_mine[200], dead_other[200], dead_untagged[200], live_mine[200];
+    snprintf(dead_mine, sizeof dead_mine, ".a.csv.conifit-%s-%ld-Ab12Cd", tag, (long)child);
+    snprintf(dead_other, sizeof dead_other, ".b.csv.conifit-0123456789abcdef-%ld-Ab12Cd",
+             (long)child);
+    snprintf(dead_untagged, sizeof dead_untagged, ".c.csv.conifit-%ld-Ab12Cd", (long)child);
+    snprintf(live_mine, sizeof live_mine, ".d.csv.conifit-%s-1-Ab12Cd", tag); /* init lives */
+    const char *all[] = {dead_mine, dead_other, dead_untagged, live_mine};
+    for (size_t k = 0; k < 4; k++)
+        touch_in(dir, all[k]);
+    snprintf(path, sizeof path, "%s/out.csv", dir);
+    assert_int_equal(write_atomic(path, "x\n", &err), CF_OK); /* sweeps the folder */
+    assert_false(exists_in(dir, dead_mine));
+    assert_true(exists_in(dir, dead_other));    /* another container's or host's: maybe alive */
+    assert_true(exists_in(dir, dead_untagged)); /* cannot be told: left alone */
+    assert_true(exists_in(dir, live_mine));
+    for (size_t k = 1; k < 4; k++) {
+        snprintf(path, sizeof path, "%s/%s", dir, all[k]);
+        unlink(path);
+    }
+    snprintf(path, sizeof path, "%s/out.csv", dir);
+    unlink(path);
+    assert_int_equal(rmdir(dir), 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(new_file_has_the_umask_permissions),
+        cmocka_unit_test(replaced_file_keeps_its_permissions_without_special_bits),
+        cmocka_unit_test(write_protected_target_is_refused_and_kept),
+        cmocka_unit_test(sweep_removes_only_dead_temporaries_of_its_own_pid_space),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
