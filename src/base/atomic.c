@@ -3,6 +3,7 @@
 */
 #define _GNU_SOURCE /* O_CLOEXEC, O_NOFOLLOW */
 #include "base/atomic.h"
+#include "base/input.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -65,17 +66,6 @@ int cf_same_file(const char *a, const char *b)
     return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
 
-static const char *kind_of(mode_t m)
-{
-    return S_ISLNK(m)    ? "a symbolic link"
-           : S_ISFIFO(m) ? "a FIFO"
-           : S_ISCHR(m)  ? "a character device"
-           : S_ISBLK(m)  ? "a block device"
-           : S_ISSOCK(m) ? "a socket"
-           : S_ISDIR(m)  ? "a folder"
-                         : "not a regular file";
-}
-
 /* CF_OK when nothing is at path or a regular file is. */
 static cf_status regular_or_absent(const char *path, cf_error *err)
 {
@@ -90,7 +80,7 @@ static cf_status regular_or_absent(const char *path, cf_error *err)
         return cf_error_set(err, CF_E_CANTWRITE,
                             "%s: is %s; conifit writes only regular files and will not replace "
                             "it",
-                            path, kind_of(s.st_mode));
+                            path, cf_file_kind(s.st_mode));
     if ((s.st_mode & 0222) == 0)
         return cf_error_set(err, CF_E_CANTWRITE,
                             "%s: is write-protected (mode %04o); conifit will not replace it",

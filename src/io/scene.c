@@ -9,10 +9,10 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include <jansson.h>
 
+#include "base/input.h"
 #include "conifit/fitfile.h"
 
 /* Most cycles and samples a scene may ask for (keeps memory and run time bounded). */
@@ -707,15 +707,9 @@ cf_status cf_scene_load(const char *path, cf_scene *sc, cf_error *err)
     memset(&c, 0, sizeof c);
     c.name = path;
     c.err = err;
-    FILE *f = fopen(path, "rb");
+    FILE *f = cf_input_open(path, "scene", err);
     if (!f)
-        return cf_error_set(err, CF_E_NOINPUT, "%s: cannot open scene: %s", path,
-                            strerror(errno));
-    struct stat fs;
-    if (fstat(fileno(f), &fs) == 0 && S_ISDIR(fs.st_mode)) {
-        fclose(f);
-        return cf_error_set(err, CF_E_NOINPUT, "%s: cannot read scene: it is a folder", path);
-    }
+        return CF_E_NOINPUT;
     json_error_t jerr;
     errno = 0;
     json_t *root = json_loadf(f, JSON_REJECT_DUPLICATES, &jerr);
