@@ -312,7 +312,7 @@ cf_status cf_gp_render(cf_gp *g, const char *path, const char *const *inputs, cf
     if (!prog || !*prog)
         prog = "gnuplot";
     posix_spawn_file_actions_t fa;
-    char *argv[] = {(char *)prog, NULL};
+    char *argv[] = {(char *)prog, "-d", NULL}; /* -d: no initialisation file (~/.gnuplot) */
     pid_t pid;
     fflush(out->fp);
     int rc = posix_spawn_file_actions_init(&fa);

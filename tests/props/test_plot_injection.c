@@ -261,6 +261,37 @@ static void fit_column_names_comments_units(void **state)
     no_marker_left("comment or unit");
 }
 
+/* gnuplot reads no initialisation file: a ~/.gnuplot that runs a command (as a hostile or merely
+** unusual one could) is live when gnuplot starts the ordinary way (the control), and conifit's
+** plots run without it (gnuplot -d). */
+static void gnuplot_init_file_is_not_read(void **state)
+{
+    (void)state;
+    if (!have_gnuplot())
+        skip();
+    write_in_scratch(".gnuplot", "system('touch PWNED8')\n");
+    char cmd[PATH_MAX + 96], home[PATH_MAX + 8];
+    snprintf(cmd, sizeof cmd, "cd '%s' && HOME='%s' gnuplot </dev/null >/dev/null 2>&1", scratch,
+             scratch);
+    assert_int_equal(system(cmd), 0);
+    assert_true(exists_in_scratch("PWNED8")); /* the control: the file is read by default */
+    snprintf(cmd, sizeof cmd, "%s/PWNED8", scratch);
+    assert_int_equal(unlink(cmd), 0);
+    table_with_header("init.csv", "strain,stress_kPa", NULL);
+    snprintf(home, sizeof home, "HOME=%s", scratch);
+    char *argv[] = {conifit_abs, "fit", "init.csv", "--plot", "init.png", "--quiet", NULL};
+    int rc = run(home, argv);
+    if (rc != 0)
+        fail_msg("fit with a ~/.gnuplot: exit %d: %s", rc, last_stderr());
+    const int ran = exists_in_scratch("PWNED8");
+    snprintf(cmd, sizeof cmd, "%s/.gnuplot", scratch);
+    unlink(cmd);
+    snprintf(cmd, sizeof cmd, "%s/PWNED8", scratch);
+    unlink(cmd); /* so that a failure here does not show in the tests after it */
+    assert_true(exists_in_scratch("init.png"));
+    assert_false(ran);
+}
+
 /* conifit fit with payloads in the table's file name and in the plot's own name. */
 static void fit_file_names(void **state)
 {
@@ -419,6 +450,7 @@ int main(void)
         cmocka_unit_test(escaping_rule),
         cmocka_unit_test(fit_column_names_comments_units),
         cmocka_unit_test(fit_file_names),
+        cmocka_unit_test(gnuplot_init_file_is_not_read),
         cmocka_unit_test(fit_series_names),
         cmocka_unit_test(simulate_names),
         cmocka_unit_test(script_holds_no_live_text),
