@@ -3,6 +3,8 @@
 */
 #include "conifit/error.h"
 
+#include "base/safetext.h"
+
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -10,11 +12,16 @@
 cf_status cf_error_set(cf_error *err, cf_status status, const char *fmt, ...)
 {
     if (err) {
+        /* Messages quote file names, column names and values from outside: whatever they hold
+        ** is shown, never acted on by a terminal (base/safetext.h). */
+        char raw[2 * CF_ERROR_MSG_LEN];
         va_list ap;
         err->status = status;
         va_start(ap, fmt);
-        vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+        int n = vsnprintf(raw, sizeof raw, fmt, ap);
         va_end(ap);
+        size_t len = n < 0 ? 0 : (size_t)n < sizeof raw ? (size_t)n : sizeof raw - 1;
+        cf_safe_text(err->msg, sizeof err->msg, raw, len);
     }
     return status;
 }

@@ -4,7 +4,8 @@
 ** The library never prints and never exits. A function that can fail returns a cf_status (zero on
 ** success, negative on failure, in the spirit of NLopt's result codes) and, when the caller passes
 ** a cf_error, leaves a one-line message there that names the file, line, column, key or parameter
-** and the offending value. Only main() turns a status into text on stderr and an exit code.
+** and the offending value, made safe for a terminal (control characters shown as \xNN). Only
+** main() turns a status into text on stderr and an exit code.
 */
 #ifndef CF_ERROR_H
 #define CF_ERROR_H

@@ -1,0 +1,20 @@
+/*
+** Text from outside (file names, column names, values, another program's output) made safe to
+** show in a message: what it says stays readable, and nothing in it can act on a terminal.
+**
+** Kept as they are: printable ASCII and whole, valid UTF-8 sequences of printable characters.
+** Shown as \xNN, byte by byte: C0 control characters (newline, tab and ESC included), DEL, the C1
+** controls U+0080..U+009F in UTF-8 (some terminals take U+009B as a command introducer), and any
+** byte that is not part of valid UTF-8 (a Windows code page's degree sign, say). The result is
+** never cut inside a character or an escape.
+*/
+#ifndef CF_SAFETEXT_H
+#define CF_SAFETEXT_H
+
+#include <stddef.h>
+
+/* Writes the safe form of the n bytes at s into out (cap bytes, NUL-terminated; cap >= 1), ending
+** with "..." when it did not fit. Returns out. */
+char *cf_safe_text(char *out, size_t cap, const char *s, size_t n);
+
+#endif
