@@ -18,9 +18,9 @@
 
 CC      ?= cc
 PKGS    := nlopt gsl jansson
-TESTPKGS := cmocka
+TESTPKGS := cmocka libxml-2.0
 DEBS    := build-essential pkg-config libnlopt-dev libgsl-dev libcmocka-dev libjansson-dev \
-           libsuitesparse-dev libmumps-seq-dev libopenblas0-serial gnuplot-nox calculix-ccx clang \
+           libsuitesparse-dev libmumps-seq-dev libopenblas0-serial libxml2-dev gnuplot-nox calculix-ccx clang \
            libclang-rt-dev
 BUILD   ?= build
 SIMD    ?=

@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -70,6 +71,35 @@ static inline int tu_run(char *out, size_t out_cap, char *errbuf, size_t err_cap
     close(fe);
     remove(outfile);
     remove(errfile);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/* Runs argv (argv[0] a full path; no shell, so arguments may hold any byte) in folder dir (NULL:
+** here) with env_extra ("NAME=VALUE", or NULL) added to the environment, standard input and
+** output on /dev/null and standard error into the file err_path (relative to dir). Returns the
+** exit status, or -1 when the program did not exit. */
+static inline int tu_exec(const char *dir, const char *env_extra, char *const argv[],
+                          const char *err_path)
+{
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        if (dir && chdir(dir) != 0)
+            _exit(126);
+        int null = open("/dev/null", O_RDWR);
+        int e = open(err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (null < 0 || e < 0)
+            _exit(126);
+        dup2(null, 0);
+        dup2(null, 1);
+        dup2(e, 2);
+        if (env_extra)
+            putenv((char *)env_extra);
+        execv(argv[0], argv);
+        _exit(127);
+    }
+    int st;
+    assert_int_equal(waitpid(pid, &st, 0), pid);
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 

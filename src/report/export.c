@@ -14,6 +14,7 @@
 
 #include "conifit/lattice.h"
 #include "conifit/version.h"
+#include "base/safetext.h"
 #include "io/fitfile_json.h"
 #include "report/export_model.h"
 
@@ -24,11 +25,6 @@ cf_export_options cf_export_default_options(void)
     o.format = CF_EXPORT_JSON;
     o.tol = CF_EXPORT_TOL_DEFAULT;
     return o;
-}
-
-static const char *src_name(const cf_export_options *opt)
-{
-    return (opt->source && *opt->source) ? opt->source : "(none)";
 }
 
 /* 1 when a Prony term of the fit changes with strain (g_per_strain). */
@@ -78,7 +74,7 @@ static void block_header(FILE *out, const char *lead, const char *tail, const ch
     fprintf(out, "%sunits: mm, N, s, tonne (force in N, elongation in mm)%s\n", lead, tail);
     fprintf(out, "%ssign: tension positive; elongation = -u (conifit compresses for u > 0)%s\n",
             lead, tail);
-    fprintf(out, "%ssource: %s%s\n", lead, src_name(opt), tail);
+    cf_export_comment_source(out, lead, tail, opt->source);
     cf_export_comment_spring(out, lead, tail, law);
     cf_export_comment_table(out, lead, tail, t, law);
 }
@@ -116,7 +112,10 @@ static cf_status write_json(FILE *out, const block_job *j, cf_error *err)
     json_object_set_new(units, "sign",
                         json_string("u > 0 compresses the spring; F has the sign of u"));
     json_object_set_new(root, "units", units);
-    json_object_set_new(prov, "fit_file", json_string(opt->source ? opt->source : ""));
+    char source[CF_EXPORT_SOURCE_MAX]; /* text from outside: valid UTF-8 for JSON */
+    const char *src = opt->source ? opt->source : "";
+    json_object_set_new(prov, "fit_file", json_string(cf_safe_text(source, sizeof source, src,
+                                                                   strlen(src))));
     json_object_set_new(prov, "data_file", json_string(fs->data_file));
     if (isfinite(fs->rmse)) {
         json_object_set_new(prov, "rmse", cf_json_number(fs->rmse));
@@ -516,7 +515,7 @@ cf_status cf_export_write(FILE *out, const cf_fitted_spring *fs, const cf_export
     } else {
         m.law = &law;
         m.base = &t;
-        m.source = src_name(opt);
+        m.source = opt->source;
         if (single_model(&m, &law, &t) != 0 || d->model(out, &m) != 0) {
             st = cf_error_set(err, CF_E_INTERNAL, "out of memory writing the model");
             goto done;

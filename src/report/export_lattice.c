@@ -224,7 +224,7 @@ static int lattice_model(cf_xmodel *m, const cf_lattice *lat, const cf_law *law,
     m->reaction_tol_N *= t->tol * law->F_C_N;
     m->law = law;
     m->base = t;
-    m->source = (opt->source && *opt->source) ? opt->source : "(none)";
+    m->source = opt->source;
     lattice_title(title, cap, &lx->cfg.lattice);
     m->title = title;
     m->nsteps = lx->nsteps;

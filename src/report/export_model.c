@@ -38,6 +38,7 @@
 #include "conifit/lattice.h"
 #include "conifit/spring.h"
 #include "conifit/version.h"
+#include "base/safetext.h"
 
 void cf_xmodel_free(cf_xmodel *m)
 {
@@ -114,6 +115,24 @@ void cf_export_inp_pair(FILE *out, double force_N, double elongation_mm)
 
 /* ---- comments shared by the writers ---------------------------------------------------------- */
 
+void cf_export_comment_source(FILE *out, const char *lead, const char *tail, const char *source)
+{
+    char safe[CF_EXPORT_SOURCE_MAX];
+    cf_safe_text(safe, CF_EXPORT_SOURCE_MAX, source && *source ? source : "(none)",
+                 source && *source ? strlen(source) : 6);
+    /* an XML comment may not hold "--" (nor end in '-'): every '-' after a '-', and a last one,
+    ** is written as its escape */
+    const int xml = strstr(tail, "-->") != NULL;
+    fprintf(out, "%ssource: ", lead);
+    for (const char *c = safe; *c; c++) {
+        if (xml && *c == '-' && ((c > safe && c[-1] == '-') || c[1] == '\0'))
+            fputs("\\x2D", out);
+        else
+            fputc(*c, out);
+    }
+    fprintf(out, "%s\n", tail);
+}
+
 void cf_export_comment_spring(FILE *out, const char *lead, const char *tail, const cf_law *law)
 {
     fprintf(out, "%sspring (%s):", lead, cf_spring_type_name(law->type));
@@ -152,8 +171,7 @@ static void model_header(FILE *out, const char *lead, const char *tail, const cf
             "%ssign: tension positive; each spring table holds elongation L - L0 (mm) and "
             "tension (N)%s\n",
             lead, tail);
-    fprintf(out, "%ssource: %s%s\n", lead, (m->source && *m->source) ? m->source : "(none)",
-            tail);
+    cf_export_comment_source(out, lead, tail, m->source);
     cf_export_comment_spring(out, lead, tail, m->law);
     cf_export_comment_table(out, lead, tail, m->base, m->law);
     fprintf(out,

@@ -83,6 +83,15 @@ void cf_export_inp_pair(FILE *out, double force_N, double elongation_mm);
 
 /* Writes a comment line with the spring's parameters, and the table's accuracy, each line
 ** starting with lead and ending with tail. */
+/* Longest source name written, in bytes (a longer one is cut, ending in "..."). */
+#define CF_EXPORT_SOURCE_MAX 256
+
+/* The comment line "source: NAME" between lead and tail. NAME (a file name: text from outside) is
+** written so that it cannot end the comment or the line: control characters (newlines included)
+** and bytes that are not UTF-8 as \xNN (base/safetext.h); in an XML comment (tail "-->") a '-'
+** after a '-' or at the end as \x2D, so "--" and "-->" cannot occur. NULL or "" is "(none)". */
+void cf_export_comment_source(FILE *out, const char *lead, const char *tail, const char *source);
+
 void cf_export_comment_spring(FILE *out, const char *lead, const char *tail, const cf_law *law);
 void cf_export_comment_table(FILE *out, const char *lead, const char *tail,
                              const cf_export_table *t, const cf_law *law);

@@ -57,26 +57,7 @@ static void write_in_scratch(const char *name, const char *text)
 ** NULL) added to the environment; stderr goes to scratch/stderr.txt. Returns the exit status. */
 static int run(const char *env_extra, char *const argv[])
 {
-    pid_t pid = fork();
-    assert_true(pid >= 0);
-    if (pid == 0) {
-        if (chdir(scratch) != 0)
-            _exit(126);
-        int null = open("/dev/null", O_RDWR);
-        int e = open("stderr.txt", O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (null < 0 || e < 0)
-            _exit(126);
-        dup2(null, 0);
-        dup2(null, 1);
-        dup2(e, 2);
-        if (env_extra)
-            putenv((char *)env_extra);
-        execv(argv[0], argv);
-        _exit(127);
-    }
-    int st;
-    assert_int_equal(waitpid(pid, &st, 0), pid);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    return tu_exec(scratch, env_extra, argv, "stderr.txt");
 }
 
 static const char *last_stderr(void)
