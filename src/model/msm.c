@@ -147,7 +147,7 @@ static inline double prony_g_at(const cf_msm_effects *fx, int i, double abs_e)
     return fx->prony_k[i] != 0 ? fx->prony_g[i] + fx->prony_k[i] * abs_e : fx->prony_g[i];
 }
 
-static void solver_free(solver *s)
+static void cf_msm_solver_free(solver *s)
 {
     free(s->eq);
     free(s->R);
@@ -180,9 +180,9 @@ static int is_prescribed(const solver *s, size_t node, int axis)
     return 0;
 }
 
-static cf_status solver_init(solver *s, cf_lattice *lat, const cf_msm_effects *fx,
-                             const cf_msm_config *cfg, cf_msm_drive drive, cf_msm_stats *st,
-                             cf_error *err)
+static cf_status cf_msm_solver_init(solver *s, cf_lattice *lat, const cf_msm_effects *fx,
+                                    const cf_msm_config *cfg, cf_msm_drive drive,
+                                    cf_msm_stats *st, cf_error *err)
 {
     memset(s, 0, sizeof *s);
     s->lat = lat;
@@ -223,7 +223,7 @@ static cf_status solver_init(solver *s, cf_lattice *lat, const cf_msm_effects *f
         goto oom;
     return CF_OK;
 oom:
-    solver_free(s);
+    cf_msm_solver_free(s);
     return cf_error_set(err, CF_E_INTERNAL, "out of memory for the lattice solver");
 }
 
@@ -238,7 +238,7 @@ static double *force(cf_lattice *lat, int a)
 }
 
 /* Places the top face for a displacement drive at compressive strain e. */
-static void place_top(cf_lattice *lat, double e)
+static void cf_msm_place_top(cf_lattice *lat, double e)
 {
     for (size_t t = 0; t < lat->ntop; t++) {
         uint32_t p = lat->top[t];
@@ -247,7 +247,7 @@ static void place_top(cf_lattice *lat, double e)
 }
 
 /* External loads: force drive on the top face, gravity on every node. */
-static void add_external(solver *s)
+static void cf_msm_add_external(solver *s)
 {
     cf_lattice *lat = s->lat;
     if (s->drive == CF_DRIVE_FORCE) {
@@ -262,7 +262,7 @@ static void add_external(solver *s)
 
 /* Forces at the current positions (kernel + quasi-static extras + loads) and the residual on the
 ** free DOFs. Returns max |u|/travel; *rnorm the infinity norm, *fscale the force scale. */
-static double residual(solver *s, double *rnorm, double *fscale)
+static double cf_msm_residual(solver *s, double *rnorm, double *fscale)
 {
     cf_lattice *lat = s->lat;
     double um = cf_lattice_forces(lat);
@@ -272,7 +272,7 @@ static double residual(solver *s, double *rnorm, double *fscale)
                         qlv_factor(s, q, NULL) * lat->w[q] * lat->F_N[q];
         cf_lattice_add_tensions(lat, s->tmp);
     }
-    add_external(s);
+    cf_msm_add_external(s);
     double rn = 0, fs = 0;
     for (size_t q = 0; q < lat->ns; q++)
         fs = fmax(fs, fabs(lat->T_N[q]));
@@ -439,7 +439,7 @@ static void note_inertia(solver *s)
 ** more than a few cells a side, and an indefinite tangent is factored as L D L^T with its negative
 ** pivots counted. Accepted when the residual is small. Returns 1 when s->dx holds the update;
 ** sets *fatal for an out-of-memory that no fallback would survive. */
-static int chol_solve(solver *s, int *fatal, cf_error *err);
+static int cf_linsolve_chord(solver *s, int *fatal, cf_error *err);
 
 static int chol_direction(solver *s, int *fatal, cf_error *err)
 {
@@ -464,7 +464,7 @@ static int chol_direction(solver *s, int *fatal, cf_error *err)
     if (st != CF_OK)
         return 0;
     s->neg_pivots = info.neg_pivots; /* the inertia holds even when the solve is refused */
-    int ok = chol_solve(s, fatal, err);
+    int ok = cf_linsolve_chord(s, fatal, err);
     s->chol_ready = ok;
     if (ok && s->st)
         s->st->linear_iters++;
@@ -473,7 +473,7 @@ static int chol_direction(solver *s, int *fatal, cf_error *err)
 
 /* The update from the factors in s->chol (of C as it was factored, scaled by s->D): solved,
 ** accepted when its residual against C is small. Returns 1 when s->dx holds it. */
-static int chol_solve(solver *s, int *fatal, cf_error *err)
+static int cf_linsolve_chord(solver *s, int *fatal, cf_error *err)
 {
     const size_t n = s->ndof;
     gsl_spmatrix *C = s->C;
@@ -607,8 +607,8 @@ done:
     return st;
 }
 
-/* Assembles the tangent K = -dR/dx at the state of the last residual(), solves K dx = R (sparse
-** Cholesky, else banded LDL^T, dense LU for small systems, GMRES) with symmetric Jacobi scaling
+/* Assembles the tangent K = -dR/dx at the state of the last cf_msm_residual(), solves K dx = R
+** (sparse Cholesky, else banded LDL^T, dense LU for small systems, GMRES) with symmetric Jacobi scaling
 ** (a congruence: the inertia is that of K). Kept as one function (~85 lines): assembly, scaling,
 ** the solver cascade and the acceptance test share the scaled system and its workspaces. */
 static cf_status tangent_solve(solver *s, cf_error *err)
@@ -700,7 +700,7 @@ done:
     return st;
 }
 
-static cf_status newton_direction(solver *s, cf_error *err)
+static cf_status cf_linsolve_direction(solver *s, cf_error *err)
 {
     cf_status st = tangent_solve(s, err);
     note_inertia(s);
@@ -727,7 +727,7 @@ static void restore_positions(solver *s)
 ** are put back where they started. Kept as one function (~105 lines): the force floor, the choice
 ** between a chord step and a fresh tangent, the line search and the retry with a fresh tangent all
 ** read and update the same iteration state (residual norms, the factorisation's age). */
-static cf_status newton(solver *s, cf_error *err)
+static cf_status cf_msm_newton(solver *s, cf_error *err)
 {
     cf_lattice *lat = s->lat;
     double *start = malloc(3 * lat->nn * sizeof(double));
@@ -739,7 +739,7 @@ static cf_status newton(solver *s, cf_error *err)
     if (s->st)
         s->st->solves++;
     double rn, fs;
-    double um = residual(s, &rn, &fs);
+    double um = cf_msm_residual(s, &rn, &fs);
     /* Floor of the force scale: a small fraction of the solid load times the largest spring
     ** weight (forces scale with it, and so does their rounding), so that an unloaded lattice is
     ** converged at once whatever its weights (a diagonal weight of 1e4 left 7e-13 N of rounding
@@ -775,7 +775,7 @@ static cf_status newton(solver *s, cf_error *err)
         const int chord = s->chord && s->chol_ready && !s->refactor;
         if (chord) {
             int fatal = 0;
-            if (!chol_solve(s, &fatal, &lerr)) {
+            if (!cf_linsolve_chord(s, &fatal, &lerr)) {
                 if (fatal) {
                     memcpy(lat->x, start, lat->nn * sizeof(double));
                     memcpy(lat->y, start + lat->nn, lat->nn * sizeof(double));
@@ -788,7 +788,7 @@ static cf_status newton(solver *s, cf_error *err)
             }
             if (s->st)
                 s->st->chord_iters++;
-        } else if (newton_direction(s, &lerr) != CF_OK) {
+        } else if (cf_linsolve_direction(s, &lerr) != CF_OK) {
             if (lerr.status == CF_E_INTERNAL) { /* out of memory: not a matter of step size */
                 memcpy(lat->x, start, lat->nn * sizeof(double));
                 memcpy(lat->y, start + lat->nn, lat->nn * sizeof(double));
@@ -809,7 +809,7 @@ static cf_status newton(solver *s, cf_error *err)
                     if (e >= 0)
                         coord(lat, a)[p] = s->xsave[a * lat->nn + p] + alpha * s->dx[e];
                 }
-            um = residual(s, &rn, &fs);
+            um = cf_msm_residual(s, &rn, &fs);
             if (um < SOLID_MARGIN && isfinite(rn) && (rn < (1 - 1e-4 * alpha) * rn0 || h >= 30)) {
                 ok = 1;
                 break;
@@ -820,7 +820,7 @@ static cf_status newton(solver *s, cf_error *err)
             restore_positions(s);
             if (!chord)
                 break;
-            um = residual(s, &rn, &fs); /* a stale tangent: try again with a fresh one */
+            um = cf_msm_residual(s, &rn, &fs); /* a stale tangent: try again with a fresh one */
             s->refactor = 1;
             continue;
         }
@@ -859,15 +859,15 @@ static cf_status static_seg(solver *s, double v0, double v1, int depth, cf_error
     s->load = v1;
     int disp = s->drive == CF_DRIVE_DISPLACEMENT;
     if (disp) {
-        place_top(s->lat, v1);
+        cf_msm_place_top(s->lat, v1);
         predict(s, v1 - v0);
     }
-    cf_status st = newton(s, err);
+    cf_status st = cf_msm_newton(s, err);
     if (st == CF_OK)
         return st;
     s->load = v0;
     if (disp) {
-        place_top(s->lat, v0);
+        cf_msm_place_top(s->lat, v0);
         predict(s, v0 - v1);
     }
     if (st != CF_E_NOCONV || depth >= MAX_BISECT)
@@ -879,14 +879,14 @@ static cf_status static_seg(solver *s, double v0, double v1, int depth, cf_error
     return static_seg(s, mid, v1, depth + 1, err);
 }
 
-static cf_status static_to(solver *s, double v, cf_error *err)
+static cf_status cf_msm_static_to(solver *s, double v, cf_error *err)
 {
     return static_seg(s, s->load, v, 0, err);
 }
 
 /* Compressive nominal stress (MPa) at the current state from the node forces of the last
 ** residual/kernel call: the reaction the top platen provides. */
-static double top_stress(const cf_lattice *lat)
+static double cf_msm_top_stress(const cf_lattice *lat)
 {
     double r = 0;
     for (size_t t = 0; t < lat->ntop; t++)
@@ -895,13 +895,13 @@ static double top_stress(const cf_lattice *lat)
 }
 
 /* Node force evaluation for reporting the reaction of a displacement drive. */
-static double reported_stress(solver *s)
+static double cf_msm_reported_stress(solver *s)
 {
     if (s->drive == CF_DRIVE_FORCE)
         return s->load;
     double rn, fs;
-    residual(s, &rn, &fs);
-    return top_stress(s->lat);
+    cf_msm_residual(s, &rn, &fs);
+    return cf_msm_top_stress(s->lat);
 }
 
 double cf_msm_path_value(const cf_msm_path *p, double t)
@@ -949,7 +949,7 @@ cf_status cf_msm_prony_at_strain(const cf_msm_effects *fx, double e, cf_error *e
 
 /* With relaxation that depends on strain, every spring's moduli at the converged state: past their
 ** bounds the relaxed spring would push back the wrong way. */
-static cf_status relaxed_share_check(const solver *s, cf_error *err)
+static cf_status cf_msm_relaxed_share_check(const solver *s, cf_error *err)
 {
     const cf_msm_effects *fx = s->fx;
     const int any = fx && cf_msm_prony_depends_on_strain(fx);
@@ -1004,15 +1004,15 @@ static cf_status quasi_step(solver *s, double h, double v, cf_error *err)
     double v0 = s->load;
     s->load = v;
     if (s->drive == CF_DRIVE_DISPLACEMENT)
-        place_top(lat, v);
-    cf_status st = newton(s, err);
+        cf_msm_place_top(lat, v);
+    cf_status st = cf_msm_newton(s, err);
     if (st != CF_OK) {
         s->load = v0;
         if (s->drive == CF_DRIVE_DISPLACEMENT)
-            place_top(lat, v0);
+            cf_msm_place_top(lat, v0);
         return st;
     }
-    if ((st = relaxed_share_check(s, err)) != CF_OK)
+    if ((st = cf_msm_relaxed_share_check(s, err)) != CF_OK)
         return st;
     if (s->sigm)
         for (size_t q = 0; q < lat->ns; q++)
@@ -1035,15 +1035,15 @@ static cf_status quasi_step(solver *s, double h, double v, cf_error *err)
 }
 
 /* Advances from t0 to t1 (the path's drive) in n implicit steps, halving on failure. */
-static cf_status quasi_advance(solver *s, const cf_msm_path *p, double t0, double t1, int n,
-                               int depth, cf_error *err)
+static cf_status cf_msm_quasi_advance(solver *s, const cf_msm_path *p, double t0, double t1,
+                                      int n, int depth, cf_error *err)
 {
     double h = (t1 - t0) / n;
     for (int k = 1; k <= n; k++) {
         double ta = t0 + (k - 1) * h, tb = t0 + k * h;
         cf_status st = quasi_step(s, h, cf_msm_path_value(p, tb), err);
         if (st == CF_E_NOCONV && depth < MAX_BISECT)
-            st = quasi_advance(s, p, ta, tb, 2, depth + 1, err);
+            st = cf_msm_quasi_advance(s, p, ta, tb, 2, depth + 1, err);
         if (st != CF_OK)
             return st;
         if (s->st && (s->st->dt_used_min_s == 0 || h < s->st->dt_used_min_s))
@@ -1091,7 +1091,7 @@ static void dyn_step(solver *s, dyn *d, double h, double v1, double rate)
     if (d->fused) {
         /* node forces are zero here (cleared by the last advance or before the interval) */
         cf_lattice_stepper_forces(&d->step);
-        add_external(s);
+        cf_msm_add_external(s);
         cf_lattice_stepper_advance(&d->step, h, d->vx, d->vy, d->vz);
         goto drive;
     }
@@ -1122,7 +1122,7 @@ static void dyn_step(solver *s, dyn *d, double h, double v1, double rate)
         }
         cf_lattice_add_tensions(lat, d->Tt);
     }
-    add_external(s);
+    cf_msm_add_external(s);
     double *v[3] = {d->vx, d->vy, d->vz};
     for (int a = 0; a < 3; a++) {
         double *x = coord(lat, a), *f = force(lat, a), *va = v[a];
@@ -1135,7 +1135,7 @@ static void dyn_step(solver *s, dyn *d, double h, double v1, double rate)
     }
 drive:
     if (s->drive == CF_DRIVE_DISPLACEMENT) {
-        place_top(lat, v1);
+        cf_msm_place_top(lat, v1);
         for (size_t t = 0; t < lat->ntop; t++)
             d->vz[lat->top[t]] = -rate * lat->height_mm;
     }
@@ -1143,7 +1143,7 @@ drive:
         s->st->steps++;
 }
 
-static double kinetic(const cf_lattice *lat, const dyn *d)
+static double cf_msm_kinetic(const cf_lattice *lat, const dyn *d)
 {
     double e = 0;
     for (size_t p = 0; p < lat->nn; p++)
@@ -1152,10 +1152,10 @@ static double kinetic(const cf_lattice *lat, const dyn *d)
 }
 
 /* Total energy for a constant load: kinetic + elastic + gravity - work potential of the load. */
-static double total_energy(solver *s, const dyn *d)
+static double cf_msm_total_energy(solver *s, const dyn *d)
 {
     cf_lattice *lat = s->lat;
-    double e = kinetic(lat, d) + cf_lattice_elastic_energy(lat);
+    double e = cf_msm_kinetic(lat, d) + cf_lattice_elastic_energy(lat);
     if (s->fx->gravity_mm_per_s2 != 0)
         for (size_t p = 0; p < lat->nn; p++)
             e += lat->mass_t[p] * s->fx->gravity_mm_per_s2 * (lat->z[p] - lat->Z[p]);
@@ -1206,7 +1206,7 @@ static cf_status check_run(const cf_msm_effects *fx, const cf_msm_path *path,
     return CF_OK;
 }
 
-static void dyn_free(dyn *d)
+static void cf_msm_dyn_free(dyn *d)
 {
     free(d->vx);
     free(d->vy);
@@ -1219,7 +1219,7 @@ static void dyn_free(dyn *d)
 
 /* The dynamic state (velocities at rest) of an explicit run; the fused step when the springs are
 ** elastic only. */
-static cf_status dyn_init(dyn *d, solver *s, cf_error *err)
+static cf_status cf_msm_dyn_init(dyn *d, solver *s, cf_error *err)
 {
     cf_lattice *lat = s->lat;
     d->vx = calloc(lat->nn, sizeof(double));
@@ -1237,8 +1237,8 @@ static cf_status dyn_init(dyn *d, solver *s, cf_error *err)
 }
 
 /* Explicit steps from t to tk, each within the stable step (and cfg->dt_s when set). */
-static cf_status explicit_interval(solver *s, dyn *d, const cf_msm_path *path, double t,
-                                   double tk, cf_msm_stats *st, cf_error *err)
+static cf_status cf_msm_explicit_interval(solver *s, dyn *d, const cf_msm_path *path,
+                                          double t, double tk, cf_msm_stats *st, cf_error *err)
 {
     cf_lattice *lat = s->lat;
     const cf_msm_effects *fx = s->fx;
@@ -1286,14 +1286,14 @@ static cf_status advance_to(solver *s, dyn *d, const cf_msm_path *path, double t
     const int timed = fx->inertia || fx->eta_MPa_s > 0 || fx->maxwell_E_MPa > 0 ||
                       fx->prony_count > 0;
     if (!timed)
-        return static_to(s, vk, err);
+        return cf_msm_static_to(s, vk, err);
     if (fx->inertia)
-        return tk > t ? explicit_interval(s, d, path, t, tk, st, err) : CF_OK;
+        return tk > t ? cf_msm_explicit_interval(s, d, path, t, tk, st, err) : CF_OK;
     if (tk > t) {
         int n = s->cfg->quasi_substeps > 0 ? s->cfg->quasi_substeps : 1;
         if (s->cfg->dt_s > 0)
             n = (int)fmin(1e9, ceil((tk - t) / s->cfg->dt_s - 1e-9));
-        return quasi_advance(s, path, t, tk, n > 0 ? n : 1, 0, err);
+        return cf_msm_quasi_advance(s, path, t, tk, n > 0 ? n : 1, 0, err);
     }
     if (k > 0)
         return CF_OK;
@@ -1310,8 +1310,8 @@ static cf_status advance_to(solver *s, dyn *d, const cf_msm_path *path, double t
         s->qlv_slope = -ksum;
         s->extras = 1;
     }
-    cf_status rc = static_to(s, vk, err);
-    return rc == CF_OK ? relaxed_share_check(s, err) : rc;
+    cf_status rc = cf_msm_static_to(s, vk, err);
+    return rc == CF_OK ? cf_msm_relaxed_share_check(s, err) : rc;
 }
 
 /* The compressive stress at the top of the current state (drive value vk). */
@@ -1333,16 +1333,16 @@ static double sample_stress(solver *s, dyn *d, const cf_msm_path *path, double v
                        (s->sigm ? lat->w[q] * H2 * s->sigm[q] : 0.0);
         }
         cf_lattice_add_tensions(lat, d->Tt);
-        add_external(s);
-        return path->drive == CF_DRIVE_FORCE ? vk : top_stress(lat);
+        cf_msm_add_external(s);
+        return path->drive == CF_DRIVE_FORCE ? vk : cf_msm_top_stress(lat);
     }
     if (s->extras) {
         /* Quasi-static: the reaction of the last step includes its viscous forces. */
         double rn, fsc;
-        residual(s, &rn, &fsc);
-        return path->drive == CF_DRIVE_FORCE ? vk : top_stress(lat);
+        cf_msm_residual(s, &rn, &fsc);
+        return path->drive == CF_DRIVE_FORCE ? vk : cf_msm_top_stress(lat);
     }
-    return reported_stress(s);
+    return cf_msm_reported_stress(s);
 }
 
 /* The run is one time loop: each sample is reached (advance_to), reported (sample_stress) and
@@ -1362,10 +1362,10 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
     if (rc != CF_OK)
         return rc;
     solver s;
-    if ((rc = solver_init(&s, lat, fx, cfg, path->drive, st, err)) != CF_OK)
+    if ((rc = cf_msm_solver_init(&s, lat, fx, cfg, path->drive, st, err)) != CF_OK)
         return rc;
     dyn d = {0};
-    if (fx->inertia && (rc = dyn_init(&d, &s, err)) != CF_OK)
+    if (fx->inertia && (rc = cf_msm_dyn_init(&d, &s, err)) != CF_OK)
         goto end;
     s.load = 0;
     double t = nsamples ? fmin(sample_t_s[0], path->t_s[0]) : 0;
@@ -1380,9 +1380,9 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
         }
         s.load = cf_msm_path_value(path, t);
         if (path->drive == CF_DRIVE_DISPLACEMENT)
-            place_top(lat, s.load);
+            cf_msm_place_top(lat, s.load);
     }
-    double E0 = fx->inertia ? total_energy(&s, &d) : 0, Escale = 0, dE = 0;
+    double E0 = fx->inertia ? cf_msm_total_energy(&s, &d) : 0, Escale = 0, dE = 0;
     for (size_t k = 0; k < nsamples; k++) {
         double tk = sample_t_s[k], vk = cf_msm_path_value(path, tk);
         if ((rc = advance_to(&s, &d, path, t, tk, vk, k, st, err)) != CF_OK)
@@ -1392,7 +1392,7 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
         out[k].t_s = tk;
         out[k].strain = cf_lattice_top_strain(lat);
         out[k].stress_MPa = sample_stress(&s, &d, path, vk);
-        out[k].kinetic_mJ = fx->inertia ? kinetic(lat, &d) : 0.0;
+        out[k].kinetic_mJ = fx->inertia ? cf_msm_kinetic(lat, &d) : 0.0;
         out[k].neg_pivots = fx->inertia ? -1 : s.neg_pivots;
         if (!isfinite(out[k].strain) || !isfinite(out[k].stress_MPa) ||
             !isfinite(out[k].kinetic_mJ)) {
@@ -1404,7 +1404,7 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
         }
         if (fx->inertia && fx->eta_MPa_s == 0 && !s.sigm) {
             /* Drift relative to the largest kinetic energy seen: the energy the load exchanges. */
-            dE = fmax(dE, fabs(total_energy(&s, &d) - E0));
+            dE = fmax(dE, fabs(cf_msm_total_energy(&s, &d) - E0));
             Escale = fmax(Escale, out[k].kinetic_mJ);
             st->max_energy_drift = Escale > 0 ? dE / Escale : 0.0;
         }
@@ -1414,8 +1414,8 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
             cfg->progress(cfg->progress_ctx, k + 1, nsamples, tk);
     }
 end:
-    dyn_free(&d);
-    solver_free(&s);
+    cf_msm_dyn_free(&d);
+    cf_msm_solver_free(&s);
     return rc;
 }
 
@@ -1458,7 +1458,7 @@ cf_status cf_msm_uniaxial(const cf_law *law, cf_law_method m, const cf_msm_confi
     }
     qsort(idx, count, sizeof(keyed), cmp_keyed);
     solver s;
-    if ((rc = solver_init(&s, &lat, NULL, &cfg, CF_DRIVE_DISPLACEMENT, st, err)) != CF_OK) {
+    if ((rc = cf_msm_solver_init(&s, &lat, NULL, &cfg, CF_DRIVE_DISPLACEMENT, st, err)) != CF_OK) {
         free(idx);
         cf_lattice_free(&lat);
         return rc;
@@ -1484,9 +1484,9 @@ cf_status cf_msm_uniaxial(const cf_law *law, cf_law_method m, const cf_msm_confi
                                   strain[i], lat.travel_mm / lat.H_mm);
                 break;
             }
-            rc = static_to(&s, e, err);
+            rc = cf_msm_static_to(&s, e, err);
             if (rc == CF_OK)
-                stress_MPa[i] = -reported_stress(&s);
+                stress_MPa[i] = -cf_msm_reported_stress(&s);
         }
     }
     if (rc == CF_OK)
@@ -1494,7 +1494,7 @@ cf_status cf_msm_uniaxial(const cf_law *law, cf_law_method m, const cf_msm_confi
             if (!isfinite(stress_MPa[i]))
                 rc = cf_error_set(err, CF_E_INTERNAL, "non-finite lattice stress at strain %g",
                                   strain[i]);
-    solver_free(&s);
+    cf_msm_solver_free(&s);
     free(idx);
     cf_lattice_free(&lat);
     return rc;
@@ -1508,10 +1508,10 @@ cf_status cf_msm_uniaxial(const cf_law *law, cf_law_method m, const cf_msm_confi
 static long inertia_here(solver *s, int *oom)
 {
     double rn, fs;
-    residual(s, &rn, &fs);
+    cf_msm_residual(s, &rn, &fs);
     s->neg_pivots = -1;
     cf_error e = {0};
-    if (newton_direction(s, &e) == CF_E_INTERNAL || e.status == CF_E_INTERNAL)
+    if (cf_linsolve_direction(s, &e) == CF_E_INTERNAL || e.status == CF_E_INTERNAL)
         *oom = 1;
     return s->neg_pivots;
 }
@@ -1523,7 +1523,7 @@ static cf_status static_open(const cf_law *law, cf_law_method m, const cf_msm_co
     cf_status rc = cf_lattice_create(lat, law, m, &cfg->lattice, err);
     if (rc != CF_OK)
         return rc;
-    if ((rc = solver_init(s, lat, NULL, cfg, CF_DRIVE_DISPLACEMENT, st, err)) != CF_OK)
+    if ((rc = cf_msm_solver_init(s, lat, NULL, cfg, CF_DRIVE_DISPLACEMENT, st, err)) != CF_OK)
         cf_lattice_free(lat);
     return rc;
 }
@@ -1555,7 +1555,7 @@ cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_ms
         memcpy(keep + 2 * lat.nn, lat.z, lat.nn * sizeof(double));
         cf_error e1 = {0};
         int oom = 0;
-        int lost = static_to(&s, dir * e, &e1) != CF_OK || inertia_here(&s, &oom) > 0;
+        int lost = cf_msm_static_to(&s, dir * e, &e1) != CF_OK || inertia_here(&s, &oom) > 0;
         if (oom || e1.status == CF_E_INTERNAL) { /* not a loss of stability: memory */
             rc = cf_error_set(err, CF_E_INTERNAL, "out of memory in the stability scan");
             goto done;
@@ -1572,9 +1572,9 @@ cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_ms
             memcpy(lat.y, keep + lat.nn, lat.nn * sizeof(double));
             memcpy(lat.z, keep + 2 * lat.nn, lat.nn * sizeof(double));
             s.load = dir * stable;
-            place_top(&lat, s.load);
+            cf_msm_place_top(&lat, s.load);
             cf_error e2 = {0};
-            int ok2 = static_to(&s, dir * mid, &e2) == CF_OK && inertia_here(&s, &oom) == 0;
+            int ok2 = cf_msm_static_to(&s, dir * mid, &e2) == CF_OK && inertia_here(&s, &oom) == 0;
             if (oom || e2.status == CF_E_INTERNAL) {
                 rc = cf_error_set(err, CF_E_INTERNAL, "out of memory in the stability scan");
                 goto done;
@@ -1593,7 +1593,7 @@ cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_ms
     }
 done:
     free(keep);
-    solver_free(&s);
+    cf_msm_solver_free(&s);
     cf_lattice_free(&lat);
     return rc;
 }
@@ -1628,7 +1628,7 @@ cf_status cf_msm_homogeneous_inertia(const cf_law *law, cf_law_method m, const c
     }
     s.load = -strain;
     double rn, fs;
-    double um = residual(&s, &rn, &fs);
+    double um = cf_msm_residual(&s, &rn, &fs);
     if (!(um < 1))
         rc = cf_error_set(err, CF_E_DATA, "strain %g: a spring of the lattice passes solid",
                           strain);
@@ -1644,13 +1644,13 @@ cf_status cf_msm_homogeneous_inertia(const cf_law *law, cf_law_method m, const c
         for (size_t k = 0; k < s.ndof; k++)
             s.R[k] = 1.0;
         cf_error e = {0};
-        (void)newton_direction(&s, &e);
+        (void)cf_linsolve_direction(&s, &e);
         *neg = s.neg_pivots;
         if (*neg < 0)
             rc = cf_error_set(err, CF_E_NOCONV, "strain %g: no factorisation of the tangent "
                               "reported its inertia", strain);
     }
-    solver_free(&s);
+    cf_msm_solver_free(&s);
     cf_lattice_free(&lat);
     return rc;
 }
