@@ -22,14 +22,12 @@
 #define GMRES_TOL 1e-13
 #define GMRES_MAX_RESTARTS 200
 #define GMRES_ACCEPT 1e-6
-/* Linear solves: sparse Cholesky (CHOLMOD, L D L^T when the tangent is indefinite) first, accepted
-** when its relative residual is below BAND_ACCEPT; if it fails, banded LDL^T (when the band fits
-** in BAND_MAX_ENTRIES doubles), else dense LU up to DENSE_MAX_DOF free DOFs (a 7x7x7 lattice has
-** ~1500), else GMRES. */
+/* Linear solves: sparse Cholesky (CHOLMOD, L D L^T by MUMPS when the tangent is indefinite) first,
+** accepted when its relative residual is below BAND_ACCEPT after at most CHOL_REFINE steps of
+** refinement; if it fails, banded LDL^T (when the band fits in CF_LINSOLVE_BAND_MAX_ENTRIES
+** doubles), else dense LU up to CF_LINSOLVE_DENSE_MAX_DOF free DOFs, else GMRES (linsolve.h). */
 #define BAND_ACCEPT 1e-10
 #define CHOL_REFINE 2
-#define BAND_MAX_ENTRIES 5e7
-#define DENSE_MAX_DOF 1200
 
 /* Index of entry (row, col) in the compressed-column matrix C, or -1 (rows within a column are
 ** not sorted by GSL's compression; a column holds at most 81 entries). */
@@ -53,7 +51,7 @@ static cf_status build_pattern(solver *s, cf_error *err)
     ** (at most 26), a 3 x 3 block each. GSL's triplet tree and its compression are not used: they
     ** crash on their own allocation failures (gsl_spmatrix_set, gsl_spmatrix_ccs); a compressed
     ** matrix allocated directly fails cleanly. */
-    enum { MAXADJ = 27 };
+    enum { MAXADJ = CF_LINSOLVE_MAX_ADJ };
     const size_t nn = lat->nn;
     uint32_t *adj = malloc((nn ? nn : 1) * MAXADJ * sizeof(uint32_t));
     unsigned char *deg = calloc(nn ? nn : 1, 1);
@@ -259,7 +257,7 @@ static int band_direction(solver *s)
 {
     const size_t n = s->ndof, b = s->band;
     const gsl_spmatrix *C = s->C;
-    if (b + 1 > n || (double)n * (double)(b + 1) > BAND_MAX_ENTRIES)
+    if (b + 1 > n || (double)n * (double)(b + 1) > CF_LINSOLVE_BAND_MAX_ENTRIES)
         return 0;
     if (!s->AB && !(s->AB = gsl_matrix_alloc(n, b + 1)))
         return 0;
@@ -402,10 +400,10 @@ static cf_status tangent_solve(solver *s, cf_error *err)
         return CF_E_INTERNAL;
     if (band_direction(s))
         return CF_OK;
-    if (n <= DENSE_MAX_DOF)
+    if (n <= CF_LINSOLVE_DENSE_MAX_DOF)
         return dense_direction(s, err);
     gsl_vector *b = gsl_vector_alloc(n), *xv = gsl_vector_calloc(n);
-    size_t restart = n < 150 ? n : 150;
+    size_t restart = n < CF_LINSOLVE_GMRES_RESTART ? n : CF_LINSOLVE_GMRES_RESTART;
     gsl_splinalg_itersolve *w = gsl_splinalg_itersolve_alloc(gsl_splinalg_itersolve_gmres, n,
                                                               restart);
     cf_status st = CF_OK;

@@ -9,9 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Safety factor on the explicit stable step. */
-#define DT_SAFETY 0.9
-
 /* ---- explicit dynamics ---------------------------------------------------------------------- */
 
 double cf_msm_stable_step(cf_lattice *lat, const cf_msm_effects *fx)
@@ -157,7 +154,7 @@ cf_status cf_msm_explicit_interval(solver *s, dyn *d, const cf_msm_path *path,
 {
     cf_lattice *lat = s->lat;
     const cf_msm_effects *fx = s->fx;
-    double stab = DT_SAFETY * cf_msm_stable_step(lat, fx);
+    double stab = CF_MSM_DT_SAFETY * cf_msm_stable_step(lat, fx);
     double want = s->cfg->dt_s > 0 ? s->cfg->dt_s : stab;
     if (want > stab) {
         want = stab;

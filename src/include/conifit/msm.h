@@ -31,6 +31,9 @@
 /* Most Prony terms of a reduced relaxation function. */
 #define CF_PRONY_MAX 8
 
+/* The explicit step as a fraction of the stable step (cf_msm_stable_step), automatic or not. */
+#define CF_MSM_DT_SAFETY 0.9
+
 /* Time-dependent effects; all zero = static. */
 typedef struct cf_msm_effects {
     int inertia;               /* 1: solve the dynamics with node masses */
@@ -174,7 +177,7 @@ cf_status cf_msm_homogeneous_inertia(const cf_law *law, cf_law_method m, const c
 
 /* The explicit stable step (s) of the lattice at its current state for the given effects
 ** (stiffest spring tangent, lightest mass, most springs at one node; the dashpots shorten it).
-** Calls cf_lattice_forces. */
+** Calls cf_lattice_forces. An explicit run steps at most CF_MSM_DT_SAFETY times it. */
 double cf_msm_stable_step(cf_lattice *lat, const cf_msm_effects *fx);
 
 #endif
