@@ -41,27 +41,17 @@ static int ccs_index(const gsl_spmatrix *C, long row, long col)
     return -1;
 }
 
-/* The sparsity pattern of the tangent, built once: for every spring the positions in C->data of
-** its four 3 x 3 blocks (ii, jj, ij, ji), so that assembly is a pass of additions. */
-static cf_status build_pattern(solver *s, cf_error *err)
+/* The pattern by hand: each node couples with itself and the nodes it shares a spring with (at
+** most 26), a 3 x 3 block each. GSL's triplet tree and its compression are not used: they crash on
+** their own allocation failures (gsl_spmatrix_set, gsl_spmatrix_ccs); a compressed matrix
+** allocated directly fails cleanly. */
+enum { MAXADJ = CF_LINSOLVE_MAX_ADJ };
+
+/* The nodes each node shares a spring with, itself first: adj[p * MAXADJ + k] for k < deg[p].
+** Returns 1 when a node has more than MAXADJ (the pattern cannot hold it). */
+static int node_adjacency(const cf_lattice *lat, uint32_t *adj, unsigned char *deg)
 {
-    cf_lattice *lat = s->lat;
-    const size_t n = s->ndof;
-    /* The pattern by hand: each node couples with itself and the nodes it shares a spring with
-    ** (at most 26), a 3 x 3 block each. GSL's triplet tree and its compression are not used: they
-    ** crash on their own allocation failures (gsl_spmatrix_set, gsl_spmatrix_ccs); a compressed
-    ** matrix allocated directly fails cleanly. */
-    enum { MAXADJ = CF_LINSOLVE_MAX_ADJ };
     const size_t nn = lat->nn;
-    uint32_t *adj = malloc((nn ? nn : 1) * MAXADJ * sizeof(uint32_t));
-    unsigned char *deg = calloc(nn ? nn : 1, 1);
-    int *colp = malloc((n + 1) * sizeof(int));
-    if (!adj || !deg || !colp) {
-        free(adj);
-        free(deg);
-        free(colp);
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent matrix");
-    }
     for (size_t p = 0; p < nn; p++) {
         adj[p * MAXADJ] = (uint32_t)p;
         deg[p] = 1;
@@ -83,11 +73,20 @@ static cf_status build_pattern(solver *s, cf_error *err)
             }
         }
     }
+    return bad;
+}
+
+/* The compressed-column matrix of the free DOFs with the pattern of adj (values zero), colp its
+** n + 1 column starts (scratch); NULL when out of memory. */
+static gsl_spmatrix *pattern_matrix(const solver *s, const uint32_t *adj, const unsigned char *deg,
+                                    int *colp)
+{
+    const size_t n = s->ndof, nn = s->lat->nn;
     /* the column of free DOF e = eq[3 p + a] holds the free DOFs of the nodes adjacent to p */
     size_t nnz = 0;
     for (size_t e = 0; e <= n; e++)
         colp[e] = 0;
-    for (size_t p = 0; p < nn && !bad; p++) {
+    for (size_t p = 0; p < nn; p++) {
         size_t rows = 0;
         for (int k = 0; k < deg[p]; k++)
             for (int b = 0; b < 3; b++)
@@ -99,43 +98,42 @@ static cf_status build_pattern(solver *s, cf_error *err)
     for (size_t e = 0; e < n; e++)
         colp[e + 1] += colp[e];
     nnz = (size_t)colp[n];
-    gsl_spmatrix *C = bad ? NULL
-                          : gsl_spmatrix_alloc_nzmax(n ? n : 1, n ? n : 1, nnz ? nnz : 1,
-                                                     GSL_SPMATRIX_CSC);
-    if (C) {
-        for (size_t e = 0; e <= n; e++)
-            C->p[e] = colp[e];
-        for (size_t p = 0; p < nn; p++)
-            for (int a = 0; a < 3; a++) {
-                long col = s->eq[3 * p + a];
-                if (col < 0)
-                    continue;
-                int at = colp[col];
-                for (int k = 0; k < deg[p]; k++)
-                    for (int b = 0; b < 3; b++) {
-                        long row = s->eq[3 * (size_t)adj[p * MAXADJ + k] + b];
-                        if (row >= 0)
-                            C->i[at++] = (int)row;
-                    }
-                /* rows in increasing order within the column (at most 81: insertion sort) */
-                for (int x = colp[col] + 1; x < at; x++) {
-                    int v = C->i[x], y = x - 1;
-                    for (; y >= colp[col] && C->i[y] > v; y--)
-                        C->i[y + 1] = C->i[y];
-                    C->i[y + 1] = v;
+    gsl_spmatrix *C = gsl_spmatrix_alloc_nzmax(n ? n : 1, n ? n : 1, nnz ? nnz : 1,
+                                               GSL_SPMATRIX_CSC);
+    if (!C)
+        return NULL;
+    for (size_t e = 0; e <= n; e++)
+        C->p[e] = colp[e];
+    for (size_t p = 0; p < nn; p++)
+        for (int a = 0; a < 3; a++) {
+            long col = s->eq[3 * p + a];
+            if (col < 0)
+                continue;
+            int at = colp[col];
+            for (int k = 0; k < deg[p]; k++)
+                for (int b = 0; b < 3; b++) {
+                    long row = s->eq[3 * (size_t)adj[p * MAXADJ + k] + b];
+                    if (row >= 0)
+                        C->i[at++] = (int)row;
                 }
+            /* rows in increasing order within the column (at most 81: insertion sort) */
+            for (int x = colp[col] + 1; x < at; x++) {
+                int v = C->i[x], y = x - 1;
+                for (; y >= colp[col] && C->i[y] > v; y--)
+                    C->i[y + 1] = C->i[y];
+                C->i[y + 1] = v;
             }
-        memset(C->data, 0, (nnz ? nnz : 1) * sizeof(double));
-        C->nz = nnz;
-    }
-    free(adj);
-    free(deg);
-    free(colp);
-    s->C = C;
-    s->map = malloc((lat->ns ? lat->ns : 1) * 36 * sizeof(int));
-    s->diag = malloc((n ? n : 1) * sizeof(int));
-    if (!s->C || !s->map || !s->diag)
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent matrix");
+        }
+    memset(C->data, 0, (nnz ? nnz : 1) * sizeof(double));
+    C->nz = nnz;
+    return C;
+}
+
+/* Where each spring's blocks, each DOF's diagonal entry lie in s->C, and its half-bandwidth. */
+static void block_map(solver *s)
+{
+    const cf_lattice *lat = s->lat;
+    const size_t n = s->ndof;
     for (size_t q = 0; q < lat->ns; q++) {
         uint32_t i = lat->si[q], j = lat->sj[q];
         for (int a = 0; a < 3; a++)
@@ -159,6 +157,35 @@ static cf_status build_pattern(solver *s, cf_error *err)
             if (off > s->band)
                 s->band = off;
         }
+}
+
+/* The sparsity pattern of the tangent, built once: for every spring the positions in C->data of
+** its four 3 x 3 blocks (ii, jj, ij, ji), so that assembly is a pass of additions. */
+static cf_status build_pattern(solver *s, cf_error *err)
+{
+    cf_lattice *lat = s->lat;
+    const size_t n = s->ndof;
+    const size_t nn = lat->nn;
+    uint32_t *adj = malloc((nn ? nn : 1) * MAXADJ * sizeof(uint32_t));
+    unsigned char *deg = calloc(nn ? nn : 1, 1);
+    int *colp = malloc((n + 1) * sizeof(int));
+    if (!adj || !deg || !colp) {
+        free(adj);
+        free(deg);
+        free(colp);
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent matrix");
+    }
+    int bad = node_adjacency(lat, adj, deg);
+    gsl_spmatrix *C = bad ? NULL : pattern_matrix(s, adj, deg, colp);
+    free(adj);
+    free(deg);
+    free(colp);
+    s->C = C;
+    s->map = malloc((lat->ns ? lat->ns : 1) * 36 * sizeof(int));
+    s->diag = malloc((n ? n : 1) * sizeof(int));
+    if (!s->C || !s->map || !s->diag)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent matrix");
+    block_map(s);
     return CF_OK;
 }
 
@@ -345,11 +372,10 @@ done:
     return st;
 }
 
-/* Assembles the tangent K = -dR/dx at the state of the last cf_msm_residual(), solves K dx = R
-** (sparse Cholesky, else banded LDL^T, dense LU for small systems, GMRES) with symmetric Jacobi scaling
-** (a congruence: the inertia is that of K). Kept as one function (~85 lines): assembly, scaling,
-** the solver cascade and the acceptance test share the scaled system and its workspaces. */
-static cf_status tangent_solve(solver *s, cf_error *err)
+/* Assembles the tangent K = -dR/dx at the state of the last cf_msm_residual() into s->C (its
+** pattern built on first use) and scales it symmetrically, K' = D^-1 K D^-1 with D = sqrt|diag|
+** in s->D (a congruence: the inertia is that of K). */
+static cf_status assemble(solver *s, cf_error *err)
 {
     cf_lattice *lat = s->lat;
     const size_t n = s->ndof;
@@ -391,17 +417,15 @@ static cf_status tangent_solve(solver *s, cf_error *err)
     for (size_t col = 0; col < n; col++)
         for (int k = C->p[col]; k < C->p[col + 1]; k++)
             C->data[k] /= s->D[C->i[k]] * s->D[col];
-    int fatal = 0;
-    s->neg_pivots = -1;
-    if (!s->cfg->banded_only && chol_direction(s, &fatal, err))
-        return CF_OK;
+    return CF_OK;
+}
 
-    if (fatal)
-        return CF_E_INTERNAL;
-    if (band_direction(s))
-        return CF_OK;
-    if (n <= CF_LINSOLVE_DENSE_MAX_DOF)
-        return dense_direction(s, err);
+/* Restarted GMRES on the scaled tangent: the last resort of the cascade, for a system above
+** CF_LINSOLVE_DENSE_MAX_DOF free DOFs that neither the sparse nor the banded factorisation solved. */
+static cf_status gmres_direction(solver *s, cf_error *err)
+{
+    const size_t n = s->ndof;
+    gsl_spmatrix *C = s->C;
     gsl_vector *b = gsl_vector_alloc(n), *xv = gsl_vector_calloc(n);
     size_t restart = n < CF_LINSOLVE_GMRES_RESTART ? n : CF_LINSOLVE_GMRES_RESTART;
     gsl_splinalg_itersolve *w = gsl_splinalg_itersolve_alloc(gsl_splinalg_itersolve_gmres, n,
@@ -436,6 +460,26 @@ done:
     gsl_vector_free(b);
     gsl_vector_free(xv);
     return st;
+}
+
+/* Assembles and scales the tangent, then solves K dx = R for the Newton update: sparse Cholesky
+** or L D L^T (unless cfg->banded_only), else banded LDL^T, dense LU for small systems, GMRES. */
+static cf_status tangent_solve(solver *s, cf_error *err)
+{
+    if (assemble(s, err) != CF_OK)
+        return CF_E_INTERNAL;
+    int fatal = 0;
+    s->neg_pivots = -1;
+    if (!s->cfg->banded_only && chol_direction(s, &fatal, err))
+        return CF_OK;
+
+    if (fatal)
+        return CF_E_INTERNAL;
+    if (band_direction(s))
+        return CF_OK;
+    if (s->ndof <= CF_LINSOLVE_DENSE_MAX_DOF)
+        return dense_direction(s, err);
+    return gmres_direction(s, err);
 }
 
 cf_status cf_linsolve_direction(solver *s, cf_error *err)
