@@ -97,6 +97,9 @@ cf_status cf_msm_newton(solver *s, cf_error *err);
 cf_status cf_msm_static_to(solver *s, double v, cf_error *err);
 double cf_msm_top_stress(const cf_lattice *lat);
 double cf_msm_reported_stress(solver *s);
+/* Copies the positions of every node into buf (3 nn doubles: x, then y, then z), and back. */
+void cf_msm_positions_get(const cf_lattice *lat, double *buf);
+void cf_msm_positions_set(cf_lattice *lat, const double *buf);
 
 /* msm_visco.c: implicit quasi-static steps with dashpots, Maxwell branches and Prony terms */
 cf_status cf_msm_relaxed_share_check(const solver *s, cf_error *err);

@@ -149,39 +149,24 @@ double cf_msm_residual(solver *s, double *rnorm, double *fscale)
     return um;
 }
 
-static void save_positions(solver *s)
+void cf_msm_positions_get(const cf_lattice *lat, double *buf)
 {
-    cf_lattice *lat = s->lat;
-    memcpy(s->xsave, lat->x, lat->nn * sizeof(double));
-    memcpy(s->xsave + lat->nn, lat->y, lat->nn * sizeof(double));
-    memcpy(s->xsave + 2 * lat->nn, lat->z, lat->nn * sizeof(double));
+    memcpy(buf, lat->x, lat->nn * sizeof(double));
+    memcpy(buf + lat->nn, lat->y, lat->nn * sizeof(double));
+    memcpy(buf + 2 * lat->nn, lat->z, lat->nn * sizeof(double));
 }
 
-static void restore_positions(solver *s)
+void cf_msm_positions_set(cf_lattice *lat, const double *buf)
 {
-    cf_lattice *lat = s->lat;
-    memcpy(lat->x, s->xsave, lat->nn * sizeof(double));
-    memcpy(lat->y, s->xsave + lat->nn, lat->nn * sizeof(double));
-    memcpy(lat->z, s->xsave + 2 * lat->nn, lat->nn * sizeof(double));
+    memcpy(lat->x, buf, lat->nn * sizeof(double));
+    memcpy(lat->y, buf + lat->nn, lat->nn * sizeof(double));
+    memcpy(lat->z, buf + 2 * lat->nn, lat->nn * sizeof(double));
 }
 
-/* Newton from the current positions (prescribed DOFs already placed). On failure the positions
-** are put back where they started. Kept as one function (~105 lines): the force floor, the choice
-** between a chord step and a fresh tangent, the line search and the retry with a fresh tangent all
-** read and update the same iteration state (residual norms, the factorisation's age). */
-cf_status cf_msm_newton(solver *s, cf_error *err)
+/* The force below which Newton's residual counts as converged, whatever the force scale. */
+static double force_floor(const solver *s)
 {
-    cf_lattice *lat = s->lat;
-    double *start = malloc(3 * lat->nn * sizeof(double));
-    if (!start)
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory");
-    memcpy(start, lat->x, lat->nn * sizeof(double));
-    memcpy(start + lat->nn, lat->y, lat->nn * sizeof(double));
-    memcpy(start + 2 * lat->nn, lat->z, lat->nn * sizeof(double));
-    if (s->st)
-        s->st->solves++;
-    double rn, fs;
-    double um = cf_msm_residual(s, &rn, &fs);
+    const cf_lattice *lat = s->lat;
     /* Floor of the force scale: a small fraction of the solid load times the largest spring
     ** weight (forces scale with it, and so does their rounding), so that an unloaded lattice is
     ** converged at once whatever its weights (a diagonal weight of 1e4 left 7e-13 N of rounding
@@ -201,7 +186,25 @@ cf_status cf_msm_newton(solver *s, cf_error *err)
         for (size_t q = 0; q < lat->ns; q++)
             dash = fmax(dash, s->kx[q] * fmax(lat->L_mm[q], xmax));
     }
-    const double floor_f = 1e-12 * lat->law->F_C_N * wmax + 1e-13 * dash;
+    return 1e-12 * lat->law->F_C_N * wmax + 1e-13 * dash;
+}
+
+/* Newton from the current positions (prescribed DOFs already placed). On failure the positions
+** are put back where they started. One function: the choice between a chord step and a fresh
+** tangent, the line search and the retry with a fresh tangent all read and update the same
+** iteration state (residual norms, the factorisation's age). */
+cf_status cf_msm_newton(solver *s, cf_error *err)
+{
+    cf_lattice *lat = s->lat;
+    double *start = malloc(3 * lat->nn * sizeof(double));
+    if (!start)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory");
+    cf_msm_positions_get(lat, start);
+    if (s->st)
+        s->st->solves++;
+    double rn, fs;
+    double um = cf_msm_residual(s, &rn, &fs);
+    const double floor_f = force_floor(s);
     cf_status st = CF_E_NOCONV;
     for (int it = 0; it <= s->cfg->newton_max_iter; it++) {
         if (um < SOLID_MARGIN && rn <= s->cfg->newton_rtol * fs + floor_f) {
@@ -219,9 +222,7 @@ cf_status cf_msm_newton(solver *s, cf_error *err)
             int fatal = 0;
             if (!cf_linsolve_chord(s, &fatal, &lerr)) {
                 if (fatal) {
-                    memcpy(lat->x, start, lat->nn * sizeof(double));
-                    memcpy(lat->y, start + lat->nn, lat->nn * sizeof(double));
-                    memcpy(lat->z, start + 2 * lat->nn, lat->nn * sizeof(double));
+                    cf_msm_positions_set(lat, start);
                     free(start);
                     return cf_error_set(err, CF_E_INTERNAL, "%s", lerr.msg);
                 }
@@ -232,16 +233,14 @@ cf_status cf_msm_newton(solver *s, cf_error *err)
                 s->st->chord_iters++;
         } else if (cf_linsolve_direction(s, &lerr) != CF_OK) {
             if (lerr.status == CF_E_INTERNAL) { /* out of memory: not a matter of step size */
-                memcpy(lat->x, start, lat->nn * sizeof(double));
-                memcpy(lat->y, start + lat->nn, lat->nn * sizeof(double));
-                memcpy(lat->z, start + 2 * lat->nn, lat->nn * sizeof(double));
+                cf_msm_positions_set(lat, start);
                 free(start);
                 return cf_error_set(err, CF_E_INTERNAL, "%s", lerr.msg);
             }
             break;
         } else
             s->refactor = 0;
-        save_positions(s);
+        cf_msm_positions_get(lat, s->xsave);
         double alpha = 1, rn0 = rn;
         int ok = 0;
         for (int h = 0; h < 40; h++) {
@@ -259,7 +258,7 @@ cf_status cf_msm_newton(solver *s, cf_error *err)
             alpha *= 0.5;
         }
         if (!ok) {
-            restore_positions(s);
+            cf_msm_positions_set(lat, s->xsave);
             if (!chord)
                 break;
             um = cf_msm_residual(s, &rn, &fs); /* a stale tangent: try again with a fresh one */
@@ -272,9 +271,7 @@ cf_status cf_msm_newton(solver *s, cf_error *err)
     if (s->st && um > s->st->max_u_over_travel && st == CF_OK)
         s->st->max_u_over_travel = um;
     if (st != CF_OK) {
-        memcpy(lat->x, start, lat->nn * sizeof(double));
-        memcpy(lat->y, start + lat->nn, lat->nn * sizeof(double));
-        memcpy(lat->z, start + 2 * lat->nn, lat->nn * sizeof(double));
+        cf_msm_positions_set(lat, start);
         cf_error_set(err, CF_E_NOCONV,
                      "lattice equilibrium not found at %s %.6g (residual %.3g N, max spring "
                      "compression %.6g of travel)",

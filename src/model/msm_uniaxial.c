@@ -146,9 +146,7 @@ cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_ms
     s.load = 0;
     for (int k = 1; k <= STABILITY_STEPS; k++) {
         double e = top * k / STABILITY_STEPS;
-        memcpy(keep, lat.x, lat.nn * sizeof(double));
-        memcpy(keep + lat.nn, lat.y, lat.nn * sizeof(double));
-        memcpy(keep + 2 * lat.nn, lat.z, lat.nn * sizeof(double));
+        cf_msm_positions_get(&lat, keep);
         cf_error e1 = {0};
         int oom = 0;
         int lost = cf_msm_static_to(&s, dir * e, &e1) != CF_OK || inertia_here(&s, &oom) > 0;
@@ -164,9 +162,7 @@ cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_ms
         double hi = e;
         for (int b = 0; b < STABILITY_BISECT; b++) {
             double mid = 0.5 * (stable + hi);
-            memcpy(lat.x, keep, lat.nn * sizeof(double));
-            memcpy(lat.y, keep + lat.nn, lat.nn * sizeof(double));
-            memcpy(lat.z, keep + 2 * lat.nn, lat.nn * sizeof(double));
+            cf_msm_positions_set(&lat, keep);
             s.load = dir * stable;
             cf_msm_place_top(&lat, s.load);
             cf_error e2 = {0};
@@ -177,9 +173,7 @@ cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_ms
             }
             if (ok2) {
                 stable = mid;
-                memcpy(keep, lat.x, lat.nn * sizeof(double));
-                memcpy(keep + lat.nn, lat.y, lat.nn * sizeof(double));
-                memcpy(keep + 2 * lat.nn, lat.z, lat.nn * sizeof(double));
+                cf_msm_positions_get(&lat, keep);
             } else {
                 hi = mid;
             }
