@@ -9,8 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* ---- explicit dynamics ---------------------------------------------------------------------- */
-
 double cf_msm_stable_step(cf_lattice *lat, const cf_msm_effects *fx)
 {
     cf_lattice_forces(lat);

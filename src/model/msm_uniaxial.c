@@ -195,7 +195,8 @@ cf_status cf_msm_homogeneous_inertia(const cf_law *law, cf_law_method m, const c
 {
     cf_msm_config cfg = cfgin ? *cfgin : cf_msm_default();
     /* the banded LDL^T (GSL): its D gives the inertia, and unlike the sparse factorisations it
-    ** may run on any thread (MUMPS may not) */
+    ** runs on any thread without waiting (every CHOLMOD and MUMPS call holds one process-wide
+    ** lock, sparse_chol.c) */
     cfg.banded_only = 1;
     *neg = -1;
     if (!isfinite(strain) || !isfinite(lateral) || !(lateral > 0))
