@@ -22,6 +22,7 @@
 
 /* ---- workspace ------------------------------------------------------------------------------- */
 
+/* One solver of one lattice: set up by cf_msm_solver_init for a run, a curve or a scan. */
 typedef struct solver {
     cf_lattice *lat;
     const cf_msm_effects *fx;
@@ -39,6 +40,7 @@ typedef struct solver {
     double qlv_scale;         /* step's law-force factor minus 1 (Prony terms; 0 when off) */
     double qlv_slope;         /* its growth per unit |strain| of the spring (0: quasi-linear) */
     double *tmp;              /* per-spring scratch */
+    /* the tangent and its factorisations (linsolve.c) */
     gsl_spmatrix *C;          /* tangent, compressed columns, pattern built once */
     int *map, *diag;          /* spring block -> C->data index; DOF -> its diagonal index */
     size_t band;              /* half-bandwidth of C (largest |row - col|) */
@@ -46,7 +48,8 @@ typedef struct solver {
     cf_sparse_chol *chol;     /* sparse factorisation of C (pattern analysed once); NULL until used */
     int chol_failed;          /* 1: the sparse factorisation could not be set up; not retried */
     long neg_pivots;          /* negative pivots of the last factored tangent, -1 unknown */
-    int chord;                /* reuse factorisations across iterations and load steps (below) */
+    int chord;                /* reuse factorisations across iterations and load steps (chord
+                                 steps, cf_msm_newton) */
     int chol_ready;           /* s->chol holds the factors of C, scaled by s->D, for a chord step */
     int refactor;             /* the next direction needs a fresh tangent */
     double load;              /* current drive value: strain or stress, MPa */
@@ -79,8 +82,10 @@ static inline double *force(cf_lattice *lat, int a)
     return a == 0 ? lat->fx : a == 1 ? lat->fy : lat->fz;
 }
 
+/* The state of an explicit run (msm_dynamic.c). */
 typedef struct dyn {
-    double *vx, *vy, *vz, *Ld, *Tt;
+    double *vx, *vy, *vz;     /* node velocities, mm/s */
+    double *Ld, *Tt;          /* per spring: rate of its length, mm/s; dashpot + Maxwell force, N */
     int fused;                /* elastic springs only: the fused step of lattice_step.h */
     cf_lattice_stepper step;  /* its state (when fused) */
 } dyn;
