@@ -29,6 +29,8 @@
 #define BAND_ACCEPT 1e-10
 #define CHOL_REFINE 2
 
+/* ---- the pattern of the tangent -------------------------------------------------------------- */
+
 /* Index of entry (row, col) in the compressed-column matrix C, or -1 (rows within a column are
 ** not sorted by GSL's compression; a column holds at most 81 entries). */
 static int ccs_index(const gsl_spmatrix *C, long row, long col)
@@ -188,6 +190,8 @@ static cf_status build_pattern(solver *s, cf_error *err)
     block_map(s);
     return CF_OK;
 }
+
+/* ---- the factorisations ---------------------------------------------------------------------- */
 
 /* Adds the inertia of the tangent just solved (s->neg_pivots, -1 unknown) to the statistics. */
 static void note_inertia(solver *s)
@@ -371,6 +375,8 @@ done:
     gsl_vector_free(xv);
     return st;
 }
+
+/* ---- assembly and the cascade ---------------------------------------------------------------- */
 
 /* Assembles the tangent K = -dR/dx at the state of the last cf_msm_residual() into s->C (its
 ** pattern built on first use) and scales it symmetrically, K' = D^-1 K D^-1 with D = sqrt|diag|

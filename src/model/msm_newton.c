@@ -17,6 +17,8 @@
 ** direction refactors. */
 #define CHORD_RATE 0.25
 
+/* ---- workspace, loads and residual ----------------------------------------------------------- */
+
 void cf_msm_solver_free(solver *s)
 {
     free(s->eq);
@@ -148,6 +150,8 @@ double cf_msm_residual(solver *s, double *rnorm, double *fscale)
     *fscale = fs;
     return um;
 }
+
+/* ---- Newton and static load steps ------------------------------------------------------------ */
 
 void cf_msm_positions_get(const cf_lattice *lat, double *buf)
 {
