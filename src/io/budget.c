@@ -8,22 +8,20 @@
 #include <string.h>
 
 #include "conifit/calibration.h"
+#include "model/linsolve.h"
 
 /* Bytes per node and per spring of the lattice and the solver state (positions, reference
 ** positions, forces, masses, velocities; spring ends, lengths, weights, tensions, law state), and
 ** per sample (the sample, its time, the single-spring comparison). Rounded up from the arrays of
-** lattice.c and msm.c. */
+** lattice.c and the lattice solvers (msm*.c). */
 #define NODE_BYTES 160.0
 #define SPRING_BYTES 200.0
 #define SAMPLE_BYTES 64.0
-/* The static and implicit solvers (msm.c): the sparse tangent (81 entries a row at most, kept
-** twice while it is compressed), the banded factor when it fits in 5e7 entries, else a dense LU
-** up to 1200 unknowns, else a GMRES basis of 150 vectors. */
-#define TANGENT_ROW_BYTES (81.0 * 64.0)
-#define BAND_MAX_ENTRIES 5e7
-#define DENSE_MAX_DOF 1200.0
-#define GMRES_BASIS 150.0
-#define DT_SAFETY 0.9
+/* The static and implicit solvers, with the limits of their cascade (model/linsolve.h): the sparse
+** tangent (3 CF_LINSOLVE_MAX_ADJ entries a row at most, counted at 64 bytes each), the banded
+** factor when it fits in CF_LINSOLVE_BAND_MAX_ENTRIES entries, else a dense LU up to
+** CF_LINSOLVE_DENSE_MAX_DOF unknowns, else a GMRES basis of CF_LINSOLVE_GMRES_RESTART vectors. */
+#define TANGENT_ROW_BYTES (3.0 * CF_LINSOLVE_MAX_ADJ * 64.0)
 
 cf_budget cf_budget_default(void)
 {
@@ -86,12 +84,12 @@ cf_status cf_budget_check_size(const cf_scene *sc, const char *name, const cf_bu
     if (!sc->effects.inertia) { /* static and implicit runs factor the tangent */
         const double band = 3 * (nx + 1) * (ny + 1) + 3;
         solver = dof * TANGENT_ROW_BYTES + springs * 36 * 4;
-        if (dof * (band + 1) <= BAND_MAX_ENTRIES)
+        if (dof * (band + 1) <= CF_LINSOLVE_BAND_MAX_ENTRIES)
             solver += 8 * dof * (band + 1);
-        else if (dof <= DENSE_MAX_DOF)
+        else if (dof <= CF_LINSOLVE_DENSE_MAX_DOF)
             solver += 8 * dof * dof;
         else
-            solver += 8 * dof * (GMRES_BASIS + 4);
+            solver += 8 * dof * (CF_LINSOLVE_GMRES_RESTART + 4.0);
     }
     const double lattice = nodes * NODE_BYTES + springs * SPRING_BYTES;
     const double samples = (double)sc->nsamples * SAMPLE_BYTES;
@@ -120,7 +118,7 @@ cf_status cf_budget_check_steps(const cf_scene *sc, const char *name, cf_lattice
     double fit = 0;
     const char *fit_what = "";
     if (fx->inertia) {
-        double stable = DT_SAFETY * cf_msm_stable_step(lat, fx);
+        double stable = CF_MSM_DT_SAFETY * cf_msm_stable_step(lat, fx);
         double dt = cfg->dt_s > 0 && cfg->dt_s < stable ? cfg->dt_s : stable;
         c->steps = dt > 0 && isfinite(dt) ? duration / dt : INFINITY;
         c->steps_kind = "explicit steps";

@@ -26,7 +26,7 @@
 ** not depend on the number of threads (same results with one thread or many). Threads start only
 ** from CF_STEP_THREADS_MIN springs, below which they cost more than they save.
 **
-** Private to the model layer (msm.c's explicit dynamics; the benchmark).
+** Private to the model layer (msm_dynamic.c's explicit dynamics; the benchmark).
 */
 #ifndef CF_MODEL_LATTICE_STEP_H
 #define CF_MODEL_LATTICE_STEP_H

@@ -11,7 +11,7 @@
 ** own L D L^T is simplicial only (no BLAS): measured on a 27 000-unknown 3-D Laplacian, 12 s per
 ** factorisation against 1.3 s for MUMPS and 1.1 s for the supernodal LL^T.
 **
-** Private to the model layer: msm.c is its only user.
+** Private to the model layer: linsolve.c is its only user.
 */
 #ifndef CF_MODEL_SPARSE_CHOL_H
 #define CF_MODEL_SPARSE_CHOL_H

@@ -1,8 +1,8 @@
 /*
-** Tests of the mass-spring lattice and its solvers (src/model/lattice.c, src/model/msm.c): the axial lattice
-** against the single spring, equal and opposite spring forces, static against damped dynamics,
-** energy of the undamped symplectic integrator, creep, hysteresis against loading rate, and the
-** refusal of an unstable time step.
+** Tests of the mass-spring lattice and its solvers (src/model/lattice.c, src/model/msm*.c): the
+** axial lattice against the single spring, equal and opposite spring forces, static against
+** damped dynamics, energy of the undamped symplectic integrator, creep, hysteresis against loading
+** rate, and the refusal of an unstable time step.
 */
 #include "testutil.h"
 

@@ -1,5 +1,5 @@
 /*
-** Tests of the lattice solvers' public functions (src/model/msm.c; the lattice itself, its
+** Tests of the lattice solvers' public functions (src/model/msm*.c; the lattice itself, its
 ** moduli, energy of the symplectic integrator and the stability of a buckling column are in
 ** test_lattice.c):
 **  - cf_msm_path_value, cf_msm_default, cf_msm_prony_check;

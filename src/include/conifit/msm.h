@@ -1,16 +1,18 @@
 /*
 ** Solvers for the mass-spring lattice (lattice.h): static equilibria, quasi-static time stepping
-** with dashpots and Maxwell branches, and explicit symplectic dynamics with inertia; plus the
-** uniaxial curve used to validate a fitted spring.
+** with dashpots, Maxwell branches and Prony terms, and explicit symplectic dynamics with inertia;
+** plus the uniaxial curve used to validate a fitted spring and its stability.
 **
 ** What runs depends only on the effects asked for:
 **   no time effect          -> a sequence of static equilibria (Newton with the law's tangent,
-**                              banded LDL^T of the sparse tangent with dense LU and GMRES as
-**                              fallbacks, backtracking so that no spring is
-**                              driven to solid); no time stepping.
-**   damping and/or Maxwell,  -> implicit quasi-static steps (backward Euler for the dashpots, the
-**   no inertia                 exact exponential update for the Maxwell branches), each a Newton
-**                              solve; unconditionally stable.
+**                              backtracking so that no spring is driven to solid); the sparse
+**                              tangent is factored by CHOLMOD's Cholesky, or as L D L^T by MUMPS
+**                              when it is indefinite, with banded LDL^T, dense LU and GMRES as
+**                              fallbacks; no time stepping.
+**   damping, Maxwell and/or -> implicit quasi-static steps (backward Euler for the dashpots, the
+**   Prony terms, no inertia    exact exponential update for the Maxwell branches, the exact
+**                              recursive one for the Prony terms with the law force linear in
+**                              time over a step), each a Newton solve; unconditionally stable.
 **   inertia                 -> explicit symplectic Euler with the stable step computed from the
 **                              stiffest spring tangent and the lightest mass.
 ** An effect that is off has no loop at all.
@@ -30,6 +32,9 @@
 
 /* Most Prony terms of a reduced relaxation function. */
 #define CF_PRONY_MAX 8
+
+/* The explicit step as a fraction of the stable step (cf_msm_stable_step), automatic or not. */
+#define CF_MSM_DT_SAFETY 0.9
 
 /* Time-dependent effects; all zero = static. */
 typedef struct cf_msm_effects {
@@ -174,7 +179,7 @@ cf_status cf_msm_homogeneous_inertia(const cf_law *law, cf_law_method m, const c
 
 /* The explicit stable step (s) of the lattice at its current state for the given effects
 ** (stiffest spring tangent, lightest mass, most springs at one node; the dashpots shorten it).
-** Calls cf_lattice_forces. */
+** Calls cf_lattice_forces. An explicit run steps at most CF_MSM_DT_SAFETY times it. */
 double cf_msm_stable_step(cf_lattice *lat, const cf_msm_effects *fx);
 
 #endif

@@ -1,0 +1,31 @@
+/*
+** The linear solves of Newton's method on the lattice (linsolve.c) and the size limits of their
+** cascade. Private to the model layer; the limits are read by the cost estimate of a scene
+** (io/budget.c), so that the estimate follows the solvers.
+*/
+#ifndef CF_MODEL_LINSOLVE_H
+#define CF_MODEL_LINSOLVE_H
+
+#include "conifit/error.h"
+
+/* A node couples with itself and at most 26 neighbours (a 3 x 3 x 3 block of nodes): a column of
+** the tangent holds at most 3 CF_LINSOLVE_MAX_ADJ entries. */
+#define CF_LINSOLVE_MAX_ADJ 27
+/* The banded LDL^T is tried only when its band fits in this many doubles, */
+#define CF_LINSOLVE_BAND_MAX_ENTRIES 5e7
+/* dense LU only up to this many free DOFs (a 7x7x7 lattice has about 1500), */
+#define CF_LINSOLVE_DENSE_MAX_DOF 1200
+/* and GMRES restarts after this many basis vectors (fewer when there are fewer DOFs). */
+#define CF_LINSOLVE_GMRES_RESTART 150
+
+struct solver; /* the solvers' workspace (msm_internal.h) */
+
+/* Assembles the tangent at the state of the last residual and solves it for the Newton update
+** s->dx, noting the tangent's inertia in the statistics. */
+cf_status cf_linsolve_direction(struct solver *s, cf_error *err);
+
+/* The update from the sparse factors of an earlier tangent (a chord step). Returns 1 when s->dx
+** holds it; sets *fatal for an out-of-memory that no fallback would survive. */
+int cf_linsolve_chord(struct solver *s, int *fatal, cf_error *err);
+
+#endif

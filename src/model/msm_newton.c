@@ -1,0 +1,348 @@
+/*
+** The lattice solvers' workspace and static equilibria (see msm_internal.h): free DOFs, loads and
+** the residual; Newton with a line search that keeps every spring short of solid, chord steps for
+** the uniaxial curve, and load increments halved when a solve fails.
+*/
+#include "model/msm_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A spring may come this close to solid (fraction of the travel) in a Newton step; beyond it the
+** step is shortened. Past it the law's stiffness grows like (s - u)^(-1/2) and Newton stalls. */
+#define SOLID_MARGIN (1.0 - 1e-9)
+/* Chord iterations (the uniaxial curve): a direction from the last factored tangent is kept while
+** each step cuts the residual at least by CHORD_RATE without shortening; otherwise the next
+** direction refactors. */
+#define CHORD_RATE 0.25
+
+/* ---- workspace, loads and residual ----------------------------------------------------------- */
+
+void cf_msm_solver_free(solver *s)
+{
+    free(s->eq);
+    free(s->R);
+    free(s->D);
+    free(s->dx);
+    free(s->xsave);
+    free(s->Tx0);
+    free(s->kx);
+    free(s->Lprev);
+    free(s->sigm);
+    free(s->hq);
+    free(s->Fprev);
+    free(s->tmp);
+    free(s->map);
+    free(s->diag);
+    if (s->C)
+        gsl_spmatrix_free(s->C);
+    if (s->AB)
+        gsl_matrix_free(s->AB);
+    cf_sparse_chol_free(s->chol);
+}
+
+static int is_prescribed(const solver *s, size_t node, int axis)
+{
+    const cf_lattice *lat = s->lat;
+    if (lat->fix[node] & (1 << axis))
+        return 1;
+    if (axis == 2 && s->drive == CF_DRIVE_DISPLACEMENT && lat->Z[node] >= lat->height_mm * 0.9999999)
+        return 1;
+    return 0;
+}
+
+cf_status cf_msm_solver_init(solver *s, cf_lattice *lat, const cf_msm_effects *fx,
+                             const cf_msm_config *cfg, cf_msm_drive drive,
+                             cf_msm_stats *st, cf_error *err)
+{
+    memset(s, 0, sizeof *s);
+    s->lat = lat;
+    s->fx = fx;
+    s->cfg = cfg;
+    s->drive = drive;
+    s->st = st;
+    s->neg_pivots = -1;
+    if (st)
+        st->neg_pivots_max = -1;
+    s->eq = malloc(3 * lat->nn * sizeof(long));
+    s->xsave = malloc(3 * lat->nn * sizeof(double));
+    s->tmp = calloc(lat->ns ? lat->ns : 1, sizeof(double));
+    if (!s->eq || !s->xsave || !s->tmp)
+        goto oom;
+    size_t n = 0;
+    for (size_t p = 0; p < lat->nn; p++)
+        for (int a = 0; a < 3; a++)
+            s->eq[3 * p + a] = is_prescribed(s, p, a) ? -1 : (long)n++;
+    s->ndof = n;
+    s->R = calloc(n ? n : 1, sizeof(double));
+    s->D = calloc(n ? n : 1, sizeof(double));
+    s->dx = calloc(n ? n : 1, sizeof(double));
+    if (!s->R || !s->D || !s->dx)
+        goto oom;
+    if (fx && (fx->eta_MPa_s > 0 || fx->maxwell_E_MPa > 0 || fx->prony_count > 0)) {
+        s->Tx0 = calloc(lat->ns, sizeof(double));
+        s->kx = calloc(lat->ns, sizeof(double));
+        s->Lprev = calloc(lat->ns, sizeof(double));
+        if (!s->Tx0 || !s->kx || !s->Lprev)
+            goto oom;
+    }
+    if (fx && fx->maxwell_E_MPa > 0 && !(s->sigm = calloc(lat->ns, sizeof(double))))
+        goto oom;
+    if (fx && fx->prony_count > 0 &&
+        (!(s->hq = calloc(lat->ns * (size_t)fx->prony_count, sizeof(double))) ||
+         !(s->Fprev = calloc(lat->ns, sizeof(double)))))
+        goto oom;
+    return CF_OK;
+oom:
+    cf_msm_solver_free(s);
+    return cf_error_set(err, CF_E_INTERNAL, "out of memory for the lattice solver");
+}
+
+/* Places the top face for a displacement drive at compressive strain e. */
+void cf_msm_place_top(cf_lattice *lat, double e)
+{
+    for (size_t t = 0; t < lat->ntop; t++) {
+        uint32_t p = lat->top[t];
+        lat->z[p] = lat->Z[p] - e * lat->height_mm;
+    }
+}
+
+/* External loads: force drive on the top face, gravity on every node. */
+void cf_msm_add_external(solver *s)
+{
+    cf_lattice *lat = s->lat;
+    if (s->drive == CF_DRIVE_FORCE) {
+        double per = s->load * lat->H_mm * lat->H_mm; /* N per unit share */
+        for (size_t t = 0; t < lat->ntop; t++)
+            lat->fz[lat->top[t]] -= per * lat->top_share[t];
+    }
+    if (s->fx && s->fx->gravity_mm_per_s2 != 0)
+        for (size_t p = 0; p < lat->nn; p++)
+            lat->fz[p] -= lat->mass_t[p] * s->fx->gravity_mm_per_s2;
+}
+
+/* Forces at the current positions (kernel + quasi-static extras + loads) and the residual on the
+** free DOFs. Returns max |u|/travel; *rnorm the infinity norm, *fscale the force scale. */
+double cf_msm_residual(solver *s, double *rnorm, double *fscale)
+{
+    cf_lattice *lat = s->lat;
+    double um = cf_lattice_forces(lat);
+    if (s->extras) {
+        for (size_t q = 0; q < lat->ns; q++)
+            s->tmp[q] = s->Tx0[q] + s->kx[q] * (lat->L_mm[q] - s->Lprev[q]) -
+                        qlv_factor(s, q, NULL) * lat->w[q] * lat->F_N[q];
+        cf_lattice_add_tensions(lat, s->tmp);
+    }
+    cf_msm_add_external(s);
+    double rn = 0, fs = 0;
+    for (size_t q = 0; q < lat->ns; q++)
+        fs = fmax(fs, fabs(lat->T_N[q]));
+    for (size_t p = 0; p < lat->nn; p++)
+        for (int a = 0; a < 3; a++) {
+            long e = s->eq[3 * p + a];
+            if (e < 0)
+                continue;
+            s->R[e] = force(lat, a)[p];
+            rn = fmax(rn, fabs(s->R[e]));
+        }
+    *rnorm = rn;
+    *fscale = fs;
+    return um;
+}
+
+/* ---- Newton and static load steps ------------------------------------------------------------ */
+
+void cf_msm_positions_get(const cf_lattice *lat, double *buf)
+{
+    memcpy(buf, lat->x, lat->nn * sizeof(double));
+    memcpy(buf + lat->nn, lat->y, lat->nn * sizeof(double));
+    memcpy(buf + 2 * lat->nn, lat->z, lat->nn * sizeof(double));
+}
+
+void cf_msm_positions_set(cf_lattice *lat, const double *buf)
+{
+    memcpy(lat->x, buf, lat->nn * sizeof(double));
+    memcpy(lat->y, buf + lat->nn, lat->nn * sizeof(double));
+    memcpy(lat->z, buf + 2 * lat->nn, lat->nn * sizeof(double));
+}
+
+/* The force below which Newton's residual counts as converged, whatever the force scale. */
+static double force_floor(const solver *s)
+{
+    const cf_lattice *lat = s->lat;
+    /* Floor of the force scale: a small fraction of the solid load times the largest spring
+    ** weight (forces scale with it, and so does their rounding), so that an unloaded lattice is
+    ** converged at once whatever its weights (a diagonal weight of 1e4 left 7e-13 N of rounding
+    ** against a floor of 1e-12 F_C). */
+    double wmax = 1, dash = 0;
+    for (size_t q = 0; q < lat->ns; q++)
+        wmax = fmax(wmax, lat->w[q]);
+    /* ... and, in an implicit step with dashpots or Maxwell branches, above the rounding of their
+    ** forces kx (L - Lprev) (kx grows as 1/dt: 1000 substeps of a 1 s ramp left 1.9e-8 N of it).
+    ** A length is known only to the rounding of the coordinates it is formed from, eps times the
+    ** largest |coordinate| of the lattice, not of the length: so the scale of those terms is kx
+    ** times that coordinate (a row of 1000 cells stalled at 1.9 times a floor taken from kx L). */
+    if (s->extras && s->kx) {
+        double xmax = 0;
+        for (size_t p = 0; p < lat->nn; p++)
+            xmax = fmax(xmax, fmax(fabs(lat->x[p]), fmax(fabs(lat->y[p]), fabs(lat->z[p]))));
+        for (size_t q = 0; q < lat->ns; q++)
+            dash = fmax(dash, s->kx[q] * fmax(lat->L_mm[q], xmax));
+    }
+    return 1e-12 * lat->law->F_C_N * wmax + 1e-13 * dash;
+}
+
+/* Newton from the current positions (prescribed DOFs already placed). On failure the positions
+** are put back where they started. One function: the choice between a chord step and a fresh
+** tangent, the line search and the retry with a fresh tangent all read and update the same
+** iteration state (residual norms, the factorisation's age). */
+cf_status cf_msm_newton(solver *s, cf_error *err)
+{
+    cf_lattice *lat = s->lat;
+    double *start = malloc(3 * lat->nn * sizeof(double));
+    if (!start)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory");
+    cf_msm_positions_get(lat, start);
+    if (s->st)
+        s->st->solves++;
+    double rn, fs;
+    double um = cf_msm_residual(s, &rn, &fs);
+    const double floor_f = force_floor(s);
+    cf_status st = CF_E_NOCONV;
+    for (int it = 0; it <= s->cfg->newton_max_iter; it++) {
+        if (um < SOLID_MARGIN && rn <= s->cfg->newton_rtol * fs + floor_f) {
+            st = CF_OK;
+            break;
+        }
+        if (it == s->cfg->newton_max_iter)
+            break;
+        if (s->st)
+            s->st->newton_iters++;
+        cf_error lerr = {0};
+        /* a chord step: the last factored tangent, while it still converges fast */
+        const int chord = s->chord && s->chol_ready && !s->refactor;
+        if (chord) {
+            int fatal = 0;
+            if (!cf_linsolve_chord(s, &fatal, &lerr)) {
+                if (fatal) {
+                    cf_msm_positions_set(lat, start);
+                    free(start);
+                    return cf_error_set(err, CF_E_INTERNAL, "%s", lerr.msg);
+                }
+                s->refactor = 1;
+                continue;
+            }
+            if (s->st)
+                s->st->chord_iters++;
+        } else if (cf_linsolve_direction(s, &lerr) != CF_OK) {
+            if (lerr.status == CF_E_INTERNAL) { /* out of memory: not a matter of step size */
+                cf_msm_positions_set(lat, start);
+                free(start);
+                return cf_error_set(err, CF_E_INTERNAL, "%s", lerr.msg);
+            }
+            break;
+        } else
+            s->refactor = 0;
+        cf_msm_positions_get(lat, s->xsave);
+        double alpha = 1, rn0 = rn;
+        int ok = 0;
+        for (int h = 0; h < 40; h++) {
+            for (size_t p = 0; p < lat->nn; p++)
+                for (int a = 0; a < 3; a++) {
+                    long e = s->eq[3 * p + a];
+                    if (e >= 0)
+                        coord(lat, a)[p] = s->xsave[a * lat->nn + p] + alpha * s->dx[e];
+                }
+            um = cf_msm_residual(s, &rn, &fs);
+            if (um < SOLID_MARGIN && isfinite(rn) && (rn < (1 - 1e-4 * alpha) * rn0 || h >= 30)) {
+                ok = 1;
+                break;
+            }
+            alpha *= 0.5;
+        }
+        if (!ok) {
+            cf_msm_positions_set(lat, s->xsave);
+            if (!chord)
+                break;
+            um = cf_msm_residual(s, &rn, &fs); /* a stale tangent: try again with a fresh one */
+            s->refactor = 1;
+            continue;
+        }
+        if (chord && (alpha < 1 || rn > CHORD_RATE * rn0))
+            s->refactor = 1;
+    }
+    if (s->st && um > s->st->max_u_over_travel && st == CF_OK)
+        s->st->max_u_over_travel = um;
+    if (st != CF_OK) {
+        cf_msm_positions_set(lat, start);
+        cf_error_set(err, CF_E_NOCONV,
+                     "lattice equilibrium not found at %s %.6g (residual %.3g N, max spring "
+                     "compression %.6g of travel)",
+                     s->drive == CF_DRIVE_DISPLACEMENT ? "strain" : "stress_MPa", s->load, rn, um);
+    }
+    free(start);
+    return st;
+}
+
+/* Moves the free z of every node by the affine part of a strain increment de (a predictor that
+** puts the interior where a uniform lattice would be). */
+static void predict(solver *s, double de)
+{
+    cf_lattice *lat = s->lat;
+    for (size_t p = 0; p < lat->nn; p++)
+        if (s->eq[3 * p + 2] >= 0)
+            lat->z[p] -= de * lat->Z[p];
+}
+
+/* Static equilibrium from drive value v0 (the current state) to v1; splits the increment in two
+** when a direct solve fails. */
+static cf_status static_seg(solver *s, double v0, double v1, int depth, cf_error *err)
+{
+    s->load = v1;
+    int disp = s->drive == CF_DRIVE_DISPLACEMENT;
+    if (disp) {
+        cf_msm_place_top(s->lat, v1);
+        predict(s, v1 - v0);
+    }
+    cf_status st = cf_msm_newton(s, err);
+    if (st == CF_OK)
+        return st;
+    s->load = v0;
+    if (disp) {
+        cf_msm_place_top(s->lat, v0);
+        predict(s, v0 - v1);
+    }
+    if (st != CF_E_NOCONV || depth >= MAX_BISECT)
+        return st;
+    double mid = 0.5 * (v0 + v1);
+    st = static_seg(s, v0, mid, depth + 1, err);
+    if (st != CF_OK)
+        return st;
+    return static_seg(s, mid, v1, depth + 1, err);
+}
+
+cf_status cf_msm_static_to(solver *s, double v, cf_error *err)
+{
+    return static_seg(s, s->load, v, 0, err);
+}
+
+/* Compressive nominal stress (MPa) at the current state from the node forces of the last
+** residual/kernel call: the reaction the top platen provides. */
+double cf_msm_top_stress(const cf_lattice *lat)
+{
+    double r = 0;
+    for (size_t t = 0; t < lat->ntop; t++)
+        r += lat->fz[lat->top[t]];
+    return r / lat->area_mm2;
+}
+
+/* Node force evaluation for reporting the reaction of a displacement drive. */
+double cf_msm_reported_stress(solver *s)
+{
+    if (s->drive == CF_DRIVE_FORCE)
+        return s->load;
+    double rn, fs;
+    cf_msm_residual(s, &rn, &fs);
+    return cf_msm_top_stress(s->lat);
+}
