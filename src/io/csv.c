@@ -34,7 +34,6 @@ void cf_csv_quote(char *out, size_t cap, const char *s, size_t n)
     out[o < cap ? o : cap - 1] = '\0';
 }
 
-
 cf_status cf_csv_error(cf_error *err, const char *path, size_t line, size_t col, const char *fmt,
                        ...)
 {
@@ -46,7 +45,6 @@ cf_status cf_csv_error(cf_error *err, const char *path, size_t line, size_t col,
     return cf_error_set(err, CF_E_DATA, "%s:%zu:%zu: %s", path, line, col, msg);
 }
 
-
 /* ---- lines and fields ------------------------------------------------------------------------ */
 
 void cf_csv_fields_free(cf_csv_fields *f)
@@ -55,7 +53,6 @@ void cf_csv_fields_free(cf_csv_fields *f)
     free(f->off);
     memset(f, 0, sizeof *f);
 }
-
 
 static int fields_reserve(cf_csv_fields *f, size_t text_len)
 {
@@ -68,7 +65,6 @@ static int fields_reserve(cf_csv_fields *f, size_t text_len)
     }
     return 0;
 }
-
 
 static int fields_push(cf_csv_fields *f, size_t off)
 {
@@ -83,7 +79,6 @@ static int fields_push(cf_csv_fields *f, size_t off)
     f->off[f->count++] = off;
     return 0;
 }
-
 
 size_t cf_csv_content_length(const char *s, size_t n)
 {
@@ -102,7 +97,6 @@ size_t cf_csv_content_length(const char *s, size_t n)
     return end;
 }
 
-
 int cf_csv_is_comment(const cf_csv_line *l)
 {
     size_t i = 0;
@@ -110,7 +104,6 @@ int cf_csv_is_comment(const cf_csv_line *l)
         i++;
     return i < l->n && l->s[i] == '#';
 }
-
 
 char cf_csv_delimiter(const char *s, size_t n)
 {
@@ -140,12 +133,10 @@ char cf_csv_delimiter(const char *s, size_t n)
     return nf >= 2 ? ' ' : 0;
 }
 
-
 static int is_blank(char c, char delim)
 {
     return c == ' ' || (c == '\t' && delim != '\t');
 }
-
 
 /* Splits a whitespace-separated line (delimiter ' ': runs of blanks and TABs) into f. A field
 ** may be double-quoted (with "" for a quote inside); a field that starts with '[' or '(' belongs
@@ -195,7 +186,6 @@ static int split_blanks(const char *s, size_t n, cf_csv_fields *f, size_t *bad_c
         f->buf[o++] = '\0';
     }
 }
-
 
 int cf_csv_split(const char *s, size_t n, char delim, cf_csv_fields *f, size_t *bad_col,
                  const char **why)
@@ -259,7 +249,6 @@ int cf_csv_split(const char *s, size_t n, char delim, cf_csv_fields *f, size_t *
     }
 }
 
-
 void cf_csv_trim_copy(char *out, size_t cap, const char *s, size_t n)
 {
     while (n > 0 && isspace((unsigned char)*s)) {
@@ -273,7 +262,6 @@ void cf_csv_trim_copy(char *out, size_t cap, const char *s, size_t n)
     memcpy(out, s, n);
     out[n] = '\0';
 }
-
 
 /* ---- bytes and characters -------------------------------------------------------------------- */
 
@@ -316,7 +304,6 @@ size_t cf_csv_bad_byte(const unsigned char *s, size_t n)
     return n;
 }
 
-
 void cf_csv_utf8_copy(char *dst, size_t cap, const char *src)
 {
     size_t o = 0, n = strlen(src), i = 0;
@@ -343,7 +330,6 @@ void cf_csv_utf8_copy(char *dst, size_t cap, const char *src)
     }
     dst[o] = '\0';
 }
-
 
 /* ---- numbers --------------------------------------------------------------------------------- */
 

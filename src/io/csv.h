@@ -40,7 +40,6 @@ typedef enum cf_csv_num {
     CF_CSV_NUM_NOT_FINITE
 } cf_csv_num;
 
-
 /* Copies text into out as a short printable quotation: control and non-ASCII bytes as \xNN,
 ** long text cut with "...". */
 void cf_csv_quote(char *out, size_t cap, const char *s, size_t n);
