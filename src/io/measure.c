@@ -291,73 +291,6 @@ static cf_status column_unit(const reader *r, size_t header_line, size_t ci, con
     return CF_OK;
 }
 
-/* The stress and strain measures: the caller's options, the '# stress:' and '# strain:' comments
-** and the column names, reconciled (io/measures.h). */
-static cf_status decide_measures(const reader *r, const char *path, const cf_measure_options *opt,
-                                 const cf_column *xc, const cf_column *yc, cf_table_measures *out,
-                                 cf_error *err)
-{
-    static const char *const what[CF_DECL_KINDS] = {"stress measure", "strain measure"};
-    static const char *const expect[CF_DECL_KINDS] = {"nominal or cauchy",
-                                                      "engineering, log or stretch"};
-    cf_measures_said said[CF_DECL_KINDS];
-    for (int k = 0; k < CF_DECL_KINDS; k++)
-        said[k] = (cf_measures_said){-1, 0, -1};
-    for (size_t i = 0; i < r->ncomments; i++) {
-        int kind, v = -1;
-        char word[64];
-        if (!cf_measures_declaration(r->comments[i].s, r->comments[i].n, &kind, word,
-                                     sizeof word))
-            continue;
-        if (kind == CF_DECL_STRESS) {
-            cf_stress_measure x;
-            v = cf_stress_measure_parse(word, &x) == 0 ? (int)x : -1;
-        } else {
-            cf_strain_measure x;
-            v = cf_strain_measure_parse(word, &x) == 0 ? (int)x : -1;
-        }
-        if (v < 0)
-            return cf_csv_error(err, path, r->comments[i].line, 1,
-                                "unknown %s (expected %s) ('%s')", what[kind], expect[kind], word);
-        if (said[kind].declared >= 0 && said[kind].declared != v)
-            return cf_csv_error(err, path, r->comments[i].line, 1,
-                                "%s declared twice, differently (line %zu says otherwise) ('%s')",
-                                what[kind], said[kind].line, word);
-        said[kind].declared = v;
-        said[kind].line = r->comments[i].line;
-    }
-    said[CF_DECL_STRESS].column = cf_measures_stress_of_column(yc->base);
-    said[CF_DECL_STRAIN].column = cf_measures_strain_of_column(xc->base);
-    int strain_opt = opt->strain_measure >= 0   ? opt->strain_measure
-                     : opt->x_is_stretch == 1   ? CF_STRAIN_STRETCH
-                     : opt->x_is_stretch == 0   ? CF_STRAIN_ENGINEERING
-                                                : -1;
-    const int option[CF_DECL_KINDS] = {opt->stress_measure, strain_opt};
-    const char *col[CF_DECL_KINDS] = {yc->name, xc->name};
-    int value[CF_DECL_KINDS], over[CF_DECL_KINDS], filev[CF_DECL_KINDS];
-    cf_decl_source from[CF_DECL_KINDS];
-    size_t line[CF_DECL_KINDS];
-    for (int k = 0; k < CF_DECL_KINDS; k++) {
-        cf_status st = cf_measures_decide(path, col[k], what[k], cf_measures_names[k], option[k],
-                                          &said[k], 0, &value[k], &from[k], &line[k], &over[k],
-                                          &filev[k], err);
-        if (st != CF_OK)
-            return st;
-    }
-    memset(out, 0, sizeof *out);
-    out->stress = (cf_stress_measure)value[CF_DECL_STRESS];
-    out->strain = (cf_strain_measure)value[CF_DECL_STRAIN];
-    out->stress_from = from[CF_DECL_STRESS];
-    out->strain_from = from[CF_DECL_STRAIN];
-    out->stress_line = line[CF_DECL_STRESS];
-    out->strain_line = line[CF_DECL_STRAIN];
-    out->stress_overridden = over[CF_DECL_STRESS];
-    out->strain_overridden = over[CF_DECL_STRAIN];
-    out->stress_file = filev[CF_DECL_STRESS];
-    out->strain_file = filev[CF_DECL_STRAIN];
-    return CF_OK;
-}
-
 /* What the header decided, for the stages after it: where it is, its delimiter, its columns and
 ** which of them are x, y, the weight and the time (-1: none). */
 typedef struct layout {
@@ -606,7 +539,8 @@ static cf_status decide_units(const reader *r, const cf_measure_options *opt, co
 {
     cf_status st = y_unit(r, opt, h, m, u, err);
     if (st == CF_OK)
-        st = decide_measures(r, r->path, opt, &r->cols[h->xi], &r->cols[h->yi], &u->meas, err);
+        st = cf_measures_read(r->comments, r->ncomments, r->path, opt, &r->cols[h->xi],
+                              &r->cols[h->yi], &u->meas, err);
     if (st != CF_OK)
         return st;
     u->stretch = u->meas.strain == CF_STRAIN_STRETCH;

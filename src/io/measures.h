@@ -11,6 +11,8 @@
 
 #include "conifit/error.h"
 #include "conifit/measure.h"
+#include "io/columns.h"
+#include "io/csv.h"
 
 /* What a declaration declares. */
 enum { CF_DECL_STRESS = 0, CF_DECL_STRAIN = 1, CF_DECL_KINDS = 2 };
@@ -47,6 +49,13 @@ cf_status cf_measures_decide(const char *path, const char *column, const char *w
                              const char *const *names, int option, const cf_measures_said *said,
                              int fallback, int *value, cf_decl_source *from, size_t *line,
                              int *overridden, int *file_value, cf_error *err);
+
+/* The stress and strain measures of a table: the caller's options, the '# stress:' and
+** '# strain:' comments and the names of the x and y columns, reconciled (a declaration that
+** names no measure, or two that disagree, is an error naming the comment's line). */
+cf_status cf_measures_read(const cf_csv_line *comments, size_t ncomments, const char *path,
+                           const cf_measure_options *opt, const cf_column *xc, const cf_column *yc,
+                           cf_table_measures *out, cf_error *err);
 
 /* Converts t's x to engineering strain and its y to nominal stress, as t->measures says (x is
 ** already stretch - 1 for a stretch column). CF_E_DATA, naming the file and the measure, for a
