@@ -1,7 +1,10 @@
 /*
-** Reading measured tables (see measure.h): the CSV dialect, unit decorations in column names and
-** in '#' comments, conversion into MPa / N / mm / s, and one precise message for each way a table
-** can be wrong. Columns in messages count fields from 1.
+** Reading measured tables (measure.h), in stages: the file's text, the header and which columns
+** are x, y, a weight and a time, their units, the rows converted into MPa / N / mm / s, and the
+** test mode; each stage refuses a table with one precise message. Columns in messages count
+** fields from 1. The stages use the lexer (io/csv.c), the units and column names
+** (io/columns.c) and the stress and strain measures (io/measures.c); what they fill is a
+** cf_table (model/table.c).
 */
 #include "conifit/measure.h"
 
@@ -22,7 +25,7 @@ cf_measure_options cf_measure_default_options(void)
     return o;
 }
 
-/* ---- the reader --------------------------------------------------------------------------- */
+/* ---- the text -------------------------------------------------------------------------------- */
 
 typedef struct reader {
     const char *path;
@@ -198,98 +201,7 @@ static cf_status split_or_fail(reader *r, const cf_csv_line *l, size_t n, char d
     return CF_OK;
 }
 
-static int push_row(reader *r, double x, double y, double w, double t)
-{
-    if (r->count == r->cap) {
-        size_t cap = r->cap ? 2 * r->cap : 64;
-        double *a[4] = {r->x, r->y, r->w, r->t};
-        for (int k = 0; k < 4; k++) {
-            double *p = realloc(a[k], cap * sizeof *p);
-            if (!p)
-                return -1;
-            a[k] = p;
-            if (k == 0)
-                r->x = p;
-            else if (k == 1)
-                r->y = p;
-            else if (k == 2)
-                r->w = p;
-            else
-                r->t = p;
-        }
-        r->cap = cap;
-    }
-    r->x[r->count] = x;
-    r->y[r->count] = y;
-    r->w[r->count] = w;
-    r->t[r->count] = t;
-    r->count++;
-    return 0;
-}
-
-/* Finds a column by name (the full header name or its base, case-insensitive). */
-static long find_column(const reader *r, const char *name)
-{
-    for (size_t i = 0; i < r->ncols; i++)
-        if (strcasecmp(r->cols[i].name, name) == 0)
-            return (long)i;
-    for (size_t i = 0; i < r->ncols; i++)
-        if (strcasecmp(r->cols[i].base, name) == 0)
-            return (long)i;
-    return -1;
-}
-
-static cf_status column_not_found(const reader *r, size_t header_line, const char *what,
-                                  const char *name, cf_error *err)
-{
-    char list[256];
-    size_t o = 0;
-    list[0] = '\0';
-    for (size_t i = 0; i < r->ncols && o + 4 < sizeof list; i++)
-        o += (size_t)snprintf(list + o, sizeof list - o, "%s%s", i ? ", " : "", r->cols[i].name);
-    char q[256];
-    cf_csv_quote(q, sizeof q, name, strlen(name));
-    return cf_csv_error(err, r->path, header_line, 1,
-                        "no %s column named '%s' (the header has: %s)", what, q, list);
-}
-
-/* Resolves the unit of column c: the option if given, else its decoration, else a '#' comment.
-** Returns CF_OK with *u NULL when no unit is stated anywhere. */
-static cf_status column_unit(const reader *r, size_t header_line, size_t ci, const char *option,
-                             const char *option_flag, int which, const cf_unit_class *want,
-                             size_t nwant, const cf_unit_def **u, cf_error *err)
-{
-    const cf_column *c = &r->cols[ci];
-    const char *text = option ? option : (c->unit[0] ? c->unit : NULL);
-    *u = NULL;
-    if (text) {
-        const cf_unit_def *d = cf_unit_find(text);
-        char q[256];
-        cf_csv_quote(q, sizeof q, text, strlen(text));
-        if (!d) {
-            if (option)
-                return cf_error_set(err, CF_E_DATA,
-                                    "%s: %s '%s': unknown unit (known units: %s)", r->path,
-                                    option_flag, q, cf_unit_list);
-            return cf_csv_error(err, r->path, header_line, ci + 1,
-                                "column '%s': unknown unit '%s' (known units, case-sensitive: %s)",
-                                c->name, q, cf_unit_list);
-        }
-        for (size_t k = 0; k < nwant; k++)
-            if (d->cls == want[k]) {
-                *u = d;
-                return CF_OK;
-            }
-        if (option)
-            return cf_error_set(err, CF_E_DATA, "%s: %s '%s' is not a unit for column '%s'",
-                                r->path, option_flag, q, c->name);
-        return cf_csv_error(err, r->path, header_line, ci + 1,
-                            "column '%s': unit '%s' does not fit this column ('%s')", c->name, q,
-                            c->name);
-    }
-    *u = cf_comment_unit(r->comments, r->ncomments, c->base, which, want, nwant);
-    return CF_OK;
-}
+/* ---- the header and its columns -------------------------------------------------------------- */
 
 /* What the header decided, for the stages after it: where it is, its delimiter, its columns and
 ** which of them are x, y, the weight and the time (-1: none). */
@@ -302,14 +214,6 @@ typedef struct layout {
     int trailing;          /* the header ends with a delimiter: so must every row */
     long xi, yi, wi, ti;
 } layout;
-
-/* The units decided: the y unit, the measures, and the factors to conifit's units. */
-typedef struct scaling {
-    const cf_unit_def *yu;
-    cf_table_measures meas;
-    int stretch;           /* x is a stretch: strain = x - 1 */
-    double xscale, yscale, tscale;
-} scaling;
 
 /* The header: the first line with content. */
 static cf_status find_header(const reader *r, layout *h, cf_error *err)
@@ -382,6 +286,32 @@ static cf_status read_header(reader *r, layout *h, cf_error *err)
     return CF_OK;
 }
 
+/* Finds a column by name (the full header name or its base, case-insensitive). */
+static long find_column(const reader *r, const char *name)
+{
+    for (size_t i = 0; i < r->ncols; i++)
+        if (strcasecmp(r->cols[i].name, name) == 0)
+            return (long)i;
+    for (size_t i = 0; i < r->ncols; i++)
+        if (strcasecmp(r->cols[i].base, name) == 0)
+            return (long)i;
+    return -1;
+}
+
+static cf_status column_not_found(const reader *r, size_t header_line, const char *what,
+                                  const char *name, cf_error *err)
+{
+    char list[256];
+    size_t o = 0;
+    list[0] = '\0';
+    for (size_t i = 0; i < r->ncols && o + 4 < sizeof list; i++)
+        o += (size_t)snprintf(list + o, sizeof list - o, "%s%s", i ? ", " : "", r->cols[i].name);
+    char q[256];
+    cf_csv_quote(q, sizeof q, name, strlen(name));
+    return cf_csv_error(err, r->path, header_line, 1,
+                        "no %s column named '%s' (the header has: %s)", what, q, list);
+}
+
 /* Which columns: x, y, weight, time (the options name x and y, else their names tell). */
 static cf_status choose_columns(const reader *r, const cf_measure_options *opt, layout *h,
                                 cf_error *err)
@@ -423,6 +353,54 @@ static cf_status choose_columns(const reader *r, const cf_measure_options *opt, 
     h->yi = yi;
     h->wi = wi == xi || wi == yi ? -1 : wi;
     h->ti = ti == xi || ti == yi ? -1 : ti;
+    return CF_OK;
+}
+
+/* ---- units ----------------------------------------------------------------------------------- */
+
+/* The units decided: the y unit, the measures, and the factors to conifit's units. */
+typedef struct scaling {
+    const cf_unit_def *yu;
+    cf_table_measures meas;
+    int stretch;           /* x is a stretch: strain = x - 1 */
+    double xscale, yscale, tscale;
+} scaling;
+
+/* Resolves the unit of column c: the option if given, else its decoration, else a '#' comment.
+** Returns CF_OK with *u NULL when no unit is stated anywhere. */
+static cf_status column_unit(const reader *r, size_t header_line, size_t ci, const char *option,
+                             const char *option_flag, int which, const cf_unit_class *want,
+                             size_t nwant, const cf_unit_def **u, cf_error *err)
+{
+    const cf_column *c = &r->cols[ci];
+    const char *text = option ? option : (c->unit[0] ? c->unit : NULL);
+    *u = NULL;
+    if (text) {
+        const cf_unit_def *d = cf_unit_find(text);
+        char q[256];
+        cf_csv_quote(q, sizeof q, text, strlen(text));
+        if (!d) {
+            if (option)
+                return cf_error_set(err, CF_E_DATA,
+                                    "%s: %s '%s': unknown unit (known units: %s)", r->path,
+                                    option_flag, q, cf_unit_list);
+            return cf_csv_error(err, r->path, header_line, ci + 1,
+                                "column '%s': unknown unit '%s' (known units, case-sensitive: %s)",
+                                c->name, q, cf_unit_list);
+        }
+        for (size_t k = 0; k < nwant; k++)
+            if (d->cls == want[k]) {
+                *u = d;
+                return CF_OK;
+            }
+        if (option)
+            return cf_error_set(err, CF_E_DATA, "%s: %s '%s' is not a unit for column '%s'",
+                                r->path, option_flag, q, c->name);
+        return cf_csv_error(err, r->path, header_line, ci + 1,
+                            "column '%s': unit '%s' does not fit this column ('%s')", c->name, q,
+                            c->name);
+    }
+    *u = cf_comment_unit(r->comments, r->ncomments, c->base, which, want, nwant);
     return CF_OK;
 }
 
@@ -547,6 +525,37 @@ static cf_status decide_units(const reader *r, const cf_measure_options *opt, co
     if ((st = x_unit(r, opt, h, m, u, err)) != CF_OK)
         return st;
     return t_unit(r, h, u, err);
+}
+
+/* ---- rows ------------------------------------------------------------------------------------ */
+
+static int push_row(reader *r, double x, double y, double w, double t)
+{
+    if (r->count == r->cap) {
+        size_t cap = r->cap ? 2 * r->cap : 64;
+        double *a[4] = {r->x, r->y, r->w, r->t};
+        for (int k = 0; k < 4; k++) {
+            double *p = realloc(a[k], cap * sizeof *p);
+            if (!p)
+                return -1;
+            a[k] = p;
+            if (k == 0)
+                r->x = p;
+            else if (k == 1)
+                r->y = p;
+            else if (k == 2)
+                r->w = p;
+            else
+                r->t = p;
+        }
+        r->cap = cap;
+    }
+    r->x[r->count] = x;
+    r->y[r->count] = y;
+    r->w[r->count] = w;
+    r->t[r->count] = t;
+    r->count++;
+    return 0;
 }
 
 /* The field count of a row (split into r->f) against the header's. */
@@ -680,6 +689,8 @@ static cf_status read_rows(reader *r, const layout *h, const scaling *u, cf_erro
                             CF_MEASURE_MIN_ROWS, r->count);
     return CF_OK;
 }
+
+/* ---- the table ------------------------------------------------------------------------------- */
 
 /* The test mode: the option wins over the file's comment. */
 static cf_status decide_mode(const reader *r, const cf_measure_options *opt, cf_table *m,
