@@ -432,10 +432,10 @@ static cf_status y_unit(const reader *r, const cf_measure_options *opt, const la
     if (st)
         return st;
     if (!u->yu) {
-        const char *hint = yname == CF_UNIT_FORCE ? "force_N or force [mN], or set option force_unit"
-                                                  : "stress_kPa or stress [kPa], or set "
-                                                    "option stress_unit (option force_unit for a "
-                                                    "force)";
+        const char *hint = yname == CF_UNIT_FORCE
+                               ? "force_N or force [mN], or set option force_unit"
+                               : "stress_kPa or stress [kPa], or set option stress_unit (option "
+                                 "force_unit for a force)";
         return cf_csv_error(err, r->path, h->header_line, (size_t)h->yi + 1,
                             "column '%s' has no unit: name it like %s ('%s')", yc->name, hint,
                             yc->name);
@@ -761,7 +761,8 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
         (st = find_header(&r, &h, err)) != CF_OK || (st = read_header(&r, &h, err)) != CF_OK ||
         (st = choose_columns(&r, &opt, &h, err)) != CF_OK ||
         (st = decide_units(&r, &opt, &h, m, &u, err)) != CF_OK ||
-        (st = read_rows(&r, &h, &u, err)) != CF_OK || (st = decide_mode(&r, &opt, m, err)) != CF_OK) {
+        (st = read_rows(&r, &h, &u, err)) != CF_OK ||
+        (st = decide_mode(&r, &opt, m, err)) != CF_OK) {
         reader_free(&r);
         memset(m, 0, sizeof *m);
         return st;
