@@ -56,9 +56,9 @@ typedef struct cf_table_measures {
     int strain_converted;       /* 1: x was converted from log strain or stretch to engineering */
 } cf_table_measures;
 
-/* A measured table in conifit's units: the one type that goes from the reader through the fit,
-** the validation, the report and the plots. The reader fills every field; a table built in code
-** (cf_table_from_arrays) has kind, count, x, y, w, y_to_file = 1 and empty names. */
+/* A measured table in conifit's units. The reader fills every field; a table built in code
+** (cf_table_from_arrays) has the fields that function names, no time column, the uniaxial mode
+** (not stated) and zeroed measures (nominal stress, engineering strain, assumed). */
 typedef struct cf_table {
     cf_table_kind kind;
     size_t count;          /* number of data rows */
@@ -83,8 +83,9 @@ typedef struct cf_table {
 } cf_table;
 
 /* A table of count points copied from x, y and w (w NULL: every weight 1), for data made in
-** code (tests, benchmarks, other front ends): the units are conifit's, y_unit "MPa" or "N",
-** path and column names "x" and "y". CF_E_INTERNAL when memory runs out. */
+** code (tests, benchmarks, other front ends): the units are conifit's (x_unit "-" or "mm", y_unit
+** "MPa" or "N", y_to_file 1), the path "(table in memory)", the column names "x" and "y", and the
+** compression flag set as the reader sets it. CF_E_INTERNAL when memory runs out. */
 cf_status cf_table_from_arrays(cf_table_kind kind, size_t count, const double *x, const double *y,
                                const double *w, cf_table *m, cf_error *err);
 
