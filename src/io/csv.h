@@ -1,8 +1,9 @@
 /*
-** The lexer of measurement tables, private to the table reader (io/measure.c): lines of text,
-** fields split at a delimiter with double quotes, '#' comments, numbers in a cell, and messages
-** "PATH:LINE:COL: what is wrong" with the offending text quoted printably. Columns count fields
-** from 1; where a line holds bytes that are not text, they count bytes.
+** The lexer of measurement tables, private to the table reader (io/measure.c, io/columns.c,
+** io/measures.c): lines of text, fields split at a delimiter with double quotes, '#' comments,
+** numbers in a cell, and messages "PATH:LINE:COL: what is wrong" with the offending text quoted
+** printably. Columns count fields from 1; where a line holds bytes that are not text, they count
+** bytes.
 */
 #ifndef CF_IO_CSV_H
 #define CF_IO_CSV_H
@@ -59,8 +60,10 @@ void cf_csv_fields_free(cf_csv_fields *f);
 ** blanks removed. */
 size_t cf_csv_content_length(const char *s, size_t n);
 
-/* Splits s[0..n) at delim into f. Returns 0, or -1 on a quoting error (with *bad_col the field
-** and *why the reason), or -2 when memory runs out. */
+/* Splits s[0..n) at delim into f (delim ' ': at runs of blanks and TABs, a field that opens with
+** '[' or '(' joined to the one before, so that "stress [kPa]" stays one name). Returns 0, or -1 on
+** a quoting error (with *bad_col the field's column, from 1, and *why the reason), or -2 when
+** memory runs out. */
 int cf_csv_split(const char *s, size_t n, char delim, cf_csv_fields *f, size_t *bad_col,
                  const char **why);
 
