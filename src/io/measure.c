@@ -1,24 +1,23 @@
 /*
-** Reading measured tables (see measure.h): the CSV dialect, unit decorations in column names and
-** in '#' comments, conversion into MPa / N / mm / s, and one precise message for each way a table
-** can be wrong. Columns in messages count fields from 1.
+** Reading measured tables (measure.h), in stages: the file's text, the header and which columns
+** are x, y, a weight and a time, their units, the rows converted into MPa / N / mm / s, and the
+** test mode; each stage refuses a table with one precise message. Columns in messages count
+** fields from 1. The stages use the lexer (io/csv.c), the units and column names
+** (io/columns.c) and the stress and strain measures (io/measures.c); what they fill is a
+** cf_table (model/table.c).
 */
 #include "conifit/measure.h"
 
+#include "io/columns.h"
+#include "io/csv.h"
 #include "io/measures.h"
 
-#include <ctype.h>
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
-#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-
-/* Longest column name kept (longer names are an error: they are not column names). */
-#define NAME_CAP 256
 
 cf_measure_options cf_measure_default_options(void)
 {
@@ -26,674 +25,19 @@ cf_measure_options cf_measure_default_options(void)
     return o;
 }
 
-/* ---- units -------------------------------------------------------------------------------- */
-
-typedef struct unit_def {
-    const char *name;
-    cf_unit_class cls;
-    double to_conifit;
-    const char *canon; /* spelling used in reports */
-} unit_def;
-
-/* 1 mmHg = 133.322387415 Pa (conventional millimetre of mercury). */
-static const unit_def units[] = {
-    {"Pa", CF_UNIT_STRESS, 1e-6, "Pa"},
-    {"kPa", CF_UNIT_STRESS, 1e-3, "kPa"},
-    {"KPa", CF_UNIT_STRESS, 1e-3, "kPa"},
-    {"MPa", CF_UNIT_STRESS, 1.0, "MPa"},
-    {"GPa", CF_UNIT_STRESS, 1e3, "GPa"},
-    {"N/mm2", CF_UNIT_STRESS, 1.0, "N/mm2"},
-    {"N/mm^2", CF_UNIT_STRESS, 1.0, "N/mm2"},
-    {"N/mm\xc2\xb2", CF_UNIT_STRESS, 1.0, "N/mm2"},
-    {"N/m2", CF_UNIT_STRESS, 1e-6, "N/m2"},
-    {"N/m^2", CF_UNIT_STRESS, 1e-6, "N/m2"},
-    {"N/m\xc2\xb2", CF_UNIT_STRESS, 1e-6, "N/m2"},
-    {"mmHg", CF_UNIT_STRESS, 133.322387415e-6, "mmHg"},
-    {"N", CF_UNIT_FORCE, 1.0, "N"},
-    {"mN", CF_UNIT_FORCE, 1e-3, "mN"},
-    {"kN", CF_UNIT_FORCE, 1e3, "kN"},
-    {"uN", CF_UNIT_FORCE, 1e-6, "uN"},
-    {"\xc2\xb5N", CF_UNIT_FORCE, 1e-6, "uN"}, /* micro sign */
-    {"\xce\xbcN", CF_UNIT_FORCE, 1e-6, "uN"}, /* Greek mu */
-    {"m", CF_UNIT_LENGTH, 1e3, "m"},
-    {"cm", CF_UNIT_LENGTH, 10.0, "cm"},
-    {"mm", CF_UNIT_LENGTH, 1.0, "mm"},
-    {"um", CF_UNIT_LENGTH, 1e-3, "um"},
-    {"\xc2\xb5m", CF_UNIT_LENGTH, 1e-3, "um"},
-    {"\xce\xbcm", CF_UNIT_LENGTH, 1e-3, "um"},
-    {"s", CF_UNIT_TIME, 1.0, "s"},
-    {"ms", CF_UNIT_TIME, 1e-3, "ms"},
-    {"min", CF_UNIT_TIME, 60.0, "min"},
-    {"h", CF_UNIT_TIME, 3600.0, "h"},
-    {"-", CF_UNIT_STRAIN, 1.0, "-"},
-    {"1", CF_UNIT_STRAIN, 1.0, "-"},
-    {"%", CF_UNIT_STRAIN, 0.01, "%"},
-};
-
-static const unit_def *unit_find(const char *name)
-{
-    for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
-        if (strcmp(units[i].name, name) == 0)
-            return &units[i];
-    return NULL;
-}
-
-/* True when name equals a known unit up to letter case ("kpa", "n"): a unit written wrongly. */
-static int unit_like(const char *name)
-{
-    for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
-        if (strcasecmp(units[i].name, name) == 0)
-            return 1;
-    return 0;
-}
-
-cf_unit_class cf_measure_unit(const char *name, double *to_conifit)
-{
-    const unit_def *u = name ? unit_find(name) : NULL;
-    if (!u)
-        return CF_UNIT_UNKNOWN;
-    if (to_conifit)
-        *to_conifit = u->to_conifit;
-    return u->cls;
-}
-
-static const char unit_list[] =
-    "stress: Pa kPa MPa GPa N/mm2 N/m2 mmHg; force: N mN kN uN; length: m cm mm um; "
-    "time: s ms min h; strain: - %";
-
-/* ---- messages ----------------------------------------------------------------------------- */
-
-/* Copies text into out as a short printable quotation: control and non-ASCII bytes as \xNN,
-** long text cut with "...". */
-static void quote(char *out, size_t cap, const char *s, size_t n)
-{
-    size_t o = 0;
-    const size_t keep = 60;
-    for (size_t i = 0; i < n && o + 8 < cap; i++) {
-        unsigned char c = (unsigned char)s[i];
-        if (i == keep) {
-            o += (size_t)snprintf(out + o, cap - o, "...");
-            break;
-        }
-        if (c >= 0x20 && c < 0x7f)
-            out[o++] = (char)c;
-        else
-            o += (size_t)snprintf(out + o, cap - o, "\\x%02X", c);
-    }
-    out[o < cap ? o : cap - 1] = '\0';
-}
-
-/* CF_E_DATA with "PATH:LINE:COL: message". */
-static cf_status data_error(cf_error *err, const char *path, size_t line, size_t col,
-                            const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 5, 6)))
-#endif
-    ;
-static cf_status data_error(cf_error *err, const char *path, size_t line, size_t col,
-                            const char *fmt, ...)
-{
-    char msg[CF_ERROR_MSG_LEN];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    return cf_error_set(err, CF_E_DATA, "%s:%zu:%zu: %s", path, line, col, msg);
-}
-
-/* ---- lines and fields --------------------------------------------------------------------- */
-
-typedef struct line_span {
-    const char *s;
-    size_t n;    /* without the line end (and without a CR before it) */
-    size_t line; /* 1-based */
-} line_span;
-
-/* The fields of one row, unquoted, each NUL-terminated inside buf. */
-typedef struct fields {
-    char *buf;
-    size_t buf_cap;
-    size_t *off;
-    size_t count, cap;
-} fields;
-
-static void fields_free(fields *f)
-{
-    free(f->buf);
-    free(f->off);
-    memset(f, 0, sizeof *f);
-}
-
-static int fields_reserve(fields *f, size_t text_len)
-{
-    if (f->buf_cap < text_len + 1) {
-        char *b = realloc(f->buf, text_len + 1);
-        if (!b)
-            return -1;
-        f->buf = b;
-        f->buf_cap = text_len + 1;
-    }
-    return 0;
-}
-
-static int fields_push(fields *f, size_t off)
-{
-    if (f->count == f->cap) {
-        size_t cap = f->cap ? 2 * f->cap : 16;
-        size_t *o = realloc(f->off, cap * sizeof *o);
-        if (!o)
-            return -1;
-        f->off = o;
-        f->cap = cap;
-    }
-    f->off[f->count++] = off;
-    return 0;
-}
-
-static const char *field(const fields *f, size_t i)
-{
-    return f->buf + f->off[i];
-}
-
-/* Length of the line's content: up to a '#' outside double quotes (a comment), trailing
-** blanks removed. */
-static size_t content_length(const char *s, size_t n)
-{
-    int q = 0;
-    size_t end = n;
-    for (size_t i = 0; i < n; i++) {
-        if (s[i] == '"')
-            q = !q;
-        else if (s[i] == '#' && !q) {
-            end = i;
-            break;
-        }
-    }
-    while (end > 0 && (s[end - 1] == ' ' || s[end - 1] == '\t'))
-        end--;
-    return end;
-}
-
-static int is_blank(char c, char delim)
-{
-    return c == ' ' || (c == '\t' && delim != '\t');
-}
-
-/* Splits a whitespace-separated line (delimiter ' ': runs of blanks and TABs) into f. A field
-** may be double-quoted (with "" for a quote inside); a field that starts with '[' or '(' belongs
-** to the one before it, so that "stress [kPa]" stays one column name. Returns as split(). */
-static int split_blanks(const char *s, size_t n, fields *f, size_t *bad_col, const char **why)
-{
-    f->count = 0;
-    if (fields_reserve(f, n) != 0)
-        return -2;
-    size_t i = 0, o = 0;
-    for (;;) {
-        while (i < n && (s[i] == ' ' || s[i] == '\t'))
-            i++;
-        if (i >= n)
-            return 0;
-        int joined = f->count > 0 && (s[i] == '[' || s[i] == '(');
-        if (joined)
-            f->buf[o - 1] = ' '; /* the previous field goes on: its NUL becomes a blank */
-        else if (fields_push(f, o) != 0)
-            return -2;
-        if (s[i] == '"') {
-            for (i++;; i++) {
-                if (i >= n) {
-                    *bad_col = f->count;
-                    *why = "unterminated double quote";
-                    return -1;
-                }
-                if (s[i] == '"' && i + 1 < n && s[i + 1] == '"')
-                    f->buf[o++] = s[i++];
-                else if (s[i] == '"')
-                    break;
-                else
-                    f->buf[o++] = s[i];
-            }
-            i++;
-        } else {
-            while (i < n && s[i] != ' ' && s[i] != '\t') {
-                if (s[i] == '"') {
-                    *bad_col = f->count;
-                    *why = "double quote inside an unquoted field";
-                    return -1;
-                }
-                f->buf[o++] = s[i++];
-            }
-        }
-        f->buf[o++] = '\0';
-    }
-}
-
-/* Splits s[0..n) at delim into f. Returns 0, or -1 on a quoting error (with *bad_col the field
-** and *why the reason), or -2 when memory runs out. */
-static int split(const char *s, size_t n, char delim, fields *f, size_t *bad_col,
-                 const char **why)
-{
-    if (delim == ' ')
-        return split_blanks(s, n, f, bad_col, why);
-    f->count = 0;
-    if (fields_reserve(f, n) != 0)
-        return -2;
-    size_t i = 0, o = 0;
-    for (;;) {
-        while (i < n && is_blank(s[i], delim))
-            i++;
-        if (fields_push(f, o) != 0)
-            return -2;
-        if (i < n && s[i] == '"') {
-            i++;
-            for (;;) {
-                if (i >= n) {
-                    *bad_col = f->count;
-                    *why = "unterminated double quote";
-                    return -1;
-                }
-                if (s[i] == '"') {
-                    if (i + 1 < n && s[i + 1] == '"') {
-                        f->buf[o++] = '"';
-                        i += 2;
-                        continue;
-                    }
-                    i++;
-                    break;
-                }
-                f->buf[o++] = s[i++];
-            }
-            while (i < n && is_blank(s[i], delim))
-                i++;
-            if (i < n && s[i] != delim) {
-                *bad_col = f->count;
-                *why = "text after a closing double quote";
-                return -1;
-            }
-        } else {
-            size_t start = o;
-            while (i < n && s[i] != delim) {
-                if (s[i] == '"') {
-                    *bad_col = f->count;
-                    *why = "double quote inside an unquoted field";
-                    return -1;
-                }
-                f->buf[o++] = s[i++];
-            }
-            while (o > start && is_blank(f->buf[o - 1], delim))
-                o--;
-        }
-        f->buf[o++] = '\0';
-        if (i >= n)
-            return 0;
-        i++; /* the delimiter: another field follows, possibly empty */
-        if (fields_reserve(f, n + f->count + 1) != 0)
-            return -2;
-    }
-}
-
-/* Checks a line for bytes that do not belong in a text table: NUL, control characters other than
-** TAB, a CR that does not end the line, and malformed UTF-8. Returns the byte offset of the first
-** bad byte, or n when the line is text. */
-static size_t bad_byte(const unsigned char *s, size_t n)
-{
-    size_t i = 0;
-    while (i < n) {
-        unsigned char c = s[i];
-        if (c < 0x80) {
-            if ((c < 0x20 && c != '\t') || c == 0x7f)
-                return i;
-            i++;
-            continue;
-        }
-        size_t len;
-        uint32_t cp;
-        if (c >= 0xc2 && c <= 0xdf) {
-            len = 2;
-            cp = c & 0x1f;
-        } else if (c >= 0xe0 && c <= 0xef) {
-            len = 3;
-            cp = c & 0x0f;
-        } else if (c >= 0xf0 && c <= 0xf4) {
-            len = 4;
-            cp = c & 0x07;
-        } else
-            return i;
-        if (i + len > n)
-            return i;
-        for (size_t k = 1; k < len; k++) {
-            if ((s[i + k] & 0xc0) != 0x80)
-                return i;
-            cp = (cp << 6) | (s[i + k] & 0x3f);
-        }
-        if ((len == 3 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) ||
-            (len == 4 && (cp < 0x10000 || cp > 0x10ffff)) || (cp >= 0x80 && cp <= 0x9f))
-            return i;
-        i += len;
-    }
-    return n;
-}
-
-/* Copies src into dst (cap bytes with the NUL) as valid UTF-8 without control characters, for
-** names that end up in reports and JSON: a byte that does not start a valid character (a file
-** name in another encoding) or is a control character becomes '?', and a name too long is cut at
-** a character boundary, never inside one. */
-static void utf8_copy(char *dst, size_t cap, const char *src)
-{
-    size_t o = 0, n = strlen(src), i = 0;
-    while (i < n && o + 1 < cap) {
-        const unsigned char *p = (const unsigned char *)src + i;
-        size_t len = 1;
-        if (*p >= 0x80) {
-            len = *p >= 0xf0 ? 4 : *p >= 0xe0 ? 3 : 2;
-            if (i + len > n || bad_byte(p, len) != len)
-                len = 0; /* not a valid character here */
-        } else if (*p < 0x20 || *p == 0x7f) {
-            len = 0;
-        }
-        if (len == 0) {
-            dst[o++] = '?';
-            i++;
-            continue;
-        }
-        if (o + len + 1 > cap)
-            break;
-        memcpy(dst + o, p, len);
-        o += len;
-        i += len;
-    }
-    dst[o] = '\0';
-}
-
-/* ---- numbers ------------------------------------------------------------------------------ */
-
-typedef enum num_result { NUM_OK, NUM_EMPTY, NUM_NOT_NUMBER, NUM_NOT_FINITE } num_result;
-
-/* Parses a cell as a finite decimal number ('.' decimal point; a single ',' is taken as the
-** decimal point when the delimiter is not a comma). */
-static num_result parse_number(const char *text, char delim, double *out)
-{
-    char tmp[128];
-    size_t n = strlen(text);
-    if (n == 0)
-        return NUM_EMPTY;
-    if (n >= sizeof tmp)
-        return NUM_NOT_NUMBER;
-    memcpy(tmp, text, n + 1);
-    const char *p = tmp;
-    if (*p == '+' || *p == '-')
-        p++;
-    if (strncasecmp(p, "nan", 3) == 0 || strncasecmp(p, "inf", 3) == 0)
-        return NUM_NOT_FINITE;
-    if (delim != ',') {
-        char *comma = strchr(tmp, ',');
-        if (comma && !strchr(tmp, '.') && !strchr(comma + 1, ','))
-            *comma = '.';
-    }
-    for (const char *c = p; *c; c++)
-        if (!isdigit((unsigned char)*c) && *c != '.' && *c != 'e' && *c != 'E' && *c != '+' &&
-            *c != '-')
-            return NUM_NOT_NUMBER;
-    char *end = NULL;
-    errno = 0;
-    double v = strtod(tmp, &end);
-    if (end == tmp || *end != '\0')
-        return NUM_NOT_NUMBER;
-    if (!isfinite(v) || (errno == ERANGE && fabs(v) > 1.0))
-        return NUM_NOT_FINITE;
-    *out = v;
-    return NUM_OK;
-}
-
-/* ---- column names ------------------------------------------------------------------------- */
-
-typedef struct column {
-    char name[NAME_CAP]; /* as in the header */
-    char base[NAME_CAP]; /* without the unit decoration */
-    char unit[NAME_CAP]; /* the decoration ("" when none) */
-} column;
-
-static void trim_copy(char *out, size_t cap, const char *s, size_t n)
-{
-    while (n > 0 && isspace((unsigned char)*s)) {
-        s++;
-        n--;
-    }
-    while (n > 0 && isspace((unsigned char)s[n - 1]))
-        n--;
-    if (n >= cap)
-        n = cap - 1;
-    memcpy(out, s, n);
-    out[n] = '\0';
-}
-
-/* Splits a header name into base and unit: "stress [kPa]", "stress (kPa)", "stress_kPa". A
-** suffix after the last '_' is a unit only when it is one (so "true_strain" stays a name) or
-** looks like one written in the wrong case ("stress_kpa", reported as an unknown unit). */
-static void column_parse(column *c, const char *name)
-{
-    snprintf(c->name, sizeof c->name, "%s", name);
-    size_t n = strlen(name);
-    c->unit[0] = '\0';
-    if (n > 0 && (name[n - 1] == ']' || name[n - 1] == ')')) {
-        char open = name[n - 1] == ']' ? '[' : '(';
-        const char *o = strrchr(name, open);
-        if (o && o > name) {
-            trim_copy(c->base, sizeof c->base, name, (size_t)(o - name));
-            trim_copy(c->unit, sizeof c->unit, o + 1, (size_t)(name + n - 1 - (o + 1)));
-            if (c->base[0])
-                return;
-        }
-    }
-    const char *us = strrchr(name, '_');
-    if (us && us > name && us[1] && (unit_find(us + 1) || unit_like(us + 1))) {
-        trim_copy(c->base, sizeof c->base, name, (size_t)(us - name));
-        snprintf(c->unit, sizeof c->unit, "%s", us + 1);
-        return;
-    }
-    trim_copy(c->base, sizeof c->base, name, n);
-    c->unit[0] = '\0';
-}
-
-static int starts_with_ci(const char *s, const char *prefix)
-{
-    return strncasecmp(s, prefix, strlen(prefix)) == 0;
-}
-
-
-static int is_x_name(const char *b)
-{
-    static const char *const p[] = {"strain", "stretch", "lambda", "displacement", "elongation",
-                                    "gamma", "shear", "log_strain", "true_strain", "hencky"};
-    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++)
-        if (starts_with_ci(b, p[i]))
-            return 1;
-    return 0;
-}
-
-static cf_unit_class y_name_class(const char *b)
-{
-    if (cf_measures_contains_ci(b, "stress") || starts_with_ci(b, "cauchy"))
-        return CF_UNIT_STRESS;
-    if (starts_with_ci(b, "load") || cf_measures_contains_ci(b, "force"))
-        return CF_UNIT_FORCE;
-    return CF_UNIT_UNKNOWN;
-}
-
-static int is_y_name(const char *b)
-{
-    return starts_with_ci(b, "stress") || starts_with_ci(b, "force") || starts_with_ci(b, "load") ||
-           starts_with_ci(b, "cauchy") || starts_with_ci(b, "true_stress");
-}
-
-static int is_weight_name(const char *b)
-{
-    return strcasecmp(b, "weight") == 0 || strcasecmp(b, "weights") == 0;
-}
-
-static int is_time_name(const char *b)
-{
-    return strcasecmp(b, "time") == 0 || strcasecmp(b, "t") == 0;
-}
-
-
-/* ---- units stated in '#' comments --------------------------------------------------------- */
-
-static int word_char(char c)
-{
-    return isalnum((unsigned char)c) || c == '_';
-}
-
-/* Does u (a bracket's content or a bare word) name a unit of one of the wanted classes? */
-static const unit_def *wanted_unit(const char *u, const cf_unit_class *want, size_t nwant)
-{
-    const unit_def *d = unit_find(u);
-    for (size_t k = 0; d && k < nwant; k++)
-        if (d->cls == want[k])
-            return d;
-    return NULL;
-}
-
-/* Looks in one comment for the column name as a word followed, in the same clause (up to ',' or
-** ';' or an unmatched closing bracket), by a bracketed unit of a wanted class:
-** "stress = nominal stress [kPa]", "displacement [mm]". Linear in the comment's length: a scan
-** that fails resumes where it stopped (a later mention of the name in the same clause would see
-** only part of what this one saw), and a bracket is searched for its closing one no further than
-** the longest unit name. */
-static const unit_def *comment_unit_after_name(const char *s, size_t n, const char *name,
-                                               const cf_unit_class *want, size_t nwant)
-{
-    size_t len = strlen(name);
-    if (len == 0)
-        return NULL;
-    size_t i = 0;
-    while (i + len <= n) {
-        if ((i > 0 && word_char(s[i - 1])) || strncasecmp(s + i, name, len) != 0 ||
-            (i + len < n && word_char(s[i + len]))) {
-            i++;
-            continue;
-        }
-        size_t j = i + len;
-        for (; j < n; j++) {
-            char c = s[j];
-            if (c == ',' || c == ';' || c == ')' || c == ']')
-                break;
-            if (c == '[' || c == '(') {
-                char close = c == '[' ? ']' : ')';
-                size_t room = n - j - 1 < NAME_CAP ? n - j - 1 : NAME_CAP;
-                const char *e = memchr(s + j + 1, close, room);
-                if (!e)
-                    break;
-                char u[NAME_CAP];
-                trim_copy(u, sizeof u, s + j + 1, (size_t)(e - (s + j + 1)));
-                const unit_def *d = wanted_unit(u, want, nwant);
-                if (d)
-                    return d;
-                j = (size_t)(e - s);
-            }
-        }
-        i = j > i ? j : i + 1;
-    }
-    return NULL;
-}
-
-/* "... (x, y): strain, MPa" or "(x, y) = mm, mN": units listed for x and y in that order. */
-static const unit_def *comment_unit_xy(const char *s, size_t n, int which,
-                                       const cf_unit_class *want, size_t nwant)
-{
-    static const char key[] = "(x, y)";
-    const size_t klen = sizeof key - 1;
-    for (size_t i = 0; i + klen <= n; i++) {
-        if (strncasecmp(s + i, key, klen) != 0)
-            continue;
-        size_t j = i + klen;
-        while (j < n && (s[j] == ' ' || s[j] == ':' || s[j] == '=' || s[j] == '\t'))
-            j++;
-        for (int k = 0; k <= which && j < n; k++) {
-            size_t start = j;
-            while (j < n && s[j] != ',' && s[j] != ';')
-                j++;
-            if (k == which) {
-                char tok[NAME_CAP];
-                trim_copy(tok, sizeof tok, s + start, j - start);
-                /* the token may be "kPa" or "stress kPa" or "[kPa]": try its last word */
-                char *w = tok + strlen(tok);
-                while (w > tok && !isspace((unsigned char)w[-1]))
-                    w--;
-                while (*w == '[' || *w == '(')
-                    w++;
-                size_t wl = strlen(w);
-                while (wl > 0 && (w[wl - 1] == ']' || w[wl - 1] == ')' || w[wl - 1] == '.'))
-                    w[--wl] = '\0';
-                return wanted_unit(w, want, nwant);
-            }
-            j++;
-        }
-    }
-    return NULL;
-}
-
-static const unit_def *comment_unit(const line_span *comments, size_t ncomments, const char *name,
-                                    int which, const cf_unit_class *want, size_t nwant)
-{
-    for (size_t i = 0; i < ncomments; i++) {
-        const unit_def *d =
-            comment_unit_after_name(comments[i].s, comments[i].n, name, want, nwant);
-        if (d)
-            return d;
-    }
-    for (size_t i = 0; i < ncomments; i++) {
-        const unit_def *d = comment_unit_xy(comments[i].s, comments[i].n, which, want, nwant);
-        if (d)
-            return d;
-    }
-    return NULL;
-}
-
-/* ---- the test mode stated in a '# mode: NAME' comment --------------------------------------- */
-
-/* Finds the comment "mode: NAME" (spaces allowed around the words; text after NAME ignored) and
-** parses NAME. Returns CF_OK with *found = 0 when no comment states a mode. */
-static cf_status comment_mode(const line_span *comments, size_t ncomments, const char *path,
-                              cf_mode *mode, int *found, cf_error *err)
-{
-    *found = 0;
-    for (size_t i = 0; i < ncomments; i++) {
-        const char *s = comments[i].s, *end = s + comments[i].n;
-        while (s < end && isspace((unsigned char)*s))
-            s++;
-        if ((size_t)(end - s) < 5 || strncmp(s, "mode:", 5) != 0)
-            continue;
-        s += 5;
-        while (s < end && isspace((unsigned char)*s))
-            s++;
-        const char *w = s;
-        while (s < end && !isspace((unsigned char)*s) && *s != ',' && *s != ';')
-            s++;
-        char name[32];
-        snprintf(name, sizeof name, "%.*s", (int)(s - w), w);
-        if (cf_mode_parse(name, mode, NULL) != CF_OK)
-            return data_error(err, path, comments[i].line, 1,
-                              "comment 'mode: %s': expected uniaxial, shear, planar, "
-                              "equibiaxial or confined ('%s')", name, name);
-        *found = 1;
-        return CF_OK;
-    }
-    return CF_OK;
-}
-
-/* ---- the reader --------------------------------------------------------------------------- */
+/* ---- the text -------------------------------------------------------------------------------- */
 
 typedef struct reader {
     const char *path;
     char *text;
     size_t size;
-    line_span *lines; /* every line of the file */
+    cf_csv_line *lines; /* every line of the file */
     size_t nlines;
-    line_span *comments; /* the '#' lines, without the '#' */
+    cf_csv_line *comments; /* the '#' lines, without the '#' */
     size_t ncomments;
-    column *cols;
+    cf_column *cols;
     size_t ncols;
-    fields f;
+    cf_csv_fields f;
     double *x, *y, *w, *t;
     size_t count, cap;
 } reader;
@@ -704,7 +48,7 @@ static void reader_free(reader *r)
     free(r->lines);
     free(r->comments);
     free(r->cols);
-    fields_free(&r->f);
+    cf_csv_fields_free(&r->f);
     free(r->x);
     free(r->y);
     free(r->w);
@@ -803,23 +147,15 @@ static cf_status cut_lines(reader *r, cf_error *err)
                                 CF_MEASURE_MAX_LINES, CF_MEASURE_MAX_ROWS);
         if (r->nlines == cap) {
             cap = cap ? 2 * cap : 256;
-            line_span *l = realloc(r->lines, cap * sizeof *l);
+            cf_csv_line *l = realloc(r->lines, cap * sizeof *l);
             if (!l)
                 return out_of_memory(err, r->path);
             r->lines = l;
         }
-        r->lines[r->nlines++] = (line_span){s, n, line};
+        r->lines[r->nlines++] = (cf_csv_line){s, n, line};
         s = nl ? nl + 1 : end;
     }
     return CF_OK;
-}
-
-static int is_comment_line(const line_span *l)
-{
-    size_t i = 0;
-    while (i < l->n && (l->s[i] == ' ' || l->s[i] == '\t'))
-        i++;
-    return i < l->n && l->s[i] == '#';
 }
 
 /* Checks every line for binary content and collects the comment lines. */
@@ -829,69 +165,369 @@ static cf_status scan_text(reader *r, cf_error *err)
     if (!r->comments)
         return out_of_memory(err, r->path);
     for (size_t i = 0; i < r->nlines; i++) {
-        const line_span *l = &r->lines[i];
-        size_t b = bad_byte((const unsigned char *)l->s, l->n);
+        const cf_csv_line *l = &r->lines[i];
+        size_t b = cf_csv_bad_byte((const unsigned char *)l->s, l->n);
         if (b < l->n) {
             char q[256];
-            quote(q, sizeof q, l->s, l->n);
+            cf_csv_quote(q, sizeof q, l->s, l->n);
             unsigned char c = (unsigned char)l->s[b];
-            return data_error(err, r->path, l->line, b + 1,
-                              "%s: byte 0x%02X is not text (the column counts bytes here) ('%s')",
-                              c == '\r' ? "carriage return inside a line" : "binary content", c,
-                              q);
+            return cf_csv_error(err, r->path, l->line, b + 1,
+                                "%s: byte 0x%02X is not text (the column counts bytes here) ('%s')",
+                                c == '\r' ? "carriage return inside a line" : "binary content", c,
+                                q);
         }
-        if (is_comment_line(l)) {
+        if (cf_csv_is_comment(l)) {
             const char *h = memchr(l->s, '#', l->n);
-            r->comments[r->ncomments++] = (line_span){h + 1, l->n - (size_t)(h + 1 - l->s),
+            r->comments[r->ncomments++] = (cf_csv_line){h + 1, l->n - (size_t)(h + 1 - l->s),
                                                       l->line};
         }
     }
     return CF_OK;
 }
 
-static char detect_delimiter(const char *s, size_t n)
-{
-    size_t comma = 0, semi = 0, tab = 0;
-    int q = 0;
-    for (size_t i = 0; i < n; i++) {
-        if (s[i] == '"')
-            q = !q;
-        else if (!q && s[i] == ',')
-            comma++;
-        else if (!q && s[i] == ';')
-            semi++;
-        else if (!q && s[i] == '\t')
-            tab++;
-    }
-    if (tab > comma && tab > semi)
-        return '\t';
-    if (semi > comma)
-        return ';';
-    if (comma > 0)
-        return ',';
-    /* none of them: columns separated by blanks (a .txt table), when there are two fields */
-    size_t nf = 0;
-    for (size_t i = 0; i < n; i++)
-        if (s[i] != ' ' && (i == 0 || s[i - 1] == ' ') && s[i] != '[' && s[i] != '(')
-            nf++;
-    return nf >= 2 ? ' ' : 0;
-}
-
-static cf_status split_or_fail(reader *r, const line_span *l, size_t n, char delim,
+static cf_status split_or_fail(reader *r, const cf_csv_line *l, size_t n, char delim,
                                cf_error *err)
 {
     size_t bad = 0;
     const char *why = NULL;
-    int rc = split(l->s, n, delim, &r->f, &bad, &why);
+    int rc = cf_csv_split(l->s, n, delim, &r->f, &bad, &why);
     if (rc == -2)
         return out_of_memory(err, r->path);
     if (rc == -1) {
         char q[256];
-        quote(q, sizeof q, l->s, n);
-        return data_error(err, r->path, l->line, bad, "%s ('%s')", why, q);
+        cf_csv_quote(q, sizeof q, l->s, n);
+        return cf_csv_error(err, r->path, l->line, bad, "%s ('%s')", why, q);
     }
     return CF_OK;
 }
+
+/* ---- the header and its columns -------------------------------------------------------------- */
+
+/* What the header decided, for the stages after it: where it is, its delimiter, its columns and
+** which of them are x, y, the weight and the time (-1: none). */
+typedef struct layout {
+    size_t hi, hn;         /* index of the header in r->lines, its content length */
+    size_t header_line;    /* its line number */
+    char hq[256];          /* the header quoted, for messages */
+    char delim;
+    size_t ncols;
+    int trailing;          /* the header ends with a delimiter: so must every row */
+    long xi, yi, wi, ti;
+} layout;
+
+/* The header: the first line with content. */
+static cf_status find_header(const reader *r, layout *h, cf_error *err)
+{
+    const char *path = r->path;
+    h->hi = 0;
+    h->hn = 0;
+    while (h->hi < r->nlines) {
+        if (!cf_csv_is_comment(&r->lines[h->hi]) &&
+            (h->hn = cf_csv_content_length(r->lines[h->hi].s, r->lines[h->hi].n)) > 0)
+            break;
+        h->hi++;
+    }
+    if (h->hi < r->nlines)
+        return CF_OK;
+    if (r->size == 0)
+        return cf_csv_error(err, path, 1, 1, "empty file: no header and no data (0 bytes)");
+    return cf_csv_error(err, path, r->nlines ? r->lines[r->nlines - 1].line : 1, 1,
+                        "no header row and no data: only comments and blank lines (%zu bytes)",
+                        r->size);
+}
+
+/* The header's delimiter and column names (r->cols). */
+static cf_status read_header(reader *r, layout *h, cf_error *err)
+{
+    const char *path = r->path;
+    const cf_csv_line *hl = &r->lines[h->hi];
+    h->header_line = hl->line;
+    cf_csv_quote(h->hq, sizeof h->hq, hl->s, h->hn);
+    h->delim = cf_csv_delimiter(hl->s, h->hn);
+    if (!h->delim)
+        return cf_csv_error(err, path, h->header_line, 1,
+                            "the header has a single column; expected at least x and y separated "
+                            "by ',' ';' TAB or blanks ('%s')", h->hq);
+    cf_status st = split_or_fail(r, hl, h->hn, h->delim, err);
+    if (st != CF_OK)
+        return st;
+    size_t ncols = r->f.count;
+    h->trailing = 0;
+    if (ncols > 1 && cf_csv_field(&r->f, ncols - 1)[0] == '\0') {
+        h->trailing = 1;
+        ncols--;
+    }
+    if (ncols > CF_MEASURE_MAX_COLUMNS)
+        return cf_csv_error(err, path, h->header_line, CF_MEASURE_MAX_COLUMNS + 1,
+                            "the header has %zu columns; a table may have at most %d ('%s')", ncols,
+                            CF_MEASURE_MAX_COLUMNS, h->hq);
+    r->cols = calloc(ncols, sizeof *r->cols);
+    if (!r->cols)
+        return out_of_memory(err, path);
+    r->ncols = h->ncols = ncols;
+    size_t numeric = 0;
+    for (size_t i = 0; i < ncols; i++) {
+        const char *name = cf_csv_field(&r->f, i);
+        double v;
+        if (name[0] == '\0')
+            return cf_csv_error(err, path, h->header_line, i + 1, "column %zu has no name ('%s')",
+                                i + 1, h->hq);
+        if (strlen(name) >= CF_COLUMN_NAME_CAP)
+            return cf_csv_error(err, path, h->header_line, i + 1,
+                                "column name too long ('%.60s...')", name);
+        if (cf_csv_number(name, h->delim, &v) == CF_CSV_NUM_OK)
+            numeric++;
+        cf_column_parse(&r->cols[i], name);
+    }
+    if (numeric == ncols)
+        return cf_csv_error(err, path, h->header_line, 1,
+                            "missing header: the first row holds numbers, not column names ('%s')",
+                            h->hq);
+    return CF_OK;
+}
+
+/* Finds a column by name (the full header name or its base, case-insensitive). */
+static long find_column(const reader *r, const char *name)
+{
+    for (size_t i = 0; i < r->ncols; i++)
+        if (strcasecmp(r->cols[i].name, name) == 0)
+            return (long)i;
+    for (size_t i = 0; i < r->ncols; i++)
+        if (strcasecmp(r->cols[i].base, name) == 0)
+            return (long)i;
+    return -1;
+}
+
+static cf_status column_not_found(const reader *r, size_t header_line, const char *what,
+                                  const char *name, cf_error *err)
+{
+    char list[256];
+    size_t o = 0;
+    list[0] = '\0';
+    for (size_t i = 0; i < r->ncols && o + 4 < sizeof list; i++)
+        o += (size_t)snprintf(list + o, sizeof list - o, "%s%s", i ? ", " : "", r->cols[i].name);
+    char q[256];
+    cf_csv_quote(q, sizeof q, name, strlen(name));
+    return cf_csv_error(err, r->path, header_line, 1,
+                        "no %s column named '%s' (the header has: %s)", what, q, list);
+}
+
+/* Which columns: x, y, weight, time (the options name x and y, else their names tell). */
+static cf_status choose_columns(const reader *r, const cf_measure_options *opt, layout *h,
+                                cf_error *err)
+{
+    const size_t ncols = h->ncols;
+    long xi = -1, yi = -1, wi = -1, ti = -1;
+    for (size_t i = 0; i < ncols; i++) {
+        if (wi < 0 && cf_column_is_weight(r->cols[i].base))
+            wi = (long)i;
+        if (ti < 0 && cf_column_is_time(r->cols[i].base))
+            ti = (long)i;
+    }
+    if (opt->x_col && (xi = find_column(r, opt->x_col)) < 0)
+        return column_not_found(r, h->header_line, "x", opt->x_col, err);
+    if (opt->y_col && (yi = find_column(r, opt->y_col)) < 0)
+        return column_not_found(r, h->header_line, "y", opt->y_col, err);
+    for (int pass = 0; pass < 2 && yi < 0; pass++)
+        for (size_t i = 0; i < ncols && yi < 0; i++)
+            if ((long)i != xi &&
+                (pass == 0 ? cf_column_is_y(r->cols[i].base)
+                           : cf_column_y_class(r->cols[i].base) != CF_UNIT_UNKNOWN))
+                yi = (long)i;
+    for (size_t i = 0; i < ncols && xi < 0; i++)
+        if ((long)i != yi && cf_column_is_x(r->cols[i].base))
+            xi = (long)i;
+    for (size_t i = 0; i < ncols && (xi < 0 || yi < 0); i++) {
+        if ((long)i == xi || (long)i == yi || (long)i == wi || (long)i == ti)
+            continue;
+        if (xi < 0)
+            xi = (long)i;
+        else
+            yi = (long)i;
+    }
+    if (xi < 0 || yi < 0 || xi == yi)
+        return cf_csv_error(err, r->path, h->header_line, 1,
+                            "cannot tell which columns are x and y; name them (strain, stress_kPa, "
+                            "...) or set option x_col and option y_col ('%s')", h->hq);
+    h->xi = xi;
+    h->yi = yi;
+    h->wi = wi == xi || wi == yi ? -1 : wi;
+    h->ti = ti == xi || ti == yi ? -1 : ti;
+    return CF_OK;
+}
+
+/* ---- units ----------------------------------------------------------------------------------- */
+
+/* The units decided: the y unit, the measures, and the factors to conifit's units. */
+typedef struct scaling {
+    const cf_unit_def *yu;
+    cf_table_measures meas;
+    int stretch;           /* x is a stretch: strain = x - 1 */
+    double xscale, yscale, tscale;
+} scaling;
+
+/* Resolves the unit of column c: the option if given, else its decoration, else a '#' comment.
+** Returns CF_OK with *u NULL when no unit is stated anywhere. */
+static cf_status column_unit(const reader *r, size_t header_line, size_t ci, const char *option,
+                             const char *option_flag, int which, const cf_unit_class *want,
+                             size_t nwant, const cf_unit_def **u, cf_error *err)
+{
+    const cf_column *c = &r->cols[ci];
+    const char *text = option ? option : (c->unit[0] ? c->unit : NULL);
+    *u = NULL;
+    if (text) {
+        const cf_unit_def *d = cf_unit_find(text);
+        char q[256];
+        cf_csv_quote(q, sizeof q, text, strlen(text));
+        if (!d) {
+            if (option)
+                return cf_error_set(err, CF_E_DATA,
+                                    "%s: %s '%s': unknown unit (known units: %s)", r->path,
+                                    option_flag, q, cf_unit_list);
+            return cf_csv_error(err, r->path, header_line, ci + 1,
+                                "column '%s': unknown unit '%s' (known units, case-sensitive: %s)",
+                                c->name, q, cf_unit_list);
+        }
+        for (size_t k = 0; k < nwant; k++)
+            if (d->cls == want[k]) {
+                *u = d;
+                return CF_OK;
+            }
+        if (option)
+            return cf_error_set(err, CF_E_DATA, "%s: %s '%s' is not a unit for column '%s'",
+                                r->path, option_flag, q, c->name);
+        return cf_csv_error(err, r->path, header_line, ci + 1,
+                            "column '%s': unit '%s' does not fit this column ('%s')", c->name, q,
+                            c->name);
+    }
+    *u = cf_comment_unit(r->comments, r->ncomments, c->base, which, want, nwant);
+    return CF_OK;
+}
+
+/* The unit of y, which decides between stress-strain and force-displacement (m->kind). */
+static cf_status y_unit(const reader *r, const cf_measure_options *opt, const layout *h,
+                        cf_table *m, scaling *u, cf_error *err)
+{
+    const cf_column *yc = &r->cols[h->yi];
+    cf_unit_class yname = cf_column_y_class(yc->base);
+    const char *yopt = NULL, *yflag = "option stress_unit";
+    cf_unit_class ywant[2] = {CF_UNIT_STRESS, CF_UNIT_FORCE};
+    size_t nywant = 2;
+    if (yname == CF_UNIT_STRESS) {
+        yopt = opt->stress_unit;
+        nywant = 1;
+    } else if (yname == CF_UNIT_FORCE) {
+        yopt = opt->force_unit;
+        yflag = "option force_unit";
+        ywant[0] = CF_UNIT_FORCE;
+        nywant = 1;
+    } else if (opt->stress_unit) {
+        yopt = opt->stress_unit;
+    } else if (opt->force_unit) {
+        yopt = opt->force_unit;
+        yflag = "option force_unit";
+    }
+    cf_status st = column_unit(r, h->header_line, (size_t)h->yi, yopt, yflag, 1, ywant, nywant,
+                               &u->yu, err);
+    if (st)
+        return st;
+    if (!u->yu) {
+        const char *hint = yname == CF_UNIT_FORCE
+                               ? "force_N or force [mN], or set option force_unit"
+                               : "stress_kPa or stress [kPa], or set option stress_unit (option "
+                                 "force_unit for a force)";
+        return cf_csv_error(err, r->path, h->header_line, (size_t)h->yi + 1,
+                            "column '%s' has no unit: name it like %s ('%s')", yc->name, hint,
+                            yc->name);
+    }
+    m->kind =
+        u->yu->cls == CF_UNIT_STRESS ? CF_TABLE_STRESS_STRAIN : CF_TABLE_FORCE_DISPLACEMENT;
+    u->yscale = u->yu->to_conifit;
+    return CF_OK;
+}
+
+/* The unit of x: a strain or stretch against a stress, a length against a force. */
+static cf_status x_unit(const reader *r, const cf_measure_options *opt, const layout *h,
+                        const cf_table *m, scaling *u, cf_error *err)
+{
+    const char *path = r->path;
+    const cf_column *xc = &r->cols[h->xi];
+    const cf_unit_def *xu = NULL;
+    u->xscale = 1.0;
+    if (m->kind == CF_TABLE_STRESS_STRAIN) {
+        cf_unit_class xw[1] = {CF_UNIT_STRAIN};
+        if (xc->unit[0]) {
+            const cf_unit_def *d = cf_unit_find(xc->unit);
+            if (!d || d->cls != CF_UNIT_STRAIN)
+                return cf_csv_error(err, path, h->header_line, (size_t)h->xi + 1,
+                                    "column '%s' has unit '%s' but y is a stress, so x must be a "
+                                    "dimensionless strain or stretch ('-' or '%%') ('%s')",
+                                    xc->name, xc->unit, xc->name);
+            xu = d;
+        } else
+            xu = cf_comment_unit(r->comments, r->ncomments, xc->base, 0, xw, 1);
+        if (xu)
+            u->xscale = xu->to_conifit;
+        if (u->stretch && u->xscale != 1.0)
+            return cf_csv_error(err, path, h->header_line, (size_t)h->xi + 1,
+                                "stretch column '%s' cannot be in '%%' ('%s')", xc->name, xc->name);
+        return CF_OK;
+    }
+    cf_unit_class xw[1] = {CF_UNIT_LENGTH};
+    if (u->stretch)
+        return cf_csv_error(err, path, h->header_line, (size_t)h->xi + 1,
+                            "column '%s' is a stretch but y is a force; give a displacement "
+                            "column or a stress ('%s')", xc->name, xc->name);
+    cf_status st = column_unit(r, h->header_line, (size_t)h->xi, opt->length_unit,
+                               "option length_unit", 0, xw, 1, &xu, err);
+    if (st)
+        return st;
+    if (!xu)
+        return cf_csv_error(err, path, h->header_line, (size_t)h->xi + 1,
+                            "column '%s' has no length unit (y is a force): name it like "
+                            "displacement_mm, or set option length_unit ('%s')", xc->name,
+                            xc->name);
+    u->xscale = xu->to_conifit;
+    return CF_OK;
+}
+
+/* The unit of the time column, if there is one. */
+static cf_status t_unit(const reader *r, const layout *h, scaling *u, cf_error *err)
+{
+    u->tscale = 1.0;
+    if (h->ti < 0)
+        return CF_OK;
+    const cf_unit_def *tu = NULL;
+    cf_unit_class tw[1] = {CF_UNIT_TIME};
+    cf_status st = column_unit(r, h->header_line, (size_t)h->ti, NULL, "", 2, tw, 1, &tu, err);
+    if (st)
+        return st;
+    if (!tu)
+        return cf_csv_error(err, r->path, h->header_line, (size_t)h->ti + 1,
+                            "time column '%s' has no unit: name it like time_s or time [s] "
+                            "(s, ms, min, h)",
+                            r->cols[h->ti].name);
+    u->tscale = tu->to_conifit;
+    return CF_OK;
+}
+
+/* Units: y first (it decides the kind of table), the measures, then x and the time. */
+static cf_status decide_units(const reader *r, const cf_measure_options *opt, const layout *h,
+                              cf_table *m, scaling *u, cf_error *err)
+{
+    cf_status st = y_unit(r, opt, h, m, u, err);
+    if (st == CF_OK)
+        st = cf_measures_read(r->comments, r->ncomments, r->path, opt, &r->cols[h->xi],
+                              &r->cols[h->yi], &u->meas, err);
+    if (st != CF_OK)
+        return st;
+    u->stretch = u->meas.strain == CF_STRAIN_STRETCH;
+    if ((st = x_unit(r, opt, h, m, u, err)) != CF_OK)
+        return st;
+    return t_unit(r, h, u, err);
+}
+
+/* ---- rows ------------------------------------------------------------------------------------ */
 
 static int push_row(reader *r, double x, double y, double w, double t)
 {
@@ -922,447 +558,61 @@ static int push_row(reader *r, double x, double y, double w, double t)
     return 0;
 }
 
-/* Finds a column by name (the full header name or its base, case-insensitive). */
-static long find_column(const reader *r, const char *name)
-{
-    for (size_t i = 0; i < r->ncols; i++)
-        if (strcasecmp(r->cols[i].name, name) == 0)
-            return (long)i;
-    for (size_t i = 0; i < r->ncols; i++)
-        if (strcasecmp(r->cols[i].base, name) == 0)
-            return (long)i;
-    return -1;
-}
-
-static cf_status column_not_found(const reader *r, size_t header_line, const char *what,
-                                  const char *name, cf_error *err)
-{
-    char list[256];
-    size_t o = 0;
-    list[0] = '\0';
-    for (size_t i = 0; i < r->ncols && o + 4 < sizeof list; i++)
-        o += (size_t)snprintf(list + o, sizeof list - o, "%s%s", i ? ", " : "", r->cols[i].name);
-    char q[256];
-    quote(q, sizeof q, name, strlen(name));
-    return data_error(err, r->path, header_line, 1, "no %s column named '%s' (the header has: %s)",
-                      what, q, list);
-}
-
-/* Resolves the unit of column c: the option if given, else its decoration, else a '#' comment.
-** Returns CF_OK with *u NULL when no unit is stated anywhere. */
-static cf_status column_unit(const reader *r, size_t header_line, size_t ci, const char *option,
-                             const char *option_flag, int which, const cf_unit_class *want,
-                             size_t nwant, const unit_def **u, cf_error *err)
-{
-    const column *c = &r->cols[ci];
-    const char *text = option ? option : (c->unit[0] ? c->unit : NULL);
-    *u = NULL;
-    if (text) {
-        const unit_def *d = unit_find(text);
-        char q[256];
-        quote(q, sizeof q, text, strlen(text));
-        if (!d) {
-            if (option)
-                return cf_error_set(err, CF_E_DATA,
-                                    "%s: %s '%s': unknown unit (known units: %s)", r->path,
-                                    option_flag, q, unit_list);
-            return data_error(err, r->path, header_line, ci + 1,
-                              "column '%s': unknown unit '%s' (known units, case-sensitive: %s)",
-                              c->name, q, unit_list);
-        }
-        for (size_t k = 0; k < nwant; k++)
-            if (d->cls == want[k]) {
-                *u = d;
-                return CF_OK;
-            }
-        if (option)
-            return cf_error_set(err, CF_E_DATA, "%s: %s '%s' is not a unit for column '%s'",
-                                r->path, option_flag, q, c->name);
-        return data_error(err, r->path, header_line, ci + 1,
-                          "column '%s': unit '%s' does not fit this column ('%s')", c->name, q,
-                          c->name);
-    }
-    *u = comment_unit(r->comments, r->ncomments, c->base, which, want, nwant);
-    return CF_OK;
-}
-
-/* The stress and strain measures: the caller's options, the '# stress:' and '# strain:' comments
-** and the column names, reconciled (io/measures.h). */
-static cf_status decide_measures(const reader *r, const char *path, const cf_measure_options *opt,
-                                 const column *xc, const column *yc, cf_table_measures *out,
-                                 cf_error *err)
-{
-    static const char *const what[CF_DECL_KINDS] = {"stress measure", "strain measure"};
-    static const char *const expect[CF_DECL_KINDS] = {"nominal or cauchy",
-                                                      "engineering, log or stretch"};
-    cf_measures_said said[CF_DECL_KINDS];
-    for (int k = 0; k < CF_DECL_KINDS; k++)
-        said[k] = (cf_measures_said){-1, 0, -1};
-    for (size_t i = 0; i < r->ncomments; i++) {
-        int kind, v = -1;
-        char word[64];
-        if (!cf_measures_declaration(r->comments[i].s, r->comments[i].n, &kind, word,
-                                     sizeof word))
-            continue;
-        if (kind == CF_DECL_STRESS) {
-            cf_stress_measure x;
-            v = cf_stress_measure_parse(word, &x) == 0 ? (int)x : -1;
-        } else {
-            cf_strain_measure x;
-            v = cf_strain_measure_parse(word, &x) == 0 ? (int)x : -1;
-        }
-        if (v < 0)
-            return data_error(err, path, r->comments[i].line, 1, "unknown %s (expected %s) ('%s')",
-                              what[kind], expect[kind], word);
-        if (said[kind].declared >= 0 && said[kind].declared != v)
-            return data_error(err, path, r->comments[i].line, 1,
-                              "%s declared twice, differently (line %zu says otherwise) ('%s')",
-                              what[kind], said[kind].line, word);
-        said[kind].declared = v;
-        said[kind].line = r->comments[i].line;
-    }
-    said[CF_DECL_STRESS].column = cf_measures_stress_of_column(yc->base);
-    said[CF_DECL_STRAIN].column = cf_measures_strain_of_column(xc->base);
-    int strain_opt = opt->strain_measure >= 0   ? opt->strain_measure
-                     : opt->x_is_stretch == 1   ? CF_STRAIN_STRETCH
-                     : opt->x_is_stretch == 0   ? CF_STRAIN_ENGINEERING
-                                                : -1;
-    const int option[CF_DECL_KINDS] = {opt->stress_measure, strain_opt};
-    const char *col[CF_DECL_KINDS] = {yc->name, xc->name};
-    int value[CF_DECL_KINDS], over[CF_DECL_KINDS], filev[CF_DECL_KINDS];
-    cf_decl_source from[CF_DECL_KINDS];
-    size_t line[CF_DECL_KINDS];
-    for (int k = 0; k < CF_DECL_KINDS; k++) {
-        cf_status st = cf_measures_decide(path, col[k], what[k], cf_measures_names[k], option[k],
-                                          &said[k], 0, &value[k], &from[k], &line[k], &over[k],
-                                          &filev[k], err);
-        if (st != CF_OK)
-            return st;
-    }
-    memset(out, 0, sizeof *out);
-    out->stress = (cf_stress_measure)value[CF_DECL_STRESS];
-    out->strain = (cf_strain_measure)value[CF_DECL_STRAIN];
-    out->stress_from = from[CF_DECL_STRESS];
-    out->strain_from = from[CF_DECL_STRAIN];
-    out->stress_line = line[CF_DECL_STRESS];
-    out->strain_line = line[CF_DECL_STRAIN];
-    out->stress_overridden = over[CF_DECL_STRESS];
-    out->strain_overridden = over[CF_DECL_STRAIN];
-    out->stress_file = filev[CF_DECL_STRESS];
-    out->strain_file = filev[CF_DECL_STRAIN];
-    return CF_OK;
-}
-
-/* What the header decided, for the stages after it: where it is, its delimiter, its columns and
-** which of them are x, y, the weight and the time (-1: none). */
-typedef struct layout {
-    size_t hi, hn;         /* index of the header in r->lines, its content length */
-    size_t header_line;    /* its line number */
-    char hq[256];          /* the header quoted, for messages */
-    char delim;
-    size_t ncols;
-    int trailing;          /* the header ends with a delimiter: so must every row */
-    long xi, yi, wi, ti;
-} layout;
-
-/* The units decided: the y unit, the measures, and the factors to conifit's units. */
-typedef struct scaling {
-    const unit_def *yu;
-    cf_table_measures meas;
-    int stretch;           /* x is a stretch: strain = x - 1 */
-    double xscale, yscale, tscale;
-} scaling;
-
-/* The header: the first line with content. */
-static cf_status find_header(const reader *r, layout *h, cf_error *err)
-{
-    const char *path = r->path;
-    h->hi = 0;
-    h->hn = 0;
-    while (h->hi < r->nlines) {
-        if (!is_comment_line(&r->lines[h->hi]) &&
-            (h->hn = content_length(r->lines[h->hi].s, r->lines[h->hi].n)) > 0)
-            break;
-        h->hi++;
-    }
-    if (h->hi < r->nlines)
-        return CF_OK;
-    if (r->size == 0)
-        return data_error(err, path, 1, 1, "empty file: no header and no data (0 bytes)");
-    return data_error(err, path, r->nlines ? r->lines[r->nlines - 1].line : 1, 1,
-                      "no header row and no data: only comments and blank lines (%zu bytes)",
-                      r->size);
-}
-
-/* The header's delimiter and column names (r->cols). */
-static cf_status read_header(reader *r, layout *h, cf_error *err)
-{
-    const char *path = r->path;
-    const line_span *hl = &r->lines[h->hi];
-    h->header_line = hl->line;
-    quote(h->hq, sizeof h->hq, hl->s, h->hn);
-    h->delim = detect_delimiter(hl->s, h->hn);
-    if (!h->delim)
-        return data_error(err, path, h->header_line, 1,
-                          "the header has a single column; expected at least x and y separated "
-                          "by ',' ';' TAB or blanks ('%s')", h->hq);
-    cf_status st = split_or_fail(r, hl, h->hn, h->delim, err);
-    if (st != CF_OK)
-        return st;
-    size_t ncols = r->f.count;
-    h->trailing = 0;
-    if (ncols > 1 && field(&r->f, ncols - 1)[0] == '\0') {
-        h->trailing = 1;
-        ncols--;
-    }
-    if (ncols > CF_MEASURE_MAX_COLUMNS)
-        return data_error(err, path, h->header_line, CF_MEASURE_MAX_COLUMNS + 1,
-                          "the header has %zu columns; a table may have at most %d ('%s')", ncols,
-                          CF_MEASURE_MAX_COLUMNS, h->hq);
-    r->cols = calloc(ncols, sizeof *r->cols);
-    if (!r->cols)
-        return out_of_memory(err, path);
-    r->ncols = h->ncols = ncols;
-    size_t numeric = 0;
-    for (size_t i = 0; i < ncols; i++) {
-        const char *name = field(&r->f, i);
-        double v;
-        if (name[0] == '\0')
-            return data_error(err, path, h->header_line, i + 1, "column %zu has no name ('%s')",
-                              i + 1, h->hq);
-        if (strlen(name) >= NAME_CAP)
-            return data_error(err, path, h->header_line, i + 1,
-                              "column name too long ('%.60s...')", name);
-        if (parse_number(name, h->delim, &v) == NUM_OK)
-            numeric++;
-        column_parse(&r->cols[i], name);
-    }
-    if (numeric == ncols)
-        return data_error(err, path, h->header_line, 1,
-                          "missing header: the first row holds numbers, not column names ('%s')",
-                          h->hq);
-    return CF_OK;
-}
-
-/* Which columns: x, y, weight, time (the options name x and y, else their names tell). */
-static cf_status choose_columns(const reader *r, const cf_measure_options *opt, layout *h,
-                                cf_error *err)
-{
-    const size_t ncols = h->ncols;
-    long xi = -1, yi = -1, wi = -1, ti = -1;
-    for (size_t i = 0; i < ncols; i++) {
-        if (wi < 0 && is_weight_name(r->cols[i].base))
-            wi = (long)i;
-        if (ti < 0 && is_time_name(r->cols[i].base))
-            ti = (long)i;
-    }
-    if (opt->x_col && (xi = find_column(r, opt->x_col)) < 0)
-        return column_not_found(r, h->header_line, "x", opt->x_col, err);
-    if (opt->y_col && (yi = find_column(r, opt->y_col)) < 0)
-        return column_not_found(r, h->header_line, "y", opt->y_col, err);
-    for (int pass = 0; pass < 2 && yi < 0; pass++)
-        for (size_t i = 0; i < ncols && yi < 0; i++)
-            if ((long)i != xi && (pass == 0 ? is_y_name(r->cols[i].base)
-                                            : y_name_class(r->cols[i].base) != CF_UNIT_UNKNOWN))
-                yi = (long)i;
-    for (size_t i = 0; i < ncols && xi < 0; i++)
-        if ((long)i != yi && is_x_name(r->cols[i].base))
-            xi = (long)i;
-    for (size_t i = 0; i < ncols && (xi < 0 || yi < 0); i++) {
-        if ((long)i == xi || (long)i == yi || (long)i == wi || (long)i == ti)
-            continue;
-        if (xi < 0)
-            xi = (long)i;
-        else
-            yi = (long)i;
-    }
-    if (xi < 0 || yi < 0 || xi == yi)
-        return data_error(err, r->path, h->header_line, 1,
-                          "cannot tell which columns are x and y; name them (strain, stress_kPa, "
-                          "...) or set option x_col and option y_col ('%s')", h->hq);
-    h->xi = xi;
-    h->yi = yi;
-    h->wi = wi == xi || wi == yi ? -1 : wi;
-    h->ti = ti == xi || ti == yi ? -1 : ti;
-    return CF_OK;
-}
-
-/* The unit of y, which decides between stress-strain and force-displacement (m->kind). */
-static cf_status y_unit(const reader *r, const cf_measure_options *opt, const layout *h,
-                        cf_table *m, scaling *u, cf_error *err)
-{
-    const column *yc = &r->cols[h->yi];
-    cf_unit_class yname = y_name_class(yc->base);
-    const char *yopt = NULL, *yflag = "option stress_unit";
-    cf_unit_class ywant[2] = {CF_UNIT_STRESS, CF_UNIT_FORCE};
-    size_t nywant = 2;
-    if (yname == CF_UNIT_STRESS) {
-        yopt = opt->stress_unit;
-        nywant = 1;
-    } else if (yname == CF_UNIT_FORCE) {
-        yopt = opt->force_unit;
-        yflag = "option force_unit";
-        ywant[0] = CF_UNIT_FORCE;
-        nywant = 1;
-    } else if (opt->stress_unit) {
-        yopt = opt->stress_unit;
-    } else if (opt->force_unit) {
-        yopt = opt->force_unit;
-        yflag = "option force_unit";
-    }
-    cf_status st = column_unit(r, h->header_line, (size_t)h->yi, yopt, yflag, 1, ywant, nywant,
-                               &u->yu, err);
-    if (st)
-        return st;
-    if (!u->yu) {
-        const char *hint = yname == CF_UNIT_FORCE ? "force_N or force [mN], or set option force_unit"
-                                                  : "stress_kPa or stress [kPa], or set "
-                                                    "option stress_unit (option force_unit for a "
-                                                    "force)";
-        return data_error(err, r->path, h->header_line, (size_t)h->yi + 1,
-                          "column '%s' has no unit: name it like %s ('%s')", yc->name, hint,
-                          yc->name);
-    }
-    m->kind =
-        u->yu->cls == CF_UNIT_STRESS ? CF_TABLE_STRESS_STRAIN : CF_TABLE_FORCE_DISPLACEMENT;
-    u->yscale = u->yu->to_conifit;
-    return CF_OK;
-}
-
-/* The unit of x: a strain or stretch against a stress, a length against a force. */
-static cf_status x_unit(const reader *r, const cf_measure_options *opt, const layout *h,
-                        const cf_table *m, scaling *u, cf_error *err)
-{
-    const char *path = r->path;
-    const column *xc = &r->cols[h->xi];
-    const unit_def *xu = NULL;
-    u->xscale = 1.0;
-    if (m->kind == CF_TABLE_STRESS_STRAIN) {
-        cf_unit_class xw[1] = {CF_UNIT_STRAIN};
-        if (xc->unit[0]) {
-            const unit_def *d = unit_find(xc->unit);
-            if (!d || d->cls != CF_UNIT_STRAIN)
-                return data_error(err, path, h->header_line, (size_t)h->xi + 1,
-                                  "column '%s' has unit '%s' but y is a stress, so x must be a "
-                                  "dimensionless strain or stretch ('-' or '%%') ('%s')",
-                                  xc->name, xc->unit, xc->name);
-            xu = d;
-        } else
-            xu = comment_unit(r->comments, r->ncomments, xc->base, 0, xw, 1);
-        if (xu)
-            u->xscale = xu->to_conifit;
-        if (u->stretch && u->xscale != 1.0)
-            return data_error(err, path, h->header_line, (size_t)h->xi + 1,
-                              "stretch column '%s' cannot be in '%%' ('%s')", xc->name, xc->name);
-        return CF_OK;
-    }
-    cf_unit_class xw[1] = {CF_UNIT_LENGTH};
-    if (u->stretch)
-        return data_error(err, path, h->header_line, (size_t)h->xi + 1,
-                          "column '%s' is a stretch but y is a force; give a displacement "
-                          "column or a stress ('%s')", xc->name, xc->name);
-    cf_status st = column_unit(r, h->header_line, (size_t)h->xi, opt->length_unit,
-                               "option length_unit", 0, xw, 1, &xu, err);
-    if (st)
-        return st;
-    if (!xu)
-        return data_error(err, path, h->header_line, (size_t)h->xi + 1,
-                          "column '%s' has no length unit (y is a force): name it like "
-                          "displacement_mm, or set option length_unit ('%s')", xc->name, xc->name);
-    u->xscale = xu->to_conifit;
-    return CF_OK;
-}
-
-/* The unit of the time column, if there is one. */
-static cf_status t_unit(const reader *r, const layout *h, scaling *u, cf_error *err)
-{
-    u->tscale = 1.0;
-    if (h->ti < 0)
-        return CF_OK;
-    const unit_def *tu = NULL;
-    cf_unit_class tw[1] = {CF_UNIT_TIME};
-    cf_status st = column_unit(r, h->header_line, (size_t)h->ti, NULL, "", 2, tw, 1, &tu, err);
-    if (st)
-        return st;
-    if (!tu)
-        return data_error(err, r->path, h->header_line, (size_t)h->ti + 1,
-                          "time column '%s' has no unit: name it like time_s or time [s] "
-                          "(s, ms, min, h)",
-                          r->cols[h->ti].name);
-    u->tscale = tu->to_conifit;
-    return CF_OK;
-}
-
-/* Units: y first (it decides the kind of table), the measures, then x and the time. */
-static cf_status decide_units(const reader *r, const cf_measure_options *opt, const layout *h,
-                              cf_table *m, scaling *u, cf_error *err)
-{
-    cf_status st = y_unit(r, opt, h, m, u, err);
-    if (st == CF_OK)
-        st = decide_measures(r, r->path, opt, &r->cols[h->xi], &r->cols[h->yi], &u->meas, err);
-    if (st != CF_OK)
-        return st;
-    u->stretch = u->meas.strain == CF_STRAIN_STRETCH;
-    if ((st = x_unit(r, opt, h, m, u, err)) != CF_OK)
-        return st;
-    return t_unit(r, h, u, err);
-}
-
 /* The field count of a row (split into r->f) against the header's. */
-static cf_status check_row_width(const reader *r, const line_span *l, const layout *h,
+static cf_status check_row_width(const reader *r, const cf_csv_line *l, const layout *h,
                                  const char *q, cf_error *err)
 {
     const size_t nf = r->f.count, want = h->ncols + (size_t)h->trailing;
     if (nf < want)
-        return data_error(err, r->path, l->line, nf + 1,
-                          "short row: %zu fields where the header has %zu%s ('%s')", nf, want,
-                          h->trailing ? " (the header ends with a delimiter, so must every row)"
+        return cf_csv_error(err, r->path, l->line, nf + 1,
+                            "short row: %zu fields where the header has %zu%s ('%s')", nf, want,
+                            h->trailing ? " (the header ends with a delimiter, so must every row)"
                                       : "",
                           q);
     if (nf > want) {
         char fq[128];
-        quote(fq, sizeof fq, field(&r->f, want), strlen(field(&r->f, want)));
-        return data_error(err, r->path, l->line, want + 1,
-                          "long row: %zu fields where the header has %zu (extra '%s') ('%s')", nf,
-                          want, fq, q);
+        cf_csv_quote(fq, sizeof fq, cf_csv_field(&r->f, want), strlen(cf_csv_field(&r->f, want)));
+        return cf_csv_error(err, r->path, l->line, want + 1,
+                            "long row: %zu fields where the header has %zu (extra '%s') ('%s')", nf,
+                            want, fq, q);
     }
-    if (h->trailing && field(&r->f, h->ncols)[0])
-        return data_error(err, r->path, l->line, h->ncols + 1,
-                          "a value in the unnamed last column (the header ends with a "
-                          "delimiter) ('%s')", field(&r->f, h->ncols));
+    if (h->trailing && cf_csv_field(&r->f, h->ncols)[0])
+        return cf_csv_error(err, r->path, l->line, h->ncols + 1,
+                            "a value in the unnamed last column (the header ends with a "
+                            "delimiter) ('%s')", cf_csv_field(&r->f, h->ncols));
     return CF_OK;
 }
 
 /* The x, y, weight and time cells of a row (split into r->f) as numbers, v[4]. */
-static cf_status row_numbers(const reader *r, const line_span *l, const layout *h, double v[4],
+static cf_status row_numbers(const reader *r, const cf_csv_line *l, const layout *h, double v[4],
                              cf_error *err)
 {
     const long idx[4] = {h->xi, h->yi, h->wi, h->ti};
     for (int k = 0; k < 4; k++) {
         if (idx[k] < 0)
             continue;
-        const char *cell = field(&r->f, (size_t)idx[k]);
-        num_result nr = parse_number(cell, h->delim, &v[k]);
-        if (nr != NUM_OK) {
+        const char *cell = cf_csv_field(&r->f, (size_t)idx[k]);
+        cf_csv_num nr = cf_csv_number(cell, h->delim, &v[k]);
+        if (nr != CF_CSV_NUM_OK) {
             char cq[128];
-            quote(cq, sizeof cq, cell, strlen(cell));
-            const char *what = nr == NUM_EMPTY        ? "empty cell"
-                               : nr == NUM_NOT_FINITE ? "not a finite number"
+            cf_csv_quote(cq, sizeof cq, cell, strlen(cell));
+            const char *what = nr == CF_CSV_NUM_EMPTY        ? "empty cell"
+                               : nr == CF_CSV_NUM_NOT_FINITE ? "not a finite number"
                                                       : "not a number";
-            return data_error(err, r->path, l->line, (size_t)idx[k] + 1, "column '%s': %s ('%s')",
-                              r->cols[idx[k]].name, what, cq);
+            return cf_csv_error(err, r->path, l->line, (size_t)idx[k] + 1, "column '%s': %s ('%s')",
+                                r->cols[idx[k]].name, what, cq);
         }
     }
     if (h->wi >= 0 && !(v[2] > 0.0))
-        return data_error(err, r->path, l->line, (size_t)h->wi + 1,
-                          "column '%s': a weight must be > 0 ('%s')", r->cols[h->wi].name,
-                          field(&r->f, (size_t)h->wi));
+        return cf_csv_error(err, r->path, l->line, (size_t)h->wi + 1,
+                            "column '%s': a weight must be > 0 ('%s')", r->cols[h->wi].name,
+                            cf_csv_field(&r->f, (size_t)h->wi));
     return CF_OK;
 }
 
 /* One data row (line l, n characters of content): checked, converted and appended. *skip = 1
 ** for a row of empty cells, which counts as blank. *tprev is the time of the row before. */
-static cf_status read_row(reader *r, const line_span *l, size_t n, const layout *h,
+static cf_status read_row(reader *r, const cf_csv_line *l, size_t n, const layout *h,
                           const scaling *u, double *tprev, int *skip, cf_error *err)
 {
     const char *path = r->path;
@@ -1371,12 +621,12 @@ static cf_status read_row(reader *r, const line_span *l, size_t n, const layout 
         return st;
     *skip = 1;
     for (size_t k = 0; k < r->f.count; k++)
-        if (field(&r->f, k)[0])
+        if (cf_csv_field(&r->f, k)[0])
             *skip = 0;
     if (*skip)
         return CF_OK;
     char q[256];
-    quote(q, sizeof q, l->s, n);
+    cf_csv_quote(q, sizeof q, l->s, n);
     double v[4] = {0.0, 0.0, 1.0, 0.0};
     if ((st = check_row_width(r, l, h, q, err)) != CF_OK ||
         (st = row_numbers(r, l, h, v, err)) != CF_OK)
@@ -1384,8 +634,8 @@ static cf_status read_row(reader *r, const line_span *l, size_t n, const layout 
     double x = u->stretch ? v[0] - 1.0 : v[0] * u->xscale;
     double y = v[1] * u->yscale, t = v[3] * u->tscale;
     if (!isfinite(x) || !isfinite(y) || !isfinite(t))
-        return data_error(err, path, l->line, (size_t)h->xi + 1,
-                          "value out of range after unit conversion ('%s')", q);
+        return cf_csv_error(err, path, l->line, (size_t)h->xi + 1,
+                            "value out of range after unit conversion ('%s')", q);
     /* finite, but so large that sums of squares over the table (RMSE, R^2, the fit's
     ** objective) would overflow: refused, so that no derived number can be Inf or NaN */
     if (fabs(x) > CF_MEASURE_MAX_VALUE || fabs(y) > CF_MEASURE_MAX_VALUE ||
@@ -1394,20 +644,20 @@ static cf_status read_row(reader *r, const line_span *l, size_t n, const layout 
                      : fabs(y) > CF_MEASURE_MAX_VALUE    ? (size_t)h->yi
                      : fabs(v[2]) > CF_MEASURE_MAX_VALUE ? (size_t)h->wi
                                                          : (size_t)h->ti;
-        return data_error(err, path, l->line, col + 1,
-                          "column '%s': magnitude above %g in conifit's units (MPa, N, mm, s): "
-                          "sums over the table would overflow ('%s')",
-                          r->cols[col].name, CF_MEASURE_MAX_VALUE, q);
+        return cf_csv_error(err, path, l->line, col + 1,
+                            "column '%s': magnitude above %g in conifit's units (MPa, N, mm, s): "
+                            "sums over the table would overflow ('%s')",
+                            r->cols[col].name, CF_MEASURE_MAX_VALUE, q);
     }
     if (r->count == CF_MEASURE_MAX_ROWS)
-        return data_error(err, path, l->line, 1,
-                          "more than %d data rows: a table may have at most %d (thin it, or "
-                          "fit a part of it)", CF_MEASURE_MAX_ROWS, CF_MEASURE_MAX_ROWS);
+        return cf_csv_error(err, path, l->line, 1,
+                            "more than %d data rows: a table may have at most %d (thin it, or "
+                            "fit a part of it)", CF_MEASURE_MAX_ROWS, CF_MEASURE_MAX_ROWS);
     if (h->ti >= 0 && r->count > 0 && !(t > *tprev))
-        return data_error(err, path, l->line, (size_t)h->ti + 1,
-                          "column '%s': time %.17g s does not increase (the row before has "
-                          "%.17g s) ('%s')",
-                          r->cols[h->ti].name, t, *tprev, field(&r->f, (size_t)h->ti));
+        return cf_csv_error(err, path, l->line, (size_t)h->ti + 1,
+                            "column '%s': time %.17g s does not increase (the row before has "
+                            "%.17g s) ('%s')",
+                            r->cols[h->ti].name, t, *tprev, cf_csv_field(&r->f, (size_t)h->ti));
     *tprev = t;
     if (push_row(r, x, y, v[2], t) != 0)
         return out_of_memory(err, path);
@@ -1420,10 +670,10 @@ static cf_status read_rows(reader *r, const layout *h, const scaling *u, cf_erro
     size_t last_line = h->header_line;
     double tprev = 0;
     for (size_t li = h->hi + 1; li < r->nlines; li++) {
-        const line_span *l = &r->lines[li];
-        if (is_comment_line(l))
+        const cf_csv_line *l = &r->lines[li];
+        if (cf_csv_is_comment(l))
             continue;
-        size_t n = content_length(l->s, l->n);
+        size_t n = cf_csv_content_length(l->s, l->n);
         if (n == 0)
             continue;
         int skip = 0;
@@ -1434,11 +684,13 @@ static cf_status read_rows(reader *r, const layout *h, const scaling *u, cf_erro
             last_line = l->line;
     }
     if (r->count < CF_MEASURE_MIN_ROWS)
-        return data_error(err, r->path, last_line, 1,
-                          "only %zu data rows; a fit needs at least %d ('%zu rows')", r->count,
-                          CF_MEASURE_MIN_ROWS, r->count);
+        return cf_csv_error(err, r->path, last_line, 1,
+                            "only %zu data rows; a fit needs at least %d ('%zu rows')", r->count,
+                            CF_MEASURE_MIN_ROWS, r->count);
     return CF_OK;
 }
+
+/* ---- the table ------------------------------------------------------------------------------- */
 
 /* The test mode: the option wins over the file's comment. */
 static cf_status decide_mode(const reader *r, const cf_measure_options *opt, cf_table *m,
@@ -1447,7 +699,7 @@ static cf_status decide_mode(const reader *r, const cf_measure_options *opt, cf_
     m->mode = CF_MODE_UNIAXIAL;
     m->mode_stated = 0;
     if (!opt->mode)
-        return comment_mode(r->comments, r->ncomments, r->path, &m->mode, &m->mode_stated, err);
+        return cf_comment_mode(r->comments, r->ncomments, r->path, &m->mode, &m->mode_stated, err);
     cf_error me = {0};
     if (cf_mode_parse(opt->mode, &m->mode, &me) != CF_OK)
         return cf_error_set(err, CF_E_DATA, "%s: --mode %s: expected uniaxial, shear, planar, "
@@ -1476,9 +728,9 @@ static void hand_over(reader *r, const layout *h, const scaling *u, cf_table *m)
     m->y_to_file = 1.0 / u->yscale;
     m->compression = neg && !pos;
     m->x_from_stretch = u->stretch;
-    utf8_copy(m->path, sizeof m->path, r->path);
-    utf8_copy(m->x_column, sizeof m->x_column, r->cols[h->xi].name);
-    utf8_copy(m->y_column, sizeof m->y_column, r->cols[h->yi].name);
+    cf_csv_utf8_copy(m->path, sizeof m->path, r->path);
+    cf_csv_utf8_copy(m->x_column, sizeof m->x_column, r->cols[h->xi].name);
+    cf_csv_utf8_copy(m->y_column, sizeof m->y_column, r->cols[h->yi].name);
     snprintf(m->x_unit, sizeof m->x_unit, "%s",
              m->kind == CF_TABLE_STRESS_STRAIN ? "-" : "mm");
     snprintf(m->y_unit, sizeof m->y_unit, "%s", u->yu->canon);
@@ -1509,7 +761,8 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
         (st = find_header(&r, &h, err)) != CF_OK || (st = read_header(&r, &h, err)) != CF_OK ||
         (st = choose_columns(&r, &opt, &h, err)) != CF_OK ||
         (st = decide_units(&r, &opt, &h, m, &u, err)) != CF_OK ||
-        (st = read_rows(&r, &h, &u, err)) != CF_OK || (st = decide_mode(&r, &opt, m, err)) != CF_OK) {
+        (st = read_rows(&r, &h, &u, err)) != CF_OK ||
+        (st = decide_mode(&r, &opt, m, err)) != CF_OK) {
         reader_free(&r);
         memset(m, 0, sizeof *m);
         return st;
@@ -1522,67 +775,5 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
         return st;
     }
     cf_error_clear(err);
-    return CF_OK;
-}
-
-void cf_table_free(cf_table *m)
-{
-    if (!m)
-        return;
-    free(m->x);
-    free(m->y);
-    free(m->w);
-    free(m->t);
-    m->x = m->y = m->w = m->t = NULL;
-    m->count = 0;
-}
-
-int cf_table_is_force(const cf_table *m)
-{
-    return m->kind == CF_TABLE_FORCE_DISPLACEMENT;
-}
-
-void cf_table_name(const cf_table *m, char *out, size_t cap)
-{
-    const char *base = strrchr(m->path, '/');
-    base = base ? base + 1 : m->path;
-    const char *dot = strrchr(base, '.');
-    int n = (dot && dot != base) ? (int)(dot - base) : (int)strlen(base);
-    snprintf(out, cap, "%.*s", n, base);
-}
-
-cf_status cf_table_from_arrays(cf_table_kind kind, size_t count, const double *x, const double *y,
-                               const double *w, cf_table *m, cf_error *err)
-{
-    memset(m, 0, sizeof *m);
-    m->kind = kind;
-    size_t bytes = sizeof(double) * (count ? count : 1);
-    m->x = malloc(bytes);
-    m->y = malloc(bytes);
-    m->w = malloc(bytes);
-    if (!m->x || !m->y || !m->w) {
-        cf_table_free(m);
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for a table of %zu points", count);
-    }
-    for (size_t i = 0; i < count; i++) {
-        m->x[i] = x[i];
-        m->y[i] = y[i];
-        m->w[i] = w ? w[i] : 1.0;
-    }
-    m->count = count;
-    m->y_to_file = 1.0;
-    snprintf(m->path, sizeof m->path, "(table in memory)");
-    snprintf(m->x_column, sizeof m->x_column, "x");
-    snprintf(m->y_column, sizeof m->y_column, "y");
-    snprintf(m->x_unit, sizeof m->x_unit, "%s", kind == CF_TABLE_FORCE_DISPLACEMENT ? "mm" : "-");
-    snprintf(m->y_unit, sizeof m->y_unit, "%s", kind == CF_TABLE_FORCE_DISPLACEMENT ? "N" : "MPa");
-    for (size_t i = 0; i < count; i++)
-        if (x[i] > 0)
-            return CF_OK;
-    m->compression = count > 0;
-    for (size_t i = 0; i < count; i++)
-        if (x[i] < 0)
-            return CF_OK;
-    m->compression = 0;
     return CF_OK;
 }

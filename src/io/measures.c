@@ -14,7 +14,11 @@
 #include <string.h>
 #include <strings.h>
 
-const char *const cf_measures_names[CF_DECL_KINDS][3] = {{"nominal", "cauchy"},
+/* What a declaration declares. */
+enum { CF_DECL_STRESS = 0, CF_DECL_STRAIN = 1, CF_DECL_KINDS = 2 };
+
+/* Names of the values of each kind, in the order of their enums. */
+static const char *const cf_measures_names[CF_DECL_KINDS][3] = {{"nominal", "cauchy"},
                                                           {"engineering", "log", "stretch"}};
 
 const char *cf_stress_measure_name(cf_stress_measure m)
@@ -26,7 +30,6 @@ const char *cf_strain_measure_name(cf_strain_measure m)
 {
     return (unsigned)m < 3 ? cf_measures_names[CF_DECL_STRAIN][m] : "?";
 }
-
 
 const char *cf_decl_source_name(cf_decl_source s)
 {
@@ -78,7 +81,10 @@ int cf_strain_measure_parse(const char *word, cf_strain_measure *m)
     return v >= 0 ? 0 : -1;
 }
 
-int cf_measures_declaration(const char *s, size_t n, int *kind, char *word, size_t cap)
+/* One comment line (without its '#'): 1 when it is a declaration "stress: WORD" or "strain: WORD"
+** (key case-insensitive, at the start of the comment), with *kind and the word copied to word
+** (at most cap - 1 characters); 0 otherwise. (The '# mode:' comment is read with the mode.) */
+static int cf_measures_declaration(const char *s, size_t n, int *kind, char *word, size_t cap)
 {
     static const char *const keys[CF_DECL_KINDS] = {"stress:", "strain:"};
     size_t i = 0;
@@ -110,7 +116,9 @@ int cf_measures_contains_ci(const char *s, const char *word)
     return 0;
 }
 
-int cf_measures_stress_of_column(const char *name)
+/* The measure a column's name states, or -1: y names true_stress, cauchy..., nominal_stress,
+** pk1...; x names log_strain, true_strain, hencky..., stretch, lambda, engineering_strain. */
+static int cf_measures_stress_of_column(const char *name)
 {
     static const char *const cauchy[] = {"cauchy", "true_stress", "true stress", "truestress"};
     static const char *const nominal[] = {"nominal", "engineering", "pk1", "piola"};
@@ -123,7 +131,7 @@ int cf_measures_stress_of_column(const char *name)
     return -1;
 }
 
-int cf_measures_strain_of_column(const char *name)
+static int cf_measures_strain_of_column(const char *name)
 {
     static const char *const logs[] = {"log", "true_strain", "true strain", "hencky"};
     for (int k = 0; k < 4; k++)
@@ -136,10 +144,23 @@ int cf_measures_strain_of_column(const char *name)
     return -1;
 }
 
-cf_status cf_measures_decide(const char *path, const char *column, const char *what,
-                             const char *const *names, int option, const cf_measures_said *said,
-                             int fallback, int *value, cf_decl_source *from, size_t *line,
-                             int *overridden, int *file_value, cf_error *err)
+/* What the file says about one quantity: from a declaration (line > 0) and/or a column (-1: it
+** says nothing). */
+typedef struct cf_measures_said {
+    int declared;       /* value of the declaration, -1: none */
+    size_t line;        /* its line */
+    int column;         /* value stated by the column's name, -1: none */
+} cf_measures_said;
+
+/* Decides one quantity: the option (>= 0) wins over the file; a declaration and a column name
+** that disagree are an error (CF_E_DATA naming the file, the line and the column); nothing said
+** gives fallback, marked assumed. `what` names the quantity in messages ("stress measure"),
+** names[] the values. */
+static cf_status cf_measures_decide(const char *path, const char *column, const char *what,
+                                    const char *const *names, int option,
+                                    const cf_measures_said *said, int fallback, int *value,
+                                    cf_decl_source *from, size_t *line, int *overridden,
+                                    int *file_value, cf_error *err)
 {
     *line = said->declared >= 0 ? said->line : 0;
     *overridden = 0;
@@ -167,6 +188,71 @@ cf_status cf_measures_decide(const char *path, const char *column, const char *w
         *value = fallback;
         *from = CF_DECL_ASSUMED;
     }
+    return CF_OK;
+}
+
+cf_status cf_measures_read(const cf_csv_line *comments, size_t ncomments, const char *path,
+                           const cf_measure_options *opt, const cf_column *xc, const cf_column *yc,
+                           cf_table_measures *out, cf_error *err)
+{
+    static const char *const what[CF_DECL_KINDS] = {"stress measure", "strain measure"};
+    static const char *const expect[CF_DECL_KINDS] = {"nominal or cauchy",
+                                                      "engineering, log or stretch"};
+    cf_measures_said said[CF_DECL_KINDS];
+    for (int k = 0; k < CF_DECL_KINDS; k++)
+        said[k] = (cf_measures_said){-1, 0, -1};
+    for (size_t i = 0; i < ncomments; i++) {
+        int kind, v = -1;
+        char word[64];
+        if (!cf_measures_declaration(comments[i].s, comments[i].n, &kind, word,
+                                     sizeof word))
+            continue;
+        if (kind == CF_DECL_STRESS) {
+            cf_stress_measure x;
+            v = cf_stress_measure_parse(word, &x) == 0 ? (int)x : -1;
+        } else {
+            cf_strain_measure x;
+            v = cf_strain_measure_parse(word, &x) == 0 ? (int)x : -1;
+        }
+        if (v < 0)
+            return cf_csv_error(err, path, comments[i].line, 1,
+                                "unknown %s (expected %s) ('%s')", what[kind], expect[kind], word);
+        if (said[kind].declared >= 0 && said[kind].declared != v)
+            return cf_csv_error(err, path, comments[i].line, 1,
+                                "%s declared twice, differently (line %zu says otherwise) ('%s')",
+                                what[kind], said[kind].line, word);
+        said[kind].declared = v;
+        said[kind].line = comments[i].line;
+    }
+    said[CF_DECL_STRESS].column = cf_measures_stress_of_column(yc->base);
+    said[CF_DECL_STRAIN].column = cf_measures_strain_of_column(xc->base);
+    int strain_opt = opt->strain_measure >= 0   ? opt->strain_measure
+                     : opt->x_is_stretch == 1   ? CF_STRAIN_STRETCH
+                     : opt->x_is_stretch == 0   ? CF_STRAIN_ENGINEERING
+                                                : -1;
+    const int option[CF_DECL_KINDS] = {opt->stress_measure, strain_opt};
+    const char *col[CF_DECL_KINDS] = {yc->name, xc->name};
+    int value[CF_DECL_KINDS], over[CF_DECL_KINDS], filev[CF_DECL_KINDS];
+    cf_decl_source from[CF_DECL_KINDS];
+    size_t line[CF_DECL_KINDS];
+    for (int k = 0; k < CF_DECL_KINDS; k++) {
+        cf_status st = cf_measures_decide(path, col[k], what[k], cf_measures_names[k], option[k],
+                                          &said[k], 0, &value[k], &from[k], &line[k], &over[k],
+                                          &filev[k], err);
+        if (st != CF_OK)
+            return st;
+    }
+    memset(out, 0, sizeof *out);
+    out->stress = (cf_stress_measure)value[CF_DECL_STRESS];
+    out->strain = (cf_strain_measure)value[CF_DECL_STRAIN];
+    out->stress_from = from[CF_DECL_STRESS];
+    out->strain_from = from[CF_DECL_STRAIN];
+    out->stress_line = line[CF_DECL_STRESS];
+    out->strain_line = line[CF_DECL_STRAIN];
+    out->stress_overridden = over[CF_DECL_STRESS];
+    out->strain_overridden = over[CF_DECL_STRAIN];
+    out->stress_file = filev[CF_DECL_STRESS];
+    out->strain_file = filev[CF_DECL_STRAIN];
     return CF_OK;
 }
 
