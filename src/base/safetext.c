@@ -6,10 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
-/* Length of the valid UTF-8 sequence of a printable character at s (n bytes left), or 0 when the
-** byte at s does not start one (a control character, DEL, a C1 control, a stray or overlong
-** byte, a surrogate). */
-static size_t printable_length(const unsigned char *s, size_t n)
+size_t cf_text_char_length(const unsigned char *s, size_t n)
 {
     const unsigned c = s[0];
     if (c < 0x80)
@@ -46,7 +43,7 @@ static size_t printable_length(const unsigned char *s, size_t n)
 ** in *used the input bytes it stands for. */
 static size_t next_piece(const unsigned char *s, size_t n, char piece[8], size_t *used)
 {
-    size_t len = printable_length(s, n);
+    size_t len = cf_text_char_length(s, n);
     if (len) {
         memcpy(piece, s, len);
         *used = len;

@@ -13,6 +13,11 @@
 
 #include <stddef.h>
 
+/* Length of the valid UTF-8 sequence of one printable character at s (n bytes left): 1 to 4, or 0
+** when the byte at s does not start one (a control character, DEL, a C1 control, a stray or overlong
+** byte, a surrogate, a sequence cut short). */
+size_t cf_text_char_length(const unsigned char *s, size_t n);
+
 /* Writes the safe form of the n bytes at s into out (cap bytes, NUL-terminated; cap >= 1), ending
 ** with "..." when it did not fit. Returns out. */
 char *cf_safe_text(char *out, size_t cap, const char *s, size_t n);

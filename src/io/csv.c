@@ -4,6 +4,8 @@
 */
 #include "io/csv.h"
 
+#include "base/safetext.h"
+
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -18,20 +20,18 @@
 
 void cf_csv_quote(char *out, size_t cap, const char *s, size_t n)
 {
-    size_t o = 0;
-    const size_t keep = 60;
-    for (size_t i = 0; i < n && o + 8 < cap; i++) {
-        unsigned char c = (unsigned char)s[i];
-        if (i == keep) {
-            o += (size_t)snprintf(out + o, cap - o, "...");
+    /* at most the first 60 bytes, cut between characters, in the form every message uses */
+    size_t keep = 0;
+    while (keep < n) {
+        size_t len = cf_text_char_length((const unsigned char *)s + keep, n - keep);
+        len = len ? len : 1; /* a byte shown as \xNN */
+        if (keep + len > 60)
             break;
-        }
-        if (c >= 0x20 && c < 0x7f)
-            out[o++] = (char)c;
-        else
-            o += (size_t)snprintf(out + o, cap - o, "\\x%02X", c);
+        keep += len;
     }
-    out[o < cap ? o : cap - 1] = '\0';
+    cf_safe_text(out, cap > 3 ? cap - 3 : cap, s, keep);
+    if (keep < n && cap > 3)
+        strcat(out, "...");
 }
 
 cf_status cf_csv_error(cf_error *err, const char *path, size_t line, size_t col, const char *fmt,
@@ -267,37 +267,11 @@ void cf_csv_trim_copy(char *out, size_t cap, const char *s, size_t n)
 
 size_t cf_csv_bad_byte(const unsigned char *s, size_t n)
 {
-    size_t i = 0;
+    size_t i = 0, len;
     while (i < n) {
-        unsigned char c = s[i];
-        if (c < 0x80) {
-            if ((c < 0x20 && c != '\t') || c == 0x7f)
-                return i;
-            i++;
-            continue;
-        }
-        size_t len;
-        uint32_t cp;
-        if (c >= 0xc2 && c <= 0xdf) {
-            len = 2;
-            cp = c & 0x1f;
-        } else if (c >= 0xe0 && c <= 0xef) {
-            len = 3;
-            cp = c & 0x0f;
-        } else if (c >= 0xf0 && c <= 0xf4) {
-            len = 4;
-            cp = c & 0x07;
-        } else
-            return i;
-        if (i + len > n)
-            return i;
-        for (size_t k = 1; k < len; k++) {
-            if ((s[i + k] & 0xc0) != 0x80)
-                return i;
-            cp = (cp << 6) | (s[i + k] & 0x3f);
-        }
-        if ((len == 3 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) ||
-            (len == 4 && (cp < 0x10000 || cp > 0x10ffff)) || (cp >= 0x80 && cp <= 0x9f))
+        if (s[i] == '\t')
+            len = 1;
+        else if ((len = cf_text_char_length(s + i, n - i)) == 0)
             return i;
         i += len;
     }

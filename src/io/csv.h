@@ -41,8 +41,9 @@ typedef enum cf_csv_num {
     CF_CSV_NUM_NOT_FINITE
 } cf_csv_num;
 
-/* Copies text into out as a short printable quotation: control and non-ASCII bytes as \xNN,
-** long text cut with "...". */
+/* Copies text into out as a short quotation for a message: at most its first 60 bytes, cut
+** between characters and ending in "..." when cut, made safe as every message is (control
+** characters and bytes that are not UTF-8 as \xNN: base/safetext.h). */
 void cf_csv_quote(char *out, size_t cap, const char *s, size_t n);
 
 /* CF_E_DATA with "PATH:LINE:COL: message". */

@@ -8,6 +8,7 @@
 */
 #include "conifit/measure.h"
 
+#include "base/input.h"
 #include "io/columns.h"
 #include "io/csv.h"
 #include "io/measures.h"
@@ -63,9 +64,9 @@ static cf_status out_of_memory(cf_error *err, const char *path)
 static cf_status read_all(reader *r, cf_error *err)
 {
     const int from_stdin = strcmp(r->path, "-") == 0; /* "-": standard input */
-    FILE *fp = from_stdin ? stdin : fopen(r->path, "rb");
+    FILE *fp = from_stdin ? stdin : cf_input_open(r->path, "table", err);
     if (!fp)
-        return cf_error_set(err, CF_E_NOINPUT, "%s: cannot open: %s", r->path, strerror(errno));
+        return CF_E_NOINPUT;
     if (from_stdin)
         r->path = "(standard input)";
     size_t cap = 1 << 16;

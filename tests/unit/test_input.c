@@ -1,7 +1,7 @@
 /*
 ** Tests of input opening (src/base/input.c): regular files (and links to them) are read; a FIFO,
 ** a device and a folder are refused at once with the kind named, never waited on; through the
-** program, a scene that is a FIFO is exit 66.
+** program, a table or a scene that is a FIFO is exit 66.
 */
 #include "testutil.h"
 
@@ -60,14 +60,17 @@ static void only_regular_files_are_opened(void **state)
     rmdir(dir);
 }
 
-static void scene_that_is_a_fifo_is_refused(void **state)
+/* Through the program: a table or a scene that is a FIFO (no writer) is exit 66, at once. */
+static void inputs_that_are_fifos_are_refused(void **state)
 {
     (void)state;
     char dir[] = "/tmp/conifit-input-XXXXXX", fifo[300], se[4096];
     assert_non_null(mkdtemp(dir));
-    snprintf(fifo, sizeof fifo, "%s/scene.json", dir);
+    snprintf(fifo, sizeof fifo, "%s/input.json", dir);
     assert_int_equal(mkfifo(fifo, 0600), 0);
     assert_int_equal(tu_run(NULL, 0, se, sizeof se, "simulate %s -o %s/out.csv", fifo, dir), 66);
+    assert_non_null(strstr(se, "a FIFO"));
+    assert_int_equal(tu_run(NULL, 0, se, sizeof se, "fit %s --quiet", fifo), 66);
     assert_non_null(strstr(se, "a FIFO"));
     unlink(fifo);
     rmdir(dir);
@@ -77,7 +80,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(only_regular_files_are_opened),
-        cmocka_unit_test(scene_that_is_a_fifo_is_refused),
+        cmocka_unit_test(inputs_that_are_fifos_are_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
