@@ -327,13 +327,3 @@ cf_status cf_fitfile_prepare(const json_t *root, const char *path, const char *c
     free(s);
     return st;
 }
-
-cf_status cf_fitfile_write(const json_t *root, const char *path, const char *const *inputs,
-                           cf_error *err)
-{
-    cf_atomic a;
-    cf_status st = cf_fitfile_prepare(root, path, inputs, &a, err);
-    if (st == CF_OK)
-        st = cf_atomic_commit(&a, err);
-    return st;
-}
