@@ -6,7 +6,6 @@
 */
 #include <errno.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -20,7 +19,9 @@
 #include "conifit/joint.h"
 #include "conifit/jointreport.h"
 #include "conifit/pipeline.h"
+#include "conifit/pipeline_joint.h"
 #include "conifit/pipeline_series.h"
+#include "pipeline/pool.h"
 #include "report/plot.h"
 
 static const char fit_help[] =
@@ -551,11 +552,13 @@ static int parse_args(int argc, char **argv, fit_args *a)
     return -1;
 }
 
-/* Through-the-lattice work takes seconds: say so on a terminal. */
+/* Through-the-lattice work and each type of a joint fit take seconds: say so on a terminal. */
 static void show_progress(void *ctx, const char *table, const char *what)
 {
     (void)ctx;
-    if (strstr(what, "through the lattice") || strstr(what, "viscoelastic"))
+    if (!table)
+        fprintf(stderr, "conifit fit: %s\n", what);
+    else if (strstr(what, "through the lattice") || strstr(what, "viscoelastic"))
         fprintf(stderr, "conifit: %s: %s...\n", table, what);
 }
 
@@ -584,26 +587,6 @@ static void run_job(fit_job *j)
         return;
     if (!a->quiet)
         j->text = cf_report_text(&j->rep);
-}
-
-typedef struct pool {
-    fit_job *jobs;
-    int count;
-    int next;
-    pthread_mutex_t lock;
-} pool;
-
-static void *worker(void *arg)
-{
-    pool *p = arg;
-    for (;;) {
-        pthread_mutex_lock(&p->lock);
-        int k = p->next++;
-        pthread_mutex_unlock(&p->lock);
-        if (k >= p->count)
-            return NULL;
-        run_job(&p->jobs[k]);
-    }
 }
 
 /* Names every output of the run before anything is read or fitted, and refuses the run when two
@@ -648,7 +631,8 @@ static int plan_outputs(const fit_args *a, fit_job *jobs, const char *const *inp
     return -1;
 }
 
-/* --joint: one lattice fitted to every table (joint.h), each spring type asked for. */
+/* --joint: one lattice fitted to every table (pipeline_joint.h), each spring type asked for;
+** the outputs checked before, put in place and printed after. */
 static int run_joint(const fit_args *a, fit_job *jobs, const char *const *inputs)
 {
     cf_error err = {0};
@@ -664,23 +648,9 @@ static int run_joint(const fit_args *a, fit_job *jobs, const char *const *inputs
     for (int i = 0; i < a->nfiles; i++)
         tabs[i] = &jobs[i].m;
     cf_joint_report r;
-    memset(&r, 0, sizeof r);
-    r.tables = tabs;
-    r.ntables = (size_t)a->nfiles;
-    r.with_timing = 1;
     int rc = CF_EXIT_OK;
-    for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING && rc == CF_EXIT_OK; ty++) {
-        if (!(a->popt.types & (1u << ty)))
-            continue;
-        if (a->progress)
-            fprintf(stderr, "conifit fit: fitting the %s spring to %d tables jointly\n",
-                    cf_spring_type_name((cf_spring_type)ty), a->nfiles);
-        if (cf_joint_fit(tabs, r.ntables, &a->popt.fit, &a->popt.lattice, (cf_spring_type)ty,
-                         &r.fits[r.nfits], &err) != CF_OK)
-            rc = cf_cli_fail(&err);
-        else
-            r.nfits++;
-    }
+    if (cf_pipeline_fit_joint(tabs, (size_t)a->nfiles, &a->popt, &r, &err) != CF_OK)
+        rc = cf_cli_fail(&err);
     cf_atomic jo, po;
     if (rc == CF_EXIT_OK &&
         cf_joint_prepare(&r, a->out, a->plot, inputs, &jo, &po, &err) != CF_OK)
@@ -748,19 +718,10 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
     return rc;
 }
 
-/* Fits every job on up to a->jobs threads. */
-static void run_pool(const fit_args *a, fit_job *jobs)
+/* The pool's task k: job k of the array ctx. */
+static void run_job_k(void *ctx, int k)
 {
-    pool p = {jobs, a->nfiles, 0, PTHREAD_MUTEX_INITIALIZER};
-    int nt = (int)(a->jobs < a->nfiles ? a->jobs : a->nfiles);
-    pthread_t th[256];
-    int started = 0;
-    for (int t = 1; t < nt; t++)
-        if (pthread_create(&th[started], NULL, worker, &p) == 0)
-            started++;
-    worker(&p);
-    for (int t = 0; t < started; t++)
-        pthread_join(th[t], NULL);
+    run_job(&((fit_job *)ctx)[k]);
 }
 
 /* All outputs or none: they go in place only when every table succeeded. Returns 1 when none
@@ -880,7 +841,7 @@ static void print_summary(const fit_args *a, const fit_job *jobs)
 ** Returns the exit status: the first failure's, else 0. */
 static int fit_all(const fit_args *a, fit_job *jobs)
 {
-    run_pool(a, jobs);
+    cf_pool_run(a->nfiles, a->jobs, run_job_k, jobs);
     const int failed = commit_outputs(a, jobs);
     int rc = CF_EXIT_OK;
     for (int i = 0; i < a->nfiles; i++) {
