@@ -261,7 +261,7 @@ static void value_se_text(FILE *o, const char *label, double v, double se, doubl
 
 /* The text report of a viscoelastic fit, section after section in the order printed (table,
 ** model, elastic quantities, Prony terms, errors over ramp and hold, predictions, springs).
-** Long (~90 lines) only because the report is: no branch depends on an earlier section. */
+** Long only because the report is: no branch depends on an earlier section. */
 char *cf_visco_report_text(const cf_visco_report *r)
 {
     char *buf = NULL;
