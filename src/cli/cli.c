@@ -9,6 +9,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 /* The library names a setting "option FIELD" (option stress_unit); the command line calls it
@@ -263,6 +264,13 @@ void cf_cli_common_help(FILE *out)
 int cf_cli_is_stdio(const char *path)
 {
     return path && strcmp(path, "-") == 0;
+}
+
+int cf_cli_is_dir_target(const char *p)
+{
+    struct stat s;
+    size_t n = strlen(p);
+    return (n > 0 && p[n - 1] == '/') || (stat(p, &s) == 0 && S_ISDIR(s.st_mode));
 }
 
 cf_status cf_cli_out_open(cf_cli_out *o, const char *path, const char *const *inputs,

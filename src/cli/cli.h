@@ -124,6 +124,9 @@ void cf_cli_out_abort(cf_cli_out *o);
 /* 1 when path names standard input or output ("-"). */
 int cf_cli_is_stdio(const char *path);
 
+/* 1 when path names a folder: it ends in '/' or is an existing directory. */
+int cf_cli_is_dir_target(const char *p);
+
 /* ---- the spring options --D1 --D2 --n --d --G --H (force, curve, info, synth) -------------- */
 
 typedef struct cf_cli_spring {

@@ -212,8 +212,8 @@ static void write_header(FILE *fp, const synth_args *a, const cf_law *law, doubl
 }
 
 /* synth: parse, check the spring and strain range, evaluate the rows, add GSL's Gaussian noise,
-** check every value finite, write the table. A straight sequence (~90 lines) whose failures all
-** free the same three buffers, so kept whole. */
+** check every value finite, write the table. A straight sequence whose failures all free the
+** same three buffers, so kept whole. */
 int cf_cli_synth(int argc, char **argv)
 {
     synth_args a;

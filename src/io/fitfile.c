@@ -76,8 +76,8 @@ static cf_status read_visco(json_t *fit, const char *path, const char *where,
 
 /* Reads one fit file top to bottom: open (a folder or "-"), parse, choose the fit (a single
 ** exported spring, the requested or better type, a tie), its params by the field table, then
-** provenance and the viscoelastic terms. Kept as one function (~130 lines) because each step
-** narrows the same JSON node and every error names the file and key it stopped at. */
+** provenance and the viscoelastic terms. Kept as one function because each step narrows the same
+** JSON node and every error names the file and key it stopped at. */
 cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spring *out,
                           cf_error *err)
 {
@@ -325,15 +325,5 @@ cf_status cf_fitfile_prepare(const json_t *root, const char *path, const char *c
         st = cf_atomic_finish(out, err);
     }
     free(s);
-    return st;
-}
-
-cf_status cf_fitfile_write(const json_t *root, const char *path, const char *const *inputs,
-                           cf_error *err)
-{
-    cf_atomic a;
-    cf_status st = cf_fitfile_prepare(root, path, inputs, &a, err);
-    if (st == CF_OK)
-        st = cf_atomic_commit(&a, err);
     return st;
 }

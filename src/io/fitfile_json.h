@@ -32,14 +32,11 @@ json_t *cf_fitfile_spring_json(const cf_law *law);
 char *cf_fitfile_dumps(const json_t *root);
 
 /* Writes the document to a temporary file beside path, complete but not in place: the caller
-** commits it (cf_atomic_commit) with its other outputs, or aborts it. Errors as below. */
+** commits it (cf_atomic_commit) with its other outputs, or aborts it. `inputs` (NULL-terminated,
+** may be NULL) are refused as targets. CF_E_CANTWRITE (or CF_E_INTERNAL when memory runs out or
+** the document holds a value that is not a finite number) on failure, no file left behind. */
 struct cf_atomic;
 cf_status cf_fitfile_prepare(const json_t *root, const char *path, const char *const *inputs,
                              struct cf_atomic *out, cf_error *err);
-
-/* Writes the document to path atomically (atomic.h); `inputs` (NULL-terminated, may be NULL) are
-** refused as targets. CF_E_CANTWRITE (or CF_E_INTERNAL when memory runs out) on failure. */
-cf_status cf_fitfile_write(const json_t *root, const char *path, const char *const *inputs,
-                           cf_error *err);
 
 #endif

@@ -62,7 +62,7 @@ static int through_lattice(const cf_table *t, const cf_pipeline_options *opt)
 #define VALIDATE_SCAN_SOLVES 64
 
 /* Each fit in the lattice, or through it. A fit the lattice cannot run keeps its validation's
-** note (report.c prints it) and is not an error; running out of memory is (CF_E_INTERNAL). */
+** note (the report states it) and is not an error; running out of memory is (CF_E_INTERNAL). */
 static cf_status validate_fits(const cf_table *t, const cf_pipeline_options *opt,
                                cf_fit_report *r, cf_error *err)
 {

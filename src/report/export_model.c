@@ -265,8 +265,8 @@ static const char *const mask_name[8] = {"", "fix_x", "fix_y", "fix_xy",
                                          "fix_z", "fix_xz", "fix_yz", "fix_xyz"};
 
 /* An FEBio 4 model, written in the order of its sections (Module, Control, Mesh with nodes,
-** node sets and the discrete set, MeshDomains, Boundary, Discrete, LoadData, Output). Long (~85
-** lines) only because the file is; each section is a few fprintf calls. */
+** node sets and the discrete set, MeshDomains, Boundary, Discrete, LoadData, Output). Long only
+** because the file is; each section is a few fprintf calls. */
 int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
 {
     fprintf(out, "<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?>\n");

@@ -282,8 +282,8 @@ static size_t settle_half(const cf_law *law, double tol, double U, double sign, 
 
 /* The adaptive table over [u_lo, u_hi]: the compression and stretch sides of u = 0 grown until
 ** each meets tol (one side mirrored when the range is symmetric), joined, and the joined table's
-** error measured on each side's check grid. Kept as one function (~80 lines) because both sides
-** share the law, the tolerance and the output table. */
+** error measured on each side's check grid. Kept as one function because both sides share the
+** law, the tolerance and the output table. */
 cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo_mm,
                                       double u_hi_mm, cf_export_table *t, cf_error *err)
 {

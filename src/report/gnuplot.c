@@ -279,8 +279,8 @@ static void first_error_line(FILE *f, char *out, size_t cap)
 
 /* Runs gnuplot on the finished script: store it in a temporary file, start gnuplot by
 ** posix_spawnp with a fixed argument vector (no shell; the script on its standard input, its
-** output into the atomic target), wait, read its error stream. Kept as one
-** function (~85 lines) because every step owns a resource that each later failure must release. */
+** output into the atomic target), wait, read its error stream. Kept as one function because every
+** step owns a resource that each later failure must release. */
 cf_status cf_gp_render(cf_gp *g, const char *path, const char *const *inputs, cf_atomic *out,
                        cf_error *err)
 {

@@ -273,16 +273,6 @@ cf_status cf_plot_fit(const cf_fit_report *r, const char *path, const char *cons
     return draw(fit_script, r, 1150, 820, path, inputs, out, err);
 }
 
-cf_status cf_plot_write(const cf_fit_report *r, const char *path, const char *const *inputs,
-                        cf_error *err)
-{
-    cf_atomic a;
-    cf_status st = cf_plot_fit(r, path, inputs, &a, err);
-    if (st == CF_OK)
-        st = cf_atomic_commit(&a, err);
-    return st;
-}
-
 typedef struct simulation_figure {
     const cf_scene *sc;
     const cf_msm_sample *s;

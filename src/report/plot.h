@@ -32,10 +32,6 @@ cf_status cf_plot_check_name(const char *path, cf_error *err);
 cf_status cf_plot_fit(const cf_fit_report *r, const char *path,
                       const char *const *inputs, cf_atomic *out, cf_error *err);
 
-/* The same, committed at once. */
-cf_status cf_plot_write(const cf_fit_report *r, const char *path,
-                        const char *const *inputs, cf_error *err);
-
 /* Draws a simulation's samples (n of them; spring_MPa[k]: one spring's F(strain H)/H^2 at the
 ** sample's strain) as the scene's protocol suggests; same outputs and errors as cf_plot_fit. */
 cf_status cf_plot_simulation(const cf_scene *sc, const cf_msm_sample *s, const double *spring_MPa,

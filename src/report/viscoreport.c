@@ -234,16 +234,6 @@ static json_t *report_json(const cf_visco_report *r)
                      "stress along the series");
 }
 
-char *cf_visco_report_json_string(const cf_visco_report *r)
-{
-    json_t *root = report_json(r);
-    if (!root)
-        return NULL;
-    char *s = cf_fitfile_dumps(root);
-    json_decref(root);
-    return s;
-}
-
 cf_status cf_visco_report_json_prepare(const cf_visco_report *r, const char *path,
                                        const char *const *inputs, struct cf_atomic *out,
                                        cf_error *err)
@@ -271,7 +261,7 @@ static void value_se_text(FILE *o, const char *label, double v, double se, doubl
 
 /* The text report of a viscoelastic fit, section after section in the order printed (table,
 ** model, elastic quantities, Prony terms, errors over ramp and hold, predictions, springs).
-** Long (~90 lines) only because the report is: no branch depends on an earlier section. */
+** Long only because the report is: no branch depends on an earlier section. */
 char *cf_visco_report_text(const cf_visco_report *r)
 {
     char *buf = NULL;

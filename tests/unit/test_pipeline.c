@@ -3,7 +3,9 @@
 **  - golden: refitting every table of data/ through cf_pipeline_fit reproduces the committed
 **    fits/NAME.json (made by `make fits`) to a stated tolerance;
 **  - the JSON keys of the spring description are the ones written to a fit file and read back;
-**  - a table made in code goes through the same call.
+**  - a table made in code goes through the same call;
+**  - the batch pool runs every task once, on any number of threads;
+**  - the joint fit fits each asked type and names each through the progress callback.
 */
 #include "testutil.h"
 
@@ -14,7 +16,9 @@
 
 #include "conifit/fitfile.h"
 #include "conifit/pipeline.h"
+#include "conifit/pipeline_joint.h"
 #include "conifit/spring.h"
+#include "pipeline/pool.h"
 
 /* Tolerances of the golden comparison, relative to the committed value. The fit is deterministic
 ** for a given build (seeded, no threads inside a fit); another compiler or optimisation level may
@@ -188,12 +192,86 @@ static void library_errors_are_data_errors_not_usage(void **state)
     assert_null(strstr(err.msg, "--"));
 }
 
+static void count_task(void *ctx, int k)
+{
+    ((int *)ctx)[k]++;
+}
+
+/* Every task of the batch runs exactly once, whatever the thread count (more threads than tasks,
+** more than the pool's most, none to run). */
+static void pool_runs_every_task_once_on_any_number_of_threads(void **state)
+{
+    (void)state;
+    const long threads[] = {1, 3, 64, CF_POOL_MAX_THREADS + 10};
+    const int counts[] = {0, 1, 7, 300};
+    static int hits[300];
+    for (size_t t = 0; t < sizeof threads / sizeof threads[0]; t++)
+        for (size_t c = 0; c < sizeof counts / sizeof counts[0]; c++) {
+            memset(hits, 0, sizeof hits);
+            cf_pool_run(counts[c], threads[t], count_task, hits);
+            for (int k = 0; k < 300; k++)
+                if (hits[k] != (k < counts[c]))
+                    fail_msg("%d tasks on %ld threads: task %d ran %d times", counts[c],
+                             threads[t], k, hits[k]);
+        }
+}
+
+typedef struct progress_log {
+    int calls;
+    int with_table;
+    char last[128];
+} progress_log;
+
+static void log_progress(void *ctx, const char *table, const char *what)
+{
+    progress_log *l = ctx;
+    l->calls++;
+    l->with_table += table != NULL;
+    snprintf(l->last, sizeof l->last, "%s", what);
+}
+
+/* Two shipped tables fitted jointly: one fit per type, each announced once with no table; one
+** table alone is refused after the announcement, with no fit to release. */
+static void joint_fit_fits_each_type_and_reports_its_progress(void **state)
+{
+    (void)state;
+    cf_measure_options mo = cf_measure_default_options();
+    cf_table t[2];
+    cf_error err = {0};
+    assert_int_equal(cf_measure_load("data/telescoping.csv", &mo, &t[0], &err), CF_OK);
+    assert_int_equal(cf_measure_load("data/non_telescoping.csv", &mo, &t[1], &err), CF_OK);
+    const cf_table *tabs[2] = {&t[0], &t[1]};
+    cf_pipeline_options opt = cf_pipeline_default_options();
+    progress_log log = {0};
+    opt.progress = log_progress;
+    opt.progress_ctx = &log;
+    cf_joint_report r;
+    if (cf_pipeline_fit_joint(tabs, 2, &opt, &r, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    assert_int_equal(r.nfits, 2);
+    assert_int_equal(r.ntables, 2);
+    assert_ptr_equal(r.tables, tabs);
+    assert_int_equal(log.calls, 2);
+    assert_int_equal(log.with_table, 0);
+    assert_string_equal(log.last, "fitting the non-telescoping spring to 2 tables jointly");
+    for (int k = 0; k < r.nfits; k++)
+        cf_joint_free(&r.fits[k]);
+    opt.types = CF_PIPELINE_TELESCOPING;
+    assert_int_not_equal(cf_pipeline_fit_joint(tabs, 1, &opt, &r, &err), CF_OK);
+    assert_int_equal(r.nfits, 0);
+    assert_int_equal(log.calls, 3);
+    cf_table_free(&t[0]);
+    cf_table_free(&t[1]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(refitting_the_shipped_tables_reproduces_the_committed_fits),
         cmocka_unit_test(spring_description_keys_round_trip_through_a_fit_file),
         cmocka_unit_test(library_errors_are_data_errors_not_usage),
+        cmocka_unit_test(pool_runs_every_task_once_on_any_number_of_threads),
+        cmocka_unit_test(joint_fit_fits_each_type_and_reports_its_progress),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,5 +1,6 @@
 /*
-** The report (report/report.c): the JSON fit file and the text, from a report the pipeline made.
+** The report (report/report.c, report_text.c): the JSON fit file and the text, from a report the
+** pipeline made.
 **  - the JSON holds the table's provenance and units, every number finite and no null (a value
 **    that is not determined is left out, with a reason beside it; a document that would hold a
 **    non-finite number is not written, and the error names its key), and reads back with the

@@ -27,8 +27,9 @@ enum {
     CF_PIPELINE_BOTH = CF_PIPELINE_TELESCOPING | CF_PIPELINE_NON_TELESCOPING
 };
 
-/* Called before each long step: `table` is the table's path, `what` says what starts ("fitting
-** the telescoping spring through the lattice"). The library itself never prints. */
+/* Called before each long step: `table` is the table's path (NULL for a step over several tables,
+** pipeline_joint.h), `what` says what starts ("fitting the telescoping spring through the
+** lattice"). The library itself never prints. */
 typedef void (*cf_pipeline_progress)(void *ctx, const char *table, const char *what);
 
 /* What the fit aims at. */

@@ -32,9 +32,6 @@ void cf_visco_report_free(cf_visco_report *r);
 /* The readable report (malloc'd; NULL when memory runs out). */
 char *cf_visco_report_text(const cf_visco_report *r);
 
-/* The JSON fit file as a string (malloc'd; NULL when memory runs out). */
-char *cf_visco_report_json_string(const cf_visco_report *r);
-
 /* Writes the JSON to a temporary file beside path, complete but not in place (the caller commits
 ** or aborts *out); inputs (NULL-terminated, may be NULL) are refused as targets. */
 struct cf_atomic;

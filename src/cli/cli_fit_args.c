@@ -1,0 +1,446 @@
+/*
+** The command line of `conifit fit` (cli_fit.h): the help, the options and the checks across
+** them.
+*/
+#include <stdio.h>
+#include <string.h>
+
+#include "cli/cli.h"
+#include "cli/cli_fit.h"
+#include "conifit/calibration.h"
+#include "conifit/fit.h"
+#include "conifit/spring.h"
+#include "report/plot.h"
+
+static const char fit_help[] =
+    "usage: conifit fit TABLE... [-o OUT.json | -o DIR/ | -o -] [options]\n"
+    "Fits the design parameters D1, D2, n, d [mm], G [MPa], H [mm] of a conical spring to a\n"
+    "measured stress-strain (or force-displacement) table, for each spring type, with linear,\n"
+    "Duffing and Fung baselines beside it. Prints a report; -o writes the JSON fit file.\n\n"
+    "  TABLE                   .csv or .txt table; '-' reads one from standard input\n"
+    "  -o, --output OUT.json | DIR/ | -   fit file (one table), folder (one NAME.json per\n"
+    "                          table), or '-': the fit file on standard output (no report)\n"
+    "  --type T                telescoping | non-telescoping | both (default both)\n"
+    "  --fix NAME=VALUE        hold a parameter: D1, D2, d, H in mm, G in MPa, n (repeatable)\n"
+    "  --index-max C           largest spring index D1/d, 3..50 (default 12; the smallest is 3)\n"
+    "  --rho-min R             smallest diameter ratio D1/D2, 0.001..1 (default 0.05)\n"
+    "  --n-max N               most active coils, 2..1000 (default 30; the fewest is 2)\n"
+    "  --D2-max-H R            largest outer diameter in free lengths, D2/H, up to 1000\n"
+    "                          (default 10)\n"
+    "  --G-max G               stiffest wire, shear modulus in MPa, up to 1e6 (default 80000,\n"
+    "                          steel)\n"
+    "  --relative              residuals relative to |stress| instead of absolute\n"
+    "  --optimizer NAME        slsqp (default) | cobyla | mma: the constrained local optimiser\n"
+    "  --seed S                seed of the global search (default 1); same seed, same result\n"
+    "  --starts N              local starts of the global search (default 8)\n"
+    "  --validate [SCENE.json] run each fitted spring in the lattice (the scene's, or 3x3x3 cells\n"
+    "                          calibrated isotropic) at the table's strains in the table's mode\n"
+    "                          and report the fit's RMSE, the lattice's RMSE and the lattice\n"
+    "                          against the law, in the table's stress unit (stress-strain tables)\n"
+    "  --target lattice|spring fit the lattice's curve in the table's mode (implies --validate)\n"
+    "                          or the spring's (default for uniaxial tables)\n"
+    "  --through-msm [SCENE.json]  --target lattice [--validate SCENE.json]\n"
+    "  --max-memory SIZE, --max-steps N, --max-work N  the validation's budget, as for\n"
+    "                          simulate (defaults 2G, 1e7 static solves and 1e10 spring-steps\n"
+    "                          of work): a larger lattice or table is refused\n"
+    "  --joint                 one lattice for every table, each in its own mode\n"
+    "  --calibration C         isotropic (default), axial, or fitted (with --joint)\n"
+    "  --mode M                the table's test mode: uniaxial, shear, planar, equibiaxial or\n"
+    "                          confined (wins over a '# mode:' comment; default uniaxial)\n"
+    "  --plot FILE.png|.svg|.pdf  draw data, fits, baselines and residuals with gnuplot\n"
+    "                          (with several tables: a folder DIR/, one NAME.png per table)\n"
+    "  --title TEXT            title of the plot (default: the table's file name without\n"
+    "                          folder and extension)\n"
+    "  --x-col NAME, --y-col NAME   columns to use in wider tables\n"
+    "  --stress-unit U         unit of a stress column without one (Pa, kPa, MPa, ...)\n"
+    "  --force-unit U          unit of a force column without one (N, mN, ...)\n"
+    "  --length-unit U         unit of a displacement column without one (mm, m, ...)\n"
+    "  --stretch               the x column is stretch (strain = stretch - 1)\n"
+    "  --stress-measure M      nominal | cauchy: what the stress column holds (default: the\n"
+    "                          table's '# stress:' comment or column name, else nominal);\n"
+    "                          Cauchy stress is converted to nominal under incompressibility\n"
+    "  --strain-measure M      engineering | log | stretch (default: '# strain:' or the name)\n"
+    "  -j, --jobs N            fit N tables at a time (default 1)\n";
+
+/* The help's second part (C17 guarantees string literals of 4095 characters only). */
+static const char fit_help_series[] =
+    "Time series (a table with a time column such as time_s) are fitted with the time-dependent\n"
+    "model: the conical law plus a Prony series on every spring, in the lattice's homogenised\n"
+    "cell, driven by the measured strain history:\n"
+    "  --branches N            Prony terms, 1..8 (default: 1..4 chosen by AIC)\n"
+    "  --dashpot               fit a dashpot beside every spring as well\n"
+    "  --relaxation R          qlv: relative moduli g_i constant (quasi-linear);\n"
+    "                          strain: g_i + g_per_strain_i |strain| at a spring's strain;\n"
+    "                          auto (default): both; kept is the lowest AIC among the\n"
+    "                          candidates whose terms the series determines\n"
+    "  --elastic FIT.json[:TYPE]  hold rho, s/H and F_C/H^2 at those of a fit file's spring\n"
+    "  --calibration C         the lattice's weights: axial (default for a series) or isotropic\n"
+    "The fitted spring stays within the design limits (--rho-min, --index-max, ...) and its\n"
+    "lattice stable up to the series' largest strain (a held --elastic spring whose lattice\n"
+    "would buckle within the series is refused).\n\n"
+    "Tables: a header row naming the columns, units in the names (stress_kPa, stress [kPa]),\n"
+    "'#' comments, ',' ';' TAB or blank-separated columns, an optional weight column. Tension\n"
+    "positive. A spreadsheet (.xlsx, .ods) must be saved as CSV first.\n";
+
+static int ends_with_json(const char *s)
+{
+    size_t n = strlen(s);
+    return n > 5 && strcmp(s + n - 5, ".json") == 0;
+}
+
+enum {
+    OPT_PLOT = CF_CLI_OPT_OWN,
+    OPT_TYPE,
+    OPT_FIX,
+    OPT_INDEX_MAX,
+    OPT_RELATIVE,
+    OPT_OPTIMIZER,
+    OPT_SEED,
+    OPT_STARTS,
+    OPT_VALIDATE,
+    OPT_THROUGH,
+    OPT_TARGET,
+    OPT_MODE,
+    OPT_JOINT,
+    OPT_CALIBRATION,
+    OPT_X_COL,
+    OPT_Y_COL,
+    OPT_STRESS_UNIT,
+    OPT_FORCE_UNIT,
+    OPT_LENGTH_UNIT,
+    OPT_STRETCH,
+    OPT_RHO_MIN,
+    OPT_N_MAX,
+    OPT_D2_MAX_H,
+    OPT_G_MAX,
+    OPT_BRANCHES,
+    OPT_DASHPOT,
+    OPT_RELAXATION,
+    OPT_ELASTIC,
+    OPT_TITLE,
+    OPT_STRESS_MEASURE,
+    OPT_STRAIN_MEASURE,
+    OPT_MAX_MEMORY,
+    OPT_MAX_STEPS,
+    OPT_MAX_WORK
+};
+
+static const struct option fit_options[] = {
+    {"plot", required_argument, NULL, OPT_PLOT},
+    {"max-memory", required_argument, NULL, OPT_MAX_MEMORY},
+    {"max-steps", required_argument, NULL, OPT_MAX_STEPS},
+    {"max-work", required_argument, NULL, OPT_MAX_WORK},
+    {"type", required_argument, NULL, OPT_TYPE},
+    {"fix", required_argument, NULL, OPT_FIX},
+    {"index-max", required_argument, NULL, OPT_INDEX_MAX},
+    {"relative", no_argument, NULL, OPT_RELATIVE},
+    {"optimizer", required_argument, NULL, OPT_OPTIMIZER},
+    {"seed", required_argument, NULL, OPT_SEED},
+    {"starts", required_argument, NULL, OPT_STARTS},
+    {"validate", optional_argument, NULL, OPT_VALIDATE},
+    {"through-msm", optional_argument, NULL, OPT_THROUGH},
+    {"target", required_argument, NULL, OPT_TARGET},
+    {"mode", required_argument, NULL, OPT_MODE},
+    {"joint", no_argument, NULL, OPT_JOINT},
+    {"calibration", required_argument, NULL, OPT_CALIBRATION},
+    {"x-col", required_argument, NULL, OPT_X_COL},
+    {"y-col", required_argument, NULL, OPT_Y_COL},
+    {"stress-unit", required_argument, NULL, OPT_STRESS_UNIT},
+    {"force-unit", required_argument, NULL, OPT_FORCE_UNIT},
+    {"length-unit", required_argument, NULL, OPT_LENGTH_UNIT},
+    {"stretch", no_argument, NULL, OPT_STRETCH},
+    {"rho-min", required_argument, NULL, OPT_RHO_MIN},
+    {"n-max", required_argument, NULL, OPT_N_MAX},
+    {"D2-max-H", required_argument, NULL, OPT_D2_MAX_H},
+    {"G-max", required_argument, NULL, OPT_G_MAX},
+    {"branches", required_argument, NULL, OPT_BRANCHES},
+    {"dashpot", no_argument, NULL, OPT_DASHPOT},
+    {"relaxation", required_argument, NULL, OPT_RELAXATION},
+    {"elastic", required_argument, NULL, OPT_ELASTIC},
+    {"title", required_argument, NULL, OPT_TITLE},
+    {"stress-measure", required_argument, NULL, OPT_STRESS_MEASURE},
+    {"strain-measure", required_argument, NULL, OPT_STRAIN_MEASURE},
+    {"jobs", required_argument, NULL, 'j'},
+    {NULL, 0, NULL, 0}};
+
+/* --fix NAME=VALUE: 0, or the exit status of a usage error. */
+static int fix_option(const char *v, fit_args *a)
+{
+    cf_error err = {0};
+    char name[32];
+    const char *eq = strchr(v, '=');
+    double val;
+    if (!eq || (size_t)(eq - v) >= sizeof name)
+        return cf_cli_usage_error("fit", "--fix '%s': expected NAME=VALUE", v);
+    snprintf(name, sizeof name, "%.*s", (int)(eq - v), v);
+    int k = cf_spring_param_find(name);
+    if (k < 0)
+        return cf_cli_usage_error("fit", "--fix %s: unknown parameter '%s' (expected D1, D2, n, "
+                                         "d, G or H)", v, name);
+    if (cf_cli_parse_double("--fix", eq + 1, &val, &err) != CF_OK)
+        return cf_cli_usage_error("fit", "%s", err.msg);
+    if (!(val > 0))
+        return cf_cli_usage_error("fit", "--fix %s=%g: the value must be positive", name, val);
+    a->popt.fit.fixed[k] = 1;
+    a->popt.fit.fixed_value[k] = val;
+    return 0;
+}
+
+/* --validate[=SCENE.json] and --through-msm[=SCENE.json]; `--validate SCENE.json` takes the next
+** argument too when it ends in .json (a table never does), as earlier versions did. */
+static void validate_option(int c, const char *value, fit_args *a)
+{
+    a->popt.validate = 1;
+    if (c == OPT_THROUGH)
+        a->popt.target = CF_TARGET_LATTICE;
+    if (value)
+        a->scene = value;
+    else if (optind < a->argc && a->argv[optind][0] != '-' && ends_with_json(a->argv[optind]))
+        a->scene = a->argv[optind++];
+}
+
+/* --stress-measure, --strain-measure: a word the table reader knows (measure.h). */
+static int measure_option(int c, const char *optval, cf_measure_options *mo)
+{
+    int bad;
+    if (c == OPT_STRESS_MEASURE) {
+        cf_stress_measure v = CF_STRESS_NOMINAL;
+        bad = cf_stress_measure_parse(optval, &v) != 0;
+        mo->stress_measure = (int)v;
+    } else {
+        cf_strain_measure v = CF_STRAIN_ENGINEERING;
+        bad = cf_strain_measure_parse(optval, &v) != 0;
+        mo->strain_measure = (int)v;
+    }
+    if (!bad)
+        return 0;
+    return cf_cli_usage_error("fit", "%s '%s': expected %s",
+                              c == OPT_STRESS_MEASURE ? "--stress-measure" : "--strain-measure",
+                              optval,
+                              c == OPT_STRESS_MEASURE ? "nominal or cauchy"
+                                                      : "engineering, log or stretch");
+}
+
+/* One option of fit: 0 to go on, else an exit status. Long only because fit has many options:
+** one case per option, each a few lines of checking. */
+static int fit_option(void *ctx, int c, const char *optval)
+{
+    fit_args *a = ctx;
+    cf_error err = {0};
+    cf_fit_options *fo = &a->popt.fit;
+    long n;
+    switch (c) {
+    case OPT_PLOT: a->plot = optval; return 0;
+    case OPT_TITLE: a->popt.title = optval; return 0;
+    case OPT_TYPE:
+        if (strcmp(optval, "both") == 0)
+            a->popt.types = CF_PIPELINE_BOTH;
+        else if (strcmp(optval, "telescoping") == 0)
+            a->popt.types = CF_PIPELINE_TELESCOPING;
+        else if (strcmp(optval, "non-telescoping") == 0)
+            a->popt.types = CF_PIPELINE_NON_TELESCOPING;
+        else
+            return cf_cli_usage_error("fit", "--type '%s': expected telescoping, "
+                                             "non-telescoping or both", optval);
+        return 0;
+    case OPT_FIX: return fix_option(optval, a);
+    case OPT_INDEX_MAX:
+        if (cf_cli_parse_double("--index-max", optval, &fo->index_max, &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        if (!(fo->index_max >= 3 && fo->index_max <= CF_FIT_INDEX_MAX_LIMIT))
+            return cf_cli_usage_error("fit", "--index-max %g: a spring index D1/d lies in [3, %g]",
+                                      fo->index_max, CF_FIT_INDEX_MAX_LIMIT);
+        return 0;
+    case OPT_RHO_MIN:
+        if (cf_cli_parse_double("--rho-min", optval, &fo->rho_min, &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        if (!(fo->rho_min >= CF_FIT_RHO_MIN_LIMIT && fo->rho_min < 1))
+            return cf_cli_usage_error("fit", "--rho-min %g: a diameter ratio D1/D2 the fit "
+                                             "searches lies in [%g, 1)",
+                                      fo->rho_min, CF_FIT_RHO_MIN_LIMIT);
+        return 0;
+    case OPT_N_MAX:
+        if (cf_cli_parse_double("--n-max", optval, &fo->upper[CF_P_N], &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        if (!(fo->upper[CF_P_N] >= 2 && fo->upper[CF_P_N] <= CF_FIT_COILS_MAX_LIMIT))
+            return cf_cli_usage_error("fit", "--n-max %g: a conical spring has 2 to %g coils",
+                                      fo->upper[CF_P_N], CF_FIT_COILS_MAX_LIMIT);
+        return 0;
+    case OPT_D2_MAX_H:
+        if (cf_cli_parse_double("--D2-max-H", optval, &fo->D2_over_H_max, &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        if (!(fo->D2_over_H_max > 0 && fo->D2_over_H_max <= CF_FIT_D2_OVER_H_MAX_LIMIT))
+            return cf_cli_usage_error("fit", "--D2-max-H %g: must lie in (0, %g]",
+                                      fo->D2_over_H_max, CF_FIT_D2_OVER_H_MAX_LIMIT);
+        return 0;
+    case OPT_G_MAX:
+        if (cf_cli_parse_double("--G-max", optval, &fo->upper[CF_P_G], &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        if (!(fo->upper[CF_P_G] > fo->lower[CF_P_G] && fo->upper[CF_P_G] <= CF_FIT_G_MAX_LIMIT))
+            return cf_cli_usage_error("fit", "--G-max %g MPa: must lie in (0, %g] MPa (no wire "
+                                             "is stiffer in shear)",
+                                      fo->upper[CF_P_G], CF_FIT_G_MAX_LIMIT);
+        return 0;
+    case OPT_RELATIVE: fo->relative = 1; return 0;
+    case OPT_MAX_MEMORY:
+        return cf_cli_budget_option("fit", "--max-memory", optval, &a->popt.budget);
+    case OPT_MAX_STEPS:
+        return cf_cli_budget_option("fit", "--max-steps", optval, &a->popt.budget);
+    case OPT_MAX_WORK:
+        return cf_cli_budget_option("fit", "--max-work", optval, &a->popt.budget);
+    case OPT_OPTIMIZER:
+        if (cf_fit_optimizer_parse(optval, &fo->optimizer, &err) != CF_OK)
+            return cf_cli_usage_error("fit", "option --optimizer: %s", err.msg);
+        return 0;
+    case OPT_SEED:
+        if (cf_cli_parse_long("--seed", optval, 0, 2147483647L, &n, &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        fo->seed = (unsigned long)n;
+        return 0;
+    case OPT_STARTS:
+        if (cf_cli_parse_long("--starts", optval, 1, 10000, &n, &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        fo->multistart = (int)n;
+        return 0;
+    case OPT_VALIDATE:
+    case OPT_THROUGH: validate_option(c, optval, a); return 0;
+    case OPT_TARGET:
+        if (strcmp(optval, "lattice") == 0)
+            a->popt.target = CF_TARGET_LATTICE, a->popt.validate = 1;
+        else if (strcmp(optval, "spring") == 0)
+            a->popt.target = CF_TARGET_SPRING;
+        else
+            return cf_cli_usage_error("fit", "--target '%s': expected lattice or spring", optval);
+        return 0;
+    case OPT_JOINT: a->joint = 1; return 0;
+    case OPT_CALIBRATION: {
+        cf_lattice_config *lc = &a->popt.lattice.cfg.lattice;
+        if (cf_calibration_parse(optval, &lc->calibration, &err) != CF_OK)
+            return cf_cli_usage_error("fit", "--%s", err.msg);
+        if (lc->calibration != CF_CAL_FITTED)
+            cf_calibration_weights(lc->calibration, lc->weight, NULL);
+        a->calibration_given = 1;
+        return 0;
+    }
+    case OPT_MODE: {
+        cf_mode md;
+        if (cf_mode_parse(optval, &md, &err) != CF_OK)
+            return cf_cli_usage_error("fit", "--%s", err.msg);
+        a->mopt.mode = optval;
+        return 0;
+    }
+    case OPT_X_COL: a->mopt.x_col = optval; return 0;
+    case OPT_Y_COL: a->mopt.y_col = optval; return 0;
+    case OPT_STRESS_UNIT: a->mopt.stress_unit = optval; return 0;
+    case OPT_FORCE_UNIT: a->mopt.force_unit = optval; return 0;
+    case OPT_LENGTH_UNIT: a->mopt.length_unit = optval; return 0;
+    case OPT_STRETCH: a->mopt.x_is_stretch = 1; return 0;
+    case OPT_BRANCHES:
+        if (cf_cli_parse_long("--branches", optval, 1, CF_PRONY_MAX, &n, &err) != CF_OK) {
+            /* a branch count outside 1..8 is refused as bad data (65), as a bad table is */
+            fprintf(stderr, "conifit fit: %s\n", err.msg);
+            return CF_EXIT_DATAERR;
+        }
+        a->vopt.nbranch = (int)n;
+        a->series_only = 1;
+        return 0;
+    case OPT_DASHPOT:
+        a->vopt.dashpot = 1;
+        a->series_only = 1;
+        return 0;
+    case OPT_RELAXATION:
+        if (strcmp(optval, "auto") == 0)
+            a->vopt.relaxation = CF_RELAX_AUTO;
+        else if (strcmp(optval, "qlv") == 0)
+            a->vopt.relaxation = CF_RELAX_QLV;
+        else if (strcmp(optval, "strain") == 0)
+            a->vopt.relaxation = CF_RELAX_STRAIN;
+        else
+            return cf_cli_usage_error("fit", "--relaxation '%s': expected auto, qlv or strain",
+                                      optval);
+        a->series_only = 1;
+        return 0;
+    case OPT_ELASTIC:
+        a->elastic = optval;
+        a->series_only = 1;
+        return 0;
+    case OPT_STRESS_MEASURE:
+    case OPT_STRAIN_MEASURE: return measure_option(c, optval, &a->mopt);
+    case 'j':
+        if (cf_cli_parse_long("-j", optval, 1, 256, &a->jobs, &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        return 0;
+    default: return cf_cli_usage_error("fit", "unexpected option");
+    }
+}
+
+/* The operands and the checks across options. -1 to go on, else an exit status. */
+int cf_cli_fit_parse(int argc, char **argv, fit_args *a)
+{
+    static const char *cmd = "fit";
+    cf_error err = {0};
+    memset(a, 0, sizeof *a);
+    a->popt = cf_pipeline_default_options();
+    a->mopt = cf_measure_default_options();
+    a->vopt = cf_visco_fit_default_options();
+    a->vopt.relaxation = CF_RELAX_AUTO;
+    a->jobs = 1;
+    cf_cli_parser p;
+    a->argc = argc;
+    a->argv = argv;
+    int rc = cf_cli_parser_init(&p, cmd, fit_help, 0, argc, argv, "j:", fit_options);
+    p.help_more = fit_help_series;
+    if (rc || (rc = cf_cli_parse(&p, fit_option, a)) >= 0)
+        return rc;
+    if (a->calibration_given && a->popt.lattice.cfg.lattice.calibration != CF_CAL_FITTED) {
+        /* a time series is fitted in the lattice of the calibration asked for */
+        a->vopt.setup.cfg.lattice.calibration = a->popt.lattice.cfg.lattice.calibration;
+        memcpy(a->vopt.setup.cfg.lattice.weight, a->popt.lattice.cfg.lattice.weight,
+               sizeof a->vopt.setup.cfg.lattice.weight);
+    }
+    a->out = p.output;
+    a->quiet = p.quiet;
+    a->progress = cf_cli_progress(&p);
+    a->files = (const char **)argv + optind;
+    a->nfiles = argc - optind;
+    if (a->nfiles == 0)
+        return cf_cli_usage_error(cmd, "no table given");
+    for (int i = 0; i < a->nfiles; i++)
+        if (cf_cli_is_stdio(a->files[i]) && a->nfiles > 1)
+            return cf_cli_usage_error(cmd, "'-' (a table on standard input) must be the only "
+                                           "table");
+    if (cf_cli_is_stdio(a->out)) {
+        if (a->nfiles > 1)
+            return cf_cli_usage_error(cmd, "-o -: with %d tables, -o must name a folder (DIR/)",
+                                      a->nfiles);
+        a->quiet = 1; /* standard output holds the fit file */
+    }
+    if (a->joint && a->nfiles < 2)
+        return cf_cli_usage_error(cmd, "--joint fits several tables at once; give at least two");
+    if (a->calibration_given && a->popt.lattice.cfg.lattice.calibration == CF_CAL_FITTED &&
+        !a->joint)
+        return cf_cli_usage_error(cmd, "--calibration fitted: the family weights are fitted in a "
+                                       "joint fit of several modes (--joint)");
+    if (a->joint && a->out && (cf_cli_is_stdio(a->out) || cf_cli_is_dir_target(a->out)))
+        return cf_cli_usage_error(cmd, "--joint -o %s: a joint fit writes one fit file "
+                                       "(-o FILE.json)", a->out);
+    if (a->joint && a->plot && cf_cli_is_dir_target(a->plot))
+        return cf_cli_usage_error(cmd, "--joint --plot %s: a joint fit draws one figure "
+                                       "(--plot FILE.png)", a->plot);
+    if (a->joint) {
+        if (a->plot && cf_plot_check_name(a->plot, &err) != CF_OK)
+            return cf_cli_usage_error(cmd, "--plot %s: the file must end in .png or .svg",
+                                      a->plot);
+        return -1;
+    }
+    if (a->nfiles > 1 && a->out && !cf_cli_is_dir_target(a->out))
+        return cf_cli_usage_error(cmd, "-o %s: with %d tables, -o must name a folder (DIR/)",
+                                  a->out, a->nfiles);
+    if (a->nfiles > 1 && a->plot && !cf_cli_is_dir_target(a->plot))
+        return cf_cli_usage_error(cmd, "--plot %s: with %d tables, --plot must name a folder",
+                                  a->plot, a->nfiles);
+    if (a->plot && !cf_cli_is_dir_target(a->plot) && cf_plot_check_name(a->plot, &err) != CF_OK)
+        return cf_cli_usage_error(cmd, "--plot %s: the file must end in .png, .svg or .pdf", a->plot);
+    return -1;
+}
+

@@ -1,0 +1,147 @@
+/*
+** The sentences a fit report states both in its text and in its JSON fit file (private to
+** src/report/): why an interval was computed, the verdict on the spring type, where a table's
+** measures came from and how its columns were converted.
+*/
+#include "report/report_words.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+/* Appends to buf (capacity cap, *n used), never past its end. */
+void cf_report_append(char *buf, size_t cap, size_t *n, const char *fmt, ...)
+{
+    if (*n + 1 >= cap)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    int k = vsnprintf(buf + *n, cap - *n, fmt, ap);
+    va_end(ap);
+    if (k > 0)
+        *n = fmin(*n + (size_t)k, cap - 1);
+}
+
+/* Why a profile interval was computed and where its ends come from, in words. */
+void cf_report_interval_reason(const cf_fit_result *f, int k, char *buf, size_t cap)
+{
+    size_t n = 0;
+    buf[0] = '\0';
+    unsigned why = f->interval_why[k], lim = why & ~CF_FIT_RANK_DEFICIENT;
+    cf_report_append(buf, cap, &n, "profile likelihood, 95 %% (F-test), because ");
+    if (why & CF_FIT_RANK_DEFICIENT)
+        cf_report_append(buf, cap, &n, "the Jacobian is rank-deficient%s", lim ? " and " : "");
+    if (lim) {
+        cf_report_append(buf, cap, &n, "the fit sits on");
+        for (int b = 0; b < CF_C_COUNT; b++)
+            if (lim & (1u << b))
+                cf_report_append(buf, cap, &n, " %s", cf_fit_constraint_name(1u << b));
+    }
+    if (!why)
+        cf_report_append(buf, cap, &n, "the standard error reaches past the quantity's range");
+    for (int e = 0; e < 2; e++) {
+        unsigned b = f->interval_end[k][e];
+        if (b)
+            cf_report_append(buf, cap, &n,
+                             "; the %s end is the limit %s: the data do not bound it",
+                             e ? "upper" : "lower", cf_fit_constraint_name(b & (0u - b)));
+    }
+}
+
+/* The one sentence that compares the two types (both fitted, at least one feasible). */
+void cf_report_verdict(const cf_fit_report *r, char *buf, size_t cap)
+{
+    size_t n = 0;
+    buf[0] = '\0';
+    cf_fit_verdict v = cf_fit_compare(&r->fits[0], &r->fits[1], r->table->count);
+    if (v.better < 0) {
+        cf_report_append(buf, cap, &n, "no verdict: neither type has a spring inside its limits");
+        return;
+    }
+    const cf_fit_result *g = &r->fits[v.better], *w = &r->fits[1 - v.better];
+    double u = r->table->y_to_file;
+    if (!w->feasible) {
+        cf_report_append(buf, cap, &n,
+                         "%s: the %s type has no spring inside its limits (violated:",
+                         cf_spring_type_name(g->type), cf_spring_type_name(w->type));
+        for (int b = 0; b < CF_C_COUNT; b++)
+            if (w->violated & (1u << b))
+                cf_report_append(buf, cap, &n, " %s", cf_fit_constraint_name(1u << b));
+        cf_report_append(buf, cap, &n, ")");
+        return;
+    }
+    double base = g->objective > 0 ? g->objective : 1.0;
+    if (v.tie) {
+        cf_report_append(buf, cap, &n,
+            "tie: the data do not tell the types apart (RMSE %.4g against %.4g %s; the residual "
+            "sum of squares differs by %.3g of the better one's, below the F-test threshold "
+            "%.3g at 95 %%)",
+            r->fits[0].rmse * u, r->fits[1].rmse * u, r->table->y_unit, v.delta_rss / base,
+            v.threshold / base);
+        return;
+    }
+    cf_report_append(buf, cap, &n,
+        "%s (RMSE %.4g against %.4g %s; the residual sum of squares of %s is higher by %.3g of "
+        "the better one's, above the F-test threshold %.3g at 95 %%); ",
+        cf_spring_type_name(g->type), g->rmse * u, w->rmse * u, r->table->y_unit,
+        cf_spring_type_name(w->type), v.delta_rss / base, v.threshold / base);
+    if (v.held) {
+        cf_report_append(buf, cap, &n, "%s is held back by", cf_spring_type_name(w->type));
+        for (int b = 0; b < CF_C_COUNT; b++)
+            if (v.held & (1u << b))
+                cf_report_append(buf, cap, &n, " %s", cf_fit_constraint_name(1u << b));
+    } else {
+        cf_report_append(buf, cap, &n,
+                         "no limit of %s is active: its optimiser stopped at a worse point",
+                         cf_spring_type_name(w->type));
+    }
+}
+
+/* Where one measure came from, in words: "comment, line 12", "column name", "assumed", ... */
+static void source_text(char *buf, size_t cap, cf_decl_source from, size_t line, int overridden,
+                        const char *file_value)
+{
+    size_t n = 0;
+    buf[0] = '\0';
+    cf_report_append(buf, cap, &n, "%s", cf_decl_source_name(from));
+    if (overridden)
+        cf_report_append(buf, cap, &n, ", which wins over the table's '%s'", file_value);
+    if (line)
+        cf_report_append(buf, cap, &n, "%sline %zu", overridden ? " on " : ", ", line);
+}
+
+/* The sources of a table's measures (stress, strain) and its mode. */
+void cf_report_sources(const cf_table *t, char src[3][128])
+{
+    const cf_table_measures *m = &t->measures;
+    source_text(src[0], sizeof src[0], m->stress_from, m->stress_line, m->stress_overridden,
+                cf_stress_measure_name((cf_stress_measure)m->stress_file));
+    source_text(src[1], sizeof src[1], m->strain_from, m->strain_line, m->strain_overridden,
+                cf_strain_measure_name((cf_strain_measure)m->strain_file));
+    snprintf(src[2], sizeof src[2], "%s", t->mode_stated ? "stated" : "assumed");
+}
+
+/* What was done to the stress and strain columns, in one sentence ("" when nothing). */
+void cf_report_conversion(const cf_table *t, char *buf, size_t cap)
+{
+    const cf_table_measures *m = &t->measures;
+    size_t n = 0;
+    buf[0] = '\0';
+    if (m->strain_converted)
+        cf_report_append(buf, cap, &n, "%s",
+                         m->strain == CF_STRAIN_LOG
+                             ? "log strain e converted to engineering strain exp(e) - 1"
+                             : "stretch l converted to engineering strain l - 1");
+    if (m->stress_converted) {
+        cf_report_append(buf, cap, &n, "%sCauchy stress converted to nominal ", n ? "; " : "");
+        if (t->mode == CF_MODE_SHEAR)
+            cf_report_append(buf, cap, &n,
+                             "(simple shear: P12 = sigma12, the sheared face keeps its area)");
+        else if (t->mode == CF_MODE_CONFINED)
+            cf_report_append(buf, cap, &n, "(confined: P = sigma, the lateral stretches are 1)");
+        else
+            cf_report_append(buf, cap, &n, "P = sigma / (1 + strain), incompressible %s",
+                             cf_mode_name(t->mode));
+    }
+}

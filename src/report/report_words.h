@@ -1,0 +1,31 @@
+/*
+** The sentences a fit report states both in its text (report_text.c) and in its JSON fit file
+** (report.c). Private to src/report/.
+*/
+#ifndef CF_REPORT_WORDS_H
+#define CF_REPORT_WORDS_H
+
+#include <stddef.h>
+
+#include "conifit/report.h"
+
+/* Appends printf-formatted text to buf (capacity cap, *n bytes used), never past its end. */
+void cf_report_append(char *buf, size_t cap, size_t *n, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
+/* Why fit f's profile interval of quantity k was computed and where its ends come from. */
+void cf_report_interval_reason(const cf_fit_result *f, int k, char *buf, size_t cap);
+
+/* The one sentence that compares the two types (both fitted, at least one feasible). */
+void cf_report_verdict(const cf_fit_report *r, char *buf, size_t cap);
+
+/* Where table t's stress and strain measures and its mode came from, one phrase each. */
+void cf_report_sources(const cf_table *t, char src[3][128]);
+
+/* What was done to the stress and strain columns, in one sentence ("" when nothing). */
+void cf_report_conversion(const cf_table *t, char *buf, size_t cap);
+
+#endif
