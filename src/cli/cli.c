@@ -3,6 +3,8 @@
 */
 #include "cli/cli.h"
 
+#include "conifit/scene.h"
+
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -343,4 +345,14 @@ void cf_cli_spring_help(FILE *out)
         fprintf(out, "  %-12s %s%s%s\n", flag, sp->meaning, strcmp(sp->unit, "-") ? ", " : "",
                 strcmp(sp->unit, "-") ? sp->unit : "");
     }
+}
+
+void cf_cli_scene_fit(const char *scene_path, char *out, size_t cap)
+{
+    cf_scene sc;
+    out[0] = '\0';
+    if (cf_scene_load(scene_path, &sc, NULL) != CF_OK)
+        return; /* the run's own reading of the scene reports why */
+    snprintf(out, cap, "%s", sc.fit_path);
+    cf_scene_free(&sc);
 }

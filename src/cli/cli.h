@@ -147,4 +147,9 @@ void cf_cli_spring_help(FILE *out);
 /* Prints the help of -q, --progress and -h (each command's help states its own -o). */
 void cf_cli_common_help(FILE *out);
 
+/* The fit file the scene at scene_path names ('spring.fit'), into out (cap bytes): an input of a
+** run that reads the scene, never to be one of its outputs. "" when it names none or cannot be
+** read (the run's own reading of the scene then says why). */
+void cf_cli_scene_fit(const char *scene_path, char *out, size_t cap);
+
 #endif

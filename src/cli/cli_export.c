@@ -131,6 +131,7 @@ static int export_option(void *ctx, int c, const char *value)
 typedef struct export_request {
     export_args ea;
     const char *out_path, *fit_path, *scene_path;
+    char scene_fit[4096]; /* the fit file the scene names, "" when none */
     int quiet;
 } export_request;
 
@@ -181,15 +182,18 @@ static int parse_request(int argc, char **argv, export_request *q)
     return -1;
 }
 
-/* The lattice to export: the scene's, or the validation's default for the spring. */
-static cf_status lattice_of(const char *scene_path, const cf_fitted_spring *fs,
+/* The lattice to export: the scene's (the fit file it names into q->scene_fit), or the
+** validation's default for the spring. */
+static cf_status lattice_of(export_request *q, const cf_fitted_spring *fs,
                             cf_export_lattice *lx, cf_error *err)
 {
     cf_status st;
+    const char *scene_path = q->scene_path;
     if (scene_path) {
         cf_scene sc;
         if ((st = cf_scene_load(scene_path, &sc, err)) != CF_OK)
             return st;
+        snprintf(q->scene_fit, sizeof q->scene_fit, "%s", sc.fit_path);
         st = cf_export_lattice_from_scene(&sc, scene_path, lx, err);
         cf_scene_free(&sc);
         return st;
@@ -225,7 +229,10 @@ static cf_status emit(const export_request *q, const char *buf, size_t len, cf_e
 {
     if (q->out_path && strcmp(q->out_path, "-") != 0) {
         cf_atomic a;
-        const char *inputs[3] = {q->fit_path, q->scene_path, NULL};
+        /* every input: the fit file, the scene and the fit file the scene names (none without
+        ** a scene) */
+        const char *inputs[4] = {q->fit_path, q->scene_path, q->scene_fit[0] ? q->scene_fit : NULL,
+                                 NULL};
         cf_status st = cf_atomic_open(&a, q->out_path, inputs, err);
         if (st != CF_OK)
             return st;
@@ -271,7 +278,8 @@ int cf_cli_export(int argc, char **argv)
     opt.source = cf_cli_is_stdio(q.fit_path) ? "(standard input)" : q.fit_path;
     opt.auto_tol = !q.ea.tol_given;
     cf_export_lattice lx;
-    if (q.ea.lattice && lattice_of(q.scene_path, &fs, &lx, &err) != CF_OK)
+    q.scene_fit[0] = '\0';
+    if (q.ea.lattice && lattice_of(&q, &fs, &lx, &err) != CF_OK)
         return cf_cli_fail(&err);
     char *buf;
     size_t len;

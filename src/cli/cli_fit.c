@@ -407,7 +407,7 @@ int cf_cli_fit(int argc, char **argv)
         return rc;
     fit_job *jobs = calloc((size_t)a.nfiles, sizeof *jobs);
     /* every input of the run, never to be an output */
-    const char **inputs = calloc((size_t)a.nfiles + 3, sizeof *inputs);
+    const char **inputs = calloc((size_t)a.nfiles + 4, sizeof *inputs);
     if (!jobs || !inputs) {
         free(jobs);
         free(inputs);
@@ -416,8 +416,16 @@ int cf_cli_fit(int argc, char **argv)
     }
     for (int i = 0; i < a.nfiles; i++)
         inputs[i] = a.files[i];
-    inputs[a.nfiles] = a.scene;
-    inputs[a.nfiles + (a.scene != NULL)] = a.elastic;
+    /* the scene, the fit file it names, the elastic fit (the list ends at the first absent) */
+    char scene_fit[4096];
+    size_t n = (size_t)a.nfiles;
+    if (a.scene) {
+        inputs[n++] = a.scene;
+        cf_cli_scene_fit(a.scene, scene_fit, sizeof scene_fit);
+        if (scene_fit[0])
+            inputs[n++] = scene_fit;
+    }
+    inputs[n] = a.elastic;
     if (!a.joint)
         rc = plan_outputs(&a, jobs, inputs);
     int nseries = 0;

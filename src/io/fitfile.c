@@ -8,11 +8,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include <jansson.h>
 
 #include "base/atomic.h"
+#include "base/input.h"
 #include "io/fitfile_json.h"
 
 static void copy_string(json_t *obj, const char *key, char *dst, size_t cap)
@@ -84,15 +84,9 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
     memset(out, 0, sizeof *out);
     out->rmse = NAN;
     const int from_stdin = strcmp(path, "-") == 0; /* "-": standard input */
-    FILE *f = from_stdin ? stdin : fopen(path, "rb");
+    FILE *f = from_stdin ? stdin : cf_input_open(path, "fit file", err);
     if (!f)
-        return cf_error_set(err, CF_E_NOINPUT, "%s: cannot open fit file: %s", path,
-                            strerror(errno));
-    struct stat fs;
-    if (!from_stdin && fstat(fileno(f), &fs) == 0 && S_ISDIR(fs.st_mode)) {
-        fclose(f);
-        return cf_error_set(err, CF_E_NOINPUT, "%s: cannot read fit file: it is a folder", path);
-    }
+        return CF_E_NOINPUT;
     json_error_t jerr;
     errno = 0;
     json_t *root = json_loadf(f, JSON_REJECT_DUPLICATES, &jerr);

@@ -134,6 +134,7 @@ static cf_status spring_section(ctx *c, json_t *sp, cf_scene *sc)
         c->from_fit = 1;
         snprintf(sc->spring_source, sizeof sc->spring_source, "%s:%s", json_string_value(fit),
                  cf_spring_type_name(fs.type));
+        snprintf(sc->fit_path, sizeof sc->fit_path, "%s", json_string_value(fit));
         return CF_OK;
     }
     if (type)

@@ -67,7 +67,7 @@ static int exists(const char *name)
     return lstat(p, &s) == 0;
 }
 
-/* Number of conifit temporaries (".NAME.conifit-PID-XXXXXX") in the folder. */
+/* Number of conifit temporaries (".NAME.conifit-TAG-PID-XXXXXX") in the folder. */
 static int temporaries(void)
 {
     DIR *d = opendir(dir);
@@ -308,6 +308,47 @@ static void signals_leave_nothing_visible(void **state)
     assert_int_equal(n, 0);
 }
 
+/* The fit file a scene names is an input of every run that reads the scene: `export --lattice
+** SCENE -o` and `fit --validate SCENE -o` naming it are refused with 73 and leave it as it was. */
+static void a_scenes_fit_file_is_never_an_output(void **state)
+{
+    (void)state;
+    char *fit = tu_slurp("fits/telescoping.json");
+    assert_non_null(fit);
+    write_text("own.json", fit);
+    free(fit);
+    char scene[600];
+    snprintf(scene, sizeof scene,
+             "{\"spring\": {\"fit\": \"%s/own.json\"},\n"
+             " \"lattice\": {\"nx\": 2, \"ny\": 2, \"nz\": 2, \"calibration\": \"isotropic\"},\n"
+             " \"protocol\": {\"kind\": \"ramp\", \"to_strain\": 0.2, \"duration_s\": 1},\n"
+             " \"samples_per_segment\": 4}\n",
+             dir);
+    write_text("scene.json", scene);
+    const char *before = read_text("own.json");
+    char keep[1 << 16];
+    snprintf(keep, sizeof keep, "%s", before);
+    /* the scene is good: the same runs with another output succeed */
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "export fits/telescoping.json --lattice %s/scene.json --format "
+                            "calculix -o %s/lat.inp --quiet",
+                            dir, dir),
+                     0);
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "export fits/telescoping.json --lattice %s/scene.json --format "
+                            "calculix -o %s/own.json --quiet",
+                            dir, dir),
+                     73);
+    assert_non_null(strstr(errb, "input"));
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "fit data/telescoping.csv --validate %s/scene.json -o %s/own.json "
+                            "--quiet",
+                            dir, dir),
+                     73);
+    assert_non_null(strstr(errb, "input"));
+    assert_string_equal(read_text("own.json"), keep);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -316,6 +357,7 @@ int main(void)
         cmocka_unit_test(failed_plot_replaces_nothing),
         cmocka_unit_test(batches_write_all_or_nothing),
         cmocka_unit_test(signals_leave_nothing_visible),
+        cmocka_unit_test(a_scenes_fit_file_is_never_an_output),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

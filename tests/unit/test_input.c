@@ -1,7 +1,7 @@
 /*
 ** Tests of input opening (src/base/input.c): regular files (and links to them) are read; a FIFO,
 ** a device and a folder are refused at once with the kind named, never waited on; through the
-** program, a table or a scene that is a FIFO is exit 66.
+** program, a table, a scene or a fit file that is a FIFO is exit 66.
 */
 #include "testutil.h"
 
@@ -60,7 +60,8 @@ static void only_regular_files_are_opened(void **state)
     rmdir(dir);
 }
 
-/* Through the program: a table or a scene that is a FIFO (no writer) is exit 66, at once. */
+/* Through the program: a table, a scene or a fit file that is a FIFO (no writer) is exit 66, at
+** once. */
 static void inputs_that_are_fifos_are_refused(void **state)
 {
     (void)state;
@@ -71,6 +72,8 @@ static void inputs_that_are_fifos_are_refused(void **state)
     assert_int_equal(tu_run(NULL, 0, se, sizeof se, "simulate %s -o %s/out.csv", fifo, dir), 66);
     assert_non_null(strstr(se, "a FIFO"));
     assert_int_equal(tu_run(NULL, 0, se, sizeof se, "fit %s --quiet", fifo), 66);
+    assert_non_null(strstr(se, "a FIFO"));
+    assert_int_equal(tu_run(NULL, 0, se, sizeof se, "export %s --format json", fifo), 66);
     assert_non_null(strstr(se, "a FIFO"));
     unlink(fifo);
     rmdir(dir);

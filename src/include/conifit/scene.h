@@ -24,6 +24,8 @@ typedef enum cf_protocol_kind {
 typedef struct cf_scene {
     cf_spring spring;           /* the spring of every lattice edge */
     char spring_source[600];    /* "params" or the fit file (and type) it came from */
+    char fit_path[4096];        /* the fit file 'spring.fit' names, "" with 'spring.params': an
+                                   input of the run like the scene itself */
     cf_law_method method;       /* law evaluator */
     size_t table_intervals;     /* for CF_LAW_TABLE */
     cf_msm_config cfg;          /* lattice and solver settings */
