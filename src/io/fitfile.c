@@ -98,9 +98,10 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
     if (!root && unreadable) /* a read error, not bad JSON */
         return cf_error_set(err, CF_E_NOINPUT, "%s: cannot read fit file: %s", path,
                             strerror(e ? e : EIO));
+    char why[JSON_ERROR_TEXT_LENGTH];
     if (!root)
         return cf_error_set(err, CF_E_DATA, "%s:%d:%d: not a valid fit file: %s", path, jerr.line,
-                            jerr.column, jerr.text);
+                            jerr.column, cf_json_reason(&jerr, why, sizeof why));
     cf_status st = CF_OK;
     json_t *fit = NULL;
     size_t i = 0;
@@ -222,6 +223,15 @@ cf_status cf_fitfile_load_spec(const char *spec, cf_fitted_spring *out, cf_error
 json_t *cf_json_number(double v)
 {
     return isfinite(v) ? json_real(v) : json_null();
+}
+
+const char *cf_json_reason(const json_error_t *e, char *out, size_t cap)
+{
+    snprintf(out, cap, "%s", e->text);
+    char *near = strstr(out, " near ");
+    if (near)
+        *near = '\0';
+    return out;
 }
 
 json_t *cf_fitfile_spring_json(const cf_law *law)

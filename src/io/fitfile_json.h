@@ -19,6 +19,11 @@
 ** a key without a value is left out, with a reason beside it. */
 json_t *cf_json_number(double v);
 
+/* jansson's reason for a document it could not parse, without the text it quotes from the file
+** ("... near 'TOKEN'"): a scene or fit path may name any readable file, and a message must not
+** show what that file holds; the line and column say where. Into out (cap bytes); returns out. */
+const char *cf_json_reason(const json_error_t *e, char *out, size_t cap);
+
 /* 1 when the document holds a null anywhere; path (capacity cap) then names its key
 ** ("fits[0].identifiable.rho.stderr"). */
 int cf_json_find_null(const json_t *root, char *path, size_t cap);

@@ -14,6 +14,7 @@
 
 #include "base/input.h"
 #include "conifit/fitfile.h"
+#include "io/fitfile_json.h"
 
 /* Most cycles and samples a scene may ask for (keeps memory and run time bounded). */
 #define MAX_CYCLES 1000
@@ -679,9 +680,10 @@ void cf_scene_free(cf_scene *sc)
 
 static cf_status finish(ctx *c, json_t *root, json_error_t *jerr, cf_scene *sc)
 {
+    char why[JSON_ERROR_TEXT_LENGTH];
     if (!root)
         return cf_error_set(c->err, CF_E_DATA, "%s:%d:%d: not valid JSON: %s", c->name,
-                            jerr->line, jerr->column, jerr->text);
+                            jerr->line, jerr->column, cf_json_reason(jerr, why, sizeof why));
     cf_status st = parse_root(c, root, sc);
     json_decref(root);
     if (st != CF_OK)

@@ -266,6 +266,41 @@ static void cycles_summary_separates_zero_force_strain_from_permanent_set(void *
     rmdir(dir);
 }
 
+/* A scene may name any readable file as its fit; when that file is not JSON, the message says
+** where and why, and shows nothing of what the file holds. The same for the scene itself. */
+static void messages_never_show_what_a_named_file_holds(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-scene-XXXXXX", p[300], q[300], text[800];
+    assert_non_null(mkdtemp(dir));
+    snprintf(p, sizeof p, "%s/secret.txt", dir);
+    FILE *f = fopen(p, "w");
+    assert_non_null(f);
+    fputs("tokenSECRET:x:0:0\n", f);
+    fclose(f);
+    snprintf(text, sizeof text,
+             "{\"spring\": {\"fit\": \"%s\"}, \"lattice\": {\"nx\": 2, \"ny\": 2, \"nz\": 2},"
+             " \"protocol\": {\"kind\": \"ramp\", \"to_strain\": 0.2, \"duration_s\": 1}}",
+             p);
+    cf_scene sc;
+    cf_error err = {0};
+    assert_int_equal(cf_scene_parse(text, "s.json", &sc, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "secret.txt:1:"));
+    assert_null(strstr(err.msg, "SECRET"));
+    /* the scene itself: not JSON */
+    snprintf(q, sizeof q, "%s/scene.json", dir);
+    f = fopen(q, "w");
+    assert_non_null(f);
+    fputs("tokenSECRET2 and more\n", f);
+    fclose(f);
+    assert_int_equal(cf_scene_load(q, &sc, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "scene.json:1:"));
+    assert_null(strstr(err.msg, "SECRET"));
+    unlink(p);
+    unlink(q);
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -274,6 +309,7 @@ int main(void)
         cmocka_unit_test(simulate_writes_nothing_for_a_bad_scene_and_a_csv_for_a_good_one),
         cmocka_unit_test(relaxation_scene_follows_published_muscle_relaxation),
         cmocka_unit_test(cycles_summary_separates_zero_force_strain_from_permanent_set),
+        cmocka_unit_test(messages_never_show_what_a_named_file_holds),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
