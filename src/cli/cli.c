@@ -3,6 +3,8 @@
 */
 #include "cli/cli.h"
 
+#include "base/safetext.h"
+
 #include "conifit/scene.h"
 
 #include <ctype.h>
@@ -36,22 +38,55 @@ static void flags_for_options(const char *msg, char *out, size_t cap)
     out[o] = '\0';
 }
 
+void cf_cli_write_safe(FILE *f, const char *text)
+{
+    char safe[4 * 1024 + 4];
+    for (const char *line = text; *line;) {
+        const char *nl = strchr(line, '\n');
+        size_t n = nl ? (size_t)(nl - line) : strlen(line);
+        /* in pieces that fit the buffer whatever they expand to (4 bytes per byte at most) */
+        for (size_t done = 0; done < n;) {
+            size_t take = n - done < 1024 ? n - done : 1024;
+            /* a piece ends on a character boundary unless the line itself ends there */
+            while (take < n - done && take > 0 && ((unsigned char)line[done + take] & 0xc0) == 0x80)
+                take--;
+            take = take ? take : 1;
+            fputs(cf_safe_text(safe, sizeof safe, line + done, take), f);
+            done += take;
+        }
+        if (!nl)
+            break;
+        fputc('\n', f);
+        line = nl + 1;
+    }
+}
+
+void cf_cli_printf_safe(FILE *f, const char *fmt, ...)
+{
+    char buf[8192];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    cf_cli_write_safe(f, buf);
+}
+
 int cf_cli_fail(const cf_error *err)
 {
     char msg[2 * CF_ERROR_MSG_LEN];
     flags_for_options(err->msg[0] ? err->msg : cf_strerror(err->status), msg, sizeof msg);
-    fprintf(stderr, "conifit: %s\n", msg);
+    cf_cli_printf_safe(stderr, "conifit: %s\n", msg);
     return cf_exit_code(err->status);
 }
 
 int cf_cli_usage_error(const char *cmd, const char *fmt, ...)
 {
+    char msg[2048];
     va_list ap;
-    fprintf(stderr, "conifit %s: ", cmd);
     va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
+    vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    fprintf(stderr, " (see 'conifit %s --help')\n", cmd);
+    cf_cli_printf_safe(stderr, "conifit %s: %s (see 'conifit %s --help')\n", cmd, msg, cmd);
     return CF_EXIT_USAGE;
 }
 

@@ -152,4 +152,16 @@ void cf_cli_common_help(FILE *out);
 ** read (the run's own reading of the scene then says why). */
 void cf_cli_scene_fit(const char *scene_path, char *out, size_t cap);
 
+/* Writes text to f as a terminal may safely show it: line breaks kept, every other control
+** character and every byte that is not UTF-8 as \xNN (base/safetext.h). For every message and
+** report line that carries text from outside (file names, column names, option values). */
+void cf_cli_write_safe(FILE *f, const char *text);
+
+/* printf into a buffer (8 KiB; longer output is cut), then cf_cli_write_safe. */
+void cf_cli_printf_safe(FILE *f, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
 #endif

@@ -93,7 +93,7 @@ static int run(int argc, char **argv)
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (strcmp(argv[1], commands[i].name) == 0)
             return commands[i].run(argc - 1, argv + 1);
-    fprintf(stderr, "conifit: unknown command '%s' (see 'conifit --help')\n", argv[1]);
+    cf_cli_printf_safe(stderr, "conifit: unknown command '%s' (see 'conifit --help')\n", argv[1]);
     return CF_EXIT_USAGE;
 }
 

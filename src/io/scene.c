@@ -13,6 +13,7 @@
 #include <jansson.h>
 
 #include "base/input.h"
+#include "base/safetext.h"
 #include "conifit/fitfile.h"
 #include "io/fitfile_json.h"
 
@@ -133,8 +134,10 @@ static cf_status spring_section(ctx *c, json_t *sp, cf_scene *sc)
         sc->spring = fs.params;
         c->fit = fs;
         c->from_fit = 1;
-        snprintf(sc->spring_source, sizeof sc->spring_source, "%s:%s", json_string_value(fit),
-                 cf_spring_type_name(fs.type));
+        /* the name as reports and output files may show it (base/safetext.h) */
+        char named[sizeof sc->spring_source];
+        snprintf(named, sizeof named, "%s:%s", json_string_value(fit), cf_spring_type_name(fs.type));
+        cf_safe_text(sc->spring_source, sizeof sc->spring_source, named, strlen(named));
         snprintf(sc->fit_path, sizeof sc->fit_path, "%s", json_string_value(fit));
         return CF_OK;
     }
