@@ -10,7 +10,6 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include <gsl/gsl_blas.h>
 #include <gsl/gsl_eigen.h>
@@ -21,6 +20,7 @@
 #include <gsl/gsl_vector.h>
 #include <nlopt.h>
 
+#include "fit/clock.h"
 #include "fit/lsq.h"
 #include "fit/subsample.h"
 
@@ -97,13 +97,6 @@ cf_fit_options cf_fit_default_options(void)
 }
 
 /* ---- small helpers --------------------------------------------------------------------------- */
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* The fit's random numbers: GSL's mt19937 (the generator conifit uses everywhere), one stream
 ** per use, seeded from the fit's seed, local to one call (no shared state between threads). */
@@ -1605,7 +1598,7 @@ static void ctx_free(fit_ctx *c)
 cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                        const double ident[3], cf_fit_result *res, cf_error *err)
 {
-    const double t0 = now_s();
+    const double t0 = cf_clock_s();
     fit_ctx c;
     cf_status st = ctx_setup(&c, data, opt, type, err);
     if (st != CF_OK) {
@@ -1633,7 +1626,7 @@ cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_sprin
         return cf_error_set(err, CF_E_INTERNAL,
                             "out of memory in the %s placement's solver (NLopt)",
                             cf_spring_type_name(type));
-    res->wall_time_s = now_s() - t0;
+    res->wall_time_s = cf_clock_s() - t0;
     return CF_OK;
 }
 
@@ -1644,7 +1637,7 @@ cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_sprin
 cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                      cf_fit_result *res, cf_error *err)
 {
-    const double t0 = now_s();
+    const double t0 = cf_clock_s();
     memset(res, 0, sizeof *res);
     fit_ctx c, sc;
     memset(&sc, 0, sizeof sc);
@@ -1757,7 +1750,7 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
     ctx_free(&c);
     ctx_free(&sc);
     cf_table_free(&subt);
-    res->wall_time_s = now_s() - t0;
+    res->wall_time_s = cf_clock_s() - t0;
     if (oom) /* a stage ran short: its result is not the fit's */
         return cf_error_set(err, CF_E_INTERNAL,
                             "out of memory in the %s fit's solvers (GSL, NLopt)",

@@ -1,8 +1,8 @@
 /*
-** Least-squares pieces shared by the fitter (fit.c), the baselines and the fit through the
-** lattice (check/validate.c), so that each is defined once: the residual weights and their floor,
-** the bounds of the diameter ratio searched, the quality measures, and the wire modulus that
-** gives a spring its solid load. Private to the library.
+** Least-squares pieces shared by the fitter (fit.c), the baselines and the fits through the
+** lattice (lattice_fit.c, joint.c), so that each is defined once: the residual weights and their
+** floor, the bounds of the diameter ratio searched, the quality measures, and the wire modulus
+** that gives a spring its solid load. Private to the library.
 */
 #ifndef CF_FIT_LSQ_H
 #define CF_FIT_LSQ_H

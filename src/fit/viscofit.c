@@ -7,7 +7,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include <gsl/gsl_blas.h>
 #include <gsl/gsl_linalg.h>
@@ -16,6 +15,7 @@
 #include <gsl/gsl_vector.h>
 
 #include "conifit/msm.h"
+#include "fit/clock.h"
 #include "fit/lsq.h"
 #include "fit/viscolimits.h"
 
@@ -40,13 +40,6 @@
 #define A_LO -30.0
 /* Relative step of the central differences for the standard errors. */
 #define SE_STEP 1e-5
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static double logit(double p)
 {
@@ -1378,7 +1371,7 @@ static cf_status fit_report(ctx *c, const cf_visco_params *bestp, cf_visco_fit *
 cf_status cf_visco_fit_run(const cf_visco_data *d, const cf_visco_fit_options *o,
                            cf_visco_fit *res, cf_error *err)
 {
-    const double t0 = now_s();
+    const double t0 = cf_clock_s();
     memset(res, 0, sizeof *res);
     const size_t n = d->count;
     if (o->nbranch < 0 || o->nbranch > CF_PRONY_MAX)
@@ -1403,7 +1396,7 @@ cf_status cf_visco_fit_run(const cf_visco_data *d, const cf_visco_fit_options *o
         st = cf_error_set(err, CF_E_INTERNAL,
                           "out of memory in the viscoelastic fit's errors and predictions");
     res->evaluations = c.evals;
-    res->wall_time_s = now_s() - t0;
+    res->wall_time_s = cf_clock_s() - t0;
     free(c.sw);
     free(c.m);
     cf_visco_limits_free(&c.lim);

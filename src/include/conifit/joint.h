@@ -21,8 +21,8 @@
 #include "conifit/calibration.h"
 #include "conifit/error.h"
 #include "conifit/fit.h"
+#include "conifit/lattice_fit.h"
 #include "conifit/measure.h"
-#include "conifit/validate.h"
 
 /* Most tables in one joint fit. */
 #define CF_JOINT_MAX 16

@@ -6,12 +6,12 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include <nlopt.h>
 
 #include "conifit/cell.h"
 #include "conifit/msm.h"
+#include "fit/clock.h"
 #include "fit/lsq.h"
 
 /* BOBYQA: relative step tolerance and curves per start (each a few tens of microseconds). */
@@ -20,13 +20,6 @@
 /* Diagonal-to-edge weight ratio searched when the weights are fitted. */
 #define Q_LO 0.02
 #define Q_HI 5.0
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 typedef struct jctx {
     const cf_table *const *t;
@@ -127,7 +120,7 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
                        const cf_validate_setup *lat, cf_spring_type type, cf_joint_result *r,
                        cf_error *err)
 {
-    const double t0 = now_s();
+    const double t0 = cf_clock_s();
     memset(r, 0, sizeof *r);
     if (n < 2 || n > CF_JOINT_MAX)
         return cf_error_set(err, CF_E_DATA, "a joint fit takes 2 to %d tables, not %zu",
@@ -278,7 +271,7 @@ out:
     free(reach_x);
     free(reach_y);
     r->evaluations = c.evals;
-    r->wall_time_s = now_s() - t0;
+    r->wall_time_s = cf_clock_s() - t0;
     if (st != CF_OK)
         cf_joint_free(r);
     return st;
