@@ -152,28 +152,6 @@ static cf_spring from_array(const double *p)
     return s;
 }
 
-/* Identifiable quantities of a parameter array for a given type. */
-static void ident_of(const double *p, cf_spring_type type, int fd, double out[3])
-{
-    double s = p[CF_P_H] - lmin_of(p, type);
-    double D1 = p[CF_P_D1], d = p[CF_P_D];
-    double FC = p[CF_P_G] * d * d * d * d * s / (8 * p[CF_P_N] * D1 * D1 * D1);
-    out[0] = D1 / p[CF_P_D2];
-    out[1] = fd ? s : s / p[CF_P_H];
-    out[2] = fd ? FC : FC / (p[CF_P_H] * p[CF_P_H]);
-}
-
-void cf_fit_identifiable(const cf_spring *p, int force_displacement, double ident[3])
-{
-    double a[CF_P_COUNT];
-    to_array(p, a);
-    cf_law law;
-    cf_spring_type type = CF_NON_TELESCOPING;
-    if (cf_law_init(&law, p, NULL) == CF_OK)
-        type = law.type;
-    ident_of(a, type, force_displacement, ident);
-}
-
 /* ---- the data as the fit sees it ------------------------------------------------------------- */
 
 typedef struct fit_ctx {
@@ -204,25 +182,6 @@ typedef struct fit_ctx {
     int oom;        /* 1 when an allocation of GSL or NLopt failed: the fit ends with an error */
 } fit_ctx;
 
-/* The canonical spring of diameter ratio rho with travel 1 mm and solid load 1 N:
-** D1 = rho, D2 = 1, n = 2, d = 0.5 (non-telescoping, L_min = 1), H = 2, G = 256 rho^3. */
-static cf_status canon_law(double rho, cf_law *law)
-{
-    cf_spring p = {rho, 1.0, 2.0, 0.5, 256.0 * rho * rho * rho, 2.0};
-    return cf_law_init(law, &p, NULL);
-}
-
-/* Reduced model value at x: A F_canon(x/B); *dB (if not NULL) receives d/dB. */
-static double reduced(const cf_law *canon, double A, double B, double x, double *dB)
-{
-    double k;
-    double t = x / B;
-    double g = cf_law_force(canon, CF_LAW_CLOSED, t, &k, NULL);
-    if (dB)
-        *dB = -A * k * t / B;
-    return A * g;
-}
-
 /* The canonical law g(t) = F/F_C at t = u/s and its derivatives dg/dt and dg/drho, analytic:
 ** region 1: g = h(rho) t, h = 4 rho^3/((1 + rho)(1 + rho^2));
 ** region 2: g = y^3 with y^4 - 4 c y + 3 = 0, c = (1 - |t|)/rho + |t|, so dy/dc = y/(y^3 - c)
@@ -252,11 +211,11 @@ static double canon_eval(const cf_law *canon, double t, double *dg_dt, double *d
 static double reduced_profile(fit_ctx *c, double rho, double B, double *A_out)
 {
     cf_law canon;
-    if (canon_law(rho, &canon) != CF_OK)
+    if (cf_ident_canon_law(rho, &canon) != CF_OK)
         return CF_LSQ_HUGE_OBJ;
     double sgy = 0, sgg = 0, syy = 0;
     for (size_t i = 0; i < c->n; i++) {
-        double g = c->sw[i] * reduced(&canon, 1.0, B, c->data->x[i], NULL);
+        double g = c->sw[i] * cf_ident_reduced(&canon, 1.0, B, c->data->x[i], NULL);
         double y = c->sw[i] * c->data->y[i];
         sgy += g * y;
         sgg += g * g;
@@ -287,14 +246,14 @@ static int lm_f(const gsl_vector *th, void *params, gsl_vector *f)
     double rho, B, A;
     unpack3(c, th, &rho, &B, &A);
     cf_law canon;
-    if (!isfinite(A) || canon_law(rho, &canon) != CF_OK)
+    if (!isfinite(A) || cf_ident_canon_law(rho, &canon) != CF_OK)
         return GSL_EDOM;
     /* residuals scaled so that the zero model has |f| = 1: GSL's gradient test is absolute
     ** below |f| = 1, which would stop early on tables in MPa of tissue (tiny numbers) */
     const double sc = 1.0 / sqrt(c->ynorm);
     for (size_t i = 0; i < c->n; i++)
         gsl_vector_set(f, i, sc * c->sw[i] *
-                                 (reduced(&canon, A, B, c->data->x[i], NULL) - c->data->y[i]));
+                                 (cf_ident_reduced(&canon, A, B, c->data->x[i], NULL) - c->data->y[i]));
     c->evals++;
     return GSL_SUCCESS;
 }
@@ -306,7 +265,7 @@ static int lm_df(const gsl_vector *th, void *params, gsl_matrix *J)
     double rho, B, A;
     unpack3(c, th, &rho, &B, &A);
     cf_law canon;
-    if (!isfinite(A) || canon_law(rho, &canon) != CF_OK)
+    if (!isfinite(A) || cf_ident_canon_law(rho, &canon) != CF_OK)
         return GSL_EDOM;
     const double s0 = sigmoid(gsl_vector_get(th, 0)), s1 = sigmoid(gsl_vector_get(th, 1));
     const double drho = (c->rho_hi - c->rho_lo) * s0 * (1 - s0);
@@ -449,7 +408,7 @@ static double stage_a(fit_ctx *c, double best3[3], start4 *found, int *nfound)
     start grid[GRID * GRID];
     size_t k = 0;
     for (int i = 0; i < GRID; i++) {
-        /* rho: half the grid log-spaced from CF_LSQ_RHO_LO, half approaching rho_hi geometrically
+        /* rho: half the grid log-spaced from CF_IDENT_RHO_LO, half approaching rho_hi geometrically
         ** (resolves nearly cylindrical springs) */
         double ti = (i + jitter(rng)) / GRID;
         double rho = (i % 2 == 0)
@@ -506,7 +465,7 @@ static int stage_a_errors(fit_ctx *c, const double v[3], double se[3], double co
             corr[a][b] = NAN;
     const double rho = v[0], B = v[1], A = v[2];
     cf_law lc;
-    if (canon_law(rho, &lc) != CF_OK || c->n <= 3)
+    if (cf_ident_canon_law(rho, &lc) != CF_OK || c->n <= 3)
         return 0;
     gsl_matrix *JtJ = gsl_matrix_calloc(3, 3), *E = gsl_matrix_alloc(3, 3);
     gsl_vector *ev = gsl_vector_alloc(3);
@@ -579,9 +538,6 @@ done:
 
 /* Number of inequality constraints of the design, and the CF_C_* bit of each. */
 #define NCON 8
-/* rho_min is met within this relative tolerance, so that a table made from a spring at exactly
-** rho_min is fitted to rounding (its optimum then lies inside stage A's range, not on its edge). */
-#define RHO_MIN_TOL 1e-6
 static const unsigned con_bit[NCON] = {CF_C_INDEX_MIN, CF_C_INDEX_MAX, CF_C_COILS, CF_C_DIAMETERS,
                                        CF_C_TRAVEL,    CF_C_TYPE,      CF_C_RHO_MIN, CF_C_D2_H};
 #define CON_TRAVEL 4
@@ -600,7 +556,7 @@ static void constraint_values(const double *p, cf_spring_type type, double xmax,
     g[4] = s > 0 ? log(umax) - log(s) : 50.0;
     double step = (p[CF_P_D2] - p[CF_P_D1]) / 2, nd = p[CF_P_N] * p[CF_P_D];
     g[5] = type == CF_TELESCOPING ? (nd - step) / p[CF_P_D2] : (step - nd) / p[CF_P_D2] + 1e-12;
-    g[6] = log(opt->rho_min * (1 - RHO_MIN_TOL)) - log(p[CF_P_D1] / p[CF_P_D2]);
+    g[6] = log(opt->rho_min * (1 - CF_IDENT_RHO_MIN_TOL)) - log(p[CF_P_D1] / p[CF_P_D2]);
     g[7] = log(p[CF_P_D2]) - log(opt->D2_over_H_max * p[CF_P_H]);
     for (int k = 0; k < NCON; k++)
         if (!isfinite(g[k]))
@@ -724,10 +680,11 @@ static double z_constraint(fit_ctx *c, const double *z, int which)
 /* log(ident(p)) - log(target): the equality constraints of placement */
 static double z_equality(fit_ctx *c, const double *z, int which)
 {
-    double p[CF_P_COUNT], id[3];
+    double p[CF_P_COUNT];
     full_params(c, z, p);
-    ident_of(p, c->type, c->fd, id);
-    double v = id[which] > 0 ? log(id[which]) - log(c->target[which]) : 50.0;
+    cf_spring sp = from_array(p);
+    const cf_ident id = cf_ident_of_type(&sp, c->type, c->fd);
+    double v = id.v[which] > 0 ? log(id.v[which]) - log(c->target[which]) : 50.0;
     return isfinite(v) ? v : 50.0;
 }
 
@@ -852,7 +809,7 @@ static void analytic_member(const fit_ctx *c, const double v[3], double *p)
     double d = c->type == CF_TELESCOPING ? Lmin : Lmin / n;
     double D1 = cidx * d, D2 = D1 / rho;
     double FC = c->fd ? v[2] : v[2] * H * H;
-    double G = cf_lsq_G_of_FC(FC, n, D1, d, s);
+    double G = cf_ident_G_of_FC(FC, n, D1, d, s);
     const double q[CF_P_COUNT] = {D1, D2, n, d, G, H};
     for (int k = 0; k < CF_P_COUNT; k++)
         p[k] = c->opt->fixed[k] ? c->opt->fixed_value[k] : q[k];
@@ -876,7 +833,7 @@ static void snap_to_family(fit_ctx *c, double *p, double *z)
     if (!fx[CF_P_G] && s > 0) {
         double FC = c->fd ? v[2] : v[2] * q[CF_P_H] * q[CF_P_H];
         double D1 = q[CF_P_D1], d = q[CF_P_D];
-        q[CF_P_G] = cf_lsq_G_of_FC(FC, q[CF_P_N], D1, d, s);
+        q[CF_P_G] = cf_ident_G_of_FC(FC, q[CF_P_N], D1, d, s);
     }
     cf_spring sp = from_array(q);
     if (!check_at(c, &sp, NULL, NULL))
@@ -889,63 +846,28 @@ static void snap_to_family(fit_ctx *c, double *p, double *z)
 /* ---- the type's limits in the space of the identifiable quantities --------------------------- */
 
 /* For a stress-strain table with no fixed parameter the design limits reduce to closed-form
-** limits on (rho, B = s/H, A = F_C/H^2), because H is a pure scale. With c = D1/d:
-**   non-telescoping (d = (1 - B) H/n): G = 8 n^2 c^3 A/(B (1 - B)), D2/H = c (1 - B)/(n rho),
-**     type n > c (1 - rho)/(2 rho): every limit is easiest at c = 3, so the family can be placed
-**     iff n_lo = max(n_min, 3 (1 - rho)/(2 rho), 3 (1 - B)/(D2max rho)) <= n_max, and then carries
-**     at most A_max = G_max B (1 - B)/(8 * 27 n_lo^2);
-**   telescoping (d = (1 - B) H): G = 8 n c^3 A/(B (1 - B)), D2/H = c (1 - B)/rho, type
-**     n <= c (1 - rho)/(2 rho): easiest at n = n_min, so iff
-**     c_lo = max(3, 2 n_min rho/(1 - rho)) <= c_hi = min(index_max, D2max rho/(1 - B)), and then
-**     A_max = G_max B (1 - B)/(8 n_min c_lo^3).
-** margin <= 0 where the family can be placed (log units); lo_bit/hi_bit name the two limits that
-** meet at the edge. REGION_SAFETY keeps solutions that far inside, so that placement finds them. */
+** limits on (rho, B = s/H, A = F_C/H^2), because H is a pure scale (family.h,
+** cf_ident_region_at). REGION_SAFETY keeps solutions that far inside, so that placement finds
+** them. */
 #define REGION_SAFETY 1e-4
 
-typedef struct region {
-    double margin;
-    double A_max;
-    unsigned lo_bit, hi_bit;
-} region;
+typedef cf_ident_region region;
+
+/* The design limits of options o as the family's space sees them. */
+static cf_ident_design design_of(const cf_fit_options *o)
+{
+    cf_ident_design d = {o->lower[CF_P_N], o->upper[CF_P_N], o->upper[CF_P_G], o->D2_over_H_max,
+                         o->index_max, o->rho_min};
+    return d;
+}
 
 static region region_at(const fit_ctx *c, double rho, double B)
 {
     region r = {-1.0, INFINITY, 0, 0};
     if (!c->region)
         return r;
-    if (!(rho > 0 && rho < 1 && B > 0 && B < 1)) {
-        r.margin = 50;
-        return r;
-    }
-    const cf_fit_options *o = c->opt;
-    const double nmin = o->lower[CF_P_N], nmax = o->upper[CF_P_N], Gmax = o->upper[CF_P_G];
-    const double Dr = o->D2_over_H_max, cmin = 3.0, cmax = o->index_max;
-    if (c->type == CF_TELESCOPING) {
-        double c_type = 2 * nmin * rho / (1 - rho), c_D = Dr * rho / (1 - B);
-        double c_lo = fmax(cmin, c_type), c_hi = fmin(cmax, c_D);
-        r.lo_bit = c_type > cmin ? CF_C_TYPE : CF_C_INDEX_MIN;
-        r.hi_bit = c_D < cmax ? CF_C_D2_H : CF_C_INDEX_MAX;
-        r.margin = log(c_lo) - log(c_hi);
-        r.A_max = Gmax * B * (1 - B) / (8 * nmin * c_lo * c_lo * c_lo);
-    } else {
-        double n_type = cmin * (1 - rho) / (2 * rho) * (1 + 1e-6);
-        double n_D = cmin * (1 - B) / (Dr * rho);
-        double n_lo = fmax(nmin, fmax(n_type, n_D));
-        r.lo_bit = n_lo == nmin ? CF_C_COILS : n_lo == n_type ? CF_C_TYPE : CF_C_D2_H;
-        r.hi_bit = CF_C_COILS_MAX;
-        r.margin = log(n_lo) - log(nmax);
-        r.A_max = Gmax * B * (1 - B) / (8 * cmin * cmin * cmin * n_lo * n_lo);
-    }
-    r.A_max *= 1 - c->inside;
-    double m_rho = log(o->rho_min * (1 - RHO_MIN_TOL)) - log(rho);
-    if (m_rho > r.margin) {
-        r.margin = m_rho;
-        r.lo_bit = CF_C_RHO_MIN;
-        r.hi_bit = 0;
-    }
-    if (!isfinite(r.margin))
-        r.margin = 50;
-    return r;
+    const cf_ident_design d = design_of(c->opt);
+    return cf_ident_region_at(&d, c->type, rho, B, c->inside);
 }
 
 double cf_fit_ident_limit(const cf_fit_options *opt, cf_spring_type type, double rho, double B,
@@ -973,11 +895,11 @@ static double rss_at(fit_ctx *c, double rho, double B, double A_fixed, double A_
 {
     cf_law canon;
     *A_out = A_fixed;
-    if (!(B > 0) || canon_law(rho, &canon) != CF_OK)
+    if (!(B > 0) || cf_ident_canon_law(rho, &canon) != CF_OK)
         return CF_LSQ_HUGE_OBJ;
     double sgy = 0, sgg = 0;
     for (size_t i = 0; i < c->n; i++) {
-        double g = c->sw[i] * reduced(&canon, 1.0, B, c->data->x[i], NULL);
+        double g = c->sw[i] * cf_ident_reduced(&canon, 1.0, B, c->data->x[i], NULL);
         c->model[i] = g;
         sgy += g * c->sw[i] * c->data->y[i];
         sgg += g * g;
@@ -1217,7 +1139,7 @@ static unsigned held_at(const fit_ctx *c, const double v[3])
 {
     unsigned h = 0;
     if (v[0] <= fmax(c->rho_lo, c->opt->rho_min) * (1 + 1e-3))
-        h |= c->opt->rho_min > CF_LSQ_RHO_LO ? CF_C_RHO_MIN : CF_C_BOUNDS;
+        h |= c->opt->rho_min > CF_IDENT_RHO_LO ? CF_C_RHO_MIN : CF_C_BOUNDS;
     if (c->travel_ok && v[1] <= c->b_lo * (1 + 1e-5))
         h |= CF_C_TRAVEL;
     if (c->region) {
@@ -1311,7 +1233,7 @@ static void profile_end(fit_ctx *c, int k, const double v[3], double limit, int 
     /* the range of each quantity, in log units */
     double lo[3] = {log(c->rho_lo), log(c->b_lo), -INFINITY};
     double hi[3] = {log(c->rho_hi * (1 - 1e-12)), log(c->b_hi), INFINITY};
-    unsigned lo_bit[3] = {c->opt->rho_min > CF_LSQ_RHO_LO ? CF_C_RHO_MIN : CF_C_BOUNDS,
+    unsigned lo_bit[3] = {c->opt->rho_min > CF_IDENT_RHO_LO ? CF_C_RHO_MIN : CF_C_BOUNDS,
                           c->travel_ok ? CF_C_TRAVEL : CF_C_BOUNDS, 0};
     unsigned hi_bit[3] = {(c->type == CF_TELESCOPING && !c->region) ? CF_C_TYPE : CF_C_DIAMETERS,
                           CF_C_BOUNDS, 0};
@@ -1384,16 +1306,16 @@ static void profile_end(fit_ctx *c, int k, const double v[3], double limit, int 
 ** 1e-10 of the largest): then no standard error is given. */
 static void uncertainty(fit_ctx *c, fit_ctx *g, cf_fit_result *res, unsigned held_a)
 {
-    const double *v = res->ident;
-    int rank_def = stage_a_errors(c, v, res->ident_se, res->corr);
+    const double *v = res->ident.v;
+    int rank_def = stage_a_errors(c, v, res->ident_se.v, res->corr);
     res->held = held_a | held_at(c, v) | (c->fd || c->region ? 0u : res->active);
     unsigned why = res->held | (rank_def ? CF_FIT_RANK_DEFICIENT : 0);
     /* a Wald interval that would cross the range of a quantity is no interval either */
     double lo[3] = {c->rho_lo, c->b_lo, 0}, hi[3] = {c->rho_hi, c->b_hi, INFINITY};
     int need = why != 0;
     for (int k = 0; k < 3; k++)
-        need = need || res->ident_se[k] < 0 || v[k] - 1.96 * res->ident_se[k] < lo[k] ||
-               v[k] + 1.96 * res->ident_se[k] > hi[k];
+        need = need || res->ident_se.v[k] < 0 || v[k] - 1.96 * res->ident_se.v[k] < lo[k] ||
+               v[k] + 1.96 * res->ident_se.v[k] > hi[k];
     if (!need || c->n <= 3)
         return;
     /* The profiles run up to the limits themselves: the searches' REGION_SAFETY is for the
@@ -1409,7 +1331,7 @@ static void uncertainty(fit_ctx *c, fit_ctx *g, cf_fit_result *res, unsigned hel
                          : rss_at(g, v[0], v[1], -1, r.A_max, &A);
     double limit = rss0 + rss_threshold(c, rss0);
     for (int k = 0; k < 3; k++) {
-        double h = res->ident_se[k] > 0 ? fmin(0.5 * res->ident_se[k] / v[k], 0.1) : 0.01;
+        double h = res->ident_se.v[k] > 0 ? fmin(0.5 * res->ident_se.v[k] / v[k], 0.1) : 0.01;
         h = fmax(h, 1e-13);
         profile_end(g, k, v, limit, -1, h, res);
         profile_end(g, k, v, limit, +1, h, res);
@@ -1490,7 +1412,7 @@ static void summarise(fit_ctx *c, const double *p, cf_fit_result *res)
 {
     res->params = from_array(p);
     cf_law_init(&res->law, &res->params, NULL);
-    ident_of(p, c->type, c->fd, res->ident);
+    res->ident = cf_ident_of_type(&res->params, c->type, c->fd);
     for (size_t i = 0; i < c->n; i++)
         c->model[i] = cf_fit_model(&res->law, c->fd, c->data->x[i]);
     cf_lsq_quality q = cf_lsq_quality_of(c->data, c->model);
@@ -1501,7 +1423,7 @@ static void summarise(fit_ctx *c, const double *p, cf_fit_result *res)
     res->objective = objective6(c, p) * c->ynorm;
     res->feasible = check_at(c, &res->params, &res->active, &res->violated);
     res->objective_zero = c->ynorm;
-    res->solid_ratio = c->xmax > 0 ? res->ident[1] / c->xmax : INFINITY;
+    res->solid_ratio = c->xmax > 0 ? res->ident.solid / c->xmax : INFINITY;
     for (int a = 0; a < 3; a++)
         for (int b = 0; b < 3; b++)
             res->corr[a][b] = NAN;
@@ -1538,8 +1460,8 @@ static cf_status ctx_setup(fit_ctx *c, const cf_table *data, const cf_fit_option
     ** the same quantities wherever neither type's limits bind; rho_min is one of those limits and
     ** stage A searches a little below it, so that an optimum on rho_min lies inside its range.
     ** Otherwise (lsq.h) telescoping stops at rho <= index_max/(index_max + 4). */
-    c->rho_lo = fmax(CF_LSQ_RHO_LO, opt->rho_min * (c->region ? 0.9 : 1 - RHO_MIN_TOL));
-    c->rho_hi = c->region ? 1.0 : cf_lsq_rho_hi(type, opt->index_max);
+    c->rho_lo = fmax(CF_IDENT_RHO_LO, opt->rho_min * (c->region ? 0.9 : 1 - CF_IDENT_RHO_MIN_TOL));
+    c->rho_hi = c->region ? 1.0 : cf_ident_rho_hi(type, opt->index_max);
     if (c->rho_hi <= c->rho_lo * (1 + 1e-9))
         return cf_error_set(err, CF_E_DATA,
                             "rho_min = %g leaves no diameter ratio a %s spring can have (at most "
@@ -1596,7 +1518,7 @@ static void ctx_free(fit_ctx *c)
 }
 
 cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
-                       const double ident[3], cf_fit_result *res, cf_error *err)
+                       const cf_ident *ident, cf_fit_result *res, cf_error *err)
 {
     const double t0 = cf_clock_s();
     fit_ctx c;
@@ -1605,19 +1527,19 @@ cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_sprin
         ctx_free(&c);
         return st;
     }
-    for (int k = 0; k < 3; k++)
-        if (!(ident[k] > 0) || !isfinite(ident[k])) {
+    for (int k = 0; k < CF_IDENT_COUNT; k++)
+        if (!(ident->v[k] > 0) || !isfinite(ident->v[k])) {
             ctx_free(&c);
             return cf_error_set(err, CF_E_DATA, "identifiable quantity %d = %g must be positive",
-                                k, ident[k]);
+                                k, ident->v[k]);
         }
     double p[CF_P_COUNT], z[CF_P_COUNT];
-    place(&c, ident, p, z);
+    place(&c, ident->v, p, z);
     memset(res, 0, sizeof *res);
     res->type = type;
     summarise(&c, p, res);
-    for (int k = 0; k < 3; k++)
-        res->ident_se[k] = -1;
+    for (int k = 0; k < CF_IDENT_COUNT; k++)
+        res->ident_se.v[k] = -1;
     res->optimizer = "placement";
     res->evaluations = res->evaluations_full = c.evals;
     const int oom = c.oom;

@@ -10,6 +10,7 @@
 #include <nlopt.h>
 
 #include "conifit/cell.h"
+#include "conifit/family.h"
 #include "conifit/msm.h"
 #include "fit/clock.h"
 #include "fit/lsq.h"
@@ -43,15 +44,6 @@ static void weights_of(double q, double w[CF_FAMILY_COUNT])
         w[f] = u[f] / E;
 }
 
-/* The spring of free length 1 with the identifiable quantities (rho, e, A) (as validate.c). */
-static cf_spring member(double rho, double e, double A)
-{
-    const double H = 1.0, Lmin = H * (1 - e), s = H * e, n = 2.0, dw = Lmin / n;
-    const double D2 = rho < 1 ? Lmin / (1 - rho) : Lmin, D1 = rho * D2;
-    cf_spring p = {D1, D2, n, dw, cf_lsq_G_of_FC(A * H * H, n, D1, dw, s), H};
-    return p;
-}
-
 /* Objective at z = (ln rho, s/H [, ln q]) with the stress scale in closed form; *A_out. */
 static double profile(jctx *c, const double *z, double *A_out)
 {
@@ -62,7 +54,8 @@ static double profile(jctx *c, const double *z, double *A_out)
         return CF_LSQ_HUGE_OBJ;
     if (c->fit_weights)
         weights_of(exp(z[2]), c->weight);
-    cf_spring p = member(rho, e, 1.0);
+    const cf_ident q = {.rho = rho, .solid = e, .scale = 1.0};
+    cf_spring p = cf_ident_member(&q);
     cf_law law;
     if (cf_law_init(&law, &p, NULL) != CF_OK)
         return CF_LSQ_HUGE_OBJ;
@@ -186,9 +179,9 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
     reach.t = NULL;
     const double xmax = cf_lsq_xmax(&reach);
     const int nz = c.fit_weights ? 3 : 2;
-    double lb[3] = {log(fmax(CF_LSQ_RHO_LO, opt->rho_min)),
+    double lb[3] = {log(fmax(CF_IDENT_RHO_LO, opt->rho_min)),
                     xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9), log(Q_LO)};
-    double ub[3] = {log(cf_lsq_rho_hi(type, opt->index_max)), 1 - 1e-9, log(Q_HI)};
+    double ub[3] = {log(cf_ident_rho_hi(type, opt->index_max)), 1 - 1e-9, log(Q_HI)};
     if (!(lb[1] < ub[1])) {
         st = cf_error_set(err, CF_E_DATA,
                           "the springs must reach a strain of %g: no spring does", xmax);
@@ -228,10 +221,10 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
         goto out;
     }
     r->objective = best;
-    r->ident[0] = exp(zb[0]), r->ident[1] = zb[1], r->ident[2] = A;
+    r->ident.rho = exp(zb[0]), r->ident.solid = zb[1], r->ident.scale = A;
     memcpy(r->weight, c.weight, sizeof r->weight);
     r->calibration = lat->cfg.lattice.calibration;
-    if ((st = cf_fit_place(&reach, opt, type, r->ident, &r->fit, err)) != CF_OK)
+    if ((st = cf_fit_place(&reach, opt, type, &r->ident, &r->fit, err)) != CF_OK)
         goto out;
     /* Each table in the lattice of the placed spring: the cell, and the full lattice when the
     ** mode is uniaxial (the verification). */

@@ -11,7 +11,7 @@
 #include <nlopt.h>
 
 #include "conifit/cell.h"
-#include "conifit/viscomodel.h"
+#include "conifit/family.h"
 #include "fit/clock.h"
 #include "fit/lattice_curve.h"
 #include "fit/lsq.h"
@@ -40,7 +40,8 @@ typedef struct tm_ctx {
 ** and the best A is a weighted linear least-squares solution. *A_out receives it. */
 static double tm_profile(tm_ctx *c, const double *z, double *A_out)
 {
-    cf_spring p = cf_spring_member(exp(z[0]), z[1], 1.0);
+    const cf_ident q = {.rho = exp(z[0]), .solid = z[1], .scale = 1.0};
+    cf_spring p = cf_ident_member(&q);
     c->evals++;
     *A_out = 0;
     /* the fitter's design limits in this space: where no spring can be placed, or the scale a
@@ -113,8 +114,8 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
 {
     const double t0 = cf_clock_s();
     memset(t, 0, sizeof *t);
-    cf_fit_identifiable(&res->params, 0, t->ident_before);
-    memcpy(t->ident_after, t->ident_before, sizeof t->ident_after);
+    t->ident_before = cf_ident_of(&res->params, 0);
+    t->ident_after = t->ident_before;
     tm_ctx c = {d, s, opt, res->type, NULL, 0, NULL, 0};
     c.sw = malloc(sizeof(double) * (d->count ? d->count : 1));
     c.curve = malloc(sizeof(double) * (d->count ? d->count : 1));
@@ -140,8 +141,8 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
     const double xmax = cf_lsq_xmax(&reach);
     c.ynorm = cf_lsq_weights(d, opt->relative, c.sw);
     t->rmse_before = cell_rmse(&res->params, &c);
-    double rho_hi = cf_lsq_rho_hi(res->type, opt->index_max);
-    double lb[2] = {log(fmax(CF_LSQ_RHO_LO, opt->rho_min)),
+    double rho_hi = cf_ident_rho_hi(res->type, opt->index_max);
+    double lb[2] = {log(fmax(CF_IDENT_RHO_LO, opt->rho_min)),
                     xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9)};
     double ub[2] = {log(rho_hi), 1 - 1e-9};
     if (!(lb[1] < ub[1]) || !(c.ynorm > 0)) {
@@ -156,8 +157,8 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
     for (int k = -1; k < 6; k++) {
         double z[2];
         if (k < 0) {
-            z[0] = log(t->ident_before[0]);
-            z[1] = t->ident_before[1];
+            z[0] = log(t->ident_before.rho);
+            z[1] = t->ident_before.solid;
         } else {
             z[0] = log(grid_rho[k % 3]);
             z[1] = lb[1] + grid_e[k / 3] * (ub[1] - lb[1]);
@@ -172,15 +173,15 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
     }
     double A = 0;
     int ok = best < CF_LSQ_HUGE_OBJ && tm_profile(&c, zb, &A) < CF_LSQ_HUGE_OBJ && A > 0;
-    double ident[3] = {exp(zb[0]), zb[1], A};
+    const cf_ident ident = {.rho = exp(zb[0]), .solid = zb[1], .scale = A};
     /* Place the design parameters as the ordinary fit does; keep them when the cell fits better. */
     cf_fit_result placed;
     cf_error e = {0};
     double after = CF_LSQ_HUGE_OBJ;
-    if (ok && cf_fit_place(&reach, opt, res->type, ident, &placed, &e) == CF_OK)
+    if (ok && cf_fit_place(&reach, opt, res->type, &ident, &placed, &e) == CF_OK)
         after = cell_rmse(&placed.params, &c);
     if (after < t->rmse_before) {
-        cf_fit_identifiable(&placed.params, 0, t->ident_after);
+        t->ident_after = cf_ident_of(&placed.params, 0);
         placed.evaluations += res->evaluations;
         placed.wall_time_s += res->wall_time_s;
         *res = placed;

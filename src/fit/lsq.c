@@ -42,23 +42,12 @@ cf_lsq_quality cf_lsq_quality_of(const cf_table *t, const double *model)
     return q;
 }
 
-double cf_lsq_rho_hi(cf_spring_type type, double index_max)
-{
-    return type == CF_TELESCOPING ? index_max / (index_max + 4) * (1 - 1e-6) : 1.0;
-}
-
 double cf_lsq_xmax(const cf_table *t)
 {
     double m = 0;
     for (size_t i = 0; i < t->count; i++)
         m = fmax(m, fabs(t->x[i]));
     return m;
-}
-
-double cf_lsq_G_of_FC(double F_C_N, double n, double D1_mm, double d_mm, double s_mm)
-{
-    const double d2 = d_mm * d_mm;
-    return 8 * n * D1_mm * D1_mm * D1_mm * F_C_N / (d2 * d2 * s_mm);
 }
 
 double cf_lsq_f95(double dof)

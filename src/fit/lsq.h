@@ -1,7 +1,7 @@
 /*
 ** Least-squares pieces shared by the fitter (fit.c), the baselines and the fits through the
 ** lattice (lattice_fit.c, joint.c), so that each is defined once: the residual weights and their
-** floor, the bounds of the diameter ratio searched, the quality measures, and the wire modulus
+** floor, the quality measures, and the wire modulus
 ** that gives a spring its solid load. Private to the library.
 */
 #ifndef CF_FIT_LSQ_H
@@ -17,9 +17,6 @@
 /* Relative residuals divide by max(|y|, CF_LSQ_REL_FLOOR max|y|) so that the point at the origin
 ** (y = 0) keeps a finite weight. */
 #define CF_LSQ_REL_FLOOR 1e-3
-/* Lowest diameter ratio searched: rho = 1e-3 is a spring whose largest coil is a thousand times
-** its smallest, far beyond any wound spring. */
-#define CF_LSQ_RHO_LO 1e-3
 /* Objective value returned where the model cannot be evaluated (an invalid spring, a lattice
 ** that does not converge). */
 #define CF_LSQ_HUGE_OBJ 1e30
@@ -38,11 +35,6 @@ typedef struct cf_lsq_quality {
 
 cf_lsq_quality cf_lsq_quality_of(const cf_table *t, const double *model);
 
-/* Largest diameter ratio of a spring type: telescoping needs n <= c (1 - rho)/(2 rho) with
-** n >= 2 and c <= index_max, so rho <= index_max/(index_max + 4) (less a hair); non-telescoping
-** reaches the cylinder, 1. */
-double cf_lsq_rho_hi(cf_spring_type type, double index_max);
-
 /* F(0.95; 1, dof), the 95 % quantile of the F distribution with 1 and dof degrees of freedom:
 ** GSL's inverse where it converges, else the square of Student's t(0.975; dof), which it equals
 ** (GSL 2.7's gsl_cdf_fdist_Pinv fails for some large dof, e.g. 4997 and 1e5, and returns NaN). */
@@ -50,10 +42,6 @@ double cf_lsq_f95(double dof);
 
 /* Largest |x| of the table. */
 double cf_lsq_xmax(const cf_table *t);
-
-/* The wire modulus G (MPa) that gives a spring of n coils, smallest coil D1, wire d and travel s
-** (mm) the solid load F_C (N): F_C = G d^4 s / (8 n D1^3). */
-double cf_lsq_G_of_FC(double F_C_N, double n, double D1_mm, double d_mm, double s_mm);
 
 /* When GSL's Levenberg-Marquardt iterations stop: its own test (xtol, gtol, ftol), the iteration
 ** limit, and two more rules. An optimum on a bound of a logit coordinate lies at infinity, where

@@ -166,14 +166,12 @@ static cf_visco_params unpack(const ctx *c, const double *z)
     memset(&p, 0, sizeof p);
     size_t j = 0;
     if (c->free_el) {
-        p.rho = c->rho_lo + (RHO_HI - c->rho_lo) * expit(z[j++]);
-        const double lo = solid_lo(c, p.rho);
-        p.solid_strain = lo + (E_HI - lo) * expit(z[j++]);
-        p.stress_scale_MPa = 1.0;
+        p.ident.rho = c->rho_lo + (RHO_HI - c->rho_lo) * expit(z[j++]);
+        const double lo = solid_lo(c, p.ident.rho);
+        p.ident.solid = lo + (E_HI - lo) * expit(z[j++]);
+        p.ident.scale = 1.0;
     } else {
-        p.rho = c->o->elastic[0];
-        p.solid_strain = c->o->elastic[1];
-        p.stress_scale_MPa = c->o->elastic[2];
+        p.ident = c->o->elastic;
     }
     p.nbranch = c->nb;
     /* the moduli at zero strain (g_i) are shares of a softmax: >= 0 and summing below 1; the
@@ -196,7 +194,7 @@ static cf_visco_params unpack(const ctx *c, const double *z)
     }
     for (int i = 0; i < c->nb; i++)
         p.k[i] = strain_term(c, i) ? (left * eb[i] / sumb - p.g[i]) / c->xmax : 0.0;
-    p.eta_MPa_s = c->dash ? exp(z[j++]) * p.stress_scale_MPa : 0.0;
+    p.eta_MPa_s = c->dash ? exp(z[j++]) * p.ident.scale : 0.0;
     return p;
 }
 
@@ -204,9 +202,9 @@ static void pack(const ctx *c, const cf_visco_params *p, double *z)
 {
     size_t j = 0;
     if (c->free_el) {
-        const double lo = solid_lo(c, p->rho);
-        z[j++] = logit((p->rho - c->rho_lo) / (RHO_HI - c->rho_lo));
-        z[j++] = logit((p->solid_strain - lo) / (E_HI - lo));
+        const double lo = solid_lo(c, p->ident.rho);
+        z[j++] = logit((p->ident.rho - c->rho_lo) / (RHO_HI - c->rho_lo));
+        z[j++] = logit((p->ident.solid - lo) / (E_HI - lo));
     }
     double ginf = 1, left = 1, gb[CF_PRONY_MAX];
     for (int i = 0; i < c->nb; i++) {
@@ -228,7 +226,7 @@ static void pack(const ctx *c, const cf_visco_params *p, double *z)
             z[j++] = gb[i] > 0 ? fmax(log(gb[i] / left / ginfb), A_LO) : A_LO;
     }
     if (c->dash)
-        z[j++] = log(fmax(p->eta_MPa_s / p->stress_scale_MPa, 1e-300));
+        z[j++] = log(fmax(p->eta_MPa_s / p->ident.scale, 1e-300));
 }
 
 /* The model at p into c->m; returns 0 on failure. */
@@ -265,7 +263,7 @@ static int lm_f(const gsl_vector *zv, void *data, gsl_vector *f)
     ctx *c = data;
     cf_visco_params p = unpack(c, zv->data);
     double A = 0;
-    int ok = curve(c, &p) && (A = profile_scale(c, p.rho, p.solid_strain)) > 0;
+    int ok = curve(c, &p) && (A = profile_scale(c, p.ident.rho, p.ident.solid)) > 0;
     const double s = 1 / sqrt(c->ynorm);
     for (size_t k = 0; k < c->n; k++) {
         double r = ok ? c->sw[k] * (A * c->m[k] - c->d->y[k])
@@ -329,8 +327,8 @@ static void keep_start(start *best, int nbest, double obj, const cf_visco_params
         return;
     /* one start per (rho, s/H): replace a worse start of the same grid point */
     for (int i = 0; i < nbest; i++)
-        if (best[i].obj < HUGE_VAL && best[i].p.rho == p->rho &&
-            best[i].p.solid_strain == p->solid_strain) {
+        if (best[i].obj < HUGE_VAL && best[i].p.ident.rho == p->ident.rho &&
+            best[i].p.ident.solid == p->ident.solid) {
             if (i < pos)
                 return;
             memmove(best + i, best + i + 1, (size_t)(nbest - 1 - i) * sizeof *best);
@@ -517,7 +515,7 @@ static int standin_params(const ctx *c, const standin *s, const double *a, const
             return 0;
         p->eta_MPa_s = cd * rate_factor; /* MPa s */
     }
-    p->stress_scale_MPa *= A;
+    p->ident.scale *= A;
     return 1;
 }
 
@@ -625,14 +623,14 @@ static int elastic_curve(ctx *c, double rho, double e, double A, double *E, doub
 {
     cf_visco_params p;
     memset(&p, 0, sizeof p);
-    p.rho = rho;
-    p.solid_strain = e;
-    p.stress_scale_MPa = A;
+    p.ident.rho = rho;
+    p.ident.solid = e;
+    p.ident.scale = A;
     cf_error err = {0};
     c->evals++;
     if (cf_visco_elastic_curve(&p, &c->o->setup, c->d->x, c->n, E, &err) != CF_OK)
         return 0;
-    cf_spring sp = cf_spring_member(rho, e, A);
+    cf_spring sp = cf_ident_member(&p.ident);
     cf_law law;
     double small = -1e-3 * e, s0 = 0;
     if (cf_law_init(&law, &sp, &err) != CF_OK)
@@ -664,16 +662,14 @@ static void grid_point(const ctx *c, int ir, int ie, cf_visco_params *el)
 {
     memset(el, 0, sizeof *el);
     if (!c->free_el) {
-        el->rho = c->o->elastic[0];
-        el->solid_strain = c->o->elastic[1];
-        el->stress_scale_MPa = c->o->elastic[2];
+        el->ident = c->o->elastic;
         return;
     }
     const double r0 = fmax(c->rho_lo * 1.001, 0.02);
-    el->rho = r0 * pow(0.98 / r0, (double)ir / (GRID_RHO - 1));
-    const double lo = solid_lo(c, el->rho), f = (ie + 1.0) / (GRID_E + 1.0);
-    el->solid_strain = lo + (E_HI - lo) * f * f;
-    el->stress_scale_MPa = 1;
+    el->ident.rho = r0 * pow(0.98 / r0, (double)ir / (GRID_RHO - 1));
+    const double lo = solid_lo(c, el->ident.rho), f = (ie + 1.0) / (GRID_E + 1.0);
+    el->ident.solid = lo + (E_HI - lo) * f * f;
+    el->ident.scale = 1;
 }
 
 /* Stage A: the best starts for nb branches. */
@@ -704,7 +700,7 @@ static int stand_in(ctx *c, start *best, int nbest)
             cf_visco_params el;
             grid_point(c, ir, ie, &el);
             double fac = 1;
-            if (!elastic_curve(c, el.rho, el.solid_strain, el.stress_scale_MPa, E, &fac))
+            if (!elastic_curve(c, el.ident.rho, el.ident.solid, el.ident.scale, E, &fac))
                 continue;
             grid_responses(c, E, taus, R);
             if (c->gs) {
@@ -713,7 +709,7 @@ static int stand_in(ctx *c, start *best, int nbest)
                 grid_responses(c, xE, taus, S);
             }
             const double A_max = c->free_el
-                                     ? cf_visco_limits_scale_max(&c->lim, el.rho, el.solid_strain)
+                                     ? cf_visco_limits_scale_max(&c->lim, el.ident.rho, el.ident.solid)
                                      : INFINITY;
             /* a dashpot eta beside every spring adds about eta * fac * rate to the stress */
             search_taus(c, E, c->gs ? xE : NULL, R, S, taus, rate, 1 / fac, A_max, &el, best,
@@ -736,7 +732,7 @@ static double *se_slot(const ctx *c, const int held[3], int which, cf_visco_para
     if (which < 3) {
         if (!c->free_el || held[which])
             return NULL;
-        return which == 0 ? &q->rho : which == 1 ? &q->solid_strain : &q->stress_scale_MPa;
+        return &q->ident.v[which];
     }
     if (which < 3 + 2 * nb) {
         int i = (which - 3) / 2;
@@ -804,7 +800,7 @@ static int se_column(ctx *c, const cf_visco_params *p, const int held[3], int wh
 static void se_store(int which, int nb, double se, cf_visco_fit *res)
 {
     if (which < 3)
-        res->se_ident[which] = se;
+        res->ident_se.v[which] = se;
     else if (which < 3 + 2 * nb)
         *((which - 3) % 2 == 0 ? &res->se_g[(which - 3) / 2] : &res->se_tau_s[(which - 3) / 2]) =
             se;
@@ -822,7 +818,7 @@ static void standard_errors(ctx *c, const cf_visco_params *p, const int held[3],
                             cf_visco_fit *res)
 {
     for (int i = 0; i < 3; i++)
-        res->se_ident[i] = -1;
+        res->ident_se.v[i] = -1;
     for (int i = 0; i < CF_PRONY_MAX; i++)
         res->se_g[i] = res->se_tau_s[i] = res->se_k[i] = res->se_g_max[i] = -1;
     res->se_eta_MPa_s = -1;
@@ -883,9 +879,9 @@ static void default_start(const ctx *c, int nb, start *s)
 {
     s->obj = 1;
     memset(&s->p, 0, sizeof s->p);
-    s->p.rho = c->free_el ? 0.3 : c->o->elastic[0];
-    s->p.solid_strain = c->free_el ? 0.5 * (solid_lo(c, 0.3) + E_HI) : c->o->elastic[1];
-    s->p.stress_scale_MPa = c->free_el ? 1 : c->o->elastic[2];
+    s->p.ident.rho = c->free_el ? 0.3 : c->o->elastic.rho;
+    s->p.ident.solid = c->free_el ? 0.5 * (solid_lo(c, 0.3) + E_HI) : c->o->elastic.solid;
+    s->p.ident.scale = c->free_el ? 1 : c->o->elastic.scale;
     s->p.nbranch = nb;
     double span = c->d->t_s[c->n - 1] - c->d->t_s[0];
     for (int i = 0; i < nb; i++) {
@@ -918,7 +914,7 @@ static double fit_nb(ctx *c, int nb, const cf_visco_params *from, cf_visco_param
             continue;
         cf_visco_params p0 = best[s].p;
         if (c->dash && !(p0.eta_MPa_s > 0))
-            p0.eta_MPa_s = 1e-6 * p0.stress_scale_MPa;
+            p0.eta_MPa_s = 1e-6 * p0.ident.scale;
         pack(c, &p0, z);
         double obj = lm_run(c, z);
         if (obj < bestobj) {
@@ -929,8 +925,8 @@ static double fit_nb(ctx *c, int nb, const cf_visco_params *from, cf_visco_param
     if (bestobj < HUGE_VAL) {
         cf_visco_params p = unpack(c, zbest);
         if (c->free_el && curve(c, &p)) {
-            double A = profile_scale(c, p.rho, p.solid_strain);
-            p.stress_scale_MPa = A;
+            double A = profile_scale(c, p.ident.rho, p.ident.solid);
+            p.ident.scale = A;
             p.eta_MPa_s *= A;
         }
         *pout = p;
@@ -1042,7 +1038,8 @@ void cf_visco_fit_free(cf_visco_fit *r)
 ** series' largest strain. 0 when it stays stable to 0.995 of solid or cannot be scanned. */
 static double stability_limit(const ctx *c, double rho, double B, double A)
 {
-    cf_spring sp = cf_spring_member(rho, B, A);
+    const cf_ident q = {.rho = rho, .solid = B, .scale = A};
+    cf_spring sp = cf_ident_member(&q);
     cf_law law;
     cf_error e = {0};
     cf_msm_config cfg = c->o->setup.cfg;
@@ -1085,7 +1082,7 @@ static cf_status fit_setup(ctx *c, const cf_visco_data *d, const cf_visco_fit_op
     }
     c->e_lo = c->xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
     c->rho_lo = o->rho_min > 0 && o->rho_min < RHO_HI ? o->rho_min : 1e-3;
-    const double *el = o->elastic;
+    const double *el = o->elastic.v;
     if (o->hold_elastic && (!(el[0] > 0 && el[0] <= 1) || !(el[1] > c->xmax && el[1] < 1) ||
                             !(el[2] > 0) || !isfinite(el[2])))
         return cf_error_set(err, CF_E_DATA,
@@ -1141,11 +1138,11 @@ static void limits_held(const ctx *c, const cf_visco_params *p, int held[3])
     held[0] = held[1] = held[2] = 0;
     if (!c->free_el)
         return;
-    held[0] = p->rho <= c->rho_lo * (1 + 1e-4);
-    held[1] = c->lim.cells > 0 && solid_lo(c, p->rho) > c->e_lo &&
-              p->solid_strain <= solid_lo(c, p->rho) * (1 + 1e-6);
-    held[2] = p->stress_scale_MPa >=
-              cf_visco_limits_scale_max(&c->lim, p->rho, p->solid_strain) * (1 - 1e-9);
+    held[0] = p->ident.rho <= c->rho_lo * (1 + 1e-4);
+    held[1] = c->lim.cells > 0 && solid_lo(c, p->ident.rho) > c->e_lo &&
+              p->ident.solid <= solid_lo(c, p->ident.rho) * (1 + 1e-6);
+    held[2] = p->ident.scale >=
+              cf_visco_limits_scale_max(&c->lim, p->ident.rho, p->ident.solid) * (1 - 1e-9);
 }
 
 /* The limits of the fitted elastic quantities, and where the elastic lattice of the fitted (or
@@ -1154,7 +1151,7 @@ static void fit_limits(const ctx *c, const cf_visco_params *p, cf_visco_fit *res
 {
     res->stable_to_strain = 0;
     if (c->o->stable_cells > 0)
-        res->stable_to_strain = stability_limit(c, p->rho, p->solid_strain, p->stress_scale_MPa);
+        res->stable_to_strain = stability_limit(c, p->ident.rho, p->ident.solid, p->ident.scale);
     limits_held(c, p, held);
     res->rho_at_limit = held[0];
     res->at_stability_limit = held[1];
@@ -1356,7 +1353,7 @@ static cf_status fit_report(ctx *c, const cf_visco_params *bestp, cf_visco_fit *
         return cf_error_set(err, CF_E_INTERNAL, "out of memory in the standard errors of the "
                                                 "viscoelastic fit");
     /* small-strain moduli of the lattice */
-    double Eel[1], small = -1e-3 * bestp->solid_strain;
+    double Eel[1], small = -1e-3 * bestp->ident.solid;
     if (cf_visco_elastic_curve(bestp, &o->setup, &small, 1, Eel, &e) == CF_OK) {
         double ginf = 1;
         for (int i = 0; i < bestp->nbranch; i++)

@@ -112,8 +112,8 @@ static const char *stderr_reason(const cf_fit_result *f)
 ** a key is present only with a value, never null. */
 static json_t *ident_json(const cf_fit_result *f, int k)
 {
-    double se = f->ident_se[k];
-    json_t *o = json_pack("{s:o}", "value", num(f->ident[k]));
+    double se = f->ident_se.v[k];
+    json_t *o = json_pack("{s:o}", "value", num(f->ident.v[k]));
     if (!o)
         return NULL;
     if (se >= 0)
@@ -200,9 +200,9 @@ static json_t *fit_json_core(const cf_fit_report *r, int i)
     json_object_set_new(o, "held_by", constraint_list(f->held));
     json_object_set_new(
         o, "extrapolation",
-        json_pack("{s:o, s:o, s:o, s:b}", fd ? "travel_mm" : "solid_strain", num(f->ident[1]),
+        json_pack("{s:o, s:o, s:o, s:b}", fd ? "travel_mm" : "solid_strain", num(f->ident.solid),
                   fd ? "largest_displacement_mm" : "largest_strain",
-                  num(f->ident[1] / f->solid_ratio), "ratio", num(f->solid_ratio), "warning",
+                  num(f->ident.solid / f->solid_ratio), "ratio", num(f->solid_ratio), "warning",
                   f->solid_ratio < CF_FIT_SOLID_RATIO_WARN));
     return o;
 }
@@ -547,18 +547,18 @@ static void ident_row(FILE *o, const cf_fit_report *r, const char *label, int k,
         const cf_fit_result *f = &r->fits[i];
         const char *sp = *unit ? " " : "";
         if (f->interval_ok[k]) {
-            const double v = f->ident[k] * scale, lo = f->interval[k][0] * scale,
+            const double v = f->ident.v[k] * scale, lo = f->interval[k][0] * scale,
                          hi = f->interval[k][1] * scale;
             const int dg = interval_digits(v, lo, hi);
             snprintf(cell, sizeof cell, "%.*g [%.*g, %.*g]*%s%s", dg > 4 ? dg : 4, v, dg, lo, dg,
                      hi, sp, unit);
         }
-        else if (f->ident_se[k] >= 0)
-            snprintf(cell, sizeof cell, "%.6g ± %.2g%s%s", f->ident[k] * scale,
-                     f->ident_se[k] * scale, sp, unit);
+        else if (f->ident_se.v[k] >= 0)
+            snprintf(cell, sizeof cell, "%.6g ± %.2g%s%s", f->ident.v[k] * scale,
+                     f->ident_se.v[k] * scale, sp, unit);
         else /* uncertainty() computes an interval wherever the error is undetermined */
             snprintf(cell, sizeof cell, "%.6g%s%s (no error: placed, not fitted)",
-                     f->ident[k] * scale, sp, unit);
+                     f->ident.v[k] * scale, sp, unit);
         fprintf(o, " %-24s", cell);
     }
     fputc('\n', o);

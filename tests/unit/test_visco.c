@@ -48,9 +48,9 @@ static cf_visco_params known(void)
 {
     cf_visco_params p;
     memset(&p, 0, sizeof p);
-    p.rho = 0.3;
-    p.solid_strain = 0.5;
-    p.stress_scale_MPa = 0.01;
+    p.ident.rho = 0.3;
+    p.ident.solid = 0.5;
+    p.ident.scale = 0.01;
     p.nbranch = 2;
     p.g[0] = 0.35;
     p.tau_s[0] = 3;
@@ -76,7 +76,7 @@ static void test_hold_relaxes_exactly(void **state)
     cf_msm_sample out[5];
     cf_error err = {0};
     assert_int_equal(cf_visco_run(&p, &s, &path, ts, 5, out, &err), CF_OK);
-    cf_spring sp = cf_spring_member(p.rho, p.solid_strain, p.stress_scale_MPa);
+    cf_spring sp = cf_ident_member(&p.ident);
     cf_law law;
     assert_int_equal(cf_law_init(&law, &sp, &err), CF_OK);
     double se = cf_law_force(&law, CF_LAW_EXACT, 0.2 * sp.H_mm, NULL, NULL) / (sp.H_mm * sp.H_mm);
@@ -100,7 +100,7 @@ static void test_zero_branches_are_elastic(void **state)
     cf_visco_series ser = {NS, t, x};
     cf_error err = {0};
     assert_int_equal(cf_visco_curve(&p, &s, &ser, y, NULL, &err), CF_OK);
-    cf_spring sp = cf_spring_member(p.rho, p.solid_strain, p.stress_scale_MPa);
+    cf_spring sp = cf_ident_member(&p.ident);
     cf_law law;
     assert_int_equal(cf_law_init(&law, &sp, &err), CF_OK);
     assert_int_equal(cf_msm_uniaxial(&law, s.method, &s.cfg, x, NS, ys, NULL, &err), CF_OK);
@@ -202,9 +202,9 @@ static void test_strained_start_is_relaxed(void **state)
 
 static void assert_recovered(const cf_visco_fit *f, const cf_visco_params *p, double tol)
 {
-    assert_close(f->p.rho, p->rho, tol * p->rho);
-    assert_close(f->p.solid_strain, p->solid_strain, tol * p->solid_strain);
-    assert_close(f->p.stress_scale_MPa, p->stress_scale_MPa, tol * p->stress_scale_MPa);
+    assert_close(f->p.ident.rho, p->ident.rho, tol * p->ident.rho);
+    assert_close(f->p.ident.solid, p->ident.solid, tol * p->ident.solid);
+    assert_close(f->p.ident.scale, p->ident.scale, tol * p->ident.scale);
     assert_int_equal(f->p.nbranch, p->nbranch);
     /* the fit may list the terms in another order: match by time constant */
     for (int i = 0; i < p->nbranch; i++) {
@@ -225,12 +225,12 @@ static void assert_within_stderr(const cf_visco_fit *f, const cf_visco_params *p
     /* an elastic quantity on a limit (rho_min, the stability bound, the design cap) has no
     ** standard error: it is set by the limit, which the fit says */
     const int on_limit[3] = {f->rho_at_limit, f->at_stability_limit, f->at_design_limit};
-    const double got[3] = {f->p.rho, f->p.solid_strain, f->p.stress_scale_MPa},
-                 want[3] = {p->rho, p->solid_strain, p->stress_scale_MPa};
+    const double got[3] = {f->p.ident.rho, f->p.ident.solid, f->p.ident.scale},
+                 want[3] = {p->ident.rho, p->ident.solid, p->ident.scale};
     for (int i = 0; i < 3; i++) {
-        assert_true(f->se_ident[i] > 0 || on_limit[i]);
-        if (f->se_ident[i] > 0)
-            assert_close(got[i], want[i], 2 * f->se_ident[i]);
+        assert_true(f->ident_se.v[i] > 0 || on_limit[i]);
+        if (f->ident_se.v[i] > 0)
+            assert_close(got[i], want[i], 2 * f->ident_se.v[i]);
     }
     for (int i = 0; i < 2; i++) {
         int j = fabs(log(f->p.tau_s[0] / p->tau_s[i])) < fabs(log(f->p.tau_s[1] / p->tau_s[i])) ? 0
@@ -255,7 +255,7 @@ static void test_recover_noiseless(void **state)
     cf_visco_fit f;
     assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_OK);
     assert_recovered(&f, &p, 1e-6);
-    assert_true(f.rmse < 1e-9 * p.stress_scale_MPa);
+    assert_true(f.rmse < 1e-9 * p.ident.scale);
     assert_int_equal(f.n_ramp, 16);
     assert_int_equal(f.n_hold, NS - 16);
     cf_visco_fit_free(&f);
@@ -342,7 +342,7 @@ static void test_strain_relaxation_recovered(void **state)
         int j = fabs(log(f.p.tau_s[0] / p.tau_s[i])) < fabs(log(f.p.tau_s[1] / p.tau_s[i])) ? 0 : 1;
         assert_close(f.p.k[j], p.k[i], 1e-6 * fabs(p.k[i]));
     }
-    assert_true(f.rmse < 1e-9 * p.stress_scale_MPa);
+    assert_true(f.rmse < 1e-9 * p.ident.scale);
     const double rmse_strain = f.rmse;
     cf_visco_fit_free(&f);
     o.relaxation = CF_RELAX_QLV;
@@ -387,9 +387,9 @@ static void test_series_refused(void **state)
     /* a held elastic fit whose solid strain is below the series' strain */
     cf_visco_fit_options o = cf_visco_fit_default_options();
     o.hold_elastic = 1;
-    o.elastic[0] = 0.3;
-    o.elastic[1] = 0.2;
-    o.elastic[2] = 0.01;
+    o.elastic.rho = 0.3;
+    o.elastic.solid = 0.2;
+    o.elastic.scale = 0.01;
     cf_visco_fit f;
     assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_E_DATA);
     assert_null(f.model_MPa);
@@ -407,9 +407,7 @@ static void held_series(const cf_visco_params *p, cf_visco_fit_options *o, doubl
     assert_int_equal(cf_visco_curve(p, &o->setup, &ser, y, NULL, &err), CF_OK);
     o->nbranch = 1;
     o->hold_elastic = 1;
-    o->elastic[0] = p->rho;
-    o->elastic[1] = p->solid_strain;
-    o->elastic[2] = p->stress_scale_MPa;
+    o->elastic = p->ident;
 }
 
 /* Holding the elastic part recovers the Prony terms alone. */
@@ -427,10 +425,10 @@ static void test_held_elastic(void **state)
     assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_OK);
     assert_int_equal(f.held_elastic, 1);
     assert_int_equal(f.k, 2);
-    assert_true(f.p.rho == p.rho && f.p.stress_scale_MPa == p.stress_scale_MPa);
+    assert_true(f.p.ident.rho == p.ident.rho && f.p.ident.scale == p.ident.scale);
     assert_close(f.p.g[0], p.g[0], 1e-6 * p.g[0]);
     assert_close(f.p.tau_s[0], p.tau_s[0], 1e-6 * p.tau_s[0]);
-    assert_close(f.se_ident[0], -1, 0);
+    assert_close(f.ident_se.rho, -1, 0);
     /* the held spring's lattice is checked as a fitted one: stable beyond the series */
     assert_true(f.stable_to_strain == 0 || f.stable_to_strain < -0.3);
     cf_visco_fit_free(&f);
@@ -443,8 +441,8 @@ static void test_held_elastic_unstable(void **state)
 {
     (void)state;
     cf_visco_params p = known();
-    p.rho = 0.1;
-    p.solid_strain = 0.35; /* the one-cell lattice needs s/H >= 0.49 at rho 0.1 to reach 0.30 */
+    p.ident.rho = 0.1;
+    p.ident.solid = 0.35; /* the one-cell lattice needs s/H >= 0.49 at rho 0.1 to reach 0.30 */
     p.nbranch = 1;
     cf_visco_fit_options o;
     double t[NS], x[NS], y[NS];
@@ -459,7 +457,8 @@ static void test_held_elastic_unstable(void **state)
     double lim = atof(at + strlen("loses stability at strain "));
     assert_true(lim < 0 && lim > -0.3);
     /* the scan agrees with the one-factorisation check on both sides of that strain */
-    cf_spring sp = cf_spring_member(p.rho, p.solid_strain, 1.0);
+    const cf_ident unit = {.rho = p.ident.rho, .solid = p.ident.solid, .scale = 1.0};
+    cf_spring sp = cf_ident_member(&unit);
     cf_law law;
     assert_int_equal(cf_law_init(&law, &sp, &err), CF_OK);
     cf_msm_config cfg = o.setup.cfg;
@@ -507,7 +506,7 @@ static void test_held_elastic_unstable(void **state)
     for (int k = 0; k < NS; k++)
         fprintf(fs, "%.17g,%.17g,%.17g\n", t[k], x[k], 1e3 * y[k]);
     fclose(fs);
-    sp = cf_spring_member(p.rho, p.solid_strain, p.stress_scale_MPa);
+    sp = cf_ident_member(&p.ident);
     assert_int_equal(cf_law_init(&law, &sp, &err), CF_OK);
     json_t *params = json_object(), *item = json_object(), *root = json_object();
     for (int k = 0; k < CF_P_COUNT; k++)
@@ -613,12 +612,8 @@ static void fit_shipped(const char *path, cf_visco_fit *f)
 static cf_visco_params shipped_truth(void)
 {
     cf_spring sp = {7.8, 15.6, 2.5, 2.6, 60, 10};
-    double id[3];
-    cf_fit_identifiable(&sp, 0, id);
     cf_visco_params p = known();
-    p.rho = id[0];
-    p.solid_strain = id[1];
-    p.stress_scale_MPa = id[2];
+    p.ident = cf_ident_of(&sp, 0);
     return p;
 }
 
@@ -706,11 +701,11 @@ static void test_stderr_coverage(void **state)
         cf_visco_fit f;
         assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_OK);
         const int j = f.p.tau_s[0] < f.p.tau_s[1] ? 0 : 1;
-        const double est[7] = {f.p.rho,    f.p.solid_strain, f.p.stress_scale_MPa, f.p.g[j],
+        const double est[7] = {f.p.ident.rho,    f.p.ident.solid, f.p.ident.scale, f.p.g[j],
                                f.p.tau_s[j], f.p.g[1 - j],     f.p.tau_s[1 - j]};
-        const double se[7] = {f.se_ident[0], f.se_ident[1],  f.se_ident[2], f.se_g[j],
+        const double se[7] = {f.ident_se.rho, f.ident_se.solid,  f.ident_se.scale, f.se_g[j],
                               f.se_tau_s[j], f.se_g[1 - j], f.se_tau_s[1 - j]};
-        const double truth[7] = {p.rho, p.solid_strain, p.stress_scale_MPa, p.g[0],
+        const double truth[7] = {p.ident.rho, p.ident.solid, p.ident.scale, p.g[0],
                                  p.tau_s[0], p.g[1], p.tau_s[1]};
         for (int i = 0; i < 7; i++) {
             assert_true(se[i] > 0);
@@ -1084,7 +1079,8 @@ static void test_export_prony(void **state)
 static void test_homogeneous_inertia(void **state)
 {
     (void)state;
-    cf_spring sp = cf_spring_member(0.05, 0.4608, 1.0);
+    const cf_ident q = {.rho = 0.05, .solid = 0.4608, .scale = 1.0};
+    cf_spring sp = cf_ident_member(&q);
     cf_law law;
     cf_error err = {0};
     assert_int_equal(cf_law_init(&law, &sp, &err), CF_OK);

@@ -16,6 +16,7 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
+#include "conifit/family.h"
 #include "conifit/fit.h"
 #include "conifit/law.h"
 #include "conifit/measure.h"
@@ -38,8 +39,8 @@ typedef struct cf_through_msm {
     double rmse_after;          /* validation RMSE of the reported spring (full lattice), MPa */
     int verified;               /* 1: the full lattice ran (uniaxial); 0: the mode is the cell's */
     double verify_max_abs;      /* largest |full lattice - cell| at the table's strains, MPa */
-    double ident_before[3];     /* rho, s/H, F_C/H^2 [MPa] of the ordinary fit */
-    double ident_after[3];      /* the same after the lattice objective */
+    cf_ident ident_before;      /* rho, s/H, F_C/H^2 [MPa] of the ordinary fit (family.h) */
+    cf_ident ident_after;       /* the same after the lattice objective */
     double wall_time_s;         /* s, the optimisation, the placement and the verification */
     long evaluations;           /* cell curves computed */
 } cf_through_msm;
