@@ -107,8 +107,8 @@ void cf_joint_free(cf_joint_result *r)
 
 /* A joint fit, stage after stage: check the tables, the springs' common reach, the search over
 ** (rho, s/H, scale) against every table's lattice curve, the placement, then each table in the
-** lattice of the placed spring. Kept as one function (~160 lines) because the stages share the
-** tables' weights, the reach and the result being filled; each stage is marked below. */
+** lattice of the placed spring. Kept as one function because the stages share the tables'
+** weights, the reach and the result being filled; each stage is marked below. */
 cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
                        const cf_validate_setup *lat, cf_spring_type type, cf_joint_result *r,
                        cf_error *err)

@@ -5,9 +5,7 @@
 
 #include <math.h>
 
-#include <gsl/gsl_blas.h>
 #include <gsl/gsl_cdf.h>
-#include <gsl/gsl_errno.h>
 
 double cf_lsq_weights(const cf_table *t, int relative, double *sw)
 {
@@ -57,30 +55,4 @@ double cf_lsq_f95(double dof)
         return f;
     double t = gsl_cdf_tdist_Pinv(0.975, dof);
     return t * t;
-}
-
-int cf_lsq_lm_iterate(gsl_multifit_nlinear_workspace *w, const cf_lsq_lm_stop *stop)
-{
-    gsl_vector *f = gsl_multifit_nlinear_residual(w);
-    double prev;
-    gsl_blas_ddot(f, f, &prev);
-    int stall = 0;
-    for (int it = 0; it < stop->max_iter; it++) {
-        int info;
-        int is = gsl_multifit_nlinear_iterate(w);
-        if (is == GSL_ENOMEM)
-            return -1;
-        if (is != GSL_SUCCESS)
-            break;
-        if (gsl_multifit_nlinear_test(stop->xtol, stop->gtol, stop->ftol, &info, w) ==
-            GSL_SUCCESS)
-            break;
-        double cur;
-        gsl_blas_ddot(f, f, &cur);
-        stall = (prev - cur <= stop->stall_rel * prev) ? stall + 1 : 0;
-        prev = cur;
-        if (stall >= stop->stall || cur <= stop->floor)
-            break;
-    }
-    return 0;
 }

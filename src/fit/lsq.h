@@ -1,8 +1,8 @@
 /*
-** Least-squares pieces shared by the fitter (fit.c), the baselines and the fits through the
-** lattice (lattice_fit.c, joint.c), so that each is defined once: the residual weights and their
-** floor, the quality measures, and the wire modulus
-** that gives a spring its solid load. Private to the library.
+** Residuals, as the fitter (fit*.c), the baselines, the viscoelastic fit and the fits through the
+** lattice (lattice_fit.c, joint.c) share them: the residual weights and their floor, the quality
+** of a model's values against a table, and the F-test on residual sums of squares. Private to
+** the library.
 */
 #ifndef CF_FIT_LSQ_H
 #define CF_FIT_LSQ_H
@@ -11,8 +11,6 @@
 
 #include "conifit/law.h"
 #include "conifit/measure.h"
-
-#include <gsl/gsl_multifit_nlinear.h>
 
 /* Relative residuals divide by max(|y|, CF_LSQ_REL_FLOOR max|y|) so that the point at the origin
 ** (y = 0) keeps a finite weight. */
@@ -42,21 +40,5 @@ double cf_lsq_f95(double dof);
 
 /* Largest |x| of the table. */
 double cf_lsq_xmax(const cf_table *t);
-
-/* When GSL's Levenberg-Marquardt iterations stop: its own test (xtol, gtol, ftol), the iteration
-** limit, and two more rules. An optimum on a bound of a logit coordinate lies at infinity, where
-** the step test never fires: stop once the sum of squares has fallen by less than stall_rel of
-** itself in `stall` iterations in a row, or once it is below `floor` (rounding level). */
-typedef struct cf_lsq_lm_stop {
-    int max_iter;
-    double xtol, gtol, ftol;
-    int stall;
-    double stall_rel;
-    double floor;
-} cf_lsq_lm_stop;
-
-/* Iterates an initialised workspace until a rule of stop fires or an iteration fails. Returns 0,
-** or -1 when an iteration ran out of memory (the position is then the last good one). */
-int cf_lsq_lm_iterate(gsl_multifit_nlinear_workspace *w, const cf_lsq_lm_stop *stop);
 
 #endif

@@ -16,6 +16,7 @@
 
 #include "conifit/msm.h"
 #include "fit/clock.h"
+#include "fit/lm.h"
 #include "fit/lsq.h"
 #include "fit/viscolimits.h"
 
@@ -40,12 +41,6 @@
 #define A_LO -30.0
 /* Relative step of the central differences for the standard errors. */
 #define SE_STEP 1e-5
-
-static double logit(double p)
-{
-    p = fmin(fmax(p, 1e-15), 1 - 1e-15);
-    return log(p / (1 - p));
-}
 
 static double expit(double z)
 {
@@ -203,8 +198,8 @@ static void pack(const ctx *c, const cf_visco_params *p, double *z)
     size_t j = 0;
     if (c->free_el) {
         const double lo = solid_lo(c, p->ident.rho);
-        z[j++] = logit((p->ident.rho - c->rho_lo) / (RHO_HI - c->rho_lo));
-        z[j++] = logit((p->ident.solid - lo) / (E_HI - lo));
+        z[j++] = cf_logit((p->ident.rho - c->rho_lo) / (RHO_HI - c->rho_lo));
+        z[j++] = cf_logit((p->ident.solid - lo) / (E_HI - lo));
     }
     double ginf = 1, left = 1, gb[CF_PRONY_MAX];
     for (int i = 0; i < c->nb; i++) {
@@ -276,16 +271,8 @@ static int lm_f(const gsl_vector *zv, void *data, gsl_vector *f)
 /* Levenberg-Marquardt from z (in place); returns the scaled sum of squares. */
 static double lm_run(ctx *c, double *z)
 {
-    gsl_multifit_nlinear_parameters fp = gsl_multifit_nlinear_default_parameters();
-    fp.trs = gsl_multifit_nlinear_trs_lm;
-    fp.scale = gsl_multifit_nlinear_scale_more;
+    gsl_multifit_nlinear_parameters fp = cf_lm_parameters();
     fp.h_df = 1e-7;
-    gsl_multifit_nlinear_workspace *w =
-        gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &fp, c->n, c->np);
-    if (!w) {
-        c->oom = 1;
-        return HUGE_VAL;
-    }
     gsl_multifit_nlinear_fdf fdf;
     memset(&fdf, 0, sizeof fdf);
     fdf.f = lm_f;
@@ -293,13 +280,18 @@ static double lm_run(ctx *c, double *z)
     fdf.n = c->n;
     fdf.p = c->np;
     fdf.params = c;
-    gsl_vector_view x0 = gsl_vector_view_array(z, c->np);
+    int init;
+    gsl_multifit_nlinear_workspace *w = cf_lm_start(&fp, &fdf, z, &init);
+    if (!w) {
+        c->oom = 1;
+        return HUGE_VAL;
+    }
     double best = HUGE_VAL;
-    if (gsl_multifit_nlinear_init(&x0.vector, &fdf, w) == GSL_SUCCESS) {
-        static const cf_lsq_lm_stop stop = {LM_MAX_ITER, 1e-14, 1e-14, 0,
-                                            LM_STALL,    LM_STALL_REL, LM_FLOOR_REL};
+    if (init == GSL_SUCCESS) {
+        static const cf_lm_stop stop = {LM_MAX_ITER, 1e-14, 1e-14, 0,
+                                        LM_STALL,    LM_STALL_REL, LM_FLOOR_REL};
         gsl_vector *f = gsl_multifit_nlinear_residual(w);
-        if (cf_lsq_lm_iterate(w, &stop) == 0)
+        if (cf_lm_iterate(w, &stop) == 0)
             gsl_blas_ddot(f, f, &best);
         else
             c->oom = 1;

@@ -98,7 +98,7 @@ cf_ident_region cf_ident_region_at(const cf_ident_design *o, cf_spring_type type
     return r;
 }
 
-/* ---- the family's curve ------------------------------------------------------------------------ */
+/* ---- the family's curve --------------------------------------------------------------------- */
 
 /* The canonical spring: D1 = rho, D2 = 1, n = 2, d = 0.5 (non-telescoping, L_min = 1), H = 2,
 ** G = 256 rho^3. */
