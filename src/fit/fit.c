@@ -18,6 +18,8 @@
 #include "fit/lsq.h"
 #include "fit/subsample.h"
 
+/* ---- names and options ----------------------------------------------------------------------- */
+
 const char *cf_fit_optimizer_name(cf_fit_optimizer o)
 {
     switch (o) {
@@ -88,6 +90,8 @@ double cf_fit_model(const cf_law *law, int force_displacement, double x)
     const double H = law->p.H_mm;
     return cf_law_force(law, CF_LAW_CLOSED, x * H, NULL, NULL) / (H * H);
 }
+
+/* ---- the checks and the working state -------------------------------------------------------- */
 
 static cf_status check_data(const cf_table *d, cf_error *err)
 {
@@ -240,6 +244,8 @@ static void ctx_free(fit_ctx *c)
 {
     free(c->sw);
 }
+
+/* ---- the fit --------------------------------------------------------------------------------- */
 
 cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                        const cf_ident *ident, cf_fit_result *res, cf_error *err)

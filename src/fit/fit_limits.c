@@ -237,6 +237,8 @@ int cf_fit_stage_a_constrained(fit_ctx *c, double v[3])
     return 1;
 }
 
+/* ---- what the limits mean for a result ------------------------------------------------------- */
+
 /* Limits the quantities v sit on (CF_C_* bits): rho_min, the travel, the type's limits. */
 unsigned cf_fit_held_at(const fit_ctx *c, const double v[3])
 {

@@ -105,10 +105,46 @@ void cf_joint_free(cf_joint_result *r)
     }
 }
 
+/* Each table in the lattice of the placed spring r->fit: the cell, and the full lattice when the
+** mode is uniaxial (the verification). */
+static cf_status verify_tables(const jctx *c, cf_joint_result *r, cf_error *err)
+{
+    cf_law law;
+    cf_status st = cf_law_init(&law, &r->fit.params, err);
+    if (st != CF_OK)
+        return st;
+    cf_validate_setup full = *c->lat;
+    memcpy(full.cfg.lattice.weight, c->weight, sizeof c->weight);
+    cf_cell cell;
+    cf_cell_init(&cell, &law, CF_LAW_CLOSED, c->weight, NULL);
+    for (size_t k = 0; k < c->n && st == CF_OK; k++) {
+        const cf_table *t = c->t[k];
+        cf_joint_table *jt = &r->tab[k];
+        if ((st = cf_cell_curve(&cell, t->mode, t->x, t->count, c->curve[k], err)) != CF_OK)
+            break;
+        jt->cell_rmse = cf_lsq_quality_of(t, c->curve[k]).rmse;
+        jt->by_cell = t->mode != CF_MODE_UNIAXIAL;
+        if (jt->by_cell)
+            memcpy(jt->lattice_MPa, c->curve[k], t->count * sizeof(double));
+        else if ((st = cf_msm_uniaxial(&law, CF_LAW_CLOSED, &full.cfg, t->x, t->count,
+                                       jt->lattice_MPa, NULL, err)) != CF_OK)
+            break;
+        jt->lattice_rmse = cf_lsq_quality_of(t, jt->lattice_MPa).rmse;
+        double ss = 0;
+        for (size_t i = 0; i < t->count; i++) {
+            double d = jt->lattice_MPa[i] - cf_fit_model(&law, 0, t->x[i]);
+            ss += d * d;
+        }
+        jt->law_rmse = t->mode == CF_MODE_UNIAXIAL ? sqrt(ss / (double)t->count) : NAN;
+    }
+    cf_law_free(&law);
+    return st;
+}
+
 /* A joint fit, stage after stage: check the tables, the springs' common reach, the search over
 ** (rho, s/H, scale) against every table's lattice curve, the placement, then each table in the
-** lattice of the placed spring. Kept as one function because the stages share the tables'
-** weights, the reach and the result being filled; each stage is marked below. */
+** lattice of the placed spring (verify_tables). Kept as one function because the stages share the
+** tables' weights, the reach and the result being filled; each stage is marked below. */
 cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
                        const cf_validate_setup *lat, cf_spring_type type, cf_joint_result *r,
                        cf_error *err)
@@ -226,36 +262,7 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
     r->calibration = lat->cfg.lattice.calibration;
     if ((st = cf_fit_place(&reach, opt, type, &r->ident, &r->fit, err)) != CF_OK)
         goto out;
-    /* Each table in the lattice of the placed spring: the cell, and the full lattice when the
-    ** mode is uniaxial (the verification). */
-    cf_law law;
-    if ((st = cf_law_init(&law, &r->fit.params, err)) != CF_OK)
-        goto out;
-    cf_validate_setup full = *lat;
-    memcpy(full.cfg.lattice.weight, c.weight, sizeof c.weight);
-    cf_cell cell;
-    cf_cell_init(&cell, &law, CF_LAW_CLOSED, c.weight, NULL);
-    for (size_t k = 0; k < n && st == CF_OK; k++) {
-        const cf_table *t = tables[k];
-        cf_joint_table *jt = &r->tab[k];
-        if ((st = cf_cell_curve(&cell, t->mode, t->x, t->count, c.curve[k], err)) != CF_OK)
-            break;
-        jt->cell_rmse = cf_lsq_quality_of(t, c.curve[k]).rmse;
-        jt->by_cell = t->mode != CF_MODE_UNIAXIAL;
-        if (jt->by_cell)
-            memcpy(jt->lattice_MPa, c.curve[k], t->count * sizeof(double));
-        else if ((st = cf_msm_uniaxial(&law, CF_LAW_CLOSED, &full.cfg, t->x, t->count,
-                                       jt->lattice_MPa, NULL, err)) != CF_OK)
-            break;
-        jt->lattice_rmse = cf_lsq_quality_of(t, jt->lattice_MPa).rmse;
-        double ss = 0;
-        for (size_t i = 0; i < t->count; i++) {
-            double d = jt->lattice_MPa[i] - cf_fit_model(&law, 0, t->x[i]);
-            ss += d * d;
-        }
-        jt->law_rmse = t->mode == CF_MODE_UNIAXIAL ? sqrt(ss / (double)t->count) : NAN;
-    }
-    cf_law_free(&law);
+    st = verify_tables(&c, r, err);
 out:
     for (size_t k = 0; k < n && k < CF_JOINT_MAX; k++) {
         free(c.sw[k]);

@@ -142,7 +142,7 @@ static double fit_nb(ctx *c, int nb, const cf_visco_params *from, cf_visco_param
     return bestobj;
 }
 
-/* ---- the fit --------------------------------------------------------------------------------- */
+/* ---- set-up and the limits of the elastic quantities ----------------------------------------- */
 
 void cf_visco_fit_free(cf_visco_fit *r)
 {
@@ -280,6 +280,8 @@ static void fit_limits(const ctx *c, const cf_visco_params *p, cf_visco_fit *res
     res->at_design_limit = held[2];
 }
 
+/* ---- the choice of the branch count ---------------------------------------------------------- */
+
 /* 1 when a positive quantity v is larger than its standard error se (se > 0: determined). */
 static int resolved(double v, double se)
 {
@@ -415,6 +417,8 @@ static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf
     c->nb = best->nbranch;
     return CF_OK;
 }
+
+/* ---- the reported model ---------------------------------------------------------------------- */
 
 /* The quality of the model curve in res->model_MPa: RSS, RMSE overall, on ramps and in holds,
 ** R^2, AIC; returns the weighted RSS. */

@@ -15,6 +15,8 @@
 
 #include "fit/viscofit_ctx.h"
 
+/* ---- the best starts ------------------------------------------------------------------------- */
+
 static void keep_start(start *best, int nbest, double obj, const cf_visco_params *p)
 {
     int pos = nbest;
@@ -36,6 +38,8 @@ static void keep_start(start *best, int nbest, double obj, const cf_visco_params
     best[pos].obj = obj;
     best[pos].p = *p;
 }
+
+/* ---- the stand-in at one grid point: non-negative least squares ------------------------------ */
 
 /* The stand-in at one grid point (rho, s/H) for one set of time constants: the elastic curve E
 ** (at unit scale, or at the held scale) and the responses of the chosen branches. The stress is
@@ -312,6 +316,8 @@ static void search_taus(ctx *c, const double *E, const double *xE, double *const
     gsl_vector_free(s.tau);
     gsl_vector_free(s.a);
 }
+
+/* ---- the grid -------------------------------------------------------------------------------- */
 
 /* Static lattice stress (table's sign) of the model's elastic part at every strain of the
 ** series, and the small-strain ratio of the lattice modulus to the spring's k0/H (the factor
