@@ -255,29 +255,30 @@ static cf_status fit_setup(ctx *c, const cf_visco_data *d, const cf_visco_fit_op
 
 /* Which limits the fitted elastic quantities sit on (rho_min, the stability bound of s/H, the
 ** design cap of F_C/H^2): held there, their standard errors are not determined. */
-static void limits_held(const ctx *c, const cf_visco_params *p, int held[3])
+static void limits_held(const ctx *c, const cf_visco_params *p, int held[CF_IDENT_COUNT])
 {
-    held[0] = held[1] = held[2] = 0;
+    held[CF_IDENT_RHO] = held[CF_IDENT_SOLID] = held[CF_IDENT_SCALE] = 0;
     if (!c->free_el)
         return;
-    held[0] = p->ident.rho <= c->rho_lo * (1 + 1e-4);
-    held[1] = c->lim.cells > 0 && cf_viscofit_solid_lo(c, p->ident.rho) > c->e_lo &&
+    held[CF_IDENT_RHO] = p->ident.rho <= c->rho_lo * (1 + 1e-4);
+    held[CF_IDENT_SOLID] = c->lim.cells > 0 && cf_viscofit_solid_lo(c, p->ident.rho) > c->e_lo &&
               p->ident.solid <= cf_viscofit_solid_lo(c, p->ident.rho) * (1 + 1e-6);
-    held[2] = p->ident.scale >=
+    held[CF_IDENT_SCALE] = p->ident.scale >=
               cf_visco_limits_scale_max(&c->lim, p->ident.rho, p->ident.solid) * (1 - 1e-9);
 }
 
 /* The limits of the fitted elastic quantities, and where the elastic lattice of the fitted (or
 ** held) spring loses stability. */
-static void fit_limits(const ctx *c, const cf_visco_params *p, cf_visco_fit *res, int held[3])
+static void fit_limits(const ctx *c, const cf_visco_params *p, cf_visco_fit *res,
+                       int held[CF_IDENT_COUNT])
 {
     res->stable_to_strain = 0;
     if (c->o->stable_cells > 0)
         res->stable_to_strain = stability_limit(c, p->ident.rho, p->ident.solid, p->ident.scale);
     limits_held(c, p, held);
-    res->rho_at_limit = held[0];
-    res->at_stability_limit = held[1];
-    res->at_design_limit = held[2];
+    res->rho_at_limit = held[CF_IDENT_RHO];
+    res->at_stability_limit = held[CF_IDENT_SOLID];
+    res->at_design_limit = held[CF_IDENT_SCALE];
 }
 
 /* ---- the choice of the branch count ---------------------------------------------------------- */
@@ -298,7 +299,7 @@ static int resolved(double v, double se)
 ** *loose gets the terms whose k_i is fitted but not larger than its error. */
 static int prony_identified(ctx *c, const cf_visco_params *p, double s2, unsigned *loose)
 {
-    int held[3];
+    int held[CF_IDENT_COUNT];
     cf_visco_fit se;
     memset(&se, 0, sizeof se);
     limits_held(c, p, held);
@@ -472,7 +473,7 @@ static cf_status fit_report(ctx *c, const cf_visco_params *bestp, cf_visco_fit *
     res->k = (c->free_el ? 3 : 0) + 2 * bestp->nbranch + cf_viscofit_strain_terms(c) + c->dash;
     double wrss = fit_quality(c, res);
     double s2 = (double)c->n > res->k ? wrss / ((double)c->n - res->k) : 0;
-    int held[3];
+    int held[CF_IDENT_COUNT];
     fit_limits(c, bestp, res, held);
     cf_viscofit_standard_errors(c, bestp, held, s2, res);
     if (c->oom)

@@ -78,7 +78,7 @@ double cf_viscofit_lm_run(ctx *c, double *z);
 int cf_viscofit_stand_in(ctx *c, start *best, int nbest);
 
 /* viscofit_se.c */
-void cf_viscofit_standard_errors(ctx *c, const cf_visco_params *p, const int held[3], double s2,
-                                 cf_visco_fit *res);
+void cf_viscofit_standard_errors(ctx *c, const cf_visco_params *p,
+                                 const int held[CF_IDENT_COUNT], double s2, cf_visco_fit *res);
 
 #endif

@@ -12,46 +12,51 @@
 
 #include "fit/viscofit_ctx.h"
 
+/* The covariance's quantities are numbered: the identifiable ones (family.h) from 0, then from Q0
+** (g_i, tau_i) per branch, the dashpot, and from QK + 2 nb the k_i. */
+#define Q0 CF_IDENT_COUNT
+#define QK (Q0 + 1)
+
 /* Quantities of the covariance, in the order rho, s/H, F_C/H^2, (g_i, tau_i) per branch, eta:
 ** the slot of quantity `which` in q, or NULL when it is not fitted or held at a limit. */
-static double *se_slot(const ctx *c, const int held[3], int which, cf_visco_params *q)
+static double *se_slot(const ctx *c, const int held[CF_IDENT_COUNT], int which, cf_visco_params *q)
 {
     const int nb = q->nbranch;
-    if (which < 3) {
+    if (which < Q0) {
         if (!c->free_el || held[which])
             return NULL;
         return &q->ident.v[which];
     }
-    if (which < 3 + 2 * nb) {
-        int i = (which - 3) / 2;
-        return (which - 3) % 2 == 0 ? &q->g[i] : &q->tau_s[i];
+    if (which < Q0 + 2 * nb) {
+        int i = (which - Q0) / 2;
+        return (which - Q0) % 2 == 0 ? &q->g[i] : &q->tau_s[i];
     }
-    if (which == 3 + 2 * nb)
+    if (which == Q0 + 2 * nb)
         return c->dash ? &q->eta_MPa_s : NULL;
-    return cf_viscofit_strain_term(c, which - 4 - 2 * nb) ? &q->k[which - 4 - 2 * nb] : NULL;
+    return cf_viscofit_strain_term(c, which - QK - 2 * nb) ? &q->k[which - QK - 2 * nb] : NULL;
 }
 
 /* One column of the Jacobian: the weighted central difference of the model in quantity `which`,
 ** its steps kept inside the quantity's domain. 0 when the model cannot be evaluated. */
-static int se_column(ctx *c, const cf_visco_params *p, const int held[3], int which,
+static int se_column(ctx *c, const cf_visco_params *p, const int held[CF_IDENT_COUNT], int which,
                      gsl_matrix *J, size_t col, double *mp, double *mm)
 {
     cf_visco_params q = *p;
     double *slot = se_slot(c, held, which, &q);
     const double v = *slot;
-    const int is_g = which >= 3 && which < 3 + 2 * p->nbranch && (which - 3) % 2 == 0;
+    const int is_g = which >= Q0 && which < Q0 + 2 * p->nbranch && (which - Q0) % 2 == 0;
     double h = SE_STEP * fmax(fabs(v), is_g ? 1e-2 : 1e-300);
     double hp = h, hm = h;
-    if (which == 0) { /* keep rho inside (0, 1] */
+    if (which == CF_IDENT_RHO) { /* keep rho inside (0, 1] */
         hp = fmin(h, 1 - v);
         hm = fmin(h, 0.5 * v);
-    } else if (which == 1) { /* s/H inside (largest strain, 1) */
+    } else if (which == CF_IDENT_SOLID) { /* s/H inside (largest strain, 1) */
         hm = fmin(h, 0.5 * (v - c->xmax));
         hp = fmin(h, 0.5 * (1 - v));
-    } else if (which >= 3 && (is_g || which > 3 + 2 * p->nbranch)) {
+    } else if (which >= Q0 && (is_g || which > Q0 + 2 * p->nbranch)) {
         /* a relative modulus or its slope: every g_i(x) >= 0 and their sum below 1 at x = 0 and
         ** at the largest strain x_max (one-sided next to a limit, as the fit may sit on it) */
-        const int i = is_g ? (which - 3) / 2 : which - 4 - 2 * p->nbranch;
+        const int i = is_g ? (which - Q0) / 2 : which - QK - 2 * p->nbranch;
         double sum0 = 0, sum1 = 0;
         for (int j = 0; j < p->nbranch; j++) {
             sum0 += p->g[j];
@@ -87,30 +92,30 @@ static int se_column(ctx *c, const cf_visco_params *p, const int held[3], int wh
 /* Stores the standard error se of quantity `which` in res. */
 static void se_store(int which, int nb, double se, cf_visco_fit *res)
 {
-    if (which < 3)
+    if (which < Q0)
         res->ident_se.v[which] = se;
-    else if (which < 3 + 2 * nb)
-        *((which - 3) % 2 == 0 ? &res->se_g[(which - 3) / 2] : &res->se_tau_s[(which - 3) / 2]) =
+    else if (which < Q0 + 2 * nb)
+        *((which - Q0) % 2 == 0 ? &res->se_g[(which - Q0) / 2] : &res->se_tau_s[(which - Q0) / 2]) =
             se;
-    else if (which == 3 + 2 * nb)
+    else if (which == Q0 + 2 * nb)
         res->se_eta_MPa_s = se;
     else
-        res->se_k[which - 4 - 2 * nb] = se;
+        res->se_k[which - QK - 2 * nb] = se;
 }
 
 /* Central-difference Jacobian of the weighted model in the reported quantities at p, and the
 ** covariance s^2 (J^T W J)^-1. A quantity on a limit (held[]: rho on rho_min, s/H on the
 ** stability bound, the scale on the design cap) is set by the limit, not by the data: it is held
 ** here (its error undetermined), or the others' errors would carry its freedom along the limit. */
-void cf_viscofit_standard_errors(ctx *c, const cf_visco_params *p, const int held[3], double s2,
-                            cf_visco_fit *res)
+void cf_viscofit_standard_errors(ctx *c, const cf_visco_params *p,
+                                 const int held[CF_IDENT_COUNT], double s2, cf_visco_fit *res)
 {
-    for (int i = 0; i < 3; i++)
+    for (int i = 0; i < CF_IDENT_COUNT; i++)
         res->ident_se.v[i] = -1;
     for (int i = 0; i < CF_PRONY_MAX; i++)
         res->se_g[i] = res->se_tau_s[i] = res->se_k[i] = res->se_g_max[i] = -1;
     res->se_eta_MPa_s = -1;
-    const int nq = 3 + 2 * p->nbranch + 1 + (c->gs ? p->nbranch : 0);
+    const int nq = Q0 + 2 * p->nbranch + 1 + (c->gs ? p->nbranch : 0);
     cf_visco_params q = *p;
     size_t k = 0;
     for (int which = 0; which < nq; which++)
@@ -128,7 +133,7 @@ void cf_viscofit_standard_errors(ctx *c, const cf_visco_params *p, const int hel
     const int cs = ok ? gsl_multifit_nlinear_covar(J, 1e-13, cov) : GSL_FAILURE;
     c->oom |= cs == GSL_ENOMEM;
     if (cs == GSL_SUCCESS) {
-        int colof[3 + 3 * CF_PRONY_MAX + 1];
+        int colof[Q0 + 3 * CF_PRONY_MAX + 1];
         col = 0;
         for (int which = 0; which < nq; which++) {
             colof[which] = -1;
@@ -141,7 +146,7 @@ void cf_viscofit_standard_errors(ctx *c, const cf_visco_params *p, const int hel
         /* each term's modulus at the largest strain, g_i + k_i x_max: its variance with the
         ** covariance of g_i and k_i */
         for (int i = 0; i < p->nbranch; i++) {
-            const int cg = colof[3 + 2 * i], ck = c->gs ? colof[4 + 2 * p->nbranch + i] : -1;
+            const int cg = colof[Q0 + 2 * i], ck = c->gs ? colof[QK + 2 * p->nbranch + i] : -1;
             if (cg < 0 || ck < 0) {
                 res->se_g_max[i] = cg < 0 ? -1 : res->se_g[i];
                 continue;
