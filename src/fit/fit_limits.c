@@ -142,8 +142,8 @@ double cf_fit_sub_g0(const sub *q, const double *x)
     return g;
 }
 
-/* Minimises the sub-problem from x (in/out); returns its RSS, CF_LSQ_HUGE_OBJ when no point meets the
-** limits. */
+/* Minimises the sub-problem from x (in/out); returns its RSS, CF_LSQ_HUGE_OBJ when no point meets
+** the limits. */
 double cf_fit_sub_solve(fit_ctx *c, sub *q, double *x, nlopt_algorithm alg)
 {
     unsigned nv = q->fixed < 0 ? 2u : q->fixed == 2 ? 2u : 1u;
@@ -291,8 +291,8 @@ int cf_fit_region_member(fit_ctx *c, const double v[3], double *p)
             double s = B * H, Lmin = H - s;
             double d = c->type == CF_TELESCOPING ? Lmin : Lmin / n;
             double D1 = cidx * d, FC = v[2] * H * H;
-            double q[CF_P_COUNT] = {D1, D1 / rho, n, d, 8 * n * D1 * D1 * D1 * FC / (d * d * d * d * s),
-                                    H};
+            double q[CF_P_COUNT] = {
+                D1, D1 / rho, n, d, 8 * n * D1 * D1 * D1 * FC / (d * d * d * d * s), H};
             cf_spring sp = from_array(q);
             if (!cf_fit_check_at(c, &sp, NULL, NULL))
                 continue;

@@ -18,7 +18,8 @@ void cf_fit_stage_a_polish(fit_ctx *c, start4 *found, int nfound, double v[3])
 {
     qsort(found, (size_t)nfound, sizeof found[0], cf_fit_cmp_start4);
     const double er = 1e-12 * (c->rho_hi - c->rho_lo), eb = 1e-12 * (c->b_hi - c->b_lo);
-    const double dof = (double)c->n - 3, within = nfound > 0 ? found[0].obj * (1 + cf_lsq_f95(dof) / dof) : 0;
+    const double dof = (double)c->n - 3;
+    const double within = nfound > 0 ? found[0].obj * (1 + cf_lsq_f95(dof) / dof) : 0;
     double best = CF_LSQ_HUGE_OBJ;
     int done = 0;
     for (int i = 0; i < nfound && done < POLISH_RUNS && (i == 0 || found[i].obj <= within); i++) {

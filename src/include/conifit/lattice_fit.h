@@ -34,7 +34,8 @@ typedef struct cf_validate_setup {
 typedef struct cf_through_msm {
     int done;                   /* 1: run */
     int improved;               /* 1: the spring was replaced (the lattice fits better) */
-    double rmse_before;         /* RMSE of the ordinary fit in the lattice (homogenised cell), MPa */
+    double rmse_before;         /* RMSE of the ordinary fit in the lattice (homogenised cell),
+                                ** MPa */
     double cell_rmse;           /* RMSE of the reported spring through the cell: the fit's, MPa */
     double rmse_after;          /* validation RMSE of the reported spring (full lattice), MPa */
     int verified;               /* 1: the full lattice ran (uniaxial); 0: the mode is the cell's */
