@@ -86,7 +86,7 @@ static void fit_warnings(const char *file, const cf_fit_report *r, const cf_fit_
         fprintf(stderr,
                 "conifit: warning: %s: the %s law goes solid at %s %.4g, %.3g times the table's "
                 "largest (below %.1f): it stiffens without bound just past the data\n",
-                file, type, cf_table_is_force(r->table) ? "displacement [mm]" : "strain", f->ident[1],
+                file, type, cf_table_is_force(r->table) ? "displacement [mm]" : "strain", f->ident.solid,
                 f->solid_ratio, CF_FIT_SOLID_RATIO_WARN);
 }
 
@@ -249,7 +249,7 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
         if (cf_fitfile_load_spec(a->elastic, &fs, &err) != CF_OK) {
             rc = cf_cli_fail(&err);
         } else {
-            cf_fit_identifiable(&fs.params, 0, a->vopt.elastic);
+            a->vopt.elastic = cf_ident_of(&fs.params, 0);
             a->vopt.hold_elastic = 1;
         }
     }

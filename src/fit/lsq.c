@@ -5,9 +5,7 @@
 
 #include <math.h>
 
-#include <gsl/gsl_blas.h>
 #include <gsl/gsl_cdf.h>
-#include <gsl/gsl_errno.h>
 
 double cf_lsq_weights(const cf_table *t, int relative, double *sw)
 {
@@ -42,23 +40,12 @@ cf_lsq_quality cf_lsq_quality_of(const cf_table *t, const double *model)
     return q;
 }
 
-double cf_lsq_rho_hi(cf_spring_type type, double index_max)
-{
-    return type == CF_TELESCOPING ? index_max / (index_max + 4) * (1 - 1e-6) : 1.0;
-}
-
 double cf_lsq_xmax(const cf_table *t)
 {
     double m = 0;
     for (size_t i = 0; i < t->count; i++)
         m = fmax(m, fabs(t->x[i]));
     return m;
-}
-
-double cf_lsq_G_of_FC(double F_C_N, double n, double D1_mm, double d_mm, double s_mm)
-{
-    const double d2 = d_mm * d_mm;
-    return 8 * n * D1_mm * D1_mm * D1_mm * F_C_N / (d2 * d2 * s_mm);
 }
 
 double cf_lsq_f95(double dof)
@@ -68,30 +55,4 @@ double cf_lsq_f95(double dof)
         return f;
     double t = gsl_cdf_tdist_Pinv(0.975, dof);
     return t * t;
-}
-
-int cf_lsq_lm_iterate(gsl_multifit_nlinear_workspace *w, const cf_lsq_lm_stop *stop)
-{
-    gsl_vector *f = gsl_multifit_nlinear_residual(w);
-    double prev;
-    gsl_blas_ddot(f, f, &prev);
-    int stall = 0;
-    for (int it = 0; it < stop->max_iter; it++) {
-        int info;
-        int is = gsl_multifit_nlinear_iterate(w);
-        if (is == GSL_ENOMEM)
-            return -1;
-        if (is != GSL_SUCCESS)
-            break;
-        if (gsl_multifit_nlinear_test(stop->xtol, stop->gtol, stop->ftol, &info, w) ==
-            GSL_SUCCESS)
-            break;
-        double cur;
-        gsl_blas_ddot(f, f, &cur);
-        stall = (prev - cur <= stop->stall_rel * prev) ? stall + 1 : 0;
-        prev = cur;
-        if (stall >= stop->stall || cur <= stop->floor)
-            break;
-    }
-    return 0;
 }

@@ -1,8 +1,8 @@
 /*
-** Least-squares pieces shared by the fitter (fit.c), the baselines and the fit through the
-** lattice (check/validate.c), so that each is defined once: the residual weights and their floor,
-** the bounds of the diameter ratio searched, the quality measures, and the wire modulus that
-** gives a spring its solid load. Private to the library.
+** Residuals, as the fitter (fit*.c), the baselines, the viscoelastic fit and the fits through the
+** lattice (lattice_fit.c, joint.c) share them: the residual weights and their floor, the quality
+** of a model's values against a table, and the F-test on residual sums of squares. Private to
+** the library.
 */
 #ifndef CF_FIT_LSQ_H
 #define CF_FIT_LSQ_H
@@ -12,14 +12,9 @@
 #include "conifit/law.h"
 #include "conifit/measure.h"
 
-#include <gsl/gsl_multifit_nlinear.h>
-
 /* Relative residuals divide by max(|y|, CF_LSQ_REL_FLOOR max|y|) so that the point at the origin
 ** (y = 0) keeps a finite weight. */
 #define CF_LSQ_REL_FLOOR 1e-3
-/* Lowest diameter ratio searched: rho = 1e-3 is a spring whose largest coil is a thousand times
-** its smallest, far beyond any wound spring. */
-#define CF_LSQ_RHO_LO 1e-3
 /* Objective value returned where the model cannot be evaluated (an invalid spring, a lattice
 ** that does not converge). */
 #define CF_LSQ_HUGE_OBJ 1e30
@@ -38,11 +33,6 @@ typedef struct cf_lsq_quality {
 
 cf_lsq_quality cf_lsq_quality_of(const cf_table *t, const double *model);
 
-/* Largest diameter ratio of a spring type: telescoping needs n <= c (1 - rho)/(2 rho) with
-** n >= 2 and c <= index_max, so rho <= index_max/(index_max + 4) (less a hair); non-telescoping
-** reaches the cylinder, 1. */
-double cf_lsq_rho_hi(cf_spring_type type, double index_max);
-
 /* F(0.95; 1, dof), the 95 % quantile of the F distribution with 1 and dof degrees of freedom:
 ** GSL's inverse where it converges, else the square of Student's t(0.975; dof), which it equals
 ** (GSL 2.7's gsl_cdf_fdist_Pinv fails for some large dof, e.g. 4997 and 1e5, and returns NaN). */
@@ -50,25 +40,5 @@ double cf_lsq_f95(double dof);
 
 /* Largest |x| of the table. */
 double cf_lsq_xmax(const cf_table *t);
-
-/* The wire modulus G (MPa) that gives a spring of n coils, smallest coil D1, wire d and travel s
-** (mm) the solid load F_C (N): F_C = G d^4 s / (8 n D1^3). */
-double cf_lsq_G_of_FC(double F_C_N, double n, double D1_mm, double d_mm, double s_mm);
-
-/* When GSL's Levenberg-Marquardt iterations stop: its own test (xtol, gtol, ftol), the iteration
-** limit, and two more rules. An optimum on a bound of a logit coordinate lies at infinity, where
-** the step test never fires: stop once the sum of squares has fallen by less than stall_rel of
-** itself in `stall` iterations in a row, or once it is below `floor` (rounding level). */
-typedef struct cf_lsq_lm_stop {
-    int max_iter;
-    double xtol, gtol, ftol;
-    int stall;
-    double stall_rel;
-    double floor;
-} cf_lsq_lm_stop;
-
-/* Iterates an initialised workspace until a rule of stop fires or an iteration fails. Returns 0,
-** or -1 when an iteration ran out of memory (the position is then the last good one). */
-int cf_lsq_lm_iterate(gsl_multifit_nlinear_workspace *w, const cf_lsq_lm_stop *stop);
 
 #endif

@@ -21,7 +21,8 @@ int cf_visco_limits_stable(const cf_visco_limits *l, double rho, double B)
 {
     if (l->cells <= 0)
         return 1;
-    cf_spring sp = cf_spring_member(rho, B, 1.0);
+    const cf_ident q = {.rho = rho, .solid = B, .scale = 1.0};
+    cf_spring sp = cf_ident_member(&q);
     cf_law law;
     cf_error e = {0};
     if (cf_law_init(&law, &sp, &e) != CF_OK)

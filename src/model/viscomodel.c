@@ -19,17 +19,6 @@ cf_visco_setup cf_visco_default(void)
     return s;
 }
 
-cf_spring cf_spring_member(double rho, double e, double A)
-{
-    /* non-telescoping with n = 2, d = L_min/2 and D2 = L_min/(1 - rho), so that (D2 - D1)/2 =
-    ** L_min/2 stays below n d = L_min */
-    const double H = 1.0, Lmin = H * (1 - e), s = H * e, n = 2.0, dw = Lmin / n;
-    const double D2 = rho < 1 ? Lmin / (1 - rho) : Lmin, D1 = rho * D2;
-    const double FC = A * H * H, d2 = dw * dw;
-    cf_spring p = {D1, D2, n, dw, 8 * n * D1 * D1 * D1 * FC / (d2 * d2 * s), H};
-    return p;
-}
-
 cf_msm_effects cf_visco_effects(const cf_visco_params *p)
 {
     cf_msm_effects fx;
@@ -46,14 +35,14 @@ cf_msm_effects cf_visco_effects(const cf_visco_params *p)
 
 static cf_status check_params(const cf_visco_params *p, cf_error *err)
 {
-    if (!(p->rho > 0 && p->rho <= 1))
-        return cf_error_set(err, CF_E_DATA, "rho = %g: must be in (0, 1]", p->rho);
-    if (!(p->solid_strain > 0 && p->solid_strain < 1))
+    if (!(p->ident.rho > 0 && p->ident.rho <= 1))
+        return cf_error_set(err, CF_E_DATA, "rho = %g: must be in (0, 1]", p->ident.rho);
+    if (!(p->ident.solid > 0 && p->ident.solid < 1))
         return cf_error_set(err, CF_E_DATA, "solid strain = %g: must be in (0, 1)",
-                            p->solid_strain);
-    if (!(p->stress_scale_MPa > 0) || !isfinite(p->stress_scale_MPa))
+                            p->ident.solid);
+    if (!(p->ident.scale > 0) || !isfinite(p->ident.scale))
         return cf_error_set(err, CF_E_DATA, "stress scale = %g MPa: must be finite and > 0",
-                            p->stress_scale_MPa);
+                            p->ident.scale);
     if (!(p->eta_MPa_s >= 0) || !isfinite(p->eta_MPa_s))
         return cf_error_set(err, CF_E_DATA, "dashpot eta = %g MPa s: must be finite and >= 0",
                             p->eta_MPa_s);
@@ -65,7 +54,7 @@ static cf_status check_params(const cf_visco_params *p, cf_error *err)
 }
 
 
-/* The law of the model's spring (cf_spring_member) after checking p, with its table when s
+/* The law of the model's spring (cf_ident_member) after checking p, with its table when s
 ** asks for one. */
 static cf_status member_law(const cf_visco_params *p, const cf_visco_setup *s, cf_law *law,
                             cf_error *err)
@@ -73,7 +62,7 @@ static cf_status member_law(const cf_visco_params *p, const cf_visco_setup *s, c
     cf_status st = check_params(p, err);
     if (st != CF_OK)
         return st;
-    cf_spring sp = cf_spring_member(p->rho, p->solid_strain, p->stress_scale_MPa);
+    cf_spring sp = cf_ident_member(&p->ident);
     st = cf_law_init(law, &sp, err);
     if (st == CF_OK && s->method == CF_LAW_TABLE &&
         (st = cf_law_table_build(law, CF_LAW_TABLE_DEFAULT, err)) != CF_OK)

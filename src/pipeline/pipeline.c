@@ -76,8 +76,8 @@ static cf_status validate_fits(const cf_table *t, const cf_pipeline_options *opt
             cf_validate_run(&r->fits[k].params, &opt->lattice, t, &r->val[k], &verr);
         } else {
             progress(opt, t, "fitting the %s spring through the lattice", type);
-            cf_validate_through_msm(t, &opt->fit, &opt->lattice, &r->fits[k], &r->val[k],
-                                    &r->thr[k], &verr);
+            cf_lattice_fit(t, &opt->fit, &opt->lattice, &r->fits[k], &r->thr[k], &verr);
+            cf_validate_lattice_fit(t, &opt->lattice, &r->fits[k], &r->val[k], &r->thr[k], &verr);
         }
         if (verr.status == CF_E_INTERNAL)
             return cf_error_set(err, CF_E_INTERNAL, "%s: %s", t->path, verr.msg);

@@ -11,20 +11,19 @@
 #include "pipeline/outputs.h"
 
 /* The reported spring must carry the fitted model: a placement that the design limits pushed off
-** the fitted rho, s/H, F_C/H^2 is replaced by the spring of cf_spring_member scaled to the
+** the fitted rho, s/H, F_C/H^2 is replaced by the spring of cf_ident_member scaled to the
 ** preferred free length (all lengths scaled, G kept: the three quantities are unchanged), checked
 ** against the same limits (so reported infeasible where they bind). 0 when no spring results. */
-static int exact_member(const cf_table *t, const cf_pipeline_options *opt, const double ident[3],
+static int exact_member(const cf_table *t, const cf_pipeline_options *opt, const cf_ident *ident,
                         cf_fit_result *f)
 {
-    double got[3];
-    cf_fit_identifiable(&f->params, 0, got);
+    const cf_ident got = cf_ident_of(&f->params, 0);
     int same = 1;
-    for (int k = 0; k < 3; k++)
-        same = same && fabs(got[k] - ident[k]) <= 1e-9 * fabs(ident[k]);
+    for (int k = 0; k < CF_IDENT_COUNT; k++)
+        same = same && fabs(got.v[k] - ident->v[k]) <= 1e-9 * fabs(ident->v[k]);
     if (same)
         return 1;
-    cf_spring p = cf_spring_member(ident[0], ident[1], ident[2]);
+    cf_spring p = cf_ident_member(ident);
     const double h = opt->fit.H_preferred_mm > 0 ? opt->fit.H_preferred_mm / p.H_mm : 10.0;
     p.D1_mm *= h;
     p.D2_mm *= h;
@@ -74,7 +73,7 @@ cf_status cf_pipeline_fit_series(const cf_table *t, const cf_pipeline_options *o
     ** (the member is non-telescoping: a telescoping placement the limits pushed off the fitted
     ** quantities is dropped, not reported as a non-telescoping spring in place of the
     ** non-telescoping placement) */
-    const double ident[3] = {r->fit.p.rho, r->fit.p.solid_strain, r->fit.p.stress_scale_MPa};
+    const cf_ident *ident = &r->fit.p.ident;
     for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING; ty++) {
         cf_error pe = {0};
         if ((opt->types & (1u << ty)) &&
@@ -87,7 +86,7 @@ cf_status cf_pipeline_fit_series(const cf_table *t, const cf_pipeline_options *o
         cf_visco_report_free(r);
         return cf_error_set(err, CF_E_DATA,
                             "%s: no spring of the requested type has rho = %.6g, s/H = %.6g",
-                            t->path, ident[0], ident[1]);
+                            t->path, ident->rho, ident->solid);
     }
     return CF_OK;
 }

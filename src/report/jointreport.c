@@ -46,7 +46,7 @@ char *cf_joint_text(const cf_joint_report *r)
                 j->fit.feasible ? "" : " (violates its constraints)");
         fprintf(o, " lattice: rho %.4g, solid strain s/H %.4g, stress scale F_C/H^2 %.4g kPa; "
                    "calibration %s (weights edge %.4g, face %.4g, body %.4g; nu %.3f)\n",
-                j->ident[0], j->ident[1], j->ident[2] * 1e3, cf_calibration_name(j->calibration),
+                j->ident.rho, j->ident.solid, j->ident.scale * 1e3, cf_calibration_name(j->calibration),
                 j->weight[0], j->weight[1], j->weight[2], cm.nu);
         fprintf(o, "  %-44s %-12s %6s %14s %14s %14s\n", "table", "mode", "points", "fit RMSE",
                 "lattice RMSE", "vs law");
@@ -107,8 +107,8 @@ static json_t *joint_json(const cf_joint_report *r)
             continue;
         cf_cubic_moduli cm = cf_cubic_moduli_of(j->weight);
         json_object_set_new(f, "identifiable",
-                            json_pack("{s:o, s:o, s:o}", "rho", num(j->ident[0]), "solid_strain",
-                                      num(j->ident[1]), "stress_scale_MPa", num(j->ident[2])));
+                            json_pack("{s:o, s:o, s:o}", "rho", num(j->ident.rho), "solid_strain",
+                                      num(j->ident.solid), "stress_scale_MPa", num(j->ident.scale)));
         json_object_set_new(
             f, "lattice",
             json_pack("{s:s, s:{s:o, s:o, s:o}, s:o, s:o}", "calibration",

@@ -77,8 +77,8 @@ static const char *stderr_reason(const cf_fit_result *f)
 ** a key is present only with a value, never null. */
 static json_t *ident_json(const cf_fit_result *f, int k)
 {
-    double se = f->ident_se[k];
-    json_t *o = json_pack("{s:o}", "value", num(f->ident[k]));
+    double se = f->ident_se.v[k];
+    json_t *o = json_pack("{s:o}", "value", num(f->ident.v[k]));
     if (!o)
         return NULL;
     if (se >= 0)
@@ -165,9 +165,9 @@ static json_t *fit_json_core(const cf_fit_report *r, int i)
     json_object_set_new(o, "held_by", constraint_list(f->held));
     json_object_set_new(
         o, "extrapolation",
-        json_pack("{s:o, s:o, s:o, s:b}", fd ? "travel_mm" : "solid_strain", num(f->ident[1]),
+        json_pack("{s:o, s:o, s:o, s:b}", fd ? "travel_mm" : "solid_strain", num(f->ident.solid),
                   fd ? "largest_displacement_mm" : "largest_strain",
-                  num(f->ident[1] / f->solid_ratio), "ratio", num(f->solid_ratio), "warning",
+                  num(f->ident.solid / f->solid_ratio), "ratio", num(f->solid_ratio), "warning",
                   f->solid_ratio < CF_FIT_SOLID_RATIO_WARN));
     return o;
 }

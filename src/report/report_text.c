@@ -64,18 +64,18 @@ static void ident_row(FILE *o, const cf_fit_report *r, const char *label, int k,
         const cf_fit_result *f = &r->fits[i];
         const char *sp = *unit ? " " : "";
         if (f->interval_ok[k]) {
-            const double v = f->ident[k] * scale, lo = f->interval[k][0] * scale,
+            const double v = f->ident.v[k] * scale, lo = f->interval[k][0] * scale,
                          hi = f->interval[k][1] * scale;
             const int dg = interval_digits(v, lo, hi);
             snprintf(cell, sizeof cell, "%.*g [%.*g, %.*g]*%s%s", dg > 4 ? dg : 4, v, dg, lo, dg,
                      hi, sp, unit);
         }
-        else if (f->ident_se[k] >= 0)
-            snprintf(cell, sizeof cell, "%.6g ± %.2g%s%s", f->ident[k] * scale,
-                     f->ident_se[k] * scale, sp, unit);
+        else if (f->ident_se.v[k] >= 0)
+            snprintf(cell, sizeof cell, "%.6g ± %.2g%s%s", f->ident.v[k] * scale,
+                     f->ident_se.v[k] * scale, sp, unit);
         else /* uncertainty() computes an interval wherever the error is undetermined */
             snprintf(cell, sizeof cell, "%.6g%s%s (no error: placed, not fitted)",
-                     f->ident[k] * scale, sp, unit);
+                     f->ident.v[k] * scale, sp, unit);
         fprintf(o, " %-24s", cell);
     }
     fputc('\n', o);

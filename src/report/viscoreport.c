@@ -161,12 +161,12 @@ static json_t *fit_json(const cf_visco_report *r, int i)
     const cf_fit_result *f = &r->placed[i];
     const cf_visco_fit *v = &r->fit;
     json_t *o = cf_fitfile_spring_json(&f->law);
-    json_t *id = json_pack("{s:{s:o}, s:{s:o}, s:{s:o}}", "rho", "value", num(v->p.rho),
-                           "solid_strain", "value", num(v->p.solid_strain), "stress_scale_MPa",
-                           "value", num(v->p.stress_scale_MPa));
-    set_se(json_object_get(id, "rho"), "stderr", v->se_ident[0], 1);
-    set_se(json_object_get(id, "solid_strain"), "stderr", v->se_ident[1], 1);
-    set_se(json_object_get(id, "stress_scale_MPa"), "stderr", v->se_ident[2], 1);
+    json_t *id = json_pack("{s:{s:o}, s:{s:o}, s:{s:o}}", "rho", "value", num(v->p.ident.rho),
+                           "solid_strain", "value", num(v->p.ident.solid), "stress_scale_MPa",
+                           "value", num(v->p.ident.scale));
+    set_se(json_object_get(id, "rho"), "stderr", v->ident_se.rho, 1);
+    set_se(json_object_get(id, "solid_strain"), "stderr", v->ident_se.solid, 1);
+    set_se(json_object_get(id, "stress_scale_MPa"), "stderr", v->ident_se.scale, 1);
     json_t *rest = json_pack("{s:o, s:b, s:o, s:o}", "identifiable", id, "feasible", f->feasible,
                              "active_constraints", constraints(f->active), "violated_constraints",
                              constraints(f->violated));
@@ -311,13 +311,13 @@ char *cf_visco_report_text(const cf_visco_report *r)
                    "this model (a standard error as large as its value, or '?' below); fewer "
                    "terms (--branches) or --relaxation qlv\n");
     fprintf(o, " elastic part%s:\n", f->held_elastic ? " (held from --elastic)" : "");
-    value_se_text(o, f->rho_at_limit ? "rho = D1/D2 (at --rho-min)" : "rho = D1/D2", f->p.rho,
-                  f->se_ident[0], 1, "");
+    value_se_text(o, f->rho_at_limit ? "rho = D1/D2 (at --rho-min)" : "rho = D1/D2", f->p.ident.rho,
+                  f->ident_se.rho, 1, "");
     value_se_text(o, f->at_stability_limit ? "solid strain s/H (at the stability limit)"
                                            : "solid strain s/H",
-                  f->p.solid_strain, f->se_ident[1], 1, "");
+                  f->p.ident.solid, f->ident_se.solid, 1, "");
     value_se_text(o, f->at_design_limit ? "F_C/H^2 (at the design limit)" : "stress scale F_C/H^2",
-                  f->p.stress_scale_MPa, f->se_ident[2], u, r->table->y_unit);
+                  f->p.ident.scale, f->ident_se.scale, u, r->table->y_unit);
     if (f->stable_to_strain != 0)
         fprintf(o, "  elastic lattice stable to strain %.4g (one cell; larger lattices further)\n",
                 f->stable_to_strain);

@@ -203,7 +203,8 @@ static void through_lattice(bench_ctx *ctx)
             if (ok) {
                 fit_rmse = res.rmse * m.y_to_file;
                 t0 = bench_now();
-                ok = cf_validate_through_msm(&d, &opt, &vs, &res, &v, &t, &err) == CF_OK;
+                ok = cf_lattice_fit(&d, &opt, &vs, &res, &t, &err) == CF_OK &&
+                     cf_validate_lattice_fit(&d, &vs, &res, &v, &t, &err) == CF_OK;
                 t_msm[r] = bench_now() - t0;
                 rmse0 = t.rmse_before * m.y_to_file;
                 rmse1 = t.rmse_after * m.y_to_file;

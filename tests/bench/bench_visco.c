@@ -31,9 +31,9 @@ static cf_visco_params truth(int nb)
     static const double g[4] = {0.3, 0.2, 0.1, 0.05}, tau[4] = {1.5, 8, 40, 200};
     cf_visco_params p;
     memset(&p, 0, sizeof p);
-    p.rho = 0.3;
-    p.solid_strain = 0.5;
-    p.stress_scale_MPa = 0.01;
+    p.ident.rho = 0.3;
+    p.ident.solid = 0.5;
+    p.ident.scale = 0.01;
     p.nbranch = nb;
     for (int i = 0; i < nb; i++) {
         p.g[i] = g[i];

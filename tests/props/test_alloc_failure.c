@@ -169,7 +169,7 @@ static void lattice_build_survives_allocation_failures(void **state)
     inject(args, total > 80 ? total - 80 : 1, total, 3, 1);
 }
 
-/* The viscoelastic fit's Levenberg-Marquardt loop (cf_lsq_lm_iterate as viscofit calls it) and
+/* The viscoelastic fit's Levenberg-Marquardt loop (cf_lm_iterate as viscofit calls it) and
 ** the model curves it computes: an allocation that fails while the loop runs ends the fit with 70
 ** and a message, and no file. (A failed curve inside the loop was taken for a bad point and the
 ** fit went on to a different result with exit 0; a failed iteration dropped its start.) */
@@ -185,14 +185,14 @@ static void visco_fit_lm_loop_survives_allocation_failures(void **state)
     while (fgets(line, sizeof line, p)) {
         char a[40], b[40], t[8], name[128];
         if (sscanf(line, "%39s %39s %7s %127s", a, b, t, name) == 4 &&
-            strcmp(name, "cf_lsq_lm_iterate") == 0) {
+            strcmp(name, "cf_lm_iterate") == 0) {
             strcpy(start, a);
             strcpy(size, b);
         }
     }
     pclose(p);
     if (!start[0])
-        fail_msg("cf_lsq_lm_iterate not found by '%s'", cmd);
+        fail_msg("cf_lm_iterate not found by '%s'", cmd);
     snprintf(within, sizeof within, "CF_FAIL_ALLOC_WITHIN=%s:%s ", start, size);
     char args[800];
     snprintf(args, sizeof args,

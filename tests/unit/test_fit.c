@@ -120,10 +120,9 @@ static void assert_recovers(const cf_spring *truth, cf_spring_type type, double 
     cf_fit_options o = cf_fit_default_options();
     cf_fit_result r;
     fit_ok(&d, &o, type, &r);
-    double id[3];
-    cf_fit_identifiable(truth, 0, id);
-    for (int k = 0; k < 3; k++)
-        assert_close(r.ident[k], id[k], 1e-6 * id[k]);
+    const cf_ident id = cf_ident_of(truth, 0);
+    for (int k = 0; k < CF_IDENT_COUNT; k++)
+        assert_close(r.ident.v[k], id.v[k], 1e-6 * id.v[k]);
     double smax = fabs(t.y[t.n - 1]);
     assert_true(r.rmse <= 1e-12 * smax);
     assert_constraints_hold(&r, &d, &o);
@@ -175,7 +174,7 @@ static void both_types_fit_the_same_law_when_rho_allows(void **state)
     cf_fit_options o = cf_fit_default_options();
     cf_fit_result r;
     fit_ok(&d, &o, CF_NON_TELESCOPING, &r);
-    assert_close(r.ident[0], 1.0 / 3.0, 1e-6);
+    assert_close(r.ident.rho, 1.0 / 3.0, 1e-6);
     assert_true(r.rmse <= 1e-12 * t.y[t.n - 1]);
     assert_constraints_hold(&r, &d, &o);
 }
@@ -193,12 +192,11 @@ static void noisy_fit_brackets_truth_within_three_standard_errors(void **state)
         cf_fit_options o = cf_fit_default_options();
         cf_fit_result r;
         fit_ok(&d, &o, types[s], &r);
-        double id[3];
-        cf_fit_identifiable(&springs[s], 0, id);
-        for (int k = 0; k < 3; k++) {
-            assert_true(r.ident_se[k] > 0);
-            assert_true(r.ident_se[k] < 0.2 * id[k]); /* the uncertainty says something */
-            assert_close(r.ident[k], id[k], 3 * r.ident_se[k]);
+        const cf_ident id = cf_ident_of(&springs[s], 0);
+        for (int k = 0; k < CF_IDENT_COUNT; k++) {
+            assert_true(r.ident_se.v[k] > 0);
+            assert_true(r.ident_se.v[k] < 0.2 * id.v[k]); /* the uncertainty says something */
+            assert_close(r.ident.v[k], id.v[k], 3 * r.ident_se.v[k]);
         }
         assert_constraints_hold(&r, &d, &o);
     }
@@ -256,8 +254,8 @@ static void fits_are_deterministic_for_a_seed(void **state)
     fit_ok(&d, &o, CF_TELESCOPING, &a);
     fit_ok(&d, &o, CF_TELESCOPING, &b);
     assert_memory_equal(&a.params, &b.params, sizeof a.params);
-    assert_memory_equal(a.ident, b.ident, sizeof a.ident);
-    assert_memory_equal(a.ident_se, b.ident_se, sizeof a.ident_se);
+    assert_memory_equal(&a.ident, &b.ident, sizeof a.ident);
+    assert_memory_equal(&a.ident_se, &b.ident_se, sizeof a.ident_se);
 }
 
 /* Bad tables are refused with CF_E_DATA and a message naming the value. */

@@ -47,10 +47,10 @@ static void assert_within_limits(const cf_fit_result *r, const cf_fit_options *o
 static void assert_has_uncertainty(const cf_fit_result *r)
 {
     for (int k = 0; k < 3; k++) {
-        assert_true(r->ident_se[k] >= 0 || r->interval_ok[k]);
+        assert_true(r->ident_se.v[k] >= 0 || r->interval_ok[k]);
         if (r->interval_ok[k]) {
-            assert_true(r->interval[k][0] <= r->ident[k] * (1 + 1e-9));
-            assert_true(r->interval[k][1] >= r->ident[k] * (1 - 1e-9));
+            assert_true(r->interval[k][0] <= r->ident.v[k] * (1 + 1e-9));
+            assert_true(r->interval[k][1] >= r->ident.v[k] * (1 - 1e-9));
         }
     }
 }
@@ -110,7 +110,7 @@ static void intervals_at_rho_min_have_width_and_name_the_limit(void **state)
         assert_true(r.held & CF_C_RHO_MIN);
         for (int k = 0; k < 3; k++) {
             assert_true(r.interval_ok[k]);
-            const double lo = r.interval[k][0], hi = r.interval[k][1], v = r.ident[k];
+            const double lo = r.interval[k][0], hi = r.interval[k][1], v = r.ident.v[k];
             if (!(lo <= v && v <= hi && hi - lo > 1e-7 * v))
                 fail_msg("pass %d, quantity %d: %.17g [%.17g, %.17g]", pass, k, v, lo, hi);
             if (k > 0 && !(lo < v && v < hi))
@@ -118,7 +118,7 @@ static void intervals_at_rho_min_have_width_and_name_the_limit(void **state)
                          k, v, lo, hi);
         }
         assert_int_equal(r.interval_end[0][0], CF_C_RHO_MIN);
-        assert_true(r.interval[0][0] <= o.rho_min && r.interval[0][1] > r.ident[0]);
+        assert_true(r.interval[0][0] <= o.rho_min && r.interval[0][1] > r.ident.rho);
         assert_int_equal(r.interval_end[0][1], 0);
     }
     cf_table_free(&d);
@@ -177,10 +177,10 @@ static void both_types_agree_where_no_limit_binds(void **state)
         assert_within_limits(&r[t], &o);
         assert_int_equal(r[t].held, 0);
         for (int k = 0; k < 3; k++)
-            assert_true(r[t].ident_se[k] >= 0);
+            assert_true(r[t].ident_se.v[k] >= 0);
     }
     for (int k = 0; k < 3; k++)
-        assert_close(r[0].ident[k], r[1].ident[k], 1e-9 * r[0].ident[k]);
+        assert_close(r[0].ident.v[k], r[1].ident.v[k], 1e-9 * r[0].ident.v[k]);
     /* noiseless and unconstrained: a tie, at rounding level */
     cf_fit_verdict v = cf_fit_compare(&r[0], &r[1], N);
     assert_int_equal(v.tie, 1);

@@ -137,10 +137,10 @@ static void assert_same_fit(const cf_table *t, const cf_fit_options *base, cf_sp
     assert_int_equal(a.held, b.held);
     assert_close(a.rmse, b.rmse, 1e-9 * b.rmse);
     for (int k = 0; k < 3; k++) {
-        assert_close(a.ident[k], b.ident[k], tol_ident * b.ident[k]);
-        assert_true((a.ident_se[k] < 0) == (b.ident_se[k] < 0));
-        if (b.ident_se[k] > 0)
-            assert_close(a.ident_se[k], b.ident_se[k], 1e-4 * b.ident_se[k]);
+        assert_close(a.ident.v[k], b.ident.v[k], tol_ident * b.ident.v[k]);
+        assert_true((a.ident_se.v[k] < 0) == (b.ident_se.v[k] < 0));
+        if (b.ident_se.v[k] > 0)
+            assert_close(a.ident_se.v[k], b.ident_se.v[k], 1e-4 * b.ident_se.v[k]);
     }
 }
 

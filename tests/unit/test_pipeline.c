@@ -99,7 +99,7 @@ static void check_golden(const char *json_path)
                                                 "identifiable.F_C_N.value"};
         for (int k = 0; k < 3; k++) {
             const char *key = cf_table_is_force(&t) ? ident_fd[k] : ident_ss[k];
-            golden_close(json_path, key, res->ident[k], jnum(f, key), 0);
+            golden_close(json_path, key, res->ident.v[k], jnum(f, key), 0);
         }
         golden_close(json_path, "rmse", res->rmse * u, jnum(f, "rmse"), abs_y);
         golden_close(json_path, "r2", res->r2, jnum(f, "r2"), 1e-12);

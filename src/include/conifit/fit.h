@@ -26,26 +26,13 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
+#include "conifit/family.h"
 #include "conifit/law.h"
 #include "conifit/measure.h"
 
 /* Arrays of design parameters below are indexed by CF_P_D1 ... CF_P_H (spring.h). */
 
-/* Constraints, as bits of cf_fit_result.active / .violated. */
-enum {
-    CF_C_INDEX_MIN = 1 << 0, /* c = D1/d >= 3 */
-    CF_C_INDEX_MAX = 1 << 1, /* c <= index_max */
-    CF_C_COILS = 1 << 2,     /* n >= 2 */
-    CF_C_DIAMETERS = 1 << 3, /* D2 >= D1 */
-    CF_C_TRAVEL = 1 << 4,    /* travel > (1 + margin) largest |u| */
-    CF_C_TYPE = 1 << 5,      /* the geometry is of the type being fitted */
-    CF_C_BOUNDS = 1 << 6,    /* a parameter at (or beyond) one of its other bounds */
-    CF_C_RHO_MIN = 1 << 7,   /* rho = D1/D2 >= rho_min */
-    CF_C_COILS_MAX = 1 << 8, /* n <= upper[CF_P_N] */
-    CF_C_G_MAX = 1 << 9,     /* G <= upper[CF_P_G] */
-    CF_C_D2_H = 1 << 10,     /* D2 <= D2_over_H_max H */
-    CF_C_COUNT = 11
-};
+/* Constraints are the CF_C_* bits of family.h. */
 
 /* Default limits that keep a fitted spring one that could be wound and defended: a diameter ratio
 ** of at least 1/20 (below it the largest coil dwarfs the smallest and the law's nonlinear region
@@ -60,7 +47,7 @@ enum {
 ** spring index of at most 50 (handbooks stop near 25; above it a coil does not hold its shape), at
 ** most 1000 coils, a wire at most 1e6 MPa stiff in shear (tungsten carbide, the stiffest wire
 ** material, is about 2.7e5 MPa), an outer diameter of at most 1000 free lengths, and a diameter
-** ratio of at least CF_LSQ_RHO_LO = 1e-3, the smallest the search reaches. Within them the fitted
+** ratio of at least CF_IDENT_RHO_LO = 1e-3, the smallest the search reaches. Within them the fitted
 ** springs stay inside their limits and the limits inside the parameter bounds of spring.h. */
 #define CF_FIT_INDEX_MAX_LIMIT 50.0
 #define CF_FIT_COILS_MAX_LIMIT 1000.0
@@ -122,18 +109,20 @@ typedef struct cf_fit_result {
     cf_spring_type type;
     cf_spring params;      /* the reported spring */
     cf_law law;            /* derived quantities of params (no table) */
-    double ident[3];       /* rho [-]; solid strain s/H [-] or travel s [mm]; F_C/H^2 [MPa] or
-                              F_C [N] */
-    double ident_se[3];    /* standard errors, same units; -1 when not determined */
+    cf_ident ident;        /* the identifiable quantities (family.h: rho [-]; solid strain s/H
+                           ** [-] or travel s [mm]; F_C/H^2 [MPa] or F_C [N]) */
+    cf_ident ident_se;     /* their standard errors, same units; -1 when not determined */
     /* Profile-likelihood interval of each identifiable quantity (95 %, F-test on the residual
     ** sum of squares), computed when the quantity sits on a bound or limit of the type, or the
     ** Jacobian is rank-deficient (then ident_se is -1); interval_ok[k] = 0 when not computed. */
-    int interval_ok[3];
-    double interval[3][2];
-    unsigned interval_end[3][2]; /* CF_C_* bit of the bound an end reached (0: the threshold) */
-    unsigned interval_why[3];    /* CF_C_* bits of the bounds the quantity sits on; with
-                                 ** CF_FIT_RANK_DEFICIENT when the Jacobian is */
-    double corr[3][3];     /* correlation of the three quantities; NAN where not determined */
+    int interval_ok[CF_IDENT_COUNT];
+    double interval[CF_IDENT_COUNT][2];
+    unsigned interval_end[CF_IDENT_COUNT][2]; /* CF_C_* bit of the bound an end reached (0: the
+                                              ** threshold) */
+    unsigned interval_why[CF_IDENT_COUNT];    /* CF_C_* bits of the bounds the quantity sits on;
+                                              ** with CF_FIT_RANK_DEFICIENT when the Jacobian is */
+    double corr[CF_IDENT_COUNT][CF_IDENT_COUNT]; /* correlation of the quantities; NAN where not
+                                                 ** determined */
     unsigned held;         /* CF_C_* bits of the limits that hold the identifiable quantities
                            ** away from the optimum of the law over every spring (the type's
                            ** geometry and the design bounds, rho_min, the travel) */
@@ -167,11 +156,11 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
                      cf_fit_result *res, cf_error *err);
 
 /* Stage B alone: places one spring of the given type whose identifiable quantities are ident
-** (rho, solid strain or travel, stress or load scale; units as in cf_fit_result.ident), exactly as
+** (family.h; of the table's kind, as cf_fit_result.ident), exactly as
 ** cf_fit_run places its spring before the polish, and fills res (quality against data, feasibility;
 ** ident_se = -1, optimizer "placement"). Used by the fit through the lattice (validate.h). */
 cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
-                       const double ident[3], cf_fit_result *res, cf_error *err);
+                       const cf_ident *ident, cf_fit_result *res, cf_error *err);
 
 /* The verdict between two fits of one table (the two spring types). Both types are constrained
 ** subsets of one three-parameter law, so the worse one is judged as the better one's law under an
@@ -200,13 +189,11 @@ int cf_fit_check(const cf_spring *p, cf_spring_type type, const cf_table *data,
 /* The type's design limits in the space of the identifiable quantities of a stress-strain table,
 ** at rho and B = s/H: returns a margin (log units, <= 0 where a spring of the type can be placed
 ** within the limits of opt) and in *A_max the largest stress scale F_C/H^2 (MPa) it can carry
-** there. With a fixed parameter no closed form exists: margin -1, *A_max = INFINITY. Used by the
-** fit through the lattice, which searches the same space. */
+** there (family.h, cf_ident_region_at, under the limits of opt). With a fixed parameter no closed
+** form exists: margin -1, *A_max = INFINITY. Used by the fits through the lattice and the
+** viscoelastic fit, which search the same space. */
 double cf_fit_ident_limit(const cf_fit_options *opt, cf_spring_type type, double rho, double B,
                           double *A_max);
-
-/* The three identifiable quantities of spring p (see cf_fit_result.ident). */
-void cf_fit_identifiable(const cf_spring *p, int force_displacement, double ident[3]);
 
 /* Name of a constraint bit ("index_min", ...), and of an optimiser ("slsqp", ...). */
 const char *cf_fit_constraint_name(unsigned bit);

@@ -20,9 +20,10 @@
 
 #include "conifit/calibration.h"
 #include "conifit/error.h"
+#include "conifit/family.h"
 #include "conifit/fit.h"
+#include "conifit/lattice_fit.h"
 #include "conifit/measure.h"
-#include "conifit/validate.h"
 
 /* Most tables in one joint fit. */
 #define CF_JOINT_MAX 16
@@ -40,7 +41,7 @@ typedef struct cf_joint_table {
 
 typedef struct cf_joint_result {
     cf_fit_result fit;              /* the placed spring (quality fields against the first table) */
-    double ident[3];                /* rho, s/H, F_C/H^2 [MPa] the search found */
+    cf_ident ident;                 /* rho, s/H, F_C/H^2 [MPa] the search found (family.h) */
     double weight[CF_FAMILY_COUNT]; /* the lattice's family weights */
     cf_calibration calibration;     /* isotropic, axial or fitted */
     size_t ntables;

@@ -4,7 +4,8 @@
 **   cf_table (measure.h) --cf_fit_run, each type--> cf_fit_result
 **                        --cf_baseline_fit_all----> linear, Duffing, Fung
 **                        --cf_validate_run---------> lattice curve, RMSE, R^2 (optional)
-**                        --cf_validate_through_msm-> the fit through the lattice (optional)
+**                        --cf_lattice_fit----------> the fit through the lattice (optional),
+**                          cf_validate_lattice_fit    verified in the full lattice
 **   = cf_fit_report (report.h) --cf_pipeline_write--> fit file (JSON) and plot
 **
 ** Every front end (the command line, the tests, the benchmark) goes through these calls, so the
@@ -37,8 +38,8 @@ typedef enum cf_pipeline_target {
     CF_TARGET_AUTO = 0,    /* the spring for uniaxial tables, the lattice for the other modes (a
                            ** single spring has no shear, planar, equibiaxial or confined form) */
     CF_TARGET_SPRING = 1,  /* the single spring's curve F(eH)/H^2 */
-    CF_TARGET_LATTICE = 2  /* the lattice's curve in the table's mode (validate.h,
-                           ** cf_validate_through_msm), verified once in the full lattice */
+    CF_TARGET_LATTICE = 2  /* the lattice's curve in the table's mode (lattice_fit.h,
+                           ** cf_lattice_fit), verified once in the full lattice */
 } cf_pipeline_target;
 
 typedef struct cf_pipeline_options {

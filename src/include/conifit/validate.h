@@ -1,5 +1,5 @@
 /*
-** Validation of a fitted spring in the mass-spring lattice, and the fit through the lattice.
+** Validation of a fitted spring in the mass-spring lattice.
 **
 ** A single spring reproduces its table by construction; a lattice of such springs, with its
 ** diagonals, boundary conditions and lateral freedom, does not. cf_validate_run drives the lattice
@@ -9,11 +9,8 @@
 ** lattice (msm.h, cf_msm_uniaxial); the other modes (shear, planar, equibiaxial, confined) run the
 ** homogenised cell (cell.h), which is the lattice under a homogeneous deformation.
 **
-** cf_validate_through_msm makes the lattice's curve the objective (conifit fit --target lattice):
-** it optimises the three identifiable quantities (rho, solid strain s/H, stress scale F_C/H^2;
-** the lattice's stress depends on the design parameters only through them, as the single
-** spring's does) through the homogenised cell, places the design parameters as the ordinary fit
-** does (cf_fit_place), and verifies the result once in the full lattice.
+** The fit through the lattice (lattice_fit.h) makes the lattice's curve the objective;
+** cf_validate_lattice_fit verifies its result once in the full lattice.
 **
 ** Stress-strain tables only: a force-displacement table is a single spring's curve, not a block
 ** of tissue, and its free length H is not determined by the data, so there is no sound nominal
@@ -28,16 +25,10 @@
 #include "conifit/cell.h"
 #include "conifit/error.h"
 #include "conifit/fit.h"
+#include "conifit/lattice_fit.h"
 #include "conifit/law.h"
 #include "conifit/msm.h"
 #include "conifit/scene.h"
-
-/* Where the lattice comes from. */
-typedef struct cf_validate_setup {
-    cf_msm_config cfg;          /* lattice and Newton settings */
-    cf_law_method method;       /* law evaluator in the lattice */
-    size_t table_intervals;     /* table size when method is CF_LAW_TABLE */
-} cf_validate_setup;
 
 /* cf_msm_default() (3 x 3 x 3 cells, face and body diagonals, bottom axial) with the fitter's own
 ** evaluator, CF_LAW_CLOSED. */
@@ -85,29 +76,13 @@ cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const 
 /* Releases v->stress_MPa. Safe on a zeroed validation. */
 void cf_validation_free(cf_validation *v);
 
-/* What the fit through the lattice did. */
-typedef struct cf_through_msm {
-    int done;                   /* 1: run */
-    int improved;               /* 1: the spring was replaced (the lattice fits better) */
-    double rmse_before;         /* RMSE of the ordinary fit in the lattice (homogenised cell), MPa */
-    double cell_rmse;           /* RMSE of the reported spring through the cell: the fit's, MPa */
-    double rmse_after;          /* validation RMSE of the reported spring (full lattice), MPa */
-    int verified;               /* 1: the full lattice ran (uniaxial); 0: the mode is the cell's */
-    double verify_max_abs;      /* largest |full lattice - cell| at the table's strains, MPa */
-    double ident_before[3];     /* rho, s/H, F_C/H^2 [MPa] of the ordinary fit */
-    double ident_after[3];      /* the same after the lattice objective */
-    double wall_time_s;         /* s, the optimisation and the placement */
-    long evaluations;           /* cell curves computed */
-} cf_through_msm;
-
-/* The fit through the lattice for one fitted spring res (in: the ordinary fit; out: the spring
-** placed from the identifiable quantities that make the homogenised cell (cell.h) reproduce the
-** table in its mode, when that lowers the cell's RMSE). Local searches (NLopt BOBYQA over
-** log rho and s/H, the stress scale in closed form) from the ordinary fit and a coarse grid; the
-** reported spring is then validated once (v, freed and refilled here) in the validation lattice,
-** and t records the cell's fit RMSE against the full lattice's. Deterministic. */
-cf_status cf_validate_through_msm(const cf_table *d, const cf_fit_options *opt,
-                                  const cf_validate_setup *s, cf_fit_result *res,
-                                  cf_validation *v, cf_through_msm *t, cf_error *err);
+/* The verification of a fit through the lattice (lattice_fit.h, cf_lattice_fit, which filled
+** t and res): the reported spring res once in the validation lattice (v, freed and refilled here),
+** t recording the validation RMSE and the largest difference between the full lattice and the
+** cell the fit ran on. A force-displacement table is recorded as skipped (v->note, CF_E_DATA); a
+** fit that did not run (t->done = 0) leaves v empty and err untouched. */
+cf_status cf_validate_lattice_fit(const cf_table *d, const cf_validate_setup *s,
+                                  const cf_fit_result *res, cf_validation *v, cf_through_msm *t,
+                                  cf_error *err);
 
 #endif

@@ -47,7 +47,7 @@ typedef struct cf_visco_fit_options {
     cf_visco_relaxation relaxation; /* quasi-linear (the zero value), depending on strain, or
                                     ** both with the choice (the command's default) */
     int hold_elastic;       /* 1: rho, s/H, F_C/H^2 held at elastic[] (an earlier fit) */
-    double elastic[3];      /* rho [-], s/H [-], F_C/H^2 [MPa] */
+    cf_ident elastic;       /* rho [-], s/H [-], F_C/H^2 [MPa] (family.h) */
     int relative;           /* 1: residuals relative to |stress| (floor 1e-3 max|stress|) */
     double rho_min;         /* smallest rho fitted (default the fitter's, 0.05) */
     /* Design limits (fit.h): when not NULL, rho, s/H and F_C/H^2 stay where a spring of one of
@@ -113,7 +113,7 @@ typedef struct cf_visco_candidate {
 
 typedef struct cf_visco_fit {
     cf_visco_params p;                  /* the fitted model (stress scale in MPa, eta in MPa s) */
-    double se_ident[3];                 /* standard errors of rho, s/H, F_C/H^2; -1: not
+    cf_ident ident_se;                  /* standard errors of rho, s/H, F_C/H^2; -1: not
                                            determined (or held) */
     double se_g[CF_PRONY_MAX];          /* standard errors of g_i, -1 when not determined */
     double se_tau_s[CF_PRONY_MAX];      /* of tau_i, s */

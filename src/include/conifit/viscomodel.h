@@ -20,14 +20,14 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
+#include "conifit/family.h"
 #include "conifit/law.h"
 #include "conifit/msm.h"
 
 /* The parameters of the time-dependent model. */
 typedef struct cf_visco_params {
-    double rho;                       /* D1/D2, - */
-    double solid_strain;              /* s/H, - */
-    double stress_scale_MPa;          /* F_C/H^2, MPa */
+    cf_ident ident;                   /* the spring's family (family.h) of a stress-strain
+                                      ** table: rho [-], s/H [-], F_C/H^2 [MPa] */
     int nbranch;                      /* Prony terms, 0..CF_PRONY_MAX */
     double g[CF_PRONY_MAX];           /* relative moduli, - */
     double tau_s[CF_PRONY_MAX];       /* time constants, s */
@@ -58,10 +58,6 @@ typedef struct cf_visco_setup {
 /* The default setup: the cell with the weights of cf_msm_default(), 10 implicit steps per
 ** measured interval, law evaluator CF_LAW_CLOSED. */
 cf_visco_setup cf_visco_default(void);
-
-/* A spring of free length 1 mm with the given identifiable quantities (non-telescoping, n = 2);
-** the lattice's nominal stress depends on nothing else. */
-cf_spring cf_spring_member(double rho, double solid_strain, double stress_scale_MPa);
 
 /* The effects of p (Prony terms and dashpot) as msm.h takes them. */
 cf_msm_effects cf_visco_effects(const cf_visco_params *p);

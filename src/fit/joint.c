@@ -6,12 +6,13 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include <nlopt.h>
 
 #include "conifit/cell.h"
+#include "conifit/family.h"
 #include "conifit/msm.h"
+#include "fit/clock.h"
 #include "fit/lsq.h"
 
 /* BOBYQA: relative step tolerance and curves per start (each a few tens of microseconds). */
@@ -20,13 +21,6 @@
 /* Diagonal-to-edge weight ratio searched when the weights are fitted. */
 #define Q_LO 0.02
 #define Q_HI 5.0
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 typedef struct jctx {
     const cf_table *const *t;
@@ -50,15 +44,6 @@ static void weights_of(double q, double w[CF_FAMILY_COUNT])
         w[f] = u[f] / E;
 }
 
-/* The spring of free length 1 with the identifiable quantities (rho, e, A) (as validate.c). */
-static cf_spring member(double rho, double e, double A)
-{
-    const double H = 1.0, Lmin = H * (1 - e), s = H * e, n = 2.0, dw = Lmin / n;
-    const double D2 = rho < 1 ? Lmin / (1 - rho) : Lmin, D1 = rho * D2;
-    cf_spring p = {D1, D2, n, dw, cf_lsq_G_of_FC(A * H * H, n, D1, dw, s), H};
-    return p;
-}
-
 /* Objective at z = (ln rho, s/H [, ln q]) with the stress scale in closed form; *A_out. */
 static double profile(jctx *c, const double *z, double *A_out)
 {
@@ -69,7 +54,8 @@ static double profile(jctx *c, const double *z, double *A_out)
         return CF_LSQ_HUGE_OBJ;
     if (c->fit_weights)
         weights_of(exp(z[2]), c->weight);
-    cf_spring p = member(rho, e, 1.0);
+    const cf_ident q = {.rho = rho, .solid = e, .scale = 1.0};
+    cf_spring p = cf_ident_member(&q);
     cf_law law;
     if (cf_law_init(&law, &p, NULL) != CF_OK)
         return CF_LSQ_HUGE_OBJ;
@@ -119,15 +105,51 @@ void cf_joint_free(cf_joint_result *r)
     }
 }
 
+/* Each table in the lattice of the placed spring r->fit: the cell, and the full lattice when the
+** mode is uniaxial (the verification). */
+static cf_status verify_tables(const jctx *c, cf_joint_result *r, cf_error *err)
+{
+    cf_law law;
+    cf_status st = cf_law_init(&law, &r->fit.params, err);
+    if (st != CF_OK)
+        return st;
+    cf_validate_setup full = *c->lat;
+    memcpy(full.cfg.lattice.weight, c->weight, sizeof c->weight);
+    cf_cell cell;
+    cf_cell_init(&cell, &law, CF_LAW_CLOSED, c->weight, NULL);
+    for (size_t k = 0; k < c->n && st == CF_OK; k++) {
+        const cf_table *t = c->t[k];
+        cf_joint_table *jt = &r->tab[k];
+        if ((st = cf_cell_curve(&cell, t->mode, t->x, t->count, c->curve[k], err)) != CF_OK)
+            break;
+        jt->cell_rmse = cf_lsq_quality_of(t, c->curve[k]).rmse;
+        jt->by_cell = t->mode != CF_MODE_UNIAXIAL;
+        if (jt->by_cell)
+            memcpy(jt->lattice_MPa, c->curve[k], t->count * sizeof(double));
+        else if ((st = cf_msm_uniaxial(&law, CF_LAW_CLOSED, &full.cfg, t->x, t->count,
+                                       jt->lattice_MPa, NULL, err)) != CF_OK)
+            break;
+        jt->lattice_rmse = cf_lsq_quality_of(t, jt->lattice_MPa).rmse;
+        double ss = 0;
+        for (size_t i = 0; i < t->count; i++) {
+            double d = jt->lattice_MPa[i] - cf_fit_model(&law, 0, t->x[i]);
+            ss += d * d;
+        }
+        jt->law_rmse = t->mode == CF_MODE_UNIAXIAL ? sqrt(ss / (double)t->count) : NAN;
+    }
+    cf_law_free(&law);
+    return st;
+}
+
 /* A joint fit, stage after stage: check the tables, the springs' common reach, the search over
 ** (rho, s/H, scale) against every table's lattice curve, the placement, then each table in the
-** lattice of the placed spring. Kept as one function (~160 lines) because the stages share the
+** lattice of the placed spring (verify_tables). Kept as one function because the stages share the
 ** tables' weights, the reach and the result being filled; each stage is marked below. */
 cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
                        const cf_validate_setup *lat, cf_spring_type type, cf_joint_result *r,
                        cf_error *err)
 {
-    const double t0 = now_s();
+    const double t0 = cf_clock_s();
     memset(r, 0, sizeof *r);
     if (n < 2 || n > CF_JOINT_MAX)
         return cf_error_set(err, CF_E_DATA, "a joint fit takes 2 to %d tables, not %zu",
@@ -193,9 +215,9 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
     reach.t = NULL;
     const double xmax = cf_lsq_xmax(&reach);
     const int nz = c.fit_weights ? 3 : 2;
-    double lb[3] = {log(fmax(CF_LSQ_RHO_LO, opt->rho_min)),
+    double lb[3] = {log(fmax(CF_IDENT_RHO_LO, opt->rho_min)),
                     xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9), log(Q_LO)};
-    double ub[3] = {log(cf_lsq_rho_hi(type, opt->index_max)), 1 - 1e-9, log(Q_HI)};
+    double ub[3] = {log(cf_ident_rho_hi(type, opt->index_max)), 1 - 1e-9, log(Q_HI)};
     if (!(lb[1] < ub[1])) {
         st = cf_error_set(err, CF_E_DATA,
                           "the springs must reach a strain of %g: no spring does", xmax);
@@ -235,41 +257,12 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
         goto out;
     }
     r->objective = best;
-    r->ident[0] = exp(zb[0]), r->ident[1] = zb[1], r->ident[2] = A;
+    r->ident.rho = exp(zb[0]), r->ident.solid = zb[1], r->ident.scale = A;
     memcpy(r->weight, c.weight, sizeof r->weight);
     r->calibration = lat->cfg.lattice.calibration;
-    if ((st = cf_fit_place(&reach, opt, type, r->ident, &r->fit, err)) != CF_OK)
+    if ((st = cf_fit_place(&reach, opt, type, &r->ident, &r->fit, err)) != CF_OK)
         goto out;
-    /* Each table in the lattice of the placed spring: the cell, and the full lattice when the
-    ** mode is uniaxial (the verification). */
-    cf_law law;
-    if ((st = cf_law_init(&law, &r->fit.params, err)) != CF_OK)
-        goto out;
-    cf_validate_setup full = *lat;
-    memcpy(full.cfg.lattice.weight, c.weight, sizeof c.weight);
-    cf_cell cell;
-    cf_cell_init(&cell, &law, CF_LAW_CLOSED, c.weight, NULL);
-    for (size_t k = 0; k < n && st == CF_OK; k++) {
-        const cf_table *t = tables[k];
-        cf_joint_table *jt = &r->tab[k];
-        if ((st = cf_cell_curve(&cell, t->mode, t->x, t->count, c.curve[k], err)) != CF_OK)
-            break;
-        jt->cell_rmse = cf_lsq_quality_of(t, c.curve[k]).rmse;
-        jt->by_cell = t->mode != CF_MODE_UNIAXIAL;
-        if (jt->by_cell)
-            memcpy(jt->lattice_MPa, c.curve[k], t->count * sizeof(double));
-        else if ((st = cf_msm_uniaxial(&law, CF_LAW_CLOSED, &full.cfg, t->x, t->count,
-                                       jt->lattice_MPa, NULL, err)) != CF_OK)
-            break;
-        jt->lattice_rmse = cf_lsq_quality_of(t, jt->lattice_MPa).rmse;
-        double ss = 0;
-        for (size_t i = 0; i < t->count; i++) {
-            double d = jt->lattice_MPa[i] - cf_fit_model(&law, 0, t->x[i]);
-            ss += d * d;
-        }
-        jt->law_rmse = t->mode == CF_MODE_UNIAXIAL ? sqrt(ss / (double)t->count) : NAN;
-    }
-    cf_law_free(&law);
+    st = verify_tables(&c, r, err);
 out:
     for (size_t k = 0; k < n && k < CF_JOINT_MAX; k++) {
         free(c.sw[k]);
@@ -278,7 +271,7 @@ out:
     free(reach_x);
     free(reach_y);
     r->evaluations = c.evals;
-    r->wall_time_s = now_s() - t0;
+    r->wall_time_s = cf_clock_s() - t0;
     if (st != CF_OK)
         cf_joint_free(r);
     return st;

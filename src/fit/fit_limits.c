@@ -1,0 +1,308 @@
+/*
+** The spring type's limits in the space of the identifiable quantities (stress-strain tables, no
+** fixed parameter; family.h gives them in closed form): stage A under those limits when its
+** optimum lies outside, the limits a result sits on, and a member of the family within them for
+** the placement to start from.
+*/
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_rng.h>
+#include <nlopt.h>
+
+#include "fit/fit_ctx.h"
+#include "fit/lsq.h"
+
+/* The design limits of options o as the family's space sees them. */
+static cf_ident_design design_of(const cf_fit_options *o)
+{
+    cf_ident_design d = {o->lower[CF_P_N], o->upper[CF_P_N], o->upper[CF_P_G], o->D2_over_H_max,
+                         o->index_max, o->rho_min};
+    return d;
+}
+
+region cf_fit_region_at(const fit_ctx *c, double rho, double B)
+{
+    region r = {-1.0, INFINITY, 0, 0};
+    if (!c->region)
+        return r;
+    const cf_ident_design d = design_of(c->opt);
+    return cf_ident_region_at(&d, c->type, rho, B, c->inside);
+}
+
+double cf_fit_ident_limit(const cf_fit_options *opt, cf_spring_type type, double rho, double B,
+                          double *A_max)
+{
+    fit_ctx c;
+    memset(&c, 0, sizeof c);
+    c.opt = opt;
+    c.type = type;
+    c.region = 1;
+    c.inside = REGION_SAFETY;
+    for (int k = 0; k < CF_P_COUNT; k++)
+        c.region &= !opt->fixed[k];
+    region r = cf_fit_region_at(&c, rho, B);
+    *A_max = r.A_max;
+    return r.margin;
+}
+
+/* Weighted residual sum of squares of the reduced model at (rho, B) with the load scale A fixed
+** (A_fixed > 0) or solved in closed form and clamped to (0, A_max]; *A_out the scale used.
+** The sum is formed from the residuals themselves, not from the expanded square, so that it
+** stays exact on noiseless tables. */
+double cf_fit_rss_at(fit_ctx *c, double rho, double B, double A_fixed, double A_max,
+                     double *A_out)
+{
+    cf_law canon;
+    *A_out = A_fixed;
+    if (!(B > 0) || cf_ident_canon_law(rho, &canon) != CF_OK)
+        return CF_LSQ_HUGE_OBJ;
+    double sgy = 0, sgg = 0;
+    for (size_t i = 0; i < c->n; i++) {
+        double g = c->sw[i] * cf_ident_reduced(&canon, 1.0, B, c->data->x[i], NULL);
+        c->model[i] = g;
+        sgy += g * c->sw[i] * c->data->y[i];
+        sgg += g * g;
+    }
+    double A = A_fixed;
+    if (!(A > 0)) {
+        A = sgg > 0 ? sgy / sgg : 0;
+        if (!(A > 0) || !isfinite(A))
+            A = 1e-300;
+        A = fmin(A, A_max);
+    }
+    double rss = 0;
+    for (size_t i = 0; i < c->n; i++) {
+        double r = A * c->model[i] - c->sw[i] * c->data->y[i];
+        rss += r * r;
+    }
+    c->evals++;
+    *A_out = A;
+    return isfinite(rss) ? rss : CF_LSQ_HUGE_OBJ;
+}
+
+void cf_fit_sub_point(const sub *q, const double *x, double *rho, double *B)
+{
+    int j = 0;
+    *rho = q->fixed == 0 ? q->t : exp(x[j++]);
+    *B = q->fixed == 1 ? q->t : x[j];
+}
+
+double cf_fit_sub_f0(const sub *q, const double *x)
+{
+    double rho, B, A;
+    cf_fit_sub_point(q, x, &rho, &B);
+    region r = cf_fit_region_at(q->c, rho, B);
+    return cf_fit_rss_at(q->c, rho, B, q->fixed == 2 ? q->t : -1, r.A_max, &A);
+}
+
+
+/* Central differences for the gradient-based optimiser (SLSQP). */
+static void sub_grad(const sub *q, double (*f)(const sub *, const double *), unsigned n,
+                     const double *x, double *grad)
+{
+    double xx[2];
+    memcpy(xx, x, sizeof(double) * n);
+    for (unsigned k = 0; k < n; k++) {
+        double h = 1e-7 * fmax(1.0, fabs(x[k]));
+        xx[k] = x[k] + h;
+        double fp = f(q, xx);
+        xx[k] = x[k] - h;
+        double fm = f(q, xx);
+        xx[k] = x[k];
+        grad[k] = (fp - fm) / (2 * h);
+    }
+}
+
+static double sub_f(unsigned n, const double *x, double *grad, void *data)
+{
+    const sub *q = data;
+    if (grad)
+        sub_grad(q, cf_fit_sub_f0, n, x, grad);
+    return cf_fit_sub_f0(q, x);
+}
+
+static double sub_g(unsigned n, const double *x, double *grad, void *data)
+{
+    const sub *q = data;
+    if (grad)
+        sub_grad(q, cf_fit_sub_g0, n, x, grad);
+    return cf_fit_sub_g0(q, x);
+}
+
+double cf_fit_sub_g0(const sub *q, const double *x)
+{
+    double rho, B;
+    cf_fit_sub_point(q, x, &rho, &B);
+    region r = cf_fit_region_at(q->c, rho, B);
+    double g = r.margin + q->c->inside;
+    if (q->fixed == 2 && isfinite(r.A_max))
+        g = fmax(g, log(q->t) - log(r.A_max));
+    return g;
+}
+
+/* Minimises the sub-problem from x (in/out); returns its RSS, CF_LSQ_HUGE_OBJ when no point meets
+** the limits. */
+double cf_fit_sub_solve(fit_ctx *c, sub *q, double *x, nlopt_algorithm alg)
+{
+    unsigned nv = q->fixed < 0 ? 2u : q->fixed == 2 ? 2u : 1u;
+    double lb[2], ub[2];
+    unsigned j = 0;
+    if (q->fixed != 0) {
+        lb[j] = log(c->rho_lo);
+        ub[j] = log(c->rho_hi * (1 - 1e-12));
+        j++;
+    }
+    if (q->fixed != 1) {
+        lb[j] = c->b_lo;
+        ub[j] = c->b_hi;
+    }
+    for (unsigned k = 0; k < nv; k++)
+        x[k] = fmin(fmax(x[k], lb[k]), ub[k]);
+    nlopt_opt o = nlopt_create(alg, nv);
+    if (!o) {
+        c->oom = 1;
+        return CF_LSQ_HUGE_OBJ;
+    }
+    int set_oom = nlopt_set_lower_bounds(o, lb) == NLOPT_OUT_OF_MEMORY;
+    set_oom |= nlopt_set_upper_bounds(o, ub) == NLOPT_OUT_OF_MEMORY;
+    set_oom |= nlopt_set_min_objective(o, sub_f, q) == NLOPT_OUT_OF_MEMORY;
+    if (c->region)
+        set_oom |= nlopt_add_inequality_constraint(o, sub_g, q, 0.0) == NLOPT_OUT_OF_MEMORY;
+    if (set_oom) {
+        c->oom = 1;
+        nlopt_destroy(o);
+        return CF_LSQ_HUGE_OBJ;
+    }
+    nlopt_set_xtol_rel(o, 1e-9);
+    nlopt_set_maxeval(o, 300);
+    double f = CF_LSQ_HUGE_OBJ;
+    nlopt_result r = nlopt_optimize(o, x, &f);
+    c->oom |= r == NLOPT_OUT_OF_MEMORY;
+    nlopt_destroy(o);
+    if (r < 0 && r != NLOPT_ROUNDOFF_LIMITED)
+        f = cf_fit_sub_f0(q, x);
+    if (c->region && cf_fit_sub_g0(q, x) > 1e-9)
+        return CF_LSQ_HUGE_OBJ;
+    return f;
+}
+
+/* Stage A under the type's limits: used when the optimum over every spring lies outside them.
+** Seeded grid over (rho, B) as in cf_fit_stage_a, feasible points only, then COBYLA from the
+** best. */
+int cf_fit_stage_a_constrained(fit_ctx *c, double v[3])
+{
+    gsl_rng *rng = cf_fit_seeded_rng(c->opt->seed, 3);
+    c->oom |= !rng;
+    start grid[GRID * GRID];
+    size_t k = 0;
+    sub q = {c, -1, 0};
+    for (int i = 0; i < GRID; i++) {
+        double ti = (i + cf_fit_jitter(rng)) / GRID;
+        double rho = c->rho_lo * pow(c->rho_hi / c->rho_lo, ti);
+        for (int j = 0; j < GRID; j++) {
+            double tj = (j + cf_fit_jitter(rng)) / GRID;
+            double B = c->b_lo + (c->b_hi - c->b_lo) * tj;
+            double x[2] = {log(rho), B};
+            if (cf_fit_sub_g0(&q, x) > 0)
+                continue;
+            grid[k].obj = cf_fit_sub_f0(&q, x);
+            grid[k].rho = rho;
+            grid[k].B = B;
+            k++;
+        }
+    }
+    gsl_rng_free(rng);
+    if (k == 0)
+        return 0;
+    qsort(grid, k, sizeof grid[0], cf_fit_cmp_start);
+    double best = CF_LSQ_HUGE_OBJ, bx[2] = {0, 0};
+    for (size_t i = 0; i < k && (int)i < c->opt->multistart; i++) {
+        double x[2] = {log(grid[i].rho), grid[i].B};
+        double f = cf_fit_sub_solve(c, &q, x, NLOPT_LN_COBYLA);
+        double f2 = cf_fit_sub_solve(c, &q, x, NLOPT_LD_SLSQP);
+        f = fmin(f, f2);
+        if (f < best) {
+            best = f;
+            memcpy(bx, x, sizeof bx);
+        }
+    }
+    if (!(best < CF_LSQ_HUGE_OBJ))
+        return 0;
+    v[0] = exp(bx[0]);
+    v[1] = bx[1];
+    region r = cf_fit_region_at(c, v[0], v[1]);
+    cf_fit_rss_at(c, v[0], v[1], -1, r.A_max, &v[2]);
+    return 1;
+}
+
+/* ---- what the limits mean for a result ------------------------------------------------------- */
+
+/* Limits the quantities v sit on (CF_C_* bits): rho_min, the travel, the type's limits. */
+unsigned cf_fit_held_at(const fit_ctx *c, const double v[3])
+{
+    unsigned h = 0;
+    if (v[0] <= fmax(c->rho_lo, c->opt->rho_min) * (1 + 1e-3))
+        h |= c->opt->rho_min > CF_IDENT_RHO_LO ? CF_C_RHO_MIN : CF_C_BOUNDS;
+    if (c->travel_ok && v[1] <= c->b_lo * (1 + 1e-5))
+        h |= CF_C_TRAVEL;
+    if (c->region) {
+        region r = cf_fit_region_at(c, v[0], v[1]);
+        if (r.margin > -10 * REGION_SAFETY)
+            h |= r.lo_bit | r.hi_bit;
+        if (v[2] >= r.A_max * (1 - 10 * REGION_SAFETY))
+            h |= CF_C_G_MAX;
+    } else if (c->rho_hi < 1 && v[0] >= c->rho_hi * (1 - 1e-4)) {
+        h |= CF_C_TYPE;
+    }
+    return h;
+}
+
+/* A member of the family v that meets every limit, for the placement to start from (stress-strain
+** tables without fixed parameters): the corner the limits leave open, then a grid over the spring
+** index and the coil count for the point closest to the preferred design. 0 when none is found. */
+int cf_fit_region_member(fit_ctx *c, const double v[3], double *p)
+{
+    const double rho = v[0], B = v[1], H = c->opt->H_preferred_mm;
+    const double nmin = c->opt->lower[CF_P_N], nmax = c->opt->upper[CF_P_N];
+    const double cmax = c->opt->index_max;
+    double best = CF_LSQ_HUGE_OBJ;
+    int found = 0;
+    for (int i = -1; i <= 40; i++)
+        for (int j = 0; j <= 40; j++) {
+            double cidx, n;
+            if (i < 0) { /* the corner of cf_ident_region_at */
+                if (j > 0)
+                    break;
+                if (c->type == CF_TELESCOPING) {
+                    cidx = fmax(3.0, 2 * nmin * rho / (1 - rho)) * (1 + 1e-5);
+                    n = nmin * (1 + 1e-7);
+                } else {
+                    cidx = 3.0 * (1 + 1e-7);
+                    n = fmax(nmin, fmax(3.0 * (1 - rho) / (2 * rho) * (1 + 1e-6),
+                                        3.0 * (1 - B) / (c->opt->D2_over_H_max * rho))) *
+                        (1 + 1e-5);
+                }
+            } else {
+                cidx = 3.0 * pow(cmax / 3.0, i / 40.0);
+                n = nmin * pow(nmax / nmin, j / 40.0);
+            }
+            double s = B * H, Lmin = H - s;
+            double d = c->type == CF_TELESCOPING ? Lmin : Lmin / n;
+            double D1 = cidx * d, FC = v[2] * H * H;
+            double q[CF_P_COUNT] = {
+                D1, D1 / rho, n, d, 8 * n * D1 * D1 * D1 * FC / (d * d * d * d * s), H};
+            cf_spring sp = from_array(q);
+            if (!cf_fit_check_at(c, &sp, NULL, NULL))
+                continue;
+            double a = log(cidx) - c->pref[0], b = log(n) - c->pref[1];
+            double score = a * a + b * b;
+            if (score < best) {
+                best = score;
+                memcpy(p, q, sizeof q);
+                found = 1;
+            }
+        }
+    return found;
+}

@@ -1,0 +1,37 @@
+/*
+** One spring's lattice curve at a table's strains (see lattice_curve.h).
+*/
+#include "fit/lattice_curve.h"
+
+#include <string.h>
+
+#include "conifit/cell.h"
+
+cf_status cf_lattice_curve(const cf_spring *p, const cf_validate_setup *s, const cf_table *d,
+                           int full, double *out, double *law_out, cf_msm_stats *stats,
+                           int *by_cell, cf_error *err)
+{
+    cf_law law;
+    cf_status st = cf_law_init(&law, p, err);
+    if (st != CF_OK)
+        return st;
+    if (s->method == CF_LAW_TABLE && (st = cf_law_table_build(&law, s->table_intervals, err)))
+        return st;
+    int cell = !full || d->mode != CF_MODE_UNIAXIAL;
+    if (by_cell)
+        *by_cell = cell;
+    if (!cell) {
+        st = cf_msm_uniaxial(&law, s->method, &s->cfg, d->x, d->count, out, stats, err);
+    } else {
+        cf_cell c;
+        if (stats)
+            memset(stats, 0, sizeof *stats);
+        st = cf_cell_init(&c, &law, s->method, s->cfg.lattice.weight, err);
+        if (st == CF_OK)
+            st = cf_cell_curve(&c, d->mode, d->x, d->count, out, err);
+    }
+    for (size_t i = 0; st == CF_OK && law_out && i < d->count; i++)
+        law_out[i] = cf_fit_model(&law, 0, d->x[i]);
+    cf_law_free(&law);
+    return st;
+}

@@ -1,0 +1,62 @@
+/*
+** The Levenberg-Marquardt of the fits (see lm.h).
+*/
+#include "fit/lm.h"
+
+#include <math.h>
+
+#include <gsl/gsl_blas.h>
+#include <gsl/gsl_errno.h>
+
+double cf_logit(double p)
+{
+    p = fmin(fmax(p, 1e-15), 1 - 1e-15);
+    return log(p / (1 - p));
+}
+
+gsl_multifit_nlinear_parameters cf_lm_parameters(void)
+{
+    gsl_multifit_nlinear_parameters fp = gsl_multifit_nlinear_default_parameters();
+    fp.trs = gsl_multifit_nlinear_trs_lm;
+    fp.scale = gsl_multifit_nlinear_scale_more;
+    return fp;
+}
+
+gsl_multifit_nlinear_workspace *cf_lm_start(const gsl_multifit_nlinear_parameters *fp,
+                                            gsl_multifit_nlinear_fdf *fdf, double *x0,
+                                            int *init)
+{
+    gsl_multifit_nlinear_workspace *w =
+        gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, fp, fdf->n, fdf->p);
+    if (!w)
+        return NULL;
+    gsl_vector_view v = gsl_vector_view_array(x0, fdf->p);
+    *init = gsl_multifit_nlinear_init(&v.vector, fdf, w);
+    return w;
+}
+
+int cf_lm_iterate(gsl_multifit_nlinear_workspace *w, const cf_lm_stop *stop)
+{
+    gsl_vector *f = gsl_multifit_nlinear_residual(w);
+    double prev;
+    gsl_blas_ddot(f, f, &prev);
+    int stall = 0;
+    for (int it = 0; it < stop->max_iter; it++) {
+        int info;
+        int is = gsl_multifit_nlinear_iterate(w);
+        if (is == GSL_ENOMEM)
+            return -1;
+        if (is != GSL_SUCCESS)
+            break;
+        if (gsl_multifit_nlinear_test(stop->xtol, stop->gtol, stop->ftol, &info, w) ==
+            GSL_SUCCESS)
+            break;
+        double cur;
+        gsl_blas_ddot(f, f, &cur);
+        stall = (prev - cur <= stop->stall_rel * prev) ? stall + 1 : 0;
+        prev = cur;
+        if (stall >= stop->stall || cur <= stop->floor)
+            break;
+    }
+    return 0;
+}

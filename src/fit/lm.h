@@ -1,0 +1,41 @@
+/*
+** The Levenberg-Marquardt of the fits (GSL's trust-region solver): its set-up, its stopping rule,
+** and the logit map that turns a bounded quantity into a free coordinate for it. Private to the
+** fit layer.
+*/
+#ifndef CF_FIT_LM_H
+#define CF_FIT_LM_H
+
+#include <gsl/gsl_multifit_nlinear.h>
+
+/* ln(p/(1 - p)), p clamped to [1e-15, 1 - 1e-15] so that a bound maps to a finite coordinate. */
+double cf_logit(double p);
+
+/* GSL's default parameters with the Levenberg-Marquardt step and More's scaling of the
+** parameters; a fit adjusts the rest (difference type, step) before cf_lm_start. */
+gsl_multifit_nlinear_parameters cf_lm_parameters(void);
+
+/* A workspace for fdf (its n residuals and p parameters) under fp, initialised at x0 (p values,
+** read). NULL when it cannot be allocated; else *init receives the status of the initialisation
+** (GSL_SUCCESS, GSL_ENOMEM, or the status of fdf's first evaluation). */
+gsl_multifit_nlinear_workspace *cf_lm_start(const gsl_multifit_nlinear_parameters *fp,
+                                            gsl_multifit_nlinear_fdf *fdf, double *x0,
+                                            int *init);
+
+/* When the iterations stop: GSL's own test (xtol, gtol, ftol), the iteration limit, and two more
+** rules. An optimum on a bound of a logit coordinate lies at infinity, where the step test never
+** fires: stop once the sum of squares has fallen by less than stall_rel of itself in `stall`
+** iterations in a row, or once it is below `floor` (rounding level). */
+typedef struct cf_lm_stop {
+    int max_iter;
+    double xtol, gtol, ftol;
+    int stall;
+    double stall_rel;
+    double floor;
+} cf_lm_stop;
+
+/* Iterates an initialised workspace until a rule of stop fires or an iteration fails. Returns 0,
+** or -1 when an iteration ran out of memory (the position is then the last good one). */
+int cf_lm_iterate(gsl_multifit_nlinear_workspace *w, const cf_lm_stop *stop);
+
+#endif

@@ -1,0 +1,58 @@
+/*
+** The fit through the lattice (conifit fit --target lattice): the lattice's curve, not the single
+** spring's, is the objective. It optimises the three identifiable quantities (rho, solid strain
+** s/H, stress scale F_C/H^2; the lattice's stress depends on the design parameters only through
+** them, as the single spring's does) through the homogenised cell (cell.h), then places the design
+** parameters as the ordinary fit does (cf_fit_place). The verification of the placed spring in
+** the full lattice is a measurement and belongs to the validation (validate.h,
+** cf_validate_lattice_fit).
+**
+** Stress-strain tables only: a force-displacement table is a single spring's curve, not a block
+** of tissue, and its free length H is not determined by the data.
+*/
+#ifndef CF_LATTICE_FIT_H
+#define CF_LATTICE_FIT_H
+
+#include <stddef.h>
+
+#include "conifit/error.h"
+#include "conifit/family.h"
+#include "conifit/fit.h"
+#include "conifit/law.h"
+#include "conifit/measure.h"
+#include "conifit/msm.h"
+
+/* Where the lattice comes from (the validation's lattice and the fits through it). */
+typedef struct cf_validate_setup {
+    cf_msm_config cfg;          /* lattice and Newton settings */
+    cf_law_method method;       /* law evaluator in the lattice */
+    size_t table_intervals;     /* table size when method is CF_LAW_TABLE */
+} cf_validate_setup;
+
+/* What the fit through the lattice did (the verification fields are filled by
+** cf_validate_lattice_fit, validate.h). */
+typedef struct cf_through_msm {
+    int done;                   /* 1: run */
+    int improved;               /* 1: the spring was replaced (the lattice fits better) */
+    double rmse_before;         /* RMSE of the ordinary fit in the lattice (homogenised cell),
+                                ** MPa */
+    double cell_rmse;           /* RMSE of the reported spring through the cell: the fit's, MPa */
+    double rmse_after;          /* validation RMSE of the reported spring (full lattice), MPa */
+    int verified;               /* 1: the full lattice ran (uniaxial); 0: the mode is the cell's */
+    double verify_max_abs;      /* largest |full lattice - cell| at the table's strains, MPa */
+    cf_ident ident_before;      /* rho, s/H, F_C/H^2 [MPa] of the ordinary fit (family.h) */
+    cf_ident ident_after;       /* the same after the lattice objective */
+    double wall_time_s;         /* s, the optimisation, the placement and the verification */
+    long evaluations;           /* cell curves computed */
+} cf_through_msm;
+
+/* The fit through the lattice for one fitted spring res (in: the ordinary fit; out: the spring
+** placed from the identifiable quantities that make the homogenised cell reproduce the table in
+** its mode, when that lowers the cell's RMSE). Local searches (NLopt BOBYQA over log rho and s/H,
+** the stress scale in closed form) from the ordinary fit and a coarse grid. t->done = 1 when it
+** ran; CF_E_DATA for a force-displacement table or a table no spring reaches, CF_E_INTERNAL when
+** memory runs out. Deterministic. cf_validate_lattice_fit (validate.h) then verifies res. */
+cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_validate_setup *s,
+                         cf_fit_result *res, cf_through_msm *t, cf_error *err);
+
+#endif

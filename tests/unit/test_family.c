@@ -1,0 +1,137 @@
+/*
+** Tests of the identifiable family (src/model/family.c): the named and indexed views of cf_ident
+** agree; a member built from a family belongs to it; the force-displacement scales are the
+** stress-strain ones times H and H^2 and the law's own travel and solid load; the wire modulus
+** of a solid load inverts the family's load scale; the family's reduced curve is the member's
+** law; the design limits in the family's space at points worked out by hand.
+*/
+#include "testutil.h"
+
+#include "conifit/family.h"
+#include "conifit/law.h"
+
+static void named_and_indexed_views_agree(void **state)
+{
+    (void)state;
+    cf_ident q = {.rho = 0.25, .solid = 0.4, .scale = 0.03};
+    assert_true(sizeof q == CF_IDENT_COUNT * sizeof(double));
+    assert_close(q.v[CF_IDENT_RHO], 0.25, 0);
+    assert_close(q.v[CF_IDENT_SOLID], 0.4, 0);
+    assert_close(q.v[CF_IDENT_SCALE], 0.03, 0);
+    q.v[CF_IDENT_SCALE] = 2;
+    assert_close(q.scale, 2, 0);
+}
+
+static void a_member_belongs_to_its_family(void **state)
+{
+    (void)state;
+    const double rhos[] = {0.001, 0.05, 0.3, 0.7, 0.999}, es[] = {0.05, 0.5, 0.95};
+    for (size_t i = 0; i < sizeof rhos / sizeof rhos[0]; i++)
+        for (size_t j = 0; j < sizeof es / sizeof es[0]; j++) {
+            const cf_ident q = {.rho = rhos[i], .solid = es[j], .scale = 0.0123};
+            cf_spring p = cf_ident_member(&q);
+            assert_close(p.H_mm, 1.0, 0);
+            cf_law law;
+            assert_int_equal(cf_law_init(&law, &p, NULL), CF_OK);
+            assert_int_equal(law.type, CF_NON_TELESCOPING);
+            cf_law_free(&law);
+            const cf_ident got = cf_ident_of(&p, 0);
+            for (int k = 0; k < CF_IDENT_COUNT; k++)
+                assert_close(got.v[k], q.v[k], 1e-12 * q.v[k]);
+        }
+}
+
+static void force_scales_are_the_stress_scales_times_H(void **state)
+{
+    (void)state;
+    const cf_spring springs[] = {{10, 30, 4, 1, 80000, 40}, {6, 15, 2.5, 2, 26, 10}};
+    for (size_t i = 0; i < sizeof springs / sizeof springs[0]; i++) {
+        const cf_spring *p = &springs[i];
+        cf_law law;
+        assert_int_equal(cf_law_init(&law, p, NULL), CF_OK);
+        const cf_ident ss = cf_ident_of(p, 0), fd = cf_ident_of(p, 1);
+        const double H = p->H_mm;
+        assert_close(fd.rho, ss.rho, 0);
+        assert_close(fd.rho, p->D1_mm / p->D2_mm, 0);
+        assert_close(fd.solid, ss.solid * H, 1e-12 * fd.solid);
+        assert_close(fd.scale, ss.scale * H * H, 1e-12 * fd.scale);
+        assert_close(fd.solid, law.travel_mm, 1e-12 * fd.solid);
+        assert_close(fd.scale, law.F_C_N, 1e-12 * fd.scale);
+        /* the wire modulus of that solid load is the spring's own */
+        const cf_ident t = cf_ident_of_type(p, law.type, 1);
+        assert_close(cf_ident_G_of_FC(t.scale, p->n, p->D1_mm, p->d_mm, t.solid), p->G_MPa,
+                     1e-12 * p->G_MPa);
+        cf_law_free(&law);
+    }
+}
+
+static void the_reduced_curve_is_the_member_law(void **state)
+{
+    (void)state;
+    const cf_ident q = {.rho = 0.2, .solid = 0.6, .scale = 0.05};
+    cf_spring p = cf_ident_member(&q);
+    cf_law law, canon;
+    assert_int_equal(cf_law_init(&law, &p, NULL), CF_OK);
+    assert_int_equal(cf_ident_canon_law(q.rho, &canon), CF_OK);
+    for (int i = -10; i <= 10; i++) {
+        const double x = 0.059 * i; /* past solid on both sides at the ends */
+        const double F = cf_law_force(&law, CF_LAW_CLOSED, x * p.H_mm, NULL, NULL) /
+                         (p.H_mm * p.H_mm);
+        double dB;
+        const double r = cf_ident_reduced(&canon, q.scale, q.solid, x, &dB);
+        assert_close(r, F, 1e-12 * q.scale);
+        /* d/dB against a central difference */
+        const double h = 1e-6;
+        const double num = (cf_ident_reduced(&canon, q.scale, q.solid + h, x, NULL) -
+                            cf_ident_reduced(&canon, q.scale, q.solid - h, x, NULL)) /
+                           (2 * h);
+        if (fabs(x) < 0.95 * q.solid)
+            assert_close(dB, num, 1e-5 * q.scale / q.solid);
+    }
+    cf_law_free(&law);
+    cf_law_free(&canon);
+}
+
+static void the_design_limits_at_points_worked_by_hand(void **state)
+{
+    (void)state;
+    assert_close(cf_ident_rho_hi(CF_NON_TELESCOPING, 12), 1.0, 0);
+    assert_close(cf_ident_rho_hi(CF_TELESCOPING, 12), 0.75 * (1 - 1e-6), 1e-15);
+    const cf_ident_design d = {2, 30, 80000, 10, 12, 0.01};
+    /* non-telescoping at rho 0.5, s/H 0.5: n_lo = max(2, 1.5, 0.3) = 2, within n <= 30 (and
+    ** rho well above rho_min: the margin is the largest of the limits' margins) */
+    cf_ident_region r = cf_ident_region_at(&d, CF_NON_TELESCOPING, 0.5, 0.5, 0);
+    assert_close(r.margin, log(2.0) - log(30.0), 1e-15);
+    assert_close(r.A_max, 80000 * 0.25 / (8 * 27 * 4.0), 1e-12);
+    assert_int_equal(r.lo_bit, CF_C_COILS);
+    assert_int_equal(r.hi_bit, CF_C_COILS_MAX);
+    /* telescoping at rho 0.1, s/H 0.5: c_lo = max(3, 4/9) = 3, c_hi = min(12, 2) = 2: outside */
+    r = cf_ident_region_at(&d, CF_TELESCOPING, 0.1, 0.5, 0);
+    assert_close(r.margin, log(3.0) - log(2.0), 1e-15);
+    assert_int_equal(r.lo_bit, CF_C_INDEX_MIN);
+    assert_int_equal(r.hi_bit, CF_C_D2_H);
+    /* below rho_min (here 0.6), the diameter ratio is the limit; outside (0, 1), no family */
+    const cf_ident_design d6 = {2, 30, 80000, 10, 12, 0.6};
+    r = cf_ident_region_at(&d6, CF_NON_TELESCOPING, 0.5, 0.5, 0);
+    assert_close(r.margin, log(0.6 * (1 - CF_IDENT_RHO_MIN_TOL)) - log(0.5), 1e-15);
+    assert_int_equal(r.lo_bit, CF_C_RHO_MIN);
+    assert_int_equal(r.hi_bit, 0);
+    assert_close(cf_ident_region_at(&d, CF_NON_TELESCOPING, 1.0, 0.5, 0).margin, 50, 0);
+    assert_close(cf_ident_region_at(&d, CF_TELESCOPING, 0.5, 0.0, 0).margin, 50, 0);
+    /* `inside` keeps that fraction of the scale in reserve */
+    const double A0 = cf_ident_region_at(&d, CF_NON_TELESCOPING, 0.5, 0.5, 0).A_max;
+    assert_close(cf_ident_region_at(&d, CF_NON_TELESCOPING, 0.5, 0.5, 1e-4).A_max,
+                 A0 * (1 - 1e-4), 1e-15 * A0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(named_and_indexed_views_agree),
+        cmocka_unit_test(a_member_belongs_to_its_family),
+        cmocka_unit_test(force_scales_are_the_stress_scales_times_H),
+        cmocka_unit_test(the_reduced_curve_is_the_member_law),
+        cmocka_unit_test(the_design_limits_at_points_worked_by_hand),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
