@@ -249,13 +249,13 @@ static void print_summary(const cf_export_format_info *fi, int lattice,
                           const cf_export_report *rep)
 {
     if (lattice)
-        fprintf(stderr,
+        cf_cli_printf_safe(stderr,
                 "conifit export: %s lattice, %zu nodes, %zu springs in %zu groups, %zu load "
                 "steps; tables of %zu rows, max error %.3g of F_C (%.3g N), tol %g\n",
                 fi->name, rep->nodes, rep->springs, rep->groups, rep->steps, rep->rows,
                 rep->max_err_rel, rep->max_err_N, rep->tol);
     else
-        fprintf(stderr,
+        cf_cli_printf_safe(stderr,
                 "conifit export: %s, %zu rows, max error %.3g of F_C (%.3g N), tol %g, table "
                 "over u in [%.10g, %.10g] mm\n",
                 fi->name, rep->rows, rep->max_err_rel, rep->max_err_N, rep->tol, rep->u_lo_mm,

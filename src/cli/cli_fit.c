@@ -77,13 +77,13 @@ static void fit_warnings(const char *file, const cf_fit_report *r, const cf_fit_
     for (int b = 0; b < CF_C_COUNT; b++) {
         unsigned bit = 1u << b;
         if (f->violated & bit)
-            fprintf(stderr,
+            cf_cli_printf_safe(stderr,
                     "conifit: warning: %s: no %s spring of this table meets the limit %s "
                     "(feasible: false); to widen it: %s\n",
                     file, type, cf_fit_constraint_name(bit), limit_flag(bit));
     }
     if (f->feasible && f->solid_ratio < CF_FIT_SOLID_RATIO_WARN)
-        fprintf(stderr,
+        cf_cli_printf_safe(stderr,
                 "conifit: warning: %s: the %s law goes solid at %s %.4g, %.3g times the table's "
                 "largest (below %.1f): it stiffens without bound just past the data\n",
                 file, type, cf_table_is_force(r->table) ? "displacement [mm]" : "strain", f->ident.solid,
@@ -95,9 +95,9 @@ static void show_progress(void *ctx, const char *table, const char *what)
 {
     (void)ctx;
     if (!table)
-        fprintf(stderr, "conifit fit: %s\n", what);
+        cf_cli_printf_safe(stderr, "conifit fit: %s\n", what);
     else if (strstr(what, "through the lattice") || strstr(what, "viscoelastic"))
-        fprintf(stderr, "conifit: %s: %s...\n", table, what);
+        cf_cli_printf_safe(stderr, "conifit: %s: %s...\n", table, what);
 }
 
 /* Fits one loaded table and writes its outputs. */
@@ -199,12 +199,12 @@ static int run_joint(const fit_args *a, fit_job *jobs, const char *const *inputs
     if (rc == CF_EXIT_OK && !a->quiet) {
         char *text = cf_joint_text(&r);
         if (text)
-            fputs(text, stdout);
+            cf_cli_write_safe(stdout, text);
         free(text);
         if (a->out)
-            printf("Fit file: %s\n", a->out);
+            cf_cli_printf_safe(stdout, "Fit file: %s\n", a->out);
         if (a->plot)
-            printf("Plot: %s\n", a->plot);
+            cf_cli_printf_safe(stdout, "Plot: %s\n", a->plot);
     }
     for (int k = 0; k < r.nfits; k++)
         cf_joint_free(&r.fits[k]);
@@ -302,11 +302,11 @@ static int report_job(const fit_args *a, fit_job *j)
         free(json);
     }
     if (j->text) {
-        fputs(j->text, stdout);
+        cf_cli_write_safe(stdout, j->text);
         if (j->json_path[0])
-            printf("Fit file: %s\n", j->json_path);
+            cf_cli_printf_safe(stdout, "Fit file: %s\n", j->json_path);
         if (j->plot_path[0])
-            printf("Plot: %s\n", j->plot_path);
+            cf_cli_printf_safe(stdout, "Plot: %s\n", j->plot_path);
         if (a->nfiles > 1)
             fputc('\n', stdout);
     }
@@ -314,7 +314,7 @@ static int report_job(const fit_args *a, fit_job *j)
         fit_warnings(j->file, &j->rep, &j->rep.fits[k]);
         const cf_validation *v = &j->rep.val[k];
         if (j->rep.validate && v->done && v->unstable_in_range)
-            fprintf(stderr,
+            cf_cli_printf_safe(stderr,
                     "conifit: warning: %s: the %s spring's lattice loses stability at strain "
                     "%.4g, inside the table's range\n",
                     j->file, cf_spring_type_name(j->rep.fits[k].type), v->stable_to_strain);
@@ -326,11 +326,11 @@ static int report_job(const fit_args *a, fit_job *j)
 static void summary_row(const fit_args *a, const fit_job *j, int wname)
 {
     if (j->st != CF_OK) {
-        printf("  %-*s failed\n", wname, j->file);
+        cf_cli_printf_safe(stdout, "  %-*s failed\n", wname, j->file);
         return;
     }
     if (j->m.t) {
-        printf("  %-*s time series: %d Prony term%s, RMSE %.4g %s\n", wname, j->file,
+        cf_cli_printf_safe(stdout, "  %-*s time series: %d Prony term%s, RMSE %.4g %s\n", wname, j->file,
                j->vrep.fit.p.nbranch, j->vrep.fit.p.nbranch == 1 ? "" : "s",
                j->vrep.fit.rmse * j->m.y_to_file, j->m.y_unit);
         return;
@@ -354,7 +354,7 @@ static void summary_row(const fit_args *a, const fit_job *j, int wname)
                  j->m.y_unit);
     else if (a->popt.validate)
         snprintf(vcell, sizeof vcell, " skipped");
-    printf("  %-*s %-18s %-18s %-22s %-16s%s\n", wname, j->file, cell[0], cell[1], bcell,
+    cf_cli_printf_safe(stdout, "  %-*s %-18s %-18s %-22s %-16s%s\n", wname, j->file, cell[0], cell[1], bcell,
            b < 0                          ? "none feasible"
            : cf_report_types_tie(&j->rep) ? "tie"
                                           : cf_spring_type_name(j->rep.fits[b].type),
@@ -390,7 +390,7 @@ static int fit_all(const fit_args *a, fit_job *jobs)
             rc = e;
     }
     if (failed && (a->out || a->plot))
-        fprintf(stderr, "conifit: no output file written (outputs are written only when every "
+        cf_cli_printf_safe(stderr, "conifit: no output file written (outputs are written only when every "
                         "table succeeds)\n");
     if (a->nfiles > 1 && !a->quiet)
         print_summary(a, jobs);
