@@ -12,21 +12,7 @@
 #include "conifit/measure.h"
 #include "conifit/scene.h"
 
-static char dir[] = "/tmp/conifit-limits-XXXXXX";
-
-static int setup(void **state)
-{
-    (void)state;
-    return mkdtemp(dir) ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    char cmd[256];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    return system(cmd) == 0 ? 0 : -1;
-}
+TU_SCRATCH_GROUP("limits")
 
 /* Opens dir/name for writing. */
 static FILE *create(const char *name, char *path, size_t cap)

@@ -13,23 +13,9 @@
 #include "testutil.h"
 
 static char out[1 << 16], errb[1 << 14];
-static char dir[] = "/tmp/conifit-writes-XXXXXX";
+TU_SCRATCH_GROUP("writes")
 
 static const char spring[] = "--D1 8 --D2 20 --n 2.5 --d 2 --G 100 --H 5";
-
-static int setup(void **state)
-{
-    (void)state;
-    return mkdtemp(dir) ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    char cmd[256];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    return system(cmd) == 0 ? 0 : -1;
-}
 
 static void path_of(char *p, size_t cap, const char *name)
 {

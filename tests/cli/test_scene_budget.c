@@ -13,24 +13,10 @@
 #include "conifit/scene.h"
 
 static char out[1 << 14], errb[1 << 14];
-static char dir[] = "/tmp/conifit-budget-XXXXXX";
+TU_SCRATCH_GROUP("budget")
 
 #define SPRING "\"spring\": {\"params\": {\"D1_mm\": 6, \"D2_mm\": 15, \"n\": 2.5, \"d_mm\": 2, " \
                "\"G_MPa\": 26, \"H_mm\": 10}}"
-
-static int setup(void **state)
-{
-    (void)state;
-    return mkdtemp(dir) ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    char cmd[256];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    return system(cmd) == 0 ? 0 : -1;
-}
 
 static void scene(const char *name, const char *body)
 {

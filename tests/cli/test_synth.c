@@ -11,21 +11,7 @@
 #include "conifit/law.h"
 #include "conifit/measure.h"
 
-static char tmpdir[] = "/tmp/conifit-synth-XXXXXX";
-
-static int setup(void **state)
-{
-    (void)state;
-    return mkdtemp(tmpdir) ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    char cmd[512];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-    return system(cmd) == 0 ? 0 : -1;
-}
+TU_SCRATCH_GROUP("synth")
 
 static char out_buf[8192], err_buf[8192];
 
@@ -39,7 +25,7 @@ static void synth_writes_the_law_in_kpa(void **state)
 {
     (void)state;
     char path[512];
-    snprintf(path, sizeof path, "%s/synth-tel.csv", tmpdir);
+    snprintf(path, sizeof path, "%s/synth-tel.csv", dir);
     /* k0 = G d^4 / (2 n (D1 + D2)(D1^2 + D2^2)) = 100 16 / (2 2.5 28 464) = 1600/64960 N/mm;
     ** region 1 ends at strain u_T/H = 0.6 (1.4)(1.16)/4 = 0.2436 */
     int rc = tu_run(out_buf, sizeof out_buf, err_buf, sizeof err_buf,
@@ -70,7 +56,7 @@ static void synth_writes_the_law_in_kpa(void **state)
     cf_table_free(&m);
     /* compression: the same table with both signs flipped */
     char cpath[512];
-    snprintf(cpath, sizeof cpath, "%s/synth-comp.csv", tmpdir);
+    snprintf(cpath, sizeof cpath, "%s/synth-comp.csv", dir);
     rc = tu_run(NULL, 0, err_buf, sizeof err_buf,
                 "synth --D1 8 --D2 20 --n 2.5 --d 2 --G 100 --H 5 --strain-max 0.5 --points 11 "
                 "--compression -o %s", cpath);
@@ -92,10 +78,10 @@ static void synth_noise_is_deterministic_and_of_the_asked_size(void **state)
     (void)state;
     const char *spring = "--D1 5 --D2 12 --n 4 --d 1.25 --G 500 --H 10 --points 400";
     char a[512], b[512], c[512], z[512];
-    snprintf(a, sizeof a, "%s/noise-a.csv", tmpdir);
-    snprintf(b, sizeof b, "%s/noise-b.csv", tmpdir);
-    snprintf(c, sizeof c, "%s/noise-c.csv", tmpdir);
-    snprintf(z, sizeof z, "%s/noise-0.csv", tmpdir);
+    snprintf(a, sizeof a, "%s/noise-a.csv", dir);
+    snprintf(b, sizeof b, "%s/noise-b.csv", dir);
+    snprintf(c, sizeof c, "%s/noise-c.csv", dir);
+    snprintf(z, sizeof z, "%s/noise-0.csv", dir);
     assert_int_equal(tu_run(NULL, 0, NULL, 0, "synth %s --noise 0.01 --seed 7 -o %s", spring, a),
                      0);
     assert_int_equal(tu_run(NULL, 0, NULL, 0, "synth %s --noise 0.01 --seed 7 -o %s", spring, b),
@@ -137,7 +123,7 @@ static void synth_refuses_bad_requests_without_writing(void **state)
 {
     (void)state;
     char path[512];
-    snprintf(path, sizeof path, "%s/never.csv", tmpdir);
+    snprintf(path, sizeof path, "%s/never.csv", dir);
     const char *sp = "--D1 8 --D2 20 --n 2.5 --d 2 --G 100 --H 5";
     assert_int_equal(tu_run(NULL, 0, err_buf, sizeof err_buf, "synth %s --points", sp), 2);
     assert_non_null(strstr(err_buf, "--points"));
@@ -157,7 +143,7 @@ static void synth_refuses_bad_requests_without_writing(void **state)
         tu_run(NULL, 0, err_buf, sizeof err_buf, "synth %s --noise -1 -o %s", sp, path), 2);
     assert_false(file_exists(path));
     char nodir[600];
-    snprintf(nodir, sizeof nodir, "%s/no/such/dir/t.csv", tmpdir);
+    snprintf(nodir, sizeof nodir, "%s/no/such/dir/t.csv", dir);
     assert_int_equal(tu_run(NULL, 0, err_buf, sizeof err_buf, "synth %s -o %s", sp, nodir), 73);
     assert_false(file_exists(nodir));
     assert_int_equal(tu_run(out_buf, sizeof out_buf, NULL, 0, "synth --help"), 0);
@@ -185,7 +171,7 @@ static void shipped_table_is_reproduced_by_its_documented_command(void **state)
         fclose(f);
         assert_true(args[0] != '\0');
         char path[512];
-        snprintf(path, sizeof path, "%s/again-%zu.csv", tmpdir, k);
+        snprintf(path, sizeof path, "%s/again-%zu.csv", dir, k);
         assert_int_equal(tu_run(NULL, 0, err_buf, sizeof err_buf, "%s -o %s", args, path), 0);
         cf_table a, b;
         cf_error err = {0};

@@ -8,21 +8,7 @@
 
 #include <sys/stat.h>
 
-static char dir[] = "/tmp/conifit-term-XXXXXX";
-
-static int setup(void **state)
-{
-    (void)state;
-    return mkdtemp(dir) ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    char cmd[256];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    return system(cmd) == 0 ? 0 : -1;
-}
+TU_SCRATCH_GROUP("term")
 
 /* The hostile pieces (no single quote: the runs pass names through sh in single quotes). */
 #define ESC_NAME "t\x1b[31mred\x1b]0;title\x07"

@@ -12,22 +12,8 @@
 
 #include "conifit/measure.h"
 
-static char dir[] = "/tmp/conifit-measures-XXXXXX";
+TU_SCRATCH_GROUP("measures")
 static char out[1 << 16], errb[1 << 14];
-
-static int setup(void **state)
-{
-    (void)state;
-    return mkdtemp(dir) ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    char cmd[600];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    return system(cmd) == 0 ? 0 : -1;
-}
 
 /* Writes text to DIR/name and returns the path (static storage). */
 static const char *table(const char *name, const char *text)

@@ -13,25 +13,11 @@
 #include "conifit/scene.h"
 #include "report/plot.h"
 
-static char dir[] = "/tmp/conifit-plot-XXXXXX";
+TU_SCRATCH_GROUP("plot")
 
 static int have_gnuplot(void)
 {
     return system("command -v gnuplot >/dev/null 2>&1") == 0;
-}
-
-static int setup(void **state)
-{
-    (void)state;
-    return mkdtemp(dir) ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    char cmd[200];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    return system(cmd) == 0 ? 0 : -1;
 }
 
 static char *slurp(const char *path, size_t *len)
