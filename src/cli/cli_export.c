@@ -276,6 +276,7 @@ int cf_cli_export(int argc, char **argv)
     if (cf_fitfile_load(q.fit_path, q.ea.type, &fs, &err) != CF_OK)
         return cf_cli_fail(&err);
     opt.source = cf_cli_is_stdio(q.fit_path) ? "(standard input)" : q.fit_path;
+    opt.output = q.out_path && !cf_cli_is_stdio(q.out_path) ? q.out_path : NULL;
     opt.auto_tol = !q.ea.tol_given;
     cf_export_lattice lx;
     q.scene_fit[0] = '\0';

@@ -516,6 +516,7 @@ cf_status cf_export_write(FILE *out, const cf_fitted_spring *fs, const cf_export
         m.law = &law;
         m.base = &t;
         m.source = opt->source;
+        m.output = opt->output;
         if (single_model(&m, &law, &t) != 0 || d->model(out, &m) != 0) {
             st = cf_error_set(err, CF_E_INTERNAL, "out of memory writing the model");
             goto done;

@@ -225,6 +225,7 @@ static int lattice_model(cf_xmodel *m, const cf_lattice *lat, const cf_law *law,
     m->law = law;
     m->base = t;
     m->source = opt->source;
+    m->output = opt->output;
     lattice_title(title, cap, &lx->cfg.lattice);
     m->title = title;
     m->nsteps = lx->nsteps;

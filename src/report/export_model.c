@@ -133,6 +133,52 @@ void cf_export_comment_source(FILE *out, const char *lead, const char *tail, con
     fprintf(out, "%s\n", tail);
 }
 
+char *cf_export_febio_log_name(char *buf, size_t cap, const char *output)
+{
+    static const char suffix[] = "_top_Rz.txt";
+    const char *base = output ? output : "";
+    for (const char *c = base; *c; c++) /* the last path component */
+        if (*c == '/' || *c == '\\')
+            base = c + 1;
+    size_t n = strlen(base);
+    const char *dot = strrchr(base, '.');
+    if (dot && dot > base)
+        n = (size_t)(dot - base);
+    if (n == 0)
+        base = "conifit", n = 7;
+    size_t w = 0;
+    buf[0] = '\0';
+    for (size_t i = 0; i < n && i < CF_EXPORT_LOG_STEM_MAX;) {
+        const unsigned char *c = (const unsigned char *)base + i;
+        size_t len = cf_text_char_length(c, n - i);
+        if (len > 1 && i + len > CF_EXPORT_LOG_STEM_MAX)
+            break; /* cut before a character that does not fit */
+        const char *put = NULL;
+        char one[8] = "_";
+        switch (len ? *c : 0) {
+        case '&': put = "&amp;"; break;
+        case '<': put = "&lt;"; break;
+        case '>': put = "&gt;"; break;
+        case '"': put = "&quot;"; break;
+        case '\'': put = "&apos;"; break;
+        case '/': case '\\': case ':': case 0: put = "_"; break;
+        default:
+            memcpy(one, c, len);
+            one[len] = '\0';
+            put = one;
+        }
+        const size_t plen = strlen(put);
+        if (w + plen + sizeof suffix > cap)
+            break;
+        memcpy(buf + w, put, plen + 1);
+        w += plen;
+        i += len ? len : 1;
+    }
+    if (w + sizeof suffix <= cap)
+        memcpy(buf + w, suffix, sizeof suffix);
+    return buf;
+}
+
 void cf_export_comment_spring(FILE *out, const char *lead, const char *tail, const cf_law *law)
 {
     fprintf(out, "%sspring (%s):", lead, cf_spring_type_name(law->type));
@@ -264,22 +310,69 @@ int cf_xmodel_write_abaqus(FILE *out, const cf_xmodel *m)
 static const char *const mask_name[8] = {"", "fix_x", "fix_y", "fix_xy",
                                          "fix_z", "fix_xz", "fix_yz", "fix_xyz"};
 
+/* Convergence of FEBio's Newton iterations (FESolidSolver2::Quasin in FEBio 4.11; user manual,
+** Control section, "Convergence tolerances"). A step converges when every enabled test passes;
+** FEBio compares squared norms: |R1|^2 <= rtol |R0|^2 (R0 the step's first residual),
+** |du|^2 <= dtol^2 |dU|^2 (du the last correction, dU the step's total increment) and
+** |du.R1| <= etol |du0.R0|; a tolerance of 0 disables its test. When the tests fail but
+** |R1|^2 < min_residual, FEBio ends the step with the warning "No force acting on the system".
+** With max_ups 0 every iteration reforms the stiffness (full Newton, quadratic convergence), so a
+** residual that reaches round-off leaves the last correction at about its square: dtol 1e-9 asked
+** for a correction below 1e-9 of the step after the residual had already passed under FEBio's
+** floor, so the steps ended on the floor with the warning (seen on every step with FEBio 4.11).
+** Chosen instead:
+** - rtol (1e-2 tol)^2: the force left unbalanced is 1e-2 tol of the step's first residual, which
+**   is at most of the order of the step's change of the spring forces, so the reaction it leaves
+**   is about 1e-2 of the reaction tolerance (tol F_C times the cut weights); at tol >= 1e-9 this
+**   is >= 1e-11 of the residual, above double round-off (~1e-14 of the summed forces).
+** - dtol 1e-6: the correction below 1e-6 of the step (squared 1e-12, far above round-off).
+** - etol 0: the energy test adds nothing to these two (manual: 0 disables a test).
+** - min_residual (1e-12 F)^2, F the force scale of the reaction (the reaction tolerance divided
+**   by tol: F_C times the cut weights): the floor about 100 times above the round-off of the
+**   summed spring forces, instead of FEBio's absolute 1e-20 N^2, which a small spring's residual
+**   reaches before the tests pass. It ends a step that prescribes no change (a hold), whose
+**   residual is round-off; should it end a real step first (tol below about 1e-6, or tiny steps),
+**   FEBio warns, and the force left is 1e-12 F, far inside the reaction tolerance. */
+static void febio_control(FILE *out, const cf_xmodel *m)
+{
+    const double tol = m->base->tol > 0 ? m->base->tol : CF_EXPORT_TOL_DEFAULT;
+    const double rtol = (1e-2 * tol) * (1e-2 * tol);
+    const double scale = m->reaction_tol_N / tol;
+    const double floor_N = 1e-12 * (scale > 0 ? scale : 1.0);
+    fprintf(out, "\t<Control>\n\t\t<analysis>STATIC</analysis>\n\t\t<time_steps>%zu</time_steps>\n"
+                 "\t\t<step_size>1</step_size>\n\t\t<solver type=\"solid\">\n"
+                 "\t\t\t<max_refs>50</max_refs>\n\t\t\t<dtol>1e-06</dtol>\n"
+                 "\t\t\t<etol>0</etol>\n\t\t\t<rtol>%.3g</rtol>\n"
+                 "\t\t\t<min_residual>%.3g</min_residual>\n"
+                 "\t\t\t<qn_method type=\"BFGS\">\n\t\t\t\t<max_ups>0</max_ups>\n"
+                 "\t\t\t</qn_method>\n\t\t</solver>\n\t</Control>\n",
+            m->nsteps, rtol, floor_N * floor_N);
+}
+
 /* An FEBio 4 model, written in the order of its sections (Module, Control, Mesh with nodes,
 ** node sets and the discrete set, MeshDomains, Boundary, Discrete, LoadData, Output). Long only
 ** because the file is; each section is a few fprintf calls. */
 int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
 {
+    char log[8 * CF_EXPORT_LOG_STEM_MAX];
+    cf_export_febio_log_name(log, sizeof log, m->output);
     fprintf(out, "<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?>\n");
     model_header(out, "<!-- ", " -->", m, "FEBio 4",
-                 "febio4 -i NAME.feb (summed top reaction: column sums of NAME_top_Rz.txt)");
+                 "febio4 -i NAME.feb (the top reaction: the sum of Rz in the logfile the Output "
+                 "section names, beside NAME.feb)");
+    /* FEBio's node data file (FECore DataRecord::Write): per converged step the lines
+    ** "*Step  = k", "*Time  = t", "*Data  = Rz", then one line "node,Rz" per node of the set.
+    ** Rz is the reaction at a prescribed degree of freedom, the force the constraint applies to
+    ** the node (FEBioMechData.cpp FENodeForceZ from FESolidSolver2's m_Fr, which the residual
+    ** assembly fills with minus the springs' forces on the node). */
+    fprintf(out,
+            "<!-- reading the result: the logfile holds, per converged step, the lines '*Step = "
+            "k', '*Time = t', '*Data = Rz' and then one line 'node,Rz' per top node; the top "
+            "reaction of step k is the sum of Rz over those lines. Rz is the force the "
+            "prescribed displacement applies to the node along z: negative under compression, "
+            "so conifit's compressive reaction above is minus that sum -->\n");
     fprintf(out, "<febio_spec version=\"4.0\">\n\t<Module type=\"solid\"/>\n");
-    fprintf(out, "\t<Control>\n\t\t<analysis>STATIC</analysis>\n\t\t<time_steps>%zu</time_steps>\n"
-                 "\t\t<step_size>1</step_size>\n\t\t<solver type=\"solid\">\n"
-                 "\t\t\t<max_refs>50</max_refs>\n\t\t\t<dtol>1e-9</dtol>\n"
-                 "\t\t\t<etol>1e-12</etol>\n\t\t\t<rtol>1e-12</rtol>\n"
-                 "\t\t\t<qn_method type=\"BFGS\">\n\t\t\t\t<max_ups>0</max_ups>\n"
-                 "\t\t\t</qn_method>\n\t\t</solver>\n\t</Control>\n",
-            m->nsteps);
+    febio_control(out, m);
     fprintf(out, "\t<Mesh>\n\t\t<Nodes name=\"conifit_nodes\">\n");
     for (size_t i = 0; i < m->nn; i++)
         fprintf(out, "\t\t\t<node id=\"%zu\">%.17g,%.17g,%.17g</node>\n", i + 1, m->X[i], m->Y[i],
@@ -347,7 +440,7 @@ int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
         fprintf(out, "\t\t\t\t<pt>%zu,%.17g</pt>\n", k + 1, m->dz_mm[k]);
     fprintf(out, "\t\t\t</points>\n\t\t</load_controller>\n\t</LoadData>\n");
     fprintf(out, "\t<Output>\n\t\t<logfile>\n\t\t\t<node_data data=\"Rz\" delim=\",\" "
-                 "file=\"NAME_top_Rz.txt\" node_set=\"top\"/>\n\t\t</logfile>\n\t</Output>\n");
+                 "file=\"%s\" node_set=\"top\"/>\n\t\t</logfile>\n\t</Output>\n", log);
     fprintf(out, "</febio_spec>\n");
     return 0;
 }

@@ -27,6 +27,8 @@ typedef struct cf_xgroup {
 typedef struct cf_xmodel {
     const char *title;      /* one line: what the model is */
     const char *source;     /* fit file name, for provenance */
+    const char *output;     /* the file written (NULL: standard output), names the model's own
+                            ** output files */
     const cf_law *law;
     const cf_export_table *base; /* the law's table (weight 1, rest length H) */
     size_t nn;              /* nodes */
@@ -80,6 +82,17 @@ int cf_xmodel_write_sofa(FILE *out, const cf_xmodel *m);
 ** spring data (reals), after deleting blank lines (ccx manual, *SPRING); each number fits the 20
 ** characters ccx reads. */
 void cf_export_inp_pair(FILE *out, double force_N, double elongation_mm);
+
+/* The name of the file FEBio writes the top nodes' reactions to, for a model written to `output`
+** (NULL or "" for standard output): the output's base name without its extension, then "_top_Rz.txt"
+** ("conifit_top_Rz.txt" for standard output), so that two models in one folder do not share it.
+** The output's name is text from outside: folders are dropped, and the rest is written for an XML
+** attribute: printable ASCII and whole printable UTF-8 characters kept, the five XML markup
+** characters as entities (FEBio's reader decodes them), path separators ('/', '\', ':') and
+** every other byte (controls, DEL, C1 controls, bytes that are not UTF-8) as '_'; a base name
+** longer than CF_EXPORT_LOG_STEM_MAX bytes is cut at a character boundary. Returns buf. */
+#define CF_EXPORT_LOG_STEM_MAX 200
+char *cf_export_febio_log_name(char *buf, size_t cap, const char *output);
 
 /* Writes a comment line with the spring's parameters, and the table's accuracy, each line
 ** starting with lead and ending with tail. */

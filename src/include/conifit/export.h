@@ -125,6 +125,8 @@ typedef struct cf_export_options {
     double u_lo_mm, u_hi_mm; /* compression range of the table, mm (u_lo <= 0 <= u_hi) */
     int example;         /* a complete one-spring model that runs as it is, instead of the block */
     const char *source;  /* name of the fit file, for provenance ("" or NULL if none) */
+    const char *output;  /* name of the file written (-o), from which a model names its own
+                         ** outputs (FEBio's log file); "" or NULL for standard output */
     int auto_tol;        /* calculix/abaqus: loosen tol (x2, x2.5, x2 ...) until the table fits
                          ** CF_EXPORT_CALCULIX_MAX_ROWS rows, instead of refusing */
 } cf_export_options;
