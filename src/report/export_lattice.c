@@ -319,7 +319,7 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
         }
     if (cf_xmodel_tables(&m) != 0 || cf_xmodel_write(out, &m, opt->format) != 0)
         goto oom;
-    r = cf_export_report_of_table(&t);
+    r = cf_export_report_of_table(&t, &law);
     r.groups = m.ng;
     r.springs = m.ns;
     r.nodes = m.nn;

@@ -1,11 +1,15 @@
 /*
-** Tests of what the FEBio exports tell their simulator and their reader
+** Tests of what the FEBio and LS-DYNA exports tell their simulator and their reader
 ** (src/report/export_model.c, export_table.c, conifit export):
 **  - FEBio: the log file of the top reactions is named after the output (-o), so two models in
 **    one folder do not share it; an output's name from outside is written XML-escaped with no
 **    folder in it (the XML parsed back by libxml2 gives the name); the header says what FEBio
 **    writes (one line per top node and step) and the sign of Rz; the convergence tolerances are
 **    ones FEBio can meet in double precision (no dtol of 1e-9);
+**  - LS-DYNA: every curve is evenly spaced with LCINT = rows, so LS-DYNA's rediscretization to
+**    LCINT equally spaced points gives the rows back; resampled here as LS-DYNA does, the curve is
+**    within the stated tolerance over the stated range, and the header and the summary on stderr
+**    state that range and what happens past it.
 */
 #include <limits.h>
 
@@ -92,6 +96,15 @@ static char *export_run(const char *out, const char *const *args)
     char *text = tu_slurp(p);
     assert_non_null(text);
     return text;
+}
+
+static char *stderr_text(void)
+{
+    char p[PATH_MAX];
+    snprintf(p, sizeof p, "%s/stderr.txt", dir);
+    char *e = tu_slurp(p);
+    assert_non_null(e);
+    return e;
 }
 
 /* The file attribute of the FEBio model's node_data log request, as an XML parser reads it
@@ -226,6 +239,216 @@ static void febio_tolerances_can_be_met_in_double_precision_and_keep_the_toleran
     cf_law_free(&law);
 }
 
+/* ---- LS-DYNA ---------------------------------------------------------------------------------- */
+
+/* Splits a fixed-width card into fields of `w` characters. */
+static void fields(const char *line, int w, int count, double *out)
+{
+    char f[24];
+    for (int k = 0; k < count; k++) {
+        snprintf(f, (size_t)w + 1, "%.*s", w, line + w * k);
+        out[k] = atof(f);
+    }
+}
+
+typedef struct curve {
+    size_t n, lcint;
+    double *x, *y; /* elongation (mm), tension (N) */
+} curve;
+
+/* Reads the *DEFINE_CURVE after position p: its LCINT and its points. Returns the position past
+** them. */
+static const char *read_curve(const char *p, curve *c)
+{
+    p = strstr(p, "*DEFINE_CURVE\n");
+    assert_non_null(p);
+    p = strchr(strchr(p, '\n') + 1, '\n') + 1; /* past the keyword and the comment */
+    double f[8];
+    fields(p, 10, 8, f);
+    c->lcint = (size_t)f[7];
+    p = strchr(strchr(p, '\n') + 1, '\n') + 1; /* past the card and the points' comment */
+    size_t cap = 1024;
+    c->n = 0;
+    c->x = malloc(cap * sizeof *c->x);
+    c->y = malloc(cap * sizeof *c->y);
+    while (*p && *p != '*' && *p != '$') {
+        if (c->n == cap) {
+            cap *= 2;
+            c->x = realloc(c->x, cap * sizeof *c->x);
+            c->y = realloc(c->y, cap * sizeof *c->y);
+        }
+        fields(p, 20, 2, f);
+        c->x[c->n] = f[0];
+        c->y[c->n++] = f[1];
+        p = strchr(p, '\n') + 1;
+    }
+    return p;
+}
+
+/* Linear interpolation of the points (x ascending) at v, the end values outside. */
+static double interp(const double *x, const double *y, size_t n, double v)
+{
+    if (v <= x[0])
+        return y[0];
+    if (v >= x[n - 1])
+        return y[n - 1];
+    size_t lo = 0, hi = n - 1;
+    while (hi - lo > 1) {
+        size_t mid = (lo + hi) / 2;
+        if (x[mid] <= v)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return y[lo] + (v - x[lo]) / (x[hi] - x[lo]) * (y[hi] - y[lo]);
+}
+
+/* The curve as LS-DYNA uses it: rediscretized to m equally spaced points between its first and
+** last abscissa (LSTC FAQ "discretization of curves"), then interpolated linearly. Returns the
+** largest distance from the law in tension, -scale F(-e L0 ... ), over [x_lo, x_hi] on a dense
+** grid of its own (uniform, and crowded towards both ends), as a fraction of F_C. */
+static double resampled_error(const curve *c, size_t m, const cf_law *law, double stretch,
+                              double weight, double x_lo, double x_hi)
+{
+    double *rx = malloc(m * sizeof *rx), *ry = malloc(m * sizeof *ry);
+    assert_true(rx && ry);
+    const double a = c->x[0], b = c->x[c->n - 1];
+    for (size_t j = 0; j < m; j++) {
+        rx[j] = a + (b - a) * (double)j / (double)(m - 1);
+        ry[j] = interp(c->x, c->y, c->n, rx[j]);
+    }
+    double worst = 0.0;
+    const int N = 200003;
+    for (int i = 0; i <= N; i++) {
+        const double w = (double)i / N, q = w * w * w;
+        const double xs[3] = {x_lo + (x_hi - x_lo) * w, x_hi - (x_hi - x_lo) * 0.5 * q,
+                              x_lo + (x_hi - x_lo) * 0.5 * q};
+        for (int k = 0; k < 3; k++) {
+            const double law_T =
+                -weight * cf_law_force(law, CF_LAW_EXACT, -xs[k] * stretch, NULL, NULL);
+            worst = fmax(worst, fabs(interp(rx, ry, m, xs[k]) - law_T) / (weight * law->F_C_N));
+        }
+    }
+    free(rx), free(ry);
+    return worst;
+}
+
+/* The rows are evenly spaced (as printed: 13 significant digits) and LCINT is their count. */
+static void assert_even_with_lcint(const curve *c)
+{
+    assert_true(c->n >= 2);
+    if (c->lcint != c->n)
+        fail_msg("LCINT %zu for a curve of %zu rows", c->lcint, c->n);
+    const double a = c->x[0], b = c->x[c->n - 1];
+    for (size_t i = 0; i < c->n; i++) {
+        const double want = a + (b - a) * (double)i / (double)(c->n - 1);
+        if (fabs(c->x[i] - want) > 1e-11 * (b - a))
+            fail_msg("row %zu at %.15g, not evenly spaced (%.15g)", i, c->x[i], want);
+    }
+}
+
+/* The range and tolerance the header states: "table: N rows over u in [lo, hi] mm ... within
+** TOL F_C". */
+static void stated_range(const char *x, size_t *rows, double *lo, double *hi, double *tol)
+{
+    const char *p = strstr(x, "table: ");
+    assert_non_null(p);
+    assert_int_equal(sscanf(p, "table: %zu rows over u in [%lf, %lf] mm", rows, lo, hi), 3);
+    p = strstr(p, "within ");
+    assert_non_null(p);
+    assert_int_equal(sscanf(p, "within %lf F_C", tol), 1);
+}
+
+static void lsdyna_curve_resampled_as_lsdyna_does_is_within_the_stated_tolerance(void **state)
+{
+    (void)state;
+    cf_law law;
+    cf_error err = {0};
+    assert_int_equal(cf_law_init(&law, &TEL, &err), CF_OK);
+    const char *full[] = {"--format", "lsdyna", "--tol", "1e-4", NULL};
+    const char *part[] = {"--format", "lsdyna", "--tol", "1e-4", "--range", "-5:30", NULL};
+    const char *const *cases[2] = {full, part};
+    for (int k = 0; k < 2; k++) {
+        char *x = export_run("spring.k", cases[k]);
+        char *e = stderr_text();
+        size_t rows;
+        double lo, hi, tol;
+        stated_range(x, &rows, &lo, &hi, &tol);
+        assert_close(tol, 1e-4, 0);
+        curve c;
+        read_curve(x, &c);
+        assert_int_equal(c.n, rows);
+        assert_even_with_lcint(&c);
+        /* the curve spans the stated range: elongation -hi .. -lo */
+        assert_close(c.x[0], -hi, 1e-9 * hi);
+        assert_close(c.x[c.n - 1], -lo, 1e-9 * hi);
+        const double err_lcint = resampled_error(&c, c.lcint, &law, 1.0, 1.0, -hi, -lo);
+        if (err_lcint > tol)
+            fail_msg("resampled to LCINT = %zu points, the curve is %g F_C off the law", c.lcint,
+                     err_lcint);
+        assert_true(err_lcint > 0.3 * tol); /* the check sees the table, not the law */
+        /* LS-DYNA's default of 100 points would not do */
+        const double err_100 = resampled_error(&c, 100, &law, 1.0, 1.0, -hi, -lo);
+        print_message("LS-DYNA curve of %zu rows over u in [%g, %g] mm: %.3g F_C off the law "
+                      "resampled to LCINT points, %.3g F_C to 100\n",
+                      rows, lo, hi, err_lcint, err_100);
+        assert_true(err_100 > (k == 0 ? 10 : 1) * tol);
+        if (k == 0) { /* the full range is shortened, within the row limit, and says so */
+            assert_true(rows <= CF_EXPORT_LSDYNA_MAX_ROWS);
+            assert_true(hi < cf_export_table_end(&law, 1e-4) && hi > 0.99 * law.travel_mm);
+            assert_non_null(strstr(x, "$ range: u in ["));
+            assert_non_null(strstr(x, "shortened from ["));
+            assert_non_null(strstr(e, "shortened from ["));
+        } else { /* a range the even rows meet is kept whole, with the fewest rows */
+            assert_close(lo, -5, 0);
+            assert_close(hi, 30, 0);
+            assert_true(rows < CF_EXPORT_LSDYNA_MAX_ROWS);
+            assert_null(strstr(x, "shortened from"));
+        }
+        assert_non_null(strstr(x, "LCINT = "));
+        assert_non_null(strstr(x, "past them LS-DYNA extrapolates"));
+        assert_non_null(strstr(e, "past them the curve is extrapolated"));
+        free(c.x), free(c.y), free(x), free(e);
+    }
+    cf_law_free(&law);
+}
+
+/* Every group of the lattice model: an even curve with LCINT = rows, within the tolerance of the
+** law at that group's rest length and weight once resampled as LS-DYNA does. */
+static void lsdyna_lattice_curves_are_even_and_within_tolerance_in_every_group(void **state)
+{
+    (void)state;
+    cf_law law;
+    cf_error err = {0};
+    assert_int_equal(cf_law_init(&law, &TEL, &err), CF_OK);
+    const char *lat[] = {"--lattice", scene, "--format", "lsdyna", "--tol", "1e-3", NULL};
+    char *x = export_run("lattice.k", lat);
+    size_t rows;
+    double lo, hi, tol;
+    stated_range(x, &rows, &lo, &hi, &tol);
+    size_t groups = 0;
+    for (const char *p = strstr(x, "\n$ group "); p; p = strstr(p + 1, "\n$ group ")) {
+        size_t g;
+        double L0, w;
+        assert_int_equal(sscanf(p, "\n$ group %zu: L0 = %lf mm, weight %lf", &g, &L0, &w), 3);
+        curve c;
+        read_curve(p, &c);
+        assert_int_equal(c.n, rows);
+        assert_even_with_lcint(&c);
+        const double stretch = TEL.H_mm / L0; /* u = -e H / L0 */
+        const double e_lo = -hi / stretch, e_hi = -lo / stretch;
+        assert_close(c.x[0], e_lo, 1e-9 * fabs(e_lo));
+        const double er = resampled_error(&c, c.lcint, &law, stretch, w, e_lo, e_hi);
+        if (er > tol)
+            fail_msg("group %zu resampled is %g F_C off the law", g, er);
+        free(c.x), free(c.y);
+        groups++;
+    }
+    assert_true(groups >= 3);
+    free(x);
+    cf_law_free(&law);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -233,6 +456,8 @@ int main(void)
         cmocka_unit_test(febio_log_file_follows_the_output_so_two_models_do_not_share_it),
         cmocka_unit_test(febio_header_says_what_febio_writes_and_the_sign_of_rz),
         cmocka_unit_test(febio_tolerances_can_be_met_in_double_precision_and_keep_the_tolerance),
+        cmocka_unit_test(lsdyna_curve_resampled_as_lsdyna_does_is_within_the_stated_tolerance),
+        cmocka_unit_test(lsdyna_lattice_curves_are_even_and_within_tolerance_in_every_group),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
