@@ -244,7 +244,8 @@ static cf_status emit(const export_request *q, const char *buf, size_t len, cf_e
     return CF_OK;
 }
 
-/* Rows and achieved error (and the lattice's size) on stderr. */
+/* Rows and achieved error (and the lattice's size) on stderr; for an evenly spaced table, its
+** range, how far the law's force goes there and what the target does past it. */
 static void print_summary(const cf_export_format_info *fi, int lattice,
                           const cf_export_report *rep)
 {
@@ -260,6 +261,20 @@ static void print_summary(const cf_export_format_info *fi, int lattice,
                 "over u in [%.10g, %.10g] mm\n",
                 fi->name, rep->rows, rep->max_err_rel, rep->max_err_N, rep->tol, rep->u_lo_mm,
                 rep->u_hi_mm);
+    if (!rep->even)
+        return;
+    const int cut = rep->u_lo_mm != rep->req_lo_mm || rep->u_hi_mm != rep->req_hi_mm;
+    fprintf(stderr, "conifit export: %s rows evenly spaced, and LCINT = rows: the target's "
+                    "resampling of each curve to LCINT even points gives them back; ",
+            fi->name);
+    if (cut)
+        fprintf(stderr,
+                "the range is shortened from [%.10g, %.10g] to [%.10g, %.10g] mm (spring "
+                "compression), where at most %zu evenly spaced rows meet the tolerance; ",
+                rep->req_lo_mm, rep->req_hi_mm, rep->u_lo_mm, rep->u_hi_mm, fi->max_rows);
+    fprintf(stderr, "at its ends the law carries %.4g of F_C; past them the curve is extrapolated "
+                    "along its end segments (the law stiffens to F_C at solid)\n",
+            rep->end_force_rel);
 }
 
 /* export: parse, load the spring (and the lattice), render the whole output in memory, write it,
@@ -276,6 +291,7 @@ int cf_cli_export(int argc, char **argv)
     if (cf_fitfile_load(q.fit_path, q.ea.type, &fs, &err) != CF_OK)
         return cf_cli_fail(&err);
     opt.source = cf_cli_is_stdio(q.fit_path) ? "(standard input)" : q.fit_path;
+    opt.output = q.out_path && !cf_cli_is_stdio(q.out_path) ? q.out_path : NULL;
     opt.auto_tol = !q.ea.tol_given;
     cf_export_lattice lx;
     q.scene_fit[0] = '\0';

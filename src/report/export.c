@@ -235,8 +235,9 @@ static cf_status write_febio(FILE *out, const block_job *j, cf_error *err)
 }
 
 /* LS-DYNA keyword cards: 10-character fields; the curve's points in two 20-character fields.
-** LCINT (field 8 of the curve's first card) is the row count: LS-DYNA otherwise resamples the
-** curve to 100 equally spaced points. */
+** The table is evenly spaced and LCINT (field 8 of the curve's first card) is its row count:
+** LS-DYNA rediscretizes every curve to LCINT equally spaced points (100 by default), which are
+** then the rows themselves (see CF_EXPORT_LSDYNA_MAX_ROWS). */
 static cf_status write_lsdyna(FILE *out, const block_job *j, cf_error *err)
 {
     (void)err;
@@ -247,7 +248,7 @@ static cf_status write_lsdyna(FILE *out, const block_job *j, cf_error *err)
     prony_comment(out, "$ ", "", j->fs,
                   "not written as cards: the viscoelastic materials with G_i, BETA_i are for "
                   "solids; *MAT_SPRING_MAXWELL holds one linear term, not a series on a curve");
-    fprintf(out, "$ LCINT = rows, so that LS-DYNA does not resample the curve to 100 points\n");
+    cf_export_comment_even(out, "$ ", "", t, j->law);
     fprintf(out, "*KEYWORD\n*MAT_SPRING_NONLINEAR_ELASTIC\n");
     fprintf(out, "$#     mid       lcd       lcr\n");
     fprintf(out, "%10d%10d%10d\n", 1, 1, 0);
@@ -275,7 +276,7 @@ typedef struct format_def {
 } format_def;
 
 /* Indexed by cf_export_format; each entry: {format, name, extension, description, model, table,
-** max_rows}, block writer, model writer, limited_by. */
+** max_rows, even}, block writer, model writer, limited_by. */
 static const format_def formats[CF_EXPORT_FORMAT_COUNT] = {
     [CF_EXPORT_JSON] = {{CF_EXPORT_JSON, "json", ".json",
       "the spring itself (schema " CF_SPRINGFILE_SCHEMA "), for any tool", 0, 0, 0},
@@ -295,7 +296,8 @@ static const format_def formats[CF_EXPORT_FORMAT_COUNT] = {
       "FEBio 4: a nonlinear-spring discrete material", 1, 1, 0},
      write_febio, cf_xmodel_write_febio, NULL},
     [CF_EXPORT_LSDYNA] = {{CF_EXPORT_LSDYNA, "lsdyna", ".k",
-      "LS-DYNA: *MAT_SPRING_NONLINEAR_ELASTIC with its *DEFINE_CURVE", 1, 1, 0},
+      "LS-DYNA: *MAT_SPRING_NONLINEAR_ELASTIC, an evenly spaced *DEFINE_CURVE", 1, 1,
+      CF_EXPORT_LSDYNA_MAX_ROWS, 1},
      write_lsdyna, cf_xmodel_write_lsdyna, NULL},
     [CF_EXPORT_SOFA] = {{CF_EXPORT_SOFA, "sofa", ".scn",
       "SOFA v24.06+: always a scene (springs as sums of polynomial springs)", 1, 1, 0},
@@ -388,6 +390,14 @@ cf_status cf_export_table_for(const cf_law *law, const cf_export_options *opt,
     const format_def *d = format_def_of(opt->format);
     const size_t max_rows = d ? d->info.max_rows : 0;
     double tol = opt->tol;
+    if (d && d->info.even) { /* evenly spaced: the range, not the tolerance, gives way */
+        double lo = opt->u_lo_mm, hi = opt->u_hi_mm;
+        if (!opt->have_range) {
+            hi = cf_export_table_end(law, tol);
+            lo = -hi;
+        }
+        return cf_export_table_build_even(law, tol, lo, hi, max_rows, t, err);
+    }
     for (int step = 0;; step++) {
         cf_status st;
         if (opt->have_range)
@@ -427,7 +437,7 @@ cf_status cf_export_table_for(const cf_law *law, const cf_export_options *opt,
     }
 }
 
-cf_export_report cf_export_report_of_table(const cf_export_table *t)
+cf_export_report cf_export_report_of_table(const cf_export_table *t, const cf_law *law)
 {
     cf_export_report r = {0};
     r.rows = t->rows;
@@ -436,6 +446,11 @@ cf_export_report cf_export_report_of_table(const cf_export_table *t)
     r.max_err_N = t->max_err_N;
     r.u_lo_mm = t->u_lo_mm;
     r.u_hi_mm = t->u_hi_mm;
+    r.even = t->even;
+    r.req_lo_mm = t->req_lo_mm;
+    r.req_hi_mm = t->req_hi_mm;
+    if (t->rows)
+        r.end_force_rel = fmax(fabs(t->F_N[0]), fabs(t->F_N[t->rows - 1])) / law->F_C_N;
     return r;
 }
 
@@ -506,7 +521,7 @@ cf_status cf_export_write(FILE *out, const cf_fitted_spring *fs, const cf_export
     if (d->info.table) {
         if ((st = cf_export_table_for(&law, opt, &t, err)) != CF_OK)
             goto done;
-        r = cf_export_report_of_table(&t);
+        r = cf_export_report_of_table(&t, &law);
     }
     if (d->block && !opt->example) {
         const block_job j = {fs, &law, &t, opt};
@@ -516,6 +531,7 @@ cf_status cf_export_write(FILE *out, const cf_fitted_spring *fs, const cf_export
         m.law = &law;
         m.base = &t;
         m.source = opt->source;
+        m.output = opt->output;
         if (single_model(&m, &law, &t) != 0 || d->model(out, &m) != 0) {
             st = cf_error_set(err, CF_E_INTERNAL, "out of memory writing the model");
             goto done;

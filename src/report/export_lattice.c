@@ -225,6 +225,7 @@ static int lattice_model(cf_xmodel *m, const cf_lattice *lat, const cf_law *law,
     m->law = law;
     m->base = t;
     m->source = opt->source;
+    m->output = opt->output;
     lattice_title(title, cap, &lx->cfg.lattice);
     m->title = title;
     m->nsteps = lx->nsteps;
@@ -318,7 +319,7 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
         }
     if (cf_xmodel_tables(&m) != 0 || cf_xmodel_write(out, &m, opt->format) != 0)
         goto oom;
-    r = cf_export_report_of_table(&t);
+    r = cf_export_report_of_table(&t, &law);
     r.groups = m.ng;
     r.springs = m.ns;
     r.nodes = m.nn;

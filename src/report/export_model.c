@@ -15,9 +15,16 @@
 **   built the mesh; "zero displacement" and "prescribed displacement" boundary conditions on
 **   named node sets, a load controller, a logfile of node data on a node set.
 ** - LS-DYNA: *MAT_SPRING_NONLINEAR_ELASTIC (MAT_S04) on *ELEMENT_DISCRETE; every *DEFINE_CURVE is
-**   resampled to LCINT equally spaced points, 100 unless the curve's own LCINT (field 8 of its
-**   first card, since 2015) or *CONTROL_SOLUTION says otherwise (LSTC FAQ "discretization of
-**   curves"); so each curve carries LCINT >= its rows.
+**   rediscretized to LCINT equally spaced points between its first and last abscissa, 100 unless
+**   the curve's own LCINT (field 8 of its first card, since 2015) or *CONTROL_SOLUTION says
+**   otherwise (LSTC FAQ "discretization of curves"; *DEFINE_CURVE remark 1). An adaptive table
+**   with LCINT = rows is still resampled: its rows crowd towards solid, the even points do not
+**   (measured on the shipped fits: 8 to 26 % of F_C off near solid, all but the nearly
+**   cylindrical one). So the curves are evenly spaced with LCINT = rows, which the
+**   rediscretization gives back (export_table.c, cf_export_table_build_even), over the range
+**   where CF_EXPORT_LSDYNA_MAX_ROWS rows meet the tolerance. Past a curve's ends LS-DYNA
+**   continues its end segments' slope (as d3view's note "Modeling symmetric/unsymmetric
+**   nonlinear discrete springs", 2006, describes), not the law's stop at solid.
 ** - SOFA: PolynomialSpringsForceField evaluates force = sum a_k |L|^k with L = (l - l0)/l0, times
 **   +1 when stretched and, when compressed, -1 if compressible="1" and 0 otherwise
 **   (PolynomialSpringsForceField.inl, addForce). No SOFA spring component reads a table, but a
@@ -133,6 +140,52 @@ void cf_export_comment_source(FILE *out, const char *lead, const char *tail, con
     fprintf(out, "%s\n", tail);
 }
 
+char *cf_export_febio_log_name(char *buf, size_t cap, const char *output)
+{
+    static const char suffix[] = "_top_Rz.txt";
+    const char *base = output ? output : "";
+    for (const char *c = base; *c; c++) /* the last path component */
+        if (*c == '/' || *c == '\\')
+            base = c + 1;
+    size_t n = strlen(base);
+    const char *dot = strrchr(base, '.');
+    if (dot && dot > base)
+        n = (size_t)(dot - base);
+    if (n == 0)
+        base = "conifit", n = 7;
+    size_t w = 0;
+    buf[0] = '\0';
+    for (size_t i = 0; i < n && i < CF_EXPORT_LOG_STEM_MAX;) {
+        const unsigned char *c = (const unsigned char *)base + i;
+        size_t len = cf_text_char_length(c, n - i);
+        if (len > 1 && i + len > CF_EXPORT_LOG_STEM_MAX)
+            break; /* cut before a character that does not fit */
+        const char *put = NULL;
+        char one[8] = "_";
+        switch (len ? *c : 0) {
+        case '&': put = "&amp;"; break;
+        case '<': put = "&lt;"; break;
+        case '>': put = "&gt;"; break;
+        case '"': put = "&quot;"; break;
+        case '\'': put = "&apos;"; break;
+        case '/': case '\\': case ':': case 0: put = "_"; break;
+        default:
+            memcpy(one, c, len);
+            one[len] = '\0';
+            put = one;
+        }
+        const size_t plen = strlen(put);
+        if (w + plen + sizeof suffix > cap)
+            break;
+        memcpy(buf + w, put, plen + 1);
+        w += plen;
+        i += len ? len : 1;
+    }
+    if (w + sizeof suffix <= cap)
+        memcpy(buf + w, suffix, sizeof suffix);
+    return buf;
+}
+
 void cf_export_comment_spring(FILE *out, const char *lead, const char *tail, const cf_law *law)
 {
     fprintf(out, "%sspring (%s):", lead, cf_spring_type_name(law->type));
@@ -159,6 +212,35 @@ void cf_export_comment_table(FILE *out, const char *lead, const char *tail,
             "that holds the last force is within %.3g F_C of the law up to solid when the table "
             "runs to its full range%s\n",
             lead, law->travel_mm, t->tol, tail);
+}
+
+void cf_export_comment_even(FILE *out, const char *lead, const char *tail,
+                            const cf_export_table *t, const cf_law *law)
+{
+    if (!t->even || t->rows < 2)
+        return;
+    const double h = (t->u_hi_mm - t->u_lo_mm) / (double)(t->rows - 1);
+    fprintf(out,
+            "%scurve: %zu rows evenly spaced, every %.10g mm of u (in a group of rest length L0, "
+            "every %.10g L0/H mm of elongation); LCINT = %zu, so LS-DYNA's rediscretization of "
+            "each curve to LCINT equally spaced points (LSTC FAQ 'discretization of curves'; "
+            "*DEFINE_CURVE remark 1) gives back these rows%s\n",
+            lead, t->rows, h, h, t->rows, tail);
+    const int cut = t->u_lo_mm != t->req_lo_mm || t->u_hi_mm != t->req_hi_mm;
+    const double F_lo = cf_law_force(law, CF_LAW_EXACT, t->u_lo_mm, NULL, NULL);
+    const double F_hi = cf_law_force(law, CF_LAW_EXACT, t->u_hi_mm, NULL, NULL);
+    if (cut)
+        fprintf(out,
+                "%srange: u in [%.10g, %.10g] mm, shortened from [%.10g, %.10g] mm: at most %zu "
+                "evenly spaced rows meet the tolerance only there (the law's curvature grows "
+                "like (1 - F/F_C)^-3 towards solid)%s\n",
+                lead, t->u_lo_mm, t->u_hi_mm, t->req_lo_mm, t->req_hi_mm, t->rows, tail);
+    fprintf(out,
+            "%sat the curve's ends the law carries %.6g and %.6g of F_C; past them LS-DYNA "
+            "extrapolates the curve along its end segments (a straight line), while the law "
+            "stiffens to F_C at solid (|u| = %.10g mm): keep the springs' compression within "
+            "the curve%s\n",
+            lead, F_lo / law->F_C_N, F_hi / law->F_C_N, law->travel_mm, tail);
 }
 
 static void model_header(FILE *out, const char *lead, const char *tail, const cf_xmodel *m,
@@ -264,22 +346,69 @@ int cf_xmodel_write_abaqus(FILE *out, const cf_xmodel *m)
 static const char *const mask_name[8] = {"", "fix_x", "fix_y", "fix_xy",
                                          "fix_z", "fix_xz", "fix_yz", "fix_xyz"};
 
+/* Convergence of FEBio's Newton iterations (FESolidSolver2::Quasin in FEBio 4.11; user manual,
+** Control section, "Convergence tolerances"). A step converges when every enabled test passes;
+** FEBio compares squared norms: |R1|^2 <= rtol |R0|^2 (R0 the step's first residual),
+** |du|^2 <= dtol^2 |dU|^2 (du the last correction, dU the step's total increment) and
+** |du.R1| <= etol |du0.R0|; a tolerance of 0 disables its test. When the tests fail but
+** |R1|^2 < min_residual, FEBio ends the step with the warning "No force acting on the system".
+** With max_ups 0 every iteration reforms the stiffness (full Newton, quadratic convergence), so a
+** residual that reaches round-off leaves the last correction at about its square: dtol 1e-9 asked
+** for a correction below 1e-9 of the step after the residual had already passed under FEBio's
+** floor, so the steps ended on the floor with the warning (seen on every step with FEBio 4.11).
+** Chosen instead:
+** - rtol (1e-2 tol)^2: the force left unbalanced is 1e-2 tol of the step's first residual, which
+**   is at most of the order of the step's change of the spring forces, so the reaction it leaves
+**   is about 1e-2 of the reaction tolerance (tol F_C times the cut weights); at tol >= 1e-9 this
+**   is >= 1e-11 of the residual, above double round-off (~1e-14 of the summed forces).
+** - dtol 1e-6: the correction below 1e-6 of the step (squared 1e-12, far above round-off).
+** - etol 0: the energy test adds nothing to these two (manual: 0 disables a test).
+** - min_residual (1e-12 F)^2, F the force scale of the reaction (the reaction tolerance divided
+**   by tol: F_C times the cut weights): the floor about 100 times above the round-off of the
+**   summed spring forces, instead of FEBio's absolute 1e-20 N^2, which a small spring's residual
+**   reaches before the tests pass. It ends a step that prescribes no change (a hold), whose
+**   residual is round-off; should it end a real step first (tol below about 1e-6, or tiny steps),
+**   FEBio warns, and the force left is 1e-12 F, far inside the reaction tolerance. */
+static void febio_control(FILE *out, const cf_xmodel *m)
+{
+    const double tol = m->base->tol > 0 ? m->base->tol : CF_EXPORT_TOL_DEFAULT;
+    const double rtol = (1e-2 * tol) * (1e-2 * tol);
+    const double scale = m->reaction_tol_N / tol;
+    const double floor_N = 1e-12 * (scale > 0 ? scale : 1.0);
+    fprintf(out, "\t<Control>\n\t\t<analysis>STATIC</analysis>\n\t\t<time_steps>%zu</time_steps>\n"
+                 "\t\t<step_size>1</step_size>\n\t\t<solver type=\"solid\">\n"
+                 "\t\t\t<max_refs>50</max_refs>\n\t\t\t<dtol>1e-06</dtol>\n"
+                 "\t\t\t<etol>0</etol>\n\t\t\t<rtol>%.3g</rtol>\n"
+                 "\t\t\t<min_residual>%.3g</min_residual>\n"
+                 "\t\t\t<qn_method type=\"BFGS\">\n\t\t\t\t<max_ups>0</max_ups>\n"
+                 "\t\t\t</qn_method>\n\t\t</solver>\n\t</Control>\n",
+            m->nsteps, rtol, floor_N * floor_N);
+}
+
 /* An FEBio 4 model, written in the order of its sections (Module, Control, Mesh with nodes,
 ** node sets and the discrete set, MeshDomains, Boundary, Discrete, LoadData, Output). Long only
 ** because the file is; each section is a few fprintf calls. */
 int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
 {
+    char log[8 * CF_EXPORT_LOG_STEM_MAX];
+    cf_export_febio_log_name(log, sizeof log, m->output);
     fprintf(out, "<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?>\n");
     model_header(out, "<!-- ", " -->", m, "FEBio 4",
-                 "febio4 -i NAME.feb (summed top reaction: column sums of NAME_top_Rz.txt)");
+                 "febio4 -i NAME.feb (the top reaction: the sum of Rz in the logfile the Output "
+                 "section names, beside NAME.feb)");
+    /* FEBio's node data file (FECore DataRecord::Write): per converged step the lines
+    ** "*Step  = k", "*Time  = t", "*Data  = Rz", then one line "node,Rz" per node of the set.
+    ** Rz is the reaction at a prescribed degree of freedom, the force the constraint applies to
+    ** the node (FEBioMechData.cpp FENodeForceZ from FESolidSolver2's m_Fr, which the residual
+    ** assembly fills with minus the springs' forces on the node). */
+    fprintf(out,
+            "<!-- reading the result: the logfile holds, per converged step, the lines '*Step = "
+            "k', '*Time = t', '*Data = Rz' and then one line 'node,Rz' per top node; the top "
+            "reaction of step k is the sum of Rz over those lines. Rz is the force the "
+            "prescribed displacement applies to the node along z: negative under compression, "
+            "so conifit's compressive reaction above is minus that sum -->\n");
     fprintf(out, "<febio_spec version=\"4.0\">\n\t<Module type=\"solid\"/>\n");
-    fprintf(out, "\t<Control>\n\t\t<analysis>STATIC</analysis>\n\t\t<time_steps>%zu</time_steps>\n"
-                 "\t\t<step_size>1</step_size>\n\t\t<solver type=\"solid\">\n"
-                 "\t\t\t<max_refs>50</max_refs>\n\t\t\t<dtol>1e-9</dtol>\n"
-                 "\t\t\t<etol>1e-12</etol>\n\t\t\t<rtol>1e-12</rtol>\n"
-                 "\t\t\t<qn_method type=\"BFGS\">\n\t\t\t\t<max_ups>0</max_ups>\n"
-                 "\t\t\t</qn_method>\n\t\t</solver>\n\t</Control>\n",
-            m->nsteps);
+    febio_control(out, m);
     fprintf(out, "\t<Mesh>\n\t\t<Nodes name=\"conifit_nodes\">\n");
     for (size_t i = 0; i < m->nn; i++)
         fprintf(out, "\t\t\t<node id=\"%zu\">%.17g,%.17g,%.17g</node>\n", i + 1, m->X[i], m->Y[i],
@@ -347,7 +476,7 @@ int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
         fprintf(out, "\t\t\t\t<pt>%zu,%.17g</pt>\n", k + 1, m->dz_mm[k]);
     fprintf(out, "\t\t\t</points>\n\t\t</load_controller>\n\t</LoadData>\n");
     fprintf(out, "\t<Output>\n\t\t<logfile>\n\t\t\t<node_data data=\"Rz\" delim=\",\" "
-                 "file=\"NAME_top_Rz.txt\" node_set=\"top\"/>\n\t\t</logfile>\n\t</Output>\n");
+                 "file=\"%s\" node_set=\"top\"/>\n\t\t</logfile>\n\t</Output>\n", log);
     fprintf(out, "</febio_spec>\n");
     return 0;
 }
@@ -365,6 +494,7 @@ int cf_xmodel_write_lsdyna(FILE *out, const cf_xmodel *m)
 {
     model_header(out, "$ ", "", m, "LS-DYNA (implicit static)",
                  "ls-dyna i=NAME.k (top reaction: spcforc / bndout of the prescribed motion)");
+    cf_export_comment_even(out, "$ ", "", m->base, m->law);
     fprintf(out, "*KEYWORD\n*TITLE\nconifit %s\n", m->title);
     fprintf(out, "*CONTROL_TERMINATION\n$#  endtim\n%10.1f\n", (double)m->nsteps);
     fprintf(out, "*CONTROL_IMPLICIT_GENERAL\n$#  imflag       dt0\n%10d%10.1f\n", 1, 1.0);

@@ -27,6 +27,8 @@ typedef struct cf_xgroup {
 typedef struct cf_xmodel {
     const char *title;      /* one line: what the model is */
     const char *source;     /* fit file name, for provenance */
+    const char *output;     /* the file written (NULL: standard output), names the model's own
+                            ** output files */
     const cf_law *law;
     const cf_export_table *base; /* the law's table (weight 1, rest length H) */
     size_t nn;              /* nodes */
@@ -65,8 +67,9 @@ int cf_xmodel_write(FILE *out, const cf_xmodel *m, cf_export_format f);
 cf_status cf_export_table_for(const cf_law *law, const cf_export_options *opt,
                               cf_export_table *t, cf_error *err);
 
-/* The report of a table: its rows, tolerance, achieved error and range (the rest zero). */
-cf_export_report cf_export_report_of_table(const cf_export_table *t);
+/* The report of a table of law: its rows, tolerance, achieved error, range and force at its ends
+** (the rest zero). */
+cf_export_report cf_export_report_of_table(const cf_export_table *t, const cf_law *law);
 
 /* The writers of runnable models, one per target: 0, or -1 when memory runs out. */
 int cf_xmodel_write_calculix(FILE *out, const cf_xmodel *m);
@@ -80,6 +83,18 @@ int cf_xmodel_write_sofa(FILE *out, const cf_xmodel *m);
 ** spring data (reals), after deleting blank lines (ccx manual, *SPRING); each number fits the 20
 ** characters ccx reads. */
 void cf_export_inp_pair(FILE *out, double force_N, double elongation_mm);
+
+/* The name of the file FEBio writes the top nodes' reactions to, for a model written to `output`
+** (NULL or "" for standard output): the output's base name without its extension, then
+** "_top_Rz.txt" ("conifit_top_Rz.txt" for standard output), so that two models in one folder do
+** not share it.
+** The output's name is text from outside: folders are dropped, and the rest is written for an XML
+** attribute: printable ASCII and whole printable UTF-8 characters kept, the five XML markup
+** characters as entities (FEBio's reader decodes them), path separators ('/', '\', ':') and
+** every other byte (controls, DEL, C1 controls, bytes that are not UTF-8) as '_'; a base name
+** longer than CF_EXPORT_LOG_STEM_MAX bytes is cut at a character boundary. Returns buf. */
+#define CF_EXPORT_LOG_STEM_MAX 200
+char *cf_export_febio_log_name(char *buf, size_t cap, const char *output);
 
 /* Writes a comment line with the spring's parameters, and the table's accuracy, each line
 ** starting with lead and ending with tail. */
@@ -95,6 +110,12 @@ void cf_export_comment_source(FILE *out, const char *lead, const char *tail, con
 void cf_export_comment_spring(FILE *out, const char *lead, const char *tail, const cf_law *law);
 void cf_export_comment_table(FILE *out, const char *lead, const char *tail,
                              const cf_export_table *t, const cf_law *law);
+
+/* For an evenly spaced table (t->even; nothing otherwise): comment lines with its spacing and
+** LCINT, the range it was shortened to and from, the law's force at its ends and what LS-DYNA
+** does past them. */
+void cf_export_comment_even(FILE *out, const char *lead, const char *tail,
+                            const cf_export_table *t, const cf_law *law);
 
 /* The SOFA form of one group's table: a linear part A + B e written as two compressible linear
 ** springs, plus one one-sided spring per interior node (see export_model.c). */

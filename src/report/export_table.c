@@ -280,14 +280,10 @@ static size_t settle_half(const cf_law *law, double tol, double U, double sign, 
     return N; /* the caller sees *err_N > goal */
 }
 
-/* The adaptive table over [u_lo, u_hi]: the compression and stretch sides of u = 0 grown until
-** each meets tol (one side mirrored when the range is symmetric), joined, and the joined table's
-** error measured on each side's check grid. Kept as one function because both sides share the
-** law, the tolerance and the output table. */
-cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo_mm,
-                                      double u_hi_mm, cf_export_table *t, cf_error *err)
+/* The tolerance and the range [u_lo, u_hi] of a table: CF_E_DATA naming what is wrong. */
+static cf_status range_check(const cf_law *law, double tol, double u_lo_mm, double u_hi_mm,
+                             cf_error *err)
 {
-    memset(t, 0, sizeof *t);
     if (!isfinite(tol) || tol < CF_EXPORT_TOL_MIN || tol > CF_EXPORT_TOL_MAX)
         return cf_error_set(err, CF_E_DATA, "tolerance %g is outside [%g, %g]", tol,
                             CF_EXPORT_TOL_MIN, CF_EXPORT_TOL_MAX);
@@ -304,10 +300,23 @@ cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo
                             "reaches |u| <= %.10g mm (where the law carries F_C (1 - tol); solid "
                             "at %.10g mm)",
                             u_lo_mm, u_hi_mm, u_end, law->travel_mm);
+    return CF_OK;
+}
+
+/* The adaptive table over [u_lo, u_hi]: the compression and stretch sides of u = 0 grown until
+** each meets tol (one side mirrored when the range is symmetric), joined, and the joined table's
+** error measured on each side's check grid. Kept as one function because both sides share the
+** law, the tolerance and the output table. */
+cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo_mm,
+                                      double u_hi_mm, cf_export_table *t, cf_error *err)
+{
+    memset(t, 0, sizeof *t);
+    cf_status status = range_check(law, tol, u_lo_mm, u_hi_mm, err);
+    if (status != CF_OK)
+        return status;
     half co = {0}, st = {0};
     cf_export_table scratch = {0};
     double eco = 0.0, est = 0.0, wco = 0.0, wst = 0.0;
-    cf_status status = CF_OK;
     const double Uco = u_hi_mm, Ust = -u_lo_mm;
     size_t Nco = 0, Nst = 0;
     if (Uco > 0.0 && (Nco = settle_half(law, tol, Uco, +1.0, &co, &scratch, &eco, &wco)) == 0)
@@ -334,8 +343,8 @@ cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo
             goto oom;
     }
     t->tol = tol;
-    t->u_lo_mm = u_lo_mm;
-    t->u_hi_mm = u_hi_mm;
+    t->u_lo_mm = t->req_lo_mm = u_lo_mm;
+    t->u_hi_mm = t->req_hi_mm = u_hi_mm;
     /* the achieved error of the joined table, on the check grid of each side */
     eco = Uco > 0.0 ? half_error(law, t, Uco, +1.0, &wco) : 0.0;
     est = Ust > 0.0 ? half_error(law, t, Ust, -1.0, &wst) : 0.0;
@@ -364,6 +373,152 @@ oom:
 done:
     free(co.u), free(co.F), free(st.u), free(st.F);
     cf_export_table_free(&scratch);
+    return status;
+}
+
+/* ---- the evenly spaced table (targets that resample curves evenly: LS-DYNA) ------------------ */
+
+/* The even table's placement aims its estimate at this fraction of the tolerance; the measured
+** error decides, lowering the aim by EVEN_SHRINK until it passes. */
+#define EVEN_AIM 0.95
+#define EVEN_SHRINK 0.9
+#define EVEN_ROUNDS 12
+
+/* Sets t to n >= 2 rows evenly spaced over [a, b], on the law. 0, or -1 out of memory. */
+static int even_fill(const cf_law *law, double a, double b, size_t n, cf_export_table *t)
+{
+    double *u = malloc(n * sizeof *u), *F = malloc(n * sizeof *F), *k = malloc(n * sizeof *k);
+    if (!u || !F || !k) {
+        free(u), free(F), free(k);
+        return -1;
+    }
+    for (size_t i = 0; i < n; i++) {
+        u[i] = i + 1 == n ? b : a + (b - a) * (double)i / (double)(n - 1);
+        F[i] = cf_law_force(law, CF_LAW_EXACT, u[i], &k[i], NULL);
+    }
+    free(t->u_mm), free(t->F_N), free(t->k_N_per_mm);
+    t->u_mm = u;
+    t->F_N = F;
+    t->k_N_per_mm = k;
+    t->rows = n;
+    t->u_lo_mm = a;
+    t->u_hi_mm = b;
+    t->even = 1;
+    return 0;
+}
+
+/* The largest distance (N) of the law from the chord of [x0, x1], probed at EVEN_PROBES points. */
+#define EVEN_PROBES 7
+static double chord_error(const cf_law *law, double x0, double x1)
+{
+    const double F0 = cf_law_force(law, CF_LAW_EXACT, x0, NULL, NULL);
+    const double F1 = cf_law_force(law, CF_LAW_EXACT, x1, NULL, NULL);
+    double worst = 0.0;
+    for (int p = 1; p <= EVEN_PROBES; p++) {
+        const double f = p / (EVEN_PROBES + 1.0);
+        const double F = cf_law_force(law, CF_LAW_EXACT, x0 + f * (x1 - x0), NULL, NULL);
+        worst = fmax(worst, fabs(F - (F0 + f * (F1 - F0))));
+    }
+    return worst;
+}
+
+/* The interpolation error (N) of n evenly spaced rows over [a, b], estimated on the two outermost
+** intervals at each end, where the law's curvature is largest (it grows with |u| in region 2 and
+** is 0 in region 1), or on every interval when there are few. */
+static double even_estimate(const cf_law *law, double a, double b, size_t n)
+{
+    const double h = (b - a) / (double)(n - 1);
+    double worst = 0.0;
+    for (size_t i = 0; i + 1 < n; i++) {
+        if (n > 16 && i >= 2 && i + 3 < n)
+            i = n - 3; /* the middle: smaller curvature */
+        worst = fmax(worst, chord_error(law, a + h * (double)i,
+                                        i + 2 == n ? b : a + h * (double)(i + 1)));
+    }
+    return worst;
+}
+
+/* The fewest rows (2 .. cap) whose estimate over [a, b] is within goal_N; cap + 1 when none is.
+** The estimate falls as the rows grow (like their spacing squared): a doubling search, then
+** bisection. */
+static size_t even_rows(const cf_law *law, double a, double b, double goal_N, size_t cap)
+{
+    size_t lo = 1, hi = 2; /* lo fails (or is below 2), hi is the candidate */
+    while (even_estimate(law, a, b, hi) > goal_N) {
+        if (hi >= cap)
+            return cap + 1;
+        lo = hi;
+        hi = hi * 2 > cap ? cap : hi * 2;
+    }
+    while (hi - lo > 1) {
+        const size_t mid = lo + (hi - lo) / 2;
+        if (mid >= 2 && even_estimate(law, a, b, mid) <= goal_N)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    return hi;
+}
+
+/* The range [lo, hi] cut at |u| <= U for the largest U whose n even rows are estimated within
+** goal_N, by bisection on U (region 1 is linear, so U = u_T always works). */
+static void even_cut(const cf_law *law, double lo, double hi, size_t n, double goal_N, double *a,
+                     double *b)
+{
+    double good = fmin(law->u_T_mm, fmax(-lo, hi)), bad = fmax(-lo, hi);
+    for (int i = 0; i < 200 && bad - good > 1e-13 * bad; i++) {
+        const double U = 0.5 * (good + bad);
+        if (even_estimate(law, fmax(lo, -U), fmin(hi, U), n) <= goal_N)
+            good = U;
+        else
+            bad = U;
+    }
+    *a = fmax(lo, -good);
+    *b = fmin(hi, good);
+}
+
+cf_status cf_export_table_build_even(const cf_law *law, double tol, double u_lo_mm,
+                                     double u_hi_mm, size_t max_rows, cf_export_table *t,
+                                     cf_error *err)
+{
+    memset(t, 0, sizeof *t);
+    cf_status status = range_check(law, tol, u_lo_mm, u_hi_mm, err);
+    if (status != CF_OK)
+        return status;
+    if (max_rows < 2)
+        max_rows = 2;
+    const double goal = tol * law->F_C_N;
+    double aim = EVEN_AIM, e_hi = 0.0, e_lo = 0.0, w_hi = 0.0, w_lo = 0.0;
+    for (int round = 0; round < EVEN_ROUNDS; round++, aim *= EVEN_SHRINK) {
+        double a = u_lo_mm, b = u_hi_mm;
+        size_t n = even_rows(law, a, b, aim * goal, max_rows);
+        if (n > max_rows) {
+            n = max_rows;
+            even_cut(law, u_lo_mm, u_hi_mm, n, aim * goal, &a, &b);
+        }
+        if (even_fill(law, a, b, n, t) != 0) {
+            cf_export_table_free(t);
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory building the export table");
+        }
+        /* measured on the check grid of each side, which knows nothing of the rows */
+        e_hi = b > 0.0 ? half_error(law, t, b, +1.0, &w_hi) : 0.0;
+        e_lo = a < 0.0 ? half_error(law, t, -a, -1.0, &w_lo) : 0.0;
+        if (fmax(e_hi, e_lo) <= goal)
+            break;
+    }
+    t->tol = tol;
+    t->req_lo_mm = u_lo_mm;
+    t->req_hi_mm = u_hi_mm;
+    t->max_err_N = fmax(e_hi, e_lo);
+    t->max_err_u_mm = e_hi >= e_lo ? w_hi : w_lo;
+    t->max_err_rel = t->max_err_N / law->F_C_N;
+    if (t->max_err_rel > tol) {
+        status = cf_error_set(err, CF_E_DATA,
+                              "the spring (rho = %.4g) cannot be tabulated evenly within the "
+                              "tolerance %g of F_C: %zu rows reach %.3g",
+                              law->rho, tol, t->rows, t->max_err_rel);
+        cf_export_table_free(t);
+    }
     return status;
 }
 

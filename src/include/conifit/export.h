@@ -41,6 +41,13 @@
 ** a longer table is read without a message and corrupts that count, which perturbs the whole
 ** curve. Exports for CalculiX (and Abaqus, so that the same file runs in both) keep to 200. */
 #define CF_EXPORT_CALCULIX_MAX_ROWS 200
+/* LS-DYNA rediscretizes every *DEFINE_CURVE to LCINT equally spaced points, 100 unless the
+** curve's LCINT says otherwise (LSTC FAQ "discretization of curves"; *DEFINE_CURVE, remark 1), so
+** its curves are written evenly spaced with LCINT = rows: the rediscretization then returns the
+** rows themselves. An even table cannot follow the law's stiffening near solid with few rows
+** (its curvature grows like (1 - F/F_C)^-3), so it has at most this many rows and its range stops
+** where they meet the tolerance. */
+#define CF_EXPORT_LSDYNA_MAX_ROWS 10000
 
 /* The export formats. What each is and what writes it is held in one registry (src/report/export.c):
 ** a new format is a value here and an entry there; the command line builds its help, its
@@ -65,6 +72,9 @@ typedef struct cf_export_format_info {
     int model;               /* 1: writes runnable models (one spring, or the lattice) */
     int table;               /* 1: writes the law as a table (json writes the spring itself) */
     size_t max_rows;         /* most rows the target reads in one table, 0 for no limit */
+    int even;                /* 1: the target resamples a curve to evenly spaced points, so its
+                             ** table is evenly spaced (max_rows at most, its range shortened to
+                             ** where that meets the tolerance) */
 } cf_export_format_info;
 
 /* The entry of a format, NULL for a value outside the enum. Formats run 0 .. COUNT - 1. */
@@ -96,6 +106,9 @@ typedef struct cf_export_table {
     double max_err_rel;  /* achieved maximum |F_table - F| / F_C over [u_lo, u_hi] */
     double max_err_N;    /* the same in N */
     double max_err_u_mm; /* where it occurs, mm */
+    int even;            /* 1: rows evenly spaced in u (cf_export_table_build_even) */
+    double req_lo_mm, req_hi_mm; /* the range asked for, mm; an even table's [u_lo, u_hi] may be
+                         ** shorter (where its rows meet the tolerance) */
 } cf_export_table;
 
 /* Where the full-range table ends: the compression (mm) at which the law carries F_C (1 - tol). */
@@ -111,6 +124,15 @@ cf_status cf_export_table_build(const cf_law *law, double tol, cf_export_table *
 cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo_mm,
                                       double u_hi_mm, cf_export_table *t, cf_error *err);
 
+/* An evenly spaced table of the law (rows on the law) over [u_lo, u_hi], or over the part of it
+** where at most max_rows (>= 2) evenly spaced rows meet the tolerance: the fewest rows that meet
+** it over the whole range; else max_rows rows over the range cut at |u| <= U, the largest U for
+** which they do (the error measured on the check grid of the adaptive table). t->req_lo_mm and
+** t->req_hi_mm keep the range asked for. Errors as cf_export_table_build_range. */
+cf_status cf_export_table_build_even(const cf_law *law, double tol, double u_lo_mm,
+                                     double u_hi_mm, size_t max_rows, cf_export_table *t,
+                                     cf_error *err);
+
 /* Releases the rows of t; safe on a zeroed table. */
 void cf_export_table_free(cf_export_table *t);
 
@@ -125,6 +147,8 @@ typedef struct cf_export_options {
     double u_lo_mm, u_hi_mm; /* compression range of the table, mm (u_lo <= 0 <= u_hi) */
     int example;         /* a complete one-spring model that runs as it is, instead of the block */
     const char *source;  /* name of the fit file, for provenance ("" or NULL if none) */
+    const char *output;  /* name of the file written (-o), from which a model names its own
+                         ** outputs (FEBio's log file); "" or NULL for standard output */
     int auto_tol;        /* calculix/abaqus: loosen tol (x2, x2.5, x2 ...) until the table fits
                          ** CF_EXPORT_CALCULIX_MAX_ROWS rows, instead of refusing */
 } cf_export_options;
@@ -138,6 +162,9 @@ typedef struct cf_export_report {
     double max_err_N;     /* the same in N (one spring, weight 1) */
     double u_lo_mm, u_hi_mm; /* range of the table, mm */
     double tol;           /* tolerance the table was built with */
+    int even;             /* 1: an evenly spaced table, over [u_lo, u_hi] of [req_lo, req_hi] */
+    double req_lo_mm, req_hi_mm; /* the range asked for, mm */
+    double end_force_rel; /* the law's force at the table's ends, fraction of F_C (the larger) */
     size_t groups;        /* lattice: spring groups (one table each) */
     size_t springs;       /* lattice: springs */
     size_t nodes;         /* lattice: nodes */
