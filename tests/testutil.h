@@ -190,4 +190,29 @@ static inline char *tu_slurp(const char *path)
     return buf;
 }
 
+/* A fresh folder /tmp/PREFIX-XXXXXX into dir (cap bytes): 0, or -1 when it cannot be made. */
+static inline int tu_make_tmpdir(char *dir, size_t cap, const char *prefix)
+{
+    snprintf(dir, cap, "/tmp/%s-XXXXXX", prefix);
+    return mkdtemp(dir) ? 0 : -1;
+}
+
+/* Writes len bytes of text into a new file at path: 0, or -1. */
+static inline int tu_write_bytes(const char *path, const char *text, size_t len)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        return -1;
+    int ok = fwrite(text, 1, len, f) == len;
+    return fclose(f) == 0 && ok ? 0 : -1;
+}
+
+/* Removes the folder dir and everything in it: 0, or -1. */
+static inline int tu_remove_tmpdir(const char *dir)
+{
+    char cmd[512];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
 #endif

@@ -31,8 +31,13 @@ typedef struct cf_column {
     char unit[CF_COLUMN_NAME_CAP]; /* the decoration ("" when none) */
 } cf_column;
 
-/* The unit spelled exactly name, or NULL. */
+/* The unit spelled name, or NULL: letter case is ignored except for a leading m or M (milli or
+** metre against mega), so "Mpa" and "kpa" are found and "mPa" is not MPa. */
 const cf_unit_def *cf_unit_find(const char *name);
+
+/* The known unit that name spells but for the case of a leading m or M ("mPa", "MN"), which
+** cf_unit_find does not take; NULL when there is none. For messages that name both readings. */
+const cf_unit_def *cf_unit_m_case(const char *name);
 
 /* The known units by class, for messages. */
 extern const char cf_unit_list[];

@@ -367,6 +367,20 @@ typedef struct scaling {
     double xscale, yscale, tscale;
 } scaling;
 
+/* Why text (quoted as q) is no unit, for a message: a unit that differs from a known one only in
+** a leading m or M names both readings; anything else lists the known units. */
+static void unit_refusal(char *out, size_t cap, const char *text, const char *q)
+{
+    const cf_unit_def *near = cf_unit_m_case(text);
+    if (near)
+        snprintf(out, cap, "unit '%s' is ambiguous: a leading m is milli (or metre) and M is "
+                 "mega, and the known unit is '%s', not '%s'; write '%s' if that is meant", q,
+                 near->name, q, near->name);
+    else
+        snprintf(out, cap, "unknown unit '%s' (known units; letter case is ignored except in a "
+                 "leading m or M: %s)", q, cf_unit_list);
+}
+
 /* Resolves the unit of column c: the option if given, else its decoration, else a '#' comment.
 ** Returns CF_OK with *u NULL when no unit is stated anywhere. */
 static cf_status column_unit(const reader *r, size_t header_line, size_t ci, const char *option,
@@ -378,16 +392,14 @@ static cf_status column_unit(const reader *r, size_t header_line, size_t ci, con
     *u = NULL;
     if (text) {
         const cf_unit_def *d = cf_unit_find(text);
-        char q[256];
+        char q[256], why[512];
         cf_csv_quote(q, sizeof q, text, strlen(text));
         if (!d) {
+            unit_refusal(why, sizeof why, text, q);
             if (option)
-                return cf_error_set(err, CF_E_DATA,
-                                    "%s: %s '%s': unknown unit (known units: %s)", r->path,
-                                    option_flag, q, cf_unit_list);
-            return cf_csv_error(err, r->path, header_line, ci + 1,
-                                "column '%s': unknown unit '%s' (known units, case-sensitive: %s)",
-                                c->name, q, cf_unit_list);
+                return cf_error_set(err, CF_E_DATA, "%s: %s %s", r->path, option_flag, why);
+            return cf_csv_error(err, r->path, header_line, ci + 1, "column '%s': %s ('%s')",
+                                c->name, why, q);
         }
         for (size_t k = 0; k < nwant; k++)
             if (d->cls == want[k]) {
@@ -447,6 +459,13 @@ static cf_status y_unit(const reader *r, const cf_measure_options *opt, const la
     return CF_OK;
 }
 
+/* 1 when a column's name without unit says it holds percent: "strain percent", "strain%",
+** "percent_strain" (so that such a column is never read as plain strain). */
+static int names_percent(const char *base)
+{
+    return strchr(base, '%') != NULL || cf_measures_contains_ci(base, "percent");
+}
+
 /* The unit of x: a strain or stretch against a stress, a length against a force. */
 static cf_status x_unit(const reader *r, const cf_measure_options *opt, const layout *h,
                         const cf_table *m, scaling *u, cf_error *err)
@@ -459,13 +478,23 @@ static cf_status x_unit(const reader *r, const cf_measure_options *opt, const la
         cf_unit_class xw[1] = {CF_UNIT_STRAIN};
         if (xc->unit[0]) {
             const cf_unit_def *d = cf_unit_find(xc->unit);
+            if (!d && cf_unit_m_case(xc->unit)) {
+                char q[256], why[512];
+                cf_csv_quote(q, sizeof q, xc->unit, strlen(xc->unit));
+                unit_refusal(why, sizeof why, xc->unit, q);
+                return cf_csv_error(err, path, h->header_line, (size_t)h->xi + 1,
+                                    "column '%s': %s ('%s')", xc->name, why, q);
+            }
             if (!d || d->cls != CF_UNIT_STRAIN)
                 return cf_csv_error(err, path, h->header_line, (size_t)h->xi + 1,
                                     "column '%s' has unit '%s' but y is a stress, so x must be a "
-                                    "dimensionless strain or stretch ('-' or '%%') ('%s')",
+                                    "dimensionless strain or stretch ('-', 'mm/mm' or '%%') "
+                                    "('%s')",
                                     xc->name, xc->unit, xc->name);
             xu = d;
-        } else
+        } else if (names_percent(xc->base))
+            xu = cf_unit_find("%");
+        else
             xu = cf_comment_unit(r->comments, r->ncomments, xc->base, 0, xw, 1);
         if (xu)
             u->xscale = xu->to_conifit;

@@ -72,7 +72,8 @@ typedef enum cf_unit_class {
     CF_UNIT_STRAIN = 5  /* dimensionless: "-", "1" or "%" (converted to a plain fraction) */
 } cf_unit_class;
 
-/* Looks up a unit name (case-sensitive: "kPa", "MPa", "N/mm2", "mN", "um", "%", ...). Returns
+/* Looks up a unit name ("kPa", "MPa", "N/mm2", "mN", "um", "%", "mm/mm", ...; letter case is
+** ignored except in a leading m or M, so "Mpa" is MPa and "mPa" is not a unit). Returns
 ** CF_UNIT_UNKNOWN for a name it does not know; otherwise the class, and in *to_conifit (if not
 ** NULL) the factor that converts a value in that unit to conifit's (MPa, N, mm, s, -). */
 cf_unit_class cf_measure_unit(const char *name, double *to_conifit);
