@@ -12,6 +12,7 @@
 #include "io/columns.h"
 #include "io/csv.h"
 #include "io/measures.h"
+#include "io/reader.h"
 
 #include <errno.h>
 #include <math.h>
@@ -22,26 +23,11 @@
 
 cf_measure_options cf_measure_default_options(void)
 {
-    cf_measure_options o = {NULL, NULL, NULL, NULL, NULL, -1, NULL, -1, -1};
+    cf_measure_options o = {NULL, NULL, NULL, NULL, NULL, -1, NULL, -1, -1, 0, NULL};
     return o;
 }
 
 /* ---- the text -------------------------------------------------------------------------------- */
-
-typedef struct reader {
-    const char *path;
-    char *text;
-    size_t size;
-    cf_csv_line *lines; /* every line of the file */
-    size_t nlines;
-    cf_csv_line *comments; /* the '#' lines, without the '#' */
-    size_t ncomments;
-    cf_column *cols;
-    size_t ncols;
-    cf_csv_fields f;
-    double *x, *y, *w, *t;
-    size_t count, cap;
-} reader;
 
 static void reader_free(reader *r)
 {
@@ -56,7 +42,7 @@ static void reader_free(reader *r)
     free(r->t);
 }
 
-static cf_status out_of_memory(cf_error *err, const char *path)
+cf_status cf_reader_out_of_memory(cf_error *err, const char *path)
 {
     return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory reading the table", path);
 }
@@ -74,7 +60,7 @@ static cf_status read_all(reader *r, cf_error *err)
     if (!r->text) {
         if (!from_stdin)
             fclose(fp);
-        return out_of_memory(err, r->path);
+        return cf_reader_out_of_memory(err, r->path);
     }
     for (;;) {
         if (r->size > CF_MEASURE_MAX_BYTES) {
@@ -90,7 +76,7 @@ static cf_status read_all(reader *r, cf_error *err)
             if (!t) {
                 if (!from_stdin)
                     fclose(fp);
-                return out_of_memory(err, r->path);
+                return cf_reader_out_of_memory(err, r->path);
             }
             r->text = t;
             cap = ncap;
@@ -150,7 +136,7 @@ static cf_status cut_lines(reader *r, cf_error *err)
             cap = cap ? 2 * cap : 256;
             cf_csv_line *l = realloc(r->lines, cap * sizeof *l);
             if (!l)
-                return out_of_memory(err, r->path);
+                return cf_reader_out_of_memory(err, r->path);
             r->lines = l;
         }
         r->lines[r->nlines++] = (cf_csv_line){s, n, line};
@@ -159,24 +145,14 @@ static cf_status cut_lines(reader *r, cf_error *err)
     return CF_OK;
 }
 
-/* Checks every line for binary content and collects the comment lines. */
-static cf_status scan_text(reader *r, cf_error *err)
+/* Collects the comment lines (which may hold any bytes: a degree sign in a Windows code page). */
+static cf_status scan_comments(reader *r, cf_error *err)
 {
     r->comments = malloc((r->nlines ? r->nlines : 1) * sizeof *r->comments);
     if (!r->comments)
-        return out_of_memory(err, r->path);
+        return cf_reader_out_of_memory(err, r->path);
     for (size_t i = 0; i < r->nlines; i++) {
         const cf_csv_line *l = &r->lines[i];
-        size_t b = cf_csv_bad_byte((const unsigned char *)l->s, l->n);
-        if (b < l->n) {
-            char q[256];
-            cf_csv_quote(q, sizeof q, l->s, l->n);
-            unsigned char c = (unsigned char)l->s[b];
-            return cf_csv_error(err, r->path, l->line, b + 1,
-                                "%s: byte 0x%02X is not text (the column counts bytes here) ('%s')",
-                                c == '\r' ? "carriage return inside a line" : "binary content", c,
-                                q);
-        }
         if (cf_csv_is_comment(l)) {
             const char *h = memchr(l->s, '#', l->n);
             r->comments[r->ncomments++] = (cf_csv_line){h + 1, l->n - (size_t)(h + 1 - l->s),
@@ -186,14 +162,36 @@ static cf_status scan_text(reader *r, cf_error *err)
     return CF_OK;
 }
 
-static cf_status split_or_fail(reader *r, const cf_csv_line *l, size_t n, char delim,
-                               cf_error *err)
+/* Checks the header and every line after it for binary content, up to a comment: only what is
+** read as the table must be text (a preamble before the header and comments may hold any bytes). */
+static cf_status check_text(const reader *r, const layout *h, cf_error *err)
+{
+    for (size_t i = h->hi; i < r->nlines; i++) {
+        const cf_csv_line *l = &r->lines[i];
+        if (cf_csv_is_comment(l))
+            continue;
+        size_t n = cf_csv_content_length(l->s, l->n);
+        size_t b = cf_csv_bad_byte((const unsigned char *)l->s, n);
+        if (b < n) {
+            char q[256];
+            cf_csv_quote(q, sizeof q, l->s, l->n);
+            unsigned char c = (unsigned char)l->s[b];
+            return cf_csv_error(err, r->path, l->line, b + 1,
+                                "%s: byte 0x%02X is not text (the column counts bytes here) ('%s')",
+                                c == '\r' ? "carriage return inside a line" : "binary content", c,
+                                q);
+        }
+    }
+    return CF_OK;
+}
+
+cf_status cf_reader_split(reader *r, const cf_csv_line *l, size_t n, char delim, cf_error *err)
 {
     size_t bad = 0;
     const char *why = NULL;
     int rc = cf_csv_split(l->s, n, delim, &r->f, &bad, &why);
     if (rc == -2)
-        return out_of_memory(err, r->path);
+        return cf_reader_out_of_memory(err, r->path);
     if (rc == -1) {
         char q[256];
         cf_csv_quote(q, sizeof q, l->s, n);
@@ -203,159 +201,6 @@ static cf_status split_or_fail(reader *r, const cf_csv_line *l, size_t n, char d
 }
 
 /* ---- the header and its columns -------------------------------------------------------------- */
-
-/* What the header decided, for the stages after it: where it is, its delimiter, its columns and
-** which of them are x, y, the weight and the time (-1: none). */
-typedef struct layout {
-    size_t hi, hn;         /* index of the header in r->lines, its content length */
-    size_t header_line;    /* its line number */
-    char hq[256];          /* the header quoted, for messages */
-    char delim;
-    size_t ncols;
-    int trailing;          /* the header ends with a delimiter: so must every row */
-    long xi, yi, wi, ti;
-} layout;
-
-/* The header: the first line with content. */
-static cf_status find_header(const reader *r, layout *h, cf_error *err)
-{
-    const char *path = r->path;
-    h->hi = 0;
-    h->hn = 0;
-    while (h->hi < r->nlines) {
-        if (!cf_csv_is_comment(&r->lines[h->hi]) &&
-            (h->hn = cf_csv_content_length(r->lines[h->hi].s, r->lines[h->hi].n)) > 0)
-            break;
-        h->hi++;
-    }
-    if (h->hi < r->nlines)
-        return CF_OK;
-    if (r->size == 0)
-        return cf_csv_error(err, path, 1, 1, "empty file: no header and no data (0 bytes)");
-    return cf_csv_error(err, path, r->nlines ? r->lines[r->nlines - 1].line : 1, 1,
-                        "no header row and no data: only comments and blank lines (%zu bytes)",
-                        r->size);
-}
-
-/* The header's delimiter and column names (r->cols). */
-static cf_status read_header(reader *r, layout *h, cf_error *err)
-{
-    const char *path = r->path;
-    const cf_csv_line *hl = &r->lines[h->hi];
-    h->header_line = hl->line;
-    cf_csv_quote(h->hq, sizeof h->hq, hl->s, h->hn);
-    h->delim = cf_csv_delimiter(hl->s, h->hn);
-    if (!h->delim)
-        return cf_csv_error(err, path, h->header_line, 1,
-                            "the header has a single column; expected at least x and y separated "
-                            "by ',' ';' TAB or blanks ('%s')", h->hq);
-    cf_status st = split_or_fail(r, hl, h->hn, h->delim, err);
-    if (st != CF_OK)
-        return st;
-    size_t ncols = r->f.count;
-    h->trailing = 0;
-    if (ncols > 1 && cf_csv_field(&r->f, ncols - 1)[0] == '\0') {
-        h->trailing = 1;
-        ncols--;
-    }
-    if (ncols > CF_MEASURE_MAX_COLUMNS)
-        return cf_csv_error(err, path, h->header_line, CF_MEASURE_MAX_COLUMNS + 1,
-                            "the header has %zu columns; a table may have at most %d ('%s')", ncols,
-                            CF_MEASURE_MAX_COLUMNS, h->hq);
-    r->cols = calloc(ncols, sizeof *r->cols);
-    if (!r->cols)
-        return out_of_memory(err, path);
-    r->ncols = h->ncols = ncols;
-    size_t numeric = 0;
-    for (size_t i = 0; i < ncols; i++) {
-        const char *name = cf_csv_field(&r->f, i);
-        double v;
-        if (name[0] == '\0')
-            return cf_csv_error(err, path, h->header_line, i + 1, "column %zu has no name ('%s')",
-                                i + 1, h->hq);
-        if (strlen(name) >= CF_COLUMN_NAME_CAP)
-            return cf_csv_error(err, path, h->header_line, i + 1,
-                                "column name too long ('%.60s...')", name);
-        if (cf_csv_number(name, h->delim, &v) == CF_CSV_NUM_OK)
-            numeric++;
-        cf_column_parse(&r->cols[i], name);
-    }
-    if (numeric == ncols)
-        return cf_csv_error(err, path, h->header_line, 1,
-                            "missing header: the first row holds numbers, not column names ('%s')",
-                            h->hq);
-    return CF_OK;
-}
-
-/* Finds a column by name (the full header name or its base, case-insensitive). */
-static long find_column(const reader *r, const char *name)
-{
-    for (size_t i = 0; i < r->ncols; i++)
-        if (strcasecmp(r->cols[i].name, name) == 0)
-            return (long)i;
-    for (size_t i = 0; i < r->ncols; i++)
-        if (strcasecmp(r->cols[i].base, name) == 0)
-            return (long)i;
-    return -1;
-}
-
-static cf_status column_not_found(const reader *r, size_t header_line, const char *what,
-                                  const char *name, cf_error *err)
-{
-    char list[256];
-    size_t o = 0;
-    list[0] = '\0';
-    for (size_t i = 0; i < r->ncols && o + 4 < sizeof list; i++)
-        o += (size_t)snprintf(list + o, sizeof list - o, "%s%s", i ? ", " : "", r->cols[i].name);
-    char q[256];
-    cf_csv_quote(q, sizeof q, name, strlen(name));
-    return cf_csv_error(err, r->path, header_line, 1,
-                        "no %s column named '%s' (the header has: %s)", what, q, list);
-}
-
-/* Which columns: x, y, weight, time (the options name x and y, else their names tell). */
-static cf_status choose_columns(const reader *r, const cf_measure_options *opt, layout *h,
-                                cf_error *err)
-{
-    const size_t ncols = h->ncols;
-    long xi = -1, yi = -1, wi = -1, ti = -1;
-    for (size_t i = 0; i < ncols; i++) {
-        if (wi < 0 && cf_column_is_weight(r->cols[i].base))
-            wi = (long)i;
-        if (ti < 0 && cf_column_is_time(r->cols[i].base))
-            ti = (long)i;
-    }
-    if (opt->x_col && (xi = find_column(r, opt->x_col)) < 0)
-        return column_not_found(r, h->header_line, "x", opt->x_col, err);
-    if (opt->y_col && (yi = find_column(r, opt->y_col)) < 0)
-        return column_not_found(r, h->header_line, "y", opt->y_col, err);
-    for (int pass = 0; pass < 2 && yi < 0; pass++)
-        for (size_t i = 0; i < ncols && yi < 0; i++)
-            if ((long)i != xi &&
-                (pass == 0 ? cf_column_is_y(r->cols[i].base)
-                           : cf_column_y_class(r->cols[i].base) != CF_UNIT_UNKNOWN))
-                yi = (long)i;
-    for (size_t i = 0; i < ncols && xi < 0; i++)
-        if ((long)i != yi && cf_column_is_x(r->cols[i].base))
-            xi = (long)i;
-    for (size_t i = 0; i < ncols && (xi < 0 || yi < 0); i++) {
-        if ((long)i == xi || (long)i == yi || (long)i == wi || (long)i == ti)
-            continue;
-        if (xi < 0)
-            xi = (long)i;
-        else
-            yi = (long)i;
-    }
-    if (xi < 0 || yi < 0 || xi == yi)
-        return cf_csv_error(err, r->path, h->header_line, 1,
-                            "cannot tell which columns are x and y; name them (strain, stress_kPa, "
-                            "...) or set option x_col and option y_col ('%s')", h->hq);
-    h->xi = xi;
-    h->yi = yi;
-    h->wi = wi == xi || wi == yi ? -1 : wi;
-    h->ti = ti == xi || ti == yi ? -1 : ti;
-    return CF_OK;
-}
 
 /* ---- units ----------------------------------------------------------------------------------- */
 
@@ -646,7 +491,7 @@ static cf_status read_row(reader *r, const cf_csv_line *l, size_t n, const layou
                           const scaling *u, double *tprev, int *skip, cf_error *err)
 {
     const char *path = r->path;
-    cf_status st = split_or_fail(r, l, n, h->delim, err);
+    cf_status st = cf_reader_split(r, l, n, h->delim, err);
     if (st != CF_OK)
         return st;
     *skip = 1;
@@ -690,7 +535,7 @@ static cf_status read_row(reader *r, const cf_csv_line *l, size_t n, const layou
                             r->cols[h->ti].name, t, *tprev, cf_csv_field(&r->f, (size_t)h->ti));
     *tprev = t;
     if (push_row(r, x, y, v[2], t) != 0)
-        return out_of_memory(err, path);
+        return cf_reader_out_of_memory(err, path);
     return CF_OK;
 }
 
@@ -787,9 +632,10 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
     r.path = path; /* read_all names standard input "(standard input)" */
     cf_status st;
     if ((st = read_all(&r, err)) != CF_OK || (st = spreadsheet_check(&r, err)) != CF_OK ||
-        (st = cut_lines(&r, err)) != CF_OK || (st = scan_text(&r, err)) != CF_OK ||
-        (st = find_header(&r, &h, err)) != CF_OK || (st = read_header(&r, &h, err)) != CF_OK ||
-        (st = choose_columns(&r, &opt, &h, err)) != CF_OK ||
+        (st = cut_lines(&r, err)) != CF_OK || (st = scan_comments(&r, err)) != CF_OK ||
+        (st = cf_header_find(&r, &opt, &h, err)) != CF_OK ||
+        (st = check_text(&r, &h, err)) != CF_OK || (st = cf_header_read(&r, &h, err)) != CF_OK ||
+        (st = cf_header_choose_columns(&r, &opt, &h, err)) != CF_OK ||
         (st = decide_units(&r, &opt, &h, m, &u, err)) != CF_OK ||
         (st = read_rows(&r, &h, &u, err)) != CF_OK ||
         (st = decide_mode(&r, &opt, m, err)) != CF_OK) {

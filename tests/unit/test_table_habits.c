@@ -132,11 +132,126 @@ static void strain_units_mm_per_mm_and_percent(void **state)
     must_refuse(six_rows("stretch (%),stress_MPa"), NULL, 1, "'stretch (%)'", "%");
 }
 
+/* ---- comments and preambles ------------------------------------------------------------------ */
+
+static void comments_and_preambles_may_hold_any_bytes(void **state)
+{
+    (void)state;
+    /* a degree sign in Windows-1252 (0xB0), in a comment line and after a value */
+    cf_table m;
+    must_read("# specimen 3, 23 \xb0" "C\nstrain,stress_kPa\n0,0\n0.1,1 # 23.5 \xb0" "C\n0.2,2\n"
+              "0.3,3\n0.4,4\n0.5,5\n",
+              NULL, &m);
+    assert_int_equal(m.count, 6);
+    cf_table_free(&m);
+    /* and in a preamble line before the header */
+    must_read("Temperature,23 \xb0" "C\nStrain (mm/mm),Stress (MPa)\n0,0\n1,1\n2,2\n3,3\n4,4\n"
+              "5,5\n",
+              NULL, &m);
+    assert_int_equal(m.count, 6);
+    cf_table_free(&m);
+    /* but not in a data row, nor in the header */
+    must_refuse("strain,stress_kPa\n0,0\n0.1,1\xb0\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n", NULL, 3,
+                "0xB0", "binary");
+    must_refuse("strain,stress \xb0kPa\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n", NULL, 1,
+                "0xB0", "binary");
+}
+
+/* An export as an Instron or Zwick program writes it: metadata lines, then the header row. */
+static const char instron[] =
+    "\"Sample ID:\",\"SPEC-3\"\n"
+    "\"Test date:\",\"2026-11-02\"\n"
+    "\"Width (mm)\",10.2,\"Thickness (mm)\",2.1\n"
+    "\n"
+    "Time (s),Strain (mm/mm),Stress (MPa)\n"
+    "0,0,0\n1,0.1,1\n2,0.2,2\n3,0.3,3\n4,0.4,4\n5,0.5,5\n";
+
+static void a_preamble_before_the_header_row_is_skipped(void **state)
+{
+    (void)state;
+    cf_table m;
+    must_read(instron, NULL, &m);
+    assert_int_equal(m.count, 6);
+    assert_string_equal(m.x_column, "Strain (mm/mm)");
+    assert_string_equal(m.y_column, "Stress (MPa)");
+    assert_close(m.y[5], 5.0, 1e-15);
+    assert_non_null(m.t); /* the time column is read: see pick_columns below to leave it out */
+    cf_table_free(&m);
+    /* the option names the header's line; the preamble before it is skipped */
+    cf_measure_options o = cf_measure_default_options();
+    o.header_row = 5;
+    must_read(instron, &o, &m);
+    assert_int_equal(m.count, 6);
+    cf_table_free(&m);
+    /* a header row of names the reader does not know: found with the option, and without it
+    ** the message names that line (5), not the first */
+    static const char unknown[] = "Operator,Smith\nMachine,5944\n\nStation A\ne,s [kPa]\n0,0\n"
+                                  "0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n";
+    must_refuse(unknown, NULL, 5, "no header row", "line 6");
+    o.header_row = 5;
+    must_read(unknown, &o, &m);
+    assert_string_equal(m.y_unit, "kPa");
+    assert_close(m.x[5], 0.5, 1e-15);
+    cf_table_free(&m);
+    /* the option on a comment, a blank line or beyond the file */
+    static const char commented[] = "# a comment\nstrain,stress_kPa\n\n0,0\n0.1,1\n0.2,2\n0.3,3\n"
+                                    "0.4,4\n0.5,5\n";
+    o.header_row = 1;
+    must_refuse(commented, &o, 1, "header_row 1", "a comment");
+    o.header_row = 3;
+    must_refuse(commented, &o, 3, "header_row 3", "blank");
+    o.header_row = 99;
+    must_refuse(commented, &o, 9, "header_row 99", "9 lines");
+    /* a table without preamble is read from its first line as before, also with the option */
+    o.header_row = 2;
+    must_read(commented, &o, &m);
+    assert_int_equal(m.count, 6);
+    cf_table_free(&m);
+}
+
+/* ---- columns picked by the caller ------------------------------------------------------------ */
+
+static void columns_option_picks_x_y_and_weight(void **state)
+{
+    (void)state;
+    static const char t[] = "time_s,weight,strain,stress_kPa,sd\n0,1,0,0,3\n1,2,0.1,1,3\n"
+                            "2,1,0.2,2,3\n3,1,0.3,3,3\n4,1,0.4,4,3\n5,1,0.5,5,3\n";
+    cf_table m;
+    cf_measure_options o = cf_measure_default_options();
+    must_read(t, NULL, &m); /* by names: a time series with weights */
+    assert_non_null(m.t);
+    assert_close(m.w[1], 2.0, 0);
+    cf_table_free(&m);
+    o.columns = "strain,stress_kPa"; /* only those: no time, every weight 1 */
+    must_read(t, &o, &m);
+    assert_null(m.t);
+    assert_close(m.w[1], 1.0, 0);
+    assert_close(m.y[5], 5e-3, 1e-18);
+    cf_table_free(&m);
+    o.columns = "3, 4, sd"; /* numbers, names, blanks around them; sd as the weight */
+    must_read(t, &o, &m);
+    assert_null(m.t);
+    assert_close(m.w[1], 3.0, 0);
+    assert_string_equal(m.x_column, "strain");
+    cf_table_free(&m);
+    o.columns = "strain,6";
+    must_refuse(t, &o, 1, "no y column named '6'", "time_s, weight");
+    o.columns = "strain,stress_kPa,strain";
+    must_refuse(t, &o, 1, "the x and the weight are one column", "'strain'");
+    o.columns = "strain";
+    must_refuse(t, &o, 0, "option columns 'strain'", "X,Y");
+    o.columns = "1,2,3,4";
+    must_refuse(t, &o, 0, "option columns '1,2,3,4'", "X,Y");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(unit_prefixes_ignore_case_unless_m_or_M),
         cmocka_unit_test(strain_units_mm_per_mm_and_percent),
+        cmocka_unit_test(comments_and_preambles_may_hold_any_bytes),
+        cmocka_unit_test(a_preamble_before_the_header_row_is_skipped),
+        cmocka_unit_test(columns_option_picks_x_y_and_weight),
     };
     return cmocka_run_group_tests_name("table_habits", tests, make_dir, drop_dir);
 }

@@ -2,7 +2,8 @@
 ** Reading measured tables: stress against strain (or stretch), or force against displacement,
 ** from a CSV file with a header row, into the units conifit works in (MPa, N, mm, s).
 **
-** Accepted: '#' comment lines (anywhere, also before the header), CRLF or LF line ends, a UTF-8
+** Accepted: '#' comment lines (anywhere, also before the header, holding any bytes), a preamble of
+** metadata lines before the header row (skipped), CRLF or LF line ends, a UTF-8
 ** byte-order mark, ',' ';' or TAB delimiters (detected from the header), double-quoted fields,
 ** an optional `weight` column, an optional `time` column. Units come from the column name
 ** (`stress_kPa`, `stress [kPa]`, `stress (kPa)`, `displacement_mm`, `force_N`) or from the options;
@@ -46,6 +47,11 @@ typedef struct cf_measure_options {
     int stress_measure;      /* -1: from the file (comment, column name; else nominal), or a
                              ** cf_stress_measure that wins over the file */
     int strain_measure;      /* -1: from the file, or a cf_strain_measure */
+    size_t header_row;       /* 1-based line of the header row, or 0: the first line with
+                             ** content, else the first after a preamble that names known columns
+                             ** and is followed by rows of numbers */
+    const char *columns;     /* "X,Y" or "X,Y,W": the x, y and weight columns by name or 1-based
+                             ** number, and no others (no weight or time found by name); or NULL */
 } cf_measure_options;
 
 /* Options with everything decided from the file. */
