@@ -139,7 +139,8 @@ static int starts_with_ci(const char *s, const char *prefix)
 int cf_column_is_x(const char *b)
 {
     static const char *const p[] = {"strain", "stretch", "lambda", "displacement", "elongation",
-                                    "gamma", "shear", "log_strain", "true_strain", "hencky"};
+                                    "gamma", "shear", "log_strain", "true_strain", "hencky",
+                                    "\xce\xbb" /* the Greek letter lambda */};
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++)
         if (starts_with_ci(b, p[i]))
             return 1;

@@ -48,7 +48,8 @@ extern const char cf_unit_list[];
 void cf_column_parse(cf_column *c, const char *name);
 
 /* 1 when a base name starts like that of an x column: strain, stretch, lambda, displacement,
-** elongation, gamma, shear, log_strain, true_strain or hencky (letter case ignored). */
+** elongation, gamma, shear, log_strain, true_strain, hencky or the letter lambda (letter case
+** ignored). */
 int cf_column_is_x(const char *b);
 
 /* What a base name says its column holds: CF_UNIT_STRESS when it contains "stress" or starts

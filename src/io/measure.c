@@ -16,6 +16,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -583,6 +584,61 @@ static cf_status decide_mode(const reader *r, const cf_measure_options *opt, cf_
     return CF_OK;
 }
 
+/* Appends one line to m->notes (cut to fit). */
+static void add_note(cf_table *m, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+static void add_note(cf_table *m, const char *fmt, ...)
+{
+    size_t o = strlen(m->notes);
+    if (o > 0 && o + 1 < sizeof m->notes)
+        m->notes[o++] = '\n', m->notes[o] = '\0';
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(m->notes + o, sizeof m->notes - o, fmt, ap);
+    va_end(ap);
+}
+
+/* A unit decoration that was read in another letter case ("Mpa" as MPa) is said. */
+static void note_unit_case(cf_table *m, const cf_column *c)
+{
+    const cf_unit_def *d = c->unit[0] ? cf_unit_find(c->unit) : NULL;
+    if (d && strcmp(d->name, c->unit) != 0)
+        add_note(m, "column '%s': unit '%s' read as %s", c->name, c->unit, d->canon);
+}
+
+/* Strain that looks like stretch: where the stress is smallest (zero, unloaded), an engineering
+** strain near 1 means 100 % strain at rest, which no specimen has; a stretch column has 1 there. */
+#define STRETCH_LIKE_TOL 0.05
+
+/* The notes of a table (table.h): a skipped preamble, units read in another case, and a strain
+** column whose values look like stretch (unless an option said what the column holds). */
+static void table_notes(const layout *h, const reader *r, cf_table *m)
+{
+    if (h->preamble)
+        add_note(m, "lines 1 to %zu before the header row (line %zu) were skipped as a preamble",
+                 h->header_line - 1, h->header_line);
+    note_unit_case(m, &r->cols[h->xi]);
+    note_unit_case(m, &r->cols[h->yi]);
+    if (m->kind != CF_TABLE_STRESS_STRAIN || m->measures.strain != CF_STRAIN_ENGINEERING ||
+        m->measures.strain_from == CF_DECL_OPTION || m->count == 0)
+        return;
+    size_t at = 0;
+    double ymax = 0.0;
+    for (size_t i = 0; i < m->count; i++) {
+        ymax = fmax(ymax, fabs(m->y[i]));
+        if (fabs(m->y[i]) < fabs(m->y[at]))
+            at = i;
+    }
+    if (fabs(m->x[at] - 1.0) <= STRETCH_LIKE_TOL && fabs(m->y[at]) <= 1e-3 * ymax)
+        add_note(m, "column '%s' holds strain %.6g where the stress is least (%.6g %s, row %zu): "
+                 "strain 1 at rest looks like stretch; if the column is stretch, name it "
+                 "stretch or give option strain_measure stretch",
+                 m->x_column, m->x[at], m->y[at] * m->y_to_file, m->y_unit, at + 1);
+}
+
 /* Hands the rows and what is known of them over to m (the reader keeps no rows). */
 static void hand_over(reader *r, const layout *h, const scaling *u, cf_table *m)
 {
@@ -610,6 +666,7 @@ static void hand_over(reader *r, const layout *h, const scaling *u, cf_table *m)
              m->kind == CF_TABLE_STRESS_STRAIN ? "-" : "mm");
     snprintf(m->y_unit, sizeof m->y_unit, "%s", u->yu->canon);
     m->measures = u->meas;
+    table_notes(h, r, m);
 }
 
 /* Reading a table is one pass through its stages in order: the text, the header, which columns,

@@ -2,7 +2,8 @@
 ** Tests of the table options of `conifit fit` through the program: --columns picks the x, y (and
 ** weight) columns so that a time column of a single ramp is ignored, --header-row names the
 ** header of an export with a preamble; a malformed value is a usage error (2), a column or line
-** the table does not have is bad data (65), each message naming what it refused.
+** the table does not have is bad data (65), each message naming what it refused; the reader's
+** notes (strain that looks like stretch) are warnings on stderr.
 */
 #include "testutil.h"
 
@@ -20,6 +21,13 @@ static int drop_dir(void **state)
     return tu_remove_tmpdir(dir);
 }
 
+/* Writes the table text as DIR/NAME into path (cap bytes). */
+static void put_table(char *path, size_t cap, const char *name, const char *text, size_t len)
+{
+    snprintf(path, cap, "%s/%s", dir, name);
+    assert_int_equal(tu_write_bytes(path, text, len), 0);
+}
+
 /* A single ramp with a time column: as a time series it cannot be fitted. */
 static const char ramp[] = "time_s,strain,stress_kPa\n0,0,0\n1,0.1,1\n2,0.2,2\n3,0.3,3\n"
                            "4,0.4,5\n5,0.5,8\n6,0.6,12\n";
@@ -34,9 +42,8 @@ static void columns_option_ignores_a_time_column(void **state)
 {
     (void)state;
     char table[512], fit[512];
-    snprintf(table, sizeof table, "%s/ramp.csv", dir);
+    put_table(table, sizeof table, "ramp.csv", ramp, sizeof ramp - 1);
     snprintf(fit, sizeof fit, "%s/ramp.json", dir);
-    assert_int_equal(tu_write_bytes(table, ramp, sizeof ramp - 1), 0);
     /* today's reading: a time series with a single ramp, refused */
     assert_int_equal(tu_run(NULL, 0, errb, sizeof errb, "fit %s -q", table), 65);
     /* by name, by number, and a name with a number */
@@ -77,8 +84,7 @@ static void header_row_option_reads_an_export_with_a_preamble(void **state)
 {
     (void)state;
     char table[512];
-    snprintf(table, sizeof table, "%s/instron.csv", dir);
-    assert_int_equal(tu_write_bytes(table, preamble, sizeof preamble - 1), 0);
+    put_table(table, sizeof table, "instron.csv", preamble, sizeof preamble - 1);
     /* the header names no known column: the message names its line (4), not line 1 */
     assert_int_equal(tu_run(NULL, 0, errb, sizeof errb, "fit %s -q", table), 65);
     assert_non_null(strstr(errb, "instron.csv:4:1:"));
@@ -95,11 +101,26 @@ static void header_row_option_reads_an_export_with_a_preamble(void **state)
     assert_non_null(strstr(errb, "blank"));
 }
 
+/* Notes of the reader reach stderr as warnings; the fit goes on. */
+static void table_notes_are_warnings(void **state)
+{
+    (void)state;
+    static const char looks[] = "strain,stress_Mpa\n1,0\n1.1,1\n1.2,2\n1.3,3\n1.4,5\n1.5,8\n";
+    char table[512];
+    put_table(table, sizeof table, "looks.csv", looks, sizeof looks - 1);
+    assert_int_equal(tu_run(NULL, 0, errb, sizeof errb, "fit %s -q", table), 0);
+    assert_non_null(strstr(errb, "conifit: warning: "));
+    assert_non_null(strstr(errb, "looks.csv: column 'strain' holds strain 1"));
+    assert_non_null(strstr(errb, "--strain-measure stretch"));
+    assert_non_null(strstr(errb, "unit 'Mpa' read as MPa"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(columns_option_ignores_a_time_column),
         cmocka_unit_test(header_row_option_reads_an_export_with_a_preamble),
+        cmocka_unit_test(table_notes_are_warnings),
     };
     return cmocka_run_group_tests_name("table_options", tests, make_dir, drop_dir);
 }

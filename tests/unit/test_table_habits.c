@@ -132,6 +132,50 @@ static void strain_units_mm_per_mm_and_percent(void **state)
     must_refuse(six_rows("stretch (%),stress_MPa"), NULL, 1, "'stretch (%)'", "%");
 }
 
+/* ---- stretch ---------------------------------------------------------------------------------- */
+
+static void stretch_columns_and_strain_that_looks_like_stretch(void **state)
+{
+    (void)state;
+    static const char *const names[] = {"stretch", "lambda", "\xce\xbb", "Lambda [-]"};
+    for (size_t k = 0; k < 4; k++) {
+        char t[256];
+        snprintf(t, sizeof t, "%s,stress_kPa\n1,0\n1.1,1\n1.2,2\n1.3,3\n1.4,5\n1.5,8\n", names[k]);
+        cf_table m;
+        must_read(t, NULL, &m);
+        assert_int_equal(m.x_from_stretch, 1);
+        assert_int_equal(m.measures.strain, CF_STRAIN_STRETCH);
+        assert_close(m.x[5], 0.5, 1e-15);
+        assert_string_equal(m.notes, "");
+        cf_table_free(&m);
+    }
+    /* stretch values in a column named strain: read as strain (the file says so), with a note */
+    static const char looks[] = "strain,stress_kPa\n1,0\n1.1,1\n1.2,2\n1.3,3\n1.4,5\n1.5,8\n";
+    cf_table m;
+    must_read(looks, NULL, &m);
+    assert_close(m.x[5], 1.5, 0);
+    assert_non_null(strstr(m.notes, "column 'strain' holds strain 1 where the stress is least"));
+    assert_non_null(strstr(m.notes, "looks like stretch"));
+    cf_table_free(&m);
+    /* the same sorted the other way, and in percent */
+    must_read("strain (%),stress_kPa\n150,8\n140,5\n130,3\n120,2\n110,1\n100,0.001\n", NULL, &m);
+    assert_non_null(strstr(m.notes, "row 6"));
+    cf_table_free(&m);
+    /* no note when the caller said what the column holds, nor for ordinary strain */
+    cf_measure_options o = cf_measure_default_options();
+    o.strain_measure = CF_STRAIN_ENGINEERING;
+    must_read(looks, &o, &m);
+    assert_string_equal(m.notes, "");
+    cf_table_free(&m);
+    must_read("strain,stress_kPa\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,5\n1.0,8\n", NULL, &m);
+    assert_string_equal(m.notes, "");
+    cf_table_free(&m);
+    /* a unit read in another letter case is noted too */
+    must_read(six_rows("strain,stress_Mpa"), NULL, &m);
+    assert_non_null(strstr(m.notes, "unit 'Mpa' read as MPa"));
+    cf_table_free(&m);
+}
+
 /* ---- comments and preambles ------------------------------------------------------------------ */
 
 static void comments_and_preambles_may_hold_any_bytes(void **state)
@@ -175,7 +219,8 @@ static void a_preamble_before_the_header_row_is_skipped(void **state)
     assert_string_equal(m.x_column, "Strain (mm/mm)");
     assert_string_equal(m.y_column, "Stress (MPa)");
     assert_close(m.y[5], 5.0, 1e-15);
-    assert_non_null(m.t); /* the time column is read: see pick_columns below to leave it out */
+    assert_non_null(m.t); /* the time column is read: --columns leaves it out (below) */
+    assert_non_null(strstr(m.notes, "lines 1 to 4 before the header row (line 5) were skipped"));
     cf_table_free(&m);
     /* the option names the header's line; the preamble before it is skipped */
     cf_measure_options o = cf_measure_default_options();
@@ -244,14 +289,40 @@ static void columns_option_picks_x_y_and_weight(void **state)
     must_refuse(t, &o, 0, "option columns '1,2,3,4'", "X,Y");
 }
 
+/* ---- the published tables -------------------------------------------------------------------- */
+
+/* The published tables read as before (their values: test_measure.c) and none draws a note. */
+static void published_tables_draw_no_note(void **state)
+{
+    (void)state;
+    const char *dir = tu_datasets();
+    if (!dir) {
+        print_message("skipped: ../shared/datasets is absent\n");
+        skip();
+    }
+    for (size_t k = 0; k < TU_PUBLISHED_COUNT; k++) {
+        char path[512];
+        snprintf(path, sizeof path, "%s/%s", dir, tu_published_tables[k]);
+        cf_table m;
+        cf_error err = {0};
+        if (cf_measure_load(path, NULL, &m, &err) != CF_OK)
+            fail_msg("%s: %s", path, err.msg);
+        if (m.notes[0])
+            fail_msg("%s: unexpected note: %s", path, m.notes);
+        cf_table_free(&m);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(unit_prefixes_ignore_case_unless_m_or_M),
         cmocka_unit_test(strain_units_mm_per_mm_and_percent),
+        cmocka_unit_test(stretch_columns_and_strain_that_looks_like_stretch),
         cmocka_unit_test(comments_and_preambles_may_hold_any_bytes),
         cmocka_unit_test(a_preamble_before_the_header_row_is_skipped),
         cmocka_unit_test(columns_option_picks_x_y_and_weight),
+        cmocka_unit_test(published_tables_draw_no_note),
     };
     return cmocka_run_group_tests_name("table_habits", tests, make_dir, drop_dir);
 }
