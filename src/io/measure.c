@@ -612,6 +612,9 @@ static void note_unit_case(cf_table *m, const cf_column *c)
 /* Strain that looks like stretch: where the stress is smallest (zero, unloaded), an engineering
 ** strain near 1 means 100 % strain at rest, which no specimen has; a stretch column has 1 there. */
 #define STRETCH_LIKE_TOL 0.05
+/* "Where the stress is least" is a row at rest when that stress is within this fraction of the
+** largest (a measured zero carries noise). */
+#define STRETCH_LIKE_REST 0.01
 
 /* The notes of a table (table.h): a skipped preamble, units read in another case, and a strain
 ** column whose values look like stretch (unless an option said what the column holds). */
@@ -632,7 +635,7 @@ static void table_notes(const layout *h, const reader *r, cf_table *m)
         if (fabs(m->y[i]) < fabs(m->y[at]))
             at = i;
     }
-    if (fabs(m->x[at] - 1.0) <= STRETCH_LIKE_TOL && fabs(m->y[at]) <= 1e-3 * ymax)
+    if (fabs(m->x[at] - 1.0) <= STRETCH_LIKE_TOL && fabs(m->y[at]) <= STRETCH_LIKE_REST * ymax)
         add_note(m, "column '%s' holds strain %.6g where the stress is least (%.6g %s, row %zu): "
                  "strain 1 at rest looks like stretch; if the column is stretch, name it "
                  "stretch or give option strain_measure stretch",
