@@ -100,10 +100,12 @@ static cf_status header_at(const reader *r, size_t line, layout *h, cf_error *er
 }
 
 /* A table whose first line with content is not followed by rows of numbers: a preamble (lines
-** before the header row, as testing machines write). The header is the first line after it that
-** names known columns and is followed by rows; when none does, h->no_header_at is the line
-** before the first row of numbers (the one that should have named the columns). */
-static void skip_preamble(reader *r, layout *h)
+** before the header row, as testing machines write; its first line may name a known column, as
+** "Strain rate,0.01 /s" does). The header is the first line after it that names known columns and
+** is followed by rows; when none does, the first line stays the header, and when that names no
+** known column either, h->no_header_at is the line before the first row of numbers (the one that
+** should have named the columns). */
+static void skip_preamble(reader *r, layout *h, int first_names_columns)
 {
     size_t first = h->hi, n = 0, prev = first;
     for (size_t i = next_content(r, first + 1, &n), seen = 0;
@@ -116,7 +118,8 @@ static void skip_preamble(reader *r, layout *h)
             return;
         }
         char delim = cf_csv_delimiter(r->lines[i].s, n);
-        if (!h->no_header_at && prev != first && numbers_in(r, i, n, delim ? delim : ',') >= 2) {
+        if (!first_names_columns && !h->no_header_at && prev != first &&
+            numbers_in(r, i, n, delim ? delim : ',') >= 2) {
             h->no_header_at = r->lines[prev].line;
             h->numbers_at = r->lines[i].line;
         }
@@ -125,8 +128,8 @@ static void skip_preamble(reader *r, layout *h)
 }
 
 /* The header row: the line the option names; else the first line with content, unless that is
-** followed by no rows and names no known column: then the first line after a preamble that
-** names known columns and is followed by rows. */
+** followed by no rows of numbers: then the first line after a preamble that names known columns
+** and is followed by rows, if there is one. */
 cf_status cf_header_find(reader *r, const cf_measure_options *opt, layout *h, cf_error *err)
 {
     const char *path = r->path;
@@ -134,8 +137,8 @@ cf_status cf_header_find(reader *r, const cf_measure_options *opt, layout *h, cf
         return header_at(r, opt->header_row, h, err);
     h->hi = next_content(r, 0, &h->hn);
     if (h->hi < r->nlines) {
-        if (!rows_follow(r, h->hi, h->hn) && !names_columns(r, h->hi, h->hn))
-            skip_preamble(r, h);
+        if (!rows_follow(r, h->hi, h->hn))
+            skip_preamble(r, h, names_columns(r, h->hi, h->hn));
         return CF_OK;
     }
     if (r->size == 0)

@@ -50,9 +50,9 @@ cf_status cf_reader_out_of_memory(cf_error *err, const char *path);
 cf_status cf_reader_split(reader *r, const cf_csv_line *l, size_t n, char delim, cf_error *err);
 
 /* The header row (h->hi, h->hn): the line opt->header_row names; else the first line with content,
-** or, when that is followed by no rows of numbers and names no known column, the first line after
-** such a preamble that names known columns and is followed by rows (h->preamble: the lines
-** skipped). When none is found, h->no_header_at is set for cf_header_read to refuse. */
+** or, when that is followed by no rows of numbers, the first line after such a preamble that names
+** known columns and is followed by rows (h->preamble: lines were skipped). When none is found and
+** the first line names no known column, h->no_header_at is set for cf_header_read to refuse. */
 cf_status cf_header_find(reader *r, const cf_measure_options *opt, layout *h, cf_error *err);
 
 /* The header's delimiter and column names (r->cols, h->ncols); CF_E_DATA for a header of one

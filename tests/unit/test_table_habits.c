@@ -222,6 +222,16 @@ static void a_preamble_before_the_header_row_is_skipped(void **state)
     assert_non_null(m.t); /* the time column is read: --columns leaves it out (below) */
     assert_non_null(strstr(m.notes, "lines 1 to 4 before the header row (line 5) were skipped"));
     cf_table_free(&m);
+    /* a preamble whose first line names a known column (strain) */
+    must_read("Strain rate,0.01,1/s\nGauge length (mm),25.0\nStrain (%),Stress (kPa)\n0,0\n"
+              "10,1\n20,2\n30,3\n40,4\n50,5\n",
+              NULL, &m);
+    assert_close(m.x[5], 0.5, 1e-15);
+    assert_non_null(strstr(m.notes, "lines 1 to 2 before the header row (line 3)"));
+    cf_table_free(&m);
+    /* a header naming known columns with a bad row after it: refused at that row, as before */
+    must_refuse("strain,stress_kPa\nabc,def\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n", NULL,
+                2, "not a number", "'abc'");
     /* the option names the header's line; the preamble before it is skipped */
     cf_measure_options o = cf_measure_default_options();
     o.header_row = 5;
