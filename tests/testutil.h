@@ -74,6 +74,24 @@ static inline int tu_run(char *out, size_t out_cap, char *errbuf, size_t err_cap
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+/* A scratch folder for a group of tests: TU_SCRATCH_GROUP("name") defines `static char dir[]`
+** (/tmp/conifit-name-XXXXXX) and the group's setup (creates it) and teardown (removes it with all
+** it holds), for cmocka_run_group_tests(tests, setup, teardown). */
+#define TU_SCRATCH_GROUP(name)                                                                     \
+    static char dir[] = "/tmp/conifit-" name "-XXXXXX";                                           \
+    static int setup(void **state)                                                                 \
+    {                                                                                              \
+        (void)state;                                                                               \
+        return mkdtemp(dir) ? 0 : -1;                                                              \
+    }                                                                                              \
+    static int teardown(void **state)                                                              \
+    {                                                                                              \
+        (void)state;                                                                               \
+        char cmd_[sizeof dir + 16];                                                                \
+        snprintf(cmd_, sizeof cmd_, "rm -rf '%s'", dir);                                           \
+        return system(cmd_) == 0 ? 0 : -1;                                                         \
+    }
+
 /* Runs argv (argv[0] a full path; no shell, so arguments may hold any byte) in folder dir (NULL:
 ** here) with env_extra ("NAME=VALUE", or NULL) added to the environment, standard input and
 ** output on /dev/null and standard error into the file err_path (relative to dir). Returns the
@@ -190,13 +208,6 @@ static inline char *tu_slurp(const char *path)
     return buf;
 }
 
-/* A fresh folder /tmp/PREFIX-XXXXXX into dir (cap bytes): 0, or -1 when it cannot be made. */
-static inline int tu_make_tmpdir(char *dir, size_t cap, const char *prefix)
-{
-    snprintf(dir, cap, "/tmp/%s-XXXXXX", prefix);
-    return mkdtemp(dir) ? 0 : -1;
-}
-
 /* Writes len bytes of text into a new file at path: 0, or -1. */
 static inline int tu_write_bytes(const char *path, const char *text, size_t len)
 {
@@ -205,14 +216,6 @@ static inline int tu_write_bytes(const char *path, const char *text, size_t len)
         return -1;
     int ok = fwrite(text, 1, len, f) == len;
     return fclose(f) == 0 && ok ? 0 : -1;
-}
-
-/* Removes the folder dir and everything in it: 0, or -1. */
-static inline int tu_remove_tmpdir(const char *dir)
-{
-    char cmd[512];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    return system(cmd) == 0 ? 0 : -1;
 }
 
 #endif

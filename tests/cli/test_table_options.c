@@ -7,19 +7,8 @@
 */
 #include "testutil.h"
 
-static char dir[256], errb[1 << 14];
-
-static int make_dir(void **state)
-{
-    (void)state;
-    return tu_make_tmpdir(dir, sizeof dir, "conifit-tableopt");
-}
-
-static int drop_dir(void **state)
-{
-    (void)state;
-    return tu_remove_tmpdir(dir);
-}
+TU_SCRATCH_GROUP("tableopt")
+static char errb[1 << 14];
 
 /* Writes the table text as DIR/NAME into path (cap bytes). */
 static void put_table(char *path, size_t cap, const char *name, const char *text, size_t len)
@@ -122,5 +111,5 @@ int main(void)
         cmocka_unit_test(header_row_option_reads_an_export_with_a_preamble),
         cmocka_unit_test(table_notes_are_warnings),
     };
-    return cmocka_run_group_tests_name("table_options", tests, make_dir, drop_dir);
+    return cmocka_run_group_tests_name("table_options", tests, setup, teardown);
 }

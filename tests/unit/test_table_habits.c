@@ -12,27 +12,15 @@
 
 #include "conifit/measure.h"
 
-static char tmpdir[256];
+TU_SCRATCH_GROUP("habits")
 static int file_counter;
-
-static int make_dir(void **state)
-{
-    (void)state;
-    return tu_make_tmpdir(tmpdir, sizeof tmpdir, "conifit-habits");
-}
-
-static int drop_dir(void **state)
-{
-    (void)state;
-    return tu_remove_tmpdir(tmpdir);
-}
 
 /* Writes the text (len bytes; (size_t)-1 for a C string) and reads it as a table. */
 static cf_status read_table(const char *text, size_t len, const cf_measure_options *opt,
                             cf_table *m, cf_error *err, const char **path_out)
 {
     static char path[512];
-    snprintf(path, sizeof path, "%s/h%03d.csv", tmpdir, ++file_counter);
+    snprintf(path, sizeof path, "%s/h%03d.csv", dir, ++file_counter);
     assert_int_equal(tu_write_bytes(path, text, len == (size_t)-1 ? strlen(text) : len), 0);
     if (path_out)
         *path_out = path;
@@ -46,7 +34,8 @@ static void must_read(const char *text, const cf_measure_options *opt, cf_table 
         fail_msg("refused: %s\n--- table ---\n%s", err.msg, text);
 }
 
-/* Refused with CF_E_DATA, the message starting "PATH:LINE:" (line 0: "PATH: ") and holding each of the words. */
+/* Refused with CF_E_DATA, the message starting "PATH:LINE:" (line 0: "PATH: ") and holding each
+** of the words. */
 static void must_refuse(const char *text, const cf_measure_options *opt, int line,
                         const char *w1, const char *w2)
 {
@@ -305,14 +294,14 @@ static void columns_option_picks_x_y_and_weight(void **state)
 static void published_tables_draw_no_note(void **state)
 {
     (void)state;
-    const char *dir = tu_datasets();
-    if (!dir) {
+    const char *datasets = tu_datasets();
+    if (!datasets) {
         print_message("skipped: ../shared/datasets is absent\n");
         skip();
     }
     for (size_t k = 0; k < TU_PUBLISHED_COUNT; k++) {
         char path[512];
-        snprintf(path, sizeof path, "%s/%s", dir, tu_published_tables[k]);
+        snprintf(path, sizeof path, "%s/%s", datasets, tu_published_tables[k]);
         cf_table m;
         cf_error err = {0};
         if (cf_measure_load(path, NULL, &m, &err) != CF_OK)
@@ -334,5 +323,5 @@ int main(void)
         cmocka_unit_test(columns_option_picks_x_y_and_weight),
         cmocka_unit_test(published_tables_draw_no_note),
     };
-    return cmocka_run_group_tests_name("table_habits", tests, make_dir, drop_dir);
+    return cmocka_run_group_tests_name("table_habits", tests, setup, teardown);
 }
