@@ -33,11 +33,12 @@ int cf_stress_measure_parse(const char *word, cf_stress_measure *m);
 int cf_strain_measure_parse(const char *word, cf_strain_measure *m);
 
 typedef struct cf_measure_options {
-    const char *x_col;       /* column name of x (with or without its unit decoration), or NULL:
-                             ** the first column named strain/stretch/lambda/displacement/
-                             ** elongation/gamma/shear..., else the first column that is not y */
-    const char *y_col;       /* column name of y, or NULL: the first column named stress/force/
-                             ** load..., else the first remaining column */
+    const char *x_col;       /* column name of x (with or without its unit decoration; a number
+                             ** from 1 when no column has that name), or NULL: the first column
+                             ** named strain/stretch/lambda/displacement/elongation/gamma/
+                             ** shear..., else the first column that is not y */
+    const char *y_col;       /* column name (or number) of y, or NULL: the first column named
+                             ** stress/force/load..., else the first remaining column */
     const char *stress_unit; /* "Pa", "kPa", "MPa", "GPa", "N/mm2", "mmHg"...; NULL: from header */
     const char *force_unit;  /* "N", "mN", "kN", "uN"; NULL: from header */
     const char *length_unit; /* "m", "mm", "um", "cm"; NULL: from header */
