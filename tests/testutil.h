@@ -208,4 +208,14 @@ static inline char *tu_slurp(const char *path)
     return buf;
 }
 
+/* Writes len bytes of text into a new file at path: 0, or -1. */
+static inline int tu_write_bytes(const char *path, const char *text, size_t len)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        return -1;
+    int ok = fwrite(text, 1, len, f) == len;
+    return fclose(f) == 0 && ok ? 0 : -1;
+}
+
 #endif

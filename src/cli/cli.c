@@ -79,6 +79,19 @@ int cf_cli_fail(const cf_error *err)
     return cf_exit_code(err->status);
 }
 
+void cf_cli_table_notes(const cf_table *m)
+{
+    for (const char *line = m->notes; *line;) {
+        const char *nl = strchr(line, '\n');
+        size_t n = nl ? (size_t)(nl - line) : strlen(line);
+        char note[sizeof m->notes], msg[2 * sizeof m->notes];
+        snprintf(note, sizeof note, "%.*s", (int)n, line);
+        flags_for_options(note, msg, sizeof msg);
+        cf_cli_printf_safe(stderr, "conifit: warning: %s: %s\n", m->path, msg);
+        line += n + (nl != NULL);
+    }
+}
+
 int cf_cli_usage_error(const char *cmd, const char *fmt, ...)
 {
     char msg[2048];

@@ -12,6 +12,7 @@
 #include "conifit/budget.h"
 #include "conifit/error.h"
 #include "conifit/law.h"
+#include "conifit/table.h"
 
 #include "conifit/version.h"
 #include "base/atomic.h"
@@ -156,6 +157,10 @@ void cf_cli_scene_fit(const char *scene_path, char *out, size_t cap);
 ** character and every byte that is not UTF-8 as \xNN (base/safetext.h). For every message and
 ** report line that carries text from outside (file names, column names, option values). */
 void cf_cli_write_safe(FILE *f, const char *text);
+
+/* The notes the table reader left in m (a skipped preamble, a unit read in another letter case,
+** strain that looks like stretch), one "conifit: warning: FILE: NOTE" line each on stderr. */
+void cf_cli_table_notes(const cf_table *m);
 
 /* printf into a buffer (8 KiB; longer output is cut), then cf_cli_write_safe. */
 void cf_cli_printf_safe(FILE *f, const char *fmt, ...)

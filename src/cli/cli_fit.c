@@ -223,6 +223,8 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
         cf_error err = {0};
         if (cf_measure_load(a->files[i], &a->mopt, &jobs[i].m, &err) != CF_OK)
             rc = cf_cli_fail(&err);
+        else
+            cf_cli_table_notes(&jobs[i].m);
     }
     if (rc < 0 && a->scene) {
         cf_error err = {0};

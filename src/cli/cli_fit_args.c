@@ -51,7 +51,10 @@ static const char fit_help[] =
     "                          (with several tables: a folder DIR/, one NAME.png per table)\n"
     "  --title TEXT            title of the plot (default: the table's file name without\n"
     "                          folder and extension)\n"
-    "  --x-col NAME, --y-col NAME   columns to use in wider tables\n"
+    "  --x-col NAME, --y-col NAME   columns to use in wider tables (a name or a number)\n"
+    "  --columns X,Y[,W]       the x, y (and weight) columns, by name or number, and no\n"
+    "                          others: a time or weight column is then ignored\n"
+    "  --header-row N          the header is line N (default: found after any preamble)\n"
     "  --stress-unit U         unit of a stress column without one (Pa, kPa, MPa, ...)\n"
     "  --force-unit U          unit of a force column without one (N, mN, ...)\n"
     "  --length-unit U         unit of a displacement column without one (mm, m, ...)\n"
@@ -105,6 +108,8 @@ enum {
     OPT_CALIBRATION,
     OPT_X_COL,
     OPT_Y_COL,
+    OPT_COLUMNS,
+    OPT_HEADER_ROW,
     OPT_STRESS_UNIT,
     OPT_FORCE_UNIT,
     OPT_LENGTH_UNIT,
@@ -145,6 +150,8 @@ static const struct option fit_options[] = {
     {"calibration", required_argument, NULL, OPT_CALIBRATION},
     {"x-col", required_argument, NULL, OPT_X_COL},
     {"y-col", required_argument, NULL, OPT_Y_COL},
+    {"columns", required_argument, NULL, OPT_COLUMNS},
+    {"header-row", required_argument, NULL, OPT_HEADER_ROW},
     {"stress-unit", required_argument, NULL, OPT_STRESS_UNIT},
     {"force-unit", required_argument, NULL, OPT_FORCE_UNIT},
     {"length-unit", required_argument, NULL, OPT_LENGTH_UNIT},
@@ -219,6 +226,24 @@ static int measure_option(int c, const char *optval, cf_measure_options *mo)
                               optval,
                               c == OPT_STRESS_MEASURE ? "nominal or cauchy"
                                                       : "engineering, log or stretch");
+}
+
+/* --columns X,Y[,W]: two or three names or numbers, none empty (the table says whether they
+** exist). */
+static int columns_option(const char *optval, cf_measure_options *mo)
+{
+    int parts = 1, empty = optval[0] == ',' || optval[0] == '\0';
+    for (const char *c = optval; *c; c++)
+        if (*c == ',') {
+            parts++;
+            empty |= c[1] == ',' || c[1] == '\0';
+        }
+    if (parts < 2 || parts > 3 || empty)
+        return cf_cli_usage_error("fit", "--columns '%s': expected X,Y or X,Y,W (names or "
+                                         "numbers from 1 of the x, y and weight columns)",
+                                  optval);
+    mo->columns = optval;
+    return 0;
 }
 
 /* One option of fit: 0 to go on, else an exit status. Long only because fit has many options:
@@ -331,6 +356,12 @@ static int fit_option(void *ctx, int c, const char *optval)
     }
     case OPT_X_COL: a->mopt.x_col = optval; return 0;
     case OPT_Y_COL: a->mopt.y_col = optval; return 0;
+    case OPT_COLUMNS: return columns_option(optval, &a->mopt);
+    case OPT_HEADER_ROW:
+        if (cf_cli_parse_long("--header-row", optval, 1, CF_MEASURE_MAX_LINES, &n, &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        a->mopt.header_row = (size_t)n;
+        return 0;
     case OPT_STRESS_UNIT: a->mopt.stress_unit = optval; return 0;
     case OPT_FORCE_UNIT: a->mopt.force_unit = optval; return 0;
     case OPT_LENGTH_UNIT: a->mopt.length_unit = optval; return 0;
@@ -398,6 +429,9 @@ int cf_cli_fit_parse(int argc, char **argv, fit_args *a)
         memcpy(a->vopt.setup.cfg.lattice.weight, a->popt.lattice.cfg.lattice.weight,
                sizeof a->vopt.setup.cfg.lattice.weight);
     }
+    if (a->mopt.columns && (a->mopt.x_col || a->mopt.y_col))
+        return cf_cli_usage_error(cmd, "--columns names x and y already: leave out --x-col and "
+                                       "--y-col");
     a->out = p.output;
     a->quiet = p.quiet;
     a->progress = cf_cli_progress(&p);

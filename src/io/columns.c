@@ -44,13 +44,39 @@ static const cf_unit_def units[] = {
     {"h", CF_UNIT_TIME, 3600.0, "h"},
     {"-", CF_UNIT_STRAIN, 1.0, "-"},
     {"1", CF_UNIT_STRAIN, 1.0, "-"},
+    {"mm/mm", CF_UNIT_STRAIN, 1.0, "-"},
+    {"m/m", CF_UNIT_STRAIN, 1.0, "-"},
+    {"in/in", CF_UNIT_STRAIN, 1.0, "-"},
     {"%", CF_UNIT_STRAIN, 0.01, "%"},
+    {"percent", CF_UNIT_STRAIN, 0.01, "%"},
+    {"pct", CF_UNIT_STRAIN, 0.01, "%"},
 };
+
+/* Letter case is ignored in a unit ("Mpa", "MPA", "kpa", "n"), except for a leading m or M: SI
+** reads m as milli (or metre) and M as mega, so "mPa" is never MPa and "MN" never mN. */
+static int same_unit(const char *spelled, const char *name)
+{
+    if ((spelled[0] == 'm' || spelled[0] == 'M' || name[0] == 'm' || name[0] == 'M') &&
+        spelled[0] != name[0])
+        return 0;
+    return strcasecmp(spelled, name) == 0;
+}
 
 const cf_unit_def *cf_unit_find(const char *name)
 {
     for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
         if (strcmp(units[i].name, name) == 0)
+            return &units[i];
+    for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
+        if (same_unit(name, units[i].name))
+            return &units[i];
+    return NULL;
+}
+
+const cf_unit_def *cf_unit_m_case(const char *name)
+{
+    for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
+        if (strcasecmp(units[i].name, name) == 0 && !same_unit(name, units[i].name))
             return &units[i];
     return NULL;
 }
@@ -76,7 +102,7 @@ cf_unit_class cf_measure_unit(const char *name, double *to_conifit)
 
 const char cf_unit_list[] =
     "stress: Pa kPa MPa GPa N/mm2 N/m2 mmHg; force: N mN kN uN; length: m cm mm um; "
-    "time: s ms min h; strain: - %";
+    "time: s ms min h; strain: - mm/mm in/in m/m % percent";
 
 /* ---- column names ------------------------------------------------------------------------- */
 
@@ -113,7 +139,8 @@ static int starts_with_ci(const char *s, const char *prefix)
 int cf_column_is_x(const char *b)
 {
     static const char *const p[] = {"strain", "stretch", "lambda", "displacement", "elongation",
-                                    "gamma", "shear", "log_strain", "true_strain", "hencky"};
+                                    "gamma", "shear", "log_strain", "true_strain", "hencky",
+                                    "\xce\xbb" /* the Greek letter lambda */};
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++)
         if (starts_with_ci(b, p[i]))
             return 1;

@@ -31,8 +31,13 @@ typedef struct cf_column {
     char unit[CF_COLUMN_NAME_CAP]; /* the decoration ("" when none) */
 } cf_column;
 
-/* The unit spelled exactly name, or NULL. */
+/* The unit spelled name, or NULL: letter case is ignored except for a leading m or M (milli or
+** metre against mega), so "Mpa" and "kpa" are found and "mPa" is not MPa. */
 const cf_unit_def *cf_unit_find(const char *name);
+
+/* The known unit that name spells but for the case of a leading m or M ("mPa", "MN"), which
+** cf_unit_find does not take; NULL when there is none. For messages that name both readings. */
+const cf_unit_def *cf_unit_m_case(const char *name);
 
 /* The known units by class, for messages. */
 extern const char cf_unit_list[];
@@ -43,7 +48,8 @@ extern const char cf_unit_list[];
 void cf_column_parse(cf_column *c, const char *name);
 
 /* 1 when a base name starts like that of an x column: strain, stretch, lambda, displacement,
-** elongation, gamma, shear, log_strain, true_strain or hencky (letter case ignored). */
+** elongation, gamma, shear, log_strain, true_strain, hencky or the letter lambda (letter case
+** ignored). */
 int cf_column_is_x(const char *b);
 
 /* What a base name says its column holds: CF_UNIT_STRESS when it contains "stress" or starts

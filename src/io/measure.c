@@ -12,9 +12,11 @@
 #include "io/columns.h"
 #include "io/csv.h"
 #include "io/measures.h"
+#include "io/reader.h"
 
 #include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,26 +24,11 @@
 
 cf_measure_options cf_measure_default_options(void)
 {
-    cf_measure_options o = {NULL, NULL, NULL, NULL, NULL, -1, NULL, -1, -1};
+    cf_measure_options o = {NULL, NULL, NULL, NULL, NULL, -1, NULL, -1, -1, 0, NULL};
     return o;
 }
 
 /* ---- the text -------------------------------------------------------------------------------- */
-
-typedef struct reader {
-    const char *path;
-    char *text;
-    size_t size;
-    cf_csv_line *lines; /* every line of the file */
-    size_t nlines;
-    cf_csv_line *comments; /* the '#' lines, without the '#' */
-    size_t ncomments;
-    cf_column *cols;
-    size_t ncols;
-    cf_csv_fields f;
-    double *x, *y, *w, *t;
-    size_t count, cap;
-} reader;
 
 static void reader_free(reader *r)
 {
@@ -56,7 +43,7 @@ static void reader_free(reader *r)
     free(r->t);
 }
 
-static cf_status out_of_memory(cf_error *err, const char *path)
+cf_status cf_reader_out_of_memory(cf_error *err, const char *path)
 {
     return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory reading the table", path);
 }
@@ -74,7 +61,7 @@ static cf_status read_all(reader *r, cf_error *err)
     if (!r->text) {
         if (!from_stdin)
             fclose(fp);
-        return out_of_memory(err, r->path);
+        return cf_reader_out_of_memory(err, r->path);
     }
     for (;;) {
         if (r->size > CF_MEASURE_MAX_BYTES) {
@@ -90,7 +77,7 @@ static cf_status read_all(reader *r, cf_error *err)
             if (!t) {
                 if (!from_stdin)
                     fclose(fp);
-                return out_of_memory(err, r->path);
+                return cf_reader_out_of_memory(err, r->path);
             }
             r->text = t;
             cap = ncap;
@@ -150,7 +137,7 @@ static cf_status cut_lines(reader *r, cf_error *err)
             cap = cap ? 2 * cap : 256;
             cf_csv_line *l = realloc(r->lines, cap * sizeof *l);
             if (!l)
-                return out_of_memory(err, r->path);
+                return cf_reader_out_of_memory(err, r->path);
             r->lines = l;
         }
         r->lines[r->nlines++] = (cf_csv_line){s, n, line};
@@ -159,24 +146,14 @@ static cf_status cut_lines(reader *r, cf_error *err)
     return CF_OK;
 }
 
-/* Checks every line for binary content and collects the comment lines. */
-static cf_status scan_text(reader *r, cf_error *err)
+/* Collects the comment lines (which may hold any bytes: a degree sign in a Windows code page). */
+static cf_status scan_comments(reader *r, cf_error *err)
 {
     r->comments = malloc((r->nlines ? r->nlines : 1) * sizeof *r->comments);
     if (!r->comments)
-        return out_of_memory(err, r->path);
+        return cf_reader_out_of_memory(err, r->path);
     for (size_t i = 0; i < r->nlines; i++) {
         const cf_csv_line *l = &r->lines[i];
-        size_t b = cf_csv_bad_byte((const unsigned char *)l->s, l->n);
-        if (b < l->n) {
-            char q[256];
-            cf_csv_quote(q, sizeof q, l->s, l->n);
-            unsigned char c = (unsigned char)l->s[b];
-            return cf_csv_error(err, r->path, l->line, b + 1,
-                                "%s: byte 0x%02X is not text (the column counts bytes here) ('%s')",
-                                c == '\r' ? "carriage return inside a line" : "binary content", c,
-                                q);
-        }
         if (cf_csv_is_comment(l)) {
             const char *h = memchr(l->s, '#', l->n);
             r->comments[r->ncomments++] = (cf_csv_line){h + 1, l->n - (size_t)(h + 1 - l->s),
@@ -186,14 +163,36 @@ static cf_status scan_text(reader *r, cf_error *err)
     return CF_OK;
 }
 
-static cf_status split_or_fail(reader *r, const cf_csv_line *l, size_t n, char delim,
-                               cf_error *err)
+/* Checks the header and every line after it for binary content, up to a comment: only what is
+** read as the table must be text (a preamble before the header and comments may hold any bytes). */
+static cf_status check_text(const reader *r, const layout *h, cf_error *err)
+{
+    for (size_t i = h->hi; i < r->nlines; i++) {
+        const cf_csv_line *l = &r->lines[i];
+        if (cf_csv_is_comment(l))
+            continue;
+        size_t n = cf_csv_content_length(l->s, l->n);
+        size_t b = cf_csv_bad_byte((const unsigned char *)l->s, n);
+        if (b < n) {
+            char q[256];
+            cf_csv_quote(q, sizeof q, l->s, l->n);
+            unsigned char c = (unsigned char)l->s[b];
+            return cf_csv_error(err, r->path, l->line, b + 1,
+                                "%s: byte 0x%02X is not text (the column counts bytes here) ('%s')",
+                                c == '\r' ? "carriage return inside a line" : "binary content", c,
+                                q);
+        }
+    }
+    return CF_OK;
+}
+
+cf_status cf_reader_split(reader *r, const cf_csv_line *l, size_t n, char delim, cf_error *err)
 {
     size_t bad = 0;
     const char *why = NULL;
     int rc = cf_csv_split(l->s, n, delim, &r->f, &bad, &why);
     if (rc == -2)
-        return out_of_memory(err, r->path);
+        return cf_reader_out_of_memory(err, r->path);
     if (rc == -1) {
         char q[256];
         cf_csv_quote(q, sizeof q, l->s, n);
@@ -204,159 +203,6 @@ static cf_status split_or_fail(reader *r, const cf_csv_line *l, size_t n, char d
 
 /* ---- the header and its columns -------------------------------------------------------------- */
 
-/* What the header decided, for the stages after it: where it is, its delimiter, its columns and
-** which of them are x, y, the weight and the time (-1: none). */
-typedef struct layout {
-    size_t hi, hn;         /* index of the header in r->lines, its content length */
-    size_t header_line;    /* its line number */
-    char hq[256];          /* the header quoted, for messages */
-    char delim;
-    size_t ncols;
-    int trailing;          /* the header ends with a delimiter: so must every row */
-    long xi, yi, wi, ti;
-} layout;
-
-/* The header: the first line with content. */
-static cf_status find_header(const reader *r, layout *h, cf_error *err)
-{
-    const char *path = r->path;
-    h->hi = 0;
-    h->hn = 0;
-    while (h->hi < r->nlines) {
-        if (!cf_csv_is_comment(&r->lines[h->hi]) &&
-            (h->hn = cf_csv_content_length(r->lines[h->hi].s, r->lines[h->hi].n)) > 0)
-            break;
-        h->hi++;
-    }
-    if (h->hi < r->nlines)
-        return CF_OK;
-    if (r->size == 0)
-        return cf_csv_error(err, path, 1, 1, "empty file: no header and no data (0 bytes)");
-    return cf_csv_error(err, path, r->nlines ? r->lines[r->nlines - 1].line : 1, 1,
-                        "no header row and no data: only comments and blank lines (%zu bytes)",
-                        r->size);
-}
-
-/* The header's delimiter and column names (r->cols). */
-static cf_status read_header(reader *r, layout *h, cf_error *err)
-{
-    const char *path = r->path;
-    const cf_csv_line *hl = &r->lines[h->hi];
-    h->header_line = hl->line;
-    cf_csv_quote(h->hq, sizeof h->hq, hl->s, h->hn);
-    h->delim = cf_csv_delimiter(hl->s, h->hn);
-    if (!h->delim)
-        return cf_csv_error(err, path, h->header_line, 1,
-                            "the header has a single column; expected at least x and y separated "
-                            "by ',' ';' TAB or blanks ('%s')", h->hq);
-    cf_status st = split_or_fail(r, hl, h->hn, h->delim, err);
-    if (st != CF_OK)
-        return st;
-    size_t ncols = r->f.count;
-    h->trailing = 0;
-    if (ncols > 1 && cf_csv_field(&r->f, ncols - 1)[0] == '\0') {
-        h->trailing = 1;
-        ncols--;
-    }
-    if (ncols > CF_MEASURE_MAX_COLUMNS)
-        return cf_csv_error(err, path, h->header_line, CF_MEASURE_MAX_COLUMNS + 1,
-                            "the header has %zu columns; a table may have at most %d ('%s')", ncols,
-                            CF_MEASURE_MAX_COLUMNS, h->hq);
-    r->cols = calloc(ncols, sizeof *r->cols);
-    if (!r->cols)
-        return out_of_memory(err, path);
-    r->ncols = h->ncols = ncols;
-    size_t numeric = 0;
-    for (size_t i = 0; i < ncols; i++) {
-        const char *name = cf_csv_field(&r->f, i);
-        double v;
-        if (name[0] == '\0')
-            return cf_csv_error(err, path, h->header_line, i + 1, "column %zu has no name ('%s')",
-                                i + 1, h->hq);
-        if (strlen(name) >= CF_COLUMN_NAME_CAP)
-            return cf_csv_error(err, path, h->header_line, i + 1,
-                                "column name too long ('%.60s...')", name);
-        if (cf_csv_number(name, h->delim, &v) == CF_CSV_NUM_OK)
-            numeric++;
-        cf_column_parse(&r->cols[i], name);
-    }
-    if (numeric == ncols)
-        return cf_csv_error(err, path, h->header_line, 1,
-                            "missing header: the first row holds numbers, not column names ('%s')",
-                            h->hq);
-    return CF_OK;
-}
-
-/* Finds a column by name (the full header name or its base, case-insensitive). */
-static long find_column(const reader *r, const char *name)
-{
-    for (size_t i = 0; i < r->ncols; i++)
-        if (strcasecmp(r->cols[i].name, name) == 0)
-            return (long)i;
-    for (size_t i = 0; i < r->ncols; i++)
-        if (strcasecmp(r->cols[i].base, name) == 0)
-            return (long)i;
-    return -1;
-}
-
-static cf_status column_not_found(const reader *r, size_t header_line, const char *what,
-                                  const char *name, cf_error *err)
-{
-    char list[256];
-    size_t o = 0;
-    list[0] = '\0';
-    for (size_t i = 0; i < r->ncols && o + 4 < sizeof list; i++)
-        o += (size_t)snprintf(list + o, sizeof list - o, "%s%s", i ? ", " : "", r->cols[i].name);
-    char q[256];
-    cf_csv_quote(q, sizeof q, name, strlen(name));
-    return cf_csv_error(err, r->path, header_line, 1,
-                        "no %s column named '%s' (the header has: %s)", what, q, list);
-}
-
-/* Which columns: x, y, weight, time (the options name x and y, else their names tell). */
-static cf_status choose_columns(const reader *r, const cf_measure_options *opt, layout *h,
-                                cf_error *err)
-{
-    const size_t ncols = h->ncols;
-    long xi = -1, yi = -1, wi = -1, ti = -1;
-    for (size_t i = 0; i < ncols; i++) {
-        if (wi < 0 && cf_column_is_weight(r->cols[i].base))
-            wi = (long)i;
-        if (ti < 0 && cf_column_is_time(r->cols[i].base))
-            ti = (long)i;
-    }
-    if (opt->x_col && (xi = find_column(r, opt->x_col)) < 0)
-        return column_not_found(r, h->header_line, "x", opt->x_col, err);
-    if (opt->y_col && (yi = find_column(r, opt->y_col)) < 0)
-        return column_not_found(r, h->header_line, "y", opt->y_col, err);
-    for (int pass = 0; pass < 2 && yi < 0; pass++)
-        for (size_t i = 0; i < ncols && yi < 0; i++)
-            if ((long)i != xi &&
-                (pass == 0 ? cf_column_is_y(r->cols[i].base)
-                           : cf_column_y_class(r->cols[i].base) != CF_UNIT_UNKNOWN))
-                yi = (long)i;
-    for (size_t i = 0; i < ncols && xi < 0; i++)
-        if ((long)i != yi && cf_column_is_x(r->cols[i].base))
-            xi = (long)i;
-    for (size_t i = 0; i < ncols && (xi < 0 || yi < 0); i++) {
-        if ((long)i == xi || (long)i == yi || (long)i == wi || (long)i == ti)
-            continue;
-        if (xi < 0)
-            xi = (long)i;
-        else
-            yi = (long)i;
-    }
-    if (xi < 0 || yi < 0 || xi == yi)
-        return cf_csv_error(err, r->path, h->header_line, 1,
-                            "cannot tell which columns are x and y; name them (strain, stress_kPa, "
-                            "...) or set option x_col and option y_col ('%s')", h->hq);
-    h->xi = xi;
-    h->yi = yi;
-    h->wi = wi == xi || wi == yi ? -1 : wi;
-    h->ti = ti == xi || ti == yi ? -1 : ti;
-    return CF_OK;
-}
-
 /* ---- units ----------------------------------------------------------------------------------- */
 
 /* The units decided: the y unit, the measures, and the factors to conifit's units. */
@@ -366,6 +212,20 @@ typedef struct scaling {
     int stretch;           /* x is a stretch: strain = x - 1 */
     double xscale, yscale, tscale;
 } scaling;
+
+/* Why text (quoted as q) is no unit, for a message: a unit that differs from a known one only in
+** a leading m or M names both readings; anything else lists the known units. */
+static void unit_refusal(char *out, size_t cap, const char *text, const char *q)
+{
+    const cf_unit_def *near = cf_unit_m_case(text);
+    if (near)
+        snprintf(out, cap, "unit '%s' is ambiguous: a leading m is milli (or metre) and M is "
+                 "mega, and the known unit is '%s', not '%s'; write '%s' if that is meant", q,
+                 near->name, q, near->name);
+    else
+        snprintf(out, cap, "unknown unit '%s' (known units; letter case is ignored except in a "
+                 "leading m or M: %s)", q, cf_unit_list);
+}
 
 /* Resolves the unit of column c: the option if given, else its decoration, else a '#' comment.
 ** Returns CF_OK with *u NULL when no unit is stated anywhere. */
@@ -378,16 +238,14 @@ static cf_status column_unit(const reader *r, size_t header_line, size_t ci, con
     *u = NULL;
     if (text) {
         const cf_unit_def *d = cf_unit_find(text);
-        char q[256];
+        char q[256], why[512];
         cf_csv_quote(q, sizeof q, text, strlen(text));
         if (!d) {
+            unit_refusal(why, sizeof why, text, q);
             if (option)
-                return cf_error_set(err, CF_E_DATA,
-                                    "%s: %s '%s': unknown unit (known units: %s)", r->path,
-                                    option_flag, q, cf_unit_list);
-            return cf_csv_error(err, r->path, header_line, ci + 1,
-                                "column '%s': unknown unit '%s' (known units, case-sensitive: %s)",
-                                c->name, q, cf_unit_list);
+                return cf_error_set(err, CF_E_DATA, "%s: %s %s", r->path, option_flag, why);
+            return cf_csv_error(err, r->path, header_line, ci + 1, "column '%s': %s ('%s')",
+                                c->name, why, q);
         }
         for (size_t k = 0; k < nwant; k++)
             if (d->cls == want[k]) {
@@ -447,6 +305,13 @@ static cf_status y_unit(const reader *r, const cf_measure_options *opt, const la
     return CF_OK;
 }
 
+/* 1 when a column's name without unit says it holds percent: "strain percent", "strain%",
+** "percent_strain" (so that such a column is never read as plain strain). */
+static int names_percent(const char *base)
+{
+    return strchr(base, '%') != NULL || cf_measures_contains_ci(base, "percent");
+}
+
 /* The unit of x: a strain or stretch against a stress, a length against a force. */
 static cf_status x_unit(const reader *r, const cf_measure_options *opt, const layout *h,
                         const cf_table *m, scaling *u, cf_error *err)
@@ -459,13 +324,23 @@ static cf_status x_unit(const reader *r, const cf_measure_options *opt, const la
         cf_unit_class xw[1] = {CF_UNIT_STRAIN};
         if (xc->unit[0]) {
             const cf_unit_def *d = cf_unit_find(xc->unit);
+            if (!d && cf_unit_m_case(xc->unit)) {
+                char q[256], why[512];
+                cf_csv_quote(q, sizeof q, xc->unit, strlen(xc->unit));
+                unit_refusal(why, sizeof why, xc->unit, q);
+                return cf_csv_error(err, path, h->header_line, (size_t)h->xi + 1,
+                                    "column '%s': %s ('%s')", xc->name, why, q);
+            }
             if (!d || d->cls != CF_UNIT_STRAIN)
                 return cf_csv_error(err, path, h->header_line, (size_t)h->xi + 1,
                                     "column '%s' has unit '%s' but y is a stress, so x must be a "
-                                    "dimensionless strain or stretch ('-' or '%%') ('%s')",
+                                    "dimensionless strain or stretch ('-', 'mm/mm' or '%%') "
+                                    "('%s')",
                                     xc->name, xc->unit, xc->name);
             xu = d;
-        } else
+        } else if (names_percent(xc->base))
+            xu = cf_unit_find("%");
+        else
             xu = cf_comment_unit(r->comments, r->ncomments, xc->base, 0, xw, 1);
         if (xu)
             u->xscale = xu->to_conifit;
@@ -617,7 +492,7 @@ static cf_status read_row(reader *r, const cf_csv_line *l, size_t n, const layou
                           const scaling *u, double *tprev, int *skip, cf_error *err)
 {
     const char *path = r->path;
-    cf_status st = split_or_fail(r, l, n, h->delim, err);
+    cf_status st = cf_reader_split(r, l, n, h->delim, err);
     if (st != CF_OK)
         return st;
     *skip = 1;
@@ -661,7 +536,7 @@ static cf_status read_row(reader *r, const cf_csv_line *l, size_t n, const layou
                             r->cols[h->ti].name, t, *tprev, cf_csv_field(&r->f, (size_t)h->ti));
     *tprev = t;
     if (push_row(r, x, y, v[2], t) != 0)
-        return out_of_memory(err, path);
+        return cf_reader_out_of_memory(err, path);
     return CF_OK;
 }
 
@@ -709,6 +584,64 @@ static cf_status decide_mode(const reader *r, const cf_measure_options *opt, cf_
     return CF_OK;
 }
 
+/* Appends one line to m->notes (cut to fit). */
+static void add_note(cf_table *m, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+static void add_note(cf_table *m, const char *fmt, ...)
+{
+    size_t o = strlen(m->notes);
+    if (o > 0 && o + 1 < sizeof m->notes)
+        m->notes[o++] = '\n', m->notes[o] = '\0';
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(m->notes + o, sizeof m->notes - o, fmt, ap);
+    va_end(ap);
+}
+
+/* A unit decoration that was read in another letter case ("Mpa" as MPa) is said. */
+static void note_unit_case(cf_table *m, const cf_column *c)
+{
+    const cf_unit_def *d = c->unit[0] ? cf_unit_find(c->unit) : NULL;
+    if (d && strcmp(d->name, c->unit) != 0)
+        add_note(m, "column '%s': unit '%s' read as %s", c->name, c->unit, d->canon);
+}
+
+/* Strain that looks like stretch: where the stress is smallest (zero, unloaded), an engineering
+** strain near 1 means 100 % strain at rest, which no specimen has; a stretch column has 1 there. */
+#define STRETCH_LIKE_TOL 0.05
+/* "Where the stress is least" is a row at rest when that stress is within this fraction of the
+** largest (a measured zero carries noise). */
+#define STRETCH_LIKE_REST 0.01
+
+/* The notes of a table (table.h): a skipped preamble, units read in another case, and a strain
+** column whose values look like stretch (unless an option said what the column holds). */
+static void table_notes(const layout *h, const reader *r, cf_table *m)
+{
+    if (h->preamble)
+        add_note(m, "lines 1 to %zu before the header row (line %zu) were skipped as a preamble",
+                 h->header_line - 1, h->header_line);
+    note_unit_case(m, &r->cols[h->xi]);
+    note_unit_case(m, &r->cols[h->yi]);
+    if (m->kind != CF_TABLE_STRESS_STRAIN || m->measures.strain != CF_STRAIN_ENGINEERING ||
+        m->measures.strain_from == CF_DECL_OPTION || m->count == 0)
+        return;
+    size_t at = 0;
+    double ymax = 0.0;
+    for (size_t i = 0; i < m->count; i++) {
+        ymax = fmax(ymax, fabs(m->y[i]));
+        if (fabs(m->y[i]) < fabs(m->y[at]))
+            at = i;
+    }
+    if (fabs(m->x[at] - 1.0) <= STRETCH_LIKE_TOL && fabs(m->y[at]) <= STRETCH_LIKE_REST * ymax)
+        add_note(m, "column '%s' holds strain %.6g where the stress is least (%.6g %s, row %zu): "
+                 "strain 1 at rest looks like stretch; if the column is stretch, name it "
+                 "stretch or give option strain_measure stretch",
+                 m->x_column, m->x[at], m->y[at] * m->y_to_file, m->y_unit, at + 1);
+}
+
 /* Hands the rows and what is known of them over to m (the reader keeps no rows). */
 static void hand_over(reader *r, const layout *h, const scaling *u, cf_table *m)
 {
@@ -736,6 +669,7 @@ static void hand_over(reader *r, const layout *h, const scaling *u, cf_table *m)
              m->kind == CF_TABLE_STRESS_STRAIN ? "-" : "mm");
     snprintf(m->y_unit, sizeof m->y_unit, "%s", u->yu->canon);
     m->measures = u->meas;
+    table_notes(h, r, m);
 }
 
 /* Reading a table is one pass through its stages in order: the text, the header, which columns,
@@ -758,9 +692,10 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
     r.path = path; /* read_all names standard input "(standard input)" */
     cf_status st;
     if ((st = read_all(&r, err)) != CF_OK || (st = spreadsheet_check(&r, err)) != CF_OK ||
-        (st = cut_lines(&r, err)) != CF_OK || (st = scan_text(&r, err)) != CF_OK ||
-        (st = find_header(&r, &h, err)) != CF_OK || (st = read_header(&r, &h, err)) != CF_OK ||
-        (st = choose_columns(&r, &opt, &h, err)) != CF_OK ||
+        (st = cut_lines(&r, err)) != CF_OK || (st = scan_comments(&r, err)) != CF_OK ||
+        (st = cf_header_find(&r, &opt, &h, err)) != CF_OK ||
+        (st = check_text(&r, &h, err)) != CF_OK || (st = cf_header_read(&r, &h, err)) != CF_OK ||
+        (st = cf_header_choose_columns(&r, &opt, &h, err)) != CF_OK ||
         (st = decide_units(&r, &opt, &h, m, &u, err)) != CF_OK ||
         (st = read_rows(&r, &h, &u, err)) != CF_OK ||
         (st = decide_mode(&r, &opt, m, err)) != CF_OK) {

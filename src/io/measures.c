@@ -117,7 +117,8 @@ int cf_measures_contains_ci(const char *s, const char *word)
 }
 
 /* The measure a column's name states, or -1: y names true_stress, cauchy..., nominal_stress,
-** pk1...; x names log_strain, true_strain, hencky..., stretch, lambda, engineering_strain. */
+** pk1...; x names log_strain, true_strain, hencky..., stretch, lambda (or the letter),
+** engineering_strain. */
 static int cf_measures_stress_of_column(const char *name)
 {
     static const char *const cauchy[] = {"cauchy", "true_stress", "true stress", "truestress"};
@@ -137,7 +138,8 @@ static int cf_measures_strain_of_column(const char *name)
     for (int k = 0; k < 4; k++)
         if (cf_measures_contains_ci(name, logs[k]))
             return CF_STRAIN_LOG;
-    if (strncasecmp(name, "stretch", 7) == 0 || strncasecmp(name, "lambda", 6) == 0)
+    if (strncasecmp(name, "stretch", 7) == 0 || strncasecmp(name, "lambda", 6) == 0 ||
+        strncmp(name, "\xce\xbb", 2) == 0) /* a Greek small lambda */
         return CF_STRAIN_STRETCH;
     if (cf_measures_contains_ci(name, "engineering") || cf_measures_contains_ci(name, "nominal"))
         return CF_STRAIN_ENGINEERING;

@@ -2,7 +2,8 @@
 ** Reading measured tables: stress against strain (or stretch), or force against displacement,
 ** from a CSV file with a header row, into the units conifit works in (MPa, N, mm, s).
 **
-** Accepted: '#' comment lines (anywhere, also before the header), CRLF or LF line ends, a UTF-8
+** Accepted: '#' comment lines (anywhere, also before the header, holding any bytes), a preamble of
+** metadata lines before the header row (skipped), CRLF or LF line ends, a UTF-8
 ** byte-order mark, ',' ';' or TAB delimiters (detected from the header), double-quoted fields,
 ** an optional `weight` column, an optional `time` column. Units come from the column name
 ** (`stress_kPa`, `stress [kPa]`, `stress (kPa)`, `displacement_mm`, `force_N`) or from the options;
@@ -32,11 +33,12 @@ int cf_stress_measure_parse(const char *word, cf_stress_measure *m);
 int cf_strain_measure_parse(const char *word, cf_strain_measure *m);
 
 typedef struct cf_measure_options {
-    const char *x_col;       /* column name of x (with or without its unit decoration), or NULL:
-                             ** the first column named strain/stretch/lambda/displacement/
-                             ** elongation/gamma/shear..., else the first column that is not y */
-    const char *y_col;       /* column name of y, or NULL: the first column named stress/force/
-                             ** load..., else the first remaining column */
+    const char *x_col;       /* column name of x (with or without its unit decoration; a number
+                             ** from 1 when no column has that name), or NULL: the first column
+                             ** named strain/stretch/lambda/displacement/elongation/gamma/
+                             ** shear..., else the first column that is not y */
+    const char *y_col;       /* column name (or number) of y, or NULL: the first column named
+                             ** stress/force/load..., else the first remaining column */
     const char *stress_unit; /* "Pa", "kPa", "MPa", "GPa", "N/mm2", "mmHg"...; NULL: from header */
     const char *force_unit;  /* "N", "mN", "kN", "uN"; NULL: from header */
     const char *length_unit; /* "m", "mm", "um", "cm"; NULL: from header */
@@ -46,6 +48,11 @@ typedef struct cf_measure_options {
     int stress_measure;      /* -1: from the file (comment, column name; else nominal), or a
                              ** cf_stress_measure that wins over the file */
     int strain_measure;      /* -1: from the file, or a cf_strain_measure */
+    size_t header_row;       /* 1-based line of the header row, or 0: the first line with
+                             ** content, else the first after a preamble that names known columns
+                             ** and is followed by rows of numbers */
+    const char *columns;     /* "X,Y" or "X,Y,W": the x, y and weight columns by name or 1-based
+                             ** number, and no others (no weight or time found by name); or NULL */
 } cf_measure_options;
 
 /* Options with everything decided from the file. */
@@ -72,7 +79,8 @@ typedef enum cf_unit_class {
     CF_UNIT_STRAIN = 5  /* dimensionless: "-", "1" or "%" (converted to a plain fraction) */
 } cf_unit_class;
 
-/* Looks up a unit name (case-sensitive: "kPa", "MPa", "N/mm2", "mN", "um", "%", ...). Returns
+/* Looks up a unit name ("kPa", "MPa", "N/mm2", "mN", "um", "%", "mm/mm", ...; letter case is
+** ignored except in a leading m or M, so "Mpa" is MPa and "mPa" is not a unit). Returns
 ** CF_UNIT_UNKNOWN for a name it does not know; otherwise the class, and in *to_conifit (if not
 ** NULL) the factor that converts a value in that unit to conifit's (MPa, N, mm, s, -). */
 cf_unit_class cf_measure_unit(const char *name, double *to_conifit);

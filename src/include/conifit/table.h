@@ -80,6 +80,9 @@ typedef struct cf_table {
     int mode_stated;       /* 1 when the option or the file named the mode */
     cf_table_measures measures; /* stress and strain measures as read; x and y hold engineering
                            ** strain and nominal stress after conversion */
+    char notes[768];       /* what the reader noticed and a front end should show: one note a
+                           ** line (a skipped preamble, a unit read in another letter case, a
+                           ** strain column that looks like stretch); "" when none */
 } cf_table;
 
 /* A table of count points copied from x, y and w (w NULL: every weight 1), for data made in
