@@ -258,6 +258,64 @@ static void work_counts_the_lattice_and_its_solves(void **state)
                      2);
 }
 
+/* Every cost a scene can ask for is in the budget: a law table of 1e7 intervals (480 MB), the
+** summary's recovery test holding ten Maxwell relaxation times (1e15 implicit steps at tau 1e12 s,
+** dt 0.01 s), and the lattice `export --lattice` builds and runs; each refused naming its key and
+** a value that would fit. */
+static void every_cost_is_in_the_budget(void **state)
+{
+    (void)state;
+    scene("table.json", "\"lattice\": {\"nx\": 2, \"ny\": 2, \"nz\": 2}, \"protocol\": {\"kind\": "
+                        "\"ramp\", \"to_strain\": 0.1}, \"law_method\": \"table\", "
+                        "\"table_intervals\": 1e7, \"samples_per_segment\": 5");
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "simulate %s/table.json -o %s/t.csv --max-memory 20M", dir, dir),
+                     65);
+    assert_non_null(strstr(errb, "'table_intervals'"));
+    assert_non_null(strstr(errb, "intervals would fit"));
+    assert_false(exists("t.csv"));
+
+    scene("hold.json", "\"lattice\": {\"nx\": 2, \"ny\": 2, \"nz\": 2}, \"protocol\": {\"kind\": "
+                       "\"cycles\", \"to_strain\": 0.1, \"period_s\": 1, \"count\": 1}, "
+                       "\"effects\": {\"viscosity\": {\"E_kPa\": 5, \"tau_s\": 1e12}}, "
+                       "\"integrator\": {\"dt_s\": 0.01}, \"samples_per_segment\": 10");
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "simulate %s/hold.json -o %s/h.csv", dir, dir),
+                     65);
+    assert_non_null(strstr(errb, "'effects.viscosity.tau_s'"));
+    assert_non_null(strstr(errb, "recovery test"));
+    assert_non_null(strstr(errb, "would fit"));
+    assert_false(exists("h.csv"));
+    /* without the summary the run itself is small */
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "simulate %s/hold.json -o %s/h.csv -q", dir, dir),
+                     0);
+
+    scene("wide.json", "\"lattice\": {\"nx\": 100, \"ny\": 100, \"nz\": 100}, \"protocol\": "
+                       "{\"kind\": \"ramp\", \"to_strain\": 0.1}, \"samples_per_segment\": 2");
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "export fits/telescoping.json --lattice %s/wide.json --format febio "
+                            "-o %s/w.feb",
+                            dir, dir),
+                     65);
+    assert_non_null(strstr(errb, "'lattice.nx/ny/nz'"));
+    assert_non_null(strstr(errb, "would fit"));
+    assert_false(exists("w.feb"));
+    scene("small.json", "\"lattice\": {\"nx\": 3, \"ny\": 3, \"nz\": 3}, \"protocol\": "
+                        "{\"kind\": \"ramp\", \"to_strain\": 0.1}, \"samples_per_segment\": 4");
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "export fits/telescoping.json --lattice %s/small.json --format febio "
+                            "-o %s/s.feb --max-work 1e4",
+                            dir, dir),
+                     65);
+    assert_non_null(strstr(errb, "'samples_per_segment'"));
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "export fits/telescoping.json --lattice %s/small.json --format febio "
+                            "-o %s/s.feb",
+                            dir, dir),
+                     0);
+}
+
 /* Under a small address-space limit every scene ends with a status, never a signal, and a lattice
 ** let past the budget that runs out of memory ends with 70 (or the OpenMP runtime's 1), never with
 ** 65 as if the data were bad. (Skipped
@@ -316,6 +374,7 @@ int main(void)
         cmocka_unit_test(limits_can_be_set),
         cmocka_unit_test(fit_validate_takes_the_scene_budget),
         cmocka_unit_test(work_counts_the_lattice_and_its_solves),
+        cmocka_unit_test(every_cost_is_in_the_budget),
         cmocka_unit_test(memory_pressure_gives_a_status_not_a_crash),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
