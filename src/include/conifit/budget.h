@@ -37,8 +37,8 @@
 ** CHOLMOD's factor holds lnz = 1.9e4, 3.6e5, 1.8e6, 5.6e6 entries at 322, 2022, 6250, 14158
 ** free unknowns (4^3 to 16^3, about 7.8 n^1.41), and at 13.5 bytes an entry of its workspace; the
 ** peak beyond the lattice and the tangent is 97 to 91 unknowns^1.45 bytes from 16^3 to 43^3
-** (196 MiB, 432 MiB, 836 MiB and 7.5 GiB at 16^3, 20^3, 24^3 and 43^3). 110 keeps the estimate
-** 11 to 18 % above every measured peak. */
+** (196 MiB, 432 MiB, 836 MiB at 16^3, 20^3, 24^3, and 8.0 GB reported for 43^3). 110 keeps the
+** estimate 11 to 18 % above each. */
 #define CF_BUDGET_FILL_BYTES 110.0
 #define CF_BUDGET_FILL_EXPONENT 1.45
 
