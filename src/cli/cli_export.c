@@ -3,6 +3,7 @@
 ** simulator (see export.h). The whole output is produced in memory first, so a failure never
 ** leaves partial output on stdout or in the -o file.
 */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,6 +12,7 @@
 #include "cli/cli.h"
 #include "conifit/export.h"
 #include "conifit/fitfile.h"
+#include "conifit/budget.h"
 #include "conifit/scene.h"
 
 static const char export_help[] =
@@ -37,7 +39,10 @@ static const char export_help[] =
     "                   0:4.5 for compression only (default: full stretch to just before solid)\n"
     "  --example        a complete one-spring model that runs as it is (formats with models;\n"
     "                   sofa always writes a scene)\n"
-    "  --lattice        the whole lattice model (see above)\n\n"
+    "  --lattice        the whole lattice model (see above)\n"
+    "  --max-memory SIZE, --max-steps N, --max-work N  the budget of SCENE.json's lattice and\n"
+    "                   conifit's static run on it, as for simulate (refused, exit 65, naming\n"
+    "                   the key and a value that would fit)\n\n"
     "FIT.json is a fit file (conifit fit -o) or an exported spring (--format json).\n";
 
 /* The formats, from the export module's registry. */
@@ -78,12 +83,23 @@ static cf_status parse_range(const char *text, double *lo, double *hi, cf_error 
     return CF_OK;
 }
 
-enum { OPT_FORMAT = CF_CLI_OPT_OWN, OPT_TYPE, OPT_TOL, OPT_RANGE, OPT_EXAMPLE, OPT_LATTICE };
+enum {
+    OPT_FORMAT = CF_CLI_OPT_OWN,
+    OPT_TYPE,
+    OPT_TOL,
+    OPT_RANGE,
+    OPT_EXAMPLE,
+    OPT_LATTICE,
+    OPT_MAX_MEMORY,
+    OPT_MAX_STEPS,
+    OPT_MAX_WORK
+};
 
 typedef struct export_args {
     cf_export_options opt;
     const char *type;
     int have_format, tol_given, lattice;
+    cf_budget budget; /* of the scene's lattice and its static run (--lattice SCENE) */
 } export_args;
 
 /* One option of export: 0 to go on, else an exit status. */
@@ -122,6 +138,12 @@ static int export_option(void *ctx, int c, const char *value)
     case OPT_LATTICE:
         a->lattice = 1;
         return 0;
+    case OPT_MAX_MEMORY:
+        return cf_cli_budget_option("export", "--max-memory", value, &a->budget);
+    case OPT_MAX_STEPS:
+        return cf_cli_budget_option("export", "--max-steps", value, &a->budget);
+    case OPT_MAX_WORK:
+        return cf_cli_budget_option("export", "--max-work", value, &a->budget);
     default:
         return cf_cli_usage_error("export", "unexpected option");
     }
@@ -145,10 +167,13 @@ static int parse_request(int argc, char **argv, export_request *q)
                                         {"range", required_argument, NULL, OPT_RANGE},
                                         {"example", no_argument, NULL, OPT_EXAMPLE},
                                         {"lattice", no_argument, NULL, OPT_LATTICE},
+                                        {"max-memory", required_argument, NULL, OPT_MAX_MEMORY},
+                                        {"max-steps", required_argument, NULL, OPT_MAX_STEPS},
+                                        {"max-work", required_argument, NULL, OPT_MAX_WORK},
                                         {NULL, 0, NULL, 0}};
     cf_error err = {0};
     export_args *ea = &q->ea;
-    *ea = (export_args){cf_export_default_options(), NULL, 0, 0, 0};
+    *ea = (export_args){cf_export_default_options(), NULL, 0, 0, 0, cf_budget_default()};
     cf_cli_parser p;
     int rc = cf_cli_parser_init(&p, "export", export_help, 0, argc, argv, "", own);
     p.help_extra = formats_help;
@@ -182,6 +207,28 @@ static int parse_request(int argc, char **argv, export_request *q)
     return -1;
 }
 
+/* conifit's static run of the export (one solve a step, budget.h) against the step and work
+** limits: CF_E_DATA naming samples_per_segment and the samples that would fit. */
+static cf_status static_run_fits(const char *name, const cf_export_lattice *lx,
+                                 const cf_scene_cost *cost, const cf_budget *b, cf_error *err)
+{
+    const double each = cf_budget_solve_work(3.0 * (double)cost->nodes);
+    const double steps = (double)lx->nsteps;
+    if (steps <= b->max_steps && steps * each <= b->max_work)
+        return CF_OK;
+    const double can = fmin(b->max_steps, floor(b->max_work / each));
+    char fits[128];
+    if (can >= 1)
+        snprintf(fits, sizeof fits, "at most %.0f samples would fit", can);
+    else
+        snprintf(fits, sizeof fits, "not even one solve fits: reduce 'lattice.nx/ny/nz'");
+    return cf_error_set(err, CF_E_DATA,
+                        "%s: key 'samples_per_segment': the export's static run needs %.0f static "
+                        "solves of %.3g spring-steps of work each, above the limit of %.4g steps "
+                        "or %.3g of work (raise them with --max-steps and --max-work); %s",
+                        name, steps, each, b->max_steps, b->max_work, fits);
+}
+
 /* The lattice to export: the scene's (the fit file it names into q->scene_fit), or the
 ** validation's default for the spring. */
 static cf_status lattice_of(export_request *q, const cf_fitted_spring *fs,
@@ -194,7 +241,10 @@ static cf_status lattice_of(export_request *q, const cf_fitted_spring *fs,
         if ((st = cf_scene_load(scene_path, &sc, err)) != CF_OK)
             return st;
         snprintf(q->scene_fit, sizeof q->scene_fit, "%s", sc.fit_path);
-        st = cf_export_lattice_from_scene(&sc, scene_path, lx, err);
+        cf_scene_cost cost;
+        if ((st = cf_budget_check_size(&sc, scene_path, &q->ea.budget, &cost, err)) == CF_OK &&
+            (st = cf_export_lattice_from_scene(&sc, scene_path, lx, err)) == CF_OK)
+            st = static_run_fits(scene_path, lx, &cost, &q->ea.budget, err);
         cf_scene_free(&sc);
         return st;
     }

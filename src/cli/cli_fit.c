@@ -320,6 +320,14 @@ static int report_job(const fit_args *a, fit_job *j)
                     "conifit: warning: %s: the %s spring's lattice loses stability at strain "
                     "%.4g, inside the table's range\n",
                     j->file, cf_spring_type_name(j->rep.fits[k].type), v->stable_to_strain);
+        const cf_through_msm *t = &j->rep.thr[k];
+        if (j->rep.through_msm && t->done && t->search_rows < j->rep.table->count)
+            cf_cli_printf_safe(stderr,
+                    "conifit: note: %s: the %s fit through the lattice searched on a %zu-row "
+                    "subsample of the %zu rows (tables above %d rows; the stress scale, the "
+                    "placement and the RMSE on every row)\n",
+                    j->file, cf_spring_type_name(j->rep.fits[k].type), t->search_rows,
+                    j->rep.table->count, CF_LATTICE_FIT_FULL_ROWS);
     }
     return rc;
 }

@@ -224,7 +224,9 @@ static cf_status run_scene(cf_scene *sc, const sim_request *q, cf_budget *budget
     if ((sc->method == CF_LAW_TABLE &&
          (s = cf_law_table_build(law, sc->table_intervals, err)) != CF_OK) ||
         (s = cf_lattice_create(lat, law, sc->method, &sc->cfg.lattice, err)) != CF_OK ||
-        (s = cf_budget_check_steps(sc, q->scene_path, lat, budget, cost, err)) != CF_OK)
+        (s = cf_budget_check_steps(sc, q->scene_path, lat, budget, cost, err)) != CF_OK ||
+        (!q->quiet &&
+         (s = cf_hysteresis_recovery_check(sc, q->scene_path, lat, budget, cost, err)) != CF_OK))
         return s;
     *samples = calloc(sc->nsamples, sizeof **samples);
     if (!*samples)
@@ -357,6 +359,7 @@ int cf_cli_simulate(int argc, char **argv)
         rc = cf_cli_fail(&err);
         goto end;
     }
+    cf_lattice_free(&lat); /* the recovery test builds its own */
     if (!q.quiet) {
         summary(a.to_stdout ? stderr : stdout, &sc, samples, sc.nsamples, &st);
         recovery(a.to_stdout ? stderr : stdout, &sc, &law, samples, sc.nsamples);

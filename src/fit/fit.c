@@ -93,11 +93,21 @@ double cf_fit_model(const cf_law *law, int force_displacement, double x)
 
 /* ---- the checks and the working state -------------------------------------------------------- */
 
+/* The smallest largest |y| (MPa or N) and |x| (strain or mm) of a table, and the range of its
+** weights, that the fit's arithmetic carries: below, the squared residuals and the weighted sums
+** underflow (a table of stresses below 1e-18 kPa fitted to R^2 = -5.8e15, weights of 5e-324 gave
+** a verdict of nan, denormal strains an infinite solid strain). Stresses down to 2e-18 MPa were
+** measured to fit as their table times 1e16 does; the limits keep three decades from that. */
+#define FIT_Y_MIN 1e-15
+#define FIT_X_MIN 1e-12
+#define FIT_W_MIN 1e-100
+
 static cf_status check_data(const cf_table *d, cf_error *err)
 {
     if (d->count < 4)
         return cf_error_set(err, CF_E_DATA, "%zu data points: a fit needs at least 4", d->count);
-    double ymax = 0, xmax = 0;
+    double ymax = 0, xmax = 0, wmax = 0;
+    size_t iy = 0, ix = 0;
     for (size_t i = 0; i < d->count; i++) {
         if (!isfinite(d->x[i]) || !isfinite(d->y[i]))
             return cf_error_set(err, CF_E_DATA, "data point %zu is not finite (%g, %g)", i + 1,
@@ -105,12 +115,33 @@ static cf_status check_data(const cf_table *d, cf_error *err)
         if (d->w && !(d->w[i] > 0 && isfinite(d->w[i])))
             return cf_error_set(err, CF_E_DATA, "weight of data point %zu is %g (must be > 0)",
                                 i + 1, d->w[i]);
-        ymax = fmax(ymax, fabs(d->y[i]));
-        xmax = fmax(xmax, fabs(d->x[i]));
+        if (fabs(d->y[i]) > ymax)
+            ymax = fabs(d->y[iy = i]);
+        if (fabs(d->x[i]) > xmax)
+            xmax = fabs(d->x[ix = i]);
+        wmax = d->w ? fmax(wmax, d->w[i]) : 1;
     }
     if (!(ymax > 0) || !(xmax > 0))
         return cf_error_set(err, CF_E_DATA, "every %s value is zero: nothing to fit",
                             !(ymax > 0) ? "y" : "x");
+    const double to_file = d->y_to_file > 0 ? d->y_to_file : 1;
+    if (ymax < FIT_Y_MIN)
+        return cf_error_set(err, CF_E_DATA,
+                            "the largest |%s| is %g %s (data point %zu), below %g %s: the fit's "
+                            "sums of squares underflow; give the column in a smaller unit",
+                            d->y_column[0] ? d->y_column : "y", ymax * to_file, d->y_unit, iy + 1,
+                            FIT_Y_MIN * to_file, d->y_unit);
+    if (xmax < FIT_X_MIN)
+        return cf_error_set(err, CF_E_DATA,
+                            "the largest |%s| is %g (data point %zu), below %g: nothing a spring "
+                            "could be fitted to",
+                            d->x_column[0] ? d->x_column : "x", xmax, ix + 1, FIT_X_MIN);
+    for (size_t i = 0; d->w && i < d->count; i++)
+        if (d->w[i] < FIT_W_MIN * wmax || d->w[i] < FIT_W_MIN)
+            return cf_error_set(err, CF_E_DATA,
+                                "weight of data point %zu is %g: weights below %g, or below %g "
+                                "of the largest (%g), underflow in the weighted sums",
+                                i + 1, d->w[i], FIT_W_MIN, FIT_W_MIN, wmax);
     return CF_OK;
 }
 

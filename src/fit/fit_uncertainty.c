@@ -6,6 +6,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "conifit/measure.h"
 #include "fit/fit_ctx.h"
 #include "fit/lsq.h"
 
@@ -37,11 +38,13 @@ static void profile_end(fit_ctx *c, int k, const double v[3], double limit, int 
 {
     /* the range of each quantity, in log units */
     double lo[3] = {log(c->rho_lo), log(c->b_lo), -INFINITY};
-    double hi[3] = {log(c->rho_hi * (1 - 1e-12)), log(c->b_hi), INFINITY};
+    /* the stress scale has no upper limit of its own: its profile stops at the largest value a
+    ** table may hold (an outlier of 1e20 kPa walked it to exp(710) = inf) */
+    double hi[3] = {log(c->rho_hi * (1 - 1e-12)), log(c->b_hi), log(CF_MEASURE_MAX_VALUE)};
     unsigned lo_bit[3] = {c->opt->rho_min > CF_IDENT_RHO_LO ? CF_C_RHO_MIN : CF_C_BOUNDS,
                           c->travel_ok ? CF_C_TRAVEL : CF_C_BOUNDS, 0};
     unsigned hi_bit[3] = {(c->type == CF_TELESCOPING && !c->region) ? CF_C_TYPE : CF_C_DIAMETERS,
-                          CF_C_BOUNDS, 0};
+                          CF_C_BOUNDS, CF_C_BOUNDS};
     sub q = {c, k, 0};
     double x0[2], xin[2];
     int j = 0;

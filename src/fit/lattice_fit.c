@@ -15,6 +15,7 @@
 #include "fit/clock.h"
 #include "fit/lattice_curve.h"
 #include "fit/lsq.h"
+#include "fit/subsample.h"
 
 /* BOBYQA stops when a step changes every variable by less than this, relative. The validation
 ** error is reported to 4 digits; 1e-6 in the variables is far below what changes them. */
@@ -33,6 +34,22 @@ typedef struct tm_ctx {
     double *curve;  /* scratch, count values */
     long evals;
 } tm_ctx;
+
+/* The context of the searches on a long table: its subsample (into *sub) with its own weights
+** and scratch. */
+static cf_status search_ctx(const tm_ctx *c, cf_table *sub, tm_ctx *cs, cf_error *err)
+{
+    cf_status st = cf_subsample(c->d, CF_SUBSAMPLE_ROWS, sub, err);
+    if (st != CF_OK)
+        return st;
+    cs->d = sub;
+    cs->sw = malloc(sizeof(double) * sub->count);
+    cs->curve = malloc(sizeof(double) * sub->count);
+    if (!cs->sw || !cs->curve)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", sub->count);
+    cs->ynorm = cf_lsq_weights(sub, c->opt->relative, cs->sw);
+    return CF_OK;
+}
 
 /* The objective at (log rho, s/H) with the stress scale solved in closed form: at a prescribed
 ** displacement the static equilibrium does not depend on the scale of the springs' forces (every
@@ -116,7 +133,10 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
     memset(t, 0, sizeof *t);
     t->ident_before = cf_ident_of(&res->params, 0);
     t->ident_after = t->ident_before;
-    tm_ctx c = {d, s, opt, res->type, NULL, 0, NULL, 0};
+    tm_ctx c = {d, s, opt, res->type, NULL, 0, NULL, 0}, cs = {NULL, s, opt, res->type, NULL, 0,
+                                                               NULL, 0};
+    cf_table sub;
+    memset(&sub, 0, sizeof sub);
     c.sw = malloc(sizeof(double) * (d->count ? d->count : 1));
     c.curve = malloc(sizeof(double) * (d->count ? d->count : 1));
     double *spring_x = malloc(sizeof(double) * (d->count ? d->count : 1));
@@ -150,6 +170,14 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
                           "largest strain %g: no spring reaches it, nothing to optimise", xmax);
         goto out;
     }
+    /* a long table is searched on its subsample */
+    tm_ctx *search = &c;
+    if (d->count > CF_LATTICE_FIT_FULL_ROWS) {
+        if ((st = search_ctx(&c, &sub, &cs, err)) != CF_OK)
+            goto out;
+        search = &cs;
+    }
+    t->search_rows = search->d->count;
     /* Starts: the ordinary fit's quantities and a coarse grid over (rho, s/H); the cell makes a
     ** curve cost microseconds, so several local searches are cheap and the best is kept. */
     double best = CF_LSQ_HUGE_OBJ, zb[2] = {0, 0};
@@ -165,7 +193,7 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
         }
         for (int j = 0; j < 2; j++)
             z[j] = fmin(fmax(z[j], lb[j]), ub[j]);
-        double f = bobyqa(&c, z, lb, ub);
+        double f = bobyqa(search, z, lb, ub);
         if (f < best) {
             best = f;
             zb[0] = z[0], zb[1] = z[1];
@@ -190,7 +218,10 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
     t->cell_rmse = t->improved ? after : t->rmse_before;
     t->done = 1;
 out:
-    t->evaluations = c.evals;
+    t->evaluations = c.evals + cs.evals;
+    free(cs.sw);
+    free(cs.curve);
+    cf_table_free(&sub);
     t->wall_time_s = cf_clock_s() - t0;
     free(c.sw);
     free(c.curve);

@@ -22,6 +22,8 @@
 ** factor when it fits in CF_LINSOLVE_BAND_MAX_ENTRIES entries, else a dense LU up to
 ** CF_LINSOLVE_DENSE_MAX_DOF unknowns, else a GMRES basis of CF_LINSOLVE_GMRES_RESTART vectors. */
 #define TANGENT_ROW_BYTES (3.0 * CF_LINSOLVE_MAX_ADJ * 64.0)
+/* A law table: two values an end and four coefficients an interval (model/law.c). */
+#define LAW_TABLE_BYTES 48.0
 
 cf_budget cf_budget_default(void)
 {
@@ -62,13 +64,9 @@ static double mib(double bytes)
     return bytes / (1024.0 * 1024.0);
 }
 
-cf_status cf_budget_check_size(const cf_scene *sc, const char *name, const cf_budget *b,
-                               cf_scene_cost *c, cf_error *err)
+/* Springs of an nx x ny x nz lattice with the families the scene weights. */
+static double lattice_springs(const cf_lattice_config *L, double nx, double ny, double nz)
 {
-    memset(c, 0, sizeof *c);
-    const cf_lattice_config *L = &sc->cfg.lattice;
-    const double nx = L->nx, ny = L->ny, nz = L->nz;
-    const double nodes = (nx + 1) * (ny + 1) * (nz + 1);
     double springs = 0;
     if (L->weight[CF_FAMILY_EDGE] > 0)
         springs += nx * (ny + 1) * (nz + 1) + ny * (nx + 1) * (nz + 1) + nz * (nx + 1) * (ny + 1);
@@ -76,33 +74,114 @@ cf_status cf_budget_check_size(const cf_scene *sc, const char *name, const cf_bu
         springs += 2 * (nx * ny * (nz + 1) + ny * nz * (nx + 1) + nx * nz * (ny + 1));
     if (L->weight[CF_FAMILY_BODY] > 0)
         springs += 4 * nx * ny * nz;
-    c->nodes = (size_t)nodes;
-    c->springs = (size_t)springs;
-    c->samples = sc->nsamples;
+    return springs;
+}
+
+/* Bytes of the lattice and its solvers for nx x ny x nz cells: the lattice, and for static and
+** implicit runs the tangent with the larger of the sparse factor's fill and the fallback's
+** workspace (band, dense LU or GMRES basis: used only when the sparse factorisation fails). */
+static double lattice_bytes(const cf_scene *sc, double nx, double ny, double nz)
+{
+    const double nodes = (nx + 1) * (ny + 1) * (nz + 1);
+    const double springs = lattice_springs(&sc->cfg.lattice, nx, ny, nz);
     const double dof = 3 * nodes;
     double solver = 0;
     if (!sc->effects.inertia) { /* static and implicit runs factor the tangent */
         const double band = 3 * (nx + 1) * (ny + 1) + 3;
-        solver = dof * TANGENT_ROW_BYTES + springs * 36 * 4;
+        double fallback;
         if (dof * (band + 1) <= CF_LINSOLVE_BAND_MAX_ENTRIES)
-            solver += 8 * dof * (band + 1);
+            fallback = 8 * dof * (band + 1);
         else if (dof <= CF_LINSOLVE_DENSE_MAX_DOF)
-            solver += 8 * dof * dof;
+            fallback = 8 * dof * dof;
         else
-            solver += 8 * dof * (CF_LINSOLVE_GMRES_RESTART + 4.0);
+            fallback = 8 * dof * (CF_LINSOLVE_GMRES_RESTART + 4.0);
+        solver = dof * TANGENT_ROW_BYTES + springs * 36 * 4 +
+                 fmax(CF_BUDGET_FILL_BYTES * pow(dof, CF_BUDGET_FILL_EXPONENT), fallback);
     }
-    const double lattice = nodes * NODE_BYTES + springs * SPRING_BYTES;
+    return CF_BUDGET_PROCESS_BYTES + nodes * NODE_BYTES + springs * SPRING_BYTES + solver;
+}
+
+/* The law table of `table_intervals` (model/law.c: values and slopes at the ends, four cubic
+** coefficients per interval), when the scene evaluates the law by table. */
+static double table_bytes(const cf_scene *sc)
+{
+    return sc->method == CF_LAW_TABLE ? LAW_TABLE_BYTES * ((double)sc->table_intervals + 1) : 0;
+}
+
+/* The largest lattice of the scene's proportions whose bytes fit in `room` (its cell counts into
+** n[3]); 0 when not even 1 x 1 x 1 fits. */
+static int lattice_that_fits(const cf_scene *sc, double room, int n[3])
+{
+    const cf_lattice_config *L = &sc->cfg.lattice;
+    double lo = 0, hi = 1;
+    for (int it = 0; it < 60; it++) {
+        const double f = 0.5 * (lo + hi);
+        if (lattice_bytes(sc, fmax(1, floor(L->nx * f)), fmax(1, floor(L->ny * f)),
+                          fmax(1, floor(L->nz * f))) <= room)
+            lo = f;
+        else
+            hi = f;
+    }
+    n[0] = (int)fmax(1, floor(L->nx * lo));
+    n[1] = (int)fmax(1, floor(L->ny * lo));
+    n[2] = (int)fmax(1, floor(L->nz * lo));
+    return lattice_bytes(sc, n[0], n[1], n[2]) <= room;
+}
+
+/* The memory refusal: the key of the largest part and a value of it that would fit. */
+static cf_status memory_refusal(const cf_scene *sc, const char *name, const cf_budget *b,
+                                const cf_scene_cost *c, double lattice, double samples,
+                                double table, cf_error *err)
+{
+    const double limit = b->max_memory_bytes;
+    const char *key;
+    char fits[160];
+    if (table >= lattice && table >= samples) {
+        key = "table_intervals";
+        const double n = floor((limit - lattice - samples) / LAW_TABLE_BYTES) - 1;
+        if (n >= 2)
+            snprintf(fits, sizeof fits, "at most %.0f intervals would fit", fmin(n, 1e7));
+        else
+            snprintf(fits, sizeof fits, "leave out 'law_method' (the exact law needs no table)");
+    } else if (samples >= lattice) {
+        key = "samples_per_segment";
+        const double n = floor((limit - lattice - table) / SAMPLE_BYTES);
+        if (n >= 2)
+            snprintf(fits, sizeof fits, "at most %.0f samples in all would fit", n);
+        else
+            snprintf(fits, sizeof fits, "not even two samples fit beside the lattice");
+    } else {
+        key = "lattice.nx/ny/nz";
+        int n[3];
+        if (lattice_that_fits(sc, limit - samples - table, n))
+            snprintf(fits, sizeof fits, "a lattice of at most %dx%dx%d cells would fit", n[0], n[1],
+                     n[2]);
+        else
+            snprintf(fits, sizeof fits, "not even a 1x1x1 lattice fits");
+    }
+    return cf_error_set(err, CF_E_DATA,
+                        "%s: key '%s': the scene needs about %.0f MiB (%zu nodes, %zu springs "
+                        "and their solver, %zu samples%s), above the limit of %.0f MiB (raise it "
+                        "with --max-memory); %s",
+                        name, key, mib(c->memory_bytes), c->nodes, c->springs, sc->nsamples,
+                        table > 0 ? ", the law table" : "", mib(limit), fits);
+}
+
+cf_status cf_budget_check_size(const cf_scene *sc, const char *name, const cf_budget *b,
+                               cf_scene_cost *c, cf_error *err)
+{
+    memset(c, 0, sizeof *c);
+    const cf_lattice_config *L = &sc->cfg.lattice;
+    const double nx = L->nx, ny = L->ny, nz = L->nz;
+    c->nodes = (size_t)((nx + 1) * (ny + 1) * (nz + 1));
+    c->springs = (size_t)lattice_springs(L, nx, ny, nz);
+    c->samples = sc->nsamples;
+    const double lattice = lattice_bytes(sc, nx, ny, nz);
     const double samples = (double)sc->nsamples * SAMPLE_BYTES;
-    c->memory_bytes = lattice + solver + samples;
-    if (c->memory_bytes > b->max_memory_bytes) {
-        const char *key = samples > lattice + solver ? "samples_per_segment" : "lattice.nx/ny/nz";
-        return cf_error_set(err, CF_E_DATA,
-                            "%s: key '%s': the scene needs about %.0f MiB (%.0f nodes, %.0f "
-                            "springs, %zu samples), above the limit of %.0f MiB (raise it with "
-                            "--max-memory)",
-                            name, key, mib(c->memory_bytes), nodes, springs, sc->nsamples,
-                            mib(b->max_memory_bytes));
-    }
+    const double table = table_bytes(sc);
+    c->memory_bytes = lattice + samples + table;
+    if (c->memory_bytes > b->max_memory_bytes)
+        return memory_refusal(sc, name, b, c, lattice, samples, table, err);
     return CF_OK;
 }
 

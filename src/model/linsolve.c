@@ -219,9 +219,17 @@ static int chol_direction(solver *s, int *fatal, cf_error *err)
     if (s->chol_failed || n == 0)
         return 0;
     cf_error lerr = {0};
-    if (!s->chol && cf_sparse_chol_create(&s->chol, n, C->p, C->i, &lerr) != CF_OK) {
-        s->chol_failed = 1;
-        return 0;
+    if (!s->chol) {
+        cf_status cs = cf_sparse_chol_create(&s->chol, n, C->p, C->i, &lerr);
+        if (cs == CF_E_INTERNAL) { /* out of memory: a fallback would only run out later */
+            *fatal = 1;
+            cf_error_set(err, CF_E_INTERNAL, "%s", lerr.msg);
+            return 0;
+        }
+        if (cs != CF_OK) {
+            s->chol_failed = 1;
+            return 0;
+        }
     }
     cf_chol_info info;
     cf_status st = cf_sparse_chol_factor(s->chol, C->data, &info, &lerr);

@@ -95,7 +95,10 @@ cf_status cf_sparse_chol_create(cf_sparse_chol **out, size_t n, int *colptr, int
     if (!ch->LL || ch->cm.status < CHOLMOD_OK) {
         const int status = ch->cm.status;
         cf_sparse_chol_free(ch);
-        return cf_error_set(err, CF_E_INTERNAL,
+        if (status == CHOLMOD_OUT_OF_MEMORY)
+            return cf_error_set(err, CF_E_INTERNAL,
+                                "out of memory analysing the tangent (%zu unknowns)", n);
+        return cf_error_set(err, CF_E_NOCONV,
                             "sparse analysis of the tangent failed (%zu unknowns, CHOLMOD status "
                             "%d)",
                             n, status);

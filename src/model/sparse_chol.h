@@ -35,8 +35,8 @@ typedef struct cf_chol_info {
 /* Prepares the factorisation of n x n symmetric matrices with the given compressed-column pattern
 ** (colptr[n + 1], rowidx[colptr[n]]; both triangles may be present, rows within a column need not
 ** be sorted; only the lower triangle is read). The arrays must stay valid and unchanged while the
-** object lives (values may change between factorisations). CF_E_INTERNAL when memory runs out or
-** the analysis fails. */
+** object lives (values may change between factorisations). CF_E_INTERNAL when memory runs out,
+** CF_E_NOCONV when the analysis fails otherwise. */
 cf_status cf_sparse_chol_create(cf_sparse_chol **out, size_t n, int *colptr, int *rowidx,
                                 cf_error *err);
 

@@ -5,9 +5,10 @@
 ** finishes or is refused before it starts. The limits are the defaults below or the caller's
 ** (`conifit simulate --max-memory`, `--max-steps`).
 **
-** The estimates are of the present solvers: memory is the lattice, the samples and the largest
-** workspace of the linear solvers a static or implicit run may use (sparse tangent, banded factor,
-** dense LU or GMRES basis); steps are static solves (one per sample), implicit steps, or explicit
+** The estimates are of the present solvers: memory is the program, the lattice, the samples, the
+** law table (`table_intervals`) and the workspace of the linear solvers a static or implicit run
+** uses (the sparse tangent and the larger of its factorisation's fill, measured below, and the
+** fallback's banded factor, dense LU or GMRES basis); steps are static solves (one per sample), implicit steps, or explicit
 ** steps at the stable step of the unloaded lattice (stiffening springs can only add sub-steps).
 ** Work is what those steps cost on the scene's lattice, in spring-steps (one spring through one
 ** explicit step, 13 to 35 ns on one core of the machine the model was measured on): an explicit
@@ -28,6 +29,18 @@
 #define CF_BUDGET_MAX_STEPS_DEFAULT 1e7                         /* steps or solves */
 #define CF_BUDGET_MAX_WORK_DEFAULT 1e10 /* spring-steps: about 2 to 6 minutes on one core */
 #define CF_BUDGET_SOLVE_WORK_3 3e4      /* spring-steps per solve of the 3^3 lattice (1 ms) */
+/* The program itself, its libraries and the inputs it holds (10 MiB peak for a 4^3 scene, with
+** room for other C libraries and thread stacks). */
+#define CF_BUDGET_PROCESS_BYTES (16.0 * 1024 * 1024)
+/* The sparse factorisation's fill, as bytes = CF_BUDGET_FILL_BYTES * unknowns^CF_BUDGET_FILL_EXPONENT
+** beside the tangent. Measured on static cubic lattices (two samples, peak resident memory):
+** CHOLMOD's factor holds lnz = 1.9e4, 3.6e5, 1.8e6, 5.6e6 entries at 322, 2022, 6250, 14158
+** free unknowns (4^3 to 16^3, about 7.8 n^1.41), and at 13.5 bytes an entry of its workspace; the
+** peak beyond the lattice and the tangent is 97 to 91 unknowns^1.45 bytes from 16^3 to 43^3
+** (196 MiB, 432 MiB, 836 MiB at 16^3, 20^3, 24^3, and 8.0 GB reported for 43^3). 110 keeps the
+** estimate 11 to 18 % above each. */
+#define CF_BUDGET_FILL_BYTES 110.0
+#define CF_BUDGET_FILL_EXPONENT 1.45
 
 typedef struct cf_budget {
     double max_memory_bytes;

@@ -12,6 +12,7 @@
 
 #include <stddef.h>
 
+#include "conifit/budget.h"
 #include "conifit/error.h"
 #include "conifit/law.h"
 #include "conifit/msm.h"
@@ -55,5 +56,13 @@ typedef struct cf_hysteresis_recovery {
 cf_status cf_hysteresis_recovery_test(const cf_scene *sc, const cf_law *law,
                                       const cf_msm_sample *s, size_t n,
                                       cf_hysteresis_recovery *r, cf_error *err);
+
+/* The recovery test's cost on the scene's lattice lat, added to the run's in *c, against the
+** budget b: CF_OK when the test does not apply or fits in what the run leaves of the step and work
+** limits; else CF_E_DATA naming the key (effects.viscosity.tau_s, integrator.dt_s or
+** integrator.substeps) and a value of it that would fit. `name` (the scene's file) starts the
+** message. */
+cf_status cf_hysteresis_recovery_check(const cf_scene *sc, const char *name, const cf_lattice *lat,
+                                       const cf_budget *b, cf_scene_cost *c, cf_error *err);
 
 #endif

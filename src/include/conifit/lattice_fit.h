@@ -44,7 +44,15 @@ typedef struct cf_through_msm {
     cf_ident ident_after;       /* the same after the lattice objective */
     double wall_time_s;         /* s, the optimisation, the placement and the verification */
     long evaluations;           /* cell curves computed */
+    size_t search_rows;         /* rows the searches ran on: a subsample of a table longer than
+                                ** CF_LATTICE_FIT_FULL_ROWS (subsample.h), else every row */
 } cf_through_msm;
+
+/* Tables up to this many rows are searched on every row; longer ones on a subsample of
+** CF_SUBSAMPLE_ROWS rows (the stress scale and the placement then on every row), so that the fit
+** through the lattice costs about what a 2000-row table does (a 65 000-row table took 430 s of
+** CPU on every row). */
+#define CF_LATTICE_FIT_FULL_ROWS 2000
 
 /* The fit through the lattice for one fitted spring res (in: the ordinary fit; out: the spring
 ** placed from the identifiable quantities that make the homogenised cell reproduce the table in

@@ -1,0 +1,93 @@
+/*
+** The memory budget against what a run really takes: static scenes of a few sizes, each run as a
+** child whose peak resident memory (getrusage ru_maxrss through wait4) must stay below the
+** estimate the budget refuses with (the program, the lattice, the tangent and the sparse
+** factorisation's fill), and the estimate within a factor of two of it, so that it neither lets
+** through a lattice that takes gigabytes nor refuses one that fits. Kept to seconds: 6^3 to 13^3.
+*/
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include "testutil.h"
+
+static char out[1 << 14], errb[1 << 14];
+TU_SCRATCH_GROUP("budgetpeak")
+
+/* A static ramp of an n^3 lattice with two samples into dir/peakN.json. */
+static void cube_scene(int n, char *path, size_t cap)
+{
+    snprintf(path, cap, "%s/peak%d.json", dir, n);
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fprintf(f, "{\"spring\": {\"params\": {\"D1_mm\": 6, \"D2_mm\": 15, \"n\": 2.5, \"d_mm\": 2, "
+               "\"G_MPa\": 26, \"H_mm\": 10}}, \"lattice\": {\"nx\": %d, \"ny\": %d, \"nz\": %d, "
+               "\"calibration\": \"isotropic\", \"bottom\": \"axial\"}, \"protocol\": {\"kind\": "
+               "\"ramp\", \"to_strain\": 0.05, \"duration_s\": 1}, \"samples_per_segment\": 2}\n",
+            n, n, n);
+    assert_int_equal(fclose(f), 0);
+}
+
+/* The estimate in MiB, read from the refusal under a limit nothing fits. */
+static double estimate_mib(const char *scene)
+{
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "simulate %s -o %s/e.csv --max-memory 1K", scene, dir),
+                     65);
+    const char *p = strstr(errb, "needs about ");
+    assert_non_null(p);
+    return strtod(p + strlen("needs about "), NULL);
+}
+
+/* The run's peak resident memory in MiB (its exit status must be 0). */
+static double peak_mib(const char *scene)
+{
+    char csv[512];
+    snprintf(csv, sizeof csv, "%s/p.csv", dir);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        int null = open("/dev/null", O_WRONLY);
+        if (null >= 0) {
+            dup2(null, 1);
+            dup2(null, 2);
+        }
+        execl(tu_conifit(), tu_conifit(), "simulate", scene, "-o", csv, "-q", (char *)NULL);
+        _exit(127);
+    }
+    int st = 0;
+    struct rusage ru;
+    assert_int_equal(wait4(pid, &st, 0, &ru), pid);
+    assert_true(WIFEXITED(st));
+    assert_int_equal(WEXITSTATUS(st), 0);
+    return ru.ru_maxrss / 1024.0; /* kilobytes on Linux */
+}
+
+static void estimate_bounds_the_real_peak(void **state)
+{
+    (void)state;
+    if (strstr(tu_conifit(), "asan") || getenv("CONIFIT_WRAPPER"))
+        skip(); /* the sanitizer's shadow memory is no part of the estimate */
+    const int sizes[] = {6, 9, 13};
+    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++) {
+        char scene[512];
+        cube_scene(sizes[i], scene, sizeof scene);
+        const double est = estimate_mib(scene), real = peak_mib(scene);
+        print_message("%d^3: estimate %.0f MiB, peak %.1f MiB\n", sizes[i], est, real);
+        if (!(real <= est))
+            fail_msg("%d^3: the run peaked at %.1f MiB, above the estimate %.0f MiB", sizes[i],
+                     real, est);
+        if (!(est <= 2 * real))
+            fail_msg("%d^3: the estimate %.0f MiB is more than twice the peak %.1f MiB",
+                     sizes[i], est, real);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(estimate_bounds_the_real_peak),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
