@@ -1,5 +1,10 @@
 # conifit: plain Makefile. Targets:
-#   make            build build/conifit (optimised, with debug info)
+#   make            build build/conifit and the library build/libconifit.a, build/libconifit.so
+#                   (optimised, with debug info)
+#   make install    install the binary, libraries, headers, conifit.pc, man pages and the Python
+#                   module under DESTDIR$(PREFIX) (PREFIX=/usr/local); make uninstall removes them
+#   make test-install  install into a scratch DESTDIR and build, link and run a C program and the
+#                   Python module against the staged tree (part of make test)
 #   make deps       install the Debian packages conifit needs (as root; otherwise prints the command)
 #   make example    set up, then fit and validate a shipped table into build/example/ (the README's
 #                   first command; as root it installs missing packages, otherwise it prints the
@@ -57,13 +62,27 @@ CLI_SRC := $(wildcard src/cli/*.c)
 LIB_SRC := $(filter-out $(CLI_SRC),$(wildcard src/*/*.c))
 LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 CLI_OBJ := $(CLI_SRC:src/%.c=$(BUILD)/obj/%.o)
+# The library: build/libconifit.a (these objects) and build/libconifit.so (the same sources built
+# again position-independent). Its version is CF_VERSION in src/include/conifit/version.h and
+# nowhere else; the SONAME carries its major number. The shared library exports exactly the cf_*
+# functions declared in the public headers (a version script made from the headers and the
+# objects), every other symbol is local to it. The conifit binary and the tests link the static
+# library (they also call internal helpers), so build/conifit runs from a fresh clone and from an
+# install without any library path; libconifit.so is for other programs and for Python.
+VERSION := $(shell sed -n 's/^\#define CF_VERSION "\(.*\)"/\1/p' src/include/conifit/version.h)
+MAJOR   := $(firstword $(subst ., ,$(VERSION)))
+LIB_A   := $(BUILD)/libconifit.a
+LIB_SO  := $(BUILD)/libconifit.so
+SONAME  := libconifit.so.$(MAJOR)
+PIC_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/pic/%.o)
+PUBLIC_H := $(wildcard src/include/conifit/*.h)
 # Tests by what they test: unit/ one module each, cli/ the command's behaviour, props/ properties
 # across modules (fuzz/ and bench/ have their own targets).
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/*/test_*.c))
 
-.PHONY: all deps example test sanitize fuzz bench bench-update clean check-deps figures fits
+.PHONY: all lib deps example test sanitize fuzz bench bench-update clean check-deps figures fits
 
-all: check-deps $(BUILD)/conifit
+all: check-deps $(BUILD)/conifit $(LIB_A) $(LIB_SO)
 
 # Fails with the exact install command when a package is missing.
 check-deps:
@@ -102,21 +121,45 @@ $(BUILD)/obj/%.o: src/%.c
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
 
-$(BUILD)/conifit: $(LIB_OBJ) $(CLI_OBJ)
-	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS)
+$(LIB_A): $(LIB_OBJ)
+	@rm -f $@
+	$(AR) rcs $@ $^
+
+$(BUILD)/pic/%.o: src/%.c
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) $(CFLAGS) -fPIC -MMD -MP -c $< -o $@
+
+# The exported set: every cf_NAME( declared in a public header that the objects define.
+$(BUILD)/libconifit.map: $(PUBLIC_H) $(PIC_OBJ) tests/exports.sh
+	sh tests/exports.sh list $(PIC_OBJ) > $@.names
+	{ echo '{ global:'; sed 's/$$/;/' $@.names; echo 'local: *; };'; } > $@
+
+$(LIB_SO).$(VERSION): $(PIC_OBJ) $(BUILD)/libconifit.map
+	$(CC) -shared $(LDFLAGS) -Wl,-soname,$(SONAME) -Wl,--version-script,$(BUILD)/libconifit.map \
+	  -Wl,--no-undefined $(PIC_OBJ) -o $@ $(LDLIBS)
+
+$(LIB_SO): $(LIB_SO).$(VERSION)
+	ln -sf $(notdir $<) $(BUILD)/$(SONAME)
+	ln -sf $(SONAME) $@
+
+lib: $(LIB_A) $(LIB_SO)
+
+$(BUILD)/conifit: $(CLI_OBJ) $(LIB_A)
+	$(CC) $(LDFLAGS) $(CLI_OBJ) $(LIB_A) -o $@ $(LDLIBS)
 
 # Each test links the library (and may see internals through -Isrc); the CLI tests run the binary.
-$(BUILD)/tests/%: tests/%.c $(LIB_OBJ)
+$(BUILD)/tests/%: tests/%.c $(LIB_A)
 	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -MMD -MP -MF $@.d $(shell pkg-config --cflags $(TESTPKGS) 2>/dev/null) $< $(LIB_OBJ) -o $@ \
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -MMD -MP -MF $@.d $(shell pkg-config --cflags $(TESTPKGS) 2>/dev/null) $< $(LIB_A) -o $@ \
 	  $(LDFLAGS) $(LDLIBS) $(shell pkg-config --libs $(TESTPKGS) 2>/dev/null)
 
 # Header dependencies, as the compiler found them (-MMD -MP): a header edit rebuilds its dependants.
--include $(wildcard $(BUILD)/obj/*/*.d $(BUILD)/tests/*/*.d build/fuzz/obj/*/*.d \
+-include $(wildcard $(BUILD)/obj/*/*.d $(BUILD)/pic/*/*.d $(BUILD)/tests/*/*.d build/fuzz/obj/*/*.d \
                     build/bench/obj/*/*.d)
 
-test: check-deps $(BUILD)/conifit $(TESTS) $(REPLAYS)
+test: check-deps $(BUILD)/conifit $(LIB_SO) $(TESTS) $(REPLAYS)
 	@sh tests/check_layers.sh
+	@sh tests/exports.sh check $(LIB_SO)
 	@$(foreach f,$(FUZZERS),CONIFIT_FUZZ_QUIET=1 $(BUILD)/fuzz-replay/$(f) $(FUZZ_SEEDS_$(f)) \
 	  tests/fuzz/regressions/$(f) || { echo "conifit: fuzz replay $(f) FAILED" >&2; exit 1; };)
 	@levels="$(SIMD)"; if [ -z "$$levels" ]; then \
@@ -158,11 +201,11 @@ FUZZ_SEEDS_fitfile = fits/*.json
 FUZZ_SEEDS_scene   = data/scenes/*.json
 FUZZ_SEEDS_args    = tests/fuzz/args
 
-$(BUILD)/fuzz-replay/%: tests/fuzz/replay.c tests/fuzz/fuzz_%.c tests/fuzz/fuzz.h $(LIB_OBJ) \
+$(BUILD)/fuzz-replay/%: tests/fuzz/replay.c tests/fuzz/fuzz_%.c tests/fuzz/fuzz.h $(LIB_A) \
                         $(BUILD)/obj/cli/cli.o
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) $(CFLAGS) tests/fuzz/replay.c tests/fuzz/fuzz_$*.c $(LIB_OBJ) \
-	  $(BUILD)/obj/cli/cli.o -o $@ $(LDFLAGS) $(LDLIBS)
+	$(CC) $(CPPFLAGS) $(CFLAGS) tests/fuzz/replay.c tests/fuzz/fuzz_$*.c \
+	  $(BUILD)/obj/cli/cli.o $(LIB_A) -o $@ $(LDFLAGS) $(LDLIBS)
 
 .SECONDARY: $(FUZZ_OBJ)
 build/fuzz/obj/%.o: src/%.c
