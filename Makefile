@@ -80,7 +80,7 @@ PUBLIC_H := $(wildcard src/include/conifit/*.h)
 # across modules (fuzz/ and bench/ have their own targets).
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/*/test_*.c))
 
-.PHONY: all lib deps example test sanitize fuzz bench bench-update clean check-deps figures fits
+.PHONY: all lib install uninstall test-install deps example test sanitize fuzz bench bench-update clean check-deps figures fits
 
 all: check-deps $(BUILD)/conifit $(LIB_A) $(LIB_SO)
 
@@ -160,6 +160,8 @@ $(BUILD)/tests/%: tests/%.c $(LIB_A)
 test: check-deps $(BUILD)/conifit $(LIB_SO) $(TESTS) $(REPLAYS)
 	@sh tests/check_layers.sh
 	@sh tests/exports.sh check $(LIB_SO)
+	@CONIFIT=$(BUILD)/conifit sh tests/man/check_options.sh
+	@$(if $(filter 1,$(SANITIZE)),,sh tests/install/run.sh)
 	@$(foreach f,$(FUZZERS),CONIFIT_FUZZ_QUIET=1 $(BUILD)/fuzz-replay/$(f) $(FUZZ_SEEDS_$(f)) \
 	  tests/fuzz/regressions/$(f) || { echo "conifit: fuzz replay $(f) FAILED" >&2; exit 1; };)
 	@levels="$(SIMD)"; if [ -z "$$levels" ]; then \
@@ -171,6 +173,51 @@ test: check-deps $(BUILD)/conifit $(LIB_SO) $(TESTS) $(REPLAYS)
 	  echo "conifit: test programs with the $$l copies of the vector code"; \
 	  for t in $(TESTS); do CONIFIT_SIMD=$$l CONIFIT=$(BUILD)/conifit $$t || fail=1; done; done; \
 	if [ $$fail = 0 ]; then echo "conifit: all test programs passed ($$levels)"; else echo "conifit: TEST FAILURES" >&2; exit 1; fi
+
+# Installation (GNU conventions): PREFIX (default /usr/local) and DESTDIR (a staging root).
+PREFIX     ?= /usr/local
+BINDIR     ?= $(PREFIX)/bin
+LIBDIR     ?= $(PREFIX)/lib
+INCLUDEDIR ?= $(PREFIX)/include
+MANDIR     ?= $(PREFIX)/share/man
+PYTHONDIR  ?= $(PREFIX)/lib/python3/dist-packages
+PKGCONFIGDIR ?= $(LIBDIR)/pkgconfig
+MANPAGES   := $(wildcard src/man/*.[13])
+INSTALL    ?= install
+
+# conifit.pc and the Python module are written for this PREFIX as they are installed (the module
+# looks for the library in LIBDIR first).
+PC_SED := -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBDIR@|$(LIBDIR)|' -e 's|@INCLUDEDIR@|$(INCLUDEDIR)|' \
+  -e 's|@VERSION@|$(VERSION)|' -e 's|@PKGS@|$(PKGS)|' \
+  -e 's|@LIBS_PRIVATE@|$(strip $(SPARSE_LIBS)) -lgomp -lm -lpthread|'
+
+install: all
+	$(INSTALL) -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR)/conifit \
+	  $(DESTDIR)$(PKGCONFIGDIR) $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(MANDIR)/man3 $(DESTDIR)$(PYTHONDIR)
+	$(INSTALL) -m 755 $(BUILD)/conifit $(DESTDIR)$(BINDIR)/conifit
+	$(INSTALL) -m 644 $(LIB_A) $(DESTDIR)$(LIBDIR)/libconifit.a
+	$(INSTALL) -m 755 $(LIB_SO).$(VERSION) $(DESTDIR)$(LIBDIR)/libconifit.so.$(VERSION)
+	ln -sf libconifit.so.$(VERSION) $(DESTDIR)$(LIBDIR)/$(SONAME)
+	ln -sf $(SONAME) $(DESTDIR)$(LIBDIR)/libconifit.so
+	$(INSTALL) -m 644 $(PUBLIC_H) $(DESTDIR)$(INCLUDEDIR)/conifit/
+	sed $(PC_SED) src/pkgconfig/conifit.pc.in > $(DESTDIR)$(PKGCONFIGDIR)/conifit.pc
+	$(INSTALL) -m 644 $(filter %.1,$(MANPAGES)) $(DESTDIR)$(MANDIR)/man1/
+	$(INSTALL) -m 644 $(filter %.3,$(MANPAGES)) $(DESTDIR)$(MANDIR)/man3/
+	sed 's|^_INSTALLED_LIBDIR = .*|_INSTALLED_LIBDIR = "$(LIBDIR)"|' src/python/conifit.py \
+	  > $(DESTDIR)$(PYTHONDIR)/conifit.py
+
+uninstall:
+	rm -f $(DESTDIR)$(BINDIR)/conifit $(DESTDIR)$(LIBDIR)/libconifit.a \
+	  $(DESTDIR)$(LIBDIR)/libconifit.so.$(VERSION) $(DESTDIR)$(LIBDIR)/$(SONAME) \
+	  $(DESTDIR)$(LIBDIR)/libconifit.so $(DESTDIR)$(PKGCONFIGDIR)/conifit.pc \
+	  $(addprefix $(DESTDIR)$(MANDIR)/man1/,$(notdir $(filter %.1,$(MANPAGES)))) \
+	  $(addprefix $(DESTDIR)$(MANDIR)/man3/,$(notdir $(filter %.3,$(MANPAGES)))) \
+	  $(DESTDIR)$(PYTHONDIR)/conifit.py
+	rm -rf $(DESTDIR)$(INCLUDEDIR)/conifit
+
+# Installs into a scratch DESTDIR with PREFIX=/usr and uses the staged tree as a user would.
+test-install: all
+	@sh tests/install/run.sh
 
 figures: check-deps $(BUILD)/conifit
 	@mkdir -p fits/figures

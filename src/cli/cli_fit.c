@@ -12,6 +12,7 @@
 #include "base/atomic.h"
 #include "cli/cli.h"
 #include "cli/cli_fit.h"
+#include "cli/cli_shard.h"
 #include "conifit/baseline.h"
 #include "conifit/fitfile.h"
 #include "conifit/joint.h"
@@ -35,22 +36,6 @@ typedef struct fit_job {
     cf_error err;
     cf_status st;
 } fit_job;
-
-/* DIR/BASENAME-without-extension.EXT */
-static void path_in_dir(char *dst, size_t cap, const char *dir, const char *file, const char *ext)
-{
-    if (strcmp(file, "-") == 0)
-        file = "stdin"; /* a table read from standard input */
-    const char *base = strrchr(file, '/');
-    base = base ? base + 1 : file;
-    size_t n = strlen(base);
-    const char *dot = strrchr(base, '.');
-    if (dot && dot != base)
-        n = (size_t)(dot - base);
-    size_t dl = strlen(dir);
-    snprintf(dst, cap, "%s%s%.*s%s", dir, (dl && dir[dl - 1] == '/') ? "" : "/", (int)n, base,
-             ext);
-}
 
 /* The flag that widens a limit, by constraint bit. */
 static const char *limit_flag(unsigned bit)
@@ -139,11 +124,11 @@ static int plan_outputs(const fit_args *a, fit_job *jobs, const char *const *inp
         if (cf_cli_is_stdio(a->out))
             ; /* the fit file goes to standard output, written by cf_cli_fit */
         else if (a->out && cf_cli_is_dir_target(a->out))
-            path_in_dir(j->json_path, sizeof j->json_path, a->out, a->files[i], ".json");
+            cf_cli_path_in_dir(j->json_path, sizeof j->json_path, a->out, a->files[i], ".json");
         else if (a->out)
             snprintf(j->json_path, sizeof j->json_path, "%s", a->out);
         if (a->plot && (a->nfiles > 1 || cf_cli_is_dir_target(a->plot)))
-            path_in_dir(j->plot_path, sizeof j->plot_path, a->plot, a->files[i], ".png");
+            cf_cli_path_in_dir(j->plot_path, sizeof j->plot_path, a->plot, a->files[i], ".png");
         else if (a->plot)
             snprintf(j->plot_path, sizeof j->plot_path, "%s", a->plot);
         const char *mine[2] = {j->json_path, j->plot_path};
@@ -412,10 +397,20 @@ static int fit_all(const fit_args *a, fit_job *jobs)
 int cf_cli_fit(int argc, char **argv)
 {
     fit_args a;
-    int rc = cf_cli_fit_parse(argc, argv, &a);
-    if (rc >= 0)
+    cf_shard sh;
+    int rc = cf_cli_shard_take(&argc, argv, &sh);
+    if (rc < 0)
+        rc = cf_cli_fit_parse(argc, argv, &a);
+    if (rc < 0 && sh.given)
+        rc = a.joint ? cf_cli_usage_error("fit", "--shard fits tables one by one, not --joint")
+                     : cf_cli_shard_select(&sh, a.out, &a.files, &a.nfiles);
+    if (rc >= 0) {
+        cf_cli_shard_free(&sh);
         return rc;
-    fit_job *jobs = calloc((size_t)a.nfiles, sizeof *jobs);
+    }
+    if (sh.given)
+        a.popt.with_timing = 0; /* fit files that depend on the table alone */
+    fit_job *jobs = calloc((size_t)a.nfiles + 1, sizeof *jobs);
     /* every input of the run, never to be an output */
     const char **inputs = calloc((size_t)a.nfiles + 4, sizeof *inputs);
     if (!jobs || !inputs) {
@@ -449,6 +444,8 @@ int cf_cli_fit(int argc, char **argv)
                      : run_joint(&a, jobs, inputs);
     if (rc < 0)
         rc = fit_all(&a, jobs);
+    if (rc == CF_EXIT_OK && sh.given)
+        rc = cf_cli_shard_summary(&sh, a.out);
     for (int i = 0; i < a.nfiles; i++) {
         cf_table_free(&jobs[i].m);
         free(jobs[i].text);
@@ -457,5 +454,8 @@ int cf_cli_fit(int argc, char **argv)
     }
     free(jobs);
     free(inputs);
+    if (sh.given)
+        free((void *)a.files); /* the shard's list, cf_cli_shard_select's */
+    cf_cli_shard_free(&sh);
     return rc;
 }

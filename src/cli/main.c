@@ -13,6 +13,7 @@
 
 #include "base/atomic.h"
 #include "cli/cli.h"
+#include "cli/cli_shard.h"
 #include "conifit/law.h"
 
 typedef struct command {
@@ -29,6 +30,7 @@ static const command commands[] = {
     {"export", cf_cli_export, "write a fitted spring for CalculiX, Abaqus, FEBio, LS-DYNA, SOFA"},
     {"synth", cf_cli_synth, "write the stress-strain table of a spring (example data)"},
     {"simulate", cf_cli_simulate, "run a scene on a mass-spring lattice of conical springs"},
+    {"merge", cf_cli_merge, "merge the summaries of a study fitted in shards (fit --shard K/N)"},
 };
 
 static void usage(FILE *out)

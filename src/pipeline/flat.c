@@ -1,0 +1,187 @@
+/*
+** Flat calls (conifit/flat.h): each one the short chain of library calls a front end makes for
+** one job, with its arguments checked before anything runs.
+*/
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "conifit/export.h"
+#include "conifit/fitfile.h"
+#include "conifit/flat.h"
+#include "conifit/hysteresis.h"
+#include "conifit/lattice.h"
+#include "conifit/law.h"
+#include "conifit/measure.h"
+#include "conifit/msm.h"
+#include "conifit/pipeline.h"
+#include "conifit/report.h"
+#include "conifit/scene.h"
+
+static cf_status need(const void *p, const char *what, cf_error *err)
+{
+    return p ? CF_OK : cf_error_set(err, CF_E_USAGE, "%s is NULL", what);
+}
+
+cf_status cf_flat_force(const double spring[6], const char *method, size_t count,
+                        const double *u_mm, double *F_N, double *k_N_per_mm, cf_error *err)
+{
+    cf_status s;
+    if ((s = need(spring, "the spring", err)) != CF_OK ||
+        (count && ((s = need(u_mm, "the displacements", err)) != CF_OK ||
+                   (s = need(F_N, "the force array", err)) != CF_OK)))
+        return s;
+    cf_law_method m = CF_LAW_CLOSED;
+    if (method && (s = cf_law_method_parse(method, &m, err)) != CF_OK)
+        return s;
+    cf_spring p = {spring[0], spring[1], spring[2], spring[3], spring[4], spring[5]};
+    cf_law law;
+    if ((s = cf_law_init(&law, &p, err)) != CF_OK)
+        return s;
+    if (m == CF_LAW_TABLE && (s = cf_law_table_build(&law, CF_LAW_TABLE_DEFAULT, err)) != CF_OK) {
+        cf_law_free(&law);
+        return s;
+    }
+    cf_law_force_many(&law, m, count, u_mm, F_N, k_N_per_mm);
+    cf_law_free(&law);
+    return CF_OK;
+}
+
+cf_status cf_flat_fit(const char *table_path, const char *type, int validate, char **json,
+                      cf_error *err)
+{
+    cf_status s;
+    if ((s = need(json, "the result pointer", err)) != CF_OK)
+        return s;
+    *json = NULL;
+    if ((s = need(table_path, "the table path", err)) != CF_OK)
+        return s;
+    cf_pipeline_options opt = cf_pipeline_default_options();
+    if (type && strcmp(type, "both") != 0) {
+        cf_spring_type t;
+        if ((s = cf_spring_type_parse(type, &t, err)) != CF_OK)
+            return s;
+        opt.types = 1u << t;
+    }
+    opt.validate = validate != 0;
+    cf_measure_options mopt = cf_measure_default_options();
+    cf_table tab;
+    if ((s = cf_measure_load(table_path, &mopt, &tab, err)) != CF_OK)
+        return s;
+    if (tab.t) {
+        cf_table_free(&tab);
+        return cf_error_set(err, CF_E_DATA, "%s is a time series: fit it with conifit fit",
+                            table_path);
+    }
+    cf_fit_report rep;
+    if ((s = cf_pipeline_fit(&tab, &opt, &rep, err)) == CF_OK) {
+        *json = cf_report_json_string(&rep);
+        if (!*json)
+            s = cf_error_set(err, CF_E_INTERNAL, "out of memory for the fit file");
+        cf_report_free(&rep);
+    }
+    cf_table_free(&tab);
+    return s;
+}
+
+cf_status cf_flat_simulate(const char *scene_path, double **samples, size_t *count,
+                           cf_error *err)
+{
+    cf_status s;
+    if ((s = need(samples, "the samples pointer", err)) != CF_OK ||
+        (s = need(count, "the count pointer", err)) != CF_OK)
+        return s;
+    *samples = NULL;
+    *count = 0;
+    if ((s = need(scene_path, "the scene path", err)) != CF_OK)
+        return s;
+    cf_scene sc;
+    if ((s = cf_scene_load(scene_path, &sc, err)) != CF_OK)
+        return s;
+    cf_law law = {0};
+    cf_lattice lat = {0};
+    cf_msm_sample *run = calloc(sc.nsamples ? sc.nsamples : 1, sizeof *run);
+    double *out = calloc(sc.nsamples ? sc.nsamples * CF_FLAT_SAMPLE_COLUMNS : 1, sizeof *out);
+    int have_lattice = 0;
+    if (!run || !out)
+        s = cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu samples", sc.nsamples);
+    else if ((s = cf_law_init(&law, &sc.spring, err)) == CF_OK &&
+             (sc.method != CF_LAW_TABLE ||
+              (s = cf_law_table_build(&law, sc.table_intervals, err)) == CF_OK) &&
+             (s = cf_lattice_create(&lat, &law, sc.method, &sc.cfg.lattice, err)) == CF_OK) {
+        have_lattice = 1;
+        cf_msm_path path = cf_scene_path(&sc);
+        size_t done = 0;
+        cf_msm_stats st;
+        s = cf_msm_run(&lat, &sc.effects, &sc.cfg, &path, sc.sample_t_s, sc.nsamples, run, &done,
+                       &st, err);
+    }
+    if (s == CF_OK) {
+        size_t lost = cf_hysteresis_first_unstable(run, sc.nsamples);
+        double H = sc.spring.H_mm;
+        for (size_t i = 0; i < sc.nsamples; i++) {
+            double *row = out + i * CF_FLAT_SAMPLE_COLUMNS;
+            row[0] = run[i].t_s;
+            row[1] = run[i].strain;
+            row[2] = run[i].stress_MPa * 1e3;
+            row[3] = run[i].kinetic_mJ;
+            row[4] = cf_law_force(&law, sc.method, run[i].strain * H, NULL, NULL) / (H * H) * 1e3;
+            row[5] = sc.effects.inertia ? -1 : i < lost;
+        }
+        *samples = out;
+        *count = sc.nsamples;
+        out = NULL;
+    }
+    if (have_lattice)
+        cf_lattice_free(&lat);
+    cf_law_free(&law);
+    free(run);
+    free(out);
+    cf_scene_free(&sc);
+    return s;
+}
+
+cf_status cf_flat_export(const char *fit_path, const char *type, const char *format, double tol,
+                         char **text, cf_error *err)
+{
+    cf_status s;
+    if ((s = need(text, "the result pointer", err)) != CF_OK)
+        return s;
+    *text = NULL;
+    if ((s = need(fit_path, "the fit file path", err)) != CF_OK ||
+        (s = need(format, "the format", err)) != CF_OK)
+        return s;
+    cf_export_options opt = cf_export_default_options();
+    if ((s = cf_export_format_parse(format, &opt.format, err)) != CF_OK)
+        return s;
+    if (tol != 0) {
+        if (!(tol >= CF_EXPORT_TOL_MIN && tol <= CF_EXPORT_TOL_MAX))
+            return cf_error_set(err, CF_E_DATA, "tolerance %g is not in %g..%g", tol,
+                                CF_EXPORT_TOL_MIN, CF_EXPORT_TOL_MAX);
+        opt.tol = tol;
+    } else {
+        opt.auto_tol = 1;
+    }
+    cf_fitted_spring fs;
+    if ((s = cf_fitfile_load(fit_path, type, &fs, err)) != CF_OK)
+        return s;
+    opt.source = fit_path;
+    size_t len = 0;
+    FILE *mem = open_memstream(text, &len);
+    if (!mem)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory");
+    cf_export_report rep;
+    s = cf_export_write(mem, &fs, &opt, &rep, err);
+    if (fclose(mem) != 0 && s == CF_OK)
+        s = cf_error_set(err, CF_E_INTERNAL, "out of memory");
+    if (s != CF_OK) {
+        free(*text);
+        *text = NULL;
+    }
+    return s;
+}
+
+void cf_flat_free(void *p)
+{
+    free(p);
+}

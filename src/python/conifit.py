@@ -1,0 +1,206 @@
+"""conifit from Python: the conical-spring law, fits, scenes and exports of libconifit.
+
+Standard library only: ctypes over libconifit.so (the flat calls of conifit/flat.h).
+
+    import conifit
+    conifit.force([4, 12, 5, 0.8, 80000, 10], [0.5, 1.5, 3.0])   # N at each compression (mm)
+    fit = conifit.fit("data/telescoping_noise1pct.csv")          # the fit file, as a dict
+    fit = conifit.fit(strain=[...], stress=[...], stress_unit="kPa")
+    rows = conifit.simulate("data/scenes/uniaxial.json")           # list of dicts, one a sample
+    text = conifit.export("fit.json", "calculix")                  # the exported block
+
+Every failure raises conifit.Error with the library's message and its status (.status: "usage",
+"data", "noinput", "cantwrite", "internal", "noconv").
+
+The library is looked for in the environment variable CONIFIT_LIBRARY (a path), then in the
+folder it was installed into, then in the build folder of a source tree holding this file
+(src/python/ beside build/), then by the system's loader (libconifit.so.0).
+"""
+
+import ctypes
+import json
+import os
+import tempfile
+
+__all__ = ["Error", "force", "fit", "simulate", "export", "library_path"]
+
+# Set by make install to the folder the library went to.
+_INSTALLED_LIBDIR = ""
+_SONAME = "libconifit.so.0"
+_MSG_LEN = 512  # CF_ERROR_MSG_LEN
+_STATUS = {-1: "usage", -2: "data", -3: "noinput", -4: "cantwrite", -5: "internal", -6: "noconv"}
+_SAMPLE_KEYS = ("time_s", "strain", "stress_kPa", "kinetic_energy_mJ", "spring_stress_kPa",
+                "stable")
+
+
+class Error(Exception):
+    """A refusal or failure of libconifit: str() is its message, .status its kind."""
+
+    def __init__(self, status, message):
+        self.status = _STATUS.get(status, "internal")
+        super().__init__(message)
+
+
+class _CfError(ctypes.Structure):
+    _fields_ = [("status", ctypes.c_int), ("msg", ctypes.c_char * _MSG_LEN)]
+
+
+def _candidates():
+    env = os.environ.get("CONIFIT_LIBRARY")
+    if env:
+        return [env]
+    here = os.path.dirname(os.path.abspath(__file__))
+    found = []
+    if _INSTALLED_LIBDIR:
+        found.append(os.path.join(_INSTALLED_LIBDIR, _SONAME))
+    found.append(os.path.join(here, "..", "..", "build", "libconifit.so"))
+    found.append(_SONAME)
+    return found
+
+
+def _load():
+    tried = []
+    for path in _candidates():
+        if os.sep in path and not os.path.exists(path):
+            tried.append(path + " (absent)")
+            continue
+        try:
+            lib = ctypes.CDLL(path)
+        except OSError as e:
+            tried.append("%s (%s)" % (path, e))
+            continue
+        return path, _declare(lib)
+    raise ImportError("conifit: cannot load libconifit: tried " + "; ".join(tried))
+
+
+def _declare(lib):
+    dp = ctypes.POINTER(ctypes.c_double)
+    err = ctypes.POINTER(_CfError)
+    lib.cf_flat_force.argtypes = [dp, ctypes.c_char_p, ctypes.c_size_t, dp, dp, dp, err]
+    lib.cf_flat_fit.argtypes = [ctypes.c_char_p, ctypes.c_char_p, ctypes.c_int,
+                                ctypes.POINTER(ctypes.c_void_p), err]
+    lib.cf_flat_simulate.argtypes = [ctypes.c_char_p, ctypes.POINTER(dp),
+                                     ctypes.POINTER(ctypes.c_size_t), err]
+    lib.cf_flat_export.argtypes = [ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p,
+                                   ctypes.c_double, ctypes.POINTER(ctypes.c_void_p), err]
+    lib.cf_flat_free.argtypes = [ctypes.c_void_p]
+    lib.cf_flat_free.restype = None
+    for name in ("cf_flat_force", "cf_flat_fit", "cf_flat_simulate", "cf_flat_export"):
+        getattr(lib, name).restype = ctypes.c_int
+    return lib
+
+
+library_path, _lib = _load()
+
+
+def _check(status, e):
+    if status != 0:
+        raise Error(status, e.msg.decode("utf-8", "replace"))
+
+
+def _text(s, what):
+    if s is None:
+        return None
+    if not isinstance(s, (str, bytes, os.PathLike)):
+        raise Error(-1, "%s must be a string, not %s" % (what, type(s).__name__))
+    return os.fsencode(s)
+
+
+def _taken(p):
+    """The malloc'd text at p as a str, released."""
+    try:
+        return ctypes.string_at(p).decode("utf-8")
+    finally:
+        _lib.cf_flat_free(p)
+
+
+def _numbers(values, what):
+    try:
+        return [float(v) for v in values]
+    except (TypeError, ValueError):
+        raise Error(-2, "%s must be a sequence of numbers" % what) from None
+
+
+def force(spring, u_mm, method="closed", stiffness=False):
+    """Force (N) of the spring [D1, D2, n, d, G, H] (mm, MPa) at each compression in u_mm (mm,
+    > 0 shortens); with stiffness=True a pair of lists (forces, tangent stiffnesses in N/mm)."""
+    p = _numbers(spring, "the spring")
+    if len(p) != 6:
+        raise Error(-1, "the spring needs 6 numbers (D1, D2, n, d, G, H), got %d" % len(p))
+    u = _numbers(u_mm, "the displacements")
+    n = len(u)
+    arr = ctypes.c_double * max(n, 1)
+    F, k = arr(), arr()
+    e = _CfError()
+    _check(_lib.cf_flat_force((ctypes.c_double * 6)(*p), _text(method, "method"), n, arr(*u), F,
+                              k if stiffness else None, ctypes.byref(e)), e)
+    if stiffness:
+        return list(F[:n]), list(k[:n])
+    return list(F[:n])
+
+
+def fit(table=None, strain=None, stress=None, stress_unit="kPa", type="both", validate=False):
+    """Fits a table (a path) or two sequences (strain, stress in stress_unit) as conifit fit
+    does and returns the fit file's content as a dict."""
+    if table is not None and (strain is not None or stress is not None):
+        raise Error(-1, "give a table path or strain and stress, not both")
+    tmp = None
+    if table is None:
+        if strain is None or stress is None:
+            raise Error(-1, "give a table path, or strain and stress")
+        x, y = _numbers(strain, "strain"), _numbers(stress, "stress")
+        if len(x) != len(y):
+            raise Error(-2, "strain has %d values, stress %d" % (len(x), len(y)))
+        if not isinstance(stress_unit, str) or not stress_unit.replace("/", "").isalnum():
+            raise Error(-1, "stress_unit must be a unit name such as kPa")
+        fd, tmp = tempfile.mkstemp(prefix="conifit-", suffix=".csv")
+        with os.fdopen(fd, "w") as f:
+            f.write("strain,stress_%s\n" % stress_unit)
+            for a, b in zip(x, y):
+                f.write("%.17g,%.17g\n" % (a, b))
+        table = tmp
+    try:
+        out = ctypes.c_void_p()
+        e = _CfError()
+        _check(_lib.cf_flat_fit(_text(table, "table"), _text(type, "type"), 1 if validate else 0,
+                                ctypes.byref(out), ctypes.byref(e)), e)
+        return json.loads(_taken(out))
+    finally:
+        if tmp:
+            os.unlink(tmp)
+
+
+def simulate(scene):
+    """Runs the scene file and returns its samples, the columns of conifit simulate's CSV: a
+    list of dicts with time_s, strain, stress_kPa (compression positive), kinetic_energy_mJ,
+    spring_stress_kPa and stable (1, 0, or -1 in explicit dynamics)."""
+    rows = ctypes.POINTER(ctypes.c_double)()
+    count = ctypes.c_size_t()
+    e = _CfError()
+    _check(_lib.cf_flat_simulate(_text(scene, "scene"), ctypes.byref(rows), ctypes.byref(count),
+                                 ctypes.byref(e)), e)
+    try:
+        w = len(_SAMPLE_KEYS)
+        out = []
+        for i in range(count.value):
+            r = dict(zip(_SAMPLE_KEYS, rows[i * w:(i + 1) * w]))
+            r["stable"] = int(r["stable"])
+            out.append(r)
+        return out
+    finally:
+        _lib.cf_flat_free(rows)
+
+
+def export(fit_file, format, type=None, tol=0.0):
+    """The spring of a fit file written for another simulator (format as conifit export
+    --format: json, csv, calculix, abaqus, febio, lsdyna, sofa), as text."""
+    out = ctypes.c_void_p()
+    e = _CfError()
+    try:
+        tol = float(tol)
+    except (TypeError, ValueError):
+        raise Error(-2, "tol must be a number") from None
+    _check(_lib.cf_flat_export(_text(fit_file, "fit file"), _text(type, "type"),
+                               _text(format, "format"), tol, ctypes.byref(out),
+                               ctypes.byref(e)), e)
+    return _taken(out)
