@@ -1,8 +1,9 @@
 /*
 ** conifit synth: writes the stress-strain table of one conical spring, as a measured table would
 ** look, optionally with Gaussian noise. One mass-spring cell is a cube of edge H whose axial spring
-** carries the stress on a face: stress = F/H^2, strain = u/H (README, "From a spring to stress
-** and strain"). Such tables are the project's own examples (data/) and the fitter's recovery tests.
+** carries the stress on a face: stress = F/H^2, strain = u/H (src/model/law.md, "From a spring to
+** stress and strain"). Such tables are the project's own examples (data/) and the fitter's recovery
+** tests.
 */
 #include <math.h>
 #include <stdio.h>

@@ -1,5 +1,5 @@
 /*
-** Scene files (see scene.h and the README's "Scenes" section): JSON parsing with jansson, strict
+** Scene files (see scene.h and src/notes/simulate.md, "Scenes"): JSON parsing with jansson, strict
 ** key checking, and the conversion of a loading protocol into a piecewise-linear path and the
 ** times at which samples are reported.
 */

@@ -341,7 +341,7 @@ static int band_direction(solver *s)
 
 /* Small systems are solved directly: LU with partial pivoting (GSL) of the scaled tangent costs
 ** well under a millisecond for the few hundred DOFs of a validation lattice, where restarted GMRES
-** took several (measured on the 3x3x3 hysteresis scene: 18 s before, see the README). */
+** took several (measured on the 3x3x3 hysteresis scene: 18 s before; src/notes/performance.md). */
 static cf_status dense_direction(solver *s, cf_error *err)
 {
     const size_t n = s->ndof;

@@ -1,8 +1,8 @@
 /*
-** Costs bounded by the input and limits stated (README, "Limits"): a comment of a megabyte is read
-** in linear time and still yields its unit; the row, column, line and size limits of a table hold
-** exactly where they are documented, with a message naming the line; a folder given as a table,
-** fit file or scene is a missing input (66). Timings belong to the benchmark, not here.
+** Costs bounded by the input and limits stated (src/notes/commands.md, "Limits"): a comment of a
+** megabyte is read in linear time and still yields its unit; the row, column, line and size limits
+** of a table hold exactly where they are documented, with a message naming the line; a folder given
+** as a table, fit file or scene is a missing input (66). Timings belong to the benchmark, not here.
 */
 #include <sys/stat.h>
 

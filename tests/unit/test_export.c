@@ -745,7 +745,7 @@ static void calculix_runs_the_one_spring_example_and_matches_the_law(void **stat
     }
 }
 
-/* What the README says of CalculiX: past the last pair it holds the force constant. */
+/* What src/notes/export.md says of CalculiX: past the last pair it holds the force constant. */
 static void calculix_holds_the_last_force_beyond_the_table(void **state)
 {
     (void)state;

@@ -3,10 +3,12 @@
 ** parameters that every reader, writer, report, export and option works from:
 **  - the table is whole: names, units, keys and meanings present and unique, bounds ordered,
 **    lookup by name and by key, get and set touching their own field only;
-**  - the README's lists of the JSON keys (the fit file's "params", the scene and the exported
-**    spring) are the table's keys in its order, so that renaming a key in the table and not in
-**    the documentation fails here.
+**  - the documentation's lists of the JSON keys (the fit file's "params", the scene and the
+**    exported spring; README.md and the notes, in src/notes/ and beside the code) are the table's
+**    keys in its order, so that renaming a key in the table and not in the documentation fails here.
 */
+#include <glob.h>
+
 #include "testutil.h"
 
 #include "conifit/spring.h"
@@ -59,11 +61,11 @@ static void check_list(const char *from, char quote, int json)
             after++;
         if (!json || *after == ':') {
             if (k >= CF_P_COUNT)
-                fail_msg("README: a params list has more than %d keys: '%.*s'", CF_P_COUNT,
+                fail_msg("documentation: a params list has more than %d keys: '%.*s'", CF_P_COUNT,
                          (int)(end - from), from);
             const char *want = cf_spring_param_info(k)->key;
             if (strlen(want) != (size_t)(q - p - 1) || strncmp(p + 1, want, strlen(want)) != 0)
-                fail_msg("README: key %d of a params list is '%.*s', the field table's is '%s' "
+                fail_msg("documentation: key %d of a params list is '%.*s', the field table's is '%s' "
                          "(src/model/spring.c); list: '%.*s'",
                          k + 1, (int)(q - p - 1), p + 1, want, (int)(end - from), from);
             k++;
@@ -71,16 +73,41 @@ static void check_list(const char *from, char quote, int json)
         p = q + 1;
     }
     if (k != CF_P_COUNT)
-        fail_msg("README: a params list has %d keys, the field table %d: '%.*s'", k, CF_P_COUNT,
+        fail_msg("documentation: a params list has %d keys, the field table %d: '%.*s'", k, CF_P_COUNT,
                  (int)(end - from), from);
 }
 
-static void the_readme_lists_the_keys_of_the_field_table(void **state)
+/* README.md and every notes file, one after another (caller frees). */
+static char *documentation(void)
+{
+    char *all = tu_slurp("README.md");
+    if (!all)
+        fail_msg("README.md not found (the tests run from the repository's top level)");
+    const char *patterns[] = {"src/notes/*.md", "src/*/*.md"};
+    for (size_t k = 0; k < sizeof patterns / sizeof patterns[0]; k++) {
+        glob_t g;
+        if (glob(patterns[k], 0, NULL, &g) != 0)
+            continue;
+        for (size_t i = 0; i < g.gl_pathc; i++) {
+            char *text = tu_slurp(g.gl_pathv[i]);
+            assert_non_null(text);
+            size_t n = strlen(all), m = strlen(text);
+            char *both = realloc(all, n + m + 2);
+            assert_non_null(both);
+            both[n] = '\n';
+            memcpy(both + n + 1, text, m + 1);
+            all = both;
+            free(text);
+        }
+        globfree(&g);
+    }
+    return all;
+}
+
+static void the_documentation_lists_the_keys_of_the_field_table(void **state)
 {
     (void)state;
-    char *readme = tu_slurp("README.md");
-    if (!readme)
-        fail_msg("README.md not found (the tests run from the repository's top level)");
+    char *readme = documentation();
     int lists = 0;
     /* JSON examples: "params": { "KEY": value, ... } */
     for (const char *p = strstr(readme, "\"params\""); p; p = strstr(p + 1, "\"params\"")) {
@@ -121,7 +148,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(the_field_table_is_whole_and_found_by_name_and_key),
-        cmocka_unit_test(the_readme_lists_the_keys_of_the_field_table),
+        cmocka_unit_test(the_documentation_lists_the_keys_of_the_field_table),
         cmocka_unit_test(the_spring_as_text_follows_the_table),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -22,7 +22,7 @@ typedef enum cf_status {
     CF_E_NOCONV = -6    /* a solver did not converge (exit 70) */
 } cf_status;
 
-/* Exit statuses documented in the README (BSD sysexits values). */
+/* Exit statuses documented in conifit(1) and src/notes/commands.md (BSD sysexits values). */
 enum {
     CF_EXIT_OK = 0,
     CF_EXIT_USAGE = 2,

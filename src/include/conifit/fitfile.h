@@ -16,7 +16,7 @@
 **     ...
 **   }
 ** The keys of "params" are those of the spring's field table (cf_spring_param_info, spring.h), in
-** its order; `tests/unit/test_spring.c` checks the README's lists of them against it.
+** its order; `tests/unit/test_spring.c` checks the documentation's lists of them against it.
 ** Only "fits[].type", "fits[].params" (and the provenance fields if present) are needed to read a
 ** spring back; everything else is report.
 **

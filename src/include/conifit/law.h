@@ -3,7 +3,7 @@
 ** spring as a function of its compression u. A pure scalar kernel: it knows nothing of meshes,
 ** fits or files.
 **
-** Law (derived from first principles in the README, "The law"; the paper's eqs. 3-12 encode it):
+** Law (derived from first principles in src/model/law.md; the paper's eqs. 3-12 encode it):
 **   travel to solid  s   = H - L_min,  L_min = d (telescoping) or n d (non-telescoping)
 **   telescoping      <=> (D2 - D1)/2 >= n d   (coils of successive radii fit inside each other)
 **   transition load  F_T = G d^4 s / (8 n D2^3),  solid load F_C = G d^4 s / (8 n D1^3)

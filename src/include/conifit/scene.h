@@ -1,9 +1,9 @@
 /*
 ** Scenes: a JSON file that says which spring, which lattice, which boundary conditions, which
-** loading protocol and which time-dependent effects a simulation uses (schema in the README,
-** section "Scenes"). Loading validates everything before anything is simulated: an unknown key,
-** a missing field, an impossible value or a missing fit file is refused with a message that names
-** the key and the value.
+** loading protocol and which time-dependent effects a simulation uses (schema in
+** src/notes/simulate.md, section "Scenes"). Loading validates everything before anything is
+** simulated: an unknown key, a missing field, an impossible value or a missing fit file is refused
+** with a message that names the key and the value.
 */
 #ifndef CF_SCENE_H
 #define CF_SCENE_H
