@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "conifit/budget.h"
 #include "conifit/export.h"
 #include "conifit/fitfile.h"
 #include "conifit/flat.h"
@@ -98,6 +99,13 @@ cf_status cf_flat_simulate(const char *scene_path, double **samples, size_t *cou
     cf_scene sc;
     if ((s = cf_scene_load(scene_path, &sc, err)) != CF_OK)
         return s;
+    /* the default budget of conifit simulate: a scene too large is refused before it runs */
+    const cf_budget budget = cf_budget_default();
+    cf_scene_cost cost;
+    if ((s = cf_budget_check_size(&sc, scene_path, &budget, &cost, err)) != CF_OK) {
+        cf_scene_free(&sc);
+        return s;
+    }
     cf_law law = {0};
     cf_lattice lat = {0};
     cf_msm_sample *run = calloc(sc.nsamples ? sc.nsamples : 1, sizeof *run);
@@ -110,11 +118,13 @@ cf_status cf_flat_simulate(const char *scene_path, double **samples, size_t *cou
               (s = cf_law_table_build(&law, sc.table_intervals, err)) == CF_OK) &&
              (s = cf_lattice_create(&lat, &law, sc.method, &sc.cfg.lattice, err)) == CF_OK) {
         have_lattice = 1;
-        cf_msm_path path = cf_scene_path(&sc);
-        size_t done = 0;
-        cf_msm_stats st;
-        s = cf_msm_run(&lat, &sc.effects, &sc.cfg, &path, sc.sample_t_s, sc.nsamples, run, &done,
-                       &st, err);
+        if ((s = cf_budget_check_steps(&sc, scene_path, &lat, &budget, &cost, err)) == CF_OK) {
+            cf_msm_path path = cf_scene_path(&sc);
+            size_t done = 0;
+            cf_msm_stats st;
+            s = cf_msm_run(&lat, &sc.effects, &sc.cfg, &path, sc.sample_t_s, sc.nsamples, run,
+                           &done, &st, err);
+        }
     }
     if (s == CF_OK) {
         size_t lost = cf_hysteresis_first_unstable(run, sc.nsamples);

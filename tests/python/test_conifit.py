@@ -107,6 +107,22 @@ class Scene(unittest.TestCase):
             conifit.simulate("no/such/scene.json")
         self.assertEqual(c.exception.status, "noinput")
 
+    def test_scene_above_the_budget_is_refused(self):
+        with open("data/scenes/uniaxial.json") as f:
+            scene = json.load(f)
+        scene["lattice"].update(nx=400, ny=400, nz=400)
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "huge.json")
+            with open(path, "w") as f:
+                json.dump(scene, f)
+            with self.assertRaises(conifit.Error) as c:
+                conifit.simulate(path)
+            self.assertEqual(c.exception.status, "data")
+            theirs = subprocess.run([BIN, "simulate", path, "-o", os.path.join(d, "out.csv")],
+                                    capture_output=True, text=True)
+            self.assertEqual(theirs.returncode, 65)
+            self.assertIn(str(c.exception), theirs.stderr)
+
 
 class Export(unittest.TestCase):
     def test_export_matches_binary(self):
