@@ -66,6 +66,14 @@ class Fit(unittest.TestCase):
                 self.assertTrue(close(a["params"][key], value, 1e-6), (key, a["params"][key], value))
         self.assertEqual(mine["data"]["points"], theirs["data"]["points"])
 
+    def test_validate_matches_binary(self):
+        mine = conifit.fit(self.TABLE, validate=True)
+        theirs = json.loads(run("fit", self.TABLE, "--validate", "-o", "-"))
+        for a, b in zip(mine["fits"], theirs["fits"]):
+            self.assertTrue(close(a["validation"]["rmse"], b["validation"]["rmse"], 1e-6),
+                            (a["validation"]["rmse"], b["validation"]["rmse"]))
+        self.assertNotIn("validation", conifit.fit(self.TABLE)["fits"][0])
+
     def test_sequences_equal_path(self):
         with open(self.TABLE) as f:
             rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
