@@ -91,6 +91,18 @@ double cf_fit_model(const cf_law *law, int force_displacement, double x)
     return cf_law_force(law, CF_LAW_CLOSED, x * H, NULL, NULL) / (H * H);
 }
 
+void cf_fit_model_many(const cf_law *law, int force_displacement, size_t count, const double *x,
+                       double *out)
+{
+    const double H = force_displacement ? 1.0 : law->p.H_mm;
+    for (size_t i = 0; i < count; i++)
+        out[i] = x[i] * H;
+    cf_law_force_many(law, CF_LAW_CLOSED, count, out, out, NULL);
+    if (!force_displacement)
+        for (size_t i = 0; i < count; i++)
+            out[i] /= H * H;
+}
+
 /* ---- the checks and the working state -------------------------------------------------------- */
 
 /* The smallest largest |y| (MPa or N) and |x| (strain or mm) of a table, and the range of its
@@ -194,8 +206,7 @@ static void summarise(fit_ctx *c, const double *p, cf_fit_result *res)
     res->params = from_array(p);
     cf_law_init(&res->law, &res->params, NULL);
     res->ident = cf_ident_of_type(&res->params, c->type, c->fd);
-    for (size_t i = 0; i < c->n; i++)
-        c->model[i] = cf_fit_model(&res->law, c->fd, c->data->x[i]);
+    cf_fit_model_many(&res->law, c->fd, c->n, c->data->x, c->model);
     cf_lsq_quality q = cf_lsq_quality_of(c->data, c->model);
     res->rss = q.rss;
     res->rmse = q.rmse;
@@ -225,11 +236,13 @@ static cf_status ctx_setup(fit_ctx *c, const cf_table *data, const cf_fit_option
     c->fd = cf_table_is_force(data);
     c->n = data->count;
     /* one block: the residual weights, then the model's values at the points (summarise, and
-    ** scratch for cf_fit_rss_at) */
-    c->sw = malloc(2 * sizeof(double) * c->n);
+    ** scratch for the stages) and the canonical law's two derivatives (stage A's Jacobian) */
+    c->sw = malloc(4 * sizeof(double) * c->n);
     if (!c->sw)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", c->n);
     c->model = c->sw + c->n;
+    c->gt = c->model + c->n;
+    c->gr = c->gt + c->n;
     c->ynorm = cf_lsq_weights(data, opt->relative, c->sw);
     c->xmax = cf_lsq_xmax(data);
     int nfixed = 0;
@@ -338,6 +351,8 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
         return st;
     }
     fit_ctx *g = long_table ? &sc : &c;
+    if (long_table)
+        c.stat_tol = LONG_TOL / (double)(c.n - 3);
     /* Stage A: the identifiable quantities, over every spring, then under the type's limits when
     ** the optimum lies outside them. */
     double v[3] = {0.5, 0.5 * (c.b_lo + c.b_hi), 1.0};
