@@ -177,8 +177,6 @@ double cf_fit_sub_solve(fit_ctx *c, sub *q, double *x, nlopt_algorithm alg)
         return CF_LSQ_HUGE_OBJ;
     }
     nlopt_set_xtol_rel(o, 1e-9);
-    if (c->stat_tol > 0)
-        nlopt_set_ftol_rel(o, c->stat_tol);
     nlopt_set_maxeval(o, 300);
     double f = CF_LSQ_HUGE_OBJ;
     nlopt_result r = nlopt_optimize(o, x, &f);
