@@ -351,16 +351,28 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
         return st;
     }
     fit_ctx *g = long_table ? &sc : &c;
-    if (long_table)
-        c.stat_tol = LONG_TOL / (double)(c.n - 3);
+    /* the local searches on the table's own rows stop at the statistical tolerance (fit_ctx.h);
+    ** a long table's searches on its subsample keep the strict rule (with the tolerance the
+    ** subsample's optimum moved enough to end 0.07 s^2 short on a ridge of a limit) */
+    c.stat_tol = LONG_TOL / (double)(c.n - 3); /* c.n >= 4 (check_data) */
     /* Stage A: the identifiable quantities, over every spring, then under the type's limits when
     ** the optimum lies outside them. */
     double v[3] = {0.5, 0.5 * (c.b_lo + c.b_hi), 1.0};
     start4 found[STAGE_A_RUNS];
     int nfound = 0;
     cf_fit_stage_a(g, v, long_table ? found : NULL, &nfound);
-    if (long_table)
+    if (long_table) {
         cf_fit_stage_a_polish(&c, found, nfound, v);
+    } else {
+        /* the starts stopped at the statistical tolerance; the best is polished to the strict
+        ** rule, so that a short table's fit is its optimum to rounding */
+        double w[3];
+        const double tol = c.stat_tol;
+        c.stat_tol = 0;
+        if (cf_fit_lm_run(&c, v[0], v[1], v[2], w) < CF_LSQ_HUGE_OBJ)
+            memcpy(v, w, sizeof w);
+        c.stat_tol = tol;
+    }
     unsigned held_a = 0; /* the limits that keep the type from stage A's optimum */
     if (c.region) {
         region r = cf_fit_region_at(&c, v[0], v[1]);
@@ -389,6 +401,8 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
     ** stress-strain table (c.region) the six parameters reach the model only through the three
     ** quantities that stage A fitted on every row, so the polish there can move the objective by
     ** rounding only (1e-14 of it on the shipped tables) and a long table skips its full pass. */
+    if (!long_table)
+        c.stat_tol = 0; /* stage C on a short table: to the optimiser's own tolerances */
     gsl_rng *rng = cf_fit_seeded_rng(opt->seed, 2);
     c.oom |= !rng;
     int starts = 1;

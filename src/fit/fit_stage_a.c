@@ -19,6 +19,7 @@
 #include "fit/fit_ctx.h"
 #include "fit/lm.h"
 #include "fit/lsq.h"
+#include "fit/subsample.h"
 
 /* The fit's random numbers: GSL's mt19937 (the generator conifit uses everywhere), one stream
 ** per use, seeded from the fit's seed, local to one call (no shared state between threads). */
@@ -127,7 +128,7 @@ double cf_fit_lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3
 {
     gsl_multifit_nlinear_parameters fp = cf_lm_parameters();
     fp.fdtype = GSL_MULTIFIT_NLINEAR_CTRDIFF;
-    if (c->stat_tol > 0) /* every row of a long table: the normal equations, not a QR of J */
+    if (c->n > CF_SUBSAMPLE_ROWS) /* every row of a long table: the normal equations, not a QR */
         fp.solver = gsl_multifit_nlinear_solver_cholesky;
     gsl_multifit_nlinear_fdf fdf;
     memset(&fdf, 0, sizeof fdf);

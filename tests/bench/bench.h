@@ -28,7 +28,7 @@ typedef struct bench_target {
     int met; /* 1 met, 0 not met, -1 not measured */
 } bench_target;
 
-#define BENCH_MAX_TARGETS 24
+#define BENCH_MAX_TARGETS 32
 
 typedef struct bench_ctx {
     FILE *md;              /* the Markdown report */
@@ -70,5 +70,6 @@ void bench_section_visco(bench_ctx *ctx);
 void bench_section_statics(bench_ctx *ctx);
 void bench_statics_early(bench_ctx *ctx);
 void bench_section_longfit(bench_ctx *ctx);
+void bench_section_fastfit(bench_ctx *ctx);
 
 #endif
