@@ -278,8 +278,8 @@ double cf_fit_stage_a(fit_ctx *c, double best3[3], start4 *found, int *nfound)
 }
 
 /* Standard errors of (rho, B, A) at a solution: s^2 (J^T J)^-1 with the analytic Jacobian of the
-** weighted residuals (cf_ident_canon_many); the correlation matrix (NAN where not determined). Returns 1
-** when J^T J is numerically singular (then the errors stay -1). */
+** weighted residuals (cf_ident_canon_many); the correlation matrix (NAN where not determined).
+** Returns 1 when J^T J is numerically singular (then the errors stay -1). */
 int cf_fit_stage_a_errors(fit_ctx *c, const double v[3], double se[3], double corr[3][3])
 {
     se[0] = se[1] = se[2] = -1;
