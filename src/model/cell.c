@@ -248,6 +248,8 @@ static double next_stretch(bracket *b, double a, double r, double g)
     else
         b->hi = a, b->have_hi = 1;
     double an = a - r / g;
+    if (g > 0 && fabs(an - a) <= 2 * DBL_EPSILON * fabs(a))
+        return an; /* converged to rounding: a step that does not move a is no reason to bisect */
     if (!(g > 0) || !(an > b->lo && an < b->hi)) {
         if (b->have_lo && b->have_hi)
             an = 0.5 * (b->lo + b->hi);
