@@ -91,6 +91,18 @@ double cf_fit_model(const cf_law *law, int force_displacement, double x)
     return cf_law_force(law, CF_LAW_CLOSED, x * H, NULL, NULL) / (H * H);
 }
 
+void cf_fit_model_many(const cf_law *law, int force_displacement, size_t count, const double *x,
+                       double *out)
+{
+    const double H = force_displacement ? 1.0 : law->p.H_mm;
+    for (size_t i = 0; i < count; i++)
+        out[i] = x[i] * H;
+    cf_law_force_many(law, CF_LAW_CLOSED, count, out, out, NULL);
+    if (!force_displacement)
+        for (size_t i = 0; i < count; i++)
+            out[i] /= H * H;
+}
+
 /* ---- the checks and the working state -------------------------------------------------------- */
 
 /* The smallest largest |y| (MPa or N) and |x| (strain or mm) of a table, and the range of its
@@ -194,8 +206,7 @@ static void summarise(fit_ctx *c, const double *p, cf_fit_result *res)
     res->params = from_array(p);
     cf_law_init(&res->law, &res->params, NULL);
     res->ident = cf_ident_of_type(&res->params, c->type, c->fd);
-    for (size_t i = 0; i < c->n; i++)
-        c->model[i] = cf_fit_model(&res->law, c->fd, c->data->x[i]);
+    cf_fit_model_many(&res->law, c->fd, c->n, c->data->x, c->model);
     cf_lsq_quality q = cf_lsq_quality_of(c->data, c->model);
     res->rss = q.rss;
     res->rmse = q.rmse;
@@ -225,11 +236,13 @@ static cf_status ctx_setup(fit_ctx *c, const cf_table *data, const cf_fit_option
     c->fd = cf_table_is_force(data);
     c->n = data->count;
     /* one block: the residual weights, then the model's values at the points (summarise, and
-    ** scratch for cf_fit_rss_at) */
-    c->sw = malloc(2 * sizeof(double) * c->n);
+    ** scratch for the stages) and the canonical law's two derivatives (stage A's Jacobian) */
+    c->sw = malloc(4 * sizeof(double) * c->n);
     if (!c->sw)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", c->n);
     c->model = c->sw + c->n;
+    c->gt = c->model + c->n;
+    c->gr = c->gt + c->n;
     c->ynorm = cf_lsq_weights(data, opt->relative, c->sw);
     c->xmax = cf_lsq_xmax(data);
     int nfixed = 0;
@@ -338,14 +351,28 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
         return st;
     }
     fit_ctx *g = long_table ? &sc : &c;
+    /* the local searches on the table's own rows stop at the statistical tolerance (fit_ctx.h);
+    ** a long table's searches on its subsample keep the strict rule (with the tolerance the
+    ** subsample's optimum moved enough to end 0.07 s^2 short on a ridge of a limit) */
+    c.stat_tol = LONG_TOL / (double)(c.n - 3); /* c.n >= 4 (check_data) */
     /* Stage A: the identifiable quantities, over every spring, then under the type's limits when
     ** the optimum lies outside them. */
     double v[3] = {0.5, 0.5 * (c.b_lo + c.b_hi), 1.0};
     start4 found[STAGE_A_RUNS];
     int nfound = 0;
     cf_fit_stage_a(g, v, long_table ? found : NULL, &nfound);
-    if (long_table)
+    if (long_table) {
         cf_fit_stage_a_polish(&c, found, nfound, v);
+    } else {
+        /* the starts stopped at the statistical tolerance; the best is polished to the strict
+        ** rule, so that a short table's fit is its optimum to rounding */
+        double w[3];
+        const double tol = c.stat_tol;
+        c.stat_tol = 0;
+        if (cf_fit_lm_run(&c, v[0], v[1], v[2], w) < CF_LSQ_HUGE_OBJ)
+            memcpy(v, w, sizeof w);
+        c.stat_tol = tol;
+    }
     unsigned held_a = 0; /* the limits that keep the type from stage A's optimum */
     if (c.region) {
         region r = cf_fit_region_at(&c, v[0], v[1]);
@@ -374,6 +401,8 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
     ** stress-strain table (c.region) the six parameters reach the model only through the three
     ** quantities that stage A fitted on every row, so the polish there can move the objective by
     ** rounding only (1e-14 of it on the shipped tables) and a long table skips its full pass. */
+    if (!long_table)
+        c.stat_tol = 0; /* stage C on a short table: to the optimiser's own tolerances */
     gsl_rng *rng = cf_fit_seeded_rng(opt->seed, 2);
     c.oom |= !rng;
     int starts = 1;

@@ -58,9 +58,10 @@ double cf_fit_rss_at(fit_ctx *c, double rho, double B, double A_fixed, double A_
     *A_out = A_fixed;
     if (!(B > 0) || cf_ident_canon_law(rho, &canon) != CF_OK)
         return CF_LSQ_HUGE_OBJ;
+    cf_ident_canon_many(&canon, B, c->n, c->data->x, c->model, NULL, NULL);
     double sgy = 0, sgg = 0;
     for (size_t i = 0; i < c->n; i++) {
-        double g = c->sw[i] * cf_ident_reduced(&canon, 1.0, B, c->data->x[i], NULL);
+        double g = c->sw[i] * c->model[i];
         c->model[i] = g;
         sgy += g * c->sw[i] * c->data->y[i];
         sgg += g * g;

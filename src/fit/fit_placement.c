@@ -26,9 +26,10 @@ double cf_fit_objective6(fit_ctx *c, const double *p)
     cf_law law;
     if (cf_law_init(&law, &s, NULL) != CF_OK)
         return CF_LSQ_HUGE_OBJ;
+    cf_fit_model_many(&law, c->fd, c->n, c->data->x, c->model);
     double sum = 0;
     for (size_t i = 0; i < c->n; i++) {
-        double r = c->sw[i] * (cf_fit_model(&law, c->fd, c->data->x[i]) - c->data->y[i]);
+        double r = c->sw[i] * (c->model[i] - c->data->y[i]);
         sum += r * r;
     }
     c->evals++;
@@ -158,6 +159,8 @@ void cf_fit_nl_run(fit_ctx *c, nlopt_algorithm alg, zfun obj, int equalities, do
     }
     nlopt_set_xtol_rel(o, c->opt->xtol_rel);
     nlopt_set_ftol_abs(o, 1e-16);
+    if (c->stat_tol > 0)
+        nlopt_set_ftol_rel(o, c->stat_tol);
     if (obj == cf_fit_z_objective) /* a fit at rounding level cannot be polished further */
         nlopt_set_stopval(o, LM_FLOOR_REL);
     nlopt_set_maxeval(o, maxeval);

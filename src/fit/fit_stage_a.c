@@ -19,6 +19,7 @@
 #include "fit/fit_ctx.h"
 #include "fit/lm.h"
 #include "fit/lsq.h"
+#include "fit/subsample.h"
 
 /* The fit's random numbers: GSL's mt19937 (the generator conifit uses everywhere), one stream
 ** per use, seeded from the fit's seed, local to one call (no shared state between threads). */
@@ -38,40 +39,16 @@ double cf_fit_jitter(gsl_rng *r)
 
 static double sigmoid(double t) { return 1.0 / (1.0 + exp(-t)); }
 
-/* The canonical law g(t) = F/F_C at t = u/s and its derivatives dg/dt and dg/drho, analytic:
-** region 1: g = h(rho) t, h = 4 rho^3/((1 + rho)(1 + rho^2));
-** region 2: g = y^3 with y^4 - 4 c y + 3 = 0, c = (1 - |t|)/rho + |t|, so dy/dc = y/(y^3 - c)
-** and dc/drho = -(1 - |t|)/rho^2; past solid g = +-1 with zero derivatives. */
-static double canon_eval(const cf_law *canon, double t, double *dg_dt, double *dg_drho)
-{
-    int flags = 0;
-    double k;
-    double g = cf_law_force(canon, CF_LAW_CLOSED, t, &k, &flags);
-    const double rho = canon->rho, a = fabs(t), sg = t < 0 ? -1.0 : 1.0;
-    *dg_dt = k;
-    if (flags & CF_LAW_SOLID) {
-        *dg_drho = 0;
-    } else if (flags & CF_LAW_LINEAR) {
-        double h = 4 * rho * rho * rho / ((1 + rho) * (1 + rho * rho));
-        *dg_drho = t * h * (3 / rho - 1 / (1 + rho) - 2 * rho / (1 + rho * rho));
-    } else {
-        double y = cbrt(fabs(g));
-        double c = (1 - a) / rho + a;
-        double den = y * y * y - c;
-        *dg_drho = den < 0 ? sg * 3 * y * y * (y / den) * (-(1 - a) / (rho * rho)) : 0.0;
-    }
-    return g;
-}
-
 /* Weighted objective of the reduced model with the load scale A solved in closed form. */
 static double reduced_profile(fit_ctx *c, double rho, double B, double *A_out)
 {
     cf_law canon;
     if (cf_ident_canon_law(rho, &canon) != CF_OK)
         return CF_LSQ_HUGE_OBJ;
+    cf_ident_canon_many(&canon, B, c->n, c->data->x, c->model, NULL, NULL);
     double sgy = 0, sgg = 0, syy = 0;
     for (size_t i = 0; i < c->n; i++) {
-        double g = c->sw[i] * cf_ident_reduced(&canon, 1.0, B, c->data->x[i], NULL);
+        double g = c->sw[i] * c->model[i];
         double y = c->sw[i] * c->data->y[i];
         sgy += g * y;
         sgg += g * g;
@@ -116,10 +93,9 @@ static int lm_f(const gsl_vector *th, void *params, gsl_vector *f)
     /* residuals scaled so that the zero model has |f| = 1: GSL's gradient test is absolute
     ** below |f| = 1, which would stop early on tables in MPa of tissue (tiny numbers) */
     const double sc = 1.0 / sqrt(c->ynorm);
+    cf_ident_canon_many(&canon, B, c->n, c->data->x, c->model, NULL, NULL);
     for (size_t i = 0; i < c->n; i++)
-        gsl_vector_set(f, i, sc * c->sw[i] *
-                                 (cf_ident_reduced(&canon, A, B, c->data->x[i], NULL) -
-                                  c->data->y[i]));
+        gsl_vector_set(f, i, sc * c->sw[i] * (A * c->model[i] - c->data->y[i]));
     c->evals++;
     return GSL_SUCCESS;
 }
@@ -136,13 +112,13 @@ static int lm_df(const gsl_vector *th, void *params, gsl_matrix *J)
     const double drho = (c->rho_hi - c->rho_lo) * s0 * (1 - s0);
     const double dB = (c->b_hi - c->b_lo) * s1 * (1 - s1);
     const double sc = 1.0 / sqrt(c->ynorm);
+    cf_ident_canon_many(&canon, B, c->n, c->data->x, c->model, c->gt, c->gr);
     for (size_t i = 0; i < c->n; i++) {
-        double t = c->data->x[i] / B, gt, gr;
-        double g = canon_eval(&canon, t, &gt, &gr);
+        double t = c->data->x[i] / B;
         double w = sc * c->sw[i];
-        gsl_matrix_set(J, i, 0, w * A * gr * drho);
-        gsl_matrix_set(J, i, 1, w * (-A * gt * t / B) * dB);
-        gsl_matrix_set(J, i, 2, w * A * g);
+        gsl_matrix_set(J, i, 0, w * A * c->gr[i] * drho);
+        gsl_matrix_set(J, i, 1, w * (-A * c->gt[i] * t / B) * dB);
+        gsl_matrix_set(J, i, 2, w * A * c->model[i]);
     }
     c->evals++;
     return GSL_SUCCESS;
@@ -152,6 +128,8 @@ double cf_fit_lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3
 {
     gsl_multifit_nlinear_parameters fp = cf_lm_parameters();
     fp.fdtype = GSL_MULTIFIT_NLINEAR_CTRDIFF;
+    if (c->n > CF_SUBSAMPLE_ROWS) /* every row of a long table: the normal equations, not a QR */
+        fp.solver = gsl_multifit_nlinear_solver_cholesky;
     gsl_multifit_nlinear_fdf fdf;
     memset(&fdf, 0, sizeof fdf);
     fdf.f = lm_f;
@@ -173,8 +151,11 @@ double cf_fit_lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3
     if (ist == GSL_SUCCESS) {
         /* an optimum on a bound of rho or of the length scale lies at infinity in the logit
         ** coordinates: the stall rule stops there (residuals are scaled by 1/sqrt(ynorm)) */
-        static const cf_lm_stop stop = {LM_MAX_ITER, 1e-15, 1e-15, 1e-15,
-                                        LM_STALL,    LM_STALL_REL, LM_FLOOR_REL};
+        cf_lm_stop stop = {LM_MAX_ITER, 1e-15, 1e-15, 1e-15, LM_STALL, LM_STALL_REL, LM_FLOOR_REL};
+        if (c->stat_tol > 0) {
+            stop.stall = LM_STALL_LONG;
+            stop.stall_rel = c->stat_tol;
+        }
         if (cf_lm_iterate(w, &stop) != 0)
             c->oom = 1;
         gsl_vector *f = gsl_multifit_nlinear_residual(w);
@@ -297,8 +278,8 @@ double cf_fit_stage_a(fit_ctx *c, double best3[3], start4 *found, int *nfound)
 }
 
 /* Standard errors of (rho, B, A) at a solution: s^2 (J^T J)^-1 with the analytic Jacobian of the
-** weighted residuals (canon_eval); the correlation matrix (NAN where not determined). Returns 1
-** when J^T J is numerically singular (then the errors stay -1). */
+** weighted residuals (cf_ident_canon_many); the correlation matrix (NAN where not determined).
+** Returns 1 when J^T J is numerically singular (then the errors stay -1). */
 int cf_fit_stage_a_errors(fit_ctx *c, const double v[3], double se[3], double corr[3][3])
 {
     se[0] = se[1] = se[2] = -1;
@@ -318,11 +299,11 @@ int cf_fit_stage_a_errors(fit_ctx *c, const double v[3], double se[3], double co
         goto done;
     }
     double rss = 0;
+    cf_ident_canon_many(&lc, B, c->n, c->data->x, c->model, c->gt, c->gr);
     for (size_t i = 0; i < c->n; i++) {
-        double x = c->data->x[i], gt, gr;
-        double g = canon_eval(&lc, x / B, &gt, &gr);
+        double x = c->data->x[i], g = c->model[i];
         double m = A * g;
-        double row[3] = {A * gr, -A * gt * x / (B * B), g};
+        double row[3] = {A * c->gr[i], -A * c->gt[i] * x / (B * B), g};
         double r = c->sw[i] * (m - c->data->y[i]);
         rss += r * r;
         for (int a = 0; a < 3; a++)

@@ -84,6 +84,7 @@ static cf_status evaluate(const cf_cell *c, const double F[9], const cf_cell_ext
 {
     const cf_law *law = c->law;
     const double H = law->p.H_mm, H3 = H * H * H;
+    double P[3][3] = {{0}}; /* summed here, not through s (no store and reload per term) */
     memset(s->P_MPa, 0, sizeof s->P_MPa);
     memcpy(s->F, F, sizeof s->F);
     s->max_u_over_travel = 0;
@@ -126,10 +127,12 @@ static cf_status evaluate(const cf_cell *c, const double F[9], const cf_cell_ext
         s->L_mm[d] = L;
         s->T_N[d] = T;
         kT[d] = dT;
+        const double q = T / (L * H3); /* one division per spring, not one per term */
         for (int i = 0; i < 3; i++)
             for (int j = 0; j < 3; j++)
-                s->P_MPa[i][j] += T * xv[i] * X[j] / (L * H3);
+                P[i][j] += q * xv[i] * X[j];
     }
+    memcpy(s->P_MPa, P, sizeof P);
     return CF_OK;
 }
 
@@ -245,6 +248,8 @@ static double next_stretch(bracket *b, double a, double r, double g)
     else
         b->hi = a, b->have_hi = 1;
     double an = a - r / g;
+    if (g > 0 && fabs(an - a) <= 2 * DBL_EPSILON * fabs(a))
+        return an; /* converged to rounding: a step that does not move a is no reason to bisect */
     if (!(g > 0) || !(an > b->lo && an < b->hi)) {
         if (b->have_lo && b->have_hi)
             an = 0.5 * (b->lo + b->hi);

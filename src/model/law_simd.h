@@ -146,9 +146,10 @@ CF_LANE double cf_lane_rsqrt(double x)
     return r + r * e * (0.5 + e * 0.375);
 }
 
-CF_LANE double cf_lane_closed(const cf_law_lanes *c, double u)
+/* Region 2's root y (F = F_C y^3) at a = |u| for every lane whatever its region (the caller
+** selects): past solid delta is 0 and y 1. */
+CF_LANE double cf_lane_closed_y(const cf_law_lanes *c, double a)
 {
-    const double a = fabs(u);
     const double sa = c->s - a;
     const double delta = c->rim1 * ((sa > 0.0 ? sa : 0.0) * c->inv_s);
     const double cc = 1.0 + delta;
@@ -176,8 +177,13 @@ CF_LANE double cf_lane_closed(const cf_law_lanes *c, double u)
     const double Q = 2.0 * M_SQRT2 * cc * rm + m * m;
     const double P0 = 12.0 * (dd - 0.5 * mu) * Q;
     const double P = P0 > 0.0 ? P0 : 0.0;
-    const double y =
-        6.0 * rm * Q / ((m * rm + M_SQRT2 * cc) * (M_SQRT2 * rm * Q + P * cf_lane_rsqrt(P)));
+    return 6.0 * rm * Q / ((m * rm + M_SQRT2 * cc) * (M_SQRT2 * rm * Q + P * cf_lane_rsqrt(P)));
+}
+
+CF_LANE double cf_lane_closed(const cf_law_lanes *c, double u)
+{
+    const double a = fabs(u);
+    const double y = cf_lane_closed_y(c, a);
     return cf_lane_regions(c, u, a, c->F_C * y * y * y);
 }
 

@@ -159,7 +159,8 @@ int main(int argc, char **argv)
                     {"lattice calibration and the homogenised cell", bench_section_calibration},
                     {"viscoelastic fit", bench_section_visco},
                     {"statics at scale", bench_section_statics},
-                    {"long tables", bench_section_longfit}};
+                    {"long tables", bench_section_longfit},
+                    {"fits at the cost of the law", bench_section_fastfit}};
     const int nsec = (int)(sizeof sections / sizeof sections[0]);
     for (int k = 0; k < nsec; k++) {
         if (only && !strstr(sections[k].what, only))

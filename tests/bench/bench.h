@@ -28,7 +28,7 @@ typedef struct bench_target {
     int met; /* 1 met, 0 not met, -1 not measured */
 } bench_target;
 
-#define BENCH_MAX_TARGETS 24
+#define BENCH_MAX_TARGETS 32
 
 typedef struct bench_ctx {
     FILE *md;              /* the Markdown report */
@@ -55,6 +55,20 @@ FILE *bench_open_data(const bench_ctx *ctx, const char *name);
 /* Runs fn(arg) in a forked child; the child's peak resident set (ru_maxrss, KiB), -1 on failure. */
 long bench_child_maxrss_kb(void (*fn)(void *), void *arg);
 
+/* CPU time of this process, s: on a shared machine the wall time of a one-core run grows with
+** the load, its CPU time does not. */
+double bench_cpu_now(void);
+
+/* Runs argv (argv[0] is the program path) with stdout and stderr to /dev/null and waits for it;
+** *ru receives its resources. 0 when it exited with status 0, else -1. */
+struct rusage;
+int bench_exec(char *const argv[], struct rusage *ru);
+
+/* Writes a CSV table "strain,stress_kPa" of n rows, strain evenly from 0 to xmax, stress
+** scale (curve(strain) + Gaussian noise of sd noise_sd, seed 1). 0 on success. */
+int bench_write_table(const char *path, size_t n, double xmax, double noise_sd, double scale,
+                      double (*curve)(double x, const void *arg), const void *arg);
+
 /* Sink that keeps the compiler from discarding benchmark work. */
 extern volatile double bench_sink;
 
@@ -70,5 +84,6 @@ void bench_section_visco(bench_ctx *ctx);
 void bench_section_statics(bench_ctx *ctx);
 void bench_statics_early(bench_ctx *ctx);
 void bench_section_longfit(bench_ctx *ctx);
+void bench_section_fastfit(bench_ctx *ctx);
 
 #endif

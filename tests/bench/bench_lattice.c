@@ -146,6 +146,13 @@ static void stencil_lin_free(stencil_lin *sl)
 
 /* Compiled like conifit's step (lattice_step.c), so that the ratios compare like with like: for
 ** each instruction set of its dispatch, loops vectorised, multiply-adds contracted. */
+#ifndef CF_DISPATCH
+#if CF_SIMD_MULTI
+#define CF_DISPATCH __attribute__((target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")))
+#else
+#define CF_DISPATCH
+#endif
+#endif
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC push_options
 #pragma GCC optimize("fp-contract=fast")

@@ -9,11 +9,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
-
-#include <gsl/gsl_randist.h>
-#include <gsl/gsl_rng.h>
 
 #include "bench.h"
 #include "conifit/baseline.h"
@@ -24,41 +20,22 @@
 /* Writes the table of the spring 8/20 mm, 2.5 coils, wire 2 mm, G 100 MPa, H 5 mm (telescoping,
 ** rho 0.4) with 1 % Gaussian noise, n rows from strain 0 to 0.95 of the solid strain, as
 ** `conifit synth --points n --noise 0.01` does. 0 on success. */
+static double spring_stress(double x, const void *arg)
+{
+    const cf_law *law = arg;
+    const double H = law->p.H_mm;
+    return cf_law_force(law, CF_LAW_EXACT, x * H, NULL, NULL) / (H * H);
+}
+
 static int write_table(const char *path, size_t n)
 {
     const cf_spring p = {8, 20, 2.5, 2, 100, 5};
     cf_law law;
     if (cf_law_init(&law, &p, NULL) != CF_OK)
         return -1;
-    FILE *f = fopen(path, "w");
-    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
-    if (!f || !r) {
-        if (f)
-            fclose(f);
-        gsl_rng_free(r);
-        return -1;
-    }
-    gsl_rng_set(r, 1);
     double smax = 0.95 * law.travel_mm / p.H_mm;
     double ymax = law.F_C_N / (p.H_mm * p.H_mm);
-    fprintf(f, "strain,stress_kPa\n");
-    for (size_t i = 0; i < n; i++) {
-        double x = smax * (double)i / (double)(n - 1);
-        double y = cf_law_force(&law, CF_LAW_EXACT, x * p.H_mm, NULL, NULL) / (p.H_mm * p.H_mm);
-        y += gsl_ran_gaussian(r, 0.01 * ymax);
-        fprintf(f, "%.17g,%.17g\n", x, 1e3 * y);
-    }
-    gsl_rng_free(r);
-    return fclose(f) == 0 ? 0 : -1;
-}
-
-/* CPU time of this process, s: on a shared machine the wall time of a one-core run grows with
-** the load, its CPU time does not. */
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    return bench_write_table(path, n, smax, 0.01 * ymax, 1e3, spring_stress, &law);
 }
 
 typedef struct long_run {
@@ -77,7 +54,7 @@ static int run_once(const char *path, size_t subsample_above, long_run *out)
     double t0 = bench_now();
     if (cf_measure_load(path, &mo, &t, &err) != CF_OK)
         return -1;
-    double t1 = bench_now(), c1 = cpu_now();
+    double t1 = bench_now(), c1 = bench_cpu_now();
     cf_fit_options o = cf_fit_default_options();
     o.subsample_above = subsample_above;
     out->evals = out->evals_full = 0;
@@ -97,7 +74,7 @@ static int run_once(const char *path, size_t subsample_above, long_run *out)
         ok = cf_baseline_fit_all(&t, b, NULL) == CF_OK;
     out->read_s = t1 - t0;
     out->fit_s = bench_now() - t1;
-    out->fit_cpu_s = cpu_now() - c1;
+    out->fit_cpu_s = bench_cpu_now() - c1;
     cf_table_free(&t);
     return ok ? 0 : -1;
 }

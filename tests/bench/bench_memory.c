@@ -59,21 +59,8 @@ long bench_child_maxrss_kb(void (*fn)(void *), void *arg)
 ** KiB, or -1 when it could not run or failed. */
 static long exec_maxrss_kb(char *const argv[])
 {
-    fflush(NULL);
-    pid_t pid = fork();
-    if (pid < 0)
-        return -1;
-    if (pid == 0) {
-        if (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr))
-            _exit(127);
-        execv(argv[0], argv);
-        _exit(127);
-    }
-    int status;
     struct rusage ru;
-    if (wait4(pid, &status, 0, &ru) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
-        return -1;
-    return ru.ru_maxrss;
+    return bench_exec(argv, &ru) == 0 ? ru.ru_maxrss : -1;
 }
 
 static long median_maxrss(char *const argv[], int repeats)

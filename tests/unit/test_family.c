@@ -3,11 +3,14 @@
 ** agree; a member built from a family belongs to it; the force-displacement scales are the
 ** stress-strain ones times H and H^2 and the law's own travel and solid load; the wire modulus
 ** of a solid load inverts the family's load scale; the family's reduced curve is the member's
-** law; the design limits in the family's space at points worked out by hand.
+** law, and its vectorised evaluation (with the derivatives the fits' Jacobians use) is the scalar
+** one, as the six-parameter model over many points is; the design limits in the family's space
+** at points worked out by hand.
 */
 #include "testutil.h"
 
 #include "conifit/family.h"
+#include "conifit/fit.h"
 #include "conifit/law.h"
 
 static void named_and_indexed_views_agree(void **state)
@@ -92,6 +95,81 @@ static void the_reduced_curve_is_the_member_law(void **state)
     cf_law_free(&canon);
 }
 
+/* The vectorised canonical law (cf_ident_canon_many, the fits' hot path) against the scalar
+** closed form point by point, and its derivatives in t and rho against central differences of
+** that scalar law: every region, both signs, points a hair from solid and from the transition,
+** and a NaN. */
+static void the_vectorised_canonical_law_is_the_scalar_one(void **state)
+{
+    (void)state;
+    const double rhos[] = {0.06, 0.2, 0.45, 0.8, 0.97};
+    enum { N = 403 };
+    double x[N], g[N], gt[N], gr[N], g0[N];
+    for (size_t r = 0; r < sizeof rhos / sizeof rhos[0]; r++) {
+        const double rho = rhos[r], B = 0.7;
+        cf_law canon;
+        assert_int_equal(cf_ident_canon_law(rho, &canon), CF_OK);
+        for (int i = 0; i < N - 3; i++)
+            x[i] = B * (-1.1 + 2.2 * i / (N - 4.0));
+        x[N - 3] = B * (1 - 1e-9);   /* next to solid */
+        x[N - 2] = B * canon.u_T_mm * (1 + 1e-9); /* just past the transition */
+        x[N - 1] = NAN;
+        cf_ident_canon_many(&canon, B, N, x, g0, NULL, NULL);
+        cf_ident_canon_many(&canon, B, N, x, g, gt, gr);
+        for (int i = 0; i < N; i++) {
+            if (isnan(x[i])) {
+                assert_true(g[i] == 0 && gt[i] == 0 && gr[i] == 0 && g0[i] == 0);
+                continue;
+            }
+            const double t = x[i] / B;
+            const double ref = cf_law_force(&canon, CF_LAW_CLOSED, t, NULL, NULL);
+            assert_close(g[i], ref, 1e-14);
+            assert_close(g0[i], ref, 1e-14);
+            double k;
+            cf_law_force(&canon, CF_LAW_CLOSED, t, &k, NULL);
+            assert_close(gt[i], k, 1e-9 * fmax(1.0, k));
+            const double a = fabs(t);
+            if (a >= 1 || fabs(a - canon.u_T_mm) < 1e-3 || 1 - a < 1e-3)
+                continue; /* central differences straddle a region boundary */
+            const double h = 1e-6;
+            cf_law lp, lm;
+            assert_int_equal(cf_ident_canon_law(rho + h, &lp), CF_OK);
+            assert_int_equal(cf_ident_canon_law(rho - h, &lm), CF_OK);
+            const double num = (cf_law_force(&lp, CF_LAW_CLOSED, t, NULL, NULL) -
+                                cf_law_force(&lm, CF_LAW_CLOSED, t, NULL, NULL)) /
+                               (2 * h);
+            assert_close(gr[i], num, 1e-6 * fmax(1.0, fabs(num)));
+            cf_law_free(&lp);
+            cf_law_free(&lm);
+        }
+        cf_law_free(&canon);
+    }
+}
+
+/* The six-parameter model over many points (the fits' objective) is the scalar one. */
+static void the_vectorised_model_is_the_scalar_one(void **state)
+{
+    (void)state;
+    const cf_spring springs[2] = {{8, 20, 2.5, 2, 100, 5}, {3, 9, 6, 0.8, 8e4, 30}};
+    enum { N = 257 };
+    double x[N], y[N];
+    for (int s = 0; s < 2; s++) {
+        cf_law law;
+        assert_int_equal(cf_law_init(&law, &springs[s], NULL), CF_OK);
+        for (int fd = 0; fd < 2; fd++) {
+            const double xmax = fd ? law.travel_mm : law.travel_mm / springs[s].H_mm;
+            for (int i = 0; i < N; i++)
+                x[i] = xmax * (-1.05 + 2.1 * i / (N - 1.0));
+            cf_fit_model_many(&law, fd, N, x, y);
+            for (int i = 0; i < N; i++) {
+                const double ref = cf_fit_model(&law, fd, x[i]);
+                assert_close(y[i], ref, 1e-13 * fmax(fabs(ref), 1e-300) + 1e-300);
+            }
+        }
+        cf_law_free(&law);
+    }
+}
+
 static void the_design_limits_at_points_worked_by_hand(void **state)
 {
     (void)state;
@@ -131,6 +209,8 @@ int main(void)
         cmocka_unit_test(a_member_belongs_to_its_family),
         cmocka_unit_test(force_scales_are_the_stress_scales_times_H),
         cmocka_unit_test(the_reduced_curve_is_the_member_law),
+        cmocka_unit_test(the_vectorised_canonical_law_is_the_scalar_one),
+        cmocka_unit_test(the_vectorised_model_is_the_scalar_one),
         cmocka_unit_test(the_design_limits_at_points_worked_by_hand),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -103,7 +103,8 @@ static void subsample_keeps_range_scale_and_total_weight(void **state)
 }
 
 /* The fit of a long table against the search on every row (subsample_above = 0), with few
-** passes over every row. tol_ident > 0: the same quantities (to that relative tolerance),
+** passes over every row. tol_ident > 0: the same quantities (to that relative tolerance, or a
+** twentieth of their standard error),
 ** standard errors and quality. tol_ident = 0: a table that leaves quantities open or holds them on
 ** a limit, where the optimum is a flat valley or a ridge on the limit: the objectives differ by
 ** far less than the F-test can tell apart (1 % of its threshold) and the same quantities get
@@ -125,7 +126,7 @@ static void assert_same_fit(const cf_table *t, const cf_fit_options *base, cf_sp
                   "RMSE %.9g (%.9g)\n",
                   t->count, a.evaluations_full, b.evaluations_full, a.rmse, b.rmse);
     assert_true(a.evaluations_full < a.evaluations);
-    assert_true(a.evaluations_full <= 400);
+    assert_true(a.evaluations_full <= 600); /* measured: 16 to 493 */
     assert_int_equal(a.feasible, b.feasible);
     cf_fit_verdict v = cf_fit_compare(&a, &b, t->count);
     assert_true(isfinite(v.threshold) && v.threshold > 0);
@@ -137,7 +138,10 @@ static void assert_same_fit(const cf_table *t, const cf_fit_options *base, cf_sp
     assert_int_equal(a.held, b.held);
     assert_close(a.rmse, b.rmse, 1e-9 * b.rmse);
     for (int k = 0; k < 3; k++) {
-        assert_close(a.ident.v[k], b.ident.v[k], tol_ident * b.ident.v[k]);
+        /* the polish on every row stops at a statistical tolerance (fit_ctx.h, LONG_TOL): within
+        ** a twentieth of the standard error where that is larger than tol_ident */
+        assert_close(a.ident.v[k], b.ident.v[k],
+                     fmax(tol_ident * b.ident.v[k], 0.05 * b.ident_se.v[k]));
         assert_true((a.ident_se.v[k] < 0) == (b.ident_se.v[k] < 0));
         if (b.ident_se.v[k] > 0)
             assert_close(a.ident_se.v[k], b.ident_se.v[k], 1e-4 * b.ident_se.v[k]);
@@ -189,6 +193,36 @@ static void long_table_with_a_fixed_parameter_fits_as_the_search_on_every_row(vo
     o.fixed[CF_P_H] = 1;
     o.fixed_value[CF_P_H] = 5;
     assert_same_fit(&t, &o, CF_TELESCOPING, 1e-5);
+    cf_table_free(&t);
+}
+
+/* A table just past the subsample's size that is no conical spring (stress 3e + 40e^3 kPa, 1 %
+** noise, strain to 0.3), as a testing machine writes one: both types fit as the search on every
+** row does (the objective within 1 % of the F-test's threshold, the same intervals). */
+static void table_past_the_subsample_size_fits_as_the_search_on_every_row(void **state)
+{
+    (void)state;
+    enum { N = 1500 };
+    double *x = malloc(N * sizeof *x), *y = malloc(N * sizeof *y);
+    assert_non_null(x);
+    assert_non_null(y);
+    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+    assert_non_null(r);
+    gsl_rng_set(r, 3);
+    for (int i = 0; i < N; i++) {
+        x[i] = 0.3 * i / (N - 1.0);
+        y[i] = 1e-3 * (3 * x[i] + 40 * x[i] * x[i] * x[i]) + gsl_ran_gaussian(r, 1e-3 * 0.0198);
+    }
+    gsl_rng_free(r);
+    cf_table t;
+    cf_error err = {0};
+    assert_int_equal(cf_table_from_arrays(CF_TABLE_STRESS_STRAIN, N, x, y, NULL, &t, &err), CF_OK);
+    free(x);
+    free(y);
+    cf_fit_options o = cf_fit_default_options();
+    assert_true(t.count > o.subsample_above);
+    assert_same_fit(&t, &o, CF_TELESCOPING, 0);
+    assert_same_fit(&t, &o, CF_NON_TELESCOPING, 0);
     cf_table_free(&t);
 }
 
@@ -258,6 +292,7 @@ int main(void)
         cmocka_unit_test(long_table_held_by_a_limit_fits_as_the_search_on_every_row),
         cmocka_unit_test(long_table_with_a_fixed_parameter_fits_as_the_search_on_every_row),
         cmocka_unit_test(long_table_with_open_quantities_fits_as_the_search_on_every_row),
+        cmocka_unit_test(table_past_the_subsample_size_fits_as_the_search_on_every_row),
         cmocka_unit_test(long_table_fung_baseline_is_the_minimum_of_the_full_scan),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -111,4 +111,11 @@ cf_status cf_ident_canon_law(double rho, cf_law *law);
 ** scale and B the length scale; *dB (if not NULL) receives its derivative in B. */
 double cf_ident_reduced(const cf_law *canon, double A, double B, double x, double *dB);
 
+/* The canonical law canon (of rho) at t = x[i]/B for count points, vectorised: g[i] = g(t) and,
+** when dg_dt and dg_drho are both given, its derivatives in t and in rho (region 1 linear,
+** region 3 constant, NaN gives 0). The closed form of the lattice's step (law_simd.h): g agrees
+** with cf_law_force(canon, CF_LAW_CLOSED, t) to a few ulps, not bit for bit. g may not alias x. */
+void cf_ident_canon_many(const cf_law *canon, double B, size_t count, const double *x, double *g,
+                         double *dg_dt, double *dg_drho);
+
 #endif

@@ -97,8 +97,10 @@ typedef struct cf_fit_options {
                                     ** CF_FIT_SUBSAMPLE_ABOVE; the baselines use the same) */
 } cf_fit_options;
 
-/* Tables up to this many rows are searched on every row (every shipped and published table). */
-#define CF_FIT_SUBSAMPLE_ABOVE 2000
+/* Tables up to this many rows are searched on every row; a longer one on its subsample of as many
+** rows (subsample.h), so that the searches cost the same at every length above it and a table
+** just past it costs no more than a longer one. */
+#define CF_FIT_SUBSAMPLE_ABOVE 1000
 
 cf_fit_options cf_fit_default_options(void);
 
@@ -180,6 +182,11 @@ cf_fit_verdict cf_fit_compare(const cf_fit_result *a, const cf_fit_result *b, si
 
 /* Evaluates the model (stress in MPa, or force in N) of spring p at x. */
 double cf_fit_model(const cf_law *law, int force_displacement, double x);
+
+/* cf_fit_model at count points x into out (which may not alias x), vectorised (the lanes of
+** cf_law_force_many): equal to it within a few ulps. */
+void cf_fit_model_many(const cf_law *law, int force_displacement, size_t count, const double *x,
+                       double *out);
 
 /* Checks the constraints of options/type/data at p: fills *active and *violated (CF_C_* bits) and
 ** returns 1 when feasible. */

@@ -1,0 +1,79 @@
+/*
+** The family's canonical law over many points at once (see family.h, cf_ident_canon_many): the
+** closed form of law_simd.h in vector lanes, with the derivatives the fits' Jacobians need.
+*/
+#include "conifit/family.h"
+
+#include "model/law_simd.h"
+
+/* What every lane of one call shares: the canonical law's lanes and its constants. */
+typedef struct canon_consts {
+    cf_law_lanes l;
+    double inv_B;  /* 1/B: t = x/B */
+    double h;      /* region 1's slope g = h t */
+    double h_rho;  /* its derivative in rho over h */
+    double inv_r2; /* 1/rho^2 */
+} canon_consts;
+
+/* g(t) and, in region 2, dg/dt and dg/drho from the root y = 1 - e of y^4 - 4 c y + 3 = 0,
+** c = 1 + delta, delta = (1/rho - 1)(1 - |t|): dg/dc = -4 y^4/(e (1 + y)(1 + y^2)), the
+** denominator being 4 y (c - y^3)/3 without cancellation once e is polished by one Newton step
+** on e^2 (6 - 4e + e^2) = 4 delta (1 - e) (the relative digits of e, which 1 - y loses near
+** solid). Region 1 is linear, region 3 (|t| >= 1) constant; NaN gives 0. */
+CF_LANE void canon_lane(const canon_consts *k, double x, double *g, double *gt, double *gr)
+{
+    const double t = x * k->inv_B, a = fabs(t);
+    const double y = cf_lane_closed_y(&k->l, a);
+    const double one_a = 1.0 - a;
+    const double delta = k->l.rim1 * (one_a > 0.0 ? one_a : 0.0);
+    double e = 1.0 - y;
+    const double f = e * e * (6.0 + e * (-4.0 + e)) - 4.0 * delta * (1.0 - e);
+    const double fp = e * (12.0 + e * (-12.0 + 4.0 * e)) + 4.0 * delta;
+    const double en = e - f / (fp > 0.0 ? fp : 1.0);
+    e = fp > 0.0 && en > 0.0 && en < 1.0 ? en : e;
+    const double yy = 1.0 - e;
+    const double den = e * (1.0 + yy) * (1.0 + yy * yy);
+    const double y2 = y * y;
+    const double q = den > 0.0 ? 4.0 * y2 * y2 / den : 0.0; /* -dg/dc */
+    const double sg = t < 0.0 ? -1.0 : 1.0;
+    const int lin = a <= k->l.u_T, solid = !(a < 1.0);
+    double G = sg * y2 * y, Gt = q * k->l.rim1, Gr = sg * q * one_a * k->inv_r2;
+    G = solid ? sg : G;
+    Gt = solid ? 0.0 : Gt;
+    Gr = solid ? 0.0 : Gr;
+    G = lin ? k->h * t : G;
+    Gt = lin ? k->h : Gt;
+    Gr = lin ? t * k->h * k->h_rho : Gr;
+    const int bad = t != t;
+    *g = bad ? 0.0 : G;
+    *gt = bad ? 0.0 : Gt;
+    *gr = bad ? 0.0 : Gr;
+}
+
+#define CANON_MANY(attr, sfx, unused)                                                              \
+    attr static void canon_many##sfx(const canon_consts *kp, size_t count, const double *x,        \
+                                     double *g, double *gt, double *gr)                            \
+    {                                                                                              \
+        const canon_consts k = *kp; /* by value: its loads leave the loop */                       \
+        if (!gt || !gr) {                                                                          \
+            _Pragma("omp simd") for (size_t i = 0; i < count; i++)                                 \
+                g[i] = cf_lane_closed(&k.l, x[i] * k.inv_B);                                       \
+            return;                                                                                \
+        }                                                                                          \
+        _Pragma("omp simd") for (size_t i = 0; i < count; i++)                                     \
+            canon_lane(&k, x[i], &g[i], &gt[i], &gr[i]);                                           \
+    }
+CF_SIMD_COPIES(CANON_MANY, 0)
+
+void cf_ident_canon_many(const cf_law *canon, double B, size_t count, const double *x, double *g,
+                         double *dg_dt, double *dg_drho)
+{
+    canon_consts k;
+    cf_law_lanes_init(canon, &k.l);
+    const double rho = canon->rho;
+    k.inv_B = 1.0 / B;
+    k.h = canon->k0_N_per_mm;
+    k.h_rho = 3 / rho - 1 / (1 + rho) - 2 * rho / (1 + rho * rho);
+    k.inv_r2 = 1.0 / (rho * rho);
+    CF_SIMD_CALL(canon_many, (&k, count, x, g, dg_dt, dg_drho));
+}
