@@ -39,21 +39,6 @@ static void row(FILE *o, const cf_fit_report *r, const char *label, const char *
     fputc('\n', o);
 }
 
-/* Significant digits that tell the ends of the interval [lo, hi] from the value v: 3, or more
-** when an end lies closer to v than 3 digits show (a precise or long table), at most 17. */
-static int interval_digits(double v, double lo, double hi)
-{
-    double w = INFINITY;
-    if (v - lo > 0)
-        w = v - lo;
-    if (hi - v > 0)
-        w = fmin(w, hi - v);
-    if (!(v != 0) || !isfinite(w))
-        return 3;
-    double d = floor(log10(fabs(v))) - floor(log10(w)) + 1;
-    return (int)fmin(17, fmax(3, d));
-}
-
 /* value ± standard error, or value [low, high] (the profile interval, marked *) */
 static void ident_row(FILE *o, const cf_fit_report *r, const char *label, int k, double scale,
                       const char *unit)
@@ -61,21 +46,7 @@ static void ident_row(FILE *o, const cf_fit_report *r, const char *label, int k,
     fprintf(o, "  %-26s", label);
     for (int i = 0; i < r->nfits; i++) {
         char cell[96];
-        const cf_fit_result *f = &r->fits[i];
-        const char *sp = *unit ? " " : "";
-        if (f->interval_ok[k]) {
-            const double v = f->ident.v[k] * scale, lo = f->interval[k][0] * scale,
-                         hi = f->interval[k][1] * scale;
-            const int dg = interval_digits(v, lo, hi);
-            snprintf(cell, sizeof cell, "%.*g [%.*g, %.*g]*%s%s", dg > 4 ? dg : 4, v, dg, lo, dg,
-                     hi, sp, unit);
-        }
-        else if (f->ident_se.v[k] >= 0)
-            snprintf(cell, sizeof cell, "%.6g ± %.2g%s%s", f->ident.v[k] * scale,
-                     f->ident_se.v[k] * scale, sp, unit);
-        else /* uncertainty() computes an interval wherever the error is undetermined */
-            snprintf(cell, sizeof cell, "%.6g%s%s (no error: placed, not fitted)",
-                     f->ident.v[k] * scale, sp, unit);
+        cf_report_ident_cell(&r->fits[i], k, scale, unit, cell, sizeof cell);
         fprintf(o, " %-24s", cell);
     }
     fputc('\n', o);
