@@ -129,8 +129,23 @@ static void choose_curves(const cf_fit_report *r, fit_curves *c)
         const cf_lattice_config *lc = &r->val[k].setup.cfg.lattice;
         snprintf(c->lattice_title[k], sizeof c->lattice_title[k], "lattice %dx%dx%d, %s", lc->nx,
                  lc->ny, lc->nz, cf_spring_type_name(r->fits[k].type));
+        /* a fit through the lattice is its lattice's curve (the cell's in a mode the single
+        ** spring has no form of): the spring's law is not what was fitted and is not drawn */
+        if (cf_report_target_is_lattice(r) && c->lattice[k]) {
+            c->fit[k] = 0;
+            snprintf(c->lattice_title[k], sizeof c->lattice_title[k], "fit: %s, %s",
+                     r->val[k].by_cell ? "lattice cell" : "lattice",
+                     cf_spring_type_name(r->fits[k].type));
+        }
     }
-    if (r->nfits != 2)
+    if (cf_report_target_is_lattice(r) && r->nfits == 2 && c->lattice[0] && c->lattice[1] &&
+        cf_report_types_tie(r)) {
+        c->lattice[1 - keep] = 0;
+        snprintf(c->lattice_title[keep], sizeof c->lattice_title[keep],
+                 "fit: lattice, both types (a tie)");
+        return;
+    }
+    if (r->nfits != 2 || cf_report_target_is_lattice(r))
         return;
     /* the two fits at the table's points and between them */
     double diff = 0, xmin = 0, xmax = 0;
@@ -200,6 +215,28 @@ static void fit_panel(cf_gp *g, const cf_fit_report *r, const fit_curves *c, int
     cf_gp_cmd(g, "");
 }
 
+/* The axes in the measures that were fitted (a table's columns are converted to engineering
+** strain, or the amount of shear, and nominal stress), naming the column's own measure when it
+** was converted: "nominal stress (from cauchy) [kPa]". */
+static void axis_labels(const cf_table *d, char *x, size_t xcap, char *y, size_t ycap)
+{
+    if (cf_table_is_force(d)) {
+        snprintf(x, xcap, "displacement [mm]");
+        snprintf(y, ycap, "%s [%s]", d->y_column, d->y_unit);
+        return;
+    }
+    const cf_table_measures *m = &d->measures;
+    char from[64] = "";
+    if (m->strain != CF_STRAIN_ENGINEERING)
+        snprintf(from, sizeof from, " (from %s)", cf_strain_measure_name(m->strain));
+    snprintf(x, xcap, "%s%s [-]",
+             d->mode == CF_MODE_SHEAR ? "amount of shear" : "engineering strain", from);
+    from[0] = '\0';
+    if (m->stress != CF_STRESS_NOMINAL)
+        snprintf(from, sizeof from, " (from %s)", cf_stress_measure_name(m->stress));
+    snprintf(y, ycap, "nominal stress%s [%s]", from, d->y_unit);
+}
+
 static void fit_script(cf_gp *g, const void *fig)
 {
     const cf_fit_report *r = fig;
@@ -223,7 +260,9 @@ static void fit_script(cf_gp *g, const void *fig)
     cf_gp_cmd(g, "set format y %q", "%g");
     cf_gp_cmd(g, "set lmargin at screen %g", PANEL_LEFT);
     cf_gp_cmd(g, "set rmargin at screen %g", PANEL_RIGHT);
-    cf_gp_cmd(g, "set xlabel %q", cf_table_is_force(d) ? "displacement [mm]" : "strain [-]");
+    char xlabel[160];
+    axis_labels(d, xlabel, sizeof xlabel, label, sizeof label);
+    cf_gp_cmd(g, "set xlabel %q noenhanced", xlabel);
     /* the model panel */
     cf_gp_cmd(g, "set title %q noenhanced", title);
     cf_gp_cmd(g, "set tmargin at screen 0.93");
@@ -231,7 +270,6 @@ static void fit_script(cf_gp *g, const void *fig)
     cf_gp_cmd(g, "set key at screen %g,0.93 left top Left reverse noenhanced spacing 1.2 "
                  "samplen 3.5 title %q",
               KEY_LEFT, "model");
-    snprintf(label, sizeof label, "%s [%s]", d->y_column, d->y_unit);
     cf_gp_cmd(g, "set ylabel %q noenhanced", label);
     fit_panel(g, r, &c, 0);
     /* the residual panel */

@@ -36,6 +36,14 @@ int cf_report_types_tie(const cf_fit_report *r)
     return r->nfits == 2 && cf_fit_compare(&r->fits[0], &r->fits[1], r->table->count).tie;
 }
 
+int cf_report_target_is_lattice(const cf_fit_report *r)
+{
+    int all = r->through_msm && r->nfits > 0;
+    for (int i = 0; i < r->nfits; i++)
+        all = all && r->thr[i].done;
+    return all;
+}
+
 double cf_report_fit_aic(const cf_fit_report *r, int i)
 {
     double f = r->table->y_to_file;
@@ -155,9 +163,33 @@ static json_t *through_json(const cf_fit_report *r, int i)
     return o;
 }
 
+/* {model: lattice | spring, mode, evaluated_by}: what the fit's numbers are of. */
+static json_t *target_json(const cf_fit_report *r)
+{
+    const int lat = cf_report_target_is_lattice(r);
+    return json_pack("{s:s, s:s, s:s}", "model", lat ? "lattice" : "spring", "mode",
+                     cf_table_is_force(r->table) ? "force-displacement" : cf_mode_name(r->table->mode),
+                     "evaluated_by", lat ? "homogenised cell" : "the spring's law");
+}
+
+/* The single spring's own law against a uniaxial table, beside a lattice target. */
+static json_t *spring_law_json(const cf_fit_report *r, int i)
+{
+    const cf_through_msm *t = &r->thr[i];
+    double u = r->table->y_to_file;
+    return json_pack("{s:s, s:o, s:o, s:o}", "what",
+                     "the single spring's uniaxial law against the table, not the fit's target",
+                     "rmse", num(t->law_rmse * u), "max_abs_error", num(t->law_max_abs_error * u),
+                     "r2", num(t->law_r2));
+}
+
 static json_t *fit_json(const cf_fit_report *r, int i)
 {
     json_t *o = fit_json_core(r, i);
+    if (o)
+        json_object_set_new(o, "target", target_json(r));
+    if (o && cf_report_target_is_lattice(r) && isfinite(r->thr[i].law_rmse))
+        json_object_set_new(o, "spring_law", spring_law_json(r, i));
     if (o && r->validate)
         json_object_set_new(o, "validation", validation_json(r, i));
     if (o && r->through_msm && r->thr[i].done)

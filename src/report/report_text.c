@@ -225,6 +225,19 @@ static void table_text(FILE *o, const cf_fit_report *r)
     fputc('\n', o);
 }
 
+/* The fit's target, once: what every headline number below (quality, errors, the type's
+** verdict) is of. */
+static void target_text(FILE *o, const cf_fit_report *r)
+{
+    if (cf_report_target_is_lattice(r))
+        fprintf(o, " fit target: the lattice in %s (its homogenised cell): every number below "
+                   "is the lattice's unless named otherwise\n\n",
+                cf_mode_name(r->table->mode));
+    else if (!cf_table_is_force(r->table))
+        fprintf(o, " fit target: the single spring (its law F(eH)/H^2 against the table)%s\n\n",
+                r->validate ? "; the lattice below is a check of that spring" : "");
+}
+
 /* The three quantities the data determine, their intervals, correlations and distance to solid. */
 static void identifiable_text(FILE *o, const cf_fit_report *r)
 {
@@ -263,6 +276,27 @@ static void identifiable_text(FILE *o, const cf_fit_report *r)
     fputc('\n', o);
 }
 
+/* The single spring's own law against the table, beside a lattice target: only for a uniaxial
+** table (in the other modes the law has no curve to compare). */
+static void spring_law_text(FILE *o, const cf_fit_report *r)
+{
+    if (!cf_report_target_is_lattice(r) || r->table->mode != CF_MODE_UNIAXIAL)
+        return;
+    enum { ROWS = 3 };
+    char buf[ROWS][2][64];
+    const double u = r->table->y_to_file;
+    for (int i = 0; i < r->nfits; i++) {
+        const cf_through_msm *t = &r->thr[i];
+        snprintf(buf[0][i], sizeof buf[0][i], "%.4g %s", t->law_rmse * u, r->table->y_unit);
+        snprintf(buf[1][i], sizeof buf[1][i], "%.4g %s", t->law_max_abs_error * u,
+                 r->table->y_unit);
+        snprintf(buf[2][i], sizeof buf[2][i], "%.6f", t->law_r2);
+    }
+    static const char *const labels[ROWS] = {"RMSE", "max |error|", "R^2"};
+    fprintf(o, " the single spring against the table (uniaxial law):\n");
+    cell_rows(o, r, buf, ROWS, labels);
+}
+
 /* One spring of the family (the field table's parameters and what follows from them), and the
 ** fit's quality. */
 static void spring_text(FILE *o, const cf_fit_report *r)
@@ -280,11 +314,12 @@ static void spring_text(FILE *o, const cf_fit_report *r)
     row(o, r, "F_T, F_C", "%.4g N", 8);
     row(o, r, "", "%.4g N", 9);
     row(o, r, "k0", "%.6g N/mm", 14);
-    fprintf(o, " quality:\n");
+    fprintf(o, " quality (the %s):\n", cf_report_target_is_lattice(r) ? "lattice's" : "spring's");
     row(o, r, "RMSE", "%.4g %s", 10);
     row(o, r, "max |error|", "%.4g %s", 11);
     row(o, r, "R^2", "%.6f", 12);
     row(o, r, "AIC (k = 3)", "%.2f", 13);
+    spring_law_text(o, r);
 }
 
 /* One row of constraint names per fit: those of its active (which = 0) or holding (1) mask,
@@ -385,6 +420,7 @@ char *cf_report_text(const cf_fit_report *r)
     if (!o)
         return NULL;
     table_text(o, r);
+    target_text(o, r);
     fprintf(o, "  %-26s", "");
     for (int i = 0; i < r->nfits; i++)
         fprintf(o, " %-24s", cf_spring_type_name(r->fits[i].type));
