@@ -75,8 +75,8 @@ static void cells(FILE *o, const cf_fit_report *r, const char *label, const char
     fputc('\n', o);
 }
 
-/* The lattice the validation ran (the setup of a fit it was done for), its moduli, the test mode
-** and what the fit targeted. */
+/* The lattice the validation ran (the setup of a fit it was done for), its moduli and the test
+** mode (the fit's target is stated once, at the top). */
 static void validation_header(FILE *o, const cf_fit_report *r)
 {
     const cf_validate_setup *su = &r->val[0].setup;
@@ -95,10 +95,9 @@ static void validation_header(FILE *o, const cf_fit_report *r)
             lc->weight[CF_FAMILY_EDGE], lc->weight[CF_FAMILY_FACE], lc->weight[CF_FAMILY_BODY],
             cm.E, cm.nu, lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial",
             cf_law_method_name(su->method));
-    fprintf(o, "  mode %s, %s; fit target: %s\n", cf_mode_name(v0->mode),
+    fprintf(o, "  mode %s, %s\n", cf_mode_name(v0->mode),
             v0->by_cell ? "homogenised cell (the full lattice has no such boundary conditions)"
-                        : "full lattice",
-            r->through_msm ? "the lattice (through the homogenised cell)" : "the single spring");
+                        : "full lattice");
 }
 
 /* Prints rows k < nrows of buf (one cell per fit) under their labels. */

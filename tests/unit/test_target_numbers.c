@@ -269,6 +269,27 @@ static void fit_file_target_reads_back(void **state)
     assert_null(strstr(errb, "fitted as a single spring"));
 }
 
+/* --target spring on a table in a mode the single spring has no curve of is refused (exit 2,
+** naming the flag and the mode), not reported as the law at a uniaxial strain. */
+static void spring_target_in_shear_is_refused(void **state)
+{
+    (void)state;
+    if (!tu_datasets())
+        skip();
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "fit %s/heart_myocardium_shear_fs.csv --target spring",
+                            tu_datasets()),
+                     2);
+    assert_non_null(strstr(errb, "--target spring"));
+    assert_non_null(strstr(errb, "shear"));
+    /* given as uniaxial, it is the spring's to fit */
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "fit %s/heart_myocardium_shear_fs.csv --target spring --mode uniaxial",
+                            tu_datasets()),
+                     0);
+    assert_non_null(strstr(out, "fit target: the single spring"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -278,6 +299,7 @@ int main(void)
         cmocka_unit_test(joint_fit_has_uncertainty_for_every_quantity),
         cmocka_unit_test(example_lattice_rmse_is_the_fit_s),
         cmocka_unit_test(fit_file_target_reads_back),
+        cmocka_unit_test(spring_target_in_shear_is_refused),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
