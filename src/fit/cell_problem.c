@@ -52,6 +52,27 @@ double cf_cell_rss(cf_cell_problem *p, double rho, double B, double *A_out)
     return isfinite(sum) ? sum : CF_LSQ_HUGE_OBJ;
 }
 
+nlopt_result cf_cell_search(cf_cell_problem *p, nlopt_algorithm alg, unsigned n, const double *lb,
+                            const double *ub, const double *step, double xtol, int maxeval,
+                            nlopt_func f, void *data, double *z, double *fz)
+{
+    *fz = CF_LSQ_HUGE_OBJ;
+    nlopt_opt o = nlopt_create(alg, n);
+    int oom = !o;
+    if (o) {
+        oom |= nlopt_set_lower_bounds(o, lb) == NLOPT_OUT_OF_MEMORY;
+        oom |= nlopt_set_upper_bounds(o, ub) == NLOPT_OUT_OF_MEMORY;
+        oom |= nlopt_set_min_objective(o, f, data) == NLOPT_OUT_OF_MEMORY;
+        oom |= nlopt_set_initial_step(o, step) == NLOPT_OUT_OF_MEMORY;
+        nlopt_set_xtol_rel(o, xtol);
+        nlopt_set_maxeval(o, maxeval);
+    }
+    nlopt_result r = oom ? NLOPT_OUT_OF_MEMORY : nlopt_optimize(o, z, fz);
+    nlopt_destroy(o);
+    p->oom |= r == NLOPT_OUT_OF_MEMORY;
+    return r;
+}
+
 /* The profile's objective: x = (log rho, B) without the quantity held (k_held in the context). */
 typedef struct prof_ctx {
     cf_cell_problem *p;
@@ -85,22 +106,14 @@ static double profile_at(void *ctx, int k, double u, double limit, double *x)
         z[j] = fmin(fmax(z[j], lb[j]), ub[j]);
     }
     p->A_fixed = k == 2 ? exp(u) : 0;
-    double f = CF_LSQ_HUGE_OBJ;
-    nlopt_opt o = nlopt_create(nx == 2 ? NLOPT_LN_BOBYQA : NLOPT_LN_COBYLA, nx);
-    if (o) {
-        double step[2] = {0.05, 0.02 * (p->ub[1] - p->lb[1])};
-        if (k == 0)
-            step[0] = step[1];
-        nlopt_set_lower_bounds(o, lb);
-        nlopt_set_upper_bounds(o, ub);
-        nlopt_set_min_objective(o, prof_objective, &q);
-        nlopt_set_initial_step(o, step);
-        nlopt_set_xtol_rel(o, PROFILE_XTOL);
-        nlopt_set_maxeval(o, PROFILE_EVALS);
-        if (nlopt_optimize(o, z, &f) < 0 && f < CF_LSQ_HUGE_OBJ)
-            f = prof_objective(nx, z, NULL, &q);
-        nlopt_destroy(o);
-    }
+    double f = CF_LSQ_HUGE_OBJ, step[2] = {0.05, 0.02 * (p->ub[1] - p->lb[1])};
+    if (k == 0)
+        step[0] = step[1];
+    nlopt_result res = cf_cell_search(p, nx == 2 ? NLOPT_LN_BOBYQA : NLOPT_LN_COBYLA, nx, lb, ub,
+                                      step, PROFILE_XTOL, PROFILE_EVALS, prof_objective, &q, z,
+                                      &f);
+    if (res < 0 && f < CF_LSQ_HUGE_OBJ)
+        f = prof_objective(nx, z, NULL, &q);
     p->A_fixed = 0;
     if (f <= limit)
         memcpy(x, z, sizeof z);
@@ -214,5 +227,7 @@ cf_status cf_cell_uncertainty(cf_cell_problem *p, cf_cell_problem *prof, cf_fit_
         .at = profile_at,
         .closed = profile_closed};
     cf_profile_intervals(&pr, v, cf_profile_limit(prof->n, rss0, prof->ynorm), why, res);
+    if (prof->oom)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory in a profile's optimiser (NLopt)");
     return CF_OK;
 }

@@ -226,20 +226,14 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
                            log(grid_q[gq])};
             for (int j = 0; j < nz; j++)
                 z[j] = fmin(fmax(z[j], lb[j]), ub[j]);
-            nlopt_opt o = nlopt_create(NLOPT_LN_BOBYQA, (unsigned)nz);
-            if (!o) {
-                st = cf_error_set(err, CF_E_INTERNAL, "cannot create the NLopt optimiser");
+            double step[3] = {0.1, 0.05 * (ub[1] - lb[1]), 0.2}, f = CF_LSQ_HUGE_OBJ;
+            nlopt_result res = cf_cell_search(&c.pr, NLOPT_LN_BOBYQA, (unsigned)nz, lb, ub, step,
+                                              XTOL_REL, MAX_EVALS, objective, &c, z, &f);
+            if (c.pr.oom) {
+                st = cf_error_set(err, CF_E_INTERNAL, "out of memory in the joint fit's "
+                                                      "optimiser (NLopt)");
                 goto out;
             }
-            double step[3] = {0.1, 0.05 * (ub[1] - lb[1]), 0.2}, f = CF_LSQ_HUGE_OBJ;
-            nlopt_set_lower_bounds(o, lb);
-            nlopt_set_upper_bounds(o, ub);
-            nlopt_set_min_objective(o, objective, &c);
-            nlopt_set_initial_step(o, step);
-            nlopt_set_xtol_rel(o, XTOL_REL);
-            nlopt_set_maxeval(o, MAX_EVALS);
-            nlopt_result res = nlopt_optimize(o, z, &f);
-            nlopt_destroy(o);
             if ((res > 0 || res == NLOPT_ROUNDOFF_LIMITED) && f < best) {
                 best = f;
                 memcpy(zb, z, sizeof zb);

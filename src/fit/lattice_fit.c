@@ -95,19 +95,9 @@ static double cell_rmse(const cf_spring *p, tm_ctx *c)
 /* One BOBYQA run from z (in and out) within [lb, ub]; returns the objective at the end. */
 static double bobyqa(tm_ctx *c, double *z, const double *lb, const double *ub)
 {
-    double f = CF_LSQ_HUGE_OBJ;
-    nlopt_opt o = nlopt_create(NLOPT_LN_BOBYQA, 2);
-    if (!o)
-        return f;
-    double step[2] = {0.05, 0.02 * (ub[1] - lb[1])};
-    nlopt_set_lower_bounds(o, lb);
-    nlopt_set_upper_bounds(o, ub);
-    nlopt_set_min_objective(o, tm_objective, c);
-    nlopt_set_initial_step(o, step);
-    nlopt_set_xtol_rel(o, XTOL_REL);
-    nlopt_set_maxeval(o, MAX_CURVES);
-    nlopt_result r = nlopt_optimize(o, z, &f);
-    nlopt_destroy(o);
+    double f, step[2] = {0.05, 0.02 * (ub[1] - lb[1])};
+    nlopt_result r = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, 2, lb, ub, step, XTOL_REL,
+                                    MAX_CURVES, tm_objective, c, z, &f);
     if (!(r > 0 || r == NLOPT_ROUNDOFF_LIMITED) || !isfinite(z[0]) || !isfinite(z[1]))
         return CF_LSQ_HUGE_OBJ;
     return f;
@@ -224,6 +214,11 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
             zb[0] = z[0], zb[1] = z[1];
         }
     }
+    if (search->pr.oom) {
+        st = cf_error_set(err, CF_E_INTERNAL, "out of memory in the lattice fit's optimiser "
+                                              "(NLopt)");
+        goto out;
+    }
     double A = 0;
     int ok = best < CF_LSQ_HUGE_OBJ && tm_profile(&c, zb, &A) < CF_LSQ_HUGE_OBJ && A > 0;
     const cf_ident ident = {.rho = exp(zb[0]), .solid = zb[1], .scale = A};
@@ -231,7 +226,12 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
     cf_fit_result placed;
     cf_error e = {0};
     double after = CF_LSQ_HUGE_OBJ;
-    if (ok && cf_fit_place(&reach, opt, res->type, &ident, &placed, &e) == CF_OK)
+    cf_status pst = ok ? cf_fit_place(&reach, opt, res->type, &ident, &placed, &e) : CF_E_DATA;
+    if (pst == CF_E_INTERNAL) {
+        st = cf_error_set(err, CF_E_INTERNAL, "%s", e.msg);
+        goto out;
+    }
+    if (pst == CF_OK)
         after = cell_rmse(&placed.params, &c);
     if (after < t->rmse_before) {
         t->ident_after = cf_ident_of(&placed.params, 0);

@@ -58,6 +58,18 @@ static void every_quantity_has_an_uncertainty(json_t *f, const char *table)
     assert_true(json_object_get(c, "matrix") || json_object_get(c, "reason"));
 }
 
+/* The fit file at json (caller frees the root) and its fits, which are the two types. */
+static json_t *two_fits(const char *json, json_t **fits)
+{
+    json_error_t e;
+    json_t *root = json_load_file(json, 0, &e);
+    if (!root)
+        fail_msg("%s: %s", json, e.text);
+    *fits = json_object_get(root, "fits");
+    assert_int_equal(json_array_size(*fits), 2);
+    return root;
+}
+
 /* Fits table (in the published folder) with extra flags into a fit file and checks each fit:
 ** target lattice in mode, rmse = the cell's RMSE and the validation's, R^2 the validation's, the
 ** single spring's law figures only for uniaxial tables, an uncertainty for every quantity. */
@@ -71,11 +83,7 @@ static void check_lattice_target(const char *table, const char *flags, const cha
     if (st != 0)
         fail_msg("%s: exit %d: %s", table, st, errb);
     assert_non_null(strstr(out, "fit target: the lattice"));
-    json_error_t e;
-    json_t *root = json_load_file(json, 0, &e);
-    assert_non_null(root);
-    json_t *fits = json_object_get(root, "fits");
-    assert_int_equal(json_array_size(fits), 2);
+    json_t *fits, *root = two_fits(json, &fits);
     for (size_t i = 0; i < 2; i++) {
         json_t *f = json_array_get(fits, i);
         json_t *t = json_object_get(f, "target");
@@ -104,25 +112,22 @@ static void check_lattice_target(const char *table, const char *flags, const cha
     json_decref(root);
 }
 
-static void shear_planar_and_equibiaxial_fits_report_the_lattice(void **state)
+/* Shear, planar and equibiaxial tables (through the lattice by default), and uniaxial ones with
+** --target lattice or --validate alone. */
+static void fits_in_every_mode_report_the_lattice(void **state)
 {
     (void)state;
     if (!tu_datasets())
         skip();
-    check_lattice_target("heart_myocardium_shear_fs.csv", "", "shear");
-    check_lattice_target("skin_porcine_stripbiaxial_x.csv", "", "planar");
-    check_lattice_target("aortic_valve_circumferential.csv", "", "equibiaxial");
-    check_lattice_target("heart_myocardium_biaxial_1to1_fiber.csv", "--validate", "equibiaxial");
-}
-
-static void uniaxial_fit_through_the_lattice_reports_the_lattice(void **state)
-{
-    (void)state;
-    if (!tu_datasets())
-        skip();
-    check_lattice_target("brain_cortex_tension.csv", "--target lattice", "uniaxial");
-    /* --validate alone fits through the lattice too */
-    check_lattice_target("brain_cortex_compression.csv", "--validate", "uniaxial");
+    static const char *const cases[][3] = {
+        {"heart_myocardium_shear_fs.csv", "", "shear"},
+        {"skin_porcine_stripbiaxial_x.csv", "", "planar"},
+        {"aortic_valve_circumferential.csv", "", "equibiaxial"},
+        {"heart_myocardium_biaxial_1to1_fiber.csv", "--validate", "equibiaxial"},
+        {"brain_cortex_tension.csv", "--target lattice", "uniaxial"},
+        {"brain_cortex_compression.csv", "--validate", "uniaxial"}};
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++)
+        check_lattice_target(cases[k][0], cases[k][1], cases[k][2]);
 }
 
 /* The hydrogel compression table: by the single springs' own law the types are about equal
@@ -180,11 +185,7 @@ static void joint_fit_has_uncertainty_for_every_quantity(void **state)
     if (st != 0)
         fail_msg("exit %d: %s", st, errb);
     assert_null(strstr(out, "no error"));
-    json_error_t e;
-    json_t *root = json_load_file(json, 0, &e);
-    assert_non_null(root);
-    json_t *fits = json_object_get(root, "fits");
-    assert_int_equal(json_array_size(fits), 2);
+    json_t *fits, *root = two_fits(json, &fits);
     for (size_t i = 0; i < 2; i++) {
         json_t *f = json_array_get(fits, i);
         assert_string_equal(
@@ -293,8 +294,7 @@ static void spring_target_in_shear_is_refused(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(shear_planar_and_equibiaxial_fits_report_the_lattice),
-        cmocka_unit_test(uniaxial_fit_through_the_lattice_reports_the_lattice),
+        cmocka_unit_test(fits_in_every_mode_report_the_lattice),
         cmocka_unit_test(type_verdict_is_the_lattice_s),
         cmocka_unit_test(joint_fit_has_uncertainty_for_every_quantity),
         cmocka_unit_test(example_lattice_rmse_is_the_fit_s),
