@@ -25,7 +25,7 @@ double cf_cell_rss(cf_cell_problem *p, double rho, double B, double *A_out)
     p->evals++;
     *A_out = 0;
     double A_max;
-    if (cf_fit_ident_limit(p->opt, p->type, rho, B, &A_max) > 0)
+    if (cf_fit_ident_limit(p->opt, p->type, rho, B, &A_max, NULL) > 0)
         return CF_LSQ_HUGE_OBJ;
     if (p->A_fixed > 0 && p->A_fixed > A_max)
         return CF_LSQ_HUGE_OBJ;
@@ -120,14 +120,17 @@ static double profile_at(void *ctx, int k, double u, double limit, double *x)
     return f;
 }
 
-/* Where the profile of k has no admissible point: the stress scale's cap, or the type's limits
-** in (rho, s/H). */
+/* Where the profile of k has no admissible point past its last one (exp(u), x): the stress
+** scale's cap, or the type's limits whose edge is there (the bounds when none is known). */
 static unsigned profile_closed(void *ctx, int k, double u, const double *x)
 {
-    (void)ctx;
-    (void)u;
-    (void)x;
-    return k == 2 ? CF_C_G_MAX : CF_C_BOUNDS;
+    const cf_cell_problem *p = ctx;
+    if (k == 2)
+        return CF_C_G_MAX;
+    double rho = k == 0 ? exp(u) : exp(x[0]), B = k == 1 ? exp(u) : x[0], A_max;
+    unsigned bits = 0;
+    cf_fit_ident_limit(p->opt, p->type, rho, B, &A_max, &bits);
+    return bits ? bits : CF_C_BOUNDS;
 }
 
 /* The limits the quantities v sit on: the search box and the stress scale's cap. */
@@ -142,7 +145,7 @@ static unsigned held_at(const cf_cell_problem *p, const double v[3])
     if (v[1] <= p->lb[1] * (1 + tol))
         held |= CF_C_TRAVEL;
     double A_max;
-    if (cf_fit_ident_limit(p->opt, p->type, v[0], v[1], &A_max) <= 0 && v[2] >= A_max * (1 - tol))
+    if (cf_fit_ident_limit(p->opt, p->type, v[0], v[1], &A_max, NULL) <= 0 && v[2] >= A_max * (1 - tol))
         held |= CF_C_G_MAX;
     return held;
 }
