@@ -160,6 +160,8 @@ static json_t *through_json(const cf_fit_report *r, int i)
                           (json_int_t)t->evaluations);
     if (o && t->verified)
         json_object_set_new(o, "verification_max_abs", num(t->verify_max_abs * u));
+    if (o) /* of evaluations: the Jacobian and the profiles of the uncertainty */
+        json_object_set_new(o, "uncertainty_evaluations", json_integer(t->uncertainty_curves));
     return o;
 }
 

@@ -170,8 +170,8 @@ static void through_rows(FILE *o, const cf_fit_report *r)
                      th->verify_max_abs * u, yu);
         else
             snprintf(buf[1][i], sizeof buf[1][i], "%s", th->done ? "cell only" : "");
-        snprintf(buf[2][i], sizeof buf[2][i], "%.3f s, %ld cell curves", th->wall_time_s,
-                 th->evaluations);
+        snprintf(buf[2][i], sizeof buf[2][i], "%.3f s, %ld cell curves (%ld for errors)",
+                 th->wall_time_s, th->evaluations, th->uncertainty_curves);
     }
     static const char *const tl[3] = {"through lattice: RMSE", "verified in full lattice",
                                       "through lattice: cost"};
