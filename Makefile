@@ -107,7 +107,7 @@ deps:
 example: deps
 	@$(MAKE) --no-print-directory all
 	@mkdir -p $(BUILD)/example
-	$(BUILD)/conifit fit data/telescoping_noise1pct.csv --target lattice -o $(BUILD)/example/telescoping_noise1pct.json --plot $(BUILD)/example/telescoping_noise1pct.png
+	$(BUILD)/conifit fit data/telescoping_noise1pct.csv --validate -o $(BUILD)/example/telescoping_noise1pct.json --plot $(BUILD)/example/telescoping_noise1pct.png
 
 fits: check-deps $(BUILD)/conifit
 	$(BUILD)/conifit fit data/*.csv --validate -o fits/ --plot fits/ -j 4

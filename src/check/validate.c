@@ -167,12 +167,17 @@ cf_status cf_validate_lattice_fit(const cf_table *d, const cf_validate_setup *s,
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", d->count);
     cf_error e = {0};
     /* Verification: the reported spring once in the validation lattice, against the cell. */
-    if (cf_lattice_curve(&res->params, s, d, 0, cell, NULL, NULL, NULL, NULL) == CF_OK &&
-        cf_validate_run(&res->params, s, d, v, &e) == CF_OK) {
+    cf_status st = cf_lattice_curve(&res->params, s, d, 0, cell, NULL, NULL, NULL, &e);
+    if (st == CF_OK)
+        st = cf_validate_run(&res->params, s, d, v, &e);
+    if (st == CF_OK) {
         t->rmse_after = v->rmse;
         for (size_t i = 0; i < d->count; i++)
             t->verify_max_abs = fmax(t->verify_max_abs, fabs(v->stress_MPa[i] - cell[i]));
         t->verified = !v->by_cell;
+    } else if (st == CF_E_INTERNAL) { /* out of memory: an error, not a skipped verification */
+        free(cell);
+        return cf_error_set(err, CF_E_INTERNAL, "%s", e.msg);
     } else if (!v->done) {
         cf_validate_run(&res->params, s, d, v, NULL);
     }

@@ -347,6 +347,11 @@ int cf_cli_export(int argc, char **argv)
     q.scene_fit[0] = '\0';
     if (q.ea.lattice && lattice_of(&q, &fs, &lx, &err) != CF_OK)
         return cf_cli_fail(&err);
+    if (q.ea.lattice && !fs.target_lattice && !q.quiet)
+        fputs("conifit export: note: the fit file's spring was fitted as a single spring "
+              "(--target spring), not through the lattice: its lattice may miss the table; fit "
+              "it again with --validate, which fits through the lattice\n",
+              stderr);
     char *buf;
     size_t len;
     cf_export_report rep;

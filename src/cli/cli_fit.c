@@ -226,6 +226,17 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
         rc = cf_cli_usage_error("fit", "--validate and --target lattice apply to stress-strain "
                                        "tables; a time series is fitted through the lattice "
                                        "already");
+    /* the single spring has no shear, planar, equibiaxial or confined curve: its law against such
+    ** a table would be the law at a uniaxial strain equal to the table's */
+    for (int i = 0; i < a->nfiles && rc < 0 && a->popt.target == CF_TARGET_SPRING && !a->joint;
+         i++)
+        if (!jobs[i].m.t && !cf_table_is_force(&jobs[i].m) &&
+            jobs[i].m.mode != CF_MODE_UNIAXIAL)
+            rc = cf_cli_usage_error("fit", "--target spring: the table's mode is %s, which a "
+                                           "single spring has no curve of; fit it through the "
+                                           "lattice (the default in that mode) or give "
+                                           "--mode uniaxial",
+                                    cf_mode_name(jobs[i].m.mode));
     if (rc < 0 && *nseries == 0 && a->series_only)
         rc = cf_cli_usage_error("fit", "--branches, --dashpot, --relaxation and --elastic apply to time "
                                        "series "

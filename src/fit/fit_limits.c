@@ -32,7 +32,7 @@ region cf_fit_region_at(const fit_ctx *c, double rho, double B)
 }
 
 double cf_fit_ident_limit(const cf_fit_options *opt, cf_spring_type type, double rho, double B,
-                          double *A_max)
+                          double *A_max, unsigned *bits)
 {
     fit_ctx c;
     memset(&c, 0, sizeof c);
@@ -44,6 +44,8 @@ double cf_fit_ident_limit(const cf_fit_options *opt, cf_spring_type type, double
         c.region &= !opt->fixed[k];
     region r = cf_fit_region_at(&c, rho, B);
     *A_max = r.A_max;
+    if (bits)
+        *bits = r.lo_bit | r.hi_bit;
     return r.margin;
 }
 

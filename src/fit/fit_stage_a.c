@@ -290,14 +290,7 @@ int cf_fit_stage_a_errors(fit_ctx *c, const double v[3], double se[3], double co
     cf_law lc;
     if (cf_ident_canon_law(rho, &lc) != CF_OK || c->n <= 3)
         return 0;
-    gsl_matrix *JtJ = gsl_matrix_calloc(3, 3), *E = gsl_matrix_alloc(3, 3);
-    gsl_vector *ev = gsl_vector_alloc(3);
-    gsl_eigen_symm_workspace *ew = gsl_eigen_symm_alloc(3);
-    int rank_def = 0;
-    if (!JtJ || !E || !ev || !ew) {
-        c->oom = 1;
-        goto done;
-    }
+    double jtj[3][3] = {{0}};
     double rss = 0;
     cf_ident_canon_many(&lc, B, c->n, c->data->x, c->model, c->gt, c->gr);
     for (size_t i = 0; i < c->n; i++) {
@@ -308,51 +301,11 @@ int cf_fit_stage_a_errors(fit_ctx *c, const double v[3], double se[3], double co
         rss += r * r;
         for (int a = 0; a < 3; a++)
             for (int b = 0; b < 3; b++)
-                *gsl_matrix_ptr(JtJ, a, b) += c->sw[i] * c->sw[i] * row[a] * row[b];
+                jtj[a][b] += c->sw[i] * c->sw[i] * row[a] * row[b];
     }
     c->evals += 3;
-    /* scale to unit diagonal before inverting (the columns differ by orders of magnitude) */
-    double dsc[3];
-    for (int a = 0; a < 3; a++) {
-        dsc[a] = sqrt(gsl_matrix_get(JtJ, a, a));
-        if (!(dsc[a] > 0 && isfinite(dsc[a]))) {
-            rank_def = 1;
-            goto done;
-        }
-    }
-    for (int a = 0; a < 3; a++)
-        for (int b = 0; b < 3; b++)
-            *gsl_matrix_ptr(JtJ, a, b) /= dsc[a] * dsc[b];
-    gsl_matrix_memcpy(E, JtJ);
-    if (gsl_eigen_symm(E, ev, ew) != GSL_SUCCESS) {
-        rank_def = 1;
-        goto done;
-    }
-    double emin = gsl_vector_min(ev), emax = gsl_vector_max(ev);
-    if (!(emin > 1e-10 * emax)) {
-        rank_def = 1;
-        goto done;
-    }
-    if (gsl_linalg_cholesky_decomp1(JtJ) == GSL_SUCCESS &&
-        gsl_linalg_cholesky_invert(JtJ) == GSL_SUCCESS) {
-        double s2 = rss / (double)(c->n - 3);
-        for (int a = 0; a < 3; a++) {
-            double var = s2 * gsl_matrix_get(JtJ, a, a) / (dsc[a] * dsc[a]);
-            se[a] = (var >= 0 && isfinite(var)) ? sqrt(var) : -1;
-        }
-        for (int a = 0; a < 3; a++)
-            for (int b = 0; b < 3; b++) {
-                double q = gsl_matrix_get(JtJ, a, b) /
-                           sqrt(gsl_matrix_get(JtJ, a, a) * gsl_matrix_get(JtJ, b, b));
-                corr[a][b] = isfinite(q) ? fmax(-1.0, fmin(1.0, q)) : NAN;
-            }
-    } else {
-        rank_def = 1;
-    }
-done:
-    gsl_eigen_symm_free(ew);
-    gsl_vector_free(ev);
-    gsl_matrix_free(E);
-    gsl_matrix_free(JtJ);
-    return rank_def;
+    int rank_def = cf_lsq_covariance(jtj, rss, c->n, se, corr);
+    if (rank_def < 0)
+        c->oom = 1;
+    return rank_def > 0;
 }

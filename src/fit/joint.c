@@ -12,6 +12,7 @@
 #include "conifit/cell.h"
 #include "conifit/family.h"
 #include "conifit/msm.h"
+#include "fit/cell_problem.h"
 #include "fit/clock.h"
 #include "fit/lsq.h"
 
@@ -32,7 +33,7 @@ typedef struct jctx {
     double weight[CF_FAMILY_COUNT]; /* the fixed weights (or the last tried) */
     double *sw[CF_JOINT_MAX];       /* per-row residual weights 1/(s_k sqrt n_k) */
     double *curve[CF_JOINT_MAX];    /* scratch: each table's cell curve at unit scale */
-    long evals;
+    cf_cell_problem pr;             /* every table's rows in order, with their weights */
 } jctx;
 
 /* Family weights of ratio q (face = body = q edge), scaled to the law's small-strain modulus. */
@@ -44,47 +45,32 @@ static void weights_of(double q, double w[CF_FAMILY_COUNT])
         w[f] = u[f] / E;
 }
 
-/* Objective at z = (ln rho, s/H [, ln q]) with the stress scale in closed form; *A_out. */
-static double profile(jctx *c, const double *z, double *A_out)
+/* Every table's cell curve at stress scale 1 for (rho, B), the tables one after another. */
+static int joint_curve(void *ctx, double rho, double B, double *out)
 {
-    c->evals++;
-    *A_out = 0;
-    double rho = exp(z[0]), e = z[1], A_max;
-    if (cf_fit_ident_limit(c->opt, c->type, rho, e, &A_max) > 0)
-        return CF_LSQ_HUGE_OBJ;
-    if (c->fit_weights)
-        weights_of(exp(z[2]), c->weight);
-    const cf_ident q = {.rho = rho, .solid = e, .scale = 1.0};
+    const jctx *c = ctx;
+    const cf_ident q = {.rho = rho, .solid = B, .scale = 1.0};
     cf_spring p = cf_ident_member(&q);
     cf_law law;
     if (cf_law_init(&law, &p, NULL) != CF_OK)
-        return CF_LSQ_HUGE_OBJ;
+        return 1;
     cf_cell cell;
     if (cf_cell_init(&cell, &law, c->lat->method == CF_LAW_TABLE ? CF_LAW_CLOSED : c->lat->method,
                      c->weight, NULL) != CF_OK)
-        return CF_LSQ_HUGE_OBJ;
-    double gy = 0, gg = 0;
-    for (size_t k = 0; k < c->n; k++) {
-        const cf_table *t = c->t[k];
-        if (cf_cell_curve(&cell, t->mode, t->x, t->count, c->curve[k], NULL) != CF_OK)
-            return CF_LSQ_HUGE_OBJ;
-        for (size_t i = 0; i < t->count; i++) {
-            double w = c->sw[k][i] * c->sw[k][i];
-            gy += w * c->curve[k][i] * t->y[i];
-            gg += w * c->curve[k][i] * c->curve[k][i];
-        }
-    }
-    double A = fmin(gy / gg, A_max);
-    if (!(A > 0) || !isfinite(A))
-        return CF_LSQ_HUGE_OBJ;
-    double sum = 0;
-    for (size_t k = 0; k < c->n; k++)
-        for (size_t i = 0; i < c->t[k]->count; i++) {
-            double r = c->sw[k][i] * (A * c->curve[k][i] - c->t[k]->y[i]);
-            sum += r * r;
-        }
-    *A_out = A;
-    return isfinite(sum) ? sum : CF_LSQ_HUGE_OBJ;
+        return 1;
+    for (size_t k = 0, m = 0; k < c->n; m += c->t[k++]->count)
+        if (cf_cell_curve(&cell, c->t[k]->mode, c->t[k]->x, c->t[k]->count, out + m, NULL) !=
+            CF_OK)
+            return 1;
+    return 0;
+}
+
+/* Objective at z = (ln rho, s/H [, ln q]) with the stress scale in closed form; *A_out. */
+static double profile(jctx *c, const double *z, double *A_out)
+{
+    if (c->fit_weights)
+        weights_of(exp(z[2]), c->weight);
+    return cf_cell_rss(&c->pr, exp(z[0]), z[1], A_out);
 }
 
 static double objective(unsigned nz, const double *z, double *grad, void *data)
@@ -174,7 +160,11 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
     for (size_t k = 0; k < n; k++)
         total += tables[k]->count;
     double *reach_x = malloc(total * sizeof(double)), *reach_y = malloc(total * sizeof(double));
-    if (!reach_x || !reach_y) {
+    double *all_sw = malloc(total * sizeof(double));
+    c.pr = (cf_cell_problem){.curve = joint_curve, .ctx = &c, .n = total, .y = reach_y,
+                             .sw = all_sw, .opt = opt, .type = type,
+                             .g = malloc(total * sizeof(double))};
+    if (!reach_x || !reach_y || !all_sw || !c.pr.g) {
         st = cf_error_set(err, CF_E_INTERNAL, "out of memory");
         goto out;
     }
@@ -201,6 +191,8 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
         r->tab[k].points = t->count;
         for (size_t i = 0; i < t->count; i++) {
             c.sw[k][i] = sqrt((t->w ? t->w[i] : 1.0) / (double)t->count) / s;
+            all_sw[m] = c.sw[k][i];
+            c.pr.ynorm += (all_sw[m] * t->y[i]) * (all_sw[m] * t->y[i]);
             reach_x[m] = copysign(cf_cell_spring_strain(t->mode, t->x[i]), t->x[i]);
             reach_y[m++] = t->y[i];
         }
@@ -223,6 +215,8 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
                           "the springs must reach a strain of %g: no spring does", xmax);
         goto out;
     }
+    memcpy(c.pr.lb, lb, sizeof c.pr.lb);
+    memcpy(c.pr.ub, ub, sizeof c.pr.ub);
     double best = CF_LSQ_HUGE_OBJ, zb[3] = {0, 0, 0};
     const double grid_rho[3] = {0.1, 0.35, 0.7}, grid_e[3] = {0.1, 0.4, 0.8};
     const double q_iso = 0.2708 / 0.6085, grid_q[2] = {q_iso, 1.0};
@@ -232,20 +226,14 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
                            log(grid_q[gq])};
             for (int j = 0; j < nz; j++)
                 z[j] = fmin(fmax(z[j], lb[j]), ub[j]);
-            nlopt_opt o = nlopt_create(NLOPT_LN_BOBYQA, (unsigned)nz);
-            if (!o) {
-                st = cf_error_set(err, CF_E_INTERNAL, "cannot create the NLopt optimiser");
+            double step[3] = {0.1, 0.05 * (ub[1] - lb[1]), 0.2}, f = CF_LSQ_HUGE_OBJ;
+            nlopt_result res = cf_cell_search(&c.pr, NLOPT_LN_BOBYQA, (unsigned)nz, lb, ub, step,
+                                              XTOL_REL, MAX_EVALS, objective, &c, z, &f);
+            if (c.pr.oom) {
+                st = cf_error_set(err, CF_E_INTERNAL, "out of memory in the joint fit's "
+                                                      "optimiser (NLopt)");
                 goto out;
             }
-            double step[3] = {0.1, 0.05 * (ub[1] - lb[1]), 0.2}, f = CF_LSQ_HUGE_OBJ;
-            nlopt_set_lower_bounds(o, lb);
-            nlopt_set_upper_bounds(o, ub);
-            nlopt_set_min_objective(o, objective, &c);
-            nlopt_set_initial_step(o, step);
-            nlopt_set_xtol_rel(o, XTOL_REL);
-            nlopt_set_maxeval(o, MAX_EVALS);
-            nlopt_result res = nlopt_optimize(o, z, &f);
-            nlopt_destroy(o);
             if ((res > 0 || res == NLOPT_ROUNDOFF_LIMITED) && f < best) {
                 best = f;
                 memcpy(zb, z, sizeof zb);
@@ -262,6 +250,11 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
     r->calibration = lat->cfg.lattice.calibration;
     if ((st = cf_fit_place(&reach, opt, type, &r->ident, &r->fit, err)) != CF_OK)
         goto out;
+    /* the uncertainty of the quantities found, the weights (fitted or not) held where they are:
+    ** each table's residuals weighted as in the search */
+    r->fit.ident = r->ident;
+    if ((st = cf_cell_uncertainty(&c.pr, &c.pr, &r->fit, err)) != CF_OK)
+        goto out;
     st = verify_tables(&c, r, err);
 out:
     for (size_t k = 0; k < n && k < CF_JOINT_MAX; k++) {
@@ -270,7 +263,9 @@ out:
     }
     free(reach_x);
     free(reach_y);
-    r->evaluations = c.evals;
+    free(all_sw);
+    free(c.pr.g);
+    r->evaluations = c.pr.evals;
     r->wall_time_s = cf_clock_s() - t0;
     if (st != CF_OK)
         cf_joint_free(r);

@@ -12,6 +12,7 @@
 
 #include "conifit/cell.h"
 #include "conifit/family.h"
+#include "fit/cell_problem.h"
 #include "fit/clock.h"
 #include "fit/lattice_curve.h"
 #include "fit/lsq.h"
@@ -27,63 +28,51 @@
 typedef struct tm_ctx {
     const cf_table *d;
     const cf_validate_setup *s;
-    const cf_fit_options *opt;
-    cf_spring_type type;
-    double *sw;     /* residual weights */
-    double ynorm;   /* weighted sum of y^2 */
-    double *curve;  /* scratch, count values */
-    long evals;
+    cf_cell_problem pr; /* the table's rows, weights and scratch */
 } tm_ctx;
 
-/* The context of the searches on a long table: its subsample (into *sub) with its own weights
-** and scratch. */
-static cf_status search_ctx(const tm_ctx *c, cf_table *sub, tm_ctx *cs, cf_error *err)
+/* The cell's curve of the member of the family at (rho, B), stress scale 1. */
+static int tm_curve(void *ctx, double rho, double B, double *out)
 {
-    cf_status st = cf_subsample(c->d, CF_SUBSAMPLE_ROWS, sub, err);
-    if (st != CF_OK)
-        return st;
-    cs->d = sub;
-    cs->sw = malloc(sizeof(double) * sub->count);
-    cs->curve = malloc(sizeof(double) * sub->count);
-    if (!cs->sw || !cs->curve)
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", sub->count);
-    cs->ynorm = cf_lsq_weights(sub, c->opt->relative, cs->sw);
+    const tm_ctx *c = ctx;
+    const cf_ident q = {.rho = rho, .solid = B, .scale = 1.0};
+    cf_spring p = cf_ident_member(&q);
+    return cf_lattice_curve(&p, c->s, c->d, 0, out, NULL, NULL, NULL, NULL) != CF_OK;
+}
+
+/* The context of table d with its weights and scratch (freed by tm_free). */
+static cf_status tm_init(tm_ctx *c, const cf_table *d, const cf_validate_setup *s,
+                         const cf_fit_options *opt, cf_spring_type type, cf_error *err)
+{
+    memset(c, 0, sizeof *c);
+    c->d = d;
+    c->s = s;
+    double *sw = malloc(sizeof(double) * (d->count ? d->count : 1));
+    c->pr = (cf_cell_problem){.curve = tm_curve, .n = d->count, .y = d->y, .sw = sw,
+                              .opt = opt, .type = type,
+                              .g = malloc(sizeof(double) * (d->count ? d->count : 1))};
+    if (!sw || !c->pr.g)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", d->count);
+    c->pr.ynorm = cf_lsq_weights(d, opt->relative, sw);
     return CF_OK;
+}
+
+static void tm_free(tm_ctx *c)
+{
+    free((double *)c->pr.sw);
+    free(c->pr.g);
 }
 
 /* The objective at (log rho, s/H) with the stress scale solved in closed form: at a prescribed
 ** displacement the static equilibrium does not depend on the scale of the springs' forces (every
 ** force is F_C times a function of u/s), so the lattice's stress is A times its stress at A = 1
-** and the best A is a weighted linear least-squares solution. *A_out receives it. */
+** and the best A is a weighted linear least-squares solution (cell_problem.h). *A_out receives
+** it. */
 static double tm_profile(tm_ctx *c, const double *z, double *A_out)
 {
-    const cf_ident q = {.rho = exp(z[0]), .solid = z[1], .scale = 1.0};
-    cf_spring p = cf_ident_member(&q);
-    c->evals++;
-    *A_out = 0;
-    /* the fitter's design limits in this space: where no spring can be placed, or the scale a
-    ** placeable spring carries at most */
-    double A_max;
-    if (cf_fit_ident_limit(c->opt, c->type, exp(z[0]), z[1], &A_max) > 0)
-        return CF_LSQ_HUGE_OBJ;
-    if (cf_lattice_curve(&p, c->s, c->d, 0, c->curve, NULL, NULL, NULL, NULL) != CF_OK)
-        return CF_LSQ_HUGE_OBJ;
-    double gy = 0, gg = 0;
-    for (size_t i = 0; i < c->d->count; i++) {
-        double w = c->sw[i] * c->sw[i];
-        gy += w * c->curve[i] * c->d->y[i];
-        gg += w * c->curve[i] * c->curve[i];
-    }
-    double A = fmin(gy / gg, A_max);
-    if (!(A > 0) || !isfinite(A))
-        return CF_LSQ_HUGE_OBJ;
-    double sum = 0;
-    for (size_t i = 0; i < c->d->count; i++) {
-        double r = c->sw[i] * (A * c->curve[i] - c->d->y[i]);
-        sum += r * r;
-    }
-    *A_out = A;
-    return isfinite(sum) ? sum / c->ynorm : CF_LSQ_HUGE_OBJ;
+    c->pr.ctx = c;
+    double f = cf_cell_rss(&c->pr, exp(z[0]), z[1], A_out);
+    return f < CF_LSQ_HUGE_OBJ ? f / c->pr.ynorm : CF_LSQ_HUGE_OBJ;
 }
 
 static double tm_objective(unsigned nz, const double *z, double *grad, void *data)
@@ -94,38 +83,60 @@ static double tm_objective(unsigned nz, const double *z, double *grad, void *dat
     return tm_profile(data, z, &A);
 }
 
-/* Cell RMSE (MPa) of spring p against the table; HUGE when the cell cannot run it. */
+/* Cell RMSE (MPa) of spring p against the table; HUGE when the cell cannot run it. The cell's
+** curve is left in c->pr.g. */
 static double cell_rmse(const cf_spring *p, tm_ctx *c)
 {
-    if (cf_lattice_curve(p, c->s, c->d, 0, c->curve, NULL, NULL, NULL, NULL) != CF_OK)
+    if (cf_lattice_curve(p, c->s, c->d, 0, c->pr.g, NULL, NULL, NULL, NULL) != CF_OK)
         return CF_LSQ_HUGE_OBJ;
-    return cf_lsq_quality_of(c->d, c->curve).rmse;
+    return cf_lsq_quality_of(c->d, c->pr.g).rmse;
 }
 
 /* One BOBYQA run from z (in and out) within [lb, ub]; returns the objective at the end. */
 static double bobyqa(tm_ctx *c, double *z, const double *lb, const double *ub)
 {
-    double f = CF_LSQ_HUGE_OBJ;
-    nlopt_opt o = nlopt_create(NLOPT_LN_BOBYQA, 2);
-    if (!o)
-        return f;
-    double step[2] = {0.05, 0.02 * (ub[1] - lb[1])};
-    nlopt_set_lower_bounds(o, lb);
-    nlopt_set_upper_bounds(o, ub);
-    nlopt_set_min_objective(o, tm_objective, c);
-    nlopt_set_initial_step(o, step);
-    nlopt_set_xtol_rel(o, XTOL_REL);
-    nlopt_set_maxeval(o, MAX_CURVES);
-    nlopt_result r = nlopt_optimize(o, z, &f);
-    nlopt_destroy(o);
+    double f, step[2] = {0.05, 0.02 * (ub[1] - lb[1])};
+    nlopt_result r = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, 2, lb, ub, step, XTOL_REL,
+                                    MAX_CURVES, tm_objective, c, z, &f);
     if (!(r > 0 || r == NLOPT_ROUNDOFF_LIMITED) || !isfinite(z[0]) || !isfinite(z[1]))
         return CF_LSQ_HUGE_OBJ;
     return f;
 }
 
+/* The fit's headline numbers become the target's: the cell's curve of the reported spring
+** against the table (c->pr.g holds it), with the single spring's own figures kept in t->law_*
+** where they mean something (a uniaxial table), and the uncertainty through the cell. */
+static cf_status take_target(tm_ctx *c, tm_ctx *search, cf_fit_result *res, cf_through_msm *t,
+                             cf_error *err)
+{
+    const int uniaxial = c->d->mode == CF_MODE_UNIAXIAL;
+    t->law_rmse = uniaxial ? res->rmse : NAN;
+    t->law_max_abs_error = uniaxial ? res->max_abs_error : NAN;
+    t->law_r2 = uniaxial ? res->r2 : NAN;
+    cf_lsq_quality q = cf_lsq_quality_of(c->d, c->pr.g);
+    double wrss = 0;
+    for (size_t i = 0; i < c->d->count; i++) {
+        double r = c->pr.sw[i] * (c->pr.g[i] - c->d->y[i]);
+        wrss += r * r;
+    }
+    res->rss = q.rss;
+    res->rmse = q.rmse;
+    res->max_abs_error = q.max_abs_error;
+    res->r2 = q.r2;
+    res->objective = wrss;
+    res->objective_zero = c->pr.ynorm;
+    res->ident = cf_ident_of(&res->params, 0);
+    c->pr.ctx = c;
+    search->pr.ctx = search;
+    const long before = c->pr.evals + (search != c ? search->pr.evals : 0);
+    cf_status st = cf_cell_uncertainty(&c->pr, &search->pr, res, err);
+    t->uncertainty_curves = c->pr.evals + (search != c ? search->pr.evals : 0) - before;
+    return st;
+}
+
 /* The fit through the lattice: the springs' reach, the starts, the search on the homogenised
-** cell and the placement, as marked below. Kept as one function because the stages share the
-** cell's setup and the result. */
+** cell, the placement and the target's numbers, as marked below. Kept as one function because
+** the stages share the cell's setup and the result. */
 cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_validate_setup *s,
                          cf_fit_result *res, cf_through_msm *t, cf_error *err)
 {
@@ -133,15 +144,15 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
     memset(t, 0, sizeof *t);
     t->ident_before = cf_ident_of(&res->params, 0);
     t->ident_after = t->ident_before;
-    tm_ctx c = {d, s, opt, res->type, NULL, 0, NULL, 0}, cs = {NULL, s, opt, res->type, NULL, 0,
-                                                               NULL, 0};
+    tm_ctx c, cs;
+    memset(&cs, 0, sizeof cs);
     cf_table sub;
     memset(&sub, 0, sizeof sub);
-    c.sw = malloc(sizeof(double) * (d->count ? d->count : 1));
-    c.curve = malloc(sizeof(double) * (d->count ? d->count : 1));
     double *spring_x = malloc(sizeof(double) * (d->count ? d->count : 1));
-    cf_status st = CF_OK;
-    if (!c.sw || !c.curve || !spring_x) {
+    cf_status st = tm_init(&c, d, s, opt, res->type, err);
+    if (st != CF_OK)
+        goto out;
+    if (!spring_x) {
         st = cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", d->count);
         goto out;
     }
@@ -159,22 +170,26 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
     for (size_t i = 0; i < d->count; i++)
         spring_x[i] = copysign(cf_cell_spring_strain(d->mode, d->x[i]), d->x[i]);
     const double xmax = cf_lsq_xmax(&reach);
-    c.ynorm = cf_lsq_weights(d, opt->relative, c.sw);
     t->rmse_before = cell_rmse(&res->params, &c);
     double rho_hi = cf_ident_rho_hi(res->type, opt->index_max);
     double lb[2] = {log(fmax(CF_IDENT_RHO_LO, opt->rho_min)),
                     xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9)};
     double ub[2] = {log(rho_hi), 1 - 1e-9};
-    if (!(lb[1] < ub[1]) || !(c.ynorm > 0)) {
+    if (!(lb[1] < ub[1]) || !(c.pr.ynorm > 0)) {
         st = cf_error_set(err, CF_E_DATA,
                           "largest strain %g: no spring reaches it, nothing to optimise", xmax);
         goto out;
     }
+    memcpy(c.pr.lb, lb, sizeof lb);
+    memcpy(c.pr.ub, ub, sizeof ub);
     /* a long table is searched on its subsample */
     tm_ctx *search = &c;
     if (d->count > CF_LATTICE_FIT_FULL_ROWS) {
-        if ((st = search_ctx(&c, &sub, &cs, err)) != CF_OK)
+        if ((st = cf_subsample(d, CF_SUBSAMPLE_ROWS, &sub, err)) != CF_OK ||
+            (st = tm_init(&cs, &sub, s, opt, res->type, err)) != CF_OK)
             goto out;
+        memcpy(cs.pr.lb, lb, sizeof lb);
+        memcpy(cs.pr.ub, ub, sizeof ub);
         search = &cs;
     }
     t->search_rows = search->d->count;
@@ -199,6 +214,11 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
             zb[0] = z[0], zb[1] = z[1];
         }
     }
+    if (search->pr.oom) {
+        st = cf_error_set(err, CF_E_INTERNAL, "out of memory in the lattice fit's optimiser "
+                                              "(NLopt)");
+        goto out;
+    }
     double A = 0;
     int ok = best < CF_LSQ_HUGE_OBJ && tm_profile(&c, zb, &A) < CF_LSQ_HUGE_OBJ && A > 0;
     const cf_ident ident = {.rho = exp(zb[0]), .solid = zb[1], .scale = A};
@@ -206,7 +226,12 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
     cf_fit_result placed;
     cf_error e = {0};
     double after = CF_LSQ_HUGE_OBJ;
-    if (ok && cf_fit_place(&reach, opt, res->type, &ident, &placed, &e) == CF_OK)
+    cf_status pst = ok ? cf_fit_place(&reach, opt, res->type, &ident, &placed, &e) : CF_E_DATA;
+    if (pst == CF_E_INTERNAL) {
+        st = cf_error_set(err, CF_E_INTERNAL, "%s", e.msg);
+        goto out;
+    }
+    if (pst == CF_OK)
         after = cell_rmse(&placed.params, &c);
     if (after < t->rmse_before) {
         t->ident_after = cf_ident_of(&placed.params, 0);
@@ -216,15 +241,16 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
         t->improved = 1;
     }
     t->cell_rmse = t->improved ? after : t->rmse_before;
-    t->done = 1;
+    /* the target's numbers: the cell's curve of the reported spring */
+    if (cell_rmse(&res->params, &c) < CF_LSQ_HUGE_OBJ)
+        st = take_target(&c, search, res, t, err);
+    t->done = st == CF_OK;
 out:
-    t->evaluations = c.evals + cs.evals;
-    free(cs.sw);
-    free(cs.curve);
+    t->evaluations = c.pr.evals + cs.pr.evals;
+    tm_free(&cs);
+    tm_free(&c);
     cf_table_free(&sub);
     t->wall_time_s = cf_clock_s() - t0;
-    free(c.sw);
-    free(c.curve);
     free(spring_x);
     return st;
 }

@@ -38,6 +38,14 @@ cf_lsq_quality cf_lsq_quality_of(const cf_table *t, const double *model);
 ** (GSL 2.7's gsl_cdf_fdist_Pinv fails for some large dof, e.g. 4997 and 1e5, and returns NaN). */
 double cf_lsq_f95(double dof);
 
+/* Standard errors s^2 (J^T W J)^-1 of three fitted quantities from jtj = J^T W J (J: the
+** model's derivatives in them at the solution) and the weighted RSS of n points, s^2 = RSS/(n - 3),
+** and their correlation matrix (NAN where not determined; errors -1). Returns 1 when J^T W J is
+** numerically singular (smallest eigenvalue of its unit-diagonal form below 1e-10 of the
+** largest) or n <= 3, -1 when memory runs out, else 0. Every fit's errors come from here. */
+int cf_lsq_covariance(double jtj[3][3], double rss, size_t n, double se[3],
+                      double corr[3][3]);
+
 /* Largest |x| of the table. */
 double cf_lsq_xmax(const cf_table *t);
 

@@ -127,7 +127,7 @@ double cf_visco_limits_scale_max(const cf_visco_limits *l, double rho, double B)
         if (!(l->types & (1u << ty)))
             continue;
         double A_max;
-        if (cf_fit_ident_limit(l->design, (cf_spring_type)ty, rho, B, &A_max) <= 0)
+        if (cf_fit_ident_limit(l->design, (cf_spring_type)ty, rho, B, &A_max, NULL) <= 0)
             best = fmax(best, A_max);
     }
     return best;

@@ -197,6 +197,10 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
         copy_string(data, "y_unit", out->y_unit, sizeof out->y_unit);
     }
     copy_string(root, "conifit_version", out->version, sizeof out->version);
+    /* a joint fit is the lattice's; a fit file's fit says so in its target */
+    const char *model = json_string_value(json_object_get(json_object_get(fit, "target"), "model"));
+    out->target_lattice = json_is_true(json_object_get(root, "joint")) ||
+                          (model && strcmp(model, "lattice") == 0);
     if ((st = read_visco(fit, path, where, out, err)) != CF_OK)
         goto done;
 done:

@@ -50,11 +50,13 @@ static void progress(const cf_pipeline_options *opt, const cf_table *t, const ch
     opt->progress(opt->progress_ctx, t->path, what);
 }
 
-/* The target of table t: the option, or AUTO's choice by the table's mode. */
+/* The target of table t: the option, or AUTO's choice: the lattice whenever a lattice is
+** involved (a validation, or a mode the single spring has no form of), a force-displacement
+** table's own spring otherwise. */
 static int through_lattice(const cf_table *t, const cf_pipeline_options *opt)
 {
     if (opt->target == CF_TARGET_AUTO)
-        return !cf_table_is_force(t) && t->mode != CF_MODE_UNIAXIAL;
+        return !cf_table_is_force(t) && (opt->validate || t->mode != CF_MODE_UNIAXIAL);
     return opt->target == CF_TARGET_LATTICE;
 }
 

@@ -14,6 +14,8 @@
 #include "conifit/version.h"
 #include "io/fitfile_json.h"
 #include "report/gnuplot.h"
+#include "report/report_json.h"
+#include "report/report_words.h"
 
 int cf_joint_better(const cf_joint_report *r)
 {
@@ -44,10 +46,24 @@ char *cf_joint_text(const cf_joint_report *r)
         fprintf(o, "\n%s spring: %s%s\n", cf_spring_type_name(j->fit.type),
                 cf_spring_text(p, 5, 0, sp, sizeof sp),
                 j->fit.feasible ? "" : " (violates its constraints)");
-        fprintf(o, " lattice: rho %.4g, solid strain s/H %.4g, stress scale F_C/H^2 %.4g kPa; "
+        char q[3][96];
+        cf_report_ident_cell(&j->fit, 0, 1, "", q[0], sizeof q[0]);
+        cf_report_ident_cell(&j->fit, 1, 1, "", q[1], sizeof q[1]);
+        cf_report_ident_cell(&j->fit, 2, 1e3, "kPa", q[2], sizeof q[2]);
+        fprintf(o, " lattice: rho %s, solid strain s/H %s, stress scale F_C/H^2 %s; "
                    "calibration %s (weights edge %.4g, face %.4g, body %.4g; nu %.3f)\n",
-                j->ident.rho, j->ident.solid, j->ident.scale * 1e3, cf_calibration_name(j->calibration),
-                j->weight[0], j->weight[1], j->weight[2], cm.nu);
+                q[0], q[1], q[2], cf_calibration_name(j->calibration), j->weight[0],
+                j->weight[1], j->weight[2], cm.nu);
+        static const char *const names[3] = {"rho", "solid strain", "stress scale"};
+        for (int k = 0; k < 3; k++)
+            if (j->fit.interval_ok[k]) {
+                char why[512];
+                cf_report_interval_reason(&j->fit, k, why, sizeof why);
+                fprintf(o, "  * %s: %s\n", names[k], why);
+            }
+        if (isfinite(j->fit.corr[0][1]))
+            fprintf(o, "  correlation rho-s %.3f, rho-A %.3f, s-A %.3f (the weights held)\n",
+                    j->fit.corr[0][1], j->fit.corr[0][2], j->fit.corr[1][2]);
         fprintf(o, "  %-44s %-12s %6s %14s %14s %14s\n", "table", "mode", "points", "fit RMSE",
                 "lattice RMSE", "vs law");
         for (size_t k = 0; k < r->ntables; k++) {
@@ -106,9 +122,15 @@ static json_t *joint_json(const cf_joint_report *r)
         if (!f)
             continue;
         cf_cubic_moduli cm = cf_cubic_moduli_of(j->weight);
-        json_object_set_new(f, "identifiable",
-                            json_pack("{s:o, s:o, s:o}", "rho", num(j->ident.rho), "solid_strain",
-                                      num(j->ident.solid), "stress_scale_MPa", num(j->ident.scale)));
+        static const char *const names[3] = {"rho", "solid_strain", "stress_scale_MPa"};
+        json_t *ident = json_object();
+        for (int k = 0; k < 3; k++)
+            json_object_set_new(ident, names[k], cf_report_ident_json(&j->fit, k));
+        json_object_set_new(f, "identifiable", ident);
+        json_object_set_new(f, "identifiable_correlation",
+                            cf_report_correlation_json(&j->fit, names));
+        json_object_set_new(f, "target", json_pack("{s:s, s:s}", "model", "lattice", "mode",
+                                                   "joint"));
         json_object_set_new(
             f, "lattice",
             json_pack("{s:s, s:{s:o, s:o, s:o}, s:o, s:o}", "calibration",

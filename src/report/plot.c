@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "conifit/cell.h"
 #include "report/gnuplot.h"
 
 /* Points on each model curve. */
@@ -60,10 +61,40 @@ static void lattice_block(cf_gp *g, const char *name, const cf_table *d,
     free(ord);
 }
 
+/* Which curves a panel draws: the fits (both, or one when the types tie) and the lattices (both,
+** one when their curves coincide, or none). */
+typedef struct fit_curves {
+    int fit[2];       /* 1: draw fit k */
+    int lattice[2];   /* 1: draw the lattice curve of fit k */
+    int style[2];     /* line style of fit k (its lattice curve: style + 5) */
+    int lattice_fit[2]; /* 1: fit k is drawn as the lattice's curve it was fitted through */
+    char fit_title[2][96];
+    char lattice_title[2][128];
+} fit_curves;
+
+/* The curve a fit through the lattice fitted, at the count strains x: its lattice's homogenised
+** cell in the table's mode (in uniaxial mode the full lattice's curve wherever that deforms
+** homogeneously: the validation's check). 0, or nonzero when the cell cannot run it. */
+static int target_curve(const cf_fit_report *r, int k, const double *x, size_t count,
+                        double *out)
+{
+    const cf_validate_setup *su = &r->val[k].setup;
+    cf_law law;
+    if (cf_law_init(&law, &r->fits[k].params, NULL) != CF_OK)
+        return 1;
+    cf_cell cell;
+    int bad = cf_cell_init(&cell, &law, su->method == CF_LAW_TABLE ? CF_LAW_CLOSED : su->method,
+                           su->cfg.lattice.weight, NULL) != CF_OK ||
+              cf_cell_curve(&cell, r->table->mode, x, count, out, NULL) != CF_OK;
+    cf_law_free(&law);
+    return bad;
+}
+
 /* The data blocks: $DATA (x, y, the residual of each fit then of each baseline) and $CURVES (x,
 ** each fit, each baseline) in the file's unit. */
-static void fit_blocks(cf_gp *g, const cf_fit_report *r)
+static void fit_blocks(cf_gp *g, const cf_fit_report *r, fit_curves *fc)
 {
+    const int *lattice_fit = fc->lattice_fit;
     const cf_table *d = r->table;
     const double u = d->y_to_file;
     const int fd = cf_table_is_force(d);
@@ -72,13 +103,31 @@ static void fit_blocks(cf_gp *g, const cf_fit_report *r)
         xmin = fmin(xmin, d->x[i]);
         xmax = fmax(xmax, d->x[i]);
     }
+    double xs[CURVE_POINTS + 1], target[2][CURVE_POINTS + 1];
+    for (int j = 0; j <= CURVE_POINTS; j++)
+        xs[j] = xmin + (xmax - xmin) * j / CURVE_POINTS;
+    for (int k = 0; k < r->nfits; k++)
+        if (lattice_fit[k] && target_curve(r, k, xs, CURVE_POINTS + 1, target[k]) != 0) {
+            /* the cell cannot run the curve between the points: the lattice at the table's
+            ** strains (the validation's) is drawn as the fit instead */
+            memset(target[k], 0, sizeof target[k]);
+            if (fc->fit[k]) {
+                fc->fit[k] = 0;
+                fc->lattice[k] = 1;
+                snprintf(fc->lattice_title[k], sizeof fc->lattice_title[k], "%s",
+                         fc->fit_title[k]);
+            }
+        }
     cf_gp_block_begin(g, "DATA");
     for (size_t i = 0; i < d->count; i++) {
         size_t c = 0;
         row[c++] = d->x[i];
         row[c++] = d->y[i] * u;
         for (int k = 0; k < r->nfits; k++)
-            row[c++] = (cf_fit_model(&r->fits[k].law, fd, d->x[i]) - d->y[i]) * u;
+            row[c++] = ((lattice_fit[k] ? r->val[k].stress_MPa[i]
+                                        : cf_fit_model(&r->fits[k].law, fd, d->x[i])) -
+                        d->y[i]) *
+                       u;
         for (int k = 0; k < CF_BASE_COUNT; k++)
             row[c++] = (cf_baseline_eval(&r->baselines[k], d->x[i]) - d->y[i]) * u;
         cf_gp_block_row(g, c, row);
@@ -87,26 +136,16 @@ static void fit_blocks(cf_gp *g, const cf_fit_report *r)
     cf_gp_block_begin(g, "CURVES");
     for (int j = 0; j <= CURVE_POINTS; j++) {
         size_t c = 0;
-        double x = xmin + (xmax - xmin) * j / CURVE_POINTS;
-        row[c++] = x;
+        row[c++] = xs[j];
         for (int k = 0; k < r->nfits; k++)
-            row[c++] = cf_fit_model(&r->fits[k].law, fd, x) * u;
+            row[c++] = (lattice_fit[k] ? target[k][j] : cf_fit_model(&r->fits[k].law, fd, xs[j])) *
+                       u;
         for (int k = 0; k < CF_BASE_COUNT; k++)
-            row[c++] = cf_baseline_eval(&r->baselines[k], x) * u;
+            row[c++] = cf_baseline_eval(&r->baselines[k], xs[j]) * u;
         cf_gp_block_row(g, c, row);
     }
     cf_gp_block_end(g);
 }
-
-/* Which curves a panel draws: the fits (both, or one when the types tie) and the lattices (both,
-** one when their curves coincide, or none). */
-typedef struct fit_curves {
-    int fit[2];       /* 1: draw fit k */
-    int lattice[2];   /* 1: draw the lattice curve of fit k */
-    int style[2];     /* line style of fit k (its lattice curve: style + 5) */
-    char fit_title[2][96];
-    char lattice_title[2][128];
-} fit_curves;
 
 /* Two curves that differ by less than this fraction of the largest |y| cannot be told apart in a
 ** figure: they are drawn once, and the legend says so. */
@@ -120,6 +159,9 @@ static void choose_curves(const cf_fit_report *r, fit_curves *c)
     int keep = cf_report_better(r);
     if (keep < 0)
         keep = 0;
+    for (int k = 0; k < r->nfits; k++)
+        c->lattice_fit[k] = cf_report_target_is_lattice(r) && r->val[k].done &&
+                            r->val[k].count == d->count && r->val[k].stress_MPa;
     for (int k = 0; k < r->nfits; k++) {
         c->fit[k] = 1;
         c->style[k] = 1 + (int)r->fits[k].type;
@@ -129,6 +171,22 @@ static void choose_curves(const cf_fit_report *r, fit_curves *c)
         const cf_lattice_config *lc = &r->val[k].setup.cfg.lattice;
         snprintf(c->lattice_title[k], sizeof c->lattice_title[k], "lattice %dx%dx%d, %s", lc->nx,
                  lc->ny, lc->nz, cf_spring_type_name(r->fits[k].type));
+        /* a fit through the lattice is its lattice's curve (the cell's in a mode the single
+        ** spring has no form of), drawn as the fit; the spring's law is not what was fitted */
+        if (c->lattice_fit[k]) {
+            c->lattice[k] = 0;
+            snprintf(c->fit_title[k], sizeof c->fit_title[k], "fit: lattice, %s",
+                     cf_spring_type_name(r->fits[k].type));
+        }
+    }
+    if (c->lattice_fit[0] && (r->nfits == 1 || c->lattice_fit[1])) {
+        if (r->nfits == 2 && cf_report_types_tie(r)) {
+            c->fit[1 - keep] = 0;
+            c->style[keep] = 1;
+            snprintf(c->fit_title[keep], sizeof c->fit_title[keep],
+                     "fit: lattice, both types (a tie)");
+        }
+        return;
     }
     if (r->nfits != 2)
         return;
@@ -200,13 +258,35 @@ static void fit_panel(cf_gp *g, const cf_fit_report *r, const fit_curves *c, int
     cf_gp_cmd(g, "");
 }
 
+/* The axes in the measures that were fitted (a table's columns are converted to engineering
+** strain, or the amount of shear, and nominal stress), naming the column's own measure when it
+** was converted: "nominal stress (from cauchy) [kPa]". */
+static void axis_labels(const cf_table *d, char *x, size_t xcap, char *y, size_t ycap)
+{
+    if (cf_table_is_force(d)) {
+        snprintf(x, xcap, "displacement [mm]");
+        snprintf(y, ycap, "%s [%s]", d->y_column, d->y_unit);
+        return;
+    }
+    const cf_table_measures *m = &d->measures;
+    char from[64] = "";
+    if (m->strain != CF_STRAIN_ENGINEERING)
+        snprintf(from, sizeof from, " (from %s)", cf_strain_measure_name(m->strain));
+    snprintf(x, xcap, "%s%s [-]",
+             d->mode == CF_MODE_SHEAR ? "amount of shear" : "engineering strain", from);
+    from[0] = '\0';
+    if (m->stress != CF_STRESS_NOMINAL)
+        snprintf(from, sizeof from, " (from %s)", cf_stress_measure_name(m->stress));
+    snprintf(y, ycap, "nominal stress%s [%s]", from, d->y_unit);
+}
+
 static void fit_script(cf_gp *g, const void *fig)
 {
     const cf_fit_report *r = fig;
     const cf_table *d = r->table;
-    fit_blocks(g, r);
     fit_curves c;
     choose_curves(r, &c);
+    fit_blocks(g, r, &c);
     static const char *const lat_name[2] = {"LATTICE0", "LATTICE1"};
     for (int k = 0; k < r->nfits; k++)
         if (c.lattice[k])
@@ -223,7 +303,9 @@ static void fit_script(cf_gp *g, const void *fig)
     cf_gp_cmd(g, "set format y %q", "%g");
     cf_gp_cmd(g, "set lmargin at screen %g", PANEL_LEFT);
     cf_gp_cmd(g, "set rmargin at screen %g", PANEL_RIGHT);
-    cf_gp_cmd(g, "set xlabel %q", cf_table_is_force(d) ? "displacement [mm]" : "strain [-]");
+    char xlabel[160];
+    axis_labels(d, xlabel, sizeof xlabel, label, sizeof label);
+    cf_gp_cmd(g, "set xlabel %q noenhanced", xlabel);
     /* the model panel */
     cf_gp_cmd(g, "set title %q noenhanced", title);
     cf_gp_cmd(g, "set tmargin at screen 0.93");
@@ -231,7 +313,6 @@ static void fit_script(cf_gp *g, const void *fig)
     cf_gp_cmd(g, "set key at screen %g,0.93 left top Left reverse noenhanced spacing 1.2 "
                  "samplen 3.5 title %q",
               KEY_LEFT, "model");
-    snprintf(label, sizeof label, "%s [%s]", d->y_column, d->y_unit);
     cf_gp_cmd(g, "set ylabel %q noenhanced", label);
     fit_panel(g, r, &c, 0);
     /* the residual panel */

@@ -13,6 +13,7 @@
 
 #include "base/atomic.h"
 #include "io/fitfile_json.h"
+#include "report/report_json.h"
 #include "report/report_words.h"
 
 void cf_report_free(cf_fit_report *r)
@@ -33,6 +34,14 @@ int cf_report_better(const cf_fit_report *r)
 int cf_report_types_tie(const cf_fit_report *r)
 {
     return r->nfits == 2 && cf_fit_compare(&r->fits[0], &r->fits[1], r->table->count).tie;
+}
+
+int cf_report_target_is_lattice(const cf_fit_report *r)
+{
+    int all = r->through_msm && r->nfits > 0;
+    for (int i = 0; i < r->nfits; i++)
+        all = all && r->thr[i].done;
+    return all;
 }
 
 double cf_report_fit_aic(const cf_fit_report *r, int i)
@@ -60,79 +69,6 @@ static json_t *constraint_list(unsigned bits)
 
 
 
-/* Why a fit has no standard errors (and no correlation matrix), in words. */
-static const char *stderr_reason(const cf_fit_result *f)
-{
-    if (strcmp(f->optimizer, "placement") == 0)
-        return "not computed: the spring is placed from the quantities of the fit through the "
-               "lattice";
-    for (int k = 0; k < 3; k++)
-        if (f->interval_ok[k] && (f->interval_why[k] & CF_FIT_RANK_DEFICIENT))
-            return "not determined: the Jacobian of the three quantities is numerically "
-                   "rank-deficient (see interval)";
-    return "not determined: the linearised covariance s^2 (J^T W J)^-1 could not be formed";
-}
-
-/* {value, stderr | stderr_reason, [interval, interval_reason]} in conifit's units (MPa, N, mm):
-** a key is present only with a value, never null. */
-static json_t *ident_json(const cf_fit_result *f, int k)
-{
-    double se = f->ident_se.v[k];
-    json_t *o = json_pack("{s:o}", "value", num(f->ident.v[k]));
-    if (!o)
-        return NULL;
-    if (se >= 0)
-        json_object_set_new(o, "stderr", num(se));
-    else
-        json_object_set_new(o, "stderr_reason", json_string(stderr_reason(f)));
-    if (f->interval_ok[k]) {
-        char why[512];
-        cf_report_interval_reason(f, k, why, sizeof why);
-        json_object_set_new(o, "interval",
-                            json_pack("[o, o]", num(f->interval[k][0]), num(f->interval[k][1])));
-        json_object_set_new(o, "interval_reason", json_string(why));
-        /* an end that is a limit, not the data's: the interval is one-sided there */
-        json_t *lim = json_object();
-        for (int e = 0; e < 2; e++) {
-            unsigned b = f->interval_end[k][e];
-            if (b && lim)
-                json_object_set_new(lim, e ? "upper" : "lower",
-                                    json_string(cf_fit_constraint_name(b & (0u - b))));
-        }
-        if (lim && json_object_size(lim) > 0)
-            json_object_set_new(o, "interval_limit", lim);
-        else
-            json_decref(lim);
-    }
-    return o;
-}
-
-/* {order, matrix} when every correlation is determined, else {order, reason}. */
-static json_t *correlation_json(const cf_fit_result *f, const char *const names[3])
-{
-    json_t *o = json_pack("{s:[s, s, s]}", "order", names[0], names[1], names[2]);
-    int ok = 1;
-    for (int a = 0; a < 3; a++)
-        for (int b = 0; b < 3; b++)
-            ok = ok && isfinite(f->corr[a][b]);
-    if (!o)
-        return NULL;
-    if (!ok) {
-        json_object_set_new(o, "reason", json_string(stderr_reason(f)));
-        return o;
-    }
-    json_t *m = json_array();
-    for (int a = 0; a < 3; a++) {
-        json_t *row = json_array();
-        for (int b = 0; b < 3; b++)
-            json_array_append_new(row, num(f->corr[a][b]));
-        json_array_append_new(m, row);
-    }
-    json_object_set_new(o, "matrix", m);
-    return o;
-}
-
-
 static json_t *fit_json_core(const cf_fit_report *r, int i)
 {
     const cf_fit_result *f = &r->fits[i];
@@ -143,7 +79,7 @@ static json_t *fit_json_core(const cf_fit_report *r, int i)
     const char *const *names = fd ? fd_names : ss_names;
     json_t *ident = json_object();
     for (int k = 0; k < 3; k++)
-        json_object_set_new(ident, names[k], ident_json(f, k));
+        json_object_set_new(ident, names[k], cf_report_ident_json(f, k));
     json_t *o = cf_fitfile_spring_json(&f->law);
     json_t *rest = json_pack(
         "{s:o, s:o, s:o, s:o, s:o, s:b, s:o, s:o, s:s, s:I, s:o}", "identifiable", ident, "rmse",
@@ -161,7 +97,7 @@ static json_t *fit_json_core(const cf_fit_report *r, int i)
     json_decref(rest);
     /* the type fitted: an infeasible fit's geometry may be of the other type */
     json_object_set_new(o, "type", json_string(cf_spring_type_name(f->type)));
-    json_object_set_new(o, "identifiable_correlation", correlation_json(f, names));
+    json_object_set_new(o, "identifiable_correlation", cf_report_correlation_json(f, names));
     json_object_set_new(o, "held_by", constraint_list(f->held));
     json_object_set_new(
         o, "extrapolation",
@@ -224,12 +160,38 @@ static json_t *through_json(const cf_fit_report *r, int i)
                           (json_int_t)t->evaluations);
     if (o && t->verified)
         json_object_set_new(o, "verification_max_abs", num(t->verify_max_abs * u));
+    if (o) /* of evaluations: the Jacobian and the profiles of the uncertainty */
+        json_object_set_new(o, "uncertainty_evaluations", json_integer(t->uncertainty_curves));
     return o;
+}
+
+/* {model: lattice | spring, mode, evaluated_by}: what the fit's numbers are of. */
+static json_t *target_json(const cf_fit_report *r)
+{
+    const int lat = cf_report_target_is_lattice(r);
+    return json_pack("{s:s, s:s, s:s}", "model", lat ? "lattice" : "spring", "mode",
+                     cf_table_is_force(r->table) ? "force-displacement" : cf_mode_name(r->table->mode),
+                     "evaluated_by", lat ? "homogenised cell" : "the spring's law");
+}
+
+/* The single spring's own law against a uniaxial table, beside a lattice target. */
+static json_t *spring_law_json(const cf_fit_report *r, int i)
+{
+    const cf_through_msm *t = &r->thr[i];
+    double u = r->table->y_to_file;
+    return json_pack("{s:s, s:o, s:o, s:o}", "what",
+                     "the single spring's uniaxial law against the table, not the fit's target",
+                     "rmse", num(t->law_rmse * u), "max_abs_error", num(t->law_max_abs_error * u),
+                     "r2", num(t->law_r2));
 }
 
 static json_t *fit_json(const cf_fit_report *r, int i)
 {
     json_t *o = fit_json_core(r, i);
+    if (o)
+        json_object_set_new(o, "target", target_json(r));
+    if (o && cf_report_target_is_lattice(r) && isfinite(r->thr[i].law_rmse))
+        json_object_set_new(o, "spring_law", spring_law_json(r, i));
     if (o && r->validate)
         json_object_set_new(o, "validation", validation_json(r, i));
     if (o && r->through_msm && r->thr[i].done)

@@ -39,21 +39,6 @@ static void row(FILE *o, const cf_fit_report *r, const char *label, const char *
     fputc('\n', o);
 }
 
-/* Significant digits that tell the ends of the interval [lo, hi] from the value v: 3, or more
-** when an end lies closer to v than 3 digits show (a precise or long table), at most 17. */
-static int interval_digits(double v, double lo, double hi)
-{
-    double w = INFINITY;
-    if (v - lo > 0)
-        w = v - lo;
-    if (hi - v > 0)
-        w = fmin(w, hi - v);
-    if (!(v != 0) || !isfinite(w))
-        return 3;
-    double d = floor(log10(fabs(v))) - floor(log10(w)) + 1;
-    return (int)fmin(17, fmax(3, d));
-}
-
 /* value ± standard error, or value [low, high] (the profile interval, marked *) */
 static void ident_row(FILE *o, const cf_fit_report *r, const char *label, int k, double scale,
                       const char *unit)
@@ -61,21 +46,7 @@ static void ident_row(FILE *o, const cf_fit_report *r, const char *label, int k,
     fprintf(o, "  %-26s", label);
     for (int i = 0; i < r->nfits; i++) {
         char cell[96];
-        const cf_fit_result *f = &r->fits[i];
-        const char *sp = *unit ? " " : "";
-        if (f->interval_ok[k]) {
-            const double v = f->ident.v[k] * scale, lo = f->interval[k][0] * scale,
-                         hi = f->interval[k][1] * scale;
-            const int dg = interval_digits(v, lo, hi);
-            snprintf(cell, sizeof cell, "%.*g [%.*g, %.*g]*%s%s", dg > 4 ? dg : 4, v, dg, lo, dg,
-                     hi, sp, unit);
-        }
-        else if (f->ident_se.v[k] >= 0)
-            snprintf(cell, sizeof cell, "%.6g ± %.2g%s%s", f->ident.v[k] * scale,
-                     f->ident_se.v[k] * scale, sp, unit);
-        else /* uncertainty() computes an interval wherever the error is undetermined */
-            snprintf(cell, sizeof cell, "%.6g%s%s (no error: placed, not fitted)",
-                     f->ident.v[k] * scale, sp, unit);
+        cf_report_ident_cell(&r->fits[i], k, scale, unit, cell, sizeof cell);
         fprintf(o, " %-24s", cell);
     }
     fputc('\n', o);
@@ -104,8 +75,8 @@ static void cells(FILE *o, const cf_fit_report *r, const char *label, const char
     fputc('\n', o);
 }
 
-/* The lattice the validation ran (the setup of a fit it was done for), its moduli, the test mode
-** and what the fit targeted. */
+/* The lattice the validation ran (the setup of a fit it was done for), its moduli and the test
+** mode (the fit's target is stated once, at the top). */
 static void validation_header(FILE *o, const cf_fit_report *r)
 {
     const cf_validate_setup *su = &r->val[0].setup;
@@ -124,10 +95,9 @@ static void validation_header(FILE *o, const cf_fit_report *r)
             lc->weight[CF_FAMILY_EDGE], lc->weight[CF_FAMILY_FACE], lc->weight[CF_FAMILY_BODY],
             cm.E, cm.nu, lc->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "axial",
             cf_law_method_name(su->method));
-    fprintf(o, "  mode %s, %s; fit target: %s\n", cf_mode_name(v0->mode),
+    fprintf(o, "  mode %s, %s\n", cf_mode_name(v0->mode),
             v0->by_cell ? "homogenised cell (the full lattice has no such boundary conditions)"
-                        : "full lattice",
-            r->through_msm ? "the lattice (through the homogenised cell)" : "the single spring");
+                        : "full lattice");
 }
 
 /* Prints rows k < nrows of buf (one cell per fit) under their labels. */
@@ -200,8 +170,8 @@ static void through_rows(FILE *o, const cf_fit_report *r)
                      th->verify_max_abs * u, yu);
         else
             snprintf(buf[1][i], sizeof buf[1][i], "%s", th->done ? "cell only" : "");
-        snprintf(buf[2][i], sizeof buf[2][i], "%.3f s, %ld cell curves", th->wall_time_s,
-                 th->evaluations);
+        snprintf(buf[2][i], sizeof buf[2][i], "%.3f s, %ld cell curves (%ld for errors)",
+                 th->wall_time_s, th->evaluations, th->uncertainty_curves);
     }
     static const char *const tl[3] = {"through lattice: RMSE", "verified in full lattice",
                                       "through lattice: cost"};
@@ -254,6 +224,19 @@ static void table_text(FILE *o, const cf_fit_report *r)
     fputc('\n', o);
 }
 
+/* The fit's target, once: what every headline number below (quality, errors, the type's
+** verdict) is of. */
+static void target_text(FILE *o, const cf_fit_report *r)
+{
+    if (cf_report_target_is_lattice(r))
+        fprintf(o, " fit target: the lattice in %s (its homogenised cell): every number below "
+                   "is the lattice's unless named otherwise\n\n",
+                cf_mode_name(r->table->mode));
+    else if (!cf_table_is_force(r->table))
+        fprintf(o, " fit target: the single spring (its law F(eH)/H^2 against the table)%s\n\n",
+                r->validate ? "; the lattice below is a check of that spring" : "");
+}
+
 /* The three quantities the data determine, their intervals, correlations and distance to solid. */
 static void identifiable_text(FILE *o, const cf_fit_report *r)
 {
@@ -292,6 +275,27 @@ static void identifiable_text(FILE *o, const cf_fit_report *r)
     fputc('\n', o);
 }
 
+/* The single spring's own law against the table, beside a lattice target: only for a uniaxial
+** table (in the other modes the law has no curve to compare). */
+static void spring_law_text(FILE *o, const cf_fit_report *r)
+{
+    if (!cf_report_target_is_lattice(r) || r->table->mode != CF_MODE_UNIAXIAL)
+        return;
+    enum { ROWS = 3 };
+    char buf[ROWS][2][64];
+    const double u = r->table->y_to_file;
+    for (int i = 0; i < r->nfits; i++) {
+        const cf_through_msm *t = &r->thr[i];
+        snprintf(buf[0][i], sizeof buf[0][i], "%.4g %s", t->law_rmse * u, r->table->y_unit);
+        snprintf(buf[1][i], sizeof buf[1][i], "%.4g %s", t->law_max_abs_error * u,
+                 r->table->y_unit);
+        snprintf(buf[2][i], sizeof buf[2][i], "%.6f", t->law_r2);
+    }
+    static const char *const labels[ROWS] = {"RMSE", "max |error|", "R^2"};
+    fprintf(o, " the single spring against the table (uniaxial law):\n");
+    cell_rows(o, r, buf, ROWS, labels);
+}
+
 /* One spring of the family (the field table's parameters and what follows from them), and the
 ** fit's quality. */
 static void spring_text(FILE *o, const cf_fit_report *r)
@@ -309,11 +313,12 @@ static void spring_text(FILE *o, const cf_fit_report *r)
     row(o, r, "F_T, F_C", "%.4g N", 8);
     row(o, r, "", "%.4g N", 9);
     row(o, r, "k0", "%.6g N/mm", 14);
-    fprintf(o, " quality:\n");
+    fprintf(o, " quality (the %s):\n", cf_report_target_is_lattice(r) ? "lattice's" : "spring's");
     row(o, r, "RMSE", "%.4g %s", 10);
     row(o, r, "max |error|", "%.4g %s", 11);
     row(o, r, "R^2", "%.6f", 12);
     row(o, r, "AIC (k = 3)", "%.2f", 13);
+    spring_law_text(o, r);
 }
 
 /* One row of constraint names per fit: those of its active (which = 0) or holding (1) mask,
@@ -414,6 +419,7 @@ char *cf_report_text(const cf_fit_report *r)
     if (!o)
         return NULL;
     table_text(o, r);
+    target_text(o, r);
     fprintf(o, "  %-26s", "");
     for (int i = 0; i < r->nfits; i++)
         fprintf(o, " %-24s", cf_spring_type_name(r->fits[i].type));

@@ -145,3 +145,37 @@ void cf_report_conversion(const cf_table *t, char *buf, size_t cap)
                              cf_mode_name(t->mode));
     }
 }
+
+/* Significant digits that tell the ends of the interval [lo, hi] from the value v: 3, or more
+** when an end lies closer to v than 3 digits show (a precise or long table), at most 17. */
+static int interval_digits(double v, double lo, double hi)
+{
+    double w = INFINITY;
+    if (v - lo > 0)
+        w = v - lo;
+    if (hi - v > 0)
+        w = fmin(w, hi - v);
+    if (!(v != 0) || !isfinite(w))
+        return 3;
+    double d = floor(log10(fabs(v))) - floor(log10(w)) + 1;
+    return (int)fmin(17, fmax(3, d));
+}
+
+void cf_report_ident_cell(const cf_fit_result *f, int k, double scale, const char *unit,
+                          char *cell, size_t cap)
+{
+    const char *sp = *unit ? " " : "";
+    if (f->interval_ok[k]) {
+        const double v = f->ident.v[k] * scale, lo = f->interval[k][0] * scale,
+                     hi = f->interval[k][1] * scale;
+        const int dg = interval_digits(v, lo, hi);
+        snprintf(cell, cap, "%.*g [%.*g, %.*g]*%s%s", dg > 4 ? dg : 4, v, dg, lo, dg, hi, sp,
+                 unit);
+    } else if (f->ident_se.v[k] >= 0) {
+        snprintf(cell, cap, "%.6g ± %.2g%s%s", f->ident.v[k] * scale, f->ident_se.v[k] * scale,
+                 sp, unit);
+    } else { /* the uncertainty code computes an interval wherever the error is undetermined */
+        snprintf(cell, cap, "%.6g%s%s (no error: not determined)", f->ident.v[k] * scale, sp,
+                 unit);
+    }
+}

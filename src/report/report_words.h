@@ -19,6 +19,11 @@ void cf_report_append(char *buf, size_t cap, size_t *n, const char *fmt, ...)
 /* Why fit f's profile interval of quantity k was computed and where its ends come from. */
 void cf_report_interval_reason(const cf_fit_result *f, int k, char *buf, size_t cap);
 
+/* Quantity k of fit f (times scale, in unit) with its standard error, "value ± se", or its
+** profile interval, "value [low, high]*" (the digits that tell the ends from the value). */
+void cf_report_ident_cell(const cf_fit_result *f, int k, double scale, const char *unit,
+                          char *cell, size_t cap);
+
 /* The one sentence that compares the two types (both fitted, at least one feasible). */
 void cf_report_verdict(const cf_fit_report *r, char *buf, size_t cap);
 

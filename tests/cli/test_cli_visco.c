@@ -34,7 +34,7 @@ static void test_cli_series_errors(void **state)
     }
     fclose(f);
     fclose(g);
-    char so[4096], se[4096];
+    char so[1 << 16], se[4096]; /* the report of the stress-strain table is long */
     assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "fit %s --branches 9 -o %s", path, out),
                      65);
     assert_non_null(strstr(se, "--branches"));

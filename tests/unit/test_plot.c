@@ -40,7 +40,8 @@ static size_t count(const char *hay, const char *needle)
     return n;
 }
 
-/* Fits data/NAME.csv through the pipeline (validated when asked) and draws it to dir/OUT. */
+/* Fits data/NAME.csv through the pipeline (validated when asked: 1 through the lattice, the
+** default, 2 the bare spring checked in the lattice) and draws it to dir/OUT. */
 static char *fit_and_draw(const char *name, int validate, const char *title, const char *out,
                           size_t *len)
 {
@@ -52,7 +53,9 @@ static char *fit_and_draw(const char *name, int validate, const char *title, con
     if (cf_measure_load(table_path, NULL, &t, &err) != CF_OK)
         fail_msg("%s", err.msg);
     cf_pipeline_options po = cf_pipeline_default_options();
-    po.validate = validate;
+    po.validate = validate != 0;
+    if (validate == 2)
+        po.target = CF_TARGET_SPRING;
     po.title = title;
     cf_fit_report r;
     if (cf_pipeline_fit(&t, &po, &r, &err) != CF_OK ||
@@ -85,14 +88,15 @@ static void every_format_is_written(void **state)
 }
 
 /* data/telescoping.csv fits both types equally well: one conical curve, labelled as a tie, in
-** both panels; the title is the table's name; both panels carry a legend. */
+** both panels; the title is the table's name; both panels carry a legend. (The bare spring's
+** fit, checked in the lattice.) */
 static void a_tie_is_one_labelled_curve_and_the_title_is_the_table(void **state)
 {
     (void)state;
     if (!have_gnuplot())
         skip();
     size_t len;
-    char *svg = fit_and_draw("telescoping", 1, NULL, "tie.svg", &len);
+    char *svg = fit_and_draw("telescoping", 2, NULL, "tie.svg", &len);
     assert_non_null(svg);
     /* a legend entry is <text>NAME</text> in the SVG */
     assert_int_equal(count(svg, "<text>conical, both types (a tie)</text>"), 2);
@@ -105,6 +109,23 @@ static void a_tie_is_one_labelled_curve_and_the_title_is_the_table(void **state)
     /* the lattice curve in both panels (its residual below) */
     assert_int_equal(count(svg, "<text>lattice 3x3x3, both types (coincide)</text>"), 2);
     /* three baselines, each in both panels */
+    assert_int_equal(count(svg, "<text>duffing</text>"), 2);
+}
+
+/* A fit through the lattice draws what was fitted: the lattice's curve and its residuals (one
+** curve for the tie), not the single spring's law; the axes name the fitted measures. */
+static void a_lattice_fit_draws_the_lattice(void **state)
+{
+    (void)state;
+    if (!have_gnuplot())
+        skip();
+    size_t len;
+    char *svg = fit_and_draw("telescoping", 1, NULL, "lat.svg", &len);
+    assert_non_null(svg);
+    assert_int_equal(count(svg, "<text>fit: lattice, both types (a tie)</text>"), 2);
+    assert_null(strstr(svg, "<text>conical,"));
+    assert_non_null(strstr(svg, "nominal stress [kPa]"));
+    assert_non_null(strstr(svg, "engineering strain [-]"));
     assert_int_equal(count(svg, "<text>duffing</text>"), 2);
 }
 
@@ -153,6 +174,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(every_format_is_written),
         cmocka_unit_test(a_tie_is_one_labelled_curve_and_the_title_is_the_table),
+        cmocka_unit_test(a_lattice_fit_draws_the_lattice),
         cmocka_unit_test(a_title_can_be_given),
         cmocka_unit_test(a_simulation_figure_has_its_legend),
     };

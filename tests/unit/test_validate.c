@@ -63,8 +63,9 @@ static int close_rel(double a, double b, double rel)
     return fabs(a - b) <= rel * fmax(fabs(a), fabs(b));
 }
 
-/* --validate with the default lattice writes finite validation keys whose RMSE equals the one
-** recomputed here from cf_msm_uniaxial with the written spring. */
+/* --validate --target spring (the bare spring, then checked in the default lattice) writes
+** finite validation keys whose RMSE equals the one recomputed here from cf_msm_uniaxial with the
+** written spring. */
 static void validate_writes_keys_consistent_with_the_lattice(void **state)
 {
     (void)state;
@@ -73,10 +74,12 @@ static void validate_writes_keys_consistent_with_the_lattice(void **state)
     char json[256];
     snprintf(json, sizeof json, "%s/v.json", dir);
     int st = tu_run(out, sizeof out, errb, sizeof errb,
-                    "fit data/telescoping_noise1pct.csv --type telescoping --validate -o %s", json);
+                    "fit data/telescoping_noise1pct.csv --type telescoping --validate --target spring "
+                    "-o %s", json);
     if (st != 0)
         fail_msg("exit %d: %s", st, errb);
     assert_non_null(strstr(out, "lattice RMSE"));
+    assert_non_null(strstr(out, "fit target: the single spring"));
     json_t *root;
     json_t *f = fit_of(json, 0, &root);
     json_t *v = json_object_get(f, "validation");

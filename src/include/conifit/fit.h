@@ -197,10 +197,11 @@ int cf_fit_check(const cf_spring *p, cf_spring_type type, const cf_table *data,
 ** at rho and B = s/H: returns a margin (log units, <= 0 where a spring of the type can be placed
 ** within the limits of opt) and in *A_max the largest stress scale F_C/H^2 (MPa) it can carry
 ** there (family.h, cf_ident_region_at, under the limits of opt). With a fixed parameter no closed
-** form exists: margin -1, *A_max = INFINITY. Used by the fits through the lattice and the
-** viscoelastic fit, which search the same space. */
+** form exists: margin -1, *A_max = INFINITY. *bits (may be NULL) receives the CF_C_* bits of the
+** two limits whose edge bounds the region there (as cf_ident_region_at's lo_bit | hi_bit). Used by the fits through the
+** lattice and the viscoelastic fit, which search the same space. */
 double cf_fit_ident_limit(const cf_fit_options *opt, cf_spring_type type, double rho, double B,
-                          double *A_max);
+                          double *A_max, unsigned *bits);
 
 /* Name of a constraint bit ("index_min", ...), and of an optimiser ("slsqp", ...). */
 const char *cf_fit_constraint_name(unsigned bit);

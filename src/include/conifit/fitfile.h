@@ -45,6 +45,9 @@ typedef struct cf_fitted_spring {
     char data_file[512];         /* "" if absent */
     char y_unit[32];             /* unit of rmse; "" if absent */
     char version[32];            /* conifit version that wrote the file; "" if absent */
+    int target_lattice;          /* 1: the spring was fitted through the lattice (the fit's
+                                 ** "target" says lattice); 0: the single spring's law (also a
+                                 ** file without "target", written before it existed) */
     /* A viscoelastic fit (of a time series) also carries its Prony terms and dashpot. */
     int viscoelastic;            /* 1 when the fit has a "prony" list */
     int prony_count;

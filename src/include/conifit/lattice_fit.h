@@ -36,7 +36,13 @@ typedef struct cf_through_msm {
     int improved;               /* 1: the spring was replaced (the lattice fits better) */
     double rmse_before;         /* RMSE of the ordinary fit in the lattice (homogenised cell),
                                 ** MPa */
-    double cell_rmse;           /* RMSE of the reported spring through the cell: the fit's, MPa */
+    double cell_rmse;           /* RMSE of the reported spring through the cell: the fit's, MPa
+                                ** (the fit's rmse, r2, ... are the cell's once done) */
+    double law_rmse;            /* the single spring's own law against the table (a uniaxial
+                                ** table; NAN in the other modes, where the law has no curve), MPa */
+    double law_max_abs_error;   /* the same, largest |error|, MPa */
+    double law_r2;              /* the same, R^2 */
+    long uncertainty_curves;    /* cell curves of the errors and profiles (in evaluations) */
     double rmse_after;          /* validation RMSE of the reported spring (full lattice), MPa */
     int verified;               /* 1: the full lattice ran (uniaxial); 0: the mode is the cell's */
     double verify_max_abs;      /* largest |full lattice - cell| at the table's strains, MPa */
@@ -59,7 +65,9 @@ typedef struct cf_through_msm {
 ** its mode, when that lowers the cell's RMSE). Local searches (NLopt BOBYQA over log rho and s/H,
 ** the stress scale in closed form) from the ordinary fit and a coarse grid. t->done = 1 when it
 ** ran; CF_E_DATA for a force-displacement table or a table no spring reaches, CF_E_INTERNAL when
-** memory runs out. Deterministic. cf_validate_lattice_fit (validate.h) then verifies res. */
+** memory runs out. Deterministic. Once done, res's quality (rss, rmse, max_abs_error, r2,
+** objective) and uncertainty (ident_se, corr, intervals, held) are the cell's, the target's: the
+** single spring's own figures move to t->law_*. cf_validate_lattice_fit (validate.h) then verifies res. */
 cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_validate_setup *s,
                          cf_fit_result *res, cf_through_msm *t, cf_error *err);
 

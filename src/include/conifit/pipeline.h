@@ -35,8 +35,9 @@ typedef void (*cf_pipeline_progress)(void *ctx, const char *table, const char *w
 
 /* What the fit aims at. */
 typedef enum cf_pipeline_target {
-    CF_TARGET_AUTO = 0,    /* the spring for uniaxial tables, the lattice for the other modes (a
-                           ** single spring has no shear, planar, equibiaxial or confined form) */
+    CF_TARGET_AUTO = 0,    /* the lattice whenever one is involved: with validate, and for every
+                           ** mode but uniaxial (a single spring has no shear, planar, equibiaxial
+                           ** or confined form); the spring for a uniaxial table fitted alone */
     CF_TARGET_SPRING = 1,  /* the single spring's curve F(eH)/H^2 */
     CF_TARGET_LATTICE = 2  /* the lattice's curve in the table's mode (lattice_fit.h,
                            ** cf_lattice_fit), verified once in the full lattice */

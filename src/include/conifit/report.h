@@ -45,6 +45,11 @@ int cf_report_better(const cf_fit_report *r);
 ** 95 % on the residual sum of squares, floored at rounding level). */
 int cf_report_types_tie(const cf_fit_report *r);
 
+/* 1 when every fit's target is the lattice (each was fitted through it): then the fits' rss,
+** rmse, max_abs_error, r2, objective and uncertainty are the lattice's (lattice_fit.h), and so
+** are the verdict, the comparison and the better type; 0: the single spring's. */
+int cf_report_target_is_lattice(const cf_fit_report *r);
+
 /* AIC of fit i, with RSS in the file's unit (comparable with the baselines' AIC of the report). */
 double cf_report_fit_aic(const cf_fit_report *r, int i);
 double cf_report_baseline_aic(const cf_fit_report *r, int k);

@@ -1,0 +1,105 @@
+/*
+** Profile-likelihood intervals over any residual function (see profile.h).
+*/
+#include "fit/profile.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "fit/lsq.h"
+
+/* F(0.95; 1, N - 3) times the residual variance (floored at rounding level): the rise of the
+** weighted RSS that the noise can explain, for one quantity. */
+double cf_profile_limit(size_t n, double rss, double ynorm)
+{
+    double dof = (double)n - 3;
+    double s2 = fmax(rss / dof, 1e-24 * ynorm / (double)n);
+    return rss + cf_lsq_f95(dof) * s2;
+}
+
+/* One end of the profile interval of quantity k (dir = -1 low, +1 high), in log units from the
+** value v[k]; res receives the end and the bit of the bound it reached. */
+static void profile_end(const cf_profile *p, int k, const double v[3], double limit, int dir,
+                        double h, cf_fit_result *res)
+{
+    double xin[2];
+    int j = 0;
+    if (k != 0)
+        xin[j++] = log(v[0]);
+    if (k != 1)
+        xin[j] = v[1];
+    double u_in = log(v[k]), u_out = NAN;
+    unsigned end_bit = 0;
+    int done = 0, infeasible = 0;
+    for (int it = 0; it < 60 && !done; it++, h *= 2) {
+        double u = u_in + dir * h;
+        int at_bound = 0;
+        if (dir < 0 && u <= p->lo[k]) {
+            u = p->lo[k];
+            at_bound = 1;
+        } else if (dir > 0 && u >= p->hi[k]) {
+            u = p->hi[k];
+            at_bound = 1;
+        }
+        double f = p->at(p->ctx, k, u, limit, xin);
+        if (f <= limit) {
+            u_in = u;
+            if (at_bound) {
+                end_bit = dir < 0 ? p->lo_bit[k] : p->hi_bit[k];
+                done = 1;
+            }
+        } else {
+            u_out = u;
+            infeasible = f >= CF_LSQ_HUGE_OBJ;
+            done = 2;
+        }
+    }
+    if (done == 2) {
+        /* to 1e-4 in log units (times |log v|) or 1 % of the end's distance from the value,
+        ** whichever is finer: the first alone returned the value itself for every interval
+        ** narrower than that (a precise table, a long one, collapsed to [value, value]) */
+        const double u0 = log(v[k]);
+        for (int it = 0; it < 60 && fabs(u_out - u_in) > fmax(fmin(1e-4 * fmax(1.0, fabs(u_in)),
+                                                                   1e-2 * fabs(u_out - u0)),
+                                                              1e-15);
+             it++) {
+            double u = 0.5 * (u_in + u_out);
+            double f = p->at(p->ctx, k, u, limit, xin);
+            if (f <= limit) {
+                u_in = u;
+            } else {
+                u_out = u;
+                infeasible = f >= CF_LSQ_HUGE_OBJ;
+            }
+        }
+        if (infeasible) /* the end is where the type's limits close, not the threshold */
+            end_bit = p->closed(p->ctx, k, u_in, xin);
+    }
+    /* exp(log(v)) may differ from v in the last bit: the interval always holds the value */
+    res->interval[k][dir < 0 ? 0 : 1] = dir < 0 ? fmin(exp(u_in), v[k]) : fmax(exp(u_in), v[k]);
+    res->interval_end[k][dir < 0 ? 0 : 1] = end_bit;
+}
+
+void cf_profile_intervals(const cf_profile *p, const double v[3], double limit, unsigned why,
+                          cf_fit_result *res)
+{
+    for (int k = 0; k < 3; k++) {
+        double h = res->ident_se.v[k] > 0 ? fmin(0.5 * res->ident_se.v[k] / v[k], 0.1) : 0.01;
+        h = fmax(h, 1e-13);
+        profile_end(p, k, v, limit, -1, h, res);
+        profile_end(p, k, v, limit, +1, h, res);
+        res->interval_ok[k] = 1;
+        res->interval_why[k] = why;
+    }
+}
+
+int cf_profile_needed(const cf_fit_result *res, const double lo[3], const double hi[3],
+                      unsigned why)
+{
+    const double *v = res->ident.v;
+    int need = why != 0;
+    for (int k = 0; k < 3; k++)
+        need = need || res->ident_se.v[k] < 0 || v[k] - 1.96 * res->ident_se.v[k] < lo[k] ||
+               v[k] + 1.96 * res->ident_se.v[k] > hi[k];
+    return need;
+}

@@ -1,0 +1,41 @@
+/*
+** Profile-likelihood intervals of the three identifiable quantities, over any residual function:
+** the ordinary fit (fit_uncertainty.c) and the fits through the lattice (lattice_fit.c, joint.c)
+** give their own profile, the interval's rules are here. Private to the library.
+*/
+#ifndef CF_FIT_PROFILE_H
+#define CF_FIT_PROFILE_H
+
+#include <stddef.h>
+
+#include "conifit/fit.h"
+
+/* A fit's profile. The other two quantities of a profile of k travel in x[2]: (log rho, B)
+** without the one profiled (both when k is the stress scale). */
+typedef struct cf_profile {
+    void *ctx;
+    double lo[3], hi[3];          /* range of each quantity, log units */
+    unsigned lo_bit[3], hi_bit[3]; /* CF_C_* bit of the limit at each end of that range */
+    /* the weighted RSS minimised over the other quantities with quantity k at exp(u), from x;
+    ** x moves to the minimiser when that RSS is within limit */
+    double (*at)(void *ctx, int k, double u, double limit, double *x);
+    /* the CF_C_* bit of the limit that closes where the profile of k has no admissible point */
+    unsigned (*closed)(void *ctx, int k, double u, const double *x);
+} cf_profile;
+
+/* The weighted RSS a profile may reach: rss plus F(0.95; 1, n - 3) times the residual variance
+** (floored at rounding level of ynorm, the data's weighted sum of squares). */
+double cf_profile_limit(size_t n, double rss, double ynorm);
+
+/* The profile interval of every quantity of v into res (interval, interval_end, interval_ok;
+** interval_why = why), each end searched outward from v in log steps that start at half the
+** standard error (res->ident_se) or 1 % and double, then bisected. */
+void cf_profile_intervals(const cf_profile *p, const double v[3], double limit, unsigned why,
+                          cf_fit_result *res);
+
+/* Whether the intervals are needed: a quantity without a standard error, held on a limit
+** (why != 0), or whose Wald interval crosses the range [lo, hi] (linear units). */
+int cf_profile_needed(const cf_fit_result *res, const double lo[3], const double hi[3],
+                      unsigned why);
+
+#endif

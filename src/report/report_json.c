@@ -1,0 +1,81 @@
+/*
+** The identifiable quantities of a fit in its fit file: value, standard error or interval, and
+** their correlation (see report_json.h).
+*/
+#include "report/report_json.h"
+
+#include <math.h>
+
+#include "io/fitfile_json.h"
+#include "report/report_words.h"
+
+#define num cf_json_number
+
+/* Why a fit has no standard errors (and no correlation matrix), in words. */
+static const char *stderr_reason(const cf_fit_result *f)
+{
+    for (int k = 0; k < 3; k++)
+        if (f->interval_ok[k] && (f->interval_why[k] & CF_FIT_RANK_DEFICIENT))
+            return "not determined: the Jacobian of the three quantities is numerically "
+                   "rank-deficient (see interval)";
+    return "not determined: the linearised covariance s^2 (J^T W J)^-1 could not be formed";
+}
+
+/* {value, stderr | stderr_reason, [interval, interval_reason]} in conifit's units (MPa, N, mm):
+** a key is present only with a value, never null. */
+json_t *cf_report_ident_json(const cf_fit_result *f, int k)
+{
+    double se = f->ident_se.v[k];
+    json_t *o = json_pack("{s:o}", "value", num(f->ident.v[k]));
+    if (!o)
+        return NULL;
+    if (se >= 0)
+        json_object_set_new(o, "stderr", num(se));
+    else
+        json_object_set_new(o, "stderr_reason", json_string(stderr_reason(f)));
+    if (f->interval_ok[k]) {
+        char why[512];
+        cf_report_interval_reason(f, k, why, sizeof why);
+        json_object_set_new(o, "interval",
+                            json_pack("[o, o]", num(f->interval[k][0]), num(f->interval[k][1])));
+        json_object_set_new(o, "interval_reason", json_string(why));
+        /* an end that is a limit, not the data's: the interval is one-sided there */
+        json_t *lim = json_object();
+        for (int e = 0; e < 2; e++) {
+            unsigned b = f->interval_end[k][e];
+            if (b && lim)
+                json_object_set_new(lim, e ? "upper" : "lower",
+                                    json_string(cf_fit_constraint_name(b & (0u - b))));
+        }
+        if (lim && json_object_size(lim) > 0)
+            json_object_set_new(o, "interval_limit", lim);
+        else
+            json_decref(lim);
+    }
+    return o;
+}
+
+/* {order, matrix} when every correlation is determined, else {order, reason}. */
+json_t *cf_report_correlation_json(const cf_fit_result *f, const char *const names[3])
+{
+    json_t *o = json_pack("{s:[s, s, s]}", "order", names[0], names[1], names[2]);
+    int ok = 1;
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            ok = ok && isfinite(f->corr[a][b]);
+    if (!o)
+        return NULL;
+    if (!ok) {
+        json_object_set_new(o, "reason", json_string(stderr_reason(f)));
+        return o;
+    }
+    json_t *m = json_array();
+    for (int a = 0; a < 3; a++) {
+        json_t *row = json_array();
+        for (int b = 0; b < 3; b++)
+            json_array_append_new(row, num(f->corr[a][b]));
+        json_array_append_new(m, row);
+    }
+    json_object_set_new(o, "matrix", m);
+    return o;
+}
