@@ -317,9 +317,10 @@ static int report_job(const fit_args *a, fit_job *j)
         const cf_validation *v = &j->rep.val[k];
         if (j->rep.validate && v->done && v->unstable_in_range)
             cf_cli_printf_safe(stderr,
-                    "conifit: warning: %s: the %s spring's lattice loses stability at strain "
-                    "%.4g, inside the table's range\n",
-                    j->file, cf_spring_type_name(j->rep.fits[k].type), v->stable_to_strain);
+                    "conifit: warning: %s: the %s spring's %s loses stability at strain "
+                    "%.4g (%s), inside the table's range\n",
+                    j->file, cf_spring_type_name(j->rep.fits[k].type),
+                    v->by_cell ? "cell" : "lattice", v->stable_to_strain, cf_mode_name(v->mode));
         const cf_through_msm *t = &j->rep.thr[k];
         if (j->rep.through_msm && t->done && t->search_rows < j->rep.table->count)
             cf_cli_printf_safe(stderr,

@@ -142,6 +142,35 @@ cf_status cf_cell_stress(const cf_cell *c, const double F[9], const cf_cell_extr
     return evaluate(c, F, extra, s, kT, err);
 }
 
+cf_status cf_cell_tangent(const cf_cell *c, const double F[9], const cf_cell_extra *extra,
+                          cf_cell_state *s, double A[81], cf_error *err)
+{
+    double kT[CF_CELL_DIRS];
+    s->stress_MPa = 0;
+    s->free_stretch = 1;
+    cf_status st = evaluate(c, F, extra, s, kT, err);
+    if (st != CF_OK)
+        return st;
+    const double H = c->law->p.H_mm, H3 = H * H * H;
+    memset(A, 0, 81 * sizeof(double));
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        int N[3], fam;
+        cf_cell_direction(d, N, &fam);
+        double X[3] = {H * N[0], H * N[1], H * N[2]}, xv[3];
+        for (int i = 0; i < 3; i++)
+            xv[i] = F[3 * i] * X[0] + F[3 * i + 1] * X[1] + F[3 * i + 2] * X[2];
+        const double L = s->L_mm[d], T = s->T_N[d], a = (kT[d] - T / L) / (L * L * H3);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                for (int k = 0; k < 3; k++)
+                    for (int l = 0; l < 3; l++)
+                        A[27 * i + 9 * j + 3 * k + l] +=
+                            a * xv[i] * X[j] * xv[k] * X[l] +
+                            (i == k ? T * X[j] * X[l] / (L * H3) : 0);
+    }
+    return CF_OK;
+}
+
 /* dP[m][m] / dF[k][k] summed over the diagonal entries k whose bit is set in kmask, at state s:
 ** dP_ij/dF_kl = (1/H^3) sum_d [(dT/dL - T/L) x_i X_j x_k X_l / L^2 + T delta_ik X_j X_l / L]. */
 static double tangent(const cf_cell *c, const cf_cell_state *s, const double kT[CF_CELL_DIRS],

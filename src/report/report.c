@@ -180,6 +180,26 @@ static json_t *weights_json(const double w[CF_FAMILY_COUNT])
 }
 
 /* validation {rmse, r2, max_abs_error (file's unit), lattice {...}, wall_time_s} or {skipped} */
+/* The stability in the table's mode: how far it holds over the table's range, by which check
+** (the full lattice's negative pivots, or the cell's incremental stiffness), or why unchecked. */
+static void stability_json(json_t *o, const cf_validation *v)
+{
+    if (!v->stability_checked) {
+        json_object_set_new(o, "stability_reason",
+                            json_string(v->stability_note[0] ? v->stability_note
+                                                             : "the stability scan did not run"));
+        return;
+    }
+    json_object_set_new(o, "stable_to_strain", num(v->stable_to_strain));
+    json_object_set_new(o, "stable_in_range", json_boolean(!v->unstable_in_range));
+    json_object_set_new(o, "stability_by", json_string(v->by_cell ? "cell tangent"
+                                                                  : "full lattice"));
+    if (v->cell_stability_checked && !v->by_cell) {
+        json_object_set_new(o, "cell_stable_to_strain", num(v->cell_stable_to_strain));
+        json_object_set_new(o, "cell_stable_in_range", json_boolean(!v->cell_unstable_in_range));
+    }
+}
+
 static json_t *validation_json(const cf_fit_report *r, int i)
 {
     const cf_validation *v = &r->val[i];
@@ -204,11 +224,8 @@ static json_t *validation_json(const cf_fit_report *r, int i)
                      "wall_time_s", num(r->with_timing ? v->wall_time_s : 0.0));
     if (o && isfinite(v->law_rmse)) /* uniaxial tables only: the law's own curve is uniaxial */
         json_object_set_new(o, "law_difference_rmse", num(v->law_rmse * u));
-    if (o && v->stability_checked) {
-        if (v->stable_to_strain != 0) /* absent: stable over the whole range checked */
-            json_object_set_new(o, "stable_to_strain", num(v->stable_to_strain));
-        json_object_set_new(o, "stable_in_range", json_boolean(!v->unstable_in_range));
-    }
+    if (o)
+        stability_json(o, v);
     return o;
 }
 

@@ -142,6 +142,37 @@ static void cell_rows(FILE *o, const cf_fit_report *r, char (*buf)[2][64], int n
     }
 }
 
+/* The stability row of one validation: how far the table's range is stable, by which check. */
+static void stability_cell(char *buf, size_t size, const cf_validation *v)
+{
+    if (!v->stability_checked)
+        snprintf(buf, size, "not checked (%.40s)",
+                 v->stability_note[0] ? v->stability_note : "the scan did not run");
+    else if (!v->unstable_in_range)
+        snprintf(buf, size, "to strain %.4g (table's end, %s)", v->stable_to_strain,
+                 v->by_cell ? "cell tangent" : "full lattice");
+    else
+        snprintf(buf, size, "to strain %.4g (!) (%s)", v->stable_to_strain,
+                 v->by_cell ? "cell tangent" : "full lattice");
+}
+
+/* The warning of a table that reaches past the stability limit of fit i's target. */
+static void stability_warning(FILE *o, const cf_fit_report *r, int i)
+{
+    const cf_validation *v = &r->val[i];
+    if (v->by_cell)
+        fprintf(o, "  (!) %s: the cell's incremental stiffness stops being positive definite at "
+                "%s strain %.4g, inside the table's range: past it a homogeneous %s state is "
+                "unstable (the tissue would localise)\n",
+                cf_spring_type_name(r->fits[i].type), cf_mode_name(v->mode), v->stable_to_strain,
+                cf_mode_name(v->mode));
+    else
+        fprintf(o, "  (!) %s: the lattice loses stability at strain %.4g, inside the table's "
+                "range: past it the static curve is an unstable equilibrium (a column of "
+                "cells buckles sideways in a dynamic run)\n",
+                cf_spring_type_name(r->fits[i].type), v->stable_to_strain);
+}
+
 /* The validation's numbers, one column per fit. */
 static void validation_rows(FILE *o, const cf_fit_report *r)
 {
@@ -168,13 +199,7 @@ static void validation_rows(FILE *o, const cf_fit_report *r)
         snprintf(buf[4][i], sizeof buf[4][i], "%.6f", v->r2);
         snprintf(buf[5][i], sizeof buf[5][i], "%.1f ms, %zu solves", 1e3 * v->wall_time_s,
                  v->solves);
-        if (!v->stability_checked)
-            snprintf(buf[6][i], sizeof buf[6][i], "not checked");
-        else if (v->stable_to_strain == 0)
-            snprintf(buf[6][i], sizeof buf[6][i], "to solid");
-        else
-            snprintf(buf[6][i], sizeof buf[6][i], "to strain %.4g%s", v->stable_to_strain,
-                     v->unstable_in_range ? " (!)" : "");
+        stability_cell(buf[6][i], sizeof buf[6][i], v);
     }
     static const char *const labels[ROWS] = {"fit RMSE (its target)", "lattice RMSE",
                                              "lattice vs law (RMSE)", "lattice max |error|",
@@ -222,10 +247,7 @@ static void validation_text(FILE *o, const cf_fit_report *r)
     validation_rows(o, r);
     for (int i = 0; i < r->nfits; i++)
         if (r->val[i].done && r->val[i].unstable_in_range)
-            fprintf(o, "  (!) %s: the lattice loses stability at strain %.4g, inside the table's "
-                    "range: past it the static curve is an unstable equilibrium (a column of "
-                    "cells buckles sideways in a dynamic run)\n",
-                    cf_spring_type_name(r->fits[i].type), r->val[i].stable_to_strain);
+            stability_warning(o, r, i);
     if (r->through_msm)
         through_rows(o, r);
     for (int i = 0; i < r->nfits; i++)

@@ -102,6 +102,12 @@ typedef struct cf_cell_state {
 cf_status cf_cell_stress(const cf_cell *c, const double F[9], const cf_cell_extra *extra,
                          cf_cell_state *s, cf_error *err);
 
+/* The state at F (as cf_cell_stress) and the cell's full tangent A = dP/dF, MPa:
+** A[27 i + 9 j + 3 k + l] = dP_ij / dF_kl (symmetric under (ij) <-> (kl): the second derivative
+** of the cell's stored energy per volume). Same failures as cf_cell_stress. */
+cf_status cf_cell_tangent(const cf_cell *c, const double F[9], const cf_cell_extra *extra,
+                          cf_cell_state *s, double A[81], cf_error *err);
+
 /* The state of test mode m at table strain e (tension positive), the free stretch solved to
 ** rounding (safeguarded Newton inside a bracket). CF_E_DATA when e is not finite or the mode
 ** cannot reach it (a spring at solid), CF_E_NOCONV when no free stretch gives zero stress. */
