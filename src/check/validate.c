@@ -231,8 +231,11 @@ cf_status cf_validate_lattice_fit(const cf_table *d, const cf_validate_setup *s,
     memset(v, 0, sizeof *v);
     if (cf_table_is_force(d))
         return cf_validate_run(&res->params, s, d, v, err); /* records the reason it is skipped */
-    if (!t->done)
+    if (!t->done) {
+        snprintf(v->note, sizeof v->note, "the fit through the lattice did not run: %.440s",
+                 t->note[0] ? t->note : "no reason recorded");
         return CF_OK;
+    }
     double *cell = malloc(sizeof(double) * (d->count ? d->count : 1));
     if (!cell)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", d->count);

@@ -5,6 +5,7 @@
 #include "conifit/lattice_fit.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -218,6 +219,9 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
     t->cell_rmse = t->improved ? after : t->rmse_before;
     t->done = 1;
 out:
+    if (!t->done)
+        snprintf(t->note, sizeof t->note, "%s",
+                 err && err->msg[0] ? err->msg : "the search found no spring to place");
     t->evaluations = c.evals + cs.evals;
     free(cs.sw);
     free(cs.curve);

@@ -186,8 +186,8 @@ static void stability_json(json_t *o, const cf_validation *v)
 {
     if (!v->stability_checked) {
         json_object_set_new(o, "stability_reason",
-                            json_string(v->stability_note[0] ? v->stability_note
-                                                             : "the stability scan did not run"));
+                            json_string(cf_report_why(v->stability_note,
+                                                      "the stability scan did not run")));
         return;
     }
     json_object_set_new(o, "stable_to_strain", num(v->stable_to_strain));
@@ -204,7 +204,8 @@ static json_t *validation_json(const cf_fit_report *r, int i)
 {
     const cf_validation *v = &r->val[i];
     if (!v->done)
-        return json_pack("{s:s}", "skipped", v->note);
+        return json_pack("{s:s}", "skipped",
+                         cf_report_why(v->note, "the validation did not run (no reason recorded)"));
     const cf_lattice_config *lc = &v->setup.cfg.lattice;
     double u = r->table->y_to_file;
     cf_cubic_moduli cm = cf_cubic_moduli_of(lc->weight);

@@ -147,7 +147,7 @@ static void stability_cell(char *buf, size_t size, const cf_validation *v)
 {
     if (!v->stability_checked)
         snprintf(buf, size, "not checked (%.40s)",
-                 v->stability_note[0] ? v->stability_note : "the scan did not run");
+                 cf_report_why(v->stability_note, "the scan did not run"));
     else if (!v->unstable_in_range)
         snprintf(buf, size, "to strain %.4g (table's end, %s)", v->stable_to_strain,
                  v->by_cell ? "cell tangent" : "full lattice");
@@ -240,7 +240,8 @@ static void validation_text(FILE *o, const cf_fit_report *r)
     for (int i = 0; i < r->nfits; i++)
         any |= r->val[i].done;
     if (!any) {
-        fprintf(o, " validation in the lattice: skipped: %s\n", r->val[0].note);
+        fprintf(o, " validation in the lattice: skipped: %s\n",
+                cf_report_why(r->val[0].note, "the validation did not run (no reason recorded)"));
         return;
     }
     validation_header(o, r);
@@ -253,7 +254,7 @@ static void validation_text(FILE *o, const cf_fit_report *r)
     for (int i = 0; i < r->nfits; i++)
         if (!r->val[i].done)
             fprintf(o, "  (%s: validation skipped: %s)\n", cf_spring_type_name(r->fits[i].type),
-                    r->val[i].note);
+                    cf_report_why(r->val[i].note, "no reason recorded"));
 }
 
 /* The table: its size, columns, sign, and (stress-strain) its measures and their conversion. */

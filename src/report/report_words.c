@@ -145,3 +145,8 @@ void cf_report_conversion(const cf_table *t, char *buf, size_t cap)
                              cf_mode_name(t->mode));
     }
 }
+
+const char *cf_report_why(const char *note, const char *fallback)
+{
+    return note && note[0] ? note : fallback;
+}

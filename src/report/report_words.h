@@ -16,6 +16,9 @@ void cf_report_append(char *buf, size_t cap, size_t *n, const char *fmt, ...)
 #endif
     ;
 
+/* note when it says something, else fallback: a reason printed or written is never empty. */
+const char *cf_report_why(const char *note, const char *fallback);
+
 /* Why fit f's profile interval of quantity k was computed and where its ends come from. */
 void cf_report_interval_reason(const cf_fit_result *f, int k, char *buf, size_t cap);
 

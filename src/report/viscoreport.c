@@ -2,6 +2,7 @@
 ** Report, fit file and plot of a viscoelastic fit (see viscoreport.h).
 */
 #include "conifit/viscoreport.h"
+#include "report/report_words.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -70,7 +71,8 @@ static json_t *predictions_json(const cf_visco_report *r)
                                 "period_s", num(p->cycle_period_s), "loop_area_kPa",
                                 num(p->loop_area_MPa * 1e3), "loading_work_kPa",
                                 num(p->loading_work_MPa * 1e3))
-                    : json_pack("{s:s}", "skipped", p->note);
+                    : json_pack("{s:s}", "skipped",
+                                cf_report_why(p->note, "not predicted (no reason recorded)"));
     /* a fraction only of a cycle that did work: absent, never NaN (which the writer refuses) */
     if (h && p->hysteresis_done && p->loading_work_MPa > 0)
         json_object_set_new(h, "dissipated_fraction",
@@ -82,7 +84,8 @@ static json_t *predictions_json(const cf_visco_report *r)
                                 "strain_end_of_ramp", num(p->creep_strain_ramp), "strain_end",
                                 num(p->creep_strain_end), "creep_strain",
                                 num(p->creep_strain_end - p->creep_strain_ramp))
-                    : json_pack("{s:s}", "skipped", p->note);
+                    : json_pack("{s:s}", "skipped",
+                                cf_report_why(p->note, "not predicted (no reason recorded)"));
     return json_pack("{s:o, s:o}", "hysteresis", h, "creep", c);
 }
 
