@@ -90,6 +90,15 @@ static void fit_warnings(const char *file, const cf_fit_report *r, const cf_fit_
                 f->solid_ratio, CF_FIT_SOLID_RATIO_WARN);
 }
 
+/* What the model cannot follow in the table (cf_report_warnings), on stderr. */
+static void report_warnings(const char *file, const cf_fit_report *r)
+{
+    char w[CF_REPORT_WARNINGS_MAX][CF_REPORT_WARNING_LEN];
+    int n = cf_report_warnings(r, w, CF_REPORT_WARNINGS_MAX);
+    for (int k = 0; k < n; k++)
+        cf_cli_printf_safe(stderr, "conifit: warning: %s: %s\n", file, w[k]);
+}
+
 /* Through-the-lattice work and each type of a joint fit take seconds: say so on a terminal. */
 static void show_progress(void *ctx, const char *table, const char *what)
 {
@@ -312,6 +321,7 @@ static int report_job(const fit_args *a, fit_job *j)
         if (a->nfiles > 1)
             fputc('\n', stdout);
     }
+    report_warnings(j->file, &j->rep);
     for (int k = 0; k < j->rep.nfits; k++) {
         fit_warnings(j->file, &j->rep, &j->rep.fits[k]);
         const cf_validation *v = &j->rep.val[k];

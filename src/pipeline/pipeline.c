@@ -136,6 +136,7 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
     if (r->nfits == 0)
         return cf_error_set(err, CF_E_DATA, "%s: no spring type chosen to fit", t->path);
     cf_error be = {0};
+    r->softening = cf_softening_of(t);
     if (cf_baseline_fit_all(t, r->baselines, &be) != CF_OK)
         return cf_error_set(err, be.status, "%s: %s", t->path, be.msg);
     if (opt->validate || through_lattice(t, opt))

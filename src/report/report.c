@@ -305,6 +305,19 @@ static json_t *limits_json(const cf_fit_report *r)
                      num(3.0), "index_max", num(o->index_max));
 }
 
+/* warnings[]: what the model cannot follow (absent when nothing). */
+static void warnings_json(json_t *root, const cf_fit_report *r)
+{
+    char w[CF_REPORT_WARNINGS_MAX][CF_REPORT_WARNING_LEN];
+    int n = cf_report_warnings(r, w, CF_REPORT_WARNINGS_MAX);
+    if (n == 0)
+        return;
+    json_t *a = json_array();
+    for (int k = 0; k < n; k++)
+        json_array_append_new(a, json_string(w[k]));
+    json_object_set_new(root, "warnings", a);
+}
+
 static json_t *report_json(const cf_fit_report *r)
 {
     json_t *data = json_pack(
@@ -347,6 +360,7 @@ static json_t *report_json(const cf_fit_report *r)
         json_object_set_new(root, "comparison", c);
     }
     json_object_set_new(root, "baselines", base);
+    warnings_json(root, r);
     json_object_set_new(root, "identifiability",
                         json_string("the law depends on the six design parameters only through "
                                     "rho, the solid strain (travel) and the stress (load) scale; "

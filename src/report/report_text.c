@@ -429,6 +429,17 @@ static void verdict_and_baselines(FILE *o, const cf_fit_report *r)
             cf_table_is_force(r->table) ? "solid load" : "stress scale");
 }
 
+/* What the model cannot follow, one sentence each. */
+static void warnings_text(FILE *o, const cf_fit_report *r)
+{
+    char w[CF_REPORT_WARNINGS_MAX][CF_REPORT_WARNING_LEN];
+    int n = cf_report_warnings(r, w, CF_REPORT_WARNINGS_MAX);
+    if (n > 0)
+        fprintf(o, "\nWarnings:\n");
+    for (int k = 0; k < n; k++)
+        fprintf(o, "  (!) %s\n", w[k]);
+}
+
 char *cf_report_text(const cf_fit_report *r)
 {
     char *buf = NULL;
@@ -447,6 +458,7 @@ char *cf_report_text(const cf_fit_report *r)
         validation_text(o, r);
     constraints_text(o, r);
     verdict_and_baselines(o, r);
+    warnings_text(o, r);
     fclose(o);
     return buf;
 }

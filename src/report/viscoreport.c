@@ -62,6 +62,46 @@ static json_t *constraints(unsigned bits)
     return a;
 }
 
+/* The names of the elastic quantities set in mask (CF_IDENT_* bits), comma-separated. */
+static void elastic_names(unsigned mask, char *buf, size_t cap)
+{
+    static const char *const names[CF_IDENT_COUNT] = {"rho", "s/H", "F_C/H^2"};
+    size_t n = 0;
+    buf[0] = '\0';
+    for (int k = 0; k < CF_IDENT_COUNT; k++)
+        if (mask >> k & 1u)
+            cf_report_append(buf, cap, &n, "%s%s", n ? ", " : "", names[k]);
+}
+
+/* The elastic quantities of the kept candidate the series does not determine: the JSON list and
+** the text warning naming each. */
+static void elastic_unresolved_json(json_t *o, const cf_visco_fit *f)
+{
+    static const char *const names[CF_IDENT_COUNT] = {"rho", "s/H", "F_C/H^2"};
+    if (!f->elastic_unresolved)
+        return;
+    json_t *a = json_array();
+    for (int k = 0; k < CF_IDENT_COUNT; k++)
+        if (f->elastic_unresolved >> k & 1u)
+            json_array_append_new(a, json_string(names[k]));
+    json_object_set_new(o, "elastic_undetermined", a);
+    json_object_set_new(o, "elastic_undetermined_reason",
+                        json_string("a standard error larger than the quantity's range (rho and "
+                                    "s/H lie in (0, 1]; the stress scale is positive)"));
+}
+
+static void elastic_unresolved_text(FILE *o, const cf_visco_fit *f)
+{
+    char names[64];
+    if (!f->elastic_unresolved)
+        return;
+    elastic_names(f->elastic_unresolved, names, sizeof names);
+    fprintf(o, " warning: the series does not determine the elastic %s (a standard error larger "
+               "than its range): the candidate is not determined; hold the elastic part "
+               "(--elastic) or fit its table jointly\n",
+            names);
+}
+
 static json_t *predictions_json(const cf_visco_report *r)
 {
     const cf_visco_predict *p = &r->fit.pred;
@@ -148,6 +188,7 @@ static void visco_keys(const cf_visco_report *r, json_t *o)
         json_object_set_new(o, "aic_by_branches", a);
     }
     json_object_set_new(o, "terms_determined", json_boolean(f->identified));
+    elastic_unresolved_json(o, f);
     json_object_set_new(o, "elastic_held", json_boolean(f->held_elastic));
     json_object_set_new(o, "rho_at_limit", json_boolean(f->rho_at_limit));
     json_object_set_new(o, "solid_strain_at_stability_limit", json_boolean(f->at_stability_limit));
@@ -301,15 +342,22 @@ char *cf_visco_report_text(const cf_visco_report *r)
                 if (gs)
                     snprintf(what, sizeof what, cd->strain_terms <= n ? "strain (%d of them)" : "strain",
                              cd->strain_terms);
+                char why[80] = " (terms undetermined)";
+                if (cd->elastic_unresolved) {
+                    char names[48];
+                    elastic_names(cd->elastic_unresolved, names, sizeof names);
+                    snprintf(why, sizeof why, " (%s undetermined)", names);
+                }
                 fprintf(o, "%s %s %.2f%s", sep, what, cd->aic + (double)f->count * log(u * u),
-                        cd->identified ? "" : " (terms undetermined)");
+                        cd->identified ? "" : why);
                 sep = ",";
             }
             if (*sep)
                 fputc('\n', o);
         }
     }
-    if (!f->identified)
+    elastic_unresolved_text(o, f);
+    if (!f->identified && !f->elastic_unresolved)
         fprintf(o, " warning: the series does not determine every time-dependent quantity of "
                    "this model (a standard error as large as its value, or '?' below); fewer "
                    "terms (--branches) or --relaxation qlv\n");
