@@ -52,23 +52,6 @@ static void path_in_dir(char *dst, size_t cap, const char *dir, const char *file
              ext);
 }
 
-/* The flag that widens a limit, by constraint bit. */
-static const char *limit_flag(unsigned bit)
-{
-    switch (bit) {
-    case CF_C_INDEX_MAX: return "--index-max";
-    case CF_C_RHO_MIN: return "--rho-min";
-    case CF_C_COILS_MAX: return "--n-max";
-    case CF_C_G_MAX: return "--G-max";
-    case CF_C_D2_H: return "--D2-max-H";
-    case CF_C_TRAVEL: return "nothing: no spring reaches the largest strain (a solid strain is "
-                             "below 1)";
-    case CF_C_TYPE: return "--rho-min, --index-max, --D2-max-H (a telescoping spring needs "
-                           "rho <= index_max/(index_max + 4))";
-    }
-    return "--fix";
-}
-
 /* Named warnings on stderr: a family that cannot be placed inside the limits, a law that goes
 ** solid close past the data. */
 static void fit_warnings(const char *file, const cf_fit_report *r, const cf_fit_result *f)
@@ -80,14 +63,17 @@ static void fit_warnings(const char *file, const cf_fit_report *r, const cf_fit_
             cf_cli_printf_safe(stderr,
                     "conifit: warning: %s: no %s spring of this table meets the limit %s "
                     "(feasible: false); to widen it: %s\n",
-                    file, type, cf_fit_constraint_name(bit), limit_flag(bit));
+                    file, type, cf_fit_constraint_name(bit), cf_fit_constraint_flag(bit));
     }
     if (f->feasible && f->solid_ratio < CF_FIT_SOLID_RATIO_WARN)
         cf_cli_printf_safe(stderr,
-                "conifit: warning: %s: the %s law goes solid at %s %.4g, %.3g times the table's "
-                "largest (below %.1f): it stiffens without bound just past the data\n",
-                file, type, cf_table_is_force(r->table) ? "displacement [mm]" : "strain", f->ident.solid,
-                f->solid_ratio, CF_FIT_SOLID_RATIO_WARN);
+                "conifit: warning: %s: the %s law goes solid at %s %.4g%s%s, %.3g times the "
+                "table's largest (below %.1f): it stiffens without bound just past the data\n",
+                file, type, cf_table_is_force(r->table) ? "displacement [mm]" : "strain",
+                f->solid_table_strain > 0 ? f->solid_table_strain : f->ident.solid,
+                cf_table_is_force(r->table) ? "" : " in ",
+                cf_table_is_force(r->table) ? "" : cf_mode_name(r->table->mode), f->solid_ratio,
+                CF_FIT_SOLID_RATIO_WARN);
 }
 
 /* What the model cannot follow in the table (cf_report_warnings), on stderr. */

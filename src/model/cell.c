@@ -288,9 +288,10 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
 {
     if ((int)m < 0 || m >= CF_MODE_COUNT)
         return cf_error_set(err, CF_E_DATA, "mode %d: unknown", (int)m);
-    if (!isfinite(e) || !(e > -1))
-        return cf_error_set(err, CF_E_DATA, "%s strain %g: must be finite and > -1",
-                            cf_mode_name(m), e);
+    /* a stretch must stay positive; simple shear has no stretch and takes any amount */
+    if (!isfinite(e) || (m != CF_MODE_SHEAR && !(e > -1)))
+        return cf_error_set(err, CF_E_DATA, "%s strain %g: must be finite%s", cf_mode_name(m), e,
+                            m == CF_MODE_SHEAR ? "" : " and > -1");
     const mode_form fm = form_of(m);
     double F[9], kT[CF_CELL_DIRS];
     cf_status st;
@@ -372,5 +373,41 @@ cf_status cf_cell_curve(const cf_cell *c, cf_mode m, const double *strain, size_
             return st;
         stress_MPa[i] = s.stress_MPa;
     }
+    return CF_OK;
+}
+
+/* 1 when mode m reaches table strain e (no spring at solid, the free stretch found). */
+static int reaches(const cf_cell *c, cf_mode m, double e)
+{
+    cf_cell_state s;
+    return cf_cell_mode(c, m, e, NULL, &s, NULL) == CF_OK;
+}
+
+cf_status cf_cell_solid_strain(const cf_cell *c, cf_mode m, int side, double *e_solid,
+                               cf_error *err)
+{
+    const double sg = side < 0 ? -1.0 : 1.0;
+    /* a bracket [good, bad] in |e|: the far end doubles until the mode cannot reach it (a
+    ** compression cannot pass -1 in a mode that stretches the loaded edge) */
+    double good = 0, bad = 0.1;
+    while (reaches(c, m, sg * bad)) {
+        good = bad;
+        bad *= 2;
+        if (bad > 1e3 || (sg < 0 && m != CF_MODE_SHEAR && bad >= 1))
+            break;
+    }
+    if (sg < 0 && m != CF_MODE_SHEAR)
+        bad = fmin(bad, 1);
+    if (reaches(c, m, sg * bad))
+        return cf_error_set(err, CF_E_DATA, "%s strain %g: no spring of the cell reaches solid",
+                            cf_mode_name(m), sg * bad);
+    for (int k = 0; k < 200 && bad - good > 1e-12 * bad; k++) {
+        const double mid = 0.5 * (good + bad);
+        if (reaches(c, m, sg * mid))
+            good = mid;
+        else
+            bad = mid;
+    }
+    *e_solid = sg * good;
     return CF_OK;
 }

@@ -133,6 +133,44 @@ static json_t *correlation_json(const cf_fit_result *f, const char *const names[
 }
 
 
+/* limit_cost {limits, rmse, rmse_without_limits, flags}: what the limits holding fit i cost,
+** present when the widened fit ran. */
+static void limit_cost_json(json_t *o, const cf_fit_report *r, int i)
+{
+    const cf_limit_cost *lc = &r->limit_cost[i];
+    if (!lc->checked || !o)
+        return;
+    json_t *flags = json_array();
+    for (int b = 0; b < CF_C_COUNT; b++)
+        if (lc->limits >> b & 1u)
+            json_array_append_new(flags, json_string(cf_fit_constraint_flag(1u << b)));
+    const double u = r->table->y_to_file;
+    json_object_set_new(o, "limit_cost",
+                        json_pack("{s:o, s:o, s:o, s:o, s:b}", "limits",
+                                  constraint_list(lc->limits), "flags", flags, "rmse",
+                                  num(lc->rmse * u), "rmse_without_limits",
+                                  num(lc->rmse_free * u), "warning",
+                                  lc->rmse > (1 + CF_LIMIT_COST_WARN) * lc->rmse_free));
+}
+
+/* How far the law is from solid at the data, in the table's own measure: the table strain at
+** which the first spring reaches solid in the table's mode (the solid strain itself in
+** uniaxial), its ratio to the table's largest strain, and whether that is close. */
+static json_t *extrapolation_json(const cf_fit_report *r, const cf_fit_result *f)
+{
+    const int fd = cf_table_is_force(r->table);
+    const double at = f->solid_table_strain > 0 ? f->solid_table_strain : f->ident.solid;
+    json_t *o = json_pack("{s:o, s:o, s:o, s:b}", fd ? "travel_mm" : "solid_strain",
+                          num(f->ident.solid), fd ? "largest_displacement_mm" : "largest_strain",
+                          num(at / f->solid_ratio), "ratio", num(f->solid_ratio), "warning",
+                          f->solid_ratio < CF_FIT_SOLID_RATIO_WARN);
+    if (o && !fd) {
+        json_object_set_new(o, "table_strain_at_solid", num(at));
+        json_object_set_new(o, "mode", json_string(cf_mode_name(r->table->mode)));
+    }
+    return o;
+}
+
 static json_t *fit_json_core(const cf_fit_report *r, int i)
 {
     const cf_fit_result *f = &r->fits[i];
@@ -163,12 +201,8 @@ static json_t *fit_json_core(const cf_fit_report *r, int i)
     json_object_set_new(o, "type", json_string(cf_spring_type_name(f->type)));
     json_object_set_new(o, "identifiable_correlation", correlation_json(f, names));
     json_object_set_new(o, "held_by", constraint_list(f->held));
-    json_object_set_new(
-        o, "extrapolation",
-        json_pack("{s:o, s:o, s:o, s:b}", fd ? "travel_mm" : "solid_strain", num(f->ident.solid),
-                  fd ? "largest_displacement_mm" : "largest_strain",
-                  num(f->ident.solid / f->solid_ratio), "ratio", num(f->solid_ratio), "warning",
-                  f->solid_ratio < CF_FIT_SOLID_RATIO_WARN));
+    json_object_set_new(o, "extrapolation", extrapolation_json(r, f));
+    limit_cost_json(o, r, i);
     return o;
 }
 
@@ -286,13 +320,26 @@ static json_t *measures_json(const cf_table *t)
     char src[3][128], conv[256];
     cf_report_sources(t, src);
     cf_report_conversion(t, conv, sizeof conv);
+    const char *strain = cf_report_strain_name(t, src);
     json_t *o = json_pack("{s:s, s:s, s:s, s:s, s:s, s:s}", "stress",
                           cf_stress_measure_name(m->stress), "stress_source", src[0], "strain",
-                          cf_strain_measure_name(m->strain), "strain_source", src[1], "mode",
+                          strain, "strain_source", src[1], "mode",
                           cf_mode_name(t->mode), "mode_source", src[2]);
     if (o && *conv) /* absent: the columns were taken as they are */
         json_object_set_new(o, "conversion", json_string(conv));
     return o;
+}
+
+/* A mode the table's kind cannot honour: stated, with why (data.mode, mode_honoured false,
+** mode_reason). */
+static void mode_dropped_json(json_t *data, const cf_table *t)
+{
+    const char *why = cf_report_mode_dropped(t);
+    if (!why || !data)
+        return;
+    json_object_set_new(data, "mode", json_string(cf_mode_name(t->mode)));
+    json_object_set_new(data, "mode_honoured", json_false());
+    json_object_set_new(data, "mode_reason", json_string(why));
 }
 
 /* The limits every fit ran under. */
@@ -328,6 +375,7 @@ static json_t *report_json(const cf_fit_report *r)
         r->table->compression ? "compression-negative" : "tension-positive");
     if (!cf_table_is_force(r->table))
         json_object_set_new(data, "measures", measures_json(r->table));
+    mode_dropped_json(data, r->table);
     json_t *fits = json_array(), *base = json_array();
     for (int i = 0; i < r->nfits; i++)
         json_array_append_new(fits, fit_json(r, i));

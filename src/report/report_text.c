@@ -257,20 +257,31 @@ static void validation_text(FILE *o, const cf_fit_report *r)
                     cf_report_why(r->val[i].note, "no reason recorded"));
 }
 
+/* A mode stated for a table whose kind cannot honour it, and why. */
+static void mode_dropped_text(FILE *o, const cf_table *t)
+{
+    const char *why = cf_report_mode_dropped(t);
+    if (why)
+        fprintf(o, " mode %s (stated) is not honoured: %s\n", cf_mode_name(t->mode), why);
+}
+
 /* The table: its size, columns, sign, and (stress-strain) its measures and their conversion. */
 static void table_text(FILE *o, const cf_fit_report *r)
 {
     fprintf(o, "%s: %zu points, %s [%s] against %s [%s], %s\n", r->table->path, r->table->count,
             r->table->x_column, r->table->x_unit, r->table->y_column, r->table->y_unit,
             r->table->compression ? "compression negative" : "tension positive");
-    if (cf_table_is_force(r->table))
+    if (cf_table_is_force(r->table)) {
+        mode_dropped_text(o, r->table);
         return;
+    }
     const cf_table_measures *m = &r->table->measures;
     char src[3][128], conv[256];
     cf_report_sources(r->table, src);
     cf_report_conversion(r->table, conv, sizeof conv);
+    const char *strain = cf_report_strain_name(r->table, src);
     fprintf(o, " measures: stress %s (%s), strain %s (%s), mode %s (%s)\n",
-            cf_stress_measure_name(m->stress), src[0], cf_strain_measure_name(m->strain), src[1],
+            cf_stress_measure_name(m->stress), src[0], strain, src[1],
             cf_mode_name(r->table->mode), src[2]);
     if (*conv)
         fprintf(o, " fitted as engineering strain and nominal stress: %s\n", conv);

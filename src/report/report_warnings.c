@@ -3,6 +3,7 @@
 ** (warnings[]) and the command line's standard error share (report.h, cf_report_warnings).
 */
 #include <stdio.h>
+#include <string.h>
 
 #include "conifit/report.h"
 
@@ -21,10 +22,69 @@ static int softening_warning(const cf_fit_report *r, char *buf, size_t cap)
     return 1;
 }
 
+/* A design limit that holds fit i away from a better fit of the table, by more than
+** CF_LIMIT_COST_WARN of RMSE. */
+static int limit_cost_warning(const cf_fit_report *r, int i, char *buf, size_t cap)
+{
+    const cf_limit_cost *lc = &r->limit_cost[i];
+    if (!lc->checked || !(lc->rmse > (1 + CF_LIMIT_COST_WARN) * lc->rmse_free))
+        return 0;
+    char names[160] = "", flags[160] = "";
+    size_t nn = 0, nf = 0;
+    for (int b = 0; b < CF_C_COUNT; b++)
+        if (lc->limits >> b & 1u) {
+            nn += (size_t)snprintf(names + nn, sizeof names - nn, "%s%s", nn ? ", " : "",
+                                   cf_fit_constraint_name(1u << b));
+            nf += (size_t)snprintf(flags + nf, sizeof flags - nf, "%s%s", nf ? ", " : "",
+                                   cf_fit_constraint_flag(1u << b));
+            if (nn >= sizeof names || nf >= sizeof flags)
+                break;
+        }
+    const double u = r->table->y_to_file, ratio = lc->rmse / lc->rmse_free;
+    char worse[48];
+    if (ratio < 10)
+        snprintf(worse, sizeof worse, "%.0f %% worse", 100 * (ratio - 1));
+    else
+        snprintf(worse, sizeof worse, "%.3g times as large", ratio);
+    snprintf(buf, cap,
+             "the %s fit is held by the design limit%s %s: RMSE %.4g %s, against %.4g %s without "
+             "(%s); widen with %s if a spring of that design is acceptable",
+             cf_spring_type_name(r->fits[i].type), strchr(names, ',') ? "s" : "", names,
+             lc->rmse * u, r->table->y_unit, lc->rmse_free * u, r->table->y_unit, worse, flags);
+    return 1;
+}
+
+/* A fit worse than the straight line through the table, for whatever reason. */
+static int worse_than_linear(const cf_fit_report *r, int i, char *buf, size_t cap)
+{
+    const cf_fit_result *f = &r->fits[i];
+    const cf_baseline *lin = &r->baselines[CF_BASE_LINEAR];
+    if (!f->feasible || !(f->rmse > lin->rmse))
+        return 0;
+    const double u = r->table->y_to_file;
+    snprintf(buf, cap,
+             "the %s fit (RMSE %.4g %s, R^2 %.3g) is worse than a straight line through the table "
+             "(RMSE %.4g %s): the law cannot follow this table%s",
+             cf_spring_type_name(f->type), f->rmse * u, r->table->y_unit, f->r2, lin->rmse * u,
+             r->table->y_unit,
+             r->limit_cost[i].checked && r->limit_cost[i].rmse >
+                                             (1 + CF_LIMIT_COST_WARN) * r->limit_cost[i].rmse_free
+                 ? " within its design limits (see the limit above)"
+             : r->softening.found ? " (it softens, see above)"
+                                  : "");
+    return 1;
+}
+
 int cf_report_warnings(const cf_fit_report *r, char (*out)[CF_REPORT_WARNING_LEN], int cap)
 {
     int n = 0;
     if (n < cap)
         n += softening_warning(r, out[n], CF_REPORT_WARNING_LEN);
+    for (int i = 0; i < r->nfits; i++) {
+        if (n < cap)
+            n += limit_cost_warning(r, i, out[n], CF_REPORT_WARNING_LEN);
+        if (n < cap)
+            n += worse_than_linear(r, i, out[n], CF_REPORT_WARNING_LEN);
+    }
     return n;
 }

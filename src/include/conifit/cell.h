@@ -120,6 +120,12 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
 ** |e|/2 (a face diagonal). Lets a fit bound the springs' solid strain by what they reach. */
 double cf_cell_spring_strain(cf_mode m, double e);
 
+/* The table strain of mode m (side < 0: compression) at which the first spring of the cell
+** reaches solid, the free stretches solved (not held): past it the mode cannot go. To 1e-12
+** relative. CF_E_DATA when no spring reaches solid up to |e| = 1000. */
+cf_status cf_cell_solid_strain(const cf_cell *c, cf_mode m, int side, double *e_solid,
+                               cf_error *err);
+
 /* The mode's stress (MPa, table sign) at each of count strains. Stops at the first failure. */
 cf_status cf_cell_curve(const cf_cell *c, cf_mode m, const double *strain, size_t count,
                         double *stress_MPa, cf_error *err);

@@ -34,6 +34,7 @@ typedef struct cf_fit_report {
     int through_msm;            /* 1: each fit was refined through the lattice (thr[i]) */
     cf_through_msm thr[2];      /* what that cost and gained (MPa) */
     cf_softening softening;     /* where the table softens, which the law cannot follow */
+    cf_limit_cost limit_cost[2]; /* what the limits holding fits[i] cost (checked when held) */
 } cf_fit_report;
 
 /* Longest warning sentence, and the most a report states. */
