@@ -75,16 +75,21 @@ static void elastic_names(unsigned mask, char *buf, size_t cap)
 
 /* The elastic quantities of the kept candidate the series does not determine: the JSON list and
 ** the text warning naming each. */
-static void elastic_unresolved_json(json_t *o, const cf_visco_fit *f)
+static json_t *elastic_list(unsigned mask)
 {
     static const char *const names[CF_IDENT_COUNT] = {"rho", "s/H", "F_C/H^2"};
-    if (!f->elastic_unresolved)
-        return;
     json_t *a = json_array();
     for (int k = 0; k < CF_IDENT_COUNT; k++)
-        if (f->elastic_unresolved >> k & 1u)
+        if (mask >> k & 1u)
             json_array_append_new(a, json_string(names[k]));
-    json_object_set_new(o, "elastic_undetermined", a);
+    return a;
+}
+
+static void elastic_unresolved_json(json_t *o, const cf_visco_fit *f)
+{
+    if (!f->elastic_unresolved)
+        return;
+    json_object_set_new(o, "elastic_undetermined", elastic_list(f->elastic_unresolved));
     json_object_set_new(o, "elastic_undetermined_reason",
                         json_string("a standard error larger than the quantity's range (rho and "
                                     "s/H lie in (0, 1]; the stress scale is positive)"));
@@ -178,12 +183,16 @@ static void visco_keys(const cf_visco_report *r, json_t *o)
         for (int n = 0; n < CF_VISCO_AIC_MAX; n++)
             for (int gs = 0; gs < 2; gs++) {
                 const cf_visco_candidate *cd = &f->by_n[n][gs];
-                if (cd->fitted)
-                    json_array_append_new(
-                        a, json_pack("{s:i, s:s, s:i, s:o, s:b}", "branches", n + 1,
-                                     "relaxation", gs ? "strain" : "qlv",
-                                     "terms_depending_on_strain", cd->strain_terms, "aic",
-                                     num(cd->aic + aic_shift), "determined", cd->identified));
+                if (!cd->fitted)
+                    continue;
+                json_t *c = json_pack("{s:i, s:s, s:i, s:o, s:b}", "branches", n + 1,
+                                      "relaxation", gs ? "strain" : "qlv",
+                                      "terms_depending_on_strain", cd->strain_terms, "aic",
+                                      num(cd->aic + aic_shift), "determined", cd->identified);
+                if (c && cd->elastic_unresolved)
+                    json_object_set_new(c, "elastic_undetermined",
+                                        elastic_list(cd->elastic_unresolved));
+                json_array_append_new(a, c);
             }
         json_object_set_new(o, "aic_by_branches", a);
     }
