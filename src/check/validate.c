@@ -74,16 +74,24 @@ static double table_reach(const cf_table *d)
     return lo < 0 ? lo : hi;
 }
 
-/* The law of spring p built for evaluator s->method; 0 when it cannot be built. */
-static int law_for(const cf_spring *p, const cf_validate_setup *s, cf_law *law, cf_error *e)
+/* The law of spring p built for evaluator s->method: 1 when built. Otherwise the stability stays
+** unchecked, the reason in v->stability_note, and *st is CF_E_INTERNAL (err set) when memory ran
+** out, else CF_OK. */
+static int law_for(const cf_spring *p, const cf_validate_setup *s, cf_law *law, cf_validation *v,
+                   cf_status *st, cf_error *err)
 {
-    if (cf_law_init(law, p, NULL) != CF_OK)
-        return 0;
-    if (s->method == CF_LAW_TABLE && cf_law_table_build(law, s->table_intervals, e) != CF_OK) {
+    cf_error e = {0};
+    *st = CF_OK;
+    if (cf_law_init(law, p, &e) == CF_OK) {
+        if (s->method != CF_LAW_TABLE || cf_law_table_build(law, s->table_intervals, &e) == CF_OK)
+            return 1;
         cf_law_free(law);
-        return 0;
     }
-    return 1;
+    snprintf(v->stability_note, sizeof v->stability_note, "the law could not be built: %.400s",
+             e.msg[0] ? e.msg : "spring refused");
+    if (e.status == CF_E_INTERNAL)
+        *st = cf_error_set(err, CF_E_INTERNAL, "%s", e.msg);
+    return 0;
 }
 
 /* The stability limit of the full uniaxial lattice on the table's side, clipped to the table's
@@ -96,11 +104,8 @@ static cf_status lattice_stability(const cf_spring *p, const cf_validate_setup *
     cf_error e = {0};
     cf_status st = CF_OK;
     double limit = 0;
-    if (!law_for(p, s, &law, &e)) {
-        snprintf(v->stability_note, sizeof v->stability_note, "the law could not be built: %.400s",
-                 e.msg[0] ? e.msg : "spring refused");
-        return e.status == CF_E_INTERNAL ? cf_error_set(err, CF_E_INTERNAL, "%s", e.msg) : CF_OK;
-    }
+    if (!law_for(p, s, &law, v, &st, err))
+        return st;
     st = cf_msm_stability_limit(&law, s->method, &s->cfg, reach < 0 ? -1 : 1, &limit, &e);
     cf_law_free(&law);
     if (st == CF_OK) {
@@ -126,12 +131,10 @@ static cf_status cell_stability(const cf_spring *p, const cf_validate_setup *s, 
     cf_law law;
     cf_cell c;
     cf_error e = {0};
-    if (!law_for(p, s, &law, &e)) {
-        snprintf(v->stability_note, sizeof v->stability_note, "the law could not be built: %.400s",
-                 e.msg[0] ? e.msg : "spring refused");
-        return e.status == CF_E_INTERNAL ? cf_error_set(err, CF_E_INTERNAL, "%s", e.msg) : CF_OK;
-    }
-    cf_status st = cf_cell_init(&c, &law, s->method, s->cfg.lattice.weight, &e);
+    cf_status st = CF_OK;
+    if (!law_for(p, s, &law, v, &st, err))
+        return st;
+    st = cf_cell_init(&c, &law, s->method, s->cfg.lattice.weight, &e);
     int lost = 0;
     double limit = reach;
     if (st == CF_OK)
