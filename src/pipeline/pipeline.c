@@ -88,13 +88,15 @@ static cf_status validate_fits(const cf_table *t, const cf_pipeline_options *opt
 }
 
 /* What the design limits holding feasible fit f cost: the same fit with them widened as far as
-** their flags go. Only memory running out is an error; a widened fit that fails is not checked. */
+** their flags go. Only memory running out is an error; a widened fit that fails is not checked.
+** A fit through the lattice is not: the spring's own RMSE compared here is not its target's. */
 static cf_status limit_cost(const cf_table *t, const cf_pipeline_options *opt,
                             const cf_fit_result *f, cf_limit_cost *lc, cf_error *err)
 {
     memset(lc, 0, sizeof *lc);
     cf_fit_options wide;
-    if (!f->feasible || !(lc->limits = cf_fit_relax(&opt->fit, f->held, &wide)))
+    if (!f->feasible || through_lattice(t, opt) ||
+        !(lc->limits = cf_fit_relax(&opt->fit, f->held, &wide)))
         return CF_OK;
     progress(opt, t, "fitting the %s spring without the limits that hold it",
              cf_spring_type_name(f->type));

@@ -54,24 +54,47 @@ static int limit_cost_warning(const cf_fit_report *r, int i, char *buf, size_t c
     return 1;
 }
 
-/* A fit worse than the straight line through the table, for whatever reason. */
+/* Why fit i cannot follow the table, in a few words after its sentence ("" when nothing says). */
+static void worse_why(const cf_fit_report *r, int i, char *buf, size_t cap)
+{
+    const cf_limit_cost *lc = &r->limit_cost[i];
+    const unsigned held = r->fits[i].held;
+    size_t n = 0;
+    buf[0] = '\0';
+    if (lc->checked && lc->rmse > (1 + CF_LIMIT_COST_WARN) * lc->rmse_free) {
+        snprintf(buf, cap, " within its design limits (see the limit above)");
+        return;
+    }
+    if (r->softening.found) {
+        snprintf(buf, cap, " (it softens, see above)");
+        return;
+    }
+    for (int b = 0; b < CF_C_COUNT && held; b++)
+        if (held >> b & 1u && n + 1 < cap)
+            n += (size_t)snprintf(buf + n, cap - n, "%s%s", n ? ", " : " (held by ",
+                                  cf_fit_constraint_name(1u << b));
+    if (n > 0 && n + 1 < cap)
+        snprintf(buf + n, cap - n, ")");
+}
+
+/* A fit worse than the straight line through the table, for whatever reason: its target's RMSE
+** (the cell's for a fit through the lattice) against the line's. */
 static int worse_than_linear(const cf_fit_report *r, int i, char *buf, size_t cap)
 {
     const cf_fit_result *f = &r->fits[i];
     const cf_baseline *lin = &r->baselines[CF_BASE_LINEAR];
-    if (!f->feasible || !(f->rmse > lin->rmse))
+    const int thr = r->through_msm && r->thr[i].done;
+    const double rmse = thr ? r->thr[i].cell_rmse : f->rmse;
+    if (!f->feasible || !(rmse > lin->rmse))
         return 0;
     const double u = r->table->y_to_file;
+    char why[192];
+    worse_why(r, i, why, sizeof why);
     snprintf(buf, cap,
-             "the %s fit (RMSE %.4g %s, R^2 %.3g) is worse than a straight line through the table "
+             "the %s fit (%sRMSE %.4g %s) is worse than a straight line through the table "
              "(RMSE %.4g %s): the law cannot follow this table%s",
-             cf_spring_type_name(f->type), f->rmse * u, r->table->y_unit, f->r2, lin->rmse * u,
-             r->table->y_unit,
-             r->limit_cost[i].checked && r->limit_cost[i].rmse >
-                                             (1 + CF_LIMIT_COST_WARN) * r->limit_cost[i].rmse_free
-                 ? " within its design limits (see the limit above)"
-             : r->softening.found ? " (it softens, see above)"
-                                  : "");
+             cf_spring_type_name(f->type), thr ? "through the lattice, " : "", rmse * u,
+             r->table->y_unit, lin->rmse * u, r->table->y_unit, why);
     return 1;
 }
 
