@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "conifit/cell_stability.h"
 #include "fit/clock.h"
 #include "fit/lattice_curve.h"
 #include "fit/lsq.h"
@@ -62,34 +63,107 @@ void cf_validation_free(cf_validation *v)
     v->stress_MPa = NULL;
 }
 
-/* The stability limit of the full uniaxial lattice on the table's side (compression when the
-** table has any), and whether the table reaches past it. A failure leaves it unchecked. */
-static cf_status stability(const cf_spring *p, const cf_validate_setup *s, const cf_table *d,
-                           cf_validation *v, cf_error *err)
+/* The table's reach on the side the stability is checked (compression when it has any). */
+static double table_reach(const cf_table *d)
 {
     double lo = 0, hi = 0;
     for (size_t i = 0; i < d->count; i++) {
         lo = fmin(lo, d->x[i]);
         hi = fmax(hi, d->x[i]);
     }
-    int side = lo < 0 ? -1 : 1;
+    return lo < 0 ? lo : hi;
+}
+
+/* The law of spring p built for evaluator s->method: 1 when built. Otherwise the stability stays
+** unchecked, the reason in v->stability_note, and *st is CF_E_INTERNAL (err set) when memory ran
+** out, else CF_OK. */
+static int law_for(const cf_spring *p, const cf_validate_setup *s, cf_law *law, cf_validation *v,
+                   cf_status *st, cf_error *err)
+{
+    cf_error e = {0};
+    *st = CF_OK;
+    if (cf_law_init(law, p, &e) == CF_OK) {
+        if (s->method != CF_LAW_TABLE || cf_law_table_build(law, s->table_intervals, &e) == CF_OK)
+            return 1;
+        cf_law_free(law);
+    }
+    snprintf(v->stability_note, sizeof v->stability_note, "the law could not be built: %.400s",
+             e.msg[0] ? e.msg : "spring refused");
+    if (e.status == CF_E_INTERNAL)
+        *st = cf_error_set(err, CF_E_INTERNAL, "%s", e.msg);
+    return 0;
+}
+
+/* The stability limit of the full uniaxial lattice on the table's side, clipped to the table's
+** reach. A failure leaves it unchecked (the reason in v->stability_note). */
+static cf_status lattice_stability(const cf_spring *p, const cf_validate_setup *s,
+                                   const cf_table *d, cf_validation *v, cf_error *err)
+{
+    const double reach = table_reach(d);
     cf_law law;
-    if (cf_law_init(&law, p, NULL) != CF_OK)
-        return CF_OK;
     cf_error e = {0};
     cf_status st = CF_OK;
-    if ((s->method != CF_LAW_TABLE || cf_law_table_build(&law, s->table_intervals, &e) == CF_OK) &&
-        (st = cf_msm_stability_limit(&law, s->method, &s->cfg, side, &v->stable_to_strain, &e)) ==
-            CF_OK) {
-        v->stability_checked = 1;
-        double reach = side < 0 ? lo : hi;
-        v->unstable_in_range = v->stable_to_strain != 0 && fabs(reach) > fabs(v->stable_to_strain);
-    }
+    double limit = 0;
+    if (!law_for(p, s, &law, v, &st, err))
+        return st;
+    st = cf_msm_stability_limit(&law, s->method, &s->cfg, reach < 0 ? -1 : 1, &limit, &e);
     cf_law_free(&law);
-    /* a scan that could not run leaves the stability unchecked; one that ran out of memory is an
-    ** error, not a finding */
+    if (st == CF_OK) {
+        v->stability_checked = 1;
+        v->unstable_in_range = limit != 0 && fabs(reach) > fabs(limit);
+        v->stable_to_strain = v->unstable_in_range ? limit : reach;
+        return CF_OK;
+    }
+    snprintf(v->stability_note, sizeof v->stability_note, "the lattice's stability scan failed: %.400s",
+             e.msg[0] ? e.msg : "no reason given");
+    /* a scan that ran out of memory is an error, not a finding */
     if (e.status == CF_E_INTERNAL || st == CF_E_INTERNAL)
         return cf_error_set(err, CF_E_INTERNAL, "%s", e.msg);
+    return CF_OK;
+}
+
+/* The stability of the homogenised cell along the table's mode up to its reach: the smallest
+** eigenvalue of the cell's incremental stiffness (cell_stability.h). */
+static cf_status cell_stability(const cf_spring *p, const cf_validate_setup *s, const cf_table *d,
+                                cf_validation *v, cf_error *err)
+{
+    const double reach = table_reach(d);
+    cf_law law;
+    cf_cell c;
+    cf_error e = {0};
+    cf_status st = CF_OK;
+    if (!law_for(p, s, &law, v, &st, err))
+        return st;
+    st = cf_cell_init(&c, &law, s->method, s->cfg.lattice.weight, &e);
+    int lost = 0;
+    double limit = reach;
+    if (st == CF_OK)
+        st = cf_cell_stable_to(&c, d->mode, reach, &limit, &lost, &e);
+    cf_law_free(&law);
+    if (st == CF_OK) {
+        v->cell_stability_checked = 1;
+        v->cell_stable_to_strain = limit;
+        v->cell_unstable_in_range = lost;
+        return CF_OK;
+    }
+    snprintf(v->stability_note, sizeof v->stability_note, "the cell's stability scan failed: %.400s",
+             e.msg[0] ? e.msg : "no reason given");
+    return st == CF_E_INTERNAL ? cf_error_set(err, CF_E_INTERNAL, "%s", e.msg) : CF_OK;
+}
+
+/* Stability in the table's mode: the full lattice's scan in uniaxial, the cell's tangent in
+** every mode; the headline (stable_to_strain) is the lattice's where it ran, else the cell's. */
+static cf_status stability(const cf_spring *p, const cf_validate_setup *s, const cf_table *d,
+                           cf_validation *v, cf_error *err)
+{
+    cf_status st = cell_stability(p, s, d, v, err);
+    if (st != CF_OK)
+        return st;
+    if (!v->by_cell)
+        return lattice_stability(p, s, d, v, err);
+    v->stability_checked = v->cell_stability_checked;
+    v->stable_to_strain = v->cell_stable_to_strain;
+    v->unstable_in_range = v->cell_unstable_in_range;
     return CF_OK;
 }
 
@@ -138,7 +212,7 @@ cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const 
     /* the law's own curve is a uniaxial one: in another mode there is nothing to compare */
     v->law_rmse = d->mode == CF_MODE_UNIAXIAL ? sqrt(ss / (double)d->count) : NAN;
     free(law);
-    if (!v->by_cell && (st = stability(p, s, d, v, &e)) != CF_OK) {
+    if ((st = stability(p, s, d, v, &e)) != CF_OK) {
         cf_validation_free(v);
         snprintf(v->note, sizeof v->note, "%s", e.msg);
         v->wall_time_s = cf_clock_s() - t0;
@@ -160,8 +234,11 @@ cf_status cf_validate_lattice_fit(const cf_table *d, const cf_validate_setup *s,
     memset(v, 0, sizeof *v);
     if (cf_table_is_force(d))
         return cf_validate_run(&res->params, s, d, v, err); /* records the reason it is skipped */
-    if (!t->done)
+    if (!t->done) {
+        snprintf(v->note, sizeof v->note, "the fit through the lattice did not run: %.440s",
+                 t->note[0] ? t->note : "no reason recorded");
         return CF_OK;
+    }
     double *cell = malloc(sizeof(double) * (d->count ? d->count : 1));
     if (!cell)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", d->count);

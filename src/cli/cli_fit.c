@@ -37,23 +37,6 @@ typedef struct fit_job {
     cf_status st;
 } fit_job;
 
-/* The flag that widens a limit, by constraint bit. */
-static const char *limit_flag(unsigned bit)
-{
-    switch (bit) {
-    case CF_C_INDEX_MAX: return "--index-max";
-    case CF_C_RHO_MIN: return "--rho-min";
-    case CF_C_COILS_MAX: return "--n-max";
-    case CF_C_G_MAX: return "--G-max";
-    case CF_C_D2_H: return "--D2-max-H";
-    case CF_C_TRAVEL: return "nothing: no spring reaches the largest strain (a solid strain is "
-                             "below 1)";
-    case CF_C_TYPE: return "--rho-min, --index-max, --D2-max-H (a telescoping spring needs "
-                           "rho <= index_max/(index_max + 4))";
-    }
-    return "--fix";
-}
-
 /* Named warnings on stderr: a family that cannot be placed inside the limits, a law that goes
 ** solid close past the data. */
 static void fit_warnings(const char *file, const cf_fit_report *r, const cf_fit_result *f)
@@ -65,14 +48,26 @@ static void fit_warnings(const char *file, const cf_fit_report *r, const cf_fit_
             cf_cli_printf_safe(stderr,
                     "conifit: warning: %s: no %s spring of this table meets the limit %s "
                     "(feasible: false); to widen it: %s\n",
-                    file, type, cf_fit_constraint_name(bit), limit_flag(bit));
+                    file, type, cf_fit_constraint_name(bit), cf_fit_constraint_flag(bit));
     }
     if (f->feasible && f->solid_ratio < CF_FIT_SOLID_RATIO_WARN)
         cf_cli_printf_safe(stderr,
-                "conifit: warning: %s: the %s law goes solid at %s %.4g, %.3g times the table's "
-                "largest (below %.1f): it stiffens without bound just past the data\n",
-                file, type, cf_table_is_force(r->table) ? "displacement [mm]" : "strain", f->ident.solid,
-                f->solid_ratio, CF_FIT_SOLID_RATIO_WARN);
+                "conifit: warning: %s: the %s law goes solid at %s %.4g%s%s, %.3g times the "
+                "table's largest (below %.1f): it stiffens without bound just past the data\n",
+                file, type, cf_table_is_force(r->table) ? "displacement [mm]" : "strain",
+                f->solid_table_strain > 0 ? f->solid_table_strain : f->ident.solid,
+                cf_table_is_force(r->table) ? "" : " in ",
+                cf_table_is_force(r->table) ? "" : cf_mode_name(r->table->mode), f->solid_ratio,
+                CF_FIT_SOLID_RATIO_WARN);
+}
+
+/* What the model cannot follow in the table (cf_report_warnings), on stderr. */
+static void report_warnings(const char *file, const cf_fit_report *r)
+{
+    char w[CF_REPORT_WARNINGS_MAX][CF_REPORT_WARNING_LEN];
+    int n = cf_report_warnings(r, w, CF_REPORT_WARNINGS_MAX);
+    for (int k = 0; k < n; k++)
+        cf_cli_printf_safe(stderr, "conifit: warning: %s: %s\n", file, w[k]);
 }
 
 /* Through-the-lattice work and each type of a joint fit take seconds: say so on a terminal. */
@@ -308,14 +303,16 @@ static int report_job(const fit_args *a, fit_job *j)
         if (a->nfiles > 1)
             fputc('\n', stdout);
     }
+    report_warnings(j->file, &j->rep);
     for (int k = 0; k < j->rep.nfits; k++) {
         fit_warnings(j->file, &j->rep, &j->rep.fits[k]);
         const cf_validation *v = &j->rep.val[k];
         if (j->rep.validate && v->done && v->unstable_in_range)
             cf_cli_printf_safe(stderr,
-                    "conifit: warning: %s: the %s spring's lattice loses stability at strain "
-                    "%.4g, inside the table's range\n",
-                    j->file, cf_spring_type_name(j->rep.fits[k].type), v->stable_to_strain);
+                    "conifit: warning: %s: the %s spring's %s loses stability at strain "
+                    "%.4g (%s), inside the table's range\n",
+                    j->file, cf_spring_type_name(j->rep.fits[k].type),
+                    v->by_cell ? "cell" : "lattice", v->stable_to_strain, cf_mode_name(v->mode));
         const cf_through_msm *t = &j->rep.thr[k];
         if (j->rep.through_msm && t->done && t->search_rows < j->rep.table->count)
             cf_cli_printf_safe(stderr,

@@ -215,6 +215,7 @@ static void summarise(fit_ctx *c, const double *p, cf_fit_result *res)
     res->objective = cf_fit_objective6(c, p) * c->ynorm;
     res->feasible = cf_fit_check_at(c, &res->params, &res->active, &res->violated);
     res->objective_zero = c->ynorm;
+    res->solid_table_strain = res->ident.solid;
     res->solid_ratio = c->xmax > 0 ? res->ident.solid / c->xmax : INFINITY;
     for (int a = 0; a < 3; a++)
         for (int b = 0; b < 3; b++)

@@ -5,6 +5,7 @@
 #include "conifit/lattice_fit.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -246,6 +247,9 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
         st = take_target(&c, search, res, t, err);
     t->done = st == CF_OK;
 out:
+    if (!t->done)
+        snprintf(t->note, sizeof t->note, "%s",
+                 err && err->msg[0] ? err->msg : "the search found no spring to place");
     t->evaluations = c.pr.evals + cs.pr.evals;
     tm_free(&cs);
     tm_free(&c);

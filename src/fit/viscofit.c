@@ -297,7 +297,26 @@ static int resolved(double v, double se)
 ** fails it; AIC assumes a regular model and would reward such a fit's extra parameters. The
 ** errors are computed at s2 = 1 and scaled, so that a noiseless series (s2 -> 0) passes.
 ** *loose gets the terms whose k_i is fitted but not larger than its error. */
-static int prony_identified(ctx *c, const cf_visco_params *p, double s2, unsigned *loose)
+/* The fitted elastic quantities (rho, s/H, F_C/H^2) whose standard error (se at s2 = 1, times s)
+** is larger than the range the quantity can take: rho and s/H lie in (0, 1], so an error above 1
+** says nothing of them; the stress scale is positive, so an error above its own value. A bit per
+** quantity (CF_IDENT_*); held quantities are not fitted and never fail. */
+static unsigned elastic_unresolved(const ctx *c, const cf_visco_params *p, const int *held,
+                                   const cf_visco_fit *se, double s)
+{
+    unsigned bad = 0;
+    if (!c->free_el)
+        return 0;
+    for (int k = 0; k < CF_IDENT_COUNT; k++) {
+        const double e = s * se->ident_se.v[k], range = k == CF_IDENT_SCALE ? p->ident.v[k] : 1.0;
+        if (!held[k] && se->ident_se.v[k] > 0 && !(e <= range))
+            bad |= 1u << k;
+    }
+    return bad;
+}
+
+static int prony_identified(ctx *c, const cf_visco_params *p, double s2, unsigned *loose,
+                            unsigned *elastic)
 {
     int held[CF_IDENT_COUNT];
     cf_visco_fit se;
@@ -306,7 +325,8 @@ static int prony_identified(ctx *c, const cf_visco_params *p, double s2, unsigne
     cf_viscofit_standard_errors(c, p, held, 1.0, &se);
     const double s = sqrt(s2);
     *loose = 0;
-    int ok = !c->dash || resolved(p->eta_MPa_s, s * se.se_eta_MPa_s);
+    *elastic = elastic_unresolved(c, p, held, &se, s);
+    int ok = !*elastic && (!c->dash || resolved(p->eta_MPa_s, s * se.se_eta_MPa_s));
     for (int i = 0; i < p->nbranch; i++) {
         ok = ok && resolved(p->tau_s[i], s * se.se_tau_s[i]) &&
              resolved(p->g[i] + p->k[i] * c->xmax, s * se.se_g_max[i]);
@@ -328,7 +348,7 @@ static int preferred(int ident_a, double aic_a, int ident_b, double aic_b)
 ** fitted (its AIC, whether the series determines it and its loose k_i in *aic, *ident, *loose),
 ** 0 when no model could be evaluated, -1 when memory ran out. */
 static int candidate(ctx *c, int nb, const cf_visco_params *from, cf_visco_params *p, double *aic,
-                     int *ident, unsigned *loose)
+                     int *ident, unsigned *loose, unsigned *elastic)
 {
     if (!(fit_nb(c, nb, from, p) < HUGE_VAL) || !cf_viscofit_curve(c, p))
         return c->oom ? -1 : 0;
@@ -341,7 +361,7 @@ static int candidate(ctx *c, int nb, const cf_visco_params *from, cf_visco_param
     const int kpar = (c->free_el ? 3 : 0) + 2 * nb + cf_viscofit_strain_terms(c) + c->dash;
     *aic = (double)c->n * log(fmax(rss, 1e-300) / (double)c->n) + 2.0 * kpar;
     const double s2 = (double)c->n > kpar ? wrss / ((double)c->n - kpar) : 0;
-    *ident = prony_identified(c, p, s2, loose);
+    *ident = prony_identified(c, p, s2, loose, elastic);
     return c->oom ? -1 : 1;
 }
 
@@ -357,7 +377,7 @@ static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf
     const int nlo = o->nbranch ? o->nbranch : 1, nhi = o->nbranch ? o->nbranch : CF_VISCO_AIC_MAX;
     double best_aic = HUGE_VAL;
     int best_ident = 0, best_gs = 0;
-    unsigned best_mask = 0;
+    unsigned best_mask = 0, best_el = 0;
     memset(best, 0, sizeof *best);
     res->chosen_by_aic = o->nbranch == 0 || o->relaxation == CF_RELAX_AUTO;
     const int gslo = o->relaxation == CF_RELAX_STRAIN, gshi = o->relaxation != CF_RELAX_QLV;
@@ -368,10 +388,10 @@ static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf
         cf_visco_params p, q;
         double aic = HUGE_VAL, aq;
         int ident = 0, iq, fitted = 0, st;
-        unsigned lq, mask = c->smask;
+        unsigned lq, mask = c->smask, eq = 0, el = 0;
         cf_visco_params from;
         const cf_visco_params *fp = NULL;
-        while ((st = candidate(c, nb, fp, &q, &aq, &iq, &lq)) != 0) {
+        while ((st = candidate(c, nb, fp, &q, &aq, &iq, &lq, &eq)) != 0) {
             if (st < 0)
                 return cf_error_set(err, CF_E_INTERNAL,
                                     "out of memory in the viscoelastic fit of %d Prony term%s",
@@ -380,6 +400,7 @@ static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf
                 p = q;
                 aic = aq;
                 ident = iq;
+                el = eq;
                 mask = c->smask;
             }
             fitted = 1;
@@ -400,12 +421,13 @@ static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf
         c->smask = mask;
         if (nb - 1 < CF_VISCO_AIC_MAX)
             res->by_n[nb - 1][c->gs] =
-                (cf_visco_candidate){1, aic, ident, c->gs ? cf_viscofit_strain_terms(c) : 0};
+                (cf_visco_candidate){1, aic, ident, c->gs ? cf_viscofit_strain_terms(c) : 0, el};
         if (best_aic == HUGE_VAL || preferred(ident, aic, best_ident, best_aic)) {
             best_aic = aic;
             best_ident = ident;
             best_gs = c->gs;
             best_mask = c->smask;
+            best_el = el;
             *best = p;
         }
     }
@@ -413,6 +435,7 @@ static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf
         return cf_error_set(err, CF_E_NOCONV,
                             "no viscoelastic model could be evaluated along this series");
     res->identified = best_ident;
+    res->elastic_unresolved = best_el;
     c->gs = best_gs;
     c->smask = best_mask;
     c->nb = best->nbranch;

@@ -63,9 +63,11 @@ static void predict_creep(const cf_visco_params *p, const cf_visco_setup *s, dou
         out->creep_hold_s = thold;
         out->creep_strain_ramp = sgn * smp[PRED_PER].strain;
         out->creep_strain_end = sgn * smp[2 * PRED_PER].strain;
-    } else if (!out->note[0]) {
-        snprintf(out->note, sizeof out->note, "creep: %.480s",
-                 sc > 0 ? ce.msg : "the series ends at zero stress");
+    } else {
+        /* after the cycle's reason, if any: each skipped prediction finds its own */
+        size_t n = strlen(out->note);
+        snprintf(out->note + n, sizeof out->note - n, "%screep: %.240s", n ? "; " : "",
+                 sc > 0 ? (ce.msg[0] ? ce.msg : "the run failed") : "the series ends at zero stress");
     }
 }
 

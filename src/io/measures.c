@@ -287,8 +287,10 @@ cf_status cf_measures_convert(cf_table *t, cf_error *err)
     } else if (m->strain == CF_STRAIN_STRETCH) {
         m->strain_converted = 1; /* the reader took stretch - 1 */
     }
+    /* a stretch must stay positive; simple shear's amount gamma is no stretch and takes either
+    ** sign without bound */
     for (size_t i = 0; i < t->count; i++)
-        if (!(t->x[i] > -1) || !isfinite(t->x[i]))
+        if (!isfinite(t->x[i]) || (!shear && !(t->x[i] > -1)))
             return cf_error_set(err, CF_E_DATA,
                                 "%s: data row %zu: strain %g is a stretch of %g; a stretch must "
                                 "be positive ('%g')",

@@ -145,6 +145,35 @@ cf_status cf_cell_stress(const cf_cell *c, const double F[9], const cf_cell_extr
     return evaluate(c, F, extra, s, kT, err);
 }
 
+cf_status cf_cell_tangent(const cf_cell *c, const double F[9], const cf_cell_extra *extra,
+                          cf_cell_state *s, double A[81], cf_error *err)
+{
+    double kT[CF_CELL_DIRS];
+    s->stress_MPa = 0;
+    s->free_stretch = 1;
+    cf_status st = evaluate(c, F, extra, s, kT, err);
+    if (st != CF_OK)
+        return st;
+    const double H = c->law->p.H_mm, H3 = H * H * H;
+    memset(A, 0, 81 * sizeof(double));
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        int N[3], fam;
+        cf_cell_direction(d, N, &fam);
+        double X[3] = {H * N[0], H * N[1], H * N[2]}, xv[3];
+        for (int i = 0; i < 3; i++)
+            xv[i] = F[3 * i] * X[0] + F[3 * i + 1] * X[1] + F[3 * i + 2] * X[2];
+        const double L = s->L_mm[d], T = s->T_N[d], a = (kT[d] - T / L) / (L * L * H3);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                for (int k = 0; k < 3; k++)
+                    for (int l = 0; l < 3; l++)
+                        A[27 * i + 9 * j + 3 * k + l] +=
+                            a * xv[i] * X[j] * xv[k] * X[l] +
+                            (i == k ? T * X[j] * X[l] / (L * H3) : 0);
+    }
+    return CF_OK;
+}
+
 /* dP[m][m] / dF[k][k] summed over the diagonal entries k whose bit is set in kmask, at state s:
 ** dP_ij/dF_kl = (1/H^3) sum_d [(dT/dL - T/L) x_i X_j x_k X_l / L^2 + T delta_ik X_j X_l / L]. */
 static double tangent(const cf_cell *c, const cf_cell_state *s, const double kT[CF_CELL_DIRS],
@@ -264,9 +293,10 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
 {
     if ((int)m < 0 || m >= CF_MODE_COUNT)
         return cf_error_set(err, CF_E_DATA, "mode %d: unknown", (int)m);
-    if (!isfinite(e) || !(e > -1))
-        return cf_error_set(err, CF_E_DATA, "%s strain %g: must be finite and > -1",
-                            cf_mode_name(m), e);
+    /* a stretch must stay positive; simple shear has no stretch and takes any amount */
+    if (!isfinite(e) || (m != CF_MODE_SHEAR && !(e > -1)))
+        return cf_error_set(err, CF_E_DATA, "%s strain %g: must be finite%s", cf_mode_name(m), e,
+                            m == CF_MODE_SHEAR ? "" : " and > -1");
     const mode_form fm = form_of(m);
     double F[9], kT[CF_CELL_DIRS];
     cf_status st;
@@ -348,5 +378,41 @@ cf_status cf_cell_curve(const cf_cell *c, cf_mode m, const double *strain, size_
             return st;
         stress_MPa[i] = s.stress_MPa;
     }
+    return CF_OK;
+}
+
+/* 1 when mode m reaches table strain e (no spring at solid, the free stretch found). */
+static int reaches(const cf_cell *c, cf_mode m, double e)
+{
+    cf_cell_state s;
+    return cf_cell_mode(c, m, e, NULL, &s, NULL) == CF_OK;
+}
+
+cf_status cf_cell_solid_strain(const cf_cell *c, cf_mode m, int side, double *e_solid,
+                               cf_error *err)
+{
+    const double sg = side < 0 ? -1.0 : 1.0;
+    /* a bracket [good, bad] in |e|: the far end doubles until the mode cannot reach it (a
+    ** compression cannot pass -1 in a mode that stretches the loaded edge) */
+    double good = 0, bad = 0.1;
+    while (reaches(c, m, sg * bad)) {
+        good = bad;
+        bad *= 2;
+        if (bad > 1e3 || (sg < 0 && m != CF_MODE_SHEAR && bad >= 1))
+            break;
+    }
+    if (sg < 0 && m != CF_MODE_SHEAR)
+        bad = fmin(bad, 1);
+    if (reaches(c, m, sg * bad))
+        return cf_error_set(err, CF_E_DATA, "%s strain %g: no spring of the cell reaches solid",
+                            cf_mode_name(m), sg * bad);
+    for (int k = 0; k < 200 && bad - good > 1e-12 * bad; k++) {
+        const double mid = 0.5 * (good + bad);
+        if (reaches(c, m, sg * mid))
+            good = mid;
+        else
+            bad = mid;
+    }
+    *e_solid = sg * good;
     return CF_OK;
 }

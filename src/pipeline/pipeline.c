@@ -5,9 +5,11 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "conifit/baseline.h"
+#include "conifit/cell.h"
 #include "conifit/scene.h"
 #include "conifit/version.h"
 #include "base/atomic.h"
@@ -87,6 +89,60 @@ static cf_status validate_fits(const cf_table *t, const cf_pipeline_options *opt
     return CF_OK;
 }
 
+/* What the design limits holding feasible fit f cost: the same fit with them widened as far as
+** their flags go. Only memory running out is an error; a widened fit that fails is not checked.
+** A fit through the lattice is not: the spring's own RMSE compared here is not its target's. */
+static cf_status limit_cost(const cf_table *t, const cf_pipeline_options *opt,
+                            const cf_fit_result *f, cf_limit_cost *lc, cf_error *err)
+{
+    memset(lc, 0, sizeof *lc);
+    cf_fit_options wide;
+    if (!f->feasible || through_lattice(t, opt) ||
+        !(lc->limits = cf_fit_relax(&opt->fit, f->held, &wide)))
+        return CF_OK;
+    progress(opt, t, "fitting the %s spring without the limits that hold it",
+             cf_spring_type_name(f->type));
+    cf_fit_result *free_fit = malloc(sizeof *free_fit);
+    if (!free_fit)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory");
+    cf_error e = {0};
+    cf_status st = cf_fit_run(t, &wide, f->type, free_fit, &e);
+    if (st == CF_OK && free_fit->feasible) {
+        lc->checked = 1;
+        lc->rmse = f->rmse;
+        lc->rmse_free = free_fit->rmse;
+    }
+    free(free_fit);
+    if (st == CF_E_INTERNAL)
+        return cf_error_set(err, st, "%s", e.msg);
+    return CF_OK;
+}
+
+/* Where fit f's first spring reaches solid in the table's own mode (a stress-strain table in a
+** mode of the cell): the table strain the solid-strain ratio and its warning are stated in. A
+** mode the cell cannot follow to solid leaves the spring's own solid strain. */
+static void solid_in_mode(const cf_table *t, const cf_pipeline_options *opt, cf_fit_result *f)
+{
+    if (cf_table_is_force(t) || t->mode == CF_MODE_UNIAXIAL || !(f->ident.solid > 0))
+        return;
+    double xmax = 0;
+    int side = 1;
+    for (size_t i = 0; i < t->count; i++)
+        if (fabs(t->x[i]) > xmax)
+            xmax = fabs(t->x[i]), side = t->x[i] < 0 ? -1 : 1;
+    cf_law law;
+    cf_cell c;
+    double e = 0;
+    if (cf_law_init(&law, &f->params, NULL) != CF_OK)
+        return;
+    if (cf_cell_init(&c, &law, CF_LAW_CLOSED, opt->lattice.cfg.lattice.weight, NULL) == CF_OK &&
+        cf_cell_solid_strain(&c, t->mode, side, &e, NULL) == CF_OK) {
+        f->solid_table_strain = fabs(e);
+        f->solid_ratio = xmax > 0 ? fabs(e) / xmax : INFINITY;
+    }
+    cf_law_free(&law);
+}
+
 cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_fit_report *r,
                           cf_error *err)
 {
@@ -131,6 +187,8 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
         progress(opt, t, "fitting the %s spring", cf_spring_type_name((cf_spring_type)ty));
         cf_error e = {0};
         cf_status st = cf_fit_run(t, &opt->fit, (cf_spring_type)ty, &r->fits[r->nfits], &e);
+        if (st == CF_OK)
+            st = limit_cost(t, opt, &r->fits[r->nfits], &r->limit_cost[r->nfits], &e);
         if (st != CF_OK)
             return cf_error_set(err, st, "%s: %s", t->path, e.msg);
         r->nfits++;
@@ -138,10 +196,14 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
     if (r->nfits == 0)
         return cf_error_set(err, CF_E_DATA, "%s: no spring type chosen to fit", t->path);
     cf_error be = {0};
+    r->softening = cf_softening_of(t);
     if (cf_baseline_fit_all(t, r->baselines, &be) != CF_OK)
         return cf_error_set(err, be.status, "%s: %s", t->path, be.msg);
-    if (opt->validate || through_lattice(t, opt))
-        return validate_fits(t, opt, r, err);
+    cf_status vst = CF_OK;
+    if ((opt->validate || through_lattice(t, opt)) && (vst = validate_fits(t, opt, r, err)) != CF_OK)
+        return vst;
+    for (int k = 0; k < r->nfits; k++)
+        solid_in_mode(t, opt, &r->fits[k]);
     return CF_OK;
 }
 

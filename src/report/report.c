@@ -69,6 +69,44 @@ static json_t *constraint_list(unsigned bits)
 
 
 
+/* limit_cost {limits, rmse, rmse_without_limits, flags}: what the limits holding fit i cost,
+** present when the widened fit ran. */
+static void limit_cost_json(json_t *o, const cf_fit_report *r, int i)
+{
+    const cf_limit_cost *lc = &r->limit_cost[i];
+    if (!lc->checked || !o)
+        return;
+    json_t *flags = json_array();
+    for (int b = 0; b < CF_C_COUNT; b++)
+        if (lc->limits >> b & 1u)
+            json_array_append_new(flags, json_string(cf_fit_constraint_flag(1u << b)));
+    const double u = r->table->y_to_file;
+    json_object_set_new(o, "limit_cost",
+                        json_pack("{s:o, s:o, s:o, s:o, s:b}", "limits",
+                                  constraint_list(lc->limits), "flags", flags, "rmse",
+                                  num(lc->rmse * u), "rmse_without_limits",
+                                  num(lc->rmse_free * u), "warning",
+                                  lc->rmse > (1 + CF_LIMIT_COST_WARN) * lc->rmse_free));
+}
+
+/* How far the law is from solid at the data, in the table's own measure: the table strain at
+** which the first spring reaches solid in the table's mode (the solid strain itself in
+** uniaxial), its ratio to the table's largest strain, and whether that is close. */
+static json_t *extrapolation_json(const cf_fit_report *r, const cf_fit_result *f)
+{
+    const int fd = cf_table_is_force(r->table);
+    const double at = f->solid_table_strain > 0 ? f->solid_table_strain : f->ident.solid;
+    json_t *o = json_pack("{s:o, s:o, s:o, s:b}", fd ? "travel_mm" : "solid_strain",
+                          num(f->ident.solid), fd ? "largest_displacement_mm" : "largest_strain",
+                          num(at / f->solid_ratio), "ratio", num(f->solid_ratio), "warning",
+                          f->solid_ratio < CF_FIT_SOLID_RATIO_WARN);
+    if (o && !fd) {
+        json_object_set_new(o, "table_strain_at_solid", num(at));
+        json_object_set_new(o, "mode", json_string(cf_mode_name(r->table->mode)));
+    }
+    return o;
+}
+
 static json_t *fit_json_core(const cf_fit_report *r, int i)
 {
     const cf_fit_result *f = &r->fits[i];
@@ -99,12 +137,8 @@ static json_t *fit_json_core(const cf_fit_report *r, int i)
     json_object_set_new(o, "type", json_string(cf_spring_type_name(f->type)));
     json_object_set_new(o, "identifiable_correlation", cf_report_correlation_json(f, names));
     json_object_set_new(o, "held_by", constraint_list(f->held));
-    json_object_set_new(
-        o, "extrapolation",
-        json_pack("{s:o, s:o, s:o, s:b}", fd ? "travel_mm" : "solid_strain", num(f->ident.solid),
-                  fd ? "largest_displacement_mm" : "largest_strain",
-                  num(f->ident.solid / f->solid_ratio), "ratio", num(f->solid_ratio), "warning",
-                  f->solid_ratio < CF_FIT_SOLID_RATIO_WARN));
+    json_object_set_new(o, "extrapolation", extrapolation_json(r, f));
+    limit_cost_json(o, r, i);
     return o;
 }
 
@@ -116,11 +150,32 @@ static json_t *weights_json(const double w[CF_FAMILY_COUNT])
 }
 
 /* validation {rmse, r2, max_abs_error (file's unit), lattice {...}, wall_time_s} or {skipped} */
+/* The stability in the table's mode: how far it holds over the table's range, by which check
+** (the full lattice's negative pivots, or the cell's incremental stiffness), or why unchecked. */
+static void stability_json(json_t *o, const cf_validation *v)
+{
+    if (!v->stability_checked) {
+        json_object_set_new(o, "stability_reason",
+                            json_string(cf_report_why(v->stability_note,
+                                                      "the stability scan did not run")));
+        return;
+    }
+    json_object_set_new(o, "stable_to_strain", num(v->stable_to_strain));
+    json_object_set_new(o, "stable_in_range", json_boolean(!v->unstable_in_range));
+    json_object_set_new(o, "stability_by", json_string(v->by_cell ? "cell tangent"
+                                                                  : "full lattice"));
+    if (v->cell_stability_checked && !v->by_cell) {
+        json_object_set_new(o, "cell_stable_to_strain", num(v->cell_stable_to_strain));
+        json_object_set_new(o, "cell_stable_in_range", json_boolean(!v->cell_unstable_in_range));
+    }
+}
+
 static json_t *validation_json(const cf_fit_report *r, int i)
 {
     const cf_validation *v = &r->val[i];
     if (!v->done)
-        return json_pack("{s:s}", "skipped", v->note);
+        return json_pack("{s:s}", "skipped",
+                         cf_report_why(v->note, "the validation did not run (no reason recorded)"));
     const cf_lattice_config *lc = &v->setup.cfg.lattice;
     double u = r->table->y_to_file;
     cf_cubic_moduli cm = cf_cubic_moduli_of(lc->weight);
@@ -140,11 +195,8 @@ static json_t *validation_json(const cf_fit_report *r, int i)
                      "wall_time_s", num(r->with_timing ? v->wall_time_s : 0.0));
     if (o && isfinite(v->law_rmse)) /* uniaxial tables only: the law's own curve is uniaxial */
         json_object_set_new(o, "law_difference_rmse", num(v->law_rmse * u));
-    if (o && v->stability_checked) {
-        if (v->stable_to_strain != 0) /* absent: stable over the whole range checked */
-            json_object_set_new(o, "stable_to_strain", num(v->stable_to_strain));
-        json_object_set_new(o, "stable_in_range", json_boolean(!v->unstable_in_range));
-    }
+    if (o)
+        stability_json(o, v);
     return o;
 }
 
@@ -230,13 +282,26 @@ static json_t *measures_json(const cf_table *t)
     char src[3][128], conv[256];
     cf_report_sources(t, src);
     cf_report_conversion(t, conv, sizeof conv);
+    const char *strain = cf_report_strain_name(t, src);
     json_t *o = json_pack("{s:s, s:s, s:s, s:s, s:s, s:s}", "stress",
                           cf_stress_measure_name(m->stress), "stress_source", src[0], "strain",
-                          cf_strain_measure_name(m->strain), "strain_source", src[1], "mode",
+                          strain, "strain_source", src[1], "mode",
                           cf_mode_name(t->mode), "mode_source", src[2]);
     if (o && *conv) /* absent: the columns were taken as they are */
         json_object_set_new(o, "conversion", json_string(conv));
     return o;
+}
+
+/* A mode the table's kind cannot honour: stated, with why (data.mode, mode_honoured false,
+** mode_reason). */
+static void mode_dropped_json(json_t *data, const cf_table *t)
+{
+    const char *why = cf_report_mode_dropped(t);
+    if (!why || !data)
+        return;
+    json_object_set_new(data, "mode", json_string(cf_mode_name(t->mode)));
+    json_object_set_new(data, "mode_honoured", json_false());
+    json_object_set_new(data, "mode_reason", json_string(why));
 }
 
 /* The limits every fit ran under. */
@@ -249,6 +314,19 @@ static json_t *limits_json(const cf_fit_report *r)
                      num(3.0), "index_max", num(o->index_max));
 }
 
+/* warnings[]: what the model cannot follow (absent when nothing). */
+static void warnings_json(json_t *root, const cf_fit_report *r)
+{
+    char w[CF_REPORT_WARNINGS_MAX][CF_REPORT_WARNING_LEN];
+    int n = cf_report_warnings(r, w, CF_REPORT_WARNINGS_MAX);
+    if (n == 0)
+        return;
+    json_t *a = json_array();
+    for (int k = 0; k < n; k++)
+        json_array_append_new(a, json_string(w[k]));
+    json_object_set_new(root, "warnings", a);
+}
+
 static json_t *report_json(const cf_fit_report *r)
 {
     json_t *data = json_pack(
@@ -259,6 +337,7 @@ static json_t *report_json(const cf_fit_report *r)
         r->table->compression ? "compression-negative" : "tension-positive");
     if (!cf_table_is_force(r->table))
         json_object_set_new(data, "measures", measures_json(r->table));
+    mode_dropped_json(data, r->table);
     json_t *fits = json_array(), *base = json_array();
     for (int i = 0; i < r->nfits; i++)
         json_array_append_new(fits, fit_json(r, i));
@@ -291,6 +370,7 @@ static json_t *report_json(const cf_fit_report *r)
         json_object_set_new(root, "comparison", c);
     }
     json_object_set_new(root, "baselines", base);
+    warnings_json(root, r);
     json_object_set_new(root, "identifiability",
                         json_string("the law depends on the six design parameters only through "
                                     "rho, the solid strain (travel) and the stress (load) scale; "

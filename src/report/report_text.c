@@ -112,6 +112,37 @@ static void cell_rows(FILE *o, const cf_fit_report *r, char (*buf)[2][64], int n
     }
 }
 
+/* The stability row of one validation: how far the table's range is stable, by which check. */
+static void stability_cell(char *buf, size_t size, const cf_validation *v)
+{
+    if (!v->stability_checked)
+        snprintf(buf, size, "not checked (%.40s)",
+                 cf_report_why(v->stability_note, "the scan did not run"));
+    else if (!v->unstable_in_range)
+        snprintf(buf, size, "to strain %.4g (table's end, %s)", v->stable_to_strain,
+                 v->by_cell ? "cell tangent" : "full lattice");
+    else
+        snprintf(buf, size, "to strain %.4g (!) (%s)", v->stable_to_strain,
+                 v->by_cell ? "cell tangent" : "full lattice");
+}
+
+/* The warning of a table that reaches past the stability limit of fit i's target. */
+static void stability_warning(FILE *o, const cf_fit_report *r, int i)
+{
+    const cf_validation *v = &r->val[i];
+    if (v->by_cell)
+        fprintf(o, "  (!) %s: the cell's incremental stiffness stops being positive definite at "
+                "%s strain %.4g, inside the table's range: past it a homogeneous %s state is "
+                "unstable (the tissue would localise)\n",
+                cf_spring_type_name(r->fits[i].type), cf_mode_name(v->mode), v->stable_to_strain,
+                cf_mode_name(v->mode));
+    else
+        fprintf(o, "  (!) %s: the lattice loses stability at strain %.4g, inside the table's "
+                "range: past it the static curve is an unstable equilibrium (a column of "
+                "cells buckles sideways in a dynamic run)\n",
+                cf_spring_type_name(r->fits[i].type), v->stable_to_strain);
+}
+
 /* The validation's numbers, one column per fit. */
 static void validation_rows(FILE *o, const cf_fit_report *r)
 {
@@ -138,13 +169,7 @@ static void validation_rows(FILE *o, const cf_fit_report *r)
         snprintf(buf[4][i], sizeof buf[4][i], "%.6f", v->r2);
         snprintf(buf[5][i], sizeof buf[5][i], "%.1f ms, %zu solves", 1e3 * v->wall_time_s,
                  v->solves);
-        if (!v->stability_checked)
-            snprintf(buf[6][i], sizeof buf[6][i], "not checked");
-        else if (v->stable_to_strain == 0)
-            snprintf(buf[6][i], sizeof buf[6][i], "to solid");
-        else
-            snprintf(buf[6][i], sizeof buf[6][i], "to strain %.4g%s", v->stable_to_strain,
-                     v->unstable_in_range ? " (!)" : "");
+        stability_cell(buf[6][i], sizeof buf[6][i], v);
     }
     static const char *const labels[ROWS] = {"fit RMSE (its target)", "lattice RMSE",
                                              "lattice vs law (RMSE)", "lattice max |error|",
@@ -185,23 +210,29 @@ static void validation_text(FILE *o, const cf_fit_report *r)
     for (int i = 0; i < r->nfits; i++)
         any |= r->val[i].done;
     if (!any) {
-        fprintf(o, " validation in the lattice: skipped: %s\n", r->val[0].note);
+        fprintf(o, " validation in the lattice: skipped: %s\n",
+                cf_report_why(r->val[0].note, "the validation did not run (no reason recorded)"));
         return;
     }
     validation_header(o, r);
     validation_rows(o, r);
     for (int i = 0; i < r->nfits; i++)
         if (r->val[i].done && r->val[i].unstable_in_range)
-            fprintf(o, "  (!) %s: the lattice loses stability at strain %.4g, inside the table's "
-                    "range: past it the static curve is an unstable equilibrium (a column of "
-                    "cells buckles sideways in a dynamic run)\n",
-                    cf_spring_type_name(r->fits[i].type), r->val[i].stable_to_strain);
+            stability_warning(o, r, i);
     if (r->through_msm)
         through_rows(o, r);
     for (int i = 0; i < r->nfits; i++)
         if (!r->val[i].done)
             fprintf(o, "  (%s: validation skipped: %s)\n", cf_spring_type_name(r->fits[i].type),
-                    r->val[i].note);
+                    cf_report_why(r->val[i].note, "no reason recorded"));
+}
+
+/* A mode stated for a table whose kind cannot honour it, and why. */
+static void mode_dropped_text(FILE *o, const cf_table *t)
+{
+    const char *why = cf_report_mode_dropped(t);
+    if (why)
+        fprintf(o, " mode %s (stated) is not honoured: %s\n", cf_mode_name(t->mode), why);
 }
 
 /* The table: its size, columns, sign, and (stress-strain) its measures and their conversion. */
@@ -210,14 +241,17 @@ static void table_text(FILE *o, const cf_fit_report *r)
     fprintf(o, "%s: %zu points, %s [%s] against %s [%s], %s\n", r->table->path, r->table->count,
             r->table->x_column, r->table->x_unit, r->table->y_column, r->table->y_unit,
             r->table->compression ? "compression negative" : "tension positive");
-    if (cf_table_is_force(r->table))
+    if (cf_table_is_force(r->table)) {
+        mode_dropped_text(o, r->table);
         return;
+    }
     const cf_table_measures *m = &r->table->measures;
     char src[3][128], conv[256];
     cf_report_sources(r->table, src);
     cf_report_conversion(r->table, conv, sizeof conv);
+    const char *strain = cf_report_strain_name(r->table, src);
     fprintf(o, " measures: stress %s (%s), strain %s (%s), mode %s (%s)\n",
-            cf_stress_measure_name(m->stress), src[0], cf_strain_measure_name(m->strain), src[1],
+            cf_stress_measure_name(m->stress), src[0], strain, src[1],
             cf_mode_name(r->table->mode), src[2]);
     if (*conv)
         fprintf(o, " fitted as engineering strain and nominal stress: %s\n", conv);
@@ -411,6 +445,17 @@ static void verdict_and_baselines(FILE *o, const cf_fit_report *r)
             cf_table_is_force(r->table) ? "solid load" : "stress scale");
 }
 
+/* What the model cannot follow, one sentence each. */
+static void warnings_text(FILE *o, const cf_fit_report *r)
+{
+    char w[CF_REPORT_WARNINGS_MAX][CF_REPORT_WARNING_LEN];
+    int n = cf_report_warnings(r, w, CF_REPORT_WARNINGS_MAX);
+    if (n > 0)
+        fprintf(o, "\nWarnings:\n");
+    for (int k = 0; k < n; k++)
+        fprintf(o, "  (!) %s\n", w[k]);
+}
+
 char *cf_report_text(const cf_fit_report *r)
 {
     char *buf = NULL;
@@ -430,6 +475,7 @@ char *cf_report_text(const cf_fit_report *r)
         validation_text(o, r);
     constraints_text(o, r);
     verdict_and_baselines(o, r);
+    warnings_text(o, r);
     fclose(o);
     return buf;
 }

@@ -179,3 +179,25 @@ void cf_report_ident_cell(const cf_fit_result *f, int k, double scale, const cha
                  unit);
     }
 }
+
+const char *cf_report_why(const char *note, const char *fallback)
+{
+    return note && note[0] ? note : fallback;
+}
+
+const char *cf_report_strain_name(const cf_table *t, char src[3][128])
+{
+    if (t->mode != CF_MODE_SHEAR)
+        return cf_strain_measure_name(t->measures.strain);
+    snprintf(src[1], sizeof src[1], "simple shear: the amount of shear, either sign");
+    return "shear strain gamma";
+}
+
+const char *cf_report_mode_dropped(const cf_table *t)
+{
+    if (!cf_table_is_force(t) || !t->mode_stated || t->mode == CF_MODE_UNIAXIAL)
+        return NULL;
+    return "a force-displacement table is one spring's force against its displacement: it is "
+           "fitted as that spring along its axis, not as a test of a block of tissue in this mode "
+           "(give stress against strain to fit the mode)";
+}

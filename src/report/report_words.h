@@ -16,6 +16,9 @@ void cf_report_append(char *buf, size_t cap, size_t *n, const char *fmt, ...)
 #endif
     ;
 
+/* note when it says something, else fallback: a reason printed or written is never empty. */
+const char *cf_report_why(const char *note, const char *fallback);
+
 /* Why fit f's profile interval of quantity k was computed and where its ends come from. */
 void cf_report_interval_reason(const cf_fit_result *f, int k, char *buf, size_t cap);
 
@@ -29,6 +32,15 @@ void cf_report_verdict(const cf_fit_report *r, char *buf, size_t cap);
 
 /* Where table t's stress and strain measures and its mode came from, one phrase each. */
 void cf_report_sources(const cf_table *t, char src[3][128]);
+
+/* The strain measure of table t as fitted, in words: "shear strain gamma" in simple shear (the
+** amount of shear, of either sign), else the measure's name; *src set to what said so (src[1] of
+** cf_report_sources, or the mode for shear). */
+const char *cf_report_strain_name(const cf_table *t, char src[3][128]);
+
+/* Why a mode stated for a force-displacement table is not honoured, or NULL when it is (none
+** stated, or uniaxial). */
+const char *cf_report_mode_dropped(const cf_table *t);
 
 /* What was done to the stress and strain columns, in one sentence ("" when nothing). */
 void cf_report_conversion(const cf_table *t, char *buf, size_t cap);

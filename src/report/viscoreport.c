@@ -2,6 +2,7 @@
 ** Report, fit file and plot of a viscoelastic fit (see viscoreport.h).
 */
 #include "conifit/viscoreport.h"
+#include "report/report_words.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -61,6 +62,51 @@ static json_t *constraints(unsigned bits)
     return a;
 }
 
+/* The names of the elastic quantities set in mask (CF_IDENT_* bits), comma-separated. */
+static void elastic_names(unsigned mask, char *buf, size_t cap)
+{
+    static const char *const names[CF_IDENT_COUNT] = {"rho", "s/H", "F_C/H^2"};
+    size_t n = 0;
+    buf[0] = '\0';
+    for (int k = 0; k < CF_IDENT_COUNT; k++)
+        if (mask >> k & 1u)
+            cf_report_append(buf, cap, &n, "%s%s", n ? ", " : "", names[k]);
+}
+
+/* The elastic quantities of the kept candidate the series does not determine: the JSON list and
+** the text warning naming each. */
+static json_t *elastic_list(unsigned mask)
+{
+    static const char *const names[CF_IDENT_COUNT] = {"rho", "s/H", "F_C/H^2"};
+    json_t *a = json_array();
+    for (int k = 0; k < CF_IDENT_COUNT; k++)
+        if (mask >> k & 1u)
+            json_array_append_new(a, json_string(names[k]));
+    return a;
+}
+
+static void elastic_unresolved_json(json_t *o, const cf_visco_fit *f)
+{
+    if (!f->elastic_unresolved)
+        return;
+    json_object_set_new(o, "elastic_undetermined", elastic_list(f->elastic_unresolved));
+    json_object_set_new(o, "elastic_undetermined_reason",
+                        json_string("a standard error larger than the quantity's range (rho and "
+                                    "s/H lie in (0, 1]; the stress scale is positive)"));
+}
+
+static void elastic_unresolved_text(FILE *o, const cf_visco_fit *f)
+{
+    char names[64];
+    if (!f->elastic_unresolved)
+        return;
+    elastic_names(f->elastic_unresolved, names, sizeof names);
+    fprintf(o, " warning: the series does not determine the elastic %s (a standard error larger "
+               "than its range): the candidate is not determined; hold the elastic part "
+               "(--elastic) or fit its table jointly\n",
+            names);
+}
+
 static json_t *predictions_json(const cf_visco_report *r)
 {
     const cf_visco_predict *p = &r->fit.pred;
@@ -70,7 +116,8 @@ static json_t *predictions_json(const cf_visco_report *r)
                                 "period_s", num(p->cycle_period_s), "loop_area_kPa",
                                 num(p->loop_area_MPa * 1e3), "loading_work_kPa",
                                 num(p->loading_work_MPa * 1e3))
-                    : json_pack("{s:s}", "skipped", p->note);
+                    : json_pack("{s:s}", "skipped",
+                                cf_report_why(p->note, "not predicted (no reason recorded)"));
     /* a fraction only of a cycle that did work: absent, never NaN (which the writer refuses) */
     if (h && p->hysteresis_done && p->loading_work_MPa > 0)
         json_object_set_new(h, "dissipated_fraction",
@@ -82,7 +129,8 @@ static json_t *predictions_json(const cf_visco_report *r)
                                 "strain_end_of_ramp", num(p->creep_strain_ramp), "strain_end",
                                 num(p->creep_strain_end), "creep_strain",
                                 num(p->creep_strain_end - p->creep_strain_ramp))
-                    : json_pack("{s:s}", "skipped", p->note);
+                    : json_pack("{s:s}", "skipped",
+                                cf_report_why(p->note, "not predicted (no reason recorded)"));
     return json_pack("{s:o, s:o}", "hysteresis", h, "creep", c);
 }
 
@@ -135,16 +183,21 @@ static void visco_keys(const cf_visco_report *r, json_t *o)
         for (int n = 0; n < CF_VISCO_AIC_MAX; n++)
             for (int gs = 0; gs < 2; gs++) {
                 const cf_visco_candidate *cd = &f->by_n[n][gs];
-                if (cd->fitted)
-                    json_array_append_new(
-                        a, json_pack("{s:i, s:s, s:i, s:o, s:b}", "branches", n + 1,
-                                     "relaxation", gs ? "strain" : "qlv",
-                                     "terms_depending_on_strain", cd->strain_terms, "aic",
-                                     num(cd->aic + aic_shift), "determined", cd->identified));
+                if (!cd->fitted)
+                    continue;
+                json_t *c = json_pack("{s:i, s:s, s:i, s:o, s:b}", "branches", n + 1,
+                                      "relaxation", gs ? "strain" : "qlv",
+                                      "terms_depending_on_strain", cd->strain_terms, "aic",
+                                      num(cd->aic + aic_shift), "determined", cd->identified);
+                if (c && cd->elastic_unresolved)
+                    json_object_set_new(c, "elastic_undetermined",
+                                        elastic_list(cd->elastic_unresolved));
+                json_array_append_new(a, c);
             }
         json_object_set_new(o, "aic_by_branches", a);
     }
     json_object_set_new(o, "terms_determined", json_boolean(f->identified));
+    elastic_unresolved_json(o, f);
     json_object_set_new(o, "elastic_held", json_boolean(f->held_elastic));
     json_object_set_new(o, "rho_at_limit", json_boolean(f->rho_at_limit));
     json_object_set_new(o, "solid_strain_at_stability_limit", json_boolean(f->at_stability_limit));
@@ -298,15 +351,22 @@ char *cf_visco_report_text(const cf_visco_report *r)
                 if (gs)
                     snprintf(what, sizeof what, cd->strain_terms <= n ? "strain (%d of them)" : "strain",
                              cd->strain_terms);
+                char why[80] = " (terms undetermined)";
+                if (cd->elastic_unresolved) {
+                    char names[48];
+                    elastic_names(cd->elastic_unresolved, names, sizeof names);
+                    snprintf(why, sizeof why, " (%s undetermined)", names);
+                }
                 fprintf(o, "%s %s %.2f%s", sep, what, cd->aic + (double)f->count * log(u * u),
-                        cd->identified ? "" : " (terms undetermined)");
+                        cd->identified ? "" : why);
                 sep = ",";
             }
             if (*sep)
                 fputc('\n', o);
         }
     }
-    if (!f->identified)
+    elastic_unresolved_text(o, f);
+    if (!f->identified && !f->elastic_unresolved)
         fprintf(o, " warning: the series does not determine every time-dependent quantity of "
                    "this model (a standard error as large as its value, or '?' below); fewer "
                    "terms (--branches) or --relaxation qlv\n");

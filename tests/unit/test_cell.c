@@ -223,6 +223,58 @@ static void bad_input_is_refused(void **state)
     assert_int_equal(cf_cell_mode(&c, CF_MODE_SHEAR, NAN, NULL, &s, &err), CF_E_DATA);
 }
 
+/* The table strain at which the first spring reaches solid: in uniaxial the loaded edge's, the
+** solid strain itself; in simple shear the stretched face diagonal's, whose stretch is
+** sqrt(((1 + g)^2 + 1) / 2): g = sqrt(2 (1 + s/H)^2 - 1) - 1 (about twice s/H), the same for
+** either sign of shear. */
+static void first_spring_at_solid_in_each_mode(void **state)
+{
+    (void)state;
+    for (int which = 0; which < 2; which++) {
+        cf_law law = law_of(which);
+        cf_cell c = iso_cell(&law, CF_LAW_CLOSED);
+        const double sH = law.travel_mm / law.p.H_mm;
+        double e = 0;
+        assert_int_equal(cf_cell_solid_strain(&c, CF_MODE_UNIAXIAL, 1, &e, NULL), CF_OK);
+        assert_close(e, sH, 1e-8);
+        const double g = sqrt(2 * (1 + sH) * (1 + sH) - 1) - 1;
+        for (int side = -1; side <= 1; side += 2) {
+            assert_int_equal(cf_cell_solid_strain(&c, CF_MODE_SHEAR, side, &e, NULL), CF_OK);
+            assert_close(e, side * g, 1e-8);
+        }
+        assert_true(g > 1.6 * sH);
+        /* equibiaxial and planar: reached, before |e| = 1 in compression */
+        for (int m = CF_MODE_PLANAR; m <= CF_MODE_EQUIBIAXIAL; m++) {
+            assert_int_equal(cf_cell_solid_strain(&c, (cf_mode)m, -1, &e, NULL), CF_OK);
+            cf_cell_state st;
+            assert_int_equal(cf_cell_mode(&c, (cf_mode)m, e * (1 - 1e-6), NULL, &st, NULL),
+                             CF_OK);
+            assert_true(st.max_u_over_travel > 0.99);
+            assert_int_equal(cf_cell_mode(&c, (cf_mode)m, e * (1 + 1e-6), NULL, &st, NULL),
+                             CF_E_DATA);
+        }
+        cf_law_free(&law);
+    }
+}
+
+/* Simple shear has no stretch limit: gamma of -1 and beyond is a state like any other, and the
+** stress is odd in gamma. */
+static void shear_takes_either_sign_past_one(void **state)
+{
+    (void)state;
+    cf_law law = law_of(1);
+    cf_cell c = iso_cell(&law, CF_LAW_CLOSED);
+    const double sH = law.travel_mm / law.p.H_mm;
+    const double g = 0.95 * (sqrt(2 * (1 + sH) * (1 + sH) - 1) - 1);
+    assert_true(g > 1);
+    cf_cell_state a, b;
+    assert_int_equal(cf_cell_mode(&c, CF_MODE_SHEAR, g, NULL, &a, NULL), CF_OK);
+    assert_int_equal(cf_cell_mode(&c, CF_MODE_SHEAR, -g, NULL, &b, NULL), CF_OK);
+    assert_true(a.stress_MPa > 0);
+    assert_close(b.stress_MPa, -a.stress_MPa, 1e-12 * a.stress_MPa);
+    cf_law_free(&law);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -232,6 +284,8 @@ int main(void)
         cmocka_unit_test(stress_is_frame_indifferent),
         cmocka_unit_test(extra_tensions_act_as_spring_forces),
         cmocka_unit_test(bad_input_is_refused),
+        cmocka_unit_test(first_spring_at_solid_in_each_mode),
+        cmocka_unit_test(shear_takes_either_sign_past_one),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -102,6 +102,12 @@ typedef struct cf_cell_state {
 cf_status cf_cell_stress(const cf_cell *c, const double F[9], const cf_cell_extra *extra,
                          cf_cell_state *s, cf_error *err);
 
+/* The state at F (as cf_cell_stress) and the cell's full tangent A = dP/dF, MPa:
+** A[27 i + 9 j + 3 k + l] = dP_ij / dF_kl (symmetric under (ij) <-> (kl): the second derivative
+** of the cell's stored energy per volume). Same failures as cf_cell_stress. */
+cf_status cf_cell_tangent(const cf_cell *c, const double F[9], const cf_cell_extra *extra,
+                          cf_cell_state *s, double A[81], cf_error *err);
+
 /* The state of test mode m at table strain e (tension positive), the free stretch solved to
 ** rounding (safeguarded Newton inside a bracket). CF_E_DATA when e is not finite or the mode
 ** cannot reach it (a spring at solid), CF_E_NOCONV when no free stretch gives zero stress. */
@@ -113,6 +119,12 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
 ** uniaxial, planar, equibiaxial and confined it is |e| (the loaded edge); for simple shear about
 ** |e|/2 (a face diagonal). Lets a fit bound the springs' solid strain by what they reach. */
 double cf_cell_spring_strain(cf_mode m, double e);
+
+/* The table strain of mode m (side < 0: compression) at which the first spring of the cell
+** reaches solid, the free stretches solved (not held): past it the mode cannot go. To 1e-12
+** relative. CF_E_DATA when no spring reaches solid up to |e| = 1000. */
+cf_status cf_cell_solid_strain(const cf_cell *c, cf_mode m, int side, double *e_solid,
+                               cf_error *err);
 
 /* The mode's stress (MPa, table sign) at each of count strains. Stops at the first failure. */
 cf_status cf_cell_curve(const cf_cell *c, cf_mode m, const double *strain, size_t count,

@@ -128,8 +128,12 @@ typedef struct cf_fit_result {
     unsigned held;         /* CF_C_* bits of the limits that hold the identifiable quantities
                            ** away from the optimum of the law over every spring (the type's
                            ** geometry and the design bounds, rho_min, the travel) */
-    double solid_ratio;    /* solid strain (travel) over the table's largest |strain|
+    double solid_ratio;    /* solid_table_strain over the table's largest |strain|
                            ** (|displacement|): how far the law is from solid at the data */
+    double solid_table_strain; /* the table strain (magnitude, on the table's loading side) at
+                           ** which the first spring reaches solid in the table's mode: the solid
+                           ** strain (travel) itself in uniaxial and for force tables; in the
+                           ** cell's other modes set by the pipeline (cf_cell_solid_strain) */
     double rss;            /* unweighted sum of squared residuals, (MPa or N)^2 */
     double rmse;           /* root mean square residual, MPa or N */
     double max_abs_error;  /* largest |residual|, MPa or N */
@@ -205,6 +209,26 @@ double cf_fit_ident_limit(const cf_fit_options *opt, cf_spring_type type, double
 
 /* Name of a constraint bit ("index_min", ...), and of an optimiser ("slsqp", ...). */
 const char *cf_fit_constraint_name(unsigned bit);
+
+/* The command-line flag that widens constraint bit (a sentence for the limits no flag widens). */
+const char *cf_fit_constraint_flag(unsigned bit);
+
+/* o with the design limits among bits (CF_C_INDEX_MAX, CF_C_RHO_MIN, CF_C_COILS_MAX, CF_C_G_MAX,
+** CF_C_D2_H) widened to the widest their flags accept (CF_FIT_*_LIMIT); returns the bits widened
+** (0: none could be: the fit is as free as the flags allow). */
+unsigned cf_fit_relax(const cf_fit_options *o, unsigned bits, cf_fit_options *out);
+
+/* What the design limits that hold a fit cost: its RMSE against that of the same fit with
+** those limits widened (cf_fit_relax). */
+typedef struct cf_limit_cost {
+    int checked;           /* 1: the widened fit ran */
+    unsigned limits;       /* CF_C_* bits widened */
+    double rmse;           /* the fit's RMSE, MPa or N */
+    double rmse_free;      /* the widened fit's, MPa or N */
+} cf_limit_cost;
+
+/* A limit whose cost is above this share of the widened fit's RMSE is warned about. */
+#define CF_LIMIT_COST_WARN 0.05
 const char *cf_fit_optimizer_name(cf_fit_optimizer o);
 cf_status cf_fit_optimizer_parse(const char *name, cf_fit_optimizer *o, cf_error *err);
 

@@ -52,6 +52,7 @@ typedef struct cf_through_msm {
     long evaluations;           /* cell curves computed */
     size_t search_rows;         /* rows the searches ran on: a subsample of a table longer than
                                 ** CF_LATTICE_FIT_FULL_ROWS (subsample.h), else every row */
+    char note[CF_ERROR_MSG_LEN]; /* why it did not run (done = 0), else empty */
 } cf_through_msm;
 
 /* Tables up to this many rows are searched on every row; longer ones on a subsample of

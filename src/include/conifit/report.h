@@ -12,6 +12,7 @@
 #include "conifit/error.h"
 #include "conifit/fit.h"
 #include "conifit/measure.h"
+#include "conifit/softening.h"
 #include "conifit/validate.h"
 
 /* One table and its fits, as the report sees it (cf_pipeline_fit fills it). Values of the fits
@@ -32,7 +33,18 @@ typedef struct cf_fit_report {
     cf_validation val[2];       /* lattice validation of fits[i] (MPa; freed by cf_report_free) */
     int through_msm;            /* 1: each fit was refined through the lattice (thr[i]) */
     cf_through_msm thr[2];      /* what that cost and gained (MPa) */
+    cf_softening softening;     /* where the table softens, which the law cannot follow */
+    cf_limit_cost limit_cost[2]; /* what the limits holding fits[i] cost (checked when held) */
 } cf_fit_report;
+
+/* Longest warning sentence, and the most a report states. */
+#define CF_REPORT_WARNING_LEN 512
+#define CF_REPORT_WARNINGS_MAX 8
+
+/* The sentences saying what the model cannot follow in the table (softening, a design limit that
+** costs fit quality), at most cap of them into out; returns how many. The text report lists them
+** under "Warnings", the fit file as warnings[], the command line on standard error. */
+int cf_report_warnings(const cf_fit_report *r, char (*out)[CF_REPORT_WARNING_LEN], int cap);
 
 /* Releases what the report owns (the validations' curves). Safe on a zeroed report. */
 void cf_report_free(cf_fit_report *r);

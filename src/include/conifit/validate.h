@@ -57,11 +57,17 @@ typedef struct cf_validation {
     double law_rmse;            /* RMSE of the lattice against the law's own curve F(eH)/H^2:
                                 ** what the lattice adds to the spring, MPa; NaN for
                                 ** the other modes (the law's curve is a uniaxial one) */
-    int stability_checked;      /* 1: the static uniaxial lattice's stability limit was sought */
-    double stable_to_strain;    /* the strain (table sign) where the lattice first loses stability
-                                ** on the table's side (compression when the table has any), or 0
-                                ** when it stays stable up to 0.995 of the solid strain */
+    int stability_checked;      /* 1: the stability in the table's mode was sought (the full
+                                ** lattice's negative pivots in uniaxial, the cell's tangent in
+                                ** the other modes) */
+    double stable_to_strain;    /* the largest strain (table sign) of the table's range up to which
+                                ** it stays stable, on the table's side (compression when the table
+                                ** has any): the table's reach when stable all the way */
     int unstable_in_range;      /* 1: the table reaches past stable_to_strain */
+    int cell_stability_checked; /* 1: the cell's incremental stiffness was followed (every mode) */
+    double cell_stable_to_strain; /* as stable_to_strain, for the cell's stiffness (cell_stability.h) */
+    int cell_unstable_in_range; /* 1: the cell's stiffness stops being positive definite in range */
+    char stability_note[CF_ERROR_MSG_LEN]; /* why the stability is not checked, else empty */
     size_t count;               /* points of stress_MPa */
     double *stress_MPa;         /* lattice stress at each table strain, MPa (owned; NULL if skipped) */
 } cf_validation;

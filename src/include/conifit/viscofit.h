@@ -109,6 +109,9 @@ typedef struct cf_visco_candidate {
     int identified;        /* 1 when the series determines its time-dependent quantities (see
                               cf_visco_fit.identified) */
     int strain_terms;      /* terms whose relative modulus changes with strain (fitted k_i) */
+    unsigned elastic_unresolved; /* bit CF_IDENT_* set for a fitted elastic quantity whose
+                                    standard error is larger than its range (rho, s/H: 1; the
+                                    stress scale: itself): the candidate is then not determined */
 } cf_visco_candidate;
 
 typedef struct cf_visco_fit {
@@ -142,7 +145,11 @@ typedef struct cf_visco_fit {
     int identified;                     /* 1 when the data determine every time-dependent
                                            quantity of the model: each tau_i, each term's
                                            modulus at the largest strain, each fitted k_i and
-                                           the dashpot is larger than its standard error */
+                                           the dashpot is larger than its standard error,
+                                           and no fitted elastic quantity has an error larger
+                                           than its range (elastic_unresolved) */
+    unsigned elastic_unresolved;        /* the kept candidate's elastic quantities that fail
+                                           (cf_visco_candidate) */
     cf_visco_candidate by_n[CF_VISCO_AIC_MAX][2]; /* when chosen by AIC: the candidates of
                                                      N = 1..4 terms, quasi-linear [0] and
                                                      depending on strain [1] */
