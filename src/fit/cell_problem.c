@@ -27,7 +27,7 @@ double cf_cell_rss(cf_cell_problem *p, double rho, double B, double *A_out)
     double A_max;
     if (cf_fit_ident_limit(p->opt, p->type, rho, B, &A_max, NULL) > 0)
         return CF_LSQ_HUGE_OBJ;
-    if (p->A_fixed > 0 && p->A_fixed > A_max)
+    if (p->A_fixed > 0 && p->A_fixed > A_max * (1 + 1e-9))
         return CF_LSQ_HUGE_OBJ;
     if (p->curve(p->ctx, rho, B, p->g) != 0)
         return CF_LSQ_HUGE_OBJ;

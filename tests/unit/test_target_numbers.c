@@ -53,6 +53,14 @@ static void every_quantity_has_an_uncertainty(json_t *f, const char *table)
                 fail_msg("%s: %s = %g outside its interval [%g, %g]", table, keys[k], v, lo, hi);
             assert_non_null(json_string_value(json_object_get(q, "interval_reason")));
         }
+        /* by the spring fit's rules: a fit held by a limit, or a Wald interval that leaves the
+        ** quantity's range (rho and s/H in (0, 1], the stress scale > 0), gets a profile */
+        const double e = se ? 1.96 * json_number_value(se) : 0,
+                     top = k == 2 ? INFINITY : 1;
+        if (json_array_size(json_object_get(f, "held_by")) > 0 || v - e <= 0 || v + e > top)
+            if (!iv)
+                fail_msg("%s: %s = %g +- %g (held by %zu limits) has no profile interval", table,
+                         keys[k], v, e / 1.96, json_array_size(json_object_get(f, "held_by")));
     }
     json_t *c = json_object_get(f, "identifiable_correlation");
     assert_true(json_object_get(c, "matrix") || json_object_get(c, "reason"));
