@@ -145,8 +145,14 @@ static unsigned held_at(const cf_cell_problem *p, const double v[3])
     if (v[1] <= p->lb[1] * (1 + tol))
         held |= CF_C_TRAVEL;
     double A_max;
-    if (cf_fit_ident_limit(p->opt, p->type, v[0], v[1], &A_max, NULL) <= 0 && v[2] >= A_max * (1 - tol))
+    unsigned edge = 0;
+    const double margin = cf_fit_ident_limit(p->opt, p->type, v[0], v[1], &A_max, &edge);
+    if (margin <= 0 && v[2] >= A_max * (1 - tol))
         held |= CF_C_G_MAX;
+    /* on the edge of the region where a spring of the type can be placed (log units): the
+    ** limits that draw that edge hold the fit, as a box bound would */
+    if (margin <= 0 && margin >= -tol)
+        held |= edge;
     return held;
 }
 
