@@ -324,6 +324,8 @@ cf_status cf_atomic_commit(cf_atomic *a, cf_error *err)
 
 void cf_atomic_abort(cf_atomic *a)
 {
+    if (!a)
+        return;
     if (a->fp)
         fclose(a->fp);
     a->fp = NULL;

@@ -26,8 +26,11 @@
 #include <stdio.h>
 
 #include "conifit/error.h"
+#include "conifit/output.h"
 
-typedef struct cf_atomic {
+/* The public cf_output (conifit/output.h) is this structure; inside the library it is used as a
+** value (a job holds its outputs) under the name cf_atomic. */
+typedef struct cf_output {
     FILE *fp;          /* write here (NULL once the file is finished) */
     char path[4096];   /* final name */
     char tmp[4200];    /* temporary name in the same folder ("" when none) */
@@ -53,9 +56,20 @@ cf_status cf_atomic_finish(cf_atomic *a, cf_error *err);
 ** is removed and CF_E_CANTWRITE returned. */
 cf_status cf_atomic_commit(cf_atomic *a, cf_error *err);
 
-/* Closes and removes the temporary file (safe to call twice, after a commit, or on a zeroed
-** cf_atomic). */
+/* Closes and removes the temporary file (safe to call twice, after a commit, on a zeroed
+** cf_atomic, or with NULL). */
 void cf_atomic_abort(cf_atomic *a);
+
+/* The argument checks of a call named `call` that prepares up to two outputs of report r:
+** CF_E_USAGE when r is NULL, a path is given without its handle, or a handle given still holds
+** an uncommitted file. Then empties the handles given (either may be NULL), so that the call may
+** abort both on failure. Handles held by value must start zeroed. */
+cf_status cf_atomic_begin(const char *call, const void *r, const char *path1, cf_atomic *out1,
+                          const char *path2, cf_atomic *out2, cf_error *err);
+
+/* The same for a call that prepares one output: the path must be given too. */
+cf_status cf_atomic_begin_one(const char *call, const void *r, const char *path, cf_atomic *out,
+                              cf_error *err);
 
 /* Removes every temporary file still open in this process. Async-signal-safe: for a handler of a
 ** fatal signal. */

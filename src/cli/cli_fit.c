@@ -169,7 +169,7 @@ static int run_joint(const fit_args *a, fit_job *jobs, const char *const *inputs
     int rc = CF_EXIT_OK;
     if (cf_pipeline_fit_joint(tabs, (size_t)a->nfiles, &a->popt, &r, &err) != CF_OK)
         rc = cf_cli_fail(&err);
-    cf_atomic jo, po;
+    cf_atomic jo = {0}, po = {0};
     if (rc == CF_EXIT_OK &&
         cf_joint_prepare(&r, a->out, a->plot, inputs, &jo, &po, &err) != CF_OK)
         rc = cf_cli_fail(&err);

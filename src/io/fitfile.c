@@ -316,7 +316,7 @@ char *cf_fitfile_dumps(const json_t *root)
 }
 
 cf_status cf_fitfile_prepare(const json_t *root, const char *path, const char *const *inputs,
-                             struct cf_atomic *out, cf_error *err)
+                             cf_output *out, cf_error *err)
 {
     memset(out, 0, sizeof *out);
     char where[256];

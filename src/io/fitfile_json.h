@@ -13,6 +13,7 @@
 
 #include "conifit/error.h"
 #include "conifit/law.h"
+#include "conifit/output.h"
 
 /* A JSON number, or null for a value that is not finite; a document holding a null is never
 ** written (cf_fitfile_dumps and cf_fitfile_prepare refuse it), so NaN and Inf never reach a file:
@@ -40,8 +41,7 @@ char *cf_fitfile_dumps(const json_t *root);
 ** commits it (cf_atomic_commit) with its other outputs, or aborts it. `inputs` (NULL-terminated,
 ** may be NULL) are refused as targets. CF_E_CANTWRITE (or CF_E_INTERNAL when memory runs out or
 ** the document holds a value that is not a finite number) on failure, no file left behind. */
-struct cf_atomic;
 cf_status cf_fitfile_prepare(const json_t *root, const char *path, const char *const *inputs,
-                             struct cf_atomic *out, cf_error *err);
+                             cf_output *out, cf_error *err);
 
 #endif

@@ -93,13 +93,14 @@ cf_status cf_pipeline_fit_series(const cf_table *t, const cf_pipeline_options *o
 
 cf_status cf_pipeline_series_prepare(const cf_visco_report *r, const char *json_path,
                                      const char *plot_path, const char *const *inputs,
-                                     struct cf_atomic *json_out, struct cf_atomic *plot_out,
+                                     cf_output *json_out, cf_output *plot_out,
                                      cf_error *err)
 {
-    memset(json_out, 0, sizeof *json_out);
-    memset(plot_out, 0, sizeof *plot_out);
-    cf_status st =
-        json_path ? cf_visco_report_json_prepare(r, json_path, inputs, json_out, err) : CF_OK;
+    cf_status st = cf_atomic_begin("cf_pipeline_series_prepare", r, json_path, json_out,
+                                   plot_path, plot_out, err);
+    if (st != CF_OK)
+        return st;
+    st = json_path ? cf_visco_report_json_prepare(r, json_path, inputs, json_out, err) : CF_OK;
     if (st == CF_OK && plot_path)
         st = cf_visco_plot(r, plot_path, inputs, plot_out, err);
     return cf_pipeline_outputs_end(st, plot_path, json_out, plot_out, err);

@@ -229,9 +229,10 @@ cf_status cf_joint_prepare(const cf_joint_report *r, const char *json_path, cons
                            const char *const *inputs, cf_atomic *json_out, cf_atomic *plot_out,
                            cf_error *err)
 {
-    memset(json_out, 0, sizeof *json_out);
-    memset(plot_out, 0, sizeof *plot_out);
-    cf_status st = CF_OK;
+    cf_status st =
+        cf_atomic_begin("cf_joint_prepare", r, json_path, json_out, plot_path, plot_out, err);
+    if (st != CF_OK)
+        return st;
     if (json_path) {
         json_t *root = joint_json(r);
         if (!root)

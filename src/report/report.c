@@ -390,13 +390,15 @@ char *cf_report_json_string(const cf_fit_report *r)
 }
 
 cf_status cf_report_json_prepare(const cf_fit_report *r, const char *path,
-                                 const char *const *inputs, struct cf_atomic *out, cf_error *err)
+                                 const char *const *inputs, cf_output *out, cf_error *err)
 {
-    memset(out, 0, sizeof *out);
+    cf_status st = cf_atomic_begin_one("cf_report_json_prepare", r, path, out, err);
+    if (st != CF_OK)
+        return st;
     json_t *root = report_json(r);
     if (!root)
         return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory building the report", path);
-    cf_status st = cf_fitfile_prepare(root, path, inputs, out, err);
+    st = cf_fitfile_prepare(root, path, inputs, out, err);
     json_decref(root);
     return st;
 }
@@ -404,7 +406,7 @@ cf_status cf_report_json_prepare(const cf_fit_report *r, const char *path,
 cf_status cf_report_json_write(const cf_fit_report *r, const char *path,
                                const char *const *inputs, cf_error *err)
 {
-    cf_atomic a;
+    cf_atomic a = {0};
     cf_status st = cf_report_json_prepare(r, path, inputs, &a, err);
     if (st == CF_OK)
         st = cf_atomic_commit(&a, err);

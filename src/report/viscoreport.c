@@ -288,13 +288,16 @@ static json_t *report_json(const cf_visco_report *r)
 }
 
 cf_status cf_visco_report_json_prepare(const cf_visco_report *r, const char *path,
-                                       const char *const *inputs, struct cf_atomic *out,
+                                       const char *const *inputs, cf_output *out,
                                        cf_error *err)
 {
+    cf_status st = cf_atomic_begin_one("cf_visco_report_json_prepare", r, path, out, err);
+    if (st != CF_OK)
+        return st;
     json_t *root = report_json(r);
     if (!root)
         return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory building the report", path);
-    cf_status st = cf_fitfile_prepare(root, path, inputs, out, err);
+    st = cf_fitfile_prepare(root, path, inputs, out, err);
     json_decref(root);
     return st;
 }
@@ -503,14 +506,16 @@ static void visco_script(cf_gp *g, const cf_visco_report *r)
 }
 
 cf_status cf_visco_plot(const cf_visco_report *r, const char *path, const char *const *inputs,
-                        struct cf_atomic *out, cf_error *err)
+                        cf_output *out, cf_error *err)
 {
+    cf_status st = cf_atomic_begin_one("cf_visco_plot", r, path, out, err);
+    if (st != CF_OK)
+        return st;
     cf_gp g;
-    memset(out, 0, sizeof *out);
     cf_gp_init(&g);
     cf_gp_terminal(&g, path, 1300, 700);
     visco_script(&g, r);
-    cf_status st = cf_gp_render(&g, path, inputs, out, err);
+    st = cf_gp_render(&g, path, inputs, out, err);
     cf_gp_free(&g);
     return st;
 }

@@ -12,8 +12,7 @@
 #include "conifit/error.h"
 #include "conifit/joint.h"
 #include "conifit/measure.h"
-
-struct cf_atomic;
+#include "conifit/output.h"
 
 /* One joint fit per spring type over the same tables. */
 typedef struct cf_joint_report {
@@ -31,9 +30,9 @@ int cf_joint_better(const cf_joint_report *r);
 char *cf_joint_text(const cf_joint_report *r);
 
 /* The fit file and the figure as complete temporaries beside their targets (either path NULL:
-** not written); the caller commits them (cf_atomic_commit). On failure neither is left. */
+** not written); the caller commits them (cf_output_commit). On failure neither is left. */
 cf_status cf_joint_prepare(const cf_joint_report *r, const char *json_path, const char *plot_path,
-                           const char *const *inputs, struct cf_atomic *json_out,
-                           struct cf_atomic *plot_out, cf_error *err);
+                           const char *const *inputs, cf_output *json_out,
+                           cf_output *plot_out, cf_error *err);
 
 #endif

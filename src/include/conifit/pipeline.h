@@ -18,6 +18,7 @@
 #include "conifit/error.h"
 #include "conifit/fit.h"
 #include "conifit/measure.h"
+#include "conifit/output.h"
 #include "conifit/report.h"
 #include "conifit/validate.h"
 
@@ -73,13 +74,12 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
                           cf_error *err);
 
 /* Writes the report's fit file to json_path and its plot to plot_path (either NULL: not
-** written) as complete temporary files beside their targets, not yet in place (base/atomic.h):
-** the caller commits them (cf_atomic_commit) when all of its outputs are ready, or aborts them.
+** written) as complete temporary files beside their targets, not yet in place (conifit/output.h):
+** the caller commits them (cf_output_commit) when all of its outputs are ready, or aborts them.
 ** On failure neither is left. `inputs` (NULL-terminated, may be NULL) are refused as targets. */
-struct cf_atomic;
 cf_status cf_pipeline_prepare(const cf_fit_report *r, const char *json_path,
                               const char *plot_path, const char *const *inputs,
-                              struct cf_atomic *json_out, struct cf_atomic *plot_out,
+                              cf_output *json_out, cf_output *plot_out,
                               cf_error *err);
 
 /* The same, both put in place at once: the plot is drawn before either file is written, so a

@@ -11,6 +11,7 @@
 
 #include "conifit/error.h"
 #include "conifit/measure.h"
+#include "conifit/output.h"
 #include "conifit/pipeline.h"
 #include "conifit/viscofit.h"
 #include "conifit/viscoreport.h"
@@ -26,10 +27,9 @@ cf_status cf_pipeline_fit_series(const cf_table *t, const cf_pipeline_options *o
 
 /* As cf_pipeline_prepare: the fit file and the plot (either path NULL: not written) as complete
 ** temporaries beside their targets, for the caller to commit or abort. */
-struct cf_atomic;
 cf_status cf_pipeline_series_prepare(const cf_visco_report *r, const char *json_path,
                                      const char *plot_path, const char *const *inputs,
-                                     struct cf_atomic *json_out, struct cf_atomic *plot_out,
+                                     cf_output *json_out, cf_output *plot_out,
                                      cf_error *err);
 
 #endif

@@ -1,7 +1,7 @@
 /*
 ** What a fit reports: the readable terminal text and the JSON fit file (schema in fitfile.h,
 ** extended with the identifiable quantities, quality measures and baselines). The JSON is written
-** atomically (atomic.h) with doubles to 17 significant digits and never a NaN or Inf.
+** atomically (conifit/output.h) with doubles to 17 significant digits and never a NaN or Inf.
 */
 #ifndef CF_REPORT_H
 #define CF_REPORT_H
@@ -12,6 +12,7 @@
 #include "conifit/error.h"
 #include "conifit/fit.h"
 #include "conifit/measure.h"
+#include "conifit/output.h"
 #include "conifit/softening.h"
 #include "conifit/validate.h"
 
@@ -69,11 +70,11 @@ double cf_report_baseline_aic(const cf_fit_report *r, int k);
 /* The JSON document as a string (malloc'd; caller frees). NULL when memory runs out. */
 char *cf_report_json_string(const cf_fit_report *r);
 
-/* Writes the JSON to a temporary file beside path, complete but not yet in place (base/atomic.h):
-** the caller commits it together with its other outputs, or aborts it. Errors as below. */
-struct cf_atomic;
+/* Writes the JSON to a temporary file beside path, complete but not yet in place, held by out
+** (conifit/output.h): the caller commits it together with its other outputs, or aborts it.
+** CF_E_USAGE when r, path or out is NULL or out still holds a file; other errors as below. */
 cf_status cf_report_json_prepare(const cf_fit_report *r, const char *path,
-                                 const char *const *inputs, struct cf_atomic *out, cf_error *err);
+                                 const char *const *inputs, cf_output *out, cf_error *err);
 
 /* Writes the JSON to path atomically; `inputs` (NULL-terminated, may be NULL) are refused as
 ** targets. CF_E_CANTWRITE on failure (no file left behind). */

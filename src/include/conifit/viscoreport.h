@@ -12,6 +12,7 @@
 #include "conifit/error.h"
 #include "conifit/fit.h"
 #include "conifit/measure.h"
+#include "conifit/output.h"
 #include "conifit/viscofit.h"
 
 typedef struct cf_visco_report {
@@ -34,15 +35,14 @@ char *cf_visco_report_text(const cf_visco_report *r);
 
 /* Writes the JSON to a temporary file beside path, complete but not in place (the caller commits
 ** or aborts *out); inputs (NULL-terminated, may be NULL) are refused as targets. */
-struct cf_atomic;
 cf_status cf_visco_report_json_prepare(const cf_visco_report *r, const char *path,
-                                       const char *const *inputs, struct cf_atomic *out,
+                                       const char *const *inputs, cf_output *out,
                                        cf_error *err);
 
 /* Draws stress against time (data, model, residuals underneath) beside stress against strain,
 ** with gnuplot, to a temporary .png or .svg beside path (as cf_plot_fit: the caller commits or
 ** aborts *out). */
 cf_status cf_visco_plot(const cf_visco_report *r, const char *path, const char *const *inputs,
-                        struct cf_atomic *out, cf_error *err);
+                        cf_output *out, cf_error *err);
 
 #endif

@@ -1,0 +1,148 @@
+/*
+** The public output handle (conifit/output.h) with the pipeline's writing call:
+**  - a fit prepared into a handle is not in place until committed, then reads back as the fit;
+**  - an aborted or freed handle leaves nothing in the folder;
+**  - NULL and malformed arguments (no handle, no report, no path, a handle that still holds a
+**    file, a commit of an empty handle) return CF_E_USAGE with a message and touch no file.
+*/
+#include "testutil.h"
+
+#include <dirent.h>
+
+#include "conifit/fitfile.h"
+#include "conifit/output.h"
+#include "conifit/pipeline.h"
+
+TU_SCRATCH_GROUP("output")
+
+/* Entries of dir other than . and .. (temporaries included). */
+static int entries(void)
+{
+    DIR *d = opendir(dir);
+    assert_non_null(d);
+    int n = 0;
+    for (struct dirent *e; (e = readdir(d));)
+        n += strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
+    closedir(d);
+    return n;
+}
+
+/* The telescoping table fitted with the defaults (both types, no validation), a target named
+** `name` in the scratch folder and a new, empty handle. */
+typedef struct case_ {
+    cf_table t;
+    cf_fit_report r;
+    char path[300];
+    cf_output *o;
+} case_;
+
+static void begin(case_ *c, const char *name)
+{
+    cf_measure_options mo = cf_measure_default_options();
+    cf_pipeline_options po = cf_pipeline_default_options();
+    cf_error err = {0};
+    assert_int_equal(cf_measure_load("data/telescoping.csv", &mo, &c->t, &err), CF_OK);
+    assert_int_equal(cf_pipeline_fit(&c->t, &po, &c->r, &err), CF_OK);
+    snprintf(c->path, sizeof c->path, "%s/%s", dir, name);
+    c->o = NULL;
+    assert_int_equal(cf_output_new(&c->o, &err), CF_OK);
+}
+
+static void end(case_ *c)
+{
+    cf_output_free(c->o);
+    unlink(c->path);
+    cf_report_free(&c->r);
+    cf_table_free(&c->t);
+}
+
+static void prepared_fit_appears_only_on_commit(void **state)
+{
+    (void)state;
+    case_ c;
+    begin(&c, "fit.json");
+    cf_output *o = c.o;
+    cf_error err = {0};
+    assert_string_equal(cf_output_path(o), "");
+    assert_int_equal(cf_pipeline_prepare(&c.r, c.path, NULL, NULL, o, NULL, &err), CF_OK);
+    assert_string_equal(cf_output_path(o), c.path);
+    assert_int_equal(access(c.path, F_OK), -1);
+    assert_int_equal(entries(), 1); /* the hidden temporary */
+    assert_int_equal(cf_output_commit(o, &err), CF_OK);
+    assert_string_equal(cf_output_path(o), "");
+    assert_int_equal(entries(), 1);
+    cf_fitted_spring fs;
+    assert_int_equal(cf_fitfile_load(c.path, "telescoping", &fs, &err), CF_OK);
+    assert_close(fs.params.D1_mm, c.r.fits[0].params.D1_mm, 1e-12);
+    assert_close(fs.rmse, c.r.fits[0].rmse, 1e-12);
+    /* the handle is empty again: a second commit is refused, a new prepare is accepted */
+    assert_int_equal(cf_output_commit(o, &err), CF_E_USAGE);
+    assert_non_null(strstr(err.msg, "holds no file"));
+    assert_int_equal(cf_pipeline_prepare(&c.r, c.path, NULL, NULL, o, NULL, &err), CF_OK);
+    cf_output_abort(o);
+    assert_int_equal(entries(), 1);
+    end(&c);
+}
+
+static void aborted_handle_leaves_nothing(void **state)
+{
+    (void)state;
+    case_ c;
+    begin(&c, "dropped.json");
+    cf_error err = {0};
+    assert_int_equal(cf_report_json_prepare(&c.r, c.path, NULL, c.o, &err), CF_OK);
+    assert_int_equal(entries(), 1);
+    cf_output_abort(c.o);
+    assert_int_equal(entries(), 0);
+    cf_output_abort(c.o); /* twice is harmless */
+    assert_int_equal(cf_report_json_prepare(&c.r, c.path, NULL, c.o, &err), CF_OK);
+    end(&c); /* freeing aborts what was not committed */
+    assert_int_equal(entries(), 0);
+}
+
+static void malformed_arguments_are_usage_errors_with_a_message(void **state)
+{
+    (void)state;
+    case_ c;
+    begin(&c, "bad.json");
+    cf_error err = {0};
+    assert_int_equal(cf_output_new(NULL, &err), CF_E_USAGE);
+    assert_non_null(strstr(err.msg, "cf_output_new"));
+    assert_int_equal(cf_output_commit(NULL, &err), CF_E_USAGE);
+    assert_non_null(strstr(err.msg, "NULL"));
+    cf_output_abort(NULL);
+    cf_output_free(NULL);
+    assert_string_equal(cf_output_path(NULL), "");
+
+    cf_output *o = c.o, *p = NULL;
+    assert_int_equal(cf_output_new(&p, &err), CF_OK);
+    assert_int_equal(cf_output_commit(o, &err), CF_E_USAGE); /* never prepared */
+    err = (cf_error){0};
+    assert_int_equal(cf_pipeline_prepare(NULL, c.path, NULL, NULL, o, NULL, &err), CF_E_USAGE);
+    assert_non_null(strstr(err.msg, "cf_pipeline_prepare: no report"));
+    assert_int_equal(cf_pipeline_prepare(&c.r, c.path, NULL, NULL, NULL, NULL, &err), CF_E_USAGE);
+    assert_non_null(strstr(err.msg, "no output handle"));
+    assert_int_equal(cf_pipeline_prepare(&c.r, NULL, c.path, NULL, o, NULL, &err), CF_E_USAGE);
+    assert_int_equal(cf_report_json_prepare(&c.r, NULL, NULL, o, &err), CF_E_USAGE);
+    assert_non_null(strstr(err.msg, "cf_report_json_prepare: no path"));
+    assert_int_equal(entries(), 0);
+
+    /* a handle that still holds a file is refused, and its file stays committable */
+    assert_int_equal(cf_pipeline_prepare(&c.r, c.path, NULL, NULL, o, NULL, &err), CF_OK);
+    assert_int_equal(cf_pipeline_prepare(&c.r, c.path, NULL, NULL, p, o, &err), CF_E_USAGE);
+    assert_non_null(strstr(err.msg, "still holds an uncommitted file"));
+    assert_int_equal(cf_output_commit(o, &err), CF_OK);
+    assert_int_equal(entries(), 1);
+    cf_output_free(p);
+    end(&c);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(prepared_fit_appears_only_on_commit),
+        cmocka_unit_test(aborted_handle_leaves_nothing),
+        cmocka_unit_test(malformed_arguments_are_usage_errors_with_a_message),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
