@@ -52,6 +52,8 @@ typedef struct ctx {
     double *m;          /* model curve scratch (n) */
     cf_visco_series series;
     long evals;
+    long max_evals;     /* the bound on evals (options.max_evaluations or the default) */
+    int bound_hit;      /* 1 once evals reached max_evals with work left */
     int oom;            /* 1 when an allocation failed in a solver or a model curve: the fit
                         ** ends with an error instead of going on without that start or point */
 } ctx;

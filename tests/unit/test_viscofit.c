@@ -70,23 +70,52 @@ static void assert_within_stderr(const cf_visco_fit *f, const cf_visco_params *p
 }
 
 /* A series made by the model from known terms is fitted back to 1e-6. */
+/* The noiseless series of the known terms fitted with two terms and options o. */
+static void fit_known_noiseless(const cf_visco_fit_options *o, cf_visco_fit *f)
+{
+    cf_visco_params p = known();
+    double t[NS], x[NS], y[NS];
+    synth_series(&p, &o->setup, t, x, y);
+    cf_error err = {0};
+    cf_visco_fit_options o2 = *o;
+    o2.nbranch = 2;
+    cf_visco_data d = {NS, t, x, y, NULL};
+    if (cf_visco_fit_run(&d, &o2, f, &err) != CF_OK)
+        fail_msg("the fit of the known terms failed: %s", err.msg);
+}
+
 static void test_recover_noiseless(void **state)
 {
     (void)state;
     cf_visco_params p = known();
     cf_visco_fit_options o = cf_visco_fit_default_options();
-    double t[NS], x[NS], y[NS];
-    synth_series(&p, &o.setup, t, x, y);
-    cf_error err = {0};
-    o.nbranch = 2;
-    cf_visco_data d = {NS, t, x, y, NULL};
     cf_visco_fit f;
-    assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_OK);
+    fit_known_noiseless(&o, &f);
     assert_recovered(&f, &p, 1e-6);
     assert_true(f.rmse < 1e-9 * p.ident.scale);
     assert_int_equal(f.n_ramp, 16);
     assert_int_equal(f.n_hold, NS - 16);
     cf_visco_fit_free(&f);
+}
+
+/* A bound on the model runs stops the fit after its first start with the best model so far and
+** says so; without the bound the same fit runs every start and does not. */
+static void test_evaluation_bound(void **state)
+{
+    (void)state;
+    cf_visco_params p = known();
+    cf_visco_fit_options o = cf_visco_fit_default_options();
+    cf_visco_fit all, bounded;
+    fit_known_noiseless(&o, &all);
+    assert_int_equal(all.evaluation_bound_reached, 0);
+    o.max_evaluations = 50; /* fewer than the stand-in's grid: one start is fitted */
+    fit_known_noiseless(&o, &bounded);
+    assert_int_equal(bounded.evaluation_bound_reached, 1);
+    assert_true(bounded.evaluations < all.evaluations);
+    assert_int_equal(bounded.p.nbranch, 2);
+    assert_true(isfinite(bounded.rmse) && bounded.rmse < 1e-3 * p.ident.scale);
+    cf_visco_fit_free(&all);
+    cf_visco_fit_free(&bounded);
 }
 
 /* With 0.5 % noise the terms are found within twice their reported standard errors. */
@@ -463,6 +492,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_recover_noiseless),
         cmocka_unit_test(test_recover_with_noise),
+        cmocka_unit_test(test_evaluation_bound),
         cmocka_unit_test(test_strain_relaxation_recovered),
         cmocka_unit_test(test_series_refused),
         cmocka_unit_test(test_held_elastic),
