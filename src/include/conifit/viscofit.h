@@ -71,6 +71,11 @@ typedef struct cf_visco_fit_options {
     ** candidate is fitted: the best model so far is kept and evaluation_bound_reached set. A
     ** search under way finishes first, so the count may pass the bound by one start's runs. */
     long max_evaluations;
+    /* 1: the Levenberg-Marquardt's Jacobian by forward differences at every step (one model run
+    ** per parameter each). 0 (the default): by differences every few steps and after a refused
+    ** trial, carried by Broyden's update in between; the same optimum for a fraction of the
+    ** model runs. */
+    int full_jacobian;
 } cf_visco_fit_options;
 
 cf_visco_fit_options cf_visco_fit_default_options(void);
