@@ -233,7 +233,8 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
                                            "--mode uniaxial",
                                     cf_mode_name(jobs[i].m.mode));
     if (rc < 0 && *nseries == 0 && a->series_only)
-        rc = cf_cli_usage_error("fit", "--branches, --dashpot, --relaxation and --elastic apply to time "
+        rc = cf_cli_usage_error("fit", "--branches, --dashpot, --relaxation, --elastic and "
+                                       "--max-evaluations apply to time "
                                        "series "
                                        "(a table with a time column) only");
     if (rc < 0 && a->elastic) {
@@ -304,6 +305,14 @@ static int report_job(const fit_args *a, fit_job *j)
             fputc('\n', stdout);
     }
     report_warnings(j->file, &j->rep);
+    if (j->m.t && j->vrep.fit.evaluation_bound_reached)
+        cf_cli_printf_safe(stderr,
+                           "conifit: warning: %s: the time-series fit stopped after %ld model "
+                           "runs, at its bound of %ld (--max-evaluations), with candidates or "
+                           "starts left unfitted: the model kept is the best of those fitted\n",
+                           j->file, j->vrep.fit.evaluations,
+                           a->vopt.max_evaluations > 0 ? a->vopt.max_evaluations
+                                                       : CF_VISCO_EVAL_MAX);
     for (int k = 0; k < j->rep.nfits; k++) {
         fit_warnings(j->file, &j->rep, &j->rep.fits[k]);
         const cf_validation *v = &j->rep.val[k];

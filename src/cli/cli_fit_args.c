@@ -83,6 +83,8 @@ static const char fit_help_series[] =
     "                          candidates whose terms the series determines\n"
     "  --elastic FIT.json[:TYPE]  hold rho, s/H and F_C/H^2 at those of a fit file's spring\n"
     "  --calibration C         the lattice's weights: axial (default for a series) or isotropic\n"
+    "  --max-evaluations N     stop after about N model runs, keeping the best model so far\n"
+    "                          (default 200000; a warning says when it is reached)\n"
     "The fitted spring stays within the design limits (--rho-min, --index-max, ...) and its\n"
     "lattice stable up to the series' largest strain (a held --elastic spring whose lattice\n"
     "would buckle within the series is refused).\n\n"
@@ -127,6 +129,7 @@ enum {
     OPT_DASHPOT,
     OPT_RELAXATION,
     OPT_ELASTIC,
+    OPT_MAX_EVALUATIONS,
     OPT_TITLE,
     OPT_STRESS_MEASURE,
     OPT_STRAIN_MEASURE,
@@ -169,6 +172,7 @@ static const struct option fit_options[] = {
     {"dashpot", no_argument, NULL, OPT_DASHPOT},
     {"relaxation", required_argument, NULL, OPT_RELAXATION},
     {"elastic", required_argument, NULL, OPT_ELASTIC},
+    {"max-evaluations", required_argument, NULL, OPT_MAX_EVALUATIONS},
     {"title", required_argument, NULL, OPT_TITLE},
     {"stress-measure", required_argument, NULL, OPT_STRESS_MEASURE},
     {"strain-measure", required_argument, NULL, OPT_STRAIN_MEASURE},
@@ -398,6 +402,12 @@ static int fit_option(void *ctx, int c, const char *optval)
         return 0;
     case OPT_ELASTIC:
         a->elastic = optval;
+        a->series_only = 1;
+        return 0;
+    case OPT_MAX_EVALUATIONS:
+        if (cf_cli_parse_long("--max-evaluations", optval, 1, 1000000000L, &n, &err) != CF_OK)
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        a->vopt.max_evaluations = n;
         a->series_only = 1;
         return 0;
     case OPT_STRESS_MEASURE:

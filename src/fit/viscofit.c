@@ -78,6 +78,14 @@ cf_status cf_visco_data_check(const cf_visco_data *d, unsigned char *is_hold, cf
 
 /* ---- one branch count ------------------------------------------------------------------------ */
 
+/* 1 when the fit has used its model runs: what is left is not started (and the fit says so). */
+static int out_of_evaluations(ctx *c)
+{
+    if (c->evals >= c->max_evals)
+        c->bound_hit = 1;
+    return c->bound_hit;
+}
+
 /* The start when the stand-in found none: equal branches spread over the series. */
 static void default_start(const ctx *c, int nb, start *s)
 {
@@ -118,6 +126,8 @@ static double fit_nb(ctx *c, int nb, const cf_visco_params *from, cf_visco_param
     for (int s = 0; z && zbest && !c->oom && s <= nstarts; s++) {
         if (!(best[s].obj < HUGE_VAL))
             continue;
+        if (bestobj < HUGE_VAL && out_of_evaluations(c))
+            break; /* one start fitted at least, so the candidate has a model */
         cf_visco_params p0 = best[s].p;
         if (c->dash && !(p0.eta_MPa_s > 0))
             p0.eta_MPa_s = 1e-6 * p0.ident.scale;
@@ -204,6 +214,7 @@ static cf_status fit_setup(ctx *c, const cf_visco_data *d, const cf_visco_fit_op
     }
     c->e_lo = c->xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
     c->rho_lo = o->rho_min > 0 && o->rho_min < RHO_HI ? o->rho_min : 1e-3;
+    c->max_evals = o->max_evaluations > 0 ? o->max_evaluations : CF_VISCO_EVAL_MAX;
     const double *el = o->elastic.v;
     if (o->hold_elastic && (!(el[0] > 0 && el[0] <= 1) || !(el[1] > c->xmax && el[1] < 1) ||
                             !(el[2] > 0) || !isfinite(el[2])))
@@ -383,6 +394,8 @@ static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf
     const int gslo = o->relaxation == CF_RELAX_STRAIN, gshi = o->relaxation != CF_RELAX_QLV;
     for (int v = 0; v < (nhi - nlo + 1) * (gshi - gslo + 1); v++) {
         const int nb = nlo + v / (gshi - gslo + 1);
+        if (best_aic < HUGE_VAL && out_of_evaluations(c))
+            break; /* the candidates left are not fitted (res->evaluation_bound_reached) */
         c->gs = gslo + v % (gshi - gslo + 1);
         c->smask = (1u << nb) - 1;
         cf_visco_params p, q;
@@ -405,7 +418,7 @@ static cf_status fit_counts(ctx *c, cf_visco_fit *res, cf_visco_params *best, cf
             }
             fitted = 1;
             /* again without the loose k_i, while some stay */
-            if (iq || !lq || (c->smask & ~lq) == 0 || c->smask != mask)
+            if (iq || !lq || (c->smask & ~lq) == 0 || c->smask != mask || out_of_evaluations(c))
                 break;
             c->smask &= ~lq;
             from = q; /* the loose terms held at their modulus halfway along the strain */
@@ -543,6 +556,7 @@ cf_status cf_visco_fit_run(const cf_visco_data *d, const cf_visco_fit_options *o
         st = cf_error_set(err, CF_E_INTERNAL,
                           "out of memory in the viscoelastic fit's errors and predictions");
     res->evaluations = c.evals;
+    res->evaluation_bound_reached = c.bound_hit;
     res->wall_time_s = cf_clock_s() - t0;
     free(c.sw);
     free(c.m);

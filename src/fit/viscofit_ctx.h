@@ -7,6 +7,10 @@
 
 #include <stddef.h>
 
+#include <gsl/gsl_matrix.h>
+#include <gsl/gsl_multifit_nlinear.h>
+#include <gsl/gsl_vector.h>
+
 #include "conifit/viscofit.h"
 #include "fit/viscolimits.h"
 
@@ -29,6 +33,9 @@
 #define LM_FLOOR_REL 1e-28
 /* g_i = e^a_i / (1 + sum e^a_j): a_i is kept above this (g_i ~ 1e-13, a branch switched off). */
 #define A_LO -30.0
+/* Accepted steps of the Levenberg-Marquardt between two Jacobians by finite differences: in
+** between, Broyden's rank-one update from the step taken (options.full_jacobian: every step). */
+#define LM_JAC_REUSE 4
 /* Relative step of the central differences for the standard errors. */
 #define SE_STEP 1e-5
 
@@ -52,6 +59,9 @@ typedef struct ctx {
     double *m;          /* model curve scratch (n) */
     cf_visco_series series;
     long evals;
+    struct lm_jac *jac; /* the Levenberg-Marquardt's Jacobian updates (viscofit_state.c) */
+    long max_evals;     /* the bound on evals (options.max_evaluations or the default) */
+    int bound_hit;      /* 1 once evals reached max_evals with work left */
     int oom;            /* 1 when an allocation failed in a solver or a model curve: the fit
                         ** ends with an error instead of going on without that start or point */
 } ctx;
@@ -73,6 +83,13 @@ void cf_viscofit_pack(const ctx *c, const cf_visco_params *p, double *z);
 int cf_viscofit_curve(ctx *c, const cf_visco_params *p);
 double cf_viscofit_profile_scale(const ctx *c, double rho, double B);
 double cf_viscofit_lm_run(ctx *c, double *z);
+
+/* viscofit_jac.c */
+struct lm_jac *cf_viscofit_jac_alloc(size_t n, size_t p, gsl_multifit_nlinear_fdf *fdf,
+                                     double h_df);
+void cf_viscofit_jac_free(struct lm_jac *j);
+void cf_viscofit_jac_record(struct lm_jac *j, const double *x, const double *f);
+int cf_viscofit_jac_df(const gsl_vector *x, void *data, gsl_matrix *J);
 
 /* viscofit_standin.c */
 int cf_viscofit_stand_in(ctx *c, start *best, int nbest);

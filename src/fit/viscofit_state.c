@@ -153,10 +153,13 @@ static int lm_f(const gsl_vector *zv, void *data, gsl_vector *f)
                       : c->sw[k] * 10 * (fabs(c->d->y[k]) + c->ymax);
         gsl_vector_set(f, k, isfinite(r) ? r * s : 1e10);
     }
+    cf_viscofit_jac_record(c->jac, zv->data, f->data);
     return GSL_SUCCESS;
 }
 
-/* Levenberg-Marquardt from z (in place); returns the scaled sum of squares. */
+/* Levenberg-Marquardt from z (in place); returns the scaled sum of squares. Its Jacobian by
+** forward differences at every step (options.full_jacobian), or by default every few steps and
+** carried by Broyden's update in between (viscofit_jac.c). */
 double cf_viscofit_lm_run(ctx *c, double *z)
 {
     gsl_multifit_nlinear_parameters fp = cf_lm_parameters();
@@ -164,13 +167,23 @@ double cf_viscofit_lm_run(ctx *c, double *z)
     gsl_multifit_nlinear_fdf fdf;
     memset(&fdf, 0, sizeof fdf);
     fdf.f = lm_f;
-    fdf.df = NULL; /* forward differences */
+    fdf.df = NULL; /* forward differences at every step */
     fdf.n = c->n;
     fdf.p = c->np;
     fdf.params = c;
+    c->jac = NULL;
+    if (!c->o->full_jacobian) { /* differences now and then, Broyden's update in between */
+        if (!(c->jac = cf_viscofit_jac_alloc(c->n, c->np, &fdf, fp.h_df))) {
+            c->oom = 1;
+            return HUGE_VAL;
+        }
+        fdf.df = cf_viscofit_jac_df;
+    }
     int init;
     gsl_multifit_nlinear_workspace *w = cf_lm_start(&fp, &fdf, z, &init);
     if (!w) {
+        cf_viscofit_jac_free(c->jac);
+        c->jac = NULL;
         c->oom = 1;
         return HUGE_VAL;
     }
@@ -188,5 +201,7 @@ double cf_viscofit_lm_run(ctx *c, double *z)
             best = HUGE_VAL;
     }
     gsl_multifit_nlinear_free(w);
+    cf_viscofit_jac_free(c->jac);
+    c->jac = NULL;
     return best;
 }

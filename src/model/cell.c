@@ -52,6 +52,15 @@ static const int dirs[CF_CELL_DIRS][3] = {
     {0, 1, 1},
     {1, 1, 1}};
 
+/* The rest length of each direction over the cell edge, sqrt(N . N) (correctly rounded, so the
+** same double as the square root computed at run time), and its family: the spring loop takes
+** them from here instead of recomputing them per spring and per evaluation. */
+#define SQRT2 1.41421356237309504880
+#define SQRT3 1.73205080756887729353
+static const double dir_len[CF_CELL_DIRS] = {1,     SQRT2, 1, SQRT2, SQRT3, SQRT2, SQRT3,
+                                             SQRT2, 1,     SQRT2, SQRT3, SQRT2, SQRT3};
+static const int dir_family[CF_CELL_DIRS] = {0, 1, 0, 1, 2, 1, 2, 1, 0, 1, 2, 1, 2};
+
 void cf_cell_direction(int d, int N[3], int *family)
 {
     if (d < 0 || d >= CF_CELL_DIRS) {
@@ -78,13 +87,63 @@ cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
     return CF_OK;
 }
 
+/* 1 when spring d carries what the earlier spring e carries: the same squared length (so the
+** same length, to the bit), the same weight and the same extra terms. Springs that a
+** deformation maps alike (the four body diagonals under a diagonal F, the lateral edges under
+** uniaxial loading) then share one evaluation of the law instead of repeating it. */
+static int same_spring(const cf_cell_extra *x, const double *L2, int d, int e)
+{
+    return L2[e] == L2[d] && dir_family[e] == dir_family[d] &&
+           (!x || (x->T0_N[e] == x->T0_N[d] && x->k_N_per_mm[e] == x->k_N_per_mm[d] &&
+                   x->Lref_mm[e] == x->Lref_mm[d]));
+}
+
+/* The tension of spring d at length L (s->T_N, s->L_mm, kT), or an error when it reaches solid;
+** *r gets |u| over the travel. */
+static cf_status spring_tension(const cf_cell *c, int d, double L, const cf_cell_extra *x,
+                                cf_cell_state *s, double kT[CF_CELL_DIRS], double *r,
+                                cf_error *err)
+{
+    const cf_law *law = c->law;
+    const double H = law->p.H_mm;
+    const int *N = dirs[d], fam = dir_family[d];
+    double L0 = H * dir_len[d];
+    double u = H * (L0 - L) / L0;
+    *r = fabs(u) / law->travel_mm;
+    if (!(*r < SOLID_MARGIN) || !(L > 0))
+        return cf_error_set(err, CF_E_DATA,
+                            "the cell's spring along (%d, %d, %d) reaches solid (stretch %.6g, "
+                            "solid at %.6g)",
+                            N[0], N[1], N[2], L / L0, 1 - copysign(law->travel_mm / H, u));
+    double k = 0;
+    double f = cf_law_force(law, c->method, u, &k, NULL);
+    double w = c->weight[fam] * c->law_scale, T, dT;
+    if (c->law_scale_strain != 0) { /* factor law_scale + law_scale_strain |u| / H */
+        const double phi = c->law_scale + c->law_scale_strain * fabs(u) / H;
+        const double dphi = c->law_scale_strain * copysign(1.0, u) / H; /* d phi / du */
+        T = -c->weight[fam] * phi * f;
+        dT = c->weight[fam] * (phi * k + dphi * f) * H / L0;
+    } else {
+        T = -w * f;
+        dT = w * k * H / L0;
+    }
+    if (x) {
+        T += x->T0_N[d] + x->k_N_per_mm[d] * (L - x->Lref_mm[d]);
+        dT += x->k_N_per_mm[d];
+    }
+    s->L_mm[d] = L;
+    s->T_N[d] = T;
+    kT[d] = dT;
+    return CF_OK;
+}
+
 /* The state at F, and dT/dL of every spring (N/mm) for the tangent. */
 static cf_status evaluate(const cf_cell *c, const double F[9], const cf_cell_extra *x,
                           cf_cell_state *s, double kT[CF_CELL_DIRS], cf_error *err)
 {
-    const cf_law *law = c->law;
-    const double H = law->p.H_mm, H3 = H * H * H;
+    const double H = c->law->p.H_mm, H3 = H * H * H;
     double P[3][3] = {{0}}; /* summed here, not through s (no store and reload per term) */
+    double L2[CF_CELL_DIRS], q[CF_CELL_DIRS], umax = 0, r;
     memset(s->P_MPa, 0, sizeof s->P_MPa);
     memcpy(s->F, F, sizeof s->F);
     s->max_u_over_travel = 0;
@@ -93,44 +152,30 @@ static cf_status evaluate(const cf_cell *c, const double F[9], const cf_cell_ext
             return cf_error_set(err, CF_E_DATA, "deformation gradient F[%d][%d] = %g is not "
                                 "finite", i / 3, i % 3, F[i]);
     for (int d = 0; d < CF_CELL_DIRS; d++) {
-        int N[3], fam;
-        cf_cell_direction(d, N, &fam);
+        const int *N = dirs[d];
         double X[3] = {H * N[0], H * N[1], H * N[2]}, xv[3];
         for (int i = 0; i < 3; i++)
             xv[i] = F[3 * i] * X[0] + F[3 * i + 1] * X[1] + F[3 * i + 2] * X[2];
-        double L = sqrt(xv[0] * xv[0] + xv[1] * xv[1] + xv[2] * xv[2]);
-        double L0 = H * sqrt((double)(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]));
-        double u = H * (L0 - L) / L0;
-        double r = fabs(u) / law->travel_mm;
-        s->max_u_over_travel = fmax(s->max_u_over_travel, r);
-        if (!(r < SOLID_MARGIN) || !(L > 0))
-            return cf_error_set(err, CF_E_DATA,
-                                "the cell's spring along (%d, %d, %d) reaches solid (stretch %.6g, "
-                                "solid at %.6g)",
-                                N[0], N[1], N[2], L / L0, 1 - copysign(law->travel_mm / H, u));
-        double k = 0;
-        double f = cf_law_force(law, c->method, u, &k, NULL);
-        double w = c->weight[fam] * c->law_scale, T, dT;
-        if (c->law_scale_strain != 0) { /* factor law_scale + law_scale_strain |u| / H */
-            const double phi = c->law_scale + c->law_scale_strain * fabs(u) / H;
-            const double dphi = c->law_scale_strain * copysign(1.0, u) / H; /* d phi / du */
-            T = -c->weight[fam] * phi * f;
-            dT = c->weight[fam] * (phi * k + dphi * f) * H / L0;
+        L2[d] = xv[0] * xv[0] + xv[1] * xv[1] + xv[2] * xv[2];
+        int e = 0;
+        while (e < d && !same_spring(x, L2, d, e))
+            e++;
+        if (e < d) { /* the same spring state as e: its results, bit for bit */
+            s->L_mm[d] = s->L_mm[e];
+            s->T_N[d] = s->T_N[e];
+            kT[d] = kT[e];
+            q[d] = q[e];
         } else {
-            T = -w * f;
-            dT = w * k * H / L0;
+            cf_status st = spring_tension(c, d, sqrt(L2[d]), x, s, kT, &r, err);
+            umax = r > umax ? r : umax; /* as fmax: a NaN r leaves it */
+            s->max_u_over_travel = umax;
+            if (st != CF_OK)
+                return st;
+            q[d] = s->T_N[d] / (s->L_mm[d] * H3); /* one division per spring, not per term */
         }
-        if (x) {
-            T += x->T0_N[d] + x->k_N_per_mm[d] * (L - x->Lref_mm[d]);
-            dT += x->k_N_per_mm[d];
-        }
-        s->L_mm[d] = L;
-        s->T_N[d] = T;
-        kT[d] = dT;
-        const double q = T / (L * H3); /* one division per spring, not one per term */
         for (int i = 0; i < 3; i++)
             for (int j = 0; j < 3; j++)
-                P[i][j] += q * xv[i] * X[j];
+                P[i][j] += q[d] * xv[i] * X[j];
     }
     memcpy(s->P_MPa, P, sizeof P);
     return CF_OK;
@@ -182,8 +227,7 @@ static double tangent(const cf_cell *c, const cf_cell_state *s, const double kT[
     const double H = c->law->p.H_mm, H3 = H * H * H;
     double g = 0;
     for (int d = 0; d < CF_CELL_DIRS; d++) {
-        int N[3], fam;
-        cf_cell_direction(d, N, &fam);
+        const int *N = dirs[d];
         double X[3] = {H * N[0], H * N[1], H * N[2]}, xv[3];
         for (int i = 0; i < 3; i++)
             xv[i] = s->F[3 * i] * X[0] + s->F[3 * i + 1] * X[1] + s->F[3 * i + 2] * X[2];

@@ -129,6 +129,33 @@ static void assert_simulate_reproduces(const char *fit, int cells)
     rmdir(dir);
 }
 
+/* --max-evaluations: a bound the fit reaches is warned about and the best model so far written;
+** one it does not reach says nothing; a bound that is no count is a usage error. */
+static void test_cli_evaluation_bound(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-visco-XXXXXX", fit[256], so[8192], se[4096];
+    assert_non_null(mkdtemp(dir));
+    snprintf(fit, sizeof fit, "%s/fit.json", dir);
+    static const char series[] = "data/series/synthetic_relaxation.csv";
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se,
+                            "fit %s --branches 1 --relaxation qlv --max-evaluations 10 -o %s",
+                            series, fit),
+                     0);
+    assert_non_null(strstr(se, "warning"));
+    assert_non_null(strstr(se, "--max-evaluations"));
+    assert_int_equal(access(fit, F_OK), 0);
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se,
+                            "fit %s --branches 1 --relaxation qlv -o %s", series, fit),
+                     0);
+    assert_null(strstr(se, "--max-evaluations"));
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se,
+                            "fit %s --max-evaluations 0 -o %s", series, fit),
+                     2);
+    unlink(fit);
+    rmdir(dir);
+}
+
 static void test_simulate_reproduces_fit(void **state)
 {
     (void)state;
@@ -424,6 +451,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cli_series_errors),
+        cmocka_unit_test(test_cli_evaluation_bound),
         cmocka_unit_test(test_simulate_reproduces_fit),
         cmocka_unit_test(test_shipped_muscle_fits),
         cmocka_unit_test(test_strain_relaxation_fibre_table),

@@ -200,6 +200,68 @@ static void extra_tensions_act_as_spring_forces(void **state)
     assert_close(s1.stress_MPa - s0.stress_MPa, 0.02 * e * H / (H * H), 1e-15);
 }
 
+/* The stress of the cell at F as the sum over every spring, each evaluated on its own (no
+** sharing between springs in the same state), with the extra terms x (may be NULL). */
+static void stress_spring_by_spring(const cf_cell *c, const double F[9], const cf_cell_extra *x,
+                                    double P[9])
+{
+    const double H = c->law->p.H_mm;
+    memset(P, 0, 9 * sizeof(double));
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        int N[3], fam;
+        cf_cell_direction(d, N, &fam);
+        double X[3] = {H * N[0], H * N[1], H * N[2]}, xv[3];
+        for (int i = 0; i < 3; i++)
+            xv[i] = F[3 * i] * X[0] + F[3 * i + 1] * X[1] + F[3 * i + 2] * X[2];
+        const double L = sqrt(xv[0] * xv[0] + xv[1] * xv[1] + xv[2] * xv[2]);
+        const double L0 = H * sqrt((double)(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]));
+        double T = -c->weight[fam] * c->law_scale *
+                   cf_law_force(c->law, c->method, H * (L0 - L) / L0, NULL, NULL);
+        if (x)
+            T += x->T0_N[d] + x->k_N_per_mm[d] * (L - x->Lref_mm[d]);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                P[3 * i + j] += T / L * xv[i] * X[j] / (H * H * H);
+    }
+}
+
+/* Springs the deformation maps alike share one evaluation of the law: the stress is still that
+** of every spring evaluated on its own, under uniaxial and equibiaxial loading (many springs
+** alike), a general F (none alike), and extra terms that split springs of one length apart. */
+static void springs_in_one_state_share_their_evaluation(void **state)
+{
+    (void)state;
+    cf_law law = law_of(0);
+    const double H = law.p.H_mm;
+    cf_cell c = iso_cell(&law, CF_LAW_CLOSED);
+    const double Fs[3][9] = {{0.97, 0, 0, 0, 0.97, 0, 0, 0, 1.08},
+                             {1.05, 0, 0, 0, 1.05, 0, 0, 0, 0.93},
+                             {1.02, 0.03, -0.01, 0.02, 0.96, 0.04, 0.01, -0.02, 1.07}};
+    cf_cell_extra x;
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        x.Lref_mm[d] = H;
+        x.k_N_per_mm[d] = 0.01;
+        x.T0_N[d] = d == 0 ? 0.02 : 0.005; /* the x edge apart from the y edge */
+    }
+    for (int f = 0; f < 3; f++)
+        for (int with = 0; with < 2; with++) {
+            cf_cell_state s;
+            double P[9];
+            assert_int_equal(cf_cell_stress(&c, Fs[f], with ? &x : NULL, &s, NULL), CF_OK);
+            stress_spring_by_spring(&c, Fs[f], with ? &x : NULL, P);
+            double big = 0;
+            for (int i = 0; i < 9; i++)
+                big = fmax(big, fabs(P[i]));
+            assert_true(big > 0);
+            for (int i = 0; i < 9; i++)
+                assert_close(s.P_MPa[i / 3][i % 3], P[i], 1e-12 * big);
+        }
+    /* in uniaxial tension the x edge carries the extra tension the y edge does not */
+    cf_cell_state s;
+    assert_int_equal(cf_cell_stress(&c, Fs[0], &x, &s, NULL), CF_OK);
+    assert_true(s.T_N[0] != s.T_N[2]);
+}
+
 static void bad_input_is_refused(void **state)
 {
     (void)state;
@@ -283,6 +345,7 @@ int main(void)
         cmocka_unit_test(uniaxial_curve_is_monotonic_with_zero_lateral_stress),
         cmocka_unit_test(stress_is_frame_indifferent),
         cmocka_unit_test(extra_tensions_act_as_spring_forces),
+        cmocka_unit_test(springs_in_one_state_share_their_evaluation),
         cmocka_unit_test(bad_input_is_refused),
         cmocka_unit_test(first_spring_at_solid_in_each_mode),
         cmocka_unit_test(shear_takes_either_sign_past_one),

@@ -28,6 +28,22 @@ static void synth_series(const cf_visco_params *p, const cf_visco_setup *s, doub
     assert_int_equal(cf_visco_curve(p, s, &ser, y, NULL, &err), CF_OK);
 }
 
+/* The series of p (synth_series) with Gaussian noise of 0.5 % of the largest stress on every
+** point after the first (seed). */
+static void noisy_series(const cf_visco_params *p, const cf_visco_fit_options *o, double *t,
+                         double *x, double *y, unsigned long seed)
+{
+    synth_series(p, &o->setup, t, x, y);
+    double ymax = 0;
+    for (int k = 0; k < NS; k++)
+        ymax = fmax(ymax, fabs(y[k]));
+    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(r, seed);
+    for (int k = 1; k < NS; k++)
+        y[k] += gsl_ran_gaussian(r, 0.005 * ymax);
+    gsl_rng_free(r);
+}
+
 static void assert_recovered(const cf_visco_fit *f, const cf_visco_params *p, double tol)
 {
     assert_close(f->p.ident.rho, p->ident.rho, tol * p->ident.rho);
@@ -70,23 +86,84 @@ static void assert_within_stderr(const cf_visco_fit *f, const cf_visco_params *p
 }
 
 /* A series made by the model from known terms is fitted back to 1e-6. */
+/* The noiseless series of the known terms fitted with two terms and options o. */
+static void fit_known_noiseless(const cf_visco_fit_options *o, cf_visco_fit *f)
+{
+    cf_visco_params p = known();
+    double t[NS], x[NS], y[NS];
+    synth_series(&p, &o->setup, t, x, y);
+    cf_error err = {0};
+    cf_visco_fit_options o2 = *o;
+    o2.nbranch = 2;
+    cf_visco_data d = {NS, t, x, y, NULL};
+    if (cf_visco_fit_run(&d, &o2, f, &err) != CF_OK)
+        fail_msg("the fit of the known terms failed: %s", err.msg);
+}
+
 static void test_recover_noiseless(void **state)
 {
     (void)state;
     cf_visco_params p = known();
     cf_visco_fit_options o = cf_visco_fit_default_options();
-    double t[NS], x[NS], y[NS];
-    synth_series(&p, &o.setup, t, x, y);
-    cf_error err = {0};
-    o.nbranch = 2;
-    cf_visco_data d = {NS, t, x, y, NULL};
     cf_visco_fit f;
-    assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_OK);
+    fit_known_noiseless(&o, &f);
     assert_recovered(&f, &p, 1e-6);
     assert_true(f.rmse < 1e-9 * p.ident.scale);
     assert_int_equal(f.n_ramp, 16);
     assert_int_equal(f.n_hold, NS - 16);
     cf_visco_fit_free(&f);
+}
+
+/* A bound on the model runs stops the fit after its first start with the best model so far and
+** says so; without the bound the same fit runs every start and does not. */
+static void test_evaluation_bound(void **state)
+{
+    (void)state;
+    cf_visco_params p = known();
+    cf_visco_fit_options o = cf_visco_fit_default_options();
+    cf_visco_fit all, bounded;
+    fit_known_noiseless(&o, &all);
+    assert_int_equal(all.evaluation_bound_reached, 0);
+    o.max_evaluations = 50; /* fewer than the stand-in's grid: one start is fitted */
+    fit_known_noiseless(&o, &bounded);
+    assert_int_equal(bounded.evaluation_bound_reached, 1);
+    assert_true(bounded.evaluations < all.evaluations);
+    assert_int_equal(bounded.p.nbranch, 2);
+    assert_true(isfinite(bounded.rmse) && bounded.rmse < 1e-3 * p.ident.scale);
+    cf_visco_fit_free(&all);
+    cf_visco_fit_free(&bounded);
+}
+
+/* The Jacobian carried by Broyden's update between differences (the default) and the one by
+** differences at every step reach the same fit of a noisy series: every quantity within a
+** tenth of its standard error, for fewer model runs. */
+static void test_updated_jacobian_matches_full(void **state)
+{
+    (void)state;
+    cf_visco_params p = known();
+    cf_visco_fit_options o = cf_visco_fit_default_options();
+    double t[NS], x[NS], y[NS];
+    noisy_series(&p, &o, t, x, y, 3);
+    o.nbranch = 2;
+    cf_visco_data d = {NS, t, x, y, NULL};
+    cf_visco_fit fast, full;
+    cf_error err = {0};
+    assert_int_equal(cf_visco_fit_run(&d, &o, &fast, &err), CF_OK);
+    o.full_jacobian = 1;
+    assert_int_equal(cf_visco_fit_run(&d, &o, &full, &err), CF_OK);
+    assert_true(fast.evaluations < full.evaluations);
+    assert_int_equal(fast.p.nbranch, full.p.nbranch);
+    for (int i = 0; i < 3; i++)
+        if (full.ident_se.v[i] > 0)
+            assert_close(fast.p.ident.v[i], full.p.ident.v[i], 0.1 * full.ident_se.v[i]);
+    for (int i = 0; i < full.p.nbranch; i++) {
+        assert_true(full.se_g[i] > 0 && full.se_tau_s[i] > 0);
+        assert_close(fast.p.g[i], full.p.g[i], 0.1 * full.se_g[i]);
+        assert_close(fast.p.tau_s[i], full.p.tau_s[i], 0.1 * full.se_tau_s[i]);
+    }
+    assert_close(fast.rmse, full.rmse, 1e-6 * full.rmse);
+    cf_visco_fit_free(&fast);
+    cf_visco_fit_free(&full);
 }
 
 /* With 0.5 % noise the terms are found within twice their reported standard errors. */
@@ -96,16 +173,8 @@ static void test_recover_with_noise(void **state)
     cf_visco_params p = known();
     cf_visco_fit_options o = cf_visco_fit_default_options();
     double t[NS], x[NS], y[NS];
-    synth_series(&p, &o.setup, t, x, y);
     cf_error err = {0};
-    double ymax = 0;
-    for (int k = 0; k < NS; k++)
-        ymax = fmax(ymax, fabs(y[k]));
-    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
-    gsl_rng_set(r, 1);
-    for (int k = 1; k < NS; k++)
-        y[k] += gsl_ran_gaussian(r, 0.005 * ymax);
-    gsl_rng_free(r);
+    noisy_series(&p, &o, t, x, y, 1);
     o.nbranch = 2;
     cf_visco_data d = {NS, t, x, y, NULL};
     cf_visco_fit f;
@@ -463,6 +532,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_recover_noiseless),
         cmocka_unit_test(test_recover_with_noise),
+        cmocka_unit_test(test_evaluation_bound),
+        cmocka_unit_test(test_updated_jacobian_matches_full),
         cmocka_unit_test(test_strain_relaxation_recovered),
         cmocka_unit_test(test_series_refused),
         cmocka_unit_test(test_held_elastic),

@@ -32,6 +32,9 @@
 
 /* Branch counts tried when the choice is left to AIC. */
 #define CF_VISCO_AIC_MAX 4
+/* The default bound on the model runs of one fit (cf_visco_fit_options.max_evaluations): well
+** above what the default choice takes on the published series. */
+#define CF_VISCO_EVAL_MAX 200000L
 
 /* How the relative moduli may depend on strain (viscomodel.h k). */
 typedef enum cf_visco_relaxation {
@@ -64,6 +67,15 @@ typedef struct cf_visco_fit_options {
     ** there. */
     int stable_cells;
     cf_visco_setup setup;   /* where the model is evaluated */
+    /* Bound on the model runs (0: CF_VISCO_EVAL_MAX). Once reached, no further start or
+    ** candidate is fitted: the best model so far is kept and evaluation_bound_reached set. A
+    ** search under way finishes first, so the count may pass the bound by one start's runs. */
+    long max_evaluations;
+    /* 1: the Levenberg-Marquardt's Jacobian by forward differences at every step (one model run
+    ** per parameter each). 0 (the default): by differences every few steps and after a refused
+    ** trial, carried by Broyden's update in between; the same optimum for a fraction of the
+    ** model runs. */
+    int full_jacobian;
 } cf_visco_fit_options;
 
 cf_visco_fit_options cf_visco_fit_default_options(void);
@@ -167,6 +179,9 @@ typedef struct cf_visco_fit {
     unsigned char *is_hold;             /* 1 for a point of a hold (owned) */
     cf_visco_predict pred;
     long evaluations;                   /* model curves computed */
+    int evaluation_bound_reached;       /* 1 when the fit stopped at its bound on model runs
+                                           (options.max_evaluations) with candidates or starts
+                                           left unfitted */
     double wall_time_s;
 } cf_visco_fit;
 
