@@ -305,7 +305,7 @@ static int resolved(double v, double se)
 ** relative modulus at the largest strain (g_i + k_i x_max), each fitted k_i (its size) and the
 ** dashpot is larger than its standard error. A term the series cannot pin down (tau_i -> 0 or
 ** far past the series, a g_i of 0 with its tau_i free, two terms trading one for the other)
-** fails it; AIC assumes a regular model and would reward such a fit's extra parameters. The
+** fails it, as does a strain term whose modulus at zero strain sits on its floor; AIC assumes a regular model and would reward such a fit's extra parameters. The
 ** errors are computed at s2 = 1 and scaled, so that a noiseless series (s2 -> 0) passes.
 ** *loose gets the terms whose k_i is fitted but not larger than its error. */
 /* The fitted elastic quantities (rho, s/H, F_C/H^2) whose standard error (se at s2 = 1, times s)
@@ -345,6 +345,11 @@ static int prony_identified(ctx *c, const cf_visco_params *p, double s2, unsigne
             ok = 0;
             *loose |= 1u << i;
         }
+        /* a modulus at zero strain held at its floor (its log-share at A_LO): the optimum is on
+        ** a bound, where the linearised errors say nothing (they swing with the last digits of
+        ** the search) and AIC's regular-model premise fails */
+        if (cf_viscofit_strain_term(c, i) && p->g[i] <= 2 * exp(A_LO))
+            ok = 0;
     }
     return ok;
 }
