@@ -23,7 +23,7 @@ cf_visco_fit_options cf_visco_fit_default_options(void)
     memset(&o, 0, sizeof o);
     o.setup = cf_visco_default();
     /* the axial calibration: its diagonals carry as much as its edges, which keeps the lattice
-    ** stable further in compression than the isotropic one (README) */
+    ** stable further in compression than the isotropic one (src/notes/time-series.md) */
     o.setup.cfg.lattice.calibration = CF_CAL_AXIAL;
     cf_calibration_weights(CF_CAL_AXIAL, o.setup.cfg.lattice.weight, NULL);
     o.rho_min = CF_FIT_RHO_MIN_DEFAULT;

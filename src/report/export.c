@@ -37,7 +37,7 @@ static int strain_moduli(const cf_fitted_spring *fs)
 }
 
 /* The Prony terms and dashpot of a viscoelastic fit, as comment lines: the time-dependent part of
-** the tissue that the simulator formats' spring elements have no place for (README, export). */
+** the tissue that the simulator formats' spring elements have no place for (src/notes/export.md). */
 static void prony_comment(FILE *out, const char *lead, const char *tail,
                           const cf_fitted_spring *fs, const char *why)
 {
