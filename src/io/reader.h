@@ -66,7 +66,8 @@ cf_status cf_header_read(reader *r, layout *h, cf_error *err);
 int cf_units_row_is(reader *r, size_t i, size_t n, char delim);
 
 /* The units row directly under the header, when there is one (h->units_line): each unit is taken
-** for its column when the header names none (cf_column.unit_from_row); CF_E_DATA naming the line
+** for its column when the header names none, or only a bracketed word that is no unit
+** ("Tensile strain (Extension)") (cf_column.unit_from_row); CF_E_DATA naming the line
 ** and column for a unit that contradicts the header's or that conifit does not know in a column
 ** the table reads. Runs after the columns are chosen. */
 cf_status cf_units_row_read(reader *r, layout *h, cf_error *err);

@@ -62,22 +62,24 @@ static cf_status take_unit(reader *r, const layout *h, size_t i, const char *u, 
 {
     cf_column *c = &r->cols[i];
     const cf_unit_def *d = cf_unit_find(u);
-    if (!d) {
-        if (!column_read(h, i))
-            return CF_OK; /* a column the table does not read may have any unit */
+    /* a bracket in the header that is no unit qualifies the name, as Instron's "Tensile strain
+    ** (Extension)" does: the units row gives the unit */
+    int header_unit = c->unit[0] && (cf_unit_find(c->unit) || cf_unit_m_case(c->unit));
+    if (!column_read(h, i) && (!d || header_unit))
+        return CF_OK; /* a column the table does not read may say anything */
+    if (header_unit) {
+        const cf_unit_def *hd = cf_unit_find(c->unit);
+        if (!hd || (d && hd->cls == d->cls && hd->to_conifit == d->to_conifit))
+            return CF_OK; /* the same unit, or a header unit the reader refuses later */
+        return cf_csv_error(err, r->path, h->units_line, i + 1,
+                            "units row: column '%s' has unit '%s', but its header (line %zu) "
+                            "says '%s'; correct one of them ('%s')",
+                            c->name, u, h->header_line, c->unit, q);
+    }
+    if (!d)
         return cf_csv_error(err, r->path, h->units_line, i + 1,
                             "units row: column '%s' has unit '%s', which is not one conifit "
                             "knows (%s) ('%s')", c->name, u, cf_unit_list, q);
-    }
-    if (c->unit[0]) {
-        const cf_unit_def *hd = cf_unit_find(c->unit);
-        if (hd && (hd->cls != d->cls || hd->to_conifit != d->to_conifit))
-            return cf_csv_error(err, r->path, h->units_line, i + 1,
-                                "units row: column '%s' has unit '%s', but its header (line "
-                                "%zu) says '%s'; correct one of them ('%s')",
-                                c->name, u, h->header_line, c->unit, q);
-        return CF_OK;
-    }
     snprintf(c->unit, sizeof c->unit, "%s", u);
     c->unit_from_row = 1;
     return CF_OK;
