@@ -620,8 +620,9 @@ static void note_unit_case(cf_table *m, const cf_column *c, size_t units_line)
 ** largest (a measured zero carries noise). */
 #define STRETCH_LIKE_REST 0.01
 
-/* The notes of a table (table.h): a skipped preamble, units read in another case, and a strain
-** column whose values look like stretch (unless an option said what the column holds). */
+/* The notes of a table (table.h): a skipped preamble, units taken from the units row or read in
+** another case (x, y and the time), and a strain column whose values look like stretch (unless
+** an option said what the column holds). */
 static void table_notes(const layout *h, const reader *r, cf_table *m)
 {
     if (h->preamble)
@@ -629,6 +630,8 @@ static void table_notes(const layout *h, const reader *r, cf_table *m)
                  h->header_line - 1, h->header_line);
     note_unit_case(m, &r->cols[h->xi], h->units_line);
     note_unit_case(m, &r->cols[h->yi], h->units_line);
+    if (h->ti >= 0)
+        note_unit_case(m, &r->cols[h->ti], h->units_line);
     if (m->kind != CF_TABLE_STRESS_STRAIN || m->measures.strain != CF_STRAIN_ENGINEERING ||
         m->measures.strain_from == CF_DECL_OPTION || m->count == 0)
         return;
