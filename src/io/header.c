@@ -54,10 +54,9 @@ static int rows_follow(reader *r, size_t i, size_t n)
         return 0;
     size_t k = i + 1, kn = 0, empty = 0;
     int numbers = 0;
-    if ((k = next_content(r, k, &kn)) < r->nlines && cf_units_row_is(r, k, kn, delim))
-        k++; /* a units row under the header */
-    else
-        k = i + 1;
+    size_t under = next_content(r, k, &kn);
+    if (under < r->nlines && cf_units_row_is(r, under, kn, delim))
+        k = under + 1; /* the rows start after a units row */
     /* rows of empty cells are skipped, as the reader skips them, but no more than a preamble's
     ** worth, so that searching a preamble stays linear in the file */
     while ((k = next_content(r, k, &kn)) < r->nlines &&

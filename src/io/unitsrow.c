@@ -8,22 +8,19 @@
 #include <stdio.h>
 #include <string.h>
 
-/* The unit a units-row cell spells, without its brackets and blanks, into out. */
-static void cell_unit(const char *cell, char *out, size_t cap)
-{
-    size_t n = strlen(cell);
-    if (n >= 2 && ((cell[0] == '(' && cell[n - 1] == ')') ||
-                   (cell[0] == '[' && cell[n - 1] == ']')))
-        cf_csv_trim_copy(out, cap, cell + 1, n - 2);
-    else
-        cf_csv_trim_copy(out, cap, cell, n);
-}
-
+/* 1 when a cell is in parentheses or brackets: "(s)", "[mm]". */
 static int bracketed(const char *cell)
 {
     size_t n = strlen(cell);
     return n >= 2 && ((cell[0] == '(' && cell[n - 1] == ')') ||
                       (cell[0] == '[' && cell[n - 1] == ']'));
+}
+
+/* The unit a units-row cell spells, without its brackets and blanks, into out. */
+static void cell_unit(const char *cell, char *out, size_t cap)
+{
+    int b = bracketed(cell);
+    cf_csv_trim_copy(out, cap, cell + b, strlen(cell) - 2 * (size_t)b);
 }
 
 int cf_units_row_is(reader *r, size_t i, size_t n, char delim)
