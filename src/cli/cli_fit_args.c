@@ -88,9 +88,12 @@ static const char fit_help_series[] =
     "The fitted spring stays within the design limits (--rho-min, --index-max, ...) and its\n"
     "lattice stable up to the series' largest strain (a held --elastic spring whose lattice\n"
     "would buckle within the series is refused).\n\n"
-    "Tables: a header row naming the columns, units in the names (stress_kPa, stress [kPa]),\n"
-    "'#' comments, ',' ';' TAB or blank-separated columns, an optional weight column. Tension\n"
-    "positive. A spreadsheet (.xlsx, .ods) must be saved as CSV first.\n";
+    "Tables: a header row naming the columns, units in the names (stress_kPa, stress [kPa])\n"
+    "or in a units row under the header ((s),(mm),(N) as testing machines write it), '#'\n"
+    "comments, ',' ';' TAB or blank-separated columns, an optional weight column. Tension\n"
+    "positive. A spreadsheet (.xlsx, .ods) must be saved as CSV first. What the reader noticed\n"
+    "(a skipped preamble, units from a units row, ...) is warned and kept in the report and in\n"
+    "the fit file (data.notes).\n";
 
 static int ends_with_json(const char *s)
 {

@@ -39,6 +39,7 @@ static const cf_unit_def units[] = {
     {"\xc2\xb5m", CF_UNIT_LENGTH, 1e-3, "um"},
     {"\xce\xbcm", CF_UNIT_LENGTH, 1e-3, "um"},
     {"s", CF_UNIT_TIME, 1.0, "s"},
+    {"sec", CF_UNIT_TIME, 1.0, "s"},
     {"ms", CF_UNIT_TIME, 1e-3, "ms"},
     {"min", CF_UNIT_TIME, 60.0, "min"},
     {"h", CF_UNIT_TIME, 3600.0, "h"},
@@ -102,7 +103,7 @@ cf_unit_class cf_measure_unit(const char *name, double *to_conifit)
 
 const char cf_unit_list[] =
     "stress: Pa kPa MPa GPa N/mm2 N/m2 mmHg; force: N mN kN uN; length: m cm mm um; "
-    "time: s ms min h; strain: - mm/mm in/in m/m % percent";
+    "time: s sec ms min h; strain: - mm/mm in/in m/m % percent";
 
 /* ---- column names ------------------------------------------------------------------------- */
 

@@ -28,7 +28,8 @@ typedef struct cf_unit_def {
 typedef struct cf_column {
     char name[CF_COLUMN_NAME_CAP]; /* as in the header */
     char base[CF_COLUMN_NAME_CAP]; /* without the unit decoration */
-    char unit[CF_COLUMN_NAME_CAP]; /* the decoration ("" when none) */
+    char unit[CF_COLUMN_NAME_CAP]; /* the decoration ("" when none), or the units row's */
+    int unit_from_row;             /* 1 when unit came from the units row under the header */
 } cf_column;
 
 /* The unit spelled name, or NULL: letter case is ignored except for a leading m or M (milli or

@@ -54,6 +54,9 @@ static int rows_follow(reader *r, size_t i, size_t n)
         return 0;
     size_t k = i + 1, kn = 0, empty = 0;
     int numbers = 0;
+    size_t under = next_content(r, k, &kn);
+    if (under < r->nlines && cf_units_row_is(r, under, kn, delim))
+        k = under + 1; /* the rows start after a units row */
     /* rows of empty cells are skipped, as the reader skips them, but no more than a preamble's
     ** worth, so that searching a preamble stays linear in the file */
     while ((k = next_content(r, k, &kn)) < r->nlines &&

@@ -550,7 +550,7 @@ static cf_status read_rows(reader *r, const layout *h, const scaling *u, cf_erro
         if (cf_csv_is_comment(l))
             continue;
         size_t n = cf_csv_content_length(l->s, l->n);
-        if (n == 0)
+        if (n == 0 || l->line == h->units_line)
             continue;
         int skip = 0;
         cf_status st = read_row(r, l, n, h, u, &tprev, &skip, err);
@@ -601,11 +601,15 @@ static void add_note(cf_table *m, const char *fmt, ...)
     va_end(ap);
 }
 
-/* A unit decoration that was read in another letter case ("Mpa" as MPa) is said. */
-static void note_unit_case(cf_table *m, const cf_column *c)
+/* A unit taken from the units row, or a unit decoration read in another letter case ("Mpa" as
+** MPa), is said. */
+static void note_unit_case(cf_table *m, const cf_column *c, size_t units_line)
 {
     const cf_unit_def *d = c->unit[0] ? cf_unit_find(c->unit) : NULL;
-    if (d && strcmp(d->name, c->unit) != 0)
+    if (d && c->unit_from_row)
+        add_note(m, "column '%s': unit '%s' read from the units row under the header (line %zu)",
+                 c->name, c->unit, units_line);
+    else if (d && strcmp(d->name, c->unit) != 0)
         add_note(m, "column '%s': unit '%s' read as %s", c->name, c->unit, d->canon);
 }
 
@@ -616,15 +620,18 @@ static void note_unit_case(cf_table *m, const cf_column *c)
 ** largest (a measured zero carries noise). */
 #define STRETCH_LIKE_REST 0.01
 
-/* The notes of a table (table.h): a skipped preamble, units read in another case, and a strain
-** column whose values look like stretch (unless an option said what the column holds). */
+/* The notes of a table (table.h): a skipped preamble, units taken from the units row or read in
+** another case (x, y and the time), and a strain column whose values look like stretch (unless
+** an option said what the column holds). */
 static void table_notes(const layout *h, const reader *r, cf_table *m)
 {
     if (h->preamble)
         add_note(m, "lines 1 to %zu before the header row (line %zu) were skipped as a preamble",
                  h->header_line - 1, h->header_line);
-    note_unit_case(m, &r->cols[h->xi]);
-    note_unit_case(m, &r->cols[h->yi]);
+    note_unit_case(m, &r->cols[h->xi], h->units_line);
+    note_unit_case(m, &r->cols[h->yi], h->units_line);
+    if (h->ti >= 0)
+        note_unit_case(m, &r->cols[h->ti], h->units_line);
     if (m->kind != CF_TABLE_STRESS_STRAIN || m->measures.strain != CF_STRAIN_ENGINEERING ||
         m->measures.strain_from == CF_DECL_OPTION || m->count == 0)
         return;
@@ -696,6 +703,7 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
         (st = cf_header_find(&r, &opt, &h, err)) != CF_OK ||
         (st = check_text(&r, &h, err)) != CF_OK || (st = cf_header_read(&r, &h, err)) != CF_OK ||
         (st = cf_header_choose_columns(&r, &opt, &h, err)) != CF_OK ||
+        (st = cf_units_row_read(&r, &h, err)) != CF_OK ||
         (st = decide_units(&r, &opt, &h, m, &u, err)) != CF_OK ||
         (st = read_rows(&r, &h, &u, err)) != CF_OK ||
         (st = decide_mode(&r, &opt, m, err)) != CF_OK) {

@@ -40,6 +40,7 @@ typedef struct layout {
     int preamble;          /* 1: lines before the header row (a preamble) were skipped */
     size_t no_header_at;   /* a preamble without a header: the line that should name the columns */
     size_t numbers_at;     /* and the first row of numbers after it */
+    size_t units_line;     /* line number of the units row under the header; 0 when none */
 } layout;
 
 /* CF_E_INTERNAL: memory ran out reading the table at path. */
@@ -58,6 +59,18 @@ cf_status cf_header_find(reader *r, const cf_measure_options *opt, layout *h, cf
 /* The header's delimiter and column names (r->cols, h->ncols); CF_E_DATA for a header of one
 ** column, an unnamed or overlong column, or a row of numbers. */
 cf_status cf_header_read(reader *r, layout *h, cf_error *err);
+
+/* 1 when line i (n bytes of content) split at delim is a units row: no cell a number, and every
+** filled cell in brackets ("(s)", "[mm]") or one of them a known unit ("sec,mm,N"). Splits into
+** r->f. */
+int cf_units_row_is(reader *r, size_t i, size_t n, char delim);
+
+/* The units row directly under the header, when there is one (h->units_line): each unit is taken
+** for its column when the header names none, or only a bracketed word that is no unit
+** ("Tensile strain (Extension)") (cf_column.unit_from_row); CF_E_DATA naming the line
+** and column for a unit that contradicts the header's or that conifit does not know in a column
+** the table reads. Runs after the columns are chosen. */
+cf_status cf_units_row_read(reader *r, layout *h, cf_error *err);
 
 /* Which columns are x, y, the weight and the time: the options name x and y, else the names
 ** tell. */

@@ -15,6 +15,7 @@
 #include "io/fitfile_json.h"
 #include "report/gnuplot.h"
 #include "report/report_json.h"
+#include "report/report_notes.h"
 #include "report/report_words.h"
 
 int cf_joint_better(const cf_joint_report *r)
@@ -38,6 +39,11 @@ char *cf_joint_text(const cf_joint_report *r)
     if (!o)
         return NULL;
     fprintf(o, "Joint fit through the lattice of %zu tables (%s)\n", r->ntables, weighting_text);
+    for (size_t k = 0; k < r->ntables; k++)
+        if (r->tables[k]->notes[0]) {
+            fprintf(o, " %s:\n", r->tables[k]->path);
+            cf_report_notes_text(o, r->tables[k], "  ");
+        }
     for (int i = 0; i < r->nfits; i++) {
         const cf_joint_result *j = &r->fits[i];
         const cf_spring *p = &j->fit.params;
@@ -170,11 +176,12 @@ static json_t *joint_json(const cf_joint_report *r)
         const cf_table *t = r->tables[k];
         const cf_joint_table *jt = &r->fits[b].tab[k];
         double u = t->y_to_file;
-        json_array_append_new(tabs, json_pack("{s:s, s:s, s:I, s:s, s:o, s:o}", "file", t->path,
-                                              "mode", cf_mode_name(jt->mode), "points",
-                                              (json_int_t)jt->points, "unit", t->y_unit, "rmse",
-                                              num(jt->cell_rmse * u), "lattice_rmse",
-                                              num(jt->lattice_rmse * u)));
+        json_t *e = json_pack("{s:s, s:s, s:I, s:s, s:o, s:o}", "file", t->path, "mode",
+                              cf_mode_name(jt->mode), "points", (json_int_t)jt->points, "unit",
+                              t->y_unit, "rmse", num(jt->cell_rmse * u), "lattice_rmse",
+                              num(jt->lattice_rmse * u));
+        cf_report_notes_json(e, t);
+        json_array_append_new(tabs, e);
     }
     json_object_set_new(root, "tables", tabs);
     return root;

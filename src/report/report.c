@@ -14,6 +14,7 @@
 #include "base/atomic.h"
 #include "io/fitfile_json.h"
 #include "report/report_json.h"
+#include "report/report_notes.h"
 #include "report/report_words.h"
 
 void cf_report_free(cf_fit_report *r)
@@ -338,6 +339,7 @@ static json_t *report_json(const cf_fit_report *r)
     if (!cf_table_is_force(r->table))
         json_object_set_new(data, "measures", measures_json(r->table));
     mode_dropped_json(data, r->table);
+    cf_report_notes_json(data, r->table);
     json_t *fits = json_array(), *base = json_array();
     for (int i = 0; i < r->nfits; i++)
         json_array_append_new(fits, fit_json(r, i));

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "report/report_notes.h"
 #include "report/report_words.h"
 
 static void row(FILE *o, const cf_fit_report *r, const char *label, const char *fmt, int which)
@@ -243,6 +244,7 @@ static void table_text(FILE *o, const cf_fit_report *r)
             r->table->compression ? "compression negative" : "tension positive");
     if (cf_table_is_force(r->table)) {
         mode_dropped_text(o, r->table);
+        cf_report_notes_text(o, r->table, " ");
         return;
     }
     const cf_table_measures *m = &r->table->measures;
@@ -255,6 +257,7 @@ static void table_text(FILE *o, const cf_fit_report *r)
             cf_mode_name(r->table->mode), src[2]);
     if (*conv)
         fprintf(o, " fitted as engineering strain and nominal stress: %s\n", conv);
+    cf_report_notes_text(o, r->table, " ");
     fputc('\n', o);
 }
 

@@ -2,6 +2,7 @@
 ** Report, fit file and plot of a viscoelastic fit (see viscoreport.h).
 */
 #include "conifit/viscoreport.h"
+#include "report/report_notes.h"
 #include "report/report_words.h"
 
 #include <math.h>
@@ -255,6 +256,7 @@ static json_t *report_json(const cf_visco_report *r)
                              "-", "y_column", tb->y_column, "y_unit", tb->y_unit, "kind",
                              "time-series", "sign",
                              tb->compression ? "compression-negative" : "tension-positive");
+    cf_report_notes_json(data, tb);
     json_t *model = json_pack(
         "{s:s, s:s, s:{s:i, s:i, s:i, s:s, s:{s:o, s:o, s:o}, s:s}, s:s, s:i}", "elastic",
         "conical spring law: the instantaneous response", "viscous",
@@ -334,6 +336,7 @@ char *cf_visco_report_text(const cf_visco_report *r)
     if (r->table->measures.stress_converted)
         fprintf(o, " (its Cauchy stress is fitted as nominal stress, converted under "
                    "incompressibility; errors below are nominal)\n");
+    cf_report_notes_text(o, r->table, " ");
     fprintf(o, " viscoelastic fit: conical law (instantaneous) + %d Prony term%s%s, in the "
                "lattice (%dx%dx%d cells, calibration %s), driven by the measured strain history\n",
             f->p.nbranch, f->p.nbranch == 1 ? "" : "s", f->dashpot ? " + dashpot" : "", lc->nx,

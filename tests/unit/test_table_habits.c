@@ -2,7 +2,7 @@
 ** Tests of the habits of real testing-machine exports that the table reader (src/io/measure.c,
 ** io/columns.c, io/header.c) accepts: unit spellings in any letter case where they are not
 ** ambiguous, strain in mm/mm or percent, stretch columns, comments in another encoding, a
-** preamble before the header row, and columns picked by the caller. The shipped and published
+** preamble before the header row, a units row under it, and columns picked by the caller. The shipped and published
 ** tables must read as before: that is tests/unit/test_measure.c and the golden outputs.
 */
 #include <errno.h>
@@ -253,6 +253,167 @@ static void a_preamble_before_the_header_row_is_skipped(void **state)
     cf_table_free(&m);
 }
 
+/* ---- a units row under the header ------------------------------------------------------------ */
+
+/* The three styles of testing machines: Instron Bluehill (quoted, units in parentheses, after a
+** preamble), ZwickRoell testXpert (semicolons, units in brackets, decimal commas) and MTS
+** TestSuite (bare units, "sec"). */
+static const char bluehill[] =
+    "\"Results Table 1\"\n\"Specimen label\",\"Sample-4\"\n\"Gauge length (mm)\",\"24.48\"\n\n"
+    "\"Time\",\"Extension\",\"Load\",\"Tensile strain (Extension)\",\"Tensile stress\"\n"
+    "\"(s)\",\"(mm)\",\"(N)\",\"(mm/mm)\",\"(MPa)\"\n"
+    "\"0.00\",\"0.000\",\"0.000\",\"0.0000\",\"0.000\"\n\"0.01\",\"0.245\",\"0.10\",\"0.0100\",\"1.0\"\n"
+    "\"0.02\",\"0.490\",\"0.30\",\"0.0200\",\"3.1\"\n\"0.03\",\"0.734\",\"0.62\",\"0.0300\",\"6.3\"\n"
+    "\"0.04\",\"0.979\",\"1.05\",\"0.0400\",\"10.7\"\n\"0.05\",\"1.224\",\"1.60\",\"0.0500\",\"16.4\"\n";
+static const char testxpert[] = "Standard travel;Standard force;Strain;Stress\n[mm];[kN];[%];[MPa]\n"
+                                "0;0;0;0\n0,5;0,010;1;0,4\n1;0,030;2;1,2\n1,5;0,062;3;2,5\n"
+                                "2;0,105;4;4,2\n2,5;0,160;5;6,4\n";
+static const char mts[] = "Time,Displacement,Force\nsec,mm,N\n0,0,0\n1,0.5,10\n2,1,30\n"
+                          "3,1.5,62\n4,2,105\n5,2.5,160\n";
+
+static void a_units_row_gives_the_units_the_header_lacks(void **state)
+{
+    (void)state;
+    cf_table m;
+    cf_measure_options o = cf_measure_default_options();
+    o.columns = "4,5"; /* Instron's strain and stress, after its preamble */
+    must_read(bluehill, &o, &m);
+    assert_int_equal(m.count, 6);
+    assert_int_equal(m.kind, CF_TABLE_STRESS_STRAIN);
+    assert_string_equal(m.y_unit, "MPa");
+    assert_close(m.x[5], 0.05, 1e-15);
+    assert_close(m.y[5], 16.4, 1e-12);
+    assert_non_null(strstr(m.notes, "lines 1 to 4 before the header row (line 5)"));
+    assert_non_null(strstr(m.notes, "column 'Tensile stress': unit 'MPa' read from the units "
+                                    "row under the header (line 6)"));
+    assert_non_null(strstr(m.notes, "'Tensile strain (Extension)': unit 'mm/mm'"));
+    cf_table_free(&m);
+    o.columns = "Extension,Load"; /* its crosshead: force against displacement */
+    must_read(bluehill, &o, &m);
+    assert_true(cf_table_is_force(&m));
+    assert_string_equal(m.y_unit, "N");
+    assert_close(m.x[5], 1.224, 1e-15);
+    cf_table_free(&m);
+    must_read(testxpert, NULL, &m); /* percent and MPa in brackets, decimal commas */
+    assert_int_equal(m.kind, CF_TABLE_STRESS_STRAIN);
+    assert_close(m.x[5], 0.05, 1e-15);
+    assert_close(m.y[5], 6.4, 1e-15);
+    assert_non_null(strstr(m.notes, "column 'Strain': unit '%' read from the units row"));
+    cf_table_free(&m);
+    o.columns = "Standard travel,Standard force"; /* its crosshead, in kN */
+    must_read(testxpert, &o, &m);
+    assert_true(cf_table_is_force(&m));
+    assert_string_equal(m.y_unit, "kN");
+    assert_close(m.x[1], 0.5, 1e-15);
+    assert_close(m.y[5] * m.y_to_file, 0.16, 1e-15);
+    assert_non_null(strstr(m.notes, "column 'Standard force': unit 'kN' read from the units row"));
+    cf_table_free(&m);
+    o.columns = "Displacement,Force";
+    must_read(mts, &o, &m); /* "sec" is seconds; the time column left out */
+    assert_null(m.t);
+    assert_close(m.y[5], 160.0, 0);
+    cf_table_free(&m);
+    must_read(mts, NULL, &m); /* with it: a time series whose time unit came from the row */
+    assert_non_null(m.t);
+    assert_close(m.t[5], 5.0, 0);
+    cf_table_free(&m);
+    /* a units row that agrees with the header's units (another case of the same unit) */
+    must_read("strain (%),stress (kPa)\n(%),(KPA)\n0,0\n10,1\n20,2\n30,3\n40,4\n50,5\n", NULL, &m);
+    assert_close(m.x[5], 0.5, 1e-15);
+    assert_null(strstr(m.notes, "units row"));
+    cf_table_free(&m);
+    /* without a units row, nothing changes: the header row without units is refused as before */
+    must_refuse("Strain,Stress\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n", NULL, 1, "no unit",
+                "'Stress'");
+}
+
+static void a_bad_or_contradicting_units_row_is_refused(void **state)
+{
+    (void)state;
+    /* a unit conifit does not know, in a column the table reads: that line and column */
+    must_refuse("Time,Extension,Load\n(s),(mm),(lbf)\n0,0,0\n1,1,1\n2,2,2\n3,3,3\n4,4,4\n5,5,5\n",
+                &(cf_measure_options){.columns = "Extension,Load"}, 2, "units row",
+                "column 'Load' has unit 'lbf'");
+    /* ... and the column is the third */
+    cf_error err = {0};
+    cf_table m;
+    cf_measure_options o = cf_measure_default_options();
+    o.columns = "Extension,Load";
+    assert_int_equal(read_table("Time,Extension,Load\n(s),(mm),(lbf)\n0,0,0\n1,1,1\n2,2,2\n"
+                                "3,3,3\n4,4,4\n5,5,5\n",
+                                (size_t)-1, &o, &m, &err, NULL),
+                     CF_E_DATA);
+    assert_non_null(strstr(err.msg, ":2:3:"));
+    /* an unknown unit in a column the table does not read is let be */
+    must_read("Temperature,Strain,Stress\n(degC),(-),(MPa)\n20,0,0\n20,0.1,1\n20,0.2,2\n"
+              "20,0.3,3\n20,0.4,4\n20,0.5,5\n",
+              NULL, &m);
+    assert_close(m.y[5], 5.0, 0);
+    cf_table_free(&m);
+    /* "mPa" under a header saying MPa: milli against mega, a contradiction */
+    must_refuse("strain,stress (MPa)\n(-),(mPa)\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n", NULL,
+                2, "has unit 'mPa', but its header (line 1) says 'MPa'", NULL);
+    /* kPa under a header saying MPa; percent under a header saying mm/mm */
+    must_refuse("strain,stress_MPa\n[-],[kPa]\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n", NULL, 2,
+                "column 'stress_MPa' has unit 'kPa'", "says 'MPa'");
+    must_refuse("strain (mm/mm);stress (MPa)\n(%);(MPa)\n0;0\n1;1\n2;2\n3;3\n4;4\n5;5\n", NULL,
+                2, "column 'strain (mm/mm)' has unit '%'", NULL);
+    /* more cells than the header has columns */
+    must_refuse("strain,stress\n(-),(MPa),(N)\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n", NULL,
+                2, "units row: 3 cells", NULL);
+}
+
+/* The raw tendon table (an Instron Bluehill export) written back in Bluehill's own layout, its
+** crosshead columns made from its gauge length and cross-section: the units row gives every unit,
+** and strain, stress and the crosshead read back the published rows. */
+static void the_tendon_export_in_bluehill_layout(void **state)
+{
+    (void)state;
+    const char *datasets = tu_datasets();
+    if (!datasets) {
+        print_message("skipped: ../shared/datasets is absent\n");
+        skip();
+    }
+    char path[512];
+    snprintf(path, sizeof path, "%s/tendon_fascicle_tension_raw.csv", datasets);
+    cf_table ref;
+    cf_error err = {0};
+    if (cf_measure_load(path, NULL, &ref, &err) != CF_OK)
+        fail_msg("%s: %s", path, err.msg);
+    const double gauge = 24.48, area = 3.14159265358979 * 0.353 * 0.353 / 4.0; /* mm, mm2 */
+    size_t cap = 512 + ref.count * 128, o = 0;
+    char *text = malloc(cap);
+    assert_non_null(text);
+    o += (size_t)snprintf(text + o, cap - o,
+                          "\"Specimen label\",\"Sample-4\"\n\"Gauge length\",\"24.48\",\"mm\"\n\n"
+                          "\"Time\",\"Extension\",\"Load\",\"Tensile strain (Extension)\","
+                          "\"Tensile stress\"\n\"(s)\",\"(mm)\",\"(N)\",\"(mm/mm)\",\"(MPa)\"\n");
+    for (size_t k = 0; k < ref.count; k++)
+        o += (size_t)snprintf(text + o, cap - o,
+                              "\"%.2f\",\"%.17g\",\"%.17g\",\"%.17g\",\"%.17g\"\n", 0.01 * (double)k,
+                              ref.x[k] * gauge, ref.y[k] * area, ref.x[k], ref.y[k]);
+    cf_table m;
+    cf_measure_options opt = cf_measure_default_options();
+    opt.columns = "Tensile strain (Extension),Tensile stress";
+    must_read(text, &opt, &m);
+    assert_int_equal(m.count, ref.count);
+    for (size_t k = 0; k < ref.count; k++) {
+        assert_close(m.x[k], ref.x[k], 0.0);
+        assert_close(m.y[k], ref.y[k], 0.0);
+    }
+    assert_non_null(strstr(m.notes, "(line 5)"));
+    cf_table_free(&m);
+    opt.columns = "2,3";
+    must_read(text, &opt, &m);
+    assert_true(cf_table_is_force(&m));
+    assert_int_equal(m.count, ref.count);
+    for (size_t k = 0; k < ref.count; k++)
+        assert_close(m.y[k], ref.y[k] * area, 0.0);
+    cf_table_free(&m);
+    cf_table_free(&ref);
+    free(text);
+}
+
 /* ---- columns picked by the caller ------------------------------------------------------------ */
 
 static void columns_option_picks_x_y_and_weight(void **state)
@@ -321,6 +482,9 @@ int main(void)
         cmocka_unit_test(comments_and_preambles_may_hold_any_bytes),
         cmocka_unit_test(a_preamble_before_the_header_row_is_skipped),
         cmocka_unit_test(columns_option_picks_x_y_and_weight),
+        cmocka_unit_test(a_units_row_gives_the_units_the_header_lacks),
+        cmocka_unit_test(a_bad_or_contradicting_units_row_is_refused),
+        cmocka_unit_test(the_tendon_export_in_bluehill_layout),
         cmocka_unit_test(published_tables_draw_no_note),
     };
     return cmocka_run_group_tests_name("table_habits", tests, setup, teardown);

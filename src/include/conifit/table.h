@@ -81,8 +81,9 @@ typedef struct cf_table {
     cf_table_measures measures; /* stress and strain measures as read; x and y hold engineering
                            ** strain and nominal stress after conversion */
     char notes[768];       /* what the reader noticed and a front end should show: one note a
-                           ** line (a skipped preamble, a unit read in another letter case, a
-                           ** strain column that looks like stretch); "" when none */
+                           ** line (a skipped preamble, a unit taken from the units row under the
+                           ** header or read in another letter case, a strain column that looks
+                           ** like stretch); "" when none. The reports keep them (notes[]). */
 } cf_table;
 
 /* A table of count points copied from x, y and w (w NULL: every weight 1), for data made in
