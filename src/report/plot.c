@@ -114,8 +114,10 @@ static void fit_blocks(cf_gp *g, const cf_fit_report *r, fit_curves *fc)
             if (fc->fit[k]) {
                 fc->fit[k] = 0;
                 fc->lattice[k] = 1;
-                snprintf(fc->lattice_title[k], sizeof fc->lattice_title[k], "%s",
-                         fc->fit_title[k]);
+                /* the fit's title (a terminated string shorter than the lattice's buffer) */
+                _Static_assert(sizeof fc->fit_title[k] <= sizeof fc->lattice_title[k],
+                               "a fit title fits a lattice title");
+                memcpy(fc->lattice_title[k], fc->fit_title[k], sizeof fc->fit_title[k]);
             }
         }
     cf_gp_block_begin(g, "DATA");
