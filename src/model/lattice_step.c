@@ -21,7 +21,9 @@ cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const
     memset(st, 0, sizeof *st);
     st->lat = lat;
     cf_law_lanes_init(lat->law, &st->lanes);
-    if (lat->method == CF_LAW_CLOSED)
+    if (lat->law->tail) /* the lanes hold the plain law only: a tail runs the scalar law */
+        st->form = -1;
+    else if (lat->method == CF_LAW_CLOSED)
         st->form = CF_LANE_CLOSED;
     else if (lat->method == CF_LAW_TABLE && st->lanes.coef)
         st->form = CF_LANE_TABLE;

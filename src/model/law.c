@@ -26,9 +26,18 @@
 
 struct cf_law_table {
     size_t intervals;  /* number of grid intervals */
-    double w_max;      /* grid spans w in [0, w_max], w = sqrt((s - |u|)/s) */
-    double inv_h;      /* intervals / w_max */
-    double h;          /* w_max / intervals */
+    double w_max;      /* grid spans w in [z0, w_max], w = sqrt((s - |u|)/s) (plain law) */
+    double inv_h;      /* intervals / (w_max - z0) */
+    double h;          /* (w_max - z0) / intervals */
+    double z0, kappa2; /* with a tail the grid variable is z = sqrt((u_C - |u|)/s + kappa^2) from
+                       ** z0 = kappa (0 and 0 without a tail). Phi has a minimum at e* < 0
+                       ** (y*^4 = 1/(1 - 4 beta)) whose value Phi(e*) ~ -3 beta^2/2 is a branch
+                       ** point of e(w) at distance ~ beta from the grid's end: e bends over
+                       ** w ~ beta. With kappa^2 = -Phi(e*) / r (r = 1/rho - 1) the branch point sits
+                       ** at z = 0 and e(z) is analytic on the grid (Morse's lemma). From
+                       ** beta = 0.2 on the minimum lies far away (y* > 1.49) and the grid
+                       ** keeps w (kappa = 0): a large kappa would make it uniform in Delta,
+                       ** too coarse where y is small */
     double *y;         /* y at the nodes, intervals + 1 values */
     double *dy;        /* dy/dw at the nodes, times h (scaled for the Hermite basis) */
     double *coef;      /* per interval, the Hermite cubic as y0 + q (m0 + q (a + q b)): y0, m0,
@@ -54,6 +63,26 @@ cf_status cf_law_init(cf_law *law, const cf_spring *p, cf_error *err)
         if ((st = check_positive(cf_spring_param_info(k)->key, cf_spring_get(p, k), err)) !=
             CF_OK)
             return st;
+    const int tail = p->n_tail != 0 || p->H_tail_mm != 0;
+    if (tail) {
+        if (!isfinite(p->n_tail) || p->n_tail < 0)
+            return cf_error_set(err, CF_E_DATA,
+                                "parameter n_tail = %.17g must be a finite number >= 0", p->n_tail);
+        if (!isfinite(p->H_tail_mm) || p->H_tail_mm < 0)
+            return cf_error_set(err, CF_E_DATA,
+                                "parameter H_tail_mm = %.17g must be a finite number >= 0",
+                                p->H_tail_mm);
+        if (p->n_tail == 0)
+            return cf_error_set(err, CF_E_DATA,
+                                "parameter H_tail_mm = %.17g is given for a spring with no tail "
+                                "coils (n_tail = 0)",
+                                p->H_tail_mm);
+        if (!(p->H_tail_mm > p->n_tail * p->d_mm))
+            return cf_error_set(err, CF_E_DATA,
+                                "parameter H_tail_mm = %.17g leaves no room for the tail's solid "
+                                "length n_tail d = %.17g mm",
+                                p->H_tail_mm, p->n_tail * p->d_mm);
+    }
     if (p->D1_mm > p->D2_mm)
         return cf_error_set(err, CF_E_DATA,
                             "parameter D1_mm = %.17g must not exceed D2_mm = %.17g", p->D1_mm,
@@ -67,7 +96,12 @@ cf_status cf_law_init(cf_law *law, const cf_spring *p, cf_error *err)
     const double nd = p->n * p->d_mm;
     law->type = (0.5 * dD >= nd) ? CF_TELESCOPING : CF_NON_TELESCOPING;
     law->L_min_mm = (law->type == CF_TELESCOPING) ? p->d_mm : nd;
-    law->travel_mm = p->H_mm - law->L_min_mm;
+    law->travel_mm = p->H_mm - p->H_tail_mm - law->L_min_mm;
+    if (tail && !(law->travel_mm > 0))
+        return cf_error_set(err, CF_E_DATA,
+                            "parameter H_tail_mm = %.17g leaves the cone no travel: H - H_tail - "
+                            "L_min = %.17g - %.17g - %.17g mm must be > 0",
+                            p->H_tail_mm, p->H_mm, p->H_tail_mm, law->L_min_mm);
     if (!(law->travel_mm > 0))
         return cf_error_set(err, CF_E_DATA,
                             "travel to solid H - L_min = %.17g - %.17g = %.17g mm must be > 0 "
@@ -94,9 +128,40 @@ cf_status cf_law_init(cf_law *law, const cf_spring *p, cf_error *err)
     /* 1 - u_T/s = (1 - rho)(3 + 2 rho + rho^2)/4 with 1 - rho = (D2 - D1)/D2 */
     law->w_T = sqrt((dD / p->D2_mm) * (3.0 + 2.0 * rho + rho * rho) * 0.25);
 
+    law->cone_travel_mm = s;
+    law->u_C_mm = s;
+    law->F_solid_N = law->F_C_N;
+    if (tail) {
+        /* the tail: k_t = G d^4/(8 n_t D1^3) = G d/(8 n_t c^3), in series with the cone */
+        const double nt = p->n_tail, s_t = p->H_tail_mm - nt * p->d_mm;
+        if (!(s_t / nt > s / p->n))
+            return cf_error_set(err, CF_E_DATA,
+                                "parameter H_tail_mm = %.17g closes the tail before the cone: its "
+                                "gap per coil (H_tail - n_tail d)/n_tail = %.17g mm must exceed "
+                                "the cone's s/n = %.17g mm",
+                                p->H_tail_mm, s_t / nt, s / p->n);
+        const double kc = law->k0_N_per_mm;
+        law->tail = 1;
+        law->k_tail_N_per_mm = p->G_MPa * p->d_mm / (8.0 * nt * c1 * c1 * c1);
+        law->tau = nt / p->n;
+        law->beta = law->rho_inv_m1 * law->tau;
+        law->u_C_mm = s + law->F_C_N / law->k_tail_N_per_mm;
+        law->F_solid_N = law->k_tail_N_per_mm * s_t;
+        law->k0_N_per_mm = kc * law->k_tail_N_per_mm / (kc + law->k_tail_N_per_mm);
+        law->u_T_mm += law->F_T_N / law->k_tail_N_per_mm;
+        law->L_min_mm += nt * p->d_mm;
+        law->travel_mm = s + s_t;
+        law->L_max_mm = p->H_mm + law->travel_mm;
+        /* (u_C - u_T)/s = (1 - rho)(3 + 2 rho + rho^2)/4 + tau (1 - rho)(1 + rho + rho^2) */
+        const double omr = dD / p->D2_mm;
+        law->w_T = sqrt(omr * ((3.0 + 2.0 * rho + rho * rho) * 0.25 +
+                               law->tau * (1.0 + rho + rho * rho)));
+    }
+
     const double derived[] = {law->rho,   law->rho_inv_m1,  law->index_c,    law->L_max_mm,
                               law->F_C_N, law->F_T_N,       law->k0_N_per_mm, law->u_T_mm,
-                              law->inv_travel, law->k_scale, law->w_T};
+                              law->inv_travel, law->k_scale, law->w_T, law->u_C_mm,
+                              law->F_solid_N, law->travel_mm};
     char sp[160];
     for (size_t i = 0; i < sizeof derived / sizeof derived[0]; i++)
         if (!isfinite(derived[i]) || (i != 1 && i != 9 && i != 10 && derived[i] <= 0))
@@ -167,10 +232,10 @@ static inline double one_minus_y4_e(double e)
 }
 
 /* Brent's method until the bracket stops shrinking; returns the midpoint of the last bracket. */
-static double brent_solve(double (*f)(double, void *), double target, double lo, double hi)
+static double brent_solve(double (*f)(double, void *), void *params, double lo, double hi)
 {
-    gsl_function fn = {f, &target};
-    double flo = f(lo, &target), fhi = f(hi, &target);
+    gsl_function fn = {f, params};
+    double flo = f(lo, params), fhi = f(hi, params);
     if (flo == 0)
         return lo;
     if (fhi == 0)
@@ -201,12 +266,13 @@ static void region2_exact(const cf_law *law, double delta, double *y, double *om
         const double e_max = fmin(0.5, law->p.D2_mm > law->p.D1_mm
                                            ? (law->p.D2_mm - law->p.D1_mm) / law->p.D2_mm
                                            : 0.0);
-        double e = brent_solve(e_residual, delta, 0.0, e_max);
+        double e = brent_solve(e_residual, &delta, 0.0, e_max);
         *y = 1.0 - e;
         *om = one_minus_y4_e(e);
         *e_out = e;
     } else {
-        double yy = brent_solve(y_residual, 1.0 + delta, law->rho, 0.5);
+        double target = 1.0 + delta;
+        double yy = brent_solve(y_residual, &target, law->rho, 0.5);
         *y = yy;
         *om = 1.0 - yy * yy * yy * yy;
         *e_out = 1.0 - yy;
@@ -300,6 +366,120 @@ static void region2_newton(double delta, double *y, double *om, double e)
     }
 }
 
+/* ---- region 2 of a spring with a tail ------------------------------------------------------ */
+
+/* With a tail the relation between Delta = (1/rho - 1)(u_C - |u|)/s and e = 1 - y gains the tail's
+** deflection F/k_t = tau s y^3:
+**   Phi(e) = delta(e) + beta psi(e) = Delta,  psi(e) = 1 - y^3 = e (3 - 3e + e^2),
+** the sum of two increasing functions of e (the cone's delta(e), region2_closed's relation, and the
+** tail's psi). Near the cone's solid Phi ~ 3 beta e, so e is regular in Delta there (no square
+** root: region 3 continues linearly). For y < 1/2 the y-form c(y) - 1 + beta (1 - y^3) = Delta. */
+typedef struct tail_target {
+    double target, beta;
+} tail_target;
+
+/* Phi(e) - Delta and its derivative, e-form: delta'(e) = 3 (1 - y^4)/(4 y^2), psi'(e) = 3 y^2. */
+static double tail_e_phi(double e, double beta, double *dphi)
+{
+    const double y = 1.0 - e;
+    if (dphi)
+        *dphi = 0.75 * one_minus_y4_e(e) / (y * y) + 3.0 * beta * y * y;
+    return e * e * (6.0 + e * (-4.0 + e)) / (4.0 * (1.0 - e)) + beta * e * (3.0 + e * (-3.0 + e));
+}
+
+/* y-form: c(y) - 1 + beta (1 - y^3), decreasing in y; *dphi its derivative in y. */
+static double tail_y_phi(double y, double beta, double *dphi)
+{
+    const double y2 = y * y;
+    if (dphi)
+        *dphi = 0.75 * (y2 * y2 - 1.0) / y2 - 3.0 * beta * y2;
+    return (3.0 + y2 * y2) / (4.0 * y) - 1.0 + beta * (1.0 - y2 * y);
+}
+
+static double tail_e_residual(double e, void *params)
+{
+    const tail_target *t = params;
+    return tail_e_phi(e, t->beta, NULL) - t->target;
+}
+
+static double tail_y_residual(double y, void *params)
+{
+    const tail_target *t = params;
+    return tail_y_phi(y, t->beta, NULL) - t->target;
+}
+
+/* Phi at y = 1/2, where the e-form hands over to the y-form. */
+static inline double tail_switch(double beta)
+{
+    return CF_DELTA_SWITCH + 0.875 * beta;
+}
+
+/* Newton's method on x in [lo, hi] for an increasing (sign = 1) or decreasing (sign = -1) residual
+** phi(x) - target, started at x0, a bisection where a step leaves the bracket; stops when a step
+** no longer changes x beyond rounding. */
+static double tail_newton(int eform, double beta, double target, double x, double lo, double hi)
+{
+    const double sign = eform ? 1.0 : -1.0;
+    for (int it = 0; it < 100; it++) {
+        double dphi;
+        const double f = (eform ? tail_e_phi(x, beta, &dphi) : tail_y_phi(x, beta, &dphi)) - target;
+        if (f == 0)
+            return x;
+        if (sign * f > 0)
+            hi = x;
+        else
+            lo = x;
+        double xn = x - f / dphi;
+        if (!(xn > lo && xn < hi))
+            xn = 0.5 * (lo + hi);
+        if (fabs(xn - x) <= 2.0 * DBL_EPSILON * fabs(x) || hi - lo <= 2.0 * DBL_EPSILON * hi)
+            return xn;
+        x = xn;
+    }
+    return x;
+}
+
+/* Region 2 with a tail at Delta >= 0: y, e = 1 - y, and 1 - y^4 + 4 beta y^4 (the stiffness's
+** denominator). exact: Brent's method to the last bit (as region2_exact); otherwise Newton from a
+** bound: e is at most the cone's alone, e_c(Delta), and at most the tail's alone,
+** psi^-1(Delta/beta) = 1 - cbrt(1 - Delta/beta). */
+static void region2_tail(const cf_law *law, int exact, double delta, double *y, double *om,
+                         double *e_out)
+{
+    const double beta = law->beta;
+    tail_target t = {delta, beta};
+    double yy, e;
+    if (delta <= tail_switch(beta)) {
+        const double e_max = fmin(0.5, (law->p.D2_mm - law->p.D1_mm) / law->p.D2_mm);
+        if (exact) {
+            e = brent_solve(tail_e_residual, &t, 0.0, e_max);
+        } else {
+            double yc, omc, ec;
+            region2_closed(delta, &yc, &omc, &ec);
+            double e0 = fmin(e_max, ec);
+            if (delta < beta)
+                e0 = fmin(e0, -expm1(log1p(-delta / beta) / 3.0));
+            e = tail_newton(1, beta, delta, fmax(e0, 0.0), 0.0, e_max);
+        }
+        yy = 1.0 - e;
+        *om = one_minus_y4_e(e);
+    } else {
+        if (exact) {
+            yy = brent_solve(tail_y_residual, &t, law->rho, 0.5);
+        } else {
+            double yc, omc, ec;
+            region2_closed(delta, &yc, &omc, &ec); /* y >= the cone's alone */
+            yy = tail_newton(0, beta, delta, fmin(fmax(yc, law->rho), 0.5), law->rho, 0.5);
+        }
+        e = 1.0 - yy;
+        *om = 1.0 - yy * yy * yy * yy;
+    }
+    const double y2 = yy * yy;
+    *om += 4.0 * beta * y2 * y2;
+    *y = yy;
+    *e_out = e;
+}
+
 /* ---- the table ------------------------------------------------------------------------------ */
 
 cf_status cf_law_table_build(cf_law *law, size_t intervals, cf_error *err)
@@ -323,27 +503,50 @@ cf_status cf_law_table_build(cf_law *law, size_t intervals, cf_error *err)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for a law table of %zu intervals",
                             intervals);
     }
-    t->intervals = intervals;
-    t->w_max = law->w_T;
-    t->h = law->w_T / (double)intervals;
-    t->inv_h = t->h > 0 ? 1.0 / t->h : 0.0;
     const double r = law->rho_inv_m1;
+    t->intervals = intervals;
+    const double beta = law->beta;
+    t->kappa2 = 0.0;
+    if (law->tail && r > 0) {
+        if (beta < 0.2) { /* e* = 1 - y* = -expm1(-log1p(-4 beta)/4) ~ -beta */
+            const double e_star = -expm1(-0.25 * log1p(-4.0 * beta));
+            t->kappa2 = -tail_e_phi(e_star, beta, NULL) / r;
+        } /* else Phi'(0) = 3 beta is large: e is analytic in w^2 and the grid stays in w */
+    }
+    t->z0 = sqrt(t->kappa2);
+    t->w_max = law->tail ? sqrt(law->w_T * law->w_T + t->kappa2) : law->w_T;
+    t->h = (t->w_max - t->z0) / (double)intervals;
+    t->inv_h = t->h > 0 ? 1.0 / t->h : 0.0;
     for (size_t i = 0; i <= intervals; i++) {
         /* grid node w_i; delta = r w^2; dy/dw = dy/ddelta * 2 r w with
-        ** dy/ddelta = -de/ddelta = -4 y^2 / (3 (1 - y^4)) */
-        const double w = (i == intervals) ? law->w_T : t->h * (double)i;
+        ** dy/ddelta = -de/ddelta = -4 y^2 / (3 (1 - y^4)); with a tail the node is z_i, delta =
+        ** r (z^2 - kappa^2), om = 1 - y^4 + 4 beta y^4 (dPhi/de = 3 om/(4 y^2)) and the same
+        ** expression gives dy/dz */
+        const double w = (i == intervals) ? t->w_max : t->z0 + t->h * (double)i;
         double y = 1, om = 0, e, dydw;
-        if (i == 0 || r == 0) {
+        if (r == 0 || (i == 0 && !law->tail)) {
             /* limit at solid: e ~ sqrt(2 delta / 3) = sqrt(2 r / 3) w */
             dydw = -sqrt(2.0 * r / 3.0);
+        } else if (i == 0) { /* at the cone's solid with a tail: y = 1, om = 4 beta */
+            om = 4.0 * beta;
+            dydw = -8.0 * r * t->z0 / (3.0 * om);
         } else {
-            region2_exact(law, r * w * w, &y, &om, &e);
+            if (law->tail)
+                region2_tail(law, 1, r * ((w - t->z0) * (w + t->z0)), &y, &om, &e);
+            else
+                region2_exact(law, r * w * w, &y, &om, &e);
             dydw = -8.0 * r * w * y * y / (3.0 * om);
         }
-        t->y[i] = y;
-        t->dy[i] = dydw * t->h;
+        if (law->tail) { /* a tailed table holds f = y^3 = F/F_C: where the tail dominates,
+                         ** y^3 ~ 1 - r w^2/beta is smooth and y, its cube root, is not */
+            t->y[i] = y * y * y;
+            t->dy[i] = 3.0 * y * y * dydw * t->h;
+        } else {
+            t->y[i] = y;
+            t->dy[i] = dydw * t->h;
+        }
     }
-    t->y[intervals] = law->rho; /* the transition, exactly */
+    t->y[intervals] = law->tail ? law->rho * law->rho * law->rho : law->rho; /* the transition */
     for (size_t i = 0; i < intervals; i++) {
         const double y0 = t->y[i], y1 = t->y[i + 1], m0 = t->dy[i], m1 = t->dy[i + 1];
         double *k = t->coef + 4 * i;
@@ -360,7 +563,7 @@ cf_status cf_law_table_build(cf_law *law, size_t intervals, cf_error *err)
 /* Hermite interpolation of y(w) and dy/dw on the uniform grid. */
 static inline double table_y(const struct cf_law_table *t, double w, double *dydw)
 {
-    double x = w * t->inv_h;
+    double x = (w - t->z0) * t->inv_h;
     size_t i = (size_t)x;
     if (i >= t->intervals)
         i = t->intervals - 1;
@@ -374,13 +577,21 @@ static inline double table_y(const struct cf_law_table *t, double w, double *dyd
 
 /* ---- evaluation ------------------------------------------------------------------------------ */
 
-/* Region 2 from the table, for |u| = a in (u_T, s): F, and dF/du when k is not NULL
+/* Region 2 from the table, for |u| = a in (u_T, u_C): F, and dF/du when k is not NULL
 ** (dF/du = 3 F_C y^2 dy/dw dw/du with dw/du = -1/(2 s w)). */
 static inline double table_region2(const cf_law *law, double u, double a, double *k)
 {
-    const double w = sqrt((law->travel_mm - a) * law->inv_travel);
+    const double v = (law->u_C_mm - a) * law->inv_travel;
+    const double w = law->tail ? sqrt(v + law->table->kappa2) : sqrt(v);
     double dydw;
     const double y = table_y(law->table, w, &dydw);
+    if (law->tail) { /* the table holds f = F/F_C and df/dz */
+        if (k) {
+            const double kk = -0.5 * law->F_C_N * law->inv_travel * dydw / w;
+            *k = (kk >= 0 && kk <= DBL_MAX) ? kk : 0.0;
+        }
+        return copysign(law->F_C_N * y, u);
+    }
     if (k) {
         const double kk = -1.5 * law->F_C_N * law->inv_travel * y * y * dydw / w;
         *k = (kk >= 0 && kk <= DBL_MAX) ? kk : 0.0;
@@ -411,27 +622,37 @@ static CF_ALWAYS_INLINE double law_eval(const cf_law *law, cf_law_method method,
         if (k)
             *k = 0.0;
         *flags = CF_LAW_SOLID;
-        return isnan(u) ? 0.0 : sign * law->F_C_N;
+        return isnan(u) ? 0.0 : sign * law->F_solid_N;
+    }
+    if (law->tail && a >= law->u_C_mm) { /* the cone is solid, the tail deflects */
+        if (k)
+            *k = law->k_tail_N_per_mm;
+        *flags = CF_LAW_TAIL;
+        return sign * (law->F_C_N + law->k_tail_N_per_mm * (a - law->u_C_mm));
     }
     *flags = 0;
     if (method == CF_LAW_TABLE && law->table)
         return table_region2(law, u, a, k);
-    const double v = (law->travel_mm - a) * law->inv_travel; /* (s - |u|)/s in (0, 1) */
+    const double v = (law->u_C_mm - a) * law->inv_travel; /* (u_C - |u|)/s, in (0, 1) untailed */
     const double delta = law->rho_inv_m1 * v;
     double y, om, e;
-    switch (method) {
-    case CF_LAW_EXACT:
-        region2_exact(law, delta, &y, &om, &e);
-        break;
-    case CF_LAW_TABLE: /* no table built: closed form with Newton */
-    case CF_LAW_CLOSED_NEWTON:
-        region2_closed(delta, &y, &om, &e);
-        region2_newton(delta, &y, &om, e);
-        break;
-    case CF_LAW_CLOSED:
-    default:
-        region2_closed(delta, &y, &om, &e);
-        break;
+    if (law->tail) {
+        region2_tail(law, method == CF_LAW_EXACT, delta, &y, &om, &e);
+    } else {
+        switch (method) {
+        case CF_LAW_EXACT:
+            region2_exact(law, delta, &y, &om, &e);
+            break;
+        case CF_LAW_TABLE: /* no table built: closed form with Newton */
+        case CF_LAW_CLOSED_NEWTON:
+            region2_closed(delta, &y, &om, &e);
+            region2_newton(delta, &y, &om, e);
+            break;
+        case CF_LAW_CLOSED:
+        default:
+            region2_closed(delta, &y, &om, &e);
+            break;
+        }
     }
     const double y2 = y * y;
     if (k) {
@@ -484,7 +705,8 @@ void cf_law_lanes_init(const cf_law *law, cf_law_lanes *lanes)
 void cf_law_force_many(const cf_law *law, cf_law_method method, size_t count, const double *u_mm,
                        double *F_N, double *k_N_per_mm)
 {
-    if (!k_N_per_mm && (method == CF_LAW_CLOSED || (method == CF_LAW_TABLE && law->table))) {
+    if (!k_N_per_mm && !law->tail &&
+        (method == CF_LAW_CLOSED || (method == CF_LAW_TABLE && law->table))) {
         /* forces alone: the vectorised lanes (law_simd.h) */
         cf_law_lanes lanes;
         cf_law_lanes_init(law, &lanes);
@@ -515,8 +737,10 @@ double cf_law_deflection(const cf_law *law, double F_N)
     const double sign = (F_N < 0) ? -1.0 : 1.0;
     if (isnan(F_N))
         return 0.0;
-    if (a >= law->F_C_N)
+    if (a >= law->F_solid_N)
         return sign * law->travel_mm;
+    if (law->tail && a >= law->F_C_N)
+        return sign * (law->u_C_mm + (a - law->F_C_N) / law->k_tail_N_per_mm);
     if (a <= law->F_T_N || law->rho_inv_m1 == 0)
         return fmin(a / law->k0_N_per_mm, law->u_T_mm) * sign;
     /* u = s (1/rho - 3/4 r - 1/4 r^-3)/(1/rho - 1), r = 1/y; as s - u = s delta/(1/rho - 1) with
@@ -524,5 +748,8 @@ double cf_law_deflection(const cf_law *law, double F_N)
     const double y = cbrt(a / law->F_C_N);
     const double e = 1.0 - y;
     const double delta = e * e * (3.0 + 2.0 * y + y * y) / (4.0 * y);
+    const double s = law->cone_travel_mm;
+    if (law->tail) /* the cone's deflection and the tail's F/k_t */
+        return sign * (s - s * delta / law->rho_inv_m1 + a / law->k_tail_N_per_mm);
     return sign * (law->travel_mm - law->travel_mm * delta / law->rho_inv_m1);
 }

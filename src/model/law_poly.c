@@ -131,7 +131,7 @@ int cf_law_lanes_fit_poly(const cf_law *law, cf_law_lanes *lanes, double *worst)
 {
     double err = NAN;
     lanes->poly_fit = 0;
-    const int ok = law->w_T > 0 && law->rho_inv_m1 > 0 && law->u_T_mm < law->travel_mm &&
+    const int ok = !law->tail && law->w_T > 0 && law->rho_inv_m1 > 0 && law->u_T_mm < law->travel_mm &&
                    (fit_degree(law, lanes, CF_POLY_DEGREE_LOW, 1, &err) ||
                     fit_degree(law, lanes, CF_POLY_DEGREE, 1, &err) ||
                     fit_degree(law, lanes, CF_POLY_DEGREE, 2, &err));

@@ -6,18 +6,26 @@
 #include <stdio.h>
 #include <string.h>
 
-static const cf_spring_param params[CF_P_COUNT] = {
+static const cf_spring_param params[CF_P_ALL] = {
     {"D1", "mm", "D1_mm", "mean diameter of the smallest active coil", 1e-6, 1e6},
     {"D2", "mm", "D2_mm", "mean diameter of the largest active coil", 1e-6, 1e9},
     {"n", "-", "n", "number of active coils (>= 2, may be fractional)", 2, 1e7},
     {"d", "mm", "d_mm", "wire diameter", 1e-7, 1e5},
     {"G", "MPa", "G_MPa", "shear modulus of the wire (N/mm^2)", 1e-15, 1e15},
     {"H", "mm", "H_mm", "free length (rest length in the mass-spring model)", 1e-6, 1e6},
+    {"n_tail", "-", "n_tail", "coils of the cylindrical tail (diameter D1, same wire; 0: none)", 0,
+     1e7},
+    {"H_tail", "mm", "H_tail_mm", "free length of the cylindrical tail (part of H)", 0, 1e6},
 };
+
+int cf_spring_has_tail(const cf_spring *p)
+{
+    return p->n_tail > 0;
+}
 
 const cf_spring_param *cf_spring_param_info(int k)
 {
-    return (k >= 0 && k < CF_P_COUNT) ? &params[k] : NULL;
+    return (k >= 0 && k < CF_P_ALL) ? &params[k] : NULL;
 }
 
 double cf_spring_get(const cf_spring *p, int k)
@@ -29,6 +37,8 @@ double cf_spring_get(const cf_spring *p, int k)
     case CF_P_D: return p->d_mm;
     case CF_P_G: return p->G_MPa;
     case CF_P_H: return p->H_mm;
+    case CF_P_N_TAIL: return p->n_tail;
+    case CF_P_H_TAIL: return p->H_tail_mm;
     default: return 0;
     }
 }
@@ -42,6 +52,8 @@ void cf_spring_set(cf_spring *p, int k, double value)
     case CF_P_D: p->d_mm = value; break;
     case CF_P_G: p->G_MPa = value; break;
     case CF_P_H: p->H_mm = value; break;
+    case CF_P_N_TAIL: p->n_tail = value; break;
+    case CF_P_H_TAIL: p->H_tail_mm = value; break;
     default: break;
     }
 }
@@ -51,7 +63,8 @@ const char *cf_spring_text(const cf_spring *p, int digits, int assign, char *buf
     size_t n = 0;
     if (cap)
         buf[0] = '\0';
-    for (int k = 0; k < CF_P_COUNT && n < cap; k++) {
+    const int count = cf_spring_has_tail(p) ? CF_P_ALL : CF_P_COUNT;
+    for (int k = 0; k < count && n < cap; k++) {
         const cf_spring_param *sp = &params[k];
         const int unit = !assign && strcmp(sp->unit, "-") != 0;
         int w = snprintf(buf + n, cap - n, "%s%s%s%.*g%s%s", k ? (assign ? " " : ", ") : "",

@@ -13,6 +13,15 @@
 **                          c = 1/rho - (u/s)(1/rho - 1)
 **   region 3 (|u| >= s): solid; the law reports F = +-F_C and the CF_LAW_SOLID flag.
 **   F(-u) = -F(u): stretching mirrors compression (paper eqs. 20-21, L_max = 2H - L_min).
+** The tail (law family conical-tail, src/model/law.md): n_t coils of diameter D1 in series with the
+** cone, stiffness k_t = G d^4/(8 n_t D1^3), tau = n_t/n = F_C/(k_t s), beta = (1/rho - 1) tau:
+**   region 1: F = k0 u with k0 the series stiffness, up to u_T + F_T/k_t;
+**   region 2: the cone's y and the tail's F/k_t add: with Delta = (1/rho - 1)(u_C - |u|)/s,
+**             u_C = s (1 + tau), y solves delta(e) + beta (1 - y^3) = Delta (e = 1 - y), i.e.
+**             (1 - 4 beta) y^4 - 4 c y + 3 = 0 with c = 1/rho - (u/s)(1/rho - 1);
+**   region 3 (u_C <= |u| < s + s_t, cone solid): F = F_C + k_t (|u| - u_C), the CF_LAW_TAIL flag;
+**   solid at s + s_t (s_t = H_tail - n_t d, the tail's own travel): F = +-k_t s_t.
+** Without a tail every quantity and every evaluation is the plain law's, bit for bit.
 ** References: Rodriguez E, Paredes M, Sartor M (2006), Analytical behavior law for a constant pitch
 ** conical compression spring, J Mech Des 128:1352-1356; the conical-springs paper (eqs. 1-21).
 **
@@ -25,6 +34,10 @@
 **   CF_LAW_CLOSED  Ferrari's closed form of the quartic, written without cancellation near solid,
 **                  in the near-cylindrical limit and for strongly conical springs.
 **   CF_LAW_CLOSED_NEWTON  the closed form followed by one Newton step in the near-solid variable.
+**   With a tail, CF_LAW_CLOSED and CF_LAW_CLOSED_NEWTON solve region 2 by Newton's method on the
+**                  explicit relation, kept inside a bracket that the cone's closed form and the
+**                  tail's cube root give (law.c, region2_tail): the y-quartic's leading
+**                  coefficient 1 - 4 beta, which vanishes at beta = 1/4, never appears.
 **   CF_LAW_TABLE   a precomputed cubic Hermite table (see cf_law_table_build) on a grid uniform in
 **                  sqrt(1 - u/s), where the law is smooth; fastest, with a measured error bound.
 */
@@ -46,13 +59,15 @@ typedef enum cf_law_method {
 /* Flags reported by an evaluation. */
 enum {
     CF_LAW_LINEAR = 1, /* |u| <= u_T: region 1 */
-    CF_LAW_SOLID = 2   /* |u| >= travel: clamped at +-F_C, stiffness reported as 0 */
+    CF_LAW_SOLID = 2,  /* |u| >= travel: clamped at +-F_solid, stiffness reported as 0 */
+    CF_LAW_TAIL = 4    /* cone solid, tail still deflecting: region 3 of a spring with a tail */
 };
 
 /* Default number of table intervals. Measured maximum force error of the table against exact at
 ** this size: 1.5e-12 of |F| at rho = 0.5, 2.3e-10 at rho = 0.1, 3e-9 at rho = 0.03, and 6.5e-7 of
 ** F_C at rho = 1e-3; the error falls as the fourth power of the size (tests/unit/test_law.c checks
-** the bound, the benchmark reports the whole curve). */
+** the bound, the benchmark reports the whole curve). A spring with a tail: at most 6.7e-8 of F_C
+** over rho 0.03-0.9 and beta 1e-9-50 (tests/unit/test_law_tail.c). */
 #define CF_LAW_TABLE_DEFAULT 256
 
 struct cf_law_table; /* opaque; built by cf_law_table_build */
@@ -65,22 +80,35 @@ typedef struct cf_law {
     double rho;          /* D1/D2, dimensionless, in (0, 1] */
     double rho_inv_m1;   /* 1/rho - 1 = (D2 - D1)/D1, formed without cancellation */
     double index_c;      /* spring index D1/d, dimensionless */
-    double L_min_mm;     /* solid length, mm */
+    double L_min_mm;     /* solid length, mm (the cone's and the tail's n_t d) */
     double L_max_mm;     /* length at full stretch, 2H - L_min, mm */
-    double travel_mm;    /* s = H - L_min, mm */
+    double travel_mm;    /* compression to solid, H - L_min, mm (s + s_t with a tail) */
     double F_T_N;        /* transition load (end of region 1), N */
-    double F_C_N;        /* solid load, N */
-    double k0_N_per_mm;  /* stiffness of region 1, N/mm */
+    double F_C_N;        /* load at which the cone is solid (the whole spring without a tail), N */
+    double k0_N_per_mm;  /* stiffness of region 1, N/mm (cone and tail in series) */
     double u_T_mm;       /* compression at the transition, mm */
-    double inv_travel;   /* 1/s, 1/mm */
-    double k_scale;      /* 4 F_C (1/rho - 1)/s, N/mm: region-2 stiffness is k_scale y^4/(1-y^4) */
-    double w_T;          /* sqrt(1 - u_T/s): where region 2 starts in the table variable */
+    double inv_travel;   /* 1/s, 1/mm (s the cone's travel) */
+    double k_scale;      /* 4 F_C (1/rho - 1)/s, N/mm: region-2 stiffness is k_scale y^4/(1-y^4)
+                         ** (k_scale y^4/(1 - y^4 + 4 beta y^4) with a tail) */
+    double w_T;          /* sqrt((u_C - u_T)/s): where region 2 starts in the table variable */
+    /* the cylindrical tail: without one tail = 0, beta = tau = k_tail = 0, u_C = s and
+    ** F_solid = F_C */
+    int tail;              /* 1 when the spring has a tail */
+    double cone_travel_mm; /* s, the cone's travel: (H - H_tail) - its solid length, mm */
+    double k_tail_N_per_mm;/* tail stiffness G d^4/(8 n_t D1^3), N/mm */
+    double tau;            /* n_t/n = F_C/(k_tail s), dimensionless */
+    double beta;           /* (1/rho - 1) tau, dimensionless */
+    double u_C_mm;         /* compression at which the cone closes, s (1 + tau), mm */
+    double F_solid_N;      /* force when the whole spring is solid, k_tail s_t (F_C), N */
     struct cf_law_table *table; /* NULL until cf_law_table_build */
 } cf_law;
 
 /* Validates p and fills law with the derived quantities (law->table = NULL). Refuses non-finite or
 ** non-positive values, D1 > D2, n < 2 and a travel <= 0 with CF_E_DATA and a message naming the
-** parameter and its value. D1 == D2 (a cylindrical spring) is valid: linear up to solid. */
+** parameter and its value. D1 == D2 (a cylindrical spring) is valid: linear up to solid. A tail
+** (n_tail > 0) must leave room for its solid length (H_tail > n_tail d) and the cone's (the cone's
+** travel > 0), and close after the cone: its gap per coil (H_tail - n_tail d)/n_tail exceeds the
+** cone's s/n; n_tail < 0, a non-finite tail value, or H_tail without n_tail is refused. */
 cf_status cf_law_init(cf_law *law, const cf_spring *p, cf_error *err);
 
 /* Releases the table of law, if any. Safe on a zeroed law and on NULL. */
@@ -103,7 +131,7 @@ void cf_law_force_many(const cf_law *law, cf_law_method method, size_t count, co
                        double *F_N, double *k_N_per_mm);
 
 /* Compression (mm, >= 0 for F >= 0) at which the spring carries force F (N): the explicit inverse
-** of the law, exact up to rounding; |F| >= F_C gives +-travel. */
+** of the law, exact up to rounding; |F| >= F_solid gives +-travel. */
 double cf_law_deflection(const cf_law *law, double F_N);
 
 /* Parses "exact", "closed", "closed+newton" or "table"; CF_E_DATA for anything else. */

@@ -1,5 +1,6 @@
 /*
-** The conical spring as data: its six design parameters, its two types, and the one description
+** The conical spring as data: its six design parameters (and the two of an optional cylindrical
+** tail), its two types, and the one description
 ** of each parameter (name, unit, JSON key, meaning, fit bounds) that every reader, writer, report,
 ** export and command-line option works from. Adding a parameter or renaming a key is a change to
 ** src/model/spring.c alone.
@@ -19,6 +20,11 @@ typedef struct cf_spring {
     double d_mm;  /* wire diameter, mm */
     double G_MPa; /* shear modulus of the wire, MPa */
     double H_mm;  /* free length, mm (rest length in the mass-spring model) */
+    /* The optional cylindrical tail (law family conical-tail, src/model/law.md): n_tail coils of
+    ** mean diameter D1 wound from the same wire, in series with the cone, taking H_tail of the free
+    ** length H. Both 0 (an initializer that lists only the six) is the plain conical spring. */
+    double n_tail;     /* number of tail coils, dimensionless (0: no tail) */
+    double H_tail_mm;  /* free length of the tail, mm (0 without a tail; the cone has H - H_tail) */
 } cf_spring;
 
 typedef enum cf_spring_type {
@@ -26,8 +32,13 @@ typedef enum cf_spring_type {
     CF_NON_TELESCOPING = 1  /* (D2 - D1)/2 <  n d, solid length n d */
 } cf_spring_type;
 
-/* Index of each design parameter, in the order D1, D2, n, d, G, H. */
+/* Index of each design parameter, in the order D1, D2, n, d, G, H: the CF_P_COUNT parameters of
+** every spring (the ones a plain fit places); then the tail's two, up to CF_P_ALL. */
 enum { CF_P_D1 = 0, CF_P_D2, CF_P_N, CF_P_D, CF_P_G, CF_P_H, CF_P_COUNT };
+enum { CF_P_N_TAIL = CF_P_COUNT, CF_P_H_TAIL, CF_P_ALL };
+
+/* 1 when p has a cylindrical tail (n_tail > 0). */
+int cf_spring_has_tail(const cf_spring *p);
 
 /* What conifit knows of one design parameter. */
 typedef struct cf_spring_param {
@@ -39,19 +50,21 @@ typedef struct cf_spring_param {
                          ** in any unit (micrometre to metre springs, foams to steel) */
 } cf_spring_param;
 
-/* The description of parameter k (0 <= k < CF_P_COUNT); NULL for another k. */
+/* The description of parameter k (0 <= k < CF_P_ALL); NULL for another k. */
 const cf_spring_param *cf_spring_param_info(int k);
 
 /* Value of parameter k of p, and setting it. */
 double cf_spring_get(const cf_spring *p, int k);
 void cf_spring_set(cf_spring *p, int k, double value);
 
-/* The six parameters as text, from the field table, into buf (cap bytes; returns buf), each value
+/* The parameters as text, from the field table, into buf (cap bytes; returns buf), each value
 ** with `digits` significant digits: "D1 10 mm, D2 30 mm, n 4, d 1 mm, G 8e+04 MPa, H 40 mm", or
-** with assign = 1 "D1=10 D2=30 n=4 d=1 G=8e+04 H=40" (no units). */
+** with assign = 1 "D1=10 D2=30 n=4 d=1 G=8e+04 H=40" (no units); the tail's two follow only when
+** the spring has a tail. */
 const char *cf_spring_text(const cf_spring *p, int digits, int assign, char *buf, size_t cap);
 
-/* Index of the parameter called name (its name "D1" or its key "D1_mm"), or -1. */
+/* Index (< CF_P_COUNT) of the parameter called name (its name "D1" or its key "D1_mm"), or -1;
+** the tail's parameters are not found here (a fit places them with the law family). */
 int cf_spring_param_find(const char *name);
 
 /* "telescoping" or "non-telescoping". */
