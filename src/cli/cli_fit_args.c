@@ -21,6 +21,10 @@ static const char fit_help[] =
     "  -o, --output OUT.json | DIR/ | -   fit file (one table), folder (one NAME.json per\n"
     "                          table), or '-': the fit file on standard output (no report)\n"
     "  --type T                telescoping | non-telescoping | both (default both)\n"
+    "  --law L                 conical | conical-tail | auto (default conical): the conical\n"
+    "                          spring, one with a cylindrical tail in series (a fourth\n"
+    "                          quantity, the tail's compliance), or both, kept by AIC;\n"
+    "                          the tail on uniaxial and force tables, the spring target\n"
     "  --fix NAME=VALUE        hold a parameter: D1, D2, d, H in mm, G in MPa, n (repeatable)\n"
     "  --index-max C           largest spring index D1/d, 3..50 (default 12; the smallest is 3)\n"
     "  --rho-min R             smallest diameter ratio D1/D2, 0.001..1 (default 0.05)\n"
@@ -138,7 +142,8 @@ enum {
     OPT_STRAIN_MEASURE,
     OPT_MAX_MEMORY,
     OPT_MAX_STEPS,
-    OPT_MAX_WORK
+    OPT_MAX_WORK,
+    OPT_LAW
 };
 
 static const struct option fit_options[] = {
@@ -147,6 +152,7 @@ static const struct option fit_options[] = {
     {"max-steps", required_argument, NULL, OPT_MAX_STEPS},
     {"max-work", required_argument, NULL, OPT_MAX_WORK},
     {"type", required_argument, NULL, OPT_TYPE},
+    {"law", required_argument, NULL, OPT_LAW},
     {"fix", required_argument, NULL, OPT_FIX},
     {"index-max", required_argument, NULL, OPT_INDEX_MAX},
     {"relative", no_argument, NULL, OPT_RELATIVE},
@@ -350,6 +356,10 @@ static int fit_option(void *ctx, int c, const char *optval)
             return cf_cli_usage_error("fit", "--target '%s': expected lattice or spring", optval);
         return 0;
     case OPT_JOINT: a->joint = 1; return 0;
+    case OPT_LAW:
+        if (cf_law_family_parse(optval, &fo->law, &err) != CF_OK)
+            return cf_cli_usage_error("fit", "--law: %s", err.msg);
+        return 0;
     case OPT_CALIBRATION: {
         cf_lattice_config *lc = &a->popt.lattice.cfg.lattice;
         if (cf_calibration_parse(optval, &lc->calibration, &err) != CF_OK)

@@ -48,7 +48,8 @@ int cf_report_target_is_lattice(const cf_fit_report *r)
 double cf_report_fit_aic(const cf_fit_report *r, int i)
 {
     double f = r->table->y_to_file;
-    return cf_baseline_aic(r->table->count, r->fits[i].rss * f * f, 3, r->ymax * f);
+    return cf_baseline_aic(r->table->count, r->fits[i].rss * f * f, r->fits[i].tail ? 4 : 3,
+                           r->ymax * f);
 }
 
 double cf_report_baseline_aic(const cf_fit_report *r, int k)
@@ -108,6 +109,20 @@ static json_t *extrapolation_json(const cf_fit_report *r, const cf_fit_result *f
     return o;
 }
 
+/* Both law families of fits[i]: their quality, AIC and which one the fit keeps. */
+static json_t *law_comparison_json(const cf_fit_report *r, int i)
+{
+    const cf_law_choice *lc = &r->law_choice[i];
+    const cf_fit_result *tail = lc->chose_tail ? &r->fits[i] : &lc->other;
+    const cf_fit_result *cone = lc->chose_tail ? &lc->other : &r->fits[i];
+    const double u = r->table->y_to_file;
+    return json_pack("{s:s, s:{s:o, s:o, s:b}, s:{s:o, s:o, s:b, s:o}}", "chosen",
+                     lc->chose_tail ? "conical-tail" : "conical", "conical", "rmse",
+                     num(cone->rmse * u), "aic", num(lc->aic_conical), "feasible", cone->feasible,
+                     "conical-tail", "rmse", num(tail->rmse * u), "aic", num(lc->aic_tail),
+                     "feasible", tail->feasible, "tail_compliance", cf_report_tail_json(tail));
+}
+
 static json_t *fit_json_core(const cf_fit_report *r, int i)
 {
     const cf_fit_result *f = &r->fits[i];
@@ -137,6 +152,12 @@ static json_t *fit_json_core(const cf_fit_report *r, int i)
     /* the type fitted: an infeasible fit's geometry may be of the other type */
     json_object_set_new(o, "type", json_string(cf_spring_type_name(f->type)));
     json_object_set_new(o, "identifiable_correlation", cf_report_correlation_json(f, names));
+    json_object_set_new(o, "law", json_string(f->tail ? "conical-tail" : "conical"));
+    if (f->tail)
+        json_object_set_new(ident, fd ? "tail_compliance_mm" : "tail_compliance",
+                            cf_report_tail_json(f));
+    if (r->law_choice[i].ran)
+        json_object_set_new(o, "law_comparison", law_comparison_json(r, i));
     json_object_set_new(o, "held_by", constraint_list(f->held));
     json_object_set_new(o, "extrapolation", extrapolation_json(r, f));
     limit_cost_json(o, r, i);

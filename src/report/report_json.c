@@ -23,6 +23,17 @@ static const char *stderr_reason(const cf_fit_result *f)
 
 /* {value, stderr | stderr_reason, [interval, interval_reason]} in conifit's units (MPa, N, mm):
 ** a key is present only with a value, never null. */
+json_t *cf_report_tail_json(const cf_fit_result *f)
+{
+    json_t *o = json_pack("{s:o}", "value", num(f->e_tail));
+    if (o && f->e_tail_se >= 0)
+        json_object_set_new(o, "stderr", num(f->e_tail_se));
+    else if (o)
+        json_object_set_new(o, "stderr_reason",
+                            json_string("the Jacobian of the four quantities is singular"));
+    return o;
+}
+
 json_t *cf_report_ident_json(const cf_fit_result *f, int k)
 {
     double se = f->ident_se.v[k];

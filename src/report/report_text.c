@@ -33,6 +33,18 @@ static void row(FILE *o, const cf_fit_report *r, const char *label, const char *
         case 12: snprintf(cell, sizeof cell, fmt, f->r2); break;
         case 13: snprintf(cell, sizeof cell, fmt, cf_report_fit_aic(r, i)); break;
         case 14: snprintf(cell, sizeof cell, fmt, f->law.k0_N_per_mm); break;
+        case 15: case 16: /* the tail's parameters, blank for a spring without one */
+            if (f->tail)
+                snprintf(cell, sizeof cell, fmt, cf_spring_get(p, which - 15 + CF_P_N_TAIL));
+            else
+                snprintf(cell, sizeof cell, "-");
+            break;
+        case 17:
+            if (f->tail)
+                snprintf(cell, sizeof cell, fmt, f->law.k_tail_N_per_mm);
+            else
+                snprintf(cell, sizeof cell, "-");
+            break;
         default: cell[0] = '\0';
         }
         fprintf(o, " %-24s", cell);
@@ -51,6 +63,62 @@ static void ident_row(FILE *o, const cf_fit_report *r, const char *label, int k,
         fprintf(o, " %-24s", cell);
     }
     fputc('\n', o);
+}
+
+static int any_tail(const cf_fit_report *r)
+{
+    for (int i = 0; i < r->nfits; i++)
+        if (r->fits[i].tail)
+            return 1;
+    return 0;
+}
+
+/* The tailed law's fourth quantity, e_t ± its error ("-" for a fit of the conical law). */
+static void tail_row(FILE *o, const cf_fit_report *r)
+{
+    const int fd = cf_table_is_force(r->table);
+    fprintf(o, "  %-26s", fd ? "tail compliance F_C/k_t" : "tail compliance e_t");
+    for (int i = 0; i < r->nfits; i++) {
+        const cf_fit_result *f = &r->fits[i];
+        char cell[96];
+        if (!f->tail)
+            snprintf(cell, sizeof cell, "-");
+        else if (f->e_tail_se >= 0)
+            snprintf(cell, sizeof cell, "%.6g ± %.2g%s", f->e_tail, f->e_tail_se, fd ? " mm" : "");
+        else
+            snprintf(cell, sizeof cell, "%.6g (error not determined)%s", f->e_tail, fd ? " mm" : "");
+        fprintf(o, " %-24s", cell);
+    }
+    fputc('\n', o);
+}
+
+/* Both law families of each type, when the fit asked for the tailed one: quality, AIC, and the
+** one kept. */
+static void law_choice_text(FILE *o, const cf_fit_report *r)
+{
+    if (r->law == CF_FAMILY_CONICAL)
+        return;
+    const double u = r->table->y_to_file;
+    fprintf(o, "\nLaw (--law %s): the conical law (3 quantities) against the conical spring with "
+               "a cylindrical tail (4)\n", cf_law_family_name(r->law));
+    for (int i = 0; i < r->nfits; i++) {
+        const cf_law_choice *lc = &r->law_choice[i];
+        if (!lc->ran)
+            continue;
+        const cf_fit_result *tail = lc->chose_tail ? &r->fits[i] : &lc->other;
+        const cf_fit_result *cone = lc->chose_tail ? &lc->other : &r->fits[i];
+        fprintf(o, "  %-16s conical      RMSE %.4g %s  AIC %.2f%s\n",
+                cf_spring_type_name(r->fits[i].type), cone->rmse * u, r->table->y_unit,
+                lc->aic_conical, cone->feasible ? "" : "  (infeasible)");
+        fprintf(o, "  %-16s conical-tail RMSE %.4g %s  AIC %.2f%s\n", "", tail->rmse * u,
+                r->table->y_unit, lc->aic_tail, tail->feasible ? "" : "  (infeasible)");
+        const char *why = r->law == CF_FAMILY_TAIL ? "asked for (--law conical-tail)"
+                          : lc->chose_tail         ? "lower AIC"
+                          : !tail->feasible        ? "the tailed spring is infeasible"
+                                                   : "the tail does not lower the AIC";
+        fprintf(o, "  %-16s kept: %s (%s)\n", "", lc->chose_tail ? "conical-tail" : "conical",
+                why);
+    }
 }
 
 /* Below the table: what each starred interval means, per type and quantity. */
@@ -286,6 +354,8 @@ static void identifiable_text(FILE *o, const cf_fit_report *r)
         ident_row(o, r, "solid strain s/H", 1, 1, "");
         ident_row(o, r, "stress scale F_C/H^2", 2, r->table->y_to_file, r->table->y_unit);
     }
+    if (any_tail(r))
+        tail_row(o, r);
     static const char *const ss_names[3] = {"rho", "solid strain", "stress scale"};
     static const char *const fd_names[3] = {"rho", "travel", "solid load"};
     interval_notes(o, r, cf_table_is_force(r->table) ? fd_names : ss_names);
@@ -350,11 +420,16 @@ static void spring_text(FILE *o, const cf_fit_report *r)
     row(o, r, "F_T, F_C", "%.4g N", 8);
     row(o, r, "", "%.4g N", 9);
     row(o, r, "k0", "%.6g N/mm", 14);
+    if (any_tail(r)) {
+        row(o, r, "n_tail (tail coils)", "%.6g", 15);
+        row(o, r, "H_tail (tail length)", "%.6g mm", 16);
+        row(o, r, "k_tail", "%.6g N/mm", 17);
+    }
     fprintf(o, " quality (the %s):\n", cf_report_target_is_lattice(r) ? "lattice's" : "spring's");
     row(o, r, "RMSE", "%.4g %s", 10);
     row(o, r, "max |error|", "%.4g %s", 11);
     row(o, r, "R^2", "%.6f", 12);
-    row(o, r, "AIC (k = 3)", "%.2f", 13);
+    row(o, r, any_tail(r) ? "AIC (k = 3, tailed 4)" : "AIC (k = 3)", "%.2f", 13);
     spring_law_text(o, r);
 }
 
@@ -477,6 +552,7 @@ char *cf_report_text(const cf_fit_report *r)
     if (r->validate)
         validation_text(o, r);
     constraints_text(o, r);
+    law_choice_text(o, r);
     verdict_and_baselines(o, r);
     warnings_text(o, r);
     fclose(o);

@@ -76,6 +76,19 @@ typedef enum cf_fit_optimizer {
 ** that the coils tangle and buckle (the usual design handbooks give the same range). */
 #define CF_FIT_INDEX_MAX_DEFAULT 12.0
 
+/* The law family a fit uses (src/model/law.md): the conical spring's law (three identifiable
+** quantities), the conical spring with a cylindrical tail in series (four: the tail's compliance
+** e_t = F_C/(k_t H) too, cf_fit_tail_run), or both with the choice by AIC (the pipeline). */
+typedef enum cf_law_family {
+    CF_FAMILY_CONICAL = 0,
+    CF_FAMILY_TAIL = 1,
+    CF_FAMILY_AUTO = 2
+} cf_law_family;
+
+/* Parses "conical", "conical-tail" or "auto"; CF_E_DATA naming the value otherwise. */
+cf_status cf_law_family_parse(const char *name, cf_law_family *f, cf_error *err);
+const char *cf_law_family_name(cf_law_family f);
+
 typedef struct cf_fit_options {
     int fixed[CF_P_COUNT];          /* 1: held at fixed_value */
     double fixed_value[CF_P_COUNT]; /* mm, -, mm, MPa, mm as in cf_spring */
@@ -95,6 +108,7 @@ typedef struct cf_fit_options {
                                     ** deterministic subsample of 1000 rows evenly along x, then
                                     ** polishes on every row; 0: never (default
                                     ** CF_FIT_SUBSAMPLE_ABOVE; the baselines use the same) */
+    cf_law_family law;              /* the law family (default conical; the pipeline reads it) */
 } cf_fit_options;
 
 /* Tables up to this many rows are searched on every row; a longer one on its subsample of as many
@@ -144,6 +158,10 @@ typedef struct cf_fit_result {
     unsigned active;       /* CF_C_* bits of constraints at their limit (within 1e-6) */
     unsigned violated;     /* CF_C_* bits of violated constraints */
     const char *optimizer; /* name of the stage-C optimiser */
+    int tail;              /* 1: a fit of the conical-tail law (params has a tail) */
+    double e_tail;         /* its tail compliance e_t = F_C/(k_t H) [-] (stress-strain) or
+                           ** F_C/k_t [mm] (force): the fourth identifiable quantity */
+    double e_tail_se;      /* its standard error, same unit; -1 when not determined */
     long evaluations;      /* evaluations of the model over the table (or its subsample), all
                            ** stages */
     long evaluations_full; /* those over every row of the table (the rest ran on the subsample
@@ -160,6 +178,14 @@ typedef struct cf_fit_result {
 ** strain >= 1, which no spring reaches) is returned with feasible = 0 and the violated bits. */
 cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                      cf_fit_result *res, cf_error *err);
+
+/* Fits the conical-tail law (one type): its four identifiable quantities by a grid and
+** Levenberg-Marquardt, their standard errors, and a spring of the type placed in closed form at
+** the preferred free length (src/fit/fit_tail.c). plain (may be NULL) is the plain law's fit of the
+** same table and type, a start. Fixed parameters are not honoured (the CLI refuses them). A spring
+** that cannot meet the limits is returned with feasible = 0 and the violated bits. */
+cf_status cf_fit_tail_run(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
+                          const cf_fit_result *plain, cf_fit_result *res, cf_error *err);
 
 /* Stage B alone: places one spring of the given type whose identifiable quantities are ident
 ** (family.h; of the table's kind, as cf_fit_result.ident), exactly as

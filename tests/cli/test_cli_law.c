@@ -1,0 +1,119 @@
+/*
+** `fit --law`: the choice between the conical law and the conical spring with a tail as the
+** command line sees it: the report shows both laws, the fit file names the law kept and carries the
+** comparison, and the combinations the tailed law does not support are usage errors (exit 2,
+** nothing written).
+*/
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+#include <jansson.h>
+
+#include "testutil.h"
+
+static int exists(const char *p)
+{
+    return access(p, F_OK) == 0;
+}
+
+/* Runs `fit ARGS -o FILE` (exit 0), the report into out; the fit file, loaded (then removed). */
+static json_t *fit_file_of(const char *args, char *out, size_t cap)
+{
+    char dir[] = "/tmp/conifit-law-XXXXXX", json[256];
+    static char errb[1 << 14];
+    assert_non_null(mkdtemp(dir));
+    snprintf(json, sizeof json, "%s/t.json", dir);
+    int st = tu_run(out, cap, errb, sizeof errb, "fit %s -o %s", args, json);
+    if (st != 0)
+        fail_msg("fit %s exited %d: %s", args, st, errb);
+    json_error_t jerr;
+    json_t *root = json_load_file(json, 0, &jerr);
+    assert_non_null(root);
+    remove(json);
+    rmdir(dir);
+    return root;
+}
+
+/* --law auto on a shipped table of a plain conical spring: both laws reported, the conical one
+** kept (the tail cannot lower the AIC of an exact conical table by more than its extra term). */
+static void auto_reports_both_laws(void **state)
+{
+    (void)state;
+    static char out[1 << 16];
+    json_t *root = fit_file_of("data/telescoping_noise1pct.csv --law auto", out, sizeof out);
+    assert_non_null(strstr(out, "Law (--law auto)"));
+    assert_non_null(strstr(out, "conical-tail RMSE"));
+    json_t *fits = json_object_get(root, "fits");
+    assert_true(json_array_size(fits) == 2);
+    for (size_t i = 0; i < 2; i++) {
+        json_t *f = json_array_get(fits, i), *lc = json_object_get(f, "law_comparison");
+        assert_non_null(lc);
+        const char *kept = json_string_value(json_object_get(lc, "chosen"));
+        assert_string_equal(kept, json_string_value(json_object_get(f, "law")));
+        const double a0 = json_number_value(json_object_get(json_object_get(lc, "conical"), "aic"));
+        const double a1 =
+            json_number_value(json_object_get(json_object_get(lc, "conical-tail"), "aic"));
+        /* the tail kept only with a lower AIC */
+        assert_true(strcmp(kept, "conical-tail") != 0 || a1 < a0);
+        assert_non_null(json_object_get(json_object_get(lc, "conical-tail"), "tail_compliance"));
+    }
+    json_decref(root);
+}
+
+/* --law conical-tail keeps the tailed law and writes its fourth quantity. */
+static void conical_tail_writes_the_tail(void **state)
+{
+    (void)state;
+    static char out[1 << 16];
+    json_t *root = fit_file_of("data/non_telescoping.csv --law conical-tail", out, sizeof out);
+    assert_non_null(strstr(out, "tail compliance e_t"));
+    assert_non_null(strstr(out, "n_tail"));
+    json_t *f = json_array_get(json_object_get(root, "fits"), 0);
+    assert_string_equal(json_string_value(json_object_get(f, "law")), "conical-tail");
+    json_t *tc = json_object_get(json_object_get(f, "identifiable"), "tail_compliance");
+    assert_non_null(tc);
+    assert_true(json_number_value(json_object_get(tc, "value")) > 0);
+    json_decref(root);
+}
+
+/* What the tailed law does not do is refused with exit 2 and nothing written. */
+static void unsupported_combinations_exit_2(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-law-XXXXXX", json[256];
+    assert_non_null(mkdtemp(dir));
+    snprintf(json, sizeof json, "%s/t.json", dir);
+    static char out[1 << 14], errb[1 << 14];
+    const char *const cases[] = {
+        "fit data/telescoping.csv --law cone -o %s",
+        "fit data/telescoping.csv --law conical-tail --target lattice -o %s",
+        "fit data/telescoping.csv data/non_telescoping.csv --joint --law auto -o %s",
+        "fit data/telescoping.csv --law auto --fix H=10 -o %s",
+        "fit data/series/synthetic_relaxation.csv --law conical-tail -o %s",
+        "fit data/telescoping.csv --law auto --mode shear -o %s",
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        int st = tu_run(out, sizeof out, errb, sizeof errb, cases[i], json);
+        if (st != 2)
+            fail_msg("'%s' exited %d: %s", cases[i], st, errb);
+        assert_non_null(strstr(errb, "--law"));
+        assert_false(exists(json));
+    }
+    rmdir(dir);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(auto_reports_both_laws),
+        cmocka_unit_test(conical_tail_writes_the_tail),
+        cmocka_unit_test(unsupported_combinations_exit_2),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
