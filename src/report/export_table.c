@@ -201,7 +201,11 @@ void cf_export_table_free(cf_export_table *t)
 
 double cf_export_table_end(const cf_law *law, double tol)
 {
-    return cf_law_deflection(law, law->F_solid_N * (1.0 - tol)); /* F_C without a tail */
+    /* where the law is within tol F_C of its solid force: holding the last row's force beyond
+    ** the table stays within tol F_C of the law up to solid (a tail's region 3 is linear) */
+    if (law->tail)
+        return cf_law_deflection(law, law->F_solid_N - tol * law->F_C_N);
+    return cf_law_deflection(law, law->F_C_N * (1.0 - tol));
 }
 
 /* The i-th point (0 <= i < 2 TABLE_CHECK) of the check grid over the half [0, U]. */
