@@ -165,6 +165,8 @@ typedef struct cf_export_report {
     int even;             /* 1: an evenly spaced table, over [u_lo, u_hi] of [req_lo, req_hi] */
     double req_lo_mm, req_hi_mm; /* the range asked for, mm */
     double end_force_rel; /* the law's force at the table's ends, fraction of F_C (the larger) */
+    double solid_force_rel; /* the law's force at solid, fraction of F_C: 1, or F_solid/F_C > 1
+                            ** for a spring with a tail */
     size_t groups;        /* lattice: spring groups (one table each) */
     size_t springs;       /* lattice: springs */
     size_t nodes;         /* lattice: nodes */
