@@ -24,6 +24,10 @@
 **
 ** The count is then settled by measurement: the maximum error on the check grid sets the next
 ** count (error ~ count^-2) until it is within the tolerance.
+**
+** A spring with a cylindrical tail (law.h): region 2 is placed the same way in r (the tail's F/k_t
+** added to the cone's deflection), ends at u_C where the cone closes (a row on the law), and the
+** tail's region 3 beyond it is straight, one exact interval to the table's end.
 */
 #include "conifit/export.h"
 

@@ -111,7 +111,8 @@ typedef struct cf_export_table {
                          ** shorter (where its rows meet the tolerance) */
 } cf_export_table;
 
-/* Where the full-range table ends: the compression (mm) at which the law carries F_C (1 - tol). */
+/* Where the full-range table ends: the compression (mm) at which the law carries F_C (1 - tol);
+** with a cylindrical tail F_solid - tol F_C, in the tail's straight region 3. */
 double cf_export_table_end(const cf_law *law, double tol);
 
 /* Samples the law into t over [-u_end, u_end] (see the top of this file). CF_E_DATA for a
