@@ -33,7 +33,7 @@ static void styles(cf_gp *g)
     cf_gp_cmd(g, "set style line 4 dt 4 lw 1.5 lc rgb %q", "#1b7837");
     cf_gp_cmd(g, "set style line 5 dt 5 lw 1.5 lc rgb %q", "#762a83");
     cf_gp_cmd(g, "set style line 6 dt (12, 4, 2, 4) lw 1.5 lc rgb %q", "#8c510a");
-    cf_gp_cmd(g, "set style line 7 dt (2, 2) lw 2 lc rgb %q", "#01665e");
+    cf_gp_cmd(g, "set style line 7 dt (8, 3, 2, 3, 2, 3) lw 2 lc rgb %q", "#01665e");
     cf_gp_cmd(g, "set style line 8 dt 1 lw 1.5 pt 4 ps 0.9 lc rgb %q", "#d6604d");
     cf_gp_cmd(g, "set style line 9 dt 2 lw 1.5 pt 8 ps 0.9 lc rgb %q", "#4393c3");
 }
