@@ -235,9 +235,11 @@ static int linear_fit(const cf_table *d, size_t ncol, basis_fn basis, const void
     return oom ? -1 : ok;
 }
 
-/* A profile and the table it runs on, for the minimiser. */
+/* A profile and the table it runs on (weighted: a subsample's weights count), for the
+** minimisers. */
 typedef struct profile_call {
     const cf_table *d;
+    int weighted;
     profile_fn f;
     void *scratch;
 } profile_call;
@@ -246,7 +248,7 @@ static double profile_rss(double p, void *data)
 {
     const profile_call *c = data;
     double A;
-    return c->f(c->d, 0, p, &A, c->scratch);
+    return c->f(c->d, c->weighted, p, &A, c->scratch);
 }
 
 /* Refines the scan's best p in (lo, hi) with Brent's method on the profile RSS; returns p
@@ -278,25 +280,29 @@ static double refine(profile_call *call, double p, double lo, double hi, int *oo
     return p;
 }
 
-/* Past Brent's resolution (GSL's Brent steps no finer than sqrt(DBL_EPSILON) of p): the vertex of
-** the parabola through the profile at p and p +- 1e-6 |p|, twice, each kept only where the RSS
-** does not grow. Near its minimum the profile is a parabola to about 1e-12 over that width, so p
-** lands within about 1e-12 of the minimum (the profile is summed from its residuals, so its
-** values resolve that). */
+/* Newton's method on the profile from p near its minimum, with the derivatives from the profile at
+** p and p +- 1e-6 |p| (the vertex of their parabola), at most six steps, each no longer than a
+** tenth of |p| and kept only where the RSS does not grow; stops once a step is below 1e-13 |p|.
+** It goes past Brent's resolution (GSL's Brent steps no finer than sqrt(DBL_EPSILON) of p) to
+** about 1e-12 of p, as the profile is summed from its residuals and resolves that; and from the
+** minimum of a subsample's profile to that of every row in a few steps. */
 static double polish(profile_call *call, double p)
 {
     double fp = profile_rss(p, call);
-    for (int it = 0; it < 2 && isfinite(fp) && p != 0; it++) {
+    for (int it = 0; it < 6 && isfinite(fp) && p != 0; it++) {
         const double h = 1e-6 * fabs(p);
         const double fm = profile_rss(p - h, call), fq = profile_rss(p + h, call);
         const double curv = fm - 2 * fp + fq;
         if (!(curv > 0) || !isfinite(fm) || !isfinite(fq))
             break;
         const double q = p - 0.5 * h * (fq - fm) / curv, fnew = profile_rss(q, call);
-        if (!(fnew <= fp) || fabs(q - p) > h)
+        if (!(fnew <= fp) || fabs(q - p) > 0.1 * fabs(p))
             break;
+        const int done = fabs(q - p) < 1e-13 * fabs(p);
         p = q;
         fp = fnew;
+        if (done)
+            break;
     }
     return p;
 }
@@ -305,19 +311,20 @@ static double polish(profile_call *call, double p)
 #define SCAN_SIDE 400
 
 /* From grid point ib of a scan over +-pmax (r: its profile RSS on the scan's table): on every row
-** of d, when the scan ran on a subsample, to the nearest minimum along the grid; then Brent
-** between the grid's neighbours, kept where it does not raise the RSS. Returns p. */
-static double from_grid_point(const cf_table *d, int subsampled, profile_fn prof, void *scratch,
-                              double pmax, int ib, double bestR, int *oom)
+** of d (weighted when dw), when the scan ran on a subsample, to the nearest minimum along the
+** grid; then Brent between the grid's neighbours, kept where it does not raise the RSS. Returns
+** p. */
+static double from_grid_point(const cf_table *d, int dw, int subsampled, profile_fn prof,
+                              void *scratch, double pmax, int ib, double bestR, int *oom)
 {
     const int N = SCAN_SIDE;
     double A;
     if (subsampled) {
-        bestR = prof(d, 0, pmax * (double)ib / N, &A, scratch);
+        bestR = prof(d, dw, pmax * (double)ib / N, &A, scratch);
         for (int dir = -1; dir <= 1; dir += 2)
             for (;;) {
                 int j = ib + dir == 0 ? ib + 2 * dir : ib + dir;
-                double r = j >= -N && j <= N ? prof(d, 0, pmax * (double)j / N, &A, scratch)
+                double r = j >= -N && j <= N ? prof(d, dw, pmax * (double)j / N, &A, scratch)
                                              : INFINITY;
                 if (!(r < bestR))
                     break;
@@ -326,24 +333,26 @@ static double from_grid_point(const cf_table *d, int subsampled, profile_fn prof
             }
     }
     double best = pmax * (double)ib / N;
-    profile_call call = {d, prof, scratch};
+    profile_call call = {d, dw, prof, scratch};
     double p = refine(&call, best, best - pmax / N, best + pmax / N, oom);
-    return prof(d, 0, p, &A, scratch) > bestR ? best : p;
+    return prof(d, dw, p, &A, scratch) > bestR ? best : p;
 }
 
-/* The shape parameter p of a profile (0 excluded): a scan over +-pmax, SCAN_SIDE points a side,
-** on scan (d itself, or its subsample, whose weights then count); then from_grid_point from the
+/* The shape parameter p of a profile (0 excluded) on d (weighted when dw): a scan over +-pmax,
+** SCAN_SIDE points a side, on scan (d itself, or its subsample, whose weights then count); then
+** from_grid_point from the
 ** scan's best point and, when tries > 1, from the lowest other local minima of the scan, up to
 ** tries in all (a profile with more than one valley); the lowest on every row is kept. Returns p
 ** with its coefficient in *A. */
-static double shape_fit(const cf_table *d, const cf_table *scan, profile_fn prof, void *scratch,
-                        double pmax, int tries, int *oom, double *A)
+static double shape_fit(const cf_table *d, int dw, const cf_table *scan, profile_fn prof,
+                        void *scratch, double pmax, int tries, int *oom, double *A)
 {
     const int N = SCAN_SIDE;
     double r[2 * SCAN_SIDE + 1], bestR = INFINITY;
     int cand[3] = {1, 0, 0}, ncand = 1;
     for (int i = -N; i <= N; i++) {
-        r[i + N] = i == 0 ? INFINITY : prof(scan, scan != d, pmax * (double)i / N, A, scratch);
+        r[i + N] = i == 0 ? INFINITY
+                          : prof(scan, scan != d || dw, pmax * (double)i / N, A, scratch);
         if (r[i + N] < bestR) {
             bestR = r[i + N];
             cand[0] = i;
@@ -369,14 +378,15 @@ static double shape_fit(const cf_table *d, const cf_table *scan, profile_fn prof
     }
     double p = pmax * (double)cand[0] / N, pbest = p, rbest = INFINITY;
     for (int c = 0; c < ncand; c++) {
-        p = from_grid_point(d, scan != d, prof, scratch, pmax, cand[c], r[cand[c] + N], oom);
-        const double rc = ncand > 1 ? prof(d, 0, p, A, scratch) : 0;
+        p = from_grid_point(d, dw, scan != d, prof, scratch, pmax, cand[c], r[cand[c] + N],
+                            oom);
+        const double rc = ncand > 1 ? prof(d, dw, p, A, scratch) : 0;
         if (c == 0 || rc < rbest) {
             rbest = rc;
             pbest = p;
         }
     }
-    prof(d, 0, pbest, A, scratch);
+    prof(d, dw, pbest, A, scratch);
     return pbest;
 }
 
@@ -418,8 +428,11 @@ static int ogden_fit(const cf_table *d, const cf_table *scan, cf_baseline *O, in
     }
     ogden_scratch s = {d->mode, g};
     double mu, amax = fmax(50.0, 50.0 / Lmax);
-    double alpha = shape_fit(&dl, scan != d ? &sl : &dl, ogden_profile, &s, amax, 3, oom, &mu);
-    profile_call call = {&dl, ogden_profile, &s};
+    /* the valleys are told apart on the subsample of a long table, whose minimum Newton's steps
+    ** then take to that of every row */
+    double alpha = scan != d ? shape_fit(&sl, 1, &sl, ogden_profile, &s, amax, 3, oom, &mu)
+                             : shape_fit(&dl, 0, &dl, ogden_profile, &s, amax, 3, oom, &mu);
+    profile_call call = {&dl, 0, ogden_profile, &s};
     alpha = polish(&call, alpha);
     if (d->mode == CF_MODE_PLANAR || d->mode == CF_MODE_SHEAR) /* even in alpha there */
         alpha = fabs(alpha);
@@ -467,8 +480,8 @@ cf_status cf_baseline_fit_all(const cf_table *d, cf_baseline out[CF_BASE_COUNT],
         scan = &sub;
     }
     /* Fung: B over +-50/xmax (exp(50) covers any stiffening a table shows) */
-    F->coef[1] = shape_fit(d, scan, fung_profile, NULL, xmax > 0 ? 50.0 / xmax : 1.0, 1, &oom,
-                           &F->coef[0]);
+    F->coef[1] = shape_fit(d, 0, scan, fung_profile, NULL, xmax > 0 ? 50.0 / xmax : 1.0, 1,
+                           &oom, &F->coef[0]);
     const char *why = cf_hyper_unfit(d);
     if (why) {
         unfit(Y, why);
