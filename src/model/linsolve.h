@@ -28,4 +28,16 @@ cf_status cf_linsolve_direction(struct solver *s, cf_error *err);
 ** holds it; sets *fatal for an out-of-memory that no fallback would survive. */
 int cf_linsolve_chord(struct solver *s, int *fatal, cf_error *err);
 
+/* The tangent at the state of the last residual into v (the pattern of s->C, which must exist),
+** scaled by the s->D of the last factorisation rather than its own diagonal: the matrix whose
+** solve the factors of s->chol precondition (linsolve_krylov.c). */
+void cf_linsolve_tangent_scaled(struct solver *s, double *v);
+
+/* The update s->dx from the current tangent, by GMRES preconditioned with the sparse factors of
+** an earlier one (s->chol, s->D), solved until its residual is eta times the right-hand side
+** (eta is kept between 1e-10 and 0.1: an inexact Newton step). Returns 1 when s->dx holds it, 0
+** when the factors are too stale for the solve to converge in a few steps (the caller refactors);
+** sets *fatal for an out-of-memory that no fallback would survive. */
+int cf_linsolve_krylov(struct solver *s, double eta, int *fatal, cf_error *err);
+
 #endif
