@@ -35,9 +35,10 @@ void cf_linsolve_tangent_scaled(struct solver *s, double *v);
 
 /* The update s->dx from the current tangent, by GMRES preconditioned with the sparse factors of
 ** an earlier one (s->chol, s->D), solved until its residual is eta times the right-hand side
-** (eta is kept between 1e-10 and 0.1: an inexact Newton step). Returns 1 when s->dx holds it, 0
-** when the factors are too stale for the solve to converge in a few steps (the caller refactors);
-** sets *fatal for an out-of-memory that no fallback would survive. */
+** (eta is kept between 1e-10 and 0.1: an inexact Newton step; after 16 GMRES steps short of eta,
+** a residual within 0.1 is still returned, a shorter step for the caller to judge). Returns 1 when
+** s->dx holds it, 0 when the factors are too stale for even that (the caller refactors); sets
+** *fatal for an out-of-memory that no fallback would survive. */
 int cf_linsolve_krylov(struct solver *s, double eta, int *fatal, cf_error *err);
 
 #endif
