@@ -34,11 +34,13 @@ int cf_linsolve_chord(struct solver *s, int *fatal, cf_error *err);
 void cf_linsolve_tangent_scaled(struct solver *s, double *v);
 
 /* The update s->dx from the current tangent, by GMRES preconditioned with the sparse factors of
-** an earlier one (s->chol, s->D), solved until its residual is eta times the right-hand side
-** (eta is kept between 1e-10 and 0.1: an inexact Newton step; after 16 GMRES steps short of eta,
-** a residual within 0.1 is still returned, a shorter step for the caller to judge). Returns 1 when
-** s->dx holds it, 0 when the factors are too stale for even that (the caller refactors); sets
-** *fatal for an out-of-memory that no fallback would survive. */
-int cf_linsolve_krylov(struct solver *s, double eta, int *fatal, cf_error *err);
+** an earlier one (s->chol, s->D). `need` is the reduction of the residual that would end Newton's
+** iteration (tolerance over residual, below 1): the linear residual is brought to a tenth of it
+** (kept between 1e-10 and 0.1 of the right-hand side: an inexact Newton step); after 16 GMRES
+** steps short of that, a linear residual within `need` or 0.1, whichever is larger (at most 0.5),
+** is still returned, a shorter step for the caller to judge. Returns 1 when s->dx holds it, 0 when
+** the factors are too stale for even that (the caller refactors); sets *fatal for an
+** out-of-memory that no fallback would survive. */
+int cf_linsolve_krylov(struct solver *s, double need, int *fatal, cf_error *err);
 
 #endif

@@ -14,11 +14,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* GMRES steps before the factors count as too stale (the caller then refactors), and the range of
-** the linear solve's residual relative to its right-hand side at which the update is accepted. */
+/* GMRES steps before the factors count as too stale, the range of the linear solve's residual
+** relative to its right-hand side aimed at (a tenth of the reduction the Newton step needs), and
+** the largest one taken after KRYLOV_MAX steps short of the aim (the caller refactors beyond). */
 #define KRYLOV_MAX 16
 #define KRYLOV_ETA_MIN 1e-10
 #define KRYLOV_ETA_MAX 0.1
+#define KRYLOV_TAKE_MAX 0.5
 
 /* y = A x for the matrix with C's pattern and the values v (both triangles stored). */
 static void pattern_mul(const gsl_spmatrix *C, const double *v, const double *x, double *y,
@@ -51,9 +53,10 @@ static int workspace(solver *s)
     return s->kval && s->kbasis;
 }
 
-int cf_linsolve_krylov(solver *s, double eta, int *fatal, cf_error *err)
+int cf_linsolve_krylov(solver *s, double need, int *fatal, cf_error *err)
 {
-    eta = fmin(fmax(eta, KRYLOV_ETA_MIN), KRYLOV_ETA_MAX);
+    const double eta = fmin(fmax(0.1 * need, KRYLOV_ETA_MIN), KRYLOV_ETA_MAX);
+    const double take = fmin(fmax(need, KRYLOV_ETA_MAX), KRYLOV_TAKE_MAX);
     const size_t n = s->ndof, m = KRYLOV_MAX;
     *fatal = 0;
     if (!s->chol || !s->C || n == 0)
@@ -113,9 +116,10 @@ int cf_linsolve_krylov(solver *s, double eta, int *fatal, cf_error *err)
         k = j + 1;
         conv = fabs(g[j + 1]) <= eta * beta || hn == 0;
     }
-    /* short of eta after KRYLOV_MAX steps: still an inexact Newton step when within the widest
-    ** eta, which the caller's line search and rate check judge */
-    if (!conv && !(fabs(g[k]) <= KRYLOV_ETA_MAX * beta))
+    /* short of eta after KRYLOV_MAX steps: still an inexact Newton step when it cuts the linear
+    ** residual by 10x, or by what the Newton step needs (at most 2x), which the caller's line
+    ** search and rate check judge */
+    if (!conv && !(fabs(g[k]) <= take * beta))
         return 0;
     double y[KRYLOV_MAX];
     for (size_t i = k; i-- > 0;) { /* H y = g, upper triangular */

@@ -260,9 +260,8 @@ cf_status cf_msm_newton(solver *s, cf_error *err)
         const int reuse = s->chord && s->chol_ready && !s->refactor;
         if (reuse) {
             int fatal = 0;
-            /* a Krylov solve only as accurate as this step needs: a tenth of the way from the
-            ** residual to the tolerance */
-            const int got = s->krylov ? cf_linsolve_krylov(s, 0.1 * target / rn, &fatal, &lerr)
+            /* a Krylov solve only as accurate as this step needs */
+            const int got = s->krylov ? cf_linsolve_krylov(s, target / rn, &fatal, &lerr)
                                       : cf_linsolve_chord(s, &fatal, &lerr);
             if (!got) {
                 if (fatal) {
@@ -312,7 +311,9 @@ cf_status cf_msm_newton(solver *s, cf_error *err)
             reuse_failed(s);
             continue;
         }
-        if (reuse && (alpha < 1 || rn > CHORD_RATE * rn0))
+        /* a slow step that ends the iteration is no reason for the next one to change */
+        if (reuse && (alpha < 1 || rn > CHORD_RATE * rn0) &&
+            !(um < SOLID_MARGIN && rn <= s->cfg->newton_rtol * fs + floor_f))
             reuse_failed(s);
     }
     if (s->st && um > s->st->max_u_over_travel && st == CF_OK)

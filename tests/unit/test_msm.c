@@ -456,7 +456,7 @@ static void krylov_step_solves_the_current_tangent(void **state)
     assert_non_null(kry);
     assert_non_null(chord);
     int fatal = 0;
-    assert_int_equal(cf_linsolve_krylov(&s, 1e-10, &fatal, &err), 1);
+    assert_int_equal(cf_linsolve_krylov(&s, 1e-9, &fatal, &err), 1);
     assert_int_equal(fatal, 0);
     memcpy(kry, s.dx, n * sizeof *kry);
     assert_int_equal(cf_linsolve_chord(&s, &fatal, &err), 1);
