@@ -228,8 +228,8 @@ static int cmp_start(const void *a, const void *b)
 
 /* ---- standard errors ------------------------------------------------------------------------- */
 
-void cf_tail_errors(cf_tail_residuals res, void *ctx, size_t n, const double v[4], double rss,
-                    double se[4], double corr[4][4], double *cov_Bt)
+void cf_tail_errors(cf_tail_residuals res, void *ctx, size_t n, const double v[4], double h_rel,
+                    double rss, double se[4], double corr[4][4], double *cov_Bt)
 {
     for (int k = 0; k < 4; k++) {
         se[k] = -1;
@@ -248,7 +248,7 @@ void cf_tail_errors(cf_tail_residuals res, void *ctx, size_t n, const double v[4
         double vp[4], vm[4];
         memcpy(vp, v, sizeof vp);
         memcpy(vm, v, sizeof vm);
-        const double h = 1e-6 * fabs(v[k]);
+        const double h = h_rel * fabs(v[k]);
         vp[k] += h;
         vm[k] -= h;
         if (k == 0) /* rho stays within (0, 1] */
@@ -563,7 +563,7 @@ cf_status cf_fit_tail_run(const cf_table *data, const cf_fit_options *opt, cf_sp
     }
     /* the identifiable quantities, their errors, the spring */
     double se[4], corr[4][4], cov_Bt;
-    cf_tail_errors(resid_at, &c, c.n, v, best, se, corr, &cov_Bt);
+    cf_tail_errors(resid_at, &c, c.n, v, 1e-6, best, se, corr, &cov_Bt);
     free(buf);
     cf_status st = cf_tail_result(data, opt, type, v, se, corr, cov_Bt, res, err);
     if (st != CF_OK)

@@ -34,6 +34,9 @@
 #define B_LO_SHARE 0.02 /* the cone's travel down to this share of the largest spring strain */
 #define Q_LO 1e-6
 #define Q_HI 0.99
+/* relative step of the errors' central differences, as the conical law's through the cell
+** (cell_problem.c) */
+#define FD_STEP 1e-4
 
 typedef struct lt_ctx {
     const cf_table *d;
@@ -240,7 +243,7 @@ cf_status cf_lattice_fit_tail(const cf_table *d, const cf_fit_options *opt,
     const double v[4] = {exp(zb[0]), zb[1], A, tau_of(zb[1], zb[2])};
     double se[4], corr[4][4], cov_Bt;
     const long before = c.pr.evals;
-    cf_tail_errors(lt_residuals, &c, d->count, v, f * c.pr.ynorm, se, corr, &cov_Bt);
+    cf_tail_errors(lt_residuals, &c, d->count, v, FD_STEP, f * c.pr.ynorm, se, corr, &cov_Bt);
     t->uncertainty_curves = c.pr.evals - before;
     if ((st = cf_tail_result(&reach, opt, plain->type, v, se, corr, cov_Bt, res, err)) != CF_OK)
         goto out;

@@ -18,11 +18,11 @@
 ** GSL_EDOM where the model cannot be evaluated there. */
 typedef int (*cf_tail_residuals)(void *ctx, const double v[4], gsl_vector *f);
 
-/* Standard errors of v = (rho, B, A, tau) from the central-difference Jacobian of res's n
-** residuals: s^2 (J^T J)^-1 with s^2 = rss/(n - 4); se[k] = -1 where J^T J is singular; corr
+/* Standard errors of v = (rho, B, A, tau) from the central-difference Jacobian (relative step
+** h_rel) of res's n residuals: s^2 (J^T J)^-1 with s^2 = rss/(n - 4); se[k] = -1 where J^T J is singular; corr
 ** their correlation (NAN where not determined), *cov_Bt the covariance of B and tau. */
-void cf_tail_errors(cf_tail_residuals res, void *ctx, size_t n, const double v[4], double rss,
-                    double se[4], double corr[4][4], double *cov_Bt);
+void cf_tail_errors(cf_tail_residuals res, void *ctx, size_t n, const double v[4], double h_rel,
+                    double rss, double se[4], double corr[4][4], double *cov_Bt);
 
 /* The largest stress scale F_C/H^2 a tailed spring of the type at (rho, B, tau) carries with
 ** G <= G_max, its whole travel past the strain need (a stress-strain table's largest strain with
