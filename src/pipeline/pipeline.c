@@ -139,10 +139,14 @@ static cf_status validate_fits(const cf_table *t, const cf_pipeline_options *opt
         } else {
             progress(opt, t, "fitting the %s spring through the lattice", type);
             cf_lattice_fit(t, &opt->fit, &opt->lattice, &r->fits[k], &r->thr[k], &verr);
+            /* the tailed law through the lattice where the conical law went through it, else
+            ** (a force table, a lattice that could not run) to the spring as without it */
             if (opt->fit.law != CF_FAMILY_CONICAL && verr.status != CF_E_INTERNAL) {
-                progress(opt, t, "fitting the %s spring with a tail through the lattice", type);
+                progress(opt, t, "fitting the %s spring with a tail", type);
                 cf_error terr = {0};
-                if (choose_law_in_lattice(t, opt, r, k, &terr) != CF_OK)
+                cf_status tst = r->thr[k].done ? choose_law_in_lattice(t, opt, r, k, &terr)
+                                               : choose_law(t, opt, r, k, &terr);
+                if (tst != CF_OK)
                     return cf_error_set(err, terr.status, "%s: %s", t->path, terr.msg);
             }
             cf_validate_lattice_fit(t, &opt->lattice, &r->fits[k], &r->val[k], &r->thr[k], &verr);

@@ -119,7 +119,7 @@ static json_t *law_comparison_json(const cf_fit_report *r, int i)
     const double u = r->table->y_to_file;
     return json_pack("{s:s, s:b, s:{s:o, s:o, s:b}, s:{s:o, s:o, s:b, s:o}}", "chosen",
                      lc->chose_tail ? "conical-tail" : "conical", "through_lattice",
-                     r->through_msm, "conical", "rmse",
+                     r->through_msm && r->thr[i].done, "conical", "rmse",
                      num(cone->rmse * u), "aic", num(lc->aic_conical), "feasible", cone->feasible,
                      "conical-tail", "rmse", num(tail->rmse * u), "aic", num(lc->aic_tail),
                      "feasible", tail->feasible, "tail_compliance", cf_report_tail_json(tail));

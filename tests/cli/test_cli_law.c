@@ -118,6 +118,27 @@ static void conical_tail_goes_through_the_lattice(void **state)
     }
 }
 
+/* A force-displacement table has no lattice: with --target lattice the conical law's fit keeps
+** its note and the tailed law goes to the spring, as without the option (exit 0). */
+static void force_table_with_lattice_target_fits_the_tail_to_the_spring(void **state)
+{
+    (void)state;
+    const char *dir = tu_datasets();
+    if (!dir)
+        skip();
+    static char out[1 << 16], args[1024];
+    snprintf(args, sizeof args,
+             "%s/thrombus_pureshear_force_displacement.csv --type non-telescoping "
+             "--law conical-tail --target lattice",
+             dir);
+    json_t *root = fit_file_of(args, out, sizeof out);
+    json_t *f = json_array_get(json_object_get(root, "fits"), 0);
+    assert_string_equal(json_string_value(json_object_get(f, "law")), "conical-tail");
+    json_t *lc = json_object_get(f, "law_comparison");
+    assert_false(json_is_true(json_object_get(lc, "through_lattice")));
+    json_decref(root);
+}
+
 /* What the tailed law does not do is refused with exit 2 and nothing written. */
 static void unsupported_combinations_exit_2(void **state)
 {
@@ -148,6 +169,7 @@ int main(void)
         cmocka_unit_test(auto_reports_both_laws),
         cmocka_unit_test(conical_tail_writes_the_tail),
         cmocka_unit_test(conical_tail_goes_through_the_lattice),
+        cmocka_unit_test(force_table_with_lattice_target_fits_the_tail_to_the_spring),
         cmocka_unit_test(unsupported_combinations_exit_2),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
