@@ -200,7 +200,7 @@ int cf_cli_parser_init(cf_cli_parser *p, const char *cmd, const char *help, int 
     size_t own = 0;
     while (longopts && longopts[own].name)
         own++;
-    size_t n = NCOMMON + (spring ? CF_P_COUNT : 0) + own;
+    size_t n = NCOMMON + (spring ? CF_P_ALL : 0) + own;
     p->longopts = calloc(n + 1, sizeof *p->longopts);
     if (!p->longopts) {
         fprintf(stderr, "conifit %s: out of memory\n", cmd);
@@ -209,7 +209,7 @@ int cf_cli_parser_init(cf_cli_parser *p, const char *cmd, const char *help, int 
     size_t k = 0;
     for (size_t i = 0; i < NCOMMON; i++)
         p->longopts[k++] = common_opts[i];
-    for (int i = 0; spring && i < CF_P_COUNT; i++)
+    for (int i = 0; spring && i < CF_P_ALL; i++)
         p->longopts[k++] = (struct option){cf_spring_param_info(i)->name, required_argument, NULL,
                                            CF_CLI_OPT_SPRING + i};
     for (size_t i = 0; i < own; i++)
@@ -361,7 +361,7 @@ void cf_cli_out_abort(cf_cli_out *o)
 int cf_cli_spring_take(cf_cli_spring *s, int c, const char *text, cf_error *err)
 {
     int k = c - CF_CLI_OPT_SPRING;
-    if (k < 0 || k >= CF_P_COUNT)
+    if (k < 0 || k >= CF_P_ALL)
         return 0;
     char flag[16];
     double v;
@@ -384,8 +384,8 @@ cf_status cf_cli_spring_complete(const cf_cli_spring *s, cf_error *err)
 
 void cf_cli_spring_help(FILE *out)
 {
-    fputs("Spring (all six required):\n", out);
-    for (int k = 0; k < CF_P_COUNT; k++) {
+    fputs("Spring (the first six required; the cylindrical tail's two optional):\n", out);
+    for (int k = 0; k < CF_P_ALL; k++) {
         const cf_spring_param *sp = cf_spring_param_info(k);
         char flag[32];
         snprintf(flag, sizeof flag, "--%s %s", sp->name,

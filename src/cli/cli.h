@@ -128,18 +128,20 @@ int cf_cli_is_stdio(const char *path);
 /* 1 when path names a folder: it ends in '/' or is an existing directory. */
 int cf_cli_is_dir_target(const char *p);
 
-/* ---- the spring options --D1 --D2 --n --d --G --H (force, curve, info, synth) -------------- */
+/* ---- the spring options --D1 --D2 --n --d --G --H, and the tail's --n_tail --H_tail (force,
+** curve, info, synth) ---------------------------------------------------------------------------- */
 
 typedef struct cf_cli_spring {
     cf_spring p;
-    int have[CF_P_COUNT]; /* which of D1, D2, n, d, G, H were given */
+    int have[CF_P_ALL]; /* which of D1, D2, n, d, G, H, n_tail, H_tail were given */
 } cf_cli_spring;
 
 /* Takes option code c (CF_CLI_OPT_SPRING + k) with value text. Returns 1 when c is a spring
 ** option it took, 0 when c is another option, -1 on a bad value (message in err). */
 int cf_cli_spring_take(cf_cli_spring *s, int c, const char *text, cf_error *err);
 
-/* After parsing: CF_E_USAGE naming the first missing spring option. */
+/* After parsing: CF_E_USAGE naming the first missing spring option (of the six; the tail's
+** two default to 0, no tail). */
 cf_status cf_cli_spring_complete(const cf_cli_spring *s, cf_error *err);
 
 /* Prints the spring options' help (from the spring description, spring.h). */

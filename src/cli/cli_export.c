@@ -323,8 +323,12 @@ static void print_summary(const cf_export_format_info *fi, int lattice,
                 "compression), where at most %zu evenly spaced rows meet the tolerance; ",
                 rep->req_lo_mm, rep->req_hi_mm, rep->u_lo_mm, rep->u_hi_mm, fi->max_rows);
     fprintf(stderr, "at its ends the law carries %.4g of F_C; past them the curve is extrapolated "
-                    "along its end segments (the law stiffens to F_C at solid)\n",
+                    "along its end segments ",
             rep->end_force_rel);
+    if (rep->solid_force_rel > 1.0) /* a tail: region 3 rises linearly to the solid force */
+        fprintf(stderr, "(the law reaches %.4g of F_C at solid)\n", rep->solid_force_rel);
+    else
+        fprintf(stderr, "(the law stiffens to F_C at solid)\n");
 }
 
 /* export: parse, load the spring (and the lattice), render the whole output in memory, write it,

@@ -23,7 +23,8 @@ static const char curve_help[] =
     "usage: conifit curve SPRING [--points N] [--method M] [-o FILE.csv]\n"
     "Prints the CSV table u_mm,force_N,stiffness_N_per_mm from full stretch (u = -travel)\n"
     "to solid (u = +travel), N points evenly spaced in u (default 201). At +-travel the\n"
-    "spring is solid: the force is +-F_C and the stiffness is reported as 0.\n\n"
+    "spring is solid: the force is +-F_C (+-F_solid with a tail) and the stiffness is\n"
+    "reported as 0.\n\n"
     "  --points N   number of rows, 2..10000000 (default 201)\n"
     "  --method M   exact | closed | closed+newton | table (default closed)\n"
     "  --table N    intervals of the table for --method table (default 256)\n"
@@ -34,7 +35,9 @@ static const char curve_help[] =
 static const char info_help[] =
     "usage: conifit info SPRING [-o FILE]\n"
     "Prints the derived quantities of a conical spring: type, solid and maximum length,\n"
-    "travel, transition and solid loads, linear stiffness, spring index and diameter ratio.\n\n"
+    "travel, transition and solid loads, linear stiffness, spring index and diameter ratio;\n"
+    "with a cylindrical tail also its stiffness, the load and compression at which the cone\n"
+    "closes, the load at which the whole spring is solid and the three regions.\n\n"
     "  -o FILE      write them to FILE (atomically) instead of standard output\n"
     "  --spring FILE.json[:TYPE]  instead of the six: the spring of a fit file or of an\n"
     "               exported spring (conifit export --format json)\n\n";
@@ -112,10 +115,10 @@ static int parse(const char *cmd, const char *help, const char *allowed, int arg
     if (optind < argc)
         return cf_cli_usage_error(cmd, "unexpected argument '%s'", argv[optind]);
     if (a->spring_file) {
-        for (int k = 0; k < CF_P_COUNT; k++)
+        for (int k = 0; k < CF_P_ALL; k++)
             if (a->spring.have[k])
-                return cf_cli_usage_error(cmd, "--spring replaces --D1 --D2 --n --d --G --H; "
-                                               "give one or the other");
+                return cf_cli_usage_error(cmd, "--spring replaces --D1 --D2 --n --d --G --H "
+                                               "(and --n_tail --H_tail); give one or the other");
         cf_fitted_spring fs;
         if (cf_fitfile_load_spec(a->spring_file, &fs, &err) != CF_OK)
             return cf_cli_fail(&err);
@@ -204,6 +207,31 @@ int cf_cli_curve(int argc, char **argv)
     return run("curve", curve_help, "points method", argc, argv, curve_body);
 }
 
+/* The tail's block of info: its stiffness and share, where the cone closes, the whole spring's
+** solid load and the three regions in compression (stretching mirrors them). */
+static void info_tail(FILE *o, const cf_law *law)
+{
+    const double H = law->p.H_mm;
+    fprintf(o, "tail (cylindrical, in series with the cone)\n");
+    fprintf(o, "  %-34s %.10g N/mm\n", "k_tail = G d^4/(8 n_tail D1^3)", law->k_tail_N_per_mm);
+    fprintf(o, "  %-34s %.10g\n", "tau = n_tail/n", law->tau);
+    fprintf(o, "  %-34s %.10g\n", "beta = (1/rho - 1) tau", law->beta);
+    fprintf(o, "  %-34s %.10g mm\n", "cone travel s", law->cone_travel_mm);
+    fprintf(o, "  %-34s %.10g mm\n", "tail travel s_t", law->travel_mm - law->cone_travel_mm);
+    fprintf(o, "  %-34s %.10g mm\n", "u_C (the cone closes)", law->u_C_mm);
+    fprintf(o, "  %-34s %.10g N\n", "F_solid (the tail closes)", law->F_solid_N);
+    fprintf(o, "  %-34s %.10g\n", "tail compliance F_C/(k_tail H)",
+            law->F_C_N / (law->k_tail_N_per_mm * H));
+    fprintf(o, "regions (compression; stretching mirrors them)\n");
+    fprintf(o, "  %-34s 0 <= u <= %.10g mm (strain %.6g)\n", "1 linear, cone and tail",
+            law->u_T_mm, law->u_T_mm / H);
+    fprintf(o, "  %-34s %.10g < u < %.10g mm (strain %.6g)\n", "2 the cone's coils close",
+            law->u_T_mm, law->u_C_mm, law->u_C_mm / H);
+    fprintf(o, "  %-34s %.10g <= u < %.10g mm (strain %.6g)\n", "3 linear, the tail alone",
+            law->u_C_mm, law->travel_mm, law->travel_mm / H);
+    fprintf(o, "  %-34s u >= %.10g mm, F = %.10g N\n", "solid", law->travel_mm, law->F_solid_N);
+}
+
 static void info_body(FILE *o, const law_args *a, const cf_law *law)
 {
     (void)a;
@@ -211,13 +239,14 @@ static void info_body(FILE *o, const law_args *a, const cf_law *law)
     fprintf(o, "conical spring, %s\n", cf_spring_type_name(law->type));
     /* the design parameters: name, unit and meaning from the spring's field table (a
     ** dimensionless one, unit "-", is printed bare) */
-    for (int k = 0; k < CF_P_COUNT; k++) {
+    for (int k = 0; k < (law->tail ? CF_P_ALL : CF_P_COUNT); k++) {
         const cf_spring_param *sp = cf_spring_param_info(k);
         const int bare = strcmp(sp->unit, "-") == 0;
         char value[64];
         snprintf(value, sizeof value, "%.10g%s%s", cf_spring_get(p, k), bare ? "" : " ",
                  bare ? "" : sp->unit);
-        fprintf(o, "  %-4s %-29s %s\n", sp->name, value, sp->meaning);
+        const int w = law->tail ? 6 : 4; /* n_tail and H_tail widen the name's column */
+        fprintf(o, "  %-*s %-*s %s\n", w, sp->name, 33 - w, value, sp->meaning);
     }
     fprintf(o, "derived\n");
     fprintf(o, "  %-34s %s ((D2-D1)/2 = %.6g mm %s n d = %.6g mm)\n", "type",
@@ -227,13 +256,18 @@ static void info_body(FILE *o, const law_args *a, const cf_law *law)
     fprintf(o, "  %-34s %.10g\n", "spring index c = D1/d", law->index_c);
     fprintf(o, "  %-34s %.10g mm\n", "L_min (solid length)", law->L_min_mm);
     fprintf(o, "  %-34s %.10g mm\n", "L_max (full stretch)", law->L_max_mm);
-    fprintf(o, "  %-34s %.10g mm\n", "travel s = H - L_min", law->travel_mm);
-    fprintf(o, "  %-34s %.10g\n", "solid strain s/H", law->travel_mm / p->H_mm);
+    fprintf(o, "  %-34s %.10g mm\n", law->tail ? "travel s + s_t = H - L_min" : "travel s = H - L_min",
+            law->travel_mm);
+    fprintf(o, "  %-34s %.10g\n", law->tail ? "solid strain (s + s_t)/H" : "solid strain s/H",
+            law->travel_mm / p->H_mm);
     fprintf(o, "  %-34s %.10g N/mm\n", "k0 (linear stiffness)", law->k0_N_per_mm);
     fprintf(o, "  %-34s %.10g mm\n", "u_T (end of linear region)", law->u_T_mm);
     fprintf(o, "  %-34s %.10g N\n", "F_T (transition load)", law->F_T_N);
-    fprintf(o, "  %-34s %.10g N\n", "F_C (solid load)", law->F_C_N);
+    fprintf(o, "  %-34s %.10g N\n", law->tail ? "F_C (the cone's solid load)" : "F_C (solid load)",
+            law->F_C_N);
     fprintf(o, "  %-34s %.10g MPa\n", "F_C/H^2 (stress scale)", law->F_C_N / (p->H_mm * p->H_mm));
+    if (law->tail)
+        info_tail(o, law);
 }
 
 int cf_cli_info(int argc, char **argv)

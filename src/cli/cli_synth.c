@@ -180,9 +180,14 @@ static void write_header(FILE *fp, const synth_args *a, const cf_law *law, doubl
     }
     fprintf(fp, "\n");
     fprintf(fp, "# spring:");
-    for (int k = 0; k < CF_P_COUNT; k++)
+    for (int k = 0; k < (law->tail ? CF_P_ALL : CF_P_COUNT); k++)
         fprintf(fp, " %s=%.17g", cf_spring_param_info(k)->key, cf_spring_get(p, k));
     fprintf(fp, "\n");
+    if (law->tail)
+        fprintf(fp, "# tail: cone_travel_mm=%.10g u_C_mm=%.10g k_tail_N_per_mm=%.10g tau=%.10g "
+                    "F_solid_N=%.10g tail_compliance=F_C/(k_tail H)=%.10g\n",
+                law->cone_travel_mm, law->u_C_mm, law->k_tail_N_per_mm, law->tau, law->F_solid_N,
+                law->F_C_N / (law->k_tail_N_per_mm * p->H_mm));
     fprintf(fp, "# type: %s ((D2 - D1)/2 = %.10g mm %s n d = %.10g mm)\n",
             cf_spring_type_name(law->type), 0.5 * (p->D2_mm - p->D1_mm),
             law->type == CF_TELESCOPING ? ">=" : "<", p->n * p->d_mm);

@@ -37,6 +37,10 @@
 #define TAIL_TAU_HI 1e3
 #define TAIL_STARTS 6
 #define TAIL_GAP 1.5          /* tail gap per coil over the cone's, where the length allows */
+#define TAIL_COILS_MIN 1.0    /* a tail of less than one coil is no tail: the cone gets more
+                              ** coils (n >= 1/tau), up to n_max */
+#define TAIL_GAP_MAX 10       /* a tail whose gap per coil would exceed ten times the cone's to
+                              ** stay open past the table is no wound spring: CF_C_TRAVEL */
 #define TAIL_SEARCH_ROWS 1000
 #define TAIL_SOLID_RATIO 1.6  /* the whole spring solid at this multiple of the table's largest
                               ** strain, where the length allows (else 1.05): the data do not
@@ -298,7 +302,8 @@ struct tail_geom {
 static double tail_extra(double B, double tau, double need, int preferred)
 {
     if (preferred)
-        return fmax((TAIL_GAP - 1) * tau * B, need * TAIL_SOLID_RATIO - B * (1 + tau));
+        return fmax((TAIL_GAP - 1) * tau * B,
+                    fmin(need * TAIL_SOLID_RATIO - B * (1 + tau), (TAIL_GAP_MAX - 1) * tau * B));
     return fmax(1e-3 * tau * B, need * (1 + 1e-9) - B * (1 + tau));
 }
 
@@ -320,13 +325,16 @@ static tail_geom tail_geometry(double rho, double B, double tau, cf_spring_type 
         g.c = cmin;
         const double n_type = cmin * (1 - rho) / (2 * rho) * (1 + 1e-6);
         const double n_D = cmin * room / ((1 + tau) * rho * o->D2_over_H_max);
-        g.n = fmax(2.0, fmax(n_type, n_D));
+        g.n = fmax(fmax(2.0, TAIL_COILS_MIN / tau), fmax(n_type, n_D));
         if (g.n > o->upper[CF_P_N])
             g.violated |= CF_C_COILS_MAX;
         g.dw = room / (g.n * (1 + tau));
     } else {
-        /* the cone's solid length d and the tail's tau n d, with n = 2 */
-        g.n = 2.0;
+        /* the cone's solid length d and the tail's tau n d, with n = 2 (more when the tail would
+        ** have less than a coil) */
+        g.n = fmax(2.0, TAIL_COILS_MIN / tau);
+        if (g.n > o->upper[CF_P_N])
+            g.violated |= CF_C_COILS_MAX;
         g.dw = room / (1 + tau * g.n);
         const double c_type = 2 * g.n * rho / (1 - rho);
         const double c_D = o->D2_over_H_max * rho / g.dw;
@@ -363,6 +371,8 @@ static cf_spring tail_place(double rho, double B, double A, double tau, cf_sprin
             break;
     }
     *violated = g.violated;
+    if (lo > (TAIL_GAP_MAX - 1) * tau * B * (1 + 1e-9))
+        *violated |= CF_C_TRAVEL;
     if (G > o->upper[CF_P_G] * (1 + 1e-9))
         *violated |= CF_C_G_MAX;
     const double D1 = g.c * g.dw;

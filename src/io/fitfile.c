@@ -159,9 +159,11 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
         goto done;
     }
     json_t *params = json_object_get(fit, "params");
-    for (int k = 0; k < CF_P_COUNT; k++) {
+    for (int k = 0; k < CF_P_ALL; k++) {
         const char *key = cf_spring_param_info(k)->key;
         json_t *v = json_object_get(params, key);
+        if (!v && k >= CF_P_COUNT) /* the tail's keys: absent without a tail */
+            continue;
         if (!json_is_number(v) || !isfinite(json_number_value(v))) {
             char *text = v ? json_dumps(v, JSON_ENCODE_ANY) : NULL;
             st = cf_error_set(err, CF_E_DATA, "%s: %s.params.%s = %.40s is not a number", path,
@@ -242,7 +244,8 @@ json_t *cf_fitfile_spring_json(const cf_law *law)
 {
     const cf_spring *p = &law->p;
     json_t *params = json_object();
-    for (int k = 0; params && k < CF_P_COUNT; k++)
+    const int count = law->tail ? CF_P_ALL : CF_P_COUNT; /* the tail's keys only with a tail */
+    for (int k = 0; params && k < count; k++)
         json_object_set_new(params, cf_spring_param_info(k)->key,
                             cf_json_number(cf_spring_get(p, k)));
     json_t *derived = json_pack(
@@ -252,6 +255,13 @@ json_t *cf_fitfile_spring_json(const cf_law *law)
         cf_json_number(law->F_C_N), "k0_N_per_mm", cf_json_number(law->k0_N_per_mm), "u_T_mm",
         cf_json_number(law->u_T_mm), "index_c", cf_json_number(law->index_c), "L_min_mm",
         cf_json_number(law->L_min_mm), "L_max_mm", cf_json_number(law->L_max_mm));
+    if (derived && law->tail) {
+        const struct { const char *key; double v; } tail[] = {
+            {"u_C_mm", law->u_C_mm}, {"F_solid_N", law->F_solid_N},
+            {"k_tail_N_per_mm", law->k_tail_N_per_mm}, {"tau", law->tau}};
+        for (size_t i = 0; i < sizeof tail / sizeof tail[0]; i++)
+            json_object_set_new(derived, tail[i].key, cf_json_number(tail[i].v));
+    }
     if (!params || !derived) {
         json_decref(params);
         json_decref(derived);

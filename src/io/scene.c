@@ -101,10 +101,10 @@ static cf_status object(ctx *c, json_t *root, const char *key, int required, jso
 static cf_status spring_section(ctx *c, json_t *sp, cf_scene *sc)
 {
     static const char *const allowed[] = {"fit", "type", "params", NULL};
-    const char *pkeys[CF_P_COUNT + 1]; /* the keys of the spring description (spring.h) */
-    for (int k = 0; k < CF_P_COUNT; k++)
+    const char *pkeys[CF_P_ALL + 1]; /* the keys of the spring description (spring.h) */
+    for (int k = 0; k < CF_P_ALL; k++)
         pkeys[k] = cf_spring_param_info(k)->key;
-    pkeys[CF_P_COUNT] = NULL;
+    pkeys[CF_P_ALL] = NULL;
     cf_status st = only_keys(c, sp, "spring", allowed);
     if (st)
         return st;
@@ -149,9 +149,10 @@ static cf_status spring_section(ctx *c, json_t *sp, cf_scene *sc)
                             c->name);
     if ((st = only_keys(c, params, "spring.params", pkeys)))
         return st;
-    for (int k = 0; k < CF_P_COUNT; k++) {
+    for (int k = 0; k < CF_P_ALL; k++) { /* the cone's six are required, the tail's two not */
         double v;
-        if ((st = number(c, params, "spring.params", pkeys[k], 1, 0, 0, 1, INFINITY, &v)))
+        const int cone = k < CF_P_COUNT;
+        if ((st = number(c, params, "spring.params", pkeys[k], cone, 0, 0, cone, INFINITY, &v)))
             return st;
         cf_spring_set(&sc->spring, k, v);
     }

@@ -24,8 +24,9 @@ static cf_status need(const void *p, const char *what, cf_error *err)
     return p ? CF_OK : cf_error_set(err, CF_E_USAGE, "%s is NULL", what);
 }
 
-cf_status cf_flat_force(const double spring[6], const char *method, size_t count,
-                        const double *u_mm, double *F_N, double *k_N_per_mm, cf_error *err)
+/* The force of spring p (the tail's two included; 0 and 0 without one): cf_flat_force's work. */
+static cf_status force_of(const double *spring, int nparams, const char *method, size_t count,
+                          const double *u_mm, double *F_N, double *k_N_per_mm, cf_error *err)
 {
     cf_status s;
     if ((s = need(spring, "the spring", err)) != CF_OK ||
@@ -35,7 +36,9 @@ cf_status cf_flat_force(const double spring[6], const char *method, size_t count
     cf_law_method m = CF_LAW_CLOSED;
     if (method && (s = cf_law_method_parse(method, &m, err)) != CF_OK)
         return s;
-    cf_spring p = {spring[0], spring[1], spring[2], spring[3], spring[4], spring[5]};
+    cf_spring p = {0};
+    for (int k = 0; k < nparams; k++)
+        cf_spring_set(&p, k, spring[k]);
     cf_law law;
     if ((s = cf_law_init(&law, &p, err)) != CF_OK)
         return s;
@@ -46,6 +49,18 @@ cf_status cf_flat_force(const double spring[6], const char *method, size_t count
     cf_law_force_many(&law, m, count, u_mm, F_N, k_N_per_mm);
     cf_law_free(&law);
     return CF_OK;
+}
+
+cf_status cf_flat_force(const double spring[6], const char *method, size_t count,
+                        const double *u_mm, double *F_N, double *k_N_per_mm, cf_error *err)
+{
+    return force_of(spring, CF_P_COUNT, method, count, u_mm, F_N, k_N_per_mm, err);
+}
+
+cf_status cf_flat_force_tail(const double spring[8], const char *method, size_t count,
+                             const double *u_mm, double *F_N, double *k_N_per_mm, cf_error *err)
+{
+    return force_of(spring, CF_P_ALL, method, count, u_mm, F_N, k_N_per_mm, err);
 }
 
 cf_status cf_flat_fit(const char *table_path, const char *type, int validate, char **json,

@@ -77,6 +77,7 @@ def _declare(lib):
     dp = ctypes.POINTER(ctypes.c_double)
     err = ctypes.POINTER(_CfError)
     lib.cf_flat_force.argtypes = [dp, ctypes.c_char_p, ctypes.c_size_t, dp, dp, dp, err]
+    lib.cf_flat_force_tail.argtypes = [dp, ctypes.c_char_p, ctypes.c_size_t, dp, dp, dp, err]
     lib.cf_flat_fit.argtypes = [ctypes.c_char_p, ctypes.c_char_p, ctypes.c_int,
                                 ctypes.POINTER(ctypes.c_void_p), err]
     lib.cf_flat_simulate.argtypes = [ctypes.c_char_p, ctypes.POINTER(dp),
@@ -85,7 +86,8 @@ def _declare(lib):
                                    ctypes.c_double, ctypes.POINTER(ctypes.c_void_p), err]
     lib.cf_flat_free.argtypes = [ctypes.c_void_p]
     lib.cf_flat_free.restype = None
-    for name in ("cf_flat_force", "cf_flat_fit", "cf_flat_simulate", "cf_flat_export"):
+    for name in ("cf_flat_force", "cf_flat_force_tail", "cf_flat_fit", "cf_flat_simulate",
+                 "cf_flat_export"):
         getattr(lib, name).restype = ctypes.c_int
     return lib
 
@@ -122,18 +124,21 @@ def _numbers(values, what):
 
 
 def force(spring, u_mm, method="closed", stiffness=False):
-    """Force (N) of the spring [D1, D2, n, d, G, H] (mm, MPa) at each compression in u_mm (mm,
-    > 0 shortens); with stiffness=True a pair of lists (forces, tangent stiffnesses in N/mm)."""
+    """Force (N) of the spring [D1, D2, n, d, G, H] (mm, MPa), or [D1, D2, n, d, G, H, n_tail,
+    H_tail] for a spring with a cylindrical tail, at each compression in u_mm (mm, > 0 shortens);
+    with stiffness=True a pair of lists (forces, tangent stiffnesses in N/mm)."""
     p = _numbers(spring, "the spring")
-    if len(p) != 6:
-        raise Error(-1, "the spring needs 6 numbers (D1, D2, n, d, G, H), got %d" % len(p))
+    if len(p) not in (6, 8):
+        raise Error(-1, "the spring needs 6 numbers (D1, D2, n, d, G, H) or 8 (and n_tail, "
+                        "H_tail), got %d" % len(p))
     u = _numbers(u_mm, "the displacements")
     n = len(u)
     arr = ctypes.c_double * max(n, 1)
     F, k = arr(), arr()
     e = _CfError()
-    _check(_lib.cf_flat_force((ctypes.c_double * 6)(*p), _text(method, "method"), n, arr(*u), F,
-                              k if stiffness else None, ctypes.byref(e)), e)
+    call = _lib.cf_flat_force if len(p) == 6 else _lib.cf_flat_force_tail
+    _check(call((ctypes.c_double * len(p))(*p), _text(method, "method"), n, arr(*u), F,
+                k if stiffness else None, ctypes.byref(e)), e)
     if stiffness:
         return list(F[:n]), list(k[:n])
     return list(F[:n])

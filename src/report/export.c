@@ -451,6 +451,7 @@ cf_export_report cf_export_report_of_table(const cf_export_table *t, const cf_la
     r.req_hi_mm = t->req_hi_mm;
     if (t->rows)
         r.end_force_rel = fmax(fabs(t->F_N[0]), fabs(t->F_N[t->rows - 1])) / law->F_C_N;
+    r.solid_force_rel = law->F_solid_N / law->F_C_N;
     return r;
 }
 

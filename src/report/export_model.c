@@ -189,7 +189,7 @@ char *cf_export_febio_log_name(char *buf, size_t cap, const char *output)
 void cf_export_comment_spring(FILE *out, const char *lead, const char *tail, const cf_law *law)
 {
     fprintf(out, "%sspring (%s):", lead, cf_spring_type_name(law->type));
-    for (int k = 0; k < CF_P_COUNT; k++) {
+    for (int k = 0; k < (law->tail ? CF_P_ALL : CF_P_COUNT); k++) {
         const cf_spring_param *sp = cf_spring_param_info(k);
         fprintf(out, "%s %s = %.17g%s%s", k ? "," : "", sp->name, cf_spring_get(&law->p, k),
                 strcmp(sp->unit, "-") ? " " : "", strcmp(sp->unit, "-") ? sp->unit : "");
@@ -197,6 +197,12 @@ void cf_export_comment_spring(FILE *out, const char *lead, const char *tail, con
     fprintf(out, "%s\n", tail);
     fprintf(out, "%stravel s = %.17g mm, F_T = %.17g N, F_C = %.17g N, k0 = %.17g N/mm%s\n", lead,
             law->travel_mm, law->F_T_N, law->F_C_N, law->k0_N_per_mm, tail);
+    if (law->tail)
+        fprintf(out,
+                "%scylindrical tail in series: k_tail = %.17g N/mm; the cone closes at u_C = "
+                "%.17g mm (F_C), then the force rises linearly to F_solid = %.17g N at solid "
+                "(travel s above is the whole spring's)%s\n",
+                lead, law->k_tail_N_per_mm, law->u_C_mm, law->F_solid_N, tail);
 }
 
 void cf_export_comment_table(FILE *out, const char *lead, const char *tail,
@@ -208,10 +214,10 @@ void cf_export_comment_table(FILE *out, const char *lead, const char *tail,
             lead, t->rows, t->u_lo_mm, t->u_hi_mm, t->tol, t->max_err_rel, t->max_err_N,
             t->max_err_u_mm, tail);
     fprintf(out,
-            "%sthe law is solid at |u| = %.17g mm (force F_C); past the table's ends a simulator "
+            "%sthe law is solid at |u| = %.17g mm (force %s); past the table's ends a simulator "
             "that holds the last force is within %.3g F_C of the law up to solid when the table "
             "runs to its full range%s\n",
-            lead, law->travel_mm, t->tol, tail);
+            lead, law->travel_mm, law->tail ? "F_solid" : "F_C", t->tol, tail);
 }
 
 void cf_export_comment_even(FILE *out, const char *lead, const char *tail,
@@ -238,9 +244,10 @@ void cf_export_comment_even(FILE *out, const char *lead, const char *tail,
     fprintf(out,
             "%sat the curve's ends the law carries %.6g and %.6g of F_C; past them LS-DYNA "
             "extrapolates the curve along its end segments (a straight line), while the law "
-            "stiffens to F_C at solid (|u| = %.10g mm): keep the springs' compression within "
+            "stiffens to %s at solid (|u| = %.10g mm): keep the springs' compression within "
             "the curve%s\n",
-            lead, F_lo / law->F_C_N, F_hi / law->F_C_N, law->travel_mm, tail);
+            lead, F_lo / law->F_C_N, F_hi / law->F_C_N, law->tail ? "F_solid" : "F_C",
+            law->travel_mm, tail);
 }
 
 static void model_header(FILE *out, const char *lead, const char *tail, const cf_xmodel *m,

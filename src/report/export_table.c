@@ -24,6 +24,10 @@
 **
 ** The count is then settled by measurement: the maximum error on the check grid sets the next
 ** count (error ~ count^-2) until it is within the tolerance.
+**
+** A spring with a cylindrical tail (law.h): region 2 is placed the same way in r (the tail's F/k_t
+** added to the cone's deflection), ends at u_C where the cone closes (a row on the law), and the
+** tail's region 3 beyond it is straight, one exact interval to the table's end.
 */
 #include "conifit/export.h"
 
@@ -59,11 +63,15 @@ static double density(double t)
 }
 
 /* Compression (mm) of the point of region 2 at r = 1 + t^2, written without cancellation near
-** solid. */
+** solid. With a tail the cone's gap is measured from its own travel s and the tail adds F/k_t. */
 static double u_of_t(const cf_law *law, double t)
 {
-    const double q = t * t, A = law->travel_mm / law->rho_inv_m1;
+    const double q = t * t, A = law->cone_travel_mm / law->rho_inv_m1;
     const double gap = A * q * q * (6.0 + q * (8.0 + 3.0 * q)) / (4.0 * (1.0 + q) * (1.0 + q) * (1.0 + q));
+    if (law->tail) {
+        const double r = 1.0 + q, F = law->F_C_N / (r * r * r);
+        return law->cone_travel_mm - gap + F / law->k_tail_N_per_mm;
+    }
     return law->travel_mm - gap;
 }
 
@@ -77,24 +85,31 @@ static double t_of_u(const cf_law *law, double u)
 }
 
 /* Fills h with the nodes of [0, U] for `intervals` region-2 intervals (before the halving of the
-** end intervals) and the law's values at them, shifted as described at the top. */
+** end intervals) and the law's values at them, shifted as described at the top. A tail's region 3
+** (from u_C, where the cone closes, to solid) is linear: region 2 ends at min(U, u_C), a node on
+** the law, and one interval reaches U; a cylindrical cone with a tail has no region 2, a node at
+** u_T and one interval beyond it. */
 static int half_place(const cf_law *law, double U, size_t intervals, half *h)
 {
     free(h->u), free(h->F);
     memset(h, 0, sizeof *h);
     const int linear_only = !(U > law->u_T_mm) || !(law->rho_inv_m1 > 0.0);
-    const size_t cap = linear_only ? 2 : intervals + 5;
+    const size_t cap = linear_only ? 3 : intervals + 6;
     h->u = malloc(cap * sizeof *h->u);
     h->F = malloc(cap * sizeof *h->F);
     if (!h->u || !h->F)
         return -1;
     h->u[h->n++] = 0.0;
+    size_t end2 = 0; /* the node where a tail's region 2 ends (0: none) */
+    const double U2 = law->tail ? fmin(U, law->u_C_mm) : U;
     if (linear_only) {
+        if (law->tail && U > law->u_T_mm)
+            h->u[h->n++] = law->u_T_mm;
         h->u[h->n++] = U;
     } else {
         h->u[h->n++] = law->u_T_mm;
-        /* running integral of g from t_T (at u_T) down to t_U (at U) */
-        const double tT = sqrt(law->rho_inv_m1), tU = t_of_u(law, U);
+        /* running integral of g from t_T (at u_T) down to t_U (at U2) */
+        const double tT = sqrt(law->rho_inv_m1), tU = U2 < U ? 0.0 : t_of_u(law, U);
         double G[TABLE_QUAD + 1];
         G[0] = 0.0;
         const double dt = (tT - tU) / TABLE_QUAD;
@@ -122,14 +137,19 @@ static int half_place(const cf_law *law, double U, size_t intervals, half *h)
             const double f = (target - G[j]) / (G[j + 1] - G[j]);
             const double t = tT - (j + f) * dt;
             const double u = u_of_t(law, t);
-            if (u > h->u[h->n - 1] && u < U)
+            if (u > h->u[h->n - 1] && u < U2)
                 h->u[h->n++] = u;
         }
-        h->u[h->n++] = U;
+        h->u[h->n++] = U2;
+        if (U2 < U) {
+            end2 = h->n - 1;
+            h->u[h->n++] = U;
+        }
     }
     for (size_t i = 0; i < h->n; i++)
         h->F[i] = cf_law_force(law, CF_LAW_EXACT, h->u[i], NULL, NULL);
-    /* shift the interior region-2 nodes by half the interpolation error of their intervals */
+    /* shift the interior region-2 nodes by half the interpolation error of their intervals (a
+    ** tail's u_C stays on the law: the straight region 3 beyond it is exact) */
     if (h->n > 4) {
         double *e = malloc(h->n * sizeof *e);
         if (!e)
@@ -144,7 +164,7 @@ static int half_place(const cf_law *law, double U, size_t intervals, half *h)
             }
             e[i] = worst;
         }
-        for (size_t i = 2; i + 1 < h->n; i++) /* nodes strictly between u_T and U */
+        for (size_t i = 2; i + 1 < (end2 ? end2 + 1 : h->n); i++) /* strictly between u_T and U2 */
             h->F[i] -= 0.25 * (e[i - 1] + e[i]);
         free(e);
     }
@@ -185,6 +205,10 @@ void cf_export_table_free(cf_export_table *t)
 
 double cf_export_table_end(const cf_law *law, double tol)
 {
+    /* where the law is within tol F_C of its solid force: holding the last row's force beyond
+    ** the table stays within tol F_C of the law up to solid (a tail's region 3 is linear) */
+    if (law->tail)
+        return cf_law_deflection(law, law->F_solid_N - tol * law->F_C_N);
     return cf_law_deflection(law, law->F_C_N * (1.0 - tol));
 }
 
@@ -195,7 +219,7 @@ static double check_point(const cf_law *law, double U, size_t i)
     if (i < N)
         return U * ((double)i + 0.5) / (double)N;
     i -= N;
-    const double s = law->travel_mm;
+    const double s = law->u_C_mm; /* the travel without a tail */
     const double w_end = sqrt(fmax(0.0, 1.0 - U / s));
     const double w = w_end + (1.0 - w_end) * ((double)i + 0.5) / (double)N;
     return fmin(s * (1.0 - w * w), U);
@@ -254,7 +278,8 @@ static size_t settle_half(const cf_law *law, double tol, double U, double sign, 
     /* first guess from the integral of g: error per interval ~ (dG)^2 / 16 in units of F_C */
     double G = 0.0;
     if (U > law->u_T_mm && law->rho_inv_m1 > 0.0) {
-        const double tT = sqrt(law->rho_inv_m1), tU = t_of_u(law, U);
+        const double tT = sqrt(law->rho_inv_m1);
+        const double tU = law->tail && U >= law->u_C_mm ? 0.0 : t_of_u(law, U);
         const int M = 512;
         for (int i = 0; i < M; i++)
             G += density(tT - (i + 0.5) * (tT - tU) / M) * (tT - tU) / M;
@@ -429,8 +454,16 @@ static double even_estimate(const cf_law *law, double a, double b, size_t n)
 {
     const double h = (b - a) / (double)(n - 1);
     double worst = 0.0;
+    /* a tail's curvature is largest where the cone closes (+-u_C), inside the range: the
+    ** intervals around those two points count too */
+    const double uc = law->u_C_mm;
+    const int tail = law->tail && n > 16;
     for (size_t i = 0; i + 1 < n; i++) {
-        if (n > 16 && i >= 2 && i + 3 < n)
+        if (tail && i >= 2 && i + 3 < n) {
+            const double x = a + h * (double)i;
+            if (fabs(fabs(x) - uc) > 3.0 * h)
+                continue;
+        } else if (n > 16 && i >= 2 && i + 3 < n)
             i = n - 3; /* the middle: smaller curvature */
         worst = fmax(worst, chord_error(law, a + h * (double)i,
                                         i + 2 == n ? b : a + h * (double)(i + 1)));

@@ -83,6 +83,8 @@ static void tail_row(FILE *o, const cf_fit_report *r)
         char cell[96];
         if (!f->tail)
             snprintf(cell, sizeof cell, "-");
+        else if (f->e_tail_se > fabs(f->e_tail))
+            snprintf(cell, sizeof cell, "%.4g%s (not determined)", f->e_tail, fd ? " mm" : "");
         else if (f->e_tail_se >= 0)
             snprintf(cell, sizeof cell, "%.6g ± %.2g%s", f->e_tail, f->e_tail_se, fd ? " mm" : "");
         else
@@ -525,6 +527,10 @@ static void verdict_and_baselines(FILE *o, const cf_fit_report *r)
                "bounds, fixed values).\n",
             cf_table_is_force(r->table) ? "travel" : "solid strain",
             cf_table_is_force(r->table) ? "solid load" : "stress scale");
+    if (any_tail(r))
+        fprintf(o, "A spring with a tail (conical-tail) adds one quantity, the tail's compliance, "
+                   "and two\nparameters, n_tail and H_tail, placed in closed form with the "
+                   "others.\n");
 }
 
 /* What the model cannot follow, one sentence each. */

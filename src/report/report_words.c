@@ -171,6 +171,9 @@ void cf_report_ident_cell(const cf_fit_result *f, int k, double scale, const cha
         const int dg = interval_digits(v, lo, hi);
         snprintf(cell, cap, "%.*g [%.*g, %.*g]*%s%s", dg > 4 ? dg : 4, v, dg, lo, dg, hi, sp,
                  unit);
+    } else if (f->tail && f->ident_se.v[k] > fabs(f->ident.v[k])) {
+        /* the tailed law's four quantities traded against each other by the data */
+        snprintf(cell, cap, "%.4g%s%s (not determined)", f->ident.v[k] * scale, sp, unit);
     } else if (f->ident_se.v[k] >= 0) {
         snprintf(cell, cap, "%.6g ± %.2g%s%s", f->ident.v[k] * scale, f->ident_se.v[k] * scale,
                  sp, unit);

@@ -151,6 +151,7 @@ int main(int argc, char **argv)
     } sections[] = {{"memory of a fit", bench_memory_fit_early},
                     {"statics at scale (measured first: it forks)", bench_statics_early},
                     {"the force law", bench_section_law},
+                    {"the spring with a cylindrical tail", bench_section_tail},
                     {"the lattice step", bench_section_lattice},
                     {"the integrators", bench_section_integrators},
                     {"fitting", bench_section_fit},

@@ -73,6 +73,7 @@ int bench_write_table(const char *path, size_t n, double xmax, double noise_sd, 
 extern volatile double bench_sink;
 
 void bench_section_law(bench_ctx *ctx);
+void bench_section_tail(bench_ctx *ctx);
 void bench_section_lattice(bench_ctx *ctx);
 void bench_section_integrators(bench_ctx *ctx);
 void bench_section_fit(bench_ctx *ctx);

@@ -9,6 +9,8 @@
 
 #include <jansson.h>
 
+#include "conifit/law.h"
+
 static char out[1 << 16], err[1 << 14];
 
 static const char *const commands[] = {"force", "curve", "info", "fit", "export", "synth",
@@ -175,6 +177,62 @@ static void library_option_names_are_shown_as_flags(void **state)
     rmdir(dir);
 }
 
+/* The tail's --n_tail and --H_tail reach force, curve, info and synth: the force in region 3 is the
+** tail's straight line, the curve ends at the solid force, info prints the tail and its regions,
+** synth's rows are the series law; a negative tail is a usage error naming it. */
+#define TAIL_SPRING "--D1 10 --D2 30 --n 4 --d 1 --G 80000 --H 40 --n_tail 1 --H_tail 10"
+
+static void the_tail_options_reach_force_curve_info_and_synth(void **state)
+{
+    (void)state;
+    const cf_spring p = {10, 30, 4, 1, 80000, 40, 1, 10};
+    cf_law law;
+    cf_error e = {0};
+    assert_int_equal(cf_law_init(&law, &p, &e), CF_OK);
+    assert_int_equal(tu_run(out, sizeof out, err, sizeof err, "force " TAIL_SPRING " --u 37"), 0);
+    const double F = strtod(out, NULL);
+    assert_close(F, law.F_C_N + law.k_tail_N_per_mm * (37 - law.u_C_mm), 1e-14 * F);
+    assert_int_equal(tu_run(out, sizeof out, err, sizeof err,
+                            "curve " TAIL_SPRING " --points 5 --method exact"),
+                     0);
+    const char *last = strrchr(out, '\n');
+    while (last > out && last[-1] != '\n')
+        last--;
+    double u, Fs, k;
+    assert_int_equal(sscanf(last, "%lf,%lf,%lf", &u, &Fs, &k), 3);
+    assert_true(u == law.travel_mm && Fs == law.F_solid_N && k == 0);
+    assert_int_equal(tu_run(out, sizeof out, err, sizeof err, "info " TAIL_SPRING), 0);
+    char line[128];
+    snprintf(line, sizeof line, "%.10g N/mm", law.k_tail_N_per_mm);
+    assert_non_null(strstr(out, line));
+    assert_non_null(strstr(out, "3 linear, the tail alone"));
+    snprintf(line, sizeof line, "F = %.10g N", law.F_solid_N);
+    assert_non_null(strstr(out, line));
+    /* synth: stress = F(strain H)/H^2 with the tail, to the solid strain's 0.95 */
+    assert_int_equal(tu_run(out, sizeof out, err, sizeof err,
+                            "synth " TAIL_SPRING " --points 20 --stress-unit MPa"),
+                     0);
+    assert_non_null(strstr(out, "# tail: "));
+    int rows = 0;
+    for (const char *q = strchr(out, '\n'); q && q[1]; q = strchr(q + 1, '\n')) {
+        double x, y;
+        if (q[1] == '#' || sscanf(q + 1, "%lf,%lf", &x, &y) != 2)
+            continue;
+        const double want = cf_law_force(&law, CF_LAW_EXACT, x * p.H_mm, NULL, NULL) /
+                            (p.H_mm * p.H_mm);
+        assert_close(y, want, 1e-12 * fabs(want) + 1e-300);
+        rows++;
+    }
+    assert_int_equal(rows, 20);
+    /* the plain spring's info has no tail block */
+    assert_int_equal(tu_run(out, sizeof out, err, sizeof err, "info " SPRING), 0);
+    assert_null(strstr(out, "tail"));
+    assert_int_equal(tu_run(out, sizeof out, err, sizeof err,
+                            "force " SPRING " --n_tail -1 --H_tail 3 --u 1"),
+                     2);
+    assert_non_null(strstr(err, "n_tail"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -184,6 +242,7 @@ int main(void)
         cmocka_unit_test(fit_and_export_work_as_a_pipe),
         cmocka_unit_test(quiet_means_the_result_only),
         cmocka_unit_test(library_option_names_are_shown_as_flags),
+        cmocka_unit_test(the_tail_options_reach_force_curve_info_and_synth),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

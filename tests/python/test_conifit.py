@@ -40,6 +40,22 @@ class Law(unittest.TestCase):
                 self.assertGreaterEqual(kk, 0)
         self.assertEqual(conifit.force(SPRING, []), [])
 
+    def test_a_tailed_spring_matches_binary(self):
+        tail = [10, 30, 4, 1, 80000, 40, 1, 10]
+        flags = ["--D1", "10", "--D2", "30", "--n", "4", "--d", "1", "--G", "80000", "--H", "40",
+                 "--n_tail", "1", "--H_tail", "10"]
+        us = [-37.5, -20, 5, 20, 36, 37, 38, 39]  # region 3 from 36.25, solid at 38 mm
+        for method in ("closed", "exact", "table"):
+            F = conifit.force(tail, us, method=method)
+            for u, f in zip(us, F):
+                want = float(run("force", *flags, "--u", str(u), "--method", method))
+                self.assertTrue(close(f, want, 1e-12), "%s F(%g) = %r, binary %r" % (method, u, f, want))
+        self.assertEqual(conifit.force(tail, [37])[0], 80.0)
+        self.assertEqual(conifit.force(tail[:6] + [0, 0], us), conifit.force(tail[:6], us))
+        with self.assertRaises(conifit.Error) as c:
+            conifit.force(tail[:6] + [-1, 10], [1])
+        self.assertIn("n_tail", str(c.exception))
+
     def test_bad_spring_raises_library_message(self):
         with self.assertRaises(conifit.Error) as c:
             conifit.force([4, 2, 5, 0.8, 80000, 10], [1])

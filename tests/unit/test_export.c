@@ -26,6 +26,21 @@ static char dir[64];
 
 static const cf_spring TEL = {10, 30, 4, 1, 80000, 40}; /* telescoping, s = 39 mm */
 static const cf_spring NON = {10, 20, 6, 1, 80000, 40}; /* non-telescoping, s = 34 mm */
+/* TEL's cone in 30 mm of the free length and a cylindrical tail of one coil in the other 10: the
+** cone closes at u_C = 36.25 mm (F_C = 72.5 N), the tail at 38 mm (F_solid = 90 N) */
+static const cf_spring TAIL = {10, 30, 4, 1, 80000, 40, 1, 10};
+
+/* Writes text into the file name of the test's folder: 0, or -1 when it cannot. */
+static int write_in_dir(const char *name, const char *text)
+{
+    char p[128];
+    snprintf(p, sizeof p, "%s/%s", dir, name);
+    FILE *f = fopen(p, "w");
+    if (!f)
+        return -1;
+    fputs(text, f);
+    return fclose(f) == 0 ? 0 : -1;
+}
 
 static int setup(void **state)
 {
@@ -33,25 +48,23 @@ static int setup(void **state)
     snprintf(dir, sizeof dir, "/tmp/conifit-export-XXXXXX");
     if (!mkdtemp(dir))
         return -1;
-    char p[128];
-    snprintf(p, sizeof p, "%s/fit.json", dir);
-    FILE *f = fopen(p, "w");
-    if (!f)
+    if (write_in_dir("fit.json",
+                     "{\"conifit_version\":\"0.1.0\",\"data\":{\"file\":\"data/t.csv\",\"y_unit\":"
+                     "\"kPa\"},\"fits\":[{\"type\":\"telescoping\",\"params\":{\"D1_mm\":10,"
+                     "\"D2_mm\":30,\"n\":4,\"d_mm\":1,\"G_MPa\":80000,\"H_mm\":40},\"rmse\":0.5},"
+                     "{\"type\":\"non-telescoping\",\"params\":{\"D1_mm\":10,\"D2_mm\":20,\"n\":6,"
+                     "\"d_mm\":1,\"G_MPa\":80000,\"H_mm\":40},\"rmse\":0.7}],\"better_type\":"
+                     "\"telescoping\"}\n") != 0)
         return -1;
-    fprintf(f, "{\"conifit_version\":\"0.1.0\",\"data\":{\"file\":\"data/t.csv\",\"y_unit\":\"kPa\"},"
-               "\"fits\":[{\"type\":\"telescoping\",\"params\":{\"D1_mm\":10,\"D2_mm\":30,\"n\":4,"
-               "\"d_mm\":1,\"G_MPa\":80000,\"H_mm\":40},\"rmse\":0.5},{\"type\":\"non-telescoping\","
-               "\"params\":{\"D1_mm\":10,\"D2_mm\":20,\"n\":6,\"d_mm\":1,\"G_MPa\":80000,\"H_mm\":40},"
-               "\"rmse\":0.7}],\"better_type\":\"telescoping\"}\n");
-    fclose(f);
-    snprintf(p, sizeof p, "%s/tel_only.json", dir);
-    f = fopen(p, "w");
-    if (!f)
+    if (write_in_dir("tel_only.json",
+                     "{\"fits\":[{\"type\":\"telescoping\",\"params\":{\"D1_mm\":10,\"D2_mm\":30,"
+                     "\"n\":4,\"d_mm\":1,\"G_MPa\":80000,\"H_mm\":40}}]}\n") != 0)
         return -1;
-    fprintf(f, "{\"fits\":[{\"type\":\"telescoping\",\"params\":{\"D1_mm\":10,\"D2_mm\":30,\"n\":4,"
-               "\"d_mm\":1,\"G_MPa\":80000,\"H_mm\":40}}]}\n");
-    fclose(f);
-    return 0;
+    /* TAIL */
+    return write_in_dir("tail.json",
+                        "{\"fits\":[{\"type\":\"telescoping\",\"params\":{\"D1_mm\":10,\"D2_mm\":30,"
+                        "\"n\":4,\"d_mm\":1,\"G_MPa\":80000,\"H_mm\":40,\"n_tail\":1,"
+                        "\"H_tail_mm\":10}}]}\n");
 }
 
 static int teardown(void **state)
@@ -96,6 +109,14 @@ static char *export_to(const char *name, const char *args)
     return export_file(fit, name, args);
 }
 
+/* The same from the test's fit file of the tailed spring. */
+static char *export_tail(const char *name, const char *args)
+{
+    char fit[96];
+    snprintf(fit, sizeof fit, "%s/tail.json", dir);
+    return export_file(fit, name, args);
+}
+
 static int have_ccx(void)
 {
     return system("command -v ccx >/dev/null 2>&1") == 0;
@@ -110,8 +131,9 @@ static void check_table(const cf_spring *p, double tol)
     cf_error err = {0};
     law_of(&law, p);
     assert_int_equal(cf_export_table_build(&law, tol, &t, &err), CF_OK);
-    /* rows ascend, are odd-symmetric, and include 0, +-u_T and the ends, which lie on the law */
-    int has0 = 0, hasT = 0;
+    /* rows ascend, are odd-symmetric, and include 0, +-u_T and the ends, which lie on the law
+    ** (and, with a tail, +-u_C where the cone closes) */
+    int has0 = 0, hasT = 0, hasC = !law.tail;
     for (size_t i = 0; i < t.rows; i++) {
         if (i > 0)
             assert_true(t.u_mm[i] > t.u_mm[i - 1]);
@@ -122,10 +144,15 @@ static void check_table(const cf_spring *p, double tol)
             hasT = 1;
             assert_close(t.F_N[i], law.F_T_N, 1e-12 * law.F_T_N);
         }
+        if (law.tail && t.u_mm[i] == law.u_C_mm) {
+            hasC = 1;
+            assert_close(t.F_N[i], law.F_C_N, 1e-12 * law.F_C_N);
+        }
     }
-    assert_true(has0 && hasT);
-    /* the end is where the law carries F_C (1 - tol), just short of solid */
-    assert_close(t.F_N[t.rows - 1], law.F_C_N * (1 - tol), 1e-9 * law.F_C_N);
+    assert_true(has0 && hasT && hasC);
+    /* the end is where the law carries F_solid - tol F_C (F_C (1 - tol) without a tail), just
+    ** short of solid */
+    assert_close(t.F_N[t.rows - 1], law.F_solid_N - tol * law.F_C_N, 1e-9 * law.F_C_N);
     assert_true(t.u_hi_mm < law.travel_mm);
     /* an independent dense grid (a different count from the module's own check) */
     const int N = 99991;
@@ -134,8 +161,9 @@ static void check_table(const cf_spring *p, double tol)
         double u = -t.u_hi_mm + 2.0 * t.u_hi_mm * i / N;
         double w = (double)i / N; /* and crowded towards the end of the table */
         double v = t.u_hi_mm * (1.0 - w * w * w * w);
-        double us[2] = {u, v};
-        for (int j = 0; j < 2; j++) {
+        double c = law.u_C_mm * (1.0 - w * w * w * w); /* crowded towards the cone's solid */
+        double us[3] = {u, v, c};
+        for (int j = 0; j < (law.tail ? 3 : 2); j++) {
             double F = cf_law_force(&law, CF_LAW_EXACT, us[j], NULL, NULL);
             double e = fabs(cf_export_table_eval(&t, us[j]) - F);
             if (e > tol * law.F_C_N)
@@ -149,8 +177,34 @@ static void check_table(const cf_spring *p, double tol)
     assert_true(worst <= t.max_err_rel * 1.05);
     /* past the table, holding the last force is within tol F_C of the law up to solid (u_end is
     ** a double a few 1e-12 mm short of solid at tol 1e-6: its rounding moves F by ~0.1 %) */
-    assert_true(law.F_C_N - t.F_N[t.rows - 1] <= tol * law.F_C_N * (1 + 1e-2));
+    assert_true(law.F_solid_N - t.F_N[t.rows - 1] <= tol * law.F_C_N * (1 + 1e-2));
     cf_export_table_free(&t);
+}
+
+/* A tailed spring: the table keeps u_C on the law, runs on through the straight region 3 to
+** within tol F_C of the solid force, and meets the tolerance on a grid crowded at u_C. */
+static void tables_of_a_tailed_spring_stay_within_tolerance_through_region_3(void **state)
+{
+    (void)state;
+    const double tols[3] = {1e-2, 1e-4, 1e-6};
+    for (int i = 0; i < 3; i++)
+        check_table(&TAIL, tols[i]);
+    cf_law law;
+    cf_export_table t;
+    cf_error err = {0};
+    law_of(&law, &TAIL);
+    assert_int_equal(cf_export_table_build(&law, 1e-4, &t, &err), CF_OK);
+    assert_true(t.u_hi_mm > law.u_C_mm); /* the table reaches region 3 */
+    /* region 3 is one straight interval: no row between u_C and the end */
+    assert_close(t.u_mm[t.rows - 2], law.u_C_mm, 0.0);
+    /* and the plain spring with the same cone needs about as many rows (region 2 alike) */
+    cf_law plain;
+    cf_export_table tp;
+    law_of(&plain, &TEL);
+    assert_int_equal(cf_export_table_build(&plain, 1e-4, &tp, &err), CF_OK);
+    assert_true(t.rows < 2 * tp.rows);
+    cf_export_table_free(&t);
+    cf_export_table_free(&tp);
 }
 
 static void tables_stay_within_tolerance_on_a_dense_grid_for_both_types(void **state)
@@ -708,16 +762,21 @@ static void calculix_runs_the_one_spring_example_and_matches_the_law(void **stat
     (void)state;
     if (!have_ccx())
         skip(); /* CI installs calculix-ccx (Makefile DEBS) */
-    const char *types[2] = {"telescoping", "non-telescoping"};
-    const cf_spring *ps[2] = {&TEL, &NON};
-    for (int k = 0; k < 2; k++) {
+    const char *types[3] = {"telescoping", "non-telescoping", "telescoping"};
+    const cf_spring *ps[3] = {&TEL, &NON, &TAIL};
+    for (int k = 0; k < 3; k++) { /* the third, the tailed spring, is pushed into region 3 */
         cf_law law;
         law_of(&law, ps[k]);
         char args[96], job[32], name[48];
         snprintf(args, sizeof args, "--format calculix --type %s --example", types[k]);
         snprintf(job, sizeof job, "example_%d", k);
         snprintf(name, sizeof name, "%s.inp", job);
-        char *x = export_to(name, args);
+        char *x = k < 2 ? export_to(name, args) : export_tail(name, args);
+        if (law.tail) { /* 0.99 of the table's end lies past u_C */
+            double dz0[16], ref0[16];
+            assert_int_equal(header_steps(x, dz0, ref0, 16), 6);
+            assert_true(-dz0[2] > law.u_C_mm);
+        }
         run_ccx(job);
         double dz[16], ref[16], rz[16];
         const int n = header_steps(x, dz, ref, 16);
@@ -789,42 +848,49 @@ static void calculix_holds_the_last_force_beyond_the_table(void **state)
 
 /* ---- lattices --------------------------------------------------------------------------------- */
 
-/* A small static uniaxial scene built from the test's fit file. */
-static void write_scene(const char *name, double to_strain, int samples)
+/* A small static uniaxial scene built from the test's fit file `fit` (fit.json or tail.json). */
+static void write_scene_of(const char *fit, const char *name, double to_strain, int samples)
 {
     char p[160];
     snprintf(p, sizeof p, "%s/%s", dir, name);
     FILE *f = fopen(p, "w");
     assert_non_null(f);
-    fprintf(f, "{\"spring\": {\"fit\": \"%s/fit.json\", \"type\": \"telescoping\"},\n"
+    fprintf(f, "{\"spring\": {\"fit\": \"%s/%s\", \"type\": \"telescoping\"},\n"
                " \"lattice\": {\"nx\": 2, \"ny\": 2, \"nz\": 2, \"diagonals\": \"face+body\", "
                "\"bottom\": \"axial\"},\n"
                " \"protocol\": {\"kind\": \"ramp\", \"to_strain\": %.17g, \"duration_s\": 1},\n"
                " \"samples_per_segment\": %d}\n",
-               dir, to_strain, samples);
+               dir, fit, to_strain, samples);
     fclose(f);
 }
 
-static void calculix_runs_the_lattice_and_matches_conifit_simulate_at_every_step(void **state)
+static void write_scene(const char *name, double to_strain, int samples)
 {
-    (void)state;
-    if (!have_ccx())
-        skip(); /* CI installs calculix-ccx (Makefile DEBS) */
-    cf_law law;
-    law_of(&law, &TEL);
-    const double to = 0.45 * law.travel_mm / TEL.H_mm;
-    write_scene("lat.json", to, 12);
-    char args[160];
-    snprintf(args, sizeof args, "--lattice %s/lat.json --format calculix --type telescoping", dir);
-    char *x = export_to("lat.inp", args);
-    run_ccx("lat");
+    write_scene_of("fit.json", name, to_strain, samples);
+}
+
+/* The lattice of spring P (the test's fit file `fit`) loaded in 12 steps to strain `to`, exported
+** for CalculiX as job `job`, run in ccx, and compared at every step with conifit simulate of the
+** same scene. */
+static void ccx_lattice_matches_simulate(const char *fit, const cf_spring *P, double to,
+                                         const char *job)
+{
+    char scene[48], args[200], name[48], ffile[96];
+    snprintf(scene, sizeof scene, "%s.json", job);
+    snprintf(name, sizeof name, "%s.inp", job);
+    snprintf(ffile, sizeof ffile, "%s/%s", dir, fit);
+    write_scene_of(fit, scene, to, 12);
+    snprintf(args, sizeof args, "--lattice %s/%s --format calculix --type telescoping", dir,
+             scene);
+    char *x = export_file(ffile, name, args);
+    run_ccx(job);
     /* conifit simulate on the same scene */
     char err[1024];
-    assert_int_equal(tu_run(NULL, 0, err, sizeof err, "simulate %s/lat.json -o %s/lat.csv", dir,
-                            dir),
+    assert_int_equal(tu_run(NULL, 0, err, sizeof err, "simulate %s/%s -o %s/%s.csv", dir, scene,
+                            dir, job),
                      0);
     char p[160];
-    snprintf(p, sizeof p, "%s/lat.csv", dir);
+    snprintf(p, sizeof p, "%s/%s.csv", dir, job);
     char *csv = tu_slurp(p);
     assert_non_null(csv);
     double strain[64], stress_kPa[64];
@@ -838,14 +904,14 @@ static void calculix_runs_the_lattice_and_matches_conifit_simulate_at_every_step
         }
     }
     assert_int_equal(ns, 12);
-    snprintf(p, sizeof p, "%s/lat.dat", dir);
+    snprintf(p, sizeof p, "%s/%s.dat", dir, job);
     char *dat = tu_slurp(p);
     assert_non_null(dat);
     double rz[64], dz[64], ref[64];
     assert_int_equal(parse_totals(dat, rz, 64), ns);
     assert_int_equal(header_steps(x, dz, ref, 64), ns);
     const double tol = header_reaction_tol(x);
-    const double area = 4.0 * TEL.H_mm * TEL.H_mm, height = 2.0 * TEL.H_mm;
+    const double area = 4.0 * P->H_mm * P->H_mm, height = 2.0 * P->H_mm;
     double worst = 0.0;
     for (int k = 0; k < ns; k++) {
         const double sim_N = stress_kPa[k] * 1e-3 * area; /* compressive top reaction */
@@ -858,30 +924,48 @@ static void calculix_runs_the_lattice_and_matches_conifit_simulate_at_every_step
                      k + 1, strain[k], ccx_N, sim_N, bound);
         worst = fmax(worst, fabs(ccx_N - sim_N) / tol);
     }
-    print_message("lattice: ccx against conifit simulate, worst step at %.3g of the tolerance\n",
+    print_message("%s: ccx against conifit simulate, worst step at %.3g of the tolerance\n", job,
                   worst);
     free(dat);
     free(csv);
     free(x);
 }
 
-/* Every format's lattice parsed back: node count, one table per group and every number of it
-** against the law at that group's rest length and weight. */
-static void lattice_models_of_every_format_hold_the_law_in_every_group(void **state)
+static void calculix_runs_the_lattice_and_matches_conifit_simulate_at_every_step(void **state)
 {
     (void)state;
+    if (!have_ccx())
+        skip(); /* CI installs calculix-ccx (Makefile DEBS) */
     cf_law law;
     law_of(&law, &TEL);
-    write_scene("latf.json", 0.3 * law.travel_mm / TEL.H_mm, 4);
+    ccx_lattice_matches_simulate("fit.json", &TEL, 0.45 * law.travel_mm / TEL.H_mm, "lat");
+    /* the same for a lattice of tailed springs (the scalar law in the lattice's step), loaded far
+    ** enough that the edges along the load are in region 2 of the series law */
+    law_of(&law, &TAIL);
+    const double to = 0.45 * law.travel_mm / TAIL.H_mm;
+    assert_true(to * TAIL.H_mm > law.u_T_mm);
+    ccx_lattice_matches_simulate("tail.json", &TAIL, to, "lat_tail");
+}
+
+/* Every format's lattice of spring P (the test's fit file `fit`) parsed back: node count, one
+** table per group and every number of it against the law at that group's rest length and weight. */
+static void lattice_models_hold_the_law(const char *fit, const cf_spring *P, const char *tag)
+{
+    cf_law law;
+    law_of(&law, P);
+    char scene[48], ffile[96];
+    snprintf(scene, sizeof scene, "%s.json", tag);
+    snprintf(ffile, sizeof ffile, "%s/%s", dir, fit);
+    write_scene_of(fit, scene, 0.3 * law.travel_mm / P->H_mm, 4);
     for (int f = 0; f < CF_EXPORT_FORMAT_COUNT; f++) {
         const cf_export_format_info *fi = cf_export_format_get((cf_export_format)f);
         if (!fi->model)
             continue;
         char args[160], name[32];
-        snprintf(args, sizeof args, "--lattice %s/latf.json --format %s --tol 1e-3", dir,
+        snprintf(args, sizeof args, "--lattice %s/%s --format %s --tol 1e-3", dir, scene,
                  fi->name);
-        snprintf(name, sizeof name, "latf.%s", fi->name);
-        char *x = export_to(name, args);
+        snprintf(name, sizeof name, "%s.%s", tag, fi->name);
+        char *x = export_file(ffile, name, args);
         /* groups from the header */
         double L0[16], w[16];
         size_t ng = 0, cnt[16];
@@ -953,7 +1037,7 @@ static void lattice_models_of_every_format_hold_the_law_in_every_group(void **st
                 const double u_end = cf_export_table_end(&law, 1e-3);
                 for (int i = 0; i <= 400; i++) {
                     const double u = -u_end + 2.0 * u_end * i / 400.0;
-                    e[n] = -u * L0[g] / TEL.H_mm;
+                    e[n] = -u * L0[g] / P->H_mm;
                     double sum = 0.0;
                     for (size_t k = 0; k < nf; k++)
                         if (sf[k].first == a && sf[k].second == b)
@@ -965,7 +1049,7 @@ static void lattice_models_of_every_format_hold_the_law_in_every_group(void **st
             }
             assert_true(n > 10);
             for (size_t i = 0; i < n; i++) {
-                const double want = -w[g] * cf_law_force(&law, CF_LAW_EXACT, -e[i] * TEL.H_mm / L0[g],
+                const double want = -w[g] * cf_law_force(&law, CF_LAW_EXACT, -e[i] * P->H_mm / L0[g],
                                                          NULL, NULL);
                 if (!(fabs(T[i] - want) <= 1.01e-3 * w[g] * law.F_C_N))
                     fail_msg("%s group %zu: %g N at elongation %g mm, law %g N", fi->name, g + 1,
@@ -978,6 +1062,24 @@ static void lattice_models_of_every_format_hold_the_law_in_every_group(void **st
         free(x);
     }
 }
+
+static void lattice_models_of_every_format_hold_the_law_in_every_group(void **state)
+{
+    (void)state;
+    lattice_models_hold_the_law("fit.json", &TEL, "latf");
+}
+
+/* Every format's lattice of tailed springs: their tables hold the series law, region 3 included
+** (the tables run to the whole spring's solid, past where the cone closes). */
+static void lattice_models_of_every_format_hold_the_tailed_law_in_every_group(void **state)
+{
+    (void)state;
+    cf_law law;
+    law_of(&law, &TAIL);
+    assert_true(cf_export_table_end(&law, 1e-3) > law.u_C_mm);
+    lattice_models_hold_the_law("tail.json", &TAIL, "latt");
+}
+
 
 /* What the one-spring model of each format must hold: its loading. */
 static const char *example_must(cf_export_format f)
@@ -1169,6 +1271,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(tables_stay_within_tolerance_on_a_dense_grid_for_both_types),
+        cmocka_unit_test(tables_of_a_tailed_spring_stay_within_tolerance_through_region_3),
         cmocka_unit_test(row_count_grows_like_inverse_square_root_of_tolerance),
         cmocka_unit_test(every_spring_from_rho_0_05_fits_200_rows_at_1e_4),
         cmocka_unit_test(a_range_covers_only_what_is_asked_and_stays_within_tolerance),
@@ -1184,6 +1287,7 @@ int main(void)
         cmocka_unit_test(calculix_holds_the_last_force_beyond_the_table),
         cmocka_unit_test(calculix_runs_the_lattice_and_matches_conifit_simulate_at_every_step),
         cmocka_unit_test(lattice_models_of_every_format_hold_the_law_in_every_group),
+        cmocka_unit_test(lattice_models_of_every_format_hold_the_tailed_law_in_every_group),
         cmocka_unit_test(every_format_has_a_runnable_example),
         cmocka_unit_test(the_format_registry_is_whole_and_drives_the_help),
         cmocka_unit_test(the_output_extension_names_the_format),

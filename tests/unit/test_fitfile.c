@@ -39,6 +39,10 @@ static const char *write_file(const char *name, const char *text)
 #define NON "{\"type\":\"non-telescoping\",\"params\":{\"D1_mm\":10,\"D2_mm\":20,\"n\":6,\"d_mm\":1," \
             "\"G_MPa\":80000,\"H_mm\":40},\"rmse\":0.7}"
 #define HEAD "{\"conifit_version\":\"0.1.0\",\"data\":{\"file\":\"data/t.csv\",\"y_unit\":\"kPa\"},"
+/* TEL's cone with a cylindrical tail of NT coils in HT mm of the free length */
+#define TAILED(NT, HT)                                                                             \
+    "{\"type\":\"telescoping\",\"params\":{\"D1_mm\":10,\"D2_mm\":30,\"n\":4,\"d_mm\":1,"        \
+    "\"G_MPa\":80000,\"H_mm\":40,\"n_tail\":" NT ",\"H_tail_mm\":" HT "}}"
 
 static void good_file_loads_both_types_and_provenance(void **state)
 {
@@ -109,6 +113,13 @@ static void every_malformed_file_is_refused_naming_key_and_value(void **state)
          NULL, "fits[0] says type 'telescoping'", "non-telescoping"},
         {"{\"schema\":\"conifit-spring-1\",\"type\":\"telescoping\",\"params\":{\"D1_mm\":10}}",
          NULL, "spring.params.D2_mm", "(missing)"},
+        /* the tail's keys: a number, >= 0, room for its solid length, closing after the cone */
+        {HEAD "\"fits\":[" TAILED("\"x\"", "10") "]}", NULL, "fits[0].params.n_tail", "\"x\""},
+        {HEAD "\"fits\":[" TAILED("-1", "10") "]}", NULL, "n_tail", "-1"},
+        {HEAD "\"fits\":[" TAILED("0", "10") "]}", NULL, "H_tail_mm", "10"},
+        {HEAD "\"fits\":[" TAILED("1", "0.5") "]}", NULL, "H_tail_mm = 0.5", "no room"},
+        {HEAD "\"fits\":[" TAILED("1", "7") "]}", NULL, "H_tail_mm = 7", "before the cone"},
+        {HEAD "\"fits\":[" TAILED("1", "39.5") "]}", NULL, "H_tail_mm = 39.5", "no travel"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         cf_fitted_spring fs;
@@ -119,6 +130,62 @@ static void every_malformed_file_is_refused_naming_key_and_value(void **state)
             fail_msg("case %zu: status %d, message '%s' lacks '%s' or '%s'", i, (int)st, err.msg,
                      cases[i].key, cases[i].value);
     }
+}
+
+/* A tailed spring goes out through the exported spring file and comes back bit for bit, with the
+** tail's derived values beside it; a plain spring's file has no tail key at all; a bad tail in a
+** fit file stops the export with status 65 naming the key, and nothing is written. */
+static void a_tailed_spring_round_trips_and_a_plain_file_has_no_tail_keys(void **state)
+{
+    (void)state;
+    char in[160], out[160], so[1024], se[2048];
+    snprintf(in, sizeof in, "%s", write_file("tail.json", HEAD "\"fits\":[" TAILED("1.25", "10.5")
+                                                          "]}"));
+    snprintf(out, sizeof out, "%s/tail_spring.json", dir);
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "export %s --format json -o %s", in, out),
+                     0);
+    cf_fitted_spring fs;
+    cf_error err = {0};
+    assert_int_equal(cf_fitfile_load(out, NULL, &fs, &err), CF_OK);
+    const cf_spring want = {10, 30, 4, 1, 80000, 40, 1.25, 10.5};
+    for (int k = 0; k < CF_P_ALL; k++)
+        assert_true(cf_spring_get(&fs.params, k) == cf_spring_get(&want, k));
+    char *text = tu_slurp(out);
+    assert_non_null(text);
+    cf_law law;
+    assert_int_equal(cf_law_init(&law, &want, &err), CF_OK);
+    const struct { const char *key; double v; } derived[] = {
+        {"\"u_C_mm\": ", law.u_C_mm}, {"\"F_solid_N\": ", law.F_solid_N},
+        {"\"k_tail_N_per_mm\": ", law.k_tail_N_per_mm}, {"\"tau\": ", law.tau},
+        {"\"travel_mm\": ", law.travel_mm}};
+    for (size_t i = 0; i < sizeof derived / sizeof derived[0]; i++) {
+        const char *at = strstr(text, derived[i].key);
+        if (!at)
+            fail_msg("exported tailed spring lacks %s", derived[i].key);
+        assert_true(strtod(at + strlen(derived[i].key), NULL) == derived[i].v);
+    }
+    assert_true(law.travel_mm > law.u_C_mm); /* the whole spring's travel, past the cone's */
+    free(text);
+    /* a plain spring: no tail key, and it reads back with no tail */
+    snprintf(in, sizeof in, "%s", write_file("plain.json", HEAD "\"fits\":[" TEL "]}"));
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "export %s --format json -o %s", in, out),
+                     0);
+    text = tu_slurp(out);
+    assert_non_null(text);
+    assert_null(strstr(text, "tail"));
+    assert_null(strstr(text, "u_C_mm"));
+    free(text);
+    assert_int_equal(cf_fitfile_load(out, NULL, &fs, &err), CF_OK);
+    assert_false(cf_spring_has_tail(&fs.params));
+    assert_true(fs.params.H_tail_mm == 0);
+    /* a bad tail: 65, the key and value named, nothing written */
+    unlink(out);
+    snprintf(in, sizeof in, "%s", write_file("bad_tail.json", HEAD "\"fits\":[" TAILED("-2", "10")
+                                                              "]}"));
+    assert_int_equal(tu_run(so, sizeof so, se, sizeof se, "export %s --format json -o %s", in, out),
+                     65);
+    assert_non_null(strstr(se, "n_tail = -2"));
+    assert_int_equal(access(out, F_OK), -1);
 }
 
 static void missing_file_is_noinput(void **state)
@@ -138,6 +205,7 @@ int main(void)
         cmocka_unit_test(good_file_loads_both_types_and_provenance),
         cmocka_unit_test(exported_spring_file_loads_and_checks_its_type),
         cmocka_unit_test(every_malformed_file_is_refused_naming_key_and_value),
+        cmocka_unit_test(a_tailed_spring_round_trips_and_a_plain_file_has_no_tail_keys),
         cmocka_unit_test(missing_file_is_noinput),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -702,6 +702,66 @@ static void stencil_step_runs_the_polynomial_where_it_fits(void **state)
         }
 }
 
+/* The work of the law from 0 to u by composite Simpson on the exact evaluator, the interval cut at
+** u_T and u_C, where the law's derivatives jump. */
+static double reference_work(const cf_law *law, double u)
+{
+    const double a = fabs(u), cuts[4] = {0, fmin(a, law->u_T_mm), fmin(a, law->u_C_mm), a};
+    double W = 0;
+    for (int k = 0; k < 3; k++) {
+        const double lo = cuts[k], hi = cuts[k + 1];
+        if (!(hi > lo))
+            continue;
+        const int N = 4000; /* even */
+        const double h = (hi - lo) / N;
+        double sum = 0;
+        for (int i = 0; i <= N; i++) {
+            const double f = cf_law_force(law, CF_LAW_EXACT, lo + h * i, NULL, NULL);
+            sum += f * (i == 0 || i == N ? 1 : i % 2 ? 4 : 2);
+        }
+        W += sum * h / 3;
+    }
+    return W;
+}
+
+/* The energy stored in a lattice of tailed springs (cone closes at u_C, tail straight up to solid)
+** is the law's work, in region 2 and in the tail's region 3, in compression and stretch. */
+static void elastic_energy_of_tailed_springs_is_the_work_of_the_series_law(void **state)
+{
+    (void)state;
+    const cf_spring p = {10, 30, 4, 1, 80000, 40, 1, 10}; /* u_T 11.0, u_C 36.25, solid 38 mm */
+    cf_law law;
+    cf_error err = {0};
+    assert_int_equal(cf_law_init(&law, &p, &err), CF_OK);
+    cf_lattice_config c = cf_lattice_default();
+    c.nx = c.ny = c.nz = 1;
+    memcpy(c.weight, W_EDGES, sizeof c.weight);
+    c.calibration = CF_CAL_CUSTOM;
+    cf_lattice lat;
+    assert_int_equal(cf_lattice_create(&lat, &law, CF_LAW_CLOSED, &c, &err), CF_OK);
+    const double us[4] = {30.0, 37.0, -20.0, -37.5}; /* region 2, region 3, stretched */
+    for (int k = 0; k < 4; k++) {
+        cf_lattice_reset(&lat);
+        for (size_t n = 0; n < lat.nn; n++)
+            if (lat.Z[n] > 0.5 * p.H_mm)
+                lat.z[n] -= us[k];
+        double want = 0;
+        for (size_t s = 0; s < lat.ns; s++) {
+            const uint32_t i = lat.si[s], j = lat.sj[s];
+            const double dx = lat.x[j] - lat.x[i], dy = lat.y[j] - lat.y[i],
+                         dz = lat.z[j] - lat.z[i];
+            const double u = (lat.L0_mm[s] - sqrt(dx * dx + dy * dy + dz * dz)) * lat.a[s];
+            want += lat.w[s] / lat.a[s] * reference_work(&law, u);
+        }
+        assert_true(want > 0);
+        const double got = cf_lattice_elastic_energy(&lat);
+        if (!(fabs(got - want) <= 1e-9 * want))
+            fail_msg("compression %g mm: energy %.15g mJ, the law's work %.15g mJ", us[k], got,
+                     want);
+    }
+    cf_lattice_free(&lat);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -721,6 +781,7 @@ int main(void)
         cmocka_unit_test(hysteresis_area_is_positive_and_vanishes_as_rate_goes_to_zero),
         cmocka_unit_test(unstable_time_step_is_refused),
         cmocka_unit_test(tangent_inertia_marks_the_loss_of_stability),
+        cmocka_unit_test(elastic_energy_of_tailed_springs_is_the_work_of_the_series_law),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

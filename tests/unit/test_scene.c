@@ -5,6 +5,8 @@
 */
 #include "testutil.h"
 
+#include "conifit/calibration.h"
+#include "conifit/cell.h"
 #include "conifit/measure.h"
 #include "conifit/scene.h"
 
@@ -46,6 +48,12 @@ static void every_bad_scene_is_refused_naming_its_key(void **state)
          "'lattice.calibration' = 'cubic'"},
         {"{" SPRING ", " RAMP ", \"lattice\": {\"bottom\": \"glued\"}}", CF_E_DATA,
          "'lattice.bottom' = 'glued'"},
+        {"{\"spring\": {\"params\": {\"D1_mm\": 6, \"D2_mm\": 15, \"n\": 2.5, \"d_mm\": 2, "
+         "\"G_MPa\": 26, \"H_mm\": 10, \"n_tail\": -1}}, " RAMP "}",
+         CF_E_DATA, "'spring.params.n_tail' = -1"},
+        {"{\"spring\": {\"params\": {\"D1_mm\": 6, \"D2_mm\": 15, \"n\": 2.5, \"d_mm\": 2, "
+         "\"G_MPa\": 26, \"H_mm\": 10, \"n_tail\": 1, \"H_tail_mm\": 1.5}}, " RAMP "}",
+         CF_E_DATA, "H_tail_mm = 1.5"},
         {"{" RAMP "}", CF_E_DATA, "'spring'"},
         {"{" SPRING "}", CF_E_DATA, "'protocol'"},
         {"{\"spring\": {\"params\": {\"D1_mm\": 6, \"D2_mm\": 15, \"n\": 2.5, \"d_mm\": 2, "
@@ -301,6 +309,81 @@ static void messages_never_show_what_a_named_file_holds(void **state)
     rmdir(dir);
 }
 
+/* A scene of tailed springs (the cone of the export tests' telescoping spring in 30 mm, one tail
+** coil in 10 mm: the cone closes at u_C = 36.25 mm, the tail at 38 mm) simulates: stretched
+** until its springs along the load pass u_C (region 3) and compressed into region 2, the lattice's
+** curve is the homogenised cell's of the same spring to 1e-6. */
+#define TAIL_SPRING "\"spring\": {\"params\": {\"D1_mm\": 10, \"D2_mm\": 30, \"n\": 4, " \
+                    "\"d_mm\": 1, \"G_MPa\": 80000, \"H_mm\": 40, \"n_tail\": 1, "      \
+                    "\"H_tail_mm\": 10}}"
+
+static void a_scene_of_tailed_springs_follows_the_cell_through_region_3(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-scene-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    const cf_spring p = {10, 30, 4, 1, 80000, 40, 1, 10};
+    cf_law law;
+    cf_error err = {0};
+    assert_int_equal(cf_law_init(&law, &p, &err), CF_OK);
+    double w[3];
+    assert_int_equal(cf_calibration_weights(CF_CAL_ISOTROPIC, w, NULL), CF_OK);
+    cf_cell c;
+    assert_int_equal(cf_cell_init(&c, &law, CF_LAW_EXACT, w, NULL), CF_OK);
+    /* compression positive: stretched past u_C/H = 0.906, compressed past u_T/H = 0.275 */
+    const double to[2] = {-0.93, 0.3};
+    for (int k = 0; k < 2; k++) {
+        char scene[256], out[256];
+        snprintf(scene, sizeof scene, "%s/tail%d.json", dir, k);
+        snprintf(out, sizeof out, "%s/tail%d.csv", dir, k);
+        FILE *f = fopen(scene, "w");
+        assert_non_null(f);
+        fprintf(f, "{" TAIL_SPRING ", \"lattice\": {\"nx\": 2, \"ny\": 2, \"nz\": 2}, "
+                   "\"protocol\": {\"kind\": \"ramp\", \"to_strain\": %g}, "
+                   "\"samples_per_segment\": 10}",
+                to[k]);
+        fclose(f);
+        char so[4096], se[4096];
+        if (tu_run(so, sizeof so, se, sizeof se, "simulate %s -o %s", scene, out) != 0)
+            fail_msg("simulate of a tailed spring: %s", se);
+        char *csv = tu_slurp(out);
+        assert_non_null(csv);
+        double strain[16], stress[16], spring[16];
+        int n = 0;
+        for (const char *line = strchr(csv, '\n'); line && line[1] && n < 16;
+             line = strchr(line + 1, '\n')) {
+            double t, e, sk, ke, sp;
+            if (sscanf(line + 1, "%lf,%lf,%lf,%lf,%lf", &t, &e, &sk, &ke, &sp) == 5 && t > 0) {
+                strain[n] = e;
+                stress[n] = sk;
+                spring[n++] = sp;
+            }
+        }
+        free(csv);
+        assert_int_equal(n, 10);
+        /* the CSV is compression positive; its single spring's stress column is the series law
+        ** itself, region 3 included */
+        double table[16];
+        for (int i = 0; i < n; i++) {
+            const double F = cf_law_force(&law, CF_LAW_EXACT, strain[i] * p.H_mm, NULL, NULL);
+            assert_close(spring[i], F / (p.H_mm * p.H_mm) * 1e3, 1e-9 * fabs(spring[i]) + 1e-12);
+            table[i] = -strain[i]; /* the cell's strains are tension positive */
+        }
+        if (k == 0) /* the last sample's spring is in the tail's straight region */
+            assert_true(-strain[n - 1] * p.H_mm > law.u_C_mm);
+        double cell[16];
+        if (cf_cell_curve(&c, CF_MODE_UNIAXIAL, table, (size_t)n, cell, &err) != CF_OK)
+            fail_msg("cell: %s", err.msg);
+        for (int i = 0; i < n; i++)
+            if (!(fabs(stress[i] + cell[i] * 1e3) <= 1e-6 * fabs(cell[i] * 1e3)))
+                fail_msg("strain %g: lattice %.10g kPa, cell %.10g kPa", strain[i], stress[i],
+                         -cell[i] * 1e3);
+        unlink(scene);
+        unlink(out);
+    }
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -310,6 +393,7 @@ int main(void)
         cmocka_unit_test(relaxation_scene_follows_published_muscle_relaxation),
         cmocka_unit_test(cycles_summary_separates_zero_force_strain_from_permanent_set),
         cmocka_unit_test(messages_never_show_what_a_named_file_holds),
+        cmocka_unit_test(a_scene_of_tailed_springs_follows_the_cell_through_region_3),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

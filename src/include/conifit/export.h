@@ -111,7 +111,8 @@ typedef struct cf_export_table {
                          ** shorter (where its rows meet the tolerance) */
 } cf_export_table;
 
-/* Where the full-range table ends: the compression (mm) at which the law carries F_C (1 - tol). */
+/* Where the full-range table ends: the compression (mm) at which the law carries F_C (1 - tol);
+** with a cylindrical tail F_solid - tol F_C, in the tail's straight region 3. */
 double cf_export_table_end(const cf_law *law, double tol);
 
 /* Samples the law into t over [-u_end, u_end] (see the top of this file). CF_E_DATA for a
@@ -165,6 +166,8 @@ typedef struct cf_export_report {
     int even;             /* 1: an evenly spaced table, over [u_lo, u_hi] of [req_lo, req_hi] */
     double req_lo_mm, req_hi_mm; /* the range asked for, mm */
     double end_force_rel; /* the law's force at the table's ends, fraction of F_C (the larger) */
+    double solid_force_rel; /* the law's force at solid, fraction of F_C: 1, or F_solid/F_C > 1
+                            ** for a spring with a tail */
     size_t groups;        /* lattice: spring groups (one table each) */
     size_t springs;       /* lattice: springs */
     size_t nodes;         /* lattice: nodes */

@@ -10,13 +10,16 @@
 **     "fits": [ { "type": "telescoping" | "non-telescoping",
 **                 "params":  { one number per design parameter, under its key },
 **                 "derived": { "rho", "travel_mm", "solid_strain", "F_T_N", "F_C_N",
-**                              "k0_N_per_mm", "u_T_mm", "index_c", "L_min_mm", "L_max_mm" },
+**                              "k0_N_per_mm", "u_T_mm", "index_c", "L_min_mm", "L_max_mm",
+**                              and with a tail "u_C_mm", "F_solid_N", "k_tail_N_per_mm", "tau" },
 **                 "rmse", "max_abs_error", "r2", ... } , ... ],
 **     "better_type": "telescoping" | "non-telescoping" | null (the types tie),
 **     ...
 **   }
 ** The keys of "params" are those of the spring's field table (cf_spring_param_info, spring.h), in
 ** its order; `tests/unit/test_spring.c` checks the documentation's lists of them against it.
+** The tail's two ("n_tail", "H_tail_mm") are written only for a spring with a tail and read as 0
+** when absent, so a plain spring's file is what it was before the tail existed.
 ** Only "fits[].type", "fits[].params" (and the provenance fields if present) are needed to read a
 ** spring back; everything else is report.
 **

@@ -20,6 +20,11 @@
 cf_status cf_flat_force(const double spring[6], const char *method, size_t count,
                         const double *u_mm, double *F_N, double *k_N_per_mm, cf_error *err);
 
+/* The same for a spring with a cylindrical tail: spring[0..7] = D1, D2, n, d, G, H, n_tail and
+** H_tail (mm); n_tail = H_tail = 0 is the plain spring of cf_flat_force. */
+cf_status cf_flat_force_tail(const double spring[8], const char *method, size_t count,
+                             const double *u_mm, double *F_N, double *k_N_per_mm, cf_error *err);
+
 /* Fits the stress-strain (or force-displacement) table at table_path as `conifit fit` does: the
 ** types named by type ("telescoping", "non-telescoping", "both"; NULL: both), run in the default
 ** lattice when validate is 1. *json receives the fit file's text (the document conifit fit -o
