@@ -227,6 +227,9 @@ figures: check-deps $(BUILD)/conifit
 	$(BUILD)/conifit simulate data/scenes/hysteresis.json -o $(BUILD)/hysteresis.csv --plot fits/figures/hysteresis.png
 	$(BUILD)/conifit simulate data/scenes/creep.json -o $(BUILD)/creep.csv --plot fits/figures/creep.png
 	gnuplot fits/figures/type_regions.gp
+	$(BUILD)/conifit curve --D1 10 --D2 30 --n 4 --d 1 --G 80000 --H 50 --n_tail 1 --H_tail 20 --points 2001 -o $(BUILD)/three_regions_tail.csv
+	$(BUILD)/conifit curve --D1 10 --D2 30 --n 4 --d 1 --G 80000 --H 30 --points 2001 -o $(BUILD)/three_regions_cone.csv
+	gnuplot fits/figures/three_regions.gp
 
 sanitize:
 	@$(MAKE) --no-print-directory test SANITIZE=1

@@ -370,9 +370,9 @@ static void summary_row(const fit_args *a, const fit_job *j, int wname)
         snprintf(cell[j->rep.fits[k].type], sizeof cell[0], "%.4g %s%s",
                  j->rep.fits[k].rmse * j->m.y_to_file, j->m.y_unit,
                  j->rep.fits[k].feasible ? "" : " (!)");
-    int bb = 0;
-    for (int k = 1; k < CF_BASE_COUNT; k++)
-        if (j->rep.baselines[k].rmse < j->rep.baselines[bb].rmse)
+    int bb = CF_BASE_LINEAR; /* always fitted; a baseline not fitted has no RMSE to compare */
+    for (int k = 0; k < CF_BASE_COUNT; k++)
+        if (j->rep.baselines[k].fitted && j->rep.baselines[k].rmse < j->rep.baselines[bb].rmse)
             bb = k;
     char bcell[48];
     snprintf(bcell, sizeof bcell, "%s %.4g %s", cf_baseline_name((cf_baseline_kind)bb),

@@ -386,17 +386,12 @@ done:
 
 /* ---- assembly and the cascade ---------------------------------------------------------------- */
 
-/* Assembles the tangent K = -dR/dx at the state of the last cf_msm_residual() into s->C (its
-** pattern built on first use) and scales it symmetrically, K' = D^-1 K D^-1 with D = sqrt|diag|
-** in s->D (a congruence: the inertia is that of K). */
-static cf_status assemble(solver *s, cf_error *err)
+/* Adds the tangent K = -dR/dx at the state of the last cf_msm_residual() into v (C's pattern,
+** zeroed first), unscaled. */
+static void assemble_values(solver *s, double *v)
 {
     cf_lattice *lat = s->lat;
-    const size_t n = s->ndof;
-    if (!s->C && build_pattern(s, err) != CF_OK)
-        return CF_E_INTERNAL;
-    gsl_spmatrix *C = s->C;
-    memset(C->data, 0, (size_t)C->p[n] * sizeof(double));
+    memset(v, 0, (size_t)s->C->p[s->ndof] * sizeof(double));
     for (size_t q = 0; q < lat->ns; q++) {
         uint32_t i = lat->si[q], j = lat->sj[q];
         double L = lat->L_mm[q];
@@ -414,24 +409,48 @@ static cf_status assemble(solver *s, cf_error *err)
                 double B = (kt - g) * nv[a] * nv[b] + (a == b ? g : 0.0);
                 int k = a * 3 + b;
                 if (m[k] >= 0)
-                    C->data[m[k]] += B;
+                    v[m[k]] += B;
                 if (m[k + 9] >= 0)
-                    C->data[m[k + 9]] += B;
+                    v[m[k + 9]] += B;
                 if (m[k + 18] >= 0)
-                    C->data[m[k + 18]] -= B;
+                    v[m[k + 18]] -= B;
                 if (m[k + 27] >= 0)
-                    C->data[m[k + 27]] -= B;
+                    v[m[k + 27]] -= B;
             }
     }
-    /* Symmetric Jacobi scaling: K' = D^-1 K D^-1 with D = sqrt|diag|. */
+}
+
+/* v <- D^-1 v D^-1 with D = s->D (C's pattern). */
+static void scale_values(const solver *s, double *v)
+{
+    const gsl_spmatrix *C = s->C;
+    for (size_t col = 0; col < s->ndof; col++)
+        for (int k = C->p[col]; k < C->p[col + 1]; k++)
+            v[k] /= s->D[C->i[k]] * s->D[col];
+}
+
+/* Assembles the tangent at the state of the last cf_msm_residual() into s->C (its pattern built on
+** first use) and scales it symmetrically, K' = D^-1 K D^-1 with D = sqrt|diag| in s->D (a
+** congruence: the inertia is that of K). */
+static cf_status assemble(solver *s, cf_error *err)
+{
+    const size_t n = s->ndof;
+    if (!s->C && build_pattern(s, err) != CF_OK)
+        return CF_E_INTERNAL;
+    gsl_spmatrix *C = s->C;
+    assemble_values(s, C->data);
     for (size_t e = 0; e < n; e++) {
         double d = C->data[s->diag[e]];
         s->D[e] = (d != 0 && isfinite(d)) ? sqrt(fabs(d)) : 1.0;
     }
-    for (size_t col = 0; col < n; col++)
-        for (int k = C->p[col]; k < C->p[col + 1]; k++)
-            C->data[k] /= s->D[C->i[k]] * s->D[col];
+    scale_values(s, C->data);
     return CF_OK;
+}
+
+void cf_linsolve_tangent_scaled(solver *s, double *v)
+{
+    assemble_values(s, v);
+    scale_values(s, v);
 }
 
 /* Restarted GMRES on the scaled tangent: the last resort of the cascade, for a system above

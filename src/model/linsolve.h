@@ -28,4 +28,19 @@ cf_status cf_linsolve_direction(struct solver *s, cf_error *err);
 ** holds it; sets *fatal for an out-of-memory that no fallback would survive. */
 int cf_linsolve_chord(struct solver *s, int *fatal, cf_error *err);
 
+/* The tangent at the state of the last residual into v (the pattern of s->C, which must exist),
+** scaled by the s->D of the last factorisation rather than its own diagonal: the matrix whose
+** solve the factors of s->chol precondition (linsolve_krylov.c). */
+void cf_linsolve_tangent_scaled(struct solver *s, double *v);
+
+/* The update s->dx from the current tangent, by GMRES preconditioned with the sparse factors of
+** an earlier one (s->chol, s->D). `need` is the reduction of the residual that would end Newton's
+** iteration (tolerance over residual, below 1): the linear residual is brought to a tenth of it
+** (kept between 1e-10 and 0.1 of the right-hand side: an inexact Newton step); after 16 GMRES
+** steps short of that, a linear residual within `need` or 0.1, whichever is larger (at most 0.5),
+** is still returned, a shorter step for the caller to judge. Returns 1 when s->dx holds it, 0 when
+** the factors are too stale for even that (the caller refactors); sets *fatal for an
+** out-of-memory that no fallback would survive. */
+int cf_linsolve_krylov(struct solver *s, double need, int *fatal, cf_error *err);
+
 #endif

@@ -52,6 +52,17 @@ typedef struct solver {
                                  steps, cf_msm_newton) */
     int chol_ready;           /* s->chol holds the factors of C, scaled by s->D, for a chord step */
     int refactor;             /* the next direction needs a fresh tangent */
+    int krylov;               /* the factored tangent no longer gives chord steps that converge:
+                                 directions solve the current tangent by Krylov steps with those
+                                 factors as preconditioner (linsolve_krylov.c) until a refactor */
+    double *kval;             /* the current tangent, C's pattern, scaled by s->D (Krylov steps) */
+    double *kbasis;           /* their Krylov basis and preconditioned basis; NULL until used */
+    /* secant predictor of the static load steps (the uniaxial curve): the converged positions at
+    ** the drive value before the current one (xprev, 3 nn as cf_msm_positions_get), vprev that
+    ** value, prev_ok whether they are there; xcur scratch. NULL/0 unless secant is set. */
+    int secant, prev_ok;
+    double vprev;
+    double *xprev, *xcur;
     double load;              /* current drive value: strain or stress, MPa */
     int extras;               /* quasi-static extras active */
     cf_msm_stats *st;
@@ -95,6 +106,9 @@ cf_status cf_msm_solver_init(solver *s, cf_lattice *lat, const cf_msm_effects *f
                              const cf_msm_config *cfg, cf_msm_drive drive, cf_msm_stats *st,
                              cf_error *err);
 void cf_msm_solver_free(solver *s);
+/* Turns on the secant predictor of static load steps (displacement drive): the caller sets
+** s->prev_ok = 0 whenever it moves the lattice other than through cf_msm_static_to. */
+cf_status cf_msm_solver_secant(solver *s, cf_error *err);
 void cf_msm_place_top(cf_lattice *lat, double e);
 void cf_msm_add_external(solver *s);
 double cf_msm_residual(solver *s, double *rnorm, double *fscale);

@@ -1,7 +1,8 @@
 /*
 ** The lattice solvers' workspace and static equilibria (see msm_internal.h): free DOFs, loads and
-** the residual; Newton with a line search that keeps every spring short of solid, chord steps for
-** the uniaxial curve, and load increments halved when a solve fails.
+** the residual; Newton with a line search that keeps every spring short of solid, chord and Krylov
+** steps for the uniaxial curve, a secant predictor of its load steps, and load increments halved
+** when a solve fails.
 */
 #include "model/msm_internal.h"
 
@@ -12,10 +13,17 @@
 /* A spring may come this close to solid (fraction of the travel) in a Newton step; beyond it the
 ** step is shortened. Past it the law's stiffness grows like (s - u)^(-1/2) and Newton stalls. */
 #define SOLID_MARGIN (1.0 - 1e-9)
-/* Chord iterations (the uniaxial curve): a direction from the last factored tangent is kept while
-** each step cuts the residual at least by CHORD_RATE without shortening; otherwise the next
+/* Steps from reused factors (the uniaxial curve): a chord step (a direction from the last factored
+** tangent) is kept while each cuts the residual at least by CHORD_RATE without shortening;
+** otherwise the next directions are Krylov steps (the current tangent solved by GMRES with those
+** factors as preconditioner, linsolve_krylov.c), held to the same rate; otherwise the next
 ** direction refactors. */
 #define CHORD_RATE 0.25
+/* Halvings of a step from reused factors (chord or Krylov) before it counts as failed: a direction
+** that needs more is not worth the residual evaluations, the next one does better (Krylov steps,
+** then a fresh tangent). A fresh tangent's step gets FRESH_HALVINGS. */
+#define REUSE_HALVINGS 4
+#define FRESH_HALVINGS 40
 
 /* ---- workspace, loads and residual ----------------------------------------------------------- */
 
@@ -35,6 +43,10 @@ void cf_msm_solver_free(solver *s)
     free(s->tmp);
     free(s->map);
     free(s->diag);
+    free(s->kval);
+    free(s->kbasis);
+    free(s->xprev);
+    free(s->xcur);
     if (s->C)
         gsl_spmatrix_free(s->C);
     if (s->AB)
@@ -97,6 +109,18 @@ cf_status cf_msm_solver_init(solver *s, cf_lattice *lat, const cf_msm_effects *f
 oom:
     cf_msm_solver_free(s);
     return cf_error_set(err, CF_E_INTERNAL, "out of memory for the lattice solver");
+}
+
+cf_status cf_msm_solver_secant(solver *s, cf_error *err)
+{
+    const size_t nn = s->lat->nn;
+    s->xprev = malloc(3 * nn * sizeof(double));
+    s->xcur = malloc(3 * nn * sizeof(double));
+    if (!s->xprev || !s->xcur)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the lattice solver");
+    s->secant = 1;
+    s->prev_ok = 0;
+    return CF_OK;
 }
 
 /* Places the top face for a displacement drive at compressive strain e. */
@@ -193,6 +217,16 @@ static double force_floor(const solver *s)
     return 1e-12 * lat->law->F_C_N * wmax + 1e-13 * dash;
 }
 
+/* A step from reused factors did not converge fast enough: chord steps give way to Krylov steps,
+** Krylov steps to a fresh tangent. */
+static void reuse_failed(solver *s)
+{
+    if (s->krylov)
+        s->refactor = 1;
+    else
+        s->krylov = 1;
+}
+
 /* Newton from the current positions (prescribed DOFs already placed). On failure the positions
 ** are put back where they started. One function: the choice between a chord step and a fresh
 ** tangent, the line search and the retry with a fresh tangent all read and update the same
@@ -211,7 +245,8 @@ cf_status cf_msm_newton(solver *s, cf_error *err)
     const double floor_f = force_floor(s);
     cf_status st = CF_E_NOCONV;
     for (int it = 0; it <= s->cfg->newton_max_iter; it++) {
-        if (um < SOLID_MARGIN && rn <= s->cfg->newton_rtol * fs + floor_f) {
+        const double target = s->cfg->newton_rtol * fs + floor_f;
+        if (um < SOLID_MARGIN && rn <= target) {
             st = CF_OK;
             break;
         }
@@ -220,17 +255,21 @@ cf_status cf_msm_newton(solver *s, cf_error *err)
         if (s->st)
             s->st->newton_iters++;
         cf_error lerr = {0};
-        /* a chord step: the last factored tangent, while it still converges fast */
-        const int chord = s->chord && s->chol_ready && !s->refactor;
-        if (chord) {
+        /* a step from the last factored tangent while it still converges fast: a chord step, or
+        ** once chord steps stall, a Krylov solve of the current tangent preconditioned by it */
+        const int reuse = s->chord && s->chol_ready && !s->refactor;
+        if (reuse) {
             int fatal = 0;
-            if (!cf_linsolve_chord(s, &fatal, &lerr)) {
+            /* a Krylov solve only as accurate as this step needs */
+            const int got = s->krylov ? cf_linsolve_krylov(s, target / rn, &fatal, &lerr)
+                                      : cf_linsolve_chord(s, &fatal, &lerr);
+            if (!got) {
                 if (fatal) {
                     cf_msm_positions_set(lat, start);
                     free(start);
                     return cf_error_set(err, CF_E_INTERNAL, "%s", lerr.msg);
                 }
-                s->refactor = 1;
+                reuse_failed(s);
                 continue;
             }
             if (s->st)
@@ -242,12 +281,15 @@ cf_status cf_msm_newton(solver *s, cf_error *err)
                 return cf_error_set(err, CF_E_INTERNAL, "%s", lerr.msg);
             }
             break;
-        } else
+        } else {
             s->refactor = 0;
+            s->krylov = 0;
+        }
         cf_msm_positions_get(lat, s->xsave);
         double alpha = 1, rn0 = rn;
         int ok = 0;
-        for (int h = 0; h < 40; h++) {
+        const int halvings = reuse ? REUSE_HALVINGS : FRESH_HALVINGS;
+        for (int h = 0; h < halvings; h++) {
             for (size_t p = 0; p < lat->nn; p++)
                 for (int a = 0; a < 3; a++) {
                     long e = s->eq[3 * p + a];
@@ -263,14 +305,16 @@ cf_status cf_msm_newton(solver *s, cf_error *err)
         }
         if (!ok) {
             cf_msm_positions_set(lat, s->xsave);
-            if (!chord)
+            if (!reuse)
                 break;
-            um = cf_msm_residual(s, &rn, &fs); /* a stale tangent: try again with a fresh one */
-            s->refactor = 1;
+            um = cf_msm_residual(s, &rn, &fs); /* stale factors: the next direction does better */
+            reuse_failed(s);
             continue;
         }
-        if (chord && (alpha < 1 || rn > CHORD_RATE * rn0))
-            s->refactor = 1;
+        /* a slow step that ends the iteration is no reason for the next one to change */
+        if (reuse && (alpha < 1 || rn > CHORD_RATE * rn0) &&
+            !(um < SOLID_MARGIN && rn <= s->cfg->newton_rtol * fs + floor_f))
+            reuse_failed(s);
     }
     if (s->st && um > s->st->max_u_over_travel && st == CF_OK)
         s->st->max_u_over_travel = um;
@@ -295,21 +339,53 @@ static void predict(solver *s, double de)
             lat->z[p] -= de * lat->Z[p];
 }
 
+/* Moves the free DOFs to the secant prediction for drive value v1 from the converged states at
+** v0 (s->xcur) and s->vprev (s->xprev): the last increment of every free coordinate, scaled to the
+** new one. Along the uniaxial curve of an 8^3 lattice it starts Newton with a residual 250 times
+** smaller than predict() (2e-6 N against 6e-4 N). */
+static void predict_secant(solver *s, double v0, double v1)
+{
+    cf_lattice *lat = s->lat;
+    const double r = (v1 - v0) / (v0 - s->vprev);
+    for (size_t p = 0; p < lat->nn; p++)
+        for (int a = 0; a < 3; a++)
+            if (s->eq[3 * p + a] >= 0) {
+                const size_t k = (size_t)a * lat->nn + p;
+                coord(lat, a)[p] = s->xcur[k] + r * (s->xcur[k] - s->xprev[k]);
+            }
+}
+
 /* Static equilibrium from drive value v0 (the current state) to v1; splits the increment in two
 ** when a direct solve fails. */
 static cf_status static_seg(solver *s, double v0, double v1, int depth, cf_error *err)
 {
     s->load = v1;
     int disp = s->drive == CF_DRIVE_DISPLACEMENT;
+    const int secant = s->secant && disp;
+    if (secant)
+        cf_msm_positions_get(s->lat, s->xcur);
     if (disp) {
         cf_msm_place_top(s->lat, v1);
-        predict(s, v1 - v0);
+        if (secant && s->prev_ok && s->vprev != v0)
+            predict_secant(s, v0, v1);
+        else
+            predict(s, v1 - v0);
     }
     cf_status st = cf_msm_newton(s, err);
-    if (st == CF_OK)
+    if (st == CF_OK) {
+        if (secant && v1 != v0) { /* the state at v0 becomes the previous one */
+            double *t = s->xprev;
+            s->xprev = s->xcur;
+            s->xcur = t;
+            s->vprev = v0;
+            s->prev_ok = 1;
+        }
         return st;
+    }
     s->load = v0;
-    if (disp) {
+    if (secant)
+        cf_msm_positions_set(s->lat, s->xcur);
+    else if (disp) {
         cf_msm_place_top(s->lat, v0);
         predict(s, v0 - v1);
     }

@@ -60,11 +60,18 @@ cf_status cf_msm_uniaxial(const cf_law *law, cf_law_method m, const cf_msm_confi
         return rc;
     }
     s.chord = 1; /* only the curve is reported, not the inertia of each state */
+    if ((rc = cf_msm_solver_secant(&s, err)) != CF_OK) {
+        cf_msm_solver_free(&s);
+        free(idx);
+        cf_lattice_free(&lat);
+        return rc;
+    }
     /* Two passes from the reference state: compression (table strain < 0), then tension. */
     for (int pass = 0; pass < 2 && rc == CF_OK; pass++) {
         cf_lattice_reset(&lat);
         s.load = 0;
         s.refactor = 1;
+        s.prev_ok = 0;
         for (size_t r = 0; r < count && rc == CF_OK; r++) {
             size_t i = idx[r].i;
             double e = -strain[i]; /* compressive-positive */

@@ -24,7 +24,7 @@
 #define PANEL_RIGHT 0.66
 #define KEY_LEFT 0.68
 
-/* Line styles: 1-2 the conical fits, 3-5 the baselines, 6-7 the lattice curves. */
+/* Line styles: 1-2 the conical fits, 3-7 the baselines, 8-9 the lattice curves. */
 static void styles(cf_gp *g)
 {
     cf_gp_cmd(g, "set style line 1 dt 1 lw 3.5 lc rgb %q", "#b2182b");
@@ -32,8 +32,10 @@ static void styles(cf_gp *g)
     cf_gp_cmd(g, "set style line 3 dt 3 lw 2 lc rgb %q", "#525252");
     cf_gp_cmd(g, "set style line 4 dt 4 lw 1.5 lc rgb %q", "#1b7837");
     cf_gp_cmd(g, "set style line 5 dt 5 lw 1.5 lc rgb %q", "#762a83");
-    cf_gp_cmd(g, "set style line 6 dt 1 lw 1.5 pt 4 ps 0.9 lc rgb %q", "#d6604d");
-    cf_gp_cmd(g, "set style line 7 dt 2 lw 1.5 pt 8 ps 0.9 lc rgb %q", "#4393c3");
+    cf_gp_cmd(g, "set style line 6 dt (12, 4, 2, 4) lw 1.5 lc rgb %q", "#8c510a");
+    cf_gp_cmd(g, "set style line 7 dt (8, 3, 2, 3, 2, 3) lw 2 lc rgb %q", "#01665e");
+    cf_gp_cmd(g, "set style line 8 dt 1 lw 1.5 pt 4 ps 0.9 lc rgb %q", "#d6604d");
+    cf_gp_cmd(g, "set style line 9 dt 2 lw 1.5 pt 8 ps 0.9 lc rgb %q", "#4393c3");
 }
 
 /* x, the lattice stress and its residual (file's unit) of every data point, sorted by x. */
@@ -66,7 +68,7 @@ static void lattice_block(cf_gp *g, const char *name, const cf_table *d,
 typedef struct fit_curves {
     int fit[2];       /* 1: draw fit k */
     int lattice[2];   /* 1: draw the lattice curve of fit k */
-    int style[2];     /* line style of fit k (its lattice curve: style + 5) */
+    int style[2];     /* line style of fit k (its lattice curve: style + 7) */
     int lattice_fit[2]; /* 1: fit k is drawn as the lattice's curve it was fitted through */
     char fit_title[2][96];
     char lattice_title[2][128];
@@ -91,7 +93,8 @@ static int target_curve(const cf_fit_report *r, int k, const double *x, size_t c
 }
 
 /* The data blocks: $DATA (x, y, the residual of each fit then of each baseline) and $CURVES (x,
-** each fit, each baseline) in the file's unit. */
+** each fit, each baseline) in the file's unit; a baseline not fitted has its columns (zero) but
+** no curve. */
 static void fit_blocks(cf_gp *g, const cf_fit_report *r, fit_curves *fc)
 {
     const int *lattice_fit = fc->lattice_fit;
@@ -131,7 +134,9 @@ static void fit_blocks(cf_gp *g, const cf_fit_report *r, fit_curves *fc)
                         d->y[i]) *
                        u;
         for (int k = 0; k < CF_BASE_COUNT; k++)
-            row[c++] = (cf_baseline_eval(&r->baselines[k], d->x[i]) - d->y[i]) * u;
+            row[c++] = r->baselines[k].fitted
+                           ? (cf_baseline_eval(&r->baselines[k], d->x[i]) - d->y[i]) * u
+                           : 0;
         cf_gp_block_row(g, c, row);
     }
     cf_gp_block_end(g);
@@ -143,7 +148,8 @@ static void fit_blocks(cf_gp *g, const cf_fit_report *r, fit_curves *fc)
             row[c++] = (lattice_fit[k] ? target[k][j] : cf_fit_model(&r->fits[k].law, fd, xs[j])) *
                        u;
         for (int k = 0; k < CF_BASE_COUNT; k++)
-            row[c++] = cf_baseline_eval(&r->baselines[k], xs[j]) * u;
+            row[c++] = r->baselines[k].fitted ? cf_baseline_eval(&r->baselines[k], xs[j]) * u
+                                              : 0;
         cf_gp_block_row(g, c, row);
     }
     cf_gp_block_end(g);
@@ -246,6 +252,8 @@ static void fit_panel(cf_gp *g, const cf_fit_report *r, const fit_curves *c, int
         }
     for (int k = 0; k < CF_BASE_COUNT; k++) {
         const char *name = cf_baseline_name((cf_baseline_kind)k);
+        if (!r->baselines[k].fitted)
+            continue;
         if (residual)
             cf_gp_cmd(g, "  , $DATA using 1:%d with lines ls %d title %q \\", 3 + r->nfits + k,
                       3 + k, name);
@@ -256,7 +264,7 @@ static void fit_panel(cf_gp *g, const cf_fit_report *r, const fit_curves *c, int
     for (int k = 0; k < r->nfits; k++)
         if (c->lattice[k])
             cf_gp_cmd(g, "  , $LATTICE%d using 1:%d with linespoints ls %d title %q \\", k,
-                      residual ? 3 : 2, 5 + c->style[k], c->lattice_title[k]);
+                      residual ? 3 : 2, 7 + c->style[k], c->lattice_title[k]);
     cf_gp_cmd(g, "");
 }
 

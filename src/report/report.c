@@ -13,6 +13,7 @@
 
 #include "base/atomic.h"
 #include "io/fitfile_json.h"
+#include "report/report_baselines.h"
 #include "report/report_json.h"
 #include "report/report_notes.h"
 #include "report/report_words.h"
@@ -275,26 +276,6 @@ static json_t *fit_json(const cf_fit_report *r, int i)
     return o;
 }
 
-static json_t *baseline_json(const cf_fit_report *r, int k)
-{
-    const cf_baseline *b = &r->baselines[k];
-    double u = r->table->y_to_file;
-    json_t *coef;
-    /* coefficients in the file's y unit per unit x */
-    if (b->kind == CF_BASE_LINEAR)
-        coef = json_pack("{s:o}", "E", num(b->coef[0] * u));
-    else if (b->kind == CF_BASE_DUFFING)
-        coef = json_pack("{s:o, s:o}", "k1", num(b->coef[0] * u), "k3", num(b->coef[1] * u));
-    else
-        coef = json_pack("{s:o, s:o}", "A", num(b->coef[0] * u), "B", num(b->coef[1]));
-    return json_pack("{s:s, s:s, s:o, s:i, s:o, s:o}", "model", cf_baseline_name(b->kind),
-                     "formula",
-                     b->kind == CF_BASE_LINEAR    ? "y = E x"
-                     : b->kind == CF_BASE_DUFFING ? "y = k1 x + k3 x^3"
-                                                  : "y = A (exp(B x) - 1)",
-                     "coefficients", coef, "parameters", b->k, "rmse", num(b->rmse * u), "aic",
-                     num(cf_report_baseline_aic(r, k)));
-}
 
 
 
@@ -367,7 +348,7 @@ static json_t *report_json(const cf_fit_report *r)
     for (int i = 0; i < r->nfits; i++)
         json_array_append_new(fits, fit_json(r, i));
     for (int k = 0; k < CF_BASE_COUNT; k++)
-        json_array_append_new(base, baseline_json(r, k));
+        json_array_append_new(base, cf_report_baseline_json(r, k));
     json_t *root = json_pack("{s:s, s:o, s:o}", "conifit_version", r->version, "data", data,
                              "fits", fits);
     json_object_set_new(root, "limits", limits_json(r));

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "report/report_baselines.h"
 #include "report/report_notes.h"
 #include "report/report_words.h"
 
@@ -505,21 +506,20 @@ static void verdict_and_baselines(FILE *o, const cf_fit_report *r)
         fprintf(o, "\nNo feasible fit: no spring meets every constraint on this table (see "
                    "'feasible' above).\n");
     }
-    fprintf(o, "\nBaselines (plain least squares):\n");
+    fprintf(o, "\nBaselines (plain least squares; Yeoh and Ogden in the %s form of an "
+               "incompressible solid):\n",
+            cf_mode_name(r->baselines[CF_BASE_YEOH].form));
     for (int k = 0; k < CF_BASE_COUNT; k++) {
         const cf_baseline *bl = &r->baselines[k];
-        char co[96];
-        double u = r->table->y_to_file;
-        if (bl->kind == CF_BASE_LINEAR)
-            snprintf(co, sizeof co, "E = %.4g %s", bl->coef[0] * u, r->table->y_unit);
-        else if (bl->kind == CF_BASE_DUFFING)
-            snprintf(co, sizeof co, "k1 = %.4g, k3 = %.4g %s", bl->coef[0] * u, bl->coef[1] * u,
-                     r->table->y_unit);
-        else
-            snprintf(co, sizeof co, "A = %.4g %s, B = %.4g", bl->coef[0] * u, r->table->y_unit,
-                     bl->coef[1]);
-        fprintf(o, "  %-8s %-36s RMSE %.4g %s   AIC %.2f (k = %d)\n", cf_baseline_name(bl->kind), co,
-                bl->rmse * u, r->table->y_unit, cf_report_baseline_aic(r, k), bl->k);
+        if (!bl->fitted) {
+            fprintf(o, "  %-8s not fitted: %s\n", cf_baseline_name(bl->kind), bl->why);
+            continue;
+        }
+        char co[128];
+        cf_report_baseline_coefficients(r, k, co, sizeof co);
+        fprintf(o, "  %-8s %-44s RMSE %.4g %s   AIC %.2f (k = %d)\n", cf_baseline_name(bl->kind),
+                co, bl->rmse * r->table->y_to_file, r->table->y_unit,
+                cf_report_baseline_aic(r, k), bl->k);
     }
     fprintf(o, "\nThe law seen through this table depends on the six design parameters only through "
                "rho,\nthe %s and the %s. The six numbers above are one member of a family of "

@@ -206,7 +206,7 @@ void bench_section_fastfit(bench_ctx *ctx)
             "A stress-strain table that is no conical spring: stress 3e + 40e^3 kPa, strain 0 to "
             "0.3 evenly spaced, 1 %% Gaussian noise of the largest stress (seed 1), written as "
             "CSV, read with `cf_measure_load` and fitted as `conifit fit` fits it without "
-            "`--validate` (both types and the three baselines), on one thread. Above %d rows "
+            "`--validate` (both types and the five baselines), on one thread. Above %d rows "
             "every search runs on a subsample of that many rows and the polish on every row; the "
             "law is evaluated in vector lanes throughout. CPU time is the process's own (the "
             "figure a shared machine does not inflate); median of the repeats. The RMSE change "

@@ -1,10 +1,13 @@
 /*
 ** Tests of `conifit fit` through the program: the bad-input catalogue (exact exit status, a
 ** message naming file, line and column, no output file), the JSON fit file read back by the
-** fit-file reader, determinism, batch runs with -j, plots and a missing gnuplot.
+** fit-file reader, determinism, batch runs with -j, plots and a missing gnuplot; the Yeoh and
+** Ogden baselines in the report, the fit file and the batch summary, and where they are not fitted.
 */
 #include <math.h>
 #include <sys/stat.h>
+
+#include <jansson.h>
 
 #include "testutil.h"
 
@@ -171,6 +174,89 @@ static void json_fit_file_round_trips_through_the_reader(void **state)
     rmdir(dir);
 }
 
+/* The baselines of a published table in the report, the fit file (five, in their order) and the
+** batch summary; a force-displacement table leaves Yeoh and Ogden out with the reason. */
+static void yeoh_and_ogden_baselines_are_reported_or_left_out_with_why(void **state)
+{
+    (void)state;
+    const char *ds = tu_datasets();
+    if (!ds) {
+        print_message("test_cli_fit: ../shared/datasets absent: the baselines are not checked\n");
+        skip();
+    }
+    char dir[] = "/tmp/conifit-base-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    static const char *const names[] = {"linear", "duffing", "fung", "yeoh", "ogden"};
+    const char *tables[2] = {"hydrogel_fibre_reinforced_compression",
+                             "thrombus_pureshear_force_displacement"};
+    for (int k = 0; k < 2; k++) {
+        char json[256];
+        snprintf(json, sizeof json, "%s/%s.json", dir, tables[k]);
+        assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb, "fit %s/%s.csv -o %s", ds,
+                                tables[k], json),
+                         0);
+        json_error_t je;
+        json_t *root = json_load_file(json, JSON_REJECT_DUPLICATES, &je);
+        if (!root)
+            fail_msg("%s: %s", json, je.text);
+        json_t *base = json_object_get(root, "baselines");
+        assert_int_equal(json_array_size(base), 5);
+        for (size_t b = 0; b < 5; b++)
+            assert_string_equal(json_string_value(json_object_get(json_array_get(base, b), "model")),
+                                names[b]);
+        json_t *yeoh = json_array_get(base, 3), *ogden = json_array_get(base, 4);
+        if (k == 0) { /* compression, uniaxial: fitted, Yeoh better than Duffing's cubic */
+            assert_non_null(strstr(out, "  yeoh     C1 = "));
+            assert_non_null(strstr(out, " MPa RMSE"));
+            assert_non_null(strstr(out, "  ogden    mu = "));
+            assert_non_null(strstr(out, "Yeoh and Ogden in the uniaxial form"));
+            assert_string_equal(json_string_value(json_object_get(yeoh, "form")), "uniaxial");
+            assert_true(json_number_value(json_object_get(yeoh, "rmse")) <
+                        0.5 * json_number_value(json_object_get(json_array_get(base, 1), "rmse")));
+            assert_non_null(json_object_get(json_object_get(ogden, "coefficients"), "alpha"));
+            /* a fit file written before Yeoh and Ogden (three baselines) still loads */
+            json_array_remove(base, 4);
+            json_array_remove(base, 3);
+            assert_int_equal(json_dump_file(root, json, JSON_INDENT(2)), 0);
+            cf_fitted_spring fs;
+            cf_error err = {0};
+            if (cf_fitfile_load(json, NULL, &fs, &err) != CF_OK)
+                fail_msg("%s", err.msg);
+            char csv[300];
+            snprintf(csv, sizeof csv, "%s/spring.csv", dir);
+            assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                                    "export %s --format csv -o %s", json, csv),
+                             0);
+            remove(csv);
+        } else { /* force against displacement: no stretch, no form */
+            assert_non_null(strstr(out, "  yeoh     not fitted: a force-displacement table"));
+            assert_non_null(strstr(out, "  ogden    not fitted: a force-displacement table"));
+            for (int j = 0; j < 2; j++) {
+                json_t *o = j ? ogden : yeoh;
+                assert_non_null(strstr(json_string_value(json_object_get(o, "reason")),
+                                       "no stretch"));
+                assert_null(json_object_get(o, "rmse"));
+                assert_null(json_object_get(o, "coefficients"));
+            }
+        }
+        json_decref(root);
+        remove(json);
+    }
+    /* the summary's best baseline may be one of the new ones */
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "fit %s/%s.csv data/telescoping.csv -o %s/", ds, tables[0], dir),
+                     0);
+    const char *row = strstr(out, "hydrogel_fibre_reinforced_compression.csv");
+    assert_non_null(row);
+    assert_non_null(strstr(row, " yeoh 0.00"));
+    char path[300];
+    snprintf(path, sizeof path, "%s/%s.json", dir, tables[0]);
+    remove(path);
+    snprintf(path, sizeof path, "%s/telescoping.json", dir);
+    remove(path);
+    rmdir(dir);
+}
+
 /* Same seed, same file (apart from the wall time). */
 static void same_seed_gives_identical_json(void **state)
 {
@@ -316,6 +402,7 @@ int main(void)
         cmocka_unit_test(bad_options_exit_2),
         cmocka_unit_test(json_fit_file_round_trips_through_the_reader),
         cmocka_unit_test(same_seed_gives_identical_json),
+        cmocka_unit_test(yeoh_and_ogden_baselines_are_reported_or_left_out_with_why),
         cmocka_unit_test(batch_in_parallel_writes_one_file_per_table),
         cmocka_unit_test(plot_is_written_or_fails_cleanly_without_gnuplot),
         cmocka_unit_test(fixed_parameter_is_in_the_fit_file),

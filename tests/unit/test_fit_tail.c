@@ -111,7 +111,7 @@ static void noiseless_springs_are_recovered(void **state)
     (void)state;
     recover(tailed(0.3, 4, 0.5, 3), CF_NON_TELESCOPING);
     recover(tailed(0.3, 4, 0.5, 3), CF_TELESCOPING); /* the family placed as the other type */
-    recover(tailed(0.15, 5, 0.2, 2), CF_TELESCOPING); /* a tail of one coil, the fewest placed */
+    recover(tailed(0.15, 5, 0.2, 2), CF_TELESCOPING); /* one tail coil, the fewest placed */
 }
 
 /* With 1 % noise each quantity lies within 3 of its reported standard errors of the truth. */

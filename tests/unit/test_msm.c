@@ -12,12 +12,17 @@
 **    network: creep under dashpots (Kelvin-Voigt, time constant H eta / k0), stress relaxation of
 **    a Maxwell branch (its tau) and of a Prony term (its tau_i, amplitude g_i);
 **  - cf_msm_stability_limit: stable just below the limit, unstable just above;
-**  - cf_msm_stable_step: the step an explicit run reports, shortened by dashpots.
+**  - cf_msm_stable_step: the step an explicit run reports, shortened by dashpots;
+**  - the steps on reused factors of the static solver (private: model/linsolve_krylov.c and the
+**    chord steps and secant predictor of model/msm_newton.c): a Krylov step solves the current
+**    tangent, and the uniaxial curve through those steps equals the one Newton finds with a fresh
+**    tangent at every iteration, past the stability limit, with a fraction of the factorisations.
 */
 #include "testutil.h"
 
 #include "conifit/lattice.h"
 #include "conifit/msm.h"
+#include "model/msm_internal.h"
 
 /* A soft, strongly stiffening non-telescoping spring (solid strain 0.5, H = 10 mm). */
 static cf_law make_law(void)
@@ -398,6 +403,117 @@ static void explicit_runs_report_the_stable_step(void **state)
     cf_law_free(&law);
 }
 
+/* Relative 2-norm distance |a - b| / |b| over n entries. */
+static double rel_dist(const double *a, const double *b, size_t n)
+{
+    double d = 0, r = 0;
+    for (size_t e = 0; e < n; e++) {
+        d += (a[e] - b[e]) * (a[e] - b[e]);
+        r += b[e] * b[e];
+    }
+    return sqrt(d / r);
+}
+
+/* Equilibrium at compressive strain e (Newton with a fresh tangent every iteration). */
+static void solve_at(solver *s, double e)
+{
+    cf_error err = {0};
+    if (cf_msm_static_to(s, e, &err) != CF_OK)
+        fail_msg("static solve at %g: %s", e, err.msg);
+}
+
+/* A Krylov step preconditioned by the factors of an earlier tangent solves the current one: the
+** direction a fresh factorisation gives, across the loss of stability between the two, where a
+** chord step on the same factors does not. */
+static void krylov_step_solves_the_current_tangent(void **state)
+{
+    (void)state;
+    cf_law law;
+    cf_msm_config cfg;
+    cf_lattice lat;
+    open_lattice(4, &law, &cfg, &lat);
+    cf_error err = {0};
+    solver s;
+    assert_int_equal(cf_msm_solver_init(&s, &lat, NULL, &cfg, CF_DRIVE_DISPLACEMENT, NULL, &err),
+                     CF_OK);
+    /* factors of the tangent at an equilibrium short of the stability limit */
+    solve_at(&s, 0.30);
+    double rn, fs;
+    cf_msm_residual(&s, &rn, &fs);
+    assert_int_equal(cf_linsolve_direction(&s, &err), CF_OK);
+    assert_true(s.chol_ready);
+    assert_int_equal(s.neg_pivots, 0); /* still stable */
+    /* a state further on, its residual solved three ways */
+    s.load = 0.33;
+    cf_msm_place_top(&lat, s.load);
+    for (size_t p = 0; p < lat.nn; p++)
+        if (s.eq[3 * p + 2] >= 0)
+            lat.z[p] -= 0.03 * lat.Z[p];
+    cf_msm_residual(&s, &rn, &fs);
+    assert_true(rn > 1e-6 * fs);
+    const size_t n = s.ndof;
+    double *kry = malloc(n * sizeof *kry), *chord = malloc(n * sizeof *chord);
+    assert_non_null(kry);
+    assert_non_null(chord);
+    int fatal = 0;
+    assert_int_equal(cf_linsolve_krylov(&s, 1e-9, &fatal, &err), 1);
+    assert_int_equal(fatal, 0);
+    memcpy(kry, s.dx, n * sizeof *kry);
+    assert_int_equal(cf_linsolve_chord(&s, &fatal, &err), 1);
+    memcpy(chord, s.dx, n * sizeof *chord);
+    assert_int_equal(cf_linsolve_direction(&s, &err), CF_OK); /* a fresh factorisation */
+    const double dk = rel_dist(kry, s.dx, n), dc = rel_dist(chord, s.dx, n);
+    assert_true(s.neg_pivots > 0); /* and past the stability limit: the factors are of a
+                                       positive definite tangent, the current one is not */
+    assert_true(dk < 1e-7);
+    assert_true(dc > 1e-3); /* the factors are stale: the chord direction is not the tangent's */
+    free(kry);
+    free(chord);
+    cf_msm_solver_free(&s);
+    cf_lattice_free(&lat);
+    cf_law_free(&law);
+}
+
+/* The spring of the shipped uniaxial scene on 5^3 cells: 45 strains to 0.45 (the lattice loses stability on the
+** way), through cf_msm_uniaxial (chord and Krylov steps, secant predictor) and through cf_msm_run
+** (a fresh tangent at every Newton iteration, the affine predictor). */
+static void uniaxial_curve_equals_fresh_newton(void **state)
+{
+    (void)state;
+    cf_law law = make_law();
+    cf_msm_config cfg = small_config(5);
+    enum { N = 45 };
+    double strain[N], fast[N], ts[N];
+    for (int k = 0; k < N; k++) {
+        strain[k] = -0.01 * (k + 1);
+        ts[k] = (k + 1) / (double)N;
+    }
+    cf_error err = {0};
+    cf_msm_stats st;
+    if (cf_msm_uniaxial(&law, CF_LAW_CLOSED, &cfg, strain, N, fast, &st, &err) != CF_OK)
+        fail_msg("uniaxial: %s", err.msg);
+    cf_lattice lat;
+    assert_int_equal(cf_lattice_create(&lat, &law, CF_LAW_CLOSED, &cfg.lattice, &err), CF_OK);
+    const double t[2] = {0, 1}, v[2] = {0, 0.45};
+    const cf_msm_path path = {CF_DRIVE_DISPLACEMENT, 2, t, v};
+    cf_msm_sample out[N];
+    cf_msm_stats full;
+    if (cf_msm_run(&lat, NULL, &cfg, &path, ts, N, out, NULL, &full, &err) != CF_OK)
+        fail_msg("static run: %s", err.msg);
+    cf_lattice_free(&lat);
+    for (int k = 0; k < N; k++) {
+        assert_close(out[k].strain, -strain[k], 1e-14);
+        assert_close(fast[k], -out[k].stress_MPa, 1e-9 * fabs(out[k].stress_MPa));
+    }
+    assert_true(out[N - 1].neg_pivots > 0); /* the curve went past the stability limit */
+    /* factors were reused: far fewer factorisations than Newton iterations */
+    assert_int_equal(full.chord_iters, 0);
+    assert_true(st.chord_iters > 0);
+    assert_true(4 * st.linear_iters < st.newton_iters);
+    assert_true(st.linear_iters < full.linear_iters / 10);
+    cf_law_free(&law);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -410,6 +526,8 @@ int main(void)
         cmocka_unit_test(held_strain_relaxes_by_its_prony_term),
         cmocka_unit_test(the_stability_limit_separates_stable_from_unstable_states),
         cmocka_unit_test(explicit_runs_report_the_stable_step),
+        cmocka_unit_test(krylov_step_solves_the_current_tangent),
+        cmocka_unit_test(uniaxial_curve_equals_fresh_newton),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

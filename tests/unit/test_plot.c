@@ -108,8 +108,11 @@ static void a_tie_is_one_labelled_curve_and_the_title_is_the_table(void **state)
     assert_non_null(strstr(svg, ">model</tspan>"));
     /* the lattice curve in both panels (its residual below) */
     assert_int_equal(count(svg, "<text>lattice 3x3x3, both types (coincide)</text>"), 2);
-    /* three baselines, each in both panels */
-    assert_int_equal(count(svg, "<text>duffing</text>"), 2);
+    /* five baselines, each in both panels */
+    const char *const base[] = {"<text>linear</text>", "<text>duffing</text>", "<text>fung</text>",
+                                "<text>yeoh</text>", "<text>ogden</text>"};
+    for (int k = 0; k < 5; k++)
+        assert_int_equal(count(svg, base[k]), 2);
 }
 
 /* A fit through the lattice draws what was fitted: the lattice's curve and its residuals (one

@@ -68,7 +68,22 @@ static void json_holds_units_finite_numbers_and_reads_back(void **state)
     /* RMSE in kPa: the fit's MPa value times 1000 */
     assert_close(json_number_value(json_object_get(f0, "rmse")), r.fits[0].rmse * 1000,
                  1e-12 * fmax(1.0, r.fits[0].rmse * 1000));
-    assert_int_equal(json_array_size(json_object_get(root, "baselines")), 3);
+    /* the five baselines in their order, each fitted, with its coefficients in kPa */
+    json_t *base = json_object_get(root, "baselines");
+    assert_int_equal(json_array_size(base), CF_BASE_COUNT);
+    for (int k = 0; k < CF_BASE_COUNT; k++) {
+        json_t *bk = json_array_get(base, (size_t)k);
+        assert_string_equal(json_string_value(json_object_get(bk, "model")),
+                            cf_baseline_name((cf_baseline_kind)k));
+        assert_null(json_object_get(bk, "reason"));
+        assert_close(json_number_value(json_object_get(bk, "rmse")), r.baselines[k].rmse * 1000,
+                     1e-12 * r.baselines[k].rmse * 1000);
+    }
+    json_t *yc = json_object_get(json_array_get(base, CF_BASE_YEOH), "coefficients");
+    assert_close(json_number_value(json_object_get(yc, "C2")), r.baselines[CF_BASE_YEOH].coef[1] * 1000,
+                 1e-12 * fabs(r.baselines[CF_BASE_YEOH].coef[1]) * 1000);
+    json_t *oc = json_object_get(json_array_get(base, CF_BASE_OGDEN), "coefficients");
+    assert_true(json_number_value(json_object_get(oc, "alpha")) == r.baselines[CF_BASE_OGDEN].coef[1]);
     json_decref(root);
     /* what is written reads back: the spring of the first fit, bit for bit */
     char dir[] = "/tmp/conifit-report-XXXXXX", path[300];
@@ -107,7 +122,8 @@ static void text_names_types_quantities_and_units(void **state)
     assert_non_null(text);
     const char *want[] = {"spring.csv", "telescoping", "non-telescoping", "rho = D1/D2",
                           "solid strain s/H", "stress scale F_C/H^2", " mm", " MPa", " kPa",
-                          "RMSE", "Baselines", "duffing", "fung"};
+                          "RMSE", "Baselines", "duffing", "fung", "yeoh     C1 = ",
+                          "ogden    mu = ", "uniaxial form"};
     for (size_t i = 0; i < sizeof want / sizeof want[0]; i++)
         if (!strstr(text, want[i]))
             fail_msg("the report text lacks '%s':\n%s", want[i], text);

@@ -117,7 +117,8 @@ typedef struct cf_msm_stats {
     size_t linear_iters;       /* linear solves: sparse, banded or dense factorisations plus
                                   GMRES cycles */
     size_t chord_iters;        /* Newton iterations that reused an earlier factorisation instead
-                                  (uniaxial curves: chord steps) */
+                                  (uniaxial curves: chord steps, and Krylov steps on the current
+                                  tangent preconditioned by it) */
     size_t indefinite_tangents;/* factored tangents with negative pivots (unstable states) */
     long neg_pivots_max;       /* most negative pivots of any factored tangent (0: every tangent
                                   was positive definite); -1 if none had a known inertia */

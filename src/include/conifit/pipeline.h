@@ -2,7 +2,7 @@
 ** The fitting pipeline as one library call: a table in, a report out.
 **
 **   cf_table (measure.h) --cf_fit_run, each type--> cf_fit_result
-**                        --cf_baseline_fit_all----> linear, Duffing, Fung
+**                        --cf_baseline_fit_all----> linear, Duffing, Fung, Yeoh, Ogden
 **                        --cf_validate_run---------> lattice curve, RMSE, R^2 (optional)
 **                        --cf_lattice_fit----------> the fit through the lattice (optional),
 **                          cf_validate_lattice_fit    verified in the full lattice

@@ -1,0 +1,24 @@
+/*
+** How a fit report states its baselines (baseline.h), in the text (report_text.c) and in the fit
+** file's baselines[] (report.c): the coefficients with their names and units. Private to
+** src/report/.
+*/
+#ifndef CF_REPORT_BASELINES_H
+#define CF_REPORT_BASELINES_H
+
+#include <stddef.h>
+
+#include <jansson.h>
+
+#include "conifit/report.h"
+
+/* Baseline k's coefficients as "C1 = 0.1, C2 = 2, C3 = -3 kPa" (values in the file's unit; the
+** unit after each run of coefficients in it). */
+void cf_report_baseline_coefficients(const cf_fit_report *r, int k, char *buf, size_t cap);
+
+/* Baseline k as the fit file's object: model, formula (the Yeoh and Ogden ones with their
+** form, the table's mode), parameters and, when fitted, coefficients, rmse and aic; when not,
+** reason. NULL when memory runs out. */
+json_t *cf_report_baseline_json(const cf_fit_report *r, int k);
+
+#endif
