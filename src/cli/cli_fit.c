@@ -232,29 +232,23 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
                                            "lattice (the default in that mode) or give "
                                            "--mode uniaxial",
                                     cf_mode_name(jobs[i].m.mode));
-    /* the tailed law is fitted to the spring itself, on uniaxial and force tables */
+    /* the tailed law: the spring itself or through the lattice, as the conical law; not in a
+    ** joint fit, a time series' elastic part or with fixed parameters */
     const cf_law_family law = a->popt.fit.law;
     int nfixed = 0;
     for (int k = 0; k < CF_P_COUNT; k++)
         nfixed += a->popt.fit.fixed[k] != 0;
     if (rc < 0 && law != CF_FAMILY_CONICAL) {
         const char *lname = cf_law_family_name(law);
-        if (a->joint || a->popt.target == CF_TARGET_LATTICE)
-            rc = cf_cli_usage_error("fit", "--law %s fits the spring itself: not with %s (use "
-                                           "--law conical)",
-                                    lname, a->joint ? "--joint" : "--target lattice");
+        if (a->joint)
+            rc = cf_cli_usage_error("fit", "--law %s: a joint fit is of the conical law (use "
+                                           "--law conical)", lname);
         else if (*nseries)
             rc = cf_cli_usage_error("fit", "--law %s: a time series' elastic part is the "
                                            "conical law (use --law conical)", lname);
         else if (nfixed)
             rc = cf_cli_usage_error("fit", "--law %s places its spring in closed form and holds "
                                            "no parameter fixed (drop --fix)", lname);
-        for (int i = 0; i < a->nfiles && rc < 0; i++)
-            if (!cf_table_is_force(&jobs[i].m) && jobs[i].m.mode != CF_MODE_UNIAXIAL)
-                rc = cf_cli_usage_error("fit", "--law %s fits the spring itself: the table's "
-                                               "mode is %s, which a single spring has no curve "
-                                               "of (use --law conical)",
-                                        lname, cf_mode_name(jobs[i].m.mode));
     }
     if (rc < 0 && *nseries == 0 && a->series_only)
         rc = cf_cli_usage_error("fit", "--branches, --dashpot, --relaxation, --elastic and "

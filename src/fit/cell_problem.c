@@ -25,8 +25,12 @@ double cf_cell_rss(cf_cell_problem *p, double rho, double B, double *A_out)
     p->evals++;
     *A_out = 0;
     double A_max;
-    if (cf_fit_ident_limit(p->opt, p->type, rho, B, &A_max, NULL) > 0)
+    if (p->A_max) {
+        if (!((A_max = p->A_max(p->ctx, rho, B)) > 0))
+            return CF_LSQ_HUGE_OBJ;
+    } else if (cf_fit_ident_limit(p->opt, p->type, rho, B, &A_max, NULL) > 0) {
         return CF_LSQ_HUGE_OBJ;
+    }
     if (p->A_fixed > 0 && p->A_fixed > A_max * (1 + 1e-9))
         return CF_LSQ_HUGE_OBJ;
     if (p->curve(p->ctx, rho, B, p->g) != 0)

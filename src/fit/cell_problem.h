@@ -18,6 +18,10 @@ typedef struct cf_cell_problem {
     /* the target's curve at stress scale 1 for rho and s/H = B: n values into out (the rows of
     ** every table, in order); nonzero when it cannot be computed */
     int (*curve)(void *ctx, double rho, double B, double *out);
+    /* NULL for the conical law's family (its design limits, cf_fit_ident_limit); else the
+    ** largest stress scale at (rho, B) that a spring of the searched family carries, <= 0 where
+    ** none is placed (the conical-tail law's, its tail read from ctx) */
+    double (*A_max)(void *ctx, double rho, double B);
     void *ctx;
     size_t n;                  /* rows */
     const double *y;           /* measured values, n, MPa */
@@ -33,7 +37,7 @@ typedef struct cf_cell_problem {
 } cf_cell_problem;
 
 /* The weighted RSS at (rho, B), the stress scale in closed form (weighted linear least squares,
-** capped at the largest scale the type carries there) or p->A_fixed; *A_out receives it.
+** capped at the largest scale the type carries there, or p->A_max's) or p->A_fixed; *A_out receives it.
 ** CF_LSQ_HUGE_OBJ where no spring of the type can be placed or the curve cannot be computed. */
 double cf_cell_rss(cf_cell_problem *p, double rho, double B, double *A_out);
 

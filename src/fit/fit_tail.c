@@ -28,6 +28,7 @@
 #include "fit/fit_ctx.h"
 #include "fit/lm.h"
 #include "fit/lsq.h"
+#include "fit/tail.h"
 
 #define TAIL_GRID_RHO 10
 #define TAIL_GRID_B 12
@@ -171,6 +172,11 @@ static int residuals(tail_ctx *c, const double v[4], double sc, gsl_vector *f)
     return GSL_SUCCESS;
 }
 
+static int resid_at(void *ctx, const double v[4], gsl_vector *f)
+{
+    return residuals(ctx, v, 1.0, f);
+}
+
 static int lm_f(const gsl_vector *th, void *params, gsl_vector *f)
 {
     tail_ctx *c = params;
@@ -226,11 +232,8 @@ static int cmp_start(const void *a, const void *b)
 
 /* ---- standard errors ------------------------------------------------------------------------- */
 
-/* Standard errors of (rho, B, A, tau) from the central-difference Jacobian of the weighted
-** residuals in those quantities: s^2 (J^T J)^-1, s^2 = RSS/(n - 4); se[k] = -1 where J^T J is
-** singular; cov_Bt the covariance of B and tau (for e_t = tau B). */
-static void tail_errors(tail_ctx *c, const double v[4], double rss, double se[4],
-                        double corr[4][4], double *cov_Bt)
+void cf_tail_errors(cf_tail_residuals res, void *ctx, size_t n, const double v[4], double h_rel,
+                    double rss, double se[4], double corr[4][4], double *cov_Bt)
 {
     for (int k = 0; k < 4; k++) {
         se[k] = -1;
@@ -238,10 +241,10 @@ static void tail_errors(tail_ctx *c, const double v[4], double rss, double se[4]
             corr[k][j] = NAN;
     }
     *cov_Bt = NAN;
-    if (c->n <= 4)
+    if (n <= 4)
         return;
-    gsl_matrix *J = gsl_matrix_alloc(c->n, 4), *JtJ = gsl_matrix_alloc(4, 4);
-    gsl_vector *fp = gsl_vector_alloc(c->n), *fm = gsl_vector_alloc(c->n);
+    gsl_matrix *J = gsl_matrix_alloc(n, 4), *JtJ = gsl_matrix_alloc(4, 4);
+    gsl_vector *fp = gsl_vector_alloc(n), *fm = gsl_vector_alloc(n);
     gsl_permutation *perm = gsl_permutation_alloc(4);
     gsl_matrix *cov = gsl_matrix_alloc(4, 4);
     int ok = J && JtJ && fp && fm && perm && cov;
@@ -249,14 +252,14 @@ static void tail_errors(tail_ctx *c, const double v[4], double rss, double se[4]
         double vp[4], vm[4];
         memcpy(vp, v, sizeof vp);
         memcpy(vm, v, sizeof vm);
-        const double h = 1e-6 * fabs(v[k]);
+        const double h = h_rel * fabs(v[k]);
         vp[k] += h;
         vm[k] -= h;
         if (k == 0) /* rho stays within (0, 1] */
             vp[0] = fmin(vp[0], 1.0);
         const double dk = vp[k] - vm[k];
-        ok = residuals(c, vp, 1.0, fp) == GSL_SUCCESS && residuals(c, vm, 1.0, fm) == GSL_SUCCESS;
-        for (size_t i = 0; ok && i < c->n; i++)
+        ok = res(ctx, vp, fp) == GSL_SUCCESS && res(ctx, vm, fm) == GSL_SUCCESS;
+        for (size_t i = 0; ok && i < n; i++)
             gsl_matrix_set(J, i, k, (gsl_vector_get(fp, i) - gsl_vector_get(fm, i)) / dk);
     }
     int sign;
@@ -264,7 +267,7 @@ static void tail_errors(tail_ctx *c, const double v[4], double rss, double se[4]
         gsl_linalg_LU_decomp(JtJ, perm, &sign) == GSL_SUCCESS &&
         fabs(gsl_linalg_LU_det(JtJ, sign)) > 0 &&
         gsl_linalg_LU_invert(JtJ, perm, cov) == GSL_SUCCESS) {
-        const double s2 = rss / (double)(c->n - 4);
+        const double s2 = rss / (double)(n - 4);
         for (int k = 0; k < 4; k++) {
             const double var = s2 * gsl_matrix_get(cov, k, k);
             se[k] = var >= 0 && isfinite(var) ? sqrt(var) : -1;
@@ -379,12 +382,98 @@ static cf_spring tail_place(double rho, double B, double A, double tau, cf_sprin
     return p;
 }
 
+double cf_tail_A_max(double rho, double B, double tau, cf_spring_type type, double need,
+                     const cf_fit_options *o)
+{
+    const tail_geom g = tail_geometry(rho, B, tau, type, tail_extra(B, tau, need, 0), o);
+    const double a = tail_A_max(&g, B, o);
+    return a > 0 && isfinite(a) ? a : 1e-300;
+}
+
 static double amax_at(const tail_ctx *c, double rho, double B, double tau)
 {
-    const tail_geom g =
-        tail_geometry(rho, B, tau, c->type, tail_extra(B, tau, c->need, 0), c->opt);
-    const double a = tail_A_max(&g, B, c->opt);
-    return a > 0 && isfinite(a) ? a : 1e-300;
+    return cf_tail_A_max(rho, B, tau, c->type, c->need, c->opt);
+}
+
+cf_status cf_tail_result(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
+                         const double v[4], const double se[4], double corr[4][4], double cov_Bt,
+                         cf_fit_result *res, cf_error *err)
+{
+    const int fd = cf_table_is_force(data);
+    const size_t n = data->count;
+    const double xmax = cf_lsq_xmax(data);
+    const double rho = v[0], B = v[1], A = v[2], tau = v[3];
+    res->type = type;
+    res->tail = 1;
+    res->ident.rho = rho;
+    res->ident.solid = B;
+    res->ident.scale = A;
+    res->e_tail = tau * B;
+    for (int q = 0; q < 3; q++)
+        res->ident_se.v[q] = se[q];
+    /* e_t = tau B: var = B^2 var(tau) + tau^2 var(B) + 2 tau B cov(B, tau) */
+    if (se[1] > 0 && se[3] > 0 && isfinite(cov_Bt)) {
+        const double var = B * B * se[3] * se[3] + tau * tau * se[1] * se[1] + 2 * tau * B * cov_Bt;
+        res->e_tail_se = var > 0 ? sqrt(var) : 0;
+    } else {
+        res->e_tail_se = -1;
+    }
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            res->corr[a][b] = corr[a][b];
+    /* place: a stress-strain table at the preferred free length; a force table at a free length
+    ** that gives its cone travel a strain of 1/(2 (1 + tau)) */
+    const double H = fd ? 2 * B * (1 + tau) : opt->H_preferred_mm;
+    const double Bs = fd ? B / H : B, As = fd ? A / (H * H) : A;
+    const double need = (fd ? xmax / H : xmax) * (1 + CF_FIT_TRAVEL_MARGIN);
+    unsigned placed_bad;
+    res->params = tail_place(rho, Bs, As, tau, type, need, H, opt, &placed_bad);
+    cf_error le = {0};
+    if (cf_law_init(&res->law, &res->params, &le) != CF_OK)
+        return cf_error_set(err, CF_E_INTERNAL,
+                            "placing the conical-tail spring (rho %g B %g A %g tau %g): %s", rho,
+                            B, A, tau, le.msg);
+    double *buf = malloc(2 * sizeof(double) * (n ? n : 1));
+    if (!buf)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", n);
+    double *sw = buf, *model = buf + n;
+    const double ynorm = cf_lsq_weights(data, opt->relative, sw);
+    cf_fit_model_many(&res->law, fd, n, data->x, model);
+    cf_lsq_quality q = cf_lsq_quality_of(data, model);
+    res->rss = q.rss;
+    res->rmse = q.rmse;
+    res->max_abs_error = q.max_abs_error;
+    res->r2 = q.r2;
+    double obj = 0;
+    for (size_t i = 0; i < n; i++) {
+        const double r = sw[i] * (model[i] - data->y[i]);
+        obj += r * r;
+    }
+    free(buf);
+    res->objective = obj;
+    res->objective_zero = ynorm;
+    res->feasible = cf_fit_check(&res->params, type, data, opt, &res->active, &res->violated);
+    /* the plain check sees the cone alone: the whole travel is the law's */
+    res->violated &= ~(unsigned)CF_C_TRAVEL;
+    res->active &= ~(unsigned)CF_C_TRAVEL;
+    const double umax = (fd ? xmax : xmax * res->params.H_mm) * (1 + CF_FIT_TRAVEL_MARGIN);
+    if (!(res->law.travel_mm > umax))
+        res->violated |= CF_C_TRAVEL;
+    res->violated |= placed_bad;
+    /* what holds the quantities: the wire's G_max (A on its largest), rho_min, the type's rho */
+    const double rho_lo = fmax(CF_IDENT_RHO_LO, opt->rho_min * (1 - CF_IDENT_RHO_MIN_TOL));
+    if (!fd && A >= (1 - 1e-3) * cf_tail_A_max(rho, B, tau, type, need, opt))
+        res->held |= CF_C_G_MAX;
+    if (rho <= rho_lo * (1 + 1e-3) && opt->rho_min > CF_IDENT_RHO_LO)
+        res->held |= CF_C_RHO_MIN;
+    if (type == CF_TELESCOPING && rho >= cf_ident_rho_hi(type, opt->index_max) * (1 - 1e-3))
+        res->held |= CF_C_TYPE;
+    if (res->law.type != type)
+        res->violated |= CF_C_TYPE;
+    res->feasible = res->violated == 0;
+    res->solid_table_strain = fd ? res->law.travel_mm : res->law.travel_mm / res->params.H_mm;
+    res->solid_ratio = xmax > 0 ? res->solid_table_strain / xmax : INFINITY;
+    return CF_OK;
 }
 
 /* ---- the fit --------------------------------------------------------------------------------- */
@@ -403,13 +492,12 @@ cf_status cf_fit_tail_run(const cf_table *data, const cf_fit_options *opt, cf_sp
     if (c.n < 6)
         return cf_error_set(err, CF_E_DATA,
                             "the conical-tail law needs at least 6 rows (the table has %zu)", c.n);
-    double *buf = malloc(4 * sizeof(double) * c.n);
+    double *buf = malloc(3 * sizeof(double) * c.n);
     if (!buf)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", c.n);
     double *sw = buf;
     c.t = buf + c.n;
     c.g = c.t + c.n;
-    double *model = c.g + c.n;
     c.ynorm = cf_lsq_weights(data, opt->relative, sw);
     c.sw = sw;
     const double xmax = cf_lsq_xmax(data);
@@ -485,76 +573,15 @@ cf_status cf_fit_tail_run(const cf_table *data, const cf_fit_options *opt, cf_sp
     }
     /* the identifiable quantities, their errors, the spring */
     double se[4], corr[4][4], cov_Bt;
-    tail_errors(&c, v, best, se, corr, &cov_Bt);
-    const double rho = v[0], B = v[1], A = v[2], tau = v[3];
-    res->type = type;
-    res->tail = 1;
-    res->ident.rho = rho;
-    res->ident.solid = B;
-    res->ident.scale = A;
-    res->e_tail = tau * B;
-    for (int q = 0; q < 3; q++)
-        res->ident_se.v[q] = se[q];
-    /* e_t = tau B: var = B^2 var(tau) + tau^2 var(B) + 2 tau B cov(B, tau) */
-    if (se[1] > 0 && se[3] > 0 && isfinite(cov_Bt)) {
-        const double var = B * B * se[3] * se[3] + tau * tau * se[1] * se[1] + 2 * tau * B * cov_Bt;
-        res->e_tail_se = var > 0 ? sqrt(var) : 0;
-    } else {
-        res->e_tail_se = -1;
-    }
-    for (int a = 0; a < 3; a++)
-        for (int b = 0; b < 3; b++)
-            res->corr[a][b] = corr[a][b];
-    /* place: a stress-strain table at the preferred free length; a force table at a free length
-    ** that gives its cone travel a strain of 1/(2 (1 + tau)) */
-    const double H = c.fd ? 2 * B * (1 + tau) : opt->H_preferred_mm;
-    const double Bs = c.fd ? B / H : B, As = c.fd ? A / (H * H) : A;
-    const double need = (c.fd ? xmax / H : xmax) * (1 + CF_FIT_TRAVEL_MARGIN);
-    unsigned placed_bad;
-    res->params = tail_place(rho, Bs, As, tau, type, need, H, opt, &placed_bad);
-    cf_error le = {0};
-    if (cf_law_init(&res->law, &res->params, &le) != CF_OK) {
-        free(buf);
-        return cf_error_set(err, CF_E_INTERNAL, "placing the conical-tail spring (rho %g B %g A %g tau %g): %s", rho, B, A, tau, le.msg);
-    }
-    cf_fit_model_many(&res->law, c.fd, c.n, data->x, model);
-    cf_lsq_quality q = cf_lsq_quality_of(data, model);
-    res->rss = q.rss;
-    res->rmse = q.rmse;
-    res->max_abs_error = q.max_abs_error;
-    res->r2 = q.r2;
-    double obj = 0;
-    for (size_t i = 0; i < c.n; i++) {
-        const double r = sw[i] * (model[i] - data->y[i]);
-        obj += r * r;
-    }
-    res->objective = obj;
-    res->objective_zero = c.ynorm;
-    res->feasible = cf_fit_check(&res->params, type, data, opt, &res->active, &res->violated);
-    /* the plain check sees the cone alone: the whole travel is the law's */
-    res->violated &= ~(unsigned)CF_C_TRAVEL;
-    res->active &= ~(unsigned)CF_C_TRAVEL;
-    const double umax = (c.fd ? xmax : xmax * res->params.H_mm) * (1 + CF_FIT_TRAVEL_MARGIN);
-    if (!(res->law.travel_mm > umax))
-        res->violated |= CF_C_TRAVEL;
-    res->violated |= placed_bad;
-    /* what holds the quantities: the wire's G_max (A on its largest), rho_min, the type's rho */
-    if (!c.fd && A >= (1 - 1e-3) * amax_at(&c, rho, B, tau))
-        res->held |= CF_C_G_MAX;
-    if (rho <= c.rho_lo * (1 + 1e-3) && opt->rho_min > CF_IDENT_RHO_LO)
-        res->held |= CF_C_RHO_MIN;
-    if (type == CF_TELESCOPING && rho >= c.rho_hi * (1 - 1e-3))
-        res->held |= CF_C_TYPE;
-    if (res->law.type != type)
-        res->violated |= CF_C_TYPE;
-    res->feasible = res->violated == 0;
-    res->solid_table_strain = c.fd ? res->law.travel_mm : res->law.travel_mm / res->params.H_mm;
-    res->solid_ratio = xmax > 0 ? res->solid_table_strain / xmax : INFINITY;
+    cf_tail_errors(resid_at, &c, c.n, v, 1e-6, best, se, corr, &cov_Bt);
+    free(buf);
+    cf_status st = cf_tail_result(data, opt, type, v, se, corr, cov_Bt, res, err);
+    if (st != CF_OK)
+        return st;
     res->optimizer = "lm";
     res->evaluations = c.evals;
     res->evaluations_full = c.evals;
     res->wall_time_s = cf_clock_s() - t0;
-    free(buf);
     return CF_OK;
 }
 

@@ -3,9 +3,11 @@
 */
 #include "fit/lattice_curve.h"
 
+#include <math.h>
 #include <string.h>
 
 #include "conifit/cell.h"
+#include "fit/lsq.h"
 
 cf_status cf_lattice_curve(const cf_spring *p, const cf_validate_setup *s, const cf_table *d,
                            int full, double *out, double *law_out, cf_msm_stats *stats,
@@ -34,4 +36,34 @@ cf_status cf_lattice_curve(const cf_spring *p, const cf_validate_setup *s, const
         law_out[i] = cf_fit_model(&law, 0, d->x[i]);
     cf_law_free(&law);
     return st;
+}
+
+cf_table cf_lattice_reach(const cf_table *d, double *spring_x)
+{
+    cf_table reach = *d;
+    reach.x = spring_x;
+    for (size_t i = 0; i < d->count; i++)
+        spring_x[i] = copysign(cf_cell_spring_strain(d->mode, d->x[i]), d->x[i]);
+    return reach;
+}
+
+void cf_lattice_take_quality(const cf_table *d, const double *g, const double *sw, double ynorm,
+                             cf_fit_result *res, cf_through_msm *t)
+{
+    const int uniaxial = d->mode == CF_MODE_UNIAXIAL;
+    t->law_rmse = uniaxial ? res->rmse : NAN;
+    t->law_max_abs_error = uniaxial ? res->max_abs_error : NAN;
+    t->law_r2 = uniaxial ? res->r2 : NAN;
+    cf_lsq_quality q = cf_lsq_quality_of(d, g);
+    double wrss = 0;
+    for (size_t i = 0; i < d->count; i++) {
+        double r = sw[i] * (g[i] - d->y[i]);
+        wrss += r * r;
+    }
+    res->rss = q.rss;
+    res->rmse = q.rmse;
+    res->max_abs_error = q.max_abs_error;
+    res->r2 = q.r2;
+    res->objective = wrss;
+    res->objective_zero = ynorm;
 }

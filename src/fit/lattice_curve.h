@@ -15,4 +15,16 @@ cf_status cf_lattice_curve(const cf_spring *p, const cf_validate_setup *s, const
                            int full, double *out, double *law_out, cf_msm_stats *stats,
                            int *by_cell, cf_error *err);
 
+/* The table the springs see in d's mode: a copy of d (sharing its y) whose x[i] is the largest
+** spring strain at row i, with the row's sign, into spring_x (d->count values). In shear the
+** springs strain about half the table's strain; in the other modes x is the table's own. */
+cf_table cf_lattice_reach(const cf_table *d, double *spring_x);
+
+/* The target's numbers of fit res once the cell's curve g of its spring at d's rows is known:
+** res's quality (rss, rmse, max_abs_error, r2, and the weighted objective with weights sw and
+** zero-model norm ynorm) become the cell's, the single spring's own figures move to t->law_*
+** (a uniaxial table; NAN in the other modes). */
+void cf_lattice_take_quality(const cf_table *d, const double *g, const double *sw, double ynorm,
+                             cf_fit_result *res, cf_through_msm *t);
+
 #endif

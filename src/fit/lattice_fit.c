@@ -110,22 +110,7 @@ static double bobyqa(tm_ctx *c, double *z, const double *lb, const double *ub)
 static cf_status take_target(tm_ctx *c, tm_ctx *search, cf_fit_result *res, cf_through_msm *t,
                              cf_error *err)
 {
-    const int uniaxial = c->d->mode == CF_MODE_UNIAXIAL;
-    t->law_rmse = uniaxial ? res->rmse : NAN;
-    t->law_max_abs_error = uniaxial ? res->max_abs_error : NAN;
-    t->law_r2 = uniaxial ? res->r2 : NAN;
-    cf_lsq_quality q = cf_lsq_quality_of(c->d, c->pr.g);
-    double wrss = 0;
-    for (size_t i = 0; i < c->d->count; i++) {
-        double r = c->pr.sw[i] * (c->pr.g[i] - c->d->y[i]);
-        wrss += r * r;
-    }
-    res->rss = q.rss;
-    res->rmse = q.rmse;
-    res->max_abs_error = q.max_abs_error;
-    res->r2 = q.r2;
-    res->objective = wrss;
-    res->objective_zero = c->pr.ynorm;
+    cf_lattice_take_quality(c->d, c->pr.g, c->pr.sw, c->pr.ynorm, res, t);
     res->ident = cf_ident_of(&res->params, 0);
     c->pr.ctx = c;
     search->pr.ctx = search;
@@ -166,10 +151,7 @@ cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_
     /* The springs' reach: in shear the springs strain about half the table's strain, so the
     ** bound on s/H and the placement see a copy of the table whose x is the largest spring
     ** strain at each row (the table itself for the other modes). */
-    cf_table reach = *d;
-    reach.x = spring_x;
-    for (size_t i = 0; i < d->count; i++)
-        spring_x[i] = copysign(cf_cell_spring_strain(d->mode, d->x[i]), d->x[i]);
+    cf_table reach = cf_lattice_reach(d, spring_x);
     const double xmax = cf_lsq_xmax(&reach);
     t->rmse_before = cell_rmse(&res->params, &c);
     double rho_hi = cf_ident_rho_hi(res->type, opt->index_max);

@@ -38,6 +38,21 @@ cf_spring cf_ident_member(const cf_ident *q)
     return p;
 }
 
+cf_spring cf_ident_member_tail(const cf_ident *q, double tau)
+{
+    const double rho = q->rho, e = q->solid, A = q->scale, n = 2.0;
+    /* the room past the cone's closing strain e (1 + tau): a small share holds the solid
+    ** lengths n d (1 + tau), the tail's travel takes the rest, so its gap per coil exceeds the
+    ** cone's and the whole travel nearly reaches the free length */
+    const double room = 1.0 - e * (1 + tau), solids = CF_IDENT_TAIL_SOLIDS * room;
+    const double dw = solids / (n * (1 + tau)), Lmin = n * dw;
+    const double D2 = rho < 1 ? Lmin / (1 - rho) : Lmin, D1 = rho * D2;
+    cf_spring p = {D1, D2, n, dw, cf_ident_G_of_FC(A, n, D1, dw, e), 1.0};
+    p.n_tail = tau * n;
+    p.H_tail_mm = p.n_tail * dw + (1.0 - e - solids);
+    return p;
+}
+
 double cf_ident_G_of_FC(double F_C_N, double n, double D1_mm, double d_mm, double s_mm)
 {
     const double d2 = d_mm * d_mm;

@@ -57,8 +57,6 @@ static void progress(const cf_pipeline_options *opt, const cf_table *t, const ch
 ** table's own spring otherwise. */
 static int through_lattice(const cf_table *t, const cf_pipeline_options *opt)
 {
-    if (opt->target == CF_TARGET_AUTO && opt->fit.law != CF_FAMILY_CONICAL)
-        return t->mode != CF_MODE_UNIAXIAL; /* the tailed law is fitted to the spring itself */
     if (opt->target == CF_TARGET_AUTO)
         return !cf_table_is_force(t) && (opt->validate || t->mode != CF_MODE_UNIAXIAL);
     return opt->target == CF_TARGET_LATTICE;
@@ -72,29 +70,53 @@ static double law_aic(const cf_fit_result *f, const cf_fit_report *r, int k)
     return cf_baseline_aic(r->table->count, f->rss * u * u, k, r->ymax * u);
 }
 
-/* The tailed law for fits[k] (opt->fit.law conical-tail or auto): fits it beside the conical
-** one already there and keeps the one the option asks for (auto: the tailed law only with a lower
-** AIC and a feasible spring). */
+/* Keeps for fits[k] the law opt->fit.law asks for, given the tailed law's fit tail of the same
+** table and type beside the conical one in fits[k] (auto: the tailed law only with a lower AIC
+** and a feasible spring). Returns 1 when the tail was kept. */
+static int keep_law(const cf_pipeline_options *opt, cf_fit_report *r, int k,
+                    const cf_fit_result *tail)
+{
+    cf_law_choice *lc = &r->law_choice[k];
+    lc->ran = 1;
+    lc->aic_conical = law_aic(&r->fits[k], r, 3);
+    lc->aic_tail = law_aic(tail, r, 4);
+    lc->chose_tail = opt->fit.law == CF_FAMILY_TAIL ||
+                     (tail->feasible && lc->aic_tail < lc->aic_conical);
+    if (lc->chose_tail) {
+        lc->other = r->fits[k];
+        r->fits[k] = *tail;
+        memset(&r->limit_cost[k], 0, sizeof r->limit_cost[k]); /* measured for the conical law */
+    } else {
+        lc->other = *tail;
+    }
+    return lc->chose_tail;
+}
+
+/* The tailed law fitted to the spring itself for fits[k], and the choice (keep_law). */
 static cf_status choose_law(const cf_table *t, const cf_pipeline_options *opt, cf_fit_report *r,
                             int k, cf_error *err)
 {
-    cf_law_choice *lc = &r->law_choice[k];
     cf_fit_result tail;
     cf_status st = cf_fit_tail_run(t, &opt->fit, r->fits[k].type, &r->fits[k], &tail, err);
-    if (st != CF_OK)
-        return st;
-    lc->ran = 1;
-    lc->aic_conical = law_aic(&r->fits[k], r, 3);
-    lc->aic_tail = law_aic(&tail, r, 4);
-    lc->chose_tail = opt->fit.law == CF_FAMILY_TAIL ||
-                     (tail.feasible && lc->aic_tail < lc->aic_conical);
-    if (lc->chose_tail) {
-        lc->other = r->fits[k];
-        r->fits[k] = tail;
-        memset(&r->limit_cost[k], 0, sizeof r->limit_cost[k]); /* measured for the conical law */
-    } else {
-        lc->other = tail;
-    }
+    if (st == CF_OK)
+        keep_law(opt, r, k, &tail);
+    return st;
+}
+
+/* The tailed law through the lattice for fits[k] (the conical law's fit through it, thr[k]), and
+** the choice (keep_law): thr[k] follows the law kept. A tailed law that finds no spring leaves
+** auto's choice to the conical law; --law conical-tail then fails. */
+static cf_status choose_law_in_lattice(const cf_table *t, const cf_pipeline_options *opt,
+                                       cf_fit_report *r, int k, cf_error *err)
+{
+    cf_fit_result tail;
+    cf_through_msm thr;
+    cf_error e = {0};
+    cf_status st = cf_lattice_fit_tail(t, &opt->fit, &opt->lattice, &r->fits[k], &tail, &thr, &e);
+    if (st == CF_E_INTERNAL || (st != CF_OK && opt->fit.law == CF_FAMILY_TAIL))
+        return cf_error_set(err, st, "%s", e.msg);
+    if (st == CF_OK && keep_law(opt, r, k, &tail))
+        r->thr[k] = thr;
     return CF_OK;
 }
 
@@ -117,6 +139,16 @@ static cf_status validate_fits(const cf_table *t, const cf_pipeline_options *opt
         } else {
             progress(opt, t, "fitting the %s spring through the lattice", type);
             cf_lattice_fit(t, &opt->fit, &opt->lattice, &r->fits[k], &r->thr[k], &verr);
+            /* the tailed law through the lattice where the conical law went through it, else
+            ** (a force table, a lattice that could not run) to the spring as without it */
+            if (opt->fit.law != CF_FAMILY_CONICAL && verr.status != CF_E_INTERNAL) {
+                progress(opt, t, "fitting the %s spring with a tail", type);
+                cf_error terr = {0};
+                cf_status tst = r->thr[k].done ? choose_law_in_lattice(t, opt, r, k, &terr)
+                                               : choose_law(t, opt, r, k, &terr);
+                if (tst != CF_OK)
+                    return cf_error_set(err, terr.status, "%s: %s", t->path, terr.msg);
+            }
             cf_validate_lattice_fit(t, &opt->lattice, &r->fits[k], &r->val[k], &r->thr[k], &verr);
         }
         if (verr.status == CF_E_INTERNAL)
@@ -191,13 +223,6 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
     for (size_t i = 0; i < t->count; i++)
         r->ymax = fmax(r->ymax, fabs(t->y[i]));
     r->law = opt->fit.law;
-    if (opt->fit.law != CF_FAMILY_CONICAL && through_lattice(t, opt))
-        return cf_error_set(err, CF_E_USAGE,
-                            "%s: --law %s fits the spring itself to a uniaxial or force table; "
-                            "this fit goes through the lattice (%s): use --law conical",
-                            t->path, cf_law_family_name(opt->fit.law),
-                            t->mode != CF_MODE_UNIAXIAL ? "the table's mode is not uniaxial"
-                                                        : "--target lattice");
     if ((opt->validate || through_lattice(t, opt)) && !cf_table_is_force(t)) {
         /* a static solve per row and type in the validation lattice, and its stability scan */
         int types = !!(opt->types & (1u << CF_TELESCOPING)) +
@@ -233,7 +258,7 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
         cf_status st = cf_fit_run(t, &opt->fit, (cf_spring_type)ty, &r->fits[r->nfits], &e);
         if (st == CF_OK)
             st = limit_cost(t, opt, &r->fits[r->nfits], &r->limit_cost[r->nfits], &e);
-        if (st == CF_OK && opt->fit.law != CF_FAMILY_CONICAL) {
+        if (st == CF_OK && opt->fit.law != CF_FAMILY_CONICAL && !through_lattice(t, opt)) {
             progress(opt, t, "fitting the %s spring with a tail",
                      cf_spring_type_name((cf_spring_type)ty));
             st = choose_law(t, opt, r, r->nfits, &e);

@@ -110,15 +110,17 @@ static json_t *extrapolation_json(const cf_fit_report *r, const cf_fit_result *f
     return o;
 }
 
-/* Both law families of fits[i]: their quality, AIC and which one the fit keeps. */
+/* Both law families of fits[i]: their quality, AIC and which one the fit keeps; through_lattice
+** when both were fitted through the lattice (their RMSE and AIC are the lattice's). */
 static json_t *law_comparison_json(const cf_fit_report *r, int i)
 {
     const cf_law_choice *lc = &r->law_choice[i];
     const cf_fit_result *tail = lc->chose_tail ? &r->fits[i] : &lc->other;
     const cf_fit_result *cone = lc->chose_tail ? &lc->other : &r->fits[i];
     const double u = r->table->y_to_file;
-    return json_pack("{s:s, s:{s:o, s:o, s:b}, s:{s:o, s:o, s:b, s:o}}", "chosen",
-                     lc->chose_tail ? "conical-tail" : "conical", "conical", "rmse",
+    return json_pack("{s:s, s:b, s:{s:o, s:o, s:b}, s:{s:o, s:o, s:b, s:o}}", "chosen",
+                     lc->chose_tail ? "conical-tail" : "conical", "through_lattice",
+                     r->through_msm && r->thr[i].done, "conical", "rmse",
                      num(cone->rmse * u), "aic", num(lc->aic_conical), "feasible", cone->feasible,
                      "conical-tail", "rmse", num(tail->rmse * u), "aic", num(lc->aic_tail),
                      "feasible", tail->feasible, "tail_compliance", cf_report_tail_json(tail));

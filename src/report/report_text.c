@@ -102,8 +102,12 @@ static void law_choice_text(FILE *o, const cf_fit_report *r)
     if (r->law == CF_FAMILY_CONICAL)
         return;
     const double u = r->table->y_to_file;
+    int lattice = r->through_msm;
+    for (int i = 0; i < r->nfits; i++)
+        lattice &= r->thr[i].done;
     fprintf(o, "\nLaw (--law %s): the conical law (3 quantities) against the conical spring with "
-               "a cylindrical tail (4)\n", cf_law_family_name(r->law));
+               "a cylindrical tail (4)%s\n", cf_law_family_name(r->law),
+            lattice ? ", both fitted through the lattice (RMSE and AIC the lattice's)" : "");
     for (int i = 0; i < r->nfits; i++) {
         const cf_law_choice *lc = &r->law_choice[i];
         if (!lc->ran)

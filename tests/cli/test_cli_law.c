@@ -1,7 +1,8 @@
 /*
 ** `fit --law`: the choice between the conical law and the conical spring with a tail as the
 ** command line sees it: the report shows both laws, the fit file names the law kept and carries the
-** comparison, and the combinations the tailed law does not support are usage errors (exit 2,
+** comparison, it goes through the lattice as the conical law does, and the combinations the tailed
+** law does not support (a joint fit, a time series, fixed parameters) are usage errors (exit 2,
 ** nothing written).
 */
 #include <setjmp.h>
@@ -82,6 +83,62 @@ static void conical_tail_writes_the_tail(void **state)
     json_decref(root);
 }
 
+/* Through the lattice as the conical law: the lattice target of a uniaxial table and a table read
+** in shear; the tailed law kept (conical-tail), its cell the fit's target, its fourth quantity and
+** the comparison with the conical law's fit through the lattice written. */
+static void conical_tail_goes_through_the_lattice(void **state)
+{
+    (void)state;
+    static char out[1 << 16];
+    const char *const cases[] = {
+        "data/non_telescoping.csv --type non-telescoping --law conical-tail --target lattice",
+        "data/non_telescoping.csv --type non-telescoping --law conical-tail --mode shear",
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        json_t *root = fit_file_of(cases[i], out, sizeof out);
+        assert_non_null(strstr(out, "fit target: the lattice"));
+        assert_non_null(strstr(out, "conical-tail RMSE"));
+        json_t *f = json_array_get(json_object_get(root, "fits"), 0);
+        assert_string_equal(json_string_value(json_object_get(f, "law")), "conical-tail");
+        assert_non_null(json_object_get(f, "through_msm"));
+        json_t *tc = json_object_get(json_object_get(f, "identifiable"), "tail_compliance");
+        assert_true(json_number_value(json_object_get(tc, "value")) > 0);
+        json_t *lc = json_object_get(f, "law_comparison");
+        assert_true(json_is_true(json_object_get(lc, "through_lattice")));
+        /* in uniaxial the tailed spring's full lattice is the cell's curve to rounding */
+        json_t *thr = json_object_get(f, "through_msm");
+        if (i == 0) {
+            assert_true(json_is_true(json_object_get(thr, "verified")));
+            const double dv = json_number_value(json_object_get(thr, "verification_max_abs"));
+            const double rmse = json_number_value(json_object_get(thr, "cell_rmse"));
+            if (!(dv < 1e-9 && rmse > 0))
+                fail_msg("full lattice against the cell: %g (fit RMSE %g)", dv, rmse);
+        }
+        json_decref(root);
+    }
+}
+
+/* A force-displacement table has no lattice: with --target lattice the conical law's fit keeps
+** its note and the tailed law goes to the spring, as without the option (exit 0). */
+static void force_table_with_lattice_target_fits_the_tail_to_the_spring(void **state)
+{
+    (void)state;
+    const char *dir = tu_datasets();
+    if (!dir)
+        skip();
+    static char out[1 << 16], args[1024];
+    snprintf(args, sizeof args,
+             "%s/thrombus_pureshear_force_displacement.csv --type non-telescoping "
+             "--law conical-tail --target lattice",
+             dir);
+    json_t *root = fit_file_of(args, out, sizeof out);
+    json_t *f = json_array_get(json_object_get(root, "fits"), 0);
+    assert_string_equal(json_string_value(json_object_get(f, "law")), "conical-tail");
+    json_t *lc = json_object_get(f, "law_comparison");
+    assert_false(json_is_true(json_object_get(lc, "through_lattice")));
+    json_decref(root);
+}
+
 /* What the tailed law does not do is refused with exit 2 and nothing written. */
 static void unsupported_combinations_exit_2(void **state)
 {
@@ -92,11 +149,9 @@ static void unsupported_combinations_exit_2(void **state)
     static char out[1 << 14], errb[1 << 14];
     const char *const cases[] = {
         "fit data/telescoping.csv --law cone -o %s",
-        "fit data/telescoping.csv --law conical-tail --target lattice -o %s",
         "fit data/telescoping.csv data/non_telescoping.csv --joint --law auto -o %s",
         "fit data/telescoping.csv --law auto --fix H=10 -o %s",
         "fit data/series/synthetic_relaxation.csv --law conical-tail -o %s",
-        "fit data/telescoping.csv --law auto --mode shear -o %s",
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         int st = tu_run(out, sizeof out, errb, sizeof errb, cases[i], json);
@@ -137,6 +192,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(auto_reports_both_laws),
         cmocka_unit_test(conical_tail_writes_the_tail),
+        cmocka_unit_test(conical_tail_goes_through_the_lattice),
+        cmocka_unit_test(force_table_with_lattice_target_fits_the_tail_to_the_spring),
         cmocka_unit_test(unsupported_combinations_exit_2),
         cmocka_unit_test(tailed_elastic_part_is_refused),
     };

@@ -73,6 +73,13 @@ cf_ident cf_ident_of(const cf_spring *p, int force_displacement);
 ** the lattice's nominal stress depends on nothing else. */
 cf_spring cf_ident_member(const cf_ident *q);
 
+/* The same with a cylindrical tail of tau = n_tail/n coils per cone coil (the conical-tail law,
+** fit.h): cone travel s/H = q->solid and solid load F_C = q->scale at free length 1 mm, tail
+** compliance F_C/(k_t H) = tau s/H; the solid lengths take CF_IDENT_TAIL_SOLIDS of the length left
+** past the cone's closing strain s/H (1 + tau) < 1, the tail's travel the rest. */
+#define CF_IDENT_TAIL_SOLIDS 0.01
+cf_spring cf_ident_member_tail(const cf_ident *q, double tau);
+
 /* The wire modulus G (MPa) that gives a spring of n coils, smallest coil D1, wire d and travel s
 ** (mm) the solid load F_C (N): F_C = G d^4 s / (8 n D1^3). */
 double cf_ident_G_of_FC(double F_C_N, double n, double D1_mm, double d_mm, double s_mm);

@@ -72,4 +72,15 @@ typedef struct cf_through_msm {
 cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_validate_setup *s,
                          cf_fit_result *res, cf_through_msm *t, cf_error *err);
 
+/* The conical-tail law (fit.h) through the lattice for the type of plain (the conical law's fit
+** through the lattice of the same table, done: its quantities start the search and its cell RMSE
+** is t->rmse_before): the four identifiable quantities (rho, s/H, F_C/H^2 and the tail's share)
+** searched through the homogenised cell (NLopt BOBYQA over three, the stress scale in closed
+** form), their standard errors through the cell, and the tailed spring placed in closed form
+** (src/fit/lattice_tail.c). res's quality is the cell's, as cf_lattice_fit's; no profile
+** intervals. Errors as cf_lattice_fit's. Deterministic. */
+cf_status cf_lattice_fit_tail(const cf_table *d, const cf_fit_options *opt,
+                              const cf_validate_setup *s, const cf_fit_result *plain,
+                              cf_fit_result *res, cf_through_msm *t, cf_error *err);
+
 #endif
