@@ -330,12 +330,9 @@ static int reduce_base(const ctx *c, const double *const *base, size_t K, double
                 s->tail2 += v * v;
         }
     }
-    if (B)
-        gsl_matrix_free(B);
-    if (tau)
-        gsl_vector_free(tau);
-    if (y)
-        gsl_vector_free(y);
+    gsl_matrix_free(B); /* GSL's free functions take NULL */
+    gsl_vector_free(tau);
+    gsl_vector_free(y);
     return ok;
 }
 
