@@ -290,15 +290,15 @@ static void standin_combo(ctx *c, standin *s, double *const *R, double *const *S
 
 /* The K columns base[] of a grid point in the space of their weighted QR factor (see standin):
 ** column j into out + j s->rows, the weighted data into yw (s->rows entries) and s->tail2. With no
-** more points than columns, the weighted columns themselves. 0 when memory runs out or the
-** factorisation fails. */
+** more points than columns (or options.full_standin), the weighted columns themselves. 0 when
+** memory runs out or the factorisation fails. */
 static int reduce_base(const ctx *c, const double *const *base, size_t K, double *out,
                        double *yw, standin *s)
 {
     const size_t n = c->n;
     s->yw = yw;
     s->tail2 = 0;
-    if (n <= K) {
+    if (n <= K || c->o->full_standin) {
         s->rows = n;
         for (size_t k = 0; k < n; k++) {
             for (size_t j = 0; j < K; j++)
