@@ -41,6 +41,11 @@ int cf_lm_iterate(gsl_multifit_nlinear_workspace *w, const cf_lm_stop *stop)
     double prev;
     gsl_blas_ddot(f, f, &prev);
     int stall = 0;
+    const int win = stop->ceiling > 0 && stop->ceiling_iter > 0 &&
+                            stop->ceiling_iter <= CF_LM_CEILING_ITER_MAX
+                        ? stop->ceiling_iter
+                        : 0;
+    double last[CF_LM_CEILING_ITER_MAX]; /* the sums of squares of the last win iterations */
     for (int it = 0; it < stop->max_iter; it++) {
         int info;
         int is = gsl_multifit_nlinear_iterate(w);
@@ -57,6 +62,12 @@ int cf_lm_iterate(gsl_multifit_nlinear_workspace *w, const cf_lm_stop *stop)
         prev = cur;
         if (stall >= stop->stall || cur <= stop->floor)
             break;
+        if (win) {
+            if (it >= win && cur > stop->ceiling &&
+                last[it % win] - cur <= stop->ceiling_rel * last[it % win])
+                break;
+            last[it % win] = cur;
+        }
     }
     return 0;
 }

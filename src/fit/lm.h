@@ -25,13 +25,20 @@ gsl_multifit_nlinear_workspace *cf_lm_start(const gsl_multifit_nlinear_parameter
 /* When the iterations stop: GSL's own test (xtol, gtol, ftol), the iteration limit, and two more
 ** rules. An optimum on a bound of a logit coordinate lies at infinity, where the step test never
 ** fires: stop once the sum of squares has fallen by less than stall_rel of itself in `stall`
-** iterations in a row, or once it is below `floor` (rounding level). */
+** iterations in a row, or once it is below `floor` (rounding level). A run that only has to beat
+** another (one of several starts) also stops once its sum of squares is above `ceiling` (> 0) and
+** has fallen by less than ceiling_rel of itself over the last ceiling_iter iterations (at most
+** CF_LM_CEILING_ITER_MAX): it is settling into an optimum it cannot win with. Zero: no ceiling. */
+#define CF_LM_CEILING_ITER_MAX 8
 typedef struct cf_lm_stop {
     int max_iter;
     double xtol, gtol, ftol;
     int stall;
     double stall_rel;
     double floor;
+    double ceiling;
+    int ceiling_iter;
+    double ceiling_rel;
 } cf_lm_stop;
 
 /* Iterates an initialised workspace until a rule of stop fires or an iteration fails. Returns 0,

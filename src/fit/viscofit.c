@@ -132,7 +132,7 @@ static double fit_nb(ctx *c, int nb, const cf_visco_params *from, cf_visco_param
         if (c->dash && !(p0.eta_MPa_s > 0))
             p0.eta_MPa_s = 1e-6 * p0.ident.scale;
         cf_viscofit_pack(c, &p0, z);
-        double obj = cf_viscofit_lm_run(c, z);
+        double obj = cf_viscofit_lm_run(c, z, bestobj);
         if (obj < bestobj) {
             bestobj = obj;
             memcpy(zbest, z, c->np * sizeof(double));

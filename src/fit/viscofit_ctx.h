@@ -36,6 +36,12 @@
 /* Accepted steps of the Levenberg-Marquardt between two Jacobians by finite differences: in
 ** between, Broyden's rank-one update from the step taken (options.full_jacobian: every step). */
 #define LM_JAC_REUSE 4
+/* A start of the Levenberg-Marquardt that has to beat an earlier start's sum of squares S is
+** abandoned once it is above LM_BEAT_FACTOR S and fell by less than LM_BEAT_REL of itself over
+** LM_BEAT_ITER iterations (cf_lm_stop.ceiling): it is converging to an optimum that loses. */
+#define LM_BEAT_FACTOR 2.0
+#define LM_BEAT_ITER 3
+#define LM_BEAT_REL 1e-3
 /* Relative step of the central differences for the standard errors. */
 #define SE_STEP 1e-5
 
@@ -82,7 +88,7 @@ cf_visco_params cf_viscofit_unpack(const ctx *c, const double *z);
 void cf_viscofit_pack(const ctx *c, const cf_visco_params *p, double *z);
 int cf_viscofit_curve(ctx *c, const cf_visco_params *p);
 double cf_viscofit_profile_scale(const ctx *c, double rho, double B);
-double cf_viscofit_lm_run(ctx *c, double *z);
+double cf_viscofit_lm_run(ctx *c, double *z, double beat);
 
 /* viscofit_jac.c */
 struct lm_jac *cf_viscofit_jac_alloc(size_t n, size_t p, gsl_multifit_nlinear_fdf *fdf,

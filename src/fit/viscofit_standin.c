@@ -53,11 +53,20 @@ typedef struct standin {
     const double *xE; /* |x| E (NULL: quasi-linear) */
     const double *basis[2 + 2 * CF_PRONY_MAX];
     double A_fixed;     /* > 0: the scale is held there (a held fit, or the design cap) */
-    gsl_matrix *X;      /* weighted design, n x (2 + 2 CF_PRONY_MAX) */
+    gsl_matrix *X;      /* weighted design, rows x (2 + 2 CF_PRONY_MAX) */
     gsl_vector *y, *tau, *a, *res;
+    /* Every column above is a combination of the few base columns of the grid point (E, the
+    ** responses, |x| E and its responses, the rate), so the least squares run in the space of
+    ** the weighted base's QR factor: rows = the base's columns (or the points, when fewer), each
+    ** vector (E, rate, basis, yw) has that many entries, and tail2 is the part of the weighted
+    ** data outside the base, which no combination reaches. */
+    size_t rows;
+    const double *yw;
+    double tail2;
 } standin;
 
 enum { NNLS_MAX = 2 + 2 * CF_PRONY_MAX }; /* columns of the stand-in's design */
+enum { BASE_MAX = 3 + 2 * GRID_TAU };     /* columns of the base of one grid point */
 
 /* Least squares of y on the columns of X marked in[] (Householder QR in Q, tau, sol, res), into z
 ** (0 on the other columns); 0 when it fails or gives a non-finite value. */
@@ -151,25 +160,27 @@ static int nnls(const gsl_matrix *X, const gsl_vector *y, double *a)
 
 /* Weighted linear least squares of the stand-in by Householder QR (GSL): the coefficients in
 ** a[] in the order of the basis (A first when free). 0 when the design is rank deficient. */
-static int standin_solve(const ctx *c, standin *s, int m, double *a)
+static int standin_solve(standin *s, int m, double *a)
 {
-    const size_t n = c->n;
+    const size_t n = s->rows;
     gsl_matrix_view X = gsl_matrix_submatrix(s->X, 0, 0, n, (size_t)m);
     gsl_vector_view tau = gsl_vector_subvector(s->tau, 0, (size_t)m);
     gsl_vector_view av = gsl_vector_subvector(s->a, 0, (size_t)m);
+    gsl_vector_view yv = gsl_vector_subvector(s->y, 0, n);
+    gsl_vector_view rv = gsl_vector_subvector(s->res, 0, n);
     const int held = s->A_fixed > 0;
     const int off = held ? 0 : 1;
     if ((size_t)m > n)
         return 0;
     for (size_t k = 0; k < n; k++) {
-        gsl_vector_set(s->y, k, c->sw[k] * (c->d->y[k] - (held ? s->A_fixed * s->E[k] : 0.0)));
+        gsl_vector_set(&yv.vector, k, s->yw[k] - (held ? s->A_fixed * s->E[k] : 0.0));
         for (int i = 0; i < m; i++) {
             const double *b = i < off ? s->E : s->basis[i - off];
-            gsl_matrix_set(&X.matrix, k, (size_t)i, c->sw[k] * b[k]);
+            gsl_matrix_set(&X.matrix, k, (size_t)i, b[k]);
         }
     }
     if (s->xE) /* relaxation growing with strain: every coefficient >= 0 */
-        return nnls(&X.matrix, s->y, a);
+        return nnls(&X.matrix, &yv.vector, a);
     if (gsl_linalg_QR_decomp(&X.matrix, &tau.vector) != GSL_SUCCESS)
         return 0;
     double dmax = 0, dmin = HUGE_VAL;
@@ -180,7 +191,8 @@ static int standin_solve(const ctx *c, standin *s, int m, double *a)
     }
     if (!(dmin > 1e-13 * dmax))
         return 0;
-    if (gsl_linalg_QR_lssolve(&X.matrix, &tau.vector, s->y, &av.vector, s->res) != GSL_SUCCESS)
+    if (gsl_linalg_QR_lssolve(&X.matrix, &tau.vector, &yv.vector, &av.vector, &rv.vector) !=
+        GSL_SUCCESS)
         return 0;
     for (int i = 0; i < m; i++)
         if (!isfinite(a[i] = gsl_vector_get(&av.vector, (size_t)i)))
@@ -224,12 +236,12 @@ static int standin_params(const ctx *c, const standin *s, const double *a, const
 static double standin_obj(const ctx *c, const standin *s, int m, const double *a)
 {
     const int held = s->A_fixed > 0, off = held ? 0 : 1;
-    double sum = 0;
-    for (size_t k = 0; k < c->n; k++) {
+    double sum = s->tail2;
+    for (size_t k = 0; k < s->rows; k++) {
         double model = held ? s->A_fixed * s->E[k] : 0.0;
         for (int i = 0; i < m; i++)
             model += a[i] * (i < off ? s->E[k] : s->basis[i - off][k]);
-        double r = c->sw[k] * (model - c->d->y[k]);
+        double r = model - s->yw[k];
         sum += r * r;
     }
     return sum / c->ynorm;
@@ -242,15 +254,16 @@ static void standin_combo(ctx *c, standin *s, double *const *R, double *const *S
                           const cf_visco_params *el, double *tmp, start *best, int nbest)
 {
     const int nb = c->nb;
+    const size_t n = s->rows;
     for (int i = 0; i < nb; i++) {
-        double *b = tmp + (size_t)i * c->n;
-        for (size_t k = 0; k < c->n; k++)
+        double *b = tmp + (size_t)i * n;
+        for (size_t k = 0; k < n; k++)
             b[k] = R[idx[i]][k] - s->E[k];
         s->basis[i] = b;
     }
     for (int i = 0; c->gs && i < nb; i++) {
-        double *b0 = tmp + (size_t)i * c->n, *b1 = tmp + (size_t)(nb + i) * c->n;
-        for (size_t k = 0; k < c->n; k++) {
+        double *b0 = tmp + (size_t)i * n, *b1 = tmp + (size_t)(nb + i) * n;
+        for (size_t k = 0; k < n; k++) {
             b1[k] = (S[idx[i]][k] - s->xE[k]) / c->xmax;
             b0[k] -= b1[k];
         }
@@ -262,17 +275,65 @@ static void standin_combo(ctx *c, standin *s, double *const *R, double *const *S
     double a[2 + 2 * CF_PRONY_MAX];
     s->A_fixed = A_held;
     int m = (s->A_fixed > 0 ? 0 : 1) + nb * (1 + c->gs) + c->dash;
-    if (!standin_solve(c, s, m, a))
+    if (!standin_solve(s, m, a))
         return;
     if (s->A_fixed == 0 && a[0] > A_max) { /* past the design cap: the scale held there */
         s->A_fixed = A_max;
         m = nb * (1 + c->gs) + c->dash;
-        if (!(A_max > 0) || !standin_solve(c, s, m, a))
+        if (!(A_max > 0) || !standin_solve(s, m, a))
             return;
     }
     cf_visco_params p = *el;
     if (standin_params(c, s, a, idx, taus, rate_factor, &p))
         keep_start(best, nbest, standin_obj(c, s, m, a), &p);
+}
+
+/* The K columns base[] of a grid point in the space of their weighted QR factor (see standin):
+** column j into out + j s->rows, the weighted data into yw (s->rows entries) and s->tail2. With no
+** more points than columns (or options.full_standin), the weighted columns themselves. 0 when
+** memory runs out or the factorisation fails. */
+static int reduce_base(const ctx *c, const double *const *base, size_t K, double *out,
+                       double *yw, standin *s)
+{
+    const size_t n = c->n;
+    s->yw = yw;
+    s->tail2 = 0;
+    if (n <= K || c->o->full_standin) {
+        s->rows = n;
+        for (size_t k = 0; k < n; k++) {
+            for (size_t j = 0; j < K; j++)
+                out[j * n + k] = c->sw[k] * base[j][k];
+            yw[k] = c->sw[k] * c->d->y[k];
+        }
+        return 1;
+    }
+    gsl_matrix *B = gsl_matrix_alloc(n, K);
+    gsl_vector *tau = gsl_vector_alloc(K), *y = gsl_vector_alloc(n);
+    int ok = B && tau && y;
+    for (size_t k = 0; ok && k < n; k++) {
+        for (size_t j = 0; j < K; j++)
+            gsl_matrix_set(B, k, j, c->sw[k] * base[j][k]);
+        gsl_vector_set(y, k, c->sw[k] * c->d->y[k]);
+    }
+    ok = ok && gsl_linalg_QR_decomp(B, tau) == GSL_SUCCESS &&
+         gsl_linalg_QR_QTvec(B, tau, y) == GSL_SUCCESS;
+    if (ok) {
+        s->rows = K;
+        for (size_t j = 0; j < K; j++)
+            for (size_t i = 0; i < K; i++)
+                out[j * K + i] = i <= j ? gsl_matrix_get(B, i, j) : 0.0;
+        for (size_t k = 0; k < n; k++) {
+            const double v = gsl_vector_get(y, k);
+            if (k < K)
+                yw[k] = v;
+            else
+                s->tail2 += v * v;
+        }
+    }
+    gsl_matrix_free(B); /* GSL's free functions take NULL */
+    gsl_vector_free(tau);
+    gsl_vector_free(y);
+    return ok;
 }
 
 /* For one elastic curve E and the Prony responses R[t][k] of every grid time constant, tries
@@ -285,20 +346,43 @@ static void search_taus(ctx *c, const double *E, const double *xE, double *const
     const int nb = c->nb;
     standin s;
     memset(&s, 0, sizeof s);
-    s.E = E;
-    s.xE = xE;
-    s.rate = rate;
     s.X = gsl_matrix_alloc(c->n, 2 + 2 * CF_PRONY_MAX);
     s.y = gsl_vector_alloc(c->n);
     s.res = gsl_vector_alloc(c->n);
     s.tau = gsl_vector_alloc(2 + 2 * CF_PRONY_MAX);
     s.a = gsl_vector_alloc(2 + 2 * CF_PRONY_MAX);
     double *tmp = malloc((size_t)(2 * nb + 1) * c->n * sizeof(double));
+    /* the base: E, its responses, with relaxation depending on strain |x| E and its responses,
+    ** with a dashpot the rate; every column of every combination is made of them */
+    const double *base[BASE_MAX];
+    size_t K = 0;
+    base[K++] = E;
+    for (int i = 0; i < GRID_TAU; i++)
+        base[K++] = R[i];
+    if (xE) {
+        base[K++] = xE;
+        for (int i = 0; i < GRID_TAU; i++)
+            base[K++] = S[i];
+    }
+    if (c->dash)
+        base[K++] = rate;
+    double *red = malloc((K + 1) * c->n * sizeof(double)), *Rr[GRID_TAU], *Sr[GRID_TAU];
+    int ready = red && reduce_base(c, base, K, red, red + K * c->n, &s);
+    if (ready) {
+        size_t j = 0;
+        s.E = red + s.rows * j++;
+        for (int i = 0; i < GRID_TAU; i++)
+            Rr[i] = red + s.rows * j++;
+        s.xE = xE ? red + s.rows * j++ : NULL;
+        for (int i = 0; xE && i < GRID_TAU; i++)
+            Sr[i] = red + s.rows * j++;
+        s.rate = c->dash ? red + s.rows * j++ : NULL;
+    }
     int idx[CF_PRONY_MAX];
     for (int i = 0; i < nb; i++)
         idx[i] = i;
-    while (tmp && s.X && s.y && s.res && s.tau && s.a) {
-        standin_combo(c, &s, R, S, idx, taus, rate_factor, A_max, el, tmp, best, nbest);
+    while (ready && tmp && s.X && s.y && s.res && s.tau && s.a) {
+        standin_combo(c, &s, Rr, Sr, idx, taus, rate_factor, A_max, el, tmp, best, nbest);
         /* next combination of nb indices out of GRID_TAU, increasing */
         int i = nb - 1;
         while (i >= 0 && idx[i] == GRID_TAU - nb + i)
@@ -310,6 +394,7 @@ static void search_taus(ctx *c, const double *E, const double *xE, double *const
             idx[j] = idx[j - 1] + 1;
     }
     free(tmp);
+    free(red);
     gsl_matrix_free(s.X);
     gsl_vector_free(s.y);
     gsl_vector_free(s.res);

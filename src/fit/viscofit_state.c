@@ -159,8 +159,10 @@ static int lm_f(const gsl_vector *zv, void *data, gsl_vector *f)
 
 /* Levenberg-Marquardt from z (in place); returns the scaled sum of squares. Its Jacobian by
 ** forward differences at every step (options.full_jacobian), or by default every few steps and
-** carried by Broyden's update in between (viscofit_jac.c). */
-double cf_viscofit_lm_run(ctx *c, double *z)
+** carried by Broyden's update in between (viscofit_jac.c). beat (HUGE_VAL: none) is the sum of
+** squares an earlier start reached: a run settling well above it stops early (LM_BEAT_*), and
+** what it returns is then above beat. */
+double cf_viscofit_lm_run(ctx *c, double *z, double beat)
 {
     gsl_multifit_nlinear_parameters fp = cf_lm_parameters();
     fp.h_df = 1e-7;
@@ -189,8 +191,16 @@ double cf_viscofit_lm_run(ctx *c, double *z)
     }
     double best = HUGE_VAL;
     if (init == GSL_SUCCESS) {
-        static const cf_lm_stop stop = {LM_MAX_ITER, 1e-14, 1e-14, 0,
-                                        LM_STALL,    LM_STALL_REL, LM_FLOOR_REL};
+        const cf_lm_stop stop = {LM_MAX_ITER,
+                                 1e-14,
+                                 1e-14,
+                                 0,
+                                 LM_STALL,
+                                 LM_STALL_REL,
+                                 LM_FLOOR_REL,
+                                 beat < HUGE_VAL ? LM_BEAT_FACTOR * beat : 0,
+                                 LM_BEAT_ITER,
+                                 LM_BEAT_REL};
         gsl_vector *f = gsl_multifit_nlinear_residual(w);
         if (cf_lm_iterate(w, &stop) == 0)
             gsl_blas_ddot(f, f, &best);

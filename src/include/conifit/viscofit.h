@@ -76,6 +76,11 @@ typedef struct cf_visco_fit_options {
     ** trial, carried by Broyden's update in between; the same optimum for a fraction of the
     ** model runs. */
     int full_jacobian;
+    /* 1: the stand-in's least squares (the starts of the Levenberg-Marquardt) on every point of
+    ** the series. 0 (the default): in the space of the QR factor of each grid point's base
+    ** (its elastic curve and responses, a few dozen columns), the same solutions to rounding at
+    ** a fraction of the cost on a long series. */
+    int full_standin;
 } cf_visco_fit_options;
 
 cf_visco_fit_options cf_visco_fit_default_options(void);
