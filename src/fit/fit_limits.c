@@ -229,6 +229,12 @@ double cf_fit_sub_solve(fit_ctx *c, sub *q, double *x, nlopt_algorithm alg)
     }
     nlopt_set_xtol_rel(o, 1e-9);
     nlopt_set_maxeval(o, 300);
+    if (q->step > 0) {
+        double dx[2];
+        for (unsigned k = 0; k < nv; k++)
+            dx[k] = q->step * (ub[k] - lb[k]);
+        nlopt_set_initial_step(o, dx);
+    }
     double f = CF_LSQ_HUGE_OBJ;
     nlopt_result r = nlopt_optimize(o, x, &f);
     c->oom |= r == NLOPT_OUT_OF_MEMORY;

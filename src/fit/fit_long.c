@@ -151,15 +151,19 @@ void cf_fit_stage_a_polish(fit_ctx *c, start4 *found, int nfound, double v[3])
     }
 }
 
-/* The constrained optimum v (found on the subsample) polished on every row, as
-** cf_fit_stage_a_constrained polishes each of its starts; v keeps its value when the polish finds
-** no better point. */
+/* The constrained optimum v (found on the subsample) polished on every row: SLSQP on the analytic
+** gradient, then COBYLA from its end in short first steps (SLSQP can stop short along an active
+** limit; the optimum on every row lies close to the subsample's, and COBYLA's default first step,
+** a fraction of the whole range, cost a hundred passes over the rows), then SLSQP again; v keeps
+** its value when the polish finds no better point. */
 void cf_fit_stage_a_constrained_polish(fit_ctx *c, double v[3])
 {
-    sub q = {c, -1, 0};
+    sub q = {c, -1, 0, 0};
     double x0[2] = {log(v[0]), v[1]}, x[2] = {x0[0], x0[1]};
     double f0 = cf_fit_sub_g0(&q, x0) <= 1e-9 ? cf_fit_sub_f0(&q, x0) : CF_LSQ_HUGE_OBJ;
-    double f = cf_fit_sub_solve(c, &q, x, NLOPT_LN_COBYLA);
+    double f = cf_fit_sub_solve(c, &q, x, NLOPT_LD_SLSQP);
+    q.step = 1e-3;
+    f = fmin(f, cf_fit_sub_solve(c, &q, x, NLOPT_LN_COBYLA));
     f = fmin(f, cf_fit_sub_solve(c, &q, x, NLOPT_LD_SLSQP));
     if (f > f0 || !(f < CF_LSQ_HUGE_OBJ))
         memcpy(x, x0, sizeof x);
