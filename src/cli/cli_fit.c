@@ -267,6 +267,11 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
         if (cf_fitfile_load_spec(a->elastic, &fs, &err) != CF_OK) {
             rc = cf_cli_fail(&err);
         } else {
+            if (cf_spring_has_tail(&fs.params))
+                rc = cf_cli_usage_error("fit", "--elastic %s: the spring has a cylindrical tail; "
+                                               "a time series' elastic part is the conical law "
+                                               "(give a fit of --law conical)",
+                                        a->elastic);
             a->vopt.elastic = cf_ident_of(&fs.params, 0);
             a->vopt.hold_elastic = 1;
         }

@@ -8,7 +8,7 @@
 cf_ident cf_ident_of_type(const cf_spring *p, cf_spring_type type, int force_displacement)
 {
     const double lmin = type == CF_TELESCOPING ? p->d_mm : p->n * p->d_mm;
-    const double s = p->H_mm - lmin;
+    const double s = p->H_mm - p->H_tail_mm - lmin; /* the cone's travel (a tail's H_tail apart) */
     const double D1 = p->D1_mm, d = p->d_mm;
     const double FC = p->G_MPa * d * d * d * d * s / (8 * p->n * D1 * D1 * D1);
     cf_ident q;

@@ -28,11 +28,11 @@ json_t *cf_report_tail_json(const cf_fit_result *f)
     json_t *o = json_pack("{s:o}", "value", num(f->e_tail));
     if (o && f->e_tail_se >= 0)
         json_object_set_new(o, "stderr", num(f->e_tail_se));
-    if (o && f->e_tail_se > fabs(f->e_tail))
-        json_object_set_new(o, "determined", json_false());
     else if (o)
         json_object_set_new(o, "stderr_reason",
                             json_string("the Jacobian of the four quantities is singular"));
+    if (o && f->e_tail_se > fabs(f->e_tail))
+        json_object_set_new(o, "determined", json_false());
     return o;
 }
 
@@ -44,10 +44,10 @@ json_t *cf_report_ident_json(const cf_fit_result *f, int k)
         return NULL;
     if (se >= 0)
         json_object_set_new(o, "stderr", num(se));
-    if (f->tail && se > fabs(f->ident.v[k]))
-        json_object_set_new(o, "determined", json_false());
     else
         json_object_set_new(o, "stderr_reason", json_string(stderr_reason(f)));
+    if (f->tail && se > fabs(f->ident.v[k]))
+        json_object_set_new(o, "determined", json_false());
     if (f->interval_ok[k]) {
         char why[512];
         cf_report_interval_reason(f, k, why, sizeof why);

@@ -108,12 +108,37 @@ static void unsupported_combinations_exit_2(void **state)
     rmdir(dir);
 }
 
+/* A tailed fit as the elastic part of a time series is refused (exit 2): the series' elastic part
+** has the conical law's three quantities, and the tail would be dropped. */
+static void tailed_elastic_part_is_refused(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-law-XXXXXX", fit[256], json[256];
+    assert_non_null(mkdtemp(dir));
+    snprintf(fit, sizeof fit, "%s/tail.json", dir);
+    snprintf(json, sizeof json, "%s/series.json", dir);
+    static char out[1 << 16], errb[1 << 14];
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "fit data/non_telescoping.csv --law conical-tail --type non-telescoping -o %s",
+                            fit),
+                     0);
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "fit data/series/synthetic_relaxation.csv --elastic %s -o %s", fit,
+                            json),
+                     2);
+    assert_non_null(strstr(errb, "cylindrical tail"));
+    assert_false(exists(json));
+    remove(fit);
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(auto_reports_both_laws),
         cmocka_unit_test(conical_tail_writes_the_tail),
         cmocka_unit_test(unsupported_combinations_exit_2),
+        cmocka_unit_test(tailed_elastic_part_is_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

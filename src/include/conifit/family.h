@@ -58,6 +58,9 @@ enum {
 ** edge). */
 #define CF_IDENT_RHO_MIN_TOL 1e-6
 
+/* (A spring with a cylindrical tail gives its cone's three quantities: the tail's compliance is
+** a fourth, cf_fit_result.e_tail.) */
+
 /* The family of spring p counted as a spring of the given type (the type being fitted, not
 ** necessarily the one its geometry has: its solid length is d for telescoping, n d otherwise);
 ** force_displacement chooses the scales' kind. */
