@@ -85,16 +85,22 @@ static double z_preference(fit_ctx *c, const double *z, int which)
 }
 
 /* The gradient of cf_fit_z_objective from one pass over the rows: the model sees the spring only
-** through its family (rho, the length scale B, the load scale A; cf_ident_of, the type its
-** geometry has), so the gradient is that of the reduced model in (rho, B, A), from the canonical
-** law's derivatives, times the family's derivatives in z, by central differences that need no
-** rows. 0 (grad untouched) where the family is not defined. */
+** through its family (rho, the length scale B, the load scale A), so the gradient is that of the
+** reduced model in (rho, B, A), from the canonical law's derivatives, times the family's
+** derivatives in z, by central differences that need no rows. 0 (grad untouched) where the family
+** is not defined, or where the geometry is not of the type being fitted: there the family jumps
+** across the type's boundary, and the search outside the type's limits keeps the differences of
+** the objective itself (measured: the analytic gradient there led a fit that no spring of the type
+** can meet to another infeasible spring, of H = 356 mm and the largest G). */
 static int objective_grad(fit_ctx *c, const double *z, double *grad)
 {
     double p[CF_P_COUNT], zz[CF_P_COUNT];
     cf_fit_full_params(c, z, p);
     cf_spring sp = from_array(p);
-    const cf_ident id = cf_ident_of(&sp, c->fd);
+    cf_law law;
+    if (cf_law_init(&law, &sp, NULL) != CF_OK || law.type != c->type)
+        return 0;
+    const cf_ident id = cf_ident_of_type(&sp, c->type, c->fd);
     const double rho = id.v[0], B = id.v[1], A = id.v[2];
     cf_law canon;
     if (!(rho > 0 && B > 0 && A > 0 && isfinite(A) && isfinite(B)) ||
@@ -119,7 +125,7 @@ static int objective_grad(fit_ctx *c, const double *z, double *grad)
             zz[k] = z[k] + (side ? -h : h);
             cf_fit_full_params(c, zz, q);
             sp = from_array(q);
-            v[side] = cf_ident_of(&sp, c->fd);
+            v[side] = cf_ident_of_type(&sp, c->type, c->fd);
         }
         zz[k] = z[k];
         double g = 0;
