@@ -102,6 +102,7 @@ typedef struct sub {
     fit_ctx *c;
     int fixed;
     double t;
+    double step; /* > 0: COBYLA's first step, relative to each variable's range (0: NLopt's) */
 } sub;
 
 typedef double (*zfun)(fit_ctx *c, const double *z, int which);

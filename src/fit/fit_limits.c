@@ -49,18 +49,20 @@ double cf_fit_ident_limit(const cf_fit_options *opt, cf_spring_type type, double
     return r.margin;
 }
 
-/* Weighted residual sum of squares of the reduced model at (rho, B) with the load scale A fixed
-** (A_fixed > 0) or solved in closed form and clamped to (0, A_max]; *A_out the scale used.
-** The sum is formed from the residuals themselves, not from the expanded square, so that it
-** stays exact on noiseless tables. */
-double cf_fit_rss_at(fit_ctx *c, double rho, double B, double A_fixed, double A_max,
-                     double *A_out)
+/* The weighted RSS of the reduced model at (rho, B) with the load scale A fixed (A_fixed > 0) or
+** solved in closed form and clamped to (0, A_max]; *A_out the scale used. With d (not NULL) also
+** its partial derivatives at that A: d[0] in log rho, d[1] in B, d[2] in A, from one pass of the
+** canonical law with its derivatives. The sum is formed from the residuals themselves, not from
+** the expanded square, so that it stays exact on noiseless tables. */
+static double rss_core(fit_ctx *c, double rho, double B, double A_fixed, double A_max,
+                       double *A_out, double d[3])
 {
     cf_law canon;
     *A_out = A_fixed;
     if (!(B > 0) || cf_ident_canon_law(rho, &canon) != CF_OK)
         return CF_LSQ_HUGE_OBJ;
-    cf_ident_canon_many(&canon, B, c->n, c->data->x, c->model, NULL, NULL);
+    cf_ident_canon_many(&canon, B, c->n, c->data->x, c->model, d ? c->gt : NULL,
+                        d ? c->gr : NULL);
     double sgy = 0, sgg = 0;
     for (size_t i = 0; i < c->n; i++) {
         double g = c->sw[i] * c->model[i];
@@ -75,14 +77,30 @@ double cf_fit_rss_at(fit_ctx *c, double rho, double B, double A_fixed, double A_
             A = 1e-300;
         A = fmin(A, A_max);
     }
-    double rss = 0;
+    double rss = 0, sr = 0, st = 0, sa = 0;
     for (size_t i = 0; i < c->n; i++) {
         double r = A * c->model[i] - c->sw[i] * c->data->y[i];
         rss += r * r;
+        if (d) {
+            sr += r * c->sw[i] * c->gr[i];
+            st += r * c->sw[i] * c->gt[i] * c->data->x[i];
+            sa += r * c->model[i];
+        }
     }
     c->evals++;
     *A_out = A;
+    if (d) {
+        d[0] = 2 * A * rho * sr;
+        d[1] = -2 * A * st / (B * B);
+        d[2] = 2 * sa;
+    }
     return isfinite(rss) ? rss : CF_LSQ_HUGE_OBJ;
+}
+
+double cf_fit_rss_at(fit_ctx *c, double rho, double B, double A_fixed, double A_max,
+                     double *A_out)
+{
+    return rss_core(c, rho, B, A_fixed, A_max, A_out, NULL);
 }
 
 void cf_fit_sub_point(const sub *q, const double *x, double *rho, double *B)
@@ -101,7 +119,8 @@ double cf_fit_sub_f0(const sub *q, const double *x)
 }
 
 
-/* Central differences for the gradient-based optimiser (SLSQP). */
+/* Central differences for the gradient-based optimiser (SLSQP): the limits' margin, which needs
+** no pass over the rows. */
 static void sub_grad(const sub *q, double (*f)(const sub *, const double *), unsigned n,
                      const double *x, double *grad)
 {
@@ -118,12 +137,42 @@ static void sub_grad(const sub *q, double (*f)(const sub *, const double *), uns
     }
 }
 
+/* log of the largest load scale the limits admit at x (the clamp of cf_fit_rss_at) */
+static double sub_log_amax(const sub *q, const double *x)
+{
+    double rho, B;
+    cf_fit_sub_point(q, x, &rho, &B);
+    return log(cf_fit_region_at(q->c, rho, B).A_max);
+}
+
+/* The sub-problem's RSS and its analytic gradient in x from one pass over the rows: the load scale
+** in closed form is optimal, so the RSS moves with x through rho and B alone, unless it is clamped
+** on the limits' largest scale, which then moves it too. */
 static double sub_f(unsigned n, const double *x, double *grad, void *data)
 {
     const sub *q = data;
-    if (grad)
-        sub_grad(q, cf_fit_sub_f0, n, x, grad);
-    return cf_fit_sub_f0(q, x);
+    if (!grad)
+        return cf_fit_sub_f0(q, x);
+    double rho, B, A, d[3];
+    cf_fit_sub_point(q, x, &rho, &B);
+    region r = cf_fit_region_at(q->c, rho, B);
+    const double A_fixed = q->fixed == 2 ? q->t : -1;
+    double f = rss_core(q->c, rho, B, A_fixed, r.A_max, &A, d);
+    unsigned j = 0;
+    if (q->fixed != 0)
+        grad[j++] = d[0];
+    if (q->fixed != 1)
+        grad[j] = d[1];
+    if (!(A_fixed > 0) && A >= r.A_max && isfinite(r.A_max)) {
+        double da[2];
+        sub_grad(q, sub_log_amax, n, x, da);
+        for (unsigned k = 0; k < n; k++)
+            grad[k] += d[2] * A * da[k];
+    }
+    for (unsigned k = 0; k < n; k++)
+        if (!isfinite(grad[k]))
+            grad[k] = 0;
+    return f;
 }
 
 static double sub_g(unsigned n, const double *x, double *grad, void *data)
@@ -180,6 +229,12 @@ double cf_fit_sub_solve(fit_ctx *c, sub *q, double *x, nlopt_algorithm alg)
     }
     nlopt_set_xtol_rel(o, 1e-9);
     nlopt_set_maxeval(o, 300);
+    if (q->step > 0) {
+        double dx[2];
+        for (unsigned k = 0; k < nv; k++)
+            dx[k] = q->step * (ub[k] - lb[k]);
+        nlopt_set_initial_step(o, dx);
+    }
     double f = CF_LSQ_HUGE_OBJ;
     nlopt_result r = nlopt_optimize(o, x, &f);
     c->oom |= r == NLOPT_OUT_OF_MEMORY;
@@ -223,9 +278,7 @@ int cf_fit_stage_a_constrained(fit_ctx *c, double v[3])
     double best = CF_LSQ_HUGE_OBJ, bx[2] = {0, 0};
     for (size_t i = 0; i < k && (int)i < c->opt->multistart; i++) {
         double x[2] = {log(grid[i].rho), grid[i].B};
-        double f = cf_fit_sub_solve(c, &q, x, NLOPT_LN_COBYLA);
-        double f2 = cf_fit_sub_solve(c, &q, x, NLOPT_LD_SLSQP);
-        f = fmin(f, f2);
+        double f = cf_fit_sub_solve(c, &q, x, NLOPT_LD_SLSQP);
         if (f < best) {
             best = f;
             memcpy(bx, x, sizeof bx);

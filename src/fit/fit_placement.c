@@ -61,14 +61,6 @@ double cf_fit_z_objective(fit_ctx *c, const double *z, int which)
     return cf_fit_objective6(c, p);
 }
 
-static double z_constraint(fit_ctx *c, const double *z, int which)
-{
-    double p[CF_P_COUNT], g[NCON];
-    cf_fit_full_params(c, z, p);
-    cf_fit_constraint_values(p, c->type, c->xmax, c->fd, c->opt, g);
-    return g[which] + SAFETY;
-}
-
 /* log(ident(p)) - log(target): the equality constraints of placement */
 static double z_equality(fit_ctx *c, const double *z, int which)
 {
@@ -92,6 +84,60 @@ static double z_preference(fit_ctx *c, const double *z, int which)
     return a * a + b * b + h * h;
 }
 
+/* The gradient of cf_fit_z_objective from one pass over the rows: the model sees the spring only
+** through its family (rho, the length scale B, the load scale A), so the gradient is that of the
+** reduced model in (rho, B, A), from the canonical law's derivatives, times the family's
+** derivatives in z, by central differences that need no rows. 0 (grad untouched) where the family
+** is not defined, or where the geometry is not of the type being fitted: there the family jumps
+** across the type's boundary, and the search outside the type's limits keeps the differences of
+** the objective itself (measured: the analytic gradient there led a fit that no spring of the type
+** can meet to another infeasible spring, of H = 356 mm and the largest G). */
+static int objective_grad(fit_ctx *c, const double *z, double *grad)
+{
+    double p[CF_P_COUNT], zz[CF_P_COUNT];
+    cf_fit_full_params(c, z, p);
+    cf_spring sp = from_array(p);
+    cf_law law;
+    if (cf_law_init(&law, &sp, NULL) != CF_OK || law.type != c->type)
+        return 0;
+    const cf_ident id = cf_ident_of_type(&sp, c->type, c->fd);
+    const double rho = id.v[0], B = id.v[1], A = id.v[2];
+    cf_law canon;
+    if (!(rho > 0 && B > 0 && A > 0 && isfinite(A) && isfinite(B)) ||
+        cf_ident_canon_law(rho, &canon) != CF_OK)
+        return 0;
+    cf_ident_canon_many(&canon, B, c->n, c->data->x, c->model, c->gt, c->gr);
+    double sr = 0, st = 0, sa = 0;
+    for (size_t i = 0; i < c->n; i++) {
+        double r = c->sw[i] * c->sw[i] * (A * c->model[i] - c->data->y[i]);
+        sa += r * c->model[i];
+        sr += r * c->gr[i];
+        st += r * c->gt[i] * c->data->x[i];
+    }
+    c->evals++;
+    const double dv[3] = {2 * A * sr / c->ynorm, -2 * A * st / (B * B * c->ynorm),
+                          2 * sa / c->ynorm};
+    memcpy(zz, z, sizeof(double) * (size_t)c->nfree);
+    for (int k = 0; k < c->nfree; k++) {
+        double h = 1e-6 * fmax(1.0, fabs(z[k])), q[CF_P_COUNT];
+        cf_ident v[2];
+        for (int side = 0; side < 2; side++) {
+            zz[k] = z[k] + (side ? -h : h);
+            cf_fit_full_params(c, zz, q);
+            sp = from_array(q);
+            v[side] = cf_ident_of_type(&sp, c->type, c->fd);
+        }
+        zz[k] = z[k];
+        double g = 0;
+        for (int j = 0; j < 3; j++)
+            g += dv[j] * (v[0].v[j] - v[1].v[j]) / (2 * h);
+        if (!isfinite(g))
+            return 0;
+        grad[k] = g;
+    }
+    return 1;
+}
+
 typedef struct nl_thunk {
     fit_ctx *c;
     zfun f;
@@ -102,9 +148,40 @@ static double nl_func(unsigned n, const double *z, double *grad, void *data)
 {
     (void)n;
     nl_thunk *t = data;
-    if (grad)
+    if (grad && !(t->f == cf_fit_z_objective && objective_grad(t->c, z, grad)))
         fd_grad(t->c, t->f, t->which, z, grad);
     return t->f(t->c, z, t->which);
+}
+
+/* The design constraints as one vector (the travel one left out when it cannot be met), with
+** their central-difference gradients: one evaluation of all of them per point. */
+static void nl_constraints(unsigned m, double *result, unsigned n, const double *z, double *grad,
+                           void *data)
+{
+    fit_ctx *c = data;
+    double p[CF_P_COUNT], g[NCON], zz[CF_P_COUNT];
+    const int skip = c->travel_ok ? -1 : CON_TRAVEL;
+    cf_fit_full_params(c, z, p);
+    cf_fit_constraint_values(p, c->type, c->xmax, c->fd, c->opt, g);
+    for (int k = 0, i = 0; k < NCON && i < (int)m; k++)
+        if (k != skip)
+            result[i++] = g[k] + SAFETY;
+    if (!grad)
+        return;
+    memcpy(zz, z, sizeof(double) * n);
+    for (unsigned v = 0; v < n; v++) {
+        double h = 1e-6 * fmax(1.0, fabs(z[v])), gp[NCON], gm[NCON];
+        zz[v] = z[v] + h;
+        cf_fit_full_params(c, zz, p);
+        cf_fit_constraint_values(p, c->type, c->xmax, c->fd, c->opt, gp);
+        zz[v] = z[v] - h;
+        cf_fit_full_params(c, zz, p);
+        cf_fit_constraint_values(p, c->type, c->xmax, c->fd, c->opt, gm);
+        zz[v] = z[v];
+        for (int k = 0, i = 0; k < NCON && i < (int)m; k++)
+            if (k != skip)
+                grad[(size_t)(i++) * n + v] = (gp[k] - gm[k]) / (2 * h);
+    }
 }
 
 nlopt_algorithm cf_fit_algorithm_of(cf_fit_optimizer o)
@@ -138,14 +215,11 @@ void cf_fit_nl_run(fit_ctx *c, nlopt_algorithm alg, zfun obj, int equalities, do
     }
     int set_oom = nlopt_set_lower_bounds(o, lb) == NLOPT_OUT_OF_MEMORY;
     set_oom |= nlopt_set_upper_bounds(o, ub) == NLOPT_OUT_OF_MEMORY;
-    nl_thunk to = {c, obj, 0}, tc[NCON], te[3];
+    nl_thunk to = {c, obj, 0}, te[3];
     set_oom |= nlopt_set_min_objective(o, nl_func, &to) == NLOPT_OUT_OF_MEMORY;
-    for (int k = 0; k < NCON; k++) {
-        tc[k] = (nl_thunk){c, z_constraint, k};
-        if (k == CON_TRAVEL && !c->travel_ok)
-            continue;
-        set_oom |= nlopt_add_inequality_constraint(o, nl_func, &tc[k], 0.0) == NLOPT_OUT_OF_MEMORY;
-    }
+    const double ctol[NCON] = {0};
+    set_oom |= nlopt_add_inequality_mconstraint(o, c->travel_ok ? NCON : NCON - 1, nl_constraints,
+                                                c, ctol) == NLOPT_OUT_OF_MEMORY;
     if (equalities)
         for (int k = 0; k < 3; k++) {
             te[k] = (nl_thunk){c, z_equality, k};

@@ -28,7 +28,7 @@ static void profile_end(const cf_profile *p, int k, const double v[3], double li
         xin[j++] = log(v[0]);
     if (k != 1)
         xin[j] = v[1];
-    double u_in = log(v[k]), u_out = NAN;
+    double u_in = log(v[k]), u_out = NAN, f_in = NAN, f_out = NAN;
     unsigned end_bit = 0;
     int done = 0, infeasible = 0;
     for (int it = 0; it < 60 && !done; it++, h *= 2) {
@@ -44,12 +44,14 @@ static void profile_end(const cf_profile *p, int k, const double v[3], double li
         double f = p->at(p->ctx, k, u, limit, xin);
         if (f <= limit) {
             u_in = u;
+            f_in = f;
             if (at_bound) {
                 end_bit = dir < 0 ? p->lo_bit[k] : p->hi_bit[k];
                 done = 1;
             }
         } else {
             u_out = u;
+            f_out = f;
             infeasible = f >= CF_LSQ_HUGE_OBJ;
             done = 2;
         }
@@ -57,18 +59,36 @@ static void profile_end(const cf_profile *p, int k, const double v[3], double li
     if (done == 2) {
         /* to 1e-4 in log units (times |log v|) or 1 % of the end's distance from the value,
         ** whichever is finer: the first alone returned the value itself for every interval
-        ** narrower than that (a precise table, a long one, collapsed to [value, value]) */
+        ** narrower than that (a precise table, a long one, collapsed to [value, value]). The
+        ** bracket shrinks by false position on the profile's values where both ends have one
+        ** (bisection otherwise, and after two steps in a row on the same side), each point kept
+        ** half the tolerance inside the bracket: once the estimate is good, the next point lands
+        ** on the far side of the end and closes the bracket to the tolerance. */
         const double u0 = log(v[k]);
-        for (int it = 0; it < 60 && fabs(u_out - u_in) > fmax(fmin(1e-4 * fmax(1.0, fabs(u_in)),
-                                                                   1e-2 * fabs(u_out - u0)),
-                                                              1e-15);
-             it++) {
-            double u = 0.5 * (u_in + u_out);
+        int same = 0, last = 0;
+        for (int it = 0; it < 60; it++) {
+            const double tol = fmax(fmin(1e-4 * fmax(1.0, fabs(u_in)), 1e-2 * fabs(u_out - u0)),
+                                    1e-15);
+            const double w = u_out - u_in;
+            if (!(fabs(w) > tol))
+                break;
+            double t = 0.5;
+            if (isfinite(f_in) && f_out < CF_LSQ_HUGE_OBJ && f_out > f_in && same < 2)
+                t = fmin(fmax((limit - f_in) / (f_out - f_in), 0.5 * tol / fabs(w)),
+                         1 - 0.5 * tol / fabs(w));
+            double u = u_in + t * w;
             double f = p->at(p->ctx, k, u, limit, xin);
+            const int side = f <= limit ? 1 : 2;
+            same = side == last ? same + 1 : 1;
+            last = side;
+            if (t == 0.5)
+                same = 0;
             if (f <= limit) {
                 u_in = u;
+                f_in = f;
             } else {
                 u_out = u;
+                f_out = f;
                 infeasible = f >= CF_LSQ_HUGE_OBJ;
             }
         }
