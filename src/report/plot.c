@@ -173,7 +173,9 @@ static void choose_curves(const cf_fit_report *r, fit_curves *c)
     for (int k = 0; k < r->nfits; k++) {
         c->fit[k] = 1;
         c->style[k] = 1 + (int)r->fits[k].type;
-        snprintf(c->fit_title[k], sizeof c->fit_title[k], "conical, %s",
+        /* the law family named: a tailed fit is "conical-tail" */
+        const char *law = r->fits[k].tail ? "conical-tail" : "conical";
+        snprintf(c->fit_title[k], sizeof c->fit_title[k], "%s, %s", law,
                  cf_spring_type_name(r->fits[k].type));
         c->lattice[k] = r->validate && r->val[k].done && r->val[k].count == d->count;
         const cf_lattice_config *lc = &r->val[k].setup.cfg.lattice;
@@ -183,8 +185,8 @@ static void choose_curves(const cf_fit_report *r, fit_curves *c)
         ** spring has no form of), drawn as the fit; the spring's law is not what was fitted */
         if (c->lattice_fit[k]) {
             c->lattice[k] = 0;
-            snprintf(c->fit_title[k], sizeof c->fit_title[k], "fit: lattice, %s",
-                     cf_spring_type_name(r->fits[k].type));
+            snprintf(c->fit_title[k], sizeof c->fit_title[k], "fit: lattice, %s%s",
+                     cf_spring_type_name(r->fits[k].type), r->fits[k].tail ? ", tail" : "");
         }
     }
     if (c->lattice_fit[0] && (r->nfits == 1 || c->lattice_fit[1])) {
