@@ -20,6 +20,30 @@
 ** rounding level, so 1e-4 leaves about 8 digits in each derivative. */
 #define FD_STEP 1e-4
 
+cf_status cf_cell_problem_init(cf_cell_problem *p, const cf_table *d, const cf_fit_options *opt,
+                               cf_spring_type type,
+                               int (*curve)(void *ctx, double rho, double B, double *out),
+                               double (*A_max)(void *ctx, double rho, double B), void *ctx,
+                               cf_error *err)
+{
+    const size_t n = d->count ? d->count : 1;
+    double *sw = malloc(sizeof(double) * n);
+    *p = (cf_cell_problem){.curve = curve, .A_max = A_max, .ctx = ctx, .n = d->count, .y = d->y,
+                           .sw = sw, .opt = opt, .type = type, .g = malloc(sizeof(double) * n)};
+    if (!sw || !p->g)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", d->count);
+    p->ynorm = cf_lsq_weights(d, opt->relative, sw);
+    return CF_OK;
+}
+
+void cf_cell_problem_free(cf_cell_problem *p)
+{
+    free((double *)p->sw);
+    free(p->g);
+    p->sw = NULL;
+    p->g = NULL;
+}
+
 double cf_cell_rss(cf_cell_problem *p, double rho, double B, double *A_out)
 {
     p->evals++;

@@ -36,6 +36,16 @@ typedef struct cf_cell_problem {
     int oom;                   /* 1: an optimiser (NLopt) ran out of memory */
 } cf_cell_problem;
 
+/* Sets p up for table d: its rows, values, residual weights (lsq.h) and scratch, with the curve,
+** A_max (may be NULL) and ctx given; the rest zero. CF_E_INTERNAL when memory runs out (then
+** cf_cell_problem_free is still safe). */
+cf_status cf_cell_problem_init(cf_cell_problem *p, const cf_table *d, const cf_fit_options *opt,
+                               cf_spring_type type,
+                               int (*curve)(void *ctx, double rho, double B, double *out),
+                               double (*A_max)(void *ctx, double rho, double B), void *ctx,
+                               cf_error *err);
+void cf_cell_problem_free(cf_cell_problem *p);
+
 /* The weighted RSS at (rho, B), the stress scale in closed form (weighted linear least squares,
 ** capped at the largest scale the type carries there, or p->A_max's) or p->A_fixed; *A_out receives it.
 ** CF_LSQ_HUGE_OBJ where no spring of the type can be placed or the curve cannot be computed. */

@@ -48,20 +48,12 @@ static cf_status tm_init(tm_ctx *c, const cf_table *d, const cf_validate_setup *
     memset(c, 0, sizeof *c);
     c->d = d;
     c->s = s;
-    double *sw = malloc(sizeof(double) * (d->count ? d->count : 1));
-    c->pr = (cf_cell_problem){.curve = tm_curve, .n = d->count, .y = d->y, .sw = sw,
-                              .opt = opt, .type = type,
-                              .g = malloc(sizeof(double) * (d->count ? d->count : 1))};
-    if (!sw || !c->pr.g)
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", d->count);
-    c->pr.ynorm = cf_lsq_weights(d, opt->relative, sw);
-    return CF_OK;
+    return cf_cell_problem_init(&c->pr, d, opt, type, tm_curve, NULL, c, err);
 }
 
 static void tm_free(tm_ctx *c)
 {
-    free((double *)c->pr.sw);
-    free(c->pr.g);
+    cf_cell_problem_free(&c->pr);
 }
 
 /* The objective at (log rho, s/H) with the stress scale solved in closed form: at a prescribed

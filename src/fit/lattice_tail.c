@@ -78,21 +78,12 @@ static cf_status lt_init(lt_ctx *c, const cf_table *d, const cf_validate_setup *
     c->d = d;
     c->s = s;
     c->need = need;
-    const size_t n = d->count ? d->count : 1;
-    double *sw = malloc(sizeof(double) * n);
-    c->pr = (cf_cell_problem){.curve = lt_curve, .A_max = lt_A_max, .ctx = c, .n = d->count,
-                              .y = d->y, .sw = sw, .opt = opt, .type = type,
-                              .g = malloc(sizeof(double) * n)};
-    if (!sw || !c->pr.g)
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", d->count);
-    c->pr.ynorm = cf_lsq_weights(d, opt->relative, sw);
-    return CF_OK;
+    return cf_cell_problem_init(&c->pr, d, opt, type, lt_curve, lt_A_max, c, err);
 }
 
 static void lt_free(lt_ctx *c)
 {
-    free((double *)c->pr.sw);
-    free(c->pr.g);
+    cf_cell_problem_free(&c->pr);
 }
 
 /* The weighted RSS over ynorm at z = (log rho, B, q), the scale in closed form into *A. */
