@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/utsname.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -51,15 +52,38 @@ FILE *bench_open_data(const bench_ctx *ctx, const char *name)
     return fopen(path, "w");
 }
 
+/* gnuplot run in the report's folder with the script on its standard input: no shell, so the
+** folder's name (a command-line argument) is never read as a command. */
 int bench_gnuplot(const bench_ctx *ctx, const char *script)
 {
-    char cmd[1200];
-    snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot", ctx->dir);
-    FILE *p = popen(cmd, "w");
-    if (!p)
+    int fd[2];
+    if (pipe(fd) != 0)
         return -1;
-    fputs(script, p);
-    return pclose(p) == 0 ? 0 : -1;
+    pid_t pid = fork();
+    if (pid < 0) {
+        close(fd[0]);
+        close(fd[1]);
+        return -1;
+    }
+    if (pid == 0) {
+        close(fd[1]);
+        if (chdir(ctx->dir) != 0 || dup2(fd[0], 0) < 0)
+            _exit(126);
+        execlp("gnuplot", "gnuplot", (char *)NULL);
+        _exit(127);
+    }
+    close(fd[0]);
+    FILE *p = fdopen(fd[1], "w");
+    if (p) {
+        fputs(script, p);
+        fclose(p);
+    } else {
+        close(fd[1]);
+    }
+    int st;
+    if (waitpid(pid, &st, 0) != pid)
+        return -1;
+    return p && WIFEXITED(st) && WEXITSTATUS(st) == 0 ? 0 : -1;
 }
 
 void bench_target_add(bench_ctx *ctx, const char *name, int met, const char *fmt, ...)
