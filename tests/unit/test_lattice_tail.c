@@ -99,22 +99,21 @@ static void known_tailed_spring_is_recovered_through_the_lattice(void **state)
 
 /* --law auto through the pipeline on a published table read in its own mode (the fit goes through
 ** the lattice): both laws fitted for each type, the AIC the rule; 0 when the tables are absent. */
-static int auto_in_lattice(const char *name, cf_mode mode, cf_fit_report *r)
+static int auto_in_lattice(const char *name, cf_mode mode, cf_table *t, cf_fit_report *r)
 {
     const char *dir = tu_datasets();
     if (!dir)
         return 0;
     char path[1024];
     snprintf(path, sizeof path, "%s/%s", dir, name);
-    static cf_table t; /* the report points at it */
     cf_measure_options mo = cf_measure_default_options();
     cf_error err = {0};
-    if (cf_measure_load(path, &mo, &t, &err) != CF_OK)
+    if (cf_measure_load(path, &mo, t, &err) != CF_OK)
         fail_msg("%s", err.msg);
-    assert_int_equal(t.mode, mode);
+    assert_int_equal(t->mode, mode);
     cf_pipeline_options po = cf_pipeline_default_options();
     po.fit.law = CF_FAMILY_AUTO;
-    if (cf_pipeline_fit(&t, &po, r, &err) != CF_OK)
+    if (cf_pipeline_fit(t, &po, r, &err) != CF_OK)
         fail_msg("%s", err.msg);
     assert_true(r->through_msm);
     for (int i = 0; i < r->nfits; i++) {
@@ -141,7 +140,8 @@ static void valve_in_equibiaxial_keeps_the_tail(void **state)
 {
     (void)state;
     cf_fit_report r;
-    if (!auto_in_lattice("aortic_valve_circumferential.csv", CF_MODE_EQUIBIAXIAL, &r))
+    cf_table t; /* the report points at it */
+    if (!auto_in_lattice("aortic_valve_circumferential.csv", CF_MODE_EQUIBIAXIAL, &t, &r))
         skip();
     assert_int_equal(r.nfits, 2);
     for (int i = 0; i < r.nfits; i++) {
@@ -162,6 +162,7 @@ static void valve_in_equibiaxial_keeps_the_tail(void **state)
     assert_true(r.law_choice[0].other.violated & CF_C_D2_H);
     assert_true(r.law_choice[1].chose_tail);
     cf_report_free(&r);
+    cf_table_free(&t);
 }
 
 /* The chicken breast in simple shear softens: both laws settle on the same compromise through the
@@ -171,7 +172,8 @@ static void softening_shear_keeps_the_conical_law(void **state)
 {
     (void)state;
     cf_fit_report r;
-    if (!auto_in_lattice("chicken_breast_shear.csv", CF_MODE_SHEAR, &r))
+    cf_table t; /* the report points at it */
+    if (!auto_in_lattice("chicken_breast_shear.csv", CF_MODE_SHEAR, &t, &r))
         skip();
     for (int i = 0; i < r.nfits; i++) {
         const cf_law_choice *lc = &r.law_choice[i];
@@ -182,6 +184,7 @@ static void softening_shear_keeps_the_conical_law(void **state)
         assert_true(lc->other.rmse > 0.99 * r.fits[i].rmse);
     }
     cf_report_free(&r);
+    cf_table_free(&t);
 }
 
 int main(void)
