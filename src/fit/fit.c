@@ -396,8 +396,10 @@ cf_status cf_fit_run_shared(const cf_table *data, const cf_fit_options *opt, cf_
             double w[3];
             const double tol = c.stat_tol;
             c.stat_tol = 0;
+            c.crawl_stop = 1;
             if (cf_fit_lm_run(&c, v[0], v[1], v[2], w) < CF_LSQ_HUGE_OBJ)
                 memcpy(v, w, sizeof w);
+            c.crawl_stop = 0;
             c.stat_tol = tol;
         }
     }
