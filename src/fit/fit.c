@@ -334,6 +334,26 @@ cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_sprin
 cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                      cf_fit_result *res, cf_error *err)
 {
+    return cf_fit_run_shared(data, opt, type, NULL, res, err);
+}
+
+/* Whether two option sets give the same stage A (every field but the stage-C optimiser and the
+** law family, which stage A does not read, compared one by one: no padding bytes). */
+static int same_stage_a_options(const cf_fit_options *a, const cf_fit_options *b)
+{
+    for (int k = 0; k < CF_P_COUNT; k++)
+        if (a->fixed[k] != b->fixed[k] || a->fixed_value[k] != b->fixed_value[k] ||
+            a->lower[k] != b->lower[k] || a->upper[k] != b->upper[k])
+            return 0;
+    return a->index_max == b->index_max && a->rho_min == b->rho_min &&
+           a->D2_over_H_max == b->D2_over_H_max && a->relative == b->relative &&
+           a->xtol_rel == b->xtol_rel && a->seed == b->seed && a->multistart == b->multistart &&
+           a->H_preferred_mm == b->H_preferred_mm && a->subsample_above == b->subsample_above;
+}
+
+cf_status cf_fit_run_shared(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
+                            cf_fit_shared *shared, cf_fit_result *res, cf_error *err)
+{
     const double t0 = cf_clock_s();
     memset(res, 0, sizeof *res);
     fit_ctx c, sc;
@@ -363,21 +383,36 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
     double v[3] = {0.5, 0.5 * (c.b_lo + c.b_hi), 1.0};
     start4 found[STAGE_A_RUNS];
     int nfound = 0;
-    if (long_table)
-        sc.stat_tol = LONG_TOL / (double)(sc.n - 3);
-    cf_fit_stage_a(g, v, long_table ? found : NULL, &nfound);
-    sc.stat_tol = 0;
-    if (long_table) {
-        cf_fit_stage_a_polish(&c, found, nfound, v);
+    /* both types' stage A searches the same range where their limits are known in closed form
+    ** (c.region): the same optimum, which the second fit of a table takes from the first */
+    const int share = shared && c.region;
+    if (share && shared->have && shared->data == data && same_stage_a_options(&shared->opt, opt)) {
+        memcpy(v, shared->v, sizeof v);
     } else {
-        /* the starts stopped at the statistical tolerance; the best is polished to the strict
-        ** rule, so that a short table's fit is its optimum to rounding */
-        double w[3];
-        const double tol = c.stat_tol;
-        c.stat_tol = 0;
-        if (cf_fit_lm_run(&c, v[0], v[1], v[2], w) < CF_LSQ_HUGE_OBJ)
-            memcpy(v, w, sizeof w);
-        c.stat_tol = tol;
+        if (long_table)
+            sc.stat_tol = LONG_TOL / (double)(sc.n - 3);
+        cf_fit_stage_a(g, v, long_table ? found : NULL, &nfound);
+        sc.stat_tol = 0;
+        if (long_table) {
+            cf_fit_stage_a_polish(&c, found, nfound, v);
+        } else {
+            /* the starts stopped at the statistical tolerance; the best is polished to the
+            ** strict rule, so that a short table's fit is its optimum to rounding */
+            double w[3];
+            const double tol = c.stat_tol;
+            c.stat_tol = 0;
+            c.crawl_stop = 1;
+            if (cf_fit_lm_run(&c, v[0], v[1], v[2], w) < CF_LSQ_HUGE_OBJ)
+                memcpy(v, w, sizeof w);
+            c.crawl_stop = 0;
+            c.stat_tol = tol;
+        }
+    }
+    if (share && !shared->have && !c.oom && !sc.oom) {
+        shared->have = 1;
+        shared->data = data;
+        shared->opt = *opt;
+        memcpy(shared->v, v, sizeof v);
     }
     unsigned held_a = 0; /* the limits that keep the type from stage A's optimum */
     if (c.region) {

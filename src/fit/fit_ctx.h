@@ -76,6 +76,8 @@ typedef struct fit_ctx {
     long evals;
     double stat_tol; /* LONG_TOL/(rows - 3) in a fit (0: placement alone): a local search stops
                      ** once a step lowers the objective by less than this fraction of it */
+    int crawl_stop;  /* 1 in a short table's strict polish of stage A: it stops at the statistical
+                     ** tolerance below rho_min (cf_fit_lm_run) */
     /* stage B/C: free parameters */
     int nfree;
     int free_idx[CF_P_COUNT];

@@ -124,6 +124,16 @@ static int lm_df(const gsl_vector *th, void *params, gsl_matrix *J)
     return GSL_SUCCESS;
 }
 
+/* Whether the position th of stage A's Levenberg-Marquardt lies below rho_min (outside the limits
+** of every type). */
+static int below_rho_min(const gsl_vector *th, void *arg)
+{
+    const fit_ctx *c = arg;
+    double rho, B, A;
+    unpack3(c, th, &rho, &B, &A);
+    return rho < c->opt->rho_min;
+}
+
 double cf_fit_lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3])
 {
     gsl_multifit_nlinear_parameters fp = cf_lm_parameters();
@@ -155,6 +165,15 @@ double cf_fit_lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3
         if (c->stat_tol > 0) {
             stop.stall = LM_STALL_LONG;
             stop.stall_rel = c->stat_tol;
+        } else if (c->crawl_stop && c->region && c->n > 3) {
+            /* the strict polish: where it crawls below rho_min (an optimum at the bound of rho,
+            ** at infinity in the logit coordinate: 300 steps that each gain a millionth of the
+            ** residual variance), every type fits again under its limits and this point only
+            ** says that it lies outside them: there the statistical rule stops it */
+            stop.outside = below_rho_min;
+            stop.outside_arg = c;
+            stop.outside_rel = LONG_TOL / (double)(c->n - 3);
+            stop.outside_stall = LM_STALL_LONG;
         }
         if (cf_lm_iterate(w, &stop) != 0)
             c->oom = 1;

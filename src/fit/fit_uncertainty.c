@@ -84,7 +84,9 @@ void cf_fit_uncertainty(fit_ctx *c, fit_ctx *g, cf_fit_result *res, unsigned hel
         .hi_bit = {(g->type == CF_TELESCOPING && !g->region) ? CF_C_TYPE : CF_C_DIAMETERS,
                    CF_C_BOUNDS, CF_C_BOUNDS},
         .at = profile_at,
-        .closed = profile_closed};
+        .closed = profile_closed,
+        .with_rss0 = 1,
+        .rss0 = rss0};
     cf_profile_intervals(&p, v, cf_profile_limit(c->n, rss0, c->ynorm), why, res);
     g->inside = REGION_SAFETY;
 }

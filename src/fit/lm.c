@@ -40,7 +40,7 @@ int cf_lm_iterate(gsl_multifit_nlinear_workspace *w, const cf_lm_stop *stop)
     gsl_vector *f = gsl_multifit_nlinear_residual(w);
     double prev;
     gsl_blas_ddot(f, f, &prev);
-    int stall = 0;
+    int stall = 0, out_stall = 0;
     const int win = stop->ceiling > 0 && stop->ceiling_iter > 0 &&
                             stop->ceiling_iter <= CF_LM_CEILING_ITER_MAX
                         ? stop->ceiling_iter
@@ -59,8 +59,12 @@ int cf_lm_iterate(gsl_multifit_nlinear_workspace *w, const cf_lm_stop *stop)
         double cur;
         gsl_blas_ddot(f, f, &cur);
         stall = (prev - cur <= stop->stall_rel * prev) ? stall + 1 : 0;
+        out_stall = (prev - cur <= stop->outside_rel * prev) ? out_stall + 1 : 0;
         prev = cur;
         if (stall >= stop->stall || cur <= stop->floor)
+            break;
+        if (stop->outside && out_stall >= stop->outside_stall &&
+            stop->outside(gsl_multifit_nlinear_position(w), stop->outside_arg))
             break;
         if (win) {
             if (it >= win && cur > stop->ceiling &&

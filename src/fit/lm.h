@@ -39,6 +39,14 @@ typedef struct cf_lm_stop {
     double ceiling;
     int ceiling_iter;
     double ceiling_rel;
+    /* A run whose result is not kept where it lands outside limits that hold every spring (the
+    ** caller then fits again under them) also stops once outside(x, outside_arg) is 1 at its
+    ** position and its sum of squares has fallen by less than outside_rel of itself in
+    ** outside_stall iterations in a row. NULL: no such rule. */
+    int (*outside)(const gsl_vector *x, void *arg);
+    void *outside_arg;
+    double outside_rel;
+    int outside_stall;
 } cf_lm_stop;
 
 /* Iterates an initialised workspace until a rule of stop fires or an iteration fails. Returns 0,

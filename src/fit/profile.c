@@ -17,6 +17,18 @@ double cf_profile_limit(size_t n, double rss, double ynorm)
     return rss + cf_lsq_f95(dof) * s2;
 }
 
+/* The rise of the profile f above the fitted RSS, as its square root: near the value the profile
+** is a parabola in u, so this is nearly linear in u and a straight line through two of its points
+** lands close to the end (on the RSS itself false position crept to the end from one side, and
+** every point outside the interval costs a second search: measured, 8 to 16 points an end). NAN
+** without rss0 or beyond the searches' admissible set. */
+static double rise(const cf_profile *p, double f)
+{
+    if (!p->with_rss0 || !(f < CF_LSQ_HUGE_OBJ) || !isfinite(f))
+        return NAN;
+    return sqrt(fmax(f - p->rss0, 0.0));
+}
+
 /* One end of the profile interval of quantity k (dir = -1 low, +1 high), in log units from the
 ** value v[k]; res receives the end and the bit of the bound it reached. */
 static void profile_end(const cf_profile *p, int k, const double v[3], double limit, int dir,
@@ -28,10 +40,12 @@ static void profile_end(const cf_profile *p, int k, const double v[3], double li
         xin[j++] = log(v[0]);
     if (k != 1)
         xin[j] = v[1];
-    double u_in = log(v[k]), u_out = NAN, f_in = NAN, f_out = NAN;
+    const double u0 = log(v[k]);
+    const double r_lim = rise(p, limit);
+    double u_in = u0, u_out = NAN, f_in = p->with_rss0 ? p->rss0 : NAN, f_out = NAN;
     unsigned end_bit = 0;
     int done = 0, infeasible = 0;
-    for (int it = 0; it < 60 && !done; it++, h *= 2) {
+    for (int it = 0; it < 60 && !done; it++) {
         double u = u_in + dir * h;
         int at_bound = 0;
         if (dir < 0 && u <= p->lo[k]) {
@@ -49,6 +63,7 @@ static void profile_end(const cf_profile *p, int k, const double v[3], double li
                 end_bit = dir < 0 ? p->lo_bit[k] : p->hi_bit[k];
                 done = 1;
             }
+            h *= 2;
         } else {
             u_out = u;
             f_out = f;
@@ -60,12 +75,15 @@ static void profile_end(const cf_profile *p, int k, const double v[3], double li
         /* to 1e-4 in log units (times |log v|) or 1 % of the end's distance from the value,
         ** whichever is finer: the first alone returned the value itself for every interval
         ** narrower than that (a precise table, a long one, collapsed to [value, value]). The
-        ** bracket shrinks by false position on the profile's values where both ends have one
-        ** (bisection otherwise, and after two steps in a row on the same side), each point kept
-        ** half the tolerance inside the bracket: once the estimate is good, the next point lands
-        ** on the far side of the end and closes the bracket to the tolerance. */
-        const double u0 = log(v[k]);
+        ** bracket shrinks by false position where both ends have a value. Where the fitted RSS
+        ** is known, on the square root of the profile's rise (the Illinois rule against
+        ** creeping from one side, bisection after four steps in a row on the same side), each
+        ** point kept 0.9 of the tolerance inside the bracket: an estimate that close to one
+        ** side is tried that far from it, and either outcome closes the bracket there.
+        ** Otherwise on the RSS itself (bisection after two steps on the same side), each point
+        ** half the tolerance inside. */
         int same = 0, last = 0;
+        double r_in = rise(p, f_in), r_out = rise(p, f_out);
         for (int it = 0; it < 60; it++) {
             const double tol = fmax(fmin(1e-4 * fmax(1.0, fabs(u_in)), 1e-2 * fabs(u_out - u0)),
                                     1e-15);
@@ -73,9 +91,18 @@ static void profile_end(const cf_profile *p, int k, const double v[3], double li
             if (!(fabs(w) > tol))
                 break;
             double t = 0.5;
-            if (isfinite(f_in) && f_out < CF_LSQ_HUGE_OBJ && f_out > f_in && same < 2)
+            if (p->with_rss0 && r_out > r_in && r_lim >= r_in && same < 4) {
+                t = (r_lim - r_in) / (r_out - r_in);
+                const double tt = 0.9 * tol / fabs(w);
+                if (t < tt)
+                    t = tt;
+                else if (t > 1 - tt)
+                    t = 1 - tt;
+            } else if (!p->with_rss0 && isfinite(f_in) && f_out < CF_LSQ_HUGE_OBJ &&
+                       f_out > f_in && same < 2) {
                 t = fmin(fmax((limit - f_in) / (f_out - f_in), 0.5 * tol / fabs(w)),
                          1 - 0.5 * tol / fabs(w));
+            }
             double u = u_in + t * w;
             double f = p->at(p->ctx, k, u, limit, xin);
             const int side = f <= limit ? 1 : 2;
@@ -86,10 +113,18 @@ static void profile_end(const cf_profile *p, int k, const double v[3], double li
             if (f <= limit) {
                 u_in = u;
                 f_in = f;
+                r_in = rise(p, f);
+                /* the Illinois rule: an end kept twice in a row has its rise drawn halfway
+                ** towards the threshold, so that the next line falls beyond the end */
+                if (same >= 2)
+                    r_out = r_lim + 0.5 * (r_out - r_lim);
             } else {
                 u_out = u;
                 f_out = f;
+                r_out = rise(p, f);
                 infeasible = f >= CF_LSQ_HUGE_OBJ;
+                if (same >= 2)
+                    r_in = r_lim - 0.5 * (r_lim - r_in);
             }
         }
         if (infeasible) /* the end is where the type's limits close, not the threshold */

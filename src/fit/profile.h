@@ -21,6 +21,10 @@ typedef struct cf_profile {
     double (*at)(void *ctx, int k, double u, double limit, double *x);
     /* the CF_C_* bit of the limit that closes where the profile of k has no admissible point */
     unsigned (*closed)(void *ctx, int k, double u, const double *x);
+    /* with_rss0 = 1: rss0 is the RSS at the fitted value, and the ends are searched on the
+    ** square root of the profile's rise above it (nearly linear in u), not on the RSS itself */
+    int with_rss0;
+    double rss0;
 } cf_profile;
 
 /* The weighted RSS a profile may reach: rss plus F(0.95; 1, n - 3) times the residual variance

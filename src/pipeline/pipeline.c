@@ -250,12 +250,15 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
                                 fmax(0.0, floor(opt->budget.max_work / each / types) -
                                               VALIDATE_SCAN_SOLVES));
     }
+    cf_fit_shared shared; /* the types' common stage A (fit.h) */
+    memset(&shared, 0, sizeof shared);
     for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING; ty++) {
         if (!(opt->types & (1u << ty)))
             continue;
         progress(opt, t, "fitting the %s spring", cf_spring_type_name((cf_spring_type)ty));
         cf_error e = {0};
-        cf_status st = cf_fit_run(t, &opt->fit, (cf_spring_type)ty, &r->fits[r->nfits], &e);
+        cf_status st = cf_fit_run_shared(t, &opt->fit, (cf_spring_type)ty, &shared,
+                                         &r->fits[r->nfits], &e);
         if (st == CF_OK)
             st = limit_cost(t, opt, &r->fits[r->nfits], &r->limit_cost[r->nfits], &e);
         if (st == CF_OK && opt->fit.law != CF_FAMILY_CONICAL && !through_lattice(t, opt)) {

@@ -42,9 +42,11 @@ static int fit_once(const cf_table *t, size_t subsample_above, fast_run *out)
     cf_error err = {0};
     double w0 = bench_now(), c0 = bench_cpu_now();
     int ok = 1;
+    cf_fit_shared shared; /* as the command shares stage A between the types */
+    memset(&shared, 0, sizeof shared);
     for (int ty = 0; ty < 2 && ok; ty++) {
         cf_fit_result r;
-        ok = cf_fit_run(t, &o, (cf_spring_type)ty, &r, &err) == CF_OK;
+        ok = cf_fit_run_shared(t, &o, (cf_spring_type)ty, &shared, &r, &err) == CF_OK;
         if (ok)
             out->rmse[ty] = r.rmse;
     }

@@ -179,6 +179,24 @@ typedef struct cf_fit_result {
 cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                      cf_fit_result *res, cf_error *err);
 
+/* What the fits of the two types of one table share. For a stress-strain table with no fixed
+** parameter both types search the same range of the three identifiable quantities, so stage A's
+** optimum over every spring (its grid, Levenberg-Marquardt and polish) is the same for both; the
+** first fit keeps it here and the second starts from it. Zero it before the first fit of a
+** table; it holds no allocation. */
+typedef struct cf_fit_shared {
+    int have;              /* 1 once a fit has kept its stage A here */
+    const cf_table *data;  /* the table and the options it was found with */
+    cf_fit_options opt;
+    double v[3];           /* stage A's optimum (rho, B, A) */
+} cf_fit_shared;
+
+/* cf_fit_run, with stage A taken from shared when it was found there for the same table and
+** options, and kept there otherwise (shared may be NULL: cf_fit_run). The result is the one
+** cf_fit_run gives, bit for bit; only its evaluations count no more than the call's own. */
+cf_status cf_fit_run_shared(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
+                            cf_fit_shared *shared, cf_fit_result *res, cf_error *err);
+
 /* Fits the conical-tail law (one type): its four identifiable quantities by a grid and
 ** Levenberg-Marquardt, their standard errors, and a spring of the type placed in closed form at
 ** the preferred free length (src/fit/fit_tail.c). plain (may be NULL) is the plain law's fit of the
