@@ -376,6 +376,8 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
             return settled(s, &fm, a);
         double an = next_stretch(&b, a, r, tangent(c, s, kT, fm.zero, fm.free_mask));
         if (fabs(an - a) <= 2 * DBL_EPSILON * fabs(a)) {
+            if (an == a) /* the state just evaluated is the one it would place again */
+                return settled(s, &fm, a);
             a = an;
             place(m, e, a, F);
             if ((st = evaluate(c, F, extra, s, kT, &e1)) != CF_OK)
