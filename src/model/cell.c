@@ -83,6 +83,7 @@ cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
     c->law_scale = 1.0;
     c->law_scale_strain = 0.0;
     c->stretch_hint = 0.0;
+    c->linear_finish = 0;
     memcpy(c->weight, weight, sizeof c->weight);
     return CF_OK;
 }
@@ -297,6 +298,47 @@ static cf_status settled(cf_cell_state *s, const mode_form *fm, double a)
     return CF_OK;
 }
 
+/* A last Newton step relative to the stretch up to which the solve may take it by linearisation
+** (c->linear_finish): the state's second-order change over it is below 1e-20 of the state. */
+#define LINEAR_STEP 1e-10
+
+/* The state at free stretch a + da from s, evaluated at a, to first order in da (s->F diagonal, as
+** every mode with a free stretch places it): each spring's length and tension move along dL/da
+** and dT/dL, the diagonal stress along its tangent (as tangent() gives it). */
+static cf_status settle_linear(const cf_cell *c, const mode_form *fm,
+                               const double kT[CF_CELL_DIRS], cf_cell_state *s, double a,
+                               double da)
+{
+    const double H = c->law->p.H_mm, H3 = H * H * H;
+    double dP[3] = {0, 0, 0}, umax = 0;
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        const int *N = dirs[d];
+        const double X[3] = {H * N[0], H * N[1], H * N[2]};
+        const double L = s->L_mm[d], T = s->T_N[d];
+        double xX = 0; /* sum over the free entries of x_k X_k, which is L dL/da */
+        for (int k = 0; k < 3; k++)
+            if (fm->free_mask & (1u << k))
+                xX += s->F[4 * k] * X[k] * X[k];
+        for (int m = 0; m < 3; m++) {
+            dP[m] += (kT[d] - T / L) * s->F[4 * m] * X[m] * X[m] * xX / (L * L * H3);
+            if (fm->free_mask & (1u << m))
+                dP[m] += T * X[m] * X[m] / (L * H3);
+        }
+        const double dL = xX / L * da;
+        s->L_mm[d] = L + dL;
+        s->T_N[d] = T + kT[d] * dL;
+        const double L0 = H * dir_len[d];
+        umax = fmax(umax, fabs(H * (L0 - s->L_mm[d]) / L0) / c->law->travel_mm);
+    }
+    for (int m = 0; m < 3; m++) {
+        s->P_MPa[m][m] += dP[m] * da;
+        if (fm->free_mask & (1u << m))
+            s->F[4 * m] = a + da;
+    }
+    s->max_u_over_travel = umax;
+    return settled(s, fm, a + da);
+}
+
 /* The rounding level of the lateral stress of state s: its largest term, MPa. */
 static double lateral_rounding(const cf_cell *c, const cf_cell_state *s)
 {
@@ -357,10 +399,12 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
     double a = c->stretch_hint > 0 ? c->stretch_hint : guess(c, m, e);
     a = fmin(fmax(a, b.lo + 1e-3 * sH), b.hi - 1e-3 * sH);
     cf_error e1 = {0};
+    double newton_before = 0; /* the Newton step that led to a, 0 when a came otherwise */
     for (int it = 0; it < MAX_ITER; it++) {
         place(m, e, a, F);
         st = evaluate(c, F, extra, s, kT, &e1);
         if (st != CF_OK) {
+            newton_before = 0;
             /* outside the domain: move halfway back toward the bracket's inside */
             if (a > 1)
                 b.hi = a;
@@ -374,7 +418,8 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
         double r = s->P_MPa[fm.zero][fm.zero];
         if (fabs(r) <= lateral_rounding(c, s))
             return settled(s, &fm, a);
-        double an = next_stretch(&b, a, r, tangent(c, s, kT, fm.zero, fm.free_mask));
+        const double g = tangent(c, s, kT, fm.zero, fm.free_mask);
+        double an = next_stretch(&b, a, r, g);
         if (fabs(an - a) <= 2 * DBL_EPSILON * fabs(a)) {
             if (an == a) /* the state just evaluated is the one it would place again */
                 return settled(s, &fm, a);
@@ -384,6 +429,16 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
                 break;
             return settled(s, &fm, a);
         }
+        /* Newton's error after this step is about C da^2, with C = |da| / db^2 from the step db
+        ** before it: when that is below rounding and da small enough for the state to be linear
+        ** in it, the state at an comes from the linearisation at a */
+        const double da = an - a;
+        const int newton = g > 0 && an == a - r / g;
+        if (c->linear_finish && newton && newton_before != 0 &&
+            fabs(da) <= LINEAR_STEP * fabs(a) &&
+            fabs(da) * da * da <= DBL_EPSILON * fabs(a) * newton_before * newton_before)
+            return settle_linear(c, &fm, kT, s, a, da);
+        newton_before = newton ? da : 0;
         a = an;
     }
     if (st == CF_OK && s->P_MPa[fm.zero][fm.zero] == 0)

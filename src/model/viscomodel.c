@@ -223,6 +223,7 @@ static cf_status cell_path(const cf_visco_params *p, const cf_visco_setup *s, co
         free(r);
         return st;
     }
+    r->cell.linear_finish = 1; /* the state to first order in the solve's last, tiny step */
     r->law = law;
     r->method = s->method;
     r->p = p;
