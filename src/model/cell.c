@@ -60,6 +60,9 @@ static const int dirs[CF_CELL_DIRS][3] = {
 static const double dir_len[CF_CELL_DIRS] = {1,     SQRT2, 1, SQRT2, SQRT3, SQRT2, SQRT3,
                                              SQRT2, 1,     SQRT2, SQRT3, SQRT2, SQRT3};
 static const int dir_family[CF_CELL_DIRS] = {0, 1, 0, 1, 2, 1, 2, 1, 0, 1, 2, 1, 2};
+/* The first direction whose offsets differ from d's in sign only: under a diagonal F it has d's
+** length to the bit, so the search for a spring alike tries it first. */
+static const int dir_mirror[CF_CELL_DIRS] = {0, 1, 2, 1, 4, 5, 4, 7, 8, 7, 4, 5, 4};
 
 void cf_cell_direction(int d, int N[3], int *family)
 {
@@ -158,9 +161,11 @@ static cf_status evaluate(const cf_cell *c, const double F[9], const cf_cell_ext
         for (int i = 0; i < 3; i++)
             xv[i] = F[3 * i] * X[0] + F[3 * i + 1] * X[1] + F[3 * i + 2] * X[2];
         L2[d] = xv[0] * xv[0] + xv[1] * xv[1] + xv[2] * xv[2];
-        int e = 0;
-        while (e < d && !same_spring(x, L2, d, e))
-            e++;
+        /* any earlier spring alike gives the same results, so which one is found does not matter */
+        int e = dir_mirror[d];
+        if (!(e < d && same_spring(x, L2, d, e)))
+            for (e = 0; e < d && !same_spring(x, L2, d, e);)
+                e++;
         if (e < d) { /* the same spring state as e: its results, bit for bit */
             s->L_mm[d] = s->L_mm[e];
             s->T_N[d] = s->T_N[e];
@@ -221,7 +226,9 @@ cf_status cf_cell_tangent(const cf_cell *c, const double F[9], const cf_cell_ext
 }
 
 /* dP[m][m] / dF[k][k] summed over the diagonal entries k whose bit is set in kmask, at state s:
-** dP_ij/dF_kl = (1/H^3) sum_d [(dT/dL - T/L) x_i X_j x_k X_l / L^2 + T delta_ik X_j X_l / L]. */
+** dP_ij/dF_kl = (1/H^3) sum_d [(dT/dL - T/L) x_i X_j x_k X_l / L^2 + T delta_ik X_j X_l / L].
+** The terms of a direction with X_m = 0 or X_k = 0 are zeros (each has the factor X_m X_k) and are
+** not summed: a zero added leaves the sum as it is. */
 static double tangent(const cf_cell *c, const cf_cell_state *s, const double kT[CF_CELL_DIRS],
                       int m, unsigned kmask)
 {
@@ -229,12 +236,14 @@ static double tangent(const cf_cell *c, const cf_cell_state *s, const double kT[
     double g = 0;
     for (int d = 0; d < CF_CELL_DIRS; d++) {
         const int *N = dirs[d];
+        if (N[m] == 0)
+            continue;
         double X[3] = {H * N[0], H * N[1], H * N[2]}, xv[3];
         for (int i = 0; i < 3; i++)
             xv[i] = s->F[3 * i] * X[0] + s->F[3 * i + 1] * X[1] + s->F[3 * i + 2] * X[2];
         double L = s->L_mm[d], T = s->T_N[d];
         for (int k = 0; k < 3; k++) {
-            if (!(kmask & (1u << k)))
+            if (!(kmask & (1u << k)) || N[k] == 0)
                 continue;
             g += (kT[d] - T / L) * xv[m] * X[m] * xv[k] * X[k] / (L * L * H3);
             if (k == m)
@@ -343,8 +352,10 @@ static cf_status settle_linear(const cf_cell *c, const mode_form *fm,
 static double lateral_rounding(const cf_cell *c, const cf_cell_state *s)
 {
     double rs = 0;
-    for (int d = 0; d < CF_CELL_DIRS; d++)
-        rs = fmax(rs, fabs(s->T_N[d]));
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        const double t = fabs(s->T_N[d]);
+        rs = t > rs ? t : rs; /* as fmax, without its call */
+    }
     return rs * (8 * DBL_EPSILON / (c->law->p.H_mm * c->law->p.H_mm));
 }
 
