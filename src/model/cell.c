@@ -95,7 +95,7 @@ cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
 ** same length, to the bit), the same weight and the same extra terms. Springs that a
 ** deformation maps alike (the four body diagonals under a diagonal F, the lateral edges under
 ** uniaxial loading) then share one evaluation of the law instead of repeating it. */
-static int same_spring(const cf_cell_extra *x, const double *L2, int d, int e)
+static inline int same_spring(const cf_cell_extra *x, const double *L2, int d, int e)
 {
     return L2[e] == L2[d] && dir_family[e] == dir_family[d] &&
            (!x || (x->T0_N[e] == x->T0_N[d] && x->k_N_per_mm[e] == x->k_N_per_mm[d] &&
@@ -155,11 +155,16 @@ static cf_status evaluate(const cf_cell *c, const double F[9], const cf_cell_ext
         if (!isfinite(F[i]))
             return cf_error_set(err, CF_E_DATA, "deformation gradient F[%d][%d] = %g is not "
                                 "finite", i / 3, i % 3, F[i]);
+    /* A diagonal F (every mode but shear places one) maps each offset axis by axis, x_i = F_ii X_i
+    ** (the products with its zeros are zeros, which leave a sum as it is), and every term of P
+    ** with X_i = 0 or X_j = 0 is a zero, not summed: the same state to the bit, with less work. */
+    const int diag = F[1] == 0 && F[2] == 0 && F[3] == 0 && F[5] == 0 && F[6] == 0 && F[7] == 0;
     for (int d = 0; d < CF_CELL_DIRS; d++) {
         const int *N = dirs[d];
         double X[3] = {H * N[0], H * N[1], H * N[2]}, xv[3];
         for (int i = 0; i < 3; i++)
-            xv[i] = F[3 * i] * X[0] + F[3 * i + 1] * X[1] + F[3 * i + 2] * X[2];
+            xv[i] = diag ? F[4 * i] * X[i]
+                         : F[3 * i] * X[0] + F[3 * i + 1] * X[1] + F[3 * i + 2] * X[2];
         L2[d] = xv[0] * xv[0] + xv[1] * xv[1] + xv[2] * xv[2];
         /* any earlier spring alike gives the same results, so which one is found does not matter */
         int e = dir_mirror[d];
@@ -179,9 +184,14 @@ static cf_status evaluate(const cf_cell *c, const double F[9], const cf_cell_ext
                 return st;
             q[d] = s->T_N[d] / (s->L_mm[d] * H3); /* one division per spring, not per term */
         }
-        for (int i = 0; i < 3; i++)
+        for (int i = 0; i < 3; i++) {
+            if (diag && N[i] == 0)
+                continue;
+            const double qx = q[d] * xv[i];
             for (int j = 0; j < 3; j++)
-                P[i][j] += q[d] * xv[i] * X[j];
+                if (!diag || N[j] != 0)
+                    P[i][j] += qx * X[j];
+        }
     }
     memcpy(s->P_MPa, P, sizeof P);
     return CF_OK;
@@ -337,7 +347,8 @@ static cf_status settle_linear(const cf_cell *c, const mode_form *fm,
         s->L_mm[d] = L + dL;
         s->T_N[d] = T + kT[d] * dL;
         const double L0 = H * dir_len[d];
-        umax = fmax(umax, fabs(H * (L0 - s->L_mm[d]) / L0) / c->law->travel_mm);
+        const double ru = fabs(H * (L0 - s->L_mm[d]) / L0) / c->law->travel_mm;
+        umax = ru > umax ? ru : umax;
     }
     for (int m = 0; m < 3; m++) {
         s->P_MPa[m][m] += dP[m] * da;
