@@ -243,21 +243,35 @@ static double tangent(const cf_cell *c, const cf_cell_state *s, const double kT[
                       int m, unsigned kmask)
 {
     const double H = c->law->p.H_mm, H3 = H * H * H;
-    double g = 0;
+    const double *F = s->F;
+    const int diag = F[1] == 0 && F[2] == 0 && F[3] == 0 && F[5] == 0 && F[6] == 0 && F[7] == 0;
+    double g = 0, t1[CF_CELL_DIRS][3], t2[CF_CELL_DIRS];
     for (int d = 0; d < CF_CELL_DIRS; d++) {
         const int *N = dirs[d];
         if (N[m] == 0)
             continue;
-        double X[3] = {H * N[0], H * N[1], H * N[2]}, xv[3];
-        for (int i = 0; i < 3; i++)
-            xv[i] = s->F[3 * i] * X[0] + s->F[3 * i + 1] * X[1] + s->F[3 * i + 2] * X[2];
         double L = s->L_mm[d], T = s->T_N[d];
+        /* under a diagonal F each term has x_i X_i, the same for a mirrored direction in the same
+        ** state: its terms, bit for bit */
+        const int e = dir_mirror[d];
+        if (diag && e < d && s->L_mm[e] == L && s->T_N[e] == T && kT[e] == kT[d]) {
+            memcpy(t1[d], t1[e], sizeof t1[d]);
+            t2[d] = t2[e];
+        } else {
+            double X[3] = {H * N[0], H * N[1], H * N[2]}, xv[3];
+            for (int i = 0; i < 3; i++)
+                xv[i] = F[3 * i] * X[0] + F[3 * i + 1] * X[1] + F[3 * i + 2] * X[2];
+            for (int k = 0; k < 3; k++)
+                if ((kmask & (1u << k)) && N[k] != 0)
+                    t1[d][k] = (kT[d] - T / L) * xv[m] * X[m] * xv[k] * X[k] / (L * L * H3);
+            t2[d] = T * X[m] * X[m] / (L * H3);
+        }
         for (int k = 0; k < 3; k++) {
             if (!(kmask & (1u << k)) || N[k] == 0)
                 continue;
-            g += (kT[d] - T / L) * xv[m] * X[m] * xv[k] * X[k] / (L * L * H3);
+            g += t1[d][k];
             if (k == m)
-                g += T * X[m] * X[m] / (L * H3);
+                g += t2[d];
         }
     }
     return g;
@@ -330,22 +344,39 @@ static cf_status settle_linear(const cf_cell *c, const mode_form *fm,
 {
     const double H = c->law->p.H_mm, H3 = H * H * H;
     double dP[3] = {0, 0, 0}, umax = 0;
+    double t1[CF_CELL_DIRS][3], t2[CF_CELL_DIRS][3], Ln[CF_CELL_DIRS], Tn[CF_CELL_DIRS];
     for (int d = 0; d < CF_CELL_DIRS; d++) {
         const int *N = dirs[d];
-        const double X[3] = {H * N[0], H * N[1], H * N[2]};
         const double L = s->L_mm[d], T = s->T_N[d];
-        double xX = 0; /* sum over the free entries of x_k X_k, which is L dL/da */
-        for (int k = 0; k < 3; k++)
-            if (fm->free_mask & (1u << k))
-                xX += s->F[4 * k] * X[k] * X[k];
-        for (int m = 0; m < 3; m++) {
-            dP[m] += (kT[d] - T / L) * s->F[4 * m] * X[m] * X[m] * xX / (L * L * H3);
-            if (fm->free_mask & (1u << m))
-                dP[m] += T * X[m] * X[m] / (L * H3);
+        const int e = dir_mirror[d]; /* every term has X_i X_i: a mirror in the same state's */
+        if (e < d && s->L_mm[e] == L && s->T_N[e] == T && kT[e] == kT[d]) {
+            memcpy(t1[d], t1[e], sizeof t1[d]);
+            memcpy(t2[d], t2[e], sizeof t2[d]);
+            Ln[d] = Ln[e];
+            Tn[d] = Tn[e];
+        } else {
+            const double X[3] = {H * N[0], H * N[1], H * N[2]};
+            double xX = 0; /* sum over the free entries of x_k X_k, which is L dL/da */
+            for (int k = 0; k < 3; k++)
+                if (fm->free_mask & (1u << k))
+                    xX += s->F[4 * k] * X[k] * X[k];
+            for (int m = 0; m < 3; m++) {
+                t1[d][m] = (kT[d] - T / L) * s->F[4 * m] * X[m] * X[m] * xX / (L * L * H3);
+                t2[d][m] = T * X[m] * X[m] / (L * H3);
+            }
+            const double dL = xX / L * da;
+            Ln[d] = L + dL;
+            Tn[d] = T + kT[d] * dL;
         }
-        const double dL = xX / L * da;
-        s->L_mm[d] = L + dL;
-        s->T_N[d] = T + kT[d] * dL;
+        for (int m = 0; m < 3; m++) {
+            dP[m] += t1[d][m];
+            if (fm->free_mask & (1u << m))
+                dP[m] += t2[d][m];
+        }
+    }
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        s->L_mm[d] = Ln[d];
+        s->T_N[d] = Tn[d];
         const double L0 = H * dir_len[d];
         const double ru = fabs(H * (L0 - s->L_mm[d]) / L0) / c->law->travel_mm;
         umax = ru > umax ? ru : umax;

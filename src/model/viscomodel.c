@@ -81,6 +81,7 @@ typedef struct cell_run {
     const cf_visco_params *p;
     double H;                          /* cell edge, mm */
     double L0[CF_CELL_DIRS], w[CF_CELL_DIRS];
+    int mirror[CF_CELL_DIRS];          /* the first direction whose offsets differ in sign only */
     double h[CF_CELL_DIRS][CF_PRONY_MAX];
     double Fprev[CF_CELL_DIRS], Lprev[CF_CELL_DIRS];
     cf_cell_state st;                  /* the current state */
@@ -134,7 +135,22 @@ static cf_status cell_step(cell_run *r, double dt, double e, cf_error *err)
     const double H = r->H, visc = dt > 0 ? p->eta_MPa_s / dt : 0;
     cf_cell_extra x;
     double e0[CF_CELL_DIRS]; /* each spring's |strain| at the start of the step */
+    /* alike[d]: d starts the step in the state of its mirror (the same length, force and branch
+    ** forces, the same rest length and weight), so every quantity of the step is the mirror's to
+    ** the bit and is copied */
+    int alike[CF_CELL_DIRS];
     for (int d = 0; d < CF_CELL_DIRS; d++) {
+        const int m = r->mirror[d];
+        alike[d] = m < d && r->Lprev[m] == r->Lprev[d] && r->Fprev[m] == r->Fprev[d];
+        for (int i = 0; i < np && alike[d]; i++)
+            alike[d] = r->h[m][i] == r->h[d][i];
+        if (alike[d]) {
+            e0[d] = e0[m];
+            x.T0_N[d] = x.T0_N[m];
+            x.k_N_per_mm[d] = x.k_N_per_mm[m];
+            x.Lref_mm[d] = x.Lref_mm[m];
+            continue;
+        }
         double c = 0;
         e0[d] = fabs(1 - r->Lprev[d] / r->L0[d]);
         for (int i = 0; i < np && dt > 0; i++)
@@ -173,6 +189,14 @@ static cf_status cell_step(cell_run *r, double dt, double e, cf_error *err)
     }
     double fd[CF_CELL_DIRS];
     for (int d = 0; d < CF_CELL_DIRS; d++) {
+        const int m = r->mirror[d];
+        if (alike[d] && r->st.L_mm[m] == r->st.L_mm[d]) { /* and ends it where its mirror does */
+            fd[d] = fd[m];
+            memcpy(r->h[d], r->h[m], (size_t)np * sizeof r->h[d][0]);
+            r->Fprev[d] = r->Fprev[m];
+            r->Lprev[d] = r->Lprev[m];
+            continue;
+        }
         const double u = H * (1 - r->st.L_mm[d] / r->L0[d]), e1 = fabs(u) / H;
         int same = 0; /* an earlier spring of the same rest and current length: its force */
         while (same < d && !(r->st.L_mm[same] == r->st.L_mm[d] && r->L0[same] == r->L0[d]))
@@ -265,8 +289,14 @@ static cf_status cell_path(const cf_visco_params *p, const cf_visco_setup *s, co
     r->strain_moduli = cf_msm_prony_depends_on_strain(&r->fx);
     r->coef_dt = NAN;
     for (int d = 0; d < CF_CELL_DIRS; d++) {
-        int N[3], fam;
+        int N[3], fam, M[3], mf;
         cf_cell_direction(d, N, &fam);
+        r->mirror[d] = d;
+        for (int e = 0; e < d && r->mirror[d] == d; e++) {
+            cf_cell_direction(e, M, &mf);
+            if (abs(M[0]) == abs(N[0]) && abs(M[1]) == abs(N[1]) && abs(M[2]) == abs(N[2]))
+                r->mirror[d] = e;
+        }
         r->L0[d] = r->H * sqrt((double)(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]));
         r->w[d] = s->cfg.lattice.weight[fam];
         r->Lprev[d] = r->L0[d];
