@@ -60,6 +60,9 @@ static const int dirs[CF_CELL_DIRS][3] = {
 static const double dir_len[CF_CELL_DIRS] = {1,     SQRT2, 1, SQRT2, SQRT3, SQRT2, SQRT3,
                                              SQRT2, 1,     SQRT2, SQRT3, SQRT2, SQRT3};
 static const int dir_family[CF_CELL_DIRS] = {0, 1, 0, 1, 2, 1, 2, 1, 0, 1, 2, 1, 2};
+/* The first direction whose offsets differ from d's in sign only: under a diagonal F it has d's
+** length to the bit, so the search for a spring alike tries it first. */
+static const int dir_mirror[CF_CELL_DIRS] = {0, 1, 2, 1, 4, 5, 4, 7, 8, 7, 4, 5, 4};
 
 void cf_cell_direction(int d, int N[3], int *family)
 {
@@ -83,6 +86,7 @@ cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
     c->law_scale = 1.0;
     c->law_scale_strain = 0.0;
     c->stretch_hint = 0.0;
+    c->linear_finish = 0;
     memcpy(c->weight, weight, sizeof c->weight);
     return CF_OK;
 }
@@ -91,7 +95,7 @@ cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
 ** same length, to the bit), the same weight and the same extra terms. Springs that a
 ** deformation maps alike (the four body diagonals under a diagonal F, the lateral edges under
 ** uniaxial loading) then share one evaluation of the law instead of repeating it. */
-static int same_spring(const cf_cell_extra *x, const double *L2, int d, int e)
+static inline int same_spring(const cf_cell_extra *x, const double *L2, int d, int e)
 {
     return L2[e] == L2[d] && dir_family[e] == dir_family[d] &&
            (!x || (x->T0_N[e] == x->T0_N[d] && x->k_N_per_mm[e] == x->k_N_per_mm[d] &&
@@ -151,15 +155,22 @@ static cf_status evaluate(const cf_cell *c, const double F[9], const cf_cell_ext
         if (!isfinite(F[i]))
             return cf_error_set(err, CF_E_DATA, "deformation gradient F[%d][%d] = %g is not "
                                 "finite", i / 3, i % 3, F[i]);
+    /* A diagonal F (every mode but shear places one) maps each offset axis by axis, x_i = F_ii X_i
+    ** (the products with its zeros are zeros, which leave a sum as it is), and every term of P
+    ** with X_i = 0 or X_j = 0 is a zero, not summed: the same state to the bit, with less work. */
+    const int diag = F[1] == 0 && F[2] == 0 && F[3] == 0 && F[5] == 0 && F[6] == 0 && F[7] == 0;
     for (int d = 0; d < CF_CELL_DIRS; d++) {
         const int *N = dirs[d];
         double X[3] = {H * N[0], H * N[1], H * N[2]}, xv[3];
         for (int i = 0; i < 3; i++)
-            xv[i] = F[3 * i] * X[0] + F[3 * i + 1] * X[1] + F[3 * i + 2] * X[2];
+            xv[i] = diag ? F[4 * i] * X[i]
+                         : F[3 * i] * X[0] + F[3 * i + 1] * X[1] + F[3 * i + 2] * X[2];
         L2[d] = xv[0] * xv[0] + xv[1] * xv[1] + xv[2] * xv[2];
-        int e = 0;
-        while (e < d && !same_spring(x, L2, d, e))
-            e++;
+        /* any earlier spring alike gives the same results, so which one is found does not matter */
+        int e = dir_mirror[d];
+        if (!(e < d && same_spring(x, L2, d, e)))
+            for (e = 0; e < d && !same_spring(x, L2, d, e);)
+                e++;
         if (e < d) { /* the same spring state as e: its results, bit for bit */
             s->L_mm[d] = s->L_mm[e];
             s->T_N[d] = s->T_N[e];
@@ -173,9 +184,14 @@ static cf_status evaluate(const cf_cell *c, const double F[9], const cf_cell_ext
                 return st;
             q[d] = s->T_N[d] / (s->L_mm[d] * H3); /* one division per spring, not per term */
         }
-        for (int i = 0; i < 3; i++)
+        for (int i = 0; i < 3; i++) {
+            if (diag && N[i] == 0)
+                continue;
+            const double qx = q[d] * xv[i];
             for (int j = 0; j < 3; j++)
-                P[i][j] += q[d] * xv[i] * X[j];
+                if (!diag || N[j] != 0)
+                    P[i][j] += qx * X[j];
+        }
     }
     memcpy(s->P_MPa, P, sizeof P);
     return CF_OK;
@@ -220,24 +236,42 @@ cf_status cf_cell_tangent(const cf_cell *c, const double F[9], const cf_cell_ext
 }
 
 /* dP[m][m] / dF[k][k] summed over the diagonal entries k whose bit is set in kmask, at state s:
-** dP_ij/dF_kl = (1/H^3) sum_d [(dT/dL - T/L) x_i X_j x_k X_l / L^2 + T delta_ik X_j X_l / L]. */
+** dP_ij/dF_kl = (1/H^3) sum_d [(dT/dL - T/L) x_i X_j x_k X_l / L^2 + T delta_ik X_j X_l / L].
+** The terms of a direction with X_m = 0 or X_k = 0 are zeros (each has the factor X_m X_k) and are
+** not summed: a zero added leaves the sum as it is. */
 static double tangent(const cf_cell *c, const cf_cell_state *s, const double kT[CF_CELL_DIRS],
                       int m, unsigned kmask)
 {
     const double H = c->law->p.H_mm, H3 = H * H * H;
-    double g = 0;
+    const double *F = s->F;
+    const int diag = F[1] == 0 && F[2] == 0 && F[3] == 0 && F[5] == 0 && F[6] == 0 && F[7] == 0;
+    double g = 0, t1[CF_CELL_DIRS][3], t2[CF_CELL_DIRS];
     for (int d = 0; d < CF_CELL_DIRS; d++) {
         const int *N = dirs[d];
-        double X[3] = {H * N[0], H * N[1], H * N[2]}, xv[3];
-        for (int i = 0; i < 3; i++)
-            xv[i] = s->F[3 * i] * X[0] + s->F[3 * i + 1] * X[1] + s->F[3 * i + 2] * X[2];
+        if (N[m] == 0)
+            continue;
         double L = s->L_mm[d], T = s->T_N[d];
+        /* under a diagonal F each term has x_i X_i, the same for a mirrored direction in the same
+        ** state: its terms, bit for bit */
+        const int e = dir_mirror[d];
+        if (diag && e < d && s->L_mm[e] == L && s->T_N[e] == T && kT[e] == kT[d]) {
+            memcpy(t1[d], t1[e], sizeof t1[d]);
+            t2[d] = t2[e];
+        } else {
+            double X[3] = {H * N[0], H * N[1], H * N[2]}, xv[3];
+            for (int i = 0; i < 3; i++)
+                xv[i] = F[3 * i] * X[0] + F[3 * i + 1] * X[1] + F[3 * i + 2] * X[2];
+            for (int k = 0; k < 3; k++)
+                if ((kmask & (1u << k)) && N[k] != 0)
+                    t1[d][k] = (kT[d] - T / L) * xv[m] * X[m] * xv[k] * X[k] / (L * L * H3);
+            t2[d] = T * X[m] * X[m] / (L * H3);
+        }
         for (int k = 0; k < 3; k++) {
-            if (!(kmask & (1u << k)))
+            if (!(kmask & (1u << k)) || N[k] == 0)
                 continue;
-            g += (kT[d] - T / L) * xv[m] * X[m] * xv[k] * X[k] / (L * L * H3);
+            g += t1[d][k];
             if (k == m)
-                g += T * X[m] * X[m] / (L * H3);
+                g += t2[d];
         }
     }
     return g;
@@ -297,12 +331,73 @@ static cf_status settled(cf_cell_state *s, const mode_form *fm, double a)
     return CF_OK;
 }
 
+/* A last Newton step relative to the stretch up to which the solve may take it by linearisation
+** (c->linear_finish): the state's second-order change over it is below 1e-20 of the state. */
+#define LINEAR_STEP 1e-10
+
+/* The state at free stretch a + da from s, evaluated at a, to first order in da (s->F diagonal, as
+** every mode with a free stretch places it): each spring's length and tension move along dL/da
+** and dT/dL, the diagonal stress along its tangent (as tangent() gives it). */
+static cf_status settle_linear(const cf_cell *c, const mode_form *fm,
+                               const double kT[CF_CELL_DIRS], cf_cell_state *s, double a,
+                               double da)
+{
+    const double H = c->law->p.H_mm, H3 = H * H * H;
+    double dP[3] = {0, 0, 0}, umax = 0;
+    double t1[CF_CELL_DIRS][3], t2[CF_CELL_DIRS][3], Ln[CF_CELL_DIRS], Tn[CF_CELL_DIRS];
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        const int *N = dirs[d];
+        const double L = s->L_mm[d], T = s->T_N[d];
+        const int e = dir_mirror[d]; /* every term has X_i X_i: a mirror in the same state's */
+        if (e < d && s->L_mm[e] == L && s->T_N[e] == T && kT[e] == kT[d]) {
+            memcpy(t1[d], t1[e], sizeof t1[d]);
+            memcpy(t2[d], t2[e], sizeof t2[d]);
+            Ln[d] = Ln[e];
+            Tn[d] = Tn[e];
+        } else {
+            const double X[3] = {H * N[0], H * N[1], H * N[2]};
+            double xX = 0; /* sum over the free entries of x_k X_k, which is L dL/da */
+            for (int k = 0; k < 3; k++)
+                if (fm->free_mask & (1u << k))
+                    xX += s->F[4 * k] * X[k] * X[k];
+            for (int m = 0; m < 3; m++) {
+                t1[d][m] = (kT[d] - T / L) * s->F[4 * m] * X[m] * X[m] * xX / (L * L * H3);
+                t2[d][m] = T * X[m] * X[m] / (L * H3);
+            }
+            const double dL = xX / L * da;
+            Ln[d] = L + dL;
+            Tn[d] = T + kT[d] * dL;
+        }
+        for (int m = 0; m < 3; m++) {
+            dP[m] += t1[d][m];
+            if (fm->free_mask & (1u << m))
+                dP[m] += t2[d][m];
+        }
+    }
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        s->L_mm[d] = Ln[d];
+        s->T_N[d] = Tn[d];
+        const double L0 = H * dir_len[d];
+        const double ru = fabs(H * (L0 - s->L_mm[d]) / L0) / c->law->travel_mm;
+        umax = ru > umax ? ru : umax;
+    }
+    for (int m = 0; m < 3; m++) {
+        s->P_MPa[m][m] += dP[m] * da;
+        if (fm->free_mask & (1u << m))
+            s->F[4 * m] = a + da;
+    }
+    s->max_u_over_travel = umax;
+    return settled(s, fm, a + da);
+}
+
 /* The rounding level of the lateral stress of state s: its largest term, MPa. */
 static double lateral_rounding(const cf_cell *c, const cf_cell_state *s)
 {
     double rs = 0;
-    for (int d = 0; d < CF_CELL_DIRS; d++)
-        rs = fmax(rs, fabs(s->T_N[d]));
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        const double t = fabs(s->T_N[d]);
+        rs = t > rs ? t : rs; /* as fmax, without its call */
+    }
     return rs * (8 * DBL_EPSILON / (c->law->p.H_mm * c->law->p.H_mm));
 }
 
@@ -357,10 +452,12 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
     double a = c->stretch_hint > 0 ? c->stretch_hint : guess(c, m, e);
     a = fmin(fmax(a, b.lo + 1e-3 * sH), b.hi - 1e-3 * sH);
     cf_error e1 = {0};
+    double newton_before = 0; /* the Newton step that led to a, 0 when a came otherwise */
     for (int it = 0; it < MAX_ITER; it++) {
         place(m, e, a, F);
         st = evaluate(c, F, extra, s, kT, &e1);
         if (st != CF_OK) {
+            newton_before = 0;
             /* outside the domain: move halfway back toward the bracket's inside */
             if (a > 1)
                 b.hi = a;
@@ -374,14 +471,27 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
         double r = s->P_MPa[fm.zero][fm.zero];
         if (fabs(r) <= lateral_rounding(c, s))
             return settled(s, &fm, a);
-        double an = next_stretch(&b, a, r, tangent(c, s, kT, fm.zero, fm.free_mask));
+        const double g = tangent(c, s, kT, fm.zero, fm.free_mask);
+        double an = next_stretch(&b, a, r, g);
         if (fabs(an - a) <= 2 * DBL_EPSILON * fabs(a)) {
+            if (an == a) /* the state just evaluated is the one it would place again */
+                return settled(s, &fm, a);
             a = an;
             place(m, e, a, F);
             if ((st = evaluate(c, F, extra, s, kT, &e1)) != CF_OK)
                 break;
             return settled(s, &fm, a);
         }
+        /* Newton's error after this step is about C da^2, with C = |da| / db^2 from the step db
+        ** before it: when that is below rounding and da small enough for the state to be linear
+        ** in it, the state at an comes from the linearisation at a */
+        const double da = an - a;
+        const int newton = g > 0 && an == a - r / g;
+        if (c->linear_finish && newton && newton_before != 0 &&
+            fabs(da) <= LINEAR_STEP * fabs(a) &&
+            fabs(da) * da * da <= DBL_EPSILON * fabs(a) * newton_before * newton_before)
+            return settle_linear(c, &fm, kT, s, a, da);
+        newton_before = newton ? da : 0;
         a = an;
     }
     if (st == CF_OK && s->P_MPa[fm.zero][fm.zero] == 0)

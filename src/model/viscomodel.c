@@ -81,11 +81,16 @@ typedef struct cell_run {
     const cf_visco_params *p;
     double H;                          /* cell edge, mm */
     double L0[CF_CELL_DIRS], w[CF_CELL_DIRS];
+    int mirror[CF_CELL_DIRS];          /* the first direction whose offsets differ in sign only */
     double h[CF_CELL_DIRS][CF_PRONY_MAX];
     double Fprev[CF_CELL_DIRS], Lprev[CF_CELL_DIRS];
     cf_cell_state st;                  /* the current state */
     int strain_moduli;                 /* 1 when a Prony modulus changes with strain */
+    cf_msm_effects fx;                 /* p's effects (cf_visco_effects) */
     double a_prev, dt_prev;            /* free stretch of the step before, and that step's dt */
+    /* the branches' decay and update factors over a step of length coef_dt (NaN: none yet): the
+    ** steps of one sample interval, and of a series sampled evenly, share them */
+    double coef_dt, pe[CF_PRONY_MAX], pb[CF_PRONY_MAX], alpha, slope;
 } cell_run;
 
 /* Where the lateral solve of a step of length dt starts: the stretch of the step before carried
@@ -113,17 +118,39 @@ static cf_status cell_step(cell_run *r, double dt, double e, cf_error *err)
 {
     const cf_visco_params *p = r->p;
     const int np = p->nbranch;
-    double pe[CF_PRONY_MAX], pb[CF_PRONY_MAX], alpha = 1, slope = 0;
-    for (int i = 0; i < np; i++) {
-        pe[i] = dt > 0 ? exp(-dt / p->tau_s[i]) : 0;
-        pb[i] = dt > 0 ? -expm1(-dt / p->tau_s[i]) * p->tau_s[i] / dt : 0;
-        alpha -= p->g[i] * (1 - pb[i]);
-        slope -= p->k[i] * (1 - pb[i]);
+    double *pe = r->pe, *pb = r->pb;
+    if (!(dt == r->coef_dt)) {
+        double alpha = 1, slope = 0;
+        for (int i = 0; i < np; i++) {
+            pe[i] = dt > 0 ? exp(-dt / p->tau_s[i]) : 0;
+            pb[i] = dt > 0 ? -expm1(-dt / p->tau_s[i]) * p->tau_s[i] / dt : 0;
+            alpha -= p->g[i] * (1 - pb[i]);
+            slope -= p->k[i] * (1 - pb[i]);
+        }
+        r->coef_dt = dt;
+        r->alpha = alpha;
+        r->slope = slope;
     }
+    const double alpha = r->alpha, slope = r->slope;
     const double H = r->H, visc = dt > 0 ? p->eta_MPa_s / dt : 0;
     cf_cell_extra x;
     double e0[CF_CELL_DIRS]; /* each spring's |strain| at the start of the step */
+    /* alike[d]: d starts the step in the state of its mirror (the same length, force and branch
+    ** forces, the same rest length and weight), so every quantity of the step is the mirror's to
+    ** the bit and is copied */
+    int alike[CF_CELL_DIRS];
     for (int d = 0; d < CF_CELL_DIRS; d++) {
+        const int m = r->mirror[d];
+        alike[d] = m < d && r->Lprev[m] == r->Lprev[d] && r->Fprev[m] == r->Fprev[d];
+        for (int i = 0; i < np && alike[d]; i++)
+            alike[d] = r->h[m][i] == r->h[d][i];
+        if (alike[d]) {
+            e0[d] = e0[m];
+            x.T0_N[d] = x.T0_N[m];
+            x.k_N_per_mm[d] = x.k_N_per_mm[m];
+            x.Lref_mm[d] = x.Lref_mm[m];
+            continue;
+        }
         double c = 0;
         e0[d] = fabs(1 - r->Lprev[d] / r->L0[d]);
         for (int i = 0; i < np && dt > 0; i++)
@@ -150,14 +177,26 @@ static cf_status cell_step(cell_run *r, double dt, double e, cf_error *err)
     }
     r->cell.stretch_hint = r->st.free_stretch; /* the next step starts here */
     if (r->strain_moduli) { /* the moduli where the springs went (msm.h) */
-        const cf_msm_effects fx = cf_visco_effects(p);
-        for (int d = 0; d < CF_CELL_DIRS && st == CF_OK; d++)
-            st = cf_msm_prony_at_strain(&fx, fabs(1 - r->st.L_mm[d] / r->L0[d]), err);
+        for (int d = 0; d < CF_CELL_DIRS && st == CF_OK; d++) {
+            int same = 0; /* an earlier spring of the same strain was checked */
+            while (same < d && !(r->st.L_mm[same] == r->st.L_mm[d] && r->L0[same] == r->L0[d]))
+                same++;
+            if (same == d)
+                st = cf_msm_prony_at_strain(&r->fx, fabs(1 - r->st.L_mm[d] / r->L0[d]), err);
+        }
         if (st != CF_OK)
             return st;
     }
     double fd[CF_CELL_DIRS];
     for (int d = 0; d < CF_CELL_DIRS; d++) {
+        const int m = r->mirror[d];
+        if (alike[d] && r->st.L_mm[m] == r->st.L_mm[d]) { /* and ends it where its mirror does */
+            fd[d] = fd[m];
+            memcpy(r->h[d], r->h[m], (size_t)np * sizeof r->h[d][0]);
+            r->Fprev[d] = r->Fprev[m];
+            r->Lprev[d] = r->Lprev[m];
+            continue;
+        }
         const double u = H * (1 - r->st.L_mm[d] / r->L0[d]), e1 = fabs(u) / H;
         int same = 0; /* an earlier spring of the same rest and current length: its force */
         while (same < d && !(r->st.L_mm[same] == r->st.L_mm[d] && r->L0[same] == r->L0[d]))
@@ -208,6 +247,24 @@ static cf_status cell_step_force(cell_run *r, double dt, double target, double e
 }
 
 
+/* cf_msm_path_value(p, t), its search started at segment *from (t past that segment's start,
+** times not decreasing: the segment it would find is then at or after it) and *from moved to the
+** segment found; the same value to the bit. */
+static double path_value_from(const cf_msm_path *p, double t, size_t *from)
+{
+    size_t i = *from;
+    if (!(i >= 1 && i < p->count && t > p->t_s[i - 1]))
+        return cf_msm_path_value(p, t);
+    for (; i < p->count; i++)
+        if (t <= p->t_s[i]) {
+            *from = i;
+            double h = p->t_s[i] - p->t_s[i - 1];
+            double f = h > 0 ? (t - p->t_s[i - 1]) / h : 1.0;
+            return p->value[i - 1] + f * (p->value[i] - p->value[i - 1]);
+        }
+    return p->value[p->count - 1];
+}
+
 /* The model in the cell along a path, stepped as cf_msm_run steps it (quasi_substeps implicit
 ** steps per sample interval, or steps of dt_s), samples as msm.h reports them (compressive
 ** positive). */
@@ -223,20 +280,32 @@ static cf_status cell_path(const cf_visco_params *p, const cf_visco_setup *s, co
         free(r);
         return st;
     }
+    r->cell.linear_finish = 1; /* the state to first order in the solve's last, tiny step */
     r->law = law;
     r->method = s->method;
     r->p = p;
     r->H = law->p.H_mm;
-    const cf_msm_effects fx = cf_visco_effects(p);
-    r->strain_moduli = cf_msm_prony_depends_on_strain(&fx);
+    r->fx = cf_visco_effects(p);
+    r->strain_moduli = cf_msm_prony_depends_on_strain(&r->fx);
+    r->coef_dt = NAN;
     for (int d = 0; d < CF_CELL_DIRS; d++) {
-        int N[3], fam;
+        int N[3], fam, M[3], mf;
         cf_cell_direction(d, N, &fam);
+        r->mirror[d] = d;
+        for (int e = 0; e < d && r->mirror[d] == d; e++) {
+            cf_cell_direction(e, M, &mf);
+            if (abs(M[0]) == abs(N[0]) && abs(M[1]) == abs(N[1]) && abs(M[2]) == abs(N[2]))
+                r->mirror[d] = e;
+        }
         r->L0[d] = r->H * sqrt((double)(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]));
         r->w[d] = s->cfg.lattice.weight[fam];
         r->Lprev[d] = r->L0[d];
     }
     const int force = path->drive == CF_DRIVE_FORCE;
+    size_t seg = 1; /* where the path's search starts (1 always starts it afresh) */
+    for (size_t i = 1; i < path->count; i++)
+        if (!(path->t_s[i] >= path->t_s[i - 1]))
+            seg = 0; /* times that go back: every search from the start */
     double t = ns ? fmin(ts[0], path->t_s[0]) : 0, e = 0;
     for (size_t k = 0; k < ns && st == CF_OK; k++) {
         const double tk = ts[k];
@@ -253,7 +322,8 @@ static cf_status cell_path(const cf_visco_params *p, const cf_visco_setup *s, co
                 n = 1;
             const double h = (tk - t) / n;
             for (int j = 1; j <= n && st == CF_OK; j++) {
-                double v = cf_msm_path_value(path, t + j * h);
+                double v = seg ? path_value_from(path, t + j * h, &seg)
+                               : cf_msm_path_value(path, t + j * h);
                 st = force ? cell_step_force(r, h, -v, e, err) : cell_step(r, h, -v, err);
                 if (force && st == CF_OK)
                     e = r->st.F[8] - 1; /* the next secant starts here */

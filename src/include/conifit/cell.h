@@ -72,9 +72,14 @@ typedef struct cf_cell {
     double stretch_hint;             /* first guess of a mode's free stretch (0 by cf_cell_init:
                                      ** from the small-strain constants); a history passes the
                                      ** last step's */
+    int linear_finish;               /* 1: a free-stretch solve whose last Newton step is too small
+                                     ** for its second-order term to reach rounding takes that step
+                                     ** by the cell's linearisation instead of evaluating the cell
+                                     ** again (0 by cf_cell_init: every state evaluated) */
 } cf_cell;
 
-/* Checks the weights (cf_calibration_check) and fills c (law_scale 1, law_scale_strain 0, stretch_hint 0). */
+/* Checks the weights (cf_calibration_check) and fills c (law_scale 1, law_scale_strain 0, stretch_hint 0,
+** linear_finish 0). */
 cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
                        const double weight[CF_FAMILY_COUNT], cf_error *err);
 
