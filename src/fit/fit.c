@@ -386,8 +386,12 @@ cf_status cf_fit_run_shared(const cf_table *data, const cf_fit_options *opt, cf_
     /* both types' stage A searches the same range where their limits are known in closed form
     ** (c.region): the same optimum, which the second fit of a table takes from the first */
     const int share = shared && c.region;
+    const long evals0 = c.evals, sub_evals0 = sc.evals;
     if (share && shared->have && shared->data == data && same_stage_a_options(&shared->opt, opt)) {
         memcpy(v, shared->v, sizeof v);
+        /* the fit rests on those evaluations as much as the first: they count in both */
+        c.evals += shared->evals_full;
+        sc.evals += shared->evals_sub;
     } else {
         if (long_table)
             sc.stat_tol = LONG_TOL / (double)(sc.n - 3);
@@ -413,6 +417,8 @@ cf_status cf_fit_run_shared(const cf_table *data, const cf_fit_options *opt, cf_
         shared->data = data;
         shared->opt = *opt;
         memcpy(shared->v, v, sizeof v);
+        shared->evals_full = c.evals - evals0;
+        shared->evals_sub = sc.evals - sub_evals0;
     }
     unsigned held_a = 0; /* the limits that keep the type from stage A's optimum */
     if (c.region) {

@@ -189,11 +189,14 @@ typedef struct cf_fit_shared {
     const cf_table *data;  /* the table and the options it was found with */
     cf_fit_options opt;
     double v[3];           /* stage A's optimum (rho, B, A) */
+    long evals_full;       /* the evaluations it took over every row, and over the subsample */
+    long evals_sub;
 } cf_fit_shared;
 
 /* cf_fit_run, with stage A taken from shared when it was found there for the same table and
 ** options, and kept there otherwise (shared may be NULL: cf_fit_run). The result is the one
-** cf_fit_run gives, bit for bit; only its evaluations count no more than the call's own. */
+** cf_fit_run gives, bit for bit, its evaluations included (the shared stage A's count in both
+** fits); only wall_time_s is the call's own. */
 cf_status cf_fit_run_shared(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                             cf_fit_shared *shared, cf_fit_result *res, cf_error *err);
 
