@@ -11,6 +11,7 @@
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <gsl/gsl_blas.h>
 #include <gsl/gsl_errno.h>
@@ -235,20 +236,35 @@ static int linear_fit(const cf_table *d, size_t ncol, basis_fn basis, const void
     return oom ? -1 : ok;
 }
 
+/* Entries of a profile's memory of the points it was evaluated at. */
+#define PROFILE_SEEN 4
+
 /* A profile and the table it runs on (weighted: a subsample's weights count), for the
-** minimisers. */
+** minimisers; with the last points it was evaluated at (a pass over the rows each) and their
+** RSS. GSL's Brent minimiser, once its bracket is as narrow as it can resolve, asks for the same
+** point at every further iteration: on a 100-row table 619 calls went to 42 distinct points. */
 typedef struct profile_call {
     const cf_table *d;
     int weighted;
     profile_fn f;
     void *scratch;
+    int seen, next;
+    double seen_p[PROFILE_SEEN], seen_r[PROFILE_SEEN];
 } profile_call;
 
 static double profile_rss(double p, void *data)
 {
-    const profile_call *c = data;
+    profile_call *c = data;
+    for (int k = 0; k < c->seen; k++)
+        if (memcmp(&c->seen_p[k], &p, sizeof p) == 0)
+            return c->seen_r[k];
     double A;
-    return c->f(c->d, c->weighted, p, &A, c->scratch);
+    const double r = c->f(c->d, c->weighted, p, &A, c->scratch);
+    c->seen_p[c->next] = p;
+    c->seen_r[c->next] = r;
+    c->next = (c->next + 1) % PROFILE_SEEN;
+    c->seen += c->seen < PROFILE_SEEN;
+    return r;
 }
 
 /* Refines the scan's best p in (lo, hi) with Brent's method on the profile RSS; returns p
@@ -310,17 +326,122 @@ static double polish(profile_call *call, double p)
 /* Points of the scan of a shape parameter on each side of 0. */
 #define SCAN_SIDE 400
 
-/* From grid point ib of a scan over +-pmax (r: its profile RSS on the scan's table): on every row
-** of d (weighted when dw), when the scan ran on a subsample, to the nearest minimum along the
-** grid; then Brent between the grid's neighbours, kept where it does not raise the RSS. Returns
-** p. */
+/* The profile RSS at every point of a scan, r[i + SCAN_SIDE] at p = pmax i/SCAN_SIDE (r[SCAN_SIDE]
+** for p = 0 left to the caller), from the table t (weighted: its weights count); 0, or -1 when it
+** cannot (memory), and the scan then evaluates the profile at each point. */
+typedef int (*scan_fn)(const cf_table *t, int weighted, double pmax, void *scratch, double *r);
+
+/* The scans of Fung's and Ogden's profiles from powers: both laws are sums of exponentials
+** exp(p z_i) of the shape parameter p, and along the scan's even grid p = k dp the k-th power of
+** exp(dp z_i), one multiplication a row and point where the profile calls exp or expm1 (the two
+** scans were most of the baselines' time). The k-th power carries at most k rounding errors (4e-14
+** of it at the scan's ends); the scan only ranks the grid's points, and each one kept is evaluated
+** again on the profile itself (from_grid_point), so that the refinement and the comparison with
+** its result are the profile's own. */
+static void scan_side(const cf_table *t, int weighted, double pmax, int side, int two,
+                      const double *c, const double *z1, const double *z2, double *u, double *v,
+                      double *g, double *r)
+{
+    const int N = SCAN_SIDE;
+    const size_t n = t->count;
+    const double dp = side * pmax / N;
+    for (size_t i = 0; i < n; i++) {
+        u[n + i] = exp(dp * z1[i]);
+        u[i] = 1.0;
+        if (two) {
+            v[n + i] = exp(dp * z2[i]);
+            v[i] = 1.0;
+        }
+    }
+    for (int k = 1; k <= N; k++) {
+        const double p = pmax * (double)(side * k) / N;
+        double sgy = 0, sgg = 0, syy = 0;
+        for (size_t i = 0; i < n; i++) {
+            u[i] *= u[n + i];
+            double gi;
+            if (two) {
+                v[i] *= v[n + i];
+                gi = c[i] * (u[i] - v[i]) / p;
+            } else {
+                gi = u[i] - 1.0;
+            }
+            g[i] = gi;
+            const double w = weighted ? t->w[i] : 1.0;
+            sgy += w * gi * t->y[i];
+            sgg += w * gi * gi;
+            syy += w * t->y[i] * t->y[i];
+        }
+        double rss;
+        if (!two) { /* as fung_profile */
+            const double A = (sgg > 0 && isfinite(sgg)) ? sgy / sgg : 0;
+            rss = syy - A * sgy;
+            rss = isfinite(rss) ? fmax(rss, 0.0) : INFINITY;
+        } else if (!(sgg > 0 && isfinite(sgg) && isfinite(sgy))) { /* as ogden_profile */
+            rss = INFINITY;
+        } else {
+            const double mu = sgy / sgg;
+            rss = 0;
+            for (size_t i = 0; i < n; i++) {
+                const double e = t->y[i] - mu * g[i];
+                rss += (weighted ? t->w[i] : 1.0) * e * e;
+            }
+            rss = isfinite(rss) ? rss : INFINITY;
+        }
+        r[N + side * k] = rss;
+    }
+}
+
+static int fung_scan(const cf_table *t, int weighted, double pmax, void *scratch, double *r)
+{
+    (void)scratch;
+    const size_t n = t->count;
+    double *u = malloc(sizeof(double) * 3 * (n ? n : 1));
+    if (!u)
+        return -1;
+    for (int side = -1; side <= 1; side += 2)
+        scan_side(t, weighted, pmax, side, 0, NULL, t->x, NULL, u, NULL, u + 2 * n, r);
+    free(u);
+    return 0;
+}
+
+/* Ogden's basis in the table's mode as c_i (exp(alpha z1_i) - exp(alpha z2_i))/alpha (see
+** cf_ogden_basis): with L the log stretch, c = 2 exp(-L), z1 = L, z2 = -q L off shear, and
+** c = 1/cosh(L), z1 = L, z2 = -L in shear. */
+static int ogden_scan(const cf_table *t, int weighted, double pmax, void *scratch, double *r)
+{
+    const ogden_scratch *s = scratch;
+    const size_t n = t->count, m = n ? n : 1;
+    double *buf = malloc(sizeof(double) * 7 * m);
+    if (!buf)
+        return -1;
+    double *c = buf, *z2 = buf + m, *u = buf + 2 * m, *v = buf + 4 * m, *g = buf + 6 * m;
+    const int shear = s->mode == CF_MODE_SHEAR;
+    const double q = shear || s->mode == CF_MODE_PLANAR ? 1.0
+                     : s->mode == CF_MODE_EQUIBIAXIAL   ? 2.0
+                                                        : 0.5;
+    for (size_t i = 0; i < n; i++) {
+        const double L = t->x[i];
+        c[i] = shear ? 1.0 / cosh(L) : 2.0 * exp(-L);
+        z2[i] = -q * L;
+    }
+    for (int side = -1; side <= 1; side += 2)
+        scan_side(t, weighted, pmax, side, 1, c, t->x, z2, u, v, g, r);
+    free(buf);
+    return 0;
+}
+
+/* From grid point ib of a scan over +-pmax, on every row of d (weighted when dw): when the scan ran
+** on a subsample, to the nearest minimum along the grid; then Brent between the grid's
+** neighbours, kept where it does not raise the RSS. Returns p. */
 static double from_grid_point(const cf_table *d, int dw, int subsampled, profile_fn prof,
-                              void *scratch, double pmax, int ib, double bestR, int *oom)
+                              void *scratch, double pmax, int ib, int *oom)
 {
     const int N = SCAN_SIDE;
     double A;
+    profile_call call = {d, dw, prof, scratch, 0, 0, {0}, {0}};
+    /* the scan's value may come from its powers (scan_fn), a few ulps off the profile's */
+    double bestR = profile_rss(pmax * (double)ib / N, &call);
     if (subsampled) {
-        bestR = prof(d, dw, pmax * (double)ib / N, &A, scratch);
         for (int dir = -1; dir <= 1; dir += 2)
             for (;;) {
                 int j = ib + dir == 0 ? ib + 2 * dir : ib + dir;
@@ -333,7 +454,6 @@ static double from_grid_point(const cf_table *d, int dw, int subsampled, profile
             }
     }
     double best = pmax * (double)ib / N;
-    profile_call call = {d, dw, prof, scratch};
     double p = refine(&call, best, best - pmax / N, best + pmax / N, oom);
     return prof(d, dw, p, &A, scratch) > bestR ? best : p;
 }
@@ -345,14 +465,16 @@ static double from_grid_point(const cf_table *d, int dw, int subsampled, profile
 ** tries in all (a profile with more than one valley); the lowest on every row is kept. Returns p
 ** with its coefficient in *A. */
 static double shape_fit(const cf_table *d, int dw, const cf_table *scan, profile_fn prof,
-                        void *scratch, double pmax, int tries, int *oom, double *A)
+                        scan_fn sfn, void *scratch, double pmax, int tries, int *oom, double *A)
 {
     const int N = SCAN_SIDE;
     double r[2 * SCAN_SIDE + 1], bestR = INFINITY;
     int cand[3] = {1, 0, 0}, ncand = 1;
+    const int powers = sfn && sfn(scan, scan != d || dw, pmax, scratch, r) == 0;
     for (int i = -N; i <= N; i++) {
-        r[i + N] = i == 0 ? INFINITY
-                          : prof(scan, scan != d || dw, pmax * (double)i / N, A, scratch);
+        if (!powers || i == 0)
+            r[i + N] = i == 0 ? INFINITY
+                              : prof(scan, scan != d || dw, pmax * (double)i / N, A, scratch);
         if (r[i + N] < bestR) {
             bestR = r[i + N];
             cand[0] = i;
@@ -378,8 +500,7 @@ static double shape_fit(const cf_table *d, int dw, const cf_table *scan, profile
     }
     double p = pmax * (double)cand[0] / N, pbest = p, rbest = INFINITY;
     for (int c = 0; c < ncand; c++) {
-        p = from_grid_point(d, dw, scan != d, prof, scratch, pmax, cand[c], r[cand[c] + N],
-                            oom);
+        p = from_grid_point(d, dw, scan != d, prof, scratch, pmax, cand[c], oom);
         const double rc = ncand > 1 ? prof(d, dw, p, A, scratch) : 0;
         if (c == 0 || rc < rbest) {
             rbest = rc;
@@ -430,9 +551,11 @@ static int ogden_fit(const cf_table *d, const cf_table *scan, cf_baseline *O, in
     double mu, amax = fmax(50.0, 50.0 / Lmax);
     /* the valleys are told apart on the subsample of a long table, whose minimum Newton's steps
     ** then take to that of every row */
-    double alpha = scan != d ? shape_fit(&sl, 1, &sl, ogden_profile, &s, amax, 3, oom, &mu)
-                             : shape_fit(&dl, 0, &dl, ogden_profile, &s, amax, 3, oom, &mu);
-    profile_call call = {&dl, 0, ogden_profile, &s};
+    double alpha = scan != d ? shape_fit(&sl, 1, &sl, ogden_profile, ogden_scan, &s, amax, 3,
+                                         oom, &mu)
+                             : shape_fit(&dl, 0, &dl, ogden_profile, ogden_scan, &s, amax, 3,
+                                         oom, &mu);
+    profile_call call = {&dl, 0, ogden_profile, &s, 0, 0, {0}, {0}};
     alpha = polish(&call, alpha);
     if (d->mode == CF_MODE_PLANAR || d->mode == CF_MODE_SHEAR) /* even in alpha there */
         alpha = fabs(alpha);
@@ -480,7 +603,8 @@ cf_status cf_baseline_fit_all(const cf_table *d, cf_baseline out[CF_BASE_COUNT],
         scan = &sub;
     }
     /* Fung: B over +-50/xmax (exp(50) covers any stiffening a table shows) */
-    F->coef[1] = shape_fit(d, 0, scan, fung_profile, NULL, xmax > 0 ? 50.0 / xmax : 1.0, 1,
+    F->coef[1] = shape_fit(d, 0, scan, fung_profile, fung_scan, NULL,
+                           xmax > 0 ? 50.0 / xmax : 1.0, 1,
                            &oom, &F->coef[0]);
     const char *why = cf_hyper_unfit(d);
     if (why) {

@@ -164,6 +164,7 @@ double cf_fit_rss_at(fit_ctx *c, double rho, double B, double A_fixed, double A_
 void cf_fit_sub_point(const sub *q, const double *x, double *rho, double *B);
 double cf_fit_sub_f0(const sub *q, const double *x);
 double cf_fit_sub_g0(const sub *q, const double *x);
+int cf_fit_sub_empty(const sub *q);
 double cf_fit_sub_solve(fit_ctx *c, sub *q, double *x, nlopt_algorithm alg);
 int cf_fit_stage_a_constrained(fit_ctx *c, double v[3]);
 unsigned cf_fit_held_at(const fit_ctx *c, const double v[3]);

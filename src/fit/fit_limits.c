@@ -194,6 +194,21 @@ double cf_fit_sub_g0(const sub *q, const double *x)
     return g;
 }
 
+/* Whether no point of the sub-problem meets the type's limits, decided without a pass over the
+** rows (0: not known). With rho held: the limits' margin does not grow with B for either type
+** (telescoping, the upper index c_hi = min(index_max, D2max rho/(1 - B)) grows with B;
+** non-telescoping, the least coil count max(n_min, n_type, 3 (1 - B)/(D2max rho)) falls with it;
+** rho_min's margin does not depend on B), so the least margin over B's range is the one at its
+** upper end, and when that is above cf_fit_sub_solve's admission (1e-9, and more than rounding
+** above it) every search ends outside: it returns CF_LSQ_HUGE_OBJ, as the search would. The
+** profile of rho reaches such points where the limits close (bisected to the end's tolerance,
+** each point a failed SLSQP and a failed COBYLA run). */
+int cf_fit_sub_empty(const sub *q)
+{
+    const double x[1] = {q->c->b_hi};
+    return q->c->region && q->fixed == 0 && cf_fit_sub_g0(q, x) > 1e-9 + 1e-12;
+}
+
 /* Minimises the sub-problem from x (in/out); returns its RSS, CF_LSQ_HUGE_OBJ when no point meets
 ** the limits. */
 double cf_fit_sub_solve(fit_ctx *c, sub *q, double *x, nlopt_algorithm alg)

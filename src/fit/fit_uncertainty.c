@@ -15,13 +15,17 @@
 /* The profile of quantity k at log value u: the RSS minimised over the other quantities from
 ** xin; xin moves to the minimiser when the RSS is within limit. SLSQP on the analytic gradient
 ** first; where it ends above the limit (outside the interval, or stopped short on a limit of the
-** type, where COBYLA's steps along the constraint do better) COBYLA from the same start decides. */
+** type, where COBYLA's steps along the constraint do better) COBYLA from the same start decides.
+** Neither runs where no point meets the limits at all (cf_fit_sub_empty), whose answer they
+** could only confirm. */
 static double profile_at(void *ctx, int k, double u, double limit, double *xin)
 {
     fit_ctx *c = ctx;
     sub q = {c, k, 0};
     double x[2] = {xin[0], xin[1]};
     q.t = exp(u);
+    if (cf_fit_sub_empty(&q))
+        return CF_LSQ_HUGE_OBJ;
     double f = cf_fit_sub_solve(c, &q, x, NLOPT_LD_SLSQP);
     if (!(f <= limit)) {
         double y[2] = {xin[0], xin[1]};
