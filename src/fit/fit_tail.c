@@ -609,6 +609,11 @@ static double prof_at(void *ctx, int k, double u, double limit, double *x)
     ** costs 4 evaluations of the law per step instead of 7 */
     gsl_multifit_nlinear_parameters fp = cf_lm_parameters();
     fp.fdtype = GSL_MULTIFIT_NLINEAR_FWDIFF;
+    /* the SVD solves the steps: a profile far out can leave all three coordinates without effect
+    ** (each on a bound of its logit, or a cell curve that no longer moves), a Jacobian of rank zero
+    ** that the default QR solver reports through GSL's error handler (an abort unless the caller
+    ** turned it off) where the SVD takes the zero step and the search ends */
+    fp.solver = gsl_multifit_nlinear_solver_svd;
     gsl_multifit_nlinear_fdf fdf;
     memset(&fdf, 0, sizeof fdf);
     fdf.f = prof_f;
