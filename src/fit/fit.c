@@ -339,6 +339,45 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
 
 /* Whether two option sets give the same stage A (every field but the stage-C optimiser and the
 ** law family, which stage A does not read, compared one by one: no padding bytes). */
+/* A force table that the law meets only in its first region (every |x| at or below the
+** transition) determines the initial stiffness alone, which depends on (rho, B, A) only through
+** A/B at a given rho: the travel and the solid load slide together along a valley of one sum of
+** squares that reaches the travel's bound of a thousand times the data, and where a search stops
+** in it is an accident of its tolerance (on a linear clot table one search ended at a travel of
+** 7.6 mm, another at 4.2 m, whose spring was as long). A stress-strain table's valley ends at a
+** solid strain of 1, where the spring still has the preferred length, and is left to the search.
+** The fit takes the valley's compact end: the
+** transition at the table's largest |x|, or further where the solid would otherwise come closer
+** to the data than the reports accept (CF_FIT_SOLID_RATIO_WARN). The law is the same on every
+** row (checked: the sum of squares may not rise beyond rounding) and the spring the shortest of
+** the family that stays linear over the table. Kept only inside the type's closed-form region
+** when it has one. */
+static void compact_first_region(fit_ctx *c, double v[3])
+{
+    cf_law canon;
+    if (!c->fd || !(c->xmax > 0) || cf_ident_canon_law(v[0], &canon) != CF_OK ||
+        !(canon.u_T_mm > 0))
+        return;
+    const double uT = v[1] * canon.u_T_mm; /* the transition in the table's x (travel 1 canon) */
+    if (!(c->xmax < uT))
+        return;
+    const double lam =
+        fmax(fmax(c->xmax / uT, CF_FIT_SOLID_RATIO_WARN * c->xmax / v[1]), c->b_lo / v[1]);
+    if (!(lam < 1))
+        return;
+    const double w[3] = {v[0], lam * v[1], lam * v[2]};
+    if (c->region) {
+        region r = cf_fit_region_at(c, w[0], w[1]);
+        if (r.margin > 0 || w[2] > r.A_max)
+            return;
+    }
+    double a;
+    const double f0 = cf_fit_rss_at(c, v[0], v[1], v[2], INFINITY, &a);
+    const double f1 = cf_fit_rss_at(c, w[0], w[1], w[2], INFINITY, &a);
+    if (f1 < CF_LSQ_HUGE_OBJ && f1 <= f0 * (1 + 1e-9))
+        memcpy(v, w, sizeof w);
+}
+
 static int same_stage_a_options(const cf_fit_options *a, const cf_fit_options *b)
 {
     for (int k = 0; k < CF_P_COUNT; k++)
@@ -420,6 +459,7 @@ cf_status cf_fit_run_shared(const cf_table *data, const cf_fit_options *opt, cf_
         shared->evals_full = c.evals - evals0;
         shared->evals_sub = sc.evals - sub_evals0;
     }
+    compact_first_region(&c, v);
     unsigned held_a = 0; /* the limits that keep the type from stage A's optimum */
     if (c.region) {
         region r = cf_fit_region_at(&c, v[0], v[1]);

@@ -2,6 +2,7 @@
 ** What the model cannot follow in a table, as sentences the text report, the fit file
 ** (warnings[]) and the command line's standard error share (report.h, cf_report_warnings).
 */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -85,16 +86,26 @@ static int worse_than_linear(const cf_fit_report *r, int i, char *buf, size_t ca
     const cf_baseline *lin = &r->baselines[CF_BASE_LINEAR];
     const int thr = r->through_msm && r->thr[i].done;
     const double rmse = thr ? r->thr[i].cell_rmse : f->rmse;
-    if (!f->feasible || !(rmse > lin->rmse))
+    /* equal to rounding: the law stays in its first, linear region over the table (it is the
+    ** line), which is said as such rather than as a loss to the line */
+    const int same = fabs(rmse - lin->rmse) <= 1e-9 * lin->rmse;
+    if (!f->feasible || !(rmse > lin->rmse || same))
         return 0;
     const double u = r->table->y_to_file;
     char why[192];
     worse_why(r, i, why, sizeof why);
-    snprintf(buf, cap,
-             "the %s fit (%sRMSE %.4g %s) is worse than a straight line through the table "
-             "(RMSE %.4g %s): the law cannot follow this table%s",
-             cf_spring_type_name(f->type), thr ? "through the lattice, " : "", rmse * u,
-             r->table->y_unit, lin->rmse * u, r->table->y_unit, why);
+    if (same)
+        snprintf(buf, cap,
+                 "the %s fit (%sRMSE %.4g %s) is no better than a straight line through the table: "
+                 "the law stays in its first, linear region over the whole table%s",
+                 cf_spring_type_name(f->type), thr ? "through the lattice, " : "", rmse * u,
+                 r->table->y_unit, why);
+    else
+        snprintf(buf, cap,
+                 "the %s fit (%sRMSE %.4g %s) is worse than a straight line through the table "
+                 "(RMSE %.4g %s): the law cannot follow this table%s",
+                 cf_spring_type_name(f->type), thr ? "through the lattice, " : "", rmse * u,
+                 r->table->y_unit, lin->rmse * u, r->table->y_unit, why);
     return 1;
 }
 

@@ -442,6 +442,48 @@ static void published_tables_fit_both_types_at_least_as_well_as_an_independent_f
     }
 }
 
+/* A force table that is a straight line leaves the travel and the solid load free along the
+** line's stiffness (the law stays in its first region over the table): the fit takes the compact
+** end of that valley whatever the search's tolerance, the transition at the table's largest
+** displacement or the solid at 1.5 times it, not a spring some metres long as a search once
+** left it. The sum of squares is the line's. */
+static void linear_force_table_gets_the_shortest_linear_spring(void **state)
+{
+    (void)state;
+    enum { N = 400 };
+    double x[N], y[N], sxy = 0, sxx = 0;
+    for (int i = 0; i < N; i++) {
+        x[i] = 5.0 * i / (N - 1);                    /* mm */
+        y[i] = 0.1 * x[i] + 1e-3 * sin(1.7 * i);      /* N: 0.1 N/mm and a wobble */
+        sxy += x[i] * y[i];
+        sxx += x[i] * x[i];
+    }
+    double rss_line = 0;
+    for (int i = 0; i < N; i++)
+        rss_line += (y[i] - sxy / sxx * x[i]) * (y[i] - sxy / sxx * x[i]);
+    cf_table d;
+    cf_error err = {0};
+    assert_int_equal(cf_table_from_arrays(CF_TABLE_FORCE_DISPLACEMENT, N, x, y, NULL, &d, &err),
+                     CF_OK);
+    cf_fit_options o = cf_fit_default_options();
+    for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING; ty++) {
+        cf_fit_result r;
+        fit_ok(&d, &o, (cf_spring_type)ty, &r);
+        assert_true(r.feasible);
+        if (!(fabs(r.rss - rss_line) <= 1e-6 * rss_line))
+            fail_msg("%s: RSS %.12g against the line's %.12g", cf_spring_type_name(r.type), r.rss,
+                     rss_line);
+        const double xmax = 5.0, uT = r.law.u_T_mm, s = r.law.travel_mm;
+        if (!(uT >= xmax * (1 - 1e-6) &&
+              (fabs(uT - xmax) <= 1e-6 * xmax || s <= CF_FIT_SOLID_RATIO_WARN * xmax * (1 + 1e-6))))
+            fail_msg("%s: transition %.6g mm, travel %.6g mm for a table to %.3g mm",
+                     cf_spring_type_name(r.type), uT, s, xmax);
+        if (!(r.params.H_mm < 200))
+            fail_msg("%s: a spring %.6g mm long", cf_spring_type_name(r.type), r.params.H_mm);
+    }
+    cf_table_free(&d);
+}
+
 int main(void)
 {
     gsl_set_error_handler_off();
@@ -459,6 +501,7 @@ int main(void)
         cmocka_unit_test(strain_beyond_any_spring_is_reported_infeasible),
         cmocka_unit_test(baselines_recover_their_own_laws),
         cmocka_unit_test(published_tables_fit_both_types_at_least_as_well_as_an_independent_fit),
+        cmocka_unit_test(linear_force_table_gets_the_shortest_linear_spring),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
