@@ -28,6 +28,7 @@
 #include "fit/fit_ctx.h"
 #include "fit/lm.h"
 #include "fit/lsq.h"
+#include "fit/profile.h"
 #include "fit/tail.h"
 
 #define TAIL_GRID_RHO 10
@@ -135,18 +136,28 @@ static double sigm(double t) { return 1.0 / (1.0 + exp(-t)); }
 /* The fourth coordinate: log tau for a force table; for a stress-strain table the strain at which
 ** the cone closes, u_C/H = B (1 + tau), as a logit between B and 1 (a spring's whole travel is
 ** below its free length, so u_C/H < 1). */
-static double tau_of(const tail_ctx *c, double B, double th3)
+static double tau_fd(int fd, double B, double th3)
 {
-    if (c->fd)
+    if (fd)
         return exp(fmin(fmax(th3, log(TAIL_TAU_LO) - 10), log(TAIL_TAU_HI)));
     return (1 - B) * (1 - 1e-9) * sigm(th3) / B;
 }
 
-static double th3_of(const tail_ctx *c, double B, double tau)
+static double th3_fd(int fd, double B, double tau)
 {
-    if (c->fd)
+    if (fd)
         return log(tau);
     return cf_logit(tau * B / ((1 - B) * (1 - 1e-9)));
+}
+
+static double tau_of(const tail_ctx *c, double B, double th3)
+{
+    return tau_fd(c->fd, B, th3);
+}
+
+static double th3_of(const tail_ctx *c, double B, double tau)
+{
+    return th3_fd(c->fd, B, tau);
 }
 
 /* The load scale: of a stress-strain table below the largest a spring of the family carries with
@@ -175,6 +186,23 @@ static int residuals(tail_ctx *c, const double v[4], double sc, gsl_vector *f)
 static int resid_at(void *ctx, const double v[4], gsl_vector *f)
 {
     return residuals(ctx, v, 1.0, f);
+}
+
+/* The weighted residuals of the rows by c->stride, each times sqrt(stride): the subsample's RSS
+** stands for the whole table's, so that a long table's profiles cost what its grid costs, not a
+** pass over every row per point. With stride 1 they are resid_at's. */
+static int resid_stride(void *ctx, const double v[4], gsl_vector *f)
+{
+    tail_ctx *c = ctx;
+    cf_law canon;
+    if (!isfinite(v[2]) || tail_canon(v[0], v[3], &canon) != CF_OK)
+        return GSL_EDOM;
+    canon_rows(c, &canon, v[1], c->stride);
+    const double w = sqrt((double)c->stride);
+    size_t m = 0;
+    for (size_t i = 0; i < c->n; i += c->stride, m++)
+        gsl_vector_set(f, m, w * c->sw[i] * (v[2] * c->g[m] - c->data->y[i]));
+    return GSL_SUCCESS;
 }
 
 static int lm_f(const gsl_vector *th, void *params, gsl_vector *f)
@@ -476,7 +504,309 @@ cf_status cf_tail_result(const cf_table *data, const cf_fit_options *opt, cf_spr
     return CF_OK;
 }
 
+/* ---- profile intervals ---------------------------------------------------------------------- */
+
+/* The profile of one quantity k of (rho, B, A, e_t) held at `fixed`: Levenberg-Marquardt over the
+** other three, in the fit's own coordinates (logit rho, logit B, the load scale as a logit of its
+** cap or its log, the cone's closing strain as a logit or log tau), so that every point it tries
+** is a spring the fit could have found. */
+typedef struct prof_run {
+    const cf_tail_profile *p;
+    int k;
+    double fixed;
+} prof_run;
+
+/* The largest B of the profile: with e_t held, the cone closes at B + e_t, below the free length
+** of a stress-strain table. */
+static double prof_b_hi(const prof_run *r)
+{
+    if (r->k == 3 && !r->p->fd)
+        return fmin(r->p->b_hi, (1 - r->fixed) * (1 - 1e-9));
+    return r->p->b_hi;
+}
+
+static double prof_A_max(const prof_run *r, const double v[4])
+{
+    return cf_tail_A_max(v[0], v[1], v[3], r->p->type, r->p->need, r->p->opt);
+}
+
+static void prof_unpack(const prof_run *r, const double *th, double v[4])
+{
+    const cf_tail_profile *p = r->p;
+    double z[4];
+    for (int i = 0, j = 0; i < 4; i++)
+        z[i] = i == r->k ? 0 : th[j++];
+    v[0] = r->k == 0 ? r->fixed : p->rho_lo + (p->rho_hi - p->rho_lo) * sigm(z[0]);
+    v[1] = r->k == 1 ? r->fixed : p->b_lo + (prof_b_hi(r) - p->b_lo) * sigm(z[1]);
+    v[3] = r->k == 3 ? r->fixed / v[1] : tau_fd(p->fd, v[1], z[3]);
+    v[2] = r->k == 2 ? r->fixed : p->fd ? exp(z[2]) : prof_A_max(r, v) * sigm(z[2]);
+}
+
+/* A logit kept 1e-9 inside its ends: a start on a bound has no slope there, and a start with every
+** coordinate on one (a fit held by its limits) would give Levenberg-Marquardt a Jacobian of rank
+** zero. */
+static double logit_in(double p)
+{
+    return cf_logit(fmin(fmax(p, 1e-9), 1 - 1e-9));
+}
+
+static void prof_pack(const prof_run *r, const double v[4], double th[3])
+{
+    const cf_tail_profile *p = r->p;
+    const double z[4] = {logit_in((v[0] - p->rho_lo) / (p->rho_hi - p->rho_lo)),
+                         logit_in((v[1] - p->b_lo) / (prof_b_hi(r) - p->b_lo)),
+                         p->fd ? log(v[2]) : logit_in(v[2] / prof_A_max(r, v)),
+                         p->fd ? log(v[3]) : logit_in(v[3] * v[1] / ((1 - v[1]) * (1 - 1e-9)))};
+    for (int i = 0, j = 0; i < 4; i++)
+        if (i != r->k)
+            th[j++] = z[i];
+}
+
+/* How far a stress-strain table's held load scale is past the cap where the other three now are
+** (log units; 0 inside). Only the profile of A can leave the cap: the others keep A below it. */
+static double prof_excess(const prof_run *r, const double v[4])
+{
+    if (r->k != 2 || r->p->fd)
+        return 0;
+    return fmax(0.0, log(v[2] / prof_A_max(r, v)));
+}
+
+/* The residuals, scaled as the fit's LM scales them; past the cap every residual grows by a steep
+** factor, so that Levenberg-Marquardt turns back from a step there as from any step that raises
+** the sum of squares and settles on the cap (its penalised value is then at most the true
+** profile's: an interval too wide by a hair, never too narrow). */
+static int prof_f(const gsl_vector *th, void *params, gsl_vector *f)
+{
+    const prof_run *r = params;
+    double v[4];
+    prof_unpack(r, th->data, v);
+    int st = r->p->res(r->p->ctx, v, f);
+    if (st != GSL_SUCCESS)
+        return st;
+    gsl_vector_scale(f, (1 + 1e4 * prof_excess(r, v)) / sqrt(r->p->ynorm));
+    return GSL_SUCCESS;
+}
+
+typedef struct prof_ctx {
+    const cf_tail_profile *p;
+    int oom;
+    double stall_rel; /* the statistical tolerance of a profile's search, relative to its RSS */
+} prof_ctx;
+
+/* cf_profile's at: x holds (rho, B, A, tau) of the last point within the limit. */
+static double prof_at(void *ctx, int k, double u, double limit, double *x)
+{
+    prof_ctx *pc = ctx;
+    const prof_run r = {pc->p, k, exp(u)};
+    if (!(prof_b_hi(&r) > pc->p->b_lo))
+        return CF_LSQ_HUGE_OBJ;
+    double v0[4] = {x[0], x[1], x[2], x[3]};
+    if (k == 3)
+        v0[3] = r.fixed / v0[1];
+    else
+        v0[k] = r.fixed;
+    /* forward differences: the Jacobian only steers the steps (the RSS decides), and a point
+    ** costs 4 evaluations of the law per step instead of 7 */
+    gsl_multifit_nlinear_parameters fp = cf_lm_parameters();
+    fp.fdtype = GSL_MULTIFIT_NLINEAR_FWDIFF;
+    /* the SVD solves the steps: a profile far out can leave all three coordinates without effect
+    ** (each on a bound of its logit, or a cell curve that no longer moves), a Jacobian of rank zero
+    ** that the default QR solver reports through GSL's error handler (an abort unless the caller
+    ** turned it off) where the SVD takes the zero step and the search ends */
+    fp.solver = gsl_multifit_nlinear_solver_svd;
+    gsl_multifit_nlinear_fdf fdf;
+    memset(&fdf, 0, sizeof fdf);
+    fdf.f = prof_f;
+    fdf.n = pc->p->m;
+    fdf.p = 3;
+    fdf.params = (void *)&r;
+    double th0[3];
+    prof_pack(&r, v0, th0);
+    int ist;
+    gsl_multifit_nlinear_workspace *w = cf_lm_start(&fp, &fdf, th0, &ist);
+    if (!w) {
+        pc->oom = 1;
+        return CF_LSQ_HUGE_OBJ;
+    }
+    double f = CF_LSQ_HUGE_OBJ, v[4];
+    if (ist == GSL_SUCCESS) {
+        /* stop once two steps in a row lower the RSS by less than a hundredth of the residual
+        ** variance (the fit's own statistical tolerance, fit.md): the ends are then placed
+        ** within a few thousandths of the threshold's rise, far inside their 1 % tolerance;
+        ** GSL's own tests at the parameters' rounding level */
+        cf_lm_stop stop = {LM_MAX_ITER, 1e-10, 1e-12, 1e-12, 2, pc->stall_rel, LM_FLOOR_REL};
+        if (cf_lm_iterate(w, &stop) < 0)
+            pc->oom = 1;
+        gsl_vector *res = gsl_multifit_nlinear_residual(w);
+        double chi2;
+        gsl_blas_ddot(res, res, &chi2);
+        prof_unpack(&r, gsl_multifit_nlinear_position(w)->data, v);
+        if (isfinite(chi2) && isfinite(v[0] + v[1] + v[2] + v[3]))
+            f = fmin(chi2 * pc->p->ynorm, CF_LSQ_HUGE_OBJ);
+    }
+    gsl_multifit_nlinear_free(w);
+    if (f <= limit)
+        memcpy(x, v, sizeof v);
+    return f;
+}
+
+/* Where a profile has no admissible point: the wire's G_max for the load scale of a stress-strain
+** table, the search's bounds otherwise. */
+static unsigned prof_closed(void *ctx, int k, double u, const double *x)
+{
+    const prof_ctx *pc = ctx;
+    (void)u;
+    (void)x;
+    return k == 2 && !pc->p->fd ? CF_C_G_MAX : CF_C_BOUNDS;
+}
+
+/* The start of every profile: the fit itself, (rho, B, A, tau) from (rho, B, A, e_t). */
+static void prof_start(void *ctx, int k, const double *q, double *x)
+{
+    (void)ctx;
+    (void)k;
+    x[0] = q[0];
+    x[1] = q[1];
+    x[2] = q[2];
+    x[3] = q[3] / q[1];
+}
+
+int cf_tail_intervals(const cf_tail_profile *p, const double v[4], double rss0, double limit,
+                      cf_fit_result *res)
+{
+    const double q[4] = {v[0], v[1], v[2], v[3] * v[1]};
+    const double se[4] = {res->ident_se.v[0], res->ident_se.v[1], res->ident_se.v[2],
+                          res->e_tail_se};
+    /* the range of each quantity: the search's box; e_t below the free length's share past the
+    ** smallest cone travel (a stress-strain table) or the largest tail the search takes */
+    const double et_lo = TAIL_TAU_LO * p->b_lo,
+                 et_hi = p->fd ? TAIL_TAU_HI * p->b_hi : (1 - p->b_lo) * (1 - 1e-9);
+    const double lo[4] = {p->rho_lo, p->b_lo, 0, et_lo}, hi[4] = {p->rho_hi, p->b_hi, INFINITY,
+                                                                  et_hi};
+    int singular = 0;
+    for (int k = 0; k < 4; k++)
+        singular = singular || !(se[k] >= 0);
+    const unsigned why = res->held | (singular ? CF_FIT_RANK_DEFICIENT : 0);
+    /* the plain law's rule (profile.h, cf_profile_needed), over the four: a standard error
+    ** larger than half its value is one whose Wald interval reaches below zero */
+    int need = why != 0;
+    for (int k = 0; k < 4; k++)
+        need = need || q[k] - 1.96 * se[k] < lo[k] || q[k] + 1.96 * se[k] > hi[k];
+    for (int k = 0; k < 4; k++)
+        need = need && q[k] > 0 && isfinite(q[k]);
+    if (!need || p->m <= 4 || !(rss0 < CF_LSQ_HUGE_OBJ) || !(limit > rss0))
+        return 0;
+    /* the residual variance from the threshold's rise F(0.95; 1, N - 4) s^2, F about 4 */
+    prof_ctx pc = {p, 0, 1e-2 * (limit - rss0) / (4 * rss0)};
+    const cf_profile pr = {
+        .ctx = &pc,
+        .lo = {log(p->rho_lo), log(p->b_lo), -INFINITY, log(et_lo)},
+        .hi = {log(p->rho_hi * (1 - 1e-12)), log(p->b_hi), log(CF_MEASURE_MAX_VALUE), log(et_hi)},
+        .lo_bit = {p->opt->rho_min > CF_IDENT_RHO_LO ? CF_C_RHO_MIN : CF_C_BOUNDS, CF_C_BOUNDS,
+                   0, CF_C_BOUNDS},
+        .hi_bit = {p->type == CF_TELESCOPING ? CF_C_TYPE : CF_C_DIAMETERS, CF_C_BOUNDS,
+                   CF_C_BOUNDS, CF_C_BOUNDS},
+        .at = prof_at,
+        .closed = prof_closed,
+        .with_rss0 = 1,
+        .rss0 = rss0,
+        .start = prof_start};
+    double out[4][2];
+    unsigned end[4][2];
+    for (int k = 0; k < 4 && !pc.oom; k++)
+        cf_profile_interval(&pr, k, q, limit, se[k], out[k], end[k]);
+    for (int k = 0; k < 4; k++)
+        for (int e = 0; e < 2; e++)
+            if (!isfinite(out[k][e]))
+                pc.oom |= 2; /* never reported: a non-finite end */
+    if (pc.oom)
+        return pc.oom & 1 ? -1 : 0;
+    for (int k = 0; k < 3; k++) {
+        memcpy(res->interval[k], out[k], sizeof out[k]);
+        memcpy(res->interval_end[k], end[k], sizeof end[k]);
+        res->interval_ok[k] = 1;
+        res->interval_why[k] = why;
+    }
+    memcpy(res->e_tail_interval, out[3], sizeof out[3]);
+    memcpy(res->e_tail_interval_end, end[3], sizeof end[3]);
+    res->e_tail_interval_ok = 1;
+    res->e_tail_interval_why = why;
+    return 0;
+}
+
 /* ---- the fit --------------------------------------------------------------------------------- */
+
+/* The fit's context over table data (its weights and scratch in buf, 3 n doubles): the ranges
+** the search takes and the rows its grid and profiles run on. */
+static void ctx_init(tail_ctx *c, const cf_table *data, const cf_fit_options *opt,
+                     cf_spring_type type, double *buf)
+{
+    memset(c, 0, sizeof *c);
+    c->data = data;
+    c->opt = opt;
+    c->fd = cf_table_is_force(data);
+    c->n = data->count;
+    double *sw = buf;
+    c->t = buf + c->n;
+    c->g = c->t + c->n;
+    c->ynorm = cf_lsq_weights(data, opt->relative, sw);
+    c->sw = sw;
+    const double xmax = cf_lsq_xmax(data);
+    c->type = type;
+    c->need = xmax * (1 + CF_FIT_TRAVEL_MARGIN);
+    c->rho_lo = fmax(CF_IDENT_RHO_LO, opt->rho_min * (1 - CF_IDENT_RHO_MIN_TOL));
+    c->rho_hi = cf_ident_rho_hi(type, opt->index_max);
+    /* the cone may close inside the data (the tail carries on); a stress-strain table's cone
+    ** travel is below 1 */
+    c->b_lo = 1e-3 * xmax;
+    c->b_hi = c->fd ? 1e3 * xmax : 1 - 1e-9;
+    c->stride = c->n > TAIL_SEARCH_ROWS ? (c->n + TAIL_SEARCH_ROWS - 1) / TAIL_SEARCH_ROWS : 1;
+}
+
+/* The weighted RSS of c's profile rows at v (rho, B, A, tau); CF_LSQ_HUGE_OBJ where the law has
+** no value. */
+static double stride_rss(tail_ctx *c, const double v[4])
+{
+    const size_t m = (c->n + c->stride - 1) / c->stride;
+    gsl_vector *fv = gsl_vector_alloc(m);
+    double rss = CF_LSQ_HUGE_OBJ;
+    if (fv && resid_stride(c, v, fv) == GSL_SUCCESS) {
+        gsl_blas_ddot(fv, fv, &rss);
+        rss = isfinite(rss) ? rss : CF_LSQ_HUGE_OBJ;
+    }
+    gsl_vector_free(fv);
+    return rss;
+}
+
+static cf_tail_profile profile_of(tail_ctx *c)
+{
+    const cf_tail_profile tp = {resid_stride, c, (c->n + c->stride - 1) / c->stride, c->ynorm,
+                                c->opt, c->type, c->fd, c->need, c->rho_lo, c->rho_hi, c->b_lo,
+                                c->b_hi};
+    return tp;
+}
+
+double cf_tail_profile_at(const cf_table *data, const cf_fit_options *opt,
+                          const cf_fit_result *fit, int k, double value, double *limit)
+{
+    *limit = NAN;
+    const size_t n = data->count;
+    double *buf = n >= 6 ? malloc(3 * sizeof(double) * n) : NULL;
+    if (!buf)
+        return NAN;
+    tail_ctx c;
+    ctx_init(&c, data, opt, fit->type, buf);
+    const double B = fit->ident.solid, tau = fit->e_tail / B;
+    const double v[4] = {fit->ident.rho, B, fit->ident.scale, tau};
+    const double rss = fit->objective, rss0 = stride_rss(&c, v);
+    *limit = rss0 + cf_profile_limit_np(n, 4, rss, c.ynorm) - rss;
+    const cf_tail_profile tp = profile_of(&c);
+    prof_ctx pc = {&tp, 0, 1e-2 * (*limit - rss0) / (4 * rss0)};
+    double x[4] = {v[0], v[1], v[2], v[3]};
+    const double f = prof_at(&pc, k, log(value), INFINITY, x);
+    free(buf);
+    return f;
+}
 
 cf_status cf_fit_tail_run(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                           const cf_fit_result *plain, cf_fit_result *res, cf_error *err)
@@ -484,32 +814,15 @@ cf_status cf_fit_tail_run(const cf_table *data, const cf_fit_options *opt, cf_sp
     memset(res, 0, sizeof *res);
     const double t0 = cf_clock_s();
     tail_ctx c;
-    memset(&c, 0, sizeof c);
-    c.data = data;
-    c.opt = opt;
-    c.fd = cf_table_is_force(data);
-    c.n = data->count;
-    if (c.n < 6)
+    if (data->count < 6)
         return cf_error_set(err, CF_E_DATA,
-                            "the conical-tail law needs at least 6 rows (the table has %zu)", c.n);
-    double *buf = malloc(3 * sizeof(double) * c.n);
+                            "the conical-tail law needs at least 6 rows (the table has %zu)",
+                            data->count);
+    double *buf = malloc(3 * sizeof(double) * data->count);
     if (!buf)
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", c.n);
-    double *sw = buf;
-    c.t = buf + c.n;
-    c.g = c.t + c.n;
-    c.ynorm = cf_lsq_weights(data, opt->relative, sw);
-    c.sw = sw;
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", data->count);
+    ctx_init(&c, data, opt, type, buf);
     const double xmax = cf_lsq_xmax(data);
-    c.type = type;
-    c.need = xmax * (1 + CF_FIT_TRAVEL_MARGIN);
-    c.rho_lo = fmax(CF_IDENT_RHO_LO, opt->rho_min * (1 - CF_IDENT_RHO_MIN_TOL));
-    c.rho_hi = cf_ident_rho_hi(type, opt->index_max);
-    /* the cone may close inside the data (the tail carries on); a stress-strain table's cone
-    ** travel is below 1 */
-    c.b_lo = 1e-3 * xmax;
-    c.b_hi = c.fd ? 1e3 * xmax : 1 - 1e-9;
-    c.stride = c.n > TAIL_SEARCH_ROWS ? (c.n + TAIL_SEARCH_ROWS - 1) / TAIL_SEARCH_ROWS : 1;
 
     /* the grid over (rho, B, tau), A in closed form */
     tail_start grid[TAIL_GRID_RHO * TAIL_GRID_B * TAIL_GRID_TAU];
@@ -574,10 +887,21 @@ cf_status cf_fit_tail_run(const cf_table *data, const cf_fit_options *opt, cf_sp
     /* the identifiable quantities, their errors, the spring */
     double se[4], corr[4][4], cov_Bt;
     cf_tail_errors(resid_at, &c, c.n, v, 1e-6, best, se, corr, &cov_Bt);
-    free(buf);
     cf_status st = cf_tail_result(data, opt, type, v, se, corr, cov_Bt, res, err);
-    if (st != CF_OK)
+    if (st != CF_OK) {
+        free(buf);
         return st;
+    }
+    /* profile intervals where the errors say nothing, on the grid's rows (every row of a table
+    ** of up to TAIL_SEARCH_ROWS), against the whole table's threshold: the rise F s^2 of the
+    ** F-test with 1 and N - 4 degrees of freedom */
+    const double rss0 = stride_rss(&c, v);
+    const cf_tail_profile tp = profile_of(&c);
+    const double rise = cf_profile_limit_np(c.n, 4, best, c.ynorm) - best;
+    const int pst = cf_tail_intervals(&tp, v, rss0, rss0 + rise, res);
+    free(buf);
+    if (pst < 0)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the profiles of %zu rows", c.n);
     res->optimizer = "lm";
     res->evaluations = c.evals;
     res->evaluations_full = c.evals;

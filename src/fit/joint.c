@@ -130,8 +130,8 @@ static cf_status verify_tables(const jctx *c, cf_joint_result *r, cf_error *err)
         for (size_t i = 0; i < t->count; i++)
             ymax = fmax(ymax, fabs(t->y[i]));
         const double u = t->y_to_file;
-        jt->aic = cf_baseline_aic(t->count, jt->cell_rmse * jt->cell_rmse * (double)t->count * u * u,
-                                  r->fit.tail ? 4 : 3, ymax * u);
+        const double rss = jt->cell_rmse * jt->cell_rmse * (double)t->count * u * u;
+        jt->aic = cf_baseline_aic(t->count, rss, r->fit.tail ? 4 : 3, ymax * u);
         jt->by_cell = t->mode != CF_MODE_UNIAXIAL;
         if (jt->by_cell)
             memcpy(jt->lattice_MPa, c->curve[k], t->count * sizeof(double));

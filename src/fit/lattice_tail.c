@@ -26,6 +26,7 @@
 #include "fit/clock.h"
 #include "fit/lattice_curve.h"
 #include "fit/lsq.h"
+#include "fit/profile.h"
 #include "fit/subsample.h"
 #include "fit/tail.h"
 #include "fit/tail_cell.h"
@@ -256,11 +257,42 @@ cf_status cf_lattice_fit_tail(const cf_table *d, const cf_fit_options *opt,
     cf_tail_cell_quantities(zb, A, v);
     double se[4], corr[4][4], cov_Bt;
     const long before = c.pr.evals;
-    cf_tail_errors(cf_tail_cell_residuals, (void *)&tc, d->count, v, FD_STEP, f * c.pr.ynorm, se, corr, &cov_Bt);
+    cf_tail_errors(cf_tail_cell_residuals, (void *)&tc, d->count, v, FD_STEP, f * c.pr.ynorm, se,
+                   corr, &cov_Bt);
     t->uncertainty_curves = c.pr.evals - before;
     if ((st = cf_tail_result(&reach, opt, plain->type, v, se, corr, cov_Bt, res, err)) != CF_OK)
         goto out;
     res->held |= cf_tail_cell_held(opt, lb, ub, zb, plain->type);
+    /* profile intervals where the errors say nothing, as fitted to the spring (tail.h), through
+    ** the cell on the search's rows (a long table's subsample) against the whole table's
+    ** threshold */
+    {
+        gsl_vector *fv = gsl_vector_alloc(search->d->count);
+        double rss0 = CF_LSQ_HUGE_OBJ;
+        if (fv && cf_tail_cell_residuals((void *)&tsearch, v, fv) == GSL_SUCCESS) {
+            rss0 = 0;
+            for (size_t i = 0; i < fv->size; i++)
+                rss0 += gsl_vector_get(fv, i) * gsl_vector_get(fv, i);
+            rss0 = isfinite(rss0) ? rss0 : CF_LSQ_HUGE_OBJ;
+        }
+        gsl_vector_free(fv);
+        const double rss = f * c.pr.ynorm;
+        const cf_tail_profile tp = {cf_tail_cell_residuals, (void *)&tsearch, search->d->count,
+                                    search->pr.ynorm, opt, plain->type, 0, need, exp(lb[0]),
+                                    exp(ub[0]), lb[1], ub[1]};
+        const long before_p = search->pr.evals;
+        const int pst = !fv ? -1
+                            : cf_tail_intervals(&tp, v, rss0,
+                                                rss0 + cf_profile_limit_np(d->count, 4, rss,
+                                                                           c.pr.ynorm) - rss,
+                                                res);
+        t->uncertainty_curves += search->pr.evals - before_p;
+        if (pst < 0) {
+            st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the profiles of %zu rows",
+                              d->count);
+            goto out;
+        }
+    }
     /* the target's numbers: the cell's curve of the placed spring */
     if ((st = cf_lattice_curve(&res->params, s, d, 0, c.pr.g, NULL, NULL, NULL, err)) != CF_OK)
         goto out;

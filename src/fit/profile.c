@@ -12,7 +12,12 @@
 ** weighted RSS that the noise can explain, for one quantity. */
 double cf_profile_limit(size_t n, double rss, double ynorm)
 {
-    double dof = (double)n - 3;
+    return cf_profile_limit_np(n, 3, rss, ynorm);
+}
+
+double cf_profile_limit_np(size_t n, int np, double rss, double ynorm)
+{
+    double dof = (double)n - np;
     double s2 = fmax(rss / dof, 1e-24 * ynorm / (double)n);
     return rss + cf_lsq_f95(dof) * s2;
 }
@@ -30,16 +35,20 @@ static double rise(const cf_profile *p, double f)
 }
 
 /* One end of the profile interval of quantity k (dir = -1 low, +1 high), in log units from the
-** value v[k]; res receives the end and the bit of the bound it reached. */
-static void profile_end(const cf_profile *p, int k, const double v[3], double limit, int dir,
-                        double h, cf_fit_result *res)
+** value v[k]; *out receives the end and *out_bit the bit of the bound it reached. */
+static void profile_end(const cf_profile *p, int k, const double *v, double limit, int dir,
+                        double h, double *out, unsigned *out_bit)
 {
-    double xin[2];
+    double xin[CF_PROFILE_X] = {0};
     int j = 0;
-    if (k != 0)
-        xin[j++] = log(v[0]);
-    if (k != 1)
-        xin[j] = v[1];
+    if (p->start) {
+        p->start(p->ctx, k, v, xin);
+    } else {
+        if (k != 0)
+            xin[j++] = log(v[0]);
+        if (k != 1)
+            xin[j] = v[1];
+    }
     const double u0 = log(v[k]);
     const double r_lim = rise(p, limit);
     double u_in = u0, u_out = NAN, f_in = p->with_rss0 ? p->rss0 : NAN, f_out = NAN;
@@ -131,18 +140,25 @@ static void profile_end(const cf_profile *p, int k, const double v[3], double li
             end_bit = p->closed(p->ctx, k, u_in, xin);
     }
     /* exp(log(v)) may differ from v in the last bit: the interval always holds the value */
-    res->interval[k][dir < 0 ? 0 : 1] = dir < 0 ? fmin(exp(u_in), v[k]) : fmax(exp(u_in), v[k]);
-    res->interval_end[k][dir < 0 ? 0 : 1] = end_bit;
+    *out = dir < 0 ? fmin(exp(u_in), v[k]) : fmax(exp(u_in), v[k]);
+    *out_bit = end_bit;
+}
+
+void cf_profile_interval(const cf_profile *p, int k, const double *v, double limit, double se,
+                         double out[2], unsigned end[2])
+{
+    double h = se > 0 ? fmin(0.5 * se / v[k], 0.1) : 0.01;
+    h = fmax(h, 1e-13);
+    profile_end(p, k, v, limit, -1, h, &out[0], &end[0]);
+    profile_end(p, k, v, limit, +1, h, &out[1], &end[1]);
 }
 
 void cf_profile_intervals(const cf_profile *p, const double v[3], double limit, unsigned why,
                           cf_fit_result *res)
 {
     for (int k = 0; k < 3; k++) {
-        double h = res->ident_se.v[k] > 0 ? fmin(0.5 * res->ident_se.v[k] / v[k], 0.1) : 0.01;
-        h = fmax(h, 1e-13);
-        profile_end(p, k, v, limit, -1, h, res);
-        profile_end(p, k, v, limit, +1, h, res);
+        cf_profile_interval(p, k, v, limit, res->ident_se.v[k], res->interval[k],
+                            res->interval_end[k]);
         res->interval_ok[k] = 1;
         res->interval_why[k] = why;
     }

@@ -10,12 +10,14 @@
 
 #include "conifit/fit.h"
 
-/* A fit's profile. The other two quantities of a profile of k travel in x[2]: (log rho, B)
-** without the one profiled (both when k is the stress scale). */
+/* A fit's profile. The other two quantities of a profile of k travel in x: (log rho, B)
+** without the one profiled (both when k is the stress scale), or, where start is given, what
+** start puts there (at most CF_PROFILE_X values: the tailed law's four quantities). */
+#define CF_PROFILE_X 4
 typedef struct cf_profile {
     void *ctx;
-    double lo[3], hi[3];          /* range of each quantity, log units */
-    unsigned lo_bit[3], hi_bit[3]; /* CF_C_* bit of the limit at each end of that range */
+    double lo[4], hi[4];          /* range of each quantity, log units (the tailed law's four) */
+    unsigned lo_bit[4], hi_bit[4]; /* CF_C_* bit of the limit at each end of that range */
     /* the weighted RSS minimised over the other quantities with quantity k at exp(u), from x;
     ** x moves to the minimiser when that RSS is within limit */
     double (*at)(void *ctx, int k, double u, double limit, double *x);
@@ -25,11 +27,24 @@ typedef struct cf_profile {
     ** square root of the profile's rise above it (nearly linear in u), not on the RSS itself */
     int with_rss0;
     double rss0;
+    /* NULL, or the start x of a profile of k from the fitted quantities v (a fit whose other
+    ** quantities are not (log rho, B): the tailed law's) */
+    void (*start)(void *ctx, int k, const double *v, double *x);
 } cf_profile;
 
 /* The weighted RSS a profile may reach: rss plus F(0.95; 1, n - 3) times the residual variance
 ** (floored at rounding level of ynorm, the data's weighted sum of squares). */
 double cf_profile_limit(size_t n, double rss, double ynorm);
+
+/* The same for a law of np quantities: F(0.95; 1, n - np) (the tailed law has four). */
+double cf_profile_limit_np(size_t n, int np, double rss, double ynorm);
+
+/* The profile interval of quantity k of v (v holds every quantity the profile's at reads) into
+** out[2], with the CF_C_* bit of the limit each end reached (0: the threshold) in end[2]; se is
+** its standard error (<= 0: none), which sets the first step. cf_profile_intervals runs it for
+** each of the three quantities of a fit. */
+void cf_profile_interval(const cf_profile *p, int k, const double *v, double limit, double se,
+                         double out[2], unsigned end[2]);
 
 /* The profile interval of every quantity of v into res (interval, interval_end, interval_ok;
 ** interval_why = why), each end searched outward from v in log steps that start at half the

@@ -40,4 +40,37 @@ cf_status cf_tail_result(const cf_table *data, const cf_fit_options *opt, cf_spr
                          const double v[4], const double se[4], double corr[4][4], double cov_Bt,
                          cf_fit_result *res, cf_error *err);
 
+/* A tailed fit's residuals for its profile intervals: m weighted residuals (the table's rows, or
+** a subsample of a long one each standing for its share of the table) at v = (rho, B, A, tau), the
+** ranges the fit searched, and what the cap on A needs (a stress-strain table's A stays below
+** cf_tail_A_max; a force table's A is free). */
+typedef struct cf_tail_profile {
+    cf_tail_residuals res;
+    void *ctx;
+    size_t m;
+    double ynorm;            /* the data's weighted sum of squares, a scale */
+    const cf_fit_options *opt;
+    cf_spring_type type;
+    int fd;                  /* 1: a force table */
+    double need;             /* the table's largest strain with the travel margin */
+    double rho_lo, rho_hi, b_lo, b_hi;
+} cf_tail_profile;
+
+/* The profile intervals of the four quantities (rho, B, A, e_t) of a tailed fit res (filled by
+** cf_tail_result, its held bits included) into res->interval* and res->e_tail_interval*, where
+** the plain law's rule asks for them: a quantity on a limit, a singular Jacobian, or a standard
+** error that reaches past the quantity's range (the "not determined" of the tailed law's
+** report). v = (rho, B, A, tau) is the fit; rss0 the weighted RSS of p's residuals there; limit the
+** weighted RSS over p's residuals a profile may reach. Deterministic; 0, or -1 when memory ran
+** out (the intervals are then not computed). */
+int cf_tail_intervals(const cf_tail_profile *p, const double v[4], double rss0, double limit,
+                      cf_fit_result *res);
+
+/* The profile of quantity k (0 rho, 1 B, 2 A, 3 e_t) of the tailed spring fit `fit` of table data
+** at `value`: the weighted RSS of the profile's rows minimised over the other three from the fit,
+** as cf_tail_intervals finds it; *limit the threshold its intervals are drawn at. NAN when out
+** of memory. For checking an interval's ends. */
+double cf_tail_profile_at(const cf_table *data, const cf_fit_options *opt,
+                          const cf_fit_result *fit, int k, double value, double *limit);
+
 #endif

@@ -21,8 +21,8 @@ cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const
     memset(st, 0, sizeof *st);
     st->lat = lat;
     cf_law_lanes_init(lat->law, &st->lanes);
-    if (lat->law->tail) /* the lanes hold the plain law only: a tail runs the scalar law */
-        st->form = -1;
+    if (lat->law->tail) /* its lanes hold the polynomial only: without it, the scalar law */
+        st->form = lat->method == CF_LAW_CLOSED || lat->method == CF_LAW_TABLE ? CF_LANE_POLY : -1;
     else if (lat->method == CF_LAW_CLOSED)
         st->form = CF_LANE_CLOSED;
     else if (lat->method == CF_LAW_TABLE && st->lanes.coef)
@@ -33,6 +33,8 @@ cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const
     ** form (more accurate than the table, cheaper than both) */
     if (st->form >= 0 && cf_law_lanes_fit_poly(lat->law, &st->lanes, &st->poly_error))
         st->form = CF_LANE_POLY;
+    else if (st->form == CF_LANE_POLY)
+        st->form = -1;
     const cf_lattice_config *cfg = &lat->cfg;
     const int nx = cfg->nx, ny = cfg->ny, nz = cfg->nz;
     st->layer = (size_t)(nx + 1) * (size_t)(ny + 1);

@@ -279,10 +279,16 @@ static void region2_exact(const cf_law *law, double delta, double *y, double *om
     }
 }
 
+static void region2_tail(const cf_law *law, int exact, double delta, double *y, double *om,
+                         double *e_out);
+
 double cf_law_region2_e(const cf_law *law, double delta)
 {
     double y, om, e;
-    region2_exact(law, delta, &y, &om, &e);
+    if (law->tail)
+        region2_tail(law, 1, delta, &y, &om, &e);
+    else
+        region2_exact(law, delta, &y, &om, &e);
     return e;
 }
 
@@ -700,6 +706,14 @@ void cf_law_lanes_init(const cf_law *law, cf_law_lanes *lanes)
     lanes->coef = law->table ? law->table->coef : NULL;
     lanes->inv_h = law->table ? law->table->inv_h : 0.0;
     lanes->xmax = law->table ? (double)(law->table->intervals - 1) : 0.0;
+    lanes->law = law;
+    if (law->tail) { /* the polynomial only (law_simd.h); kappa2 and z0 come with its fit */
+        lanes->tail = 1;
+        lanes->u_C = law->u_C_mm;
+        lanes->k_t = law->k_tail_N_per_mm;
+        lanes->F_sol = law->F_solid_N;
+        lanes->b4 = 4.0 * law->beta;
+    }
 }
 
 void cf_law_force_many(const cf_law *law, cf_law_method method, size_t count, const double *u_mm,

@@ -53,7 +53,9 @@ cf_simd cf_simd_level(void)
                                       const double *u, double *F)                                  \
     {                                                                                              \
         const cf_law_lanes c = *lanes; /* by value: its loads leave the loop */                    \
-        if (form == CF_LANE_TABLE && c.coef)                                                       \
+        if (c.tail && !(form == CF_LANE_POLY && c.poly_fit))                                       \
+            cf_law_force_many(c.law, CF_LAW_CLOSED, count, u, F, NULL); /* the scalar law */      \
+        else if (form == CF_LANE_TABLE && c.coef)                                                  \
             cf_lanes_table(&c, count, u, F);                                                       \
         else if (form == CF_LANE_POLY && c.poly_fit)                                               \
             cf_lanes_poly(&c, count, u, F);                                                        \

@@ -98,6 +98,15 @@ typedef struct cf_law_lanes {
     double w_T, w_split, r4; /* w_T, the pieces' boundary, 4 (1/rho - 1) */
     double px_a[2], px_b[2];
     double pa[2][CF_POLY_DEGREE + 1], pb[2][CF_POLY_DEGREE + 1];
+    /* a spring with a cylindrical tail (tail = 1; law.md): the lanes hold its polynomial only
+    ** (cf_lane_poly_tail), s is the whole travel to solid and inv_s the cone's 1/s; the
+    ** polynomial's variable is z = sqrt((u_C - |u|)/s + kappa2), clamped to w_T (the fit's end,
+    ** the transition) and from z0 = sqrt(kappa2) (the cone's solid); law: the law itself, which
+    ** cf_law_force_lanes runs for any other form */
+    int tail, tail_form; /* tail_form: CF_TAIL_NEAR, CF_TAIL_W or CF_TAIL_V (below) */
+    const cf_law *law;
+    double u_C, k_t, F_sol, kappa2, z0, b4; /* u_C, k_tail, F_solid, kappa^2, kappa, 4 beta */
+    double e_star, q0, q1, q2; /* CF_TAIL_NEAR: e* and Q(e) = q0 + q1 e + q2 e^2 */
 } cf_law_lanes;
 
 /* Fills lanes from law; the table coefficients are those of law's table when it has one. No
@@ -112,7 +121,8 @@ void cf_law_lanes_init(const cf_law *law, cf_law_lanes *lanes);
 ** error of the last fit tried, or NAN when nothing was fitted. */
 int cf_law_lanes_fit_poly(const cf_law *law, cf_law_lanes *lanes, double *worst);
 
-/* e = 1 - y of region 2 at delta >= 0 from the exact solver (law.c). */
+/* e = 1 - y of region 2 at delta >= 0 from the exact solver (law.c); with a tail delta is the
+** tailed relation's Delta = (1/rho - 1)(u_C - |u|)/s. */
 double cf_law_region2_e(const cf_law *law, double delta);
 
 /* The same force of one lane for any form: the caller has chosen it at compile time. */
@@ -228,6 +238,61 @@ CF_LANE double cf_lane_poly(const cf_law_lanes *c, double u, int deg, int pieces
     return cf_lane_regions(c, u, a, c->F_C * y * y * y);
 }
 
+/* The force of a spring with a tail from its fitted polynomial (law_poly.c), in one of three forms
+** (form: a constant where it is inlined, c->tail_form), each followed by one division-free Newton
+** step on the tailed relation Phi(e) = Delta (law.c) multiplied by 4 (1 - e) = 4 y,
+**   N(e) - 4 (1 - e)(Delta - Phi*) = 0,
+**   N(e) = e^2 (6 - 4e + e^2) + 4 beta e (1 - e)(3 - 3e + e^2) - 4 (1 - e) Phi*:
+** - CF_TAIL_NEAR (beta < 1/4): Phi's minimum e* < 0 (law.c, struct cf_law_table) is a double root
+**   of N for Phi* = Phi(e*) = -r kappa^2, N = (e - e*)^2 Q(e) with Q quadratic; in
+**   z = sqrt(v + kappa^2), v = (u_C - |u|)/s, Delta - Phi* = r z^2, so e = e* + z P with P regular
+**   and h(P) = P^2 Q(e) - 4 r (1 - e) = 0: the plain law's relation (e* = 0, Q = 6 - 4e + e^2),
+**   shifted. The polynomials are P0(z) ~ P and K(z) ~ 1/h'(P), as for the plain law. (A form in e
+**   itself would need 1/h'(e), which has a pole at distance ~ beta from the cone's solid.)
+** - CF_TAIL_W and CF_TAIL_V (Phi* = 0): E(z) ~ e and K(z) ~ 1/h'(e), z = sqrt(v) or v, with
+**   h(e) = N(e) - 4 (1 - e) Delta, whose derivative at the root, 4 y Phi'(e), is at least about
+**   12 beta there. e is analytic in Delta at the cone's solid once beta is not small; which
+**   variable converges faster depends on rho and beta (law_poly.c tries both).
+** Delta is formed as the scalar law forms it. Regions 1 and 3 and the two solids by selection, in
+** the scalar law's order (law.c, law_eval): region 1 up to u_T, the tail's line
+** F_C + k_t (|u| - u_C) from u_C, F_solid from s. */
+enum { CF_TAIL_NEAR = 0, CF_TAIL_W = 1, CF_TAIL_V = 2 };
+CF_LANE double cf_lane_poly_tail(const cf_law_lanes *c, double u, int deg, int pieces, int form)
+{
+    const double a = fabs(u), va = (c->u_C - a) * c->inv_s;
+    const double v = va > 0.0 ? va : 0.0; /* region 3, the solid and NaN map to the cone's solid */
+    double z = form == CF_TAIL_V ? v : sqrt(v + c->kappa2);
+    z = z < c->w_T ? z : c->w_T; /* region 1 maps to the fit's end */
+    const int q = pieces == 2 && z > c->w_split;
+    const double x = z * (q ? c->px_a[1] : c->px_a[0]) + (q ? c->px_b[1] : c->px_b[0]);
+    double P = q ? c->pa[1][deg] : c->pa[0][deg], K = q ? c->pb[1][deg] : c->pb[0][deg];
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC unroll 32
+#endif
+    for (int j = deg - 1; j >= 0; j--) {
+        P = P * x + (q ? c->pa[1][j] : c->pa[0][j]);
+        K = K * x + (q ? c->pb[1][j] : c->pb[0][j]);
+    }
+    double y;
+    if (form == CF_TAIL_NEAR) {
+        const double e = c->e_star + z * P;
+        const double h = P * P * (c->q0 + e * (c->q1 + e * c->q2)) - c->r4 * (1.0 - e);
+        y = (1.0 - c->e_star) - z * (P - h * K);
+    } else {
+        const double om = 1.0 - P;
+        const double h = P * P * (6.0 + P * (-4.0 + P)) +
+                         c->b4 * (P * om) * (3.0 + P * (-3.0 + P)) - 4.0 * om * (c->rim1 * v);
+        y = om + h * K;
+    }
+    const double F2 = c->F_C * y * y * y;
+    const double F3 = c->F_C + c->k_t * (a - c->u_C);
+    double F = a < c->s ? F3 : c->F_sol;
+    F = a < c->u_C ? F2 : F;
+    F = a <= c->u_T ? c->k0 * a : F;
+    F = copysign(F, u);
+    return u != u ? 0.0 : F;
+}
+
 /* Forces F[k] of count displacements u[k] (F may be u), each form a few vectorised loops over
 ** chunks: the table's y of every lane first, stored, then the regions; a lookup inside the
 ** region selection would be a conditional load, which the compiler does not vectorise. */
@@ -240,8 +305,37 @@ CF_LANE void cf_lanes_closed(const cf_law_lanes *c, size_t count, const double *
         F[k] = cf_lane_closed(c, u[k]);
 }
 
+#define CF_LANES_POLY_TAIL(form)                                                                   \
+    do {                                                                                           \
+        if (c->poly_pieces == 2) {                                                                 \
+            _Pragma("omp simd") for (size_t k = 0; k < count; k++)                                 \
+                F[k] = cf_lane_poly_tail(c, u[k], CF_POLY_DEGREE, 2, form);                        \
+        } else if (c->poly_degree == CF_POLY_DEGREE_LOW) {                                         \
+            _Pragma("omp simd") for (size_t k = 0; k < count; k++)                                 \
+                F[k] = cf_lane_poly_tail(c, u[k], CF_POLY_DEGREE_LOW, 1, form);                    \
+        } else {                                                                                   \
+            _Pragma("omp simd") for (size_t k = 0; k < count; k++)                                 \
+                F[k] = cf_lane_poly_tail(c, u[k], CF_POLY_DEGREE, 1, form);                        \
+        }                                                                                          \
+    } while (0)
+
+CF_LANE void cf_lanes_poly_tail(const cf_law_lanes *c, size_t count, const double *u, double *F)
+{
+    if (c->tail_form == CF_TAIL_NEAR)
+        CF_LANES_POLY_TAIL(CF_TAIL_NEAR);
+    else if (c->tail_form == CF_TAIL_W)
+        CF_LANES_POLY_TAIL(CF_TAIL_W);
+    else
+        CF_LANES_POLY_TAIL(CF_TAIL_V);
+}
+
+/* The spring's polynomial, with or without a tail. */
 CF_LANE void cf_lanes_poly(const cf_law_lanes *c, size_t count, const double *u, double *F)
 {
+    if (c->tail) {
+        cf_lanes_poly_tail(c, count, u, F);
+        return;
+    }
     if (c->poly_pieces == 2) {
 #pragma omp simd
         for (size_t k = 0; k < count; k++)
@@ -277,7 +371,8 @@ CF_LANE void cf_lanes_table(const cf_law_lanes *c, size_t count, const double *u
 
 /* Forces of count displacements with the closed form, the table (lanes->coef not NULL) or the
 ** polynomial (lanes->poly_fit): F[i] for u[i]. Vectorised, dispatched at run time. A form whose
-** data lanes lacks runs the closed form. */
+** data lanes lacks runs the closed form; a spring with a tail has the polynomial only, and any
+** other form (or no fitted polynomial) runs its scalar closed form. */
 void cf_law_force_lanes(const cf_law_lanes *lanes, int form, size_t count, const double *u,
                         double *F);
 

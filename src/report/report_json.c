@@ -16,13 +16,38 @@ static const char *stderr_reason(const cf_fit_result *f)
 {
     for (int k = 0; k < 3; k++)
         if (f->interval_ok[k] && (f->interval_why[k] & CF_FIT_RANK_DEFICIENT))
-            return "not determined: the Jacobian of the three quantities is numerically "
-                   "rank-deficient (see interval)";
+            return f->tail ? "not determined: the Jacobian of the four quantities is singular "
+                             "(see interval)"
+                           : "not determined: the Jacobian of the three quantities is "
+                             "numerically rank-deficient (see interval)";
     return "not determined: the linearised covariance s^2 (J^T W J)^-1 could not be formed";
 }
 
 /* {value, stderr | stderr_reason, [interval, interval_reason]} in conifit's units (MPa, N, mm):
 ** a key is present only with a value, never null. */
+/* o's interval, interval_reason and interval_limit for quantity k (report_words.h: k < 3 or
+** CF_REPORT_TAIL), its interval [lo, hi] whose ends reached the limits end[2] (0: the data's). */
+static void interval_json(json_t *o, const cf_fit_result *f, int k, const double iv[2],
+                          const unsigned end[2])
+{
+    char why[512];
+    cf_report_interval_reason(f, k, why, sizeof why);
+    json_object_set_new(o, "interval", json_pack("[o, o]", num(iv[0]), num(iv[1])));
+    json_object_set_new(o, "interval_reason", json_string(why));
+    /* an end that is a limit, not the data's: the interval is one-sided there */
+    json_t *lim = json_object();
+    for (int e = 0; e < 2; e++) {
+        unsigned b = end[e];
+        if (b && lim)
+            json_object_set_new(lim, e ? "upper" : "lower",
+                                json_string(cf_fit_constraint_name(b & (0u - b))));
+    }
+    if (lim && json_object_size(lim) > 0)
+        json_object_set_new(o, "interval_limit", lim);
+    else
+        json_decref(lim);
+}
+
 json_t *cf_report_tail_json(const cf_fit_result *f)
 {
     json_t *o = json_pack("{s:o}", "value", num(f->e_tail));
@@ -33,6 +58,8 @@ json_t *cf_report_tail_json(const cf_fit_result *f)
                             json_string("the Jacobian of the four quantities is singular"));
     if (o && f->e_tail_se > fabs(f->e_tail))
         json_object_set_new(o, "determined", json_false());
+    if (o && f->e_tail_interval_ok)
+        interval_json(o, f, CF_REPORT_TAIL, f->e_tail_interval, f->e_tail_interval_end);
     return o;
 }
 
@@ -48,25 +75,8 @@ json_t *cf_report_ident_json(const cf_fit_result *f, int k)
         json_object_set_new(o, "stderr_reason", json_string(stderr_reason(f)));
     if (f->tail && se > fabs(f->ident.v[k]))
         json_object_set_new(o, "determined", json_false());
-    if (f->interval_ok[k]) {
-        char why[512];
-        cf_report_interval_reason(f, k, why, sizeof why);
-        json_object_set_new(o, "interval",
-                            json_pack("[o, o]", num(f->interval[k][0]), num(f->interval[k][1])));
-        json_object_set_new(o, "interval_reason", json_string(why));
-        /* an end that is a limit, not the data's: the interval is one-sided there */
-        json_t *lim = json_object();
-        for (int e = 0; e < 2; e++) {
-            unsigned b = f->interval_end[k][e];
-            if (b && lim)
-                json_object_set_new(lim, e ? "upper" : "lower",
-                                    json_string(cf_fit_constraint_name(b & (0u - b))));
-        }
-        if (lim && json_object_size(lim) > 0)
-            json_object_set_new(o, "interval_limit", lim);
-        else
-            json_decref(lim);
-    }
+    if (f->interval_ok[k])
+        interval_json(o, f, k, f->interval[k], f->interval_end[k]);
     return o;
 }
 

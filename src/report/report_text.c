@@ -84,12 +84,8 @@ static void tail_row(FILE *o, const cf_fit_report *r)
         char cell[96];
         if (!f->tail)
             snprintf(cell, sizeof cell, "-");
-        else if (f->e_tail_se > fabs(f->e_tail))
-            snprintf(cell, sizeof cell, "%.4g%s (not determined)", f->e_tail, fd ? " mm" : "");
-        else if (f->e_tail_se >= 0)
-            snprintf(cell, sizeof cell, "%.6g ± %.2g%s", f->e_tail, f->e_tail_se, fd ? " mm" : "");
         else
-            snprintf(cell, sizeof cell, "%.6g (error not determined)%s", f->e_tail, fd ? " mm" : "");
+            cf_report_ident_cell(f, CF_REPORT_TAIL, 1, fd ? "mm" : "", cell, sizeof cell);
         fprintf(o, " %-24s", cell);
     }
     fputc('\n', o);
@@ -128,13 +124,14 @@ static void law_choice_text(FILE *o, const cf_fit_report *r)
     }
 }
 
-/* Below the table: what each starred interval means, per type and quantity. */
-static void interval_notes(FILE *o, const cf_fit_report *r, const char *const names[3])
+/* Below the table: what each starred interval means, per type and quantity (the tail's
+** compliance after the three). */
+static void interval_notes(FILE *o, const cf_fit_report *r, const char *const names[4])
 {
     for (int i = 0; i < r->nfits; i++)
-        for (int k = 0; k < 3; k++) {
+        for (int k = 0; k < 4; k++) {
             const cf_fit_result *f = &r->fits[i];
-            if (!f->interval_ok[k])
+            if (k < 3 ? !f->interval_ok[k] : !(f->tail && f->e_tail_interval_ok))
                 continue;
             char why[512];
             cf_report_interval_reason(f, k, why, sizeof why);
@@ -363,8 +360,9 @@ static void identifiable_text(FILE *o, const cf_fit_report *r)
     }
     if (any_tail(r))
         tail_row(o, r);
-    static const char *const ss_names[3] = {"rho", "solid strain", "stress scale"};
-    static const char *const fd_names[3] = {"rho", "travel", "solid load"};
+    static const char *const ss_names[4] = {"rho", "solid strain", "stress scale",
+                                            "tail compliance"};
+    static const char *const fd_names[4] = {"rho", "travel", "solid load", "tail compliance"};
     interval_notes(o, r, cf_table_is_force(r->table) ? fd_names : ss_names);
     fprintf(o, "  %-26s", "correlation rho-s, rho-A, s-A");
     for (int i = 0; i < r->nfits; i++) {

@@ -23,12 +23,32 @@ void cf_report_append(char *buf, size_t cap, size_t *n, const char *fmt, ...)
         *n = fmin(*n + (size_t)k, cap - 1);
 }
 
+/* Quantity k of f with its error and profile interval: k < 3 the identifiable quantities,
+** CF_REPORT_TAIL the tailed law's e_t. Returns interval_ok. */
+static int quantity(const cf_fit_result *f, int k, double *v, double *se, const double **iv,
+                    const unsigned **end, unsigned *why)
+{
+    if (k == CF_REPORT_TAIL) {
+        *v = f->e_tail, *se = f->e_tail_se, *iv = f->e_tail_interval;
+        *end = f->e_tail_interval_end, *why = f->e_tail_interval_why;
+        return f->e_tail_interval_ok;
+    }
+    *v = f->ident.v[k], *se = f->ident_se.v[k], *iv = f->interval[k];
+    *end = f->interval_end[k], *why = f->interval_why[k];
+    return f->interval_ok[k];
+}
+
 /* Why a profile interval was computed and where its ends come from, in words. */
 void cf_report_interval_reason(const cf_fit_result *f, int k, char *buf, size_t cap)
 {
     size_t n = 0;
     buf[0] = '\0';
-    unsigned why = f->interval_why[k], lim = why & ~CF_FIT_RANK_DEFICIENT;
+    double v, se;
+    const double *iv;
+    const unsigned *ends;
+    unsigned why;
+    quantity(f, k, &v, &se, &iv, &ends, &why);
+    unsigned lim = why & ~CF_FIT_RANK_DEFICIENT;
     cf_report_append(buf, cap, &n, "profile likelihood, 95 %% (F-test), because ");
     if (why & CF_FIT_RANK_DEFICIENT)
         cf_report_append(buf, cap, &n, "the Jacobian is rank-deficient%s", lim ? " and " : "");
@@ -41,7 +61,7 @@ void cf_report_interval_reason(const cf_fit_result *f, int k, char *buf, size_t 
     if (!why)
         cf_report_append(buf, cap, &n, "the standard error reaches past the quantity's range");
     for (int e = 0; e < 2; e++) {
-        unsigned b = f->interval_end[k][e];
+        unsigned b = ends[e];
         if (b)
             cf_report_append(buf, cap, &n,
                              "; the %s end is the limit %s: the data do not bound it",
@@ -165,21 +185,24 @@ void cf_report_ident_cell(const cf_fit_result *f, int k, double scale, const cha
                           char *cell, size_t cap)
 {
     const char *sp = *unit ? " " : "";
-    if (f->interval_ok[k]) {
-        const double v = f->ident.v[k] * scale, lo = f->interval[k][0] * scale,
-                     hi = f->interval[k][1] * scale;
+    double q, se;
+    const double *iv;
+    const unsigned *ends;
+    unsigned why;
+    if (quantity(f, k, &q, &se, &iv, &ends, &why)) {
+        const double v = q * scale, lo = iv[0] * scale, hi = iv[1] * scale;
         const int dg = interval_digits(v, lo, hi);
         snprintf(cell, cap, "%.*g [%.*g, %.*g]*%s%s", dg > 4 ? dg : 4, v, dg, lo, dg, hi, sp,
                  unit);
-    } else if (f->tail && f->ident_se.v[k] > fabs(f->ident.v[k])) {
+    } else if (f->tail && se > fabs(q)) {
         /* the tailed law's four quantities traded against each other by the data */
-        snprintf(cell, cap, "%.4g%s%s (not determined)", f->ident.v[k] * scale, sp, unit);
-    } else if (f->ident_se.v[k] >= 0) {
-        snprintf(cell, cap, "%.6g ± %.2g%s%s", f->ident.v[k] * scale, f->ident_se.v[k] * scale,
-                 sp, unit);
+        snprintf(cell, cap, "%.4g%s%s (not determined)", q * scale, sp, unit);
+    } else if (se >= 0) {
+        snprintf(cell, cap, "%.6g ± %.2g%s%s", q * scale, se * scale, sp, unit);
+    } else if (k == CF_REPORT_TAIL) {
+        snprintf(cell, cap, "%.6g%s%s (error not determined)", q * scale, sp, unit);
     } else { /* the uncertainty code computes an interval wherever the error is undetermined */
-        snprintf(cell, cap, "%.6g%s%s (no error: not determined)", f->ident.v[k] * scale, sp,
-                 unit);
+        snprintf(cell, cap, "%.6g%s%s (no error: not determined)", q * scale, sp, unit);
     }
 }
 

@@ -147,6 +147,51 @@ static void force_table_with_lattice_target_fits_the_tail_to_the_spring(void **s
     json_decref(root);
 }
 
+/* The aortic valve leaflet read as uniaxial keeps the tail, whose four quantities the table trades
+** against each other: the report prints each as value [low, high]* with the reason below, and the
+** fit file gives each, the tail's compliance too, its interval and interval_reason. */
+static void tailed_fit_reports_profile_intervals(void **state)
+{
+    (void)state;
+    const char *dir = tu_datasets();
+    if (!dir)
+        skip();
+    static char out[1 << 16], args[1024];
+    snprintf(args, sizeof args,
+             "%s/aortic_valve_circumferential.csv --mode uniaxial --type non-telescoping "
+             "--law auto",
+             dir);
+    json_t *root = fit_file_of(args, out, sizeof out);
+    json_t *f = json_array_get(json_object_get(root, "fits"), 0);
+    assert_string_equal(json_string_value(json_object_get(f, "law")), "conical-tail");
+    const char *line = strstr(out, "tail compliance e_t");
+    assert_non_null(line);
+    const char *eol = strchr(line, '\n');
+    assert_non_null(eol);
+    const char *star = strstr(line, "]*");
+    assert_true(star && star < eol);
+    assert_non_null(strstr(out, "* non-telescoping, tail compliance: profile likelihood, 95 %"));
+    json_t *id = json_object_get(f, "identifiable");
+    static const char *const keys[4] = {"rho", "solid_strain", "stress_scale_MPa",
+                                        "tail_compliance"};
+    for (int k = 0; k < 4; k++) {
+        json_t *q = json_object_get(id, keys[k]), *iv = json_object_get(q, "interval");
+        assert_non_null(q);
+        assert_true(json_array_size(iv) == 2);
+        const double v = json_number_value(json_object_get(q, "value"));
+        const double lo = json_number_value(json_array_get(iv, 0)),
+                     hi = json_number_value(json_array_get(iv, 1));
+        assert_true(lo <= v && v <= hi && lo < hi);
+        assert_non_null(json_string_value(json_object_get(q, "interval_reason")));
+    }
+    /* the comparison of the laws carries the same */
+    json_t *tc = json_object_get(json_object_get(json_object_get(f, "law_comparison"),
+                                                 "conical-tail"),
+                                 "tail_compliance");
+    assert_true(json_array_size(json_object_get(tc, "interval")) == 2);
+    json_decref(root);
+}
+
 /* What the tailed law does not do is refused with exit 2 and nothing written. */
 static void unsupported_combinations_exit_2(void **state)
 {
@@ -251,6 +296,7 @@ int main(void)
         cmocka_unit_test(conical_tail_writes_the_tail),
         cmocka_unit_test(conical_tail_goes_through_the_lattice),
         cmocka_unit_test(force_table_with_lattice_target_fits_the_tail_to_the_spring),
+        cmocka_unit_test(tailed_fit_reports_profile_intervals),
         cmocka_unit_test(unsupported_combinations_exit_2),
         cmocka_unit_test(joint_auto_reports_both_laws),
         cmocka_unit_test(tailed_elastic_part_is_refused),

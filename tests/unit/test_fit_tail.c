@@ -1,7 +1,8 @@
 /*
 ** The fit of the conical-tail law: known tailed springs recovered from synthetic tables (noiseless
 ** to 1e-6 in the four identifiable quantities, noisy within their reported errors), the placed
-** spring of the type fitted, and --law auto on published tables: the tail kept only with an AIC
+** spring of the type fitted, profile intervals where the quantities trade off (and none where the
+** errors say enough), and --law auto on published tables: the tail kept only with an AIC
 ** gain, kept where it gains (aortic valve leaflet read as uniaxial), not where it cannot (a
 ** softening brain tension table).
 */
@@ -14,11 +15,13 @@
 #include <string.h>
 
 #include <cmocka.h>
+#include <gsl/gsl_errno.h>
 
 #include "conifit/fit.h"
 #include "conifit/measure.h"
 #include "conifit/pipeline.h"
 #include "conifit/report.h"
+#include "fit/tail.h"
 #include "testutil.h"
 
 /* A tailed spring: D1 = 3 d, D2 = D1/rho, cone travel 20 mm, tail of tau n coils whose gap per
@@ -55,6 +58,33 @@ static void table_of(const cf_spring *p, size_t npts, double noise, cf_table *t)
             const double u2 = ((double)(s >> 11) + 0.5) / 9007199254740992.0;
             z = sqrt(-2 * log(u1)) * cos(2 * M_PI * u2);
         }
+        y[i] = cf_law_force(&law, CF_LAW_EXACT, x[i] * H, NULL, NULL) / (H * H) * (1 + noise * z);
+    }
+    cf_error err = {0};
+    assert_int_equal(cf_table_from_arrays(CF_TABLE_STRESS_STRAIN, npts, x, y, NULL, t, &err), CF_OK);
+    free(x);
+    free(y);
+}
+
+/* The stress-strain table of spring p at npts strains up to `share` of its cone's travel s (the
+** cone closes only past the table's end, at s (1 + tau)), with relative Gaussian noise as above. */
+static void table_short_of(const cf_spring *p, size_t npts, double noise, double share,
+                           cf_table *t)
+{
+    cf_law law;
+    assert_int_equal(cf_law_init(&law, p, NULL), CF_OK);
+    double *x = malloc(npts * sizeof *x), *y = malloc(npts * sizeof *y);
+    assert_non_null(x);
+    assert_non_null(y);
+    const double H = p->H_mm, emax = share * law.cone_travel_mm / H;
+    unsigned long long s = 987654321;
+    for (size_t i = 0; i < npts; i++) {
+        x[i] = emax * (double)(i + 1) / (double)npts;
+        s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+        const double u1 = ((double)(s >> 11) + 0.5) / 9007199254740992.0;
+        s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+        const double u2 = ((double)(s >> 11) + 0.5) / 9007199254740992.0;
+        const double z = sqrt(-2 * log(u1)) * cos(2 * M_PI * u2);
         y[i] = cf_law_force(&law, CF_LAW_EXACT, x[i] * H, NULL, NULL) / (H * H) * (1 + noise * z);
     }
     cf_error err = {0};
@@ -133,6 +163,67 @@ static void noisy_spring_is_within_its_errors(void **state)
         if (!(fabs(f[k] - q[k]) <= 3 * se[k]))
             fail_msg("quantity %d: fitted %.8g ± %.3g, true %.8g", k, f[k], se[k], q[k]);
     }
+    /* every quantity determined, none on a limit: no profile intervals (the plain law's rule) */
+    for (int k = 0; k < 3; k++)
+        assert_false(r.interval_ok[k]);
+    assert_false(r.e_tail_interval_ok);
+    cf_table_free(&t);
+}
+
+/* Where the cone closes past the table's end the four quantities trade off and their errors say
+** nothing: each gets a profile interval that holds its value and the truth, and an end the data
+** draw is where the profile crosses the threshold (just inside it below, just outside above). */
+static void undetermined_quantities_get_profile_intervals(void **state)
+{
+    (void)state;
+    cf_spring p = tailed(0.3, 4, 0.5, 3);
+    cf_table t;
+    table_short_of(&p, 100, 0.01, 0.9, &t);
+    cf_fit_options o = cf_fit_default_options();
+    cf_fit_result r;
+    cf_error err = {0};
+    assert_int_equal(cf_fit_tail_run(&t, &o, CF_NON_TELESCOPING, NULL, &r, &err), CF_OK);
+    double q[4], f[4], se[4] = {r.ident_se.rho, r.ident_se.solid, r.ident_se.scale, r.e_tail_se};
+    truth_of(&p, q);
+    fitted_of(&r, f);
+    int undetermined = 0;
+    for (int k = 0; k < 4; k++)
+        undetermined += se[k] < 0 || se[k] > fabs(f[k]);
+    assert_true(undetermined > 0);
+    const double *iv[4] = {r.interval[0], r.interval[1], r.interval[2], r.e_tail_interval};
+    const unsigned *end[4] = {r.interval_end[0], r.interval_end[1], r.interval_end[2],
+                              r.e_tail_interval_end};
+    for (int k = 0; k < 3; k++)
+        assert_true(r.interval_ok[k]);
+    assert_true(r.e_tail_interval_ok);
+    for (int k = 0; k < 4; k++) {
+        assert_true(isfinite(iv[k][0]) && isfinite(iv[k][1]));
+        if (!(iv[k][0] <= f[k] && f[k] <= iv[k][1]))
+            fail_msg("quantity %d: %.8g outside its interval [%.8g, %.8g]", k, f[k], iv[k][0],
+                     iv[k][1]);
+        if (!(iv[k][0] <= q[k] && q[k] <= iv[k][1]))
+            fail_msg("quantity %d: true %.8g outside the interval [%.8g, %.8g] of %.8g", k, q[k],
+                     iv[k][0], iv[k][1], f[k]);
+    }
+    /* each end the threshold drew: the profile 3 % of the end's distance (log units) inside it
+    ** is below the threshold, 3 % outside above it (the ends are found to 1 %) */
+    int checked = 0;
+    for (int k = 0; k < 4; k++)
+        for (int e = 0; e < 2; e++) {
+            const double u0 = log(f[k]), ue = log(iv[k][e]);
+            if (end[k][e] || !(fabs(ue - u0) > 1e-3))
+                continue;
+            double lim_in, lim_out;
+            const double in = cf_tail_profile_at(&t, &o, &r, k, exp(ue - 0.03 * (ue - u0)), &lim_in);
+            const double out =
+                cf_tail_profile_at(&t, &o, &r, k, exp(ue + 0.03 * (ue - u0)), &lim_out);
+            assert_true(isfinite(lim_in) && lim_in == lim_out);
+            if (!(in <= lim_in && out > lim_out))
+                fail_msg("quantity %d, %s end %.8g: profile %.10g inside, %.10g outside, "
+                         "threshold %.10g", k, e ? "upper" : "lower", iv[k][e], in, out, lim_in);
+            checked++;
+        }
+    assert_true(checked >= 2);
     cf_table_free(&t);
 }
 
@@ -178,6 +269,17 @@ static void auto_keeps_the_tail_where_it_gains(void **state)
         if (r.law_choice[i].chose_tail) {
             kept = 1;
             assert_true(r.fits[i].rmse < 0.6 * r.law_choice[i].other.rmse);
+            /* its four quantities trade off (the cone closes near the table's end): each has a
+            ** profile interval around its value */
+            const cf_fit_result *f = &r.fits[i];
+            assert_true(f->e_tail_interval_ok);
+            assert_true(f->e_tail_interval[0] <= f->e_tail && f->e_tail <= f->e_tail_interval[1]);
+            assert_true(f->e_tail_interval[1] > f->e_tail_interval[0]);
+            for (int k = 0; k < 3; k++) {
+                assert_true(f->interval_ok[k]);
+                assert_true(f->interval[k][0] <= f->ident.v[k] &&
+                            f->ident.v[k] <= f->interval[k][1]);
+            }
         }
     assert_true(kept);
     cf_report_free(&r);
@@ -201,9 +303,11 @@ static void auto_keeps_the_conical_law_where_the_tail_cannot_help(void **state)
 
 int main(void)
 {
+    gsl_set_error_handler_off();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(noiseless_springs_are_recovered),
         cmocka_unit_test(noisy_spring_is_within_its_errors),
+        cmocka_unit_test(undetermined_quantities_get_profile_intervals),
         cmocka_unit_test(auto_keeps_the_tail_where_it_gains),
         cmocka_unit_test(auto_keeps_the_conical_law_where_the_tail_cannot_help),
     };

@@ -702,6 +702,86 @@ static void stencil_step_runs_the_polynomial_where_it_fits(void **state)
         }
 }
 
+/* A lattice of tailed springs steps through the spring's polynomial (law_simd.h,
+** cf_lane_poly_tail) for the closed form and the table where it fits (beta = 0.5 and 0.03 here),
+** and the scalar law where it does not (a cone of rho = 0.02 with beta = 3) or for exact; in every
+** case the forces are the edge-list kernel's (the scalar law; its closed form where the step runs
+** the polynomial, which stands for both) to rounding, the largest compression
+** the same, with the springs compressed into each region (the linear one, the cone's nonlinear one,
+** the tail's line, past the tail's solid) and stretched. */
+static void stencil_step_of_tailed_springs_equals_edge_list_kernel(void **state)
+{
+    (void)state;
+    static const cf_spring springs[] = {{10, 30, 4, 1, 80000, 40, 1, 10},
+                                        {6, 15, 2.5, 2, 26, 12, 0.05, 2},
+                                        {0.3, 15, 4, 0.1, 26, 40, 0.245, 8}};
+    const cf_law_method methods[3] = {CF_LAW_CLOSED, CF_LAW_TABLE, CF_LAW_EXACT};
+    int compared = 0;
+    for (int si = 0; si < 3; si++) {
+        cf_law law;
+        cf_error err = {0};
+        if (cf_law_init(&law, &springs[si], &err) != CF_OK)
+            fail_msg("spring %d refused: %s", si, err.msg);
+        assert_true(law.tail);
+        assert_int_equal(cf_law_table_build(&law, 256, &err), CF_OK);
+        const double H = springs[si].H_mm;
+        const double squeeze[] = {1.15, 1 - 0.5 * law.u_T_mm / H,
+                                  1 - 0.5 * (law.u_T_mm + law.u_C_mm) / H,
+                                  1 - 0.5 * (law.u_C_mm + law.travel_mm) / H,
+                                  1 - 1.05 * law.travel_mm / H};
+        for (int mi = 0; mi < 3; mi++)
+            for (size_t qi = 0; qi < sizeof squeeze / sizeof squeeze[0]; qi++) {
+                cf_lattice_config c = cf_lattice_default();
+                c.nx = 4, c.ny = 3, c.nz = 5;
+                cf_lattice lat;
+                assert_int_equal(cf_lattice_create(&lat, &law, methods[mi], &c, &err), CF_OK);
+                srand((unsigned)(100 * si + 10 * mi + (int)qi));
+                const double jit = 0.02 * H;
+                for (size_t p = 0; p < lat.nn; p++) {
+                    lat.x[p] += jit * (rand() / (double)RAND_MAX - 0.5);
+                    lat.y[p] += jit * (rand() / (double)RAND_MAX - 0.5);
+                    lat.z[p] = squeeze[qi] * lat.Z[p] + jit * (rand() / (double)RAND_MAX - 0.5);
+                }
+                lat.with_stiffness = 0;
+                /* the polynomial stands for the closed form (the table's own error is larger) */
+                const int expect = mi == 2 || si == 2 ? -1 : CF_LANE_POLY;
+                lat.method = expect == CF_LANE_POLY ? CF_LAW_CLOSED : methods[mi];
+                const double um_edges = cf_lattice_forces(&lat);
+                lat.method = methods[mi];
+                double *g = malloc(3 * lat.nn * sizeof(double));
+                assert_non_null(g);
+                double scale = 0;
+                for (size_t p = 0; p < lat.nn; p++) {
+                    g[3 * p] = lat.fx[p], g[3 * p + 1] = lat.fy[p], g[3 * p + 2] = lat.fz[p];
+                    scale = fmax(scale, fmax(fabs(lat.fx[p]), fmax(fabs(lat.fy[p]), fabs(lat.fz[p]))));
+                }
+                assert_true(scale > 0);
+                cf_lattice_stepper st;
+                assert_int_equal(cf_lattice_stepper_init(&st, &lat, NULL, &err), CF_OK);
+                assert_int_equal(st.form, expect);
+                if (expect == CF_LANE_POLY) {
+                    assert_true(st.lanes.tail && st.lanes.poly_fit);
+                    assert_true(st.poly_error <= CF_POLY_TOL);
+                }
+                memset(lat.fx, 0, lat.nn * sizeof(double));
+                memset(lat.fy, 0, lat.nn * sizeof(double));
+                memset(lat.fz, 0, lat.nn * sizeof(double));
+                assert_close(cf_lattice_stepper_forces(&st), um_edges, 1e-15);
+                for (size_t p = 0; p < lat.nn; p++) {
+                    assert_close(lat.fx[p], g[3 * p], 1e-12 * scale);
+                    assert_close(lat.fy[p], g[3 * p + 1], 1e-12 * scale);
+                    assert_close(lat.fz[p], g[3 * p + 2], 1e-12 * scale);
+                }
+                compared++;
+                free(g);
+                cf_lattice_stepper_free(&st);
+                cf_lattice_free(&lat);
+            }
+        cf_law_free(&law);
+    }
+    assert_int_equal(compared, 3 * 3 * 5);
+}
+
 /* The work of the law from 0 to u by composite Simpson on the exact evaluator, the interval cut at
 ** u_T and u_C, where the law's derivatives jump. */
 static double reference_work(const cf_law *law, double u)
@@ -773,6 +853,7 @@ int main(void)
         cmocka_unit_test(fused_step_matches_independent_forces),
         cmocka_unit_test(stencil_step_equals_edge_list_kernel),
         cmocka_unit_test(stencil_step_runs_the_polynomial_where_it_fits),
+        cmocka_unit_test(stencil_step_of_tailed_springs_equals_edge_list_kernel),
         cmocka_unit_test(lattice_masses_and_top_shares_add_up),
         cmocka_unit_test(static_solve_and_long_damped_dynamic_run_agree),
         cmocka_unit_test(stability_limit_is_confirmed_by_a_slow_damped_dynamic_run),

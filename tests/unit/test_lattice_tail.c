@@ -148,7 +148,8 @@ static int auto_in_lattice(const char *name, cf_mode mode, cf_table *t, cf_fit_r
 /* The aortic valve leaflet in its own mode (equibiaxial): through the lattice the conical law
 ** reaches 346.9 Pa (telescoping) and 264.4 Pa (non-telescoping), AIC 181.5 and 173.3; the tailed
 ** law 97.53 Pa for both, AIC 145.4, its cone closing inside the table (s/H 0.194, the table's
-** largest strain 0.224) so that the tail's compliance is determined (e_t 0.0104 +- 0.0044). The
+** largest strain 0.224) so that the tail's compliance is determined (e_t 0.0104 +- 0.0044), its
+** profile interval [0.0051, 0.0217] about as wide. The
 ** non-telescoping tailed spring is feasible and kept; the telescoping one is not (a tail of one
 ** coil at tau = n_tail/n = 0.053 asks for 19 cone coils, and D2 then exceeds 10 H), so auto keeps
 ** the conical law for that type although the tail's AIC is lower. */
@@ -171,6 +172,21 @@ static void valve_in_equibiaxial_keeps_the_tail(void **state)
         assert_true(lc->aic_conical - lc->aic_tail > 20);
         assert_true(tail->e_tail_se > 0 && tail->e_tail_se < tail->e_tail);
         assert_true(tail->ident.solid < 0.224);
+        /* the other quantities trade off, so all four have profile intervals (the plain law's
+        ** rule) that hold their values; e_t's, which its error determines, is about as wide as
+        ** +-1.96 of it (0.0051 to 0.0217 against 0.0018 to 0.019: the profile is skewed) */
+        assert_true(tail->e_tail_interval_ok);
+        for (int k = 0; k < 3; k++) {
+            assert_true(tail->interval_ok[k]);
+            assert_true(tail->interval[k][0] <= tail->ident.v[k] &&
+                        tail->ident.v[k] <= tail->interval[k][1]);
+        }
+        const double *ie = tail->e_tail_interval;
+        assert_true(ie[0] <= tail->e_tail && tail->e_tail <= ie[1]);
+        const double ratio = (ie[1] - ie[0]) / (2 * 1.96 * tail->e_tail_se);
+        if (!(ratio > 0.5 && ratio < 2))
+            fail_msg("e_t %.4g: interval [%.4g, %.4g] against ± 1.96 × %.3g", tail->e_tail,
+                     ie[0], ie[1], tail->e_tail_se);
         assert_int_equal(lc->chose_tail, tail->feasible);
         assert_true(r.thr[i].cell_rmse == r.fits[i].rmse);
     }

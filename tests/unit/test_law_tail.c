@@ -10,11 +10,13 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <cmocka.h>
 
 #include "conifit/law.h"
+#include "model/law_simd.h"
 #include "testutil.h"
 
 /* A tailed spring: cone D1 = rho, D2 = 1, n coils, wire d, G, H = 3 with the tail's n_t = tau n
@@ -244,8 +246,8 @@ static void regions_stiffness_and_inverse(void **state)
     cf_law_free(&lc);
 }
 
-/* The batch evaluation of a tailed law equals the scalar one (the vector lanes hold the plain law
-** only, so a tail takes the scalar path). */
+/* The batch evaluation of a tailed law equals the scalar one (the law's batch has no vector lanes
+** for a tail: only the lattice step's polynomial, below, is one). */
 static void batch_equals_scalar(void **state)
 {
     (void)state;
@@ -261,6 +263,92 @@ static void batch_equals_scalar(void **state)
         for (size_t i = 0; i < np; i++)
             assert_close(F[i], cf_law_force(&law, ms[m], u[i], NULL, NULL), 0);
     }
+}
+
+/* Displacements for the polynomial: the probes, every region boundary and one ulp either side,
+** random ones in each region and past the tail's solid, half of them stretched, then NaN and
+** +-Inf. */
+static size_t poly_points(const cf_law *law, double *u, unsigned seed)
+{
+    size_t k = probes(law, u);
+    const double b[] = {law->u_T_mm, law->u_C_mm, law->travel_mm};
+    for (int i = 0; i < 3; i++) {
+        u[k++] = nextafter(b[i], 0.0);
+        u[k++] = b[i];
+        u[k++] = -nextafter(b[i], INFINITY);
+    }
+    const double ends[5] = {0, law->u_T_mm, law->u_C_mm, law->travel_mm, 1.2 * law->travel_mm};
+    srand(seed);
+    for (int r = 0; r < 4; r++)
+        for (int i = 0; i < 250; i++) {
+            const double f = rand() / (double)RAND_MAX;
+            const double a = ends[r] + (ends[r + 1] - ends[r]) * f;
+            u[k++] = (i & 1) ? -a : a;
+        }
+    u[k++] = NAN;
+    u[k++] = INFINITY;
+    u[k++] = -INFINITY;
+    return k;
+}
+
+/* The lattice step's polynomial of a tailed spring (law_poly.c, law_simd.h cf_lane_poly_tail),
+** through the dispatched batch at the level CONIFIT_SIMD allows, against the scalar closed form:
+** within CF_POLY_TOL of |F| at every point of every region, the boundaries and both solids
+** included, in compression and stretch. It must fit for beta <= 0.2 down to rho = 0.03 (the plain
+** law's range), for beta up to 0.3 down to rho = 0.1, up to 1 down to rho = 0.2 and for every
+** beta at rho >= 0.5; elsewhere it may be refused, and the batch then runs the scalar law. */
+static void polynomial_matches_the_closed_form(void **state)
+{
+    (void)state;
+    static const double prho[] = {0.9, 0.5, 0.3, 0.2, 0.1, 0.05, 0.03, 0.02};
+    static const double pbeta[] = {1e-9, 1e-3, 0.1, 0.2, 0.25 * (1 - 1e-9), 0.25,
+                                   0.25 * (1 + 1e-9), 0.3, 1.0, 3.0, 50.0};
+    static double u[1200], F[1200];
+    double worst = 0;
+    char where[96] = "";
+    int fitted = 0, refused = 0;
+    for (size_t a = 0; a < sizeof prho / sizeof prho[0]; a++)
+        for (size_t b = 0; b < sizeof pbeta / sizeof pbeta[0]; b++) {
+            const double rho = prho[a], beta = pbeta[b];
+            cf_spring p = tailed(rho, 4, beta / (1 / rho - 1), 1.5);
+            cf_law law;
+            assert_int_equal(cf_law_init(&law, &p, NULL), CF_OK);
+            cf_law_lanes lanes;
+            cf_law_lanes_init(&law, &lanes);
+            double err;
+            const int ok = cf_law_lanes_fit_poly(&law, &lanes, &err);
+            const int must = (beta <= 0.2 && rho >= 0.03) || (beta <= 0.3 && rho >= 0.1) ||
+                             (beta <= 1 && rho >= 0.2) || rho >= 0.5;
+            if (must && !ok)
+                fail_msg("rho %g beta %.10g: no polynomial (error %.3g)", rho, beta, err);
+            if (ok) {
+                assert_true(err <= CF_POLY_TOL);
+                fitted++;
+            } else {
+                refused++;
+            }
+            const size_t np = poly_points(&law, u, (unsigned)(100 * a + b));
+            assert_true(np <= sizeof u / sizeof u[0]);
+            cf_law_force_lanes(&lanes, CF_LANE_POLY, np, u, F);
+            for (size_t i = 0; i < np; i++) {
+                const double R = cf_law_force(&law, CF_LAW_CLOSED, u[i], NULL, NULL);
+                assert_true(isfinite(F[i]));
+                const double dev = fabs(F[i] - R);
+                const double rel = dev == 0 ? 0 : dev / fmax(fabs(R), DBL_MIN);
+                if (ok && rel > worst) {
+                    worst = rel;
+                    snprintf(where, sizeof where, "rho %g beta %.3g u/u_C %.17g", rho, beta,
+                             u[i] / law.u_C_mm);
+                }
+                if (rel > (ok ? CF_POLY_TOL : 0))
+                    fail_msg("rho %g beta %.10g u %.17g: polynomial %.17g, closed form %.17g "
+                             "(rel %.3g)", rho, beta, u[i], F[i], R, rel);
+            }
+            cf_law_free(&law);
+        }
+    printf("# tailed polynomial (%s): %d fitted, %d refused; worst relative force error %.3g "
+           "against the closed form at %s\n",
+           cf_simd_name(cf_simd_level()), fitted, refused, worst, where);
 }
 
 static void expect_refused(cf_spring p, const char *key)
@@ -326,6 +414,7 @@ int main(void)
         cmocka_unit_test(table_is_within_its_bound),
         cmocka_unit_test(regions_stiffness_and_inverse),
         cmocka_unit_test(batch_equals_scalar),
+        cmocka_unit_test(polynomial_matches_the_closed_form),
         cmocka_unit_test(bad_tails_are_refused_naming_the_key),
         cmocka_unit_test(no_tail_is_the_plain_law),
     };

@@ -167,6 +167,14 @@ typedef struct cf_fit_result {
     long evaluations_full; /* those over every row of the table (the rest ran on the subsample
                            ** of a long table: cf_fit_options.subsample_above) */
     double wall_time_s;    /* s */
+    /* The profile-likelihood interval of the tail compliance e_t (a fit of the conical-tail law),
+    ** as interval_ok, interval, interval_end and interval_why above are of the three quantities,
+    ** computed by the same rule (the tail's intervals are of all four or none); placed last, so
+    ** that the fields before keep their places. */
+    int e_tail_interval_ok;
+    double e_tail_interval[2];
+    unsigned e_tail_interval_end[2];
+    unsigned e_tail_interval_why;
 } cf_fit_result;
 
 /* Extra bit in interval_why: the Jacobian of the three quantities is (numerically) singular. */
