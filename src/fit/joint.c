@@ -202,7 +202,8 @@ static cf_status search_conical(jctx *c, const cf_table *reach, double xmax, cf_
 
 /* The conical-tail law's search through the cell (tail_cell.h), the weights held at the conical
 ** law's fit plain, from its quantities; the tailed spring placed in closed form (tail.h) with the
-** errors of its four quantities from the joint residuals. */
+** errors of its four quantities from the joint residuals, and their profile intervals where the
+** errors say nothing. */
 static cf_status search_tail(jctx *c, const cf_table *reach, double xmax,
                              const cf_joint_result *plain, cf_joint_result *r, cf_error *err)
 {
@@ -233,6 +234,11 @@ static cf_status search_tail(jctx *c, const cf_table *reach, double xmax,
     if (st != CF_OK)
         return st;
     r->fit.held |= cf_tail_cell_held(c->opt, lb, ub, zb, c->type);
+    /* profile intervals where the errors say nothing, as for one table, on every table's rows */
+    if (cf_tail_cell_intervals(&tc, c->opt, c->type, c->need, lb, ub, c->pr.n, r->objective,
+                               c->pr.ynorm, v, &r->fit) < 0)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the profiles of %zu rows",
+                            c->pr.n);
     r->ident = r->fit.ident;
     return CF_OK;
 }

@@ -195,6 +195,30 @@ unsigned cf_tail_cell_held(const cf_fit_options *opt, const double lb[3], const 
     return held;
 }
 
+int cf_tail_cell_intervals(const cf_tail_cell *tc, const cf_fit_options *opt,
+                           cf_spring_type type, double need, const double lb[3],
+                           const double ub[3], size_t rows, double rss, double ynorm,
+                           const double v[4], cf_fit_result *res)
+{
+    /* as fitted to the spring (tail.h): the profiles on tc's rows from their own RSS at v, the
+    ** threshold the whole problem's */
+    gsl_vector *fv = gsl_vector_alloc(tc->pr->n);
+    if (!fv)
+        return -1;
+    double rss0 = CF_LSQ_HUGE_OBJ;
+    if (cf_tail_cell_residuals((void *)tc, v, fv) == GSL_SUCCESS) {
+        rss0 = 0;
+        for (size_t i = 0; i < fv->size; i++)
+            rss0 += gsl_vector_get(fv, i) * gsl_vector_get(fv, i);
+        rss0 = isfinite(rss0) ? rss0 : CF_LSQ_HUGE_OBJ;
+    }
+    gsl_vector_free(fv);
+    const cf_tail_profile tp = {cf_tail_cell_residuals, (void *)tc, tc->pr->n, tc->pr->ynorm,
+                                opt, type, 0, need, exp(lb[0]), exp(ub[0]), lb[1], ub[1]};
+    return cf_tail_intervals(&tp, v, rss0,
+                             rss0 + cf_profile_limit_np(rows, 4, rss, ynorm) - rss, res);
+}
+
 cf_status cf_lattice_fit_tail(const cf_table *d, const cf_fit_options *opt,
                               const cf_validate_setup *s, const cf_fit_result *plain,
                               cf_fit_result *res, cf_through_msm *t, cf_error *err)
@@ -263,35 +287,16 @@ cf_status cf_lattice_fit_tail(const cf_table *d, const cf_fit_options *opt,
     if ((st = cf_tail_result(&reach, opt, plain->type, v, se, corr, cov_Bt, res, err)) != CF_OK)
         goto out;
     res->held |= cf_tail_cell_held(opt, lb, ub, zb, plain->type);
-    /* profile intervals where the errors say nothing, as fitted to the spring (tail.h), through
-    ** the cell on the search's rows (a long table's subsample) against the whole table's
-    ** threshold */
-    {
-        gsl_vector *fv = gsl_vector_alloc(search->d->count);
-        double rss0 = CF_LSQ_HUGE_OBJ;
-        if (fv && cf_tail_cell_residuals((void *)&tsearch, v, fv) == GSL_SUCCESS) {
-            rss0 = 0;
-            for (size_t i = 0; i < fv->size; i++)
-                rss0 += gsl_vector_get(fv, i) * gsl_vector_get(fv, i);
-            rss0 = isfinite(rss0) ? rss0 : CF_LSQ_HUGE_OBJ;
-        }
-        gsl_vector_free(fv);
-        const double rss = f * c.pr.ynorm;
-        const cf_tail_profile tp = {cf_tail_cell_residuals, (void *)&tsearch, search->d->count,
-                                    search->pr.ynorm, opt, plain->type, 0, need, exp(lb[0]),
-                                    exp(ub[0]), lb[1], ub[1]};
-        const long before_p = search->pr.evals;
-        const int pst = !fv ? -1
-                            : cf_tail_intervals(&tp, v, rss0,
-                                                rss0 + cf_profile_limit_np(d->count, 4, rss,
-                                                                           c.pr.ynorm) - rss,
-                                                res);
-        t->uncertainty_curves += search->pr.evals - before_p;
-        if (pst < 0) {
-            st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the profiles of %zu rows",
-                              d->count);
-            goto out;
-        }
+    /* profile intervals where the errors say nothing, through the cell on the search's rows (a
+    ** long table's subsample) against the whole table's threshold */
+    const long before_p = search->pr.evals;
+    const int pst = cf_tail_cell_intervals(&tsearch, opt, plain->type, need, lb, ub, d->count,
+                                           f * c.pr.ynorm, c.pr.ynorm, v, res);
+    t->uncertainty_curves += search->pr.evals - before_p;
+    if (pst < 0) {
+        st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the profiles of %zu rows",
+                          d->count);
+        goto out;
     }
     /* the target's numbers: the cell's curve of the placed spring */
     if ((st = cf_lattice_curve(&res->params, s, d, 0, c.pr.g, NULL, NULL, NULL, err)) != CF_OK)

@@ -44,6 +44,15 @@ void cf_tail_cell_quantities(const double z[3], double A, double v[4]);
 ** ctx a cf_tail_cell). */
 int cf_tail_cell_residuals(void *ctx, const double v[4], gsl_vector *f);
 
+/* The profile intervals of the tailed fit res at v = (rho, B, A, tau) where its errors say
+** nothing (tail.h, cf_tail_intervals), profiled on tc's rows (a long table's subsample, or the
+** problem itself) within the search box lb, ub, against the threshold of the whole problem's
+** rows, weighted RSS at v and ynorm. 0, or -1 when memory ran out. */
+int cf_tail_cell_intervals(const cf_tail_cell *tc, const cf_fit_options *opt,
+                           cf_spring_type type, double need, const double lb[3],
+                           const double ub[3], size_t rows, double rss, double ynorm,
+                           const double v[4], cf_fit_result *res);
+
 /* The flags of the box bounds zb sits on (the ones cf_tail_result does not see). */
 unsigned cf_tail_cell_held(const cf_fit_options *opt, const double lb[3], const double ub[3],
                            const double zb[3], cf_spring_type type);

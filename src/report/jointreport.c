@@ -122,19 +122,18 @@ char *cf_joint_text(const cf_joint_report *r)
                    "calibration %s (weights edge %.4g, face %.4g, body %.4g; nu %.3f)\n",
                 q[0], q[1], q[2], cf_calibration_name(j->calibration), j->weight[0],
                 j->weight[1], j->weight[2], cm.nu);
-        static const char *const names[3] = {"rho", "solid strain", "stress scale"};
-        for (int k = 0; k < 3; k++)
-            if (j->fit.interval_ok[k]) {
+        static const char *const names[4] = {"rho", "solid strain", "stress scale",
+                                             "tail compliance"};
+        for (int k = 0; k < (j->fit.tail ? 4 : 3); k++)
+            if (k == CF_REPORT_TAIL ? j->fit.e_tail_interval_ok : j->fit.interval_ok[k]) {
                 char why[512];
                 cf_report_interval_reason(&j->fit, k, why, sizeof why);
                 fprintf(o, "  * %s: %s\n", names[k], why);
             }
         if (j->fit.tail) {
-            if (j->fit.e_tail_se >= 0 && j->fit.e_tail_se <= fabs(j->fit.e_tail))
-                fprintf(o, "  tail compliance e_t %.6g ± %.2g\n", j->fit.e_tail,
-                        j->fit.e_tail_se);
-            else
-                fprintf(o, "  tail compliance e_t %.6g (error not determined)\n", j->fit.e_tail);
+            char et[96];
+            cf_report_ident_cell(&j->fit, CF_REPORT_TAIL, 1, "", et, sizeof et);
+            fprintf(o, "  tail compliance e_t %s\n", et);
         }
         if (isfinite(j->fit.corr[0][1]))
             fprintf(o, "  correlation rho-s %.3f, rho-A %.3f, s-A %.3f (the weights held)\n",
