@@ -186,8 +186,7 @@ static int run_joint(const fit_args *a, fit_job *jobs, const char *const *inputs
         if (a->plot)
             cf_cli_printf_safe(stdout, "Plot: %s\n", a->plot);
     }
-    for (int k = 0; k < r.nfits; k++)
-        cf_joint_free(&r.fits[k]);
+    cf_joint_report_free(&r);
     return rc;
 }
 
@@ -232,18 +231,15 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
                                            "lattice (the default in that mode) or give "
                                            "--mode uniaxial",
                                     cf_mode_name(jobs[i].m.mode));
-    /* the tailed law: the spring itself or through the lattice, as the conical law; not in a
-    ** joint fit, a time series' elastic part or with fixed parameters */
+    /* the tailed law: the spring itself or through the lattice (one table or several jointly),
+    ** as the conical law; not in a time series' elastic part or with fixed parameters */
     const cf_law_family law = a->popt.fit.law;
     int nfixed = 0;
     for (int k = 0; k < CF_P_COUNT; k++)
         nfixed += a->popt.fit.fixed[k] != 0;
     if (rc < 0 && law != CF_FAMILY_CONICAL) {
         const char *lname = cf_law_family_name(law);
-        if (a->joint)
-            rc = cf_cli_usage_error("fit", "--law %s: a joint fit is of the conical law (use "
-                                           "--law conical)", lname);
-        else if (*nseries)
+        if (*nseries)
             rc = cf_cli_usage_error("fit", "--law %s: a time series' elastic part is the "
                                            "conical law (use --law conical)", lname);
         else if (nfixed)

@@ -9,12 +9,15 @@
 
 #include <nlopt.h>
 
+#include "conifit/baseline.h"
 #include "conifit/cell.h"
 #include "conifit/family.h"
 #include "conifit/msm.h"
 #include "fit/cell_problem.h"
 #include "fit/clock.h"
 #include "fit/lsq.h"
+#include "fit/tail.h"
+#include "fit/tail_cell.h"
 
 /* BOBYQA: relative step tolerance and curves per start (each a few tens of microseconds). */
 #define XTOL_REL 1e-7
@@ -22,6 +25,9 @@
 /* Diagonal-to-edge weight ratio searched when the weights are fitted. */
 #define Q_LO 0.02
 #define Q_HI 5.0
+/* relative step of the tailed law's errors' central differences, as its single fit through the
+** lattice takes (lattice_tail.c) */
+#define TAIL_FD_STEP 1e-4
 
 typedef struct jctx {
     const cf_table *const *t;
@@ -34,6 +40,9 @@ typedef struct jctx {
     double *sw[CF_JOINT_MAX];       /* per-row residual weights 1/(s_k sqrt n_k) */
     double *curve[CF_JOINT_MAX];    /* scratch: each table's cell curve at unit scale */
     cf_cell_problem pr;             /* every table's rows in order, with their weights */
+    int tail;                       /* 1: the conical-tail law's members, their tail tau */
+    double tau;
+    double need;                    /* the largest spring strain with the travel margin */
 } jctx;
 
 /* Family weights of ratio q (face = body = q edge), scaled to the law's small-strain modulus. */
@@ -50,7 +59,7 @@ static int joint_curve(void *ctx, double rho, double B, double *out)
 {
     const jctx *c = ctx;
     const cf_ident q = {.rho = rho, .solid = B, .scale = 1.0};
-    cf_spring p = cf_ident_member(&q);
+    cf_spring p = c->tail ? cf_ident_member_tail(&q, c->tau) : cf_ident_member(&q);
     cf_law law;
     if (cf_law_init(&law, &p, NULL) != CF_OK)
         return 1;
@@ -63,6 +72,13 @@ static int joint_curve(void *ctx, double rho, double B, double *out)
             CF_OK)
             return 1;
     return 0;
+}
+
+/* The tailed law's cap on the stress scale at (rho, B) and the context's tau (tail_cell.h). */
+static double joint_A_max(void *ctx, double rho, double B)
+{
+    const jctx *c = ctx;
+    return cf_tail_cell_A_max(rho, B, c->tau, c->need, c->type, c->opt);
 }
 
 /* Objective at z = (ln rho, s/H [, ln q]) with the stress scale in closed form; *A_out. */
@@ -109,6 +125,13 @@ static cf_status verify_tables(const jctx *c, cf_joint_result *r, cf_error *err)
         if ((st = cf_cell_curve(&cell, t->mode, t->x, t->count, c->curve[k], err)) != CF_OK)
             break;
         jt->cell_rmse = cf_lsq_quality_of(t, c->curve[k]).rmse;
+        /* the table's own AIC at the joint law, in the table's unit as a single fit states it */
+        double ymax = 0;
+        for (size_t i = 0; i < t->count; i++)
+            ymax = fmax(ymax, fabs(t->y[i]));
+        const double u = t->y_to_file;
+        const double rss = jt->cell_rmse * jt->cell_rmse * (double)t->count * u * u;
+        jt->aic = cf_baseline_aic(t->count, rss, r->fit.tail ? 4 : 3, ymax * u);
         jt->by_cell = t->mode != CF_MODE_UNIAXIAL;
         if (jt->by_cell)
             memcpy(jt->lattice_MPa, c->curve[k], t->count * sizeof(double));
@@ -127,13 +150,107 @@ static cf_status verify_tables(const jctx *c, cf_joint_result *r, cf_error *err)
     return st;
 }
 
-/* A joint fit, stage after stage: check the tables, the springs' common reach, the search over
-** (rho, s/H, scale) against every table's lattice curve, the placement, then each table in the
-** lattice of the placed spring (verify_tables). Kept as one function because the stages share the
-** tables' weights, the reach and the result being filled; each stage is marked below. */
-cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
-                       const cf_validate_setup *lat, cf_spring_type type, cf_joint_result *r,
-                       cf_error *err)
+/* The conical law's search over (rho, s/H [, the weight ratio]) from a grid of starts, every
+** table's curve through the cell, and the spring placed from the best; the reach bounds s/H. */
+static cf_status search_conical(jctx *c, const cf_table *reach, double xmax, cf_joint_result *r,
+                                cf_error *err)
+{
+    const cf_fit_options *opt = c->opt;
+    const int nz = c->fit_weights ? 3 : 2;
+    double lb[3] = {log(fmax(CF_IDENT_RHO_LO, opt->rho_min)),
+                    xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9), log(Q_LO)};
+    double ub[3] = {log(cf_ident_rho_hi(c->type, opt->index_max)), 1 - 1e-9, log(Q_HI)};
+    if (!(lb[1] < ub[1]))
+        return cf_error_set(err, CF_E_DATA, "the springs must reach a strain of %g: no spring "
+                                            "does", xmax);
+    memcpy(c->pr.lb, lb, sizeof c->pr.lb);
+    memcpy(c->pr.ub, ub, sizeof c->pr.ub);
+    double best = CF_LSQ_HUGE_OBJ, zb[3] = {0, 0, 0};
+    const double grid_rho[3] = {0.1, 0.35, 0.7}, grid_e[3] = {0.1, 0.4, 0.8};
+    const double q_iso = 0.2708 / 0.6085, grid_q[2] = {q_iso, 1.0};
+    for (int gq = 0; gq < (c->fit_weights ? 2 : 1); gq++)
+        for (int g = 0; g < 9; g++) {
+            double z[3] = {log(grid_rho[g % 3]), lb[1] + grid_e[g / 3] * (ub[1] - lb[1]),
+                           log(grid_q[gq])};
+            for (int j = 0; j < nz; j++)
+                z[j] = fmin(fmax(z[j], lb[j]), ub[j]);
+            double step[3] = {0.1, 0.05 * (ub[1] - lb[1]), 0.2}, f = CF_LSQ_HUGE_OBJ;
+            nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)nz, lb, ub,
+                                              step, XTOL_REL, MAX_EVALS, objective, c, z, &f);
+            if (c->pr.oom)
+                return cf_error_set(err, CF_E_INTERNAL, "out of memory in the joint fit's "
+                                                        "optimiser (NLopt)");
+            if ((res > 0 || res == NLOPT_ROUNDOFF_LIMITED) && f < best) {
+                best = f;
+                memcpy(zb, z, sizeof zb);
+            }
+        }
+    double A = 0;
+    if (!(best < CF_LSQ_HUGE_OBJ) || !(profile(c, zb, &A) < CF_LSQ_HUGE_OBJ) || !(A > 0))
+        return cf_error_set(err, CF_E_NOCONV, "the joint fit found no lattice that runs every "
+                                              "table");
+    r->objective = best;
+    r->ident.rho = exp(zb[0]), r->ident.solid = zb[1], r->ident.scale = A;
+    cf_status st = cf_fit_place(reach, opt, c->type, &r->ident, &r->fit, err);
+    if (st != CF_OK)
+        return st;
+    /* the uncertainty of the quantities found, the weights (fitted or not) held where they are:
+    ** each table's residuals weighted as in the search */
+    r->fit.ident = r->ident;
+    return cf_cell_uncertainty(&c->pr, &c->pr, &r->fit, err);
+}
+
+/* The conical-tail law's search through the cell (tail_cell.h), the weights held at the conical
+** law's fit plain, from its quantities; the tailed spring placed in closed form (tail.h) with the
+** errors of its four quantities from the joint residuals, and their profile intervals where the
+** errors say nothing. */
+static cf_status search_tail(jctx *c, const cf_table *reach, double xmax,
+                             const cf_joint_result *plain, cf_joint_result *r, cf_error *err)
+{
+    c->tail = 1;
+    c->fit_weights = 0;
+    c->need = xmax * (1 + CF_FIT_TRAVEL_MARGIN);
+    c->pr.A_max = joint_A_max;
+    if (!(c->need < 1))
+        return cf_error_set(err, CF_E_DATA, "the springs must reach a strain of %g: no spring "
+                                            "does", xmax);
+    double lb[3], ub[3], zb[3] = {0, 0, 0}, A = 0;
+    cf_tail_cell_box(c->opt, c->type, xmax, lb, ub);
+    const cf_tail_cell tc = {&c->pr, &c->tau};
+    const double best = cf_tail_cell_search(&tc, &plain->ident, lb, ub, zb);
+    if (c->pr.oom)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory in the joint fit's optimiser "
+                                                "(NLopt)");
+    const double f = best < CF_LSQ_HUGE_OBJ ? cf_tail_cell_profile(&tc, zb, &A) : CF_LSQ_HUGE_OBJ;
+    if (!(f < CF_LSQ_HUGE_OBJ) || !(A > 0))
+        return cf_error_set(err, CF_E_NOCONV, "the joint fit found no conical-tail law that runs "
+                                              "every table");
+    double v[4], se[4], corr[4][4], cov_Bt;
+    cf_tail_cell_quantities(zb, A, v);
+    r->objective = f * c->pr.ynorm;
+    cf_tail_errors(cf_tail_cell_residuals, (void *)&tc, c->pr.n, v, TAIL_FD_STEP, r->objective,
+                   se, corr, &cov_Bt);
+    cf_status st = cf_tail_result(reach, c->opt, c->type, v, se, corr, cov_Bt, &r->fit, err);
+    if (st != CF_OK)
+        return st;
+    r->fit.held |= cf_tail_cell_held(c->opt, lb, ub, zb, c->type);
+    /* profile intervals where the errors say nothing, as for one table, on every table's rows */
+    if (cf_tail_cell_intervals(&tc, c->opt, c->type, c->need, lb, ub, c->pr.n, r->objective,
+                               c->pr.ynorm, v, &r->fit) < 0)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the profiles of %zu rows",
+                            c->pr.n);
+    r->ident = r->fit.ident;
+    return CF_OK;
+}
+
+/* A joint fit, stage after stage: check the tables, the springs' common reach, the search of the
+** law (search_conical; search_tail when plain, the conical law's joint fit, is given), then each
+** table in the lattice of the placed spring (verify_tables). Kept as one function because the
+** stages share the tables' weights, the reach and the result being filled; each stage is marked
+** below. */
+static cf_status joint_run(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
+                           const cf_validate_setup *lat, cf_spring_type type,
+                           const cf_joint_result *plain, cf_joint_result *r, cf_error *err)
 {
     const double t0 = cf_clock_s();
     memset(r, 0, sizeof *r);
@@ -154,7 +271,7 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
     c.lat = lat;
     c.type = type;
     c.fit_weights = lat->cfg.lattice.calibration == CF_CAL_FITTED;
-    memcpy(c.weight, lat->cfg.lattice.weight, sizeof c.weight);
+    memcpy(c.weight, plain ? plain->weight : lat->cfg.lattice.weight, sizeof c.weight);
     cf_status st = CF_OK;
     size_t total = 0;
     for (size_t k = 0; k < n; k++)
@@ -206,55 +323,15 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
     reach.w = NULL;
     reach.t = NULL;
     const double xmax = cf_lsq_xmax(&reach);
-    const int nz = c.fit_weights ? 3 : 2;
-    double lb[3] = {log(fmax(CF_IDENT_RHO_LO, opt->rho_min)),
-                    xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9), log(Q_LO)};
-    double ub[3] = {log(cf_ident_rho_hi(type, opt->index_max)), 1 - 1e-9, log(Q_HI)};
-    if (!(lb[1] < ub[1])) {
-        st = cf_error_set(err, CF_E_DATA,
-                          "the springs must reach a strain of %g: no spring does", xmax);
+    /* the search and the placement */
+    st = plain ? search_tail(&c, &reach, xmax, plain, r, err)
+               : search_conical(&c, &reach, xmax, r, err);
+    if (st != CF_OK)
         goto out;
-    }
-    memcpy(c.pr.lb, lb, sizeof c.pr.lb);
-    memcpy(c.pr.ub, ub, sizeof c.pr.ub);
-    double best = CF_LSQ_HUGE_OBJ, zb[3] = {0, 0, 0};
-    const double grid_rho[3] = {0.1, 0.35, 0.7}, grid_e[3] = {0.1, 0.4, 0.8};
-    const double q_iso = 0.2708 / 0.6085, grid_q[2] = {q_iso, 1.0};
-    for (int gq = 0; gq < (c.fit_weights ? 2 : 1); gq++)
-        for (int g = 0; g < 9; g++) {
-            double z[3] = {log(grid_rho[g % 3]), lb[1] + grid_e[g / 3] * (ub[1] - lb[1]),
-                           log(grid_q[gq])};
-            for (int j = 0; j < nz; j++)
-                z[j] = fmin(fmax(z[j], lb[j]), ub[j]);
-            double step[3] = {0.1, 0.05 * (ub[1] - lb[1]), 0.2}, f = CF_LSQ_HUGE_OBJ;
-            nlopt_result res = cf_cell_search(&c.pr, NLOPT_LN_BOBYQA, (unsigned)nz, lb, ub, step,
-                                              XTOL_REL, MAX_EVALS, objective, &c, z, &f);
-            if (c.pr.oom) {
-                st = cf_error_set(err, CF_E_INTERNAL, "out of memory in the joint fit's "
-                                                      "optimiser (NLopt)");
-                goto out;
-            }
-            if ((res > 0 || res == NLOPT_ROUNDOFF_LIMITED) && f < best) {
-                best = f;
-                memcpy(zb, z, sizeof zb);
-            }
-        }
-    double A = 0;
-    if (!(best < CF_LSQ_HUGE_OBJ) || !(profile(&c, zb, &A) < CF_LSQ_HUGE_OBJ) || !(A > 0)) {
-        st = cf_error_set(err, CF_E_NOCONV, "the joint fit found no lattice that runs every table");
-        goto out;
-    }
-    r->objective = best;
-    r->ident.rho = exp(zb[0]), r->ident.solid = zb[1], r->ident.scale = A;
     memcpy(r->weight, c.weight, sizeof r->weight);
     r->calibration = lat->cfg.lattice.calibration;
-    if ((st = cf_fit_place(&reach, opt, type, &r->ident, &r->fit, err)) != CF_OK)
-        goto out;
-    /* the uncertainty of the quantities found, the weights (fitted or not) held where they are:
-    ** each table's residuals weighted as in the search */
-    r->fit.ident = r->ident;
-    if ((st = cf_cell_uncertainty(&c.pr, &c.pr, &r->fit, err)) != CF_OK)
-        goto out;
+    r->aic = cf_baseline_aic(total, r->objective, r->fit.tail ? 4 : 3, 1.0);
+    /* each table in the lattice of the placed spring */
     st = verify_tables(&c, r, err);
 out:
     for (size_t k = 0; k < n && k < CF_JOINT_MAX; k++) {
@@ -270,4 +347,18 @@ out:
     if (st != CF_OK)
         cf_joint_free(r);
     return st;
+}
+
+cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
+                       const cf_validate_setup *lat, cf_spring_type type, cf_joint_result *r,
+                       cf_error *err)
+{
+    return joint_run(tables, n, opt, lat, type, NULL, r, err);
+}
+
+cf_status cf_joint_fit_tail(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
+                            const cf_validate_setup *lat, const cf_joint_result *plain,
+                            cf_joint_result *r, cf_error *err)
+{
+    return joint_run(tables, n, opt, lat, plain->fit.type, plain, r, err);
 }

@@ -29,6 +29,7 @@
 #include "fit/profile.h"
 #include "fit/subsample.h"
 #include "fit/tail.h"
+#include "fit/tail_cell.h"
 
 #define XTOL_REL 1e-6 /* as the conical law's search (lattice_fit.c) */
 #define MAX_CURVES 600
@@ -60,15 +61,19 @@ static int lt_curve(void *ctx, double rho, double B, double *out)
     return cf_lattice_curve(&p, c->s, c->d, 0, out, NULL, NULL, NULL, NULL) != CF_OK;
 }
 
-/* The cap on the stress scale at (rho, B) and the context's tau; 0 where the member's whole
-** travel does not pass the table's strain. */
+double cf_tail_cell_A_max(double rho, double B, double tau, double need, cf_spring_type type,
+                          const cf_fit_options *opt)
+{
+    const double room = 1 - B * (1 + tau);
+    if (!(room > 0) || !(need < 1 - CF_IDENT_TAIL_SOLIDS * room))
+        return 0;
+    return cf_tail_A_max(rho, B, tau, type, need, opt);
+}
+
 static double lt_A_max(void *ctx, double rho, double B)
 {
     const lt_ctx *c = ctx;
-    const double room = 1 - B * (1 + c->tau);
-    if (!(room > 0) || !(c->need < 1 - CF_IDENT_TAIL_SOLIDS * room))
-        return 0;
-    return cf_tail_A_max(rho, B, c->tau, c->pr.type, c->need, c->pr.opt);
+    return cf_tail_cell_A_max(rho, B, c->tau, c->need, c->pr.type, c->pr.opt);
 }
 
 static cf_status lt_init(lt_ctx *c, const cf_table *d, const cf_validate_setup *s,
@@ -87,13 +92,30 @@ static void lt_free(lt_ctx *c)
     cf_cell_problem_free(&c->pr);
 }
 
-/* The weighted RSS over ynorm at z = (log rho, B, q), the scale in closed form into *A. */
-static double lt_profile(lt_ctx *c, const double *z, double *A)
+void cf_tail_cell_box(const cf_fit_options *opt, cf_spring_type type, double xmax, double lb[3],
+                      double ub[3])
 {
-    c->tau = tau_of(z[1], z[2]);
-    c->pr.ctx = c;
-    const double f = cf_cell_rss(&c->pr, exp(z[0]), z[1], A);
-    return f < CF_LSQ_HUGE_OBJ ? f / c->pr.ynorm : CF_LSQ_HUGE_OBJ;
+    lb[0] = log(fmax(CF_IDENT_RHO_LO, opt->rho_min));
+    lb[1] = B_LO_SHARE * xmax;
+    lb[2] = Q_LO;
+    ub[0] = log(cf_ident_rho_hi(type, opt->index_max));
+    ub[1] = 1 - 1e-6;
+    ub[2] = Q_HI;
+}
+
+void cf_tail_cell_quantities(const double z[3], double A, double v[4])
+{
+    v[0] = exp(z[0]);
+    v[1] = z[1];
+    v[2] = A;
+    v[3] = tau_of(z[1], z[2]);
+}
+
+double cf_tail_cell_profile(const cf_tail_cell *tc, const double z[3], double *A)
+{
+    *tc->tau = tau_of(z[1], z[2]);
+    const double f = cf_cell_rss(tc->pr, exp(z[0]), z[1], A);
+    return f < CF_LSQ_HUGE_OBJ ? f / tc->pr->ynorm : CF_LSQ_HUGE_OBJ;
 }
 
 static double lt_objective(unsigned nz, const double *z, double *grad, void *data)
@@ -101,39 +123,38 @@ static double lt_objective(unsigned nz, const double *z, double *grad, void *dat
     (void)nz;
     (void)grad;
     double A;
-    return lt_profile(data, z, &A);
+    return cf_tail_cell_profile(data, z, &A);
 }
 
-/* The weighted residuals at v = (rho, B, A, tau) (tail.h). */
-static int lt_residuals(void *ctx, const double v[4], gsl_vector *f)
+int cf_tail_cell_residuals(void *ctx, const double v[4], gsl_vector *f)
 {
-    lt_ctx *c = ctx;
+    const cf_tail_cell *tc = ctx;
+    cf_cell_problem *pr = tc->pr;
     if (!(v[1] > 0 && v[1] * (1 + v[3]) < 1 && v[0] > 0 && v[0] <= 1))
         return GSL_EDOM;
-    c->tau = v[3];
-    c->pr.evals++;
-    if (lt_curve(c, v[0], v[1], c->pr.g) != 0)
+    *tc->tau = v[3];
+    pr->evals++;
+    if (pr->curve(pr->ctx, v[0], v[1], pr->g) != 0)
         return GSL_EDOM;
-    for (size_t i = 0; i < c->pr.n; i++)
-        gsl_vector_set(f, i, c->pr.sw[i] * (v[2] * c->pr.g[i] - c->pr.y[i]));
+    for (size_t i = 0; i < pr->n; i++)
+        gsl_vector_set(f, i, pr->sw[i] * (v[2] * pr->g[i] - pr->y[i]));
     return GSL_SUCCESS;
 }
 
 /* One BOBYQA run from z (in and out); the objective at the end. */
-static double bobyqa(lt_ctx *c, double *z, const double *lb, const double *ub)
+static double bobyqa(const cf_tail_cell *tc, double *z, const double *lb, const double *ub)
 {
     double f, step[3] = {0.05, 0.02 * (ub[1] - lb[1]), 0.05};
-    nlopt_result r = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, 3, lb, ub, step, XTOL_REL,
-                                    MAX_CURVES, lt_objective, c, z, &f);
+    nlopt_result r = cf_cell_search(tc->pr, NLOPT_LN_BOBYQA, 3, lb, ub, step, XTOL_REL,
+                                    MAX_CURVES, lt_objective, (void *)tc, z, &f);
     if (!(r > 0 || r == NLOPT_ROUNDOFF_LIMITED) || !isfinite(z[0]) || !isfinite(z[1]) ||
         !isfinite(z[2]))
         return CF_LSQ_HUGE_OBJ;
     return f;
 }
 
-/* The search from the conical law's quantities and a coarse grid; the best z into zb. */
-static double search_all(lt_ctx *c, const cf_ident *start, const double *lb, const double *ub,
-                         double zb[3])
+double cf_tail_cell_search(const cf_tail_cell *tc, const cf_ident *start, const double lb[3],
+                           const double ub[3], double zb[3])
 {
     static const double grid_rho[3] = {0.1, 0.35, 0.7}, grid_e[2] = {0.15, 0.6};
     static const double start_q[2] = {0.01, 0.2};
@@ -151,7 +172,7 @@ static double search_all(lt_ctx *c, const cf_ident *start, const double *lb, con
         }
         for (int j = 0; j < 3; j++)
             z[j] = isfinite(z[j]) ? fmin(fmax(z[j], lb[j]), ub[j]) : 0.5 * (lb[j] + ub[j]);
-        const double f = bobyqa(c, z, lb, ub);
+        const double f = bobyqa(tc, z, lb, ub);
         if (f < best) {
             best = f;
             memcpy(zb, z, 3 * sizeof z[0]);
@@ -160,9 +181,8 @@ static double search_all(lt_ctx *c, const cf_ident *start, const double *lb, con
     return best;
 }
 
-/* The box bounds the quantities sit on (the ones cf_tail_result does not see). */
-static unsigned held_in_box(const cf_fit_options *opt, const double *lb, const double *ub,
-                            const double zb[3], cf_spring_type type)
+unsigned cf_tail_cell_held(const cf_fit_options *opt, const double lb[3], const double ub[3],
+                           const double zb[3], cf_spring_type type)
 {
     const double tol = 1e-6;
     unsigned held = 0;
@@ -173,6 +193,30 @@ static unsigned held_in_box(const cf_fit_options *opt, const double *lb, const d
     if (zb[1] <= lb[1] * (1 + tol) || zb[2] >= ub[2] * (1 - tol) || zb[2] <= lb[2] * (1 + tol))
         held |= CF_C_BOUNDS;
     return held;
+}
+
+int cf_tail_cell_intervals(const cf_tail_cell *tc, const cf_fit_options *opt,
+                           cf_spring_type type, double need, const double lb[3],
+                           const double ub[3], size_t rows, double rss, double ynorm,
+                           const double v[4], cf_fit_result *res)
+{
+    /* as fitted to the spring (tail.h): the profiles on tc's rows from their own RSS at v, the
+    ** threshold the whole problem's */
+    gsl_vector *fv = gsl_vector_alloc(tc->pr->n);
+    if (!fv)
+        return -1;
+    double rss0 = CF_LSQ_HUGE_OBJ;
+    if (cf_tail_cell_residuals((void *)tc, v, fv) == GSL_SUCCESS) {
+        rss0 = 0;
+        for (size_t i = 0; i < fv->size; i++)
+            rss0 += gsl_vector_get(fv, i) * gsl_vector_get(fv, i);
+        rss0 = isfinite(rss0) ? rss0 : CF_LSQ_HUGE_OBJ;
+    }
+    gsl_vector_free(fv);
+    const cf_tail_profile tp = {cf_tail_cell_residuals, (void *)tc, tc->pr->n, tc->pr->ynorm,
+                                opt, type, 0, need, exp(lb[0]), exp(ub[0]), lb[1], ub[1]};
+    return cf_tail_intervals(&tp, v, rss0,
+                             rss0 + cf_profile_limit_np(rows, 4, rss, ynorm) - rss, res);
 }
 
 cf_status cf_lattice_fit_tail(const cf_table *d, const cf_fit_options *opt,
@@ -201,8 +245,8 @@ cf_status cf_lattice_fit_tail(const cf_table *d, const cf_fit_options *opt,
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu points", d->count);
     const cf_table reach = cf_lattice_reach(d, spring_x);
     const double xmax = cf_lsq_xmax(&reach), need = xmax * (1 + CF_FIT_TRAVEL_MARGIN);
-    const double lb[3] = {log(fmax(CF_IDENT_RHO_LO, opt->rho_min)), B_LO_SHARE * xmax, Q_LO};
-    const double ub[3] = {log(cf_ident_rho_hi(plain->type, opt->index_max)), 1 - 1e-6, Q_HI};
+    double lb[3], ub[3];
+    cf_tail_cell_box(opt, plain->type, xmax, lb, ub);
     cf_status st = lt_init(&c, d, s, opt, plain->type, need, err);
     if (st != CF_OK)
         goto out;
@@ -220,55 +264,39 @@ cf_status cf_lattice_fit_tail(const cf_table *d, const cf_fit_options *opt,
     }
     t->search_rows = search->d->count;
     double zb[3] = {0, 0, 0}, A = 0;
-    const double best = search_all(search, &plain->ident, lb, ub, zb);
+    const cf_tail_cell tsearch = {&search->pr, &search->tau}, tc = {&c.pr, &c.tau};
+    const double best = cf_tail_cell_search(&tsearch, &plain->ident, lb, ub, zb);
     if (search->pr.oom) {
         st = cf_error_set(err, CF_E_INTERNAL,
                           "out of memory in the lattice fit's optimiser (NLopt)");
         goto out;
     }
-    const double f = best < CF_LSQ_HUGE_OBJ ? lt_profile(&c, zb, &A) : CF_LSQ_HUGE_OBJ;
+    const double f = best < CF_LSQ_HUGE_OBJ ? cf_tail_cell_profile(&tc, zb, &A) : CF_LSQ_HUGE_OBJ;
     if (!(f < CF_LSQ_HUGE_OBJ) || !(A > 0)) {
         st = cf_error_set(err, CF_E_DATA, "%s: no conical-tail law fits the table through the "
                                           "lattice", d->path);
         goto out;
     }
-    const double v[4] = {exp(zb[0]), zb[1], A, tau_of(zb[1], zb[2])};
+    double v[4];
+    cf_tail_cell_quantities(zb, A, v);
     double se[4], corr[4][4], cov_Bt;
     const long before = c.pr.evals;
-    cf_tail_errors(lt_residuals, &c, d->count, v, FD_STEP, f * c.pr.ynorm, se, corr, &cov_Bt);
+    cf_tail_errors(cf_tail_cell_residuals, (void *)&tc, d->count, v, FD_STEP, f * c.pr.ynorm, se,
+                   corr, &cov_Bt);
     t->uncertainty_curves = c.pr.evals - before;
     if ((st = cf_tail_result(&reach, opt, plain->type, v, se, corr, cov_Bt, res, err)) != CF_OK)
         goto out;
-    res->held |= held_in_box(opt, lb, ub, zb, plain->type);
-    /* profile intervals where the errors say nothing, as fitted to the spring (tail.h), through
-    ** the cell on the search's rows (a long table's subsample) against the whole table's
-    ** threshold */
-    {
-        gsl_vector *fv = gsl_vector_alloc(search->d->count);
-        double rss0 = CF_LSQ_HUGE_OBJ;
-        if (fv && lt_residuals(search, v, fv) == GSL_SUCCESS) {
-            rss0 = 0;
-            for (size_t i = 0; i < fv->size; i++)
-                rss0 += gsl_vector_get(fv, i) * gsl_vector_get(fv, i);
-            rss0 = isfinite(rss0) ? rss0 : CF_LSQ_HUGE_OBJ;
-        }
-        gsl_vector_free(fv);
-        const double rss = f * c.pr.ynorm;
-        const cf_tail_profile tp = {lt_residuals, search, search->d->count, search->pr.ynorm,
-                                    opt, plain->type, 0, need, exp(lb[0]), exp(ub[0]), lb[1],
-                                    ub[1]};
-        const long before_p = search->pr.evals;
-        const int pst = !fv ? -1
-                            : cf_tail_intervals(&tp, v, rss0,
-                                                rss0 + cf_profile_limit_np(d->count, 4, rss,
-                                                                           c.pr.ynorm) - rss,
-                                                res);
-        t->uncertainty_curves += search->pr.evals - before_p;
-        if (pst < 0) {
-            st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the profiles of %zu rows",
-                              d->count);
-            goto out;
-        }
+    res->held |= cf_tail_cell_held(opt, lb, ub, zb, plain->type);
+    /* profile intervals where the errors say nothing, through the cell on the search's rows (a
+    ** long table's subsample) against the whole table's threshold */
+    const long before_p = search->pr.evals;
+    const int pst = cf_tail_cell_intervals(&tsearch, opt, plain->type, need, lb, ub, d->count,
+                                           f * c.pr.ynorm, c.pr.ynorm, v, res);
+    t->uncertainty_curves += search->pr.evals - before_p;
+    if (pst < 0) {
+        st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the profiles of %zu rows",
+                          d->count);
+        goto out;
     }
     /* the target's numbers: the cell's curve of the placed spring */
     if ((st = cf_lattice_curve(&res->params, s, d, 0, c.pr.g, NULL, NULL, NULL, err)) != CF_OK)

@@ -8,6 +8,40 @@
 
 #include "conifit/joint.h"
 
+/* The tailed law's joint fit beside the conical one in fits[k], and the law kept: --law
+** conical-tail the tail, auto the tail only with a lower joint AIC and a feasible spring, as a
+** single fit chooses (pipeline.c). A tailed law that finds no spring leaves auto's choice to the
+** conical law; --law conical-tail then fails. */
+static cf_status choose_law(const cf_table *const *tables, size_t n,
+                            const cf_pipeline_options *opt, cf_joint_report *r, int k,
+                            cf_error *err)
+{
+    if (opt->progress) {
+        char what[128];
+        snprintf(what, sizeof what, "fitting the %s spring with a tail to %zu tables jointly",
+                 cf_spring_type_name(r->fits[k].fit.type), n);
+        opt->progress(opt->progress_ctx, NULL, what);
+    }
+    cf_joint_law_choice *lc = &r->law_choice[k];
+    cf_joint_result tail;
+    cf_error e = {0};
+    cf_status st = cf_joint_fit_tail(tables, n, &opt->fit, &opt->lattice, &r->fits[k], &tail, &e);
+    if (st == CF_E_INTERNAL || (st != CF_OK && opt->fit.law == CF_FAMILY_TAIL))
+        return cf_error_set(err, st, "%s", e.msg);
+    if (st != CF_OK)
+        return CF_OK; /* auto: the conical law, the report saying no tail was fitted */
+    lc->ran = 1;
+    lc->chose_tail = opt->fit.law == CF_FAMILY_TAIL ||
+                     (tail.fit.feasible && tail.aic < r->fits[k].aic);
+    if (lc->chose_tail) {
+        lc->other = r->fits[k];
+        r->fits[k] = tail;
+    } else {
+        lc->other = tail;
+    }
+    return CF_OK;
+}
+
 cf_status cf_pipeline_fit_joint(const cf_table *const *tables, size_t n,
                                 const cf_pipeline_options *opt, cf_joint_report *r,
                                 cf_error *err)
@@ -16,6 +50,7 @@ cf_status cf_pipeline_fit_joint(const cf_table *const *tables, size_t n,
     r->tables = tables;
     r->ntables = n;
     r->with_timing = opt->with_timing;
+    r->law = opt->fit.law;
     for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING; ty++) {
         if (!(opt->types & (1u << ty)))
             continue;
@@ -27,9 +62,16 @@ cf_status cf_pipeline_fit_joint(const cf_table *const *tables, size_t n,
         }
         cf_status st = cf_joint_fit(tables, n, &opt->fit, &opt->lattice, (cf_spring_type)ty,
                                     &r->fits[r->nfits], err);
-        if (st != CF_OK)
+        if (st != CF_OK) {
+            cf_joint_report_free(r);
             return st;
+        }
         r->nfits++;
+        if (opt->fit.law != CF_FAMILY_CONICAL &&
+            (st = choose_law(tables, n, opt, r, r->nfits - 1, err)) != CF_OK) {
+            cf_joint_report_free(r);
+            return st;
+        }
     }
     return CF_OK;
 }

@@ -18,6 +18,16 @@
 #include "report/report_notes.h"
 #include "report/report_words.h"
 
+void cf_joint_report_free(cf_joint_report *r)
+{
+    if (!r)
+        return;
+    for (int k = 0; k < 2; k++) {
+        cf_joint_free(&r->fits[k]);
+        cf_joint_free(&r->law_choice[k].other);
+    }
+}
+
 int cf_joint_better(const cf_joint_report *r)
 {
     int b = -1;
@@ -27,9 +37,61 @@ int cf_joint_better(const cf_joint_report *r)
     return b;
 }
 
+/* The conical and the tailed joint fit of type i, whichever was kept. */
+static void both_laws(const cf_joint_report *r, int i, const cf_joint_result **cone,
+                      const cf_joint_result **tail)
+{
+    const cf_joint_law_choice *lc = &r->law_choice[i];
+    *tail = lc->chose_tail ? &r->fits[i] : &lc->other;
+    *cone = lc->chose_tail ? &lc->other : &r->fits[i];
+}
+
 static const char *weighting_text =
     "each table's residuals divided by its RMS stress and by the square root of its number of "
     "rows, so every table counts once whatever its stress scale and length";
+
+/* Both laws of each type, when the fit asked for the tailed one: the joint AIC, the weighted
+** objective, feasibility and each table's RMSE and AIC, and the law kept. */
+static void law_choice_text(FILE *o, const cf_joint_report *r)
+{
+    if (r->law == CF_FAMILY_CONICAL)
+        return;
+    size_t rows = 0;
+    for (size_t k = 0; k < r->ntables; k++)
+        rows += r->tables[k]->count;
+    fprintf(o, "\nLaw (--law %s): the conical law (3 quantities) against the conical spring with "
+               "a cylindrical tail (4), both fitted jointly through the lattice; joint AIC = N "
+               "ln(objective/N) + 2k over the N = %zu rows\n",
+            cf_law_family_name(r->law), rows);
+    for (int i = 0; i < r->nfits; i++) {
+        const cf_joint_law_choice *lc = &r->law_choice[i];
+        const char *type = cf_spring_type_name(r->fits[i].fit.type);
+        if (!lc->ran) {
+            fprintf(o, "  %-16s no conical-tail law runs every table: conical kept\n", type);
+            continue;
+        }
+        const cf_joint_result *cone, *tail;
+        both_laws(r, i, &cone, &tail);
+        const cf_joint_result *law[2] = {cone, tail};
+        static const char *const lname[2] = {"conical", "conical-tail"};
+        for (int l = 0; l < 2; l++) {
+            fprintf(o, "  %-16s %-12s joint AIC %.2f, objective %.4g%s\n", l ? "" : type,
+                    lname[l], law[l]->aic, law[l]->objective,
+                    law[l]->fit.feasible ? "" : " (infeasible)");
+            for (size_t k = 0; k < r->ntables; k++) {
+                const cf_table *t = r->tables[k];
+                fprintf(o, "  %-16s %-12s   %s: RMSE %.4g %s, AIC %.2f\n", "", "", t->path,
+                        law[l]->tab[k].cell_rmse * t->y_to_file, t->y_unit, law[l]->tab[k].aic);
+            }
+        }
+        const char *why = r->law == CF_FAMILY_TAIL ? "asked for (--law conical-tail)"
+                          : lc->chose_tail         ? "lower joint AIC"
+                          : !tail->fit.feasible    ? "the tailed spring is infeasible"
+                                                   : "the tail does not lower the joint AIC";
+        fprintf(o, "  %-16s kept: %s (%s)\n", "", lc->chose_tail ? "conical-tail" : "conical",
+                why);
+    }
+}
 
 char *cf_joint_text(const cf_joint_report *r)
 {
@@ -60,13 +122,19 @@ char *cf_joint_text(const cf_joint_report *r)
                    "calibration %s (weights edge %.4g, face %.4g, body %.4g; nu %.3f)\n",
                 q[0], q[1], q[2], cf_calibration_name(j->calibration), j->weight[0],
                 j->weight[1], j->weight[2], cm.nu);
-        static const char *const names[3] = {"rho", "solid strain", "stress scale"};
-        for (int k = 0; k < 3; k++)
-            if (j->fit.interval_ok[k]) {
+        static const char *const names[4] = {"rho", "solid strain", "stress scale",
+                                             "tail compliance"};
+        for (int k = 0; k < (j->fit.tail ? 4 : 3); k++)
+            if (k == CF_REPORT_TAIL ? j->fit.e_tail_interval_ok : j->fit.interval_ok[k]) {
                 char why[512];
                 cf_report_interval_reason(&j->fit, k, why, sizeof why);
                 fprintf(o, "  * %s: %s\n", names[k], why);
             }
+        if (j->fit.tail) {
+            char et[96];
+            cf_report_ident_cell(&j->fit, CF_REPORT_TAIL, 1, "", et, sizeof et);
+            fprintf(o, "  tail compliance e_t %s\n", et);
+        }
         if (isfinite(j->fit.corr[0][1]))
             fprintf(o, "  correlation rho-s %.3f, rho-A %.3f, s-A %.3f (the weights held)\n",
                     j->fit.corr[0][1], j->fit.corr[0][2], j->fit.corr[1][2]);
@@ -91,6 +159,7 @@ char *cf_joint_text(const cf_joint_report *r)
                    "%ld cell curves, %.3f s)\n",
                 j->evaluations, j->wall_time_s);
     }
+    law_choice_text(o, r);
     int b = cf_joint_better(r);
     if (b >= 0)
         fprintf(o, "\nBetter type: %s (lower weighted objective %.4g)\n",
@@ -105,6 +174,38 @@ char *cf_joint_text(const cf_joint_report *r)
 static json_t *num(double v)
 {
     return cf_json_number(v);
+}
+
+/* One law's joint fit in the comparison: its joint AIC, objective, feasibility and each table's
+** RMSE and AIC. */
+static json_t *law_json(const cf_joint_report *r, const cf_joint_result *j)
+{
+    json_t *per = json_array();
+    for (size_t k = 0; per && k < r->ntables; k++) {
+        const cf_table *t = r->tables[k];
+        json_array_append_new(per, json_pack("{s:s, s:s, s:o, s:o}", "file", t->path, "unit",
+                                             t->y_unit, "rmse",
+                                             num(j->tab[k].cell_rmse * t->y_to_file), "aic",
+                                             num(j->tab[k].aic)));
+    }
+    json_t *o = json_pack("{s:o, s:o, s:b, s:o}", "aic", num(j->aic), "objective",
+                          num(j->objective), "feasible", j->fit.feasible, "tables",
+                          per ? per : json_array());
+    if (o && j->fit.tail)
+        json_object_set_new(o, "tail_compliance", cf_report_tail_json(&j->fit));
+    return o;
+}
+
+/* Both laws of type i as a single fit's law_comparison states them, through_lattice and joint
+** true (their RMSE and AIC the cell's, the AIC the joint one over every row). */
+static json_t *law_comparison_json(const cf_joint_report *r, int i)
+{
+    const cf_joint_result *cone, *tail;
+    both_laws(r, i, &cone, &tail);
+    return json_pack("{s:s, s:b, s:b, s:o, s:o}", "chosen",
+                     r->law_choice[i].chose_tail ? "conical-tail" : "conical", "through_lattice",
+                     1, "joint", 1, "conical", law_json(r, cone), "conical-tail",
+                     law_json(r, tail));
 }
 
 static json_t *joint_json(const cf_joint_report *r)
@@ -132,7 +233,13 @@ static json_t *joint_json(const cf_joint_report *r)
         json_t *ident = json_object();
         for (int k = 0; k < 3; k++)
             json_object_set_new(ident, names[k], cf_report_ident_json(&j->fit, k));
+        if (j->fit.tail)
+            json_object_set_new(ident, "tail_compliance", cf_report_tail_json(&j->fit));
         json_object_set_new(f, "identifiable", ident);
+        json_object_set_new(f, "law", json_string(j->fit.tail ? "conical-tail" : "conical"));
+        json_object_set_new(f, "aic", num(j->aic));
+        if (r->law_choice[i].ran)
+            json_object_set_new(f, "law_comparison", law_comparison_json(r, i));
         json_object_set_new(f, "identifiable_correlation",
                             cf_report_correlation_json(&j->fit, names));
         json_object_set_new(f, "target", json_pack("{s:s, s:s}", "model", "lattice", "mode",
@@ -159,6 +266,8 @@ static json_t *joint_json(const cf_joint_report *r)
                                   num(jt->lattice_rmse * u), "lattice_model",
                                   jt->by_cell ? "homogenised cell" : "full lattice", "scale",
                                   num(jt->scale_MPa * u));
+            if (e)
+                json_object_set_new(e, "aic", num(jt->aic));
             if (e && isfinite(jt->law_rmse)) /* uniaxial tables only */
                 json_object_set_new(e, "law_difference_rmse", num(jt->law_rmse * u));
             json_array_append_new(per, e);

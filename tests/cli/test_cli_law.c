@@ -2,8 +2,8 @@
 ** `fit --law`: the choice between the conical law and the conical spring with a tail as the
 ** command line sees it: the report shows both laws, the fit file names the law kept and carries the
 ** comparison, it goes through the lattice as the conical law does, and the combinations the tailed
-** law does not support (a joint fit, a time series, fixed parameters) are usage errors (exit 2,
-** nothing written).
+** law does not support (a time series, fixed parameters) are usage errors (exit 2, nothing
+** written); a joint fit of several tables compares both laws by its joint AIC.
 */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -41,6 +41,16 @@ static json_t *fit_file_of(const char *args, char *out, size_t cap)
     return root;
 }
 
+/* The law_comparison of fit f, present, its choice the law f names; the law kept. */
+static const char *law_kept(json_t *f, json_t **lc)
+{
+    *lc = json_object_get(f, "law_comparison");
+    assert_non_null(*lc);
+    const char *kept = json_string_value(json_object_get(*lc, "chosen"));
+    assert_string_equal(kept, json_string_value(json_object_get(f, "law")));
+    return kept;
+}
+
 /* --law auto on a shipped table of a plain conical spring: both laws reported, the conical one
 ** kept (the tail cannot lower the AIC of an exact conical table by more than its extra term). */
 static void auto_reports_both_laws(void **state)
@@ -53,10 +63,8 @@ static void auto_reports_both_laws(void **state)
     json_t *fits = json_object_get(root, "fits");
     assert_true(json_array_size(fits) == 2);
     for (size_t i = 0; i < 2; i++) {
-        json_t *f = json_array_get(fits, i), *lc = json_object_get(f, "law_comparison");
-        assert_non_null(lc);
-        const char *kept = json_string_value(json_object_get(lc, "chosen"));
-        assert_string_equal(kept, json_string_value(json_object_get(f, "law")));
+        json_t *lc;
+        const char *kept = law_kept(json_array_get(fits, i), &lc);
         const double a0 = json_number_value(json_object_get(json_object_get(lc, "conical"), "aic"));
         const double a1 =
             json_number_value(json_object_get(json_object_get(lc, "conical-tail"), "aic"));
@@ -194,7 +202,6 @@ static void unsupported_combinations_exit_2(void **state)
     static char out[1 << 14], errb[1 << 14];
     const char *const cases[] = {
         "fit data/telescoping.csv --law cone -o %s",
-        "fit data/telescoping.csv data/non_telescoping.csv --joint --law auto -o %s",
         "fit data/telescoping.csv --law auto --fix H=10 -o %s",
         "fit data/series/synthetic_relaxation.csv --law conical-tail -o %s",
     };
@@ -206,6 +213,56 @@ static void unsupported_combinations_exit_2(void **state)
         assert_false(exists(json));
     }
     rmdir(dir);
+}
+
+/* --joint --law auto: both laws fitted jointly for each type and reported, the fit file's law
+** the one its comparison chose, the tail only with a lower joint AIC and a feasible spring. On
+** the brain cortex tables (when present) the kept spring exports as a lattice. */
+static void joint_auto_reports_both_laws(void **state)
+{
+    (void)state;
+    static char out[1 << 16];
+    json_t *root = fit_file_of("data/telescoping.csv data/non_telescoping.csv --joint --law auto",
+                               out, sizeof out);
+    assert_non_null(strstr(out, "Law (--law auto)"));
+    assert_non_null(strstr(out, "conical-tail joint AIC"));
+    json_t *fits = json_object_get(root, "fits");
+    assert_true(json_array_size(fits) == 2);
+    for (size_t i = 0; i < 2; i++) {
+        json_t *f = json_array_get(fits, i), *lc;
+        const char *kept = law_kept(f, &lc);
+        assert_true(json_is_true(json_object_get(lc, "joint")));
+        json_t *cone = json_object_get(lc, "conical"), *tail = json_object_get(lc, "conical-tail");
+        const double a0 = json_number_value(json_object_get(cone, "aic"));
+        const double a1 = json_number_value(json_object_get(tail, "aic"));
+        assert_true(strcmp(kept, "conical-tail") != 0 ||
+                    (a1 < a0 && json_is_true(json_object_get(tail, "feasible"))));
+        assert_true(json_array_size(json_object_get(tail, "tables")) == 2);
+        assert_true((json_object_get(json_object_get(f, "params"), "n_tail") != NULL) ==
+                    (strcmp(kept, "conical-tail") == 0));
+    }
+    json_decref(root);
+    const char *dir = tu_datasets();
+    if (!dir)
+        return;
+    char tmp[] = "/tmp/conifit-law-XXXXXX", json[256], inp[256], args[1024];
+    static char errb[1 << 14];
+    assert_non_null(mkdtemp(tmp));
+    snprintf(json, sizeof json, "%s/brain.json", tmp);
+    snprintf(inp, sizeof inp, "%s/brain.inp", tmp);
+    snprintf(args, sizeof args, "%s/brain_cortex_tension.csv %s/brain_cortex_compression.csv "
+             "%s/brain_cortex_shear.csv --joint --law auto -o %s", dir, dir, dir, json);
+    int st = tu_run(out, sizeof out, errb, sizeof errb, "fit %s", args);
+    if (st != 0)
+        fail_msg("fit %s exited %d: %s", args, st, errb);
+    st = tu_run(out, sizeof out, errb, sizeof errb, "export %s --lattice --format calculix -o %s",
+                json, inp);
+    if (st != 0)
+        fail_msg("export --lattice of the joint tailed fit exited %d: %s", st, errb);
+    assert_true(exists(inp));
+    remove(json);
+    remove(inp);
+    rmdir(tmp);
 }
 
 /* A tailed fit as the elastic part of a time series is refused (exit 2): the series' elastic part
@@ -241,6 +298,7 @@ int main(void)
         cmocka_unit_test(force_table_with_lattice_target_fits_the_tail_to_the_spring),
         cmocka_unit_test(tailed_fit_reports_profile_intervals),
         cmocka_unit_test(unsupported_combinations_exit_2),
+        cmocka_unit_test(joint_auto_reports_both_laws),
         cmocka_unit_test(tailed_elastic_part_is_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -3,15 +3,21 @@
 ** spring recovered from its own homogenised cell's equibiaxial curve; --law auto on published
 ** tables in their own modes: both laws reported, the tail kept only with an AIC gain and a feasible
 ** spring, kept on the aortic valve leaflet (equibiaxial, non-telescoping) and not on a softening
-** shear table (chicken breast).
+** shear table (chicken breast). In a joint fit (joint.h, cf_joint_fit_tail): the known spring
+** recovered from a uniaxial and a shear curve together, and the three brain cortex tables with
+** --law auto, the tail kept only with a lower joint AIC, its fit file loading back with the tail.
 */
 #include "testutil.h"
 
 #include "conifit/calibration.h"
 #include "conifit/cell.h"
+#include "conifit/fitfile.h"
+#include "conifit/joint.h"
+#include "conifit/jointreport.h"
 #include "conifit/lattice_fit.h"
 #include "conifit/measure.h"
 #include "conifit/pipeline.h"
+#include "conifit/pipeline_joint.h"
 #include "conifit/report.h"
 #include "conifit/validate.h"
 
@@ -53,6 +59,20 @@ static void cell_table(const cf_spring *p, cf_mode m, double e_end, size_t n, cf
     free(y);
 }
 
+/* The known spring, its four quantities (rho, s/H, F_C/H^2, e_t) into q. */
+static cf_spring known_quantities(double q[4])
+{
+    const cf_spring p = known_spring();
+    cf_law law;
+    assert_int_equal(cf_law_init(&law, &p, NULL), CF_OK);
+    const double H = p.H_mm;
+    q[0] = law.rho;
+    q[1] = law.cone_travel_mm / H;
+    q[2] = law.F_C_N / (H * H);
+    q[3] = law.F_C_N / (law.k_tail_N_per_mm * H);
+    return p;
+}
+
 static void close_rel(const char *what, double got, double want, double rel)
 {
     if (!(fabs(got - want) <= rel * fabs(want)))
@@ -64,12 +84,8 @@ static void close_rel(const char *what, double got, double want, double rel)
 static void known_tailed_spring_is_recovered_through_the_lattice(void **state)
 {
     (void)state;
-    const cf_spring p = known_spring();
-    cf_law law;
-    assert_int_equal(cf_law_init(&law, &p, NULL), CF_OK);
-    const double H = p.H_mm;
-    const double q[4] = {law.rho, law.cone_travel_mm / H, law.F_C_N / (H * H),
-                         law.F_C_N / (law.k_tail_N_per_mm * H)};
+    double q[4];
+    const cf_spring p = known_quantities(q);
     cf_table t;
     cell_table(&p, CF_MODE_EQUIBIAXIAL, 0.44, 40, &t);
     cf_fit_options o = cf_fit_default_options();
@@ -203,12 +219,138 @@ static void softening_shear_keeps_the_conical_law(void **state)
     cf_table_free(&t);
 }
 
+/* A uniaxial and a shear table of the known spring's cell, both past the cone's closing: the
+** conical law's joint fit, then the tailed law's from it, recovers the four quantities. */
+static void known_tailed_spring_is_recovered_jointly(void **state)
+{
+    (void)state;
+    double q[4];
+    const cf_spring p = known_quantities(q);
+    cf_table t[2];
+    cell_table(&p, CF_MODE_UNIAXIAL, 0.42, 30, &t[0]);
+    cell_table(&p, CF_MODE_SHEAR, 0.6, 30, &t[1]);
+    /* both tables past the cone's closing (spring strain 0.4), short of the whole spring's */
+    for (int k = 0; k < 2; k++) {
+        const double e = cf_cell_spring_strain(t[k].mode, t[k].x[t[k].count - 1]);
+        assert_true(e > 0.3 && e < 0.46);
+    }
+    const cf_table *tabs[2] = {&t[0], &t[1]};
+    cf_fit_options o = cf_fit_default_options();
+    cf_validate_setup s = cf_validate_default();
+    cf_joint_result plain, tail;
+    cf_error err = {0};
+    if (cf_joint_fit(tabs, 2, &o, &s, CF_NON_TELESCOPING, &plain, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    if (cf_joint_fit_tail(tabs, 2, &o, &s, &plain, &tail, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    assert_true(tail.fit.tail);
+    assert_true(cf_spring_has_tail(&tail.fit.params));
+    close_rel("rho", tail.ident.rho, q[0], 1e-4);
+    close_rel("s/H", tail.ident.solid, q[1], 1e-4);
+    close_rel("F_C/H^2", tail.ident.scale, q[2], 1e-4);
+    close_rel("e_t", tail.fit.e_tail, q[3], 1e-4);
+    /* the errors of the four quantities from the joint residuals, as a single fit's */
+    for (int k = 0; k < 3; k++)
+        assert_true(tail.fit.ident_se.v[k] >= 0 && isfinite(tail.fit.ident_se.v[k]));
+    assert_true(tail.fit.e_tail_se >= 0 && isfinite(tail.fit.e_tail_se));
+    /* the tables reproduced by the tail, not by the cone alone; the tail's AIC far lower */
+    for (int k = 0; k < 2; k++) {
+        assert_true(tail.tab[k].cell_rmse <= 1e-4 * tail.tab[k].scale_MPa);
+        assert_true(plain.tab[k].cell_rmse > 10 * tail.tab[k].cell_rmse);
+    }
+    assert_true(tail.aic < plain.aic - 20);
+    assert_true(tail.objective < plain.objective);
+    cf_joint_free(&plain);
+    cf_joint_free(&tail);
+    cf_table_free(&t[0]);
+    cf_table_free(&t[1]);
+}
+
+/* The brain cortex in tension, compression and shear, --joint --law auto: both laws for each
+** type, finite joint AICs, the tail kept only with a lower one and a feasible spring, never worse
+** in the weighted objective than the conical law it nests; the fit file holds both laws and its
+** kept spring loads back with its tail. */
+static void brain_cortex_joint_auto(void **state)
+{
+    (void)state;
+    const char *dir = tu_datasets();
+    if (!dir)
+        skip();
+    static const char *const names[3] = {"brain_cortex_tension.csv",
+                                         "brain_cortex_compression.csv",
+                                         "brain_cortex_shear.csv"};
+    cf_table t[3];
+    const cf_table *tabs[3];
+    cf_measure_options mo = cf_measure_default_options();
+    cf_error err = {0};
+    for (int k = 0; k < 3; k++) {
+        char path[1024];
+        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
+        if (cf_measure_load(path, &mo, &t[k], &err) != CF_OK)
+            fail_msg("%s", err.msg);
+        tabs[k] = &t[k];
+    }
+    cf_pipeline_options po = cf_pipeline_default_options();
+    po.fit.law = CF_FAMILY_AUTO;
+    cf_joint_report r;
+    if (cf_pipeline_fit_joint(tabs, 3, &po, &r, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    assert_int_equal(r.nfits, 2);
+    for (int i = 0; i < r.nfits; i++) {
+        const cf_joint_law_choice *lc = &r.law_choice[i];
+        assert_true(lc->ran);
+        const cf_joint_result *tail = lc->chose_tail ? &r.fits[i] : &lc->other;
+        const cf_joint_result *cone = lc->chose_tail ? &lc->other : &r.fits[i];
+        assert_true(tail->fit.tail && !cone->fit.tail);
+        assert_true(isfinite(tail->aic) && isfinite(cone->aic));
+        assert_int_equal(lc->chose_tail, tail->fit.feasible && tail->aic < cone->aic);
+        assert_int_equal(r.fits[i].fit.tail, lc->chose_tail);
+        assert_true(tail->objective <= cone->objective * (1 + 1e-9));
+        for (size_t k = 0; k < 3; k++)
+            assert_true(isfinite(tail->tab[k].cell_rmse) && isfinite(tail->tab[k].aic));
+    }
+    char *text = cf_joint_text(&r);
+    assert_non_null(text);
+    assert_non_null(strstr(text, "conical-tail joint AIC"));
+    assert_non_null(strstr(text, "kept: "));
+    free(text);
+    char dirt[] = "/tmp/conifit-jt-XXXXXX", json[256];
+    assert_non_null(mkdtemp(dirt));
+    snprintf(json, sizeof json, "%s/joint.json", dirt);
+    cf_output *jo = NULL;
+    assert_int_equal(cf_output_new(&jo, &err), CF_OK);
+    assert_int_equal(cf_joint_prepare(&r, json, NULL, NULL, jo, NULL, &err), CF_OK);
+    assert_int_equal(cf_output_commit(jo, &err), CF_OK);
+    cf_output_free(jo);
+    char *file = tu_slurp(json);
+    assert_non_null(file);
+    assert_non_null(strstr(file, "\"law_comparison\""));
+    free(file);
+    for (int i = 0; i < r.nfits; i++) {
+        cf_fitted_spring fs;
+        if (cf_fitfile_load(json, cf_spring_type_name(r.fits[i].fit.type), &fs, &err) != CF_OK)
+            fail_msg("%s", err.msg);
+        assert_int_equal(cf_spring_has_tail(&fs.params), r.fits[i].fit.tail);
+        if (r.fits[i].fit.tail) {
+            close_rel("n_tail", fs.params.n_tail, r.fits[i].fit.params.n_tail, 1e-12);
+            close_rel("H_tail", fs.params.H_tail_mm, r.fits[i].fit.params.H_tail_mm, 1e-12);
+        }
+    }
+    remove(json);
+    rmdir(dirt);
+    cf_joint_report_free(&r);
+    for (int k = 0; k < 3; k++)
+        cf_table_free(&t[k]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(known_tailed_spring_is_recovered_through_the_lattice),
         cmocka_unit_test(valve_in_equibiaxial_keeps_the_tail),
         cmocka_unit_test(softening_shear_keeps_the_conical_law),
+        cmocka_unit_test(known_tailed_spring_is_recovered_jointly),
+        cmocka_unit_test(brain_cortex_joint_auto),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

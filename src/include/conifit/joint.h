@@ -36,6 +36,8 @@ typedef struct cf_joint_table {
     double lattice_rmse;   /* the full lattice (uniaxial tables; else the cell), MPa */
     int by_cell;           /* 1: lattice_rmse is the cell's (a mode the full lattice lacks) */
     double law_rmse;       /* the lattice against the law's own curve, MPa */
+    double aic;            /* the table's AIC at the joint law (its rows, its unit, the law's
+                           ** 3 or 4 quantities), as a single fit's report states it */
     double *lattice_MPa;   /* the lattice's stress at each row (owned), MPa */
 } cf_joint_table;
 
@@ -47,6 +49,8 @@ typedef struct cf_joint_result {
     size_t ntables;
     cf_joint_table tab[CF_JOINT_MAX];
     double objective;               /* the weighted objective at the optimum, - */
+    double aic;                     /* the joint AIC: N ln(objective/N) + 2k over all N rows, k 3
+                                    ** (conical) or 4 (conical-tail); what auto compares */
     long evaluations;               /* cell curves computed */
     double wall_time_s;
 } cf_joint_result;
@@ -58,6 +62,16 @@ typedef struct cf_joint_result {
 cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
                        const cf_validate_setup *lat, cf_spring_type type, cf_joint_result *r,
                        cf_error *err);
+
+/* The conical-tail law fitted jointly to the same tables as plain, the conical law's joint fit
+** (its type, weights and quantities the start): its four quantities (rho, s/H, F_C/H^2, the tail
+** tau) searched through the cell as a single table's are (lattice_fit.h, cf_lattice_fit_tail),
+** each table weighted as in the conical joint fit, the tailed spring placed in closed form and
+** r->fit.tail set. Fitted weights stay where the conical fit left them. CF_E_NOCONV when no
+** tailed spring runs every table. */
+cf_status cf_joint_fit_tail(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
+                            const cf_validate_setup *lat, const cf_joint_result *plain,
+                            cf_joint_result *r, cf_error *err);
 
 /* Releases the per-table curves. Safe on a zeroed result. */
 void cf_joint_free(cf_joint_result *r);

@@ -14,14 +14,26 @@
 #include "conifit/measure.h"
 #include "conifit/output.h"
 
+/* Both laws of one type's joint fit (--law conical-tail or auto): the law not kept. */
+typedef struct cf_joint_law_choice {
+    int ran;                /* 1: the tailed law was fitted beside the conical one */
+    int chose_tail;         /* 1: fits[] holds the tailed law, other the conical one */
+    cf_joint_result other;  /* the other law's joint fit (its curves owned) */
+} cf_joint_law_choice;
+
 /* One joint fit per spring type over the same tables. */
 typedef struct cf_joint_report {
     const cf_table *const *tables;
     size_t ntables;
     int nfits;
     cf_joint_result fits[2];
+    cf_joint_law_choice law_choice[2];
+    cf_law_family law;          /* the law asked for (--law) */
     int with_timing;            /* 0: wall times written as 0 */
 } cf_joint_report;
+
+/* Releases every fit's curves, the law not kept's too. Safe on a zeroed report. */
+void cf_joint_report_free(cf_joint_report *r);
 
 /* Index of the better fit (lower weighted objective), -1 when none. */
 int cf_joint_better(const cf_joint_report *r);
