@@ -28,12 +28,18 @@ void cf_joint_report_free(cf_joint_report *r)
     }
 }
 
+/* A spring that can be built before one that cannot, then the lower objective: a tie of the two
+** types' laws (both tailed fits reach the same one) must not hand the user the infeasible spring. */
 int cf_joint_better(const cf_joint_report *r)
 {
     int b = -1;
-    for (int i = 0; i < r->nfits; i++)
-        if (b < 0 || r->fits[i].objective < r->fits[b].objective)
+    for (int i = 0; i < r->nfits; i++) {
+        const int fi = r->fits[i].fit.feasible != 0;
+        if (b < 0 || (fi != (r->fits[b].fit.feasible != 0)
+                          ? fi
+                          : r->fits[i].objective < r->fits[b].objective))
             b = i;
+    }
     return b;
 }
 
@@ -161,9 +167,16 @@ char *cf_joint_text(const cf_joint_report *r)
     }
     law_choice_text(o, r);
     int b = cf_joint_better(r);
-    if (b >= 0)
-        fprintf(o, "\nBetter type: %s (lower weighted objective %.4g)\n",
-                cf_spring_type_name(r->fits[b].fit.type), r->fits[b].objective);
+    if (b >= 0) {
+        /* the reason that decided: buildability when only one spring can be built */
+        int other_infeasible = 0;
+        for (int i = 0; i < r->nfits; i++)
+            other_infeasible |= i != b && !r->fits[i].fit.feasible && r->fits[b].fit.feasible;
+        fprintf(o, "\nBetter type: %s (%s %.4g)\n", cf_spring_type_name(r->fits[b].fit.type),
+                other_infeasible ? "the other type's spring cannot be built; weighted objective"
+                                 : "lower weighted objective",
+                r->fits[b].objective);
+    }
     if (fclose(o) != 0) {
         free(buf);
         return NULL;

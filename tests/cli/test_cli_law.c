@@ -289,6 +289,35 @@ static void tailed_elastic_part_is_refused(void **state)
     rmdir(dir);
 }
 
+/* Both types' tailed joint fits of the shipped telescoping and non-telescoping tables reach the
+** same objective, and the telescoping spring cannot be built: the better type is the one that
+** can, and the report says why. */
+static void joint_tie_prefers_the_buildable_spring(void **state)
+{
+    (void)state;
+    static char out[1 << 16];
+    json_t *root = fit_file_of("data/telescoping.csv data/non_telescoping.csv --joint "
+                               "--law conical-tail",
+                               out, sizeof out);
+    const char *better = json_string_value(json_object_get(root, "better_type"));
+    assert_non_null(better);
+    json_t *fits = json_object_get(root, "fits");
+    int seen = 0, infeasible = 0;
+    for (size_t i = 0; i < json_array_size(fits); i++) {
+        json_t *f = json_array_get(fits, i);
+        const int feasible = json_is_true(json_object_get(f, "feasible"));
+        infeasible |= !feasible;
+        if (strcmp(json_string_value(json_object_get(f, "type")), better) == 0) {
+            seen = 1;
+            assert_true(feasible);
+        }
+    }
+    assert_true(seen);
+    if (infeasible)
+        assert_non_null(strstr(out, "the other type's spring cannot be built"));
+    json_decref(root);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -300,6 +329,7 @@ int main(void)
         cmocka_unit_test(unsupported_combinations_exit_2),
         cmocka_unit_test(joint_auto_reports_both_laws),
         cmocka_unit_test(tailed_elastic_part_is_refused),
+        cmocka_unit_test(joint_tie_prefers_the_buildable_spring),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
