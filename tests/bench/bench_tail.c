@@ -206,7 +206,7 @@ static void step(bench_ctx *ctx)
 void bench_section_tail(bench_ctx *ctx)
 {
     fprintf(ctx->md,
-            "\n## The spring with a cylindrical tail\n\n"
+            "\n## 1b. The spring with a cylindrical tail\n\n"
             "The export tests' telescoping spring (D1 10, D2 30, n 4, d 1, G 80000, H 40 mm) and the "
             "same coils with the cone in 30 mm and one tail coil in 10 mm (rho = 1/3, tau = 0.25, "
             "beta = 0.5). Region 2 of each (u_T to u_C), uniform and crowded at both ends; CPU "
