@@ -232,7 +232,8 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
                                            "--mode uniaxial",
                                     cf_mode_name(jobs[i].m.mode));
     /* the tailed law: the spring itself or through the lattice (one table or several jointly),
-    ** as the conical law; not in a time series' elastic part or with fixed parameters */
+    ** as the conical law; not with fixed parameters, and a time series' elastic part is fitted as
+    ** the conical law (a tailed one is held, --elastic with a tailed fit) */
     const cf_law_family law = a->popt.fit.law;
     int nfixed = 0;
     for (int k = 0; k < CF_P_COUNT; k++)
@@ -240,8 +241,9 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
     if (rc < 0 && law != CF_FAMILY_CONICAL) {
         const char *lname = cf_law_family_name(law);
         if (*nseries)
-            rc = cf_cli_usage_error("fit", "--law %s: a time series' elastic part is the "
-                                           "conical law (use --law conical)", lname);
+            rc = cf_cli_usage_error("fit", "--law %s: a time series' elastic part is fitted as "
+                                           "the conical law (use --law conical; a tailed spring "
+                                           "is held with --elastic of a tailed fit)", lname);
         else if (nfixed)
             rc = cf_cli_usage_error("fit", "--law %s places its spring in closed form and holds "
                                            "no parameter fixed (drop --fix)", lname);
@@ -257,12 +259,12 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
         if (cf_fitfile_load_spec(a->elastic, &fs, &err) != CF_OK) {
             rc = cf_cli_fail(&err);
         } else {
-            if (cf_spring_has_tail(&fs.params))
-                rc = cf_cli_usage_error("fit", "--elastic %s: the spring has a cylindrical tail; "
-                                               "a time series' elastic part is the conical law "
-                                               "(give a fit of --law conical)",
-                                        a->elastic);
+            /* a tailed spring is held with its fourth quantity, the tail's compliance
+            ** e_t = F_C/(k_t H) = (s/H) n_tail/n: the model runs the tailed law */
             a->vopt.elastic = cf_ident_of(&fs.params, 0);
+            a->vopt.elastic_e_tail = cf_spring_has_tail(&fs.params)
+                                         ? a->vopt.elastic.solid * fs.params.n_tail / fs.params.n
+                                         : 0.0;
             a->vopt.hold_elastic = 1;
         }
     }

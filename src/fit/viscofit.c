@@ -95,6 +95,7 @@ static void default_start(const ctx *c, int nb, start *s)
     s->p.ident.solid =
         c->free_el ? 0.5 * (cf_viscofit_solid_lo(c, 0.3) + E_HI) : c->o->elastic.solid;
     s->p.ident.scale = c->free_el ? 1 : c->o->elastic.scale;
+    s->p.e_tail = c->free_el ? 0 : c->o->elastic_e_tail;
     s->p.nbranch = nb;
     double span = c->d->t_s[c->n - 1] - c->d->t_s[0];
     for (int i = 0; i < nb; i++) {
@@ -164,14 +165,18 @@ void cf_visco_fit_free(cf_visco_fit *r)
     r->is_hold = NULL;
 }
 
-/* Where the static elastic lattice of stable_cells^3 cells of the spring (rho, s/H, F_C/H^2)
-** first loses stability (table's sign), by the scan of cf_msm_stability_limit on each side the
-** series reaches: a side where it does so within the series first, else the side of the
-** series' largest strain. 0 when it stays stable to 0.995 of solid or cannot be scanned. */
-static double stability_limit(const ctx *c, double rho, double B, double A)
+/* Where the static elastic lattice of stable_cells^3 cells of the spring (rho, s/H, F_C/H^2, and
+** the tail's compliance e_t, 0 without a tail) first loses stability (table's sign), by the scan
+** of cf_msm_stability_limit on each side the series reaches: a side where it does so within the
+** series first, else the side of the series' largest strain. 0 when it stays stable to 0.995 of
+** solid or cannot be scanned. */
+static double stability_limit(const ctx *c, double rho, double B, double A, double e_tail)
 {
-    const cf_ident q = {.rho = rho, .solid = B, .scale = A};
-    cf_spring sp = cf_ident_member(&q);
+    cf_visco_params q;
+    memset(&q, 0, sizeof q);
+    q.ident = (cf_ident){.rho = rho, .solid = B, .scale = A};
+    q.e_tail = e_tail;
+    cf_spring sp = cf_visco_member(&q);
     cf_law law;
     cf_error e = {0};
     cf_msm_config cfg = c->o->setup.cfg;
@@ -215,9 +220,29 @@ static cf_status fit_setup(ctx *c, const cf_visco_data *d, const cf_visco_fit_op
     c->e_lo = c->xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
     c->rho_lo = o->rho_min > 0 && o->rho_min < RHO_HI ? o->rho_min : 1e-3;
     c->max_evals = o->max_evaluations > 0 ? o->max_evaluations : CF_VISCO_EVAL_MAX;
-    const double *el = o->elastic.v;
-    if (o->hold_elastic && (!(el[0] > 0 && el[0] <= 1) || !(el[1] > c->xmax && el[1] < 1) ||
-                            !(el[2] > 0) || !isfinite(el[2])))
+    const double *el = o->elastic.v, et = o->elastic_e_tail;
+    if (!o->hold_elastic && et != 0)
+        return cf_error_set(err, CF_E_DATA,
+                            "tail compliance %g: a tail is carried only by a held elastic part "
+                            "(the fitted one is the conical law)",
+                            et);
+    if (o->hold_elastic && et != 0) {
+        /* the tailed spring: the cone may close within the series (its third, linear region is
+        ** the point of the tail); the model's member (cf_ident_member_tail) is solid only near
+        ** its free length, which the series must stay short of */
+        const double whole = 1 - CF_IDENT_TAIL_SOLIDS * (1 - el[1] - et);
+        if (!(el[0] > 0 && el[0] <= 1) || !(el[1] > 0 && el[1] < 1) || !(el[2] > 0) ||
+            !isfinite(el[2]) || !(et > 0) || !isfinite(et) || !(el[1] + et < 1) ||
+            !(c->xmax < whole))
+            return cf_error_set(err, CF_E_DATA,
+                                "the held elastic fit (rho %g, s/H %g, F_C/H^2 %g MPa, tail "
+                                "compliance %g) cannot carry this series: its cone must close "
+                                "(at s/H + e_t) below the free length and the spring stay short "
+                                "of solid at the largest strain %g",
+                                el[0], el[1], el[2], et, c->xmax);
+    } else if (o->hold_elastic &&
+               (!(el[0] > 0 && el[0] <= 1) || !(el[1] > c->xmax && el[1] < 1) ||
+                !(el[2] > 0) || !isfinite(el[2])))
         return cf_error_set(err, CF_E_DATA,
                             "the held elastic fit (rho %g, s/H %g, F_C/H^2 %g MPa) cannot carry "
                             "this series: its solid strain must exceed the largest strain %g",
@@ -248,8 +273,11 @@ static cf_status fit_setup(ctx *c, const cf_visco_data *d, const cf_visco_fit_op
         ** stable at the series' largest strain, or refused */
         cf_visco_limits held = c->lim;
         held.cells = o->stable_cells;
-        if (!cf_visco_limits_stable(&held, el[0], el[1])) {
-            double at = stability_limit(c, el[0], el[1], el[2]);
+        /* the limits' grid is the conical law's: a tailed spring is scanned itself */
+        const double at_tail = et != 0 ? stability_limit(c, el[0], el[1], el[2], et) : 0;
+        if (et != 0 ? at_tail != 0 && at_tail >= c->xlo && at_tail <= c->xhi
+                    : !cf_visco_limits_stable(&held, el[0], el[1])) {
+            double at = et != 0 ? at_tail : stability_limit(c, el[0], el[1], el[2], 0);
             char where[96] = "is not stable at that strain";
             if (at != 0)
                 snprintf(where, sizeof where, "loses stability at strain %.6g", at);
@@ -285,7 +313,8 @@ static void fit_limits(const ctx *c, const cf_visco_params *p, cf_visco_fit *res
 {
     res->stable_to_strain = 0;
     if (c->o->stable_cells > 0)
-        res->stable_to_strain = stability_limit(c, p->ident.rho, p->ident.solid, p->ident.scale);
+        res->stable_to_strain =
+            stability_limit(c, p->ident.rho, p->ident.solid, p->ident.scale, p->e_tail);
     limits_held(c, p, held);
     res->rho_at_limit = held[CF_IDENT_RHO];
     res->at_stability_limit = held[CF_IDENT_SOLID];

@@ -407,18 +407,18 @@ static void search_taus(ctx *c, const double *E, const double *xE, double *const
 /* Static lattice stress (table's sign) of the model's elastic part at every strain of the
 ** series, and the small-strain ratio of the lattice modulus to the spring's k0/H (the factor
 ** that maps a spring's dashpot to the lattice's). */
-static int elastic_curve(ctx *c, double rho, double e, double A, double *E, double *lat_factor)
+static int elastic_curve(ctx *c, const cf_visco_params *el, double *E, double *lat_factor)
 {
     cf_visco_params p;
     memset(&p, 0, sizeof p);
-    p.ident.rho = rho;
-    p.ident.solid = e;
-    p.ident.scale = A;
+    p.ident = el->ident;
+    p.e_tail = el->e_tail; /* a held tailed spring's tail goes with it */
+    const double e = p.ident.solid;
     cf_error err = {0};
     c->evals++;
     if (cf_visco_elastic_curve(&p, &c->o->setup, c->d->x, c->n, E, &err) != CF_OK)
         return 0;
-    cf_spring sp = cf_ident_member(&p.ident);
+    cf_spring sp = cf_visco_member(&p);
     cf_law law;
     double small = -1e-3 * e, s0 = 0;
     if (cf_law_init(&law, &sp, &err) != CF_OK)
@@ -451,6 +451,7 @@ static void grid_point(const ctx *c, int ir, int ie, cf_visco_params *el)
     memset(el, 0, sizeof *el);
     if (!c->free_el) {
         el->ident = c->o->elastic;
+        el->e_tail = c->o->elastic_e_tail;
         return;
     }
     const double r0 = fmax(c->rho_lo * 1.001, 0.02);
@@ -488,7 +489,7 @@ int cf_viscofit_stand_in(ctx *c, start *best, int nbest)
             cf_visco_params el;
             grid_point(c, ir, ie, &el);
             double fac = 1;
-            if (!elastic_curve(c, el.ident.rho, el.ident.solid, el.ident.scale, E, &fac))
+            if (!elastic_curve(c, &el, E, &fac))
                 continue;
             grid_responses(c, E, taus, R);
             if (c->gs) {

@@ -54,6 +54,7 @@ cf_visco_params cf_viscofit_unpack(const ctx *c, const double *z)
         p.ident.scale = 1.0;
     } else {
         p.ident = c->o->elastic;
+        p.e_tail = c->o->elastic_e_tail;
     }
     p.nbranch = c->nb;
     /* the moduli at zero strain (g_i) are shares of a softmax: >= 0 and summing below 1; the

@@ -43,6 +43,12 @@ static cf_status check_params(const cf_visco_params *p, cf_error *err)
     if (!(p->ident.scale > 0) || !isfinite(p->ident.scale))
         return cf_error_set(err, CF_E_DATA, "stress scale = %g MPa: must be finite and > 0",
                             p->ident.scale);
+    /* the cone closes at s/H + e_t: below the free length, with room for the solid lengths */
+    if (!(p->e_tail >= 0) || !isfinite(p->e_tail) || !(p->ident.solid + p->e_tail < 1))
+        return cf_error_set(err, CF_E_DATA,
+                            "tail compliance e_t = %g: must be finite, >= 0 and below 1 - s/H "
+                            "(%g)",
+                            p->e_tail, 1 - p->ident.solid);
     if (!(p->eta_MPa_s >= 0) || !isfinite(p->eta_MPa_s))
         return cf_error_set(err, CF_E_DATA, "dashpot eta = %g MPa s: must be finite and >= 0",
                             p->eta_MPa_s);
@@ -54,7 +60,13 @@ static cf_status check_params(const cf_visco_params *p, cf_error *err)
 }
 
 
-/* The law of the model's spring (cf_ident_member) after checking p, with its table when s
+cf_spring cf_visco_member(const cf_visco_params *p)
+{
+    return p->e_tail > 0 ? cf_ident_member_tail(&p->ident, p->e_tail / p->ident.solid)
+                         : cf_ident_member(&p->ident);
+}
+
+/* The law of the model's spring (cf_visco_member) after checking p, with its table when s
 ** asks for one. */
 static cf_status member_law(const cf_visco_params *p, const cf_visco_setup *s, cf_law *law,
                             cf_error *err)
@@ -62,7 +74,7 @@ static cf_status member_law(const cf_visco_params *p, const cf_visco_setup *s, c
     cf_status st = check_params(p, err);
     if (st != CF_OK)
         return st;
-    cf_spring sp = cf_ident_member(&p->ident);
+    cf_spring sp = cf_visco_member(p);
     st = cf_law_init(law, &sp, err);
     if (st == CF_OK && s->method == CF_LAW_TABLE &&
         (st = cf_law_table_build(law, CF_LAW_TABLE_DEFAULT, err)) != CF_OK)

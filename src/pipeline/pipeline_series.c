@@ -8,6 +8,8 @@
 
 #include "base/atomic.h"
 #include "conifit/version.h"
+#include "fit/lsq.h"
+#include "fit/tail.h"
 #include "pipeline/outputs.h"
 
 /* The reported spring must carry the fitted model: a placement that the design limits pushed off
@@ -37,6 +39,59 @@ static int exact_member(const cf_table *t, const cf_pipeline_options *opt, const
     f->law = law;
     f->type = law.type;
     f->feasible = cf_fit_check(&p, law.type, t, &opt->fit, &f->active, &f->violated);
+    return 1;
+}
+
+/* The held tailed spring of type ty placed for the series as a tailed static fit places it
+** (cf_tail_result: the cone's and the tail's coils in closed form, the whole spring solid past the
+** series' largest strain), with the four quantities of p (rho, s/H, F_C/H^2, e_t). A placement
+** that does not carry them to 1e-9 is replaced by the model's own member (cf_visco_member) scaled
+** to the preferred free length, checked against the same limits. 0 when no spring of the type
+** results. */
+static int place_tail(const cf_table *t, const cf_pipeline_options *opt, cf_spring_type ty,
+                      const cf_visco_params *p, cf_fit_result *f)
+{
+    memset(f, 0, sizeof *f);
+    const double B = p->ident.solid, tau = p->e_tail / B;
+    const double v[4] = {p->ident.rho, B, p->ident.scale, tau}, se[4] = {-1, -1, -1, -1};
+    double corr[4][4];
+    for (int a = 0; a < 4; a++)
+        for (int b = 0; b < 4; b++)
+            corr[a][b] = NAN;
+    cf_error e = {0};
+    if (cf_tail_result(t, &opt->fit, ty, v, se, corr, NAN, f, &e) != CF_OK)
+        return 0;
+    f->optimizer = "placement";
+    f->e_tail_se = -1;
+    for (int k = 0; k < CF_IDENT_COUNT; k++)
+        f->ident_se.v[k] = -1;
+    const cf_ident got = cf_ident_of(&f->params, 0);
+    const double got_et = got.solid * f->params.n_tail / f->params.n;
+    int same = fabs(got_et - p->e_tail) <= 1e-9 * p->e_tail;
+    for (int k = 0; k < CF_IDENT_COUNT; k++)
+        same = same && fabs(got.v[k] - p->ident.v[k]) <= 1e-9 * fabs(p->ident.v[k]);
+    if (same)
+        return f->law.type == ty;
+    cf_spring m = cf_visco_member(p);
+    const double h = opt->fit.H_preferred_mm > 0 ? opt->fit.H_preferred_mm / m.H_mm : 10.0;
+    m.D1_mm *= h;
+    m.D2_mm *= h;
+    m.d_mm *= h;
+    m.H_mm *= h;
+    m.H_tail_mm *= h;
+    cf_law law;
+    if (cf_law_init(&law, &m, &e) != CF_OK || law.type != ty)
+        return 0;
+    f->params = m;
+    f->law = law;
+    f->type = law.type;
+    f->feasible = cf_fit_check(&m, law.type, t, &opt->fit, &f->active, &f->violated);
+    /* the plain check sees the cone alone: the whole travel is the law's */
+    f->violated &= ~(unsigned)CF_C_TRAVEL;
+    f->active &= ~(unsigned)CF_C_TRAVEL;
+    if (!(law.travel_mm > cf_lsq_xmax(t) * m.H_mm * (1 + CF_FIT_TRAVEL_MARGIN)))
+        f->violated |= CF_C_TRAVEL;
+    f->feasible = f->violated == 0;
     return 1;
 }
 
@@ -76,10 +131,14 @@ cf_status cf_pipeline_fit_series(const cf_table *t, const cf_pipeline_options *o
     const cf_ident *ident = &r->fit.p.ident;
     for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING; ty++) {
         cf_error pe = {0};
-        if ((opt->types & (1u << ty)) &&
-            cf_fit_place(t, &opt->fit, (cf_spring_type)ty, ident, &r->placed[r->nplaced], &pe) ==
-                CF_OK && exact_member(t, opt, ident, &r->placed[r->nplaced]) &&
-            r->placed[r->nplaced].type == (cf_spring_type)ty)
+        if (!(opt->types & (1u << ty)))
+            continue;
+        if (r->fit.p.e_tail > 0 ? place_tail(t, opt, (cf_spring_type)ty, &r->fit.p,
+                                             &r->placed[r->nplaced])
+                                : cf_fit_place(t, &opt->fit, (cf_spring_type)ty, ident,
+                                               &r->placed[r->nplaced], &pe) == CF_OK &&
+                                      exact_member(t, opt, ident, &r->placed[r->nplaced]) &&
+                                      r->placed[r->nplaced].type == (cf_spring_type)ty)
             r->nplaced++;
     }
     if (r->nplaced == 0) {

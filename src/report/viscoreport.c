@@ -230,6 +230,14 @@ static json_t *fit_json(const cf_visco_report *r, int i)
         return NULL;
     }
     json_decref(rest);
+    /* a held tailed spring: the law named and its fourth quantity, held (no standard error), as a
+    ** static fit of the conical-tail law writes them; absent for the conical law */
+    if (v->p.e_tail > 0) {
+        json_object_set_new(o, "law", json_string("conical-tail"));
+        json_t *et = json_pack("{s:o}", "value", num(v->p.e_tail));
+        set_se(et, "stderr", -1, 1); /* held */
+        json_object_set_new(id, "tail_compliance", et);
+    }
     visco_keys(r, o);
     return o;
 }
@@ -257,9 +265,13 @@ static json_t *report_json(const cf_visco_report *r)
                              "time-series", "sign",
                              tb->compression ? "compression-negative" : "tension-positive");
     cf_report_notes_json(data, tb);
+    const int tailed = r->fit.p.e_tail > 0;
     json_t *model = json_pack(
         "{s:s, s:s, s:{s:i, s:i, s:i, s:s, s:{s:o, s:o, s:o}, s:s}, s:s, s:i}", "elastic",
-        "conical spring law: the instantaneous response", "viscous",
+        tailed ? "conical spring law with a cylindrical tail (conical-tail): the instantaneous "
+                 "response"
+               : "conical spring law: the instantaneous response",
+        "viscous",
         r->fit.strain_relaxation
             ? "Prony series on every spring, relaxation depending on strain: g_i(e) = g_i + "
               "g_per_strain_i |e| at the spring's strain e, each branch relaxing g_i(e) times the "
@@ -284,9 +296,12 @@ static json_t *report_json(const cf_visco_report *r)
                      "data", data, "model", model, "fits", fits, "better_type",
                      cf_spring_type_name(r->placed[better].type), "series", series_json(r),
                      "identifiability",
-                     "the model depends on the six design parameters only through rho, the "
-                     "solid strain and the stress scale; every placed spring gives the same "
-                     "stress along the series");
+                     tailed ? "the model depends on the eight design parameters only through "
+                              "rho, the solid strain, the stress scale and the tail compliance; "
+                              "every placed spring gives the same stress along the series"
+                            : "the model depends on the six design parameters only through rho, "
+                              "the solid strain and the stress scale; every placed spring gives "
+                              "the same stress along the series");
 }
 
 cf_status cf_visco_report_json_prepare(const cf_visco_report *r, const char *path,
@@ -337,9 +352,9 @@ char *cf_visco_report_text(const cf_visco_report *r)
         fprintf(o, " (its Cauchy stress is fitted as nominal stress, converted under "
                    "incompressibility; errors below are nominal)\n");
     cf_report_notes_text(o, r->table, " ");
-    fprintf(o, " viscoelastic fit: conical law (instantaneous) + %d Prony term%s%s, in the "
+    fprintf(o, " viscoelastic fit: %s law (instantaneous) + %d Prony term%s%s, in the "
                "lattice (%dx%dx%d cells, calibration %s), driven by the measured strain history\n",
-            f->p.nbranch, f->p.nbranch == 1 ? "" : "s", f->dashpot ? " + dashpot" : "", lc->nx,
+            f->p.e_tail > 0 ? "conical-tail" : "conical", f->p.nbranch, f->p.nbranch == 1 ? "" : "s", f->dashpot ? " + dashpot" : "", lc->nx,
             lc->ny, lc->nz, cf_calibration_name(lc->calibration));
     if (f->chosen_by_aic) {
         fprintf(o, " chosen: the lowest AIC among the candidates whose terms the series "
@@ -384,6 +399,8 @@ char *cf_visco_report_text(const cf_visco_report *r)
                   f->p.ident.solid, f->ident_se.solid, 1, "");
     value_se_text(o, f->at_design_limit ? "F_C/H^2 (at the design limit)" : "stress scale F_C/H^2",
                   f->p.ident.scale, f->ident_se.scale, u, r->table->y_unit);
+    if (f->p.e_tail > 0)
+        value_se_text(o, "tail compliance e_t", f->p.e_tail, -1, 1, "");
     if (f->stable_to_strain != 0)
         fprintf(o, "  elastic lattice stable to strain %.4g (one cell; larger lattices further)\n",
                 f->stable_to_strain);
@@ -435,7 +452,8 @@ char *cf_visco_report_text(const cf_visco_report *r)
                 p->creep_strain_end - p->creep_strain_ramp);
     if (p->note[0])
         fprintf(o, "  note: %s\n", p->note);
-    fprintf(o, " one spring of the family (the model depends only on rho, s/H, F_C/H^2):\n");
+    fprintf(o, " one spring of the family (the model depends only on rho, s/H, F_C/H^2%s):\n",
+            f->p.e_tail > 0 ? ", e_t" : "");
     for (int i = 0; i < r->nplaced; i++) {
         char sp[160];
         fprintf(o, "  %-30s %s%s\n", cf_spring_type_name(r->placed[i].type),

@@ -265,9 +265,11 @@ static void joint_auto_reports_both_laws(void **state)
     rmdir(tmp);
 }
 
-/* A tailed fit as the elastic part of a time series is refused (exit 2): the series' elastic part
-** has the conical law's three quantities, and the tail would be dropped. */
-static void tailed_elastic_part_is_refused(void **state)
+/* A tailed fit as the held elastic part of a time series keeps its tail: the fit file names the
+** law conical-tail and carries the tail's compliance, and every placed spring has a tail. A
+** tailed elastic part fitted with the series (--law conical-tail) is refused (exit 2), nothing
+** written. */
+static void tailed_elastic_part_is_held(void **state)
 {
     (void)state;
     char dir[] = "/tmp/conifit-law-XXXXXX", fit[256], json[256];
@@ -280,11 +282,28 @@ static void tailed_elastic_part_is_refused(void **state)
                             fit),
                      0);
     assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
-                            "fit data/series/synthetic_relaxation.csv --elastic %s -o %s", fit,
+                            "fit data/series/synthetic_relaxation.csv --law conical-tail -o %s",
                             json),
                      2);
-    assert_non_null(strstr(errb, "cylindrical tail"));
+    assert_non_null(strstr(errb, "--elastic"));
     assert_false(exists(json));
+    assert_int_equal(tu_run(out, sizeof out, errb, sizeof errb,
+                            "fit data/series/synthetic_relaxation.csv --elastic %s -o %s", fit,
+                            json),
+                     0);
+    json_error_t je;
+    json_t *root = json_load_file(json, 0, &je);
+    assert_non_null(root);
+    json_t *it;
+    size_t k;
+    json_array_foreach(json_object_get(root, "fits"), k, it) {
+        assert_string_equal(json_string_value(json_object_get(it, "law")), "conical-tail");
+        assert_true(json_number_value(json_object_get(json_object_get(it, "params"), "n_tail")) >
+                    0);
+        assert_non_null(json_object_get(json_object_get(it, "identifiable"), "tail_compliance"));
+    }
+    json_decref(root);
+    remove(json);
     remove(fit);
     rmdir(dir);
 }
@@ -328,7 +347,7 @@ int main(void)
         cmocka_unit_test(tailed_fit_reports_profile_intervals),
         cmocka_unit_test(unsupported_combinations_exit_2),
         cmocka_unit_test(joint_auto_reports_both_laws),
-        cmocka_unit_test(tailed_elastic_part_is_refused),
+        cmocka_unit_test(tailed_elastic_part_is_held),
         cmocka_unit_test(joint_tie_prefers_the_buildable_spring),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -332,6 +332,58 @@ static void test_held_elastic(void **state)
     cf_visco_fit_free(&f);
 }
 
+/* A held spring with a cylindrical tail: the series of a known tailed spring (its cone closing at
+** strain 0.25, within the series' 0.3, so the tail's linear region is run) and two Prony terms,
+** fitted with that spring held, recovers the terms to 1e-6 and keeps the tail in the model; the
+** same three quantities without the tail cannot even run the series (the cone passes solid at
+** 0.15), so a dropped tail could not fit. A tail without a held elastic part, or one that leaves
+** the cone no room, is refused. */
+static void test_held_tailed_elastic(void **state)
+{
+    (void)state;
+    cf_visco_params p = known();
+    p.ident.rho = 0.8; /* its one-cell lattice stable to 0.3 (at rho 0.3 it buckles at 0.19) */
+    p.ident.solid = 0.15;
+    p.e_tail = 0.1;
+    cf_visco_fit_options o;
+    double t[NS], x[NS], y[NS], yc[NS];
+    cf_error err = {0};
+    held_series(&p, &o, t, x, y);
+    o.nbranch = 2;
+    o.elastic_e_tail = p.e_tail;
+    cf_visco_params cone = p;
+    cone.e_tail = 0;
+    cf_visco_series ser = {NS, t, x};
+    assert_true(cf_visco_curve(&cone, &o.setup, &ser, yc, NULL, &err) != CF_OK);
+    double ymax = 0;
+    for (int k = 0; k < NS; k++)
+        ymax = fmax(ymax, fabs(y[k]));
+    cf_visco_data d = {NS, t, x, y, NULL};
+    cf_visco_fit f;
+    assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_OK);
+    assert_int_equal(f.held_elastic, 1);
+    assert_int_equal(f.k, 4);
+    assert_true(f.p.e_tail == p.e_tail && f.p.ident.solid == p.ident.solid);
+    int a = f.p.tau_s[0] < f.p.tau_s[1] ? 0 : 1;
+    for (int i = 0; i < 2; i++) {
+        assert_close(f.p.g[(a + i) % 2], p.g[i], 1e-6 * p.g[i]);
+        assert_close(f.p.tau_s[(a + i) % 2], p.tau_s[i], 1e-6 * p.tau_s[i]);
+    }
+    assert_true(f.rmse < 1e-8 * ymax);
+    cf_visco_fit_free(&f);
+    /* a tail with the elastic part fitted; a tail past the free length */
+    o.hold_elastic = 0;
+    assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "tail"));
+    o.hold_elastic = 1;
+    o.elastic_e_tail = 0.85;
+    assert_int_equal(cf_visco_fit_run(&d, &o, &f, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "tail compliance"));
+    cone.e_tail = 0.85;
+    assert_int_equal(cf_visco_curve(&cone, &o.setup, &ser, yc, NULL, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "tail compliance"));
+}
+
 /* A held elastic fit whose lattice buckles within the series is refused, naming the strain where
 ** it loses stability (from the library and from the command line, nothing written); the same
 ** spring with the check switched off is fitted. */
@@ -573,6 +625,7 @@ int main(void)
         cmocka_unit_test(test_series_refused),
         cmocka_unit_test(test_held_elastic),
         cmocka_unit_test(test_held_elastic_unstable),
+        cmocka_unit_test(test_held_tailed_elastic),
         cmocka_unit_test(test_shipped_synthetic_series),
         cmocka_unit_test(test_stderr_coverage),
         cmocka_unit_test(test_extra_terms_undetermined),

@@ -51,6 +51,9 @@ typedef struct cf_visco_fit_options {
                                     ** both with the choice (the command's default) */
     int hold_elastic;       /* 1: rho, s/H, F_C/H^2 held at elastic[] (an earlier fit) */
     cf_ident elastic;       /* rho [-], s/H [-], F_C/H^2 [MPa] (family.h) */
+    double elastic_e_tail;  /* with hold_elastic: the held spring's tail compliance F_C/(k_t H)
+                            ** (viscomodel.h e_tail), - ; 0: no tail. Only held: a fitted
+                            ** elastic part is the conical law (CF_E_DATA otherwise) */
     int relative;           /* 1: residuals relative to |stress| (floor 1e-3 max|stress|) */
     double rho_min;         /* smallest rho fitted (default the fitter's, 0.05) */
     /* Design limits (fit.h): when not NULL, rho, s/H and F_C/H^2 stay where a spring of one of

@@ -10,6 +10,9 @@
 ** the solid strain s/H and the stress scale F_C/H^2: at a prescribed displacement every force of
 ** the lattice (law and branches) is proportional to F_C, so the equilibrium does not depend on
 ** it, except through the dashpot, which the model therefore takes relative to the stress scale.
+** A spring with a cylindrical tail adds a fourth quantity, the tail's compliance e_t: the model
+** then runs the member of cf_ident_member_tail, whose tail closes near the free length, past any
+** strain a series can reach.
 **
 ** Sign: the series is read in the table's own sign (tension positive, compression negative) and
 ** the stress returned in it.
@@ -28,6 +31,9 @@
 typedef struct cf_visco_params {
     cf_ident ident;                   /* the spring's family (family.h) of a stress-strain
                                       ** table: rho [-], s/H [-], F_C/H^2 [MPa] */
+    double e_tail;                    /* the compliance F_C/(k_t H) of a cylindrical tail in
+                                      ** series with the cone (the conical-tail law, law.md), - ;
+                                      ** 0: none, the conical law */
     int nbranch;                      /* Prony terms, 0..CF_PRONY_MAX */
     double g[CF_PRONY_MAX];           /* relative moduli, - */
     double tau_s[CF_PRONY_MAX];       /* time constants, s */
@@ -58,6 +64,10 @@ typedef struct cf_visco_setup {
 /* The default setup: the cell with the weights of cf_msm_default(), 10 implicit steps per
 ** measured interval, law evaluator CF_LAW_CLOSED. */
 cf_visco_setup cf_visco_default(void);
+
+/* The spring the model runs for p: cf_ident_member, or cf_ident_member_tail with tau = e_t/(s/H)
+** when p has a tail. Free length 1 mm. */
+cf_spring cf_visco_member(const cf_visco_params *p);
 
 /* The effects of p (Prony terms and dashpot) as msm.h takes them. */
 cf_msm_effects cf_visco_effects(const cf_visco_params *p);
