@@ -14,6 +14,11 @@ double cf_logit(double p)
     return log(p / (1 - p));
 }
 
+double cf_logistic(double t)
+{
+    return 1.0 / (1.0 + exp(-t));
+}
+
 gsl_multifit_nlinear_parameters cf_lm_parameters(void)
 {
     gsl_multifit_nlinear_parameters fp = gsl_multifit_nlinear_default_parameters();

@@ -11,6 +11,9 @@
 /* ln(p/(1 - p)), p clamped to [1e-15, 1 - 1e-15] so that a bound maps to a finite coordinate. */
 double cf_logit(double p);
 
+/* 1/(1 + exp(-t)), the inverse of cf_logit. */
+double cf_logistic(double t);
+
 /* GSL's default parameters with the Levenberg-Marquardt step and More's scaling of the
 ** parameters; a fit adjusts the rest (difference type, step) before cf_lm_start. */
 gsl_multifit_nlinear_parameters cf_lm_parameters(void);

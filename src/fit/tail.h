@@ -14,6 +14,17 @@
 
 #include "conifit/fit.h"
 
+/* The range of tau = n_t/n the fits search. */
+#define TAIL_TAU_LO 1e-4
+#define TAIL_TAU_HI 1e3
+
+/* The fits' fourth coordinate th3 and tau = n_t/n at length scale B: log tau for a force table;
+** for a stress-strain table the strain at which the cone closes, u_C/H = B (1 + tau), as a logit
+** between B and 1 (a spring's whole travel is below its free length, so u_C/H < 1).
+** cf_tail_coord is cf_tail_tau's inverse. */
+double cf_tail_tau(int fd, double B, double th3);
+double cf_tail_coord(int fd, double B, double tau);
+
 /* Weighted residuals of n rows at the quantities v = (rho, B, A, tau) into f; GSL_SUCCESS, or
 ** GSL_EDOM where the model cannot be evaluated there. */
 typedef int (*cf_tail_residuals)(void *ctx, const double v[4], gsl_vector *f);
@@ -65,6 +76,12 @@ typedef struct cf_tail_profile {
 ** out (the intervals are then not computed). */
 int cf_tail_intervals(const cf_tail_profile *p, const double v[4], double rss0, double limit,
                       cf_fit_result *res);
+
+/* One point of p's profile of quantity k (0 rho, 1 B, 2 A, 3 e_t) at `value`, searched as
+** cf_tail_intervals searches it (rss0 and limit as there) from x = (rho, B, A, tau), which receives
+** the point reached: the weighted RSS minimised over the other three. */
+double cf_tail_profile_point(const cf_tail_profile *p, int k, double value, double rss0,
+                             double limit, double x[4]);
 
 /* The profile of quantity k (0 rho, 1 B, 2 A, 3 e_t) of the tailed spring fit `fit` of table data
 ** at `value`: the weighted RSS of the profile's rows minimised over the other three from the fit,
