@@ -12,10 +12,41 @@
 #include "fit/tail.h"
 #include "pipeline/outputs.h"
 
+/* Member m of the fitted family scaled to the preferred free length (all lengths scaled, G kept:
+** the identifiable quantities are unchanged) into f, checked against the design limits, so that a
+** spring the limits would not allow is reported infeasible. A tail's travel is the law's whole
+** travel, which the plain check (the cone alone) does not see. 0 when m has no law or, with
+** want >= 0, not that type. */
+static int scaled_member(const cf_table *t, const cf_pipeline_options *opt, cf_spring m, int want,
+                         cf_fit_result *f)
+{
+    const double h = opt->fit.H_preferred_mm > 0 ? opt->fit.H_preferred_mm / m.H_mm : 10.0;
+    m.D1_mm *= h;
+    m.D2_mm *= h;
+    m.d_mm *= h;
+    m.H_mm *= h;
+    m.H_tail_mm *= h;
+    cf_error e = {0};
+    cf_law law;
+    if (cf_law_init(&law, &m, &e) != CF_OK || (want >= 0 && law.type != (cf_spring_type)want))
+        return 0;
+    f->params = m;
+    f->law = law;
+    f->type = law.type;
+    f->feasible = cf_fit_check(&m, law.type, t, &opt->fit, &f->active, &f->violated);
+    if (cf_spring_has_tail(&m)) {
+        f->violated &= ~(unsigned)CF_C_TRAVEL;
+        f->active &= ~(unsigned)CF_C_TRAVEL;
+        if (!(law.travel_mm > cf_lsq_xmax(t) * m.H_mm * (1 + CF_FIT_TRAVEL_MARGIN)))
+            f->violated |= CF_C_TRAVEL;
+        f->feasible = f->violated == 0;
+    }
+    return 1;
+}
+
 /* The reported spring must carry the fitted model: a placement that the design limits pushed off
 ** the fitted rho, s/H, F_C/H^2 is replaced by the spring of cf_ident_member scaled to the
-** preferred free length (all lengths scaled, G kept: the three quantities are unchanged), checked
-** against the same limits (so reported infeasible where they bind). 0 when no spring results. */
+** preferred free length (scaled_member). 0 when no spring results. */
 static int exact_member(const cf_table *t, const cf_pipeline_options *opt, const cf_ident *ident,
                         cf_fit_result *f)
 {
@@ -23,23 +54,7 @@ static int exact_member(const cf_table *t, const cf_pipeline_options *opt, const
     int same = 1;
     for (int k = 0; k < CF_IDENT_COUNT; k++)
         same = same && fabs(got.v[k] - ident->v[k]) <= 1e-9 * fabs(ident->v[k]);
-    if (same)
-        return 1;
-    cf_spring p = cf_ident_member(ident);
-    const double h = opt->fit.H_preferred_mm > 0 ? opt->fit.H_preferred_mm / p.H_mm : 10.0;
-    p.D1_mm *= h;
-    p.D2_mm *= h;
-    p.d_mm *= h;
-    p.H_mm *= h;
-    cf_error e = {0};
-    cf_law law;
-    if (cf_law_init(&law, &p, &e) != CF_OK)
-        return 0;
-    f->params = p;
-    f->law = law;
-    f->type = law.type;
-    f->feasible = cf_fit_check(&p, law.type, t, &opt->fit, &f->active, &f->violated);
-    return 1;
+    return same || scaled_member(t, opt, cf_ident_member(ident), -1, f);
 }
 
 /* The held tailed spring of type ty placed for the series as a tailed static fit places it
@@ -72,27 +87,7 @@ static int place_tail(const cf_table *t, const cf_pipeline_options *opt, cf_spri
         same = same && fabs(got.v[k] - p->ident.v[k]) <= 1e-9 * fabs(p->ident.v[k]);
     if (same)
         return f->law.type == ty;
-    cf_spring m = cf_visco_member(p);
-    const double h = opt->fit.H_preferred_mm > 0 ? opt->fit.H_preferred_mm / m.H_mm : 10.0;
-    m.D1_mm *= h;
-    m.D2_mm *= h;
-    m.d_mm *= h;
-    m.H_mm *= h;
-    m.H_tail_mm *= h;
-    cf_law law;
-    if (cf_law_init(&law, &m, &e) != CF_OK || law.type != ty)
-        return 0;
-    f->params = m;
-    f->law = law;
-    f->type = law.type;
-    f->feasible = cf_fit_check(&m, law.type, t, &opt->fit, &f->active, &f->violated);
-    /* the plain check sees the cone alone: the whole travel is the law's */
-    f->violated &= ~(unsigned)CF_C_TRAVEL;
-    f->active &= ~(unsigned)CF_C_TRAVEL;
-    if (!(law.travel_mm > cf_lsq_xmax(t) * m.H_mm * (1 + CF_FIT_TRAVEL_MARGIN)))
-        f->violated |= CF_C_TRAVEL;
-    f->feasible = f->violated == 0;
-    return 1;
+    return scaled_member(t, opt, cf_visco_member(p), (int)ty, f);
 }
 
 cf_status cf_pipeline_fit_series(const cf_table *t, const cf_pipeline_options *opt,
