@@ -214,14 +214,11 @@ CF_LANE double cf_lane_table_y(const cf_law_lanes *c, double u)
     return k[j] + q * (k[j + 1] + q * (k[j + 2] + q * k[j + 3]));
 }
 
-/* The force from the fitted polynomial of degree deg in pieces pieces (constants where it is
-** inlined; they must be c->poly_degree and c->poly_pieces), for every lane (the caller selects
-** the region). */
-CF_LANE double cf_lane_poly(const cf_law_lanes *c, double u, int deg, int pieces)
+/* The fitted polynomials P and K of a spring's law (law_poly.c) at the variable w (w in the plain
+** law, z with a tail), from the piece w falls in: Horner's rule over both at once. */
+CF_LANE void cf_lane_poly_pk(const cf_law_lanes *c, double w, int deg, int pieces, double *P_out,
+                             double *K_out)
 {
-    const double a = fabs(u), sa = c->s - a;
-    double w = sqrt((sa > 0.0 ? sa : 0.0) * c->inv_s);
-    w = w < c->w_T ? w : c->w_T; /* region 1 maps to the fit's end; NaN to 0 */
     const int q = pieces == 2 && w > c->w_split;
     const double x = w * (q ? c->px_a[1] : c->px_a[0]) + (q ? c->px_b[1] : c->px_b[0]);
     double P = q ? c->pa[1][deg] : c->pa[0][deg], K = q ? c->pb[1][deg] : c->pb[0][deg];
@@ -232,6 +229,20 @@ CF_LANE double cf_lane_poly(const cf_law_lanes *c, double u, int deg, int pieces
         P = P * x + (q ? c->pa[1][j] : c->pa[0][j]);
         K = K * x + (q ? c->pb[1][j] : c->pb[0][j]);
     }
+    *P_out = P;
+    *K_out = K;
+}
+
+/* The force from the fitted polynomial of degree deg in pieces pieces (constants where it is
+** inlined; they must be c->poly_degree and c->poly_pieces), for every lane (the caller selects
+** the region). */
+CF_LANE double cf_lane_poly(const cf_law_lanes *c, double u, int deg, int pieces)
+{
+    const double a = fabs(u), sa = c->s - a;
+    double w = sqrt((sa > 0.0 ? sa : 0.0) * c->inv_s);
+    w = w < c->w_T ? w : c->w_T; /* region 1 maps to the fit's end; NaN to 0 */
+    double P, K;
+    cf_lane_poly_pk(c, w, deg, pieces, &P, &K);
     const double e = w * P;
     const double h = P * P * (6.0 + e * (-4.0 + e)) - c->r4 * (1.0 - e);
     const double y = 1.0 - w * (P - h * K);
@@ -263,16 +274,8 @@ CF_LANE double cf_lane_poly_tail(const cf_law_lanes *c, double u, int deg, int p
     const double v = va > 0.0 ? va : 0.0; /* region 3, the solid and NaN map to the cone's solid */
     double z = form == CF_TAIL_V ? v : sqrt(v + c->kappa2);
     z = z < c->w_T ? z : c->w_T; /* region 1 maps to the fit's end */
-    const int q = pieces == 2 && z > c->w_split;
-    const double x = z * (q ? c->px_a[1] : c->px_a[0]) + (q ? c->px_b[1] : c->px_b[0]);
-    double P = q ? c->pa[1][deg] : c->pa[0][deg], K = q ? c->pb[1][deg] : c->pb[0][deg];
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC unroll 32
-#endif
-    for (int j = deg - 1; j >= 0; j--) {
-        P = P * x + (q ? c->pa[1][j] : c->pa[0][j]);
-        K = K * x + (q ? c->pb[1][j] : c->pb[0][j]);
-    }
+    double P, K;
+    cf_lane_poly_pk(c, z, deg, pieces, &P, &K);
     double y;
     if (form == CF_TAIL_NEAR) {
         const double e = c->e_star + z * P;
