@@ -442,6 +442,41 @@ static void published_tables_fit_both_types_at_least_as_well_as_an_independent_f
     }
 }
 
+/* The two types of one table sharing stage A (cf_fit_run_shared) give what each type's own fit
+** gives, to the bit, evaluations included (the second counts the shared stage A); the shared
+** optimum is taken only for the table and options it was found with. */
+static void shared_stage_a_is_each_types_own_fit(void **state)
+{
+    (void)state;
+    cf_spring p = {8, 20, 2.5, 2, 100, 5};
+    table t;
+    synth(&p, 60, 0.9, 0.01, 7, &t);
+    cf_table d = data_of(&t);
+    cf_fit_options o = cf_fit_default_options();
+    cf_fit_shared sh;
+    memset(&sh, 0, sizeof sh);
+    for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING; ty++) {
+        cf_fit_result own, shared;
+        cf_error err = {0};
+        fit_ok(&d, &o, (cf_spring_type)ty, &own);
+        assert_int_equal(cf_fit_run_shared(&d, &o, (cf_spring_type)ty, &sh, &shared, &err), CF_OK);
+        assert_true(sh.have);
+        assert_memory_equal(&own.params, &shared.params, sizeof own.params);
+        assert_memory_equal(&own.ident, &shared.ident, sizeof own.ident);
+        assert_true(own.rss == shared.rss);
+        assert_int_equal(own.evaluations, shared.evaluations);
+    }
+    /* other options: the kept optimum is not reused (the fit is the unshared one) */
+    cf_fit_options o2 = o;
+    o2.seed = o.seed + 1;
+    cf_fit_result own2, shared2;
+    cf_error err = {0};
+    fit_ok(&d, &o2, CF_TELESCOPING, &own2);
+    assert_int_equal(cf_fit_run_shared(&d, &o2, CF_TELESCOPING, &sh, &shared2, &err), CF_OK);
+    assert_memory_equal(&own2.params, &shared2.params, sizeof own2.params);
+    assert_int_equal(own2.evaluations, shared2.evaluations);
+}
+
 /* A force table that is a straight line leaves the travel and the solid load free along the
 ** line's stiffness (the law stays in its first region over the table): the fit takes the compact
 ** end of that valley whatever the search's tolerance, the transition at the table's largest
@@ -502,6 +537,7 @@ int main(void)
         cmocka_unit_test(baselines_recover_their_own_laws),
         cmocka_unit_test(published_tables_fit_both_types_at_least_as_well_as_an_independent_fit),
         cmocka_unit_test(linear_force_table_gets_the_shortest_linear_spring),
+        cmocka_unit_test(shared_stage_a_is_each_types_own_fit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
