@@ -2,6 +2,12 @@
 ** The family's canonical law over many points at once (see family.h, cf_ident_canon_many): the
 ** closed form of law_simd.h in vector lanes, with the derivatives the fits' Jacobians need.
 */
+/* Multiply-adds fused where the copy has them (AVX2, AVX-512): a fifth fewer instructions in the
+** lanes, at least as accurate; the baseline copy has none, so the copies differ by rounding, as
+** law_simd.h allows. */
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC optimize("fp-contract=fast")
+#endif
 #include "conifit/family.h"
 
 #include "model/law_simd.h"
@@ -50,9 +56,15 @@ CF_LANE void canon_lane(const canon_consts *k, double x, double *g, double *gt, 
     *gr = bad ? 0.0 : Gr;
 }
 
+/* The points in whole blocks of the copy's width (CANON_BLOCK_v1, _v3, _v4), then the last few
+** copied into one padded block (padded with the last point) and run through the same loop: no
+** scalar remainder, whose four points cost a fifth of a 100-point call at eight lanes. */
+#define CANON_BLOCK_v1 2
+#define CANON_BLOCK_v3 4
+#define CANON_BLOCK_v4 8
 #define CANON_MANY(attr, sfx, unused)                                                              \
-    attr static void canon_many##sfx(const canon_consts *kp, size_t count, const double *x,        \
-                                     double *g, double *gt, double *gr)                            \
+    attr static void canon_run##sfx(const canon_consts *kp, size_t count, const double *x,         \
+                                    double *g, double *gt, double *gr)                             \
     {                                                                                              \
         const canon_consts k = *kp; /* by value: its loads leave the loop */                       \
         if (!gt || !gr) {                                                                          \
@@ -62,6 +74,27 @@ CF_LANE void canon_lane(const canon_consts *k, double x, double *g, double *gt, 
         }                                                                                          \
         _Pragma("omp simd") for (size_t i = 0; i < count; i++)                                     \
             canon_lane(&k, x[i], &g[i], &gt[i], &gr[i]);                                           \
+    }                                                                                              \
+    attr static void canon_many##sfx(const canon_consts *kp, size_t count, const double *x,        \
+                                     double *g, double *gt, double *gr)                            \
+    {                                                                                              \
+        const size_t whole = count - count % CANON_BLOCK##sfx, rest = count - whole;               \
+        canon_run##sfx(kp, whole, x, g, gt, gr);                                                   \
+        if (rest == 0)                                                                             \
+            return;                                                                                \
+        enum { W = CANON_BLOCK##sfx };                                                             \
+        double px[W], pg[W], pt[W], pr[W];                                                         \
+        for (size_t i = 0; i < W; i++)                                                             \
+            px[i] = x[whole + (i < rest ? i : rest - 1)];                                          \
+        const int d = gt && gr;                                                                    \
+        canon_run##sfx(kp, W, px, pg, d ? pt : NULL, d ? pr : NULL);                               \
+        for (size_t i = 0; i < rest; i++) {                                                        \
+            g[whole + i] = pg[i];                                                                  \
+            if (d) {                                                                               \
+                gt[whole + i] = pt[i];                                                             \
+                gr[whole + i] = pr[i];                                                             \
+            }                                                                                      \
+        }                                                                                          \
     }
 CF_SIMD_COPIES(CANON_MANY, 0)
 

@@ -142,6 +142,25 @@ static void the_vectorised_canonical_law_is_the_scalar_one(void **state)
             cf_law_free(&lp);
             cf_law_free(&lm);
         }
+        /* every count, whole vectors or not (the last few points run in a padded block): each
+        ** point as in the long call, the points after the count untouched */
+        for (size_t count = 1; count <= 19; count++) {
+            double h[24], ht[24], hr[24];
+            for (int i = 0; i < 24; i++)
+                h[i] = ht[i] = hr[i] = -7.0;
+            const size_t at = N - count; /* the last points: by solid, the transition, NaN */
+            cf_ident_canon_many(&canon, B, count, x + at, h, ht, hr);
+            for (size_t i = 0; i < count; i++) {
+                assert_close(h[i], g[at + i], 1e-15);
+                assert_close(ht[i], gt[at + i], 1e-15 * fmax(1.0, fabs(gt[at + i])));
+                assert_close(hr[i], gr[at + i], 1e-15 * fmax(1.0, fabs(gr[at + i])));
+            }
+            for (size_t i = count; i < 24; i++)
+                assert_true(h[i] == -7.0 && ht[i] == -7.0 && hr[i] == -7.0);
+            cf_ident_canon_many(&canon, B, count, x + at, h, NULL, NULL);
+            for (size_t i = 0; i < count; i++)
+                assert_close(h[i], g0[at + i], 1e-15);
+        }
         cf_law_free(&canon);
     }
 }
