@@ -69,12 +69,10 @@ static double lanes_sum(const double p[RSS_LANES])
 static double rss_core(fit_ctx *c, double rho, double B, double A_fixed, double A_max,
                        double *A_out, double d[3])
 {
-    cf_law canon;
     *A_out = A_fixed;
-    if (!(B > 0) || cf_ident_canon_law(rho, &canon) != CF_OK)
+    if (!(B > 0) || cf_ident_canon_many_rho(rho, B, c->n, c->data->x, c->model,
+                                            d ? c->gt : NULL, d ? c->gr : NULL) != CF_OK)
         return CF_LSQ_HUGE_OBJ;
-    cf_ident_canon_many(&canon, B, c->n, c->data->x, c->model, d ? c->gt : NULL,
-                        d ? c->gr : NULL);
     /* the sums in RSS_LANES partial sums each, added at the end: RSS_LANES chains of additions in
     ** flight instead of one, whose latency was a tenth of a short table's fit */
     const size_t n = c->n;

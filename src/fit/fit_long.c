@@ -31,12 +31,11 @@ static void unpack(const fit_ctx *c, const double th[3], double q[3], double dq[
 static double normal_pass(fit_ctx *c, const double th[3], double jtj[3][3], double jtr[3])
 {
     double q[3], dq[2];
-    cf_law canon;
     unpack(c, th, q, dq);
-    if (!isfinite(q[2]) || cf_ident_canon_law(q[0], &canon) != CF_OK)
+    if (!isfinite(q[2]) ||
+        cf_ident_canon_many_rho(q[0], q[1], c->n, c->data->x, c->model, c->gt, c->gr) != CF_OK)
         return CF_LSQ_HUGE_OBJ;
     const double B = q[1], A = q[2], sc = 1.0 / sqrt(c->ynorm);
-    cf_ident_canon_many(&canon, B, c->n, c->data->x, c->model, c->gt, c->gr);
     double chi2 = 0;
     memset(jtj, 0, 9 * sizeof(double));
     memset(jtr, 0, 3 * sizeof(double));

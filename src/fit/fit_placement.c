@@ -102,11 +102,9 @@ static int objective_grad(fit_ctx *c, const double *z, double *grad)
         return 0;
     const cf_ident id = cf_ident_of_type(&sp, c->type, c->fd);
     const double rho = id.v[0], B = id.v[1], A = id.v[2];
-    cf_law canon;
     if (!(rho > 0 && B > 0 && A > 0 && isfinite(A) && isfinite(B)) ||
-        cf_ident_canon_law(rho, &canon) != CF_OK)
+        cf_ident_canon_many_rho(rho, B, c->n, c->data->x, c->model, c->gt, c->gr) != CF_OK)
         return 0;
-    cf_ident_canon_many(&canon, B, c->n, c->data->x, c->model, c->gt, c->gr);
     double sr = 0, st = 0, sa = 0;
     for (size_t i = 0; i < c->n; i++) {
         double r = c->sw[i] * c->sw[i] * (A * c->model[i] - c->data->y[i]);

@@ -42,10 +42,8 @@ static double sigmoid(double t) { return 1.0 / (1.0 + exp(-t)); }
 /* Weighted objective of the reduced model with the load scale A solved in closed form. */
 static double reduced_profile(fit_ctx *c, double rho, double B, double *A_out)
 {
-    cf_law canon;
-    if (cf_ident_canon_law(rho, &canon) != CF_OK)
+    if (cf_ident_canon_many_rho(rho, B, c->n, c->data->x, c->model, NULL, NULL) != CF_OK)
         return CF_LSQ_HUGE_OBJ;
-    cf_ident_canon_many(&canon, B, c->n, c->data->x, c->model, NULL, NULL);
     double sgy = 0, sgg = 0, syy = 0;
     for (size_t i = 0; i < c->n; i++) {
         double g = c->sw[i] * c->model[i];
@@ -73,12 +71,14 @@ static void unpack3(const fit_ctx *c, const gsl_vector *th, double *rho, double 
     *A = exp(gsl_vector_get(th, 2));
 }
 
-/* The quantities at th and the canonical law of their rho; GSL_EDOM where there is none. */
-static int canon_at(const fit_ctx *c, const gsl_vector *th, double *rho, double *B, double *A,
-                    cf_law *canon)
+/* The quantities at th and the canonical law there (g, and with gt and gr its derivatives, at
+** every row: cf_ident_canon_many_rho); GSL_EDOM where there is none. */
+static int canon_at(fit_ctx *c, const gsl_vector *th, double *rho, double *B, double *A,
+                    double *gt, double *gr)
 {
     unpack3(c, th, rho, B, A);
-    if (!isfinite(*A) || cf_ident_canon_law(*rho, canon) != CF_OK)
+    if (!isfinite(*A) ||
+        cf_ident_canon_many_rho(*rho, *B, c->n, c->data->x, c->model, gt, gr) != CF_OK)
         return GSL_EDOM;
     return GSL_SUCCESS;
 }
@@ -87,13 +87,11 @@ static int lm_f(const gsl_vector *th, void *params, gsl_vector *f)
 {
     fit_ctx *c = params;
     double rho, B, A;
-    cf_law canon;
-    if (canon_at(c, th, &rho, &B, &A, &canon) != GSL_SUCCESS)
+    if (canon_at(c, th, &rho, &B, &A, NULL, NULL) != GSL_SUCCESS)
         return GSL_EDOM;
     /* residuals scaled so that the zero model has |f| = 1: GSL's gradient test is absolute
     ** below |f| = 1, which would stop early on tables in MPa of tissue (tiny numbers) */
     const double sc = 1.0 / sqrt(c->ynorm);
-    cf_ident_canon_many(&canon, B, c->n, c->data->x, c->model, NULL, NULL);
     for (size_t i = 0; i < c->n; i++)
         gsl_vector_set(f, i, sc * c->sw[i] * (A * c->model[i] - c->data->y[i]));
     c->evals++;
@@ -105,14 +103,12 @@ static int lm_df(const gsl_vector *th, void *params, gsl_matrix *J)
 {
     fit_ctx *c = params;
     double rho, B, A;
-    cf_law canon;
-    if (canon_at(c, th, &rho, &B, &A, &canon) != GSL_SUCCESS)
+    if (canon_at(c, th, &rho, &B, &A, c->gt, c->gr) != GSL_SUCCESS)
         return GSL_EDOM;
     const double s0 = sigmoid(gsl_vector_get(th, 0)), s1 = sigmoid(gsl_vector_get(th, 1));
     const double drho = (c->rho_hi - c->rho_lo) * s0 * (1 - s0);
     const double dB = (c->b_hi - c->b_lo) * s1 * (1 - s1);
     const double sc = 1.0 / sqrt(c->ynorm);
-    cf_ident_canon_many(&canon, B, c->n, c->data->x, c->model, c->gt, c->gr);
     for (size_t i = 0; i < c->n; i++) {
         double t = c->data->x[i] / B;
         double w = sc * c->sw[i];

@@ -2,15 +2,21 @@
 ** The family's canonical law over many points at once (see family.h, cf_ident_canon_many): the
 ** closed form of law_simd.h in vector lanes, with the derivatives the fits' Jacobians need.
 */
-/* Multiply-adds fused where the copy has them (AVX2, AVX-512): a fifth fewer instructions in the
-** lanes, at least as accurate; the baseline copy has none, so the copies differ by rounding, as
-** law_simd.h allows. */
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC optimize("fp-contract=fast")
-#endif
 #include "conifit/family.h"
 
+#include <float.h>
+#include <string.h>
+
 #include "model/law_simd.h"
+
+/* Multiply-adds fused in the lanes where the copy has them (AVX2, AVX-512): a fifth fewer
+** instructions, at least as accurate; the baseline copy has none, so the copies differ by
+** rounding, as law_simd.h allows. Only the lanes: the constants below are derived as law.c
+** derives them. */
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC push_options
+#pragma GCC optimize("fp-contract=fast")
+#endif
 
 /* What every lane of one call shares: the canonical law's lanes and its constants. */
 typedef struct canon_consts {
@@ -98,15 +104,50 @@ CF_LANE void canon_lane(const canon_consts *k, double x, double *g, double *gt, 
     }
 CF_SIMD_COPIES(CANON_MANY, 0)
 
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC pop_options
+#endif
+
+/* The constants every call shares, from the lanes of the canonical law and its rho and k0. */
+static void canon_consts_of(canon_consts *k, double rho, double k0, double B)
+{
+    k->inv_B = 1.0 / B;
+    k->h = k0;
+    k->h_rho = 3 / rho - 1 / (1 + rho) - 2 * rho / (1 + rho * rho);
+    k->inv_r2 = 1.0 / (rho * rho);
+}
+
 void cf_ident_canon_many(const cf_law *canon, double B, size_t count, const double *x, double *g,
                          double *dg_dt, double *dg_drho)
 {
     canon_consts k;
     cf_law_lanes_init(canon, &k.l);
-    const double rho = canon->rho;
-    k.inv_B = 1.0 / B;
-    k.h = canon->k0_N_per_mm;
-    k.h_rho = 3 / rho - 1 / (1 + rho) - 2 * rho / (1 + rho * rho);
-    k.inv_r2 = 1.0 / (rho * rho);
+    canon_consts_of(&k, canon->rho, canon->k0_N_per_mm, B);
     CF_SIMD_CALL(canon_many, (&k, count, x, g, dg_dt, dg_drho));
+}
+
+/* The canonical spring (family.c: D1 = rho, D2 = 1, n = 2, d = 0.5, G = 256 rho^3, H = 2 mm) as
+** cf_law_init derives it: travel 2 - 1 = 1 mm; F_C = G s d/(8 n c^3) with c = 2 rho, where
+** G = 256 fl(fl(rho^2) rho) and c^3 = 8 fl(fl(rho^2) rho) (powers of two scale exactly), so
+** F_C = 1 exactly; k0 = G d/(2 n c2^3 shape) = 4 fl(fl(rho^2) rho)/shape with c2 = 2, shape =
+** (1 + rho)(1 + rho^2); u_T = min(shape/4, 1); 1/rho - 1 = (1 - rho)/rho. The law's other checks
+** hold for every rho in (0, 1] whose cube is a normal number. */
+cf_status cf_ident_canon_many_rho(double rho, double B, size_t count, const double *x, double *g,
+                                  double *dg_dt, double *dg_drho)
+{
+    const double r3 = rho * rho * rho;
+    if (!(rho > 0 && rho <= 1) || !(256.0 * r3 >= DBL_MIN))
+        return CF_E_DATA;
+    const double shape = (1.0 + rho) * (1.0 + rho * rho);
+    canon_consts k;
+    memset(&k.l, 0, sizeof k.l);
+    k.l.u_T = fmin(shape * 0.25, 1.0);
+    k.l.s = 1.0;
+    k.l.inv_s = 1.0;
+    k.l.k0 = 128.0 * r3 / (32.0 * shape);
+    k.l.F_C = 1.0;
+    k.l.rim1 = (1.0 - rho) / rho;
+    canon_consts_of(&k, rho, k.l.k0, B);
+    CF_SIMD_CALL(canon_many, (&k, count, x, g, dg_dt, dg_drho));
+    return CF_OK;
 }

@@ -166,6 +166,42 @@ static void the_vectorised_canonical_law_is_the_scalar_one(void **state)
 }
 
 /* The six-parameter model over many points (the fits' objective) is the scalar one. */
+/* The canonical law's lanes from rho alone are those of the built law, bit for bit: every rho of
+** a log grid from 1e-3 to 1 and its neighbours one ulp away, values and derivatives; rho outside
+** (0, 1] or NaN is refused with nothing written. */
+static void the_canonical_lanes_of_rho_are_those_of_the_law(void **state)
+{
+    (void)state;
+    enum { N = 37 };
+    double x[N], g[N], gt[N], gr[N], h[N], ht[N], hr[N];
+    for (int i = 0; i < N; i++)
+        x[i] = -1.2 + 2.4 * i / (N - 1.0);
+    for (int k = 0; k <= 60; k++) {
+        const double r0 = pow(10.0, -3.0 + 3.0 * k / 60.0);
+        const double rhos[3] = {nextafter(r0, 0), r0, fmin(nextafter(r0, 2), 1.0)};
+        for (int j = 0; j < 3; j++) {
+            const double B = 0.37 + 0.5 * j;
+            cf_law canon;
+            assert_int_equal(cf_ident_canon_law(rhos[j], &canon), CF_OK);
+            cf_ident_canon_many(&canon, B, N, x, g, gt, gr);
+            assert_int_equal(cf_ident_canon_many_rho(rhos[j], B, N, x, h, ht, hr), CF_OK);
+            assert_memory_equal(g, h, sizeof g);
+            assert_memory_equal(gt, ht, sizeof gt);
+            assert_memory_equal(gr, hr, sizeof gr);
+            cf_ident_canon_many(&canon, B, N, x, g, NULL, NULL);
+            assert_int_equal(cf_ident_canon_many_rho(rhos[j], B, N, x, h, NULL, NULL), CF_OK);
+            assert_memory_equal(g, h, sizeof g);
+            cf_law_free(&canon);
+        }
+    }
+    const double bad[] = {0.0, -0.5, nextafter(1.0, 2.0), 2.0, NAN, INFINITY};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        h[0] = -7.0;
+        assert_int_equal(cf_ident_canon_many_rho(bad[k], 0.5, N, x, h, NULL, NULL), CF_E_DATA);
+        assert_true(h[0] == -7.0);
+    }
+}
+
 static void the_vectorised_model_is_the_scalar_one(void **state)
 {
     (void)state;
@@ -229,6 +265,7 @@ int main(void)
         cmocka_unit_test(force_scales_are_the_stress_scales_times_H),
         cmocka_unit_test(the_reduced_curve_is_the_member_law),
         cmocka_unit_test(the_vectorised_canonical_law_is_the_scalar_one),
+        cmocka_unit_test(the_canonical_lanes_of_rho_are_those_of_the_law),
         cmocka_unit_test(the_vectorised_model_is_the_scalar_one),
         cmocka_unit_test(the_design_limits_at_points_worked_by_hand),
     };

@@ -128,4 +128,11 @@ double cf_ident_reduced(const cf_law *canon, double A, double B, double x, doubl
 void cf_ident_canon_many(const cf_law *canon, double B, size_t count, const double *x, double *g,
                          double *dg_dt, double *dg_drho);
 
+/* cf_ident_canon_many for the canonical law of rho without building it: the same values, bit for
+** bit, as cf_ident_canon_law(rho) followed by cf_ident_canon_many (the lanes need four of its
+** constants, derived here by the same operations; the fits' searches call this for every point
+** they try). CF_E_DATA, and nothing written, where cf_ident_canon_law has no law for rho. */
+cf_status cf_ident_canon_many_rho(double rho, double B, size_t count, const double *x, double *g,
+                                  double *dg_dt, double *dg_drho);
+
 #endif
