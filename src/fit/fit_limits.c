@@ -49,6 +49,18 @@ double cf_fit_ident_limit(const cf_fit_options *opt, cf_spring_type type, double
     return r.margin;
 }
 
+#define RSS_LANES 4
+#if defined(__GNUC__) && !defined(__clang__)
+#define RSS_UNROLL _Pragma("GCC unroll 4")
+#else
+#define RSS_UNROLL
+#endif
+
+static double lanes_sum(const double p[RSS_LANES])
+{
+    return (p[0] + p[1]) + (p[2] + p[3]);
+}
+
 /* The weighted RSS of the reduced model at (rho, B) with the load scale A fixed (A_fixed > 0) or
 ** solved in closed form and clamped to (0, A_max]; *A_out the scale used. With d (not NULL) also
 ** its partial derivatives at that A: d[0] in log rho, d[1] in B, d[2] in A, from one pass of the
@@ -61,19 +73,25 @@ static double rss_core(fit_ctx *c, double rho, double B, double A_fixed, double 
     if (!(B > 0) || cf_ident_canon_many_rho(rho, B, c->n, c->data->x, c->model,
                                             d ? c->gt : NULL, d ? c->gr : NULL) != CF_OK)
         return CF_LSQ_HUGE_OBJ;
-    /* the sums in vector lanes (partial sums per lane, added at the end): one chain of additions
-    ** in flight made these two passes a tenth of a short table's fit */
+    /* the sums in RSS_LANES partial sums each, added at the end: RSS_LANES chains of additions in
+    ** flight instead of one, whose latency was a tenth of a short table's fit */
     const size_t n = c->n;
     const double *sw = c->sw, *x = c->data->x, *y = c->data->y;
     double *m = c->model;
-    double sgy = 0, sgg = 0;
-#pragma omp simd reduction(+ : sgy, sgg)
-    for (size_t i = 0; i < n; i++) {
-        const double g = sw[i] * m[i];
-        m[i] = g;
-        sgy += g * sw[i] * y[i];
-        sgg += g * g;
+    double pgy[RSS_LANES] = {0}, pgg[RSS_LANES] = {0};
+    const size_t whole = n - n % RSS_LANES;
+    for (size_t i0 = 0; i0 < n; i0 += RSS_LANES) {
+        const size_t lanes = i0 < whole ? RSS_LANES : n - whole;
+        RSS_UNROLL
+        for (size_t l = 0; l < lanes; l++) {
+            const size_t i = i0 + l;
+            const double g = sw[i] * m[i];
+            m[i] = g;
+            pgy[l] += g * sw[i] * y[i];
+            pgg[l] += g * g;
+        }
     }
+    const double sgy = lanes_sum(pgy), sgg = lanes_sum(pgg);
     double A = A_fixed;
     if (!(A > 0)) {
         A = sgg > 0 ? sgy / sgg : 0;
@@ -81,24 +99,30 @@ static double rss_core(fit_ctx *c, double rho, double B, double A_fixed, double 
             A = 1e-300;
         A = fmin(A, A_max);
     }
-    double rss = 0, sr = 0, st = 0, sa = 0;
-    if (d) {
-        const double *gt = c->gt, *gr = c->gr;
-#pragma omp simd reduction(+ : rss, sr, st, sa)
-        for (size_t i = 0; i < n; i++) {
-            const double r = A * m[i] - sw[i] * y[i];
-            rss += r * r;
-            sr += r * sw[i] * gr[i];
-            st += r * sw[i] * gt[i] * x[i];
-            sa += r * m[i];
-        }
-    } else {
-#pragma omp simd reduction(+ : rss)
-        for (size_t i = 0; i < n; i++) {
-            const double r = A * m[i] - sw[i] * y[i];
-            rss += r * r;
+    double prs[RSS_LANES] = {0}, psr[RSS_LANES] = {0}, pst[RSS_LANES] = {0},
+           psa[RSS_LANES] = {0};
+    for (size_t i0 = 0; i0 < n; i0 += RSS_LANES) {
+        const size_t lanes = i0 < whole ? RSS_LANES : n - whole;
+        if (d) {
+            RSS_UNROLL
+            for (size_t l = 0; l < lanes; l++) {
+                const size_t i = i0 + l;
+                const double r = A * m[i] - sw[i] * y[i];
+                prs[l] += r * r;
+                psr[l] += r * sw[i] * c->gr[i];
+                pst[l] += r * sw[i] * c->gt[i] * x[i];
+                psa[l] += r * m[i];
+            }
+        } else {
+            RSS_UNROLL
+            for (size_t l = 0; l < lanes; l++) {
+                const double r = A * m[i0 + l] - sw[i0 + l] * y[i0 + l];
+                prs[l] += r * r;
+            }
         }
     }
+    const double rss = lanes_sum(prs), sr = lanes_sum(psr), st = lanes_sum(pst),
+                 sa = lanes_sum(psa);
     c->evals++;
     *A_out = A;
     if (d) {
