@@ -422,6 +422,8 @@ cf_status cf_fit_run_shared(const cf_table *data, const cf_fit_options *opt, cf_
     double v[3] = {0.5, 0.5 * (c.b_lo + c.b_hi), 1.0};
     start4 found[STAGE_A_RUNS];
     int nfound = 0;
+    grid_point pts[GRID * GRID]; /* stage A's grid, when this fit runs it */
+    int pts_ok = 0;
     /* both types' stage A searches the same range where their limits are known in closed form
     ** (c.region): the same optimum, which the second fit of a table takes from the first */
     const int share = shared && c.region;
@@ -434,7 +436,8 @@ cf_status cf_fit_run_shared(const cf_table *data, const cf_fit_options *opt, cf_
     } else {
         if (long_table)
             sc.stat_tol = LONG_TOL / (double)(sc.n - 3);
-        cf_fit_stage_a(g, v, long_table ? found : NULL, &nfound);
+        cf_fit_stage_a(g, v, long_table ? found : NULL, &nfound, pts);
+        pts_ok = 1;
         sc.stat_tol = 0;
         if (long_table) {
             cf_fit_stage_a_polish(&c, found, nfound, v);
@@ -466,7 +469,7 @@ cf_status cf_fit_run_shared(const cf_table *data, const cf_fit_options *opt, cf_
         int out = r.margin > 0, over = v[2] > r.A_max / (1 - REGION_SAFETY);
         if (out || over) {
             held_a = (out ? r.lo_bit | r.hi_bit : 0u) | (over ? (unsigned)CF_C_G_MAX : 0u);
-            if (cf_fit_stage_a_constrained(g, v)) {
+            if (cf_fit_stage_a_constrained(g, v, pts_ok ? pts : NULL)) {
                 if (long_table)
                     cf_fit_stage_a_constrained_polish(&c, v);
                 held_a |= cf_fit_held_at(&c, v);

@@ -92,6 +92,16 @@ typedef struct start {
     double obj, rho, B;
 } start;
 
+/* A point of stage A's grid over (rho, B) and the reduced model's fit there with the load scale in
+** closed form: its RSS at the optimal scale A (rss; syy at A = 1e-300 where that scale is not
+** positive) and sgg, the sum of the weighted model's squares, so that the RSS at any other scale
+** A' is rss + (A' - A)^2 sgg without a pass over the rows (the constrained stage clamps the scale
+** to the type's largest). done = 0: not evaluated yet. */
+typedef struct grid_point {
+    double rho, B, rss, A, sgg;
+    int done;
+} grid_point;
+
 /* A result of stage A's Levenberg-Marquardt runs (at most 1 + multistart of them are kept). */
 typedef struct start4 {
     double obj, v[3];
@@ -140,7 +150,10 @@ double cf_fit_jitter(gsl_rng *r);
 double cf_fit_lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3]);
 int cf_fit_cmp_start4(const void *a, const void *b);
 int cf_fit_cmp_start(const void *a, const void *b);
-double cf_fit_stage_a(fit_ctx *c, double best3[3], start4 *found, int *nfound);
+void cf_fit_grid_points(fit_ctx *c, grid_point pts[GRID * GRID]);
+void cf_fit_grid_value(fit_ctx *c, grid_point *p);
+double cf_fit_stage_a(fit_ctx *c, double best3[3], start4 *found, int *nfound,
+                      grid_point *pts);
 int cf_fit_stage_a_errors(fit_ctx *c, const double v[3], double se[3], double corr[3][3]);
 
 /* fit_constraints.c */
@@ -166,7 +179,7 @@ double cf_fit_sub_f0(const sub *q, const double *x);
 double cf_fit_sub_g0(const sub *q, const double *x);
 int cf_fit_sub_empty(const sub *q);
 double cf_fit_sub_solve(fit_ctx *c, sub *q, double *x, nlopt_algorithm alg);
-int cf_fit_stage_a_constrained(fit_ctx *c, double v[3]);
+int cf_fit_stage_a_constrained(fit_ctx *c, double v[3], grid_point *pts);
 unsigned cf_fit_held_at(const fit_ctx *c, const double v[3]);
 int cf_fit_region_member(fit_ctx *c, const double v[3], double *p);
 

@@ -298,31 +298,33 @@ double cf_fit_sub_solve(fit_ctx *c, sub *q, double *x, nlopt_algorithm alg)
 }
 
 /* Stage A under the type's limits: used when the optimum over every spring lies outside them.
-** Seeded grid over (rho, B) as in cf_fit_stage_a, feasible points only, then COBYLA from the
-** best. */
-int cf_fit_stage_a_constrained(fit_ctx *c, double v[3])
+** The points of stage A's grid that meet the limits, ranked by the RSS with the load scale
+** clamped to the type's largest (from each point's fit in closed form: pts, stage A's own when
+** this fit ran it, else evaluated here at those points alone, to the same values), then SLSQP
+** from the best. */
+int cf_fit_stage_a_constrained(fit_ctx *c, double v[3], grid_point *pts)
 {
-    gsl_rng *rng = cf_fit_seeded_rng(c->opt->seed, 3);
-    c->oom |= !rng;
+    grid_point own[GRID * GRID];
+    grid_point *gp = pts;
+    if (!gp) {
+        gp = own;
+        cf_fit_grid_points(c, gp);
+    }
     start grid[GRID * GRID];
     size_t k = 0;
     sub q = {c, -1, 0};
-    for (int i = 0; i < GRID; i++) {
-        double ti = (i + cf_fit_jitter(rng)) / GRID;
-        double rho = c->rho_lo * pow(c->rho_hi / c->rho_lo, ti);
-        for (int j = 0; j < GRID; j++) {
-            double tj = (j + cf_fit_jitter(rng)) / GRID;
-            double B = c->b_lo + (c->b_hi - c->b_lo) * tj;
-            double x[2] = {log(rho), B};
-            if (cf_fit_sub_g0(&q, x) > 0)
-                continue;
-            grid[k].obj = cf_fit_sub_f0(&q, x);
-            grid[k].rho = rho;
-            grid[k].B = B;
-            k++;
-        }
+    for (size_t i = 0; i < GRID * GRID; i++) {
+        double x[2] = {log(gp[i].rho), gp[i].B};
+        if (cf_fit_sub_g0(&q, x) > 0)
+            continue;
+        if (!gp[i].done)
+            cf_fit_grid_value(c, &gp[i]);
+        const double A = fmin(gp[i].A, cf_fit_region_at(c, gp[i].rho, gp[i].B).A_max);
+        grid[k].obj = gp[i].rss + (A - gp[i].A) * (A - gp[i].A) * gp[i].sgg;
+        grid[k].rho = gp[i].rho;
+        grid[k].B = gp[i].B;
+        k++;
     }
-    gsl_rng_free(rng);
     if (k == 0)
         return 0;
     qsort(grid, k, sizeof grid[0], cf_fit_cmp_start);

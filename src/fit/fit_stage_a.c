@@ -39,11 +39,16 @@ double cf_fit_jitter(gsl_rng *r)
 
 static double sigmoid(double t) { return 1.0 / (1.0 + exp(-t)); }
 
-/* Weighted objective of the reduced model with the load scale A solved in closed form. */
-static double reduced_profile(fit_ctx *c, double rho, double B, double *A_out)
+/* Weighted objective of the reduced model with the load scale A solved in closed form; *sgg_out
+** (may be NULL) the sum of the weighted model's squares. */
+static double reduced_fit(fit_ctx *c, double rho, double B, double *A_out, double *sgg_out)
 {
-    if (cf_ident_canon_many_rho(rho, B, c->n, c->data->x, c->model, NULL, NULL) != CF_OK)
+    if (sgg_out)
+        *sgg_out = 0;
+    if (cf_ident_canon_many_rho(rho, B, c->n, c->data->x, c->model, NULL, NULL) != CF_OK) {
+        *A_out = 1e-300;
         return CF_LSQ_HUGE_OBJ;
+    }
     double sgy = 0, sgg = 0, syy = 0;
     for (size_t i = 0; i < c->n; i++) {
         double g = c->sw[i] * c->model[i];
@@ -53,6 +58,8 @@ static double reduced_profile(fit_ctx *c, double rho, double B, double *A_out)
         syy += y * y;
     }
     c->evals++;
+    if (sgg_out)
+        *sgg_out = sgg;
     double A = sgg > 0 ? sgy / sgg : 0;
     if (!(A > 0) || !isfinite(A)) {
         *A_out = 1e-300;
@@ -60,6 +67,42 @@ static double reduced_profile(fit_ctx *c, double rho, double B, double *A_out)
     }
     *A_out = A;
     return fmax(syy - A * sgy, 0.0);
+}
+
+static double reduced_profile(fit_ctx *c, double rho, double B, double *A_out)
+{
+    return reduced_fit(c, rho, B, A_out, NULL);
+}
+
+/* The grid of stage A: GRID x GRID points over (rho, B), seeded jitter in each cell (stream 1);
+** rho half log-spaced from rho_lo, half approaching rho_hi geometrically (resolves nearly
+** cylindrical springs); B half quadratic in its range, half geometric towards its lower end. */
+void cf_fit_grid_points(fit_ctx *c, grid_point pts[GRID * GRID])
+{
+    gsl_rng *rng = cf_fit_seeded_rng(c->opt->seed, 1);
+    c->oom |= !rng;
+    size_t k = 0;
+    for (int i = 0; i < GRID; i++) {
+        double ti = (i + cf_fit_jitter(rng)) / GRID;
+        double rho = (i % 2 == 0)
+                         ? c->rho_lo * pow(c->rho_hi / c->rho_lo, ti)
+                         : c->rho_hi - (c->rho_hi - c->rho_lo) * pow(1e-7, ti);
+        for (int j = 0; j < GRID; j++) {
+            double tj = (j + cf_fit_jitter(rng)) / GRID;
+            pts[k].rho = rho;
+            pts[k].B = (j % 2 == 0) ? c->b_lo + (c->b_hi - c->b_lo) * tj * tj
+                                    : c->b_lo + (c->b_hi - c->b_lo) * pow(1e-7, 1 - tj);
+            pts[k].done = 0;
+            k++;
+        }
+    }
+    gsl_rng_free(rng);
+}
+
+void cf_fit_grid_value(fit_ctx *c, grid_point *p)
+{
+    p->rss = reduced_fit(c, p->rho, p->B, &p->A, &p->sgg);
+    p->done = 1;
 }
 
 /* ---- stage A: Levenberg-Marquardt on the three identifiable quantities ----------------------- */
@@ -236,34 +279,23 @@ int cf_fit_cmp_start(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Global stage over (rho, B) with A in closed form, then LM from the best starts. Each LM
-** result (objective, rho, B, A) goes to found[] when found is not NULL (at most
-** STAGE_A_RUNS, counted in *nfound). */
-double cf_fit_stage_a(fit_ctx *c, double best3[3], start4 *found, int *nfound)
+/* Global stage over (rho, B) with A in closed form (cf_fit_grid_points), then LM from the best
+** starts. Each LM result (objective, rho, B, A) goes to found[] when found is not NULL (at most
+** STAGE_A_RUNS, counted in *nfound); the grid's points with their fits go to pts when it is not
+** NULL (the constrained stage ranks its starts from them). */
+double cf_fit_stage_a(fit_ctx *c, double best3[3], start4 *found, int *nfound, grid_point *pts)
 {
-    gsl_rng *rng = cf_fit_seeded_rng(c->opt->seed, 1);
-    c->oom |= !rng;
+    grid_point own[GRID * GRID];
+    grid_point *gp = pts ? pts : own;
+    cf_fit_grid_points(c, gp);
     start grid[GRID * GRID];
     size_t k = 0;
-    for (int i = 0; i < GRID; i++) {
-        /* rho: half the grid log-spaced from CF_IDENT_RHO_LO, half approaching rho_hi geometrically
-        ** (resolves nearly cylindrical springs) */
-        double ti = (i + cf_fit_jitter(rng)) / GRID;
-        double rho = (i % 2 == 0)
-                         ? c->rho_lo * pow(c->rho_hi / c->rho_lo, ti)
-                         : c->rho_hi - (c->rho_hi - c->rho_lo) * pow(1e-7, ti);
-        for (int j = 0; j < GRID; j++) {
-            double tj = (j + cf_fit_jitter(rng)) / GRID;
-            double B = (j % 2 == 0) ? c->b_lo + (c->b_hi - c->b_lo) * tj * tj
-                                    : c->b_lo + (c->b_hi - c->b_lo) * pow(1e-7, 1 - tj);
-            double A;
-            grid[k].obj = reduced_profile(c, rho, B, &A);
-            grid[k].rho = rho;
-            grid[k].B = B;
-            k++;
-        }
+    for (; k < GRID * GRID; k++) {
+        cf_fit_grid_value(c, &gp[k]);
+        grid[k].obj = gp[k].rss;
+        grid[k].rho = gp[k].rho;
+        grid[k].B = gp[k].B;
     }
-    gsl_rng_free(rng);
     qsort(grid, k, sizeof grid[0], cf_fit_cmp_start);
     double best = CF_LSQ_HUGE_OBJ;
     double r, B, A, out[3];
