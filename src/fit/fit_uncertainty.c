@@ -12,12 +12,31 @@
 #include "fit/profile.h"
 #include "fit/profile.h"
 
+/* How far inside the type's limits (their margin, log units) SLSQP's end must lie for COBYLA to
+** start from it. */
+#define PROFILE_CLEAR 1e-3
+
+/* Whether SLSQP's end x of sub-problem q is a minimum COBYLA may start from: clear of the type's
+** limits (on a limit SLSQP stops short, and COBYLA's steps along the constraint do better from
+** the profile's previous point) and not where the law is linear over the whole table (every row
+** below the transition, |x|/B <= u_T(rho) = min((1 + rho)(1 + rho^2)/4, 1): there the RSS is
+** constant along a valley in which SLSQP stops anywhere, and COBYLA's wider steps from the
+** previous point leave it). */
+static int slsqp_end_trusted(const fit_ctx *c, const sub *q, const double *x)
+{
+    double rho, B;
+    cf_fit_sub_point(q, x, &rho, &B);
+    const double u_T = fmin(0.25 * (1 + rho) * (1 + rho * rho), 1.0);
+    return cf_fit_sub_g0(q, x) < -PROFILE_CLEAR && !(c->xmax / B <= u_T);
+}
+
 /* The profile of quantity k at log value u: the RSS minimised over the other quantities from
 ** xin; xin moves to the minimiser when the RSS is within limit. SLSQP on the analytic gradient
-** first; where it ends above the limit (outside the interval, or stopped short on a limit of the
-** type, where COBYLA's steps along the constraint do better) COBYLA from the same start decides.
-** Neither runs where no point meets the limits at all (cf_fit_sub_empty), whose answer they
-** could only confirm. */
+** first; where it ends above the limit, COBYLA decides: from SLSQP's end where that can be trusted
+** as a minimum (slsqp_end_trusted), where from the previous point it only crawled back to the
+** same RSS (up to its 300 evaluations each at the stress scale's lower end of the 100-row
+** benchmark table, a third of that fit); from the previous point elsewhere. Neither runs where no
+** point meets the limits at all (cf_fit_sub_empty), whose answer they could only confirm. */
 static double profile_at(void *ctx, int k, double u, double limit, double *xin)
 {
     fit_ctx *c = ctx;
@@ -28,7 +47,8 @@ static double profile_at(void *ctx, int k, double u, double limit, double *xin)
         return CF_LSQ_HUGE_OBJ;
     double f = cf_fit_sub_solve(c, &q, x, NLOPT_LD_SLSQP);
     if (!(f <= limit)) {
-        double y[2] = {xin[0], xin[1]};
+        const double *from = slsqp_end_trusted(c, &q, x) ? x : xin;
+        double y[2] = {from[0], from[1]};
         double g = cf_fit_sub_solve(c, &q, y, NLOPT_LN_COBYLA);
         if (g < f) {
             f = g;
