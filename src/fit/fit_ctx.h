@@ -41,6 +41,12 @@
 ** gained 0.02 and 0.11 s^2 in 65 steps each over 1e5 rows, and the fits of 100 and 1000 rows
 ** moved by 1e-3 s^2 and 3e-5 of a standard error. */
 #define LONG_TOL 1e-2
+
+/* Stage A's Levenberg-Marquardt solves its steps by QR on tables of up to this many rows (the
+** digits of an ill-conditioned Jacobian on a short, precise table), by the normal equations above
+** (their cost is a few products over the rows; the step's digits matter less there, the optimum's
+** condition J^T r = 0 is the same). */
+#define LM_QR_ROWS 256
 #define LM_STALL_LONG 2
 
 /* Number of inequality constraints of the design, and the CF_C_* bit of each. */

@@ -177,7 +177,10 @@ double cf_fit_lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3
 {
     gsl_multifit_nlinear_parameters fp = cf_lm_parameters();
     fp.fdtype = GSL_MULTIFIT_NLINEAR_CTRDIFF;
-    if (c->n > CF_SUBSAMPLE_ROWS) /* every row of a long table: the normal equations, not a QR */
+    /* above LM_QR_ROWS rows the normal equations, not a QR: GSL's Householder passes and column
+    ** norms over the rows were a quarter of a 1000-row fit, which then cost more than a 1001-row
+    ** one (searched on its 1000-row subsample, polished by normal equations: fit_long.c) */
+    if (c->n > LM_QR_ROWS)
         fp.solver = gsl_multifit_nlinear_solver_cholesky;
     gsl_multifit_nlinear_fdf fdf;
     memset(&fdf, 0, sizeof fdf);
