@@ -84,6 +84,9 @@ typedef struct fit_ctx {
                      ** once a step lowers the objective by less than this fraction of it */
     int crawl_stop;  /* 1 in a short table's strict polish of stage A: it stops at the statistical
                      ** tolerance below rho_min (cf_fit_lm_run) */
+    int lm_have;     /* 1 while model, gt and gr hold the law and its derivatives at lm_at, the
+                     ** position of stage A's Levenberg-Marquardt last evaluated (cf_fit_lm_run) */
+    double lm_at[3];
     /* stage B/C: free parameters */
     int nfree;
     int free_idx[CF_P_COUNT];

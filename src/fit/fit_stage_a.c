@@ -126,12 +126,20 @@ static int canon_at(fit_ctx *c, const gsl_vector *th, double *rho, double *B, do
     return GSL_SUCCESS;
 }
 
+/* The residuals at th. The law's derivatives come with them (a fifth more than the law alone) and
+** are kept with th: GSL asks for the Jacobian at the point whose residuals it has just accepted,
+** which lm_df then takes from here instead of evaluating the law there again (the same values:
+** the lanes' g is the same with or without derivatives). */
 static int lm_f(const gsl_vector *th, void *params, gsl_vector *f)
 {
     fit_ctx *c = params;
     double rho, B, A;
-    if (canon_at(c, th, &rho, &B, &A, NULL, NULL) != GSL_SUCCESS)
+    c->lm_have = 0;
+    if (canon_at(c, th, &rho, &B, &A, c->gt, c->gr) != GSL_SUCCESS)
         return GSL_EDOM;
+    for (int k = 0; k < 3; k++)
+        c->lm_at[k] = gsl_vector_get(th, k);
+    c->lm_have = 1;
     /* residuals scaled so that the zero model has |f| = 1: GSL's gradient test is absolute
     ** below |f| = 1, which would stop early on tables in MPa of tissue (tiny numbers) */
     const double sc = 1.0 / sqrt(c->ynorm);
@@ -146,7 +154,11 @@ static int lm_df(const gsl_vector *th, void *params, gsl_matrix *J)
 {
     fit_ctx *c = params;
     double rho, B, A;
-    if (canon_at(c, th, &rho, &B, &A, c->gt, c->gr) != GSL_SUCCESS)
+    const int kept = c->lm_have && gsl_vector_get(th, 0) == c->lm_at[0] &&
+                     gsl_vector_get(th, 1) == c->lm_at[1] && gsl_vector_get(th, 2) == c->lm_at[2];
+    if (kept)
+        unpack3(c, th, &rho, &B, &A);
+    else if (canon_at(c, th, &rho, &B, &A, c->gt, c->gr) != GSL_SUCCESS)
         return GSL_EDOM;
     const double s0 = sigmoid(gsl_vector_get(th, 0)), s1 = sigmoid(gsl_vector_get(th, 1));
     const double drho = (c->rho_hi - c->rho_lo) * s0 * (1 - s0);
@@ -159,7 +171,7 @@ static int lm_df(const gsl_vector *th, void *params, gsl_matrix *J)
         gsl_matrix_set(J, i, 1, w * (-A * c->gt[i] * t / B) * dB);
         gsl_matrix_set(J, i, 2, w * A * c->model[i]);
     }
-    c->evals++;
+    c->evals += !kept;
     return GSL_SUCCESS;
 }
 
@@ -184,6 +196,7 @@ double cf_fit_lm_run(fit_ctx *c, double rho0, double B0, double A0, double out[3
         fp.solver = gsl_multifit_nlinear_solver_cholesky;
     gsl_multifit_nlinear_fdf fdf;
     memset(&fdf, 0, sizeof fdf);
+    c->lm_have = 0;
     fdf.f = lm_f;
     fdf.df = lm_df;
     fdf.n = c->n;

@@ -9,15 +9,6 @@
 
 #include "model/law_simd.h"
 
-/* Multiply-adds fused in the lanes where the copy has them (AVX2, AVX-512): a fifth fewer
-** instructions, at least as accurate; the baseline copy has none, so the copies differ by
-** rounding, as law_simd.h allows. Only the lanes: the constants below are derived as law.c
-** derives them. */
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC push_options
-#pragma GCC optimize("fp-contract=fast")
-#endif
-
 /* What every lane of one call shares: the canonical law's lanes and its constants. */
 typedef struct canon_consts {
     cf_law_lanes l;
@@ -103,10 +94,6 @@ CF_LANE void canon_lane(const canon_consts *k, double x, double *g, double *gt, 
         }                                                                                          \
     }
 CF_SIMD_COPIES(CANON_MANY, 0)
-
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC pop_options
-#endif
 
 /* The constants every call shares, from the lanes of the canonical law and its rho and k0. */
 static void canon_consts_of(canon_consts *k, double rho, double k0, double B)
