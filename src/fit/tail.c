@@ -387,13 +387,12 @@ typedef struct prof_ctx {
     double stall_rel; /* the statistical tolerance of a profile's search, relative to its RSS */
 } prof_ctx;
 
-/* cf_profile's at: x holds (rho, B, A, tau) of the last point within the limit. */
-static double prof_at(void *ctx, int k, double u, double limit, double *x)
+/* The profile's search of run r from the point x, (rho, B, A, tau), with r's quantity held: the
+** RSS it reaches, and in v the point. */
+static double prof_search(prof_ctx *pc, const prof_run *rp, const double *x, double v[4])
 {
-    prof_ctx *pc = ctx;
-    const prof_run r = {pc->p, k, exp(u)};
-    if (!(prof_b_hi(&r) > pc->p->b_lo))
-        return CF_LSQ_HUGE_OBJ;
+    const prof_run r = *rp;
+    const int k = r.k;
     double v0[4] = {x[0], x[1], x[2], x[3]};
     if (k == 3)
         v0[3] = r.fixed / v0[1];
@@ -422,7 +421,8 @@ static double prof_at(void *ctx, int k, double u, double limit, double *x)
         pc->oom = 1;
         return CF_LSQ_HUGE_OBJ;
     }
-    double f = CF_LSQ_HUGE_OBJ, v[4];
+    double f = CF_LSQ_HUGE_OBJ;
+    v[0] = v[1] = v[2] = v[3] = NAN;
     if (ist == GSL_SUCCESS) {
         /* stop once two steps in a row lower the RSS by less than a hundredth of the residual
         ** variance (the fit's own statistical tolerance, fit.md): the ends are then placed
@@ -439,6 +439,27 @@ static double prof_at(void *ctx, int k, double u, double limit, double *x)
             f = fmin(chi2 * pc->p->ynorm, CF_LSQ_HUGE_OBJ);
     }
     gsl_multifit_nlinear_free(w);
+    return f;
+}
+
+/* cf_profile's at: x holds (rho, B, A, tau) of the last point within the limit, where the search
+** starts; where it ends above the limit, again from each of the fit's other optima (p->alt). */
+static double prof_at(void *ctx, int k, double u, double limit, double *x)
+{
+    prof_ctx *pc = ctx;
+    const prof_run r = {pc->p, k, exp(u)};
+    if (!(prof_b_hi(&r) > pc->p->b_lo))
+        return CF_LSQ_HUGE_OBJ;
+    double v[4];
+    double f = prof_search(pc, &r, x, v);
+    for (int a = 0; a < pc->p->nalt && !(f <= limit) && !pc->oom; a++) {
+        double w[4];
+        const double g = prof_search(pc, &r, pc->p->alt[a], w);
+        if (g < f) {
+            f = g;
+            memcpy(v, w, sizeof v);
+        }
+    }
     if (f <= limit)
         memcpy(x, v, sizeof v);
     return f;
@@ -532,5 +553,5 @@ double cf_tail_profile_point(const cf_tail_profile *p, int k, double value, doub
                              double limit, double x[4])
 {
     prof_ctx pc = {p, 0, prof_stall(rss0, limit)};
-    return prof_at(&pc, k, log(value), INFINITY, x);
+    return prof_at(&pc, k, log(value), limit, x);
 }

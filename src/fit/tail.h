@@ -65,6 +65,11 @@ typedef struct cf_tail_profile {
     int fd;                  /* 1: a force table */
     double need;             /* the table's largest strain with the travel margin */
     double rho_lo, rho_hi, b_lo, b_hi;
+    /* Other optima of the fit (rho, B, A, tau), each within the threshold of the best: a profile
+    ** point the search from the previous point leaves above the threshold is searched again from
+    ** each (a flat valley of the law in several pieces that a local search does not join). */
+    const double (*alt)[4];
+    int nalt;
 } cf_tail_profile;
 
 /* The profile intervals of the four quantities (rho, B, A, e_t) of a tailed fit res (filled by
@@ -84,10 +89,13 @@ double cf_tail_profile_point(const cf_tail_profile *p, int k, double value, doub
                              double limit, double x[4]);
 
 /* The profile of quantity k (0 rho, 1 B, 2 A, 3 e_t) of the tailed spring fit `fit` of table data
-** at `value`: the weighted RSS of the profile's rows minimised over the other three from the fit,
-** as cf_tail_intervals finds it; *limit the threshold its intervals are drawn at. NAN when out
-** of memory. For checking an interval's ends. */
+** (fitted from the plain fit `plain`, may be NULL, as cf_fit_tail_run was given it) at `value`: the
+** weighted RSS of the profile's rows minimised over the other three from the fit and, where that
+** ends above the threshold, from the fit search's other optima, as cf_tail_intervals finds it;
+** *limit the threshold its intervals are drawn at. NAN when out of memory. For checking an
+** interval's ends. */
 double cf_tail_profile_at(const cf_table *data, const cf_fit_options *opt,
-                          const cf_fit_result *fit, int k, double value, double *limit);
+                          const cf_fit_result *plain, const cf_fit_result *fit, int k,
+                          double value, double *limit);
 
 #endif

@@ -214,9 +214,10 @@ static void undetermined_quantities_get_profile_intervals(void **state)
             if (end[k][e] || !(fabs(ue - u0) > 1e-3))
                 continue;
             double lim_in, lim_out;
-            const double in = cf_tail_profile_at(&t, &o, &r, k, exp(ue - 0.03 * (ue - u0)), &lim_in);
+            const double in =
+                cf_tail_profile_at(&t, &o, NULL, &r, k, exp(ue - 0.03 * (ue - u0)), &lim_in);
             const double out =
-                cf_tail_profile_at(&t, &o, &r, k, exp(ue + 0.03 * (ue - u0)), &lim_out);
+                cf_tail_profile_at(&t, &o, NULL, &r, k, exp(ue + 0.03 * (ue - u0)), &lim_out);
             assert_true(isfinite(lim_in) && lim_in == lim_out);
             if (!(in <= lim_in && out > lim_out))
                 fail_msg("quantity %d, %s end %.8g: profile %.10g inside, %.10g outside, "
@@ -301,6 +302,44 @@ static void auto_keeps_the_conical_law_where_the_tail_cannot_help(void **state)
     cf_table_free(&t);
 }
 
+/* A flat valley of the tailed law in pieces: the fibre-reinforced hydrogel's telescoping tailed fit
+** has optima at rho 0.199 (the tail compliance by its bound) and 0.244 with the same RSS to 15
+** digits, which a local profile search from the first does not reach (its interval stopped at
+** 0.1996). The profile searches again from the fit search's other optimum: rho's interval holds
+** both, and the end it draws is where the profile searched that way crosses the threshold. */
+static void profile_reaches_the_other_pieces_of_a_flat_valley(void **state)
+{
+    (void)state;
+    cf_fit_report r;
+    cf_table t;
+    if (!auto_on("hydrogel_fibre_reinforced_compression.csv", "uniaxial", &t, &r))
+        skip();
+    int seen = 0;
+    for (int i = 0; i < r.nfits; i++) {
+        const cf_fit_result *f = &r.fits[i];
+        if (f->type != CF_TELESCOPING || !f->tail)
+            continue;
+        seen = 1;
+        assert_true(f->interval_ok[0]);
+        if (!(f->interval[0][0] <= 0.2 && f->interval[0][1] >= 0.25))
+            fail_msg("rho %.6g [%.6g, %.6g]: the valley runs from 0.199 to 0.244", f->ident.rho,
+                     f->interval[0][0], f->interval[0][1]);
+        double lim_in, lim_out;
+        const double u0 = log(f->ident.rho), ue = log(f->interval[0][1]);
+        cf_fit_result plain = r.law_choice[i].other;
+        const double in = cf_tail_profile_at(&t, &r.fit_options, &plain, f, 0,
+                                             exp(ue - 0.03 * (ue - u0)), &lim_in);
+        const double out = cf_tail_profile_at(&t, &r.fit_options, &plain, f, 0,
+                                              exp(ue + 0.03 * (ue - u0)), &lim_out);
+        if (!(in <= lim_in && out > lim_out))
+            fail_msg("rho's upper end %.8g: profile %.10g inside, %.10g outside, threshold %.10g",
+                     f->interval[0][1], in, out, lim_in);
+    }
+    assert_true(seen);
+    cf_report_free(&r);
+    cf_table_free(&t);
+}
+
 int main(void)
 {
     gsl_set_error_handler_off();
@@ -310,6 +349,7 @@ int main(void)
         cmocka_unit_test(undetermined_quantities_get_profile_intervals),
         cmocka_unit_test(auto_keeps_the_tail_where_it_gains),
         cmocka_unit_test(auto_keeps_the_conical_law_where_the_tail_cannot_help),
+        cmocka_unit_test(profile_reaches_the_other_pieces_of_a_flat_valley),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
