@@ -354,11 +354,9 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
 ** when it has one. */
 static void compact_first_region(fit_ctx *c, double v[3])
 {
-    cf_law canon;
-    if (!c->fd || !(c->xmax > 0) || cf_ident_canon_law(v[0], &canon) != CF_OK ||
-        !(canon.u_T_mm > 0))
+    if (!c->fd || !(c->xmax > 0) || !(v[0] > 0 && v[0] <= 1))
         return;
-    const double uT = v[1] * canon.u_T_mm; /* the transition in the table's x (travel 1 canon) */
+    const double uT = v[1] * cf_ident_canon_transition(v[0]); /* the transition in the table's x */
     if (!(c->xmax < uT))
         return;
     const double lam =

@@ -69,11 +69,6 @@ static double reduced_fit(fit_ctx *c, double rho, double B, double *A_out, doubl
     return fmax(syy - A * sgy, 0.0);
 }
 
-static double reduced_profile(fit_ctx *c, double rho, double B, double *A_out)
-{
-    return reduced_fit(c, rho, B, A_out, NULL);
-}
-
 /* The grid of stage A: GRID x GRID points over (rho, B), seeded jitter in each cell (stream 1);
 ** rho half log-spaced from rho_lo, half approaching rho_hi geometrically (resolves nearly
 ** cylindrical springs); B half quadratic in its range, half geometric towards its lower end. */
@@ -316,7 +311,7 @@ double cf_fit_stage_a(fit_ctx *c, double best3[3], start4 *found, int *nfound, g
     double best = CF_LSQ_HUGE_OBJ;
     double r, B, A, out[3];
     two_point_start(c, &r, &B, &A);
-    reduced_profile(c, r, B, &A);
+    reduced_fit(c, r, B, &A, NULL);
     best = cf_fit_lm_run(c, r, B, A, best3);
     record(found, nfound, best, best3);
     int used = 0;
@@ -329,7 +324,7 @@ double cf_fit_stage_a(fit_ctx *c, double best3[3], start4 *found, int *nfound, g
         if (near && i > 0)
             continue;
         used++;
-        reduced_profile(c, grid[i].rho, grid[i].B, &A);
+        reduced_fit(c, grid[i].rho, grid[i].B, &A, NULL);
         double v = cf_fit_lm_run(c, grid[i].rho, grid[i].B, A, out);
         record(found, nfound, v, out);
         if (v < best) {

@@ -19,15 +19,15 @@
 /* Whether SLSQP's end x of sub-problem q is a minimum COBYLA may start from: clear of the type's
 ** limits (on a limit SLSQP stops short, and COBYLA's steps along the constraint do better from
 ** the profile's previous point) and not where the law is linear over the whole table (every row
-** below the transition, |x|/B <= u_T(rho) = min((1 + rho)(1 + rho^2)/4, 1): there the RSS is
-** constant along a valley in which SLSQP stops anywhere, and COBYLA's wider steps from the
-** previous point leave it). */
+** at or below the transition, cf_ident_canon_transition: there the RSS is constant along a
+** valley in which SLSQP stops anywhere, and COBYLA's wider steps from the previous point leave
+** it). */
 static int slsqp_end_trusted(const fit_ctx *c, const sub *q, const double *x)
 {
     double rho, B;
     cf_fit_sub_point(q, x, &rho, &B);
-    const double u_T = fmin(0.25 * (1 + rho) * (1 + rho * rho), 1.0);
-    return cf_fit_sub_g0(q, x) < -PROFILE_CLEAR && !(c->xmax / B <= u_T);
+    return cf_fit_sub_g0(q, x) < -PROFILE_CLEAR &&
+           !(c->xmax <= B * cf_ident_canon_transition(rho));
 }
 
 /* The profile of quantity k at log value u: the RSS minimised over the other quantities from

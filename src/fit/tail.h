@@ -84,7 +84,8 @@ int cf_tail_intervals(const cf_tail_profile *p, const double v[4], double rss0, 
 
 /* One point of p's profile of quantity k (0 rho, 1 B, 2 A, 3 e_t) at `value`, searched as
 ** cf_tail_intervals searches it (rss0 and limit as there) from x = (rho, B, A, tau), which receives
-** the point reached: the weighted RSS minimised over the other three. */
+** the point reached when its RSS is within limit: the weighted RSS minimised over the other
+** three. */
 double cf_tail_profile_point(const cf_tail_profile *p, int k, double value, double rss0,
                              double limit, double x[4]);
 

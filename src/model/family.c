@@ -123,6 +123,12 @@ cf_status cf_ident_canon_law(double rho, cf_law *law)
     return cf_law_init(law, &p, NULL);
 }
 
+double cf_ident_canon_transition(double rho)
+{
+    /* as cf_law_init: u_T = min(s shape/4, s) with s = 1 */
+    return fmin((1.0 + rho) * (1.0 + rho * rho) * 0.25, 1.0);
+}
+
 double cf_ident_reduced(const cf_law *canon, double A, double B, double x, double *dB)
 {
     double k;

@@ -128,7 +128,7 @@ cf_status cf_ident_canon_many_rho(double rho, double B, size_t count, const doub
     const double shape = (1.0 + rho) * (1.0 + rho * rho);
     canon_consts k;
     memset(&k.l, 0, sizeof k.l);
-    k.l.u_T = fmin(shape * 0.25, 1.0);
+    k.l.u_T = cf_ident_canon_transition(rho);
     k.l.s = 1.0;
     k.l.inv_s = 1.0;
     k.l.k0 = 128.0 * r3 / (32.0 * shape);

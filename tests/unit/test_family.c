@@ -183,6 +183,7 @@ static void the_canonical_lanes_of_rho_are_those_of_the_law(void **state)
             const double B = 0.37 + 0.5 * j;
             cf_law canon;
             assert_int_equal(cf_ident_canon_law(rhos[j], &canon), CF_OK);
+            assert_true(cf_ident_canon_transition(rhos[j]) == canon.u_T_mm);
             cf_ident_canon_many(&canon, B, N, x, g, gt, gr);
             assert_int_equal(cf_ident_canon_many_rho(rhos[j], B, N, x, h, ht, hr), CF_OK);
             assert_memory_equal(g, h, sizeof g);

@@ -117,6 +117,10 @@ cf_ident_region cf_ident_region_at(const cf_ident_design *o, cf_spring_type type
 ** 1 N; every spring of the family is it scaled: F(u) = F_C g(u/s), g the canonical law. */
 cf_status cf_ident_canon_law(double rho, cf_law *law);
 
+/* The canonical law's transition t_T = min((1 + rho)(1 + rho^2)/4, 1), its u_T_mm: the law is
+** linear (region 1) for |t| <= t_T, and a table of largest |x| <= B t_T sees only that line. */
+double cf_ident_canon_transition(double rho);
+
 /* The family's reduced model at x: A g(x/B) for the canonical law canon (of rho), with A the load
 ** scale and B the length scale; *dB (if not NULL) receives its derivative in B. */
 double cf_ident_reduced(const cf_law *canon, double A, double B, double x, double *dB);
