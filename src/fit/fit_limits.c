@@ -314,12 +314,14 @@ int cf_fit_stage_a_constrained(fit_ctx *c, double v[3], grid_point *pts)
     size_t k = 0;
     sub q = {c, -1, 0};
     for (size_t i = 0; i < GRID * GRID; i++) {
-        double x[2] = {log(gp[i].rho), gp[i].B};
-        if (cf_fit_sub_g0(&q, x) > 0)
+        /* the limits at the point, once: its margin (cf_fit_sub_g0's with nothing held) and the
+        ** largest scale */
+        const region r = cf_fit_region_at(c, gp[i].rho, gp[i].B);
+        if (r.margin + c->inside > 0)
             continue;
         if (!gp[i].done)
             cf_fit_grid_value(c, &gp[i]);
-        const double A = fmin(gp[i].A, cf_fit_region_at(c, gp[i].rho, gp[i].B).A_max);
+        const double A = fmin(gp[i].A, r.A_max);
         grid[k].obj = gp[i].rss + (A - gp[i].A) * (A - gp[i].A) * gp[i].sgg;
         grid[k].rho = gp[i].rho;
         grid[k].B = gp[i].B;
