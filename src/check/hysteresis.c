@@ -2,6 +2,7 @@
 ** Hysteresis, residual strain and recovery of a scene's run (see hysteresis.h).
 */
 #include "conifit/hysteresis.h"
+#include "base/gslguard.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -102,6 +103,7 @@ cf_status cf_hysteresis_recovery_test(const cf_scene *sc, const cf_law *law,
                                       const cf_msm_sample *s, size_t n,
                                       cf_hysteresis_recovery *r, cf_error *err)
 {
+    CF_GSL_GUARD;
     memset(r, 0, sizeof *r);
     double T, hold;
     if (!recovery_plan(sc, &T, &hold))

@@ -2,6 +2,7 @@
 ** Validation of fitted springs in the static uniaxial lattice (see validate.h).
 */
 #include "conifit/validate.h"
+#include "base/gslguard.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -170,6 +171,7 @@ static cf_status stability(const cf_spring *p, const cf_validate_setup *s, const
 cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const cf_table *d,
                           cf_validation *v, cf_error *err)
 {
+    CF_GSL_GUARD;
     const double t0 = cf_clock_s();
     memset(v, 0, sizeof *v);
     v->setup = *s;
@@ -229,6 +231,7 @@ cf_status cf_validate_lattice_fit(const cf_table *d, const cf_validate_setup *s,
                                   const cf_fit_result *res, cf_validation *v, cf_through_msm *t,
                                   cf_error *err)
 {
+    CF_GSL_GUARD;
     const double t0 = cf_clock_s();
     cf_validation_free(v);
     memset(v, 0, sizeof *v);

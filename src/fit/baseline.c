@@ -7,6 +7,7 @@
 ** table's test mode: hyperelastic.h.
 */
 #include "conifit/baseline.h"
+#include "base/gslguard.h"
 
 #include <float.h>
 #include <math.h>
@@ -571,6 +572,7 @@ static int ogden_fit(const cf_table *d, const cf_table *scan, cf_baseline *O, in
 
 cf_status cf_baseline_fit_all(const cf_table *d, cf_baseline out[CF_BASE_COUNT], cf_error *err)
 {
+    CF_GSL_GUARD;
     double xmax = 0, ymax = 0, s2 = 0, sy1 = 0;
     for (size_t i = 0; i < d->count; i++) {
         double x = d->x[i], y = d->y[i];

@@ -5,6 +5,7 @@
 ** constraints of fit_constraints.c), then the uncertainty (fit_uncertainty.c).
 */
 #include "conifit/fit.h"
+#include "base/gslguard.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -334,6 +335,7 @@ cf_status cf_fit_place(const cf_table *data, const cf_fit_options *opt, cf_sprin
 cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                      cf_fit_result *res, cf_error *err)
 {
+    CF_GSL_GUARD;
     return cf_fit_run_shared(data, opt, type, NULL, res, err);
 }
 
@@ -391,6 +393,7 @@ static int same_stage_a_options(const cf_fit_options *a, const cf_fit_options *b
 cf_status cf_fit_run_shared(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                             cf_fit_shared *shared, cf_fit_result *res, cf_error *err)
 {
+    CF_GSL_GUARD;
     const double t0 = cf_clock_s();
     memset(res, 0, sizeof *res);
     fit_ctx c, sc;
@@ -560,6 +563,7 @@ cf_status cf_fit_run_shared(const cf_table *data, const cf_fit_options *opt, cf_
 
 cf_fit_verdict cf_fit_compare(const cf_fit_result *a, const cf_fit_result *b, size_t points)
 {
+    CF_GSL_GUARD;
     cf_fit_verdict v = {0, -1, NAN, NAN, 0};
     const cf_fit_result *f[2] = {a, b};
     if (a->feasible && b->feasible)

@@ -21,6 +21,7 @@
 #include <gsl/gsl_multifit_nlinear.h>
 
 #include "fit/clock.h"
+#include "base/gslguard.h"
 #include "fit/fit_ctx.h"
 #include "fit/lm.h"
 #include "fit/lsq.h"
@@ -417,6 +418,7 @@ double cf_tail_profile_at(const cf_table *data, const cf_fit_options *opt,
 cf_status cf_fit_tail_run(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                           const cf_fit_result *plain, cf_fit_result *res, cf_error *err)
 {
+    CF_GSL_GUARD;
     memset(res, 0, sizeof *res);
     const double t0 = cf_clock_s();
     tail_ctx c;

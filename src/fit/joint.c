@@ -2,6 +2,7 @@
 ** The joint fit of several tables through the lattice (see joint.h).
 */
 #include "conifit/joint.h"
+#include "base/gslguard.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -353,6 +354,7 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
                        const cf_validate_setup *lat, cf_spring_type type, cf_joint_result *r,
                        cf_error *err)
 {
+    CF_GSL_GUARD;
     return joint_run(tables, n, opt, lat, type, NULL, r, err);
 }
 
@@ -360,5 +362,6 @@ cf_status cf_joint_fit_tail(const cf_table *const *tables, size_t n, const cf_fi
                             const cf_validate_setup *lat, const cf_joint_result *plain,
                             cf_joint_result *r, cf_error *err)
 {
+    CF_GSL_GUARD;
     return joint_run(tables, n, opt, lat, plain->fit.type, plain, r, err);
 }

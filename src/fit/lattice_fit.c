@@ -3,6 +3,7 @@
 ** then the placement of the design parameters (see lattice_fit.h).
 */
 #include "conifit/lattice_fit.h"
+#include "base/gslguard.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -118,6 +119,7 @@ static cf_status take_target(tm_ctx *c, tm_ctx *search, cf_fit_result *res, cf_t
 cf_status cf_lattice_fit(const cf_table *d, const cf_fit_options *opt, const cf_validate_setup *s,
                          cf_fit_result *res, cf_through_msm *t, cf_error *err)
 {
+    CF_GSL_GUARD;
     const double t0 = cf_clock_s();
     memset(t, 0, sizeof *t);
     t->ident_before = cf_ident_of(&res->params, 0);

@@ -12,6 +12,7 @@
 ** of (rho, B, A, tau) come from the cell's central-difference Jacobian (8 curves).
 */
 #include "conifit/lattice_fit.h"
+#include "base/gslguard.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -223,6 +224,7 @@ cf_status cf_lattice_fit_tail(const cf_table *d, const cf_fit_options *opt,
                               const cf_validate_setup *s, const cf_fit_result *plain,
                               cf_fit_result *res, cf_through_msm *t, cf_error *err)
 {
+    CF_GSL_GUARD;
     const double t0 = cf_clock_s();
     memset(res, 0, sizeof *res);
     memset(t, 0, sizeof *t);

@@ -7,6 +7,7 @@
 ** viscofit_predict.c.
 */
 #include "conifit/viscofit.h"
+#include "base/gslguard.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -565,6 +566,7 @@ static cf_status fit_report(ctx *c, const cf_visco_params *bestp, cf_visco_fit *
 cf_status cf_visco_fit_run(const cf_visco_data *d, const cf_visco_fit_options *o,
                            cf_visco_fit *res, cf_error *err)
 {
+    CF_GSL_GUARD;
     const double t0 = cf_clock_s();
     memset(res, 0, sizeof *res);
     const size_t n = d->count;

@@ -3,6 +3,7 @@
 ** (hysteresis) and a creep test (see viscofit.h, cf_visco_predict).
 */
 #include "conifit/viscofit.h"
+#include "base/gslguard.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -74,6 +75,7 @@ static void predict_creep(const cf_visco_params *p, const cf_visco_setup *s, dou
 void cf_visco_predictions(const cf_visco_params *p, const cf_visco_setup *s,
                           const cf_visco_data *d, cf_visco_predict *out)
 {
+    CF_GSL_GUARD;
     memset(out, 0, sizeof *out);
     const size_t n = d->count;
     /* the largest strain, when it is first reached, and the loading time from the last zero */

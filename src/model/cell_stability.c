@@ -3,6 +3,7 @@
 ** cell_stability.h).
 */
 #include "conifit/cell_stability.h"
+#include "base/gslguard.h"
 
 #include <gsl/gsl_eigen.h>
 #include <gsl/gsl_matrix.h>
@@ -52,6 +53,7 @@ static cf_status min_eigen(const double K[36], double *lambda, cf_error *err)
 cf_status cf_cell_min_stiffness(const cf_cell *c, const double F[9], double *lambda_MPa,
                                 cf_error *err)
 {
+    CF_GSL_GUARD;
     double A[81], dF[6][9], K[36];
     cf_cell_state s;
     cf_status st = cf_cell_tangent(c, F, NULL, &s, A, err);
@@ -100,6 +102,7 @@ static int stable_at(const cf_cell *c, cf_mode m, double e, cf_status *st, cf_er
 cf_status cf_cell_stable_to(const cf_cell *c, cf_mode m, double reach, double *limit, int *lost,
                             cf_error *err)
 {
+    CF_GSL_GUARD;
     *limit = reach;
     *lost = 0;
     if (!isfinite(reach))

@@ -3,6 +3,7 @@
 ** boundary fixities, and the force kernel the solvers call on every step.
 */
 #include "conifit/lattice.h"
+#include "base/gslguard.h"
 
 #include "conifit/cell.h"
 
@@ -345,6 +346,7 @@ static double law_work(const cf_law *law, cf_law_method m, double u,
 
 double cf_lattice_elastic_energy(const cf_lattice *lat)
 {
+    CF_GSL_GUARD;
     /* GSL keeps the 8-point nodes precomputed: the table is a small allocation, no computation */
     gsl_integration_glfixed_table *gl = gsl_integration_glfixed_table_alloc(8);
     if (!gl)

@@ -10,6 +10,7 @@
 ** The stiffness is dF/du = k_scale y^4/(1 - y^4) with 1 - y^4 = e (4 - 6e + 4e^2 - e^3).
 */
 #include "conifit/law.h"
+#include "base/gslguard.h"
 #include "model/law_simd.h"
 
 #include <float.h>
@@ -234,6 +235,7 @@ static inline double one_minus_y4_e(double e)
 /* Brent's method until the bracket stops shrinking; returns the midpoint of the last bracket. */
 static double brent_solve(double (*f)(double, void *), void *params, double lo, double hi)
 {
+    CF_GSL_GUARD;
     gsl_function fn = {f, params};
     double flo = f(lo, params), fhi = f(hi, params);
     if (flo == 0)

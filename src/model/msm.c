@@ -5,6 +5,7 @@
 ** msm_uniaxial.c, the linear solves in linsolve.c.
 */
 #include "model/msm_internal.h"
+#include "base/gslguard.h"
 
 #include <math.h>
 #include <string.h>
@@ -149,6 +150,7 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
                      const cf_msm_path *path, const double *sample_t_s, size_t nsamples,
                      cf_msm_sample *out, size_t *done, cf_msm_stats *stats, cf_error *err)
 {
+    CF_GSL_GUARD;
     cf_msm_effects none = {0};
     const cf_msm_effects *fx = fxin ? fxin : &none;
     cf_msm_stats local = {0};

@@ -3,6 +3,7 @@
 ** stability, and the inertia of a homogeneous state.
 */
 #include "model/msm_internal.h"
+#include "base/gslguard.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -32,6 +33,7 @@ cf_status cf_msm_uniaxial(const cf_law *law, cf_law_method m, const cf_msm_confi
                           const double *strain, size_t count, double *stress_MPa,
                           cf_msm_stats *stats, cf_error *err)
 {
+    CF_GSL_GUARD;
     cf_msm_config cfg = cfgin ? *cfgin : cf_msm_default();
     cf_msm_stats local = {0};
     cf_msm_stats *st = stats ? stats : &local;
@@ -134,6 +136,7 @@ static cf_status static_open(const cf_law *law, cf_law_method m, const cf_msm_co
 cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_msm_config *cfgin,
                                  int side, double *limit, cf_error *err)
 {
+    CF_GSL_GUARD;
     cf_msm_config cfg = cfgin ? *cfgin : cf_msm_default();
     *limit = 0;
     cf_lattice lat;
@@ -200,6 +203,7 @@ done:
 cf_status cf_msm_homogeneous_inertia(const cf_law *law, cf_law_method m, const cf_msm_config *cfgin,
                                      double strain, double lateral, long *neg, cf_error *err)
 {
+    CF_GSL_GUARD;
     cf_msm_config cfg = cfgin ? *cfgin : cf_msm_default();
     /* the banded LDL^T (GSL): its D gives the inertia, and unlike the sparse factorisations it
     ** runs on any thread without waiting (every CHOLMOD and MUMPS call holds one process-wide

@@ -3,6 +3,7 @@
 ** branches, driven by a measured strain history.
 */
 #include "conifit/viscomodel.h"
+#include "base/gslguard.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -384,6 +385,7 @@ cf_status cf_visco_run(const cf_visco_params *p, const cf_visco_setup *s, const 
                        const double *sample_t_s, size_t nsamples, cf_msm_sample *out,
                        cf_error *err)
 {
+    CF_GSL_GUARD;
     return run(p, s, path, sample_t_s, nsamples, out, NULL, err);
 }
 
@@ -391,6 +393,7 @@ cf_status cf_visco_curve(const cf_visco_params *p, const cf_visco_setup *s,
                          const cf_visco_series *series, double *stress_MPa, cf_msm_stats *stats,
                          cf_error *err)
 {
+    CF_GSL_GUARD;
     const size_t n = series->count;
     if (n < 2)
         return cf_error_set(err, CF_E_DATA, "a time series needs at least 2 points");
@@ -424,6 +427,7 @@ cf_status cf_visco_elastic_curve(const cf_visco_params *p, const cf_visco_setup 
                                  const double *strain, size_t count, double *stress_MPa,
                                  cf_error *err)
 {
+    CF_GSL_GUARD;
     cf_law law;
     cf_status st = member_law(p, s, &law, err);
     if (st != CF_OK)

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "conifit/budget.h"
+#include "base/gslguard.h"
 #include "conifit/export.h"
 #include "conifit/fitfile.h"
 #include "conifit/flat.h"
@@ -66,6 +67,7 @@ cf_status cf_flat_force_tail(const double spring[8], const char *method, size_t 
 cf_status cf_flat_fit(const char *table_path, const char *type, int validate, char **json,
                       cf_error *err)
 {
+    CF_GSL_GUARD;
     cf_status s;
     if ((s = need(json, "the result pointer", err)) != CF_OK)
         return s;
@@ -103,6 +105,7 @@ cf_status cf_flat_fit(const char *table_path, const char *type, int validate, ch
 cf_status cf_flat_simulate(const char *scene_path, double **samples, size_t *count,
                            cf_error *err)
 {
+    CF_GSL_GUARD;
     cf_status s;
     if ((s = need(samples, "the samples pointer", err)) != CF_OK ||
         (s = need(count, "the count pointer", err)) != CF_OK)

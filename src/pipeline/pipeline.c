@@ -2,6 +2,7 @@
 ** The fitting pipeline (see pipeline.h).
 */
 #include "conifit/pipeline.h"
+#include "base/gslguard.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -214,6 +215,7 @@ static void solid_in_mode(const cf_table *t, const cf_pipeline_options *opt, cf_
 cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_fit_report *r,
                           cf_error *err)
 {
+    CF_GSL_GUARD;
     memset(r, 0, sizeof *r);
     r->version = CF_VERSION;
     r->table = t;
@@ -289,6 +291,7 @@ cf_status cf_pipeline_prepare(const cf_fit_report *r, const char *json_path,
                               cf_output *json_out, cf_output *plot_out,
                               cf_error *err)
 {
+    CF_GSL_GUARD;
     cf_status st = cf_atomic_begin("cf_pipeline_prepare", r, json_path, json_out, plot_path,
                                    plot_out, err);
     if (st != CF_OK)
@@ -314,6 +317,7 @@ cf_status cf_pipeline_outputs_end(cf_status st, const char *plot_path, cf_atomic
 cf_status cf_pipeline_write(const cf_fit_report *r, const char *json_path, const char *plot_path,
                             const char *const *inputs, cf_error *err)
 {
+    CF_GSL_GUARD;
     cf_atomic a = {0}, b = {0};
     cf_status st = cf_pipeline_prepare(r, json_path, plot_path, inputs, &a, &b, err);
     if (st == CF_OK && json_path)

@@ -2,6 +2,7 @@
 ** The joint fit (see pipeline_joint.h).
 */
 #include "conifit/pipeline_joint.h"
+#include "base/gslguard.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -46,6 +47,7 @@ cf_status cf_pipeline_fit_joint(const cf_table *const *tables, size_t n,
                                 const cf_pipeline_options *opt, cf_joint_report *r,
                                 cf_error *err)
 {
+    CF_GSL_GUARD;
     memset(r, 0, sizeof *r);
     r->tables = tables;
     r->ntables = n;

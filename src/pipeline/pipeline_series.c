@@ -2,6 +2,7 @@
 ** The pipeline of a time series (see pipeline_series.h).
 */
 #include "conifit/pipeline_series.h"
+#include "base/gslguard.h"
 
 #include <math.h>
 #include <string.h>
@@ -94,6 +95,7 @@ cf_status cf_pipeline_fit_series(const cf_table *t, const cf_pipeline_options *o
                                  const cf_visco_fit_options *vo, cf_visco_report *r,
                                  cf_error *err)
 {
+    CF_GSL_GUARD;
     memset(r, 0, sizeof *r);
     r->version = CF_VERSION;
     r->table = t;

@@ -2,6 +2,7 @@
 ** The batch pool (see pool.h): threads that take the next task under one lock.
 */
 #include "pipeline/pool.h"
+#include "base/gslguard.h"
 
 #include <pthread.h>
 
@@ -15,6 +16,7 @@ typedef struct pool {
 
 static void *worker(void *arg)
 {
+    CF_GSL_GUARD;
     pool *p = arg;
     for (;;) {
         pthread_mutex_lock(&p->lock);

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "conifit/export.h"
+#include "base/gslguard.h"
 #include "conifit/lattice.h"
 #include "conifit/validate.h"
 #include "report/export_model.h"
@@ -286,6 +287,7 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
                                   const cf_export_options *opt, const cf_export_lattice *lx,
                                   cf_export_report *rep, cf_error *err)
 {
+    CF_GSL_GUARD;
     cf_law law;
     cf_lattice lat;
     cf_export_table t = {0};

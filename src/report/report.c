@@ -3,6 +3,7 @@
 ** the JSON fit file, through jansson. The readable text is in report_text.c.
 */
 #include "conifit/report.h"
+#include "base/gslguard.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -28,6 +29,7 @@ void cf_report_free(cf_fit_report *r)
 
 int cf_report_better(const cf_fit_report *r)
 {
+    CF_GSL_GUARD;
     if (r->nfits == 2)
         return cf_fit_compare(&r->fits[0], &r->fits[1], r->table->count).better;
     return r->nfits == 1 && r->fits[0].feasible ? 0 : -1;
@@ -35,6 +37,7 @@ int cf_report_better(const cf_fit_report *r)
 
 int cf_report_types_tie(const cf_fit_report *r)
 {
+    CF_GSL_GUARD;
     return r->nfits == 2 && cf_fit_compare(&r->fits[0], &r->fits[1], r->table->count).tie;
 }
 
@@ -387,6 +390,7 @@ static json_t *report_json(const cf_fit_report *r)
 
 char *cf_report_json_string(const cf_fit_report *r)
 {
+    CF_GSL_GUARD;
     json_t *root = report_json(r);
     if (!root)
         return NULL;
@@ -398,6 +402,7 @@ char *cf_report_json_string(const cf_fit_report *r)
 cf_status cf_report_json_prepare(const cf_fit_report *r, const char *path,
                                  const char *const *inputs, cf_output *out, cf_error *err)
 {
+    CF_GSL_GUARD;
     cf_status st = cf_atomic_begin_one("cf_report_json_prepare", r, path, out, err);
     if (st != CF_OK)
         return st;
@@ -412,6 +417,7 @@ cf_status cf_report_json_prepare(const cf_fit_report *r, const char *path,
 cf_status cf_report_json_write(const cf_fit_report *r, const char *path,
                                const char *const *inputs, cf_error *err)
 {
+    CF_GSL_GUARD;
     cf_atomic a = {0};
     cf_status st = cf_report_json_prepare(r, path, inputs, &a, err);
     if (st == CF_OK)

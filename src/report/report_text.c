@@ -4,6 +4,7 @@
 ** the baselines.
 */
 #include "conifit/report.h"
+#include "base/gslguard.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -544,6 +545,7 @@ static void warnings_text(FILE *o, const cf_fit_report *r)
 
 char *cf_report_text(const cf_fit_report *r)
 {
+    CF_GSL_GUARD;
     char *buf = NULL;
     size_t len = 0;
     FILE *o = open_memstream(&buf, &len);
