@@ -1,7 +1,7 @@
 # conifit: plain Makefile. Targets:
 #   make            build build/conifit and the library build/libconifit.a, build/libconifit.so
 #                   (optimised, with debug info)
-#   make install    install the binary, libraries, headers, conifit.pc, man pages and the Python
+#   make install    install the binary, libraries, headers, conifit.pc and conifit-static.pc (libconifit.a), man pages and the Python
 #                   module under DESTDIR$(PREFIX) (PREFIX=/usr/local); make uninstall removes them
 #   make test-install  install into a scratch DESTDIR and build, link and run a C program and the
 #                   Python module against the staged tree (part of make test)
@@ -82,7 +82,7 @@ PUBLIC_H := $(wildcard src/include/conifit/*.h)
 # across modules (fuzz/ and bench/ have their own targets).
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/*/test_*.c))
 
-.PHONY: all lib install uninstall test-install deps example test sanitize fuzz bench bench-update clean check-deps figures fits
+.PHONY: all lib install install-paths uninstall test-install deps example test sanitize fuzz bench bench-update clean check-deps figures fits
 
 all: check-deps $(BUILD)/conifit $(LIB_A) $(LIB_SO)
 
@@ -193,29 +193,44 @@ PC_SED := -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBDIR@|$(LIBDIR)|' -e 's|@INCLUDEDI
   -e 's|@VERSION@|$(VERSION)|' -e 's|@PKGS@|$(PKGS)|' \
   -e 's|@LIBS_PRIVATE@|$(strip $(SPARSE_LIBS)) -lgomp -lm -lpthread|'
 
-install: all
-	$(INSTALL) -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR)/conifit \
-	  $(DESTDIR)$(PKGCONFIGDIR) $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(MANDIR)/man3 $(DESTDIR)$(PYTHONDIR)
-	$(INSTALL) -m 755 $(BUILD)/conifit $(DESTDIR)$(BINDIR)/conifit
-	$(INSTALL) -m 644 $(LIB_A) $(DESTDIR)$(LIBDIR)/libconifit.a
-	$(INSTALL) -m 755 $(LIB_SO).$(VERSION) $(DESTDIR)$(LIBDIR)/libconifit.so.$(VERSION)
-	ln -sf libconifit.so.$(VERSION) $(DESTDIR)$(LIBDIR)/$(SONAME)
-	ln -sf $(SONAME) $(DESTDIR)$(LIBDIR)/libconifit.so
-	$(INSTALL) -m 644 $(PUBLIC_H) $(DESTDIR)$(INCLUDEDIR)/conifit/
-	sed $(PC_SED) src/pkgconfig/conifit.pc.in > $(DESTDIR)$(PKGCONFIGDIR)/conifit.pc
-	$(INSTALL) -m 644 $(filter %.1,$(MANPAGES)) $(DESTDIR)$(MANDIR)/man1/
-	$(INSTALL) -m 644 $(filter %.3,$(MANPAGES)) $(DESTDIR)$(MANDIR)/man3/
-	sed 's|^_INSTALLED_LIBDIR = .*|_INSTALLED_LIBDIR = "$(LIBDIR)"|' src/python/conifit.py \
-	  > $(DESTDIR)$(PYTHONDIR)/conifit.py
+# Every installed path is quoted in the recipes, and a DESTDIR or directory holding a blank,
+# tab or quote is refused before anything is written or removed: make splits words at blanks, so
+# "DIR/notes.txt stage" would otherwise name two paths (one of them the user's file) and a
+# trailing blank would leave DESTDIR out of the path (the real installation under PREFIX).
+INSTALL_VARS := DESTDIR PREFIX BINDIR LIBDIR INCLUDEDIR MANDIR PYTHONDIR PKGCONFIGDIR
+install-paths:
+	@$(foreach v,$(INSTALL_VARS),$(if $(or $(filter-out 1,$(words x$($(v))x)),$(findstring ',$($(v))),$(findstring ",$($(v)))),\
+	  printf '%s\n' 'conifit: $(v)='\''$(subst ','\'',$($(v)))'\'' holds a blank or a quote: install and uninstall refuse it (name a folder without one)' >&2; exit 2;))true
 
-uninstall:
-	rm -f $(DESTDIR)$(BINDIR)/conifit $(DESTDIR)$(LIBDIR)/libconifit.a \
-	  $(DESTDIR)$(LIBDIR)/libconifit.so.$(VERSION) $(DESTDIR)$(LIBDIR)/$(SONAME) \
-	  $(DESTDIR)$(LIBDIR)/libconifit.so $(DESTDIR)$(PKGCONFIGDIR)/conifit.pc \
-	  $(addprefix $(DESTDIR)$(MANDIR)/man1/,$(notdir $(filter %.1,$(MANPAGES)))) \
-	  $(addprefix $(DESTDIR)$(MANDIR)/man3/,$(notdir $(filter %.3,$(MANPAGES)))) \
-	  $(DESTDIR)$(PYTHONDIR)/conifit.py
-	rm -rf $(DESTDIR)$(INCLUDEDIR)/conifit
+D := $(DESTDIR)
+install: install-paths all
+	$(INSTALL) -d '$(D)$(BINDIR)' '$(D)$(LIBDIR)' '$(D)$(INCLUDEDIR)/conifit' \
+	  '$(D)$(PKGCONFIGDIR)' '$(D)$(MANDIR)/man1' '$(D)$(MANDIR)/man3' '$(D)$(PYTHONDIR)'
+	$(INSTALL) -m 755 $(BUILD)/conifit '$(D)$(BINDIR)/conifit'
+	$(INSTALL) -m 644 $(LIB_A) '$(D)$(LIBDIR)/libconifit.a'
+	$(INSTALL) -m 755 $(LIB_SO).$(VERSION) '$(D)$(LIBDIR)/libconifit.so.$(VERSION)'
+	ln -sf libconifit.so.$(VERSION) '$(D)$(LIBDIR)/$(SONAME)'
+	ln -sf $(SONAME) '$(D)$(LIBDIR)/libconifit.so'
+	$(INSTALL) -m 644 $(PUBLIC_H) '$(D)$(INCLUDEDIR)/conifit/'
+	sed $(PC_SED) src/pkgconfig/conifit.pc.in > '$(D)$(PKGCONFIGDIR)/conifit.pc'
+	sed $(PC_SED) src/pkgconfig/conifit-static.pc.in > '$(D)$(PKGCONFIGDIR)/conifit-static.pc'
+	$(INSTALL) -m 644 $(filter %.1,$(MANPAGES)) '$(D)$(MANDIR)/man1/'
+	$(INSTALL) -m 644 $(filter %.3,$(MANPAGES)) '$(D)$(MANDIR)/man3/'
+	sed 's|^_INSTALLED_LIBDIR = .*|_INSTALLED_LIBDIR = "$(LIBDIR)"|' src/python/conifit.py \
+	  > '$(D)$(PYTHONDIR)/conifit.py'
+
+# Also the bytecode Python wrote beside the module when it was imported
+# (__pycache__/conifit.*.pyc), and that folder when nothing else is left in it.
+uninstall: install-paths
+	rm -f '$(D)$(BINDIR)/conifit' '$(D)$(LIBDIR)/libconifit.a' \
+	  '$(D)$(LIBDIR)/libconifit.so.$(VERSION)' '$(D)$(LIBDIR)/$(SONAME)' \
+	  '$(D)$(LIBDIR)/libconifit.so' '$(D)$(PKGCONFIGDIR)/conifit.pc' \
+	  '$(D)$(PKGCONFIGDIR)/conifit-static.pc' \
+	  $(foreach m,$(notdir $(filter %.1,$(MANPAGES))),'$(D)$(MANDIR)/man1/$(m)') \
+	  $(foreach m,$(notdir $(filter %.3,$(MANPAGES))),'$(D)$(MANDIR)/man3/$(m)') \
+	  '$(D)$(PYTHONDIR)/conifit.py' '$(D)$(PYTHONDIR)/__pycache__'/conifit.*.pyc
+	-rmdir '$(D)$(PYTHONDIR)/__pycache__' 2>/dev/null
+	rm -rf '$(D)$(INCLUDEDIR)/conifit'
 
 # Installs into a scratch DESTDIR with PREFIX=/usr and uses the staged tree as a user would.
 test-install: all

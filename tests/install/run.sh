@@ -1,11 +1,14 @@
 #!/bin/sh
 # make test-install: installs conifit into a scratch DESTDIR with PREFIX=/usr, then uses the staged
 # tree as a user would: builds tests/install/law_example.c and fit_example.c with `pkg-config
-# --cflags --libs conifit` against the shared library and with `--static` against the static one,
-# runs them and compares the forces with the installed binary's `conifit force`, and the fit file
+# --cflags --libs conifit` against the shared library and with `pkg-config --static --libs
+# conifit-static` against the static one (which must not need libconifit.so), runs them and compares the forces with the installed binary's `conifit force`, and the fit file
 # written through the output handle with `conifit fit data/telescoping.csv -o` (the identifiable
 # quantities of each type, to 1e-9 relative); runs the installed Python module; checks the man
-# pages are in place; finally `make uninstall` must leave no file behind.
+# pages are in place; finally `make uninstall` must leave no file behind (nor the bytecode Python
+# wrote beside the module). Install and uninstall refuse a DESTDIR or PREFIX holding a blank or a
+# quote without touching anything (a trailing blank, or "DIR/notes.txt stage", once named the
+# real installation or the user's file).
 # Exit 1 naming the first failing step.
 set -eu
 cd "$(dirname "$0")/../.."
@@ -18,7 +21,7 @@ ${MAKE:-make} --no-print-directory -s install BUILD="$BUILD" DESTDIR="$stage/roo
   >"$stage/install.log" 2>&1 || { cat "$stage/install.log" >&2; fail "make install"; }
 root=$stage/root
 for f in usr/bin/conifit usr/lib/libconifit.a usr/lib/libconifit.so usr/include/conifit/law.h \
-         usr/lib/pkgconfig/conifit.pc usr/share/man/man1/conifit.1 usr/share/man/man3/libconifit.3 \
+         usr/lib/pkgconfig/conifit.pc usr/lib/pkgconfig/conifit-static.pc usr/share/man/man1/conifit.1 usr/share/man/man3/libconifit.3 \
          usr/lib/python3/dist-packages/conifit.py; do
   [ -e "$root/$f" ] || fail "make install did not install /$f"
 done
@@ -28,9 +31,8 @@ soname=$(readelf -d "$root/usr/lib/libconifit.so" | sed -n 's/.*SONAME.*\[\(.*\)
 export PKG_CONFIG_SYSROOT_DIR="$root" PKG_CONFIG_PATH="$root/usr/lib/pkgconfig"
 cflags=$(pkg-config --cflags conifit) || fail "pkg-config --cflags conifit"
 libs=$(pkg-config --libs conifit) || fail "pkg-config --libs conifit"
-static=$(pkg-config --static --libs conifit) || fail "pkg-config --static --libs conifit"
-# -l:libconifit.a: the static library while the system's own libraries stay shared
-static=$(printf '%s\n' "$static" | sed 's/-lconifit\b/-l:libconifit.a/')
+# the static library while the system's own libraries stay shared, exactly as pkg-config says
+static=$(pkg-config --static --libs conifit-static) || fail "pkg-config --static --libs conifit-static"
 # build NAME: tests/install/NAME_example.c as $stage/NAME-shared and $stage/NAME-static
 build() {
   ${CC:-cc} -std=c17 "tests/install/$1_example.c" $cflags -o "$stage/$1-shared" $libs ||
@@ -40,6 +42,8 @@ build() {
   LD_LIBRARY_PATH="$root/usr/lib" ldd "$stage/$1-shared" | grep -q "$soname => $root/usr/lib/" ||
     fail "the shared $1 example does not load $root/usr/lib/$soname"
   ! ldd "$stage/$1-static" | grep -q libconifit || fail "the static $1 example loads libconifit.so"
+  ! readelf -d "$stage/$1-static" | grep NEEDED | grep -q libconifit ||
+    fail "the static $1 example needs libconifit.so (linked with: $static)"
 }
 build law
 build fit
@@ -101,8 +105,38 @@ else
   echo "test-install: python3 absent: the installed Python module is not tried"
 fi
 
+# the bytecode an import writes beside the module (whether or not the example's import wrote it)
+if command -v python3 >/dev/null 2>&1; then
+  python3 -c 'import py_compile, sys; py_compile.compile(sys.argv[1], doraise=True)' \
+    "$root/usr/lib/python3/dist-packages/conifit.py" || fail "compiling the installed module"
+  [ -d "$root/usr/lib/python3/dist-packages/__pycache__" ] || fail "no __pycache__ after compiling"
+fi
+
+# A DESTDIR or PREFIX holding a blank is refused and touches nothing: a trailing blank once let
+# uninstall remove the real installation under PREFIX, and "DIR/notes.txt stage" the user's file.
+echo "the user's notes" > "$stage/notes.txt"
+# (PREFIX: the staged installation, standing for the real one)
+for bad in "$stage/notes.txt stage" "$stage/x " "$stage/it's"; do
+  code=0
+  ${MAKE:-make} --no-print-directory -s uninstall BUILD="$BUILD" DESTDIR="$bad" PREFIX="$root/usr" \
+    >"$stage/bad.log" 2>&1 || code=$?
+  [ $code -ne 0 ] || fail "make uninstall DESTDIR='$bad' was not refused"
+  grep -q "DESTDIR=.* holds a blank or a quote" "$stage/bad.log" ||
+    { cat "$stage/bad.log" >&2; fail "make uninstall DESTDIR='$bad': no clear message"; }
+done
+code=0
+${MAKE:-make} --no-print-directory -s install BUILD="$BUILD" DESTDIR="$stage/new" PREFIX="/usr/my prefix" \
+  >"$stage/bad.log" 2>&1 || code=$?
+[ $code -ne 0 ] && grep -q "PREFIX=.* holds a blank" "$stage/bad.log" || fail "PREFIX with a blank not refused"
+[ ! -e "$stage/new" ] || fail "a refused install wrote $stage/new"
+[ "$(cat "$stage/notes.txt")" = "the user's notes" ] || fail "a refused uninstall touched notes.txt"
+[ -x "$root/usr/bin/conifit" ] && [ -e "$root/usr/lib/libconifit.so" ] ||
+  fail "a refused uninstall removed the staged installation"
+rm -f "$stage/notes.txt"
+
 ${MAKE:-make} --no-print-directory -s uninstall BUILD="$BUILD" DESTDIR="$root" PREFIX=/usr \
   >"$stage/uninstall.log" 2>&1 || { cat "$stage/uninstall.log" >&2; fail "make uninstall"; }
 left=$(find "$root" -type f -o -type l)
 [ -z "$left" ] || fail "make uninstall left: $left"
-echo "test-install: staged install (PREFIX=/usr) built and ran shared and static against pkg-config; forces match conifit force; fit files written through the output handle match conifit fit; uninstall clean"
+[ ! -e "$root/usr/lib/python3/dist-packages/__pycache__" ] || fail "make uninstall left __pycache__"
+echo "test-install: staged install (PREFIX=/usr) built and ran shared and static against pkg-config; forces match conifit force; fit files written through the output handle match conifit fit; conifit-static needs no libconifit.so; blanks in DESTDIR/PREFIX refused; uninstall clean"
