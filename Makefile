@@ -1,8 +1,9 @@
 # conifit: plain Makefile. Targets:
 #   make            build build/conifit and the library build/libconifit.a, build/libconifit.so
 #                   (optimised, with debug info)
-#   make install    install the binary, libraries, headers, conifit.pc and conifit-static.pc (libconifit.a), man pages and the Python
-#                   module under DESTDIR$(PREFIX) (PREFIX=/usr/local); make uninstall removes them
+#   make install    install the binary, libraries, headers, conifit.pc and conifit-static.pc (a
+#                   static link of libconifit), man pages and the Python module under
+#                   DESTDIR$(PREFIX) (PREFIX=/usr/local); make uninstall removes them
 #   make test-install  install into a scratch DESTDIR and build, link and run a C program and the
 #                   Python module against the staged tree (part of make test)
 #   make deps       install the Debian packages conifit needs (as root; otherwise prints the command)
