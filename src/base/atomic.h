@@ -61,8 +61,9 @@ cf_status cf_atomic_commit(cf_atomic *a, cf_error *err);
 void cf_atomic_abort(cf_atomic *a);
 
 /* The argument checks of a call named `call` that prepares up to two outputs of report r:
-** CF_E_USAGE when r is NULL, a path is given without its handle, or a handle given still holds
-** an uncommitted file. Then empties the handles given (either may be NULL), so that the call may
+** CF_E_USAGE when r is NULL, a path is given without its handle, a handle given still holds
+** an uncommitted file, or both paths are given with one handle or name one file (the second
+** output would replace the first). Then empties the handles given (either may be NULL), so that the call may
 ** abort both on failure. Handles held by value must start zeroed. */
 cf_status cf_atomic_begin(const char *call, const void *r, const char *path1, cf_atomic *out1,
                           const char *path2, cf_atomic *out2, cf_error *err);

@@ -1,7 +1,11 @@
 /* The public output handle (conifit/output.h) over the atomic writer (base/atomic.h). */
 #include "conifit/output.h"
 
+#include <libgen.h>
+#include <limits.h>
 #include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
 
 #include "base/atomic.h"
 
@@ -59,6 +63,28 @@ static cf_status check_one(const char *call, const char *path, const cf_atomic *
     return CF_OK;
 }
 
+/* 1 when paths a and b name one file: the same text, one existing file (same device and inode),
+** or, for files not there yet, the same name in the same folder (the folders resolved). */
+static int same_target(const char *a, const char *b)
+{
+    if (strcmp(a, b) == 0)
+        return 1;
+    struct stat sa, sb;
+    int ea = stat(a, &sa) == 0, eb = stat(b, &sb) == 0;
+    if (ea || eb)
+        return ea && eb && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    char ca[PATH_MAX], cb[PATH_MAX], ra[PATH_MAX], rb[PATH_MAX];
+    if (strlen(a) >= sizeof ca || strlen(b) >= sizeof cb)
+        return 0;
+    strcpy(ca, a);
+    strcpy(cb, b);
+    if (strcmp(basename(ca), basename(cb)) != 0)
+        return 0;
+    strcpy(ca, a);
+    strcpy(cb, b);
+    return realpath(dirname(ca), ra) && realpath(dirname(cb), rb) && strcmp(ra, rb) == 0;
+}
+
 cf_status cf_atomic_begin(const char *call, const void *r, const char *path1, cf_atomic *out1,
                           const char *path2, cf_atomic *out2, cf_error *err)
 {
@@ -69,6 +95,15 @@ cf_status cf_atomic_begin(const char *call, const void *r, const char *path1, cf
         st = check_one(call, path2, out2, err);
     if (st != CF_OK)
         return st;
+    /* one handle or one file for both: the second output would replace the first */
+    if (path1 && path2 && out1 == out2)
+        return cf_error_set(err, CF_E_USAGE,
+                            "%s: one output handle given for both files (%s and %s): give each "
+                            "its own",
+                            call, path1, path2);
+    if (path1 && path2 && same_target(path1, path2))
+        return cf_error_set(err, CF_E_USAGE, "%s: both outputs name one file (%s and %s)", call,
+                            path1, path2);
     if (out1)
         *out1 = (cf_atomic){0};
     if (out2)

@@ -3,7 +3,9 @@
 **  - a fit prepared into a handle is not in place until committed, then reads back as the fit;
 **  - an aborted or freed handle leaves nothing in the folder;
 **  - NULL and malformed arguments (no handle, no report, no path, a handle that still holds a
-**    file, a commit of an empty handle) return CF_E_USAGE with a message and touch no file.
+**    file, a commit of an empty handle) return CF_E_USAGE with a message and touch no file;
+**  - one handle given for both the fit file and the plot, or one file named for both (by the
+**    same or another path), is refused the same way: the fit file was lost before.
 */
 #include "testutil.h"
 
@@ -137,12 +139,56 @@ static void malformed_arguments_are_usage_errors_with_a_message(void **state)
     end(&c);
 }
 
+static void one_handle_or_one_file_for_both_is_refused(void **state)
+{
+    (void)state;
+    case_ c;
+    begin(&c, "both.png");
+    cf_error err = {0};
+    char other[320], json[320];
+    snprintf(json, sizeof json, "%s/fit.json", dir);
+    /* one handle for two files */
+    assert_int_equal(cf_pipeline_prepare(&c.r, json, c.path, NULL, c.o, c.o, &err), CF_E_USAGE);
+    assert_non_null(strstr(err.msg, "one output handle given for both files"));
+    assert_string_equal(cf_output_path(c.o), "");
+    assert_int_equal(entries(), 0);
+    /* one file by two spellings of its path, with two handles */
+    cf_output *p = NULL;
+    assert_int_equal(cf_output_new(&p, &err), CF_OK);
+    snprintf(other, sizeof other, "%s/./both.png", dir);
+    const char *same[][2] = {{c.path, c.path}, {c.path, other}};
+    for (int k = 0; k < 2; k++) {
+        err = (cf_error){0};
+        assert_int_equal(cf_pipeline_prepare(&c.r, same[k][0], same[k][1], NULL, c.o, p, &err),
+                         CF_E_USAGE);
+        assert_non_null(strstr(err.msg, "both outputs name one file"));
+        assert_int_equal(entries(), 0);
+    }
+    /* an existing file through a link to its folder */
+    assert_int_equal(tu_write_bytes(c.path, "old", 3), 0);
+    snprintf(other, sizeof other, "%s/link", dir);
+    assert_int_equal(symlink(".", other), 0);
+    snprintf(other, sizeof other, "%s/link/both.png", dir);
+    assert_int_equal(cf_pipeline_prepare(&c.r, c.path, other, NULL, c.o, p, &err), CF_E_USAGE);
+    assert_non_null(strstr(err.msg, "both outputs name one file"));
+    assert_int_equal(entries(), 2); /* the old file and the link, nothing else */
+    snprintf(other, sizeof other, "%s/link", dir);
+    unlink(other);
+    /* the same handles for two files are accepted */
+    assert_int_equal(cf_pipeline_prepare(&c.r, json, NULL, NULL, c.o, p, &err), CF_OK);
+    cf_output_abort(c.o);
+    cf_output_free(p);
+    end(&c);
+    assert_int_equal(entries(), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(prepared_fit_appears_only_on_commit),
         cmocka_unit_test(aborted_handle_leaves_nothing),
         cmocka_unit_test(malformed_arguments_are_usage_errors_with_a_message),
+        cmocka_unit_test(one_handle_or_one_file_for_both_is_refused),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

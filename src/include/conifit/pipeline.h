@@ -76,7 +76,8 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
 /* Writes the report's fit file to json_path and its plot to plot_path (either NULL: not
 ** written) as complete temporary files beside their targets, not yet in place (conifit/output.h):
 ** the caller commits them (cf_output_commit) when all of its outputs are ready, or aborts them.
-** On failure neither is left. `inputs` (NULL-terminated, may be NULL) are refused as targets. */
+** On failure neither is left. `inputs` (NULL-terminated, may be NULL) are refused as targets.
+** CF_E_USAGE, nothing written, when both paths are given with one handle or name one file. */
 cf_status cf_pipeline_prepare(const cf_fit_report *r, const char *json_path,
                               const char *plot_path, const char *const *inputs,
                               cf_output *json_out, cf_output *plot_out,
