@@ -47,6 +47,13 @@
 #define TABLE_ROUNDS 12
 /* Probes per interval when measuring its interpolation error for the shift. */
 #define TABLE_PROBES 15
+/* Most region-2 intervals of one half. The tightest tolerance (1e-9) needs about 30000 on the
+** springs tried (rho 0.003 to 0.997, tails of 1e-6 to 1 coils); a law whose error does not fall as the rows grow (a tail so stiff that its
+** deflection is below rounding of the cone's travel) would otherwise grow the table without
+** bound: the placement stops there and the table is refused. */
+#define TABLE_MAX_INTERVALS 200000
+/* settle_half's answer when the next round would pass TABLE_MAX_INTERVALS. */
+#define TABLE_TOO_MANY ((size_t)-1)
 
 /* ---- one half of the table (compression side, 0 <= u <= U) ----------------------------------- */
 
@@ -270,7 +277,8 @@ static int join(const cf_law *law, const half *st, const half *co, cf_export_tab
     return 0;
 }
 
-/* Places one half to the tolerance: returns its region-2 interval count, 0 on failure. */
+/* Places one half to the tolerance: returns its region-2 interval count, 0 on failure (memory),
+** TABLE_TOO_MANY when the count would pass TABLE_MAX_INTERVALS (*err_N: the last error). */
 static size_t settle_half(const cf_law *law, double tol, double U, double sign, half *h,
                           cf_export_table *scratch, double *err_N, double *where)
 {
@@ -284,7 +292,10 @@ static size_t settle_half(const cf_law *law, double tol, double U, double sign, 
         for (int i = 0; i < M; i++)
             G += density(tT - (i + 0.5) * (tT - tU) / M) * (tT - tU) / M;
     }
-    size_t N = (size_t)ceil(G / sqrt(16.0 * TABLE_AIM * tol)) + 1;
+    const double first = ceil(G / sqrt(16.0 * TABLE_AIM * tol)) + 1;
+    if (!(first <= TABLE_MAX_INTERVALS))
+        return TABLE_TOO_MANY;
+    size_t N = (size_t)first;
     half empty = {0};
     for (int round = 0; round < TABLE_ROUNDS; round++) {
         if (half_place(law, U, N, h) != 0)
@@ -299,8 +310,10 @@ static size_t settle_half(const cf_law *law, double tol, double U, double sign, 
             return N;
         if (h->n <= 2) /* region 1 only: exact, cannot improve */
             return N;
-        double next = N * sqrt(*err_N / (TABLE_AIM * goal));
-        N = (size_t)fmax((double)N + 1.0, ceil(next));
+        double next = fmax((double)N + 1.0, ceil(N * sqrt(*err_N / (TABLE_AIM * goal))));
+        if (!(next <= TABLE_MAX_INTERVALS))
+            return TABLE_TOO_MANY;
+        N = (size_t)next;
     }
     return N; /* the caller sees *err_N > goal */
 }
@@ -346,6 +359,8 @@ cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo
     size_t Nco = 0, Nst = 0;
     if (Uco > 0.0 && (Nco = settle_half(law, tol, Uco, +1.0, &co, &scratch, &eco, &wco)) == 0)
         goto oom;
+    if (Nco == TABLE_TOO_MANY)
+        goto too_many;
     if (Ust > 0.0) {
         if (Ust == Uco) { /* the law is odd: the stretch half mirrors the compression half */
             st.n = co.n;
@@ -360,6 +375,8 @@ cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo
             Nst = Nco;
         } else if ((Nst = settle_half(law, tol, Ust, -1.0, &st, &scratch, &est, &wst)) == 0) {
             goto oom;
+        } else if (Nst == TABLE_TOO_MANY) {
+            goto too_many;
         }
     }
     {
@@ -391,6 +408,24 @@ cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo
         cf_export_table_free(t);
     }
     (void)Nst;
+    goto done;
+too_many:
+    if (law->tail)
+        status = cf_error_set(err, CF_E_DATA,
+                              "the spring cannot be tabulated within the tolerance %g of F_C in "
+                              "%d rows (the error stops falling as rows are added): its tail "
+                              "(n_tail = %g, H_tail = %g mm) is %.3g times as stiff as the cone "
+                              "(deflection %.3g mm at F_C beside the cone's travel %g mm); "
+                              "loosen the tolerance, or for a tail that stiff use none (n_tail 0)",
+                              tol, 2 * TABLE_MAX_INTERVALS, law->p.n_tail, law->p.H_tail_mm,
+                              law->k_tail_N_per_mm * (law->cone_travel_mm / law->F_C_N),
+                              law->F_C_N / law->k_tail_N_per_mm, law->cone_travel_mm);
+    else
+        status = cf_error_set(err, CF_E_DATA,
+                              "the spring (rho = %.4g) cannot be tabulated within the tolerance "
+                              "%g of F_C in %d rows; loosen the tolerance",
+                              law->rho, tol, 2 * TABLE_MAX_INTERVALS);
+    cf_export_table_free(t);
     goto done;
 oom:
     status = cf_error_set(err, CF_E_INTERNAL, "out of memory building the export table");

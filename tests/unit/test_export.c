@@ -7,7 +7,9 @@
 **    the force SOFA computes from the file's springs), the lattice models of every format;
 **  - the proof by running: CalculiX (ccx) on the exported single spring and on the exported
 **    lattice, its reactions matched against the law and against `conifit simulate`;
-**  - bad input: exit status, message with the number that works, nothing written.
+**  - bad input: exit status, message with the number that works, nothing written;
+**  - a tail so stiff that the table's error stops falling (n_tail 1e-15: the table grew without
+**    bound) is refused, naming n_tail and its value, while tails of 1e-6 coils still tabulate.
 */
 #include <sys/stat.h>
 
@@ -205,6 +207,35 @@ static void tables_of_a_tailed_spring_stay_within_tolerance_through_region_3(voi
     assert_true(t.rows < 2 * tp.rows);
     cf_export_table_free(&t);
     cf_export_table_free(&tp);
+}
+
+static void a_tail_too_stiff_to_tabulate_is_refused_naming_n_tail(void **state)
+{
+    (void)state;
+    /* (a guard, not a speed target: the unbounded table ran for minutes and took gigabytes) */
+    alarm(300);
+    const double tols[2] = {1e-4, 1e-9};
+    for (int i = 0; i < 2; i++) {
+        cf_spring p = TAIL;
+        p.n_tail = 1e-15;
+        cf_law law;
+        law_of(&law, &p);
+        cf_export_table t;
+        cf_error err = {0};
+        assert_int_equal(cf_export_table_build(&law, tols[i], &t, &err), CF_E_DATA);
+        assert_non_null(strstr(err.msg, "n_tail = 1e-15"));
+        assert_int_equal(t.rows, 0);
+        assert_null(t.u_mm);
+        cf_law_free(&law);
+        /* a tail of a millionth of a coil is stiff but still tabulates, at both tolerances */
+        p.n_tail = 1e-6;
+        law_of(&law, &p);
+        assert_int_equal(cf_export_table_build(&law, tols[i], &t, &err), CF_OK);
+        assert_true(t.max_err_rel <= tols[i]);
+        cf_export_table_free(&t);
+        cf_law_free(&law);
+    }
+    alarm(0);
 }
 
 static void tables_stay_within_tolerance_on_a_dense_grid_for_both_types(void **state)
@@ -1272,6 +1303,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(tables_stay_within_tolerance_on_a_dense_grid_for_both_types),
         cmocka_unit_test(tables_of_a_tailed_spring_stay_within_tolerance_through_region_3),
+        cmocka_unit_test(a_tail_too_stiff_to_tabulate_is_refused_naming_n_tail),
         cmocka_unit_test(row_count_grows_like_inverse_square_root_of_tolerance),
         cmocka_unit_test(every_spring_from_rho_0_05_fits_200_rows_at_1e_4),
         cmocka_unit_test(a_range_covers_only_what_is_asked_and_stays_within_tolerance),
