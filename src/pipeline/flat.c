@@ -2,6 +2,7 @@
 ** Flat calls (conifit/flat.h): each one the short chain of library calls a front end makes for
 ** one job, with its arguments checked before anything runs.
 */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -34,6 +35,13 @@ static cf_status force_of(const double *spring, int nparams, const char *method,
         (count && ((s = need(u_mm, "the displacements", err)) != CF_OK ||
                    (s = need(F_N, "the force array", err)) != CF_OK)))
         return s;
+    for (size_t i = 0; i < count; i++)
+        if (!isfinite(u_mm[i]))
+            return cf_error_set(err, CF_E_DATA,
+                                "displacement %zu (counting from 0) is not a finite number (%s): "
+                                "give each u in mm",
+                                i, isnan(u_mm[i]) ? "not a number" : u_mm[i] > 0 ? "+infinity"
+                                                                                 : "-infinity");
     cf_law_method m = CF_LAW_CLOSED;
     if (method && (s = cf_law_method_parse(method, &m, err)) != CF_OK)
         return s;

@@ -6,7 +6,7 @@ Standard library only: ctypes over libconifit.so (the flat calls of conifit/flat
     conifit.force([4, 12, 5, 0.8, 80000, 10], [0.5, 1.5, 3.0])   # N at each compression (mm)
     fit = conifit.fit("data/telescoping_noise1pct.csv")          # the fit file, as a dict
     fit = conifit.fit(strain=[...], stress=[...], stress_unit="kPa")
-    rows = conifit.simulate("data/scenes/uniaxial.json")           # list of dicts, one a sample
+    cols = conifit.simulate("data/scenes/uniaxial.json")           # dict of columns (array.array)
     text = conifit.export("fit.json", "calculix")                  # the exported block
 
 Every failure raises conifit.Error with the library's message and its status (.status: "usage",
@@ -17,9 +17,11 @@ folder it was installed into, then in the build folder of a source tree holding 
 (src/python/ beside build/), then by the system's loader (libconifit.so.0).
 """
 
+import array
 import ctypes
 import json
 import os
+import re
 import tempfile
 
 __all__ = ["Error", "force", "fit", "simulate", "export", "library_path"]
@@ -105,7 +107,11 @@ def _text(s, what):
         return None
     if not isinstance(s, (str, bytes, os.PathLike)):
         raise Error(-1, "%s must be a string, not %s" % (what, type(s).__name__))
-    return os.fsencode(s)
+    b = os.fsencode(s)
+    if b"\0" in b:
+        # C reads a string up to its first NUL: the rest would be dropped without a word
+        raise Error(-1, "%s holds a NUL character (at %d): %r" % (what, b.index(b"\0"), s))
+    return b
 
 
 def _taken(p):
@@ -116,22 +122,33 @@ def _taken(p):
         _lib.cf_flat_free(p)
 
 
+def _number(v, what):
+    try:
+        return float(v)
+    except OverflowError:
+        raise Error(-2, "%s is too large for a floating-point number (beyond 1.8e308)"
+                    % what) from None
+    except (TypeError, ValueError):
+        raise Error(-2, "%s must be a number, not %r" % (what, v)) from None
+
+
 def _numbers(values, what):
     try:
-        return [float(v) for v in values]
-    except (TypeError, ValueError):
+        items = list(values)
+    except TypeError:
         raise Error(-2, "%s must be a sequence of numbers" % what) from None
+    return [_number(v, "%s[%d]" % (what, i)) for i, v in enumerate(items)]
 
 
 def force(spring, u_mm, method="closed", stiffness=False):
     """Force (N) of the spring [D1, D2, n, d, G, H] (mm, MPa), or [D1, D2, n, d, G, H, n_tail,
     H_tail] for a spring with a cylindrical tail, at each compression in u_mm (mm, > 0 shortens);
     with stiffness=True a pair of lists (forces, tangent stiffnesses in N/mm)."""
-    p = _numbers(spring, "the spring")
+    p = _numbers(spring, "spring")
     if len(p) not in (6, 8):
         raise Error(-1, "the spring needs 6 numbers (D1, D2, n, d, G, H) or 8 (and n_tail, "
                         "H_tail), got %d" % len(p))
-    u = _numbers(u_mm, "the displacements")
+    u = _numbers(u_mm, "u_mm")
     n = len(u)
     arr = ctypes.c_double * max(n, 1)
     F, k = arr(), arr()
@@ -170,30 +187,55 @@ def fit(table=None, strain=None, stress=None, stress_unit="kPa", type="both", va
         _check(_lib.cf_flat_fit(_text(table, "table"), _text(type, "type"), 1 if validate else 0,
                                 ctypes.byref(out), ctypes.byref(e)), e)
         return json.loads(_taken(out))
+    except Error as err:
+        if not tmp:
+            raise
+        raise _in_sequences(err, tmp, len(x)) from None
     finally:
         if tmp:
             os.unlink(tmp)
 
 
+def _in_sequences(err, tmp, count):
+    """err about the temporary table fit() wrote from strain and stress, told in their terms:
+    "TMP:LINE:COLUMN: column '...': ..." (a value) names strain[i] or stress[i] (line 2 holds
+    index 0), anything else both sequences; the temporary is never named (it is gone)."""
+    msg = str(err)
+    m = re.match(re.escape(tmp) + r":(\d+)(?::(\d+))?: ", msg)
+    if m:
+        i, col = int(m.group(1)) - 2, m.group(2)
+        if 0 <= i < count and col in ("1", "2") and msg[m.end():].startswith("column '"):
+            where = "%s[%d]" % ("strain" if col == "1" else "stress", i)
+        else:
+            where = "strain, stress"
+        msg = where + ": " + msg[m.end():]
+    msg = msg.replace(tmp, "the strain and stress given")
+    out = Error(0, msg)
+    out.status = err.status
+    return out
+
+
 def simulate(scene):
-    """Runs the scene file and returns its samples, the columns of conifit simulate's CSV: a
-    list of dicts with time_s, strain, stress_kPa (compression positive), kinetic_energy_mJ,
-    spring_stress_kPa and stable (1, 0, or -1 in explicit dynamics)."""
+    """Runs the scene file and returns its samples as the columns of conifit simulate's CSV: a
+    dict of array.array, one a column, the i-th sample at index i of each: time_s, strain,
+    stress_kPa (compression positive), kinetic_energy_mJ, spring_stress_kPa (typecode 'd') and
+    stable (typecode 'b': 1, 0, or -1 in explicit dynamics). 8 bytes a number (a scene's
+    samples within the budget fit in memory as they do in the library)."""
     rows = ctypes.POINTER(ctypes.c_double)()
     count = ctypes.c_size_t()
     e = _CfError()
     _check(_lib.cf_flat_simulate(_text(scene, "scene"), ctypes.byref(rows), ctypes.byref(count),
                                  ctypes.byref(e)), e)
     try:
-        w = len(_SAMPLE_KEYS)
-        out = []
-        for i in range(count.value):
-            r = dict(zip(_SAMPLE_KEYS, rows[i * w:(i + 1) * w]))
-            r["stable"] = int(r["stable"])
-            out.append(r)
-        return out
+        w, n = len(_SAMPLE_KEYS), count.value
+        flat = array.array("d")
+        if n:
+            flat.frombytes(ctypes.string_at(rows, n * w * ctypes.sizeof(ctypes.c_double)))
     finally:
         _lib.cf_flat_free(rows)
+    out = {key: flat[j::w] for j, key in enumerate(_SAMPLE_KEYS)}
+    out["stable"] = array.array("b", (int(v) for v in out["stable"]))
+    return out
 
 
 def export(fit_file, format, type=None, tol=0.0):
@@ -201,10 +243,7 @@ def export(fit_file, format, type=None, tol=0.0):
     --format: json, csv, calculix, abaqus, febio, lsdyna, sofa), as text."""
     out = ctypes.c_void_p()
     e = _CfError()
-    try:
-        tol = float(tol)
-    except (TypeError, ValueError):
-        raise Error(-2, "tol must be a number") from None
+    tol = _number(tol, "tol")
     _check(_lib.cf_flat_export(_text(fit_file, "fit file"), _text(type, "type"),
                                _text(format, "format"), tol, ctypes.byref(out),
                                ctypes.byref(e)), e)

@@ -3,6 +3,7 @@ scene and export through ctypes as through the command line, and the library's r
 as conifit.Error with its message. Run by tests/cli/test_python.c (which sets CONIFIT, the
 binary, and CONIFIT_LIBRARY, the shared library of the same build)."""
 
+import array
 import csv
 import io
 import json
@@ -56,6 +57,22 @@ class Law(unittest.TestCase):
             conifit.force(tail[:6] + [-1, 10], [1])
         self.assertIn("n_tail", str(c.exception))
 
+    def test_non_finite_displacements_are_refused(self):
+        for bad, word in ((float("nan"), "not a number"), (float("inf"), "+infinity"),
+                          (float("-inf"), "-infinity")):
+            for spring in (SPRING, SPRING + [0, 0]):
+                with self.assertRaises(conifit.Error) as c:
+                    conifit.force(spring, [1.0, bad])
+                self.assertEqual(c.exception.status, "data")
+                self.assertIn("displacement 1", str(c.exception))
+                self.assertIn(word, str(c.exception))
+        with self.assertRaises(conifit.Error) as c:  # an int beyond a double: no OverflowError
+            conifit.force(SPRING, [1, 10 ** 400])
+        self.assertIn("u_mm[1]", str(c.exception))
+        with self.assertRaises(conifit.Error) as c:
+            conifit.force(SPRING[:5] + [10 ** 400], [1])
+        self.assertIn("spring[5]", str(c.exception))
+
     def test_bad_spring_raises_library_message(self):
         with self.assertRaises(conifit.Error) as c:
             conifit.force([4, 2, 5, 0.8, 80000, 10], [1])
@@ -102,6 +119,42 @@ class Fit(unittest.TestCase):
         for key, value in b["fits"][0]["params"].items():
             self.assertTrue(close(a["fits"][0]["params"][key], value, 1e-9), key)
 
+    def test_a_table_whose_f_quantile_gsl_cannot_invert(self):
+        # 274 rows: the F-test's F(0.95; 1, 271), whose inverse GSL 2.7 does not converge; with
+        # GSL's default handler (Python never turns it off) this session was killed by abort()
+        x = [0.5 * (i + 1) / 274 for i in range(274)]
+        y = [10 * e + 40 * e ** 3 for e in x]
+        got = conifit.fit(strain=x, stress=y)
+        self.assertEqual(len(got["fits"]), 2)
+        self.assertEqual(got["data"]["points"], 274)
+
+    def test_strings_with_a_nul_are_refused(self):
+        for call in (lambda: conifit.fit(self.TABLE + "\0x"),
+                     lambda: conifit.fit(self.TABLE, type="telescoping\0x"),
+                     lambda: conifit.force(SPRING, [1], method="closed\0x"),
+                     lambda: conifit.simulate("data/scenes/uniaxial.json\0x"),
+                     lambda: conifit.export(self.TABLE, "csv\0x")):
+            with self.assertRaises(conifit.Error) as c:
+                call()
+            self.assertEqual(c.exception.status, "usage")
+            self.assertIn("NUL", str(c.exception))
+
+    def test_refusals_of_sequences_name_the_value_not_a_temporary(self):
+        x = [0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6]
+        y = [0, 1, 2, float("nan"), 4, 5, 6]
+        with self.assertRaises(conifit.Error) as c:
+            conifit.fit(strain=x, stress=y)
+        self.assertEqual(c.exception.status, "data")
+        self.assertTrue(str(c.exception).startswith("stress[3]: "), str(c.exception))
+        self.assertNotIn(tempfile.gettempdir(), str(c.exception))
+        with self.assertRaises(conifit.Error) as c:
+            conifit.fit(strain=[0, 0.1], stress=[0, 1])
+        self.assertTrue(str(c.exception).startswith("strain, stress: "), str(c.exception))
+        self.assertNotIn(".csv", str(c.exception))
+        with self.assertRaises(conifit.Error) as c:
+            conifit.fit(strain=x[:6] + [10 ** 400], stress=y)
+        self.assertIn("strain[6]", str(c.exception))
+
     def test_errors(self):
         with self.assertRaises(conifit.Error) as c:
             conifit.fit("no/such/table.csv")
@@ -119,14 +172,20 @@ class Fit(unittest.TestCase):
 class Scene(unittest.TestCase):
     def test_simulate_matches_binary(self):
         scene = "data/scenes/uniaxial.json"
-        rows = conifit.simulate(scene)
+        cols = conifit.simulate(scene)
         theirs = list(csv.DictReader(io.StringIO(run("simulate", scene, "-o", "-", "-q"))))
-        self.assertEqual(len(rows), len(theirs))
-        for a, b in zip(rows, theirs):
+        # columns, not a dict a sample: 8 bytes a number (1 for stable)
+        self.assertEqual(sorted(cols), sorted(theirs[0]))
+        for key, col in cols.items():
+            self.assertIsInstance(col, array.array)
+            self.assertEqual(col.typecode, "b" if key == "stable" else "d")
+            self.assertEqual(len(col), len(theirs))
+        for i, b in enumerate(theirs):
             for key in ("time_s", "strain", "stress_kPa", "spring_stress_kPa"):
-                self.assertTrue(abs(a[key] - float(b[key])) <= 1e-9 * max(1, abs(float(b[key]))),
-                                (key, a[key], b[key]))
-            self.assertEqual(a["stable"], int(b["stable"]))
+                a = cols[key][i]
+                self.assertTrue(abs(a - float(b[key])) <= 1e-9 * max(1, abs(float(b[key]))),
+                                (key, i, a, b[key]))
+            self.assertEqual(cols["stable"][i], int(b["stable"]))
         with self.assertRaises(conifit.Error) as c:
             conifit.simulate("no/such/scene.json")
         self.assertEqual(c.exception.status, "noinput")
@@ -164,6 +223,25 @@ class Export(unittest.TestCase):
             self.assertIn("nastran", str(c.exception))
             with self.assertRaises(conifit.Error):
                 conifit.export(fit, "csv", tol=5)
+            with self.assertRaises(conifit.Error) as c:
+                conifit.export(fit, "csv", tol=10 ** 400)
+            self.assertIn("tol", str(c.exception))
+
+    def test_a_tail_too_stiff_to_tabulate_is_refused(self):
+        # n_tail 1e-15: the table grew without bound (15 GB after 200 s)
+        spring = run("export", "fits/telescoping.json", "--format", "json", "-q")
+        doc = json.loads(spring)
+        doc["params"].update(D1_mm=10, D2_mm=30, n=4, d_mm=1, G_MPa=80000, H_mm=50,
+                             n_tail=1e-15, H_tail_mm=10)
+        doc.pop("derived")
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "stiff.json")
+            with open(path, "w") as f:
+                json.dump(doc, f)
+            with self.assertRaises(conifit.Error) as c:
+                conifit.export(path, "csv")
+            self.assertEqual(c.exception.status, "data")
+            self.assertIn("n_tail = 1e-15", str(c.exception))
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 /*
 ** The flat calls (conifit/flat.h, src/pipeline/flat.c): NULL and malformed arguments refused with
-** a status and a message, never a crash; the batch force equal to the law's one-by-one; a fit of
+** a status and a message, never a crash (a displacement that is not finite among them); the
+** batch force equal to the law's one-by-one; a fit of
 ** the published tables equal to the pipeline's own; a time series refused; a scene's samples and
 ** an export complete and finite.
 */
@@ -67,6 +68,27 @@ static void null_and_malformed_arguments_are_refused(void **state)
     refused(cf_flat_export("fits/telescoping.json", "conical", "csv", 0, &text, &e), CF_E_DATA, &e, NULL);
     assert_null(text);
     cf_flat_free(NULL);
+}
+
+/* A displacement that is not a finite number is refused, naming its index, for both calls and
+** every method (before: CF_OK with 0 N at NaN and F_C at +-inf). */
+static void non_finite_displacements_are_refused(void **state)
+{
+    (void)state;
+    const double tail[8] = {10, 30, 4, 1, 80000, 40, 1, 10};
+    const double bad[3] = {NAN, INFINITY, -INFINITY};
+    const char *methods[4] = {"closed", "exact", "closed+newton", "table"};
+    for (int b = 0; b < 3; b++)
+        for (int m = 0; m < 4; m++) {
+            double u[3] = {0.5, 1.0, bad[b]}, F[3] = {7, 7, 7}, k[3];
+            cf_error e = {0};
+            refused(cf_flat_force(spring, methods[m], 3, u, F, k, &e), CF_E_DATA, &e,
+                    "displacement 2 ");
+            assert_null(strstr(e.msg, "nan"));
+            e = (cf_error){0};
+            refused(cf_flat_force_tail(tail, methods[m], 3, u, F, NULL, &e), CF_E_DATA, &e,
+                    "displacement 2 ");
+        }
 }
 
 static void the_batch_is_the_law_one_by_one(void **state)
@@ -195,6 +217,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(null_and_malformed_arguments_are_refused),
+        cmocka_unit_test(non_finite_displacements_are_refused),
         cmocka_unit_test(the_batch_is_the_law_one_by_one),
         cmocka_unit_test(a_fit_of_the_published_tables_is_the_pipelines),
         cmocka_unit_test(a_scene_and_an_export_are_whole_and_finite),

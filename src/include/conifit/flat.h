@@ -16,7 +16,8 @@
 /* The force F_N[i] (N) and, when k_N_per_mm is not NULL, the tangent stiffness (N/mm) at each of
 ** count compressions u_mm[i] (mm, > 0 shortens) of the spring spring[0..5] = D1 (mm), D2 (mm), n,
 ** d (mm), G (MPa), H (mm), with the evaluator named by method ("exact", "closed",
-** "closed+newton", "table"; NULL: "closed"). */
+** "closed+newton", "table"; NULL: "closed"). A displacement that is not a finite number is refused
+** (CF_E_DATA naming its index), as is a spring cf_law_init refuses. */
 cf_status cf_flat_force(const double spring[6], const char *method, size_t count,
                         const double *u_mm, double *F_N, double *k_N_per_mm, cf_error *err);
 
