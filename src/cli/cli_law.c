@@ -135,7 +135,7 @@ static int prepare(const law_args *a, cf_law *law)
 {
     cf_error err = {0};
     if (cf_law_init(law, &a->spring.p, &err) != CF_OK)
-        return cf_cli_usage_error("spring", "%s", err.msg);
+        return cf_cli_usage_error(a->cmd, "%s", err.msg);
     if (a->method == CF_LAW_TABLE && cf_law_table_build(law, (size_t)a->table, &err) != CF_OK)
         return cf_cli_fail(&err);
     return -1;

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "base/atomic.h"
+#include "base/input.h"
 #include "base/safetext.h"
 #include "cli/cli.h"
 #include "cli/cli_shard.h"
@@ -59,6 +60,10 @@ int cf_cli_shard_take(int *argc, char **argv, cf_shard *sh)
             argv[w++] = argv[i];
             continue;
         }
+        if (sh->given)
+            return cf_cli_usage_error("fit", "--shard given twice (%ld/%ld, then '%s'): a "
+                                             "process fits one share",
+                                      sh->k, sh->n, v);
         if (parse_kn(v, &sh->k, &sh->n) != 0)
             return cf_cli_usage_error("fit", "--shard '%s': expected K/N, two whole numbers", v);
         if (sh->n < 1 || sh->n > 1000000 || sh->k < 1 || sh->k > sh->n)
@@ -201,7 +206,8 @@ static const char merge_help[] =
     "Merges the summaries that `conifit fit --shard K/N -o DIR/` writes (DIR/summary-K-of-N.tsv)\n"
     "into the summary of the whole study, as one process (--shard 1/1) writes it: rows sorted by\n"
     "table. Refused (exit 65) unless the files are the N shards of one split, each once, with\n"
-    "every table once.\n\n"
+    "every table once. After --, every argument is a summary, even one whose name starts with\n"
+    "'-'.\n\n"
     "  -o, --output FILE  the merged summary (atomically); default, or '-': standard output\n";
 
 typedef struct row {
@@ -222,11 +228,9 @@ static int read_summary(const char *path, long *k, long *n, long *total, row **r
                         size_t *nrows, size_t *cap)
 {
     cf_error err = {0};
-    FILE *f = fopen(path, "r");
-    if (!f) {
-        cf_error_set(&err, CF_E_NOINPUT, "%s: cannot open: %s", path, strerror(errno));
+    FILE *f = cf_input_open(path, "shard summary", &err); /* a folder: 66, as for any input */
+    if (!f)
         return cf_cli_fail(&err);
-    }
     char line[ROW_MAX];
     int rc = -1;
     if (!fgets(line, sizeof line, f) || sscanf(line, SUMMARY_MAGIC "%ld/%ld of %ld tables", k, n,
@@ -320,6 +324,9 @@ int cf_cli_merge(int argc, char **argv)
                 rc = cf_cli_usage_error("merge", "%s needs a file name", argv[i]);
             else
                 out = argv[++i];
+        } else if (strcmp(argv[i], "--") == 0) { /* summaries from here on, whatever their name */
+            while (++i < argc)
+                paths[nfiles++] = argv[i];
         } else if (argv[i][0] == '-' && argv[i][1]) {
             rc = cf_cli_usage_error("merge", "unknown option '%s'", argv[i]);
         } else {

@@ -16,6 +16,7 @@
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -159,17 +160,45 @@ cf_status cf_law_init(cf_law *law, const cf_spring *p, cf_error *err)
                                law->tau * (1.0 + rho + rho * rho)));
     }
 
-    const double derived[] = {law->rho,   law->rho_inv_m1,  law->index_c,    law->L_max_mm,
-                              law->F_C_N, law->F_T_N,       law->k0_N_per_mm, law->u_T_mm,
-                              law->inv_travel, law->k_scale, law->w_T, law->u_C_mm,
-                              law->F_solid_N, law->travel_mm};
+    /* every derived quantity must be a finite number (and > 0 but for three that may be 0):
+    ** named in the refusal, never shown as NaN or Inf */
+    const struct {
+        const char *name;
+        double v;
+        int may_be_zero;
+    } derived[] = {{"rho = D1/D2", law->rho, 0},
+                   {"1/rho - 1", law->rho_inv_m1, 1},
+                   {"the spring index D1/d", law->index_c, 0},
+                   {"L_max (full stretch, mm)", law->L_max_mm, 0},
+                   {"F_C (the cone's solid load, N)", law->F_C_N, 0},
+                   {"F_T (the transition load, N)", law->F_T_N, 0},
+                   {"k0 (the linear stiffness, N/mm)", law->k0_N_per_mm, 0},
+                   {"u_T (the end of the linear region, mm)", law->u_T_mm, 0},
+                   {"1/travel (1/mm)", law->inv_travel, 0},
+                   {"the stiffness scale 4 F_C (1/rho - 1)/s (N/mm)", law->k_scale, 1},
+                   {"w_T", law->w_T, 1},
+                   {"u_C (mm)", law->u_C_mm, 0},
+                   {"F_solid (N)", law->F_solid_N, 0},
+                   {"the travel to solid (mm)", law->travel_mm, 0}};
     char sp[160];
-    for (size_t i = 0; i < sizeof derived / sizeof derived[0]; i++)
-        if (!isfinite(derived[i]) || (i != 1 && i != 9 && i != 10 && derived[i] <= 0))
-            return cf_error_set(err, CF_E_DATA,
-                                "spring %s is outside the range where its loads can be "
-                                "represented (derived value %zu = %g)",
-                                cf_spring_text(p, 6, 1, sp, sizeof sp), i, derived[i]);
+    for (size_t i = 0; i < sizeof derived / sizeof derived[0]; i++) {
+        const double v = derived[i].v;
+        if (isfinite(v) && (v > 0 || (derived[i].may_be_zero && v == 0)))
+            continue;
+        char what[64];
+        if (isnan(v))
+            snprintf(what, sizeof what, "cannot be computed in floating point");
+        else if (isinf(v))
+            snprintf(what, sizeof what, "overflows floating point");
+        else if (v == 0)
+            snprintf(what, sizeof what, "underflows to 0");
+        else
+            snprintf(what, sizeof what, "= %g, not > 0", v);
+        return cf_error_set(err, CF_E_DATA,
+                            "spring %s is outside the range where its loads can be "
+                            "represented: %s %s",
+                            cf_spring_text(p, 6, 1, sp, sizeof sp), derived[i].name, what);
+    }
     return CF_OK;
 }
 
