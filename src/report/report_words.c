@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Appends to buf (capacity cap, *n used), never past its end. */
@@ -166,19 +167,62 @@ void cf_report_conversion(const cf_table *t, char *buf, size_t cap)
     }
 }
 
+/* Most significant digits an interval is shown with: an end closer to the value than this
+** shows (a bound the fit sits on, or one a rounding step away) is shown as the value itself. */
+#define INTERVAL_MAX_DIGITS 6
+
+/* 1 when end e of an interval about v is v as far as INTERVAL_MAX_DIGITS digits show. */
+static int end_is_value(double v, double e)
+{
+    return fabs(e - v) <= 0.5 * pow(10.0, -INTERVAL_MAX_DIGITS) * fabs(v);
+}
+
 /* Significant digits that tell the ends of the interval [lo, hi] from the value v: 3, or more
-** when an end lies closer to v than 3 digits show (a precise or long table), at most 17. */
+** when an end lies closer to v than 3 digits show (a precise or long table), at most
+** INTERVAL_MAX_DIGITS; ends that are the value (end_is_value) do not count. */
 static int interval_digits(double v, double lo, double hi)
 {
     double w = INFINITY;
-    if (v - lo > 0)
+    if (v - lo > 0 && !end_is_value(v, lo))
         w = v - lo;
-    if (hi - v > 0)
+    if (hi - v > 0 && !end_is_value(v, hi))
         w = fmin(w, hi - v);
     if (!(v != 0) || !isfinite(w))
         return 3;
     double d = floor(log10(fabs(v))) - floor(log10(w)) + 1;
-    return (int)fmin(17, fmax(3, d));
+    return (int)fmin(INTERVAL_MAX_DIGITS, fmax(3, d));
+}
+
+/* x to `digits` significant digits, rounded away from the value (down for a lower end, dir -1;
+** up for an upper end, dir +1), so that the printed interval holds the interval. */
+static void outward(char *buf, size_t cap, double x, int digits, int dir)
+{
+    if (x == 0 || !isfinite(x)) {
+        snprintf(buf, cap, "%.*g", digits, x);
+        return;
+    }
+    const double step = pow(10.0, floor(log10(fabs(x))) - digits + 1);
+    const double r = (dir < 0 ? floor(x / step) : ceil(x / step)) * step;
+    snprintf(buf, cap, "%.*g", digits, r);
+}
+
+/* The cell "v [lo, hi]" of an interval: v with at least 4 digits, the ends rounded outward; an end
+** that is the value, or that would print past it, printed as the value, so that the printed
+** interval always holds the printed value. */
+static void interval_text(double v, double lo, double hi, char *cell, size_t cap, const char *sp,
+                          const char *unit)
+{
+    const int dg = interval_digits(v, lo, hi);
+    char tv[40], tl[40], th[40];
+    snprintf(tv, sizeof tv, "%.*g", dg > 4 ? dg : 4, v);
+    const double pv = strtod(tv, NULL);
+    outward(tl, sizeof tl, lo, dg, -1);
+    outward(th, sizeof th, hi, dg, +1);
+    if (end_is_value(v, lo) || strtod(tl, NULL) > pv)
+        snprintf(tl, sizeof tl, "%s", tv);
+    if (end_is_value(v, hi) || strtod(th, NULL) < pv)
+        snprintf(th, sizeof th, "%s", tv);
+    snprintf(cell, cap, "%s [%s, %s]*%s%s", tv, tl, th, sp, unit);
 }
 
 void cf_report_ident_cell(const cf_fit_result *f, int k, double scale, const char *unit,
@@ -190,10 +234,7 @@ void cf_report_ident_cell(const cf_fit_result *f, int k, double scale, const cha
     const unsigned *ends;
     unsigned why;
     if (quantity(f, k, &q, &se, &iv, &ends, &why)) {
-        const double v = q * scale, lo = iv[0] * scale, hi = iv[1] * scale;
-        const int dg = interval_digits(v, lo, hi);
-        snprintf(cell, cap, "%.*g [%.*g, %.*g]*%s%s", dg > 4 ? dg : 4, v, dg, lo, dg, hi, sp,
-                 unit);
+        interval_text(q * scale, iv[0] * scale, iv[1] * scale, cell, cap, sp, unit);
     } else if (f->tail && se > fabs(q)) {
         /* the tailed law's four quantities traded against each other by the data */
         snprintf(cell, cap, "%.4g%s%s (not determined)", q * scale, sp, unit);

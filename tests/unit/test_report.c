@@ -8,7 +8,10 @@
 **  - numbers in the file's own unit (kPa here), not conifit's MPa;
 **  - the text names both types, the identifiable quantities and the units;
 **  - a table that tells the types apart is reported with a better type, one that does not as a
-**    tie.
+**    tie;
+**  - a profile interval is shown with at most 6 significant digits, its ends rounded outward and
+**    never printed past the value (an end one ulp below the value printed 17 digits, the end
+**    below the value).
 */
 #include "testutil.h"
 
@@ -16,6 +19,7 @@
 
 #include "conifit/fitfile.h"
 #include "conifit/pipeline.h"
+#include "report/report_words.h"
 
 /* A kPa stress-strain table of one spring's law (noise-free: both types fit it). */
 static void law_table(const cf_spring *p, int n, double emax, cf_table *t)
@@ -163,12 +167,75 @@ static void one_type_has_no_comparison(void **state)
     cf_table_free(&t);
 }
 
+/* The parts of "v [lo, hi]*" as printed; their significant digits (mantissa digits) at most
+** `most`. */
+static void interval_cell(double v, double lo, double hi, double *pv, double *plo, double *phi,
+                          int most)
+{
+    cf_fit_result f;
+    memset(&f, 0, sizeof f);
+    f.ident.v[0] = v;
+    f.ident_se.v[0] = -1;
+    f.interval[0][0] = lo;
+    f.interval[0][1] = hi;
+    f.interval_ok[0] = 1;
+    char cell[128], a[40], b[40], c[40];
+    cf_report_ident_cell(&f, 0, 1, "", cell, sizeof cell);
+    assert_int_equal(sscanf(cell, "%39[^ ] [%39[^,], %39[^]]]*", a, b, c), 3);
+    const char *parts[3] = {a, b, c};
+    for (int i = 0; i < 3; i++) {
+        int digits = 0, seen = 0;
+        for (const char *p = parts[i]; *p && *p != 'e'; p++)
+            if (*p >= '0' && *p <= '9') {
+                seen |= *p != '0';
+                digits += seen;
+            }
+        if (digits > most)
+            fail_msg("'%s' has %d significant digits in '%s'", parts[i], digits, cell);
+    }
+    *pv = strtod(a, NULL), *plo = strtod(b, NULL), *phi = strtod(c, NULL);
+}
+
+static void intervals_print_few_digits_and_hold_their_value(void **state)
+{
+    (void)state;
+    double v, lo, hi;
+    /* an end one ulp below the value: shown as the value */
+    const double x = 0.37212345678901234;
+    interval_cell(x, nextafter(x, 0), 0.9, &v, &lo, &hi, 6);
+    assert_true(lo <= v && v <= hi);
+    assert_true(lo == v);
+    interval_cell(x, 0.1, nextafter(x, 1), &v, &lo, &hi, 6);
+    assert_true(lo <= v && v <= hi && hi == v);
+    /* ends close to the value: more digits, at most 6, rounded outward */
+    interval_cell(1.23456789, 1.2345, 1.2347, &v, &lo, &hi, 6);
+    assert_true(lo <= 1.2345 && hi >= 1.2347 && lo < v && v < hi);
+    /* an ordinary interval: 3 digits for the ends, outward */
+    interval_cell(9293.1, 24.52, 10234.5, &v, &lo, &hi, 4);
+    assert_true(lo <= 24.52 && hi >= 10234.5 && lo <= v && v <= hi);
+    /* many random intervals: the printed interval always holds the printed value */
+    unsigned seed = 12345;
+    for (int i = 0; i < 20000; i++) {
+        seed = seed * 1103515245u + 12345u;
+        double c = ldexp((double)(seed >> 8) / 16777216.0 + 0.5, (int)(seed % 40) - 20);
+        seed = seed * 1103515245u + 12345u;
+        double wl = c * ldexp((double)(seed >> 8) / 16777216.0, -(int)(seed % 56));
+        seed = seed * 1103515245u + 12345u;
+        double wh = c * ldexp((double)(seed >> 8) / 16777216.0, -(int)(seed % 56));
+        interval_cell(c, c - wl, c + wh, &v, &lo, &hi, 6);
+        if (!(lo <= v && v <= hi))
+            fail_msg("value %.17g in [%.17g, %.17g] printed %.17g [%.17g, %.17g]", c, c - wl,
+                     c + wh, v, lo, hi);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(json_holds_units_finite_numbers_and_reads_back),
         cmocka_unit_test(text_names_types_quantities_and_units),
         cmocka_unit_test(one_type_has_no_comparison),
+        cmocka_unit_test(intervals_print_few_digits_and_hold_their_value),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
