@@ -6,7 +6,9 @@
 **    and never prints NaN (it said "derived value 4 = -nan");
 **  - conifit merge takes `--` as the end of its options, refuses a folder as a missing input (66,
 **    as every other command does; it was 65), and conifit fit refuses --shard given twice (2; the
-**    last one was taken silently).
+**    last one was taken silently);
+**  - (item 6) -o and --plot naming one file through a hard link: exit 2, the file untouched and
+**    no temporary left.
 */
 #include "testutil.h"
 
@@ -140,6 +142,26 @@ static void a_repeated_shard_is_a_usage_error(void **state)
     assert_int_equal(access(path, F_OK), -1); /* nothing written */
 }
 
+static void one_file_for_the_fit_and_the_plot_is_refused(void **state)
+{
+    (void)state;
+    char a[512], b[512], cmd[2400];
+    snprintf(a, sizeof a, "%s/h/fit.json", dir);
+    snprintf(b, sizeof b, "%s/h/fit.png", dir);
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s/h' && echo old > '%s' && ln '%s' '%s'", dir, a, a, b);
+    assert_int_equal(system(cmd), 0);
+    int rc = tu_run(out, sizeof out, err, sizeof err, "fit data/telescoping.csv -o '%s' --plot '%s'",
+                    a, b);
+    assert_int_equal(rc, 2);
+    assert_non_null(strstr(err, "both outputs name one file"));
+    char *text = tu_slurp(a);
+    assert_non_null(text);
+    assert_string_equal(text, "old\n");
+    free(text);
+    snprintf(cmd, sizeof cmd, "test $(ls -A '%s/h' | wc -l) -eq 2", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -147,6 +169,7 @@ int main(void)
         cmocka_unit_test(an_unrepresentable_spring_names_the_quantity_never_nan),
         cmocka_unit_test(merge_takes_double_dash_and_refuses_a_folder_as_missing),
         cmocka_unit_test(a_repeated_shard_is_a_usage_error),
+        cmocka_unit_test(one_file_for_the_fit_and_the_plot_is_refused),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
