@@ -163,6 +163,7 @@ $(BUILD)/tests/%: tests/%.c $(LIB_A)
 test: check-deps $(BUILD)/conifit $(LIB_SO) $(TESTS) $(REPLAYS)
 	@sh tests/check_layers.sh
 	@sh tests/exports.sh check $(LIB_SO)
+	@sh tests/check_gsl_guard.sh $(BUILD)
 	@CONIFIT=$(BUILD)/conifit sh tests/man/check_options.sh
 	@$(if $(filter 1,$(SANITIZE)),,sh tests/install/run.sh)
 	@$(foreach f,$(FUZZERS),CONIFIT_FUZZ_QUIET=1 $(BUILD)/fuzz-replay/$(f) $(FUZZ_SEEDS_$(f)) \

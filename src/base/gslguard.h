@@ -18,6 +18,8 @@
 **
 ** Every public function that can reach GSL has a guard (its first statement), except the law's
 ** force evaluations, called once a point, which take it around the one GSL call they can make.
+** tests/check_gsl_guard.sh (part of make test) checks this on the objects' call graph: no path
+** from a public function to GSL may avoid a function that enters a guard.
 */
 #ifndef CF_GSLGUARD_H
 #define CF_GSLGUARD_H
