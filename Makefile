@@ -231,7 +231,7 @@ uninstall: install-paths
 	  $(foreach m,$(notdir $(filter %.1,$(MANPAGES))),'$(D)$(MANDIR)/man1/$(m)') \
 	  $(foreach m,$(notdir $(filter %.3,$(MANPAGES))),'$(D)$(MANDIR)/man3/$(m)') \
 	  '$(D)$(PYTHONDIR)/conifit.py' '$(D)$(PYTHONDIR)/__pycache__'/conifit.*.pyc
-	-rmdir '$(D)$(PYTHONDIR)/__pycache__' 2>/dev/null
+	rmdir '$(D)$(PYTHONDIR)/__pycache__' 2>/dev/null || true
 	rm -rf '$(D)$(INCLUDEDIR)/conifit'
 
 # Installs into a scratch DESTDIR with PREFIX=/usr and uses the staged tree as a user would.
