@@ -48,7 +48,8 @@ static void fit_warnings(const char *file, const cf_fit_report *r, const cf_fit_
             cf_cli_printf_safe(stderr,
                     "conifit: warning: %s: no %s spring of this table meets the limit %s "
                     "(feasible: false); to widen it: %s\n",
-                    file, type, cf_fit_constraint_name(bit), cf_fit_constraint_flag(bit));
+                    file, type, cf_fit_constraint_name(bit),
+                    cf_fit_constraint_flag_for(bit, cf_table_is_force(r->table)));
     }
     if (f->feasible && f->solid_ratio < CF_FIT_SOLID_RATIO_WARN)
         cf_cli_printf_safe(stderr,

@@ -20,6 +20,14 @@ const char *cf_fit_constraint_flag(unsigned bit)
     return "--fix";
 }
 
+const char *cf_fit_constraint_flag_for(unsigned bit, int force_displacement)
+{
+    if (bit == CF_C_TRAVEL && force_displacement)
+        return "nothing: no spring of the fitted law travels past the table's largest "
+               "displacement";
+    return cf_fit_constraint_flag(bit);
+}
+
 unsigned cf_fit_relax(const cf_fit_options *o, unsigned bits, cf_fit_options *out)
 {
     *out = *o;

@@ -133,7 +133,7 @@ static void unpack(const tail_ctx *c, const double *th, double v[4])
 {
     v[0] = c->rho_lo + (c->rho_hi - c->rho_lo) * cf_logistic(th[0]);
     v[1] = c->b_lo + (c->b_hi - c->b_lo) * cf_logistic(th[1]);
-    v[3] = tau_of(c, v[1], th[3]);
+    v[3] = fmin(tau_of(c, v[1], th[3]), cf_tail_tau_max(c->opt));
     v[2] = c->fd ? exp(th[2]) : amax_at(c, v[0], v[1], v[3]) * cf_logistic(th[2]);
 }
 
@@ -194,7 +194,7 @@ static double lm_run(tail_ctx *c, const double v0[4], double out[4])
     double th0[4] = {cf_logit((v0[0] - c->rho_lo) / (c->rho_hi - c->rho_lo)),
                      cf_logit((v0[1] - c->b_lo) / (c->b_hi - c->b_lo)),
                      c->fd ? log(v0[2]) : cf_logit(v0[2] / amax_at(c, v0[0], v0[1], v0[3])),
-                     th3_of(c, v0[1], v0[3])};
+                     th3_of(c, v0[1], fmin(v0[3], cf_tail_tau_max(c->opt)))};
     int ist;
     gsl_multifit_nlinear_workspace *w = cf_lm_start(&fp, &fdf, th0, &ist);
     if (!w)
@@ -312,7 +312,7 @@ static double tail_search(tail_ctx *c, const cf_fit_result *plain, double v[4],
                 continue;
             for (int l = 0; l < TAIL_GRID_TAU; l++) {
                 const double tau = 1e-3 * pow(1e5, (double)l / (TAIL_GRID_TAU - 1));
-                if (!c->fd && B * (1 + tau) >= 1)
+                if ((!c->fd && B * (1 + tau) >= 1) || tau > cf_tail_tau_max(c->opt))
                     continue;
                 double A;
                 grid[k].obj = tail_profile(c, rho, B, tau, c->stride, &A);
@@ -435,6 +435,16 @@ cf_status cf_fit_tail_run(const cf_table *data, const cf_fit_options *opt, cf_sp
     const double best = tail_search(&c, plain, v, ends, end_obj, &ns);
     if (!isfinite(best)) {
         free(buf);
+        /* the conical law the tailed law contains: its fit with no tail */
+        if (plain && !plain->tail && isfinite(plain->objective)) {
+            res->evaluations = res->evaluations_full = c.evals;
+            res->feasible = 0;
+            res->objective = INFINITY;
+            res->rmse = 0;
+            cf_tail_nest(plain, res);
+            res->wall_time_s = cf_clock_s() - t0;
+            return CF_OK;
+        }
         return cf_error_set(err, CF_E_DATA, "%s: no conical-tail law fits the table",
                             data->path);
     }
@@ -464,6 +474,8 @@ cf_status cf_fit_tail_run(const cf_table *data, const cf_fit_options *opt, cf_sp
     res->evaluations = c.evals;
     res->evaluations_full = c.evals;
     res->wall_time_s = cf_clock_s() - t0;
+    /* never reported worse than the conical law it contains */
+    cf_tail_nest(plain, res);
     return CF_OK;
 }
 

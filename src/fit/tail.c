@@ -50,6 +50,12 @@ double cf_tail_coord(int fd, double B, double tau)
     return cf_logit(tau * B / ((1 - B) * (1 - 1e-9)));
 }
 
+double cf_tail_tau_max(const cf_fit_options *o)
+{
+    const double nmin = fmax(o->lower[CF_P_N], 1.0), cap = o->upper[CF_P_N] / nmin;
+    return cap > 0 && cap < TAIL_TAU_HI ? cap : TAIL_TAU_HI;
+}
+
 /* ---- standard errors ------------------------------------------------------------------------- */
 
 void cf_tail_errors(cf_tail_residuals res, void *ctx, size_t n, const double v[4], double h_rel,
@@ -162,6 +168,9 @@ static tail_geom tail_geometry(double rho, double B, double tau, cf_spring_type 
         if (g.c > fmin(o->index_max, c_D))
             g.violated |= g.c > c_D ? CF_C_D2_H : CF_C_INDEX_MAX;
     }
+    /* the tail's coils are wound coils like the cone's: the same most */
+    if (tau * g.n > o->upper[CF_P_N] * (1 + 1e-9))
+        g.violated |= CF_C_COILS_MAX;
     return g;
 }
 
@@ -281,6 +290,8 @@ cf_status cf_tail_result(const cf_table *data, const cf_fit_options *opt, cf_spr
         res->held |= CF_C_G_MAX;
     if (rho <= rho_lo * (1 + 1e-3) && opt->rho_min > CF_IDENT_RHO_LO)
         res->held |= CF_C_RHO_MIN;
+    if (tau >= cf_tail_tau_max(opt) * (1 - 1e-3) && cf_tail_tau_max(opt) < TAIL_TAU_HI)
+        res->held |= CF_C_COILS_MAX; /* the tail's coils at n_max */
     if (type == CF_TELESCOPING && rho >= cf_ident_rho_hi(type, opt->index_max) * (1 - 1e-3))
         res->held |= CF_C_TYPE;
     if (res->law.type != type)
@@ -289,6 +300,36 @@ cf_status cf_tail_result(const cf_table *data, const cf_fit_options *opt, cf_spr
     res->solid_table_strain = fd ? res->law.travel_mm : res->law.travel_mm / res->params.H_mm;
     res->solid_ratio = xmax > 0 ? res->solid_table_strain / xmax : INFINITY;
     return CF_OK;
+}
+
+int cf_tail_nest(const cf_fit_result *plain, cf_fit_result *tail)
+{
+    if (!plain || plain->tail || !(plain->objective >= 0) || !isfinite(plain->objective))
+        return 0;
+    const int loses = (plain->feasible && !tail->feasible) ||
+                      (plain->feasible == tail->feasible &&
+                       !(tail->objective <= plain->objective * (1 + 1e-9)));
+    if (!loses)
+        return 0;
+    const long evals = tail->evaluations, full = tail->evaluations_full;
+    const double wall = tail->wall_time_s;
+    /* what the tailed search ended on, for the report */
+    const unsigned lost = tail->feasible ? 0 : tail->violated;
+    const double lost_rmse = isfinite(tail->rmse) && isfinite(tail->objective) ? tail->rmse : 0;
+    *tail = *plain;
+    tail->nested_rmse = lost_rmse;
+    tail->nested_violated = lost;
+    tail->tail = 1;
+    tail->e_tail = 0;
+    tail->e_tail_se = 0;
+    tail->e_tail_interval_ok = 0;
+    tail->params.n_tail = 0;
+    tail->params.H_tail_mm = 0;
+    /* the search's cost is the tailed fit's own */
+    tail->evaluations = evals;
+    tail->evaluations_full = full;
+    tail->wall_time_s = wall;
+    return 1;
 }
 
 /* ---- profile intervals ---------------------------------------------------------------------- */
@@ -325,7 +366,8 @@ static void prof_unpack(const prof_run *r, const double *th, double v[4])
         z[i] = i == r->k ? 0 : th[j++];
     v[0] = r->k == 0 ? r->fixed : p->rho_lo + (p->rho_hi - p->rho_lo) * cf_logistic(z[0]);
     v[1] = r->k == 1 ? r->fixed : p->b_lo + (prof_b_hi(r) - p->b_lo) * cf_logistic(z[1]);
-    v[3] = r->k == 3 ? r->fixed / v[1] : cf_tail_tau(p->fd, v[1], z[3]);
+    v[3] = r->k == 3 ? r->fixed / v[1]
+                     : fmin(cf_tail_tau(p->fd, v[1], z[3]), cf_tail_tau_max(p->opt));
     v[2] = r->k == 2 ? r->fixed : p->fd ? exp(z[2]) : prof_A_max(r, v) * cf_logistic(z[2]);
 }
 

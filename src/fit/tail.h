@@ -23,6 +23,10 @@
 ** between B and 1 (a spring's whole travel is below its free length, so u_C/H < 1).
 ** cf_tail_coord is cf_tail_tau's inverse. */
 double cf_tail_tau(int fd, double B, double th3);
+
+/* The largest tau = n_t/n a buildable tailed spring has: its tail's coils n_t = tau n are wound
+** coils like the cone's, at most n_max, and the cone has at least n_min (cf_fit_options). */
+double cf_tail_tau_max(const cf_fit_options *o);
 double cf_tail_coord(int fd, double B, double tau);
 
 /* Weighted residuals of n rows at the quantities v = (rho, B, A, tau) into f; GSL_SUCCESS, or
@@ -50,6 +54,13 @@ double cf_tail_A_max(double rho, double B, double tau, cf_spring_type type, doub
 cf_status cf_tail_result(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                          const double v[4], const double se[4], double corr[4][4], double cov_Bt,
                          cf_fit_result *res, cf_error *err);
+
+/* The tailed law contains the conical law (tail compliance 0): a tailed fit tail that ends worse
+** than the conical fit plain of the same table, type and target (infeasible where plain is
+** feasible, or a larger objective at the same feasibility) is replaced by plain as a tailed fit
+** with no tail (e_tail 0, n_tail 0: the law is plain's), the lost one's RMSE and violated bits in
+** nested_rmse and nested_violated. Returns 1 when replaced. */
+int cf_tail_nest(const cf_fit_result *plain, cf_fit_result *tail);
 
 /* A tailed fit's residuals for its profile intervals: m weighted residuals (the table's rows, or
 ** a subsample of a long one each standing for its share of the table) at v = (rho, B, A, tau), the

@@ -15,6 +15,7 @@
 #include "conifit/version.h"
 #include "base/atomic.h"
 #include "report/plot.h"
+#include "fit/tail.h"
 #include "pipeline/outputs.h"
 
 cf_pipeline_options cf_pipeline_default_options(void)
@@ -98,10 +99,14 @@ static cf_status choose_law(const cf_table *t, const cf_pipeline_options *opt, c
                             int k, cf_error *err)
 {
     cf_fit_result tail;
-    cf_status st = cf_fit_tail_run(t, &opt->fit, r->fits[k].type, &r->fits[k], &tail, err);
+    cf_error e = {0};
+    cf_status st = cf_fit_tail_run(t, &opt->fit, r->fits[k].type, &r->fits[k], &tail, &e);
     if (st == CF_OK)
         keep_law(opt, r, k, &tail);
-    return st;
+    /* auto keeps the conical law where the tailed one cannot be fitted (too few rows) */
+    if (st == CF_E_INTERNAL || (st != CF_OK && opt->fit.law == CF_FAMILY_TAIL))
+        return cf_error_set(err, st, "%s", e.msg);
+    return CF_OK;
 }
 
 /* The tailed law through the lattice for fits[k] (the conical law's fit through it, thr[k]), and
@@ -114,7 +119,19 @@ static cf_status choose_law_in_lattice(const cf_table *t, const cf_pipeline_opti
     cf_through_msm thr;
     cf_error e = {0};
     cf_status st = cf_lattice_fit_tail(t, &opt->fit, &opt->lattice, &r->fits[k], &tail, &thr, &e);
-    if (st == CF_E_INTERNAL || (st != CF_OK && opt->fit.law == CF_FAMILY_TAIL))
+    if (st == CF_E_INTERNAL)
+        return cf_error_set(err, st, "%s", e.msg);
+    /* the tailed law contains the conical law: where its search ends worse than the conical fit
+    ** through the lattice, or finds nothing, that fit with no tail is the tailed law's */
+    if (st != CF_OK) {
+        memset(&tail, 0, sizeof tail);
+        tail.objective = INFINITY; /* none found: nested_rmse 0 */
+    }
+    if (cf_tail_nest(&r->fits[k], &tail)) {
+        thr = r->thr[k];
+        st = CF_OK;
+    }
+    if (st != CF_OK && opt->fit.law == CF_FAMILY_TAIL)
         return cf_error_set(err, st, "%s", e.msg);
     if (st == CF_OK && keep_law(opt, r, k, &tail))
         r->thr[k] = thr;

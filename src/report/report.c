@@ -121,12 +121,18 @@ static json_t *law_comparison_json(const cf_fit_report *r, int i)
     const cf_fit_result *tail = lc->chose_tail ? &r->fits[i] : &lc->other;
     const cf_fit_result *cone = lc->chose_tail ? &lc->other : &r->fits[i];
     const double u = r->table->y_to_file;
-    return json_pack("{s:s, s:b, s:{s:o, s:o, s:b}, s:{s:o, s:o, s:b, s:o}}", "chosen",
-                     lc->chose_tail ? "conical-tail" : "conical", "through_lattice",
-                     r->through_msm && r->thr[i].done, "conical", "rmse",
-                     num(cone->rmse * u), "aic", num(lc->aic_conical), "feasible", cone->feasible,
-                     "conical-tail", "rmse", num(tail->rmse * u), "aic", num(lc->aic_tail),
-                     "feasible", tail->feasible, "tail_compliance", cf_report_tail_json(tail));
+    json_t *o = json_pack("{s:s, s:b, s:{s:o, s:o, s:b}, s:{s:o, s:o, s:b, s:o}}", "chosen",
+                          lc->chose_tail ? "conical-tail" : "conical", "through_lattice",
+                          r->through_msm && r->thr[i].done, "conical", "rmse",
+                          num(cone->rmse * u), "aic", num(lc->aic_conical), "feasible",
+                          cone->feasible, "conical-tail", "rmse", num(tail->rmse * u), "aic",
+                          num(lc->aic_tail), "feasible", tail->feasible, "tail_compliance",
+                          cf_report_tail_json(tail));
+    char nested[320];
+    cf_report_nested(r, tail, nested, sizeof nested);
+    if (o && nested[0]) /* the conical optimum it contains: why */
+        json_object_set_new(json_object_get(o, "conical-tail"), "no_tail", json_string(nested));
+    return o;
 }
 
 static json_t *fit_json_core(const cf_fit_report *r, int i)

@@ -36,13 +36,13 @@ static void row(FILE *o, const cf_fit_report *r, const char *label, const char *
         case 13: snprintf(cell, sizeof cell, fmt, cf_report_fit_aic(r, i)); break;
         case 14: snprintf(cell, sizeof cell, fmt, f->law.k0_N_per_mm); break;
         case 15: case 16: /* the tail's parameters, blank for a spring without one */
-            if (f->tail)
+            if (f->tail && p->n_tail > 0)
                 snprintf(cell, sizeof cell, fmt, cf_spring_get(p, which - 15 + CF_P_N_TAIL));
             else
-                snprintf(cell, sizeof cell, "-");
+                snprintf(cell, sizeof cell, f->tail ? "none" : "-");
             break;
         case 17:
-            if (f->tail)
+            if (f->tail && p->n_tail > 0)
                 snprintf(cell, sizeof cell, fmt, f->law.k_tail_N_per_mm);
             else
                 snprintf(cell, sizeof cell, "-");
@@ -85,6 +85,8 @@ static void tail_row(FILE *o, const cf_fit_report *r)
         char cell[96];
         if (!f->tail)
             snprintf(cell, sizeof cell, "-");
+        else if (f->params.n_tail == 0) /* cf_fit_tail_run: the conical optimum it contains */
+            snprintf(cell, sizeof cell, "0 (none: conical)");
         else
             cf_report_ident_cell(f, CF_REPORT_TAIL, 1, fd ? "mm" : "", cell, sizeof cell);
         fprintf(o, " %-24s", cell);
@@ -114,8 +116,11 @@ static void law_choice_text(FILE *o, const cf_fit_report *r)
         fprintf(o, "  %-16s conical      RMSE %.4g %s  AIC %.2f%s\n",
                 cf_spring_type_name(r->fits[i].type), cone->rmse * u, r->table->y_unit,
                 lc->aic_conical, cone->feasible ? "" : "  (infeasible)");
-        fprintf(o, "  %-16s conical-tail RMSE %.4g %s  AIC %.2f%s\n", "", tail->rmse * u,
-                r->table->y_unit, lc->aic_tail, tail->feasible ? "" : "  (infeasible)");
+        char nested[320];
+        cf_report_nested(r, tail, nested, sizeof nested);
+        fprintf(o, "  %-16s conical-tail RMSE %.4g %s  AIC %.2f%s%s%s%s\n", "", tail->rmse * u,
+                r->table->y_unit, lc->aic_tail, tail->feasible ? "" : "  (infeasible)",
+                nested[0] ? "  (" : "", nested, nested[0] ? ")" : "");
         const char *why = r->law == CF_FAMILY_TAIL ? "asked for (--law conical-tail)"
                           : lc->chose_tail         ? "lower AIC"
                           : !tail->feasible        ? "the tailed spring is infeasible"
@@ -381,8 +386,11 @@ static void identifiable_text(FILE *o, const cf_fit_report *r)
     for (int i = 0; i < r->nfits; i++) {
         char cell[64];
         const cf_fit_result *f = &r->fits[i];
+        /* below 1 the data run past the spring's solid: not "close" to it */
         snprintf(cell, sizeof cell, "%.3g%s", f->solid_ratio,
-                 f->solid_ratio < CF_FIT_SOLID_RATIO_WARN ? " (close to solid!)" : "");
+                 f->solid_ratio < 1                       ? " (data past solid!)"
+                 : f->solid_ratio < CF_FIT_SOLID_RATIO_WARN ? " (close to solid!)"
+                                                            : "");
         fprintf(o, " %-24s", cell);
     }
     fputc('\n', o);

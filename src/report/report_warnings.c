@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "conifit/report.h"
+#include "report/report_words.h"
 
 /* The table softens: the conical law only stiffens. */
 static int softening_warning(const cf_fit_report *r, char *buf, size_t cap)
@@ -89,11 +90,14 @@ static int worse_than_linear(const cf_fit_report *r, int i, char *buf, size_t ca
     /* equal to rounding: the law stays in its first, linear region over the table (it is the
     ** line), which is said as such rather than as a loss to the line */
     const int same = fabs(rmse - lin->rmse) <= 1e-9 * lin->rmse;
-    if (!f->feasible || !(rmse > lin->rmse || same))
+    if (!lin->fitted || !(rmse > lin->rmse || same))
         return 0;
     const double u = r->table->y_to_file;
     char why[192];
-    worse_why(r, i, why, sizeof why);
+    if (f->feasible)
+        worse_why(r, i, why, sizeof why);
+    else
+        snprintf(why, sizeof why, " (and its spring is infeasible)");
     if (same)
         snprintf(buf, cap,
                  "the %s fit (%sRMSE %.4g %s) is no better than a straight line through the table: "
@@ -109,6 +113,60 @@ static int worse_than_linear(const cf_fit_report *r, int i, char *buf, size_t ca
     return 1;
 }
 
+/* A force-displacement table's spring placed far beyond the table's own scale: its largest size
+** (D2, H or the tail's length) over the table's largest |displacement| above this. */
+#define SCALE_WARN 100.0
+
+static int scale_warning(const cf_fit_report *r, int i, char *buf, size_t cap)
+{
+    const cf_fit_result *f = &r->fits[i];
+    if (!cf_table_is_force(r->table))
+        return 0;
+    double xmax = 0;
+    for (size_t k = 0; k < r->table->count; k++)
+        xmax = fmax(xmax, fabs(r->table->x[k]));
+    const cf_spring *p = &f->params;
+    const double size = fmax(fmax(p->D2_mm, p->H_mm), p->H_tail_mm);
+    if (!(xmax > 0) || !(size > SCALE_WARN * xmax))
+        return 0;
+    snprintf(buf, cap,
+             "the %s spring placed for this force-displacement table is %.3g times its largest "
+             "displacement (%.4g mm): D1 %.4g mm, D2 %.4g mm, d %.4g mm, H %.4g mm; the limits, "
+             "not the data, set its size, and no spring of the specimen's own scale was found: "
+             "read the law's quantities (rho, the travel, the solid load), not these dimensions",
+             cf_spring_type_name(f->type), size / xmax, xmax, p->D1_mm, p->D2_mm, p->d_mm,
+             p->H_mm);
+    return 1;
+}
+
+/* A fit through the lattice asked for (its mode, or --validate) that did not run: the numbers are
+** the single spring's, not the lattice's. */
+static int target_warning(const cf_fit_report *r, int i, char *buf, size_t cap)
+{
+    const cf_through_msm *t = &r->thr[i];
+    if (!r->through_msm || t->done)
+        return 0;
+    snprintf(buf, cap,
+             "the %s fit is of the single spring, not the lattice in %s: the fit through the "
+             "lattice did not run (%s)",
+             cf_spring_type_name(r->fits[i].type), cf_mode_name(r->table->mode),
+             t->note[0] ? t->note : r->val[i].note[0] ? r->val[i].note : "no reason given");
+    return 1;
+}
+
+/* The tailed law asked for whose search did no better than the conical law it contains: the
+** conical optimum with no tail is what is reported (cf_fit_tail_run). */
+static int nested_warning(const cf_fit_report *r, int i, char *buf, size_t cap)
+{
+    const cf_fit_result *f = &r->fits[i];
+    if (!f->tail || f->params.n_tail != 0)
+        return 0;
+    char why[320];
+    cf_report_nested(r, f, why, sizeof why);
+    snprintf(buf, cap, "the %s conical-tail fit has %s", cf_spring_type_name(f->type), why);
+    return 1;
+}
+
 int cf_report_warnings(const cf_fit_report *r, char (*out)[CF_REPORT_WARNING_LEN], int cap)
 {
     int n = 0;
@@ -119,6 +177,12 @@ int cf_report_warnings(const cf_fit_report *r, char (*out)[CF_REPORT_WARNING_LEN
             n += limit_cost_warning(r, i, out[n], CF_REPORT_WARNING_LEN);
         if (n < cap)
             n += worse_than_linear(r, i, out[n], CF_REPORT_WARNING_LEN);
+        if (n < cap)
+            n += scale_warning(r, i, out[n], CF_REPORT_WARNING_LEN);
+        if (n < cap)
+            n += target_warning(r, i, out[n], CF_REPORT_WARNING_LEN);
+        if (n < cap)
+            n += nested_warning(r, i, out[n], CF_REPORT_WARNING_LEN);
     }
     return n;
 }

@@ -70,6 +70,64 @@ void cf_report_interval_reason(const cf_fit_result *f, int k, char *buf, size_t 
     }
 }
 
+/* The limits that keep the law of fit g (its rho, B, A) from a spring of type t: 0 where one is
+** placed within them. A stress-strain table's spring is at (rho, B) with any free length; a force
+** table's free length H is free too (B/H and A/H^2 the stress-strain quantities), searched over
+** B/H in (0, 1). */
+static unsigned law_blocked_for(const cf_fit_report *r, const cf_fit_result *g, cf_spring_type t)
+{
+    const cf_fit_options *o = &r->fit_options;
+    const cf_ident_design d = {o->lower[CF_P_N], o->upper[CF_P_N], o->upper[CF_P_G],
+                               o->D2_over_H_max, o->index_max, o->rho_min};
+    const int fd = cf_table_is_force(r->table);
+    const double rho = g->ident.rho, B = g->ident.solid, A = g->ident.scale;
+    double best = INFINITY;
+    unsigned bits = 0;
+    const int steps = fd ? 400 : 1;
+    for (int k = 0; k < steps; k++) {
+        /* a force table: B/H from 1e-4 to 1 - 1e-4, logarithmically in B/H and in 1 - B/H */
+        const double q = (k + 0.5) / steps;
+        const double Bs = fd ? (q < 0.5 ? 1e-4 * pow(0.5e4, 2 * q) : 1 - 1e-4 * pow(0.5e4, 2 * (1 - q)))
+                             : B;
+        const double H = fd ? B / Bs : 1, As = A / (H * H);
+        const cf_ident_region reg = cf_ident_region_at(&d, t, rho, Bs, 0);
+        if (reg.margin <= 0 && As <= reg.A_max * (1 + 1e-9))
+            return 0;
+        /* the nearest miss: outside the region by the least, or inside it with too large a load */
+        const double miss = reg.margin > 0 ? reg.margin + 100 : log(As / reg.A_max);
+        if (miss < best) {
+            best = miss;
+            bits = reg.margin > 0 ? reg.lo_bit | reg.hi_bit : CF_C_G_MAX;
+        }
+    }
+    return bits;
+}
+
+void cf_report_nested(const cf_fit_report *r, const cf_fit_result *f, char *buf, size_t cap)
+{
+    size_t n = 0;
+    buf[0] = '\0';
+    if (!f->tail || f->params.n_tail != 0)
+        return;
+    const double u = r->table->y_to_file;
+    cf_report_append(buf, cap, &n, "no tail: the conical optimum the tailed law contains, since ");
+    if (!(f->nested_rmse > 0)) {
+        cf_report_append(buf, cap, &n, "the tailed search found no spring");
+        return;
+    }
+    cf_report_append(buf, cap, &n, "the tailed spring its search ended on (RMSE %.4g %s) ",
+                     f->nested_rmse * u, r->table->y_unit);
+    const unsigned v = f->nested_violated;
+    if (!v) {
+        cf_report_append(buf, cap, &n, "fits worse");
+        return;
+    }
+    cf_report_append(buf, cap, &n, "breaks the limit%s", (v & (v - 1)) ? "s" : "");
+    for (int b = 0; b < CF_C_COUNT; b++)
+        if (v & (1u << b))
+            cf_report_append(buf, cap, &n, " %s", cf_fit_constraint_name(1u << b));
+}
+
 /* The one sentence that compares the two types (both fitted, at least one feasible). */
 void cf_report_verdict(const cf_fit_report *r, char *buf, size_t cap)
 {
@@ -107,10 +165,50 @@ void cf_report_verdict(const cf_fit_report *r, char *buf, size_t cap)
         "the better one's, above the F-test threshold %.3g at 95 %%); ",
         cf_spring_type_name(g->type), g->rmse * u, w->rmse * u, r->table->y_unit,
         cf_spring_type_name(w->type), v.delta_rss / base, v.threshold / base);
-    if (v.held) {
+    const cf_law_choice *lw = &r->law_choice[1 - v.better];
+    unsigned blocked = 0;
+    if (lw->ran && !lw->chose_tail && g->tail) {
+        /* the law choice decided: the better type keeps the tailed law, the other the conical */
+        cf_report_append(buf, cap, &n, "%s keeps the conical law (the better one the "
+                                       "conical-tail law): its conical-tail fit ",
+                         cf_spring_type_name(w->type));
+        /* its tailed spring broke limits: infeasible, or held at no tail by them (tail.h,
+        ** cf_tail_nest) */
+        const cf_fit_result *wt = &lw->other;
+        const unsigned lim = !wt->feasible           ? wt->violated
+                             : wt->params.n_tail == 0 ? wt->nested_violated
+                                                      : 0;
+        if (lim) {
+            cf_report_append(buf, cap, &n, "is excluded by the limit%s",
+                             (lim & (lim - 1)) ? "s" : "");
+            for (int b = 0; b < CF_C_COUNT; b++)
+                if (lim & (1u << b))
+                    cf_report_append(buf, cap, &n, " %s", cf_fit_constraint_name(1u << b));
+        } else {
+            cf_report_append(buf, cap, &n, "does not lower its AIC");
+        }
+        if (w->held) {
+            cf_report_append(buf, cap, &n, "; its conical fit is held by");
+            for (int b = 0; b < CF_C_COUNT; b++)
+                if (w->held & (1u << b))
+                    cf_report_append(buf, cap, &n, " %s", cf_fit_constraint_name(1u << b));
+        }
+    } else if (v.held) {
         cf_report_append(buf, cap, &n, "%s is held back by", cf_spring_type_name(w->type));
         for (int b = 0; b < CF_C_COUNT; b++)
             if (v.held & (1u << b))
+                cf_report_append(buf, cap, &n, " %s", cf_fit_constraint_name(1u << b));
+    } else if (g->tail == w->tail && !g->tail && (blocked = law_blocked_for(r, g, w->type))) {
+        /* no limit holds the worse fit where it ended, but the better one's law is no spring of
+        ** the worse type: the limits there decide */
+        cf_report_append(buf, cap, &n,
+                         "no limit of %s is active where its fit ended, but the law %s fits "
+                         "(rho %.4g) is no %s spring within the limit%s",
+                         cf_spring_type_name(w->type), cf_spring_type_name(g->type),
+                         g->ident.rho, cf_spring_type_name(w->type),
+                         (blocked & (blocked - 1)) ? "s" : "");
+        for (int b = 0; b < CF_C_COUNT; b++)
+            if (blocked & (1u << b))
                 cf_report_append(buf, cap, &n, " %s", cf_fit_constraint_name(1u << b));
     } else {
         cf_report_append(buf, cap, &n,

@@ -34,6 +34,10 @@ void cf_report_ident_cell(const cf_fit_result *f, int k, double scale, const cha
 /* The one sentence that compares the two types (both fitted, at least one feasible). */
 void cf_report_verdict(const cf_fit_report *r, char *buf, size_t cap);
 
+/* Why a conical-tail fit f of report r has no tail (it is the conical optimum it contains:
+** fit.h, nested_rmse), in one sentence; "" for any other fit. */
+void cf_report_nested(const cf_fit_report *r, const cf_fit_result *f, char *buf, size_t cap);
+
 /* Where table t's stress and strain measures and its mode came from, one phrase each. */
 void cf_report_sources(const cf_table *t, char src[3][128]);
 

@@ -175,6 +175,11 @@ typedef struct cf_fit_result {
     double e_tail_interval[2];
     unsigned e_tail_interval_end[2];
     unsigned e_tail_interval_why;
+    /* A conical-tail fit that is the conical optimum it contains (tail 1, n_tail 0; fit_tail.c):
+    ** the tailed spring its search ended on lost to it, with this RMSE (0: the search found none)
+    ** and these violated CF_C_* bits (0: it was feasible but fitted worse). */
+    double nested_rmse;
+    unsigned nested_violated;
 } cf_fit_result;
 
 /* Extra bit in interval_why: the Jacobian of the three quantities is (numerically) singular. */
@@ -211,8 +216,11 @@ cf_status cf_fit_run_shared(const cf_table *data, const cf_fit_options *opt, cf_
 /* Fits the conical-tail law (one type): its four identifiable quantities by a grid and
 ** Levenberg-Marquardt, their standard errors, and a spring of the type placed in closed form at
 ** the preferred free length (src/fit/fit_tail.c). plain (may be NULL) is the plain law's fit of the
-** same table and type, a start. Fixed parameters are not honoured (the CLI refuses them). A spring
-** that cannot meet the limits is returned with feasible = 0 and the violated bits. */
+** same table and type, a start; the tailed law contains it (tail compliance 0), so a tailed fit
+** that ends worse than plain (infeasible where plain is feasible, or a larger objective) or finds
+** nothing is returned as plain with no tail (tail 1, e_tail 0, n_tail 0). Fixed parameters are
+** not honoured (the CLI refuses them). A spring that cannot meet the limits is returned with
+** feasible = 0 and the violated bits. */
 cf_status cf_fit_tail_run(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                           const cf_fit_result *plain, cf_fit_result *res, cf_error *err);
 
@@ -267,6 +275,10 @@ const char *cf_fit_constraint_name(unsigned bit);
 
 /* The command-line flag that widens constraint bit (a sentence for the limits no flag widens). */
 const char *cf_fit_constraint_flag(unsigned bit);
+
+/* The same for a table of the kind given (force_displacement 1: its sentences speak of
+** displacements, not strains). */
+const char *cf_fit_constraint_flag_for(unsigned bit, int force_displacement);
 
 /* o with the design limits among bits (CF_C_INDEX_MAX, CF_C_RHO_MIN, CF_C_COILS_MAX, CF_C_G_MAX,
 ** CF_C_D2_H) widened to the widest their flags accept (CF_FIT_*_LIMIT); returns the bits widened

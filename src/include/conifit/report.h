@@ -53,7 +53,7 @@ typedef struct cf_fit_report {
 
 /* Longest warning sentence, and the most a report states. */
 #define CF_REPORT_WARNING_LEN 512
-#define CF_REPORT_WARNINGS_MAX 8
+#define CF_REPORT_WARNINGS_MAX 12
 
 /* The sentences saying what the model cannot follow in the table (softening, a design limit that
 ** costs fit quality), at most cap of them into out; returns how many. The text report lists them
