@@ -26,7 +26,7 @@ PKGS    := nlopt gsl jansson
 TESTPKGS := cmocka libxml-2.0
 DEBS    := build-essential pkg-config libnlopt-dev libgsl-dev libcmocka-dev libjansson-dev \
            libsuitesparse-dev libmumps-seq-dev libopenblas0-serial libxml2-dev gnuplot-nox calculix-ccx clang \
-           libclang-rt-dev
+           libclang-rt-dev libgmsh-dev python3-vtk9
 BUILD   ?= build
 SIMD    ?=
 
@@ -47,7 +47,7 @@ SPARSE_CFLAGS := $(shell pkg-config --cflags CHOLMOD 2>/dev/null || echo -I/usr/
 # MUMPS (sequential build: L D L^T of indefinite tangents) likewise has no pkg-config file.
 SPARSE_CFLAGS += -I/usr/include/mumps_seq
 SPARSE_LIBS   := $(shell pkg-config --libs CHOLMOD 2>/dev/null || echo -lcholmod) \
-                 -ldmumps_seq -lmumps_common_seq -lmpiseq_seq -lpord_seq
+                 -ldmumps_seq -lmumps_common_seq -lmpiseq_seq -lpord_seq -lgmsh
 CFLAGS  += -std=c17 $(OPT) -fopenmp $(WARN) $(shell pkg-config --cflags $(PKGS) 2>/dev/null) $(SPARSE_CFLAGS)
 LDLIBS  += $(shell pkg-config --libs $(PKGS) 2>/dev/null) $(SPARSE_LIBS) -fopenmp -lm -lpthread
 
@@ -91,6 +91,7 @@ check-deps:
 	@missing=""; for p in $(PKGS) $(TESTPKGS); do pkg-config --exists $$p 2>/dev/null || missing="$$missing $$p"; done; \
 	printf '#include <cholmod.h>\n' | $(CC) $(SPARSE_CFLAGS) -E - >/dev/null 2>&1 || missing="$$missing cholmod"; \
 	printf '#include <dmumps_c.h>\n' | $(CC) $(SPARSE_CFLAGS) -E - >/dev/null 2>&1 || missing="$$missing mumps"; \
+	printf '#include <gmshc.h>\n' | $(CC) -E - >/dev/null 2>&1 || missing="$$missing gmsh"; \
 	if [ -n "$$missing" ]; then \
 	  echo "conifit: missing libraries:$$missing. Install them with:" >&2; \
 	  echo "  apt-get update && apt-get install -y $(DEBS)   (or: make deps, as root)" >&2; exit 1; fi

@@ -1,0 +1,24 @@
+/*
+** Reading volume meshes for bodies (body.h) with Gmsh's library, and meshing a box with it.
+*/
+#ifndef CF_MESH_H
+#define CF_MESH_H
+
+#include "conifit/body.h"
+#include "conifit/error.h"
+
+/* Reads the volume mesh at path (any format Gmsh opens; .msh of every version) into m: its
+** tetrahedra, and each hexahedron as six tetrahedra; higher-order elements by their corners.
+** Coordinates are multiplied by unit_mm. Nodes that no volume element uses are dropped. The mesh
+** is checked (cf_mesh_check). CF_E_NOINPUT when the file cannot be opened, CF_E_DATA for a file
+** Gmsh cannot read, a mesh with no volume elements, another kind of volume element, or a
+** degenerate or inverted element (the message names the file and the element's number). */
+cf_status cf_mesh_read(const char *path, double unit_mm, cf_mesh *m, cf_error *err);
+
+/* Meshes the box lo..hi (mm) into tetrahedra with Gmsh (Delaunay, seed fixed): element size
+** size_near at the point focus, growing by `growth` mm per mm of distance from it, at most
+** size_far. CF_E_DATA for a bad box or sizes. */
+cf_status cf_mesh_box(const double lo[3], const double hi[3], const double focus[3],
+                      double size_near, double size_far, double growth, cf_mesh *m, cf_error *err);
+
+#endif
