@@ -47,7 +47,9 @@ SPARSE_CFLAGS := $(shell pkg-config --cflags CHOLMOD 2>/dev/null || echo -I/usr/
 # MUMPS (sequential build: L D L^T of indefinite tangents) likewise has no pkg-config file.
 SPARSE_CFLAGS += -I/usr/include/mumps_seq
 SPARSE_LIBS   := $(shell pkg-config --libs CHOLMOD 2>/dev/null || echo -lcholmod) \
-                 -ldmumps_seq -lmumps_common_seq -lmpiseq_seq -lpord_seq -lgmsh
+                 -ldmumps_seq -lmumps_common_seq -lmpiseq_seq -lpord_seq
+# Gmsh (volume meshes of tissue bodies): Debian's libgmsh-dev has no pkg-config file either.
+SPARSE_LIBS   += -lgmsh
 CFLAGS  += -std=c17 $(OPT) -fopenmp $(WARN) $(shell pkg-config --cflags $(PKGS) 2>/dev/null) $(SPARSE_CFLAGS)
 LDLIBS  += $(shell pkg-config --libs $(PKGS) 2>/dev/null) $(SPARSE_LIBS) -fopenmp -lm -lpthread
 

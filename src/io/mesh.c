@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include <gmshc.h>
 
@@ -211,9 +212,28 @@ end:
     return st;
 }
 
+/* The mesh formats read (by the name's ending, which is how Gmsh chooses its reader): files of
+** data only. Gmsh opens any other name as a script of its own language, which can run commands,
+** so no other name is passed to it (input is data, never code). */
+static const char *const mesh_exts[] = {".msh", ".mesh", ".vtk", ".unv", ".bdf", ".nas", NULL};
+
+static int mesh_ext_ok(const char *path)
+{
+    size_t n = strlen(path);
+    for (size_t k = 0; mesh_exts[k]; k++) {
+        size_t e = strlen(mesh_exts[k]);
+        if (n > e && strcasecmp(path + n - e, mesh_exts[k]) == 0)
+            return 1;
+    }
+    return 0;
+}
+
 cf_status cf_mesh_read(const char *path, double unit_mm, cf_mesh *m, cf_error *err)
 {
     memset(m, 0, sizeof *m);
+    if (!mesh_ext_ok(path))
+        return cf_error_set(err, CF_E_DATA, "%s: not a mesh file name: expected .msh, .mesh, "
+                            ".vtk, .unv, .bdf or .nas (Gmsh's mesh formats)", path);
     if (!(unit_mm > 0) || !isfinite(unit_mm))
         return cf_error_set(err, CF_E_DATA, "%s: unit %g mm: must be finite and > 0", path, unit_mm);
     FILE *f = fopen(path, "rb");
@@ -228,10 +248,16 @@ cf_status cf_mesh_read(const char *path, double unit_mm, cf_mesh *m, cf_error *e
         st = cf_error_set(err, CF_E_INTERNAL, "%s: Gmsh could not start", path);
     } else {
         gmshOpen(path, &ierr);
-        st = ierr ? cf_error_set(err, CF_E_DATA, "%s: not a mesh Gmsh reads: %s", path,
-                                 gmsh_reason(why, sizeof why))
-                  : extract(path, unit_mm, m, err);
-        gmshClear(&ierr);
+        if (ierr) {
+            st = cf_error_set(err, CF_E_DATA, "%s: not a mesh Gmsh reads: %s", path,
+                              gmsh_reason(why, sizeof why));
+            /* Gmsh keeps a failed read's state: the next model would be empty; start afresh */
+            gmshFinalize(&ierr);
+            gmsh_ready = 0;
+        } else {
+            st = extract(path, unit_mm, m, err);
+            gmshClear(&ierr);
+        }
     }
     pthread_mutex_unlock(&gmsh_lock);
     if (st == CF_OK && (st = cf_mesh_check(m, path, err)) != CF_OK)

@@ -351,14 +351,18 @@ long cf_body_probe_inside(const cf_body *b, const cf_probe *probe)
     return -1;
 }
 
-/* The sparse pattern of the tangent: 3 x 3 blocks for every node with itself and with every node
-** it shares a spring with (a tetrahedron's four nodes are all joined by springs). */
+/* The sparse pattern of the tangent in 3 x 3 blocks: column node j holds the blocks of the nodes
+** in nb[nbp[j] .. nbp[j + 1]) (sorted, j among them): the nodes of the tetrahedra around j (its
+** springs' other ends), and with a volume term those of the tetrahedra around each of these (the
+** nodal volume couples every pair of nodes around one node). */
 typedef struct pattern {
     size_t n;              /* 3 nn */
     int *colptr, *rowidx;
     double *val;
-    size_t *pos_ii;        /* per node: offset of its own block in its column */
-    size_t *pos_ij, *pos_ji; /* per spring: block (si row, sj col) and (sj row, si col) */
+    size_t *nbp;           /* nn + 1 */
+    uint32_t *nb;
+    size_t *tp;            /* tetrahedra around each node: tl[tp[a] .. tp[a + 1]) */
+    uint32_t *tl;
 } pattern;
 
 static void pattern_free(pattern *P)
@@ -366,66 +370,117 @@ static void pattern_free(pattern *P)
     free(P->colptr);
     free(P->rowidx);
     free(P->val);
-    free(P->pos_ii);
-    free(P->pos_ij);
-    free(P->pos_ji);
+    free(P->nbp);
+    free(P->nb);
+    free(P->tp);
+    free(P->tl);
+}
+
+/* Block index of row node i in column node j's columns (i must be in the pattern). */
+static size_t blk_of(const pattern *P, size_t j, size_t i)
+{
+    size_t lo = P->nbp[j], hi = P->nbp[j + 1];
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (P->nb[mid] < i)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo - P->nbp[j];
+}
+
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
 }
 
 static int pattern_build(const cf_body *b, pattern *P)
 {
     memset(P, 0, sizeof *P);
-    const size_t nn = b->nn;
-    size_t *deg = calloc(nn + 1, sizeof *deg), *fillp = NULL;
+    const size_t nn = b->nn, nt = b->nt;
+    const int two = b->kappa_MPa > 0;
     P->n = 3 * nn;
-    P->colptr = malloc((3 * nn + 1) * sizeof *P->colptr);
-    P->pos_ii = malloc(nn * sizeof *P->pos_ii);
-    P->pos_ij = malloc(b->ns * sizeof *P->pos_ij);
-    P->pos_ji = malloc(b->ns * sizeof *P->pos_ji);
-    if (!deg || !P->colptr || !P->pos_ii || !P->pos_ij || !P->pos_ji)
+    P->tp = calloc(nn + 1, sizeof *P->tp);
+    P->tl = malloc(4 * nt * sizeof *P->tl);
+    P->nbp = malloc((nn + 1) * sizeof *P->nbp);
+    uint32_t *mark = malloc(nn * sizeof *mark), *list = NULL;
+    size_t cap = 0, nnb = 0;
+    if (!P->tp || !P->tl || !P->nbp || !mark)
         goto fail;
-    for (size_t s = 0; s < b->ns; s++) {
-        deg[b->si[s]]++;
-        deg[b->sj[s]]++;
+    for (size_t t = 0; t < nt; t++)
+        for (int k = 0; k < 4; k++)
+            P->tp[b->tet[4 * t + k] + 1]++;
+    for (size_t a = 0; a < nn; a++)
+        P->tp[a + 1] += P->tp[a];
+    size_t *fill = malloc(nn * sizeof *fill);
+    if (!fill)
+        goto fail;
+    memcpy(fill, P->tp, nn * sizeof *fill);
+    for (size_t t = 0; t < nt; t++)
+        for (int k = 0; k < 4; k++)
+            P->tl[fill[b->tet[4 * t + k]]++] = (uint32_t)t;
+    free(fill);
+    for (size_t a = 0; a < nn; a++)
+        mark[a] = UINT32_MAX;
+    /* the neighbours of each node: its ring, or the rings of its ring's nodes */
+    P->nbp[0] = 0;
+    for (size_t j = 0; j < nn; j++) {
+        size_t start = nnb;
+#define ADD_NODE(q)                                                                                 \
+    do {                                                                                            \
+        uint32_t q_ = (q);                                                                          \
+        if (mark[q_] != (uint32_t)j) {                                                              \
+            mark[q_] = (uint32_t)j;                                                                 \
+            if (nnb == cap) {                                                                       \
+                size_t nc = cap ? 2 * cap : 64 * nn + 64;                                           \
+                uint32_t *nl = realloc(list, nc * sizeof *nl);                                      \
+                if (!nl)                                                                            \
+                    goto fail;                                                                      \
+                list = nl;                                                                          \
+                cap = nc;                                                                           \
+            }                                                                                       \
+            list[nnb++] = q_;                                                                       \
+        }                                                                                           \
+    } while (0)
+        ADD_NODE((uint32_t)j);
+        for (size_t k = P->tp[j]; k < P->tp[j + 1]; k++)
+            for (int c = 0; c < 4; c++) {
+                uint32_t a = b->tet[4 * P->tl[k] + c];
+                ADD_NODE(a);
+                if (two)
+                    for (size_t k2 = P->tp[a]; k2 < P->tp[a + 1]; k2++)
+                        for (int c2 = 0; c2 < 4; c2++)
+                            ADD_NODE(b->tet[4 * P->tl[k2] + c2]);
+            }
+#undef ADD_NODE
+        qsort(list + start, nnb - start, sizeof *list, cmp_u32);
+        P->nbp[j + 1] = nnb;
     }
-    /* column 3j + c holds 3 (deg_j + 1) rows: node j's block first, then its neighbours' */
+    P->nb = list;
+    list = NULL;
+    if (9 * nnb > 2147483647u)
+        goto fail;
+    P->colptr = malloc((3 * nn + 1) * sizeof *P->colptr);
+    P->rowidx = malloc(9 * nnb * sizeof *P->rowidx);
+    P->val = malloc(9 * nnb * sizeof *P->val);
+    if (!P->colptr || !P->rowidx || !P->val)
+        goto fail;
     size_t nnz = 0;
     P->colptr[0] = 0;
     for (size_t j = 0; j < nn; j++)
         for (int c = 0; c < 3; c++) {
-            nnz += 3 * (deg[j] + 1);
-            if (nnz > 2147483647u)
-                goto fail;
+            for (size_t k = P->nbp[j]; k < P->nbp[j + 1]; k++)
+                for (int a = 0; a < 3; a++)
+                    P->rowidx[nnz++] = (int)(3 * P->nb[k] + (size_t)a);
             P->colptr[3 * j + c + 1] = (int)nnz;
         }
-    P->rowidx = malloc(nnz * sizeof *P->rowidx);
-    P->val = malloc(nnz * sizeof *P->val);
-    fillp = calloc(nn, sizeof *fillp); /* blocks placed so far in each node's columns */
-    if (!P->rowidx || !P->val || !fillp)
-        goto fail;
-    for (size_t j = 0; j < nn; j++) {
-        P->pos_ii[j] = 0;
-        for (int c = 0; c < 3; c++)
-            for (int a = 0; a < 3; a++)
-                P->rowidx[P->colptr[3 * j + c] + a] = (int)(3 * j + a);
-        fillp[j] = 1;
-    }
-    for (size_t s = 0; s < b->ns; s++) {
-        size_t i = b->si[s], j = b->sj[s];
-        size_t bj = fillp[j]++, bi = fillp[i]++;
-        P->pos_ij[s] = bj; /* row node i in column node j */
-        P->pos_ji[s] = bi;
-        for (int c = 0; c < 3; c++)
-            for (int a = 0; a < 3; a++) {
-                P->rowidx[P->colptr[3 * j + c] + 3 * bj + a] = (int)(3 * i + a);
-                P->rowidx[P->colptr[3 * i + c] + 3 * bi + a] = (int)(3 * j + a);
-            }
-    }
-    free(deg);
-    free(fillp);
+    free(mark);
     return 1;
 fail:
-    free(deg);
-    free(fillp);
+    free(mark);
+    free(list);
     pattern_free(P);
     return 0;
 }
@@ -438,6 +493,114 @@ static void add_block(pattern *P, size_t col, size_t blk, const double B[9])
         for (int a = 0; a < 3; a++)
             v[a] += B[3 * a + c];
     }
+}
+
+/* The volume of tetrahedron t at positions x and its gradient dV[4][3]. */
+static double tet_dV(const cf_body *b, const double *x, size_t t, double dV[4][3])
+{
+    const uint32_t *v = b->tet + 4 * t;
+    const double *p0 = x + 3 * v[0];
+    double e[3][3];
+    for (int m = 0; m < 3; m++)
+        for (int a = 0; a < 3; a++)
+            e[m][a] = x[3 * v[m + 1] + a] - p0[a];
+    for (int m = 0; m < 3; m++) {
+        const double *p = e[(m + 1) % 3], *q = e[(m + 2) % 3];
+        dV[m + 1][0] = (p[1] * q[2] - p[2] * q[1]) / 6;
+        dV[m + 1][1] = (p[2] * q[0] - p[0] * q[2]) / 6;
+        dV[m + 1][2] = (p[0] * q[1] - p[1] * q[0]) / 6;
+    }
+    for (int a = 0; a < 3; a++)
+        dV[0][a] = -(dV[1][a] + dV[2][a] + dV[3][a]);
+    return e[0][0] * dV[1][0] + e[0][1] * dV[1][1] + e[0][2] * dV[1][2];
+}
+
+/* The volume term, averaged over nodes: each node a owns a quarter of the volume of every
+** tetrahedron around it, V_a and V0_a, and stores V0_a (kappa/2)(J_a - 1)^2 with J_a = V_a/V0_a
+** (the average nodal pressure tetrahedron of Bonet & Burton 1998, Commun Numer Meth Engng
+** 14:437-449: one volume constraint per node instead of per element, which keeps linear
+** tetrahedra from locking as nu approaches 1/2). Adds its gradient to g and, when P is not NULL,
+** its Gauss-Newton tangent sum_a (kappa/V0_a) dV_a dV_a^T (the term in (J_a - 1) d2V_a is left
+** out: Newton then converges linearly where J is far from 1, to the same state). Returns 0 when
+** memory runs out. */
+static int volume_term(const cf_body *b, const double *x, double *g, pattern *P)
+{
+    const size_t nn = b->nn, nt = b->nt;
+    double *Vn = calloc(nn, sizeof *Vn), *V0n = calloc(nn, sizeof *V0n);
+    double *w = NULL;
+    uint32_t *loc = NULL, *ring = NULL;
+    int ok = 0;
+    if (!Vn || !V0n)
+        goto end;
+    for (size_t t = 0; t < nt; t++) {
+        double dV[4][3];
+        double V = tet_dV(b, x, t, dV);
+        for (int k = 0; k < 4; k++) {
+            Vn[b->tet[4 * t + k]] += V / 4;
+            V0n[b->tet[4 * t + k]] += b->V0[t] / 4;
+        }
+    }
+    for (size_t t = 0; t < nt; t++) {
+        double dV[4][3], f = 0;
+        tet_dV(b, x, t, dV);
+        for (int k = 0; k < 4; k++) {
+            size_t a = b->tet[4 * t + k];
+            f += b->kappa_MPa * (Vn[a] / V0n[a] - 1) / 4;
+        }
+        for (int m = 0; m < 4; m++)
+            for (int a = 0; a < 3; a++)
+                g[3 * b->tet[4 * t + m] + a] += f * dV[m][a];
+    }
+    if (P) {
+        loc = malloc(nn * sizeof *loc);
+        size_t maxring = 0;
+        for (size_t a = 0; a < nn; a++)
+            maxring = P->tp[a + 1] - P->tp[a] > maxring ? P->tp[a + 1] - P->tp[a] : maxring;
+        ring = malloc((4 * maxring + 1) * sizeof *ring);
+        w = malloc(3 * (4 * maxring + 1) * sizeof *w);
+        if (!loc || !ring || !w)
+            goto end;
+        for (size_t a = 0; a < nn; a++)
+            loc[a] = UINT32_MAX;
+        for (size_t a = 0; a < nn; a++) {
+            size_t nr = 0;
+            for (size_t k = P->tp[a]; k < P->tp[a + 1]; k++) {
+                size_t t = P->tl[k];
+                double dV[4][3];
+                tet_dV(b, x, t, dV);
+                for (int m = 0; m < 4; m++) {
+                    uint32_t q = b->tet[4 * t + m];
+                    if (loc[q] == UINT32_MAX) {
+                        loc[q] = (uint32_t)nr;
+                        ring[nr] = q;
+                        w[3 * nr] = w[3 * nr + 1] = w[3 * nr + 2] = 0;
+                        nr++;
+                    }
+                    for (int c = 0; c < 3; c++)
+                        w[3 * loc[q] + c] += dV[m][c] / 4;
+                }
+            }
+            const double kk = b->kappa_MPa / V0n[a];
+            for (size_t cq = 0; cq < nr; cq++)
+                for (size_t rq = 0; rq < nr; rq++) {
+                    double B[9];
+                    for (int r = 0; r < 3; r++)
+                        for (int c = 0; c < 3; c++)
+                            B[3 * r + c] = kk * w[3 * rq + r] * w[3 * cq + c];
+                    add_block(P, ring[cq], blk_of(P, ring[cq], ring[rq]), B);
+                }
+            for (size_t q = 0; q < nr; q++)
+                loc[ring[q]] = UINT32_MAX;
+        }
+    }
+    ok = 1;
+end:
+    free(Vn);
+    free(V0n);
+    free(w);
+    free(loc);
+    free(ring);
+    return ok;
 }
 
 /* Energy gradient g (3 nn) and, when P is not NULL, the tangent at positions x; contact forces of
@@ -469,60 +632,13 @@ static double assemble(const cf_body *b, const double *x, const cf_probe *pr, co
                 B[3 * a + q] = (kax - geo) * n[a] * n[q] + (a == q ? geo : 0);
                 Bn[3 * a + q] = -B[3 * a + q];
             }
-        add_block(P, i, P->pos_ii[i], B);
-        add_block(P, j, P->pos_ii[j], B);
-        add_block(P, j, P->pos_ij[s], Bn);
-        add_block(P, i, P->pos_ji[s], Bn);
+        add_block(P, i, blk_of(P, i, i), B);
+        add_block(P, j, blk_of(P, j, j), B);
+        add_block(P, j, blk_of(P, j, i), Bn);
+        add_block(P, i, blk_of(P, i, j), Bn);
     }
-    if (b->kappa_MPa > 0)
-        for (size_t t = 0; t < b->nt; t++) {
-            const uint32_t *v = b->tet + 4 * t;
-            const double *p0 = x + 3 * v[0];
-            double e[3][3], dV[4][3];
-            for (int m = 0; m < 3; m++)
-                for (int a = 0; a < 3; a++)
-                    e[m][a] = x[3 * v[m + 1] + a] - p0[a];
-            for (int m = 0; m < 3; m++) {
-                const double *p = e[(m + 1) % 3], *q = e[(m + 2) % 3];
-                dV[m + 1][0] = (p[1] * q[2] - p[2] * q[1]) / 6;
-                dV[m + 1][1] = (p[2] * q[0] - p[0] * q[2]) / 6;
-                dV[m + 1][2] = (p[0] * q[1] - p[1] * q[0]) / 6;
-            }
-            for (int a = 0; a < 3; a++)
-                dV[0][a] = -(dV[1][a] + dV[2][a] + dV[3][a]);
-            double V = e[0][0] * dV[1][0] + e[0][1] * dV[1][1] + e[0][2] * dV[1][2];
-            double J = V / b->V0[t], f = b->kappa_MPa * (J - 1);
-            for (int m = 0; m < 4; m++)
-                for (int a = 0; a < 3; a++)
-                    g[3 * v[m] + a] += f * dV[m][a];
-            if (!P)
-                continue;
-            /* the Gauss-Newton part kappa/V0 dV dV^T (the term in (J - 1) d2V is left out:
-            ** Newton then converges linearly where J is far from 1, still to the same state) */
-            const double kk = b->kappa_MPa / b->V0[t];
-            for (int m = 0; m < 4; m++)
-                for (int q = 0; q < 4; q++) {
-                    double B[9];
-                    for (int a = 0; a < 3; a++)
-                        for (int r = 0; r < 3; r++)
-                            B[3 * a + r] = kk * dV[m][a] * dV[q][r];
-                    size_t col = v[q], row = v[m], blk = SIZE_MAX;
-                    if (row == col) {
-                        blk = P->pos_ii[col];
-                    } else {
-                        /* the block of the spring between row and col */
-                        int *ri = P->rowidx + P->colptr[3 * col];
-                        size_t nb = (size_t)(P->colptr[3 * col + 1] - P->colptr[3 * col]) / 3;
-                        for (size_t k2 = 1; k2 < nb; k2++)
-                            if ((size_t)ri[3 * k2] == 3 * row) {
-                                blk = k2;
-                                break;
-                            }
-                    }
-                    if (blk != SIZE_MAX)
-                        add_block(P, col, blk, B);
-                }
-        }
+    if (b->kappa_MPa > 0 && !volume_term(b, x, g, P))
+        return NAN;
     double force = 0;
     int nc = 0;
     if (pr && c && active)
@@ -542,7 +658,7 @@ static double assemble(const cf_body *b, const double *x, const cf_probe *pr, co
             for (int a = 0; a < 3; a++)
                 for (int q = 0; q < 3; q++)
                     B[3 * a + q] = kp * ((1 + curv) * nrm[a] * nrm[q] - (a == q ? curv : 0));
-            add_block(P, i, P->pos_ii[i], B);
+            add_block(P, i, blk_of(P, i, i), B);
         }
     if (contacts)
         *contacts = nc;
@@ -569,9 +685,11 @@ static void apply_fixed(const cf_body *b, pattern *P, double *g)
     }
 }
 
-void cf_body_internal_force(const cf_body *b, double *g)
+cf_status cf_body_internal_force(const cf_body *b, double *g, cf_error *err)
 {
-    assemble(b, b->x, NULL, NULL, 0, NULL, g, NULL, NULL);
+    if (isnan(assemble(b, b->x, NULL, NULL, 0, NULL, g, NULL, NULL)))
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's forces");
+    return CF_OK;
 }
 
 /* 1 when positions x invert no tetrahedron and take no spring to solid. */
@@ -635,9 +753,13 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
         int conv = 0;
         for (int k = 0; k < 100 && !conv; k++, it++) {
             force = assemble(b, b->x, probe, c, kp, active, g, &P, &contacts);
+            if (isnan(force)) {
+                st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's tangent");
+                goto end;
+            }
             apply_fixed(b, &P, g);
             double r = norm_inf(g, n);
-            if (r <= 1e-10 * fscale) {
+            if (r <= 1e-8 * fscale) {
                 conv = 1;
                 break;
             }

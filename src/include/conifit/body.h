@@ -21,9 +21,11 @@
 ** tetrahedron's six directions cannot be isotropic, the mesh's volume-averaged tensor is then
 ** projected on the isotropic tensors and every c scaled once so that its shear modulus is mu.
 **
-** The volume term. Each tetrahedron stores W = V0 (kappa/2)(J - 1)^2, J = V/V0 its volume ratio:
-** it adds kappa to lambda and nothing to mu, so nu = (mu + kappa)/(2 (2 mu + kappa)), the same
-** term and formula as the homogenised cell's. A scene gives kappa ("volume_modulus_MPa") or nu
+** The volume term. W = V0 (kappa/2)(J - 1)^2 per unit reference volume V0, J its volume ratio,
+** the same term as the homogenised cell's: it adds kappa to lambda and nothing to mu, so
+** nu = (mu + kappa)/(2 (2 mu + kappa)). J is taken per node (a quarter of the volume of every
+** tetrahedron around it; Bonet & Burton 1998), so that linear tetrahedra do not lock as nu nears
+** 1/2; each tetrahedron's own J is reported. A scene gives kappa ("volume_modulus_MPa") or nu
 ** ("poisson_ratio", 0.25 <= nu < 0.5, kappa = mu (4 nu - 1)/(1 - 2 nu)).
 **
 ** Units: mm, N, MPa. Sign: the probe's force is positive pushing into the body.
@@ -142,8 +144,9 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
                         double penalty_N_per_mm, cf_body_step *out, cf_error *err);
 
 /* The body's elastic forces on its nodes at the current positions (the gradient of its energy,
-** N; g has 3 nn entries): at a held component, minus the support's reaction. */
-void cf_body_internal_force(const cf_body *b, double *g);
+** N; g has 3 nn entries): at a held component, minus the support's reaction. CF_E_INTERNAL when
+** memory runs out. */
+cf_status cf_body_internal_force(const cf_body *b, double *g, cf_error *err);
 
 /* Index of a node inside the probe at depth 0 (the probe starts inside the body), or -1. */
 long cf_body_probe_inside(const cf_body *b, const cf_probe *probe);

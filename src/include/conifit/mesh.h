@@ -7,7 +7,8 @@
 #include "conifit/body.h"
 #include "conifit/error.h"
 
-/* Reads the volume mesh at path (any format Gmsh opens; .msh of every version) into m: its
+/* Reads the volume mesh at path (Gmsh's mesh formats: .msh of every version, .mesh, .vtk, .unv,
+** .bdf, .nas; a name with another ending is refused, since Gmsh would run it as a script) into m: its
 ** tetrahedra, and each hexahedron as six tetrahedra; higher-order elements by their corners.
 ** Coordinates are multiplied by unit_mm. Nodes that no volume element uses are dropped. The mesh
 ** is checked (cf_mesh_check). CF_E_NOINPUT when the file cannot be opened, CF_E_DATA for a file
