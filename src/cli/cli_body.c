@@ -42,7 +42,8 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
     if ((st = cf_law_init(&r->law, &sc->spring, err)) != CF_OK ||
         (sc->method == CF_LAW_TABLE &&
          (st = cf_law_table_build(&r->law, sc->table_intervals, err)) != CF_OK) ||
-        (st = cf_mesh_read(sc->body_mesh, sc->body_unit_mm, &r->mesh, err)) != CF_OK)
+        (st = cf_mesh_read_refined(sc->body_mesh, sc->body_unit_mm, sc->body_refine, &r->mesh,
+                                   err)) != CF_OK)
         return st;
     const size_t steps = (size_t)sc->probe.steps;
     /* memory: the factor of the tangent (about 40 times its 3 x 3 blocks for meshes of organ

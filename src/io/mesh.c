@@ -230,10 +230,18 @@ static int mesh_ext_ok(const char *path)
 
 cf_status cf_mesh_read(const char *path, double unit_mm, cf_mesh *m, cf_error *err)
 {
+    return cf_mesh_read_refined(path, unit_mm, 0, m, err);
+}
+
+cf_status cf_mesh_read_refined(const char *path, double unit_mm, int refine, cf_mesh *m,
+                               cf_error *err)
+{
     memset(m, 0, sizeof *m);
     if (!mesh_ext_ok(path))
         return cf_error_set(err, CF_E_DATA, "%s: not a mesh file name: expected .msh, .mesh, "
                             ".vtk, .unv, .bdf or .nas (Gmsh's mesh formats)", path);
+    if (refine < 0 || refine > 4)
+        return cf_error_set(err, CF_E_DATA, "%s: refinement %d: must be 0 to 4", path, refine);
     if (!(unit_mm > 0) || !isfinite(unit_mm))
         return cf_error_set(err, CF_E_DATA, "%s: unit %g mm: must be finite and > 0", path, unit_mm);
     FILE *f = fopen(path, "rb");
@@ -255,7 +263,11 @@ cf_status cf_mesh_read(const char *path, double unit_mm, cf_mesh *m, cf_error *e
             gmshFinalize(&ierr);
             gmsh_ready = 0;
         } else {
-            st = extract(path, unit_mm, m, err);
+            for (int k = 0; k < refine && !ierr; k++)
+                gmshModelMeshRefine(&ierr);
+            st = ierr ? cf_error_set(err, CF_E_DATA, "%s: Gmsh could not refine it: %s", path,
+                                     gmsh_reason(why, sizeof why))
+                      : extract(path, unit_mm, m, err);
             gmshClear(&ierr);
         }
     }

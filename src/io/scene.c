@@ -637,7 +637,8 @@ static cf_status vec3(ctx *c, json_t *obj, const char *where, const char *key, d
 /* "body", "fixed" and "probe": a tissue body of a mesh pressed by a probe. */
 static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
 {
-    static const char *const bk[] = {"mesh", "unit_mm", "poisson_ratio", "volume_modulus_MPa", NULL};
+    static const char *const bk[] = {"mesh", "unit_mm", "refine", "poisson_ratio",
+                                     "volume_modulus_MPa", NULL};
     static const char *const fk[] = {"below", NULL};
     static const char *const fbk[] = {"axis", "value_mm", NULL};
     static const char *const pk[] = {"shape", "radius_mm", "center_mm", "direction", "depth_mm",
@@ -652,8 +653,14 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
     if (!json_is_string(mesh))
         return cf_error_set(c->err, CF_E_DATA, "%s: key 'body.mesh' must be a file name", c->name);
     snprintf(sc->body_mesh, sizeof sc->body_mesh, "%s", json_string_value(mesh));
-    if ((st = number(c, bd, "body", "unit_mm", 1, 1, 0, 1, 1e9, &sc->body_unit_mm)))
+    double refine;
+    if ((st = number(c, bd, "body", "unit_mm", 1, 1, 0, 1, 1e9, &sc->body_unit_mm)) ||
+        (st = number(c, bd, "body", "refine", 0, 0, 0, 0, 4, &refine)))
         return st;
+    if (refine != floor(refine))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'body.refine' = %g: must be a whole "
+                            "number", c->name, refine);
+    sc->body_refine = (int)refine;
     json_t *pr = json_object_get(bd, "poisson_ratio"), *km = json_object_get(bd, "volume_modulus_MPa");
     if (pr && km)
         return cf_error_set(c->err, CF_E_DATA, "%s: keys 'body.poisson_ratio' and "

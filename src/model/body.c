@@ -794,6 +794,10 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
         for (size_t i = 0; i < b->nn; i++) {
             double nrm[3];
             uint8_t in = b->fix[i] != CF_BODY_FIX_ALL && penetration(probe, c, b->x + 3 * i, nrm, 0) > 0;
+            /* a node at a punch's rim can slide out past the radius and back in as the set
+            ** changes; after ten rounds a node in the set stays while it is still pushed */
+            if (rounds >= 10 && active[i] && penetration(probe, c, b->x + 3 * i, nrm, 1) > 0)
+                in = 1;
             changed += in != active[i];
             active[i] = in;
         }

@@ -16,6 +16,11 @@
 ** degenerate or inverted element (the message names the file and the element's number). */
 cf_status cf_mesh_read(const char *path, double unit_mm, cf_mesh *m, cf_error *err);
 
+/* The same, with the mesh refined `refine` times (0 to 4) by Gmsh's uniform splitting (each
+** tetrahedron into eight, new nodes at the edges' midpoints: the geometry of the mesh unchanged). */
+cf_status cf_mesh_read_refined(const char *path, double unit_mm, int refine, cf_mesh *m,
+                               cf_error *err);
+
 /* Meshes the box lo..hi (mm) into tetrahedra with Gmsh (Delaunay, seed fixed): element size
 ** size_near at the point focus, growing by `growth` mm per mm of distance from it, at most
 ** size_far. CF_E_DATA for a bad box or sizes. */

@@ -43,6 +43,7 @@ typedef struct cf_scene {
     int has_body;               /* 1 when the scene has "body" (then no "lattice" or "protocol") */
     char body_mesh[4096];       /* body.mesh: the volume mesh file */
     double body_unit_mm;        /* body.unit_mm: mesh coordinates times this are mm */
+    int body_refine;            /* body.refine: uniform refinements of the mesh (0 to 4) */
     int body_volume;            /* 0 no volume term, 1 body.volume_modulus_MPa, 2 body.poisson_ratio */
     double body_volume_value;   /* kappa (MPa) or nu */
     int fixed_axis;             /* fixed.below.axis: 0, 1, 2 (x, y, z) */
