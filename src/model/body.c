@@ -515,14 +515,57 @@ static double tet_dV(const cf_body *b, const double *x, size_t t, double dV[4][3
     return e[0][0] * dV[1][0] + e[0][1] * dV[1][1] + e[0][2] * dV[1][2];
 }
 
+/* Adds f times the second derivative of tetrahedron t's volume to the tangent. With the edges
+** e_m = x_m - x_0 (m = 1, 2, 3) and V = e_1 . (e_2 x e_3)/6, the block of e_a and e_b for (a, b, c)
+** in cyclic order is -[e_c]x / 6 ([v]x the matrix of v x), its transpose for the reverse order,
+** zero for a = b; node 0 enters through every edge with the sign minus. */
+static void volume_hessian(const cf_body *b, const double *x, size_t t, double f, pattern *P)
+{
+    const uint32_t *v = b->tet + 4 * t;
+    double e[3][3], He[3][3][9], Hx[4][4][9];
+    for (int m = 0; m < 3; m++)
+        for (int a = 0; a < 3; a++)
+            e[m][a] = x[3 * v[m + 1] + a] - x[3 * v[0] + a];
+    memset(He, 0, sizeof He);
+    for (int a = 0; a < 3; a++) {
+        int bb = (a + 1) % 3, c = (a + 2) % 3;
+        const double *w = e[c];
+        /* -[w]x / 6 = (1/6) [[0, w2, -w1], [-w2, 0, w0], [w1, -w0, 0]] */
+        double M[9] = {0, w[2] / 6, -w[1] / 6, -w[2] / 6, 0, w[0] / 6, w[1] / 6, -w[0] / 6, 0};
+        for (int r = 0; r < 3; r++)
+            for (int q = 0; q < 3; q++) {
+                He[a][bb][3 * r + q] = M[3 * r + q];
+                He[bb][a][3 * q + r] = M[3 * r + q];
+            }
+    }
+    memset(Hx, 0, sizeof Hx);
+    for (int a = 0; a < 3; a++)
+        for (int c = 0; c < 3; c++)
+            for (int k = 0; k < 9; k++) {
+                double h = He[a][c][k];
+                Hx[a + 1][c + 1][k] += h;
+                Hx[0][c + 1][k] -= h;
+                Hx[a + 1][0][k] -= h;
+                Hx[0][0][k] += h;
+            }
+    for (int m = 0; m < 4; m++)
+        for (int q = 0; q < 4; q++) {
+            if (m == q)
+                continue; /* the diagonal blocks are zero */
+            double B[9];
+            for (int k = 0; k < 9; k++)
+                B[k] = f * Hx[m][q][k];
+            add_block(P, v[q], blk_of(P, v[q], v[m]), B);
+        }
+}
+
 /* The volume term, averaged over nodes: each node a owns a quarter of the volume of every
 ** tetrahedron around it, V_a and V0_a, and stores V0_a (kappa/2)(J_a - 1)^2 with J_a = V_a/V0_a
 ** (the average nodal pressure tetrahedron of Bonet & Burton 1998, Commun Numer Meth Engng
 ** 14:437-449: one volume constraint per node instead of per element, which keeps linear
 ** tetrahedra from locking as nu approaches 1/2). Adds its gradient to g and, when P is not NULL,
-** its Gauss-Newton tangent sum_a (kappa/V0_a) dV_a dV_a^T (the term in (J_a - 1) d2V_a is left
-** out: Newton then converges linearly where J is far from 1, to the same state). Returns 0 when
-** memory runs out. */
+** its tangent sum_a (kappa/V0_a) dV_a dV_a^T + sum_t f_t d2V_t, f_t = (kappa/4) sum over the
+** tetrahedron's nodes of (J_a - 1). Returns 0 when memory runs out. */
 static int volume_term(const cf_body *b, const double *x, double *g, pattern *P)
 {
     const size_t nn = b->nn, nt = b->nt;
@@ -550,6 +593,8 @@ static int volume_term(const cf_body *b, const double *x, double *g, pattern *P)
         for (int m = 0; m < 4; m++)
             for (int a = 0; a < 3; a++)
                 g[3 * b->tet[4 * t + m] + a] += f * dV[m][a];
+        if (P && f != 0)
+            volume_hessian(b, x, t, f, P);
     }
     if (P) {
         loc = malloc(nn * sizeof *loc);
