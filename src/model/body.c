@@ -9,22 +9,6 @@
 #include "conifit/body.h"
 #include "model/sparse_chol.h"
 
-void cf_body_free(cf_body *b)
-{
-    if (!b)
-        return;
-    free(b->X);
-    free(b->x);
-    free(b->fix);
-    free(b->tet);
-    free(b->V0);
-    free(b->si);
-    free(b->sj);
-    free(b->L0);
-    free(b->c);
-    memset(b, 0, sizeof *b);
-}
-
 double cf_body_mu_of_law(const cf_law *law)
 {
     return law->k0_N_per_mm / law->p.H_mm / 2.5; /* E0 = k0/H at nu = 1/4 (calibration.h) */
@@ -715,6 +699,11 @@ static void apply_fixed(const cf_body *b, pattern *P, double *g)
 {
     for (size_t j = 0; j < b->nn; j++) {
         for (int c = 0; c < 3; c++) {
+            if (!P) {
+                if ((b->fix[j] >> c) & 1)
+                    g[3 * j + c] = 0;
+                continue;
+            }
             int *ri = P->rowidx + P->colptr[3 * j + c];
             double *v = P->val + P->colptr[3 * j + c];
             size_t len = (size_t)(P->colptr[3 * j + c + 1] - P->colptr[3 * j + c]);
@@ -762,6 +751,77 @@ static double norm_inf(const double *v, size_t n)
     return m;
 }
 
+/* What the solves of a body keep between calls: the pattern and the analysed factorisation of its
+** tangent, the last factors (reused as chord steps while they converge fast enough), and work
+** vectors. */
+typedef struct body_work {
+    pattern P;
+    cf_sparse_chol *ch;
+    double *g, *dx, *xt;
+    uint8_t *active;
+    int factored;       /* ch holds the factors of a tangent of this body */
+} body_work;
+
+static void work_free(body_work *w)
+{
+    if (!w)
+        return;
+    cf_sparse_chol_free(w->ch);
+    pattern_free(&w->P);
+    free(w->g);
+    free(w->dx);
+    free(w->xt);
+    free(w->active);
+    free(w);
+}
+
+void cf_body_free(cf_body *b)
+{
+    if (!b)
+        return;
+    work_free(b->work);
+    free(b->X);
+    free(b->x);
+    free(b->fix);
+    free(b->tet);
+    free(b->V0);
+    free(b->si);
+    free(b->sj);
+    free(b->L0);
+    free(b->c);
+    memset(b, 0, sizeof *b);
+}
+
+static cf_status work_get(cf_body *b, body_work **out, cf_error *err)
+{
+    if (b->work) {
+        *out = b->work;
+        return CF_OK;
+    }
+    const size_t n = 3 * b->nn;
+    body_work *w = calloc(1, sizeof *w);
+    if (!w || !pattern_build(b, &w->P)) {
+        free(w);
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent of %zu nodes", b->nn);
+    }
+    w->g = malloc(n * sizeof *w->g);
+    w->dx = malloc(n * sizeof *w->dx);
+    w->xt = malloc(n * sizeof *w->xt);
+    w->active = malloc(b->nn);
+    cf_status st = CF_OK;
+    if (!w->g || !w->dx || !w->xt || !w->active)
+        st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent of %zu nodes", b->nn);
+    else
+        st = cf_sparse_chol_create(&w->ch, n, w->P.colptr, w->P.rowidx, err);
+    if (st != CF_OK) {
+        work_free(w);
+        return st;
+    }
+    b->work = w;
+    *out = w;
+    return CF_OK;
+}
+
 cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
                         double penalty_N_per_mm, cf_body_step *out, cf_error *err)
 {
@@ -770,50 +830,71 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
     double c[3];
     for (int k = 0; k < 3; k++)
         c[k] = probe->center_mm[k] + depth_mm * probe->dir[k];
-    pattern P;
-    if (!pattern_build(b, &P))
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent of %zu nodes", b->nn);
-    double *g = malloc(n * sizeof *g), *dx = malloc(n * sizeof *dx), *xt = malloc(n * sizeof *xt);
-    uint8_t *active = malloc(b->nn);
-    cf_sparse_chol *ch = NULL;
-    cf_status st = CF_OK;
-    if (!g || !dx || !xt || !active) {
-        st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent of %zu nodes", b->nn);
-        goto end;
-    }
-    if ((st = cf_sparse_chol_create(&ch, n, P.colptr, P.rowidx, err)) != CF_OK)
-        goto end;
+    body_work *w = NULL;
+    cf_status st = work_get(b, &w, err);
+    if (st != CF_OK)
+        return st;
+    pattern *P = &w->P;
+    double *g = w->g, *dx = w->dx, *xt = w->xt;
+    uint8_t *active = w->active;
     /* Active set: Newton's method with the set of nodes in contact held (each held node pushed
     ** back by the penalty in proportion to its signed depth), then the set replaced by the nodes
     ** inside the probe, until it no longer changes (penalty contact with a set that changes
-    ** inside Newton's iteration cycles between states). */
+    ** inside Newton's iteration cycles between states). Within a set, the factors of an earlier
+    ** tangent serve as long as each step reduces the residual to a quarter (chord steps: the
+    ** next update of a probe moving slowly reuses the last factors); otherwise, and whenever the
+    ** set changes, the tangent is assembled and factored afresh. */
     const double fscale = b->E_MPa * b->mean_edge_mm * b->mean_edge_mm;
-    int it = 0, contacts = 0, rounds;
+    int it = 0, contacts = 0, rounds, fresh = 0;
     double force = 0;
     for (size_t i = 0; i < b->nn; i++) {
         double nrm[3];
-        active[i] = b->fix[i] != CF_BODY_FIX_ALL && penetration(probe, c, b->x + 3 * i, nrm, 0) > 0;
+        uint8_t in = b->fix[i] != CF_BODY_FIX_ALL && penetration(probe, c, b->x + 3 * i, nrm, 0) > 0;
+        fresh |= in != active[i];
+        active[i] = in;
     }
+    fresh |= !w->factored;
     for (rounds = 0; rounds < 100; rounds++) {
         int conv = 0;
-        for (int k = 0; k < 100 && !conv; k++, it++) {
-            force = assemble(b, b->x, probe, c, kp, active, g, &P, &contacts);
+        double rprev = INFINITY;
+        for (int k = 0; k < 200 && !conv; k++, it++) {
+            force = assemble(b, b->x, probe, c, kp, active, g, fresh ? P : NULL, &contacts);
             if (isnan(force)) {
                 st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's tangent");
                 goto end;
             }
-            apply_fixed(b, &P, g);
+            apply_fixed(b, fresh ? P : NULL, g);
             double r = norm_inf(g, n);
             if (r <= 1e-8 * fscale) {
                 conv = 1;
                 break;
             }
-            if ((st = cf_sparse_chol_factor(ch, P.val, NULL, err)) != CF_OK ||
-                (st = cf_sparse_chol_solve(ch, g, dx, err)) != CF_OK)
+            if (!fresh && !(r <= 0.25 * rprev)) {
+                /* the old factors no longer converge fast: take the tangent here */
+                fresh = 1;
+                rprev = INFINITY;
+                k--;
+                it--;
+                continue;
+            }
+            if (fresh) {
+                w->factored = 0;
+                if ((st = cf_sparse_chol_factor(w->ch, P->val, NULL, err)) != CF_OK)
+                    goto end;
+                w->factored = 1;
+            }
+            if ((st = cf_sparse_chol_solve(w->ch, g, dx, err)) != CF_OK)
                 goto end;
-            double alpha = 1;
+            for (size_t i = 0; i < b->nn; i++) /* held components never move (old factors */
+                for (int a = 0; a < 3; a++)    /* may have been made with other ones held) */
+                    if ((b->fix[i] >> a) & 1)
+                        dx[3 * i + (size_t)a] = 0;
+            fresh = 0;
+            rprev = r;
+            double alpha = 2;
             int ok = 0;
-            for (int bt = 0; bt < 40 && !ok; bt++, alpha *= 0.5) {
+            for (int bt = 0; bt < 40 && !ok; bt++) {
+                alpha *= 0.5;
                 for (size_t i = 0; i < n; i++)
                     xt[i] = b->x[i] - alpha * dx[i];
                 ok = admissible(b, xt);
@@ -826,7 +907,9 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
                 goto end;
             }
             memcpy(b->x, xt, n * sizeof *xt);
-            if (2 * alpha * norm_inf(dx, n) <= 1e-14 * b->mean_edge_mm)
+            if (alpha < 0.99)
+                fresh = 1; /* a shortened step: take the tangent where it landed */
+            if (alpha * norm_inf(dx, n) <= 1e-14 * b->mean_edge_mm)
                 conv = 1;
         }
         if (!conv) {
@@ -848,6 +931,7 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
         }
         if (!changed)
             break;
+        fresh = 1;
     }
     if (rounds == 100) {
         st = cf_error_set(err, CF_E_NOCONV,
@@ -861,11 +945,5 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
     out->newton_iters = it;
     out->min_J = cf_body_measure(b, NULL, &out->max_u_over_travel);
 end:
-    cf_sparse_chol_free(ch);
-    pattern_free(&P);
-    free(g);
-    free(dx);
-    free(xt);
-    free(active);
     return st;
 }

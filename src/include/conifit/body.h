@@ -93,6 +93,9 @@ typedef struct cf_body {
     double kappa_MPa;      /* volume modulus of the volume term */
     double E_MPa, nu;      /* the body's small-strain E and nu (isotropic part of its tangent) */
     double mean_edge_mm;   /* mean rest length of the springs */
+    void *work;            /* the solver's pattern, factors and vectors (NULL until the first
+                           ** solve; cf_body_free releases them). Not thread-safe: one solve of a
+                           ** body at a time */
 } cf_body;
 
 /* Every component of a node held. */
