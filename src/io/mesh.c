@@ -15,26 +15,74 @@
 #include <string.h>
 #include <strings.h>
 
+#include <dlfcn.h>
 #include <gmshc.h>
 
 static pthread_mutex_t gmsh_lock = PTHREAD_MUTEX_INITIALIZER;
 static int gmsh_ready;
 
+/* Gmsh's library is loaded when a mesh is first read, not linked: it is large (with its
+** geometry kernel it adds tens of megabytes to a process), and a run that reads no mesh should
+** not carry it. Its functions, by their own names. */
+#define GMSH_FUNCTIONS(X)                                                                          \
+    X(gmshClear) X(gmshFinalize) X(gmshFree) X(gmshInitialize) X(gmshLoggerGetLastError)           \
+    X(gmshModelAdd) X(gmshModelMeshFieldAdd) X(gmshModelMeshFieldSetAsBackgroundMesh)              \
+    X(gmshModelMeshFieldSetString) X(gmshModelMeshGenerate) X(gmshModelMeshGetElements)            \
+    X(gmshModelMeshGetNodes) X(gmshModelMeshRefine) X(gmshModelOccAddBox)                          \
+    X(gmshModelOccSynchronize) X(gmshOpen) X(gmshOptionSetNumber)
+#define GMSH_FIELD(f) __typeof__(&f) f;
+static struct {
+    GMSH_FUNCTIONS(GMSH_FIELD)
+} gm;
+static void *gmsh_handle;
+
+/* Loads the library (once); 0 with the reason in why when it cannot. */
+static int gmsh_load(char *why, size_t cap)
+{
+    if (gmsh_handle)
+        return 1;
+    char soname[64];
+    snprintf(soname, sizeof soname, "libgmsh.so.%d.%d", GMSH_API_VERSION_MAJOR,
+             GMSH_API_VERSION_MINOR);
+    void *h = dlopen(soname, RTLD_NOW | RTLD_LOCAL);
+    if (!h)
+        h = dlopen("libgmsh.so", RTLD_NOW | RTLD_LOCAL);
+    if (!h) {
+        const char *e = dlerror();
+        snprintf(why, cap, "cannot load Gmsh's library (%s): %s", soname, e ? e : "not found");
+        return 0;
+    }
+#define GMSH_BIND(f)                                                                               \
+    *(void **)(&gm.f) = dlsym(h, #f);                                                              \
+    if (!gm.f) {                                                                                   \
+        snprintf(why, cap, "Gmsh's library %s has no %s", soname, #f);                             \
+        dlclose(h);                                                                                \
+        return 0;                                                                                  \
+    }
+    GMSH_FUNCTIONS(GMSH_BIND)
+#undef GMSH_BIND
+    gmsh_handle = h;
+    return 1;
+}
+
 /* Starts Gmsh once (quiet) and clears its model. Returns 0 on failure. */
-static int gmsh_begin(void)
+static int gmsh_begin(char *why, size_t cap)
 {
     int ierr = 0;
+    if (!gmsh_load(why, cap))
+        return 0;
+    snprintf(why, cap, "Gmsh could not start");
     if (!gmsh_ready) {
         char prog[] = "conifit";
         char *argv[] = {prog, NULL};
-        gmshInitialize(1, argv, 0, &ierr);
+        gm.gmshInitialize(1, argv, 0, &ierr);
         if (ierr)
             return 0;
         gmsh_ready = 1;
     }
-    gmshOptionSetNumber("General.Terminal", 0, &ierr);
-    gmshOptionSetNumber("General.Verbosity", 0, &ierr);
-    gmshClear(&ierr);
+    gm.gmshOptionSetNumber("General.Terminal", 0, &ierr);
+    gm.gmshOptionSetNumber("General.Verbosity", 0, &ierr);
+    gm.gmshClear(&ierr);
     return ierr == 0;
 }
 
@@ -42,10 +90,10 @@ static const char *gmsh_reason(char *buf, size_t cap)
 {
     char *msg = NULL;
     int ierr = 0;
-    gmshLoggerGetLastError(&msg, &ierr);
+    gm.gmshLoggerGetLastError(&msg, &ierr);
     snprintf(buf, cap, "%s", msg && *msg && !ierr ? msg : "Gmsh could not read it");
     if (msg)
-        gmshFree(msg);
+        gm.gmshFree(msg);
     for (char *p = buf; *p; p++) /* one line, printable */
         if ((unsigned char)*p < 32)
             *p = ' ';
@@ -87,7 +135,7 @@ static cf_status extract(const char *name, double unit_mm, cf_mesh *m, cf_error 
     cf_status st = CF_OK;
     char why[300];
     memset(m, 0, sizeof *m);
-    gmshModelMeshGetElements(&types, &ntypes, &etags, &etags_n, &etags_nn, &ntags, &ntags_n,
+    gm.gmshModelMeshGetElements(&types, &ntypes, &etags, &etags_n, &etags_nn, &ntags, &ntags_n,
                              &ntags_nn, 3, -1, &ierr);
     if (ierr) {
         st = cf_error_set(err, CF_E_DATA, "%s: %s", name, gmsh_reason(why, sizeof why));
@@ -110,7 +158,7 @@ static cf_status extract(const char *name, double unit_mm, cf_mesh *m, cf_error 
                           "%s: no tetrahedra or hexahedra: not a volume mesh", name);
         goto end;
     }
-    gmshModelMeshGetNodes(&tags, &tags_n, &coord, &coord_n, &par, &par_n, -1, -1, 0, 0, &ierr);
+    gm.gmshModelMeshGetNodes(&tags, &tags_n, &coord, &coord_n, &par, &par_n, -1, -1, 0, 0, &ierr);
     if (ierr || coord_n != 3 * tags_n) {
         st = cf_error_set(err, CF_E_DATA, "%s: %s", name, gmsh_reason(why, sizeof why));
         goto end;
@@ -198,17 +246,17 @@ end:
         cf_mesh_free(m);
     free(sorted);
     for (size_t k = 0; k < ntypes; k++) {
-        gmshFree(etags ? etags[k] : NULL);
-        gmshFree(ntags ? ntags[k] : NULL);
+        gm.gmshFree(etags ? etags[k] : NULL);
+        gm.gmshFree(ntags ? ntags[k] : NULL);
     }
-    gmshFree(types);
-    gmshFree(etags);
-    gmshFree(etags_n);
-    gmshFree(ntags);
-    gmshFree(ntags_n);
-    gmshFree(tags);
-    gmshFree(coord);
-    gmshFree(par);
+    gm.gmshFree(types);
+    gm.gmshFree(etags);
+    gm.gmshFree(etags_n);
+    gm.gmshFree(ntags);
+    gm.gmshFree(ntags_n);
+    gm.gmshFree(tags);
+    gm.gmshFree(coord);
+    gm.gmshFree(par);
     return st;
 }
 
@@ -252,23 +300,23 @@ cf_status cf_mesh_read_refined(const char *path, double unit_mm, int refine, cf_
     cf_status st;
     int ierr = 0;
     char why[300];
-    if (!gmsh_begin()) {
-        st = cf_error_set(err, CF_E_INTERNAL, "%s: Gmsh could not start", path);
+    if (!gmsh_begin(why, sizeof why)) {
+        st = cf_error_set(err, CF_E_INTERNAL, "%s: %s", path, why);
     } else {
-        gmshOpen(path, &ierr);
+        gm.gmshOpen(path, &ierr);
         if (ierr) {
             st = cf_error_set(err, CF_E_DATA, "%s: not a mesh Gmsh reads: %s", path,
                               gmsh_reason(why, sizeof why));
             /* Gmsh keeps a failed read's state: the next model would be empty; start afresh */
-            gmshFinalize(&ierr);
+            gm.gmshFinalize(&ierr);
             gmsh_ready = 0;
         } else {
             for (int k = 0; k < refine && !ierr; k++)
-                gmshModelMeshRefine(&ierr);
+                gm.gmshModelMeshRefine(&ierr);
             st = ierr ? cf_error_set(err, CF_E_DATA, "%s: Gmsh could not refine it: %s", path,
                                      gmsh_reason(why, sizeof why))
                       : extract(path, unit_mm, m, err);
-            gmshClear(&ierr);
+            gm.gmshClear(&ierr);
         }
     }
     pthread_mutex_unlock(&gmsh_lock);
@@ -297,25 +345,25 @@ cf_status cf_mesh_box(const double lo[3], const double hi[3], const double focus
     cf_status st = CF_OK;
     int ierr = 0;
     char why[300], expr[400];
-    if (!gmsh_begin()) {
-        st = cf_error_set(err, CF_E_INTERNAL, "box: Gmsh could not start");
+    if (!gmsh_begin(why, sizeof why)) {
+        st = cf_error_set(err, CF_E_INTERNAL, "box: %s", why);
         goto end;
     }
-    gmshModelAdd("box", &ierr);
-    gmshModelOccAddBox(lo[0], lo[1], lo[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], -1, &ierr);
-    gmshModelOccSynchronize(&ierr);
-    int fld = gmshModelMeshFieldAdd("MathEval", -1, &ierr);
+    gm.gmshModelAdd("box", &ierr);
+    gm.gmshModelOccAddBox(lo[0], lo[1], lo[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], -1, &ierr);
+    gm.gmshModelOccSynchronize(&ierr);
+    int fld = gm.gmshModelMeshFieldAdd("MathEval", -1, &ierr);
     snprintf(expr, sizeof expr, "Min(%.17g, %.17g + %.17g * Sqrt((x - %.17g)^2 + (y - %.17g)^2 + "
                                 "(z - %.17g)^2))",
              size_far, size_near, growth, focus[0], focus[1], focus[2]);
-    gmshModelMeshFieldSetString(fld, "F", expr, &ierr);
-    gmshModelMeshFieldSetAsBackgroundMesh(fld, &ierr);
-    gmshOptionSetNumber("Mesh.MeshSizeExtendFromBoundary", 0, &ierr);
-    gmshOptionSetNumber("Mesh.MeshSizeFromPoints", 0, &ierr);
-    gmshOptionSetNumber("Mesh.MeshSizeFromCurvature", 0, &ierr);
-    gmshOptionSetNumber("Mesh.RandomSeed", 1, &ierr);
-    gmshOptionSetNumber("General.NumThreads", 1, &ierr);
-    gmshModelMeshGenerate(3, &ierr);
+    gm.gmshModelMeshFieldSetString(fld, "F", expr, &ierr);
+    gm.gmshModelMeshFieldSetAsBackgroundMesh(fld, &ierr);
+    gm.gmshOptionSetNumber("Mesh.MeshSizeExtendFromBoundary", 0, &ierr);
+    gm.gmshOptionSetNumber("Mesh.MeshSizeFromPoints", 0, &ierr);
+    gm.gmshOptionSetNumber("Mesh.MeshSizeFromCurvature", 0, &ierr);
+    gm.gmshOptionSetNumber("Mesh.RandomSeed", 1, &ierr);
+    gm.gmshOptionSetNumber("General.NumThreads", 1, &ierr);
+    gm.gmshModelMeshGenerate(3, &ierr);
     if (ierr) {
         st = cf_error_set(err, CF_E_DATA, "box: Gmsh could not mesh it: %s",
                           gmsh_reason(why, sizeof why));
@@ -323,7 +371,7 @@ cf_status cf_mesh_box(const double lo[3], const double hi[3], const double focus
     }
     st = extract("box", 1, m, err);
 end:
-    gmshClear(&ierr);
+    gm.gmshClear(&ierr);
     pthread_mutex_unlock(&gmsh_lock);
     if (st == CF_OK && (st = cf_mesh_check(m, "box", err)) != CF_OK)
         cf_mesh_free(m);
