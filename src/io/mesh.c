@@ -86,6 +86,16 @@ static int gmsh_begin(char *why, size_t cap)
     return ierr == 0;
 }
 
+/* Ends Gmsh after every use: it keeps a failed read's state (the next model would be empty), and
+** its global model and tables are released only by finalizing it. */
+static void gmsh_end(void)
+{
+    int ierr = 0;
+    if (gmsh_ready)
+        gm.gmshFinalize(&ierr);
+    gmsh_ready = 0;
+}
+
 static const char *gmsh_reason(char *buf, size_t cap)
 {
     char *msg = NULL;
@@ -307,17 +317,14 @@ cf_status cf_mesh_read_refined(const char *path, double unit_mm, int refine, cf_
         if (ierr) {
             st = cf_error_set(err, CF_E_DATA, "%s: not a mesh Gmsh reads: %s", path,
                               gmsh_reason(why, sizeof why));
-            /* Gmsh keeps a failed read's state: the next model would be empty; start afresh */
-            gm.gmshFinalize(&ierr);
-            gmsh_ready = 0;
         } else {
             for (int k = 0; k < refine && !ierr; k++)
                 gm.gmshModelMeshRefine(&ierr);
             st = ierr ? cf_error_set(err, CF_E_DATA, "%s: Gmsh could not refine it: %s", path,
                                      gmsh_reason(why, sizeof why))
                       : extract(path, unit_mm, m, err);
-            gm.gmshClear(&ierr);
         }
+        gmsh_end();
     }
     pthread_mutex_unlock(&gmsh_lock);
     if (st == CF_OK && (st = cf_mesh_check(m, path, err)) != CF_OK)
@@ -371,7 +378,7 @@ cf_status cf_mesh_box(const double lo[3], const double hi[3], const double focus
     }
     st = extract("box", 1, m, err);
 end:
-    gm.gmshClear(&ierr);
+    gmsh_end();
     pthread_mutex_unlock(&gmsh_lock);
     if (st == CF_OK && (st = cf_mesh_check(m, "box", err)) != CF_OK)
         cf_mesh_free(m);

@@ -125,6 +125,7 @@ static void the_block_generator_gives_conforming_positive_tetrahedra(void **stat
         V += v6 / 6;
     }
     assert_close(V, 64, 1e-12);
+    cf_mesh_free(&m);
     double bad[3] = {0, 1, 1};
     cf_error err = {0};
     assert_int_equal(cf_mesh_block(&m, bad, 2, g, 3, g, 3, &err), CF_E_DATA);
