@@ -347,6 +347,16 @@ typedef struct pattern {
     uint32_t *nb;
     size_t *tp;            /* tetrahedra around each node: tl[tp[a] .. tp[a + 1]) */
     uint32_t *tl;
+    /* block indices found once (a search per block at every assembly cost more than the rest):
+    ** per spring (i, j): (i in i), (j in j), (i in j), (j in i); per tetrahedron: (row m in
+    ** column q) for its 16 corner pairs; per node a with a volume term: its ring (the nodes of
+    ** the tetrahedra around it, in the order the assembly meets them) and the blocks of every
+    ** pair of ring nodes */
+    uint32_t *sblk, *tblk;
+    size_t *rp;            /* nn + 1: ring of a in rn[rp[a] .. rp[a + 1]) */
+    uint32_t *rn;
+    size_t *bp;            /* nn + 1: blocks of a's ring pairs in rblk[bp[a] ..), row-major */
+    uint32_t *rblk;
 } pattern;
 
 static void pattern_free(pattern *P)
@@ -358,6 +368,12 @@ static void pattern_free(pattern *P)
     free(P->nb);
     free(P->tp);
     free(P->tl);
+    free(P->sblk);
+    free(P->tblk);
+    free(P->rp);
+    free(P->rn);
+    free(P->bp);
+    free(P->rblk);
 }
 
 /* Block index of row node i in column node j's columns (i must be in the pattern). */
@@ -378,6 +394,77 @@ static int cmp_u32(const void *a, const void *b)
 {
     uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
     return (x > y) - (x < y);
+}
+
+/* The block indices of pattern.sblk, tblk and the rings (see pattern); mark is nn scratch. */
+static int pattern_blocks(const cf_body *b, pattern *P, uint32_t *mark)
+{
+    const size_t nn = b->nn, nt = b->nt;
+    P->sblk = malloc(4 * b->ns * sizeof *P->sblk);
+    P->tblk = malloc(16 * nt * sizeof *P->tblk);
+    if (!P->sblk || !P->tblk)
+        return 0;
+    for (size_t s = 0; s < b->ns; s++) {
+        size_t i = b->si[s], j = b->sj[s];
+        P->sblk[4 * s] = (uint32_t)blk_of(P, i, i);
+        P->sblk[4 * s + 1] = (uint32_t)blk_of(P, j, j);
+        P->sblk[4 * s + 2] = (uint32_t)blk_of(P, j, i);
+        P->sblk[4 * s + 3] = (uint32_t)blk_of(P, i, j);
+    }
+    for (size_t t = 0; t < nt; t++)
+        for (int m = 0; m < 4; m++)
+            for (int q = 0; q < 4; q++)
+                P->tblk[16 * t + 4 * (size_t)m + (size_t)q] =
+                    (uint32_t)blk_of(P, b->tet[4 * t + q], b->tet[4 * t + m]);
+    if (!(b->kappa_MPa > 0))
+        return 1;
+    P->rp = malloc((nn + 1) * sizeof *P->rp);
+    P->bp = malloc((nn + 1) * sizeof *P->bp);
+    if (!P->rp || !P->bp)
+        return 0;
+    for (size_t a = 0; a < nn; a++)
+        mark[a] = UINT32_MAX;
+    /* ring sizes first */
+    size_t nr_all = 0, nb_all = 0;
+    for (size_t a = 0; a < nn; a++) {
+        size_t nr = 0;
+        for (size_t k = P->tp[a]; k < P->tp[a + 1]; k++)
+            for (int m = 0; m < 4; m++) {
+                uint32_t q = b->tet[4 * P->tl[k] + m];
+                if (mark[q] != (uint32_t)a) {
+                    mark[q] = (uint32_t)a;
+                    nr++;
+                }
+            }
+        P->rp[a] = nr_all;
+        P->bp[a] = nb_all;
+        nr_all += nr;
+        nb_all += nr * nr;
+    }
+    P->rp[nn] = nr_all;
+    P->bp[nn] = nb_all;
+    P->rn = malloc((nr_all ? nr_all : 1) * sizeof *P->rn);
+    P->rblk = malloc((nb_all ? nb_all : 1) * sizeof *P->rblk);
+    if (!P->rn || !P->rblk)
+        return 0;
+    for (size_t a = 0; a < nn; a++)
+        mark[a] = UINT32_MAX;
+    for (size_t a = 0; a < nn; a++) {
+        size_t nr = 0;
+        uint32_t *ring = P->rn + P->rp[a];
+        for (size_t k = P->tp[a]; k < P->tp[a + 1]; k++)
+            for (int m = 0; m < 4; m++) {
+                uint32_t q = b->tet[4 * P->tl[k] + m];
+                if (mark[q] != (uint32_t)(nn + a)) { /* other marks than the sizing pass's */
+                    mark[q] = (uint32_t)(nn + a);
+                    ring[nr++] = q;
+                }
+            }
+        for (size_t rq = 0; rq < nr; rq++)
+            for (size_t cq = 0; cq < nr; cq++)
+                P->rblk[P->bp[a] + rq * nr + cq] = (uint32_t)blk_of(P, ring[cq], ring[rq]);
+    }
+    return 1;
 }
 
 static int pattern_build(const cf_body *b, pattern *P)
@@ -460,6 +547,8 @@ static int pattern_build(const cf_body *b, pattern *P)
                     P->rowidx[nnz++] = (int)(3 * P->nb[k] + (size_t)a);
             P->colptr[3 * j + c + 1] = (int)nnz;
         }
+    if (!pattern_blocks(b, P, mark))
+        goto fail;
     free(mark);
     return 1;
 fail:
@@ -539,7 +628,7 @@ static void volume_hessian(const cf_body *b, const double *x, size_t t, double f
             double B[9];
             for (int k = 0; k < 9; k++)
                 B[k] = f * Hx[m][q][k];
-            add_block(P, v[q], blk_of(P, v[q], v[m]), B);
+            add_block(P, v[q], P->tblk[16 * t + 4 * (size_t)m + (size_t)q], B);
         }
 }
 
@@ -554,13 +643,13 @@ static int volume_term(const cf_body *b, const double *x, double *g, pattern *P)
 {
     const size_t nn = b->nn, nt = b->nt;
     double *Vn = calloc(nn, sizeof *Vn), *V0n = calloc(nn, sizeof *V0n);
-    double *w = NULL;
+    double *dVall = malloc(12 * nt * sizeof *dVall), *w = NULL;
     uint32_t *loc = NULL, *ring = NULL;
     int ok = 0;
-    if (!Vn || !V0n)
+    if (!Vn || !V0n || !dVall)
         goto end;
     for (size_t t = 0; t < nt; t++) {
-        double dV[4][3];
+        double(*dV)[3] = (double(*)[3])(dVall + 12 * t);
         double V = tet_dV(b, x, t, dV);
         for (int k = 0; k < 4; k++) {
             Vn[b->tet[4 * t + k]] += V / 4;
@@ -568,8 +657,8 @@ static int volume_term(const cf_body *b, const double *x, double *g, pattern *P)
         }
     }
     for (size_t t = 0; t < nt; t++) {
-        double dV[4][3], f = 0;
-        tet_dV(b, x, t, dV);
+        double(*dV)[3] = (double(*)[3])(dVall + 12 * t);
+        double f = 0;
         for (int k = 0; k < 4; k++) {
             size_t a = b->tet[4 * t + k];
             f += b->kappa_MPa * (Vn[a] / V0n[a] - 1) / 4;
@@ -582,53 +671,47 @@ static int volume_term(const cf_body *b, const double *x, double *g, pattern *P)
     }
     if (P) {
         loc = malloc(nn * sizeof *loc);
-        size_t maxring = 0;
+        size_t maxring = 1;
         for (size_t a = 0; a < nn; a++)
-            maxring = P->tp[a + 1] - P->tp[a] > maxring ? P->tp[a + 1] - P->tp[a] : maxring;
-        ring = malloc((4 * maxring + 1) * sizeof *ring);
-        w = malloc(3 * (4 * maxring + 1) * sizeof *w);
-        if (!loc || !ring || !w)
+            maxring = P->rp[a + 1] - P->rp[a] > maxring ? P->rp[a + 1] - P->rp[a] : maxring;
+        w = malloc(3 * maxring * sizeof *w);
+        if (!loc || !w)
             goto end;
-        for (size_t a = 0; a < nn; a++)
-            loc[a] = UINT32_MAX;
         for (size_t a = 0; a < nn; a++) {
-            size_t nr = 0;
+            const size_t nr = P->rp[a + 1] - P->rp[a];
+            ring = P->rn + P->rp[a];
+            for (size_t q = 0; q < nr; q++) {
+                loc[ring[q]] = (uint32_t)q;
+                w[3 * q] = w[3 * q + 1] = w[3 * q + 2] = 0;
+            }
             for (size_t k = P->tp[a]; k < P->tp[a + 1]; k++) {
                 size_t t = P->tl[k];
-                double dV[4][3];
-                tet_dV(b, x, t, dV);
+                const double *dV = dVall + 12 * t;
                 for (int m = 0; m < 4; m++) {
-                    uint32_t q = b->tet[4 * t + m];
-                    if (loc[q] == UINT32_MAX) {
-                        loc[q] = (uint32_t)nr;
-                        ring[nr] = q;
-                        w[3 * nr] = w[3 * nr + 1] = w[3 * nr + 2] = 0;
-                        nr++;
-                    }
+                    uint32_t q = loc[b->tet[4 * t + m]];
                     for (int c = 0; c < 3; c++)
-                        w[3 * loc[q] + c] += dV[m][c] / 4;
+                        w[3 * q + c] += dV[3 * m + c] / 4;
                 }
             }
             const double kk = b->kappa_MPa / V0n[a];
-            for (size_t cq = 0; cq < nr; cq++)
-                for (size_t rq = 0; rq < nr; rq++) {
+            const uint32_t *blk = P->rblk + P->bp[a];
+            for (size_t rq = 0; rq < nr; rq++)
+                for (size_t cq = 0; cq < nr; cq++) {
                     double B[9];
                     for (int r = 0; r < 3; r++)
                         for (int c = 0; c < 3; c++)
                             B[3 * r + c] = kk * w[3 * rq + r] * w[3 * cq + c];
-                    add_block(P, ring[cq], blk_of(P, ring[cq], ring[rq]), B);
+                    add_block(P, ring[cq], blk[rq * nr + cq], B);
                 }
-            for (size_t q = 0; q < nr; q++)
-                loc[ring[q]] = UINT32_MAX;
         }
     }
     ok = 1;
 end:
     free(Vn);
     free(V0n);
+    free(dVall);
     free(w);
     free(loc);
-    free(ring);
     return ok;
 }
 
@@ -661,10 +744,10 @@ static double assemble(const cf_body *b, const double *x, const cf_probe *pr, co
                 B[3 * a + q] = (kax - geo) * n[a] * n[q] + (a == q ? geo : 0);
                 Bn[3 * a + q] = -B[3 * a + q];
             }
-        add_block(P, i, blk_of(P, i, i), B);
-        add_block(P, j, blk_of(P, j, j), B);
-        add_block(P, j, blk_of(P, j, i), Bn);
-        add_block(P, i, blk_of(P, i, j), Bn);
+        add_block(P, i, P->sblk[4 * s], B);
+        add_block(P, j, P->sblk[4 * s + 1], B);
+        add_block(P, j, P->sblk[4 * s + 2], Bn);
+        add_block(P, i, P->sblk[4 * s + 3], Bn);
     }
     if (b->kappa_MPa > 0 && !volume_term(b, x, g, P))
         return NAN;
