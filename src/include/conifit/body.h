@@ -1,7 +1,7 @@
 /*
 ** Tissue bodies: a tetrahedral volume mesh whose every edge carries the fitted spring law, scaled
-** per edge so that the network is the fitted material at small strain, plus a volume term per
-** tetrahedron; regions fixed, a rigid probe pressed into it, static equilibria solved by Newton's
+** per edge so that the network is the fitted material at small strain, plus a volume term; regions
+** fixed, a rigid probe pressed into it, static equilibria solved by Newton's
 ** method with the sparse solver of the lattice. Schema and physics: src/notes/simulate.md, "Bodies".
 **
 ** The material. The cubic lattice with its isotropic calibration (calibration.h) is a material of
@@ -14,9 +14,9 @@
 ** the Cauchy relation): a linear tetrahedron deforms affinely, so its spring stiffness matrix is
 ** V B^T C_s B with C_s = (1/V) sum_e k_e L_e^2 n_e n_e n_e n_e, and matching C_s to the isotropic
 ** C in the least-squares sense (over the 15 independent components of a fully symmetric tensor,
-** k_e >= 0) matches the element's stiffness matrix to the linear finite element's (the criterion
-** of Lloyd, Szekely & Harders 2007, IEEE TVCG 13:1081-1094, applied to the strain tensor instead
-** of the 12 x 12 matrix; San-Vicente, Aguinaga & Celiguieta 2012 fit the same kind of per-element
+** k_e >= 0) matches the element's stiffness matrix to the linear finite element's V B^T C B in a
+** norm of the tensors (Lloyd, Szekely & Harders 2007, IEEE TVCG 13:1081-1094, match the 12 x 12
+** matrices themselves; San-Vicente, Aguinaga & Celiguieta 2012 fit the same kind of per-element
 ** constants). An edge's stiffness is the sum of its tetrahedra's shares. Since a single
 ** tetrahedron's six directions cannot be isotropic, the mesh's volume-averaged tensor is then
 ** projected on the isotropic tensors and every c scaled once so that its shear modulus is mu.
@@ -52,8 +52,9 @@ typedef struct cf_mesh {
 void cf_mesh_free(cf_mesh *m);
 
 /* A block of tetrahedra on the grid xs[0..nx] x ys[0..ny] x zs[0..nz] (mm, each strictly
-** increasing, at least two values), every cell split into six tetrahedra around its diagonal
-** from the lowest to the highest corner (Kuhn's subdivision: neighbouring cells' faces match).
+** increasing, at least two values), every cell split into six tetrahedra around one of its body
+** diagonals (Kuhn's subdivision), the cell mirrored along each axis where its index is odd, so
+** that neighbouring cells' faces match and the block holds both diagonals of every face.
 ** A graded grid refines where the coordinates are dense. CF_E_DATA for a bad grid. */
 cf_status cf_mesh_block(cf_mesh *m, const double *xs, int nx, const double *ys, int ny,
                         const double *zs, int nz, cf_error *err);
