@@ -18,7 +18,8 @@
 #   make fuzz       libFuzzer (clang, ASan + UBSan) on each parser for FUZZ_SECONDS (default 60) s
 #   make bench      the benchmark report into build/bench/report/ (optimised build, separate from
 #                   the tests); make bench-update copies it over the committed tests/bench/
-#   make figures    regenerate fits/figures/*.png (validation, hysteresis, creep) from data/scenes
+#   make figures    regenerate fits/figures/*.png (validation, hysteresis, creep, the probed liver)
+#                   from data/scenes
 #   make clean
 # WERROR=1 turns warnings into errors (CI sets it).
 
@@ -27,7 +28,7 @@ PKGS    := nlopt gsl jansson
 TESTPKGS := cmocka libxml-2.0
 DEBS    := build-essential pkg-config libnlopt-dev libgsl-dev libcmocka-dev libjansson-dev \
            libsuitesparse-dev libmumps-seq-dev libopenblas0-serial libxml2-dev gnuplot-nox calculix-ccx clang \
-           libclang-rt-dev
+           libclang-rt-dev libgmsh-dev python3-vtk9
 BUILD   ?= build
 SIMD    ?=
 
@@ -49,6 +50,9 @@ SPARSE_CFLAGS := $(shell pkg-config --cflags CHOLMOD 2>/dev/null || echo -I/usr/
 SPARSE_CFLAGS += -I/usr/include/mumps_seq
 SPARSE_LIBS   := $(shell pkg-config --libs CHOLMOD 2>/dev/null || echo -lcholmod) \
                  -ldmumps_seq -lmumps_common_seq -lmpiseq_seq -lpord_seq
+# Gmsh (volume meshes of tissue bodies) is loaded with dlopen when a mesh is read (src/io/mesh.c):
+# only its header is needed to build.
+SPARSE_LIBS   += -ldl
 CFLAGS  += -std=c17 $(OPT) -fopenmp $(WARN) $(shell pkg-config --cflags $(PKGS) 2>/dev/null) $(SPARSE_CFLAGS)
 LDLIBS  += $(shell pkg-config --libs $(PKGS) 2>/dev/null) $(SPARSE_LIBS) -fopenmp -lm -lpthread
 
@@ -92,6 +96,7 @@ check-deps:
 	@missing=""; for p in $(PKGS) $(TESTPKGS); do pkg-config --exists $$p 2>/dev/null || missing="$$missing $$p"; done; \
 	printf '#include <cholmod.h>\n' | $(CC) $(SPARSE_CFLAGS) -E - >/dev/null 2>&1 || missing="$$missing cholmod"; \
 	printf '#include <dmumps_c.h>\n' | $(CC) $(SPARSE_CFLAGS) -E - >/dev/null 2>&1 || missing="$$missing mumps"; \
+	printf '#include <gmshc.h>\n' | $(CC) -E - >/dev/null 2>&1 || missing="$$missing gmsh"; \
 	if [ -n "$$missing" ]; then \
 	  echo "conifit: missing libraries:$$missing. Install them with:" >&2; \
 	  echo "  apt-get update && apt-get install -y $(DEBS)   (or: make deps, as root)" >&2; exit 1; fi
@@ -243,6 +248,10 @@ figures: check-deps $(BUILD)/conifit
 	$(BUILD)/conifit simulate data/scenes/uniaxial.json -o $(BUILD)/uniaxial.csv --plot fits/figures/validation.png
 	$(BUILD)/conifit simulate data/scenes/hysteresis.json -o $(BUILD)/hysteresis.csv --plot fits/figures/hysteresis.png
 	$(BUILD)/conifit simulate data/scenes/creep.json -o $(BUILD)/creep.csv --plot fits/figures/creep.png
+	@if [ -f ../shared/meshes/liver2.msh ]; then \
+	  $(BUILD)/conifit simulate data/scenes/liver_probe.json -o $(BUILD)/liver_probe.csv --vtu $(BUILD)/liver_probe && \
+	  python3 fits/figures/liver_probe.py $(BUILD)/liver_probe fits/figures/liver_probe.png; \
+	else echo "conifit: ../shared/meshes absent: fits/figures/liver_probe.png is not refreshed"; fi
 	gnuplot fits/figures/type_regions.gp
 	$(BUILD)/conifit curve --D1 10 --D2 30 --n 4 --d 1 --G 80000 --H 50 --n_tail 1 --H_tail 20 --points 2001 -o $(BUILD)/three_regions_tail.csv
 	$(BUILD)/conifit curve --D1 10 --D2 30 --n 4 --d 1 --G 80000 --H 30 --points 2001 -o $(BUILD)/three_regions_cone.csv

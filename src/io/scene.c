@@ -615,11 +615,112 @@ static cf_status protocol_section(ctx *c, json_t *pr, cf_scene *sc, double sampl
     return st != CF_OK ? st : path_samples(c, sc, samples_per_segment);
 }
 
+/* A JSON array of three finite numbers at obj[key] into v. */
+static cf_status vec3(ctx *c, json_t *obj, const char *where, const char *key, double v[3])
+{
+    json_t *a = json_object_get(obj, key);
+    if (!a)
+        return cf_error_set(c->err, CF_E_DATA, "%s: missing key '%s.%s'", c->name, where, key);
+    if (!json_is_array(a) || json_array_size(a) != 3)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.%s' must be an array of 3 numbers",
+                            c->name, where, key);
+    for (size_t i = 0; i < 3; i++) {
+        json_t *x = json_array_get(a, i);
+        if (!json_is_number(x) || !isfinite(json_number_value(x)))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.%s' must be an array of 3 finite "
+                                "numbers", c->name, where, key);
+        v[i] = json_number_value(x);
+    }
+    return CF_OK;
+}
+
+/* "body", "fixed" and "probe": a tissue body of a mesh pressed by a probe. */
+static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
+{
+    static const char *const bk[] = {"mesh", "unit_mm", "refine", "poisson_ratio",
+                                     "volume_modulus_MPa", NULL};
+    static const char *const fk[] = {"below", NULL};
+    static const char *const fbk[] = {"axis", "value_mm", NULL};
+    static const char *const pk[] = {"shape", "radius_mm", "center_mm", "direction", "depth_mm",
+                                     "steps", NULL};
+    cf_status st;
+    if (json_object_get(root, "lattice") || json_object_get(root, "protocol"))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'body' replaces 'lattice' and "
+                            "'protocol' (the probe is the loading)", c->name);
+    if ((st = only_keys(c, bd, "body", bk)))
+        return st;
+    json_t *mesh = json_object_get(bd, "mesh");
+    if (!json_is_string(mesh))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'body.mesh' must be a file name", c->name);
+    snprintf(sc->body_mesh, sizeof sc->body_mesh, "%s", json_string_value(mesh));
+    double refine;
+    if ((st = number(c, bd, "body", "unit_mm", 1, 1, 0, 1, 1e9, &sc->body_unit_mm)) ||
+        (st = number(c, bd, "body", "refine", 0, 0, 0, 0, 4, &refine)))
+        return st;
+    if (refine != floor(refine))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'body.refine' = %g: must be a whole "
+                            "number", c->name, refine);
+    sc->body_refine = (int)refine;
+    json_t *pr = json_object_get(bd, "poisson_ratio"), *km = json_object_get(bd, "volume_modulus_MPa");
+    if (pr && km)
+        return cf_error_set(c->err, CF_E_DATA, "%s: keys 'body.poisson_ratio' and "
+                            "'body.volume_modulus_MPa' exclude each other", c->name);
+    if (pr) {
+        sc->body_volume = 2;
+        if ((st = number(c, bd, "body", "poisson_ratio", 1, 0, 0.25, 0, 0.4999, &sc->body_volume_value)))
+            return st;
+    } else if (km) {
+        sc->body_volume = 1;
+        if ((st = number(c, bd, "body", "volume_modulus_MPa", 1, 0, 0, 0, 1e12, &sc->body_volume_value)))
+            return st;
+    }
+    json_t *fx, *below, *pb;
+    if ((st = object(c, root, "fixed", 1, &fx)) || (st = only_keys(c, fx, "fixed", fk)) ||
+        (st = object(c, fx, "below", 1, &below)) || (st = only_keys(c, below, "fixed.below", fbk)))
+        return st;
+    json_t *ax = json_object_get(below, "axis");
+    const char *an = json_is_string(ax) ? json_string_value(ax) : "";
+    if (strlen(an) != 1 || !strchr("xyz", an[0]))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'fixed.below.axis' = '%s': expected x, y "
+                            "or z", c->name, an);
+    sc->fixed_axis = an[0] - 'x';
+    if ((st = number(c, below, "fixed.below", "value_mm", 1, 0, -1e12, 0, 1e12, &sc->fixed_value_mm)))
+        return st;
+    if ((st = object(c, root, "probe", 1, &pb)) || (st = only_keys(c, pb, "probe", pk)))
+        return st;
+    json_t *shape = json_object_get(pb, "shape");
+    const char *sn = json_is_string(shape) ? json_string_value(shape) : "";
+    if (strcmp(sn, "sphere") == 0)
+        sc->probe.shape = CF_PROBE_SPHERE;
+    else if (strcmp(sn, "punch") == 0)
+        sc->probe.shape = CF_PROBE_PUNCH;
+    else
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'probe.shape' = '%s': expected sphere or "
+                            "punch", c->name, sn);
+    double steps, d[3];
+    if ((st = number(c, pb, "probe", "radius_mm", 1, 0, 0, 1, 1e12, &sc->probe.radius_mm)) ||
+        (st = number(c, pb, "probe", "depth_mm", 1, 0, 0, 1, 1e12, &sc->probe.depth_mm)) ||
+        (st = number(c, pb, "probe", "steps", 0, 10, 1, 0, 100000, &steps)) ||
+        (st = vec3(c, pb, "probe", "center_mm", sc->probe.center_mm)) ||
+        (st = vec3(c, pb, "probe", "direction", d)))
+        return st;
+    sc->probe.steps = (int)steps;
+    double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (!(len > 0) || !isfinite(len))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'probe.direction' = [%g, %g, %g]: must "
+                            "not be zero", c->name, d[0], d[1], d[2]);
+    for (int k = 0; k < 3; k++)
+        sc->probe.dir[k] = d[k] / len;
+    sc->has_body = 1;
+    return CF_OK;
+}
+
 static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
 {
     static const char *const allowed[] = {"spring", "lattice", "density_t_per_mm3", "protocol",
                                           "effects", "integrator", "law_method", "table_intervals",
-                                          "samples_per_segment", "comment", NULL};
+                                          "samples_per_segment", "comment", "body", "fixed",
+                                          "probe", NULL};
     cf_status st;
     if (!json_is_object(root))
         return cf_error_set(c->err, CF_E_DATA, "%s: a scene must be a JSON object", c->name);
@@ -630,6 +731,14 @@ static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
     sc->table_intervals = CF_LAW_TABLE_DEFAULT;
     json_t *sp, *lt, *pr, *ef, *in;
     if ((st = object(c, root, "spring", 1, &sp)) || (st = spring_section(c, sp, sc)))
+        return st;
+    json_t *bd;
+    if ((st = object(c, root, "body", 0, &bd)))
+        return st;
+    if (!bd && (json_object_get(root, "fixed") || json_object_get(root, "probe")))
+        return cf_error_set(c->err, CF_E_DATA, "%s: keys 'fixed' and 'probe' need a 'body'",
+                            c->name);
+    if (bd && (st = body_sections(c, root, bd, sc)))
         return st;
     if ((st = object(c, root, "lattice", 0, &lt)) || (st = lattice_section(c, lt, sc)))
         return st;
@@ -666,6 +775,8 @@ static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
     if ((st = number(c, root, "", "samples_per_segment", 0, 50, 1, 0, MAX_SAMPLES_PER_SEGMENT,
                      &per)))
         return st;
+    if (sc->has_body)
+        return CF_OK; /* the probe is the loading */
     if ((st = object(c, root, "protocol", 1, &pr)) ||
         (st = protocol_section(c, pr, sc, floor(per))))
         return st;

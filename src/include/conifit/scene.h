@@ -10,6 +10,7 @@
 
 #include <stddef.h>
 
+#include "conifit/body.h"
 #include "conifit/error.h"
 #include "conifit/law.h"
 #include "conifit/msm.h"
@@ -38,6 +39,16 @@ typedef struct cf_scene {
     double *path_t_s, *path_v;  /* the path (value as in cf_msm_path) */
     size_t nsamples;            /* reported samples */
     double *sample_t_s;         /* their times, s */
+    /* A tissue body instead of the lattice (body.h; src/notes/simulate.md, "Bodies"): */
+    int has_body;               /* 1 when the scene has "body" (then no "lattice" or "protocol") */
+    char body_mesh[4096];       /* body.mesh: the volume mesh file */
+    double body_unit_mm;        /* body.unit_mm: mesh coordinates times this are mm */
+    int body_refine;            /* body.refine: uniform refinements of the mesh (0 to 4) */
+    int body_volume;            /* 0 no volume term, 1 body.volume_modulus_MPa, 2 body.poisson_ratio */
+    double body_volume_value;   /* kappa (MPa) or nu */
+    int fixed_axis;             /* fixed.below.axis: 0, 1, 2 (x, y, z) */
+    double fixed_value_mm;      /* fixed.below.value_mm */
+    cf_probe probe;             /* probe */
 } cf_scene;
 
 /* Most samples a scene may report (segments x samples_per_segment + 1); the memory and steps of

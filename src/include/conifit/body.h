@@ -1,0 +1,158 @@
+/*
+** Tissue bodies: a tetrahedral volume mesh whose every edge carries the fitted spring law, scaled
+** per edge so that the network is the fitted material at small strain, plus a volume term; regions
+** fixed, a rigid probe pressed into it, static equilibria solved by Newton's
+** method with the sparse solver of the lattice. Schema and physics: src/notes/simulate.md, "Bodies".
+**
+** The material. The cubic lattice with its isotropic calibration (calibration.h) is a material of
+** Young's modulus E0 = k0/H and nu = 1/4, so shear modulus mu = E0/2.5 (k0 the law's linear
+** stiffness, H its free length). A body is the same material: every edge of rest length L0 carries
+** the law in strain form (the compression u = H (L0 - L)/L0, as the lattice's diagonals do) times
+** a factor c, so that its axial stiffness at small strain is k = c k0 H/L0. The edge stiffnesses
+** come from matching, tetrahedron by tetrahedron, the tangent of its six springs to the isotropic
+** tangent with Lame constants lambda = mu (the one isotropic tensor central springs can give,
+** the Cauchy relation): a linear tetrahedron deforms affinely, so its spring stiffness matrix is
+** V B^T C_s B with C_s = (1/V) sum_e k_e L_e^2 n_e n_e n_e n_e, and matching C_s to the isotropic
+** C in the least-squares sense (over the 15 independent components of a fully symmetric tensor,
+** k_e >= 0) matches the element's stiffness matrix to the linear finite element's V B^T C B in a
+** norm of the tensors (Lloyd, Szekely & Harders 2007, IEEE TVCG 13:1081-1094, match the 12 x 12
+** matrices themselves; San-Vicente, Aguinaga & Celiguieta 2012 fit the same kind of per-element
+** constants). An edge's stiffness is the sum of its tetrahedra's shares. Since a single
+** tetrahedron's six directions cannot be isotropic, the mesh's volume-averaged tensor is then
+** projected on the isotropic tensors and every c scaled once so that its shear modulus is mu.
+**
+** The volume term. W = V0 (kappa/2)(J - 1)^2 per unit reference volume V0, J its volume ratio,
+** the same term as the homogenised cell's: it adds kappa to lambda and nothing to mu, so
+** nu = (mu + kappa)/(2 (2 mu + kappa)). J is taken per node (a quarter of the volume of every
+** tetrahedron around it; Bonet & Burton 1998), so that linear tetrahedra do not lock as nu nears
+** 1/2; each tetrahedron's own J is reported. A scene gives kappa ("volume_modulus_MPa") or nu
+** ("poisson_ratio", 0.25 <= nu < 0.5, kappa = mu (4 nu - 1)/(1 - 2 nu)).
+**
+** Units: mm, N, MPa. Sign: the probe's force is positive pushing into the body.
+*/
+#ifndef CF_BODY_H
+#define CF_BODY_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "conifit/error.h"
+#include "conifit/law.h"
+
+/* A tetrahedral mesh: nodes (mm) and elements of four node indices each, every element positively
+** oriented (its signed volume (x1-x0).((x2-x0)x(x3-x0))/6 > 0). */
+typedef struct cf_mesh {
+    size_t nn, nt;
+    double *X;      /* 3 nn coordinates, mm */
+    uint32_t *tet;  /* 4 nt node indices */
+    uint32_t *id;   /* nn node numbers of the file (1-based for a generated block) */
+    uint64_t *eid;  /* nt element numbers of the file (a hexahedron's six tetrahedra share one) */
+} cf_mesh;
+
+void cf_mesh_free(cf_mesh *m);
+
+/* A block of tetrahedra on the grid xs[0..nx] x ys[0..ny] x zs[0..nz] (mm, each strictly
+** increasing, at least two values), every cell split into six tetrahedra around one of its body
+** diagonals (Kuhn's subdivision), the cell mirrored along each axis where its index is odd, so
+** that neighbouring cells' faces match and the block holds both diagonals of every face.
+** A graded grid refines where the coordinates are dense. CF_E_DATA for a bad grid. */
+cf_status cf_mesh_block(cf_mesh *m, const double *xs, int nx, const double *ys, int ny,
+                        const double *zs, int nz, cf_error *err);
+
+/* Checks m and orients it: every coordinate finite, every node index in range, every element of
+** volume above 1e-12 of the cube of its longest edge (else "degenerate"), all elements of one
+** orientation (an element whose orientation differs from the majority's is "inverted"); a mesh
+** whose elements are all negatively oriented is renumbered. `name` is used in messages, which
+** name the element by its number in the file. CF_E_DATA. */
+cf_status cf_mesh_check(cf_mesh *m, const char *name, cf_error *err);
+
+/* Where a scene's regions, probe and outputs come from. */
+typedef enum cf_probe_shape { CF_PROBE_SPHERE = 0, CF_PROBE_PUNCH = 1 } cf_probe_shape;
+
+typedef struct cf_probe {
+    cf_probe_shape shape;
+    double radius_mm;
+    double center_mm[3]; /* sphere centre, or the centre of the punch's flat face, at depth 0 */
+    double dir[3];       /* unit direction of travel */
+    double depth_mm;     /* travel at the last step */
+    int steps;           /* equal steps from 0 to depth_mm */
+} cf_probe;
+
+/* The body: the mesh's nodes and tetrahedra, its edges as springs. */
+typedef struct cf_body {
+    const cf_law *law;     /* not owned */
+    cf_law_method method;
+    size_t nn, ns, nt;
+    double *X, *x;         /* 3 nn reference and current positions, mm */
+    uint8_t *fix;          /* per node: bit c (1, 2, 4) set = component c held where it is */
+    uint32_t *tet;         /* 4 nt */
+    double *V0;            /* nt reference volumes, mm^3 */
+    uint32_t *si, *sj;     /* ns spring end nodes */
+    double *L0;            /* ns rest lengths, mm */
+    double *c;             /* ns factors on the law force, - */
+    double mu_MPa;         /* shear modulus the calibration aims at, E0/2.5 */
+    double kappa_MPa;      /* volume modulus of the volume term */
+    double E_MPa, nu;      /* the body's small-strain E and nu (isotropic part of its tangent) */
+    double mean_edge_mm;   /* mean rest length of the springs */
+    void *work;            /* the solver's pattern, factors and vectors (NULL until the first
+                           ** solve; cf_body_free releases them). Not thread-safe: one solve of a
+                           ** body at a time */
+} cf_body;
+
+/* Every component of a node held. */
+#define CF_BODY_FIX_ALL 7
+
+/* Builds the body of mesh m (checked by cf_mesh_check) with law and the volume modulus kappa
+** (MPa, >= 0). The law must outlive the body; with CF_LAW_TABLE its table must be built.
+** CF_E_DATA for a bad kappa, CF_E_INTERNAL when memory runs out. */
+cf_status cf_body_create(cf_body *b, const cf_mesh *m, const cf_law *law, cf_law_method method,
+                         double kappa_MPa, cf_error *err);
+void cf_body_free(cf_body *b);
+
+/* kappa of the volume term that gives the calibrated body (shear modulus mu) Poisson's ratio nu
+** (0.25 <= nu < 0.5). */
+double cf_body_kappa_for_nu(double mu_MPa, double nu);
+
+/* The shear modulus mu = E0/2.5 of the law's material (E0 = k0/H), MPa. */
+double cf_body_mu_of_law(const cf_law *law);
+
+/* Per-state quantities of the body (cf_body_measure). */
+typedef struct cf_body_state {
+    double *strain;   /* ns engineering strains (L - L0)/L0 of the springs, tension positive */
+    uint8_t *solid;   /* ns: 1 where the spring's law is at solid */
+    double *J;        /* nt volume ratios */
+} cf_body_state;
+
+/* Fills st (arrays of the sizes above, caller's) at the current positions; returns the smallest
+** J and sets *max_u_over_travel (if not NULL) to the largest |u| / travel over the springs. */
+double cf_body_measure(const cf_body *b, cf_body_state *st, double *max_u_over_travel);
+
+/* One probe step's result. */
+typedef struct cf_body_step {
+    double depth_mm;
+    double force_N;       /* reaction along dir, positive pushing into the body */
+    int contacts;         /* nodes in contact */
+    int newton_iters;
+    double min_J;
+    double max_u_over_travel;
+} cf_body_step;
+
+/* Solves the static equilibrium of b with the probe at depth (probe->dir times depth from its
+** start), starting from the current positions (the previous step's), with the held components kept
+** where they are (at their reference positions unless the caller moved them). A probe with
+** radius 0 touches nothing. Contact is frictionless, by a penalty on each node inside the probe
+** (stiffness penalty_N_per_mm; 0 = automatic, 1e4 E times the mean edge). CF_E_NOCONV when Newton
+** does not converge or every step back would still invert a tetrahedron or take a spring to
+** solid (message: the depth). */
+cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
+                        double penalty_N_per_mm, cf_body_step *out, cf_error *err);
+
+/* The body's elastic forces on its nodes at the current positions (the gradient of its energy,
+** N; g has 3 nn entries): at a held component, minus the support's reaction. CF_E_INTERNAL when
+** memory runs out. */
+cf_status cf_body_internal_force(const cf_body *b, double *g, cf_error *err);
+
+/* Index of a node inside the probe at depth 0 (the probe starts inside the body), or -1. */
+long cf_body_probe_inside(const cf_body *b, const cf_probe *probe);
+
+#endif

@@ -1,0 +1,386 @@
+/*
+** Volume meshes through Gmsh's library (gmshc.h, Gmsh 4.8 C API): any file Gmsh opens (.msh of
+** every version, and the other formats it reads) becomes a cf_mesh (body.h) of linear tetrahedra;
+** a box meshed by Gmsh with an element size that grows away from a point serves the tests and
+** examples. Gmsh keeps one global model, so every use is serialised by a mutex; its messages are
+** switched off (the library prints nothing) and its last error is read back into the message.
+*/
+#include "conifit/mesh.h"
+
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include <dlfcn.h>
+#include <gmshc.h>
+
+static pthread_mutex_t gmsh_lock = PTHREAD_MUTEX_INITIALIZER;
+static int gmsh_ready;
+
+/* Gmsh's library is loaded when a mesh is first read, not linked: it is large (with its
+** geometry kernel it adds tens of megabytes to a process), and a run that reads no mesh should
+** not carry it. Its functions, by their own names. */
+#define GMSH_FUNCTIONS(X)                                                                          \
+    X(gmshClear) X(gmshFinalize) X(gmshFree) X(gmshInitialize) X(gmshLoggerGetLastError)           \
+    X(gmshModelAdd) X(gmshModelMeshFieldAdd) X(gmshModelMeshFieldSetAsBackgroundMesh)              \
+    X(gmshModelMeshFieldSetString) X(gmshModelMeshGenerate) X(gmshModelMeshGetElements)            \
+    X(gmshModelMeshGetNodes) X(gmshModelMeshRefine) X(gmshModelOccAddBox)                          \
+    X(gmshModelOccSynchronize) X(gmshOpen) X(gmshOptionSetNumber)
+#define GMSH_FIELD(f) __typeof__(&f) f;
+static struct {
+    GMSH_FUNCTIONS(GMSH_FIELD)
+} gm;
+static void *gmsh_handle;
+
+/* Loads the library (once); 0 with the reason in why when it cannot. */
+static int gmsh_load(char *why, size_t cap)
+{
+    if (gmsh_handle)
+        return 1;
+    char soname[64];
+    snprintf(soname, sizeof soname, "libgmsh.so.%d.%d", GMSH_API_VERSION_MAJOR,
+             GMSH_API_VERSION_MINOR);
+    void *h = dlopen(soname, RTLD_NOW | RTLD_LOCAL);
+    if (!h)
+        h = dlopen("libgmsh.so", RTLD_NOW | RTLD_LOCAL);
+    if (!h) {
+        const char *e = dlerror();
+        snprintf(why, cap, "cannot load Gmsh's library (%s): %s", soname, e ? e : "not found");
+        return 0;
+    }
+#define GMSH_BIND(f)                                                                               \
+    *(void **)(&gm.f) = dlsym(h, #f);                                                              \
+    if (!gm.f) {                                                                                   \
+        snprintf(why, cap, "Gmsh's library %s has no %s", soname, #f);                             \
+        dlclose(h);                                                                                \
+        return 0;                                                                                  \
+    }
+    GMSH_FUNCTIONS(GMSH_BIND)
+#undef GMSH_BIND
+    gmsh_handle = h;
+    return 1;
+}
+
+/* Starts Gmsh once (quiet) and clears its model. Returns 0 on failure. */
+static int gmsh_begin(char *why, size_t cap)
+{
+    int ierr = 0;
+    if (!gmsh_load(why, cap))
+        return 0;
+    snprintf(why, cap, "Gmsh could not start");
+    if (!gmsh_ready) {
+        char prog[] = "conifit";
+        char *argv[] = {prog, NULL};
+        gm.gmshInitialize(1, argv, 0, &ierr);
+        if (ierr)
+            return 0;
+        gmsh_ready = 1;
+    }
+    gm.gmshOptionSetNumber("General.Terminal", 0, &ierr);
+    gm.gmshOptionSetNumber("General.Verbosity", 0, &ierr);
+    gm.gmshClear(&ierr);
+    return ierr == 0;
+}
+
+/* Ends Gmsh after every use: it keeps a failed read's state (the next model would be empty), and
+** its global model and tables are released only by finalizing it. */
+static void gmsh_end(void)
+{
+    int ierr = 0;
+    if (gmsh_ready)
+        gm.gmshFinalize(&ierr);
+    gmsh_ready = 0;
+}
+
+static const char *gmsh_reason(char *buf, size_t cap)
+{
+    char *msg = NULL;
+    int ierr = 0;
+    gm.gmshLoggerGetLastError(&msg, &ierr);
+    snprintf(buf, cap, "%s", msg && *msg && !ierr ? msg : "Gmsh could not read it");
+    if (msg)
+        gm.gmshFree(msg);
+    for (char *p = buf; *p; p++) /* one line, printable */
+        if ((unsigned char)*p < 32)
+            *p = ' ';
+    return buf;
+}
+
+static int cmp_size(const void *a, const void *b)
+{
+    size_t x = *(const size_t *)a, y = *(const size_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Corner count and tetrahedra of Gmsh element type t: linear or higher-order tetrahedra (their
+** four corners) and hexahedra (six tetrahedra around the diagonal from corner 0 to corner 6). */
+static int volume_type(int t, int *corners, int *tets)
+{
+    switch (t) {
+    case 4: case 11: case 29: case 30: case 31:
+        *corners = 4;
+        *tets = 1;
+        return 1;
+    case 5: case 12: case 17: case 92: case 93:
+        *corners = 8;
+        *tets = 6;
+        return 1;
+    default:
+        return 0;
+    }
+}
+
+/* The current Gmsh model's volume elements into m (node coordinates times unit_mm). */
+static cf_status extract(const char *name, double unit_mm, cf_mesh *m, cf_error *err)
+{
+    int ierr = 0, *types = NULL;
+    size_t ntypes = 0, **etags = NULL, *etags_n = NULL, etags_nn = 0, **ntags = NULL,
+           *ntags_n = NULL, ntags_nn = 0, *tags = NULL, tags_n = 0, *sorted = NULL;
+    double *coord = NULL, *par = NULL;
+    size_t coord_n = 0, par_n = 0;
+    cf_status st = CF_OK;
+    char why[300];
+    memset(m, 0, sizeof *m);
+    gm.gmshModelMeshGetElements(&types, &ntypes, &etags, &etags_n, &etags_nn, &ntags, &ntags_n,
+                             &ntags_nn, 3, -1, &ierr);
+    if (ierr) {
+        st = cf_error_set(err, CF_E_DATA, "%s: %s", name, gmsh_reason(why, sizeof why));
+        goto end;
+    }
+    size_t nt = 0;
+    for (size_t k = 0; k < ntypes; k++) {
+        int corners = 4, per = 1;
+        if (!volume_type(types[k], &corners, &per)) {
+            st = cf_error_set(err, CF_E_DATA,
+                              "%s: element %zu is of Gmsh type %d: only tetrahedra and hexahedra "
+                              "are read",
+                              name, etags_n[k] ? etags[k][0] : (size_t)0, types[k]);
+            goto end;
+        }
+        nt += etags_n[k] * (size_t)per;
+    }
+    if (nt == 0) {
+        st = cf_error_set(err, CF_E_DATA,
+                          "%s: no tetrahedra or hexahedra: not a volume mesh", name);
+        goto end;
+    }
+    gm.gmshModelMeshGetNodes(&tags, &tags_n, &coord, &coord_n, &par, &par_n, -1, -1, 0, 0, &ierr);
+    if (ierr || coord_n != 3 * tags_n) {
+        st = cf_error_set(err, CF_E_DATA, "%s: %s", name, gmsh_reason(why, sizeof why));
+        goto end;
+    }
+    /* the nodes the volume elements use, in the order of their tags */
+    size_t nused = 0;
+    for (size_t k = 0; k < ntypes; k++)
+        nused += ntags_n[k];
+    sorted = malloc((nused ? nused : 1) * sizeof *sorted);
+    m->tet = malloc(4 * nt * sizeof *m->tet);
+    m->eid = malloc(nt * sizeof *m->eid);
+    if (!sorted || !m->tet || !m->eid)
+        goto oom;
+    nused = 0;
+    for (size_t k = 0; k < ntypes; k++) {
+        int corners = 4, per = 1;
+        volume_type(types[k], &corners, &per);
+        size_t stride = etags_n[k] ? ntags_n[k] / etags_n[k] : 0;
+        for (size_t e = 0; e < etags_n[k]; e++)
+            for (int c = 0; c < corners; c++)
+                sorted[nused++] = ntags[k][e * stride + (size_t)c];
+    }
+    qsort(sorted, nused, sizeof *sorted, cmp_size);
+    size_t nn = 0;
+    for (size_t i = 0; i < nused; i++)
+        if (i == 0 || sorted[i] != sorted[nn - 1])
+            sorted[nn++] = sorted[i];
+    if (nn > UINT32_MAX) {
+        st = cf_error_set(err, CF_E_DATA, "%s: %zu nodes: too many", name, nn);
+        goto end;
+    }
+    m->nn = nn;
+    m->X = malloc(3 * nn * sizeof *m->X);
+    m->id = malloc(nn * sizeof *m->id);
+    size_t *order = malloc((tags_n ? tags_n : 1) * sizeof *order);
+    if (!m->X || !m->id || !order) {
+        free(order);
+        goto oom;
+    }
+    for (size_t i = 0; i < nn; i++)
+        m->id[i] = (uint32_t)(sorted[i] <= UINT32_MAX ? sorted[i] : 0);
+    /* coordinates: find each used tag among Gmsh's nodes */
+    for (size_t i = 0; i < nn; i++)
+        m->X[3 * i] = NAN;
+    for (size_t j = 0; j < tags_n; j++) {
+        size_t *hit = bsearch(&tags[j], sorted, nn, sizeof *sorted, cmp_size);
+        if (hit)
+            for (int a = 0; a < 3; a++)
+                m->X[3 * (size_t)(hit - sorted) + a] = coord[3 * j + a] * unit_mm;
+    }
+    free(order);
+    for (size_t i = 0; i < nn; i++)
+        if (isnan(m->X[3 * i])) {
+            st = cf_error_set(err, CF_E_DATA, "%s: node %zu is used by an element but not defined",
+                              name, sorted[i]);
+            goto end;
+        }
+    size_t t = 0;
+    static const int hex_tet[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6},
+                                      {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
+    for (size_t k = 0; k < ntypes; k++) {
+        int corners = 4, per = 1;
+        volume_type(types[k], &corners, &per);
+        size_t stride = etags_n[k] ? ntags_n[k] / etags_n[k] : 0;
+        for (size_t e = 0; e < etags_n[k]; e++) {
+            uint32_t v[8];
+            for (int c = 0; c < corners; c++) {
+                size_t *hit = bsearch(&ntags[k][e * stride + (size_t)c], sorted, nn,
+                                      sizeof *sorted, cmp_size);
+                v[c] = (uint32_t)(hit - sorted);
+            }
+            for (int p = 0; p < per; p++, t++) {
+                for (int c = 0; c < 4; c++)
+                    m->tet[4 * t + c] = corners == 4 ? v[c] : v[hex_tet[p][c]];
+                m->eid[t] = etags[k][e];
+            }
+        }
+    }
+    m->nt = nt;
+    goto end;
+oom:
+    st = cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the mesh", name);
+end:
+    if (st != CF_OK)
+        cf_mesh_free(m);
+    free(sorted);
+    for (size_t k = 0; k < ntypes; k++) {
+        gm.gmshFree(etags ? etags[k] : NULL);
+        gm.gmshFree(ntags ? ntags[k] : NULL);
+    }
+    gm.gmshFree(types);
+    gm.gmshFree(etags);
+    gm.gmshFree(etags_n);
+    gm.gmshFree(ntags);
+    gm.gmshFree(ntags_n);
+    gm.gmshFree(tags);
+    gm.gmshFree(coord);
+    gm.gmshFree(par);
+    return st;
+}
+
+/* The mesh formats read (by the name's ending, which is how Gmsh chooses its reader): files of
+** data only. Gmsh opens any other name as a script of its own language, which can run commands,
+** so no other name is passed to it (input is data, never code). */
+static const char *const mesh_exts[] = {".msh", ".mesh", ".vtk", ".unv", ".bdf", ".nas", NULL};
+
+static int mesh_ext_ok(const char *path)
+{
+    size_t n = strlen(path);
+    for (size_t k = 0; mesh_exts[k]; k++) {
+        size_t e = strlen(mesh_exts[k]);
+        if (n > e && strcasecmp(path + n - e, mesh_exts[k]) == 0)
+            return 1;
+    }
+    return 0;
+}
+
+cf_status cf_mesh_read(const char *path, double unit_mm, cf_mesh *m, cf_error *err)
+{
+    return cf_mesh_read_refined(path, unit_mm, 0, m, err);
+}
+
+cf_status cf_mesh_read_refined(const char *path, double unit_mm, int refine, cf_mesh *m,
+                               cf_error *err)
+{
+    memset(m, 0, sizeof *m);
+    if (!mesh_ext_ok(path))
+        return cf_error_set(err, CF_E_DATA, "%s: not a mesh file name: expected .msh, .mesh, "
+                            ".vtk, .unv, .bdf or .nas (Gmsh's mesh formats)", path);
+    if (refine < 0 || refine > 4)
+        return cf_error_set(err, CF_E_DATA, "%s: refinement %d: must be 0 to 4", path, refine);
+    if (!(unit_mm > 0) || !isfinite(unit_mm))
+        return cf_error_set(err, CF_E_DATA, "%s: unit %g mm: must be finite and > 0", path, unit_mm);
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return cf_error_set(err, CF_E_NOINPUT, "%s: cannot open mesh: %s", path, strerror(errno));
+    fclose(f);
+    pthread_mutex_lock(&gmsh_lock);
+    cf_status st;
+    int ierr = 0;
+    char why[300];
+    if (!gmsh_begin(why, sizeof why)) {
+        st = cf_error_set(err, CF_E_INTERNAL, "%s: %s", path, why);
+    } else {
+        gm.gmshOpen(path, &ierr);
+        if (ierr) {
+            st = cf_error_set(err, CF_E_DATA, "%s: not a mesh Gmsh reads: %s", path,
+                              gmsh_reason(why, sizeof why));
+        } else {
+            for (int k = 0; k < refine && !ierr; k++)
+                gm.gmshModelMeshRefine(&ierr);
+            st = ierr ? cf_error_set(err, CF_E_DATA, "%s: Gmsh could not refine it: %s", path,
+                                     gmsh_reason(why, sizeof why))
+                      : extract(path, unit_mm, m, err);
+        }
+        gmsh_end();
+    }
+    pthread_mutex_unlock(&gmsh_lock);
+    if (st == CF_OK && (st = cf_mesh_check(m, path, err)) != CF_OK)
+        cf_mesh_free(m);
+    return st;
+}
+
+cf_status cf_mesh_box(const double lo[3], const double hi[3], const double focus[3],
+                      double size_near, double size_far, double growth, cf_mesh *m, cf_error *err)
+{
+    memset(m, 0, sizeof *m);
+    for (int a = 0; a < 3; a++)
+        if (!isfinite(lo[a]) || !isfinite(hi[a]) || !(hi[a] > lo[a]) || !isfinite(focus[a]))
+            return cf_error_set(err, CF_E_DATA, "box: corner %d is not finite and increasing", a);
+    if (!(size_near > 0) || !(size_far >= size_near) || !isfinite(size_far) || !(growth >= 0) ||
+        !isfinite(growth))
+        return cf_error_set(err, CF_E_DATA, "box: element sizes %g, %g and growth %g: need "
+                                            "0 < near <= far and growth >= 0",
+                            size_near, size_far, growth);
+    double vol = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+    if (vol / (size_near * size_near * size_near) > 1e8)
+        return cf_error_set(err, CF_E_DATA, "box: element size %g mm too small for the box",
+                            size_near);
+    pthread_mutex_lock(&gmsh_lock);
+    cf_status st = CF_OK;
+    int ierr = 0;
+    char why[300], expr[400];
+    if (!gmsh_begin(why, sizeof why)) {
+        st = cf_error_set(err, CF_E_INTERNAL, "box: %s", why);
+        goto end;
+    }
+    gm.gmshModelAdd("box", &ierr);
+    gm.gmshModelOccAddBox(lo[0], lo[1], lo[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], -1, &ierr);
+    gm.gmshModelOccSynchronize(&ierr);
+    int fld = gm.gmshModelMeshFieldAdd("MathEval", -1, &ierr);
+    snprintf(expr, sizeof expr, "Min(%.17g, %.17g + %.17g * Sqrt((x - %.17g)^2 + (y - %.17g)^2 + "
+                                "(z - %.17g)^2))",
+             size_far, size_near, growth, focus[0], focus[1], focus[2]);
+    gm.gmshModelMeshFieldSetString(fld, "F", expr, &ierr);
+    gm.gmshModelMeshFieldSetAsBackgroundMesh(fld, &ierr);
+    gm.gmshOptionSetNumber("Mesh.MeshSizeExtendFromBoundary", 0, &ierr);
+    gm.gmshOptionSetNumber("Mesh.MeshSizeFromPoints", 0, &ierr);
+    gm.gmshOptionSetNumber("Mesh.MeshSizeFromCurvature", 0, &ierr);
+    gm.gmshOptionSetNumber("Mesh.RandomSeed", 1, &ierr);
+    gm.gmshOptionSetNumber("General.NumThreads", 1, &ierr);
+    gm.gmshModelMeshGenerate(3, &ierr);
+    if (ierr) {
+        st = cf_error_set(err, CF_E_DATA, "box: Gmsh could not mesh it: %s",
+                          gmsh_reason(why, sizeof why));
+        goto end;
+    }
+    st = extract("box", 1, m, err);
+end:
+    gmsh_end();
+    pthread_mutex_unlock(&gmsh_lock);
+    if (st == CF_OK && (st = cf_mesh_check(m, "box", err)) != CF_OK)
+        cf_mesh_free(m);
+    return st;
+}

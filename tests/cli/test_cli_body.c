@@ -1,0 +1,298 @@
+/*
+** `conifit simulate` on a scene with a tissue body: the depth-force CSV, the summary's E and nu,
+** the ParaView files read back by VTK's own reader (python3-vtk9; the check skips when VTK is
+** absent), bad scenes refused with exit 65 naming the key and nothing written, and a fitted
+** tissue's body probed deep into its nonlinear range (the shared brain table, when present).
+*/
+#include "testutil.h"
+
+#include <sys/stat.h>
+
+#include "conifit/body.h"
+
+TU_SCRATCH_GROUP("cli-body")
+
+#define SPRING "\"spring\": {\"params\": {\"D1_mm\": 10, \"D2_mm\": 30, \"n\": 4, \"d_mm\": 1, " \
+               "\"G_MPa\": 80000, \"H_mm\": 40}}"
+
+/* A block of 6 x 6 x 3 cells over 30 x 30 x 15 mm, as a Gmsh 2.2 file. */
+static void write_block(const char *path)
+{
+    double xs[7], zs[4];
+    for (int i = 0; i <= 6; i++)
+        xs[i] = 5.0 * i;
+    for (int i = 0; i <= 3; i++)
+        zs[i] = 5.0 * i;
+    cf_mesh m;
+    assert_int_equal(cf_mesh_block(&m, xs, 6, xs, 6, zs, 3, NULL), CF_OK);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f, "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n%zu\n", m.nn);
+    for (size_t i = 0; i < m.nn; i++)
+        fprintf(f, "%zu %.17g %.17g %.17g\n", i + 1, m.X[3 * i], m.X[3 * i + 1], m.X[3 * i + 2]);
+    fprintf(f, "$EndNodes\n$Elements\n%zu\n", m.nt);
+    for (size_t t = 0; t < m.nt; t++)
+        fprintf(f, "%zu 4 2 0 1 %u %u %u %u\n", t + 1, m.tet[4 * t] + 1, m.tet[4 * t + 1] + 1,
+                m.tet[4 * t + 2] + 1, m.tet[4 * t + 3] + 1);
+    fprintf(f, "$EndElements\n");
+    fclose(f);
+    cf_mesh_free(&m);
+}
+
+static void write_scene(const char *path, const char *body_extra, const char *fixed_value,
+                        const char *center_z)
+{
+    char mesh[600];
+    snprintf(mesh, sizeof mesh, "%s/block.msh", dir);
+    write_block(mesh);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f,
+            "{" SPRING ",\n \"body\": {\"mesh\": \"%s\", \"unit_mm\": 1, \"poisson_ratio\": 0.45%s},\n"
+            " \"fixed\": {\"below\": {\"axis\": \"z\", \"value_mm\": %s}},\n"
+            " \"probe\": {\"shape\": \"sphere\", \"radius_mm\": 5, \"center_mm\": [15, 15, %s], "
+            "\"direction\": [0, 0, -2], \"depth_mm\": 1, \"steps\": 4}}\n",
+            mesh, body_extra, fixed_value, center_z);
+    fclose(f);
+}
+
+static int exists(const char *path)
+{
+    struct stat sb;
+    return stat(path, &sb) == 0;
+}
+
+static void a_probe_scene_writes_the_curve_and_the_summary(void **state)
+{
+    (void)state;
+    char scene[600], csv[600], vtu[600], out[8192], err[8192];
+    snprintf(scene, sizeof scene, "%s/probe.json", dir);
+    snprintf(csv, sizeof csv, "%s/probe.csv", dir);
+    snprintf(vtu, sizeof vtu, "%s/vtu", dir);
+    write_scene(scene, "", "0", "20");
+    assert_int_equal(tu_run(out, sizeof out, err, sizeof err, "simulate %s -o %s --vtu %s", scene,
+                            csv, vtu),
+                     0);
+    /* the summary's E and nu: the spring's material (E0 = k0/H, mu = E0/2.5) with the volume
+    ** term of nu = 0.45 */
+    cf_spring p = {10, 30, 4, 1, 8e4, 40};
+    cf_law law;
+    assert_int_equal(cf_law_init(&law, &p, NULL), CF_OK);
+    const double mu = cf_body_mu_of_law(&law), lam = mu + cf_body_kappa_for_nu(mu, 0.45);
+    const double E = mu * (3 * lam + 2 * mu) / (lam + mu);
+    const char *s = strstr(out, "body: E = ");
+    assert_non_null(s);
+    double E_kPa, nu;
+    assert_int_equal(sscanf(s, "body: E = %lf kPa, nu = %lf", &E_kPa, &nu), 2);
+    assert_close(E_kPa, E * 1e3, 1e-5 * E * 1e3);
+    assert_close(nu, 0.45, 1e-6);
+    /* the curve: depth 0 .. 1 in 4 steps, the force growing from 0 */
+    FILE *f = fopen(csv, "r");
+    assert_non_null(f);
+    char line[256];
+    assert_non_null(fgets(line, sizeof line, f));
+    assert_string_equal(line, "depth_mm,force_N\n");
+    double d[5], F[5];
+    int n = 0;
+    while (n < 6 && fgets(line, sizeof line, f))
+        if (sscanf(line, "%lf,%lf", &d[n], &F[n]) == 2)
+            n++;
+    fclose(f);
+    assert_int_equal(n, 5);
+    assert_close(F[0], 0, 0);
+    for (int k = 1; k < 5; k++) {
+        assert_close(d[k], 0.25 * k, 1e-12);
+        assert_true(F[k] > F[k - 1]);
+    }
+    print_message("sphere on the block: force %.6g N at depth 1 mm, %.4f of the step before\n",
+                  F[4], F[4] / F[3]);
+    char pvd[700];
+    snprintf(pvd, sizeof pvd, "%s/body.pvd", vtu);
+    char *text = tu_slurp(pvd);
+    assert_non_null(text);
+    assert_non_null(strstr(text, "file=\"body_0004.vtu\""));
+    assert_non_null(strstr(text, "file=\"springs_0004.vtu\""));
+    free(text);
+    cf_law_free(&law);
+}
+
+static void vtk_reads_the_files(void **state)
+{
+    (void)state;
+    /* the Python that has Debian's VTK: the first python3 on the path, or the system's own (a
+    ** python3 of a virtual environment first on the path does not see Debian's modules) */
+    const char *python = NULL;
+    static const char *const pythons[] = {"python3", "/usr/bin/python3"};
+    for (int k = 0; k < 2 && !python; k++) {
+        char probe[200];
+        snprintf(probe, sizeof probe, "%s -c 'import vtkmodules.vtkIOXML' >/dev/null 2>&1",
+                 pythons[k]);
+        if (system(probe) == 0)
+            python = pythons[k];
+    }
+    if (!python)
+        skip(); /* python3-vtk9 absent (Makefile DEBS installs it) */
+    char vtu[600], cmd[2400];
+    snprintf(vtu, sizeof vtu, "%s/vtu", dir);
+    if (!exists(vtu))
+        skip(); /* the run of the test before did not write them (it failed) */
+    char py[700];
+    snprintf(py, sizeof py, "%s/read.py", dir);
+    FILE *f = fopen(py, "w");
+    assert_non_null(f);
+    fputs("import sys\n"
+          "from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader\n"
+          "def read(path):\n"
+          "    r = vtkXMLUnstructuredGridReader()\n"
+          "    r.SetFileName(path)\n"
+          "    r.Update()\n"
+          "    return r.GetOutput()\n"
+          "b = read(sys.argv[1] + '/body_0004.vtu')\n"
+          "s = read(sys.argv[1] + '/springs_0004.vtu')\n"
+          "u = b.GetPointData().GetArray('displacement')\n"
+          "J = b.GetCellData().GetArray('J')\n"
+          "e = s.GetCellData().GetArray('strain')\n"
+          "so = s.GetCellData().GetArray('solid')\n"
+          "uz = min(u.GetComponent(i, 2) for i in range(u.GetNumberOfTuples()))\n"
+          "print(b.GetNumberOfPoints(), b.GetNumberOfCells(), s.GetNumberOfCells(), \n"
+          "      '%.9g %.9g %.9g %.9g %d' % (uz, J.GetRange()[0], e.GetRange()[0], "
+          "e.GetRange()[1], int(so.GetRange()[1])), b.GetCellType(0), s.GetCellType(0))\n",
+          f);
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "%s %s %s > %s/vtk.txt 2>&1", python, py, vtu, dir);
+    assert_int_equal(system(cmd), 0);
+    snprintf(cmd, sizeof cmd, "%s/vtk.txt", dir);
+    char *text = tu_slurp(cmd);
+    assert_non_null(text);
+    long np, nt, ns;
+    int solid, tt, st;
+    double uz, Jmin, emin, emax;
+    if (sscanf(text, "%ld %ld %ld %lf %lf %lf %lf %d %d %d", &np, &nt, &ns, &uz, &Jmin, &emin,
+               &emax, &solid, &tt, &st) != 10)
+        fail_msg("VTK's reader said: %s", text);
+    free(text);
+    assert_int_equal(np, 7 * 7 * 4);
+    assert_int_equal(nt, 6 * 6 * 6 * 3);
+    assert_true(ns > nt / 2);
+    assert_int_equal(tt, 10); /* VTK_TETRA */
+    assert_int_equal(st, 3);  /* VTK_LINE */
+    /* the node under the sphere went down by about the depth (1 mm less the 0.x mm the sphere
+    ** started above the surface: centre 20, radius 5, surface 15) */
+    assert_close(uz, -1, 0.05);
+    assert_true(Jmin > 0.8 && Jmin < 1);
+    assert_true(emin < 0 && emax > 0);
+    assert_int_equal(solid, 0);
+}
+
+static void bad_probe_scenes_are_refused_and_write_nothing(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *extra, *fixed, *center, *must;
+        int rc;
+    } cases[] = {
+        {"", "0", "18", "'probe.center_mm'", 65},         /* the sphere reaches below z = 15 */
+        {"", "-1", "20", "'fixed.below'", 65},            /* no node at z <= -1 */
+        {", \"colour\": 1", "0", "20", "'body.colour'", 65},
+        {", \"poisson_ratio\": 0.2", "0", "20", "duplicate", 65},
+        {", \"refine\": 1.5", "0", "20", "'body.refine' = 1.5", 65},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char scene[600], csv[600], vtu[600], out[4096], err[4096];
+        snprintf(scene, sizeof scene, "%s/bad%zu.json", dir, k);
+        snprintf(csv, sizeof csv, "%s/bad%zu.csv", dir, k);
+        snprintf(vtu, sizeof vtu, "%s/badvtu%zu", dir, k);
+        write_scene(scene, cases[k].extra, cases[k].fixed, cases[k].center);
+        int rc = tu_run(out, sizeof out, err, sizeof err, "simulate %s -o %s --vtu %s", scene,
+                        csv, vtu);
+        if (rc != cases[k].rc || !strstr(err, cases[k].must))
+            fail_msg("case %zu: exit %d, stderr '%s'; expected %d naming %s", k, rc, err,
+                     cases[k].rc, cases[k].must);
+        assert_false(exists(csv));
+        assert_false(exists(vtu));
+    }
+    /* a missing mesh: exit 66 naming it */
+    char scene[600], out[4096], err[4096];
+    snprintf(scene, sizeof scene, "%s/nomesh.json", dir);
+    FILE *f = fopen(scene, "w");
+    assert_non_null(f);
+    fprintf(f, "{" SPRING ", \"body\": {\"mesh\": \"%s/none.msh\", \"unit_mm\": 1}, \"fixed\": "
+               "{\"below\": {\"axis\": \"z\", \"value_mm\": 0}}, \"probe\": {\"shape\": \"punch\", "
+               "\"radius_mm\": 1, \"center_mm\": [0, 0, 9], \"direction\": [0, 0, -1], "
+               "\"depth_mm\": 1}}",
+            dir);
+    fclose(f);
+    assert_int_equal(tu_run(out, sizeof out, err, sizeof err, "simulate %s -o %s/x.csv", scene, dir),
+                     66);
+    assert_non_null(strstr(err, "none.msh"));
+    /* --vtu with a lattice scene is a usage error */
+    assert_int_equal(tu_run(out, sizeof out, err, sizeof err,
+                            "simulate data/scenes/uniaxial.json -o %s/y.csv --vtu %s/v", dir, dir),
+                     2);
+}
+
+/* A fitted brain table's body probed deep: stable (no spring at solid, every J > 0) and stiffening
+** as the fit's law does. The fitted springs of the cortex in compression close at 15 % of their
+** free length; a punch 2.5 mm into the 15 mm layer takes the most compressed spring to 0.9 of
+** that and a tetrahedron to J = 0.59. Skips without ../shared/datasets. */
+static void a_fitted_brain_body_probed_deep_stays_stable(void **state)
+{
+    (void)state;
+    const char *ds = tu_datasets();
+    if (!ds)
+        skip(); /* ../shared/datasets absent */
+    char out[16384], err[8192], fit[600], scene[600], csv[600];
+    snprintf(fit, sizeof fit, "%s/brain.json", dir);
+    assert_int_equal(tu_run(out, sizeof out, err, sizeof err,
+                            "fit %s/brain_cortex_compression.csv -o %s -q", ds, fit),
+                     0);
+    char mesh[600];
+    snprintf(mesh, sizeof mesh, "%s/block.msh", dir);
+    write_block(mesh);
+    snprintf(scene, sizeof scene, "%s/brain_probe.json", dir);
+    snprintf(csv, sizeof csv, "%s/brain_probe.csv", dir);
+    FILE *f = fopen(scene, "w");
+    assert_non_null(f);
+    fprintf(f, "{\"spring\": {\"fit\": \"%s\"}, \"body\": {\"mesh\": \"%s\", \"unit_mm\": 1, "
+               "\"poisson_ratio\": 0.45}, \"fixed\": {\"below\": {\"axis\": \"z\", \"value_mm\": 0}}, "
+               "\"probe\": {\"shape\": \"punch\", \"radius_mm\": 6, \"center_mm\": [15, 15, 15], "
+               "\"direction\": [0, 0, -1], \"depth_mm\": 2.5, \"steps\": 16}}",
+            fit, mesh);
+    fclose(f);
+    if (tu_run(out, sizeof out, err, sizeof err, "simulate %s -o %s", scene, csv) != 0)
+        fail_msg("%s", err);
+    print_message("%s", out);
+    const char *s = strstr(out, "smallest J ");
+    assert_non_null(s);
+    double J, u;
+    assert_int_equal(sscanf(s, "smallest J %lf, largest spring compression %lf", &J, &u), 2);
+    assert_true(J > 0);
+    assert_true(u > 0.05 && u < 1);
+    /* the force grows faster than the depth (the law stiffens): the last quarter's slope above
+    ** the first's */
+    FILE *c = fopen(csv, "r");
+    assert_non_null(c);
+    char line[256];
+    double d[17], F[17];
+    int n = 0;
+    assert_non_null(fgets(line, sizeof line, c));
+    while (n < 17 && fgets(line, sizeof line, c))
+        if (sscanf(line, "%lf,%lf", &d[n], &F[n]) == 2)
+            n++;
+    fclose(c);
+    assert_int_equal(n, 17);
+    for (int k = 1; k < 17; k++)
+        assert_true(F[k] > F[k - 1]);
+    assert_true((F[16] - F[12]) / (d[16] - d[12]) > (F[4] - F[0]) / (d[4] - d[0]));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(a_probe_scene_writes_the_curve_and_the_summary),
+        cmocka_unit_test(vtk_reads_the_files),
+        cmocka_unit_test(bad_probe_scenes_are_refused_and_write_nothing),
+        cmocka_unit_test(a_fitted_brain_body_probed_deep_stays_stable),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
