@@ -206,7 +206,7 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
     lat->method = method;
     lat->with_stiffness = 1;
     lat->H_mm = law->p.H_mm;
-    lat->travel_mm = law->travel_mm;
+    lat->travel_mm = cf_law_travel_min(law); /* a pair: the side that closes first */
 
     /* The spring directions of the cell (each unordered pair of neighbours once). */
     int off[CF_CELL_DIRS][3];
@@ -320,6 +320,8 @@ static double law_at(double v, void *p)
 static double law_work(const cf_law *law, cf_law_method m, double u,
                        const gsl_integration_glfixed_table *gl)
 {
+    if (u < 0 && law->extension) /* a pair's extension side: its own spring compressed by -u */
+        law = law->extension, u = -u;
     double au = fabs(u), uT = law->u_T_mm, uC = law->u_C_mm, s = law->travel_mm;
     double e = 0.5 * law->k0_N_per_mm * fmin(au, uT) * fmin(au, uT);
     if (au > uT) {

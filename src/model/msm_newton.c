@@ -214,7 +214,9 @@ static double force_floor(const solver *s)
         for (size_t q = 0; q < lat->ns; q++)
             dash = fmax(dash, s->kx[q] * fmax(lat->L_mm[q], xmax));
     }
-    return 1e-12 * lat->law->F_C_N * wmax + 1e-13 * dash;
+    const double FC = lat->law->extension ? fmax(lat->law->F_C_N, lat->law->extension->F_C_N)
+                                          : lat->law->F_C_N;
+    return 1e-12 * FC * wmax + 1e-13 * dash;
 }
 
 /* A step from reused factors did not converge fast enough: chord steps give way to Krylov steps,

@@ -25,6 +25,7 @@ void cf_joint_report_free(cf_joint_report *r)
     for (int k = 0; k < 2; k++) {
         cf_joint_free(&r->fits[k]);
         cf_joint_free(&r->law_choice[k].other);
+        cf_joint_free(&r->law_choice[k].pair_other);
     }
 }
 

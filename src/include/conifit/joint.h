@@ -53,6 +53,20 @@ typedef struct cf_joint_result {
                                     ** (conical) or 4 (conical-tail); what auto compares */
     long evaluations;               /* cell curves computed */
     double wall_time_s;
+    /* The double-acting element (law double-acting) and the volume term (joint fits only): */
+    int pair;                       /* 1: fit is the compression spring, ext the extension one */
+    cf_fit_result ext;              /* the extension spring placed (its ident, ident_se; H = fit's) */
+    cf_volume volume;               /* how kappa was set: none, declared, from nu, fitted */
+    double volume_modulus_MPa;      /* kappa of the volume term (0: none), MPa */
+    double volume_modulus_se;       /* its standard error (fitted), MPa; -1 when not determined
+                                    ** or not fitted */
+    double nu_compression;          /* the lattice's small-strain nu, loaded along an axis, with
+                                    ** the compression spring's k0 (the odd law: the only one) */
+    double nu_extension;            /* the same with the extension spring's k0 */
+    double E_compression_MPa;       /* the lattice's small-strain Young's modulus along an axis,
+                                    ** each side (MPa, the volume term included) */
+    double E_extension_MPa;
+    int nparams;                    /* the quantities fitted (3, 4, 6 or 7; the AIC's k) */
 } cf_joint_result;
 
 /* Fits the n tables jointly with spring type `type` in the lattice of `lat` (its calibration:
@@ -72,6 +86,27 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
 cf_status cf_joint_fit_tail(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
                             const cf_validate_setup *lat, const cf_joint_result *plain,
                             cf_joint_result *r, cf_error *err);
+
+/* The double-acting element fitted jointly (opt->law double-acting, or any law with a volume term
+** opt->volume): the compression spring's (rho, s/H, F_C/H^2) and, for the pair, the extension
+** spring's, with kappa fitted, declared or derived from a declared nu, all through the cell (its
+** springs' sides by the sign of their compression, cell.h); each table weighted as in the conical
+** joint fit, BOBYQA from plain's quantities (may be NULL) and a grid. Both springs placed as the
+** conical law's (the extension spring at the compression spring's H); errors of every quantity
+** (kappa too) from the joint residuals' central-difference Jacobian, -1 for those the data do
+** not determine (the Jacobian's null space). pair 0 fits the odd conical law with the volume
+** term. CF_E_DATA for a declared nu below the springs' own (the term only raises it). */
+cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
+                            const cf_validate_setup *lat, cf_spring_type type, int pair,
+                            const cf_joint_result *plain, cf_joint_result *r, cf_error *err);
+
+/* The volume modulus kappa (MPa) that gives a lattice of family weights w and small-strain
+** modulus scale k0/H (MPa) the small-strain nu along an axis: with the cubic constants C11, C12
+** (calibration.h) kappa = (nu (C11 + C12) - C12)/(1 - 2 nu) k0/H, from nu = (C12 + kappa)/(C11
+** + C12 + 2 kappa) (the term adds kappa to C11 and C12, Lame's lambda, nothing to C44). Negative
+** when nu is below the springs' own. And the inverse, nu of a lattice with kappa. */
+double cf_joint_kappa_of_nu(const double w[CF_FAMILY_COUNT], double k0_over_H, double nu);
+double cf_joint_nu_of_kappa(const double w[CF_FAMILY_COUNT], double k0_over_H, double kappa);
 
 /* Releases the per-table curves. Safe on a zeroed result. */
 void cf_joint_free(cf_joint_result *r);
