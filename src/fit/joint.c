@@ -372,13 +372,163 @@ enum { PQ_RC = 0, PQ_BC, PQ_AC, PQ_RE, PQ_BE, PQ_AE, PQ_K, PQ_COUNT };
 static int pair_residuals(jctx *c, const double v[PQ_COUNT], double *g, double *res)
 {
     c->ext[0] = v[PQ_RE], c->ext[1] = v[PQ_BE], c->ext[2] = v[PQ_AE] / v[PQ_AC];
-    c->kappa_mode = KAPPA_UNIT;
-    c->kappa = v[PQ_K] / v[PQ_AC];
+    if (c->opt->volume == CF_VOLUME_POISSON) { /* kappa follows the springs */
+        c->kappa_mode = KAPPA_NU;
+        c->kappa = c->opt->volume_value;
+    } else {
+        c->kappa_mode = KAPPA_UNIT;
+        c->kappa = v[PQ_K] / v[PQ_AC];
+    }
     if (joint_curve(c, v[PQ_RC], v[PQ_BC], g) != 0)
         return 1;
     for (size_t i = 0; i < c->pr.n; i++)
         res[i] = c->pr.sw[i] * (v[PQ_AC] * g[i] - c->pr.y[i]);
     return 0;
+}
+
+/* 1 when quantity k of v is searched in logarithm (the scales, ratios and kappa), 0 for the solid
+** strains. */
+static int pq_log(int k)
+{
+    return k != PQ_BC && k != PQ_BE;
+}
+
+/* The weighted RSS at v (the residuals into res), CF_LSQ_HUGE_OBJ where a curve fails, a strain
+** leaves [Blo, Bhi], a ratio [rlo, rhi], or the compression spring's scale passes what the pair
+** carries there. */
+static double pair_rss(jctx *c, const double v[PQ_COUNT], const double box[4], double *g,
+                       double *res)
+{
+    if (v[PQ_BC] < box[0] || v[PQ_BC] > box[1] || v[PQ_RC] < box[2] || v[PQ_RC] > box[3])
+        return CF_LSQ_HUGE_OBJ;
+    if (c->pair && (v[PQ_BE] < box[0] || v[PQ_BE] > box[1] || v[PQ_RE] < box[2] ||
+                    v[PQ_RE] > box[3]))
+        return CF_LSQ_HUGE_OBJ;
+    if (pair_residuals(c, v, g, res) != 0)
+        return CF_LSQ_HUGE_OBJ;
+    if (!(v[PQ_AC] <= pair_A_max(c, v[PQ_RC], v[PQ_BC]) * (1 + 1e-12)))
+        return CF_LSQ_HUGE_OBJ;
+    double ss = 0;
+    for (size_t i = 0; i < c->pr.n; i++)
+        ss += res[i] * res[i];
+    return isfinite(ss) ? ss : CF_LSQ_HUGE_OBJ;
+}
+
+/* Levenberg-Marquardt from v over the used quantities (logarithms of the scales and kappa, the
+** strains as they are), central-difference Jacobians, inside the search's box: BOBYQA's optimum
+** polished to where the residuals stop falling (a noiseless table's quantities to ~1e-8). Returns
+** the RSS at v (updated in place). */
+static double pair_polish(jctx *c, double v[PQ_COUNT], const int used[PQ_COUNT],
+                          const double box[4])
+{
+    const size_t n = c->pr.n;
+    int idx[PQ_COUNT], p = 0;
+    for (int k = 0; k < PQ_COUNT; k++)
+        if (used[k] && v[k] > 0)
+            idx[p++] = k;
+    double *g = malloc(sizeof(double) * n), *r0 = malloc(sizeof(double) * n);
+    double *rp = malloc(sizeof(double) * n), *rm = malloc(sizeof(double) * n);
+    double *J = malloc(sizeof(double) * n * (size_t)(p ? p : 1));
+    double f = CF_LSQ_HUGE_OBJ;
+    if (g && r0 && rp && rm && J)
+        f = pair_rss(c, v, box, g, r0);
+    double lambda = 1e-3;
+    for (int it = 0; it < 40 && f < CF_LSQ_HUGE_OBJ && f > 0; it++) {
+        int bad = 0;
+        for (int a = 0; a < p && !bad; a++) {
+            const int k = idx[a];
+            const double h = 1e-6 * (pq_log(k) ? 1.0 : fabs(v[k]));
+            double vp[PQ_COUNT], vm[PQ_COUNT];
+            memcpy(vp, v, sizeof vp);
+            memcpy(vm, v, sizeof vm);
+            vp[k] = pq_log(k) ? v[k] * exp(h) : v[k] + h;
+            vm[k] = pq_log(k) ? v[k] * exp(-h) : v[k] - h;
+            bad = pair_residuals(c, vp, g, rp) != 0 || pair_residuals(c, vm, g, rm) != 0;
+            for (size_t i = 0; i < n && !bad; i++)
+                J[i * (size_t)p + (size_t)a] = (rp[i] - rm[i]) / (2 * h);
+        }
+        c->pr.evals += 2 * p;
+        if (bad)
+            break;
+        double A[PQ_COUNT][PQ_COUNT], b[PQ_COUNT];
+        for (int a = 0; a < p; a++) {
+            b[a] = 0;
+            for (size_t i = 0; i < n; i++)
+                b[a] -= J[i * (size_t)p + (size_t)a] * r0[i];
+            for (int bb = 0; bb < p; bb++) {
+                double d = 0;
+                for (size_t i = 0; i < n; i++)
+                    d += J[i * (size_t)p + (size_t)a] * J[i * (size_t)p + (size_t)bb];
+                A[a][bb] = d;
+            }
+        }
+        int improved = 0;
+        for (int tries = 0; tries < 8 && !improved; tries++) {
+            /* (J^T J + lambda diag) delta = -J^T r by Gaussian elimination with pivoting */
+            double M[PQ_COUNT][PQ_COUNT + 1];
+            for (int a = 0; a < p; a++) {
+                for (int bb = 0; bb < p; bb++)
+                    M[a][bb] = A[a][bb] + (a == bb ? lambda * (A[a][a] > 0 ? A[a][a] : 1) : 0);
+                M[a][p] = b[a];
+            }
+            int singular = 0;
+            for (int col = 0; col < p && !singular; col++) {
+                int piv = col;
+                for (int row = col + 1; row < p; row++)
+                    if (fabs(M[row][col]) > fabs(M[piv][col]))
+                        piv = row;
+                if (!(fabs(M[piv][col]) > 0)) {
+                    singular = 1;
+                    break;
+                }
+                for (int q = 0; q <= p; q++) {
+                    const double t = M[col][q];
+                    M[col][q] = M[piv][q];
+                    M[piv][q] = t;
+                }
+                for (int row = col + 1; row < p; row++) {
+                    const double fct = M[row][col] / M[col][col];
+                    for (int q = col; q <= p; q++)
+                        M[row][q] -= fct * M[col][q];
+                }
+            }
+            double delta[PQ_COUNT];
+            for (int a = p - 1; a >= 0 && !singular; a--) {
+                double t = M[a][p];
+                for (int q = a + 1; q < p; q++)
+                    t -= M[a][q] * delta[q];
+                delta[a] = t / M[a][a];
+            }
+            double vt[PQ_COUNT];
+            memcpy(vt, v, sizeof vt);
+            for (int a = 0; a < p && !singular; a++) {
+                const int k = idx[a];
+                vt[k] = pq_log(k) ? v[k] * exp(fmax(fmin(delta[a], 1.0), -1.0)) : v[k] + delta[a];
+            }
+            const double ft = singular ? CF_LSQ_HUGE_OBJ : pair_rss(c, vt, box, g, rp);
+            c->pr.evals++;
+            if (ft < f) {
+                const double drop = (f - ft) / f;
+                memcpy(v, vt, sizeof vt);
+                memcpy(r0, rp, sizeof(double) * n);
+                f = ft;
+                lambda = fmax(lambda / 10, 1e-12);
+                improved = 1;
+                if (drop < 1e-12)
+                    it = 40; /* converged */
+            } else {
+                lambda *= 10;
+            }
+        }
+        if (!improved)
+            break;
+    }
+    free(g);
+    free(r0);
+    free(rp);
+    free(rm);
+    free(J);
+    return f;
 }
 
 /* Standard errors of the used quantities (used[k]) from the central-difference Jacobian of the
@@ -585,6 +735,30 @@ static cf_status search_pair(jctx *c, const cf_table *reach, double xmax,
     v[PQ_K] = A * curve_kappa(c, &lc);
     if (c->pair)
         v[PQ_RE] = c->ext[0], v[PQ_BE] = c->ext[1], v[PQ_AE] = A * c->ext[2];
+    /* Levenberg-Marquardt from BOBYQA's optimum, the weights held */
+    int used[PQ_COUNT] = {1, 1, 1, c->pair, c->pair, c->pair, opt->volume == CF_VOLUME_FIT};
+    const double box[4] = {pv.lb[1], pv.ub[1], exp(pv.lb[0]), exp(pv.ub[0])};
+    const int was_fw = c->fit_weights;
+    c->fit_weights = 0;
+    {
+        double vp[PQ_COUNT];
+        memcpy(vp, v, sizeof vp);
+        const double fp = pair_polish(c, vp, used, box);
+        if (fp < best) {
+            memcpy(v, vp, sizeof vp);
+            best = fp;
+            A = v[PQ_AC];
+            const cf_ident qp = {.rho = v[PQ_RC], .solid = v[PQ_BC], .scale = 1.0};
+            const cf_spring pp = cf_ident_member(&qp);
+            if (cf_law_init(&lc, &pp, err) != CF_OK)
+                return CF_E_INTERNAL;
+            if (opt->volume == CF_VOLUME_POISSON) {
+                c->kappa_mode = KAPPA_NU;
+                c->kappa = opt->volume_value;
+                v[PQ_K] = A * curve_kappa(c, &lc);
+            }
+        }
+    }
     r->objective = best;
     r->pair = c->pair;
     r->volume = opt->volume;
@@ -620,10 +794,7 @@ static cf_status search_pair(jctx *c, const cf_table *reach, double xmax,
     r->E_compression_MPa = E_of_kappa(c->weight, k0c, v[PQ_K]);
     r->E_extension_MPa = E_of_kappa(c->weight, k0e, v[PQ_K]);
     /* the errors of every quantity fitted (the weights held) */
-    int used[PQ_COUNT] = {1, 1, 1, c->pair, c->pair, c->pair, opt->volume == CF_VOLUME_FIT};
     double se[PQ_COUNT];
-    const int was_fw = c->fit_weights;
-    c->fit_weights = 0;
     if (pair_errors(c, v, used, best, se) < 0)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the errors of %zu rows",
                             c->pr.n);
