@@ -538,6 +538,11 @@ int cf_cli_fit_parse(int argc, char **argv, fit_args *a)
                                   a->popt.fit.volume == CF_VOLUME_FIT       ? "--volume fit"
                                   : a->popt.fit.volume == CF_VOLUME_POISSON ? "--poisson"
                                                                             : "--volume-modulus");
+    if (a->popt.fit.law == CF_FAMILY_DOUBLE && a->popt.fit.volume == CF_VOLUME_POISSON)
+        return cf_cli_usage_error(cmd, "--poisson %g with --law double-acting: its lattice has one "
+                                       "small-strain nu in compression and another in tension; "
+                                       "declare kappa (--volume-modulus) or fit it (--volume fit)",
+                                  a->popt.fit.volume_value);
     if (a->joint && a->popt.fit.law == CF_FAMILY_TAIL && a->popt.fit.volume != CF_VOLUME_NONE)
         return cf_cli_usage_error(cmd, "--law conical-tail has no volume term yet (use conical, "
                                        "double-acting or auto)");

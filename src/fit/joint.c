@@ -72,15 +72,6 @@ double cf_joint_nu_of_kappa(const double w[CF_FAMILY_COUNT], double k0_over_H, d
     return (cm.C12 + k) / (cm.C11 + cm.C12 + 2 * k);
 }
 
-/* The small-strain Young's modulus along an axis of the lattice with kappa: 1/S33 of the cubic
-** constants C11 + kappa, C12 + kappa (MPa). */
-static double E_of_kappa(const double w[CF_FAMILY_COUNT], double k0_over_H, double kappa)
-{
-    const cf_cubic_moduli cm = cf_cubic_moduli_of(w);
-    const double k = kappa / k0_over_H, a = cm.C11 + k, b = cm.C12 + k;
-    return (a - b) * (a + 2 * b) / (a + b) * k0_over_H;
-}
-
 /* The cell's volume modulus for a curve whose compression law (at stress scale 1) is law. */
 static double curve_kappa(const jctx *c, const cf_law *law)
 {
@@ -616,6 +607,32 @@ static int pair_errors(jctx *c, const double v0[PQ_COUNT], const int used[PQ_COU
     return oom || bad < 0 ? -1 : bad; /* a curve that failed: every error stays -1 */
 }
 
+/* The lattice's small-strain Young's modulus and Poisson's ratio in uniaxial compression and in
+** tension (strain -+1e-6, every spring inside its linear region) from the cell of the quantities
+** v; NAN where the cell fails. */
+static void small_strain_moduli(jctx *c, const double v[PQ_COUNT], cf_joint_result *r)
+{
+    const cf_ident qc = {.rho = v[PQ_RC], .solid = v[PQ_BC], .scale = v[PQ_AC]};
+    const cf_ident qe = {.rho = v[PQ_RE], .solid = v[PQ_BE], .scale = v[PQ_AE]};
+    const cf_spring pc = cf_ident_member(&qc), pe = cf_ident_member(&qe);
+    cf_law lc, le;
+    cf_cell cell;
+    r->E_compression_MPa = r->E_extension_MPa = r->nu_compression = r->nu_extension = NAN;
+    if (cf_law_init(&lc, &pc, NULL) != CF_OK ||
+        (c->pair && (cf_law_init(&le, &pe, NULL) != CF_OK || cf_law_pair(&lc, &le, NULL) != CF_OK)) ||
+        cf_cell_init(&cell, &lc, CF_LAW_CLOSED, c->weight, NULL) != CF_OK)
+        return;
+    cell.volume_modulus_MPa = v[PQ_K];
+    for (int side = 0; side < 2; side++) {
+        const double e = side ? 1e-6 : -1e-6;
+        cf_cell_state s;
+        if (cf_cell_mode(&cell, CF_MODE_UNIAXIAL, e, NULL, &s, NULL) != CF_OK)
+            continue;
+        *(side ? &r->E_extension_MPa : &r->E_compression_MPa) = s.stress_MPa / e;
+        *(side ? &r->nu_extension : &r->nu_compression) = (1 - s.free_stretch) / e;
+    }
+}
+
 /* The double-acting element's (and the volume term's) search from plain's quantities and a grid,
 ** every table through the cell; both springs placed; the errors of every quantity. */
 static cf_status search_pair(jctx *c, const cf_table *reach, double xmax,
@@ -781,18 +798,11 @@ static cf_status search_pair(jctx *c, const cf_table *reach, double xmax,
         /* the element is buildable when both springs are: fit.feasible says it for the pair */
         r->fit.feasible = r->fit.feasible && r->ext.feasible;
     }
-    /* the small-strain moduli each side */
-    cf_law le;
-    const cf_ident qe1 = {.rho = v[PQ_RE], .solid = v[PQ_BE], .scale = v[PQ_AE]};
-    const cf_spring pe1 = cf_ident_member(&qe1);
-    const double k0c = A * lc.k0_N_per_mm / lc.p.H_mm;
-    double k0e = k0c;
-    if (c->pair && cf_law_init(&le, &pe1, NULL) == CF_OK)
-        k0e = le.k0_N_per_mm / le.p.H_mm;
-    r->nu_compression = cf_joint_nu_of_kappa(c->weight, k0c, v[PQ_K]);
-    r->nu_extension = cf_joint_nu_of_kappa(c->weight, k0e, v[PQ_K]);
-    r->E_compression_MPa = E_of_kappa(c->weight, k0c, v[PQ_K]);
-    r->E_extension_MPa = E_of_kappa(c->weight, k0e, v[PQ_K]);
+    /* the small-strain moduli each side, from the cell of the quantities found: a bimodular
+    ** lattice's uniaxial compression loads its axial springs' compression sides and its lateral
+    ** springs' extension sides (and the reverse in tension), so neither side's E and nu is that
+    ** of one spring's k0 alone */
+    small_strain_moduli(c, v, r);
     /* the errors of every quantity fitted (the weights held) */
     double se[PQ_COUNT];
     if (pair_errors(c, v, used, best, se) < 0)
@@ -938,6 +948,12 @@ cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fi
                             const cf_validate_setup *lat, cf_spring_type type, int pair,
                             const cf_joint_result *plain, cf_joint_result *r, cf_error *err)
 {
+    if (opt->volume == CF_VOLUME_POISSON && pair)
+        return cf_error_set(err, CF_E_DATA,
+                            "--poisson %g: a double-acting element's lattice has one small-strain "
+                            "nu in compression and another in tension; declare kappa "
+                            "(--volume-modulus) or fit it (--volume fit)",
+                            opt->volume_value);
     if (opt->volume == CF_VOLUME_POISSON) {
         const double *w = plain ? plain->weight : lat->cfg.lattice.weight;
         const double nu0 = cf_cubic_moduli_of(w).nu;

@@ -129,7 +129,9 @@ cf_status cf_pipeline_fit_joint(const cf_table *const *tables, size_t n,
             st = with_volume(tables, n, opt, r, k, &plain, err);
         else if (law == CF_FAMILY_TAIL || law == CF_FAMILY_AUTO)
             st = choose_law(tables, n, opt, r, k, err);
-        if (st == CF_OK && (law == CF_FAMILY_DOUBLE || law == CF_FAMILY_AUTO)) {
+        /* a declared nu has no meaning for a pair's two sides: auto then keeps single-sided */
+        if (st == CF_OK && (law == CF_FAMILY_DOUBLE ||
+                            (law == CF_FAMILY_AUTO && opt->fit.volume != CF_VOLUME_POISSON))) {
             const cf_joint_law_choice *lc = &r->law_choice[k];
             const cf_joint_result *start = volume && law != CF_FAMILY_DOUBLE ? &plain
                                            : lc->ran && lc->chose_tail       ? &lc->other

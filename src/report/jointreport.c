@@ -113,7 +113,11 @@ static void pair_choice_text(FILE *o, const cf_joint_report *r)
         const cf_joint_law_choice *lc = &r->law_choice[i];
         const char *type = cf_spring_type_name(r->fits[i].fit.type);
         if (!lc->pair_ran) {
-            fprintf(o, "  %-16s no double-acting element runs every table\n", type);
+            fprintf(o, "  %-16s %s\n", type,
+                    r->fits[i].volume == CF_VOLUME_POISSON
+                        ? "not fitted: a declared nu (--poisson) has no meaning for a pair's two "
+                          "sides"
+                        : "no double-acting element runs every table");
             continue;
         }
         const cf_joint_result *pair = lc->chose_pair ? &r->fits[i] : &lc->pair_other;

@@ -42,6 +42,8 @@ static void bad_input_exits_2_naming_the_option(void **state)
         {"fit " TWO " --joint --law conical-tail --volume fit -o /tmp/conifit-pair-no.json",
          "conical-tail"},
         {"fit " TWO " --joint --law double-sided -o /tmp/conifit-pair-no.json", "double-sided"},
+        {"fit " TWO " --joint --law double-acting --poisson 0.4 -o /tmp/conifit-pair-no.json",
+         "--poisson 0.4"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         const int rc = tu_run(out, sizeof out, errb, sizeof errb, "%s", cases[i].args);

@@ -60,11 +60,14 @@ typedef struct cf_joint_result {
     double volume_modulus_MPa;      /* kappa of the volume term (0: none), MPa */
     double volume_modulus_se;       /* its standard error (fitted), MPa; -1 when not determined
                                     ** or not fitted */
-    double nu_compression;          /* the lattice's small-strain nu, loaded along an axis, with
-                                    ** the compression spring's k0 (the odd law: the only one) */
-    double nu_extension;            /* the same with the extension spring's k0 */
+    double nu_compression;          /* the lattice's small-strain nu in uniaxial compression
+                                    ** along an axis (the cell at strain -1e-6): a pair's axial
+                                    ** springs on their compression side, its lateral ones on
+                                    ** their extension side */
+    double nu_extension;            /* the same in uniaxial tension (+1e-6) */
     double E_compression_MPa;       /* the lattice's small-strain Young's modulus along an axis,
-                                    ** each side (MPa, the volume term included) */
+                                    ** in compression and in tension (MPa, the volume term
+                                    ** included); NAN where the cell failed */
     double E_extension_MPa;
     int nparams;                    /* the quantities fitted (3, 4, 6 or 7; the AIC's k) */
 } cf_joint_result;
@@ -95,7 +98,9 @@ cf_status cf_joint_fit_tail(const cf_table *const *tables, size_t n, const cf_fi
 ** conical law's (the extension spring at the compression spring's H); errors of every quantity
 ** (kappa too) from the joint residuals' central-difference Jacobian, -1 for those the data do
 ** not determine (the Jacobian's null space). pair 0 fits the odd conical law with the volume
-** term. CF_E_DATA for a declared nu below the springs' own (the term only raises it). */
+** term. CF_E_DATA for a declared nu below the springs' own (the term only raises it), and for
+** a declared nu with the pair (a bimodular lattice has one small-strain nu per side, none to
+** declare: declare kappa or fit it). */
 cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
                             const cf_validate_setup *lat, cf_spring_type type, int pair,
                             const cf_joint_result *plain, cf_joint_result *r, cf_error *err);
