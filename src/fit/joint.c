@@ -12,6 +12,7 @@
 
 #include "conifit/baseline.h"
 #include "conifit/cell.h"
+#include "conifit/cell_stability.h"
 #include "conifit/family.h"
 #include "conifit/msm.h"
 #include "fit/cell_problem.h"
@@ -193,6 +194,19 @@ static cf_status verify_tables(const jctx *c, cf_joint_result *r, cf_error *err)
                                        jt->lattice_MPa, NULL, err)) != CF_OK)
             break;
         jt->lattice_rmse = cf_lsq_quality_of(t, jt->lattice_MPa).rmse;
+        if (r->pair || r->volume_modulus_MPa != 0) { /* stable over the table's whole range? */
+            double reach = 0, limit = 0;
+            int lost = 1;
+            for (size_t i = 0; i < t->count; i++)
+                if (fabs(t->x[i]) > fabs(reach))
+                    reach = t->x[i];
+            if (reach != 0 && cf_cell_stable_to(&cell, t->mode, reach, &limit, &lost, NULL) ==
+                                  CF_OK) {
+                jt->stability_checked = 1;
+                jt->stable_in_range = !lost;
+                jt->stable_to = limit;
+            }
+        }
         double ss = 0;
         for (size_t i = 0; i < t->count; i++) {
             /* the law's stress at table strain x (tension positive): -F(-x H)/H^2, the odd

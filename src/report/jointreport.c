@@ -188,6 +188,24 @@ static void pair_volume_text(FILE *o, const cf_joint_result *j)
                 j->nu_extension);
 }
 
+/* Whether the lattice of a pair or a volume term stays stable over every table's range. */
+static void stability_text(FILE *o, const cf_joint_report *r, const cf_joint_result *j)
+{
+    int checked = 0, all = 1;
+    for (size_t k = 0; k < r->ntables; k++) {
+        const cf_joint_table *jt = &j->tab[k];
+        checked += jt->stability_checked;
+        if (jt->stability_checked && !jt->stable_in_range) {
+            all = 0;
+            fprintf(o, "  %s: the lattice loses stability at strain %.4g, inside the table\n",
+                    r->tables[k]->path, jt->stable_to);
+        }
+    }
+    if (checked == (int)r->ntables && all)
+        fprintf(o, "  stable over every table's range (the cell's incremental stiffness positive "
+                   "definite from 0 to each table's farthest strain)\n");
+}
+
 char *cf_joint_text(const cf_joint_report *r)
 {
     char *buf = NULL;
@@ -251,6 +269,7 @@ char *cf_joint_text(const cf_joint_report *r)
             fprintf(o, "  %-44s %-12s %6zu %14s %14s %14s\n", t->path, cf_mode_name(jt->mode),
                     jt->points, a, b, c);
         }
+        stability_text(o, r, j);
         fprintf(o, "  (* homogenised cell: %s; %ld cell curves, %.3f s)\n",
                 j->volume_modulus_MPa != 0 ? "the full lattice has no volume term yet"
                                            : "the full lattice has no such boundary conditions",
@@ -429,6 +448,10 @@ static json_t *joint_json(const cf_joint_report *r)
                 json_object_set_new(e, "aic", num(jt->aic));
             if (e && isfinite(jt->law_rmse)) /* uniaxial tables only */
                 json_object_set_new(e, "law_difference_rmse", num(jt->law_rmse * u));
+            if (e && jt->stability_checked) {
+                json_object_set_new(e, "stable_in_range", json_boolean(jt->stable_in_range));
+                json_object_set_new(e, "stable_to_strain", num(jt->stable_to));
+            }
             json_array_append_new(per, e);
         }
         json_object_set_new(f, "tables", per);

@@ -208,7 +208,7 @@ static void declared_nu_is_the_lattices(void **state)
 /* The brain cortex (Budday et al. 2017) in tension, compression and shear, --joint --law auto
 ** --volume fit: the weighted objective at most half one-term Ogden's 0.0343 (fitted jointly with
 ** the same weights), the kept element a buildable double-acting pair, every table's cell curve
-** finite; the fit file holds params_extension and lattice.volume_modulus_MPa. */
+** finite and the lattice stable over its range; the fit file holds params_extension and lattice.volume_modulus_MPa. */
 static void brain_cortex_pair_beats_half_of_ogden(void **state)
 {
     (void)state;
@@ -245,8 +245,11 @@ static void brain_cortex_pair_beats_half_of_ogden(void **state)
                 isfinite(j->nu_extension));
     /* brain is stiffer in compression than in tension at small strain too */
     assert_true(j->E_compression_MPa > j->E_extension_MPa && j->E_extension_MPa > 0);
-    for (size_t k = 0; k < 3; k++)
+    /* the lattice stable over every table's range (the cell's incremental stiffness) */
+    for (size_t k = 0; k < 3; k++) {
         assert_true(isfinite(j->tab[k].cell_rmse));
+        assert_true(j->tab[k].stability_checked && j->tab[k].stable_in_range);
+    }
     char dirt[] = "/tmp/conifit-jp-XXXXXX", json[256];
     assert_non_null(mkdtemp(dirt));
     snprintf(json, sizeof json, "%s/joint.json", dirt);

@@ -39,6 +39,12 @@ typedef struct cf_joint_table {
     double aic;            /* the table's AIC at the joint law (its rows, its unit, the law's
                            ** 3 or 4 quantities), as a single fit's report states it */
     double *lattice_MPa;   /* the lattice's stress at each row (owned), MPa */
+    /* a double-acting element or a volume term (cell_stability.h, the cell of the placed
+    ** springs and kappa): stability checked = 1, stable_in_range 1 when the cell's incremental
+    ** stiffness stays positive definite from 0 to the table's farthest strain, stable_to the
+    ** strain up to which it does (table sign) */
+    int stability_checked, stable_in_range;
+    double stable_to;
 } cf_joint_table;
 
 typedef struct cf_joint_result {
