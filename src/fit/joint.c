@@ -169,6 +169,7 @@ static cf_status verify_tables(const jctx *c, cf_joint_result *r, cf_error *err)
         return st;
     cf_validate_setup full = *c->lat;
     memcpy(full.cfg.lattice.weight, c->weight, sizeof c->weight);
+    full.cfg.lattice.volume_modulus_MPa = r->volume_modulus_MPa;
     cf_cell cell;
     cf_cell_init(&cell, &law, CF_LAW_CLOSED, c->weight, NULL);
     cell.volume_modulus_MPa = r->volume_modulus_MPa;
@@ -186,8 +187,7 @@ static cf_status verify_tables(const jctx *c, cf_joint_result *r, cf_error *err)
         const double u = t->y_to_file;
         const double rss = jt->cell_rmse * jt->cell_rmse * (double)t->count * u * u;
         jt->aic = cf_baseline_aic(t->count, rss, k_aic, ymax * u);
-        /* the full lattice has no volume term: with one, every table is the cell's */
-        jt->by_cell = t->mode != CF_MODE_UNIAXIAL || r->volume_modulus_MPa != 0;
+        jt->by_cell = t->mode != CF_MODE_UNIAXIAL;
         if (jt->by_cell)
             memcpy(jt->lattice_MPa, c->curve[k], t->count * sizeof(double));
         else if ((st = cf_msm_uniaxial(&law, CF_LAW_CLOSED, &full.cfg, t->x, t->count,

@@ -270,9 +270,8 @@ char *cf_joint_text(const cf_joint_report *r)
                     jt->points, a, b, c);
         }
         stability_text(o, r, j);
-        fprintf(o, "  (* homogenised cell: %s; %ld cell curves, %.3f s)\n",
-                j->volume_modulus_MPa != 0 ? "the full lattice has no volume term yet"
-                                           : "the full lattice has no such boundary conditions",
+        fprintf(o, "  (* homogenised cell: the full lattice has no such boundary conditions; "
+                   "%ld cell curves, %.3f s)\n",
                 j->evaluations, j->wall_time_s);
     }
     law_choice_text(o, r);

@@ -377,6 +377,89 @@ static void full_lattice_with_the_pair_equals_the_cell(void **state)
     }
 }
 
+/* The full lattice with the volume term (lattice.h, volume_modulus_MPa): a cell's J is det F under
+** a homogeneous F, its volume gradient and Hessian are the derivatives of its volume, and under
+** uniaxial loading the lattice with a pair and kappa equals the cell. */
+static void full_lattice_with_the_volume_term_equals_the_cell(void **state)
+{
+    (void)state;
+    cf_law comp = law_of(&comp_p), ext = law_of(&ext_p[1]);
+    assert_int_equal(cf_law_pair(&comp, &ext, NULL), CF_OK);
+    double w[3];
+    assert_int_equal(cf_calibration_weights(CF_CAL_ISOTROPIC, w, NULL), CF_OK);
+    const double kappa = 3 * comp.k0_N_per_mm / comp.p.H_mm;
+    /* the cell's volume under a homogeneous F, and its derivatives by central differences */
+    cf_lattice_config lc = cf_lattice_default();
+    lc.nx = 2, lc.ny = 1, lc.nz = 2;
+    lc.volume_modulus_MPa = kappa;
+    cf_lattice lat;
+    assert_int_equal(cf_lattice_create(&lat, &comp, CF_LAW_CLOSED, &lc, NULL), CF_OK);
+    const double F[9] = {1.05, 0.02, -0.03, 0.01, 0.97, 0.04, 0.02, -0.01, 1.1};
+    const double detF = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) +
+                        F[2] * (F[3] * F[7] - F[4] * F[6]);
+    for (size_t p = 0; p < lat.nn; p++) {
+        const double X[3] = {lat.X[p], lat.Y[p], lat.Z[p]};
+        lat.x[p] = F[0] * X[0] + F[1] * X[1] + F[2] * X[2];
+        lat.y[p] = F[3] * X[0] + F[4] * X[1] + F[5] * X[2];
+        lat.z[p] = F[6] * X[0] + F[7] * X[1] + F[8] * X[2];
+    }
+    uint32_t node[8];
+    double g[8][3], g2[8][3], hess[8][8][3][3];
+    for (size_t c = 0; c < 4; c++)
+        assert_close(cf_lattice_cell_volume(&lat, c, node, g, hess), detF, 1e-14);
+    /* a non-affine state: move one node, then check g and the Hessian of cell 3 */
+    lat.x[node[5]] += 0.7, lat.z[node[2]] -= 0.4;
+    const double J0 = cf_lattice_cell_volume(&lat, 3, node, g, hess), H3 = 1000;
+    double *coord[3] = {lat.x, lat.y, lat.z};
+    for (int b = 0; b < 8; b++)
+        for (int k = 0; k < 3; k++) {
+            const double h = 1e-4, keep = coord[k][node[b]];
+            coord[k][node[b]] = keep + h;
+            const double Jp = cf_lattice_cell_volume(&lat, 3, node, g2, NULL);
+            double gp[8][3];
+            memcpy(gp, g2, sizeof gp);
+            coord[k][node[b]] = keep - h;
+            const double Jm = cf_lattice_cell_volume(&lat, 3, node, g2, NULL);
+            coord[k][node[b]] = keep;
+            assert_close(g[b][k], (Jp - Jm) * H3 / (2 * h), 1e-6 * (fabs(g[b][k]) + 1));
+            for (int a = 0; a < 8; a++)
+                for (int i = 0; i < 3; i++)
+                    assert_close(hess[a][b][i][k], (gp[a][i] - g2[a][i]) / (2 * h),
+                                 1e-6 * (fabs(hess[a][b][i][k]) + 1));
+        }
+    (void)J0;
+    cf_lattice_free(&lat);
+    /* the full lattice against the cell, uniaxial, tension and compression */
+    cf_cell c;
+    assert_int_equal(cf_cell_init(&c, &comp, CF_LAW_CLOSED, w, NULL), CF_OK);
+    c.volume_modulus_MPa = kappa;
+    double x[] = {-0.3, -0.15, -1e-3, 1e-3, 0.1, 0.3};
+    const size_t n = sizeof x / sizeof x[0];
+    double cell[6], full[6];
+    cf_error err = {0};
+    if (cf_cell_curve(&c, CF_MODE_UNIAXIAL, x, n, cell, &err) != CF_OK)
+        fail_msg("cell: %s", err.msg);
+    const int sizes[2][3] = {{1, 1, 1}, {2, 3, 2}};
+    for (int z = 0; z < 2; z++) {
+        cf_msm_config cfg = cf_msm_default();
+        cfg.lattice.nx = sizes[z][0], cfg.lattice.ny = sizes[z][1], cfg.lattice.nz = sizes[z][2];
+        memcpy(cfg.lattice.weight, w, sizeof w);
+        cfg.lattice.volume_modulus_MPa = kappa;
+        if (cf_msm_uniaxial(&comp, CF_LAW_CLOSED, &cfg, x, n, full, NULL, &err) != CF_OK)
+            fail_msg("lattice: %s", err.msg);
+        /* the static solve's absolute tolerance: a floor of 1e-10 of the largest stress */
+        for (size_t i = 0; i < n; i++)
+            if (!(fabs(cell[i] - full[i]) <= 1e-9 * fabs(cell[i]) + 1e-10 * fabs(cell[0])))
+                fail_msg("%dx%dx%d cells, strain %g: cell %.17g, lattice %.17g", sizes[z][0],
+                         sizes[z][1], sizes[z][2], x[i], cell[i], full[i]);
+    }
+    /* kappa changes the lattice's answer (the comparison is not of two lattices without it) */
+    c.volume_modulus_MPa = 0;
+    double bare[6];
+    assert_int_equal(cf_cell_curve(&c, CF_MODE_UNIAXIAL, x, n, bare, NULL), CF_OK);
+    assert_true(fabs(bare[0] - cell[0]) > 1e-3 * fabs(cell[0]));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -386,6 +469,7 @@ int main(void)
         cmocka_unit_test(volume_term_adds_kappa_to_lambda_and_nothing_to_shear),
         cmocka_unit_test(tangent_with_the_volume_term_is_the_stress_derivative),
         cmocka_unit_test(full_lattice_with_the_pair_equals_the_cell),
+        cmocka_unit_test(full_lattice_with_the_volume_term_equals_the_cell),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
