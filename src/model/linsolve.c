@@ -420,9 +420,7 @@ static void volume_tangent(solver *s, double *v)
     const cf_lattice *lat = s->lat;
     const double kappa = lat->cfg.volume_modulus_MPa, H = lat->H_mm, V0 = H * H * H;
     const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
-    double(*hess)[8][3][3] = malloc(8 * sizeof *hess);
-    if (!hess)
-        return; /* no memory: the tangent lacks the term, the Newton steps still converge slower */
+    double hess[8][8][3][3]; /* 4.6 kB */
     for (size_t c = 0; c < nc; c++) {
         uint32_t node[8];
         double g[8][3];
@@ -438,7 +436,6 @@ static void volume_tangent(solver *s, double *v)
                                      kappa * (J - 1) * hess[a][b][i][k];
                     }
     }
-    free(hess);
 }
 
 /* Adds the tangent K = -dR/dx at the state of the last cf_msm_residual() into v (C's pattern,
