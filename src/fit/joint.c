@@ -60,19 +60,6 @@ typedef struct jctx {
 ** stress scale held, or the errors' Jacobian); from a declared nu. */
 enum { KAPPA_NONE = 0, KAPPA_REL, KAPPA_UNIT, KAPPA_NU };
 
-double cf_joint_kappa_of_nu(const double w[CF_FAMILY_COUNT], double k0_over_H, double nu)
-{
-    const cf_cubic_moduli cm = cf_cubic_moduli_of(w);
-    return (nu * (cm.C11 + cm.C12) - cm.C12) / (1 - 2 * nu) * k0_over_H;
-}
-
-double cf_joint_nu_of_kappa(const double w[CF_FAMILY_COUNT], double k0_over_H, double kappa)
-{
-    const cf_cubic_moduli cm = cf_cubic_moduli_of(w);
-    const double k = kappa / k0_over_H;
-    return (cm.C12 + k) / (cm.C11 + cm.C12 + 2 * k);
-}
-
 /* The cell's volume modulus for a curve whose compression law (at stress scale 1) is law. */
 static double curve_kappa(const jctx *c, const cf_law *law)
 {
@@ -80,7 +67,7 @@ static double curve_kappa(const jctx *c, const cf_law *law)
     switch (c->kappa_mode) {
     case KAPPA_REL: return c->kappa * k0H;
     case KAPPA_UNIT: return c->kappa;
-    case KAPPA_NU: return fmax(0.0, cf_joint_kappa_of_nu(c->weight, k0H, c->kappa));
+    case KAPPA_NU: return fmax(0.0, cf_cubic_kappa_of_nu(c->weight, k0H, c->kappa));
     default: return 0.0;
     }
 }

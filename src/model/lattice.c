@@ -472,6 +472,20 @@ double cf_lattice_elastic_energy(const cf_lattice *lat)
     return e;
 }
 
+double cf_lattice_lateral_stretch(const cf_lattice *lat)
+{
+    const double W = lat->cfg.nx * lat->H_mm;
+    double hi = 0, lo = 0;
+    size_t nhi = 0, nlo = 0;
+    for (size_t p = 0; p < lat->nn; p++) {
+        if (lat->X[p] == W)
+            hi += lat->x[p], nhi++;
+        else if (lat->X[p] == 0)
+            lo += lat->x[p], nlo++;
+    }
+    return (hi / (double)nhi - lo / (double)nlo) / W;
+}
+
 double cf_lattice_top_strain(const cf_lattice *lat)
 {
     double sum = 0, wsum = 0;

@@ -30,7 +30,7 @@ _SONAME = "libconifit.so.0"
 _MSG_LEN = 512  # CF_ERROR_MSG_LEN
 _STATUS = {-1: "usage", -2: "data", -3: "noinput", -4: "cantwrite", -5: "internal", -6: "noconv"}
 _SAMPLE_KEYS = ("time_s", "strain", "stress_kPa", "kinetic_energy_mJ", "spring_stress_kPa",
-                "stable")
+                "stable", "lateral_stretch")
 
 
 class Error(Exception):
@@ -178,7 +178,8 @@ def fit(table=None, strain=None, stress=None, stress_unit="kPa", type="both", va
 def simulate(scene):
     """Runs the scene file and returns its samples, the columns of conifit simulate's CSV: a
     list of dicts with time_s, strain, stress_kPa (compression positive), kinetic_energy_mJ,
-    spring_stress_kPa and stable (1, 0, or -1 in explicit dynamics)."""
+    spring_stress_kPa, stable (1, 0, or -1 in explicit dynamics) and lateral_stretch (the
+    lattice's width along x over its rest width)."""
     rows = ctypes.POINTER(ctypes.c_double)()
     count = ctypes.c_size_t()
     e = _CfError()

@@ -11,7 +11,6 @@
 #include "testutil.h"
 
 #include "conifit/cell.h"
-#include "conifit/joint.h"
 #include "conifit/msm.h"
 
 /* The compression spring (non-telescoping, solid strain 0.5, H 10 mm) and an extension spring
@@ -276,10 +275,10 @@ static void volume_term_adds_kappa_to_lambda_and_nothing_to_shear(void **state)
     const double mu = cm.C44 * k0H;
     for (int k = 0; k < 4; k++) {
         const double nu_want = (double[]){0.25, 0.3, 0.45, 0.49}[k];
-        const double kappa = cf_joint_kappa_of_nu(w, k0H, nu_want);
+        const double kappa = cf_cubic_kappa_of_nu(w, k0H, nu_want);
         /* the isotropic lattice: kappa = mu (4 nu - 1)/(1 - 2 nu) */
         assert_close(kappa, mu * (4 * nu_want - 1) / (1 - 2 * nu_want), 1e-12 * (mu + kappa));
-        assert_close(cf_joint_nu_of_kappa(w, k0H, kappa), nu_want, 1e-14);
+        assert_close(cf_cubic_nu_of_kappa(w, k0H, kappa), nu_want, 1e-14);
         cf_cell c;
         assert_int_equal(cf_cell_init(&c, &law, CF_LAW_EXACT, w, NULL), CF_OK);
         c.volume_modulus_MPa = kappa;

@@ -111,14 +111,6 @@ cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fi
                             const cf_validate_setup *lat, cf_spring_type type, int pair,
                             const cf_joint_result *plain, cf_joint_result *r, cf_error *err);
 
-/* The volume modulus kappa (MPa) that gives a lattice of family weights w and small-strain
-** modulus scale k0/H (MPa) the small-strain nu along an axis: with the cubic constants C11, C12
-** (calibration.h) kappa = (nu (C11 + C12) - C12)/(1 - 2 nu) k0/H, from nu = (C12 + kappa)/(C11
-** + C12 + 2 kappa) (the term adds kappa to C11 and C12, Lame's lambda, nothing to C44). Negative
-** when nu is below the springs' own. And the inverse, nu of a lattice with kappa. */
-double cf_joint_kappa_of_nu(const double w[CF_FAMILY_COUNT], double k0_over_H, double nu);
-double cf_joint_nu_of_kappa(const double w[CF_FAMILY_COUNT], double k0_over_H, double kappa);
-
 /* Releases the per-table curves. Safe on a zeroed result. */
 void cf_joint_free(cf_joint_result *r);
 

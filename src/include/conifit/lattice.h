@@ -141,6 +141,10 @@ double cf_lattice_cell_volume(const cf_lattice *lat, size_t c, uint32_t node[8],
 ** of the law over each spring's compression; accurate to about 1e-10 relative away from solid). */
 double cf_lattice_elastic_energy(const cf_lattice *lat);
 
+/* The lattice's width along x over its rest width nx H: the mean x of the nodes of the +x face
+** less that of the -x face, over nx H (1 at rest). */
+double cf_lattice_lateral_stretch(const cf_lattice *lat);
+
 /* Mean z displacement of the top face (mm, compression positive) and nominal compressive strain. */
 double cf_lattice_top_strain(const cf_lattice *lat);
 
