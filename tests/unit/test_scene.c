@@ -205,8 +205,8 @@ static void relaxation_scene_follows_published_muscle_relaxation(void **state)
     size_t row = 0, at = 0;
     f = fopen(out, "r");
     assert_non_null(fgets(line, sizeof line, f));
-    double k, sp;
-    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf,%d", &t, &e, &s, &k, &sp, &stable) == 6) {
+    double k, sp, lat;
+    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf,%d,%lf", &t, &e, &s, &k, &sp, &stable, &lat) == 7) {
         speak = fmax(speak, s);
         send = s;
         unstable_rows += stable == 0;
