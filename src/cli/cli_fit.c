@@ -168,7 +168,11 @@ static int run_joint(const fit_args *a, fit_job *jobs, const char *const *inputs
         tabs[i] = &jobs[i].m;
     cf_joint_report r;
     int rc = CF_EXIT_OK;
-    if (cf_pipeline_fit_joint(tabs, (size_t)a->nfiles, &a->popt, &r, &err) != CF_OK)
+    /* a declared kappa is in the tables' stress unit (the first table's) */
+    cf_pipeline_options popt = a->popt;
+    if (popt.fit.volume == CF_VOLUME_MODULUS)
+        popt.fit.volume_value /= tabs[0]->y_to_file;
+    if (cf_pipeline_fit_joint(tabs, (size_t)a->nfiles, &popt, &r, &err) != CF_OK)
         rc = cf_cli_fail(&err);
     cf_atomic jo = {0}, po = {0};
     if (rc == CF_EXIT_OK &&

@@ -22,9 +22,11 @@ static const char fit_help[] =
     "  -o, --output OUT.json | DIR/ | -   fit file (one table), folder (one NAME.json per\n"
     "                          table), or '-': the fit file on standard output (no report)\n"
     "  --type T                telescoping | non-telescoping | both (default both)\n"
-    "  --law L                 conical | conical-tail | auto (default conical): the conical\n"
-    "                          spring, one with a cylindrical tail in series (a fourth\n"
-    "                          quantity, the tail's compliance), or both, kept by AIC;\n"
+    "  --law L                 conical | conical-tail | auto | double-acting (default\n"
+    "                          conical): the conical spring, one with a cylindrical tail in\n"
+    "                          series (a fourth quantity, the tail's compliance), a\n"
+    "                          double-acting element (its own conical spring for extension,\n"
+    "                          six quantities; --joint only), or all of them, kept by AIC;\n"
     "                          to the spring or through the lattice as the conical law,\n"
     "                          jointly with --joint (not with --fix or time series; a\n"
     "                          series holds a tailed spring with --elastic)\n"
@@ -55,6 +57,13 @@ static const char fit_help[] =
     "                          of work): a larger lattice or table is refused\n"
     "  --joint                 one lattice for every table, each in its own mode\n"
     "  --calibration C         isotropic (default), axial, or fitted (with --joint)\n"
+    "  --volume fit            a volume term (kappa/2)(J - 1)^2 in every cell, kappa fitted\n"
+    "                          (with --joint)\n"
+    "  --volume-modulus K      the volume term's kappa declared, in the tables' stress unit\n"
+    "                          (with --joint)\n"
+    "  --poisson NU            the lattice's small-strain nu declared, 0.25 <= NU < 0.5: kappa\n"
+    "                          from it (with --joint; a double-acting element: its compression\n"
+    "                          side)\n"
     "  --mode M                the table's test mode: uniaxial, shear, planar, equibiaxial or\n"
     "                          confined (wins over a '# mode:' comment; default uniaxial)\n"
     "  --plot FILE.png|.svg|.pdf  draw data, fits, baselines and residuals with gnuplot\n"
@@ -149,7 +158,10 @@ enum {
     OPT_MAX_MEMORY,
     OPT_MAX_STEPS,
     OPT_MAX_WORK,
-    OPT_LAW
+    OPT_LAW,
+    OPT_VOLUME,
+    OPT_VOLUME_MODULUS,
+    OPT_POISSON
 };
 
 static const struct option fit_options[] = {
@@ -159,6 +171,9 @@ static const struct option fit_options[] = {
     {"max-work", required_argument, NULL, OPT_MAX_WORK},
     {"type", required_argument, NULL, OPT_TYPE},
     {"law", required_argument, NULL, OPT_LAW},
+    {"volume", required_argument, NULL, OPT_VOLUME},
+    {"volume-modulus", required_argument, NULL, OPT_VOLUME_MODULUS},
+    {"poisson", required_argument, NULL, OPT_POISSON},
     {"fix", required_argument, NULL, OPT_FIX},
     {"index-max", required_argument, NULL, OPT_INDEX_MAX},
     {"relative", no_argument, NULL, OPT_RELATIVE},
@@ -366,6 +381,36 @@ static int fit_option(void *ctx, int c, const char *optval)
         if (cf_law_family_parse(optval, &fo->law, &err) != CF_OK)
             return cf_cli_usage_error("fit", "--law: %s", err.msg);
         return 0;
+    case OPT_VOLUME:
+        if (strcmp(optval, "fit") != 0)
+            return cf_cli_usage_error("fit", "--volume '%s': expected fit (or declare kappa with "
+                                             "--volume-modulus, nu with --poisson)", optval);
+        if (fo->volume != CF_VOLUME_NONE && fo->volume != CF_VOLUME_FIT)
+            return cf_cli_usage_error("fit", "--volume fit: kappa is declared already (one of "
+                                             "--volume, --volume-modulus, --poisson)");
+        fo->volume = CF_VOLUME_FIT;
+        return 0;
+    case OPT_VOLUME_MODULUS:
+    case OPT_POISSON: {
+        const int modulus = c == OPT_VOLUME_MODULUS;
+        const char *name = modulus ? "--volume-modulus" : "--poisson";
+        double v;
+        if (cf_cli_parse_double(name, optval, &v, &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        if (modulus && !(v >= 0 && v <= CF_MEASURE_MAX_VALUE))
+            return cf_cli_usage_error("fit", "--volume-modulus %s: kappa must be a finite number "
+                                             ">= 0", optval);
+        if (!modulus && !(v >= 0.25 && v < 0.5))
+            return cf_cli_usage_error("fit", "--poisson %s: nu must lie in [0.25, 0.5) (a lattice "
+                                             "of central springs has 0.25; 0.5 is "
+                                             "incompressible)", optval);
+        if (fo->volume != CF_VOLUME_NONE)
+            return cf_cli_usage_error("fit", "%s %s: kappa is set already (one of --volume, "
+                                             "--volume-modulus, --poisson)", name, optval);
+        fo->volume = modulus ? CF_VOLUME_MODULUS : CF_VOLUME_POISSON;
+        fo->volume_value = v;
+        return 0;
+    }
     case OPT_CALIBRATION: {
         cf_lattice_config *lc = &a->popt.lattice.cfg.lattice;
         if (cf_calibration_parse(optval, &lc->calibration, &err) != CF_OK)
@@ -485,6 +530,23 @@ int cf_cli_fit_parse(int argc, char **argv, fit_args *a)
     }
     if (a->joint && a->nfiles < 2)
         return cf_cli_usage_error(cmd, "--joint fits several tables at once; give at least two");
+    if (!a->joint && a->popt.fit.law == CF_FAMILY_DOUBLE)
+        return cf_cli_usage_error(cmd, "--law double-acting: its extension spring is fitted with "
+                                       "tension and compression tables together (--joint)");
+    if (!a->joint && a->popt.fit.volume != CF_VOLUME_NONE)
+        return cf_cli_usage_error(cmd, "%s: the volume term is fitted through the lattice with "
+                                       "several tables (--joint)",
+                                  a->popt.fit.volume == CF_VOLUME_FIT       ? "--volume fit"
+                                  : a->popt.fit.volume == CF_VOLUME_POISSON ? "--poisson"
+                                                                            : "--volume-modulus");
+    if (a->popt.fit.law == CF_FAMILY_DOUBLE && a->popt.fit.volume == CF_VOLUME_POISSON)
+        return cf_cli_usage_error(cmd, "--poisson %g with --law double-acting: its lattice has one "
+                                       "small-strain nu in compression and another in tension; "
+                                       "declare kappa (--volume-modulus) or fit it (--volume fit)",
+                                  a->popt.fit.volume_value);
+    if (a->joint && a->popt.fit.law == CF_FAMILY_TAIL && a->popt.fit.volume != CF_VOLUME_NONE)
+        return cf_cli_usage_error(cmd, "--law conical-tail has no volume term yet (use conical, "
+                                       "double-acting or auto)");
     if (a->calibration_given && a->popt.lattice.cfg.lattice.calibration == CF_CAL_FITTED &&
         !a->joint)
         return cf_cli_usage_error(cmd, "--calibration fitted: the family weights are fitted in a "

@@ -26,11 +26,13 @@ static const char simulate_help[] =
     "usage: conifit simulate SCENE.json -o OUT.csv [--plot OUT.png|.svg|.pdf] [-q]\n"
     "       conifit simulate BODY-SCENE.json -o PROBE.csv [--vtu DIR] [-q]\n"
     "Runs the scene on a mass-spring lattice of conical springs and writes the CSV\n"
-    "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,stable (compression positive:\n"
-    "strain is the top face's shortening over the height, stress the top reaction over nx ny H^2,\n"
-    "in kPa; spring_stress_kPa is one spring's F(strain H)/H^2 at the same strain, for comparison;\n"
-    "stable is 1 up to the first sample whose tangent has a negative pivot and 0 from there on,\n"
-    "-1 in explicit dynamics, which factors no tangent).\n"
+    "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,stable,lateral_stretch\n"
+    "(compression positive: strain is the top face's shortening over the height, stress the top\n"
+    "reaction over nx ny H^2, in kPa; spring_stress_kPa is one spring's F(strain H)/H^2 at the same\n"
+    "strain, for comparison; stable is 1 up to the first sample whose tangent has a negative pivot\n"
+    "and 0 from there on, -1 in explicit dynamics, which factors no tangent; lateral_stretch the\n"
+    "lattice's width along x over its rest width, so that (1 - lateral_stretch)/strain is its\n"
+    "Poisson's ratio under a uniaxial load).\n"
     "A scene with no inertia, damping or viscosity is solved as static equilibria.\n\n"
     "  -o, --output FILE   CSV to write (written to a temporary name, then renamed); '-'\n"
     "                      writes it to standard output and the summary to stderr\n"
@@ -230,14 +232,11 @@ static int parse_request(int argc, char **argv, sim_request *q)
 
 /* The lattice of the scene, run along its path into samples (allocated here, sc->nsamples). */
 static cf_status run_scene(cf_scene *sc, const sim_request *q, cf_budget *budget,
-                           cf_scene_cost *cost, cf_law *law, cf_lattice *lat,
+                           cf_scene_cost *cost, cf_law *law, cf_law *ext, cf_lattice *lat,
                            cf_msm_sample **samples, cf_msm_stats *st, cf_error *err)
 {
     cf_status s;
-    if ((s = cf_law_init(law, &sc->spring, err)) != CF_OK)
-        return s;
-    if ((sc->method == CF_LAW_TABLE &&
-         (s = cf_law_table_build(law, sc->table_intervals, err)) != CF_OK) ||
+    if ((s = cf_scene_law(sc, law, ext, err)) != CF_OK ||
         (s = cf_lattice_create(lat, law, sc->method, &sc->cfg.lattice, err)) != CF_OK ||
         (s = cf_budget_check_steps(sc, q->scene_path, lat, budget, cost, err)) != CF_OK ||
         (!q->quiet &&
@@ -289,12 +288,13 @@ static cf_status write_table(FILE *o, const cf_msm_sample *s, size_t n, const si
 /* The run's curve, with one spring's stress at the same strain (spring, MPa) beside it. */
 static void write_curve(FILE *o, const cf_scene *sc, const cf_msm_sample *s, const double *spring)
 {
-    fprintf(o, "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,stable\n");
+    fprintf(o, "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,stable,"
+               "lateral_stretch\n");
     size_t lost = cf_hysteresis_first_unstable(s, sc->nsamples);
     for (size_t k = 0; k < sc->nsamples; k++)
-        fprintf(o, "%.17g,%.17g,%.17g,%.17g,%.17g,%d\n", s[k].t_s, s[k].strain,
+        fprintf(o, "%.17g,%.17g,%.17g,%.17g,%.17g,%d,%.17g\n", s[k].t_s, s[k].strain,
                 s[k].stress_MPa * 1e3, s[k].kinetic_mJ, spring[k] * 1e3,
-                sc->effects.inertia ? -1 : k < lost);
+                sc->effects.inertia ? -1 : k < lost, s[k].lateral_stretch);
 }
 
 /* The inputs of a run, never to be outputs: the scene and the fit file it names (its name into
@@ -346,8 +346,9 @@ int cf_cli_simulate(int argc, char **argv)
         cf_scene_free(&sc);
         return cf_cli_fail(&err);
     }
-    cf_law law;
+    cf_law law, ext;
     memset(&law, 0, sizeof law);
+    memset(&ext, 0, sizeof ext);
     cf_lattice lat;
     memset(&lat, 0, sizeof lat);
     cf_msm_sample *samples = NULL;
@@ -356,7 +357,7 @@ int cf_cli_simulate(int argc, char **argv)
     cf_atomic pa = {0};
     double *spring = NULL;
     rc = CF_EXIT_OK;
-    if (run_scene(&sc, &q, &budget, &cost, &law, &lat, &samples, &st, &err) != CF_OK ||
+    if (run_scene(&sc, &q, &budget, &cost, &law, &ext, &lat, &samples, &st, &err) != CF_OK ||
         cf_cli_out_open(&a, out, inputs, &err) != CF_OK) {
         rc = cf_cli_fail(&err);
         goto end;
@@ -397,6 +398,7 @@ end:
     free(samples);
     cf_lattice_free(&lat);
     cf_law_free(&law);
+    cf_law_free(&ext);
     cf_scene_free(&sc);
     return rc;
 }

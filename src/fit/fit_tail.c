@@ -482,14 +482,16 @@ cf_status cf_fit_tail_run(const cf_table *data, const cf_fit_options *opt, cf_sp
 cf_status cf_law_family_parse(const char *name, cf_law_family *f, cf_error *err)
 {
     static const struct { const char *name; cf_law_family f; } map[] = {
-        {"conical", CF_FAMILY_CONICAL}, {"conical-tail", CF_FAMILY_TAIL}, {"auto", CF_FAMILY_AUTO}};
+        {"conical", CF_FAMILY_CONICAL}, {"conical-tail", CF_FAMILY_TAIL}, {"auto", CF_FAMILY_AUTO},
+        {"double-acting", CF_FAMILY_DOUBLE}};
     for (size_t i = 0; i < sizeof map / sizeof map[0]; i++)
         if (name && strcmp(name, map[i].name) == 0) {
             *f = map[i].f;
             return CF_OK;
         }
     return cf_error_set(err, CF_E_DATA,
-                        "unknown law '%s' (expected conical, conical-tail or auto)",
+                        "unknown law '%s' (expected conical, conical-tail, auto or "
+                        "double-acting)",
                         name ? name : "(null)");
 }
 
@@ -499,6 +501,7 @@ const char *cf_law_family_name(cf_law_family f)
     case CF_FAMILY_CONICAL: return "conical";
     case CF_FAMILY_TAIL: return "conical-tail";
     case CF_FAMILY_AUTO: return "auto";
+    case CF_FAMILY_DOUBLE: return "double-acting";
     }
     return "?";
 }

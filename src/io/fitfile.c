@@ -78,8 +78,87 @@ static cf_status read_visco(json_t *fit, const char *path, const char *where,
 ** exported spring, the requested or better type, a tie), its params by the field table, then
 ** provenance and the viscoelastic terms. Kept as one function because each step narrows the same
 ** JSON node and every error names the file and key it stopped at. */
+/* The six parameters of a spring object (key `name` of fit, at `where`) into *p, each a finite
+** number; CF_E_DATA naming the key and value otherwise. */
+static cf_status read_params6(json_t *fit, const char *name, const char *path, const char *where,
+                              cf_spring *p, cf_error *err)
+{
+    json_t *params = json_object_get(fit, name);
+    memset(p, 0, sizeof *p);
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        const char *key = cf_spring_param_info(k)->key;
+        json_t *v = json_object_get(params, key);
+        if (!json_is_number(v) || !isfinite(json_number_value(v))) {
+            char *text = v ? json_dumps(v, JSON_ENCODE_ANY) : NULL;
+            cf_status st = cf_error_set(err, CF_E_DATA, "%s: %s.%s.%s = %.40s is not a number",
+                                        path, where, name, key, text ? text : "(missing)");
+            free(text);
+            return st;
+        }
+        cf_spring_set(p, k, json_number_value(v));
+    }
+    return CF_OK;
+}
+
+/* The double-acting element and the volume term of fit (see cf_fitfile_load_element), or their
+** refusal when allow is 0. */
+static cf_status read_element(json_t *fit, const char *path, const char *where, int allow,
+                              cf_fitted_spring *out, cf_error *err)
+{
+    json_t *pe = json_object_get(fit, "params_extension");
+    json_t *kv = json_object_get(json_object_get(fit, "lattice"), "volume_modulus_MPa");
+    if (kv && (!json_is_number(kv) || !isfinite(json_number_value(kv)) ||
+               json_number_value(kv) < 0))
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: %s.lattice.volume_modulus_MPa is not a finite number >= 0", path,
+                            where);
+    const double kappa = kv ? json_number_value(kv) : 0.0;
+    if (!allow && (pe || kappa > 0))
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: %s is %s: export and a scene's 'spring.fit' read one spring per "
+                            "element and no volume term yet, and will not run it as its "
+                            "compression spring alone (a scene takes the pair and kappa by "
+                            "'spring_extension' and 'lattice.volume_modulus_MPa')",
+                            path, where,
+                            pe ? "a double-acting element (key 'params_extension')"
+                               : "a lattice with a volume term (key "
+                                 "'lattice.volume_modulus_MPa')");
+    out->volume_modulus_MPa = kappa;
+    if (!pe)
+        return CF_OK;
+    cf_status st = read_params6(fit, "params_extension", path, where, &out->extension, err);
+    if (st != CF_OK)
+        return st;
+    cf_law le;
+    cf_error lerr = {0};
+    if (cf_law_init(&le, &out->extension, &lerr) != CF_OK)
+        return cf_error_set(err, CF_E_DATA, "%s: %s.params_extension: %s", path, where, lerr.msg);
+    if (out->extension.H_mm != out->params.H_mm)
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: %s.params_extension.H_mm = %.17g differs from params.H_mm = "
+                            "%.17g (a double-acting element shares its free length)",
+                            path, where, out->extension.H_mm, out->params.H_mm);
+    out->has_extension = 1;
+    return CF_OK;
+}
+
+static cf_status load(const char *path, const char *type_name, int allow_element,
+                      cf_fitted_spring *out, cf_error *err);
+
 cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spring *out,
                           cf_error *err)
+{
+    return load(path, type_name, 0, out, err);
+}
+
+cf_status cf_fitfile_load_element(const char *path, const char *type_name,
+                                  cf_fitted_spring *out, cf_error *err)
+{
+    return load(path, type_name, 1, out, err);
+}
+
+static cf_status load(const char *path, const char *type_name, int allow_element,
+                      cf_fitted_spring *out, cf_error *err)
 {
     memset(out, 0, sizeof *out);
     out->rmse = NAN;
@@ -204,6 +283,8 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
     out->target_lattice = json_is_true(json_object_get(root, "joint")) ||
                           (model && strcmp(model, "lattice") == 0);
     if ((st = read_visco(fit, path, where, out, err)) != CF_OK)
+        goto done;
+    if ((st = read_element(fit, path, where, allow_element, out, err)) != CF_OK)
         goto done;
 done:
     json_decref(root);

@@ -164,6 +164,90 @@ static cf_status spring_section(ctx *c, json_t *sp, cf_scene *sc)
     return CF_OK;
 }
 
+/* 'spring_extension': {"params": {...}}, the extension spring of a double-acting element (the
+** six parameters of a conical spring, H the spring's). */
+static cf_status extension_section(ctx *c, json_t *ex, cf_scene *sc)
+{
+    static const char *const allowed[] = {"params", NULL};
+    const char *pkeys[CF_P_COUNT + 1];
+    for (int k = 0; k < CF_P_COUNT; k++)
+        pkeys[k] = cf_spring_param_info(k)->key;
+    pkeys[CF_P_COUNT] = NULL;
+    cf_status st = only_keys(c, ex, "spring_extension", allowed);
+    if (st)
+        return st;
+    json_t *params = json_object_get(ex, "params");
+    if (!json_is_object(params))
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'spring_extension.params' must be an object", c->name);
+    if ((st = only_keys(c, params, "spring_extension.params", pkeys)))
+        return st;
+    memset(&sc->extension, 0, sizeof sc->extension);
+    for (int k = 0; k < CF_P_COUNT; k++) {
+        double v;
+        if ((st = number(c, params, "spring_extension.params", pkeys[k], 1, 0, 0, 1, INFINITY,
+                         &v)))
+            return st;
+        cf_spring_set(&sc->extension, k, v);
+    }
+    cf_law law;
+    cf_error lerr = {0};
+    if (cf_law_init(&law, &sc->extension, &lerr) != CF_OK)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'spring_extension.params': %s", c->name,
+                            lerr.msg);
+    if (sc->extension.H_mm != sc->spring.H_mm)
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'spring_extension.params.H_mm' = %g: a double-acting element "
+                            "shares the spring's free length %g mm",
+                            c->name, sc->extension.H_mm, sc->spring.H_mm);
+    sc->has_extension = 1;
+    return CF_OK;
+}
+
+/* The volume term: 'lattice.volume_modulus_MPa' (kappa >= 0) or 'lattice.poisson_ratio' (the
+** small-strain nu along an axis, 0.25 <= nu < 0.5 and at least the springs' own: kappa from the
+** weights and the spring's k0/H, calibration.h); not both, and no nu for a double-acting
+** element (its lattice has one nu in compression and another in tension). */
+static cf_status volume_keys(ctx *c, json_t *lt, cf_scene *sc)
+{
+    cf_lattice_config *L = &sc->cfg.lattice;
+    json_t *kv = lt ? json_object_get(lt, "volume_modulus_MPa") : NULL;
+    json_t *nv = lt ? json_object_get(lt, "poisson_ratio") : NULL;
+    cf_status st;
+    if (kv && nv)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'lattice' takes 'volume_modulus_MPa' or "
+                                               "'poisson_ratio', not both", c->name);
+    if ((st = number(c, lt, "lattice", "volume_modulus_MPa", 0, 0, 0, 0, 1e100,
+                     &L->volume_modulus_MPa)))
+        return st;
+    if (!nv)
+        return CF_OK;
+    double nu;
+    if ((st = number(c, lt, "lattice", "poisson_ratio", 1, 0, 0.25, 0, 0.5, &nu)))
+        return st;
+    if (!(nu < 0.5))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'lattice.poisson_ratio' = %g: must be "
+                                               "below 0.5 (incompressible)", c->name, nu);
+    if (sc->has_extension)
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'lattice.poisson_ratio' = %g: a double-acting element's "
+                            "lattice has one small-strain nu in compression and another in "
+                            "tension; give 'volume_modulus_MPa'",
+                            c->name, nu);
+    cf_law law;
+    if (cf_law_init(&law, &sc->spring, NULL) != CF_OK)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'lattice.poisson_ratio': no spring",
+                            c->name);
+    const double kappa = cf_cubic_kappa_of_nu(L->weight, law.k0_N_per_mm / law.p.H_mm, nu);
+    if (!(kappa >= 0))
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'lattice.poisson_ratio' = %g: the lattice's springs alone "
+                            "give %.4g along an axis, and the volume term only raises it",
+                            c->name, nu, cf_cubic_moduli_of(L->weight).nu);
+    L->volume_modulus_MPa = kappa;
+    return CF_OK;
+}
+
 /* The family weights: exactly one of 'weights' {edge, face, body}, 'calibration' (isotropic,
 ** axial), or the shorthands 'diagonals' / 'diagonal_weight' (edges 1, the named diagonals the
 ** given weight: the uncalibrated lattice); none of them: isotropic. */
@@ -245,7 +329,8 @@ static cf_status weights_section(ctx *c, json_t *lt, cf_lattice_config *L)
 static cf_status lattice_section(ctx *c, json_t *lt, cf_scene *sc)
 {
     static const char *const allowed[] = {"nx", "ny", "nz", "weights", "calibration", "diagonals",
-                                          "diagonal_weight", "bottom", NULL};
+                                          "diagonal_weight", "bottom", "volume_modulus_MPa",
+                                          "poisson_ratio", NULL};
     cf_status st;
     cf_lattice_config *L = &sc->cfg.lattice;
     if (lt && (st = only_keys(c, lt, "lattice", allowed)))
@@ -275,7 +360,7 @@ static cf_status lattice_section(ctx *c, json_t *lt, cf_scene *sc)
                                 "%s: key 'lattice.bottom' = '%s': expected axial or clamped",
                                 c->name, s ? s : "(not a string)");
     }
-    return CF_OK;
+    return volume_keys(c, lt, sc);
 }
 
 /* effects.viscosity.prony: [{"g": .., "tau_s": .., "g_per_strain": ..}, ...] (g_per_strain
@@ -717,8 +802,9 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
 
 static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
 {
-    static const char *const allowed[] = {"spring", "lattice", "density_t_per_mm3", "protocol",
-                                          "effects", "integrator", "law_method", "table_intervals",
+    static const char *const allowed[] = {"spring", "spring_extension", "lattice",
+                                          "density_t_per_mm3", "protocol", "effects",
+                                          "integrator", "law_method", "table_intervals",
                                           "samples_per_segment", "comment", "body", "fixed",
                                           "probe", NULL};
     cf_status st;
@@ -731,6 +817,10 @@ static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
     sc->table_intervals = CF_LAW_TABLE_DEFAULT;
     json_t *sp, *lt, *pr, *ef, *in;
     if ((st = object(c, root, "spring", 1, &sp)) || (st = spring_section(c, sp, sc)))
+        return st;
+    json_t *ex;
+    if ((st = object(c, root, "spring_extension", 0, &ex)) ||
+        (ex && (st = extension_section(c, ex, sc))))
         return st;
     json_t *bd;
     if ((st = object(c, root, "body", 0, &bd)))
@@ -804,6 +894,21 @@ static cf_status finish(ctx *c, json_t *root, json_error_t *jerr, cf_scene *sc)
     if (st != CF_OK)
         cf_scene_free(sc);
     return st;
+}
+
+cf_status cf_scene_law(const cf_scene *sc, cf_law *law, cf_law *ext, cf_error *err)
+{
+    memset(ext, 0, sizeof *ext);
+    cf_status s = cf_law_init(law, &sc->spring, err);
+    if (s == CF_OK && sc->method == CF_LAW_TABLE)
+        s = cf_law_table_build(law, sc->table_intervals, err);
+    if (s == CF_OK && sc->has_extension) {
+        if ((s = cf_law_init(ext, &sc->extension, err)) == CF_OK && sc->method == CF_LAW_TABLE)
+            s = cf_law_table_build(ext, sc->table_intervals, err);
+        if (s == CF_OK)
+            s = cf_law_pair(law, ext, err);
+    }
+    return s;
 }
 
 cf_status cf_scene_parse(const char *json_text, const char *name, cf_scene *sc, cf_error *err)

@@ -93,3 +93,16 @@ const char *cf_family_name(int family)
     static const char *const names[CF_FAMILY_COUNT] = {"edge", "face", "body"};
     return family >= 0 && family < CF_FAMILY_COUNT ? names[family] : "?";
 }
+
+double cf_cubic_kappa_of_nu(const double w[CF_FAMILY_COUNT], double k0_over_H, double nu)
+{
+    const cf_cubic_moduli cm = cf_cubic_moduli_of(w);
+    return (nu * (cm.C11 + cm.C12) - cm.C12) / (1 - 2 * nu) * k0_over_H;
+}
+
+double cf_cubic_nu_of_kappa(const double w[CF_FAMILY_COUNT], double k0_over_H, double kappa)
+{
+    const cf_cubic_moduli cm = cf_cubic_moduli_of(w);
+    const double k = kappa / k0_over_H;
+    return (cm.C12 + k) / (cm.C11 + cm.C12 + 2 * k);
+}

@@ -87,6 +87,7 @@ cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
     c->law_scale_strain = 0.0;
     c->stretch_hint = 0.0;
     c->linear_finish = 0;
+    c->volume_modulus_MPa = 0.0;
     memcpy(c->weight, weight, sizeof c->weight);
     return CF_OK;
 }
@@ -113,12 +114,13 @@ static cf_status spring_tension(const cf_cell *c, int d, double L, const cf_cell
     const int *N = dirs[d], fam = dir_family[d];
     double L0 = H * dir_len[d];
     double u = H * (L0 - L) / L0;
-    *r = fabs(u) / law->travel_mm;
+    const double travel = cf_law_travel_at(law, u); /* a pair: the side u loads */
+    *r = fabs(u) / travel;
     if (!(*r < SOLID_MARGIN) || !(L > 0))
         return cf_error_set(err, CF_E_DATA,
                             "the cell's spring along (%d, %d, %d) reaches solid (stretch %.6g, "
                             "solid at %.6g)",
-                            N[0], N[1], N[2], L / L0, 1 - copysign(law->travel_mm / H, u));
+                            N[0], N[1], N[2], L / L0, 1 - copysign(travel / H, u));
     double k = 0;
     double f = cf_law_force(law, c->method, u, &k, NULL);
     double w = c->weight[fam] * c->law_scale, T, dT;
@@ -139,6 +141,40 @@ static cf_status spring_tension(const cf_cell *c, int d, double L, const cf_cell
     s->T_N[d] = T;
     kT[d] = dT;
     return CF_OK;
+}
+
+/* The cofactor matrix of F (cof F = J F^-T, row-major) and J = det F. */
+static double cofactor(const double F[9], double C[9])
+{
+    C[0] = F[4] * F[8] - F[5] * F[7];
+    C[1] = F[5] * F[6] - F[3] * F[8];
+    C[2] = F[3] * F[7] - F[4] * F[6];
+    C[3] = F[2] * F[7] - F[1] * F[8];
+    C[4] = F[0] * F[8] - F[2] * F[6];
+    C[5] = F[1] * F[6] - F[0] * F[7];
+    C[6] = F[1] * F[5] - F[2] * F[4];
+    C[7] = F[2] * F[3] - F[0] * F[5];
+    C[8] = F[0] * F[4] - F[1] * F[3];
+    return F[0] * C[0] + F[1] * C[1] + F[2] * C[2];
+}
+
+/* The volume term's nominal stress kappa (J - 1) cof F added to P. */
+static void volume_stress(double kappa, const double F[9], double P[3][3])
+{
+    double C[9];
+    const double J = cofactor(F, C), g = kappa * (J - 1);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            P[i][j] += g * C[3 * i + j];
+}
+
+/* The volume term's tangent dP_ij/dF_kl = kappa C_ij C_kl + kappa (J - 1)/J (C_ij C_kl - C_il C_kj),
+** C = cof F (d cof F_ij / dF_kl = (C_ij C_kl - C_il C_kj)/J, dJ/dF = C). */
+static double volume_tangent(double kappa, const double C[9], double J, int i, int j, int k,
+                             int l)
+{
+    const double cc = C[3 * i + j] * C[3 * k + l];
+    return kappa * cc + kappa * (J - 1) / J * (cc - C[3 * i + l] * C[3 * k + j]);
 }
 
 /* The state at F, and dT/dL of every spring (N/mm) for the tangent. */
@@ -193,6 +229,8 @@ static cf_status evaluate(const cf_cell *c, const double F[9], const cf_cell_ext
                     P[i][j] += qx * X[j];
         }
     }
+    if (c->volume_modulus_MPa != 0)
+        volume_stress(c->volume_modulus_MPa, F, P);
     memcpy(s->P_MPa, P, sizeof P);
     return CF_OK;
 }
@@ -231,6 +269,13 @@ cf_status cf_cell_tangent(const cf_cell *c, const double F[9], const cf_cell_ext
                         A[27 * i + 9 * j + 3 * k + l] +=
                             a * xv[i] * X[j] * xv[k] * X[l] +
                             (i == k ? T * X[j] * X[l] / (L * H3) : 0);
+    }
+    if (c->volume_modulus_MPa != 0) {
+        double C[9];
+        const double J = cofactor(F, C);
+        for (int i = 0; i < 81; i++)
+            A[i] += volume_tangent(c->volume_modulus_MPa, C, J, i / 27, (i / 9) % 3, (i / 3) % 3,
+                                   i % 3);
     }
     return CF_OK;
 }
@@ -273,6 +318,13 @@ static double tangent(const cf_cell *c, const cf_cell_state *s, const double kT[
             if (k == m)
                 g += t2[d];
         }
+    }
+    if (c->volume_modulus_MPa != 0) {
+        double C[9];
+        const double J = cofactor(F, C);
+        for (int k = 0; k < 3; k++)
+            if (kmask & (1u << k))
+                g += volume_tangent(c->volume_modulus_MPa, C, J, m, m, k, k);
     }
     return g;
 }
@@ -378,7 +430,8 @@ static cf_status settle_linear(const cf_cell *c, const mode_form *fm,
         s->L_mm[d] = Ln[d];
         s->T_N[d] = Tn[d];
         const double L0 = H * dir_len[d];
-        const double ru = fabs(H * (L0 - s->L_mm[d]) / L0) / c->law->travel_mm;
+        const double uu = H * (L0 - s->L_mm[d]) / L0;
+        const double ru = fabs(uu) / cf_law_travel_at(c->law, uu);
         umax = ru > umax ? ru : umax;
     }
     for (int m = 0; m < 3; m++) {
@@ -398,7 +451,15 @@ static double lateral_rounding(const cf_cell *c, const cf_cell_state *s)
         const double t = fabs(s->T_N[d]);
         rs = t > rs ? t : rs; /* as fmax, without its call */
     }
-    return rs * (8 * DBL_EPSILON / (c->law->p.H_mm * c->law->p.H_mm));
+    rs /= c->law->p.H_mm * c->law->p.H_mm;
+    if (c->volume_modulus_MPa != 0) { /* the volume term's stress, its largest entry */
+        double C[9], cm = 0;
+        const double J = cofactor(s->F, C);
+        for (int i = 0; i < 9; i++)
+            cm = fmax(cm, fabs(C[i]));
+        rs = fmax(rs, fabs(c->volume_modulus_MPa * (J - 1)) * cm);
+    }
+    return rs * (8 * DBL_EPSILON);
 }
 
 /* What the search for the free stretch knows: r(lo) < 0 < r(hi) once have_lo and have_hi. */
@@ -447,10 +508,11 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
     }
     /* Safeguarded Newton on r(a) = P[zero][zero], increasing in a: a bracket [lo, hi] with
     ** r(lo) < 0 < r(hi) is kept once known; a step that leaves it, or the domain, bisects. */
-    const double sH = c->law->travel_mm / c->law->p.H_mm;
-    bracket b = {1 - sH, 1 + sH, 0, 0}; /* the edge along a free axis reaches solid there */
+    const double sH = c->law->travel_mm / c->law->p.H_mm; /* compression side */
+    const double sHe = cf_law_travel_at(c->law, -1) / c->law->p.H_mm; /* extension side */
+    bracket b = {1 - sH, 1 + sHe, 0, 0}; /* the edge along a free axis reaches solid there */
     double a = c->stretch_hint > 0 ? c->stretch_hint : guess(c, m, e);
-    a = fmin(fmax(a, b.lo + 1e-3 * sH), b.hi - 1e-3 * sH);
+    a = fmin(fmax(a, b.lo + 1e-3 * sH), b.hi - 1e-3 * sHe);
     cf_error e1 = {0};
     double newton_before = 0; /* the Newton step that led to a, 0 when a came otherwise */
     for (int it = 0; it < MAX_ITER; it++) {
@@ -487,7 +549,7 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
         ** in it, the state at an comes from the linearisation at a */
         const double da = an - a;
         const int newton = g > 0 && an == a - r / g;
-        if (c->linear_finish && newton && newton_before != 0 &&
+        if (c->linear_finish && c->volume_modulus_MPa == 0 && newton && newton_before != 0 &&
             fabs(da) <= LINEAR_STEP * fabs(a) &&
             fabs(da) * da * da <= DBL_EPSILON * fabs(a) * newton_before * newton_before)
             return settle_linear(c, &fm, kT, s, a, da);

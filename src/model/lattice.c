@@ -21,6 +21,7 @@ cf_lattice_config cf_lattice_default(void)
     cf_calibration_weights(c.calibration, c.weight, NULL);
     c.density_t_per_mm3 = 1e-9;
     c.bottom = CF_BOTTOM_AXIAL;
+    c.volume_modulus_MPa = 0;
     return c;
 }
 
@@ -76,6 +77,9 @@ static cf_status check_config(const cf_lattice_config *cfg, cf_error *err)
     if (!(cfg->density_t_per_mm3 > 0) || !isfinite(cfg->density_t_per_mm3))
         return cf_error_set(err, CF_E_DATA, "density_t_per_mm3 = %g: must be finite and > 0",
                             cfg->density_t_per_mm3);
+    if (!(cfg->volume_modulus_MPa >= 0) || !isfinite(cfg->volume_modulus_MPa))
+        return cf_error_set(err, CF_E_DATA, "lattice volume_modulus_MPa = %g: must be finite and "
+                                            ">= 0", cfg->volume_modulus_MPa);
     return cf_calibration_check(cfg->weight, err);
 }
 
@@ -207,7 +211,7 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
     lat->method = method;
     lat->with_stiffness = 1;
     lat->H_mm = law->p.H_mm;
-    lat->travel_mm = law->travel_mm;
+    lat->travel_mm = cf_law_travel_min(law); /* a pair: the side that closes first */
 
     /* The spring directions of the cell (each unordered pair of neighbours once). */
     int off[CF_CELL_DIRS][3];
@@ -238,6 +242,101 @@ void cf_lattice_reset(cf_lattice *lat)
     memcpy(lat->x, lat->X, lat->nn * sizeof(double));
     memcpy(lat->y, lat->Y, lat->nn * sizeof(double));
     memcpy(lat->z, lat->Z, lat->nn * sizeof(double));
+}
+
+/* Gauss points of [0, 1] (two, weight 1/2 each) and the trilinear shape functions' derivatives
+** there: dN[g][a][j] = dN_a/dxi_j at point g (of 8), corner a = di + 2 dj + 4 dk. */
+static void shape_derivatives(double dN[8][8][3])
+{
+    const double q[2] = {0.5 - 0.5 / 1.7320508075688772935, 0.5 + 0.5 / 1.7320508075688772935};
+    for (int g = 0; g < 8; g++) {
+        const double xi[3] = {q[g & 1], q[(g >> 1) & 1], q[(g >> 2) & 1]};
+        for (int a = 0; a < 8; a++) {
+            const int d[3] = {a & 1, (a >> 1) & 1, (a >> 2) & 1};
+            double f[3], df[3];
+            for (int j = 0; j < 3; j++) {
+                f[j] = d[j] ? xi[j] : 1 - xi[j];
+                df[j] = d[j] ? 1.0 : -1.0;
+            }
+            dN[g][a][0] = df[0] * f[1] * f[2];
+            dN[g][a][1] = f[0] * df[1] * f[2];
+            dN[g][a][2] = f[0] * f[1] * df[2];
+        }
+    }
+}
+
+double cf_lattice_cell_volume(const cf_lattice *lat, size_t c, uint32_t node[8], double g[8][3],
+                              double (*hess)[8][3][3])
+{
+    const cf_lattice_config *cfg = &lat->cfg;
+    const size_t nx = (size_t)cfg->nx, ny = (size_t)cfg->ny;
+    const int ci = (int)(c % nx), cj = (int)((c / nx) % ny), ck = (int)(c / (nx * ny));
+    double dN[8][8][3], X[8][3];
+    shape_derivatives(dN);
+    for (int a = 0; a < 8; a++) {
+        node[a] = (uint32_t)node_id(cfg, ci + (a & 1), cj + ((a >> 1) & 1), ck + ((a >> 2) & 1));
+        X[a][0] = lat->x[node[a]], X[a][1] = lat->y[node[a]], X[a][2] = lat->z[node[a]];
+    }
+    memset(g, 0, 8 * 3 * sizeof(double));
+    if (hess)
+        memset(hess, 0, 8 * 8 * 3 * 3 * sizeof(double));
+    double V = 0;
+    for (int p = 0; p < 8; p++) {
+        double M[3][3] = {{0}}; /* dx_i/dxi_j */
+        for (int a = 0; a < 8; a++)
+            for (int i = 0; i < 3; i++)
+                for (int j = 0; j < 3; j++)
+                    M[i][j] += X[a][i] * dN[p][a][j];
+        double C[3][3];
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                const int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+                C[i][j] = M[i1][j1] * M[i2][j2] - M[i1][j2] * M[i2][j1];
+            }
+        V += 0.125 * (M[0][0] * C[0][0] + M[0][1] * C[0][1] + M[0][2] * C[0][2]);
+        for (int a = 0; a < 8; a++)
+            for (int i = 0; i < 3; i++)
+                g[a][i] += 0.125 * (C[i][0] * dN[p][a][0] + C[i][1] * dN[p][a][1] +
+                                    C[i][2] * dN[p][a][2]);
+        if (!hess)
+            continue;
+        /* d2 det/(dM_ij dM_kl) = sum_mn eps_ikm eps_jln M_mn */
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++) {
+                if (i == k)
+                    continue;
+                const int m = 3 - i - k, sik = ((k - i + 3) % 3 == 1) ? 1 : -1;
+                for (int j = 0; j < 3; j++)
+                    for (int l = 0; l < 3; l++) {
+                        if (j == l)
+                            continue;
+                        const int n = 3 - j - l, sjl = ((l - j + 3) % 3 == 1) ? 1 : -1;
+                        const double h = 0.125 * sik * sjl * M[m][n];
+                        for (int a = 0; a < 8; a++)
+                            for (int b = 0; b < 8; b++)
+                                hess[a][b][i][k] += h * dN[p][a][j] * dN[p][b][l];
+                    }
+            }
+    }
+    const double H = lat->H_mm;
+    return V / (H * H * H);
+}
+
+/* The volume term's node forces, -kappa (J - 1) dV/dx, added to fx, fy, fz. */
+static void volume_forces(cf_lattice *lat)
+{
+    const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
+    const double kappa = lat->cfg.volume_modulus_MPa;
+    for (size_t c = 0; c < nc; c++) {
+        uint32_t node[8];
+        double g[8][3];
+        const double J = cf_lattice_cell_volume(lat, c, node, g, NULL), f = -kappa * (J - 1);
+        for (int a = 0; a < 8; a++) {
+            lat->fx[node[a]] += f * g[a][0];
+            lat->fy[node[a]] += f * g[a][1];
+            lat->fz[node[a]] += f * g[a][2];
+        }
+    }
 }
 
 double cf_lattice_forces(cf_lattice *lat)
@@ -279,6 +378,8 @@ double cf_lattice_forces(cf_lattice *lat)
         fy[j] -= gy;
         fz[j] -= gz;
     }
+    if (lat->cfg.volume_modulus_MPa != 0)
+        volume_forces(lat);
     return umax / lat->travel_mm;
 }
 
@@ -321,6 +422,8 @@ static double law_at(double v, void *p)
 static double law_work(const cf_law *law, cf_law_method m, double u,
                        const gsl_integration_glfixed_table *gl)
 {
+    if (u < 0 && law->extension) /* a pair's extension side: its own spring compressed by -u */
+        law = law->extension, u = -u;
     double au = fabs(u), uT = law->u_T_mm, uC = law->u_C_mm, s = law->travel_mm;
     double e = 0.5 * law->k0_N_per_mm * fmin(au, uT) * fmin(au, uT);
     if (au > uT) {
@@ -360,7 +463,29 @@ double cf_lattice_elastic_energy(const cf_lattice *lat)
         e += lat->w[s] / lat->a[s] * law_work(lat->law, lat->method, u, gl);
     }
     gsl_integration_glfixed_table_free(gl);
+    const double kappa = lat->cfg.volume_modulus_MPa, H = lat->H_mm;
+    const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
+    for (size_t c = 0; kappa != 0 && c < nc; c++) { /* the volume term, (kappa/2)(J - 1)^2 H^3 */
+        uint32_t node[8];
+        double g[8][3];
+        const double J = cf_lattice_cell_volume(lat, c, node, g, NULL);
+        e += 0.5 * kappa * (J - 1) * (J - 1) * H * H * H;
+    }
     return e;
+}
+
+double cf_lattice_lateral_stretch(const cf_lattice *lat)
+{
+    const double W = lat->cfg.nx * lat->H_mm;
+    double hi = 0, lo = 0;
+    size_t nhi = 0, nlo = 0;
+    for (size_t p = 0; p < lat->nn; p++) {
+        if (lat->X[p] == W)
+            hi += lat->x[p], nhi++;
+        else if (lat->X[p] == 0)
+            lo += lat->x[p], nlo++;
+    }
+    return (hi / (double)nhi - lo / (double)nlo) / W;
 }
 
 double cf_lattice_top_strain(const cf_lattice *lat)

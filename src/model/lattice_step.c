@@ -21,7 +21,9 @@ cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const
     memset(st, 0, sizeof *st);
     st->lat = lat;
     cf_law_lanes_init(lat->law, &st->lanes);
-    if (lat->law->tail) /* its lanes hold the polynomial only: without it, the scalar law */
+    if (lat->law->extension) /* a double-acting element: the scalar law, side by side */
+        st->form = -1;
+    else if (lat->law->tail) /* its lanes hold the polynomial only: without it, the scalar law */
         st->form = lat->method == CF_LAW_CLOSED || lat->method == CF_LAW_TABLE ? CF_LANE_POLY : -1;
     else if (lat->method == CF_LAW_CLOSED)
         st->form = CF_LANE_CLOSED;
@@ -31,7 +33,7 @@ cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const
         st->form = -1;
     /* closed form and table: the spring's polynomial when it is within CF_POLY_TOL of the closed
     ** form (more accurate than the table, cheaper than both) */
-    if (st->form >= 0 && cf_law_lanes_fit_poly(lat->law, &st->lanes, &st->poly_error))
+    if (st->form >= 0 && !lat->law->extension && cf_law_lanes_fit_poly(lat->law, &st->lanes, &st->poly_error))
         st->form = CF_LANE_POLY;
     else if (st->form == CF_LANE_POLY)
         st->form = -1;

@@ -644,7 +644,7 @@ static inline double table_region2(const cf_law *law, double u, double a, double
 #define CF_ALWAYS_INLINE inline
 #endif
 
-static CF_ALWAYS_INLINE double law_eval(const cf_law *law, cf_law_method method, double u,
+static CF_ALWAYS_INLINE double law_side(const cf_law *law, cf_law_method method, double u,
                                         double *k, int *flags)
 {
     const double a = fabs(u);
@@ -699,6 +699,36 @@ static CF_ALWAYS_INLINE double law_eval(const cf_law *law, cf_law_method method,
     return sign * law->F_C_N * y2 * y;
 }
 
+/* The extension side of a pair: -F_e(-u), its stiffness k_e(-u). */
+static double law_extension(const cf_law *law, cf_law_method method, double u, double *k,
+                            int *flags)
+{
+    return -law_side(law->extension, method, -u, k, flags);
+}
+
+/* The law at one displacement: the odd law, or a pair's side. */
+static CF_ALWAYS_INLINE double law_eval(const cf_law *law, cf_law_method method, double u,
+                                        double *k, int *flags)
+{
+    if (u < 0 && law->extension)
+        return law_extension(law, method, u, k, flags);
+    return law_side(law, method, u, k, flags);
+}
+
+cf_status cf_law_pair(cf_law *law, const cf_law *ext, cf_error *err)
+{
+    if (ext && ext->extension)
+        return cf_error_set(err, CF_E_DATA, "an extension spring cannot have its own extension "
+                                            "spring");
+    if (ext && ext->p.H_mm != law->p.H_mm)
+        return cf_error_set(err, CF_E_DATA,
+                            "the extension spring's free length H = %.17g mm differs from the "
+                            "compression spring's %.17g mm (a double-acting element shares it)",
+                            ext->p.H_mm, law->p.H_mm);
+    law->extension = ext;
+    return CF_OK;
+}
+
 double cf_law_force(const cf_law *law, cf_law_method method, double u_mm, double *k_N_per_mm,
                     int *flags)
 {
@@ -750,7 +780,7 @@ void cf_law_lanes_init(const cf_law *law, cf_law_lanes *lanes)
 void cf_law_force_many(const cf_law *law, cf_law_method method, size_t count, const double *u_mm,
                        double *F_N, double *k_N_per_mm)
 {
-    if (!k_N_per_mm && !law->tail &&
+    if (!k_N_per_mm && !law->tail && !law->extension &&
         (method == CF_LAW_CLOSED || (method == CF_LAW_TABLE && law->table))) {
         /* forces alone: the vectorised lanes (law_simd.h) */
         cf_law_lanes lanes;
@@ -778,6 +808,8 @@ void cf_law_force_many(const cf_law *law, cf_law_method method, size_t count, co
 
 double cf_law_deflection(const cf_law *law, double F_N)
 {
+    if (F_N < 0 && law->extension)
+        return -cf_law_deflection(law->extension, -F_N);
     const double a = fabs(F_N);
     const double sign = (F_N < 0) ? -1.0 : 1.0;
     if (isnan(F_N))

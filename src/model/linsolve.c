@@ -49,6 +49,18 @@ static int ccs_index(const gsl_spmatrix *C, long row, long col)
 ** allocated directly fails cleanly. */
 enum { MAXADJ = CF_LINSOLVE_MAX_ADJ };
 
+/* Adds b to a's adjacent nodes unless there: 0, or 1 when a has MAXADJ already. */
+static int adjacent(uint32_t *adj, unsigned char *deg, uint32_t a, uint32_t b)
+{
+    for (int k = 0; k < deg[a]; k++)
+        if (adj[a * MAXADJ + k] == b)
+            return 0;
+    if (deg[a] == MAXADJ)
+        return 1;
+    adj[a * MAXADJ + deg[a]++] = b;
+    return 0;
+}
+
 /* The nodes each node shares a spring with, itself first: adj[p * MAXADJ + k] for k < deg[p].
 ** Returns 1 when a node has more than MAXADJ (the pattern cannot hold it). */
 static int node_adjacency(const cf_lattice *lat, uint32_t *adj, unsigned char *deg)
@@ -61,19 +73,19 @@ static int node_adjacency(const cf_lattice *lat, uint32_t *adj, unsigned char *d
     int bad = 0;
     for (size_t q = 0; q < lat->ns && !bad; q++) {
         uint32_t ends[2] = {lat->si[q], lat->sj[q]};
-        for (int e = 0; e < 2; e++) {
-            uint32_t a = ends[e], b = ends[1 - e];
-            int have = 0;
-            for (int k = 0; k < deg[a] && !have; k++)
-                have = adj[a * MAXADJ + k] == b;
-            if (!have) {
-                if (deg[a] == MAXADJ) {
-                    bad = 1;
-                    break;
-                }
-                adj[a * MAXADJ + deg[a]++] = b;
-            }
-        }
+        for (int e = 0; e < 2 && !bad; e++)
+            bad = adjacent(adj, deg, ends[e], ends[1 - e]);
+    }
+    /* the volume term couples every two nodes of a cell (a spring does unless its family's
+    ** weight is 0) */
+    const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
+    for (size_t c = 0; lat->cfg.volume_modulus_MPa != 0 && c < nc && !bad; c++) {
+        uint32_t node[8];
+        double g[8][3];
+        cf_lattice_cell_volume(lat, c, node, g, NULL);
+        for (int a = 0; a < 8 && !bad; a++)
+            for (int b = 0; b < 8 && !bad; b++)
+                bad = a != b && adjacent(adj, deg, node[a], node[b]);
     }
     return bad;
 }
@@ -151,6 +163,18 @@ static void block_map(solver *s)
     }
     for (size_t e = 0; e < n; e++)
         s->diag[e] = ccs_index(s->C, (long)e, (long)e);
+    const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
+    for (size_t c = 0; s->vmap && c < nc; c++) {
+        uint32_t node[8];
+        double g[8][3];
+        cf_lattice_cell_volume(lat, c, node, g, NULL);
+        for (int a = 0; a < 8; a++)
+            for (int b = 0; b < 8; b++)
+                for (int i = 0; i < 3; i++)
+                    for (int k = 0; k < 3; k++)
+                        s->vmap[((c * 8 + (size_t)a) * 8 + (size_t)b) * 9 + (size_t)(i * 3 + k)] =
+                            ccs_index(s->C, s->eq[3 * node[a] + i], s->eq[3 * node[b] + k]);
+    }
     s->band = 0;
     for (size_t col = 0; col < n; col++)
         for (int k = s->C->p[col]; k < s->C->p[col + 1]; k++) {
@@ -185,7 +209,10 @@ static cf_status build_pattern(solver *s, cf_error *err)
     s->C = C;
     s->map = malloc((lat->ns ? lat->ns : 1) * 36 * sizeof(int));
     s->diag = malloc((n ? n : 1) * sizeof(int));
-    if (!s->C || !s->map || !s->diag)
+    const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
+    if (lat->cfg.volume_modulus_MPa != 0)
+        s->vmap = malloc(nc * 8 * 8 * 9 * sizeof(int));
+    if (!s->C || !s->map || !s->diag || (lat->cfg.volume_modulus_MPa != 0 && !s->vmap))
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent matrix");
     block_map(s);
     return CF_OK;
@@ -386,6 +413,31 @@ done:
 
 /* ---- assembly and the cascade ---------------------------------------------------------------- */
 
+/* The volume term's tangent added into v: per cell, kappa/H^3 g_a g_b^T + kappa (J - 1) d2V/dx_a
+** dx_b (W = (kappa/2)(J - 1)^2 H^3, J = V/H^3, g = dV/dx). */
+static void volume_tangent(solver *s, double *v)
+{
+    const cf_lattice *lat = s->lat;
+    const double kappa = lat->cfg.volume_modulus_MPa, H = lat->H_mm, V0 = H * H * H;
+    const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
+    double hess[8][8][3][3]; /* 4.6 kB */
+    for (size_t c = 0; c < nc; c++) {
+        uint32_t node[8];
+        double g[8][3];
+        const double J = cf_lattice_cell_volume(lat, c, node, g, hess);
+        for (int a = 0; a < 8; a++)
+            for (int b = 0; b < 8; b++)
+                for (int i = 0; i < 3; i++)
+                    for (int k = 0; k < 3; k++) {
+                        const int at =
+                            s->vmap[((c * 8 + (size_t)a) * 8 + (size_t)b) * 9 + (size_t)(i * 3 + k)];
+                        if (at >= 0)
+                            v[at] += kappa / V0 * g[a][i] * g[b][k] +
+                                     kappa * (J - 1) * hess[a][b][i][k];
+                    }
+    }
+}
+
 /* Adds the tangent K = -dR/dx at the state of the last cf_msm_residual() into v (C's pattern,
 ** zeroed first), unscaled. */
 static void assemble_values(solver *s, double *v)
@@ -418,6 +470,8 @@ static void assemble_values(solver *s, double *v)
                     v[m[k + 27]] -= B;
             }
     }
+    if (lat->cfg.volume_modulus_MPa != 0)
+        volume_tangent(s, v);
 }
 
 /* v <- D^-1 v D^-1 with D = s->D (C's pattern). */

@@ -191,6 +191,7 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
         s.load = vk;
         out[k].t_s = tk;
         out[k].strain = cf_lattice_top_strain(lat);
+        out[k].lateral_stretch = cf_lattice_lateral_stretch(lat);
         out[k].stress_MPa = sample_stress(&s, &d, path, vk);
         out[k].kinetic_mJ = fx->inertia ? cf_msm_kinetic(lat, &d) : 0.0;
         out[k].neg_pivots = fx->inertia ? -1 : s.neg_pivots;

@@ -132,6 +132,11 @@ void cf_msm_dyn_free(dyn *d)
 cf_status cf_msm_dyn_init(dyn *d, solver *s, cf_error *err)
 {
     cf_lattice *lat = s->lat;
+    if (lat->cfg.volume_modulus_MPa != 0)
+        return cf_error_set(err, CF_E_DATA, "lattice volume_modulus_MPa = %g: the volume term is in "
+                                            "the lattice's statics only, not yet in an explicit "
+                                            "(dynamic) run",
+                            lat->cfg.volume_modulus_MPa);
     d->vx = calloc(lat->nn, sizeof(double));
     d->vy = calloc(lat->nn, sizeof(double));
     d->vz = calloc(lat->nn, sizeof(double));

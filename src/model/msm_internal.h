@@ -43,6 +43,8 @@ typedef struct solver {
     /* the tangent and its factorisations (linsolve.c) */
     gsl_spmatrix *C;          /* tangent, compressed columns, pattern built once */
     int *map, *diag;          /* spring block -> C->data index; DOF -> its diagonal index */
+    int *vmap;                /* the volume term's blocks: cell c's (a, b) entry (i, k) at
+                                 vmap[((c * 8 + a) * 8 + b) * 9 + i * 3 + k] (NULL without one) */
     size_t band;              /* half-bandwidth of C (largest |row - col|) */
     gsl_matrix *AB;           /* banded LDL^T workspace, ndof x (band + 1); NULL until used */
     cf_sparse_chol *chol;     /* sparse factorisation of C (pattern analysed once); NULL until used */

@@ -42,6 +42,7 @@ void cf_msm_solver_free(solver *s)
     free(s->Fprev);
     free(s->tmp);
     free(s->map);
+    free(s->vmap);
     free(s->diag);
     free(s->kval);
     free(s->kbasis);
@@ -214,7 +215,11 @@ static double force_floor(const solver *s)
         for (size_t q = 0; q < lat->ns; q++)
             dash = fmax(dash, s->kx[q] * fmax(lat->L_mm[q], xmax));
     }
-    return 1e-12 * lat->law->F_C_N * wmax + 1e-13 * dash;
+    const double FC = lat->law->extension ? fmax(lat->law->F_C_N, lat->law->extension->F_C_N)
+                                          : lat->law->F_C_N;
+    /* the volume term's forces scale with kappa H^2 as the springs' with F_C */
+    const double vol = lat->cfg.volume_modulus_MPa * lat->H_mm * lat->H_mm;
+    return 1e-12 * FC * wmax + 1e-13 * dash + (vol != 0 ? 1e-12 * vol : 0.0);
 }
 
 /* A step from reused factors did not converge fast enough: chord steps give way to Krylov steps,

@@ -83,10 +83,13 @@ cf_status cf_msm_uniaxial(const cf_law *law, cf_law_method m, const cf_msm_confi
                 stress_MPa[i] = 0;
                 continue;
             }
-            if (fabs(e) * lat.H_mm >= lat.travel_mm) {
+            /* the loaded edge's spring on the table's side (a pair: tension closes the extension
+            ** spring) */
+            const double side_travel = cf_law_travel_at(lat.law, -e);
+            if (fabs(e) * lat.H_mm >= side_travel) {
                 rc = cf_error_set(err, CF_E_DATA,
                                   "strain %.6g is at or beyond the spring's solid strain %.6g",
-                                  strain[i], lat.travel_mm / lat.H_mm);
+                                  strain[i], side_travel / lat.H_mm);
                 break;
             }
             rc = cf_msm_static_to(&s, e, err);
@@ -151,7 +154,8 @@ cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_ms
         goto done;
     }
     /* compressive-positive drive: a table strain of sign `side` is -side times it */
-    const double dir = side < 0 ? 1.0 : -1.0, top = STABILITY_REACH * lat.travel_mm / lat.H_mm;
+    const double dir = side < 0 ? 1.0 : -1.0;
+    const double top = STABILITY_REACH * cf_law_travel_at(lat.law, -side) / lat.H_mm;
     double stable = 0;
     s.load = 0;
     for (int k = 1; k <= STABILITY_STEPS; k++) {

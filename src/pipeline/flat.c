@@ -132,16 +132,14 @@ cf_status cf_flat_simulate(const char *scene_path, double **samples, size_t *cou
         cf_scene_free(&sc);
         return s;
     }
-    cf_law law = {0};
+    cf_law law = {0}, ext = {0};
     cf_lattice lat = {0};
     cf_msm_sample *run = calloc(sc.nsamples ? sc.nsamples : 1, sizeof *run);
     double *out = calloc(sc.nsamples ? sc.nsamples * CF_FLAT_SAMPLE_COLUMNS : 1, sizeof *out);
     int have_lattice = 0;
     if (!run || !out)
         s = cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu samples", sc.nsamples);
-    else if ((s = cf_law_init(&law, &sc.spring, err)) == CF_OK &&
-             (sc.method != CF_LAW_TABLE ||
-              (s = cf_law_table_build(&law, sc.table_intervals, err)) == CF_OK) &&
+    else if ((s = cf_scene_law(&sc, &law, &ext, err)) == CF_OK &&
              (s = cf_lattice_create(&lat, &law, sc.method, &sc.cfg.lattice, err)) == CF_OK) {
         have_lattice = 1;
         if ((s = cf_budget_check_steps(&sc, scene_path, &lat, &budget, &cost, err)) == CF_OK) {
@@ -163,6 +161,7 @@ cf_status cf_flat_simulate(const char *scene_path, double **samples, size_t *cou
             row[3] = run[i].kinetic_mJ;
             row[4] = cf_law_force(&law, sc.method, run[i].strain * H, NULL, NULL) / (H * H) * 1e3;
             row[5] = sc.effects.inertia ? -1 : i < lost;
+            row[6] = run[i].lateral_stretch;
         }
         *samples = out;
         *count = sc.nsamples;
@@ -171,6 +170,7 @@ cf_status cf_flat_simulate(const char *scene_path, double **samples, size_t *cou
     if (have_lattice)
         cf_lattice_free(&lat);
     cf_law_free(&law);
+    cf_law_free(&ext);
     free(run);
     free(out);
     cf_scene_free(&sc);

@@ -43,6 +43,58 @@ static cf_status choose_law(const cf_table *const *tables, size_t n,
     return CF_OK;
 }
 
+/* The double-acting element's joint fit beside the single-sided law in fits[k] (from the conical
+** law's quantities plain), and the law kept: double-acting the pair, auto the pair only with a
+** lower joint AIC and both springs buildable. A pair that finds no lattice leaves auto's choice
+** alone; double-acting then fails. */
+static cf_status choose_pair(const cf_table *const *tables, size_t n,
+                             const cf_pipeline_options *opt, const cf_joint_result *plain,
+                             cf_joint_report *r, int k, cf_error *err)
+{
+    if (opt->progress) {
+        char what[128];
+        snprintf(what, sizeof what, "fitting the %s double-acting element to %zu tables jointly",
+                 cf_spring_type_name(r->fits[k].fit.type), n);
+        opt->progress(opt->progress_ctx, NULL, what);
+    }
+    cf_joint_law_choice *lc = &r->law_choice[k];
+    cf_joint_result pair;
+    cf_error e = {0};
+    cf_status st = cf_joint_fit_pair(tables, n, &opt->fit, &opt->lattice, r->fits[k].fit.type, 1,
+                                     plain, &pair, &e);
+    if (st == CF_E_INTERNAL || (st != CF_OK && opt->fit.law == CF_FAMILY_DOUBLE))
+        return cf_error_set(err, st, "%s", e.msg);
+    if (st != CF_OK)
+        return CF_OK;
+    lc->pair_ran = 1;
+    lc->chose_pair = opt->fit.law == CF_FAMILY_DOUBLE ||
+                     (pair.fit.feasible && pair.aic < r->fits[k].aic);
+    if (lc->chose_pair) {
+        lc->pair_other = r->fits[k];
+        r->fits[k] = pair;
+    } else {
+        lc->pair_other = pair;
+    }
+    return CF_OK;
+}
+
+/* The single-sided law with the volume term (the conical law's fit plain its start) in place of
+** plain in fits[k]. */
+static cf_status with_volume(const cf_table *const *tables, size_t n,
+                             const cf_pipeline_options *opt, cf_joint_report *r, int k,
+                             cf_joint_result *plain, cf_error *err)
+{
+    *plain = r->fits[k];
+    memset(&r->fits[k], 0, sizeof r->fits[k]);
+    cf_status st = cf_joint_fit_pair(tables, n, &opt->fit, &opt->lattice, plain->fit.type, 0,
+                                     plain, &r->fits[k], err);
+    if (st != CF_OK) {
+        r->fits[k] = *plain;
+        memset(plain, 0, sizeof *plain);
+    }
+    return st;
+}
+
 cf_status cf_pipeline_fit_joint(const cf_table *const *tables, size_t n,
                                 const cf_pipeline_options *opt, cf_joint_report *r,
                                 cf_error *err)
@@ -69,8 +121,27 @@ cf_status cf_pipeline_fit_joint(const cf_table *const *tables, size_t n,
             return st;
         }
         r->nfits++;
-        if (opt->fit.law != CF_FAMILY_CONICAL &&
-            (st = choose_law(tables, n, opt, r, r->nfits - 1, err)) != CF_OK) {
+        const int k = r->nfits - 1;
+        const cf_law_family law = opt->fit.law;
+        const int volume = opt->fit.volume != CF_VOLUME_NONE;
+        cf_joint_result plain;
+        memset(&plain, 0, sizeof plain);
+        /* with a volume term the single-sided law is the conical law with it (no tailed law) */
+        if (volume && law != CF_FAMILY_DOUBLE)
+            st = with_volume(tables, n, opt, r, k, &plain, err);
+        else if (law == CF_FAMILY_TAIL || law == CF_FAMILY_AUTO)
+            st = choose_law(tables, n, opt, r, k, err);
+        /* a declared nu has no meaning for a pair's two sides: auto then keeps single-sided */
+        if (st == CF_OK && (law == CF_FAMILY_DOUBLE ||
+                            (law == CF_FAMILY_AUTO && opt->fit.volume != CF_VOLUME_POISSON))) {
+            const cf_joint_law_choice *lc = &r->law_choice[k];
+            const cf_joint_result *start = volume && law != CF_FAMILY_DOUBLE ? &plain
+                                           : lc->ran && lc->chose_tail       ? &lc->other
+                                                                             : &r->fits[k];
+            st = choose_pair(tables, n, opt, start, r, k, err);
+        }
+        cf_joint_free(&plain);
+        if (st != CF_OK) {
             cf_joint_report_free(r);
             return st;
         }

@@ -32,7 +32,7 @@ _SONAME = "libconifit.so.0"
 _MSG_LEN = 512  # CF_ERROR_MSG_LEN
 _STATUS = {-1: "usage", -2: "data", -3: "noinput", -4: "cantwrite", -5: "internal", -6: "noconv"}
 _SAMPLE_KEYS = ("time_s", "strain", "stress_kPa", "kinetic_energy_mJ", "spring_stress_kPa",
-                "stable")
+                "stable", "lateral_stretch")
 
 
 class Error(Exception):
@@ -218,9 +218,10 @@ def _in_sequences(err, tmp, count):
 def simulate(scene):
     """Runs the scene file and returns its samples as the columns of conifit simulate's CSV: a
     dict of array.array, one a column, the i-th sample at index i of each: time_s, strain,
-    stress_kPa (compression positive), kinetic_energy_mJ, spring_stress_kPa (typecode 'd') and
-    stable (typecode 'b': 1, 0, or -1 in explicit dynamics). 8 bytes a number (a scene's
-    samples within the budget fit in memory as they do in the library)."""
+    stress_kPa (compression positive), kinetic_energy_mJ, spring_stress_kPa, lateral_stretch (the
+    lattice's width along x over its rest width; typecode 'd') and stable (typecode 'b': 1, 0, or
+    -1 in explicit dynamics). 8 bytes a number (a scene's samples within the budget fit in memory
+    as they do in the library)."""
     rows = ctypes.POINTER(ctypes.c_double)()
     count = ctypes.c_size_t()
     e = _CfError()

@@ -25,6 +25,7 @@ void cf_joint_report_free(cf_joint_report *r)
     for (int k = 0; k < 2; k++) {
         cf_joint_free(&r->fits[k]);
         cf_joint_free(&r->law_choice[k].other);
+        cf_joint_free(&r->law_choice[k].pair_other);
     }
 }
 
@@ -60,7 +61,8 @@ static const char *weighting_text =
 ** objective, feasibility and each table's RMSE and AIC, and the law kept. */
 static void law_choice_text(FILE *o, const cf_joint_report *r)
 {
-    if (r->law == CF_FAMILY_CONICAL)
+    if (r->law == CF_FAMILY_CONICAL || r->law == CF_FAMILY_DOUBLE ||
+        (r->nfits > 0 && r->fits[0].volume != CF_VOLUME_NONE && !r->law_choice[0].ran))
         return;
     size_t rows = 0;
     for (size_t k = 0; k < r->ntables; k++)
@@ -97,6 +99,111 @@ static void law_choice_text(FILE *o, const cf_joint_report *r)
         fprintf(o, "  %-16s kept: %s (%s)\n", "", lc->chose_tail ? "conical-tail" : "conical",
                 why);
     }
+}
+
+/* The double-acting element against the single-sided law of each type (double-acting, auto). */
+static void pair_choice_text(FILE *o, const cf_joint_report *r)
+{
+    if (r->law != CF_FAMILY_DOUBLE && r->law != CF_FAMILY_AUTO)
+        return;
+    fprintf(o, "\nDouble-acting element (--law %s): its own conical spring for extension (6 "
+               "quantities, 7 with a fitted kappa) against the single-sided law kept above\n",
+            cf_law_family_name(r->law));
+    for (int i = 0; i < r->nfits; i++) {
+        const cf_joint_law_choice *lc = &r->law_choice[i];
+        const char *type = cf_spring_type_name(r->fits[i].fit.type);
+        if (!lc->pair_ran) {
+            fprintf(o, "  %-16s %s\n", type,
+                    r->fits[i].volume == CF_VOLUME_POISSON
+                        ? "not fitted: a declared nu (--poisson) has no meaning for a pair's two "
+                          "sides"
+                        : "no double-acting element runs every table");
+            continue;
+        }
+        const cf_joint_result *pair = lc->chose_pair ? &r->fits[i] : &lc->pair_other;
+        const cf_joint_result *single = lc->chose_pair ? &lc->pair_other : &r->fits[i];
+        const cf_joint_result *law[2] = {single, pair};
+        static const char *const lname[2] = {"single-sided", "double-acting"};
+        for (int l = 0; l < 2; l++)
+            fprintf(o, "  %-16s %-13s joint AIC %.2f, objective %.4g (%d quantities)%s\n",
+                    l ? "" : type, lname[l], law[l]->aic, law[l]->objective, law[l]->nparams,
+                    law[l]->fit.feasible ? "" : " (infeasible)");
+        const char *why = r->law == CF_FAMILY_DOUBLE ? "asked for (--law double-acting)"
+                          : lc->chose_pair           ? "lower joint AIC"
+                          : !pair->fit.feasible      ? "a spring of the pair is infeasible"
+                                                     : "the pair does not lower the joint AIC";
+        fprintf(o, "  %-16s kept: %s (%s)\n", "", lc->chose_pair ? "double-acting" : "single-sided",
+                why);
+    }
+}
+
+/* A quantity with its standard error, or "(not determined by the data)". */
+static void value_se(char *buf, size_t cap, double v, double se, double scale, const char *unit)
+{
+    if (se >= 0)
+        snprintf(buf, cap, "%.6g ± %.2g%s%s", v * scale, se * scale, unit[0] ? " " : "", unit);
+    else
+        snprintf(buf, cap, "%.6g%s%s (not determined by the data)", v * scale,
+                 unit[0] ? " " : "", unit);
+}
+
+static const char *volume_how(cf_volume v)
+{
+    switch (v) {
+    case CF_VOLUME_FIT: return "fitted";
+    case CF_VOLUME_MODULUS: return "declared";
+    case CF_VOLUME_POISSON: return "from the declared nu";
+    default: return "none";
+    }
+}
+
+/* The double-acting element's extension spring and the volume term of fit j, when it has them. */
+static void pair_volume_text(FILE *o, const cf_joint_result *j)
+{
+    if (j->pair) {
+        char sp[160], q[3][96];
+        fprintf(o, " double-acting element: the spring above closes under compression; its "
+                   "extension spring (the same H) closes under extension:\n  %s%s\n",
+                cf_spring_text(&j->ext.params, 5, 0, sp, sizeof sp),
+                j->ext.feasible ? "" : " (violates its constraints)");
+        value_se(q[0], sizeof q[0], j->ext.ident.rho, j->ext.ident_se.rho, 1, "");
+        value_se(q[1], sizeof q[1], j->ext.ident.solid, j->ext.ident_se.solid, 1, "");
+        value_se(q[2], sizeof q[2], j->ext.ident.scale, j->ext.ident_se.scale, 1e3, "kPa");
+        fprintf(o, "  extension: rho %s, solid strain s/H %s, stress scale F_C/H^2 %s\n", q[0],
+                q[1], q[2]);
+    }
+    if (j->volume != CF_VOLUME_NONE) {
+        char k[96];
+        value_se(k, sizeof k, j->volume_modulus_MPa,
+                 j->volume == CF_VOLUME_FIT ? j->volume_modulus_se : 0, 1e3, "kPa");
+        if (j->volume != CF_VOLUME_FIT)
+            snprintf(k, sizeof k, "%.6g kPa", j->volume_modulus_MPa * 1e3);
+        fprintf(o, " volume term (kappa/2)(J - 1)^2 per cell: kappa %s (%s)\n", k,
+                volume_how(j->volume));
+    }
+    if (j->pair || j->volume != CF_VOLUME_NONE)
+        fprintf(o, " small strain, along an axis: compression E %.4g kPa, nu %.4f; extension E "
+                   "%.4g kPa, nu %.4f\n",
+                j->E_compression_MPa * 1e3, j->nu_compression, j->E_extension_MPa * 1e3,
+                j->nu_extension);
+}
+
+/* Whether the lattice of a pair or a volume term stays stable over every table's range. */
+static void stability_text(FILE *o, const cf_joint_report *r, const cf_joint_result *j)
+{
+    int checked = 0, all = 1;
+    for (size_t k = 0; k < r->ntables; k++) {
+        const cf_joint_table *jt = &j->tab[k];
+        checked += jt->stability_checked;
+        if (jt->stability_checked && !jt->stable_in_range) {
+            all = 0;
+            fprintf(o, "  %s: the lattice loses stability at strain %.4g, inside the table\n",
+                    r->tables[k]->path, jt->stable_to);
+        }
+    }
+    if (checked == (int)r->ntables && all)
+        fprintf(o, "  stable over every table's range (the cell's incremental stiffness positive "
+                   "definite from 0 to each table's farthest strain)\n");
 }
 
 char *cf_joint_text(const cf_joint_report *r)
@@ -144,6 +251,7 @@ char *cf_joint_text(const cf_joint_report *r)
         if (isfinite(j->fit.corr[0][1]))
             fprintf(o, "  correlation rho-s %.3f, rho-A %.3f, s-A %.3f (the weights held)\n",
                     j->fit.corr[0][1], j->fit.corr[0][2], j->fit.corr[1][2]);
+        pair_volume_text(o, j);
         fprintf(o, "  %-44s %-12s %6s %14s %14s %14s\n", "table", "mode", "points", "fit RMSE",
                 "lattice RMSE", "vs law");
         for (size_t k = 0; k < r->ntables; k++) {
@@ -161,11 +269,13 @@ char *cf_joint_text(const cf_joint_report *r)
             fprintf(o, "  %-44s %-12s %6zu %14s %14s %14s\n", t->path, cf_mode_name(jt->mode),
                     jt->points, a, b, c);
         }
+        stability_text(o, r, j);
         fprintf(o, "  (* homogenised cell: the full lattice has no such boundary conditions; "
                    "%ld cell curves, %.3f s)\n",
                 j->evaluations, j->wall_time_s);
     }
     law_choice_text(o, r);
+    pair_choice_text(o, r);
     int b = cf_joint_better(r);
     if (b >= 0) {
         /* the reason that decided: buildability when only one spring can be built */
@@ -221,6 +331,54 @@ static json_t *law_comparison_json(const cf_joint_report *r, int i)
                      law_json(r, tail));
 }
 
+/* A quantity and its standard error as the fit file states them: {value, stderr} or {value,
+** determined: false}. */
+static json_t *ident_json(double v, double se)
+{
+    return se >= 0 ? json_pack("{s:o, s:o}", "value", num(v), "stderr", num(se))
+                   : json_pack("{s:o, s:b}", "value", num(v), "determined", 0);
+}
+
+/* The extension spring of a double-acting element: params_extension (its six parameters, H the
+** compression spring's), derived_extension, identifiable_extension, feasible_extension. */
+static void pair_json(json_t *f, const cf_joint_result *j)
+{
+    cf_law le;
+    if (cf_law_init(&le, &j->ext.params, NULL) != CF_OK)
+        return;
+    json_t *e = cf_fitfile_spring_json(&le);
+    if (e) {
+        json_object_set(f, "params_extension", json_object_get(e, "params"));
+        json_object_set(f, "derived_extension", json_object_get(e, "derived"));
+        json_object_set(f, "type_extension", json_object_get(e, "type"));
+        json_decref(e);
+    }
+    json_object_set_new(f, "identifiable_extension",
+                        json_pack("{s:o, s:o, s:o}", "rho",
+                                  ident_json(j->ext.ident.rho, j->ext.ident_se.rho),
+                                  "solid_strain",
+                                  ident_json(j->ext.ident.solid, j->ext.ident_se.solid),
+                                  "stress_scale_MPa",
+                                  ident_json(j->ext.ident.scale, j->ext.ident_se.scale)));
+    json_object_set_new(f, "feasible_extension", json_boolean(j->ext.feasible));
+}
+
+/* The lattice's volume term and its small-strain moduli each side, into its `lattice` object. */
+static void volume_json(json_t *lat, const cf_joint_result *j)
+{
+    if (!lat)
+        return;
+    json_object_set_new(lat, "volume_modulus_MPa", num(j->volume_modulus_MPa));
+    if (j->volume == CF_VOLUME_FIT)
+        json_object_set_new(lat, "volume_modulus",
+                            ident_json(j->volume_modulus_MPa, j->volume_modulus_se));
+    json_object_set_new(lat, "volume_term", json_string(volume_how(j->volume)));
+    json_object_set_new(lat, "poisson_ratio_compression", num(j->nu_compression));
+    json_object_set_new(lat, "poisson_ratio_extension", num(j->nu_extension));
+    json_object_set_new(lat, "modulus_compression_MPa", num(j->E_compression_MPa));
+    json_object_set_new(lat, "modulus_extension_MPa", num(j->E_extension_MPa));
+}
+
 static json_t *joint_json(const cf_joint_report *r)
 {
     json_t *root = json_object(), *fits = json_array(), *tabs = json_array();
@@ -249,7 +407,11 @@ static json_t *joint_json(const cf_joint_report *r)
         if (j->fit.tail)
             json_object_set_new(ident, "tail_compliance", cf_report_tail_json(&j->fit));
         json_object_set_new(f, "identifiable", ident);
-        json_object_set_new(f, "law", json_string(j->fit.tail ? "conical-tail" : "conical"));
+        json_object_set_new(f, "law", json_string(j->pair       ? "double-acting"
+                                                  : j->fit.tail ? "conical-tail"
+                                                                : "conical"));
+        if (j->pair)
+            pair_json(f, j);
         json_object_set_new(f, "aic", num(j->aic));
         if (r->law_choice[i].ran)
             json_object_set_new(f, "law_comparison", law_comparison_json(r, i));
@@ -263,6 +425,8 @@ static json_t *joint_json(const cf_joint_report *r)
                       cf_calibration_name(j->calibration), "weights", "edge", num(j->weight[0]),
                       "face", num(j->weight[1]), "body", num(j->weight[2]), "modulus_ratio",
                       num(cm.E), "poisson_ratio", num(cm.nu)));
+        if (j->pair || j->volume != CF_VOLUME_NONE)
+            volume_json(json_object_get(f, "lattice"), j);
         json_object_set_new(f, "feasible", json_boolean(j->fit.feasible));
         json_object_set_new(f, "objective", num(j->objective));
         json_object_set_new(f, "evaluations", json_integer(j->evaluations));
@@ -283,6 +447,10 @@ static json_t *joint_json(const cf_joint_report *r)
                 json_object_set_new(e, "aic", num(jt->aic));
             if (e && isfinite(jt->law_rmse)) /* uniaxial tables only */
                 json_object_set_new(e, "law_difference_rmse", num(jt->law_rmse * u));
+            if (e && jt->stability_checked) {
+                json_object_set_new(e, "stable_in_range", json_boolean(jt->stable_in_range));
+                json_object_set_new(e, "stable_to_strain", num(jt->stable_to));
+            }
             json_array_append_new(per, e);
         }
         json_object_set_new(f, "tables", per);

@@ -150,11 +150,12 @@ static void simulate_writes_nothing_for_a_bad_scene_and_a_csv_for_a_good_one(voi
     assert_non_null(f);
     char line[512];
     assert_non_null(fgets(line, sizeof line, f));
-    assert_string_equal(line,
-                        "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,stable\n");
+    assert_string_equal(line, "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,"
+                              "stable,lateral_stretch\n");
     int rows = 0, stable;
-    double t, e = 0, s = 0, k, sp;
-    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf,%d", &t, &e, &s, &k, &sp, &stable) == 6) {
+    double t, e = 0, s = 0, k, sp, lat;
+    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf,%d,%lf", &t, &e, &s, &k, &sp, &stable, &lat) == 7) {
+        assert_true(lat >= 1); /* compressed: the lattice widens */
         rows++;
         assert_int_equal(stable, 1); /* 20 % compression: inside the stable range */
     }
@@ -204,8 +205,8 @@ static void relaxation_scene_follows_published_muscle_relaxation(void **state)
     size_t row = 0, at = 0;
     f = fopen(out, "r");
     assert_non_null(fgets(line, sizeof line, f));
-    double k, sp;
-    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf,%d", &t, &e, &s, &k, &sp, &stable) == 6) {
+    double k, sp, lat;
+    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf,%d,%lf", &t, &e, &s, &k, &sp, &stable, &lat) == 7) {
         speak = fmax(speak, s);
         send = s;
         unstable_rows += stable == 0;

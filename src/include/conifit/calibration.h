@@ -55,6 +55,14 @@ typedef struct cf_cubic_moduli {
 /* The moduli of a lattice with family weights w (each finite and >= 0). */
 cf_cubic_moduli cf_cubic_moduli_of(const double w[CF_FAMILY_COUNT]);
 
+/* The volume term (cell.h) adds kappa to C11 and C12 (Lame's lambda), nothing to C44: the
+** volume modulus kappa (MPa) that gives a lattice of weights w and small-strain modulus scale
+** k0/H (MPa) the Poisson's ratio nu along an axis, kappa = (nu (C11 + C12) - C12)/(1 - 2 nu) k0/H
+** from nu = (C12 + kappa)/(C11 + C12 + 2 kappa) (negative when nu is below the springs' own; the
+** isotropic lattice: kappa = mu (4 nu - 1)/(1 - 2 nu)); and the inverse. */
+double cf_cubic_kappa_of_nu(const double w[CF_FAMILY_COUNT], double k0_over_H, double nu);
+double cf_cubic_nu_of_kappa(const double w[CF_FAMILY_COUNT], double k0_over_H, double kappa);
+
 /* The family weights of calibration c (isotropic or axial, derived from the formulas above).
 ** CF_E_DATA for fitted or custom, which carry their own weights. */
 cf_status cf_calibration_weights(cf_calibration c, double w[CF_FAMILY_COUNT], cf_error *err);

@@ -24,6 +24,15 @@
 **   confined     F = diag(1, 1, 1 + e), lateral stretches held; stress P_zz
 ** Only uniaxial is a mode of the full lattice (cf_msm_uniaxial); the others are the cell's.
 **
+** The volume term (Golec et al. 2020, The Visual Computer 36:809-825): with volume_modulus_MPa =
+** kappa > 0 the cell also stores W = (kappa/2)(J - 1)^2 per unit reference volume, J = det F,
+** whose nominal stress kappa (J - 1) cof F (cof F = J F^-T) adds to the springs'. At small strain
+** it adds kappa to Lame's lambda and nothing to mu: the isotropic lattice (lambda = mu) gets
+** nu = (mu + kappa)/(2 (2 mu + kappa)). Simple shear keeps J = 1 and does not feel it. kappa = 0
+** (cf_cell_init's value) leaves every result of the springs alone, bit for bit.
+** A double-acting law (law.h, law->extension) enters through the law alone: each spring's side
+** (and the travel to solid on that side) follows the sign of its compression.
+**
 ** For time-dependent models the cell takes, per direction, an extra tension affine in the
 ** spring's length, T_extra = T0 + k (L - Lref): a backward-Euler dashpot or the exponential update
 ** of a Maxwell branch over one step has that form. A strain history is then a loop of
@@ -72,6 +81,7 @@ typedef struct cf_cell {
     double stretch_hint;             /* first guess of a mode's free stretch (0 by cf_cell_init:
                                      ** from the small-strain constants); a history passes the
                                      ** last step's */
+    double volume_modulus_MPa;       /* kappa of the volume term, MPa (0 by cf_cell_init: none) */
     int linear_finish;               /* 1: a free-stretch solve whose last Newton step is too small
                                      ** for its second-order term to reach rounding takes that step
                                      ** by the cell's linearisation instead of evaluating the cell

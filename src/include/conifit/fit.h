@@ -82,10 +82,23 @@ typedef enum cf_fit_optimizer {
 typedef enum cf_law_family {
     CF_FAMILY_CONICAL = 0,
     CF_FAMILY_TAIL = 1,
-    CF_FAMILY_AUTO = 2
+    CF_FAMILY_AUTO = 2,
+    CF_FAMILY_DOUBLE = 3 /* double-acting: a conical compression spring and a conical extension
+                         ** spring sharing H (law.h, cf_law.extension; six quantities); joint fits
+                         ** only (joint.h), where auto compares it too */
 } cf_law_family;
 
-/* Parses "conical", "conical-tail" or "auto"; CF_E_DATA naming the value otherwise. */
+/* The volume term of a fit through the lattice (cell.h, volume_modulus_MPa): none, kappa declared
+** (MPa), the small-strain nu declared (kappa from the lattice's moduli, joint.h), or kappa fitted. */
+typedef enum cf_volume {
+    CF_VOLUME_NONE = 0,
+    CF_VOLUME_MODULUS = 1,
+    CF_VOLUME_POISSON = 2,
+    CF_VOLUME_FIT = 3
+} cf_volume;
+
+/* Parses "conical", "conical-tail", "auto" or "double-acting"; CF_E_DATA naming the value
+** otherwise. */
 cf_status cf_law_family_parse(const char *name, cf_law_family *f, cf_error *err);
 const char *cf_law_family_name(cf_law_family f);
 
@@ -109,6 +122,8 @@ typedef struct cf_fit_options {
                                     ** polishes on every row; 0: never (default
                                     ** CF_FIT_SUBSAMPLE_ABOVE; the baselines use the same) */
     cf_law_family law;              /* the law family (default conical; the pipeline reads it) */
+    cf_volume volume;               /* the volume term of a joint fit (default none) */
+    double volume_value;            /* its declared kappa (MPa) or nu (-) */
 } cf_fit_options;
 
 /* Tables up to this many rows are searched on every row; a longer one on its subsample of as many

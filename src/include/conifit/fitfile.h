@@ -58,6 +58,11 @@ typedef struct cf_fitted_spring {
     double prony_k[CF_PRONY_MAX]; /* change of g_i per unit |strain| ("g_per_strain"; 0 when
                                   ** absent: quasi-linear) */
     double eta_MPa_s;            /* dashpot, 0 when none */
+    /* A joint fit's double-acting element and volume term (joint.h), read by
+    ** cf_fitfile_load_element only: */
+    int has_extension;           /* 1: "params_extension" holds the extension spring */
+    cf_spring extension;         /* its parameters (H the compression spring's) */
+    double volume_modulus_MPa;   /* "lattice.volume_modulus_MPa", 0 when absent */
 } cf_fitted_spring;
 
 /* Loads the spring of the given type from the fit file at path ("-":
@@ -68,6 +73,16 @@ typedef struct cf_fitted_spring {
 ** non-finite or invalid value (the message names the file, the key and the value). */
 cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spring *out,
                           cf_error *err);
+
+/* cf_fitfile_load refuses a fit whose element is double-acting ("params_extension") or whose
+** lattice has a volume term ("lattice.volume_modulus_MPa" > 0) with CF_E_DATA naming the key:
+** export and a scene's 'spring.fit' read one spring per element and no volume term yet, and must
+** not run such a fit as its compression spring alone (a scene gives both by its own keys,
+** scene.h). cf_fitfile_load_element reads
+** them (has_extension, extension, volume_modulus_MPa), checking the extension spring as params
+** (every key, a law it makes, the compression spring's H). */
+cf_status cf_fitfile_load_element(const char *path, const char *type_name,
+                                  cf_fitted_spring *out, cf_error *err);
 
 /* Splits "FILE.json:TYPE" into path and type (type NULL when there is no ":TYPE" suffix naming a
 ** spring type) and loads it. */

@@ -37,9 +37,10 @@ cf_status cf_flat_fit(const char *table_path, const char *type, int validate, ch
 ** when its estimated memory, steps or work exceed conifit simulate's default budget (budget.h).
 ** *samples receives *count rows of CF_FLAT_SAMPLE_COLUMNS numbers, the columns of conifit
 ** simulate's CSV: time (s), compressive strain, compressive nominal stress (kPa), kinetic energy (mJ), one spring's
-** F(strain H)/H^2 (kPa) and stable (1 up to the first sample whose tangent had a negative pivot,
-** 0 from there on, -1 in explicit dynamics). */
-enum { CF_FLAT_SAMPLE_COLUMNS = 6 };
+** F(strain H)/H^2 (kPa), stable (1 up to the first sample whose tangent had a negative pivot,
+** 0 from there on, -1 in explicit dynamics) and the lateral stretch (the width along x over the
+** rest width). */
+enum { CF_FLAT_SAMPLE_COLUMNS = 7 };
 cf_status cf_flat_simulate(const char *scene_path, double **samples, size_t *count,
                            cf_error *err);
 

@@ -39,6 +39,12 @@ typedef struct cf_joint_table {
     double aic;            /* the table's AIC at the joint law (its rows, its unit, the law's
                            ** 3 or 4 quantities), as a single fit's report states it */
     double *lattice_MPa;   /* the lattice's stress at each row (owned), MPa */
+    /* a double-acting element or a volume term (cell_stability.h, the cell of the placed
+    ** springs and kappa): stability checked = 1, stable_in_range 1 when the cell's incremental
+    ** stiffness stays positive definite from 0 to the table's farthest strain, stable_to the
+    ** strain up to which it does (table sign) */
+    int stability_checked, stable_in_range;
+    double stable_to;
 } cf_joint_table;
 
 typedef struct cf_joint_result {
@@ -53,6 +59,23 @@ typedef struct cf_joint_result {
                                     ** (conical) or 4 (conical-tail); what auto compares */
     long evaluations;               /* cell curves computed */
     double wall_time_s;
+    /* The double-acting element (law double-acting) and the volume term (joint fits only): */
+    int pair;                       /* 1: fit is the compression spring, ext the extension one */
+    cf_fit_result ext;              /* the extension spring placed (its ident, ident_se; H = fit's) */
+    cf_volume volume;               /* how kappa was set: none, declared, from nu, fitted */
+    double volume_modulus_MPa;      /* kappa of the volume term (0: none), MPa */
+    double volume_modulus_se;       /* its standard error (fitted), MPa; -1 when not determined
+                                    ** or not fitted */
+    double nu_compression;          /* the lattice's small-strain nu in uniaxial compression
+                                    ** along an axis (the cell at strain -1e-6): a pair's axial
+                                    ** springs on their compression side, its lateral ones on
+                                    ** their extension side */
+    double nu_extension;            /* the same in uniaxial tension (+1e-6) */
+    double E_compression_MPa;       /* the lattice's small-strain Young's modulus along an axis,
+                                    ** in compression and in tension (MPa, the volume term
+                                    ** included); NAN where the cell failed */
+    double E_extension_MPa;
+    int nparams;                    /* the quantities fitted (3, 4, 6 or 7; the AIC's k) */
 } cf_joint_result;
 
 /* Fits the n tables jointly with spring type `type` in the lattice of `lat` (its calibration:
@@ -72,6 +95,21 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
 cf_status cf_joint_fit_tail(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
                             const cf_validate_setup *lat, const cf_joint_result *plain,
                             cf_joint_result *r, cf_error *err);
+
+/* The double-acting element fitted jointly (opt->law double-acting, or any law with a volume term
+** opt->volume): the compression spring's (rho, s/H, F_C/H^2) and, for the pair, the extension
+** spring's, with kappa fitted, declared or derived from a declared nu, all through the cell (its
+** springs' sides by the sign of their compression, cell.h); each table weighted as in the conical
+** joint fit, BOBYQA from plain's quantities (may be NULL) and a grid. Both springs placed as the
+** conical law's (the extension spring at the compression spring's H); errors of every quantity
+** (kappa too) from the joint residuals' central-difference Jacobian, -1 for those the data do
+** not determine (the Jacobian's null space). pair 0 fits the odd conical law with the volume
+** term. CF_E_DATA for a declared nu below the springs' own (the term only raises it), and for
+** a declared nu with the pair (a bimodular lattice has one small-strain nu per side, none to
+** declare: declare kappa or fit it). */
+cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
+                            const cf_validate_setup *lat, cf_spring_type type, int pair,
+                            const cf_joint_result *plain, cf_joint_result *r, cf_error *err);
 
 /* Releases the per-table curves. Safe on a zeroed result. */
 void cf_joint_free(cf_joint_result *r);

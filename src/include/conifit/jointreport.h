@@ -19,6 +19,9 @@ typedef struct cf_joint_law_choice {
     int ran;                /* 1: the tailed law was fitted beside the conical one */
     int chose_tail;         /* 1: fits[] holds the tailed law, other the conical one */
     cf_joint_result other;  /* the other law's joint fit (its curves owned) */
+    int pair_ran;           /* 1: the double-acting element was fitted too (double-acting, auto) */
+    int chose_pair;         /* 1: fits[] holds the pair, pair_other the single-sided law it beat */
+    cf_joint_result pair_other; /* the pair when not kept, else the law it displaced (owned) */
 } cf_joint_law_choice;
 
 /* One joint fit per spring type over the same tables. */

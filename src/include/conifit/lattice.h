@@ -49,6 +49,11 @@ typedef struct cf_lattice_config {
     cf_calibration calibration; /* where the weights came from (reported with them) */
     double density_t_per_mm3; /* mass density, tonne/mm^3 (1e-9 = 1000 kg/m^3), > 0 */
     cf_bottom_bc bottom;      /* bottom-face boundary condition */
+    double volume_modulus_MPa; /* kappa of the volume term (cell.h): every cell stores
+                              ** (kappa/2)(J - 1)^2 H^3, J its volume (the trilinear hexahedron of
+                              ** its eight nodes, 2 x 2 x 2 Gauss points: exact) over H^3; >= 0,
+                              ** 0 (the default) for none. Statics only: the explicit step
+                              ** (lattice_step.h) refuses a lattice with one */
 } cf_lattice_config;
 
 /* 3 x 3 x 3 cells, the isotropic calibration, density 1e-9 t/mm^3, bottom axial. */
@@ -126,9 +131,19 @@ double cf_lattice_forces(cf_lattice *lat);
 ** spring's current axis (uses L_mm from the last cf_lattice_forces) and adds them to T_N. */
 void cf_lattice_add_tensions(cf_lattice *lat, const double *Textra_N);
 
+/* The volume term of cell c (0 <= c < nx ny nz, x fastest): its eight nodes (the corner
+** (di, dj, dk) at index di + 2 dj + 4 dk), J = V/H^3, dV/dx of each node (g, mm^2) and, when hess
+** is not NULL, d2V/(dx_a dx_b) (hess[a][b][i][k], mm). */
+double cf_lattice_cell_volume(const cf_lattice *lat, size_t c, uint32_t node[8], double g[8][3],
+                              double (*hess)[8][3][3]);
+
 /* Elastic energy stored in the springs at the current state, mJ = N mm (Gauss-Legendre quadrature
 ** of the law over each spring's compression; accurate to about 1e-10 relative away from solid). */
 double cf_lattice_elastic_energy(const cf_lattice *lat);
+
+/* The lattice's width along x over its rest width nx H: the mean x of the nodes of the +x face
+** less that of the -x face, over nx H (1 at rest). */
+double cf_lattice_lateral_stretch(const cf_lattice *lat);
 
 /* Mean z displacement of the top face (mm, compression positive) and nominal compressive strain. */
 double cf_lattice_top_strain(const cf_lattice *lat);

@@ -101,6 +101,12 @@ typedef struct cf_law {
     double u_C_mm;         /* compression at which the cone closes, s (1 + tau), mm */
     double F_solid_N;      /* force when the whole spring is solid, k_tail s_t (F_C), N */
     struct cf_law_table *table; /* NULL until cf_law_table_build */
+    /* The double-acting element (law kind double-acting): a cage of two springs sharing the free
+    ** length H, the compression spring (this law) for u >= 0 and the extension spring, which a
+    ** stretch compresses, for u < 0: F(u) = -F_e(-u) there, k(u) = k_e(-u). NULL (cf_law_init's
+    ** value) for the odd law F(-u) = -F(u). Not owned; its H must be this law's (cf_law_pair).
+    ** A pair of equal springs gives the odd law's values bit for bit. */
+    const struct cf_law *extension;
 } cf_law;
 
 /* Validates p and fills law with the derived quantities (law->table = NULL). Refuses non-finite or
@@ -110,6 +116,24 @@ typedef struct cf_law {
 ** travel > 0), and close after the cone: its gap per coil (H_tail - n_tail d)/n_tail exceeds the
 ** cone's s/n; n_tail < 0, a non-finite tail value, or H_tail without n_tail is refused. */
 cf_status cf_law_init(cf_law *law, const cf_spring *p, cf_error *err);
+
+/* Joins the extension spring ext to law (law->extension = ext): CF_E_DATA when their free lengths
+** differ (the message gives both) or ext itself has an extension. */
+cf_status cf_law_pair(cf_law *law, const cf_law *ext, cf_error *err);
+
+/* The travel to solid on the side of u: the extension spring's for u < 0 when there is one. */
+static inline double cf_law_travel_at(const cf_law *law, double u_mm)
+{
+    return u_mm < 0 && law->extension ? law->extension->travel_mm : law->travel_mm;
+}
+
+/* The smaller travel of the two sides (the law's own without an extension spring). */
+static inline double cf_law_travel_min(const cf_law *law)
+{
+    return law->extension && law->extension->travel_mm < law->travel_mm
+               ? law->extension->travel_mm
+               : law->travel_mm;
+}
 
 /* Releases the table of law, if any. Safe on a zeroed law and on NULL. */
 void cf_law_free(cf_law *law);
@@ -121,7 +145,8 @@ cf_status cf_law_table_build(cf_law *law, size_t intervals, cf_error *err);
 /* Force (N) at compression u (mm) with the chosen method; *k_N_per_mm (if not NULL) receives the
 ** tangent stiffness dF/du >= 0 and *flags (if not NULL) CF_LAW_LINEAR / CF_LAW_SOLID. A non-finite
 ** u is treated as solid with the sign of u (NaN as +0 force). CF_LAW_TABLE without a built table
-** falls back to CF_LAW_CLOSED_NEWTON. Never returns NaN or Inf for a law that cf_law_init accepted. */
+** falls back to CF_LAW_CLOSED_NEWTON (for each spring of a pair, by its own table). With an
+** extension spring, u < 0 is its law mirrored (law->extension). Never returns NaN or Inf for a law that cf_law_init accepted. */
 double cf_law_force(const cf_law *law, cf_law_method method, double u_mm, double *k_N_per_mm,
                     int *flags);
 

@@ -136,6 +136,9 @@ typedef struct cf_msm_sample {
     double strain;             /* compressive nominal strain of the top face, - */
     double stress_MPa;         /* compressive nominal stress: top reaction / (nx ny H^2), MPa */
     double kinetic_mJ;         /* kinetic energy, mJ = N mm (0 without inertia) */
+    double lateral_stretch;    /* the lattice's width along x over its rest width
+                                  (cf_lattice_lateral_stretch), - (1 at rest; in a uniaxial run
+                                  lateral strain over axial strain is -nu) */
     long neg_pivots;           /* negative pivots (negative eigenvalues) of the tangent factored in
                                   the last Newton iteration of this sample's solve: 0 a stable
                                   equilibrium, > 0 an unstable one; -1 unknown (explicit dynamics,

@@ -24,6 +24,9 @@ typedef enum cf_protocol_kind {
 
 typedef struct cf_scene {
     cf_spring spring;           /* the spring of every lattice edge */
+    int has_extension;          /* 1: 'spring_extension' makes every element double-acting
+                                   (law.h, cf_law.extension) with the spring below */
+    cf_spring extension;        /* its extension spring (the same H) */
     char spring_source[600];    /* "params" or the fit file (and type) it came from */
     char fit_path[4096];        /* the fit file 'spring.fit' names, "" with 'spring.params': an
                                    input of the run like the scene itself */
@@ -61,6 +64,12 @@ cf_status cf_scene_load(const char *path, cf_scene *sc, cf_error *err);
 
 /* The same from JSON text; `name` is used in messages. */
 cf_status cf_scene_parse(const char *json_text, const char *name, cf_scene *sc, cf_error *err);
+
+/* The law of the scene's springs into *law (with its table for the table method) and, with
+** 'spring_extension', the extension spring into *ext joined to it (law->extension = ext: ext must
+** outlive law's use). Release both with cf_law_free. CF_E_DATA / CF_E_INTERNAL as cf_law_init and
+** cf_law_table_build. */
+cf_status cf_scene_law(const cf_scene *sc, cf_law *law, cf_law *ext, cf_error *err);
 
 /* Releases the arrays of sc. Safe on a zeroed scene. */
 void cf_scene_free(cf_scene *sc);

@@ -1,0 +1,217 @@
+/*
+** The command line of the double-acting element and the volume term (conifit fit --joint --law
+** double-acting|auto, --volume fit, --volume-modulus K, --poisson NU): bad input exits 2 naming
+** the option and its value, nothing written; a fit file of a pair is refused by export (65)
+** rather than exported as its compression spring alone; on the brain cortex tables (when
+** present) the fit file holds the pair and kappa. Scenes: 'lattice.poisson_ratio' 0.45 gives a
+** static uniaxial simulate whose lateral_stretch column reads nu = 0.45 +- 0.005 at 0.1 % strain;
+** 'spring_extension' and 'lattice.volume_modulus_MPa' run the pair and the volume term, equal to
+** the homogenised cell; bad keys exit 65 naming them.
+*/
+#include "testutil.h"
+
+#include <sys/stat.h>
+
+#include "conifit/cell.h"
+
+static char out[1 << 16], errb[1 << 12];
+
+static int exists(const char *p)
+{
+    struct stat st;
+    return stat(p, &st) == 0;
+}
+
+#define TWO "data/telescoping.csv data/telescoping_compression.csv"
+
+static void bad_input_exits_2_naming_the_option(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *args, *says;
+    } cases[] = {
+        {"fit " TWO " --joint --poisson 0.2 -o /tmp/conifit-pair-no.json", "--poisson 0.2"},
+        {"fit " TWO " --joint --poisson 0.5 -o /tmp/conifit-pair-no.json", "--poisson 0.5"},
+        {"fit " TWO " --joint --poisson nan -o /tmp/conifit-pair-no.json", "--poisson"},
+        {"fit " TWO " --joint --volume-modulus -1 -o /tmp/conifit-pair-no.json",
+         "--volume-modulus -1"},
+        {"fit " TWO " --joint --volume-modulus inf -o /tmp/conifit-pair-no.json",
+         "--volume-modulus"},
+        {"fit " TWO " --joint --volume guess -o /tmp/conifit-pair-no.json", "--volume 'guess'"},
+        {"fit " TWO " --joint --volume fit --poisson 0.3 -o /tmp/conifit-pair-no.json",
+         "--poisson 0.3"},
+        {"fit data/telescoping.csv --volume fit -o /tmp/conifit-pair-no.json", "--volume fit"},
+        {"fit data/telescoping.csv --poisson 0.3 -o /tmp/conifit-pair-no.json", "--poisson"},
+        {"fit data/telescoping.csv --law double-acting -o /tmp/conifit-pair-no.json",
+         "--law double-acting"},
+        {"fit " TWO " --joint --law conical-tail --volume fit -o /tmp/conifit-pair-no.json",
+         "conical-tail"},
+        {"fit " TWO " --joint --law double-sided -o /tmp/conifit-pair-no.json", "double-sided"},
+        {"fit " TWO " --joint --law double-acting --poisson 0.4 -o /tmp/conifit-pair-no.json",
+         "--poisson 0.4"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const int rc = tu_run(out, sizeof out, errb, sizeof errb, "%s", cases[i].args);
+        if (rc != 2 || !strstr(errb, cases[i].says))
+            fail_msg("'%s': exit %d, message '%s' (expected 2 naming '%s')", cases[i].args, rc,
+                     errb, cases[i].says);
+        assert_false(exists("/tmp/conifit-pair-no.json"));
+    }
+}
+
+/* The brain cortex, --joint --law auto --volume fit: the fit file holds the pair and kappa, and
+** export refuses it with 65 naming the key, writing nothing. */
+static void brain_pair_fit_file_and_export(void **state)
+{
+    (void)state;
+    const char *d = tu_datasets();
+    if (!d)
+        skip();
+    char dir[] = "/tmp/conifit-pair-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char json[256];
+    snprintf(json, sizeof json, "%s/brain.json", dir);
+    int rc = tu_run(out, sizeof out, errb, sizeof errb,
+                    "fit %s/brain_cortex_tension.csv %s/brain_cortex_compression.csv "
+                    "%s/brain_cortex_shear.csv --joint --law auto --volume fit -o %s",
+                    d, d, d, json);
+    if (rc != 0)
+        fail_msg("exit %d: %s", rc, errb);
+    assert_non_null(strstr(out, "double-acting element"));
+    assert_non_null(strstr(out, "volume term"));
+    char *file = tu_slurp(json);
+    assert_non_null(file);
+    assert_non_null(strstr(file, "\"params_extension\""));
+    assert_non_null(strstr(file, "\"volume_modulus_MPa\""));
+    free(file);
+    rc = tu_run(out, sizeof out, errb, sizeof errb, "export %s --format csv -o %s/t.csv", json,
+                dir);
+    assert_int_equal(rc, 65);
+    assert_non_null(strstr(errb, "params_extension"));
+    char t[300];
+    snprintf(t, sizeof t, "%s/t.csv", dir);
+    assert_false(exists(t));
+    remove(json);
+    rmdir(dir);
+}
+
+static void write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+/* The last row of a simulate CSV: strain, stress (kPa), lateral stretch. */
+static void last_row(const char *csv, double *e, double *s, double *lat)
+{
+    FILE *f = fopen(csv, "r");
+    assert_non_null(f);
+    char line[512];
+    assert_non_null(fgets(line, sizeof line, f));
+    assert_non_null(strstr(line, ",lateral_stretch"));
+    double t, k, sp;
+    int stable, rows = 0;
+    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf,%d,%lf", &t, e, s, &k, &sp, &stable, lat) == 7)
+        rows++;
+    fclose(f);
+    assert_true(rows >= 2);
+}
+
+#define SPRING "{\"params\": {\"D1_mm\": 6, \"D2_mm\": 15, \"n\": 2.5, \"d_mm\": 2, " \
+               "\"G_MPa\": 26, \"H_mm\": 10}}"
+#define EXTENSION "{\"params\": {\"D1_mm\": 3, \"D2_mm\": 14, \"n\": 3, \"d_mm\": 1, " \
+                  "\"G_MPa\": 300, \"H_mm\": 10}}"
+
+static void scene_poisson_ratio_and_pair(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-pair-XXXXXX", scene[256], csv[256];
+    assert_non_null(mkdtemp(dir));
+    snprintf(scene, sizeof scene, "%s/s.json", dir);
+    snprintf(csv, sizeof csv, "%s/s.csv", dir);
+    /* a lattice declared nu = 0.45: static uniaxial compression to 0.1 % */
+    write_text(scene, "{\"spring\": " SPRING ", \"lattice\": {\"nx\": 3, \"ny\": 3, \"nz\": 3, "
+                      "\"poisson_ratio\": 0.45}, \"protocol\": {\"kind\": \"ramp\", "
+                      "\"to_strain\": 0.001, \"duration_s\": 1}, \"samples_per_segment\": 4}");
+    int rc = tu_run(out, sizeof out, errb, sizeof errb, "simulate %s -o %s", scene, csv);
+    if (rc != 0)
+        fail_msg("simulate exited %d: %s", rc, errb);
+    double e, s, lat;
+    last_row(csv, &e, &s, &lat);
+    assert_close(e, 0.001, 1e-9);
+    const double nu = (lat - 1) / e; /* compression positive: the lattice widens */
+    if (!(fabs(nu - 0.45) <= 0.005))
+        fail_msg("lateral over axial strain %.6g, expected 0.45 +- 0.005", nu);
+    /* the pair and a volume term: the full lattice under static compression equals the cell */
+    const double kappa = 0.005; /* MPa, about 3.3 times the compression spring's k0/H */
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"spring\": " SPRING ", \"spring_extension\": " EXTENSION ", \"lattice\": "
+             "{\"nx\": 2, \"ny\": 2, \"nz\": 2, \"volume_modulus_MPa\": %g}, \"protocol\": "
+             "{\"kind\": \"ramp\", \"to_strain\": 0.2, \"duration_s\": 1}, "
+             "\"samples_per_segment\": 4}",
+             kappa);
+    write_text(scene, text);
+    rc = tu_run(out, sizeof out, errb, sizeof errb, "simulate %s -o %s", scene, csv);
+    if (rc != 0)
+        fail_msg("simulate exited %d: %s", rc, errb);
+    last_row(csv, &e, &s, &lat);
+    const cf_spring pc = {6, 15, 2.5, 2, 26, 10}, pe = {3, 14, 3, 1, 300, 10};
+    cf_law lc, le;
+    assert_int_equal(cf_law_init(&lc, &pc, NULL), CF_OK);
+    assert_int_equal(cf_law_init(&le, &pe, NULL), CF_OK);
+    assert_int_equal(cf_law_pair(&lc, &le, NULL), CF_OK);
+    double w[3];
+    assert_int_equal(cf_calibration_weights(CF_CAL_ISOTROPIC, w, NULL), CF_OK);
+    cf_cell c;
+    assert_int_equal(cf_cell_init(&c, &lc, CF_LAW_CLOSED, w, NULL), CF_OK);
+    c.volume_modulus_MPa = kappa;
+    cf_cell_state st;
+    assert_int_equal(cf_cell_mode(&c, CF_MODE_UNIAXIAL, -e, NULL, &st, NULL), CF_OK);
+    assert_close(-st.stress_MPa * 1e3, s, 1e-7 * fabs(s));
+    assert_close(st.free_stretch, lat, 1e-9);
+    /* bad keys: 65 naming them, nothing written */
+    remove(csv);
+    static const struct {
+        const char *lattice, *extra, *says;
+    } bad[] = {
+        {"\"poisson_ratio\": 0.5", "", "poisson_ratio"},
+        {"\"poisson_ratio\": 0.2", "", "poisson_ratio"},
+        {"\"poisson_ratio\": 0.3, \"volume_modulus_MPa\": 1", "", "not both"},
+        {"\"volume_modulus_MPa\": -1", "", "volume_modulus_MPa"},
+        {"\"poisson_ratio\": 0.3", ", \"spring_extension\": " EXTENSION, "poisson_ratio"},
+        {"\"nx\": 2", ", \"spring_extension\": {\"params\": {\"D1_mm\": 3, \"D2_mm\": 14, "
+                     "\"n\": 3, \"d_mm\": 1, \"G_MPa\": 300, \"H_mm\": 12}}",
+         "spring_extension.params.H_mm"},
+        {"\"nx\": 2", ", \"spring_extension\": {\"params\": {\"D1_mm\": 3}}",
+         "spring_extension.params"},
+        {"\"volume_modulus_MPa\": 0.01", ", \"effects\": {\"inertia\": true}",
+         "volume_modulus_MPa"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        snprintf(text, sizeof text,
+                 "{\"spring\": " SPRING "%s, \"lattice\": {%s}, \"protocol\": {\"kind\": "
+                 "\"ramp\", \"to_strain\": 0.01, \"duration_s\": 1}}",
+                 bad[i].extra, bad[i].lattice);
+        write_text(scene, text);
+        rc = tu_run(out, sizeof out, errb, sizeof errb, "simulate %s -o %s", scene, csv);
+        if (rc != 65 || !strstr(errb, bad[i].says))
+            fail_msg("scene %zu: exit %d, '%s' (expected 65 naming '%s')", i, rc, errb,
+                     bad[i].says);
+        assert_false(exists(csv));
+    }
+    remove(scene);
+    rmdir(dir);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(bad_input_exits_2_naming_the_option),
+        cmocka_unit_test(brain_pair_fit_file_and_export),
+        cmocka_unit_test(scene_poisson_ratio_and_pair),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
