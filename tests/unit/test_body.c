@@ -8,6 +8,7 @@
 #include "testutil.h"
 
 #include "conifit/body.h"
+#include "conifit/fitfile.h"
 #include "conifit/mesh.h"
 
 TU_SCRATCH_GROUP("body")
@@ -508,6 +509,105 @@ static void liver_calculix_nu_045(void **state)
     liver_force_matches_calculix(0.45);
 }
 
+/* ---- the probe loop at haptic rate -------------------------------------------------------------- */
+
+/* Bodies bh and bs of one mesh and law: bh driven by cf_body_haptic_step (3 chord iterations per
+** update) to depth in `updates` equal moves, then held there for as many updates; bs solved
+** statically at depth in 10 steps. Returns the haptic force at rest over the static one. */
+static double haptic_over_static(cf_body *bh, cf_body *bs, const cf_probe *pr, double depth,
+                                 int updates)
+{
+    cf_error err = {0};
+    cf_body_step st = {0}, ss = {0};
+    int touched = 0;
+    for (int k = 1; k <= 2 * updates; k++) {
+        if (cf_body_haptic_step(bh, pr, depth * (k < updates ? k : updates) / updates, 0, 3, &st,
+                                &err) != CF_OK)
+            fail_msg("haptic update %d: %s", k, err.msg);
+        assert_true(isfinite(st.force_N) && st.min_J > 0);
+        touched |= st.contacts > 0;
+    }
+    assert_true(touched);
+    for (int k = 1; k <= 10; k++)
+        if (cf_body_solve(bs, pr, depth * k / 10, 0, &ss, &err) != CF_OK)
+            fail_msg("%s", err.msg);
+    assert_true(ss.force_N > 0);
+    print_message("haptic loop: %d contacts, force at rest %.6g N, static %.6g N (ratio %.5f)\n",
+                  st.contacts, st.force_N, ss.force_N, st.force_N / ss.force_N);
+    return st.force_N / ss.force_N;
+}
+
+/* A sphere pressed 0.1 mm into a Gmsh block (nu 0.45) by haptic updates: at rest, the static
+** equilibrium's force within 5 %. */
+static void haptic_loop_rests_at_the_static_force_block(void **state)
+{
+    (void)state;
+    cf_law law = test_law();
+    double lo[3] = {0, 0, -30}, hi[3] = {30, 30, 0}, f[3] = {0, 0, 0};
+    cf_mesh m;
+    cf_error err = {0};
+    assert_int_equal(cf_mesh_box(lo, hi, f, 0.3, 8, 0.4, &m, &err), CF_OK);
+    cf_body bh, bs;
+    const double kappa = cf_body_kappa_for_nu(cf_body_mu_of_law(&law), 0.45);
+    assert_int_equal(cf_body_create(&bh, &m, &law, CF_LAW_CLOSED, kappa, &err), CF_OK);
+    assert_int_equal(cf_body_create(&bs, &m, &law, CF_LAW_CLOSED, kappa, &err), CF_OK);
+    for (size_t i = 0; i < bh.nn; i++) {
+        const double *X = bh.X + 3 * i;
+        bh.fix[i] = bs.fix[i] = (X[0] < 1e-9) | (X[1] < 1e-9) << 1;
+        if (X[2] < -30 + 1e-9)
+            bh.fix[i] = bs.fix[i] = CF_BODY_FIX_ALL;
+    }
+    cf_probe pr = {CF_PROBE_SPHERE, 10, {0, 0, 10}, {0, 0, -1}, 0.1, 1};
+    const double ratio = haptic_over_static(&bh, &bs, &pr, 0.1, 50);
+    assert_true(fabs(ratio - 1) <= 0.05);
+    cf_body_free(&bh);
+    cf_body_free(&bs);
+    cf_mesh_free(&m);
+    cf_law_free(&law);
+}
+
+/* The benchmark's loop on liver2.msh: the fitted muscle spring, nu 0.45, held below z = -60 mm, a
+** sphere of radius 10 mm moved 5 um per update to 1 mm into the top and held: at rest, the static
+** force within 5 %. */
+static void haptic_loop_rests_at_the_static_force_liver(void **state)
+{
+    (void)state;
+    FILE *fm = fopen("../shared/meshes/liver2.msh", "r");
+    if (!fm)
+        skip(); /* ../shared/meshes absent */
+    fclose(fm);
+    cf_fitted_spring fs;
+    cf_law law;
+    cf_error err = {0};
+    if (cf_fitfile_load("fits/series/muscle_compression_relaxation_fiber30.json", NULL, &fs, &err) !=
+            CF_OK ||
+        cf_law_init(&law, &fs.params, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    cf_mesh m;
+    if (cf_mesh_read("../shared/meshes/liver2.msh", 100, &m, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    cf_body bh, bs;
+    const double kappa = cf_body_kappa_for_nu(cf_body_mu_of_law(&law), 0.45);
+    assert_int_equal(cf_body_create(&bh, &m, &law, CF_LAW_CLOSED, kappa, &err), CF_OK);
+    assert_int_equal(cf_body_create(&bs, &m, &law, CF_LAW_CLOSED, kappa, &err), CF_OK);
+    size_t top = 0;
+    for (size_t i = 0; i < bh.nn; i++) {
+        if (bh.X[3 * i + 2] <= -60)
+            bh.fix[i] = bs.fix[i] = CF_BODY_FIX_ALL;
+        if (bh.X[3 * i + 2] > bh.X[3 * top + 2])
+            top = i;
+    }
+    cf_probe pr = {CF_PROBE_SPHERE, 10,
+                   {bh.X[3 * top], bh.X[3 * top + 1], bh.X[3 * top + 2] + 10.001},
+                   {0, 0, -1}, 1, 1};
+    const double ratio = haptic_over_static(&bh, &bs, &pr, 1, 200);
+    assert_true(fabs(ratio - 1) <= 0.05);
+    cf_body_free(&bh);
+    cf_body_free(&bs);
+    cf_mesh_free(&m);
+    cf_law_free(&law);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -522,6 +622,8 @@ int main(void)
         cmocka_unit_test(a_probe_inside_the_body_is_found),
         cmocka_unit_test(liver_calculix_nu_025),
         cmocka_unit_test(liver_calculix_nu_045),
+        cmocka_unit_test(haptic_loop_rests_at_the_static_force_block),
+        cmocka_unit_test(haptic_loop_rests_at_the_static_force_liver),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
