@@ -8,6 +8,7 @@
 #include "testutil.h"
 
 #include "conifit/body.h"
+#include "conifit/export.h"
 #include "conifit/fitfile.h"
 #include "conifit/mesh.h"
 
@@ -608,6 +609,101 @@ static void haptic_loop_rests_at_the_static_force_liver(void **state)
     cf_law_free(&law);
 }
 
+/* ---- the body exported to CalculiX ---------------------------------------------------------- */
+
+/* A Gmsh block 30 x 30 x 15 mm held at its bottom, a flat punch of radius 4 mm pressed 0.1 mm
+** into the middle of its top in 4 steps (no node enters the punch after the first contact):
+** solved by conifit, written by cf_export_write_body, run by ccx; returns the largest relative
+** difference of ccx's punch force from conifit's. */
+static double body_export_against_ccx(double nu, const char *job)
+{
+    cf_law law = test_law();
+    double lo[3] = {-15, -15, -15}, hi[3] = {15, 15, 0}, f[3] = {0, 0, 0};
+    cf_mesh m;
+    cf_error err = {0};
+    assert_int_equal(cf_mesh_box(lo, hi, f, 1, 5, 0.4, &m, &err), CF_OK);
+    cf_body b;
+    assert_int_equal(cf_body_create(&b, &m, &law, CF_LAW_CLOSED,
+                                    cf_body_kappa_for_nu(cf_body_mu_of_law(&law), nu), &err),
+                     CF_OK);
+    for (size_t i = 0; i < b.nn; i++)
+        if (b.X[3 * i + 2] < -15 + 1e-9)
+            b.fix[i] = CF_BODY_FIX_ALL;
+    cf_probe pr = {CF_PROBE_PUNCH, 4, {0, 0, 0}, {0, 0, -1}, 0.1, 4};
+    double depth[4], force[4];
+    for (int k = 0; k < 4; k++) {
+        cf_body_step st;
+        depth[k] = pr.depth_mm * (k + 1) / 4;
+        if (cf_body_solve(&b, &pr, depth[k], 0, &st, &err) != CF_OK)
+            fail_msg("%s", err.msg);
+        force[k] = st.force_N;
+    }
+    char path[700];
+    snprintf(path, sizeof path, "%s/%s.inp", dir, job);
+    FILE *out = fopen(path, "w");
+    assert_non_null(out);
+    cf_export_options opt = cf_export_default_options();
+    opt.format = CF_EXPORT_CALCULIX;
+    opt.auto_tol = 1;
+    cf_export_report rep;
+    if (cf_export_write_body(out, &b, &pr, 4, depth, force, &opt, &rep, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    fclose(out);
+    /* a sphere is refused, naming the probe */
+    cf_probe sph = pr;
+    sph.shape = CF_PROBE_SPHERE;
+    FILE *null = fopen("/dev/null", "w");
+    assert_int_equal(cf_export_write_body(null, &b, &sph, 4, depth, force, &opt, &rep, &err),
+                     CF_E_DATA);
+    fclose(null);
+    assert_non_null(strstr(err.msg, "probe"));
+    cf_body_free(&b);
+    cf_mesh_free(&m);
+    cf_law_free(&law);
+    char cmd[1600];
+    snprintf(cmd, sizeof cmd, "cd %s && ccx -i %s > %s.log 2>&1", dir, job, job);
+    if (system(cmd) != 0)
+        fail_msg("ccx failed on %s/%s.inp", dir, job);
+    snprintf(path, sizeof path, "%s/%s.dat", dir, job);
+    char *text = tu_slurp(path);
+    assert_non_null(text);
+    double worst = 0;
+    int n = 0;
+    for (const char *p = text; (p = strstr(p, "total force (fx,fy,fz) for set NTOP and time")); p++) {
+        double t, fx, fy, fz;
+        if (sscanf(p, "total force (fx,fy,fz) for set NTOP and time %lf %lf %lf %lf", &t, &fx,
+                   &fy, &fz) != 4)
+            continue;
+        const double k = floor(t + 0.5);
+        if (fabs(t - k) > 1e-9 || k < 1 || k > 4)
+            continue;
+        const double rel = -fz / force[(int)k - 1] - 1;
+        print_message("%s step %d: ccx %.6g N, conifit %.6g N (%+.2f %%)\n", job, (int)k, -fz,
+                      force[(int)k - 1], 100 * rel);
+        worst = fmax(worst, fabs(rel));
+        n++;
+    }
+    free(text);
+    if (n < 4)
+        fail_msg("%s: %d of 4 steps in ccx's output", job, n);
+    return worst;
+}
+
+static void body_export_runs_in_calculix(void **state)
+{
+    (void)state;
+    if (system("command -v ccx >/dev/null 2>&1") != 0)
+        skip(); /* CI installs calculix-ccx (Makefile DEBS) */
+    const double w25 = body_export_against_ccx(0.25, "body_nu25");
+    const double w45 = body_export_against_ccx(0.45, "body_nu45");
+    print_message("body export: worst step %.3g (nu 0.25), %.3g (nu 0.45)\n", w25, w45);
+    /* springs only: the same model (the penalty's penetration and the table's tolerance) */
+    assert_true(w25 <= 1e-3);
+    /* the volume elements take J per tetrahedron, stiffer than the body's J per node (33 % on
+    ** this block): present and acting, not the same model */
+    assert_true(w45 >= 0.1 && w45 <= 0.5);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -624,6 +720,7 @@ int main(void)
         cmocka_unit_test(liver_calculix_nu_045),
         cmocka_unit_test(haptic_loop_rests_at_the_static_force_block),
         cmocka_unit_test(haptic_loop_rests_at_the_static_force_liver),
+        cmocka_unit_test(body_export_runs_in_calculix),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
