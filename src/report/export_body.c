@@ -1,5 +1,6 @@
 /*
-** Export of a tissue body (see export.h, cf_export_write_body): every edge of the body its own
+** Export of a tissue body (see export.h, cf_export_write_body), to CalculiX or SOFA: every edge of
+** the body its own
 ** spring group (its rest length and its calibration factor as the weight, so its table is the law
 ** in strain form times that factor, as the lattice export writes its groups), the volume term as
 ** tetrahedra of a purely volumetric material, the held nodes, and a flat punch pressed along z as
@@ -47,9 +48,15 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, 
                                const cf_export_options *opt, cf_export_report *rep, cf_error *err)
 {
     CF_GSL_GUARD;
-    if (opt->format != CF_EXPORT_CALCULIX)
-        return cf_error_set(err, CF_E_DATA, "a body is exported to calculix only, not %s",
+    if (opt->format != CF_EXPORT_CALCULIX && opt->format != CF_EXPORT_SOFA)
+        return cf_error_set(err, CF_E_DATA, "a body is exported to calculix or sofa, not %s",
                             cf_export_format_name(opt->format));
+    if (opt->format == CF_EXPORT_SOFA && b->kappa_MPa > 0)
+        return cf_error_set(err, CF_E_DATA,
+                            "sofa: the body's volume term (kappa = %g MPa, nu = %g > 0.25) has no "
+                            "form among SOFA's springs; export it to calculix, or take "
+                            "poisson_ratio 0.25",
+                            b->kappa_MPa, b->nu);
     if (pr->shape != CF_PROBE_PUNCH || fabs(pr->dir[0]) > 1e-12 || fabs(pr->dir[1]) > 1e-12)
         return cf_error_set(err, CF_E_DATA,
                             "probe: a body's export takes a flat punch moving along z (a prescribed "
@@ -133,9 +140,11 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, 
         m.ref_N[k] = force_N[k] * (pr->dir[2] < 0 ? 1 : -1);
         m.strain[k] = depth_mm[k] / m.height_mm;
     }
-    m.nt = b->nt;
-    m.tet = b->tet;
-    m.kappa_MPa = b->kappa_MPa;
+    if (opt->format == CF_EXPORT_CALCULIX) {
+        m.nt = b->nt;
+        m.tet = b->tet;
+        m.kappa_MPa = b->kappa_MPa;
+    }
     if (cf_xmodel_tables(&m) != 0 || cf_xmodel_write(out, &m, opt->format) != 0)
         goto oom;
     r = cf_export_report_of_table(&t, law);
@@ -144,7 +153,8 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, 
     r.nodes = m.nn;
     r.steps = m.nsteps;
     if (ferror(out))
-        st = cf_error_set(err, CF_E_CANTWRITE, "cannot write the body's calculix model");
+        st = cf_error_set(err, CF_E_CANTWRITE, "cannot write the body's %s model",
+                          cf_export_format_name(opt->format));
     goto done;
 oom:
     st = cf_error_set(err, CF_E_INTERNAL, "out of memory writing the body's model");

@@ -154,8 +154,9 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
 ** (a rank-one term per node, its three columns of the inverse computed once at its first contact),
 ** so that contact changes need no new factorisation. Stops early when the residual is below
 ** 1e-8 E h^2 (h the mean edge). The force is that of the positions at the start of the last
-** iteration; repeated at one depth the updates converge to cf_body_solve's equilibrium. Same
-** errors as cf_body_solve. */
+** iteration; repeated at one depth the updates converge to cf_body_solve's equilibrium. The kept
+** columns grow by 9 nn numbers per node that has ever touched the probe (cf_body_free releases
+** them). Same errors as cf_body_solve. */
 cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm,
                               double penalty_N_per_mm, int max_iters, cf_body_step *out,
                               cf_error *err);

@@ -214,8 +214,11 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
                                   const cf_export_options *opt, const cf_export_lattice *lx,
                                   cf_export_report *rep, cf_error *err);
 
-/* Writes the tissue body b (conifit/body.h) as a CalculiX model (opt->format calculix; others
-** CF_E_DATA): every edge a spring group of its own, rest length L0 and its calibration factor as
+/* Writes the tissue body b (conifit/body.h) as a CalculiX model or a SOFA scene (opt->format
+** calculix or sofa; others CF_E_DATA; sofa only without a volume term, kappa = 0, nu = 0.25, since
+** SOFA's springs cannot express it: the scene holds the springs as the SOFA lattice export writes
+** them and the probe as a PartialLinearMovementProjectiveConstraint): every edge a spring group
+** of its own, rest length L0 and its calibration factor as
 ** the weight (the law in strain form times that factor, as the lattice's groups); with a volume
 ** term, its tetrahedra as C3D4 of a purely volumetric material (neo-Hookean with C10 = 0 and
 ** D1 = 2/kappa: (kappa/2)(J - 1)^2 per unit volume, J per tetrahedron where conifit takes J per
