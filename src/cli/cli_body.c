@@ -228,3 +228,34 @@ end:
     run_free(&r);
     return rc;
 }
+
+cf_status cf_cli_body_export(const cf_scene *sc, const char *scene_path, const cf_budget *budget,
+                             FILE *out, const cf_export_options *opt, cf_export_report *rep,
+                             cf_error *err)
+{
+    run r;
+    memset(&r, 0, sizeof r);
+    cf_status st = solve(sc, scene_path, budget, &r, err);
+    const size_t steps = (size_t)sc->probe.steps;
+    double *depth = NULL, *force = NULL;
+    if (st == CF_OK) {
+        depth = malloc(steps * sizeof *depth);
+        force = malloc(steps * sizeof *force);
+        if (!depth || !force)
+            st = cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu steps", steps);
+    }
+    if (st == CF_OK) {
+        for (size_t k = 0; k < steps; k++) {
+            depth[k] = r.step[k + 1].depth_mm;
+            force[k] = r.step[k + 1].force_N;
+        }
+        st = cf_export_write_body(out, &r.body, &sc->probe, steps, depth, force, opt, rep, err);
+        if (st != CF_OK)
+            snprintf(err->msg + strlen(err->msg), sizeof err->msg - strlen(err->msg), " (%s)",
+                     scene_path);
+    }
+    free(depth);
+    free(force);
+    run_free(&r);
+    return st;
+}

@@ -14,6 +14,7 @@
 #include "conifit/fitfile.h"
 #include "conifit/budget.h"
 #include "conifit/scene.h"
+#include "cli/cli_body.h"
 
 static const char export_help[] =
     "usage: conifit export FIT.json --format F [--type T] [-o FILE] [--tol REL] [--range LO:HI]\n"
@@ -26,7 +27,12 @@ static const char export_help[] =
     "built from the spring (every spring family with its weight and its own table, boundary\n"
     "conditions, the uniaxial loading of SCENE.json or, without it, 20 steps to half the solid\n"
     "strain, and output requests) as a model that runs in the target as it is; conifit's own\n"
-    "reaction at every step is written in its header. Row count and error go to stderr.\n"
+    "reaction at every step is written in its header. A SCENE.json with a body (calculix;\n"
+    "sofa without a volume term, poisson_ratio 0.25) writes the body: every edge a spring\n"
+    "with its own table, the volume term as tetrahedra of a purely volumetric material (J per\n"
+    "tetrahedron), the held nodes, and a flat punch along z as the prescribed motion of the\n"
+    "nodes under its face; conifit's probe force at every step in its header (a sphere probe\n"
+    "is refused: its contact set changes with depth). Row count and error go to stderr.\n"
     "Units: mm, N, s, tonne (stated inside each file).\n\n"
     "  FIT.json         '-' reads the fit file from standard input\n"
     "  --format F       one of the formats below (default: the format -o's extension names)\n"
@@ -155,6 +161,10 @@ typedef struct export_request {
     const char *out_path, *fit_path, *scene_path;
     char scene_fit[4096]; /* the fit file the scene names, "" when none */
     int quiet;
+    int body;             /* the scene holds a body: its model is in body_buf (body_len bytes) */
+    char *body_buf;
+    size_t body_len;
+    cf_export_report body_rep;
 } export_request;
 
 /* Parses the arguments into q and checks their combinations (the format from -o's extension
@@ -241,6 +251,27 @@ static cf_status lattice_of(export_request *q, const cf_fitted_spring *fs,
         if ((st = cf_scene_load(scene_path, &sc, err)) != CF_OK)
             return st;
         snprintf(q->scene_fit, sizeof q->scene_fit, "%s", sc.fit_path);
+        if (sc.has_body) {
+            /* a body: solved with the fit file's spring as simulate solves it, its model
+            ** rendered now */
+            sc.spring = fs->params;
+            FILE *mem = open_memstream(&q->body_buf, &q->body_len);
+            if (!mem)
+                st = cf_error_set(err, CF_E_INTERNAL, "out of memory");
+            else {
+                cf_export_options opt = q->ea.opt;
+                opt.source = cf_cli_is_stdio(q->fit_path) ? "(standard input)" : q->fit_path;
+                opt.output = q->out_path && !cf_cli_is_stdio(q->out_path) ? q->out_path : NULL;
+                opt.auto_tol = !q->ea.tol_given;
+                st = cf_cli_body_export(&sc, scene_path, &q->ea.budget, mem, &opt, &q->body_rep,
+                                        err);
+                if (fclose(mem) != 0 && st == CF_OK)
+                    st = cf_error_set(err, CF_E_INTERNAL, "out of memory");
+            }
+            q->body = 1;
+            cf_scene_free(&sc);
+            return st;
+        }
         cf_scene_cost cost;
         if ((st = cf_budget_check_size(&sc, scene_path, &q->ea.budget, &cost, err)) == CF_OK &&
             (st = cf_export_lattice_from_scene(&sc, scene_path, lx, err)) == CF_OK)
@@ -349,8 +380,28 @@ int cf_cli_export(int argc, char **argv)
     opt.auto_tol = !q.ea.tol_given;
     cf_export_lattice lx;
     q.scene_fit[0] = '\0';
-    if (q.ea.lattice && lattice_of(&q, &fs, &lx, &err) != CF_OK)
+    q.body = 0;
+    q.body_buf = NULL;
+    if (q.ea.lattice && lattice_of(&q, &fs, &lx, &err) != CF_OK) {
+        free(q.body_buf);
         return cf_cli_fail(&err);
+    }
+    if (q.body) {
+        cf_status st = emit(&q, q.body_buf, q.body_len, &err);
+        free(q.body_buf);
+        if (st != CF_OK)
+            return cf_cli_fail(&err);
+        if (!q.quiet)
+            cf_cli_printf_safe(stderr,
+                               "conifit export: %s body, %zu nodes, %zu edge springs in %zu "
+                               "groups, %zu load steps; tables of %zu rows, max error %.3g of "
+                               "F_C (%.3g N), tol %g\n",
+                               cf_export_format_name(opt.format), q.body_rep.nodes,
+                               q.body_rep.springs, q.body_rep.groups, q.body_rep.steps,
+                               q.body_rep.rows, q.body_rep.max_err_rel, q.body_rep.max_err_N,
+                               q.body_rep.tol);
+        return CF_EXIT_OK;
+    }
     if (q.ea.lattice && !fs.target_lattice && !q.quiet)
         fputs("conifit export: note: the fit file's spring was fitted as a single spring "
               "(--target spring), not through the lattice: its lattice may miss the table; fit "

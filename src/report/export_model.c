@@ -319,6 +319,21 @@ static void write_inp(FILE *out, const cf_xmodel *m, int abaqus)
         for (size_t i = 0; i < m->g[g].rows; i++)
             cf_export_inp_pair(out, m->g[g].T_N[i], m->g[g].e_mm[i]);
     }
+    if (m->nt > 0 && m->kappa_MPa > 0) {
+        /* W = C10 (I1bar - 3) + (J - 1)^2 / D1: with C10 = 0 and D1 = 2/kappa the volume term */
+        fprintf(out, "** the volume term: a purely volumetric material, (kappa/2)(J - 1)^2 per unit "
+                     "volume, kappa = %.17g MPa, J per tetrahedron\n",
+                m->kappa_MPa);
+        fprintf(out, "*ELEMENT, TYPE=C3D4, ELSET=VOLUME\n");
+        for (size_t t = 0; t < m->nt; t++)
+            fprintf(out, "%zu, %u, %u, %u, %u\n", m->ns + t + 1, m->tet[4 * t] + 1,
+                    m->tet[4 * t + 1] + 1, m->tet[4 * t + 2] + 1, m->tet[4 * t + 3] + 1);
+        char d1[32];
+        inp_real(d1, 2 / m->kappa_MPa);
+        fprintf(out, "*MATERIAL, NAME=VOLUME\n*HYPERELASTIC, NEO HOOKE\n0., %s\n"
+                     "*SOLID SECTION, ELSET=VOLUME, MATERIAL=VOLUME\n",
+                d1);
+    }
     fprintf(out, "*BOUNDARY\n");
     for (size_t i = 0; i < m->nn; i++)
         for (int a = 0; a < 3; a++)

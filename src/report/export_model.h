@@ -49,6 +49,11 @@ typedef struct cf_xmodel {
                             ** weights of the springs a horizontal plane cuts, projected on z */
     double area_mm2;        /* loaded area (lattice: nx ny H^2), mm^2 */
     double height_mm;       /* height along z, mm */
+    /* a body's volume term (calculix, abaqus): nt tetrahedra (4 node indices each, not owned)
+    ** of a purely volumetric material, W = (kappa/2)(J - 1)^2 per unit volume; 0 = none */
+    size_t nt;
+    const uint32_t *tet;
+    double kappa_MPa;
 } cf_xmodel;
 
 /* Releases what the model owns (its arrays and group tables). Safe on a zeroed model. */

@@ -286,6 +286,82 @@ static void a_fitted_brain_body_probed_deep_stays_stable(void **state)
     assert_true((F[16] - F[12]) / (d[16] - d[12]) > (F[4] - F[0]) / (d[4] - d[0]));
 }
 
+/* `conifit export FIT --lattice SCENE` with a body scene: the CalculiX model of the body run by
+** ccx gives simulate's punch force at every step (springs only at nu = 0.25: the same model); a
+** sphere probe is refused (exit 65 naming the probe) and nothing written. */
+static void a_body_scene_exports_to_calculix_and_runs(void **state)
+{
+    (void)state;
+    if (system("command -v ccx >/dev/null 2>&1") != 0)
+        skip(); /* CI installs calculix-ccx (Makefile DEBS) */
+    const char *fit = "fits/series/muscle_compression_relaxation_fiber30.json";
+    char mesh[600], scene[600], csv[600], inp[600], out[8192], err[8192];
+    snprintf(mesh, sizeof mesh, "%s/block.msh", dir);
+    write_block(mesh);
+    snprintf(scene, sizeof scene, "%s/punch.json", dir);
+    snprintf(csv, sizeof csv, "%s/punch.csv", dir);
+    snprintf(inp, sizeof inp, "%s/punch.inp", dir);
+    for (int sphere = 1; sphere >= 0; sphere--) {
+        FILE *f = fopen(scene, "w");
+        assert_non_null(f);
+        fprintf(f, "{\"spring\": {\"fit\": \"%s\"}, \"body\": {\"mesh\": \"%s\", \"unit_mm\": 1, "
+                   "\"poisson_ratio\": 0.25}, \"fixed\": {\"below\": {\"axis\": \"z\", "
+                   "\"value_mm\": 0}}, \"probe\": {\"shape\": \"%s\", \"radius_mm\": 6, "
+                   "\"center_mm\": [15, 15, %s], \"direction\": [0, 0, -1], \"depth_mm\": 0.2, "
+                   "\"steps\": 2}}",
+                fit, mesh, sphere ? "sphere" : "punch", sphere ? "21" : "15");
+        fclose(f);
+        int rc = tu_run(out, sizeof out, err, sizeof err,
+                        "export %s --lattice %s --format calculix -o %s", fit, scene, inp);
+        if (sphere) {
+            assert_int_equal(rc, 65);
+            assert_non_null(strstr(err, "probe"));
+            assert_false(exists(inp));
+            continue;
+        }
+        if (rc != 0)
+            fail_msg("export: %s", err);
+    }
+    if (tu_run(out, sizeof out, err, sizeof err, "simulate %s -o %s", scene, csv) != 0)
+        fail_msg("simulate: %s", err);
+    double F[3] = {0};
+    FILE *c = fopen(csv, "r");
+    assert_non_null(c);
+    char line[256];
+    int n = 0;
+    assert_non_null(fgets(line, sizeof line, c));
+    double d;
+    while (n < 3 && fgets(line, sizeof line, c))
+        if (sscanf(line, "%lf,%lf", &d, &F[n]) == 2)
+            n++;
+    fclose(c);
+    assert_int_equal(n, 3);
+    char cmd[1600];
+    snprintf(cmd, sizeof cmd, "cd %s && ccx -i punch > punch.log 2>&1", dir);
+    if (system(cmd) != 0)
+        fail_msg("ccx failed on %s", inp);
+    char dat[620];
+    snprintf(dat, sizeof dat, "%s/punch.dat", dir);
+    char *text = tu_slurp(dat);
+    assert_non_null(text);
+    int found = 0;
+    for (const char *p = text; (p = strstr(p, "total force (fx,fy,fz) for set NTOP and time")); p++) {
+        double t, fx, fy, fz;
+        if (sscanf(p, "total force (fx,fy,fz) for set NTOP and time %lf %lf %lf %lf", &t, &fx,
+                   &fy, &fz) != 4)
+            continue;
+        const int k = (int)floor(t + 0.5);
+        if (fabs(t - k) > 1e-9 || k < 1 || k > 2)
+            continue;
+        print_message("body export, step %d: ccx %.7g N, conifit simulate %.7g N\n", k, -fz, F[k]);
+        if (!(fabs(-fz - F[k]) <= 1e-3 * F[k]))
+            fail_msg("step %d: ccx %.7g N, conifit simulate %.7g N: beyond 1e-3", k, -fz, F[k]);
+        found++;
+    }
+    free(text);
+    assert_int_equal(found, 2);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -293,6 +369,7 @@ int main(void)
         cmocka_unit_test(vtk_reads_the_files),
         cmocka_unit_test(bad_probe_scenes_are_refused_and_write_nothing),
         cmocka_unit_test(a_fitted_brain_body_probed_deep_stays_stable),
+        cmocka_unit_test(a_body_scene_exports_to_calculix_and_runs),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -8,6 +8,8 @@
 #include "testutil.h"
 
 #include "conifit/body.h"
+#include "conifit/export.h"
+#include "conifit/fitfile.h"
 #include "conifit/mesh.h"
 
 TU_SCRATCH_GROUP("body")
@@ -292,6 +294,416 @@ static void a_probe_inside_the_body_is_found(void **state)
     cf_law_free(&law);
 }
 
+/* ---- the liver against CalculiX -------------------------------------------------------------- */
+
+/* The liver (../shared/meshes/liver2.msh, 1 unit = 100 mm, refined `refine` times by Gmsh) held
+** below z = -60 mm, and a rigid, frictionless flat punch of radius R pressed down by D at the top:
+** the nodes of the punch's cylinder above its face at depth D are the loaded set, each moved down
+** onto the face (only its z prescribed, x and y free: frictionless), every other node free. The
+** same loaded set with the same prescribed displacements is solved by the spring body and by
+** CalculiX (linear elasticity with the body's reported E and nu on the same tetrahedra made
+** quadratic, C3D10, a node at every edge's midpoint: linear C3D4 of this coarse mesh are 30 to 40 %
+** stiffer than the quadratic ones and lock as nu nears 1/2), so that the two solve the same
+** problem; the reactions summed over the loaded set are compared. The displacements are scaled so
+** that the deepest is umax, in the law's linear range.
+** Returns 0 when ccx could not run the model; fills the two forces and the loaded count. */
+static int cmp_u64(const void *a, const void *b)
+{
+    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static int liver_and_calculix(int refine, double nu, double R, double D, double umax,
+                              double *F_body,
+                              double *F_ccx, int *loaded, double *strain_max)
+{
+    cf_law law = test_law();
+    cf_mesh m;
+    cf_error err = {0};
+    if (cf_mesh_read_refined("../shared/meshes/liver2.msh", 100, refine, &m, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    cf_body b;
+    assert_int_equal(cf_body_create(&b, &m, &law, CF_LAW_CLOSED,
+                                    cf_body_kappa_for_nu(cf_body_mu_of_law(&law), nu), &err),
+                     CF_OK);
+    /* the punch's axis through the highest node */
+    size_t top = 0;
+    for (size_t i = 0; i < b.nn; i++)
+        if (b.X[3 * i + 2] > b.X[3 * top + 2])
+            top = i;
+    const double cx = b.X[3 * top], cy = b.X[3 * top + 1], face = b.X[3 * top + 2] - D;
+    uint8_t *load = calloc(b.nn, 1);
+    assert_non_null(load);
+    int nl = 0, nfix = 0;
+    for (size_t i = 0; i < b.nn; i++) {
+        const double *X = b.X + 3 * i;
+        if (X[2] <= -60) {
+            b.fix[i] = CF_BODY_FIX_ALL;
+            nfix++;
+        } else if (hypot(X[0] - cx, X[1] - cy) <= R && X[2] > face) {
+            load[i] = 1;
+            b.fix[i] = 4;
+            nl++;
+        }
+    }
+    assert_true(nfix > 0 && nl > 0);
+    /* the prescribed displacements scaled so that the deepest is `umax` (the linear range) */
+    double dmax = 0;
+    for (size_t i = 0; i < b.nn; i++)
+        if (load[i])
+            dmax = fmax(dmax, b.X[3 * i + 2] - face);
+    const double s = umax / dmax;
+    for (size_t i = 0; i < b.nn; i++)
+        if (load[i])
+            b.x[3 * i + 2] = b.X[3 * i + 2] - s * (b.X[3 * i + 2] - face);
+    cf_probe none = {0};
+    none.dir[2] = -1;
+    cf_body_step st;
+    if (cf_body_solve(&b, &none, 0, 0, &st, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    *strain_max = st.max_u_over_travel;
+    double *g = malloc(3 * b.nn * sizeof *g);
+    assert_non_null(g);
+    assert_int_equal(cf_body_internal_force(&b, g, &err), CF_OK);
+    double F = 0;
+    for (size_t i = 0; i < b.nn; i++)
+        if (load[i])
+            F -= g[3 * i + 2];
+    *F_body = F;
+    *loaded = nl;
+    free(g);
+
+    /* the CalculiX model of the same problem */
+    char job[64], path[700];
+    snprintf(job, sizeof job, "liver_r%d_nu%02d", refine, (int)(nu * 100 + 0.5));
+    snprintf(path, sizeof path, "%s/%s.inp", dir, job);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f, "*NODE\n");
+    for (size_t i = 0; i < b.nn; i++)
+        fprintf(f, "%zu, %.17g, %.17g, %.17g\n", i + 1, b.X[3 * i], b.X[3 * i + 1],
+                b.X[3 * i + 2]);
+    /* quadratic tetrahedra (C3D10): a node at every edge's midpoint, numbered after the corners */
+    static const int ends[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+    const size_t ne = 6 * b.nt;
+    uint64_t *key = malloc(ne * sizeof *key);
+    size_t *mid = malloc(ne * sizeof *mid);
+    assert_true(key && mid);
+    for (size_t t = 0; t < b.nt; t++)
+        for (int e = 0; e < 6; e++) {
+            uint64_t a = b.tet[4 * t + ends[e][0]], c = b.tet[4 * t + ends[e][1]];
+            key[6 * t + e] = a < c ? a << 32 | c : c << 32 | a;
+        }
+    uint64_t *sorted = malloc(ne * sizeof *sorted);
+    assert_non_null(sorted);
+    memcpy(sorted, key, ne * sizeof *key);
+    qsort(sorted, ne, sizeof *sorted, cmp_u64);
+    size_t nu_ = 0;
+    for (size_t k = 0; k < ne; k++)
+        if (k == 0 || sorted[k] != sorted[k - 1])
+            sorted[nu_++] = sorted[k];
+    for (size_t k = 0; k < ne; k++) {
+        const uint64_t *hit = bsearch(key + k, sorted, nu_, sizeof *sorted, cmp_u64);
+        mid[k] = b.nn + 1 + (size_t)(hit - sorted);
+    }
+    for (size_t k = 0; k < nu_; k++) {
+        const size_t a = sorted[k] >> 32, c = sorted[k] & 0xffffffffu;
+        fprintf(f, "%zu, %.17g, %.17g, %.17g\n", b.nn + 1 + k, (b.X[3 * a] + b.X[3 * c]) / 2,
+                (b.X[3 * a + 1] + b.X[3 * c + 1]) / 2, (b.X[3 * a + 2] + b.X[3 * c + 2]) / 2);
+    }
+    fprintf(f, "*ELEMENT, TYPE=C3D10, ELSET=BODY\n");
+    for (size_t t = 0; t < b.nt; t++) {
+        fprintf(f, "%zu, %u, %u, %u, %u", t + 1, b.tet[4 * t] + 1, b.tet[4 * t + 1] + 1,
+                b.tet[4 * t + 2] + 1, b.tet[4 * t + 3] + 1);
+        for (int e = 0; e < 6; e++)
+            fprintf(f, ",%s %zu", e == 3 ? "\n" : "", mid[6 * t + e]);
+        fprintf(f, "\n");
+    }
+    /* an edge's midpoint is held when both its ends are, loaded when both are (the punch's face
+    ** is flat: the prescribed displacement is linear along the edge) */
+    fprintf(f, "*NSET, NSET=FIX\n");
+    for (size_t i = 0; i < b.nn; i++)
+        if (b.fix[i] == CF_BODY_FIX_ALL)
+            fprintf(f, "%zu\n", i + 1);
+    for (size_t k = 0; k < nu_; k++)
+        if (b.fix[sorted[k] >> 32] == CF_BODY_FIX_ALL && b.fix[sorted[k] & 0xffffffffu] == CF_BODY_FIX_ALL)
+            fprintf(f, "%zu\n", b.nn + 1 + k);
+    fprintf(f, "*NSET, NSET=NTOP\n");
+    for (size_t i = 0; i < b.nn; i++)
+        if (load[i])
+            fprintf(f, "%zu\n", i + 1);
+    for (size_t k = 0; k < nu_; k++)
+        if (load[sorted[k] >> 32] && load[sorted[k] & 0xffffffffu])
+            fprintf(f, "%zu\n", b.nn + 1 + k);
+    fprintf(f, "*MATERIAL, NAME=TISSUE\n*ELASTIC\n%.17g, %.17g\n"
+               "*SOLID SECTION, ELSET=BODY, MATERIAL=TISSUE\n*STEP\n*STATIC\n*BOUNDARY\nFIX, 1, 3\n",
+            b.E_MPa, b.nu);
+    for (size_t i = 0; i < b.nn; i++)
+        if (load[i])
+            fprintf(f, "%zu, 3, 3, %.17g\n", i + 1, s * (face - b.X[3 * i + 2]));
+    for (size_t k = 0; k < nu_; k++) {
+        const size_t a = sorted[k] >> 32, c = sorted[k] & 0xffffffffu;
+        if (load[a] && load[c])
+            fprintf(f, "%zu, 3, 3, %.17g\n", b.nn + 1 + k,
+                    s * (face - (b.X[3 * a + 2] + b.X[3 * c + 2]) / 2));
+    }
+    fprintf(f, "*NODE PRINT, NSET=NTOP, TOTALS=ONLY\nRF\n*END STEP\n");
+    fclose(f);
+    free(key);
+    free(mid);
+    free(sorted);
+    free(load);
+    cf_body_free(&b);
+    cf_mesh_free(&m);
+    cf_law_free(&law);
+
+    char cmd[1600];
+    snprintf(cmd, sizeof cmd, "cd %s && ccx -i %s > %s.log 2>&1", dir, job, job);
+    if (system(cmd) != 0)
+        return 0;
+    snprintf(path, sizeof path, "%s/%s.dat", dir, job);
+    char *text = tu_slurp(path);
+    assert_non_null(text);
+    const char *p = strstr(text, "total force (fx,fy,fz) for set NTOP and time");
+    double t, fx, fy, fz;
+    if (!p || sscanf(p, "total force (fx,fy,fz) for set NTOP and time %lf %lf %lf %lf", &t, &fx,
+                     &fy, &fz) != 4)
+        fail_msg("%s: no total force of set NTOP", path);
+    free(text);
+    *F_ccx = -fz;
+    return 1;
+}
+
+static void liver_force_matches_calculix(double nu)
+{
+    FILE *f = fopen("../shared/meshes/liver2.msh", "r");
+    if (!f)
+        skip(); /* ../shared/meshes absent */
+    fclose(f);
+    if (system("command -v ccx >/dev/null 2>&1") != 0)
+        skip(); /* CI installs calculix-ccx (Makefile DEBS) */
+    /* the punch's set at 15 mm under a 60 mm punch: 49 nodes of liver2.msh; the deepest moved
+    ** 0.5 mm (springs at 3 % of their travel) */
+    const int refine = 0;
+    const double R = 60, D = 15, U = 0.5;
+    double Fb, Fc, sm;
+    int nl;
+    if (!liver_and_calculix(refine, nu, R, D, U, &Fb, &Fc, &nl, &sm))
+        fail_msg("ccx failed on the liver model (see its .log in %s)", dir);
+    print_message("liver, nu %.2f, punch %g mm at %g mm, %d nodes loaded: springs %.4g N, ccx C3D10 "
+                  "%.4g N (%+.1f %%), springs at %.2g of travel\n",
+                  nu, R, D, nl, Fb, Fc, 100 * (Fb / Fc - 1), sm);
+    assert_true(sm < 0.1); /* the linear range of the law */
+    if (!(fabs(Fb / Fc - 1) <= 0.15))
+        fail_msg("liver, nu %.2f: springs %.4g N against CalculiX %.4g N: beyond 15 %%", nu, Fb, Fc);
+}
+
+static void liver_calculix_nu_025(void **state)
+{
+    (void)state;
+    liver_force_matches_calculix(0.25);
+}
+
+static void liver_calculix_nu_045(void **state)
+{
+    (void)state;
+    liver_force_matches_calculix(0.45);
+}
+
+/* ---- the probe loop at haptic rate -------------------------------------------------------------- */
+
+/* Bodies bh and bs of one mesh and law: bh driven by cf_body_haptic_step (3 chord iterations per
+** update) to depth in `updates` equal moves, then held there for as many updates; bs solved
+** statically at depth in 10 steps. Returns the haptic force at rest over the static one. */
+static double haptic_over_static(cf_body *bh, cf_body *bs, const cf_probe *pr, double depth,
+                                 int updates)
+{
+    cf_error err = {0};
+    cf_body_step st = {0}, ss = {0};
+    int touched = 0;
+    for (int k = 1; k <= 2 * updates; k++) {
+        if (cf_body_haptic_step(bh, pr, depth * (k < updates ? k : updates) / updates, 0, 3, &st,
+                                &err) != CF_OK)
+            fail_msg("haptic update %d: %s", k, err.msg);
+        assert_true(isfinite(st.force_N) && st.min_J > 0);
+        touched |= st.contacts > 0;
+    }
+    assert_true(touched);
+    for (int k = 1; k <= 10; k++)
+        if (cf_body_solve(bs, pr, depth * k / 10, 0, &ss, &err) != CF_OK)
+            fail_msg("%s", err.msg);
+    assert_true(ss.force_N > 0);
+    print_message("haptic loop: %d contacts, force at rest %.6g N, static %.6g N (ratio %.5f)\n",
+                  st.contacts, st.force_N, ss.force_N, st.force_N / ss.force_N);
+    return st.force_N / ss.force_N;
+}
+
+/* A sphere pressed 0.1 mm into a Gmsh block (nu 0.45) by haptic updates: at rest, the static
+** equilibrium's force within 5 %. */
+static void haptic_loop_rests_at_the_static_force_block(void **state)
+{
+    (void)state;
+    cf_law law = test_law();
+    double lo[3] = {0, 0, -30}, hi[3] = {30, 30, 0}, f[3] = {0, 0, 0};
+    cf_mesh m;
+    cf_error err = {0};
+    assert_int_equal(cf_mesh_box(lo, hi, f, 0.3, 8, 0.4, &m, &err), CF_OK);
+    cf_body bh, bs;
+    const double kappa = cf_body_kappa_for_nu(cf_body_mu_of_law(&law), 0.45);
+    assert_int_equal(cf_body_create(&bh, &m, &law, CF_LAW_CLOSED, kappa, &err), CF_OK);
+    assert_int_equal(cf_body_create(&bs, &m, &law, CF_LAW_CLOSED, kappa, &err), CF_OK);
+    for (size_t i = 0; i < bh.nn; i++) {
+        const double *X = bh.X + 3 * i;
+        bh.fix[i] = bs.fix[i] = (X[0] < 1e-9) | (X[1] < 1e-9) << 1;
+        if (X[2] < -30 + 1e-9)
+            bh.fix[i] = bs.fix[i] = CF_BODY_FIX_ALL;
+    }
+    cf_probe pr = {CF_PROBE_SPHERE, 10, {0, 0, 10}, {0, 0, -1}, 0.1, 1};
+    const double ratio = haptic_over_static(&bh, &bs, &pr, 0.1, 50);
+    assert_true(fabs(ratio - 1) <= 0.05);
+    cf_body_free(&bh);
+    cf_body_free(&bs);
+    cf_mesh_free(&m);
+    cf_law_free(&law);
+}
+
+/* The benchmark's loop on liver2.msh: the fitted muscle spring, nu 0.45, held below z = -60 mm, a
+** sphere of radius 10 mm moved 5 um per update to 1 mm into the top and held: at rest, the static
+** force within 5 %. */
+static void haptic_loop_rests_at_the_static_force_liver(void **state)
+{
+    (void)state;
+    FILE *fm = fopen("../shared/meshes/liver2.msh", "r");
+    if (!fm)
+        skip(); /* ../shared/meshes absent */
+    fclose(fm);
+    cf_fitted_spring fs;
+    cf_law law;
+    cf_error err = {0};
+    if (cf_fitfile_load("fits/series/muscle_compression_relaxation_fiber30.json", NULL, &fs, &err) !=
+            CF_OK ||
+        cf_law_init(&law, &fs.params, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    cf_mesh m;
+    if (cf_mesh_read("../shared/meshes/liver2.msh", 100, &m, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    cf_body bh, bs;
+    const double kappa = cf_body_kappa_for_nu(cf_body_mu_of_law(&law), 0.45);
+    assert_int_equal(cf_body_create(&bh, &m, &law, CF_LAW_CLOSED, kappa, &err), CF_OK);
+    assert_int_equal(cf_body_create(&bs, &m, &law, CF_LAW_CLOSED, kappa, &err), CF_OK);
+    size_t top = 0;
+    for (size_t i = 0; i < bh.nn; i++) {
+        if (bh.X[3 * i + 2] <= -60)
+            bh.fix[i] = bs.fix[i] = CF_BODY_FIX_ALL;
+        if (bh.X[3 * i + 2] > bh.X[3 * top + 2])
+            top = i;
+    }
+    cf_probe pr = {CF_PROBE_SPHERE, 10,
+                   {bh.X[3 * top], bh.X[3 * top + 1], bh.X[3 * top + 2] + 10.001},
+                   {0, 0, -1}, 1, 1};
+    const double ratio = haptic_over_static(&bh, &bs, &pr, 1, 200);
+    assert_true(fabs(ratio - 1) <= 0.05);
+    cf_body_free(&bh);
+    cf_body_free(&bs);
+    cf_mesh_free(&m);
+    cf_law_free(&law);
+}
+
+/* ---- the body exported to CalculiX ---------------------------------------------------------- */
+
+/* A Gmsh block 30 x 30 x 15 mm held at its bottom, a flat punch of radius 4 mm pressed 0.1 mm
+** into the middle of its top in 4 steps (no node enters the punch after the first contact):
+** solved by conifit, written by cf_export_write_body, run by ccx; returns the largest relative
+** difference of ccx's punch force from conifit's. */
+static double body_export_against_ccx(double nu, const char *job)
+{
+    cf_law law = test_law();
+    double lo[3] = {-15, -15, -15}, hi[3] = {15, 15, 0}, f[3] = {0, 0, 0};
+    cf_mesh m;
+    cf_error err = {0};
+    assert_int_equal(cf_mesh_box(lo, hi, f, 1, 5, 0.4, &m, &err), CF_OK);
+    cf_body b;
+    assert_int_equal(cf_body_create(&b, &m, &law, CF_LAW_CLOSED,
+                                    cf_body_kappa_for_nu(cf_body_mu_of_law(&law), nu), &err),
+                     CF_OK);
+    for (size_t i = 0; i < b.nn; i++)
+        if (b.X[3 * i + 2] < -15 + 1e-9)
+            b.fix[i] = CF_BODY_FIX_ALL;
+    cf_probe pr = {CF_PROBE_PUNCH, 4, {0, 0, 0}, {0, 0, -1}, 0.1, 4};
+    double depth[4], force[4];
+    for (int k = 0; k < 4; k++) {
+        cf_body_step st;
+        depth[k] = pr.depth_mm * (k + 1) / 4;
+        if (cf_body_solve(&b, &pr, depth[k], 0, &st, &err) != CF_OK)
+            fail_msg("%s", err.msg);
+        force[k] = st.force_N;
+    }
+    char path[700];
+    snprintf(path, sizeof path, "%s/%s.inp", dir, job);
+    FILE *out = fopen(path, "w");
+    assert_non_null(out);
+    cf_export_options opt = cf_export_default_options();
+    opt.format = CF_EXPORT_CALCULIX;
+    opt.auto_tol = 1;
+    cf_export_report rep;
+    if (cf_export_write_body(out, &b, &pr, 4, depth, force, &opt, &rep, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    fclose(out);
+    /* a sphere is refused, naming the probe */
+    cf_probe sph = pr;
+    sph.shape = CF_PROBE_SPHERE;
+    FILE *null = fopen("/dev/null", "w");
+    assert_int_equal(cf_export_write_body(null, &b, &sph, 4, depth, force, &opt, &rep, &err),
+                     CF_E_DATA);
+    fclose(null);
+    assert_non_null(strstr(err.msg, "probe"));
+    cf_body_free(&b);
+    cf_mesh_free(&m);
+    cf_law_free(&law);
+    char cmd[1600];
+    snprintf(cmd, sizeof cmd, "cd %s && ccx -i %s > %s.log 2>&1", dir, job, job);
+    if (system(cmd) != 0)
+        fail_msg("ccx failed on %s/%s.inp", dir, job);
+    snprintf(path, sizeof path, "%s/%s.dat", dir, job);
+    char *text = tu_slurp(path);
+    assert_non_null(text);
+    double worst = 0;
+    int n = 0;
+    for (const char *p = text; (p = strstr(p, "total force (fx,fy,fz) for set NTOP and time")); p++) {
+        double t, fx, fy, fz;
+        if (sscanf(p, "total force (fx,fy,fz) for set NTOP and time %lf %lf %lf %lf", &t, &fx,
+                   &fy, &fz) != 4)
+            continue;
+        const double k = floor(t + 0.5);
+        if (fabs(t - k) > 1e-9 || k < 1 || k > 4)
+            continue;
+        const double rel = -fz / force[(int)k - 1] - 1;
+        print_message("%s step %d: ccx %.6g N, conifit %.6g N (%+.2f %%)\n", job, (int)k, -fz,
+                      force[(int)k - 1], 100 * rel);
+        worst = fmax(worst, fabs(rel));
+        n++;
+    }
+    free(text);
+    if (n < 4)
+        fail_msg("%s: %d of 4 steps in ccx's output", job, n);
+    return worst;
+}
+
+static void body_export_runs_in_calculix(void **state)
+{
+    (void)state;
+    if (system("command -v ccx >/dev/null 2>&1") != 0)
+        skip(); /* CI installs calculix-ccx (Makefile DEBS) */
+    const double w25 = body_export_against_ccx(0.25, "body_nu25");
+    const double w45 = body_export_against_ccx(0.45, "body_nu45");
+    print_message("body export: worst step %.3g (nu 0.25), %.3g (nu 0.45)\n", w25, w45);
+    /* springs only: the same model (the penalty's penetration and the table's tolerance) */
+    assert_true(w25 <= 1e-3);
+    /* the volume elements take J per tetrahedron, stiffer than the body's J per node (33 % on
+    ** this block): present and acting, not the same model */
+    assert_true(w45 >= 0.1 && w45 <= 0.5);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -304,6 +716,11 @@ int main(void)
         cmocka_unit_test(boussinesq_punch_nu_025),
         cmocka_unit_test(boussinesq_punch_nu_045),
         cmocka_unit_test(a_probe_inside_the_body_is_found),
+        cmocka_unit_test(liver_calculix_nu_025),
+        cmocka_unit_test(liver_calculix_nu_045),
+        cmocka_unit_test(haptic_loop_rests_at_the_static_force_block),
+        cmocka_unit_test(haptic_loop_rests_at_the_static_force_liver),
+        cmocka_unit_test(body_export_runs_in_calculix),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

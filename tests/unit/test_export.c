@@ -17,6 +17,7 @@
 
 #include <glob.h>
 
+#include "conifit/body.h"
 #include "conifit/export.h"
 #include "conifit/fitfile.h"
 #include "conifit/law.h"
@@ -1298,6 +1299,90 @@ static void an_unstable_lattice_loading_is_refused_with_the_strain_that_works(
     assert_non_null(strstr(err, "protocol.kind"));
 }
 
+/* A body (a block of 2 x 2 x 2 cells, no volume term) exported to SOFA by cf_export_write_body:
+** every edge's PolynomialSpringsForceField terms sum to its calibrated law (the factor c times
+** the law in strain form) within the table's tolerance, the punch drives the nodes under its
+** face, and a body with a volume term is refused. */
+static void a_body_scene_for_sofa_holds_every_edge_law(void **state)
+{
+    (void)state;
+    cf_law law;
+    law_of(&law, &TEL);
+    double g[3] = {0, 20, 40};
+    cf_mesh m;
+    assert_int_equal(cf_mesh_block(&m, g, 2, g, 2, g, 2, NULL), CF_OK);
+    cf_body b;
+    cf_error err = {0};
+    assert_int_equal(cf_body_create(&b, &m, &law, CF_LAW_CLOSED, 0, &err), CF_OK);
+    for (size_t i = 0; i < b.nn; i++)
+        if (b.X[3 * i + 2] < 1e-9)
+            b.fix[i] = CF_BODY_FIX_ALL;
+    cf_probe pr = {CF_PROBE_PUNCH, 25, {20, 20, 40}, {0, 0, -1}, 1, 1};
+    double depth = 1, force = 0.5;
+    char *x = NULL;
+    size_t len = 0;
+    FILE *mem = open_memstream(&x, &len);
+    assert_non_null(mem);
+    cf_export_options opt = cf_export_default_options();
+    opt.format = CF_EXPORT_SOFA;
+    opt.tol = 1e-4;
+    cf_export_report rep;
+    if (cf_export_write_body(mem, &b, &pr, 1, &depth, &force, &opt, &rep, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    fclose(mem);
+    assert_int_equal(rep.groups, b.ns);
+    /* the punch of radius 25 on the top's centre rests on 5 nodes: (20, 20) and its 4 neighbours */
+    const char *d = strstr(x, "movedDirections=\"0 0 1\" indices=\"");
+    assert_non_null(d);
+    int idx = 0;
+    for (const char *p = d + strlen("movedDirections=\"0 0 1\" indices=\""); *p != '"'; p++)
+        idx += (*p != ' ' && (p[1] == ' ' || p[1] == '"'));
+    assert_int_equal(idx, 5);
+    static sofa_field f[1 << 17];
+    const size_t n = sofa_fields(x, f, 1 << 17);
+    assert_true(n <= 1 << 17);
+    /* from full stretch to near solid, as for one spring: u = H (L0 - l)/L0 */
+    const double H = TEL.H_mm, u_end = cf_export_table_end(&law, 1e-4);
+    size_t *mine = malloc(n * sizeof *mine);
+    assert_non_null(mine);
+    double worst = 0;
+    for (size_t s = 0; s < b.ns; s++) {
+        const unsigned i = b.si[s], j = b.sj[s];
+        size_t terms = 0;
+        for (size_t k = 0; k < n; k++)
+            if ((f[k].first == i && f[k].second == j) || (f[k].first == j && f[k].second == i))
+                mine[terms++] = k;
+        assert_true(terms >= 2);
+        for (int q = -400; q <= 400; q++) {
+            const double u = u_end * q / 400, l = b.L0[s] * (1 - u / H);
+            double T = 0;
+            for (size_t k = 0; k < terms; k++)
+                T += sofa_force(l, f[mine[k]].l0, f[mine[k]].a, f[mine[k]].compressible);
+            const double want = b.c[s] * tension(&law, -u);
+            worst = fmax(worst, fabs(T - want) / (b.c[s] * law.F_C_N));
+        }
+    }
+    free(mine);
+    print_message("body for SOFA: %zu springs, %zu force fields, worst %.3g of c F_C\n", b.ns, n,
+                  worst);
+    if (worst > 1e-4)
+        fail_msg("SOFA springs of the body off their laws by %g of c F_C", worst);
+    assert_true(worst > 1e-7); /* the comparison sees the tables, not a copy of the law */
+    free(x);
+    /* with a volume term: refused, naming sofa and the way out */
+    cf_body bv;
+    assert_int_equal(cf_body_create(&bv, &m, &law, CF_LAW_CLOSED, 1e-3, &err), CF_OK);
+    FILE *null = fopen("/dev/null", "w");
+    assert_int_equal(cf_export_write_body(null, &bv, &pr, 1, &depth, &force, &opt, &rep, &err),
+                     CF_E_DATA);
+    fclose(null);
+    assert_non_null(strstr(err.msg, "volume term"));
+    cf_body_free(&bv);
+    cf_body_free(&b);
+    cf_mesh_free(&m);
+    cf_law_free(&law);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1312,6 +1397,7 @@ int main(void)
         cmocka_unit_test(febio_output_follows_the_febio4_layout_and_the_law),
         cmocka_unit_test(lsdyna_curve_carries_lcint_of_at_least_its_rows),
         cmocka_unit_test(sofa_scene_is_compressible_and_follows_the_law_within_tol),
+        cmocka_unit_test(a_body_scene_for_sofa_holds_every_edge_law),
         cmocka_unit_test(inp_block_has_its_layout_and_the_law),
         cmocka_unit_test(json_round_trips_through_force_spring),
         cmocka_unit_test(bad_input_gives_its_exit_status_the_number_that_works_and_no_output),

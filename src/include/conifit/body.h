@@ -147,6 +147,20 @@ typedef struct cf_body_step {
 cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
                         double penalty_N_per_mm, cf_body_step *out, cf_error *err);
 
+/* One update of the probe loop at haptic rate: the probe moved to depth, then at most max_iters
+** chord iterations from the current positions, each with the exact residual (springs, volume
+** term, penalty contact) and a step with the tangent of the body without contact, assembled and
+** factored at the first call and kept, corrected for the nodes in contact by Woodbury's identity
+** (a rank-one term per node, its three columns of the inverse computed once at its first contact),
+** so that contact changes need no new factorisation. Stops early when the residual is below
+** 1e-8 E h^2 (h the mean edge). The force is that of the positions at the start of the last
+** iteration; repeated at one depth the updates converge to cf_body_solve's equilibrium. The kept
+** columns grow by 9 nn numbers per node that has ever touched the probe (cf_body_free releases
+** them). Same errors as cf_body_solve. */
+cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm,
+                              double penalty_N_per_mm, int max_iters, cf_body_step *out,
+                              cf_error *err);
+
 /* The body's elastic forces on its nodes at the current positions (the gradient of its energy,
 ** N; g has 3 nn entries): at a held component, minus the support's reaction. CF_E_INTERNAL when
 ** memory runs out. */

@@ -1,0 +1,167 @@
+/*
+** Export of a tissue body (see export.h, cf_export_write_body), to CalculiX or SOFA: every edge of
+** the body its own
+** spring group (its rest length and its calibration factor as the weight, so its table is the law
+** in strain form times that factor, as the lattice export writes its groups), the volume term as
+** tetrahedra of a purely volumetric material, the held nodes, and a flat punch pressed along z as
+** the prescribed motion of the nodes under its face.
+*/
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "conifit/export.h"
+#include "base/gslguard.h"
+#include "conifit/body.h"
+#include "conifit/lattice.h"
+#include "report/export_model.h"
+
+/* The nodes the punch's face rests on at depth 0 (on its plane within 1e-9 of the mean edge and
+** inside its radius), into m->top. 0, -1 out of memory. */
+static int punch_nodes(const cf_body *b, const cf_probe *pr, cf_xmodel *m)
+{
+    m->top = malloc(b->nn * sizeof *m->top);
+    if (!m->top)
+        return -1;
+    const double tol = 1e-9 * b->mean_edge_mm;
+    for (size_t i = 0; i < b->nn; i++) {
+        if (b->fix[i] == CF_BODY_FIX_ALL)
+            continue;
+        const double *X = b->X + 3 * i;
+        double r[3], s = 0, q2 = 0;
+        for (int a = 0; a < 3; a++) {
+            r[a] = X[a] - pr->center_mm[a];
+            s += r[a] * pr->dir[a];
+        }
+        for (int a = 0; a < 3; a++) {
+            const double q = r[a] - s * pr->dir[a];
+            q2 += q * q;
+        }
+        if (fabs(s) <= tol && q2 < pr->radius_mm * pr->radius_mm)
+            m->top[m->ntop++] = (uint32_t)i;
+    }
+    return 0;
+}
+
+cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, size_t nsteps,
+                               const double *depth_mm, const double *force_N,
+                               const cf_export_options *opt, cf_export_report *rep, cf_error *err)
+{
+    CF_GSL_GUARD;
+    if (opt->format != CF_EXPORT_CALCULIX && opt->format != CF_EXPORT_SOFA)
+        return cf_error_set(err, CF_E_DATA, "a body is exported to calculix or sofa, not %s",
+                            cf_export_format_name(opt->format));
+    if (opt->format == CF_EXPORT_SOFA && b->kappa_MPa > 0)
+        return cf_error_set(err, CF_E_DATA,
+                            "sofa: the body's volume term (kappa = %g MPa, nu = %g > 0.25) has no "
+                            "form among SOFA's springs; export it to calculix, or take "
+                            "poisson_ratio 0.25",
+                            b->kappa_MPa, b->nu);
+    if (pr->shape != CF_PROBE_PUNCH || fabs(pr->dir[0]) > 1e-12 || fabs(pr->dir[1]) > 1e-12)
+        return cf_error_set(err, CF_E_DATA,
+                            "probe: a body's export takes a flat punch moving along z (a prescribed "
+                            "motion of the nodes under its face); a sphere's contact set changes "
+                            "with depth");
+    if (nsteps == 0 || nsteps > CF_EXPORT_MAX_STEPS)
+        return cf_error_set(err, CF_E_DATA, "%zu load steps: a body export takes 1 to %d", nsteps,
+                            CF_EXPORT_MAX_STEPS);
+    for (size_t k = 0; k < nsteps; k++)
+        if (!isfinite(depth_mm[k]) || !isfinite(force_N[k]))
+            return cf_error_set(err, CF_E_DATA, "load step %zu: depth or force is not finite",
+                                k + 1);
+    const cf_law *law = b->law;
+    cf_export_table t = {0};
+    cf_xmodel m = {0};
+    cf_export_report r = {0};
+    cf_status st = cf_export_table_for(law, opt, &t, err);
+    if (st != CF_OK)
+        return st;
+    char title[200];
+    snprintf(title, sizeof title,
+             "tissue body of %zu nodes, %zu edge springs and %zu tetrahedra (E = %.6g MPa, nu = "
+             "%.6g), pressed by a flat punch of radius %.6g mm",
+             b->nn, b->ns, b->nt, b->E_MPa, b->nu, pr->radius_mm);
+    m.title = title;
+    m.source = opt->source;
+    m.output = opt->output;
+    m.law = law;
+    m.base = &t;
+    m.nn = b->nn;
+    m.ns = m.ng = b->ns;
+    m.X = malloc(b->nn * sizeof *m.X);
+    m.Y = malloc(b->nn * sizeof *m.Y);
+    m.Z = malloc(b->nn * sizeof *m.Z);
+    m.fix = malloc(b->nn);
+    m.si = malloc(b->ns * sizeof *m.si);
+    m.sj = malloc(b->ns * sizeof *m.sj);
+    m.grp = malloc(b->ns * sizeof *m.grp);
+    m.g = calloc(b->ns, sizeof *m.g);
+    m.nsteps = nsteps;
+    m.dz_mm = malloc(nsteps * sizeof *m.dz_mm);
+    m.ref_N = malloc(nsteps * sizeof *m.ref_N);
+    m.strain = malloc(nsteps * sizeof *m.strain);
+    if (!m.X || !m.Y || !m.Z || !m.fix || !m.si || !m.sj || !m.grp || !m.g || !m.dz_mm ||
+        !m.ref_N || !m.strain || punch_nodes(b, pr, &m) != 0)
+        goto oom;
+    if (m.ntop == 0) {
+        st = cf_error_set(err, CF_E_DATA,
+                          "probe: the punch's face rests on no node of the body at depth 0 "
+                          "(center_mm must lie on a flat face of the mesh)");
+        goto done;
+    }
+    double zlo = INFINITY, zhi = -INFINITY;
+    for (size_t i = 0; i < b->nn; i++) {
+        m.X[i] = b->X[3 * i];
+        m.Y[i] = b->X[3 * i + 1];
+        m.Z[i] = b->X[3 * i + 2];
+        m.fix[i] = b->fix[i] & (CF_FIX_X | CF_FIX_Y | CF_FIX_Z);
+        zlo = fmin(zlo, m.Z[i]);
+        zhi = fmax(zhi, m.Z[i]);
+    }
+    m.height_mm = zhi - zlo;
+    /* the tables allow tol F_C per unit weight in each spring a horizontal plane cuts: the plane
+    ** halfway up the body */
+    const double zmid = (zlo + zhi) / 2;
+    double wcut = 0;
+    for (size_t s = 0; s < b->ns; s++) {
+        m.si[s] = b->si[s];
+        m.sj[s] = b->sj[s];
+        m.grp[s] = (uint32_t)s;
+        m.g[s].L0_mm = b->L0[s];
+        m.g[s].weight = b->c[s];
+        m.g[s].count = 1;
+        const double zi = b->X[3 * b->si[s] + 2], zj = b->X[3 * b->sj[s] + 2];
+        if ((zi - zmid) * (zj - zmid) < 0)
+            wcut += b->c[s] * fabs(zi - zj) / b->L0[s];
+    }
+    m.reaction_tol_N = t.tol * law->F_C_N * wcut;
+    for (size_t k = 0; k < nsteps; k++) {
+        m.dz_mm[k] = depth_mm[k] * pr->dir[2];
+        m.ref_N[k] = force_N[k] * (pr->dir[2] < 0 ? 1 : -1);
+        m.strain[k] = depth_mm[k] / m.height_mm;
+    }
+    if (opt->format == CF_EXPORT_CALCULIX) {
+        m.nt = b->nt;
+        m.tet = b->tet;
+        m.kappa_MPa = b->kappa_MPa;
+    }
+    if (cf_xmodel_tables(&m) != 0 || cf_xmodel_write(out, &m, opt->format) != 0)
+        goto oom;
+    r = cf_export_report_of_table(&t, law);
+    r.groups = m.ng;
+    r.springs = m.ns;
+    r.nodes = m.nn;
+    r.steps = m.nsteps;
+    if (ferror(out))
+        st = cf_error_set(err, CF_E_CANTWRITE, "cannot write the body's %s model",
+                          cf_export_format_name(opt->format));
+    goto done;
+oom:
+    st = cf_error_set(err, CF_E_INTERNAL, "out of memory writing the body's model");
+done:
+    if (rep)
+        *rep = r;
+    cf_xmodel_free(&m);
+    cf_export_table_free(&t);
+    return st;
+}
