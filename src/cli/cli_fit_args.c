@@ -75,9 +75,11 @@ static const char fit_help[] =
     "                          Cauchy stress is converted to nominal under incompressibility\n"
     "  --strain-measure M      engineering | log | stretch (default: '# strain:' or the name)\n"
     "  -j, --jobs N            fit N tables at a time (default 1)\n"
-    "  --shard K/N             fit share K (1..N) of N of the tables, sorted by path (every\n"
-    "                          N-th), into -o DIR/, skipping tables whose fit file is already\n"
-    "                          complete; writes DIR/summary-K-of-N.tsv (conifit merge joins them)\n";
+    "  --shard K/N             fit share K (1..N) of N of the tables, sorted by name (every\n"
+    "                          N-th), into -o DIR/, each fit file as soon as its table is done,\n"
+    "                          skipping tables already fitted with the same options; writes\n"
+    "                          DIR/summary-K-of-N.tsv, a failed table as a row (conifit merge\n"
+    "                          joins them)\n";
 
 /* The help's second part (C17 guarantees string literals of 4095 characters only). */
 static const char fit_help_series[] =

@@ -402,8 +402,9 @@ static const char merge_help[] =
     "usage: conifit merge SUMMARY.tsv... [-o FILE]\n"
     "Merges the summaries that `conifit fit --shard K/N -o DIR/` writes (DIR/summary-K-of-N.tsv)\n"
     "into the summary of the whole study, as one process (--shard 1/1) writes it: rows sorted by\n"
-    "table. Refused (exit 65) unless the files are the N shards of one split, each once, with\n"
-    "every table once.\n\n"
+    "table. Refused (exit 65, naming the file and what is wrong) unless the files are the N\n"
+    "shards of one study (one table count, study and options), each once, each holding its whole\n"
+    "share, and their rows the tables each shard takes; a FIFO or device is refused unread.\n\n"
     "  -o, --output FILE  the merged summary (atomically); default, or '-': standard output\n";
 
 /* Reads one shard's summary into s: a regular file (a FIFO or device would block or never end),

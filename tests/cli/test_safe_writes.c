@@ -1,8 +1,8 @@
 /*
 ** Writes that leave nothing wrong behind, through the program: targets that are not regular files
 ** are refused and left as they were; a standard output that cannot be written is exit 73 with a
-** message; a failed plot replaces nothing; a batch writes each finished table and nothing of a failed one; two outputs of one run
-** never share a name; a run stopped by SIGTERM removes its temporaries, and those of a run killed
+** message; a failed plot replaces nothing; a batch writes each finished table and nothing of a
+** failed one; two outputs of one run never share a name; a run stopped by SIGTERM removes its temporaries, and those of a run killed
 ** outright are hidden and swept by the next run.
 */
 #include <dirent.h>
