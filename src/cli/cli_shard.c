@@ -516,6 +516,12 @@ int cf_cli_merge(int argc, char **argv)
             rc = cf_cli_out_close(&o, &err) == CF_OK ? CF_EXIT_OK : cf_cli_fail(&err);
         }
     }
+    size_t failed = 0;
+    for (size_t i = 0; rc == CF_EXIT_OK && i < nrows; i++)
+        failed += strstr(rows[i]->line, "\tfailed: ") != NULL;
+    if (failed)
+        fprintf(stderr, "conifit merge: note: %zu of %zu tables failed (their rows say why); run "
+                        "their shards again to try them again\n", failed, nrows);
     free(rows);
     for (int i = 0; i < nread; i++)
         cf_summary_free(&sums[i]);

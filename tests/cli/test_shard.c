@@ -282,6 +282,7 @@ static void test_failed_table_is_a_row(void **state)
     snprintf(path, sizeof path, "%s/fail-merged.tsv", dir);
     assert_int_equal(tu_run(NULL, 0, err, sizeof err, "merge '%s'/summary-*-of-2.tsv -o '%s'", o,
                             path), 0);
+    assert_non_null(strstr(err, "1 of 4 tables failed"));
     char *text = tu_slurp(path);
     assert_non_null(text);
     char *row = strstr(text, "/five.csv\t");
