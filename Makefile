@@ -263,14 +263,15 @@ sanitize:
 # Fuzzing (tests/fuzz/README.md): one libFuzzer harness per parser, the library built again with
 # clang and ASan + UBSan; seed corpora from data/ and fits/. `make test` replays the seeds and the
 # saved crash inputs (tests/fuzz/regressions/NAME/) through the same harnesses, built with $(CC).
-FUZZERS      := table fitfile scene args
+FUZZERS      := table fitfile scene args merge unitsrow
 FUZZ_SECONDS ?= 60
 FUZZ_CC      ?= clang
 FUZZ_CFLAGS  := -std=c17 -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined \
                 -fno-sanitize-recover=all $(shell pkg-config --cflags $(PKGS) 2>/dev/null) \
                 $(SPARSE_CFLAGS)
 FUZZ_LIBS    := $(shell pkg-config --libs $(PKGS) 2>/dev/null) $(SPARSE_LIBS) -lm -lpthread
-FUZZ_OBJ     := $(LIB_SRC:src/%.c=build/fuzz/obj/%.o) build/fuzz/obj/cli/cli.o
+FUZZ_OBJ     := $(LIB_SRC:src/%.c=build/fuzz/obj/%.o) build/fuzz/obj/cli/cli.o \
+                build/fuzz/obj/cli/cli_summary.o
 REPLAYS      := $(FUZZERS:%=$(BUILD)/fuzz-replay/%)
 # (named here, after the test rule read its prerequisites: make expands them on reading)
 test: $(REPLAYS)
@@ -278,12 +279,14 @@ FUZZ_SEEDS_table   = data/*.csv
 FUZZ_SEEDS_fitfile = fits/*.json
 FUZZ_SEEDS_scene   = data/scenes/*.json
 FUZZ_SEEDS_args    = tests/fuzz/args
+FUZZ_SEEDS_merge   = tests/fuzz/merge
+FUZZ_SEEDS_unitsrow = tests/fuzz/unitsrow
 
 $(BUILD)/fuzz-replay/%: tests/fuzz/replay.c tests/fuzz/fuzz_%.c tests/fuzz/fuzz.h $(LIB_A) \
-                        $(BUILD)/obj/cli/cli.o
+                        $(BUILD)/obj/cli/cli.o $(BUILD)/obj/cli/cli_summary.o
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) $(CFLAGS) tests/fuzz/replay.c tests/fuzz/fuzz_$*.c \
-	  $(BUILD)/obj/cli/cli.o $(LIB_A) -o $@ $(LDFLAGS) $(LDLIBS)
+	  $(BUILD)/obj/cli/cli.o $(BUILD)/obj/cli/cli_summary.o $(LIB_A) -o $@ $(LDFLAGS) $(LDLIBS)
 
 .SECONDARY: $(FUZZ_OBJ)
 build/fuzz/obj/%.o: src/%.c
@@ -297,12 +300,13 @@ build/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz.h $(FUZZ_OBJ)
 # repository; a crash stops the run with its input in build/fuzz/crash-NAME-*: add it to
 # tests/fuzz/regressions/NAME/ once fixed.
 fuzz: check-deps $(FUZZERS:%=build/fuzz/fuzz_%)
-	@mkdir -p build/fuzz/corpus/table build/fuzz/corpus/fitfile build/fuzz/corpus/scene \
-	  build/fuzz/corpus/args
+	@mkdir -p $(FUZZERS:%=build/fuzz/corpus/%)
 	@cp $(FUZZ_SEEDS_table) build/fuzz/corpus/table/
 	@cp $(FUZZ_SEEDS_fitfile) build/fuzz/corpus/fitfile/
 	@cp $(FUZZ_SEEDS_scene) build/fuzz/corpus/scene/
 	@cp $(FUZZ_SEEDS_args)/* build/fuzz/corpus/args/
+	@cp $(FUZZ_SEEDS_merge)/* build/fuzz/corpus/merge/
+	@cp $(FUZZ_SEEDS_unitsrow)/* build/fuzz/corpus/unitsrow/
 	@for f in $(FUZZERS); do \
 	  echo "conifit: fuzzing $$f for $(FUZZ_SECONDS) s"; \
 	  build/fuzz/fuzz_$$f -max_total_time=$(FUZZ_SECONDS) -timeout=20 -rss_limit_mb=2048 -close_fd_mask=3 \

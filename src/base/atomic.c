@@ -19,43 +19,69 @@
 #include <unistd.h>
 
 /* The temporaries this process has open: copies of their names, so that a signal handler can
-** remove them. A full list only means that a temporary is not removed on a signal (it is still
-** hidden, and swept later). */
-#define LIVE_MAX 4096
-static char *_Atomic live[LIVE_MAX];
-static pthread_mutex_t live_lock = PTHREAD_MUTEX_INITIALIZER;
+** remove them. A list of chunks of entries that only grows (a new chunk when every entry is in
+** use) and whose entries are reused: it holds as many temporaries as are ever open at once, with
+** no bound, and a handler can walk it at any moment (chunks are never freed or moved, and each
+** entry's state is read atomically). An entry is FREE, CLAIMED (its name being written) or LIVE. */
+enum { LIVE_FREE, LIVE_CLAIMED, LIVE_IN_USE };
+#define LIVE_CHUNK 32
+typedef struct live_chunk {
+    struct live_chunk *_Atomic next;
+    struct {
+        atomic_int state;
+        char name[sizeof ((cf_atomic *)0)->tmp];
+    } entry[LIVE_CHUNK];
+} live_chunk;
+static live_chunk live_first;
+static pthread_mutex_t live_grow = PTHREAD_MUTEX_INITIALIZER; /* appends a chunk */
 
+/* Claims a free entry for name (a new chunk when none is free): 1 + its index, or 0 when memory
+** ran out (the temporary is then not removed on a signal: still hidden, and swept later). */
 static int live_add(const char *name)
 {
-    char *copy = strdup(name);
-    if (!copy)
+    const size_t n = strlen(name);
+    if (n >= sizeof live_first.entry[0].name)
         return 0;
-    pthread_mutex_lock(&live_lock);
-    for (int i = 0; i < LIVE_MAX; i++)
-        if (atomic_load(&live[i]) == NULL) {
-            atomic_store(&live[i], copy);
-            pthread_mutex_unlock(&live_lock);
-            return i + 1;
+    int index = 0;
+    for (live_chunk *c = &live_first; c;) {
+        for (int i = 0; i < LIVE_CHUNK; i++, index++) {
+            int expect = LIVE_FREE;
+            if (atomic_compare_exchange_strong(&c->entry[i].state, &expect, LIVE_CLAIMED)) {
+                memcpy(c->entry[i].name, name, n + 1);
+                atomic_store(&c->entry[i].state, LIVE_IN_USE);
+                return index + 1;
+            }
         }
-    pthread_mutex_unlock(&live_lock);
-    free(copy);
+        live_chunk *next = atomic_load(&c->next);
+        if (!next) {
+            pthread_mutex_lock(&live_grow);
+            next = atomic_load(&c->next);
+            if (!next && (next = calloc(1, sizeof *next)) != NULL)
+                atomic_store(&c->next, next);
+            pthread_mutex_unlock(&live_grow);
+        }
+        c = next;
+    }
     return 0;
 }
 
 static void live_remove(int slot)
 {
-    if (slot <= 0 || slot > LIVE_MAX)
+    if (slot <= 0)
         return;
-    free(atomic_exchange(&live[slot - 1], NULL));
+    live_chunk *c = &live_first;
+    for (int k = (slot - 1) / LIVE_CHUNK; k > 0 && c; k--)
+        c = atomic_load(&c->next);
+    if (c)
+        atomic_store(&c->entry[(slot - 1) % LIVE_CHUNK].state, LIVE_FREE);
 }
 
 void cf_atomic_remove_temporaries(void)
 {
-    for (int i = 0; i < LIVE_MAX; i++) {
-        char *name = atomic_load(&live[i]);
-        if (name)
-            unlink(name);
-    }
+    for (live_chunk *c = &live_first; c; c = atomic_load(&c->next))
+        for (int i = 0; i < LIVE_CHUNK; i++)
+            if (atomic_load(&c->entry[i].state) == LIVE_IN_USE)
+                unlink(c->entry[i].name);
 }
 
 int cf_same_file(const char *a, const char *b)

@@ -30,7 +30,8 @@ typedef struct fit_job {
     cf_visco_report vrep;        /* a time series (m.t not NULL) */
     char json_path[4096];        /* "" when not written */
     char plot_path[4096];
-    cf_atomic json_out, plot_out; /* both complete, put in place only when every job succeeded */
+    cf_atomic json_out, plot_out; /* both complete, put in place as soon as the job succeeds */
+    const cf_shard *shard;       /* --shard: its fit file is stamped with the study's options */
     char *text;
     const char *const *inputs;   /* every input of the run: never an output */
     cf_error err;
@@ -81,8 +82,37 @@ static void show_progress(void *ctx, const char *table, const char *what)
         cf_cli_printf_safe(stderr, "conifit: %s: %s...\n", table, what);
 }
 
-/* Fits one loaded table and writes its outputs. */
+static void fit_one(fit_job *j);
+
+/* Puts a job's outputs in place, the plot first: a fit file in place means a finished table
+** (what a resumed shard looks for). On failure nothing of the job's is left but what was in
+** place already. */
+static void put_in_place(fit_job *j)
+{
+    if (j->st == CF_OK && j->shard && j->json_path[0])
+        j->st = cf_cli_shard_stamp(j->shard, j->file, &j->json_out, &j->err);
+    if (j->st == CF_OK && j->plot_path[0])
+        j->st = cf_atomic_commit(&j->plot_out, &j->err);
+    if (j->st == CF_OK && j->json_path[0])
+        j->st = cf_atomic_commit(&j->json_out, &j->err);
+    cf_atomic_abort(&j->json_out);
+    cf_atomic_abort(&j->plot_out);
+    if (j->st != CF_OK)
+        j->json_path[0] = j->plot_path[0] = '\0'; /* not written (by this run) */
+}
+
+/* Fits one loaded table and writes its outputs as soon as they are complete, so that a batch
+** stopped part way keeps every table it finished. */
 static void run_job(fit_job *j)
+{
+    if (j->st != CF_OK) /* its table could not be read */
+        return;
+    fit_one(j);
+    put_in_place(j);
+}
+
+/* Fits one table and prepares its outputs as complete temporaries. */
+static void fit_one(fit_job *j)
 {
     const fit_args *a = j->args;
     if (j->m.t) { /* a time series: the viscoelastic fit */
@@ -98,7 +128,7 @@ static void run_job(fit_job *j)
     j->st = cf_pipeline_fit(&j->m, &a->popt, &j->rep, &j->err);
     if (j->st != CF_OK)
         return;
-    /* both outputs as temporaries; cf_cli_fit puts them in place when every table succeeded */
+    /* both outputs as temporaries, put in place by run_job */
     j->st = cf_pipeline_prepare(&j->rep, j->json_path[0] ? j->json_path : NULL,
                                 j->plot_path[0] ? j->plot_path : NULL, j->inputs, &j->json_out,
                                 &j->plot_out, &j->err);
@@ -195,20 +225,20 @@ static int run_joint(const fit_args *a, fit_job *jobs, const char *const *inputs
     return rc;
 }
 
-/* Reads every table (a bad one stops the run before anything is written), the scene, and the
-** elastic fit a series is held to, and checks the options against what was read. -1 to go on,
-** else an exit status. */
+/* Reads every table (one that cannot be read is a failed table of the batch, as one that
+** cannot be fitted: the others go on), the scene, and the elastic fit a series is held to, and
+** checks the options against the tables read. -1 to go on, else an exit status. */
 static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
 {
-    int rc = -1;
-    for (int i = 0; i < a->nfiles && rc < 0; i++) {
+    int rc = -1, nread = 0;
+    for (int i = 0; i < a->nfiles; i++) {
         jobs[i].args = a;
         jobs[i].file = a->files[i];
-        cf_error err = {0};
-        if (cf_measure_load(a->files[i], &a->mopt, &jobs[i].m, &err) != CF_OK)
-            rc = cf_cli_fail(&err);
-        else
+        jobs[i].st = cf_measure_load(a->files[i], &a->mopt, &jobs[i].m, &jobs[i].err);
+        if (jobs[i].st == CF_OK) {
             cf_cli_table_notes(&jobs[i].m);
+            nread++;
+        }
     }
     if (rc < 0 && a->scene) {
         cf_error err = {0};
@@ -217,10 +247,10 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
     }
     *nseries = 0;
     for (int i = 0; i < a->nfiles && rc < 0; i++)
-        *nseries += jobs[i].m.t != NULL;
+        *nseries += jobs[i].st == CF_OK && jobs[i].m.t != NULL;
     /* as the series' options in a batch with stress-strain tables, these apply to the tables
-    ** they concern; refused when no table is one */
-    if (rc < 0 && *nseries == a->nfiles &&
+    ** they concern; refused when every table read is a series */
+    if (rc < 0 && *nseries > 0 && *nseries == nread &&
         (a->popt.validate || a->popt.target == CF_TARGET_LATTICE))
         rc = cf_cli_usage_error("fit", "--validate and --target lattice apply to stress-strain "
                                        "tables; a time series is fitted through the lattice "
@@ -229,7 +259,7 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
     ** a table would be the law at a uniaxial strain equal to the table's */
     for (int i = 0; i < a->nfiles && rc < 0 && a->popt.target == CF_TARGET_SPRING && !a->joint;
          i++)
-        if (!jobs[i].m.t && !cf_table_is_force(&jobs[i].m) &&
+        if (jobs[i].st == CF_OK && !jobs[i].m.t && !cf_table_is_force(&jobs[i].m) &&
             jobs[i].m.mode != CF_MODE_UNIAXIAL)
             rc = cf_cli_usage_error("fit", "--target spring: the table's mode is %s, which a "
                                            "single spring has no curve of; fit it through the "
@@ -253,7 +283,7 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
             rc = cf_cli_usage_error("fit", "--law %s places its spring in closed form and holds "
                                            "no parameter fixed (drop --fix)", lname);
     }
-    if (rc < 0 && *nseries == 0 && a->series_only)
+    if (rc < 0 && *nseries == 0 && nread > 0 && a->series_only)
         rc = cf_cli_usage_error("fit", "--branches, --dashpot, --relaxation, --elastic and "
                                        "--max-evaluations apply to time "
                                        "series "
@@ -280,28 +310,6 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
 static void run_job_k(void *ctx, int k)
 {
     run_job(&((fit_job *)ctx)[k]);
-}
-
-/* All outputs or none: they go in place only when every table succeeded. Returns 1 when none
-** was put in place because a job failed. */
-static int commit_outputs(const fit_args *a, fit_job *jobs)
-{
-    int failed = 0;
-    for (int i = 0; i < a->nfiles; i++)
-        failed |= jobs[i].st != CF_OK;
-    for (int i = 0; i < a->nfiles && !failed; i++) {
-        fit_job *j = &jobs[i];
-        if ((j->json_path[0] && (j->st = cf_atomic_commit(&j->json_out, &j->err)) != CF_OK) ||
-            (j->plot_path[0] && (j->st = cf_atomic_commit(&j->plot_out, &j->err)) != CF_OK))
-            failed = 1;
-    }
-    for (int i = 0; i < a->nfiles; i++) {
-        cf_atomic_abort(&jobs[i].json_out);
-        cf_atomic_abort(&jobs[i].plot_out);
-        if (failed && jobs[i].st == CF_OK)
-            jobs[i].json_path[0] = jobs[i].plot_path[0] = '\0'; /* not written */
-    }
-    return failed;
 }
 
 /* What one job prints: its error, or the fit file on standard output (-o -), its report, where
@@ -413,13 +421,14 @@ static void print_summary(const fit_args *a, const fit_job *jobs)
         summary_row(a, &jobs[i], wname);
 }
 
-/* Fits the jobs, puts their outputs in place (all or none), prints each report and the summary.
-** Returns the exit status: the first failure's, else 0. */
+/* Fits the jobs (each puts its outputs in place when it succeeds), prints each report and the
+** summary. Returns the exit status: the first failure's, else 0. */
 static int fit_all(const fit_args *a, fit_job *jobs)
 {
     cf_pool_run(a->nfiles, a->jobs, run_job_k, jobs);
-    const int failed = commit_outputs(a, jobs);
-    int rc = CF_EXIT_OK;
+    int rc = CF_EXIT_OK, failed = 0;
+    for (int i = 0; i < a->nfiles; i++)
+        failed += jobs[i].st != CF_OK;
     for (int i = 0; i < a->nfiles; i++) {
         const int e = report_job(a, &jobs[i]);
         if (jobs[i].st != CF_OK) /* the first failed table's status stands */
@@ -427,9 +436,9 @@ static int fit_all(const fit_args *a, fit_job *jobs)
         else if (e != CF_EXIT_OK) /* a fit file that standard output refused */
             rc = e;
     }
-    if (failed && (a->out || a->plot))
-        cf_cli_printf_safe(stderr, "conifit: no output file written (outputs are written only when every "
-                        "table succeeds)\n");
+    if (failed && a->nfiles > 1 && (a->out || a->plot))
+        cf_cli_printf_safe(stderr, "conifit: %d of %d tables failed and have no output file; "
+                           "the others' are written\n", failed, a->nfiles);
     if (a->nfiles > 1 && !a->quiet)
         print_summary(a, jobs);
     return rc;
@@ -446,9 +455,11 @@ int cf_cli_fit(int argc, char **argv)
         rc = cf_cli_fit_parse(argc, argv, &a);
     if (rc < 0 && sh.given)
         rc = a.joint ? cf_cli_usage_error("fit", "--shard fits tables one by one, not --joint")
-                     : cf_cli_shard_select(&sh, a.out, &a.files, &a.nfiles);
+                     : cf_cli_shard_select(&sh, a.out, a.options ? a.options : "-", &a.files,
+                                           &a.nfiles);
     if (rc >= 0) {
         cf_cli_shard_free(&sh);
+        free(a.options);
         return rc;
     }
     if (sh.given)
@@ -476,19 +487,33 @@ int cf_cli_fit(int argc, char **argv)
     inputs[n] = a.elastic;
     if (!a.joint)
         rc = plan_outputs(&a, jobs, inputs);
+    for (int i = 0; i < a.nfiles; i++)
+        jobs[i].shard = sh.given ? &sh : NULL;
     int nseries = 0;
+    if (rc < 0 && a.nfiles == 0) /* a shard with nothing (left) to fit: its summary only */
+        rc = CF_EXIT_OK;
     if (rc < 0)
         rc = load_inputs(&a, jobs, &nseries);
+    for (int i = 0; i < a.nfiles && rc < 0 && a.joint; i++)
+        if (jobs[i].st != CF_OK) /* one lattice for every table: each must be read */
+            rc = cf_cli_fail(&jobs[i].err);
     if (a.progress)
         a.popt.progress = show_progress;
     if (rc < 0 && a.joint)
         rc = nseries ? cf_cli_usage_error("fit", "--joint fits stress-strain tables; a time "
                                                  "series is fitted on its own")
                      : run_joint(&a, jobs, inputs);
+    int fitted = rc < 0;
     if (rc < 0)
         rc = fit_all(&a, jobs);
-    if (rc == CF_EXIT_OK && sh.given)
-        rc = cf_cli_shard_summary(&sh, a.out);
+    if (sh.given && (fitted || rc == CF_EXIT_OK)) {
+        /* a failed table is a row of the summary, written all the same */
+        for (int i = 0; i < a.nfiles; i++)
+            if (jobs[i].st != CF_OK)
+                cf_cli_shard_failed(&sh, jobs[i].file, jobs[i].err.msg);
+        const int src = cf_cli_shard_summary(&sh, a.out);
+        rc = rc == CF_EXIT_OK ? src : rc;
+    }
     for (int i = 0; i < a.nfiles; i++) {
         cf_table_free(&jobs[i].m);
         free(jobs[i].text);
@@ -500,5 +525,6 @@ int cf_cli_fit(int argc, char **argv)
     if (sh.given)
         free((void *)a.files); /* the shard's list, cf_cli_shard_select's */
     cf_cli_shard_free(&sh);
+    free(a.options);
     return rc;
 }

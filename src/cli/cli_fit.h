@@ -27,6 +27,8 @@ typedef struct fit_args {
     int series_only;             /* an option for time series only was given */
     int joint;                   /* --joint: one lattice for every table */
     int calibration_given;       /* --calibration was given */
+    char *options;               /* the options that change a fit, escaped (cli_summary.h), by
+                                 ** their long names, in order; NULL for none (malloc'd) */
 } fit_args;
 
 /* Parses fit's command line into a: the options, the operands (the tables) and the checks across

@@ -3,10 +3,12 @@
 ** them.
 */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "cli/cli.h"
 #include "cli/cli_fit.h"
+#include "cli/cli_summary.h"
 #include "conifit/calibration.h"
 #include "conifit/fit.h"
 #include "conifit/spring.h"
@@ -83,9 +85,11 @@ static const char fit_help[] =
     "                          Cauchy stress is converted to nominal under incompressibility\n"
     "  --strain-measure M      engineering | log | stretch (default: '# strain:' or the name)\n"
     "  -j, --jobs N            fit N tables at a time (default 1)\n"
-    "  --shard K/N             fit share K (1..N) of N of the tables, sorted by path (every\n"
-    "                          N-th), into -o DIR/, skipping tables whose fit file is already\n"
-    "                          complete; writes DIR/summary-K-of-N.tsv (conifit merge joins them)\n";
+    "  --shard K/N             fit share K (1..N) of N of the tables, sorted by name (every\n"
+    "                          N-th), into -o DIR/, each fit file as soon as its table is done,\n"
+    "                          skipping tables already fitted with the same options; writes\n"
+    "                          DIR/summary-K-of-N.tsv, a failed table as a row (conifit merge\n"
+    "                          joins them)\n";
 
 /* The help's second part (C17 guarantees string literals of 4095 characters only). */
 static const char fit_help_series[] =
@@ -287,7 +291,7 @@ static int columns_option(const char *optval, cf_measure_options *mo)
 
 /* One option of fit: 0 to go on, else an exit status. Long only because fit has many options:
 ** one case per option, each a few lines of checking. */
-static int fit_option(void *ctx, int c, const char *optval)
+static int fit_option_apply(void *ctx, int c, const char *optval)
 {
     fit_args *a = ctx;
     cf_error err = {0};
@@ -482,6 +486,48 @@ static int fit_option(void *ctx, int c, const char *optval)
         return 0;
     default: return cf_cli_usage_error("fit", "unexpected option");
     }
+}
+
+/* Appends the escaped word w (n bytes) to a->options, a blank before it unless first. */
+static int record_word(fit_args *a, const char *w, size_t n)
+{
+    char *e = cf_summary_escape(w, n, 1);
+    size_t have = a->options ? strlen(a->options) : 0;
+    char *grown = e ? realloc(a->options, have + strlen(e) + 2) : NULL;
+    if (!grown) {
+        free(e);
+        return -1;
+    }
+    snprintf(grown + have, strlen(e) + 2, "%s%s", have ? " " : "", e);
+    a->options = grown;
+    free(e);
+    return 0;
+}
+
+/* Applies one option and records it in a->options by its long name, whatever form it was
+** given in (short, abbreviated, --name=value), for the options of a sharded study; -j, which
+** changes no fit, is not recorded (nor -o, -q, --progress, which never reach here). */
+static int fit_option(void *ctx, int c, const char *optval)
+{
+    fit_args *a = ctx;
+    const char *scene = a->scene;
+    int rc = fit_option_apply(ctx, c, optval);
+    if (rc != 0 || c == 'j')
+        return rc;
+    const char *name = NULL;
+    for (const struct option *o = fit_options; o->name && !name; o++)
+        if (o->val == c)
+            name = o->name;
+    if (!optval && (c == OPT_VALIDATE || c == OPT_THROUGH) && a->scene != scene)
+        optval = a->scene; /* --validate SCENE.json */
+    char flag[64];
+    snprintf(flag, sizeof flag, "--%s", name ? name : "?");
+    if (record_word(a, flag, strlen(flag)) != 0 ||
+        (optval && record_word(a, optval, strlen(optval)) != 0)) {
+        fprintf(stderr, "conifit: out of memory\n");
+        return CF_EXIT_SOFTWARE;
+    }
+    return 0;
 }
 
 /* The operands and the checks across options. -1 to go on, else an exit status. */

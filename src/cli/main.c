@@ -105,10 +105,14 @@ int main(int argc, char **argv)
     ** status, never by aborting. */
     setlocale(LC_ALL, "C");
     gsl_set_error_handler_off();
-    /* SIGPIPE (a reader of standard output went away) ends the run as usual, but cleanly */
+    /* SIGPIPE (a reader of standard output went away) ends the run as usual, but cleanly. A
+    ** signal the parent set to be ignored (nohup: SIGHUP; a shell's background job: SIGINT) stays
+    ** ignored: the run was protected from it on purpose. */
     static const int fatal[] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE};
     for (size_t i = 0; i < sizeof fatal / sizeof fatal[0]; i++) {
-        struct sigaction sa;
+        struct sigaction sa, old;
+        if (sigaction(fatal[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN)
+            continue;
         memset(&sa, 0, sizeof sa);
         sa.sa_handler = on_signal;
         sigemptyset(&sa.sa_mask);

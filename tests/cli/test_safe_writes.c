@@ -1,8 +1,8 @@
 /*
 ** Writes that leave nothing wrong behind, through the program: targets that are not regular files
 ** are refused and left as they were; a standard output that cannot be written is exit 73 with a
-** message; a failed plot replaces nothing; a batch writes all or nothing; two outputs of one run
-** never share a name; a run stopped by SIGTERM removes its temporaries, and those of a run killed
+** message; a failed plot replaces nothing; a batch writes each finished table and nothing of a
+** failed one; two outputs of one run never share a name; a run stopped by SIGTERM removes its temporaries, and those of a run killed
 ** outright are hidden and swept by the next run.
 */
 #include <dirent.h>
@@ -185,10 +185,11 @@ static void failed_plot_replaces_nothing(void **state)
     remove(keep);
 }
 
-/* A batch writes all of its files or none: a bad table stops it before any fit; a failure of one
-** table's outputs (here its plot) leaves the other tables' files unwritten too. Two tables with
-** one base name are refused before anything runs. */
-static void batches_write_all_or_nothing(void **state)
+/* A batch writes each table's files as soon as that table is done, and none of a table that
+** failed: a bad table fails alone (exit 65, the good table's files written); a table whose plot
+** fails (gnuplot missing) has neither its plot nor its fit file. Two tables with one base name are
+** refused before anything runs. */
+static void batches_write_each_finished_table(void **state)
 {
     (void)state;
     char sub[512];
@@ -198,9 +199,17 @@ static void batches_write_all_or_nothing(void **state)
     int st = tu_run(out, sizeof out, errb, sizeof errb,
                     "fit data/telescoping.csv %s/bad.csv -o %s/out/ --plot %s/out/", dir, dir, dir);
     assert_int_equal(st, 65);
-    assert_false(exists("out/telescoping.json"));
-    assert_false(exists("out/telescoping.png"));
-    /* every table fits, but plotting fails: nothing is written */
+    assert_non_null(strstr(errb, "bad.csv:3"));
+    assert_non_null(strstr(errb, "1 of 2 tables failed"));
+    assert_true(exists("out/telescoping.json"));
+    assert_true(exists("out/telescoping.png"));
+    assert_false(exists("out/bad.json"));
+    assert_false(exists("out/bad.png"));
+    assert_int_equal(temporaries(), 0);
+    char rm[600];
+    snprintf(rm, sizeof rm, "rm -f %s/out/*", dir);
+    assert_int_equal(system(rm), 0);
+    /* every table fits, but plotting fails: neither file of a table is written */
     char cmd[1024];
     snprintf(cmd, sizeof cmd,
              "CONIFIT_GNUPLOT=/bin/false %s fit data/telescoping.csv data/non_telescoping.csv "
@@ -208,9 +217,10 @@ static void batches_write_all_or_nothing(void **state)
              tu_conifit(), dir, dir, dir);
     st = system(cmd);
     assert_int_equal(WEXITSTATUS(st), 70);
-    assert_non_null(strstr(read_text("err"), "no output file written"));
+    assert_non_null(strstr(read_text("err"), "2 of 2 tables failed"));
     assert_false(exists("out/telescoping.json"));
     assert_false(exists("out/non_telescoping.json"));
+    assert_int_equal(temporaries(), 0);
     /* duplicate base names */
     char sub2[512];
     path_of(sub2, sizeof sub2, "other");
@@ -341,7 +351,7 @@ int main(void)
         cmocka_unit_test(non_regular_targets_are_refused),
         cmocka_unit_test(stdout_errors_are_exit_73),
         cmocka_unit_test(failed_plot_replaces_nothing),
-        cmocka_unit_test(batches_write_all_or_nothing),
+        cmocka_unit_test(batches_write_each_finished_table),
         cmocka_unit_test(signals_leave_nothing_visible),
         cmocka_unit_test(a_scenes_fit_file_is_never_an_output),
     };

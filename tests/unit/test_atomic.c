@@ -1,8 +1,9 @@
 /*
 ** Tests of the atomic output files (src/base/atomic.c): the permissions of what they write (the
 ** umask for a new file, no special bits on a replaced one), write-protected targets refused and
-** left alone, and the sweep of dead runs' temporaries, which judges only temporaries of its own
-** PID space.
+** left alone, the sweep of dead runs' temporaries, which judges only temporaries of its own
+** PID space, and the removal on a signal of every temporary open, however many (more than the
+** 4096 an earlier fixed list held).
 */
 #include "testutil.h"
 
@@ -157,6 +158,72 @@ static void sweep_removes_only_dead_temporaries_of_its_own_pid_space(void **stat
     assert_int_equal(rmdir(dir), 0);
 }
 
+/* Files in dir whose name starts with a dot (temporaries). */
+static int hidden_in(const char *dir)
+{
+    DIR *d = opendir(dir);
+    assert_non_null(d);
+    int n = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL)
+        n += e->d_name[0] == '.' && strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
+    closedir(d);
+    return n;
+}
+
+/* 5000 temporaries open at once (finished, so no descriptor stays open), in 50 folders: the
+** signal handler's cf_atomic_remove_temporaries removes every one; the entries are then reused,
+** and an aborted handle frees its own. */
+static void every_open_temporary_is_removed_on_a_signal(void **state)
+{
+    (void)state;
+    enum { NDIR = 50, PER = 100 };
+    char root[] = "/tmp/conifit-atomic-XXXXXX", dir[NDIR][320], path[400];
+    assert_non_null(mkdtemp(root));
+    static cf_atomic a[NDIR * PER];
+    cf_error err = {0};
+    for (int d = 0; d < NDIR; d++) {
+        snprintf(dir[d], sizeof dir[d], "%s/d%02d", root, d);
+        assert_int_equal(mkdir(dir[d], 0700), 0);
+        for (int i = 0; i < PER; i++) {
+            snprintf(path, sizeof path, "%.300s/f%03d.json", dir[d], i);
+            assert_int_equal(cf_atomic_open(&a[d * PER + i], path, NULL, &err), CF_OK);
+            fputs("{}\n", a[d * PER + i].fp);
+            assert_int_equal(cf_atomic_finish(&a[d * PER + i], &err), CF_OK);
+        }
+    }
+    int left = 0;
+    for (int d = 0; d < NDIR; d++)
+        left += hidden_in(dir[d]);
+    assert_int_equal(left, NDIR * PER);
+    cf_atomic_remove_temporaries();
+    left = 0;
+    for (int d = 0; d < NDIR; d++)
+        left += hidden_in(dir[d]);
+    assert_int_equal(left, 0);
+    for (int k = 0; k < NDIR * PER; k++) {
+        a[k].tmp[0] = '\0'; /* removed already */
+        cf_atomic_abort(&a[k]);
+    }
+    /* the entries are free again: a new temporary is removed as well, a committed one is not */
+    snprintf(path, sizeof path, "%.300s/again.json", dir[0]);
+    cf_atomic b, c;
+    assert_int_equal(cf_atomic_open(&b, path, NULL, &err), CF_OK);
+    assert_int_equal(cf_atomic_finish(&b, &err), CF_OK);
+    snprintf(path, sizeof path, "%.300s/kept.json", dir[0]);
+    assert_int_equal(cf_atomic_open(&c, path, NULL, &err), CF_OK);
+    assert_int_equal(cf_atomic_commit(&c, &err), CF_OK);
+    assert_int_equal(b.slot, 1);
+    cf_atomic_remove_temporaries();
+    assert_int_equal(hidden_in(dir[0]), 0);
+    assert_int_equal(access(path, F_OK), 0);
+    b.tmp[0] = '\0';
+    cf_atomic_abort(&b);
+    char cmd[400];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", root);
+    assert_int_equal(system(cmd), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -164,6 +231,7 @@ int main(void)
         cmocka_unit_test(replaced_file_keeps_its_permissions_without_special_bits),
         cmocka_unit_test(write_protected_target_is_refused_and_kept),
         cmocka_unit_test(sweep_removes_only_dead_temporaries_of_its_own_pid_space),
+        cmocka_unit_test(every_open_temporary_is_removed_on_a_signal),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
