@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 
 #include "conifit/cell.h"
+#include "conifit/fitfile.h"
 
 static char out[1 << 16], errb[1 << 12];
 
@@ -59,6 +60,82 @@ static void bad_input_exits_2_naming_the_option(void **state)
     }
 }
 
+static void write_text(const char *path, const char *text);
+static void last_row(const char *csv, double *e, double *s, double *lat);
+
+/* A scene naming the brain's pair-and-kappa fit ("spring": {"fit": PATH}) runs the whole element:
+** its static uniaxial runs in tension and in compression equal the homogenised cell of the pair
+** and kappa the fit file holds (cf_fitfile_load_element); the scene's own 'spring_extension' or
+** volume keys beside such a fit, or a body, are refused (65) naming the key. */
+static void fit_scene_is_the_element(const char *dir, const char *json)
+{
+    cf_fitted_spring fs;
+    cf_error err = {0};
+    assert_int_equal(cf_fitfile_load_element(json, NULL, &fs, &err), CF_OK);
+    assert_true(fs.has_extension);
+    assert_true(fs.volume_modulus_MPa > 0);
+    cf_law lc, le;
+    assert_int_equal(cf_law_init(&lc, &fs.params, NULL), CF_OK);
+    assert_int_equal(cf_law_init(&le, &fs.extension, NULL), CF_OK);
+    assert_int_equal(cf_law_pair(&lc, &le, NULL), CF_OK);
+    double w[3];
+    assert_int_equal(cf_calibration_weights(CF_CAL_ISOTROPIC, w, NULL), CF_OK);
+    cf_cell c;
+    assert_int_equal(cf_cell_init(&c, &lc, CF_LAW_CLOSED, w, NULL), CF_OK);
+    c.volume_modulus_MPa = fs.volume_modulus_MPa;
+    char scene[300], csv[300], text[1024];
+    snprintf(scene, sizeof scene, "%s/fit_scene.json", dir);
+    snprintf(csv, sizeof csv, "%s/fit_scene.csv", dir);
+    const double strain[2] = {0.1, -0.1}; /* compression positive, then tension */
+    double stress[2];
+    for (int i = 0; i < 2; i++) {
+        snprintf(text, sizeof text,
+                 "{\"spring\": {\"fit\": \"%s\"}, \"lattice\": {\"nx\": 2, \"ny\": 2, "
+                 "\"nz\": 2}, \"protocol\": {\"kind\": \"ramp\", \"to_strain\": %g, "
+                 "\"duration_s\": 1}, \"samples_per_segment\": 4}",
+                 json, strain[i]);
+        write_text(scene, text);
+        int rc = tu_run(out, sizeof out, errb, sizeof errb, "simulate %s -o %s", scene, csv);
+        if (rc != 0)
+            fail_msg("simulate of the fit's scene exited %d: %s", rc, errb);
+        assert_non_null(strstr(out, "element: double-acting"));
+        double e, s, lat;
+        last_row(csv, &e, &s, &lat);
+        assert_close(e, strain[i], 1e-9);
+        cf_cell_state st;
+        assert_int_equal(cf_cell_mode(&c, CF_MODE_UNIAXIAL, -e, NULL, &st, NULL), CF_OK);
+        assert_close(-st.stress_MPa * 1e3, s, 1e-7 * fabs(s));
+        assert_close(st.free_stretch, lat, 1e-9);
+        stress[i] = s;
+        remove(csv);
+    }
+    /* the pair answers compression and tension differently (the compression spring alone would
+    ** not: its law is odd) */
+    assert_true(fabs(stress[0] + stress[1]) > 0.05 * fabs(stress[0]));
+    static const struct {
+        const char *extra, *says;
+    } bad[] = {
+        {", \"spring_extension\": " "{\"params\": {\"D1_mm\": 3, \"D2_mm\": 14, \"n\": 3, "
+         "\"d_mm\": 1, \"G_MPa\": 300, \"H_mm\": 10}}", "spring_extension"},
+        {", \"lattice\": {\"volume_modulus_MPa\": 0.01}", "volume_modulus_MPa"},
+        {", \"lattice\": {\"poisson_ratio\": 0.4}", "poisson_ratio"},
+        {", \"body\": {\"mesh\": \"none.msh\", \"unit_mm\": 1}", "body"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        snprintf(text, sizeof text,
+                 "{\"spring\": {\"fit\": \"%s\"}%s, \"protocol\": {\"kind\": \"ramp\", "
+                 "\"to_strain\": 0.01, \"duration_s\": 1}}",
+                 json, bad[i].extra);
+        write_text(scene, text);
+        int rc = tu_run(out, sizeof out, errb, sizeof errb, "simulate %s -o %s", scene, csv);
+        if (rc != 65 || !strstr(errb, bad[i].says))
+            fail_msg("fit scene %zu: exit %d, '%s' (expected 65 naming '%s')", i, rc, errb,
+                     bad[i].says);
+        assert_false(exists(csv));
+    }
+    remove(scene);
+}
+
 /* The brain cortex, --joint --law auto --volume fit: the fit file holds the pair and kappa, and
 ** export refuses it with 65 naming the key, writing nothing. */
 static void brain_pair_fit_file_and_export(void **state)
@@ -84,6 +161,7 @@ static void brain_pair_fit_file_and_export(void **state)
     assert_non_null(strstr(file, "\"params_extension\""));
     assert_non_null(strstr(file, "\"volume_modulus_MPa\""));
     free(file);
+    fit_scene_is_the_element(dir, json);
     rc = tu_run(out, sizeof out, errb, sizeof errb, "export %s --format csv -o %s/t.csv", json,
                 dir);
     assert_int_equal(rc, 65);

@@ -76,9 +76,8 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
 
 /* cf_fitfile_load refuses a fit whose element is double-acting ("params_extension") or whose
 ** lattice has a volume term ("lattice.volume_modulus_MPa" > 0) with CF_E_DATA naming the key:
-** export and a scene's 'spring.fit' read one spring per element and no volume term yet, and must
-** not run such a fit as its compression spring alone (a scene gives both by its own keys,
-** scene.h). cf_fitfile_load_element reads
+** readers of one spring per element must not run such a fit as its compression spring alone.
+** cf_fitfile_load_element (a scene's 'spring.fit', export) reads
 ** them (has_extension, extension, volume_modulus_MPa), checking the extension spring as params
 ** (every key, a law it makes, the compression spring's H). */
 cf_status cf_fitfile_load_element(const char *path, const char *type_name,
