@@ -29,6 +29,9 @@
 **     "params": { ... as above ... },
 **     "derived": { ... as above ... }, "units": { ... },
 **     "provenance": { "fit_file", "data_file", "rmse", "rmse_unit", "fit_version" } }
+** and, for a double-acting element, "params_extension" and "derived_extension" (its extension
+** spring) and, for a lattice with a volume term, "lattice": { "volume_modulus_MPa" }, the keys of
+** the fit file, which cf_fitfile_load_element reads back.
 */
 #ifndef CF_FITFILE_H
 #define CF_FITFILE_H
