@@ -2,10 +2,9 @@
 ** Section "the double-acting element and the volume term" (issue 35): what the pair and the
 ** volume term cost in the lattice's two force kernels, against today's odd law on the same
 ** lattice, and the joint fit's CPU time on the three brain cortex tables.
-**   - the explicit step (cf_lattice_stepper_forces + cf_lattice_stepper_advance, one core): the
-**     odd law through the vector lanes and the step's polynomial, the pair through the scalar law
-**     (lattice_step.c: not yet in the lanes). Explicit runs refuse a volume term (msm_dynamic.c),
-**     so it has no row here;
+**   - the explicit step (cf_lattice_stepper_forces, the volume term's forces when there is one,
+**     cf_lattice_stepper_advance; one core): the odd law through the vector lanes and the step's
+**     polynomial, the pair through the scalar law (lattice_step.c: not yet in the lanes);
 **   - the statics force kernel (cf_lattice_forces, which every Newton iteration of a static run
 **     calls): odd law, pair, and each with the volume term (every cell's J from its eight nodes);
 **   - `conifit fit` of the brain cortex tension, compression and shear tables with --joint --law
@@ -41,8 +40,10 @@ static void shake(cf_lattice *lat)
         }
 }
 
-/* One sample: ns per spring per explicit step over about sample_s (h = 0: the state stays). */
-static double sample_step(cf_lattice_stepper *st, double *const v[3], size_t ns, double sample_s)
+/* One sample: ns per spring per explicit step over about sample_s (h = 0: the state stays), the
+** volume term's forces added as the explicit run adds them (msm_dynamic.c). */
+static double sample_step(cf_lattice_stepper *st, cf_lattice *lat, double *const v[3], size_t ns,
+                          double sample_s)
 {
     size_t steps = 0;
     const double t0 = bench_now();
@@ -50,6 +51,7 @@ static double sample_step(cf_lattice_stepper *st, double *const v[3], size_t ns,
     do {
         for (int k = 0; k < 8; k++, steps++) {
             bench_sink += cf_lattice_stepper_forces(st);
+            cf_lattice_add_volume_forces(lat);
             cf_lattice_stepper_advance(st, 0.0, v[0], v[1], v[2]);
         }
     } while ((now = bench_now()) - t0 < sample_s);
@@ -130,8 +132,8 @@ void bench_section_pair(bench_ctx *ctx)
     /* lattice 2 l + k: law l, volume term k; samples taken round-robin over the six variants (two
     ** steps, four force kernels), so that a change of the machine's load falls on all alike */
     cf_lattice lat[4];
-    cf_lattice_stepper stp[2];
-    int have[4] = {0}, have_st[2] = {0};
+    cf_lattice_stepper stp[4];
+    int have[4] = {0}, have_st[4] = {0};
     size_t ns = 0;
     for (int l = 0; l < 2; l++)
         for (int k = 0; k < 2; k++) {
@@ -145,31 +147,30 @@ void bench_section_pair(bench_ctx *ctx)
                 shake(&lat[2 * l + k]);
             }
         }
-    for (int l = 0; l < 2; l++) {
-        have_st[l] = have[2 * l] && cf_lattice_stepper_init(&stp[l], &lat[2 * l], NULL, NULL) ==
-                                        CF_OK;
-        if (have_st[l])
-            stp[l].threads = 0; /* one core */
+    for (int j = 0; j < 4; j++) {
+        have_st[j] = have[j] && cf_lattice_stepper_init(&stp[j], &lat[j], NULL, NULL) == CF_OK;
+        if (have_st[j])
+            stp[j].threads = 0; /* one core */
     }
     double *v[3] = {calloc(8 * ns + 8, sizeof(double)), calloc(8 * ns + 8, sizeof(double)),
                     calloc(8 * ns + 8, sizeof(double))}; /* more than the nodes */
-    double ts[2][16], tf[4][16];
+    double ts[4][16], tf[4][16];
     for (int q = 0; q < repeats && v[0] && v[1] && v[2]; q++) {
-        for (int l = 0; l < 2; l++)
-            ts[l][q] = have_st[l] ? sample_step(&stp[l], v, ns, sample_s) : NAN;
+        for (int j = 0; j < 4; j++)
+            ts[j][q] = have_st[j] ? sample_step(&stp[j], &lat[j], v, ns, sample_s) : NAN;
         for (int j = 0; j < 4; j++)
             tf[j][q] = have[j] ? sample_forces(&lat[j], sample_s) : NAN;
     }
-    bench_stats step[2], forces[2][2];
-    for (int l = 0; l < 2; l++) {
-        step[l] = bench_summarise(ts[l], repeats);
-        for (int k = 0; k < 2; k++)
-            forces[l][k] = bench_summarise(tf[2 * l + k], repeats);
-    }
-    free(v[0]), free(v[1]), free(v[2]);
+    bench_stats step[2][2], forces[2][2];
     for (int l = 0; l < 2; l++)
-        if (have_st[l])
-            cf_lattice_stepper_free(&stp[l]);
+        for (int k = 0; k < 2; k++) {
+            step[l][k] = bench_summarise(ts[2 * l + k], repeats);
+            forces[l][k] = bench_summarise(tf[2 * l + k], repeats);
+        }
+    free(v[0]), free(v[1]), free(v[2]);
+    for (int j = 0; j < 4; j++)
+        if (have_st[j])
+            cf_lattice_stepper_free(&stp[j]);
     for (int j = 0; j < 4; j++)
         if (have[j])
             cf_lattice_free(&lat[j]);
@@ -182,10 +183,10 @@ void bench_section_pair(bench_ctx *ctx)
             "one core) and the ratio to the odd law's time in the same kernel.\n\n"
             "| kernel | ns per spring | spread | × odd law |\n|---|---|---|---|\n",
             n, ns, kappa, repeats);
-    row(md, "explicit step, odd law (lanes, the step's polynomial)", step[0], step[0]);
-    row(md, "explicit step, double-acting (scalar law per spring)", step[1], step[0]);
-    fprintf(md, "| explicit step with the volume term | – | refused: explicit runs with a volume "
-                "term are not built | – |\n");
+    row(md, "explicit step, odd law (lanes, the step's polynomial)", step[0][0], step[0][0]);
+    row(md, "explicit step, double-acting (scalar law per spring)", step[1][0], step[0][0]);
+    row(md, "explicit step, odd law + volume term", step[0][1], step[0][0]);
+    row(md, "explicit step, double-acting + volume term", step[1][1], step[0][0]);
     row(md, "statics force kernel, odd law", forces[0][0], forces[0][0]);
     row(md, "statics force kernel, double-acting", forces[1][0], forces[0][0]);
     row(md, "statics force kernel, odd law + volume term", forces[0][1], forces[0][0]);
