@@ -52,11 +52,17 @@ typedef struct cf_step_dir {
     double *wl;          /* weight over the first nodes of a layer (0: no spring there) */
 } cf_step_dir;
 
+/* The forms of a double-acting element's step (beside law_simd.h's CF_LANE_*): each spring of
+** the pair through its own lanes in that form, every lane evaluated for both and the side chosen
+** by the sign of u. */
+enum { CF_STEP_PAIR_CLOSED = 3, CF_STEP_PAIR_TABLE = 4, CF_STEP_PAIR_POLY = 5 };
+
 typedef struct cf_lattice_stepper {
     cf_lattice *lat;       /* not owned */
     cf_law_lanes lanes;
-    int form;              /* CF_LANE_POLY, CF_LANE_CLOSED, CF_LANE_TABLE, or -1: the scalar law
-                              per block */
+    cf_law_lanes ext_lanes; /* a double-acting element's extension spring (its H the same) */
+    int form;              /* CF_LANE_POLY, CF_LANE_CLOSED, CF_LANE_TABLE, CF_STEP_PAIR_*, or -1:
+                              the scalar law per block */
     double poly_error;     /* the polynomial's measured error (law_simd.h), NaN when not fitted */
     int ndir;              /* directions with springs (families of weight > 0) */
     cf_step_dir dir[CF_CELL_DIRS];

@@ -4,7 +4,8 @@
 ** lattice, and the joint fit's CPU time on the three brain cortex tables.
 **   - the explicit step (cf_lattice_stepper_forces, the volume term's forces when there is one,
 **     cf_lattice_stepper_advance; one core): the odd law through the vector lanes and the step's
-**     polynomial, the pair through the scalar law (lattice_step.c: not yet in the lanes);
+**     polynomial, the pair through both springs' lanes (each spring's polynomial when both fit,
+**     every lane evaluated for both, lattice_step.c);
 **   - the statics force kernel (cf_lattice_forces, which every Newton iteration of a static run
 **     calls): odd law, pair, and each with the volume term (every cell's J from its eight nodes);
 **   - `conifit fit` of the brain cortex tension, compression and shear tables with --joint --law
@@ -184,9 +185,9 @@ void bench_section_pair(bench_ctx *ctx)
             "| kernel | ns per spring | spread | × odd law |\n|---|---|---|---|\n",
             n, ns, kappa, repeats);
     row(md, "explicit step, odd law (lanes, the step's polynomial)", step[0][0], step[0][0]);
-    row(md, "explicit step, double-acting (scalar law per spring)", step[1][0], step[0][0]);
+    row(md, "explicit step, double-acting (both springs' lanes)", step[1][0], step[0][0]);
     row(md, "explicit step, odd law + volume term", step[0][1], step[0][0]);
-    row(md, "explicit step, double-acting + volume term", step[1][1], step[0][0]);
+    row(md, "explicit step, double-acting (lanes) + volume term", step[1][1], step[0][0]);
     row(md, "statics force kernel, odd law", forces[0][0], forces[0][0]);
     row(md, "statics force kernel, double-acting", forces[1][0], forces[0][0]);
     row(md, "statics force kernel, odd law + volume term", forces[0][1], forces[0][0]);
