@@ -283,6 +283,7 @@ static cf_status lattice_of(export_request *q, const cf_fitted_spring *fs,
     if ((st = cf_law_init(&law, &fs->params, err)) != CF_OK)
         return st;
     *lx = cf_export_lattice_default(&law);
+    lx->cfg.lattice.volume_modulus_MPa = fs->volume_modulus_MPa;
     cf_law_free(&law);
     return CF_OK;
 }
@@ -373,7 +374,7 @@ int cf_cli_export(int argc, char **argv)
     cf_error err = {0};
     cf_export_options opt = q.ea.opt;
     cf_fitted_spring fs;
-    if (cf_fitfile_load(q.fit_path, q.ea.type, &fs, &err) != CF_OK)
+    if (cf_fitfile_load_element(q.fit_path, q.ea.type, &fs, &err) != CF_OK)
         return cf_cli_fail(&err);
     opt.source = cf_cli_is_stdio(q.fit_path) ? "(standard input)" : q.fit_path;
     opt.output = q.out_path && !cf_cli_is_stdio(q.out_path) ? q.out_path : NULL;

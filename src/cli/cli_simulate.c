@@ -99,6 +99,11 @@ static void summary(FILE *o, const cf_scene *sc, const cf_msm_sample *s, size_t 
            lc->weight[CF_FAMILY_EDGE], lc->weight[CF_FAMILY_FACE], lc->weight[CF_FAMILY_BODY],
            !timed ? "static equilibria"
            : sc->effects.inertia ? "explicit symplectic Euler" : "implicit quasi-static steps");
+    if (sc->has_extension || lc->volume_modulus_MPa > 0)
+        fprintf(o, "element: %s; volume term: kappa %.6g MPa\n",
+                sc->has_extension ? "double-acting (its own extension spring)"
+                                  : "one spring both ways",
+                lc->volume_modulus_MPa);
     if (sc->effects.inertia)
         fprintf(o, "time step: stable %.6g s, smallest used %.6g s, %zu steps, %zu intervals "
                "sub-stepped\n",

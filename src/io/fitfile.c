@@ -115,10 +115,9 @@ static cf_status read_element(json_t *fit, const char *path, const char *where, 
     const double kappa = kv ? json_number_value(kv) : 0.0;
     if (!allow && (pe || kappa > 0))
         return cf_error_set(err, CF_E_DATA,
-                            "%s: %s is %s: export and a scene's 'spring.fit' read one spring per "
-                            "element and no volume term yet, and will not run it as its "
-                            "compression spring alone (a scene takes the pair and kappa by "
-                            "'spring_extension' and 'lattice.volume_modulus_MPa')",
+                            "%s: %s is %s: this reader takes one spring per element and no volume "
+                            "term, and will not run it as its compression spring alone (a "
+                            "scene's 'spring.fit' runs the whole element)",
                             path, where,
                             pe ? "a double-acting element (key 'params_extension')"
                                : "a lattice with a volume term (key "

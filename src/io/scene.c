@@ -128,10 +128,16 @@ static cf_status spring_section(ctx *c, json_t *sp, cf_scene *sc)
                                 c->name, tn);
         cf_fitted_spring fs;
         cf_error ferr = {0};
-        st = cf_fitfile_load(json_string_value(fit), tn, &fs, &ferr);
+        /* the whole element: a double-acting fit's extension spring and its lattice's volume
+        ** term come with it (never its compression spring alone) */
+        st = cf_fitfile_load_element(json_string_value(fit), tn, &fs, &ferr);
         if (st)
             return cf_error_set(c->err, st, "%s: key 'spring.fit': %s", c->name, ferr.msg);
         sc->spring = fs.params;
+        if (fs.has_extension) {
+            sc->extension = fs.extension;
+            sc->has_extension = 1;
+        }
         c->fit = fs;
         c->from_fit = 1;
         /* the name as reports and output files may show it (base/safetext.h) */
@@ -176,6 +182,11 @@ static cf_status extension_section(ctx *c, json_t *ex, cf_scene *sc)
     cf_status st = only_keys(c, ex, "spring_extension", allowed);
     if (st)
         return st;
+    if (sc->has_extension) /* from 'spring.fit' */
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'spring_extension': 'spring.fit' = '%s' already holds a "
+                            "double-acting element's extension spring",
+                            c->name, sc->fit_path);
     json_t *params = json_object_get(ex, "params");
     if (!json_is_object(params))
         return cf_error_set(c->err, CF_E_DATA,
@@ -217,7 +228,14 @@ static cf_status volume_keys(ctx *c, json_t *lt, cf_scene *sc)
     if (kv && nv)
         return cf_error_set(c->err, CF_E_DATA, "%s: key 'lattice' takes 'volume_modulus_MPa' or "
                                                "'poisson_ratio', not both", c->name);
-    if ((st = number(c, lt, "lattice", "volume_modulus_MPa", 0, 0, 0, 0, 1e100,
+    const double fit_kappa = c->from_fit ? c->fit.volume_modulus_MPa : 0.0;
+    if ((kv || nv) && fit_kappa > 0)
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'lattice.%s': 'spring.fit' = '%s' already gives the "
+                            "lattice's volume term (volume_modulus_MPa = %g)",
+                            c->name, kv ? "volume_modulus_MPa" : "poisson_ratio", sc->fit_path,
+                            fit_kappa);
+    if ((st = number(c, lt, "lattice", "volume_modulus_MPa", 0, fit_kappa, 0, 0, 1e100,
                      &L->volume_modulus_MPa)))
         return st;
     if (!nv)
@@ -828,6 +846,12 @@ static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
     if (!bd && (json_object_get(root, "fixed") || json_object_get(root, "probe")))
         return cf_error_set(c->err, CF_E_DATA, "%s: keys 'fixed' and 'probe' need a 'body'",
                             c->name);
+    if (bd && (sc->has_extension || (c->from_fit && c->fit.volume_modulus_MPa > 0)))
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'body': a body's edges take one spring law and its volume "
+                            "term from 'body'; %s is not built for bodies",
+                            c->name, sc->has_extension ? "a double-acting element"
+                                                       : "the fit's lattice volume term");
     if (bd && (st = body_sections(c, root, bd, sc)))
         return st;
     if ((st = object(c, root, "lattice", 0, &lt)) || (st = lattice_section(c, lt, sc)))

@@ -6,6 +6,7 @@
 #include "base/gslguard.h"
 
 #include "conifit/cell.h"
+#include "model/lattice_step.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -323,6 +324,44 @@ double cf_lattice_cell_volume(const cf_lattice *lat, size_t c, uint32_t node[8],
 }
 
 /* The volume term's node forces, -kappa (J - 1) dV/dx, added to fx, fy, fz. */
+static void volume_forces(cf_lattice *lat);
+
+void cf_lattice_add_volume_forces(cf_lattice *lat)
+{
+    if (lat->cfg.volume_modulus_MPa != 0)
+        volume_forces(lat);
+}
+
+double cf_lattice_volume_row_bound(const cf_lattice *lat)
+{
+    const double kappa = lat->cfg.volume_modulus_MPa, H = lat->H_mm;
+    if (!(kappa > 0))
+        return 0.0;
+    const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
+    double *row = calloc(3 * lat->nn, sizeof *row);
+    if (!row) /* no memory for the exact bound: the rest state's, 12 kappa H, doubled */
+        return 24.0 * kappa * H;
+    for (size_t c = 0; c < nc; c++) {
+        uint32_t node[8];
+        double g[8][3], hess[8][8][3][3];
+        const double J = cf_lattice_cell_volume(lat, c, node, g, hess);
+        const double a1 = kappa / (H * H * H), a2 = kappa * (J - 1);
+        for (int a = 0; a < 8; a++)
+            for (int i = 0; i < 3; i++) {
+                double r = 0;
+                for (int b = 0; b < 8; b++)
+                    for (int k = 0; k < 3; k++)
+                        r += fabs(a1 * g[a][i] * g[b][k] + a2 * hess[a][b][i][k]);
+                row[3 * node[a] + i] += r;
+            }
+    }
+    double worst = 0;
+    for (size_t q = 0; q < 3 * lat->nn; q++)
+        worst = fmax(worst, row[q]);
+    free(row);
+    return worst;
+}
+
 static void volume_forces(cf_lattice *lat)
 {
     const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;

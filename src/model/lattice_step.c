@@ -21,9 +21,28 @@ cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const
     memset(st, 0, sizeof *st);
     st->lat = lat;
     cf_law_lanes_init(lat->law, &st->lanes);
-    if (lat->law->extension) /* a double-acting element: the scalar law, side by side */
-        st->form = -1;
-    else if (lat->law->tail) /* its lanes hold the polynomial only: without it, the scalar law */
+    if (lat->law->extension) { /* a double-acting element: both springs' lanes, side by side */
+        const cf_law *e = lat->law->extension;
+        cf_law_lanes_init(e, &st->ext_lanes);
+        st->poly_error = NAN;
+        cf_law plain = *lat->law; /* the compression spring alone (its fit checks both signs) */
+        plain.extension = NULL;
+        double pe1, pe2;
+        if (lat->law->tail || e->tail) /* tailed sides: not in the pair's lanes yet */
+            st->form = -1;
+        else if (lat->method != CF_LAW_CLOSED && lat->method != CF_LAW_TABLE)
+            st->form = -1;
+        else if (cf_law_lanes_fit_poly(&plain, &st->lanes, &pe1) &&
+                 cf_law_lanes_fit_poly(e, &st->ext_lanes, &pe2)) {
+            st->form = CF_STEP_PAIR_POLY; /* both within CF_POLY_TOL of their closed forms */
+            st->poly_error = fmax(pe1, pe2);
+        } else if (lat->method == CF_LAW_CLOSED)
+            st->form = CF_STEP_PAIR_CLOSED;
+        else if (st->lanes.coef && st->ext_lanes.coef)
+            st->form = CF_STEP_PAIR_TABLE;
+        else
+            st->form = -1;
+    } else if (lat->law->tail) /* its lanes hold the polynomial only: without it, the scalar law */
         st->form = lat->method == CF_LAW_CLOSED || lat->method == CF_LAW_TABLE ? CF_LANE_POLY : -1;
     else if (lat->method == CF_LAW_CLOSED)
         st->form = CF_LANE_CLOSED;
@@ -94,8 +113,8 @@ void cf_lattice_stepper_free(cf_lattice_stepper *st)
 ** vectorised loop over contiguous nodes. form is a constant in every call site, so each copy is
 ** specialised. Returns the largest |u| of the real springs. */
 static inline __attribute__((always_inline)) double
-run_dir(const cf_lattice *lat, const cf_law_lanes *c, int form, const cf_step_dir *sd, double wk,
-        size_t p0, size_t n, const double *restrict W)
+run_dir(const cf_lattice *lat, const cf_law_lanes *c, const cf_law_lanes *e, int form,
+        const cf_step_dir *sd, double wk, size_t p0, size_t n, const double *restrict W)
 {
     const size_t D = sd->D;
     const double L0 = sd->L0, A = sd->a;
@@ -121,7 +140,20 @@ run_dir(const cf_lattice *lat, const cf_law_lanes *c, int form, const cf_step_di
     const size_t n8 = (n + 7) & ~(size_t)7;
     for (size_t k = n; k < n8; k++)
         u[k] = 0.0;
-    if (form == CF_LANE_POLY)
+    if (form == CF_STEP_PAIR_CLOSED || form == CF_STEP_PAIR_TABLE || form == CF_STEP_PAIR_POLY) {
+        /* the pair: every lane through both springs, the side by the sign of u (the lanes are
+        ** odd, so the extension spring's value at u < 0 is -F_e(|u|)) */
+        double Fe[CF_STEP_BLOCK];
+        if (form == CF_STEP_PAIR_POLY)
+            cf_lanes_poly(c, n8, u, F), cf_lanes_poly(e, n8, u, Fe);
+        else if (form == CF_STEP_PAIR_TABLE)
+            cf_lanes_table(c, n8, u, F), cf_lanes_table(e, n8, u, Fe);
+        else
+            cf_lanes_closed(c, n8, u, F), cf_lanes_closed(e, n8, u, Fe);
+#pragma omp simd
+        for (size_t k = 0; k < n8; k++)
+            F[k] = u[k] < 0.0 ? Fe[k] : F[k];
+    } else if (form == CF_LANE_POLY)
         cf_lanes_poly(c, n8, u, F);
     else if (form == CF_LANE_TABLE)
         cf_lanes_table(c, n8, u, F);
@@ -157,7 +189,7 @@ static inline __attribute__((always_inline)) double
 layer_springs(const cf_lattice_stepper *st, int form, size_t k)
 {
     const cf_lattice *lat = st->lat;
-    const cf_law_lanes c = st->lanes;
+    const cf_law_lanes c = st->lanes, e = st->ext_lanes;
     const int nx = lat->cfg.nx, ny = lat->cfg.ny, nz = lat->cfg.nz;
     const size_t row = (size_t)nx + 1, base = k * st->layer;
     const int edge = k == 0 || k == (size_t)nz;
@@ -175,7 +207,7 @@ layer_springs(const cf_lattice_stepper *st, int form, size_t k)
             if (a >= b)
                 continue;
             const double um =
-                run_dir(lat, &c, form, sd, sd->wk[edge], base + a, b - a, sd->wl + a);
+                run_dir(lat, &c, &e, form, sd, sd->wk[edge], base + a, b - a, sd->wl + a);
             umax = um > umax ? um : umax;
         }
     }
@@ -198,6 +230,9 @@ layer_springs(const cf_lattice_stepper *st, int form, size_t k)
 CF_SIMD_COPIES(CF_SLABS, slabs_closed, CF_LANE_CLOSED)
 CF_SIMD_COPIES(CF_SLABS, slabs_table, CF_LANE_TABLE)
 CF_SIMD_COPIES(CF_SLABS, slabs_poly, CF_LANE_POLY)
+CF_SIMD_COPIES(CF_SLABS, slabs_pair_closed, CF_STEP_PAIR_CLOSED)
+CF_SIMD_COPIES(CF_SLABS, slabs_pair_table, CF_STEP_PAIR_TABLE)
+CF_SIMD_COPIES(CF_SLABS, slabs_pair_poly, CF_STEP_PAIR_POLY)
 CF_SLABS(, , slabs_scalar, -1)
 
 double cf_lattice_stepper_forces(cf_lattice_stepper *st)
@@ -207,7 +242,11 @@ double cf_lattice_stepper_forces(cf_lattice_stepper *st)
         double um = st->form == CF_LANE_POLY     ? CF_SIMD_CALL(slabs_poly, (st, parity))
                     : st->form == CF_LANE_CLOSED ? CF_SIMD_CALL(slabs_closed, (st, parity))
                     : st->form == CF_LANE_TABLE  ? CF_SIMD_CALL(slabs_table, (st, parity))
-                                                 : slabs_scalar(st, parity);
+                    : st->form == CF_STEP_PAIR_CLOSED
+                        ? CF_SIMD_CALL(slabs_pair_closed, (st, parity))
+                    : st->form == CF_STEP_PAIR_TABLE ? CF_SIMD_CALL(slabs_pair_table, (st, parity))
+                    : st->form == CF_STEP_PAIR_POLY  ? CF_SIMD_CALL(slabs_pair_poly, (st, parity))
+                                                     : slabs_scalar(st, parity);
         umax = um > umax ? um : umax;
     }
     return umax / st->lat->travel_mm;

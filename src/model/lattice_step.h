@@ -52,11 +52,17 @@ typedef struct cf_step_dir {
     double *wl;          /* weight over the first nodes of a layer (0: no spring there) */
 } cf_step_dir;
 
+/* The forms of a double-acting element's step (beside law_simd.h's CF_LANE_*): each spring of
+** the pair through its own lanes in that form, every lane evaluated for both and the side chosen
+** by the sign of u. */
+enum { CF_STEP_PAIR_CLOSED = 3, CF_STEP_PAIR_TABLE = 4, CF_STEP_PAIR_POLY = 5 };
+
 typedef struct cf_lattice_stepper {
     cf_lattice *lat;       /* not owned */
     cf_law_lanes lanes;
-    int form;              /* CF_LANE_POLY, CF_LANE_CLOSED, CF_LANE_TABLE, or -1: the scalar law
-                              per block */
+    cf_law_lanes ext_lanes; /* a double-acting element's extension spring (its H the same) */
+    int form;              /* CF_LANE_POLY, CF_LANE_CLOSED, CF_LANE_TABLE, CF_STEP_PAIR_*, or -1:
+                              the scalar law per block */
     double poly_error;     /* the polynomial's measured error (law_simd.h), NaN when not fitted */
     int ndir;              /* directions with springs (families of weight > 0) */
     cf_step_dir dir[CF_CELL_DIRS];
@@ -82,5 +88,15 @@ void cf_lattice_stepper_advance(cf_lattice_stepper *st, double h, double *vx, do
                                 double *vz);
 
 void cf_lattice_stepper_free(cf_lattice_stepper *st);
+
+/* The volume term's node forces, -kappa (J - 1) dV/dx of every cell, added to lat->fx, fy, fz
+** (nothing when lat->cfg.volume_modulus_MPa is 0): the fused step's springs do not include them
+** (lattice.c). */
+void cf_lattice_add_volume_forces(cf_lattice *lat);
+
+/* A bound on the largest row sum of |d2W/dx2| of the volume term at the current positions, over
+** every node's three rows (N/mm): per cell kappa/H^3 g g^T + kappa (J - 1) d2V/dx2, summed over the
+** cells of each node (Gershgorin, for the explicit step's stability; 0 without a volume term). */
+double cf_lattice_volume_row_bound(const cf_lattice *lat);
 
 #endif

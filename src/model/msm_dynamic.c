@@ -21,9 +21,10 @@ double cf_msm_stable_step(cf_lattice *lat, const cf_msm_effects *fx)
         kmax = fmax(kmax, k);
         cmax = fmax(cmax, lat->w[q] * H2 * fx->eta_MPa_s / lat->L0_mm[q]);
     }
-    /* Gershgorin: omega^2 <= 2 * degree * k_max / m_min. */
+    /* Gershgorin: omega^2 <= (2 * degree * k_max + the volume term's largest row sum) / m_min
+    ** (the row sums of the springs' and the volume term's stiffness add) */
     double deg = lat->max_degree > 0 ? lat->max_degree : 1;
-    double om2 = 2 * deg * kmax / lat->m_min_t;
+    double om2 = (2 * deg * kmax + cf_lattice_volume_row_bound(lat)) / lat->m_min_t;
     if (!(om2 > 0))
         return INFINITY;
     double om = sqrt(om2);
@@ -40,6 +41,7 @@ static void dyn_step(solver *s, dyn *d, double h, double v1, double rate)
     if (d->fused) {
         /* node forces are zero here (cleared by the last advance or before the interval) */
         cf_lattice_stepper_forces(&d->step);
+        cf_lattice_add_volume_forces(lat);
         cf_msm_add_external(s);
         cf_lattice_stepper_advance(&d->step, h, d->vx, d->vy, d->vz);
         goto drive;
@@ -132,11 +134,6 @@ void cf_msm_dyn_free(dyn *d)
 cf_status cf_msm_dyn_init(dyn *d, solver *s, cf_error *err)
 {
     cf_lattice *lat = s->lat;
-    if (lat->cfg.volume_modulus_MPa != 0)
-        return cf_error_set(err, CF_E_DATA, "lattice volume_modulus_MPa = %g: the volume term is in "
-                                            "the lattice's statics only, not yet in an explicit "
-                                            "(dynamic) run",
-                            lat->cfg.volume_modulus_MPa);
     d->vx = calloc(lat->nn, sizeof(double));
     d->vy = calloc(lat->nn, sizeof(double));
     d->vz = calloc(lat->nn, sizeof(double));

@@ -199,7 +199,7 @@ cf_status cf_flat_export(const char *fit_path, const char *type, const char *for
         opt.auto_tol = 1;
     }
     cf_fitted_spring fs;
-    if ((s = cf_fitfile_load(fit_path, type, &fs, err)) != CF_OK)
+    if ((s = cf_fitfile_load_element(fit_path, type, &fs, err)) != CF_OK) /* a pair whole */
         return s;
     opt.source = fit_path;
     size_t len = 0;

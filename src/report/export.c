@@ -65,10 +65,23 @@ static void prony_comment(FILE *out, const char *lead, const char *tail,
     fprintf(out, "%s%s%s\n", lead, why, tail);
 }
 
+/* The fit's lattice volume term, as a comment line: a property of the lattice's cells, which a
+** table of one spring has no place for (export --lattice carries it where the format can). */
+static void volume_comment(FILE *out, const char *lead, const char *tail,
+                           const cf_fitted_spring *fs)
+{
+    if (fs && fs->volume_modulus_MPa > 0)
+        fprintf(out,
+                "%sthe fit's lattice also has a volume term, not in this table: every cell stores "
+                "(kappa/2)(J - 1)^2 of its rest volume, kappa = %.17g MPa (export --lattice "
+                "writes it as volume elements for calculix and abaqus)%s\n",
+                lead, fs->volume_modulus_MPa, tail);
+}
+
 /* Comment lines shared by the blocks: what, units, sign, source, spring and table. */
 static void block_header(FILE *out, const char *lead, const char *tail, const char *what,
                          const cf_law *law, const cf_export_table *t,
-                         const cf_export_options *opt)
+                         const cf_export_options *opt, const cf_fitted_spring *fs)
 {
     fprintf(out, "%sconifit %s: %s%s\n", lead, CF_VERSION, what, tail);
     fprintf(out, "%sunits: mm, N, s, tonne (force in N, elongation in mm)%s\n", lead, tail);
@@ -77,6 +90,7 @@ static void block_header(FILE *out, const char *lead, const char *tail, const ch
     cf_export_comment_source(out, lead, tail, opt->source);
     cf_export_comment_spring(out, lead, tail, law);
     cf_export_comment_table(out, lead, tail, t, law);
+    volume_comment(out, lead, tail, fs);
 }
 
 /* What a block writer writes from: the fitted spring, its law, the table of the law (none for
@@ -105,6 +119,22 @@ static cf_status write_json(FILE *out, const block_job *j, cf_error *err)
     }
     json_object_update(root, spring);
     json_decref(spring);
+    if (j->law->extension) { /* the keys of a fit file's double-acting element (fitfile.h) */
+        json_t *es = cf_fitfile_spring_json(j->law->extension);
+        if (!es) {
+            json_decref(root);
+            json_decref(units);
+            json_decref(prov);
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory building the JSON spring");
+        }
+        json_object_set(root, "params_extension", json_object_get(es, "params"));
+        json_object_set(root, "derived_extension", json_object_get(es, "derived"));
+        json_decref(es);
+    }
+    if (fs->volume_modulus_MPa > 0)
+        json_object_set_new(root, "lattice",
+                            json_pack("{s:o}", "volume_modulus_MPa",
+                                      cf_json_number(fs->volume_modulus_MPa)));
     json_object_set_new(units, "length", json_string("mm"));
     json_object_set_new(units, "force", json_string("N"));
     json_object_set_new(units, "modulus", json_string("MPa"));
@@ -167,6 +197,12 @@ static cf_status write_csv(FILE *out, const block_job *j, cf_error *err)
     prony_comment(out, "# ", "", j->fs,
                   "the table below is the instantaneous (elastic) law; G(t) scales its response "
                   "in time");
+    if (j->law->extension) {
+        fprintf(out, "# double-acting element: u >= 0 the compression spring, u < 0 its own "
+                     "extension spring (the same free length H)\n");
+        cf_export_comment_spring(out, "# ", "", j->law);
+    }
+    volume_comment(out, "# ", "", j->fs);
     fprintf(out, "u_mm,force_N,stiffness_N_per_mm\n");
     for (size_t i = 0; i < t->rows; i++)
         fprintf(out, "%.17g,%.17g,%.17g\n", t->u_mm[i], t->F_N[i], t->k_N_per_mm[i]);
@@ -178,7 +214,7 @@ static cf_status write_csv(FILE *out, const block_job *j, cf_error *err)
 static void write_inp_block(FILE *out, const block_job *j, const char *what)
 {
     const cf_export_table *t = j->t;
-    block_header(out, "** ", "", what, j->law, t, j->opt);
+    block_header(out, "** ", "", what, j->law, t, j->opt, j->fs);
     prony_comment(out, "** ", "", j->fs,
                   "not written as keywords: *VISCOELASTIC, TIME=PRONY belongs to a *MATERIAL of "
                   "continuum elements; SPRINGA elements take *SPRING alone, elastic");
@@ -209,7 +245,7 @@ static cf_status write_febio(FILE *out, const block_job *j, cf_error *err)
     const cf_export_table *t = j->t;
     fprintf(out, "<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?>\n");
     block_header(out, "<!-- ", " -->", "conical spring for FEBio 4 as a nonlinear spring", law, t,
-                 j->opt);
+                 j->opt, j->fs);
     prony_comment(out, "<!-- ", " -->", j->fs,
                   "not written as material: FEBio's viscoelastic material (g1..g6, t1..t6) wraps a "
                   "solid's elastic material; a discrete nonlinear spring has no relaxation");
@@ -244,7 +280,7 @@ static cf_status write_lsdyna(FILE *out, const block_job *j, cf_error *err)
     const cf_export_table *t = j->t;
     block_header(out, "$ ", "",
                  "conical spring for LS-DYNA as *MAT_SPRING_NONLINEAR_ELASTIC (MAT_S04)", j->law,
-                 t, j->opt);
+                 t, j->opt, j->fs);
     prony_comment(out, "$ ", "", j->fs,
                   "not written as cards: the viscoelastic materials with G_i, BETA_i are for "
                   "solids; *MAT_SPRING_MAXWELL holds one linear term, not a series on a curve");
@@ -394,7 +430,7 @@ cf_status cf_export_table_for(const cf_law *law, const cf_export_options *opt,
         double lo = opt->u_lo_mm, hi = opt->u_hi_mm;
         if (!opt->have_range) {
             hi = cf_export_table_end(law, tol);
-            lo = -hi;
+            lo = -cf_export_table_end(law->extension ? law->extension : law, tol);
         }
         return cf_export_table_build_even(law, tol, lo, hi, max_rows, t, err);
     }
@@ -512,13 +548,23 @@ cf_status cf_export_write(FILE *out, const cf_fitted_spring *fs, const cf_export
         return cf_error_set(err, CF_E_INTERNAL, "unknown export format %d", (int)opt->format);
     if (opt->example && !d->model)
         return cf_error_set(err, CF_E_DATA, "format %s writes no model", d->info.name);
-    cf_law law;
+    if (opt->example && fs->volume_modulus_MPa > 0)
+        return cf_error_set(err, CF_E_DATA,
+                            "the fit's lattice has a volume term (kappa = %g MPa), which the "
+                            "one-spring example has no cells for: export the lattice (--lattice) "
+                            "to calculix or abaqus",
+                            fs->volume_modulus_MPa);
+    cf_law law, ext;
     cf_export_table t = {0};
     cf_export_report r = {0};
     cf_xmodel m = {0};
+    memset(&ext, 0, sizeof ext);
     cf_status st = cf_law_init(&law, &fs->params, err);
     if (st != CF_OK)
         return st;
+    if (fs->has_extension && ((st = cf_law_init(&ext, &fs->extension, err)) != CF_OK ||
+                              (st = cf_law_pair(&law, &ext, err)) != CF_OK))
+        goto done;
     if (d->info.table) {
         if ((st = cf_export_table_for(&law, opt, &t, err)) != CF_OK)
             goto done;
@@ -546,5 +592,6 @@ done:
     cf_xmodel_free(&m);
     cf_export_table_free(&t);
     cf_law_free(&law);
+    cf_law_free(&ext);
     return st;
 }

@@ -126,6 +126,17 @@ static int model_of_lattice(cf_xmodel *m, const cf_lattice *lat)
     }
     m->area_mm2 = lat->area_mm2;
     m->height_mm = lat->height_mm;
+    m->kappa_MPa = lat->cfg.volume_modulus_MPa;
+    if (m->kappa_MPa > 0) { /* every cell's eight nodes, corner di + 2 dj + 4 dk */
+        m->ncells = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
+        m->cell = malloc(8 * m->ncells * sizeof *m->cell);
+        if (!m->cell)
+            return -1;
+        for (size_t c = 0; c < m->ncells; c++) {
+            double g[8][3];
+            cf_lattice_cell_volume(lat, c, m->cell + 8 * c, g, NULL);
+        }
+    }
     /* the springs a horizontal plane through the middle of a layer of cells cuts */
     const double zc = lat->H_mm * (floor(lat->cfg.nz / 2.0) + 0.5);
     double cut = 0.0;
@@ -288,26 +299,44 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
                                   cf_export_report *rep, cf_error *err)
 {
     CF_GSL_GUARD;
-    cf_law law;
+    cf_law law, ext;
     cf_lattice lat;
     cf_export_table t = {0};
     cf_xmodel m = {0};
     cf_export_report r = {0};
     char title[256];
     memset(&lat, 0, sizeof lat);
+    memset(&ext, 0, sizeof ext);
     cf_status st = check_loading(opt, lx, err);
     if (st != CF_OK || (st = cf_law_init(&law, &fs->params, err)) != CF_OK)
         return st;
+    /* the fit's whole element and volume term (a scene naming the fit file brings the same) */
+    cf_lattice_config lc = lx->cfg.lattice;
+    if (!(lc.volume_modulus_MPa > 0))
+        lc.volume_modulus_MPa = fs->volume_modulus_MPa;
+    if (fs->has_extension && ((st = cf_law_init(&ext, &fs->extension, err)) != CF_OK ||
+                              (st = cf_law_pair(&law, &ext, err)) != CF_OK))
+        goto done;
     if ((st = cf_export_table_for(&law, opt, &t, err)) != CF_OK ||
-        (st = cf_lattice_create(&lat, &law, lx->method, &lx->cfg.lattice, err)) != CF_OK)
+        (st = cf_lattice_create(&lat, &law, lx->method, &lc, err)) != CF_OK)
         goto done;
     if (lattice_model(&m, &lat, &law, &t, lx, opt, title, sizeof title) != 0)
         goto oom;
+    const char *no_volume = cf_xmodel_volume_refusal(&m, opt->format);
+    if (no_volume) {
+        st = cf_error_set(err, CF_E_DATA,
+                          "the lattice has a volume term (kappa = %g MPa) that format %s cannot "
+                          "carry: %s",
+                          m.kappa_MPa, cf_export_format_name(opt->format), no_volume);
+        goto done;
+    }
     double umax = 0.0;
     size_t unstable = 0;
     long pivots = 0;
     cf_error run_err = {0};
     st = reference_run(&lat, lx, m.ref_N, &umax, &unstable, &pivots, &run_err);
+    /* the table's ends against the largest compression (either side: max_u_over_travel is of
+    ** each spring's own side's travel) */
     const double u_limit = fmin(t.u_hi_mm, -t.u_lo_mm);
     if (st != CF_OK || umax > u_limit || unstable) {
         st = refuse_loading(&lat, &law, lx, st, &run_err, umax, u_limit, unstable, pivots, err);
@@ -339,5 +368,6 @@ done:
     cf_lattice_free(&lat);
     cf_export_table_free(&t);
     cf_law_free(&law);
+    cf_law_free(&ext);
     return st;
 }

@@ -53,7 +53,7 @@ void cf_xmodel_free(cf_xmodel *m)
         return;
     free(m->X), free(m->Y), free(m->Z), free(m->fix);
     free(m->si), free(m->sj), free(m->grp), free(m->top);
-    free(m->dz_mm), free(m->ref_N), free(m->strain);
+    free(m->dz_mm), free(m->ref_N), free(m->strain), free(m->cell);
     for (size_t g = 0; g < m->ng && m->g; g++)
         free(m->g[g].e_mm), free(m->g[g].T_N);
     free(m->g);
@@ -186,9 +186,25 @@ char *cf_export_febio_log_name(char *buf, size_t cap, const char *output)
     return buf;
 }
 
+static void comment_one_spring(FILE *out, const char *lead, const char *tail, const cf_law *law,
+                               const char *what);
+
 void cf_export_comment_spring(FILE *out, const char *lead, const char *tail, const cf_law *law)
 {
-    fprintf(out, "%sspring (%s):", lead, cf_spring_type_name(law->type));
+    comment_one_spring(out, lead, tail, law, law->extension ? "compression spring" : "spring");
+    if (!law->extension)
+        return;
+    fprintf(out,
+            "%sdouble-acting element: the compression spring for u > 0, its own extension "
+            "spring for u < 0 (the same free length H); every table below holds both sides%s\n",
+            lead, tail);
+    comment_one_spring(out, lead, tail, law->extension, "extension spring");
+}
+
+static void comment_one_spring(FILE *out, const char *lead, const char *tail, const cf_law *law,
+                               const char *what)
+{
+    fprintf(out, "%s%s (%s):", lead, what, cf_spring_type_name(law->type));
     for (int k = 0; k < (law->tail ? CF_P_ALL : CF_P_COUNT); k++) {
         const cf_spring_param *sp = cf_spring_param_info(k);
         fprintf(out, "%s %s = %.17g%s%s", k ? "," : "", sp->name, cf_spring_get(&law->p, k),
@@ -213,6 +229,15 @@ void cf_export_comment_table(FILE *out, const char *lead, const char *tail,
             "F_C of the law, achieved %.3g F_C (%.3g N at u = %.6g mm)%s\n",
             lead, t->rows, t->u_lo_mm, t->u_hi_mm, t->tol, t->max_err_rel, t->max_err_N,
             t->max_err_u_mm, tail);
+    if (law->extension) {
+        fprintf(out,
+                "%sthe law is solid at u = %.17g mm (F_C) and at u = -%.17g mm (the extension "
+                "spring's F_C); past the table's ends a simulator that holds the last force is "
+                "within %.3g of that side's F_C of the law up to solid when the table runs to "
+                "its full range%s\n",
+                lead, law->travel_mm, law->extension->travel_mm, t->tol, tail);
+        return;
+    }
     fprintf(out,
             "%sthe law is solid at |u| = %.17g mm (force %s); past the table's ends a simulator "
             "that holds the last force is within %.3g F_C of the law up to solid when the table "
@@ -278,6 +303,11 @@ static void model_header(FILE *out, const char *lead, const char *tail, const cf
             "%sreaction tolerance implied by the tables: %.6g N (tol F_C times the weights of "
             "the springs a horizontal plane cuts, projected on z)%s\n",
             lead, m->reaction_tol_N, tail);
+    if (m->kappa_MPa > 0)
+        fprintf(out,
+                "%svolume term: each of the %zu cells stores (kappa/2)(J - 1)^2 of its rest "
+                "volume, kappa = %.17g MPa, J its volume over its rest volume%s\n",
+                lead, m->ncells, m->kappa_MPa, tail);
     for (size_t k = 0; k < m->nsteps; k++)
         fprintf(out, "%s  step %zu: top z displacement %.17g mm (strain %.10g), conifit reaction "
                      "%.17g N%s\n",
@@ -290,6 +320,54 @@ static void model_header(FILE *out, const char *lead, const char *tail, const cf
 ** so that the reaction is converged far below the table's tolerance; the other entries are the
 ** defaults of the *CONTROLS, PARAMETERS=FIELD line. */
 static const char inp_controls[] = "1.e-9,1.e-6,0.01,,0.02,1.e-5,1.e-3,1.e-8\n";
+
+/* The volume term as one C3D8 hexahedron per cell (element numbers after the springs') of a
+** neo-Hookean material with no shear term: W = C10 (I1bar - 3) + (1/D1)(J - 1)^2 with C10 = 0
+** and D1 = 2/kappa is (kappa/2)(J - 1)^2 (CalculiX and Abaqus manuals, *HYPERELASTIC). The
+** element integrates it at its 2 x 2 x 2 Gauss points, conifit over the cell's volume from its
+** eight nodes: the same wherever J is uniform over a cell (the homogeneous loading of the
+** export). */
+static void write_inp_volume(FILE *out, const cf_xmodel *m)
+{
+    static const int order[8] = {0, 1, 3, 2, 4, 5, 7, 6}; /* corner di + 2 dj + 4 dk -> C3D8 */
+    fprintf(out, "** volume term: kappa = %.17g MPa on every cell\n", m->kappa_MPa);
+    fprintf(out, "*ELEMENT, TYPE=C3D8, ELSET=CELLS\n");
+    for (size_t c = 0; c < m->ncells; c++) {
+        fprintf(out, "%zu", m->ns + c + 1);
+        for (int a = 0; a < 8; a++)
+            fprintf(out, ", %u", m->cell[8 * c + order[a]] + 1);
+        fputc('\n', out);
+    }
+    char d1[32];
+    inp_real(d1, 2.0 / m->kappa_MPa);
+    fprintf(out, "*MATERIAL, NAME=CONIFIT_VOLUME\n*HYPERELASTIC, NEO HOOKE\n0., %s\n", d1);
+    fprintf(out, "*SOLID SECTION, ELSET=CELLS, MATERIAL=CONIFIT_VOLUME\n");
+}
+
+const char *cf_xmodel_volume_refusal(const cf_xmodel *m, cf_export_format f)
+{
+    if (!(m->kappa_MPa > 0))
+        return NULL;
+    switch (f) {
+    case CF_EXPORT_CALCULIX:
+    case CF_EXPORT_ABAQUS:
+        return NULL;
+    case CF_EXPORT_FEBIO:
+        return "the volumetric energies of FEBio's solid materials are in ln J (neo-Hookean: "
+               "(lambda/2)(ln J)^2; the uncoupled materials: (k/2)(ln J)^2), not the lattice's "
+               "(kappa/2)(J - 1)^2, so its run would not be conifit's lattice; export calculix or "
+               "abaqus, whose neo-Hookean material with C10 = 0 is that term";
+    case CF_EXPORT_LSDYNA:
+        return "this export writes LS-DYNA's discrete springs only, and none of the solid "
+               "materials it writes has exactly the lattice's (kappa/2)(J - 1)^2 and no shear; "
+               "export calculix or abaqus";
+    case CF_EXPORT_SOFA:
+        return "SOFA's spring force fields have no volume term and this export writes no FEM "
+               "force field; export calculix or abaqus";
+    default:
+        return "the format writes no volume elements";
+    }
+}
 
 static void write_inp(FILE *out, const cf_xmodel *m, int abaqus)
 {
@@ -319,7 +397,7 @@ static void write_inp(FILE *out, const cf_xmodel *m, int abaqus)
         for (size_t i = 0; i < m->g[g].rows; i++)
             cf_export_inp_pair(out, m->g[g].T_N[i], m->g[g].e_mm[i]);
     }
-    if (m->nt > 0 && m->kappa_MPa > 0) {
+    if (m->nt > 0 && m->kappa_MPa > 0) { /* a body's tetrahedra */
         /* W = C10 (I1bar - 3) + (J - 1)^2 / D1: with C10 = 0 and D1 = 2/kappa the volume term */
         fprintf(out, "** the volume term: a purely volumetric material, (kappa/2)(J - 1)^2 per unit "
                      "volume, kappa = %.17g MPa, J per tetrahedron\n",
@@ -334,6 +412,8 @@ static void write_inp(FILE *out, const cf_xmodel *m, int abaqus)
                      "*SOLID SECTION, ELSET=VOLUME, MATERIAL=VOLUME\n",
                 d1);
     }
+    else if (m->kappa_MPa > 0) /* a lattice's cells */
+        write_inp_volume(out, m);
     fprintf(out, "*BOUNDARY\n");
     for (size_t i = 0; i < m->nn; i++)
         for (int a = 0; a < 3; a++)

@@ -53,8 +53,15 @@ typedef struct cf_xmodel {
     ** of a purely volumetric material, W = (kappa/2)(J - 1)^2 per unit volume; 0 = none */
     size_t nt;
     const uint32_t *tet;
-    double kappa_MPa;
+    /* The lattice's volume term (cell.h): every cell stores (kappa/2)(J - 1)^2 of its rest volume;
+    ** written as an eight-node hexahedron per cell with a purely volumetric material by the
+    ** formats that can (CalculiX, Abaqus; cf_xmodel_volume_refusal). */
+    double kappa_MPa;       /* 0: no volume term (a body's or a lattice's) */
+    size_t ncells;
+    uint32_t *cell;         /* 8 nodes (0-based) per cell, in the C3D8 / HEX8 order */
 } cf_xmodel;
+/* NULL when format f can carry m's volume term (none, or CalculiX/Abaqus), else why it cannot. */
+const char *cf_xmodel_volume_refusal(const cf_xmodel *m, cf_export_format f);
 
 /* Releases what the model owns (its arrays and group tables). Safe on a zeroed model. */
 void cf_xmodel_free(cf_xmodel *m);

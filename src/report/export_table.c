@@ -219,6 +219,19 @@ double cf_export_table_end(const cf_law *law, double tol)
     return cf_law_deflection(law, law->F_C_N * (1.0 - tol));
 }
 
+/* The spring that carries the side of sign (the extension spring of a double-acting element on
+** the stretch side, law.h; the law itself otherwise). */
+static const cf_law *side_law(const cf_law *law, double sign)
+{
+    return sign < 0 && law->extension ? law->extension : law;
+}
+
+/* The stretch end of a table of law (the extension spring's end for a pair), mm, positive. */
+static double stretch_end(const cf_law *law, double tol)
+{
+    return cf_export_table_end(side_law(law, -1.0), tol);
+}
+
 /* The i-th point (0 <= i < 2 TABLE_CHECK) of the check grid over the half [0, U]. */
 static double check_point(const cf_law *law, double U, size_t i)
 {
@@ -238,7 +251,7 @@ static double half_error(const cf_law *law, const cf_export_table *t, double U, 
 {
     double worst = 0.0;
     for (size_t i = 0; i < 2 * (size_t)TABLE_CHECK; i++) {
-        const double u = sign * check_point(law, U, i);
+        const double u = sign * check_point(side_law(law, sign), U, i);
         const double e = fabs(cf_export_table_eval(t, u) - cf_law_force(law, CF_LAW_EXACT, u, NULL,
                                                                         NULL));
         if (e > worst) {
@@ -325,19 +338,27 @@ static cf_status range_check(const cf_law *law, double tol, double u_lo_mm, doub
     if (!isfinite(tol) || tol < CF_EXPORT_TOL_MIN || tol > CF_EXPORT_TOL_MAX)
         return cf_error_set(err, CF_E_DATA, "tolerance %g is outside [%g, %g]", tol,
                             CF_EXPORT_TOL_MIN, CF_EXPORT_TOL_MAX);
-    const double u_end = cf_export_table_end(law, tol);
+    const double u_end = cf_export_table_end(law, tol), s_end = stretch_end(law, tol);
     if (!isfinite(u_lo_mm) || !isfinite(u_hi_mm) || u_lo_mm > 0.0 || u_hi_mm < 0.0 ||
         !(u_hi_mm > u_lo_mm))
         return cf_error_set(err, CF_E_DATA,
                             "range [%g, %g] mm must contain the rest state u = 0 and be wider "
                             "than a point",
                             u_lo_mm, u_hi_mm);
-    if (u_hi_mm > u_end || -u_lo_mm > u_end)
+    if (!law->extension && (u_hi_mm > u_end || -u_lo_mm > u_end))
         return cf_error_set(err, CF_E_DATA,
                             "range [%g, %g] mm passes the end of the spring's travel: the table "
                             "reaches |u| <= %.10g mm (where the law carries F_C (1 - tol); solid "
                             "at %.10g mm)",
                             u_lo_mm, u_hi_mm, u_end, law->travel_mm);
+    if (u_hi_mm > u_end || -u_lo_mm > s_end) /* a pair: each side its own spring's */
+        return cf_error_set(err, CF_E_DATA,
+                            "range [%g, %g] mm passes the end of a spring's travel: the table "
+                            "reaches u <= %.10g mm (the compression spring) and u >= -%.10g mm "
+                            "(the extension spring), where each carries its F_C (1 - tol); solid "
+                            "at %.10g and -%.10g mm",
+                            u_lo_mm, u_hi_mm, u_end, s_end, law->travel_mm,
+                            law->extension->travel_mm);
     return CF_OK;
 }
 
@@ -362,7 +383,13 @@ cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo
     if (Nco == TABLE_TOO_MANY)
         goto too_many;
     if (Ust > 0.0) {
-        if (Ust == Uco) { /* the law is odd: the stretch half mirrors the compression half */
+        if (law->extension) { /* a pair: the extension spring's own half, mirrored by join */
+            if ((Nst = settle_half(law->extension, tol, Ust, +1.0, &st, &scratch, &est, &wst)) ==
+                0)
+                goto oom;
+            if (Nst == TABLE_TOO_MANY)
+                goto too_many;
+        } else if (Ust == Uco) { /* the law is odd: the stretch half mirrors the compression half */
             st.n = co.n;
             st.u = malloc(co.n * sizeof *st.u);
             st.F = malloc(co.n * sizeof *st.F);
@@ -390,9 +417,12 @@ cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo
     /* the achieved error of the joined table, on the check grid of each side */
     eco = Uco > 0.0 ? half_error(law, t, Uco, +1.0, &wco) : 0.0;
     est = Ust > 0.0 ? half_error(law, t, Ust, -1.0, &wst) : 0.0;
-    t->max_err_N = fmax(eco, est);
-    t->max_err_u_mm = eco >= est ? wco : wst;
-    t->max_err_rel = t->max_err_N / law->F_C_N;
+    {   /* each side's error in its own spring's F_C (the same spring unless a pair) */
+        const double rco = eco / law->F_C_N, rst = est / side_law(law, -1.0)->F_C_N;
+        t->max_err_N = fmax(eco, est);
+        t->max_err_u_mm = rco >= rst ? wco : wst;
+        t->max_err_rel = fmax(rco, rst);
+    }
     for (size_t i = 0; i < t->rows; i++)
         if (!isfinite(t->u_mm[i]) || !isfinite(t->F_N[i]) || !isfinite(t->k_N_per_mm[i])) {
             status = cf_error_set(err, CF_E_INTERNAL, "export table row %zu is not finite", i);
@@ -533,7 +563,8 @@ static size_t even_rows(const cf_law *law, double a, double b, double goal_N, si
 static void even_cut(const cf_law *law, double lo, double hi, size_t n, double goal_N, double *a,
                      double *b)
 {
-    double good = fmin(law->u_T_mm, fmax(-lo, hi)), bad = fmax(-lo, hi);
+    double good = fmin(fmin(law->u_T_mm, side_law(law, -1.0)->u_T_mm), fmax(-lo, hi));
+    double bad = fmax(-lo, hi);
     for (int i = 0; i < 200 && bad - good > 1e-13 * bad; i++) {
         const double U = 0.5 * (good + bad);
         if (even_estimate(law, fmax(lo, -U), fmin(hi, U), n) <= goal_N)
@@ -555,7 +586,9 @@ cf_status cf_export_table_build_even(const cf_law *law, double tol, double u_lo_
         return status;
     if (max_rows < 2)
         max_rows = 2;
-    const double goal = tol * law->F_C_N;
+    /* a pair: the rows placed for the weaker spring's F_C, each side measured against its own */
+    const double goal = tol * fmin(law->F_C_N, side_law(law, -1.0)->F_C_N);
+    const double goal_lo = tol * side_law(law, -1.0)->F_C_N, goal_hi = tol * law->F_C_N;
     double aim = EVEN_AIM, e_hi = 0.0, e_lo = 0.0, w_hi = 0.0, w_lo = 0.0;
     for (int round = 0; round < EVEN_ROUNDS; round++, aim *= EVEN_SHRINK) {
         double a = u_lo_mm, b = u_hi_mm;
@@ -571,15 +604,15 @@ cf_status cf_export_table_build_even(const cf_law *law, double tol, double u_lo_
         /* measured on the check grid of each side, which knows nothing of the rows */
         e_hi = b > 0.0 ? half_error(law, t, b, +1.0, &w_hi) : 0.0;
         e_lo = a < 0.0 ? half_error(law, t, -a, -1.0, &w_lo) : 0.0;
-        if (fmax(e_hi, e_lo) <= goal)
+        if (e_hi <= goal_hi && e_lo <= goal_lo)
             break;
     }
     t->tol = tol;
     t->req_lo_mm = u_lo_mm;
     t->req_hi_mm = u_hi_mm;
     t->max_err_N = fmax(e_hi, e_lo);
-    t->max_err_u_mm = e_hi >= e_lo ? w_hi : w_lo;
-    t->max_err_rel = t->max_err_N / law->F_C_N;
+    t->max_err_u_mm = e_hi / goal_hi >= e_lo / goal_lo ? w_hi : w_lo;
+    t->max_err_rel = fmax(e_hi / law->F_C_N, e_lo / side_law(law, -1.0)->F_C_N);
     if (t->max_err_rel > tol) {
         status = cf_error_set(err, CF_E_DATA,
                               "the spring (rho = %.4g) cannot be tabulated evenly within the "
@@ -598,5 +631,5 @@ cf_status cf_export_table_build(const cf_law *law, double tol, cf_export_table *
                             CF_EXPORT_TOL_MIN, CF_EXPORT_TOL_MAX);
     }
     const double u_end = cf_export_table_end(law, tol);
-    return cf_export_table_build_range(law, tol, -u_end, u_end, t, err);
+    return cf_export_table_build_range(law, tol, -stretch_end(law, tol), u_end, t, err);
 }

@@ -177,6 +177,7 @@ int main(int argc, char **argv)
                     {"the force law", bench_section_law},
                     {"the spring with a cylindrical tail", bench_section_tail},
                     {"the lattice step", bench_section_lattice},
+                    {"the double-acting element and the volume term", bench_section_pair},
                     {"the integrators", bench_section_integrators},
                     {"fitting", bench_section_fit},
                     {"lattice resolution", bench_section_resolution},

@@ -75,6 +75,7 @@ extern volatile double bench_sink;
 void bench_section_law(bench_ctx *ctx);
 void bench_section_tail(bench_ctx *ctx);
 void bench_section_lattice(bench_ctx *ctx);
+void bench_section_pair(bench_ctx *ctx);
 void bench_section_integrators(bench_ctx *ctx);
 void bench_section_fit(bench_ctx *ctx);
 void bench_section_resolution(bench_ctx *ctx);

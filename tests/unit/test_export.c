@@ -904,8 +904,8 @@ static void write_scene(const char *name, double to_strain, int samples)
 /* The lattice of spring P (the test's fit file `fit`) loaded in 12 steps to strain `to`, exported
 ** for CalculiX as job `job`, run in ccx, and compared at every step with conifit simulate of the
 ** same scene. */
-static void ccx_lattice_matches_simulate(const char *fit, const cf_spring *P, double to,
-                                         const char *job)
+static double ccx_lattice_matches_simulate(const char *fit, const cf_spring *P, double to,
+                                           const char *job)
 {
     char scene[48], args[200], name[48], ffile[96];
     snprintf(scene, sizeof scene, "%s.json", job);
@@ -961,6 +961,172 @@ static void ccx_lattice_matches_simulate(const char *fit, const cf_spring *P, do
     free(dat);
     free(csv);
     free(x);
+    return tol;
+}
+
+/* ---- a double-acting element and a volume term ------------------------------------------------ */
+
+/* TEL in compression, its own extension spring EXT (the same H) in extension. */
+static const cf_spring EXT = {8, 24, 6, 1.2, 80000, 40};
+#define PAIR_PARAMS                                                                               \
+    "\"params\": {\"D1_mm\": 10, \"D2_mm\": 30, \"n\": 4, \"d_mm\": 1, \"G_MPa\": 80000, "     \
+    "\"H_mm\": 40}, \"params_extension\": {\"D1_mm\": 8, \"D2_mm\": 24, \"n\": 6, "            \
+    "\"d_mm\": 1.2, \"G_MPa\": 80000, \"H_mm\": 40}"
+
+/* pair.json: TEL and EXT with a volume term kappa = 0.5 MPa; pair0.json: the same pair alone. */
+static void write_pair_fits(void)
+{
+    assert_int_equal(write_in_dir("pair.json",
+                                  "{\"fits\": [{\"type\": \"telescoping\", " PAIR_PARAMS
+                                  ", \"lattice\": {\"volume_modulus_MPa\": 0.5}}]}\n"),
+                     0);
+    assert_int_equal(write_in_dir("pair0.json",
+                                  "{\"fits\": [{\"type\": \"telescoping\", " PAIR_PARAMS "}]}\n"),
+                     0);
+}
+
+/* The last stress (kPa) of `conifit simulate` on a scene of fit file `fit` loaded to `to`. */
+static double simulated_end_kPa(const char *fit, double to, const char *job)
+{
+    char scene[48], err[1024], p[160];
+    snprintf(scene, sizeof scene, "%s.json", job);
+    write_scene_of(fit, scene, to, 12);
+    assert_int_equal(tu_run(NULL, 0, err, sizeof err, "simulate %s/%s -o %s/%s.csv", dir, scene,
+                            dir, job),
+                     0);
+    snprintf(p, sizeof p, "%s/%s.csv", dir, job);
+    char *csv = tu_slurp(p);
+    assert_non_null(csv);
+    double s = NAN, t, e, v;
+    for (const char *line = strchr(csv, '\n'); line && line[1]; line = strchr(line + 1, '\n'))
+        if (sscanf(line + 1, "%lf,%lf,%lf", &t, &e, &v) == 3)
+            s = v;
+    free(csv);
+    return s;
+}
+
+/* The lattice of a double-acting element with a volume term, exported for CalculiX (SPRINGA tables
+** holding both springs, one C3D8 hexahedron per cell of a neo-Hookean material with C10 = 0 and
+** D1 = 2/kappa), runs in ccx within the stated tolerance of conifit simulate at every step of a
+** compression and of an extension; the volume term moves the reaction by far more than that
+** tolerance (so the hexahedra carry it), and the compression spring alone would not be the
+** lattice in extension. */
+static void calculix_runs_the_pair_and_volume_lattice_and_matches_simulate(void **state)
+{
+    (void)state;
+    if (!have_ccx())
+        skip(); /* CI installs calculix-ccx (Makefile DEBS) */
+    write_pair_fits();
+    const double area = 4.0 * TEL.H_mm * TEL.H_mm;
+    const double to[2] = {0.3, -0.3};
+    const char *job[2] = {"lat_pair_c", "lat_pair_t"}, *job0[2] = {"pair0_c", "pair0_t"};
+    for (int i = 0; i < 2; i++) {
+        const double tol_N = ccx_lattice_matches_simulate("pair.json", &TEL, to[i], job[i]);
+        const double with = simulated_end_kPa("pair.json", to[i], job[i]);
+        const double without = simulated_end_kPa("pair0.json", to[i], job0[i]);
+        const double moved_N = fabs(with - without) * 1e-3 * area;
+        if (!(moved_N > 10.0 * tol_N))
+            fail_msg("%s: the volume term moves the reaction by %.4g N, not above 10 times the "
+                     "tolerance %.4g N",
+                     job[i], moved_N, tol_N);
+    }
+}
+
+/* Every table of a pair holds both springs: the CSV's rows at u >= 0 on the compression spring's
+** law and at u < 0 on the extension spring's, within tol of that spring's F_C; the JSON carries
+** params_extension and the volume term back through the fit-file reader; the model formats that
+** cannot carry a volume term refuse the lattice (65, naming the format and why, nothing written),
+** as does the one-spring example of a fit with one; without the volume term every model format
+** writes the pair's lattice. */
+static void every_export_of_a_pair_holds_both_springs(void **state)
+{
+    (void)state;
+    write_pair_fits();
+    char fit[96], fit0[96];
+    snprintf(fit, sizeof fit, "%s/pair.json", dir);
+    snprintf(fit0, sizeof fit0, "%s/pair0.json", dir);
+    cf_law lc, le, pair;
+    law_of(&lc, &TEL);
+    law_of(&le, &EXT);
+    law_of(&pair, &TEL);
+    assert_int_equal(cf_law_pair(&pair, &le, NULL), CF_OK);
+    char *csv = export_file(fit, "pair.csv", "--format csv --tol 1e-4");
+    assert_non_null(strstr(csv, "# extension spring"));
+    assert_non_null(strstr(csv, "volume term"));
+    size_t below = 0, above = 0;
+    double lo = 0;
+    for (const char *line = strstr(csv, "u_mm,force_N"); line && (line = strchr(line, '\n')) &&
+                                                         line[1];
+         line++) {
+        double u, F, k;
+        if (sscanf(line + 1, "%lf,%lf,%lf", &u, &F, &k) != 3)
+            continue;
+        const cf_law *side = u < 0 ? &le : &lc;
+        const double law_F = u < 0 ? -cf_law_force(&le, CF_LAW_EXACT, -u, NULL, NULL)
+                                   : cf_law_force(&lc, CF_LAW_EXACT, u, NULL, NULL);
+        assert_close(F, law_F, 1e-4 * side->F_C_N);
+        assert_close(F, cf_law_force(&pair, CF_LAW_EXACT, u, NULL, NULL), 1e-4 * side->F_C_N);
+        below += u < 0;
+        above += u > 0;
+        lo = fmin(lo, u);
+    }
+    assert_true(below > 10 && above > 10);
+    /* the stretch side runs to the extension spring's travel, not the compression spring's */
+    assert_true(-lo <= le.travel_mm && -lo > 0.99 * le.travel_mm && le.travel_mm < lc.travel_mm);
+    free(csv);
+    /* JSON: read back as the whole element */
+    free(export_file(fit, "pair_spring.json", "--format json"));
+    char p[160];
+    snprintf(p, sizeof p, "%s/pair_spring.json", dir);
+    cf_fitted_spring fs;
+    cf_error err = {0};
+    assert_int_equal(cf_fitfile_load_element(p, NULL, &fs, &err), CF_OK);
+    assert_true(fs.has_extension);
+    for (int k = 0; k < CF_P_COUNT; k++)
+        assert_true(cf_spring_get(&fs.extension, k) == cf_spring_get(&EXT, k));
+    assert_true(fs.volume_modulus_MPa == 0.5);
+    /* lattices: the volume term only where it can be carried */
+    write_scene_of("pair.json", "pair_lat.json", 0.2, 4);
+    write_scene_of("pair0.json", "pair0_lat.json", 0.2, 4);
+    for (int f = 0; f < CF_EXPORT_FORMAT_COUNT; f++) {
+        const cf_export_format_info *fi = cf_export_format_get((cf_export_format)f);
+        if (!fi->model)
+            continue;
+        char args[512], name[48], errb[2048];
+        snprintf(name, sizeof name, "pair_lat.%s", fi->name);
+        snprintf(args, sizeof args, "export %s --lattice %s/pair_lat.json --format %s -o %s/%s",
+                 fit, dir, fi->name, dir, name);
+        const int rc = tu_run(NULL, 0, errb, sizeof errb, "%s", args);
+        snprintf(p, sizeof p, "%s/%s", dir, name);
+        struct stat st;
+        if (f == CF_EXPORT_CALCULIX || f == CF_EXPORT_ABAQUS) {
+            if (rc != 0)
+                fail_msg("%s: exit %d: %s", args, rc, errb);
+            char *x = tu_slurp(p);
+            assert_non_null(strstr(x, "*ELEMENT, TYPE=C3D8, ELSET=CELLS"));
+            assert_non_null(strstr(x, "*HYPERELASTIC, NEO HOOKE\n0., 4.\n"));
+            free(x);
+        } else {
+            if (rc != 65 || !strstr(errb, "volume term") || !strstr(errb, fi->name))
+                fail_msg("%s: exit %d, '%s' (expected 65 naming the volume term and %s)", args, rc,
+                         errb, fi->name);
+            assert_int_equal(stat(p, &st), -1);
+        }
+        snprintf(name, sizeof name, "pair0_lat.%s", fi->name);
+        snprintf(args, sizeof args, "--lattice %s/pair0_lat.json --format %s", dir, fi->name);
+        char *x = export_file(fit0, name, args);
+        assert_non_null(strstr(x, "extension spring"));
+        free(x);
+    }
+    char errb[2048];
+    snprintf(p, sizeof p, "%s/pair_example.inp", dir);
+    assert_int_equal(tu_run(NULL, 0, errb, sizeof errb, "export %s --format calculix --example "
+                            "-o %s", fit, p),
+                     65);
+    assert_non_null(strstr(errb, "volume term"));
+    struct stat st;
+    assert_int_equal(stat(p, &st), -1);
+    free(export_file(fit0, "pair0_example.inp", "--format calculix --example"));
 }
 
 static void calculix_runs_the_lattice_and_matches_conifit_simulate_at_every_step(void **state)
@@ -1404,6 +1570,8 @@ int main(void)
         cmocka_unit_test(calculix_runs_the_one_spring_example_and_matches_the_law),
         cmocka_unit_test(calculix_holds_the_last_force_beyond_the_table),
         cmocka_unit_test(calculix_runs_the_lattice_and_matches_conifit_simulate_at_every_step),
+        cmocka_unit_test(calculix_runs_the_pair_and_volume_lattice_and_matches_simulate),
+        cmocka_unit_test(every_export_of_a_pair_holds_both_springs),
         cmocka_unit_test(lattice_models_of_every_format_hold_the_law_in_every_group),
         cmocka_unit_test(lattice_models_of_every_format_hold_the_tailed_law_in_every_group),
         cmocka_unit_test(every_format_has_a_runnable_example),

@@ -211,6 +211,33 @@ static void a_scene_and_an_export_are_whole_and_finite(void **state)
     assert_null(strstr(text, "nan"));
     assert_null(strstr(text, "inf"));
     cf_flat_free(text);
+    /* a double-acting element: both springs in the table (u < 0 the extension spring's) */
+    char dir[] = "/tmp/conifit-flat-XXXXXX", fit[64];
+    assert_non_null(mkdtemp(dir));
+    snprintf(fit, sizeof fit, "%s/pair.json", dir);
+    FILE *f = fopen(fit, "w");
+    assert_non_null(f);
+    fputs("{\"fits\": [{\"type\": \"telescoping\", \"params\": {\"D1_mm\": 10, \"D2_mm\": 30, "
+          "\"n\": 4, \"d_mm\": 1, \"G_MPa\": 80000, \"H_mm\": 40}, \"params_extension\": "
+          "{\"D1_mm\": 8, \"D2_mm\": 24, \"n\": 6, \"d_mm\": 1.2, \"G_MPa\": 80000, "
+          "\"H_mm\": 40}}]}\n", f);
+    fclose(f);
+    text = NULL;
+    assert_int_equal(cf_flat_export(fit, NULL, "csv", 1e-4, &text, &e), CF_OK);
+    assert_non_null(strstr(text, "# extension spring"));
+    const cf_spring ext = {8, 24, 6, 1.2, 80000, 40};
+    cf_law le;
+    assert_int_equal(cf_law_init(&le, &ext, NULL), CF_OK);
+    const char *row = strstr(text, "u_mm,force_N");
+    assert_non_null(row);
+    double u, F, k;
+    assert_int_equal(sscanf(strchr(row, '\n') + 1, "%lf,%lf,%lf", &u, &F, &k), 3);
+    /* the first row: the extension spring's end, within 1e-4 F_C of its law */
+    assert_true(u < 0 && u >= -le.travel_mm);
+    assert_close(F, -cf_law_force(&le, CF_LAW_EXACT, -u, NULL, NULL), 1e-4 * le.F_C_N);
+    cf_flat_free(text);
+    remove(fit);
+    rmdir(dir);
 }
 
 int main(void)

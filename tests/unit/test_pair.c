@@ -12,6 +12,7 @@
 
 #include "conifit/cell.h"
 #include "conifit/msm.h"
+#include "model/lattice_step.h"
 
 /* The compression spring (non-telescoping, solid strain 0.5, H 10 mm) and an extension spring
 ** of the same H: a stiffer, nearly cylindrical one, and a strongly conical one. */
@@ -459,6 +460,107 @@ static void full_lattice_with_the_volume_term_equals_the_cell(void **state)
     assert_true(fabs(bare[0] - cell[0]) > 1e-3 * fabs(cell[0]));
 }
 
+/* The explicit step of a lattice of double-acting elements (lattice_step.c) through both springs'
+** vector lanes: for both extension springs, with the closed form (the pair's polynomial when both
+** fit, else its closed form), the tables and exact (the scalar law), the node forces of a jittered
+** lattice squeezed and stretched (every spring region of both sides seen) equal an independent sum
+** over the springs with the exact law of the pair, within 1e-12 of the largest, and the step's
+** largest |u| equals it over the smaller travel. */
+static void explicit_step_runs_the_pair_through_its_lanes(void **state)
+{
+    (void)state;
+    int lanes_seen[6] = {0};
+    for (int ei = 0; ei < 2; ei++) {
+        cf_law lc = law_of(&comp_p), le = law_of(&ext_p[ei]);
+        cf_error err = {0};
+        assert_int_equal(cf_law_table_build(&lc, 4096, &err), CF_OK);
+        assert_int_equal(cf_law_table_build(&le, 4096, &err), CF_OK);
+        assert_int_equal(cf_law_pair(&lc, &le, &err), CF_OK);
+        const cf_law_method methods[3] = {CF_LAW_CLOSED, CF_LAW_TABLE, CF_LAW_EXACT};
+        /* the axial springs half way into region 2 of each side */
+        const double squeeze[2] = {1 - 0.5 * (lc.u_T_mm + lc.travel_mm) / lc.p.H_mm,
+                                   1 + 0.5 * (le.u_T_mm + le.travel_mm) / le.p.H_mm};
+        for (int mi = 0; mi < 3; mi++) {
+            int seen[2][2] = {{0}}; /* [side][past u_T] over both loadings */
+            for (int qi = 0; qi < 2; qi++) {
+                cf_lattice_config c = cf_lattice_default();
+                c.nx = 4, c.ny = 3, c.nz = 5;
+                cf_lattice lat;
+                assert_int_equal(cf_lattice_create(&lat, &lc, methods[mi], &c, &err), CF_OK);
+                srand((unsigned)(10 * ei + 3 * mi + qi + 1));
+                const double jit = 0.01 * fmin(lc.travel_mm - lc.u_T_mm, le.travel_mm - le.u_T_mm);
+                for (size_t p = 0; p < lat.nn; p++) {
+                    lat.x[p] += jit * (rand() / (double)RAND_MAX - 0.5);
+                    lat.y[p] += jit * (rand() / (double)RAND_MAX - 0.5);
+                    lat.z[p] = squeeze[qi] * lat.Z[p] + jit * (rand() / (double)RAND_MAX - 0.5);
+                }
+                double *g = calloc(3 * lat.nn, sizeof(double));
+                assert_non_null(g);
+                double scale = 0, umax = 0;
+                for (size_t q = 0; q < lat.ns; q++) {
+                    const uint32_t i = lat.si[q], j = lat.sj[q];
+                    const double d[3] = {lat.x[j] - lat.x[i], lat.y[j] - lat.y[i],
+                                         lat.z[j] - lat.z[i]};
+                    const double L = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                    const double u = (lat.L0_mm[q] - L) * lat.a[q];
+                    const cf_law *side = u < 0 ? &le : &lc;
+                    assert_true(fabs(u) < side->travel_mm);
+                    seen[u < 0][fabs(u) > side->u_T_mm] = 1;
+                    umax = fmax(umax, fabs(u));
+                    const double T = -lat.w[q] * cf_law_force(&lc, CF_LAW_EXACT, u, NULL, NULL);
+                    scale = fmax(scale, fabs(T));
+                    for (int a = 0; a < 3; a++) {
+                        g[3 * i + a] += T * d[a] / L;
+                        g[3 * j + a] -= T * d[a] / L;
+                    }
+                }
+                cf_lattice_stepper st;
+                assert_int_equal(cf_lattice_stepper_init(&st, &lat, NULL, &err), CF_OK);
+                if (mi == 2)
+                    assert_int_equal(st.form, -1);
+                else
+                    assert_true(st.form == CF_STEP_PAIR_POLY ||
+                                st.form == (mi ? CF_STEP_PAIR_TABLE : CF_STEP_PAIR_CLOSED));
+                /* the form chosen, then the method's own lanes forced (the polynomial fits these
+                ** springs, so the closed form and the tables run only when asked) */
+                const int forms[2] = {st.form, mi == 2   ? -1
+                                               : mi == 1 ? CF_STEP_PAIR_TABLE
+                                                         : CF_STEP_PAIR_CLOSED};
+                for (int fi = 0; fi < 2; fi++) {
+                    st.form = forms[fi];
+                    if (st.form >= CF_STEP_PAIR_CLOSED)
+                        lanes_seen[st.form] = 1;
+                    memset(lat.fx, 0, lat.nn * sizeof(double));
+                    memset(lat.fy, 0, lat.nn * sizeof(double));
+                    memset(lat.fz, 0, lat.nn * sizeof(double));
+                    assert_close(cf_lattice_stepper_forces(&st), umax / lat.travel_mm, 1e-15);
+                    /* the tables' own error (4096 intervals) is far below 1e-10 of the force */
+                    const double tol = (st.form == CF_STEP_PAIR_TABLE ? 1e-10 : 1e-12) * scale;
+                    for (size_t p = 0; p < lat.nn; p++) {
+                        assert_close(lat.fx[p], g[3 * p], tol);
+                        assert_close(lat.fy[p], g[3 * p + 1], tol);
+                        assert_close(lat.fz[p], g[3 * p + 2], tol);
+                    }
+                }
+                free(g);
+                cf_lattice_stepper_free(&st);
+                cf_lattice_free(&lat);
+            }
+            if (!(seen[0][0] && seen[0][1] && seen[1][0] && seen[1][1]))
+                fail_msg("extension spring %d: regions seen: compression %d %d, extension %d %d",
+                         ei, seen[0][0], seen[0][1], seen[1][0], seen[1][1]);
+        }
+        cf_law_free(&lc);
+        cf_law_free(&le);
+    }
+    /* every form of the pair's lanes ran */
+    assert_true(lanes_seen[CF_STEP_PAIR_POLY] && lanes_seen[CF_STEP_PAIR_CLOSED] &&
+                lanes_seen[CF_STEP_PAIR_TABLE]);
+    print_message("pair lanes seen: closed %d, table %d, polynomial %d\n",
+                  lanes_seen[CF_STEP_PAIR_CLOSED], lanes_seen[CF_STEP_PAIR_TABLE],
+                  lanes_seen[CF_STEP_PAIR_POLY]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -469,6 +571,7 @@ int main(void)
         cmocka_unit_test(tangent_with_the_volume_term_is_the_stress_derivative),
         cmocka_unit_test(full_lattice_with_the_pair_equals_the_cell),
         cmocka_unit_test(full_lattice_with_the_volume_term_equals_the_cell),
+        cmocka_unit_test(explicit_step_runs_the_pair_through_its_lanes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -29,6 +29,9 @@
 **     "params": { ... as above ... },
 **     "derived": { ... as above ... }, "units": { ... },
 **     "provenance": { "fit_file", "data_file", "rmse", "rmse_unit", "fit_version" } }
+** and, for a double-acting element, "params_extension" and "derived_extension" (its extension
+** spring) and, for a lattice with a volume term, "lattice": { "volume_modulus_MPa" }, the keys of
+** the fit file, which cf_fitfile_load_element reads back.
 */
 #ifndef CF_FITFILE_H
 #define CF_FITFILE_H
@@ -76,9 +79,8 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
 
 /* cf_fitfile_load refuses a fit whose element is double-acting ("params_extension") or whose
 ** lattice has a volume term ("lattice.volume_modulus_MPa" > 0) with CF_E_DATA naming the key:
-** export and a scene's 'spring.fit' read one spring per element and no volume term yet, and must
-** not run such a fit as its compression spring alone (a scene gives both by its own keys,
-** scene.h). cf_fitfile_load_element reads
+** readers of one spring per element must not run such a fit as its compression spring alone.
+** cf_fitfile_load_element (a scene's 'spring.fit', export) reads
 ** them (has_extension, extension, volume_modulus_MPa), checking the extension spring as params
 ** (every key, a law it makes, the compression spring's H). */
 cf_status cf_fitfile_load_element(const char *path, const char *type_name,

@@ -46,7 +46,8 @@ cf_status cf_flat_simulate(const char *scene_path, double **samples, size_t *cou
 
 /* Writes the spring of the fit file (or exported spring) at fit_path, of the type named by type
 ** (NULL: the better fit), in the format named by format (as conifit export --format), with table
-** tolerance tol (fraction of F_C; 0: the default) into *text. */
+** tolerance tol (fraction of F_C; 0: the default) into *text. A double-acting element is written
+** whole (its table's u < 0 side the extension spring's), as conifit export writes it. */
 cf_status cf_flat_export(const char *fit_path, const char *type, const char *format, double tol,
                          char **text, cf_error *err);
 
