@@ -53,6 +53,32 @@ static void both_laws(const cf_joint_report *r, int i, const cf_joint_result **c
     *cone = lc->chose_tail ? &lc->other : &r->fits[i];
 }
 
+/* A tailed joint fit that is the conical optimum it contains (cf_joint_fit_tail): why, into buf
+** (empty when it has its tail). */
+static void joint_nested(const cf_joint_result *tail, char *buf, size_t cap)
+{
+    size_t n = 0;
+    buf[0] = '\0';
+    if (!tail->fit.tail || tail->fit.params.n_tail != 0)
+        return;
+    cf_report_append(buf, cap, &n, "no tail: the conical optimum the tailed law contains, since ");
+    if (!(tail->nested_objective > 0)) {
+        cf_report_append(buf, cap, &n, "the tailed search found no spring running every table");
+        return;
+    }
+    cf_report_append(buf, cap, &n, "the tailed spring its search ended on (objective %.4g) ",
+                     tail->nested_objective);
+    const unsigned v = tail->fit.nested_violated;
+    if (!v) {
+        cf_report_append(buf, cap, &n, "fits worse");
+        return;
+    }
+    cf_report_append(buf, cap, &n, "breaks the limit%s", (v & (v - 1)) ? "s" : "");
+    for (int b = 0; b < CF_C_COUNT; b++)
+        if (v & (1u << b))
+            cf_report_append(buf, cap, &n, " %s", cf_fit_constraint_name(1u << b));
+}
+
 static const char *weighting_text =
     "each table's residuals divided by its RMS stress and by the square root of its number of "
     "rows, so every table counts once whatever its stress scale and length";
@@ -92,7 +118,12 @@ static void law_choice_text(FILE *o, const cf_joint_report *r)
                         law[l]->tab[k].cell_rmse * t->y_to_file, t->y_unit, law[l]->tab[k].aic);
             }
         }
+        char nested[320];
+        joint_nested(tail, nested, sizeof nested);
+        if (nested[0])
+            fprintf(o, "  %-16s %s\n", "", nested);
         const char *why = r->law == CF_FAMILY_TAIL ? "asked for (--law conical-tail)"
+                          : nested[0]              ? "the tailed law's fit is the conical one"
                           : lc->chose_tail         ? "lower joint AIC"
                           : !tail->fit.feasible    ? "the tailed spring is infeasible"
                                                    : "the tail does not lower the joint AIC";
@@ -316,6 +347,10 @@ static json_t *law_json(const cf_joint_report *r, const cf_joint_result *j)
                           per ? per : json_array());
     if (o && j->fit.tail)
         json_object_set_new(o, "tail_compliance", cf_report_tail_json(&j->fit));
+    char nested[320];
+    joint_nested(j, nested, sizeof nested);
+    if (o && nested[0])
+        json_object_set_new(o, "no_tail", json_string(nested));
     return o;
 }
 
