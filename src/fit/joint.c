@@ -816,6 +816,38 @@ static cf_status search_pair(jctx *c, const cf_table *reach, double xmax,
         /* the element is buildable when both springs are: fit.feasible says it for the pair */
         r->fit.feasible = r->fit.feasible && r->ext.feasible;
     }
+    /* the pair contains the single-sided law plain (two equal springs): a pair infeasible where
+    ** plain is feasible is plain's optimum as two equal springs, what its search ended on kept
+    ** in nested_objective and fit.nested_* (issue 37) */
+    if (c->pair && plain && !plain->pair && plain->volume == CF_VOLUME_NONE &&
+        opt->volume == CF_VOLUME_NONE && plain->fit.feasible && !r->fit.feasible) {
+        const double lost = best, lost_rmse = r->fit.rmse;
+        const unsigned lost_bits = r->fit.violated | r->ext.violated;
+        double zq[8] = {log(plain->ident.rho), plain->ident.solid, 0};
+        zq[pv.ie] = zq[0], zq[pv.ie + 1] = zq[1], zq[pv.ie + 2] = 0;
+        if (pv.iq >= 0)
+            zq[pv.iq] = log(plain->weight[1] / plain->weight[0]);
+        pair_set(c, &pv, zq);
+        best = cf_cell_rss(&c->pr, plain->ident.rho, plain->ident.solid, &A);
+        const double vq[PQ_COUNT] = {plain->ident.rho, plain->ident.solid, A, plain->ident.rho,
+                                     plain->ident.solid, A, 0};
+        memcpy(v, vq, sizeof v);
+        r->objective = best;
+        r->ident.rho = v[PQ_RC], r->ident.solid = v[PQ_BC], r->ident.scale = A;
+        if ((st = cf_fit_place(reach, opt, c->type, &r->ident, &r->fit, err)) != CF_OK)
+            return st;
+        r->fit.ident = r->ident;
+        cf_fit_options oe = *opt;
+        oe.fixed[CF_P_H] = 1;
+        oe.fixed_value[CF_P_H] = r->fit.params.H_mm;
+        if ((st = cf_fit_place(reach, &oe, c->type, &r->ident, &r->ext, err)) != CF_OK)
+            return st;
+        r->ext.ident = r->ident;
+        r->fit.feasible = r->fit.feasible && r->ext.feasible;
+        r->nested_objective = lost;
+        r->fit.nested_rmse = lost_rmse;
+        r->fit.nested_violated = lost_bits;
+    }
     /* the small-strain moduli each side, from the cell of the quantities found: a bimodular
     ** lattice's uniaxial compression loads its axial springs' compression sides and its lateral
     ** springs' extension sides (and the reverse in tension), so neither side's E and nu is that

@@ -159,6 +159,16 @@ static void pair_choice_text(FILE *o, const cf_joint_report *r)
             fprintf(o, "  %-16s %-13s joint AIC %.2f, objective %.4g (%d quantities)%s\n",
                     l ? "" : type, lname[l], law[l]->aic, law[l]->objective, law[l]->nparams,
                     law[l]->fit.feasible ? "" : " (infeasible)");
+        if (pair->nested_objective > 0) {
+            const unsigned v = pair->fit.nested_violated;
+            fprintf(o, "  %-16s two equal springs: the single-sided law's optimum the pair "
+                       "contains, since the pair its search ended on (objective %.4g) breaks "
+                       "the limit%s", "", pair->nested_objective, (v & (v - 1)) ? "s" : "");
+            for (int b = 0; b < CF_C_COUNT; b++)
+                if (v & (1u << b))
+                    fprintf(o, " %s", cf_fit_constraint_name(1u << b));
+            fputc('\n', o);
+        }
         const char *why = r->law == CF_FAMILY_DOUBLE ? "asked for (--law double-acting)"
                           : lc->chose_pair           ? "lower joint AIC"
                           : !pair->fit.feasible      ? "a spring of the pair is infeasible"
@@ -396,6 +406,17 @@ static void pair_json(json_t *f, const cf_joint_result *j)
                                   "stress_scale_MPa",
                                   ident_json(j->ext.ident.scale, j->ext.ident_se.scale)));
     json_object_set_new(f, "feasible_extension", json_boolean(j->ext.feasible));
+    /* two equal springs in place of an infeasible pair (cf_joint_fit_pair): what its search
+    ** ended on */
+    if (j->nested_objective > 0) {
+        json_t *bits = json_array();
+        for (int b = 0; bits && b < CF_C_COUNT; b++)
+            if (j->fit.nested_violated & (1u << b))
+                json_array_append_new(bits, json_string(cf_fit_constraint_name(1u << b)));
+        json_object_set_new(f, "equal_springs",
+                            json_pack("{s:o, s:o}", "search_objective", num(j->nested_objective),
+                                      "search_violated", bits ? bits : json_array()));
+    }
 }
 
 /* The lattice's volume term and its small-strain moduli each side, into its `lattice` object. */
