@@ -681,7 +681,10 @@ static cf_status search_pair(jctx *c, const cf_table *reach, double xmax,
     const double A0 = plain ? plain->ident.scale : 0;
     const double grid_rc[2] = {rc0, 0.1}, grid_re[3] = {0.9, 0.5, 0.15},
                  grid_be[2] = {0.25, 0.7}, grid_k[2] = {0.3, 3.0};
-    const int nre = c->pair ? 3 : 1, nbe = c->pair ? 2 : 1, nk = pv.ik >= 0 ? 2 : 1;
+    /* the pair contains the single-sided law (two equal springs): with plain, its optimum is a
+    ** start too (ge 3), so the pair never ends worse than the law it contains */
+    const int nre = c->pair ? (plain ? 4 : 3) : 1, nbe = c->pair ? 2 : 1,
+              nk = pv.ik >= 0 ? 2 : 1;
     const pair_obj o = {c, &pv};
     double best = CF_LSQ_HUGE_OBJ, zb[8] = {0};
     for (int gc = 0; gc < 2; gc++)
@@ -689,9 +692,13 @@ static cf_status search_pair(jctx *c, const cf_table *reach, double xmax,
             for (int gb = 0; gb < nbe; gb++)
                 for (int gk = 0; gk < nk; gk++) {
                     double z[8];
+                    if (ge == 3 && (gc != 0 || gb != 0))
+                        continue;
                     z[0] = log(grid_rc[gc]);
                     z[1] = gc == 0 ? bc0 : pv.lb[1] + 0.3 * (pv.ub[1] - pv.lb[1]);
-                    if (pv.ie >= 0) {
+                    if (pv.ie >= 0 && ge == 3) {
+                        z[pv.ie] = z[0], z[pv.ie + 1] = z[1], z[pv.ie + 2] = 0;
+                    } else if (pv.ie >= 0) {
                         z[pv.ie] = log(grid_re[ge]);
                         z[pv.ie + 1] = pv.lb[1] + grid_be[gb] * (pv.ub[1] - pv.lb[1]);
                         z[pv.ie + 2] = log(0.5);
@@ -709,6 +716,15 @@ static cf_status search_pair(jctx *c, const cf_table *reach, double xmax,
                         step[j] = j == 1 || j == pv.ie + 1 ? 0.05 * (pv.ub[j] - pv.lb[j]) : 0.2;
                     }
                     double f = CF_LSQ_HUGE_OBJ;
+                    if (ge == 3) {
+                        /* BOBYQA may move a start near a bound before its first evaluation:
+                        ** the contained law's optimum counts as it is */
+                        const double f0 = pair_objective((unsigned)pv.n, z, NULL, (void *)&o);
+                        if (f0 < best) {
+                            best = f0;
+                            memcpy(zb, z, sizeof zb);
+                        }
+                    }
                     nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)pv.n,
                                                       pv.lb, pv.ub, step, XTOL_REL,
                                                       PAIR_MAX_EVALS, pair_objective, (void *)&o,
@@ -799,6 +815,38 @@ static cf_status search_pair(jctx *c, const cf_table *reach, double xmax,
         r->ext.ident = qe;
         /* the element is buildable when both springs are: fit.feasible says it for the pair */
         r->fit.feasible = r->fit.feasible && r->ext.feasible;
+    }
+    /* the pair contains the single-sided law plain (two equal springs): a pair infeasible where
+    ** plain is feasible is plain's optimum as two equal springs, what its search ended on kept
+    ** in nested_objective and fit.nested_* (issue 37) */
+    if (c->pair && plain && !plain->pair && plain->volume == CF_VOLUME_NONE &&
+        opt->volume == CF_VOLUME_NONE && plain->fit.feasible && !r->fit.feasible) {
+        const double lost = best, lost_rmse = r->fit.rmse;
+        const unsigned lost_bits = r->fit.violated | r->ext.violated;
+        double zq[8] = {log(plain->ident.rho), plain->ident.solid, 0};
+        zq[pv.ie] = zq[0], zq[pv.ie + 1] = zq[1], zq[pv.ie + 2] = 0;
+        if (pv.iq >= 0)
+            zq[pv.iq] = log(plain->weight[1] / plain->weight[0]);
+        pair_set(c, &pv, zq);
+        best = cf_cell_rss(&c->pr, plain->ident.rho, plain->ident.solid, &A);
+        const double vq[PQ_COUNT] = {plain->ident.rho, plain->ident.solid, A, plain->ident.rho,
+                                     plain->ident.solid, A, 0};
+        memcpy(v, vq, sizeof v);
+        r->objective = best;
+        r->ident.rho = v[PQ_RC], r->ident.solid = v[PQ_BC], r->ident.scale = A;
+        if ((st = cf_fit_place(reach, opt, c->type, &r->ident, &r->fit, err)) != CF_OK)
+            return st;
+        r->fit.ident = r->ident;
+        cf_fit_options oe = *opt;
+        oe.fixed[CF_P_H] = 1;
+        oe.fixed_value[CF_P_H] = r->fit.params.H_mm;
+        if ((st = cf_fit_place(reach, &oe, c->type, &r->ident, &r->ext, err)) != CF_OK)
+            return st;
+        r->ext.ident = r->ident;
+        r->fit.feasible = r->fit.feasible && r->ext.feasible;
+        r->nested_objective = lost;
+        r->fit.nested_rmse = lost_rmse;
+        r->fit.nested_violated = lost_bits;
     }
     /* the small-strain moduli each side, from the cell of the quantities found: a bimodular
     ** lattice's uniaxial compression loads its axial springs' compression sides and its lateral
@@ -975,5 +1023,50 @@ cf_status cf_joint_fit_tail(const cf_table *const *tables, size_t n, const cf_fi
                             cf_joint_result *r, cf_error *err)
 {
     CF_GSL_GUARD;
-    return joint_run(tables, n, opt, lat, plain->fit.type, plain, -1, r, err);
+    cf_status st = joint_run(tables, n, opt, lat, plain->fit.type, plain, -1, r, err);
+    if (st == CF_E_INTERNAL || !(plain->objective >= 0) || !isfinite(plain->objective))
+        return st;
+    /* the tailed law contains the conical law (tail compliance 0): a search that finds nothing,
+    ** ends infeasible where plain is feasible, or ends with a larger weighted objective at the
+    ** same feasibility gives plain with no tail (cf_tail_nest for one table) */
+    const int found = st == CF_OK;
+    if (found && !(plain->fit.feasible && !r->fit.feasible) &&
+        !(plain->fit.feasible == r->fit.feasible &&
+          !(r->objective <= plain->objective * (1 + 1e-9))))
+        return CF_OK;
+    cf_joint_result nest = *plain;
+    for (size_t k = 0; k < CF_JOINT_MAX; k++)
+        nest.tab[k].lattice_MPa = NULL;
+    for (size_t k = 0; k < plain->ntables; k++) {
+        const size_t m = plain->tab[k].points;
+        if (!plain->tab[k].lattice_MPa)
+            continue;
+        nest.tab[k].lattice_MPa = malloc(m * sizeof(double));
+        if (!nest.tab[k].lattice_MPa) {
+            cf_joint_free(&nest);
+            if (found)
+                cf_joint_free(r);
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory");
+        }
+        memcpy(nest.tab[k].lattice_MPa, plain->tab[k].lattice_MPa, m * sizeof(double));
+    }
+    cf_fit_result *f = &nest.fit;
+    f->nested_rmse = found && isfinite(r->fit.rmse) ? r->fit.rmse : 0;
+    f->nested_violated = found && !r->fit.feasible ? r->fit.violated : 0;
+    nest.nested_objective = found && isfinite(r->objective) ? r->objective : 0;
+    f->tail = 1;
+    f->e_tail = 0;
+    f->e_tail_se = 0;
+    f->e_tail_interval_ok = 0;
+    f->params.n_tail = 0;
+    f->params.H_tail_mm = 0;
+    /* the search's cost is the tailed fit's own */
+    nest.evaluations = found ? r->evaluations : 0;
+    nest.wall_time_s = found ? r->wall_time_s : 0;
+    if (found)
+        cf_joint_free(r);
+    *r = nest;
+    if (err)
+        memset(err, 0, sizeof *err);
+    return CF_OK;
 }

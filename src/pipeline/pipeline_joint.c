@@ -11,8 +11,9 @@
 
 /* The tailed law's joint fit beside the conical one in fits[k], and the law kept: --law
 ** conical-tail the tail, auto the tail only with a lower joint AIC and a feasible spring, as a
-** single fit chooses (pipeline.c). A tailed law that finds no spring leaves auto's choice to the
-** conical law; --law conical-tail then fails. */
+** single fit chooses (pipeline.c). A tailed fit that ends worse than the conical one or finds
+** no spring is the conical optimum it contains, with no tail (cf_joint_fit_tail): auto then keeps
+** the conical law, --law conical-tail reports that optimum. */
 static cf_status choose_law(const cf_table *const *tables, size_t n,
                             const cf_pipeline_options *opt, cf_joint_report *r, int k,
                             cf_error *err)

@@ -53,6 +53,32 @@ static void both_laws(const cf_joint_report *r, int i, const cf_joint_result **c
     *cone = lc->chose_tail ? &lc->other : &r->fits[i];
 }
 
+/* A tailed joint fit that is the conical optimum it contains (cf_joint_fit_tail): why, into buf
+** (empty when it has its tail). */
+static void joint_nested(const cf_joint_result *tail, char *buf, size_t cap)
+{
+    size_t n = 0;
+    buf[0] = '\0';
+    if (!tail->fit.tail || tail->fit.params.n_tail != 0)
+        return;
+    cf_report_append(buf, cap, &n, "no tail: the conical optimum the tailed law contains, since ");
+    if (!(tail->nested_objective > 0)) {
+        cf_report_append(buf, cap, &n, "the tailed search found no spring running every table");
+        return;
+    }
+    cf_report_append(buf, cap, &n, "the tailed spring its search ended on (objective %.4g) ",
+                     tail->nested_objective);
+    const unsigned v = tail->fit.nested_violated;
+    if (!v) {
+        cf_report_append(buf, cap, &n, "fits worse");
+        return;
+    }
+    cf_report_append(buf, cap, &n, "breaks the limit%s", (v & (v - 1)) ? "s" : "");
+    for (int b = 0; b < CF_C_COUNT; b++)
+        if (v & (1u << b))
+            cf_report_append(buf, cap, &n, " %s", cf_fit_constraint_name(1u << b));
+}
+
 static const char *weighting_text =
     "each table's residuals divided by its RMS stress and by the square root of its number of "
     "rows, so every table counts once whatever its stress scale and length";
@@ -92,7 +118,12 @@ static void law_choice_text(FILE *o, const cf_joint_report *r)
                         law[l]->tab[k].cell_rmse * t->y_to_file, t->y_unit, law[l]->tab[k].aic);
             }
         }
+        char nested[320];
+        joint_nested(tail, nested, sizeof nested);
+        if (nested[0])
+            fprintf(o, "  %-16s %s\n", "", nested);
         const char *why = r->law == CF_FAMILY_TAIL ? "asked for (--law conical-tail)"
+                          : nested[0]              ? "the tailed law's fit is the conical one"
                           : lc->chose_tail         ? "lower joint AIC"
                           : !tail->fit.feasible    ? "the tailed spring is infeasible"
                                                    : "the tail does not lower the joint AIC";
@@ -128,6 +159,16 @@ static void pair_choice_text(FILE *o, const cf_joint_report *r)
             fprintf(o, "  %-16s %-13s joint AIC %.2f, objective %.4g (%d quantities)%s\n",
                     l ? "" : type, lname[l], law[l]->aic, law[l]->objective, law[l]->nparams,
                     law[l]->fit.feasible ? "" : " (infeasible)");
+        if (pair->nested_objective > 0) {
+            const unsigned v = pair->fit.nested_violated;
+            fprintf(o, "  %-16s two equal springs: the single-sided law's optimum the pair "
+                       "contains, since the pair its search ended on (objective %.4g) breaks "
+                       "the limit%s", "", pair->nested_objective, (v & (v - 1)) ? "s" : "");
+            for (int b = 0; b < CF_C_COUNT; b++)
+                if (v & (1u << b))
+                    fprintf(o, " %s", cf_fit_constraint_name(1u << b));
+            fputc('\n', o);
+        }
         const char *why = r->law == CF_FAMILY_DOUBLE ? "asked for (--law double-acting)"
                           : lc->chose_pair           ? "lower joint AIC"
                           : !pair->fit.feasible      ? "a spring of the pair is infeasible"
@@ -316,6 +357,10 @@ static json_t *law_json(const cf_joint_report *r, const cf_joint_result *j)
                           per ? per : json_array());
     if (o && j->fit.tail)
         json_object_set_new(o, "tail_compliance", cf_report_tail_json(&j->fit));
+    char nested[320];
+    joint_nested(j, nested, sizeof nested);
+    if (o && nested[0])
+        json_object_set_new(o, "no_tail", json_string(nested));
     return o;
 }
 
@@ -361,6 +406,17 @@ static void pair_json(json_t *f, const cf_joint_result *j)
                                   "stress_scale_MPa",
                                   ident_json(j->ext.ident.scale, j->ext.ident_se.scale)));
     json_object_set_new(f, "feasible_extension", json_boolean(j->ext.feasible));
+    /* two equal springs in place of an infeasible pair (cf_joint_fit_pair): what its search
+    ** ended on */
+    if (j->nested_objective > 0) {
+        json_t *bits = json_array();
+        for (int b = 0; bits && b < CF_C_COUNT; b++)
+            if (j->fit.nested_violated & (1u << b))
+                json_array_append_new(bits, json_string(cf_fit_constraint_name(1u << b)));
+        json_object_set_new(f, "equal_springs",
+                            json_pack("{s:o, s:o}", "search_objective", num(j->nested_objective),
+                                      "search_violated", bits ? bits : json_array()));
+    }
 }
 
 /* The lattice's volume term and its small-strain moduli each side, into its `lattice` object. */

@@ -409,6 +409,78 @@ static void brain_cortex_joint_auto(void **state)
         cf_table_free(&t[k]);
 }
 
+/* The chicken breast in tension, compression and shear, jointly (issue 37): the tailed search of
+** either type ends on a spring that breaks a limit (telescoping D2_max_H and index_max,
+** non-telescoping the travel; on main reported so) beside a feasible conical fit, so the tailed law's joint fit is the conical
+** optimum it contains, with no tail, never infeasible or worse in the weighted objective; --law
+** conical-tail reports that optimum and says what the search ended on. */
+static void chicken_breast_joint_tail_never_loses(void **state)
+{
+    (void)state;
+    const char *dir = tu_datasets();
+    if (!dir)
+        skip();
+    static const char *const names[3] = {"chicken_breast_tension.csv",
+                                         "chicken_breast_compression.csv",
+                                         "chicken_breast_shear.csv"};
+    cf_table t[3];
+    const cf_table *tabs[3];
+    cf_measure_options mo = cf_measure_default_options();
+    cf_error err = {0};
+    for (int k = 0; k < 3; k++) {
+        char path[1024];
+        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
+        if (cf_measure_load(path, &mo, &t[k], &err) != CF_OK)
+            fail_msg("%s", err.msg);
+        tabs[k] = &t[k];
+    }
+    cf_fit_options o = cf_fit_default_options();
+    cf_validate_setup s = cf_validate_default();
+    for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING; ty++) {
+        cf_joint_result plain, tail;
+        if (cf_joint_fit(tabs, 3, &o, &s, (cf_spring_type)ty, &plain, &err) != CF_OK)
+            fail_msg("%s", err.msg);
+        assert_true(plain.fit.feasible);
+        if (cf_joint_fit_tail(tabs, 3, &o, &s, &plain, &tail, &err) != CF_OK)
+            fail_msg("%s", err.msg);
+        assert_true(tail.fit.tail);
+        assert_true(tail.fit.feasible);
+        if (!(tail.objective <= plain.objective * (1 + 1e-9)))
+            fail_msg("type %d: tailed joint objective %.6g above the conical %.6g", ty,
+                     tail.objective, plain.objective);
+        /* here the search's own spring lost: lower objective, broken limits */
+        assert_true(tail.fit.params.n_tail == 0 && tail.fit.e_tail == 0);
+        assert_true(tail.nested_objective > 0 && tail.nested_objective < plain.objective);
+        assert_true(tail.fit.nested_rmse > 0);
+        assert_true(tail.fit.nested_violated != 0);
+        assert_true(tail.objective == plain.objective && tail.aic == plain.aic);
+        for (size_t k = 0; k < 3; k++)
+            assert_true(tail.tab[k].lattice_MPa != plain.tab[k].lattice_MPa &&
+                        tail.tab[k].lattice_MPa[0] == plain.tab[k].lattice_MPa[0]);
+        cf_joint_free(&plain);
+        cf_joint_free(&tail);
+    }
+    cf_pipeline_options po = cf_pipeline_default_options();
+    po.fit.law = CF_FAMILY_TAIL;
+    cf_joint_report r;
+    if (cf_pipeline_fit_joint(tabs, 3, &po, &r, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    for (int i = 0; i < r.nfits; i++) {
+        assert_true(r.law_choice[i].ran && r.law_choice[i].chose_tail);
+        assert_true(r.fits[i].fit.feasible && r.fits[i].fit.params.n_tail == 0);
+    }
+    char *text = cf_joint_text(&r);
+    assert_non_null(text);
+    if (!strstr(text, "no tail: the conical optimum the tailed law contains, since the tailed "
+                      "spring its search ended on (objective"))
+        fail_msg("the report does not say what the tailed search ended on:\n%s", text);
+    assert_non_null(strstr(text, "breaks the limit"));
+    free(text);
+    cf_joint_report_free(&r);
+    for (int k = 0; k < 3; k++)
+        cf_table_free(&t[k]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -418,6 +490,7 @@ int main(void)
         cmocka_unit_test(tail_through_the_lattice_never_loses_to_the_conical_law),
         cmocka_unit_test(known_tailed_spring_is_recovered_jointly),
         cmocka_unit_test(brain_cortex_joint_auto),
+        cmocka_unit_test(chicken_breast_joint_tail_never_loses),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -76,6 +76,12 @@ typedef struct cf_joint_result {
                                     ** included); NAN where the cell failed */
     double E_extension_MPa;
     int nparams;                    /* the quantities fitted (3, 4, 6 or 7; the AIC's k) */
+    /* A conical-tail fit that is the conical optimum it contains (fit.tail 1, n_tail 0;
+    ** cf_joint_fit_tail), or a pair that is the single-sided law's optimum as two equal springs
+    ** (cf_joint_fit_pair): the weighted objective of the fit its search ended on (0: it found
+    ** none, or the fit is its own); fit.nested_rmse and fit.nested_violated as for one table
+    ** (fit.h). */
+    double nested_objective;
 } cf_joint_result;
 
 /* Fits the n tables jointly with spring type `type` in the lattice of `lat` (its calibration:
@@ -90,8 +96,11 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
 ** (its type, weights and quantities the start): its four quantities (rho, s/H, F_C/H^2, the tail
 ** tau) searched through the cell as a single table's are (lattice_fit.h, cf_lattice_fit_tail),
 ** each table weighted as in the conical joint fit, the tailed spring placed in closed form and
-** r->fit.tail set. Fitted weights stay where the conical fit left them. CF_E_NOCONV when no
-** tailed spring runs every table. */
+** r->fit.tail set. Fitted weights stay where the conical fit left them. The tailed law contains
+** the conical one: a search that finds no tailed spring running every table, ends infeasible
+** where plain is feasible, or ends with a larger weighted objective at the same feasibility
+** returns plain with no tail (fit.tail 1, e_tail 0, n_tail 0; nested_objective says what the
+** search ended on). */
 cf_status cf_joint_fit_tail(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
                             const cf_validate_setup *lat, const cf_joint_result *plain,
                             cf_joint_result *r, cf_error *err);
@@ -103,7 +112,10 @@ cf_status cf_joint_fit_tail(const cf_table *const *tables, size_t n, const cf_fi
 ** joint fit, BOBYQA from plain's quantities (may be NULL) and a grid. Both springs placed as the
 ** conical law's (the extension spring at the compression spring's H); errors of every quantity
 ** (kappa too) from the joint residuals' central-difference Jacobian, -1 for those the data do
-** not determine (the Jacobian's null space). pair 0 fits the odd conical law with the volume
+** not determine (the Jacobian's null space). The pair contains plain (two equal springs, no
+** volume term): plain's optimum is a start, and a pair infeasible where plain is feasible is
+** plain's optimum as two equal springs (nested_objective what its search ended on). pair 0 fits
+** the odd conical law with the volume
 ** term. CF_E_DATA for a declared nu below the springs' own (the term only raises it), and for
 ** a declared nu with the pair (a bimodular lattice has one small-strain nu per side, none to
 ** declare: declare kappa or fit it). */
