@@ -144,6 +144,79 @@ void cf_joint_free(cf_joint_result *r)
     }
 }
 
+/* Full-lattice checks of a pair's or a volume term's stability: the lattices of 2 x 2 x 2 (the
+** export's) and 3 x 3 x 3 cells (simulate's default), bottom sliding, and the scan's steps and
+** bisections over the table's range. */
+#define LATTICE_CHECK_SIZES 2
+#define STABLE_SCAN_STEPS 32
+#define STABLE_BISECT 20
+
+/* 1 when every checked lattice (cfg with n^3 cells, n = 2, 3) is stable at the homogeneous
+** uniaxial state of table strain e that the cell c gives, 0 when one is not (or the state cannot
+** be reached), -1 on running out of memory. The homogeneous state is the sliding-bottom
+** lattice's equilibrium, so no Newton solve: one factorisation of each tangent, whose negative
+** pivots (cf_msm_homogeneous_inertia) are the columns of cells that buckle sideways -- a
+** cell-scale mode the homogenised cell's positive-definite tangent does not see. */
+static int lattice_stable_at(const cf_cell *c, const cf_msm_config *cfg, double e)
+{
+    cf_cell_state s;
+    cf_error e1 = {0};
+    if (cf_cell_mode(c, CF_MODE_UNIAXIAL, e, NULL, &s, &e1) != CF_OK)
+        return 0;
+    for (int n = 2; n < 2 + LATTICE_CHECK_SIZES; n++) {
+        cf_msm_config k = *cfg;
+        k.lattice.nx = k.lattice.ny = k.lattice.nz = n;
+        k.lattice.bottom = CF_BOTTOM_AXIAL;
+        long neg = -1;
+        cf_error e2 = {0};
+        cf_status st = cf_msm_homogeneous_inertia(c->law, CF_LAW_CLOSED, &k, e, s.F[0], &neg,
+                                                  &e2);
+        if (st == CF_E_INTERNAL)
+            return -1;
+        if (st != CF_OK || neg != 0)
+            return 0;
+    }
+    return 1;
+}
+
+/* Follows the uniaxial state from 0 to reach (table sign) in the full lattices and returns the
+** largest |strain| up to which every one stays stable (*lost 1 when that is short of reach), as
+** cf_cell_stable_to does for the cell. CF_E_INTERNAL when memory runs out. */
+static cf_status lattice_stable_to(const cf_cell *c, const cf_msm_config *cfg, double reach,
+                                   double *limit, int *lost, cf_error *err)
+{
+    *limit = reach;
+    *lost = 0;
+    double good = 0;
+    for (int k = 1; k <= STABLE_SCAN_STEPS; k++) {
+        const double e = reach * k / STABLE_SCAN_STEPS;
+        int r = lattice_stable_at(c, cfg, e);
+        if (r < 0)
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory in the lattice's stability "
+                                                    "check");
+        if (r) {
+            good = e;
+            continue;
+        }
+        double bad = e;
+        for (int b = 0; b < STABLE_BISECT && fabs(bad - good) > 1e-6 * fabs(reach); b++) {
+            const double mid = 0.5 * (good + bad);
+            r = lattice_stable_at(c, cfg, mid);
+            if (r < 0)
+                return cf_error_set(err, CF_E_INTERNAL, "out of memory in the lattice's "
+                                                        "stability check");
+            if (r)
+                good = mid;
+            else
+                bad = mid;
+        }
+        *limit = good;
+        *lost = 1;
+        return CF_OK;
+    }
+    return CF_OK;
+}
+
 /* Each table in the lattice of the placed spring r->fit: the cell, and the full lattice when the
 ** mode is uniaxial (the verification). */
 static cf_status verify_tables(const jctx *c, cf_joint_result *r, cf_error *err)
@@ -193,6 +266,18 @@ static cf_status verify_tables(const jctx *c, cf_joint_result *r, cf_error *err)
                 jt->stability_checked = 1;
                 jt->stable_in_range = !lost;
                 jt->stable_to = limit;
+            }
+            /* a uniaxial table: the full lattice too, which can buckle where the cell does not */
+            if (jt->stability_checked && t->mode == CF_MODE_UNIAXIAL) {
+                double llim = reach;
+                int llost = 0;
+                if ((st = lattice_stable_to(&cell, &full.cfg, reach, &llim, &llost, err)) !=
+                    CF_OK)
+                    break;
+                jt->lattice_checked = 1;
+                if (llost && fabs(llim) < fabs(jt->stable_to))
+                    jt->stable_to = llim;
+                jt->stable_in_range = jt->stable_in_range && !llost;
             }
         }
         double ss = 0;
