@@ -134,6 +134,14 @@ static double objective(unsigned nz, const double *z, double *grad, void *data)
     return profile(data, z, &A);
 }
 
+int cf_joint_stable(const cf_joint_result *r)
+{
+    for (size_t k = 0; k < r->ntables && k < CF_JOINT_MAX; k++)
+        if (r->tab[k].stability_checked && !r->tab[k].stable_in_range)
+            return 0;
+    return 1;
+}
+
 void cf_joint_free(cf_joint_result *r)
 {
     if (!r)

@@ -115,6 +115,10 @@ cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fi
                             const cf_joint_result *plain, cf_joint_result *r, cf_error *err);
 
 /* Releases the per-table curves. Safe on a zeroed result. */
+/* 1 unless a table's stability check (cf_joint_table) found the lattice losing stability inside
+** that table's range. */
+int cf_joint_stable(const cf_joint_result *r);
+
 void cf_joint_free(cf_joint_result *r);
 
 #endif
