@@ -33,6 +33,11 @@
 #define TAIL_FD_STEP 1e-4
 /* BOBYQA's curves per start of the double-acting element's (or the volume term's) search */
 #define PAIR_MAX_EVALS 1500
+/* the pair's starts (at most), and the searches kept to stable lattices from their ends */
+#define MAX_PAIR_STARTS 32
+#define STABLE_RESTARTS 3
+#define STABLE_BISECT_SEGMENT 12
+#define STABLE_MAX_EVALS 500
 
 typedef struct jctx {
     const cf_table *const *t;
@@ -54,6 +59,11 @@ typedef struct jctx {
     int kappa_mode;                 /* the cell's kappa: KAPPA_* */
     double kappa;                   /* KAPPA_REL: over the compression spring's k0/H; KAPPA_UNIT:
                                     ** over its stress scale; KAPPA_NU: the declared nu */
+    /* the pair's search keeps to lattices stable over the uniaxial tables' ranges: a point that
+    ** would lower the best objective of the current start (stab_best) counts only when its full
+    ** lattice is stable there (joint_stable_at); stab_on 0: no such check */
+    int stab_on;
+    double stab_best;
 } jctx;
 
 /* How a curve's volume modulus is set (jctx.kappa_mode): none; kappa/(k0/H) of the compression
@@ -134,6 +144,14 @@ static double objective(unsigned nz, const double *z, double *grad, void *data)
     return profile(data, z, &A);
 }
 
+int cf_joint_stable(const cf_joint_result *r)
+{
+    for (size_t k = 0; k < r->ntables && k < CF_JOINT_MAX; k++)
+        if (r->tab[k].stability_checked && !r->tab[k].stable_in_range)
+            return 0;
+    return 1;
+}
+
 void cf_joint_free(cf_joint_result *r)
 {
     if (!r)
@@ -142,6 +160,135 @@ void cf_joint_free(cf_joint_result *r)
         free(r->tab[k].lattice_MPa);
         r->tab[k].lattice_MPa = NULL;
     }
+}
+
+/* Full-lattice checks of a pair's or a volume term's stability: the lattices of 2 x 2 x 2 (the
+** export's) and 3 x 3 x 3 cells (simulate's default), bottom sliding, and the scan's steps and
+** bisections over the table's range. */
+#define LATTICE_CHECK_SIZES 2
+#define STABLE_SCAN_STEPS 32
+#define STABLE_BISECT 20
+
+/* 1 when every checked lattice (cfg with n^3 cells, n = 2 .. 1 + sizes) is stable at the homogeneous
+** uniaxial state of table strain e that the cell c gives, 0 when one is not (or the state cannot
+** be reached), -1 on running out of memory. The homogeneous state is the sliding-bottom
+** lattice's equilibrium, so no Newton solve: one factorisation of each tangent, whose negative
+** pivots (cf_msm_homogeneous_inertia) are the columns of cells that buckle sideways -- a
+** cell-scale mode the homogenised cell's positive-definite tangent does not see. */
+static int lattice_stable_at(const cf_cell *c, const cf_msm_config *cfg, double e, int sizes)
+{
+    cf_cell_state s;
+    cf_error e1 = {0};
+    if (cf_cell_mode(c, CF_MODE_UNIAXIAL, e, NULL, &s, &e1) != CF_OK)
+        return 0;
+    for (int n = 2; n < 2 + sizes; n++) {
+        cf_msm_config k = *cfg;
+        k.lattice.nx = k.lattice.ny = k.lattice.nz = n;
+        k.lattice.bottom = CF_BOTTOM_AXIAL;
+        long neg = -1;
+        cf_error e2 = {0};
+        cf_status st = cf_msm_homogeneous_inertia(c->law, CF_LAW_CLOSED, &k, e, s.F[0], &neg,
+                                                  &e2);
+        if (st == CF_E_INTERNAL)
+            return -1;
+        if (st != CF_OK || neg != 0)
+            return 0;
+    }
+    return 1;
+}
+
+/* Follows the uniaxial state from 0 to reach (table sign) in the full lattices and returns the
+** largest |strain| up to which every one stays stable (*lost 1 when that is short of reach), as
+** cf_cell_stable_to does for the cell. CF_E_INTERNAL when memory runs out. */
+static cf_status lattice_stable_to(const cf_cell *c, const cf_msm_config *cfg, double reach,
+                                   double *limit, int *lost, cf_error *err)
+{
+    *limit = reach;
+    *lost = 0;
+    double good = 0;
+    for (int k = 1; k <= STABLE_SCAN_STEPS; k++) {
+        const double e = reach * k / STABLE_SCAN_STEPS;
+        int r = lattice_stable_at(c, cfg, e, LATTICE_CHECK_SIZES);
+        if (r < 0)
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory in the lattice's stability "
+                                                    "check");
+        if (r) {
+            good = e;
+            continue;
+        }
+        double bad = e;
+        for (int b = 0; b < STABLE_BISECT && fabs(bad - good) > 1e-6 * fabs(reach); b++) {
+            const double mid = 0.5 * (good + bad);
+            r = lattice_stable_at(c, cfg, mid, LATTICE_CHECK_SIZES);
+            if (r < 0)
+                return cf_error_set(err, CF_E_INTERNAL, "out of memory in the lattice's "
+                                                        "stability check");
+            if (r)
+                good = mid;
+            else
+                bad = mid;
+        }
+        *limit = good;
+        *lost = 1;
+        return CF_OK;
+    }
+    return CF_OK;
+}
+
+/* Strains of a uniaxial table's range at which the search checks the full lattice (the
+** verification scans it finely, verify_tables). */
+#define SEARCH_STABLE_STEPS 5
+
+/* 1 when the full lattices of the curve's law at (rho, B) (the context's extension spring and
+** kappa, at unit stress scale: every force scales alike, so stability does not depend on the
+** scale) of 2^3 cells (the more slender, the first to buckle; the verification checks 3^3 too)
+** are stable at SEARCH_STABLE_STEPS strains up to each uniaxial table's farthest one. */
+static int joint_stable_at(const jctx *c, double rho, double B)
+{
+    const cf_ident q = {.rho = rho, .solid = B, .scale = 1.0};
+    cf_spring p = cf_ident_member(&q);
+    cf_law law, ext;
+    if (cf_law_init(&law, &p, NULL) != CF_OK)
+        return 0;
+    if (c->pair) {
+        const cf_ident qe = {.rho = c->ext[0], .solid = c->ext[1], .scale = c->ext[2]};
+        const cf_spring pe = cf_ident_member(&qe);
+        if (cf_law_init(&ext, &pe, NULL) != CF_OK || cf_law_pair(&law, &ext, NULL) != CF_OK)
+            return 0;
+    }
+    cf_cell cell;
+    if (cf_cell_init(&cell, &law, CF_LAW_CLOSED, c->weight, NULL) != CF_OK)
+        return 0;
+    if (c->kappa_mode != KAPPA_NONE)
+        cell.volume_modulus_MPa = curve_kappa(c, &law);
+    cf_msm_config cfg = c->lat->cfg;
+    memcpy(cfg.lattice.weight, c->weight, sizeof c->weight);
+    cfg.lattice.volume_modulus_MPa = cell.volume_modulus_MPa;
+    for (size_t k = 0; k < c->n; k++) {
+        const cf_table *t = c->t[k];
+        if (t->mode != CF_MODE_UNIAXIAL)
+            continue;
+        double reach = 0;
+        for (size_t i = 0; i < t->count; i++)
+            if (fabs(t->x[i]) > fabs(reach))
+                reach = t->x[i];
+        double e[SEARCH_STABLE_STEPS], lat[SEARCH_STABLE_STEPS];
+        for (int j = 0; j < SEARCH_STABLE_STEPS; j++) {
+            cf_cell_state st;
+            e[j] = reach * (j + 1) / SEARCH_STABLE_STEPS;
+            if (cf_cell_mode(&cell, CF_MODE_UNIAXIAL, e[j], NULL, &st, NULL) != CF_OK)
+                return 0;
+            lat[j] = st.F[0];
+        }
+        cfg.lattice.nx = cfg.lattice.ny = cfg.lattice.nz = 2;
+        cfg.lattice.bottom = CF_BOTTOM_AXIAL;
+        long neg = -1;
+        if (cf_msm_homogeneous_inertias(&law, CF_LAW_CLOSED, &cfg, e, lat, SEARCH_STABLE_STEPS,
+                                        &neg, NULL) != CF_OK ||
+            neg != 0)
+            return 0;
+    }
+    return 1;
 }
 
 /* Each table in the lattice of the placed spring r->fit: the cell, and the full lattice when the
@@ -193,6 +340,18 @@ static cf_status verify_tables(const jctx *c, cf_joint_result *r, cf_error *err)
                 jt->stability_checked = 1;
                 jt->stable_in_range = !lost;
                 jt->stable_to = limit;
+            }
+            /* a uniaxial table: the full lattice too, which can buckle where the cell does not */
+            if (jt->stability_checked && t->mode == CF_MODE_UNIAXIAL) {
+                double llim = reach;
+                int llost = 0;
+                if ((st = lattice_stable_to(&cell, &full.cfg, reach, &llim, &llost, err)) !=
+                    CF_OK)
+                    break;
+                jt->lattice_checked = 1;
+                if (llost && fabs(llim) < fabs(jt->stable_to))
+                    jt->stable_to = llim;
+                jt->stable_in_range = jt->stable_in_range && !llost;
             }
         }
         double ss = 0;
@@ -326,6 +485,13 @@ static void pair_set(jctx *c, const pvars *pv, const double *z)
         weights_of(exp(z[pv->iq]), c->weight);
 }
 
+/* 1 when the search's point z (pair_set) has full lattices stable over the uniaxial tables. */
+static int z_stable(jctx *c, const pvars *pv, const double *z)
+{
+    pair_set(c, pv, z);
+    return joint_stable_at(c, exp(z[0]), z[1]);
+}
+
 typedef struct pair_obj {
     jctx *c;
     const pvars *pv;
@@ -336,9 +502,16 @@ static double pair_objective(unsigned nz, const double *z, double *grad, void *d
     (void)nz;
     (void)grad;
     const pair_obj *o = data;
-    pair_set(o->c, o->pv, z);
+    jctx *c = o->c;
+    pair_set(c, o->pv, z);
     double A;
-    return cf_cell_rss(&o->c->pr, exp(z[0]), z[1], &A);
+    const double f = cf_cell_rss(&c->pr, exp(z[0]), z[1], &A);
+    if (c->stab_on && f < c->stab_best) {
+        if (!joint_stable_at(c, exp(z[0]), z[1]))
+            return CF_LSQ_HUGE_OBJ;
+        c->stab_best = f;
+    }
+    return f;
 }
 
 /* The largest compression stress scale at (rho, B) with the extension spring of the context: the
@@ -687,6 +860,9 @@ static cf_status search_pair(jctx *c, const cf_table *reach, double xmax,
               nk = pv.ik >= 0 ? 2 : 1;
     const pair_obj o = {c, &pv};
     double best = CF_LSQ_HUGE_OBJ, zb[8] = {0};
+    double ends[MAX_PAIR_STARTS][8], fends[MAX_PAIR_STARTS];
+    int nends = 0;
+    c->stab_on = 0;
     for (int gc = 0; gc < 2; gc++)
         for (int ge = 0; ge < nre; ge++)
             for (int gb = 0; gb < nbe; gb++)
@@ -732,18 +908,77 @@ static cf_status search_pair(jctx *c, const cf_table *reach, double xmax,
                     if (c->pr.oom)
                         return cf_error_set(err, CF_E_INTERNAL, "out of memory in the joint "
                                                                 "fit's optimiser (NLopt)");
-                    if ((res > 0 || res == NLOPT_ROUNDOFF_LIMITED || res == NLOPT_MAXEVAL_REACHED) &&
-                        f < best) {
+                    const int ok = res > 0 || res == NLOPT_ROUNDOFF_LIMITED ||
+                                   res == NLOPT_MAXEVAL_REACHED;
+                    if (ok && f < CF_LSQ_HUGE_OBJ && nends < MAX_PAIR_STARTS) {
+                        memcpy(ends[nends], z, sizeof z);
+                        fends[nends++] = f;
+                    }
+                    if (ok && f < best) {
                         best = f;
                         memcpy(zb, z, sizeof zb);
                     }
                 }
+    /* An optimum whose full lattice buckles inside a uniaxial table's range: the search again,
+    ** kept to stable lattices, from the stable point nearest the optimum on the segment to each
+    ** of the best (up to STABLE_RESTARTS) starts' ends that are stable. None stable: the optimum
+    ** stays, and the verification reports the loss. */
+    if (best < CF_LSQ_HUGE_OBJ && !z_stable(c, &pv, zb)) {
+        double sb = CF_LSQ_HUGE_OBJ, zs[8] = {0};
+        for (int tries = 0; tries < STABLE_RESTARTS; tries++) {
+            int pick = -1;
+            for (int i = 0; i < nends; i++)
+                if (fends[i] < CF_LSQ_HUGE_OBJ && (pick < 0 || fends[i] < fends[pick]))
+                    pick = i;
+            if (pick < 0)
+                break;
+            fends[pick] = CF_LSQ_HUGE_OBJ; /* tried */
+            if (!z_stable(c, &pv, ends[pick])) {
+                tries--;
+                continue;
+            }
+            /* from the stable point nearest the optimum on the segment to this end */
+            double z[8], step[8], f = CF_LSQ_HUGE_OBJ, lo = 0, hi = 1;
+            for (int b = 0; b < STABLE_BISECT_SEGMENT; b++) {
+                const double mid = 0.5 * (lo + hi);
+                for (int j = 0; j < pv.n; j++)
+                    z[j] = zb[j] + mid * (ends[pick][j] - zb[j]);
+                if (z_stable(c, &pv, z))
+                    hi = mid;
+                else
+                    lo = mid;
+            }
+            for (int j = 0; j < pv.n; j++)
+                z[j] = zb[j] + hi * (ends[pick][j] - zb[j]);
+            for (int j = 0; j < pv.n; j++)
+                step[j] = j == 1 || j == pv.ie + 1 ? 0.05 * (pv.ub[j] - pv.lb[j]) : 0.2;
+            c->stab_on = 1;
+            c->stab_best = CF_LSQ_HUGE_OBJ;
+            nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)pv.n, pv.lb,
+                                              pv.ub, step, XTOL_REL, STABLE_MAX_EVALS,
+                                              pair_objective, (void *)&o, z, &f);
+            if (c->pr.oom)
+                return cf_error_set(err, CF_E_INTERNAL, "out of memory in the joint fit's "
+                                                        "optimiser (NLopt)");
+            if ((res > 0 || res == NLOPT_ROUNDOFF_LIMITED || res == NLOPT_MAXEVAL_REACHED) &&
+                f < sb) {
+                sb = f;
+                memcpy(zs, z, sizeof zs);
+            }
+        }
+        c->stab_on = sb < CF_LSQ_HUGE_OBJ;
+        if (c->stab_on) {
+            best = sb;
+            memcpy(zb, zs, sizeof zb);
+        }
+    }
     /* a last polish from the best start */
     if (best < CF_LSQ_HUGE_OBJ) {
         double z[8], f = CF_LSQ_HUGE_OBJ, step[8];
         memcpy(z, zb, sizeof z);
         for (int j = 0; j < pv.n; j++)
             step[j] = j == 1 || j == pv.ie + 1 ? 0.01 * (pv.ub[j] - pv.lb[j]) : 0.05;
+        c->stab_best = CF_LSQ_HUGE_OBJ;
         nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)pv.n, pv.lb, pv.ub,
                                           step, XTOL_REL * 1e-2, PAIR_MAX_EVALS, pair_objective,
                                           (void *)&o, z, &f);
@@ -754,6 +989,7 @@ static cf_status search_pair(jctx *c, const cf_table *reach, double xmax,
         }
     }
     double A = 0;
+    c->stab_best = CF_LSQ_HUGE_OBJ;
     if (!(best < CF_LSQ_HUGE_OBJ) || !(pair_objective((unsigned)pv.n, zb, NULL, (void *)&o) <
                                        CF_LSQ_HUGE_OBJ))
         return cf_error_set(err, CF_E_NOCONV, "the joint fit found no %s that runs every table",
@@ -778,7 +1014,16 @@ static cf_status search_pair(jctx *c, const cf_table *reach, double xmax,
     {
         double vp[PQ_COUNT];
         memcpy(vp, v, sizeof vp);
-        const double fp = pair_polish(c, vp, used, box);
+        const int stab = c->stab_on;
+        c->stab_on = 0;
+        double fp = pair_polish(c, vp, used, box);
+        if (stab && fp < best) { /* the polish's point under the search's stability check */
+            c->ext[0] = vp[PQ_RE], c->ext[1] = vp[PQ_BE], c->ext[2] = vp[PQ_AE] / vp[PQ_AC];
+            if (opt->volume != CF_VOLUME_POISSON)
+                c->kappa_mode = KAPPA_UNIT, c->kappa = vp[PQ_K] / vp[PQ_AC];
+            if (!joint_stable_at(c, vp[PQ_RC], vp[PQ_BC]))
+                fp = CF_LSQ_HUGE_OBJ;
+        }
         if (fp < best) {
             memcpy(v, vp, sizeof vp);
             best = fp;

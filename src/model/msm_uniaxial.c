@@ -207,6 +207,14 @@ done:
 cf_status cf_msm_homogeneous_inertia(const cf_law *law, cf_law_method m, const cf_msm_config *cfgin,
                                      double strain, double lateral, long *neg, cf_error *err)
 {
+    return cf_msm_homogeneous_inertias(law, m, cfgin, &strain, &lateral, 1, neg, err);
+}
+
+cf_status cf_msm_homogeneous_inertias(const cf_law *law, cf_law_method m,
+                                      const cf_msm_config *cfgin, const double *strains,
+                                      const double *laterals, size_t count, long *neg,
+                                      cf_error *err)
+{
     CF_GSL_GUARD;
     cf_msm_config cfg = cfgin ? *cfgin : cf_msm_default();
     /* the banded LDL^T (GSL): its D gives the inertia, and unlike the sparse factorisations it
@@ -214,9 +222,10 @@ cf_status cf_msm_homogeneous_inertia(const cf_law *law, cf_law_method m, const c
     ** lock, sparse_chol.c) */
     cfg.banded_only = 1;
     *neg = -1;
-    if (!isfinite(strain) || !isfinite(lateral) || !(lateral > 0))
-        return cf_error_set(err, CF_E_DATA, "strain %g, lateral stretch %g: not a deformation",
-                            strain, lateral);
+    for (size_t q = 0; q < count; q++)
+        if (!isfinite(strains[q]) || !isfinite(laterals[q]) || !(laterals[q] > 0))
+            return cf_error_set(err, CF_E_DATA, "strain %g, lateral stretch %g: not a "
+                                "deformation", strains[q], laterals[q]);
     if (cfg.lattice.bottom != CF_BOTTOM_AXIAL)
         return cf_error_set(err, CF_E_DATA, "a clamped bottom holds the lattice's base: its "
                             "uniaxial state is never homogeneous");
@@ -226,35 +235,40 @@ cf_status cf_msm_homogeneous_inertia(const cf_law *law, cf_law_method m, const c
     cf_status rc = static_open(law, m, &cfg, &lat, &s, &st, err);
     if (rc != CF_OK)
         return rc;
-    /* F = diag(a, a, 1 + strain) about the pinned corner (the origin) */
-    for (size_t p = 0; p < lat.nn; p++) {
-        lat.x[p] = lateral * lat.X[p];
-        lat.y[p] = lateral * lat.Y[p];
-        lat.z[p] = (1 + strain) * lat.Z[p];
-    }
-    s.load = -strain;
-    double rn, fs;
-    double um = cf_msm_residual(&s, &rn, &fs);
-    if (!(um < 1))
-        rc = cf_error_set(err, CF_E_DATA, "strain %g: a spring of the lattice passes solid",
-                          strain);
-    else if (!(rn <= 1e-7 * fs))
-        rc = cf_error_set(err, CF_E_DATA,
-                          "strain %g, lateral stretch %.17g: not an equilibrium of this lattice "
-                          "(residual %.3g of the largest tension; a clamped bottom is never "
-                          "homogeneous)",
-                          strain, lateral, rn / fs);
-    else {
-        /* a right-hand side of ones, whose solution is discarded, so that the factorisation's
-        ** residual check means something at an equilibrium (R = 0) */
-        for (size_t k = 0; k < s.ndof; k++)
-            s.R[k] = 1.0;
-        cf_error e = {0};
-        (void)cf_linsolve_direction(&s, &e);
-        *neg = s.neg_pivots;
-        if (*neg < 0)
-            rc = cf_error_set(err, CF_E_NOCONV, "strain %g: no factorisation of the tangent "
-                              "reported its inertia", strain);
+    for (size_t q = 0; q < count && rc == CF_OK; q++) {
+        const double strain = strains[q], lateral = laterals[q];
+        /* F = diag(a, a, 1 + strain) about the pinned corner (the origin) */
+        for (size_t p = 0; p < lat.nn; p++) {
+            lat.x[p] = lateral * lat.X[p];
+            lat.y[p] = lateral * lat.Y[p];
+            lat.z[p] = (1 + strain) * lat.Z[p];
+        }
+        s.load = -strain;
+        double rn, fs;
+        double um = cf_msm_residual(&s, &rn, &fs);
+        if (!(um < 1))
+            rc = cf_error_set(err, CF_E_DATA, "strain %g: a spring of the lattice passes solid",
+                              strain);
+        else if (!(rn <= 1e-7 * fs))
+            rc = cf_error_set(err, CF_E_DATA,
+                              "strain %g, lateral stretch %.17g: not an equilibrium of this lattice "
+                              "(residual %.3g of the largest tension; a clamped bottom is never "
+                              "homogeneous)",
+                              strain, lateral, rn / fs);
+        else {
+            /* a right-hand side of ones, whose solution is discarded, so that the factorisation's
+            ** residual check means something at an equilibrium (R = 0) */
+            for (size_t k = 0; k < s.ndof; k++)
+                s.R[k] = 1.0;
+            cf_error e = {0};
+            (void)cf_linsolve_direction(&s, &e);
+            *neg = s.neg_pivots;
+            if (*neg < 0)
+                rc = cf_error_set(err, CF_E_NOCONV, "strain %g: no factorisation of the tangent "
+                                  "reported its inertia", strain);
+        }
+        if (rc == CF_OK && *neg != 0)
+            break; /* the first state with a negative pivot */
     }
     cf_msm_solver_free(&s);
     cf_lattice_free(&lat);

@@ -46,7 +46,8 @@ static cf_status choose_law(const cf_table *const *tables, size_t n,
 
 /* The double-acting element's joint fit beside the single-sided law in fits[k] (from the conical
 ** law's quantities plain), and the law kept: double-acting the pair, auto the pair only with a
-** lower joint AIC and both springs buildable. A pair that finds no lattice leaves auto's choice
+** lower joint AIC, both springs buildable and a lattice stable over every table's range (unless
+** the single-sided law's is not either). A pair that finds no lattice leaves auto's choice
 ** alone; double-acting then fails. */
 static cf_status choose_pair(const cf_table *const *tables, size_t n,
                              const cf_pipeline_options *opt, const cf_joint_result *plain,
@@ -68,8 +69,11 @@ static cf_status choose_pair(const cf_table *const *tables, size_t n,
     if (st != CF_OK)
         return CF_OK;
     lc->pair_ran = 1;
+    /* auto keeps a pair whose lattice loses stability inside a table's range only when the
+    ** single-sided law's does too */
     lc->chose_pair = opt->fit.law == CF_FAMILY_DOUBLE ||
-                     (pair.fit.feasible && pair.aic < r->fits[k].aic);
+                     (pair.fit.feasible && pair.aic < r->fits[k].aic &&
+                      (cf_joint_stable(&pair) || !cf_joint_stable(&r->fits[k])));
     if (lc->chose_pair) {
         lc->pair_other = r->fits[k];
         r->fits[k] = pair;

@@ -35,10 +35,11 @@ int cf_joint_better(const cf_joint_report *r)
 {
     int b = -1;
     for (int i = 0; i < r->nfits; i++) {
-        const int fi = r->fits[i].fit.feasible != 0;
-        if (b < 0 || (fi != (r->fits[b].fit.feasible != 0)
-                          ? fi
-                          : r->fits[i].objective < r->fits[b].objective))
+        const int fi = r->fits[i].fit.feasible != 0, si = cf_joint_stable(&r->fits[i]);
+        const int fb = b >= 0 && r->fits[b].fit.feasible != 0, sb = b >= 0 && cf_joint_stable(&r->fits[b]);
+        if (b < 0 || (fi != fb   ? fi
+                      : si != sb ? si
+                                 : r->fits[i].objective < r->fits[b].objective))
             b = i;
     }
     return b;
@@ -172,7 +173,9 @@ static void pair_choice_text(FILE *o, const cf_joint_report *r)
         const char *why = r->law == CF_FAMILY_DOUBLE ? "asked for (--law double-acting)"
                           : lc->chose_pair           ? "lower joint AIC"
                           : !pair->fit.feasible      ? "a spring of the pair is infeasible"
-                                                     : "the pair does not lower the joint AIC";
+                          : !cf_joint_stable(pair) && pair->aic < single->aic
+                              ? "the pair's lattice loses stability inside a table's range"
+                              : "the pair does not lower the joint AIC";
         fprintf(o, "  %-16s kept: %s (%s)\n", "", lc->chose_pair ? "double-acting" : "single-sided",
                 why);
     }
@@ -244,7 +247,8 @@ static void stability_text(FILE *o, const cf_joint_report *r, const cf_joint_res
     }
     if (checked == (int)r->ntables && all)
         fprintf(o, "  stable over every table's range (the cell's incremental stiffness positive "
-                   "definite from 0 to each table's farthest strain)\n");
+                   "definite from 0 to each table's farthest strain; for a uniaxial table the "
+                   "full lattices of 2^3 and 3^3 cells too)\n");
 }
 
 char *cf_joint_text(const cf_joint_report *r)
@@ -320,11 +324,17 @@ char *cf_joint_text(const cf_joint_report *r)
     int b = cf_joint_better(r);
     if (b >= 0) {
         /* the reason that decided: buildability when only one spring can be built */
-        int other_infeasible = 0;
-        for (int i = 0; i < r->nfits; i++)
+        int other_infeasible = 0, other_unstable = 0;
+        for (int i = 0; i < r->nfits; i++) {
             other_infeasible |= i != b && !r->fits[i].fit.feasible && r->fits[b].fit.feasible;
+            other_unstable |= i != b && r->fits[i].fit.feasible && !cf_joint_stable(&r->fits[i]) &&
+                              cf_joint_stable(&r->fits[b]) &&
+                              r->fits[i].objective < r->fits[b].objective;
+        }
         fprintf(o, "\nBetter type: %s (%s %.4g)\n", cf_spring_type_name(r->fits[b].fit.type),
                 other_infeasible ? "the other type's spring cannot be built; weighted objective"
+                : other_unstable ? "the other type's lattice loses stability inside a table's "
+                                   "range; weighted objective"
                                  : "lower weighted objective",
                 r->fits[b].objective);
     }

@@ -196,6 +196,59 @@ static void ccx_runs_the_brain_lattice(const char *dir, const char *json)
     assert_int_equal(system(cmd), 0);
 }
 
+/* Every row's stable flag of a simulate CSV: the number of rows, the first unstable row's strain
+** in *lost (NaN when none). */
+static int rows_stable(const char *csv, double *lost)
+{
+    FILE *f = fopen(csv, "r");
+    assert_non_null(f);
+    char line[512];
+    assert_non_null(fgets(line, sizeof line, f));
+    double t, e, s, k, sp, lat;
+    int stable, rows = 0;
+    *lost = NAN;
+    while (fscanf(f, "%lf,%lf,%lf,%lf,%lf,%d,%lf", &t, &e, &s, &k, &sp, &stable, &lat) == 7) {
+        rows++;
+        if (!stable && isnan(*lost))
+            *lost = e;
+    }
+    fclose(f);
+    return rows;
+}
+
+/* The kept fit (a scene naming it: the better type's pair and kappa) in the full lattice of 2^3
+** and 3^3 cells over each uniaxial table's whole range (10 % compression, 10 % extension):
+** every row stable, as the fit's verdict says. */
+static void kept_fit_stable_in_lattice(const char *dir, const char *json)
+{
+    char scene[300], csv[300], text[1024];
+    snprintf(scene, sizeof scene, "%s/stab_scene.json", dir);
+    snprintf(csv, sizeof csv, "%s/stab_scene.csv", dir);
+    const double strain[2] = {0.1, -0.1}; /* compression positive, then tension */
+    for (int n = 2; n <= 3; n++)
+        for (int i = 0; i < 2; i++) {
+            snprintf(text, sizeof text,
+                     "{\"spring\": {\"fit\": \"%s\"}, \"lattice\": {\"nx\": %d, \"ny\": %d, "
+                     "\"nz\": %d}, \"protocol\": {\"kind\": \"ramp\", \"to_strain\": %g, "
+                     "\"duration_s\": 1}, \"samples_per_segment\": 50}",
+                     json, n, n, n, strain[i]);
+            write_text(scene, text);
+            int rc = tu_run(out, sizeof out, errb, sizeof errb, "simulate %s -o %s", scene, csv);
+            if (rc != 0)
+                fail_msg("simulate of the kept fit (%d^3 cells, strain %g) exited %d: %s", n,
+                         strain[i], rc, errb);
+            double lost;
+            int rows = rows_stable(csv, &lost);
+            assert_true(rows >= 50);
+            if (!isnan(lost))
+                fail_msg("the kept brain fit's %d^3 lattice is unstable from strain %g, inside "
+                         "the table's range %g (the fit said it was stable)",
+                         n, lost, strain[i]);
+            remove(csv);
+        }
+    remove(scene);
+}
+
 /* The brain cortex, --joint --law auto --volume fit: the fit file holds the pair and kappa, and
 ** export refuses it with 65 naming the key, writing nothing. */
 static void brain_pair_fit_file_and_export(void **state)
@@ -216,12 +269,27 @@ static void brain_pair_fit_file_and_export(void **state)
         fail_msg("exit %d: %s", rc, errb);
     assert_non_null(strstr(out, "double-acting element"));
     assert_non_null(strstr(out, "volume term"));
+    /* the better type's verdict: stable over every table's range, in the full lattice too */
+    const char *better = strstr(out, "Better type: ");
+    assert_non_null(better);
+    const char *type = strncmp(better + 13, "telescoping", 11) == 0 ? "telescoping spring:"
+                                                                     : "non-telescoping spring:";
+    const char *block = strstr(out, type);
+    assert_non_null(block);
+    const char *end = strstr(block, "\n\n");
+    const size_t len = end ? (size_t)(end - block) : strlen(block);
+    char *text = strndup(block, len);
+    assert_non_null(text);
+    if (!strstr(text, "\n  stable over every table's range") || strstr(text, "loses stability"))
+        fail_msg("the kept fit's verdict is not stable over every table's range:\n%s", text);
+    free(text);
     char *file = tu_slurp(json);
     assert_non_null(file);
     assert_non_null(strstr(file, "\"params_extension\""));
     assert_non_null(strstr(file, "\"volume_modulus_MPa\""));
     free(file);
     fit_scene_is_the_element(dir, json);
+    kept_fit_stable_in_lattice(dir, json);
     /* the spring's table holds both springs and names the volume term */
     char t[300];
     snprintf(t, sizeof t, "%s/t.csv", dir);

@@ -206,10 +206,12 @@ static void declared_nu_is_the_lattices(void **state)
 }
 
 /* The brain cortex (Budday et al. 2017) in tension, compression and shear, --joint --law auto
-** --volume fit: the weighted objective at most half one-term Ogden's 0.0343 (fitted jointly with
-** the same weights), the kept element a buildable double-acting pair, every table's cell curve
-** finite and the lattice stable over its range; the fit file holds params_extension and lattice.volume_modulus_MPa. */
-static void brain_cortex_pair_beats_half_of_ogden(void **state)
+** --volume fit: the kept element a buildable double-acting pair whose full lattice (2^3 and 3^3
+** cells) is stable over every table's range, its weighted objective at most 0.019 (0.01864
+** measured): a stable pair does not reach half one-term Ogden's 0.0343 (0.01715; the buckling
+** optimum's 0.01713 did), but stays within 9 % of it; every table's cell curve finite; the fit
+** file holds params_extension and lattice.volume_modulus_MPa. */
+static void brain_cortex_stable_pair_near_half_of_ogden(void **state)
 {
     (void)state;
     const char *dir = tu_datasets();
@@ -238,17 +240,20 @@ static void brain_cortex_pair_beats_half_of_ogden(void **state)
     const int b = cf_joint_better(&r);
     assert_true(b >= 0);
     const cf_joint_result *j = &r.fits[b];
-    if (!(j->objective <= 0.5 * 0.0343))
-        fail_msg("objective %.6g above half of one-term Ogden's 0.0343", j->objective);
+    if (!(j->objective <= 0.019))
+        fail_msg("objective %.6g above 0.019 (half of one-term Ogden's 0.0343 is 0.01715)",
+                 j->objective);
     assert_true(j->pair && j->fit.feasible && j->ext.feasible);
     assert_true(j->volume_modulus_MPa > 0 && isfinite(j->nu_compression) &&
                 isfinite(j->nu_extension));
     /* brain is stiffer in compression than in tension at small strain too */
     assert_true(j->E_compression_MPa > j->E_extension_MPa && j->E_extension_MPa > 0);
-    /* the lattice stable over every table's range (the cell's incremental stiffness) */
+    /* the lattice stable over every table's range (the cell's incremental stiffness, and for
+    ** the uniaxial tables the full lattice's tangent) */
     for (size_t k = 0; k < 3; k++) {
         assert_true(isfinite(j->tab[k].cell_rmse));
         assert_true(j->tab[k].stability_checked && j->tab[k].stable_in_range);
+        assert_int_equal(j->tab[k].lattice_checked, j->tab[k].mode == CF_MODE_UNIAXIAL);
         /* the uniaxial tables run in the full lattice, pair and volume term included: its RMSE
         ** is the cell's */
         if (j->tab[k].mode == CF_MODE_UNIAXIAL) {
@@ -394,7 +399,7 @@ int main(void)
         cmocka_unit_test(known_pair_and_kappa_are_recovered),
         cmocka_unit_test(auto_keeps_the_odd_law_where_the_pair_buys_nothing),
         cmocka_unit_test(declared_nu_is_the_lattices),
-        cmocka_unit_test(brain_cortex_pair_beats_half_of_ogden),
+        cmocka_unit_test(brain_cortex_stable_pair_near_half_of_ogden),
         cmocka_unit_test(chicken_breast_pair_never_loses_to_the_odd_law),
         cmocka_unit_test(coronaradiata_pair_infeasible_is_the_odd_law),
     };

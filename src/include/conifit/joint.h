@@ -41,9 +41,12 @@ typedef struct cf_joint_table {
     double *lattice_MPa;   /* the lattice's stress at each row (owned), MPa */
     /* a double-acting element or a volume term (cell_stability.h, the cell of the placed
     ** springs and kappa): stability checked = 1, stable_in_range 1 when the cell's incremental
-    ** stiffness stays positive definite from 0 to the table's farthest strain, stable_to the
-    ** strain up to which it does (table sign) */
-    int stability_checked, stable_in_range;
+    ** stiffness stays positive definite from 0 to the table's farthest strain and, for a
+    ** uniaxial table (lattice_checked = 1), the full lattices of 2^3 and 3^3 cells with a
+    ** sliding bottom stay stable there too (no negative pivot of their tangent at the
+    ** homogeneous state: no column of cells buckles); stable_to the strain up to which all do
+    ** (table sign) */
+    int stability_checked, stable_in_range, lattice_checked;
     double stable_to;
 } cf_joint_table;
 
@@ -124,6 +127,10 @@ cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fi
                             const cf_joint_result *plain, cf_joint_result *r, cf_error *err);
 
 /* Releases the per-table curves. Safe on a zeroed result. */
+/* 1 unless a table's stability check (cf_joint_table) found the lattice losing stability inside
+** that table's range. */
+int cf_joint_stable(const cf_joint_result *r);
+
 void cf_joint_free(cf_joint_result *r);
 
 #endif

@@ -181,6 +181,14 @@ cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_ms
 cf_status cf_msm_homogeneous_inertia(const cf_law *law, cf_law_method m, const cf_msm_config *cfg,
                                      double strain, double lateral, long *neg, cf_error *err);
 
+/* The same for count states (strains[q], laterals[q]) of one lattice, built once: *neg is the
+** first state's with a negative pivot (the scan stops there), else 0. Failures as above, for the
+** first state that fails. */
+cf_status cf_msm_homogeneous_inertias(const cf_law *law, cf_law_method m,
+                                      const cf_msm_config *cfg, const double *strains,
+                                      const double *laterals, size_t count, long *neg,
+                                      cf_error *err);
+
 /* The explicit stable step (s) of the lattice at its current state for the given effects
 ** (stiffest spring tangent, lightest mass, most springs at one node; the dashpots shorten it).
 ** Calls cf_lattice_forces. An explicit run steps at most CF_MSM_DT_SAFETY times it. */
