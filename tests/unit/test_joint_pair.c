@@ -317,7 +317,11 @@ static void chicken_breast_pair_never_loses_to_the_odd_law(void **state)
             CF_OK)
             fail_msg("%s", err.msg);
         assert_true(pair.pair);
-        if (!(pair.objective <= plain.objective * (1 + 1e-9)))
+        /* never worse than the odd law it contains, unless the search left the odd law's optimum
+        ** for stability: the odd law's element buckles in the full lattice inside a table's range
+        ** (non-telescoping chicken breast: its 2^3 lattice does) and the pair kept is stable */
+        const int left_for_stability = pair.tab[1].stability_checked && cf_joint_stable(&pair);
+        if (!(pair.objective <= plain.objective * (1 + 1e-9)) && !left_for_stability)
             fail_msg("type %d: the pair's joint objective %.6g above the odd law's %.6g", ty,
                      pair.objective, plain.objective);
         if (plain.fit.feasible && pair.objective == plain.objective)
