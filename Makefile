@@ -243,6 +243,9 @@ uninstall: install-paths
 test-install: all
 	@sh tests/install/run.sh
 
+# Debian's python3-vtk9 serves Debian's interpreter (another python3 first on PATH lacks VTK).
+FIGURE_PYTHON ?= /usr/bin/python3
+
 figures: check-deps $(BUILD)/conifit
 	@mkdir -p fits/figures
 	$(BUILD)/conifit simulate data/scenes/uniaxial.json -o $(BUILD)/uniaxial.csv --plot fits/figures/validation.png
@@ -250,7 +253,7 @@ figures: check-deps $(BUILD)/conifit
 	$(BUILD)/conifit simulate data/scenes/creep.json -o $(BUILD)/creep.csv --plot fits/figures/creep.png
 	@if [ -f ../shared/meshes/liver2.msh ]; then \
 	  $(BUILD)/conifit simulate data/scenes/liver_probe.json -o $(BUILD)/liver_probe.csv --vtu $(BUILD)/liver_probe && \
-	  python3 fits/figures/liver_probe.py $(BUILD)/liver_probe fits/figures/liver_probe.png; \
+	  $(FIGURE_PYTHON) fits/figures/liver_probe.py $(BUILD)/liver_probe fits/figures/liver_probe.png; \
 	else echo "conifit: ../shared/meshes absent: fits/figures/liver_probe.png is not refreshed"; fi
 	gnuplot fits/figures/type_regions.gp
 	$(BUILD)/conifit curve --D1 10 --D2 30 --n 4 --d 1 --G 80000 --H 50 --n_tail 1 --H_tail 20 --points 2001 -o $(BUILD)/three_regions_tail.csv

@@ -13,8 +13,21 @@ import tempfile
 from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
 from vtkmodules.vtkFiltersGeometry import vtkGeometryFilter
 
+if len(sys.argv) != 3:
+    sys.exit("usage: python3 fits/figures/liver_probe.py DIR OUT.png")
 folder, out = sys.argv[1], sys.argv[2]
-last = sorted(glob.glob(folder + "/body_*.vtu"))[-1]
+# the output name goes into gnuplot's script inside quotes: a name that could end the quotes or
+# the line (and so become a gnuplot command) is refused, not escaped
+if any(ch in out for ch in "'\"`\\\n\r;") or not out:
+    sys.stderr.write("liver_probe.py: output name %r: quotes, backslashes, semicolons and "
+                     "line breaks are not allowed\n" % out)
+    sys.exit(2)
+steps = sorted(glob.glob(glob.escape(folder) + "/body_*.vtu"))
+if not steps:
+    sys.stderr.write("liver_probe.py: %s: no body_*.vtu (run conifit simulate ... --vtu DIR)\n"
+                     % folder)
+    sys.exit(66)
+last = steps[-1]
 reader = vtkXMLUnstructuredGridReader()
 reader.SetFileName(last)
 reader.Update()
@@ -26,6 +39,9 @@ poly = surface.GetOutput()
 disp = poly.GetPointData().GetArray("displacement")
 mag = [math.sqrt(sum(disp.GetComponent(i, k) ** 2 for k in range(3)))
        for i in range(poly.GetNumberOfPoints())]
+if not mag or not all(math.isfinite(m) for m in mag):
+    sys.stderr.write("liver_probe.py: %s: no finite displacement to draw\n" % last)
+    sys.exit(65)
 top = max(mag) or 1.0
 with tempfile.NamedTemporaryFile("w", suffix=".dat", delete=False) as dat:
     # each triangle as a degenerate pm3d quadrangle: two scans of two points
