@@ -1,12 +1,12 @@
 #!/bin/sh
 # Layer check: no source or header of conifit includes one from a higher layer.
 # Order, lowest first (README, "Architecture"):
-#   base < model < io < fit < check < report < pipeline < cli
+#   base < model < io < fit < check < report < export < pipeline < cli
 # A file's layer is its folder src/LAYER/. A public header src/include/conifit/NAME.h belongs to
 # the layer of src/LAYER/NAME.c; a public header with no such source names its layer in a comment
 # "conifit-layer: LAYER". Exit 1 with every upward include listed.
 cd "$(dirname "$0")/.." || exit 70
-order="base model io fit check report pipeline cli"
+order="base model io fit check report export pipeline cli"
 
 rank() {
   i=0

@@ -1,5 +1,5 @@
 /*
-** Tests of the export (src/report/export*.c, conifit export):
+** Tests of the export (src/export/export*.c, conifit export):
 **  - tables: within tol F_C of the law on a dense grid of their own, rows where the error is (at
 **    most 200 at 1e-4 for every rho >= 0.05; the shipped fits through the command line), ranges;
 **  - each format parsed back and every number checked against the law: the CalculiX/Abaqus and

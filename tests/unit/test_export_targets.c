@@ -1,6 +1,6 @@
 /*
 ** Tests of what the FEBio and LS-DYNA exports tell their simulator and their reader
-** (src/report/export_model.c, export_table.c, conifit export):
+** (src/export/export_model.c, export_table.c, conifit export):
 **  - FEBio: the log file of the top reactions is named after the output (-o), so two models in
 **    one folder do not share it; an output's name from outside is written XML-escaped with no
 **    folder in it (the XML parsed back by libxml2 gives the name); the header says what FEBio
@@ -20,7 +20,7 @@
 
 #include "conifit/export.h"
 #include "conifit/law.h"
-#include "report/export_model.h"
+#include "export/export_model.h"
 
 static char dir[] = "/tmp/conifit-xtargets-XXXXXX";
 static char conifit_abs[PATH_MAX], fit[PATH_MAX + 16], scene[PATH_MAX + 16];

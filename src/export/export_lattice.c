@@ -14,7 +14,7 @@
 #include "base/gslguard.h"
 #include "conifit/lattice.h"
 #include "conifit/validate.h"
-#include "report/export_model.h"
+#include "export/export_model.h"
 
 /* Two springs belong to one group when their rest lengths and weights agree to this relative
 ** difference (they are computed by the same formulas, so they agree to rounding). */

@@ -14,7 +14,7 @@
 #include "base/gslguard.h"
 #include "conifit/body.h"
 #include "conifit/lattice.h"
-#include "report/export_model.h"
+#include "export/export_model.h"
 
 /* The nodes the punch's face rests on at depth 0 (on its plane within 1e-9 of the mean edge and
 ** inside its radius), into m->top. 0, -1 out of memory. */

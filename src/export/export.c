@@ -16,7 +16,7 @@
 #include "conifit/version.h"
 #include "base/safetext.h"
 #include "io/fitfile_json.h"
-#include "report/export_model.h"
+#include "export/export_model.h"
 
 cf_export_options cf_export_default_options(void)
 {

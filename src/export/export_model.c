@@ -36,7 +36,7 @@
 **   implicit solver sees the constant stiffness of all springs engaged, the last slope of the
 **   table: stable and right at equilibrium, slower to settle than the force alone would be.
 */
-#include "report/export_model.h"
+#include "export/export_model.h"
 
 #include <math.h>
 #include <stdlib.h>
