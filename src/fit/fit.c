@@ -92,17 +92,6 @@ double cf_fit_model(const cf_law *law, int force_displacement, double x)
     return cf_law_force(law, CF_LAW_CLOSED, x * H, NULL, NULL) / (H * H);
 }
 
-void cf_fit_model_many(const cf_law *law, int force_displacement, size_t count, const double *x,
-                       double *out)
-{
-    const double H = force_displacement ? 1.0 : law->p.H_mm;
-    for (size_t i = 0; i < count; i++)
-        out[i] = x[i] * H;
-    cf_law_force_many(law, CF_LAW_CLOSED, count, out, out, NULL);
-    if (!force_displacement)
-        for (size_t i = 0; i < count; i++)
-            out[i] /= H * H;
-}
 
 /* ---- the checks and the working state -------------------------------------------------------- */
 

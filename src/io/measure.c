@@ -43,10 +43,6 @@ static void reader_free(reader *r)
     free(r->t);
 }
 
-cf_status cf_reader_out_of_memory(cf_error *err, const char *path)
-{
-    return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory reading the table", path);
-}
 
 static cf_status read_all(reader *r, cf_error *err)
 {
@@ -186,20 +182,6 @@ static cf_status check_text(const reader *r, const layout *h, cf_error *err)
     return CF_OK;
 }
 
-cf_status cf_reader_split(reader *r, const cf_csv_line *l, size_t n, char delim, cf_error *err)
-{
-    size_t bad = 0;
-    const char *why = NULL;
-    int rc = cf_csv_split(l->s, n, delim, &r->f, &bad, &why);
-    if (rc == -2)
-        return cf_reader_out_of_memory(err, r->path);
-    if (rc == -1) {
-        char q[256];
-        cf_csv_quote(q, sizeof q, l->s, n);
-        return cf_csv_error(err, r->path, l->line, bad, "%s ('%s')", why, q);
-    }
-    return CF_OK;
-}
 
 /* ---- the header and its columns -------------------------------------------------------------- */
 

@@ -777,18 +777,11 @@ void cf_law_lanes_init(const cf_law *law, cf_law_lanes *lanes)
     }
 }
 
-void cf_law_force_many(const cf_law *law, cf_law_method method, size_t count, const double *u_mm,
-                       double *F_N, double *k_N_per_mm)
+/* The scalar law over many points (law_simd.h): the batch's path for the exact method, the
+** stiffness, and the laws the lanes do not carry. */
+void cf_law_force_scalar_many(const cf_law *law, cf_law_method method, size_t count,
+                              const double *u_mm, double *F_N, double *k_N_per_mm)
 {
-    if (!k_N_per_mm && !law->tail && !law->extension &&
-        (method == CF_LAW_CLOSED || (method == CF_LAW_TABLE && law->table))) {
-        /* forces alone: the vectorised lanes (law_simd.h) */
-        cf_law_lanes lanes;
-        cf_law_lanes_init(law, &lanes);
-        cf_law_force_lanes(&lanes, method == CF_LAW_TABLE ? CF_LANE_TABLE : CF_LANE_CLOSED,
-                           count, u_mm, F_N);
-        return;
-    }
     switch (method) { /* one branch per method so each loop body is specialised */
     case CF_LAW_EXACT:
         law_many(law, CF_LAW_EXACT, count, u_mm, F_N, k_N_per_mm);

@@ -54,7 +54,7 @@ cf_simd cf_simd_level(void)
     {                                                                                              \
         const cf_law_lanes c = *lanes; /* by value: its loads leave the loop */                    \
         if (c.tail && !(form == CF_LANE_POLY && c.poly_fit))                                       \
-            cf_law_force_many(c.law, CF_LAW_CLOSED, count, u, F, NULL); /* the scalar law */      \
+            cf_law_force_scalar_many(c.law, CF_LAW_CLOSED, count, u, F, NULL); /* scalar law */ \
         else if (form == CF_LANE_TABLE && c.coef)                                                  \
             cf_lanes_table(&c, count, u, F);                                                       \
         else if (form == CF_LANE_POLY && c.poly_fit)                                               \
@@ -68,4 +68,20 @@ void cf_law_force_lanes(const cf_law_lanes *lanes, int form, size_t count, const
                         double *F)
 {
     CF_SIMD_CALL(force_lanes, (lanes, form, count, u, F));
+}
+
+/* The law over many points (conifit/law.h): forces alone of a law the lanes carry go through
+** them, everything else through the scalar law (law.c). */
+void cf_law_force_many(const cf_law *law, cf_law_method method, size_t count, const double *u_mm,
+                       double *F_N, double *k_N_per_mm)
+{
+    if (!k_N_per_mm && !law->tail && !law->extension &&
+        (method == CF_LAW_CLOSED || (method == CF_LAW_TABLE && law->table))) {
+        cf_law_lanes lanes;
+        cf_law_lanes_init(law, &lanes);
+        cf_law_force_lanes(&lanes, method == CF_LAW_TABLE ? CF_LANE_TABLE : CF_LANE_CLOSED,
+                           count, u_mm, F_N);
+        return;
+    }
+    cf_law_force_scalar_many(law, method, count, u_mm, F_N, k_N_per_mm);
 }

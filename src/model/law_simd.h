@@ -376,6 +376,11 @@ CF_LANE void cf_lanes_table(const cf_law_lanes *c, size_t count, const double *u
 ** polynomial (lanes->poly_fit): F[i] for u[i]. Vectorised, dispatched at run time. A form whose
 ** data lanes lacks runs the closed form; a spring with a tail has the polynomial only, and any
 ** other form (or no fitted polynomial) runs its scalar closed form. */
+/* The scalar law over many points with the method given (law.c): what cf_law_force_many runs for
+** the stiffness, the exact method and the laws the lanes do not carry. */
+void cf_law_force_scalar_many(const cf_law *law, cf_law_method method, size_t count,
+                              const double *u_mm, double *F_N, double *k_N_per_mm);
+
 void cf_law_force_lanes(const cf_law_lanes *lanes, int form, size_t count, const double *u,
                         double *F);
 

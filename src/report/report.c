@@ -56,11 +56,6 @@ double cf_report_fit_aic(const cf_fit_report *r, int i)
                            r->ymax * f);
 }
 
-double cf_report_baseline_aic(const cf_fit_report *r, int k)
-{
-    double f = r->table->y_to_file;
-    return cf_baseline_aic(r->table->count, r->baselines[k].rss * f * f, r->baselines[k].k, r->ymax * f);
-}
 
 #define num cf_json_number
 

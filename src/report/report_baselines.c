@@ -10,6 +10,12 @@
 
 /* The names of baseline kind's coefficients, and which are in the stress (force) unit: the
 ** others are per unit x (Fung's B) or dimensionless (Ogden's alpha). Returns their count. */
+double cf_report_baseline_aic(const cf_fit_report *r, int k)
+{
+    double f = r->table->y_to_file;
+    return cf_baseline_aic(r->table->count, r->baselines[k].rss * f * f, r->baselines[k].k, r->ymax * f);
+}
+
 static int coefficient_names(cf_baseline_kind kind, const char *name[3], int in_y[3])
 {
     static const char *const names[CF_BASE_COUNT][3] = {
