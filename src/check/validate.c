@@ -2,6 +2,7 @@
 ** Validation of fitted springs in the static uniaxial lattice (see validate.h).
 */
 #include "conifit/validate.h"
+#include "model/mode.h"
 #include "base/gslguard.h"
 
 #include <math.h>
@@ -212,7 +213,7 @@ cf_status cf_validate_run(const cf_spring *p, const cf_validate_setup *s, const 
     for (size_t i = 0; i < d->count; i++)
         ss += (v->stress_MPa[i] - law[i]) * (v->stress_MPa[i] - law[i]);
     /* the law's own curve is a uniaxial one: in another mode there is nothing to compare */
-    v->law_rmse = d->mode == CF_MODE_UNIAXIAL ? sqrt(ss / (double)d->count) : NAN;
+    v->law_rmse = cf_mode_row_of(d->mode)->spring_curve ? sqrt(ss / (double)d->count) : NAN;
     free(law);
     if ((st = stability(p, s, d, v, &e)) != CF_OK) {
         cf_validation_free(v);

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "base/atomic.h"
+#include "model/mode.h"
 #include "cli/cli.h"
 #include "cli/cli_fit.h"
 #include "cli/cli_shard.h"
@@ -260,7 +261,7 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
     for (int i = 0; i < a->nfiles && rc < 0 && a->popt.target == CF_TARGET_SPRING && !a->joint;
          i++)
         if (jobs[i].st == CF_OK && !jobs[i].m.t && !cf_table_is_force(&jobs[i].m) &&
-            jobs[i].m.mode != CF_MODE_UNIAXIAL)
+            !cf_mode_row_of(jobs[i].m.mode)->spring_curve)
             rc = cf_cli_usage_error("fit", "--target spring: the table's mode is %s, which a "
                                            "single spring has no curve of; fit it through the "
                                            "lattice (the default in that mode) or give "

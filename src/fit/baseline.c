@@ -7,6 +7,7 @@
 ** table's test mode: hyperelastic.h.
 */
 #include "conifit/baseline.h"
+#include "model/mode.h"
 #include "base/gslguard.h"
 
 #include <float.h>
@@ -37,29 +38,13 @@ const char *cf_baseline_name(cf_baseline_kind kind)
 
 const char *cf_baseline_formula(cf_baseline_kind kind, cf_mode m)
 {
-    static const char *const yeoh[CF_MODE_COUNT] = {
-        [CF_MODE_UNIAXIAL] = "y = 2 (l - l^-2) (C1 + 2 C2 (I1 - 3) + 3 C3 (I1 - 3)^2), "
-                             "I1 = l^2 + 2/l, l = 1 + x",
-        [CF_MODE_SHEAR] = "y = 2 x (C1 + 2 C2 x^2 + 3 C3 x^4)",
-        [CF_MODE_PLANAR] = "y = 2 (l - l^-3) (C1 + 2 C2 (I1 - 3) + 3 C3 (I1 - 3)^2), "
-                           "I1 = l^2 + 1 + l^-2, l = 1 + x",
-        [CF_MODE_EQUIBIAXIAL] = "y = 2 (l - l^-5) (C1 + 2 C2 (I1 - 3) + 3 C3 (I1 - 3)^2), "
-                                "I1 = 2 l^2 + l^-4, l = 1 + x",
-    };
-    static const char *const ogden[CF_MODE_COUNT] = {
-        [CF_MODE_UNIAXIAL] = "y = (2 mu / alpha) (l^(alpha - 1) - l^(-alpha/2 - 1)), l = 1 + x",
-        [CF_MODE_SHEAR] = "y = (2 mu / alpha) sinh(alpha a) / cosh(a), a = asinh(x/2)",
-        [CF_MODE_PLANAR] = "y = (2 mu / alpha) (l^(alpha - 1) - l^(-alpha - 1)), l = 1 + x",
-        [CF_MODE_EQUIBIAXIAL] = "y = (2 mu / alpha) (l^(alpha - 1) - l^(-2 alpha - 1)), "
-                                "l = 1 + x",
-    };
-    const int mi = m >= 0 && m < CF_MODE_COUNT ? (int)m : 0;
+    const cf_mode_row *row = cf_mode_row_of(m) ? cf_mode_row_of(m) : cf_mode_row_of(0);
     switch (kind) {
     case CF_BASE_LINEAR: return "y = E x";
     case CF_BASE_DUFFING: return "y = k1 x + k3 x^3";
     case CF_BASE_FUNG: return "y = A (exp(B x) - 1)";
-    case CF_BASE_YEOH: return yeoh[mi] ? yeoh[mi] : "(no form in this mode)";
-    case CF_BASE_OGDEN: return ogden[mi] ? ogden[mi] : "(no form in this mode)";
+    case CF_BASE_YEOH: return row->yeoh ? row->yeoh : "(no form in this mode)";
+    case CF_BASE_OGDEN: return row->ogden ? row->ogden : "(no form in this mode)";
     case CF_BASE_COUNT: break;
     }
     return "?";
@@ -416,10 +401,8 @@ static int ogden_scan(const cf_table *t, int weighted, double pmax, void *scratc
     if (!buf)
         return -1;
     double *c = buf, *z2 = buf + m, *u = buf + 2 * m, *v = buf + 4 * m, *g = buf + 6 * m;
-    const int shear = s->mode == CF_MODE_SHEAR;
-    const double q = shear || s->mode == CF_MODE_PLANAR ? 1.0
-                     : s->mode == CF_MODE_EQUIBIAXIAL   ? 2.0
-                                                        : 0.5;
+    const int shear = cf_mode_row_of(s->mode)->any_sign;
+    const double q = cf_mode_row_of(s->mode)->q;
     for (size_t i = 0; i < n; i++) {
         const double L = t->x[i];
         c[i] = shear ? 1.0 / cosh(L) : 2.0 * exp(-L);
@@ -558,7 +541,7 @@ static int ogden_fit(const cf_table *d, const cf_table *scan, cf_baseline *O, in
                                          oom, &mu);
     profile_call call = {&dl, 0, ogden_profile, &s, 0, 0, {0}, {0}};
     alpha = polish(&call, alpha);
-    if (d->mode == CF_MODE_PLANAR || d->mode == CF_MODE_SHEAR) /* even in alpha there */
+    if (cf_mode_row_of(d->mode)->q == 1.0) /* q = 1: even in alpha */
         alpha = fabs(alpha);
     const int finite = isfinite(ogden_profile(&dl, 0, alpha, &mu, &s));
     free(L);

@@ -2,6 +2,7 @@
 ** Yeoh's and one-term Ogden's nominal stress in the test modes (see hyperelastic.h).
 */
 #include "fit/hyperelastic.h"
+#include "model/mode.h"
 
 #include <math.h>
 
@@ -10,9 +11,9 @@ const char *cf_hyper_unfit(const cf_table *t)
     if (t->kind == CF_TABLE_FORCE_DISPLACEMENT)
         return "a force-displacement table has no stretch (x is a displacement, and the "
                "specimen's length and section are not known)";
-    if (t->mode == CF_MODE_CONFINED)
-        return "confined compression holds the lateral stretches, which an incompressible "
-               "solid cannot follow";
+    const cf_mode_row *row = cf_mode_row_of(t->mode);
+    if (row && !(row->q > 0))
+        return row->no_incompressible;
     int strained = 0;
     for (size_t i = 0; i < t->count; i++) {
         if (!cf_hyper_in_domain(t->mode, t->x[i]))
@@ -24,7 +25,7 @@ const char *cf_hyper_unfit(const cf_table *t)
 
 int cf_hyper_in_domain(cf_mode m, double x)
 {
-    return isfinite(x) && (m == CF_MODE_SHEAR || x > -1);
+    return isfinite(x) && (cf_mode_row_of(m)->any_sign || x > -1);
 }
 
 void cf_yeoh_basis(cf_mode m, double x, double g[3])
@@ -60,15 +61,15 @@ void cf_yeoh_basis(cf_mode m, double x, double g[3])
 
 double cf_ogden_log_stretch(cf_mode m, double x)
 {
-    return m == CF_MODE_SHEAR ? asinh(0.5 * x) : log1p(x);
+    return cf_mode_row_of(m)->any_sign ? asinh(0.5 * x) : log1p(x);
 }
 
 double cf_ogden_basis(cf_mode m, double L, double alpha)
 {
-    if (m == CF_MODE_SHEAR) /* (2/alpha) sinh(alpha a) / cosh(a) */
+    if (cf_mode_row_of(m)->any_sign) /* (2/alpha) sinh(alpha a) / cosh(a) */
         return (alpha != 0 ? 2 * sinh(alpha * L) / alpha : 2 * L) / cosh(L);
-    /* (2/alpha) (lambda^(alpha - 1) - lambda^(-q alpha - 1)) with q = 1/2, 1, 2 */
-    const double q = m == CF_MODE_PLANAR ? 1.0 : m == CF_MODE_EQUIBIAXIAL ? 2.0 : 0.5;
+    /* (2/alpha) (lambda^(alpha - 1) - lambda^(-q alpha - 1)) with the mode's q: 1/2, 1, 2 */
+    const double q = cf_mode_row_of(m)->q;
     const double a = (-q * alpha - 1) * L, b = (1 + q) * alpha * L;
     if (alpha == 0)
         return 2 * (1 + q) * L * exp(-L);

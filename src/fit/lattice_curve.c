@@ -2,6 +2,7 @@
 ** One spring's lattice curve at a table's strains (see lattice_curve.h).
 */
 #include "fit/lattice_curve.h"
+#include "model/mode.h"
 
 #include <math.h>
 #include <string.h>
@@ -19,7 +20,8 @@ cf_status cf_lattice_curve(const cf_spring *p, const cf_validate_setup *s, const
         return st;
     if (s->method == CF_LAW_TABLE && (st = cf_law_table_build(&law, s->table_intervals, err)))
         return st;
-    int cell = !full || d->mode != CF_MODE_UNIAXIAL;
+    int cell = !full || !cf_mode_row_of(d->mode)->spring_curve; /* the full lattice runs the
+                                                                  spring's own (uniaxial) test */
     if (by_cell)
         *by_cell = cell;
     if (!cell) {
@@ -50,7 +52,7 @@ cf_table cf_lattice_reach(const cf_table *d, double *spring_x)
 void cf_lattice_take_quality(const cf_table *d, const double *g, const double *sw, double ynorm,
                              cf_fit_result *res, cf_through_msm *t)
 {
-    const int uniaxial = d->mode == CF_MODE_UNIAXIAL;
+    const int uniaxial = cf_mode_row_of(d->mode)->spring_curve;
     t->law_rmse = uniaxial ? res->rmse : NAN;
     t->law_max_abs_error = uniaxial ? res->max_abs_error : NAN;
     t->law_r2 = uniaxial ? res->r2 : NAN;

@@ -7,6 +7,7 @@
 ** J = l1 and P11 = sigma11. Log strain e gives the stretch exp(e), engineering strain exp(e) - 1.
 */
 #include "io/measures.h"
+#include "model/mode.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -261,7 +262,7 @@ cf_status cf_measures_read(const cf_csv_line *comments, size_t ncomments, const 
 cf_status cf_measures_convert(cf_table *t, cf_error *err)
 {
     cf_table_measures *m = &t->measures;
-    const int shear = t->mode == CF_MODE_SHEAR;
+    const int shear = cf_mode_row_of(t->mode)->any_sign;
     if (t->kind == CF_TABLE_FORCE_DISPLACEMENT) {
         if (m->stress == CF_STRESS_CAUCHY)
             return cf_error_set(err, CF_E_DATA,
@@ -296,7 +297,7 @@ cf_status cf_measures_convert(cf_table *t, cf_error *err)
                                 "be positive ('%g')",
                                 t->path, i + 1, t->x[i], 1 + t->x[i], t->x[i]);
     if (m->stress == CF_STRESS_CAUCHY) {
-        if (!shear && t->mode != CF_MODE_CONFINED)
+        if (cf_mode_row_of(t->mode)->cauchy_over_stretch)
             for (size_t i = 0; i < t->count; i++)
                 t->y[i] /= 1 + t->x[i];
         m->stress_converted = 1;

@@ -4,6 +4,7 @@
 ** safeguarded Newton solve of that stretch.
 */
 #include "conifit/cell.h"
+#include "model/mode.h"
 
 #include <float.h>
 #include <math.h>
@@ -14,26 +15,6 @@
 #define SOLID_MARGIN (1.0 - 1e-9)
 /* Newton iterations for a free stretch. */
 #define MAX_ITER 100
-
-static const char *const mode_names[CF_MODE_COUNT] = {"uniaxial", "shear", "planar",
-                                                      "equibiaxial", "confined"};
-
-const char *cf_mode_name(cf_mode m)
-{
-    return (int)m >= 0 && m < CF_MODE_COUNT ? mode_names[m] : "?";
-}
-
-cf_status cf_mode_parse(const char *name, cf_mode *m, cf_error *err)
-{
-    for (int k = 0; name && k < CF_MODE_COUNT; k++)
-        if (strcmp(name, mode_names[k]) == 0) {
-            *m = (cf_mode)k;
-            return CF_OK;
-        }
-    return cf_error_set(err, CF_E_DATA,
-                        "mode '%s': expected uniaxial, shear, planar, equibiaxial or confined",
-                        name ? name : "(none)");
-}
 
 /* The 13 directions, each unordered pair of neighbours once: offsets with dz > 0, or dz = 0 and
 ** dy > 0, or dz = dy = 0 and dx > 0, in the order z, y, x from -1 to 1. */
@@ -339,40 +320,22 @@ typedef struct mode_form {
 
 static mode_form form_of(cf_mode m)
 {
-    switch (m) {
-    case CF_MODE_UNIAXIAL: return (mode_form){3u, 0, 2, 2};
-    case CF_MODE_SHEAR: return (mode_form){0u, -1, 0, 2};
-    case CF_MODE_PLANAR: return (mode_form){4u, 2, 0, 0};
-    case CF_MODE_EQUIBIAXIAL: return (mode_form){4u, 2, 0, 0};
-    case CF_MODE_CONFINED: return (mode_form){0u, -1, 2, 2};
-    default: return (mode_form){0u, -1, 2, 2};
-    }
+    const cf_mode_row *r = cf_mode_row_of(m);
+    return r ? (mode_form){r->free_mask, r->zero, r->si, r->sj} : (mode_form){0u, -1, 2, 2};
 }
 
-static void place(cf_mode m, double e, double a, double F[9])
-{
-    memset(F, 0, 9 * sizeof(double));
-    F[0] = F[4] = F[8] = 1;
-    switch (m) {
-    case CF_MODE_UNIAXIAL: F[0] = F[4] = a, F[8] = 1 + e; break;
-    case CF_MODE_SHEAR: F[2] = e; break;
-    case CF_MODE_PLANAR: F[0] = 1 + e, F[8] = a; break;
-    case CF_MODE_EQUIBIAXIAL: F[0] = F[4] = 1 + e, F[8] = a; break;
-    case CF_MODE_CONFINED: F[8] = 1 + e; break;
-    default: break;
-    }
-}
-
-/* First guess of the free stretch from the small-strain constants of the weights. */
+/* First guess of the free stretch from the small-strain constants of the weights: a free pair
+** contracts by nu, a single free stretch by C12/C11 for each loaded one. */
 static double guess(const cf_cell *c, cf_mode m, double e)
 {
+    const cf_mode_row *r = cf_mode_row_of(m);
+    const int nf = __builtin_popcount(r->free_mask), nl = __builtin_popcount(r->strain_mask);
     cf_cubic_moduli cm = cf_cubic_moduli_of(c->weight);
-    switch (m) {
-    case CF_MODE_UNIAXIAL: return 1 - cm.nu * e;
-    case CF_MODE_PLANAR: return 1 - cm.C12 / cm.C11 * e;
-    case CF_MODE_EQUIBIAXIAL: return 1 - 2 * cm.C12 / cm.C11 * e;
-    default: return 1;
-    }
+    if (nf == 2)
+        return 1 - cm.nu * e;
+    if (nf == 1)
+        return 1 - nl * cm.C12 / cm.C11 * e;
+    return 1;
 }
 
 /* The state once its free stretch a is found: the stress of the mode's loaded component. */
@@ -494,14 +457,15 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
     if ((int)m < 0 || m >= CF_MODE_COUNT)
         return cf_error_set(err, CF_E_DATA, "mode %d: unknown", (int)m);
     /* a stretch must stay positive; simple shear has no stretch and takes any amount */
-    if (!isfinite(e) || (m != CF_MODE_SHEAR && !(e > -1)))
+    const int any_sign = cf_mode_row_of(m)->any_sign;
+    if (!isfinite(e) || (!any_sign && !(e > -1)))
         return cf_error_set(err, CF_E_DATA, "%s strain %g: must be finite%s", cf_mode_name(m), e,
-                            m == CF_MODE_SHEAR ? "" : " and > -1");
+                            any_sign ? "" : " and > -1");
     const mode_form fm = form_of(m);
     double F[9], kT[CF_CELL_DIRS];
     cf_status st;
     if (fm.zero < 0) {
-        place(m, e, 1, F);
+        cf_mode_place(m, e, 1, F);
         if ((st = evaluate(c, F, extra, s, kT, err)) != CF_OK)
             return st;
         return settled(s, &fm, 1);
@@ -516,7 +480,7 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
     cf_error e1 = {0};
     double newton_before = 0; /* the Newton step that led to a, 0 when a came otherwise */
     for (int it = 0; it < MAX_ITER; it++) {
-        place(m, e, a, F);
+        cf_mode_place(m, e, a, F);
         st = evaluate(c, F, extra, s, kT, &e1);
         if (st != CF_OK) {
             newton_before = 0;
@@ -539,7 +503,7 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
             if (an == a) /* the state just evaluated is the one it would place again */
                 return settled(s, &fm, a);
             a = an;
-            place(m, e, a, F);
+            cf_mode_place(m, e, a, F);
             if ((st = evaluate(c, F, extra, s, kT, &e1)) != CF_OK)
                 break;
             return settled(s, &fm, a);
@@ -571,7 +535,7 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
 double cf_cell_spring_strain(cf_mode m, double e)
 {
     double F[9], r = 0;
-    place(m, e, 1, F);
+    cf_mode_place(m, e, 1, F);
     for (int d = 0; d < CF_CELL_DIRS; d++) {
         double X[3] = {dirs[d][0], dirs[d][1], dirs[d][2]}, L2 = 0, L02 = 0;
         for (int i = 0; i < 3; i++) {
@@ -611,13 +575,14 @@ cf_status cf_cell_solid_strain(const cf_cell *c, cf_mode m, int side, double *e_
     /* a bracket [good, bad] in |e|: the far end doubles until the mode cannot reach it (a
     ** compression cannot pass -1 in a mode that stretches the loaded edge) */
     double good = 0, bad = 0.1;
+    const int stretch = cf_mode_row_of(m) && !cf_mode_row_of(m)->any_sign;
     while (reaches(c, m, sg * bad)) {
         good = bad;
         bad *= 2;
-        if (bad > 1e3 || (sg < 0 && m != CF_MODE_SHEAR && bad >= 1))
+        if (bad > 1e3 || (sg < 0 && stretch && bad >= 1))
             break;
     }
-    if (sg < 0 && m != CF_MODE_SHEAR)
+    if (sg < 0 && stretch)
         bad = fmin(bad, 1);
     if (reaches(c, m, sg * bad))
         return cf_error_set(err, CF_E_DATA, "%s strain %g: no spring of the cell reaches solid",

@@ -2,6 +2,7 @@
 ** The fitting pipeline (see pipeline.h).
 */
 #include "conifit/pipeline.h"
+#include "model/mode.h"
 #include "base/gslguard.h"
 
 #include <math.h>
@@ -60,7 +61,7 @@ static void progress(const cf_pipeline_options *opt, const cf_table *t, const ch
 static int through_lattice(const cf_table *t, const cf_pipeline_options *opt)
 {
     if (opt->target == CF_TARGET_AUTO)
-        return !cf_table_is_force(t) && (opt->validate || t->mode != CF_MODE_UNIAXIAL);
+        return !cf_table_is_force(t) && (opt->validate || !cf_mode_row_of(t->mode)->spring_curve);
     return opt->target == CF_TARGET_LATTICE;
 }
 
@@ -209,7 +210,7 @@ static cf_status limit_cost(const cf_table *t, const cf_pipeline_options *opt,
 ** mode the cell cannot follow to solid leaves the spring's own solid strain. */
 static void solid_in_mode(const cf_table *t, const cf_pipeline_options *opt, cf_fit_result *f)
 {
-    if (cf_table_is_force(t) || t->mode == CF_MODE_UNIAXIAL || !(f->ident.solid > 0))
+    if (cf_table_is_force(t) || cf_mode_row_of(t->mode)->spring_curve || !(f->ident.solid > 0))
         return;
     double xmax = 0;
     int side = 1;

@@ -2,6 +2,7 @@
 ** Text, fit file and figure of a joint fit (see jointreport.h).
 */
 #include "conifit/jointreport.h"
+#include "model/mode.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -575,8 +576,9 @@ static cf_status joint_plot(const cf_joint_report *r, const char *path,
         const char *base = strrchr(t->path, '/');
         base = base ? base + 1 : t->path;
         cf_gp_cmd(&g, "set title %q noenhanced", base);
-        cf_gp_cmd(&g, "set xlabel %q", t->mode == CF_MODE_SHEAR ? "amount of shear [-]"
-                                                                : "strain [-]");
+        char xl[64];
+        snprintf(xl, sizeof xl, "%s [-]", cf_mode_row_of(t->mode)->x_short);
+        cf_gp_cmd(&g, "set xlabel %q", xl);
         cf_gp_cmd(&g, "set ylabel %q noenhanced", t->y_unit);
         cf_gp_cmd(&g, "plot $T%d using 1:2 with points pt 7 ps 0.7 lc rgb %q title %q, "
                       "$T%d using 1:3 with lines lw 2 lc rgb %q title %q",

@@ -2,6 +2,7 @@
 ** conifit's figures (see plot.h), written as gnuplot scripts under the rule of gnuplot.h.
 */
 #include "report/plot.h"
+#include "model/mode.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -285,7 +286,7 @@ static void axis_labels(const cf_table *d, char *x, size_t xcap, char *y, size_t
     if (m->strain != CF_STRAIN_ENGINEERING)
         snprintf(from, sizeof from, " (from %s)", cf_strain_measure_name(m->strain));
     snprintf(x, xcap, "%s%s [-]",
-             d->mode == CF_MODE_SHEAR ? "amount of shear" : "engineering strain", from);
+             cf_mode_row_of(d->mode)->x_quantity, from);
     from[0] = '\0';
     if (m->stress != CF_STRESS_NOMINAL)
         snprintf(from, sizeof from, " (from %s)", cf_stress_measure_name(m->stress));

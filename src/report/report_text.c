@@ -4,6 +4,7 @@
 ** the baselines.
 */
 #include "conifit/report.h"
+#include "model/mode.h"
 #include "base/gslguard.h"
 
 #include <math.h>
@@ -400,7 +401,7 @@ static void identifiable_text(FILE *o, const cf_fit_report *r)
 ** table (in the other modes the law has no curve to compare). */
 static void spring_law_text(FILE *o, const cf_fit_report *r)
 {
-    if (!cf_report_target_is_lattice(r) || r->table->mode != CF_MODE_UNIAXIAL)
+    if (!cf_report_target_is_lattice(r) || !cf_mode_row_of(r->table->mode)->spring_curve)
         return;
     enum { ROWS = 3 };
     char buf[ROWS][2][64];

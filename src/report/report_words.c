@@ -4,6 +4,7 @@
 ** measures came from and how its columns were converted.
 */
 #include "report/report_words.h"
+#include "model/mode.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -254,14 +255,7 @@ void cf_report_conversion(const cf_table *t, char *buf, size_t cap)
                              : "stretch l converted to engineering strain l - 1");
     if (m->stress_converted) {
         cf_report_append(buf, cap, &n, "%sCauchy stress converted to nominal ", n ? "; " : "");
-        if (t->mode == CF_MODE_SHEAR)
-            cf_report_append(buf, cap, &n,
-                             "(simple shear: P12 = sigma12, the sheared face keeps its area)");
-        else if (t->mode == CF_MODE_CONFINED)
-            cf_report_append(buf, cap, &n, "(confined: P = sigma, the lateral stretches are 1)");
-        else
-            cf_report_append(buf, cap, &n, "P = sigma / (1 + strain), incompressible %s",
-                             cf_mode_name(t->mode));
+        cf_report_append(buf, cap, &n, "%s", cf_mode_row_of(t->mode)->cauchy_words);
     }
 }
 
@@ -352,7 +346,7 @@ const char *cf_report_why(const char *note, const char *fallback)
 
 const char *cf_report_strain_name(const cf_table *t, char src[3][128])
 {
-    if (t->mode != CF_MODE_SHEAR)
+    if (!cf_mode_row_of(t->mode)->any_sign)
         return cf_strain_measure_name(t->measures.strain);
     snprintf(src[1], sizeof src[1], "simple shear: the amount of shear, either sign");
     return "shear strain gamma";
@@ -360,7 +354,7 @@ const char *cf_report_strain_name(const cf_table *t, char src[3][128])
 
 const char *cf_report_mode_dropped(const cf_table *t)
 {
-    if (!cf_table_is_force(t) || !t->mode_stated || t->mode == CF_MODE_UNIAXIAL)
+    if (!cf_table_is_force(t) || !t->mode_stated || cf_mode_row_of(t->mode)->spring_curve)
         return NULL;
     return "a force-displacement table is one spring's force against its displacement: it is "
            "fitted as that spring along its axis, not as a test of a block of tissue in this mode "

@@ -9,6 +9,7 @@
 
 #include "conifit/cell.h"
 #include "conifit/msm.h"
+#include "model/mode.h"
 
 /* A soft, strongly stiffening non-telescoping spring (solid strain 0.5, H = 10 mm), and a
 ** telescoping one with a deeper nonlinear range. */
@@ -337,6 +338,55 @@ static void shear_takes_either_sign_past_one(void **state)
     cf_law_free(&law);
 }
 
+
+/* The mode table (src/model/mode.c): every mode's name parses back to it; its deformation is a
+** consistent row (a free stretch is not a loaded one, the stretch it zeroes is free, the stress it
+** reads is loaded); the cell's free stretch leaves exactly that stress at zero and the mode's
+** stress is the one the row names (a shear stress in shear, a normal one elsewhere); the
+** incompressible forms are there exactly where q says; an unknown mode has no row. */
+static void every_mode_is_one_consistent_row(void **state)
+{
+    (void)state;
+    cf_law law = law_of(0);
+    cf_cell c = iso_cell(&law, CF_LAW_EXACT);
+    for (int k = 0; k < CF_MODE_COUNT; k++) {
+        const cf_mode_row *r = cf_mode_row_of((cf_mode)k);
+        assert_non_null(r);
+        cf_mode back = CF_MODE_COUNT;
+        assert_int_equal(cf_mode_parse(cf_mode_name((cf_mode)k), &back, NULL), CF_OK);
+        assert_int_equal(back, k);
+        assert_int_equal(r->free_mask & r->strain_mask, 0u);
+        if (r->zero >= 0)
+            assert_true(r->free_mask & (1u << r->zero));
+        else
+            assert_int_equal(r->free_mask, 0u);
+        if (r->si == r->sj)
+            assert_true(r->strain_mask & (1u << r->si));
+        else
+            assert_true(r->shear_i == r->si && r->shear_j == r->sj);
+        assert_int_equal(r->q > 0, r->ogden != NULL);
+        assert_int_equal(r->q > 0, r->yeoh != NULL);
+        assert_int_equal(r->q > 0, r->no_incompressible == NULL);
+        double F[9];
+        cf_mode_place((cf_mode)k, 0.05, 0.97, F);
+        for (int i = 0; i < 3; i++)
+            assert_true(F[4 * i] == (r->strain_mask & (1u << i)  ? 1.05
+                                     : r->free_mask & (1u << i) ? 0.97
+                                                                : 1.0));
+        cf_cell_state s;
+        assert_int_equal(cf_cell_mode(&c, (cf_mode)k, 0.05, NULL, &s, NULL), CF_OK);
+        assert_true(s.P_MPa[r->si][r->sj] > 0);
+        if (r->zero >= 0)
+            assert_true(fabs(s.P_MPa[r->zero][r->zero]) <= 1e-12 * fabs(s.P_MPa[r->si][r->sj]));
+    }
+    assert_null(cf_mode_row_of(CF_MODE_COUNT));
+    assert_null(cf_mode_row_of((cf_mode)-1));
+    cf_mode m;
+    cf_error err = {0};
+    assert_int_equal(cf_mode_parse("torsion", &m, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "expected uniaxial, shear, planar, equibiaxial or confined"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -349,6 +399,7 @@ int main(void)
         cmocka_unit_test(bad_input_is_refused),
         cmocka_unit_test(first_spring_at_solid_in_each_mode),
         cmocka_unit_test(shear_takes_either_sign_past_one),
+        cmocka_unit_test(every_mode_is_one_consistent_row),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
