@@ -379,6 +379,151 @@ static int same_stage_a_options(const cf_fit_options *a, const cf_fit_options *b
            a->H_preferred_mm == b->H_preferred_mm && a->subsample_above == b->subsample_above;
 }
 
+/* Stage A: the identifiable quantities v, over every spring (a long table's starts on its
+** subsample g, polished on every row c; a short table's best polished to the strict rule), or
+** the other type's stage A of the same table where both search the same range (shared). pts
+** holds the grid when this fit ran it (*pts_ok). */
+static void stage_a(fit_ctx *c, fit_ctx *sc, fit_ctx *g, int long_table, const cf_table *data,
+                    const cf_fit_options *opt, cf_fit_shared *shared, double v[3],
+                    grid_point *pts, int *pts_ok)
+{
+    start4 found[STAGE_A_RUNS];
+    int nfound = 0;
+    /* both types' stage A searches the same range where their limits are known in closed form
+    ** (c->region): the same optimum, which the second fit of a table takes from the first */
+    const int share = shared && c->region;
+    const long evals0 = c->evals, sub_evals0 = sc->evals;
+    if (share && shared->have && shared->data == data && same_stage_a_options(&shared->opt, opt)) {
+        memcpy(v, shared->v, 3 * sizeof *v);
+        /* the fit rests on those evaluations as much as the first: they count in both */
+        c->evals += shared->evals_full;
+        sc->evals += shared->evals_sub;
+    } else {
+        if (long_table)
+            sc->stat_tol = LONG_TOL / (double)(sc->n - 3);
+        cf_fit_stage_a(g, v, long_table ? found : NULL, &nfound, pts);
+        *pts_ok = 1;
+        sc->stat_tol = 0;
+        if (long_table) {
+            cf_fit_stage_a_polish(c, found, nfound, v);
+        } else {
+            /* the starts stopped at the statistical tolerance; the best is polished to the
+            ** strict rule, so that a short table's fit is its optimum to rounding */
+            double w[3];
+            const double tol = c->stat_tol;
+            c->stat_tol = 0;
+            c->crawl_stop = 1;
+            if (cf_fit_lm_run(c, v[0], v[1], v[2], w) < CF_LSQ_HUGE_OBJ)
+                memcpy(v, w, sizeof w);
+            c->crawl_stop = 0;
+            c->stat_tol = tol;
+        }
+    }
+    if (share && !shared->have && !c->oom && !sc->oom) {
+        shared->have = 1;
+        shared->data = data;
+        shared->opt = *opt;
+        memcpy(shared->v, v, 3 * sizeof *v);
+        shared->evals_full = c->evals - evals0;
+        shared->evals_sub = sc->evals - sub_evals0;
+    }
+}
+
+/* Stage A under the type's limits when its optimum v lies outside them: the limits that held it
+** (0: none). */
+static unsigned stage_a_limits(fit_ctx *c, fit_ctx *g, int long_table, double v[3],
+                               grid_point *pts)
+{
+    unsigned held_a = 0;
+    if (c->region) {
+        region r = cf_fit_region_at(c, v[0], v[1]);
+        int out = r.margin > 0, over = v[2] > r.A_max / (1 - REGION_SAFETY);
+        if (out || over) {
+            held_a = (out ? r.lo_bit | r.hi_bit : 0u) | (over ? (unsigned)CF_C_G_MAX : 0u);
+            if (cf_fit_stage_a_constrained(g, v, pts)) {
+                if (long_table)
+                    cf_fit_stage_a_constrained_polish(c, v);
+                held_a |= cf_fit_held_at(c, v);
+            }
+        }
+    }
+    return held_a;
+}
+
+/* The best spring so far: its parameters, objective and feasibility. */
+typedef struct best6 {
+    double p[CF_P_COUNT];
+    double obj;
+    int feas;
+} best6;
+
+/* Takes q (feasibility feas, objective o) when it beats b: feasible first, then lower. */
+static void best_take(best6 *b, const double *q, int feas, double o)
+{
+    if ((feas && !b->feas) || (feas == b->feas && o < b->obj)) {
+        b->obj = o;
+        b->feas = feas;
+        memcpy(b->p, q, sizeof b->p);
+    }
+}
+
+/* Stage C: local polish on the real objective from stage B's placement z; with fixed parameters
+** the family may be out of reach, so then also from seeded starts around the placement. A long
+** table polishes its starts on the subsample and the best of them on every row; without fixed
+** parameters on a stress-strain table (c->region) the six parameters reach the model only
+** through the three quantities that stage A fitted on every row, so the polish there can move the
+** objective by rounding only (1e-14 of it on the shipped tables) and a long table skips its full
+** pass. */
+static void stage_c(fit_ctx *c, fit_ctx *g, int long_table, unsigned held_a,
+                    const cf_fit_options *opt, const double *z, best6 *best)
+{
+    if (!long_table)
+        c->stat_tol = 0; /* stage C on a short table: to the optimiser's own tolerances */
+    gsl_rng *rng = cf_fit_seeded_rng(opt->seed, 2);
+    c->oom |= !rng;
+    int starts = 1;
+    for (int k = 0; k < CF_P_COUNT; k++)
+        if (opt->fixed[k])
+            starts = opt->multistart;
+    const nlopt_algorithm alg = cf_fit_algorithm_of(opt->optimizer);
+    unsigned act, vio;
+    cf_spring sp;
+    double cand_z[CF_P_COUNT];
+    best6 cand = {{0}, CF_LSQ_HUGE_OBJ, 0};
+    int have_cand = 0;
+    for (int s = 0; s < starts; s++) {
+        double zz[CF_P_COUNT];
+        for (int k = 0; k < c->nfree; k++)
+            zz[k] = z[k] + (s == 0 ? 0.0 : 0.5 * (cf_fit_jitter(rng) - 0.5));
+        cf_fit_nl_run(g, alg, cf_fit_z_objective, 0, zz, 3000);
+        double q[CF_P_COUNT];
+        cf_fit_full_params(c, zz, q);
+        sp = from_array(q);
+        int feas = cf_fit_check_at(c, &sp, &act, &vio);
+        double o = cf_fit_objective6(g, q);
+        if (long_table) {
+            if (!have_cand || (feas && !cand.feas) || (feas == cand.feas && o < cand.obj)) {
+                have_cand = 1;
+                cand.obj = o;
+                cand.feas = feas;
+                memcpy(cand_z, zz, sizeof zz);
+            }
+        } else {
+            best_take(best, q, feas, o);
+        }
+    }
+    gsl_rng_free(rng);
+    if (have_cand) {
+        if (!c->region || held_a)
+            cf_fit_nl_run(c, alg, cf_fit_z_objective, 0, cand_z, 3000);
+        double q[CF_P_COUNT];
+        cf_fit_full_params(c, cand_z, q);
+        sp = from_array(q);
+        int feas = cf_fit_check_at(c, &sp, &act, &vio);
+        best_take(best, q, feas, cf_fit_objective6(c, q));
+    }
+}
+
 cf_status cf_fit_run_shared(const cf_table *data, const cf_fit_options *opt, cf_spring_type type,
                             cf_fit_shared *shared, cf_fit_result *res, cf_error *err)
 {
@@ -407,131 +552,25 @@ cf_status cf_fit_run_shared(const cf_table *data, const cf_fit_options *opt, cf_
     ** while its constrained search on the subsample keeps the strict rule (with the tolerance the
     ** subsample's optimum moved enough to end 0.07 s^2 short on a ridge of a limit) */
     c.stat_tol = LONG_TOL / (double)(c.n - 3); /* c.n >= 4 (check_data) */
-    /* Stage A: the identifiable quantities, over every spring, then under the type's limits when
-    ** the optimum lies outside them. */
     double v[3] = {0.5, 0.5 * (c.b_lo + c.b_hi), 1.0};
-    start4 found[STAGE_A_RUNS];
-    int nfound = 0;
     grid_point pts[GRID * GRID]; /* stage A's grid, when this fit runs it */
     int pts_ok = 0;
-    /* both types' stage A searches the same range where their limits are known in closed form
-    ** (c.region): the same optimum, which the second fit of a table takes from the first */
-    const int share = shared && c.region;
-    const long evals0 = c.evals, sub_evals0 = sc.evals;
-    if (share && shared->have && shared->data == data && same_stage_a_options(&shared->opt, opt)) {
-        memcpy(v, shared->v, sizeof v);
-        /* the fit rests on those evaluations as much as the first: they count in both */
-        c.evals += shared->evals_full;
-        sc.evals += shared->evals_sub;
-    } else {
-        if (long_table)
-            sc.stat_tol = LONG_TOL / (double)(sc.n - 3);
-        cf_fit_stage_a(g, v, long_table ? found : NULL, &nfound, pts);
-        pts_ok = 1;
-        sc.stat_tol = 0;
-        if (long_table) {
-            cf_fit_stage_a_polish(&c, found, nfound, v);
-        } else {
-            /* the starts stopped at the statistical tolerance; the best is polished to the
-            ** strict rule, so that a short table's fit is its optimum to rounding */
-            double w[3];
-            const double tol = c.stat_tol;
-            c.stat_tol = 0;
-            c.crawl_stop = 1;
-            if (cf_fit_lm_run(&c, v[0], v[1], v[2], w) < CF_LSQ_HUGE_OBJ)
-                memcpy(v, w, sizeof w);
-            c.crawl_stop = 0;
-            c.stat_tol = tol;
-        }
-    }
-    if (share && !shared->have && !c.oom && !sc.oom) {
-        shared->have = 1;
-        shared->data = data;
-        shared->opt = *opt;
-        memcpy(shared->v, v, sizeof v);
-        shared->evals_full = c.evals - evals0;
-        shared->evals_sub = sc.evals - sub_evals0;
-    }
+    stage_a(&c, &sc, g, long_table, data, opt, shared, v, pts, &pts_ok);
     compact_first_region(&c, v);
-    unsigned held_a = 0; /* the limits that keep the type from stage A's optimum */
-    if (c.region) {
-        region r = cf_fit_region_at(&c, v[0], v[1]);
-        int out = r.margin > 0, over = v[2] > r.A_max / (1 - REGION_SAFETY);
-        if (out || over) {
-            held_a = (out ? r.lo_bit | r.hi_bit : 0u) | (over ? (unsigned)CF_C_G_MAX : 0u);
-            if (cf_fit_stage_a_constrained(g, v, pts_ok ? pts : NULL)) {
-                if (long_table)
-                    cf_fit_stage_a_constrained_polish(&c, v);
-                held_a |= cf_fit_held_at(&c, v);
-            }
-        }
-    }
+    /* the limits that keep the type from stage A's optimum */
+    const unsigned held_a = stage_a_limits(&c, g, long_table, v, pts_ok ? pts : NULL);
     /* Stage B: place a spring of the family. */
     double p[CF_P_COUNT], z[CF_P_COUNT];
     cf_fit_stage_b(&c, v, p, z);
-    double best_obj = cf_fit_objective6(&c, p);
-    double best_p[CF_P_COUNT];
-    memcpy(best_p, p, sizeof p);
+    best6 best;
+    best.obj = cf_fit_objective6(&c, p);
+    memcpy(best.p, p, sizeof p);
     unsigned act, vio;
     cf_spring sp = from_array(p);
-    int best_feas = cf_fit_check_at(&c, &sp, &act, &vio);
-    /* Stage C: local polish on the real objective; with fixed parameters the family may be out
-    ** of reach, so then also from seeded starts around the placement. A long table polishes its
-    ** starts on the subsample and the best of them on every row; without fixed parameters on a
-    ** stress-strain table (c.region) the six parameters reach the model only through the three
-    ** quantities that stage A fitted on every row, so the polish there can move the objective by
-    ** rounding only (1e-14 of it on the shipped tables) and a long table skips its full pass. */
-    if (!long_table)
-        c.stat_tol = 0; /* stage C on a short table: to the optimiser's own tolerances */
-    gsl_rng *rng = cf_fit_seeded_rng(opt->seed, 2);
-    c.oom |= !rng;
-    int starts = 1;
-    for (int k = 0; k < CF_P_COUNT; k++)
-        if (opt->fixed[k])
-            starts = opt->multistart;
-    const nlopt_algorithm alg = cf_fit_algorithm_of(opt->optimizer);
-    double cand_z[CF_P_COUNT], cand_obj = CF_LSQ_HUGE_OBJ;
-    int cand_feas = 0, have_cand = 0;
-    for (int s = 0; s < starts; s++) {
-        double zz[CF_P_COUNT];
-        for (int k = 0; k < c.nfree; k++)
-            zz[k] = z[k] + (s == 0 ? 0.0 : 0.5 * (cf_fit_jitter(rng) - 0.5));
-        cf_fit_nl_run(g, alg, cf_fit_z_objective, 0, zz, 3000);
-        double q[CF_P_COUNT];
-        cf_fit_full_params(&c, zz, q);
-        sp = from_array(q);
-        int feas = cf_fit_check_at(&c, &sp, &act, &vio);
-        double o = cf_fit_objective6(g, q);
-        if (long_table) {
-            if (!have_cand || (feas && !cand_feas) || (feas == cand_feas && o < cand_obj)) {
-                have_cand = 1;
-                cand_obj = o;
-                cand_feas = feas;
-                memcpy(cand_z, zz, sizeof zz);
-            }
-        } else if ((feas && !best_feas) || (feas == best_feas && o < best_obj)) {
-            best_obj = o;
-            best_feas = feas;
-            memcpy(best_p, q, sizeof q);
-        }
-    }
-    gsl_rng_free(rng);
-    if (have_cand) {
-        if (!c.region || held_a)
-            cf_fit_nl_run(&c, alg, cf_fit_z_objective, 0, cand_z, 3000);
-        double q[CF_P_COUNT];
-        cf_fit_full_params(&c, cand_z, q);
-        sp = from_array(q);
-        int feas = cf_fit_check_at(&c, &sp, &act, &vio);
-        double o = cf_fit_objective6(&c, q);
-        if ((feas && !best_feas) || (feas == best_feas && o < best_obj)) {
-            best_obj = o;
-            best_feas = feas;
-            memcpy(best_p, q, sizeof q);
-        }
-    }
+    best.feas = cf_fit_check_at(&c, &sp, &act, &vio);
+    stage_c(&c, g, long_table, held_a, opt, z, &best);
     res->type = type;
-    summarise(&c, best_p, res);
+    summarise(&c, best.p, res);
     /* Errors, correlation and, where the data leave a quantity open, its profile interval: at
     ** the reported spring's quantities. */
     cf_fit_uncertainty(&c, g, res, held_a);
