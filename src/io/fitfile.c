@@ -156,86 +156,89 @@ cf_status cf_fitfile_load_element(const char *path, const char *type_name,
     return load(path, type_name, 1, out, err);
 }
 
-static cf_status load(const char *path, const char *type_name, int allow_element,
-                      cf_fitted_spring *out, cf_error *err)
+/* The fit file at path (or standard input, "-") parsed as JSON into *root; *shown is the name
+** for messages. */
+static cf_status read_root(const char *path, const char **shown, json_t **root, cf_error *err)
 {
-    memset(out, 0, sizeof *out);
-    out->rmse = NAN;
     const int from_stdin = strcmp(path, "-") == 0; /* "-": standard input */
+    *shown = path;
     FILE *f = from_stdin ? stdin : cf_input_open(path, "fit file", err);
     if (!f)
         return CF_E_NOINPUT;
     json_error_t jerr;
     errno = 0;
-    json_t *root = json_loadf(f, JSON_REJECT_DUPLICATES, &jerr);
+    *root = json_loadf(f, JSON_REJECT_DUPLICATES, &jerr);
     int unreadable = ferror(f), e = errno;
     if (from_stdin)
-        path = "(standard input)";
+        *shown = "(standard input)";
     else
         fclose(f);
-    if (!root && unreadable) /* a read error, not bad JSON */
-        return cf_error_set(err, CF_E_NOINPUT, "%s: cannot read fit file: %s", path,
+    if (!*root && unreadable) /* a read error, not bad JSON */
+        return cf_error_set(err, CF_E_NOINPUT, "%s: cannot read fit file: %s", *shown,
                             strerror(e ? e : EIO));
     char why[JSON_ERROR_TEXT_LENGTH];
-    if (!root)
-        return cf_error_set(err, CF_E_DATA, "%s:%d:%d: not a valid fit file: %s", path, jerr.line,
-                            jerr.column, cf_json_reason(&jerr, why, sizeof why));
-    cf_status st = CF_OK;
-    json_t *fit = NULL;
-    size_t i = 0;
-    char where[64];
-    const char *want = (type_name && *type_name) ? type_name : NULL;
+    if (!*root)
+        return cf_error_set(err, CF_E_DATA, "%s:%d:%d: not a valid fit file: %s", *shown,
+                            jerr.line, jerr.column, cf_json_reason(&jerr, why, sizeof why));
+    return CF_OK;
+}
+
+/* The fit of type want (NULL: the better type, or the first feasible one where the types tie)
+** in root: root itself for an exported spring, else an entry of its 'fits'; where names it for
+** messages. */
+static cf_status pick_fit(json_t *root, const char *path, const char *want, json_t **fit,
+                          char where[64], cf_error *err)
+{
+    *fit = NULL;
     const char *schema = json_string_value(json_object_get(root, "schema"));
     if (schema && strcmp(schema, CF_SPRINGFILE_SCHEMA) == 0) {
         /* a single exported spring: the root itself holds type and params */
         const char *t = json_string_value(json_object_get(root, "type"));
-        if (want && (!t || strcmp(t, want) != 0)) {
-            st = cf_error_set(err, CF_E_DATA, "%s: the spring is of type '%s', not '%s'", path,
-                              t ? t : "(missing)", want);
-            goto done;
-        }
-        fit = root;
-        snprintf(where, sizeof where, "spring");
-    } else {
-        json_t *fits = json_object_get(root, "fits");
-        if (!json_is_array(fits) || json_array_size(fits) == 0) {
-            st = cf_error_set(err, CF_E_DATA,
-                              "%s: key 'fits' is missing or not a non-empty array", path);
-            goto done;
-        }
-        int tie = 0; /* the types tie: the first feasible fit stands for both */
-        if (!want && json_array_size(fits) > 1) {
-            want = json_string_value(json_object_get(root, "better_type"));
-            tie = !want && json_is_true(json_object_get(json_object_get(root, "comparison"), "tie"));
-            if (!want && !tie) {
-                st = cf_error_set(err, CF_E_DATA,
-                                  "%s: several fits and no 'better_type'; name the type", path);
-                goto done;
-            }
-        }
-        json_t *item;
-        json_array_foreach(fits, i, item)
-        {
-            const char *t = json_string_value(json_object_get(item, "type"));
-            if (tie ? json_is_true(json_object_get(item, "feasible"))
-                    : (!want || (t && strcmp(t, want) == 0))) {
-                fit = item;
-                break;
-            }
-        }
-        if (!fit) {
-            st = cf_error_set(err, CF_E_DATA, "%s: no fit of type '%s' in 'fits'", path, want);
-            goto done;
-        }
-        snprintf(where, sizeof where, "fits[%zu]", i);
+        if (want && (!t || strcmp(t, want) != 0))
+            return cf_error_set(err, CF_E_DATA, "%s: the spring is of type '%s', not '%s'", path,
+                                t ? t : "(missing)", want);
+        *fit = root;
+        snprintf(where, 64, "spring");
+        return CF_OK;
     }
+    json_t *fits = json_object_get(root, "fits");
+    if (!json_is_array(fits) || json_array_size(fits) == 0)
+        return cf_error_set(err, CF_E_DATA, "%s: key 'fits' is missing or not a non-empty array",
+                            path);
+    int tie = 0; /* the types tie: the first feasible fit stands for both */
+    if (!want && json_array_size(fits) > 1) {
+        want = json_string_value(json_object_get(root, "better_type"));
+        tie = !want && json_is_true(json_object_get(json_object_get(root, "comparison"), "tie"));
+        if (!want && !tie)
+            return cf_error_set(err, CF_E_DATA,
+                                "%s: several fits and no 'better_type'; name the type", path);
+    }
+    size_t i = 0;
+    json_t *item;
+    json_array_foreach(fits, i, item)
+    {
+        const char *t = json_string_value(json_object_get(item, "type"));
+        if (tie ? json_is_true(json_object_get(item, "feasible"))
+                : (!want || (t && strcmp(t, want) == 0))) {
+            *fit = item;
+            break;
+        }
+    }
+    if (!*fit)
+        return cf_error_set(err, CF_E_DATA, "%s: no fit of type '%s' in 'fits'", path, want);
+    snprintf(where, 64, "fits[%zu]", i);
+    return CF_OK;
+}
+
+/* The fit's type and design parameters, checked to make a spring of that type. */
+static cf_status read_spring(json_t *fit, const char *path, const char *where,
+                             cf_fitted_spring *out, cf_error *err)
+{
     const char *t = json_string_value(json_object_get(fit, "type"));
-    if (cf_spring_type_parse(t, &out->type, NULL) != CF_OK) {
-        st = cf_error_set(err, CF_E_DATA,
-                          "%s: %s.type = '%s' is not telescoping or non-telescoping", path,
-                          where, t ? t : "(missing)");
-        goto done;
-    }
+    if (cf_spring_type_parse(t, &out->type, NULL) != CF_OK)
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: %s.type = '%s' is not telescoping or non-telescoping", path,
+                            where, t ? t : "(missing)");
     json_t *params = json_object_get(fit, "params");
     for (int k = 0; k < CF_P_ALL; k++) {
         const char *key = cf_spring_param_info(k)->key;
@@ -244,26 +247,28 @@ static cf_status load(const char *path, const char *type_name, int allow_element
             continue;
         if (!json_is_number(v) || !isfinite(json_number_value(v))) {
             char *text = v ? json_dumps(v, JSON_ENCODE_ANY) : NULL;
-            st = cf_error_set(err, CF_E_DATA, "%s: %s.params.%s = %.40s is not a number", path,
-                              where, key, text ? text : "(missing)");
+            cf_status st = cf_error_set(err, CF_E_DATA, "%s: %s.params.%s = %.40s is not a number",
+                                        path, where, key, text ? text : "(missing)");
             free(text);
-            goto done;
+            return st;
         }
         cf_spring_set(&out->params, k, json_number_value(v));
     }
     cf_law law;
     cf_error lerr = {0};
-    if (cf_law_init(&law, &out->params, &lerr) != CF_OK) {
-        st = cf_error_set(err, CF_E_DATA, "%s: %s.params: %s", path, where, lerr.msg);
-        goto done;
-    }
-    if (law.type != out->type) {
-        st = cf_error_set(err, CF_E_DATA,
-                          "%s: %s says type '%s' but its parameters make a %s spring", path,
-                          where, t, cf_spring_type_name(law.type));
-        goto done;
-    }
+    if (cf_law_init(&law, &out->params, &lerr) != CF_OK)
+        return cf_error_set(err, CF_E_DATA, "%s: %s.params: %s", path, where, lerr.msg);
     cf_law_free(&law);
+    if (law.type != out->type)
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: %s says type '%s' but its parameters make a %s spring", path,
+                            where, t, cf_spring_type_name(law.type));
+    return CF_OK;
+}
+
+/* Where the fit came from: its RMSE, data file and unit, the version, whether it is a lattice's. */
+static void read_provenance(json_t *root, json_t *fit, cf_fitted_spring *out)
+{
     json_t *prov = json_object_get(root, "provenance");
     json_t *r = json_object_get(fit == root ? prov : fit, "rmse");
     if (json_is_number(r) && isfinite(json_number_value(r)))
@@ -281,11 +286,23 @@ static cf_status load(const char *path, const char *type_name, int allow_element
     const char *model = json_string_value(json_object_get(json_object_get(fit, "target"), "model"));
     out->target_lattice = json_is_true(json_object_get(root, "joint")) ||
                           (model && strcmp(model, "lattice") == 0);
-    if ((st = read_visco(fit, path, where, out, err)) != CF_OK)
-        goto done;
-    if ((st = read_element(fit, path, where, allow_element, out, err)) != CF_OK)
-        goto done;
-done:
+}
+
+static cf_status load(const char *path, const char *type_name, int allow_element,
+                      cf_fitted_spring *out, cf_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->rmse = NAN;
+    json_t *root = NULL, *fit = NULL;
+    char where[64];
+    const char *want = (type_name && *type_name) ? type_name : NULL;
+    cf_status st = read_root(path, &path, &root, err);
+    if (st == CF_OK && (st = pick_fit(root, path, want, &fit, where, err)) == CF_OK &&
+        (st = read_spring(fit, path, where, out, err)) == CF_OK) {
+        read_provenance(root, fit, out);
+        if ((st = read_visco(fit, path, where, out, err)) == CF_OK)
+            st = read_element(fit, path, where, allow_element, out, err);
+    }
     json_decref(root);
     return st;
 }
