@@ -55,14 +55,32 @@ static void progress(const cf_pipeline_options *opt, const cf_table *t, const ch
     opt->progress(opt->progress_ctx, t->path, what);
 }
 
-/* The target of table t: the option, or AUTO's choice: the lattice whenever a lattice is
-** involved (a validation, or a mode the single spring has no form of), a force-displacement
-** table's own spring otherwise. */
-static int through_lattice(const cf_table *t, const cf_pipeline_options *opt)
+/* What a fit of a table will do, decided once on entry to cf_pipeline_fit and read by every
+** stage. The target: the option, or AUTO's choice: the lattice whenever a lattice is involved (a
+** validation, or a mode the single spring has no form of), a force-displacement table's own
+** spring otherwise. */
+typedef struct fit_plan {
+    int lattice;  /* the fit's target is the lattice: the spring's fit is the start of a fit
+                     through it (a stress-strain table validated, or in a mode the single
+                     spring has no curve of, or asked for) */
+    int validate; /* each fit run in the lattice (or fitted through it) */
+    int tail;     /* the tailed law fitted beside the conical one (--law conical-tail, auto) */
+    int solves;   /* the lattice's static solves are part of the run: their budget checked */
+} fit_plan;
+
+/* What cf_pipeline_fit will do with table t, decided once on entry. */
+static fit_plan plan_of(const cf_table *t, const cf_pipeline_options *opt)
 {
+    fit_plan p;
     if (opt->target == CF_TARGET_AUTO)
-        return !cf_table_is_force(t) && (opt->validate || !cf_mode_row_of(t->mode)->spring_curve);
-    return opt->target == CF_TARGET_LATTICE;
+        p.lattice = !cf_table_is_force(t) &&
+                    (opt->validate || !cf_mode_row_of(t->mode)->spring_curve);
+    else
+        p.lattice = opt->target == CF_TARGET_LATTICE;
+    p.validate = opt->validate || p.lattice;
+    p.tail = opt->fit.law != CF_FAMILY_CONICAL;
+    p.solves = p.validate && !cf_table_is_force(t);
+    return p;
 }
 
 /* AIC of a fit with k identifiable quantities: the report's (cf_report_fit_aic), on the plain
@@ -145,10 +163,10 @@ static cf_status choose_law_in_lattice(const cf_table *t, const cf_pipeline_opti
 /* Each fit in the lattice, or through it. A fit the lattice cannot run keeps its validation's
 ** note (the report states it) and is not an error; running out of memory is (CF_E_INTERNAL). */
 static cf_status validate_fits(const cf_table *t, const cf_pipeline_options *opt,
-                               cf_fit_report *r, cf_error *err)
+                               const fit_plan *plan, cf_fit_report *r, cf_error *err)
 {
     r->validate = 1;
-    r->through_msm = through_lattice(t, opt);
+    r->through_msm = plan->lattice;
     for (int k = 0; k < r->nfits; k++) {
         cf_error verr = {0};
         const char *type = cf_spring_type_name(r->fits[k].type);
@@ -160,7 +178,7 @@ static cf_status validate_fits(const cf_table *t, const cf_pipeline_options *opt
             cf_lattice_fit(t, &opt->fit, &opt->lattice, &r->fits[k], &r->thr[k], &verr);
             /* the tailed law through the lattice where the conical law went through it, else
             ** (a force table, a lattice that could not run) to the spring as without it */
-            if (opt->fit.law != CF_FAMILY_CONICAL && verr.status != CF_E_INTERNAL) {
+            if (plan->tail && verr.status != CF_E_INTERNAL) {
                 progress(opt, t, "fitting the %s spring with a tail", type);
                 cf_error terr = {0};
                 cf_status tst = r->thr[k].done ? choose_law_in_lattice(t, opt, r, k, &terr)
@@ -180,11 +198,12 @@ static cf_status validate_fits(const cf_table *t, const cf_pipeline_options *opt
 ** their flags go. Only memory running out is an error; a widened fit that fails is not checked.
 ** A fit through the lattice is not: the spring's own RMSE compared here is not its target's. */
 static cf_status limit_cost(const cf_table *t, const cf_pipeline_options *opt,
-                            const cf_fit_result *f, cf_limit_cost *lc, cf_error *err)
+                            const fit_plan *plan, const cf_fit_result *f, cf_limit_cost *lc,
+                            cf_error *err)
 {
     memset(lc, 0, sizeof *lc);
     cf_fit_options wide;
-    if (!f->feasible || through_lattice(t, opt) ||
+    if (!f->feasible || plan->lattice ||
         !(lc->limits = cf_fit_relax(&opt->fit, f->held, &wide)))
         return CF_OK;
     progress(opt, t, "fitting the %s spring without the limits that hold it",
@@ -243,7 +262,8 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
     for (size_t i = 0; i < t->count; i++)
         r->ymax = fmax(r->ymax, fabs(t->y[i]));
     r->law = opt->fit.law;
-    if ((opt->validate || through_lattice(t, opt)) && !cf_table_is_force(t)) {
+    const fit_plan plan = plan_of(t, opt);
+    if (plan.solves) {
         /* a static solve per row and type in the validation lattice, and its stability scan */
         int types = !!(opt->types & (1u << CF_TELESCOPING)) +
                     !!(opt->types & (1u << CF_NON_TELESCOPING));
@@ -280,8 +300,8 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
         cf_status st = cf_fit_run_shared(t, &opt->fit, (cf_spring_type)ty, &shared,
                                          &r->fits[r->nfits], &e);
         if (st == CF_OK)
-            st = limit_cost(t, opt, &r->fits[r->nfits], &r->limit_cost[r->nfits], &e);
-        if (st == CF_OK && opt->fit.law != CF_FAMILY_CONICAL && !through_lattice(t, opt)) {
+            st = limit_cost(t, opt, &plan, &r->fits[r->nfits], &r->limit_cost[r->nfits], &e);
+        if (st == CF_OK && plan.tail && !plan.lattice) {
             progress(opt, t, "fitting the %s spring with a tail",
                      cf_spring_type_name((cf_spring_type)ty));
             st = choose_law(t, opt, r, r->nfits, &e);
@@ -297,7 +317,7 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
     if (cf_baseline_fit_all(t, r->baselines, &be) != CF_OK)
         return cf_error_set(err, be.status, "%s: %s", t->path, be.msg);
     cf_status vst = CF_OK;
-    if ((opt->validate || through_lattice(t, opt)) && (vst = validate_fits(t, opt, r, err)) != CF_OK)
+    if (plan.validate && (vst = validate_fits(t, opt, &plan, r, err)) != CF_OK)
         return vst;
     for (int k = 0; k < r->nfits; k++)
         solid_in_mode(t, opt, &r->fits[k]);
