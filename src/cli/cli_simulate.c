@@ -17,6 +17,7 @@
 #include "conifit/hysteresis.h"
 #include "conifit/msm.h"
 #include "conifit/scene.h"
+#include "pipeline/simulate.h"
 #include "report/plot.h"
 
 #include <gsl/gsl_randist.h>
@@ -236,33 +237,6 @@ static int parse_request(int argc, char **argv, sim_request *q)
 }
 
 /* The lattice of the scene, run along its path into samples (allocated here, sc->nsamples). */
-static cf_status run_scene(cf_scene *sc, const sim_request *q, cf_budget *budget,
-                           cf_scene_cost *cost, cf_law *law, cf_law *ext, cf_lattice *lat,
-                           cf_msm_sample **samples, cf_msm_stats *st, cf_error *err)
-{
-    cf_status s;
-    if ((s = cf_scene_law(sc, law, ext, err)) != CF_OK ||
-        (s = cf_lattice_create(lat, law, sc->method, &sc->cfg.lattice, err)) != CF_OK ||
-        (s = cf_budget_check_steps(sc, q->scene_path, lat, budget, cost, err)) != CF_OK ||
-        (!q->quiet &&
-         (s = cf_hysteresis_recovery_check(sc, q->scene_path, lat, budget, cost, err)) != CF_OK))
-        return s;
-    *samples = calloc(sc->nsamples, sizeof **samples);
-    if (!*samples)
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu samples", sc->nsamples);
-    cf_msm_path path = cf_scene_path(sc);
-    size_t done = 0;
-    if (q->progress) {
-        sc->cfg.progress = show_progress;
-        sc->cfg.progress_ctx = NULL;
-    }
-    s = cf_msm_run(lat, &sc->effects, &sc->cfg, &path, sc->sample_t_s, sc->nsamples, *samples,
-                   &done, st, err);
-    if (sc->cfg.progress)
-        fputs("\r\033[K", stderr); /* clear the progress line */
-    return s;
-}
-
 /* --table: a measurement table of the run, tension positive, with the noise asked for. */
 static cf_status write_table(FILE *o, const cf_msm_sample *s, size_t n, const sim_opts *so,
                              cf_error *err)
@@ -326,7 +300,6 @@ int cf_cli_simulate(int argc, char **argv)
         return rc;
     const char *png = q.so.png, *out = q.out;
     cf_budget budget = q.so.budget;
-    cf_scene_cost cost;
     cf_error err = {0};
     cf_scene sc;
     if (cf_scene_load(q.scene_path, &sc, &err) != CF_OK)
@@ -346,36 +319,27 @@ int cf_cli_simulate(int argc, char **argv)
     const char *inputs[3];
     scene_inputs(&sc, q.scene_path, fitfile, inputs);
     if ((!cf_cli_is_stdio(out) && cf_atomic_check(out, inputs, &err) != CF_OK) ||
-        (png && cf_atomic_check(png, inputs, &err) != CF_OK) ||
-        cf_budget_check_size(&sc, q.scene_path, &budget, &cost, &err) != CF_OK) {
+        (png && cf_atomic_check(png, inputs, &err) != CF_OK)) {
         cf_scene_free(&sc);
         return cf_cli_fail(&err);
     }
-    cf_law law, ext;
-    memset(&law, 0, sizeof law);
-    memset(&ext, 0, sizeof ext);
-    cf_lattice lat;
-    memset(&lat, 0, sizeof lat);
-    cf_msm_sample *samples = NULL;
-    cf_msm_stats st;
+    cf_sim_run run;
     cf_cli_out a = {0};
     cf_atomic pa = {0};
-    double *spring = NULL;
     rc = CF_EXIT_OK;
-    if (run_scene(&sc, &q, &budget, &cost, &law, &ext, &lat, &samples, &st, &err) != CF_OK ||
-        cf_cli_out_open(&a, out, inputs, &err) != CF_OK) {
+    if (q.progress) {
+        sc.cfg.progress = show_progress;
+        sc.cfg.progress_ctx = NULL;
+    }
+    cf_status rs = cf_pipeline_simulate(&sc, q.scene_path, &budget, !q.quiet, &run, &err);
+    if (sc.cfg.progress)
+        fputs("\r\033[K", stderr); /* clear the progress line */
+    if (rs != CF_OK || cf_cli_out_open(&a, out, inputs, &err) != CF_OK) {
         rc = cf_cli_fail(&err);
         goto end;
     }
-    spring = malloc(sc.nsamples * sizeof *spring);
-    if (!spring) {
-        cf_error_set(&err, CF_E_INTERNAL, "out of memory for %zu samples", sc.nsamples);
-        rc = cf_cli_fail(&err);
-        goto end;
-    }
-    double H = law.p.H_mm;
-    for (size_t k = 0; k < sc.nsamples; k++)
-        spring[k] = cf_law_force(&law, sc.method, samples[k].strain * H, NULL, NULL) / (H * H);
+    const cf_msm_sample *samples = run.samples;
+    const double *spring = run.spring_MPa;
     if (q.so.table) {
         if (write_table(a.fp, samples, sc.nsamples, &q.so, &err) != CF_OK) {
             rc = cf_cli_fail(&err);
@@ -391,19 +355,15 @@ int cf_cli_simulate(int argc, char **argv)
         rc = cf_cli_fail(&err);
         goto end;
     }
-    cf_lattice_free(&lat); /* the recovery test builds its own */
+    cf_lattice_free(&run.lat); /* the recovery test builds its own */
     if (!q.quiet) {
-        summary(a.to_stdout ? stderr : stdout, &sc, samples, sc.nsamples, &st);
-        recovery(a.to_stdout ? stderr : stdout, &sc, &law, samples, sc.nsamples);
+        summary(a.to_stdout ? stderr : stdout, &sc, samples, sc.nsamples, &run.stats);
+        recovery(a.to_stdout ? stderr : stdout, &sc, &run.law, samples, sc.nsamples);
     }
 end:
     cf_cli_out_abort(&a);
     cf_atomic_abort(&pa);
-    free(spring);
-    free(samples);
-    cf_lattice_free(&lat);
-    cf_law_free(&law);
-    cf_law_free(&ext);
+    cf_sim_run_free(&run);
     cf_scene_free(&sc);
     return rc;
 }

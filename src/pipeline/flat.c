@@ -12,6 +12,7 @@
 #include "conifit/export.h"
 #include "conifit/fitfile.h"
 #include "conifit/flat.h"
+#include "pipeline/simulate.h"
 #include "conifit/hysteresis.h"
 #include "conifit/lattice.h"
 #include "conifit/law.h"
@@ -127,52 +128,28 @@ cf_status cf_flat_simulate(const char *scene_path, double **samples, size_t *cou
         return s;
     /* the default budget of conifit simulate: a scene too large is refused before it runs */
     const cf_budget budget = cf_budget_default();
-    cf_scene_cost cost;
-    if ((s = cf_budget_check_size(&sc, scene_path, &budget, &cost, err)) != CF_OK) {
-        cf_scene_free(&sc);
-        return s;
-    }
-    cf_law law = {0}, ext = {0};
-    cf_lattice lat = {0};
-    cf_msm_sample *run = calloc(sc.nsamples ? sc.nsamples : 1, sizeof *run);
-    double *out = calloc(sc.nsamples ? sc.nsamples * CF_FLAT_SAMPLE_COLUMNS : 1, sizeof *out);
-    int have_lattice = 0;
-    if (!run || !out)
-        s = cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu samples", sc.nsamples);
-    else if ((s = cf_scene_law(&sc, &law, &ext, err)) == CF_OK &&
-             (s = cf_lattice_create(&lat, &law, sc.method, &sc.cfg.lattice, err)) == CF_OK) {
-        have_lattice = 1;
-        if ((s = cf_budget_check_steps(&sc, scene_path, &lat, &budget, &cost, err)) == CF_OK) {
-            cf_msm_path path = cf_scene_path(&sc);
-            size_t done = 0;
-            cf_msm_stats st;
-            s = cf_msm_run(&lat, &sc.effects, &sc.cfg, &path, sc.sample_t_s, sc.nsamples, run,
-                           &done, &st, err);
-        }
-    }
+    cf_sim_run run;
+    double *out = NULL;
+    if ((s = cf_pipeline_simulate(&sc, scene_path, &budget, 0, &run, err)) == CF_OK &&
+        !(out = calloc(run.count ? run.count * CF_FLAT_SAMPLE_COLUMNS : 1, sizeof *out)))
+        s = cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu samples", run.count);
     if (s == CF_OK) {
-        size_t lost = cf_hysteresis_first_unstable(run, sc.nsamples);
-        double H = sc.spring.H_mm;
-        for (size_t i = 0; i < sc.nsamples; i++) {
+        size_t lost = cf_hysteresis_first_unstable(run.samples, run.count);
+        for (size_t i = 0; i < run.count; i++) {
+            const cf_msm_sample *m = &run.samples[i];
             double *row = out + i * CF_FLAT_SAMPLE_COLUMNS;
-            row[0] = run[i].t_s;
-            row[1] = run[i].strain;
-            row[2] = run[i].stress_MPa * 1e3;
-            row[3] = run[i].kinetic_mJ;
-            row[4] = cf_law_force(&law, sc.method, run[i].strain * H, NULL, NULL) / (H * H) * 1e3;
+            row[0] = m->t_s;
+            row[1] = m->strain;
+            row[2] = m->stress_MPa * 1e3;
+            row[3] = m->kinetic_mJ;
+            row[4] = run.spring_MPa[i] * 1e3;
             row[5] = sc.effects.inertia ? -1 : i < lost;
-            row[6] = run[i].lateral_stretch;
+            row[6] = m->lateral_stretch;
         }
         *samples = out;
-        *count = sc.nsamples;
-        out = NULL;
+        *count = run.count;
     }
-    if (have_lattice)
-        cf_lattice_free(&lat);
-    cf_law_free(&law);
-    cf_law_free(&ext);
-    free(run);
-    free(out);
+    cf_sim_run_free(&run);
     cf_scene_free(&sc);
     return s;
 }
