@@ -10,6 +10,7 @@
 
 #include "base/atomic.h"
 #include "cli/cli.h"
+#include "pipeline/export.h"
 #include "conifit/export.h"
 #include "conifit/fitfile.h"
 #include "conifit/budget.h"
@@ -288,24 +289,6 @@ static cf_status lattice_of(export_request *q, const cf_fitted_spring *fs,
     return CF_OK;
 }
 
-/* The whole export in memory (*buf, *len; the caller frees *buf), so that a failure never leaves
-** partial output. */
-static cf_status render(const export_request *q, const cf_fitted_spring *fs,
-                        const cf_export_options *opt, const cf_export_lattice *lx,
-                        cf_export_report *rep, char **buf, size_t *len, cf_error *err)
-{
-    *buf = NULL;
-    *len = 0;
-    FILE *mem = open_memstream(buf, len);
-    if (!mem)
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory");
-    cf_status st = q->ea.lattice ? cf_export_write_lattice(mem, fs, opt, lx, rep, err)
-                                 : cf_export_write(mem, fs, opt, rep, err);
-    if (fclose(mem) != 0 && st == CF_OK)
-        st = cf_error_set(err, CF_E_INTERNAL, "out of memory");
-    return st;
-}
-
 /* buf to the -o file (atomically) or to standard output. */
 static cf_status emit(const export_request *q, const char *buf, size_t len, cf_error *err)
 {
@@ -411,7 +394,7 @@ int cf_cli_export(int argc, char **argv)
     char *buf;
     size_t len;
     cf_export_report rep;
-    if (render(&q, &fs, &opt, &lx, &rep, &buf, &len, &err) != CF_OK ||
+    if (cf_pipeline_export(&fs, &opt, q.ea.lattice ? &lx : NULL, &rep, &buf, &len, &err) != CF_OK ||
         emit(&q, buf, len, &err) != CF_OK) {
         free(buf);
         return cf_cli_fail(&err);

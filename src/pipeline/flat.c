@@ -12,6 +12,7 @@
 #include "conifit/export.h"
 #include "conifit/fitfile.h"
 #include "conifit/flat.h"
+#include "pipeline/export.h"
 #include "pipeline/simulate.h"
 #include "conifit/hysteresis.h"
 #include "conifit/lattice.h"
@@ -180,17 +181,7 @@ cf_status cf_flat_export(const char *fit_path, const char *type, const char *for
         return s;
     opt.source = fit_path;
     size_t len = 0;
-    FILE *mem = open_memstream(text, &len);
-    if (!mem)
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory");
-    cf_export_report rep;
-    s = cf_export_write(mem, &fs, &opt, &rep, err);
-    if (fclose(mem) != 0 && s == CF_OK)
-        s = cf_error_set(err, CF_E_INTERNAL, "out of memory");
-    if (s != CF_OK) {
-        free(*text);
-        *text = NULL;
-    }
+    s = cf_pipeline_export(&fs, &opt, NULL, NULL, text, &len, err);
     return s;
 }
 
