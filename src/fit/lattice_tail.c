@@ -220,6 +220,48 @@ int cf_tail_cell_intervals(const cf_tail_cell *tc, const cf_fit_options *opt,
                              rss0 + cf_profile_limit_np(rows, 4, rss, ynorm) - rss, res);
 }
 
+/* The search through the cell (on search's rows: a long table's subsample) from the conical
+** fit plain, and its result on every row (c): the quantities, their errors and, where the errors
+** say nothing, their profile intervals. */
+static cf_status lt_search(lt_ctx *c, lt_ctx *search, const cf_table *d, const cf_table *reach,
+                           const cf_fit_options *opt, const cf_fit_result *plain,
+                           const double lb[3], const double ub[3], double need,
+                           cf_fit_result *res, cf_through_msm *t, cf_error *err)
+{
+    cf_status st;
+    double zb[3] = {0, 0, 0}, A = 0;
+    const cf_tail_cell tsearch = {&search->pr, &search->tau}, tc = {&c->pr, &c->tau};
+    const double best = cf_tail_cell_search(&tsearch, &plain->ident, lb, ub, zb);
+    if (search->pr.oom)
+        return cf_error_set(err, CF_E_INTERNAL,
+                            "out of memory in the lattice fit's optimiser (NLopt)");
+    const double f = best < CF_LSQ_HUGE_OBJ ? cf_tail_cell_profile(&tc, zb, &A) : CF_LSQ_HUGE_OBJ;
+    if (!(f < CF_LSQ_HUGE_OBJ) || !(A > 0))
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: no conical-tail law fits the table through the lattice",
+                            d->path);
+    double v[4];
+    cf_tail_cell_quantities(zb, A, v);
+    double se[4], corr[4][4], cov_Bt;
+    const long before = c->pr.evals;
+    cf_tail_errors(cf_tail_cell_residuals, (void *)&tc, d->count, v, FD_STEP, f * c->pr.ynorm, se,
+                   corr, &cov_Bt);
+    t->uncertainty_curves = c->pr.evals - before;
+    if ((st = cf_tail_result(reach, opt, plain->type, v, se, corr, cov_Bt, res, err)) != CF_OK)
+        return st;
+    res->held |= cf_tail_cell_held(opt, lb, ub, zb, plain->type);
+    /* profile intervals where the errors say nothing, through the cell on the search's rows (a
+    ** long table's subsample) against the whole table's threshold */
+    const long before_p = search->pr.evals;
+    const int pst = cf_tail_cell_intervals(&tsearch, opt, plain->type, need, lb, ub, d->count,
+                                           f * c->pr.ynorm, c->pr.ynorm, v, res);
+    t->uncertainty_curves += search->pr.evals - before_p;
+    if (pst < 0)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the profiles of %zu rows",
+                            d->count);
+    return CF_OK;
+}
+
 cf_status cf_lattice_fit_tail(const cf_table *d, const cf_fit_options *opt,
                               const cf_validate_setup *s, const cf_fit_result *plain,
                               cf_fit_result *res, cf_through_msm *t, cf_error *err)
@@ -265,41 +307,8 @@ cf_status cf_lattice_fit_tail(const cf_table *d, const cf_fit_options *opt,
         search = &cs;
     }
     t->search_rows = search->d->count;
-    double zb[3] = {0, 0, 0}, A = 0;
-    const cf_tail_cell tsearch = {&search->pr, &search->tau}, tc = {&c.pr, &c.tau};
-    const double best = cf_tail_cell_search(&tsearch, &plain->ident, lb, ub, zb);
-    if (search->pr.oom) {
-        st = cf_error_set(err, CF_E_INTERNAL,
-                          "out of memory in the lattice fit's optimiser (NLopt)");
+    if ((st = lt_search(&c, search, d, &reach, opt, plain, lb, ub, need, res, t, err)) != CF_OK)
         goto out;
-    }
-    const double f = best < CF_LSQ_HUGE_OBJ ? cf_tail_cell_profile(&tc, zb, &A) : CF_LSQ_HUGE_OBJ;
-    if (!(f < CF_LSQ_HUGE_OBJ) || !(A > 0)) {
-        st = cf_error_set(err, CF_E_DATA, "%s: no conical-tail law fits the table through the "
-                                          "lattice", d->path);
-        goto out;
-    }
-    double v[4];
-    cf_tail_cell_quantities(zb, A, v);
-    double se[4], corr[4][4], cov_Bt;
-    const long before = c.pr.evals;
-    cf_tail_errors(cf_tail_cell_residuals, (void *)&tc, d->count, v, FD_STEP, f * c.pr.ynorm, se,
-                   corr, &cov_Bt);
-    t->uncertainty_curves = c.pr.evals - before;
-    if ((st = cf_tail_result(&reach, opt, plain->type, v, se, corr, cov_Bt, res, err)) != CF_OK)
-        goto out;
-    res->held |= cf_tail_cell_held(opt, lb, ub, zb, plain->type);
-    /* profile intervals where the errors say nothing, through the cell on the search's rows (a
-    ** long table's subsample) against the whole table's threshold */
-    const long before_p = search->pr.evals;
-    const int pst = cf_tail_cell_intervals(&tsearch, opt, plain->type, need, lb, ub, d->count,
-                                           f * c.pr.ynorm, c.pr.ynorm, v, res);
-    t->uncertainty_curves += search->pr.evals - before_p;
-    if (pst < 0) {
-        st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the profiles of %zu rows",
-                          d->count);
-        goto out;
-    }
     /* the target's numbers: the cell's curve of the placed spring */
     if ((st = cf_lattice_curve(&res->params, s, d, 0, c.pr.g, NULL, NULL, NULL, err)) != CF_OK)
         goto out;
