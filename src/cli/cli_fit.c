@@ -270,12 +270,12 @@ static int load_inputs(fit_args *a, fit_job *jobs, int *nseries)
     /* the tailed law: the spring itself or through the lattice (one table or several jointly),
     ** as the conical law; not with fixed parameters, and a time series' elastic part is fitted as
     ** the conical law (a tailed one is held, --elastic with a tailed fit) */
-    const cf_law_family law = a->popt.fit.law;
+    const cf_law_kind law = a->popt.fit.law;
     int nfixed = 0;
     for (int k = 0; k < CF_P_COUNT; k++)
         nfixed += a->popt.fit.fixed[k] != 0;
-    if (rc < 0 && law != CF_FAMILY_CONICAL) {
-        const char *lname = cf_law_family_name(law);
+    if (rc < 0 && law != CF_KIND_CONICAL) {
+        const char *lname = cf_law_kind_name(law);
         if (*nseries)
             rc = cf_cli_usage_error("fit", "--law %s: a time series' elastic part is fitted as "
                                            "the conical law (use --law conical; a tailed spring "

@@ -382,7 +382,7 @@ static int fit_option_apply(void *ctx, int c, const char *optval)
         return 0;
     case OPT_JOINT: a->joint = 1; return 0;
     case OPT_LAW:
-        if (cf_law_family_parse(optval, &fo->law, &err) != CF_OK)
+        if (cf_law_kind_parse(optval, &fo->law, &err) != CF_OK)
             return cf_cli_usage_error("fit", "--law: %s", err.msg);
         return 0;
     case OPT_VOLUME:
@@ -576,7 +576,7 @@ int cf_cli_fit_parse(int argc, char **argv, fit_args *a)
     }
     if (a->joint && a->nfiles < 2)
         return cf_cli_usage_error(cmd, "--joint fits several tables at once; give at least two");
-    if (!a->joint && a->popt.fit.law == CF_FAMILY_DOUBLE)
+    if (!a->joint && a->popt.fit.law == CF_KIND_DOUBLE)
         return cf_cli_usage_error(cmd, "--law double-acting: its extension spring is fitted with "
                                        "tension and compression tables together (--joint)");
     if (!a->joint && a->popt.fit.volume != CF_VOLUME_NONE)
@@ -585,12 +585,12 @@ int cf_cli_fit_parse(int argc, char **argv, fit_args *a)
                                   a->popt.fit.volume == CF_VOLUME_FIT       ? "--volume fit"
                                   : a->popt.fit.volume == CF_VOLUME_POISSON ? "--poisson"
                                                                             : "--volume-modulus");
-    if (a->popt.fit.law == CF_FAMILY_DOUBLE && a->popt.fit.volume == CF_VOLUME_POISSON)
+    if (a->popt.fit.law == CF_KIND_DOUBLE && a->popt.fit.volume == CF_VOLUME_POISSON)
         return cf_cli_usage_error(cmd, "--poisson %g with --law double-acting: its lattice has one "
                                        "small-strain nu in compression and another in tension; "
                                        "declare kappa (--volume-modulus) or fit it (--volume fit)",
                                   a->popt.fit.volume_value);
-    if (a->joint && a->popt.fit.law == CF_FAMILY_TAIL && a->popt.fit.volume != CF_VOLUME_NONE)
+    if (a->joint && a->popt.fit.law == CF_KIND_TAIL && a->popt.fit.volume != CF_VOLUME_NONE)
         return cf_cli_usage_error(cmd, "--law conical-tail has no volume term yet (use conical, "
                                        "double-acting or auto)");
     if (a->calibration_given && a->popt.lattice.cfg.lattice.calibration == CF_CAL_FITTED &&

@@ -329,7 +329,7 @@ cf_status cf_fit_run(const cf_table *data, const cf_fit_options *opt, cf_spring_
 }
 
 /* Whether two option sets give the same stage A (every field but the stage-C optimiser and the
-** law family, which stage A does not read, compared one by one: no padding bytes). */
+** law kind, which stage A does not read, compared one by one: no padding bytes). */
 /* A force table that the law meets only in its first region (every |x| at or below the
 ** transition) determines the initial stiffness alone, which depends on (rho, B, A) only through
 ** A/B at a given rho: the travel and the solid load slide together along a valley of one sum of

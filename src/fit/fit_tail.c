@@ -479,11 +479,11 @@ cf_status cf_fit_tail_run(const cf_table *data, const cf_fit_options *opt, cf_sp
     return CF_OK;
 }
 
-cf_status cf_law_family_parse(const char *name, cf_law_family *f, cf_error *err)
+cf_status cf_law_kind_parse(const char *name, cf_law_kind *f, cf_error *err)
 {
-    static const struct { const char *name; cf_law_family f; } map[] = {
-        {"conical", CF_FAMILY_CONICAL}, {"conical-tail", CF_FAMILY_TAIL}, {"auto", CF_FAMILY_AUTO},
-        {"double-acting", CF_FAMILY_DOUBLE}};
+    static const struct { const char *name; cf_law_kind f; } map[] = {
+        {"conical", CF_KIND_CONICAL}, {"conical-tail", CF_KIND_TAIL}, {"auto", CF_KIND_AUTO},
+        {"double-acting", CF_KIND_DOUBLE}};
     for (size_t i = 0; i < sizeof map / sizeof map[0]; i++)
         if (name && strcmp(name, map[i].name) == 0) {
             *f = map[i].f;
@@ -495,13 +495,13 @@ cf_status cf_law_family_parse(const char *name, cf_law_family *f, cf_error *err)
                         name ? name : "(null)");
 }
 
-const char *cf_law_family_name(cf_law_family f)
+const char *cf_law_kind_name(cf_law_kind f)
 {
     switch (f) {
-    case CF_FAMILY_CONICAL: return "conical";
-    case CF_FAMILY_TAIL: return "conical-tail";
-    case CF_FAMILY_AUTO: return "auto";
-    case CF_FAMILY_DOUBLE: return "double-acting";
+    case CF_KIND_CONICAL: return "conical";
+    case CF_KIND_TAIL: return "conical-tail";
+    case CF_KIND_AUTO: return "auto";
+    case CF_KIND_DOUBLE: return "double-acting";
     }
     return "?";
 }

@@ -78,7 +78,7 @@ static fit_plan plan_of(const cf_table *t, const cf_pipeline_options *opt)
     else
         p.lattice = opt->target == CF_TARGET_LATTICE;
     p.validate = opt->validate || p.lattice;
-    p.tail = opt->fit.law != CF_FAMILY_CONICAL;
+    p.tail = opt->fit.law != CF_KIND_CONICAL;
     p.solves = p.validate && !cf_table_is_force(t);
     return p;
 }
@@ -101,7 +101,7 @@ static int keep_law(const cf_pipeline_options *opt, cf_fit_report *r, int k,
     lc->ran = 1;
     lc->aic_conical = law_aic(&r->fits[k], r, 3);
     lc->aic_tail = law_aic(tail, r, 4);
-    lc->chose_tail = opt->fit.law == CF_FAMILY_TAIL ||
+    lc->chose_tail = opt->fit.law == CF_KIND_TAIL ||
                      (tail->feasible && lc->aic_tail < lc->aic_conical);
     if (lc->chose_tail) {
         lc->other = r->fits[k];
@@ -123,7 +123,7 @@ static cf_status choose_law(const cf_table *t, const cf_pipeline_options *opt, c
     if (st == CF_OK)
         keep_law(opt, r, k, &tail);
     /* auto keeps the conical law where the tailed one cannot be fitted (too few rows) */
-    if (st == CF_E_INTERNAL || (st != CF_OK && opt->fit.law == CF_FAMILY_TAIL))
+    if (st == CF_E_INTERNAL || (st != CF_OK && opt->fit.law == CF_KIND_TAIL))
         return cf_error_set(err, st, "%s", e.msg);
     return CF_OK;
 }
@@ -150,7 +150,7 @@ static cf_status choose_law_in_lattice(const cf_table *t, const cf_pipeline_opti
         thr = r->thr[k];
         st = CF_OK;
     }
-    if (st != CF_OK && opt->fit.law == CF_FAMILY_TAIL)
+    if (st != CF_OK && opt->fit.law == CF_KIND_TAIL)
         return cf_error_set(err, st, "%s", e.msg);
     if (st == CF_OK && keep_law(opt, r, k, &tail))
         r->thr[k] = thr;

@@ -28,12 +28,12 @@ static cf_status choose_law(const cf_table *const *tables, size_t n,
     cf_joint_result tail;
     cf_error e = {0};
     cf_status st = cf_joint_fit_tail(tables, n, &opt->fit, &opt->lattice, &r->fits[k], &tail, &e);
-    if (st == CF_E_INTERNAL || (st != CF_OK && opt->fit.law == CF_FAMILY_TAIL))
+    if (st == CF_E_INTERNAL || (st != CF_OK && opt->fit.law == CF_KIND_TAIL))
         return cf_error_set(err, st, "%s", e.msg);
     if (st != CF_OK)
         return CF_OK; /* auto: the conical law, the report saying no tail was fitted */
     lc->ran = 1;
-    lc->chose_tail = opt->fit.law == CF_FAMILY_TAIL ||
+    lc->chose_tail = opt->fit.law == CF_KIND_TAIL ||
                      (tail.fit.feasible && tail.aic < r->fits[k].aic);
     if (lc->chose_tail) {
         lc->other = r->fits[k];
@@ -64,14 +64,14 @@ static cf_status choose_pair(const cf_table *const *tables, size_t n,
     cf_error e = {0};
     cf_status st = cf_joint_fit_pair(tables, n, &opt->fit, &opt->lattice, r->fits[k].fit.type, 1,
                                      plain, &pair, &e);
-    if (st == CF_E_INTERNAL || (st != CF_OK && opt->fit.law == CF_FAMILY_DOUBLE))
+    if (st == CF_E_INTERNAL || (st != CF_OK && opt->fit.law == CF_KIND_DOUBLE))
         return cf_error_set(err, st, "%s", e.msg);
     if (st != CF_OK)
         return CF_OK;
     lc->pair_ran = 1;
     /* auto keeps a pair whose lattice loses stability inside a table's range only when the
     ** single-sided law's does too */
-    lc->chose_pair = opt->fit.law == CF_FAMILY_DOUBLE ||
+    lc->chose_pair = opt->fit.law == CF_KIND_DOUBLE ||
                      (pair.fit.feasible && pair.aic < r->fits[k].aic &&
                       (cf_joint_stable(&pair) || !cf_joint_stable(&r->fits[k])));
     if (lc->chose_pair) {
@@ -127,20 +127,20 @@ cf_status cf_pipeline_fit_joint(const cf_table *const *tables, size_t n,
         }
         r->nfits++;
         const int k = r->nfits - 1;
-        const cf_law_family law = opt->fit.law;
+        const cf_law_kind law = opt->fit.law;
         const int volume = opt->fit.volume != CF_VOLUME_NONE;
         cf_joint_result plain;
         memset(&plain, 0, sizeof plain);
         /* with a volume term the single-sided law is the conical law with it (no tailed law) */
-        if (volume && law != CF_FAMILY_DOUBLE)
+        if (volume && law != CF_KIND_DOUBLE)
             st = with_volume(tables, n, opt, r, k, &plain, err);
-        else if (law == CF_FAMILY_TAIL || law == CF_FAMILY_AUTO)
+        else if (law == CF_KIND_TAIL || law == CF_KIND_AUTO)
             st = choose_law(tables, n, opt, r, k, err);
         /* a declared nu has no meaning for a pair's two sides: auto then keeps single-sided */
-        if (st == CF_OK && (law == CF_FAMILY_DOUBLE ||
-                            (law == CF_FAMILY_AUTO && opt->fit.volume != CF_VOLUME_POISSON))) {
+        if (st == CF_OK && (law == CF_KIND_DOUBLE ||
+                            (law == CF_KIND_AUTO && opt->fit.volume != CF_VOLUME_POISSON))) {
             const cf_joint_law_choice *lc = &r->law_choice[k];
-            const cf_joint_result *start = volume && law != CF_FAMILY_DOUBLE ? &plain
+            const cf_joint_result *start = volume && law != CF_KIND_DOUBLE ? &plain
                                            : lc->ran && lc->chose_tail       ? &lc->other
                                                                              : &r->fits[k];
             st = choose_pair(tables, n, opt, start, r, k, err);

@@ -89,7 +89,7 @@ static const char *weighting_text =
 ** objective, feasibility and each table's RMSE and AIC, and the law kept. */
 static void law_choice_text(FILE *o, const cf_joint_report *r)
 {
-    if (r->law == CF_FAMILY_CONICAL || r->law == CF_FAMILY_DOUBLE ||
+    if (r->law == CF_KIND_CONICAL || r->law == CF_KIND_DOUBLE ||
         (r->nfits > 0 && r->fits[0].volume != CF_VOLUME_NONE && !r->law_choice[0].ran))
         return;
     size_t rows = 0;
@@ -98,7 +98,7 @@ static void law_choice_text(FILE *o, const cf_joint_report *r)
     fprintf(o, "\nLaw (--law %s): the conical law (3 quantities) against the conical spring with "
                "a cylindrical tail (4), both fitted jointly through the lattice; joint AIC = N "
                "ln(objective/N) + 2k over the N = %zu rows\n",
-            cf_law_family_name(r->law), rows);
+            cf_law_kind_name(r->law), rows);
     for (int i = 0; i < r->nfits; i++) {
         const cf_joint_law_choice *lc = &r->law_choice[i];
         const char *type = cf_spring_type_name(r->fits[i].fit.type);
@@ -124,7 +124,7 @@ static void law_choice_text(FILE *o, const cf_joint_report *r)
         joint_nested(tail, nested, sizeof nested);
         if (nested[0])
             fprintf(o, "  %-16s %s\n", "", nested);
-        const char *why = r->law == CF_FAMILY_TAIL ? "asked for (--law conical-tail)"
+        const char *why = r->law == CF_KIND_TAIL ? "asked for (--law conical-tail)"
                           : nested[0]              ? "the tailed law's fit is the conical one"
                           : lc->chose_tail         ? "lower joint AIC"
                           : !tail->fit.feasible    ? "the tailed spring is infeasible"
@@ -137,11 +137,11 @@ static void law_choice_text(FILE *o, const cf_joint_report *r)
 /* The double-acting element against the single-sided law of each type (double-acting, auto). */
 static void pair_choice_text(FILE *o, const cf_joint_report *r)
 {
-    if (r->law != CF_FAMILY_DOUBLE && r->law != CF_FAMILY_AUTO)
+    if (r->law != CF_KIND_DOUBLE && r->law != CF_KIND_AUTO)
         return;
     fprintf(o, "\nDouble-acting element (--law %s): its own conical spring for extension (6 "
                "quantities, 7 with a fitted kappa) against the single-sided law kept above\n",
-            cf_law_family_name(r->law));
+            cf_law_kind_name(r->law));
     for (int i = 0; i < r->nfits; i++) {
         const cf_joint_law_choice *lc = &r->law_choice[i];
         const char *type = cf_spring_type_name(r->fits[i].fit.type);
@@ -171,7 +171,7 @@ static void pair_choice_text(FILE *o, const cf_joint_report *r)
                     fprintf(o, " %s", cf_fit_constraint_name(1u << b));
             fputc('\n', o);
         }
-        const char *why = r->law == CF_FAMILY_DOUBLE ? "asked for (--law double-acting)"
+        const char *why = r->law == CF_KIND_DOUBLE ? "asked for (--law double-acting)"
                           : lc->chose_pair           ? "lower joint AIC"
                           : !pair->fit.feasible      ? "a spring of the pair is infeasible"
                           : !cf_joint_stable(pair) && pair->aic < single->aic

@@ -174,7 +174,7 @@ static void choose_curves(const cf_fit_report *r, fit_curves *c)
     for (int k = 0; k < r->nfits; k++) {
         c->fit[k] = 1;
         c->style[k] = 1 + (int)r->fits[k].type;
-        /* the law family named: a tailed fit is "conical-tail" */
+        /* the law kind named: a tailed fit is "conical-tail" */
         const char *law = r->fits[k].tail ? "conical-tail" : "conical";
         snprintf(c->fit_title[k], sizeof c->fit_title[k], "%s, %s", law,
                  cf_spring_type_name(r->fits[k].type));

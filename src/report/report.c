@@ -108,7 +108,7 @@ static json_t *extrapolation_json(const cf_fit_report *r, const cf_fit_result *f
     return o;
 }
 
-/* Both law families of fits[i]: their quality, AIC and which one the fit keeps; through_lattice
+/* Both law kinds of fits[i]: their quality, AIC and which one the fit keeps; through_lattice
 ** when both were fitted through the lattice (their RMSE and AIC are the lattice's). */
 static json_t *law_comparison_json(const cf_fit_report *r, int i)
 {

@@ -95,18 +95,18 @@ static void tail_row(FILE *o, const cf_fit_report *r)
     fputc('\n', o);
 }
 
-/* Both law families of each type, when the fit asked for the tailed one: quality, AIC, and the
+/* Both law kinds of each type, when the fit asked for the tailed one: quality, AIC, and the
 ** one kept. */
 static void law_choice_text(FILE *o, const cf_fit_report *r)
 {
-    if (r->law == CF_FAMILY_CONICAL)
+    if (r->law == CF_KIND_CONICAL)
         return;
     const double u = r->table->y_to_file;
     int lattice = r->through_msm;
     for (int i = 0; i < r->nfits; i++)
         lattice &= r->thr[i].done;
     fprintf(o, "\nLaw (--law %s): the conical law (3 quantities) against the conical spring with "
-               "a cylindrical tail (4)%s\n", cf_law_family_name(r->law),
+               "a cylindrical tail (4)%s\n", cf_law_kind_name(r->law),
             lattice ? ", both fitted through the lattice (RMSE and AIC the lattice's)" : "");
     for (int i = 0; i < r->nfits; i++) {
         const cf_law_choice *lc = &r->law_choice[i];
@@ -122,7 +122,7 @@ static void law_choice_text(FILE *o, const cf_fit_report *r)
         fprintf(o, "  %-16s conical-tail RMSE %.4g %s  AIC %.2f%s%s%s%s\n", "", tail->rmse * u,
                 r->table->y_unit, lc->aic_tail, tail->feasible ? "" : "  (infeasible)",
                 nested[0] ? "  (" : "", nested, nested[0] ? ")" : "");
-        const char *why = r->law == CF_FAMILY_TAIL ? "asked for (--law conical-tail)"
+        const char *why = r->law == CF_KIND_TAIL ? "asked for (--law conical-tail)"
                           : lc->chose_tail         ? "lower AIC"
                           : !tail->feasible        ? "the tailed spring is infeasible"
                                                    : "the tail does not lower the AIC";

@@ -242,7 +242,7 @@ static int auto_on(const char *name, const char *mode, cf_table *t, cf_fit_repor
     if (cf_measure_load(path, &mo, t, &err) != CF_OK)
         fail_msg("%s", err.msg);
     cf_pipeline_options po = cf_pipeline_default_options();
-    po.fit.law = CF_FAMILY_AUTO;
+    po.fit.law = CF_KIND_AUTO;
     if (cf_pipeline_fit(t, &po, r, &err) != CF_OK)
         fail_msg("%s", err.msg);
     for (int i = 0; i < r->nfits; i++) {
@@ -341,7 +341,7 @@ static void profile_reaches_the_other_pieces_of_a_flat_valley(void **state)
 }
 
 /* The pipeline on table path (mode may be NULL) with law `law` and the default limits but n_max. */
-static void law_fit(const char *path, const char *mode, cf_law_family law, double n_max,
+static void law_fit(const char *path, const char *mode, cf_law_kind law, double n_max,
                     cf_table *t, cf_fit_report *r)
 {
     cf_measure_options mo = cf_measure_default_options();
@@ -389,7 +389,7 @@ static void tailed_fit_never_loses_to_the_conical_law(void **state)
     assert_non_null(mkdtemp(dir));
     snprintf(path, sizeof path, "%s/ligament.csv", dir);
     assert_int_equal(tu_ligament_csv(path), 0);
-    static const cf_law_family laws[2] = {CF_FAMILY_AUTO, CF_FAMILY_TAIL};
+    static const cf_law_kind laws[2] = {CF_KIND_AUTO, CF_KIND_TAIL};
     for (int l = 0; l < 2; l++) {
         cf_table t;
         cf_fit_report r;
@@ -397,7 +397,7 @@ static void tailed_fit_never_loses_to_the_conical_law(void **state)
         assert_nested(&r, "ligament");
         for (int i = 0; i < r.nfits; i++) {
             assert_true(r.fits[i].feasible);
-            if (laws[l] == CF_FAMILY_TAIL) { /* kept as asked, with no tail */
+            if (laws[l] == CF_KIND_TAIL) { /* kept as asked, with no tail */
                 assert_true(r.fits[i].tail);
                 assert_true(r.fits[i].e_tail == 0 && r.fits[i].params.n_tail == 0);
                 assert_true(fabs(r.fits[i].rmse - r.law_choice[i].other.rmse) <=
@@ -421,7 +421,7 @@ static void tailed_fit_never_loses_to_the_conical_law(void **state)
         snprintf(path, sizeof path, "%s/%s", ds, names[k]);
         cf_table t;
         cf_fit_report r;
-        law_fit(path, NULL, CF_FAMILY_AUTO, 0, &t, &r);
+        law_fit(path, NULL, CF_KIND_AUTO, 0, &t, &r);
         assert_nested(&r, names[k]);
         cf_report_free(&r);
         cf_table_free(&t);
@@ -446,14 +446,14 @@ static void auto_keeps_the_conical_law_where_the_tail_cannot_be_fitted(void **st
     cf_pipeline_options po = cf_pipeline_default_options();
     cf_fit_report r;
     cf_error err = {0};
-    po.fit.law = CF_FAMILY_AUTO;
+    po.fit.law = CF_KIND_AUTO;
     if (cf_pipeline_fit(&t, &po, &r, &err) != CF_OK)
         fail_msg("auto on 5 rows: %s", err.msg);
     for (int i = 0; i < r.nfits; i++)
         assert_false(r.fits[i].tail);
     cf_report_free(&r);
     /* the tailed law asked for is refused, naming why */
-    po.fit.law = CF_FAMILY_TAIL;
+    po.fit.law = CF_KIND_TAIL;
     assert_int_equal(cf_pipeline_fit(&t, &po, &r, &err), CF_E_DATA);
     assert_non_null(strstr(err.msg, "6 rows"));
     cf_report_free(&r);
@@ -477,7 +477,7 @@ static void tail_coils_are_limited_like_the_cone(void **state)
     for (int k = 0; k < 2; k++) {
         cf_table t;
         cf_fit_report r;
-        law_fit(path, NULL, CF_FAMILY_TAIL, nmax[k], &t, &r);
+        law_fit(path, NULL, CF_KIND_TAIL, nmax[k], &t, &r);
         const double lim = r.fit_options.upper[CF_P_N];
         int gained = 0;
         for (int i = 0; i < r.nfits; i++) {

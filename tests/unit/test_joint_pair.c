@@ -142,7 +142,7 @@ static void auto_keeps_the_odd_law_where_the_pair_buys_nothing(void **state)
     cell_table(&known_c, NULL, kappa, CF_MODE_SHEAR, 0.5, 20, 5e-3, &t[2]);
     const cf_table *tabs[3] = {&t[0], &t[1], &t[2]};
     cf_pipeline_options po = cf_pipeline_default_options();
-    po.fit.law = CF_FAMILY_AUTO;
+    po.fit.law = CF_KIND_AUTO;
     po.fit.volume = CF_VOLUME_FIT;
     po.types = 1u << CF_NON_TELESCOPING;
     cf_joint_report r;
@@ -232,7 +232,7 @@ static void brain_cortex_stable_pair_near_half_of_ogden(void **state)
         tabs[k] = &t[k];
     }
     cf_pipeline_options po = cf_pipeline_default_options();
-    po.fit.law = CF_FAMILY_AUTO;
+    po.fit.law = CF_KIND_AUTO;
     po.fit.volume = CF_VOLUME_FIT;
     cf_joint_report r;
     if (cf_pipeline_fit_joint(tabs, 3, &po, &r, &err) != CF_OK)
@@ -357,7 +357,7 @@ static void coronaradiata_pair_infeasible_is_the_odd_law(void **state)
         tabs[k] = &t[k];
     }
     cf_pipeline_options po = cf_pipeline_default_options();
-    po.fit.law = CF_FAMILY_DOUBLE;
+    po.fit.law = CF_KIND_DOUBLE;
     po.types = 1u << CF_TELESCOPING;
     cf_joint_report r;
     if (cf_pipeline_fit_joint(tabs, 2, &po, &r, &err) != CF_OK)

@@ -128,7 +128,7 @@ static int auto_in_lattice(const char *name, cf_mode mode, cf_table *t, cf_fit_r
         fail_msg("%s", err.msg);
     assert_int_equal(t->mode, mode);
     cf_pipeline_options po = cf_pipeline_default_options();
-    po.fit.law = CF_FAMILY_AUTO;
+    po.fit.law = CF_KIND_AUTO;
     if (cf_pipeline_fit(t, &po, r, &err) != CF_OK)
         fail_msg("%s", err.msg);
     assert_true(r->through_msm);
@@ -250,7 +250,7 @@ static void tail_through_the_lattice_never_loses_to_the_conical_law(void **state
     if (cf_measure_load(path, &mo, &t, &err) != CF_OK)
         fail_msg("%s", err.msg);
     cf_pipeline_options po = cf_pipeline_default_options();
-    po.fit.law = CF_FAMILY_AUTO;
+    po.fit.law = CF_KIND_AUTO;
     po.validate = 1;
     if (cf_pipeline_fit(&t, &po, &r, &err) != CF_OK)
         fail_msg("%s", err.msg);
@@ -344,7 +344,7 @@ static void brain_cortex_joint_auto(void **state)
         tabs[k] = &t[k];
     }
     cf_pipeline_options po = cf_pipeline_default_options();
-    po.fit.law = CF_FAMILY_AUTO;
+    po.fit.law = CF_KIND_AUTO;
     cf_joint_report r;
     if (cf_pipeline_fit_joint(tabs, 3, &po, &r, &err) != CF_OK)
         fail_msg("%s", err.msg);
@@ -461,7 +461,7 @@ static void chicken_breast_joint_tail_never_loses(void **state)
         cf_joint_free(&tail);
     }
     cf_pipeline_options po = cf_pipeline_default_options();
-    po.fit.law = CF_FAMILY_TAIL;
+    po.fit.law = CF_KIND_TAIL;
     cf_joint_report r;
     if (cf_pipeline_fit_joint(tabs, 3, &po, &r, &err) != CF_OK)
         fail_msg("%s", err.msg);

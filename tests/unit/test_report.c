@@ -232,7 +232,7 @@ static void intervals_print_few_digits_and_hold_their_value(void **state)
 
 /* The pipeline on the table at path (mode may be NULL), with law `law` and index_max (0: the
 ** default); its text, warnings and fit file into the arguments (the caller frees text and json). */
-static void report_of(const char *path, const char *mode, cf_law_family law, double index_max,
+static void report_of(const char *path, const char *mode, cf_law_kind law, double index_max,
                       cf_table *t, cf_fit_report *r, char **text, char **json,
                       char w[CF_REPORT_WARNINGS_MAX][CF_REPORT_WARNING_LEN], int *nw)
 {
@@ -285,7 +285,7 @@ static void ligament_spring_scale_and_verdict(void **state)
     cf_fit_report r;
     char *text, *json, w[CF_REPORT_WARNINGS_MAX][CF_REPORT_WARNING_LEN];
     int nw;
-    report_of(path, NULL, CF_FAMILY_CONICAL, 0, &t, &r, &text, &json, w, &nw);
+    report_of(path, NULL, CF_KIND_CONICAL, 0, &t, &r, &text, &json, w, &nw);
     assert_int_equal(warned(w, nw, "non-telescoping spring placed for this force-displacement "
                                    "table is", text, json), 1);
     /* the telescoping one (D2 0.21 m) is within 100 times: only the sentence above */
@@ -294,7 +294,7 @@ static void ligament_spring_scale_and_verdict(void **state)
     free(json);
     cf_report_free(&r);
     cf_table_free(&t);
-    report_of(path, NULL, CF_FAMILY_CONICAL, 20, &t, &r, &text, &json, w, &nw);
+    report_of(path, NULL, CF_KIND_CONICAL, 20, &t, &r, &text, &json, w, &nw);
     assert_int_equal(cf_report_better(&r), 1);
     assert_null(strstr(text, "optimiser stopped"));
     assert_non_null(strstr(text, "is no telescoping spring within the limit G_max"));
@@ -325,7 +325,7 @@ static void infeasible_rubber_warnings(void **state)
         cf_fit_report r;
         char *text, *json, w[CF_REPORT_WARNINGS_MAX][CF_REPORT_WARNING_LEN];
         int nw;
-        report_of(path, modes[m], CF_FAMILY_CONICAL, 0, &t, &r, &text, &json, w, &nw);
+        report_of(path, modes[m], CF_KIND_CONICAL, 0, &t, &r, &text, &json, w, &nw);
         for (int i = 0; i < r.nfits; i++)
             assert_false(r.fits[i].feasible);
         assert_int_equal(warned(w, nw, "worse than a straight line", text, json), 2);
@@ -356,7 +356,7 @@ static void verdict_names_the_law_choice(void **state)
     cf_fit_report r;
     char *text, *json, w[CF_REPORT_WARNINGS_MAX][CF_REPORT_WARNING_LEN];
     int nw;
-    report_of(path, "uniaxial", CF_FAMILY_AUTO, 0, &t, &r, &text, &json, w, &nw);
+    report_of(path, "uniaxial", CF_KIND_AUTO, 0, &t, &r, &text, &json, w, &nw);
     assert_int_equal(cf_report_better(&r), 1);
     if (!strstr(text, "telescoping keeps the conical law (the better one the conical-tail law): "
                       "its conical-tail fit is excluded by the limit D2_max_H"))

@@ -76,17 +76,17 @@ typedef enum cf_fit_optimizer {
 ** that the coils tangle and buckle (the usual design handbooks give the same range). */
 #define CF_FIT_INDEX_MAX_DEFAULT 12.0
 
-/* The law family a fit uses (src/model/law.md): the conical spring's law (three identifiable
+/* The law kind a fit uses (src/model/law.md): the conical spring's law (three identifiable
 ** quantities), the conical spring with a cylindrical tail in series (four: the tail's compliance
 ** e_t = F_C/(k_t H) too, cf_fit_tail_run), or both with the choice by AIC (the pipeline). */
-typedef enum cf_law_family {
-    CF_FAMILY_CONICAL = 0,
-    CF_FAMILY_TAIL = 1,
-    CF_FAMILY_AUTO = 2,
-    CF_FAMILY_DOUBLE = 3 /* double-acting: a conical compression spring and a conical extension
+typedef enum cf_law_kind {
+    CF_KIND_CONICAL = 0,
+    CF_KIND_TAIL = 1,
+    CF_KIND_AUTO = 2,
+    CF_KIND_DOUBLE = 3 /* double-acting: a conical compression spring and a conical extension
                          ** spring sharing H (law.h, cf_law.extension; six quantities); joint fits
                          ** only (joint.h), where auto compares it too */
-} cf_law_family;
+} cf_law_kind;
 
 /* The volume term of a fit through the lattice (cell.h, volume_modulus_MPa): none, kappa declared
 ** (MPa), the small-strain nu declared (kappa from the lattice's moduli, joint.h), or kappa fitted. */
@@ -99,8 +99,8 @@ typedef enum cf_volume {
 
 /* Parses "conical", "conical-tail", "auto" or "double-acting"; CF_E_DATA naming the value
 ** otherwise. */
-cf_status cf_law_family_parse(const char *name, cf_law_family *f, cf_error *err);
-const char *cf_law_family_name(cf_law_family f);
+cf_status cf_law_kind_parse(const char *name, cf_law_kind *f, cf_error *err);
+const char *cf_law_kind_name(cf_law_kind f);
 
 typedef struct cf_fit_options {
     int fixed[CF_P_COUNT];          /* 1: held at fixed_value */
@@ -121,7 +121,7 @@ typedef struct cf_fit_options {
                                     ** deterministic subsample of 1000 rows evenly along x, then
                                     ** polishes on every row; 0: never (default
                                     ** CF_FIT_SUBSAMPLE_ABOVE; the baselines use the same) */
-    cf_law_family law;              /* the law family (default conical; the pipeline reads it) */
+    cf_law_kind law;              /* the law kind (default conical; the pipeline reads it) */
     cf_volume volume;               /* the volume term of a joint fit (default none) */
     double volume_value;            /* its declared kappa (MPa) or nu (-) */
 } cf_fit_options;

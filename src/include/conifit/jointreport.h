@@ -31,7 +31,7 @@ typedef struct cf_joint_report {
     int nfits;
     cf_joint_result fits[2];
     cf_joint_law_choice law_choice[2];
-    cf_law_family law;          /* the law asked for (--law) */
+    cf_law_kind law;          /* the law asked for (--law) */
     int with_timing;            /* 0: wall times written as 0 */
 } cf_joint_report;
 

@@ -13,7 +13,7 @@
 **                          c = 1/rho - (u/s)(1/rho - 1)
 **   region 3 (|u| >= s): solid; the law reports F = +-F_C and the CF_LAW_SOLID flag.
 **   F(-u) = -F(u): stretching mirrors compression (paper eqs. 20-21, L_max = 2H - L_min).
-** The tail (law family conical-tail, src/model/law.md): n_t coils of diameter D1 in series with the
+** The tail (law kind conical-tail, src/model/law.md): n_t coils of diameter D1 in series with the
 ** cone, stiffness k_t = G d^4/(8 n_t D1^3), tau = n_t/n = F_C/(k_t s), beta = (1/rho - 1) tau:
 **   region 1: F = k0 u with k0 the series stiffness, up to u_T + F_T/k_t;
 **   region 2: the cone's y and the tail's F/k_t add: with Delta = (1/rho - 1)(u_C - |u|)/s,

@@ -19,7 +19,7 @@
 /* One table and its fits, as the report sees it (cf_pipeline_fit fills it). Values of the fits
 ** are in conifit's units (MPa or N); table->y_to_file converts them to the file's own unit for
 ** display and JSON. */
-/* Both law families fitted to one type (cf_fit_options.law conical-tail or auto): the one in
+/* Both law kinds fitted to one type (cf_fit_options.law conical-tail or auto): the one in
 ** fits[] and the other one, with their AIC (n ln(RSS_w/n) + 2 k, k = 3 quantities for the conical
 ** law and 4 for the tailed one, on the weighted residuals). auto keeps the tailed law only when its
 ** AIC is lower and its spring is feasible. */
@@ -47,7 +47,7 @@ typedef struct cf_fit_report {
     cf_through_msm thr[2];      /* what that cost and gained (MPa) */
     cf_softening softening;     /* where the table softens, which the law cannot follow */
     cf_limit_cost limit_cost[2]; /* what the limits holding fits[i] cost (checked when held) */
-    cf_law_family law;          /* the law family asked for (fit.h) */
+    cf_law_kind law;          /* the law kind asked for (fit.h) */
     cf_law_choice law_choice[2]; /* for fits[i], both laws (ran = 0 with the conical law alone) */
 } cf_fit_report;
 

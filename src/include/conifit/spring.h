@@ -20,7 +20,7 @@ typedef struct cf_spring {
     double d_mm;  /* wire diameter, mm */
     double G_MPa; /* shear modulus of the wire, MPa */
     double H_mm;  /* free length, mm (rest length in the mass-spring model) */
-    /* The optional cylindrical tail (law family conical-tail, src/model/law.md): n_tail coils of
+    /* The optional cylindrical tail (law kind conical-tail, src/model/law.md): n_tail coils of
     ** mean diameter D1 wound from the same wire, in series with the cone, taking H_tail of the free
     ** length H. Both 0 (an initializer that lists only the six) is the plain conical spring. */
     double n_tail;     /* number of tail coils, dimensionless (0: no tail) */
@@ -64,7 +64,7 @@ void cf_spring_set(cf_spring *p, int k, double value);
 const char *cf_spring_text(const cf_spring *p, int digits, int assign, char *buf, size_t cap);
 
 /* Index (< CF_P_COUNT) of the parameter called name (its name "D1" or its key "D1_mm"), or -1;
-** the tail's parameters are not found here (a fit places them with the law family). */
+** the tail's parameters are not found here (a fit places them with the law kind). */
 int cf_spring_param_find(const char *name);
 
 /* "telescoping" or "non-telescoping". */
