@@ -13,6 +13,7 @@
 
 #include "base/atomic.h"
 #include "cli/cli.h"
+#include "cli/cli_probe.h"
 #include "conifit/body.h"
 #include "conifit/mesh.h"
 #include "report/vtu.h"
@@ -177,7 +178,7 @@ static void summary(FILE *o, const cf_scene *sc, const run *r)
 }
 
 int cf_cli_simulate_body(const cf_scene *sc, const char *scene_path, const char *out,
-                         const char *vtu_dir, const cf_budget *budget, int quiet)
+                         const char *vtu_dir, const char *png, const cf_budget *budget, int quiet)
 {
     cf_error err = {0};
     run r;
@@ -187,8 +188,10 @@ int cf_cli_simulate_body(const cf_scene *sc, const char *scene_path, const char 
     const size_t nfiles = 2 * ((size_t)sc->probe.steps + 1) + 1;
     cf_atomic *files = NULL;
     cf_cli_out csv = {0};
+    cf_atomic plot = {0};
     int rc = CF_EXIT_OK;
     if ((!cf_cli_is_stdio(out) && cf_atomic_check(out, inputs, &err) != CF_OK) ||
+        (png && cf_atomic_check(png, inputs, &err) != CF_OK) ||
         solve(sc, scene_path, budget, &r, &err) != CF_OK) {
         rc = cf_cli_fail(&err);
         goto end;
@@ -205,7 +208,9 @@ int cf_cli_simulate_body(const cf_scene *sc, const char *scene_path, const char 
         rc = cf_cli_fail(&err);
         goto end;
     }
-    if (write_all(sc, &r, out, vtu_dir, inputs, &csv, files, &err) != CF_OK) {
+    if (write_all(sc, &r, out, vtu_dir, inputs, &csv, files, &err) != CF_OK ||
+        (png && cf_cli_probe_plot(sc, r.step, (size_t)sc->probe.steps + 1, png, inputs, &plot,
+                                  &err) != CF_OK)) {
         rc = cf_cli_fail(&err);
         goto end;
     }
@@ -214,7 +219,7 @@ int cf_cli_simulate_body(const cf_scene *sc, const char *scene_path, const char 
             rc = cf_cli_fail(&err);
             goto end;
         }
-    if (cf_cli_out_close(&csv, &err) != CF_OK) {
+    if (cf_cli_out_close(&csv, &err) != CF_OK || (png && cf_atomic_commit(&plot, &err) != CF_OK)) {
         rc = cf_cli_fail(&err);
         goto end;
     }
@@ -222,6 +227,7 @@ int cf_cli_simulate_body(const cf_scene *sc, const char *scene_path, const char 
         summary(csv.to_stdout ? stderr : stdout, sc, &r);
 end:
     cf_cli_out_abort(&csv);
+    cf_atomic_abort(&plot);
     for (size_t k = 0; files && k < nfiles; k++)
         cf_atomic_abort(&files[k]);
     free(files);

@@ -10,9 +10,10 @@
 #include "conifit/scene.h"
 
 /* Runs sc (sc->has_body) and writes out (CSV, "-" for standard output) and, when vtu_dir is not
-** NULL, vtu_dir/body_NNNN.vtu, springs_NNNN.vtu and body.pvd. Returns the exit status. */
+** NULL, vtu_dir/body_NNNN.vtu, springs_NNNN.vtu and body.pvd, and when png is not NULL the
+** depth-force plot (cli_probe.h). Returns the exit status. */
 int cf_cli_simulate_body(const cf_scene *sc, const char *scene_path, const char *out,
-                         const char *vtu_dir, const cf_budget *budget, int quiet);
+                         const char *vtu_dir, const char *png, const cf_budget *budget, int quiet);
 
 /* Solves sc's body step by step as simulate does and writes it as a model (cf_export_write_body:
 ** CalculiX) to out, with conifit's force at every step in its header. */

@@ -13,6 +13,7 @@
 #include "base/atomic.h"
 #include "cli/cli.h"
 #include "cli/cli_body.h"
+#include "cli/cli_probe.h"
 #include "conifit/budget.h"
 #include "conifit/hysteresis.h"
 #include "conifit/msm.h"
@@ -25,7 +26,8 @@
 
 static const char simulate_help[] =
     "usage: conifit simulate SCENE.json -o OUT.csv [--plot OUT.png|.svg|.pdf] [-q]\n"
-    "       conifit simulate BODY-SCENE.json -o PROBE.csv [--vtu DIR] [-q]\n"
+    "       conifit simulate BODY-SCENE.json -o PROBE.csv [--vtu DIR] [--plot PNG] [-q]\n"
+    "       conifit simulate BODY-SCENE.json --haptic -o FORCES.csv [--plot PNG] [-q]\n"
     "Runs the scene on a mass-spring lattice of conical springs and writes the CSV\n"
     "time_s,strain,stress_kPa,kinetic_energy_mJ,spring_stress_kPa,stable,lateral_stretch\n"
     "(compression positive: strain is the top face's shortening over the height, stress the top\n"
@@ -37,7 +39,8 @@ static const char simulate_help[] =
     "A scene with no inertia, damping or viscosity is solved as static equilibria.\n\n"
     "  -o, --output FILE   CSV to write (written to a temporary name, then renamed); '-'\n"
     "                      writes it to standard output and the summary to stderr\n"
-    "  --plot FILE.png|.svg|.pdf  also plot the result with gnuplot\n"
+    "  --plot FILE.png|.svg|.pdf  also plot the result with gnuplot (a body: the probe's\n"
+    "                      force against depth, or against time with --haptic)\n"
     "  --table             write a measurement table instead: time_s,strain,stress_kPa in the\n"
     "                      published tables' sign (tension positive, compression negative),\n"
     "                      '#' lines naming the scene; conifit fit reads it as a time series\n"
@@ -59,7 +62,13 @@ static const char simulate_help[] =
     "depth_mm,force_N (force along the direction, positive pushing into the body) and prints\n"
     "the body's small-strain E and nu.\n"
     "  --vtu DIR           with a body: also write DIR/body_NNNN.vtu, DIR/springs_NNNN.vtu per\n"
-    "                      step and DIR/body.pvd (ParaView)\n";
+    "                      step and DIR/body.pvd (ParaView)\n"
+    "  --haptic            with a body: move the probe along the scene's \"haptic\": {\"path\":\n"
+    "                      [[t_ms, depth_mm], ...], \"iterations\": N} (linear between the\n"
+    "                      points, from 0 ms), one update of the haptic loop per ms of simulated\n"
+    "                      time (at most N chord iterations, default 3); writes\n"
+    "                      t_ms,depth_mm,force_N and prints the wall time per update and, at\n"
+    "                      the last depth, the static solve's force for comparison\n";
 
 /* The recovery test (hysteresis.h), printed: whether the strain left at zero force recovers. */
 static void recovery(FILE *o, const cf_scene *sc, const cf_law *law, const cf_msm_sample *s,
@@ -152,7 +161,8 @@ enum {
     OPT_TABLE,
     OPT_NOISE,
     OPT_SEED,
-    OPT_VTU
+    OPT_VTU,
+    OPT_HAPTIC
 };
 
 typedef struct sim_opts {
@@ -162,6 +172,7 @@ typedef struct sim_opts {
     double noise;   /* --noise REL */
     long seed;      /* --seed S */
     const char *vtu; /* --vtu DIR */
+    int haptic;      /* --haptic */
 } sim_opts;
 
 /* simulate's own options: --plot, --table, --noise, --seed and the budget's. */
@@ -173,6 +184,8 @@ static int take_option(void *ctx, int c, const char *value)
         o->png = value;
     } else if (c == OPT_VTU) {
         o->vtu = value;
+    } else if (c == OPT_HAPTIC) {
+        o->haptic = 1;
     } else if (c == OPT_TABLE) {
         o->table = 1;
     } else if (c == OPT_NOISE) {
@@ -209,9 +222,10 @@ static int parse_request(int argc, char **argv, sim_request *q)
                                         {"noise", required_argument, NULL, OPT_NOISE},
                                         {"seed", required_argument, NULL, OPT_SEED},
                                         {"vtu", required_argument, NULL, OPT_VTU},
+                                        {"haptic", no_argument, NULL, OPT_HAPTIC},
                                         {NULL, 0, NULL, 0}};
     cf_error err = {0};
-    q->so = (sim_opts){NULL, cf_budget_default(), 0, 0, 1, NULL};
+    q->so = (sim_opts){NULL, cf_budget_default(), 0, 0, 1, NULL, 0};
     cf_cli_parser p;
     int rc = cf_cli_parser_init(&p, "simulate", simulate_help, 0, argc, argv, "", own);
     if (rc || (rc = cf_cli_parse(&p, take_option, &q->so)) >= 0)
@@ -304,14 +318,18 @@ int cf_cli_simulate(int argc, char **argv)
     cf_scene sc;
     if (cf_scene_load(q.scene_path, &sc, &err) != CF_OK)
         return cf_cli_fail(&err);
-    if (sc.has_body || q.so.vtu) {
-        if (!sc.has_body || png || q.so.table) {
+    if (sc.has_body || q.so.vtu || q.so.haptic) {
+        if (!sc.has_body || q.so.table || (q.so.haptic && q.so.vtu)) {
             cf_scene_free(&sc);
-            return cf_cli_usage_error("simulate", "%s", !sc.has_body
-                                          ? "--vtu needs a scene with a body"
-                                          : "--plot and --table are for lattice scenes");
+            return cf_cli_usage_error("simulate", "%s",
+                                      !sc.has_body ? "--vtu and --haptic need a scene with a body"
+                                      : q.so.table ? "--table is for lattice scenes"
+                                                   : "--vtu is for the static probe run, not "
+                                                     "--haptic");
         }
-        rc = cf_cli_simulate_body(&sc, q.scene_path, out, q.so.vtu, &budget, q.quiet);
+        rc = q.so.haptic ? cf_cli_simulate_haptic(&sc, q.scene_path, out, png, &budget, q.quiet)
+                         : cf_cli_simulate_body(&sc, q.scene_path, out, q.so.vtu, png, &budget,
+                                                q.quiet);
         cf_scene_free(&sc);
         return rc;
     }

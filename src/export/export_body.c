@@ -1,6 +1,6 @@
 /*
-** Export of a tissue body (see export.h, cf_export_write_body), to CalculiX or SOFA: every edge of
-** the body its own
+** Export of a tissue body (see export.h, cf_export_write_body), to CalculiX, FEBio or SOFA: every
+** edge of the body its own
 ** spring group (its rest length and its calibration factor as the weight, so its table is the law
 ** in strain form times that factor, as the lattice export writes its groups), the volume term as
 ** tetrahedra of a purely volumetric material, the held nodes, and a flat punch pressed along z as
@@ -48,8 +48,9 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, 
                                const cf_export_options *opt, cf_export_report *rep, cf_error *err)
 {
     CF_GSL_GUARD;
-    if (opt->format != CF_EXPORT_CALCULIX && opt->format != CF_EXPORT_SOFA)
-        return cf_error_set(err, CF_E_DATA, "a body is exported to calculix or sofa, not %s",
+    if (opt->format != CF_EXPORT_CALCULIX && opt->format != CF_EXPORT_FEBIO &&
+        opt->format != CF_EXPORT_SOFA)
+        return cf_error_set(err, CF_E_DATA, "a body is exported to calculix, febio or sofa, not %s",
                             cf_export_format_name(opt->format));
     if (opt->format == CF_EXPORT_SOFA && b->kappa_MPa > 0)
         return cf_error_set(err, CF_E_DATA,
@@ -140,7 +141,7 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, 
         m.ref_N[k] = force_N[k] * (pr->dir[2] < 0 ? 1 : -1);
         m.strain[k] = depth_mm[k] / m.height_mm;
     }
-    if (opt->format == CF_EXPORT_CALCULIX) {
+    if (opt->format == CF_EXPORT_CALCULIX || opt->format == CF_EXPORT_FEBIO) {
         m.nt = b->nt;
         m.tet = b->tet;
         m.kappa_MPa = b->kappa_MPa;

@@ -305,9 +305,10 @@ static void model_header(FILE *out, const char *lead, const char *tail, const cf
             lead, m->reaction_tol_N, tail);
     if (m->kappa_MPa > 0)
         fprintf(out,
-                "%svolume term: each of the %zu cells stores (kappa/2)(J - 1)^2 of its rest "
+                "%svolume term: each of the %zu %s stores (kappa/2)(J - 1)^2 of its rest "
                 "volume, kappa = %.17g MPa, J its volume over its rest volume%s\n",
-                lead, m->ncells, m->kappa_MPa, tail);
+                lead, m->nt > 0 ? m->nt : m->ncells, m->nt > 0 ? "tetrahedra" : "cells",
+                m->kappa_MPa, tail);
     for (size_t k = 0; k < m->nsteps; k++)
         fprintf(out, "%s  step %zu: top z displacement %.17g mm (strain %.10g), conifit reaction "
                      "%.17g N%s\n",
@@ -351,12 +352,8 @@ const char *cf_xmodel_volume_refusal(const cf_xmodel *m, cf_export_format f)
     switch (f) {
     case CF_EXPORT_CALCULIX:
     case CF_EXPORT_ABAQUS:
-        return NULL;
     case CF_EXPORT_FEBIO:
-        return "the volumetric energies of FEBio's solid materials are in ln J (neo-Hookean: "
-               "(lambda/2)(ln J)^2; the uncoupled materials: (k/2)(ln J)^2), not the lattice's "
-               "(kappa/2)(J - 1)^2, so its run would not be conifit's lattice; export calculix or "
-               "abaqus, whose neo-Hookean material with C10 = 0 is that term";
+        return NULL;
     case CF_EXPORT_LSDYNA:
         return "this export writes LS-DYNA's discrete springs only, and none of the solid "
                "materials it writes has exactly the lattice's (kappa/2)(J - 1)^2 and no shear; "
@@ -487,6 +484,49 @@ static void febio_control(FILE *out, const cf_xmodel *m)
             m->nsteps, rtol, floor_N * floor_N);
 }
 
+/* The volume term in FEBio 4: a Mooney-Rivlin material with c1 = c2 = 0 is purely volumetric,
+** W = U(J), and pressure_model 2 ("Abaqus") of FEBio's uncoupled materials is U(J) =
+** (k/2)(J - 1)^2 (FEUncoupledMaterial::U, case 2, since FEBio 3; user manual, "Uncoupled Elastic
+** Solids"): with k = kappa the term of conifit's lattice and body. A body's tetrahedra become tet4
+** elements (J per tetrahedron, as in CalculiX's C3D4; conifit takes J per node); a lattice's cells
+** hex8 elements, which FEBio gives an uncoupled material's three-field formulation by default
+** (FESolidDomainFactory: hex8 with an uncoupled material), whose pressure is U'(v/V) with v/V the
+** element's volume ratio, the cell's J of conifit exactly. Nothing written without a volume term. */
+static void febio_volume_material(FILE *out, const cf_xmodel *m)
+{
+    if (!(m->kappa_MPa > 0) || (m->nt == 0 && m->ncells == 0))
+        return;
+    fprintf(out, "\t<!-- the volume term: (kappa/2)(J - 1)^2 per unit rest volume, kappa = %.17g "
+                 "MPa, J per %s: a Mooney-Rivlin solid with c1 = c2 = 0 and pressure_model 2, "
+                 "U(J) = (k/2)(J - 1)^2 -->\n",
+            m->kappa_MPa, m->nt > 0 ? "tetrahedron (conifit's body takes J per node)"
+                                    : "cell (the three-field hex8's volume ratio)");
+    fprintf(out, "\t<Material>\n\t\t<material id=\"1\" name=\"volume\" type=\"Mooney-Rivlin\">\n"
+                 "\t\t\t<density>1e-09</density>\n\t\t\t<c1>0</c1>\n\t\t\t<c2>0</c2>\n"
+                 "\t\t\t<k>%.17g</k>\n\t\t\t<pressure_model>2</pressure_model>\n"
+                 "\t\t</material>\n\t</Material>\n",
+            m->kappa_MPa);
+}
+
+/* The volume elements inside Mesh (see febio_volume_material). */
+static void febio_volume_elements(FILE *out, const cf_xmodel *m)
+{
+    if (!(m->kappa_MPa > 0) || (m->nt == 0 && m->ncells == 0))
+        return;
+    static const int order[8] = {0, 1, 3, 2, 4, 5, 7, 6}; /* corner di + 2 dj + 4 dk -> hex8 */
+    const int tet = m->nt > 0;
+    const size_t n = tet ? m->nt : m->ncells;
+    fprintf(out, "\t\t<Elements type=\"%s\" name=\"volume\">\n", tet ? "tet4" : "hex8");
+    for (size_t e = 0; e < n; e++) {
+        fprintf(out, "\t\t\t<elem id=\"%zu\">", e + 1);
+        for (int a = 0; a < (tet ? 4 : 8); a++)
+            fprintf(out, "%s%u", a ? "," : "",
+                    (tet ? m->tet[4 * e + (size_t)a] : m->cell[8 * e + (size_t)order[a]]) + 1);
+        fprintf(out, "</elem>\n");
+    }
+    fprintf(out, "\t\t</Elements>\n");
+}
+
 /* An FEBio 4 model, written in the order of its sections (Module, Control, Mesh with nodes,
 ** node sets and the discrete set, MeshDomains, Boundary, Discrete, LoadData, Output). Long only
 ** because the file is; each section is a few fprintf calls. */
@@ -511,11 +551,13 @@ int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
             "so conifit's compressive reaction above is minus that sum -->\n");
     fprintf(out, "<febio_spec version=\"4.0\">\n\t<Module type=\"solid\"/>\n");
     febio_control(out, m);
+    febio_volume_material(out, m);
     fprintf(out, "\t<Mesh>\n\t\t<Nodes name=\"conifit_nodes\">\n");
     for (size_t i = 0; i < m->nn; i++)
         fprintf(out, "\t\t\t<node id=\"%zu\">%.17g,%.17g,%.17g</node>\n", i + 1, m->X[i], m->Y[i],
                 m->Z[i]);
     fprintf(out, "\t\t</Nodes>\n");
+    febio_volume_elements(out, m);
     for (unsigned mask = 1; mask < 8; mask++) {
         size_t cnt = 0;
         for (size_t i = 0; i < m->nn; i++)
@@ -543,7 +585,11 @@ int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
     /* FEBio 4 builds the mesh (nodes, sets, degrees of freedom) when it reads MeshDomains
     ** (FEBioMeshDomainsSection4::Parse), even an empty one; without it the discrete and node sets
     ** named below are not found. */
-    fprintf(out, "\t</Mesh>\n\t<MeshDomains/>\n\t<Boundary>\n");
+    if (m->kappa_MPa > 0 && (m->nt > 0 || m->ncells > 0))
+        fprintf(out, "\t</Mesh>\n\t<MeshDomains>\n\t\t<SolidDomain name=\"volume\" "
+                     "mat=\"volume\"/>\n\t</MeshDomains>\n\t<Boundary>\n");
+    else
+        fprintf(out, "\t</Mesh>\n\t<MeshDomains/>\n\t<Boundary>\n");
     for (unsigned mask = 1; mask < 8; mask++) {
         size_t cnt = 0;
         for (size_t i = 0; i < m->nn; i++)

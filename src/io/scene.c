@@ -16,6 +16,7 @@
 #include "base/safetext.h"
 #include "conifit/fitfile.h"
 #include "io/fitfile_json.h"
+#include "io/scene_haptic.h"
 
 /* Most cycles and samples a scene may ask for (keeps memory and run time bounded). */
 #define MAX_CYCLES 1000
@@ -818,13 +819,22 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
     return CF_OK;
 }
 
+/* "haptic" (scene_haptic.h): a body's probe path in time. */
+static cf_status haptic_key(ctx *c, json_t *root, cf_scene *sc)
+{
+    json_t *h = json_object_get(root, "haptic");
+    if (h && !sc->has_body)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'haptic' needs a 'body'", c->name);
+    return h ? cf_scene_haptic_parse(h, c->name, sc, c->err) : CF_OK;
+}
+
 static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
 {
     static const char *const allowed[] = {"spring", "spring_extension", "lattice",
                                           "density_t_per_mm3", "protocol", "effects",
                                           "integrator", "law_method", "table_intervals",
                                           "samples_per_segment", "comment", "body", "fixed",
-                                          "probe", NULL};
+                                          "probe", "haptic", NULL};
     cf_status st;
     if (!json_is_object(root))
         return cf_error_set(c->err, CF_E_DATA, "%s: a scene must be a JSON object", c->name);
@@ -853,6 +863,8 @@ static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
                             c->name, sc->has_extension ? "a double-acting element"
                                                        : "the fit's lattice volume term");
     if (bd && (st = body_sections(c, root, bd, sc)))
+        return st;
+    if ((st = haptic_key(c, root, sc)))
         return st;
     if ((st = object(c, root, "lattice", 0, &lt)) || (st = lattice_section(c, lt, sc)))
         return st;
@@ -904,7 +916,9 @@ void cf_scene_free(cf_scene *sc)
     free(sc->path_t_s);
     free(sc->path_v);
     free(sc->sample_t_s);
-    sc->path_t_s = sc->path_v = sc->sample_t_s = NULL;
+    free(sc->haptic_t_ms);
+    free(sc->haptic_depth_mm);
+    sc->path_t_s = sc->path_v = sc->sample_t_s = sc->haptic_t_ms = sc->haptic_depth_mm = NULL;
 }
 
 static cf_status finish(ctx *c, json_t *root, json_error_t *jerr, cf_scene *sc)

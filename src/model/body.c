@@ -1191,11 +1191,19 @@ cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm
     const double fscale = b->E_MPa * b->mean_edge_mm * b->mean_edge_mm;
     int it = 0, contacts = 0;
     double force = 0, r = INFINITY;
+    size_t m = 0;
     for (it = 0; it < max_iters; it++) {
-        /* the contact set where the body is: nodes inside the probe, and nodes of the last set
-        ** still pushed */
-        size_t m = 0;
-        for (size_t i = 0; i < nn; i++) {
+        /* the contact set where the body is at the update's start: nodes inside the probe, and
+        ** nodes of the last set still pushed; held through the update's iterations (a node the
+        ** step leaves just outside a curved probe, by its slip along the surface, would otherwise
+        ** drop out and spring back every other iteration), its normals renewed */
+        for (size_t k = 0; it > 0 && k < m; k++) {
+            penetration(probe, c, b->x + 3 * list[k], nv + 3 * k, 1);
+            for (int a = 0; a < 3; a++)
+                if ((b->fix[list[k]] >> a) & 1)
+                    nv[3 * k + (size_t)a] = 0;
+        }
+        for (size_t i = 0; it == 0 && i < nn; i++) {
             double nrm[3];
             uint8_t in = b->fix[i] != CF_BODY_FIX_ALL &&
                          (penetration(probe, c, b->x + 3 * i, nrm, 0) > 0 ||

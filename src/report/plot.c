@@ -433,3 +433,38 @@ cf_status cf_plot_simulation(const cf_scene *sc, const cf_msm_sample *s, const d
     simulation_figure f = {sc, s, spring_MPa, n};
     return draw(simulation_script, &f, 800, 560, path, inputs, out, err);
 }
+
+typedef struct probe_figure {
+    const char *title, *series, *xlabel;
+    const double *x, *force_N;
+    size_t n;
+} probe_figure;
+
+static void probe_script(cf_gp *g, const void *fig)
+{
+    const probe_figure *f = fig;
+    cf_gp_block_begin(g, "PROBE");
+    for (size_t k = 0; k < f->n; k++) {
+        double row[2] = {f->x[k], f->force_N[k]};
+        cf_gp_block_row(g, 2, row);
+    }
+    cf_gp_block_end(g);
+    cf_gp_cmd(g, "set key below noenhanced spacing 1.2 samplen 3.5");
+    cf_gp_cmd(g, "set bmargin 5");
+    cf_gp_cmd(g, "set grid lc rgb %q", "#d9d9d9");
+    cf_gp_cmd(g, "set format x %q", "%g");
+    cf_gp_cmd(g, "set format y %q", "%g");
+    styles(g);
+    cf_gp_cmd(g, "set title %q noenhanced", f->title);
+    cf_gp_cmd(g, "set xlabel %q", f->xlabel);
+    cf_gp_cmd(g, "set ylabel %q", "probe force (N), pushing into the body");
+    cf_gp_cmd(g, "plot $PROBE using 1:2 with linespoints ls 8 title %q", f->series);
+}
+
+cf_status cf_plot_probe(const char *title, const char *series, const char *xlabel,
+                        const double *x, const double *force_N, size_t n, const char *path,
+                        const char *const *inputs, cf_atomic *out, cf_error *err)
+{
+    probe_figure f = {title, series, xlabel, x, force_N, n};
+    return draw(probe_script, &f, 800, 560, path, inputs, out, err);
+}

@@ -5,7 +5,8 @@
 **   - a fit: the measured points, both conical fits, the baselines and (with --validate) the
 **     lattice curve of each fit on top, the residuals of each model underneath (multiplot);
 **   - a simulation: the lattice's stress-strain curve (with one spring's for comparison), the
-**     load-unload loops, or creep / relaxation against time.
+**     load-unload loops, or creep / relaxation against time;
+**   - a body's probe: its force against depth (or against time in the haptic loop).
 ** A failed plot leaves no file.
 */
 #ifndef CF_PLOT_H
@@ -37,5 +38,13 @@ cf_status cf_plot_fit(const cf_fit_report *r, const char *path,
 cf_status cf_plot_simulation(const cf_scene *sc, const cf_msm_sample *s, const double *spring_MPa,
                              size_t n, const char *path, const char *const *inputs,
                              cf_atomic *out, cf_error *err);
+
+/* Draws a probe's force (N, positive pushing into the body) against x (the depth in mm, or the
+** time in ms of a haptic run: xlabel says which), n points, titled `title` with the curve named
+** `series` (both may hold text from input: they reach gnuplot as string literals only); same
+** outputs and errors as cf_plot_fit. */
+cf_status cf_plot_probe(const char *title, const char *series, const char *xlabel,
+                        const double *x, const double *force_N, size_t n, const char *path,
+                        const char *const *inputs, cf_atomic *out, cf_error *err);
 
 #endif

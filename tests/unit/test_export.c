@@ -1034,8 +1034,9 @@ static void calculix_runs_the_pair_and_volume_lattice_and_matches_simulate(void 
 
 /* Every table of a pair holds both springs: the CSV's rows at u >= 0 on the compression spring's
 ** law and at u < 0 on the extension spring's, within tol of that spring's F_C; the JSON carries
-** params_extension and the volume term back through the fit-file reader; the model formats that
-** cannot carry a volume term refuse the lattice (65, naming the format and why, nothing written),
+** params_extension and the volume term back through the fit-file reader; CalculiX, Abaqus and
+** FEBio write the volume term as hexahedra of a purely volumetric material; the model formats that
+** cannot carry it refuse the lattice (65, naming the format and why, nothing written),
 ** as does the one-spring example of a fit with one; without the volume term every model format
 ** writes the pair's lattice. */
 static void every_export_of_a_pair_holds_both_springs(void **state)
@@ -1105,6 +1106,20 @@ static void every_export_of_a_pair_holds_both_springs(void **state)
             char *x = tu_slurp(p);
             assert_non_null(strstr(x, "*ELEMENT, TYPE=C3D8, ELSET=CELLS"));
             assert_non_null(strstr(x, "*HYPERELASTIC, NEO HOOKE\n0., 4.\n"));
+            free(x);
+        } else if (f == CF_EXPORT_FEBIO) { /* 8 hex8 of U(J) = (k/2)(J - 1)^2, k = kappa */
+            if (rc != 0)
+                fail_msg("%s: exit %d: %s", args, rc, errb);
+            char *x = tu_slurp(p);
+            const char *el = strstr(x, "<Elements type=\"hex8\" name=\"volume\">");
+            assert_non_null(el);
+            assert_non_null(strstr(el, "<elem id=\"8\">"));
+            assert_null(strstr(el, "<elem id=\"9\">"));
+            assert_non_null(strstr(x, "type=\"Mooney-Rivlin\">"));
+            assert_non_null(strstr(x, "<c1>0</c1>"));
+            assert_non_null(strstr(x, "<k>0.5</k>"));
+            assert_non_null(strstr(x, "<pressure_model>2</pressure_model>"));
+            assert_non_null(strstr(x, "<SolidDomain name=\"volume\" mat=\"volume\"/>"));
             free(x);
         } else {
             if (rc != 65 || !strstr(errb, "volume term") || !strstr(errb, fi->name))

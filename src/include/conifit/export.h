@@ -214,15 +214,17 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
                                   const cf_export_options *opt, const cf_export_lattice *lx,
                                   cf_export_report *rep, cf_error *err);
 
-/* Writes the tissue body b (conifit/body.h) as a CalculiX model or a SOFA scene (opt->format
-** calculix or sofa; others CF_E_DATA; sofa only without a volume term, kappa = 0, nu = 0.25, since
-** SOFA's springs cannot express it: the scene holds the springs as the SOFA lattice export writes
-** them and the probe as a PartialLinearMovementProjectiveConstraint): every edge a spring group
-** of its own, rest length L0 and its calibration factor as
+/* Writes the tissue body b (conifit/body.h) as a CalculiX or FEBio 4 model or a SOFA scene
+** (opt->format calculix, febio or sofa; others CF_E_DATA; sofa only without a volume term,
+** kappa = 0, nu = 0.25, since SOFA's springs cannot express it: the scene holds the springs as the
+** SOFA lattice export writes them and the probe as a PartialLinearMovementProjectiveConstraint):
+** every edge a spring group of its own, rest length L0 and its calibration factor as
 ** the weight (the law in strain form times that factor, as the lattice's groups); with a volume
-** term, its tetrahedra as C3D4 of a purely volumetric material (neo-Hookean with C10 = 0 and
-** D1 = 2/kappa: (kappa/2)(J - 1)^2 per unit volume, J per tetrahedron where conifit takes J per
-** node, so the model is stiffer than the body as nu nears 1/2); the held components; the probe, a
+** term, its tetrahedra as elements of a purely volumetric material, (kappa/2)(J - 1)^2 per unit
+** volume (CalculiX: C3D4, neo-Hookean with C10 = 0 and D1 = 2/kappa; FEBio: tet4, Mooney-Rivlin
+** with c1 = c2 = 0, k = kappa and pressure_model 2, U(J) = (k/2)(J - 1)^2), J per tetrahedron
+** where conifit takes J per node, so the model is stiffer than the body as nu nears 1/2; the held
+** components; the probe, a
 ** flat punch moving along +-z whose face starts on nodes of the body, as the prescribed z motion
 ** of the nodes under its face (x and y free: frictionless) to depth_mm[k] at step k, with
 ** conifit's probe force force_N[k] (positive pushing into the body) in the header for comparison.

@@ -52,6 +52,10 @@ typedef struct cf_scene {
     int fixed_axis;             /* fixed.below.axis: 0, 1, 2 (x, y, z) */
     double fixed_value_mm;      /* fixed.below.value_mm */
     cf_probe probe;             /* probe */
+    /* "haptic": the probe's path in time for `simulate --haptic` (src/notes/simulate.md) */
+    size_t haptic_n;            /* vertices of the path (0: no "haptic") */
+    double *haptic_t_ms, *haptic_depth_mm; /* [t_ms, depth_mm], t from 0 strictly increasing */
+    int haptic_iterations;      /* chord iterations per update (cf_body_haptic_step), 1..100 */
 } cf_scene;
 
 /* Most samples a scene may report (segments x samples_per_segment + 1); the memory and steps of
