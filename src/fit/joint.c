@@ -291,7 +291,9 @@ static cf_status joint_run(const cf_table *const *tables, size_t n, const cf_fit
     reach.t = NULL;
     const double xmax = cf_lsq_xmax(&reach);
     /* the search and the placement */
-    c.pair = pair_mode == 1;
+    c.pair = pair_mode >= 1;
+    c.tail = pair_mode == 2; /* the pair's compression spring with a tail */
+    c.need = xmax * (1 + CF_FIT_TRAVEL_MARGIN);
     if (pair_mode >= 0) {
         memcpy(c.weight, lat->cfg.lattice.weight, sizeof c.weight);
         if (plain && !c.fit_weights)
@@ -339,6 +341,10 @@ cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fi
                             const cf_joint_result *plain, cf_joint_result *r, cf_error *err)
 {
     CF_GSL_GUARD;
+    if (pair < 0 || pair > 2)
+        return cf_error_set(err, CF_E_DATA, "pair %d: 0 (single-sided), 1 (double-acting) or 2 "
+                                            "(double-acting, the compression spring tailed)",
+                            pair);
     if (opt->volume == CF_VOLUME_POISSON && pair)
         return cf_error_set(err, CF_E_DATA,
                             "--poisson %g: a double-acting element's lattice has one small-strain "
@@ -354,7 +360,7 @@ cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fi
                                 "an axis and the volume term only raises it (up to 0.5)",
                                 opt->volume_value, nu0);
     }
-    return joint_run(tables, n, opt, lat, type, plain, pair ? 1 : 0, r, err);
+    return joint_run(tables, n, opt, lat, type, plain, pair, r, err);
 }
 
 cf_status cf_joint_fit_tail(const cf_table *const *tables, size_t n, const cf_fit_options *opt,

@@ -15,6 +15,8 @@
 #include "fit/cell_problem.h"
 #include "fit/joint_ctx.h"
 #include "fit/lsq.h"
+#include "fit/tail.h"
+#include "fit/tail_cell.h"
 
 /* BOBYQA's curves per start of the double-acting element's (or the volume term's) search */
 #define PAIR_MAX_EVALS 1500
@@ -23,14 +25,21 @@
 #define STABLE_RESTARTS 3
 #define STABLE_BISECT_SEGMENT 12
 #define STABLE_MAX_EVALS 500
+/* the tailed compression spring's tau (its tail's coils over the cone's): the search's range, and
+** the value held through the starts and the searches kept to stable lattices */
+#define TAU_LO 1e-3
+#define TAU_HI 30.0
+#define TAU_HELD 1.0
 
 /* The pair's and the volume term's search variables, in order: ln rho, s/H of the compression
 ** spring; with the pair ln rho, s/H of the extension spring and ln of its stress scale over the
 ** compression one's; with kappa fitted ln (kappa/(k0/H)); with kappa declared ln of the stress
-** scale (held, kappa over it then known); with fitted weights ln q. */
+** scale (held, kappa over it then known); with fitted weights ln q; with a tailed compression
+** spring ln tau, its tail's coils over the cone's. */
 typedef struct pvars {
     int n;                         /* variables */
-    int ie, ik, iA, iq;            /* index of the extension's first, kappa's, A's, q's; -1 none */
+    int ie, ik, iA, iq, it;        /* index of the extension's first, kappa's, A's, q's, tau's;
+                                   ** -1 none */
     double lb[8], ub[8];
 } pvars;
 
@@ -47,6 +56,8 @@ static void pair_set(jctx *c, const pvars *pv, const double *z)
     }
     if (pv->iq >= 0)
         cf_joint_weights_of(exp(z[pv->iq]), c->weight);
+    if (pv->it >= 0)
+        c->tau = exp(z[pv->it]);
 }
 
 /* 1 when the search's point z (pair_set) has full lattices stable over the uniaxial tables. */
@@ -79,13 +90,16 @@ static double pair_objective(unsigned nz, const double *z, double *grad, void *d
 }
 
 /* The largest compression stress scale at (rho, B) with the extension spring of the context: the
-** smaller of what a spring of the type carries there and what the extension spring carries over
-** its share; 0 where either cannot be placed. */
+** smaller of what a spring of the type (with the context's tail tau, when it has one) carries
+** there and what the extension spring carries over its share; 0 where either cannot be placed. */
 static double pair_A_max(void *ctx, double rho, double B)
 {
     const jctx *c = ctx;
     double Ac, Ae = INFINITY;
-    if (cf_fit_ident_limit(c->opt, c->type, rho, B, &Ac, NULL) > 0)
+    if (c->tail) {
+        if (!((Ac = cf_tail_cell_A_max(rho, B, c->tau, c->need, c->type, c->opt)) > 0))
+            return 0;
+    } else if (cf_fit_ident_limit(c->opt, c->type, rho, B, &Ac, NULL) > 0)
         return 0;
     if (c->pair) {
         if (cf_fit_ident_limit(c->opt, c->type, c->ext[0], c->ext[1], &Ae, NULL) > 0)
@@ -95,13 +109,22 @@ static double pair_A_max(void *ctx, double rho, double B)
     return fmin(Ac, Ae);
 }
 
-/* The seven (at most) quantities v = rho_c, B_c, A_c, rho_e, B_e, A_e, kappa into the context
-** for a curve at stress scale 1 (kappa over A_c). */
-enum { PQ_RC = 0, PQ_BC, PQ_AC, PQ_RE, PQ_BE, PQ_AE, PQ_K, PQ_COUNT };
+/* The eight (at most) quantities v = rho_c, B_c, A_c, rho_e, B_e, A_e, kappa, tau (the
+** compression spring's tail) into the context for a curve at stress scale 1 (kappa over A_c). */
+enum { PQ_RC = 0, PQ_BC, PQ_AC, PQ_RE, PQ_BE, PQ_AE, PQ_K, PQ_T, PQ_COUNT };
+
+/* The compression spring of the quantities v at stress scale 1 (tailed when the context is). */
+static cf_spring compression_member(const jctx *c, const double v[PQ_COUNT])
+{
+    const cf_ident q = {.rho = v[PQ_RC], .solid = v[PQ_BC], .scale = 1.0};
+    return c->tail ? cf_ident_member_tail(&q, v[PQ_T]) : cf_ident_member(&q);
+}
 
 static int pair_residuals(jctx *c, const double v[PQ_COUNT], double *g, double *res)
 {
     c->ext[0] = v[PQ_RE], c->ext[1] = v[PQ_BE], c->ext[2] = v[PQ_AE] / v[PQ_AC];
+    if (c->tail)
+        c->tau = v[PQ_T];
     if (c->opt->volume == CF_VOLUME_POISSON) { /* kappa follows the springs */
         c->kappa_mode = KAPPA_NU;
         c->kappa = c->opt->volume_value;
@@ -264,11 +287,13 @@ static double pair_polish(jctx *c, double v[PQ_COUNT], const int used[PQ_COUNT],
 /* Standard errors of the used quantities (used[k]) from the central-difference Jacobian of the
 ** weighted residuals: s^2 (J^T J)^+ with s^2 = rss/(N - p), the pseudo-inverse over the
 ** eigenvalues of J^T J's unit-diagonal form above 1e-10 of the largest; a quantity with a
-** component in the discarded directions is not determined (se -1). 0, or -1 when memory runs out
-** or a curve fails. */
+** component in the discarded directions is not determined (se -1); *cov_bt the covariance of
+** the compression spring's B and tau when both are determined (NAN otherwise). 0, or -1 when
+** memory runs out or a curve fails. */
 static int pair_errors(jctx *c, const double v0[PQ_COUNT], const int used[PQ_COUNT],
-                       double rss, double se[PQ_COUNT])
+                       double rss, double se[PQ_COUNT], double *cov_bt)
 {
+    *cov_bt = NAN;
     const size_t n = c->pr.n;
     int idx[PQ_COUNT], p = 0;
     for (int k = 0; k < PQ_COUNT; k++) {
@@ -331,6 +356,17 @@ static int pair_errors(jctx *c, const double v0[PQ_COUNT], const int used[PQ_COU
                 if (dsc[a] > 0 && null < 1e-6)
                     se[idx[a]] = sqrt(s2 * var) * dsc[a];
             }
+            for (int a = 0; a < p; a++) /* B_c is idx 1; tau, when used, the last */
+                if (idx[a] == PQ_T && se[PQ_T] >= 0 && se[PQ_BC] >= 0) {
+                    double cv = 0;
+                    for (int b = 0; b < p; b++) {
+                        const double e = gsl_vector_get(ev, (size_t)b);
+                        if (e > 1e-10 * emax)
+                            cv += gsl_matrix_get(V, (size_t)a, (size_t)b) *
+                                  gsl_matrix_get(V, 1, (size_t)b) / e;
+                    }
+                    *cov_bt = s2 * cv * dsc[a] * dsc[1];
+                }
         }
         gsl_eigen_symmv_free(ws);
         gsl_vector_free(ev);
@@ -353,7 +389,8 @@ static void small_strain_moduli(jctx *c, const double v[PQ_COUNT], cf_joint_resu
 {
     const cf_ident qc = {.rho = v[PQ_RC], .solid = v[PQ_BC], .scale = v[PQ_AC]};
     const cf_ident qe = {.rho = v[PQ_RE], .solid = v[PQ_BE], .scale = v[PQ_AE]};
-    const cf_spring pc = cf_ident_member(&qc), pe = cf_ident_member(&qe);
+    const cf_spring pc = c->tail ? cf_ident_member_tail(&qc, v[PQ_T]) : cf_ident_member(&qc),
+                    pe = cf_ident_member(&qe);
     cf_law lc, le;
     cf_cell cell;
     r->E_compression_MPa = r->E_extension_MPa = r->nu_compression = r->nu_extension = NAN;
@@ -402,7 +439,7 @@ static void pair_steps(const pvars *pv, int fine, double step[8])
 static cf_status pair_box(jctx *c, double xmax, pvars *pv, cf_error *err)
 {
     const cf_fit_options *opt = c->opt;
-    *pv = (pvars){.n = 2, .ie = -1, .ik = -1, .iA = -1, .iq = -1};
+    *pv = (pvars){.n = 2, .ie = -1, .ik = -1, .iA = -1, .iq = -1, .it = -1};
     pv->lb[0] = log(fmax(CF_IDENT_RHO_LO, opt->rho_min));
     pv->ub[0] = log(cf_ident_rho_hi(c->type, opt->index_max));
     pv->lb[1] = xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
@@ -432,6 +469,10 @@ static cf_status pair_box(jctx *c, double xmax, pvars *pv, cf_error *err)
         pv->iq = pv->n;
         pv->lb[pv->n] = log(Q_LO), pv->ub[pv->n++] = log(Q_HI);
     }
+    if (c->tail) {
+        pv->it = pv->n;
+        pv->lb[pv->n] = log(TAU_LO), pv->ub[pv->n++] = log(TAU_HI);
+    }
     memcpy(c->pr.lb, pv->lb, sizeof c->pr.lb);
     memcpy(c->pr.ub, pv->ub, sizeof c->pr.ub);
     c->pr.A_max = pair_A_max;
@@ -452,7 +493,7 @@ static cf_status pair_starts(jctx *c, const cf_joint_result *plain, pair_search 
     const double A0 = plain ? plain->ident.scale : 0;
     const double grid_rc[2] = {rc0, 0.1}, grid_re[3] = {0.9, 0.5, 0.15},
                  grid_be[2] = {0.25, 0.7}, grid_k[2] = {0.3, 3.0};
-    const int nre = c->pair ? (plain ? 4 : 3) : 1, nbe = c->pair ? 2 : 1,
+    const int nre = c->pair ? (plain && !c->tail ? 4 : 3) : 1, nbe = c->pair ? 2 : 1,
               nk = pv->ik >= 0 ? 2 : 1;
     s->best = CF_LSQ_HUGE_OBJ;
     memset(s->zb, 0, sizeof s->zb);
@@ -614,9 +655,10 @@ static double pair_quantities(jctx *c, pair_search *s, const int used[PQ_COUNT],
     c->pr.A_fixed = 0;
     memset(v, 0, sizeof(double) * PQ_COUNT);
     v[PQ_RC] = exp(s->zb[0]), v[PQ_BC] = s->zb[1], v[PQ_AC] = *A;
+    if (c->tail)
+        v[PQ_T] = c->tau;
     cf_law lc;
-    const cf_ident qc = {.rho = v[PQ_RC], .solid = v[PQ_BC], .scale = 1.0};
-    const cf_spring pc = cf_ident_member(&qc);
+    const cf_spring pc = compression_member(c, v);
     if (cf_law_init(&lc, &pc, err) != CF_OK)
         return -1;
     v[PQ_K] = *A * cf_joint_curve_kappa(c, &lc);
@@ -630,6 +672,8 @@ static double pair_quantities(jctx *c, pair_search *s, const int used[PQ_COUNT],
     double fp = pair_polish(c, vp, used, box);
     if (stab && fp < best) { /* the polish's point under the search's stability check */
         c->ext[0] = vp[PQ_RE], c->ext[1] = vp[PQ_BE], c->ext[2] = vp[PQ_AE] / vp[PQ_AC];
+        if (c->tail)
+            c->tau = vp[PQ_T];
         if (opt->volume != CF_VOLUME_POISSON)
             c->kappa_mode = KAPPA_UNIT, c->kappa = vp[PQ_K] / vp[PQ_AC];
         if (!cf_joint_stable_at(c, vp[PQ_RC], vp[PQ_BC]))
@@ -639,8 +683,7 @@ static double pair_quantities(jctx *c, pair_search *s, const int used[PQ_COUNT],
         memcpy(v, vp, sizeof vp);
         best = fp;
         *A = v[PQ_AC];
-        const cf_ident qp = {.rho = v[PQ_RC], .solid = v[PQ_BC], .scale = 1.0};
-        const cf_spring pp = cf_ident_member(&qp);
+        const cf_spring pp = compression_member(c, v);
         if (cf_law_init(&lc, &pp, err) != CF_OK)
             return -1;
         if (opt->volume == CF_VOLUME_POISSON) {
@@ -658,7 +701,17 @@ static cf_status pair_place(jctx *c, const cf_table *reach, const double v[PQ_CO
                             cf_joint_result *r, cf_error *err)
 {
     r->ident.rho = v[PQ_RC], r->ident.solid = v[PQ_BC], r->ident.scale = v[PQ_AC];
-    cf_status st = cf_fit_place(reach, c->opt, c->type, &r->ident, &r->fit, err);
+    cf_status st;
+    if (c->tail) { /* the tailed spring in closed form (tail.h); its errors follow the search */
+        const double vt[4] = {v[PQ_RC], v[PQ_BC], v[PQ_AC], v[PQ_T]}, se[4] = {-1, -1, -1, -1};
+        double corr[4][4];
+        for (int a = 0; a < 4; a++)
+            for (int b = 0; b < 4; b++)
+                corr[a][b] = NAN;
+        st = cf_tail_result(reach, c->opt, c->type, vt, se, corr, NAN, &r->fit, err);
+    } else {
+        st = cf_fit_place(reach, c->opt, c->type, &r->ident, &r->fit, err);
+    }
     if (st != CF_OK)
         return st;
     r->fit.ident = r->ident;
@@ -684,7 +737,7 @@ static cf_status pair_nest(jctx *c, const cf_table *reach, const cf_joint_result
 {
     const cf_fit_options *opt = c->opt;
     const pvars *pv = &s->pv;
-    if (!(c->pair && plain && !plain->pair && plain->volume == CF_VOLUME_NONE &&
+    if (!(c->pair && !c->tail && plain && !plain->pair && plain->volume == CF_VOLUME_NONE &&
           opt->volume == CF_VOLUME_NONE && plain->fit.feasible && !r->fit.feasible))
         return CF_OK;
     const double lost = *best, lost_rmse = r->fit.rmse;
@@ -728,13 +781,28 @@ cf_status cf_joint_search_pair(jctx *c, const cf_table *reach, double xmax,
     cf_status st = pair_box(c, xmax, &s.pv, err);
     if (st != CF_OK)
         return st;
+    /* a tailed compression spring: the starts and the searches kept to stable lattices hold tau
+    ** at TAU_HELD (the last variable), the last search frees it. With tau free from the start every
+    ** end drifts to long tails whose lattices buckle, and the searches kept to stable lattices
+    ** then end far above (brain cortex: 0.0183 against 0.0125 with tau held) */
+    const pvars full = s.pv;
+    if (c->tail) {
+        s.pv.n--;
+        s.pv.it = -1;
+        c->tau = TAU_HELD;
+    }
     s.o = (pair_obj){c, &s.pv};
     if ((st = pair_starts(c, plain, &s, err)) != CF_OK ||
         (st = pair_keep_stable(c, &s, err)) != CF_OK)
         return st;
+    if (c->tail) {
+        s.pv = full;
+        s.zb[full.it] = log(TAU_HELD);
+    }
     pair_last_search(c, &s);
     /* the quantities found, polished with the weights held */
-    const int used[PQ_COUNT] = {1, 1, 1, c->pair, c->pair, c->pair, opt->volume == CF_VOLUME_FIT};
+    const int used[PQ_COUNT] = {1,       1,       1, c->pair, c->pair, c->pair,
+                                opt->volume == CF_VOLUME_FIT, c->tail};
     double v[PQ_COUNT], A = 0;
     const int was_fw = c->fit_weights;
     c->fit_weights = 0;
@@ -748,7 +816,7 @@ cf_status cf_joint_search_pair(jctx *c, const cf_table *reach, double xmax,
     r->volume = opt->volume;
     r->volume_modulus_MPa = v[PQ_K];
     r->volume_modulus_se = -1;
-    r->nparams = 3 + (c->pair ? 3 : 0) + (opt->volume == CF_VOLUME_FIT ? 1 : 0);
+    r->nparams = 3 + (c->pair ? 3 : 0) + (opt->volume == CF_VOLUME_FIT ? 1 : 0) + c->tail;
     if ((st = pair_place(c, reach, v, r, err)) != CF_OK ||
         (st = pair_nest(c, reach, plain, &s, v, &best, r, err)) != CF_OK)
         return st;
@@ -758,8 +826,8 @@ cf_status cf_joint_search_pair(jctx *c, const cf_table *reach, double xmax,
     ** of one spring's k0 alone */
     small_strain_moduli(c, v, r);
     /* the errors of every quantity fitted (the weights held) */
-    double se[PQ_COUNT];
-    if (pair_errors(c, v, used, best, se) < 0)
+    double se[PQ_COUNT], cov_bt;
+    if (pair_errors(c, v, used, best, se, &cov_bt) < 0)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the errors of %zu rows",
                             c->pr.n);
     c->fit_weights = was_fw;
@@ -771,5 +839,12 @@ cf_status cf_joint_search_pair(jctx *c, const cf_table *reach, double xmax,
             r->fit.corr[k][m] = r->ext.corr[k][m] = NAN;
     }
     r->volume_modulus_se = opt->volume == CF_VOLUME_FIT ? se[PQ_K] : -1;
+    if (c->tail) { /* e_t = tau B: var = B^2 var(tau) + tau^2 var(B) + 2 tau B cov(B, tau) */
+        const double B = v[PQ_BC], tau = v[PQ_T];
+        const double var = B * B * se[PQ_T] * se[PQ_T] + tau * tau * se[PQ_BC] * se[PQ_BC] +
+                           2 * tau * B * cov_bt;
+        r->fit.e_tail_se = isfinite(cov_bt) ? (var > 0 ? sqrt(var) : 0) : -1;
+        r->fit.e_tail_interval_ok = 0;
+    }
     return CF_OK;
 }

@@ -98,7 +98,7 @@ static cf_status lattice_stable_to(const cf_cell *c, const cf_msm_config *cfg, d
 int cf_joint_stable_at(const jctx *c, double rho, double B)
 {
     const cf_ident q = {.rho = rho, .solid = B, .scale = 1.0};
-    cf_spring p = cf_ident_member(&q);
+    cf_spring p = c->tail ? cf_ident_member_tail(&q, c->tau) : cf_ident_member(&q);
     cf_law law, ext;
     if (cf_law_init(&law, &p, NULL) != CF_OK)
         return 0;
