@@ -90,12 +90,86 @@ static double profile(jctx *c, const double *z, double *A_out)
     return cf_cell_rss(&c->pr, exp(z[0]), z[1], A_out);
 }
 
+/* The conical search's objective; with the context's stab_on a point that would lower the best
+** objective of the current search (stab_best) counts only when its full lattice is stable over
+** the uniaxial tables (cf_joint_stable_at), as in the pair's search. */
 static double objective(unsigned nz, const double *z, double *grad, void *data)
 {
     (void)nz;
     (void)grad;
+    jctx *c = data;
     double A;
-    return profile(data, z, &A);
+    const double f = profile(c, z, &A);
+    if (c->stab_on && f < c->stab_best) {
+        if (!cf_joint_stable_at(c, exp(z[0]), z[1]))
+            return CF_LSQ_HUGE_OBJ;
+        c->stab_best = f;
+    }
+    return f;
+}
+
+/* 1 when the conical law's point z (its weights set by profile) has full lattices stable over the
+** uniaxial tables. */
+static int conical_stable(jctx *c, const double *z)
+{
+    double A;
+    profile(c, z, &A);
+    return cf_joint_stable_at(c, exp(z[0]), z[1]);
+}
+
+/* The searches in stable lattices, when the best point zb (objective *best) buckles: from the
+** stable point nearest it on the segment to each of the (up to CONICAL_STABLE_RESTARTS) best
+** stable ends, BOBYQA under the stability check; the best of them into zb and *best. None stable:
+** zb stays (the verification reports the loss). */
+#define CONICAL_STABLE_RESTARTS 3
+#define CONICAL_STABLE_BISECT 12
+static void conical_keep_stable(jctx *c, int nz, const double *lb, const double *ub,
+                                double ends[][3], double *fends, int nends, double zb[3],
+                                double *best)
+{
+    if (!(*best < CF_LSQ_HUGE_OBJ) || conical_stable(c, zb))
+        return;
+    double sb = CF_LSQ_HUGE_OBJ, zs[3] = {0, 0, 0};
+    for (int tries = 0; tries < CONICAL_STABLE_RESTARTS; tries++) {
+        int pick = -1;
+        for (int i = 0; i < nends; i++)
+            if (fends[i] < CF_LSQ_HUGE_OBJ && (pick < 0 || fends[i] < fends[pick]))
+                pick = i;
+        if (pick < 0)
+            break;
+        fends[pick] = CF_LSQ_HUGE_OBJ; /* tried */
+        if (!conical_stable(c, ends[pick])) {
+            tries--;
+            continue;
+        }
+        double z[3] = {0, 0, 0}, lo = 0, hi = 1, f = CF_LSQ_HUGE_OBJ;
+        for (int b = 0; b < CONICAL_STABLE_BISECT; b++) {
+            const double mid = 0.5 * (lo + hi);
+            for (int j = 0; j < nz; j++)
+                z[j] = zb[j] + mid * (ends[pick][j] - zb[j]);
+            if (conical_stable(c, z))
+                hi = mid;
+            else
+                lo = mid;
+        }
+        for (int j = 0; j < nz; j++)
+            z[j] = zb[j] + hi * (ends[pick][j] - zb[j]);
+        double step[3] = {0.1, 0.05 * (ub[1] - lb[1]), 0.2};
+        c->stab_on = 1;
+        c->stab_best = CF_LSQ_HUGE_OBJ;
+        nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)nz, lb, ub, step,
+                                          XTOL_REL, MAX_EVALS, objective, c, z, &f);
+        c->stab_on = 0;
+        if ((res > 0 || res == NLOPT_ROUNDOFF_LIMITED || res == NLOPT_MAXEVAL_REACHED) &&
+            f < sb && conical_stable(c, z)) {
+            sb = f;
+            memcpy(zs, z, sizeof zs);
+        }
+    }
+    if (sb < CF_LSQ_HUGE_OBJ) {
+        *best = sb;
+        memcpy(zb, zs, sizeof zs);
+    }
 }
 
 int cf_joint_stable(const cf_joint_result *r)
@@ -131,7 +205,9 @@ static cf_status search_conical(jctx *c, const cf_table *reach, double xmax, cf_
                                             "does", xmax);
     memcpy(c->pr.lb, lb, sizeof c->pr.lb);
     memcpy(c->pr.ub, ub, sizeof c->pr.ub);
-    double best = CF_LSQ_HUGE_OBJ, zb[3] = {0, 0, 0};
+    double best = CF_LSQ_HUGE_OBJ, zb[3] = {0, 0, 0}, ends[18][3], fends[18];
+    int nends = 0;
+    c->stab_on = 0;
     const double grid_rho[3] = {0.1, 0.35, 0.7}, grid_e[3] = {0.1, 0.4, 0.8};
     const double q_iso = 0.2708 / 0.6085, grid_q[2] = {q_iso, 1.0};
     for (int gq = 0; gq < (c->fit_weights ? 2 : 1); gq++)
@@ -150,7 +226,18 @@ static cf_status search_conical(jctx *c, const cf_table *reach, double xmax, cf_
                 best = f;
                 memcpy(zb, z, sizeof zb);
             }
+            if ((res > 0 || res == NLOPT_ROUNDOFF_LIMITED || res == NLOPT_MAXEVAL_REACHED) &&
+                f < CF_LSQ_HUGE_OBJ && nends < 18) {
+                memcpy(ends[nends], z, sizeof z);
+                fends[nends++] = f;
+            }
         }
+    /* an optimum whose full lattice buckles inside a uniaxial table's range: the search again,
+    ** kept to stable lattices, as the pair's (joint_pair.c) */
+    conical_keep_stable(c, nz, lb, ub, ends, fends, nends, zb, &best);
+    if (c->pr.oom)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory in the joint fit's optimiser "
+                                                "(NLopt)");
     double A = 0;
     if (!(best < CF_LSQ_HUGE_OBJ) || !(profile(c, zb, &A) < CF_LSQ_HUGE_OBJ) || !(A > 0))
         return cf_error_set(err, CF_E_NOCONV, "the joint fit found no lattice that runs every "

@@ -181,7 +181,8 @@ cf_status cf_joint_verify_tables(const jctx *c, cf_joint_result *r, cf_error *er
                                        jt->lattice_MPa, NULL, err)) != CF_OK)
             break;
         jt->lattice_rmse = cf_lsq_quality_of(t, jt->lattice_MPa).rmse;
-        if (r->pair || r->volume_modulus_MPa != 0) { /* stable over the table's whole range? */
+        { /* stable over the table's whole range? (every law: the odd law's lattice can buckle
+          ** at the cell's scale too) */
             double reach = 0, limit = 0;
             int lost = 1;
             for (size_t i = 0; i < t->count; i++)

@@ -10,8 +10,9 @@
 #include "conifit/joint.h"
 
 /* The tailed law's joint fit beside the conical one in fits[k], and the law kept: --law
-** conical-tail the tail, auto the tail only with a lower joint AIC and a feasible spring, as a
-** single fit chooses (pipeline.c). A tailed fit that ends worse than the conical one or finds
+** conical-tail the tail, auto the tail only with a lower joint AIC, a feasible spring and a
+** lattice stable over every table's range (unless the conical law's is not either), as a single
+** fit chooses (pipeline.c). A tailed fit that ends worse than the conical one or finds
 ** no spring is the conical optimum it contains, with no tail (cf_joint_fit_tail): auto then keeps
 ** the conical law, --law conical-tail reports that optimum. */
 static cf_status choose_law(const cf_table *const *tables, size_t n,
@@ -33,8 +34,11 @@ static cf_status choose_law(const cf_table *const *tables, size_t n,
     if (st != CF_OK)
         return CF_OK; /* auto: the conical law, the report saying no tail was fitted */
     lc->ran = 1;
+    /* auto keeps a tail whose lattice loses stability inside a table's range only when the
+    ** conical law's does too */
     lc->chose_tail = opt->fit.law == CF_FAMILY_TAIL ||
-                     (tail.fit.feasible && tail.aic < r->fits[k].aic);
+                     (tail.fit.feasible && tail.aic < r->fits[k].aic &&
+                      (cf_joint_stable(&tail) || !cf_joint_stable(&r->fits[k])));
     if (lc->chose_tail) {
         lc->other = r->fits[k];
         r->fits[k] = tail;
