@@ -10,8 +10,9 @@
 #include "conifit/joint.h"
 
 /* The tailed law's joint fit beside the conical one in fits[k], and the law kept: --law
-** conical-tail the tail, auto the tail only with a lower joint AIC and a feasible spring, as a
-** single fit chooses (pipeline.c). A tailed fit that ends worse than the conical one or finds
+** conical-tail the tail, auto the tail only with a lower joint AIC, a feasible spring and a
+** lattice stable over every table's range (unless the conical law's is not either), as a single
+** fit chooses (pipeline.c). A tailed fit that ends worse than the conical one or finds
 ** no spring is the conical optimum it contains, with no tail (cf_joint_fit_tail): auto then keeps
 ** the conical law, --law conical-tail reports that optimum. */
 static cf_status choose_law(const cf_table *const *tables, size_t n,
@@ -33,13 +34,66 @@ static cf_status choose_law(const cf_table *const *tables, size_t n,
     if (st != CF_OK)
         return CF_OK; /* auto: the conical law, the report saying no tail was fitted */
     lc->ran = 1;
+    /* auto keeps a tail whose lattice loses stability inside a table's range only when the
+    ** conical law's does too */
     lc->chose_tail = opt->fit.law == CF_KIND_TAIL ||
-                     (tail.fit.feasible && tail.aic < r->fits[k].aic);
+                     (tail.fit.feasible && tail.aic < r->fits[k].aic &&
+                      (cf_joint_stable(&tail) || !cf_joint_stable(&r->fits[k])));
     if (lc->chose_tail) {
         lc->other = r->fits[k];
         r->fits[k] = tail;
     } else {
         lc->other = tail;
+    }
+    return CF_OK;
+}
+
+/* 1 when the pair a ranks above b: a buildable element first, then a lattice stable over every
+** table's range, then the lower joint AIC. */
+static int pair_ranks_above(const cf_joint_result *a, const cf_joint_result *b)
+{
+    if (a->fit.feasible != b->fit.feasible)
+        return a->fit.feasible;
+    if (cf_joint_stable(a) != cf_joint_stable(b))
+        return cf_joint_stable(a);
+    return a->aic < b->aic;
+}
+
+/* The pair with a tailed compression spring fitted from the pair *pair (conical compression
+** spring), and the better kept in *pair (pair_ranks_above), the other summarised in lc. A tailed
+** pair that finds no lattice leaves *pair alone. */
+static cf_status choose_pair_tail(const cf_table *const *tables, size_t n,
+                                  const cf_pipeline_options *opt, const cf_joint_result *plain,
+                                  cf_joint_law_choice *lc, cf_joint_result *pair, cf_error *err)
+{
+    if (opt->progress) {
+        char what[160];
+        snprintf(what, sizeof what, "fitting the %s double-acting element with a tailed "
+                                    "compression spring to %zu tables jointly",
+                 cf_spring_type_name(pair->fit.type), n);
+        opt->progress(opt->progress_ctx, NULL, what);
+    }
+    cf_joint_result tp;
+    cf_error e = {0};
+    cf_status st = cf_joint_fit_pair(tables, n, &opt->fit, &opt->lattice, pair->fit.type, 2,
+                                     plain, &tp, &e);
+    if (st == CF_E_INTERNAL)
+        return cf_error_set(err, st, "%s", e.msg);
+    if (st != CF_OK)
+        return CF_OK;
+    lc->pair_tail_ran = 1;
+    lc->pair_tail_kept = pair_ranks_above(&tp, pair);
+    const cf_joint_result *alt = lc->pair_tail_kept ? pair : &tp;
+    lc->alt_aic = alt->aic;
+    lc->alt_objective = alt->objective;
+    lc->alt_feasible = alt->fit.feasible;
+    lc->alt_stable = cf_joint_stable(alt);
+    lc->alt_nparams = alt->nparams;
+    if (lc->pair_tail_kept) {
+        cf_joint_free(pair);
+        *pair = tp;
+    } else {
+        cf_joint_free(&tp);
     }
     return CF_OK;
 }
@@ -68,6 +122,10 @@ static cf_status choose_pair(const cf_table *const *tables, size_t n,
         return cf_error_set(err, st, "%s", e.msg);
     if (st != CF_OK)
         return CF_OK;
+    if ((st = choose_pair_tail(tables, n, opt, plain, lc, &pair, err)) != CF_OK) {
+        cf_joint_free(&pair);
+        return st;
+    }
     lc->pair_ran = 1;
     /* auto keeps a pair whose lattice loses stability inside a table's range only when the
     ** single-sided law's does too */

@@ -140,7 +140,8 @@ static void pair_choice_text(FILE *o, const cf_joint_report *r)
     if (r->law != CF_KIND_DOUBLE && r->law != CF_KIND_AUTO)
         return;
     fprintf(o, "\nDouble-acting element (--law %s): its own conical spring for extension (6 "
-               "quantities, 7 with a fitted kappa) against the single-sided law kept above\n",
+               "quantities, 7 with a fitted kappa, one more with a tailed compression spring) "
+               "against the single-sided law kept above\n",
             cf_law_kind_name(r->law));
     for (int i = 0; i < r->nfits; i++) {
         const cf_joint_law_choice *lc = &r->law_choice[i];
@@ -179,6 +180,17 @@ static void pair_choice_text(FILE *o, const cf_joint_report *r)
                               : "the pair does not lower the joint AIC";
         fprintf(o, "  %-16s kept: %s (%s)\n", "", lc->chose_pair ? "double-acting" : "single-sided",
                 why);
+        if (lc->pair_tail_ran)
+            fprintf(o, "  %-16s the pair's compression spring %s: %s (the %s one: objective "
+                       "%.4g, joint AIC %.2f, %d quantities%s%s)\n",
+                    "", lc->pair_tail_kept ? "with a tail" : "conical",
+                    lc->pair_tail_kept ? "kept (buildable first, then stable over every "
+                                         "table's range, then the lower joint AIC)"
+                                       : "kept (the tailed one is not buildable, stable or "
+                                         "lower in joint AIC before it)",
+                    lc->pair_tail_kept ? "conical" : "tailed", lc->alt_objective, lc->alt_aic,
+                    lc->alt_nparams, lc->alt_feasible ? "" : ", infeasible",
+                    lc->alt_stable ? "" : ", its lattice loses stability inside a table's range");
     }
 }
 
@@ -479,6 +491,15 @@ static json_t *joint_json(const cf_joint_report *r)
                                                                 : "conical"));
         if (j->pair)
             pair_json(f, j);
+        const cf_joint_law_choice *lc = &r->law_choice[i];
+        if (j->pair && lc->pair_tail_ran) /* the pair's other compression spring */
+            json_object_set_new(
+                f, "pair_alternative",
+                json_pack("{s:s, s:o, s:o, s:i, s:b, s:b}", "compression_law",
+                          lc->pair_tail_kept ? "conical" : "conical-tail", "objective",
+                          num(lc->alt_objective), "aic", num(lc->alt_aic), "quantities",
+                          lc->alt_nparams, "feasible", lc->alt_feasible, "stable",
+                          lc->alt_stable));
         json_object_set_new(f, "aic", num(j->aic));
         if (r->law_choice[i].ran)
             json_object_set_new(f, "law_comparison", law_comparison_json(r, i));

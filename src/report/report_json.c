@@ -55,7 +55,7 @@ json_t *cf_report_tail_json(const cf_fit_result *f)
         json_object_set_new(o, "stderr", num(f->e_tail_se));
     else if (o)
         json_object_set_new(o, "stderr_reason",
-                            json_string("the Jacobian of the four quantities is singular"));
+                            json_string("the Jacobian of the fitted quantities is singular"));
     if (o && f->e_tail_se > fabs(f->e_tail))
         json_object_set_new(o, "determined", json_false());
     if (o && f->e_tail_interval_ok)

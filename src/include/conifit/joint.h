@@ -118,8 +118,11 @@ cf_status cf_joint_fit_tail(const cf_table *const *tables, size_t n, const cf_fi
 ** not determine (the Jacobian's null space). The pair contains plain (two equal springs, no
 ** volume term): plain's optimum is a start, and a pair infeasible where plain is feasible is
 ** plain's optimum as two equal springs (nested_objective what its search ended on). pair 0 fits
-** the odd conical law with the volume
-** term. CF_E_DATA for a declared nu below the springs' own (the term only raises it), and for
+** the odd conical law with the volume term. pair 2 fits the pair with a tailed compression spring
+** (conical-tail, its tau searched too: 7 quantities, 8 with kappa fitted) from plain, the pair's
+** own joint fit (pair 1; CF_E_DATA otherwise), at tau 0.3, 1 and 3; the compression spring placed
+** as the tailed law's (fit.tail 1, e_tail and its error); the extension spring stays conical.
+** CF_E_DATA for a declared nu below the springs' own (the term only raises it), and for
 ** a declared nu with the pair (a bimodular lattice has one small-strain nu per side, none to
 ** declare: declare kappa or fit it). */
 cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fit_options *opt,

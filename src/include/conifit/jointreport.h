@@ -22,6 +22,12 @@ typedef struct cf_joint_law_choice {
     int pair_ran;           /* 1: the double-acting element was fitted too (double-acting, auto) */
     int chose_pair;         /* 1: fits[] holds the pair, pair_other the single-sided law it beat */
     cf_joint_result pair_other; /* the pair when not kept, else the law it displaced (owned) */
+    /* the pair with a tailed compression spring (cf_joint_fit_pair, pair 2) against the pair
+    ** with a conical one: the one kept is the pair above, the other summarised here */
+    int pair_tail_ran;          /* 1: the tailed pair was fitted (from the conical pair) */
+    int pair_tail_kept;         /* 1: the pair above has the tailed compression spring */
+    double alt_aic, alt_objective; /* the pair not kept: its joint AIC and weighted objective */
+    int alt_feasible, alt_stable, alt_nparams;
 } cf_joint_law_choice;
 
 /* One joint fit per spring type over the same tables. */

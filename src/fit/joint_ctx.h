@@ -1,0 +1,75 @@
+/*
+** The joint fit's working state and what its files share (joint.c: the context, the conical and
+** tailed searches, the run and the public calls; joint_pair.c: the double-acting element's and
+** the volume term's search; joint_stable.c: the full lattice's stability and each table's
+** verification). Private to the fit layer: none of these names is in a public header.
+*/
+#ifndef CF_FIT_JOINT_CTX_H
+#define CF_FIT_JOINT_CTX_H
+
+#include <stddef.h>
+
+#include "conifit/cell.h"
+#include "conifit/family.h"
+#include "conifit/joint.h"
+#include "conifit/law.h"
+#include "fit/cell_problem.h"
+
+/* BOBYQA's relative step tolerance (each curve a few tens of microseconds). */
+#define XTOL_REL 1e-7
+/* Diagonal-to-edge weight ratio searched when the weights are fitted. */
+#define Q_LO 0.02
+#define Q_HI 5.0
+/* relative step of the tailed law's errors' central differences, as its single fit through the
+** lattice takes (lattice_tail.c); the pair's errors take it too */
+#define TAIL_FD_STEP 1e-4
+
+typedef struct jctx {
+    const cf_table *const *t;
+    size_t n;
+    const cf_fit_options *opt;
+    const cf_validate_setup *lat;
+    cf_spring_type type;
+    int fit_weights;
+    double weight[CF_FAMILY_COUNT]; /* the fixed weights (or the last tried) */
+    double *sw[CF_JOINT_MAX];       /* per-row residual weights 1/(s_k sqrt n_k) */
+    double *curve[CF_JOINT_MAX];    /* scratch: each table's cell curve at unit scale */
+    cf_cell_problem pr;             /* every table's rows in order, with their weights */
+    int tail;                       /* 1: the conical-tail law's members, their tail tau */
+    double tau;
+    double need;                    /* the largest spring strain with the travel margin */
+    /* the double-acting element and the volume term (cf_joint_fit_pair) */
+    int pair;                       /* 1: every curve's law has the extension spring ext */
+    double ext[3];                  /* its rho, s/H and stress scale over the compression one's */
+    int kappa_mode;                 /* the cell's kappa: KAPPA_* */
+    double kappa;                   /* KAPPA_REL: over the compression spring's k0/H; KAPPA_UNIT:
+                                    ** over its stress scale; KAPPA_NU: the declared nu */
+    /* the pair's search keeps to lattices stable over the uniaxial tables' ranges: a point that
+    ** would lower the best objective of the current start (stab_best) counts only when its full
+    ** lattice is stable there (joint_stable_at); stab_on 0: no such check */
+    int stab_on;
+    double stab_best;
+} jctx;
+
+/* How a curve's volume modulus is set (jctx.kappa_mode): none; kappa/(k0/H) of the compression
+** spring (the fit's search variable); kappa per unit stress scale (a declared kappa over the
+** stress scale held, or the errors' Jacobian); from a declared nu. */
+enum { KAPPA_NONE = 0, KAPPA_REL, KAPPA_UNIT, KAPPA_NU };
+
+/* The cell's volume modulus for a curve whose compression law (at stress scale 1) is law. */
+double cf_joint_curve_kappa(const jctx *c, const cf_law *law);
+/* Family weights of ratio q (face = body = q edge), scaled to the law's small-strain modulus. */
+void cf_joint_weights_of(double q, double w[CF_FAMILY_COUNT]);
+/* Every table's cell curve at stress scale 1 for (rho, B), the tables one after another (the
+** cell problem's curve; ctx a jctx). 0, or 1 where a curve fails. */
+int cf_joint_curve(void *ctx, double rho, double B, double *out);
+/* 1 when the full lattices of the context's law at (rho, B) are stable over every uniaxial
+** table's range at the search's strains (joint_stable.c). */
+int cf_joint_stable_at(const jctx *c, double rho, double B);
+/* Each table in the lattice of the placed spring r->fit (joint_stable.c). */
+cf_status cf_joint_verify_tables(const jctx *c, cf_joint_result *r, cf_error *err);
+/* The double-acting element's (and the volume term's) search (joint_pair.c). */
+cf_status cf_joint_search_pair(jctx *c, const cf_table *reach, double xmax,
+                               const cf_joint_result *plain, cf_joint_result *r, cf_error *err);
+
+#endif

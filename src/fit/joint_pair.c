@@ -1,0 +1,850 @@
+/*
+** The double-acting element's and the volume term's joint search through the cell (joint_ctx.h,
+** cf_joint_fit_pair): BOBYQA from a grid of starts, kept to stable full lattices, polished by
+** Levenberg-Marquardt; both springs placed, the errors of every quantity.
+*/
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_eigen.h>
+#include <nlopt.h>
+
+#include "conifit/cell.h"
+#include "conifit/family.h"
+#include "fit/cell_problem.h"
+#include "fit/joint_ctx.h"
+#include "fit/lsq.h"
+#include "fit/tail.h"
+#include "fit/tail_cell.h"
+
+/* BOBYQA's curves per start of the double-acting element's (or the volume term's) search */
+#define PAIR_MAX_EVALS 1500
+/* the pair's starts (at most), and the searches kept to stable lattices from their ends */
+#define MAX_PAIR_STARTS 32
+#define STABLE_RESTARTS 3
+#define STABLE_BISECT_SEGMENT 12
+#define STABLE_MAX_EVALS 500
+/* the tailed compression spring's tau (its tail's coils over the cone's): the search's range, and
+** the value held through the starts and the searches kept to stable lattices */
+#define TAU_LO 1e-3
+#define TAU_HI 30.0
+#define TAU_HELD 1.0
+
+/* The pair's and the volume term's search variables, in order: ln rho, s/H of the compression
+** spring; with the pair ln rho, s/H of the extension spring and ln of its stress scale over the
+** compression one's; with kappa fitted ln (kappa/(k0/H)); with kappa declared ln of the stress
+** scale (held, kappa over it then known); with fitted weights ln q; with a tailed compression
+** spring ln tau, its tail's coils over the cone's. */
+typedef struct pvars {
+    int n;                         /* variables */
+    int ie, ik, iA, iq, it;        /* index of the extension's first, kappa's, A's, q's, tau's;
+                                   ** -1 none */
+    double lb[8], ub[8];
+} pvars;
+
+/* The quantities the search's z stands for into the context (and the stress scale held, or 0). */
+static void pair_set(jctx *c, const pvars *pv, const double *z)
+{
+    if (pv->ie >= 0)
+        c->ext[0] = exp(z[pv->ie]), c->ext[1] = z[pv->ie + 1], c->ext[2] = exp(z[pv->ie + 2]);
+    if (pv->ik >= 0)
+        c->kappa = exp(z[pv->ik]);
+    if (pv->iA >= 0) {
+        c->pr.A_fixed = exp(z[pv->iA]);
+        c->kappa = c->opt->volume_value / c->pr.A_fixed;
+    }
+    if (pv->iq >= 0)
+        cf_joint_weights_of(exp(z[pv->iq]), c->weight);
+    if (pv->it >= 0)
+        c->tau = exp(z[pv->it]);
+}
+
+/* 1 when the search's point z (pair_set) has full lattices stable over the uniaxial tables. */
+static int z_stable(jctx *c, const pvars *pv, const double *z)
+{
+    pair_set(c, pv, z);
+    return cf_joint_stable_at(c, exp(z[0]), z[1]);
+}
+
+typedef struct pair_obj {
+    jctx *c;
+    const pvars *pv;
+} pair_obj;
+
+static double pair_objective(unsigned nz, const double *z, double *grad, void *data)
+{
+    (void)nz;
+    (void)grad;
+    const pair_obj *o = data;
+    jctx *c = o->c;
+    pair_set(c, o->pv, z);
+    double A;
+    const double f = cf_cell_rss(&c->pr, exp(z[0]), z[1], &A);
+    if (c->stab_on && f < c->stab_best) {
+        if (!cf_joint_stable_at(c, exp(z[0]), z[1]))
+            return CF_LSQ_HUGE_OBJ;
+        c->stab_best = f;
+    }
+    return f;
+}
+
+/* The largest compression stress scale at (rho, B) with the extension spring of the context: the
+** smaller of what a spring of the type (with the context's tail tau, when it has one) carries
+** there and what the extension spring carries over its share; 0 where either cannot be placed. */
+static double pair_A_max(void *ctx, double rho, double B)
+{
+    const jctx *c = ctx;
+    double Ac, Ae = INFINITY;
+    if (c->tail) {
+        if (!((Ac = cf_tail_cell_A_max(rho, B, c->tau, c->need, c->type, c->opt)) > 0))
+            return 0;
+    } else if (cf_fit_ident_limit(c->opt, c->type, rho, B, &Ac, NULL) > 0)
+        return 0;
+    if (c->pair) {
+        if (cf_fit_ident_limit(c->opt, c->type, c->ext[0], c->ext[1], &Ae, NULL) > 0)
+            return 0;
+        Ae /= c->ext[2];
+    }
+    return fmin(Ac, Ae);
+}
+
+/* The eight (at most) quantities v = rho_c, B_c, A_c, rho_e, B_e, A_e, kappa, tau (the
+** compression spring's tail) into the context for a curve at stress scale 1 (kappa over A_c). */
+enum { PQ_RC = 0, PQ_BC, PQ_AC, PQ_RE, PQ_BE, PQ_AE, PQ_K, PQ_T, PQ_COUNT };
+
+/* The compression spring of the quantities v at stress scale 1 (tailed when the context is). */
+static cf_spring compression_member(const jctx *c, const double v[PQ_COUNT])
+{
+    const cf_ident q = {.rho = v[PQ_RC], .solid = v[PQ_BC], .scale = 1.0};
+    return c->tail ? cf_ident_member_tail(&q, v[PQ_T]) : cf_ident_member(&q);
+}
+
+static int pair_residuals(jctx *c, const double v[PQ_COUNT], double *g, double *res)
+{
+    c->ext[0] = v[PQ_RE], c->ext[1] = v[PQ_BE], c->ext[2] = v[PQ_AE] / v[PQ_AC];
+    if (c->tail)
+        c->tau = v[PQ_T];
+    if (c->opt->volume == CF_VOLUME_POISSON) { /* kappa follows the springs */
+        c->kappa_mode = KAPPA_NU;
+        c->kappa = c->opt->volume_value;
+    } else {
+        c->kappa_mode = KAPPA_UNIT;
+        c->kappa = v[PQ_K] / v[PQ_AC];
+    }
+    if (cf_joint_curve(c, v[PQ_RC], v[PQ_BC], g) != 0)
+        return 1;
+    for (size_t i = 0; i < c->pr.n; i++)
+        res[i] = c->pr.sw[i] * (v[PQ_AC] * g[i] - c->pr.y[i]);
+    return 0;
+}
+
+/* 1 when quantity k of v is searched in logarithm (the scales, ratios and kappa), 0 for the solid
+** strains. */
+static int pq_log(int k)
+{
+    return k != PQ_BC && k != PQ_BE;
+}
+
+/* The weighted RSS at v (the residuals into res), CF_LSQ_HUGE_OBJ where a curve fails, a strain
+** leaves [Blo, Bhi], a ratio [rlo, rhi], or the compression spring's scale passes what the pair
+** carries there. */
+static double pair_rss(jctx *c, const double v[PQ_COUNT], const double box[4], double *g,
+                       double *res)
+{
+    if (v[PQ_BC] < box[0] || v[PQ_BC] > box[1] || v[PQ_RC] < box[2] || v[PQ_RC] > box[3])
+        return CF_LSQ_HUGE_OBJ;
+    if (c->pair && (v[PQ_BE] < box[0] || v[PQ_BE] > box[1] || v[PQ_RE] < box[2] ||
+                    v[PQ_RE] > box[3]))
+        return CF_LSQ_HUGE_OBJ;
+    if (pair_residuals(c, v, g, res) != 0)
+        return CF_LSQ_HUGE_OBJ;
+    if (!(v[PQ_AC] <= pair_A_max(c, v[PQ_RC], v[PQ_BC]) * (1 + 1e-12)))
+        return CF_LSQ_HUGE_OBJ;
+    double ss = 0;
+    for (size_t i = 0; i < c->pr.n; i++)
+        ss += res[i] * res[i];
+    return isfinite(ss) ? ss : CF_LSQ_HUGE_OBJ;
+}
+
+/* Levenberg-Marquardt from v over the used quantities (logarithms of the scales and kappa, the
+** strains as they are), central-difference Jacobians, inside the search's box: BOBYQA's optimum
+** polished to where the residuals stop falling (a noiseless table's quantities to ~1e-8). Returns
+** the RSS at v (updated in place). */
+static double pair_polish(jctx *c, double v[PQ_COUNT], const int used[PQ_COUNT],
+                          const double box[4])
+{
+    const size_t n = c->pr.n;
+    int idx[PQ_COUNT], p = 0;
+    for (int k = 0; k < PQ_COUNT; k++)
+        if (used[k] && v[k] > 0)
+            idx[p++] = k;
+    double *g = malloc(sizeof(double) * n), *r0 = malloc(sizeof(double) * n);
+    double *rp = malloc(sizeof(double) * n), *rm = malloc(sizeof(double) * n);
+    double *J = malloc(sizeof(double) * n * (size_t)(p ? p : 1));
+    double f = CF_LSQ_HUGE_OBJ;
+    if (g && r0 && rp && rm && J)
+        f = pair_rss(c, v, box, g, r0);
+    double lambda = 1e-3;
+    for (int it = 0; it < 40 && f < CF_LSQ_HUGE_OBJ && f > 0; it++) {
+        int bad = 0;
+        for (int a = 0; a < p && !bad; a++) {
+            const int k = idx[a];
+            const double h = 1e-6 * (pq_log(k) ? 1.0 : fabs(v[k]));
+            double vp[PQ_COUNT], vm[PQ_COUNT];
+            memcpy(vp, v, sizeof vp);
+            memcpy(vm, v, sizeof vm);
+            vp[k] = pq_log(k) ? v[k] * exp(h) : v[k] + h;
+            vm[k] = pq_log(k) ? v[k] * exp(-h) : v[k] - h;
+            bad = pair_residuals(c, vp, g, rp) != 0 || pair_residuals(c, vm, g, rm) != 0;
+            for (size_t i = 0; i < n && !bad; i++)
+                J[i * (size_t)p + (size_t)a] = (rp[i] - rm[i]) / (2 * h);
+        }
+        c->pr.evals += 2 * p;
+        if (bad)
+            break;
+        double A[PQ_COUNT][PQ_COUNT], b[PQ_COUNT];
+        for (int a = 0; a < p; a++) {
+            b[a] = 0;
+            for (size_t i = 0; i < n; i++)
+                b[a] -= J[i * (size_t)p + (size_t)a] * r0[i];
+            for (int bb = 0; bb < p; bb++) {
+                double d = 0;
+                for (size_t i = 0; i < n; i++)
+                    d += J[i * (size_t)p + (size_t)a] * J[i * (size_t)p + (size_t)bb];
+                A[a][bb] = d;
+            }
+        }
+        int improved = 0;
+        for (int tries = 0; tries < 8 && !improved; tries++) {
+            /* (J^T J + lambda diag) delta = -J^T r by Gaussian elimination with pivoting */
+            double M[PQ_COUNT][PQ_COUNT + 1];
+            for (int a = 0; a < p; a++) {
+                for (int bb = 0; bb < p; bb++)
+                    M[a][bb] = A[a][bb] + (a == bb ? lambda * (A[a][a] > 0 ? A[a][a] : 1) : 0);
+                M[a][p] = b[a];
+            }
+            int singular = 0;
+            for (int col = 0; col < p && !singular; col++) {
+                int piv = col;
+                for (int row = col + 1; row < p; row++)
+                    if (fabs(M[row][col]) > fabs(M[piv][col]))
+                        piv = row;
+                if (!(fabs(M[piv][col]) > 0)) {
+                    singular = 1;
+                    break;
+                }
+                for (int q = 0; q <= p; q++) {
+                    const double t = M[col][q];
+                    M[col][q] = M[piv][q];
+                    M[piv][q] = t;
+                }
+                for (int row = col + 1; row < p; row++) {
+                    const double fct = M[row][col] / M[col][col];
+                    for (int q = col; q <= p; q++)
+                        M[row][q] -= fct * M[col][q];
+                }
+            }
+            double delta[PQ_COUNT];
+            for (int a = p - 1; a >= 0 && !singular; a--) {
+                double t = M[a][p];
+                for (int q = a + 1; q < p; q++)
+                    t -= M[a][q] * delta[q];
+                delta[a] = t / M[a][a];
+            }
+            double vt[PQ_COUNT];
+            memcpy(vt, v, sizeof vt);
+            for (int a = 0; a < p && !singular; a++) {
+                const int k = idx[a];
+                vt[k] = pq_log(k) ? v[k] * exp(fmax(fmin(delta[a], 1.0), -1.0)) : v[k] + delta[a];
+            }
+            const double ft = singular ? CF_LSQ_HUGE_OBJ : pair_rss(c, vt, box, g, rp);
+            c->pr.evals++;
+            if (ft < f) {
+                const double drop = (f - ft) / f;
+                memcpy(v, vt, sizeof vt);
+                memcpy(r0, rp, sizeof(double) * n);
+                f = ft;
+                lambda = fmax(lambda / 10, 1e-12);
+                improved = 1;
+                if (drop < 1e-12)
+                    it = 40; /* converged */
+            } else {
+                lambda *= 10;
+            }
+        }
+        if (!improved)
+            break;
+    }
+    free(g);
+    free(r0);
+    free(rp);
+    free(rm);
+    free(J);
+    return f;
+}
+
+/* Standard errors of the used quantities (used[k]) from the central-difference Jacobian of the
+** weighted residuals: s^2 (J^T J)^+ with s^2 = rss/(N - p), the pseudo-inverse over the
+** eigenvalues of J^T J's unit-diagonal form above 1e-10 of the largest; a quantity with a
+** component in the discarded directions is not determined (se -1); *cov_bt the covariance of
+** the compression spring's B and tau when both are determined (NAN otherwise). 0, or -1 when
+** memory runs out or a curve fails. */
+static int pair_errors(jctx *c, const double v0[PQ_COUNT], const int used[PQ_COUNT],
+                       double rss, double se[PQ_COUNT], double *cov_bt)
+{
+    *cov_bt = NAN;
+    const size_t n = c->pr.n;
+    int idx[PQ_COUNT], p = 0;
+    for (int k = 0; k < PQ_COUNT; k++) {
+        se[k] = -1;
+        if (used[k])
+            idx[p++] = k;
+    }
+    double *J = malloc(sizeof(double) * n * (size_t)p), *g = malloc(sizeof(double) * n);
+    double *rp = malloc(sizeof(double) * n), *rm = malloc(sizeof(double) * n);
+    const int oom = !J || !g || !rp || !rm;
+    int bad = oom;
+    for (int a = 0; a < p && !bad; a++) {
+        double v[PQ_COUNT];
+        memcpy(v, v0, sizeof v);
+        const double h = TAIL_FD_STEP * fabs(v0[idx[a]]);
+        v[idx[a]] = v0[idx[a]] + h;
+        bad = pair_residuals(c, v, g, rp);
+        v[idx[a]] = v0[idx[a]] - h;
+        bad = bad || pair_residuals(c, v, g, rm);
+        for (size_t i = 0; i < n && !bad; i++)
+            J[i * (size_t)p + (size_t)a] = (rp[i] - rm[i]) / (2 * h);
+    }
+    c->pr.evals += 2 * p;
+    if (!bad && (size_t)p < n) {
+        gsl_matrix *M = gsl_matrix_alloc((size_t)p, (size_t)p);
+        gsl_matrix *V = gsl_matrix_alloc((size_t)p, (size_t)p);
+        gsl_vector *ev = gsl_vector_alloc((size_t)p);
+        gsl_eigen_symmv_workspace *ws = gsl_eigen_symmv_alloc((size_t)p);
+        double dsc[PQ_COUNT];
+        const int oom2 = !M || !V || !ev || !ws;
+        bad = oom2;
+        for (int a = 0; a < p && !bad; a++) {
+            double d = 0;
+            for (size_t i = 0; i < n; i++)
+                d += J[i * (size_t)p + (size_t)a] * J[i * (size_t)p + (size_t)a];
+            dsc[a] = d > 0 ? 1 / sqrt(d) : 0;
+        }
+        for (int a = 0; a < p && !bad; a++)
+            for (int b = 0; b < p; b++) {
+                double d = 0;
+                for (size_t i = 0; i < n; i++)
+                    d += J[i * (size_t)p + (size_t)a] * J[i * (size_t)p + (size_t)b];
+                gsl_matrix_set(M, (size_t)a, (size_t)b, d * dsc[a] * dsc[b]);
+            }
+        if (!bad && gsl_eigen_symmv(M, ev, V, ws) == GSL_SUCCESS) {
+            double emax = 0;
+            for (int a = 0; a < p; a++)
+                emax = fmax(emax, gsl_vector_get(ev, (size_t)a));
+            const double s2 = rss / (double)((int)n - p);
+            for (int a = 0; a < p; a++) {
+                double var = 0, null = 0;
+                for (int b = 0; b < p; b++) {
+                    const double e = gsl_vector_get(ev, (size_t)b), x = gsl_matrix_get(V, (size_t)a,
+                                                                                     (size_t)b);
+                    if (e > 1e-10 * emax)
+                        var += x * x / e;
+                    else
+                        null += x * x;
+                }
+                if (dsc[a] > 0 && null < 1e-6)
+                    se[idx[a]] = sqrt(s2 * var) * dsc[a];
+            }
+            for (int a = 0; a < p; a++) /* B_c is idx 1; tau, when used, the last */
+                if (idx[a] == PQ_T && se[PQ_T] >= 0 && se[PQ_BC] >= 0) {
+                    double cv = 0;
+                    for (int b = 0; b < p; b++) {
+                        const double e = gsl_vector_get(ev, (size_t)b);
+                        if (e > 1e-10 * emax)
+                            cv += gsl_matrix_get(V, (size_t)a, (size_t)b) *
+                                  gsl_matrix_get(V, 1, (size_t)b) / e;
+                    }
+                    *cov_bt = s2 * cv * dsc[a] * dsc[1];
+                }
+        }
+        gsl_eigen_symmv_free(ws);
+        gsl_vector_free(ev);
+        gsl_matrix_free(V);
+        gsl_matrix_free(M);
+        if (oom2)
+            bad = -1;
+    }
+    free(J);
+    free(g);
+    free(rp);
+    free(rm);
+    return oom || bad < 0 ? -1 : bad; /* a curve that failed: every error stays -1 */
+}
+
+/* The lattice's small-strain Young's modulus and Poisson's ratio in uniaxial compression and in
+** tension (strain -+1e-6, every spring inside its linear region) from the cell of the quantities
+** v; NAN where the cell fails. */
+static void small_strain_moduli(jctx *c, const double v[PQ_COUNT], cf_joint_result *r)
+{
+    const cf_ident qc = {.rho = v[PQ_RC], .solid = v[PQ_BC], .scale = v[PQ_AC]};
+    const cf_ident qe = {.rho = v[PQ_RE], .solid = v[PQ_BE], .scale = v[PQ_AE]};
+    const cf_spring pc = c->tail ? cf_ident_member_tail(&qc, v[PQ_T]) : cf_ident_member(&qc),
+                    pe = cf_ident_member(&qe);
+    cf_law lc, le;
+    cf_cell cell;
+    r->E_compression_MPa = r->E_extension_MPa = r->nu_compression = r->nu_extension = NAN;
+    if (cf_law_init(&lc, &pc, NULL) != CF_OK ||
+        (c->pair && (cf_law_init(&le, &pe, NULL) != CF_OK || cf_law_pair(&lc, &le, NULL) != CF_OK)) ||
+        cf_cell_init(&cell, &lc, CF_LAW_CLOSED, c->weight, NULL) != CF_OK)
+        return;
+    cell.volume_modulus_MPa = v[PQ_K];
+    for (int side = 0; side < 2; side++) {
+        const double e = side ? 1e-6 : -1e-6;
+        cf_cell_state s;
+        if (cf_cell_mode(&cell, CF_MODE_UNIAXIAL, e, NULL, &s, NULL) != CF_OK)
+            continue;
+        *(side ? &r->E_extension_MPa : &r->E_compression_MPa) = s.stress_MPa / e;
+        *(side ? &r->nu_extension : &r->nu_compression) = (1 - s.free_stretch) / e;
+    }
+}
+
+/* The search's state between its steps: the variables, the objective's data, the best point and
+** the starts' ends (for the searches kept to stable lattices). */
+typedef struct pair_search {
+    pvars pv;
+    pair_obj o;
+    double best, zb[8];
+    double ends[MAX_PAIR_STARTS][8], fends[MAX_PAIR_STARTS];
+    int nends;
+} pair_search;
+
+/* 1 when BOBYQA's end res is a point to keep (converged, or out of curves). */
+static int search_ended(nlopt_result res)
+{
+    return res > 0 || res == NLOPT_ROUNDOFF_LIMITED || res == NLOPT_MAXEVAL_REACHED;
+}
+
+/* BOBYQA's initial steps: a twentieth of the solid strains' range (fine: a hundredth), 0.2 in the
+** logarithms (fine: 0.05). */
+static void pair_steps(const pvars *pv, int fine, double step[8])
+{
+    for (int j = 0; j < pv->n; j++)
+        step[j] = j == 1 || j == pv->ie + 1 ? (fine ? 0.01 : 0.05) * (pv->ub[j] - pv->lb[j])
+                                            : (fine ? 0.05 : 0.2);
+}
+
+/* Step 1: the search's variables and their box (pvars) into the context's problem; the volume
+** term's mode. */
+static cf_status pair_box(jctx *c, double xmax, pvars *pv, cf_error *err)
+{
+    const cf_fit_options *opt = c->opt;
+    *pv = (pvars){.n = 2, .ie = -1, .ik = -1, .iA = -1, .iq = -1, .it = -1};
+    pv->lb[0] = log(fmax(CF_IDENT_RHO_LO, opt->rho_min));
+    pv->ub[0] = log(cf_ident_rho_hi(c->type, opt->index_max));
+    pv->lb[1] = xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
+    pv->ub[1] = 1 - 1e-9;
+    if (!(pv->lb[1] < pv->ub[1]))
+        return cf_error_set(err, CF_E_DATA, "the springs must reach a strain of %g: no spring "
+                                            "does", xmax);
+    if (c->pair) {
+        pv->ie = pv->n;
+        pv->lb[pv->n] = pv->lb[0], pv->ub[pv->n++] = pv->ub[0];
+        pv->lb[pv->n] = pv->lb[1], pv->ub[pv->n++] = pv->ub[1];
+        pv->lb[pv->n] = log(1e-4), pv->ub[pv->n++] = log(1e4);
+    }
+    if (opt->volume == CF_VOLUME_FIT) {
+        pv->ik = pv->n;
+        pv->lb[pv->n] = log(1e-5), pv->ub[pv->n++] = log(1e4);
+        c->kappa_mode = KAPPA_REL;
+    } else if (opt->volume == CF_VOLUME_MODULUS) {
+        pv->iA = pv->n;
+        pv->lb[pv->n] = log(1e-12), pv->ub[pv->n++] = log(CF_MEASURE_MAX_VALUE);
+        c->kappa_mode = KAPPA_UNIT;
+    } else if (opt->volume == CF_VOLUME_POISSON) {
+        c->kappa_mode = KAPPA_NU;
+        c->kappa = opt->volume_value;
+    }
+    if (c->fit_weights) {
+        pv->iq = pv->n;
+        pv->lb[pv->n] = log(Q_LO), pv->ub[pv->n++] = log(Q_HI);
+    }
+    if (c->tail) {
+        pv->it = pv->n;
+        pv->lb[pv->n] = log(TAU_LO), pv->ub[pv->n++] = log(TAU_HI);
+    }
+    memcpy(c->pr.lb, pv->lb, sizeof c->pr.lb);
+    memcpy(c->pr.ub, pv->ub, sizeof c->pr.ub);
+    c->pr.A_max = pair_A_max;
+    return CF_OK;
+}
+
+/* Step 2: BOBYQA from every start, the best end into s->best and s->zb and every end kept. The
+** starts: the compression spring at plain's quantities (or the middle of the box) and on a coarse
+** grid; the extension spring from a near-cylinder (linear) to a strong cone. The pair contains
+** the single-sided law (two equal springs): with plain, its optimum is a start too (ge 3), so the
+** pair never ends worse than the law it contains. */
+static cf_status pair_starts(jctx *c, const cf_joint_result *plain, pair_search *s,
+                             cf_error *err)
+{
+    const pvars *pv = &s->pv;
+    const double rc0 = plain ? plain->ident.rho : 0.35;
+    const double bc0 = plain ? plain->ident.solid : pv->lb[1] + 0.4 * (pv->ub[1] - pv->lb[1]);
+    const double A0 = plain ? plain->ident.scale : 0;
+    const double grid_rc[2] = {rc0, 0.1}, grid_re[3] = {0.9, 0.5, 0.15},
+                 grid_be[2] = {0.25, 0.7}, grid_k[2] = {0.3, 3.0};
+    const int nre = c->pair ? (plain && !c->tail ? 4 : 3) : 1, nbe = c->pair ? 2 : 1,
+              nk = pv->ik >= 0 ? 2 : 1;
+    s->best = CF_LSQ_HUGE_OBJ;
+    memset(s->zb, 0, sizeof s->zb);
+    s->nends = 0;
+    c->stab_on = 0;
+    for (int gc = 0; gc < 2; gc++)
+        for (int ge = 0; ge < nre; ge++)
+            for (int gb = 0; gb < nbe; gb++)
+                for (int gk = 0; gk < nk; gk++) {
+                    double z[8];
+                    if (ge == 3 && (gc != 0 || gb != 0))
+                        continue;
+                    z[0] = log(grid_rc[gc]);
+                    z[1] = gc == 0 ? bc0 : pv->lb[1] + 0.3 * (pv->ub[1] - pv->lb[1]);
+                    if (pv->ie >= 0 && ge == 3) {
+                        z[pv->ie] = z[0], z[pv->ie + 1] = z[1], z[pv->ie + 2] = 0;
+                    } else if (pv->ie >= 0) {
+                        z[pv->ie] = log(grid_re[ge]);
+                        z[pv->ie + 1] = pv->lb[1] + grid_be[gb] * (pv->ub[1] - pv->lb[1]);
+                        z[pv->ie + 2] = log(0.5);
+                    }
+                    if (pv->ik >= 0)
+                        z[pv->ik] = log(grid_k[gk]);
+                    if (pv->iA >= 0)
+                        z[pv->iA] = log(A0 > 0 ? A0 : 1e-3);
+                    if (pv->iq >= 0)
+                        z[pv->iq] = log(plain ? plain->weight[1] / plain->weight[0]
+                                              : 0.2708 / 0.6085);
+                    double step[8];
+                    for (int j = 0; j < pv->n; j++)
+                        z[j] = fmin(fmax(z[j], pv->lb[j]), pv->ub[j]);
+                    pair_steps(pv, 0, step);
+                    double f = CF_LSQ_HUGE_OBJ;
+                    if (ge == 3) {
+                        /* BOBYQA may move a start near a bound before its first evaluation:
+                        ** the contained law's optimum counts as it is */
+                        const double f0 =
+                            pair_objective((unsigned)pv->n, z, NULL, (void *)&s->o);
+                        if (f0 < s->best) {
+                            s->best = f0;
+                            memcpy(s->zb, z, sizeof s->zb);
+                        }
+                    }
+                    nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)pv->n,
+                                                      pv->lb, pv->ub, step, XTOL_REL,
+                                                      PAIR_MAX_EVALS, pair_objective,
+                                                      (void *)&s->o, z, &f);
+                    if (c->pr.oom)
+                        return cf_error_set(err, CF_E_INTERNAL, "out of memory in the joint "
+                                                                "fit's optimiser (NLopt)");
+                    const int ok = search_ended(res);
+                    if (ok && f < CF_LSQ_HUGE_OBJ && s->nends < MAX_PAIR_STARTS) {
+                        memcpy(s->ends[s->nends], z, sizeof z);
+                        s->fends[s->nends++] = f;
+                    }
+                    if (ok && f < s->best) {
+                        s->best = f;
+                        memcpy(s->zb, z, sizeof s->zb);
+                    }
+                }
+    return CF_OK;
+}
+
+/* Step 3: an optimum whose full lattice buckles inside a uniaxial table's range: the search again,
+** kept to stable lattices, from the stable point nearest the optimum on the segment to each of
+** the best (up to STABLE_RESTARTS) starts' ends that are stable. None stable: the optimum stays,
+** and the verification reports the loss. c->stab_on says afterwards whether the search kept to
+** stable lattices. */
+static cf_status pair_keep_stable(jctx *c, pair_search *s, cf_error *err)
+{
+    const pvars *pv = &s->pv;
+    if (!(s->best < CF_LSQ_HUGE_OBJ) || z_stable(c, pv, s->zb))
+        return CF_OK;
+    double sb = CF_LSQ_HUGE_OBJ, zs[8] = {0};
+    for (int tries = 0; tries < STABLE_RESTARTS; tries++) {
+        int pick = -1;
+        for (int i = 0; i < s->nends; i++)
+            if (s->fends[i] < CF_LSQ_HUGE_OBJ && (pick < 0 || s->fends[i] < s->fends[pick]))
+                pick = i;
+        if (pick < 0)
+            break;
+        s->fends[pick] = CF_LSQ_HUGE_OBJ; /* tried */
+        if (!z_stable(c, pv, s->ends[pick])) {
+            tries--;
+            continue;
+        }
+        /* from the stable point nearest the optimum on the segment to this end */
+        double z[8], step[8], f = CF_LSQ_HUGE_OBJ, lo = 0, hi = 1;
+        for (int b = 0; b < STABLE_BISECT_SEGMENT; b++) {
+            const double mid = 0.5 * (lo + hi);
+            for (int j = 0; j < pv->n; j++)
+                z[j] = s->zb[j] + mid * (s->ends[pick][j] - s->zb[j]);
+            if (z_stable(c, pv, z))
+                hi = mid;
+            else
+                lo = mid;
+        }
+        for (int j = 0; j < pv->n; j++)
+            z[j] = s->zb[j] + hi * (s->ends[pick][j] - s->zb[j]);
+        pair_steps(pv, 0, step);
+        c->stab_on = 1;
+        c->stab_best = CF_LSQ_HUGE_OBJ;
+        nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)pv->n, pv->lb,
+                                          pv->ub, step, XTOL_REL, STABLE_MAX_EVALS,
+                                          pair_objective, (void *)&s->o, z, &f);
+        if (c->pr.oom)
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory in the joint fit's "
+                                                    "optimiser (NLopt)");
+        if (search_ended(res) && f < sb) {
+            sb = f;
+            memcpy(zs, z, sizeof zs);
+        }
+    }
+    c->stab_on = sb < CF_LSQ_HUGE_OBJ;
+    if (c->stab_on) {
+        s->best = sb;
+        memcpy(s->zb, zs, sizeof s->zb);
+    }
+    return CF_OK;
+}
+
+/* Step 4: a last, finer BOBYQA from the best point (under the stability check when step 3 kept
+** to stable lattices). */
+static void pair_last_search(jctx *c, pair_search *s)
+{
+    const pvars *pv = &s->pv;
+    if (!(s->best < CF_LSQ_HUGE_OBJ))
+        return;
+    double z[8], f = CF_LSQ_HUGE_OBJ, step[8];
+    memcpy(z, s->zb, sizeof z);
+    pair_steps(pv, 1, step);
+    c->stab_best = CF_LSQ_HUGE_OBJ;
+    nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)pv->n, pv->lb, pv->ub,
+                                      step, XTOL_REL * 1e-2, PAIR_MAX_EVALS, pair_objective,
+                                      (void *)&s->o, z, &f);
+    if (search_ended(res) && f < s->best) {
+        s->best = f;
+        memcpy(s->zb, z, sizeof s->zb);
+    }
+}
+
+/* Step 5: the quantities of the search's best point into v (*A the compression stress scale),
+** then Levenberg-Marquardt from them over the used quantities, the weights held, its point kept
+** when lower (and, after a search kept to stable lattices, stable). Returns the RSS of v,
+** CF_LSQ_HUGE_OBJ when the best point runs no table. */
+static double pair_quantities(jctx *c, pair_search *s, const int used[PQ_COUNT],
+                              double v[PQ_COUNT], double *A, cf_error *err)
+{
+    const cf_fit_options *opt = c->opt;
+    const pvars *pv = &s->pv;
+    c->stab_best = CF_LSQ_HUGE_OBJ;
+    if (!(s->best < CF_LSQ_HUGE_OBJ) ||
+        !(pair_objective((unsigned)pv->n, s->zb, NULL, (void *)&s->o) < CF_LSQ_HUGE_OBJ)) {
+        cf_error_set(err, CF_E_NOCONV, "the joint fit found no %s that runs every table",
+                     c->pair ? "double-acting element" : "lattice with a volume term");
+        return CF_LSQ_HUGE_OBJ;
+    }
+    double best = cf_cell_rss(&c->pr, exp(s->zb[0]), s->zb[1], A);
+    c->pr.A_fixed = 0;
+    memset(v, 0, sizeof(double) * PQ_COUNT);
+    v[PQ_RC] = exp(s->zb[0]), v[PQ_BC] = s->zb[1], v[PQ_AC] = *A;
+    if (c->tail)
+        v[PQ_T] = c->tau;
+    cf_law lc;
+    const cf_spring pc = compression_member(c, v);
+    if (cf_law_init(&lc, &pc, err) != CF_OK)
+        return -1;
+    v[PQ_K] = *A * cf_joint_curve_kappa(c, &lc);
+    if (c->pair)
+        v[PQ_RE] = c->ext[0], v[PQ_BE] = c->ext[1], v[PQ_AE] = *A * c->ext[2];
+    const double box[4] = {pv->lb[1], pv->ub[1], exp(pv->lb[0]), exp(pv->ub[0])};
+    double vp[PQ_COUNT];
+    memcpy(vp, v, sizeof vp);
+    const int stab = c->stab_on;
+    c->stab_on = 0;
+    double fp = pair_polish(c, vp, used, box);
+    if (stab && fp < best) { /* the polish's point under the search's stability check */
+        c->ext[0] = vp[PQ_RE], c->ext[1] = vp[PQ_BE], c->ext[2] = vp[PQ_AE] / vp[PQ_AC];
+        if (c->tail)
+            c->tau = vp[PQ_T];
+        if (opt->volume != CF_VOLUME_POISSON)
+            c->kappa_mode = KAPPA_UNIT, c->kappa = vp[PQ_K] / vp[PQ_AC];
+        if (!cf_joint_stable_at(c, vp[PQ_RC], vp[PQ_BC]))
+            fp = CF_LSQ_HUGE_OBJ;
+    }
+    if (fp < best) {
+        memcpy(v, vp, sizeof vp);
+        best = fp;
+        *A = v[PQ_AC];
+        const cf_spring pp = compression_member(c, v);
+        if (cf_law_init(&lc, &pp, err) != CF_OK)
+            return -1;
+        if (opt->volume == CF_VOLUME_POISSON) {
+            c->kappa_mode = KAPPA_NU;
+            c->kappa = opt->volume_value;
+            v[PQ_K] = *A * cf_joint_curve_kappa(c, &lc);
+        }
+    }
+    return best;
+}
+
+/* Step 6: both springs of the quantities v placed (the extension spring at the compression
+** spring's H); the element is buildable when both are (fit.feasible says it for the pair). */
+static cf_status pair_place(jctx *c, const cf_table *reach, const double v[PQ_COUNT],
+                            cf_joint_result *r, cf_error *err)
+{
+    r->ident.rho = v[PQ_RC], r->ident.solid = v[PQ_BC], r->ident.scale = v[PQ_AC];
+    cf_status st;
+    if (c->tail) { /* the tailed spring in closed form (tail.h); its errors follow the search */
+        const double vt[4] = {v[PQ_RC], v[PQ_BC], v[PQ_AC], v[PQ_T]}, se[4] = {-1, -1, -1, -1};
+        double corr[4][4];
+        for (int a = 0; a < 4; a++)
+            for (int b = 0; b < 4; b++)
+                corr[a][b] = NAN;
+        st = cf_tail_result(reach, c->opt, c->type, vt, se, corr, NAN, &r->fit, err);
+    } else {
+        st = cf_fit_place(reach, c->opt, c->type, &r->ident, &r->fit, err);
+    }
+    if (st != CF_OK)
+        return st;
+    r->fit.ident = r->ident;
+    if (c->pair) {
+        cf_fit_options oe = *c->opt;
+        oe.fixed[CF_P_H] = 1;
+        oe.fixed_value[CF_P_H] = r->fit.params.H_mm;
+        const cf_ident qe = {.rho = v[PQ_RE], .solid = v[PQ_BE], .scale = v[PQ_AE]};
+        if ((st = cf_fit_place(reach, &oe, c->type, &qe, &r->ext, err)) != CF_OK)
+            return st;
+        r->ext.ident = qe;
+        r->fit.feasible = r->fit.feasible && r->ext.feasible;
+    }
+    return CF_OK;
+}
+
+/* Step 7: the pair contains the single-sided law plain (two equal springs): a pair infeasible
+** where plain is feasible is plain's optimum as two equal springs, what its search ended on kept
+** in nested_objective and fit.nested_* (issue 37). v and *best follow. */
+static cf_status pair_nest(jctx *c, const cf_table *reach, const cf_joint_result *plain,
+                           pair_search *s, double v[PQ_COUNT], double *best, cf_joint_result *r,
+                           cf_error *err)
+{
+    const cf_fit_options *opt = c->opt;
+    const pvars *pv = &s->pv;
+    if (!(c->pair && !c->tail && plain && !plain->pair && plain->volume == CF_VOLUME_NONE &&
+          opt->volume == CF_VOLUME_NONE && plain->fit.feasible && !r->fit.feasible))
+        return CF_OK;
+    const double lost = *best, lost_rmse = r->fit.rmse;
+    const unsigned lost_bits = r->fit.violated | r->ext.violated;
+    double zq[8] = {log(plain->ident.rho), plain->ident.solid, 0}, A = 0;
+    zq[pv->ie] = zq[0], zq[pv->ie + 1] = zq[1], zq[pv->ie + 2] = 0;
+    if (pv->iq >= 0)
+        zq[pv->iq] = log(plain->weight[1] / plain->weight[0]);
+    pair_set(c, pv, zq);
+    *best = cf_cell_rss(&c->pr, plain->ident.rho, plain->ident.solid, &A);
+    const double vq[PQ_COUNT] = {plain->ident.rho, plain->ident.solid, A, plain->ident.rho,
+                                 plain->ident.solid, A, 0};
+    memcpy(v, vq, sizeof vq);
+    r->objective = *best;
+    r->ident.rho = v[PQ_RC], r->ident.solid = v[PQ_BC], r->ident.scale = A;
+    cf_status st = cf_fit_place(reach, opt, c->type, &r->ident, &r->fit, err);
+    if (st != CF_OK)
+        return st;
+    r->fit.ident = r->ident;
+    cf_fit_options oe = *opt;
+    oe.fixed[CF_P_H] = 1;
+    oe.fixed_value[CF_P_H] = r->fit.params.H_mm;
+    if ((st = cf_fit_place(reach, &oe, c->type, &r->ident, &r->ext, err)) != CF_OK)
+        return st;
+    r->ext.ident = r->ident;
+    r->fit.feasible = r->fit.feasible && r->ext.feasible;
+    r->nested_objective = lost;
+    r->fit.nested_rmse = lost_rmse;
+    r->fit.nested_violated = lost_bits;
+    return CF_OK;
+}
+
+/* The double-acting element's (and the volume term's) search from plain's quantities and a grid,
+** every table through the cell, step after step; both springs placed; the errors of every
+** quantity. */
+cf_status cf_joint_search_pair(jctx *c, const cf_table *reach, double xmax,
+                               const cf_joint_result *plain, cf_joint_result *r, cf_error *err)
+{
+    const cf_fit_options *opt = c->opt;
+    pair_search s;
+    cf_status st = pair_box(c, xmax, &s.pv, err);
+    if (st != CF_OK)
+        return st;
+    /* a tailed compression spring: the starts and the searches kept to stable lattices hold tau
+    ** at TAU_HELD (the last variable), the last search frees it. With tau free from the start every
+    ** end drifts to long tails whose lattices buckle, and the searches kept to stable lattices
+    ** then end far above (brain cortex: 0.0183 against 0.0125 with tau held) */
+    const pvars full = s.pv;
+    if (c->tail) {
+        s.pv.n--;
+        s.pv.it = -1;
+        c->tau = TAU_HELD;
+    }
+    s.o = (pair_obj){c, &s.pv};
+    if ((st = pair_starts(c, plain, &s, err)) != CF_OK ||
+        (st = pair_keep_stable(c, &s, err)) != CF_OK)
+        return st;
+    if (c->tail) {
+        s.pv = full;
+        s.zb[full.it] = log(TAU_HELD);
+    }
+    pair_last_search(c, &s);
+    /* the quantities found, polished with the weights held */
+    const int used[PQ_COUNT] = {1,       1,       1, c->pair, c->pair, c->pair,
+                                opt->volume == CF_VOLUME_FIT, c->tail};
+    double v[PQ_COUNT], A = 0;
+    const int was_fw = c->fit_weights;
+    c->fit_weights = 0;
+    double best = pair_quantities(c, &s, used, v, &A, err);
+    if (best < 0)
+        return CF_E_INTERNAL;
+    if (!(best < CF_LSQ_HUGE_OBJ))
+        return CF_E_NOCONV;
+    r->objective = best;
+    r->pair = c->pair;
+    r->volume = opt->volume;
+    r->volume_modulus_MPa = v[PQ_K];
+    r->volume_modulus_se = -1;
+    r->nparams = 3 + (c->pair ? 3 : 0) + (opt->volume == CF_VOLUME_FIT ? 1 : 0) + c->tail;
+    if ((st = pair_place(c, reach, v, r, err)) != CF_OK ||
+        (st = pair_nest(c, reach, plain, &s, v, &best, r, err)) != CF_OK)
+        return st;
+    /* the small-strain moduli each side, from the cell of the quantities found: a bimodular
+    ** lattice's uniaxial compression loads its axial springs' compression sides and its lateral
+    ** springs' extension sides (and the reverse in tension), so neither side's E and nu is that
+    ** of one spring's k0 alone */
+    small_strain_moduli(c, v, r);
+    /* the errors of every quantity fitted (the weights held) */
+    double se[PQ_COUNT], cov_bt;
+    if (pair_errors(c, v, used, best, se, &cov_bt) < 0)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the errors of %zu rows",
+                            c->pr.n);
+    c->fit_weights = was_fw;
+    for (int k = 0; k < 3; k++) {
+        r->fit.ident_se.v[k] = se[k];
+        r->ext.ident_se.v[k] = c->pair ? se[PQ_RE + k] : -1;
+        r->fit.interval_ok[k] = r->ext.interval_ok[k] = 0;
+        for (int m = 0; m < 3; m++)
+            r->fit.corr[k][m] = r->ext.corr[k][m] = NAN;
+    }
+    r->volume_modulus_se = opt->volume == CF_VOLUME_FIT ? se[PQ_K] : -1;
+    if (c->tail) { /* e_t = tau B: var = B^2 var(tau) + tau^2 var(B) + 2 tau B cov(B, tau) */
+        const double B = v[PQ_BC], tau = v[PQ_T];
+        const double var = B * B * se[PQ_T] * se[PQ_T] + tau * tau * se[PQ_BC] * se[PQ_BC] +
+                           2 * tau * B * cov_bt;
+        r->fit.e_tail_se = isfinite(cov_bt) ? (var > 0 ? sqrt(var) : 0) : -1;
+        r->fit.e_tail_interval_ok = 0;
+    }
+    return CF_OK;
+}
