@@ -141,4 +141,15 @@ typedef struct cf_sofa_terms {
 int cf_sofa_terms_of(const cf_xgroup *g, cf_sofa_terms *s);
 void cf_sofa_terms_free(cf_sofa_terms *s);
 
+/* Shared by the writers (export_model.c): the comment header every model starts with (lead and
+** tail open and close a comment line of the target), and the set names of the fixed-direction
+** masks (bit 0 x, 1 y, 2 z). */
+void cf_xmodel_header(FILE *out, const char *lead, const char *tail, const cf_xmodel *m,
+                      const char *target, const char *how);
+extern const char *const cf_xmodel_mask_name[8];
+
+/* A real for CalculiX/Abaqus input: at most 20 characters, always with a decimal point
+** (export_inp.c). */
+void cf_export_inp_real(char buf[32], double x);
+
 #endif

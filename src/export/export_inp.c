@@ -1,0 +1,158 @@
+/*
+** Runnable models for CalculiX and Abaqus (export_model.h).
+** What the target reads, as checked against its documentation and source:
+** - CalculiX ccx: SPRINGA elements with *SPRING, NONLINEAR take (force, elongation) pairs; ccx
+**   holds the force constant past the last pair, and copies the curve into a fixed array of 200
+**   pairs (materialdata_sp.f, plconloc(802)), hence the 200-row limit. *NODE PRINT with TOTALS
+**   prints the summed reaction of a node set for every increment.
+** - Abaqus/Standard reads the same *SPRING layout (ccx took its input language from it).
+*/
+#include "export/export_model.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "conifit/lattice.h"
+#include "conifit/spring.h"
+#include "conifit/version.h"
+#include "base/safetext.h"
+
+/* A real for CalculiX/Abaqus input: at most 20 characters (ccx reads a number from a field of
+** 20 characters), always with a decimal point, with as many significant digits as fit (17, or 14
+** for a negative number with an exponent). */
+void cf_export_inp_real(char buf[32], double x)
+{
+    if (x == 0.0)
+        x = 0.0; /* no "-0" */
+    for (int p = 17; p >= 8; p--) {
+        char t[40];
+        snprintf(t, sizeof t, "%.*g", p, x);
+        char *e = strpbrk(t, "eE");
+        if (!strchr(t, '.')) { /* 40 -> 40.  1e-05 -> 1.e-05 */
+            char tail[40];
+            snprintf(tail, sizeof tail, "%s", e ? e : "");
+            if (e)
+                *e = '\0';
+            strcat(t, ".");
+            strcat(t, tail);
+        }
+        if (strlen(t) <= 20) {
+            memcpy(buf, t, strlen(t) + 1);
+            return;
+        }
+    }
+    snprintf(buf, 32, "%.8e", x);
+}
+
+void cf_export_inp_pair(FILE *out, double force_N, double elongation_mm)
+{
+    char a[32], b[32];
+    cf_export_inp_real(a, force_N);
+    cf_export_inp_real(b, elongation_mm);
+    fprintf(out, "%s, %s\n", a, b);
+}
+
+
+/* ---- CalculiX and Abaqus ---------------------------------------------------------------------- */
+
+/* Convergence: the residual force criterion R_n tightened from its default 0.005 of the mean force
+** so that the reaction is converged far below the table's tolerance; the other entries are the
+** defaults of the *CONTROLS, PARAMETERS=FIELD line. */
+static const char inp_controls[] = "1.e-9,1.e-6,0.01,,0.02,1.e-5,1.e-3,1.e-8\n";
+
+/* The volume term as one C3D8 hexahedron per cell (element numbers after the springs') of a
+** neo-Hookean material with no shear term: W = C10 (I1bar - 3) + (1/D1)(J - 1)^2 with C10 = 0
+** and D1 = 2/kappa is (kappa/2)(J - 1)^2 (CalculiX and Abaqus manuals, *HYPERELASTIC). The
+** element integrates it at its 2 x 2 x 2 Gauss points, conifit over the cell's volume from its
+** eight nodes: the same wherever J is uniform over a cell (the homogeneous loading of the
+** export). */
+static void write_inp_volume(FILE *out, const cf_xmodel *m)
+{
+    static const int order[8] = {0, 1, 3, 2, 4, 5, 7, 6}; /* corner di + 2 dj + 4 dk -> C3D8 */
+    fprintf(out, "** volume term: kappa = %.17g MPa on every cell\n", m->kappa_MPa);
+    fprintf(out, "*ELEMENT, TYPE=C3D8, ELSET=CELLS\n");
+    for (size_t c = 0; c < m->ncells; c++) {
+        fprintf(out, "%zu", m->ns + c + 1);
+        for (int a = 0; a < 8; a++)
+            fprintf(out, ", %u", m->cell[8 * c + order[a]] + 1);
+        fputc('\n', out);
+    }
+    char d1[32];
+    cf_export_inp_real(d1, 2.0 / m->kappa_MPa);
+    fprintf(out, "*MATERIAL, NAME=CONIFIT_VOLUME\n*HYPERELASTIC, NEO HOOKE\n0., %s\n", d1);
+    fprintf(out, "*SOLID SECTION, ELSET=CELLS, MATERIAL=CONIFIT_VOLUME\n");
+}
+
+static void write_inp(FILE *out, const cf_xmodel *m, int abaqus)
+{
+    const char *target = abaqus ? "Abaqus/Standard" : "CalculiX (ccx)";
+    cf_xmodel_header(out, "** ", "", m, target,
+                 abaqus ? "abaqus job=NAME (summed top reaction RF3 in NAME.dat per increment)"
+                        : "ccx -i NAME (summed top reaction in NAME.dat, 'total force' lines)");
+    fprintf(out, "*NODE, NSET=NALL\n");
+    for (size_t i = 0; i < m->nn; i++) {
+        char x[32], y[32], z[32];
+        cf_export_inp_real(x, m->X[i]);
+        cf_export_inp_real(y, m->Y[i]);
+        cf_export_inp_real(z, m->Z[i]);
+        fprintf(out, "%zu, %s, %s, %s\n", i + 1, x, y, z);
+    }
+    fprintf(out, "*NSET, NSET=NTOP\n");
+    for (size_t t = 0; t < m->ntop; t++)
+        fprintf(out, "%u%s", m->top[t] + 1, (t % 16 == 15 || t + 1 == m->ntop) ? "\n" : ", ");
+    for (size_t g = 0; g < m->ng; g++) {
+        fprintf(out, "*ELEMENT, TYPE=SPRINGA, ELSET=G%zu\n", g + 1);
+        for (size_t s = 0; s < m->ns; s++)
+            if (m->grp[s] == g)
+                fprintf(out, "%zu, %u, %u\n", s + 1, m->si[s] + 1, m->sj[s] + 1);
+        fprintf(out, "** group %zu: L0 = %.17g mm, weight %.17g; force (N), elongation (mm)\n",
+                g + 1, m->g[g].L0_mm, m->g[g].weight);
+        fprintf(out, "*SPRING, ELSET=G%zu, NONLINEAR\n\n", g + 1);
+        for (size_t i = 0; i < m->g[g].rows; i++)
+            cf_export_inp_pair(out, m->g[g].T_N[i], m->g[g].e_mm[i]);
+    }
+    if (m->nt > 0 && m->kappa_MPa > 0) { /* a body's tetrahedra */
+        /* W = C10 (I1bar - 3) + (J - 1)^2 / D1: with C10 = 0 and D1 = 2/kappa the volume term */
+        fprintf(out, "** the volume term: a purely volumetric material, (kappa/2)(J - 1)^2 per unit "
+                     "volume, kappa = %.17g MPa, J per tetrahedron\n",
+                m->kappa_MPa);
+        fprintf(out, "*ELEMENT, TYPE=C3D4, ELSET=VOLUME\n");
+        for (size_t t = 0; t < m->nt; t++)
+            fprintf(out, "%zu, %u, %u, %u, %u\n", m->ns + t + 1, m->tet[4 * t] + 1,
+                    m->tet[4 * t + 1] + 1, m->tet[4 * t + 2] + 1, m->tet[4 * t + 3] + 1);
+        char d1[32];
+        cf_export_inp_real(d1, 2 / m->kappa_MPa);
+        fprintf(out, "*MATERIAL, NAME=VOLUME\n*HYPERELASTIC, NEO HOOKE\n0., %s\n"
+                     "*SOLID SECTION, ELSET=VOLUME, MATERIAL=VOLUME\n",
+                d1);
+    }
+    else if (m->kappa_MPa > 0) /* a lattice's cells */
+        write_inp_volume(out, m);
+    fprintf(out, "*BOUNDARY\n");
+    for (size_t i = 0; i < m->nn; i++)
+        for (int a = 0; a < 3; a++)
+            if (m->fix[i] & (1u << a))
+                fprintf(out, "%zu, %d, %d\n", i + 1, a + 1, a + 1);
+    for (size_t k = 0; k < m->nsteps; k++) {
+        fprintf(out, "*STEP, NLGEOM%s, INC=1000\n*STATIC\n1., 1.\n", abaqus ? "=YES" : "");
+        fprintf(out, "*CONTROLS, PARAMETERS=FIELD%s\n%s", abaqus ? ", FIELD=DISPLACEMENT" : "",
+                inp_controls);
+        char dz[32];
+        cf_export_inp_real(dz, m->dz_mm[k]);
+        fprintf(out, "*BOUNDARY\nNTOP, 3, 3, %s\n", dz);
+        fprintf(out, "*NODE PRINT, NSET=NTOP, TOTALS=ONLY\nRF\n*END STEP\n");
+    }
+}
+
+int cf_xmodel_write_calculix(FILE *out, const cf_xmodel *m)
+{
+    write_inp(out, m, 0);
+    return 0;
+}
+
+int cf_xmodel_write_abaqus(FILE *out, const cf_xmodel *m)
+{
+    write_inp(out, m, 1);
+    return 0;
+}
