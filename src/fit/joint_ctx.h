@@ -72,4 +72,22 @@ cf_status cf_joint_verify_tables(const jctx *c, cf_joint_result *r, cf_error *er
 cf_status cf_joint_search_pair(jctx *c, const cf_table *reach, double xmax,
                                const cf_joint_result *plain, cf_joint_result *r, cf_error *err);
 
+/* The eight (at most) quantities v = rho_c, B_c, A_c, rho_e, B_e, A_e, kappa, tau (the
+** compression spring's tail) into the context for a curve at stress scale 1 (kappa over A_c). */
+enum { PQ_RC = 0, PQ_BC, PQ_AC, PQ_RE, PQ_BE, PQ_AE, PQ_K, PQ_T, PQ_COUNT };
+
+/* The pair's least-squares problem (joint_pair_lsq.c): the largest compression stress scale at
+** (rho, B) with the context's extension spring (0 where either spring cannot be placed); the
+** compression spring of v at stress scale 1; v polished by Levenberg-Marquardt over the used
+** quantities inside box (returns the RSS at v); the standard errors of the used quantities (se -1
+** where not determined; 0, or -1 when memory runs out or a curve fails); the lattice's
+** small-strain E and nu in tension and compression into r. */
+double cf_joint_pair_A_max(void *ctx, double rho, double B);
+cf_spring cf_joint_compression_member(const jctx *c, const double v[PQ_COUNT]);
+double cf_joint_pair_polish(jctx *c, double v[PQ_COUNT], const int used[PQ_COUNT],
+                            const double box[4]);
+int cf_joint_pair_errors(jctx *c, const double v0[PQ_COUNT], const int used[PQ_COUNT],
+                         double rss, double se[PQ_COUNT], double *cov_bt);
+void cf_joint_small_strain_moduli(jctx *c, const double v[PQ_COUNT], cf_joint_result *r);
+
 #endif

@@ -89,328 +89,6 @@ static double pair_objective(unsigned nz, const double *z, double *grad, void *d
     return f;
 }
 
-/* The largest compression stress scale at (rho, B) with the extension spring of the context: the
-** smaller of what a spring of the type (with the context's tail tau, when it has one) carries
-** there and what the extension spring carries over its share; 0 where either cannot be placed. */
-static double pair_A_max(void *ctx, double rho, double B)
-{
-    const jctx *c = ctx;
-    double Ac, Ae = INFINITY;
-    if (c->tail) {
-        if (!((Ac = cf_tail_cell_A_max(rho, B, c->tau, c->need, c->type, c->opt)) > 0))
-            return 0;
-    } else if (cf_fit_ident_limit(c->opt, c->type, rho, B, &Ac, NULL) > 0)
-        return 0;
-    if (c->pair) {
-        if (cf_fit_ident_limit(c->opt, c->type, c->ext[0], c->ext[1], &Ae, NULL) > 0)
-            return 0;
-        Ae /= c->ext[2];
-    }
-    return fmin(Ac, Ae);
-}
-
-/* The eight (at most) quantities v = rho_c, B_c, A_c, rho_e, B_e, A_e, kappa, tau (the
-** compression spring's tail) into the context for a curve at stress scale 1 (kappa over A_c). */
-enum { PQ_RC = 0, PQ_BC, PQ_AC, PQ_RE, PQ_BE, PQ_AE, PQ_K, PQ_T, PQ_COUNT };
-
-/* The compression spring of the quantities v at stress scale 1 (tailed when the context is). */
-static cf_spring compression_member(const jctx *c, const double v[PQ_COUNT])
-{
-    const cf_ident q = {.rho = v[PQ_RC], .solid = v[PQ_BC], .scale = 1.0};
-    return c->tail ? cf_ident_member_tail(&q, v[PQ_T]) : cf_ident_member(&q);
-}
-
-static int pair_residuals(jctx *c, const double v[PQ_COUNT], double *g, double *res)
-{
-    c->ext[0] = v[PQ_RE], c->ext[1] = v[PQ_BE], c->ext[2] = v[PQ_AE] / v[PQ_AC];
-    if (c->tail)
-        c->tau = v[PQ_T];
-    if (c->opt->volume == CF_VOLUME_POISSON) { /* kappa follows the springs */
-        c->kappa_mode = KAPPA_NU;
-        c->kappa = c->opt->volume_value;
-    } else {
-        c->kappa_mode = KAPPA_UNIT;
-        c->kappa = v[PQ_K] / v[PQ_AC];
-    }
-    if (cf_joint_curve(c, v[PQ_RC], v[PQ_BC], g) != 0)
-        return 1;
-    for (size_t i = 0; i < c->pr.n; i++)
-        res[i] = c->pr.sw[i] * (v[PQ_AC] * g[i] - c->pr.y[i]);
-    return 0;
-}
-
-/* 1 when quantity k of v is searched in logarithm (the scales, ratios and kappa), 0 for the solid
-** strains. */
-static int pq_log(int k)
-{
-    return k != PQ_BC && k != PQ_BE;
-}
-
-/* The weighted RSS at v (the residuals into res), CF_LSQ_HUGE_OBJ where a curve fails, a strain
-** leaves [Blo, Bhi], a ratio [rlo, rhi], or the compression spring's scale passes what the pair
-** carries there. */
-static double pair_rss(jctx *c, const double v[PQ_COUNT], const double box[4], double *g,
-                       double *res)
-{
-    if (v[PQ_BC] < box[0] || v[PQ_BC] > box[1] || v[PQ_RC] < box[2] || v[PQ_RC] > box[3])
-        return CF_LSQ_HUGE_OBJ;
-    if (c->pair && (v[PQ_BE] < box[0] || v[PQ_BE] > box[1] || v[PQ_RE] < box[2] ||
-                    v[PQ_RE] > box[3]))
-        return CF_LSQ_HUGE_OBJ;
-    if (pair_residuals(c, v, g, res) != 0)
-        return CF_LSQ_HUGE_OBJ;
-    if (!(v[PQ_AC] <= pair_A_max(c, v[PQ_RC], v[PQ_BC]) * (1 + 1e-12)))
-        return CF_LSQ_HUGE_OBJ;
-    double ss = 0;
-    for (size_t i = 0; i < c->pr.n; i++)
-        ss += res[i] * res[i];
-    return isfinite(ss) ? ss : CF_LSQ_HUGE_OBJ;
-}
-
-/* Levenberg-Marquardt from v over the used quantities (logarithms of the scales and kappa, the
-** strains as they are), central-difference Jacobians, inside the search's box: BOBYQA's optimum
-** polished to where the residuals stop falling (a noiseless table's quantities to ~1e-8). Returns
-** the RSS at v (updated in place). */
-static double pair_polish(jctx *c, double v[PQ_COUNT], const int used[PQ_COUNT],
-                          const double box[4])
-{
-    const size_t n = c->pr.n;
-    int idx[PQ_COUNT], p = 0;
-    for (int k = 0; k < PQ_COUNT; k++)
-        if (used[k] && v[k] > 0)
-            idx[p++] = k;
-    double *g = malloc(sizeof(double) * n), *r0 = malloc(sizeof(double) * n);
-    double *rp = malloc(sizeof(double) * n), *rm = malloc(sizeof(double) * n);
-    double *J = malloc(sizeof(double) * n * (size_t)(p ? p : 1));
-    double f = CF_LSQ_HUGE_OBJ;
-    if (g && r0 && rp && rm && J)
-        f = pair_rss(c, v, box, g, r0);
-    double lambda = 1e-3;
-    for (int it = 0; it < 40 && f < CF_LSQ_HUGE_OBJ && f > 0; it++) {
-        int bad = 0;
-        for (int a = 0; a < p && !bad; a++) {
-            const int k = idx[a];
-            const double h = 1e-6 * (pq_log(k) ? 1.0 : fabs(v[k]));
-            double vp[PQ_COUNT], vm[PQ_COUNT];
-            memcpy(vp, v, sizeof vp);
-            memcpy(vm, v, sizeof vm);
-            vp[k] = pq_log(k) ? v[k] * exp(h) : v[k] + h;
-            vm[k] = pq_log(k) ? v[k] * exp(-h) : v[k] - h;
-            bad = pair_residuals(c, vp, g, rp) != 0 || pair_residuals(c, vm, g, rm) != 0;
-            for (size_t i = 0; i < n && !bad; i++)
-                J[i * (size_t)p + (size_t)a] = (rp[i] - rm[i]) / (2 * h);
-        }
-        c->pr.evals += 2 * p;
-        if (bad)
-            break;
-        double A[PQ_COUNT][PQ_COUNT], b[PQ_COUNT];
-        for (int a = 0; a < p; a++) {
-            b[a] = 0;
-            for (size_t i = 0; i < n; i++)
-                b[a] -= J[i * (size_t)p + (size_t)a] * r0[i];
-            for (int bb = 0; bb < p; bb++) {
-                double d = 0;
-                for (size_t i = 0; i < n; i++)
-                    d += J[i * (size_t)p + (size_t)a] * J[i * (size_t)p + (size_t)bb];
-                A[a][bb] = d;
-            }
-        }
-        int improved = 0;
-        for (int tries = 0; tries < 8 && !improved; tries++) {
-            /* (J^T J + lambda diag) delta = -J^T r by Gaussian elimination with pivoting */
-            double M[PQ_COUNT][PQ_COUNT + 1];
-            for (int a = 0; a < p; a++) {
-                for (int bb = 0; bb < p; bb++)
-                    M[a][bb] = A[a][bb] + (a == bb ? lambda * (A[a][a] > 0 ? A[a][a] : 1) : 0);
-                M[a][p] = b[a];
-            }
-            int singular = 0;
-            for (int col = 0; col < p && !singular; col++) {
-                int piv = col;
-                for (int row = col + 1; row < p; row++)
-                    if (fabs(M[row][col]) > fabs(M[piv][col]))
-                        piv = row;
-                if (!(fabs(M[piv][col]) > 0)) {
-                    singular = 1;
-                    break;
-                }
-                for (int q = 0; q <= p; q++) {
-                    const double t = M[col][q];
-                    M[col][q] = M[piv][q];
-                    M[piv][q] = t;
-                }
-                for (int row = col + 1; row < p; row++) {
-                    const double fct = M[row][col] / M[col][col];
-                    for (int q = col; q <= p; q++)
-                        M[row][q] -= fct * M[col][q];
-                }
-            }
-            double delta[PQ_COUNT];
-            for (int a = p - 1; a >= 0 && !singular; a--) {
-                double t = M[a][p];
-                for (int q = a + 1; q < p; q++)
-                    t -= M[a][q] * delta[q];
-                delta[a] = t / M[a][a];
-            }
-            double vt[PQ_COUNT];
-            memcpy(vt, v, sizeof vt);
-            for (int a = 0; a < p && !singular; a++) {
-                const int k = idx[a];
-                vt[k] = pq_log(k) ? v[k] * exp(fmax(fmin(delta[a], 1.0), -1.0)) : v[k] + delta[a];
-            }
-            const double ft = singular ? CF_LSQ_HUGE_OBJ : pair_rss(c, vt, box, g, rp);
-            c->pr.evals++;
-            if (ft < f) {
-                const double drop = (f - ft) / f;
-                memcpy(v, vt, sizeof vt);
-                memcpy(r0, rp, sizeof(double) * n);
-                f = ft;
-                lambda = fmax(lambda / 10, 1e-12);
-                improved = 1;
-                if (drop < 1e-12)
-                    it = 40; /* converged */
-            } else {
-                lambda *= 10;
-            }
-        }
-        if (!improved)
-            break;
-    }
-    free(g);
-    free(r0);
-    free(rp);
-    free(rm);
-    free(J);
-    return f;
-}
-
-/* Standard errors of the used quantities (used[k]) from the central-difference Jacobian of the
-** weighted residuals: s^2 (J^T J)^+ with s^2 = rss/(N - p), the pseudo-inverse over the
-** eigenvalues of J^T J's unit-diagonal form above 1e-10 of the largest; a quantity with a
-** component in the discarded directions is not determined (se -1); *cov_bt the covariance of
-** the compression spring's B and tau when both are determined (NAN otherwise). 0, or -1 when
-** memory runs out or a curve fails. */
-static int pair_errors(jctx *c, const double v0[PQ_COUNT], const int used[PQ_COUNT],
-                       double rss, double se[PQ_COUNT], double *cov_bt)
-{
-    *cov_bt = NAN;
-    const size_t n = c->pr.n;
-    int idx[PQ_COUNT], p = 0;
-    for (int k = 0; k < PQ_COUNT; k++) {
-        se[k] = -1;
-        if (used[k])
-            idx[p++] = k;
-    }
-    double *J = malloc(sizeof(double) * n * (size_t)p), *g = malloc(sizeof(double) * n);
-    double *rp = malloc(sizeof(double) * n), *rm = malloc(sizeof(double) * n);
-    const int oom = !J || !g || !rp || !rm;
-    int bad = oom;
-    for (int a = 0; a < p && !bad; a++) {
-        double v[PQ_COUNT];
-        memcpy(v, v0, sizeof v);
-        const double h = TAIL_FD_STEP * fabs(v0[idx[a]]);
-        v[idx[a]] = v0[idx[a]] + h;
-        bad = pair_residuals(c, v, g, rp);
-        v[idx[a]] = v0[idx[a]] - h;
-        bad = bad || pair_residuals(c, v, g, rm);
-        for (size_t i = 0; i < n && !bad; i++)
-            J[i * (size_t)p + (size_t)a] = (rp[i] - rm[i]) / (2 * h);
-    }
-    c->pr.evals += 2 * p;
-    if (!bad && (size_t)p < n) {
-        gsl_matrix *M = gsl_matrix_alloc((size_t)p, (size_t)p);
-        gsl_matrix *V = gsl_matrix_alloc((size_t)p, (size_t)p);
-        gsl_vector *ev = gsl_vector_alloc((size_t)p);
-        gsl_eigen_symmv_workspace *ws = gsl_eigen_symmv_alloc((size_t)p);
-        double dsc[PQ_COUNT];
-        const int oom2 = !M || !V || !ev || !ws;
-        bad = oom2;
-        for (int a = 0; a < p && !bad; a++) {
-            double d = 0;
-            for (size_t i = 0; i < n; i++)
-                d += J[i * (size_t)p + (size_t)a] * J[i * (size_t)p + (size_t)a];
-            dsc[a] = d > 0 ? 1 / sqrt(d) : 0;
-        }
-        for (int a = 0; a < p && !bad; a++)
-            for (int b = 0; b < p; b++) {
-                double d = 0;
-                for (size_t i = 0; i < n; i++)
-                    d += J[i * (size_t)p + (size_t)a] * J[i * (size_t)p + (size_t)b];
-                gsl_matrix_set(M, (size_t)a, (size_t)b, d * dsc[a] * dsc[b]);
-            }
-        if (!bad && gsl_eigen_symmv(M, ev, V, ws) == GSL_SUCCESS) {
-            double emax = 0;
-            for (int a = 0; a < p; a++)
-                emax = fmax(emax, gsl_vector_get(ev, (size_t)a));
-            const double s2 = rss / (double)((int)n - p);
-            for (int a = 0; a < p; a++) {
-                double var = 0, null = 0;
-                for (int b = 0; b < p; b++) {
-                    const double e = gsl_vector_get(ev, (size_t)b), x = gsl_matrix_get(V, (size_t)a,
-                                                                                     (size_t)b);
-                    if (e > 1e-10 * emax)
-                        var += x * x / e;
-                    else
-                        null += x * x;
-                }
-                if (dsc[a] > 0 && null < 1e-6)
-                    se[idx[a]] = sqrt(s2 * var) * dsc[a];
-            }
-            for (int a = 0; a < p; a++) /* B_c is idx 1; tau, when used, the last */
-                if (idx[a] == PQ_T && se[PQ_T] >= 0 && se[PQ_BC] >= 0) {
-                    double cv = 0;
-                    for (int b = 0; b < p; b++) {
-                        const double e = gsl_vector_get(ev, (size_t)b);
-                        if (e > 1e-10 * emax)
-                            cv += gsl_matrix_get(V, (size_t)a, (size_t)b) *
-                                  gsl_matrix_get(V, 1, (size_t)b) / e;
-                    }
-                    *cov_bt = s2 * cv * dsc[a] * dsc[1];
-                }
-        }
-        gsl_eigen_symmv_free(ws);
-        gsl_vector_free(ev);
-        gsl_matrix_free(V);
-        gsl_matrix_free(M);
-        if (oom2)
-            bad = -1;
-    }
-    free(J);
-    free(g);
-    free(rp);
-    free(rm);
-    return oom || bad < 0 ? -1 : bad; /* a curve that failed: every error stays -1 */
-}
-
-/* The lattice's small-strain Young's modulus and Poisson's ratio in uniaxial compression and in
-** tension (strain -+1e-6, every spring inside its linear region) from the cell of the quantities
-** v; NAN where the cell fails. */
-static void small_strain_moduli(jctx *c, const double v[PQ_COUNT], cf_joint_result *r)
-{
-    const cf_ident qc = {.rho = v[PQ_RC], .solid = v[PQ_BC], .scale = v[PQ_AC]};
-    const cf_ident qe = {.rho = v[PQ_RE], .solid = v[PQ_BE], .scale = v[PQ_AE]};
-    const cf_spring pc = c->tail ? cf_ident_member_tail(&qc, v[PQ_T]) : cf_ident_member(&qc),
-                    pe = cf_ident_member(&qe);
-    cf_law lc, le;
-    cf_cell cell;
-    r->E_compression_MPa = r->E_extension_MPa = r->nu_compression = r->nu_extension = NAN;
-    if (cf_law_init(&lc, &pc, NULL) != CF_OK ||
-        (c->pair && (cf_law_init(&le, &pe, NULL) != CF_OK || cf_law_pair(&lc, &le, NULL) != CF_OK)) ||
-        cf_cell_init(&cell, &lc, CF_LAW_CLOSED, c->weight, NULL) != CF_OK)
-        return;
-    cell.volume_modulus_MPa = v[PQ_K];
-    for (int side = 0; side < 2; side++) {
-        const double e = side ? 1e-6 : -1e-6;
-        cf_cell_state s;
-        if (cf_cell_mode(&cell, CF_MODE_UNIAXIAL, e, NULL, &s, NULL) != CF_OK)
-            continue;
-        *(side ? &r->E_extension_MPa : &r->E_compression_MPa) = s.stress_MPa / e;
-        *(side ? &r->nu_extension : &r->nu_compression) = (1 - s.free_stretch) / e;
-    }
-}
-
-/* The search's state between its steps: the variables, the objective's data, the best point and
-** the starts' ends (for the searches kept to stable lattices). */
 typedef struct pair_search {
     pvars pv;
     pair_obj o;
@@ -475,7 +153,7 @@ static cf_status pair_box(jctx *c, double xmax, pvars *pv, cf_error *err)
     }
     memcpy(c->pr.lb, pv->lb, sizeof c->pr.lb);
     memcpy(c->pr.ub, pv->ub, sizeof c->pr.ub);
-    c->pr.A_max = pair_A_max;
+    c->pr.A_max = cf_joint_pair_A_max;
     return CF_OK;
 }
 
@@ -658,7 +336,7 @@ static double pair_quantities(jctx *c, pair_search *s, const int used[PQ_COUNT],
     if (c->tail)
         v[PQ_T] = c->tau;
     cf_law lc;
-    const cf_spring pc = compression_member(c, v);
+    const cf_spring pc = cf_joint_compression_member(c, v);
     if (cf_law_init(&lc, &pc, err) != CF_OK)
         return -1;
     v[PQ_K] = *A * cf_joint_curve_kappa(c, &lc);
@@ -669,7 +347,7 @@ static double pair_quantities(jctx *c, pair_search *s, const int used[PQ_COUNT],
     memcpy(vp, v, sizeof vp);
     const int stab = c->stab_on;
     c->stab_on = 0;
-    double fp = pair_polish(c, vp, used, box);
+    double fp = cf_joint_pair_polish(c, vp, used, box);
     if (stab && fp < best) { /* the polish's point under the search's stability check */
         c->ext[0] = vp[PQ_RE], c->ext[1] = vp[PQ_BE], c->ext[2] = vp[PQ_AE] / vp[PQ_AC];
         if (c->tail)
@@ -683,7 +361,7 @@ static double pair_quantities(jctx *c, pair_search *s, const int used[PQ_COUNT],
         memcpy(v, vp, sizeof vp);
         best = fp;
         *A = v[PQ_AC];
-        const cf_spring pp = compression_member(c, v);
+        const cf_spring pp = cf_joint_compression_member(c, v);
         if (cf_law_init(&lc, &pp, err) != CF_OK)
             return -1;
         if (opt->volume == CF_VOLUME_POISSON) {
@@ -824,10 +502,10 @@ cf_status cf_joint_search_pair(jctx *c, const cf_table *reach, double xmax,
     ** lattice's uniaxial compression loads its axial springs' compression sides and its lateral
     ** springs' extension sides (and the reverse in tension), so neither side's E and nu is that
     ** of one spring's k0 alone */
-    small_strain_moduli(c, v, r);
+    cf_joint_small_strain_moduli(c, v, r);
     /* the errors of every quantity fitted (the weights held) */
     double se[PQ_COUNT], cov_bt;
-    if (pair_errors(c, v, used, best, se, &cov_bt) < 0)
+    if (cf_joint_pair_errors(c, v, used, best, se, &cov_bt) < 0)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the errors of %zu rows",
                             c->pr.n);
     c->fit_weights = was_fw;

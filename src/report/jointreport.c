@@ -458,6 +458,35 @@ static void volume_json(json_t *lat, const cf_joint_result *j)
     json_object_set_new(lat, "modulus_extension_MPa", num(j->E_extension_MPa));
 }
 
+/* Fit j's numbers in each table: its RMSE in the cell and the lattice, AIC, and the stability
+** of its lattice over the table's range (uniaxial tables). */
+static json_t *tables_json(const cf_joint_report *r, const cf_joint_result *j)
+{
+    json_t *per = json_array();
+    for (size_t k = 0; k < r->ntables; k++) {
+        const cf_table *t = r->tables[k];
+        const cf_joint_table *jt = &j->tab[k];
+        double u = t->y_to_file;
+        json_t *e = json_pack("{s:s, s:s, s:I, s:s, s:o, s:o, s:s, s:o}", "file", t->path,
+                              "mode", cf_mode_name(jt->mode), "points",
+                              (json_int_t)jt->points, "unit", t->y_unit, "rmse",
+                              num(jt->cell_rmse * u), "lattice_rmse",
+                              num(jt->lattice_rmse * u), "lattice_model",
+                              jt->by_cell ? "homogenised cell" : "full lattice", "scale",
+                              num(jt->scale_MPa * u));
+        if (e)
+            json_object_set_new(e, "aic", num(jt->aic));
+        if (e && isfinite(jt->law_rmse)) /* uniaxial tables only */
+            json_object_set_new(e, "law_difference_rmse", num(jt->law_rmse * u));
+        if (e && jt->stability_checked) {
+            json_object_set_new(e, "stable_in_range", json_boolean(jt->stable_in_range));
+            json_object_set_new(e, "stable_to_strain", num(jt->stable_to));
+        }
+        json_array_append_new(per, e);
+    }
+    return per;
+}
+
 static json_t *joint_json(const cf_joint_report *r)
 {
     json_t *root = json_object(), *fits = json_array(), *tabs = json_array();
@@ -519,29 +548,7 @@ static json_t *joint_json(const cf_joint_report *r)
         json_object_set_new(f, "objective", num(j->objective));
         json_object_set_new(f, "evaluations", json_integer(j->evaluations));
         json_object_set_new(f, "wall_time_s", num(r->with_timing ? j->wall_time_s : 0.0));
-        json_t *per = json_array();
-        for (size_t k = 0; k < r->ntables; k++) {
-            const cf_table *t = r->tables[k];
-            const cf_joint_table *jt = &j->tab[k];
-            double u = t->y_to_file;
-            json_t *e = json_pack("{s:s, s:s, s:I, s:s, s:o, s:o, s:s, s:o}", "file", t->path,
-                                  "mode", cf_mode_name(jt->mode), "points",
-                                  (json_int_t)jt->points, "unit", t->y_unit, "rmse",
-                                  num(jt->cell_rmse * u), "lattice_rmse",
-                                  num(jt->lattice_rmse * u), "lattice_model",
-                                  jt->by_cell ? "homogenised cell" : "full lattice", "scale",
-                                  num(jt->scale_MPa * u));
-            if (e)
-                json_object_set_new(e, "aic", num(jt->aic));
-            if (e && isfinite(jt->law_rmse)) /* uniaxial tables only */
-                json_object_set_new(e, "law_difference_rmse", num(jt->law_rmse * u));
-            if (e && jt->stability_checked) {
-                json_object_set_new(e, "stable_in_range", json_boolean(jt->stable_in_range));
-                json_object_set_new(e, "stable_to_strain", num(jt->stable_to));
-            }
-            json_array_append_new(per, e);
-        }
-        json_object_set_new(f, "tables", per);
+        json_object_set_new(f, "tables", tables_json(r, j));
         json_array_append_new(fits, f);
     }
     int b = cf_joint_better(r);
