@@ -43,11 +43,12 @@ static int punch_nodes(const cf_body *b, const cf_probe *pr, cf_xmodel *m)
     return 0;
 }
 
-cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, size_t nsteps,
-                               const double *depth_mm, const double *force_N,
-                               const cf_export_options *opt, cf_export_report *rep, cf_error *err)
+/* What a body's export takes: CalculiX, FEBio or SOFA (SOFA without a volume term), a flat
+** punch along z, 1 to CF_EXPORT_MAX_STEPS finite load steps. */
+static cf_status check_body(const cf_body *b, const cf_probe *pr, size_t nsteps,
+                            const double *depth_mm, const double *force_N,
+                            const cf_export_options *opt, cf_error *err)
 {
-    CF_GSL_GUARD;
     if (opt->format != CF_EXPORT_CALCULIX && opt->format != CF_EXPORT_FEBIO &&
         opt->format != CF_EXPORT_SOFA)
         return cf_error_set(err, CF_E_DATA, "a body is exported to calculix, febio or sofa, not %s",
@@ -70,12 +71,55 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, 
         if (!isfinite(depth_mm[k]) || !isfinite(force_N[k]))
             return cf_error_set(err, CF_E_DATA, "load step %zu: depth or force is not finite",
                                 k + 1);
+    return CF_OK;
+}
+
+/* The body's nodes, held directions, springs (one group per edge: its rest length and its
+** calibration factor as the weight) and the reaction tolerance the tables imply into m. */
+static void fill_model(const cf_body *b, const cf_export_table *t, const cf_law *law,
+                       cf_xmodel *m)
+{
+    double zlo = INFINITY, zhi = -INFINITY;
+    for (size_t i = 0; i < b->nn; i++) {
+        m->X[i] = b->X[3 * i];
+        m->Y[i] = b->X[3 * i + 1];
+        m->Z[i] = b->X[3 * i + 2];
+        m->fix[i] = b->fix[i] & (CF_FIX_X | CF_FIX_Y | CF_FIX_Z);
+        zlo = fmin(zlo, m->Z[i]);
+        zhi = fmax(zhi, m->Z[i]);
+    }
+    m->height_mm = zhi - zlo;
+    /* the tables allow tol F_C per unit weight in each spring a horizontal plane cuts: the plane
+    ** halfway up the body */
+    const double zmid = (zlo + zhi) / 2;
+    double wcut = 0;
+    for (size_t s = 0; s < b->ns; s++) {
+        m->si[s] = b->si[s];
+        m->sj[s] = b->sj[s];
+        m->grp[s] = (uint32_t)s;
+        m->g[s].L0_mm = b->L0[s];
+        m->g[s].weight = b->c[s];
+        m->g[s].count = 1;
+        const double zi = b->X[3 * b->si[s] + 2], zj = b->X[3 * b->sj[s] + 2];
+        if ((zi - zmid) * (zj - zmid) < 0)
+            wcut += b->c[s] * fabs(zi - zj) / b->L0[s];
+    }
+    m->reaction_tol_N = t->tol * law->F_C_N * wcut;
+}
+
+cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, size_t nsteps,
+                               const double *depth_mm, const double *force_N,
+                               const cf_export_options *opt, cf_export_report *rep, cf_error *err)
+{
+    CF_GSL_GUARD;
+    cf_status st = check_body(b, pr, nsteps, depth_mm, force_N, opt, err);
+    if (st != CF_OK)
+        return st;
     const cf_law *law = b->law;
     cf_export_table t = {0};
     cf_xmodel m = {0};
     cf_export_report r = {0};
-    cf_status st = cf_export_table_for(law, opt, &t, err);
-    if (st != CF_OK)
+    if ((st = cf_export_table_for(law, opt, &t, err)) != CF_OK)
         return st;
     char title[200];
     snprintf(title, sizeof title,
@@ -110,32 +154,7 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, 
                           "(center_mm must lie on a flat face of the mesh)");
         goto done;
     }
-    double zlo = INFINITY, zhi = -INFINITY;
-    for (size_t i = 0; i < b->nn; i++) {
-        m.X[i] = b->X[3 * i];
-        m.Y[i] = b->X[3 * i + 1];
-        m.Z[i] = b->X[3 * i + 2];
-        m.fix[i] = b->fix[i] & (CF_FIX_X | CF_FIX_Y | CF_FIX_Z);
-        zlo = fmin(zlo, m.Z[i]);
-        zhi = fmax(zhi, m.Z[i]);
-    }
-    m.height_mm = zhi - zlo;
-    /* the tables allow tol F_C per unit weight in each spring a horizontal plane cuts: the plane
-    ** halfway up the body */
-    const double zmid = (zlo + zhi) / 2;
-    double wcut = 0;
-    for (size_t s = 0; s < b->ns; s++) {
-        m.si[s] = b->si[s];
-        m.sj[s] = b->sj[s];
-        m.grp[s] = (uint32_t)s;
-        m.g[s].L0_mm = b->L0[s];
-        m.g[s].weight = b->c[s];
-        m.g[s].count = 1;
-        const double zi = b->X[3 * b->si[s] + 2], zj = b->X[3 * b->sj[s] + 2];
-        if ((zi - zmid) * (zj - zmid) < 0)
-            wcut += b->c[s] * fabs(zi - zj) / b->L0[s];
-    }
-    m.reaction_tol_N = t.tol * law->F_C_N * wcut;
+    fill_model(b, &t, law, &m);
     for (size_t k = 0; k < nsteps; k++) {
         m.dz_mm[k] = depth_mm[k] * pr->dir[2];
         m.ref_N[k] = force_N[k] * (pr->dir[2] < 0 ? 1 : -1);
