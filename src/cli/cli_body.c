@@ -21,9 +21,16 @@ typedef struct run {
     cf_law law;
     cf_mesh mesh;
     cf_body body;
+    size_t steps;
     double *xs;          /* (steps + 1) x 3 nn positions */
     cf_body_step *step;  /* steps + 1 */
-    size_t nfixed;
+    size_t nfixed;       /* nodes with a held component */
+    double *presc;       /* 3 nn: each held component's displacement at the last step, mm */
+    double *fload;       /* 3 nn: the loads at the last step, N (NULL: none) */
+    uint8_t *mark;       /* nregions x nn: the nodes of each region */
+    size_t *nsel;        /* nregions: how many */
+    double *rv;          /* (steps + 1) x nregions x 3: a held region's support force (N), a loaded
+                         ** one's mean displacement (mm) */
 } run;
 
 static void run_free(run *r)
@@ -33,6 +40,90 @@ static void run_free(run *r)
     cf_law_free(&r->law);
     free(r->xs);
     free(r->step);
+    free(r->presc);
+    free(r->fload);
+    free(r->mark);
+    free(r->nsel);
+    free(r->rv);
+}
+
+/* The regions of sc on the body: held components and their displacements, the loads. A region
+** that selects nothing, and a component two regions hold at different displacements, are
+** refused. */
+static cf_status regions(const cf_scene *sc, const char *scene_path, run *r, cf_error *err)
+{
+    cf_body *b = &r->body;
+    const size_t nn = b->nn, nr = sc->nregions;
+    uint8_t *owner = calloc(3 * nn, 1); /* 1 + the region that holds a component */
+    r->presc = calloc(3 * nn, sizeof *r->presc);
+    r->mark = calloc(nr * nn + 1, 1);
+    r->nsel = calloc(nr + 1, sizeof *r->nsel);
+    r->rv = calloc((r->steps + 1) * nr * 3 + 1, sizeof *r->rv);
+    b->reaction = calloc(3 * nn, sizeof *b->reaction);
+    cf_status st = CF_OK;
+    if (!owner || !r->presc || !r->mark || !r->nsel || !r->rv || !b->reaction) {
+        free(owner);
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the regions");
+    }
+    for (size_t k = 0; k < nr && st == CF_OK; k++) {
+        const cf_scene_region *g = &sc->regions[k];
+        uint8_t *m = r->mark + k * nn;
+        r->nsel[k] = cf_mesh_select(&r->mesh, &g->sel, m);
+        if (r->nsel[k] == 0) {
+            st = cf_error_set(err, CF_E_DATA, "%s: key '%s.%s' selects no node of %s",
+                              scene_path, g->key, cf_select_name(g->sel.kind), sc->body_mesh);
+            break;
+        }
+        if (g->use == CF_REGION_LOADED) {
+            if (!r->fload && !(r->fload = calloc(3 * nn, sizeof *r->fload)))
+                st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the loads");
+            else if (cf_body_spread_force(b, m, g->vec, r->fload) == 0)
+                st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the loads");
+            continue;
+        }
+        for (size_t i = 0; i < nn && st == CF_OK; i++)
+            for (int a = 0; m[i] && a < 3; a++) {
+                if (!((g->comps >> a) & 1))
+                    continue;
+                const size_t q = 3 * i + (size_t)a;
+                if (owner[q] && r->presc[q] != g->vec[a]) {
+                    st = cf_error_set(err, CF_E_DATA, "%s: keys '%s' and '%s' hold the %c "
+                                      "component of node %lu of %s at different displacements "
+                                      "(%g and %g mm)", scene_path, sc->regions[owner[q] - 1].key,
+                                      g->key, 'x' + a, (unsigned long)r->mesh.id[i],
+                                      sc->body_mesh, r->presc[q], g->vec[a]);
+                    break;
+                }
+                owner[q] = (uint8_t)(k + 1);
+                r->presc[q] = g->vec[a];
+                b->fix[i] |= (uint8_t)(1u << a);
+            }
+    }
+    free(owner);
+    for (size_t i = 0; i < nn; i++)
+        r->nfixed += b->fix[i] != 0;
+    return st;
+}
+
+/* The regions' numbers at step k: support forces of held regions (at the components they hold),
+** mean displacements of loaded ones. */
+static void region_values(const cf_scene *sc, run *r, size_t k)
+{
+    const cf_body *b = &r->body;
+    const size_t nn = b->nn, nr = sc->nregions;
+    for (size_t g = 0; g < nr; g++) {
+        double *v = r->rv + (k * nr + g) * 3;
+        const uint8_t *m = r->mark + g * nn;
+        v[0] = v[1] = v[2] = 0;
+        const unsigned comps = sc->regions[g].use == CF_REGION_LOADED ? 7 : sc->regions[g].comps;
+        for (size_t i = 0; i < nn; i++)
+            for (int a = 0; m[i] && a < 3; a++)
+                if ((comps >> a) & 1)
+                    v[a] += sc->regions[g].use == CF_REGION_LOADED
+                            ? (b->x[3 * i + (size_t)a] - b->X[3 * i + (size_t)a]) /
+                                  (double)r->nsel[g]
+                            : b->reaction[3 * i + (size_t)a];
+    }
 }
 
 static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budget *budget, run *r,
@@ -45,11 +136,12 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
         (st = cf_mesh_read_refined(sc->body_mesh, sc->body_unit_mm, sc->body_refine, &r->mesh,
                                    err)) != CF_OK)
         return st;
-    const size_t steps = (size_t)sc->probe.steps;
+    const size_t steps = r->steps = (size_t)sc->body_steps;
     /* memory: the factor of the tangent (about 40 times its 3 x 3 blocks for meshes of organ
     ** size), the matrix, and one copy of the positions per step */
     double bytes = (double)r->mesh.nn * 3 * (81.0 * 16 * 8 + 40.0 * 81 * 8) +
-                   (double)(steps + 1) * 3 * (double)r->mesh.nn * 8;
+                   (double)(steps + 1) * 3 * (double)r->mesh.nn * 8 +
+                   (double)sc->nregions * (double)r->mesh.nn;
     if (bytes > budget->max_memory_bytes)
         return cf_error_set(err, CF_E_DATA, "%s: the body of %s (%zu nodes, %zu steps) needs "
                             "about %.3g bytes, over the limit %.3g (--max-memory)",
@@ -63,16 +155,11 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
     if ((st = cf_body_create(&r->body, &r->mesh, &r->law, sc->method, kappa, err)) != CF_OK)
         return st;
     cf_body *b = &r->body;
-    for (size_t i = 0; i < b->nn; i++)
-        if (b->X[3 * i + (size_t)sc->fixed_axis] <= sc->fixed_value_mm) {
-            b->fix[i] = CF_BODY_FIX_ALL;
-            r->nfixed++;
-        }
-    if (r->nfixed == 0)
-        return cf_error_set(err, CF_E_DATA, "%s: key 'fixed.below' (%c <= %g mm) selects no node "
-                            "of %s", scene_path, 'x' + sc->fixed_axis, sc->fixed_value_mm,
-                            sc->body_mesh);
-    long in = cf_body_probe_inside(b, &sc->probe);
+    if ((st = regions(sc, scene_path, r, err)) != CF_OK)
+        return st;
+    cf_probe none = {.shape = CF_PROBE_SPHERE, .dir = {0, 0, 1}}; /* radius 0: touches nothing */
+    const cf_probe *probe = sc->has_probe ? &sc->probe : &none;
+    long in = cf_body_probe_inside(b, probe);
     if (in >= 0)
         return cf_error_set(err, CF_E_DATA, "%s: key 'probe.center_mm': the probe starts inside "
                             "the body (node %lu of %s at [%g, %g, %g] mm)",
@@ -80,19 +167,52 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
                             b->X[3 * in], b->X[3 * in + 1], b->X[3 * in + 2]);
     r->xs = malloc((steps + 1) * 3 * b->nn * sizeof *r->xs);
     r->step = calloc(steps + 1, sizeof *r->step);
+    if (r->fload && !(b->f_ext = calloc(3 * b->nn, sizeof *b->f_ext)))
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the loads");
     if (!r->xs || !r->step)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu steps", steps);
     memcpy(r->xs, b->x, 3 * b->nn * sizeof *r->xs);
     r->step[0].min_J = 1;
     for (size_t k = 1; k <= steps; k++) {
-        double depth = sc->probe.depth_mm * (double)k / (double)steps;
-        if ((st = cf_body_solve(b, &sc->probe, depth, 0, &r->step[k], err)) != CF_OK)
+        const double lam = (double)k / (double)steps;
+        const double depth = sc->has_probe ? sc->probe.depth_mm * lam : 0;
+        for (size_t q = 0; q < 3 * b->nn; q++) {
+            if ((b->fix[q / 3] >> (q % 3)) & 1)
+                b->x[q] = b->X[q] + lam * r->presc[q];
+            if (r->fload)
+                b->f_ext[q] = lam * r->fload[q];
+        }
+        if ((st = cf_body_solve(b, probe, depth, 0, &r->step[k], err)) != CF_OK) {
+            if (err) /* which step: without a probe the depth says nothing */
+                snprintf(err->msg + strlen(err->msg), sizeof err->msg - strlen(err->msg),
+                         " (step %zu of %zu, loads at %g of the scene's)", k, steps, lam);
             return st;
+        }
+        if (!sc->has_probe)
+            r->step[k].depth_mm = lam; /* the load factor stands for the depth */
         if (!isfinite(r->step[k].force_N))
-            return cf_error_set(err, CF_E_INTERNAL, "body: force not finite at depth %g mm", depth);
+            return cf_error_set(err, CF_E_INTERNAL, "body: force not finite at step %zu", k);
+        region_values(sc, r, k);
         memcpy(r->xs + k * 3 * b->nn, b->x, 3 * b->nn * sizeof *r->xs);
     }
     return CF_OK;
+}
+
+/* The CSV's column names of region k (a held region's support force, a loaded one's mean
+** displacement), or 0 for a fixed region (no columns). */
+static int region_columns(const cf_scene_region *g, FILE *f)
+{
+    if (g->use == CF_REGION_FIXED)
+        return 0;
+    char name[48];
+    size_t n = 0;
+    for (const char *p = g->key; *p && n + 1 < sizeof name; p++) /* "displaced[1]" -> displaced1 */
+        if (*p != '[' && *p != ']')
+            name[n++] = *p;
+    name[n] = 0;
+    for (int a = 0; a < 3; a++)
+        fprintf(f, g->use == CF_REGION_LOADED ? ",%s_u%c_mm" : ",%s_F%c_N", name, 'x' + a);
+    return 1;
 }
 
 /* Opens, writes and finishes every output (nothing committed yet). */
@@ -101,13 +221,24 @@ static cf_status write_all(const cf_scene *sc, const run *r, const char *out, co
                            cf_error *err)
 {
     const cf_body *b = &r->body;
-    const size_t steps = (size_t)sc->probe.steps;
+    const size_t steps = r->steps;
     cf_status st = cf_cli_out_open(csv, out, inputs, err);
     if (st)
         return st;
-    fprintf(csv->fp, "depth_mm,force_N\n");
-    for (size_t k = 0; k <= steps; k++)
-        fprintf(csv->fp, "%.17g,%.17g\n", r->step[k].depth_mm, r->step[k].force_N);
+    fprintf(csv->fp, sc->has_probe ? "depth_mm,force_N" : "load_factor");
+    for (size_t g = 0; g < sc->nregions; g++)
+        region_columns(&sc->regions[g], csv->fp);
+    fprintf(csv->fp, "\n");
+    for (size_t k = 0; k <= steps; k++) {
+        fprintf(csv->fp, "%.17g", r->step[k].depth_mm);
+        if (sc->has_probe)
+            fprintf(csv->fp, ",%.17g", r->step[k].force_N);
+        for (size_t g = 0; g < sc->nregions; g++)
+            if (sc->regions[g].use != CF_REGION_FIXED)
+                for (int a = 0; a < 3; a++)
+                    fprintf(csv->fp, ",%.17g", r->rv[(k * sc->nregions + g) * 3 + (size_t)a]);
+        fprintf(csv->fp, "\n");
+    }
     if (!dir)
         return CF_OK;
     cf_body_state bs;
@@ -155,7 +286,7 @@ end:
 static void summary(FILE *o, const cf_scene *sc, const run *r)
 {
     const cf_body *b = &r->body;
-    const size_t steps = (size_t)sc->probe.steps;
+    const size_t steps = r->steps;
     double minJ = 1, umax = 0;
     int iters = 0;
     for (size_t k = 1; k <= steps; k++) {
@@ -163,11 +294,25 @@ static void summary(FILE *o, const cf_scene *sc, const run *r)
         umax = fmax(umax, r->step[k].max_u_over_travel);
         iters += r->step[k].newton_iters;
     }
-    fprintf(o, "spring: %s; body: %s, %zu nodes, %zu tetrahedra, %zu springs, %zu nodes fixed\n",
+    fprintf(o, "spring: %s; body: %s, %zu nodes, %zu tetrahedra, %zu springs, %zu nodes held\n",
             sc->spring_source, sc->body_mesh, b->nn, b->nt, b->ns, r->nfixed);
     fprintf(o, "body: E = %.6g kPa, nu = %.6g (shear modulus %.6g kPa from the spring, volume "
                "modulus %.6g kPa)\n",
             b->E_MPa * 1e3, b->nu, b->mu_MPa * 1e3, b->kappa_MPa * 1e3);
+    for (size_t g = 0; g < sc->nregions; g++) {
+        const cf_scene_region *rg = &sc->regions[g];
+        const double *v = r->rv + (steps * sc->nregions + g) * 3;
+        fprintf(o, "region %s.%s: %zu nodes; at the end %s [%.6g, %.6g, %.6g] %s\n", rg->key,
+                cf_select_name(rg->sel.kind), r->nsel[g],
+                rg->use == CF_REGION_LOADED ? "mean displacement" : "support force", v[0], v[1],
+                v[2], rg->use == CF_REGION_LOADED ? "mm" : "N");
+    }
+    if (!sc->has_probe) {
+        fprintf(o, "no probe: loads ramped in %zu steps; Newton iterations: %d; smallest J %.6g, "
+                   "largest spring compression %.4g of travel\n",
+                steps, iters, minJ, umax);
+        return;
+    }
     fprintf(o, "probe: %s of radius %g mm to depth %g mm in %zu steps; Newton iterations: %d\n",
             sc->probe.shape == CF_PROBE_SPHERE ? "sphere" : "flat punch", sc->probe.radius_mm,
             sc->probe.depth_mm, steps, iters);
@@ -184,7 +329,7 @@ int cf_cli_simulate_body(const cf_scene *sc, const char *scene_path, const char 
     memset(&r, 0, sizeof r);
     const char *fit = sc->fit_path[0] ? sc->fit_path : NULL;
     const char *inputs[4] = {scene_path, sc->body_mesh, fit, NULL};
-    const size_t nfiles = 2 * ((size_t)sc->probe.steps + 1) + 1;
+    const size_t nfiles = 2 * ((size_t)sc->body_steps + 1) + 1;
     cf_atomic *files = NULL;
     cf_cli_out csv = {0};
     int rc = CF_EXIT_OK;
@@ -235,8 +380,16 @@ cf_status cf_cli_body_export(const cf_scene *sc, const char *scene_path, const c
 {
     run r;
     memset(&r, 0, sizeof r);
+    for (size_t g = 0; g < sc->nregions; g++) /* the export holds fixed nodes and moves a probe */
+        if (sc->regions[g].use != CF_REGION_FIXED)
+            return cf_error_set(err, CF_E_DATA, "%s: key '%s': the export of a body takes "
+                                "fixed regions and a probe only", scene_path,
+                                sc->regions[g].key);
+    if (!sc->has_probe)
+        return cf_error_set(err, CF_E_DATA, "%s: missing key 'probe': the export of a body "
+                            "moves a probe", scene_path);
     cf_status st = solve(sc, scene_path, budget, &r, err);
-    const size_t steps = (size_t)sc->probe.steps;
+    const size_t steps = r.steps;
     double *depth = NULL, *force = NULL;
     if (st == CF_OK) {
         depth = malloc(steps * sizeof *depth);

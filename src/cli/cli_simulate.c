@@ -56,7 +56,14 @@ static const char simulate_help[] =
     "sphere|punch, \"radius_mm\", \"center_mm\", \"direction\", \"depth_mm\", \"steps\"} puts the\n"
     "fitted spring on every edge of the mesh and presses the probe in; it writes the CSV\n"
     "depth_mm,force_N (force along the direction, positive pushing into the body) and prints\n"
-    "the body's small-strain E and nu.\n"
+    "the body's small-strain E and nu. Regions (each an object or an array of them, with one\n"
+    "selector: \"below\"/\"above\" {\"axis\", \"value_mm\"} or {\"normal\", \"point_mm\"},\n"
+    "\"box\" {\"min_mm\", \"max_mm\"}, \"sphere\" {\"center_mm\", \"radius_mm\"}, \"group\" NAME|NUMBER\n"
+    "or {\"name\"|\"tag\", \"dim\"}, a physical group of the mesh file): \"fixed\" holds them,\n"
+    "\"displaced\" moves them by \"by_mm\": [dx, dy, dz] (null: that component free), \"loaded\"\n"
+    "spreads \"force_N\": [Fx, Fy, Fz] over them; all ramp with the steps. Without a probe,\n"
+    "\"body\": {\"steps\": N} (default 10) and the CSV starts with load_factor; displaced regions\n"
+    "add their support force (_Fx_N..), loaded ones their mean displacement (_ux_mm..).\n"
     "  --vtu DIR           with a body: also write DIR/body_NNNN.vtu, DIR/springs_NNNN.vtu per\n"
     "                      step and DIR/body.pvd (ParaView)\n";
 

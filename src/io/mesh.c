@@ -29,7 +29,8 @@ static int gmsh_ready;
     X(gmshModelAdd) X(gmshModelMeshFieldAdd) X(gmshModelMeshFieldSetAsBackgroundMesh)              \
     X(gmshModelMeshFieldSetString) X(gmshModelMeshGenerate) X(gmshModelMeshGetElements)            \
     X(gmshModelMeshGetNodes) X(gmshModelMeshRefine) X(gmshModelOccAddBox)                          \
-    X(gmshModelOccSynchronize) X(gmshOpen) X(gmshOptionSetNumber)
+    X(gmshModelOccSynchronize) X(gmshOpen) X(gmshOptionSetNumber) X(gmshModelGetPhysicalGroups)     \
+    X(gmshModelGetPhysicalName) X(gmshModelMeshGetNodesForPhysicalGroup)
 #define GMSH_FIELD(f) __typeof__(&f) f;
 static struct {
     GMSH_FUNCTIONS(GMSH_FIELD)
@@ -116,6 +117,12 @@ static int cmp_size(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
 /* Corner count and tetrahedra of Gmsh element type t: linear or higher-order tetrahedra (their
 ** four corners) and hexahedra (six tetrahedra around the diagonal from corner 0 to corner 6). */
 static int volume_type(int t, int *corners, int *tets)
@@ -132,6 +139,53 @@ static int volume_type(int t, int *corners, int *tets)
     default:
         return 0;
     }
+}
+
+/* The current Gmsh model's physical groups into m: each group's nodes among the nn used ones
+** (their tags in sorted); a node of a group that no volume element uses is left out. */
+static cf_status extract_groups(const char *name, cf_mesh *m, const size_t *sorted, size_t nn,
+                                cf_error *err)
+{
+    int ierr = 0, *dt = NULL;
+    size_t ndt = 0;
+    gm.gmshModelGetPhysicalGroups(&dt, &ndt, -1, &ierr);
+    if (ierr || ndt == 0) {
+        gm.gmshFree(dt);
+        return CF_OK; /* no groups */
+    }
+    cf_status st = CF_OK;
+    m->groups = calloc(ndt / 2, sizeof *m->groups);
+    if (!m->groups) {
+        gm.gmshFree(dt);
+        return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the mesh's groups", name);
+    }
+    for (size_t k = 0; k + 1 < ndt && st == CF_OK; k += 2) {
+        cf_mesh_group *g = &m->groups[m->ngroups++];
+        g->dim = dt[k];
+        g->tag = dt[k + 1];
+        char *gname = NULL;
+        gm.gmshModelGetPhysicalName(g->dim, g->tag, &gname, &ierr);
+        snprintf(g->name, sizeof g->name, "%s", !ierr && gname ? gname : "");
+        gm.gmshFree(gname);
+        size_t *tags = NULL, ntags = 0, ncoord = 0;
+        double *coord = NULL;
+        gm.gmshModelMeshGetNodesForPhysicalGroup(g->dim, g->tag, &tags, &ntags, &coord, &ncoord,
+                                                 &ierr);
+        g->nodes = malloc((ntags ? ntags : 1) * sizeof *g->nodes);
+        if (!g->nodes)
+            st = cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the mesh's groups", name);
+        for (size_t j = 0; g->nodes && !ierr && j < ntags; j++) {
+            const size_t *hit = bsearch(&tags[j], sorted, nn, sizeof *sorted, cmp_size);
+            if (hit)
+                g->nodes[g->nnodes++] = (uint32_t)(hit - sorted);
+        }
+        gm.gmshFree(tags);
+        gm.gmshFree(coord);
+        if (g->nodes)
+            qsort(g->nodes, g->nnodes, sizeof *g->nodes, cmp_u32);
+    }
+    gm.gmshFree(dt);
+    return st;
 }
 
 /* The current Gmsh model's volume elements into m (node coordinates times unit_mm). */
@@ -248,6 +302,7 @@ static cf_status extract(const char *name, double unit_mm, cf_mesh *m, cf_error 
         }
     }
     m->nt = nt;
+    st = extract_groups(name, m, sorted, nn, err);
     goto end;
 oom:
     st = cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the mesh", name);

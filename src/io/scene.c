@@ -648,7 +648,7 @@ static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
                                           "density_t_per_mm3", "protocol", "effects",
                                           "integrator", "law_method", "table_intervals",
                                           "samples_per_segment", "comment", "body", "fixed",
-                                          "probe", NULL};
+                                          "displaced", "loaded", "probe", NULL};
     cf_status st;
     if (!json_is_object(root))
         return cf_error_set(c->err, CF_E_DATA, "%s: a scene must be a JSON object", c->name);

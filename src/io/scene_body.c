@@ -7,13 +7,233 @@
 
 #include "io/scene_internal.h"
 
-/* "body", "fixed" and "probe": a tissue body of a mesh pressed by a probe. */
+/* A plane selector, "below" or "above": {"axis": "x"|"y"|"z", "value_mm": V} (the coordinate
+** against V) or {"normal": [nx, ny, nz], "point_mm": [x, y, z]} (the side of the plane through the
+** point, along the normal). */
+static cf_status plane(ctx *c, json_t *v, const char *where, cf_select *s)
+{
+    static const char *const ok[] = {"axis", "value_mm", "normal", "point_mm", NULL};
+    cf_status st;
+    if (!json_is_object(v))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be an object", c->name, where);
+    if ((st = cf_scene_only_keys(c, v, where, ok)))
+        return st;
+    json_t *ax = json_object_get(v, "axis");
+    if (ax) {
+        const char *an = json_is_string(ax) ? json_string_value(ax) : "";
+        if (strlen(an) != 1 || !strchr("xyz", an[0]))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.axis' = '%s': expected x, y or z",
+                                c->name, where, an);
+        if (json_object_get(v, "normal") || json_object_get(v, "point_mm"))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' takes 'axis' and 'value_mm' or "
+                                "'normal' and 'point_mm'", c->name, where);
+        s->n[an[0] - 'x'] = 1;
+        return cf_scene_number(c, v, where, "value_mm", 1, 0, -1e12, 0, 1e12, &s->value_mm);
+    }
+    double p[3];
+    if (json_object_get(v, "value_mm"))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.value_mm' goes with 'axis'", c->name,
+                            where);
+    if ((st = cf_scene_vec3(c, v, where, "normal", s->n)) ||
+        (st = cf_scene_vec3(c, v, where, "point_mm", p)))
+        return st;
+    double len = sqrt(s->n[0] * s->n[0] + s->n[1] * s->n[1] + s->n[2] * s->n[2]);
+    if (!(len > 0) || !isfinite(len))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.normal' = [%g, %g, %g]: must not be "
+                            "zero", c->name, where, s->n[0], s->n[1], s->n[2]);
+    for (int a = 0; a < 3; a++)
+        s->n[a] /= len;
+    s->value_mm = s->n[0] * p[0] + s->n[1] * p[1] + s->n[2] * p[2];
+    return CF_OK;
+}
+
+/* "group": a name, a number, or {"name": NAME} / {"tag": NUMBER} with an optional "dim". */
+static cf_status group(ctx *c, json_t *v, const char *where, cf_select *s)
+{
+    static const char *const ok[] = {"name", "tag", "dim", NULL};
+    cf_status st;
+    s->group_tag = -1;
+    s->group_dim = -1;
+    json_t *name = v, *tag = v;
+    if (json_is_object(v)) {
+        if ((st = cf_scene_only_keys(c, v, where, ok)))
+            return st;
+        name = json_object_get(v, "name");
+        tag = json_object_get(v, "tag");
+        if ((name != NULL) == (tag != NULL))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' takes one of 'name' or 'tag'",
+                                c->name, where);
+        if (json_object_get(v, "dim")) {
+            double d;
+            if ((st = cf_scene_number(c, v, where, "dim", 1, 0, 0, 0, 3, &d)))
+                return st;
+            if (d != floor(d))
+                return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.dim' = %g: expected 0, 1, 2 "
+                                    "or 3", c->name, where, d);
+            s->group_dim = (int)d;
+        }
+    }
+    if (name && json_is_string(name)) {
+        if (strlen(json_string_value(name)) >= sizeof s->group_name || !*json_string_value(name))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s': a group's name has 1 to %zu "
+                                "characters", c->name, where, sizeof s->group_name - 1);
+        snprintf(s->group_name, sizeof s->group_name, "%s", json_string_value(name));
+        return CF_OK;
+    }
+    if (tag && json_is_integer(tag) && json_integer_value(tag) >= 0 &&
+        json_integer_value(tag) <= 2147483647) {
+        s->group_tag = (int)json_integer_value(tag);
+        return CF_OK;
+    }
+    return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be a physical group's name or "
+                        "number (a whole number >= 0)", c->name, where);
+}
+
+/* One region at key: exactly one selector (the table below), and the value its use takes. */
+static cf_status region(ctx *c, json_t *v, const char *key, cf_region_use use, cf_scene *sc)
+{
+    static const char *const sel[] = {"below", "above", "box", "sphere", "group"};
+    static const char *const vkey[] = {NULL, "by_mm", "force_N"};
+    cf_status st;
+    if (sc->nregions == CF_SCENE_MAX_REGIONS)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s': more than %d regions", c->name, key,
+                            CF_SCENE_MAX_REGIONS);
+    cf_scene_region *r = &sc->regions[sc->nregions];
+    memset(r, 0, sizeof *r);
+    r->use = use;
+    snprintf(r->key, sizeof r->key, "%s", key);
+    if (!json_is_object(v))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be an object (a region) or an "
+                            "array of them", c->name, key);
+    const char *k;
+    json_t *x, *selv = NULL;
+    int found = -1;
+    json_object_foreach(v, k, x)
+    {
+        int kind = -1;
+        for (int i = 0; i < 5; i++)
+            if (strcmp(k, sel[i]) == 0)
+                kind = i;
+        if (kind >= 0) {
+            if (found >= 0)
+                return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' has two selectors, '%s' and "
+                                    "'%s': a region takes one", c->name, key, sel[found], k);
+            found = kind;
+            selv = x;
+        } else if (!vkey[use] || strcmp(k, vkey[use]) != 0)
+            return cf_error_set(c->err, CF_E_DATA, "%s: unknown key '%s.%s'", c->name, key, k);
+    }
+    if (found < 0)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' needs a selector: below, above, box, "
+                            "sphere or group", c->name, key);
+    char where[96];
+    snprintf(where, sizeof where, "%s.%s", key, sel[found]);
+    r->sel.kind = (cf_select_kind)found;
+    switch (r->sel.kind) {
+    case CF_SELECT_BELOW:
+    case CF_SELECT_ABOVE:
+        st = plane(c, selv, where, &r->sel);
+        break;
+    case CF_SELECT_BOX: {
+        static const char *const ok[] = {"min_mm", "max_mm", NULL};
+        if (!json_is_object(selv))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be an object", c->name, where);
+        if ((st = cf_scene_only_keys(c, selv, where, ok)) ||
+            (st = cf_scene_vec3(c, selv, where, "min_mm", r->sel.lo_mm)) ||
+            (st = cf_scene_vec3(c, selv, where, "max_mm", r->sel.hi_mm)))
+            return st;
+        for (int a = 0; a < 3; a++)
+            if (!(r->sel.hi_mm[a] >= r->sel.lo_mm[a]))
+                return cf_error_set(c->err, CF_E_DATA, "%s: key '%s': max_mm[%d] = %g is below "
+                                    "min_mm[%d] = %g", c->name, where, a, r->sel.hi_mm[a], a,
+                                    r->sel.lo_mm[a]);
+        break;
+    }
+    case CF_SELECT_SPHERE: {
+        static const char *const ok[] = {"center_mm", "radius_mm", NULL};
+        if (!json_is_object(selv))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be an object", c->name, where);
+        if ((st = cf_scene_only_keys(c, selv, where, ok)) ||
+            (st = cf_scene_vec3(c, selv, where, "center_mm", r->sel.center_mm)) ||
+            (st = cf_scene_number(c, selv, where, "radius_mm", 1, 0, 0, 1, 1e12,
+                                  &r->sel.radius_mm)))
+            return st;
+        break;
+    }
+    default:
+        st = group(c, selv, where, &r->sel);
+        break;
+    }
+    if (st)
+        return st;
+    if (use == CF_REGION_FIXED) {
+        r->comps = 7;
+    } else if (use == CF_REGION_LOADED) {
+        if ((st = cf_scene_vec3(c, v, key, "force_N", r->vec)))
+            return st;
+    } else {
+        /* by_mm: three numbers, null for a component left free */
+        json_t *a = json_object_get(v, "by_mm");
+        if (!a || !json_is_array(a) || json_array_size(a) != 3)
+            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.by_mm' must be an array of 3 "
+                                "numbers (null for a free component)", c->name, key);
+        for (size_t i = 0; i < 3; i++) {
+            json_t *e = json_array_get(a, i);
+            if (json_is_null(e))
+                continue;
+            if (!json_is_number(e) || !isfinite(json_number_value(e)) ||
+                fabs(json_number_value(e)) > 1e12)
+                return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.by_mm' must be an array of 3 "
+                                    "finite numbers or null", c->name, key);
+            r->vec[i] = json_number_value(e);
+            r->comps |= 1u << i;
+        }
+        if (!r->comps)
+            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.by_mm' prescribes no component",
+                                c->name, key);
+    }
+    sc->nregions++;
+    return CF_OK;
+}
+
+/* "fixed", "displaced" and "loaded": each a region or an array of regions. */
+static cf_status regions_section(ctx *c, json_t *root, cf_scene *sc)
+{
+    static const char *const uses[] = {"fixed", "displaced", "loaded"};
+    cf_status st;
+    for (int u = 0; u < 3; u++) {
+        json_t *v = json_object_get(root, uses[u]);
+        if (!v)
+            continue;
+        if (!json_is_array(v)) {
+            if ((st = region(c, v, uses[u], (cf_region_use)u, sc)))
+                return st;
+            continue;
+        }
+        if (json_array_size(v) == 0)
+            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' is an empty array", c->name,
+                                uses[u]);
+        for (size_t i = 0; i < json_array_size(v); i++) {
+            char key[48];
+            snprintf(key, sizeof key, "%s[%zu]", uses[u], i);
+            if ((st = region(c, json_array_get(v, i), key, (cf_region_use)u, sc)))
+                return st;
+        }
+    }
+    int held = 0;
+    for (size_t k = 0; k < sc->nregions; k++)
+        held |= sc->regions[k].use != CF_REGION_LOADED;
+    if (!held)
+        return cf_error_set(c->err, CF_E_DATA, "%s: missing key 'fixed': a body needs a 'fixed' "
+                            "or a 'displaced' region to hold it", c->name);
+    return CF_OK;
+}
+
+/* "body", the regions and "probe": a tissue body of a mesh, held, loaded and probed. */
 static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
 {
     static const char *const bk[] = {"mesh", "unit_mm", "refine", "poisson_ratio",
-                                     "volume_modulus_MPa", NULL};
-    static const char *const fk[] = {"below", NULL};
-    static const char *const fbk[] = {"axis", "value_mm", NULL};
+                                     "volume_modulus_MPa", "steps", NULL};
     static const char *const pk[] = {"shape", "radius_mm", "center_mm", "direction", "depth_mm",
                                      "steps", NULL};
     cf_status st;
@@ -47,20 +267,31 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
         if ((st = cf_scene_number(c, bd, "body", "volume_modulus_MPa", 1, 0, 0, 0, 1e12, &sc->body_volume_value)))
             return st;
     }
-    json_t *fx, *below, *pb;
-    if ((st = cf_scene_object(c, root, "fixed", 1, &fx)) || (st = cf_scene_only_keys(c, fx, "fixed", fk)) ||
-        (st = cf_scene_object(c, fx, "below", 1, &below)) || (st = cf_scene_only_keys(c, below, "fixed.below", fbk)))
+    if ((st = regions_section(c, root, sc)))
         return st;
-    json_t *ax = json_object_get(below, "axis");
-    const char *an = json_is_string(ax) ? json_string_value(ax) : "";
-    if (strlen(an) != 1 || !strchr("xyz", an[0]))
-        return cf_error_set(c->err, CF_E_DATA, "%s: key 'fixed.below.axis' = '%s': expected x, y "
-                            "or z", c->name, an);
-    sc->fixed_axis = an[0] - 'x';
-    if ((st = cf_scene_number(c, below, "fixed.below", "value_mm", 1, 0, -1e12, 0, 1e12, &sc->fixed_value_mm)))
+    double bsteps;
+    json_t *pb;
+    if ((st = cf_scene_number(c, bd, "body", "steps", 0, 10, 1, 0, 100000, &bsteps)))
         return st;
-    if ((st = cf_scene_object(c, root, "probe", 1, &pb)) || (st = cf_scene_only_keys(c, pb, "probe", pk)))
+    sc->body_steps = (int)bsteps;
+    if ((st = cf_scene_object(c, root, "probe", 0, &pb)))
         return st;
+    if (!pb) {
+        int loads = 0;
+        for (size_t k = 0; k < sc->nregions; k++)
+            loads |= sc->regions[k].use != CF_REGION_FIXED;
+        if (!loads)
+            return cf_error_set(c->err, CF_E_DATA, "%s: missing key 'probe': a body needs a probe, "
+                                "a 'displaced' or a 'loaded' region", c->name);
+        sc->has_body = 1;
+        return CF_OK;
+    }
+    if (json_object_get(bd, "steps"))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'body.steps': with a probe, "
+                            "'probe.steps' counts the steps", c->name);
+    if ((st = cf_scene_only_keys(c, pb, "probe", pk)))
+        return st;
+    sc->has_probe = 1;
     json_t *shape = json_object_get(pb, "shape");
     const char *sn = json_is_string(shape) ? json_string_value(shape) : "";
     if (strcmp(sn, "sphere") == 0)
@@ -78,6 +309,7 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
         (st = cf_scene_vec3(c, pb, "probe", "direction", d)))
         return st;
     sc->probe.steps = (int)steps;
+    sc->body_steps = (int)steps;
     double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
     if (!(len > 0) || !isfinite(len))
         return cf_error_set(c->err, CF_E_DATA, "%s: key 'probe.direction' = [%g, %g, %g]: must "
@@ -94,9 +326,10 @@ cf_status cf_scene_body(ctx *c, json_t *root, cf_scene *sc)
     json_t *bd;
     if ((st = cf_scene_object(c, root, "body", 0, &bd)))
         return st;
-    if (!bd && (json_object_get(root, "fixed") || json_object_get(root, "probe")))
-        return cf_error_set(c->err, CF_E_DATA, "%s: keys 'fixed' and 'probe' need a 'body'",
-                            c->name);
+    if (!bd && (json_object_get(root, "fixed") || json_object_get(root, "displaced") ||
+                json_object_get(root, "loaded") || json_object_get(root, "probe")))
+        return cf_error_set(c->err, CF_E_DATA, "%s: keys 'fixed', 'displaced', 'loaded' and "
+                            "'probe' need a 'body'", c->name);
     if (bd && (sc->has_extension || (c->from_fit && c->fit.volume_modulus_MPa > 0)))
         return cf_error_set(c->err, CF_E_DATA,
                             "%s: key 'body': a body's edges take one spring law and its volume "

@@ -328,6 +328,8 @@ void cf_body_free(cf_body *b)
     free(b->sj);
     free(b->L0);
     free(b->c);
+    free(b->f_ext);
+    free(b->reaction);
     memset(b, 0, sizeof *b);
 }
 

@@ -401,6 +401,9 @@ double cf_body_assemble(const cf_body *b, const double *x, const cf_probe *pr, c
     }
     if (b->kappa_MPa > 0 && !volume_term(b, x, g, P))
         return NAN;
+    if (b->f_ext)
+        for (size_t i = 0; i < 3 * b->nn; i++)
+            g[i] -= b->f_ext[i];
     double force = 0;
     int nc = 0;
     if (pr && c && active)
@@ -425,6 +428,17 @@ double cf_body_assemble(const cf_body *b, const double *x, const cf_probe *pr, c
     if (contacts)
         *contacts = nc;
     return force;
+}
+
+/* Copies the residual g at the held components into b->reaction (when there is one): at an
+** equilibrium, the force the supports apply there. */
+void cf_body_keep_reaction(const cf_body *b, const double *g)
+{
+    if (!b->reaction)
+        return;
+    for (size_t i = 0; i < b->nn; i++)
+        for (int a = 0; a < 3; a++)
+            b->reaction[3 * i + (size_t)a] = ((b->fix[i] >> a) & 1) ? g[3 * i + (size_t)a] : 0;
 }
 
 /* Zeroes the rows and columns of fixed components (diagonal 1) and their gradient entries. */
@@ -456,6 +470,9 @@ cf_status cf_body_internal_force(const cf_body *b, double *g, cf_error *err)
 {
     if (isnan(cf_body_assemble(b, b->x, NULL, NULL, 0, NULL, g, NULL, NULL)))
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's forces");
+    if (b->f_ext)
+        for (size_t i = 0; i < 3 * b->nn; i++)
+            g[i] += b->f_ext[i];
     return CF_OK;
 }
 

@@ -195,6 +195,7 @@ cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm
             st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's forces");
             goto end;
         }
+        cf_body_keep_reaction(b, w->g);
         cf_body_apply_fixed(b, NULL, w->g);
         r = body_norm_inf(w->g, n);
         if (r <= 1e-8 * fscale)

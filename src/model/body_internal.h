@@ -106,6 +106,8 @@ double cf_body_penetration(const cf_probe *pr, const double *c, const double *p,
 ** direction and the number of nodes in contact; NAN when memory runs out. */
 double cf_body_assemble(const cf_body *b, const double *x, const cf_probe *pr, const double *c,
                         double kp, const uint8_t *active, double *g, pattern *P, int *contacts);
+/* The residual g (before cf_body_apply_fixed) at the held components into b->reaction. */
+void cf_body_keep_reaction(const cf_body *b, const double *g);
 /* Zeroes the rows and columns of fixed components (diagonal 1) and their gradient entries. */
 void cf_body_apply_fixed(const cf_body *b, pattern *P, double *g);
 /* 1 when positions x invert no tetrahedron and take no spring to solid. */

@@ -16,6 +16,9 @@ void cf_mesh_free(cf_mesh *m)
     free(m->tet);
     free(m->id);
     free(m->eid);
+    for (size_t k = 0; k < m->ngroups; k++)
+        free(m->groups[k].nodes);
+    free(m->groups);
     memset(m, 0, sizeof *m);
 }
 

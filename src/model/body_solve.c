@@ -125,6 +125,7 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
         goto end;
     }
     force = cf_body_assemble(b, b->x, probe, c, kp, active, g, NULL, &contacts);
+    cf_body_keep_reaction(b, g);
     out->depth_mm = depth_mm;
     out->force_N = force;
     out->contacts = contacts;
