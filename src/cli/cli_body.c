@@ -25,6 +25,7 @@ typedef struct run {
     double *xs;          /* (steps + 1) x 3 nn positions */
     cf_body_step *step;  /* steps + 1 */
     size_t nfixed;       /* nodes with a held component */
+    cf_mesh_surface_info surface; /* a surface filled with tetrahedra: what was found and done */
     double *presc;       /* 3 nn: each held component's displacement at the last step, mm */
     double *fload;       /* 3 nn: the loads at the last step, N (NULL: none) */
     uint8_t *mark;       /* nregions x nn: the nodes of each region */
@@ -133,8 +134,12 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
     if ((st = cf_law_init(&r->law, &sc->spring, err)) != CF_OK ||
         (sc->method == CF_LAW_TABLE &&
          (st = cf_law_table_build(&r->law, sc->table_intervals, err)) != CF_OK) ||
-        (st = cf_mesh_read_refined(sc->body_mesh, sc->body_unit_mm, sc->body_refine, &r->mesh,
-                                   err)) != CF_OK)
+        (sc->body_element_size_mm > 0
+             ? (st = cf_mesh_from_surface(sc->body_mesh, sc->body_unit_mm,
+                                          sc->body_element_size_mm, &r->mesh, &r->surface,
+                                          err)) != CF_OK
+             : (st = cf_mesh_read_refined(sc->body_mesh, sc->body_unit_mm, sc->body_refine,
+                                          &r->mesh, err)) != CF_OK))
         return st;
     const size_t steps = r->steps = (size_t)sc->body_steps;
     /* memory: the factor of the tangent (about 40 times its 3 x 3 blocks for meshes of organ
@@ -299,6 +304,20 @@ static void summary(FILE *o, const cf_scene *sc, const run *r)
     fprintf(o, "body: E = %.6g kPa, nu = %.6g (shear modulus %.6g kPa from the spring, volume "
                "modulus %.6g kPa)\n",
             b->E_MPa * 1e3, b->nu, b->mu_MPa * 1e3, b->kappa_MPa * 1e3);
+    if (sc->body_element_size_mm > 0) {
+        const cf_mesh_surface_info *si = &r->surface;
+        double V = 0;
+        for (size_t t = 0; t < b->nt; t++)
+            V += b->V0[t];
+        fprintf(o, "surface: %zu vertices, %zu triangles%s, enclosing %.6g mm^3; filled with "
+                   "tetrahedra of %g mm: %.6g mm^3 (%.4f of it)\n",
+                si->vertices, si->triangles, si->reversed ? " (turned outward)" : "",
+                si->enclosed_mm3, sc->body_element_size_mm, V, V / si->enclosed_mm3);
+        if (si->crossings)
+            fprintf(o, "surface: %zu edges crossed the surface elsewhere; %zu vertices smoothed "
+                       "(moved at most %.3g mm) to undo it\n",
+                    si->crossings, si->smoothed, si->max_move_mm);
+    }
     for (size_t g = 0; g < sc->nregions; g++) {
         const cf_scene_region *rg = &sc->regions[g];
         const double *v = r->rv + (steps * sc->nregions + g) * 3;

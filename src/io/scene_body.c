@@ -4,6 +4,7 @@
 */
 #include <math.h>
 #include <string.h>
+#include <strings.h>
 
 #include "io/scene_internal.h"
 
@@ -229,11 +230,46 @@ static cf_status regions_section(ctx *c, json_t *root, cf_scene *sc)
     return CF_OK;
 }
 
+static int ends_with(const char *s, const char *ext)
+{
+    size_t n = strlen(s), e = strlen(ext);
+    return n > e && strcasecmp(s + n - e, ext) == 0;
+}
+
+/* body.mesh's kind: a volume mesh (refine allowed), a closed surface (.obj, .stl) that takes
+** body.element_size_mm, or a Gmsh script (.geo), refused: Gmsh's language runs commands, and a
+** scene's inputs are data. */
+static cf_status mesh_kind(ctx *c, json_t *bd, cf_scene *sc)
+{
+    const char *m = sc->body_mesh;
+    cf_status st;
+    if (ends_with(m, ".geo") || ends_with(m, ".geo_unrolled"))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'body.mesh' = '%s': a Gmsh script is a "
+                            "program (its System calls run commands) and conifit reads data only: "
+                            "mesh it with gmsh -3 and give the .msh, or give its closed surface "
+                            "as .stl or .obj with 'body.element_size_mm'", c->name, m);
+    const int surface = ends_with(m, ".obj") || ends_with(m, ".stl");
+    json_t *h = json_object_get(bd, "element_size_mm");
+    if (surface && !h)
+        return cf_error_set(c->err, CF_E_DATA, "%s: missing key 'body.element_size_mm': '%s' is a "
+                            "surface, filled with tetrahedra of that size", c->name, m);
+    if (!surface && h)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'body.element_size_mm' goes with a closed "
+                            "surface (.obj, .stl) for 'body.mesh', not '%s'", c->name, m);
+    if (surface && sc->body_refine)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'body.refine' goes with a volume mesh; "
+                            "give a smaller 'body.element_size_mm'", c->name);
+    if (surface && (st = cf_scene_number(c, bd, "body", "element_size_mm", 1, 0, 0, 1, 1e9,
+                                         &sc->body_element_size_mm)))
+        return st;
+    return CF_OK;
+}
+
 /* "body", the regions and "probe": a tissue body of a mesh, held, loaded and probed. */
 static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
 {
     static const char *const bk[] = {"mesh", "unit_mm", "refine", "poisson_ratio",
-                                     "volume_modulus_MPa", "steps", NULL};
+                                     "volume_modulus_MPa", "steps", "element_size_mm", NULL};
     static const char *const pk[] = {"shape", "radius_mm", "center_mm", "direction", "depth_mm",
                                      "steps", NULL};
     cf_status st;
@@ -254,6 +290,8 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
         return cf_error_set(c->err, CF_E_DATA, "%s: key 'body.refine' = %g: must be a whole "
                             "number", c->name, refine);
     sc->body_refine = (int)refine;
+    if ((st = mesh_kind(c, bd, sc)))
+        return st;
     json_t *pr = json_object_get(bd, "poisson_ratio"), *km = json_object_get(bd, "volume_modulus_MPa");
     if (pr && km)
         return cf_error_set(c->err, CF_E_DATA, "%s: keys 'body.poisson_ratio' and "

@@ -67,6 +67,9 @@ typedef struct cf_scene {
     char body_mesh[4096];       /* body.mesh: the volume mesh file */
     double body_unit_mm;        /* body.unit_mm: mesh coordinates times this are mm */
     int body_refine;            /* body.refine: uniform refinements of the mesh (0 to 4) */
+    double body_element_size_mm; /* body.element_size_mm: with a closed surface (.obj, .stl) for
+                                    body.mesh, the target size of the tetrahedra filling it, mm;
+                                    0 with a volume mesh */
     int body_volume;            /* 0 no volume term, 1 body.volume_modulus_MPa, 2 body.poisson_ratio */
     double body_volume_value;   /* kappa (MPa) or nu */
     int body_steps;             /* static steps of the run: probe.steps, or body.steps without a
