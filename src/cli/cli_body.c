@@ -178,6 +178,7 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu steps", steps);
     memcpy(r->xs, b->x, 3 * b->nn * sizeof *r->xs);
     r->step[0].min_J = 1;
+    double fdepth = 0; /* a force-driven probe's depth, found step by step */
     for (size_t k = 1; k <= steps; k++) {
         const double lam = (double)k / (double)steps;
         const double depth = sc->has_probe ? sc->probe.depth_mm * lam : 0;
@@ -187,7 +188,16 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
             if (r->fload)
                 b->f_ext[q] = lam * r->fload[q];
         }
-        if ((st = cf_body_solve(b, probe, depth, 0, &r->step[k], err)) != CF_OK) {
+        if ((st = sc->has_probe && sc->probe.force_N > 0
+                      ? cf_body_solve_force(b, probe, sc->probe.force_N * lam, &fdepth, 0,
+                                            &r->step[k], err)
+                      : cf_body_solve(b, probe, depth, 0, &r->step[k], err)) != CF_OK) {
+            if (err && st == CF_E_DATA && sc->probe.force_N > 0) { /* the scene's key */
+                char why[sizeof err->msg];
+                snprintf(why, sizeof why, "%s", err->msg);
+                snprintf(err->msg, sizeof err->msg, "%s: key 'probe.force_N' = %g: %.400s",
+                         scene_path, sc->probe.force_N, why);
+            }
             if (err) /* which step: without a probe the depth says nothing */
                 snprintf(err->msg + strlen(err->msg), sizeof err->msg - strlen(err->msg),
                          " (step %zu of %zu, loads at %g of the scene's)", k, steps, lam);
@@ -332,9 +342,16 @@ static void summary(FILE *o, const cf_scene *sc, const run *r)
                 steps, iters, minJ, umax);
         return;
     }
-    fprintf(o, "probe: %s of radius %g mm to depth %g mm in %zu steps; Newton iterations: %d\n",
-            sc->probe.shape == CF_PROBE_SPHERE ? "sphere" : "flat punch", sc->probe.radius_mm,
-            sc->probe.depth_mm, steps, iters);
+    if (sc->probe.force_N > 0)
+        fprintf(o, "probe: %s of radius %g mm pressed to %g N in %zu steps; Newton iterations: "
+                   "%d\n",
+                sc->probe.shape == CF_PROBE_SPHERE ? "sphere" : "flat punch",
+                sc->probe.radius_mm, sc->probe.force_N, steps, iters);
+    else
+        fprintf(o, "probe: %s of radius %g mm to depth %g mm in %zu steps; Newton iterations: "
+                   "%d\n",
+                sc->probe.shape == CF_PROBE_SPHERE ? "sphere" : "flat punch",
+                sc->probe.radius_mm, sc->probe.depth_mm, steps, iters);
     fprintf(o, "end: depth %.6g mm, force %.6g N, %d nodes in contact; smallest J %.6g, largest "
                "spring compression %.4g of travel\n",
             r->step[steps].depth_mm, r->step[steps].force_N, r->step[steps].contacts, minJ, umax);

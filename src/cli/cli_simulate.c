@@ -65,6 +65,8 @@ static const char simulate_help[] =
     "spreads \"force_N\": [Fx, Fy, Fz] over them; all ramp with the steps. Without a probe,\n"
     "\"body\": {\"steps\": N} (default 10) and the CSV starts with load_factor; displaced regions\n"
     "add their support force (_Fx_N..), loaded ones their mean displacement (_ux_mm..).\n"
+    "\"probe\": {\"force_N\": F} instead of \"depth_mm\" presses the probe to the force F in equal\n"
+    "steps of force (the depth of each found by regula falsi).\n"
     "  --vtu DIR           with a body: also write DIR/body_NNNN.vtu, DIR/springs_NNNN.vtu per\n"
     "                      step and DIR/body.pvd (ParaView)\n";
 

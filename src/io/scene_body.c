@@ -230,6 +230,20 @@ static cf_status regions_section(ctx *c, json_t *root, cf_scene *sc)
     return CF_OK;
 }
 
+/* The probe's drive: exactly one of 'probe.depth_mm' (the travel at the last step) or
+** 'probe.force_N' (the force it is pressed to at the last step). */
+static cf_status probe_drive(ctx *c, json_t *pb, cf_probe *p)
+{
+    json_t *d = json_object_get(pb, "depth_mm"), *f = json_object_get(pb, "force_N");
+    if (d && f)
+        return cf_error_set(c->err, CF_E_DATA, "%s: keys 'probe.depth_mm' and 'probe.force_N' "
+                            "exclude each other: the probe goes to a depth or to a force",
+                            c->name);
+    if (f)
+        return cf_scene_number(c, pb, "probe", "force_N", 1, 0, 0, 1, 1e12, &p->force_N);
+    return cf_scene_number(c, pb, "probe", "depth_mm", 1, 0, 0, 1, 1e12, &p->depth_mm);
+}
+
 static int ends_with(const char *s, const char *ext)
 {
     size_t n = strlen(s), e = strlen(ext);
@@ -271,7 +285,7 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
     static const char *const bk[] = {"mesh", "unit_mm", "refine", "poisson_ratio",
                                      "volume_modulus_MPa", "steps", "element_size_mm", NULL};
     static const char *const pk[] = {"shape", "radius_mm", "center_mm", "direction", "depth_mm",
-                                     "steps", NULL};
+                                     "force_N", "steps", NULL};
     cf_status st;
     if (json_object_get(root, "lattice") || json_object_get(root, "protocol"))
         return cf_error_set(c->err, CF_E_DATA, "%s: key 'body' replaces 'lattice' and "
@@ -341,7 +355,7 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
                             "punch", c->name, sn);
     double steps, d[3];
     if ((st = cf_scene_number(c, pb, "probe", "radius_mm", 1, 0, 0, 1, 1e12, &sc->probe.radius_mm)) ||
-        (st = cf_scene_number(c, pb, "probe", "depth_mm", 1, 0, 0, 1, 1e12, &sc->probe.depth_mm)) ||
+        (st = probe_drive(c, pb, &sc->probe)) ||
         (st = cf_scene_number(c, pb, "probe", "steps", 0, 10, 1, 0, 100000, &steps)) ||
         (st = cf_scene_vec3(c, pb, "probe", "center_mm", sc->probe.center_mm)) ||
         (st = cf_scene_vec3(c, pb, "probe", "direction", d)))

@@ -368,6 +368,87 @@ static void bad_regions_are_refused_naming_the_key_and_write_nothing(void **stat
     }
 }
 
+/* Runs the cube on rollers probed by a sphere from above, to `drive` ("depth_mm": D or
+** "force_N": F) in 4 steps; reads the CSV's depth and force into d[5], F[5]. */
+static void probe_cube(const char *name, const char *drive, double d[5], double F[5])
+{
+    char mesh[600], scene[600], csv[600], out[8192], err[8192], head[2048];
+    snprintf(mesh, sizeof mesh, "%s/cube.msh", dir);
+    snprintf(scene, sizeof scene, "%s/%s.json", dir, name);
+    snprintf(csv, sizeof csv, "%s/%s.csv", dir, name);
+    write_cube(mesh, 1.25);
+    FILE *f = fopen(scene, "w");
+    assert_non_null(f);
+    fprintf(f,
+            "{" SPRING ",\n \"body\": {\"mesh\": \"%s\", \"unit_mm\": 1, \"poisson_ratio\": 0.45},\n"
+            " \"fixed\": {\"below\": {\"axis\": \"z\", \"value_mm\": 0}},\n"
+            " \"probe\": {\"shape\": \"sphere\", \"radius_mm\": 3, \"center_mm\": [5, 5, 13.2], "
+            "\"direction\": [0, 0, -1], %s, \"steps\": 4}}\n",
+            mesh, drive);
+    fclose(f);
+    assert_int_equal(tu_run(out, sizeof out, err, sizeof err, "simulate %s -o %s", scene, csv), 0);
+    double v[10];
+    assert_int_equal(read_csv(csv, head, sizeof head, v, 2, 5), 5);
+    assert_string_equal(head, "depth_mm,force_N\n");
+    for (int k = 0; k < 5; k++) {
+        d[k] = v[2 * k];
+        F[k] = v[2 * k + 1];
+    }
+}
+
+static void a_probe_pressed_to_a_force_stops_at_the_depth_of_that_force(void **state)
+{
+    (void)state;
+    double dd[5], Fd[5], df[5], Ff[5];
+    probe_cube("bydepth", "\"depth_mm\": 1", dd, Fd);
+    char drive[100];
+    snprintf(drive, sizeof drive, "\"force_N\": %.17g", Fd[4]);
+    probe_cube("byforce", drive, df, Ff);
+    print_message("sphere on the cube: to depth 1 mm %.6g N; to that force: depth %.9g mm, "
+                  "force %.9g N; steps at %.5g %.5g %.5g mm\n",
+                  Fd[4], df[4], Ff[4], df[1], df[2], df[3]);
+    for (int k = 1; k <= 4; k++) {
+        assert_close(Ff[k], Fd[4] * k / 4, 2e-6 * Fd[4]); /* the ramp of forces */
+        assert_true(df[k] > df[k - 1]);
+    }
+    assert_close(df[4], 1, 1e-5);
+    /* the sphere touches at 0.2 mm: a quarter of the force is reached past it, deeper than a
+    ** quarter of the depth (Hertz: F ~ d^1.5) */
+    assert_true(df[1] > 0.2 && df[1] < 1);
+}
+
+static void a_probe_with_two_drives_or_none_to_touch_is_refused(void **state)
+{
+    (void)state;
+    char mesh[600], scene[600], csv[600], out[8192], err[8192];
+    snprintf(mesh, sizeof mesh, "%s/cube.msh", dir);
+    snprintf(scene, sizeof scene, "%s/drive.json", dir);
+    snprintf(csv, sizeof csv, "%s/drive.csv", dir);
+    write_cube(mesh, 2.5);
+    static const struct {
+        const char *probe, *must;
+    } cases[] = {
+        {"\"direction\": [0, 0, -1], \"depth_mm\": 1, \"force_N\": 1", "exclude each other"},
+        {"\"direction\": [0, 0, 1], \"force_N\": 1", "key 'probe.force_N' = 1: body: the probe moves past"},
+        {"\"direction\": [0, 0, -1], \"force_N\": -1", "'probe.force_N' = -1"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        FILE *f = fopen(scene, "w");
+        assert_non_null(f);
+        fprintf(f, "{" SPRING ", \"body\": {\"mesh\": \"%s\", \"unit_mm\": 1}, \"fixed\": "
+                   "{\"below\": {\"axis\": \"z\", \"value_mm\": 0}}, \"probe\": {\"shape\": "
+                   "\"sphere\", \"radius_mm\": 3, \"center_mm\": [5, 5, 14], %s}}\n",
+                mesh, cases[k].probe);
+        fclose(f);
+        int rc = tu_run(out, sizeof out, err, sizeof err, "simulate %s -o %s", scene, csv);
+        if (rc != 65 || !strstr(err, cases[k].must))
+            fail_msg("case %zu: exit %d, expected 65 with \"%s\"; stderr: %s", k, rc,
+                     cases[k].must, err);
+        struct stat sb;
+        assert_true(stat(csv, &sb) != 0);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -376,6 +457,8 @@ int main(void)
         cmocka_unit_test(the_livers_physical_group_is_its_boundary),
         cmocka_unit_test(a_liver_pulled_by_its_group_and_a_sphere_is_carried_by_its_support),
         cmocka_unit_test(bad_regions_are_refused_naming_the_key_and_write_nothing),
+        cmocka_unit_test(a_probe_pressed_to_a_force_stops_at_the_depth_of_that_force),
+        cmocka_unit_test(a_probe_with_two_drives_or_none_to_touch_is_refused),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

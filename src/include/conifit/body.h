@@ -116,7 +116,9 @@ typedef struct cf_probe {
     double center_mm[3]; /* sphere centre, or the centre of the punch's flat face, at depth 0 */
     double dir[3];       /* unit direction of travel */
     double depth_mm;     /* travel at the last step */
-    int steps;           /* equal steps from 0 to depth_mm */
+    double force_N;      /* > 0: the probe is driven by force instead, to this force at the last
+                         ** step (depth_mm unused); 0: by depth */
+    int steps;           /* equal steps from 0 to depth_mm (or to force_N) */
 } cf_probe;
 
 /* The body: the mesh's nodes and tetrahedra, its edges as springs. */
@@ -192,6 +194,16 @@ typedef struct cf_body_step {
 ** solid (message: the depth). */
 cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
                         double penalty_N_per_mm, cf_body_step *out, cf_error *err);
+
+/* The depth at which the probe's reaction is force_N (> 0) and the equilibrium there: the depth
+** found by bracketing from the current one (or, without contact yet, from where the probe first
+** touches a node) and regula falsi (Illinois), each trial a cf_body_solve started from the nearer
+** end of the bracket, until the force is within 1e-6 of force_N (or the bracket narrower than
+** 1e-12 of the mean edge). *depth_mm holds the current depth on entry (0 at rest) and the depth
+** found on return. CF_E_NOCONV when a trial solve fails before the force is reached (the body
+** cannot carry it: the message names the force and the depth), else as cf_body_solve. */
+cf_status cf_body_solve_force(cf_body *b, const cf_probe *probe, double force_N, double *depth_mm,
+                              double penalty_N_per_mm, cf_body_step *out, cf_error *err);
 
 /* One update of the probe loop at haptic rate: the probe moved to depth, then at most max_iters
 ** chord iterations from the current positions, each with the exact residual (springs, volume
