@@ -30,6 +30,7 @@ typedef struct run {
     double *fload;       /* 3 nn: the loads at the last step, N (NULL: none) */
     uint8_t *mark;       /* nregions x nn: the nodes of each region */
     size_t *nsel;        /* nregions: how many */
+    double *time;        /* steps + 1: a probe path's times, s */
     double *rv;          /* (steps + 1) x nregions x 3: a held region's support force (N), a loaded
                          ** one's mean displacement (mm) */
 } run;
@@ -46,6 +47,7 @@ static void run_free(run *r)
     free(r->mark);
     free(r->nsel);
     free(r->rv);
+    free(r->time);
 }
 
 /* The regions of sc on the body: held components and their displacements, the loads. A region
@@ -172,6 +174,11 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
                             b->X[3 * in], b->X[3 * in + 1], b->X[3 * in + 2]);
     r->xs = malloc((steps + 1) * 3 * b->nn * sizeof *r->xs);
     r->step = calloc(steps + 1, sizeof *r->step);
+    r->time = calloc(steps + 1, sizeof *r->time);
+    if (!r->time)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu steps", steps);
+    if (sc->probe_npath)
+        r->time[0] = sc->probe_path_t_s[0];
     if (r->fload && !(b->f_ext = calloc(3 * b->nn, sizeof *b->f_ext)))
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the loads");
     if (!r->xs || !r->step)
@@ -188,10 +195,30 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
             if (r->fload)
                 b->f_ext[q] = lam * r->fload[q];
         }
+        cf_probe moved = sc->probe; /* a probe on a path: its reference point at this time */
+        const cf_probe *pk = probe;
+        double dk = depth, travel = 0;
+        if (sc->probe_npath) {
+            const size_t np = sc->probe_npath;
+            const double *ts = sc->probe_path_t_s;
+            const double t = ts[0] + lam * (ts[np - 1] - ts[0]);
+            size_t j = 0;
+            while (j + 2 < np && ts[j + 1] < t)
+                j++;
+            const double w = fmin(1, fmax(0, (t - ts[j]) / (ts[j + 1] - ts[j])));
+            for (int a = 0; a < 3; a++) {
+                moved.center_mm[a] =
+                    (1 - w) * sc->probe_path_mm[j][a] + w * sc->probe_path_mm[j + 1][a];
+                travel += (moved.center_mm[a] - sc->probe.center_mm[a]) * sc->probe.dir[a];
+            }
+            r->time[k] = t;
+            pk = &moved;
+            dk = 0;
+        }
         if ((st = sc->has_probe && sc->probe.force_N > 0
-                      ? cf_body_solve_force(b, probe, sc->probe.force_N * lam, &fdepth, 0,
+                      ? cf_body_solve_force(b, pk, sc->probe.force_N * lam, &fdepth, 0,
                                             &r->step[k], err)
-                      : cf_body_solve(b, probe, depth, 0, &r->step[k], err)) != CF_OK) {
+                      : cf_body_solve(b, pk, dk, 0, &r->step[k], err)) != CF_OK) {
             if (err && st == CF_E_DATA && sc->probe.force_N > 0) { /* the scene's key */
                 char why[sizeof err->msg];
                 snprintf(why, sizeof why, "%s", err->msg);
@@ -205,6 +232,8 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
         }
         if (!sc->has_probe)
             r->step[k].depth_mm = lam; /* the load factor stands for the depth */
+        if (sc->probe_npath)
+            r->step[k].depth_mm = travel; /* along the direction, from the path's start */
         if (!isfinite(r->step[k].force_N))
             return cf_error_set(err, CF_E_INTERNAL, "body: force not finite at step %zu", k);
         region_values(sc, r, k);
@@ -240,11 +269,14 @@ static cf_status write_all(const cf_scene *sc, const run *r, const char *out, co
     cf_status st = cf_cli_out_open(csv, out, inputs, err);
     if (st)
         return st;
-    fprintf(csv->fp, sc->has_probe ? "depth_mm,force_N" : "load_factor");
+    fprintf(csv->fp, !sc->has_probe ? "load_factor" : sc->probe_npath ? "time_s,depth_mm,force_N"
+                                                                      : "depth_mm,force_N");
     for (size_t g = 0; g < sc->nregions; g++)
         region_columns(&sc->regions[g], csv->fp);
     fprintf(csv->fp, "\n");
     for (size_t k = 0; k <= steps; k++) {
+        if (sc->probe_npath)
+            fprintf(csv->fp, "%.17g,", r->time[k]);
         fprintf(csv->fp, "%.17g", r->step[k].depth_mm);
         if (sc->has_probe)
             fprintf(csv->fp, ",%.17g", r->step[k].force_N);
@@ -270,7 +302,7 @@ static cf_status write_all(const cf_scene *sc, const run *r, const char *out, co
     for (size_t k = 0; k <= steps && st == CF_OK; k++) {
         tmp.x = r->xs + k * 3 * b->nn;
         cf_body_measure(&tmp, &bs, NULL);
-        depth[k] = r->step[k].depth_mm;
+        depth[k] = sc->probe_npath ? r->time[k] : r->step[k].depth_mm; /* the PVD's times */
         snprintf(path, sizeof path, "%s/body_%04zu.vtu", dir, k);
         if ((st = cf_atomic_open(&files[2 * k], path, inputs, err)) != CF_OK)
             break;
@@ -342,7 +374,13 @@ static void summary(FILE *o, const cf_scene *sc, const run *r)
                 steps, iters, minJ, umax);
         return;
     }
-    if (sc->probe.force_N > 0)
+    if (sc->probe_npath)
+        fprintf(o, "probe: %s of radius %g mm along a path of %zu points over %g s in %zu steps; "
+                   "Newton iterations: %d\n",
+                sc->probe.shape == CF_PROBE_SPHERE ? "sphere" : "flat punch",
+                sc->probe.radius_mm, sc->probe_npath,
+                sc->probe_path_t_s[sc->probe_npath - 1] - sc->probe_path_t_s[0], steps, iters);
+    else if (sc->probe.force_N > 0)
         fprintf(o, "probe: %s of radius %g mm pressed to %g N in %zu steps; Newton iterations: "
                    "%d\n",
                 sc->probe.shape == CF_PROBE_SPHERE ? "sphere" : "flat punch",
@@ -424,6 +462,9 @@ cf_status cf_cli_body_export(const cf_scene *sc, const char *scene_path, const c
     if (!sc->has_probe)
         return cf_error_set(err, CF_E_DATA, "%s: missing key 'probe': the export of a body "
                             "moves a probe", scene_path);
+    if (sc->probe_npath)
+        return cf_error_set(err, CF_E_DATA, "%s: key 'probe.path': the export of a body moves "
+                            "the probe along its direction only", scene_path);
     cf_status st = solve(sc, scene_path, budget, &r, err);
     const size_t steps = r.steps;
     double *depth = NULL, *force = NULL;

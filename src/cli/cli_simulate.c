@@ -66,7 +66,9 @@ static const char simulate_help[] =
     "\"body\": {\"steps\": N} (default 10) and the CSV starts with load_factor; displaced regions\n"
     "add their support force (_Fx_N..), loaded ones their mean displacement (_ux_mm..).\n"
     "\"probe\": {\"force_N\": F} instead of \"depth_mm\" presses the probe to the force F in equal\n"
-    "steps of force (the depth of each found by regula falsi).\n"
+    "steps of force (the depth of each found by regula falsi); \"path\": {\"t_s\": [...],\n"
+    "\"center_mm\": [[x, y, z], ...]} instead of center_mm and depth moves it along a path in\n"
+    "time, in steps equal in time (CSV time_s,depth_mm,force_N).\n"
     "  --vtu DIR           with a body: also write DIR/body_NNNN.vtu, DIR/springs_NNNN.vtu per\n"
     "                      step and DIR/body.pvd (ParaView)\n";
 

@@ -232,9 +232,59 @@ static cf_status regions_section(ctx *c, json_t *root, cf_scene *sc)
 
 /* The probe's drive: exactly one of 'probe.depth_mm' (the travel at the last step) or
 ** 'probe.force_N' (the force it is pressed to at the last step). */
-static cf_status probe_drive(ctx *c, json_t *pb, cf_probe *p)
+/* 'probe.path': {"t_s": [t0, t1, ...], "center_mm": [[x, y, z], ...]}, the probe's reference
+** point in time (in place of 'center_mm' and of a depth or force). */
+static cf_status probe_path(ctx *c, json_t *pa, cf_scene *sc)
 {
+    static const char *const ok[] = {"t_s", "center_mm", NULL};
+    cf_status st;
+    if (!json_is_object(pa))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'probe.path' must be an object {\"t_s\": "
+                            "[...], \"center_mm\": [[x, y, z], ...]}", c->name);
+    if ((st = cf_scene_only_keys(c, pa, "probe.path", ok)))
+        return st;
+    json_t *t = json_object_get(pa, "t_s"), *x = json_object_get(pa, "center_mm");
+    const size_t n = json_is_array(t) ? json_array_size(t) : 0;
+    if (n < 2 || n > CF_SCENE_MAX_PATH || !json_is_array(x) || json_array_size(x) != n)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'probe.path': 't_s' and 'center_mm' must "
+                            "be arrays of the same length, 2 to %d", c->name, CF_SCENE_MAX_PATH);
+    for (size_t i = 0; i < n; i++) {
+        json_t *ti = json_array_get(t, i), *xi = json_array_get(x, i);
+        if (!json_is_number(ti) || !isfinite(json_number_value(ti)) ||
+            fabs(json_number_value(ti)) > 1e12 ||
+            (i > 0 && !(json_number_value(ti) > sc->probe_path_t_s[i - 1])))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key 'probe.path.t_s[%zu]': the times must "
+                                "be finite and increasing", c->name, i);
+        sc->probe_path_t_s[i] = json_number_value(ti);
+        if (!json_is_array(xi) || json_array_size(xi) != 3)
+            return cf_error_set(c->err, CF_E_DATA, "%s: key 'probe.path.center_mm[%zu]' must be "
+                                "an array of 3 numbers", c->name, i);
+        for (size_t a = 0; a < 3; a++) {
+            json_t *v = json_array_get(xi, a);
+            if (!json_is_number(v) || !isfinite(json_number_value(v)) ||
+                fabs(json_number_value(v)) > 1e12)
+                return cf_error_set(c->err, CF_E_DATA, "%s: key 'probe.path.center_mm[%zu]' must "
+                                    "be an array of 3 finite numbers", c->name, i);
+            sc->probe_path_mm[i][a] = json_number_value(v);
+        }
+    }
+    sc->probe_npath = n;
+    memcpy(sc->probe.center_mm, sc->probe_path_mm[0], sizeof sc->probe.center_mm);
+    return CF_OK;
+}
+
+static cf_status probe_drive(ctx *c, json_t *pb, cf_scene *sc)
+{
+    cf_probe *p = &sc->probe;
     json_t *d = json_object_get(pb, "depth_mm"), *f = json_object_get(pb, "force_N");
+    json_t *pa = json_object_get(pb, "path");
+    if (pa) {
+        if (d || f || json_object_get(pb, "center_mm"))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key 'probe.path' takes the place of "
+                                "'probe.center_mm', 'probe.depth_mm' and 'probe.force_N'",
+                                c->name);
+        return probe_path(c, pa, sc);
+    }
     if (d && f)
         return cf_error_set(c->err, CF_E_DATA, "%s: keys 'probe.depth_mm' and 'probe.force_N' "
                             "exclude each other: the probe goes to a depth or to a force",
@@ -285,7 +335,7 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
     static const char *const bk[] = {"mesh", "unit_mm", "refine", "poisson_ratio",
                                      "volume_modulus_MPa", "steps", "element_size_mm", NULL};
     static const char *const pk[] = {"shape", "radius_mm", "center_mm", "direction", "depth_mm",
-                                     "force_N", "steps", NULL};
+                                     "force_N", "path", "steps", NULL};
     cf_status st;
     if (json_object_get(root, "lattice") || json_object_get(root, "protocol"))
         return cf_error_set(c->err, CF_E_DATA, "%s: key 'body' replaces 'lattice' and "
@@ -355,9 +405,10 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
                             "punch", c->name, sn);
     double steps, d[3];
     if ((st = cf_scene_number(c, pb, "probe", "radius_mm", 1, 0, 0, 1, 1e12, &sc->probe.radius_mm)) ||
-        (st = probe_drive(c, pb, &sc->probe)) ||
+        (st = probe_drive(c, pb, sc)) ||
         (st = cf_scene_number(c, pb, "probe", "steps", 0, 10, 1, 0, 100000, &steps)) ||
-        (st = cf_scene_vec3(c, pb, "probe", "center_mm", sc->probe.center_mm)) ||
+        (!sc->probe_npath &&
+         (st = cf_scene_vec3(c, pb, "probe", "center_mm", sc->probe.center_mm))) ||
         (st = cf_scene_vec3(c, pb, "probe", "direction", d)))
         return st;
     sc->probe.steps = (int)steps;

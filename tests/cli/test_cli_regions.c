@@ -449,6 +449,73 @@ static void a_probe_with_two_drives_or_none_to_touch_is_refused(void **state)
     }
 }
 
+static void a_probe_on_a_path_in_time_follows_it(void **state)
+{
+    (void)state;
+    char mesh[600], scene[600], csv[600], out[8192], err[8192], head[2048];
+    snprintf(mesh, sizeof mesh, "%s/cube.msh", dir);
+    snprintf(scene, sizeof scene, "%s/path.json", dir);
+    snprintf(csv, sizeof csv, "%s/path.csv", dir);
+    write_cube(mesh, 1.25);
+    /* straight down 1 mm in the first second (as probe_cube's depth-driven run, in 4 of the 16
+    ** steps), 2 mm across and back, and up again */
+    FILE *f = fopen(scene, "w");
+    assert_non_null(f);
+    fprintf(f,
+            "{" SPRING ",\n \"body\": {\"mesh\": \"%s\", \"unit_mm\": 1, \"poisson_ratio\": 0.45},\n"
+            " \"fixed\": {\"below\": {\"axis\": \"z\", \"value_mm\": 0}},\n"
+            " \"probe\": {\"shape\": \"sphere\", \"radius_mm\": 3, \"direction\": [0, 0, -1], "
+            "\"steps\": 16, \"path\": {\"t_s\": [0, 1, 2, 3, 4], \"center_mm\": [[5, 5, 13.2], "
+            "[5, 5, 12.2], [3, 5, 12.2], [5, 5, 12.2], [5, 5, 13.2]]}}}\n",
+            mesh);
+    fclose(f);
+    assert_int_equal(tu_run(out, sizeof out, err, sizeof err, "simulate %s -o %s", scene, csv), 0);
+    double v[17 * 3], dd[5], Fd[5];
+    assert_int_equal(read_csv(csv, head, sizeof head, v, 3, 17), 17);
+    assert_string_equal(head, "time_s,depth_mm,force_N\n");
+    probe_cube("bydepth2", "\"depth_mm\": 1", dd, Fd);
+    for (int k = 0; k <= 4; k++) { /* the way down is the depth-driven run */
+        assert_close(v[3 * k], 0.25 * k, 1e-12);
+        assert_close(v[3 * k + 1], dd[k], 1e-12);
+        assert_close(v[3 * k + 2], Fd[k], 1e-9 * Fd[4]);
+    }
+    /* elastic and static: back at a place and depth, the force of the way down */
+    print_message("path: down %.6g %.6g N; across and back %.6g %.6g %.6g N; up %.6g %.6g N\n",
+                  v[3 * 2 + 2], v[3 * 4 + 2], v[3 * 6 + 2], v[3 * 8 + 2], v[3 * 12 + 2],
+                  v[3 * 14 + 2], v[3 * 16 + 2]);
+    for (int k = 12; k <= 16; k++) {
+        assert_close(v[3 * k + 1], dd[16 - k], 1e-12);
+        assert_close(v[3 * k + 2], Fd[16 - k], 0.01 * Fd[4]);
+    }
+    for (int k = 5; k <= 11; k++) /* across the top of the block, about the same force */
+        assert_close(v[3 * k + 2] / Fd[4], 1, 0.2);
+    assert_true(strstr(out, "along a path of 5 points over 4 s in 16 steps") != NULL);
+    /* a path beside center_mm, or with times that do not increase, is refused */
+    static const char *const bad[][2] = {
+        {"\"center_mm\": [5, 5, 13], \"path\": {\"t_s\": [0, 1], \"center_mm\": [[5, 5, 13], [5, "
+         "5, 12]]}",
+         "'probe.path' takes the place of"},
+        {"\"path\": {\"t_s\": [0, 0], \"center_mm\": [[5, 5, 13], [5, 5, 12]]}",
+         "'probe.path.t_s[1]'"},
+    };
+    for (size_t k = 0; k < 2; k++) {
+        f = fopen(scene, "w");
+        assert_non_null(f);
+        fprintf(f, "{" SPRING ", \"body\": {\"mesh\": \"%s\", \"unit_mm\": 1}, \"fixed\": "
+                   "{\"below\": {\"axis\": \"z\", \"value_mm\": 0}}, \"probe\": {\"shape\": "
+                   "\"sphere\", \"radius_mm\": 1, \"direction\": [0, 0, -1], %s}}\n",
+                mesh, bad[k][0]);
+        fclose(f);
+        remove(csv);
+        int rc = tu_run(out, sizeof out, err, sizeof err, "simulate %s -o %s", scene, csv);
+        if (rc != 65 || !strstr(err, bad[k][1]))
+            fail_msg("bad path %zu: exit %d, expected 65 with \"%s\"; stderr: %s", k, rc,
+                     bad[k][1], err);
+        struct stat sb;
+        assert_true(stat(csv, &sb) != 0);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -459,6 +526,7 @@ int main(void)
         cmocka_unit_test(bad_regions_are_refused_naming_the_key_and_write_nothing),
         cmocka_unit_test(a_probe_pressed_to_a_force_stops_at_the_depth_of_that_force),
         cmocka_unit_test(a_probe_with_two_drives_or_none_to_touch_is_refused),
+        cmocka_unit_test(a_probe_on_a_path_in_time_follows_it),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -39,6 +39,9 @@ typedef struct cf_scene_region {
     char key[48];               /* the scene key that names it ("fixed", "displaced[1]") */
 } cf_scene_region;
 
+/* Most points of a probe's path. */
+#define CF_SCENE_MAX_PATH 1000
+
 /* Most regions a scene may have. */
 #define CF_SCENE_MAX_REGIONS 64
 
@@ -77,6 +80,12 @@ typedef struct cf_scene {
     size_t nregions;            /* the regions "fixed", "displaced", "loaded", in that order */
     cf_scene_region regions[CF_SCENE_MAX_REGIONS];
     int has_probe;              /* 1 when the scene has "probe" */
+    size_t probe_npath;         /* probe.path: 0, or its points (2 to CF_SCENE_MAX_PATH): the
+                                   probe's reference point at times probe_path_t_s (strictly
+                                   increasing), straight between them; probe.center_mm is the
+                                   first point and the steps are equal in time */
+    double probe_path_t_s[CF_SCENE_MAX_PATH];
+    double probe_path_mm[CF_SCENE_MAX_PATH][3];
     cf_probe probe;             /* probe */
 } cf_scene;
 
