@@ -116,9 +116,10 @@ typedef struct cf_probe {
     double center_mm[3]; /* sphere centre, or the centre of the punch's flat face, at depth 0 */
     double dir[3];       /* unit direction of travel */
     double depth_mm;     /* travel at the last step */
-    double force_N;      /* > 0: the probe is driven by force instead, to this force at the last
-                         ** step (depth_mm unused); 0: by depth */
     int steps;           /* equal steps from 0 to depth_mm (or to force_N) */
+    double force_N;      /* > 0: the probe is driven by force instead, to this force at the last
+                         ** step (depth_mm unused); 0: by depth (last, so that an initialiser of
+                         ** the fields above in order still holds) */
 } cf_probe;
 
 /* The body: the mesh's nodes and tetrahedra, its edges as springs. */
