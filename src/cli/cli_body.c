@@ -22,9 +22,18 @@ typedef struct run {
     cf_law law;
     cf_mesh mesh;
     cf_body body;
+    size_t steps;
     double *xs;          /* (steps + 1) x 3 nn positions */
     cf_body_step *step;  /* steps + 1 */
-    size_t nfixed;
+    size_t nfixed;       /* nodes with a held component */
+    cf_mesh_surface_info surface; /* a surface filled with tetrahedra: what was found and done */
+    double *presc;       /* 3 nn: each held component's displacement at the last step, mm */
+    double *fload;       /* 3 nn: the loads at the last step, N (NULL: none) */
+    uint8_t *mark;       /* nregions x nn: the nodes of each region */
+    size_t *nsel;        /* nregions: how many */
+    double *time;        /* steps + 1: a probe path's times, s */
+    double *rv;          /* (steps + 1) x nregions x 3: a held region's support force (N), a loaded
+                         ** one's mean displacement (mm) */
 } run;
 
 static void run_free(run *r)
@@ -34,66 +43,244 @@ static void run_free(run *r)
     cf_law_free(&r->law);
     free(r->xs);
     free(r->step);
+    free(r->presc);
+    free(r->fload);
+    free(r->mark);
+    free(r->nsel);
+    free(r->rv);
+    free(r->time);
+}
+
+cf_status cf_cli_body_load(const cf_scene *sc, cf_law *law, cf_mesh *mesh,
+                           cf_mesh_surface_info *surface, cf_error *err)
+{
+    cf_status st;
+    cf_mesh_surface_info unused;
+    if ((st = cf_law_init(law, &sc->spring, err)) != CF_OK ||
+        (sc->method == CF_LAW_TABLE &&
+         (st = cf_law_table_build(law, sc->table_intervals, err)) != CF_OK))
+        return st;
+    return sc->body_element_size_mm > 0
+               ? cf_mesh_from_surface(sc->body_mesh, sc->body_unit_mm, sc->body_element_size_mm,
+                                      mesh, surface ? surface : &unused, err)
+               : cf_mesh_read_refined(sc->body_mesh, sc->body_unit_mm, sc->body_refine, mesh,
+                                      err);
+}
+
+cf_status cf_cli_body_create(const cf_scene *sc, const cf_law *law, const cf_mesh *mesh,
+                             cf_body *b, cf_error *err)
+{
+    double kappa = 0, mu = cf_body_mu_of_law(law);
+    if (sc->body_volume == 1)
+        kappa = sc->body_volume_value;
+    else if (sc->body_volume == 2)
+        kappa = cf_body_kappa_for_nu(mu, sc->body_volume_value);
+    return cf_body_create(b, mesh, law, sc->method, kappa, err);
+}
+
+cf_status cf_cli_body_probe_outside(const cf_scene *sc, const char *scene_path,
+                                    const cf_body *b, const cf_mesh *mesh, const cf_probe *probe,
+                                    cf_error *err)
+{
+    long in = cf_body_probe_inside(b, probe);
+    if (in >= 0)
+        return cf_error_set(err, CF_E_DATA, "%s: key 'probe.center_mm': the probe starts inside "
+                            "the body (node %lu of %s at [%g, %g, %g] mm)",
+                            scene_path, (unsigned long)mesh->id[in], sc->body_mesh,
+                            b->X[3 * in], b->X[3 * in + 1], b->X[3 * in + 2]);
+    return CF_OK;
+}
+
+/* The regions of sc on the body: held components and their displacements, the loads. A region
+** that selects nothing, and a component two regions hold at different displacements, are
+** refused. */
+static cf_status regions(const cf_scene *sc, const char *scene_path, run *r, cf_error *err)
+{
+    cf_body *b = &r->body;
+    const size_t nn = b->nn, nr = sc->nregions;
+    uint8_t *owner = calloc(3 * nn, 1); /* 1 + the region that holds a component */
+    r->presc = calloc(3 * nn, sizeof *r->presc);
+    r->mark = calloc(nr * nn + 1, 1);
+    r->nsel = calloc(nr + 1, sizeof *r->nsel);
+    r->rv = calloc((r->steps + 1) * nr * 3 + 1, sizeof *r->rv);
+    b->reaction = calloc(3 * nn, sizeof *b->reaction);
+    cf_status st = CF_OK;
+    if (!owner || !r->presc || !r->mark || !r->nsel || !r->rv || !b->reaction) {
+        free(owner);
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the regions");
+    }
+    for (size_t k = 0; k < nr && st == CF_OK; k++) {
+        const cf_scene_region *g = &sc->regions[k];
+        uint8_t *m = r->mark + k * nn;
+        r->nsel[k] = cf_mesh_select(&r->mesh, &g->sel, m);
+        if (r->nsel[k] == 0) {
+            st = cf_error_set(err, CF_E_DATA, "%s: key '%s.%s' selects no node of %s",
+                              scene_path, g->key, cf_select_name(g->sel.kind), sc->body_mesh);
+            break;
+        }
+        if (g->use == CF_REGION_LOADED) {
+            if (!r->fload && !(r->fload = calloc(3 * nn, sizeof *r->fload)))
+                st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the loads");
+            else if (cf_body_spread_force(b, m, g->vec, r->fload) == 0)
+                st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the loads");
+            continue;
+        }
+        for (size_t i = 0; i < nn && st == CF_OK; i++)
+            for (int a = 0; m[i] && a < 3; a++) {
+                if (!((g->comps >> a) & 1))
+                    continue;
+                const size_t q = 3 * i + (size_t)a;
+                if (owner[q] && r->presc[q] != g->vec[a]) {
+                    st = cf_error_set(err, CF_E_DATA, "%s: keys '%s' and '%s' hold the %c "
+                                      "component of node %lu of %s at different displacements "
+                                      "(%g and %g mm)", scene_path, sc->regions[owner[q] - 1].key,
+                                      g->key, 'x' + a, (unsigned long)r->mesh.id[i],
+                                      sc->body_mesh, r->presc[q], g->vec[a]);
+                    break;
+                }
+                owner[q] = (uint8_t)(k + 1);
+                r->presc[q] = g->vec[a];
+                b->fix[i] |= (uint8_t)(1u << a);
+            }
+    }
+    free(owner);
+    for (size_t i = 0; i < nn; i++)
+        r->nfixed += b->fix[i] != 0;
+    return st;
+}
+
+/* The regions' numbers at step k: support forces of held regions (at the components they hold),
+** mean displacements of loaded ones. */
+static void region_values(const cf_scene *sc, run *r, size_t k)
+{
+    const cf_body *b = &r->body;
+    const size_t nn = b->nn, nr = sc->nregions;
+    for (size_t g = 0; g < nr; g++) {
+        double *v = r->rv + (k * nr + g) * 3;
+        const uint8_t *m = r->mark + g * nn;
+        v[0] = v[1] = v[2] = 0;
+        const unsigned comps = sc->regions[g].use == CF_REGION_LOADED ? 7 : sc->regions[g].comps;
+        for (size_t i = 0; i < nn; i++)
+            for (int a = 0; m[i] && a < 3; a++)
+                if ((comps >> a) & 1)
+                    v[a] += sc->regions[g].use == CF_REGION_LOADED
+                            ? (b->x[3 * i + (size_t)a] - b->X[3 * i + (size_t)a]) /
+                                  (double)r->nsel[g]
+                            : b->reaction[3 * i + (size_t)a];
+    }
 }
 
 static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budget *budget, run *r,
                        cf_error *err)
 {
     cf_status st;
-    if ((st = cf_law_init(&r->law, &sc->spring, err)) != CF_OK ||
-        (sc->method == CF_LAW_TABLE &&
-         (st = cf_law_table_build(&r->law, sc->table_intervals, err)) != CF_OK) ||
-        (st = cf_mesh_read_refined(sc->body_mesh, sc->body_unit_mm, sc->body_refine, &r->mesh,
-                                   err)) != CF_OK)
+    if ((st = cf_cli_body_load(sc, &r->law, &r->mesh, &r->surface, err)) != CF_OK)
         return st;
-    const size_t steps = (size_t)sc->probe.steps;
+    const size_t steps = r->steps = (size_t)sc->body_steps;
     /* memory: the factor of the tangent (about 40 times its 3 x 3 blocks for meshes of organ
     ** size), the matrix, and one copy of the positions per step */
     double bytes = (double)r->mesh.nn * 3 * (81.0 * 16 * 8 + 40.0 * 81 * 8) +
-                   (double)(steps + 1) * 3 * (double)r->mesh.nn * 8;
+                   (double)(steps + 1) * 3 * (double)r->mesh.nn * 8 +
+                   (double)sc->nregions * (double)r->mesh.nn;
     if (bytes > budget->max_memory_bytes)
         return cf_error_set(err, CF_E_DATA, "%s: the body of %s (%zu nodes, %zu steps) needs "
                             "about %.3g bytes, over the limit %.3g (--max-memory)",
                             scene_path, sc->body_mesh, r->mesh.nn, steps, bytes,
                             budget->max_memory_bytes);
-    double kappa = 0, mu = cf_body_mu_of_law(&r->law);
-    if (sc->body_volume == 1)
-        kappa = sc->body_volume_value;
-    else if (sc->body_volume == 2)
-        kappa = cf_body_kappa_for_nu(mu, sc->body_volume_value);
-    if ((st = cf_body_create(&r->body, &r->mesh, &r->law, sc->method, kappa, err)) != CF_OK)
+    if ((st = cf_cli_body_create(sc, &r->law, &r->mesh, &r->body, err)) != CF_OK)
         return st;
     cf_body *b = &r->body;
-    for (size_t i = 0; i < b->nn; i++)
-        if (b->X[3 * i + (size_t)sc->fixed_axis] <= sc->fixed_value_mm) {
-            b->fix[i] = CF_BODY_FIX_ALL;
-            r->nfixed++;
-        }
-    if (r->nfixed == 0)
-        return cf_error_set(err, CF_E_DATA, "%s: key 'fixed.below' (%c <= %g mm) selects no node "
-                            "of %s", scene_path, 'x' + sc->fixed_axis, sc->fixed_value_mm,
-                            sc->body_mesh);
-    long in = cf_body_probe_inside(b, &sc->probe);
-    if (in >= 0)
-        return cf_error_set(err, CF_E_DATA, "%s: key 'probe.center_mm': the probe starts inside "
-                            "the body (node %lu of %s at [%g, %g, %g] mm)",
-                            scene_path, (unsigned long)r->mesh.id[in], sc->body_mesh,
-                            b->X[3 * in], b->X[3 * in + 1], b->X[3 * in + 2]);
+    if ((st = regions(sc, scene_path, r, err)) != CF_OK)
+        return st;
+    cf_probe none = {.shape = CF_PROBE_SPHERE, .dir = {0, 0, 1}}; /* radius 0: touches nothing */
+    const cf_probe *probe = sc->has_probe ? &sc->probe : &none;
+    if ((st = cf_cli_body_probe_outside(sc, scene_path, b, &r->mesh, probe, err)) != CF_OK)
+        return st;
     r->xs = malloc((steps + 1) * 3 * b->nn * sizeof *r->xs);
     r->step = calloc(steps + 1, sizeof *r->step);
+    r->time = calloc(steps + 1, sizeof *r->time);
+    if (!r->time)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu steps", steps);
+    if (sc->probe_npath)
+        r->time[0] = sc->probe_path_t_s[0];
+    if (r->fload && !(b->f_ext = calloc(3 * b->nn, sizeof *b->f_ext)))
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the loads");
     if (!r->xs || !r->step)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu steps", steps);
     memcpy(r->xs, b->x, 3 * b->nn * sizeof *r->xs);
     r->step[0].min_J = 1;
+    double fdepth = 0; /* a force-driven probe's depth, found step by step */
     for (size_t k = 1; k <= steps; k++) {
-        double depth = sc->probe.depth_mm * (double)k / (double)steps;
-        if ((st = cf_body_solve(b, &sc->probe, depth, 0, &r->step[k], err)) != CF_OK)
+        const double lam = (double)k / (double)steps;
+        const double depth = sc->has_probe ? sc->probe.depth_mm * lam : 0;
+        for (size_t q = 0; q < 3 * b->nn; q++) {
+            if ((b->fix[q / 3] >> (q % 3)) & 1)
+                b->x[q] = b->X[q] + lam * r->presc[q];
+            if (r->fload)
+                b->f_ext[q] = lam * r->fload[q];
+        }
+        cf_probe moved = sc->probe; /* a probe on a path: its reference point at this time */
+        const cf_probe *pk = probe;
+        double dk = depth, travel = 0;
+        if (sc->probe_npath) {
+            const size_t np = sc->probe_npath;
+            const double *ts = sc->probe_path_t_s;
+            const double t = ts[0] + lam * (ts[np - 1] - ts[0]);
+            size_t j = 0;
+            while (j + 2 < np && ts[j + 1] < t)
+                j++;
+            const double w = fmin(1, fmax(0, (t - ts[j]) / (ts[j + 1] - ts[j])));
+            for (int a = 0; a < 3; a++) {
+                moved.center_mm[a] =
+                    (1 - w) * sc->probe_path_mm[j][a] + w * sc->probe_path_mm[j + 1][a];
+                travel += (moved.center_mm[a] - sc->probe.center_mm[a]) * sc->probe.dir[a];
+            }
+            r->time[k] = t;
+            pk = &moved;
+            dk = 0;
+        }
+        if ((st = sc->has_probe && sc->probe.force_N > 0
+                      ? cf_body_solve_force(b, pk, sc->probe.force_N * lam, &fdepth, 0,
+                                            &r->step[k], err)
+                      : cf_body_solve(b, pk, dk, 0, &r->step[k], err)) != CF_OK) {
+            if (err && st == CF_E_DATA && sc->probe.force_N > 0) { /* the scene's key */
+                char why[sizeof err->msg];
+                snprintf(why, sizeof why, "%s", err->msg);
+                snprintf(err->msg, sizeof err->msg, "%s: key 'probe.force_N' = %g: %.400s",
+                         scene_path, sc->probe.force_N, why);
+            }
+            if (err) /* which step: without a probe the depth says nothing */
+                snprintf(err->msg + strlen(err->msg), sizeof err->msg - strlen(err->msg),
+                         " (step %zu of %zu, loads at %g of the scene's)", k, steps, lam);
             return st;
+        }
+        if (!sc->has_probe)
+            r->step[k].depth_mm = lam; /* the load factor stands for the depth */
+        if (sc->probe_npath)
+            r->step[k].depth_mm = travel; /* along the direction, from the path's start */
         if (!isfinite(r->step[k].force_N))
-            return cf_error_set(err, CF_E_INTERNAL, "body: force not finite at depth %g mm", depth);
+            return cf_error_set(err, CF_E_INTERNAL, "body: force not finite at step %zu", k);
+        region_values(sc, r, k);
         memcpy(r->xs + k * 3 * b->nn, b->x, 3 * b->nn * sizeof *r->xs);
     }
     return CF_OK;
+}
+
+/* The CSV's column names of region k (a held region's support force, a loaded one's mean
+** displacement), or 0 for a fixed region (no columns). */
+static int region_columns(const cf_scene_region *g, FILE *f)
+{
+    if (g->use == CF_REGION_FIXED)
+        return 0;
+    char name[48];
+    size_t n = 0;
+    for (const char *p = g->key; *p && n + 1 < sizeof name; p++) /* "displaced[1]" -> displaced1 */
+        if (*p != '[' && *p != ']')
+            name[n++] = *p;
+    name[n] = 0;
+    for (int a = 0; a < 3; a++)
+        fprintf(f, g->use == CF_REGION_LOADED ? ",%s_u%c_mm" : ",%s_F%c_N", name, 'x' + a);
+    return 1;
 }
 
 /* Opens, writes and finishes every output (nothing committed yet). */
@@ -102,13 +289,27 @@ static cf_status write_all(const cf_scene *sc, const run *r, const char *out, co
                            cf_error *err)
 {
     const cf_body *b = &r->body;
-    const size_t steps = (size_t)sc->probe.steps;
+    const size_t steps = r->steps;
     cf_status st = cf_cli_out_open(csv, out, inputs, err);
     if (st)
         return st;
-    fprintf(csv->fp, "depth_mm,force_N\n");
-    for (size_t k = 0; k <= steps; k++)
-        fprintf(csv->fp, "%.17g,%.17g\n", r->step[k].depth_mm, r->step[k].force_N);
+    fprintf(csv->fp, !sc->has_probe ? "load_factor" : sc->probe_npath ? "time_s,depth_mm,force_N"
+                                                                      : "depth_mm,force_N");
+    for (size_t g = 0; g < sc->nregions; g++)
+        region_columns(&sc->regions[g], csv->fp);
+    fprintf(csv->fp, "\n");
+    for (size_t k = 0; k <= steps; k++) {
+        if (sc->probe_npath)
+            fprintf(csv->fp, "%.17g,", r->time[k]);
+        fprintf(csv->fp, "%.17g", r->step[k].depth_mm);
+        if (sc->has_probe)
+            fprintf(csv->fp, ",%.17g", r->step[k].force_N);
+        for (size_t g = 0; g < sc->nregions; g++)
+            if (sc->regions[g].use != CF_REGION_FIXED)
+                for (int a = 0; a < 3; a++)
+                    fprintf(csv->fp, ",%.17g", r->rv[(k * sc->nregions + g) * 3 + (size_t)a]);
+        fprintf(csv->fp, "\n");
+    }
     if (!dir)
         return CF_OK;
     cf_body_state bs;
@@ -125,7 +326,7 @@ static cf_status write_all(const cf_scene *sc, const run *r, const char *out, co
     for (size_t k = 0; k <= steps && st == CF_OK; k++) {
         tmp.x = r->xs + k * 3 * b->nn;
         cf_body_measure(&tmp, &bs, NULL);
-        depth[k] = r->step[k].depth_mm;
+        depth[k] = sc->probe_npath ? r->time[k] : r->step[k].depth_mm; /* the PVD's times */
         snprintf(path, sizeof path, "%s/body_%04zu.vtu", dir, k);
         if ((st = cf_atomic_open(&files[2 * k], path, inputs, err)) != CF_OK)
             break;
@@ -156,7 +357,7 @@ end:
 static void summary(FILE *o, const cf_scene *sc, const run *r)
 {
     const cf_body *b = &r->body;
-    const size_t steps = (size_t)sc->probe.steps;
+    const size_t steps = r->steps;
     double minJ = 1, umax = 0;
     int iters = 0;
     for (size_t k = 1; k <= steps; k++) {
@@ -164,14 +365,55 @@ static void summary(FILE *o, const cf_scene *sc, const run *r)
         umax = fmax(umax, r->step[k].max_u_over_travel);
         iters += r->step[k].newton_iters;
     }
-    fprintf(o, "spring: %s; body: %s, %zu nodes, %zu tetrahedra, %zu springs, %zu nodes fixed\n",
+    fprintf(o, "spring: %s; body: %s, %zu nodes, %zu tetrahedra, %zu springs, %zu nodes held\n",
             sc->spring_source, sc->body_mesh, b->nn, b->nt, b->ns, r->nfixed);
     fprintf(o, "body: E = %.6g kPa, nu = %.6g (shear modulus %.6g kPa from the spring, volume "
                "modulus %.6g kPa)\n",
             b->E_MPa * 1e3, b->nu, b->mu_MPa * 1e3, b->kappa_MPa * 1e3);
-    fprintf(o, "probe: %s of radius %g mm to depth %g mm in %zu steps; Newton iterations: %d\n",
-            sc->probe.shape == CF_PROBE_SPHERE ? "sphere" : "flat punch", sc->probe.radius_mm,
-            sc->probe.depth_mm, steps, iters);
+    if (sc->body_element_size_mm > 0) {
+        const cf_mesh_surface_info *si = &r->surface;
+        double V = 0;
+        for (size_t t = 0; t < b->nt; t++)
+            V += b->V0[t];
+        fprintf(o, "surface: %zu vertices, %zu triangles%s, enclosing %.6g mm^3; filled with "
+                   "tetrahedra of %g mm: %.6g mm^3 (%.4f of it)\n",
+                si->vertices, si->triangles, si->reversed ? " (turned outward)" : "",
+                si->enclosed_mm3, sc->body_element_size_mm, V, V / si->enclosed_mm3);
+        if (si->crossings)
+            fprintf(o, "surface: %zu edges crossed the surface elsewhere; %zu vertices smoothed "
+                       "(moved at most %.3g mm) to undo it\n",
+                    si->crossings, si->smoothed, si->max_move_mm);
+    }
+    for (size_t g = 0; g < sc->nregions; g++) {
+        const cf_scene_region *rg = &sc->regions[g];
+        const double *v = r->rv + (steps * sc->nregions + g) * 3;
+        fprintf(o, "region %s.%s: %zu nodes; at the end %s [%.6g, %.6g, %.6g] %s\n", rg->key,
+                cf_select_name(rg->sel.kind), r->nsel[g],
+                rg->use == CF_REGION_LOADED ? "mean displacement" : "support force", v[0], v[1],
+                v[2], rg->use == CF_REGION_LOADED ? "mm" : "N");
+    }
+    if (!sc->has_probe) {
+        fprintf(o, "no probe: loads ramped in %zu steps; Newton iterations: %d; smallest J %.6g, "
+                   "largest spring compression %.4g of travel\n",
+                steps, iters, minJ, umax);
+        return;
+    }
+    if (sc->probe_npath)
+        fprintf(o, "probe: %s of radius %g mm along a path of %zu points over %g s in %zu steps; "
+                   "Newton iterations: %d\n",
+                sc->probe.shape == CF_PROBE_SPHERE ? "sphere" : "flat punch",
+                sc->probe.radius_mm, sc->probe_npath,
+                sc->probe_path_t_s[sc->probe_npath - 1] - sc->probe_path_t_s[0], steps, iters);
+    else if (sc->probe.force_N > 0)
+        fprintf(o, "probe: %s of radius %g mm pressed to %g N in %zu steps; Newton iterations: "
+                   "%d\n",
+                sc->probe.shape == CF_PROBE_SPHERE ? "sphere" : "flat punch",
+                sc->probe.radius_mm, sc->probe.force_N, steps, iters);
+    else
+        fprintf(o, "probe: %s of radius %g mm to depth %g mm in %zu steps; Newton iterations: "
+                   "%d\n",
+                sc->probe.shape == CF_PROBE_SPHERE ? "sphere" : "flat punch",
+                sc->probe.radius_mm, sc->probe.depth_mm, steps, iters);
     fprintf(o, "end: depth %.6g mm, force %.6g N, %d nodes in contact; smallest J %.6g, largest "
                "spring compression %.4g of travel\n",
             r->step[steps].depth_mm, r->step[steps].force_N, r->step[steps].contacts, minJ, umax);
@@ -185,7 +427,7 @@ int cf_cli_simulate_body(const cf_scene *sc, const char *scene_path, const char 
     memset(&r, 0, sizeof r);
     const char *fit = sc->fit_path[0] ? sc->fit_path : NULL;
     const char *inputs[4] = {scene_path, sc->body_mesh, fit, NULL};
-    const size_t nfiles = 2 * ((size_t)sc->probe.steps + 1) + 1;
+    const size_t nfiles = 2 * ((size_t)sc->body_steps + 1) + 1;
     cf_atomic *files = NULL;
     cf_cli_out csv = {0};
     cf_atomic plot = {0};
@@ -241,8 +483,19 @@ cf_status cf_cli_body_export(const cf_scene *sc, const char *scene_path, const c
 {
     run r;
     memset(&r, 0, sizeof r);
+    for (size_t g = 0; g < sc->nregions; g++) /* the export holds fixed nodes and moves a probe */
+        if (sc->regions[g].use != CF_REGION_FIXED)
+            return cf_error_set(err, CF_E_DATA, "%s: key '%s': the export of a body takes "
+                                "fixed regions and a probe only", scene_path,
+                                sc->regions[g].key);
+    if (!sc->has_probe)
+        return cf_error_set(err, CF_E_DATA, "%s: missing key 'probe': the export of a body "
+                            "moves a probe", scene_path);
+    if (sc->probe_npath)
+        return cf_error_set(err, CF_E_DATA, "%s: key 'probe.path': the export of a body moves "
+                            "the probe along its direction only", scene_path);
     cf_status st = solve(sc, scene_path, budget, &r, err);
-    const size_t steps = (size_t)sc->probe.steps;
+    const size_t steps = r.steps;
     double *depth = NULL, *force = NULL;
     if (st == CF_OK) {
         depth = malloc(steps * sizeof *depth);

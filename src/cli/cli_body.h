@@ -5,7 +5,9 @@
 #ifndef CF_CLI_BODY_H
 #define CF_CLI_BODY_H
 
+#include "conifit/body.h"
 #include "conifit/budget.h"
+#include "conifit/mesh.h"
 #include "conifit/export.h"
 #include "conifit/scene.h"
 
@@ -20,5 +22,17 @@ int cf_cli_simulate_body(const cf_scene *sc, const char *scene_path, const char 
 cf_status cf_cli_body_export(const cf_scene *sc, const char *scene_path, const cf_budget *budget,
                              FILE *out, const cf_export_options *opt, cf_export_report *rep,
                              cf_error *err);
+
+/* What every body command builds as simulate does (cli_haptic.c too): the scene's law (with its
+** table) and mesh (read and refined, or filled from a closed surface; surface, which may be NULL,
+** receives what filling found); the body on them with the scene's volume term; the probe checked
+** to start outside it (CF_E_DATA naming probe.center_mm and the node). */
+cf_status cf_cli_body_load(const cf_scene *sc, cf_law *law, cf_mesh *mesh,
+                           cf_mesh_surface_info *surface, cf_error *err);
+cf_status cf_cli_body_create(const cf_scene *sc, const cf_law *law, const cf_mesh *mesh,
+                             cf_body *b, cf_error *err);
+cf_status cf_cli_body_probe_outside(const cf_scene *sc, const char *scene_path,
+                                    const cf_body *b, const cf_mesh *mesh, const cf_probe *probe,
+                                    cf_error *err);
 
 #endif

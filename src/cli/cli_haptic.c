@@ -17,6 +17,7 @@
 
 #include "base/atomic.h"
 #include "cli/cli.h"
+#include "cli/cli_body.h"
 #include "conifit/mesh.h"
 #include "report/plot.h"
 
@@ -58,35 +59,44 @@ static double path_depth(const cf_scene *sc, double t)
     return sc->haptic_depth_mm[i - 1] + a * (sc->haptic_depth_mm[i] - sc->haptic_depth_mm[i - 1]);
 }
 
-/* Builds b on r's mesh and law as the static run does: volume term, held nodes, probe outside. */
+/* Builds b on r's mesh and law as the static run does (cli_body.h): volume term, the fixed
+** regions' nodes held, probe outside. A region that displaces or loads is refused: the loop holds
+** its supports still. */
 static cf_status make_body(const cf_scene *sc, const char *scene_path, haptic_run *r, cf_body *b,
                            cf_error *err)
 {
-    double kappa = 0, mu = cf_body_mu_of_law(&r->law);
-    if (sc->body_volume == 1)
-        kappa = sc->body_volume_value;
-    else if (sc->body_volume == 2)
-        kappa = cf_body_kappa_for_nu(mu, sc->body_volume_value);
-    cf_status st = cf_body_create(b, &r->mesh, &r->law, sc->method, kappa, err);
+    cf_status st = cf_cli_body_create(sc, &r->law, &r->mesh, b, err);
     if (st != CF_OK)
         return st;
+    uint8_t *mark = malloc(b->nn ? b->nn : 1);
+    if (!mark)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the regions");
     r->nfixed = 0;
-    for (size_t i = 0; i < b->nn; i++)
-        if (b->X[3 * i + (size_t)sc->fixed_axis] <= sc->fixed_value_mm) {
-            b->fix[i] = CF_BODY_FIX_ALL;
-            r->nfixed++;
+    for (size_t k = 0; k < sc->nregions && st == CF_OK; k++) {
+        const cf_scene_region *g = &sc->regions[k];
+        if (g->use != CF_REGION_FIXED) {
+            st = cf_error_set(err, CF_E_DATA, "%s: key '%s': the haptic loop holds its supports "
+                              "still ('fixed' regions only); run the scene without --haptic",
+                              scene_path, g->key);
+            break;
         }
-    if (r->nfixed == 0)
-        return cf_error_set(err, CF_E_DATA, "%s: key 'fixed.below' (%c <= %g mm) selects no node "
-                            "of %s", scene_path, 'x' + sc->fixed_axis, sc->fixed_value_mm,
-                            sc->body_mesh);
-    long in = cf_body_probe_inside(b, &sc->probe);
-    if (in >= 0)
-        return cf_error_set(err, CF_E_DATA, "%s: key 'probe.center_mm': the probe starts inside "
-                            "the body (node %lu of %s at [%g, %g, %g] mm)",
-                            scene_path, (unsigned long)r->mesh.id[in], sc->body_mesh,
-                            b->X[3 * in], b->X[3 * in + 1], b->X[3 * in + 2]);
-    return CF_OK;
+        if (cf_mesh_select(&r->mesh, &g->sel, mark) == 0) {
+            st = cf_error_set(err, CF_E_DATA, "%s: key '%s.%s' selects no node of %s",
+                              scene_path, g->key, cf_select_name(g->sel.kind), sc->body_mesh);
+            break;
+        }
+        for (size_t i = 0; i < b->nn; i++)
+            if (mark[i])
+                b->fix[i] = CF_BODY_FIX_ALL;
+    }
+    free(mark);
+    for (size_t i = 0; st == CF_OK && i < b->nn; i++)
+        r->nfixed += b->fix[i] != 0;
+    if (st == CF_OK && r->nfixed == 0)
+        st = cf_error_set(err, CF_E_DATA, "%s: no node of %s is held: the haptic loop needs a "
+                          "'fixed' region", scene_path, sc->body_mesh);
+    return st != CF_OK ? st
+                       : cf_cli_body_probe_outside(sc, scene_path, b, &r->mesh, &sc->probe, err);
 }
 
 static double now_ms(void)
@@ -101,18 +111,13 @@ static cf_status run(const cf_scene *sc, const char *scene_path, const cf_budget
                      haptic_run *r, cf_error *err)
 {
     cf_status st;
-    if ((st = cf_law_init(&r->law, &sc->spring, err)) != CF_OK ||
-        (sc->method == CF_LAW_TABLE &&
-         (st = cf_law_table_build(&r->law, sc->table_intervals, err)) != CF_OK))
-        return st;
     const double T = sc->haptic_t_ms[sc->haptic_n - 1];
     r->n = (size_t)floor(T) + 1;
     if ((double)r->n > budget->max_steps)
         return cf_error_set(err, CF_E_DATA, "%s: key 'haptic.path' asks for %zu updates (one per "
                             "ms to %g ms), over the limit %.3g (--max-steps)",
                             scene_path, r->n, T, budget->max_steps);
-    if ((st = cf_mesh_read_refined(sc->body_mesh, sc->body_unit_mm, sc->body_refine, &r->mesh,
-                                   err)) != CF_OK)
+    if ((st = cf_cli_body_load(sc, &r->law, &r->mesh, NULL, err)) != CF_OK)
         return st;
     /* memory: two bodies (the loop's and the static one) as the static run estimates one, the
     ** loop's kept columns of the inverse (9 nn per node that touches the probe, at most all of

@@ -7,6 +7,8 @@
 */
 #include "conifit/mesh.h"
 
+#include "io/surface.h"
+
 #include <errno.h>
 #include <math.h>
 #include <pthread.h>
@@ -29,7 +31,11 @@ static int gmsh_ready;
     X(gmshModelAdd) X(gmshModelMeshFieldAdd) X(gmshModelMeshFieldSetAsBackgroundMesh)              \
     X(gmshModelMeshFieldSetString) X(gmshModelMeshGenerate) X(gmshModelMeshGetElements)            \
     X(gmshModelMeshGetNodes) X(gmshModelMeshRefine) X(gmshModelOccAddBox)                          \
-    X(gmshModelOccSynchronize) X(gmshOpen) X(gmshOptionSetNumber)
+    X(gmshModelOccSynchronize) X(gmshOpen) X(gmshOptionSetNumber) X(gmshModelGetPhysicalGroups)     \
+    X(gmshModelGetPhysicalName) X(gmshModelMeshGetNodesForPhysicalGroup)                          \
+    X(gmshModelAddDiscreteEntity) X(gmshModelMeshAddNodes) X(gmshModelMeshAddElementsByType)      \
+    X(gmshModelMeshClassifySurfaces) X(gmshModelMeshCreateGeometry) X(gmshModelGetEntities)       \
+    X(gmshModelGeoAddSurfaceLoop) X(gmshModelGeoAddVolume) X(gmshModelGeoSynchronize)
 #define GMSH_FIELD(f) __typeof__(&f) f;
 static struct {
     GMSH_FUNCTIONS(GMSH_FIELD)
@@ -116,6 +122,12 @@ static int cmp_size(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
 /* Corner count and tetrahedra of Gmsh element type t: linear or higher-order tetrahedra (their
 ** four corners) and hexahedra (six tetrahedra around the diagonal from corner 0 to corner 6). */
 static int volume_type(int t, int *corners, int *tets)
@@ -132,6 +144,53 @@ static int volume_type(int t, int *corners, int *tets)
     default:
         return 0;
     }
+}
+
+/* The current Gmsh model's physical groups into m: each group's nodes among the nn used ones
+** (their tags in sorted); a node of a group that no volume element uses is left out. */
+static cf_status extract_groups(const char *name, cf_mesh *m, const size_t *sorted, size_t nn,
+                                cf_error *err)
+{
+    int ierr = 0, *dt = NULL;
+    size_t ndt = 0;
+    gm.gmshModelGetPhysicalGroups(&dt, &ndt, -1, &ierr);
+    if (ierr || ndt == 0) {
+        gm.gmshFree(dt);
+        return CF_OK; /* no groups */
+    }
+    cf_status st = CF_OK;
+    m->groups = calloc(ndt / 2, sizeof *m->groups);
+    if (!m->groups) {
+        gm.gmshFree(dt);
+        return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the mesh's groups", name);
+    }
+    for (size_t k = 0; k + 1 < ndt && st == CF_OK; k += 2) {
+        cf_mesh_group *g = &m->groups[m->ngroups++];
+        g->dim = dt[k];
+        g->tag = dt[k + 1];
+        char *gname = NULL;
+        gm.gmshModelGetPhysicalName(g->dim, g->tag, &gname, &ierr);
+        snprintf(g->name, sizeof g->name, "%s", !ierr && gname ? gname : "");
+        gm.gmshFree(gname);
+        size_t *tags = NULL, ntags = 0, ncoord = 0;
+        double *coord = NULL;
+        gm.gmshModelMeshGetNodesForPhysicalGroup(g->dim, g->tag, &tags, &ntags, &coord, &ncoord,
+                                                 &ierr);
+        g->nodes = malloc((ntags ? ntags : 1) * sizeof *g->nodes);
+        if (!g->nodes)
+            st = cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the mesh's groups", name);
+        for (size_t j = 0; g->nodes && !ierr && j < ntags; j++) {
+            const size_t *hit = bsearch(&tags[j], sorted, nn, sizeof *sorted, cmp_size);
+            if (hit)
+                g->nodes[g->nnodes++] = (uint32_t)(hit - sorted);
+        }
+        gm.gmshFree(tags);
+        gm.gmshFree(coord);
+        if (g->nodes)
+            qsort(g->nodes, g->nnodes, sizeof *g->nodes, cmp_u32);
+    }
+    gm.gmshFree(dt);
+    return st;
 }
 
 /* The current Gmsh model's volume elements into m (node coordinates times unit_mm). */
@@ -248,6 +307,7 @@ static cf_status extract(const char *name, double unit_mm, cf_mesh *m, cf_error 
         }
     }
     m->nt = nt;
+    st = extract_groups(name, m, sorted, nn, err);
     goto end;
 oom:
     st = cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the mesh", name);
@@ -381,6 +441,126 @@ end:
     gmsh_end();
     pthread_mutex_unlock(&gmsh_lock);
     if (st == CF_OK && (st = cf_mesh_check(m, "box", err)) != CF_OK)
+        cf_mesh_free(m);
+    return st;
+}
+
+/* The Gmsh part of cf_mesh_from_surface: the prepared surface s into the current model as one
+** discrete surface, classified into patches (40 degrees), reparametrised, bounded into a volume and
+** meshed at size h (file units). */
+static cf_status fill_surface(const char *path, const cf_surface *s, double unit_mm, double h,
+                              cf_mesh *m, cf_error *err)
+{
+    int ierr = 0, *dt = NULL;
+    size_t ndt = 0;
+    char why[300];
+    size_t *tags = malloc(s->nv * sizeof *tags), *etags = malloc(s->nf * sizeof *etags),
+           *conn = malloc(3 * s->nf * sizeof *conn);
+    int *surf = NULL;
+    cf_status st = CF_OK;
+    if (!tags || !etags || !conn) {
+        st = cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the surface", path);
+        goto end;
+    }
+    for (size_t i = 0; i < s->nv; i++)
+        tags[i] = i + 1;
+    for (size_t t = 0; t < s->nf; t++) {
+        etags[t] = t + 1;
+        for (int k = 0; k < 3; k++)
+            conn[3 * t + (size_t)k] = (size_t)s->tri[3 * t + (size_t)k] + 1;
+    }
+    gm.gmshModelAdd("surface", &ierr);
+    int tag = gm.gmshModelAddDiscreteEntity(2, -1, NULL, 0, &ierr);
+    gm.gmshModelMeshAddNodes(2, tag, tags, s->nv, s->X, 3 * s->nv, NULL, 0, &ierr);
+    gm.gmshModelMeshAddElementsByType(tag, 2, etags, s->nf, conn, 3 * s->nf, &ierr);
+    if (ierr)
+        goto gmsh_failed;
+    const double pi = 3.14159265358979323846;
+    gm.gmshModelMeshClassifySurfaces(40 * pi / 180, 1, 1, pi, 0, &ierr);
+    if (!ierr)
+        gm.gmshModelMeshCreateGeometry(NULL, 0, &ierr);
+    if (!ierr)
+        gm.gmshModelGetEntities(&dt, &ndt, 2, &ierr);
+    if (ierr || ndt == 0)
+        goto gmsh_failed;
+    surf = malloc(ndt / 2 * sizeof *surf);
+    if (!surf) {
+        st = cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the surface", path);
+        goto end;
+    }
+    for (size_t k = 0; k < ndt / 2; k++)
+        surf[k] = dt[2 * k + 1];
+    int loop = gm.gmshModelGeoAddSurfaceLoop(surf, ndt / 2, -1, &ierr);
+    if (!ierr)
+        gm.gmshModelGeoAddVolume(&loop, 1, -1, &ierr);
+    if (!ierr)
+        gm.gmshModelGeoSynchronize(&ierr);
+    if (ierr)
+        goto gmsh_failed;
+    gm.gmshOptionSetNumber("Mesh.MeshSizeMin", h, &ierr);
+    gm.gmshOptionSetNumber("Mesh.MeshSizeMax", h, &ierr);
+    gm.gmshOptionSetNumber("Mesh.RandomSeed", 1, &ierr);
+    gm.gmshOptionSetNumber("General.NumThreads", 1, &ierr);
+    gm.gmshModelMeshGenerate(3, &ierr);
+    if (ierr) {
+        st = cf_error_set(err, CF_E_DATA, "%s: Gmsh could not fill the surface with tetrahedra: "
+                          "%s", path, gmsh_reason(why, sizeof why));
+        goto end;
+    }
+    st = extract(path, unit_mm, m, err);
+    goto end;
+gmsh_failed:
+    st = cf_error_set(err, CF_E_DATA, "%s: Gmsh could not make a geometry of the surface: %s",
+                      path, gmsh_reason(why, sizeof why));
+end:
+    gm.gmshFree(dt);
+    free(surf);
+    free(tags);
+    free(etags);
+    free(conn);
+    return st;
+}
+
+cf_status cf_mesh_from_surface(const char *path, double unit_mm, double size_mm, cf_mesh *m,
+                               cf_mesh_surface_info *info, cf_error *err)
+{
+    memset(m, 0, sizeof *m);
+    cf_mesh_surface_info dummy;
+    if (!info)
+        info = &dummy;
+    memset(info, 0, sizeof *info);
+    if (!cf_surface_name(path))
+        return cf_error_set(err, CF_E_DATA, "%s: not a surface file name: expected .obj or .stl",
+                            path);
+    if (!(unit_mm > 0) || !isfinite(unit_mm))
+        return cf_error_set(err, CF_E_DATA, "%s: unit %g mm: must be finite and > 0", path, unit_mm);
+    if (!(size_mm > 0) || !isfinite(size_mm))
+        return cf_error_set(err, CF_E_DATA, "%s: element size %g mm: must be finite and > 0", path,
+                            size_mm);
+    cf_surface s;
+    cf_status st = cf_surface_read(path, &s, err);
+    if (st == CF_OK)
+        st = cf_surface_prepare(&s, path, unit_mm, info, err);
+    /* a regular tetrahedron of edge h holds h^3 / (6 sqrt 2): the count of a fill, roughly */
+    const double count = info->enclosed_mm3 / (size_mm * size_mm * size_mm / (6 * sqrt(2)));
+    if (st == CF_OK && count > 5e6)
+        st = cf_error_set(err, CF_E_DATA, "%s: element size %g mm would fill the %.4g mm^3 it "
+                          "encloses with about %.3g tetrahedra, over 5e6", path, size_mm,
+                          info->enclosed_mm3, count);
+    if (st != CF_OK) {
+        cf_surface_free(&s);
+        return st;
+    }
+    pthread_mutex_lock(&gmsh_lock);
+    char why[300];
+    if (!gmsh_begin(why, sizeof why))
+        st = cf_error_set(err, CF_E_INTERNAL, "%s: %s", path, why);
+    else
+        st = fill_surface(path, &s, unit_mm, size_mm / unit_mm, m, err);
+    gmsh_end();
+    pthread_mutex_unlock(&gmsh_lock);
+    cf_surface_free(&s);
+    if (st == CF_OK && (st = cf_mesh_check(m, path, err)) != CF_OK)
         cf_mesh_free(m);
     return st;
 }

@@ -17,87 +17,11 @@
 #include "conifit/fitfile.h"
 #include "io/fitfile_json.h"
 #include "io/scene_haptic.h"
+#include "io/scene_internal.h"
 
 /* Most cycles and samples a scene may ask for (keeps memory and run time bounded). */
 #define MAX_CYCLES 1000
 #define MAX_SAMPLES_PER_SEGMENT 100000
-
-typedef struct ctx {
-    const char *name;
-    cf_error *err;
-    cf_fitted_spring fit;  /* the spring's fit file, when it names one (its Prony terms) */
-    int from_fit;
-} ctx;
-
-/* Refuses keys of obj that are not in the NULL-terminated list. */
-static cf_status only_keys(ctx *c, json_t *obj, const char *where, const char *const *allowed)
-{
-    const char *key;
-    json_t *v;
-    json_object_foreach(obj, key, v)
-    {
-        int ok = 0;
-        for (size_t i = 0; allowed[i]; i++)
-            ok |= strcmp(key, allowed[i]) == 0;
-        if (!ok)
-            return cf_error_set(c->err, CF_E_DATA, "%s: unknown key '%s%s%s'", c->name, where,
-                                *where ? "." : "", key);
-    }
-    return CF_OK;
-}
-
-/* A number at obj[key]: required or default; checked finite and within [lo, hi] (or (lo, hi]
-** with open_lo). */
-static cf_status number(ctx *c, json_t *obj, const char *where, const char *key, int required,
-                        double dflt, double lo, int open_lo, double hi, double *out)
-{
-    json_t *v = obj ? json_object_get(obj, key) : NULL;
-    const char *dot = *where ? "." : "";
-    if (!v) {
-        if (required)
-            return cf_error_set(c->err, CF_E_DATA, "%s: missing key '%s%s%s'", c->name, where,
-                                dot, key);
-        *out = dflt;
-        return CF_OK;
-    }
-    if (!json_is_number(v))
-        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s%s%s' must be a number", c->name,
-                            where, dot, key);
-    double x = json_number_value(v);
-    if (!isfinite(x) || (open_lo ? !(x > lo) : !(x >= lo)) || !(x <= hi))
-        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s%s%s' = %g: must be %s %g and <= %g",
-                            c->name, where, dot, key, x, open_lo ? ">" : ">=", lo, hi);
-    *out = x;
-    return CF_OK;
-}
-
-static cf_status boolean(ctx *c, json_t *obj, const char *where, const char *key, int *out)
-{
-    json_t *v = obj ? json_object_get(obj, key) : NULL;
-    *out = 0;
-    if (!v)
-        return CF_OK;
-    if (!json_is_boolean(v))
-        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.%s' must be true or false", c->name,
-                            where, key);
-    *out = json_is_true(v);
-    return CF_OK;
-}
-
-static cf_status object(ctx *c, json_t *root, const char *key, int required, json_t **out)
-{
-    json_t *v = json_object_get(root, key);
-    *out = NULL;
-    if (!v) {
-        if (required)
-            return cf_error_set(c->err, CF_E_DATA, "%s: missing key '%s'", c->name, key);
-        return CF_OK;
-    }
-    if (!json_is_object(v))
-        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be an object", c->name, key);
-    *out = v;
-    return CF_OK;
-}
 
 static cf_status spring_section(ctx *c, json_t *sp, cf_scene *sc)
 {
@@ -106,7 +30,7 @@ static cf_status spring_section(ctx *c, json_t *sp, cf_scene *sc)
     for (int k = 0; k < CF_P_ALL; k++)
         pkeys[k] = cf_spring_param_info(k)->key;
     pkeys[CF_P_ALL] = NULL;
-    cf_status st = only_keys(c, sp, "spring", allowed);
+    cf_status st = cf_scene_only_keys(c, sp, "spring", allowed);
     if (st)
         return st;
     json_t *fit = json_object_get(sp, "fit"), *params = json_object_get(sp, "params");
@@ -154,12 +78,12 @@ static cf_status spring_section(ctx *c, json_t *sp, cf_scene *sc)
     if (!json_is_object(params))
         return cf_error_set(c->err, CF_E_DATA, "%s: key 'spring.params' must be an object",
                             c->name);
-    if ((st = only_keys(c, params, "spring.params", pkeys)))
+    if ((st = cf_scene_only_keys(c, params, "spring.params", pkeys)))
         return st;
     for (int k = 0; k < CF_P_ALL; k++) { /* the cone's six are required, the tail's two not */
         double v;
         const int cone = k < CF_P_COUNT;
-        if ((st = number(c, params, "spring.params", pkeys[k], cone, 0, 0, cone, INFINITY, &v)))
+        if ((st = cf_scene_number(c, params, "spring.params", pkeys[k], cone, 0, 0, cone, INFINITY, &v)))
             return st;
         cf_spring_set(&sc->spring, k, v);
     }
@@ -180,7 +104,7 @@ static cf_status extension_section(ctx *c, json_t *ex, cf_scene *sc)
     for (int k = 0; k < CF_P_COUNT; k++)
         pkeys[k] = cf_spring_param_info(k)->key;
     pkeys[CF_P_COUNT] = NULL;
-    cf_status st = only_keys(c, ex, "spring_extension", allowed);
+    cf_status st = cf_scene_only_keys(c, ex, "spring_extension", allowed);
     if (st)
         return st;
     if (sc->has_extension) /* from 'spring.fit' */
@@ -192,12 +116,12 @@ static cf_status extension_section(ctx *c, json_t *ex, cf_scene *sc)
     if (!json_is_object(params))
         return cf_error_set(c->err, CF_E_DATA,
                             "%s: key 'spring_extension.params' must be an object", c->name);
-    if ((st = only_keys(c, params, "spring_extension.params", pkeys)))
+    if ((st = cf_scene_only_keys(c, params, "spring_extension.params", pkeys)))
         return st;
     memset(&sc->extension, 0, sizeof sc->extension);
     for (int k = 0; k < CF_P_COUNT; k++) {
         double v;
-        if ((st = number(c, params, "spring_extension.params", pkeys[k], 1, 0, 0, 1, INFINITY,
+        if ((st = cf_scene_number(c, params, "spring_extension.params", pkeys[k], 1, 0, 0, 1, INFINITY,
                          &v)))
             return st;
         cf_spring_set(&sc->extension, k, v);
@@ -236,13 +160,13 @@ static cf_status volume_keys(ctx *c, json_t *lt, cf_scene *sc)
                             "lattice's volume term (volume_modulus_MPa = %g)",
                             c->name, kv ? "volume_modulus_MPa" : "poisson_ratio", sc->fit_path,
                             fit_kappa);
-    if ((st = number(c, lt, "lattice", "volume_modulus_MPa", 0, fit_kappa, 0, 0, 1e100,
+    if ((st = cf_scene_number(c, lt, "lattice", "volume_modulus_MPa", 0, fit_kappa, 0, 0, 1e100,
                      &L->volume_modulus_MPa)))
         return st;
     if (!nv)
         return CF_OK;
     double nu;
-    if ((st = number(c, lt, "lattice", "poisson_ratio", 1, 0, 0.25, 0, 0.5, &nu)))
+    if ((st = cf_scene_number(c, lt, "lattice", "poisson_ratio", 1, 0, 0.25, 0, 0.5, &nu)))
         return st;
     if (!(nu < 0.5))
         return cf_error_set(c->err, CF_E_DATA, "%s: key 'lattice.poisson_ratio' = %g: must be "
@@ -292,10 +216,10 @@ static cf_status weights_section(ctx *c, json_t *lt, cf_lattice_config *L)
                                 "%s: key 'lattice.weights' must be an object {\"edge\": ..., "
                                 "\"face\": ..., \"body\": ...}",
                                 c->name);
-        if ((st = only_keys(c, w, "lattice.weights", wkeys)))
+        if ((st = cf_scene_only_keys(c, w, "lattice.weights", wkeys)))
             return st;
         for (int f = 0; f < CF_FAMILY_COUNT; f++)
-            if ((st = number(c, w, "lattice.weights", wkeys[f], 1, 0, 0, 0, 1e6, &L->weight[f])))
+            if ((st = cf_scene_number(c, w, "lattice.weights", wkeys[f], 1, 0, 0, 0, 1e6, &L->weight[f])))
                 return st;
         if (cf_calibration_check(L->weight, &e) != CF_OK)
             return cf_error_set(c->err, CF_E_DATA, "%s: key %s", c->name, e.msg);
@@ -319,7 +243,7 @@ static cf_status weights_section(ctx *c, json_t *lt, cf_lattice_config *L)
     if (!dg && !dw)
         return CF_OK; /* the default of cf_lattice_default(): isotropic */
     double wd = 1;
-    if ((st = number(c, lt, "lattice", "diagonal_weight", 0, 1, 0, 0, 1e6, &wd)))
+    if ((st = cf_scene_number(c, lt, "lattice", "diagonal_weight", 0, 1, 0, 0, 1e6, &wd)))
         return st;
     unsigned fam = 3; /* bit 0 face, bit 1 body */
     if (dg) {
@@ -352,13 +276,13 @@ static cf_status lattice_section(ctx *c, json_t *lt, cf_scene *sc)
                                           "poisson_ratio", NULL};
     cf_status st;
     cf_lattice_config *L = &sc->cfg.lattice;
-    if (lt && (st = only_keys(c, lt, "lattice", allowed)))
+    if (lt && (st = cf_scene_only_keys(c, lt, "lattice", allowed)))
         return st;
     const char *dn[3] = {"nx", "ny", "nz"};
     int *dv[3] = {&L->nx, &L->ny, &L->nz};
     for (int k = 0; k < 3; k++) {
         double v;
-        if ((st = number(c, lt, "lattice", dn[k], 0, *dv[k], 1, 0, 1000, &v)))
+        if ((st = cf_scene_number(c, lt, "lattice", dn[k], 0, *dv[k], 1, 0, 1000, &v)))
             return st;
         if (v != floor(v))
             return cf_error_set(c->err, CF_E_DATA, "%s: key 'lattice.%s' = %g: must be a whole "
@@ -408,10 +332,10 @@ static cf_status prony_list(ctx *c, json_t *vs, json_t *pr, cf_msm_effects *e)
         if (!json_is_object(term))
             return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be an object", c->name,
                                 where);
-        if ((st = only_keys(c, term, where, tkeys)) ||
-            (st = number(c, term, where, "g", 1, 0, 0, 0, 1, &e->prony_g[i])) ||
-            (st = number(c, term, where, "tau_s", 1, 0, 0, 1, 1e12, &e->prony_tau_s[i])) ||
-            (st = number(c, term, where, "g_per_strain", 0, 0, -1e6, 0, 1e6, &e->prony_k[i])))
+        if ((st = cf_scene_only_keys(c, term, where, tkeys)) ||
+            (st = cf_scene_number(c, term, where, "g", 1, 0, 0, 0, 1, &e->prony_g[i])) ||
+            (st = cf_scene_number(c, term, where, "tau_s", 1, 0, 0, 1, 1e12, &e->prony_tau_s[i])) ||
+            (st = cf_scene_number(c, term, where, "g_per_strain", 0, 0, -1e6, 0, 1e6, &e->prony_k[i])))
             return st;
     }
     e->prony_count = (int)json_array_size(pr);
@@ -442,12 +366,12 @@ static cf_status effects_section(ctx *c, json_t *ef, cf_scene *sc)
     }
     if (!ef)
         return CF_OK;
-    if ((st = only_keys(c, ef, "effects", allowed)))
+    if ((st = cf_scene_only_keys(c, ef, "effects", allowed)))
         return st;
-    if ((st = boolean(c, ef, "effects", "inertia", &e->inertia)))
+    if ((st = cf_scene_boolean(c, ef, "effects", "inertia", &e->inertia)))
         return st;
     int g = 0;
-    if ((st = boolean(c, ef, "effects", "gravity", &g)))
+    if ((st = cf_scene_boolean(c, ef, "effects", "gravity", &g)))
         return st;
     e->gravity_mm_per_s2 = g ? 9806.65 : 0.0;
     json_t *dm = json_object_get(ef, "damping"), *vs = json_object_get(ef, "viscosity");
@@ -457,8 +381,8 @@ static cf_status effects_section(ctx *c, json_t *ef, cf_scene *sc)
                                 "{\"eta_kPa_s\": ...}", c->name);
         double eta;
         e->eta_MPa_s = 0;
-        if ((st = only_keys(c, dm, "effects.damping", dkeys)) ||
-            (st = number(c, dm, "effects.damping", "eta_kPa_s", 1, 0, 0, 1, 1e12, &eta)))
+        if ((st = cf_scene_only_keys(c, dm, "effects.damping", dkeys)) ||
+            (st = cf_scene_number(c, dm, "effects.damping", "eta_kPa_s", 1, 0, 0, 1, 1e12, &eta)))
             return st;
         e->eta_MPa_s = eta * 1e-3;
     }
@@ -469,14 +393,14 @@ static cf_status effects_section(ctx *c, json_t *ef, cf_scene *sc)
         double E, tau;
         json_t *pr = json_object_get(vs, "prony");
         e->prony_count = 0;
-        if ((st = only_keys(c, vs, "effects.viscosity", vkeys)))
+        if ((st = cf_scene_only_keys(c, vs, "effects.viscosity", vkeys)))
             return st;
         if (pr) {
             if ((st = prony_list(c, vs, pr, e)))
                 return st;
         } else {
-            if ((st = number(c, vs, "effects.viscosity", "E_kPa", 1, 0, 0, 1, 1e12, &E)) ||
-                (st = number(c, vs, "effects.viscosity", "tau_s", 1, 0, 0, 1, 1e12, &tau)))
+            if ((st = cf_scene_number(c, vs, "effects.viscosity", "E_kPa", 1, 0, 0, 1, 1e12, &E)) ||
+                (st = cf_scene_number(c, vs, "effects.viscosity", "tau_s", 1, 0, 0, 1, 1e12, &tau)))
                 return st;
             e->maxwell_E_MPa = E * 1e-3;
             e->maxwell_tau_s = tau;
@@ -523,7 +447,7 @@ static cf_status history_protocol(ctx *c, json_t *pr, cf_scene *sc, size_t *cap)
 {
     static const char *const ok[] = {"kind", "t_s", "to_strain", "to_stress_kPa", NULL};
     cf_status st;
-    if ((st = only_keys(c, pr, "protocol", ok)))
+    if ((st = cf_scene_only_keys(c, pr, "protocol", ok)))
         return st;
     json_t *t = json_object_get(pr, "t_s"), *vs = json_object_get(pr, "to_strain"),
            *vf = json_object_get(pr, "to_stress_kPa");
@@ -583,7 +507,7 @@ static cf_status protocol_target(ctx *c, json_t *pr, cf_scene *sc)
     double target;
     if (ts) {
         sc->drive = CF_DRIVE_DISPLACEMENT;
-        if ((st = number(c, pr, "protocol", "to_strain", 1, 0, -0.999, 0, 0.999, &target)))
+        if ((st = cf_scene_number(c, pr, "protocol", "to_strain", 1, 0, -0.999, 0, 0.999, &target)))
             return st;
         /* A compressive strain at or past the spring's solid strain cannot be reached. */
         cf_law law;
@@ -595,7 +519,7 @@ static cf_status protocol_target(ctx *c, json_t *pr, cf_scene *sc)
                                 c->name, target, law.travel_mm / law.p.H_mm);
     } else {
         sc->drive = CF_DRIVE_FORCE;
-        if ((st = number(c, pr, "protocol", "to_stress_kPa", 1, 0, -1e9, 0, 1e9, &target)))
+        if ((st = cf_scene_number(c, pr, "protocol", "to_stress_kPa", 1, 0, -1e9, 0, 1e9, &target)))
             return st;
         target *= 1e-3;
     }
@@ -614,8 +538,8 @@ static cf_status ramp_protocol(ctx *c, json_t *pr, cf_scene *sc, size_t *cap)
     static const char *const ok[] = {"kind", "to_strain", "to_stress_kPa", "duration_s", NULL};
     double dur;
     cf_status st;
-    if ((st = only_keys(c, pr, "protocol", ok)) ||
-        (st = number(c, pr, "protocol", "duration_s", 0, 1, 0, 1, 1e9, &dur)))
+    if ((st = cf_scene_only_keys(c, pr, "protocol", ok)) ||
+        (st = cf_scene_number(c, pr, "protocol", "duration_s", 0, 1, 0, 1, 1e9, &dur)))
         return st;
     sc->kind = CF_PROTO_RAMP;
     if (push(sc, cap, 0, 0) || push(sc, cap, dur, sc->target))
@@ -630,9 +554,9 @@ static cf_status cycles_protocol(ctx *c, json_t *pr, cf_scene *sc, size_t *cap)
                                      NULL};
     double period, count;
     cf_status st;
-    if ((st = only_keys(c, pr, "protocol", ok)) ||
-        (st = number(c, pr, "protocol", "period_s", 1, 0, 0, 1, 1e9, &period)) ||
-        (st = number(c, pr, "protocol", "count", 0, 1, 1, 0, MAX_CYCLES, &count)))
+    if ((st = cf_scene_only_keys(c, pr, "protocol", ok)) ||
+        (st = cf_scene_number(c, pr, "protocol", "period_s", 1, 0, 0, 1, 1e9, &period)) ||
+        (st = cf_scene_number(c, pr, "protocol", "count", 0, 1, 1, 0, MAX_CYCLES, &count)))
         return st;
     if (count != floor(count))
         return cf_error_set(c->err, CF_E_DATA, "%s: key 'protocol.count' = %g: must be a "
@@ -654,9 +578,9 @@ static cf_status hold_protocol(ctx *c, json_t *pr, cf_scene *sc, size_t *cap)
                                      NULL};
     double ramp, hold;
     cf_status st;
-    if ((st = only_keys(c, pr, "protocol", ok)) ||
-        (st = number(c, pr, "protocol", "ramp_s", 1, 0, 0, 1, 1e9, &ramp)) ||
-        (st = number(c, pr, "protocol", "hold_s", 1, 0, 0, 1, 1e9, &hold)))
+    if ((st = cf_scene_only_keys(c, pr, "protocol", ok)) ||
+        (st = cf_scene_number(c, pr, "protocol", "ramp_s", 1, 0, 0, 1, 1e9, &ramp)) ||
+        (st = cf_scene_number(c, pr, "protocol", "hold_s", 1, 0, 0, 1, 1e9, &hold)))
         return st;
     sc->kind = CF_PROTO_HOLD;
     if (push(sc, cap, 0, 0) || push(sc, cap, ramp, sc->target) ||
@@ -695,7 +619,7 @@ static cf_status protocol_section(ctx *c, json_t *pr, cf_scene *sc, double sampl
     static const char *const allowed[] = {"kind", "to_strain", "to_stress_kPa", "duration_s",
                                           "period_s", "count", "ramp_s", "hold_s", "t_s", NULL};
     cf_status st;
-    if ((st = only_keys(c, pr, "protocol", allowed)))
+    if ((st = cf_scene_only_keys(c, pr, "protocol", allowed)))
         return st;
     const char *kind = json_string_value(json_object_get(pr, "kind"));
     if (!kind)
@@ -719,106 +643,6 @@ static cf_status protocol_section(ctx *c, json_t *pr, cf_scene *sc, double sampl
     return st != CF_OK ? st : path_samples(c, sc, samples_per_segment);
 }
 
-/* A JSON array of three finite numbers at obj[key] into v. */
-static cf_status vec3(ctx *c, json_t *obj, const char *where, const char *key, double v[3])
-{
-    json_t *a = json_object_get(obj, key);
-    if (!a)
-        return cf_error_set(c->err, CF_E_DATA, "%s: missing key '%s.%s'", c->name, where, key);
-    if (!json_is_array(a) || json_array_size(a) != 3)
-        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.%s' must be an array of 3 numbers",
-                            c->name, where, key);
-    for (size_t i = 0; i < 3; i++) {
-        json_t *x = json_array_get(a, i);
-        if (!json_is_number(x) || !isfinite(json_number_value(x)))
-            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.%s' must be an array of 3 finite "
-                                "numbers", c->name, where, key);
-        v[i] = json_number_value(x);
-    }
-    return CF_OK;
-}
-
-/* "body", "fixed" and "probe": a tissue body of a mesh pressed by a probe. */
-static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
-{
-    static const char *const bk[] = {"mesh", "unit_mm", "refine", "poisson_ratio",
-                                     "volume_modulus_MPa", NULL};
-    static const char *const fk[] = {"below", NULL};
-    static const char *const fbk[] = {"axis", "value_mm", NULL};
-    static const char *const pk[] = {"shape", "radius_mm", "center_mm", "direction", "depth_mm",
-                                     "steps", NULL};
-    cf_status st;
-    if (json_object_get(root, "lattice") || json_object_get(root, "protocol"))
-        return cf_error_set(c->err, CF_E_DATA, "%s: key 'body' replaces 'lattice' and "
-                            "'protocol' (the probe is the loading)", c->name);
-    if ((st = only_keys(c, bd, "body", bk)))
-        return st;
-    json_t *mesh = json_object_get(bd, "mesh");
-    if (!json_is_string(mesh))
-        return cf_error_set(c->err, CF_E_DATA, "%s: key 'body.mesh' must be a file name", c->name);
-    snprintf(sc->body_mesh, sizeof sc->body_mesh, "%s", json_string_value(mesh));
-    double refine;
-    if ((st = number(c, bd, "body", "unit_mm", 1, 1, 0, 1, 1e9, &sc->body_unit_mm)) ||
-        (st = number(c, bd, "body", "refine", 0, 0, 0, 0, 4, &refine)))
-        return st;
-    if (refine != floor(refine))
-        return cf_error_set(c->err, CF_E_DATA, "%s: key 'body.refine' = %g: must be a whole "
-                            "number", c->name, refine);
-    sc->body_refine = (int)refine;
-    json_t *pr = json_object_get(bd, "poisson_ratio"), *km = json_object_get(bd, "volume_modulus_MPa");
-    if (pr && km)
-        return cf_error_set(c->err, CF_E_DATA, "%s: keys 'body.poisson_ratio' and "
-                            "'body.volume_modulus_MPa' exclude each other", c->name);
-    if (pr) {
-        sc->body_volume = 2;
-        if ((st = number(c, bd, "body", "poisson_ratio", 1, 0, 0.25, 0, 0.4999, &sc->body_volume_value)))
-            return st;
-    } else if (km) {
-        sc->body_volume = 1;
-        if ((st = number(c, bd, "body", "volume_modulus_MPa", 1, 0, 0, 0, 1e12, &sc->body_volume_value)))
-            return st;
-    }
-    json_t *fx, *below, *pb;
-    if ((st = object(c, root, "fixed", 1, &fx)) || (st = only_keys(c, fx, "fixed", fk)) ||
-        (st = object(c, fx, "below", 1, &below)) || (st = only_keys(c, below, "fixed.below", fbk)))
-        return st;
-    json_t *ax = json_object_get(below, "axis");
-    const char *an = json_is_string(ax) ? json_string_value(ax) : "";
-    if (strlen(an) != 1 || !strchr("xyz", an[0]))
-        return cf_error_set(c->err, CF_E_DATA, "%s: key 'fixed.below.axis' = '%s': expected x, y "
-                            "or z", c->name, an);
-    sc->fixed_axis = an[0] - 'x';
-    if ((st = number(c, below, "fixed.below", "value_mm", 1, 0, -1e12, 0, 1e12, &sc->fixed_value_mm)))
-        return st;
-    if ((st = object(c, root, "probe", 1, &pb)) || (st = only_keys(c, pb, "probe", pk)))
-        return st;
-    json_t *shape = json_object_get(pb, "shape");
-    const char *sn = json_is_string(shape) ? json_string_value(shape) : "";
-    if (strcmp(sn, "sphere") == 0)
-        sc->probe.shape = CF_PROBE_SPHERE;
-    else if (strcmp(sn, "punch") == 0)
-        sc->probe.shape = CF_PROBE_PUNCH;
-    else
-        return cf_error_set(c->err, CF_E_DATA, "%s: key 'probe.shape' = '%s': expected sphere or "
-                            "punch", c->name, sn);
-    double steps, d[3];
-    if ((st = number(c, pb, "probe", "radius_mm", 1, 0, 0, 1, 1e12, &sc->probe.radius_mm)) ||
-        (st = number(c, pb, "probe", "depth_mm", 1, 0, 0, 1, 1e12, &sc->probe.depth_mm)) ||
-        (st = number(c, pb, "probe", "steps", 0, 10, 1, 0, 100000, &steps)) ||
-        (st = vec3(c, pb, "probe", "center_mm", sc->probe.center_mm)) ||
-        (st = vec3(c, pb, "probe", "direction", d)))
-        return st;
-    sc->probe.steps = (int)steps;
-    double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    if (!(len > 0) || !isfinite(len))
-        return cf_error_set(c->err, CF_E_DATA, "%s: key 'probe.direction' = [%g, %g, %g]: must "
-                            "not be zero", c->name, d[0], d[1], d[2]);
-    for (int k = 0; k < 3; k++)
-        sc->probe.dir[k] = d[k] / len;
-    sc->has_body = 1;
-    return CF_OK;
-}
-
 /* "haptic" (scene_haptic.h): a body's probe path in time. */
 static cf_status haptic_key(ctx *c, json_t *root, cf_scene *sc)
 {
@@ -834,44 +658,30 @@ static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
                                           "density_t_per_mm3", "protocol", "effects",
                                           "integrator", "law_method", "table_intervals",
                                           "samples_per_segment", "comment", "body", "fixed",
-                                          "probe", "haptic", NULL};
+                                          "displaced", "loaded", "probe", "haptic", NULL};
     cf_status st;
     if (!json_is_object(root))
         return cf_error_set(c->err, CF_E_DATA, "%s: a scene must be a JSON object", c->name);
-    if ((st = only_keys(c, root, "", allowed)))
+    if ((st = cf_scene_only_keys(c, root, "", allowed)))
         return st;
     sc->cfg = cf_msm_default();
     sc->method = CF_LAW_CLOSED;
     sc->table_intervals = CF_LAW_TABLE_DEFAULT;
     json_t *sp, *lt, *pr, *ef, *in;
-    if ((st = object(c, root, "spring", 1, &sp)) || (st = spring_section(c, sp, sc)))
+    if ((st = cf_scene_object(c, root, "spring", 1, &sp)) || (st = spring_section(c, sp, sc)))
         return st;
     json_t *ex;
-    if ((st = object(c, root, "spring_extension", 0, &ex)) ||
+    if ((st = cf_scene_object(c, root, "spring_extension", 0, &ex)) ||
         (ex && (st = extension_section(c, ex, sc))))
         return st;
-    json_t *bd;
-    if ((st = object(c, root, "body", 0, &bd)))
+    if ((st = cf_scene_body(c, root, sc)) || (st = haptic_key(c, root, sc)))
         return st;
-    if (!bd && (json_object_get(root, "fixed") || json_object_get(root, "probe")))
-        return cf_error_set(c->err, CF_E_DATA, "%s: keys 'fixed' and 'probe' need a 'body'",
-                            c->name);
-    if (bd && (sc->has_extension || (c->from_fit && c->fit.volume_modulus_MPa > 0)))
-        return cf_error_set(c->err, CF_E_DATA,
-                            "%s: key 'body': a body's edges take one spring law and its volume "
-                            "term from 'body'; %s is not built for bodies",
-                            c->name, sc->has_extension ? "a double-acting element"
-                                                       : "the fit's lattice volume term");
-    if (bd && (st = body_sections(c, root, bd, sc)))
+    if ((st = cf_scene_object(c, root, "lattice", 0, &lt)) || (st = lattice_section(c, lt, sc)))
         return st;
-    if ((st = haptic_key(c, root, sc)))
-        return st;
-    if ((st = object(c, root, "lattice", 0, &lt)) || (st = lattice_section(c, lt, sc)))
-        return st;
-    if ((st = number(c, root, "", "density_t_per_mm3", 0, 1e-9, 0, 1, 1, 
+    if ((st = cf_scene_number(c, root, "", "density_t_per_mm3", 0, 1e-9, 0, 1, 1, 
                      &sc->cfg.lattice.density_t_per_mm3)))
         return st;
-    if ((st = object(c, root, "effects", 0, &ef)) || (st = effects_section(c, ef, sc)))
+    if ((st = cf_scene_object(c, root, "effects", 0, &ef)) || (st = effects_section(c, ef, sc)))
         return st;
     json_t *lm = json_object_get(root, "law_method");
     if (lm) {
@@ -883,27 +693,27 @@ static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
                                 c->name, json_is_string(lm) ? json_string_value(lm) : "?");
     }
     double ti;
-    if ((st = number(c, root, "", "table_intervals", 0, CF_LAW_TABLE_DEFAULT, 2, 0, 1e7, &ti)))
+    if ((st = cf_scene_number(c, root, "", "table_intervals", 0, CF_LAW_TABLE_DEFAULT, 2, 0, 1e7, &ti)))
         return st;
     sc->table_intervals = (size_t)ti;
-    if ((st = object(c, root, "integrator", 0, &in)))
+    if ((st = cf_scene_object(c, root, "integrator", 0, &in)))
         return st;
     if (in) {
         static const char *const ik[] = {"dt_s", "substeps", NULL};
         double sub;
-        if ((st = only_keys(c, in, "integrator", ik)) ||
-            (st = number(c, in, "integrator", "dt_s", 0, 0, 0, 0, 1e6, &sc->cfg.dt_s)) ||
-            (st = number(c, in, "integrator", "substeps", 0, 10, 1, 0, 1e6, &sub)))
+        if ((st = cf_scene_only_keys(c, in, "integrator", ik)) ||
+            (st = cf_scene_number(c, in, "integrator", "dt_s", 0, 0, 0, 0, 1e6, &sc->cfg.dt_s)) ||
+            (st = cf_scene_number(c, in, "integrator", "substeps", 0, 10, 1, 0, 1e6, &sub)))
             return st;
         sc->cfg.quasi_substeps = (int)sub;
     }
     double per;
-    if ((st = number(c, root, "", "samples_per_segment", 0, 50, 1, 0, MAX_SAMPLES_PER_SEGMENT,
+    if ((st = cf_scene_number(c, root, "", "samples_per_segment", 0, 50, 1, 0, MAX_SAMPLES_PER_SEGMENT,
                      &per)))
         return st;
     if (sc->has_body)
         return CF_OK; /* the probe is the loading */
-    if ((st = object(c, root, "protocol", 1, &pr)) ||
+    if ((st = cf_scene_object(c, root, "protocol", 1, &pr)) ||
         (st = protocol_section(c, pr, sc, floor(per))))
         return st;
     return CF_OK;

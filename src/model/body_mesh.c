@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "conifit/body.h"
+#include "model/body_internal.h"
 
 void cf_mesh_free(cf_mesh *m)
 {
@@ -16,20 +16,10 @@ void cf_mesh_free(cf_mesh *m)
     free(m->tet);
     free(m->id);
     free(m->eid);
+    for (size_t k = 0; k < m->ngroups; k++)
+        free(m->groups[k].nodes);
+    free(m->groups);
     memset(m, 0, sizeof *m);
-}
-
-/* Six times the signed volume of the tetrahedron a, b, c, d. */
-static double vol6(const double *a, const double *b, const double *c, const double *d)
-{
-    double u[3], v[3], w[3];
-    for (int k = 0; k < 3; k++) {
-        u[k] = b[k] - a[k];
-        v[k] = c[k] - a[k];
-        w[k] = d[k] - a[k];
-    }
-    return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-           u[2] * (v[0] * w[1] - v[1] * w[0]);
 }
 
 static cf_status grid_ok(const double *g, int n, const char *axis, cf_error *err)
@@ -95,7 +85,7 @@ cf_status cf_mesh_block(cf_mesh *m, const double *xs, int nx, const double *ys, 
                             q[a] = base[a] + (c[a] ^ (base[a] % 2));
                         v[s] = (uint32_t)(q[0] + px * (q[1] + py * q[2]));
                     }
-                    if (vol6(m->X + 3 * v[0], m->X + 3 * v[1], m->X + 3 * v[2], m->X + 3 * v[3]) < 0) {
+                    if (body_vol6(m->X + 3 * v[0], m->X + 3 * v[1], m->X + 3 * v[2], m->X + 3 * v[3]) < 0) {
                         uint32_t tmp = v[2];
                         v[2] = v[3];
                         v[3] = tmp;
@@ -139,7 +129,7 @@ cf_status cf_mesh_check(cf_mesh *m, const char *name, cf_error *err)
                 }
                 lmax = fmax(lmax, sqrt(d2));
             }
-        double v6 = vol6(m->X + 3 * v[0], m->X + 3 * v[1], m->X + 3 * v[2], m->X + 3 * v[3]);
+        double v6 = body_vol6(m->X + 3 * v[0], m->X + 3 * v[1], m->X + 3 * v[2], m->X + 3 * v[3]);
         if (!(fabs(v6) > 6e-12 * lmax * lmax * lmax))
             return cf_error_set(err, CF_E_DATA,
                                 "%s: element %lu is degenerate (volume %.3g mm^3, longest edge "
@@ -150,7 +140,7 @@ cf_status cf_mesh_check(cf_mesh *m, const char *name, cf_error *err)
     const int flip = 2 * neg > m->nt; /* the majority's orientation is the mesh's */
     for (size_t t = 0; t < m->nt; t++) {
         uint32_t *v = m->tet + 4 * t;
-        double v6 = vol6(m->X + 3 * v[0], m->X + 3 * v[1], m->X + 3 * v[2], m->X + 3 * v[3]);
+        double v6 = body_vol6(m->X + 3 * v[0], m->X + 3 * v[1], m->X + 3 * v[2], m->X + 3 * v[3]);
         if ((v6 < 0) != flip)
             return cf_error_set(err, CF_E_DATA,
                                 "%s: element %lu is inverted (its orientation is the opposite of "

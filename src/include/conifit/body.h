@@ -41,12 +41,23 @@
 
 /* A tetrahedral mesh: nodes (mm) and elements of four node indices each, every element positively
 ** oriented (its signed volume (x1-x0).((x2-x0)x(x3-x0))/6 > 0). */
+/* A physical group of the mesh's file (Gmsh's named or numbered sets of elements): the mesh's
+** nodes on its elements. */
+typedef struct cf_mesh_group {
+    int dim, tag;       /* Gmsh's dimension (0 to 3) and number of the group */
+    char name[128];     /* its name, "" when it has none */
+    size_t nnodes;
+    uint32_t *nodes;    /* nnodes indices into the mesh's nodes, sorted */
+} cf_mesh_group;
+
 typedef struct cf_mesh {
     size_t nn, nt;
     double *X;      /* 3 nn coordinates, mm */
     uint32_t *tet;  /* 4 nt node indices */
     uint32_t *id;   /* nn node numbers of the file (1-based for a generated block) */
     uint64_t *eid;  /* nt element numbers of the file (a hexahedron's six tetrahedra share one) */
+    size_t ngroups;
+    cf_mesh_group *groups; /* the file's physical groups (none for a generated mesh) */
 } cf_mesh;
 
 void cf_mesh_free(cf_mesh *m);
@@ -66,6 +77,36 @@ cf_status cf_mesh_block(cf_mesh *m, const double *xs, int nx, const double *ys, 
 ** name the element by its number in the file. CF_E_DATA. */
 cf_status cf_mesh_check(cf_mesh *m, const char *name, cf_error *err);
 
+/* A region of a body: the nodes a selector picks. A new kind of selector is a row of the table
+** in body_region.c (its name and its test of a node) and a case of the scene's reader. */
+typedef enum cf_select_kind {
+    CF_SELECT_BELOW = 0,  /* n . X <= value_mm */
+    CF_SELECT_ABOVE = 1,  /* n . X >= value_mm */
+    CF_SELECT_BOX = 2,    /* lo_mm <= X <= hi_mm, every component */
+    CF_SELECT_SPHERE = 3, /* |X - center_mm| <= radius_mm */
+    CF_SELECT_GROUP = 4   /* the nodes of the mesh's physical groups of that name or number */
+} cf_select_kind;
+
+typedef struct cf_select {
+    cf_select_kind kind;
+    double n[3];          /* below, above: unit normal of the plane */
+    double value_mm;      /* below, above: n . X of the plane */
+    double lo_mm[3], hi_mm[3];        /* box */
+    double center_mm[3], radius_mm;   /* sphere */
+    int group_tag;        /* group: its number, or -1 to go by name */
+    int group_dim;        /* group: its dimension, or -1 for groups of any dimension */
+    char group_name[128]; /* group: its name when group_tag is -1 */
+} cf_select;
+
+/* The name of a selector kind as a scene writes it ("below", "above", "box", "sphere", "group"). */
+const char *cf_select_name(cf_select_kind kind);
+
+/* Sets mark[i] = 1 for every node i of m that s selects (mark has m->nn entries; other entries
+** are left as they are) and returns how many it selects. A node on a selector's boundary is
+** selected (the comparisons allow 1e-9 of the mesh's extent, so that nodes on a plane given by
+** their coordinate are in). */
+size_t cf_mesh_select(const cf_mesh *m, const cf_select *s, uint8_t *mark);
+
 /* Where a scene's regions, probe and outputs come from. */
 typedef enum cf_probe_shape { CF_PROBE_SPHERE = 0, CF_PROBE_PUNCH = 1 } cf_probe_shape;
 
@@ -75,7 +116,10 @@ typedef struct cf_probe {
     double center_mm[3]; /* sphere centre, or the centre of the punch's flat face, at depth 0 */
     double dir[3];       /* unit direction of travel */
     double depth_mm;     /* travel at the last step */
-    int steps;           /* equal steps from 0 to depth_mm */
+    int steps;           /* equal steps from 0 to depth_mm (or to force_N) */
+    double force_N;      /* > 0: the probe is driven by force instead, to this force at the last
+                         ** step (depth_mm unused); 0: by depth (last, so that an initialiser of
+                         ** the fields above in order still holds) */
 } cf_probe;
 
 /* The body: the mesh's nodes and tetrahedra, its edges as springs. */
@@ -94,6 +138,11 @@ typedef struct cf_body {
     double kappa_MPa;      /* volume modulus of the volume term */
     double E_MPa, nu;      /* the body's small-strain E and nu (isotropic part of its tangent) */
     double mean_edge_mm;   /* mean rest length of the springs */
+    double *f_ext;         /* 3 nn external forces on the nodes (N), or NULL for none; the solves
+                           ** balance them. Set by the caller, released by cf_body_free */
+    double *reaction;      /* 3 nn, or NULL: when the caller allocates it, each solve leaves there
+                           ** the force the supports apply at every held component (N; 0 at free
+                           ** ones). Released by cf_body_free */
     void *work;            /* the solver's pattern, factors and vectors (NULL until the first
                            ** solve; cf_body_free releases them). Not thread-safe: one solve of a
                            ** body at a time */
@@ -147,6 +196,16 @@ typedef struct cf_body_step {
 cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
                         double penalty_N_per_mm, cf_body_step *out, cf_error *err);
 
+/* The depth at which the probe's reaction is force_N (> 0) and the equilibrium there: the depth
+** found by bracketing from the current one (or, without contact yet, from where the probe first
+** touches a node) and regula falsi (Illinois), each trial a cf_body_solve started from the nearer
+** end of the bracket, until the force is within 1e-6 of force_N (or the bracket narrower than
+** 1e-12 of the mean edge). *depth_mm holds the current depth on entry (0 at rest) and the depth
+** found on return. CF_E_NOCONV when a trial solve fails before the force is reached (the body
+** cannot carry it: the message names the force and the depth), else as cf_body_solve. */
+cf_status cf_body_solve_force(cf_body *b, const cf_probe *probe, double force_N, double *depth_mm,
+                              double penalty_N_per_mm, cf_body_step *out, cf_error *err);
+
 /* One update of the probe loop at haptic rate: the probe moved to depth, then at most max_iters
 ** chord iterations from the current positions, each with the exact residual (springs, volume
 ** term, penalty contact) and a step with the tangent of the body without contact, assembled and
@@ -162,9 +221,16 @@ cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm
                               cf_error *err);
 
 /* The body's elastic forces on its nodes at the current positions (the gradient of its energy,
-** N; g has 3 nn entries): at a held component, minus the support's reaction. CF_E_INTERNAL when
+** N; g has 3 nn entries; the external forces f_ext are not in it). CF_E_INTERNAL when
 ** memory runs out. */
 cf_status cf_body_internal_force(const cf_body *b, double *g, cf_error *err);
+
+/* Spreads the total force F (N) over the marked nodes of b into f (3 nn, added to): a traction
+** on the part of the body's boundary whose triangles have all three corners marked, each node
+** taking a third of the area of its triangles there; where the marked nodes hold no boundary
+** triangle, in proportion to their nodal volumes (a quarter of each tetrahedron around them).
+** Returns the number of nodes that received a share (0 also when memory runs out). */
+size_t cf_body_spread_force(const cf_body *b, const uint8_t *mark, const double F[3], double *f);
 
 /* Index of a node inside the probe at depth 0 (the probe starts inside the body), or -1. */
 long cf_body_probe_inside(const cf_body *b, const cf_probe *probe);

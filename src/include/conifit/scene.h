@@ -22,6 +22,29 @@ typedef enum cf_protocol_kind {
     CF_PROTO_HISTORY = 3 /* through listed (time, value) points: a measured loading history */
 } cf_protocol_kind;
 
+/* What a region of a body does (src/notes/simulate.md, "Regions"): every prescribed component of
+** its nodes held (fixed) or moved by a displacement (displaced), or a total force spread over it
+** (loaded); each ramps from 0 over the run's steps, as the probe does. */
+typedef enum cf_region_use {
+    CF_REGION_FIXED = 0,
+    CF_REGION_DISPLACED = 1,
+    CF_REGION_LOADED = 2
+} cf_region_use;
+
+typedef struct cf_scene_region {
+    cf_region_use use;
+    cf_select sel;              /* which nodes */
+    unsigned comps;             /* fixed, displaced: bit c set = component c prescribed */
+    double vec[3];              /* displaced: displacement, mm; loaded: total force, N */
+    char key[48];               /* the scene key that names it ("fixed", "displaced[1]") */
+} cf_scene_region;
+
+/* Most points of a probe's path. */
+#define CF_SCENE_MAX_PATH 1000
+
+/* Most regions a scene may have. */
+#define CF_SCENE_MAX_REGIONS 64
+
 typedef struct cf_scene {
     cf_spring spring;           /* the spring of every lattice edge */
     int has_extension;          /* 1: 'spring_extension' makes every element double-acting
@@ -47,10 +70,22 @@ typedef struct cf_scene {
     char body_mesh[4096];       /* body.mesh: the volume mesh file */
     double body_unit_mm;        /* body.unit_mm: mesh coordinates times this are mm */
     int body_refine;            /* body.refine: uniform refinements of the mesh (0 to 4) */
+    double body_element_size_mm; /* body.element_size_mm: with a closed surface (.obj, .stl) for
+                                    body.mesh, the target size of the tetrahedra filling it, mm;
+                                    0 with a volume mesh */
     int body_volume;            /* 0 no volume term, 1 body.volume_modulus_MPa, 2 body.poisson_ratio */
     double body_volume_value;   /* kappa (MPa) or nu */
-    int fixed_axis;             /* fixed.below.axis: 0, 1, 2 (x, y, z) */
-    double fixed_value_mm;      /* fixed.below.value_mm */
+    int body_steps;             /* static steps of the run: probe.steps, or body.steps without a
+                                   probe */
+    size_t nregions;            /* the regions "fixed", "displaced", "loaded", in that order */
+    cf_scene_region regions[CF_SCENE_MAX_REGIONS];
+    int has_probe;              /* 1 when the scene has "probe" */
+    size_t probe_npath;         /* probe.path: 0, or its points (2 to CF_SCENE_MAX_PATH): the
+                                   probe's reference point at times probe_path_t_s (strictly
+                                   increasing), straight between them; probe.center_mm is the
+                                   first point and the steps are equal in time */
+    double probe_path_t_s[CF_SCENE_MAX_PATH];
+    double probe_path_mm[CF_SCENE_MAX_PATH][3];
     cf_probe probe;             /* probe */
     /* "haptic": the probe's path in time for `simulate --haptic` (src/notes/simulate.md) */
     size_t haptic_n;            /* vertices of the path (0: no "haptic") */

@@ -1,0 +1,39 @@
+/*
+** What the files that read scenes share (scene.c: the spring, the lattice, the effects and the
+** protocol; scene_keys.c: the checked reading of keys; scene_body.c: a tissue body's "body",
+** "fixed" and "probe"). Private to the io layer.
+*/
+#ifndef CF_IO_SCENE_INTERNAL_H
+#define CF_IO_SCENE_INTERNAL_H
+
+#include <jansson.h>
+
+#include "conifit/fitfile.h"
+#include "conifit/scene.h"
+
+typedef struct ctx {
+    const char *name;
+    cf_error *err;
+    cf_fitted_spring fit;  /* the spring's fit file, when it names one (its Prony terms) */
+    int from_fit;
+} ctx;
+
+/* scene_keys.c: every message names the file (c->name) and the key, 'where.key'. */
+/* Refuses keys of obj that are not in the NULL-terminated list. */
+cf_status cf_scene_only_keys(ctx *c, json_t *obj, const char *where, const char *const *allowed);
+/* A number at obj[key]: required or default; checked finite and within [lo, hi] (or (lo, hi]
+** with open_lo). */
+cf_status cf_scene_number(ctx *c, json_t *obj, const char *where, const char *key, int required,
+                          double dflt, double lo, int open_lo, double hi, double *out);
+/* A boolean at obj[key] (false when absent). */
+cf_status cf_scene_boolean(ctx *c, json_t *obj, const char *where, const char *key, int *out);
+/* An object at root[key] (NULL when absent and not required). */
+cf_status cf_scene_object(ctx *c, json_t *root, const char *key, int required, json_t **out);
+/* A JSON array of three finite numbers at obj[key] into v. */
+cf_status cf_scene_vec3(ctx *c, json_t *obj, const char *where, const char *key, double v[3]);
+
+/* scene_body.c: "body", "fixed" and "probe" of root (nothing when root has no "body"; "fixed" or
+** "probe" without it refused). */
+cf_status cf_scene_body(ctx *c, json_t *root, cf_scene *sc);
+
+#endif

@@ -1,0 +1,97 @@
+/*
+** Scene files (scene.h): the checked reading of one key, whose messages name the file, the key and
+** the value.
+*/
+#include <math.h>
+#include <string.h>
+
+#include "io/scene_internal.h"
+
+/* Refuses keys of obj that are not in the NULL-terminated list. */
+cf_status cf_scene_only_keys(ctx *c, json_t *obj, const char *where, const char *const *allowed)
+{
+    const char *key;
+    json_t *v;
+    json_object_foreach(obj, key, v)
+    {
+        int ok = 0;
+        for (size_t i = 0; allowed[i]; i++)
+            ok |= strcmp(key, allowed[i]) == 0;
+        if (!ok)
+            return cf_error_set(c->err, CF_E_DATA, "%s: unknown key '%s%s%s'", c->name, where,
+                                *where ? "." : "", key);
+    }
+    return CF_OK;
+}
+
+/* A number at obj[key]: required or default; checked finite and within [lo, hi] (or (lo, hi]
+** with open_lo). */
+cf_status cf_scene_number(ctx *c, json_t *obj, const char *where, const char *key, int required,
+                          double dflt, double lo, int open_lo, double hi, double *out)
+{
+    json_t *v = obj ? json_object_get(obj, key) : NULL;
+    const char *dot = *where ? "." : "";
+    if (!v) {
+        if (required)
+            return cf_error_set(c->err, CF_E_DATA, "%s: missing key '%s%s%s'", c->name, where,
+                                dot, key);
+        *out = dflt;
+        return CF_OK;
+    }
+    if (!json_is_number(v))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s%s%s' must be a number", c->name,
+                            where, dot, key);
+    double x = json_number_value(v);
+    if (!isfinite(x) || (open_lo ? !(x > lo) : !(x >= lo)) || !(x <= hi))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s%s%s' = %g: must be %s %g and <= %g",
+                            c->name, where, dot, key, x, open_lo ? ">" : ">=", lo, hi);
+    *out = x;
+    return CF_OK;
+}
+
+cf_status cf_scene_boolean(ctx *c, json_t *obj, const char *where, const char *key, int *out)
+{
+    json_t *v = obj ? json_object_get(obj, key) : NULL;
+    *out = 0;
+    if (!v)
+        return CF_OK;
+    if (!json_is_boolean(v))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.%s' must be true or false", c->name,
+                            where, key);
+    *out = json_is_true(v);
+    return CF_OK;
+}
+
+cf_status cf_scene_object(ctx *c, json_t *root, const char *key, int required, json_t **out)
+{
+    json_t *v = json_object_get(root, key);
+    *out = NULL;
+    if (!v) {
+        if (required)
+            return cf_error_set(c->err, CF_E_DATA, "%s: missing key '%s'", c->name, key);
+        return CF_OK;
+    }
+    if (!json_is_object(v))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be an object", c->name, key);
+    *out = v;
+    return CF_OK;
+}
+
+/* A JSON array of three finite numbers at obj[key] into v. */
+cf_status cf_scene_vec3(ctx *c, json_t *obj, const char *where, const char *key, double v[3])
+{
+    json_t *a = json_object_get(obj, key);
+    if (!a)
+        return cf_error_set(c->err, CF_E_DATA, "%s: missing key '%s.%s'", c->name, where, key);
+    if (!json_is_array(a) || json_array_size(a) != 3)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.%s' must be an array of 3 numbers",
+                            c->name, where, key);
+    for (size_t i = 0; i < 3; i++) {
+        json_t *x = json_array_get(a, i);
+        if (!json_is_number(x) || !isfinite(json_number_value(x)))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.%s' must be an array of 3 finite "
+                                "numbers", c->name, where, key);
+        v[i] = json_number_value(x);
+    }
+    return CF_OK;
+}

@@ -1,0 +1,42 @@
+/*
+** Closed triangulated surfaces (Wavefront OBJ, STL ASCII or binary) read as data, checked and
+** made fit for a volume mesher (surface.c): every edge in exactly two triangles of opposite
+** orientation, the normals outward, and local self-crossings smoothed away. Private to the io
+** layer; mesh.c hands the result to Gmsh (cf_mesh_from_surface, conifit/mesh.h).
+*/
+#ifndef CF_IO_SURFACE_H
+#define CF_IO_SURFACE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "conifit/error.h"
+#include "conifit/mesh.h"
+
+typedef struct cf_surface {
+    size_t nv, nf;
+    double *X;      /* 3 nv vertex coordinates, in the file's units */
+    uint32_t *tri;  /* 3 nf vertex indices */
+} cf_surface;
+
+void cf_surface_free(cf_surface *s);
+
+/* 1 when path names a surface file this reader takes (.obj, .stl). */
+int cf_surface_name(const char *path);
+
+/* Reads the OBJ or STL file at path (by its ending; polygons of an OBJ split into fans; an STL's
+** repeated vertices merged). CF_E_NOINPUT when it cannot be opened, CF_E_DATA naming the file and
+** line (or triangle) for anything malformed or not finite. */
+cf_status cf_surface_read(const char *path, cf_surface *s, cf_error *err);
+
+/* Checks s as the boundary of a solid and prepares it (info filled in mm, with unit_mm): no
+** triangle of zero area, every edge in two triangles of opposite orientation (else "not a closed
+** surface" naming the vertices), the triangles turned outward when they enclose a negative volume;
+** edges that cross a triangle not their own are removed by moving the corners of the triangles
+** involved to the mean of their neighbours, up to CF_SURFACE_SMOOTH_ROUNDS rounds (else refused
+** naming the crossing). CF_E_DATA / CF_E_INTERNAL. */
+#define CF_SURFACE_SMOOTH_ROUNDS 5
+cf_status cf_surface_prepare(cf_surface *s, const char *name, double unit_mm,
+                             cf_mesh_surface_info *info, cf_error *err);
+
+#endif

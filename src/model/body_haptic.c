@@ -1,0 +1,245 @@
+/*
+** Tissue bodies (body.h): the probe loop at haptic rate, chord iterations on the factored
+** contact-free tangent corrected for the nodes in contact by Woodbury's identity.
+*/
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "model/body_internal.h"
+
+/* The three columns of the inverse of the contact-free tangent at node i (held components zero),
+** computed at its first contact and kept (*out). */
+static cf_status haptic_columns(body_work *w, size_t nn, size_t i, const double **out,
+                                cf_error *err)
+{
+    const size_t n = 3 * nn;
+    cf_status st;
+    if (w->slot[i]) {
+        *out = w->Z + (size_t)(w->slot[i] - 1) * 3 * n;
+        return CF_OK;
+    }
+    if (w->nslot == w->capslot) {
+        size_t cap = w->capslot ? 2 * w->capslot : 16;
+        double *Z = realloc(w->Z, cap * 3 * n * sizeof *Z);
+        if (!Z)
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory for the haptic loop's columns");
+        w->Z = Z;
+        w->capslot = cap;
+    }
+    double *col = w->Z + w->nslot * 3 * n;
+    for (int a = 0; a < 3; a++) {
+        memset(w->hrhs, 0, n * sizeof *w->hrhs);
+        w->hrhs[3 * i + (size_t)a] = 1;
+        if ((st = cf_sparse_chol_solve(w->hch, w->hrhs, col + (size_t)a * n, err)) != CF_OK)
+            return st;
+    }
+    w->slot[i] = (uint32_t)++w->nslot;
+    *out = col;
+    return CF_OK;
+}
+
+/* Solves (K0 + U U^T) dx = g by Woodbury's identity: K0 the factored contact-free tangent, U one
+** column sqrt(kp) n_i (at node i's components, held ones zero) per node in contact. m nodes in
+** list[], their normals in nv[3 m]; M is m x m work space, rhs m. */
+static cf_status haptic_solve(cf_body *b, body_work *w, double kp, const size_t *list,
+                              const double *nv, size_t m, double *M, double *rhs, double *dx,
+                              cf_error *err)
+{
+    const size_t n = 3 * b->nn;
+    cf_status st = cf_sparse_chol_solve(w->hch, w->g, dx, err);
+    if (st != CF_OK || m == 0)
+        return st;
+    const double sk = sqrt(kp);
+    /* v_k = K0^-1 u_k is sqrt(kp) Z_k n_k; M = I + U^T K0^-1 U; rhs = U^T y */
+    for (size_t k = 0; k < m; k++) {
+        const double *Zk = NULL;
+        if ((st = haptic_columns(w, b->nn, list[k], &Zk, err)) != CF_OK)
+            return st;
+        const size_t ik = list[k];
+        rhs[k] = 0;
+        for (int a = 0; a < 3; a++)
+            rhs[k] += sk * nv[3 * k + a] * dx[3 * ik + (size_t)a];
+        for (size_t q = 0; q < m; q++) {
+            const size_t iq = list[q];
+            double s = 0;
+            for (int a = 0; a < 3; a++)     /* row of node iq, component a */
+                for (int c = 0; c < 3; c++) /* column c of node ik */
+                    s += nv[3 * q + a] * Zk[(size_t)c * n + 3 * iq + (size_t)a] * nv[3 * k + c];
+            M[q * m + k] = kp * s + (q == k);
+        }
+    }
+    /* M is symmetric positive definite: Cholesky in place, then rhs = M^-1 rhs */
+    for (size_t j = 0; j < m; j++) {
+        double d = M[j * m + j];
+        for (size_t k = 0; k < j; k++)
+            d -= M[j * m + k] * M[j * m + k];
+        if (!(d > 0))
+            return cf_error_set(err, CF_E_NOCONV, "body: the haptic loop's contact matrix is "
+                                                  "not positive definite");
+        d = sqrt(d);
+        M[j * m + j] = d;
+        for (size_t i = j + 1; i < m; i++) {
+            double s = M[i * m + j];
+            for (size_t k = 0; k < j; k++)
+                s -= M[i * m + k] * M[j * m + k];
+            M[i * m + j] = s / d;
+        }
+    }
+    for (size_t i = 0; i < m; i++) {
+        double s = rhs[i];
+        for (size_t k = 0; k < i; k++)
+            s -= M[i * m + k] * rhs[k];
+        rhs[i] = s / M[i * m + i];
+    }
+    for (size_t i = m; i-- > 0;) {
+        double s = rhs[i];
+        for (size_t k = i + 1; k < m; k++)
+            s -= M[k * m + i] * rhs[k];
+        rhs[i] = s / M[i * m + i];
+    }
+    for (size_t k = 0; k < m; k++) {
+        const double *Zk = w->Z + (size_t)(w->slot[list[k]] - 1) * 3 * n;
+        for (int c = 0; c < 3; c++) {
+            const double f = sk * nv[3 * k + c] * rhs[k];
+            if (f == 0)
+                continue;
+            const double *z = Zk + (size_t)c * n;
+            for (size_t r = 0; r < n; r++)
+                dx[r] -= f * z[r];
+        }
+    }
+    return CF_OK;
+}
+
+cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm,
+                              double penalty_N_per_mm, int max_iters, cf_body_step *out,
+                              cf_error *err)
+{
+    const size_t n = 3 * b->nn, nn = b->nn;
+    const double kp = penalty_N_per_mm > 0 ? penalty_N_per_mm : 1e4 * b->E_MPa * b->mean_edge_mm;
+    double c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = probe->center_mm[k] + depth_mm * probe->dir[k];
+    body_work *w = NULL;
+    cf_status st = cf_body_work_get(b, &w, err);
+    if (st != CF_OK)
+        return st;
+    if (!w->hch) {
+        w->hactive = calloc(nn, 1);
+        w->slot = calloc(nn, sizeof *w->slot);
+        w->hy = malloc(n * sizeof *w->hy);
+        w->hrhs = malloc(n * sizeof *w->hrhs);
+        if (!w->hactive || !w->slot || !w->hy || !w->hrhs)
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory for the haptic loop");
+        if ((st = cf_sparse_chol_create(&w->hch, n, w->P.colptr, w->P.rowidx, err)) != CF_OK)
+            return st;
+    }
+    if (!w->hfactored) {
+        /* the contact-free tangent where the body is now, factored once */
+        if (isnan(cf_body_assemble(b, b->x, NULL, NULL, 0, NULL, w->g, &w->P, NULL)))
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's tangent");
+        cf_body_apply_fixed(b, &w->P, w->g);
+        if ((st = cf_sparse_chol_factor(w->hch, w->P.val, NULL, err)) != CF_OK)
+            return st;
+        w->factored = 0; /* the Newton solver's factors were of the same values: refactor */
+        w->hfactored = 1;
+        w->nslot = 0;
+        memset(w->slot, 0, nn * sizeof *w->slot);
+    }
+    size_t *list = NULL, cap = 0;
+    double *nv = NULL, *M = NULL, *rhs = NULL;
+    const double fscale = b->E_MPa * b->mean_edge_mm * b->mean_edge_mm;
+    int it = 0, contacts = 0;
+    double force = 0, r = INFINITY;
+    size_t m = 0;
+    for (it = 0; it < max_iters; it++) {
+        /* the contact set where the body is at the update's start: nodes inside the probe, and
+        ** nodes of the last set still pushed; held through the update's iterations (a node the
+        ** step leaves just outside a curved probe, by its slip along the surface, would otherwise
+        ** drop out and spring back every other iteration), its normals renewed */
+        for (size_t k = 0; it > 0 && k < m; k++) {
+            cf_body_penetration(probe, c, b->x + 3 * list[k], nv + 3 * k, 1);
+            for (int a = 0; a < 3; a++)
+                if ((b->fix[list[k]] >> a) & 1)
+                    nv[3 * k + (size_t)a] = 0;
+        }
+        for (size_t i = 0; it == 0 && i < nn; i++) {
+            double nrm[3];
+            uint8_t in = b->fix[i] != CF_BODY_FIX_ALL &&
+                         (cf_body_penetration(probe, c, b->x + 3 * i, nrm, 0) > 0 ||
+                          (w->hactive[i] && cf_body_penetration(probe, c, b->x + 3 * i, nrm, 1) > 0));
+            w->hactive[i] = in;
+            if (!in)
+                continue;
+            if (m == cap) {
+                cap = cap ? 2 * cap : 16;
+                size_t *l2 = realloc(list, cap * sizeof *l2);
+                double *n2 = l2 ? realloc(nv, 3 * cap * sizeof *n2) : NULL;
+                double *M2 = n2 ? realloc(M, cap * cap * sizeof *M2) : NULL;
+                double *r2 = M2 ? realloc(rhs, cap * sizeof *r2) : NULL;
+                if (l2)
+                    list = l2;
+                if (n2)
+                    nv = n2;
+                if (M2)
+                    M = M2;
+                if (r2)
+                    rhs = r2;
+                if (!r2) {
+                    st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the haptic loop");
+                    goto end;
+                }
+            }
+            list[m] = i;
+            cf_body_penetration(probe, c, b->x + 3 * i, nv + 3 * m, 1);
+            for (int a = 0; a < 3; a++)
+                if ((b->fix[i] >> a) & 1)
+                    nv[3 * m + (size_t)a] = 0;
+            m++;
+        }
+        force = cf_body_assemble(b, b->x, probe, c, kp, w->hactive, w->g, NULL, &contacts);
+        if (isnan(force)) {
+            st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's forces");
+            goto end;
+        }
+        cf_body_keep_reaction(b, w->g);
+        cf_body_apply_fixed(b, NULL, w->g);
+        r = body_norm_inf(w->g, n);
+        if (r <= 1e-8 * fscale)
+            break;
+        if ((st = haptic_solve(b, w, kp, list, nv, m, M, rhs, w->dx, err)) != CF_OK)
+            goto end;
+        for (size_t i = 0; i < nn; i++)
+            for (int a = 0; a < 3; a++)
+                if ((b->fix[i] >> a) & 1)
+                    w->dx[3 * i + (size_t)a] = 0;
+        double alpha = 2;
+        int ok = 0;
+        for (int bt = 0; bt < 40 && !ok; bt++) {
+            alpha *= 0.5;
+            for (size_t i = 0; i < n; i++)
+                w->xt[i] = b->x[i] - alpha * w->dx[i];
+            ok = cf_body_admissible(b, w->xt);
+        }
+        if (!ok) {
+            st = cf_error_set(err, CF_E_NOCONV,
+                              "body: at probe depth %g mm every haptic step would invert a "
+                              "tetrahedron or take a spring to solid",
+                              depth_mm);
+            goto end;
+        }
+        memcpy(b->x, w->xt, n * sizeof *w->xt);
+    }
+    out->depth_mm = depth_mm;
+    out->force_N = force;
+    out->contacts = contacts;
+    out->newton_iters = it;
+    out->min_J = cf_body_measure(b, NULL, &out->max_u_over_travel);
+end:
+    free(list);
+    free(nv);
+    free(M);
+    free(rhs);
+    return st;
+}

@@ -1,0 +1,119 @@
+/*
+** What the files of the tissue body share (body.c: the springs, their calibration and the probe's
+** geometry; body_assemble.c: the tangent's pattern, the forces and tangent, the solver's workspace;
+** body_solve.c: the static probe solve; body_haptic.c: the probe loop at haptic rate). Private to
+** the model layer.
+*/
+#ifndef CF_MODEL_BODY_INTERNAL_H
+#define CF_MODEL_BODY_INTERNAL_H
+
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "conifit/body.h"
+#include "model/sparse_chol.h"
+
+/* Six times the signed volume of the tetrahedron a, b, c, d. */
+static inline double body_vol6(const double *a, const double *b, const double *c, const double *d)
+{
+    double u[3], v[3], w[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = b[k] - a[k];
+        v[k] = c[k] - a[k];
+        w[k] = d[k] - a[k];
+    }
+    return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+           u[2] * (v[0] * w[1] - v[1] * w[0]);
+}
+
+/* A spring's length, unit axis (from i to j) and law compression at positions x. */
+static inline double body_spring_geom(const cf_body *b, const double *x, size_t s, double n[3], double *u)
+{
+    const double *p = x + 3 * b->si[s], *q = x + 3 * b->sj[s];
+    double d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+    double L = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    for (int k = 0; k < 3; k++)
+        n[k] = d[k] / L;
+    *u = b->law->p.H_mm * (b->L0[s] - L) / b->L0[s];
+    return L;
+}
+
+static inline double body_norm_inf(const double *v, size_t n)
+{
+    double m = 0;
+    for (size_t i = 0; i < n; i++)
+        m = fmax(m, fabs(v[i]));
+    return m;
+}
+
+/* The sparse pattern of the tangent in 3 x 3 blocks: column node j holds the blocks of the nodes
+** in nb[nbp[j] .. nbp[j + 1]) (sorted, j among them): the nodes of the tetrahedra around j (its
+** springs' other ends), and with a volume term those of the tetrahedra around each of these (the
+** nodal volume couples every pair of nodes around one node). */
+typedef struct pattern {
+    size_t n;              /* 3 nn */
+    int *colptr, *rowidx;
+    double *val;
+    size_t *nbp;           /* nn + 1 */
+    uint32_t *nb;
+    size_t *tp;            /* tetrahedra around each node: tl[tp[a] .. tp[a + 1]) */
+    uint32_t *tl;
+    /* block indices found once (a search per block at every assembly cost more than the rest):
+    ** per spring (i, j): (i in i), (j in j), (i in j), (j in i); per tetrahedron: (row m in
+    ** column q) for its 16 corner pairs; per node a with a volume term: its ring (the nodes of
+    ** the tetrahedra around it, in the order the assembly meets them) and the blocks of every
+    ** pair of ring nodes */
+    uint32_t *sblk, *tblk;
+    size_t *rp;            /* nn + 1: ring of a in rn[rp[a] .. rp[a + 1]) */
+    uint32_t *rn;
+    size_t *bp;            /* nn + 1: blocks of a's ring pairs in rblk[bp[a] ..), row-major */
+    uint32_t *rblk;
+} pattern;
+
+/* What the solves of a body keep between calls: the pattern and the analysed factorisation of its
+** tangent, the last factors (reused as chord steps while they converge fast enough), and work
+** vectors. */
+typedef struct body_work {
+    pattern P;
+    cf_sparse_chol *ch;
+    double *g, *dx, *xt;
+    uint8_t *active;
+    int factored;       /* ch holds the factors of a tangent of this body */
+    /* the haptic loop (cf_body_haptic_step): the factors of the tangent without contact, taken
+    ** once, and per node that has touched the probe the three columns of its inverse at that
+    ** node (slot[i] + 1 indexes Z, 0 = none yet) */
+    cf_sparse_chol *hch;
+    int hfactored;
+    uint8_t *hactive;
+    uint32_t *slot;
+    double *Z;          /* 9 nn per slot: columns 3 nn each */
+    size_t nslot, capslot;
+    double *hy, *hrhs;
+} body_work;
+
+/* body.c */
+/* Penetration of the node at p into the probe whose reference point is at c, and the unit
+** direction in which the probe pushes it. With signed = 0: 0 when the node is outside. With
+** signed = 1 (a node of the active set): the signed depth along that direction, negative when the
+** node has left the probe's surface. */
+double cf_body_penetration(const cf_probe *pr, const double *c, const double *p, double nrm[3],
+                           int sgn);
+
+/* body_assemble.c */
+/* Energy gradient g (3 nn) and, when P is not NULL, the tangent at positions x; contact forces of
+** the probe at c added (as -f to g) with their tangent. Returns the reaction along the probe's
+** direction and the number of nodes in contact; NAN when memory runs out. */
+double cf_body_assemble(const cf_body *b, const double *x, const cf_probe *pr, const double *c,
+                        double kp, const uint8_t *active, double *g, pattern *P, int *contacts);
+/* The residual g (before cf_body_apply_fixed) at the held components into b->reaction. */
+void cf_body_keep_reaction(const cf_body *b, const double *g);
+/* Zeroes the rows and columns of fixed components (diagonal 1) and their gradient entries. */
+void cf_body_apply_fixed(const cf_body *b, pattern *P, double *g);
+/* 1 when positions x invert no tetrahedron and take no spring to solid. */
+int cf_body_admissible(const cf_body *b, const double *x);
+/* The body's workspace (made at the first call), and its release. */
+cf_status cf_body_work_get(cf_body *b, body_work **out, cf_error *err);
+void cf_body_work_free(body_work *w);
+
+#endif
