@@ -80,6 +80,7 @@ static cf_status make_body(const cf_scene *sc, const char *scene_path, haptic_ru
                               scene_path, g->key);
             break;
         }
+        memset(mark, 0, b->nn);
         if (cf_mesh_select(&r->mesh, &g->sel, mark) == 0) {
             st = cf_error_set(err, CF_E_DATA, "%s: key '%s.%s' selects no node of %s",
                               scene_path, g->key, cf_select_name(g->sel.kind), sc->body_mesh);
