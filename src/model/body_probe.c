@@ -1,0 +1,51 @@
+/*
+** The probe's geometry (body_internal.h): how far a node is inside a sphere or a flat punch and
+** the direction the probe pushes it, and whether a probe starts inside a body. Below the body's
+** assembly and solvers, which call it.
+*/
+#include <math.h>
+
+#include "model/body_internal.h"
+
+/* Penetration of the node at p into the probe whose reference point is at c, and the unit
+** direction in which the probe pushes it. With signed = 0: 0 when the node is outside. With
+** signed = 1 (a node of the active set): the signed depth along that direction, negative when the
+** node has left the probe's surface. */
+double cf_body_penetration(const cf_probe *pr, const double *c, const double *p, double nrm[3],
+                           int sgn)
+{
+    double r[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+    if (pr->shape == CF_PROBE_SPHERE) {
+        double d = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+        if ((!sgn && !(d < pr->radius_mm)) || d == 0)
+            return 0;
+        for (int k = 0; k < 3; k++)
+            nrm[k] = r[k] / d;
+        return pr->radius_mm - d;
+    }
+    double s = r[0] * pr->dir[0] + r[1] * pr->dir[1] + r[2] * pr->dir[2];
+    for (int k = 0; k < 3; k++)
+        nrm[k] = pr->dir[k];
+    if (sgn)
+        return -s;
+    if (!(s < 0))
+        return 0;
+    double rad2 = 0;
+    for (int k = 0; k < 3; k++) {
+        double q = r[k] - s * pr->dir[k];
+        rad2 += q * q;
+    }
+    if (!(rad2 < pr->radius_mm * pr->radius_mm))
+        return 0;
+    return -s;
+}
+
+
+long cf_body_probe_inside(const cf_body *b, const cf_probe *probe)
+{
+    double nrm[3];
+    for (size_t i = 0; i < b->nn; i++)
+        if (cf_body_penetration(probe, probe->center_mm, b->X + 3 * i, nrm, 0) > 0)
+            return (long)i;
+    return -1;
+}
