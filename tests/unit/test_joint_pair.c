@@ -6,6 +6,7 @@
 ** cortex in three modes reaches half one-term Ogden's weighted objective (0.0343) with a buildable
 ** pair, and the fit file says so.
 */
+#include "jointutil.h"
 #include "testutil.h"
 
 #include "conifit/cell.h"
@@ -215,23 +216,11 @@ static void declared_nu_is_the_lattices(void **state)
 static void brain_cortex_stable_pair_below_half_of_ogden(void **state)
 {
     (void)state;
-    const char *dir = tu_datasets();
-    if (!dir)
-        skip();
-    static const char *const names[3] = {"brain_cortex_tension.csv",
-                                         "brain_cortex_compression.csv",
-                                         "brain_cortex_shear.csv"};
     cf_table t[3];
     const cf_table *tabs[3];
-    cf_measure_options mo = cf_measure_default_options();
+    if (!tu_load_modes("brain_cortex", tu_tcs, 3, t, tabs))
+        skip();
     cf_error err = {0};
-    for (int k = 0; k < 3; k++) {
-        char path[1024];
-        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
-        if (cf_measure_load(path, &mo, &t[k], &err) != CF_OK)
-            fail_msg("%s", err.msg);
-        tabs[k] = &t[k];
-    }
     cf_pipeline_options po = cf_pipeline_default_options();
     po.fit.law = CF_KIND_AUTO;
     po.fit.volume = CF_VOLUME_FIT;
@@ -296,23 +285,11 @@ static void brain_cortex_stable_pair_below_half_of_ogden(void **state)
 static void chicken_breast_pair_never_loses_to_the_odd_law(void **state)
 {
     (void)state;
-    const char *dir = tu_datasets();
-    if (!dir)
-        skip();
-    static const char *const names[3] = {"chicken_breast_tension.csv",
-                                         "chicken_breast_compression.csv",
-                                         "chicken_breast_shear.csv"};
     cf_table t[3];
     const cf_table *tabs[3];
-    cf_measure_options mo = cf_measure_default_options();
+    if (!tu_load_modes("chicken_breast", tu_tcs, 3, t, tabs))
+        skip();
     cf_error err = {0};
-    for (int k = 0; k < 3; k++) {
-        char path[1024];
-        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
-        if (cf_measure_load(path, &mo, &t[k], &err) != CF_OK)
-            fail_msg("%s", err.msg);
-        tabs[k] = &t[k];
-    }
     cf_fit_options o = cf_fit_default_options();
     cf_validate_setup s = cf_validate_default();
     for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING; ty++) {
@@ -358,22 +335,12 @@ static void chicken_breast_pair_never_loses_to_the_odd_law(void **state)
 static void coronaradiata_pair_infeasible_is_the_odd_law(void **state)
 {
     (void)state;
-    const char *dir = tu_datasets();
-    if (!dir)
-        skip();
-    static const char *const names[2] = {"brain_coronaradiata_tension.csv",
-                                         "brain_coronaradiata_compression.csv"};
     cf_table t[2];
     const cf_table *tabs[2];
-    cf_measure_options mo = cf_measure_default_options();
+    static const char *const modes[2] = {"tension", "compression"};
+    if (!tu_load_modes("brain_coronaradiata", modes, 2, t, tabs))
+        skip();
     cf_error err = {0};
-    for (int k = 0; k < 2; k++) {
-        char path[1024];
-        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
-        if (cf_measure_load(path, &mo, &t[k], &err) != CF_OK)
-            fail_msg("%s", err.msg);
-        tabs[k] = &t[k];
-    }
     cf_pipeline_options po = cf_pipeline_default_options();
     po.fit.law = CF_KIND_DOUBLE;
     po.types = 1u << CF_TELESCOPING;

@@ -7,6 +7,7 @@
 ** recovered from a uniaxial and a shear curve together, and the three brain cortex tables with
 ** --law auto, the tail kept only with a lower joint AIC, its fit file loading back with the tail.
 */
+#include "jointutil.h"
 #include "testutil.h"
 
 #include "conifit/calibration.h"
@@ -326,23 +327,11 @@ static void known_tailed_spring_is_recovered_jointly(void **state)
 static void brain_cortex_joint_auto(void **state)
 {
     (void)state;
-    const char *dir = tu_datasets();
-    if (!dir)
-        skip();
-    static const char *const names[3] = {"brain_cortex_tension.csv",
-                                         "brain_cortex_compression.csv",
-                                         "brain_cortex_shear.csv"};
     cf_table t[3];
     const cf_table *tabs[3];
-    cf_measure_options mo = cf_measure_default_options();
+    if (!tu_load_modes("brain_cortex", tu_tcs, 3, t, tabs))
+        skip();
     cf_error err = {0};
-    for (int k = 0; k < 3; k++) {
-        char path[1024];
-        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
-        if (cf_measure_load(path, &mo, &t[k], &err) != CF_OK)
-            fail_msg("%s", err.msg);
-        tabs[k] = &t[k];
-    }
     cf_pipeline_options po = cf_pipeline_default_options();
     po.fit.law = CF_KIND_AUTO;
     cf_joint_report r;
@@ -417,23 +406,11 @@ static void brain_cortex_joint_auto(void **state)
 static void chicken_breast_joint_tail_never_loses(void **state)
 {
     (void)state;
-    const char *dir = tu_datasets();
-    if (!dir)
-        skip();
-    static const char *const names[3] = {"chicken_breast_tension.csv",
-                                         "chicken_breast_compression.csv",
-                                         "chicken_breast_shear.csv"};
     cf_table t[3];
     const cf_table *tabs[3];
-    cf_measure_options mo = cf_measure_default_options();
+    if (!tu_load_modes("chicken_breast", tu_tcs, 3, t, tabs))
+        skip();
     cf_error err = {0};
-    for (int k = 0; k < 3; k++) {
-        char path[1024];
-        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
-        if (cf_measure_load(path, &mo, &t[k], &err) != CF_OK)
-            fail_msg("%s", err.msg);
-        tabs[k] = &t[k];
-    }
     cf_fit_options o = cf_fit_default_options();
     cf_validate_setup s = cf_validate_default();
     for (int ty = CF_TELESCOPING; ty <= CF_NON_TELESCOPING; ty++) {

@@ -1,0 +1,40 @@
+/*
+** What the tests of tissue bodies share: a block mesh written as a Gmsh file, and a spring.
+*/
+#ifndef CF_TESTS_BODYUTIL_H
+#define CF_TESTS_BODYUTIL_H
+
+#include <stdio.h>
+
+#include "conifit/body.h"
+#include "conifit/mesh.h"
+#include "testutil.h"
+
+#define SPRING "\"spring\": {\"params\": {\"D1_mm\": 10, \"D2_mm\": 30, \"n\": 4, \"d_mm\": 1, " \
+               "\"G_MPa\": 80000, \"H_mm\": 40}}"
+
+/* A block of 6 x 6 x 3 cells over 30 x 30 x 15 mm, as a Gmsh 2.2 file. */
+static inline void write_block(const char *path)
+{
+    double xs[7], zs[4];
+    for (int i = 0; i <= 6; i++)
+        xs[i] = 5.0 * i;
+    for (int i = 0; i <= 3; i++)
+        zs[i] = 5.0 * i;
+    cf_mesh m;
+    assert_int_equal(cf_mesh_block(&m, xs, 6, xs, 6, zs, 3, NULL), CF_OK);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f, "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n%zu\n", m.nn);
+    for (size_t i = 0; i < m.nn; i++)
+        fprintf(f, "%zu %.17g %.17g %.17g\n", i + 1, m.X[3 * i], m.X[3 * i + 1], m.X[3 * i + 2]);
+    fprintf(f, "$EndNodes\n$Elements\n%zu\n", m.nt);
+    for (size_t t = 0; t < m.nt; t++)
+        fprintf(f, "%zu 4 2 0 1 %u %u %u %u\n", t + 1, m.tet[4 * t] + 1, m.tet[4 * t + 1] + 1,
+                m.tet[4 * t + 2] + 1, m.tet[4 * t + 3] + 1);
+    fprintf(f, "$EndElements\n");
+    fclose(f);
+    cf_mesh_free(&m);
+}
+
+#endif
