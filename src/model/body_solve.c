@@ -9,10 +9,79 @@
 
 #include "model/body_internal.h"
 
+/* Newton's method with the contact set w->active held (each node of it pushed back by the
+** penalty kp in proportion to its signed depth), probe reference point at c: at most 200 steps,
+** chord steps on the last factors while each cuts the residual to a quarter (*fresh 0), the
+** tangent taken afresh otherwise. *conv 1 when the residual or the step fell below rounding;
+** *it counts the iterations, *force and *contacts are the last assembly's. */
+static cf_status newton_in_set(cf_body *b, body_work *w, const cf_probe *probe, const double c[3],
+                               double kp, double depth_mm, int *fresh, int *it, int *contacts,
+                               double *force, int *conv, cf_error *err)
+{
+    const size_t n = 3 * b->nn;
+    const double fscale = b->E_MPa * b->mean_edge_mm * b->mean_edge_mm;
+    pattern *P = &w->P;
+    double *g = w->g, *dx = w->dx, *xt = w->xt;
+    const uint8_t *active = w->active;
+    cf_status st;
+    double rprev = INFINITY;
+    for (int k = 0; k < 200 && !*conv; k++, (*it)++) {
+        *force = cf_body_assemble(b, b->x, probe, c, kp, active, g, *fresh ? P : NULL, contacts);
+        if (isnan(*force))
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's tangent");
+        cf_body_apply_fixed(b, *fresh ? P : NULL, g);
+        double r = body_norm_inf(g, n);
+        if (r <= 1e-8 * fscale) {
+            *conv = 1;
+            break;
+        }
+        if (!*fresh && !(r <= 0.25 * rprev)) {
+            /* the old factors no longer converge fast: take the tangent here */
+            *fresh = 1;
+            rprev = INFINITY;
+            k--;
+            (*it)--;
+            continue;
+        }
+        if (*fresh) {
+            w->factored = 0;
+            if ((st = cf_sparse_chol_factor(w->ch, P->val, NULL, err)) != CF_OK)
+                return st;
+            w->factored = 1;
+        }
+        if ((st = cf_sparse_chol_solve(w->ch, g, dx, err)) != CF_OK)
+            return st;
+        for (size_t i = 0; i < b->nn; i++) /* held components never move (old factors */
+            for (int a = 0; a < 3; a++)    /* may have been made with other ones held) */
+                if ((b->fix[i] >> a) & 1)
+                    dx[3 * i + (size_t)a] = 0;
+        *fresh = 0;
+        rprev = r;
+        double alpha = 2;
+        int ok = 0;
+        for (int bt = 0; bt < 40 && !ok; bt++) {
+            alpha *= 0.5;
+            for (size_t i = 0; i < n; i++)
+                xt[i] = b->x[i] - alpha * dx[i];
+            ok = cf_body_admissible(b, xt);
+        }
+        if (!ok)
+            return cf_error_set(err, CF_E_NOCONV,
+                                "body: at probe depth %g mm every Newton step would invert a "
+                                "tetrahedron or take a spring to solid",
+                                depth_mm);
+        memcpy(b->x, xt, n * sizeof *xt);
+        if (alpha < 0.99)
+            *fresh = 1; /* a shortened step: take the tangent where it landed */
+        if (alpha * body_norm_inf(dx, n) <= 1e-14 * b->mean_edge_mm)
+            *conv = 1;
+    }
+    return CF_OK;
+}
+
 cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
                         double penalty_N_per_mm, cf_body_step *out, cf_error *err)
 {
-    const size_t n = 3 * b->nn;
     const double kp = penalty_N_per_mm > 0 ? penalty_N_per_mm : 1e4 * b->E_MPa * b->mean_edge_mm;
     double c[3];
     for (int k = 0; k < 3; k++)
@@ -21,8 +90,7 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
     cf_status st = cf_body_work_get(b, &w, err);
     if (st != CF_OK)
         return st;
-    pattern *P = &w->P;
-    double *g = w->g, *dx = w->dx, *xt = w->xt;
+    double *g = w->g;
     uint8_t *active = w->active;
     /* Active set: Newton's method with the set of nodes in contact held (each held node pushed
     ** back by the penalty in proportion to its signed depth), then the set replaced by the nodes
@@ -31,7 +99,6 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
     ** tangent serve as long as each step reduces the residual to a quarter (chord steps: the
     ** next update of a probe moving slowly reuses the last factors); otherwise, and whenever the
     ** set changes, the tangent is assembled and factored afresh. */
-    const double fscale = b->E_MPa * b->mean_edge_mm * b->mean_edge_mm;
     int it = 0, contacts = 0, rounds, fresh = 0;
     double force = 0;
     for (size_t i = 0; i < b->nn; i++) {
@@ -43,62 +110,9 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
     fresh |= !w->factored;
     for (rounds = 0; rounds < 100; rounds++) {
         int conv = 0;
-        double rprev = INFINITY;
-        for (int k = 0; k < 200 && !conv; k++, it++) {
-            force = cf_body_assemble(b, b->x, probe, c, kp, active, g, fresh ? P : NULL, &contacts);
-            if (isnan(force)) {
-                st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's tangent");
-                goto end;
-            }
-            cf_body_apply_fixed(b, fresh ? P : NULL, g);
-            double r = body_norm_inf(g, n);
-            if (r <= 1e-8 * fscale) {
-                conv = 1;
-                break;
-            }
-            if (!fresh && !(r <= 0.25 * rprev)) {
-                /* the old factors no longer converge fast: take the tangent here */
-                fresh = 1;
-                rprev = INFINITY;
-                k--;
-                it--;
-                continue;
-            }
-            if (fresh) {
-                w->factored = 0;
-                if ((st = cf_sparse_chol_factor(w->ch, P->val, NULL, err)) != CF_OK)
-                    goto end;
-                w->factored = 1;
-            }
-            if ((st = cf_sparse_chol_solve(w->ch, g, dx, err)) != CF_OK)
-                goto end;
-            for (size_t i = 0; i < b->nn; i++) /* held components never move (old factors */
-                for (int a = 0; a < 3; a++)    /* may have been made with other ones held) */
-                    if ((b->fix[i] >> a) & 1)
-                        dx[3 * i + (size_t)a] = 0;
-            fresh = 0;
-            rprev = r;
-            double alpha = 2;
-            int ok = 0;
-            for (int bt = 0; bt < 40 && !ok; bt++) {
-                alpha *= 0.5;
-                for (size_t i = 0; i < n; i++)
-                    xt[i] = b->x[i] - alpha * dx[i];
-                ok = cf_body_admissible(b, xt);
-            }
-            if (!ok) {
-                st = cf_error_set(err, CF_E_NOCONV,
-                                  "body: at probe depth %g mm every Newton step would invert a "
-                                  "tetrahedron or take a spring to solid",
-                                  depth_mm);
-                goto end;
-            }
-            memcpy(b->x, xt, n * sizeof *xt);
-            if (alpha < 0.99)
-                fresh = 1; /* a shortened step: take the tangent where it landed */
-            if (alpha * body_norm_inf(dx, n) <= 1e-14 * b->mean_edge_mm)
-                conv = 1;
-        }
+        if ((st = newton_in_set(b, w, probe, c, kp, depth_mm, &fresh, &it, &contacts, &force,
+                                &conv, err)) != CF_OK)
+            goto end;
         if (!conv) {
             st = cf_error_set(err, CF_E_NOCONV,
                               "body: Newton's method did not converge at probe depth %g mm",
@@ -162,6 +176,116 @@ static double touch_depth(const cf_body *b, const cf_probe *pr, double now)
     return dmin;
 }
 
+/* A bracket of the probe's depth for a force: below at dlo (force flo, body xlo; flo -INFINITY
+** when unknown), at or above at dhi (fhi, xhi); the Newton iterations of every trial. */
+typedef struct depth_bracket {
+    double dlo, flo, dhi, fhi;
+    double *xlo, *xhi;
+    int iters;
+} depth_bracket;
+
+/* The bracket's ends from the probe's current depth: the lower end there, or where the probe
+** first touches; the upper end by steps that double from a tenth of the mean edge. *s is the
+** last solve's step. */
+static cf_status bracket_force(cf_body *b, const cf_probe *probe, double force_N, double depth_mm,
+                               double kp, depth_bracket *q, cf_body_step *s, cf_error *err)
+{
+    const size_t n = 3 * b->nn;
+    cf_status st;
+    q->dlo = depth_mm, q->flo = 0, q->dhi = 0, q->fhi = 0;
+    if ((st = cf_body_solve(b, probe, q->dlo, kp, s, err)) != CF_OK)
+        return st;
+    q->flo = s->force_N;
+    q->iters += s->newton_iters;
+    if (s->contacts == 0) {
+        const double dt = touch_depth(b, probe, q->dlo);
+        if (!isfinite(dt))
+            return cf_error_set(err, CF_E_DATA, "body: the probe moves past the body without "
+                                "touching it, so it cannot reach %g N", force_N);
+        if (dt > q->dlo) {
+            q->dlo = dt;
+            q->flo = 0;
+        }
+    }
+    memcpy(q->xlo, b->x, n * sizeof *q->xlo);
+    if (q->flo >= force_N) { /* already there or past it: the bracket's upper end is here */
+        q->dhi = q->dlo;
+        q->fhi = q->flo;
+        memcpy(q->xhi, q->xlo, n * sizeof *q->xhi);
+        q->dlo = depth_mm > q->dhi ? q->dhi : depth_mm;
+        q->flo = -INFINITY;
+    }
+    double step = 0.1 * b->mean_edge_mm;
+    for (int k = 0; q->fhi < force_N; k++) {
+        if (k == 60)
+            return cf_error_set(err, CF_E_NOCONV, "body: the probe did not reach %g N", force_N);
+        q->dhi = q->dlo + step;
+        memcpy(b->x, q->xlo, n * sizeof *q->xlo);
+        if ((st = cf_body_solve(b, probe, q->dhi, kp, s, err)) != CF_OK) {
+            if (err)
+                snprintf(err->msg + strlen(err->msg), sizeof err->msg - strlen(err->msg),
+                         " (seeking the depth of the probe force %g N)", force_N);
+            return st;
+        }
+        q->fhi = s->force_N;
+        q->iters += s->newton_iters;
+        memcpy(q->xhi, b->x, n * sizeof *q->xhi);
+        if (q->fhi < force_N) {
+            q->dlo = q->dhi;
+            q->flo = q->fhi;
+            memcpy(q->xlo, q->xhi, n * sizeof *q->xlo);
+            step *= 2;
+        }
+    }
+    return CF_OK;
+}
+
+/* Regula falsi with Illinois' halving inside bracket q to 1e-6 of the force, from the bracket's
+** last solve *s; *s ends as the solve at the depth found. */
+static cf_status refine_force(cf_body *b, const cf_probe *probe, double force_N, double kp,
+                              depth_bracket *q, cf_body_step *s, cf_error *err)
+{
+    const size_t n = 3 * b->nn;
+    cf_status st;
+    int side = 0;
+    double d = q->dhi, f = q->fhi;
+    for (int it = 0; it < 200; it++) {
+        if (fabs(f - force_N) <= 1e-6 * force_N || q->dhi - q->dlo <= 1e-12 * b->mean_edge_mm)
+            break;
+        d = isfinite(q->flo) && q->fhi > q->flo
+                ? q->dlo + (force_N - q->flo) * (q->dhi - q->dlo) / (q->fhi - q->flo)
+                : 0.5 * (q->dlo + q->dhi);
+        if (!(d > q->dlo && d < q->dhi))
+            d = 0.5 * (q->dlo + q->dhi);
+        memcpy(b->x, force_N - q->flo < q->fhi - force_N ? q->xlo : q->xhi, n * sizeof *q->xlo);
+        if ((st = cf_body_solve(b, probe, d, kp, s, err)) != CF_OK)
+            return st;
+        q->iters += s->newton_iters;
+        f = s->force_N;
+        if (f < force_N) {
+            q->dlo = d;
+            q->flo = f;
+            memcpy(q->xlo, b->x, n * sizeof *q->xlo);
+            if (side == -1 && isfinite(q->fhi))
+                q->fhi = force_N + 0.5 * (q->fhi - force_N);
+            side = -1;
+        } else {
+            q->dhi = d;
+            q->fhi = f;
+            memcpy(q->xhi, b->x, n * sizeof *q->xhi);
+            if (side == 1 && isfinite(q->flo))
+                q->flo = force_N - 0.5 * (force_N - q->flo);
+            side = 1;
+        }
+    }
+    if (d != s->depth_mm) { /* the last trial was not at d: solve there */
+        if ((st = cf_body_solve(b, probe, d, kp, s, err)) != CF_OK)
+            return st;
+        q->iters += s->newton_iters;
+    }
+    return CF_OK;
+}
+
 cf_status cf_body_solve_force(cf_body *b, const cf_probe *probe, double force_N, double *depth_mm,
                               double penalty_N_per_mm, cf_body_step *out, cf_error *err)
 {
@@ -169,108 +293,21 @@ cf_status cf_body_solve_force(cf_body *b, const cf_probe *probe, double force_N,
     if (!(force_N > 0) || !isfinite(force_N) || !isfinite(*depth_mm))
         return cf_error_set(err, CF_E_DATA, "body: probe force %g N: must be finite and > 0",
                             force_N);
-    double *xlo = malloc(n * sizeof *xlo), *xhi = malloc(n * sizeof *xhi);
-    if (!xlo || !xhi) {
-        free(xlo);
-        free(xhi);
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the force-driven probe");
-    }
-    cf_status st = CF_OK;
+    depth_bracket q = {0};
+    q.xlo = malloc(n * sizeof *q.xlo);
+    q.xhi = malloc(n * sizeof *q.xhi);
     cf_body_step s = {0};
-    int iters = 0; /* Newton iterations of every trial */
-    /* the lower end: the current depth, or where the probe first touches */
-    double dlo = *depth_mm, flo = 0, dhi = 0, fhi = 0;
-    if ((st = cf_body_solve(b, probe, dlo, penalty_N_per_mm, &s, err)) != CF_OK)
-        goto end;
-    flo = s.force_N;
-    iters += s.newton_iters;
-    if (s.contacts == 0) {
-        const double dt = touch_depth(b, probe, dlo);
-        if (!isfinite(dt)) {
-            st = cf_error_set(err, CF_E_DATA, "body: the probe moves past the body without "
-                              "touching it, so it cannot reach %g N", force_N);
-            goto end;
-        }
-        if (dt > dlo) {
-            dlo = dt;
-            flo = 0;
-        }
+    cf_status st;
+    if (!q.xlo || !q.xhi)
+        st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the force-driven probe");
+    else if ((st = bracket_force(b, probe, force_N, *depth_mm, penalty_N_per_mm, &q, &s, err)) ==
+                 CF_OK &&
+             (st = refine_force(b, probe, force_N, penalty_N_per_mm, &q, &s, err)) == CF_OK) {
+        *depth_mm = s.depth_mm;
+        *out = s;
+        out->newton_iters = q.iters;
     }
-    memcpy(xlo, b->x, n * sizeof *xlo);
-    if (flo >= force_N) { /* already there or past it: the bracket's upper end is here */
-        dhi = dlo;
-        fhi = flo;
-        memcpy(xhi, xlo, n * sizeof *xhi);
-        dlo = *depth_mm > dhi ? dhi : *depth_mm;
-        flo = -INFINITY;
-    }
-    /* the upper end: steps that double from a tenth of the mean edge */
-    double step = 0.1 * b->mean_edge_mm;
-    for (int k = 0; fhi < force_N; k++) {
-        if (k == 60) {
-            st = cf_error_set(err, CF_E_NOCONV, "body: the probe did not reach %g N", force_N);
-            goto end;
-        }
-        dhi = dlo + step;
-        memcpy(b->x, xlo, n * sizeof *xlo);
-        if ((st = cf_body_solve(b, probe, dhi, penalty_N_per_mm, &s, err)) != CF_OK) {
-            if (err)
-                snprintf(err->msg + strlen(err->msg), sizeof err->msg - strlen(err->msg),
-                         " (seeking the depth of the probe force %g N)", force_N);
-            goto end;
-        }
-        fhi = s.force_N;
-        iters += s.newton_iters;
-        memcpy(xhi, b->x, n * sizeof *xhi);
-        if (fhi < force_N) {
-            dlo = dhi;
-            flo = fhi;
-            memcpy(xlo, xhi, n * sizeof *xlo);
-            step *= 2;
-        }
-    }
-    /* regula falsi with Illinois' halving between dlo (force below) and dhi (at or above) */
-    int side = 0;
-    double d = dhi, f = fhi;
-    for (int it = 0; it < 200; it++) {
-        if (fabs(f - force_N) <= 1e-6 * force_N ||
-            dhi - dlo <= 1e-12 * b->mean_edge_mm)
-            break;
-        d = isfinite(flo) && fhi > flo ? dlo + (force_N - flo) * (dhi - dlo) / (fhi - flo)
-                                       : 0.5 * (dlo + dhi);
-        if (!(d > dlo && d < dhi))
-            d = 0.5 * (dlo + dhi);
-        memcpy(b->x, force_N - flo < fhi - force_N ? xlo : xhi, n * sizeof *xlo);
-        if ((st = cf_body_solve(b, probe, d, penalty_N_per_mm, &s, err)) != CF_OK)
-            goto end;
-        iters += s.newton_iters;
-        f = s.force_N;
-        if (f < force_N) {
-            dlo = d;
-            flo = f;
-            memcpy(xlo, b->x, n * sizeof *xlo);
-            if (side == -1 && isfinite(fhi))
-                fhi = force_N + 0.5 * (fhi - force_N);
-            side = -1;
-        } else {
-            dhi = d;
-            fhi = f;
-            memcpy(xhi, b->x, n * sizeof *xhi);
-            if (side == 1 && isfinite(flo))
-                flo = force_N - 0.5 * (force_N - flo);
-            side = 1;
-        }
-    }
-    if (d != s.depth_mm) { /* the last trial was not at d: solve there */
-        if ((st = cf_body_solve(b, probe, d, penalty_N_per_mm, &s, err)) != CF_OK)
-            goto end;
-        iters += s.newton_iters;
-    }
-    *depth_mm = s.depth_mm;
-    *out = s;
-    out->newton_iters = iters;
-end:
-    free(xlo);
-    free(xhi);
+    free(q.xlo);
+    free(q.xhi);
     return st;
 }
