@@ -112,19 +112,12 @@ static cf_status haptic_solve(cf_body *b, body_work *w, double kp, const size_t 
     return CF_OK;
 }
 
-cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm,
-                              double penalty_N_per_mm, int max_iters, cf_body_step *out,
-                              cf_error *err)
+/* The loop's workspace on first use, and the contact-free tangent where the body is now,
+** factored once (until the body moves on without the loop). */
+static cf_status haptic_prepare(cf_body *b, body_work *w, cf_error *err)
 {
     const size_t n = 3 * b->nn, nn = b->nn;
-    const double kp = penalty_N_per_mm > 0 ? penalty_N_per_mm : 1e4 * b->E_MPa * b->mean_edge_mm;
-    double c[3];
-    for (int k = 0; k < 3; k++)
-        c[k] = probe->center_mm[k] + depth_mm * probe->dir[k];
-    body_work *w = NULL;
-    cf_status st = cf_body_work_get(b, &w, err);
-    if (st != CF_OK)
-        return st;
+    cf_status st;
     if (!w->hch) {
         w->hactive = calloc(nn, 1);
         w->slot = calloc(nn, sizeof *w->slot);
@@ -147,6 +140,44 @@ cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm
         w->nslot = 0;
         memset(w->slot, 0, nn * sizeof *w->slot);
     }
+    return CF_OK;
+}
+
+/* Doubles the contact set's room (list, normals, the Schur matrix and its right side); -1 when
+** memory runs out (what was reallocated is kept for the caller to free). */
+static int grow(size_t *cap, size_t **list, double **nv, double **M, double **rhs)
+{
+    *cap = *cap ? 2 * *cap : 16;
+    size_t *l2 = realloc(*list, *cap * sizeof *l2);
+    double *n2 = l2 ? realloc(*nv, 3 * *cap * sizeof *n2) : NULL;
+    double *M2 = n2 ? realloc(*M, *cap * *cap * sizeof *M2) : NULL;
+    double *r2 = M2 ? realloc(*rhs, *cap * sizeof *r2) : NULL;
+    if (l2)
+        *list = l2;
+    if (n2)
+        *nv = n2;
+    if (M2)
+        *M = M2;
+    if (r2)
+        *rhs = r2;
+    return r2 ? 0 : -1;
+}
+
+cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm,
+                              double penalty_N_per_mm, int max_iters, cf_body_step *out,
+                              cf_error *err)
+{
+    const size_t n = 3 * b->nn, nn = b->nn;
+    const double kp = penalty_N_per_mm > 0 ? penalty_N_per_mm : 1e4 * b->E_MPa * b->mean_edge_mm;
+    double c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = probe->center_mm[k] + depth_mm * probe->dir[k];
+    body_work *w = NULL;
+    cf_status st = cf_body_work_get(b, &w, err);
+    if (st != CF_OK)
+        return st;
+    if ((st = haptic_prepare(b, w, err)) != CF_OK)
+        return st;
     size_t *list = NULL, cap = 0;
     double *nv = NULL, *M = NULL, *rhs = NULL;
     const double fscale = b->E_MPa * b->mean_edge_mm * b->mean_edge_mm;
@@ -172,24 +203,9 @@ cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm
             w->hactive[i] = in;
             if (!in)
                 continue;
-            if (m == cap) {
-                cap = cap ? 2 * cap : 16;
-                size_t *l2 = realloc(list, cap * sizeof *l2);
-                double *n2 = l2 ? realloc(nv, 3 * cap * sizeof *n2) : NULL;
-                double *M2 = n2 ? realloc(M, cap * cap * sizeof *M2) : NULL;
-                double *r2 = M2 ? realloc(rhs, cap * sizeof *r2) : NULL;
-                if (l2)
-                    list = l2;
-                if (n2)
-                    nv = n2;
-                if (M2)
-                    M = M2;
-                if (r2)
-                    rhs = r2;
-                if (!r2) {
-                    st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the haptic loop");
-                    goto end;
-                }
+            if (m == cap && grow(&cap, &list, &nv, &M, &rhs) != 0) {
+                st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the haptic loop");
+                goto end;
             }
             list[m] = i;
             cf_body_penetration(probe, c, b->x + 3 * i, nv + 3 * m, 1);
