@@ -168,6 +168,7 @@ $(BUILD)/tests/%: tests/%.c $(LIB_A)
 test: check-deps $(BUILD)/conifit $(LIB_SO) $(TESTS) $(REPLAYS)
 	@sh tests/check_layers.sh
 	@sh tests/check_cycles.sh $(LIB_OBJ)
+	@sh tests/check_size.sh
 	@sh tests/exports.sh check $(LIB_SO)
 	@sh tests/check_gsl_guard.sh $(BUILD)
 	@CONIFIT=$(BUILD)/conifit sh tests/man/check_options.sh

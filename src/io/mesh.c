@@ -193,6 +193,74 @@ static cf_status extract_groups(const char *name, cf_mesh *m, const size_t *sort
     return st;
 }
 
+/* The tags of the nodes the volume elements use at their corners, sorted and each once, into
+** sorted; returns how many. */
+static size_t used_nodes(const int *types, size_t ntypes, const size_t *etags_n,
+                         size_t *const *ntags, const size_t *ntags_n, size_t *sorted)
+{
+    size_t nused = 0;
+    for (size_t k = 0; k < ntypes; k++) {
+        int corners = 4, per = 1;
+        volume_type(types[k], &corners, &per);
+        size_t stride = etags_n[k] ? ntags_n[k] / etags_n[k] : 0;
+        for (size_t e = 0; e < etags_n[k]; e++)
+            for (int c = 0; c < corners; c++)
+                sorted[nused++] = ntags[k][e * stride + (size_t)c];
+    }
+    qsort(sorted, nused, sizeof *sorted, cmp_size);
+    size_t nn = 0;
+    for (size_t i = 0; i < nused; i++)
+        if (i == 0 || sorted[i] != sorted[nn - 1])
+            sorted[nn++] = sorted[i];
+    return nn;
+}
+
+/* The mesh's nodes: their tags (sorted, nn of them) and their coordinates times unit_mm, looked
+** up among Gmsh's nodes (tags, coord); a node no Gmsh node defines is left NAN. */
+static void fill_nodes(cf_mesh *m, const size_t *sorted, size_t nn, const size_t *tags,
+                       size_t tags_n, const double *coord, double unit_mm)
+{
+    for (size_t i = 0; i < nn; i++)
+        m->id[i] = (uint32_t)(sorted[i] <= UINT32_MAX ? sorted[i] : 0);
+    for (size_t i = 0; i < nn; i++)
+        m->X[3 * i] = NAN;
+    for (size_t j = 0; j < tags_n; j++) {
+        size_t *hit = bsearch(&tags[j], sorted, nn, sizeof *sorted, cmp_size);
+        if (hit)
+            for (int a = 0; a < 3; a++)
+                m->X[3 * (size_t)(hit - sorted) + a] = coord[3 * j + a] * unit_mm;
+    }
+}
+
+/* The volume elements as tetrahedra of the mesh's node indices (a hexahedron as six around its
+** diagonal 0-6), each with its Gmsh element tag. */
+static void fill_elements(cf_mesh *m, const int *types, size_t ntypes, size_t *const *etags,
+                          const size_t *etags_n, size_t *const *ntags, const size_t *ntags_n,
+                          const size_t *sorted, size_t nn)
+{
+    size_t t = 0;
+    static const int hex_tet[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6},
+                                      {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
+    for (size_t k = 0; k < ntypes; k++) {
+        int corners = 4, per = 1;
+        volume_type(types[k], &corners, &per);
+        size_t stride = etags_n[k] ? ntags_n[k] / etags_n[k] : 0;
+        for (size_t e = 0; e < etags_n[k]; e++) {
+            uint32_t v[8];
+            for (int c = 0; c < corners; c++) {
+                size_t *hit = bsearch(&ntags[k][e * stride + (size_t)c], sorted, nn,
+                                      sizeof *sorted, cmp_size);
+                v[c] = (uint32_t)(hit - sorted);
+            }
+            for (int p = 0; p < per; p++, t++) {
+                for (int c = 0; c < 4; c++)
+                    m->tet[4 * t + c] = corners == 4 ? v[c] : v[hex_tet[p][c]];
+                m->eid[t] = etags[k][e];
+            }
+        }
+    }
+}
+
 /* The current Gmsh model's volume elements into m (node coordinates times unit_mm). */
 static cf_status extract(const char *name, double unit_mm, cf_mesh *m, cf_error *err)
 {
@@ -241,20 +309,7 @@ static cf_status extract(const char *name, double unit_mm, cf_mesh *m, cf_error 
     m->eid = malloc(nt * sizeof *m->eid);
     if (!sorted || !m->tet || !m->eid)
         goto oom;
-    nused = 0;
-    for (size_t k = 0; k < ntypes; k++) {
-        int corners = 4, per = 1;
-        volume_type(types[k], &corners, &per);
-        size_t stride = etags_n[k] ? ntags_n[k] / etags_n[k] : 0;
-        for (size_t e = 0; e < etags_n[k]; e++)
-            for (int c = 0; c < corners; c++)
-                sorted[nused++] = ntags[k][e * stride + (size_t)c];
-    }
-    qsort(sorted, nused, sizeof *sorted, cmp_size);
-    size_t nn = 0;
-    for (size_t i = 0; i < nused; i++)
-        if (i == 0 || sorted[i] != sorted[nn - 1])
-            sorted[nn++] = sorted[i];
+    const size_t nn = used_nodes(types, ntypes, etags_n, ntags, ntags_n, sorted);
     if (nn > UINT32_MAX) {
         st = cf_error_set(err, CF_E_DATA, "%s: %zu nodes: too many", name, nn);
         goto end;
@@ -262,50 +317,16 @@ static cf_status extract(const char *name, double unit_mm, cf_mesh *m, cf_error 
     m->nn = nn;
     m->X = malloc(3 * nn * sizeof *m->X);
     m->id = malloc(nn * sizeof *m->id);
-    size_t *order = malloc((tags_n ? tags_n : 1) * sizeof *order);
-    if (!m->X || !m->id || !order) {
-        free(order);
+    if (!m->X || !m->id)
         goto oom;
-    }
-    for (size_t i = 0; i < nn; i++)
-        m->id[i] = (uint32_t)(sorted[i] <= UINT32_MAX ? sorted[i] : 0);
-    /* coordinates: find each used tag among Gmsh's nodes */
-    for (size_t i = 0; i < nn; i++)
-        m->X[3 * i] = NAN;
-    for (size_t j = 0; j < tags_n; j++) {
-        size_t *hit = bsearch(&tags[j], sorted, nn, sizeof *sorted, cmp_size);
-        if (hit)
-            for (int a = 0; a < 3; a++)
-                m->X[3 * (size_t)(hit - sorted) + a] = coord[3 * j + a] * unit_mm;
-    }
-    free(order);
+    fill_nodes(m, sorted, nn, tags, tags_n, coord, unit_mm);
     for (size_t i = 0; i < nn; i++)
         if (isnan(m->X[3 * i])) {
             st = cf_error_set(err, CF_E_DATA, "%s: node %zu is used by an element but not defined",
                               name, sorted[i]);
             goto end;
         }
-    size_t t = 0;
-    static const int hex_tet[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6},
-                                      {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
-    for (size_t k = 0; k < ntypes; k++) {
-        int corners = 4, per = 1;
-        volume_type(types[k], &corners, &per);
-        size_t stride = etags_n[k] ? ntags_n[k] / etags_n[k] : 0;
-        for (size_t e = 0; e < etags_n[k]; e++) {
-            uint32_t v[8];
-            for (int c = 0; c < corners; c++) {
-                size_t *hit = bsearch(&ntags[k][e * stride + (size_t)c], sorted, nn,
-                                      sizeof *sorted, cmp_size);
-                v[c] = (uint32_t)(hit - sorted);
-            }
-            for (int p = 0; p < per; p++, t++) {
-                for (int c = 0; c < 4; c++)
-                    m->tet[4 * t + c] = corners == 4 ? v[c] : v[hex_tet[p][c]];
-                m->eid[t] = etags[k][e];
-            }
-        }
-    }
+    fill_elements(m, types, ntypes, etags, etags_n, ntags, ntags_n, sorted, nn);
     m->nt = nt;
     st = extract_groups(name, m, sorted, nn, err);
     goto end;

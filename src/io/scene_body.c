@@ -90,6 +90,41 @@ static cf_status group(ctx *c, json_t *v, const char *where, cf_select *s)
                         "number (a whole number >= 0)", c->name, where);
 }
 
+/* What a region's use takes: nothing for fixed (all three components held), force_N for
+** loaded, by_mm for displaced (three numbers, null for a component left free). */
+static cf_status region_value(ctx *c, json_t *v, const char *key, cf_region_use use,
+                              cf_scene_region *r)
+{
+    cf_status st;
+    if (use == CF_REGION_FIXED) {
+        r->comps = 7;
+    } else if (use == CF_REGION_LOADED) {
+        if ((st = cf_scene_vec3(c, v, key, "force_N", r->vec)))
+            return st;
+    } else {
+        /* by_mm: three numbers, null for a component left free */
+        json_t *a = json_object_get(v, "by_mm");
+        if (!a || !json_is_array(a) || json_array_size(a) != 3)
+            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.by_mm' must be an array of 3 "
+                                "numbers (null for a free component)", c->name, key);
+        for (size_t i = 0; i < 3; i++) {
+            json_t *e = json_array_get(a, i);
+            if (json_is_null(e))
+                continue;
+            if (!json_is_number(e) || !isfinite(json_number_value(e)) ||
+                fabs(json_number_value(e)) > 1e12)
+                return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.by_mm' must be an array of 3 "
+                                    "finite numbers or null", c->name, key);
+            r->vec[i] = json_number_value(e);
+            r->comps |= 1u << i;
+        }
+        if (!r->comps)
+            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.by_mm' prescribes no component",
+                                c->name, key);
+    }
+    return CF_OK;
+}
+
 /* One region at key: exactly one selector (the table below), and the value its use takes. */
 static cf_status region(ctx *c, json_t *v, const char *key, cf_region_use use, cf_scene *sc)
 {
@@ -167,32 +202,8 @@ static cf_status region(ctx *c, json_t *v, const char *key, cf_region_use use, c
     }
     if (st)
         return st;
-    if (use == CF_REGION_FIXED) {
-        r->comps = 7;
-    } else if (use == CF_REGION_LOADED) {
-        if ((st = cf_scene_vec3(c, v, key, "force_N", r->vec)))
-            return st;
-    } else {
-        /* by_mm: three numbers, null for a component left free */
-        json_t *a = json_object_get(v, "by_mm");
-        if (!a || !json_is_array(a) || json_array_size(a) != 3)
-            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.by_mm' must be an array of 3 "
-                                "numbers (null for a free component)", c->name, key);
-        for (size_t i = 0; i < 3; i++) {
-            json_t *e = json_array_get(a, i);
-            if (json_is_null(e))
-                continue;
-            if (!json_is_number(e) || !isfinite(json_number_value(e)) ||
-                fabs(json_number_value(e)) > 1e12)
-                return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.by_mm' must be an array of 3 "
-                                    "finite numbers or null", c->name, key);
-            r->vec[i] = json_number_value(e);
-            r->comps |= 1u << i;
-        }
-        if (!r->comps)
-            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.by_mm' prescribes no component",
-                                c->name, key);
-    }
+    if ((st = region_value(c, v, key, use, r)))
+        return st;
     sc->nregions++;
     return CF_OK;
 }
