@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "conifit/export.h"
+#include "model/lattice_cells.h"
 #include "base/gslguard.h"
 #include "conifit/lattice.h"
 #include "conifit/validate.h"
@@ -132,10 +133,8 @@ static int model_of_lattice(cf_xmodel *m, const cf_lattice *lat)
         m->cell = malloc(8 * m->ncells * sizeof *m->cell);
         if (!m->cell)
             return -1;
-        for (size_t c = 0; c < m->ncells; c++) {
-            double g[8][3];
-            cf_lattice_cell_volume(lat, c, m->cell + 8 * c, g, NULL);
-        }
+        for (size_t c = 0; c < m->ncells; c++)
+            cf_lattice_cell_nodes(lat, c, m->cell + 8 * c);
     }
     /* the springs a horizontal plane through the middle of a layer of cells cuts */
     const double zc = lat->H_mm * (floor(lat->cfg.nz / 2.0) + 0.5);

@@ -3,6 +3,7 @@
 ** boundary fixities, and the force kernel the solvers call on every step.
 */
 #include "conifit/lattice.h"
+#include "model/lattice_cells.h"
 #include "base/gslguard.h"
 
 #include "conifit/cell.h"
@@ -11,6 +12,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <threads.h>
 
 #include <gsl/gsl_integration.h>
 
@@ -247,8 +249,12 @@ void cf_lattice_reset(cf_lattice *lat)
 
 /* Gauss points of [0, 1] (two, weight 1/2 each) and the trilinear shape functions' derivatives
 ** there: dN[g][a][j] = dN_a/dxi_j at point g (of 8), corner a = di + 2 dj + 4 dk. */
-static void shape_derivatives(double dN[8][8][3])
+static double dN_table[8][8][3];
+static once_flag dN_once = ONCE_FLAG_INIT;
+
+static void shape_derivatives(void)
 {
+    double (*dN)[8][3] = dN_table;
     const double q[2] = {0.5 - 0.5 / 1.7320508075688772935, 0.5 + 0.5 / 1.7320508075688772935};
     for (int g = 0; g < 8; g++) {
         const double xi[3] = {q[g & 1], q[(g >> 1) & 1], q[(g >> 2) & 1]};
@@ -266,18 +272,24 @@ static void shape_derivatives(double dN[8][8][3])
     }
 }
 
-double cf_lattice_cell_volume(const cf_lattice *lat, size_t c, uint32_t node[8], double g[8][3],
-                              double (*hess)[8][3][3])
+void cf_lattice_cell_nodes(const cf_lattice *lat, size_t c, uint32_t node[8])
 {
     const cf_lattice_config *cfg = &lat->cfg;
     const size_t nx = (size_t)cfg->nx, ny = (size_t)cfg->ny;
     const int ci = (int)(c % nx), cj = (int)((c / nx) % ny), ck = (int)(c / (nx * ny));
-    double dN[8][8][3], X[8][3];
-    shape_derivatives(dN);
-    for (int a = 0; a < 8; a++) {
+    for (int a = 0; a < 8; a++)
         node[a] = (uint32_t)node_id(cfg, ci + (a & 1), cj + ((a >> 1) & 1), ck + ((a >> 2) & 1));
+}
+
+double cf_lattice_cell_volume(const cf_lattice *lat, size_t c, uint32_t node[8], double g[8][3],
+                              double (*hess)[8][3][3])
+{
+    double X[8][3];
+    call_once(&dN_once, shape_derivatives); /* the same at every cell: computed once */
+    const double (*dN)[8][3] = (const double (*)[8][3])dN_table;
+    cf_lattice_cell_nodes(lat, c, node);
+    for (int a = 0; a < 8; a++)
         X[a][0] = lat->x[node[a]], X[a][1] = lat->y[node[a]], X[a][2] = lat->z[node[a]];
-    }
     memset(g, 0, 8 * 3 * sizeof(double));
     if (hess)
         memset(hess, 0, 8 * 8 * 3 * 3 * sizeof(double));
@@ -301,22 +313,25 @@ double cf_lattice_cell_volume(const cf_lattice *lat, size_t c, uint32_t node[8],
                                     C[i][2] * dN[p][a][2]);
         if (!hess)
             continue;
-        /* d2 det/(dM_ij dM_kl) = sum_mn eps_ikm eps_jln M_mn */
-        for (int i = 0; i < 3; i++)
-            for (int k = 0; k < 3; k++) {
-                if (i == k)
-                    continue;
-                const int m = 3 - i - k, sik = ((k - i + 3) % 3 == 1) ? 1 : -1;
-                for (int j = 0; j < 3; j++)
-                    for (int l = 0; l < 3; l++) {
-                        if (j == l)
-                            continue;
-                        const int n = 3 - j - l, sjl = ((l - j + 3) % 3 == 1) ? 1 : -1;
-                        const double h = 0.125 * sik * sjl * M[m][n];
-                        for (int a = 0; a < 8; a++)
-                            for (int b = 0; b < 8; b++)
-                                hess[a][b][i][k] += h * dN[p][a][j] * dN[p][b][l];
-                    }
+        /* d2 det/(dM_ij dM_kl) = sum_mn eps_ikm eps_jln M_mn, so the Gauss point adds to
+        ** hess[a][b][i][k] (i != k, m the third index) eps_ikm M_m . (dN_a x dN_b) / 8, where
+        ** M_m is row m of M: one cross product and three dot products per pair of nodes (a node
+        ** with itself adds nothing, and the pair (b, a) adds the transposed block) */
+        for (int a = 0; a < 8; a++)
+            for (int b = a + 1; b < 8; b++) {
+                const double *u = dN[p][a], *v = dN[p][b];
+                const double w[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                                     u[0] * v[1] - u[1] * v[0]};
+                double t[3];
+                for (int m = 0; m < 3; m++)
+                    t[m] = 0.125 * (M[m][0] * w[0] + M[m][1] * w[1] + M[m][2] * w[2]);
+                /* eps_ikm = +1 for (i, k, m) a cyclic order of (0, 1, 2), -1 otherwise */
+                hess[a][b][0][1] += t[2], hess[a][b][1][0] -= t[2];
+                hess[a][b][1][2] += t[0], hess[a][b][2][1] -= t[0];
+                hess[a][b][2][0] += t[1], hess[a][b][0][2] -= t[1];
+                hess[b][a][1][0] += t[2], hess[b][a][0][1] -= t[2];
+                hess[b][a][2][1] += t[0], hess[b][a][1][2] -= t[0];
+                hess[b][a][0][2] += t[1], hess[b][a][2][0] -= t[1];
             }
     }
     const double H = lat->H_mm;

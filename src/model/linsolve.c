@@ -4,6 +4,7 @@
 ** sparse_chol.h), banded LDL^T, dense LU, GMRES.
 */
 #include "model/msm_internal.h"
+#include "model/lattice_cells.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -81,8 +82,7 @@ static int node_adjacency(const cf_lattice *lat, uint32_t *adj, unsigned char *d
     const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
     for (size_t c = 0; lat->cfg.volume_modulus_MPa != 0 && c < nc && !bad; c++) {
         uint32_t node[8];
-        double g[8][3];
-        cf_lattice_cell_volume(lat, c, node, g, NULL);
+        cf_lattice_cell_nodes(lat, c, node);
         for (int a = 0; a < 8 && !bad; a++)
             for (int b = 0; b < 8 && !bad; b++)
                 bad = a != b && adjacent(adj, deg, node[a], node[b]);
@@ -166,8 +166,7 @@ static void block_map(solver *s)
     const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
     for (size_t c = 0; s->vmap && c < nc; c++) {
         uint32_t node[8];
-        double g[8][3];
-        cf_lattice_cell_volume(lat, c, node, g, NULL);
+        cf_lattice_cell_nodes(lat, c, node);
         for (int a = 0; a < 8; a++)
             for (int b = 0; b < 8; b++)
                 for (int i = 0; i < 3; i++)

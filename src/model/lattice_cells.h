@@ -1,0 +1,17 @@
+/*
+** The cells of a lattice (lattice.c): which nodes are a cell's corners, for the solvers' sparsity
+** patterns and the exports, without the volume and gradient cf_lattice_cell_volume computes.
+*/
+#ifndef CF_MODEL_LATTICE_CELLS_H
+#define CF_MODEL_LATTICE_CELLS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "conifit/lattice.h"
+
+/* The eight corner nodes of cell c (corner di + 2 dj + 4 dk), as cf_lattice_cell_volume gives
+** them. */
+void cf_lattice_cell_nodes(const cf_lattice *lat, size_t c, uint32_t node[8]);
+
+#endif
