@@ -38,10 +38,40 @@ static int ccs_index(const gsl_spmatrix *C, long row, long col)
 {
     if (row < 0 || col < 0)
         return -1;
-    for (int k = C->p[col]; k < C->p[col + 1]; k++)
-        if (C->i[k] == row)
-            return k;
-    return -1;
+    /* the rows of a column are in increasing order (pattern_matrix): binary search */
+    int lo = C->p[col], hi = C->p[col + 1];
+    while (lo < hi) {
+        const int mid = lo + (hi - lo) / 2;
+        if (C->i[mid] < row)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < C->p[col + 1] && C->i[lo] == row ? lo : -1;
+}
+
+/* The positions in column col of a node's three DOFs rows[0..2] (-1 where fixed): one binary
+** search, then the next free rows by a short scan forward (a node's free DOFs are numbered in
+** increasing order, so they follow one another in the column); a full search where the scan does
+** not find one. */
+static void ccs_index3(const gsl_spmatrix *C, const long rows[3], long col, int out[3])
+{
+    int at = -1;
+    for (int r = 0; r < 3; r++) {
+        out[r] = -1;
+        if (rows[r] < 0 || col < 0)
+            continue;
+        if (at >= 0) {
+            int x = at + 1;
+            while (x < C->p[col + 1] && C->i[x] < rows[r])
+                x++;
+            out[r] = x < C->p[col + 1] && C->i[x] == rows[r] ? x : ccs_index(C, rows[r], col);
+        } else {
+            out[r] = ccs_index(C, rows[r], col);
+        }
+        if (out[r] >= 0)
+            at = out[r];
+    }
 }
 
 /* The pattern by hand: each node couples with itself and the nodes it shares a spring with (at
@@ -150,16 +180,19 @@ static void block_map(solver *s)
     const size_t n = s->ndof;
     for (size_t q = 0; q < lat->ns; q++) {
         uint32_t i = lat->si[q], j = lat->sj[q];
-        for (int a = 0; a < 3; a++)
-            for (int b = 0; b < 3; b++) {
-                long ia = s->eq[3 * i + a], ib = s->eq[3 * i + b];
-                long ja = s->eq[3 * j + a], jb = s->eq[3 * j + b];
-                int *m = s->map + q * 36 + a * 3 + b;
-                m[0] = ccs_index(s->C, ia, ib);
-                m[9] = ccs_index(s->C, ja, jb);
-                m[18] = ccs_index(s->C, ia, jb);
-                m[27] = ccs_index(s->C, ja, ib);
-            }
+        const long ri[3] = {s->eq[3 * i], s->eq[3 * i + 1], s->eq[3 * i + 2]};
+        const long rj[3] = {s->eq[3 * j], s->eq[3 * j + 1], s->eq[3 * j + 2]};
+        int *m = s->map + q * 36;
+        for (int b = 0; b < 3; b++) {
+            int pos[4][3]; /* block (i, i), (j, j), (i, j), (j, i): rows a of column b */
+            ccs_index3(s->C, ri, ri[b], pos[0]);
+            ccs_index3(s->C, rj, rj[b], pos[1]);
+            ccs_index3(s->C, ri, rj[b], pos[2]);
+            ccs_index3(s->C, rj, ri[b], pos[3]);
+            for (int a = 0; a < 3; a++)
+                for (int blk = 0; blk < 4; blk++)
+                    m[9 * blk + a * 3 + b] = pos[blk][a];
+        }
     }
     for (size_t e = 0; e < n; e++)
         s->diag[e] = ccs_index(s->C, (long)e, (long)e);
@@ -167,12 +200,18 @@ static void block_map(solver *s)
     for (size_t c = 0; s->vmap && c < nc; c++) {
         uint32_t node[8];
         cf_lattice_cell_nodes(lat, c, node);
-        for (int a = 0; a < 8; a++)
+        for (int a = 0; a < 8; a++) {
+            const long ra[3] = {s->eq[3 * node[a]], s->eq[3 * node[a] + 1],
+                                s->eq[3 * node[a] + 2]};
             for (int b = 0; b < 8; b++)
-                for (int i = 0; i < 3; i++)
-                    for (int k = 0; k < 3; k++)
+                for (int k = 0; k < 3; k++) {
+                    int pos[3];
+                    ccs_index3(s->C, ra, s->eq[3 * node[b] + k], pos);
+                    for (int i = 0; i < 3; i++)
                         s->vmap[((c * 8 + (size_t)a) * 8 + (size_t)b) * 9 + (size_t)(i * 3 + k)] =
-                            ccs_index(s->C, s->eq[3 * node[a] + i], s->eq[3 * node[b] + k]);
+                            pos[i];
+                }
+        }
     }
     s->band = 0;
     for (size_t col = 0; col < n; col++)
