@@ -162,7 +162,7 @@ static void a_body_for_febio_holds_its_mesh_springs_volume_and_punch(void **stat
     double *X = malloc(3 * b.nn * sizeof *X);
     assert_non_null(X);
     for (size_t i = 0; i < b.nn; i++) {
-        char id[16];
+        char id[32];
         snprintf(id, sizeof id, "%zu", i + 1);
         assert_true(attr_is(nl[i], "id", id));
         char *t = text(nl[i]);
