@@ -574,11 +574,15 @@ int cf_cli_fit_parse(int argc, char **argv, fit_args *a)
                                       a->nfiles);
         a->quiet = 1; /* standard output holds the fit file */
     }
-    if (a->joint && a->nfiles < 2)
-        return cf_cli_usage_error(cmd, "--joint fits several tables at once; give at least two");
-    if (!a->joint && a->popt.fit.law == CF_KIND_DOUBLE)
-        return cf_cli_usage_error(cmd, "--law double-acting: its extension spring is fitted with "
-                                       "tension and compression tables together (--joint)");
+    /* a double-acting element is fitted by the joint fit, of one table as of several */
+    if (a->popt.fit.law == CF_KIND_DOUBLE && a->popt.target == CF_TARGET_SPRING)
+        return cf_cli_usage_error(cmd, "--law double-acting --target spring: the element is "
+                                       "fitted through the lattice (drop --target spring)");
+    if (!a->joint && a->popt.fit.law == CF_KIND_DOUBLE && a->nfiles > 1)
+        return cf_cli_usage_error(cmd, "--law double-acting with %d tables: fit them together "
+                                       "(--joint) or one at a time", a->nfiles);
+    if (a->popt.fit.law == CF_KIND_DOUBLE)
+        a->joint = 1;
     if (!a->joint && a->popt.fit.volume != CF_VOLUME_NONE)
         return cf_cli_usage_error(cmd, "%s: the volume term is fitted through the lattice with "
                                        "several tables (--joint)",
@@ -594,7 +598,7 @@ int cf_cli_fit_parse(int argc, char **argv, fit_args *a)
         return cf_cli_usage_error(cmd, "--law conical-tail has no volume term yet (use conical, "
                                        "double-acting or auto)");
     if (a->calibration_given && a->popt.lattice.cfg.lattice.calibration == CF_CAL_FITTED &&
-        !a->joint)
+        (!a->joint || a->nfiles < 2))
         return cf_cli_usage_error(cmd, "--calibration fitted: the family weights are fitted in a "
                                        "joint fit of several modes (--joint)");
     if (a->joint && a->out && (cf_cli_is_stdio(a->out) || cf_cli_is_dir_target(a->out)))

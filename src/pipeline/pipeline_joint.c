@@ -120,8 +120,10 @@ static cf_status choose_pair(const cf_table *const *tables, size_t n,
                                      plain, &pair, &e);
     if (st == CF_E_INTERNAL || (st != CF_OK && opt->fit.law == CF_KIND_DOUBLE))
         return cf_error_set(err, st, "%s", e.msg);
-    if (st != CF_OK)
+    if (st != CF_OK) { /* auto: the single-sided law, the report saying why */
+        snprintf(lc->pair_refused, sizeof lc->pair_refused, "%s", e.msg);
         return CF_OK;
+    }
     if ((st = choose_pair_tail(tables, n, opt, plain, lc, &pair, err)) != CF_OK) {
         cf_joint_free(&pair);
         return st;
