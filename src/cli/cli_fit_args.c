@@ -28,7 +28,8 @@ static const char fit_help[] =
     "                          conical): the conical spring, one with a cylindrical tail in\n"
     "                          series (a fourth quantity, the tail's compliance), a\n"
     "                          double-acting element (its own conical spring for extension,\n"
-    "                          six quantities; --joint only), or all of them, kept by AIC;\n"
+    "                          six quantities; by the joint fit, of one table or several),\n"
+    "                          or all of them, kept by AIC (the pair with --joint);\n"
     "                          to the spring or through the lattice as the conical law,\n"
     "                          jointly with --joint (not with --fix or time series; a\n"
     "                          series holds a tailed spring with --elastic)\n"
@@ -57,7 +58,8 @@ static const char fit_help[] =
     "  --max-memory SIZE, --max-steps N, --max-work N  the validation's budget, as for\n"
     "                          simulate (defaults 2G, 1e7 static solves and 1e10 spring-steps\n"
     "                          of work): a larger lattice or table is refused\n"
-    "  --joint                 one lattice for every table, each in its own mode\n"
+    "  --joint                 one lattice for every table (one or more), each in its own\n"
+    "                          mode\n"
     "  --calibration C         isotropic (default), axial, or fitted (with --joint)\n"
     "  --volume fit            a volume term (kappa/2)(J - 1)^2 in every cell, kappa fitted\n"
     "                          (with --joint)\n"
@@ -574,11 +576,15 @@ int cf_cli_fit_parse(int argc, char **argv, fit_args *a)
                                       a->nfiles);
         a->quiet = 1; /* standard output holds the fit file */
     }
-    if (a->joint && a->nfiles < 2)
-        return cf_cli_usage_error(cmd, "--joint fits several tables at once; give at least two");
-    if (!a->joint && a->popt.fit.law == CF_KIND_DOUBLE)
-        return cf_cli_usage_error(cmd, "--law double-acting: its extension spring is fitted with "
-                                       "tension and compression tables together (--joint)");
+    /* a double-acting element is fitted by the joint fit, of one table as of several */
+    if (a->popt.fit.law == CF_KIND_DOUBLE && a->popt.target == CF_TARGET_SPRING)
+        return cf_cli_usage_error(cmd, "--law double-acting --target spring: the element is "
+                                       "fitted through the lattice (drop --target spring)");
+    if (!a->joint && a->popt.fit.law == CF_KIND_DOUBLE && a->nfiles > 1)
+        return cf_cli_usage_error(cmd, "--law double-acting with %d tables: fit them together "
+                                       "(--joint) or one at a time", a->nfiles);
+    if (a->popt.fit.law == CF_KIND_DOUBLE)
+        a->joint = 1;
     if (!a->joint && a->popt.fit.volume != CF_VOLUME_NONE)
         return cf_cli_usage_error(cmd, "%s: the volume term is fitted through the lattice with "
                                        "several tables (--joint)",
@@ -594,7 +600,7 @@ int cf_cli_fit_parse(int argc, char **argv, fit_args *a)
         return cf_cli_usage_error(cmd, "--law conical-tail has no volume term yet (use conical, "
                                        "double-acting or auto)");
     if (a->calibration_given && a->popt.lattice.cfg.lattice.calibration == CF_CAL_FITTED &&
-        !a->joint)
+        (!a->joint || a->nfiles < 2))
         return cf_cli_usage_error(cmd, "--calibration fitted: the family weights are fitted in a "
                                        "joint fit of several modes (--joint)");
     if (a->joint && a->out && (cf_cli_is_stdio(a->out) || cf_cli_is_dir_target(a->out)))

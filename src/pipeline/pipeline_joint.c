@@ -21,8 +21,8 @@ static cf_status choose_law(const cf_table *const *tables, size_t n,
 {
     if (opt->progress) {
         char what[128];
-        snprintf(what, sizeof what, "fitting the %s spring with a tail to %zu tables jointly",
-                 cf_spring_type_name(r->fits[k].fit.type), n);
+        snprintf(what, sizeof what, "fitting the %s spring with a tail to %zu table%s jointly",
+                 cf_spring_type_name(r->fits[k].fit.type), n, n == 1 ? "" : "s");
         opt->progress(opt->progress_ctx, NULL, what);
     }
     cf_joint_law_choice *lc = &r->law_choice[k];
@@ -69,8 +69,8 @@ static cf_status choose_pair_tail(const cf_table *const *tables, size_t n,
     if (opt->progress) {
         char what[160];
         snprintf(what, sizeof what, "fitting the %s double-acting element with a tailed "
-                                    "compression spring to %zu tables jointly",
-                 cf_spring_type_name(pair->fit.type), n);
+                                    "compression spring to %zu table%s jointly",
+                 cf_spring_type_name(pair->fit.type), n, n == 1 ? "" : "s");
         opt->progress(opt->progress_ctx, NULL, what);
     }
     cf_joint_result tp;
@@ -109,8 +109,8 @@ static cf_status choose_pair(const cf_table *const *tables, size_t n,
 {
     if (opt->progress) {
         char what[128];
-        snprintf(what, sizeof what, "fitting the %s double-acting element to %zu tables jointly",
-                 cf_spring_type_name(r->fits[k].fit.type), n);
+        snprintf(what, sizeof what, "fitting the %s double-acting element to %zu table%s jointly",
+                 cf_spring_type_name(r->fits[k].fit.type), n, n == 1 ? "" : "s");
         opt->progress(opt->progress_ctx, NULL, what);
     }
     cf_joint_law_choice *lc = &r->law_choice[k];
@@ -120,8 +120,10 @@ static cf_status choose_pair(const cf_table *const *tables, size_t n,
                                      plain, &pair, &e);
     if (st == CF_E_INTERNAL || (st != CF_OK && opt->fit.law == CF_KIND_DOUBLE))
         return cf_error_set(err, st, "%s", e.msg);
-    if (st != CF_OK)
+    if (st != CF_OK) { /* auto: the single-sided law, the report saying why */
+        snprintf(lc->pair_refused, sizeof lc->pair_refused, "%s", e.msg);
         return CF_OK;
+    }
     if ((st = choose_pair_tail(tables, n, opt, plain, lc, &pair, err)) != CF_OK) {
         cf_joint_free(&pair);
         return st;
@@ -173,8 +175,8 @@ cf_status cf_pipeline_fit_joint(const cf_table *const *tables, size_t n,
             continue;
         if (opt->progress) {
             char what[128];
-            snprintf(what, sizeof what, "fitting the %s spring to %zu tables jointly",
-                     cf_spring_type_name((cf_spring_type)ty), n);
+            snprintf(what, sizeof what, "fitting the %s spring to %zu table%s jointly",
+                     cf_spring_type_name((cf_spring_type)ty), n, n == 1 ? "" : "s");
             opt->progress(opt->progress_ctx, NULL, what);
         }
         cf_status st = cf_joint_fit(tables, n, &opt->fit, &opt->lattice, (cf_spring_type)ty,

@@ -51,8 +51,10 @@ static void both_laws(const cf_joint_report *r, int i, const cf_joint_result **c
                       const cf_joint_result **tail)
 {
     const cf_joint_law_choice *lc = &r->law_choice[i];
-    *tail = lc->chose_tail ? &r->fits[i] : &lc->other;
-    *cone = lc->chose_tail ? &lc->other : &r->fits[i];
+    /* a kept double-acting element displaced the single-sided law kept (pair_other) */
+    const cf_joint_result *kept = lc->chose_pair ? &lc->pair_other : &r->fits[i];
+    *tail = lc->chose_tail ? kept : &lc->other;
+    *cone = lc->chose_tail ? &lc->other : kept;
 }
 
 /* A tailed joint fit that is the conical optimum it contains (cf_joint_fit_tail): why, into buf
@@ -147,11 +149,13 @@ static void pair_choice_text(FILE *o, const cf_joint_report *r)
         const cf_joint_law_choice *lc = &r->law_choice[i];
         const char *type = cf_spring_type_name(r->fits[i].fit.type);
         if (!lc->pair_ran) {
-            fprintf(o, "  %-16s %s\n", type,
+            fprintf(o, "  %-16s %s%s\n", type,
                     r->fits[i].volume == CF_VOLUME_POISSON
                         ? "not fitted: a declared nu (--poisson) has no meaning for a pair's two "
                           "sides"
-                        : "no double-acting element runs every table");
+                    : lc->pair_refused[0] ? "not fitted: "
+                                          : "no double-acting element runs every table",
+                    r->fits[i].volume != CF_VOLUME_POISSON ? lc->pair_refused : "");
             continue;
         }
         const cf_joint_result *pair = lc->chose_pair ? &r->fits[i] : &lc->pair_other;
@@ -271,7 +275,12 @@ char *cf_joint_text(const cf_joint_report *r)
     FILE *o = open_memstream(&buf, &len);
     if (!o)
         return NULL;
-    fprintf(o, "Joint fit through the lattice of %zu tables (%s)\n", r->ntables, weighting_text);
+    if (r->ntables == 1) /* a double-acting element of one table goes by the joint fit */
+        fprintf(o, "Fit through the lattice of one table, by the joint fit (its residuals divided "
+                   "by its RMS stress and by the square root of its number of rows)\n");
+    else
+        fprintf(o, "Joint fit through the lattice of %zu tables (%s)\n", r->ntables,
+                weighting_text);
     for (size_t k = 0; k < r->ntables; k++)
         if (r->tables[k]->notes[0]) {
             fprintf(o, " %s:\n", r->tables[k]->path);
@@ -529,6 +538,8 @@ static json_t *joint_json(const cf_joint_report *r)
                           num(lc->alt_objective), "aic", num(lc->alt_aic), "quantities",
                           lc->alt_nparams, "feasible", lc->alt_feasible, "stable",
                           lc->alt_stable));
+        if (lc->pair_refused[0]) /* auto: the data do not determine the pair */
+            json_object_set_new(f, "pair_not_fitted", json_string(lc->pair_refused));
         json_object_set_new(f, "aic", num(j->aic));
         if (r->law_choice[i].ran)
             json_object_set_new(f, "law_comparison", law_comparison_json(r, i));

@@ -88,8 +88,9 @@ typedef struct cf_joint_result {
 } cf_joint_result;
 
 /* Fits the n tables jointly with spring type `type` in the lattice of `lat` (its calibration:
-** isotropic or axial as they are; CF_CAL_FITTED fits the weights). CF_E_DATA for fewer than two or
-** more than CF_JOINT_MAX tables, or a force-displacement table (its length scale is its own, not
+** isotropic or axial as they are; CF_CAL_FITTED fits the weights). One table is a fit of that
+** table alone by the same search. CF_E_DATA for no table or more than CF_JOINT_MAX tables, or a
+** force-displacement table (its length scale is its own, not
 ** a strain a lattice shares; the message names the file). */
 cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
                        const cf_validate_setup *lat, cf_spring_type type, cf_joint_result *r,
@@ -122,7 +123,11 @@ cf_status cf_joint_fit_tail(const cf_table *const *tables, size_t n, const cf_fi
 ** (conical-tail, its tau searched too: 7 quantities, 8 with kappa fitted) from plain, the pair's
 ** own joint fit (pair 1; CF_E_DATA otherwise), at tau 0.3, 1 and 3; the compression spring placed
 ** as the tailed law's (fit.tail 1, e_tail and its error); the extension spring stays conical.
-** CF_E_DATA for a declared nu below the springs' own (the term only raises it), and for
+** CF_E_DATA (pair 1, 2) when the tables do not determine both springs, the message naming the
+** spring left free and why: a table with a loaded axis strains the springs along it directly only
+** on its rows' side (positive strain: the extension spring), simple shear fixes about the sum of
+** the two laws (determining the pair beside a table of either side, not alone). CF_E_DATA for a
+** declared nu below the springs' own (the term only raises it), and for
 ** a declared nu with the pair (a bimodular lattice has one small-strain nu per side, none to
 ** declare: declare kappa or fit it). */
 cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fit_options *opt,

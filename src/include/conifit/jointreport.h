@@ -22,6 +22,8 @@ typedef struct cf_joint_law_choice {
     int pair_ran;           /* 1: the double-acting element was fitted too (double-acting, auto) */
     int chose_pair;         /* 1: fits[] holds the pair, pair_other the single-sided law it beat */
     cf_joint_result pair_other; /* the pair when not kept, else the law it displaced (owned) */
+    char pair_refused[CF_ERROR_MSG_LEN]; /* auto: why the pair was not fitted ("" when it was,
+                                         ** or the reason is a declared nu) */
     /* the pair with a tailed compression spring (cf_joint_fit_pair, pair 2) against the pair
     ** with a conical one: the one kept is the pair above, the other summarised here */
     int pair_tail_ran;          /* 1: the tailed pair was fitted (from the conical pair) */
