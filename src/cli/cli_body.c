@@ -15,6 +15,7 @@
 #include "cli/cli.h"
 #include "cli/cli_probe.h"
 #include "conifit/body.h"
+#include "conifit/budget.h"
 #include "conifit/mesh.h"
 #include "report/vtu.h"
 
@@ -34,6 +35,7 @@ typedef struct run {
     double *time;        /* steps + 1: a probe path's times, s */
     double *rv;          /* (steps + 1) x nregions x 3: a held region's support force (N), a loaded
                          ** one's mean displacement (mm) */
+    cf_body_motion motion; /* a dynamic run's masses and state */
 } run;
 
 static void run_free(run *r)
@@ -49,6 +51,7 @@ static void run_free(run *r)
     free(r->nsel);
     free(r->rv);
     free(r->time);
+    cf_body_motion_free(&r->motion);
 }
 
 cf_status cf_cli_body_load(const cf_scene *sc, cf_law *law, cf_mesh *mesh,
@@ -170,6 +173,35 @@ static void region_values(const cf_scene *sc, run *r, size_t k)
     }
 }
 
+/* A dynamic run's steps and their work (an implicit step costs about a static solve of the same
+** unknowns, cf_budget_solve_work) against --max-steps and --max-work, before anything runs. */
+static cf_status dynamic_budget(const cf_scene *sc, const char *scene_path,
+                                const cf_budget *budget, size_t nn, cf_error *err)
+{
+    const double steps = sc->body_steps, each = cf_budget_solve_work(3.0 * (double)nn);
+    if (steps <= budget->max_steps && steps * each <= budget->max_work)
+        return CF_OK;
+    const double fits = fmin(budget->max_steps, floor(budget->max_work / each));
+    return cf_error_set(err, CF_E_DATA, "%s: key 'integrator.dt_s' = %g: %.0f implicit steps of "
+                        "the body of %s (%zu nodes, about %.3g spring-steps each) are over the "
+                        "limits %.3g steps (--max-steps) or %.3g spring-steps (--max-work); "
+                        "at most %.0f steps fit, a step of at least %.3g s",
+                        scene_path, sc->cfg.dt_s, steps, sc->body_mesh, nn, each,
+                        budget->max_steps, budget->max_work, fits,
+                        fits >= 1 ? sc->body_duration_s / fits : INFINITY);
+}
+
+/* The fraction of the scene's loads, displacements and probe depth at step k of `steps`: k/steps
+** in a static run; in a dynamic one, the time k dt over body.ramp_s, 1 after it (and from the
+** first step when ramp_s is 0). */
+static double load_factor(const cf_scene *sc, size_t k, size_t steps)
+{
+    if (!sc->body_dynamic)
+        return (double)k / (double)steps;
+    const double t = (double)k * sc->body_dt_s;
+    return sc->body_ramp_s > 0 ? fmin(1, t / sc->body_ramp_s) : (k > 0);
+}
+
 static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budget *budget, run *r,
                        cf_error *err)
 {
@@ -187,6 +219,8 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
                             "about %.3g bytes, over the limit %.3g (--max-memory)",
                             scene_path, sc->body_mesh, r->mesh.nn, steps, bytes,
                             budget->max_memory_bytes);
+    if (sc->body_dynamic && (st = dynamic_budget(sc, scene_path, budget, r->mesh.nn, err)))
+        return st;
     if ((st = cf_cli_body_create(sc, &r->law, &r->mesh, &r->body, err)) != CF_OK)
         return st;
     cf_body *b = &r->body;
@@ -209,9 +243,13 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu steps", steps);
     memcpy(r->xs, b->x, 3 * b->nn * sizeof *r->xs);
     r->step[0].min_J = 1;
+    if (sc->body_dynamic &&
+        (st = cf_body_motion_init(b, sc->cfg.lattice.density_t_per_mm3, sc->body_damping_per_s,
+                                  &r->motion, err)) != CF_OK)
+        return st;
     double fdepth = 0; /* a force-driven probe's depth, found step by step */
     for (size_t k = 1; k <= steps; k++) {
-        const double lam = (double)k / (double)steps;
+        const double lam = load_factor(sc, k, steps);
         const double depth = sc->has_probe ? sc->probe.depth_mm * lam : 0;
         for (size_t q = 0; q < 3 * b->nn; q++) {
             if ((b->fix[q / 3] >> (q % 3)) & 1)
@@ -239,7 +277,12 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
             pk = &moved;
             dk = 0;
         }
-        if ((st = sc->has_probe && sc->probe.force_N > 0
+        if (sc->body_dynamic)
+            r->time[k] = (double)k * sc->body_dt_s;
+        if ((st = sc->body_dynamic
+                      ? cf_body_dynamic_step(b, &r->motion, pk, dk, sc->body_dt_s, 0, &r->step[k],
+                                             err)
+                  : sc->has_probe && sc->probe.force_N > 0
                       ? cf_body_solve_force(b, pk, sc->probe.force_N * lam, &fdepth, 0,
                                             &r->step[k], err)
                       : cf_body_solve(b, pk, dk, 0, &r->step[k], err)) != CF_OK) {
@@ -293,13 +336,15 @@ static cf_status write_all(const cf_scene *sc, const run *r, const char *out, co
     cf_status st = cf_cli_out_open(csv, out, inputs, err);
     if (st)
         return st;
-    fprintf(csv->fp, !sc->has_probe ? "load_factor" : sc->probe_npath ? "time_s,depth_mm,force_N"
-                                                                      : "depth_mm,force_N");
+    const int timed = sc->probe_npath || sc->body_dynamic; /* a time column */
+    if (timed)
+        fprintf(csv->fp, "time_s,");
+    fprintf(csv->fp, !sc->has_probe ? "load_factor" : "depth_mm,force_N");
     for (size_t g = 0; g < sc->nregions; g++)
         region_columns(&sc->regions[g], csv->fp);
     fprintf(csv->fp, "\n");
     for (size_t k = 0; k <= steps; k++) {
-        if (sc->probe_npath)
+        if (timed)
             fprintf(csv->fp, "%.17g,", r->time[k]);
         fprintf(csv->fp, "%.17g", r->step[k].depth_mm);
         if (sc->has_probe)
@@ -326,7 +371,7 @@ static cf_status write_all(const cf_scene *sc, const run *r, const char *out, co
     for (size_t k = 0; k <= steps && st == CF_OK; k++) {
         tmp.x = r->xs + k * 3 * b->nn;
         cf_body_measure(&tmp, &bs, NULL);
-        depth[k] = sc->probe_npath ? r->time[k] : r->step[k].depth_mm; /* the PVD's times */
+        depth[k] = timed ? r->time[k] : r->step[k].depth_mm; /* the PVD's times */
         snprintf(path, sizeof path, "%s/body_%04zu.vtu", dir, k);
         if ((st = cf_atomic_open(&files[2 * k], path, inputs, err)) != CF_OK)
             break;
@@ -352,6 +397,14 @@ end:
     free(bs.J);
     free(depth);
     return st;
+}
+
+static double total_mass(const run *r)
+{
+    double m = 0;
+    for (size_t i = 0; r->motion.mass && i < r->body.nn; i++)
+        m += r->motion.mass[i];
+    return m;
 }
 
 static void summary(FILE *o, const cf_scene *sc, const run *r)
@@ -392,6 +445,11 @@ static void summary(FILE *o, const cf_scene *sc, const run *r)
                 rg->use == CF_REGION_LOADED ? "mean displacement" : "support force", v[0], v[1],
                 v[2], rg->use == CF_REGION_LOADED ? "mm" : "N");
     }
+    if (sc->body_dynamic)
+        fprintf(o, "dynamic: %zu implicit steps (Newmark, average acceleration) of %g s to %g s, "
+                   "loads ramped over %g s, density %g t/mm^3, damping %g 1/s, mass %.6g t\n",
+                steps, sc->body_dt_s, sc->body_duration_s, sc->body_ramp_s,
+                sc->cfg.lattice.density_t_per_mm3, sc->body_damping_per_s, total_mass(r));
     if (!sc->has_probe) {
         fprintf(o, "no probe: loads ramped in %zu steps; Newton iterations: %d; smallest J %.6g, "
                    "largest spring compression %.4g of travel\n",
@@ -451,7 +509,7 @@ int cf_cli_simulate_body(const cf_scene *sc, const char *scene_path, const char 
         goto end;
     }
     if (write_all(sc, &r, out, vtu_dir, inputs, &csv, files, &err) != CF_OK ||
-        (png && cf_cli_probe_plot(sc, r.step, (size_t)sc->probe.steps + 1, png, inputs, &plot,
+        (png && cf_cli_probe_plot(sc, r.step, r.steps + 1, png, inputs, &plot,
                                   &err) != CF_OK)) {
         rc = cf_cli_fail(&err);
         goto end;
