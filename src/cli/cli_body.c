@@ -202,6 +202,25 @@ static double load_factor(const cf_scene *sc, size_t k, size_t steps)
     return sc->body_ramp_s > 0 ? fmin(1, t / sc->body_ramp_s) : (k > 0);
 }
 
+/* A probe on a path at the fraction lam of its time: its reference point into *moved, its travel
+** along the direction from the path's start into *travel; returns the time. */
+static double path_probe(const cf_scene *sc, double lam, cf_probe *moved, double *travel)
+{
+    const size_t np = sc->probe_npath;
+    const double *ts = sc->probe_path_t_s;
+    const double t = ts[0] + lam * (ts[np - 1] - ts[0]);
+    size_t j = 0;
+    while (j + 2 < np && ts[j + 1] < t)
+        j++;
+    const double w = fmin(1, fmax(0, (t - ts[j]) / (ts[j + 1] - ts[j])));
+    *travel = 0;
+    for (int a = 0; a < 3; a++) {
+        moved->center_mm[a] = (1 - w) * sc->probe_path_mm[j][a] + w * sc->probe_path_mm[j + 1][a];
+        *travel += (moved->center_mm[a] - sc->probe.center_mm[a]) * sc->probe.dir[a];
+    }
+    return t;
+}
+
 static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budget *budget, run *r,
                        cf_error *err)
 {
@@ -261,19 +280,7 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
         const cf_probe *pk = probe;
         double dk = depth, travel = 0;
         if (sc->probe_npath) {
-            const size_t np = sc->probe_npath;
-            const double *ts = sc->probe_path_t_s;
-            const double t = ts[0] + lam * (ts[np - 1] - ts[0]);
-            size_t j = 0;
-            while (j + 2 < np && ts[j + 1] < t)
-                j++;
-            const double w = fmin(1, fmax(0, (t - ts[j]) / (ts[j + 1] - ts[j])));
-            for (int a = 0; a < 3; a++) {
-                moved.center_mm[a] =
-                    (1 - w) * sc->probe_path_mm[j][a] + w * sc->probe_path_mm[j + 1][a];
-                travel += (moved.center_mm[a] - sc->probe.center_mm[a]) * sc->probe.dir[a];
-            }
-            r->time[k] = t;
+            r->time[k] = path_probe(sc, lam, &moved, &travel);
             pk = &moved;
             dk = 0;
         }
@@ -552,6 +559,9 @@ cf_status cf_cli_body_export(const cf_scene *sc, const char *scene_path, const c
     if (sc->probe_npath)
         return cf_error_set(err, CF_E_DATA, "%s: key 'probe.path': the export of a body moves "
                             "the probe along its direction only", scene_path);
+    if (sc->body_dynamic)
+        return cf_error_set(err, CF_E_DATA, "%s: key 'effects.inertia': the export of a body "
+                            "takes a static run", scene_path);
     cf_status st = solve(sc, scene_path, budget, &r, err);
     const size_t steps = r.steps;
     double *depth = NULL, *force = NULL;

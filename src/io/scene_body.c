@@ -491,6 +491,10 @@ cf_status cf_scene_body_dynamics(ctx *c, json_t *root, cf_scene *sc)
                                 in ? "integrator" : "density_t_per_mm3");
         return CF_OK;
     }
+    if (sc->haptic_n)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'haptic': the haptic loop solves each "
+                            "update as an equilibrium; it does not take 'effects.inertia'",
+                            c->name);
     if (json_object_get(bd, "steps") || (pb && json_object_get(pb, "steps")))
         return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.steps': a dynamic run's steps are "
                             "'integrator.dt_s'", c->name, json_object_get(bd, "steps") ? "body"

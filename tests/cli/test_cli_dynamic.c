@@ -261,12 +261,115 @@ static void a_damped_column_settles_at_the_static_displacement(void **state)
     assert_true(fabs(uz[STEPS / 2] / us - 1) > fabs(uz[STEPS] / us - 1)); /* decaying */
 }
 
+/* A small dynamic scene of the cube with the given extra keys (body keys, root keys); its run's
+** exit status, stderr in err. */
+static int dynamic_scene(const char *name, const char *body_keys, const char *root_keys,
+                         const char *args, char *err, size_t cap)
+{
+    char mesh[600], scene[600], csv[600], out[8192];
+    snprintf(mesh, sizeof mesh, "%s/small.msh", dir);
+    snprintf(scene, sizeof scene, "%s/%s.json", dir, name);
+    snprintf(csv, sizeof csv, "%s/%s.csv", dir, name);
+    write_cube(mesh, 2.5);
+    FILE *f = fopen(scene, "w");
+    assert_non_null(f);
+    fprintf(f, "{" SPRING ",\n \"body\": {\"mesh\": \"%s\", \"unit_mm\": 1%s},\n"
+            " \"fixed\": {\"below\": {\"axis\": \"z\", \"value_mm\": 0}},\n"
+            " \"loaded\": {\"above\": {\"axis\": \"z\", \"value_mm\": 10}, \"force_N\": [0, 0, -1e-3]}%s}\n",
+            mesh, body_keys, root_keys);
+    fclose(f);
+    return tu_run(out, sizeof out, err, cap, "simulate %s -o %s %s", scene, csv, args);
+}
+
+static void bad_dynamic_keys_are_refused_naming_the_key_and_write_nothing(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *body, *root, *args, *must;
+    } cases[] = {
+        {", \"duration_s\": 1", "", "", "key 'body.duration_s' goes with a dynamic run"},
+        {"", ", \"integrator\": {\"dt_s\": 0.01}", "", "key 'integrator' goes with a body's dynamic"},
+        {"", ", \"density_t_per_mm3\": 1e-9", "", "key 'density_t_per_mm3' goes with"},
+        {"", ", \"effects\": {\"inertia\": true}, \"integrator\": {\"dt_s\": 0.01}", "",
+         "missing key 'body.duration_s'"},
+        {", \"duration_s\": 1", ", \"effects\": {\"inertia\": true}", "",
+         "missing key 'integrator.dt_s'"},
+        {", \"duration_s\": 1", ", \"effects\": {\"inertia\": true}, \"integrator\": {\"dt_s\": -1}", "",
+         "'integrator.dt_s'"},
+        {", \"duration_s\": 1, \"ramp_s\": -2", ", \"effects\": {\"inertia\": true}, "
+         "\"integrator\": {\"dt_s\": 0.1}", "", "'body.ramp_s'"},
+        {", \"duration_s\": 1, \"damping_per_s\": \"x\"", ", \"effects\": {\"inertia\": true}, "
+         "\"integrator\": {\"dt_s\": 0.1}", "", "'body.damping_per_s'"},
+        {", \"duration_s\": 1, \"steps\": 4", ", \"effects\": {\"inertia\": true}, "
+         "\"integrator\": {\"dt_s\": 0.1}", "", "key 'body.steps': a dynamic run's steps"},
+        {", \"duration_s\": 1", ", \"effects\": {\"inertia\": true, \"gravity\": true}, "
+         "\"integrator\": {\"dt_s\": 0.1}", "", "key 'effects.gravity': a body takes"},
+        {", \"duration_s\": 1", ", \"effects\": {\"inertia\": true}, "
+         "\"integrator\": {\"dt_s\": 0.1, \"substeps\": 3}", "", "key 'integrator.substeps'"},
+        {", \"duration_s\": 1", ", \"effects\": {\"inertia\": true}, "
+         "\"integrator\": {\"dt_s\": 1e-8}", "", "key 'integrator.dt_s' = 1e-08"},
+        {", \"duration_s\": 1", ", \"effects\": {\"inertia\": true}, \"density_t_per_mm3\": 0, "
+         "\"integrator\": {\"dt_s\": 0.1}", "", "'density_t_per_mm3'"},
+        {", \"duration_s\": 1", ", \"effects\": {\"inertia\": true}, "
+         "\"integrator\": {\"dt_s\": 0.1}, \"haptic\": {\"path\": [[0, 0], [10, 0.1]]}", "",
+         "key 'haptic': the haptic loop"},
+        /* the budget: 1000 implicit steps over --max-steps, and over --max-work */
+        {", \"duration_s\": 1", ", \"effects\": {\"inertia\": true}, "
+         "\"integrator\": {\"dt_s\": 0.001}", "--max-steps 999",
+         "key 'integrator.dt_s' = 0.001: 1000 implicit steps"},
+        {", \"duration_s\": 1", ", \"effects\": {\"inertia\": true}, "
+         "\"integrator\": {\"dt_s\": 0.001}", "--max-work 1e6", "at most"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char err[8192], csv[600];
+        int rc = dynamic_scene("bad", cases[k].body, cases[k].root, cases[k].args, err, sizeof err);
+        if (rc != 65 || !strstr(err, cases[k].must))
+            fail_msg("case %zu: exit %d, expected 65 with \"%s\"; stderr: %s", k, rc,
+                     cases[k].must, err);
+        snprintf(csv, sizeof csv, "%s/bad.csv", dir);
+        struct stat sb;
+        assert_true(stat(csv, &sb) != 0);
+    }
+    /* the same scene within the budget runs, and writes one VTU pair per step and their times */
+    char err[8192], path[700];
+    assert_int_equal(dynamic_scene("good", ", \"duration_s\": 0.004, \"ramp_s\": 0.002",
+                                   ", \"effects\": {\"inertia\": true}, "
+                                   "\"integrator\": {\"dt_s\": 0.001}",
+                                   "--max-steps 4 --vtu /dev/null/x", err, sizeof err), 73);
+    snprintf(path, sizeof path, "--vtu %s/vtu", dir);
+    if (dynamic_scene("good", ", \"duration_s\": 0.004, \"ramp_s\": 0.002",
+                      ", \"effects\": {\"inertia\": true}, \"integrator\": {\"dt_s\": 0.001}",
+                      path, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    snprintf(path, sizeof path, "%s/vtu/body.pvd", dir);
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    char pvd[8192];
+    size_t n = fread(pvd, 1, sizeof pvd - 1, f);
+    pvd[n] = 0;
+    fclose(f);
+    assert_non_null(strstr(pvd, "timestep=\"0.004\" group=\"\" part=\"1\" file=\"springs_0004.vtu\""));
+    assert_null(strstr(pvd, "0005"));
+    snprintf(path, sizeof path, "%s/vtu/body_0002.vtu", dir);
+    struct stat sb;
+    assert_int_equal(stat(path, &sb), 0);
+    char head[256];
+    double v[5 * 5];
+    snprintf(path, sizeof path, "%s/good.csv", dir);
+    assert_int_equal(read_csv(path, head, sizeof head, v, 5, 5), 5);
+    assert_string_equal(head, "time_s,load_factor,loaded_ux_mm,loaded_uy_mm,loaded_uz_mm\n");
+    assert_close(v[5 * 1 + 1], 0.5, 1e-12); /* half the ramp at 1 ms */
+    assert_close(v[5 * 4 + 1], 1, 0);
+    assert_true(v[5 * 4 + 4] < 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(a_slow_ramp_gives_the_static_force_depth_curve),
         cmocka_unit_test(a_load_applied_at_once_makes_the_column_ring_at_its_wave_period),
         cmocka_unit_test(a_damped_column_settles_at_the_static_displacement),
+        cmocka_unit_test(bad_dynamic_keys_are_refused_naming_the_key_and_write_nothing),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
