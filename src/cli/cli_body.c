@@ -228,6 +228,8 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
     if ((st = cf_cli_body_load(sc, &r->law, &r->mesh, &r->surface, err)) != CF_OK)
         return st;
     const size_t steps = r->steps = (size_t)sc->body_steps;
+    if (sc->body_dynamic && (st = dynamic_budget(sc, scene_path, budget, r->mesh.nn, err)))
+        return st;
     /* memory: the factor of the tangent (about 40 times its 3 x 3 blocks for meshes of organ
     ** size), the matrix, and one copy of the positions per step */
     double bytes = (double)r->mesh.nn * 3 * (81.0 * 16 * 8 + 40.0 * 81 * 8) +
@@ -238,8 +240,6 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
                             "about %.3g bytes, over the limit %.3g (--max-memory)",
                             scene_path, sc->body_mesh, r->mesh.nn, steps, bytes,
                             budget->max_memory_bytes);
-    if (sc->body_dynamic && (st = dynamic_budget(sc, scene_path, budget, r->mesh.nn, err)))
-        return st;
     if ((st = cf_cli_body_create(sc, &r->law, &r->mesh, &r->body, err)) != CF_OK)
         return st;
     cf_body *b = &r->body;
