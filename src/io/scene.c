@@ -406,7 +406,7 @@ static cf_status effects_section(ctx *c, json_t *ef, cf_scene *sc)
             e->maxwell_tau_s = tau;
         }
     }
-    if (e->prony_count > 0 && e->inertia)
+    if (e->prony_count > 0 && e->inertia && !sc->has_body) /* a body uses the elastic law */
         return cf_error_set(c->err, CF_E_DATA,
                             "%s: Prony terms (effects.viscosity.prony or a viscoelastic "
                             "spring.fit) are solved quasi-statically: they do not combine with "
