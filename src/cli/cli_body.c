@@ -266,6 +266,7 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
         (st = cf_body_motion_init(b, sc->cfg.lattice.density_t_per_mm3, sc->body_damping_per_s,
                                   &r->motion, err)) != CF_OK)
         return st;
+    r->motion.gamma = sc->body_newmark_gamma;
     double fdepth = 0; /* a force-driven probe's depth, found step by step */
     for (size_t k = 1; k <= steps; k++) {
         const double lam = load_factor(sc, k, steps);
@@ -453,9 +454,9 @@ static void summary(FILE *o, const cf_scene *sc, const run *r)
                 v[2], rg->use == CF_REGION_LOADED ? "mm" : "N");
     }
     if (sc->body_dynamic)
-        fprintf(o, "dynamic: %zu implicit steps (Newmark, average acceleration) of %g s to %g s, "
+        fprintf(o, "dynamic: %zu implicit steps (Newmark, gamma %g) of %g s to %g s, "
                    "loads ramped over %g s, density %g t/mm^3, damping %g 1/s, mass %.6g t\n",
-                steps, sc->body_dt_s, sc->body_duration_s, sc->body_ramp_s,
+                steps, sc->body_newmark_gamma, sc->body_dt_s, sc->body_duration_s, sc->body_ramp_s,
                 sc->cfg.lattice.density_t_per_mm3, sc->body_damping_per_s, total_mass(r));
     if (!sc->has_probe) {
         fprintf(o, "no probe: loads ramped in %zu steps; Newton iterations: %d; smallest J %.6g, "

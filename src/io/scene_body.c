@@ -345,7 +345,8 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
 {
     static const char *const bk[] = {"mesh", "unit_mm", "refine", "poisson_ratio",
                                      "volume_modulus_MPa", "steps", "element_size_mm",
-                                     "duration_s", "ramp_s", "damping_per_s", NULL};
+                                     "duration_s", "ramp_s", "damping_per_s", "newmark_gamma",
+                                     NULL};
     static const char *const pk[] = {"shape", "radius_mm", "center_mm", "direction", "depth_mm",
                                      "force_N", "path", "steps", NULL};
     cf_status st;
@@ -473,7 +474,7 @@ static cf_status body_effects_refused(ctx *c, json_t *root)
 
 cf_status cf_scene_body_dynamics(ctx *c, json_t *root, cf_scene *sc)
 {
-    static const char *const dyn[] = {"duration_s", "ramp_s", "damping_per_s"};
+    static const char *const dyn[] = {"duration_s", "ramp_s", "damping_per_s", "newmark_gamma"};
     json_t *bd = json_object_get(root, "body"), *pb = json_object_get(root, "probe");
     json_t *in = json_object_get(root, "integrator");
     cf_status st;
@@ -481,7 +482,7 @@ cf_status cf_scene_body_dynamics(ctx *c, json_t *root, cf_scene *sc)
         return st;
     sc->body_dynamic = sc->effects.inertia;
     if (!sc->body_dynamic) {
-        for (int k = 0; k < 3; k++)
+        for (int k = 0; k < 4; k++)
             if (json_object_get(bd, dyn[k]))
                 return cf_error_set(c->err, CF_E_DATA, "%s: key 'body.%s' goes with a dynamic "
                                     "run ('effects.inertia' = true)", c->name, dyn[k]);
@@ -511,7 +512,9 @@ cf_status cf_scene_body_dynamics(ctx *c, json_t *root, cf_scene *sc)
         (st = cf_scene_number(c, bd, "body", "ramp_s", 0, sc->body_duration_s, 0, 0, 1e9,
                               &sc->body_ramp_s)) ||
         (st = cf_scene_number(c, bd, "body", "damping_per_s", 0, 0, 0, 0, 1e12,
-                              &sc->body_damping_per_s)))
+                              &sc->body_damping_per_s)) ||
+        (st = cf_scene_number(c, bd, "body", "newmark_gamma", 0, 0.5, 0.5, 0, 1,
+                              &sc->body_newmark_gamma)))
         return st;
     const double dt = sc->cfg.dt_s;
     if (!(dt > 0))

@@ -65,13 +65,21 @@ cf_status cf_body_dynamic_step(cf_body *b, cf_body_motion *m, const cf_probe *pr
         return st;
     const size_t n = 3 * b->nn;
     const double c = m->damping_per_s;
-    const double mcoef = 4 / (dt_s * dt_s) + 2 * c / dt_s;
+    /* Newmark's family: gamma >= 1/2, beta = (gamma + 1/2)^2 / 4 (gamma 1/2: average
+    ** acceleration); A = 1/(beta dt^2), a = A (x - x_n) - A dt v_n - (1/(2 beta) - 1) a_n,
+    ** v = v_n + dt ((1 - gamma) a_n + gamma a) */
+    const double gam = m->gamma > 0.5 ? m->gamma : 0.5, beta = 0.25 * (gam + 0.5) * (gam + 0.5);
+    const double A = 1 / (beta * dt_s * dt_s), ka = 1 / (2 * beta) - 1;
+    const double mcoef = A * (1 + c * gam * dt_s);
     double *xstar = malloc(n * sizeof *xstar);
     if (!xstar)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the motion of %zu nodes",
                             b->nn);
     for (size_t q = 0; q < n; q++) {
-        xstar[q] = m->xprev[q] + ((4 / dt_s + c) * m->v[q] + m->a[q]) / mcoef;
+        /* a + c v = mcoef (x - x_n) + r0, r0 the terms without x */
+        const double a0 = -A * dt_s * m->v[q] - ka * m->a[q];
+        const double v0 = m->v[q] + dt_s * (1 - gam) * m->a[q] + dt_s * gam * a0;
+        xstar[q] = m->xprev[q] - (a0 + c * v0) / mcoef;
         if (!((b->fix[q / 3] >> (q % 3)) & 1))
             b->x[q] = m->xprev[q] + dt_s * m->v[q]; /* the predictor: constant velocity */
     }
@@ -89,9 +97,8 @@ cf_status cf_body_dynamic_step(cf_body *b, cf_body_motion *m, const cf_probe *pr
     if (st != CF_OK)
         return st;
     for (size_t q = 0; q < n; q++) {
-        const double d = b->x[q] - m->xprev[q];
-        const double a = 4 / (dt_s * dt_s) * d - 4 / dt_s * m->v[q] - m->a[q];
-        m->v[q] = 2 / dt_s * d - m->v[q];
+        const double a = A * (b->x[q] - m->xprev[q]) - A * dt_s * m->v[q] - ka * m->a[q];
+        m->v[q] += dt_s * ((1 - gam) * m->a[q] + gam * a);
         m->a[q] = a;
         m->xprev[q] = b->x[q];
     }

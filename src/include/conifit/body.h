@@ -229,6 +229,10 @@ typedef struct cf_body_motion {
     double *v, *a;         /* 3 nn velocities (mm/s) and accelerations (mm/s^2) */
     double *xprev;         /* 3 nn positions at the end of the last step */
     double t_s;            /* time of the last step (0 at the start) */
+    double gamma;          /* Newmark's gamma, 1/2 (0 is read as 1/2: average acceleration, no
+                           ** numerical damping) to 1; above 1/2, with beta = (gamma + 1/2)^2/4,
+                           ** the step damps the highest frequencies (a penalty contact's
+                           ** node-on-probe vibration) and is first-order accurate */
 } cf_body_motion;
 
 /* Starts b's motion at rest at its current positions, which must be an equilibrium with the
@@ -238,8 +242,9 @@ cf_status cf_body_motion_init(const cf_body *b, double rho_t_per_mm3, double dam
                               cf_body_motion *m, cf_error *err);
 void cf_body_motion_free(cf_body_motion *m);
 
-/* One implicit step of dt_s (> 0) of the body's motion m, by Newmark's average-acceleration
-** scheme (beta 1/4, gamma 1/2; unconditionally stable, no numerical damping): with the held
+/* One implicit step of dt_s (> 0) of the body's motion m, by Newmark's scheme (m->gamma; at the
+** default, gamma 1/2 and beta 1/4, the average acceleration: unconditionally stable, no numerical
+** damping; the formulas below are that case's): with the held
 ** components and f_ext already set to their values at the step's end, the positions x solve
 ** M a + c M v + g(x) = f_ext + contact, a = 4 (x - x_n - dt v_n)/dt^2 - a_n,
 ** v = v_n + dt (a_n + a)/2, by cf_body_solve's Newton iteration and active set with the inertia's
