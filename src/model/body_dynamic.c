@@ -6,7 +6,9 @@
 ** positions x: with a = (4/dt^2)(x - x_n) - (4/dt) v_n - a_n and v = (2/dt)(x - x_n) - v_n,
 ** M a + c M v = mcoef M (x - xstar), mcoef = 4/dt^2 + 2c/dt,
 ** xstar = x_n + ((4/dt + c) v_n + a_n)/mcoef, a term the assembly adds to the residual and, as
-** mcoef m_i, to the diagonal of the tangent (cf_body_add_inertia).
+** mcoef m_i, to the diagonal of the tangent (cf_body_add_inertia). The step takes Newmark's
+** gamma from the motion (cf_body_motion.gamma; beta = (gamma + 1/2)^2/4), of which these are
+** the formulas at gamma = 1/2; above it the step damps the fastest vibrations.
 */
 #include <math.h>
 #include <stdlib.h>

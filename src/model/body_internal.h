@@ -91,7 +91,7 @@ typedef struct body_work {
     size_t nslot, capslot;
     double *hy, *hrhs;
     /* an implicit dynamic step (body_dynamic.c) while it solves: the inertia (and mass-
-    ** proportional damping) of Newmark's average-acceleration step as a term mcoef m_i (x - xstar)
+    ** proportional damping) of a Newmark step as a term mcoef m_i (x - xstar)
     ** in the residual and mcoef m_i on the tangent's diagonal; mcoef 0 = a static solve */
     const double *mass; /* nn lumped masses, t */
     const double *xstar;
