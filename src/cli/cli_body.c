@@ -15,6 +15,7 @@
 #include "cli/cli.h"
 #include "cli/cli_probe.h"
 #include "conifit/body.h"
+#include "conifit/budget.h"
 #include "conifit/mesh.h"
 #include "report/vtu.h"
 
@@ -34,6 +35,7 @@ typedef struct run {
     double *time;        /* steps + 1: a probe path's times, s */
     double *rv;          /* (steps + 1) x nregions x 3: a held region's support force (N), a loaded
                          ** one's mean displacement (mm) */
+    cf_body_motion motion; /* a dynamic run's masses and state */
 } run;
 
 static void run_free(run *r)
@@ -49,6 +51,7 @@ static void run_free(run *r)
     free(r->nsel);
     free(r->rv);
     free(r->time);
+    cf_body_motion_free(&r->motion);
 }
 
 cf_status cf_cli_body_load(const cf_scene *sc, cf_law *law, cf_mesh *mesh,
@@ -170,6 +173,54 @@ static void region_values(const cf_scene *sc, run *r, size_t k)
     }
 }
 
+/* A dynamic run's steps and their work (an implicit step costs about a static solve of the same
+** unknowns, cf_budget_solve_work) against --max-steps and --max-work, before anything runs. */
+static cf_status dynamic_budget(const cf_scene *sc, const char *scene_path,
+                                const cf_budget *budget, size_t nn, cf_error *err)
+{
+    const double steps = sc->body_steps, each = cf_budget_solve_work(3.0 * (double)nn);
+    if (steps <= budget->max_steps && steps * each <= budget->max_work)
+        return CF_OK;
+    const double fits = fmin(budget->max_steps, floor(budget->max_work / each));
+    return cf_error_set(err, CF_E_DATA, "%s: key 'integrator.dt_s' = %g: %.0f implicit steps of "
+                        "the body of %s (%zu nodes, about %.3g spring-steps each) are over the "
+                        "limits %.3g steps (--max-steps) or %.3g spring-steps (--max-work); "
+                        "at most %.0f steps fit, a step of at least %.3g s",
+                        scene_path, sc->cfg.dt_s, steps, sc->body_mesh, nn, each,
+                        budget->max_steps, budget->max_work, fits,
+                        fits >= 1 ? sc->body_duration_s / fits : INFINITY);
+}
+
+/* The fraction of the scene's loads, displacements and probe depth at step k of `steps`: k/steps
+** in a static run; in a dynamic one, the time k dt over body.ramp_s, 1 after it (and from the
+** first step when ramp_s is 0). */
+static double load_factor(const cf_scene *sc, size_t k, size_t steps)
+{
+    if (!sc->body_dynamic)
+        return (double)k / (double)steps;
+    const double t = (double)k * sc->body_dt_s;
+    return sc->body_ramp_s > 0 ? fmin(1, t / sc->body_ramp_s) : (k > 0);
+}
+
+/* A probe on a path at the fraction lam of its time: its reference point into *moved, its travel
+** along the direction from the path's start into *travel; returns the time. */
+static double path_probe(const cf_scene *sc, double lam, cf_probe *moved, double *travel)
+{
+    const size_t np = sc->probe_npath;
+    const double *ts = sc->probe_path_t_s;
+    const double t = ts[0] + lam * (ts[np - 1] - ts[0]);
+    size_t j = 0;
+    while (j + 2 < np && ts[j + 1] < t)
+        j++;
+    const double w = fmin(1, fmax(0, (t - ts[j]) / (ts[j + 1] - ts[j])));
+    *travel = 0;
+    for (int a = 0; a < 3; a++) {
+        moved->center_mm[a] = (1 - w) * sc->probe_path_mm[j][a] + w * sc->probe_path_mm[j + 1][a];
+        *travel += (moved->center_mm[a] - sc->probe.center_mm[a]) * sc->probe.dir[a];
+    }
+    return t;
+}
+
 static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budget *budget, run *r,
                        cf_error *err)
 {
@@ -177,6 +228,8 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
     if ((st = cf_cli_body_load(sc, &r->law, &r->mesh, &r->surface, err)) != CF_OK)
         return st;
     const size_t steps = r->steps = (size_t)sc->body_steps;
+    if (sc->body_dynamic && (st = dynamic_budget(sc, scene_path, budget, r->mesh.nn, err)))
+        return st;
     /* memory: the factor of the tangent (about 40 times its 3 x 3 blocks for meshes of organ
     ** size), the matrix, and one copy of the positions per step */
     double bytes = (double)r->mesh.nn * 3 * (81.0 * 16 * 8 + 40.0 * 81 * 8) +
@@ -209,9 +262,14 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu steps", steps);
     memcpy(r->xs, b->x, 3 * b->nn * sizeof *r->xs);
     r->step[0].min_J = 1;
+    if (sc->body_dynamic &&
+        (st = cf_body_motion_init(b, sc->cfg.lattice.density_t_per_mm3, sc->body_damping_per_s,
+                                  &r->motion, err)) != CF_OK)
+        return st;
+    r->motion.gamma = sc->body_newmark_gamma;
     double fdepth = 0; /* a force-driven probe's depth, found step by step */
     for (size_t k = 1; k <= steps; k++) {
-        const double lam = (double)k / (double)steps;
+        const double lam = load_factor(sc, k, steps);
         const double depth = sc->has_probe ? sc->probe.depth_mm * lam : 0;
         for (size_t q = 0; q < 3 * b->nn; q++) {
             if ((b->fix[q / 3] >> (q % 3)) & 1)
@@ -223,23 +281,16 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
         const cf_probe *pk = probe;
         double dk = depth, travel = 0;
         if (sc->probe_npath) {
-            const size_t np = sc->probe_npath;
-            const double *ts = sc->probe_path_t_s;
-            const double t = ts[0] + lam * (ts[np - 1] - ts[0]);
-            size_t j = 0;
-            while (j + 2 < np && ts[j + 1] < t)
-                j++;
-            const double w = fmin(1, fmax(0, (t - ts[j]) / (ts[j + 1] - ts[j])));
-            for (int a = 0; a < 3; a++) {
-                moved.center_mm[a] =
-                    (1 - w) * sc->probe_path_mm[j][a] + w * sc->probe_path_mm[j + 1][a];
-                travel += (moved.center_mm[a] - sc->probe.center_mm[a]) * sc->probe.dir[a];
-            }
-            r->time[k] = t;
+            r->time[k] = path_probe(sc, lam, &moved, &travel);
             pk = &moved;
             dk = 0;
         }
-        if ((st = sc->has_probe && sc->probe.force_N > 0
+        if (sc->body_dynamic)
+            r->time[k] = (double)k * sc->body_dt_s;
+        if ((st = sc->body_dynamic
+                      ? cf_body_dynamic_step(b, &r->motion, pk, dk, sc->body_dt_s, 0, &r->step[k],
+                                             err)
+                  : sc->has_probe && sc->probe.force_N > 0
                       ? cf_body_solve_force(b, pk, sc->probe.force_N * lam, &fdepth, 0,
                                             &r->step[k], err)
                       : cf_body_solve(b, pk, dk, 0, &r->step[k], err)) != CF_OK) {
@@ -293,13 +344,15 @@ static cf_status write_all(const cf_scene *sc, const run *r, const char *out, co
     cf_status st = cf_cli_out_open(csv, out, inputs, err);
     if (st)
         return st;
-    fprintf(csv->fp, !sc->has_probe ? "load_factor" : sc->probe_npath ? "time_s,depth_mm,force_N"
-                                                                      : "depth_mm,force_N");
+    const int timed = sc->probe_npath || sc->body_dynamic; /* a time column */
+    if (timed)
+        fprintf(csv->fp, "time_s,");
+    fprintf(csv->fp, !sc->has_probe ? "load_factor" : "depth_mm,force_N");
     for (size_t g = 0; g < sc->nregions; g++)
         region_columns(&sc->regions[g], csv->fp);
     fprintf(csv->fp, "\n");
     for (size_t k = 0; k <= steps; k++) {
-        if (sc->probe_npath)
+        if (timed)
             fprintf(csv->fp, "%.17g,", r->time[k]);
         fprintf(csv->fp, "%.17g", r->step[k].depth_mm);
         if (sc->has_probe)
@@ -326,7 +379,7 @@ static cf_status write_all(const cf_scene *sc, const run *r, const char *out, co
     for (size_t k = 0; k <= steps && st == CF_OK; k++) {
         tmp.x = r->xs + k * 3 * b->nn;
         cf_body_measure(&tmp, &bs, NULL);
-        depth[k] = sc->probe_npath ? r->time[k] : r->step[k].depth_mm; /* the PVD's times */
+        depth[k] = timed ? r->time[k] : r->step[k].depth_mm; /* the PVD's times */
         snprintf(path, sizeof path, "%s/body_%04zu.vtu", dir, k);
         if ((st = cf_atomic_open(&files[2 * k], path, inputs, err)) != CF_OK)
             break;
@@ -352,6 +405,14 @@ end:
     free(bs.J);
     free(depth);
     return st;
+}
+
+static double total_mass(const run *r)
+{
+    double m = 0;
+    for (size_t i = 0; r->motion.mass && i < r->body.nn; i++)
+        m += r->motion.mass[i];
+    return m;
 }
 
 static void summary(FILE *o, const cf_scene *sc, const run *r)
@@ -392,6 +453,11 @@ static void summary(FILE *o, const cf_scene *sc, const run *r)
                 rg->use == CF_REGION_LOADED ? "mean displacement" : "support force", v[0], v[1],
                 v[2], rg->use == CF_REGION_LOADED ? "mm" : "N");
     }
+    if (sc->body_dynamic)
+        fprintf(o, "dynamic: %zu implicit steps (Newmark, gamma %g) of %g s to %g s, "
+                   "loads ramped over %g s, density %g t/mm^3, damping %g 1/s, mass %.6g t\n",
+                steps, sc->body_newmark_gamma, sc->body_dt_s, sc->body_duration_s, sc->body_ramp_s,
+                sc->cfg.lattice.density_t_per_mm3, sc->body_damping_per_s, total_mass(r));
     if (!sc->has_probe) {
         fprintf(o, "no probe: loads ramped in %zu steps; Newton iterations: %d; smallest J %.6g, "
                    "largest spring compression %.4g of travel\n",
@@ -451,7 +517,7 @@ int cf_cli_simulate_body(const cf_scene *sc, const char *scene_path, const char 
         goto end;
     }
     if (write_all(sc, &r, out, vtu_dir, inputs, &csv, files, &err) != CF_OK ||
-        (png && cf_cli_probe_plot(sc, r.step, (size_t)sc->probe.steps + 1, png, inputs, &plot,
+        (png && cf_cli_probe_plot(sc, r.step, r.steps + 1, png, inputs, &plot,
                                   &err) != CF_OK)) {
         rc = cf_cli_fail(&err);
         goto end;
@@ -494,6 +560,9 @@ cf_status cf_cli_body_export(const cf_scene *sc, const char *scene_path, const c
     if (sc->probe_npath)
         return cf_error_set(err, CF_E_DATA, "%s: key 'probe.path': the export of a body moves "
                             "the probe along its direction only", scene_path);
+    if (sc->body_dynamic)
+        return cf_error_set(err, CF_E_DATA, "%s: key 'effects.inertia': the export of a body "
+                            "takes a static run", scene_path);
     cf_status st = solve(sc, scene_path, budget, &r, err);
     const size_t steps = r.steps;
     double *depth = NULL, *force = NULL;

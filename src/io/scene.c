@@ -406,7 +406,7 @@ static cf_status effects_section(ctx *c, json_t *ef, cf_scene *sc)
             e->maxwell_tau_s = tau;
         }
     }
-    if (e->prony_count > 0 && e->inertia)
+    if (e->prony_count > 0 && e->inertia && !sc->has_body) /* a body uses the elastic law */
         return cf_error_set(c->err, CF_E_DATA,
                             "%s: Prony terms (effects.viscosity.prony or a viscoelastic "
                             "spring.fit) are solved quasi-statically: they do not combine with "
@@ -711,8 +711,8 @@ static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
     if ((st = cf_scene_number(c, root, "", "samples_per_segment", 0, 50, 1, 0, MAX_SAMPLES_PER_SEGMENT,
                      &per)))
         return st;
-    if (sc->has_body)
-        return CF_OK; /* the probe is the loading */
+    if (sc->has_body) /* the probe is the loading */
+        return cf_scene_body_dynamics(c, root, sc);
     if ((st = cf_scene_object(c, root, "protocol", 1, &pr)) ||
         (st = protocol_section(c, pr, sc, floor(per))))
         return st;

@@ -344,7 +344,9 @@ static cf_status mesh_kind(ctx *c, json_t *bd, cf_scene *sc)
 static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
 {
     static const char *const bk[] = {"mesh", "unit_mm", "refine", "poisson_ratio",
-                                     "volume_modulus_MPa", "steps", "element_size_mm", NULL};
+                                     "volume_modulus_MPa", "steps", "element_size_mm",
+                                     "duration_s", "ramp_s", "damping_per_s", "newmark_gamma",
+                                     NULL};
     static const char *const pk[] = {"shape", "radius_mm", "center_mm", "direction", "depth_mm",
                                      "force_N", "path", "steps", NULL};
     cf_status st;
@@ -451,4 +453,79 @@ cf_status cf_scene_body(ctx *c, json_t *root, cf_scene *sc)
                             c->name, sc->has_extension ? "a double-acting element"
                                                        : "the fit's lattice volume term");
     return bd ? body_sections(c, root, bd, sc) : CF_OK;
+}
+
+/* The keys of the lattice's effects and integrator that a body does not take, refused by name
+** rather than ignored. */
+static cf_status body_effects_refused(ctx *c, json_t *root)
+{
+    static const char *const ef[] = {"damping", "viscosity", "gravity"};
+    json_t *e = json_object_get(root, "effects"), *in = json_object_get(root, "integrator");
+    for (int k = 0; k < 3 && e; k++)
+        if (json_object_get(e, ef[k]))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key 'effects.%s': a body takes "
+                                "'effects.inertia' only (damping: 'body.damping_per_s')",
+                                c->name, ef[k]);
+    if (in && json_object_get(in, "substeps"))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'integrator.substeps': a body's dynamic "
+                            "run takes 'integrator.dt_s' only", c->name);
+    return CF_OK;
+}
+
+cf_status cf_scene_body_dynamics(ctx *c, json_t *root, cf_scene *sc)
+{
+    static const char *const dyn[] = {"duration_s", "ramp_s", "damping_per_s", "newmark_gamma"};
+    json_t *bd = json_object_get(root, "body"), *pb = json_object_get(root, "probe");
+    json_t *in = json_object_get(root, "integrator");
+    cf_status st;
+    if ((st = body_effects_refused(c, root)))
+        return st;
+    sc->body_dynamic = sc->effects.inertia;
+    if (!sc->body_dynamic) {
+        for (int k = 0; k < 4; k++)
+            if (json_object_get(bd, dyn[k]))
+                return cf_error_set(c->err, CF_E_DATA, "%s: key 'body.%s' goes with a dynamic "
+                                    "run ('effects.inertia' = true)", c->name, dyn[k]);
+        if (in || json_object_get(root, "density_t_per_mm3"))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' goes with a body's dynamic run "
+                                "('effects.inertia' = true)", c->name,
+                                in ? "integrator" : "density_t_per_mm3");
+        return CF_OK;
+    }
+    if (sc->haptic_n)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'haptic': the haptic loop solves each "
+                            "update as an equilibrium; it does not take 'effects.inertia'",
+                            c->name);
+    if (json_object_get(bd, "steps") || (pb && json_object_get(pb, "steps")))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.steps': a dynamic run's steps are "
+                            "'integrator.dt_s'", c->name, json_object_get(bd, "steps") ? "body"
+                                                                                   : "probe");
+    if (sc->probe.force_N > 0 || sc->probe_npath)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'probe.%s': a dynamic run drives the "
+                            "probe by 'probe.depth_mm'", c->name,
+                            sc->probe_npath ? "path" : "force_N");
+    if (!in || !json_object_get(in, "dt_s"))
+        return cf_error_set(c->err, CF_E_DATA, "%s: missing key 'integrator.dt_s': a body's "
+                            "dynamic run needs its time step", c->name);
+    if ((st = cf_scene_number(c, bd, "body", "duration_s", 1, 0, 0, 1, 1e9,
+                              &sc->body_duration_s)) ||
+        (st = cf_scene_number(c, bd, "body", "ramp_s", 0, sc->body_duration_s, 0, 0, 1e9,
+                              &sc->body_ramp_s)) ||
+        (st = cf_scene_number(c, bd, "body", "damping_per_s", 0, 0, 0, 0, 1e12,
+                              &sc->body_damping_per_s)) ||
+        (st = cf_scene_number(c, bd, "body", "newmark_gamma", 0, 0.5, 0.5, 0, 1,
+                              &sc->body_newmark_gamma)))
+        return st;
+    const double dt = sc->cfg.dt_s;
+    if (!(dt > 0))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'integrator.dt_s' = %g: must be > 0",
+                            c->name, dt);
+    const double n = ceil(sc->body_duration_s / dt * (1 - 1e-12));
+    if (n > 1e7)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'integrator.dt_s' = %g: %g steps over "
+                            "'body.duration_s' = %g s, more than 10^7", c->name, dt, n,
+                            sc->body_duration_s);
+    sc->body_steps = (int)fmax(n, 1);
+    sc->body_dt_s = sc->body_duration_s / sc->body_steps;
+    return CF_OK;
 }

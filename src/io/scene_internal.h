@@ -35,5 +35,9 @@ cf_status cf_scene_vec3(ctx *c, json_t *obj, const char *where, const char *key,
 /* scene_body.c: "body", "fixed" and "probe" of root (nothing when root has no "body"; "fixed" or
 ** "probe" without it refused). */
 cf_status cf_scene_body(ctx *c, json_t *root, cf_scene *sc);
+/* A body's dynamic run: 'effects.inertia', 'density_t_per_mm3', 'integrator.dt_s' and
+** 'body.duration_s', 'body.ramp_s', 'body.damping_per_s' (after the effects and the integrator
+** are read); the lattice's other effects refused for a body. */
+cf_status cf_scene_body_dynamics(ctx *c, json_t *root, cf_scene *sc);
 
 #endif

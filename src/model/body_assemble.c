@@ -430,6 +430,22 @@ double cf_body_assemble(const cf_body *b, const double *x, const cf_probe *pr, c
     return force;
 }
 
+void cf_body_add_inertia(const cf_body *b, const body_work *w, const double *x, double *g,
+                         pattern *P)
+{
+    if (!(w->mcoef > 0))
+        return;
+    for (size_t i = 0; i < b->nn; i++) {
+        const double k = w->mcoef * w->mass[i];
+        for (int a = 0; a < 3; a++)
+            g[3 * i + (size_t)a] += k * (x[3 * i + (size_t)a] - w->xstar[3 * i + (size_t)a]);
+        if (P) {
+            const double B[9] = {k, 0, 0, 0, k, 0, 0, 0, k};
+            add_block(P, i, blk_of(P, i, i), B);
+        }
+    }
+}
+
 /* Copies the residual g at the held components into b->reaction (when there is one): at an
 ** equilibrium, the force the supports apply there. */
 void cf_body_keep_reaction(const cf_body *b, const double *g)

@@ -90,6 +90,12 @@ typedef struct body_work {
     double *Z;          /* 9 nn per slot: columns 3 nn each */
     size_t nslot, capslot;
     double *hy, *hrhs;
+    /* an implicit dynamic step (body_dynamic.c) while it solves: the inertia (and mass-
+    ** proportional damping) of a Newmark step as a term mcoef m_i (x - xstar)
+    ** in the residual and mcoef m_i on the tangent's diagonal; mcoef 0 = a static solve */
+    const double *mass; /* nn lumped masses, t */
+    const double *xstar;
+    double mcoef;       /* 1/s^2 */
 } body_work;
 
 /* body.c */
@@ -106,6 +112,10 @@ double cf_body_penetration(const cf_probe *pr, const double *c, const double *p,
 ** direction and the number of nodes in contact; NAN when memory runs out. */
 double cf_body_assemble(const cf_body *b, const double *x, const cf_probe *pr, const double *c,
                         double kp, const uint8_t *active, double *g, pattern *P, int *contacts);
+/* Adds the inertia of an implicit dynamic step (w->mcoef > 0) at positions x to g and, when P is
+** not NULL, to the tangent's diagonal blocks. */
+void cf_body_add_inertia(const cf_body *b, const body_work *w, const double *x, double *g,
+                         pattern *P);
 /* The residual g (before cf_body_apply_fixed) at the held components into b->reaction. */
 void cf_body_keep_reaction(const cf_body *b, const double *g);
 /* Zeroes the rows and columns of fixed components (diagonal 1) and their gradient entries. */

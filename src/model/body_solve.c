@@ -29,6 +29,7 @@ static cf_status newton_in_set(cf_body *b, body_work *w, const cf_probe *probe, 
         *force = cf_body_assemble(b, b->x, probe, c, kp, active, g, *fresh ? P : NULL, contacts);
         if (isnan(*force))
             return cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's tangent");
+        cf_body_add_inertia(b, w, b->x, g, *fresh ? P : NULL);
         cf_body_apply_fixed(b, *fresh ? P : NULL, g);
         double r = body_norm_inf(g, n);
         if (r <= 1e-8 * fscale) {
@@ -140,6 +141,7 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
         goto end;
     }
     force = cf_body_assemble(b, b->x, probe, c, kp, active, g, NULL, &contacts);
+    cf_body_add_inertia(b, w, b->x, g, NULL);
     cf_body_keep_reaction(b, g);
     out->depth_mm = depth_mm;
     out->force_N = force;

@@ -220,6 +220,41 @@ cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm
                               double penalty_N_per_mm, int max_iters, cf_body_step *out,
                               cf_error *err);
 
+/* The motion of a body in a dynamic run (cf_body_dynamic_step): lumped masses, mass-proportional
+** damping, and the state of Newmark's average-acceleration scheme. */
+typedef struct cf_body_motion {
+    double *mass;          /* nn lumped masses (t): density times a quarter of the volume of
+                           ** every tetrahedron around the node */
+    double damping_per_s;  /* c of the damping force c m v on each node (s^-1), >= 0 */
+    double *v, *a;         /* 3 nn velocities (mm/s) and accelerations (mm/s^2) */
+    double *xprev;         /* 3 nn positions at the end of the last step */
+    double t_s;            /* time of the last step (0 at the start) */
+    double gamma;          /* Newmark's gamma, 1/2 (0 is read as 1/2: average acceleration, no
+                           ** numerical damping) to 1; above 1/2, with beta = (gamma + 1/2)^2/4,
+                           ** the step damps the highest frequencies (a penalty contact's
+                           ** node-on-probe vibration) and is first-order accurate */
+} cf_body_motion;
+
+/* Starts b's motion at rest at its current positions, which must be an equilibrium with the
+** loads at time 0 (so the accelerations are 0): masses from the density rho (t/mm^3, > 0).
+** CF_E_DATA for a bad rho or damping, CF_E_INTERNAL when memory runs out. */
+cf_status cf_body_motion_init(const cf_body *b, double rho_t_per_mm3, double damping_per_s,
+                              cf_body_motion *m, cf_error *err);
+void cf_body_motion_free(cf_body_motion *m);
+
+/* One implicit step of dt_s (> 0) of the body's motion m, by Newmark's scheme (m->gamma; at the
+** default, gamma 1/2 and beta 1/4, the average acceleration: unconditionally stable, no numerical
+** damping; the formulas below are that case's): with the held
+** components and f_ext already set to their values at the step's end, the positions x solve
+** M a + c M v + g(x) = f_ext + contact, a = 4 (x - x_n - dt v_n)/dt^2 - a_n,
+** v = v_n + dt (a_n + a)/2, by cf_body_solve's Newton iteration and active set with the inertia's
+** (4/dt^2 + 2c/dt) M on the tangent's diagonal: the volume term's stiffness, which limits an
+** explicit step, does not limit this one. out as for cf_body_solve (the force is the probe's
+** contact force). Same errors as cf_body_solve. */
+cf_status cf_body_dynamic_step(cf_body *b, cf_body_motion *m, const cf_probe *probe,
+                               double depth_mm, double dt_s, double penalty_N_per_mm,
+                               cf_body_step *out, cf_error *err);
+
 /* The body's elastic forces on its nodes at the current positions (the gradient of its energy,
 ** N; g has 3 nn entries; the external forces f_ext are not in it). CF_E_INTERNAL when
 ** memory runs out. */

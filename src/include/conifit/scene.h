@@ -77,6 +77,15 @@ typedef struct cf_scene {
     double body_volume_value;   /* kappa (MPa) or nu */
     int body_steps;             /* static steps of the run: probe.steps, or body.steps without a
                                    probe */
+    int body_dynamic;           /* 1: 'effects.inertia' = true, a dynamic run (body_steps implicit
+                                   steps of body_dt_s from 0 to body.duration_s) */
+    double body_duration_s;     /* body.duration_s */
+    double body_ramp_s;         /* body.ramp_s: the loads and the probe ramp from 0 over it, then
+                                   hold (0: applied at the first step) */
+    double body_damping_per_s;  /* body.damping_per_s: mass-proportional damping c (c m v) */
+    double body_newmark_gamma;  /* body.newmark_gamma: 1/2 (average acceleration) to 1 */
+    double body_dt_s;           /* the step: integrator.dt_s, shortened so that the duration is a
+                                   whole number of steps */
     size_t nregions;            /* the regions "fixed", "displaced", "loaded", in that order */
     cf_scene_region regions[CF_SCENE_MAX_REGIONS];
     int has_probe;              /* 1 when the scene has "probe" */
