@@ -13,6 +13,24 @@
 #define SPRING "\"spring\": {\"params\": {\"D1_mm\": 10, \"D2_mm\": 30, \"n\": 4, \"d_mm\": 1, " \
                "\"G_MPa\": 80000, \"H_mm\": 40}}"
 
+/* Mesh m as a Gmsh 2.2 file at path (tetrahedra, node numbers from 1); m is freed. */
+static inline void write_msh(const char *path, cf_mesh *m)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f, "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n%zu\n", m->nn);
+    for (size_t i = 0; i < m->nn; i++)
+        fprintf(f, "%zu %.17g %.17g %.17g\n", i + 1, m->X[3 * i], m->X[3 * i + 1],
+                m->X[3 * i + 2]);
+    fprintf(f, "$EndNodes\n$Elements\n%zu\n", m->nt);
+    for (size_t t = 0; t < m->nt; t++)
+        fprintf(f, "%zu 4 2 0 1 %u %u %u %u\n", t + 1, m->tet[4 * t] + 1, m->tet[4 * t + 1] + 1,
+                m->tet[4 * t + 2] + 1, m->tet[4 * t + 3] + 1);
+    fprintf(f, "$EndElements\n");
+    fclose(f);
+    cf_mesh_free(m);
+}
+
 /* A block of 6 x 6 x 3 cells over 30 x 30 x 15 mm, as a Gmsh 2.2 file. */
 static inline void write_block(const char *path)
 {
@@ -23,18 +41,18 @@ static inline void write_block(const char *path)
         zs[i] = 5.0 * i;
     cf_mesh m;
     assert_int_equal(cf_mesh_block(&m, xs, 6, xs, 6, zs, 3, NULL), CF_OK);
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fprintf(f, "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n%zu\n", m.nn);
-    for (size_t i = 0; i < m.nn; i++)
-        fprintf(f, "%zu %.17g %.17g %.17g\n", i + 1, m.X[3 * i], m.X[3 * i + 1], m.X[3 * i + 2]);
-    fprintf(f, "$EndNodes\n$Elements\n%zu\n", m.nt);
-    for (size_t t = 0; t < m.nt; t++)
-        fprintf(f, "%zu 4 2 0 1 %u %u %u %u\n", t + 1, m.tet[4 * t] + 1, m.tet[4 * t + 1] + 1,
-                m.tet[4 * t + 2] + 1, m.tet[4 * t + 3] + 1);
-    fprintf(f, "$EndElements\n");
-    fclose(f);
-    cf_mesh_free(&m);
+    write_msh(path, &m);
+}
+
+/* The 10 mm cube meshed by Gmsh (Delaunay, element size h), as a Gmsh 2.2 file. */
+static inline void write_cube(const char *path, double h)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {10, 10, 10}, f[3] = {5, 5, 5};
+    cf_mesh m;
+    cf_error err = {0};
+    if (cf_mesh_box(lo, hi, f, h, h, 0, &m, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    write_msh(path, &m);
 }
 
 #endif

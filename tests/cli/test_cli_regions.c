@@ -7,6 +7,7 @@
 ** region that selects nothing, two selectors, and two displacements of one component are refused
 ** with exit 65 naming the key, and nothing is written.
 */
+#include "bodyutil.h"
 #include "testutil.h"
 
 #include <sys/stat.h>
@@ -17,31 +18,6 @@
 #include "conifit/mesh.h"
 
 TU_SCRATCH_GROUP("cli-regions")
-
-#define SPRING "\"spring\": {\"params\": {\"D1_mm\": 10, \"D2_mm\": 30, \"n\": 4, \"d_mm\": 1, " \
-               "\"G_MPa\": 80000, \"H_mm\": 40}}"
-
-/* The 10 mm cube meshed by Gmsh (Delaunay, element size h), as a Gmsh 2.2 file. */
-static void write_cube(const char *path, double h)
-{
-    double lo[3] = {0, 0, 0}, hi[3] = {10, 10, 10}, f[3] = {5, 5, 5};
-    cf_mesh m;
-    cf_error err = {0};
-    if (cf_mesh_box(lo, hi, f, h, h, 0, &m, &err) != CF_OK)
-        fail_msg("%s", err.msg);
-    FILE *o = fopen(path, "w");
-    assert_non_null(o);
-    fprintf(o, "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n%zu\n", m.nn);
-    for (size_t i = 0; i < m.nn; i++)
-        fprintf(o, "%zu %.17g %.17g %.17g\n", i + 1, m.X[3 * i], m.X[3 * i + 1], m.X[3 * i + 2]);
-    fprintf(o, "$EndNodes\n$Elements\n%zu\n", m.nt);
-    for (size_t t = 0; t < m.nt; t++)
-        fprintf(o, "%zu 4 2 0 1 %u %u %u %u\n", t + 1, m.tet[4 * t] + 1, m.tet[4 * t + 1] + 1,
-                m.tet[4 * t + 2] + 1, m.tet[4 * t + 3] + 1);
-    fprintf(o, "$EndElements\n");
-    fclose(o);
-    cf_mesh_free(&m);
-}
 
 /* The bottom on rollers (z held), x and y of the corner at the origin and y of the corner at
 ** x = 10 held: the cube is free to expand sideways, as the homogenised cell in uniaxial mode. */
