@@ -237,8 +237,11 @@ cf_status cf_cell_uncertainty(cf_cell_problem *p, cf_cell_problem *prof, cf_fit_
     free(gp);
     free(gm);
     int rank_def = 1;
-    if (bad == 0)
-        rank_def = cf_lsq_covariance(jtj, rss, p->n, res->ident_se.v, res->corr);
+    double corr[3][3];
+    if (bad == 0) {
+        rank_def = cf_lsq_covariance(jtj, rss, p->n, res->ident_se.v, corr);
+        cf_fit_corr3(res, corr);
+    }
     if (bad < 0 || rank_def < 0)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the errors of %zu rows",
                             p->n);

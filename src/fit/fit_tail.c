@@ -397,7 +397,7 @@ double cf_tail_profile_at(const cf_table *data, const cf_fit_options *opt,
         return NAN;
     tail_ctx c;
     ctx_init(&c, data, opt, fit->type, buf);
-    const double B = fit->ident.solid, tau = fit->e_tail / B;
+    const double B = fit->ident.solid, tau = fit->q[CF_Q_TAIL] / B;
     const double v[4] = {fit->ident.rho, B, fit->ident.scale, tau};
     const double rss = fit->objective, rss0 = stride_rss(&c, v);
     *limit = rss0 + cf_profile_limit_np(n, 4, rss, c.ynorm) - rss;
@@ -477,31 +477,4 @@ cf_status cf_fit_tail_run(const cf_table *data, const cf_fit_options *opt, cf_sp
     /* never reported worse than the conical law it contains */
     cf_tail_nest(plain, res);
     return CF_OK;
-}
-
-cf_status cf_law_kind_parse(const char *name, cf_law_kind *f, cf_error *err)
-{
-    static const struct { const char *name; cf_law_kind f; } map[] = {
-        {"conical", CF_KIND_CONICAL}, {"conical-tail", CF_KIND_TAIL}, {"auto", CF_KIND_AUTO},
-        {"double-acting", CF_KIND_DOUBLE}};
-    for (size_t i = 0; i < sizeof map / sizeof map[0]; i++)
-        if (name && strcmp(name, map[i].name) == 0) {
-            *f = map[i].f;
-            return CF_OK;
-        }
-    return cf_error_set(err, CF_E_DATA,
-                        "unknown law '%s' (expected conical, conical-tail, auto or "
-                        "double-acting)",
-                        name ? name : "(null)");
-}
-
-const char *cf_law_kind_name(cf_law_kind f)
-{
-    switch (f) {
-    case CF_KIND_CONICAL: return "conical";
-    case CF_KIND_TAIL: return "conical-tail";
-    case CF_KIND_AUTO: return "auto";
-    case CF_KIND_DOUBLE: return "double-acting";
-    }
-    return "?";
 }

@@ -78,7 +78,9 @@ static unsigned profile_closed(void *ctx, int k, double u, const double *xin)
 void cf_fit_uncertainty(fit_ctx *c, fit_ctx *g, cf_fit_result *res, unsigned held_a)
 {
     const double *v = res->ident.v;
-    int rank_def = cf_fit_stage_a_errors(c, v, res->ident_se.v, res->corr);
+    double corr[3][3];
+    int rank_def = cf_fit_stage_a_errors(c, v, res->ident_se.v, corr);
+    cf_fit_corr3(res, corr);
     res->held = held_a | cf_fit_held_at(c, v) | (c->fd || c->region ? 0u : res->active);
     unsigned why = res->held | (rank_def ? CF_FIT_RANK_DEFICIENT : 0);
     /* a Wald interval that would cross the range of a quantity is no interval either */

@@ -500,9 +500,9 @@ cf_status cf_joint_fit_tail(const cf_table *const *tables, size_t n, const cf_fi
     f->nested_violated = found && !r->fit.feasible ? r->fit.violated : 0;
     nest.nested_objective = found && isfinite(r->objective) ? r->objective : 0;
     f->tail = 1;
-    f->e_tail = 0;
-    f->e_tail_se = 0;
-    f->e_tail_interval_ok = 0;
+    f->q[CF_Q_TAIL] = 0;
+    f->q_se[CF_Q_TAIL] = 0;
+    f->interval_ok[CF_Q_TAIL] = 0;
     f->params.n_tail = 0;
     f->params.H_tail_mm = 0;
     /* the search's cost is the tailed fit's own */

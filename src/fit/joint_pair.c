@@ -521,8 +521,8 @@ cf_status cf_joint_search_pair(jctx *c, const cf_table *reach, double xmax,
         const double B = v[PQ_BC], tau = v[PQ_T];
         const double var = B * B * se[PQ_T] * se[PQ_T] + tau * tau * se[PQ_BC] * se[PQ_BC] +
                            2 * tau * B * cov_bt;
-        r->fit.e_tail_se = isfinite(cov_bt) ? (var > 0 ? sqrt(var) : 0) : -1;
-        r->fit.e_tail_interval_ok = 0;
+        r->fit.q_se[CF_Q_TAIL] = isfinite(cov_bt) ? (var > 0 ? sqrt(var) : 0) : -1;
+        r->fit.interval_ok[CF_Q_TAIL] = 0;
     }
     return CF_OK;
 }

@@ -193,3 +193,10 @@ int cf_profile_needed(const cf_fit_result *res, const double lo[3], const double
                v[k] + 1.96 * res->ident_se.v[k] > hi[k];
     return need;
 }
+
+void cf_fit_corr3(cf_fit_result *res, double corr[3][3])
+{
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            res->corr[a][b] = corr[a][b];
+}

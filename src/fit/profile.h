@@ -13,11 +13,12 @@
 /* A fit's profile. The other two quantities of a profile of k travel in x: (log rho, B)
 ** without the one profiled (both when k is the stress scale), or, where start is given, what
 ** start puts there (at most CF_PROFILE_X values: the tailed law's four quantities). */
-#define CF_PROFILE_X 4
+#define CF_PROFILE_X CF_Q_MAX
 typedef struct cf_profile {
     void *ctx;
-    double lo[4], hi[4];          /* range of each quantity, log units (the tailed law's four) */
-    unsigned lo_bit[4], hi_bit[4]; /* CF_C_* bit of the limit at each end of that range */
+    double lo[CF_PROFILE_X], hi[CF_PROFILE_X]; /* range of each quantity, log units */
+    /* CF_C_* bit of the limit at each end of that range */
+    unsigned lo_bit[CF_PROFILE_X], hi_bit[CF_PROFILE_X];
     /* the weighted RSS minimised over the other quantities with quantity k at exp(u), from x;
     ** x moves to the minimiser when that RSS is within limit */
     double (*at)(void *ctx, int k, double u, double limit, double *x);
@@ -56,5 +57,8 @@ void cf_profile_intervals(const cf_profile *p, const double v[3], double limit, 
 ** (why != 0), or whose Wald interval crosses the range [lo, hi] (linear units). */
 int cf_profile_needed(const cf_fit_result *res, const double lo[3], const double hi[3],
                       unsigned why);
+
+/* Puts the correlation of the cone's three quantities (cf_lsq_covariance's) in res->corr. */
+void cf_fit_corr3(cf_fit_result *res, double corr[3][3]);
 
 #endif

@@ -232,15 +232,15 @@ cf_status cf_tail_result(const cf_table *data, const cf_fit_options *opt, cf_spr
     res->ident.rho = rho;
     res->ident.solid = B;
     res->ident.scale = A;
-    res->e_tail = tau * B;
+    res->q[CF_Q_TAIL] = tau * B;
     for (int q = 0; q < 3; q++)
         res->ident_se.v[q] = se[q];
     /* e_t = tau B: var = B^2 var(tau) + tau^2 var(B) + 2 tau B cov(B, tau) */
     if (se[1] > 0 && se[3] > 0 && isfinite(cov_Bt)) {
         const double var = B * B * se[3] * se[3] + tau * tau * se[1] * se[1] + 2 * tau * B * cov_Bt;
-        res->e_tail_se = var > 0 ? sqrt(var) : 0;
+        res->q_se[CF_Q_TAIL] = var > 0 ? sqrt(var) : 0;
     } else {
-        res->e_tail_se = -1;
+        res->q_se[CF_Q_TAIL] = -1;
     }
     for (int a = 0; a < 3; a++)
         for (int b = 0; b < 3; b++)
@@ -320,9 +320,9 @@ int cf_tail_nest(const cf_fit_result *plain, cf_fit_result *tail)
     tail->nested_rmse = lost_rmse;
     tail->nested_violated = lost;
     tail->tail = 1;
-    tail->e_tail = 0;
-    tail->e_tail_se = 0;
-    tail->e_tail_interval_ok = 0;
+    tail->q[CF_Q_TAIL] = 0;
+    tail->q_se[CF_Q_TAIL] = 0;
+    tail->interval_ok[CF_Q_TAIL] = 0;
     tail->params.n_tail = 0;
     tail->params.H_tail_mm = 0;
     /* the search's cost is the tailed fit's own */
@@ -533,7 +533,7 @@ int cf_tail_intervals(const cf_tail_profile *p, const double v[4], double rss0, 
 {
     const double q[4] = {v[0], v[1], v[2], v[3] * v[1]};
     const double se[4] = {res->ident_se.v[0], res->ident_se.v[1], res->ident_se.v[2],
-                          res->e_tail_se};
+                          res->q_se[CF_Q_TAIL]};
     /* the range of each quantity: the search's box; e_t below the free length's share past the
     ** smallest cone travel (a stress-strain table) or the largest tail the search takes */
     const double et_lo = TAIL_TAU_LO * p->b_lo,
@@ -584,10 +584,10 @@ int cf_tail_intervals(const cf_tail_profile *p, const double v[4], double rss0, 
         res->interval_ok[k] = 1;
         res->interval_why[k] = why;
     }
-    memcpy(res->e_tail_interval, out[3], sizeof out[3]);
-    memcpy(res->e_tail_interval_end, end[3], sizeof end[3]);
-    res->e_tail_interval_ok = 1;
-    res->e_tail_interval_why = why;
+    memcpy(res->interval[CF_Q_TAIL], out[3], sizeof out[3]);
+    memcpy(res->interval_end[CF_Q_TAIL], end[3], sizeof end[3]);
+    res->interval_ok[CF_Q_TAIL] = 1;
+    res->interval_why[CF_Q_TAIL] = why;
     return 0;
 }
 

@@ -78,7 +78,7 @@ static int place_tail(const cf_table *t, const cf_pipeline_options *opt, cf_spri
     if (cf_tail_result(t, &opt->fit, ty, v, se, corr, NAN, f, &e) != CF_OK)
         return 0;
     f->optimizer = "placement";
-    f->e_tail_se = -1;
+    f->q_se[CF_Q_TAIL] = -1;
     for (int k = 0; k < CF_IDENT_COUNT; k++)
         f->ident_se.v[k] = -1;
     const cf_ident got = cf_ident_of(&f->params, 0);

@@ -305,7 +305,7 @@ char *cf_joint_text(const cf_joint_report *r)
         static const char *const names[4] = {"rho", "solid strain", "stress scale",
                                              "tail compliance"};
         for (int k = 0; k < (j->fit.tail ? 4 : 3); k++)
-            if (k == CF_REPORT_TAIL ? j->fit.e_tail_interval_ok : j->fit.interval_ok[k]) {
+            if (k == CF_REPORT_TAIL ? j->fit.interval_ok[CF_Q_TAIL] : j->fit.interval_ok[k]) {
                 char why[512];
                 cf_report_interval_reason(&j->fit, k, why, sizeof why);
                 fprintf(o, "  * %s: %s\n", names[k], why);

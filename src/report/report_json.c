@@ -50,16 +50,16 @@ static void interval_json(json_t *o, const cf_fit_result *f, int k, const double
 
 json_t *cf_report_tail_json(const cf_fit_result *f)
 {
-    json_t *o = json_pack("{s:o}", "value", num(f->e_tail));
-    if (o && f->e_tail_se >= 0)
-        json_object_set_new(o, "stderr", num(f->e_tail_se));
+    json_t *o = json_pack("{s:o}", "value", num(f->q[CF_Q_TAIL]));
+    if (o && f->q_se[CF_Q_TAIL] >= 0)
+        json_object_set_new(o, "stderr", num(f->q_se[CF_Q_TAIL]));
     else if (o)
         json_object_set_new(o, "stderr_reason",
                             json_string("the Jacobian of the fitted quantities is singular"));
-    if (o && f->e_tail_se > fabs(f->e_tail))
+    if (o && f->q_se[CF_Q_TAIL] > fabs(f->q[CF_Q_TAIL]))
         json_object_set_new(o, "determined", json_false());
-    if (o && f->e_tail_interval_ok)
-        interval_json(o, f, CF_REPORT_TAIL, f->e_tail_interval, f->e_tail_interval_end);
+    if (o && f->interval_ok[CF_Q_TAIL])
+        interval_json(o, f, CF_REPORT_TAIL, f->interval[CF_Q_TAIL], f->interval_end[CF_Q_TAIL]);
     return o;
 }
 

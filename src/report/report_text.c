@@ -138,7 +138,7 @@ static void interval_notes(FILE *o, const cf_fit_report *r, const char *const na
     for (int i = 0; i < r->nfits; i++)
         for (int k = 0; k < 4; k++) {
             const cf_fit_result *f = &r->fits[i];
-            if (k < 3 ? !f->interval_ok[k] : !(f->tail && f->e_tail_interval_ok))
+            if (k < 3 ? !f->interval_ok[k] : !(f->tail && f->interval_ok[CF_Q_TAIL]))
                 continue;
             char why[512];
             cf_report_interval_reason(f, k, why, sizeof why);

@@ -31,9 +31,9 @@ static int quantity(const cf_fit_result *f, int k, double *v, double *se, const 
                     const unsigned **end, unsigned *why)
 {
     if (k == CF_REPORT_TAIL) {
-        *v = f->e_tail, *se = f->e_tail_se, *iv = f->e_tail_interval;
-        *end = f->e_tail_interval_end, *why = f->e_tail_interval_why;
-        return f->e_tail_interval_ok;
+        *v = f->q[CF_Q_TAIL], *se = f->q_se[CF_Q_TAIL], *iv = f->interval[CF_Q_TAIL];
+        *end = f->interval_end[CF_Q_TAIL], *why = f->interval_why[CF_Q_TAIL];
+        return f->interval_ok[CF_Q_TAIL];
     }
     *v = f->ident.v[k], *se = f->ident_se.v[k], *iv = f->interval[k];
     *end = f->interval_end[k], *why = f->interval_why[k];

@@ -20,6 +20,10 @@
 /* Index of each quantity in cf_ident.v. */
 enum { CF_IDENT_RHO = 0, CF_IDENT_SOLID, CF_IDENT_SCALE, CF_IDENT_COUNT };
 
+/* The most identifiable quantities a law kind has (lawkind.h; the double-acting pair has six),
+** and the index of the tailed kind's fourth, its tail compliance, after the cone's three. */
+enum { CF_Q_MAX = 8, CF_Q_TAIL = CF_IDENT_COUNT };
+
 /* The identifiable quantities of one spring, by name or by index (v[CF_IDENT_*]). The length and
 ** load scales take the table's kind: a stress-strain table (sigma = F/H^2, epsilon = u/H) sees the
 ** solid strain and the stress scale, a force-displacement table the travel and the solid load. */

@@ -140,20 +140,31 @@ typedef struct cf_fit_result {
     cf_spring_type type;
     cf_spring params;      /* the reported spring */
     cf_law law;            /* derived quantities of params (no table) */
-    cf_ident ident;        /* the identifiable quantities (family.h: rho [-]; solid strain s/H
-                           ** [-] or travel s [mm]; F_C/H^2 [MPa] or F_C [N]) */
-    cf_ident ident_se;     /* their standard errors, same units; -1 when not determined */
+    const struct cf_law_row *kind; /* the law kind fitted (lawkind.h): the names, units and
+                           ** number kind->nq of the quantities below */
+    /* The identifiable quantities q[0 .. kind->nq - 1] (lawkind.h names them); for the conical
+    ** kinds the first three are the cone's family (family.h: rho [-]; solid strain s/H [-] or
+    ** travel s [mm]; F_C/H^2 [MPa] or F_C [N]), which ident names, and the tailed kind's fourth
+    ** is its tail compliance. q_se: their standard errors, same units; -1 when not determined. */
+    union {
+        cf_ident ident;
+        double q[CF_Q_MAX];
+    };
+    union {
+        cf_ident ident_se;
+        double q_se[CF_Q_MAX];
+    };
     /* Profile-likelihood interval of each identifiable quantity (95 %, F-test on the residual
     ** sum of squares), computed when the quantity sits on a bound or limit of the type, or the
-    ** Jacobian is rank-deficient (then ident_se is -1); interval_ok[k] = 0 when not computed. */
-    int interval_ok[CF_IDENT_COUNT];
-    double interval[CF_IDENT_COUNT][2];
-    unsigned interval_end[CF_IDENT_COUNT][2]; /* CF_C_* bit of the bound an end reached (0: the
-                                              ** threshold) */
-    unsigned interval_why[CF_IDENT_COUNT];    /* CF_C_* bits of the bounds the quantity sits on;
-                                              ** with CF_FIT_RANK_DEFICIENT when the Jacobian is */
-    double corr[CF_IDENT_COUNT][CF_IDENT_COUNT]; /* correlation of the quantities; NAN where not
-                                                 ** determined */
+    ** Jacobian is rank-deficient (then q_se is -1); interval_ok[k] = 0 when not computed. */
+    int interval_ok[CF_Q_MAX];
+    double interval[CF_Q_MAX][2];
+    unsigned interval_end[CF_Q_MAX][2]; /* CF_C_* bit of the bound an end reached (0: the
+                                        ** threshold) */
+    unsigned interval_why[CF_Q_MAX];    /* CF_C_* bits of the bounds the quantity sits on;
+                                        ** with CF_FIT_RANK_DEFICIENT when the Jacobian is */
+    double corr[CF_Q_MAX][CF_Q_MAX];    /* correlation of the quantities; NAN where not
+                                        ** determined */
     unsigned held;         /* CF_C_* bits of the limits that hold the identifiable quantities
                            ** away from the optimum of the law over every spring (the type's
                            ** geometry and the design bounds, rho_min, the travel) */
@@ -174,22 +185,11 @@ typedef struct cf_fit_result {
     unsigned violated;     /* CF_C_* bits of violated constraints */
     const char *optimizer; /* name of the stage-C optimiser */
     int tail;              /* 1: a fit of the conical-tail law (params has a tail) */
-    double e_tail;         /* its tail compliance e_t = F_C/(k_t H) [-] (stress-strain) or
-                           ** F_C/k_t [mm] (force): the fourth identifiable quantity */
-    double e_tail_se;      /* its standard error, same unit; -1 when not determined */
     long evaluations;      /* evaluations of the model over the table (or its subsample), all
                            ** stages */
     long evaluations_full; /* those over every row of the table (the rest ran on the subsample
                            ** of a long table: cf_fit_options.subsample_above) */
     double wall_time_s;    /* s */
-    /* The profile-likelihood interval of the tail compliance e_t (a fit of the conical-tail law),
-    ** as interval_ok, interval, interval_end and interval_why above are of the three quantities,
-    ** computed by the same rule (the tail's intervals are of all four or none); placed last, so
-    ** that the fields before keep their places. */
-    int e_tail_interval_ok;
-    double e_tail_interval[2];
-    unsigned e_tail_interval_end[2];
-    unsigned e_tail_interval_why;
     /* A conical-tail fit that is the conical optimum it contains (tail 1, n_tail 0; fit_tail.c):
     ** the tailed spring its search ended on lost to it, with this RMSE (0: the search found none)
     ** and these violated CF_C_* bits (0: it was feasible but fitted worse). */
