@@ -16,7 +16,7 @@
 #include "conifit/version.h"
 #include "base/atomic.h"
 #include "report/plot.h"
-#include "fit/tail.h"
+#include "fit/lawkind.h"
 #include "pipeline/outputs.h"
 
 cf_pipeline_options cf_pipeline_default_options(void)
@@ -64,7 +64,11 @@ typedef struct fit_plan {
                      through it (a stress-strain table validated, or in a mode the single
                      spring has no curve of, or asked for) */
     int validate; /* each fit run in the lattice (or fitted through it) */
-    int tail;     /* the tailed law fitted beside the conical one (--law conical-tail, auto) */
+    /* the law kinds fitted beside the conical one (--law conical-tail or auto: the tailed law;
+    ** or cf_fit_options.kinds), and whether the one other kind was asked for (conical-tail) */
+    const cf_law_row *others[CF_LAW_KINDS_MAX];
+    int nothers;
+    int asked;
     int solves;   /* the lattice's static solves are part of the run: their budget checked */
 } fit_plan;
 
@@ -78,82 +82,78 @@ static fit_plan plan_of(const cf_table *t, const cf_pipeline_options *opt)
     else
         p.lattice = opt->target == CF_TARGET_LATTICE;
     p.validate = opt->validate || p.lattice;
-    p.tail = opt->fit.law != CF_KIND_CONICAL;
+    p.nothers = 0;
+    p.asked = 0;
+    if (opt->fit.nkinds > 0) {
+        for (int i = 0; i < opt->fit.nkinds && p.nothers < CF_LAW_KINDS_MAX - 1; i++)
+            if (opt->fit.kinds[i] != &cf_law_conical_row)
+                p.others[p.nothers++] = opt->fit.kinds[i];
+    } else if (opt->fit.law == CF_KIND_TAIL || opt->fit.law == CF_KIND_AUTO) {
+        p.others[p.nothers++] = &cf_law_tail_row;
+        p.asked = opt->fit.law == CF_KIND_TAIL;
+    }
     p.solves = p.validate && !cf_table_is_force(t);
     return p;
 }
 
-/* AIC of a fit with k identifiable quantities: the report's (cf_report_fit_aic), on the plain
+/* AIC of a fit: the report's (cf_report_fit_aic, k the kind's quantities), on the plain
 ** residual sum of squares, so that the choice is the one the report's AIC rows show. */
-static double law_aic(const cf_fit_result *f, const cf_fit_report *r, int k)
+static double law_aic(const cf_fit_result *f, const cf_fit_report *r)
 {
     const double u = r->table->y_to_file;
-    return cf_baseline_aic(r->table->count, f->rss * u * u, k, r->ymax * u);
+    return cf_baseline_aic(r->table->count, f->rss * u * u, cf_fit_kind_of(f)->nq, r->ymax * u);
 }
 
-/* Keeps for fits[k] the law opt->fit.law asks for, given the tailed law's fit tail of the same
-** table and type beside the conical one in fits[k] (auto: the tailed law only with a lower AIC
-** and a feasible spring). Returns 1 when the tail was kept. */
-static int keep_law(const cf_pipeline_options *opt, cf_fit_report *r, int k,
-                    const cf_fit_result *tail)
+/* The law kinds of the plan fitted for fits[k] (the conical law's fit, to the spring or through
+** the lattice, thr[k]), each to the fit's own target, and the one kept (report.h,
+** cf_law_choice): fits[k] and thr[k] follow it. A kind that cannot be fitted leaves the choice
+** to the others, unless it alone was asked for. */
+static cf_status choose_law(const cf_table *t, const cf_pipeline_options *opt,
+                            const fit_plan *plan, cf_fit_report *r, int k, cf_error *err)
 {
     cf_law_choice *lc = &r->law_choice[k];
-    lc->ran = 1;
-    lc->aic_conical = law_aic(&r->fits[k], r, 3);
-    lc->aic_tail = law_aic(tail, r, 4);
-    lc->chose_tail = opt->fit.law == CF_KIND_TAIL ||
-                     (tail->feasible && lc->aic_tail < lc->aic_conical);
-    if (lc->chose_tail) {
-        lc->other = r->fits[k];
-        r->fits[k] = *tail;
+    const int lattice = r->through_msm && r->thr[k].done;
+    cf_through_msm thr[CF_LAW_KINDS_MAX];
+    lc->cand[0] = r->fits[k];
+    lc->aic[0] = law_aic(&r->fits[k], r);
+    thr[0] = r->thr[k];
+    lc->n = 1;
+    for (int j = 0; j < plan->nothers; j++) {
+        const cf_law_row *row = plan->others[j];
+        char what[120];
+        snprintf(what, sizeof what, "fitting the %s spring with the %s",
+                 cf_spring_type_name(r->fits[k].type), row->title);
+        progress(opt, t, "%s", what);
+        cf_error e = {0};
+        cf_fit_result *c = &lc->cand[lc->n];
+        cf_status st;
+        if (!lattice)
+            st = cf_law_kind_fit(row, t, &opt->fit, r->fits[k].type, &r->fits[k], c, &e);
+        else if (row->fit_lattice)
+            st = row->fit_lattice(t, &opt->fit, &opt->lattice, &r->fits[k], &r->thr[k], c,
+                                  &thr[lc->n], &e);
+        else
+            st = cf_error_set(&e, CF_E_DATA, "the %s cannot be fitted through the lattice",
+                              row->title);
+        if (st == CF_OK)
+            c->kind = row;
+        if (st == CF_E_INTERNAL || (st != CF_OK && plan->asked))
+            return cf_error_set(err, st, "%s", e.msg);
+        if (st != CF_OK)
+            continue;
+        lc->aic[lc->n++] = law_aic(c, r);
+    }
+    lc->ran = lc->n > 1;
+    lc->asked = plan->asked;
+    lc->chosen = 0;
+    for (int j = 1; j < lc->n; j++)
+        if (plan->asked || (lc->cand[j].feasible && lc->aic[j] < lc->aic[lc->chosen]))
+            lc->chosen = j;
+    if (lc->chosen != 0) {
+        r->fits[k] = lc->cand[lc->chosen];
+        r->thr[k] = thr[lc->chosen];
         memset(&r->limit_cost[k], 0, sizeof r->limit_cost[k]); /* measured for the conical law */
-    } else {
-        lc->other = *tail;
     }
-    return lc->chose_tail;
-}
-
-/* The tailed law fitted to the spring itself for fits[k], and the choice (keep_law). */
-static cf_status choose_law(const cf_table *t, const cf_pipeline_options *opt, cf_fit_report *r,
-                            int k, cf_error *err)
-{
-    cf_fit_result tail;
-    cf_error e = {0};
-    cf_status st = cf_fit_tail_run(t, &opt->fit, r->fits[k].type, &r->fits[k], &tail, &e);
-    if (st == CF_OK)
-        keep_law(opt, r, k, &tail);
-    /* auto keeps the conical law where the tailed one cannot be fitted (too few rows) */
-    if (st == CF_E_INTERNAL || (st != CF_OK && opt->fit.law == CF_KIND_TAIL))
-        return cf_error_set(err, st, "%s", e.msg);
-    return CF_OK;
-}
-
-/* The tailed law through the lattice for fits[k] (the conical law's fit through it, thr[k]), and
-** the choice (keep_law): thr[k] follows the law kept. A tailed law that finds no spring leaves
-** auto's choice to the conical law; --law conical-tail then fails. */
-static cf_status choose_law_in_lattice(const cf_table *t, const cf_pipeline_options *opt,
-                                       cf_fit_report *r, int k, cf_error *err)
-{
-    cf_fit_result tail;
-    cf_through_msm thr;
-    cf_error e = {0};
-    cf_status st = cf_lattice_fit_tail(t, &opt->fit, &opt->lattice, &r->fits[k], &tail, &thr, &e);
-    if (st == CF_E_INTERNAL)
-        return cf_error_set(err, st, "%s", e.msg);
-    /* the tailed law contains the conical law: where its search ends worse than the conical fit
-    ** through the lattice, or finds nothing, that fit with no tail is the tailed law's */
-    if (st != CF_OK) {
-        memset(&tail, 0, sizeof tail);
-        tail.objective = INFINITY; /* none found: nested_rmse 0 */
-    }
-    if (cf_tail_nest(&r->fits[k], &tail)) {
-        thr = r->thr[k];
-        st = CF_OK;
-    }
-    if (st != CF_OK && opt->fit.law == CF_KIND_TAIL)
-        return cf_error_set(err, st, "%s", e.msg);
-    if (st == CF_OK && keep_law(opt, r, k, &tail))
-        r->thr[k] = thr;
     return CF_OK;
 }
 
@@ -176,14 +176,11 @@ static cf_status validate_fits(const cf_table *t, const cf_pipeline_options *opt
         } else {
             progress(opt, t, "fitting the %s spring through the lattice", type);
             cf_lattice_fit(t, &opt->fit, &opt->lattice, &r->fits[k], &r->thr[k], &verr);
-            /* the tailed law through the lattice where the conical law went through it, else
-            ** (a force table, a lattice that could not run) to the spring as without it */
-            if (plan->tail && verr.status != CF_E_INTERNAL) {
-                progress(opt, t, "fitting the %s spring with a tail", type);
+            /* the other law kinds through the lattice where the conical law went through it,
+            ** else (a force table, a lattice that could not run) to the spring */
+            if (plan->nothers > 0 && verr.status != CF_E_INTERNAL) {
                 cf_error terr = {0};
-                cf_status tst = r->thr[k].done ? choose_law_in_lattice(t, opt, r, k, &terr)
-                                               : choose_law(t, opt, r, k, &terr);
-                if (tst != CF_OK)
+                if (choose_law(t, opt, plan, r, k, &terr) != CF_OK)
                     return cf_error_set(err, terr.status, "%s: %s", t->path, terr.msg);
             }
             cf_validate_lattice_fit(t, &opt->lattice, &r->fits[k], &r->val[k], &r->thr[k], &verr);
@@ -301,11 +298,8 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
                                          &r->fits[r->nfits], &e);
         if (st == CF_OK)
             st = limit_cost(t, opt, &plan, &r->fits[r->nfits], &r->limit_cost[r->nfits], &e);
-        if (st == CF_OK && plan.tail && !plan.lattice) {
-            progress(opt, t, "fitting the %s spring with a tail",
-                     cf_spring_type_name((cf_spring_type)ty));
-            st = choose_law(t, opt, r, r->nfits, &e);
-        }
+        if (st == CF_OK && plan.nothers > 0 && !plan.lattice)
+            st = choose_law(t, opt, &plan, r, r->nfits, &e);
         if (st != CF_OK)
             return cf_error_set(err, st, "%s: %s", t->path, e.msg);
         r->nfits++;

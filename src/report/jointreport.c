@@ -14,6 +14,7 @@
 #include "base/atomic.h"
 #include "conifit/version.h"
 #include "io/fitfile_json.h"
+#include "fit/lawkind.h"
 #include "report/gnuplot.h"
 #include "report/report_json.h"
 #include "report/report_notes.h"
@@ -302,13 +303,12 @@ char *cf_joint_text(const cf_joint_report *r)
                    "calibration %s (weights edge %.4g, face %.4g, body %.4g; nu %.3f)\n",
                 q[0], q[1], q[2], cf_calibration_name(j->calibration), j->weight[0],
                 j->weight[1], j->weight[2], cm.nu);
-        static const char *const names[4] = {"rho", "solid strain", "stress scale",
-                                             "tail compliance"};
-        for (int k = 0; k < (j->fit.tail ? 4 : 3); k++)
-            if (k == CF_REPORT_TAIL ? j->fit.interval_ok[CF_Q_TAIL] : j->fit.interval_ok[k]) {
+        const cf_law_row *row = cf_fit_kind_of(&j->fit);
+        for (int k = 0; k < row->nq; k++)
+            if (j->fit.interval_ok[k]) {
                 char why[512];
                 cf_report_interval_reason(&j->fit, k, why, sizeof why);
-                fprintf(o, "  * %s: %s\n", names[k], why);
+                fprintf(o, "  * %s: %s\n", row->q[k].name, why);
             }
         if (j->fit.tail) {
             char et[96];
@@ -388,7 +388,7 @@ static json_t *law_json(const cf_joint_report *r, const cf_joint_result *j)
                           num(j->objective), "feasible", j->fit.feasible, "tables",
                           per ? per : json_array());
     if (o && j->fit.tail)
-        json_object_set_new(o, "tail_compliance", cf_report_tail_json(&j->fit));
+        json_object_set_new(o, "tail_compliance", cf_report_ident_json(&j->fit, CF_Q_TAIL));
     char nested[320];
     joint_nested(j, nested, sizeof nested);
     if (o && nested[0])
@@ -517,16 +517,16 @@ static json_t *joint_json(const cf_joint_report *r)
         if (!f)
             continue;
         cf_cubic_moduli cm = cf_cubic_moduli_of(j->weight);
-        static const char *const names[3] = {"rho", "solid_strain", "stress_scale_MPa"};
+        /* the compression spring's quantities (the pair's extension spring's: pair_json) */
+        const cf_law_row *row = cf_fit_kind_of(&j->fit);
+        const char *names[CF_Q_MAX];
         json_t *ident = json_object();
-        for (int k = 0; k < 3; k++)
+        for (int k = 0; k < row->nq; k++) {
+            names[k] = row->q[k].key;
             json_object_set_new(ident, names[k], cf_report_ident_json(&j->fit, k));
-        if (j->fit.tail)
-            json_object_set_new(ident, "tail_compliance", cf_report_tail_json(&j->fit));
+        }
         json_object_set_new(f, "identifiable", ident);
-        json_object_set_new(f, "law", json_string(j->pair       ? "double-acting"
-                                                  : j->fit.tail ? "conical-tail"
-                                                                : "conical"));
+        json_object_set_new(f, "law", json_string(j->pair ? cf_law_double_row.name : row->name));
         if (j->pair)
             pair_json(f, j);
         const cf_joint_law_choice *lc = &r->law_choice[i];
@@ -544,7 +544,8 @@ static json_t *joint_json(const cf_joint_report *r)
         if (r->law_choice[i].ran)
             json_object_set_new(f, "law_comparison", law_comparison_json(r, i));
         json_object_set_new(f, "identifiable_correlation",
-                            cf_report_correlation_json(&j->fit, names));
+                            cf_report_correlation_json(&j->fit, names,
+                                                       row->ncorr ? row->ncorr : row->nq));
         json_object_set_new(f, "target", json_pack("{s:s, s:s}", "model", "lattice", "mode",
                                                    "joint"));
         json_object_set_new(

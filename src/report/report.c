@@ -18,6 +18,7 @@
 #include "report/report_json.h"
 #include "report/report_notes.h"
 #include "report/report_words.h"
+#include "fit/lawkind.h"
 
 void cf_report_free(cf_fit_report *r)
 {
@@ -52,7 +53,7 @@ int cf_report_target_is_lattice(const cf_fit_report *r)
 double cf_report_fit_aic(const cf_fit_report *r, int i)
 {
     double f = r->table->y_to_file;
-    return cf_baseline_aic(r->table->count, r->fits[i].rss * f * f, r->fits[i].tail ? 4 : 3,
+    return cf_baseline_aic(r->table->count, r->fits[i].rss * f * f, cf_fit_kind_of(&r->fits[i])->nq,
                            r->ymax * f);
 }
 
@@ -108,25 +109,35 @@ static json_t *extrapolation_json(const cf_fit_report *r, const cf_fit_result *f
     return o;
 }
 
-/* Both law kinds of fits[i]: their quality, AIC and which one the fit keeps; through_lattice
-** when both were fitted through the lattice (their RMSE and AIC are the lattice's). */
+/* The law kinds fitted for fits[i]: each one's quality, AIC, feasibility and the quantities it
+** has beyond the conical law's, and which one the fit keeps; through_lattice when they were
+** fitted through the lattice (their RMSE and AIC are the lattice's). */
 static json_t *law_comparison_json(const cf_fit_report *r, int i)
 {
     const cf_law_choice *lc = &r->law_choice[i];
-    const cf_fit_result *tail = lc->chose_tail ? &r->fits[i] : &lc->other;
-    const cf_fit_result *cone = lc->chose_tail ? &lc->other : &r->fits[i];
     const double u = r->table->y_to_file;
-    json_t *o = json_pack("{s:s, s:b, s:{s:o, s:o, s:b}, s:{s:o, s:o, s:b, s:o}}", "chosen",
-                          lc->chose_tail ? "conical-tail" : "conical", "through_lattice",
-                          r->through_msm && r->thr[i].done, "conical", "rmse",
-                          num(cone->rmse * u), "aic", num(lc->aic_conical), "feasible",
-                          cone->feasible, "conical-tail", "rmse", num(tail->rmse * u), "aic",
-                          num(lc->aic_tail), "feasible", tail->feasible, "tail_compliance",
-                          cf_report_tail_json(tail));
-    char nested[320];
-    cf_report_nested(r, tail, nested, sizeof nested);
-    if (o && nested[0]) /* the conical optimum it contains: why */
-        json_object_set_new(json_object_get(o, "conical-tail"), "no_tail", json_string(nested));
+    const cf_law_row *first = cf_fit_kind_of(&lc->cand[0]);
+    json_t *o = json_pack("{s:s, s:b}", "chosen", cf_fit_kind_of(&lc->cand[lc->chosen])->name,
+                          "through_lattice", r->through_msm && r->thr[i].done);
+    for (int j = 0; o && j < lc->n; j++) {
+        const cf_fit_result *f = &lc->cand[j];
+        const cf_law_row *row = cf_fit_kind_of(f);
+        json_t *c = json_pack("{s:o, s:o, s:b}", "rmse", num(f->rmse * u), "aic",
+                              num(lc->aic[j]), "feasible", f->feasible);
+        for (int k = 0; c && k < row->nq; k++) {
+            const char *key = cf_law_q_key(row, k, r->table);
+            int shared = 0;
+            for (int m = 0; m < first->nq; m++)
+                shared = shared || strcmp(key, cf_law_q_key(first, m, r->table)) == 0;
+            if (!shared)
+                json_object_set_new(c, key, cf_report_ident_json(f, k));
+        }
+        char nested[320];
+        cf_report_nested(r, f, nested, sizeof nested);
+        if (c && nested[0]) /* the conical optimum it contains: why */
+            json_object_set_new(c, "no_tail", json_string(nested));
+        json_object_set_new(o, row->name, c);
+    }
     return o;
 }
 
@@ -134,13 +145,13 @@ static json_t *fit_json_core(const cf_fit_report *r, int i)
 {
     const cf_fit_result *f = &r->fits[i];
     double u = r->table->y_to_file;
-    static const char *const ss_names[3] = {"rho", "solid_strain", "stress_scale_MPa"};
-    static const char *const fd_names[3] = {"rho", "travel_mm", "F_C_N"};
-    const int fd = cf_table_is_force(r->table);
-    const char *const *names = fd ? fd_names : ss_names;
+    const cf_law_row *row = cf_fit_kind_of(f);
+    const char *names[CF_Q_MAX];
     json_t *ident = json_object();
-    for (int k = 0; k < 3; k++)
+    for (int k = 0; k < row->nq; k++) {
+        names[k] = cf_law_q_key(row, k, r->table);
         json_object_set_new(ident, names[k], cf_report_ident_json(f, k));
+    }
     json_t *o = cf_fitfile_spring_json(&f->law);
     json_t *rest = json_pack(
         "{s:o, s:o, s:o, s:o, s:o, s:b, s:o, s:o, s:s, s:I, s:o}", "identifiable", ident, "rmse",
@@ -158,11 +169,8 @@ static json_t *fit_json_core(const cf_fit_report *r, int i)
     json_decref(rest);
     /* the type fitted: an infeasible fit's geometry may be of the other type */
     json_object_set_new(o, "type", json_string(cf_spring_type_name(f->type)));
-    json_object_set_new(o, "identifiable_correlation", cf_report_correlation_json(f, names));
-    json_object_set_new(o, "law", json_string(f->tail ? "conical-tail" : "conical"));
-    if (f->tail)
-        json_object_set_new(ident, fd ? "tail_compliance_mm" : "tail_compliance",
-                            cf_report_tail_json(f));
+    json_object_set_new(o, "identifiable_correlation", cf_report_correlation_json(f, names, row->ncorr ? row->ncorr : row->nq));
+    json_object_set_new(o, "law", json_string(row->name));
     if (r->law_choice[i].ran)
         json_object_set_new(o, "law_comparison", law_comparison_json(r, i));
     json_object_set_new(o, "held_by", constraint_list(f->held));

@@ -3,6 +3,7 @@
 ** their correlation (see report_json.h).
 */
 #include "report/report_json.h"
+#include "fit/lawkind.h"
 
 #include <math.h>
 
@@ -14,12 +15,15 @@
 /* Why a fit has no standard errors (and no correlation matrix), in words. */
 static const char *stderr_reason(const cf_fit_result *f)
 {
-    for (int k = 0; k < 3; k++)
+    const int nq = cf_fit_kind_of(f)->nq;
+    for (int k = 0; k < nq; k++)
         if (f->interval_ok[k] && (f->interval_why[k] & CF_FIT_RANK_DEFICIENT))
-            return f->tail ? "not determined: the Jacobian of the four quantities is singular "
+            return nq == 3 ? "not determined: the Jacobian of the three quantities is "
+                             "numerically rank-deficient (see interval)"
+                 : nq == 4 ? "not determined: the Jacobian of the four quantities is singular "
                              "(see interval)"
-                           : "not determined: the Jacobian of the three quantities is "
-                             "numerically rank-deficient (see interval)";
+                           : "not determined: the Jacobian of the fitted quantities is singular "
+                             "(see interval)";
     return "not determined: the linearised covariance s^2 (J^T W J)^-1 could not be formed";
 }
 
@@ -48,45 +52,34 @@ static void interval_json(json_t *o, const cf_fit_result *f, int k, const double
         json_decref(lim);
 }
 
-json_t *cf_report_tail_json(const cf_fit_result *f)
-{
-    json_t *o = json_pack("{s:o}", "value", num(f->q[CF_Q_TAIL]));
-    if (o && f->q_se[CF_Q_TAIL] >= 0)
-        json_object_set_new(o, "stderr", num(f->q_se[CF_Q_TAIL]));
-    else if (o)
-        json_object_set_new(o, "stderr_reason",
-                            json_string("the Jacobian of the fitted quantities is singular"));
-    if (o && f->q_se[CF_Q_TAIL] > fabs(f->q[CF_Q_TAIL]))
-        json_object_set_new(o, "determined", json_false());
-    if (o && f->interval_ok[CF_Q_TAIL])
-        interval_json(o, f, CF_REPORT_TAIL, f->interval[CF_Q_TAIL], f->interval_end[CF_Q_TAIL]);
-    return o;
-}
-
 json_t *cf_report_ident_json(const cf_fit_result *f, int k)
 {
-    double se = f->ident_se.v[k];
-    json_t *o = json_pack("{s:o}", "value", num(f->ident.v[k]));
+    double se = f->q_se[k];
+    json_t *o = json_pack("{s:o}", "value", num(f->q[k]));
     if (!o)
         return NULL;
     if (se >= 0)
         json_object_set_new(o, "stderr", num(se));
     else
         json_object_set_new(o, "stderr_reason", json_string(stderr_reason(f)));
-    if (f->tail && se > fabs(f->ident.v[k]))
+    if (cf_fit_kind_of(f) != &cf_law_conical_row && se > fabs(f->q[k]))
         json_object_set_new(o, "determined", json_false());
     if (f->interval_ok[k])
         interval_json(o, f, k, f->interval[k], f->interval_end[k]);
     return o;
 }
 
-/* {order, matrix} when every correlation is determined, else {order, reason}. */
-json_t *cf_report_correlation_json(const cf_fit_result *f, const char *const names[3])
+/* {order, matrix} of the first n quantities (names) when every correlation is determined, else
+** {order, reason}. */
+json_t *cf_report_correlation_json(const cf_fit_result *f, const char *const *names, int n)
 {
-    json_t *o = json_pack("{s:[s, s, s]}", "order", names[0], names[1], names[2]);
+    json_t *order = json_array();
+    for (int a = 0; a < n; a++)
+        json_array_append_new(order, json_string(names[a]));
+    json_t *o = json_pack("{s:o}", "order", order);
     int ok = 1;
-    for (int a = 0; a < 3; a++)
-        for (int b = 0; b < 3; b++)
+    for (int a = 0; a < n; a++)
+        for (int b = 0; b < n; b++)
             ok = ok && isfinite(f->corr[a][b]);
     if (!o)
         return NULL;
@@ -95,9 +88,9 @@ json_t *cf_report_correlation_json(const cf_fit_result *f, const char *const nam
         return o;
     }
     json_t *m = json_array();
-    for (int a = 0; a < 3; a++) {
+    for (int a = 0; a < n; a++) {
         json_t *row = json_array();
-        for (int b = 0; b < 3; b++)
+        for (int b = 0; b < n; b++)
             json_array_append_new(row, num(f->corr[a][b]));
         json_array_append_new(m, row);
     }

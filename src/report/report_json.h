@@ -13,10 +13,8 @@
 ** in conifit's units (MPa, N, mm): a key is present only with a value, never null. */
 json_t *cf_report_ident_json(const cf_fit_result *f, int k);
 
-/* {value, stderr} of a tailed fit's tail compliance e_t. */
-json_t *cf_report_tail_json(const cf_fit_result *f);
-
-/* {order: names, matrix} when every correlation is determined, else {order, reason}. */
-json_t *cf_report_correlation_json(const cf_fit_result *f, const char *const names[3]);
+/* {order: names, matrix} of the first n quantities when every correlation is determined, else
+** {order, reason}. */
+json_t *cf_report_correlation_json(const cf_fit_result *f, const char *const *names, int n);
 
 #endif

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fit/lawkind.h"
 #include "report/report_baselines.h"
 #include "report/report_notes.h"
 #include "report/report_words.h"
@@ -55,19 +56,7 @@ static void row(FILE *o, const cf_fit_report *r, const char *label, const char *
     fputc('\n', o);
 }
 
-/* value ± standard error, or value [low, high] (the profile interval, marked *) */
-static void ident_row(FILE *o, const cf_fit_report *r, const char *label, int k, double scale,
-                      const char *unit)
-{
-    fprintf(o, "  %-26s", label);
-    for (int i = 0; i < r->nfits; i++) {
-        char cell[96];
-        cf_report_ident_cell(&r->fits[i], k, scale, unit, cell, sizeof cell);
-        fprintf(o, " %-24s", cell);
-    }
-    fputc('\n', o);
-}
-
+/* 1 when a fit has a tailed spring (its tail's design parameters get rows). */
 static int any_tail(const cf_fit_report *r)
 {
     for (int i = 0; i < r->nfits; i++)
@@ -76,74 +65,145 @@ static int any_tail(const cf_fit_report *r)
     return 0;
 }
 
-/* The tailed law's fourth quantity, e_t ± its error ("-" for a fit of the conical law). */
-static void tail_row(FILE *o, const cf_fit_report *r)
+/* The row of quantity `key` (value ± standard error, or value [low, high], the profile interval
+** marked *): a cell per fit, "-" for a fit whose kind has no such quantity. */
+static void ident_row(FILE *o, const cf_fit_report *r, const cf_law_row *row, int k)
 {
-    const int fd = cf_table_is_force(r->table);
-    fprintf(o, "  %-26s", fd ? "tail compliance F_C/k_t" : "tail compliance e_t");
+    const char *key = cf_law_q_key(row, k, r->table);
+    const char *unit = cf_law_q_unit(row, k, r->table);
+    const int in_y = strcmp(unit, "y") == 0;
+    fprintf(o, "  %-26s", cf_law_q_label(row, k, r->table));
     for (int i = 0; i < r->nfits; i++) {
         const cf_fit_result *f = &r->fits[i];
+        const cf_law_row *fk = cf_fit_kind_of(f);
         char cell[96];
-        if (!f->tail)
+        int m = 0;
+        while (m < fk->nq && strcmp(cf_law_q_key(fk, m, r->table), key) != 0)
+            m++;
+        if (m == fk->nq)
             snprintf(cell, sizeof cell, "-");
-        else if (f->params.n_tail == 0) /* cf_fit_tail_run: the conical optimum it contains */
-            snprintf(cell, sizeof cell, "0 (none: conical)");
+        else if (fk->q[m].zero_text && f->q[m] == 0)
+            snprintf(cell, sizeof cell, "%s", fk->q[m].zero_text);
         else
-            cf_report_ident_cell(f, CF_REPORT_TAIL, 1, fd ? "mm" : "", cell, sizeof cell);
+            cf_report_ident_cell(f, m, in_y ? r->table->y_to_file : 1,
+                                 in_y ? r->table->y_unit : unit, cell, sizeof cell);
         fprintf(o, " %-24s", cell);
     }
     fputc('\n', o);
 }
 
-/* Both law kinds of each type, when the fit asked for the tailed one: quality, AIC, and the
-** one kept. */
+/* A row per quantity of the fits' kinds, each once, in the order of the first kind that has it. */
+static void ident_rows(FILE *o, const cf_fit_report *r)
+{
+    for (int i = 0; i < r->nfits; i++) {
+        const cf_law_row *row = cf_fit_kind_of(&r->fits[i]);
+        for (int k = 0; k < row->nq; k++) {
+            const char *key = cf_law_q_key(row, k, r->table);
+            int seen = 0;
+            for (int h = 0; h < i && !seen; h++) {
+                const cf_law_row *prev = cf_fit_kind_of(&r->fits[h]);
+                for (int m = 0; m < prev->nq; m++)
+                    seen = seen || strcmp(cf_law_q_key(prev, m, r->table), key) == 0;
+            }
+            if (!seen)
+                ident_row(o, r, row, k);
+        }
+    }
+}
+
+/* The kinds compared in law choice lc, as "the conical law (3 quantities) against the conical
+** spring with a cylindrical tail (4)". */
+static void kinds_compared(FILE *o, const cf_law_choice *lc)
+{
+    for (int j = 0; j < lc->n; j++) {
+        const cf_law_row *row = cf_fit_kind_of(&lc->cand[j]);
+        if (j == 0)
+            fprintf(o, "the %s (%d quantities)", row->title, row->nq);
+        else
+            fprintf(o, " %s the %s (%d)", j == 1 ? "against" : "and", row->title, row->nq);
+    }
+}
+
+/* Why lc kept the kind it kept, in words. */
+static const char *kept_why(const cf_fit_report *r, const cf_law_choice *lc, char *buf,
+                            size_t cap)
+{
+    if (lc->asked) {
+        snprintf(buf, cap, "asked for (--law %s)", cf_law_kind_name(r->law));
+        return buf;
+    }
+    if (lc->chosen != 0)
+        return "lower AIC";
+    /* the best of the others by AIC: infeasible, or no lower */
+    int b = 1;
+    for (int j = 2; j < lc->n; j++)
+        if (lc->aic[j] < lc->aic[b])
+            b = j;
+    const cf_law_row *row = cf_fit_kind_of(&lc->cand[b]);
+    if (!lc->cand[b].feasible)
+        snprintf(buf, cap, "%s is infeasible", row->spring);
+    else if (row->adds)
+        snprintf(buf, cap, "%s does not lower the AIC", row->adds);
+    else
+        snprintf(buf, cap, "the %s does not lower the AIC", row->title);
+    return buf;
+}
+
+/* The law kinds fitted to each type, when more than one was: quality, AIC, and the one kept. */
 static void law_choice_text(FILE *o, const cf_fit_report *r)
 {
-    if (r->law == CF_KIND_CONICAL)
+    int first = -1;
+    for (int i = 0; i < r->nfits && first < 0; i++)
+        if (r->law_choice[i].ran)
+            first = i;
+    if (first < 0)
         return;
     const double u = r->table->y_to_file;
     int lattice = r->through_msm;
     for (int i = 0; i < r->nfits; i++)
         lattice &= r->thr[i].done;
-    fprintf(o, "\nLaw (--law %s): the conical law (3 quantities) against the conical spring with "
-               "a cylindrical tail (4)%s\n", cf_law_kind_name(r->law),
-            lattice ? ", both fitted through the lattice (RMSE and AIC the lattice's)" : "");
+    if (r->fit_options.nkinds > 0)
+        fprintf(o, "\nLaw kinds compared: ");
+    else
+        fprintf(o, "\nLaw (--law %s): ", cf_law_kind_name(r->law));
+    kinds_compared(o, &r->law_choice[first]);
+    fprintf(o, "%s\n", lattice ? ", both fitted through the lattice (RMSE and AIC the lattice's)"
+                               : "");
     for (int i = 0; i < r->nfits; i++) {
         const cf_law_choice *lc = &r->law_choice[i];
         if (!lc->ran)
             continue;
-        const cf_fit_result *tail = lc->chose_tail ? &r->fits[i] : &lc->other;
-        const cf_fit_result *cone = lc->chose_tail ? &lc->other : &r->fits[i];
-        fprintf(o, "  %-16s conical      RMSE %.4g %s  AIC %.2f%s\n",
-                cf_spring_type_name(r->fits[i].type), cone->rmse * u, r->table->y_unit,
-                lc->aic_conical, cone->feasible ? "" : "  (infeasible)");
-        char nested[320];
-        cf_report_nested(r, tail, nested, sizeof nested);
-        fprintf(o, "  %-16s conical-tail RMSE %.4g %s  AIC %.2f%s%s%s%s\n", "", tail->rmse * u,
-                r->table->y_unit, lc->aic_tail, tail->feasible ? "" : "  (infeasible)",
-                nested[0] ? "  (" : "", nested, nested[0] ? ")" : "");
-        const char *why = r->law == CF_KIND_TAIL ? "asked for (--law conical-tail)"
-                          : lc->chose_tail         ? "lower AIC"
-                          : !tail->feasible        ? "the tailed spring is infeasible"
-                                                   : "the tail does not lower the AIC";
-        fprintf(o, "  %-16s kept: %s (%s)\n", "", lc->chose_tail ? "conical-tail" : "conical",
-                why);
+        for (int j = 0; j < lc->n; j++) {
+            const cf_fit_result *f = &lc->cand[j];
+            char nested[320];
+            cf_report_nested(r, f, nested, sizeof nested);
+            fprintf(o, "  %-16s %-12s RMSE %.4g %s  AIC %.2f%s%s%s%s\n",
+                    j == 0 ? cf_spring_type_name(r->fits[i].type) : "", cf_fit_kind_of(f)->name,
+                    f->rmse * u, r->table->y_unit, lc->aic[j], f->feasible ? "" : "  (infeasible)",
+                    nested[0] ? "  (" : "", nested, nested[0] ? ")" : "");
+        }
+        char why[160];
+        fprintf(o, "  %-16s kept: %s (%s)\n", "", cf_fit_kind_of(&lc->cand[lc->chosen])->name,
+                kept_why(r, lc, why, sizeof why));
     }
 }
 
 /* Below the table: what each starred interval means, per type and quantity (the tail's
 ** compliance after the three). */
-static void interval_notes(FILE *o, const cf_fit_report *r, const char *const names[4])
+static void interval_notes(FILE *o, const cf_fit_report *r)
 {
-    for (int i = 0; i < r->nfits; i++)
-        for (int k = 0; k < 4; k++) {
-            const cf_fit_result *f = &r->fits[i];
-            if (k < 3 ? !f->interval_ok[k] : !(f->tail && f->interval_ok[CF_Q_TAIL]))
+    for (int i = 0; i < r->nfits; i++) {
+        const cf_fit_result *f = &r->fits[i];
+        const cf_law_row *row = cf_fit_kind_of(f);
+        for (int k = 0; k < row->nq; k++) {
+            if (!f->interval_ok[k])
                 continue;
             char why[512];
             cf_report_interval_reason(f, k, why, sizeof why);
-            fprintf(o, "  * %s, %s: %s\n", cf_spring_type_name(f->type), names[k], why);
+            fprintf(o, "  * %s, %s: %s\n", cf_spring_type_name(f->type),
+                    cf_law_q_name(row, k, r->table), why);
         }
+    }
 }
 
 /* One cell per fit from a printf format and a value (MPa values are converted by the caller). */
@@ -357,20 +417,8 @@ static void target_text(FILE *o, const cf_fit_report *r)
 static void identifiable_text(FILE *o, const cf_fit_report *r)
 {
     fprintf(o, " identifiable (determined by the data):\n");
-    ident_row(o, r, "rho = D1/D2", 0, 1, "");
-    if (cf_table_is_force(r->table)) {
-        ident_row(o, r, "travel s", 1, 1, "mm");
-        ident_row(o, r, "solid load F_C", 2, 1, "N");
-    } else {
-        ident_row(o, r, "solid strain s/H", 1, 1, "");
-        ident_row(o, r, "stress scale F_C/H^2", 2, r->table->y_to_file, r->table->y_unit);
-    }
-    if (any_tail(r))
-        tail_row(o, r);
-    static const char *const ss_names[4] = {"rho", "solid strain", "stress scale",
-                                            "tail compliance"};
-    static const char *const fd_names[4] = {"rho", "travel", "solid load", "tail compliance"};
-    interval_notes(o, r, cf_table_is_force(r->table) ? fd_names : ss_names);
+    ident_rows(o, r);
+    interval_notes(o, r);
     fprintf(o, "  %-26s", "correlation rho-s, rho-A, s-A");
     for (int i = 0; i < r->nfits; i++) {
         char cell[64];

@@ -4,6 +4,7 @@
 ** measures came from and how its columns were converted.
 */
 #include "report/report_words.h"
+#include "fit/lawkind.h"
 #include "model/mode.h"
 
 #include <math.h>
@@ -30,12 +31,7 @@ void cf_report_append(char *buf, size_t cap, size_t *n, const char *fmt, ...)
 static int quantity(const cf_fit_result *f, int k, double *v, double *se, const double **iv,
                     const unsigned **end, unsigned *why)
 {
-    if (k == CF_REPORT_TAIL) {
-        *v = f->q[CF_Q_TAIL], *se = f->q_se[CF_Q_TAIL], *iv = f->interval[CF_Q_TAIL];
-        *end = f->interval_end[CF_Q_TAIL], *why = f->interval_why[CF_Q_TAIL];
-        return f->interval_ok[CF_Q_TAIL];
-    }
-    *v = f->ident.v[k], *se = f->ident_se.v[k], *iv = f->interval[k];
+    *v = f->q[k], *se = f->q_se[k], *iv = f->interval[k];
     *end = f->interval_end[k], *why = f->interval_why[k];
     return f->interval_ok[k];
 }
@@ -168,14 +164,18 @@ void cf_report_verdict(const cf_fit_report *r, char *buf, size_t cap)
         cf_spring_type_name(w->type), v.delta_rss / base, v.threshold / base);
     const cf_law_choice *lw = &r->law_choice[1 - v.better];
     unsigned blocked = 0;
-    if (lw->ran && !lw->chose_tail && g->tail) {
-        /* the law choice decided: the better type keeps the tailed law, the other the conical */
-        cf_report_append(buf, cap, &n, "%s keeps the conical law (the better one the "
-                                       "conical-tail law): its conical-tail fit ",
-                         cf_spring_type_name(w->type));
-        /* its tailed spring broke limits: infeasible, or held at no tail by them (tail.h,
+    const cf_law_row *gk = cf_fit_kind_of(g), *wk = cf_fit_kind_of(w);
+    const cf_fit_result *wt = NULL; /* the worse type's fit of the better one's kind */
+    for (int j = 0; lw->ran && j < lw->n; j++)
+        if (cf_fit_kind_of(&lw->cand[j]) == gk)
+            wt = &lw->cand[j];
+    if (wt && wk != gk) {
+        /* the law choice decided: the better type keeps one kind, the other another */
+        cf_report_append(buf, cap, &n, "%s keeps the %s law (the better one the %s law): its "
+                                       "%s fit ",
+                         cf_spring_type_name(w->type), wk->name, gk->name, gk->name);
+        /* its spring of that kind broke limits: infeasible, or held at no tail by them (tail.h,
         ** cf_tail_nest) */
-        const cf_fit_result *wt = &lw->other;
         const unsigned lim = !wt->feasible           ? wt->violated
                              : wt->params.n_tail == 0 ? wt->nested_violated
                                                       : 0;
@@ -189,7 +189,7 @@ void cf_report_verdict(const cf_fit_report *r, char *buf, size_t cap)
             cf_report_append(buf, cap, &n, "does not lower its AIC");
         }
         if (w->held) {
-            cf_report_append(buf, cap, &n, "; its conical fit is held by");
+            cf_report_append(buf, cap, &n, "; its %s fit is held by", wk->name);
             for (int b = 0; b < CF_C_COUNT; b++)
                 if (w->held & (1u << b))
                     cf_report_append(buf, cap, &n, " %s", cf_fit_constraint_name(1u << b));

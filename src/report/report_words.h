@@ -21,7 +21,7 @@ const char *cf_report_why(const char *note, const char *fallback);
 
 /* The index of the tailed law's fourth quantity, its tail compliance e_t, where the two below
 ** take the quantity k (0, 1, 2 the identifiable quantities). */
-#define CF_REPORT_TAIL 3
+#define CF_REPORT_TAIL CF_Q_TAIL
 
 /* Why fit f's profile interval of quantity k was computed and where its ends come from. */
 void cf_report_interval_reason(const cf_fit_result *f, int k, char *buf, size_t cap);

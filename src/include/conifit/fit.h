@@ -102,6 +102,9 @@ typedef enum cf_volume {
 cf_status cf_law_kind_parse(const char *name, cf_law_kind *f, cf_error *err);
 const char *cf_law_kind_name(cf_law_kind f);
 
+/* The most law kinds one fit compares (cf_fit_options.kinds; the conical law among them). */
+#define CF_LAW_KINDS_MAX 4
+
 typedef struct cf_fit_options {
     int fixed[CF_P_COUNT];          /* 1: held at fixed_value */
     double fixed_value[CF_P_COUNT]; /* mm, -, mm, MPa, mm as in cf_spring */
@@ -122,6 +125,10 @@ typedef struct cf_fit_options {
                                     ** polishes on every row; 0: never (default
                                     ** CF_FIT_SUBSAMPLE_ABOVE; the baselines use the same) */
     cf_law_kind law;              /* the law kind (default conical; the pipeline reads it) */
+    /* Or the law kinds to compare by AIC, listed (their rows, lawkind.h; the conical law is
+    ** always fitted first): nkinds 0 takes them from law. At most CF_LAW_KINDS_MAX. */
+    const struct cf_law_row *const *kinds;
+    int nkinds;
     cf_volume volume;               /* the volume term of a joint fit (default none) */
     double volume_value;            /* its declared kappa (MPa) or nu (-) */
 } cf_fit_options;

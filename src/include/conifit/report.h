@@ -19,15 +19,19 @@
 /* One table and its fits, as the report sees it (cf_pipeline_fit fills it). Values of the fits
 ** are in conifit's units (MPa or N); table->y_to_file converts them to the file's own unit for
 ** display and JSON. */
-/* Both law kinds fitted to one type (cf_fit_options.law conical-tail or auto): the one in
-** fits[] and the other one, with their AIC (n ln(RSS_w/n) + 2 k, k = 3 quantities for the conical
-** law and 4 for the tailed one, on the weighted residuals). auto keeps the tailed law only when its
-** AIC is lower and its spring is feasible. */
+/* The law kinds fitted to one type (cf_fit_options.law conical-tail or auto, or the kinds a
+** caller lists in cf_fit_options.kinds): each one's fit and AIC (n ln(RSS_w/n) + 2 k, k the
+** kind's number of quantities, lawkind.h, on the weighted residuals), and the one kept in fits[]:
+** the feasible one of lowest AIC, the conical law where no other is feasible and lower, or the
+** one kind asked for. */
 typedef struct cf_law_choice {
-    int ran;               /* 1: both laws were fitted */
-    cf_fit_result other;   /* the law not in fits[] */
-    double aic_conical, aic_tail;
-    int chose_tail;        /* 1: fits[] holds the tailed law */
+    int ran;                                /* 1: more than one kind was fitted */
+    int n;                                  /* kinds fitted: cand[0] the conical law, then the
+                                            ** others in the order asked */
+    cf_fit_result cand[CF_LAW_KINDS_MAX];  /* their fits (cand[chosen] is fits[]'s) */
+    double aic[CF_LAW_KINDS_MAX];
+    int chosen;                             /* index of the one kept */
+    int asked;                              /* 1: kept because it alone was asked for */
 } cf_law_choice;
 
 typedef struct cf_fit_report {
