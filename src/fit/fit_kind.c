@@ -254,7 +254,10 @@ static void summarise(kfit *c, const cf_fit_options *opt, cf_spring_type type, c
     res->params = c->row->member(res->q, c->fd, type);
     cf_law_init(&res->law, &res->params, NULL);
     res->feasible = cf_fit_check(&res->params, type, c->t, opt, &res->active, &res->violated);
-    res->solid_ratio = INFINITY;
+    const cf_ident fam = cf_ident_of_type(&res->params, type, c->fd);
+    const double xmax = cf_lsq_xmax(c->t);
+    res->solid_table_strain = fam.solid;
+    res->solid_ratio = xmax > 0 ? fam.solid / xmax : INFINITY;
 }
 
 static cf_status generic_fit(const cf_law_row *row, const cf_table *t, const cf_fit_options *opt,

@@ -139,3 +139,11 @@ const cf_law_row *cf_fit_kind_of(const cf_fit_result *f)
 {
     return f->kind ? f->kind : f->tail ? &cf_law_tail_row : &cf_law_conical_row;
 }
+
+cf_ident cf_fit_family(const cf_fit_result *f, int force_displacement)
+{
+    const cf_law_row *row = cf_fit_kind_of(f);
+    if (row->fit || row == &cf_law_conical_row || row == &cf_law_double_row)
+        return f->ident;
+    return cf_ident_of_type(&f->params, f->type, force_displacement);
+}

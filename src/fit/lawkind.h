@@ -79,6 +79,10 @@ const char *cf_law_q_unit(const cf_law_row *row, int k, const cf_table *t);
 ** tailed one by f->tail. */
 const cf_law_row *cf_fit_kind_of(const cf_fit_result *f);
 
+/* The cone family (family.h) of fit f's spring: its first three quantities for the conical
+** kinds, which are that family; for a kind of other quantities, its member's family. */
+cf_ident cf_fit_family(const cf_fit_result *f, int force_displacement);
+
 /* Fits kind row to table t for spring type `type`: the row's own fitter, or the generic fit
 ** (weighted least squares over log q within the row's range, NLopt BOBYQA then its errors
 ** s^2 (J^T W J)^-1 and profile intervals where a quantity sits on its range or is not

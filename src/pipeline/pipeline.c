@@ -226,7 +226,7 @@ static cf_status limit_cost(const cf_table *t, const cf_pipeline_options *opt,
 ** mode the cell cannot follow to solid leaves the spring's own solid strain. */
 static void solid_in_mode(const cf_table *t, const cf_pipeline_options *opt, cf_fit_result *f)
 {
-    if (cf_table_is_force(t) || cf_mode_row_of(t->mode)->spring_curve || !(f->ident.solid > 0))
+    if (cf_table_is_force(t) || cf_mode_row_of(t->mode)->spring_curve || !(cf_fit_family(f, 0).solid > 0))
         return;
     double xmax = 0;
     int side = 1;

@@ -97,9 +97,9 @@ static void limit_cost_json(json_t *o, const cf_fit_report *r, int i)
 static json_t *extrapolation_json(const cf_fit_report *r, const cf_fit_result *f)
 {
     const int fd = cf_table_is_force(r->table);
-    const double at = f->solid_table_strain > 0 ? f->solid_table_strain : f->ident.solid;
-    json_t *o = json_pack("{s:o, s:o, s:o, s:b}", fd ? "travel_mm" : "solid_strain",
-                          num(f->ident.solid), fd ? "largest_displacement_mm" : "largest_strain",
+    const double solid = cf_fit_family(f, fd).solid;
+    const double at = f->solid_table_strain > 0 ? f->solid_table_strain : solid;
+    json_t *o = json_pack("{s:o, s:o, s:o, s:b}", fd ? "travel_mm" : "solid_strain", num(solid), fd ? "largest_displacement_mm" : "largest_strain",
                           num(at / f->solid_ratio), "ratio", num(f->solid_ratio), "warning",
                           f->solid_ratio < CF_FIT_SOLID_RATIO_WARN);
     if (o && !fd) {

@@ -77,7 +77,8 @@ static unsigned law_blocked_for(const cf_fit_report *r, const cf_fit_result *g, 
     const cf_ident_design d = {o->lower[CF_P_N], o->upper[CF_P_N], o->upper[CF_P_G],
                                o->D2_over_H_max, o->index_max, o->rho_min};
     const int fd = cf_table_is_force(r->table);
-    const double rho = g->ident.rho, B = g->ident.solid, A = g->ident.scale;
+    const cf_ident gi = cf_fit_family(g, fd);
+    const double rho = gi.rho, B = gi.solid, A = gi.scale;
     double best = INFINITY;
     unsigned bits = 0;
     const int steps = fd ? 400 : 1;
@@ -206,7 +207,8 @@ void cf_report_verdict(const cf_fit_report *r, char *buf, size_t cap)
                          "no limit of %s is active where its fit ended, but the law %s fits "
                          "(rho %.4g) is no %s spring within the limit%s",
                          cf_spring_type_name(w->type), cf_spring_type_name(g->type),
-                         g->ident.rho, cf_spring_type_name(w->type),
+                         cf_fit_family(g, cf_table_is_force(r->table)).rho,
+                         cf_spring_type_name(w->type),
                          (blocked & (blocked - 1)) ? "s" : "");
         for (int b = 0; b < CF_C_COUNT; b++)
             if (blocked & (1u << b))

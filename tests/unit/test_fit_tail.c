@@ -110,7 +110,7 @@ static void fitted_of(const cf_fit_result *f, double q[4])
     q[0] = f->ident.rho;
     q[1] = f->ident.solid;
     q[2] = f->ident.scale;
-    q[3] = f->e_tail;
+    q[3] = f->q[CF_Q_TAIL];
 }
 
 static void recover(cf_spring p, cf_spring_type type)
@@ -155,7 +155,7 @@ static void noisy_spring_is_within_its_errors(void **state)
     cf_fit_result r;
     cf_error err = {0};
     assert_int_equal(cf_fit_tail_run(&t, &o, CF_NON_TELESCOPING, NULL, &r, &err), CF_OK);
-    double q[4], f[4], se[4] = {r.ident_se.rho, r.ident_se.solid, r.ident_se.scale, r.e_tail_se};
+    double q[4], f[4], se[4] = {r.ident_se.rho, r.ident_se.solid, r.ident_se.scale, r.q_se[CF_Q_TAIL]};
     truth_of(&p, q);
     fitted_of(&r, f);
     for (int k = 0; k < 4; k++) {
@@ -166,7 +166,7 @@ static void noisy_spring_is_within_its_errors(void **state)
     /* every quantity determined, none on a limit: no profile intervals (the plain law's rule) */
     for (int k = 0; k < 3; k++)
         assert_false(r.interval_ok[k]);
-    assert_false(r.e_tail_interval_ok);
+    assert_false(r.interval_ok[CF_Q_TAIL]);
     cf_table_free(&t);
 }
 
@@ -183,19 +183,19 @@ static void undetermined_quantities_get_profile_intervals(void **state)
     cf_fit_result r;
     cf_error err = {0};
     assert_int_equal(cf_fit_tail_run(&t, &o, CF_NON_TELESCOPING, NULL, &r, &err), CF_OK);
-    double q[4], f[4], se[4] = {r.ident_se.rho, r.ident_se.solid, r.ident_se.scale, r.e_tail_se};
+    double q[4], f[4], se[4] = {r.ident_se.rho, r.ident_se.solid, r.ident_se.scale, r.q_se[CF_Q_TAIL]};
     truth_of(&p, q);
     fitted_of(&r, f);
     int undetermined = 0;
     for (int k = 0; k < 4; k++)
         undetermined += se[k] < 0 || se[k] > fabs(f[k]);
     assert_true(undetermined > 0);
-    const double *iv[4] = {r.interval[0], r.interval[1], r.interval[2], r.e_tail_interval};
+    const double *iv[4] = {r.interval[0], r.interval[1], r.interval[2], r.interval[CF_Q_TAIL]};
     const unsigned *end[4] = {r.interval_end[0], r.interval_end[1], r.interval_end[2],
-                              r.e_tail_interval_end};
+                              r.interval_end[CF_Q_TAIL]};
     for (int k = 0; k < 3; k++)
         assert_true(r.interval_ok[k]);
-    assert_true(r.e_tail_interval_ok);
+    assert_true(r.interval_ok[CF_Q_TAIL]);
     for (int k = 0; k < 4; k++) {
         assert_true(isfinite(iv[k][0]) && isfinite(iv[k][1]));
         if (!(iv[k][0] <= f[k] && f[k] <= iv[k][1]))
@@ -249,9 +249,9 @@ static int auto_on(const char *name, const char *mode, cf_table *t, cf_fit_repor
         const cf_law_choice *lc = &r->law_choice[i];
         assert_true(lc->ran);
         /* never the tail without an AIC gain */
-        if (lc->chose_tail)
-            assert_true(lc->aic_tail < lc->aic_conical && r->fits[i].feasible);
-        assert_int_equal(r->fits[i].tail, lc->chose_tail);
+        if (lc->chosen)
+            assert_true(lc->aic[1] < lc->aic[0] && r->fits[i].feasible);
+        assert_int_equal(r->fits[i].tail, lc->chosen);
     }
     return 1;
 }
@@ -267,15 +267,15 @@ static void auto_keeps_the_tail_where_it_gains(void **state)
     ** Fung's 189 Pa */
     int kept = 0;
     for (int i = 0; i < r.nfits; i++)
-        if (r.law_choice[i].chose_tail) {
+        if (r.law_choice[i].chosen) {
             kept = 1;
-            assert_true(r.fits[i].rmse < 0.6 * r.law_choice[i].other.rmse);
+            assert_true(r.fits[i].rmse < 0.6 * r.law_choice[i].cand[1 - r.law_choice[i].chosen].rmse);
             /* its four quantities trade off (the cone closes near the table's end): each has a
             ** profile interval around its value */
             const cf_fit_result *f = &r.fits[i];
-            assert_true(f->e_tail_interval_ok);
-            assert_true(f->e_tail_interval[0] <= f->e_tail && f->e_tail <= f->e_tail_interval[1]);
-            assert_true(f->e_tail_interval[1] > f->e_tail_interval[0]);
+            assert_true(f->interval_ok[CF_Q_TAIL]);
+            assert_true(f->interval[CF_Q_TAIL][0] <= f->q[CF_Q_TAIL] && f->q[CF_Q_TAIL] <= f->interval[CF_Q_TAIL][1]);
+            assert_true(f->interval[CF_Q_TAIL][1] > f->interval[CF_Q_TAIL][0]);
             for (int k = 0; k < 3; k++) {
                 assert_true(f->interval_ok[k]);
                 assert_true(f->interval[k][0] <= f->ident.v[k] &&
@@ -295,7 +295,7 @@ static void auto_keeps_the_conical_law_where_the_tail_cannot_help(void **state)
     if (!auto_on("brain_cortex_tension.csv", NULL, &t, &r))
         skip();
     for (int i = 0; i < r.nfits; i++) {
-        assert_false(r.law_choice[i].chose_tail);
+        assert_false(r.law_choice[i].chosen);
         assert_false(r.fits[i].tail);
     }
     cf_report_free(&r);
@@ -326,7 +326,7 @@ static void profile_reaches_the_other_pieces_of_a_flat_valley(void **state)
                      f->interval[0][0], f->interval[0][1]);
         double lim_in, lim_out;
         const double u0 = log(f->ident.rho), ue = log(f->interval[0][1]);
-        cf_fit_result plain = r.law_choice[i].other;
+        cf_fit_result plain = r.law_choice[i].cand[1 - r.law_choice[i].chosen];
         const double in = cf_tail_profile_at(&t, &r.fit_options, &plain, f, 0,
                                              exp(ue - 0.03 * (ue - u0)), &lim_in);
         const double out = cf_tail_profile_at(&t, &r.fit_options, &plain, f, 0,
@@ -364,8 +364,8 @@ static void assert_nested(const cf_fit_report *r, const char *what)
     for (int i = 0; i < r->nfits; i++) {
         const cf_law_choice *lc = &r->law_choice[i];
         assert_true(lc->ran);
-        const cf_fit_result *tail = lc->chose_tail ? &r->fits[i] : &lc->other;
-        const cf_fit_result *cone = lc->chose_tail ? &lc->other : &r->fits[i];
+        const cf_fit_result *tail = lc->chosen ? &r->fits[i] : &lc->cand[1 - lc->chosen];
+        const cf_fit_result *cone = lc->chosen ? &lc->cand[1 - lc->chosen] : &r->fits[i];
         assert_true(tail->tail && !cone->tail);
         if (cone->feasible && !tail->feasible)
             fail_msg("%s, %s: the tailed fit is infeasible (RMSE %g) where the conical one is "
@@ -399,9 +399,9 @@ static void tailed_fit_never_loses_to_the_conical_law(void **state)
             assert_true(r.fits[i].feasible);
             if (laws[l] == CF_KIND_TAIL) { /* kept as asked, with no tail */
                 assert_true(r.fits[i].tail);
-                assert_true(r.fits[i].e_tail == 0 && r.fits[i].params.n_tail == 0);
-                assert_true(fabs(r.fits[i].rmse - r.law_choice[i].other.rmse) <=
-                            1e-12 * r.law_choice[i].other.rmse);
+                assert_true(r.fits[i].q[CF_Q_TAIL] == 0 && r.fits[i].params.n_tail == 0);
+                assert_true(fabs(r.fits[i].rmse - r.law_choice[i].cand[1 - r.law_choice[i].chosen].rmse) <=
+                            1e-12 * r.law_choice[i].cand[1 - r.law_choice[i].chosen].rmse);
             }
         }
         cf_report_free(&r);
@@ -486,7 +486,7 @@ static void tail_coils_are_limited_like_the_cone(void **state)
                 fail_msg("n_max %g: a feasible %s spring with %g tail coils", lim,
                          cf_spring_type_name(f->type), f->params.n_tail);
             if (f->feasible && f->params.n_tail > 0 &&
-                f->rmse < 0.6 * r.law_choice[i].other.rmse) {
+                f->rmse < 0.6 * r.law_choice[i].cand[1 - r.law_choice[i].chosen].rmse) {
                 gained = 1;
                 assert_true(f->held & CF_C_COILS_MAX);
             }

@@ -301,7 +301,7 @@ static void brain_cortex_stable_pair_below_half_of_ogden(void **state)
     if (!(j->objective <= 0.01715))
         fail_msg("objective %.6g above half of one-term Ogden's 0.0343 (0.01715)", j->objective);
     assert_true(j->pair && j->fit.feasible && j->ext.feasible);
-    assert_true(j->fit.tail && j->fit.params.n_tail > 0 && j->fit.e_tail > 0);
+    assert_true(j->fit.tail && j->fit.params.n_tail > 0 && j->fit.q[CF_Q_TAIL] > 0);
     assert_true(r.law_choice[b].pair_tail_kept && r.law_choice[b].alt_stable &&
                 r.law_choice[b].alt_objective > j->objective);
     assert_true(j->volume_modulus_MPa > 0 && isfinite(j->nu_compression) &&
