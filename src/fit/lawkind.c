@@ -147,3 +147,14 @@ cf_ident cf_fit_family(const cf_fit_result *f, int force_displacement)
         return f->ident;
     return cf_ident_of_type(&f->params, f->type, force_displacement);
 }
+
+int cf_law_pick(const cf_law_standing *s, int n, int asked)
+{
+    if (asked >= 0 && asked < n)
+        return asked;
+    int kept = 0;
+    for (int j = 1; j < n; j++)
+        if (s[j].feasible && s[j].aic < s[kept].aic && (s[j].stable || !s[kept].stable))
+            kept = j;
+    return kept;
+}

@@ -79,6 +79,19 @@ const char *cf_law_q_unit(const cf_law_row *row, int k, const cf_table *t);
 ** tailed one by f->tail. */
 const cf_law_row *cf_fit_kind_of(const cf_fit_result *f);
 
+/* Where one fitted law kind stands in a law choice. */
+typedef struct cf_law_standing {
+    int feasible; /* its spring (or pair) is buildable within the limits */
+    int stable;   /* its lattice is stable over every table's range (1 where not checked) */
+    double aic;   /* its AIC (k its number of quantities) */
+} cf_law_standing;
+
+/* The one law choice of every fit (single, joint, pair): the index of the kind kept among the n
+** fitted, s[0] the incumbent (the conical law, or the single-sided law a pair is compared with).
+** asked >= 0: that one, asked for by name. Otherwise a kind replaces the one kept so far only
+** when it is feasible, has a lower AIC, and is stable or the one kept is not either. */
+int cf_law_pick(const cf_law_standing *s, int n, int asked);
+
 /* The cone family (family.h) of fit f's spring: its first three quantities for the conical
 ** kinds, which are that family; for a kind of other quantities, its member's family. */
 cf_ident cf_fit_family(const cf_fit_result *f, int force_displacement);

@@ -126,6 +126,7 @@ static cf_status choose_law(const cf_table *t, const cf_pipeline_options *opt,
         progress(opt, t, "%s", what);
         cf_error e = {0};
         cf_fit_result *c = &lc->cand[lc->n];
+        thr[lc->n] = r->thr[k]; /* a kind fitted to the spring leaves the lattice record */
         cf_status st;
         if (!lattice)
             st = cf_law_kind_fit(row, t, &opt->fit, r->fits[k].type, &r->fits[k], c, &e);
@@ -145,10 +146,10 @@ static cf_status choose_law(const cf_table *t, const cf_pipeline_options *opt,
     }
     lc->ran = lc->n > 1;
     lc->asked = plan->asked;
-    lc->chosen = 0;
-    for (int j = 1; j < lc->n; j++)
-        if (plan->asked || (lc->cand[j].feasible && lc->aic[j] < lc->aic[lc->chosen]))
-            lc->chosen = j;
+    cf_law_standing st[CF_LAW_KINDS_MAX];
+    for (int j = 0; j < lc->n; j++)
+        st[j] = (cf_law_standing){lc->cand[j].feasible, 1, lc->aic[j]};
+    lc->chosen = cf_law_pick(st, lc->n, plan->asked && lc->n > 1 ? 1 : -1);
     if (lc->chosen != 0) {
         r->fits[k] = lc->cand[lc->chosen];
         r->thr[k] = thr[lc->chosen];

@@ -8,6 +8,17 @@
 #include <string.h>
 
 #include "conifit/joint.h"
+#include "fit/lawkind.h"
+
+/* 1 when the joint fit b is kept over a (the one law choice, cf_law_pick): asked for, or
+** feasible with a lower joint AIC and a lattice stable over every table's range unless a's is
+** not either. */
+static int pick(const cf_joint_result *a, const cf_joint_result *b, int asked)
+{
+    const cf_law_standing s[2] = {{a->fit.feasible, cf_joint_stable(a), a->aic},
+                                  {b->fit.feasible, cf_joint_stable(b), b->aic}};
+    return cf_law_pick(s, 2, asked ? 1 : -1) == 1;
+}
 
 /* The tailed law's joint fit beside the conical one in fits[k], and the law kept: --law
 ** conical-tail the tail, auto the tail only with a lower joint AIC, a feasible spring and a
@@ -36,9 +47,7 @@ static cf_status choose_law(const cf_table *const *tables, size_t n,
     lc->ran = 1;
     /* auto keeps a tail whose lattice loses stability inside a table's range only when the
     ** conical law's does too */
-    lc->chose_tail = opt->fit.law == CF_KIND_TAIL ||
-                     (tail.fit.feasible && tail.aic < r->fits[k].aic &&
-                      (cf_joint_stable(&tail) || !cf_joint_stable(&r->fits[k])));
+    lc->chose_tail = pick(&r->fits[k], &tail, opt->fit.law == CF_KIND_TAIL);
     if (lc->chose_tail) {
         lc->other = r->fits[k];
         r->fits[k] = tail;
@@ -131,9 +140,7 @@ static cf_status choose_pair(const cf_table *const *tables, size_t n,
     lc->pair_ran = 1;
     /* auto keeps a pair whose lattice loses stability inside a table's range only when the
     ** single-sided law's does too */
-    lc->chose_pair = opt->fit.law == CF_KIND_DOUBLE ||
-                     (pair.fit.feasible && pair.aic < r->fits[k].aic &&
-                      (cf_joint_stable(&pair) || !cf_joint_stable(&r->fits[k])));
+    lc->chose_pair = pick(&r->fits[k], &pair, opt->fit.law == CF_KIND_DOUBLE);
     if (lc->chose_pair) {
         lc->pair_other = r->fits[k];
         r->fits[k] = pair;

@@ -61,7 +61,10 @@ json_t *cf_report_ident_json(const cf_fit_result *f, int k)
     if (se >= 0)
         json_object_set_new(o, "stderr", num(se));
     else
-        json_object_set_new(o, "stderr_reason", json_string(stderr_reason(f)));
+        json_object_set_new(o, "stderr_reason",
+                            json_string(k < CF_IDENT_COUNT ? stderr_reason(f)
+                                                           : "the Jacobian of the fitted "
+                                                             "quantities is singular"));
     if (cf_fit_kind_of(f) != &cf_law_conical_row && se > fabs(f->q[k]))
         json_object_set_new(o, "determined", json_false());
     if (f->interval_ok[k])
