@@ -9,6 +9,9 @@
 #include <string.h>
 
 #include <gsl/gsl_eigen.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
+#include <gsl/gsl_permutation.h>
 
 #include "conifit/cell.h"
 #include "conifit/family.h"
@@ -117,45 +120,29 @@ static int pair_jacobian(jctx *c, const double v[PQ_COUNT], const int *idx, int 
 }
 
 /* The Levenberg-Marquardt step: (A + lambda diag A) delta = b for the p x p normal equations A
-** (a zero diagonal entry damped by lambda), by Gaussian elimination with partial pivoting (at most
-** eight unknowns). 1 when the system is singular. */
+** (a zero diagonal entry damped by lambda), by GSL's LU decomposition with partial pivoting. 1
+** when the system is singular. */
 static int lm_step(double A[PQ_COUNT][PQ_COUNT], const double b[PQ_COUNT], int p,
                    double lambda, double delta[PQ_COUNT])
 {
-    double M[PQ_COUNT][PQ_COUNT + 1];
+    double M[PQ_COUNT * PQ_COUNT], rhs[PQ_COUNT];
+    size_t perm_data[PQ_COUNT];
     for (int a = 0; a < p; a++) {
         for (int bb = 0; bb < p; bb++)
-            M[a][bb] = A[a][bb] + (a == bb ? lambda * (A[a][a] > 0 ? A[a][a] : 1) : 0);
-        M[a][p] = b[a];
+            M[a * p + bb] = A[a][bb] + (a == bb ? lambda * (A[a][a] > 0 ? A[a][a] : 1) : 0);
+        rhs[a] = b[a];
     }
-    int singular = 0;
-    for (int col = 0; col < p && !singular; col++) {
-        int piv = col;
-        for (int row = col + 1; row < p; row++)
-            if (fabs(M[row][col]) > fabs(M[piv][col]))
-                piv = row;
-        if (!(fabs(M[piv][col]) > 0)) {
-            singular = 1;
-            break;
-        }
-        for (int q = 0; q <= p; q++) {
-            const double t = M[col][q];
-            M[col][q] = M[piv][q];
-            M[piv][q] = t;
-        }
-        for (int row = col + 1; row < p; row++) {
-            const double fct = M[row][col] / M[col][col];
-            for (int q = col; q <= p; q++)
-                M[row][q] -= fct * M[col][q];
-        }
-    }
-    for (int a = p - 1; a >= 0 && !singular; a--) {
-        double t = M[a][p];
-        for (int q = a + 1; q < p; q++)
-            t -= M[a][q] * delta[q];
-        delta[a] = t / M[a][a];
-    }
-    return singular;
+    gsl_matrix_view m = gsl_matrix_view_array(M, (size_t)p, (size_t)p);
+    gsl_vector_view bv = gsl_vector_view_array(rhs, (size_t)p);
+    gsl_vector_view x = gsl_vector_view_array(delta, (size_t)p);
+    gsl_permutation perm = {(size_t)p, perm_data};
+    int signum;
+    if (gsl_linalg_LU_decomp(&m.matrix, &perm, &signum) != GSL_SUCCESS)
+        return 1;
+    for (int a = 0; a < p; a++) /* a zero pivot: singular (GSL would divide by it) */
+        if (!(fabs(M[a * p + a]) > 0))
+            return 1;
+    return gsl_linalg_LU_solve(&m.matrix, &perm, &bv.vector, &x.vector) != GSL_SUCCESS;
 }
 
 /* Levenberg-Marquardt from v over the used quantities (logarithms of the scales and kappa, the
