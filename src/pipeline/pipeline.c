@@ -316,6 +316,7 @@ cf_status cf_pipeline_fit(const cf_table *t, const cf_pipeline_options *opt, cf_
         return vst;
     for (int k = 0; k < r->nfits; k++)
         solid_in_mode(t, opt, &r->fits[k]);
+    cf_report_settle(r);
     return CF_OK;
 }
 

@@ -28,18 +28,24 @@ void cf_report_free(cf_fit_report *r)
         cf_validation_free(&r->val[i]);
 }
 
-int cf_report_better(const cf_fit_report *r)
+void cf_report_settle(cf_fit_report *r)
 {
     CF_GSL_GUARD;
+    memset(&r->verdict, 0, sizeof r->verdict);
     if (r->nfits == 2)
-        return cf_fit_compare(&r->fits[0], &r->fits[1], r->table->count).better;
-    return r->nfits == 1 && r->fits[0].feasible ? 0 : -1;
+        r->verdict = cf_fit_compare(&r->fits[0], &r->fits[1], r->table->count);
+    else
+        r->verdict.better = r->nfits == 1 && r->fits[0].feasible ? 0 : -1;
+}
+
+int cf_report_better(const cf_fit_report *r)
+{
+    return r->verdict.better;
 }
 
 int cf_report_types_tie(const cf_fit_report *r)
 {
-    CF_GSL_GUARD;
-    return r->nfits == 2 && cf_fit_compare(&r->fits[0], &r->fits[1], r->table->count).tie;
+    return r->nfits == 2 && r->verdict.tie;
 }
 
 int cf_report_target_is_lattice(const cf_fit_report *r)
@@ -369,7 +375,7 @@ static json_t *report_json(const cf_fit_report *r)
         json_object_set_new(root, "better_type", json_string(cf_spring_type_name(r->fits[b].type)));
     if (r->nfits == 2 && b >= 0) {
         int o = 1 - b;
-        cf_fit_verdict v = cf_fit_compare(&r->fits[0], &r->fits[1], r->table->count);
+        const cf_fit_verdict v = r->verdict;
         char text[1024];
         cf_report_verdict(r, text, sizeof text);
         json_t *c = json_pack("{s:b, s:s, s:s, s:o, s:o, s:o}", "tie", tie, "verdict", text,

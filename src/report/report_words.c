@@ -131,7 +131,7 @@ void cf_report_verdict(const cf_fit_report *r, char *buf, size_t cap)
 {
     size_t n = 0;
     buf[0] = '\0';
-    cf_fit_verdict v = cf_fit_compare(&r->fits[0], &r->fits[1], r->table->count);
+    const cf_fit_verdict v = r->verdict;
     if (v.better < 0) {
         cf_report_append(buf, cap, &n, "no verdict: neither type has a spring inside its limits");
         return;

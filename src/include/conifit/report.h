@@ -53,6 +53,10 @@ typedef struct cf_fit_report {
     cf_limit_cost limit_cost[2]; /* what the limits holding fits[i] cost (checked when held) */
     cf_law_kind law;          /* the law kind asked for (fit.h) */
     cf_law_choice law_choice[2]; /* for fits[i], both laws (ran = 0 with the conical law alone) */
+    /* The verdict on the two types, made once when the fit is made (cf_pipeline_fit) and read by
+    ** every part of the report: with two fits cf_fit_compare's; with one, better 0 when its
+    ** spring is feasible, else -1 (tie 0). */
+    cf_fit_verdict verdict;
 } cf_fit_report;
 
 /* Longest warning sentence, and the most a report states. */
@@ -66,6 +70,9 @@ int cf_report_warnings(const cf_fit_report *r, char (*out)[CF_REPORT_WARNING_LEN
 
 /* Releases what the report owns (the validations' curves). Safe on a zeroed report. */
 void cf_report_free(cf_fit_report *r);
+
+/* Makes r's verdict (above) from its fits; cf_pipeline_fit calls it last. */
+void cf_report_settle(cf_fit_report *r);
 
 /* Index of the better fit in r->fits: the feasible one with the lower objective (-1 if none);
 ** on a tie (cf_report_types_tie) this is the one a command uses, never one the report names. */
