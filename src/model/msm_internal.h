@@ -39,7 +39,8 @@ typedef struct solver {
     double *tmp;              /* per-spring scratch */
     /* the tangent (msm_tangent.c) and its linear solver, which holds the matrix, its scale and
     ** its factorisations (linsolve.h) */
-    cf_linsolve *ls;          /* NULL until the first direction */
+    cf_linsolve *ls;          /* NULL until the first direction; it assembles through a pointer
+                                 to this struct, which must not move while it is there */
     size_t nnz;               /* entries of the tangent's pattern */
     int *map;                 /* spring q's blocks ii, jj, ij, ji: entry (a, b) of block blk at
                                  index map[q * 36 + 9 * blk + 3 a + b] of the values, -1 fixed */

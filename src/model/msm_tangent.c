@@ -219,6 +219,11 @@ static cf_status build_tangent(solver *s, cf_error *err)
     st = cf_linsolve_create(&s->ls, n, C.p, C.i, fill, s, s->cfg->banded_only, err);
     free(C.p);
     free(C.i);
+    if (st != CF_OK) { /* built again on the next direction */
+        free(s->map);
+        free(s->vmap);
+        s->map = s->vmap = NULL;
+    }
     return st;
 oom:
     free(adj);
