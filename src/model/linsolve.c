@@ -1,7 +1,7 @@
 /*
-** Linear solves with sparse symmetric matrices (see linsolve.h): the solver object, the scaling, and
-** the cascade sparse Cholesky or L D L^T (CHOLMOD, MUMPS: sparse_chol.h), banded LDL^T, dense LU,
-** GMRES.
+** Linear solves with sparse symmetric matrices (see linsolve.h): the solver object, the scaling,
+** and the cascade sparse Cholesky or L D L^T (CHOLMOD, MUMPS: sparse_chol.h), banded LDL^T,
+** dense LU, GMRES.
 */
 #include "model/linsolve_internal.h"
 
@@ -89,6 +89,12 @@ void cf_linsolve_free(cf_linsolve *s)
     free(s->kval);
     free(s->kbasis);
     free(s);
+}
+
+void cf_linsolve_pattern(const cf_linsolve *s, const int **colp, const int **rowi)
+{
+    *colp = s->C->p;
+    *rowi = s->C->i;
 }
 
 long cf_linsolve_neg_pivots(const cf_linsolve *s)
@@ -305,7 +311,8 @@ static cf_status gmres_direction(cf_linsolve *s, const double *b, double *x, cf_
     }
     /* Stagnation near rounding is accepted when the update is still accurate to a few digits:
     ** Newton corrects the rest (inexact Newton). */
-    if (status != GSL_SUCCESS && gsl_splinalg_itersolve_normr(w) <= GMRES_ACCEPT * gsl_blas_dnrm2(bv))
+    if (status != GSL_SUCCESS &&
+        gsl_splinalg_itersolve_normr(w) <= GMRES_ACCEPT * gsl_blas_dnrm2(bv))
         status = GSL_SUCCESS;
     if (status != GSL_SUCCESS) {
         st = cf_error_set(err, CF_E_NOCONV,

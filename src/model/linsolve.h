@@ -38,6 +38,10 @@ cf_status cf_linsolve_create(cf_linsolve **out, size_t n, const int *colp, const
                              cf_linsolve_fill *fill, void *ctx, int banded_only, cf_error *err);
 void cf_linsolve_free(cf_linsolve *ls);
 
+/* The solver's copy of the pattern (valid while it lives): *colp the column starts, *rowi the
+** rows; an entry's index there is its index in the values fill writes. */
+void cf_linsolve_pattern(const cf_linsolve *ls, const int **colp, const int **rowi);
+
 /* Assembles the matrix A (through fill), scales it and solves A x = b by the cascade. *solves
 ** (may be NULL) is increased by the linear solves done: one per factorisation accepted, one per
 ** GMRES restart. The inertia found is then cf_linsolve_neg_pivots(). */

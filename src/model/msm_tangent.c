@@ -14,7 +14,7 @@
 /* A pattern in compressed columns: the column starts p[n + 1], the rows i[p[n]], increasing
 ** within each column. */
 typedef struct ccs {
-    int *p, *i;
+    const int *p, *i;
 } ccs;
 
 static void fill(void *ctx, double *v);
@@ -104,12 +104,12 @@ static int node_adjacency(const cf_lattice *lat, uint32_t *adj, unsigned char *d
     return bad;
 }
 
-/* The compressed-column pattern of the free DOFs with the pattern of adj into C: C->p (n + 1
-** column starts) given, C->i allocated here. 1 when out of memory. */
-static int pattern(const solver *s, const uint32_t *adj, const unsigned char *deg, ccs *C)
+/* The compressed-column pattern of the free DOFs that adj couples: its n + 1 column starts into
+** colp, its rows into *rowi (allocated here). 1 when out of memory. */
+static int pattern(const solver *s, const uint32_t *adj, const unsigned char *deg, int *colp,
+                   int **rowi)
 {
     const size_t n = s->ndof, nn = s->lat->nn;
-    int *colp = C->p;
     /* the column of free DOF e = eq[3 p + a] holds the free DOFs of the nodes adjacent to p */
     size_t nnz = 0;
     for (size_t e = 0; e <= n; e++)
@@ -126,7 +126,8 @@ static int pattern(const solver *s, const uint32_t *adj, const unsigned char *de
     for (size_t e = 0; e < n; e++)
         colp[e + 1] += colp[e];
     nnz = (size_t)colp[n];
-    if (!(C->i = malloc((nnz ? nnz : 1) * sizeof(int))))
+    int *ri = malloc((nnz ? nnz : 1) * sizeof(int));
+    if (!(*rowi = ri))
         return 1;
     for (size_t p = 0; p < nn; p++)
         for (int a = 0; a < 3; a++) {
@@ -138,14 +139,14 @@ static int pattern(const solver *s, const uint32_t *adj, const unsigned char *de
                 for (int b = 0; b < 3; b++) {
                     long row = s->eq[3 * (size_t)adj[p * MAXADJ + k] + b];
                     if (row >= 0)
-                        C->i[at++] = (int)row;
+                        ri[at++] = (int)row;
                 }
             /* rows in increasing order within the column (at most 81: insertion sort) */
             for (int x = colp[col] + 1; x < at; x++) {
-                int v = C->i[x], y = x - 1;
-                for (; y >= colp[col] && C->i[y] > v; y--)
-                    C->i[y + 1] = C->i[y];
-                C->i[y + 1] = v;
+                int v = ri[x], y = x - 1;
+                for (; y >= colp[col] && ri[y] > v; y--)
+                    ri[y + 1] = ri[y];
+                ri[y + 1] = v;
             }
         }
     return 0;
@@ -190,9 +191,9 @@ static void block_map(solver *s, const ccs *C)
     }
 }
 
-/* The sparsity pattern of the tangent, built once: for every spring the positions in the values
-** of its four 3 x 3 blocks (ii, jj, ij, ji), so that assembly is a pass of additions; then the
-** linear solver of that pattern. */
+/* The sparsity pattern of the tangent, built once, and the linear solver of that pattern; then
+** for every spring the positions in the values of its four 3 x 3 blocks (ii, jj, ij, ji), and the
+** volume term's, so that assembly is a pass of additions. */
 static cf_status build_tangent(solver *s, cf_error *err)
 {
     cf_lattice *lat = s->lat;
@@ -200,40 +201,39 @@ static cf_status build_tangent(solver *s, cf_error *err)
     const size_t nn = lat->nn;
     uint32_t *adj = malloc((nn ? nn : 1) * MAXADJ * sizeof(uint32_t));
     unsigned char *deg = calloc(nn ? nn : 1, 1);
-    ccs C = {malloc((n + 1) * sizeof(int)), NULL};
-    cf_status st = CF_OK;
-    const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
-    if (!adj || !deg || !C.p || node_adjacency(lat, adj, deg) || pattern(s, adj, deg, &C))
-        goto oom;
+    int *colp = malloc((n + 1) * sizeof(int)), *rowi = NULL;
+    if (!adj || !deg || !colp || node_adjacency(lat, adj, deg) ||
+        pattern(s, adj, deg, colp, &rowi)) {
+        free(adj);
+        free(deg);
+        free(colp);
+        free(rowi);
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent matrix");
+    }
     free(adj);
     free(deg);
-    adj = NULL;
-    deg = NULL;
+    s->nnz = (size_t)colp[n];
+    cf_status st = cf_linsolve_create(&s->ls, n, colp, rowi, fill, s, s->cfg->banded_only, err);
+    free(colp);
+    free(rowi);
+    if (st != CF_OK)
+        return st;
+    const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
     s->map = malloc((lat->ns ? lat->ns : 1) * 36 * sizeof(int));
     if (lat->cfg.volume_modulus_MPa != 0)
         s->vmap = malloc(nc * 8 * 8 * 9 * sizeof(int));
-    if (!s->map || (lat->cfg.volume_modulus_MPa != 0 && !s->vmap))
-        goto oom;
-    block_map(s, &C);
-    s->nnz = (size_t)C.p[n];
-    st = cf_linsolve_create(&s->ls, n, C.p, C.i, fill, s, s->cfg->banded_only, err);
-    free(C.p);
-    free(C.i);
-    if (st != CF_OK) { /* built again on the next direction */
+    if (!s->map || (lat->cfg.volume_modulus_MPa != 0 && !s->vmap)) {
         free(s->map);
         free(s->vmap);
         s->map = s->vmap = NULL;
+        cf_linsolve_free(s->ls); /* built again on the next direction */
+        s->ls = NULL;
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent matrix");
     }
-    return st;
-oom:
-    free(adj);
-    free(deg);
-    free(C.p);
-    free(C.i);
-    free(s->map);
-    free(s->vmap);
-    s->map = s->vmap = NULL;
-    return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent matrix");
+    ccs C;
+    cf_linsolve_pattern(s->ls, &C.p, &C.i);
+    block_map(s, &C);
+    return CF_OK;
 }
 
 /* The volume term's tangent added into v: per cell, kappa/H^3 g_a g_b^T + kappa (J - 1) d2V/dx_a
