@@ -9,6 +9,7 @@
 
 #include "conifit/calibration.h"
 #include "model/linsolve.h"
+#include "model/msm_tangent.h"
 
 /* Bytes per node and per spring of the lattice and the solver state (positions, reference
 ** positions, forces, masses, velocities; spring ends, lengths, weights, tensions, law state), and
@@ -18,10 +19,10 @@
 #define SPRING_BYTES 200.0
 #define SAMPLE_BYTES 64.0
 /* The static and implicit solvers, with the limits of their cascade (model/linsolve.h): the sparse
-** tangent (3 CF_LINSOLVE_MAX_ADJ entries a row at most, counted at 64 bytes each), the banded
+** tangent (3 CF_MSM_TANGENT_MAX_ADJ entries a row at most, counted at 64 bytes each), the banded
 ** factor when it fits in CF_LINSOLVE_BAND_MAX_ENTRIES entries, else a dense LU up to
 ** CF_LINSOLVE_DENSE_MAX_DOF unknowns, else a GMRES basis of CF_LINSOLVE_GMRES_RESTART vectors. */
-#define TANGENT_ROW_BYTES (3.0 * CF_LINSOLVE_MAX_ADJ * 64.0)
+#define TANGENT_ROW_BYTES (3.0 * CF_MSM_TANGENT_MAX_ADJ * 64.0)
 /* A law table: two values an end and four coefficients an interval (model/law.c). */
 #define LAW_TABLE_BYTES 48.0
 

@@ -8,7 +8,7 @@
 ** in a few steps, each one solve with the old factors and one product with the new tangent: far
 ** cheaper than a new factorisation (at 24^3 cells one factorisation costs about 30 solves).
 */
-#include "model/msm_internal.h"
+#include "model/linsolve_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -43,9 +43,9 @@ static double dot(const double *a, const double *b, size_t n)
 }
 
 /* Workspace: the current tangent's values and the two bases, kept between calls. */
-static int workspace(solver *s)
+static int workspace(cf_linsolve *s)
 {
-    const size_t n = s->ndof, nnz = (size_t)s->C->p[n];
+    const size_t n = s->n, nnz = (size_t)s->C->p[n];
     if (!s->kval)
         s->kval = malloc((nnz ? nnz : 1) * sizeof(double));
     if (!s->kbasis)
@@ -53,11 +53,12 @@ static int workspace(solver *s)
     return s->kval && s->kbasis;
 }
 
-int cf_linsolve_krylov(solver *s, double need, int *fatal, cf_error *err)
+int cf_linsolve_krylov(cf_linsolve *s, const double *b, double *x, double need, int *fatal,
+                       cf_error *err)
 {
     const double eta = fmin(fmax(0.1 * need, KRYLOV_ETA_MIN), KRYLOV_ETA_MAX);
     const double take = fmin(fmax(need, KRYLOV_ETA_MAX), KRYLOV_TAKE_MAX);
-    const size_t n = s->ndof, m = KRYLOV_MAX;
+    const size_t n = s->n, m = KRYLOV_MAX;
     *fatal = 0;
     if (!s->chol || !s->C || n == 0)
         return 0;
@@ -66,11 +67,12 @@ int cf_linsolve_krylov(solver *s, double need, int *fatal, cf_error *err)
         cf_error_set(err, CF_E_INTERNAL, "out of memory for the Krylov steps");
         return 0;
     }
-    cf_linsolve_tangent_scaled(s, s->kval);
+    s->fill(s->ctx, s->kval); /* the current matrix, scaled as the factored one */
+    cf_linsolve_scale(s, s->kval);
     double *V = s->kbasis, *Z = s->kbasis + (m + 1) * n; /* V: m + 1 vectors, Z = M^-1 V: m */
     double H[KRYLOV_MAX + 1][KRYLOV_MAX], cs[KRYLOV_MAX], sn[KRYLOV_MAX], g[KRYLOV_MAX + 1];
     for (size_t e = 0; e < n; e++)
-        V[e] = s->R[e] / s->D[e];
+        V[e] = b[e] / s->D[e];
     const double beta = sqrt(dot(V, V, n));
     if (!(beta > 0) || !isfinite(beta))
         return 0;
@@ -130,8 +132,8 @@ int cf_linsolve_krylov(solver *s, double need, int *fatal, cf_error *err)
         double t = 0;
         for (size_t i = 0; i < k; i++)
             t += y[i] * Z[i * n + e];
-        s->dx[e] = t / s->D[e];
-        ok = isfinite(s->dx[e]);
+        x[e] = t / s->D[e];
+        ok = isfinite(x[e]);
     }
     return ok;
 }

@@ -2,7 +2,7 @@
 ** Solvers for the mass-spring lattice (see msm.h): the defaults, the loading path and the runner,
 ** which reaches each sample by static equilibria (msm_newton.c), implicit viscous steps
 ** (msm_visco.c) or explicit dynamics (msm_dynamic.c). The uniaxial curve and its stability are in
-** msm_uniaxial.c, the linear solves in linsolve.c.
+** msm_uniaxial.c, the tangent in msm_tangent.c, which hands it to the linear solver (linsolve.h).
 */
 #include "model/msm_internal.h"
 #include "base/gslguard.h"

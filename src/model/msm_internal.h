@@ -1,6 +1,6 @@
 /*
-** The workspace the lattice solvers share (msm.c, msm_newton.c, msm_visco.c, msm_dynamic.c,
-** msm_uniaxial.c, linsolve.c) and the functions they call in one another. Private to the model
+** The workspace the lattice solvers share (msm.c, msm_newton.c, msm_tangent.c, msm_visco.c,
+** msm_dynamic.c, msm_uniaxial.c) and the functions they call in one another. Private to the model
 ** layer.
 */
 #ifndef CF_MODEL_MSM_INTERNAL_H
@@ -9,13 +9,10 @@
 #include <math.h>
 #include <stddef.h>
 
-#include <gsl/gsl_matrix.h>
-#include <gsl/gsl_spmatrix.h>
-
 #include "conifit/msm.h"
 #include "model/lattice_step.h"
 #include "model/linsolve.h"
-#include "model/sparse_chol.h"
+#include "model/msm_tangent.h"
 
 /* Bisections of a load increment (or time step) before a solve is declared non-converged. */
 #define MAX_BISECT 12
@@ -30,7 +27,7 @@ typedef struct solver {
     cf_msm_drive drive;
     size_t ndof;              /* free DOFs */
     long *eq;                 /* node*3+axis -> equation or -1 */
-    double *R, *D, *dx;       /* residual, Jacobi scale, update (ndof) */
+    double *R, *dx;           /* residual, update (ndof) */
     double *xsave;            /* 3 nn positions for backtracking */
     double *Tx0, *kx, *Lprev; /* quasi-static extras per spring (NULL when static) */
     double *sigm;             /* Maxwell branch stress per spring, MPa (NULL when off) */
@@ -40,25 +37,22 @@ typedef struct solver {
     double qlv_scale;         /* step's law-force factor minus 1 (Prony terms; 0 when off) */
     double qlv_slope;         /* its growth per unit |strain| of the spring (0: quasi-linear) */
     double *tmp;              /* per-spring scratch */
-    /* the tangent and its factorisations (linsolve.c) */
-    gsl_spmatrix *C;          /* tangent, compressed columns, pattern built once */
-    int *map, *diag;          /* spring block -> C->data index; DOF -> its diagonal index */
+    /* the tangent (msm_tangent.c) and its linear solver, which holds the matrix, its scale and
+    ** its factorisations (linsolve.h) */
+    cf_linsolve *ls;          /* NULL until the first direction; it assembles through a pointer
+                                 to this struct, which must not move while it is there */
+    size_t nnz;               /* entries of the tangent's pattern */
+    int *map;                 /* spring q's blocks ii, jj, ij, ji: entry (a, b) of block blk at
+                                 index map[q * 36 + 9 * blk + 3 a + b] of the values, -1 fixed */
     int *vmap;                /* the volume term's blocks: cell c's (a, b) entry (i, k) at
                                  vmap[((c * 8 + a) * 8 + b) * 9 + i * 3 + k] (NULL without one) */
-    size_t band;              /* half-bandwidth of C (largest |row - col|) */
-    gsl_matrix *AB;           /* banded LDL^T workspace, ndof x (band + 1); NULL until used */
-    cf_sparse_chol *chol;     /* sparse factorisation of C (pattern analysed once); NULL until used */
-    int chol_failed;          /* 1: the sparse factorisation could not be set up; not retried */
     long neg_pivots;          /* negative pivots of the last factored tangent, -1 unknown */
     int chord;                /* reuse factorisations across iterations and load steps (chord
                                  steps, cf_msm_newton) */
-    int chol_ready;           /* s->chol holds the factors of C, scaled by s->D, for a chord step */
     int refactor;             /* the next direction needs a fresh tangent */
     int krylov;               /* the factored tangent no longer gives chord steps that converge:
                                  directions solve the current tangent by Krylov steps with those
                                  factors as preconditioner (linsolve_krylov.c) until a refactor */
-    double *kval;             /* the current tangent, C's pattern, scaled by s->D (Krylov steps) */
-    double *kbasis;           /* their Krylov basis and preconditioned basis; NULL until used */
     /* secant predictor of the static load steps (the uniaxial curve): the converged positions at
     ** the drive value before the current one (xprev, 3 nn as cf_msm_positions_get), vprev that
     ** value, prev_ok whether they are there; xcur scratch. NULL/0 unless secant is set. */
@@ -121,6 +115,18 @@ double cf_msm_reported_stress(solver *s);
 /* Copies the positions of every node into buf (3 nn doubles: x, then y, then z), and back. */
 void cf_msm_positions_get(const cf_lattice *lat, double *buf);
 void cf_msm_positions_set(cf_lattice *lat, const double *buf);
+
+/* msm_tangent.c: the tangent at the state of the last cf_msm_residual() and the Newton update
+** s->dx it gives for s->R. cf_msm_direction assembles and factors it (the pattern and the linear
+** solver built on first use), noting its inertia in s->neg_pivots and the statistics;
+** cf_msm_factored tells whether the factors of the last direction are there; cf_msm_chord solves
+** with them (a chord step), cf_msm_krylov solves the current tangent by GMRES preconditioned with
+** them (cf_linsolve_chord, cf_linsolve_krylov: 1 when s->dx holds the update, *fatal on an
+** out-of-memory no fallback would survive). */
+cf_status cf_msm_direction(solver *s, cf_error *err);
+int cf_msm_factored(const solver *s);
+int cf_msm_chord(solver *s, int *fatal, cf_error *err);
+int cf_msm_krylov(solver *s, double need, int *fatal, cf_error *err);
 
 /* msm_visco.c: implicit quasi-static steps with dashpots, Maxwell branches and Prony terms */
 cf_status cf_msm_relaxed_share_check(const solver *s, cf_error *err);

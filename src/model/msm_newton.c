@@ -31,7 +31,6 @@ void cf_msm_solver_free(solver *s)
 {
     free(s->eq);
     free(s->R);
-    free(s->D);
     free(s->dx);
     free(s->xsave);
     free(s->Tx0);
@@ -43,16 +42,9 @@ void cf_msm_solver_free(solver *s)
     free(s->tmp);
     free(s->map);
     free(s->vmap);
-    free(s->diag);
-    free(s->kval);
-    free(s->kbasis);
     free(s->xprev);
     free(s->xcur);
-    if (s->C)
-        gsl_spmatrix_free(s->C);
-    if (s->AB)
-        gsl_matrix_free(s->AB);
-    cf_sparse_chol_free(s->chol);
+    cf_linsolve_free(s->ls);
 }
 
 static int is_prescribed(const solver *s, size_t node, int axis)
@@ -89,9 +81,8 @@ cf_status cf_msm_solver_init(solver *s, cf_lattice *lat, const cf_msm_effects *f
             s->eq[3 * p + a] = is_prescribed(s, p, a) ? -1 : (long)n++;
     s->ndof = n;
     s->R = calloc(n ? n : 1, sizeof(double));
-    s->D = calloc(n ? n : 1, sizeof(double));
     s->dx = calloc(n ? n : 1, sizeof(double));
-    if (!s->R || !s->D || !s->dx)
+    if (!s->R || !s->dx)
         goto oom;
     if (fx && (fx->eta_MPa_s > 0 || fx->maxwell_E_MPa > 0 || fx->prony_count > 0)) {
         s->Tx0 = calloc(lat->ns, sizeof(double));
@@ -262,12 +253,12 @@ cf_status cf_msm_newton(solver *s, cf_error *err)
         cf_error lerr = {0};
         /* a step from the last factored tangent while it still converges fast: a chord step, or
         ** once chord steps stall, a Krylov solve of the current tangent preconditioned by it */
-        const int reuse = s->chord && s->chol_ready && !s->refactor;
+        const int reuse = s->chord && cf_msm_factored(s) && !s->refactor;
         if (reuse) {
             int fatal = 0;
             /* a Krylov solve only as accurate as this step needs */
-            const int got = s->krylov ? cf_linsolve_krylov(s, target / rn, &fatal, &lerr)
-                                      : cf_linsolve_chord(s, &fatal, &lerr);
+            const int got = s->krylov ? cf_msm_krylov(s, target / rn, &fatal, &lerr)
+                                      : cf_msm_chord(s, &fatal, &lerr);
             if (!got) {
                 if (fatal) {
                     cf_msm_positions_set(lat, start);
@@ -279,7 +270,7 @@ cf_status cf_msm_newton(solver *s, cf_error *err)
             }
             if (s->st)
                 s->st->chord_iters++;
-        } else if (cf_linsolve_direction(s, &lerr) != CF_OK) {
+        } else if (cf_msm_direction(s, &lerr) != CF_OK) {
             if (lerr.status == CF_E_INTERNAL) { /* out of memory: not a matter of step size */
                 cf_msm_positions_set(lat, start);
                 free(start);

@@ -119,7 +119,7 @@ static long inertia_here(solver *s, int *oom)
     cf_msm_residual(s, &rn, &fs);
     s->neg_pivots = -1;
     cf_error e = {0};
-    if (cf_linsolve_direction(s, &e) == CF_E_INTERNAL || e.status == CF_E_INTERNAL)
+    if (cf_msm_direction(s, &e) == CF_E_INTERNAL || e.status == CF_E_INTERNAL)
         *oom = 1;
     return s->neg_pivots;
 }
@@ -261,7 +261,7 @@ cf_status cf_msm_homogeneous_inertias(const cf_law *law, cf_law_method m,
             for (size_t k = 0; k < s.ndof; k++)
                 s.R[k] = 1.0;
             cf_error e = {0};
-            (void)cf_linsolve_direction(&s, &e);
+            (void)cf_msm_direction(&s, &e);
             *neg = s.neg_pivots;
             if (*neg < 0)
                 rc = cf_error_set(err, CF_E_NOCONV, "strain %g: no factorisation of the tangent "

@@ -13,9 +13,9 @@
 **    a Maxwell branch (its tau) and of a Prony term (its tau_i, amplitude g_i);
 **  - cf_msm_stability_limit: stable just below the limit, unstable just above;
 **  - cf_msm_stable_step: the step an explicit run reports, shortened by dashpots;
-**  - the steps on reused factors of the static solver (private: model/linsolve_krylov.c and the
-**    chord steps and secant predictor of model/msm_newton.c): a Krylov step solves the current
-**    tangent, and the uniaxial curve through those steps equals the one Newton finds with a fresh
+**  - the steps on reused factors of the static solver (private: model/msm_tangent.c over
+**    model/linsolve_krylov.c, and the chord steps and secant predictor of model/msm_newton.c): a
+**    Krylov step solves the current tangent, and the uniaxial curve through those steps equals the one Newton finds with a fresh
 **    tangent at every iteration, past the stability limit, with a fraction of the factorisations.
 */
 #include "testutil.h"
@@ -440,8 +440,8 @@ static void krylov_step_solves_the_current_tangent(void **state)
     solve_at(&s, 0.30);
     double rn, fs;
     cf_msm_residual(&s, &rn, &fs);
-    assert_int_equal(cf_linsolve_direction(&s, &err), CF_OK);
-    assert_true(s.chol_ready);
+    assert_int_equal(cf_msm_direction(&s, &err), CF_OK);
+    assert_true(cf_msm_factored(&s));
     assert_int_equal(s.neg_pivots, 0); /* still stable */
     /* a state further on, its residual solved three ways */
     s.load = 0.33;
@@ -456,12 +456,12 @@ static void krylov_step_solves_the_current_tangent(void **state)
     assert_non_null(kry);
     assert_non_null(chord);
     int fatal = 0;
-    assert_int_equal(cf_linsolve_krylov(&s, 1e-9, &fatal, &err), 1);
+    assert_int_equal(cf_msm_krylov(&s, 1e-9, &fatal, &err), 1);
     assert_int_equal(fatal, 0);
     memcpy(kry, s.dx, n * sizeof *kry);
-    assert_int_equal(cf_linsolve_chord(&s, &fatal, &err), 1);
+    assert_int_equal(cf_msm_chord(&s, &fatal, &err), 1);
     memcpy(chord, s.dx, n * sizeof *chord);
-    assert_int_equal(cf_linsolve_direction(&s, &err), CF_OK); /* a fresh factorisation */
+    assert_int_equal(cf_msm_direction(&s, &err), CF_OK); /* a fresh factorisation */
     const double dk = rel_dist(kry, s.dx, n), dc = rel_dist(chord, s.dx, n);
     assert_true(s.neg_pivots > 0); /* and past the stability limit: the factors are of a
                                        positive definite tangent, the current one is not */
