@@ -12,7 +12,7 @@
 #include <gsl/gsl_matrix.h>
 #include <gsl/gsl_spmatrix.h>
 
-#include "conifit/msm.h"
+#include "model/msm.h"
 #include "model/lattice_step.h"
 #include "model/linsolve.h"
 #include "model/sparse_chol.h"

@@ -10,9 +10,9 @@
 #include "base/gslguard.h"
 #include "conifit/tablefit.h"
 #include "fit/lawkind.h"
-#include "conifit/measure.h"
-#include "conifit/pipeline.h"
-#include "conifit/report.h"
+#include "io/measure.h"
+#include "pipeline/pipeline.h"
+#include "report/report.h"
 
 struct cf_tablefit {
     cf_table table;    /* the report points at it: the handle never moves */

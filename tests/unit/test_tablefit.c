@@ -12,8 +12,8 @@
 
 #include "conifit/tablefit.h"
 #include "fit/lawkind.h"
-#include "conifit/measure.h"
-#include "conifit/pipeline.h"
+#include "io/measure.h"
+#include "pipeline/pipeline.h"
 
 static void refused(cf_status got, cf_status want, const cf_error *e, const char *needle)
 {
