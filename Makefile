@@ -64,7 +64,8 @@ OPT     := -O1 -g
 endif
 
 # Sources by layer (README, "Architecture"): src/LAYER/*.c. The library is every layer but cli/;
-# public headers live in src/include/conifit/, private ones beside their sources.
+# the public headers (what a program calls, at most 10: tests/check_public.sh) live in
+# src/include/conifit/ and are installed, every other header beside its sources in src/LAYER/.
 CLI_SRC := $(wildcard src/cli/*.c)
 LIB_SRC := $(filter-out $(CLI_SRC),$(wildcard src/*/*.c))
 LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
@@ -167,6 +168,7 @@ $(BUILD)/tests/%: tests/%.c $(LIB_A)
 
 test: check-deps $(BUILD)/conifit $(LIB_SO) $(TESTS) $(REPLAYS)
 	@sh tests/check_layers.sh
+	@CC='$(CC)' sh tests/check_public.sh
 	@sh tests/check_cycles.sh $(LIB_OBJ)
 	@sh tests/check_size.sh
 	@sh tests/exports.sh check $(LIB_SO)

@@ -6,8 +6,8 @@
 
 #include <stdio.h>
 
-#include "conifit/body.h"
-#include "conifit/mesh.h"
+#include "model/body.h"
+#include "io/mesh.h"
 #include "testutil.h"
 
 #define SPRING "\"spring\": {\"params\": {\"D1_mm\": 10, \"D2_mm\": 30, \"n\": 4, \"d_mm\": 1, " \

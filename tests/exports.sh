@@ -1,13 +1,15 @@
 #!/bin/sh
 # The public interface of libconifit is the set of cf_* functions declared in the headers of
-# src/include/conifit/. Two uses:
+# src/include/conifit/ (the installed ones; every other header is internal, beside its sources in
+# src/LAYER/, and its functions stay local to the shared library; a name in a comment is not a
+# declaration). Two uses:
 #   exports.sh list OBJECT...   those of them the objects define (the shared library's version
 #                               script is made from this list)
 #   exports.sh check LIB.so     exit 1 naming every dynamic symbol the library defines that is
 #                               not such a function, and every such function it does not export
 cd "$(dirname "$0")/.." || exit 70
 declared() {
-  cat src/include/conifit/*.h | tr -s ' \n\t' '   ' | grep -oE '\bcf_[A-Za-z0-9_]+ ?\(' |
+  cat src/include/conifit/*.h | tr -s ' \n\t' '   ' | sed -E 's#/\*([^*]|\*+[^*/])*\*+/##g' | grep -oE '\bcf_[A-Za-z0-9_]+ ?\(' |
     tr -d ' (' | sort -u
 }
 case $1 in

@@ -7,7 +7,7 @@
 
 #include <stdio.h>
 
-#include "conifit/measure.h"
+#include "io/measure.h"
 #include "testutil.h"
 
 /* The shared tables STEM_MODE.csv for the n modes given (e.g. "brain_cortex" and tension,

@@ -124,7 +124,7 @@ static inline int tu_exec(const char *dir, const char *env_extra, char *const ar
 /* Fails unless the text files a and b hold the same lines with the same words, where a word that
 ** reads as a number (strtod, whole word) need only agree with its counterpart to rel relatively
 ** (|x - y| <= rel * max(|x|, |y|)). For outputs whose numbers pass through the vector copies of the
-** law or the lattice (conifit/law.h, cf_simd_level), which round differently from one another. */
+** law or the lattice (model/simd.h, cf_simd_level), which round differently from one another. */
 #define assert_text_close(a, b, rel) tu_assert_text_close((a), (b), (rel), __FILE__, __LINE__)
 static inline void tu_assert_text_close(const char *a, const char *b, double rel, const char *file,
                                         int line)

@@ -8,7 +8,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "conifit/viscomodel.h"
+#include "model/viscomodel.h"
 
 /* A ramp to compressive strain 0.3 (table's sign: -0.3) in 30 s, then held to 330 s: 16 ramp
 ** points, 20 hold points spaced geometrically (the protocol of the published muscle tables). */

@@ -1,15 +1,15 @@
 /*
 ** Hysteresis, residual strain and recovery of a scene's run (see hysteresis.h).
 */
-#include "conifit/hysteresis.h"
+#include "check/hysteresis.h"
 #include "base/gslguard.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-#include "conifit/budget.h"
-#include "conifit/lattice.h"
+#include "io/budget.h"
+#include "model/lattice.h"
 
 size_t cf_hysteresis_first_unstable(const cf_msm_sample *s, size_t n)
 {

@@ -1,7 +1,7 @@
 /*
 ** Validation of fitted springs in the static uniaxial lattice (see validate.h).
 */
-#include "conifit/validate.h"
+#include "check/validate.h"
 #include "model/mode.h"
 #include "base/gslguard.h"
 
@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "conifit/cell_stability.h"
+#include "model/cell_stability.h"
 #include "fit/clock.h"
 #include "fit/lattice_curve.h"
 #include "fit/lsq.h"

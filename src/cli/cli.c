@@ -5,7 +5,7 @@
 
 #include "base/safetext.h"
 
-#include "conifit/scene.h"
+#include "io/scene.h"
 
 #include <ctype.h>
 #include <errno.h>

@@ -9,10 +9,10 @@
 #include <getopt.h>
 #include <stdio.h>
 
-#include "conifit/budget.h"
+#include "io/budget.h"
 #include "conifit/error.h"
 #include "conifit/law.h"
-#include "conifit/table.h"
+#include "model/table.h"
 
 #include "conifit/version.h"
 #include "base/atomic.h"

@@ -14,9 +14,9 @@
 #include "base/atomic.h"
 #include "cli/cli.h"
 #include "cli/cli_probe.h"
-#include "conifit/body.h"
-#include "conifit/budget.h"
-#include "conifit/mesh.h"
+#include "model/body.h"
+#include "io/budget.h"
+#include "io/mesh.h"
 #include "report/vtu.h"
 
 typedef struct run {

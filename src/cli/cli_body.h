@@ -5,11 +5,11 @@
 #ifndef CF_CLI_BODY_H
 #define CF_CLI_BODY_H
 
-#include "conifit/body.h"
-#include "conifit/budget.h"
-#include "conifit/mesh.h"
-#include "conifit/export.h"
-#include "conifit/scene.h"
+#include "model/body.h"
+#include "io/budget.h"
+#include "io/mesh.h"
+#include "export/export.h"
+#include "io/scene.h"
 
 /* Runs sc (sc->has_body) and writes out (CSV, "-" for standard output) and, when vtu_dir is not
 ** NULL, vtu_dir/body_NNNN.vtu, springs_NNNN.vtu and body.pvd, and when png is not NULL the

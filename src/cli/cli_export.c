@@ -11,10 +11,10 @@
 #include "base/atomic.h"
 #include "cli/cli.h"
 #include "pipeline/export.h"
-#include "conifit/export.h"
-#include "conifit/fitfile.h"
-#include "conifit/budget.h"
-#include "conifit/scene.h"
+#include "export/export.h"
+#include "io/fitfile.h"
+#include "io/budget.h"
+#include "io/scene.h"
 #include "cli/cli_body.h"
 
 static const char export_help[] =

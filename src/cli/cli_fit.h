@@ -5,9 +5,9 @@
 #ifndef CF_CLI_FIT_H
 #define CF_CLI_FIT_H
 
-#include "conifit/measure.h"
-#include "conifit/pipeline.h"
-#include "conifit/viscofit.h"
+#include "io/measure.h"
+#include "pipeline/pipeline.h"
+#include "fit/viscofit.h"
 
 typedef struct fit_args {
     const char **files;

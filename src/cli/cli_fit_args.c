@@ -9,8 +9,8 @@
 #include "cli/cli.h"
 #include "cli/cli_fit.h"
 #include "cli/cli_summary.h"
-#include "conifit/calibration.h"
-#include "conifit/fit.h"
+#include "model/calibration.h"
+#include "fit/fit.h"
 #include "conifit/spring.h"
 #include "report/plot.h"
 

@@ -18,7 +18,7 @@
 #include "base/atomic.h"
 #include "cli/cli.h"
 #include "cli/cli_body.h"
-#include "conifit/mesh.h"
+#include "io/mesh.h"
 #include "report/plot.h"
 
 typedef struct haptic_run {

@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "cli/cli.h"
-#include "conifit/fitfile.h"
+#include "io/fitfile.h"
 
 static const char force_help[] =
     "usage: conifit force SPRING --u MM [--method M] [-o FILE]\n"

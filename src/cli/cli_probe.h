@@ -8,9 +8,9 @@
 #include <stddef.h>
 
 #include "base/atomic.h"
-#include "conifit/body.h"
-#include "conifit/budget.h"
-#include "conifit/scene.h"
+#include "model/body.h"
+#include "io/budget.h"
+#include "io/scene.h"
 
 /* Draws the probe's force against depth of the n steps (cf_plot_probe) to png as a temporary left
 ** in *out for the caller to commit with its other outputs. Errors as cf_plot_probe. */

@@ -27,7 +27,7 @@
 #include "cli/cli.h"
 #include "cli/cli_shard.h"
 #include "cli/cli_summary.h"
-#include "conifit/fitfile.h"
+#include "io/fitfile.h"
 
 static int parse_kn(const char *v, long *k, long *n)
 {

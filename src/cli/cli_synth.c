@@ -14,7 +14,7 @@
 #include <gsl/gsl_rng.h>
 
 #include "cli/cli.h"
-#include "conifit/measure.h"
+#include "io/measure.h"
 
 static const char synth_help[] =
     "usage: conifit synth SPRING [--strain-max E] [--points N] [--noise REL] [--seed S]\n"

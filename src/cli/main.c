@@ -14,7 +14,7 @@
 #include "base/atomic.h"
 #include "cli/cli.h"
 #include "cli/cli_shard.h"
-#include "conifit/law.h"
+#include "model/simd.h"
 
 typedef struct command {
     const char *name;

@@ -3,7 +3,7 @@
 ** CalculiX/Abaqus *SPRING, FEBio discrete material, LS-DYNA material and curve), the JSON spring,
 ** and the runnable models (export_model.c) of one spring (--example) or of the whole lattice.
 */
-#include "conifit/export.h"
+#include "export/export.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -12,7 +12,7 @@
 
 #include <jansson.h>
 
-#include "conifit/lattice.h"
+#include "model/lattice.h"
 #include "conifit/version.h"
 #include "base/safetext.h"
 #include "io/fitfile_json.h"

@@ -10,10 +10,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "conifit/export.h"
+#include "export/export.h"
 #include "base/gslguard.h"
-#include "conifit/body.h"
-#include "conifit/lattice.h"
+#include "model/body.h"
+#include "model/lattice.h"
 #include "export/export_model.h"
 
 /* The nodes the punch's face rests on at depth 0 (on its plane within 1e-9 of the mean edge and

@@ -10,11 +10,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "conifit/export.h"
+#include "export/export.h"
 #include "model/lattice_cells.h"
 #include "base/gslguard.h"
-#include "conifit/lattice.h"
-#include "conifit/validate.h"
+#include "model/lattice.h"
+#include "check/validate.h"
 #include "export/export_model.h"
 
 /* Two springs belong to one group when their rest lengths and weights agree to this relative

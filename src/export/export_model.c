@@ -12,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "conifit/lattice.h"
+#include "model/lattice.h"
 #include "conifit/spring.h"
 #include "conifit/version.h"
 #include "base/safetext.h"

@@ -11,7 +11,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "conifit/export.h"
+#include "export/export.h"
 #include "conifit/law.h"
 
 /* Springs of one rest length and one weight: their table in their own elongation and tension. */

@@ -29,7 +29,7 @@
 ** added to the cone's deflection), ends at u_C where the cone closes (a row on the law), and the
 ** tail's region 3 beyond it is straight, one exact interval to the table's end.
 */
-#include "conifit/export.h"
+#include "export/export.h"
 
 #include <float.h>
 #include <math.h>

@@ -6,7 +6,7 @@
 ** refinement of the profile RSS with GSL's Brent minimiser. Yeoh's and Ogden's stress in the
 ** table's test mode: hyperelastic.h.
 */
-#include "conifit/baseline.h"
+#include "fit/baseline.h"
 #include "model/mode.h"
 #include "base/gslguard.h"
 

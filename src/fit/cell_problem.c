@@ -9,7 +9,7 @@
 
 #include <nlopt.h>
 
-#include "conifit/family.h"
+#include "model/family.h"
 #include "fit/lsq.h"
 #include "fit/profile.h"
 

@@ -12,7 +12,7 @@
 
 #include <nlopt.h>
 
-#include "conifit/fit.h"
+#include "fit/fit.h"
 
 typedef struct cf_cell_problem {
     /* the target's curve at stress scale 1 for rho and s/H = B: n values into out (the rows of

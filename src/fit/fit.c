@@ -4,7 +4,7 @@
 ** fit_limits.c and the long-table polish of fit_long.c), B and C (fit_placement.c, under the
 ** constraints of fit_constraints.c), then the uncertainty (fit_uncertainty.c).
 */
-#include "conifit/fit.h"
+#include "fit/fit.h"
 #include "base/gslguard.h"
 
 #include <math.h>

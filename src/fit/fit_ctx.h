@@ -10,8 +10,8 @@
 #include <gsl/gsl_rng.h>
 #include <nlopt.h>
 
-#include "conifit/family.h"
-#include "conifit/fit.h"
+#include "model/family.h"
+#include "fit/fit.h"
 
 /* Constraint tolerances (constraints are in log units, i.e. relative): a constraint counts as
 ** violated beyond FEAS_TOL and active within ACTIVE_TOL of its limit. The optimisers see the

@@ -3,7 +3,7 @@
 ** displacement): what every spring fit compares with its data. Kept apart from the fit's driver
 ** (fit.c), which the stages it calls (fit_placement.c, tail.c) must not call back.
 */
-#include "conifit/fit.h"
+#include "fit/fit.h"
 
 void cf_fit_model_many(const cf_law *law, int force_displacement, size_t count, const double *x,
                        double *out)

@@ -2,7 +2,7 @@
 ** The design limits a flag widens, and options with the limits that hold a fit widened as far as
 ** those flags go (fit.h): what the fit would reach without them.
 */
-#include "conifit/fit.h"
+#include "fit/fit.h"
 
 const char *cf_fit_constraint_flag(unsigned bit)
 {

@@ -6,7 +6,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "conifit/measure.h"
+#include "io/measure.h"
 #include "fit/fit_ctx.h"
 #include "fit/lsq.h"
 #include "fit/profile.h"

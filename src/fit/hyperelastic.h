@@ -23,8 +23,8 @@
 #ifndef CF_FIT_HYPERELASTIC_H
 #define CF_FIT_HYPERELASTIC_H
 
-#include "conifit/cell.h"
-#include "conifit/measure.h"
+#include "model/cell.h"
+#include "io/measure.h"
 
 /* NULL when both laws have a form for every row of t; else why not, as a sentence (a
 ** force-displacement table, confined compression, a stretch <= 0, no strained row). */

@@ -4,7 +4,7 @@
 ** joint_pair.c, the full lattice's stability and each table's verification in joint_stable.c,
 ** the curves they all evaluate in joint_curve.c.
 */
-#include "conifit/joint.h"
+#include "fit/joint.h"
 #include "base/gslguard.h"
 
 #include <math.h>
@@ -13,9 +13,9 @@
 
 #include <nlopt.h>
 
-#include "conifit/baseline.h"
-#include "conifit/cell.h"
-#include "conifit/family.h"
+#include "fit/baseline.h"
+#include "model/cell.h"
+#include "model/family.h"
 #include "fit/cell_problem.h"
 #include "fit/clock.h"
 #include "fit/joint_ctx.h"

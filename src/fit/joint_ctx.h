@@ -9,9 +9,9 @@
 
 #include <stddef.h>
 
-#include "conifit/cell.h"
-#include "conifit/family.h"
-#include "conifit/joint.h"
+#include "model/cell.h"
+#include "model/family.h"
+#include "fit/joint.h"
 #include "conifit/law.h"
 #include "fit/cell_problem.h"
 

@@ -7,8 +7,8 @@
 
 #include <math.h>
 
-#include "conifit/cell.h"
-#include "conifit/family.h"
+#include "model/cell.h"
+#include "model/family.h"
 
 /* The cell's volume modulus for a curve whose compression law (at stress scale 1) is law. */
 double cf_joint_curve_kappa(const jctx *c, const cf_law *law)

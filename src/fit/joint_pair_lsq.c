@@ -13,8 +13,8 @@
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_permutation.h>
 
-#include "conifit/cell.h"
-#include "conifit/family.h"
+#include "model/cell.h"
+#include "model/family.h"
 #include "fit/cell_problem.h"
 #include "fit/joint_ctx.h"
 #include "fit/lsq.h"

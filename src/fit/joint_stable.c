@@ -6,11 +6,11 @@
 #include <math.h>
 #include <string.h>
 
-#include "conifit/baseline.h"
-#include "conifit/cell.h"
-#include "conifit/cell_stability.h"
-#include "conifit/family.h"
-#include "conifit/msm.h"
+#include "fit/baseline.h"
+#include "model/cell.h"
+#include "model/cell_stability.h"
+#include "model/family.h"
+#include "model/msm.h"
 #include "fit/joint_ctx.h"
 #include "fit/lsq.h"
 

@@ -7,7 +7,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "conifit/cell.h"
+#include "model/cell.h"
 #include "fit/lsq.h"
 
 cf_status cf_lattice_curve(const cf_spring *p, const cf_validate_setup *s, const cf_table *d,

@@ -5,7 +5,7 @@
 #ifndef CF_FIT_LATTICE_CURVE_H
 #define CF_FIT_LATTICE_CURVE_H
 
-#include "conifit/lattice_fit.h"
+#include "fit/lattice_fit.h"
 
 /* The curve of spring p at the strains of d in the table's mode: the full lattice (cf_msm_uniaxial)
 ** when full is set and the mode is uniaxial, else the homogenised cell (cell.h), which equals the

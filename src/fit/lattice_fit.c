@@ -2,7 +2,7 @@
 ** The fit through the lattice: the identifiable quantities searched through the homogenised cell,
 ** then the placement of the design parameters (see lattice_fit.h).
 */
-#include "conifit/lattice_fit.h"
+#include "fit/lattice_fit.h"
 #include "base/gslguard.h"
 
 #include <math.h>
@@ -12,8 +12,8 @@
 
 #include <nlopt.h>
 
-#include "conifit/cell.h"
-#include "conifit/family.h"
+#include "model/cell.h"
+#include "model/family.h"
 #include "fit/cell_problem.h"
 #include "fit/clock.h"
 #include "fit/lattice_curve.h"

@@ -11,7 +11,7 @@
 ** bounded below by a small share of the table's largest spring strain, not by it. Standard errors
 ** of (rho, B, A, tau) come from the cell's central-difference Jacobian (8 curves).
 */
-#include "conifit/lattice_fit.h"
+#include "fit/lattice_fit.h"
 #include "base/gslguard.h"
 
 #include <math.h>
@@ -22,7 +22,7 @@
 #include <gsl/gsl_errno.h>
 #include <nlopt.h>
 
-#include "conifit/family.h"
+#include "model/family.h"
 #include "fit/cell_problem.h"
 #include "fit/clock.h"
 #include "fit/lattice_curve.h"

@@ -19,10 +19,10 @@
 #define CF_FIT_LAWKIND_H
 
 #include "conifit/error.h"
-#include "conifit/family.h"
-#include "conifit/fit.h"
-#include "conifit/lattice_fit.h"
-#include "conifit/measure.h"
+#include "model/family.h"
+#include "fit/fit.h"
+#include "fit/lattice_fit.h"
+#include "io/measure.h"
 
 /* One identifiable quantity. unit "y" is the table's stress or force unit (the report converts
 ** to the file's own); "" is dimensionless. The _force variants are a force-displacement table's. */

@@ -10,7 +10,7 @@
 #include <stddef.h>
 
 #include "conifit/law.h"
-#include "conifit/measure.h"
+#include "io/measure.h"
 
 /* Relative residuals divide by max(|y|, CF_LSQ_REL_FLOOR max|y|) so that the point at the origin
 ** (y = 0) keeps a finite weight. */

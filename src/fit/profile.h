@@ -8,7 +8,7 @@
 
 #include <stddef.h>
 
-#include "conifit/fit.h"
+#include "fit/fit.h"
 
 /* A fit's profile. The other two quantities of a profile of k travel in x: (log rho, B)
 ** without the one profiled (both when k is the stress scale), or, where start is given, what

@@ -1,7 +1,7 @@
 /*
 ** Softening (concave) parts of a table's loading side (see softening.h).
 */
-#include "conifit/softening.h"
+#include "fit/softening.h"
 
 #include <math.h>
 #include <stdlib.h>

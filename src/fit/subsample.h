@@ -10,7 +10,7 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
-#include "conifit/measure.h"
+#include "io/measure.h"
 
 /* Rows kept by cf_subsample (at most). */
 #define CF_SUBSAMPLE_ROWS 1000

@@ -12,7 +12,7 @@
 
 #include <gsl/gsl_vector.h>
 
-#include "conifit/fit.h"
+#include "fit/fit.h"
 
 /* The range of tau = n_t/n the fits search. */
 #define TAIL_TAU_LO 1e-4

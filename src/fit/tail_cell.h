@@ -11,8 +11,8 @@
 
 #include <gsl/gsl_vector.h>
 
-#include "conifit/family.h"
-#include "conifit/fit.h"
+#include "model/family.h"
+#include "fit/fit.h"
 #include "fit/cell_problem.h"
 
 typedef struct cf_tail_cell {

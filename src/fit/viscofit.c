@@ -6,7 +6,7 @@
 ** viscofit_standin.c, the standard errors in viscofit_se.c, the predictions in
 ** viscofit_predict.c.
 */
-#include "conifit/viscofit.h"
+#include "fit/viscofit.h"
 #include "base/gslguard.h"
 
 #include <math.h>
@@ -14,7 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "conifit/msm.h"
+#include "model/msm.h"
 #include "fit/clock.h"
 #include "fit/viscofit_ctx.h"
 

@@ -11,7 +11,7 @@
 #include <gsl/gsl_multifit_nlinear.h>
 #include <gsl/gsl_vector.h>
 
-#include "conifit/viscofit.h"
+#include "fit/viscofit.h"
 #include "fit/viscolimits.h"
 
 /* Bounds of rho and of the solid strain (the largest strain must stay CF_FIT_TRAVEL_MARGIN

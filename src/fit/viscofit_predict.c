@@ -2,14 +2,14 @@
 ** The predicted response of a fitted viscoelastic model to two stated loads: a load-unload cycle
 ** (hysteresis) and a creep test (see viscofit.h, cf_visco_predict).
 */
-#include "conifit/viscofit.h"
+#include "fit/viscofit.h"
 #include "base/gslguard.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-#include "conifit/msm.h"
+#include "model/msm.h"
 #include "fit/viscofit_ctx.h"
 
 enum { PRED_PER = 200 }; /* samples per half of a predicted history */

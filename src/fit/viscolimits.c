@@ -9,8 +9,8 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_interp.h>
 
-#include "conifit/cell.h"
-#include "conifit/msm.h"
+#include "model/cell.h"
+#include "model/msm.h"
 
 /* Bisection steps of the stability bound, and its safety margin (relative to s/H): the bound is
 ** interpolated between grid points, where it is smooth, well within this. */

@@ -17,8 +17,8 @@
 
 #include <gsl/gsl_interp.h>
 
-#include "conifit/fit.h"
-#include "conifit/viscomodel.h"
+#include "fit/fit.h"
+#include "model/viscomodel.h"
 
 #define CF_VISCO_STAB_GRID 25
 

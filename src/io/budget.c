@@ -1,13 +1,13 @@
 /*
 ** Cost estimates of a scene before it runs (see budget.h).
 */
-#include "conifit/budget.h"
+#include "io/budget.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-#include "conifit/calibration.h"
+#include "model/calibration.h"
 #include "model/linsolve.h"
 #include "model/msm_tangent.h"
 

@@ -8,9 +8,9 @@
 
 #include <stddef.h>
 
-#include "conifit/cell.h"
+#include "model/cell.h"
 #include "conifit/error.h"
-#include "conifit/measure.h"
+#include "io/measure.h"
 #include "io/csv.h"
 
 /* Longest column name kept (longer names are an error: they are not column names). */

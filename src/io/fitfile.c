@@ -1,7 +1,7 @@
 /*
 ** Reading fitted springs back from a conifit fit file (see fitfile.h for the schema).
 */
-#include "conifit/fitfile.h"
+#include "io/fitfile.h"
 
 #include <errno.h>
 #include <math.h>

@@ -6,7 +6,7 @@
 ** (io/columns.c) and the stress and strain measures (io/measures.c); what they fill is a
 ** cf_table (model/table.c).
 */
-#include "conifit/measure.h"
+#include "io/measure.h"
 
 #include "base/input.h"
 #include "io/columns.h"

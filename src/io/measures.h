@@ -11,7 +11,7 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
-#include "conifit/measure.h"
+#include "io/measure.h"
 #include "io/columns.h"
 #include "io/csv.h"
 

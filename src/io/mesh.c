@@ -5,7 +5,7 @@
 ** examples. Gmsh keeps one global model, so every use is serialised by a mutex; its messages are
 ** switched off (the library prints nothing) and its last error is read back into the message.
 */
-#include "conifit/mesh.h"
+#include "io/mesh.h"
 
 #include "io/surface.h"
 

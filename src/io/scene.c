@@ -3,7 +3,7 @@
 ** key checking, and the conversion of a loading protocol into a piecewise-linear path and the
 ** times at which samples are reported.
 */
-#include "conifit/scene.h"
+#include "io/scene.h"
 
 #include <errno.h>
 #include <math.h>
@@ -14,7 +14,7 @@
 
 #include "base/input.h"
 #include "base/safetext.h"
-#include "conifit/fitfile.h"
+#include "io/fitfile.h"
 #include "io/fitfile_json.h"
 #include "io/scene_haptic.h"
 #include "io/scene_internal.h"

@@ -7,7 +7,7 @@
 
 #include <jansson.h>
 
-#include "conifit/scene.h"
+#include "io/scene.h"
 
 /* Most updates (milliseconds of simulated time) a haptic path may ask for; the run is further
 ** bounded by the budget's steps (budget.h). */

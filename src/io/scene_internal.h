@@ -8,8 +8,8 @@
 
 #include <jansson.h>
 
-#include "conifit/fitfile.h"
-#include "conifit/scene.h"
+#include "io/fitfile.h"
+#include "io/scene.h"
 
 typedef struct ctx {
     const char *name;

@@ -2,7 +2,7 @@
 ** Closed triangulated surfaces (Wavefront OBJ, STL ASCII or binary) read as data, checked and
 ** made fit for a volume mesher (surface.c): every edge in exactly two triangles of opposite
 ** orientation, the normals outward, and local self-crossings smoothed away. Private to the io
-** layer; mesh.c hands the result to Gmsh (cf_mesh_from_surface, conifit/mesh.h).
+** layer; mesh.c hands the result to Gmsh (cf_mesh_from_surface, io/mesh.h).
 */
 #ifndef CF_IO_SURFACE_H
 #define CF_IO_SURFACE_H
@@ -11,7 +11,7 @@
 #include <stdint.h>
 
 #include "conifit/error.h"
-#include "conifit/mesh.h"
+#include "io/mesh.h"
 
 typedef struct cf_surface {
     size_t nv, nf;

@@ -11,7 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "conifit/body.h"
+#include "model/body.h"
 #include "model/sparse_chol.h"
 
 /* Six times the signed volume of the tetrahedron a, b, c, d. */

@@ -1,7 +1,7 @@
 /*
 ** Family weights of the cubic lattice from its Cauchy-Born elastic constants (see calibration.h).
 */
-#include "conifit/calibration.h"
+#include "model/calibration.h"
 
 #include <math.h>
 #include <string.h>

@@ -3,7 +3,7 @@
 ** homogeneous deformation, its tangent along the free stretch of a test mode, and the
 ** safeguarded Newton solve of that stretch.
 */
-#include "conifit/cell.h"
+#include "model/cell.h"
 #include "model/mode.h"
 
 #include <float.h>

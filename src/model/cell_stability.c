@@ -2,7 +2,7 @@
 ** Positive definiteness of the cell's incremental stiffness along a test mode (see
 ** cell_stability.h).
 */
-#include "conifit/cell_stability.h"
+#include "model/cell_stability.h"
 #include "base/gslguard.h"
 
 #include <gsl/gsl_eigen.h>

@@ -1,7 +1,7 @@
 /*
 ** The identifiable family of a conical spring (see family.h).
 */
-#include "conifit/family.h"
+#include "model/family.h"
 
 #include <math.h>
 

@@ -2,7 +2,7 @@
 ** The family's canonical law over many points at once (see family.h, cf_ident_canon_many): the
 ** closed form of law_simd.h in vector lanes, with the derivatives the fits' Jacobians need.
 */
-#include "conifit/family.h"
+#include "model/family.h"
 
 #include <float.h>
 #include <string.h>

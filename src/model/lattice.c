@@ -2,11 +2,11 @@
 ** The mass-spring lattice (see lattice.h): construction of nodes, springs, weights, masses and
 ** boundary fixities, and the force kernel the solvers call on every step.
 */
-#include "conifit/lattice.h"
+#include "model/lattice.h"
 #include "model/lattice_cells.h"
 #include "base/gslguard.h"
 
-#include "conifit/cell.h"
+#include "model/cell.h"
 #include "model/lattice_step.h"
 
 #include <math.h>

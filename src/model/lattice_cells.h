@@ -8,7 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "conifit/lattice.h"
+#include "model/lattice.h"
 
 /* The eight corner nodes of cell c (corner di + 2 dj + 4 dk), as cf_lattice_cell_volume gives
 ** them. */

@@ -33,9 +33,9 @@
 
 #include <stddef.h>
 
-#include "conifit/cell.h"
+#include "model/cell.h"
 #include "conifit/error.h"
-#include "conifit/lattice.h"
+#include "model/lattice.h"
 #include "model/law_simd.h"
 
 #define CF_STEP_BLOCK 256

@@ -48,6 +48,7 @@
 #include <string.h>
 
 #include "conifit/law.h"
+#include "model/simd.h"
 
 #if defined(__GNUC__)
 #define CF_LANE static inline __attribute__((always_inline))
@@ -59,7 +60,7 @@
 ** `attr static ... name##sfx(...)`; CF_SIMD_COPIES(DEF, ...) expands it for baseline x86-64 (SSE2,
 ** suffix _v1), x86-64-v3 (AVX2, FMA; _v3) and x86-64-v4 (AVX-512; _v4), and CF_SIMD_CALL(name, args)
 ** calls the widest copy that the processor has and that the environment variable CONIFIT_SIMD
-** allows (cf_simd_level, conifit/law.h): so the tests run every copy on a machine that has it, not
+** allows (cf_simd_level, model/simd.h): so the tests run every copy on a machine that has it, not
 ** only the widest. A copy is a whole function, its OpenMP regions included, so the threads of a
 ** parallel loop run the same instruction set as the copy. Elsewhere (clang, other processors, the
 ** sanitizer build) one baseline copy. The copies evaluate the same expressions, but their widths

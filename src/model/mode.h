@@ -1,5 +1,5 @@
 /*
-** The test modes as a table (mode.c): one row per mode of conifit/cell.h's cf_mode, holding what
+** The test modes as a table (mode.c): one row per mode of model/cell.h's cf_mode, holding what
 ** every layer needs to know of a mode -- its name, how it deforms a block (which stretches it sets,
 ** which it leaves free, which stress it reads), what its abscissa is, how a Cauchy stress becomes
 ** a nominal one, the incompressible forms of the hyperelastic baselines, and the words and labels
@@ -9,7 +9,7 @@
 #ifndef CF_MODEL_MODE_H
 #define CF_MODEL_MODE_H
 
-#include "conifit/cell.h"
+#include "model/cell.h"
 
 typedef struct cf_mode_row {
     const char *name;          /* as in tables' "# mode:" and the fit file */

@@ -9,7 +9,7 @@
 #include <math.h>
 #include <stddef.h>
 
-#include "conifit/msm.h"
+#include "model/msm.h"
 #include "model/lattice_step.h"
 #include "model/linsolve.h"
 #include "model/msm_tangent.h"

@@ -3,7 +3,7 @@
 ** quasi-static runner (msm.c), the viscous and the explicit steps (msm_visco.c, msm_dynamic.c) and
 ** the viscoelastic model, none of which need each other for it.
 */
-#include "conifit/msm.h"
+#include "model/msm.h"
 
 double cf_msm_path_value(const cf_msm_path *p, double t)
 {

@@ -2,7 +2,7 @@
 ** The measured table (table.h): building one from arrays, what it is, its name, releasing it.
 ** Reading one from a file is the reader's job (io/measure.c).
 */
-#include "conifit/table.h"
+#include "model/table.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -2,14 +2,14 @@
 ** The time-dependent model of a fitted tissue (see viscomodel.h): the lattice of msm.h with Prony
 ** branches, driven by a measured strain history.
 */
-#include "conifit/viscomodel.h"
+#include "model/viscomodel.h"
 #include "base/gslguard.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "conifit/cell.h"
+#include "model/cell.h"
 
 cf_visco_setup cf_visco_default(void)
 {

@@ -8,8 +8,8 @@
 
 #include <stddef.h>
 
-#include "conifit/export.h"
-#include "conifit/fitfile.h"
+#include "export/export.h"
+#include "io/fitfile.h"
 
 /* Renders fitted spring fs as opt says into *buf (*len bytes; the caller frees *buf, NULL on
 ** failure): the spring's table, or with lx the lattice lx describes as a model. *rep (may be

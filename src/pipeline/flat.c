@@ -7,21 +7,21 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "conifit/budget.h"
+#include "io/budget.h"
 #include "base/gslguard.h"
-#include "conifit/export.h"
-#include "conifit/fitfile.h"
+#include "export/export.h"
+#include "io/fitfile.h"
 #include "conifit/flat.h"
 #include "pipeline/export.h"
 #include "pipeline/simulate.h"
-#include "conifit/hysteresis.h"
-#include "conifit/lattice.h"
+#include "check/hysteresis.h"
+#include "model/lattice.h"
 #include "conifit/law.h"
-#include "conifit/measure.h"
-#include "conifit/msm.h"
-#include "conifit/pipeline.h"
-#include "conifit/report.h"
-#include "conifit/scene.h"
+#include "io/measure.h"
+#include "model/msm.h"
+#include "pipeline/pipeline.h"
+#include "report/report.h"
+#include "io/scene.h"
 
 static cf_status need(const void *p, const char *what, cf_error *err)
 {

@@ -1,7 +1,7 @@
 /*
 ** The fitting pipeline (see pipeline.h).
 */
-#include "conifit/pipeline.h"
+#include "pipeline/pipeline.h"
 #include "model/mode.h"
 #include "base/gslguard.h"
 
@@ -10,9 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "conifit/baseline.h"
-#include "conifit/cell.h"
-#include "conifit/scene.h"
+#include "fit/baseline.h"
+#include "model/cell.h"
+#include "io/scene.h"
 #include "conifit/version.h"
 #include "base/atomic.h"
 #include "report/plot.h"

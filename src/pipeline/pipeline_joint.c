@@ -1,13 +1,13 @@
 /*
 ** The joint fit (see pipeline_joint.h).
 */
-#include "conifit/pipeline_joint.h"
+#include "pipeline/pipeline_joint.h"
 #include "base/gslguard.h"
 
 #include <stdio.h>
 #include <string.h>
 
-#include "conifit/joint.h"
+#include "fit/joint.h"
 #include "fit/lawkind.h"
 
 /* 1 when the joint fit b is kept over a (the one law choice, cf_law_pick): asked for, or

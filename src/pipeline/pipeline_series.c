@@ -1,7 +1,7 @@
 /*
 ** The pipeline of a time series (see pipeline_series.h).
 */
-#include "conifit/pipeline_series.h"
+#include "pipeline/pipeline_series.h"
 #include "base/gslguard.h"
 
 #include <math.h>

@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "conifit/hysteresis.h"
+#include "check/hysteresis.h"
 
 cf_status cf_pipeline_simulate(const cf_scene *sc, const char *name, const cf_budget *budget,
                                int recovery, cf_sim_run *run, cf_error *err)

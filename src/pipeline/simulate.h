@@ -8,9 +8,9 @@
 
 #include <stddef.h>
 
-#include "conifit/budget.h"
-#include "conifit/msm.h"
-#include "conifit/scene.h"
+#include "io/budget.h"
+#include "model/msm.h"
+#include "io/scene.h"
 
 typedef struct cf_sim_run {
     cf_law law, ext;          /* the scene's law (and a double-acting element's extension) */

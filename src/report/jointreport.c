@@ -1,7 +1,7 @@
 /*
 ** Text, fit file and figure of a joint fit (see jointreport.h).
 */
-#include "conifit/jointreport.h"
+#include "report/jointreport.h"
 #include "model/mode.h"
 
 #include <math.h>

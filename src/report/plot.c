@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "conifit/cell.h"
+#include "model/cell.h"
 #include "report/gnuplot.h"
 
 /* Points on each model curve. */

@@ -16,10 +16,10 @@
 
 #include "base/atomic.h"
 #include "conifit/error.h"
-#include "conifit/fit.h"
-#include "conifit/msm.h"
-#include "conifit/report.h"
-#include "conifit/scene.h"
+#include "fit/fit.h"
+#include "model/msm.h"
+#include "report/report.h"
+#include "io/scene.h"
 
 /* CF_OK when path names a format conifit draws (.png, .svg or .pdf, any case); CF_E_DATA otherwise. A
 ** command checks this before any work, so that a misspelt name costs nothing. */

@@ -2,7 +2,7 @@
 ** Fit reports (see report.h): what the report says of its fits (the better type, a tie, AIC) and
 ** the JSON fit file, through jansson. The readable text is in report_text.c.
 */
-#include "conifit/report.h"
+#include "report/report.h"
 #include "base/gslguard.h"
 
 #include <math.h>

@@ -10,7 +10,7 @@
 
 #include <jansson.h>
 
-#include "conifit/report.h"
+#include "report/report.h"
 
 /* Baseline k's coefficients as "C1 = 0.1, C2 = 2, C3 = -3 kPa" (values in the file's unit; the
 ** unit after each run of coefficients in it). */

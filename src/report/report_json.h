@@ -7,7 +7,7 @@
 
 #include <jansson.h>
 
-#include "conifit/fit.h"
+#include "fit/fit.h"
 
 /* {value, stderr | stderr_reason, [interval, interval_reason, interval_limit]} of quantity k
 ** in conifit's units (MPa, N, mm): a key is present only with a value, never null. */

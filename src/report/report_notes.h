@@ -10,7 +10,7 @@
 
 #include <jansson.h>
 
-#include "conifit/table.h"
+#include "model/table.h"
 
 /* Writes each note of t as one line "INDENT note: TEXT" (safe text); nothing when none. */
 void cf_report_notes_text(FILE *o, const cf_table *t, const char *indent);

@@ -3,7 +3,7 @@
 ** quantities the data determine, the springs, the validation, the constraints, the verdict and
 ** the baselines.
 */
-#include "conifit/report.h"
+#include "report/report.h"
 #include "model/mode.h"
 #include "base/gslguard.h"
 

@@ -6,7 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "conifit/report.h"
+#include "report/report.h"
 #include "report/report_words.h"
 
 /* The table softens: the conical law only stiffens. */

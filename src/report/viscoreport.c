@@ -1,7 +1,7 @@
 /*
 ** Report, fit file and plot of a viscoelastic fit (see viscoreport.h).
 */
-#include "conifit/viscoreport.h"
+#include "report/viscoreport.h"
 #include "report/report_notes.h"
 #include "report/report_words.h"
 

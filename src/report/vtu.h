@@ -10,7 +10,7 @@
 
 #include <stdio.h>
 
-#include "conifit/body.h"
+#include "model/body.h"
 #include "conifit/error.h"
 
 /* The tetrahedra with positions x (3 nn) and volume ratios J (nt) to f. */

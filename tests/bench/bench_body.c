@@ -12,9 +12,9 @@
 #include <string.h>
 
 #include "bench.h"
-#include "conifit/body.h"
-#include "conifit/fitfile.h"
-#include "conifit/mesh.h"
+#include "model/body.h"
+#include "io/fitfile.h"
+#include "io/mesh.h"
 
 #define UPDATES 200
 #define HAPTIC_ITERS 3

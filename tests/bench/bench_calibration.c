@@ -11,11 +11,11 @@
 #include <string.h>
 
 #include "bench.h"
-#include "conifit/cell.h"
-#include "conifit/fit.h"
-#include "conifit/joint.h"
-#include "conifit/msm.h"
-#include "conifit/validate.h"
+#include "model/cell.h"
+#include "fit/fit.h"
+#include "fit/joint.h"
+#include "model/msm.h"
+#include "check/validate.h"
 
 #define ROWS 40
 

@@ -13,9 +13,9 @@
 #include <unistd.h>
 
 #include "bench.h"
-#include "conifit/baseline.h"
-#include "conifit/fit.h"
-#include "conifit/measure.h"
+#include "fit/baseline.h"
+#include "fit/fit.h"
+#include "io/measure.h"
 
 static double cubic(double e, const void *arg)
 {

@@ -10,9 +10,9 @@
 #include <string.h>
 
 #include "bench.h"
-#include "conifit/fit.h"
-#include "conifit/measure.h"
-#include "conifit/validate.h"
+#include "fit/fit.h"
+#include "io/measure.h"
+#include "check/validate.h"
 
 static const cf_fit_optimizer optimizers[] = {CF_OPT_SLSQP, CF_OPT_COBYLA, CF_OPT_MMA};
 #define NOPT 3

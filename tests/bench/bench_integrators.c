@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "bench.h"
-#include "conifit/msm.h"
+#include "model/msm.h"
 
 #define NSAMP 9
 #define STRAIN_MAX 0.45

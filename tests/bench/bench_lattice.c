@@ -11,7 +11,7 @@
 #include <time.h>
 
 #include "bench.h"
-#include "conifit/lattice.h"
+#include "model/lattice.h"
 #include "model/lattice_step.h"
 
 /* The spring behind data/telescoping.csv: solid strain 0.6, region 2 from strain 0.24. */

@@ -12,10 +12,10 @@
 #include <unistd.h>
 
 #include "bench.h"
-#include "conifit/baseline.h"
-#include "conifit/fit.h"
+#include "fit/baseline.h"
+#include "fit/fit.h"
 #include "conifit/law.h"
-#include "conifit/measure.h"
+#include "io/measure.h"
 
 /* Writes the table of the spring 8/20 mm, 2.5 coils, wire 2 mm, G 100 MPa, H 5 mm (telescoping,
 ** rho 0.4) with 1 % Gaussian noise, n rows from strain 0 to 0.95 of the solid strain, as

@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 #include "bench.h"
-#include "conifit/lattice.h"
+#include "model/lattice.h"
 
 typedef struct lat_job {
     int n;    /* cells per edge; 0: do nothing (the floor) */

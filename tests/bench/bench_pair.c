@@ -21,7 +21,7 @@
 #include <unistd.h>
 
 #include "bench.h"
-#include "conifit/lattice.h"
+#include "model/lattice.h"
 #include "conifit/law.h"
 #include "model/lattice_step.h"
 

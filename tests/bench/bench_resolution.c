@@ -8,9 +8,9 @@
 #include <string.h>
 
 #include "bench.h"
-#include "conifit/fit.h"
-#include "conifit/measure.h"
-#include "conifit/msm.h"
+#include "fit/fit.h"
+#include "io/measure.h"
+#include "model/msm.h"
 
 #define TABLE "data/telescoping_noise1pct.csv"
 

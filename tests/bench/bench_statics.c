@@ -14,7 +14,7 @@
 #include <unistd.h>
 
 #include "bench.h"
-#include "conifit/msm.h"
+#include "model/msm.h"
 
 enum { NSTRAIN = 45, NOUT = 5 + NSTRAIN };
 

@@ -11,7 +11,7 @@
 #include <time.h>
 
 #include "bench.h"
-#include "conifit/lattice.h"
+#include "model/lattice.h"
 #include "conifit/law.h"
 #include "model/lattice_step.h"
 

@@ -8,8 +8,8 @@
 #include <string.h>
 
 #include "bench.h"
-#include "conifit/viscofit.h"
-#include "conifit/viscomodel.h"
+#include "fit/viscofit.h"
+#include "model/viscomodel.h"
 
 /* A ramp to 30 % compressive strain in 30 s held to 330 s, n points (a third on the ramp). */
 static void series(size_t n, double *t, double *x)

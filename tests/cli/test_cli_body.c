@@ -9,7 +9,7 @@
 
 #include <sys/stat.h>
 
-#include "conifit/body.h"
+#include "model/body.h"
 
 TU_SCRATCH_GROUP("cli-body")
 

@@ -13,8 +13,8 @@
 
 #include <sys/stat.h>
 
-#include "conifit/body.h"
-#include "conifit/mesh.h"
+#include "model/body.h"
+#include "io/mesh.h"
 
 TU_SCRATCH_GROUP("cli-dynamic")
 

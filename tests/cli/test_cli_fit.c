@@ -11,7 +11,7 @@
 
 #include "testutil.h"
 
-#include "conifit/fitfile.h"
+#include "io/fitfile.h"
 
 static char out[1 << 16], errb[1 << 14];
 

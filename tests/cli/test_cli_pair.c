@@ -15,8 +15,8 @@
 
 #include <jansson.h>
 
-#include "conifit/cell.h"
-#include "conifit/fitfile.h"
+#include "model/cell.h"
+#include "io/fitfile.h"
 
 static char out[1 << 16], errb[1 << 12];
 

@@ -12,10 +12,10 @@
 
 #include <sys/stat.h>
 
-#include "conifit/body.h"
-#include "conifit/calibration.h"
-#include "conifit/cell.h"
-#include "conifit/mesh.h"
+#include "model/body.h"
+#include "model/calibration.h"
+#include "model/cell.h"
+#include "io/mesh.h"
 
 TU_SCRATCH_GROUP("cli-regions")
 

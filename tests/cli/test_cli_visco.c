@@ -7,8 +7,8 @@
 
 #include <jansson.h>
 
-#include "conifit/fitfile.h"
-#include "conifit/viscofit.h"
+#include "io/fitfile.h"
+#include "fit/viscofit.h"
 #include "viscoutil.h"
 
 /* The command line: a time series with a bad branch count or a time that goes back exits 65 and

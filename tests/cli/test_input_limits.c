@@ -8,9 +8,9 @@
 
 #include "testutil.h"
 
-#include "conifit/fitfile.h"
-#include "conifit/measure.h"
-#include "conifit/scene.h"
+#include "io/fitfile.h"
+#include "io/measure.h"
+#include "io/scene.h"
 
 TU_SCRATCH_GROUP("limits")
 

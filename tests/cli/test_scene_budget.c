@@ -9,8 +9,8 @@
 
 #include <math.h>
 
-#include "conifit/budget.h"
-#include "conifit/scene.h"
+#include "io/budget.h"
+#include "io/scene.h"
 
 static char out[1 << 14], errb[1 << 14];
 TU_SCRATCH_GROUP("budget")

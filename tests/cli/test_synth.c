@@ -9,7 +9,7 @@
 #include "testutil.h"
 
 #include "conifit/law.h"
-#include "conifit/measure.h"
+#include "io/measure.h"
 
 TU_SCRATCH_GROUP("synth")
 

@@ -8,8 +8,8 @@
 
 #include <jansson.h>
 
-#include "conifit/fit.h"
-#include "conifit/measure.h"
+#include "fit/fit.h"
+#include "io/measure.h"
 
 static char out[1 << 16], errb[1 << 14];
 

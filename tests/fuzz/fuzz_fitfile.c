@@ -4,7 +4,7 @@
 */
 #include "fuzz.h"
 
-#include "conifit/fitfile.h"
+#include "io/fitfile.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {

@@ -6,9 +6,9 @@
 
 #include <string.h>
 
-#include "conifit/budget.h"
-#include "conifit/lattice.h"
-#include "conifit/scene.h"
+#include "io/budget.h"
+#include "model/lattice.h"
+#include "io/scene.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {

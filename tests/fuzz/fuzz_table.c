@@ -4,7 +4,7 @@
 */
 #include "fuzz.h"
 
-#include "conifit/measure.h"
+#include "io/measure.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {

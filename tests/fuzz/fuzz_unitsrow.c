@@ -7,7 +7,7 @@
 
 #include <string.h>
 
-#include "conifit/measure.h"
+#include "io/measure.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {

@@ -2,9 +2,11 @@
 # make test-install: installs conifit into a scratch DESTDIR with PREFIX=/usr, then uses the staged
 # tree as a user would: builds tests/install/law_example.c and fit_example.c with `pkg-config
 # --cflags --libs conifit` against the shared library and with `pkg-config --static --libs
-# conifit-static` against the static one (which must not need libconifit.so), runs them and compares the forces with the installed binary's `conifit force`, and the fit file
-# written through the output handle with `conifit fit data/telescoping.csv -o` (the identifiable
-# quantities of each type, to 1e-9 relative); runs the installed Python module; checks the man
+# conifit-static` against the static one (which must not need libconifit.so), runs them and
+# compares the forces with the installed binary's `conifit force`, and the fit file fit_example.c
+# writes through the table-fit handle (conifit/tablefit.h) and the output handle with `conifit fit
+# data/telescoping.csv -o` (the identifiable quantities of each type, to 1e-9 relative); compiles
+# every installed header alone against the staged include folder; runs the installed Python module; checks the man
 # pages are in place; finally `make uninstall` must leave no file behind (nor the bytecode Python
 # wrote beside the module). Install and uninstall refuse a DESTDIR or PREFIX holding a blank or a
 # quote without touching anything (a trailing blank, or "DIR/notes.txt stage", once named the
@@ -24,6 +26,12 @@ for f in usr/bin/conifit usr/lib/libconifit.a usr/lib/libconifit.so usr/include/
          usr/lib/pkgconfig/conifit.pc usr/lib/pkgconfig/conifit-static.pc usr/share/man/man1/conifit.1 usr/share/man/man3/libconifit.3 \
          usr/lib/python3/dist-packages/conifit.py; do
   [ -e "$root/$f" ] || fail "make install did not install /$f"
+done
+# every installed header alone, with only the staged include folder on the path
+for h in "$root"/usr/include/conifit/*.h; do
+  printf '#include <conifit/%s>\n' "$(basename "$h")" |
+    ${CC:-cc} -std=c17 -fsyntax-only -I"$root/usr/include" -x c - ||
+    fail "the installed header $(basename "$h") does not compile alone"
 done
 soname=$(readelf -d "$root/usr/lib/libconifit.so" | sed -n 's/.*SONAME.*\[\(.*\)\]/\1/p')
 [ -e "$root/usr/lib/$soname" ] || fail "no /usr/lib/$soname (the SONAME $soname)"
@@ -139,4 +147,4 @@ ${MAKE:-make} --no-print-directory -s uninstall BUILD="$BUILD" DESTDIR="$root" P
 left=$(find "$root" -type f -o -type l)
 [ -z "$left" ] || fail "make uninstall left: $left"
 [ ! -e "$root/usr/lib/python3/dist-packages/__pycache__" ] || fail "make uninstall left __pycache__"
-echo "test-install: staged install (PREFIX=/usr) built and ran shared and static against pkg-config; forces match conifit force; fit files written through the output handle match conifit fit; conifit-static needs no libconifit.so; blanks in DESTDIR/PREFIX refused; uninstall clean"
+echo "test-install: staged install (PREFIX=/usr) built and ran shared and static against pkg-config; forces match conifit force; fit files written through the table-fit and output handles match conifit fit; installed headers compile alone; conifit-static needs no libconifit.so; blanks in DESTDIR/PREFIX refused; uninstall clean"

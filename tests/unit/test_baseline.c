@@ -12,8 +12,8 @@
 
 #include <float.h>
 
-#include "conifit/baseline.h"
-#include "conifit/measure.h"
+#include "fit/baseline.h"
+#include "io/measure.h"
 
 static void fung_recovers_stiffening_and_softening_in_both_signs(void **state)
 {

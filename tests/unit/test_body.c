@@ -1,5 +1,5 @@
 /*
-** Tests of tissue bodies (conifit/body.h, conifit/mesh.h): meshes read with Gmsh and refused when
+** Tests of tissue bodies (model/body.h, io/mesh.h): meshes read with Gmsh and refused when
 ** they are not volumes or hold degenerate or inverted elements; the calibrated network's measured
 ** small-strain E and nu against the reported ones; load propagation against contact mechanics
 ** (Hertz's sphere and Boussinesq's flat punch on a half-space) at nu = 0.25 and 0.45, on two
@@ -7,10 +7,10 @@
 */
 #include "testutil.h"
 
-#include "conifit/body.h"
-#include "conifit/export.h"
-#include "conifit/fitfile.h"
-#include "conifit/mesh.h"
+#include "model/body.h"
+#include "export/export.h"
+#include "io/fitfile.h"
+#include "io/mesh.h"
 
 TU_SCRATCH_GROUP("body")
 

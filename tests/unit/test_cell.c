@@ -7,8 +7,8 @@
 */
 #include "testutil.h"
 
-#include "conifit/cell.h"
-#include "conifit/msm.h"
+#include "model/cell.h"
+#include "model/msm.h"
 #include "model/mode.h"
 
 /* A soft, strongly stiffening non-telescoping spring (solid strain 0.5, H = 10 mm), and a

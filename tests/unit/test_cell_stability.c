@@ -7,8 +7,8 @@
 */
 #include "testutil.h"
 
-#include "conifit/cell_stability.h"
-#include "conifit/msm.h"
+#include "model/cell_stability.h"
+#include "model/msm.h"
 
 static cf_law law_of(int which)
 {

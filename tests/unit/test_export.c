@@ -17,9 +17,9 @@
 
 #include <glob.h>
 
-#include "conifit/body.h"
-#include "conifit/export.h"
-#include "conifit/fitfile.h"
+#include "model/body.h"
+#include "export/export.h"
+#include "io/fitfile.h"
 #include "conifit/law.h"
 
 /* ccx prints forces with 7 significant digits. */

@@ -12,8 +12,8 @@
 #include <libxml/parser.h>
 #include <libxml/tree.h>
 
-#include "conifit/body.h"
-#include "conifit/export.h"
+#include "model/body.h"
+#include "export/export.h"
 #include "conifit/law.h"
 
 static const cf_spring TEL = {10, 30, 4, 1, 80000, 40}; /* telescoping, s = 39 mm */

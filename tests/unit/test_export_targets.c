@@ -18,7 +18,7 @@
 #include <libxml/parser.h>
 #include <libxml/tree.h>
 
-#include "conifit/export.h"
+#include "export/export.h"
 #include "conifit/law.h"
 #include "export/export_model.h"
 

@@ -9,8 +9,8 @@
 */
 #include "testutil.h"
 
-#include "conifit/family.h"
-#include "conifit/fit.h"
+#include "model/family.h"
+#include "fit/fit.h"
 #include "conifit/law.h"
 
 static void named_and_indexed_views_agree(void **state)

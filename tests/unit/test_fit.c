@@ -12,10 +12,10 @@
 #include <gsl/gsl_blas.h>
 #include <gsl/gsl_multifit_nlinear.h>
 
-#include "conifit/baseline.h"
-#include "conifit/fit.h"
+#include "fit/baseline.h"
+#include "fit/fit.h"
 #include "conifit/law.h"
-#include "conifit/measure.h"
+#include "io/measure.h"
 
 /* ---- synthetic tables ------------------------------------------------------------------------ */
 

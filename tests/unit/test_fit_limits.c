@@ -13,9 +13,9 @@
 #include <gsl/gsl_errno.h>
 #include <jansson.h>
 
-#include "conifit/fit.h"
+#include "fit/fit.h"
 #include "conifit/law.h"
-#include "conifit/measure.h"
+#include "io/measure.h"
 
 static char out[1 << 16], errb[1 << 14];
 

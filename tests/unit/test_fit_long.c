@@ -15,10 +15,10 @@
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 
-#include "conifit/baseline.h"
-#include "conifit/fit.h"
+#include "fit/baseline.h"
+#include "fit/fit.h"
 #include "conifit/law.h"
-#include "conifit/measure.h"
+#include "io/measure.h"
 #include "fit/lsq.h"
 #include "fit/subsample.h"
 

@@ -17,10 +17,10 @@
 #include <cmocka.h>
 #include <gsl/gsl_errno.h>
 
-#include "conifit/fit.h"
-#include "conifit/measure.h"
-#include "conifit/pipeline.h"
-#include "conifit/report.h"
+#include "fit/fit.h"
+#include "io/measure.h"
+#include "pipeline/pipeline.h"
+#include "report/report.h"
 #include "fit/tail.h"
 #include "testutil.h"
 

@@ -4,7 +4,7 @@
 */
 #include "testutil.h"
 
-#include "conifit/fitfile.h"
+#include "io/fitfile.h"
 
 static char dir[64];
 static char path[128];

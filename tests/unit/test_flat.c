@@ -11,8 +11,8 @@
 
 #include "conifit/flat.h"
 #include "conifit/law.h"
-#include "conifit/measure.h"
-#include "conifit/pipeline.h"
+#include "io/measure.h"
+#include "pipeline/pipeline.h"
 
 static const double spring[6] = {4, 12, 5, 0.8, 80000, 10};
 

@@ -14,11 +14,11 @@
 #include <gsl/gsl_cdf.h>
 #include <gsl/gsl_errno.h>
 
-#include "conifit/fit.h"
+#include "fit/fit.h"
 #include "conifit/law.h"
 #include "conifit/output.h"
-#include "conifit/pipeline.h"
-#include "conifit/report.h"
+#include "pipeline/pipeline.h"
+#include "report/report.h"
 
 #define ROWS 274 /* dof 271: GSL 2.7's gsl_cdf_fdist_Pinv(0.95, 1, 271) fails to converge */
 

@@ -10,8 +10,8 @@
 */
 #include "testutil.h"
 
-#include "conifit/hysteresis.h"
-#include "conifit/lattice.h"
+#include "check/hysteresis.h"
+#include "model/lattice.h"
 #include "conifit/spring.h"
 
 static void the_first_unstable_sample_is_found(void **state)

@@ -9,14 +9,14 @@
 #include "jointutil.h"
 #include "testutil.h"
 
-#include "conifit/cell.h"
-#include "conifit/fitfile.h"
-#include "conifit/joint.h"
-#include "conifit/jointreport.h"
-#include "conifit/measure.h"
+#include "model/cell.h"
+#include "io/fitfile.h"
+#include "fit/joint.h"
+#include "report/jointreport.h"
+#include "io/measure.h"
 #include "conifit/output.h"
-#include "conifit/pipeline_joint.h"
-#include "conifit/validate.h"
+#include "pipeline/pipeline_joint.h"
+#include "check/validate.h"
 
 /* The known springs at H = 1 mm from their quantities (family.h: a stress-strain table sees only
 ** rho, s/H and F_C/H^2): compression rho 0.4, s/H 0.5, 2 kPa; extension rho 0.2, s/H 0.7, 0.5 kPa. */

@@ -10,17 +10,17 @@
 #include "jointutil.h"
 #include "testutil.h"
 
-#include "conifit/calibration.h"
-#include "conifit/cell.h"
-#include "conifit/fitfile.h"
-#include "conifit/joint.h"
-#include "conifit/jointreport.h"
-#include "conifit/lattice_fit.h"
-#include "conifit/measure.h"
-#include "conifit/pipeline.h"
-#include "conifit/pipeline_joint.h"
-#include "conifit/report.h"
-#include "conifit/validate.h"
+#include "model/calibration.h"
+#include "model/cell.h"
+#include "io/fitfile.h"
+#include "fit/joint.h"
+#include "report/jointreport.h"
+#include "fit/lattice_fit.h"
+#include "io/measure.h"
+#include "pipeline/pipeline.h"
+#include "pipeline/pipeline_joint.h"
+#include "report/report.h"
+#include "check/validate.h"
 
 /* A non-telescoping tailed spring: D1 = 3, D2 = 10, n = 4, d = 1 (solid length 4), cone travel
 ** 3 mm, a tail of 2 coils whose gap per coil is 1.5 times the cone's. s/H = 0.267, the cone

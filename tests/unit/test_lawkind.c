@@ -16,11 +16,11 @@
 #include <cmocka.h>
 #include <jansson.h>
 
-#include "conifit/baseline.h"
-#include "conifit/family.h"
-#include "conifit/measure.h"
-#include "conifit/pipeline.h"
-#include "conifit/report.h"
+#include "fit/baseline.h"
+#include "model/family.h"
+#include "io/measure.h"
+#include "pipeline/pipeline.h"
+#include "report/report.h"
 #include "fit/lawkind.h"
 #include "testutil.h"
 

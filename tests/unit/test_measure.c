@@ -10,7 +10,7 @@
 #include "testutil.h"
 
 #include "conifit/law.h"
-#include "conifit/measure.h"
+#include "io/measure.h"
 
 /* Relative tolerance for values that went through one unit conversion (a product of doubles). */
 #define CONV_TOL 1e-15

@@ -10,7 +10,7 @@
 
 #include "testutil.h"
 
-#include "conifit/measure.h"
+#include "io/measure.h"
 
 TU_SCRATCH_GROUP("measures")
 static char out[1 << 16], errb[1 << 14];

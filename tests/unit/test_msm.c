@@ -20,8 +20,8 @@
 */
 #include "testutil.h"
 
-#include "conifit/lattice.h"
-#include "conifit/msm.h"
+#include "model/lattice.h"
+#include "model/msm.h"
 #include "model/msm_internal.h"
 
 /* A soft, strongly stiffening non-telescoping spring (solid strain 0.5, H = 10 mm). */

@@ -11,9 +11,9 @@
 
 #include <dirent.h>
 
-#include "conifit/fitfile.h"
+#include "io/fitfile.h"
 #include "conifit/output.h"
-#include "conifit/pipeline.h"
+#include "pipeline/pipeline.h"
 
 TU_SCRATCH_GROUP("output")
 

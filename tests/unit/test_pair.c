@@ -10,8 +10,8 @@
 */
 #include "testutil.h"
 
-#include "conifit/cell.h"
-#include "conifit/msm.h"
+#include "model/cell.h"
+#include "model/msm.h"
 #include "model/lattice_step.h"
 
 /* The compression spring (non-telescoping, solid strain 0.5, H 10 mm) and an extension spring

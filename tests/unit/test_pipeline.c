@@ -14,9 +14,9 @@
 
 #include <jansson.h>
 
-#include "conifit/fitfile.h"
-#include "conifit/pipeline.h"
-#include "conifit/pipeline_joint.h"
+#include "io/fitfile.h"
+#include "pipeline/pipeline.h"
+#include "pipeline/pipeline_joint.h"
 #include "conifit/spring.h"
 #include "pipeline/pool.h"
 

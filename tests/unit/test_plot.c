@@ -8,9 +8,9 @@
 
 #include <sys/stat.h>
 
-#include "conifit/msm.h"
-#include "conifit/pipeline.h"
-#include "conifit/scene.h"
+#include "model/msm.h"
+#include "pipeline/pipeline.h"
+#include "io/scene.h"
 #include "report/plot.h"
 
 TU_SCRATCH_GROUP("plot")

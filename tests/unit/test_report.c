@@ -17,9 +17,9 @@
 
 #include <jansson.h>
 
-#include "conifit/fitfile.h"
-#include "conifit/measure.h"
-#include "conifit/pipeline.h"
+#include "io/fitfile.h"
+#include "io/measure.h"
+#include "pipeline/pipeline.h"
 #include "report/report_words.h"
 
 /* A kPa stress-strain table of one spring's law (noise-free: both types fit it). */

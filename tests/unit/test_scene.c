@@ -5,10 +5,10 @@
 */
 #include "testutil.h"
 
-#include "conifit/calibration.h"
-#include "conifit/cell.h"
-#include "conifit/measure.h"
-#include "conifit/scene.h"
+#include "model/calibration.h"
+#include "model/cell.h"
+#include "io/measure.h"
+#include "io/scene.h"
 
 #define SPRING "\"spring\": {\"params\": {\"D1_mm\": 6, \"D2_mm\": 15, \"n\": 2.5, \"d_mm\": 2, " \
                "\"G_MPa\": 26, \"H_mm\": 10}}"

@@ -9,8 +9,8 @@
 
 #include "testutil.h"
 
-#include "conifit/measure.h"
-#include "conifit/softening.h"
+#include "io/measure.h"
+#include "fit/softening.h"
 
 static cf_softening of_file(const char *path)
 {

@@ -4,7 +4,7 @@
 */
 #include "testutil.h"
 
-#include "conifit/table.h"
+#include "model/table.h"
 
 static void arrays_are_copied_with_names_and_units_of_their_kind(void **state)
 {

@@ -10,7 +10,7 @@
 
 #include "testutil.h"
 
-#include "conifit/measure.h"
+#include "io/measure.h"
 
 TU_SCRATCH_GROUP("habits")
 static int file_counter;

@@ -12,7 +12,7 @@
 #include <jansson.h>
 
 #include "conifit/law.h"
-#include "conifit/cell.h"
+#include "model/cell.h"
 
 static char out[1 << 16], errb[1 << 14];
 

@@ -12,7 +12,7 @@
 
 #include <jansson.h>
 
-#include "conifit/fitfile.h"
+#include "io/fitfile.h"
 
 static char out[1 << 16], errb[1 << 14];
 

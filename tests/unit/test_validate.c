@@ -11,9 +11,9 @@
 
 #include "testutil.h"
 
-#include "conifit/measure.h"
-#include "conifit/msm.h"
-#include "conifit/validate.h"
+#include "io/measure.h"
+#include "model/msm.h"
+#include "check/validate.h"
 
 static char out[1 << 16], errb[1 << 14];
 

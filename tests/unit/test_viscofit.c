@@ -10,11 +10,11 @@
 
 #include <jansson.h>
 
-#include "conifit/cell.h"
-#include "conifit/measure.h"
-#include "conifit/msm.h"
-#include "conifit/viscofit.h"
-#include "conifit/viscomodel.h"
+#include "model/cell.h"
+#include "io/measure.h"
+#include "model/msm.h"
+#include "fit/viscofit.h"
+#include "model/viscomodel.h"
 #include "viscoutil.h"
 
 /* The ramp and hold of the model p evaluated as setup s says: times t, strains x, stresses y

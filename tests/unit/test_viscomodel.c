@@ -5,9 +5,9 @@
 */
 #include "testutil.h"
 
-#include "conifit/cell.h"
-#include "conifit/msm.h"
-#include "conifit/viscomodel.h"
+#include "model/cell.h"
+#include "model/msm.h"
+#include "model/viscomodel.h"
 #include "viscoutil.h"
 
 /* During a hold the law force is constant, so every branch decays exactly as exp(-t/tau): in a

@@ -163,18 +163,4 @@ double cf_law_deflection(const cf_law *law, double F_N);
 cf_status cf_law_method_parse(const char *name, cf_law_method *method, cf_error *err);
 const char *cf_law_method_name(cf_law_method method);
 
-/* Instruction sets of the vectorised batches (the law's lanes, the lattice's spring sweep), each
-** the former's superset. Processors without AVX2 run the baseline copy. */
-typedef enum { CF_SIMD_SSE2 = 0, CF_SIMD_AVX2 = 1, CF_SIMD_AVX512 = 2 } cf_simd;
-
-/* The widest instruction set the batches may use: the processor's, lowered by the environment
-** variable CONIFIT_SIMD ("sse2", "avx2" or "avx512"; unset or empty for no limit). A build without
-** the copies (clang, the sanitizer build, other processors) always gives CF_SIMD_SSE2. Read once.
-** cf_simd_level_supported gives the processor's alone; cf_simd_parse returns -1 for a name not in
-** the list; cf_simd_name gives a level's name. */
-cf_simd cf_simd_level(void);
-cf_simd cf_simd_level_supported(void);
-int cf_simd_parse(const char *name);
-const char *cf_simd_name(cf_simd level);
-
 #endif

@@ -1,15 +1,15 @@
 /*
 ** Output handles: a file that appears whole or not at all.
 **
-** The calls that write a fit file or a plot (cf_pipeline_prepare, cf_pipeline_series_prepare,
-** cf_joint_prepare, cf_report_json_prepare, cf_visco_report_json_prepare, cf_visco_plot) leave
-** each output as a complete temporary file beside its target, held by a cf_output. The caller
-** puts it in place with cf_output_commit once every output of its run is ready, or drops it
-** with cf_output_abort; so a run with several outputs replaces all of them or none.
+** The calls that write a fit file (cf_tablefit_prepare, conifit/tablefit.h; and inside the
+** library the pipeline's, the report's and the plot's) leave each output as a complete temporary
+** file beside its target, held by a cf_output. The caller puts it in place with cf_output_commit
+** once every output of its run is ready, or drops it with cf_output_abort; so a run with several
+** outputs replaces all of them or none.
 **
 **   cf_output *json = NULL;
 **   cf_output_new(&json, &err);
-**   if (cf_pipeline_prepare(&r, "tissue.json", NULL, NULL, json, NULL, &err) == CF_OK)
+**   if (cf_tablefit_prepare(fit, "tissue.json", json, &err) == CF_OK)
 **       cf_output_commit(json, &err);
 **   cf_output_free(json);              (aborts what was not committed)
 **

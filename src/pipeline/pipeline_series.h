@@ -10,11 +10,11 @@
 #define CF_PIPELINE_SERIES_H
 
 #include "conifit/error.h"
-#include "conifit/measure.h"
+#include "io/measure.h"
 #include "conifit/output.h"
-#include "conifit/pipeline.h"
-#include "conifit/viscofit.h"
-#include "conifit/viscoreport.h"
+#include "pipeline/pipeline.h"
+#include "fit/viscofit.h"
+#include "report/viscoreport.h"
 
 /* Fits the series t (t->t not NULL) with vo and places a spring of each type of opt->types from
 ** the fitted identifiable quantities (opt->fit: fixed parameters, index bound). Fills r (r->table

@@ -18,12 +18,12 @@
 
 #include <stddef.h>
 
-#include "conifit/calibration.h"
+#include "model/calibration.h"
 #include "conifit/error.h"
-#include "conifit/family.h"
-#include "conifit/fit.h"
-#include "conifit/lattice_fit.h"
-#include "conifit/measure.h"
+#include "model/family.h"
+#include "fit/fit.h"
+#include "fit/lattice_fit.h"
+#include "io/measure.h"
 
 /* Most tables in one joint fit. */
 #define CF_JOINT_MAX 16

@@ -13,7 +13,7 @@
 #ifndef CF_SOFTENING_H
 #define CF_SOFTENING_H
 
-#include "conifit/table.h"
+#include "model/table.h"
 
 #define CF_SOFTENING_BEND 0.0125
 #define CF_SOFTENING_SHARE 0.25

@@ -12,11 +12,11 @@
 
 #include <stddef.h>
 
-#include "conifit/budget.h"
+#include "io/budget.h"
 #include "conifit/error.h"
 #include "conifit/law.h"
-#include "conifit/msm.h"
-#include "conifit/scene.h"
+#include "model/msm.h"
+#include "io/scene.h"
 
 /* Index of the first sample whose tangent had a negative pivot; n when none did. */
 size_t cf_hysteresis_first_unstable(const cf_msm_sample *s, size_t n);

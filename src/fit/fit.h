@@ -26,9 +26,9 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
-#include "conifit/family.h"
+#include "model/family.h"
 #include "conifit/law.h"
-#include "conifit/measure.h"
+#include "io/measure.h"
 
 /* Arrays of design parameters below are indexed by CF_P_D1 ... CF_P_H (spring.h). */
 

@@ -27,7 +27,7 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
-#include "conifit/lattice.h"
+#include "model/lattice.h"
 #include "conifit/law.h"
 
 /* Most Prony terms of a reduced relaxation function. */

@@ -10,10 +10,10 @@
 #define CF_VISCOREPORT_H
 
 #include "conifit/error.h"
-#include "conifit/fit.h"
-#include "conifit/measure.h"
+#include "fit/fit.h"
+#include "io/measure.h"
 #include "conifit/output.h"
-#include "conifit/viscofit.h"
+#include "fit/viscofit.h"
 
 typedef struct cf_visco_report {
     const char *version;       /* conifit version */

@@ -9,7 +9,7 @@
 
 #include <stddef.h>
 
-#include "conifit/cell.h"
+#include "model/cell.h"
 #include "conifit/error.h"
 
 typedef enum cf_table_kind {

@@ -22,8 +22,8 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
-#include "conifit/lattice.h"
-#include "conifit/scene.h"
+#include "model/lattice.h"
+#include "io/scene.h"
 
 #define CF_BUDGET_MAX_MEMORY_DEFAULT (2.0 * 1024 * 1024 * 1024) /* bytes: 2 GiB */
 #define CF_BUDGET_MAX_STEPS_DEFAULT 1e7                         /* steps or solves */

@@ -38,7 +38,7 @@
 
 #include "conifit/error.h"
 #include "conifit/law.h"
-#include "conifit/msm.h"
+#include "model/msm.h"
 
 /* The "schema" value of a single exported spring. */
 #define CF_SPRINGFILE_SCHEMA "conifit-spring-1"

@@ -14,8 +14,8 @@
 #ifndef CF_BASELINE_H
 #define CF_BASELINE_H
 
-#include "conifit/cell.h"
-#include "conifit/fit.h"
+#include "model/cell.h"
+#include "fit/fit.h"
 
 typedef enum cf_baseline_kind {
     CF_BASE_LINEAR = 0,

@@ -23,9 +23,9 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
-#include "conifit/family.h"
+#include "model/family.h"
 #include "conifit/law.h"
-#include "conifit/msm.h"
+#include "model/msm.h"
 
 /* The parameters of the time-dependent model. */
 typedef struct cf_visco_params {

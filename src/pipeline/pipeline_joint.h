@@ -11,9 +11,9 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
-#include "conifit/jointreport.h"
-#include "conifit/measure.h"
-#include "conifit/pipeline.h"
+#include "report/jointreport.h"
+#include "io/measure.h"
+#include "pipeline/pipeline.h"
 
 /* Fits one lattice (opt->lattice) to the n tables jointly with opt->fit, once for each spring
 ** type of opt->types, and fills r: r->tables = tables (which must outlive r), r->with_timing from

@@ -10,7 +10,7 @@
 #ifndef CF_CELL_STABILITY_H
 #define CF_CELL_STABILITY_H
 
-#include "conifit/cell.h"
+#include "model/cell.h"
 #include "conifit/error.h"
 
 /* The smallest eigenvalue (MPa) of the cell's incremental stiffness at F. CF_E_DATA as

@@ -19,7 +19,7 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
-#include "conifit/table.h"
+#include "model/table.h"
 
 /* Names of the measures a table records (table.h), as messages and reports spell them. */
 const char *cf_stress_measure_name(cf_stress_measure m); /* "nominal", "cauchy" */

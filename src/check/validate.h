@@ -22,13 +22,13 @@
 
 #include <stddef.h>
 
-#include "conifit/cell.h"
+#include "model/cell.h"
 #include "conifit/error.h"
-#include "conifit/fit.h"
-#include "conifit/lattice_fit.h"
+#include "fit/fit.h"
+#include "fit/lattice_fit.h"
 #include "conifit/law.h"
-#include "conifit/msm.h"
-#include "conifit/scene.h"
+#include "model/msm.h"
+#include "io/scene.h"
 
 /* cf_msm_default() (3 x 3 x 3 cells, face and body diagonals, bottom axial) with the fitter's own
 ** evaluator, CF_LAW_CLOSED. */

@@ -26,10 +26,10 @@
 #include <stdio.h>
 
 #include "conifit/error.h"
-#include "conifit/fitfile.h"
+#include "io/fitfile.h"
 #include "conifit/law.h"
-#include "conifit/msm.h"
-#include "conifit/scene.h"
+#include "model/msm.h"
+#include "io/scene.h"
 
 /* Default tolerance of the table (fraction of F_C), and the range accepted. Below 1e-9 the rows
 ** near solid would have to be closer than the spacing of doubles allows. */
@@ -214,7 +214,7 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
                                   const cf_export_options *opt, const cf_export_lattice *lx,
                                   cf_export_report *rep, cf_error *err);
 
-/* Writes the tissue body b (conifit/body.h) as a CalculiX or FEBio 4 model or a SOFA scene
+/* Writes the tissue body b (model/body.h) as a CalculiX or FEBio 4 model or a SOFA scene
 ** (opt->format calculix, febio or sofa; others CF_E_DATA; sofa only without a volume term,
 ** kappa = 0, nu = 0.25, since SOFA's springs cannot express it: the scene holds the springs as the
 ** SOFA lattice export writes them and the probe as a PartialLinearMovementProjectiveConstraint):

@@ -33,7 +33,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "conifit/calibration.h"
+#include "model/calibration.h"
 #include "conifit/error.h"
 #include "conifit/law.h"
 

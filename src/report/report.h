@@ -8,13 +8,13 @@
 
 #include <stddef.h>
 
-#include "conifit/baseline.h"
+#include "fit/baseline.h"
 #include "conifit/error.h"
-#include "conifit/fit.h"
-#include "conifit/measure.h"
+#include "fit/fit.h"
+#include "io/measure.h"
 #include "conifit/output.h"
-#include "conifit/softening.h"
-#include "conifit/validate.h"
+#include "fit/softening.h"
+#include "check/validate.h"
 
 /* One table and its fits, as the report sees it (cf_pipeline_fit fills it). Values of the fits
 ** are in conifit's units (MPa or N); table->y_to_file converts them to the file's own unit for

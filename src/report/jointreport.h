@@ -10,8 +10,8 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
-#include "conifit/joint.h"
-#include "conifit/measure.h"
+#include "fit/joint.h"
+#include "io/measure.h"
 #include "conifit/output.h"
 
 /* Both laws of one type's joint fit (--law conical-tail or auto): the law not kept. */

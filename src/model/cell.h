@@ -44,7 +44,7 @@
 
 #include <stddef.h>
 
-#include "conifit/calibration.h"
+#include "model/calibration.h"
 #include "conifit/error.h"
 #include "conifit/law.h"
 

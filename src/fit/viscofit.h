@@ -27,8 +27,8 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
-#include "conifit/fit.h"
-#include "conifit/viscomodel.h"
+#include "fit/fit.h"
+#include "model/viscomodel.h"
 
 /* Branch counts tried when the choice is left to AIC. */
 #define CF_VISCO_AIC_MAX 4

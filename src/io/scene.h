@@ -10,10 +10,10 @@
 
 #include <stddef.h>
 
-#include "conifit/body.h"
+#include "model/body.h"
 #include "conifit/error.h"
 #include "conifit/law.h"
-#include "conifit/msm.h"
+#include "model/msm.h"
 
 typedef enum cf_protocol_kind {
     CF_PROTO_RAMP = 0,   /* 0 -> target over duration_s */

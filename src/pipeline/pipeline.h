@@ -14,13 +14,13 @@
 #ifndef CF_PIPELINE_H
 #define CF_PIPELINE_H
 
-#include "conifit/budget.h"
+#include "io/budget.h"
 #include "conifit/error.h"
-#include "conifit/fit.h"
-#include "conifit/measure.h"
+#include "fit/fit.h"
+#include "io/measure.h"
 #include "conifit/output.h"
-#include "conifit/report.h"
-#include "conifit/validate.h"
+#include "report/report.h"
+#include "check/validate.h"
 
 /* Spring types to fit, as bits of cf_pipeline_options.types. */
 enum {

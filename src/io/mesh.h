@@ -4,7 +4,7 @@
 #ifndef CF_MESH_H
 #define CF_MESH_H
 
-#include "conifit/body.h"
+#include "model/body.h"
 #include "conifit/error.h"
 
 /* Reads the volume mesh at path (Gmsh's mesh formats: .msh of every version, .mesh, .vtk, .unv,

@@ -16,11 +16,11 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
-#include "conifit/family.h"
-#include "conifit/fit.h"
+#include "model/family.h"
+#include "fit/fit.h"
 #include "conifit/law.h"
-#include "conifit/measure.h"
-#include "conifit/msm.h"
+#include "io/measure.h"
+#include "model/msm.h"
 
 /* Where the lattice comes from (the validation's lattice and the fits through it). */
 typedef struct cf_validate_setup {
