@@ -1,8 +1,8 @@
 /*
-** Tissue bodies (body.h): the springs on the edges of a tetrahedral mesh and their calibration,
-** and the state measured at a body's positions. The probe's geometry is in body_probe.c, the
-** tangent and forces in body_assemble.c, the static solve in body_solve.c, the haptic loop in
-** body_haptic.c.
+** Tissue bodies (body.h): the body of a tetrahedral mesh's net (net.h; its springs on the mesh's
+** edges and their calibration are made by net_mesh.c), and the state measured at a body's
+** positions. The probe's geometry is in body_probe.c, the tangent and forces in body_assemble.c,
+** the static solve in body_solve.c, the haptic loop in body_haptic.c.
 */
 #include <math.h>
 #include <stdlib.h>

@@ -1,6 +1,7 @@
 /*
-** The mass-spring lattice (see lattice.h): construction of nodes, springs, weights, masses and
-** boundary fixities, and the force kernel the solvers call on every step.
+** The mass-spring lattice (see lattice.h): its net (net.h: nodes, springs, weights and the bottom's
+** fixity, made by cf_net_lattice) copied into structures of arrays with the nodes' masses and the
+** top face, and the force kernel the solvers call on every step.
 */
 #include "conifit/lattice.h"
 #include "model/lattice_cells.h"

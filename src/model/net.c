@@ -81,18 +81,34 @@ static void add_springs(cf_net *n, const cf_lattice_config *cfg, double H, const
     }
 }
 
-/* The springs the lattice of cfg has: per node, those of its directions whose far end is inside. */
-static size_t count_springs(const cf_lattice_config *cfg, const int (*off)[3], int noff)
+/* The spring directions of the lattice of cfg into off (each unordered pair of neighbours once,
+** those of the families of non-zero weight, in the order of cell.h): how many. */
+static int lattice_dirs(const cf_lattice_config *cfg, int off[CF_CELL_DIRS][3])
 {
-    size_t ns = 0;
-    const int dim[3] = {cfg->nx, cfg->ny, cfg->nz};
-    for (int o = 0; o < noff; o++) {
-        size_t c = 1;
-        for (int a = 0; a < 3; a++)
-            c *= (size_t)(dim[a] + 1 - abs(off[o][a]));
-        ns += c;
+    int noff = 0;
+    for (int d = 0; d < CF_CELL_DIRS; d++) {
+        int fam;
+        cf_cell_direction(d, off[noff], &fam);
+        if (cfg->weight[fam] != 0)
+            noff++;
     }
-    return ns;
+    return noff;
+}
+
+void cf_net_lattice_size(const cf_lattice_config *cfg, double *nodes, double *springs)
+{
+    int off[CF_CELL_DIRS][3];
+    const int noff = lattice_dirs(cfg, off);
+    const double dim[3] = {cfg->nx, cfg->ny, cfg->nz};
+    *nodes = (dim[0] + 1) * (dim[1] + 1) * (dim[2] + 1);
+    /* a direction of offsets o has prod (n_a + 1 - |o_a|) springs: the nodes whose far end is in */
+    *springs = 0;
+    for (int o = 0; o < noff; o++) {
+        double c = 1;
+        for (int a = 0; a < 3; a++)
+            c *= dim[a] + 1 - abs(off[o][a]);
+        *springs += c;
+    }
 }
 
 /* The bottom face's fixity of cfg->bottom and the lattice's cells (x fastest). */
@@ -133,20 +149,14 @@ cf_status cf_net_lattice(cf_net *n, const cf_lattice_config *cfg, double H_mm, c
     if (!(H_mm > 0) || !isfinite(H_mm))
         return cf_error_set(err, CF_E_DATA, "lattice cell edge %g mm: must be finite and > 0",
                             H_mm);
-    /* the spring directions of the cell (each unordered pair of neighbours once); a family of
-    ** weight 0 has no springs */
     int off[CF_CELL_DIRS][3];
-    int noff = 0;
-    for (int d = 0; d < CF_CELL_DIRS; d++) {
-        int fam;
-        cf_cell_direction(d, off[noff], &fam);
-        if (cfg->weight[fam] != 0)
-            noff++;
-    }
+    const int noff = lattice_dirs(cfg, off);
     n->nn = (size_t)(cfg->nx + 1) * (cfg->ny + 1) * (cfg->nz + 1);
     n->nc = (size_t)cfg->nx * cfg->ny * cfg->nz;
     n->cell_kind = CF_NET_HEX8;
-    const size_t cap = count_springs(cfg, (const int (*)[3])off, noff);
+    double nodes, springs;
+    cf_net_lattice_size(cfg, &nodes, &springs);
+    const size_t cap = (size_t)springs;
     n->X = malloc(3 * n->nn * sizeof *n->X);
     n->fix = calloc(n->nn, 1);
     n->si = malloc((cap ? cap : 1) * sizeof *n->si);

@@ -56,6 +56,10 @@ typedef struct cf_net {
 ** runs out (n is then empty). */
 cf_status cf_net_lattice(cf_net *n, const cf_lattice_config *cfg, double H_mm, cf_error *err);
 
+/* The nodes and springs cf_net_lattice makes of cfg (cells >= 1 along each axis), counted without
+** making them (exact integers below 2^53), for the budgets of scenes. */
+void cf_net_lattice_size(const cf_lattice_config *cfg, double *nodes, double *springs);
+
 /* The net of the tetrahedral mesh m (checked by cf_mesh_check): its nodes, none held; its edges
 ** as springs in the order of their end nodes, rest length the edge's, weight the calibration of
 ** body.h for law (per tetrahedron the edge stiffnesses that best match an isotropic tensor, the

@@ -45,6 +45,9 @@ static void check_lattice(const cf_lattice_config *cfg)
     assert_int_equal(cf_net_cell_size(n.cell_kind), 8);
     assert_string_equal(cf_net_cell_name(n.cell_kind), "hex8");
     assert_int_equal(n.nc, nx * ny * nz);
+    double nodes, springs; /* the count the budgets take, without making the net */
+    cf_net_lattice_size(cfg, &nodes, &springs);
+    assert_true(nodes == (double)n.nn && springs == (double)n.ns);
     /* springs per family: a cell direction with offsets o has prod (n_a + 1 - |o_a|) springs */
     size_t expect[CF_FAMILY_COUNT] = {0}, count[CF_FAMILY_COUNT] = {0};
     double wsum[CF_FAMILY_COUNT] = {0};
