@@ -104,8 +104,8 @@ static int lattice_alloc(cf_lattice *lat, size_t nn, size_t cap, size_t ntop)
     return lat->fix && lat->family && lat->si && lat->sj && lat->top && lat->top_share ? 0 : -1;
 }
 
-/* The nodes of net at their places, each with its share of the cells' mass, and its springs,
-** copied into the lattice's arrays (allocated for net->ns springs); the most springs at one node. */
+/* The nodes of net at their places, each with its share of the cells' mass, its fixity and its
+** springs, copied into the lattice's arrays (allocated for net->ns springs). */
 static void copy_net(cf_lattice *lat, const cf_net *net)
 {
     const cf_lattice_config *cfg = &lat->cfg;
