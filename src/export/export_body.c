@@ -74,17 +74,17 @@ static cf_status check_body(const cf_body *b, const cf_probe *pr, size_t nsteps,
     return CF_OK;
 }
 
-/* The body's nodes, held directions, springs (one group per edge: its rest length and its
-** calibration factor as the weight) and the reaction tolerance the tables imply into m. */
-static void fill_model(const cf_body *b, const cf_export_table *t, const cf_law *law,
-                       cf_xmodel *m)
+/* The body's net into m (every edge its own spring group: its rest length and its calibration
+** factor as the weight), its height and the reaction tolerance the tables imply. 0, or -1 out of
+** memory. */
+static int fill_model(const cf_body *b, const cf_export_table *t, const cf_law *law,
+                      cf_xmodel *m)
 {
+    const cf_net net = cf_net_of_body(b);
+    if (cf_xmodel_of_net(m, &net, CF_XGROUP_EACH) != 0)
+        return -1;
     double zlo = INFINITY, zhi = -INFINITY;
     for (size_t i = 0; i < b->nn; i++) {
-        m->X[i] = b->X[3 * i];
-        m->Y[i] = b->X[3 * i + 1];
-        m->Z[i] = b->X[3 * i + 2];
-        m->fix[i] = b->fix[i] & (CF_FIX_X | CF_FIX_Y | CF_FIX_Z);
         zlo = fmin(zlo, m->Z[i]);
         zhi = fmax(zhi, m->Z[i]);
     }
@@ -94,17 +94,12 @@ static void fill_model(const cf_body *b, const cf_export_table *t, const cf_law 
     const double zmid = (zlo + zhi) / 2;
     double wcut = 0;
     for (size_t s = 0; s < b->ns; s++) {
-        m->si[s] = b->si[s];
-        m->sj[s] = b->sj[s];
-        m->grp[s] = (uint32_t)s;
-        m->g[s].L0_mm = b->L0[s];
-        m->g[s].weight = b->c[s];
-        m->g[s].count = 1;
         const double zi = b->X[3 * b->si[s] + 2], zj = b->X[3 * b->sj[s] + 2];
         if ((zi - zmid) * (zj - zmid) < 0)
             wcut += b->c[s] * fabs(zi - zj) / b->L0[s];
     }
     m->reaction_tol_N = t->tol * law->F_C_N * wcut;
+    return 0;
 }
 
 cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, size_t nsteps,
@@ -131,22 +126,11 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, 
     m.output = opt->output;
     m.law = law;
     m.base = &t;
-    m.nn = b->nn;
-    m.ns = m.ng = b->ns;
-    m.X = malloc(b->nn * sizeof *m.X);
-    m.Y = malloc(b->nn * sizeof *m.Y);
-    m.Z = malloc(b->nn * sizeof *m.Z);
-    m.fix = malloc(b->nn);
-    m.si = malloc(b->ns * sizeof *m.si);
-    m.sj = malloc(b->ns * sizeof *m.sj);
-    m.grp = malloc(b->ns * sizeof *m.grp);
-    m.g = calloc(b->ns, sizeof *m.g);
     m.nsteps = nsteps;
     m.dz_mm = malloc(nsteps * sizeof *m.dz_mm);
     m.ref_N = malloc(nsteps * sizeof *m.ref_N);
     m.strain = malloc(nsteps * sizeof *m.strain);
-    if (!m.X || !m.Y || !m.Z || !m.fix || !m.si || !m.sj || !m.grp || !m.g || !m.dz_mm ||
-        !m.ref_N || !m.strain || punch_nodes(b, pr, &m) != 0)
+    if (!m.dz_mm || !m.ref_N || !m.strain || punch_nodes(b, pr, &m) != 0)
         goto oom;
     if (m.ntop == 0) {
         st = cf_error_set(err, CF_E_DATA,
@@ -154,7 +138,8 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, 
                           "(center_mm must lie on a flat face of the mesh)");
         goto done;
     }
-    fill_model(b, &t, law, &m);
+    if (fill_model(b, &t, law, &m) != 0)
+        goto oom;
     for (size_t k = 0; k < nsteps; k++) {
         m.dz_mm[k] = depth_mm[k] * pr->dir[2];
         m.ref_N[k] = force_N[k] * (pr->dir[2] < 0 ? 1 : -1);

@@ -11,15 +11,10 @@
 #include <string.h>
 
 #include "export/export.h"
-#include "model/lattice_cells.h"
 #include "base/gslguard.h"
 #include "model/lattice.h"
 #include "check/validate.h"
 #include "export/export_model.h"
-
-/* Two springs belong to one group when their rest lengths and weights agree to this relative
-** difference (they are computed by the same formulas, so they agree to rounding). */
-#define GROUP_REL 1e-12
 
 cf_export_lattice cf_export_lattice_default(const cf_law *law)
 {
@@ -84,58 +79,32 @@ static void lattice_title(char *buf, size_t cap, const cf_lattice_config *c)
              c->bottom == CF_BOTTOM_CLAMPED ? "clamped" : "held along z (sliding)");
 }
 
-static int same(double a, double b)
-{
-    return fabs(a - b) <= GROUP_REL * fmax(fabs(a), fabs(b));
-}
-
-/* Copies the lattice's nodes, springs and boundary into m and groups the springs. */
+/* The lattice's net (its generator's nodes, springs and fixity: those the lattice was built from)
+** into m with its springs grouped, its top nodes and its cells. */
 static int model_of_lattice(cf_xmodel *m, const cf_lattice *lat)
 {
-    m->nn = lat->nn;
-    m->ns = lat->ns;
+    cf_net net;
+    cf_error e = {0};
+    if (cf_net_lattice(&net, &lat->cfg, lat->H_mm, &e) != CF_OK)
+        return -1; /* the lattice was built from this configuration: only memory can fail */
+    int rc = cf_xmodel_of_net(m, &net, CF_XGROUP_SHARED);
     m->ntop = lat->ntop;
-    m->X = malloc(m->nn * sizeof *m->X);
-    m->Y = malloc(m->nn * sizeof *m->Y);
-    m->Z = malloc(m->nn * sizeof *m->Z);
-    m->fix = malloc(m->nn);
-    m->si = malloc(m->ns * sizeof *m->si);
-    m->sj = malloc(m->ns * sizeof *m->sj);
-    m->grp = malloc(m->ns * sizeof *m->grp);
     m->top = malloc(m->ntop * sizeof *m->top);
-    m->g = calloc(m->ns, sizeof *m->g); /* at most one group per spring */
-    if (!m->X || !m->Y || !m->Z || !m->fix || !m->si || !m->sj || !m->grp || !m->top || !m->g)
-        return -1;
-    memcpy(m->X, lat->X, m->nn * sizeof *m->X);
-    memcpy(m->Y, lat->Y, m->nn * sizeof *m->Y);
-    memcpy(m->Z, lat->Z, m->nn * sizeof *m->Z);
-    memcpy(m->fix, lat->fix, m->nn);
-    memcpy(m->si, lat->si, m->ns * sizeof *m->si);
-    memcpy(m->sj, lat->sj, m->ns * sizeof *m->sj);
-    memcpy(m->top, lat->top, m->ntop * sizeof *m->top);
-    for (size_t s = 0; s < m->ns; s++) {
-        size_t g = 0;
-        while (g < m->ng && !(same(m->g[g].L0_mm, lat->L0_mm[s]) && same(m->g[g].weight, lat->w[s])))
-            g++;
-        if (g == m->ng) {
-            m->g[g].L0_mm = lat->L0_mm[s];
-            m->g[g].weight = lat->w[s];
-            m->ng++;
-        }
-        m->g[g].count++;
-        m->grp[s] = (uint32_t)g;
-    }
     m->area_mm2 = lat->area_mm2;
     m->height_mm = lat->height_mm;
     m->kappa_MPa = lat->cfg.volume_modulus_MPa;
-    if (m->kappa_MPa > 0) { /* every cell's eight nodes, corner di + 2 dj + 4 dk */
-        m->ncells = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
+    if (m->kappa_MPa > 0) { /* the net's cells, eight nodes each, corner di + 2 dj + 4 dk */
+        m->ncells = net.nc;
         m->cell = malloc(8 * m->ncells * sizeof *m->cell);
-        if (!m->cell)
-            return -1;
-        for (size_t c = 0; c < m->ncells; c++)
-            cf_lattice_cell_nodes(lat, c, m->cell + 8 * c);
+        if (m->cell)
+            memcpy(m->cell, net.cell, 8 * m->ncells * sizeof *m->cell);
+        else
+            rc = -1;
     }
+    cf_net_free(&net);
+    if (rc != 0 || !m->top)
+        return -1;
+    memcpy(m->top, lat->top, m->ntop * sizeof *m->top);
     /* the springs a horizontal plane through the middle of a layer of cells cuts */
     const double zc = lat->H_mm * (floor(lat->cfg.nz / 2.0) + 0.5);
     double cut = 0.0;

@@ -17,6 +17,53 @@
 #include "conifit/version.h"
 #include "base/safetext.h"
 
+/* Two springs belong to one shared group when their rest lengths and weights agree to this relative
+** difference (they are computed by the same formulas, so they agree to rounding). */
+#define GROUP_REL 1e-12
+
+static int same(double a, double b)
+{
+    return fabs(a - b) <= GROUP_REL * fmax(fabs(a), fabs(b));
+}
+
+int cf_xmodel_of_net(cf_xmodel *m, const cf_net *n, cf_xgrouping grouping)
+{
+    m->nn = n->nn;
+    m->ns = n->ns;
+    m->ng = 0;
+    m->X = malloc(n->nn * sizeof *m->X);
+    m->Y = malloc(n->nn * sizeof *m->Y);
+    m->Z = malloc(n->nn * sizeof *m->Z);
+    m->fix = malloc(n->nn ? n->nn : 1);
+    m->si = malloc(n->ns * sizeof *m->si);
+    m->sj = malloc(n->ns * sizeof *m->sj);
+    m->grp = malloc(n->ns * sizeof *m->grp);
+    m->g = calloc(n->ns, sizeof *m->g); /* at most one group per spring */
+    if (!m->X || !m->Y || !m->Z || !m->fix || !m->si || !m->sj || !m->grp || !m->g)
+        return -1;
+    for (size_t i = 0; i < n->nn; i++) {
+        m->X[i] = n->X[3 * i];
+        m->Y[i] = n->X[3 * i + 1];
+        m->Z[i] = n->X[3 * i + 2];
+        m->fix[i] = n->fix[i] & (CF_FIX_X | CF_FIX_Y | CF_FIX_Z);
+    }
+    memcpy(m->si, n->si, n->ns * sizeof *m->si);
+    memcpy(m->sj, n->sj, n->ns * sizeof *m->sj);
+    for (size_t s = 0; s < n->ns; s++) {
+        size_t g = grouping == CF_XGROUP_EACH ? m->ng : 0;
+        while (g < m->ng && !(same(m->g[g].L0_mm, n->L0_mm[s]) && same(m->g[g].weight, n->w[s])))
+            g++;
+        if (g == m->ng) {
+            m->g[g].L0_mm = n->L0_mm[s];
+            m->g[g].weight = n->w[s];
+            m->ng++;
+        }
+        m->g[g].count++;
+        m->grp[s] = (uint32_t)g;
+    }
+    return 0;
+}
+
 void cf_xmodel_free(cf_xmodel *m)
 {
     if (!m)

@@ -13,6 +13,7 @@
 
 #include "export/export.h"
 #include "conifit/law.h"
+#include "model/net.h"
 
 /* Springs of one rest length and one weight: their table in their own elongation and tension. */
 typedef struct cf_xgroup {
@@ -62,6 +63,15 @@ typedef struct cf_xmodel {
 } cf_xmodel;
 /* NULL when format f can carry m's volume term (none, or CalculiX/Abaqus), else why it cannot. */
 const char *cf_xmodel_volume_refusal(const cf_xmodel *m, cf_export_format f);
+
+/* Groups of springs: one per spring (a body's every edge its own weight), or one per rest length
+** and weight (a lattice's few, equal to 1e-12 relative). */
+typedef enum cf_xgrouping { CF_XGROUP_EACH = 0, CF_XGROUP_SHARED = 1 } cf_xgrouping;
+
+/* The nodes of net n (positions, held directions) and its springs (end nodes, groups with their
+** rest lengths and weights) into m's arrays, allocated here; m's other fields are left as they
+** are. 0, or -1 when memory runs out (what was allocated is left for cf_xmodel_free). */
+int cf_xmodel_of_net(cf_xmodel *m, const cf_net *n, cf_xgrouping grouping);
 
 /* Releases what the model owns (its arrays and group tables). Safe on a zeroed model. */
 void cf_xmodel_free(cf_xmodel *m);

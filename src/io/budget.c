@@ -10,6 +10,7 @@
 #include "model/calibration.h"
 #include "model/linsolve.h"
 #include "model/msm_tangent.h"
+#include "model/net.h"
 
 /* Bytes per node and per spring of the lattice and the solver state (positions, reference
 ** positions, forces, masses, velocities; spring ends, lengths, weights, tensions, law state), and
@@ -65,17 +66,14 @@ static double mib(double bytes)
     return bytes / (1024.0 * 1024.0);
 }
 
-/* Springs of an nx x ny x nz lattice with the families the scene weights. */
-static double lattice_springs(const cf_lattice_config *L, double nx, double ny, double nz)
+/* Nodes and springs of an nx x ny x nz lattice with the families the scene weights: those of its
+** net (cf_net_lattice_size). */
+static void lattice_size(const cf_lattice_config *L, double nx, double ny, double nz,
+                         double *nodes, double *springs)
 {
-    double springs = 0;
-    if (L->weight[CF_FAMILY_EDGE] > 0)
-        springs += nx * (ny + 1) * (nz + 1) + ny * (nx + 1) * (nz + 1) + nz * (nx + 1) * (ny + 1);
-    if (L->weight[CF_FAMILY_FACE] > 0)
-        springs += 2 * (nx * ny * (nz + 1) + ny * nz * (nx + 1) + nx * nz * (ny + 1));
-    if (L->weight[CF_FAMILY_BODY] > 0)
-        springs += 4 * nx * ny * nz;
-    return springs;
+    cf_lattice_config c = *L;
+    c.nx = (int)nx, c.ny = (int)ny, c.nz = (int)nz;
+    cf_net_lattice_size(&c, nodes, springs);
 }
 
 /* Bytes of the lattice and its solvers for nx x ny x nz cells: the lattice, and for static and
@@ -83,8 +81,8 @@ static double lattice_springs(const cf_lattice_config *L, double nx, double ny, 
 ** workspace (band, dense LU or GMRES basis: used only when the sparse factorisation fails). */
 static double lattice_bytes(const cf_scene *sc, double nx, double ny, double nz)
 {
-    const double nodes = (nx + 1) * (ny + 1) * (nz + 1);
-    const double springs = lattice_springs(&sc->cfg.lattice, nx, ny, nz);
+    double nodes, springs;
+    lattice_size(&sc->cfg.lattice, nx, ny, nz, &nodes, &springs);
     const double dof = 3 * nodes;
     double solver = 0;
     if (!sc->effects.inertia) { /* static and implicit runs factor the tangent */
@@ -174,8 +172,10 @@ cf_status cf_budget_check_size(const cf_scene *sc, const char *name, const cf_bu
     memset(c, 0, sizeof *c);
     const cf_lattice_config *L = &sc->cfg.lattice;
     const double nx = L->nx, ny = L->ny, nz = L->nz;
-    c->nodes = (size_t)((nx + 1) * (ny + 1) * (nz + 1));
-    c->springs = (size_t)lattice_springs(L, nx, ny, nz);
+    double nodes, springs;
+    lattice_size(L, nx, ny, nz, &nodes, &springs);
+    c->nodes = (size_t)nodes;
+    c->springs = (size_t)springs;
     c->samples = sc->nsamples;
     const double lattice = lattice_bytes(sc, nx, ny, nz);
     const double samples = (double)sc->nsamples * SAMPLE_BYTES;

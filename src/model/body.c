@@ -1,158 +1,21 @@
 /*
-** Tissue bodies (body.h): the springs on the edges of a tetrahedral mesh and their calibration,
-** and the state measured at a body's positions. The probe's geometry is in body_probe.c, the
-** tangent and forces in body_assemble.c, the static solve in body_solve.c, the haptic loop in
-** body_haptic.c.
+** Tissue bodies (body.h): the body of a tetrahedral mesh's net (net.h; its springs on the mesh's
+** edges and their calibration are made by net_mesh.c), and the state measured at a body's
+** positions. The probe's geometry is in body_probe.c, the tangent and forces in body_assemble.c,
+** the static solve in body_solve.c, the haptic loop in body_haptic.c.
 */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "model/body_internal.h"
-
-double cf_body_mu_of_law(const cf_law *law)
-{
-    return law->k0_N_per_mm / law->p.H_mm / 2.5; /* E0 = k0/H at nu = 1/4 (calibration.h) */
-}
+#include "model/net.h"
 
 double cf_body_kappa_for_nu(double mu_MPa, double nu)
 {
     return mu_MPa * (4 * nu - 1) / (1 - 2 * nu);
 }
 
-
-/* The six edges of a tetrahedron, as pairs of its corners. */
-static const int tet_edge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-
-static int cmp_u64(const void *a, const void *b)
-{
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
-}
-
-static uint64_t edge_key(uint32_t a, uint32_t b)
-{
-    return a < b ? ((uint64_t)a << 32) | b : ((uint64_t)b << 32) | a;
-}
-
-static size_t edge_find(const uint64_t *keys, size_t n, uint64_t k)
-{
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (keys[mid] < k)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
-/* Solves the symmetric positive definite n x n system A x = r (row-major, destroyed) by
-** Gaussian elimination; returns 0 when a pivot is not positive. */
-static int spd_solve(double *A, double *r, int n)
-{
-    for (int k = 0; k < n; k++) {
-        if (!(A[k * n + k] > 0))
-            return 0;
-        for (int i = k + 1; i < n; i++) {
-            double f = A[i * n + k] / A[k * n + k];
-            for (int j = k; j < n; j++)
-                A[i * n + j] -= f * A[k * n + j];
-            r[i] -= f * r[k];
-        }
-    }
-    for (int k = n - 1; k >= 0; k--) {
-        double s = r[k];
-        for (int j = k + 1; j < n; j++)
-            s -= A[k * n + j] * r[j];
-        r[k] = s / A[k * n + k];
-    }
-    return 1;
-}
-
-/* The 15 monomials n_x^a n_y^b n_z^c of degree 4: a fully symmetric fourth-order tensor has one
-** component each, appearing 4!/(a! b! c!) times. */
-static int mono[15][3];
-static double mono_mult[15], mono_iso[15];
-
-static void mono_init(void)
-{
-    static const double fact[5] = {1, 1, 2, 6, 24};
-    int m = 0;
-    for (int a = 4; a >= 0; a--)
-        for (int bb = 4 - a; bb >= 0; bb--) {
-            int c = 4 - a - bb;
-            mono[m][0] = a;
-            mono[m][1] = bb;
-            mono[m][2] = c;
-            mono_mult[m] = 24 / (fact[a] * fact[bb] * fact[c]);
-            /* mu (d_ij d_kl + d_ik d_jl + d_il d_jk) in units of mu: 3 for iiii, 1 for iijj */
-            mono_iso[m] = (a == 4 || bb == 4 || c == 4) ? 3
-                          : ((a == 2 || a == 0) && (bb == 2 || bb == 0) && (c == 2 || c == 0)) ? 1
-                                                                                               : 0;
-            m++;
-        }
-}
-
-static double ipow(double x, int p)
-{
-    double r = 1;
-    while (p-- > 0)
-        r *= x;
-    return r;
-}
-
-/* The six edge stiffnesses k[6] >= 0 (N/mm, per unit mu) of tetrahedron v whose spring tensor
-** (1/V) sum k L^2 n n n n best matches the isotropic tensor of lambda = mu = 1 (weighted least
-** squares over the 15 components; edges whose stiffness would be negative are dropped, one at a
-** time, the most negative first). */
-static void tet_springs(const double *X, const uint32_t *v, double V, double k[6])
-{
-    double A[15][6], t[15];
-    for (int e = 0; e < 6; e++) {
-        const double *p = X + 3 * v[tet_edge[e][0]], *q = X + 3 * v[tet_edge[e][1]];
-        double d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-        double L = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        for (int m = 0; m < 15; m++)
-            A[m][e] = sqrt(mono_mult[m]) * ipow(d[0] / L, mono[m][0]) * ipow(d[1] / L, mono[m][1]) *
-                      ipow(d[2] / L, mono[m][2]) * L * L / V;
-    }
-    for (int m = 0; m < 15; m++)
-        t[m] = sqrt(mono_mult[m]) * mono_iso[m];
-    int on[6] = {1, 1, 1, 1, 1, 1};
-    for (int round = 0; round < 6; round++) {
-        int idx[6], n = 0;
-        for (int e = 0; e < 6; e++)
-            if (on[e])
-                idx[n++] = e;
-        double N[36], r[6];
-        for (int i = 0; i < n; i++) {
-            r[i] = 0;
-            for (int m = 0; m < 15; m++)
-                r[i] += A[m][idx[i]] * t[m];
-            for (int j = 0; j < n; j++) {
-                double s = 0;
-                for (int m = 0; m < 15; m++)
-                    s += A[m][idx[i]] * A[m][idx[j]];
-                N[i * n + j] = s;
-            }
-        }
-        for (int e = 0; e < 6; e++)
-            k[e] = 0;
-        if (n == 0 || !spd_solve(N, r, n))
-            return;
-        int worst = -1;
-        for (int i = 0; i < n; i++) {
-            k[idx[i]] = r[i];
-            if (r[i] < 0 && (worst < 0 || r[i] < k[worst]))
-                worst = idx[i];
-        }
-        if (worst < 0)
-            return;
-        on[worst] = 0;
-    }
-}
 
 cf_status cf_body_create(cf_body *b, const cf_mesh *m, const cf_law *law, cf_law_method method,
                          double kappa_MPa, cf_error *err)
@@ -161,91 +24,64 @@ cf_status cf_body_create(cf_body *b, const cf_mesh *m, const cf_law *law, cf_law
     if (!isfinite(kappa_MPa) || kappa_MPa < 0)
         return cf_error_set(err, CF_E_DATA, "body: volume modulus %g MPa: must be finite and >= 0",
                             kappa_MPa);
+    /* the mesh's net: the body takes its arrays */
+    cf_net net;
+    cf_status st = cf_net_mesh(&net, m, law, err);
+    if (st != CF_OK)
+        return st;
     b->law = law;
     b->method = method;
-    b->nn = m->nn;
-    b->nt = m->nt;
-    uint64_t *keys = malloc(6 * m->nt * sizeof *keys);
-    b->X = malloc(3 * m->nn * sizeof *b->X);
-    b->x = malloc(3 * m->nn * sizeof *b->x);
-    b->fix = calloc(m->nn, 1);
-    b->tet = malloc(4 * m->nt * sizeof *b->tet);
-    b->V0 = malloc(m->nt * sizeof *b->V0);
-    if (!keys || !b->X || !b->x || !b->fix || !b->tet || !b->V0)
-        goto oom;
-    memcpy(b->X, m->X, 3 * m->nn * sizeof *b->X);
-    memcpy(b->x, m->X, 3 * m->nn * sizeof *b->x);
-    memcpy(b->tet, m->tet, 4 * m->nt * sizeof *b->tet);
-    for (size_t t = 0; t < m->nt; t++) {
-        const uint32_t *v = m->tet + 4 * t;
+    b->nn = net.nn;
+    b->nt = net.nc;
+    b->ns = net.ns;
+    b->X = net.X;
+    b->fix = net.fix;
+    b->tet = net.cell;
+    b->si = net.si;
+    b->sj = net.sj;
+    b->L0 = net.L0_mm;
+    b->c = net.w;
+    free(net.family);
+    b->x = malloc(3 * b->nn * sizeof *b->x);
+    b->V0 = malloc(b->nt * sizeof *b->V0);
+    if (!b->x || !b->V0) {
+        cf_body_free(b);
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for a body of %zu nodes", m->nn);
+    }
+    memcpy(b->x, b->X, 3 * b->nn * sizeof *b->x);
+    for (size_t t = 0; t < b->nt; t++) {
+        const uint32_t *v = b->tet + 4 * t;
         b->V0[t] = body_vol6(b->X + 3 * v[0], b->X + 3 * v[1], b->X + 3 * v[2], b->X + 3 * v[3]) / 6;
-        for (int e = 0; e < 6; e++)
-            keys[6 * t + e] = edge_key(v[tet_edge[e][0]], v[tet_edge[e][1]]);
     }
-    qsort(keys, 6 * m->nt, sizeof *keys, cmp_u64);
-    size_t ns = 0;
-    for (size_t i = 0; i < 6 * m->nt; i++)
-        if (i == 0 || keys[i] != keys[ns - 1])
-            keys[ns++] = keys[i];
-    b->ns = ns;
-    b->si = malloc(ns * sizeof *b->si);
-    b->sj = malloc(ns * sizeof *b->sj);
-    b->L0 = malloc(ns * sizeof *b->L0);
-    b->c = calloc(ns, sizeof *b->c);
-    if (!b->si || !b->sj || !b->L0 || !b->c)
-        goto oom;
     double Lsum = 0;
-    for (size_t s = 0; s < ns; s++) {
-        b->si[s] = (uint32_t)(keys[s] >> 32);
-        b->sj[s] = (uint32_t)(keys[s] & 0xffffffffu);
-        double d2 = 0;
-        for (int k = 0; k < 3; k++) {
-            double d = b->X[3 * b->sj[s] + k] - b->X[3 * b->si[s] + k];
-            d2 += d * d;
-        }
-        b->L0[s] = sqrt(d2);
+    for (size_t s = 0; s < b->ns; s++)
         Lsum += b->L0[s];
-    }
-    b->mean_edge_mm = Lsum / (double)ns;
-    /* per-tetrahedron matching (stiffnesses per unit mu collected in c for now) */
-    mono_init();
-    double Vtot = 0;
-    for (size_t t = 0; t < m->nt; t++) {
-        double k[6];
-        const uint32_t *v = m->tet + 4 * t;
-        tet_springs(b->X, v, b->V0[t], k);
-        Vtot += b->V0[t];
-        for (int e = 0; e < 6; e++)
-            b->c[edge_find(keys, ns, edge_key(v[tet_edge[e][0]], v[tet_edge[e][1]]))] += k[e];
-    }
-    /* the isotropic part of the whole network's tensor (1/Vtot) sum k L^2 nnnn: for a fully
-    ** symmetric tensor its shear modulus is the full trace over 15 */
-    double trace = 0;
-    for (size_t s = 0; s < ns; s++)
-        trace += b->c[s] * b->L0[s] * b->L0[s];
-    const double mu = cf_body_mu_of_law(law), mu_net = trace / (15 * Vtot);
-    if (!(mu_net > 0) || !(mu > 0))
-        goto bad;
-    const double g = mu / mu_net, H = law->p.H_mm, k0 = law->k0_N_per_mm;
-    for (size_t s = 0; s < ns; s++)
-        b->c[s] *= g * b->L0[s] / (k0 * H); /* k = c k0 H / L0 */
+    b->mean_edge_mm = Lsum / (double)b->ns;
+    const double mu = cf_body_mu_of_law(law);
     b->mu_MPa = mu;
     b->kappa_MPa = kappa_MPa;
     const double lam = mu + kappa_MPa;
     b->E_MPa = mu * (3 * lam + 2 * mu) / (lam + mu);
     b->nu = lam / (2 * (lam + mu));
-    free(keys);
     return CF_OK;
-bad:
-    free(keys);
-    cf_body_free(b);
-    return cf_error_set(err, CF_E_DATA, "body: the calibration found no stiffness");
-oom:
-    free(keys);
-    cf_body_free(b);
-    return cf_error_set(err, CF_E_INTERNAL, "out of memory for a body of %zu nodes", m->nn);
 }
 
+cf_net cf_net_of_body(const cf_body *b)
+{
+    cf_net n = {0};
+    n.nn = b->nn;
+    n.X = b->X;
+    n.fix = b->fix;
+    n.ns = b->ns;
+    n.si = b->si;
+    n.sj = b->sj;
+    n.L0_mm = b->L0;
+    n.w = b->c;
+    n.cell_kind = CF_NET_TET4;
+    n.nc = b->nt;
+    n.cell = b->tet;
+    return n;
+}
 
 double cf_body_measure(const cf_body *b, cf_body_state *st, double *max_u_over_travel)
 {

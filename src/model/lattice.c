@@ -1,6 +1,7 @@
 /*
-** The mass-spring lattice (see lattice.h): construction of nodes, springs, weights, masses and
-** boundary fixities, and the force kernel the solvers call on every step.
+** The mass-spring lattice (see lattice.h): its net (net.h: nodes, springs, weights and the bottom's
+** fixity, made by cf_net_lattice) copied into structures of arrays with the nodes' masses and the
+** top face, and the force kernel the solvers call on every step.
 */
 #include "model/lattice.h"
 #include "model/lattice_cells.h"
@@ -8,6 +9,7 @@
 
 #include "model/cell.h"
 #include "model/lattice_step.h"
+#include "model/net.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -50,13 +52,6 @@ void cf_lattice_free(cf_lattice *lat)
     free(lat->top);
     lat->fix = NULL;
     lat->si = lat->sj = lat->top = NULL;
-}
-
-double cf_lattice_axis_share(int p, int o, int n)
-{
-    if (o != 0)
-        return p + o >= 0 && p + o <= n ? 1.0 : 0.0;
-    return p == 0 || p == n ? 0.5 : 1.0;
 }
 
 static size_t node_id(const cf_lattice_config *c, int i, int j, int k)
@@ -109,64 +104,49 @@ static int lattice_alloc(cf_lattice *lat, size_t nn, size_t cap, size_t ntop)
     return lat->fix && lat->family && lat->si && lat->sj && lat->top && lat->top_share ? 0 : -1;
 }
 
-/* The springs from node (i, j, k) along the noff cell directions off, each with its rest length
-** and its weight (the family's, times the share of the cells that hold it); appended at
-** lat->ns, counted in degree. */
-static void add_springs(cf_lattice *lat, const int (*off)[3], int noff, int i, int j, int k,
-                        int *degree)
-{
-    const cf_lattice_config *cfg = &lat->cfg;
-    const double H = lat->H_mm;
-    const size_t p = node_id(cfg, i, j, k);
-    for (int o = 0; o < noff; o++) {
-        int i2 = i + off[o][0], j2 = j + off[o][1], k2 = k + off[o][2];
-        if (i2 < 0 || i2 > cfg->nx || j2 < 0 || j2 > cfg->ny || k2 < 0 || k2 > cfg->nz)
-            continue;
-        double share = cf_lattice_axis_share(i, off[o][0], cfg->nx) *
-                       cf_lattice_axis_share(j, off[o][1], cfg->ny) *
-                       cf_lattice_axis_share(k, off[o][2], cfg->nz); /* 1/4, 1/2 or 1 */
-        int nzc = (off[o][0] != 0) + (off[o][1] != 0) + (off[o][2] != 0);
-        double L0 = H * sqrt((double)nzc);
-        size_t q = node_id(cfg, i2, j2, k2), ns = lat->ns;
-        lat->si[ns] = (uint32_t)(p < q ? p : q);
-        lat->sj[ns] = (uint32_t)(p < q ? q : p);
-        lat->L0_mm[ns] = L0;
-        lat->a[ns] = H / L0;
-        lat->w[ns] = share * cfg->weight[nzc - 1];
-        lat->family[ns] = (uint8_t)(nzc - 1);
-        degree[p]++;
-        degree[q]++;
-        lat->ns = ns + 1;
-    }
-}
-
-/* Every node at its place with its share of the cells' mass, and the springs from it. 0, or -1
-** when memory runs out. */
-static int place_nodes(cf_lattice *lat, const int (*off)[3], int noff)
+/* The nodes of net at their places, each with its share of the cells' mass, its fixity and its
+** springs, copied into the lattice's arrays (allocated for net->ns springs). */
+static void copy_net(cf_lattice *lat, const cf_net *net)
 {
     const cf_lattice_config *cfg = &lat->cfg;
     const double H = lat->H_mm;
     const double cell_mass = cfg->density_t_per_mm3 * H * H * H;
-    int *degree = calloc(lat->nn, sizeof(int));
-    if (!degree)
-        return -1;
-    lat->ns = 0;
     lat->m_min_t = INFINITY;
     for (int k = 0; k <= cfg->nz; k++)
         for (int j = 0; j <= cfg->ny; j++)
             for (int i = 0; i <= cfg->nx; i++) {
                 size_t p = node_id(cfg, i, j, k);
-                lat->X[p] = lat->x[p] = i * H;
-                lat->Y[p] = lat->y[p] = j * H;
-                lat->Z[p] = lat->z[p] = k * H;
+                lat->X[p] = lat->x[p] = net->X[3 * p];
+                lat->Y[p] = lat->y[p] = net->X[3 * p + 1];
+                lat->Z[p] = lat->z[p] = net->X[3 * p + 2];
                 /* the node's share of the 1 to 8 cells around it */
                 lat->mass_t[p] = cell_mass * cf_lattice_axis_share(i, 0, cfg->nx) *
                                  cf_lattice_axis_share(j, 0, cfg->ny) *
                                  cf_lattice_axis_share(k, 0, cfg->nz);
                 if (lat->mass_t[p] < lat->m_min_t)
                     lat->m_min_t = lat->mass_t[p];
-                add_springs(lat, off, noff, i, j, k, degree);
             }
+    memcpy(lat->fix, net->fix, lat->nn);
+    lat->ns = net->ns;
+    memcpy(lat->si, net->si, net->ns * sizeof *lat->si);
+    memcpy(lat->sj, net->sj, net->ns * sizeof *lat->sj);
+    memcpy(lat->L0_mm, net->L0_mm, net->ns * sizeof *lat->L0_mm);
+    memcpy(lat->w, net->w, net->ns * sizeof *lat->w);
+    memcpy(lat->family, net->family, net->ns);
+    for (size_t s = 0; s < net->ns; s++)
+        lat->a[s] = H / net->L0_mm[s];
+}
+
+/* The most springs meeting at one node of the lattice: 0, or -1 when memory runs out. */
+static int set_max_degree(cf_lattice *lat)
+{
+    int *degree = calloc(lat->nn, sizeof(int));
+    if (!degree)
+        return -1;
+    for (size_t s = 0; s < lat->ns; s++) {
+        degree[lat->si[s]]++;
+        degree[lat->sj[s]]++;
+    }
     lat->max_degree = 0;
     for (size_t p = 0; p < lat->nn; p++)
         if (degree[p] > lat->max_degree)
@@ -175,23 +155,10 @@ static int place_nodes(cf_lattice *lat, const int (*off)[3], int noff)
     return 0;
 }
 
-/* Boundary: bottom face held in z (and x, y when clamped); with a sliding bottom, node (0,0,0)
-** is pinned in x and y and node (nx,0,0) in y, which removes the rigid lateral motions without
-** restraining the lateral expansion. The top nodes, with their shares of the top face. */
-static void set_boundary(cf_lattice *lat)
+/* The top nodes, with their shares of the top face. */
+static void set_top(cf_lattice *lat)
 {
     const cf_lattice_config *cfg = &lat->cfg;
-    for (int j = 0; j <= cfg->ny; j++)
-        for (int i = 0; i <= cfg->nx; i++) {
-            size_t p = node_id(cfg, i, j, 0);
-            lat->fix[p] = CF_FIX_Z;
-            if (cfg->bottom == CF_BOTTOM_CLAMPED)
-                lat->fix[p] |= CF_FIX_X | CF_FIX_Y;
-        }
-    if (cfg->bottom == CF_BOTTOM_AXIAL) {
-        lat->fix[node_id(cfg, 0, 0, 0)] |= CF_FIX_X | CF_FIX_Y;
-        lat->fix[node_id(cfg, cfg->nx, 0, 0)] |= CF_FIX_Y;
-    }
     size_t t = 0;
     for (int j = 0; j <= cfg->ny; j++)
         for (int i = 0; i <= cfg->nx; i++) {
@@ -215,26 +182,27 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
     lat->with_stiffness = 1;
     lat->H_mm = law->p.H_mm;
     lat->travel_mm = cf_law_travel_min(law); /* a pair: the side that closes first */
-
-    /* The spring directions of the cell (each unordered pair of neighbours once). */
-    int off[CF_CELL_DIRS][3];
-    int noff = 0;
-    for (int d = 0; d < CF_CELL_DIRS; d++) {
-        int fam;
-        cf_cell_direction(d, off[noff], &fam);
-        if (cfg->weight[fam] != 0)
-            noff++; /* a family of weight 0 has no springs */
-    }
-    lat->nn = (size_t)(cfg->nx + 1) * (cfg->ny + 1) * (cfg->nz + 1);
+    /* the net of the lattice (its nodes, springs, weights and fixity), copied into the structures
+    ** of arrays the kernels run on */
+    cf_net net;
+    if ((st = cf_net_lattice(&net, cfg, lat->H_mm, err)) != CF_OK)
+        return st;
+    lat->nn = net.nn;
     lat->ntop = (size_t)(cfg->nx + 1) * (cfg->ny + 1);
-    /* at most noff springs per node */
-    if (lattice_alloc(lat, lat->nn, lat->nn * (size_t)noff, lat->ntop) != 0 ||
-        place_nodes(lat, (const int (*)[3])off, noff) != 0) {
+    if (lattice_alloc(lat, lat->nn, net.ns, lat->ntop) != 0) {
+        cf_net_free(&net);
         cf_lattice_free(lat);
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for a %d x %d x %d lattice",
                             cfg->nx, cfg->ny, cfg->nz);
     }
-    set_boundary(lat);
+    copy_net(lat, &net);
+    cf_net_free(&net);
+    if (set_max_degree(lat) != 0) {
+        cf_lattice_free(lat);
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for a %d x %d x %d lattice",
+                            cfg->nx, cfg->ny, cfg->nz);
+    }
+    set_top(lat);
     lat->area_mm2 = (double)cfg->nx * cfg->ny * lat->H_mm * lat->H_mm;
     lat->height_mm = cfg->nz * lat->H_mm;
     return CF_OK;
