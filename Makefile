@@ -63,7 +63,7 @@ LDFLAGS += -fsanitize=address,undefined
 OPT     := -O1 -g
 endif
 
-# Sources by layer (README, "Architecture"): src/LAYER/*.c. The library is every layer but cli/;
+# Sources by layer (src/notes/architecture.md): src/LAYER/*.c. The library is every layer but cli/;
 # the public headers (what a program calls, at most 10: tests/check_public.sh) live in
 # src/include/conifit/ and are installed, every other header beside its sources in src/LAYER/.
 CLI_SRC := $(wildcard src/cli/*.c)

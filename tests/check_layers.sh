@@ -1,6 +1,6 @@
 #!/bin/sh
 # Layer check: no source or header of conifit includes one from a higher layer.
-# Order, lowest first (README, "Architecture"):
+# Order, lowest first (src/notes/architecture.md):
 #   base < model < io < fit < check < report < export < pipeline < cli
 # A file's layer is its folder src/LAYER/. A public header src/include/conifit/NAME.h belongs to
 # the layer of src/LAYER/NAME.c; a public header with no such source names its layer in a comment
