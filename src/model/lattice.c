@@ -62,12 +62,9 @@ static size_t node_id(const cf_lattice_config *c, int i, int j, int k)
 /* The configuration is one a lattice can be built from: CF_E_DATA naming what is not. */
 static cf_status check_config(const cf_lattice_config *cfg, cf_error *err)
 {
-    const int dims[3] = {cfg->nx, cfg->ny, cfg->nz};
-    const char *names[3] = {"nx", "ny", "nz"};
-    for (int a = 0; a < 3; a++)
-        if (dims[a] < 1 || dims[a] > 10000)
-            return cf_error_set(err, CF_E_DATA, "lattice.%s = %d: must be between 1 and 10000",
-                                names[a], dims[a]);
+    cf_status st = cf_net_lattice_check_cells(cfg, err);
+    if (st != CF_OK)
+        return st;
     if ((double)(cfg->nx + 1) * (cfg->ny + 1) * (cfg->nz + 1) > CF_LATTICE_MAX_NODES)
         return cf_error_set(err, CF_E_DATA,
                             "lattice %d x %d x %d cells: more than %.0f nodes", cfg->nx, cfg->ny,

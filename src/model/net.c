@@ -134,15 +134,23 @@ static void lattice_boundary_cells(cf_net *n, const cf_lattice_config *cfg)
                                              k + ((a >> 2) & 1));
 }
 
-cf_status cf_net_lattice(cf_net *n, const cf_lattice_config *cfg, double H_mm, cf_error *err)
+cf_status cf_net_lattice_check_cells(const cf_lattice_config *cfg, cf_error *err)
 {
-    memset(n, 0, sizeof *n);
     const int dims[3] = {cfg->nx, cfg->ny, cfg->nz};
     const char *names[3] = {"nx", "ny", "nz"};
     for (int a = 0; a < 3; a++)
         if (dims[a] < 1 || dims[a] > 10000)
             return cf_error_set(err, CF_E_DATA, "lattice.%s = %d: must be between 1 and 10000",
                                 names[a], dims[a]);
+    return CF_OK;
+}
+
+cf_status cf_net_lattice(cf_net *n, const cf_lattice_config *cfg, double H_mm, cf_error *err)
+{
+    memset(n, 0, sizeof *n);
+    cf_status st = cf_net_lattice_check_cells(cfg, err);
+    if (st != CF_OK)
+        return st;
     if ((double)(cfg->nx + 1) * (cfg->ny + 1) * (cfg->nz + 1) > (double)UINT32_MAX)
         return cf_error_set(err, CF_E_DATA, "lattice %d x %d x %d cells: too many nodes to number",
                             cfg->nx, cfg->ny, cfg->nz);

@@ -56,6 +56,10 @@ typedef struct cf_net {
 ** runs out (n is then empty). */
 cf_status cf_net_lattice(cf_net *n, const cf_lattice_config *cfg, double H_mm, cf_error *err);
 
+/* The cell counts of cfg: each between 1 and 10000, else CF_E_DATA naming the key
+** (lattice.nx ...). cf_net_lattice and the lattice's own check use it. */
+cf_status cf_net_lattice_check_cells(const cf_lattice_config *cfg, cf_error *err);
+
 /* The nodes and springs cf_net_lattice makes of cfg (cells >= 1 along each axis), counted without
 ** making them (exact integers below 2^53), for the budgets of scenes. */
 void cf_net_lattice_size(const cf_lattice_config *cfg, double *nodes, double *springs);
