@@ -48,6 +48,7 @@ const cf_law_row cf_law_conical_row = {
     .title = "conical law",
     .spring = "the conical spring",
     .nq = 3,
+    .cone = 1,
     .q = {CONE_QUANTITIES},
 };
 
@@ -57,6 +58,7 @@ const cf_law_row cf_law_tail_row = {
     .adds = "the tail",
     .spring = "the tailed spring",
     .nq = 4,
+    .cone = 1,
     .ncorr = 3,
     .q = {CONE_QUANTITIES,
           {"tail_compliance", "tail_compliance_mm", "tail compliance e_t",
@@ -72,6 +74,7 @@ const cf_law_row cf_law_double_row = {
     .adds = "the extension spring",
     .spring = "the pair",
     .nq = 6,
+    .cone = 1,
     .ncorr = 3,
     .q = {CONE_QUANTITIES,
           {"extension_rho", "extension_rho", "extension rho", "extension rho",
@@ -143,7 +146,7 @@ const cf_law_row *cf_fit_kind_of(const cf_fit_result *f)
 cf_ident cf_fit_family(const cf_fit_result *f, int force_displacement)
 {
     const cf_law_row *row = cf_fit_kind_of(f);
-    if (row->fit || row == &cf_law_conical_row || row == &cf_law_double_row)
+    if (row->cone)
         return f->ident;
     return cf_ident_of_type(&f->params, f->type, force_displacement);
 }

@@ -41,6 +41,8 @@ typedef struct cf_law_row {
     const char *adds;   /* what it adds to the kind it is compared with ("the tail"), or NULL */
     const char *spring; /* its spring in a sentence ("the tailed spring") */
     int nq;             /* identifiable quantities, at most CF_Q_MAX */
+    int cone;           /* 1: its first three quantities are the cone's family (family.h), as
+                        ** the conical kinds'; 0: its spring's family comes from its member */
     int ncorr;          /* the first ncorr of them have a correlation matrix (0: all nq); the
                         ** tailed law's is its cone's three */
     cf_law_quantity q[CF_Q_MAX];
