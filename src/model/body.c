@@ -124,6 +124,7 @@ void cf_body_free(cf_body *b)
     free(b->c);
     free(b->f_ext);
     free(b->reaction);
+    free(b->contact);
     memset(b, 0, sizeof *b);
 }
 

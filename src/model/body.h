@@ -143,6 +143,9 @@ typedef struct cf_body {
     double *reaction;      /* 3 nn, or NULL: when the caller allocates it, each solve leaves there
                            ** the force the supports apply at every held component (N; 0 at free
                            ** ones). Released by cf_body_free */
+    double *contact;       /* 3 nn, or NULL: when the caller allocates it, each solve leaves there
+                           ** the probe's contact force on every node (N; 0 off the contact set).
+                           ** Released by cf_body_free */
     void *work;            /* the solver's pattern, factors and vectors (NULL until the first
                            ** solve; cf_body_free releases them). Not thread-safe: one solve of a
                            ** body at a time */
@@ -175,6 +178,29 @@ typedef struct cf_body_state {
 /* Fills st (arrays of the sizes above, caller's) at the current positions; returns the smallest
 ** J and sets *max_u_over_travel (if not NULL) to the largest |u| / travel over the springs. */
 double cf_body_measure(const cf_body *b, cf_body_state *st, double *max_u_over_travel);
+
+/* The stress and strain fields of a body's state (cf_body_fields_at; derivation in
+** src/notes/simulate.md, "Fields"). Symmetric tensors as six numbers in VTK's order xx, yy, zz,
+** xy, yz, xz; stresses Cauchy's, MPa, tension positive. */
+typedef struct cf_body_fields {
+    double *node_stress; /* 6 nn: the virial of each node's dual cell (a quarter of every
+                         ** tetrahedron around it, current volume): half of every spring at the
+                         ** node, T l n n, over the cell's volume, plus the volume term's
+                         ** pressure kappa (J_a - 1) of the node */
+    double *stress;      /* 6 nt: each tetrahedron's, the mean of its four corners' (so that the
+                         ** tetrahedra's stresses times their volumes sum to the nodes') */
+    double *mises;       /* nt: von Mises stress of it, MPa */
+    double *strain;      /* 6 nt: Green-Lagrange strain (F^T F - I)/2 of the tetrahedron's
+                         ** deformation gradient F, - */
+    double *force;       /* ns: spring forces, N, tension positive */
+} cf_body_fields;
+
+/* Fills f (arrays of the sizes above, caller's) at positions x (3 nn). Over the whole body (or
+** any set of nodes' dual cells) the stress times the volume is the virial sum_i x_i (x) g_i of
+** the elastic nodal forces g, so its volume average is the stress the boundary's forces carry.
+** Never writes a non-finite value (0 instead). CF_E_INTERNAL when memory runs out. */
+cf_status cf_body_fields_at(const cf_body *b, const double *x, cf_body_fields *f,
+                            cf_error *err);
 
 /* One probe step's result. */
 typedef struct cf_body_step {

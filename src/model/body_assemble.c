@@ -457,6 +457,23 @@ void cf_body_keep_reaction(const cf_body *b, const double *g)
             b->reaction[3 * i + (size_t)a] = ((b->fix[i] >> a) & 1) ? g[3 * i + (size_t)a] : 0;
 }
 
+/* The probe's penalty force kp d n on every node of the contact set (the force the assembly
+** subtracts from g), 0 elsewhere, into b->contact (when there is one). */
+void cf_body_keep_contact(const cf_body *b, const cf_probe *pr, const double *c, double kp,
+                          const uint8_t *active)
+{
+    if (!b->contact)
+        return;
+    memset(b->contact, 0, 3 * b->nn * sizeof *b->contact);
+    for (size_t i = 0; pr && c && active && i < b->nn; i++) {
+        if (!active[i])
+            continue;
+        double nrm[3], d = cf_body_penetration(pr, c, b->x + 3 * i, nrm, 1);
+        for (int a = 0; a < 3; a++)
+            b->contact[3 * i + (size_t)a] = kp * d * nrm[a];
+    }
+}
+
 /* Zeroes the rows and columns of fixed components (diagonal 1) and their gradient entries. */
 void cf_body_apply_fixed(const cf_body *b, pattern *P, double *g)
 {

@@ -118,6 +118,10 @@ void cf_body_add_inertia(const cf_body *b, const body_work *w, const double *x, 
                          pattern *P);
 /* The residual g (before cf_body_apply_fixed) at the held components into b->reaction. */
 void cf_body_keep_reaction(const cf_body *b, const double *g);
+/* The contact forces of the probe at c (penalty kp, nodes of the set active) on every node into
+** b->contact (when there is one), N. */
+void cf_body_keep_contact(const cf_body *b, const cf_probe *pr, const double *c, double kp,
+                          const uint8_t *active);
 /* Zeroes the rows and columns of fixed components (diagonal 1) and their gradient entries. */
 void cf_body_apply_fixed(const cf_body *b, pattern *P, double *g);
 /* 1 when positions x invert no tetrahedron and take no spring to solid. */

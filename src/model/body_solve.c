@@ -143,6 +143,7 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
     force = cf_body_assemble(b, b->x, probe, c, kp, active, g, NULL, &contacts);
     cf_body_add_inertia(b, w, b->x, g, NULL);
     cf_body_keep_reaction(b, g);
+    cf_body_keep_contact(b, probe, c, kp, active);
     out->depth_mm = depth_mm;
     out->force_N = force;
     out->contacts = contacts;
