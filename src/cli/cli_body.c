@@ -36,6 +36,9 @@ typedef struct run {
     double *rv;          /* (steps + 1) x nregions x 3: a held region's support force (N), a loaded
                          ** one's mean displacement (mm) */
     cf_body_motion motion; /* a dynamic run's masses and state */
+    int keep_forces;     /* keep each step's contact and support forces (for --vtu) */
+    double *contact;     /* (steps + 1) x 3 nn: the probe's force on each node, N */
+    double *reaction;    /* (steps + 1) x 3 nn: the supports' force at each held component, N */
 } run;
 
 static void run_free(run *r)
@@ -51,6 +54,8 @@ static void run_free(run *r)
     free(r->nsel);
     free(r->rv);
     free(r->time);
+    free(r->contact);
+    free(r->reaction);
     cf_body_motion_free(&r->motion);
 }
 
@@ -233,7 +238,7 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
     /* memory: the factor of the tangent (about 40 times its 3 x 3 blocks for meshes of organ
     ** size), the matrix, and one copy of the positions per step */
     double bytes = (double)r->mesh.nn * 3 * (81.0 * 16 * 8 + 40.0 * 81 * 8) +
-                   (double)(steps + 1) * 3 * (double)r->mesh.nn * 8 +
+                   (double)(steps + 1) * 3 * (double)r->mesh.nn * 8 * (r->keep_forces ? 3 : 1) +
                    (double)sc->nregions * (double)r->mesh.nn;
     if (bytes > budget->max_memory_bytes)
         return cf_error_set(err, CF_E_DATA, "%s: the body of %s (%zu nodes, %zu steps) needs "
@@ -260,6 +265,13 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the loads");
     if (!r->xs || !r->step)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu steps", steps);
+    if (r->keep_forces) {
+        r->contact = calloc((steps + 1) * 3 * b->nn, sizeof *r->contact);
+        r->reaction = calloc((steps + 1) * 3 * b->nn, sizeof *r->reaction);
+        b->contact = calloc(3 * b->nn, sizeof *b->contact);
+        if (!r->contact || !r->reaction || !b->contact)
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu steps' forces", steps);
+    }
     memcpy(r->xs, b->x, 3 * b->nn * sizeof *r->xs);
     r->step[0].min_J = 1;
     if (sc->body_dynamic &&
@@ -313,6 +325,10 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
             return cf_error_set(err, CF_E_INTERNAL, "body: force not finite at step %zu", k);
         region_values(sc, r, k);
         memcpy(r->xs + k * 3 * b->nn, b->x, 3 * b->nn * sizeof *r->xs);
+        if (r->keep_forces) {
+            memcpy(r->contact + k * 3 * b->nn, b->contact, 3 * b->nn * sizeof *r->contact);
+            memcpy(r->reaction + k * 3 * b->nn, b->reaction, 3 * b->nn * sizeof *r->reaction);
+        }
     }
     return CF_OK;
 }
@@ -334,12 +350,82 @@ static int region_columns(const cf_scene_region *g, FILE *f)
     return 1;
 }
 
+/* The ParaView files of every step into dir (nothing committed yet): the PVD's time is the
+** run's time (s) when it has one, else the load factor k/steps (the pseudo time of a static
+** run, 0 to 1); the probe's depth and force are each file's field data. */
+static cf_status write_vtu(const cf_scene *sc, const run *r, const char *dir, int timed,
+                           const char *const *inputs, cf_atomic *files, cf_error *err)
+{
+    const cf_body *b = &r->body;
+    const size_t steps = r->steps;
+    cf_status st = CF_OK;
+    cf_body_state bs;
+    bs.strain = malloc(b->ns * sizeof *bs.strain);
+    bs.solid = malloc(b->ns);
+    bs.J = malloc(b->nt * sizeof *bs.J);
+    cf_body_fields q;
+    q.node_stress = malloc(6 * b->nn * sizeof *q.node_stress);
+    q.stress = malloc(6 * b->nt * sizeof *q.stress);
+    q.strain = malloc(6 * b->nt * sizeof *q.strain);
+    q.mises = malloc(b->nt * sizeof *q.mises);
+    q.force = malloc(b->ns * sizeof *q.force);
+    double *time = malloc((steps + 1) * sizeof *time);
+    cf_body tmp = *b; /* the body's arrays with each step's positions */
+    if (!bs.strain || !bs.solid || !bs.J || !time || !q.node_stress || !q.stress || !q.strain ||
+        !q.mises || !q.force) {
+        st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the VTU files");
+        goto end;
+    }
+    char path[4200];
+    for (size_t k = 0; k <= steps && st == CF_OK; k++) {
+        tmp.x = r->xs + k * 3 * b->nn;
+        cf_body_measure(&tmp, &bs, NULL);
+        if ((st = cf_body_fields_at(b, tmp.x, &q, err)) != CF_OK)
+            break;
+        time[k] = timed ? r->time[k] : (double)k / (double)steps;
+        const cf_vtu_state vs = {tmp.x, bs.J, &q, r->contact + k * 3 * b->nn,
+                                 r->reaction + k * 3 * b->nn, bs.strain, bs.solid, time[k], k,
+                                 sc->has_probe, r->step[k].depth_mm, r->step[k].force_N};
+        snprintf(path, sizeof path, "%s/body_%04zu.vtu", dir, k);
+        if ((st = cf_atomic_open(&files[2 * k], path, inputs, err)) != CF_OK)
+            break;
+        cf_vtu_body(files[2 * k].fp, b, &vs);
+        if ((st = cf_atomic_finish(&files[2 * k], err)) != CF_OK)
+            break;
+        snprintf(path, sizeof path, "%s/springs_%04zu.vtu", dir, k);
+        if ((st = cf_atomic_open(&files[2 * k + 1], path, inputs, err)) != CF_OK)
+            break;
+        cf_vtu_springs(files[2 * k + 1].fp, b, &vs);
+        st = cf_atomic_finish(&files[2 * k + 1], err);
+    }
+    if (st == CF_OK) {
+        snprintf(path, sizeof path, "%s/body.pvd", dir);
+        if ((st = cf_atomic_open(&files[2 * steps + 2], path, inputs, err)) == CF_OK) {
+            cf_vtu_pvd(files[2 * steps + 2].fp, steps + 1, time,
+                       timed ? "the run's time in s"
+                             : "the load factor, step k of n at k/n (static equilibria); "
+                               "field data probe_depth_mm holds the depth");
+            st = cf_atomic_finish(&files[2 * steps + 2], err);
+        }
+    }
+end:
+    free(bs.strain);
+    free(bs.solid);
+    free(bs.J);
+    free(q.node_stress);
+    free(q.stress);
+    free(q.strain);
+    free(q.mises);
+    free(q.force);
+    free(time);
+    return st;
+}
+
 /* Opens, writes and finishes every output (nothing committed yet). */
 static cf_status write_all(const cf_scene *sc, const run *r, const char *out, const char *dir,
                            const char *const *inputs, cf_cli_out *csv, cf_atomic *files,
                            cf_error *err)
 {
-    const cf_body *b = &r->body;
     const size_t steps = r->steps;
     cf_status st = cf_cli_out_open(csv, out, inputs, err);
     if (st)
@@ -365,46 +451,7 @@ static cf_status write_all(const cf_scene *sc, const run *r, const char *out, co
     }
     if (!dir)
         return CF_OK;
-    cf_body_state bs;
-    bs.strain = malloc(b->ns * sizeof *bs.strain);
-    bs.solid = malloc(b->ns);
-    bs.J = malloc(b->nt * sizeof *bs.J);
-    double *depth = malloc((steps + 1) * sizeof *depth);
-    cf_body tmp = *b; /* the body's arrays with each step's positions */
-    if (!bs.strain || !bs.solid || !bs.J || !depth) {
-        st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the VTU files");
-        goto end;
-    }
-    char path[4200];
-    for (size_t k = 0; k <= steps && st == CF_OK; k++) {
-        tmp.x = r->xs + k * 3 * b->nn;
-        cf_body_measure(&tmp, &bs, NULL);
-        depth[k] = timed ? r->time[k] : r->step[k].depth_mm; /* the PVD's times */
-        snprintf(path, sizeof path, "%s/body_%04zu.vtu", dir, k);
-        if ((st = cf_atomic_open(&files[2 * k], path, inputs, err)) != CF_OK)
-            break;
-        cf_vtu_body(files[2 * k].fp, b, tmp.x, bs.J);
-        if ((st = cf_atomic_finish(&files[2 * k], err)) != CF_OK)
-            break;
-        snprintf(path, sizeof path, "%s/springs_%04zu.vtu", dir, k);
-        if ((st = cf_atomic_open(&files[2 * k + 1], path, inputs, err)) != CF_OK)
-            break;
-        cf_vtu_springs(files[2 * k + 1].fp, b, tmp.x, bs.strain, bs.solid);
-        st = cf_atomic_finish(&files[2 * k + 1], err);
-    }
-    if (st == CF_OK) {
-        snprintf(path, sizeof path, "%s/body.pvd", dir);
-        if ((st = cf_atomic_open(&files[2 * steps + 2], path, inputs, err)) == CF_OK) {
-            cf_vtu_pvd(files[2 * steps + 2].fp, steps + 1, depth);
-            st = cf_atomic_finish(&files[2 * steps + 2], err);
-        }
-    }
-end:
-    free(bs.strain);
-    free(bs.solid);
-    free(bs.J);
-    free(depth);
-    return st;
+    return write_vtu(sc, r, dir, timed, inputs, files, err);
 }
 
 static double total_mass(const run *r)
@@ -498,6 +545,7 @@ int cf_cli_simulate_body(const cf_scene *sc, const char *scene_path, const char 
     cf_cli_out csv = {0};
     cf_atomic plot = {0};
     int rc = CF_EXIT_OK;
+    r.keep_forces = vtu_dir != NULL;
     if ((!cf_cli_is_stdio(out) && cf_atomic_check(out, inputs, &err) != CF_OK) ||
         (png && cf_atomic_check(png, inputs, &err) != CF_OK) ||
         solve(sc, scene_path, budget, &r, &err) != CF_OK) {
