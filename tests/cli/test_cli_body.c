@@ -1,7 +1,7 @@
 /*
 ** `conifit simulate` on a scene with a tissue body: the depth-force CSV, the summary's E and nu,
 ** the ParaView files read back by VTK's own reader (python3-vtk9; the check skips when VTK is
-** absent), bad scenes refused with exit 65 naming the key and nothing written, and a fitted
+** absent), with the stress, strain, force and time fields, bad scenes refused with exit 65 naming the key and nothing written, and a fitted
 ** tissue's body probed deep into its nonlinear range (the shared brain table, when present).
 */
 #include "bodyutil.h"
@@ -128,6 +128,19 @@ static void vtk_reads_the_files(void **state)
           "e = s.GetCellData().GetArray('strain')\n"
           "so = s.GetCellData().GetArray('solid')\n"
           "uz = min(u.GetComponent(i, 2) for i in range(u.GetNumberOfTuples()))\n"
+          "for d, names in ((b.GetPointData(), 'stress_kPa:6 contact_force_N:3 reaction_N:3'),\n"
+          "                 (b.GetCellData(), 'stress_kPa:6 von_mises_kPa:1 "
+          "strain_green_lagrange:6'),\n"
+          "                 (s.GetCellData(), 'force_N:1'),\n"
+          "                 (b.GetFieldData(), 'TimeValue:1 probe_depth_mm:1 probe_force_N:1')):\n"
+          "    for nc in names.split():\n"
+          "        n, c = nc.split(':')\n"
+          "        a = d.GetArray(n)\n"
+          "        if a is None or a.GetNumberOfComponents() != int(c):\n"
+          "            sys.exit('VTK does not read the array ' + n)\n"
+          "if b.GetFieldData().GetArray('TimeValue').GetValue(0) != 1 or "
+          "b.GetFieldData().GetArray('probe_depth_mm').GetValue(0) != 1:\n"
+          "    sys.exit('time or depth')\n"
           "print(b.GetNumberOfPoints(), b.GetNumberOfCells(), s.GetNumberOfCells(), \n"
           "      '%.9g %.9g %.9g %.9g %d' % (uz, J.GetRange()[0], e.GetRange()[0], "
           "e.GetRange()[1], int(so.GetRange()[1])), b.GetCellType(0), s.GetCellType(0))\n",
