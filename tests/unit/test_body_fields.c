@@ -2,7 +2,8 @@
 ** The stress and strain fields of a body (cf_body_fields_at): at any state the tetrahedra's
 ** stresses times their volumes sum to the virial of the nodal forces (every spring and the volume
 ** term counted once, with its sign); a rigid motion stresses and strains nothing; the strain is
-** the Green-Lagrange strain of an affine deformation. The uniaxial block against sigma = E eps is
+** the Green-Lagrange strain of an affine deformation; on rollers the mean stress is the support
+** force over the area (and what E it gives, printed). The uniaxial block against sigma = E eps is
 ** tests/cli/test_cli_vtu.c's (read back from the ParaView files).
 */
 #include "bodyutil.h"
@@ -170,11 +171,87 @@ static void rotations_are_stress_free_and_the_strain_is_green_lagranges(void **s
     cf_law_free(&law);
 }
 
+/* A 10 mm block on rollers compressed 1e-4 along z (free to expand sideways), meshed by Gmsh at
+** h (h 0: Kuhn's cells, n per side, of cf_mesh_block): the volume mean of the tetrahedra's sigma_zz
+** is the top's support force over its area (the virial of the boundary's forces), and the lateral
+** means vanish. Returns the mean sigma_zz over E eps, E the body's calibrated modulus. */
+static double rollers(int n, double h, double nu)
+{
+    cf_law law = test_law();
+    cf_mesh m;
+    if (h > 0)
+        cube(&m, h);
+    else {
+        double g[17];
+        for (int i = 0; i <= n; i++)
+            g[i] = 10.0 * i / n;
+        assert_int_equal(cf_mesh_block(&m, g, n, g, n, g, n, NULL), CF_OK);
+    }
+    cf_body b;
+    cf_error err = {0};
+    assert_int_equal(cf_body_create(&b, &m, &law, CF_LAW_CLOSED,
+                                    cf_body_kappa_for_nu(cf_body_mu_of_law(&law), nu), &err),
+                     CF_OK);
+    const double eps = -1e-4, tol = 1e-9;
+    for (size_t i = 0; i < b.nn; i++) {
+        const double *X = b.X + 3 * i;
+        b.fix[i] |= (X[0] < tol) | (X[1] < tol) << 1 | (X[2] < tol) << 2;
+        if (X[2] > 10 - tol) {
+            b.fix[i] |= 4;
+            b.x[3 * i + 2] = X[2] * (1 + eps);
+        }
+    }
+    b.reaction = calloc(3 * b.nn, sizeof *b.reaction);
+    assert_non_null(b.reaction);
+    cf_probe none = {0};
+    none.dir[2] = 1;
+    cf_body_step st;
+    assert_int_equal(cf_body_solve(&b, &none, 0, 0, &st, &err), CF_OK);
+    fields q;
+    fields_alloc(&b, &q);
+    assert_int_equal(cf_body_fields_at(&b, b.x, &q.f, &err), CF_OK);
+    double F = 0, V = 0, s[3] = {0, 0, 0};
+    for (size_t i = 0; i < b.nn; i++)
+        if (b.X[3 * i + 2] > 10 - tol)
+            F += b.reaction[3 * i + 2];
+    for (size_t t = 0; t < b.nt; t++) {
+        const double v = vol(&b, b.x, t);
+        V += v;
+        for (int k = 0; k < 3; k++)
+            s[k] += v * q.f.stress[6 * t + k];
+    }
+    for (int k = 0; k < 3; k++)
+        s[k] /= V;
+    const double ratio = s[2] / (b.E_MPa * eps);
+    print_message("%s, nu %.2f, %zu nodes: mean sigma_zz / (E eps) %.4f\n",
+                  h > 0 ? "Gmsh cube" : "Kuhn block", nu, b.nn, ratio);
+    assert_close(s[2], F / (V / (10 * (1 + eps))), 1e-4 * fabs(s[2])); /* the mean section */
+    if (!(fabs(s[0]) < 1e-5 * fabs(s[2]) && fabs(s[1]) < 1e-5 * fabs(s[2]))) /* Newton's tolerance */
+        fail_msg("lateral %g %g of %g", s[0], s[1], s[2]);
+    fields_free(&q);
+    cf_body_free(&b);
+    cf_mesh_free(&m);
+    cf_law_free(&law);
+    return ratio;
+}
+
+static void on_rollers_the_mean_stress_is_the_support_force(void **state)
+{
+    (void)state;
+    assert_close(rollers(0, 1, 0.25), 1, 0.02);
+    rollers(0, 2, 0.25);
+    rollers(0, 1, 0.45);
+    /* the Kuhn block: its network is much stiffer along the axes than its isotropic part */
+    assert_true(rollers(4, 0, 0.25) > 1.3);
+    rollers(4, 0, 0.45);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(the_stresses_sum_to_the_virial_of_the_nodal_forces),
         cmocka_unit_test(rotations_are_stress_free_and_the_strain_is_green_lagranges),
+        cmocka_unit_test(on_rollers_the_mean_stress_is_the_support_force),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
