@@ -226,6 +226,27 @@ static double path_probe(const cf_scene *sc, double lam, cf_probe *moved, double
     return t;
 }
 
+/* With r->keep_forces: at k = 0 the arrays of every step's contact and support forces (step 0's
+** zero) and the body's contact forces; at k > 0 step k's copied from the body. */
+static cf_status keep_forces(run *r, size_t k, cf_error *err)
+{
+    cf_body *b = &r->body;
+    const size_t n = 3 * b->nn;
+    if (!r->keep_forces)
+        return CF_OK;
+    if (k > 0) {
+        memcpy(r->contact + k * n, b->contact, n * sizeof *r->contact);
+        memcpy(r->reaction + k * n, b->reaction, n * sizeof *r->reaction);
+        return CF_OK;
+    }
+    r->contact = calloc((r->steps + 1) * n, sizeof *r->contact);
+    r->reaction = calloc((r->steps + 1) * n, sizeof *r->reaction);
+    b->contact = calloc(n, sizeof *b->contact);
+    if (!r->contact || !r->reaction || !b->contact)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu steps' forces", r->steps);
+    return CF_OK;
+}
+
 static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budget *budget, run *r,
                        cf_error *err)
 {
@@ -265,13 +286,8 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the loads");
     if (!r->xs || !r->step)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu steps", steps);
-    if (r->keep_forces) {
-        r->contact = calloc((steps + 1) * 3 * b->nn, sizeof *r->contact);
-        r->reaction = calloc((steps + 1) * 3 * b->nn, sizeof *r->reaction);
-        b->contact = calloc(3 * b->nn, sizeof *b->contact);
-        if (!r->contact || !r->reaction || !b->contact)
-            return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu steps' forces", steps);
-    }
+    if ((st = keep_forces(r, 0, err)) != CF_OK)
+        return st;
     memcpy(r->xs, b->x, 3 * b->nn * sizeof *r->xs);
     r->step[0].min_J = 1;
     if (sc->body_dynamic &&
@@ -325,10 +341,7 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
             return cf_error_set(err, CF_E_INTERNAL, "body: force not finite at step %zu", k);
         region_values(sc, r, k);
         memcpy(r->xs + k * 3 * b->nn, b->x, 3 * b->nn * sizeof *r->xs);
-        if (r->keep_forces) {
-            memcpy(r->contact + k * 3 * b->nn, b->contact, 3 * b->nn * sizeof *r->contact);
-            memcpy(r->reaction + k * 3 * b->nn, b->reaction, 3 * b->nn * sizeof *r->reaction);
-        }
+        keep_forces(r, k, err);
     }
     return CF_OK;
 }
