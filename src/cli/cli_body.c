@@ -36,6 +36,7 @@ typedef struct run {
     double *rv;          /* (steps + 1) x nregions x 3: a held region's support force (N), a loaded
                          ** one's mean displacement (mm) */
     cf_body_motion motion; /* a dynamic run's masses and state */
+    uint8_t *contact;    /* (steps + 1) x nn: each static step's contact set (for the export) */
 } run;
 
 static void run_free(run *r)
@@ -51,6 +52,7 @@ static void run_free(run *r)
     free(r->nsel);
     free(r->rv);
     free(r->time);
+    free(r->contact);
     cf_body_motion_free(&r->motion);
 }
 
@@ -252,7 +254,8 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
     r->xs = malloc((steps + 1) * 3 * b->nn * sizeof *r->xs);
     r->step = calloc(steps + 1, sizeof *r->step);
     r->time = calloc(steps + 1, sizeof *r->time);
-    if (!r->time)
+    r->contact = calloc((steps + 1) * b->nn, 1);
+    if (!r->time || !r->contact)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for %zu steps", steps);
     if (sc->probe_npath)
         r->time[0] = sc->probe_path_t_s[0];
@@ -313,6 +316,8 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
             return cf_error_set(err, CF_E_INTERNAL, "body: force not finite at step %zu", k);
         region_values(sc, r, k);
         memcpy(r->xs + k * 3 * b->nn, b->x, 3 * b->nn * sizeof *r->xs);
+        if (!sc->body_dynamic)
+            cf_body_contact_set(b, r->contact + k * b->nn);
     }
     return CF_OK;
 }
@@ -577,7 +582,9 @@ cf_status cf_cli_body_export(const cf_scene *sc, const char *scene_path, const c
             depth[k] = r.step[k + 1].depth_mm;
             force[k] = r.step[k + 1].force_N;
         }
-        st = cf_export_write_body(out, &r.body, &sc->probe, steps, depth, force, opt, rep, err);
+        const cf_export_body_run er = {steps, depth, force, r.xs + 3 * r.body.nn,
+                                       r.contact + r.body.nn};
+        st = cf_export_write_body(out, &r.body, &sc->probe, &er, opt, rep, err);
         if (st != CF_OK)
             snprintf(err->msg + strlen(err->msg), sizeof err->msg - strlen(err->msg), " (%s)",
                      scene_path);
