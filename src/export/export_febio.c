@@ -152,6 +152,62 @@ static void febio_volume_elements(FILE *out, const cf_xmodel *m)
     fprintf(out, "\t\t</Elements>\n");
 }
 
+/* The node sets inside Mesh: one per held-direction mask, the top (or every node ever in a body's
+** contact set), and a body's contact nodes one by one (p<node>). */
+static void febio_node_sets(FILE *out, const cf_xmodel *m)
+{
+    for (unsigned mask = 1; mask < 8; mask++) {
+        size_t cnt = 0;
+        for (size_t i = 0; i < m->nn; i++)
+            cnt += (m->fix[i] & 7u) == mask;
+        if (!cnt)
+            continue;
+        fprintf(out, "\t\t<NodeSet name=\"%s\">", cf_xmodel_mask_name[mask]);
+        size_t w = 0;
+        for (size_t i = 0; i < m->nn; i++)
+            if ((m->fix[i] & 7u) == mask)
+                fprintf(out, "%s%zu", w++ ? "," : "", i + 1);
+        fprintf(out, "</NodeSet>\n");
+    }
+    fprintf(out, "\t\t<NodeSet name=\"top\">");
+    for (size_t t = 0; t < m->ntop; t++)
+        fprintf(out, "%s%u", t ? "," : "", m->top[t] + 1);
+    fprintf(out, "</NodeSet>\n");
+    for (size_t t = 0; m->pp && t < m->ntop; t++)
+        fprintf(out, "\t\t<NodeSet name=\"p%u\">%u</NodeSet>\n", m->top[t] + 1, m->top[t] + 1);
+}
+
+/* The drive in Boundary: the top nodes together along z (load controller 1), or a body's probe
+** replayed, each node of its contact set along z on its own curve (load controller t + 2). */
+static void febio_drive(FILE *out, const cf_xmodel *m)
+{
+    if (m->pp) /* a body's probe replayed: each node its own curve (load controller t + 2) */
+        for (size_t t = 0; t < m->ntop; t++)
+            fprintf(out, "\t\t<bc name=\"probe%u\" node_set=\"p%u\" type=\"prescribed "
+                         "displacement\">\n\t\t\t<dof>z</dof>\n\t\t\t<value lc=\"%zu\">1</value>\n"
+                         "\t\t\t<relative>0</relative>\n\t\t</bc>\n",
+                    m->top[t] + 1, m->top[t] + 1, t + 2);
+    else
+        fprintf(out, "\t\t<bc name=\"drive\" node_set=\"top\" type=\"prescribed displacement\">\n"
+                     "\t\t\t<dof>z</dof>\n\t\t\t<value lc=\"1\">1</value>\n"
+                     "\t\t\t<relative>0</relative>\n\t\t</bc>\n");
+}
+
+/* A body's replayed probe: each node's z displacement as conifit solved it at every step (a node
+** outside the step's contact set where conifit's equilibrium has it, its reaction zero). */
+static void febio_probe_curves(FILE *out, const cf_xmodel *m)
+{
+    for (size_t t = 0; m->pp && t < m->ntop; t++) {
+        fprintf(out, "\t\t<load_controller id=\"%zu\" name=\"probe%u\" type=\"loadcurve\">\n"
+                     "\t\t\t<interpolate>LINEAR</interpolate>\n\t\t\t<points>\n"
+                     "\t\t\t\t<pt>0,0</pt>\n",
+                t + 2, m->top[t] + 1);
+        for (size_t k = 0; k < m->nsteps; k++)
+            fprintf(out, "\t\t\t\t<pt>%zu,%.17g</pt>\n", k + 1, m->udz_mm[k * m->ntop + t]);
+        fprintf(out, "\t\t\t</points>\n\t\t</load_controller>\n");
+    }
+}
+
 /* An FEBio 4 model, written in the order of its sections (Module, Control, Mesh with nodes,
 ** node sets and the discrete set, MeshDomains, Boundary, Discrete, LoadData, Output). Long only
 ** because the file is; each section is a few fprintf calls. */
@@ -183,25 +239,7 @@ int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
                 m->Z[i]);
     fprintf(out, "\t\t</Nodes>\n");
     febio_volume_elements(out, m);
-    for (unsigned mask = 1; mask < 8; mask++) {
-        size_t cnt = 0;
-        for (size_t i = 0; i < m->nn; i++)
-            cnt += (m->fix[i] & 7u) == mask;
-        if (!cnt)
-            continue;
-        fprintf(out, "\t\t<NodeSet name=\"%s\">", cf_xmodel_mask_name[mask]);
-        size_t w = 0;
-        for (size_t i = 0; i < m->nn; i++)
-            if ((m->fix[i] & 7u) == mask)
-                fprintf(out, "%s%zu", w++ ? "," : "", i + 1);
-        fprintf(out, "</NodeSet>\n");
-    }
-    fprintf(out, "\t\t<NodeSet name=\"top\">");
-    for (size_t t = 0; t < m->ntop; t++)
-        fprintf(out, "%s%u", t ? "," : "", m->top[t] + 1);
-    fprintf(out, "</NodeSet>\n");
-    for (size_t t = 0; m->pp && t < m->ntop; t++)
-        fprintf(out, "\t\t<NodeSet name=\"p%u\">%u</NodeSet>\n", m->top[t] + 1, m->top[t] + 1);
+    febio_node_sets(out, m);
     for (size_t g = 0; g < m->ng; g++) {
         fprintf(out, "\t\t<DiscreteSet name=\"G%zu\">\n", g + 1);
         for (size_t s = 0; s < m->ns; s++)
@@ -232,16 +270,7 @@ int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
                      "\t\t</bc>\n",
                 cf_xmodel_mask_name[mask], cf_xmodel_mask_name[mask], !!(mask & 1u), !!(mask & 2u), !!(mask & 4u));
     }
-    if (m->pp) /* a body's probe replayed: each node its own curve (load controller t + 2) */
-        for (size_t t = 0; t < m->ntop; t++)
-            fprintf(out, "\t\t<bc name=\"probe%u\" node_set=\"p%u\" type=\"prescribed "
-                         "displacement\">\n\t\t\t<dof>z</dof>\n\t\t\t<value lc=\"%zu\">1</value>\n"
-                         "\t\t\t<relative>0</relative>\n\t\t</bc>\n",
-                    m->top[t] + 1, m->top[t] + 1, t + 2);
-    else
-        fprintf(out, "\t\t<bc name=\"drive\" node_set=\"top\" type=\"prescribed displacement\">\n"
-                     "\t\t\t<dof>z</dof>\n\t\t\t<value lc=\"1\">1</value>\n"
-                     "\t\t\t<relative>0</relative>\n\t\t</bc>\n");
+    febio_drive(out, m);
     fprintf(out, "\t</Boundary>\n");
     fprintf(out, "\t<Discrete>\n");
     for (size_t g = 0; g < m->ng; g++) {
@@ -262,15 +291,7 @@ int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
     for (size_t k = 0; k < m->nsteps; k++)
         fprintf(out, "\t\t\t\t<pt>%zu,%.17g</pt>\n", k + 1, m->dz_mm[k]);
     fprintf(out, "\t\t\t</points>\n\t\t</load_controller>\n");
-    for (size_t t = 0; m->pp && t < m->ntop; t++) {
-        fprintf(out, "\t\t<load_controller id=\"%zu\" name=\"probe%u\" type=\"loadcurve\">\n"
-                     "\t\t\t<interpolate>LINEAR</interpolate>\n\t\t\t<points>\n"
-                     "\t\t\t\t<pt>0,0</pt>\n",
-                t + 2, m->top[t] + 1);
-        for (size_t k = 0; k < m->nsteps; k++)
-            fprintf(out, "\t\t\t\t<pt>%zu,%.17g</pt>\n", k + 1, m->udz_mm[k * m->ntop + t]);
-        fprintf(out, "\t\t\t</points>\n\t\t</load_controller>\n");
-    }
+    febio_probe_curves(out, m);
     fprintf(out, "\t</LoadData>\n");
     fprintf(out, "\t<Output>\n\t\t<logfile>\n\t\t\t<node_data data=\"Rz\" delim=\",\" "
                  "file=\"%s\" node_set=\"top\"/>\n\t\t</logfile>\n\t</Output>\n", log);
