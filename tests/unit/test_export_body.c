@@ -380,8 +380,14 @@ static void a_body_without_volume_term_writes_springs_only_and_a_sphere_is_refus
     assert_non_null(null);
     const cf_export_body_run run = {2, depth, force, xs, contact};
     assert_int_equal(cf_export_write_body(null, &b, &pr, &run, &opt, &rep, &err), CF_E_DATA);
-    fclose(null);
     assert_non_null(strstr(err.msg, "probe"));
+    /* a run whose probe touches nothing has no contact to carry: refused, saying so */
+    pr.shape = CF_PROBE_PUNCH;
+    static const uint8_t none[2 * 27];
+    const cf_export_body_run untouched = {2, depth, force, xs, none};
+    assert_int_equal(cf_export_write_body(null, &b, &pr, &untouched, &opt, &rep, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "touches no node"));
+    fclose(null);
     cf_body_free(&b);
     cf_mesh_free(&m);
     cf_law_free(&law);
