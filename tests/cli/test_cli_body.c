@@ -349,6 +349,36 @@ static void a_body_scene_exports_to_calculix_and_runs(void **state)
     }
 }
 
+/* The CalculiX model of a body takes its volume term about every step's state (about 1 kB per
+** node and step): a run whose model would pass --max-memory is refused, exit 65 naming the steps
+** and the limit, and nothing is written. */
+static void a_body_export_over_the_memory_limit_is_refused(void **state)
+{
+    (void)state;
+    const char *fit = "fits/series/muscle_compression_relaxation_fiber30.json";
+    char mesh[600], scene[600], inp[600], out[4096], err[4096];
+    snprintf(mesh, sizeof mesh, "%s/block.msh", dir);
+    write_block(mesh);
+    snprintf(scene, sizeof scene, "%s/many.json", dir);
+    snprintf(inp, sizeof inp, "%s/many.inp", dir);
+    FILE *f = fopen(scene, "w");
+    assert_non_null(f);
+    fprintf(f, "{\"spring\": {\"fit\": \"%s\"}, \"body\": {\"mesh\": \"%s\", \"unit_mm\": 1, "
+               "\"poisson_ratio\": 0.45}, \"fixed\": {\"below\": {\"axis\": \"z\", "
+               "\"value_mm\": 0}}, \"probe\": {\"shape\": \"punch\", \"radius_mm\": 6, "
+               "\"center_mm\": [15, 15, 15], \"direction\": [0, 0, -1], \"depth_mm\": 0.15, "
+               "\"steps\": 150}}",
+            fit, mesh);
+    fclose(f);
+    assert_int_equal(tu_run(out, sizeof out, err, sizeof err, "export %s --lattice %s --format "
+                            "calculix -o %s --max-memory 25M", fit, scene, inp),
+                     65);
+    assert_non_null(strstr(err, "CalculiX model"));
+    assert_non_null(strstr(err, "150 steps"));
+    assert_non_null(strstr(err, "--max-memory"));
+    assert_false(exists(inp));
+}
+
 /* The README's liver probe (data/scenes/liver_probe.json: ../shared/meshes/liver2.msh, a punch of
 ** 20 mm pressed 8 mm in 16 steps; skipped when the mesh is absent) exports as shipped, with the
 ** warning that names the replayed contact; exported at nu 0.25 and 0.45 and run by ccx, its force
@@ -423,6 +453,7 @@ int main(void)
         cmocka_unit_test(bad_probe_scenes_are_refused_and_write_nothing),
         cmocka_unit_test(a_fitted_brain_body_probed_deep_stays_stable),
         cmocka_unit_test(a_body_scene_exports_to_calculix_and_runs),
+        cmocka_unit_test(a_body_export_over_the_memory_limit_is_refused),
         cmocka_unit_test(the_liver_probe_exports_and_runs_in_calculix),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
