@@ -77,7 +77,9 @@ static void write_inp_probe_steps(FILE *out, const cf_xmodel *m, int abaqus)
 {
     const size_t f0 = m->nn + cf_xmodel_inp_volume_nodes(m); /* face node t: f0 + t + 1 */
     fprintf(out, "** the punch's face: node %zu + t tied to the t-th node of NTOP along z by a "
-                 "spring of conifit's penalty stiffness\n*NODE, NSET=NFACE\n", f0 + 1);
+                 "spring of conifit's penalty stiffness; the probe force of a step is minus the z "
+                 "total of the reaction of set NFACE ('total force ... for set NFACE' in "
+                 "NAME.dat)\n*NODE, NSET=NFACE\n", f0 + 1);
     for (size_t t = 0; t < m->ntop; t++) {
         char x[32], y[32], z[32];
         cf_export_inp_real(x, m->X[m->top[t]]);
