@@ -186,10 +186,13 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr,
     r.nodes = m.nn;
     r.steps = m.nsteps;
     snprintf(r.warning, sizeof r.warning,
-             "the probe is not a contact in the %s model: conifit's own contact set (%zu nodes "
-             "in all) and the z displacements it solved are prescribed at every step, so the "
-             "model reproduces conifit's run, it does not solve the contact itself",
-             cf_export_format_name(opt->format), m.ntop);
+             "the probe is not a contact the %s model detects: conifit's own contact set (%zu "
+             "nodes in all) is replayed, %s at every step, so the model reproduces conifit's run "
+             "rather than solving the contact itself",
+             cf_export_format_name(opt->format), m.ntop,
+             opt->format == CF_EXPORT_CALCULIX
+                 ? "its nodes pressed by conifit's penalty springs against the punch's face"
+                 : "its nodes moved along z as conifit solved them");
     if (ferror(out))
         st = cf_error_set(err, CF_E_CANTWRITE, "cannot write the body's %s model",
                           cf_export_format_name(opt->format));
