@@ -375,6 +375,8 @@ int cf_cli_export(int argc, char **argv)
         free(q.body_buf);
         if (st != CF_OK)
             return cf_cli_fail(&err);
+        if (q.body_rep.warning[0])
+            cf_cli_printf_safe(stderr, "conifit export: warning: %s\n", q.body_rep.warning);
         if (!q.quiet)
             cf_cli_printf_safe(stderr,
                                "conifit export: %s body, %zu nodes, %zu edge springs in %zu "

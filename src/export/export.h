@@ -172,6 +172,8 @@ typedef struct cf_export_report {
     size_t springs;       /* lattice: springs */
     size_t nodes;         /* lattice: nodes */
     size_t steps;         /* lattice: load steps */
+    char warning[400];    /* "" or what the model does not do as conifit does (a body's probe
+                          ** replayed rather than solved as a contact) */
 } cf_export_report;
 
 /* Writes the spring in the chosen format to out. Never writes NaN or Inf. */
@@ -214,25 +216,36 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
                                   const cf_export_options *opt, const cf_export_lattice *lx,
                                   cf_export_report *rep, cf_error *err);
 
+/* conifit's own static run of a body probed by a flat punch, step by step: what a body's export
+** carries (cf_export_write_body). Arrays of the caller's. */
+typedef struct cf_export_body_run {
+    size_t nsteps;
+    const double *depth_mm;  /* nsteps: the probe's depth at each step */
+    const double *force_N;   /* nsteps: conifit's probe force (positive pushing into the body) */
+    const double *x_mm;      /* nsteps * 3 nn: the positions solved at each step */
+    const uint8_t *contact;  /* nsteps * nn: 1 for the nodes in the probe's contact set at each
+                             ** step (cf_body_contact_set) */
+} cf_export_body_run;
+
 /* Writes the tissue body b (model/body.h) as a CalculiX or FEBio 4 model or a SOFA scene
 ** (opt->format calculix, febio or sofa; others CF_E_DATA; sofa only without a volume term,
-** kappa = 0, nu = 0.25, since SOFA's springs cannot express it: the scene holds the springs as the
-** SOFA lattice export writes them and the probe as a PartialLinearMovementProjectiveConstraint):
-** every edge a spring group of its own, rest length L0 and its calibration factor as
-** the weight (the law in strain form times that factor, as the lattice's groups); with a volume
-** term, its tetrahedra as elements of a purely volumetric material, (kappa/2)(J - 1)^2 per unit
-** volume (CalculiX: C3D4, neo-Hookean with C10 = 0 and D1 = 2/kappa; FEBio: tet4, Mooney-Rivlin
-** with c1 = c2 = 0, k = kappa and pressure_model 2, U(J) = (k/2)(J - 1)^2), J per tetrahedron
-** where conifit takes J per node, so the model is stiffer than the body as nu nears 1/2; the held
-** components; the probe, a
-** flat punch moving along +-z whose face starts on nodes of the body, as the prescribed z motion
-** of the nodes under its face (x and y free: frictionless) to depth_mm[k] at step k, with
-** conifit's probe force force_N[k] (positive pushing into the body) in the header for comparison.
-** A node that the punch would reach later is not driven. CF_E_DATA for another probe or a face
-** that rests on no node. Never writes NaN or Inf. */
+** kappa = 0, nu = 0.25, since SOFA's springs cannot express it): every edge a spring group of its
+** own, rest length L0 and its calibration factor as the weight (the law in strain form times that
+** factor, as the lattice's groups); the held components; the volume term as conifit takes it, per
+** node (J_a of the quarter volumes around node a): CalculiX has no element that does, so it is
+** written as one grounded linear spring per node whose displacement an *EQUATION ties to the
+** node's volume change, linearised about the rest state (src/notes/export.md gives what that
+** costs); FEBio: tet4 elements in a ut4 domain (FEBio's node-averaged tetrahedron) with alpha 0,
+** of a Mooney-Rivlin material with c1 = c2 = 0, k = kappa and pressure_model 2. The probe (a flat
+** punch moving along +-z) is carried as conifit ran it: its contact set and the displacement along
+** z of each node of it at each step, from run, prescribed (x and y free: frictionless); CalculiX
+** one *STEP per load step with that step's set, FEBio and SOFA every node that is ever in contact
+** driven along its solved z displacement at every step (a node outside the set then sits at
+** conifit's equilibrium, where its reaction is zero). conifit's probe force at every step is in
+** the header for comparison, and rep->warning names the replay. CF_E_DATA for another probe or a
+** run without contact. Never writes NaN or Inf. */
 cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr,
-                               size_t nsteps, const double *depth_mm, const double *force_N,
-                               const cf_export_options *opt, cf_export_report *rep,
-                               cf_error *err);
+                               const cf_export_body_run *run, const cf_export_options *opt,
+                               cf_export_report *rep, cf_error *err);
 
 #endif

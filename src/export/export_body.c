@@ -16,39 +16,61 @@
 #include "model/lattice.h"
 #include "export/export_model.h"
 
-/* The nodes the punch's face rests on at depth 0 (on its plane within 1e-9 of the mean edge and
-** inside its radius), into m->top. 0, -1 out of memory. */
-static int punch_nodes(const cf_body *b, const cf_probe *pr, cf_xmodel *m)
+/* conifit's contact sets of run into m: top the nodes ever in contact (ascending), with their z
+** displacement at every step, and each step's set with its nodes' z displacements. 0, -1 out of
+** memory. */
+static int replay(const cf_body *b, const cf_probe *pr, const cf_export_body_run *run,
+                  cf_xmodel *m)
 {
-    m->top = malloc(b->nn * sizeof *m->top);
-    if (!m->top)
+    const size_t nn = b->nn, ns = run->nsteps;
+    size_t total = 0;
+    m->top = malloc(nn * sizeof *m->top);
+    m->pp = malloc((ns + 1) * sizeof *m->pp);
+    if (!m->top || !m->pp)
         return -1;
-    const double tol = 1e-9 * b->mean_edge_mm;
-    for (size_t i = 0; i < b->nn; i++) {
-        if (b->fix[i] == CF_BODY_FIX_ALL)
-            continue;
-        const double *X = b->X + 3 * i;
-        double r[3], s = 0, q2 = 0;
-        for (int a = 0; a < 3; a++) {
-            r[a] = X[a] - pr->center_mm[a];
-            s += r[a] * pr->dir[a];
-        }
-        for (int a = 0; a < 3; a++) {
-            const double q = r[a] - s * pr->dir[a];
-            q2 += q * q;
-        }
-        if (fabs(s) <= tol && q2 < pr->radius_mm * pr->radius_mm)
+    for (size_t i = 0; i < nn; i++) {
+        int ever = 0;
+        for (size_t k = 0; k < ns; k++)
+            ever |= run->contact[k * nn + i] != 0;
+        if (ever)
             m->top[m->ntop++] = (uint32_t)i;
     }
+    for (size_t k = 0; k < ns * nn; k++)
+        total += run->contact[k] != 0;
+    m->pn = malloc((total ? total : 1) * sizeof *m->pn);
+    m->pdz_mm = malloc((total ? total : 1) * sizeof *m->pdz_mm);
+    m->udz_mm = malloc((ns * m->ntop > 0 ? ns * m->ntop : 1) * sizeof *m->udz_mm);
+    m->fdz_mm = malloc((ns * m->ntop > 0 ? ns * m->ntop : 1) * sizeof *m->fdz_mm);
+    if (!m->pn || !m->pdz_mm || !m->udz_mm || !m->fdz_mm)
+        return -1;
+    m->kp_N_per_mm = cf_body_penalty(b);
+    size_t w = 0;
+    for (size_t k = 0; k < ns; k++) {
+        const double *x = run->x_mm + 3 * nn * k;
+        m->pp[k] = w;
+        for (size_t i = 0; i < nn; i++)
+            if (run->contact[k * nn + i]) {
+                m->pn[w] = (uint32_t)i;
+                m->pdz_mm[w++] = x[3 * i + 2] - b->X[3 * i + 2];
+            }
+        const double face = pr->center_mm[2] + run->depth_mm[k] * pr->dir[2];
+        for (size_t t = 0; t < m->ntop; t++) {
+            const size_t i = m->top[t];
+            m->udz_mm[k * m->ntop + t] = x[3 * i + 2] - b->X[3 * i + 2];
+            m->fdz_mm[k * m->ntop + t] =
+                run->contact[k * nn + i] ? face - b->X[3 * i + 2] : m->udz_mm[k * m->ntop + t];
+        }
+    }
+    m->pp[ns] = w;
     return 0;
 }
 
 /* What a body's export takes: CalculiX, FEBio or SOFA (SOFA without a volume term), a flat
 ** punch along z, 1 to CF_EXPORT_MAX_STEPS finite load steps. */
-static cf_status check_body(const cf_body *b, const cf_probe *pr, size_t nsteps,
-                            const double *depth_mm, const double *force_N,
+static cf_status check_body(const cf_body *b, const cf_probe *pr, const cf_export_body_run *run,
                             const cf_export_options *opt, cf_error *err)
 {
+    const size_t nsteps = run->nsteps;
     if (opt->format != CF_EXPORT_CALCULIX && opt->format != CF_EXPORT_FEBIO &&
         opt->format != CF_EXPORT_SOFA)
         return cf_error_set(err, CF_E_DATA, "a body is exported to calculix, febio or sofa, not %s",
@@ -61,16 +83,20 @@ static cf_status check_body(const cf_body *b, const cf_probe *pr, size_t nsteps,
                             b->kappa_MPa, b->nu);
     if (pr->shape != CF_PROBE_PUNCH || fabs(pr->dir[0]) > 1e-12 || fabs(pr->dir[1]) > 1e-12)
         return cf_error_set(err, CF_E_DATA,
-                            "probe: a body's export takes a flat punch moving along z (a prescribed "
-                            "motion of the nodes under its face); a sphere's contact set changes "
-                            "with depth");
+                            "probe: a body's export takes a flat punch moving along z (its contact "
+                            "set replayed as prescribed z motions); a sphere pushes its nodes "
+                            "along their own normals");
     if (nsteps == 0 || nsteps > CF_EXPORT_MAX_STEPS)
         return cf_error_set(err, CF_E_DATA, "%zu load steps: a body export takes 1 to %d", nsteps,
                             CF_EXPORT_MAX_STEPS);
     for (size_t k = 0; k < nsteps; k++)
-        if (!isfinite(depth_mm[k]) || !isfinite(force_N[k]))
+        if (!isfinite(run->depth_mm[k]) || !isfinite(run->force_N[k]))
             return cf_error_set(err, CF_E_DATA, "load step %zu: depth or force is not finite",
                                 k + 1);
+    for (size_t q = 0; q < 3 * b->nn * nsteps; q++)
+        if (!isfinite(run->x_mm[q]))
+            return cf_error_set(err, CF_E_DATA, "load step %zu: a position is not finite",
+                                q / (3 * b->nn) + 1);
     return CF_OK;
 }
 
@@ -102,12 +128,12 @@ static int fill_model(const cf_body *b, const cf_export_table *t, const cf_law *
     return 0;
 }
 
-cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, size_t nsteps,
-                               const double *depth_mm, const double *force_N,
-                               const cf_export_options *opt, cf_export_report *rep, cf_error *err)
+cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr,
+                               const cf_export_body_run *run, const cf_export_options *opt,
+                               cf_export_report *rep, cf_error *err)
 {
     CF_GSL_GUARD;
-    cf_status st = check_body(b, pr, nsteps, depth_mm, force_N, opt, err);
+    cf_status st = check_body(b, pr, run, opt, err);
     if (st != CF_OK)
         return st;
     const cf_law *law = b->law;
@@ -126,29 +152,31 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, 
     m.output = opt->output;
     m.law = law;
     m.base = &t;
-    m.nsteps = nsteps;
+    const size_t nsteps = m.nsteps = run->nsteps;
     m.dz_mm = malloc(nsteps * sizeof *m.dz_mm);
     m.ref_N = malloc(nsteps * sizeof *m.ref_N);
     m.strain = malloc(nsteps * sizeof *m.strain);
-    if (!m.dz_mm || !m.ref_N || !m.strain || punch_nodes(b, pr, &m) != 0)
+    if (!m.dz_mm || !m.ref_N || !m.strain || replay(b, pr, run, &m) != 0)
         goto oom;
     if (m.ntop == 0) {
         st = cf_error_set(err, CF_E_DATA,
-                          "probe: the punch's face rests on no node of the body at depth 0 "
-                          "(center_mm must lie on a flat face of the mesh)");
+                          "probe: the punch touches no node of the body at any of the %zu steps "
+                          "(its depth reaches %g mm): nothing to export",
+                          nsteps, run->depth_mm[nsteps - 1]);
         goto done;
     }
     if (fill_model(b, &t, law, &m) != 0)
         goto oom;
     for (size_t k = 0; k < nsteps; k++) {
-        m.dz_mm[k] = depth_mm[k] * pr->dir[2];
-        m.ref_N[k] = force_N[k] * (pr->dir[2] < 0 ? 1 : -1);
-        m.strain[k] = depth_mm[k] / m.height_mm;
+        m.dz_mm[k] = run->depth_mm[k] * pr->dir[2];
+        m.ref_N[k] = run->force_N[k] * (pr->dir[2] < 0 ? 1 : -1);
+        m.strain[k] = run->depth_mm[k] / m.height_mm;
     }
     if (opt->format == CF_EXPORT_CALCULIX || opt->format == CF_EXPORT_FEBIO) {
         m.nt = b->nt;
         m.tet = b->tet;
         m.kappa_MPa = b->kappa_MPa;
+        m.xk_mm = run->x_mm;
     }
     if (cf_xmodel_tables(&m) != 0 || cf_xmodel_write(out, &m, opt->format) != 0)
         goto oom;
@@ -157,6 +185,14 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr, 
     r.springs = m.ns;
     r.nodes = m.nn;
     r.steps = m.nsteps;
+    snprintf(r.warning, sizeof r.warning,
+             "the probe is not a contact the %s model detects: conifit's own contact set (%zu "
+             "nodes in all) is replayed, %s at every step, so the model reproduces conifit's run "
+             "rather than solving the contact itself",
+             cf_export_format_name(opt->format), m.ntop,
+             opt->format == CF_EXPORT_CALCULIX
+                 ? "its nodes pressed by conifit's penalty springs against the punch's face"
+                 : "its nodes moved along z as conifit solved them");
     if (ferror(out))
         st = cf_error_set(err, CF_E_CANTWRITE, "cannot write the body's %s model",
                           cf_export_format_name(opt->format));

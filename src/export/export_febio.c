@@ -110,7 +110,10 @@ static void febio_control(FILE *out, const cf_xmodel *m)
 ** W = U(J), and pressure_model 2 ("Abaqus") of FEBio's uncoupled materials is U(J) =
 ** (k/2)(J - 1)^2 (FEUncoupledMaterial::U, case 2, since FEBio 3; user manual, "Uncoupled Elastic
 ** Solids"): with k = kappa the term of conifit's lattice and body. A body's tetrahedra become tet4
-** elements (J per tetrahedron, as in CalculiX's C3D4; conifit takes J per node); a lattice's cells
+** elements of a ut4 domain with alpha 0 (FEBio's uniform nodal strain tetrahedron, FEUT4Domain:
+** the deformation gradient averaged over the tetrahedra around each node, their volumes a quarter
+** each; alpha 0 leaves out its element-wise stabilisation), so J per node as conifit takes it; a
+** lattice's cells
 ** hex8 elements, which FEBio gives an uncoupled material's three-field formulation by default
 ** (FESolidDomainFactory: hex8 with an uncoupled material), whose pressure is U'(v/V) with v/V the
 ** element's volume ratio, the cell's J of conifit exactly. Nothing written without a volume term. */
@@ -121,7 +124,7 @@ static void febio_volume_material(FILE *out, const cf_xmodel *m)
     fprintf(out, "\t<!-- the volume term: (kappa/2)(J - 1)^2 per unit rest volume, kappa = %.17g "
                  "MPa, J per %s: a Mooney-Rivlin solid with c1 = c2 = 0 and pressure_model 2, "
                  "U(J) = (k/2)(J - 1)^2 -->\n",
-            m->kappa_MPa, m->nt > 0 ? "tetrahedron (conifit's body takes J per node)"
+            m->kappa_MPa, m->nt > 0 ? "node (the ut4 domain's nodal average, alpha 0)"
                                     : "cell (the three-field hex8's volume ratio)");
     fprintf(out, "\t<Material>\n\t\t<material id=\"1\" name=\"volume\" type=\"Mooney-Rivlin\">\n"
                  "\t\t\t<density>1e-09</density>\n\t\t\t<c1>0</c1>\n\t\t\t<c2>0</c2>\n"
@@ -147,6 +150,62 @@ static void febio_volume_elements(FILE *out, const cf_xmodel *m)
         fprintf(out, "</elem>\n");
     }
     fprintf(out, "\t\t</Elements>\n");
+}
+
+/* The node sets inside Mesh: one per held-direction mask, the top (or every node ever in a body's
+** contact set), and a body's contact nodes one by one (p<node>). */
+static void febio_node_sets(FILE *out, const cf_xmodel *m)
+{
+    for (unsigned mask = 1; mask < 8; mask++) {
+        size_t cnt = 0;
+        for (size_t i = 0; i < m->nn; i++)
+            cnt += (m->fix[i] & 7u) == mask;
+        if (!cnt)
+            continue;
+        fprintf(out, "\t\t<NodeSet name=\"%s\">", cf_xmodel_mask_name[mask]);
+        size_t w = 0;
+        for (size_t i = 0; i < m->nn; i++)
+            if ((m->fix[i] & 7u) == mask)
+                fprintf(out, "%s%zu", w++ ? "," : "", i + 1);
+        fprintf(out, "</NodeSet>\n");
+    }
+    fprintf(out, "\t\t<NodeSet name=\"top\">");
+    for (size_t t = 0; t < m->ntop; t++)
+        fprintf(out, "%s%u", t ? "," : "", m->top[t] + 1);
+    fprintf(out, "</NodeSet>\n");
+    for (size_t t = 0; m->pp && t < m->ntop; t++)
+        fprintf(out, "\t\t<NodeSet name=\"p%u\">%u</NodeSet>\n", m->top[t] + 1, m->top[t] + 1);
+}
+
+/* The drive in Boundary: the top nodes together along z (load controller 1), or a body's probe
+** replayed, each node of its contact set along z on its own curve (load controller t + 2). */
+static void febio_drive(FILE *out, const cf_xmodel *m)
+{
+    if (m->pp) /* a body's probe replayed: each node its own curve (load controller t + 2) */
+        for (size_t t = 0; t < m->ntop; t++)
+            fprintf(out, "\t\t<bc name=\"probe%u\" node_set=\"p%u\" type=\"prescribed "
+                         "displacement\">\n\t\t\t<dof>z</dof>\n\t\t\t<value lc=\"%zu\">1</value>\n"
+                         "\t\t\t<relative>0</relative>\n\t\t</bc>\n",
+                    m->top[t] + 1, m->top[t] + 1, t + 2);
+    else
+        fprintf(out, "\t\t<bc name=\"drive\" node_set=\"top\" type=\"prescribed displacement\">\n"
+                     "\t\t\t<dof>z</dof>\n\t\t\t<value lc=\"1\">1</value>\n"
+                     "\t\t\t<relative>0</relative>\n\t\t</bc>\n");
+}
+
+/* A body's replayed probe: each node's z displacement as conifit solved it at every step (a node
+** outside the step's contact set where conifit's equilibrium has it, its reaction zero). */
+static void febio_probe_curves(FILE *out, const cf_xmodel *m)
+{
+    for (size_t t = 0; m->pp && t < m->ntop; t++) {
+        fprintf(out, "\t\t<load_controller id=\"%zu\" name=\"probe%u\" type=\"loadcurve\">\n"
+                     "\t\t\t<interpolate>LINEAR</interpolate>\n\t\t\t<points>\n"
+                     "\t\t\t\t<pt>0,0</pt>\n",
+                t + 2, m->top[t] + 1);
+        for (size_t k = 0; k < m->nsteps; k++)
+            fprintf(out, "\t\t\t\t<pt>%zu,%.17g</pt>\n", k + 1, m->udz_mm[k * m->ntop + t]);
+        fprintf(out, "\t\t\t</points>\n\t\t</load_controller>\n");
+    }
 }
 
 /* An FEBio 4 model, written in the order of its sections (Module, Control, Mesh with nodes,
@@ -180,23 +239,7 @@ int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
                 m->Z[i]);
     fprintf(out, "\t\t</Nodes>\n");
     febio_volume_elements(out, m);
-    for (unsigned mask = 1; mask < 8; mask++) {
-        size_t cnt = 0;
-        for (size_t i = 0; i < m->nn; i++)
-            cnt += (m->fix[i] & 7u) == mask;
-        if (!cnt)
-            continue;
-        fprintf(out, "\t\t<NodeSet name=\"%s\">", cf_xmodel_mask_name[mask]);
-        size_t w = 0;
-        for (size_t i = 0; i < m->nn; i++)
-            if ((m->fix[i] & 7u) == mask)
-                fprintf(out, "%s%zu", w++ ? "," : "", i + 1);
-        fprintf(out, "</NodeSet>\n");
-    }
-    fprintf(out, "\t\t<NodeSet name=\"top\">");
-    for (size_t t = 0; t < m->ntop; t++)
-        fprintf(out, "%s%u", t ? "," : "", m->top[t] + 1);
-    fprintf(out, "</NodeSet>\n");
+    febio_node_sets(out, m);
     for (size_t g = 0; g < m->ng; g++) {
         fprintf(out, "\t\t<DiscreteSet name=\"G%zu\">\n", g + 1);
         for (size_t s = 0; s < m->ns; s++)
@@ -207,7 +250,11 @@ int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
     /* FEBio 4 builds the mesh (nodes, sets, degrees of freedom) when it reads MeshDomains
     ** (FEBioMeshDomainsSection4::Parse), even an empty one; without it the discrete and node sets
     ** named below are not found. */
-    if (m->kappa_MPa > 0 && (m->nt > 0 || m->ncells > 0))
+    if (m->kappa_MPa > 0 && m->nt > 0)
+        fprintf(out, "\t</Mesh>\n\t<MeshDomains>\n\t\t<SolidDomain name=\"volume\" "
+                     "mat=\"volume\" elem_type=\"ut4\">\n\t\t\t<alpha>0</alpha>\n"
+                     "\t\t</SolidDomain>\n\t</MeshDomains>\n\t<Boundary>\n");
+    else if (m->kappa_MPa > 0 && m->ncells > 0)
         fprintf(out, "\t</Mesh>\n\t<MeshDomains>\n\t\t<SolidDomain name=\"volume\" "
                      "mat=\"volume\"/>\n\t</MeshDomains>\n\t<Boundary>\n");
     else
@@ -223,9 +270,8 @@ int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
                      "\t\t</bc>\n",
                 cf_xmodel_mask_name[mask], cf_xmodel_mask_name[mask], !!(mask & 1u), !!(mask & 2u), !!(mask & 4u));
     }
-    fprintf(out, "\t\t<bc name=\"drive\" node_set=\"top\" type=\"prescribed displacement\">\n"
-                 "\t\t\t<dof>z</dof>\n\t\t\t<value lc=\"1\">1</value>\n"
-                 "\t\t\t<relative>0</relative>\n\t\t</bc>\n\t</Boundary>\n");
+    febio_drive(out, m);
+    fprintf(out, "\t</Boundary>\n");
     fprintf(out, "\t<Discrete>\n");
     for (size_t g = 0; g < m->ng; g++) {
         fprintf(out, "\t\t<discrete_material id=\"%zu\" name=\"G%zu\" type=\"nonlinear spring\">\n"
@@ -244,7 +290,9 @@ int cf_xmodel_write_febio(FILE *out, const cf_xmodel *m)
                  "\t\t\t<points>\n\t\t\t\t<pt>0,0</pt>\n");
     for (size_t k = 0; k < m->nsteps; k++)
         fprintf(out, "\t\t\t\t<pt>%zu,%.17g</pt>\n", k + 1, m->dz_mm[k]);
-    fprintf(out, "\t\t\t</points>\n\t\t</load_controller>\n\t</LoadData>\n");
+    fprintf(out, "\t\t\t</points>\n\t\t</load_controller>\n");
+    febio_probe_curves(out, m);
+    fprintf(out, "\t</LoadData>\n");
     fprintf(out, "\t<Output>\n\t\t<logfile>\n\t\t\t<node_data data=\"Rz\" delim=\",\" "
                  "file=\"%s\" node_set=\"top\"/>\n\t\t</logfile>\n\t</Output>\n", log);
     fprintf(out, "</febio_spec>\n");

@@ -18,42 +18,6 @@
 #include "conifit/version.h"
 #include "base/safetext.h"
 
-/* A real for CalculiX/Abaqus input: at most 20 characters (ccx reads a number from a field of
-** 20 characters), always with a decimal point, with as many significant digits as fit (17, or 14
-** for a negative number with an exponent). */
-void cf_export_inp_real(char buf[32], double x)
-{
-    if (x == 0.0)
-        x = 0.0; /* no "-0" */
-    for (int p = 17; p >= 8; p--) {
-        char t[40];
-        snprintf(t, sizeof t, "%.*g", p, x);
-        char *e = strpbrk(t, "eE");
-        if (!strchr(t, '.')) { /* 40 -> 40.  1e-05 -> 1.e-05 */
-            char tail[40];
-            snprintf(tail, sizeof tail, "%s", e ? e : "");
-            if (e)
-                *e = '\0';
-            strcat(t, ".");
-            strcat(t, tail);
-        }
-        if (strlen(t) <= 20) {
-            memcpy(buf, t, strlen(t) + 1);
-            return;
-        }
-    }
-    snprintf(buf, 32, "%.8e", x);
-}
-
-void cf_export_inp_pair(FILE *out, double force_N, double elongation_mm)
-{
-    char a[32], b[32];
-    cf_export_inp_real(a, force_N);
-    cf_export_inp_real(b, elongation_mm);
-    fprintf(out, "%s, %s\n", a, b);
-}
-
-
 /* ---- CalculiX and Abaqus ---------------------------------------------------------------------- */
 
 /* Convergence: the residual force criterion R_n tightened from its default 0.005 of the mean force
@@ -84,7 +48,87 @@ static void write_inp_volume(FILE *out, const cf_xmodel *m)
     fprintf(out, "*SOLID SECTION, ELSET=CELLS, MATERIAL=CONIFIT_VOLUME\n");
 }
 
-static void write_inp(FILE *out, const cf_xmodel *m, int abaqus)
+/* The held components (after *BOUNDARY or *BOUNDARY, OP=NEW), and with a nodal volume term the
+** unused directions 2 and 3 of its auxiliary nodes. */
+static void write_inp_held_lines(FILE *out, const cf_xmodel *m)
+{
+    for (size_t i = 0; i < m->nn; i++)
+        for (int a = 0; a < 3; a++)
+            if (m->fix[i] & (1u << a))
+                fprintf(out, "%zu, %d, %d\n", i + 1, a + 1, a + 1);
+    cf_xmodel_inp_volume_held(out, m);
+}
+
+static void write_inp_held(FILE *out, const cf_xmodel *m)
+{
+    fprintf(out, "*BOUNDARY\n");
+    write_inp_held_lines(out, m);
+}
+
+/* A body's probe as conifit's penalty contact with its contact set replayed: each node ever in
+** contact (top) is tied along z by a SPRING2 of conifit's penalty stiffness to a node of the
+** punch's face (numbered after the body's nodes and the volume term's auxiliary ones, x and y
+** held); one *STEP per load step moves each face node to the face at that depth when its body
+** node is in conifit's contact set, and to where the spring is slack (the node's solved z) when
+** it is not. The reaction is summed over the face nodes (NFACE): the springs' forces, the probe
+** force however the body carries it (the volume term's equations included, whose forces ccx
+** leaves out of a body node's RF). */
+static void write_inp_probe_steps(FILE *out, const cf_xmodel *m, int abaqus)
+{
+    const size_t f0 = m->nn + cf_xmodel_inp_volume_nodes(m); /* face node t: f0 + t + 1 */
+    fprintf(out, "** the punch's face: node %zu + t tied to the t-th node of NTOP along z by a "
+                 "spring of conifit's penalty stiffness; the probe force of a step is minus the z "
+                 "total of the reaction of set NFACE ('total force ... for set NFACE' in "
+                 "NAME.dat)\n*NODE, NSET=NFACE\n", f0 + 1);
+    for (size_t t = 0; t < m->ntop; t++) {
+        char x[32], y[32], z[32];
+        cf_export_inp_real(x, m->X[m->top[t]]);
+        cf_export_inp_real(y, m->Y[m->top[t]]);
+        cf_export_inp_real(z, m->Z[m->top[t]]);
+        fprintf(out, "%zu, %s, %s, %s\n", f0 + t + 1, x, y, z);
+    }
+    const size_t e0 = m->ns + cf_xmodel_inp_volume_nodes(m);
+    fprintf(out, "*ELEMENT, TYPE=SPRING2, ELSET=PROBE\n");
+    for (size_t t = 0; t < m->ntop; t++)
+        fprintf(out, "%zu, %u, %zu\n", e0 + t + 1, m->top[t] + 1, f0 + t + 1);
+    char kp[32];
+    cf_export_inp_real(kp, m->kp_N_per_mm);
+    fprintf(out, "*SPRING, ELSET=PROBE\n3, 3\n%s\n", kp);
+    write_inp_held(out, m);
+    for (size_t t = 0; t < m->ntop; t++)
+        fprintf(out, "%zu, 1, 2\n", f0 + t + 1);
+    for (size_t k = 0; k < m->nsteps; k++) {
+        fprintf(out, "*STEP, NLGEOM%s, INC=1000\n*STATIC\n1., 1.\n", abaqus ? "=YES" : "");
+        fprintf(out, "*CONTROLS, PARAMETERS=FIELD%s\n%s", abaqus ? ", FIELD=DISPLACEMENT" : "",
+                inp_controls);
+        cf_xmodel_inp_volume_step(out, m, k);
+        fprintf(out, "** step %zu: %zu nodes in conifit's contact set (NC%zu); the face nodes of "
+                     "the others where their springs are slack\n*BOUNDARY\n",
+                k + 1, m->pp[k + 1] - m->pp[k], k + 1);
+        for (size_t t = 0; t < m->ntop; t++) {
+            char dz[32];
+            cf_export_inp_real(dz, m->fdz_mm[k * m->ntop + t]);
+            fprintf(out, "%zu, 3, 3, %s\n", f0 + t + 1, dz);
+        }
+        fprintf(out, "*NODE PRINT, NSET=NFACE, TOTALS=ONLY\nRF\n*END STEP\n");
+    }
+}
+
+/* The node sets of a replayed probe: NC<k> the contact set of step k (steps without contact have
+** none). */
+static void write_inp_probe_sets(FILE *out, const cf_xmodel *m)
+{
+    for (size_t k = 0; m->pp && k < m->nsteps; k++) {
+        const size_t n = m->pp[k + 1] - m->pp[k];
+        if (!n)
+            continue;
+        fprintf(out, "*NSET, NSET=NC%zu\n", k + 1);
+        for (size_t q = 0; q < n; q++)
+            fprintf(out, "%u%s", m->pn[m->pp[k] + q] + 1, (q % 16 == 15 || q + 1 == n) ? "\n" : ", ");
+    }
+}
+
+static int write_inp(FILE *out, const cf_xmodel *m, int abaqus)
 {
     const char *target = abaqus ? "Abaqus/Standard" : "CalculiX (ccx)";
     cf_xmodel_header(out, "** ", "", m, target,
@@ -101,6 +145,7 @@ static void write_inp(FILE *out, const cf_xmodel *m, int abaqus)
     fprintf(out, "*NSET, NSET=NTOP\n");
     for (size_t t = 0; t < m->ntop; t++)
         fprintf(out, "%u%s", m->top[t] + 1, (t % 16 == 15 || t + 1 == m->ntop) ? "\n" : ", ");
+    write_inp_probe_sets(out, m);
     for (size_t g = 0; g < m->ng; g++) {
         fprintf(out, "*ELEMENT, TYPE=SPRINGA, ELSET=G%zu\n", g + 1);
         for (size_t s = 0; s < m->ns; s++)
@@ -112,28 +157,17 @@ static void write_inp(FILE *out, const cf_xmodel *m, int abaqus)
         for (size_t i = 0; i < m->g[g].rows; i++)
             cf_export_inp_pair(out, m->g[g].T_N[i], m->g[g].e_mm[i]);
     }
-    if (m->nt > 0 && m->kappa_MPa > 0) { /* a body's tetrahedra */
-        /* W = C10 (I1bar - 3) + (J - 1)^2 / D1: with C10 = 0 and D1 = 2/kappa the volume term */
-        fprintf(out, "** the volume term: a purely volumetric material, (kappa/2)(J - 1)^2 per unit "
-                     "volume, kappa = %.17g MPa, J per tetrahedron\n",
-                m->kappa_MPa);
-        fprintf(out, "*ELEMENT, TYPE=C3D4, ELSET=VOLUME\n");
-        for (size_t t = 0; t < m->nt; t++)
-            fprintf(out, "%zu, %u, %u, %u, %u\n", m->ns + t + 1, m->tet[4 * t] + 1,
-                    m->tet[4 * t + 1] + 1, m->tet[4 * t + 2] + 1, m->tet[4 * t + 3] + 1);
-        char d1[32];
-        cf_export_inp_real(d1, 2 / m->kappa_MPa);
-        fprintf(out, "*MATERIAL, NAME=VOLUME\n*HYPERELASTIC, NEO HOOKE\n0., %s\n"
-                     "*SOLID SECTION, ELSET=VOLUME, MATERIAL=VOLUME\n",
-                d1);
+    if (m->nt > 0 && m->kappa_MPa > 0) { /* a body's nodal volume term */
+        if (cf_xmodel_inp_nodal_volume(out, m) != 0)
+            return -1;
     }
     else if (m->kappa_MPa > 0) /* a lattice's cells */
         write_inp_volume(out, m);
-    fprintf(out, "*BOUNDARY\n");
-    for (size_t i = 0; i < m->nn; i++)
-        for (int a = 0; a < 3; a++)
-            if (m->fix[i] & (1u << a))
-                fprintf(out, "%zu, %d, %d\n", i + 1, a + 1, a + 1);
+    if (m->pp) {
+        write_inp_probe_steps(out, m, abaqus);
+        return 0;
+    }
+    write_inp_held(out, m);
     for (size_t k = 0; k < m->nsteps; k++) {
         fprintf(out, "*STEP, NLGEOM%s, INC=1000\n*STATIC\n1., 1.\n", abaqus ? "=YES" : "");
         fprintf(out, "*CONTROLS, PARAMETERS=FIELD%s\n%s", abaqus ? ", FIELD=DISPLACEMENT" : "",
@@ -143,16 +177,15 @@ static void write_inp(FILE *out, const cf_xmodel *m, int abaqus)
         fprintf(out, "*BOUNDARY\nNTOP, 3, 3, %s\n", dz);
         fprintf(out, "*NODE PRINT, NSET=NTOP, TOTALS=ONLY\nRF\n*END STEP\n");
     }
+    return 0;
 }
 
 int cf_xmodel_write_calculix(FILE *out, const cf_xmodel *m)
 {
-    write_inp(out, m, 0);
-    return 0;
+    return write_inp(out, m, 0);
 }
 
 int cf_xmodel_write_abaqus(FILE *out, const cf_xmodel *m)
 {
-    write_inp(out, m, 1);
-    return 0;
+    return write_inp(out, m, 1);
 }

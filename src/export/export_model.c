@@ -71,6 +71,7 @@ void cf_xmodel_free(cf_xmodel *m)
     free(m->X), free(m->Y), free(m->Z), free(m->fix);
     free(m->si), free(m->sj), free(m->grp), free(m->top);
     free(m->dz_mm), free(m->ref_N), free(m->strain), free(m->cell);
+    free(m->pp), free(m->pn), free(m->pdz_mm), free(m->udz_mm), free(m->fdz_mm);
     for (size_t g = 0; g < m->ng && m->g; g++)
         free(m->g[g].e_mm), free(m->g[g].T_N);
     free(m->g);
@@ -231,10 +232,19 @@ void cf_xmodel_header(FILE *out, const char *lead, const char *tail, const cf_xm
     for (size_t g = 0; g < m->ng; g++)
         fprintf(out, "%s  group %zu: L0 = %.17g mm, weight = %.17g, %zu springs, %zu rows%s\n",
                 lead, g + 1, m->g[g].L0_mm, m->g[g].weight, m->g[g].count, m->g[g].rows, tail);
-    fprintf(out,
-            "%sloading: the %zu top nodes move along z together (x, y free unless fixed); at each "
-            "step, conifit's compressive top reaction (N) for comparison:%s\n",
-            lead, m->ntop, tail);
+    if (m->pp)
+        fprintf(out,
+                "%sloading: conifit's probe replayed (a contact this format solves would not give "
+                "conifit's penalty contact): at each step the nodes of conifit's contact set have "
+                "their z displacement prescribed as conifit solved it (x, y free: frictionless), "
+                "%zu nodes in all; the reaction is summed over them. The header's reaction is "
+                "conifit's probe force, the 'top z displacement' the probe's travel%s\n",
+                lead, m->ntop, tail);
+    else
+        fprintf(out,
+                "%sloading: the %zu top nodes move along z together (x, y free unless fixed); at "
+                "each step, conifit's compressive top reaction (N) for comparison:%s\n",
+                lead, m->ntop, tail);
     fprintf(out,
             "%sreaction tolerance implied by the tables: %.6g N (tol F_C times the weights of "
             "the springs a horizontal plane cuts, projected on z)%s\n",
@@ -243,7 +253,8 @@ void cf_xmodel_header(FILE *out, const char *lead, const char *tail, const cf_xm
         fprintf(out,
                 "%svolume term: each of the %zu %s stores (kappa/2)(J - 1)^2 of its rest "
                 "volume, kappa = %.17g MPa, J its volume over its rest volume%s\n",
-                lead, m->nt > 0 ? m->nt : m->ncells, m->nt > 0 ? "tetrahedra" : "cells",
+                lead, m->nt > 0 ? m->nn : m->ncells,
+                m->nt > 0 ? "nodes (a quarter of each tetrahedron around it)" : "cells",
                 m->kappa_MPa, tail);
     for (size_t k = 0; k < m->nsteps; k++)
         fprintf(out, "%s  step %zu: top z displacement %.17g mm (strain %.10g), conifit reaction "

@@ -42,6 +42,22 @@ typedef struct cf_xmodel {
     cf_xgroup *g;
     size_t ntop;            /* driven nodes: z displacement prescribed, x and y free unless fixed */
     uint32_t *top;
+    /* A body's probe replayed (NULL: the top nodes move together by dz_mm): at step k, the nodes
+    ** of conifit's contact set pn[pp[k] .. pp[k + 1]) with their z displacements pdz_mm[..]
+    ** (nsteps + 1 offsets); and every node of top (all nodes ever in contact) with its z
+    ** displacement udz_mm[k ntop + t] at step k, contact or not */
+    size_t *pp;
+    uint32_t *pn;
+    double *pdz_mm, *udz_mm;
+    /* and conifit's penalty contact for CalculiX: each node of top tied along z by a linear
+    ** spring of stiffness kp_N_per_mm to a node of the punch's face (numbered after the body's
+    ** and the volume term's), whose z displacement at step k is fdz_mm[k ntop + t]: the face at
+    ** that depth for a node in contact, where the spring is slack (the node's solved position)
+    ** otherwise */
+    double kp_N_per_mm;
+    double *fdz_mm;
+    const double *xk_mm;    /* nsteps x 3 nn: the positions conifit solved at each step (not
+                            ** owned; NULL: none), about which CalculiX's volume term is taken */
     size_t nsteps;          /* load steps */
     double *dz_mm;          /* z displacement of the driven nodes at the end of each step, mm */
     double *ref_N;          /* conifit's compressive top reaction at each step, N */
@@ -50,8 +66,9 @@ typedef struct cf_xmodel {
                             ** weights of the springs a horizontal plane cuts, projected on z */
     double area_mm2;        /* loaded area (lattice: nx ny H^2), mm^2 */
     double height_mm;       /* height along z, mm */
-    /* a body's volume term (calculix, abaqus): nt tetrahedra (4 node indices each, not owned)
-    ** of a purely volumetric material, W = (kappa/2)(J - 1)^2 per unit volume; 0 = none */
+    /* a body's volume term: nt tetrahedra (4 node indices each, not owned); each node a stores
+    ** V0_a (kappa/2)(J_a - 1)^2 with V0_a, V_a a quarter of the rest and current volumes of the
+    ** tetrahedra around it (conifit's nodal volume term); 0 = none */
     size_t nt;
     const uint32_t *tet;
     /* The lattice's volume term (cell.h): every cell stores (kappa/2)(J - 1)^2 of its rest volume;
@@ -157,6 +174,15 @@ void cf_sofa_terms_free(cf_sofa_terms *s);
 void cf_xmodel_header(FILE *out, const char *lead, const char *tail, const cf_xmodel *m,
                       const char *target, const char *how);
 extern const char *const cf_xmodel_mask_name[8];
+
+/* A body's nodal volume term for CalculiX and Abaqus (export_inp_volume.c): how many auxiliary
+** nodes (and SPRING1 elements) it adds after the body's nodes (and the springs' elements); its
+** nodes, elements and equations (0, -1 out of memory); the lines of its held directions (inside
+** a *BOUNDARY); and what step k (0-based) changes (*MODEL CHANGE: only step k's springs act). */
+size_t cf_xmodel_inp_volume_nodes(const cf_xmodel *m);
+int cf_xmodel_inp_nodal_volume(FILE *out, const cf_xmodel *m);
+void cf_xmodel_inp_volume_held(FILE *out, const cf_xmodel *m);
+void cf_xmodel_inp_volume_step(FILE *out, const cf_xmodel *m, size_t k);
 
 /* A real for CalculiX/Abaqus input: at most 20 characters, always with a decimal point
 ** (export_inp.c). */

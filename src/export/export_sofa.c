@@ -143,17 +143,22 @@ int cf_xmodel_write_sofa(FILE *out, const cf_xmodel *m)
         if (w)
             fprintf(out, "\"/>\n");
     }
-    fprintf(out, "\t\t<PartialLinearMovementProjectiveConstraint name=\"drive\" "
-                 "movedDirections=\"0 0 1\" indices=\"");
-    for (size_t t = 0; t < m->ntop; t++)
-        fprintf(out, "%s%u", t ? " " : "", m->top[t]);
-    fprintf(out, "\" keyTimes=\"0");
-    for (size_t k = 0; k < m->nsteps; k++)
-        fprintf(out, " %zu", k + 1);
-    fprintf(out, "\" movements=\"0 0 0");
-    for (size_t k = 0; k < m->nsteps; k++)
-        fprintf(out, "  0 0 %.17g", m->dz_mm[k]);
-    fprintf(out, "\"/>\n");
+    /* the drive: the top nodes together, or (a body's probe replayed) each node of it along its
+    ** own solved z displacement */
+    for (size_t t = 0; t < (m->pp ? m->ntop : 1); t++) {
+        fprintf(out, "\t\t<PartialLinearMovementProjectiveConstraint name=\"%s%u\" "
+                     "movedDirections=\"0 0 1\" indices=\"",
+                m->pp ? "probe" : "drive", m->pp ? m->top[t] : 0u);
+        for (size_t q = 0; q < (m->pp ? 1 : m->ntop); q++)
+            fprintf(out, "%s%u", q ? " " : "", m->top[m->pp ? t : q]);
+        fprintf(out, "\" keyTimes=\"0");
+        for (size_t k = 0; k < m->nsteps; k++)
+            fprintf(out, " %zu", k + 1);
+        fprintf(out, "\" movements=\"0 0 0");
+        for (size_t k = 0; k < m->nsteps; k++)
+            fprintf(out, "  0 0 %.17g", m->pp ? m->udz_mm[k * m->ntop + t] : m->dz_mm[k]);
+        fprintf(out, "\"/>\n");
+    }
     for (size_t g = 0; g < m->ng; g++) {
         const cf_sofa_terms s = terms[g];
         char name[64];

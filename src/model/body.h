@@ -296,4 +296,13 @@ size_t cf_body_spread_force(const cf_body *b, const uint8_t *mark, const double 
 /* Index of a node inside the probe at depth 0 (the probe starts inside the body), or -1. */
 long cf_body_probe_inside(const cf_body *b, const cf_probe *probe);
 
+/* The contact set of the last static solve (cf_body_solve, cf_body_solve_force): mark[i] = 1 for
+** every node the probe pushed at the equilibrium (its penalty in the force), 0 for the others
+** (mark has nn entries). Returns how many are marked (0 before the first solve). */
+size_t cf_body_contact_set(const cf_body *b, uint8_t *mark);
+
+/* The penalty stiffness of a contact node that the solves take when given 0: 1e4 E times the mean
+** edge (N/mm). */
+double cf_body_penalty(const cf_body *b);
+
 #endif

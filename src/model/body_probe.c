@@ -49,3 +49,19 @@ long cf_body_probe_inside(const cf_body *b, const cf_probe *probe)
             return (long)i;
     return -1;
 }
+
+size_t cf_body_contact_set(const cf_body *b, uint8_t *mark)
+{
+    const body_work *w = b->work;
+    size_t n = 0;
+    for (size_t i = 0; i < b->nn; i++) {
+        mark[i] = w && w->active && w->active[i];
+        n += mark[i];
+    }
+    return n;
+}
+
+double cf_body_penalty(const cf_body *b)
+{
+    return 1e4 * b->E_MPa * b->mean_edge_mm; /* as cf_body_solve's automatic penalty */
+}

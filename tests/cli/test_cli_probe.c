@@ -46,8 +46,8 @@ static int exists(const char *path)
 }
 
 /* `conifit export FIT --lattice BODY_SCENE --format febio`: a well-formed FEBio 4 file (xmllint,
-** when installed) holding the block's 196 nodes, its 648 tetrahedra of the volume term and the
-** punch; the same scene with a sphere is refused, exit 65 naming the probe, nothing written. */
+** when installed) holding the block's 196 nodes, its 648 tetrahedra of the volume term (a ut4
+** domain, alpha 0: J per node) and the punch's contact set; the same scene with a sphere is refused, exit 65 naming the probe, nothing written. */
 static void a_body_scene_exports_to_febio(void **state)
 {
     (void)state;
@@ -71,7 +71,8 @@ static void a_body_scene_exports_to_febio(void **state)
                            "<pressure_model>2</pressure_model>", "<Mesh>",
                            "<Elements type=\"tet4\" name=\"volume\">", "<elem id=\"648\">",
                            "</Elements>", "<NodeSet name=\"top\">", "<DiscreteSet name=\"G1\">",
-                           "<SolidDomain name=\"volume\" mat=\"volume\"/>",
+                           "<SolidDomain name=\"volume\" mat=\"volume\" elem_type=\"ut4\">",
+                           "<alpha>0</alpha>",
                            "type=\"prescribed displacement\"", "type=\"nonlinear spring\"",
                            "<LoadData>", "<Output>", "</febio_spec>"};
     const char *at = x;

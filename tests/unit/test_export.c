@@ -1499,7 +1499,15 @@ static void a_body_scene_for_sofa_holds_every_edge_law(void **state)
         if (b.X[3 * i + 2] < 1e-9)
             b.fix[i] = CF_BODY_FIX_ALL;
     cf_probe pr = {CF_PROBE_PUNCH, 25, {20, 20, 40}, {0, 0, -1}, 1, 1};
-    double depth = 1, force = 0.5;
+    double depth = 1, force;
+    cf_body_step bst;
+    if (cf_body_solve(&b, &pr, depth, 0, &bst, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    force = bst.force_N;
+    uint8_t contact[27];
+    assert_int_equal(b.nn, 27);
+    assert_int_equal(cf_body_contact_set(&b, contact), 5);
+    const cf_export_body_run run = {1, &depth, &force, b.x, contact};
     char *x = NULL;
     size_t len = 0;
     FILE *mem = open_memstream(&x, &len);
@@ -1508,16 +1516,22 @@ static void a_body_scene_for_sofa_holds_every_edge_law(void **state)
     opt.format = CF_EXPORT_SOFA;
     opt.tol = 1e-4;
     cf_export_report rep;
-    if (cf_export_write_body(mem, &b, &pr, 1, &depth, &force, &opt, &rep, &err) != CF_OK)
+    if (cf_export_write_body(mem, &b, &pr, &run, &opt, &rep, &err) != CF_OK)
         fail_msg("%s", err.msg);
     fclose(mem);
     assert_int_equal(rep.groups, b.ns);
-    /* the punch of radius 25 on the top's centre rests on 5 nodes: (20, 20) and its 4 neighbours */
-    const char *d = strstr(x, "movedDirections=\"0 0 1\" indices=\"");
-    assert_non_null(d);
+    /* the punch of radius 25 on the top's centre pushes 5 nodes, (20, 20) and its 4 neighbours:
+    ** each driven along z as conifit solved it */
     int idx = 0;
-    for (const char *p = d + strlen("movedDirections=\"0 0 1\" indices=\""); *p != '"'; p++)
-        idx += (*p != ' ' && (p[1] == ' ' || p[1] == '"'));
+    for (const char *d = x; (d = strstr(d, "movedDirections=\"0 0 1\" indices=\"")); d++) {
+        unsigned i;
+        assert_int_equal(sscanf(d, "movedDirections=\"0 0 1\" indices=\"%u\"", &i), 1);
+        assert_true(i < 27 && contact[i]);
+        char want[96];
+        snprintf(want, sizeof want, "movements=\"0 0 0  0 0 %.17g\"", b.x[3 * i + 2] - b.X[3 * i + 2]);
+        assert_non_null(strstr(d, want));
+        idx++;
+    }
     assert_int_equal(idx, 5);
     static sofa_field f[1 << 17];
     const size_t n = sofa_fields(x, f, 1 << 17);
@@ -1554,8 +1568,7 @@ static void a_body_scene_for_sofa_holds_every_edge_law(void **state)
     cf_body bv;
     assert_int_equal(cf_body_create(&bv, &m, &law, CF_LAW_CLOSED, 1e-3, &err), CF_OK);
     FILE *null = fopen("/dev/null", "w");
-    assert_int_equal(cf_export_write_body(null, &bv, &pr, 1, &depth, &force, &opt, &rep, &err),
-                     CF_E_DATA);
+    assert_int_equal(cf_export_write_body(null, &bv, &pr, &run, &opt, &rep, &err), CF_E_DATA);
     fclose(null);
     assert_non_null(strstr(err.msg, "volume term"));
     cf_body_free(&bv);

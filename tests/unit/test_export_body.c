@@ -76,6 +76,10 @@ static int attr_is(xmlNodePtr n, const char *attr, const char *value)
     return hit;
 }
 
+/* The positions and contact sets of block_body's two steps (27 nodes). */
+static double xs[2 * 3 * 27];
+static uint8_t contact[2 * 27];
+
 /* A 2 x 2 x 2 block of cells over 40 mm (27 nodes, 48 tetrahedra) of TEL's material at nu, held
 ** at its bottom, and a flat punch of radius 25 mm on the top's centre pressed 1 mm in 2 steps,
 ** solved as simulate solves it: the depths and forces of the steps. */
@@ -100,6 +104,9 @@ static void block_body(cf_law *law, cf_mesh *m, cf_body *b, cf_probe *pr, double
             fail_msg("%s", err.msg);
         force[k] = st.force_N;
         assert_true(force[k] > 0);
+        assert_int_equal(b->nn, 27);
+        memcpy(xs + 3 * 27 * k, b->x, sizeof xs / 2);
+        assert_true(cf_body_contact_set(b, contact + 27 * k) > 0);
     }
 }
 
@@ -115,7 +122,8 @@ static char *febio_of(const cf_body *b, const cf_probe *pr, const double *depth,
     opt.format = CF_EXPORT_FEBIO;
     opt.tol = tol;
     cf_error err = {0};
-    if (cf_export_write_body(mem, b, pr, 2, depth, force, &opt, rep, &err) != CF_OK)
+    const cf_export_body_run run = {2, depth, force, xs, contact};
+    if (cf_export_write_body(mem, b, pr, &run, &opt, rep, &err) != CF_OK)
         fail_msg("%s", err.msg);
     fclose(mem);
     return x;
@@ -197,6 +205,10 @@ static void a_body_for_febio_holds_its_mesh_springs_volume_and_punch(void **stat
     xmlNodePtr dom = child(sec[4], "SolidDomain");
     assert_non_null(dom);
     assert_true(attr_is(dom, "name", "volume") && attr_is(dom, "mat", "volume"));
+    /* J per node as conifit takes it: FEBio's node-averaged tetrahedron without its element-wise
+    ** stabilisation */
+    assert_true(attr_is(dom, "elem_type", "ut4"));
+    assert_true(number(child(dom, "alpha")) == 0);
     /* the held nodes: all of the bottom, in all three directions */
     xmlNodePtr held = child_with(mesh, "NodeSet", "name", "fix_xyz");
     assert_non_null(held);
@@ -214,7 +226,8 @@ static void a_body_for_febio_holds_its_mesh_springs_volume_and_punch(void **stat
     assert_int_equal(nheld, 9);
     xmlNodePtr zero = child_with(sec[5], "bc", "node_set", "fix_xyz");
     assert_true(zero && attr_is(zero, "type", "zero displacement"));
-    /* the punch: the 5 nodes its face rests on, moved along z to -depth at each step */
+    /* the punch: conifit's contact set, the 5 nodes its face rests on, each moved along z as
+    ** conifit solved it at each step (its own load curve) */
     xmlNodePtr top = child_with(mesh, "NodeSet", "name", "top");
     assert_non_null(top);
     char *ts = text(top);
@@ -225,16 +238,34 @@ static void a_body_for_febio_holds_its_mesh_springs_volume_and_punch(void **stat
         assert_true(end > p && id >= 1 && id <= b.nn);
         const double *P = b.X + 3 * (id - 1);
         assert_true(P[2] == 40 && hypot(P[0] - 20, P[1] - 20) < 25);
+        char set[32];
+        snprintf(set, sizeof set, "p%lu", id);
+        xmlNodePtr bc = child_with(sec[5], "bc", "node_set", set);
+        assert_true(bc && attr_is(bc, "type", "prescribed displacement"));
+        char *d = text(child(bc, "dof"));
+        assert_string_equal(d, "z");
+        xmlFree(d);
+        char *lcid = (char *)xmlGetProp(child(bc, "value"), (const xmlChar *)"lc");
+        assert_non_null(lcid);
+        xmlNodePtr c = child_with(sec[7], "load_controller", "id", lcid);
+        xmlFree(lcid);
+        assert_non_null(c);
+        xmlNodePtr q[4];
+        assert_int_equal(children(child(c, "points"), q, 4), 3);
+        for (int k = 1; k < 3; k++) {
+            char *qs = text(q[k]);
+            double t, z;
+            assert_int_equal(sscanf(qs, "%lf,%lf", &t, &z), 2);
+            xmlFree(qs);
+            assert_true(t == k && z == xs[3 * 27 * (k - 1) + 3 * (id - 1) + 2] - P[2]);
+            assert_true(z < 0 && z > -depth[k - 1] - 1e-3);
+        }
         ntop++;
         p = *end == ',' ? end + 1 : end;
     }
     xmlFree(ts);
     assert_int_equal(ntop, 5);
-    xmlNodePtr drive = child_with(sec[5], "bc", "node_set", "top");
-    assert_true(drive && attr_is(drive, "type", "prescribed displacement"));
-    char *dof = text(child(drive, "dof"));
-    assert_string_equal(dof, "z");
-    xmlFree(dof);
+    assert_null(child_with(sec[5], "bc", "node_set", "top")); /* no longer one drive for all */
     xmlNodePtr lc = child(child(sec[7], "load_controller"), "points"), pts[8];
     assert_int_equal(children(lc, pts, 8), 3);
     for (int k = 0; k < 3; k++) {
@@ -347,10 +378,16 @@ static void a_body_without_volume_term_writes_springs_only_and_a_sphere_is_refus
     cf_error err = {0};
     FILE *null = fopen("/dev/null", "w");
     assert_non_null(null);
-    assert_int_equal(cf_export_write_body(null, &b, &pr, 2, depth, force, &opt, &rep, &err),
-                     CF_E_DATA);
-    fclose(null);
+    const cf_export_body_run run = {2, depth, force, xs, contact};
+    assert_int_equal(cf_export_write_body(null, &b, &pr, &run, &opt, &rep, &err), CF_E_DATA);
     assert_non_null(strstr(err.msg, "probe"));
+    /* a run whose probe touches nothing has no contact to carry: refused, saying so */
+    pr.shape = CF_PROBE_PUNCH;
+    static const uint8_t none[2 * 27];
+    const cf_export_body_run untouched = {2, depth, force, xs, none};
+    assert_int_equal(cf_export_write_body(null, &b, &pr, &untouched, &opt, &rep, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "touches no node"));
+    fclose(null);
     cf_body_free(&b);
     cf_mesh_free(&m);
     cf_law_free(&law);
