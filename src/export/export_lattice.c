@@ -282,6 +282,12 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
     cf_lattice_config lc = lx->cfg.lattice;
     if (!(lc.volume_modulus_MPa > 0))
         lc.volume_modulus_MPa = fs->volume_modulus_MPa;
+    /* no hourglass control: the files hold springs and volume elements, and no format's spring or
+    ** element carries the cells' hourglass energy (lattice_hourglass.h). It vanishes on the
+    ** export's homogeneous loading, so the reference reactions are the same; the stability check
+    ** below is then of the model the file holds, which can buckle where conifit's lattice with
+    ** hourglass control does not, and is refused there */
+    lc.hourglass = 0;
     if (fs->has_extension && ((st = cf_law_init(&ext, &fs->extension, err)) != CF_OK ||
                               (st = cf_law_pair(&law, &ext, err)) != CF_OK))
         goto done;

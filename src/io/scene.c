@@ -273,7 +273,7 @@ static cf_status lattice_section(ctx *c, json_t *lt, cf_scene *sc)
 {
     static const char *const allowed[] = {"nx", "ny", "nz", "weights", "calibration", "diagonals",
                                           "diagonal_weight", "bottom", "volume_modulus_MPa",
-                                          "poisson_ratio", NULL};
+                                          "poisson_ratio", "hourglass", NULL};
     cf_status st;
     cf_lattice_config *L = &sc->cfg.lattice;
     if (lt && (st = cf_scene_only_keys(c, lt, "lattice", allowed)))
@@ -303,6 +303,11 @@ static cf_status lattice_section(ctx *c, json_t *lt, cf_scene *sc)
                                 "%s: key 'lattice.bottom' = '%s': expected axial or clamped",
                                 c->name, s ? s : "(not a string)");
     }
+    /* hourglass control (lattice_hourglass.h): absent, the default (CF_HOURGLASS_DEFAULT of the
+    ** cell's shear stiffness with a volume term, none without); 0 none */
+    if (lt && json_object_get(lt, "hourglass") &&
+        (st = cf_scene_number(c, lt, "lattice", "hourglass", 1, 0, 0, 0, 1000, &L->hourglass)))
+        return st;
     return volume_keys(c, lt, sc);
 }
 
