@@ -20,6 +20,7 @@
 #include "model/lattice_hourglass.h"
 #include "model/msm.h"
 #include "model/msm_internal.h"
+#include "model/lattice_step.h"
 
 /* The compression spring (non-telescoping, H 10 mm) and an extension spring of the same
 ** geometry whose wire is 1000 times softer: k0_e = 1e-3 k0_c. */
@@ -386,6 +387,60 @@ static void hourglass_control_in_a_clamped_block(void **state)
     }
 }
 
+/* The explicit step carries it: on a jittered lattice the fused step's spring forces plus the
+** cells' forces (cf_lattice_add_volume_forces, as msm_dynamic.c adds them) equal the force
+** kernel's, hourglass control included, and the stable step's bound counts its stiffness
+** (3 k_h / 16 per cell, 8 cells a node). */
+static void explicit_step_carries_the_hourglass_forces(void **state)
+{
+    (void)state;
+    cf_law law = pair_law();
+    cf_lattice_config lc = cf_lattice_default();
+    lc.volume_modulus_MPa = 0.3 * law.k0_N_per_mm / law.p.H_mm;
+    lc.hourglass = 2.0;
+    cf_lattice lat;
+    cf_error err = {0};
+    assert_int_equal(cf_lattice_create(&lat, &law, CF_LAW_CLOSED, &lc, &err), CF_OK);
+    unsigned seed = 5;
+    for (size_t p = 0; p < lat.nn; p++) {
+        lat.x[p] += 0.2 * rnd(&seed);
+        lat.y[p] += 0.2 * rnd(&seed);
+        lat.z[p] += 0.2 * rnd(&seed);
+    }
+    cf_lattice_forces(&lat);
+    const size_t n = lat.nn;
+    double *ref = malloc(3 * n * sizeof *ref);
+    assert_non_null(ref);
+    double scale = 0;
+    for (size_t p = 0; p < n; p++) {
+        ref[3 * p] = lat.fx[p], ref[3 * p + 1] = lat.fy[p], ref[3 * p + 2] = lat.fz[p];
+        scale = fmax(scale, fabs(lat.fx[p]) + fabs(lat.fy[p]) + fabs(lat.fz[p]));
+    }
+    const double hg_energy = cf_lattice_hourglass_energy(&lat);
+    assert_true(hg_energy > 0);
+    cf_lattice_stepper st;
+    assert_int_equal(cf_lattice_stepper_init(&st, &lat, NULL, &err), CF_OK);
+    memset(lat.fx, 0, n * sizeof(double));
+    memset(lat.fy, 0, n * sizeof(double));
+    memset(lat.fz, 0, n * sizeof(double));
+    cf_lattice_stepper_forces(&st);
+    cf_lattice_add_volume_forces(&lat);
+    for (size_t p = 0; p < n; p++) {
+        assert_close(lat.fx[p], ref[3 * p], 1e-12 * scale);
+        assert_close(lat.fy[p], ref[3 * p + 1], 1e-12 * scale);
+        assert_close(lat.fz[p], ref[3 * p + 2], 1e-12 * scale);
+    }
+    cf_lattice_stepper_free(&st);
+    cf_lattice_free(&lat);
+    free(ref);
+    lc.volume_modulus_MPa = 0; /* the hourglass control alone: its exact bound */
+    assert_int_equal(cf_lattice_create(&lat, &law, CF_LAW_CLOSED, &lc, &err), CF_OK);
+    assert_close(cf_lattice_volume_row_bound(&lat), 1.5 * lat.hg_k_N_per_mm,
+                 1e-15 * lat.hg_k_N_per_mm);
+    cf_lattice_free(&lat);
+    cf_law_free(&law);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -394,6 +449,7 @@ int main(void)
         cmocka_unit_test(homogeneous_response_is_unchanged),
         cmocka_unit_test(hourglass_control_stabilises_the_soft_sided_lattice),
         cmocka_unit_test(hourglass_control_in_a_clamped_block),
+        cmocka_unit_test(explicit_step_carries_the_hourglass_forces),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
