@@ -292,21 +292,16 @@ static cf_status lattice_section(ctx *c, json_t *lt, cf_scene *sc)
     if ((st = weights_section(c, lt, L)))
         return st;
     json_t *b = lt ? json_object_get(lt, "bottom") : NULL;
-    if (b) {
-        const char *s = json_string_value(b);
-        if (s && strcmp(s, "axial") == 0)
-            L->bottom = CF_BOTTOM_AXIAL;
-        else if (s && strcmp(s, "clamped") == 0)
-            L->bottom = CF_BOTTOM_CLAMPED;
-        else
-            return cf_error_set(c->err, CF_E_DATA,
-                                "%s: key 'lattice.bottom' = '%s': expected axial or clamped",
-                                c->name, s ? s : "(not a string)");
-    }
-    /* hourglass control (lattice_hourglass.h): absent, the default (CF_HOURGLASS_DEFAULT of the
-    ** cell's shear stiffness with a volume term, none without); 0 none */
-    if (lt && json_object_get(lt, "hourglass") &&
-        (st = cf_scene_number(c, lt, "lattice", "hourglass", 1, 0, 0, 0, 1000, &L->hourglass)))
+    const char *bs = b ? json_string_value(b) : NULL;
+    if (b && !(bs && (strcmp(bs, "axial") == 0 || strcmp(bs, "clamped") == 0)))
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'lattice.bottom' = '%s': expected axial or clamped", c->name,
+                            bs ? bs : "(not a string)");
+    if (b)
+        L->bottom = strcmp(bs, "clamped") == 0 ? CF_BOTTOM_CLAMPED : CF_BOTTOM_AXIAL;
+    /* hourglass control (lattice_hourglass.h), absent: automatic */
+    if ((st = cf_scene_number(c, lt, "lattice", "hourglass", 0, CF_HOURGLASS_AUTO, 0, 0, 1000,
+                              &L->hourglass)))
         return st;
     return volume_keys(c, lt, sc);
 }
