@@ -5,7 +5,8 @@
 #include "model/lattice.h"
 
 /* h_i(a) for corner a = di + 2 dj + 4 dk: xi eta, eta zeta, zeta xi, xi eta zeta. */
-static int pattern(int i, int a)
+#define pattern cf_hourglass_pattern
+int cf_hourglass_pattern(int i, int a)
 {
     const int xi = 2 * (a & 1) - 1, eta = 2 * ((a >> 1) & 1) - 1, zeta = 2 * ((a >> 2) & 1) - 1;
     switch (i) {

@@ -23,6 +23,9 @@
 #include "model/calibration.h"
 #include "conifit/law.h"
 
+/* h_i(a) (+1 or -1) of mode i (0..3) at corner a (0..7, a = di + 2 dj + 4 dk). */
+int cf_hourglass_pattern(int i, int a);
+
 /* d2W/(dx_a dx_b) / k_h for corners a and b (0..7, a = di + 2 dj + 4 dk): 1/16 for a == b,
 ** -1/32 along an edge, 0 across a face, +1/32 across the body. */
 double cf_hourglass_coef(int a, int b);
