@@ -134,6 +134,11 @@ static void summary(FILE *o, const cf_scene *sc, const cf_msm_sample *s, size_t 
                 sc->has_extension ? "double-acting (its own extension spring)"
                                   : "one spring both ways",
                 lc->volume_modulus_MPa);
+    const double hg = lc->hourglass < 0 ? (lc->volume_modulus_MPa > 0 ? CF_HOURGLASS_DEFAULT : 0)
+                                        : lc->hourglass;
+    if (hg > 0)
+        fprintf(o, "hourglass control: %.6g of the cell's shear stiffness (lattice.hourglass)\n",
+                hg);
     if (sc->effects.inertia)
         fprintf(o, "time step: stable %.6g s, smallest used %.6g s, %zu steps, %zu intervals "
                "sub-stepped\n",

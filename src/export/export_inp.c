@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "model/lattice.h"
+#include "model/lattice_hourglass.h"
 #include "conifit/spring.h"
 #include "conifit/version.h"
 #include "base/safetext.h"
@@ -128,6 +129,47 @@ static void write_inp_probe_sets(FILE *out, const cf_xmodel *m)
     }
 }
 
+/* The hourglass control (lattice_hourglass.h): per cell and mode i an extra node (numbers after
+** the lattice's, at the cell's first corner) whose displacement along each axis *EQUATION sets to
+** q_i = sum_a h_i(a)/8 u_a (q_i is F sum gamma X + sum gamma c = 0 for affine motion, and
+** sum_a gamma_a X_a = 0, so it is the same in displacements as in positions), held by a grounded
+** SPRING1 of stiffness k_h on each axis (element numbers after the springs' and the cells'): the
+** energy (k_h/2) sum_i |q_i|^2, exactly. */
+static void write_inp_hourglass(FILE *out, const cf_xmodel *m)
+{
+    const size_t n0 = m->nn, e0 = m->ns + (m->kappa_MPa > 0 ? m->ncells : 0);
+    fprintf(out, "** hourglass control: k_h = %.17g N/mm on each of the 4 modes of every cell\n",
+            m->hg_k_N_per_mm);
+    fprintf(out, "*NODE, NSET=NHOURGLASS\n");
+    for (size_t c = 0; c < m->ncells; c++)
+        for (int i = 0; i < 4; i++) {
+            char x[32], y[32], z[32];
+            const uint32_t p = m->cell[8 * c];
+            cf_export_inp_real(x, m->X[p]);
+            cf_export_inp_real(y, m->Y[p]);
+            cf_export_inp_real(z, m->Z[p]);
+            fprintf(out, "%zu, %s, %s, %s\n", n0 + 4 * c + (size_t)i + 1, x, y, z);
+        }
+    fprintf(out, "*EQUATION\n");
+    for (size_t c = 0; c < m->ncells; c++)
+        for (int i = 0; i < 4; i++)
+            for (int d = 1; d <= 3; d++) {
+                fprintf(out, "9\n%zu, %d, -1.", n0 + 4 * c + (size_t)i + 1, d);
+                for (int a = 0; a < 8; a++)
+                    fprintf(out, "%s%u, %d, %s", a % 4 == 3 ? "\n" : ", ", m->cell[8 * c + a] + 1,
+                            d, cf_hourglass_pattern(i, a) > 0 ? "0.125" : "-0.125");
+                fputc('\n', out);
+            }
+    char k[32];
+    cf_export_inp_real(k, m->hg_k_N_per_mm);
+    for (int d = 1; d <= 3; d++) {
+        fprintf(out, "*ELEMENT, TYPE=SPRING1, ELSET=HOURGLASS%d\n", d);
+        for (size_t h = 0; h < 4 * m->ncells; h++)
+            fprintf(out, "%zu, %zu\n", e0 + (size_t)(d - 1) * 4 * m->ncells + h + 1, n0 + h + 1);
+        fprintf(out, "*SPRING, ELSET=HOURGLASS%d\n%d\n%s\n", d, d, k);
+    }
+}
+
 static int write_inp(FILE *out, const cf_xmodel *m, int abaqus)
 {
     const char *target = abaqus ? "Abaqus/Standard" : "CalculiX (ccx)";
@@ -163,6 +205,8 @@ static int write_inp(FILE *out, const cf_xmodel *m, int abaqus)
     }
     else if (m->kappa_MPa > 0) /* a lattice's cells */
         write_inp_volume(out, m);
+    if (m->nt == 0 && m->hg_k_N_per_mm > 0)
+        write_inp_hourglass(out, m);
     if (m->pp) {
         write_inp_probe_steps(out, m, abaqus);
         return 0;

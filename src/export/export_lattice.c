@@ -93,7 +93,9 @@ static int model_of_lattice(cf_xmodel *m, const cf_lattice *lat)
     m->area_mm2 = lat->area_mm2;
     m->height_mm = lat->height_mm;
     m->kappa_MPa = lat->cfg.volume_modulus_MPa;
-    if (m->kappa_MPa > 0) { /* the net's cells, eight nodes each, corner di + 2 dj + 4 dk */
+    m->hg_k_N_per_mm = lat->hg_k_N_per_mm;
+    if (m->kappa_MPa > 0 || m->hg_k_N_per_mm > 0) { /* the net's cells, eight nodes each, corner
+                                                    ** di + 2 dj + 4 dk */
         m->ncells = net.nc;
         m->cell = malloc(8 * m->ncells * sizeof *m->cell);
         if (m->cell)
@@ -282,6 +284,13 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
     cf_lattice_config lc = lx->cfg.lattice;
     if (!(lc.volume_modulus_MPa > 0))
         lc.volume_modulus_MPa = fs->volume_modulus_MPa;
+    /* the cells' hourglass control (lattice_hourglass.h) as CalculiX and Abaqus write it; the other
+    ** formats have no element that carries it, so their lattice is built without it: the
+    ** reference reactions of a homogeneous loading are the same, and the stability check below is
+    ** then of the model the file holds (which can buckle where conifit's lattice with hourglass
+    ** control does not, and is refused there) */
+    if (!cf_xmodel_carries_hourglass(opt->format))
+        lc.hourglass = 0;
     if (fs->has_extension && ((st = cf_law_init(&ext, &fs->extension, err)) != CF_OK ||
                               (st = cf_law_pair(&law, &ext, err)) != CF_OK))
         goto done;

@@ -266,6 +266,11 @@ void cf_xmodel_header(FILE *out, const char *lead, const char *tail, const cf_xm
 const char *const cf_xmodel_mask_name[8] = {"", "fix_x", "fix_y", "fix_xy",
                                          "fix_z", "fix_xz", "fix_yz", "fix_xyz"};
 
+int cf_xmodel_carries_hourglass(cf_export_format f)
+{
+    return f == CF_EXPORT_CALCULIX || f == CF_EXPORT_ABAQUS;
+}
+
 const char *cf_xmodel_volume_refusal(const cf_xmodel *m, cf_export_format f)
 {
     if (!(m->kappa_MPa > 0))

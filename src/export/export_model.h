@@ -76,8 +76,16 @@ typedef struct cf_xmodel {
     ** formats that can (CalculiX, Abaqus; cf_xmodel_volume_refusal). */
     double kappa_MPa;       /* 0: no volume term (a body's or a lattice's) */
     size_t ncells;
-    uint32_t *cell;         /* 8 nodes (0-based) per cell, in the C3D8 / HEX8 order */
+    uint32_t *cell;         /* 8 nodes (0-based) per cell, corner di + 2 dj + 4 dk */
+    /* The lattice's hourglass control (lattice_hourglass.h): every cell stores (k_h/2) sum_i
+    ** |q_i|^2; written by CalculiX and Abaqus as an extra node per mode and cell whose
+    ** displacement *EQUATION makes q_i (exact: q_i is linear in the displacements) on three
+    ** grounded SPRING1 of stiffness k_h. 0: none (the other formats' lattices are built
+    ** without it, cf_xmodel_carries_hourglass). */
+    double hg_k_N_per_mm;
 } cf_xmodel;
+/* 1 when format f writes a lattice's hourglass control (CalculiX, Abaqus), else 0. */
+int cf_xmodel_carries_hourglass(cf_export_format f);
 /* NULL when format f can carry m's volume term (none, or CalculiX/Abaqus), else why it cannot. */
 const char *cf_xmodel_volume_refusal(const cf_xmodel *m, cf_export_format f);
 

@@ -273,7 +273,7 @@ static cf_status lattice_section(ctx *c, json_t *lt, cf_scene *sc)
 {
     static const char *const allowed[] = {"nx", "ny", "nz", "weights", "calibration", "diagonals",
                                           "diagonal_weight", "bottom", "volume_modulus_MPa",
-                                          "poisson_ratio", NULL};
+                                          "poisson_ratio", "hourglass", NULL};
     cf_status st;
     cf_lattice_config *L = &sc->cfg.lattice;
     if (lt && (st = cf_scene_only_keys(c, lt, "lattice", allowed)))
@@ -292,17 +292,17 @@ static cf_status lattice_section(ctx *c, json_t *lt, cf_scene *sc)
     if ((st = weights_section(c, lt, L)))
         return st;
     json_t *b = lt ? json_object_get(lt, "bottom") : NULL;
-    if (b) {
-        const char *s = json_string_value(b);
-        if (s && strcmp(s, "axial") == 0)
-            L->bottom = CF_BOTTOM_AXIAL;
-        else if (s && strcmp(s, "clamped") == 0)
-            L->bottom = CF_BOTTOM_CLAMPED;
-        else
-            return cf_error_set(c->err, CF_E_DATA,
-                                "%s: key 'lattice.bottom' = '%s': expected axial or clamped",
-                                c->name, s ? s : "(not a string)");
-    }
+    const char *bs = b ? json_string_value(b) : NULL;
+    if (b && !(bs && (strcmp(bs, "axial") == 0 || strcmp(bs, "clamped") == 0)))
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key 'lattice.bottom' = '%s': expected axial or clamped", c->name,
+                            bs ? bs : "(not a string)");
+    if (b)
+        L->bottom = strcmp(bs, "clamped") == 0 ? CF_BOTTOM_CLAMPED : CF_BOTTOM_AXIAL;
+    /* hourglass control (lattice_hourglass.h), absent: automatic */
+    if ((st = cf_scene_number(c, lt, "lattice", "hourglass", 0, CF_HOURGLASS_AUTO, 0, 0, 1000,
+                              &L->hourglass)))
+        return st;
     return volume_keys(c, lt, sc);
 }
 

@@ -5,7 +5,9 @@
 ** independent strain components, whatever the mode loads; rigid rotations, which change no
 ** spring length, are left out). The state is stable while that 6 x 6 quadratic form is positive
 ** definite: its smallest eigenvalue (GSL's symmetric eigen solver) is the stiffness of the
-** softest strain increment.
+** softest strain increment. The lattice's hourglass control (lattice_hourglass.h) has no part
+** here: it is zero, with its forces and stiffness along every affine motion, for every
+** homogeneous deformation; it acts on the node-scale modes the full lattice's check sees.
 */
 #ifndef CF_CELL_STABILITY_H
 #define CF_CELL_STABILITY_H

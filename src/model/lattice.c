@@ -8,6 +8,7 @@
 #include "base/gslguard.h"
 
 #include "model/cell.h"
+#include "model/lattice_hourglass.h"
 #include "model/lattice_step.h"
 #include "model/net.h"
 
@@ -27,6 +28,7 @@ cf_lattice_config cf_lattice_default(void)
     c.density_t_per_mm3 = 1e-9;
     c.bottom = CF_BOTTOM_AXIAL;
     c.volume_modulus_MPa = 0;
+    c.hourglass = CF_HOURGLASS_AUTO;
     return c;
 }
 
@@ -75,6 +77,10 @@ static cf_status check_config(const cf_lattice_config *cfg, cf_error *err)
     if (!(cfg->volume_modulus_MPa >= 0) || !isfinite(cfg->volume_modulus_MPa))
         return cf_error_set(err, CF_E_DATA, "lattice volume_modulus_MPa = %g: must be finite and "
                                             ">= 0", cfg->volume_modulus_MPa);
+    if (!(cfg->hourglass == CF_HOURGLASS_AUTO || (cfg->hourglass >= 0 && cfg->hourglass <= 1000)))
+        return cf_error_set(err, CF_E_DATA, "lattice hourglass = %g: must be from 0 to 1000 (the "
+                                            "fraction of the cell's shear stiffness)",
+                            cfg->hourglass);
     return cf_calibration_check(cfg->weight, err);
 }
 
@@ -202,6 +208,8 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
     set_top(lat);
     lat->area_mm2 = (double)cfg->nx * cfg->ny * lat->H_mm * lat->H_mm;
     lat->height_mm = cfg->nz * lat->H_mm;
+    lat->hg_k_N_per_mm =
+        cf_hourglass_stiffness(cfg->weight, cfg->volume_modulus_MPa, cfg->hourglass, law);
     return CF_OK;
 }
 
@@ -303,24 +311,41 @@ double cf_lattice_cell_volume(const cf_lattice *lat, size_t c, uint32_t node[8],
     return V / (H * H * H);
 }
 
-/* The volume term's node forces, -kappa (J - 1) dV/dx, added to fx, fy, fz. */
-static void volume_forces(cf_lattice *lat);
+/* The cells' node forces, the volume term's -kappa (J - 1) dV/dx and the hourglass control's,
+** added to fx, fy, fz. */
+static void cell_forces(cf_lattice *lat);
+
+int cf_lattice_has_cells(const cf_lattice *lat)
+{
+    return lat->cfg.volume_modulus_MPa != 0 || lat->hg_k_N_per_mm != 0;
+}
 
 void cf_lattice_add_volume_forces(cf_lattice *lat)
 {
-    if (lat->cfg.volume_modulus_MPa != 0)
-        volume_forces(lat);
+    if (cf_lattice_has_cells(lat))
+        cell_forces(lat);
+}
+
+/* The corner positions of cell c into x (and its nodes into node). */
+static void cell_positions(const cf_lattice *lat, size_t c, uint32_t node[8], double x[8][3])
+{
+    cf_lattice_cell_nodes(lat, c, node);
+    for (int a = 0; a < 8; a++)
+        x[a][0] = lat->x[node[a]], x[a][1] = lat->y[node[a]], x[a][2] = lat->z[node[a]];
 }
 
 double cf_lattice_volume_row_bound(const cf_lattice *lat)
 {
     const double kappa = lat->cfg.volume_modulus_MPa, H = lat->H_mm;
+    /* the hourglass control's rows: k_h sum_b |coef(a, b)| = k_h (1/16 + 3/32 + 1/32) = 3 k_h / 16
+    ** per cell, at most 8 cells a node, whatever the positions */
+    const double hg = 8 * 0.1875 * lat->hg_k_N_per_mm;
     if (!(kappa > 0))
-        return 0.0;
+        return hg;
     const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
     double *row = calloc(3 * lat->nn, sizeof *row);
     if (!row) /* no memory for the exact bound: the rest state's, 12 kappa H, doubled */
-        return 24.0 * kappa * H;
+        return 24.0 * kappa * H + hg;
     for (size_t c = 0; c < nc; c++) {
         uint32_t node[8];
         double g[8][3], hess[8][8][3][3];
@@ -339,21 +364,34 @@ double cf_lattice_volume_row_bound(const cf_lattice *lat)
     for (size_t q = 0; q < 3 * lat->nn; q++)
         worst = fmax(worst, row[q]);
     free(row);
-    return worst;
+    return worst + hg;
 }
 
-static void volume_forces(cf_lattice *lat)
+static void cell_forces(cf_lattice *lat)
 {
     const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
-    const double kappa = lat->cfg.volume_modulus_MPa;
+    const double kappa = lat->cfg.volume_modulus_MPa, kh = lat->hg_k_N_per_mm;
     for (size_t c = 0; c < nc; c++) {
         uint32_t node[8];
-        double g[8][3];
-        const double J = cf_lattice_cell_volume(lat, c, node, g, NULL), f = -kappa * (J - 1);
-        for (int a = 0; a < 8; a++) {
-            lat->fx[node[a]] += f * g[a][0];
-            lat->fy[node[a]] += f * g[a][1];
-            lat->fz[node[a]] += f * g[a][2];
+        if (kappa != 0) {
+            double g[8][3];
+            const double J = cf_lattice_cell_volume(lat, c, node, g, NULL), f = -kappa * (J - 1);
+            for (int a = 0; a < 8; a++) {
+                lat->fx[node[a]] += f * g[a][0];
+                lat->fy[node[a]] += f * g[a][1];
+                lat->fz[node[a]] += f * g[a][2];
+            }
+        }
+        if (kh != 0) {
+            double x[8][3], q[4][3], f[8][3];
+            cell_positions(lat, c, node, x);
+            cf_hourglass_modes(x, q);
+            cf_hourglass_forces(q, kh, f);
+            for (int a = 0; a < 8; a++) {
+                lat->fx[node[a]] += f[a][0];
+                lat->fy[node[a]] += f[a][1];
+                lat->fz[node[a]] += f[a][2];
+            }
         }
     }
 }
@@ -397,8 +435,8 @@ double cf_lattice_forces(cf_lattice *lat)
         fy[j] -= gy;
         fz[j] -= gz;
     }
-    if (lat->cfg.volume_modulus_MPa != 0)
-        volume_forces(lat);
+    if (cf_lattice_has_cells(lat))
+        cell_forces(lat);
     return umax / lat->travel_mm;
 }
 
@@ -489,6 +527,22 @@ double cf_lattice_elastic_energy(const cf_lattice *lat)
         double g[8][3];
         const double J = cf_lattice_cell_volume(lat, c, node, g, NULL);
         e += 0.5 * kappa * (J - 1) * (J - 1) * H * H * H;
+    }
+    return e + cf_lattice_hourglass_energy(lat);
+}
+
+double cf_lattice_hourglass_energy(const cf_lattice *lat)
+{
+    const double kh = lat->hg_k_N_per_mm;
+    const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
+    double e = 0;
+    for (size_t c = 0; kh != 0 && c < nc; c++) { /* (k_h/2) sum_i |q_i|^2 */
+        uint32_t node[8];
+        double x[8][3], q[4][3];
+        cell_positions(lat, c, node, x);
+        cf_hourglass_modes(x, q);
+        for (int i = 0; i < 4; i++)
+            e += 0.5 * kh * (q[i][0] * q[i][0] + q[i][1] * q[i][1] + q[i][2] * q[i][2]);
     }
     return e;
 }

@@ -52,11 +52,23 @@ typedef struct cf_lattice_config {
     double volume_modulus_MPa; /* kappa of the volume term (cell.h): every cell stores
                               ** (kappa/2)(J - 1)^2 H^3, J its volume (the trilinear hexahedron of
                               ** its eight nodes, 2 x 2 x 2 Gauss points: exact) over H^3; >= 0,
-                              ** 0 (the default) for none. Statics only: the explicit step
-                              ** (lattice_step.h) refuses a lattice with one */
+                              ** 0 (the default) for none */
+    double hourglass;         /* hourglass control (lattice_hourglass.h): every cell stores
+                              ** (k_h/2) sum_i |q_i|^2 over its four hourglass modes, zero for every
+                              ** affine motion of the cell; k_h is this fraction of the cell's
+                              ** small-strain shear stiffness (as the energy of a simple shear of
+                              ** the same node motion); 0 for none, at most 1000;
+                              ** CF_HOURGLASS_AUTO (the default): CF_HOURGLASS_DEFAULT with a
+                              ** volume term, 0 without */
 } cf_lattice_config;
 
-/* 3 x 3 x 3 cells, the isotropic calibration, density 1e-9 t/mm^3, bottom axial. */
+/* The hourglass fraction that means "the default with a volume term, none without", and that
+** default (lattice_hourglass.h). */
+#define CF_HOURGLASS_AUTO (-1.0)
+#define CF_HOURGLASS_DEFAULT 0.5
+
+/* 3 x 3 x 3 cells, the isotropic calibration, density 1e-9 t/mm^3, bottom axial, no volume term,
+** hourglass control automatic. */
 cf_lattice_config cf_lattice_default(void);
 
 /* DOF fixity bits per node. */
@@ -99,6 +111,8 @@ typedef struct cf_lattice {
     double height_mm;       /* nz H, mm */
     double m_min_t;         /* lightest node mass, t */
     int max_degree;         /* most springs meeting at one node */
+    double hg_k_N_per_mm;   /* the hourglass stiffness k_h of every cell (cfg.hourglass resolved
+                            ** for this law), N/mm; 0: no hourglass control */
 } cf_lattice;
 
 /* Builds the lattice at its reference (undeformed) state. CF_E_DATA with a message naming the
@@ -137,9 +151,13 @@ void cf_lattice_add_tensions(cf_lattice *lat, const double *Textra_N);
 double cf_lattice_cell_volume(const cf_lattice *lat, size_t c, uint32_t node[8], double g[8][3],
                               double (*hess)[8][3][3]);
 
-/* Elastic energy stored in the springs at the current state, mJ = N mm (Gauss-Legendre quadrature
-** of the law over each spring's compression; accurate to about 1e-10 relative away from solid). */
+/* Elastic energy stored in the springs and the cells at the current state, mJ = N mm (Gauss-
+** Legendre quadrature of the law over each spring's compression, accurate to about 1e-10 relative
+** away from solid; the volume term and the hourglass control exactly). */
 double cf_lattice_elastic_energy(const cf_lattice *lat);
+
+/* The hourglass control's part of it (lattice_hourglass.h), mJ; 0 without. */
+double cf_lattice_hourglass_energy(const cf_lattice *lat);
 
 /* The lattice's width along x over its rest width nx H: the mean x of the nodes of the +x face
 ** less that of the -x face, over nx H (1 at rest). */

@@ -14,4 +14,8 @@
 ** them. */
 void cf_lattice_cell_nodes(const cf_lattice *lat, size_t c, uint32_t node[8]);
 
+/* 1 when the lattice's cells carry an energy (a volume term or hourglass control: their forces,
+** their tangent blocks), 0 when only the springs do. */
+int cf_lattice_has_cells(const cf_lattice *lat);
+
 #endif

@@ -208,8 +208,10 @@ static double force_floor(const solver *s)
     }
     const double FC = lat->law->extension ? fmax(lat->law->F_C_N, lat->law->extension->F_C_N)
                                           : lat->law->F_C_N;
-    /* the volume term's forces scale with kappa H^2 as the springs' with F_C */
-    const double vol = lat->cfg.volume_modulus_MPa * lat->H_mm * lat->H_mm;
+    /* the volume term's forces scale with kappa H^2 as the springs' with F_C, the hourglass
+    ** control's with k_h H */
+    const double vol =
+        lat->cfg.volume_modulus_MPa * lat->H_mm * lat->H_mm + lat->hg_k_N_per_mm * lat->H_mm;
     return 1e-12 * FC * wmax + 1e-13 * dash + (vol != 0 ? 1e-12 * vol : 0.0);
 }
 

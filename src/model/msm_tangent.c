@@ -6,6 +6,7 @@
 */
 #include "model/msm_internal.h"
 #include "model/lattice_cells.h"
+#include "model/lattice_hourglass.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -91,10 +92,10 @@ static int node_adjacency(const cf_lattice *lat, uint32_t *adj, unsigned char *d
         for (int e = 0; e < 2 && !bad; e++)
             bad = adjacent(adj, deg, ends[e], ends[1 - e]);
     }
-    /* the volume term couples every two nodes of a cell (a spring does unless its family's
-    ** weight is 0) */
+    /* the volume term and the hourglass control couple every two nodes of a cell (a spring does
+    ** unless its family's weight is 0) */
     const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
-    for (size_t c = 0; lat->cfg.volume_modulus_MPa != 0 && c < nc && !bad; c++) {
+    for (size_t c = 0; cf_lattice_has_cells(lat) && c < nc && !bad; c++) {
         uint32_t node[8];
         cf_lattice_cell_nodes(lat, c, node);
         for (int a = 0; a < 8 && !bad; a++)
@@ -220,9 +221,9 @@ static cf_status build_tangent(solver *s, cf_error *err)
         return st;
     const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
     s->map = malloc((lat->ns ? lat->ns : 1) * 36 * sizeof(int));
-    if (lat->cfg.volume_modulus_MPa != 0)
+    if (cf_lattice_has_cells(lat))
         s->vmap = malloc(nc * 8 * 8 * 9 * sizeof(int));
-    if (!s->map || (lat->cfg.volume_modulus_MPa != 0 && !s->vmap)) {
+    if (!s->map || (cf_lattice_has_cells(lat) && !s->vmap)) {
         free(s->map);
         free(s->vmap);
         s->map = s->vmap = NULL;
@@ -236,27 +237,37 @@ static cf_status build_tangent(solver *s, cf_error *err)
     return CF_OK;
 }
 
-/* The volume term's tangent added into v: per cell, kappa/H^3 g_a g_b^T + kappa (J - 1) d2V/dx_a
-** dx_b (W = (kappa/2)(J - 1)^2 H^3, J = V/H^3, g = dV/dx). */
+/* The cells' tangent added into v: per cell, the volume term's kappa/H^3 g_a g_b^T + kappa (J - 1)
+** d2V/dx_a dx_b (W = (kappa/2)(J - 1)^2 H^3, J = V/H^3, g = dV/dx) and the hourglass control's
+** constant k_h coef(a, b) I (lattice_hourglass.h). */
 static void volume_tangent(solver *s, double *v)
 {
     const cf_lattice *lat = s->lat;
     const double kappa = lat->cfg.volume_modulus_MPa, H = lat->H_mm, V0 = H * H * H;
+    const double kh = lat->hg_k_N_per_mm;
     const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
     double hess[8][8][3][3]; /* 4.6 kB */
+    double hg[8][8];
+    for (int a = 0; a < 8; a++)
+        for (int b = 0; b < 8; b++)
+            hg[a][b] = kh * cf_hourglass_coef(a, b);
     for (size_t c = 0; c < nc; c++) {
         uint32_t node[8];
         double g[8][3];
-        const double J = cf_lattice_cell_volume(lat, c, node, g, hess);
+        const double J = kappa != 0 ? cf_lattice_cell_volume(lat, c, node, g, hess) : 1.0;
         for (int a = 0; a < 8; a++)
             for (int b = 0; b < 8; b++)
                 for (int i = 0; i < 3; i++)
                     for (int k = 0; k < 3; k++) {
                         const int at =
                             s->vmap[((c * 8 + (size_t)a) * 8 + (size_t)b) * 9 + (size_t)(i * 3 + k)];
-                        if (at >= 0)
+                        if (at < 0)
+                            continue;
+                        if (kappa != 0)
                             v[at] += kappa / V0 * g[a][i] * g[b][k] +
                                      kappa * (J - 1) * hess[a][b][i][k];
+                        if (i == k)
+                            v[at] += hg[a][b];
                     }
     }
 }
@@ -294,7 +305,7 @@ static void fill(void *ctx, double *v)
                     v[m[k + 27]] -= B;
             }
     }
-    if (lat->cfg.volume_modulus_MPa != 0)
+    if (cf_lattice_has_cells(lat))
         volume_tangent(s, v);
 }
 /* ---- the directions ------------------------------------------------------------------------- */

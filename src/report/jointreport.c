@@ -266,7 +266,10 @@ static void stability_text(FILE *o, const cf_joint_report *r, const cf_joint_res
     if (checked == (int)r->ntables && all)
         fprintf(o, "  stable over every table's range (the cell's incremental stiffness positive "
                    "definite from 0 to each table's farthest strain; for a uniaxial table the "
-                   "full lattices of 2^3 and 3^3 cells too)\n");
+                   "full lattices of 2^3 and 3^3 cells too%s)\n",
+                j->volume_modulus_MPa > 0 ? ", with their cells' default hourglass control, "
+                                            "which a scene's lattice.hourglass 0 turns off"
+                                          : "");
 }
 
 char *cf_joint_text(const cf_joint_report *r)

@@ -277,8 +277,9 @@ static void declared_nu_is_the_lattices(void **state)
 /* The brain cortex (Budday et al. 2017) in tension, compression and shear, --joint --law auto
 ** --volume fit (issue 35's target): the kept element a buildable double-acting pair whose full
 ** lattice (2^3 and 3^3 cells) is stable over every table's range, its weighted objective at or
-** below half one-term Ogden's 0.0343 (0.01715; 0.01248 measured, with a tailed compression
-** spring: the stable pair with a conical one ends at 0.01864, its buckling optimum at 0.01713);
+** below half one-term Ogden's 0.0343 (0.01715; 0.01713 measured with the lattice's hourglass
+** control, a conical compression spring, whose optimum buckled without it; 0.01248 before, with a
+** tailed one);
 ** every table's cell curve finite; the fit file holds params_extension, the tail and
 ** lattice.volume_modulus_MPa. */
 static void brain_cortex_stable_pair_below_half_of_ogden(void **state)
@@ -301,9 +302,14 @@ static void brain_cortex_stable_pair_below_half_of_ogden(void **state)
     if (!(j->objective <= 0.01715))
         fail_msg("objective %.6g above half of one-term Ogden's 0.0343 (0.01715)", j->objective);
     assert_true(j->pair && j->fit.feasible && j->ext.feasible);
-    assert_true(j->fit.tail && j->fit.params.n_tail > 0 && j->fit.q[CF_Q_TAIL] > 0);
-    assert_true(r.law_choice[b].pair_tail_kept && r.law_choice[b].alt_stable &&
-                r.law_choice[b].alt_objective > j->objective);
+    /* which compression spring: with the lattice's hourglass control (lattice_hourglass.h) the
+    ** conical pair's optimum, 0.01713, is stable and kept, and the tailed pair's search ends on
+    ** an unbuildable spring (0.007852); before, the tailed pair was kept at 0.01248 */
+    const int tail = r.law_choice[b].pair_tail_kept;
+    assert_int_equal(j->fit.tail != 0, tail);
+    if (tail)
+        assert_true(j->fit.params.n_tail > 0 && j->fit.q[CF_Q_TAIL] > 0 &&
+                    r.law_choice[b].alt_stable && r.law_choice[b].alt_objective > j->objective);
     assert_true(j->volume_modulus_MPa > 0 && isfinite(j->nu_compression) &&
                 isfinite(j->nu_extension));
     /* brain is stiffer in compression than in tension at small strain too */
@@ -335,7 +341,7 @@ static void brain_cortex_stable_pair_below_half_of_ogden(void **state)
     assert_non_null(strstr(file, "\"volume_modulus_MPa\""));
     assert_non_null(strstr(file, "\"double-acting\""));
     assert_non_null(strstr(file, "\"poisson_ratio_extension\""));
-    assert_non_null(strstr(file, "\"tail_compliance\""));
+    assert_true(!tail || strstr(file, "\"tail_compliance\""));
     assert_non_null(strstr(file, "\"pair_alternative\""));
     free(file);
     remove(json);

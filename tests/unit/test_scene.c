@@ -48,6 +48,10 @@ static void every_bad_scene_is_refused_naming_its_key(void **state)
          "'lattice.calibration' = 'cubic'"},
         {"{" SPRING ", " RAMP ", \"lattice\": {\"bottom\": \"glued\"}}", CF_E_DATA,
          "'lattice.bottom' = 'glued'"},
+        {"{" SPRING ", " RAMP ", \"lattice\": {\"hourglass\": -0.1}}", CF_E_DATA,
+         "'lattice.hourglass' = -0.1"},
+        {"{" SPRING ", " RAMP ", \"lattice\": {\"hourglass\": \"on\"}}", CF_E_DATA,
+         "'lattice.hourglass'"},
         {"{\"spring\": {\"params\": {\"D1_mm\": 6, \"D2_mm\": 15, \"n\": 2.5, \"d_mm\": 2, "
          "\"G_MPa\": 26, \"H_mm\": 10, \"n_tail\": -1}}, " RAMP "}",
          CF_E_DATA, "'spring.params.n_tail' = -1"},
@@ -117,6 +121,12 @@ static void good_scene_builds_its_loading_path(void **state)
     assert_int_equal(sc.nsamples, 6 * 5 + 1);
     assert_close(sc.effects.eta_MPa_s, 4e-3, 1e-18);
     assert_int_equal(sc.cfg.lattice.nx, 3); /* default lattice */
+    assert_true(sc.cfg.lattice.hourglass == CF_HOURGLASS_AUTO); /* hourglass control automatic */
+    cf_scene_free(&sc);
+    const char *hg = "{" SPRING ", " RAMP ", \"lattice\": {\"hourglass\": 0.25}}";
+    if (cf_scene_parse(hg, "s.json", &sc, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    assert_true(sc.cfg.lattice.hourglass == 0.25);
     cf_scene_free(&sc);
 }
 
