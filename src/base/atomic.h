@@ -14,8 +14,10 @@
 **   - a failed or aborted write leaves no file at all;
 **   - temporaries still open when the process is stopped by a signal are removed by
 **     cf_atomic_remove_temporaries (main calls it on SIGINT, SIGTERM, SIGHUP, SIGPIPE); those of a
-**     process killed outright (SIGKILL) stay hidden (dot names) and are swept by the next
-**     cf_atomic_open in the same folder, once no process of that PID is alive. TAG names the PID
+**     process killed outright (SIGKILL) stay hidden (dot names) and are swept by a later
+**     cf_atomic_open in the same folder, once no process of that PID is alive: the first open
+**     of a process in a folder sweeps it, later ones only after ten minutes (so n files in one
+**     folder cost one reading of it, not n). TAG names the PID
 **     space (host, boot and PID namespace): only temporaries of this one are judged, so a run in
 **     another container or on another host sharing the folder is never swept while it writes.
 ** The list of live temporaries is the one process-wide state of the library; it is thread-safe.
@@ -75,6 +77,13 @@ cf_status cf_atomic_begin_one(const char *call, const void *r, const char *path,
 /* Removes every temporary file still open in this process. Async-signal-safe: for a handler of a
 ** fatal signal. */
 void cf_atomic_remove_temporaries(void);
+
+/* How many times this process has swept a folder for dead runs' temporaries (for tests). */
+unsigned long cf_atomic_sweeps(void);
+
+/* 1 when paths a and b name one file: the same text, one existing file (same device and inode),
+** or, for files not there yet, the same name in the same folder (the folders resolved). */
+int cf_same_target(const char *a, const char *b);
 
 /* True when a and b name the same existing file (same device and inode). */
 int cf_same_file(const char *a, const char *b);

@@ -63,9 +63,7 @@ static cf_status check_one(const char *call, const char *path, const cf_atomic *
     return CF_OK;
 }
 
-/* 1 when paths a and b name one file: the same text, one existing file (same device and inode),
-** or, for files not there yet, the same name in the same folder (the folders resolved). */
-static int same_target(const char *a, const char *b)
+int cf_same_target(const char *a, const char *b)
 {
     if (strcmp(a, b) == 0)
         return 1;
@@ -101,7 +99,7 @@ cf_status cf_atomic_begin(const char *call, const void *r, const char *path1, cf
                             "%s: one output handle given for both files (%s and %s): give each "
                             "its own",
                             call, path1, path2);
-    if (path1 && path2 && same_target(path1, path2))
+    if (path1 && path2 && cf_same_target(path1, path2))
         return cf_error_set(err, CF_E_USAGE, "%s: both outputs name one file (%s and %s)", call,
                             path1, path2);
     if (out1)

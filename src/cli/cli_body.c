@@ -550,6 +550,31 @@ static void summary(FILE *o, const cf_scene *sc, const run *r)
             r->step[steps].depth_mm, r->step[steps].force_N, r->step[steps].contacts, minJ, umax);
 }
 
+/* 1 when path names one of the files --vtu dir writes for a run of steps steps: dir/body.pvd,
+** dir/body_NNNN.vtu or dir/springs_NNNN.vtu with NNNN from 0000 to the last step. */
+static int vtu_file(const char *path, const char *dir, size_t steps)
+{
+    const char *slash = strrchr(path, '/'), *base = slash ? slash + 1 : path;
+    const char *num = strncmp(base, "body_", 5) == 0      ? base + 5
+                      : strncmp(base, "springs_", 8) == 0 ? base + 8
+                                                          : NULL;
+    if (strcmp(base, "body.pvd") != 0) {
+        if (!num)
+            return 0;
+        char *end;
+        errno = 0;
+        unsigned long long k = strtoull(num, &end, 10);
+        char again[32];
+        snprintf(again, sizeof again, "%04llu", k);
+        if (errno || end == num || strcmp(end, ".vtu") != 0 || k > steps ||
+            strncmp(again, num, (size_t)(end - num)) != 0 || strlen(again) != (size_t)(end - num))
+            return 0;
+    }
+    char mine[4200];
+    snprintf(mine, sizeof mine, "%s/%s", dir, base);
+    return cf_same_target(path, mine);
+}
+
 int cf_cli_simulate_body(const cf_scene *sc, const char *scene_path, const char *out,
                          const char *vtu_dir, const char *png, const cf_budget *budget, int quiet)
 {
@@ -563,6 +588,13 @@ int cf_cli_simulate_body(const cf_scene *sc, const char *scene_path, const char 
     cf_cli_out csv = {0};
     cf_atomic plot = {0};
     int rc = CF_EXIT_OK;
+    /* the CSV must not replace a ParaView file (a plot's name ends in .png, .svg or .pdf) */
+    if (vtu_dir && !cf_cli_is_stdio(out) && vtu_file(out, vtu_dir, (size_t)sc->body_steps))
+        return cf_cli_usage_error("simulate",
+                                  "-o %s is one of the files --vtu %s writes (body.pvd, "
+                                  "body_NNNN.vtu and springs_NNNN.vtu for steps 0 to %d); name "
+                                  "another",
+                                  out, vtu_dir, sc->body_steps);
     r.keep_forces = vtu_dir != NULL;
     if ((!cf_cli_is_stdio(out) && cf_atomic_check(out, inputs, &err) != CF_OK) ||
         (png && cf_atomic_check(png, inputs, &err) != CF_OK) ||

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "base/atomic.h"
+#include "model/calibration.h"
 #include "model/mode.h"
 #include "cli/cli.h"
 #include "cli/cli_fit.h"
@@ -201,8 +202,15 @@ static int run_joint(const fit_args *a, fit_job *jobs, const char *const *inputs
     int rc = CF_EXIT_OK;
     /* a declared kappa is in the tables' stress unit (the first table's) */
     cf_pipeline_options popt = a->popt;
-    if (popt.fit.volume == CF_VOLUME_MODULUS)
+    if (popt.fit.volume == CF_VOLUME_MODULUS) {
         popt.fit.volume_value /= tabs[0]->y_to_file;
+        if (!(popt.fit.volume_value <= CF_KAPPA_MAX_MPA))
+            return cf_cli_usage_error("fit",
+                                      "--volume-modulus %g %s (%s's stress unit) is %g MPa: kappa "
+                                      "must be at most %g MPa (" CF_KAPPA_MAX_WHY ")",
+                                      a->popt.fit.volume_value, tabs[0]->y_unit, tabs[0]->path,
+                                      popt.fit.volume_value, CF_KAPPA_MAX_MPA);
+    }
     if (cf_pipeline_fit_joint(tabs, (size_t)a->nfiles, &popt, &r, &err) != CF_OK)
         rc = cf_cli_fail(&err);
     cf_atomic jo = {0}, po = {0};

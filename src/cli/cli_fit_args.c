@@ -2,6 +2,7 @@
 ** The command line of `conifit fit` (cli_fit.h): the help, the options and the checks across
 ** them.
 */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -63,7 +64,8 @@ static const char fit_help[] =
     "  --calibration C         isotropic (default), axial, or fitted (with --joint)\n"
     "  --volume fit            a volume term (kappa/2)(J - 1)^2 in every cell, kappa fitted\n"
     "                          (with --joint)\n"
-    "  --volume-modulus K      the volume term's kappa declared, in the tables' stress unit\n"
+    "  --volume-modulus K      the volume term's kappa declared, in the first table's stress\n"
+    "                          unit, at most 1e6 MPa\n"
     "                          (with --joint)\n"
     "  --poisson NU            the lattice's small-strain nu declared, 0.25 <= NU < 0.5: kappa\n"
     "                          from it (with --joint; a double-acting element: its compression\n"
@@ -403,9 +405,10 @@ static int fit_option_apply(void *ctx, int c, const char *optval)
         double v;
         if (cf_cli_parse_double(name, optval, &v, &err))
             return cf_cli_usage_error("fit", "%s", err.msg);
-        if (modulus && !(v >= 0 && v <= CF_MEASURE_MAX_VALUE))
-            return cf_cli_usage_error("fit", "--volume-modulus %s: kappa must be a finite number "
-                                             ">= 0", optval);
+        if (modulus && !(v >= 0 && isfinite(v)))
+            return cf_cli_usage_error("fit", "--volume-modulus %s: kappa must be >= 0 (in the "
+                                             "first table's stress unit) and at most %g MPa",
+                                      optval, CF_KAPPA_MAX_MPA);
         if (!modulus && !(v >= 0.25 && v < 0.5))
             return cf_cli_usage_error("fit", "--poisson %s: nu must lie in [0.25, 0.5) (a lattice "
                                              "of central springs has 0.25; 0.5 is "

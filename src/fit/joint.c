@@ -388,7 +388,7 @@ cf_status cf_joint_fit(const cf_table *const *tables, size_t n, const cf_fit_opt
 ** quantity of both springs in the Jacobian's null space, by a compression spring of almost no
 ** stiffness, small-strain E 0.008 kPa in compression against 4.0 in tension, that no row
 ** tests). */
-static cf_status pair_determined(const cf_table *const *tables, size_t n, cf_error *err)
+cf_status cf_joint_pair_determined(const cf_table *const *tables, size_t n, cf_error *err)
 {
     int stretch = 0, shorten = 0, shear = 0;
     for (size_t k = 0; k < n; k++) {
@@ -441,7 +441,7 @@ cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fi
                                             "(double-acting, the compression spring tailed)",
                             pair);
     if (pair && n >= 1) {
-        cf_status st = pair_determined(tables, n, err);
+        cf_status st = cf_joint_pair_determined(tables, n, err);
         if (st != CF_OK)
             return st;
     }

@@ -134,6 +134,10 @@ cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fi
                             const cf_validate_setup *lat, cf_spring_type type, int pair,
                             const cf_joint_result *plain, cf_joint_result *r, cf_error *err);
 
+/* Whether the n tables determine both springs of a double-acting element (the check
+** cf_joint_fit_pair makes first): CF_OK, or CF_E_DATA with its message. */
+cf_status cf_joint_pair_determined(const cf_table *const *tables, size_t n, cf_error *err);
+
 /* Releases the per-table curves. Safe on a zeroed result. */
 /* 1 unless a table's stability check (cf_joint_table) found the lattice losing stability inside
 ** that table's range. */

@@ -14,6 +14,7 @@
 #include "base/atomic.h"
 #include "base/input.h"
 #include "io/fitfile_json.h"
+#include "model/calibration.h"
 
 static void copy_string(json_t *obj, const char *key, char *dst, size_t cap)
 {
@@ -107,11 +108,12 @@ static cf_status read_element(json_t *fit, const char *path, const char *where, 
 {
     json_t *pe = json_object_get(fit, "params_extension");
     json_t *kv = json_object_get(json_object_get(fit, "lattice"), "volume_modulus_MPa");
-    if (kv && (!json_is_number(kv) || !isfinite(json_number_value(kv)) ||
-               json_number_value(kv) < 0))
+    if (kv && (!json_is_number(kv) || !(json_number_value(kv) >= 0 &&
+                                         json_number_value(kv) <= CF_KAPPA_MAX_MPA)))
         return cf_error_set(err, CF_E_DATA,
-                            "%s: %s.lattice.volume_modulus_MPa is not a finite number >= 0", path,
-                            where);
+                            "%s: %s.lattice.volume_modulus_MPa is not a number from 0 to %g MPa "
+                            "(" CF_KAPPA_MAX_WHY ")",
+                            path, where, CF_KAPPA_MAX_MPA);
     const double kappa = kv ? json_number_value(kv) : 0.0;
     if (!allow && (pe || kappa > 0))
         return cf_error_set(err, CF_E_DATA,

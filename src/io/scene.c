@@ -160,8 +160,7 @@ static cf_status volume_keys(ctx *c, json_t *lt, cf_scene *sc)
                             "lattice's volume term (volume_modulus_MPa = %g)",
                             c->name, kv ? "volume_modulus_MPa" : "poisson_ratio", sc->fit_path,
                             fit_kappa);
-    if ((st = cf_scene_number(c, lt, "lattice", "volume_modulus_MPa", 0, fit_kappa, 0, 0, 1e100,
-                     &L->volume_modulus_MPa)))
+    if ((st = cf_scene_kappa(c, lt, "lattice", &sc->spring, fit_kappa, &L->volume_modulus_MPa)))
         return st;
     if (!nv)
         return CF_OK;

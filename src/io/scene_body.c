@@ -379,7 +379,7 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
             return st;
     } else if (km) {
         sc->body_volume = 1;
-        if ((st = cf_scene_number(c, bd, "body", "volume_modulus_MPa", 1, 0, 0, 0, 1e12, &sc->body_volume_value)))
+        if ((st = cf_scene_kappa(c, bd, "body", &sc->spring, 0, &sc->body_volume_value)))
             return st;
     }
     if ((st = regions_section(c, root, sc)))

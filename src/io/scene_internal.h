@@ -25,6 +25,11 @@ cf_status cf_scene_only_keys(ctx *c, json_t *obj, const char *where, const char 
 ** with open_lo). */
 cf_status cf_scene_number(ctx *c, json_t *obj, const char *where, const char *key, int required,
                           double dflt, double lo, int open_lo, double hi, double *out);
+/* A volume modulus at obj["volume_modulus_MPa"] (dflt when absent): >= 0, at most
+** CF_KAPPA_MAX_MPA and, when the key is given, at most CF_KAPPA_MAX_RATIO times spring's k0/H
+** (model/calibration.h), the message saying why. */
+cf_status cf_scene_kappa(ctx *c, json_t *obj, const char *where, const cf_spring *spring,
+                         double dflt, double *out);
 /* A boolean at obj[key] (false when absent). */
 cf_status cf_scene_boolean(ctx *c, json_t *obj, const char *where, const char *key, int *out);
 /* An object at root[key] (NULL when absent and not required). */

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "io/scene_internal.h"
+#include "model/calibration.h"
 
 /* Refuses keys of obj that are not in the NULL-terminated list. */
 cf_status cf_scene_only_keys(ctx *c, json_t *obj, const char *where, const char *const *allowed)
@@ -45,6 +46,34 @@ cf_status cf_scene_number(ctx *c, json_t *obj, const char *where, const char *ke
     if (!isfinite(x) || (open_lo ? !(x > lo) : !(x >= lo)) || !(x <= hi))
         return cf_error_set(c->err, CF_E_DATA, "%s: key '%s%s%s' = %g: must be %s %g and <= %g",
                             c->name, where, dot, key, x, open_lo ? ">" : ">=", lo, hi);
+    *out = x;
+    return CF_OK;
+}
+
+cf_status cf_scene_kappa(ctx *c, json_t *obj, const char *where, const cf_spring *spring,
+                         double dflt, double *out)
+{
+    double x;
+    cf_status st = cf_scene_number(c, obj, where, "volume_modulus_MPa", 0, dflt, 0, 0, INFINITY, &x);
+    if (st != CF_OK)
+        return st;
+    if (!(x <= CF_KAPPA_MAX_MPA))
+        return cf_error_set(c->err, CF_E_DATA,
+                            "%s: key '%s.volume_modulus_MPa' = %g: must be >= 0 and at most %g MPa "
+                            "(" CF_KAPPA_MAX_WHY ")",
+                            c->name, where, x, CF_KAPPA_MAX_MPA);
+    cf_law law;
+    if (obj && json_object_get(obj, "volume_modulus_MPa") && spring &&
+        cf_law_init(&law, spring, NULL) == CF_OK) {
+        const double k = law.k0_N_per_mm / law.p.H_mm;
+        cf_law_free(&law);
+        if (!(x <= CF_KAPPA_MAX_RATIO * k))
+            return cf_error_set(c->err, CF_E_DATA,
+                                "%s: key '%s.volume_modulus_MPa' = %g: must be at most %g times "
+                                "the spring's small-strain stiffness k0/H = %g MPa, %g MPa "
+                                "(" CF_KAPPA_RATIO_WHY ")",
+                                c->name, where, x, CF_KAPPA_MAX_RATIO, k, CF_KAPPA_MAX_RATIO * k);
+    }
     *out = x;
     return CF_OK;
 }

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "model/body_internal.h"
+#include "model/calibration.h"
 #include "model/net.h"
 
 double cf_body_kappa_for_nu(double mu_MPa, double nu)
@@ -21,9 +22,11 @@ cf_status cf_body_create(cf_body *b, const cf_mesh *m, const cf_law *law, cf_law
                          double kappa_MPa, cf_error *err)
 {
     memset(b, 0, sizeof *b);
-    if (!isfinite(kappa_MPa) || kappa_MPa < 0)
-        return cf_error_set(err, CF_E_DATA, "body: volume modulus %g MPa: must be finite and >= 0",
-                            kappa_MPa);
+    if (!(kappa_MPa >= 0 && kappa_MPa <= CF_KAPPA_MAX_MPA))
+        return cf_error_set(err, CF_E_DATA,
+                            "body: volume modulus %g MPa: must be >= 0 and at most %g MPa "
+                            "(" CF_KAPPA_MAX_WHY ")",
+                            kappa_MPa, CF_KAPPA_MAX_MPA);
     /* the mesh's net: the body takes its arrays */
     cf_net net;
     cf_status st = cf_net_mesh(&net, m, law, err);

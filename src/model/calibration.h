@@ -60,6 +60,31 @@ cf_cubic_moduli cf_cubic_moduli_of(const double w[CF_FAMILY_COUNT]);
 ** k0/H (MPa) the Poisson's ratio nu along an axis, kappa = (nu (C11 + C12) - C12)/(1 - 2 nu) k0/H
 ** from nu = (C12 + kappa)/(C11 + C12 + 2 kappa) (negative when nu is below the springs' own; the
 ** isotropic lattice: kappa = mu (4 nu - 1)/(1 - 2 nu)); and the inverse. */
+/* The largest volume modulus kappa (MPa) a lattice or a body takes, from any source (a scene's
+** 'lattice.volume_modulus_MPa' or 'body.volume_modulus_MPa', a fit file, conifit fit
+** --volume-modulus, the library's configurations): 1e6 MPa = 1 TPa, above the bulk modulus of
+** any solid (diamond's is 0.44 TPa; water's 2.2 GPa, what nearly incompressible tissue
+** approaches). The springs' stiffness k0/H of soft tissue is of order 1e-3 to 1 MPa, so at the
+** bound the volume term outweighs them 1e6 to 1e9 times and a solve in double precision (unit
+** roundoff 1.1e-16) still carries their forces to about 1e-7 of their size; from about 1e14 MPa
+** the springs vanish in the rounding and a lattice run's stresses changed sign (measured: -1.5e12
+** kPa at kappa 1e25), which no check downstream catches. CF_KAPPA_MAX_WHY says it in a message.
+** Where the spring is known as kappa is declared (a scene's keys), kappa is also held to
+** CF_KAPPA_MAX_RATIO times the spring's k0/H: the lattice's stability check reads the signs of
+** its tangent's pivots, which the springs' share must still reach. Measured on the shipped
+** uniaxial scene (k0/H 1.5e-3 MPa): the loss of stability found at strain 0.36-0.38 for kappa up
+** to 1e4 MPa (6.6e6 k0/H), at 0.30 for 1e5 and at 0.01 (false) for 1e6, with the stresses still
+** right. 1e6 k0/H is a Poisson's ratio of 0.4999998 in the isotropic lattice, beyond any
+** measured tissue's; a body's 'poisson_ratio' (at most 0.4999) stays 500 times below it. */
+#define CF_KAPPA_MAX_MPA 1e6
+#define CF_KAPPA_MAX_WHY                                                                           \
+    "1 TPa, above any solid's bulk modulus; beyond it the springs' forces are lost in the "       \
+    "solve's rounding"
+#define CF_KAPPA_MAX_RATIO 1e6
+#define CF_KAPPA_RATIO_WHY                                                                         \
+    "beyond it the springs' share of the tangent is lost to the precision its stability check "   \
+    "needs"
+
 double cf_cubic_kappa_of_nu(const double w[CF_FAMILY_COUNT], double k0_over_H, double nu);
 double cf_cubic_nu_of_kappa(const double w[CF_FAMILY_COUNT], double k0_over_H, double kappa);
 

@@ -74,9 +74,11 @@ static cf_status check_config(const cf_lattice_config *cfg, cf_error *err)
     if (!(cfg->density_t_per_mm3 > 0) || !isfinite(cfg->density_t_per_mm3))
         return cf_error_set(err, CF_E_DATA, "density_t_per_mm3 = %g: must be finite and > 0",
                             cfg->density_t_per_mm3);
-    if (!(cfg->volume_modulus_MPa >= 0) || !isfinite(cfg->volume_modulus_MPa))
-        return cf_error_set(err, CF_E_DATA, "lattice volume_modulus_MPa = %g: must be finite and "
-                                            ">= 0", cfg->volume_modulus_MPa);
+    if (!(cfg->volume_modulus_MPa >= 0 && cfg->volume_modulus_MPa <= CF_KAPPA_MAX_MPA))
+        return cf_error_set(err, CF_E_DATA,
+                            "lattice volume_modulus_MPa = %g: must be >= 0 and at most %g MPa "
+                            "(" CF_KAPPA_MAX_WHY ")",
+                            cfg->volume_modulus_MPa, CF_KAPPA_MAX_MPA);
     if (!(cfg->hourglass == CF_HOURGLASS_AUTO || (cfg->hourglass >= 0 && cfg->hourglass <= 1000)))
         return cf_error_set(err, CF_E_DATA, "lattice hourglass = %g: must be from 0 to 1000 (the "
                                             "fraction of the cell's shear stiffness)",

@@ -85,7 +85,9 @@ int cf_spring_param_find(const char *name)
 
 const char *cf_spring_type_name(cf_spring_type type)
 {
-    return type == CF_TELESCOPING ? "telescoping" : "non-telescoping";
+    return type == CF_TELESCOPING       ? "telescoping"
+           : type == CF_NON_TELESCOPING ? "non-telescoping"
+                                        : "none";
 }
 
 cf_status cf_spring_type_parse(const char *name, cf_spring_type *type, cf_error *err)

@@ -16,6 +16,11 @@ cf_status cf_pipeline_simulate(const cf_scene *sc, const char *name, const cf_bu
     memset(run, 0, sizeof *run);
     cf_scene_cost cost;
     cf_status s;
+    if (sc->has_body) /* a body's run (static probe, dynamics, haptics) is the command's */
+        return cf_error_set(err, CF_E_USAGE,
+                            "%s: the scene has a tissue body (key 'body'); this call runs lattice "
+                            "scenes only: run a body with conifit simulate",
+                            name);
     if ((s = cf_budget_check_size(sc, name, budget, &cost, err)) != CF_OK ||
         (s = cf_scene_law(sc, &run->law, &run->ext, err)) != CF_OK ||
         (s = cf_lattice_create(&run->lat, &run->law, sc->method, &sc->cfg.lattice, err)) != CF_OK ||

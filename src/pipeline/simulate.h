@@ -23,7 +23,8 @@ typedef struct cf_sim_run {
 
 /* Runs lattice scene sc (named name in messages) within budget: its size and step limits (and,
 ** with recovery, the recovery test's) checked before the run (CF_E_DATA naming the key), the
-** scene's progress callback called during it. On CF_OK *run holds the samples; free it with
+** scene's progress callback called during it (a scene with a body: CF_E_USAGE, the command runs
+** those). On CF_OK *run holds the samples; free it with
 ** cf_sim_run_free whatever the status. */
 cf_status cf_pipeline_simulate(const cf_scene *sc, const char *name, const cf_budget *budget,
                                int recovery, cf_sim_run *run, cf_error *err);

@@ -9,6 +9,7 @@
 
 #include "base/gslguard.h"
 #include "conifit/tablefit.h"
+#include "fit/joint.h"
 #include "fit/lawkind.h"
 #include "io/measure.h"
 #include "pipeline/pipeline.h"
@@ -62,9 +63,22 @@ cf_status cf_tablefit_run(const char *table_path, const cf_tablefit_options *opt
         free(f);
         return s;
     }
+    const cf_table *one = &f->table;
     if (f->table.t) {
         s = cf_error_set(err, CF_E_DATA, "%s is a time series: fit it with conifit fit",
                          table_path);
+    } else if (po.fit.law == CF_KIND_DOUBLE) {
+        /* conifit fit --law double-acting fits the element through the lattice (a joint fit of
+        ** its tables); a table that cannot determine both springs is refused as it refuses it,
+        ** one that can is the joint fit's, which this handle does not hold */
+        s = cf_joint_pair_determined(&one, 1, err);
+        if (s == CF_OK)
+            s = cf_error_set(err, CF_E_USAGE,
+                             "%s: law 'double-acting' is fitted through the lattice as one "
+                             "element (conifit fit --law double-acting); this call fits one "
+                             "spring per type: give law \"conical\", \"conical-tail\" or "
+                             "\"auto\"",
+                             table_path);
     } else {
         s = cf_pipeline_fit(&f->table, &po, &f->rep, err);
     }
@@ -96,7 +110,7 @@ int cf_tablefit_better(const cf_tablefit *f)
 cf_spring_type cf_tablefit_type(const cf_tablefit *f, int i)
 {
     const cf_fit_result *r = fit_at(f, i);
-    return r ? r->type : CF_TELESCOPING;
+    return r ? r->type : CF_SPRING_TYPE_NONE;
 }
 
 const cf_spring *cf_tablefit_spring(const cf_tablefit *f, int i)

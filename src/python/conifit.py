@@ -163,7 +163,10 @@ def force(spring, u_mm, method="closed", stiffness=False):
 
 def fit(table=None, strain=None, stress=None, stress_unit="kPa", type="both", validate=False):
     """Fits a table (a path) or two sequences (strain, stress in stress_unit) as conifit fit
-    does and returns the fit file's content as a dict."""
+    does and returns the fit file's content as a dict. From sequences, the data section names no
+    file (its "file" is None, its "source" says where the data came from) and holds the
+    sequences as "strain" and "stress" (in stress_unit); no text of the result names the
+    temporary table the fit read."""
     if table is not None and (strain is not None or stress is not None):
         raise Error(-1, "give a table path or strain and stress, not both")
     tmp = None
@@ -186,7 +189,10 @@ def fit(table=None, strain=None, stress=None, stress_unit="kPa", type="both", va
         e = _CfError()
         _check(_lib.cf_flat_fit(_text(table, "table"), _text(type, "type"), 1 if validate else 0,
                                 ctypes.byref(out), ctypes.byref(e)), e)
-        return json.loads(_taken(out))
+        result = json.loads(_taken(out))
+        if tmp:
+            result = _from_sequences(result, tmp, x, y, stress_unit)
+        return result
     except Error as err:
         if not tmp:
             raise
@@ -194,6 +200,29 @@ def fit(table=None, strain=None, stress=None, stress_unit="kPa", type="both", va
     finally:
         if tmp:
             os.unlink(tmp)
+
+
+def _from_sequences(result, tmp, x, y, stress_unit):
+    """The fit of the temporary table tmp told as a fit of the sequences x, y: every text naming
+    tmp names the sequences instead, and the data section names no file (tmp is deleted once
+    the fit returns) but holds the sequences."""
+    def scrub(v):
+        if isinstance(v, str):
+            return v.replace(tmp, "the strain and stress given")
+        if isinstance(v, list):
+            return [scrub(e) for e in v]
+        if isinstance(v, dict):
+            return {k: scrub(e) for k, e in v.items()}
+        return v
+    result = scrub(result)
+    data = result.get("data")
+    if isinstance(data, dict):
+        data["file"] = None
+        data["source"] = "strain and stress sequences given to conifit.fit (stress in %s)" % \
+            stress_unit
+        data["strain"] = list(x)
+        data["stress"] = list(y)
+    return result
 
 
 def _in_sequences(err, tmp, count):

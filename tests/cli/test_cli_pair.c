@@ -8,6 +8,7 @@
 ** 'spring_extension' and 'lattice.volume_modulus_MPa' run the pair and the volume term, equal to
 ** the homogenised cell; bad keys exit 65 naming them.
 */
+/* conifit: vector-level: explicit runs of the double-acting lattice */
 #include "testutil.h"
 
 #include <math.h>

@@ -119,6 +119,22 @@ class Fit(unittest.TestCase):
         for key, value in b["fits"][0]["params"].items():
             self.assertTrue(close(a["fits"][0]["params"][key], value, 1e-9), key)
 
+    def test_a_fit_of_sequences_names_no_deleted_file(self):
+        # the fit reads a temporary table it deletes before returning: the result must not name
+        # it (an earlier version's data.file did), and keeps the data it was given
+        x = [0.01 * i for i in range(1, 21)]
+        y = [10 * e + 40 * e ** 3 for e in x]
+        got = conifit.fit(strain=x, stress=y, stress_unit="kPa", type="telescoping")
+        data = got["data"]
+        self.assertIsNone(data["file"])
+        self.assertIn("sequences", data["source"])
+        self.assertEqual(data["strain"], x)
+        self.assertEqual(data["stress"], y)
+        self.assertEqual(data["points"], 20)
+        text = json.dumps(got)
+        self.assertNotIn(tempfile.gettempdir() + "/conifit-", text)
+        self.assertNotIn(".csv", text)
+
     def test_a_table_whose_f_quantile_gsl_cannot_invert(self):
         # 274 rows: the F-test's F(0.95; 1, 271), whose inverse GSL 2.7 does not converge; with
         # GSL's default handler (Python never turns it off) this session was killed by abort()

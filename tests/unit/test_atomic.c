@@ -2,8 +2,8 @@
 ** Tests of the atomic output files (src/base/atomic.c): the permissions of what they write (the
 ** umask for a new file, no special bits on a replaced one), write-protected targets refused and
 ** left alone, the sweep of dead runs' temporaries, which judges only temporaries of its own
-** PID space, and the removal on a signal of every temporary open, however many (more than the
-** 4096 an earlier fixed list held).
+** PID space and reads a folder once for many files, and the removal on a signal of every
+** temporary open, however many (more than the 4096 an earlier fixed list held).
 */
 #include "testutil.h"
 
@@ -115,10 +115,12 @@ static void touch_in(const char *dir, const char *name)
 static void sweep_removes_only_dead_temporaries_of_its_own_pid_space(void **state)
 {
     (void)state;
-    char dir[] = "/tmp/conifit-atomic-XXXXXX", path[300];
+    char dir[] = "/tmp/conifit-atomic-XXXXXX", other[] = "/tmp/conifit-atomic-XXXXXX", path[300];
     assert_non_null(mkdtemp(dir));
-    /* this run's tag, from the name of one of its temporaries */
-    snprintf(path, sizeof path, "%s/probe.csv", dir);
+    assert_non_null(mkdtemp(other));
+    /* this run's tag, from the name of one of its temporaries (in another folder: the first
+    ** open in dir must be the one that sweeps it) */
+    snprintf(path, sizeof path, "%s/probe.csv", other);
     cf_atomic a;
     cf_error err = {0};
     assert_int_equal(cf_atomic_open(&a, path, NULL, &err), CF_OK);
@@ -128,6 +130,7 @@ static void sweep_removes_only_dead_temporaries_of_its_own_pid_space(void **stat
     assert_int_equal(sscanf(t + 9, "%63[0-9a-f]", tag), 1);
     assert_int_equal(strlen(tag), 16);
     cf_atomic_abort(&a);
+    assert_int_equal(rmdir(other), 0);
     /* a PID that was this PID space's and is dead now */
     pid_t child = fork();
     assert_true(child >= 0);
@@ -156,6 +159,35 @@ static void sweep_removes_only_dead_temporaries_of_its_own_pid_space(void **stat
     snprintf(path, sizeof path, "%s/out.csv", dir);
     unlink(path);
     assert_int_equal(rmdir(dir), 0);
+}
+
+/* A run writing many files into one folder (a body's VTU series) sweeps it once, not once per
+** file: the sweep reads the whole folder, so n files would cost O(n^2). Another folder is swept
+** on its own first open. */
+static void a_folder_is_swept_once_for_many_files(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-atomic-XXXXXX", other[] = "/tmp/conifit-atomic-XXXXXX", path[300];
+    assert_non_null(mkdtemp(dir));
+    assert_non_null(mkdtemp(other));
+    cf_error err = {0};
+    const unsigned long before = cf_atomic_sweeps();
+    for (int i = 0; i < 200; i++) {
+        snprintf(path, sizeof path, "%s/body_%04d.vtu", dir, i);
+        assert_int_equal(write_atomic(path, "<VTKFile/>\n", &err), CF_OK);
+    }
+    assert_int_equal(cf_atomic_sweeps() - before, 1);
+    snprintf(path, sizeof path, "%s/body.pvd", other);
+    assert_int_equal(write_atomic(path, "<VTKFile/>\n", &err), CF_OK);
+    assert_int_equal(cf_atomic_sweeps() - before, 2);
+    for (int i = 0; i < 200; i++) {
+        snprintf(path, sizeof path, "%s/body_%04d.vtu", dir, i);
+        assert_int_equal(unlink(path), 0);
+    }
+    snprintf(path, sizeof path, "%s/body.pvd", other);
+    assert_int_equal(unlink(path), 0);
+    assert_int_equal(rmdir(dir), 0);
+    assert_int_equal(rmdir(other), 0);
 }
 
 /* Files in dir whose name starts with a dot (temporaries). */
@@ -232,6 +264,7 @@ int main(void)
         cmocka_unit_test(write_protected_target_is_refused_and_kept),
         cmocka_unit_test(sweep_removes_only_dead_temporaries_of_its_own_pid_space),
         cmocka_unit_test(every_open_temporary_is_removed_on_a_signal),
+        cmocka_unit_test(a_folder_is_swept_once_for_many_files),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

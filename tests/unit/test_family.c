@@ -7,6 +7,7 @@
 ** one, as the six-parameter model over many points is; the design limits in the family's space
 ** at points worked out by hand.
 */
+/* conifit: vector-level: the family's lanes, cf_ident_canon_many */
 #include "testutil.h"
 
 #include "model/family.h"

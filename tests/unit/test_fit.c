@@ -4,6 +4,7 @@
 ** fixed parameters, determinism, and the published tables against an independent
 ** three-parameter least-squares fit.
 */
+/* conifit: vector-level: the spring fit, whose first stage runs the family's lanes */
 #include <float.h>
 #include <math.h>
 

@@ -3,8 +3,10 @@
 ** a status and a message, never a crash (a displacement that is not finite among them); the
 ** batch force equal to the law's one-by-one; a fit of
 ** the published tables equal to the pipeline's own; a time series refused; a scene's samples and
-** an export complete and finite.
+** an export complete and finite; a scene with a body refused by the lattice's runner, saying so
+** (it said "loading path is empty").
 */
+#include "bodyutil.h"
 #include "testutil.h"
 
 #include <jansson.h>
@@ -240,6 +242,36 @@ static void a_scene_and_an_export_are_whole_and_finite(void **state)
     rmdir(dir);
 }
 
+static void a_body_scene_is_refused_by_the_lattice_runner(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/conifit-flat-XXXXXX", mesh[300], scene[300];
+    assert_non_null(mkdtemp(dir));
+    snprintf(mesh, sizeof mesh, "%s/block.msh", dir);
+    snprintf(scene, sizeof scene, "%s/body.json", dir);
+    write_block(mesh);
+    FILE *f = fopen(scene, "w");
+    assert_non_null(f);
+    fprintf(f,
+            "{" SPRING ",\n \"body\": {\"mesh\": \"%s\", \"unit_mm\": 1, \"poisson_ratio\": 0.45},\n"
+            " \"fixed\": {\"below\": {\"axis\": \"z\", \"value_mm\": 0}},\n"
+            " \"probe\": {\"shape\": \"sphere\", \"radius_mm\": 5, \"center_mm\": [15, 15, 20], "
+            "\"direction\": [0, 0, -1], \"depth_mm\": 0.1, \"steps\": 1}}\n",
+            mesh);
+    fclose(f);
+    double *rows = (double *)1;
+    size_t n = 7;
+    cf_error e = {0};
+    refused(cf_flat_simulate(scene, &rows, &n, &e), CF_E_USAGE, &e, "tissue body");
+    assert_non_null(strstr(e.msg, "conifit simulate"));
+    assert_null(strstr(e.msg, "loading path"));
+    assert_null(rows);
+    assert_int_equal(n, 0);
+    unlink(mesh);
+    unlink(scene);
+    assert_int_equal(rmdir(dir), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -248,6 +280,7 @@ int main(void)
         cmocka_unit_test(the_batch_is_the_law_one_by_one),
         cmocka_unit_test(a_fit_of_the_published_tables_is_the_pipelines),
         cmocka_unit_test(a_scene_and_an_export_are_whole_and_finite),
+        cmocka_unit_test(a_body_scene_is_refused_by_the_lattice_runner),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,3 +1,4 @@
+/* conifit: vector-level: the explicit step's hourglass forces */
 /*
 ** Tests of the lattice's hourglass control (lattice_hourglass.h, cf_lattice_config.hourglass):
 **  - its energy and forces vanish for every affine motion of a cell (random F and translation,

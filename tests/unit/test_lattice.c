@@ -4,6 +4,7 @@
 ** damped dynamics, energy of the undamped symplectic integrator, creep, hysteresis against loading
 ** rate, and the refusal of an unstable time step.
 */
+/* conifit: vector-level: the lattice's explicit step, cf_lattice_stepper_* */
 #include "testutil.h"
 
 #include "model/lattice.h"

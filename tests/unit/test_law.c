@@ -3,6 +3,7 @@
 ** independent long-double evaluation over the hard corners of the domain, the invariants of the
 ** law, parameter checks, and the force/curve/info command line.
 */
+/* conifit: vector-level: the law's lanes against the scalar law */
 #include <float.h>
 #include <math.h>
 

@@ -4,6 +4,7 @@
 ** u(F) = u_cone(F) + F/k_t by bisection on F; the hard corners (beta near 1/4, beta small and
 ** large, near the cone's solid and near the tail's); region 3; the design checks on bad input.
 */
+/* conifit: vector-level: the tailed law's lanes, the level CONIFIT_SIMD names */
 #include <math.h>
 #include <float.h>
 #include <setjmp.h>

@@ -18,6 +18,7 @@
 **    Krylov step solves the current tangent, and the uniaxial curve through those steps equals the one Newton finds with a fresh
 **    tangent at every iteration, past the stability limit, with a fraction of the factorisations.
 */
+/* conifit: vector-level: explicit lattice runs, the vectorised step */
 #include "testutil.h"
 
 #include "model/lattice.h"

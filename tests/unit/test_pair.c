@@ -8,6 +8,7 @@
 ** with a pair equals the cell under homogeneous uniaxial loading (every lateral spring crossing
 ** zero on the other side from the loaded ones) and stays at rest at rest.
 */
+/* conifit: vector-level: the double-acting law's lanes and explicit step */
 #include "testutil.h"
 
 #include "model/cell.h"

@@ -55,6 +55,8 @@ static void bad_arguments_are_refused(void **state)
     double se = 0;
     assert_true(isnan(cf_tablefit_quantity(NULL, 0, "rho", &se)));
     assert_true(se == -1);
+    assert_int_equal(cf_tablefit_type(NULL, 0), CF_SPRING_TYPE_NONE); /* never a real type */
+    assert_string_equal(cf_spring_type_name(CF_SPRING_TYPE_NONE), "none");
     refused(cf_tablefit_prepare(NULL, "x.json", NULL, &e), CF_E_USAGE, &e, "handle");
     cf_tablefit_free(NULL);
 }
@@ -135,6 +137,8 @@ static void a_fit_is_the_pipelines(void **state)
     }
     assert_null(cf_tablefit_spring(f, 2));
     assert_null(cf_tablefit_spring(f, -1));
+    assert_int_equal(cf_tablefit_type(f, 2), CF_SPRING_TYPE_NONE);
+    assert_int_equal(cf_tablefit_type(f, -1), CF_SPRING_TYPE_NONE);
     cf_report_free(&r);
     cf_table_free(&t);
 
@@ -185,12 +189,51 @@ static void one_type_when_one_is_asked(void **state)
     cf_tablefit_free(f);
 }
 
+/* law "double-acting": conifit fit fits the element through the lattice (a joint fit); the handle
+** refuses a table that cannot determine both springs with the command's own message (it returned
+** CF_OK with plain conical fits), and one that can with CF_E_USAGE saying where it is fitted. */
+static void a_double_acting_law_is_refused_as_the_command_refuses_it(void **state)
+{
+    (void)state;
+    cf_tablefit_options o = cf_tablefit_default_options();
+    o.law = "double-acting";
+    cf_tablefit *f = (cf_tablefit *)1;
+    cf_error e = {0};
+    refused(cf_tablefit_run("data/telescoping.csv", &o, &f, &e), CF_E_DATA, &e,
+            "a double-acting element's compression spring is not determined by the table");
+    assert_null(f);
+    char out[4096], err[8192];
+    assert_int_equal(tu_run(out, sizeof out, err, sizeof err,
+                            "fit data/telescoping.csv --law double-acting -o "
+                            "/tmp/conifit-tablefit-never.json"),
+                     65);
+    char *nl = strchr(err, '\n');
+    if (nl)
+        *nl = '\0';
+    assert_string_equal(err + strlen("conifit: "), e.msg); /* the same message */
+    /* a table of both signs determines the pair: the joint fit's, not this handle's */
+    char path[] = "/tmp/conifit-tablefit-XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    FILE *t = fdopen(fd, "w");
+    assert_non_null(t);
+    fprintf(t, "strain,stress_kPa\n");
+    for (int i = -10; i <= 10; i++)
+        fprintf(t, "%g,%g\n", 0.02 * i, 5.0 * 0.02 * i * (1 + 0.02 * i * 0.02 * i));
+    fclose(t);
+    e = (cf_error){0};
+    refused(cf_tablefit_run(path, &o, &f, &e), CF_E_USAGE, &e, "conifit fit --law double-acting");
+    assert_null(f);
+    unlink(path);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(bad_arguments_are_refused),
         cmocka_unit_test(a_fit_is_the_pipelines),
         cmocka_unit_test(one_type_when_one_is_asked),
+        cmocka_unit_test(a_double_acting_law_is_refused_as_the_command_refuses_it),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

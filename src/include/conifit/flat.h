@@ -34,7 +34,9 @@ cf_status cf_flat_fit(const char *table_path, const char *type, int validate, ch
                       cf_error *err);
 
 /* Runs the scene at scene_path (a scene file, as conifit simulate reads it), refused with CF_E_DATA
-** when its estimated memory, steps or work exceed conifit simulate's default budget.
+** when its estimated memory, steps or work exceed conifit simulate's default budget. Lattice
+** scenes only: a scene with a tissue body (key 'body') is refused with CF_E_USAGE, a message
+** saying so (conifit simulate runs it).
 ** *samples receives *count rows of CF_FLAT_SAMPLE_COLUMNS numbers, the columns of conifit
 ** simulate's CSV: time (s), compressive strain, compressive nominal stress (kPa), kinetic energy (mJ), one spring's
 ** F(strain H)/H^2 (kPa), stable (1 up to the first sample whose tangent had a negative pivot,

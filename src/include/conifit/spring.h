@@ -29,7 +29,8 @@ typedef struct cf_spring {
 
 typedef enum cf_spring_type {
     CF_TELESCOPING = 0,     /* (D2 - D1)/2 >= n d, solid length d */
-    CF_NON_TELESCOPING = 1  /* (D2 - D1)/2 <  n d, solid length n d */
+    CF_NON_TELESCOPING = 1, /* (D2 - D1)/2 <  n d, solid length n d */
+    CF_SPRING_TYPE_NONE = -1 /* no spring: what an accessor returns for a fit that is not there */
 } cf_spring_type;
 
 /* Index of each design parameter, in the order D1, D2, n, d, G, H: the CF_P_COUNT parameters of

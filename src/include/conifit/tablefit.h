@@ -37,7 +37,10 @@ enum {
 typedef struct cf_tablefit_options {
     unsigned types;   /* CF_TABLEFIT_* bits (default both) */
     const char *law;  /* the law kind, as conifit fit --law names it ("conical", "conical-tail",
-                      ** "auto"); NULL: the default, the conical law */
+                      ** "auto"); NULL: the default, the conical law. "double-acting" (an
+                      ** element fitted through the lattice, conifit fit's joint fit) is
+                      ** refused: CF_E_DATA with conifit fit's message when the table cannot
+                      ** determine both springs, CF_E_USAGE when it can */
     int validate;     /* 1: run each fit in the default lattice (conifit fit --validate) */
     int with_timing;  /* 0 (default): wall times written as 0, so fit files are reproducible */
 } cf_tablefit_options;
@@ -59,7 +62,8 @@ int cf_tablefit_count(const cf_tablefit *f);
 /* Index of the better fit (the feasible one of lower objective), -1 if neither is feasible. */
 int cf_tablefit_better(const cf_tablefit *f);
 
-/* Fit i's spring type, and its spring (NULL for a bad i). */
+/* Fit i's spring type (CF_SPRING_TYPE_NONE for a bad i, never a type), and its spring (NULL for
+** a bad i). */
 cf_spring_type cf_tablefit_type(const cf_tablefit *f, int i);
 const cf_spring *cf_tablefit_spring(const cf_tablefit *f, int i);
 
