@@ -7,21 +7,27 @@
 */
 #include "io/mesh.h"
 
+#include "io/isolate.h"
 #include "io/surface.h"
 
 #include <errno.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 
+#include <stdint.h>
+
 #include <dlfcn.h>
 #include <gmshc.h>
 
-static pthread_mutex_t gmsh_lock = PTHREAD_MUTEX_INITIALIZER;
 static int gmsh_ready;
+
+/* Gmsh's process: the library and its model before a mesh (bytes), and what it holds per
+** tetrahedron while it refines or fills (measured: peak resident memory of its process). */
+#define GMSH_BYTES_BASE (64.0 * 1024 * 1024)
+#define GMSH_TET_BYTES 600.0
 
 /* Gmsh's library is loaded when a mesh is first read, not linked: it is large (with its
 ** geometry kernel it adds tens of megabytes to a process), and a run that reads no mesh should
@@ -90,16 +96,6 @@ static int gmsh_begin(char *why, size_t cap)
     gm.gmshOptionSetNumber("General.Verbosity", 0, &ierr);
     gm.gmshClear(&ierr);
     return ierr == 0;
-}
-
-/* Ends Gmsh after every use: it keeps a failed read's state (the next model would be empty), and
-** its global model and tables are released only by finalizing it. */
-static void gmsh_end(void)
-{
-    int ierr = 0;
-    if (gmsh_ready)
-        gm.gmshFinalize(&ierr);
-    gmsh_ready = 0;
 }
 
 static const char *gmsh_reason(char *buf, size_t cap)
@@ -216,9 +212,10 @@ static size_t used_nodes(const int *types, size_t ntypes, const size_t *etags_n,
 }
 
 /* The mesh's nodes: their tags (sorted, nn of them) and their coordinates times unit_mm, looked
-** up among Gmsh's nodes (tags, coord); a node no Gmsh node defines is left NAN. */
-static void fill_nodes(cf_mesh *m, const size_t *sorted, size_t nn, const size_t *tags,
-                       size_t tags_n, const double *coord, double unit_mm)
+** up among Gmsh's nodes (tags, coord); a node no Gmsh node defines is left NAN. Returns the index
+** into tags of a node given twice at different places (the file defines it twice), or tags_n. */
+static size_t fill_nodes(cf_mesh *m, const size_t *sorted, size_t nn, const size_t *tags,
+                         size_t tags_n, const double *coord, double unit_mm)
 {
     for (size_t i = 0; i < nn; i++)
         m->id[i] = (uint32_t)(sorted[i] <= UINT32_MAX ? sorted[i] : 0);
@@ -226,10 +223,16 @@ static void fill_nodes(cf_mesh *m, const size_t *sorted, size_t nn, const size_t
         m->X[3 * i] = NAN;
     for (size_t j = 0; j < tags_n; j++) {
         size_t *hit = bsearch(&tags[j], sorted, nn, sizeof *sorted, cmp_size);
-        if (hit)
-            for (int a = 0; a < 3; a++)
-                m->X[3 * (size_t)(hit - sorted) + a] = coord[3 * j + a] * unit_mm;
+        if (!hit)
+            continue;
+        double *x = m->X + 3 * (size_t)(hit - sorted);
+        if (!isnan(x[0]) && (x[0] != coord[3 * j] * unit_mm || x[1] != coord[3 * j + 1] * unit_mm ||
+                             x[2] != coord[3 * j + 2] * unit_mm))
+            return j;
+        for (int a = 0; a < 3; a++)
+            x[a] = coord[3 * j + a] * unit_mm;
     }
+    return tags_n;
 }
 
 /* The volume elements as tetrahedra of the mesh's node indices (a hexahedron as six around its
@@ -319,7 +322,12 @@ static cf_status extract(const char *name, double unit_mm, cf_mesh *m, cf_error 
     m->id = malloc(nn * sizeof *m->id);
     if (!m->X || !m->id)
         goto oom;
-    fill_nodes(m, sorted, nn, tags, tags_n, coord, unit_mm);
+    const size_t twice = fill_nodes(m, sorted, nn, tags, tags_n, coord, unit_mm);
+    if (twice < tags_n) {
+        st = cf_error_set(err, CF_E_DATA, "%s: node %zu is defined twice, at different places",
+                          name, tags[twice]);
+        goto end;
+    }
     for (size_t i = 0; i < nn; i++)
         if (isnan(m->X[3 * i])) {
             st = cf_error_set(err, CF_E_DATA, "%s: node %zu is used by an element but not defined",
@@ -367,15 +375,225 @@ static int mesh_ext_ok(const char *path)
     return 0;
 }
 
-cf_status cf_mesh_read(const char *path, double unit_mm, cf_mesh *m, cf_error *err)
+typedef struct node_at {
+    double x[3];
+    uint32_t i;
+} node_at;
+
+static int cmp_node_at(const void *pa, const void *pb)
 {
-    return cf_mesh_read_refined(path, unit_mm, 0, m, err);
+    const node_at *a = pa, *b = pb;
+    for (int k = 0; k < 3; k++)
+        if (a->x[k] != b->x[k])
+            return (a->x[k] > b->x[k]) - (a->x[k] < b->x[k]);
+    return (a->i > b->i) - (a->i < b->i);
 }
 
-cf_status cf_mesh_read_refined(const char *path, double unit_mm, int refine, cf_mesh *m,
-                               cf_error *err)
+/* Two nodes of a mesh file at one point: the elements on either side are not joined (a crack the
+** file does not show), so the mesh is refused naming both. */
+static cf_status mesh_check_nodes(cf_mesh *m, const char *name, cf_error *err)
+{
+    node_at *o = malloc((m->nn + 1) * sizeof *o);
+    if (!o) {
+        cf_mesh_free(m);
+        return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the mesh", name);
+    }
+    for (size_t i = 0; i < m->nn; i++) {
+        memcpy(o[i].x, m->X + 3 * i, sizeof o[i].x);
+        o[i].i = (uint32_t)i;
+    }
+    qsort(o, m->nn, sizeof *o, cmp_node_at);
+    cf_status st = CF_OK;
+    for (size_t k = 1; k < m->nn && st == CF_OK; k++)
+        if (memcmp(o[k].x, o[k - 1].x, sizeof o[k].x) == 0)
+            st = cf_error_set(err, CF_E_DATA, "%s: nodes %lu and %lu are at the same point (%g, "
+                              "%g, %g) mm: the elements on either side are not joined (merge "
+                              "them in the file)", name, (unsigned long)m->id[o[k - 1].i],
+                              (unsigned long)m->id[o[k].i], o[k].x[0], o[k].x[1], o[k].x[2]);
+    free(o);
+    if (st != CF_OK)
+        cf_mesh_free(m);
+    return st;
+}
+
+cf_mesh_limits cf_mesh_limits_default(void)
+{
+    cf_mesh_limits l = {CF_MESH_MAX_BYTES_DEFAULT, CF_MESH_MAX_SECONDS_DEFAULT, 0};
+    return l;
+}
+
+/* The mesh through the pipe from Gmsh's process: counts, then the arrays, then the groups. */
+static void put_mesh(cf_isolate_buf *o, const cf_mesh *m)
+{
+    const uint64_t h[3] = {m->nn, m->nt, m->ngroups};
+    cf_isolate_put(o, h, sizeof h);
+    cf_isolate_put(o, m->X, 3 * m->nn * sizeof *m->X);
+    cf_isolate_put(o, m->id, m->nn * sizeof *m->id);
+    cf_isolate_put(o, m->tet, 4 * m->nt * sizeof *m->tet);
+    cf_isolate_put(o, m->eid, m->nt * sizeof *m->eid);
+    for (size_t g = 0; g < m->ngroups; g++) {
+        const cf_mesh_group *G = &m->groups[g];
+        const int64_t gh[3] = {G->dim, G->tag, (int64_t)G->nnodes};
+        cf_isolate_put(o, gh, sizeof gh);
+        cf_isolate_put(o, G->name, sizeof G->name);
+        cf_isolate_put(o, G->nodes, G->nnodes * sizeof *G->nodes);
+    }
+}
+
+/* Reads put_mesh's bytes into m; CF_E_INTERNAL when they are short or inconsistent. */
+static cf_status get_mesh(cf_isolate_buf *in, const char *name, cf_mesh *m, cf_error *err)
 {
     memset(m, 0, sizeof *m);
+    uint64_t h[3];
+    const size_t left = in->len - in->pos;
+    if (!cf_isolate_get(in, h, sizeof h) || h[0] > left / 28 || h[1] > left / 24 ||
+        h[2] > left / 24)
+        goto bad;
+    m->nn = (size_t)h[0];
+    m->nt = (size_t)h[1];
+    m->X = malloc((3 * m->nn + 1) * sizeof *m->X);
+    m->id = malloc((m->nn + 1) * sizeof *m->id);
+    m->tet = malloc((4 * m->nt + 1) * sizeof *m->tet);
+    m->eid = malloc((m->nt + 1) * sizeof *m->eid);
+    m->groups = calloc((size_t)h[2] + 1, sizeof *m->groups);
+    if (!m->X || !m->id || !m->tet || !m->eid || !m->groups) {
+        cf_mesh_free(m);
+        return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the mesh", name);
+    }
+    if (!cf_isolate_get(in, m->X, 3 * m->nn * sizeof *m->X) ||
+        !cf_isolate_get(in, m->id, m->nn * sizeof *m->id) ||
+        !cf_isolate_get(in, m->tet, 4 * m->nt * sizeof *m->tet) ||
+        !cf_isolate_get(in, m->eid, m->nt * sizeof *m->eid))
+        goto bad;
+    for (size_t g = 0; g < h[2]; g++) {
+        cf_mesh_group *G = &m->groups[m->ngroups++];
+        int64_t gh[3];
+        if (!cf_isolate_get(in, gh, sizeof gh) || !cf_isolate_get(in, G->name, sizeof G->name) ||
+            gh[2] < 0 || (uint64_t)gh[2] > (in->len - in->pos) / sizeof *G->nodes)
+            goto bad;
+        G->dim = (int)gh[0];
+        G->tag = (int)gh[1];
+        G->nnodes = (size_t)gh[2];
+        G->name[sizeof G->name - 1] = '\0';
+        if (!(G->nodes = malloc((G->nnodes + 1) * sizeof *G->nodes))) {
+            cf_mesh_free(m);
+            return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the mesh", name);
+        }
+        cf_isolate_get(in, G->nodes, G->nnodes * sizeof *G->nodes);
+    }
+    if (in->pos == in->len)
+        return CF_OK;
+bad:
+    cf_mesh_free(m);
+    return cf_error_set(err, CF_E_INTERNAL, "%s: the mesh from Gmsh's process is incomplete", name);
+}
+
+/* What a mesh of about `nodes` nodes and `tets` tetrahedra costs, against the limits, before
+** Gmsh makes it: Gmsh's process (GMSH_BYTES_BASE and GMSH_TET_BYTES, measured) and the caller's
+** use of its nodes. `what` says how the mesh would be made. */
+static cf_status mesh_cost(const char *name, const char *what, double nodes, double tets,
+                           const cf_mesh_limits *lim, cf_error *err)
+{
+    const double gmsh = GMSH_BYTES_BASE + tets * GMSH_TET_BYTES, use = nodes * lim->node_bytes;
+    if (!(lim->max_bytes > 0) || fmax(gmsh, use) <= lim->max_bytes)
+        return CF_OK;
+    return cf_error_set(err, CF_E_DATA, "%s: %s would give about %.3g nodes and %.3g tetrahedra, "
+                        "about %.0f MiB for Gmsh to make%s%.0f MiB to use, over the memory limit "
+                        "of %.0f MiB: refused before meshing",
+                        name, what, nodes, tets, gmsh / 1048576.0,
+                        use > 0 ? " and " : " them", use > 0 ? use / 1048576.0 : 0.0,
+                        lim->max_bytes / 1048576.0);
+}
+
+/* What Gmsh's process needs: a mesh file and its refinement, or a surface, and the limits. */
+typedef struct gmsh_job {
+    const char *path;
+    double unit_mm;
+    int refine;
+    const cf_mesh_limits *lim;
+    const cf_surface *surface; /* a surface to fill at size h (file units) */
+    double h;
+    const double *box;         /* a box: lo[3], hi[3], focus[3], near, far, growth */
+} gmsh_job;
+
+/* In Gmsh's process: the mesh file read, its cost after refinement checked before refining
+** (each refinement multiplies the tetrahedra by 8 and, on meshes larger than a few elements, the
+** nodes by at most 8), refined, and sent. */
+static cf_status read_job(const gmsh_job *j, cf_mesh *m, cf_error *err)
+{
+    char why[300];
+    int ierr = 0;
+    gm.gmshOpen(j->path, &ierr);
+    if (ierr)
+        return cf_error_set(err, CF_E_DATA, "%s: not a mesh Gmsh reads: %s", j->path,
+                            gmsh_reason(why, sizeof why));
+    cf_status st = extract(j->path, j->unit_mm, m, err);
+    if (st != CF_OK || j->refine == 0)
+        return st;
+    const double f = pow(8, j->refine);
+    char what[80];
+    snprintf(what, sizeof what, "refining its %zu tetrahedra %d times", m->nt, j->refine);
+    st = mesh_cost(j->path, what, (double)m->nn * f, (double)m->nt * f, j->lim, err);
+    cf_mesh_free(m);
+    if (st != CF_OK)
+        return st;
+    for (int k = 0; k < j->refine && !ierr; k++)
+        gm.gmshModelMeshRefine(&ierr);
+    if (ierr)
+        return cf_error_set(err, CF_E_DATA, "%s: Gmsh could not refine it: %s", j->path,
+                            gmsh_reason(why, sizeof why));
+    return extract(j->path, j->unit_mm, m, err);
+}
+
+static cf_status box_job(const gmsh_job *j, cf_mesh *m, cf_error *err);
+static cf_status fill_surface(const char *path, const cf_surface *s, double unit_mm, double h,
+                              cf_mesh *m, cf_error *err);
+
+/* Gmsh's process: starts Gmsh, runs the job, sends the mesh. */
+static cf_status gmsh_child(void *arg, cf_isolate_buf *out, cf_error *err)
+{
+    const gmsh_job *j = arg;
+    char why[300];
+    if (!gmsh_begin(why, sizeof why))
+        return cf_error_set(err, CF_E_INTERNAL, "%s: %s", j->path, why);
+    cf_mesh m;
+    memset(&m, 0, sizeof m);
+    cf_status st = j->box       ? box_job(j, &m, err)
+                   : j->surface ? fill_surface(j->path, j->surface, j->unit_mm, j->h, &m, err)
+                                : read_job(j, &m, err);
+    if (st == CF_OK)
+        put_mesh(out, &m);
+    cf_mesh_free(&m);
+    return st;
+}
+
+/* Runs the job in Gmsh's own process under the limits and checks the mesh it sends. */
+static cf_status gmsh_run(const gmsh_job *j, cf_mesh *m, cf_error *err)
+{
+    char what[300];
+    snprintf(what, sizeof what, "%s: Gmsh", j->path);
+    cf_isolate_buf in;
+    cf_status st = cf_isolate_run(what, gmsh_child, (void *)j, j->lim->max_bytes,
+                                  j->lim->max_seconds, &in, err);
+    if (st == CF_OK) {
+        st = get_mesh(&in, j->path, m, err);
+        free(in.data);
+    }
+    if (st == CF_OK && (st = cf_mesh_check(m, j->path, err)) != CF_OK)
+        cf_mesh_free(m);
+    return st;
+}
+
+cf_status cf_mesh_read(const char *path, double unit_mm, cf_mesh *m, cf_error *err)
+{
+    return cf_mesh_read_refined(path, unit_mm, 0, NULL, m, err);
+}
+
+cf_status cf_mesh_read_refined(const char *path, double unit_mm, int refine,
+                               const cf_mesh_limits *lim, cf_mesh *m, cf_error *err)
+{
+    memset(m, 0, sizeof *m);
+    const cf_mesh_limits dflt = cf_mesh_limits_default();
     if (!mesh_ext_ok(path))
         return cf_error_set(err, CF_E_DATA, "%s: not a mesh file name: expected .msh, .mesh, "
                             ".vtk, .unv, .bdf or .nas (Gmsh's mesh formats)", path);
@@ -387,29 +605,10 @@ cf_status cf_mesh_read_refined(const char *path, double unit_mm, int refine, cf_
     if (!f)
         return cf_error_set(err, CF_E_NOINPUT, "%s: cannot open mesh: %s", path, strerror(errno));
     fclose(f);
-    pthread_mutex_lock(&gmsh_lock);
-    cf_status st;
-    int ierr = 0;
-    char why[300];
-    if (!gmsh_begin(why, sizeof why)) {
-        st = cf_error_set(err, CF_E_INTERNAL, "%s: %s", path, why);
-    } else {
-        gm.gmshOpen(path, &ierr);
-        if (ierr) {
-            st = cf_error_set(err, CF_E_DATA, "%s: not a mesh Gmsh reads: %s", path,
-                              gmsh_reason(why, sizeof why));
-        } else {
-            for (int k = 0; k < refine && !ierr; k++)
-                gm.gmshModelMeshRefine(&ierr);
-            st = ierr ? cf_error_set(err, CF_E_DATA, "%s: Gmsh could not refine it: %s", path,
-                                     gmsh_reason(why, sizeof why))
-                      : extract(path, unit_mm, m, err);
-        }
-        gmsh_end();
-    }
-    pthread_mutex_unlock(&gmsh_lock);
-    if (st == CF_OK && (st = cf_mesh_check(m, path, err)) != CF_OK)
-        cf_mesh_free(m);
+    const gmsh_job j = {path, unit_mm, refine, lim ? lim : &dflt, NULL, 0, NULL};
+    cf_status st = gmsh_run(&j, m, err);
+    if (st == CF_OK)
+        st = mesh_check_nodes(m, path, err);
     return st;
 }
 
@@ -429,14 +628,20 @@ cf_status cf_mesh_box(const double lo[3], const double hi[3], const double focus
     if (vol / (size_near * size_near * size_near) > 1e8)
         return cf_error_set(err, CF_E_DATA, "box: element size %g mm too small for the box",
                             size_near);
-    pthread_mutex_lock(&gmsh_lock);
-    cf_status st = CF_OK;
+    const double box[12] = {lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], focus[0], focus[1], focus[2],
+                            size_near, size_far, growth};
+    const cf_mesh_limits dflt = cf_mesh_limits_default();
+    const gmsh_job j = {"box", 1, 0, &dflt, NULL, 0, box};
+    return gmsh_run(&j, m, err);
+}
+
+/* In Gmsh's process: the box of j->box meshed. */
+static cf_status box_job(const gmsh_job *j, cf_mesh *m, cf_error *err)
+{
+    const double *lo = j->box, *hi = j->box + 3, *focus = j->box + 6;
+    const double size_near = j->box[9], size_far = j->box[10], growth = j->box[11];
     int ierr = 0;
     char why[300], expr[400];
-    if (!gmsh_begin(why, sizeof why)) {
-        st = cf_error_set(err, CF_E_INTERNAL, "box: %s", why);
-        goto end;
-    }
     gm.gmshModelAdd("box", &ierr);
     gm.gmshModelOccAddBox(lo[0], lo[1], lo[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], -1, &ierr);
     gm.gmshModelOccSynchronize(&ierr);
@@ -452,18 +657,10 @@ cf_status cf_mesh_box(const double lo[3], const double hi[3], const double focus
     gm.gmshOptionSetNumber("Mesh.RandomSeed", 1, &ierr);
     gm.gmshOptionSetNumber("General.NumThreads", 1, &ierr);
     gm.gmshModelMeshGenerate(3, &ierr);
-    if (ierr) {
-        st = cf_error_set(err, CF_E_DATA, "box: Gmsh could not mesh it: %s",
-                          gmsh_reason(why, sizeof why));
-        goto end;
-    }
-    st = extract("box", 1, m, err);
-end:
-    gmsh_end();
-    pthread_mutex_unlock(&gmsh_lock);
-    if (st == CF_OK && (st = cf_mesh_check(m, "box", err)) != CF_OK)
-        cf_mesh_free(m);
-    return st;
+    if (ierr)
+        return cf_error_set(err, CF_E_DATA, "box: Gmsh could not mesh it: %s",
+                            gmsh_reason(why, sizeof why));
+    return extract("box", 1, m, err);
 }
 
 /* The Gmsh part of cf_mesh_from_surface: the prepared surface s into the current model as one
@@ -542,10 +739,15 @@ end:
     return st;
 }
 
-cf_status cf_mesh_from_surface(const char *path, double unit_mm, double size_mm, cf_mesh *m,
+
+cf_status cf_mesh_from_surface(const char *path, double unit_mm, double size_mm,
+                               const cf_mesh_limits *lim, cf_mesh *m,
                                cf_mesh_surface_info *info, cf_error *err)
 {
     memset(m, 0, sizeof *m);
+    const cf_mesh_limits dflt = cf_mesh_limits_default();
+    if (!lim)
+        lim = &dflt;
     cf_mesh_surface_info dummy;
     if (!info)
         info = &dummy;
@@ -561,27 +763,19 @@ cf_status cf_mesh_from_surface(const char *path, double unit_mm, double size_mm,
     cf_surface s;
     cf_status st = cf_surface_read(path, &s, err);
     if (st == CF_OK)
-        st = cf_surface_prepare(&s, path, unit_mm, info, err);
-    /* a regular tetrahedron of edge h holds h^3 / (6 sqrt 2): the count of a fill, roughly */
-    const double count = info->enclosed_mm3 / (size_mm * size_mm * size_mm / (6 * sqrt(2)));
-    if (st == CF_OK && count > 5e6)
-        st = cf_error_set(err, CF_E_DATA, "%s: element size %g mm would fill the %.4g mm^3 it "
-                          "encloses with about %.3g tetrahedra, over 5e6", path, size_mm,
-                          info->enclosed_mm3, count);
+        st = cf_surface_prepare(&s, path, unit_mm, size_mm, info, err);
+    if (st == CF_OK) { /* the fill's cost, before Gmsh starts (counted as cf_surface_prepare) */
+        char what[120];
+        snprintf(what, sizeof what, "filling it at an element size of %g mm", size_mm);
+        st = mesh_cost(path, what, info->estimated_tets / 4 + (double)info->vertices,
+                       info->estimated_tets, lim, err);
+    }
     if (st != CF_OK) {
         cf_surface_free(&s);
         return st;
     }
-    pthread_mutex_lock(&gmsh_lock);
-    char why[300];
-    if (!gmsh_begin(why, sizeof why))
-        st = cf_error_set(err, CF_E_INTERNAL, "%s: %s", path, why);
-    else
-        st = fill_surface(path, &s, unit_mm, size_mm / unit_mm, m, err);
-    gmsh_end();
-    pthread_mutex_unlock(&gmsh_lock);
+    const gmsh_job j = {path, unit_mm, 0, lim, &s, size_mm / unit_mm, NULL};
+    st = gmsh_run(&j, m, err);
     cf_surface_free(&s);
-    if (st == CF_OK && (st = cf_mesh_check(m, path, err)) != CF_OK)
-        cf_mesh_free(m);
     return st;
 }

@@ -27,7 +27,7 @@ static int loop(const char *path, int refine, const cf_law *law, int haptic, dou
 {
     cf_mesh m;
     cf_error err = {0};
-    if (cf_mesh_read_refined(path, 100, refine, &m, &err) != CF_OK)
+    if (cf_mesh_read_refined(path, 100, refine, NULL, &m, &err) != CF_OK)
         return 0;
     cf_body b;
     if (cf_body_create(&b, &m, law, CF_LAW_CLOSED,
