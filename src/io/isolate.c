@@ -74,6 +74,21 @@ static double mapped_bytes(void)
     return (double)pages * (double)sysconf(_SC_PAGESIZE);
 }
 
+static double child_max_bytes; /* in the child: its memory limit, applied by the work */
+
+void cf_isolate_limit_memory(void)
+{
+#if !defined(__SANITIZE_ADDRESS__) /* AddressSanitizer reserves terabytes of address space */
+    if (child_max_bytes > 0 && child_max_bytes < 1e15) {
+        struct rlimit r;
+        r.rlim_cur = r.rlim_max = (rlim_t)(mapped_bytes() + child_max_bytes);
+        setrlimit(RLIMIT_AS, &r);
+    }
+#else
+    (void)mapped_bytes;
+#endif
+}
+
 /* The child: limits, quiet, default signals; runs the work and writes its trailer. Never
 ** returns. */
 static void child(int fd, pid_t parent, cf_isolate_fn fn, void *arg, double max_bytes,
@@ -100,14 +115,7 @@ static void child(int fd, pid_t parent, cf_isolate_fn fn, void *arg, double max_
         r.rlim_cur = r.rlim_max = (rlim_t)ceil(max_seconds) + 1;
         setrlimit(RLIMIT_CPU, &r);
     }
-#if !defined(__SANITIZE_ADDRESS__) /* AddressSanitizer reserves terabytes of address space */
-    if (max_bytes > 0 && max_bytes < 1e15) {
-        r.rlim_cur = r.rlim_max = (rlim_t)(mapped_bytes() + max_bytes);
-        setrlimit(RLIMIT_AS, &r);
-    }
-#else
-    (void)mapped_bytes;
-#endif
+    child_max_bytes = max_bytes;
     cf_isolate_buf out = {.fd = fd};
     cf_error e = {0};
     trailer t;

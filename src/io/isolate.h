@@ -25,12 +25,16 @@ typedef struct cf_isolate_buf {
 ** message in err comes back to the caller as it is). */
 typedef cf_status (*cf_isolate_fn)(void *arg, cf_isolate_buf *out, cf_error *err);
 
+/* In the child: its memory limit (max_bytes beyond what it maps now) takes effect; the work calls
+** it once its libraries are loaded. */
+void cf_isolate_limit_memory(void);
+
 void cf_isolate_put(cf_isolate_buf *out, const void *p, size_t n);
 /* n bytes of the result into p; 0 when fewer are left. */
 int cf_isolate_get(cf_isolate_buf *in, void *p, size_t n);
 
-/* Runs fn(arg) in a child with an address space of max_bytes beyond what the caller's process
-** maps already (0: no limit) for at most max_seconds of wall time. On CF_OK, *in holds the bytes
+/* Runs fn(arg) in a child with an address space of max_bytes beyond what it maps when fn calls
+** cf_isolate_limit_memory (0: no limit) for at most max_seconds of wall time. On CF_OK, *in holds the bytes
 ** the child wrote (free in->data). Otherwise the child's own status and message, or CF_E_DATA when
 ** it ran out of time ("did not finish within"), CF_E_DATA when it died of a signal under the
 ** memory limit (the signal named), CF_E_INTERNAL when no child could be started. `what` names the
