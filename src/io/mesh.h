@@ -55,6 +55,7 @@ typedef struct cf_mesh_surface_info {
     double max_move_mm;          /* the largest move, mm */
     int reversed;                /* 1: the triangles were turned to face outward */
     size_t shells;               /* closed shells: one, or a solid and its cavities */
+    size_t pair_tests;           /* edge-triangle tests the search for crossings made */
     double estimated_tets;       /* the fill's tetrahedra, about (from the volume and size) */
 } cf_mesh_surface_info;
 

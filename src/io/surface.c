@@ -329,6 +329,8 @@ typedef struct bvh_node {
     double lo[3], hi[3];
     uint32_t first, count; /* a leaf's triangles: order[first .. first + count - 1] */
     uint32_t left;         /* an inner node's children: left and left + 1 */
+    uint32_t common;       /* a corner every triangle under the node has, or UINT32_MAX: an edge
+                           ** from it crosses none of them (a fan's centre: a cylinder's cap) */
 } bvh_node;
 
 typedef struct bvh {
@@ -336,6 +338,7 @@ typedef struct bvh {
     size_t nn;
     uint32_t *order;
     double *box; /* 6 nf: each triangle's lo[3], hi[3] */
+    const uint32_t *tri;
 } bvh;
 
 typedef struct keyed {
@@ -373,8 +376,21 @@ static void bvh_build(bvh *h, size_t k, uint32_t first, uint32_t count, keyed *t
     }
     n->first = first;
     n->count = count;
-    if (count <= 4)
+    n->common = UINT32_MAX;
+    if (count <= 4) {
+        const uint32_t *T0 = h->tri + 3 * (size_t)h->order[first];
+        for (int c = 0; c < 3 && n->common == UINT32_MAX; c++) {
+            uint32_t i = first + 1;
+            for (; i < first + count; i++) {
+                const uint32_t *T = h->tri + 3 * (size_t)h->order[i];
+                if (T[0] != T0[c] && T[1] != T0[c] && T[2] != T0[c])
+                    break;
+            }
+            if (i == first + count)
+                n->common = T0[c];
+        }
         return;
+    }
     int ax = 0;
     for (int a = 1; a < 3; a++)
         if (chi[a] - clo[a] > chi[ax] - clo[ax])
@@ -393,6 +409,9 @@ static void bvh_build(bvh *h, size_t k, uint32_t first, uint32_t count, keyed *t
     h->nn += 2;
     bvh_build(h, n->left, first, half, tmp);
     bvh_build(h, h->node[k].left + 1, first + half, count - half, tmp);
+    const uint32_t l = h->node[k].left;
+    if (h->node[l].common == h->node[l + 1].common)
+        h->node[k].common = h->node[l].common;
 }
 
 static void bvh_free(bvh *h)
@@ -425,6 +444,7 @@ static int bvh_make(const cf_surface *s, bvh *h)
         h->order[t] = (uint32_t)t;
     }
     h->nn = 1;
+    h->tri = s->tri;
     bvh_build(h, 0, 0, (uint32_t)s->nf, tmp);
     free(tmp);
     return 1;
@@ -456,7 +476,8 @@ static int segment_hits(const cf_surface *s, const double *P, const double *D, c
 /* The crossings of edge a-b with the triangles of the tree (not its own): counted into *hits,
 ** their corners marked, the first recorded. */
 static void edge_crossings(const cf_surface *s, const bvh *h, uint32_t a, uint32_t b,
-                           uint8_t *mark, long *hits, uint32_t *fa, uint32_t *fb, uint32_t *ft)
+                           uint8_t *mark, long *hits, uint32_t *fa, uint32_t *fb, uint32_t *ft,
+                           size_t *tests)
 {
     const double *P = s->X + 3 * (size_t)a;
     double D[3], lo[3], hi[3];
@@ -469,8 +490,8 @@ static void edge_crossings(const cf_surface *s, const bvh *h, uint32_t a, uint32
     stack[top++] = 0;
     while (top > 0) {
         const bvh_node *n = &h->node[stack[--top]];
-        if (n->lo[0] > hi[0] || n->hi[0] < lo[0] || n->lo[1] > hi[1] || n->hi[1] < lo[1] ||
-            n->lo[2] > hi[2] || n->hi[2] < lo[2])
+        if (n->common == a || n->common == b || n->lo[0] > hi[0] || n->hi[0] < lo[0] ||
+            n->lo[1] > hi[1] || n->hi[1] < lo[1] || n->lo[2] > hi[2] || n->hi[2] < lo[2])
             continue;
         if (n->count == 0) {
             stack[top++] = n->left;
@@ -480,8 +501,10 @@ static void edge_crossings(const cf_surface *s, const bvh *h, uint32_t a, uint32
         for (uint32_t i = n->first; i < n->first + n->count; i++) {
             const uint32_t t = h->order[i];
             const uint32_t *T = s->tri + 3 * (size_t)t;
-            if (T[0] == a || T[1] == a || T[2] == a || T[0] == b || T[1] == b || T[2] == b ||
-                !segment_hits(s, P, D, T))
+            if (T[0] == a || T[1] == a || T[2] == a || T[0] == b || T[1] == b || T[2] == b)
+                continue;
+            ++*tests;
+            if (!segment_hits(s, P, D, T))
                 continue;
             if (*hits == 0) {
                 *fa = a;
@@ -496,8 +519,9 @@ static void edge_crossings(const cf_surface *s, const bvh *h, uint32_t a, uint32
 
 /* Marks (mark[v] = 1) the corners of every edge that crosses a triangle not its own, and that
 ** triangle's corners; returns the number of crossings, or -1 when memory runs out. *fa, *fb and
-** *ft get the first crossing found. */
-static long crossings(const cf_surface *s, uint8_t *mark, uint32_t *fa, uint32_t *fb, uint32_t *ft)
+** *ft get the first crossing found; *tests counts the edge-triangle tests made. */
+static long crossings(const cf_surface *s, uint8_t *mark, uint32_t *fa, uint32_t *fb, uint32_t *ft,
+                      size_t *tests)
 {
     bvh h;
     if (!bvh_make(s, &h))
@@ -507,7 +531,7 @@ static long crossings(const cf_surface *s, uint8_t *mark, uint32_t *fa, uint32_t
         for (int k = 0; k < 3; k++) {
             uint32_t a = s->tri[3 * e + (size_t)k], b = s->tri[3 * e + (size_t)(k + 1) % 3];
             if (a < b) /* each edge once (a closed surface has it both ways) */
-                edge_crossings(s, &h, a, b, mark, &hits, fa, fb, ft);
+                edge_crossings(s, &h, a, b, mark, &hits, fa, fb, ft, tests);
         }
     bvh_free(&h);
     return hits;
@@ -728,7 +752,7 @@ cf_status cf_surface_prepare(cf_surface *s, const char *name, double unit_mm, do
     for (int round = 0;; round++) {
         uint32_t a = 0, b = 0, t = 0;
         memset(mark, 0, s->nv);
-        long n = crossings(s, mark, &a, &b, &t);
+        long n = crossings(s, mark, &a, &b, &t, &info->pair_tests);
         if (n < 0) {
             st = cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the surface", name);
             break;
