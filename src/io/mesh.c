@@ -8,6 +8,7 @@
 #include "io/mesh.h"
 
 #include "io/isolate.h"
+#include "io/mesh_nodes.h"
 #include "io/surface.h"
 
 #include <errno.h>
@@ -379,117 +380,10 @@ static int mesh_ext_ok(const char *path)
     return 0;
 }
 
-typedef struct node_at {
-    double x[3];
-    uint32_t i;
-} node_at;
-
-static int cmp_node_at(const void *pa, const void *pb)
-{
-    const node_at *a = pa, *b = pb;
-    for (int k = 0; k < 3; k++)
-        if (a->x[k] != b->x[k])
-            return (a->x[k] > b->x[k]) - (a->x[k] < b->x[k]);
-    return (a->i > b->i) - (a->i < b->i);
-}
-
-/* Two nodes of a mesh file at one point: the elements on either side are not joined (a crack the
-** file does not show), so the mesh is refused naming both. */
-static cf_status mesh_check_nodes(cf_mesh *m, const char *name, cf_error *err)
-{
-    node_at *o = malloc((m->nn + 1) * sizeof *o);
-    if (!o) {
-        cf_mesh_free(m);
-        return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the mesh", name);
-    }
-    for (size_t i = 0; i < m->nn; i++) {
-        memcpy(o[i].x, m->X + 3 * i, sizeof o[i].x);
-        o[i].i = (uint32_t)i;
-    }
-    qsort(o, m->nn, sizeof *o, cmp_node_at);
-    cf_status st = CF_OK;
-    for (size_t k = 1; k < m->nn && st == CF_OK; k++)
-        if (memcmp(o[k].x, o[k - 1].x, sizeof o[k].x) == 0)
-            st = cf_error_set(err, CF_E_DATA, "%s: nodes %lu and %lu are at the same point (%g, "
-                              "%g, %g) mm: the elements on either side are not joined (merge "
-                              "them in the file)", name, (unsigned long)m->id[o[k - 1].i],
-                              (unsigned long)m->id[o[k].i], o[k].x[0], o[k].x[1], o[k].x[2]);
-    free(o);
-    if (st != CF_OK)
-        cf_mesh_free(m);
-    return st;
-}
-
 cf_mesh_limits cf_mesh_limits_default(void)
 {
     cf_mesh_limits l = {CF_MESH_MAX_BYTES_DEFAULT, CF_MESH_MAX_SECONDS_DEFAULT, 0};
     return l;
-}
-
-/* The mesh through the pipe from Gmsh's process: counts, then the arrays, then the groups. */
-static void put_mesh(cf_isolate_buf *o, const cf_mesh *m)
-{
-    const uint64_t h[3] = {m->nn, m->nt, m->ngroups};
-    cf_isolate_put(o, h, sizeof h);
-    cf_isolate_put(o, m->X, 3 * m->nn * sizeof *m->X);
-    cf_isolate_put(o, m->id, m->nn * sizeof *m->id);
-    cf_isolate_put(o, m->tet, 4 * m->nt * sizeof *m->tet);
-    cf_isolate_put(o, m->eid, m->nt * sizeof *m->eid);
-    for (size_t g = 0; g < m->ngroups; g++) {
-        const cf_mesh_group *G = &m->groups[g];
-        const int64_t gh[3] = {G->dim, G->tag, (int64_t)G->nnodes};
-        cf_isolate_put(o, gh, sizeof gh);
-        cf_isolate_put(o, G->name, sizeof G->name);
-        cf_isolate_put(o, G->nodes, G->nnodes * sizeof *G->nodes);
-    }
-}
-
-/* Reads put_mesh's bytes into m; CF_E_INTERNAL when they are short or inconsistent. */
-static cf_status get_mesh(cf_isolate_buf *in, const char *name, cf_mesh *m, cf_error *err)
-{
-    memset(m, 0, sizeof *m);
-    uint64_t h[3];
-    const size_t left = in->len - in->pos;
-    if (!cf_isolate_get(in, h, sizeof h) || h[0] > left / 28 || h[1] > left / 24 ||
-        h[2] > left / 24)
-        goto bad;
-    m->nn = (size_t)h[0];
-    m->nt = (size_t)h[1];
-    m->X = malloc((3 * m->nn + 1) * sizeof *m->X);
-    m->id = malloc((m->nn + 1) * sizeof *m->id);
-    m->tet = malloc((4 * m->nt + 1) * sizeof *m->tet);
-    m->eid = malloc((m->nt + 1) * sizeof *m->eid);
-    m->groups = calloc((size_t)h[2] + 1, sizeof *m->groups);
-    if (!m->X || !m->id || !m->tet || !m->eid || !m->groups) {
-        cf_mesh_free(m);
-        return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the mesh", name);
-    }
-    if (!cf_isolate_get(in, m->X, 3 * m->nn * sizeof *m->X) ||
-        !cf_isolate_get(in, m->id, m->nn * sizeof *m->id) ||
-        !cf_isolate_get(in, m->tet, 4 * m->nt * sizeof *m->tet) ||
-        !cf_isolate_get(in, m->eid, m->nt * sizeof *m->eid))
-        goto bad;
-    for (size_t g = 0; g < h[2]; g++) {
-        cf_mesh_group *G = &m->groups[m->ngroups++];
-        int64_t gh[3];
-        if (!cf_isolate_get(in, gh, sizeof gh) || !cf_isolate_get(in, G->name, sizeof G->name) ||
-            gh[2] < 0 || (uint64_t)gh[2] > (in->len - in->pos) / sizeof *G->nodes)
-            goto bad;
-        G->dim = (int)gh[0];
-        G->tag = (int)gh[1];
-        G->nnodes = (size_t)gh[2];
-        G->name[sizeof G->name - 1] = '\0';
-        if (!(G->nodes = malloc((G->nnodes + 1) * sizeof *G->nodes))) {
-            cf_mesh_free(m);
-            return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the mesh", name);
-        }
-        cf_isolate_get(in, G->nodes, G->nnodes * sizeof *G->nodes);
-    }
-    if (in->pos == in->len)
-        return CF_OK;
-bad:
-    cf_mesh_free(m);
-    return cf_error_set(err, CF_E_INTERNAL, "%s: the mesh from Gmsh's process is incomplete", name);
 }
 
 /* What a mesh of about `nodes` nodes and `tets` tetrahedra costs, against the limits, before
@@ -626,7 +520,7 @@ static cf_status gmsh_child(void *arg, cf_isolate_buf *out, cf_error *err)
                    : j->surface ? fill_surface(j->path, j->surface, j->unit_mm, j->h, &m, err)
                                 : read_job(j, &m, err);
     if (st == CF_OK)
-        put_mesh(out, &m);
+        cf_mesh_put(out, &m);
     cf_mesh_free(&m);
     return st;
 }
@@ -640,7 +534,7 @@ static cf_status gmsh_run(const gmsh_job *j, cf_mesh *m, cf_error *err)
     cf_status st = cf_isolate_run(what, gmsh_child, (void *)j, j->lim->max_bytes,
                                   j->lim->max_seconds, &in, err);
     if (st == CF_OK) {
-        st = get_mesh(&in, j->path, m, err);
+        st = cf_mesh_get(&in, j->path, m, err);
         free(in.data);
     }
     if (st == CF_OK && (st = cf_mesh_check(m, j->path, err)) != CF_OK)
@@ -670,9 +564,11 @@ cf_status cf_mesh_read_refined(const char *path, double unit_mm, int refine,
         return cf_error_set(err, CF_E_NOINPUT, "%s: cannot open mesh: %s", path, strerror(errno));
     fclose(f);
     const gmsh_job j = {path, unit_mm, refine, lim ? lim : &dflt, NULL, 0, NULL};
-    cf_status st = gmsh_run(&j, m, err);
+    cf_status st = cf_mesh_msh_nodes_once(path, err);
     if (st == CF_OK)
-        st = mesh_check_nodes(m, path, err);
+        st = gmsh_run(&j, m, err);
+    if (st == CF_OK)
+        st = cf_mesh_check_coincident(m, path, err);
     return st;
 }
 

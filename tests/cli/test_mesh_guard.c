@@ -6,7 +6,8 @@
 ** triangles (a 40,000-triangle cylinder of long triangles, counted in edge-triangle tests) and comes
 ** after the cheap size check; a refinement and a fill over --max-memory are refused before Gmsh
 ** starts; a solid within a solid (two nested shells facing outward) is refused, a cavity filled;
-** two nodes of a mesh file at one point are refused naming both.
+** two nodes of a mesh file at one point are refused naming both, a node defined twice naming its
+** lines.
 */
 #include "testutil.h"
 
@@ -366,6 +367,27 @@ static void coincident_nodes_of_a_mesh_file_are_refused(void **state)
     assert_int_equal(cf_mesh_read(path, 1, &m, &err), CF_E_DATA);
     print_message("%s\n", err.msg);
     assert_non_null(strstr(err.msg, "crack.msh: nodes 1 and 5 are at the same point"));
+    /* a node defined twice (Gmsh keeps the last), in a version 2 and a version 4.1 file */
+    snprintf(path, sizeof path, "%s/twice.msh", dir);
+    f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f, "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 0 1 0\n"
+               "4 0 0 1\n4 0 0 2\n$EndNodes\n$Elements\n1\n1 4 2 0 1 1 2 3 4\n$EndElements\n");
+    fclose(f);
+    assert_int_equal(cf_mesh_read(path, 1, &m, &err), CF_E_DATA);
+    print_message("%s\n", err.msg);
+    assert_non_null(strstr(err.msg, "twice.msh:10: node 4 is defined a second time (first at "
+                                    "line 9)"));
+    snprintf(path, sizeof path, "%s/twice4.msh", dir);
+    f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f, "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n2 5 1 4\n3 1 0 4\n1\n2\n3\n4\n"
+               "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 1 0 1\n4\n0 0 2\n$EndNodes\n$Elements\n"
+               "1 1 1 1\n3 1 4 1\n1 1 2 3 4\n$EndElements\n");
+    fclose(f);
+    assert_int_equal(cf_mesh_read(path, 1, &m, &err), CF_E_DATA);
+    print_message("%s\n", err.msg);
+    assert_non_null(strstr(err.msg, "twice4.msh:16: node 4 is defined a second time"));
 }
 
 int main(void)
