@@ -2,8 +2,11 @@
 ** Volume meshes through Gmsh's library (gmshc.h, Gmsh 4.8 C API): any file Gmsh opens (.msh of
 ** every version, and the other formats it reads) becomes a cf_mesh (body.h) of linear tetrahedra;
 ** a box meshed by Gmsh with an element size that grows away from a point serves the tests and
-** examples. Gmsh keeps one global model, so every use is serialised by a mutex; its messages are
-** switched off (the library prints nothing) and its last error is read back into the message.
+** examples. Every use of Gmsh runs in a process of its own (io/isolate.h: a Gmsh that loops,
+** exhausts memory or aborts ends in an error, not in its caller; its one global model is that
+** process's alone), after the mesh's cost is checked against the limits (cf_mesh_limits); the
+** mesh comes back through a pipe (mesh_nodes.h). Gmsh's messages are switched off (the library
+** prints nothing) and its last error is read back into the message.
 */
 #include "io/mesh.h"
 
@@ -13,6 +16,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -529,6 +533,13 @@ static cf_status gmsh_child(void *arg, cf_isolate_buf *out, cf_error *err)
 static cf_status gmsh_run(const gmsh_job *j, cf_mesh *m, cf_error *err)
 {
     char what[300];
+    /* the library loaded here, once: each process of Gmsh starts with it mapped */
+    static pthread_mutex_t load_lock = PTHREAD_MUTEX_INITIALIZER;
+    pthread_mutex_lock(&load_lock);
+    const int loaded = gmsh_load(what, sizeof what);
+    pthread_mutex_unlock(&load_lock);
+    if (!loaded)
+        return cf_error_set(err, CF_E_INTERNAL, "%s: %s", j->path, what);
     snprintf(what, sizeof what, "%s: Gmsh", j->path);
     cf_isolate_buf in;
     cf_status st = cf_isolate_run(what, gmsh_child, (void *)j, j->lim->max_bytes,
