@@ -738,8 +738,8 @@ cf_status cf_mesh_from_surface(const char *path, double unit_mm, double size_mm,
     if (st == CF_OK) { /* the fill's cost, before Gmsh starts (counted as cf_surface_prepare) */
         char what[120];
         snprintf(what, sizeof what, "filling it at an element size of %g mm", size_mm);
-        st = mesh_cost(path, what, info->estimated_tets / 4 + (double)info->vertices,
-                       info->estimated_tets, GMSH_FILL_TET_BYTES, lim, err);
+        st = mesh_cost(path, what, info->estimated_nodes, info->estimated_tets,
+                       GMSH_FILL_TET_BYTES, lim, err);
     }
     if (st != CF_OK) {
         cf_surface_free(&s);

@@ -443,6 +443,16 @@ cf_status cf_surface_prepare(cf_surface *s, const char *name, double unit_mm, do
     ** tetrahedron of edge h holds h^3 / (6 sqrt 2) */
     const double V = fabs(enclosed(s)) * unit_mm * unit_mm * unit_mm;
     info->estimated_tets = V / (size_mm * size_mm * size_mm / (6 * sqrt(2)));
+    double area = 0;
+    for (size_t t = 0; t < s->nf; t++) {
+        const uint32_t *v = s->tri + 3 * t;
+        double e1[3], e2[3], c[3];
+        sub3(s->X + 3 * (size_t)v[1], s->X + 3 * (size_t)v[0], e1);
+        sub3(s->X + 3 * (size_t)v[2], s->X + 3 * (size_t)v[0], e2);
+        cross3(e1, e2, c);
+        area += 0.5 * sqrt(dot3(c, c)) * unit_mm * unit_mm;
+    }
+    info->estimated_nodes = info->estimated_tets / 8 + 1.15 * area / (size_mm * size_mm);
     if (info->estimated_tets > CF_MESH_MAX_FILL_TETS) /* 5e6 */
         return cf_error_set(err, CF_E_DATA, "%s: element size %g mm would fill the %.4g mm^3 it "
                             "encloses with about %.3g tetrahedra, over 5e6", name, size_mm, V,
