@@ -103,6 +103,12 @@ static void child(int fd, pid_t parent, cf_isolate_fn fn, void *arg, double max_
     sigset_t all;
     sigemptyset(&all);
     sigprocmask(SIG_SETMASK, &all, NULL);
+    /* no descriptor of the caller but the pipe: another thread's pipe held open here would keep
+    ** its reader from seeing the end */
+    long maxfd = sysconf(_SC_OPEN_MAX);
+    for (long k = 3; k < (maxfd > 0 && maxfd < 65536 ? maxfd : 65536); k++)
+        if (k != fd)
+            close((int)k);
     int null = open("/dev/null", O_RDWR);
     if (null >= 0) {
         dup2(null, 0);
