@@ -61,8 +61,9 @@ static void run_free(run *r)
     cf_body_motion_free(&r->motion);
 }
 
-cf_status cf_cli_body_load(const cf_scene *sc, cf_law *law, cf_mesh *mesh,
-                           cf_mesh_surface_info *surface, cf_error *err)
+cf_status cf_cli_body_load(const cf_scene *sc, const cf_budget *budget, double node_bytes,
+                           cf_law *law, cf_mesh *mesh, cf_mesh_surface_info *surface,
+                           cf_error *err)
 {
     cf_status st;
     cf_mesh_surface_info unused;
@@ -70,11 +71,26 @@ cf_status cf_cli_body_load(const cf_scene *sc, cf_law *law, cf_mesh *mesh,
         (sc->method == CF_LAW_TABLE &&
          (st = cf_law_table_build(law, sc->table_intervals, err)) != CF_OK))
         return st;
-    return sc->body_element_size_mm > 0
-               ? cf_mesh_from_surface(sc->body_mesh, sc->body_unit_mm, sc->body_element_size_mm,
-                                      mesh, surface ? surface : &unused, err)
-               : cf_mesh_read_refined(sc->body_mesh, sc->body_unit_mm, sc->body_refine, mesh,
-                                      err);
+    cf_mesh_limits lim = cf_mesh_limits_default();
+    lim.max_bytes = budget->max_memory_bytes;
+    lim.node_bytes = node_bytes;
+    st = sc->body_element_size_mm > 0
+             ? cf_mesh_from_surface(sc->body_mesh, sc->body_unit_mm, sc->body_element_size_mm,
+                                    &lim, mesh, surface ? surface : &unused, err)
+             : cf_mesh_read_refined(sc->body_mesh, sc->body_unit_mm, sc->body_refine, &lim, mesh,
+                                    err);
+    if (st == CF_E_DATA && err && strstr(err->msg, "over the memory limit")) {
+        const size_t n = strlen(err->msg);
+        snprintf(err->msg + n, sizeof err->msg - n, " (raise it with --max-memory)");
+    }
+    return st;
+}
+
+/* What a static or dynamic run spends per node (solve's estimate, below). */
+static double body_node_bytes(const cf_scene *sc, int keep_forces)
+{
+    return 3 * (81.0 * 16 * 8 + 40.0 * 81 * 8) +
+           (sc->body_steps + 1.0) * 3 * 8 * (keep_forces ? 3 : 1) + (double)sc->nregions;
 }
 
 cf_status cf_cli_body_create(const cf_scene *sc, const cf_law *law, const cf_mesh *mesh,
@@ -253,16 +269,15 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
                        cf_error *err)
 {
     cf_status st;
-    if ((st = cf_cli_body_load(sc, &r->law, &r->mesh, &r->surface, err)) != CF_OK)
+    if ((st = cf_cli_body_load(sc, budget, body_node_bytes(sc, r->keep_forces), &r->law, &r->mesh,
+                               &r->surface, err)) != CF_OK)
         return st;
     const size_t steps = r->steps = (size_t)sc->body_steps;
     if (sc->body_dynamic && (st = dynamic_budget(sc, scene_path, budget, r->mesh.nn, err)))
         return st;
     /* memory: the factor of the tangent (about 40 times its 3 x 3 blocks for meshes of organ
     ** size), the matrix, and one copy of the positions per step */
-    double bytes = (double)r->mesh.nn * 3 * (81.0 * 16 * 8 + 40.0 * 81 * 8) +
-                   (double)(steps + 1) * 3 * (double)r->mesh.nn * 8 * (r->keep_forces ? 3 : 1) +
-                   (double)sc->nregions * (double)r->mesh.nn;
+    double bytes = (double)r->mesh.nn * body_node_bytes(sc, r->keep_forces);
     if (bytes > budget->max_memory_bytes)
         return cf_error_set(err, CF_E_DATA, "%s: the body of %s (%zu nodes, %zu steps) needs "
                             "about %.3g bytes, over the limit %.3g (--max-memory)",

@@ -118,7 +118,9 @@ static cf_status run(const cf_scene *sc, const char *scene_path, const cf_budget
         return cf_error_set(err, CF_E_DATA, "%s: key 'haptic.path' asks for %zu updates (one per "
                             "ms to %g ms), over the limit %.3g (--max-steps)",
                             scene_path, r->n, T, budget->max_steps);
-    if ((st = cf_cli_body_load(sc, &r->law, &r->mesh, NULL, err)) != CF_OK)
+    /* per node: two bodies as the static run counts one, and the kept columns (below) */
+    if ((st = cf_cli_body_load(sc, budget, 2 * 3 * (81.0 * 16 * 8 + 40.0 * 81 * 8) + 9 * 1000 * 8,
+                               &r->law, &r->mesh, NULL, err)) != CF_OK)
         return st;
     /* memory: two bodies (the loop's and the static one) as the static run estimates one, the
     ** loop's kept columns of the inverse (9 nn per node that touches the probe, at most all of

@@ -2,11 +2,16 @@
 ** Volume meshes through Gmsh's library (gmshc.h, Gmsh 4.8 C API): any file Gmsh opens (.msh of
 ** every version, and the other formats it reads) becomes a cf_mesh (body.h) of linear tetrahedra;
 ** a box meshed by Gmsh with an element size that grows away from a point serves the tests and
-** examples. Gmsh keeps one global model, so every use is serialised by a mutex; its messages are
-** switched off (the library prints nothing) and its last error is read back into the message.
+** examples. Every use of Gmsh runs in a process of its own (io/isolate.h: a Gmsh that loops,
+** exhausts memory or aborts ends in an error, not in its caller; its one global model is that
+** process's alone), after the mesh's cost is checked against the limits (cf_mesh_limits); the
+** mesh comes back through a pipe (mesh_nodes.h). Gmsh's messages are switched off (the library
+** prints nothing) and its last error is read back into the message.
 */
 #include "io/mesh.h"
 
+#include "io/isolate.h"
+#include "io/mesh_nodes.h"
 #include "io/surface.h"
 
 #include <errno.h>
@@ -17,11 +22,21 @@
 #include <string.h>
 #include <strings.h>
 
+#include <stdint.h>
+
 #include <dlfcn.h>
 #include <gmshc.h>
 
-static pthread_mutex_t gmsh_lock = PTHREAD_MUTEX_INITIALIZER;
 static int gmsh_ready;
+
+/* Gmsh's process: the library and its model before a mesh (bytes), and what it holds per
+** tetrahedron while it refines a mesh or fills a surface (per tetrahedron of the estimate).
+** Measured as the peak resident memory of its process: 46 MiB for liver2.msh, 211 MiB refined
+** three times (764,416 tetrahedra: 232 bytes each); 146 MiB filling a 10 mm cube at 0.3 mm
+** (178,818 tetrahedra, 570 bytes each; 314,000 estimated, 325 bytes each). */
+#define GMSH_BYTES_BASE (64.0 * 1024 * 1024)
+#define GMSH_REFINE_TET_BYTES 260.0
+#define GMSH_FILL_TET_BYTES 600.0
 
 /* Gmsh's library is loaded when a mesh is first read, not linked: it is large (with its
 ** geometry kernel it adds tens of megabytes to a process), and a run that reads no mesh should
@@ -90,16 +105,6 @@ static int gmsh_begin(char *why, size_t cap)
     gm.gmshOptionSetNumber("General.Verbosity", 0, &ierr);
     gm.gmshClear(&ierr);
     return ierr == 0;
-}
-
-/* Ends Gmsh after every use: it keeps a failed read's state (the next model would be empty), and
-** its global model and tables are released only by finalizing it. */
-static void gmsh_end(void)
-{
-    int ierr = 0;
-    if (gmsh_ready)
-        gm.gmshFinalize(&ierr);
-    gmsh_ready = 0;
 }
 
 static const char *gmsh_reason(char *buf, size_t cap)
@@ -216,9 +221,10 @@ static size_t used_nodes(const int *types, size_t ntypes, const size_t *etags_n,
 }
 
 /* The mesh's nodes: their tags (sorted, nn of them) and their coordinates times unit_mm, looked
-** up among Gmsh's nodes (tags, coord); a node no Gmsh node defines is left NAN. */
-static void fill_nodes(cf_mesh *m, const size_t *sorted, size_t nn, const size_t *tags,
-                       size_t tags_n, const double *coord, double unit_mm)
+** up among Gmsh's nodes (tags, coord); a node no Gmsh node defines is left NAN. Returns the index
+** into tags of a node given twice at different places (the file defines it twice), or tags_n. */
+static size_t fill_nodes(cf_mesh *m, const size_t *sorted, size_t nn, const size_t *tags,
+                         size_t tags_n, const double *coord, double unit_mm)
 {
     for (size_t i = 0; i < nn; i++)
         m->id[i] = (uint32_t)(sorted[i] <= UINT32_MAX ? sorted[i] : 0);
@@ -226,10 +232,16 @@ static void fill_nodes(cf_mesh *m, const size_t *sorted, size_t nn, const size_t
         m->X[3 * i] = NAN;
     for (size_t j = 0; j < tags_n; j++) {
         size_t *hit = bsearch(&tags[j], sorted, nn, sizeof *sorted, cmp_size);
-        if (hit)
-            for (int a = 0; a < 3; a++)
-                m->X[3 * (size_t)(hit - sorted) + a] = coord[3 * j + a] * unit_mm;
+        if (!hit)
+            continue;
+        double *x = m->X + 3 * (size_t)(hit - sorted);
+        if (!isnan(x[0]) && (x[0] != coord[3 * j] * unit_mm || x[1] != coord[3 * j + 1] * unit_mm ||
+                             x[2] != coord[3 * j + 2] * unit_mm))
+            return j;
+        for (int a = 0; a < 3; a++)
+            x[a] = coord[3 * j + a] * unit_mm;
     }
+    return tags_n;
 }
 
 /* The volume elements as tetrahedra of the mesh's node indices (a hexahedron as six around its
@@ -319,7 +331,12 @@ static cf_status extract(const char *name, double unit_mm, cf_mesh *m, cf_error 
     m->id = malloc(nn * sizeof *m->id);
     if (!m->X || !m->id)
         goto oom;
-    fill_nodes(m, sorted, nn, tags, tags_n, coord, unit_mm);
+    const size_t twice = fill_nodes(m, sorted, nn, tags, tags_n, coord, unit_mm);
+    if (twice < tags_n) {
+        st = cf_error_set(err, CF_E_DATA, "%s: node %zu is defined twice, at different places",
+                          name, tags[twice]);
+        goto end;
+    }
     for (size_t i = 0; i < nn; i++)
         if (isnan(m->X[3 * i])) {
             st = cf_error_set(err, CF_E_DATA, "%s: node %zu is used by an element but not defined",
@@ -367,15 +384,185 @@ static int mesh_ext_ok(const char *path)
     return 0;
 }
 
-cf_status cf_mesh_read(const char *path, double unit_mm, cf_mesh *m, cf_error *err)
+cf_mesh_limits cf_mesh_limits_default(void)
 {
-    return cf_mesh_read_refined(path, unit_mm, 0, m, err);
+    cf_mesh_limits l = {CF_MESH_MAX_BYTES_DEFAULT, CF_MESH_MAX_SECONDS_DEFAULT, 0};
+    return l;
 }
 
-cf_status cf_mesh_read_refined(const char *path, double unit_mm, int refine, cf_mesh *m,
-                               cf_error *err)
+/* What a mesh of about `nodes` nodes and `tets` tetrahedra costs, against the limits, before
+** Gmsh makes it: Gmsh's process (GMSH_BYTES_BASE and tet_bytes each, measured) and the caller's
+** use of its nodes. `what` says how the mesh would be made. */
+static cf_status mesh_cost(const char *name, const char *what, double nodes, double tets,
+                           double tet_bytes, const cf_mesh_limits *lim, cf_error *err)
+{
+    const double gmsh = GMSH_BYTES_BASE + tets * tet_bytes, use = nodes * lim->node_bytes;
+    if (!(lim->max_bytes > 0) || fmax(gmsh, use) <= lim->max_bytes)
+        return CF_OK;
+    char uses[80] = "";
+    if (use > 0)
+        snprintf(uses, sizeof uses, " and %.0f MiB to use", use / 1048576.0);
+    return cf_error_set(err, CF_E_DATA, "%s: %s would give about %.3g nodes and %.3g tetrahedra, "
+                        "about %.0f MiB for Gmsh to make%s, over the memory limit of %.0f MiB: "
+                        "refused before meshing", name, what, nodes, tets, gmsh / 1048576.0,
+                        use > 0 ? uses : " them", lim->max_bytes / 1048576.0);
+}
+
+/* What Gmsh's process needs: a mesh file and its refinement, or a surface, and the limits. */
+typedef struct gmsh_job {
+    const char *path;
+    double unit_mm;
+    int refine;
+    const cf_mesh_limits *lim;
+    const cf_surface *surface; /* a surface to fill at size h (file units) */
+    double h;
+    const double *box;         /* a box: lo[3], hi[3], focus[3], near, far, growth */
+} gmsh_job;
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Distinct keys among n sorted ones. */
+static size_t distinct(uint64_t *k, size_t n)
+{
+    qsort(k, n, sizeof *k, cmp_u64);
+    size_t d = 0;
+    for (size_t i = 0; i < n; i++)
+        d += i == 0 || k[i] != k[i - 1];
+    return d;
+}
+
+/* The nodes and tetrahedra of m refined r times, counted exactly from its edges E and faces F:
+** each refinement puts a node on every edge (V + E), halves the edges and adds three in each face
+** and one in each tetrahedron (2E + 3F + T), splits each face in four and adds eight inside each
+** tetrahedron (4F + 8T), each tetrahedron in eight (8T). 0 when memory runs out. */
+static int refined_size(const cf_mesh *m, int r, double *nodes, double *tets)
+{
+    uint64_t *k = malloc((6 * m->nt + 1) * sizeof *k);
+    if (!k)
+        return 0;
+    static const int ed[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+    for (size_t t = 0; t < m->nt; t++)
+        for (int e = 0; e < 6; e++) {
+            uint64_t a = m->tet[4 * t + (size_t)ed[e][0]], b = m->tet[4 * t + (size_t)ed[e][1]];
+            k[6 * t + (size_t)e] = a < b ? a << 32 | b : b << 32 | a;
+        }
+    double E = (double)distinct(k, 6 * m->nt);
+    for (size_t t = 0; t < m->nt; t++) /* a face by its three corners, 21 bits each */
+        for (int f = 0; f < 4; f++) {
+            uint64_t c[3], x;
+            for (int j = 0, n = 0; j < 4; j++)
+                if (j != f)
+                    c[n++] = m->tet[4 * t + (size_t)j];
+            if (c[0] > c[1]) x = c[0], c[0] = c[1], c[1] = x;
+            if (c[1] > c[2]) x = c[1], c[1] = c[2], c[2] = x;
+            if (c[0] > c[1]) x = c[0], c[0] = c[1], c[1] = x;
+            k[4 * t + (size_t)f] = c[0] << 42 ^ c[1] << 21 ^ c[2];
+        }
+    double F = (double)distinct(k, 4 * m->nt), V = (double)m->nn, T = (double)m->nt;
+    free(k);
+    for (int i = 0; i < r; i++) {
+        V += E;
+        E = 2 * E + 3 * F + T;
+        F = 4 * F + 8 * T;
+        T *= 8;
+    }
+    *nodes = V;
+    *tets = T;
+    return 1;
+}
+
+/* In Gmsh's process: the mesh file read, its cost after refinement checked before refining
+** (refined_size), refined, and sent. */
+static cf_status read_job(const gmsh_job *j, cf_mesh *m, cf_error *err)
+{
+    char why[300];
+    int ierr = 0;
+    gm.gmshOpen(j->path, &ierr);
+    if (ierr)
+        return cf_error_set(err, CF_E_DATA, "%s: not a mesh Gmsh reads: %s", j->path,
+                            gmsh_reason(why, sizeof why));
+    cf_status st = extract(j->path, j->unit_mm, m, err);
+    if (st != CF_OK || j->refine == 0)
+        return st;
+    double nodes, tets;
+    if (!refined_size(m, j->refine, &nodes, &tets))
+        return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the mesh", j->path);
+    char what[80];
+    snprintf(what, sizeof what, "refining its %zu tetrahedra %d time%s", m->nt, j->refine,
+             j->refine > 1 ? "s" : "");
+    st = mesh_cost(j->path, what, nodes, tets, GMSH_REFINE_TET_BYTES, j->lim, err);
+    cf_mesh_free(m);
+    if (st != CF_OK)
+        return st;
+    for (int k = 0; k < j->refine && !ierr; k++)
+        gm.gmshModelMeshRefine(&ierr);
+    if (ierr)
+        return cf_error_set(err, CF_E_DATA, "%s: Gmsh could not refine it: %s", j->path,
+                            gmsh_reason(why, sizeof why));
+    return extract(j->path, j->unit_mm, m, err);
+}
+
+static cf_status box_job(const gmsh_job *j, cf_mesh *m, cf_error *err);
+static cf_status fill_surface(const char *path, const cf_surface *s, double unit_mm, double h,
+                              cf_mesh *m, cf_error *err);
+
+/* Gmsh's process: starts Gmsh, runs the job, sends the mesh. */
+static cf_status gmsh_child(void *arg, cf_isolate_buf *out, cf_error *err)
+{
+    const gmsh_job *j = arg;
+    char why[300];
+    if (!gmsh_begin(why, sizeof why))
+        return cf_error_set(err, CF_E_INTERNAL, "%s: %s", j->path, why);
+    cf_isolate_limit_memory(); /* Gmsh's library loaded: its model under the limit */
+    cf_mesh m;
+    memset(&m, 0, sizeof m);
+    cf_status st = j->box       ? box_job(j, &m, err)
+                   : j->surface ? fill_surface(j->path, j->surface, j->unit_mm, j->h, &m, err)
+                                : read_job(j, &m, err);
+    if (st == CF_OK)
+        cf_mesh_put(out, &m);
+    cf_mesh_free(&m);
+    return st;
+}
+
+/* Runs the job in Gmsh's own process under the limits and checks the mesh it sends. */
+static cf_status gmsh_run(const gmsh_job *j, cf_mesh *m, cf_error *err)
+{
+    char what[300];
+    /* the library loaded here, once: each process of Gmsh starts with it mapped */
+    static pthread_mutex_t load_lock = PTHREAD_MUTEX_INITIALIZER;
+    pthread_mutex_lock(&load_lock);
+    const int loaded = gmsh_load(what, sizeof what);
+    pthread_mutex_unlock(&load_lock);
+    if (!loaded)
+        return cf_error_set(err, CF_E_INTERNAL, "%s: %s", j->path, what);
+    snprintf(what, sizeof what, "%s: Gmsh", j->path);
+    cf_isolate_buf in;
+    cf_status st = cf_isolate_run(what, gmsh_child, (void *)j, j->lim->max_bytes,
+                                  j->lim->max_seconds, &in, err);
+    if (st == CF_OK) {
+        st = cf_mesh_get(&in, j->path, m, err);
+        free(in.data);
+    }
+    if (st == CF_OK && (st = cf_mesh_check(m, j->path, err)) != CF_OK)
+        cf_mesh_free(m);
+    return st;
+}
+
+cf_status cf_mesh_read(const char *path, double unit_mm, cf_mesh *m, cf_error *err)
+{
+    return cf_mesh_read_refined(path, unit_mm, 0, NULL, m, err);
+}
+
+cf_status cf_mesh_read_refined(const char *path, double unit_mm, int refine,
+                               const cf_mesh_limits *lim, cf_mesh *m, cf_error *err)
 {
     memset(m, 0, sizeof *m);
+    const cf_mesh_limits dflt = cf_mesh_limits_default();
     if (!mesh_ext_ok(path))
         return cf_error_set(err, CF_E_DATA, "%s: not a mesh file name: expected .msh, .mesh, "
                             ".vtk, .unv, .bdf or .nas (Gmsh's mesh formats)", path);
@@ -387,29 +574,12 @@ cf_status cf_mesh_read_refined(const char *path, double unit_mm, int refine, cf_
     if (!f)
         return cf_error_set(err, CF_E_NOINPUT, "%s: cannot open mesh: %s", path, strerror(errno));
     fclose(f);
-    pthread_mutex_lock(&gmsh_lock);
-    cf_status st;
-    int ierr = 0;
-    char why[300];
-    if (!gmsh_begin(why, sizeof why)) {
-        st = cf_error_set(err, CF_E_INTERNAL, "%s: %s", path, why);
-    } else {
-        gm.gmshOpen(path, &ierr);
-        if (ierr) {
-            st = cf_error_set(err, CF_E_DATA, "%s: not a mesh Gmsh reads: %s", path,
-                              gmsh_reason(why, sizeof why));
-        } else {
-            for (int k = 0; k < refine && !ierr; k++)
-                gm.gmshModelMeshRefine(&ierr);
-            st = ierr ? cf_error_set(err, CF_E_DATA, "%s: Gmsh could not refine it: %s", path,
-                                     gmsh_reason(why, sizeof why))
-                      : extract(path, unit_mm, m, err);
-        }
-        gmsh_end();
-    }
-    pthread_mutex_unlock(&gmsh_lock);
-    if (st == CF_OK && (st = cf_mesh_check(m, path, err)) != CF_OK)
-        cf_mesh_free(m);
+    const gmsh_job j = {path, unit_mm, refine, lim ? lim : &dflt, NULL, 0, NULL};
+    cf_status st = cf_mesh_msh_nodes_once(path, err);
+    if (st == CF_OK)
+        st = gmsh_run(&j, m, err);
+    if (st == CF_OK)
+        st = cf_mesh_check_coincident(m, path, err);
     return st;
 }
 
@@ -429,14 +599,20 @@ cf_status cf_mesh_box(const double lo[3], const double hi[3], const double focus
     if (vol / (size_near * size_near * size_near) > 1e8)
         return cf_error_set(err, CF_E_DATA, "box: element size %g mm too small for the box",
                             size_near);
-    pthread_mutex_lock(&gmsh_lock);
-    cf_status st = CF_OK;
+    const double box[12] = {lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], focus[0], focus[1], focus[2],
+                            size_near, size_far, growth};
+    const cf_mesh_limits dflt = cf_mesh_limits_default();
+    const gmsh_job j = {"box", 1, 0, &dflt, NULL, 0, box};
+    return gmsh_run(&j, m, err);
+}
+
+/* In Gmsh's process: the box of j->box meshed. */
+static cf_status box_job(const gmsh_job *j, cf_mesh *m, cf_error *err)
+{
+    const double *lo = j->box, *hi = j->box + 3, *focus = j->box + 6;
+    const double size_near = j->box[9], size_far = j->box[10], growth = j->box[11];
     int ierr = 0;
     char why[300], expr[400];
-    if (!gmsh_begin(why, sizeof why)) {
-        st = cf_error_set(err, CF_E_INTERNAL, "box: %s", why);
-        goto end;
-    }
     gm.gmshModelAdd("box", &ierr);
     gm.gmshModelOccAddBox(lo[0], lo[1], lo[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], -1, &ierr);
     gm.gmshModelOccSynchronize(&ierr);
@@ -452,18 +628,10 @@ cf_status cf_mesh_box(const double lo[3], const double hi[3], const double focus
     gm.gmshOptionSetNumber("Mesh.RandomSeed", 1, &ierr);
     gm.gmshOptionSetNumber("General.NumThreads", 1, &ierr);
     gm.gmshModelMeshGenerate(3, &ierr);
-    if (ierr) {
-        st = cf_error_set(err, CF_E_DATA, "box: Gmsh could not mesh it: %s",
-                          gmsh_reason(why, sizeof why));
-        goto end;
-    }
-    st = extract("box", 1, m, err);
-end:
-    gmsh_end();
-    pthread_mutex_unlock(&gmsh_lock);
-    if (st == CF_OK && (st = cf_mesh_check(m, "box", err)) != CF_OK)
-        cf_mesh_free(m);
-    return st;
+    if (ierr)
+        return cf_error_set(err, CF_E_DATA, "box: Gmsh could not mesh it: %s",
+                            gmsh_reason(why, sizeof why));
+    return extract("box", 1, m, err);
 }
 
 /* The Gmsh part of cf_mesh_from_surface: the prepared surface s into the current model as one
@@ -542,10 +710,15 @@ end:
     return st;
 }
 
-cf_status cf_mesh_from_surface(const char *path, double unit_mm, double size_mm, cf_mesh *m,
+
+cf_status cf_mesh_from_surface(const char *path, double unit_mm, double size_mm,
+                               const cf_mesh_limits *lim, cf_mesh *m,
                                cf_mesh_surface_info *info, cf_error *err)
 {
     memset(m, 0, sizeof *m);
+    const cf_mesh_limits dflt = cf_mesh_limits_default();
+    if (!lim)
+        lim = &dflt;
     cf_mesh_surface_info dummy;
     if (!info)
         info = &dummy;
@@ -561,27 +734,19 @@ cf_status cf_mesh_from_surface(const char *path, double unit_mm, double size_mm,
     cf_surface s;
     cf_status st = cf_surface_read(path, &s, err);
     if (st == CF_OK)
-        st = cf_surface_prepare(&s, path, unit_mm, info, err);
-    /* a regular tetrahedron of edge h holds h^3 / (6 sqrt 2): the count of a fill, roughly */
-    const double count = info->enclosed_mm3 / (size_mm * size_mm * size_mm / (6 * sqrt(2)));
-    if (st == CF_OK && count > 5e6)
-        st = cf_error_set(err, CF_E_DATA, "%s: element size %g mm would fill the %.4g mm^3 it "
-                          "encloses with about %.3g tetrahedra, over 5e6", path, size_mm,
-                          info->enclosed_mm3, count);
+        st = cf_surface_prepare(&s, path, unit_mm, size_mm, info, err);
+    if (st == CF_OK) { /* the fill's cost, before Gmsh starts (counted as cf_surface_prepare) */
+        char what[120];
+        snprintf(what, sizeof what, "filling it at an element size of %g mm", size_mm);
+        st = mesh_cost(path, what, info->estimated_nodes, info->estimated_tets,
+                       GMSH_FILL_TET_BYTES, lim, err);
+    }
     if (st != CF_OK) {
         cf_surface_free(&s);
         return st;
     }
-    pthread_mutex_lock(&gmsh_lock);
-    char why[300];
-    if (!gmsh_begin(why, sizeof why))
-        st = cf_error_set(err, CF_E_INTERNAL, "%s: %s", path, why);
-    else
-        st = fill_surface(path, &s, unit_mm, size_mm / unit_mm, m, err);
-    gmsh_end();
-    pthread_mutex_unlock(&gmsh_lock);
+    const gmsh_job j = {path, unit_mm, 0, lim, &s, size_mm / unit_mm, NULL};
+    st = gmsh_run(&j, m, err);
     cf_surface_free(&s);
-    if (st == CF_OK && (st = cf_mesh_check(m, path, err)) != CF_OK)
-        cf_mesh_free(m);
     return st;
 }

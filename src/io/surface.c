@@ -4,6 +4,7 @@
 ** triangles, as in scanned or smoothed organ surfaces) before a volume mesher sees it.
 */
 #include "io/surface.h"
+#include "io/surface_geom.h"
 
 #include <errno.h>
 #include <math.h>
@@ -269,24 +270,6 @@ cf_status cf_surface_read(const char *path, cf_surface *s, cf_error *err)
     return st;
 }
 
-static void sub3(const double *a, const double *b, double *c)
-{
-    for (int k = 0; k < 3; k++)
-        c[k] = a[k] - b[k];
-}
-
-static void cross3(const double *a, const double *b, double *c)
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static double dot3(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
 static int cmp_u64(const void *a, const void *b)
 {
     uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
@@ -321,90 +304,6 @@ static cf_status closed(const cf_surface *s, const char *name, cf_error *err)
     return st;
 }
 
-typedef struct tri_box {
-    double lo, hi; /* x extent */
-    uint32_t t;
-} tri_box;
-
-static int cmp_box(const void *a, const void *b)
-{
-    double x = ((const tri_box *)a)->lo, y = ((const tri_box *)b)->lo;
-    return (x > y) - (x < y);
-}
-
-/* Marks (mark[v] = 1) the corners of every edge that crosses a triangle not its own, and that
-** triangle's corners; returns the number of crossings, or -1 when memory runs out. *first_a,
-** first_b and first_t get the first crossing found. */
-static long crossings(const cf_surface *s, uint8_t *mark, uint32_t *fa, uint32_t *fb, uint32_t *ft)
-{
-    tri_box *bx = malloc(s->nf * sizeof *bx);
-    if (!bx)
-        return -1;
-    double wmax = 0;
-    for (size_t t = 0; t < s->nf; t++) {
-        const uint32_t *v = s->tri + 3 * t;
-        bx[t].lo = fmin(s->X[3 * v[0]], fmin(s->X[3 * v[1]], s->X[3 * v[2]]));
-        bx[t].hi = fmax(s->X[3 * v[0]], fmax(s->X[3 * v[1]], s->X[3 * v[2]]));
-        bx[t].t = (uint32_t)t;
-        wmax = fmax(wmax, bx[t].hi - bx[t].lo);
-    }
-    qsort(bx, s->nf, sizeof *bx, cmp_box);
-    long hits = 0;
-    for (size_t e = 0; e < s->nf; e++)
-        for (int k = 0; k < 3; k++) {
-            uint32_t a = s->tri[3 * e + (size_t)k], b = s->tri[3 * e + (size_t)(k + 1) % 3];
-            if (a > b)
-                continue; /* each edge once (a closed surface has it both ways) */
-            const double *P = s->X + 3 * (size_t)a;
-            double D[3];
-            sub3(s->X + 3 * (size_t)b, P, D);
-            const double elo = fmin(P[0], P[0] + D[0]), ehi = fmax(P[0], P[0] + D[0]);
-            size_t lo = 0, hi = s->nf; /* the first box with lo >= elo - wmax */
-            while (lo < hi) {
-                size_t mid = lo + (hi - lo) / 2;
-                if (bx[mid].lo < elo - wmax)
-                    lo = mid + 1;
-                else
-                    hi = mid;
-            }
-            for (size_t j = lo; j < s->nf && bx[j].lo <= ehi; j++) {
-                if (bx[j].hi < elo)
-                    continue;
-                const uint32_t *T = s->tri + 3 * (size_t)bx[j].t;
-                if (T[0] == a || T[1] == a || T[2] == a || T[0] == b || T[1] == b || T[2] == b)
-                    continue;
-                /* Moller and Trumbore's segment-triangle test, ends and edges included */
-                double e1[3], e2[3], h[3], q[3], r[3];
-                sub3(s->X + 3 * (size_t)T[1], s->X + 3 * (size_t)T[0], e1);
-                sub3(s->X + 3 * (size_t)T[2], s->X + 3 * (size_t)T[0], e2);
-                cross3(D, e2, h);
-                const double det = dot3(e1, h);
-                if (fabs(det) < 1e-300)
-                    continue;
-                sub3(P, s->X + 3 * (size_t)T[0], r);
-                const double u = dot3(r, h) / det;
-                if (u < 0 || u > 1)
-                    continue;
-                cross3(r, e1, q);
-                const double v = dot3(D, q) / det;
-                if (v < 0 || u + v > 1)
-                    continue;
-                const double tt = dot3(e2, q) / det;
-                if (tt < 0 || tt > 1)
-                    continue;
-                if (hits == 0) {
-                    *fa = a;
-                    *fb = b;
-                    *ft = bx[j].t;
-                }
-                hits++;
-                mark[a] = mark[b] = mark[T[0]] = mark[T[1]] = mark[T[2]] = 1;
-            }
-        }
-    free(bx);
-    return hits;
-}
-
 static double enclosed(const cf_surface *s)
 {
     double V = 0;
@@ -417,8 +316,61 @@ static double enclosed(const cf_surface *s)
     return V;
 }
 
-cf_status cf_surface_prepare(cf_surface *s, const char *name, double unit_mm,
-                             cf_mesh_surface_info *info, cf_error *err)
+/* Each triangle into four at its edges' midpoints (the same shape, every edge halved); 0 when
+** memory runs out (s unchanged). */
+static int split_in_four(cf_surface *s)
+{
+    const size_t ne = 3 * s->nf / 2; /* a closed surface: every edge in two triangles */
+    uint64_t *key = malloc(3 * s->nf * sizeof *key);
+    double *X = malloc(3 * (s->nv + ne) * sizeof *X);
+    uint32_t *tri = malloc(12 * s->nf * sizeof *tri);
+    if (!key || !X || !tri) {
+        free(key);
+        free(X);
+        free(tri);
+        return 0;
+    }
+    for (size_t t = 0; t < s->nf; t++)
+        for (int k = 0; k < 3; k++) {
+            uint32_t a = s->tri[3 * t + (size_t)k], b = s->tri[3 * t + (size_t)(k + 1) % 3];
+            key[3 * t + (size_t)k] = (uint64_t)(a < b ? a : b) << 32 | (a < b ? b : a);
+        }
+    qsort(key, 3 * s->nf, sizeof *key, cmp_u64);
+    size_t nk = 0;
+    for (size_t i = 0; i < 3 * s->nf; i++)
+        if (i == 0 || key[i] != key[nk - 1])
+            key[nk++] = key[i];
+    memcpy(X, s->X, 3 * s->nv * sizeof *X);
+    for (size_t e = 0; e < nk; e++)
+        for (int c = 0; c < 3; c++)
+            X[3 * (s->nv + e) + (size_t)c] = 0.5 * (s->X[3 * (size_t)(key[e] >> 32) + (size_t)c] +
+                                                    s->X[3 * (size_t)(uint32_t)key[e] + (size_t)c]);
+    for (size_t t = 0; t < s->nf; t++) {
+        uint32_t v[3], m[3];
+        for (int k = 0; k < 3; k++) {
+            v[k] = s->tri[3 * t + (size_t)k];
+            uint32_t a = v[k], b = s->tri[3 * t + (size_t)(k + 1) % 3];
+            uint64_t q = (uint64_t)(a < b ? a : b) << 32 | (a < b ? b : a);
+            m[k] = (uint32_t)(s->nv + (size_t)((uint64_t *)bsearch(&q, key, nk, sizeof *key,
+                                                                    cmp_u64) - key));
+        }
+        const uint32_t four[4][3] = {{v[0], m[0], m[2]}, {m[0], v[1], m[1]}, {m[2], m[1], v[2]},
+                                     {m[0], m[1], m[2]}};
+        memcpy(tri + 12 * t, four, sizeof four);
+    }
+    free(key);
+    free(s->X);
+    free(s->tri);
+    s->X = X;
+    s->tri = tri;
+    s->nv += nk;
+    s->nf *= 4;
+    return 1;
+}
+
+/* info started; every triangle with an area (else refused, named). */
+static cf_status has_area(const cf_surface *s, const char *name, cf_mesh_surface_info *info,
+                          cf_error *err)
 {
     memset(info, 0, sizeof *info);
     info->vertices = s->nv;
@@ -436,7 +388,47 @@ cf_status cf_surface_prepare(cf_surface *s, const char *name, double unit_mm,
             return cf_error_set(err, CF_E_DATA, "%s: triangle %zu (vertices %u, %u, %u) has no "
                                 "area", name, t + 1, v[0] + 1, v[1] + 1, v[2] + 1);
     }
-    cf_status st = closed(s, name, err);
+    return CF_OK;
+}
+
+/* Each marked vertex to the mean of its neighbours (each met twice: the mean holds); the moves
+** into info. */
+static void smooth_marked(cf_surface *s, const uint8_t *mark, uint8_t *moved, double *sum,
+                          uint32_t *cnt, double unit_mm, cf_mesh_surface_info *info)
+{
+    memset(sum, 0, 3 * s->nv * sizeof *sum);
+    memset(cnt, 0, s->nv * sizeof *cnt);
+    for (size_t f = 0; f < s->nf; f++)
+        for (int k = 0; k < 3; k++) {
+            uint32_t p = s->tri[3 * f + (size_t)k], q = s->tri[3 * f + (size_t)(k + 1) % 3];
+            for (int c = 0; c < 3; c++) {
+                sum[3 * (size_t)p + (size_t)c] += s->X[3 * (size_t)q + (size_t)c];
+                sum[3 * (size_t)q + (size_t)c] += s->X[3 * (size_t)p + (size_t)c];
+            }
+            cnt[p]++;
+            cnt[q]++;
+        }
+    for (size_t v = 0; v < s->nv; v++) {
+        if (!mark[v] || !cnt[v])
+            continue;
+        double d2 = 0;
+        for (int c = 0; c < 3; c++) {
+            double x = sum[3 * v + (size_t)c] / cnt[v];
+            d2 += (x - s->X[3 * v + (size_t)c]) * (x - s->X[3 * v + (size_t)c]);
+            s->X[3 * v + (size_t)c] = x;
+        }
+        info->max_move_mm = fmax(info->max_move_mm, sqrt(d2) * unit_mm);
+        info->smoothed += !moved[v];
+        moved[v] = 1;
+    }
+}
+
+cf_status cf_surface_prepare(cf_surface *s, const char *name, double unit_mm, double size_mm,
+                             cf_mesh_surface_info *info, cf_error *err)
+{
+    cf_status st = has_area(s, name, info, err);
+    if (st == CF_OK)
+        st = closed(s, name, err);
     if (st)
         return st;
     if (enclosed(s) < 0) {
@@ -447,6 +439,26 @@ cf_status cf_surface_prepare(cf_surface *s, const char *name, double unit_mm,
             s->tri[3 * t + 2] = x;
         }
     }
+    /* the fill's size first (it is cheap, the search for crossings is not): a regular
+    ** tetrahedron of edge h holds h^3 / (6 sqrt 2) */
+    const double V = fabs(enclosed(s)) * unit_mm * unit_mm * unit_mm;
+    info->estimated_tets = V / (size_mm * size_mm * size_mm / (6 * sqrt(2)));
+    double area = 0;
+    for (size_t t = 0; t < s->nf; t++) {
+        const uint32_t *v = s->tri + 3 * t;
+        double e1[3], e2[3], c[3];
+        sub3(s->X + 3 * (size_t)v[1], s->X + 3 * (size_t)v[0], e1);
+        sub3(s->X + 3 * (size_t)v[2], s->X + 3 * (size_t)v[0], e2);
+        cross3(e1, e2, c);
+        area += 0.5 * sqrt(dot3(c, c)) * unit_mm * unit_mm;
+    }
+    info->estimated_nodes = info->estimated_tets / 8 + 1.15 * area / (size_mm * size_mm);
+    if (info->estimated_tets > CF_MESH_MAX_FILL_TETS) /* 5e6 */
+        return cf_error_set(err, CF_E_DATA, "%s: element size %g mm would fill the %.4g mm^3 it "
+                            "encloses with about %.3g tetrahedra, over 5e6", name, size_mm, V,
+                            info->estimated_tets);
+    if ((st = cf_surface_nested_shells(s, name, unit_mm, info, err)) != CF_OK)
+        return st;
     uint8_t *mark = malloc(s->nv), *moved = calloc(s->nv, 1);
     double *sum = malloc(3 * s->nv * sizeof *sum);
     uint32_t *cnt = malloc(s->nv * sizeof *cnt);
@@ -457,7 +469,7 @@ cf_status cf_surface_prepare(cf_surface *s, const char *name, double unit_mm,
     for (int round = 0;; round++) {
         uint32_t a = 0, b = 0, t = 0;
         memset(mark, 0, s->nv);
-        long n = crossings(s, mark, &a, &b, &t);
+        long n = cf_surface_crossings(s, mark, &a, &b, &t, &info->pair_tests);
         if (n < 0) {
             st = cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the surface", name);
             break;
@@ -475,34 +487,12 @@ cf_status cf_surface_prepare(cf_surface *s, const char *name, double unit_mm,
                               CF_SURFACE_SMOOTH_ROUNDS);
             break;
         }
-        /* each marked vertex to the mean of its neighbours (each met twice: the mean holds) */
-        memset(sum, 0, 3 * s->nv * sizeof *sum);
-        memset(cnt, 0, s->nv * sizeof *cnt);
-        for (size_t f = 0; f < s->nf; f++)
-            for (int k = 0; k < 3; k++) {
-                uint32_t p = s->tri[3 * f + (size_t)k], q = s->tri[3 * f + (size_t)(k + 1) % 3];
-                for (int c = 0; c < 3; c++) {
-                    sum[3 * (size_t)p + (size_t)c] += s->X[3 * (size_t)q + (size_t)c];
-                    sum[3 * (size_t)q + (size_t)c] += s->X[3 * (size_t)p + (size_t)c];
-                }
-                cnt[p]++;
-                cnt[q]++;
-            }
-        for (size_t v = 0; v < s->nv; v++) {
-            if (!mark[v] || !cnt[v])
-                continue;
-            double d2 = 0;
-            for (int c = 0; c < 3; c++) {
-                double x = sum[3 * v + (size_t)c] / cnt[v];
-                d2 += (x - s->X[3 * v + (size_t)c]) * (x - s->X[3 * v + (size_t)c]);
-                s->X[3 * v + (size_t)c] = x;
-            }
-            info->max_move_mm = fmax(info->max_move_mm, sqrt(d2) * unit_mm);
-            info->smoothed += !moved[v];
-            moved[v] = 1;
-        }
+        smooth_marked(s, mark, moved, sum, cnt, unit_mm, info);
     }
     info->enclosed_mm3 = enclosed(s) * unit_mm * unit_mm * unit_mm;
+    while (st == CF_OK && s->nf < CF_SURFACE_MIN_TRIANGLES)
+        if (!split_in_four(s))
+            st = cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the surface", name);
 end:
     free(mark);
     free(moved);

@@ -34,9 +34,15 @@ cf_status cf_surface_read(const char *path, cf_surface *s, cf_error *err);
 ** surface" naming the vertices), the triangles turned outward when they enclose a negative volume;
 ** edges that cross a triangle not their own are removed by moving the corners of the triangles
 ** involved to the mean of their neighbours, up to CF_SURFACE_SMOOTH_ROUNDS rounds (else refused
-** naming the crossing). CF_E_DATA / CF_E_INTERNAL. */
+** naming the crossing); the element size's fill is counted (info->estimated_tets) and refused
+** over CF_MESH_MAX_FILL_TETS before crossings are sought; a shell that faces outward inside the
+** solid of another is refused (a solid within a solid). A surface of fewer than
+** CF_SURFACE_MIN_TRIANGLES triangles is then split, each triangle into four at its edges'
+** midpoints (the same shape), until it has as many: Gmsh 4.8's classification of a tetrahedron's
+** four triangles never ends. CF_E_DATA / CF_E_INTERNAL. */
 #define CF_SURFACE_SMOOTH_ROUNDS 5
-cf_status cf_surface_prepare(cf_surface *s, const char *name, double unit_mm,
+#define CF_SURFACE_MIN_TRIANGLES 64
+cf_status cf_surface_prepare(cf_surface *s, const char *name, double unit_mm, double size_mm,
                              cf_mesh_surface_info *info, cf_error *err);
 
 #endif

@@ -5,7 +5,8 @@
 ** one static equilibrium per 1 ms of simulated time (5 um of travel per update), each solve
 ** starting from the last. Reported: the wall and CPU time per update (median over the updates
 ** after the first contact), by mesh size (liver2.msh as read and refined once by Gmsh), and
-** whether one update fits in 1 ms (1 kHz).
+** whether one update fits in 1 ms (1 kHz). First, the search for a surface's crossings on
+** cylinders of long triangles, by triangle count.
 */
 #include <math.h>
 #include <stdlib.h>
@@ -15,6 +16,7 @@
 #include "model/body.h"
 #include "io/fitfile.h"
 #include "io/mesh.h"
+#include "io/surface.h"
 
 #define UPDATES 200
 #define HAPTIC_ITERS 3
@@ -27,7 +29,7 @@ static int loop(const char *path, int refine, const cf_law *law, int haptic, dou
 {
     cf_mesh m;
     cf_error err = {0};
-    if (cf_mesh_read_refined(path, 100, refine, &m, &err) != CF_OK)
+    if (cf_mesh_read_refined(path, 100, refine, NULL, &m, &err) != CF_OK)
         return 0;
     cf_body b;
     if (cf_body_create(&b, &m, law, CF_LAW_CLOSED,
@@ -77,9 +79,74 @@ static int loop(const char *path, int refine, const cf_law *law, int haptic, dou
     return 1;
 }
 
+/* A cylinder along x (length 100 mm, radius 5 mm) of n long side triangles pairs and two fan
+** caps: 4 n triangles, in memory. */
+static int cylinder(int n, cf_surface *s)
+{
+    s->nv = 2 * (size_t)n + 2;
+    s->nf = 4 * (size_t)n;
+    s->X = malloc(3 * s->nv * sizeof *s->X);
+    s->tri = malloc(3 * s->nf * sizeof *s->tri);
+    if (!s->X || !s->tri) {
+        cf_surface_free(s);
+        return 0;
+    }
+    const double pi = 3.14159265358979323846;
+    for (int k = 0; k < n; k++)
+        for (int e = 0; e < 2; e++) {
+            double *x = s->X + 3 * (size_t)(2 * k + e);
+            x[0] = 100.0 * e;
+            x[1] = 5 * cos(2 * pi * k / n);
+            x[2] = 5 * sin(2 * pi * k / n);
+        }
+    const uint32_t c0 = 2 * (uint32_t)n, c1 = c0 + 1;
+    memset(s->X + 3 * (size_t)c0, 0, 6 * sizeof *s->X);
+    s->X[3 * (size_t)c1] = 100;
+    for (uint32_t k = 0; k < (uint32_t)n; k++) {
+        const uint32_t a0 = 2 * k, a1 = 2 * k + 1, b0 = 2 * ((k + 1) % (uint32_t)n), b1 = b0 + 1;
+        const uint32_t t[4][3] = {{a0, a1, b1}, {a0, b1, b0}, {c0, a0, b0}, {c1, b1, a1}};
+        memcpy(s->tri + 12 * (size_t)k, t, sizeof t);
+    }
+    return 1;
+}
+
+/* The search for a surface's crossings (cf_surface_prepare) on cylinders of long triangles and
+** fan caps, the shape a sweep along one axis made quadratic (60.8 s at 40,000 triangles). */
+static void surface_crossings(bench_ctx *ctx)
+{
+    FILE *md = ctx->md;
+    fprintf(md, "## Tissue bodies: a surface's checks on long triangles\n\n"
+                "cf_surface_prepare (closedness, shells, crossings) on a cylinder 100 mm long, "
+                "5 mm in radius, of long side triangles and fan caps.\n\n"
+                "| triangles | edge-triangle tests | wall |\n|---|---|---|\n");
+    double t40 = -1;
+    for (int n = 2500; n <= 40000; n *= 2) {
+        cf_surface s;
+        cf_mesh_surface_info info;
+        cf_error err = {0};
+        if (!cylinder(n, &s))
+            break;
+        const double t0 = bench_now();
+        const cf_status st = cf_surface_prepare(&s, "cylinder", 1, 2, &info, &err);
+        const double t = bench_now() - t0;
+        cf_surface_free(&s);
+        if (st != CF_OK) {
+            fprintf(md, "| %d | failed: %s | |\n", 4 * n, err.msg);
+            continue;
+        }
+        if (4 * n == 40000)
+            t40 = t;
+        fprintf(md, "| %d | %zu | %.3g s |\n", 4 * n, info.pair_tests, t);
+    }
+    fprintf(md, "\n");
+    bench_target_add(ctx, "crossing check of a 40,000-triangle cylinder within 2 s",
+                     t40 >= 0 && t40 < 2, "%.3g s", t40);
+}
+
 void bench_section_body(bench_ctx *ctx)
 {
     FILE *md = ctx->md;
+    surface_crossings(ctx);
     fprintf(md, "## Tissue bodies: the probe loop at haptic rate\n\n");
     FILE *f = fopen("../shared/meshes/liver2.msh", "r");
     if (!f) {

@@ -102,7 +102,7 @@ static void a_cube_surface_fills_with_its_volume(void **state)
         cf_mesh m;
         cf_mesh_surface_info info;
         cf_error err = {0};
-        if (cf_mesh_from_surface(path, 1, 2, &m, &info, &err) != CF_OK)
+        if (cf_mesh_from_surface(path, 1, 2, NULL, &m, &info, &err) != CF_OK)
             fail_msg("%s", err.msg);
         const double V = mesh_volume(&m);
         print_message("cube surface %d: %zu vertices, %zu triangles, reversed %d; %zu nodes, %zu "
@@ -169,7 +169,7 @@ static void the_liver_surface_fills_near_its_volume(void **state)
         cf_mesh m;
         cf_mesh_surface_info info;
         cf_error err = {0};
-        if (cf_mesh_from_surface(LIVER, 10, sizes[k], &m, &info, &err) != CF_OK)
+        if (cf_mesh_from_surface(LIVER, 10, sizes[k], NULL, &m, &info, &err) != CF_OK)
             fail_msg("%s", err.msg);
         cf_body b;
         assert_int_equal(cf_body_create(&b, &m, &law, CF_LAW_CLOSED, 0, &err), CF_OK);

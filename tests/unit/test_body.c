@@ -320,7 +320,7 @@ static int liver_and_calculix(int refine, double nu, double R, double D, double 
     cf_law law = test_law();
     cf_mesh m;
     cf_error err = {0};
-    if (cf_mesh_read_refined("../shared/meshes/liver2.msh", 100, refine, &m, &err) != CF_OK)
+    if (cf_mesh_read_refined("../shared/meshes/liver2.msh", 100, refine, NULL, &m, &err) != CF_OK)
         fail_msg("%s", err.msg);
     cf_body b;
     assert_int_equal(cf_body_create(&b, &m, &law, CF_LAW_CLOSED,
