@@ -187,7 +187,8 @@ int main(int argc, char **argv)
                     {"statics at scale", bench_section_statics},
                     {"long tables", bench_section_longfit},
                     {"fits at the cost of the law", bench_section_fastfit},
-                    {"tissue bodies: the probe loop", bench_section_body}};
+                    {"tissue bodies: the probe loop", bench_section_body},
+                    {"tissue bodies: Hertz on the finest contact mesh", bench_section_contact}};
     const int nsec = (int)(sizeof sections / sizeof sections[0]);
     for (int k = 0; k < nsec; k++) {
         if (only && !strstr(sections[k].what, only))
