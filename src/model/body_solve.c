@@ -152,7 +152,8 @@ end:
 /* Load-step control: the probe's reference point moves from where the body was last solved
 ** (w->c_last; at depth 0 before the first solve) to c. When the solve of the whole move fails to
 ** converge, the body goes back to where it was and the move is taken in parts, each half the
-** last that failed and twice the last that converged, down to a millionth of the move. */
+** last that failed and twice the last that converged, down to a millionth of the move (at most
+** 200 parts tried). */
 static cf_status solve_cut(cf_body *b, body_work *w, const cf_probe *probe, const double c[3],
                            double depth_mm, double kp, cf_body_step *out, cf_error *err)
 {
@@ -171,7 +172,7 @@ static cf_status solve_cut(cf_body *b, body_work *w, const cf_probe *probe, cons
     }
     int iters = out->newton_iters, cuts = 0;
     double t = 0, h = 0.5;
-    while (t < 1) {
+    for (int tries = 0; t < 1; tries++) {
         const double tn = fmin(1, t + h);
         double ci[3];
         for (int k = 0; k < 3; k++)
@@ -184,7 +185,7 @@ static cf_status solve_cut(cf_body *b, body_work *w, const cf_probe *probe, cons
             t = tn;
             memcpy(w->xs, b->x, n * sizeof *w->xs);
             h *= 2;
-        } else if (st == CF_E_NOCONV && h > 1e-6) {
+        } else if (st == CF_E_NOCONV && h > 1e-6 && tries < 200) {
             h *= 0.5;
             cuts++;
         } else {
