@@ -542,6 +542,8 @@ void cf_body_work_free(body_work *w)
     free(w->dx);
     free(w->xt);
     free(w->active);
+    free(w->touch);
+    free(w->xs);
     free(w);
 }
 
@@ -561,8 +563,9 @@ cf_status cf_body_work_get(cf_body *b, body_work **out, cf_error *err)
     w->dx = malloc(n * sizeof *w->dx);
     w->xt = malloc(n * sizeof *w->xt);
     w->active = malloc(b->nn);
+    w->touch = malloc(b->nn);
     cf_status st = CF_OK;
-    if (!w->g || !w->dx || !w->xt || !w->active)
+    if (!w->g || !w->dx || !w->xt || !w->active || !w->touch || !cf_body_touchable(b, w->touch))
         st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent of %zu nodes", b->nn);
     else
         st = cf_sparse_chol_create(&w->ch, n, w->P.colptr, w->P.rowidx, err);

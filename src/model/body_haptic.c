@@ -197,7 +197,7 @@ cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm
         }
         for (size_t i = 0; it == 0 && i < nn; i++) {
             double nrm[3];
-            uint8_t in = b->fix[i] != CF_BODY_FIX_ALL &&
+            uint8_t in = w->touch[i] && b->fix[i] != CF_BODY_FIX_ALL &&
                          (cf_body_penetration(probe, c, b->x + 3 * i, nrm, 0) > 0 ||
                           (w->hactive[i] && cf_body_penetration(probe, c, b->x + 3 * i, nrm, 1) > 0));
             w->hactive[i] = in;

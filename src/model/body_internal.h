@@ -79,6 +79,11 @@ typedef struct body_work {
     cf_sparse_chol *ch;
     double *g, *dx, *xt;
     uint8_t *active;
+    uint8_t *touch;     /* nn: 1 = a node on the body's surface, which a probe can touch */
+    double *xs;         /* 3 nn: the body at the last converged part of a static solve's move */
+    double c_last[3];   /* the probe's reference point at the last converged static solve */
+    double depth_last;  /* and its depth, mm */
+    int has_last;       /* 0 before the first */
     int factored;       /* ch holds the factors of a tangent of this body */
     /* the haptic loop (cf_body_haptic_step): the factors of the tangent without contact, taken
     ** once, and per node that has touched the probe the three columns of its inverse at that
@@ -105,6 +110,13 @@ typedef struct body_work {
 ** node has left the probe's surface. */
 double cf_body_penetration(const cf_probe *pr, const double *c, const double *p, double nrm[3],
                            int sgn);
+
+/* Marks (mark[i] = 1, nn entries; 0 elsewhere) the nodes a probe can touch: those on the body's
+** surface (of a face that only one tetrahedron has). An interior node
+** inside a probe is not touched by it: it is where it is because the surface above it has not
+** yet moved, and pushing it out would flatten the tetrahedra between it and the surface.
+** Returns 0 when memory runs out. */
+int cf_body_touchable(const cf_body *b, uint8_t *mark);
 
 /* body_assemble.c */
 /* Energy gradient g (3 nn) and, when P is not NULL, the tangent at positions x; contact forces of

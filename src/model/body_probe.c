@@ -4,6 +4,8 @@
 ** assembly and solvers, which call it.
 */
 #include <math.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "model/body_internal.h"
 
@@ -64,4 +66,53 @@ size_t cf_body_contact_set(const cf_body *b, uint8_t *mark)
 double cf_body_penalty(const cf_body *b)
 {
     return 1e4 * b->E_MPa * b->mean_edge_mm; /* as cf_body_solve's automatic penalty */
+}
+
+/* A face of a tetrahedron as its three nodes in increasing order. */
+typedef struct tri_face {
+    uint32_t v[3];
+} tri_face;
+
+static int cmp_face(const void *a, const void *b)
+{
+    const tri_face *p = a, *q = b;
+    for (int k = 0; k < 3; k++)
+        if (p->v[k] != q->v[k])
+            return (p->v[k] > q->v[k]) - (p->v[k] < q->v[k]);
+    return 0;
+}
+
+int cf_body_touchable(const cf_body *b, uint8_t *mark)
+{
+    static const int face[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+    tri_face *f = malloc(4 * b->nt * sizeof *f + 1);
+    if (!f)
+        return 0;
+    for (size_t t = 0; t < b->nt; t++)
+        for (int k = 0; k < 4; k++) {
+            uint32_t *v = f[4 * t + (size_t)k].v;
+            for (int a = 0; a < 3; a++)
+                v[a] = b->tet[4 * t + (size_t)face[k][a]];
+            for (int a = 0; a < 2; a++) /* three elements sorted */
+                for (int q = 0; q < 2 - a; q++)
+                    if (v[q] > v[q + 1]) {
+                        const uint32_t s = v[q];
+                        v[q] = v[q + 1];
+                        v[q + 1] = s;
+                    }
+        }
+    const size_t nf = 4 * b->nt;
+    qsort(f, nf, sizeof *f, cmp_face);
+    memset(mark, 0, b->nn);
+    for (size_t k = 0; k < nf;) {
+        size_t e = k + 1;
+        while (e < nf && cmp_face(f + k, f + e) == 0)
+            e++;
+        if (e - k == 1) /* a face of one tetrahedron only: on the boundary */
+            for (int a = 0; a < 3; a++)
+                mark[f[k].v[a]] = 1;
+        k = e;
+    }
+    free(f);
+    return 1;
 }

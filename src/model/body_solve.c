@@ -66,7 +66,7 @@ static cf_status newton_in_set(cf_body *b, body_work *w, const cf_probe *probe, 
                 xt[i] = b->x[i] - alpha * dx[i];
             ok = cf_body_admissible(b, xt);
         }
-        if (!ok)
+        if (!ok || alpha < 0x1p-20)
             return cf_error_set(err, CF_E_NOCONV,
                                 "body: at probe depth %g mm every Newton step would invert a "
                                 "tetrahedron or take a spring to solid",
@@ -74,23 +74,18 @@ static cf_status newton_in_set(cf_body *b, body_work *w, const cf_probe *probe, 
         memcpy(b->x, xt, n * sizeof *xt);
         if (alpha < 0.99)
             *fresh = 1; /* a shortened step: take the tangent where it landed */
-        if (alpha * body_norm_inf(dx, n) <= 1e-14 * b->mean_edge_mm)
-            *conv = 1;
+        else if (body_norm_inf(dx, n) <= 1e-14 * b->mean_edge_mm)
+            *conv = 1; /* a full step below rounding (a cut one says nothing of convergence) */
     }
     return CF_OK;
 }
 
-cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
-                        double penalty_N_per_mm, cf_body_step *out, cf_error *err)
+/* The static solve with the probe's reference point at c (depth_mm names it in messages), from
+** the body where it is. */
+static cf_status solve_at(cf_body *b, body_work *w, const cf_probe *probe, const double c[3],
+                          double depth_mm, double kp, cf_body_step *out, cf_error *err)
 {
-    const double kp = penalty_N_per_mm > 0 ? penalty_N_per_mm : 1e4 * b->E_MPa * b->mean_edge_mm;
-    double c[3];
-    for (int k = 0; k < 3; k++)
-        c[k] = probe->center_mm[k] + depth_mm * probe->dir[k];
-    body_work *w = NULL;
-    cf_status st = cf_body_work_get(b, &w, err);
-    if (st != CF_OK)
-        return st;
+    cf_status st;
     double *g = w->g;
     uint8_t *active = w->active;
     /* Active set: Newton's method with the set of nodes in contact held (each held node pushed
@@ -104,7 +99,8 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
     double force = 0;
     for (size_t i = 0; i < b->nn; i++) {
         double nrm[3];
-        uint8_t in = b->fix[i] != CF_BODY_FIX_ALL && cf_body_penetration(probe, c, b->x + 3 * i, nrm, 0) > 0;
+        uint8_t in = w->touch[i] && b->fix[i] != CF_BODY_FIX_ALL &&
+                         cf_body_penetration(probe, c, b->x + 3 * i, nrm, 0) > 0;
         fresh |= in != active[i];
         active[i] = in;
     }
@@ -123,7 +119,8 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
         int changed = 0;
         for (size_t i = 0; i < b->nn; i++) {
             double nrm[3];
-            uint8_t in = b->fix[i] != CF_BODY_FIX_ALL && cf_body_penetration(probe, c, b->x + 3 * i, nrm, 0) > 0;
+            uint8_t in = w->touch[i] && b->fix[i] != CF_BODY_FIX_ALL &&
+                         cf_body_penetration(probe, c, b->x + 3 * i, nrm, 0) > 0;
             /* a node at a punch's rim can slide out past the radius and back in as the set
             ** changes; after ten rounds a node in the set stays while it is still pushed */
             if (rounds >= 10 && active[i] && cf_body_penetration(probe, c, b->x + 3 * i, nrm, 1) > 0)
@@ -153,14 +150,88 @@ end:
     return st;
 }
 
+/* Load-step control: the probe's reference point moves from where the body was last solved
+** (w->c_last; at depth 0 before the first solve) to c. When the solve of the whole move fails to
+** converge, the body goes back to where it was and the move is taken in parts, each half the
+** last that failed and twice the last that converged, down to a millionth of the move (at most
+** 200 parts tried). */
+static cf_status solve_cut(cf_body *b, body_work *w, const cf_probe *probe, const double c[3],
+                           double depth_mm, double kp, cf_body_step *out, cf_error *err)
+{
+    const size_t n = 3 * b->nn;
+    const double *c0 = w->has_last ? w->c_last : probe->center_mm;
+    const double d0 = w->has_last ? w->depth_last : 0;
+    cf_error first = {0};
+    if (!w->xs && !(w->xs = malloc(n * sizeof *w->xs)))
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's load steps");
+    memcpy(w->xs, b->x, n * sizeof *w->xs);
+    cf_status st = solve_at(b, w, probe, c, depth_mm, kp, out, &first);
+    if (st != CF_E_NOCONV || (c[0] == c0[0] && c[1] == c0[1] && c[2] == c0[2])) {
+        if (err && st != CF_OK)
+            *err = first;
+        return st;
+    }
+    int iters = out->newton_iters, cuts = 0;
+    double t = 0, h = 0.5;
+    for (int tries = 0; t < 1; tries++) {
+        const double tn = fmin(1, t + h);
+        double ci[3];
+        for (int k = 0; k < 3; k++)
+            ci[k] = tn < 1 ? c0[k] + tn * (c[k] - c0[k]) : c[k];
+        memcpy(b->x, w->xs, n * sizeof *w->xs);
+        cf_error e = {0};
+        st = solve_at(b, w, probe, ci, d0 + tn * (depth_mm - d0), kp, out, &e);
+        iters += out->newton_iters;
+        if (st == CF_OK) {
+            t = tn;
+            memcpy(w->xs, b->x, n * sizeof *w->xs);
+            h *= 2;
+        } else if (st == CF_E_NOCONV && h > 1e-6 && tries < 200) {
+            h *= 0.5;
+            cuts++;
+        } else {
+            memcpy(b->x, w->xs, n * sizeof *w->xs);
+            if (err)
+                *err = st == CF_E_NOCONV ? first : e;
+            if (err && st == CF_E_NOCONV)
+                snprintf(err->msg + strlen(err->msg), sizeof err->msg - strlen(err->msg),
+                         " (also in steps cut %d times, to %g of the move from depth %g mm)",
+                         cuts, h, d0);
+            return st;
+        }
+    }
+    out->newton_iters = iters;
+    return CF_OK;
+}
+
+cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
+                        double penalty_N_per_mm, cf_body_step *out, cf_error *err)
+{
+    const double kp = penalty_N_per_mm > 0 ? penalty_N_per_mm : 1e4 * b->E_MPa * b->mean_edge_mm;
+    double c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = probe->center_mm[k] + depth_mm * probe->dir[k];
+    body_work *w = NULL;
+    cf_status st = cf_body_work_get(b, &w, err);
+    if (st != CF_OK)
+        return st;
+    if ((st = solve_cut(b, w, probe, c, depth_mm, kp, out, err)) == CF_OK) {
+        memcpy(w->c_last, c, sizeof w->c_last);
+        w->depth_last = depth_mm;
+        w->has_last = 1;
+    }
+    return st;
+}
+
 /* The depth, from `now` on, at which the probe first touches a node at its current position
 ** (INFINITY: never). */
 static double touch_depth(const cf_body *b, const cf_probe *pr, double now)
 {
     double dmin = INFINITY;
     const double R = pr->radius_mm;
+    const uint8_t *touch = ((const body_work *)b->work)->touch; /* a solve made the work */
     for (size_t i = 0; i < b->nn; i++) {
-        if (b->fix[i] == CF_BODY_FIX_ALL)
+        if (b->fix[i] == CF_BODY_FIX_ALL || !touch[i])
             continue;
         double r[3], s = 0, r2 = 0;
         for (int a = 0; a < 3; a++) {

@@ -188,7 +188,8 @@ int main(int argc, char **argv)
                     {"long tables", bench_section_longfit},
                     {"fits at the cost of the law", bench_section_fastfit},
                     {"tissue bodies: the probe loop", bench_section_body},
-                    {"output files: a --vtu series", bench_section_output}};
+                    {"output files: a --vtu series", bench_section_output},
+                    {"tissue bodies: Hertz on the finest contact mesh", bench_section_contact}};
     const int nsec = (int)(sizeof sections / sizeof sections[0]);
     for (int k = 0; k < nsec; k++) {
         if (only && !strstr(sections[k].what, only))

@@ -89,5 +89,6 @@ void bench_section_longfit(bench_ctx *ctx);
 void bench_section_fastfit(bench_ctx *ctx);
 void bench_section_body(bench_ctx *ctx);
 void bench_section_output(bench_ctx *ctx);
+void bench_section_contact(bench_ctx *ctx);
 
 #endif
