@@ -106,40 +106,79 @@ static double table_reach(const cf_table *t)
     return reach;
 }
 
-static int table_stable(const cf_cell *cell, const cf_msm_config *cfg, const cf_table *t)
+/* The uniaxial states of table t at the check's strains e (the farthest first) and their lateral
+** stretches lat; 0 when one cannot be reached. */
+static int check_states(const cf_cell *cell, const cf_table *t, double e[CHECK_STEPS],
+                        double lat[CHECK_STEPS], double F[CHECK_STEPS][9])
 {
     const double reach = table_reach(t) * CF_JOINT_STABLE_MARGIN;
-    if (reach == 0)
-        return 1;
-    double e[CHECK_STEPS], lat[CHECK_STEPS];
     for (int j = 0; j < CHECK_STEPS; j++) {
         cf_cell_state st;
-        double lambda = 0;
-        e[j] = reach * (CHECK_STEPS - j) / CHECK_STEPS; /* the farthest first */
+        e[j] = reach * (CHECK_STEPS - j) / CHECK_STEPS;
         if (cf_cell_mode(cell, t->mode, e[j], NULL, &st, NULL) != CF_OK)
             return 0;
-        cf_status s = cf_cell_min_stiffness(cell, st.F, &lambda, NULL);
-        if (s == CF_E_INTERNAL)
-            return -1;
-        if (s != CF_OK || !(lambda > 0))
-            return 0;
         lat[j] = st.F[0];
+        memcpy(F[j], st.F, sizeof F[j]);
+    }
+    return 1;
+}
+
+/* The part of the check for table t (check_states' e, lat and F): part 0 the 2^3 lattice, 1 the
+** cell, 2 the 3^3 lattice (the lattices for a uniaxial table only). 1 stable, 0 not, -1 out of
+** memory. */
+static int check_part(const cf_cell *cell, const cf_msm_config *cfg, const cf_table *t, int part,
+                      const double e[CHECK_STEPS], const double lat[CHECK_STEPS],
+                      double F[CHECK_STEPS][9])
+{
+    if (part == 1) {
+        for (int j = 0; j < CHECK_STEPS; j++) {
+            double lambda = 0;
+            cf_status s = cf_cell_min_stiffness(cell, F[j], &lambda, NULL);
+            if (s == CF_E_INTERNAL)
+                return -1;
+            if (s != CF_OK || !(lambda > 0))
+                return 0;
+        }
+        return 1;
     }
     if (t->mode != CF_MODE_UNIAXIAL)
         return 1;
-    for (int n = 2; n < 2 + LATTICE_CHECK_SIZES; n++) {
-        cf_msm_config k = *cfg;
-        k.lattice.nx = k.lattice.ny = k.lattice.nz = n;
-        k.lattice.bottom = CF_BOTTOM_AXIAL;
-        long neg = -1;
-        cf_status s = cf_msm_homogeneous_inertias(cell->law, CF_LAW_CLOSED, &k, e, lat,
-                                                  CHECK_STEPS, &neg, NULL);
-        if (s == CF_E_INTERNAL)
-            return -1;
-        if (s != CF_OK || neg != 0)
+    cf_msm_config k = *cfg;
+    k.lattice.nx = k.lattice.ny = k.lattice.nz = part == 0 ? 2 : 3;
+    k.lattice.bottom = CF_BOTTOM_AXIAL;
+    long neg = -1;
+    cf_status s = cf_msm_homogeneous_inertias(cell->law, CF_LAW_CLOSED, &k, e, lat, CHECK_STEPS,
+                                              &neg, NULL);
+    if (s == CF_E_INTERNAL)
+        return -1;
+    return s == CF_OK && neg == 0;
+}
+
+/* The check on the n tables, part after part over all of them (the 2^3 lattice, the most slender
+** and the first to buckle, then the cell, then the 3^3 lattice), so a point that fails usually
+** fails at the first part; the verdict is the same in any order. */
+static int tables_stable(const cf_cell *cell, const cf_msm_config *cfg, const cf_table *const *t,
+                         size_t n)
+{
+    double e[CF_JOINT_MAX][CHECK_STEPS], lat[CF_JOINT_MAX][CHECK_STEPS];
+    double F[CF_JOINT_MAX][CHECK_STEPS][9];
+    for (size_t k = 0; k < n && k < CF_JOINT_MAX; k++)
+        if (table_reach(t[k]) != 0 && !check_states(cell, t[k], e[k], lat[k], F[k]))
             return 0;
-    }
+    for (int part = 0; part < 3; part++)
+        for (size_t k = 0; k < n && k < CF_JOINT_MAX; k++) {
+            if (table_reach(t[k]) == 0)
+                continue;
+            const int r = check_part(cell, cfg, t[k], part, e[k], lat[k], F[k]);
+            if (r != 1)
+                return r;
+        }
     return 1;
+}
+
+static int table_stable(const cf_cell *cell, const cf_msm_config *cfg, const cf_table *t)
+{
+    return tables_stable(cell, cfg, &t, 1);
 }
 
 int cf_joint_lattice_stable(const cf_law *law, const double weight[CF_FAMILY_COUNT],
@@ -153,12 +192,7 @@ int cf_joint_lattice_stable(const cf_law *law, const double weight[CF_FAMILY_COU
     cf_msm_config cfg = lat->cfg;
     memcpy(cfg.lattice.weight, weight, sizeof cfg.lattice.weight);
     cfg.lattice.volume_modulus_MPa = kappa_MPa;
-    for (size_t k = 0; k < n; k++) {
-        const int r = table_stable(&cell, &cfg, t[k]);
-        if (r != 1)
-            return r;
-    }
-    return 1;
+    return tables_stable(&cell, &cfg, t, n);
 }
 
 /* 1 when the lattice of the curve's law at (rho, B) (the context's extension spring and kappa, at
