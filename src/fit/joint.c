@@ -73,8 +73,8 @@ static int conical_stable(jctx *c, const double *z)
 ** stable point nearest it on the segment to each of the (up to CONICAL_STABLE_RESTARTS) best
 ** stable ends, BOBYQA under the stability check; the best of them into zb and *best. None stable:
 ** zb stays (the verification reports the loss). */
-#define CONICAL_STABLE_RESTARTS 4
-#define CONICAL_STABLE_BISECT 8
+#define CONICAL_STABLE_RESTARTS 8
+#define CONICAL_STABLE_BISECT 12
 static void conical_keep_stable(jctx *c, int nz, const double *lb, const double *ub,
                                 double ends[][3], double *fends, int nends, double zb[3],
                                 double *best, cf_joint_result *r)

@@ -22,9 +22,9 @@
 #define PAIR_MAX_EVALS 1500
 /* the pair's starts (at most), and the searches kept to stable lattices from their ends */
 #define MAX_PAIR_STARTS 32
-#define STABLE_RESTARTS 6
+#define STABLE_RESTARTS 8
 #define STABLE_SAME 1e-3
-#define STABLE_BISECT_SEGMENT 8
+#define STABLE_BISECT_SEGMENT 12
 #define STABLE_MAX_EVALS 500
 /* the tailed compression spring's tau (its tail's coils over the cone's): the search's range, and
 ** the value held through the starts and the searches kept to stable lattices */

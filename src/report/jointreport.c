@@ -221,6 +221,9 @@ static void value_se(char *buf, size_t cap, double v, double se, double scale, c
                  unit[0] ? " " : "", unit);
 }
 
+/* CF_JOINT_NU_MAX (joint.h) as the report states it */
+#define NU_MAX_TEXT "0.499"
+
 static const char *volume_how(cf_volume v)
 {
     switch (v) {
@@ -254,8 +257,8 @@ static void pair_volume_text(FILE *o, const cf_joint_result *j)
             snprintf(k, sizeof k, "%.6g kPa", j->volume_modulus_MPa * 1e3);
         fprintf(o, " volume term (kappa/2)(J - 1)^2 per cell: kappa %s (%s%s)\n", k,
                 volume_how(j->volume),
-                j->volume == CF_VOLUME_FIT ? ", bounded to the kappa of small-strain nu 0.499 "
-                                             "in the compression spring's lattice"
+                j->volume == CF_VOLUME_FIT ? ", at most the kappa of small-strain nu " NU_MAX_TEXT
+                                             " in the compression spring's lattice"
                                            : "");
     }
     if (j->pair || j->volume != CF_VOLUME_NONE)
@@ -290,6 +293,11 @@ static void stability_text(FILE *o, const cf_joint_report *r, const cf_joint_res
                    "2^3 and 3^3 cells free of negative pivots, at 8 strains from 0 to %.2fx each "
                    "table's farthest strain: the search's own check)\n",
                 CF_JOINT_STABLE_MARGIN);
+    /* what the search tried */
+    fprintf(o, "  search: %d starts, %d stable end%s, %d restart%s kept to lattices stable to "
+               "%.2fx each table's farthest strain\n",
+            j->starts, j->stable_ends, j->stable_ends == 1 ? "" : "s", j->restarts,
+            j->restarts == 1 ? "" : "s", CF_JOINT_STABLE_MARGIN);
 }
 
 char *cf_joint_text(const cf_joint_report *r)
@@ -360,10 +368,6 @@ char *cf_joint_text(const cf_joint_report *r)
                     jt->points, a, b, c);
         }
         stability_text(o, r, j);
-        fprintf(o, "  search: %d starts, %d stable end%s, %d restart%s kept to lattices stable "
-                   "to %.2fx each table's farthest strain\n",
-                j->starts, j->stable_ends, j->stable_ends == 1 ? "" : "s", j->restarts,
-                j->restarts == 1 ? "" : "s", CF_JOINT_STABLE_MARGIN);
         fprintf(o, "  (* homogenised cell: the full lattice has no such boundary conditions; "
                    "%ld cell curves, %.3f s)\n",
                 j->evaluations, j->wall_time_s);
