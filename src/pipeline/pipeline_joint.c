@@ -171,14 +171,8 @@ static cf_status with_volume(const cf_table *const *tables, size_t n,
         memset(plain, 0, sizeof *plain);
         return st;
     }
-    /* a volume term whose lattice is unstable at rest models no solid: the conical law without
-    ** it (kappa 0, which the fit contains) is kept, the fitted one freed */
-    if (!cf_joint_stable_at_rest(&r->fits[k]) && cf_joint_stable_at_rest(plain)) {
-        cf_joint_result v = r->fits[k];
-        r->fits[k] = *plain;
-        *plain = v;
-        r->volume_dropped[k] = 1;
-    }
+    /* a volume term whose lattice is unstable at rest where kappa 0's is not came back as kappa
+    ** 0 (cf_joint_fit_pair: the fit contains it and it ranks above) */
     return st;
 }
 

@@ -255,6 +255,11 @@ static void pair_volume_text(FILE *o, const cf_joint_result *j)
                  j->volume == CF_VOLUME_FIT ? j->volume_modulus_se : 0, 1e3, "kPa");
         if (j->volume != CF_VOLUME_FIT)
             snprintf(k, sizeof k, "%.6g kPa", j->volume_modulus_MPa * 1e3);
+        if (!j->pair && j->volume == CF_VOLUME_FIT && j->volume_modulus_MPa == 0 &&
+            j->nested_objective > 0)
+            fprintf(o, " volume term: kappa 0, the law without it, which the fit contains, ranks "
+                       "above what its search ended on (objective %.4g)\n",
+                    j->nested_objective);
         fprintf(o, " volume term (kappa/2)(J - 1)^2 per cell: kappa %s (%s%s)\n", k,
                 volume_how(j->volume),
                 j->volume == CF_VOLUME_FIT ? ", at most the kappa of small-strain nu " NU_MAX_TEXT

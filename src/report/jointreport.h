@@ -40,8 +40,6 @@ typedef struct cf_joint_report {
     cf_joint_result fits[2];
     cf_joint_law_choice law_choice[2];
     cf_law_kind law;          /* the law asked for (--law) */
-    int volume_dropped[2];    /* 1: the fitted volume term's lattice was unstable at rest, so the
-                              ** type's fit is the conical law without it (kappa 0) */
     int with_timing;            /* 0: wall times written as 0 */
 } cf_joint_report;
 

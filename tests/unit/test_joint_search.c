@@ -250,6 +250,34 @@ static void kappa_bounded_and_stable_at_rest(void **state)
         cf_table_free(&t[k]);
 }
 
+/* The better type: a lattice unstable at rest never, even with the lower objective and a
+** buildable spring against one that buckles inside a table's range or cannot be built. */
+static void unstable_at_rest_is_never_better(void **state)
+{
+    (void)state;
+    for (int other_feasible = 0; other_feasible < 2; other_feasible++) {
+        cf_joint_report r;
+        memset(&r, 0, sizeof r);
+        r.nfits = 2;
+        for (int i = 0; i < 2; i++) {
+            cf_joint_result *j = &r.fits[i];
+            j->ntables = 1;
+            j->tab[0].stability_checked = 1;
+            j->tab[0].stable_in_range = 0;
+        }
+        r.fits[0].fit.feasible = 1; /* unstable at rest, the lower objective */
+        r.fits[0].objective = 0.01;
+        r.fits[0].tab[0].stable_to = 0;
+        r.fits[0].tab[0].unstable_at_rest = 1;
+        r.fits[1].fit.feasible = other_feasible; /* buckles at 5 % */
+        r.fits[1].objective = 0.1;
+        r.fits[1].tab[0].stable_to = 0.05;
+        assert_false(cf_joint_stable_at_rest(&r.fits[0]));
+        assert_true(cf_joint_stable_at_rest(&r.fits[1]));
+        assert_int_equal(cf_joint_better(&r), 1);
+    }
+}
+
 /* ---- nested laws never lose, and the brain-like Ogden solids ---- */
 
 /* 1 when a ranks at or above b on the tiers before the objective (a buildable spring, then a
@@ -327,6 +355,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(boundary_point_is_rejected),
+        cmocka_unit_test(unstable_at_rest_is_never_better),
         cmocka_unit_test(kappa_bounded_and_stable_at_rest),
         cmocka_unit_test(brain_like_ogden_solids),
     };
