@@ -234,14 +234,15 @@ static int rows_stable(const char *csv, double *lost)
 }
 
 /* The kept fit (a scene naming it: the better type's pair and kappa) in the full lattice of 2^3
-** and 3^3 cells over each uniaxial table's whole range (10 % compression, 10 % extension):
-** every row stable, as the fit's verdict says. */
+** and 3^3 cells over 1.05 times each uniaxial table's whole range (10.5 % compression and
+** extension: the joint fit's stability margin, issue 42): every row stable, as the fit's verdict
+** says. Before the margin the kept lattice buckled at 10.1 % compression. */
 static void kept_fit_stable_in_lattice(const char *dir, const char *json)
 {
     char scene[300], csv[300], text[1024];
     snprintf(scene, sizeof scene, "%s/stab_scene.json", dir);
     snprintf(csv, sizeof csv, "%s/stab_scene.csv", dir);
-    const double strain[2] = {0.1, -0.1}; /* compression positive, then tension */
+    const double strain[2] = {0.105, -0.105}; /* compression positive, then tension */
     for (int n = 2; n <= 3; n++)
         for (int i = 0; i < 2; i++) {
             snprintf(text, sizeof text,
@@ -259,7 +260,7 @@ static void kept_fit_stable_in_lattice(const char *dir, const char *json)
             assert_true(rows >= 50);
             if (!isnan(lost))
                 fail_msg("the kept brain fit's %d^3 lattice is unstable from strain %g, inside "
-                         "the table's range %g (the fit said it was stable)",
+                         "1.05x the table's range, %g (the fit said it was stable)",
                          n, lost, strain[i]);
             remove(csv);
         }
