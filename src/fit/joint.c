@@ -73,27 +73,43 @@ static int conical_stable(jctx *c, const double *z)
 ** stable point nearest it on the segment to each of the (up to CONICAL_STABLE_RESTARTS) best
 ** stable ends, BOBYQA under the stability check; the best of them into zb and *best. None stable:
 ** zb stays (the verification reports the loss). */
-#define CONICAL_STABLE_RESTARTS 3
+#define CONICAL_STABLE_RESTARTS 8
 #define CONICAL_STABLE_BISECT 12
 static void conical_keep_stable(jctx *c, int nz, const double *lb, const double *ub,
                                 double ends[][3], double *fends, int nends, double zb[3],
-                                double *best)
+                                double *best, cf_joint_result *r)
 {
-    if (!(*best < CF_LSQ_HUGE_OBJ) || conical_stable(c, zb))
+    if (!(*best < CF_LSQ_HUGE_OBJ))
         return;
+    if (conical_stable(c, zb)) {
+        r->stable_ends = 1;
+        return;
+    }
     double sb = CF_LSQ_HUGE_OBJ, zs[3] = {0, 0, 0};
     for (int tries = 0; tries < CONICAL_STABLE_RESTARTS; tries++) {
         int pick = -1;
         for (int i = 0; i < nends; i++)
-            if (fends[i] < CF_LSQ_HUGE_OBJ && (pick < 0 || fends[i] < fends[pick]))
+            if (fends[i] >= 0 && fends[i] < CF_LSQ_HUGE_OBJ &&
+                (pick < 0 || fends[i] < fends[pick]))
                 pick = i;
         if (pick < 0)
             break;
         fends[pick] = CF_LSQ_HUGE_OBJ; /* tried */
-        if (!conical_stable(c, ends[pick])) {
+        int same = 0; /* an end the search has already restarted from (within 1e-3 of the box) */
+        for (int t = 0; t < nends && !same; t++) {
+            if (t == pick || fends[t] != -1.0)
+                continue;
+            same = 1;
+            for (int j = 0; j < nz && same; j++)
+                same = fabs(ends[pick][j] - ends[t][j]) <= 1e-3 * (ub[j] - lb[j]);
+        }
+        if (same || !conical_stable(c, ends[pick])) {
             tries--;
             continue;
         }
+        fends[pick] = -1.0; /* restarted from */
+        r->stable_ends++;
+        r->restarts++;
         double z[3] = {0, 0, 0}, lo = 0, hi = 1, f = CF_LSQ_HUGE_OBJ;
         for (int b = 0; b < CONICAL_STABLE_BISECT; b++) {
             const double mid = 0.5 * (lo + hi);
@@ -128,6 +144,14 @@ int cf_joint_stable(const cf_joint_result *r)
 {
     for (size_t k = 0; k < r->ntables && k < CF_JOINT_MAX; k++)
         if (r->tab[k].stability_checked && !r->tab[k].stable_in_range)
+            return 0;
+    return 1;
+}
+
+int cf_joint_stable_at_rest(const cf_joint_result *r)
+{
+    for (size_t k = 0; k < r->ntables && k < CF_JOINT_MAX; k++)
+        if (r->tab[k].stability_checked && r->tab[k].unstable_at_rest)
             return 0;
     return 1;
 }
@@ -186,7 +210,8 @@ static cf_status search_conical(jctx *c, const cf_table *reach, double xmax, cf_
         }
     /* an optimum whose full lattice buckles inside a uniaxial table's range: the search again,
     ** kept to stable lattices, as the pair's (joint_pair.c) */
-    conical_keep_stable(c, nz, lb, ub, ends, fends, nends, zb, &best);
+    r->starts = (c->fit_weights ? 2 : 1) * 9;
+    conical_keep_stable(c, nz, lb, ub, ends, fends, nends, zb, &best, r);
     if (c->pr.oom)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory in the joint fit's optimiser "
                                                 "(NLopt)");
@@ -431,6 +456,114 @@ cf_status cf_joint_pair_determined(const cf_table *const *tables, size_t n, cf_e
                         ext ? "tension" : "compression");
 }
 
+/* 1 when the fit a ranks above b: a lattice stable at rest, a buildable spring, a lattice stable
+** over every table's range, then the lower objective, in that order. */
+static int ranks_above(const cf_joint_result *a, const cf_joint_result *b)
+{
+    const int ra = cf_joint_stable_at_rest(a), rb = cf_joint_stable_at_rest(b);
+    if (ra != rb)
+        return ra;
+    if ((a->fit.feasible != 0) != (b->fit.feasible != 0))
+        return a->fit.feasible != 0;
+    if (cf_joint_stable(a) != cf_joint_stable(b))
+        return cf_joint_stable(a);
+    return a->objective * (1 + 1e-9) < b->objective;
+}
+
+/* A deep copy of r into *to (its per-table curves its own). CF_E_INTERNAL when memory runs out. */
+static cf_status copy_result(const cf_joint_result *r, cf_joint_result *to, cf_error *err)
+{
+    *to = *r;
+    for (size_t k = 0; k < CF_JOINT_MAX; k++)
+        to->tab[k].lattice_MPa = NULL;
+    for (size_t k = 0; k < r->ntables && k < CF_JOINT_MAX; k++) {
+        const size_t m = r->tab[k].points;
+        if (!r->tab[k].lattice_MPa)
+            continue;
+        to->tab[k].lattice_MPa = malloc(m * sizeof(double));
+        if (!to->tab[k].lattice_MPa) {
+            cf_joint_free(to);
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory");
+        }
+        memcpy(to->tab[k].lattice_MPa, r->tab[k].lattice_MPa, m * sizeof(double));
+    }
+    return CF_OK;
+}
+
+/* Nested laws never lose: the law a pair search fits (pair 0 the volume term, 1 the pair, 2 the
+** pair with a tailed compression spring) contains plain's (kappa 0; two equal springs; a tail of
+** no coils) when plain has the same volume treatment (for pair 0: none, the term fitted). When
+** the search found nothing (st not CF_OK) or plain ranks above what it found (ranks_above),
+** the result is plain's optimum in the form of the law asked for, with the same lattice, curves
+** and stability, and nested_objective what the search ended on. */
+static cf_status nest_pair(const cf_joint_result *plain, int pair, const cf_fit_options *opt,
+                           cf_status st, cf_joint_result *r, cf_error *err)
+{
+    const int contained =
+        plain && (pair == 0   ? plain->volume == CF_VOLUME_NONE && opt->volume == CF_VOLUME_FIT
+                  : pair == 1 ? !plain->pair && plain->volume == opt->volume
+                              : plain->pair == 1 && !plain->fit.tail &&
+                                    plain->volume == opt->volume);
+    if (!contained || !(plain->objective >= 0) || !isfinite(plain->objective))
+        return st;
+    const int found = st == CF_OK;
+    if (found && !ranks_above(plain, r))
+        return CF_OK;
+    cf_joint_result nest;
+    cf_status cs = copy_result(plain, &nest, err);
+    if (cs != CF_OK) {
+        if (found)
+            cf_joint_free(r);
+        return cs;
+    }
+    nest.nested_objective = found && isfinite(r->objective) ? r->objective : 0;
+    nest.fit.nested_rmse = found && isfinite(r->fit.rmse) ? r->fit.rmse : 0;
+    nest.fit.nested_violated = found && !r->fit.feasible ? r->fit.violated | r->ext.violated : 0;
+    if (pair == 0) { /* the term at kappa 0 */
+        nest.volume = CF_VOLUME_FIT;
+        nest.volume_modulus_MPa = 0;
+        nest.volume_modulus_se = -1;
+        nest.nparams = (plain->nparams ? plain->nparams : 3) + 1;
+    } else if (pair == 1) { /* two equal springs */
+        nest.pair = 1;
+        nest.ext = plain->fit;
+        nest.ext.ident = plain->ident;
+        nest.nparams = 6 + (opt->volume == CF_VOLUME_FIT);
+    } else { /* the compression spring's tail of no coils */
+        nest.fit.tail = 1;
+        nest.fit.q[CF_Q_TAIL] = 0;
+        nest.fit.q_se[CF_Q_TAIL] = 0;
+        nest.fit.interval_ok[CF_Q_TAIL] = 0;
+        nest.fit.params.n_tail = 0;
+        nest.fit.params.H_tail_mm = 0;
+        nest.nparams = plain->nparams + 1;
+    }
+    size_t total = 0;
+    for (size_t k = 0; k < nest.ntables; k++)
+        total += nest.tab[k].points;
+    nest.aic = cf_baseline_aic(total, nest.objective, nest.nparams, 1.0);
+    if (!(nest.E_compression_MPa > 0)) { /* the single-sided lattice's small-strain moduli */
+        jctx m;
+        memset(&m, 0, sizeof m);
+        memcpy(m.weight, nest.weight, sizeof m.weight);
+        m.pair = nest.pair;
+        const double v[PQ_COUNT] = {nest.ident.rho,  nest.ident.solid, nest.ident.scale,
+                                    nest.ident.rho,  nest.ident.solid, nest.ident.scale,
+                                    nest.volume_modulus_MPa, 0};
+        cf_joint_small_strain_moduli(&m, v, &nest);
+    }
+    if (found) {
+        nest.evaluations = r->evaluations;
+        nest.wall_time_s = r->wall_time_s;
+        nest.starts = r->starts, nest.stable_ends = r->stable_ends, nest.restarts = r->restarts;
+        cf_joint_free(r);
+    }
+    *r = nest;
+    if (err)
+        memset(err, 0, sizeof *err);
+    return CF_OK;
+}
+
 cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fit_options *opt,
                             const cf_validate_setup *lat, cf_spring_type type, int pair,
                             const cf_joint_result *plain, cf_joint_result *r, cf_error *err)
@@ -460,7 +593,10 @@ cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fi
                                 "an axis and the volume term only raises it (up to 0.5)",
                                 opt->volume_value, nu0);
     }
-    return joint_run(tables, n, opt, lat, type, plain, pair, r, err);
+    cf_status st = joint_run(tables, n, opt, lat, type, plain, pair, r, err);
+    if (st == CF_E_INTERNAL)
+        return st;
+    return nest_pair(plain, pair, opt, st, r, err);
 }
 
 cf_status cf_joint_fit_tail(const cf_table *const *tables, size_t n, const cf_fit_options *opt,

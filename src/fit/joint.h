@@ -27,6 +27,13 @@
 
 /* Most tables in one joint fit. */
 #define CF_JOINT_MAX 16
+/* A joint fit's lattice must stay stable to this factor times each table's farthest strain: a
+** simulator that presses a little further than the test did must not meet a buckled lattice. */
+#define CF_JOINT_STABLE_MARGIN 1.05
+/* A fitted volume modulus is a material's, not a free knob: at most the kappa that gives the
+** lattice of the compression spring this small-strain Poisson's ratio along an axis
+** (cf_cubic_kappa_of_nu); a stiffer term models no tissue and makes the lattice ill-conditioned. */
+#define CF_JOINT_NU_MAX 0.499
 
 typedef struct cf_joint_table {
     cf_mode mode;
@@ -48,6 +55,9 @@ typedef struct cf_joint_table {
     ** (table sign) */
     int stability_checked, stable_in_range, lattice_checked;
     double stable_to;
+    /* 1: the lattice is unstable at rest already (stable_to under a thousandth of the range):
+    ** never the better type nor the law kept over one that is not */
+    int unstable_at_rest;
 } cf_joint_table;
 
 typedef struct cf_joint_result {
@@ -85,6 +95,10 @@ typedef struct cf_joint_result {
     ** none, or the fit is its own); fit.nested_rmse and fit.nested_violated as for one table
     ** (fit.h). */
     double nested_objective;
+    /* What the search tried: its starts (grid and space-filling), the ends of those whose lattice
+    ** passed the stability check, and the searches restarted under the check (from each stable
+    ** end and from the nearest stable point towards the unconstrained optimum). */
+    int starts, stable_ends, restarts;
 } cf_joint_result;
 
 /* Fits the n tables jointly with spring type `type` in the lattice of `lat` (its calibration:
@@ -138,10 +152,24 @@ cf_status cf_joint_fit_pair(const cf_table *const *tables, size_t n, const cf_fi
 ** cf_joint_fit_pair makes first): CF_OK, or CF_E_DATA with its message. */
 cf_status cf_joint_pair_determined(const cf_table *const *tables, size_t n, cf_error *err);
 
-/* Releases the per-table curves. Safe on a zeroed result. */
 /* 1 unless a table's stability check (cf_joint_table) found the lattice losing stability inside
-** that table's range. */
+** that table's range (to CF_JOINT_STABLE_MARGIN times its farthest strain). */
 int cf_joint_stable(const cf_joint_result *r);
+/* 1 unless a table's check found the lattice unstable at rest (cf_joint_table.unstable_at_rest). */
+int cf_joint_stable_at_rest(const cf_joint_result *r);
+
+/* The joint fit's one stability check, which its search applies to every point it keeps and its
+** verification to the placed springs: the lattice of law (a pair through law's extension), family
+** weights weight and volume modulus kappa (MPa), in lat's lattice, for each of the n tables the
+** homogenised cell's incremental stiffness positive definite and, for a uniaxial table, the full
+** lattices of 2^3 and 3^3 cells with a sliding bottom free of negative pivots, at 8 strains
+** evenly from 0 to CF_JOINT_STABLE_MARGIN times the table's farthest strain. 1 stable, 0 not, -1
+** out of memory. */
+int cf_joint_lattice_stable(const cf_law *law, const double weight[CF_FAMILY_COUNT],
+                            double kappa_MPa, const cf_validate_setup *lat,
+                            const cf_table *const *t, size_t n);
+
+/* Releases the per-table curves. Safe on a zeroed result. */
 
 void cf_joint_free(cf_joint_result *r);
 

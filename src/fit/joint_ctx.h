@@ -49,6 +49,8 @@ typedef struct jctx {
     ** lattice is stable there (joint_stable_at); stab_on 0: no such check */
     int stab_on;
     double stab_best;
+    /* a fitted kappa's bound over the compression spring's k0/H (CF_JOINT_NU_MAX; 0: none) */
+    double kappa_rel_max;
 } jctx;
 
 /* How a curve's volume modulus is set (jctx.kappa_mode): none; kappa/(k0/H) of the compression

@@ -22,7 +22,8 @@
 #define PAIR_MAX_EVALS 1500
 /* the pair's starts (at most), and the searches kept to stable lattices from their ends */
 #define MAX_PAIR_STARTS 32
-#define STABLE_RESTARTS 3
+#define STABLE_RESTARTS 8
+#define STABLE_SAME 1e-3
 #define STABLE_BISECT_SEGMENT 12
 #define STABLE_MAX_EVALS 500
 /* the tailed compression spring's tau (its tail's coils over the cone's): the search's range, and
@@ -95,7 +96,24 @@ typedef struct pair_search {
     double best, zb[8];
     double ends[MAX_PAIR_STARTS][8], fends[MAX_PAIR_STARTS];
     int nends;
+    int starts, stable_ends, restarts; /* what the search tried (cf_joint_result) */
+    int tried[MAX_PAIR_STARTS], ntried; /* the ends restarted from */
 } pair_search;
+
+/* 1 when end i lies within STABLE_SAME (in every search variable, relative to its box) of an end
+** already restarted from. */
+static int same_end(const pvars *pv, const pair_search *s, int i)
+{
+    for (int t = 0; t < s->ntried; t++) {
+        int same = 1;
+        for (int j = 0; j < pv->n && same; j++)
+            same = fabs(s->ends[i][j] - s->ends[s->tried[t]][j]) <=
+                   STABLE_SAME * (pv->ub[j] - pv->lb[j]);
+        if (same)
+            return 1;
+    }
+    return 0;
+}
 
 /* 1 when BOBYQA's end res is a point to keep (converged, or out of curves). */
 static int search_ended(nlopt_result res)
@@ -133,7 +151,10 @@ static cf_status pair_box(jctx *c, double xmax, pvars *pv, cf_error *err)
     }
     if (opt->volume == CF_VOLUME_FIT) {
         pv->ik = pv->n;
-        pv->lb[pv->n] = log(1e-5), pv->ub[pv->n++] = log(1e4);
+        /* kappa/(k0/H) at most the one of nu CF_JOINT_NU_MAX (the weights as they start) */
+        const double kmax = cf_cubic_kappa_of_nu(c->weight, 1.0, CF_JOINT_NU_MAX);
+        pv->lb[pv->n] = log(1e-5), pv->ub[pv->n++] = log(fmin(1e4, fmax(kmax, 1e-4)));
+        c->kappa_rel_max = exp(pv->ub[pv->n - 1]);
         c->kappa_mode = KAPPA_REL;
     } else if (opt->volume == CF_VOLUME_MODULUS) {
         pv->iA = pv->n;
@@ -157,6 +178,52 @@ static cf_status pair_box(jctx *c, double xmax, pvars *pv, cf_error *err)
     return CF_OK;
 }
 
+/* The fitted kappa of the law a search contains (plain) over its compression spring's k0/H (the
+** search's variable, KAPPA_REL); 0 when it has none. */
+static double nest_kappa_rel(const cf_joint_result *plain)
+{
+    if (plain->volume != CF_VOLUME_FIT || !(plain->volume_modulus_MPa > 0) ||
+        !(plain->ident.scale > 0))
+        return 0;
+    const cf_ident q1 = {.rho = plain->ident.rho, .solid = plain->ident.solid, .scale = 1.0};
+    const cf_spring p1 = cf_ident_member(&q1);
+    cf_law l1;
+    if (cf_law_init(&l1, &p1, NULL) != CF_OK)
+        return 0;
+    return plain->volume_modulus_MPa / (plain->ident.scale * l1.k0_N_per_mm / l1.p.H_mm);
+}
+
+/* The tailed pair contains the conical pair plain (a tail of no coils): plain's optimum, its tail
+** at the search's shortest, replaces the best point when it is lower (and, after a search kept
+** to stable lattices, stable), so the last search starts from it. */
+static void tail_nest_start(jctx *c, const cf_joint_result *plain, pair_search *s)
+{
+    const pvars *pv = &s->pv;
+    if (!plain || !plain->pair || pv->it < 0 || pv->ie < 0)
+        return;
+    double z[8] = {0};
+    z[0] = log(plain->ident.rho), z[1] = plain->ident.solid;
+    z[pv->ie] = log(plain->ext.ident.rho), z[pv->ie + 1] = plain->ext.ident.solid;
+    z[pv->ie + 2] = log(plain->ext.ident.scale / plain->ident.scale);
+    if (pv->ik >= 0) {
+        const double k = nest_kappa_rel(plain);
+        z[pv->ik] = log(k > 0 ? k : 1e-5);
+    }
+    if (pv->iA >= 0)
+        z[pv->iA] = log(plain->ident.scale);
+    if (pv->iq >= 0)
+        z[pv->iq] = log(plain->weight[1] / plain->weight[0]);
+    z[pv->it] = log(TAU_LO);
+    for (int j = 0; j < pv->n; j++)
+        z[j] = isfinite(z[j]) ? fmin(fmax(z[j], pv->lb[j]), pv->ub[j]) : pv->lb[j];
+    c->stab_best = CF_LSQ_HUGE_OBJ;
+    const double f = pair_objective((unsigned)pv->n, z, NULL, (void *)&s->o);
+    if (f < s->best) {
+        s->best = f;
+        memcpy(s->zb, z, sizeof s->zb);
+    }
+}
+
 /* Step 2: BOBYQA from every start, the best end into s->best and s->zb and every end kept. The
 ** starts: the compression spring at plain's quantities (or the middle of the box) and on a coarse
 ** grid; the extension spring from a near-cylinder (linear) to a strong cone. The pair contains
@@ -171,22 +238,31 @@ static cf_status pair_starts(jctx *c, const cf_joint_result *plain, pair_search 
     const double A0 = plain ? plain->ident.scale : 0;
     const double grid_rc[2] = {rc0, 0.1}, grid_re[3] = {0.9, 0.5, 0.15},
                  grid_be[2] = {0.25, 0.7}, grid_k[2] = {0.3, 3.0};
-    const int nre = c->pair ? (plain && !c->tail ? 4 : 3) : 1, nbe = c->pair ? 2 : 1,
+    /* the law this one contains: the single-sided law (two equal springs) for the pair, the
+    ** conical pair for the tailed one; its optimum is a start, its kappa too when it has one */
+    const int nest = plain && (c->tail ? plain->pair : !plain->pair);
+    const int nre = c->pair ? (nest ? 4 : 3) : 1, nbe = c->pair ? 2 : 1,
               nk = pv->ik >= 0 ? 2 : 1;
+    const double k_nest = nest && pv->ik >= 0 ? nest_kappa_rel(plain) : 0;
     s->best = CF_LSQ_HUGE_OBJ;
     memset(s->zb, 0, sizeof s->zb);
     s->nends = 0;
+    s->starts = s->stable_ends = s->restarts = s->ntried = 0;
     c->stab_on = 0;
     for (int gc = 0; gc < 2; gc++)
         for (int ge = 0; ge < nre; ge++)
             for (int gb = 0; gb < nbe; gb++)
                 for (int gk = 0; gk < nk; gk++) {
                     double z[8];
-                    if (ge == 3 && (gc != 0 || gb != 0))
+                    if (ge == 3 && (gc != 0 || gb != 0 || (k_nest > 0 && gk != 0)))
                         continue;
                     z[0] = log(grid_rc[gc]);
                     z[1] = gc == 0 ? bc0 : pv->lb[1] + 0.3 * (pv->ub[1] - pv->lb[1]);
-                    if (pv->ie >= 0 && ge == 3) {
+                    if (pv->ie >= 0 && ge == 3 && plain->pair) {
+                        z[pv->ie] = log(plain->ext.ident.rho);
+                        z[pv->ie + 1] = plain->ext.ident.solid;
+                        z[pv->ie + 2] = log(plain->ext.ident.scale / plain->ident.scale);
+                    } else if (pv->ie >= 0 && ge == 3) {
                         z[pv->ie] = z[0], z[pv->ie + 1] = z[1], z[pv->ie + 2] = 0;
                     } else if (pv->ie >= 0) {
                         z[pv->ie] = log(grid_re[ge]);
@@ -194,7 +270,7 @@ static cf_status pair_starts(jctx *c, const cf_joint_result *plain, pair_search 
                         z[pv->ie + 2] = log(0.5);
                     }
                     if (pv->ik >= 0)
-                        z[pv->ik] = log(grid_k[gk]);
+                        z[pv->ik] = log(ge == 3 && k_nest > 0 ? k_nest : grid_k[gk]);
                     if (pv->iA >= 0)
                         z[pv->iA] = log(A0 > 0 ? A0 : 1e-3);
                     if (pv->iq >= 0)
@@ -215,6 +291,7 @@ static cf_status pair_starts(jctx *c, const cf_joint_result *plain, pair_search 
                             memcpy(s->zb, z, sizeof s->zb);
                         }
                     }
+                    s->starts++;
                     nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)pv->n,
                                                       pv->lb, pv->ub, step, XTOL_REL,
                                                       PAIR_MAX_EVALS, pair_objective,
@@ -235,16 +312,22 @@ static cf_status pair_starts(jctx *c, const cf_joint_result *plain, pair_search 
     return CF_OK;
 }
 
-/* Step 3: an optimum whose full lattice buckles inside a uniaxial table's range: the search again,
-** kept to stable lattices, from the stable point nearest the optimum on the segment to each of
-** the best (up to STABLE_RESTARTS) starts' ends that are stable. None stable: the optimum stays,
-** and the verification reports the loss. c->stab_on says afterwards whether the search kept to
-** stable lattices. */
+/* Step 3: an optimum whose lattice fails the joint fit's stability check (the verification's,
+** cf_joint_lattice_stable): the search again, kept to stable lattices, from the stable point
+** nearest the optimum on the segment to each starts' end that is stable, best first (ends within
+** STABLE_SAME of one already restarted from are the same end), at most STABLE_RESTARTS. None
+** stable: the optimum stays, and the verification reports the loss. c->stab_on says afterwards
+** whether the search kept to stable lattices. */
 static cf_status pair_keep_stable(jctx *c, pair_search *s, cf_error *err)
 {
     const pvars *pv = &s->pv;
-    if (!(s->best < CF_LSQ_HUGE_OBJ) || z_stable(c, pv, s->zb))
+    if (!(s->best < CF_LSQ_HUGE_OBJ))
         return CF_OK;
+    if (z_stable(c, pv, s->zb)) { /* the later steps keep to stable lattices too */
+        s->stable_ends = 1;
+        c->stab_on = 1;
+        return CF_OK;
+    }
     double sb = CF_LSQ_HUGE_OBJ, zs[8] = {0};
     for (int tries = 0; tries < STABLE_RESTARTS; tries++) {
         int pick = -1;
@@ -254,10 +337,13 @@ static cf_status pair_keep_stable(jctx *c, pair_search *s, cf_error *err)
         if (pick < 0)
             break;
         s->fends[pick] = CF_LSQ_HUGE_OBJ; /* tried */
-        if (!z_stable(c, pv, s->ends[pick])) {
+        if (!z_stable(c, pv, s->ends[pick]) || same_end(pv, s, pick)) {
             tries--;
             continue;
         }
+        s->stable_ends++;
+        s->restarts++;
+        s->tried[s->ntried++] = pick;
         /* from the stable point nearest the optimum on the segment to this end */
         double z[8], step[8], f = CF_LSQ_HUGE_OBJ, lo = 0, hi = 1;
         for (int b = 0; b < STABLE_BISECT_SEGMENT; b++) {
@@ -476,6 +562,7 @@ cf_status cf_joint_search_pair(jctx *c, const cf_table *reach, double xmax,
     if (c->tail) {
         s.pv = full;
         s.zb[full.it] = log(TAU_HELD);
+        tail_nest_start(c, plain, &s);
     }
     pair_last_search(c, &s);
     /* the quantities found, polished with the weights held */
@@ -490,6 +577,7 @@ cf_status cf_joint_search_pair(jctx *c, const cf_table *reach, double xmax,
     if (!(best < CF_LSQ_HUGE_OBJ))
         return CF_E_NOCONV;
     r->objective = best;
+    r->starts = s.starts, r->stable_ends = s.stable_ends, r->restarts = s.restarts;
     r->pair = c->pair;
     r->volume = opt->volume;
     r->volume_modulus_MPa = v[PQ_K];

@@ -90,6 +90,13 @@ static double pair_rss(jctx *c, const double v[PQ_COUNT], const double box[4], d
         return CF_LSQ_HUGE_OBJ;
     if (!(v[PQ_AC] <= cf_joint_pair_A_max(c, v[PQ_RC], v[PQ_BC]) * (1 + 1e-12)))
         return CF_LSQ_HUGE_OBJ;
+    if (c->kappa_rel_max > 0) { /* a fitted kappa within its bound (CF_JOINT_NU_MAX) */
+        const cf_spring pc = cf_joint_compression_member(c, v);
+        cf_law lc;
+        if (cf_law_init(&lc, &pc, NULL) != CF_OK ||
+            !(v[PQ_K] <= c->kappa_rel_max * v[PQ_AC] * lc.k0_N_per_mm / lc.p.H_mm * (1 + 1e-9)))
+            return CF_LSQ_HUGE_OBJ;
+    }
     double ss = 0;
     for (size_t i = 0; i < c->pr.n; i++)
         ss += res[i] * res[i];

@@ -87,14 +87,117 @@ static cf_status lattice_stable_to(const cf_cell *c, const cf_msm_config *cfg, d
     return CF_OK;
 }
 
-/* Strains of a uniaxial table's range at which the search checks the full lattice (the
-** verification scans it finely, verify_tables). */
-#define SEARCH_STABLE_STEPS 5
+/* The one stability check of a joint fit, which the search applies to every point it would keep
+** and the verification to the placed springs (so a point the search keeps passes the final check,
+** and no other does): for each table, the cell's incremental stiffness positive definite and, for
+** a uniaxial table, the full lattices of 2^3 and 3^3 cells with a sliding bottom free of negative
+** pivots, at CHECK_STEPS strains evenly from 0 to CF_JOINT_STABLE_MARGIN times the table's
+** farthest strain. The farthest strain is checked first (where a lattice fitted at the edge of
+** stability buckles first, so the check fails fast). 1 stable, 0 not, -1 out of memory. */
+#define CHECK_STEPS 8
 
-/* 1 when the full lattices of the curve's law at (rho, B) (the context's extension spring and
-** kappa, at unit stress scale: every force scales alike, so stability does not depend on the
-** scale) of 2^3 cells (the more slender, the first to buckle; the verification checks 3^3 too)
-** are stable at SEARCH_STABLE_STEPS strains up to each uniaxial table's farthest one. */
+/* The table's farthest strain (table sign), 0 for an empty table. */
+static double table_reach(const cf_table *t)
+{
+    double reach = 0;
+    for (size_t i = 0; i < t->count; i++)
+        if (fabs(t->x[i]) > fabs(reach))
+            reach = t->x[i];
+    return reach;
+}
+
+/* The uniaxial states of table t at the check's strains e (the farthest first) and their lateral
+** stretches lat; 0 when one cannot be reached. */
+static int check_states(const cf_cell *cell, const cf_table *t, double e[CHECK_STEPS],
+                        double lat[CHECK_STEPS], double F[CHECK_STEPS][9])
+{
+    const double reach = table_reach(t) * CF_JOINT_STABLE_MARGIN;
+    for (int j = 0; j < CHECK_STEPS; j++) {
+        cf_cell_state st;
+        e[j] = reach * (CHECK_STEPS - j) / CHECK_STEPS;
+        if (cf_cell_mode(cell, t->mode, e[j], NULL, &st, NULL) != CF_OK)
+            return 0;
+        lat[j] = st.F[0];
+        memcpy(F[j], st.F, sizeof F[j]);
+    }
+    return 1;
+}
+
+/* The part of the check for table t (check_states' e, lat and F): part 0 the 2^3 lattice, 1 the
+** cell, 2 the 3^3 lattice (the lattices for a uniaxial table only). 1 stable, 0 not, -1 out of
+** memory. */
+static int check_part(const cf_cell *cell, const cf_msm_config *cfg, const cf_table *t, int part,
+                      const double e[CHECK_STEPS], const double lat[CHECK_STEPS],
+                      double F[CHECK_STEPS][9])
+{
+    if (part == 1) {
+        for (int j = 0; j < CHECK_STEPS; j++) {
+            double lambda = 0;
+            cf_status s = cf_cell_min_stiffness(cell, F[j], &lambda, NULL);
+            if (s == CF_E_INTERNAL)
+                return -1;
+            if (s != CF_OK || !(lambda > 0))
+                return 0;
+        }
+        return 1;
+    }
+    if (t->mode != CF_MODE_UNIAXIAL)
+        return 1;
+    cf_msm_config k = *cfg;
+    k.lattice.nx = k.lattice.ny = k.lattice.nz = part == 0 ? 2 : 3;
+    k.lattice.bottom = CF_BOTTOM_AXIAL;
+    long neg = -1;
+    cf_status s = cf_msm_homogeneous_inertias(cell->law, CF_LAW_CLOSED, &k, e, lat, CHECK_STEPS,
+                                              &neg, NULL);
+    if (s == CF_E_INTERNAL)
+        return -1;
+    return s == CF_OK && neg == 0;
+}
+
+/* The check on the n tables, part after part over all of them (the 2^3 lattice, the most slender
+** and the first to buckle, then the cell, then the 3^3 lattice), so a point that fails usually
+** fails at the first part; the verdict is the same in any order. */
+static int tables_stable(const cf_cell *cell, const cf_msm_config *cfg, const cf_table *const *t,
+                         size_t n)
+{
+    double e[CF_JOINT_MAX][CHECK_STEPS], lat[CF_JOINT_MAX][CHECK_STEPS];
+    double F[CF_JOINT_MAX][CHECK_STEPS][9];
+    for (size_t k = 0; k < n && k < CF_JOINT_MAX; k++)
+        if (table_reach(t[k]) != 0 && !check_states(cell, t[k], e[k], lat[k], F[k]))
+            return 0;
+    for (int part = 0; part < 3; part++)
+        for (size_t k = 0; k < n && k < CF_JOINT_MAX; k++) {
+            if (table_reach(t[k]) == 0)
+                continue;
+            const int r = check_part(cell, cfg, t[k], part, e[k], lat[k], F[k]);
+            if (r != 1)
+                return r;
+        }
+    return 1;
+}
+
+static int table_stable(const cf_cell *cell, const cf_msm_config *cfg, const cf_table *t)
+{
+    return tables_stable(cell, cfg, &t, 1);
+}
+
+int cf_joint_lattice_stable(const cf_law *law, const double weight[CF_FAMILY_COUNT],
+                            double kappa_MPa, const cf_validate_setup *lat,
+                            const cf_table *const *t, size_t n)
+{
+    cf_cell cell;
+    if (cf_cell_init(&cell, law, CF_LAW_CLOSED, weight, NULL) != CF_OK)
+        return 0;
+    cell.volume_modulus_MPa = kappa_MPa;
+    cf_msm_config cfg = lat->cfg;
+    memcpy(cfg.lattice.weight, weight, sizeof cfg.lattice.weight);
+    cfg.lattice.volume_modulus_MPa = kappa_MPa;
+    return tables_stable(&cell, &cfg, t, n);
+}
+
+/* 1 when the lattice of the curve's law at (rho, B) (the context's extension spring and kappa, at
+** unit stress scale: every force scales alike, so stability does not depend on the scale) passes
+** the joint fit's stability check (cf_joint_lattice_stable) on every table. */
 int cf_joint_stable_at(const jctx *c, double rho, double B)
 {
     const cf_ident q = {.rho = rho, .solid = B, .scale = 1.0};
@@ -108,39 +211,45 @@ int cf_joint_stable_at(const jctx *c, double rho, double B)
         if (cf_law_init(&ext, &pe, NULL) != CF_OK || cf_law_pair(&law, &ext, NULL) != CF_OK)
             return 0;
     }
-    cf_cell cell;
-    if (cf_cell_init(&cell, &law, CF_LAW_CLOSED, c->weight, NULL) != CF_OK)
-        return 0;
-    if (c->kappa_mode != KAPPA_NONE)
-        cell.volume_modulus_MPa = cf_joint_curve_kappa(c, &law);
-    cf_msm_config cfg = c->lat->cfg;
-    memcpy(cfg.lattice.weight, c->weight, sizeof c->weight);
-    cfg.lattice.volume_modulus_MPa = cell.volume_modulus_MPa;
-    for (size_t k = 0; k < c->n; k++) {
-        const cf_table *t = c->t[k];
-        if (t->mode != CF_MODE_UNIAXIAL)
-            continue;
-        double reach = 0;
-        for (size_t i = 0; i < t->count; i++)
-            if (fabs(t->x[i]) > fabs(reach))
-                reach = t->x[i];
-        double e[SEARCH_STABLE_STEPS], lat[SEARCH_STABLE_STEPS];
-        for (int j = 0; j < SEARCH_STABLE_STEPS; j++) {
-            cf_cell_state st;
-            e[j] = reach * (j + 1) / SEARCH_STABLE_STEPS;
-            if (cf_cell_mode(&cell, CF_MODE_UNIAXIAL, e[j], NULL, &st, NULL) != CF_OK)
-                return 0;
-            lat[j] = st.F[0];
-        }
-        cfg.lattice.nx = cfg.lattice.ny = cfg.lattice.nz = 2;
-        cfg.lattice.bottom = CF_BOTTOM_AXIAL;
-        long neg = -1;
-        if (cf_msm_homogeneous_inertias(&law, CF_LAW_CLOSED, &cfg, e, lat, SEARCH_STABLE_STEPS,
-                                        &neg, NULL) != CF_OK ||
-            neg != 0)
-            return 0;
+    const double kappa = c->kappa_mode != KAPPA_NONE ? cf_joint_curve_kappa(c, &law) : 0.0;
+    return cf_joint_lattice_stable(&law, c->weight, kappa, c->lat, c->t, c->n) == 1;
+}
+
+/* Table t's stability verdict for the lattice of cell (cfg its full lattice) into jt: the joint
+** fit's one check (table_stable, the search's) says whether it is stable to the margin; where it
+** is not, the scans (the cell's, cf_cell_stable_to, and the full lattices', lattice_stable_to)
+** say from which strain on, and whether the lattice is unstable at rest already (the first strain
+** of the check, a CHECK_STEPS-th of the range, is then unstable too, and the scans end at 0). */
+static cf_status table_verdict(const cf_cell *cell, const cf_msm_config *cfg, const cf_table *t,
+                               cf_joint_table *jt, cf_error *err)
+{
+    const double reach = table_reach(t) * CF_JOINT_STABLE_MARGIN;
+    if (reach == 0)
+        return CF_OK;
+    const int r = table_stable(cell, cfg, t);
+    if (r < 0)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory in the lattice's stability check");
+    jt->stability_checked = 1;
+    jt->lattice_checked = t->mode == CF_MODE_UNIAXIAL;
+    jt->stable_in_range = r;
+    jt->stable_to = reach;
+    if (r)
+        return CF_OK;
+    double limit = reach;
+    int lost = 0;
+    if (cf_cell_stable_to(cell, t->mode, reach, &limit, &lost, NULL) == CF_OK && lost)
+        jt->stable_to = limit;
+    if (t->mode == CF_MODE_UNIAXIAL) {
+        double llim = reach;
+        int llost = 0;
+        cf_status st = lattice_stable_to(cell, cfg, reach, &llim, &llost, err);
+        if (st != CF_OK)
+            return st;
+        if (llost && fabs(llim) < fabs(jt->stable_to))
+            jt->stable_to = llim;
     }
-    return 1;
+    jt->unstable_at_rest = fabs(jt->stable_to) < 1e-3 * fabs(reach);
+    return CF_OK;
 }
 
 /* Each table in the lattice of the placed spring r->fit: the cell, and the full lattice when the
@@ -181,32 +290,8 @@ cf_status cf_joint_verify_tables(const jctx *c, cf_joint_result *r, cf_error *er
                                        jt->lattice_MPa, NULL, err)) != CF_OK)
             break;
         jt->lattice_rmse = cf_lsq_quality_of(t, jt->lattice_MPa).rmse;
-        { /* stable over the table's whole range? (every law: the odd law's lattice can buckle
-          ** at the cell's scale too) */
-            double reach = 0, limit = 0;
-            int lost = 1;
-            for (size_t i = 0; i < t->count; i++)
-                if (fabs(t->x[i]) > fabs(reach))
-                    reach = t->x[i];
-            if (reach != 0 && cf_cell_stable_to(&cell, t->mode, reach, &limit, &lost, NULL) ==
-                                  CF_OK) {
-                jt->stability_checked = 1;
-                jt->stable_in_range = !lost;
-                jt->stable_to = limit;
-            }
-            /* a uniaxial table: the full lattice too, which can buckle where the cell does not */
-            if (jt->stability_checked && t->mode == CF_MODE_UNIAXIAL) {
-                double llim = reach;
-                int llost = 0;
-                if ((st = lattice_stable_to(&cell, &full.cfg, reach, &llim, &llost, err)) !=
-                    CF_OK)
-                    break;
-                jt->lattice_checked = 1;
-                if (llost && fabs(llim) < fabs(jt->stable_to))
-                    jt->stable_to = llim;
-                jt->stable_in_range = jt->stable_in_range && !llost;
-            }
-        }
+        if ((st = table_verdict(&cell, &full.cfg, t, jt, err)) != CF_OK)
+            break;
         double ss = 0;
         for (size_t i = 0; i < t->count; i++) {
             /* the law's stress at table strain x (tension positive): -F(-x H)/H^2, the odd

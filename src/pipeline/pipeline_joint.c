@@ -15,6 +15,9 @@
 ** not either. */
 static int pick(const cf_joint_result *a, const cf_joint_result *b, int asked)
 {
+    /* a lattice unstable at rest models no solid: never kept over one that is stable there */
+    if (!asked && cf_joint_stable_at_rest(a) != cf_joint_stable_at_rest(b))
+        return cf_joint_stable_at_rest(b);
     const cf_law_standing s[2] = {{a->fit.feasible, cf_joint_stable(a), a->aic},
                                   {b->fit.feasible, cf_joint_stable(b), b->aic}};
     return cf_law_pick(s, 2, asked ? 1 : -1) == 1;
@@ -61,6 +64,8 @@ static cf_status choose_law(const cf_table *const *tables, size_t n,
 ** table's range, then the lower joint AIC. */
 static int pair_ranks_above(const cf_joint_result *a, const cf_joint_result *b)
 {
+    if (cf_joint_stable_at_rest(a) != cf_joint_stable_at_rest(b))
+        return cf_joint_stable_at_rest(a);
     if (a->fit.feasible != b->fit.feasible)
         return a->fit.feasible;
     if (cf_joint_stable(a) != cf_joint_stable(b))
@@ -69,11 +74,11 @@ static int pair_ranks_above(const cf_joint_result *a, const cf_joint_result *b)
 }
 
 /* The pair with a tailed compression spring fitted from the pair *pair (conical compression
-** spring), and the better kept in *pair (pair_ranks_above), the other summarised in lc. A tailed
+** spring; its optimum the tailed search's start and floor, cf_joint_fit_pair), and the better kept in *pair (pair_ranks_above), the other summarised in lc. A tailed
 ** pair that finds no lattice leaves *pair alone. */
 static cf_status choose_pair_tail(const cf_table *const *tables, size_t n,
-                                  const cf_pipeline_options *opt, const cf_joint_result *plain,
-                                  cf_joint_law_choice *lc, cf_joint_result *pair, cf_error *err)
+                                  const cf_pipeline_options *opt, cf_joint_law_choice *lc,
+                                  cf_joint_result *pair, cf_error *err)
 {
     if (opt->progress) {
         char what[160];
@@ -84,8 +89,9 @@ static cf_status choose_pair_tail(const cf_table *const *tables, size_t n,
     }
     cf_joint_result tp;
     cf_error e = {0};
+    /* the tailed pair contains the conical pair: its optimum is the start, and the floor */
     cf_status st = cf_joint_fit_pair(tables, n, &opt->fit, &opt->lattice, pair->fit.type, 2,
-                                     plain, &tp, &e);
+                                     pair, &tp, &e);
     if (st == CF_E_INTERNAL)
         return cf_error_set(err, st, "%s", e.msg);
     if (st != CF_OK)
@@ -133,7 +139,7 @@ static cf_status choose_pair(const cf_table *const *tables, size_t n,
         snprintf(lc->pair_refused, sizeof lc->pair_refused, "%s", e.msg);
         return CF_OK;
     }
-    if ((st = choose_pair_tail(tables, n, opt, plain, lc, &pair, err)) != CF_OK) {
+    if ((st = choose_pair_tail(tables, n, opt, lc, &pair, err)) != CF_OK) {
         cf_joint_free(&pair);
         return st;
     }
@@ -163,7 +169,10 @@ static cf_status with_volume(const cf_table *const *tables, size_t n,
     if (st != CF_OK) {
         r->fits[k] = *plain;
         memset(plain, 0, sizeof *plain);
+        return st;
     }
+    /* a volume term whose lattice is unstable at rest where kappa 0's is not came back as kappa
+    ** 0 (cf_joint_fit_pair: the fit contains it and it ranks above) */
     return st;
 }
 
@@ -198,8 +207,9 @@ cf_status cf_pipeline_fit_joint(const cf_table *const *tables, size_t n,
         const int volume = opt->fit.volume != CF_VOLUME_NONE;
         cf_joint_result plain;
         memset(&plain, 0, sizeof plain);
-        /* with a volume term the single-sided law is the conical law with it (no tailed law) */
-        if (volume && law != CF_KIND_DOUBLE)
+        /* with a volume term the single-sided law is the conical law with it (no tailed law),
+        ** also where the pair is asked for: the pair starts from it */
+        if (volume)
             st = with_volume(tables, n, opt, r, k, &plain, err);
         else if (law == CF_KIND_TAIL || law == CF_KIND_AUTO)
             st = choose_law(tables, n, opt, r, k, err);
@@ -207,9 +217,9 @@ cf_status cf_pipeline_fit_joint(const cf_table *const *tables, size_t n,
         if (st == CF_OK && (law == CF_KIND_DOUBLE ||
                             (law == CF_KIND_AUTO && opt->fit.volume != CF_VOLUME_POISSON))) {
             const cf_joint_law_choice *lc = &r->law_choice[k];
-            const cf_joint_result *start = volume && law != CF_KIND_DOUBLE ? &plain
-                                           : lc->ran && lc->chose_tail       ? &lc->other
-                                                                             : &r->fits[k];
+            /* the single-sided law with the same kappa treatment: the pair contains it */
+            const cf_joint_result *start = !volume && lc->ran && lc->chose_tail ? &lc->other
+                                                                                : &r->fits[k];
             st = choose_pair(tables, n, opt, start, r, k, err);
         }
         cf_joint_free(&plain);

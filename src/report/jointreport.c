@@ -31,17 +31,22 @@ void cf_joint_report_free(cf_joint_report *r)
     }
 }
 
-/* A spring that can be built before one that cannot, then the lower objective: a tie of the two
-** types' laws (both tailed fits reach the same one) must not hand the user the infeasible spring. */
+/* A lattice stable at rest before one that is not (it models no solid at all), then a spring that
+** can be built before one that cannot, then a lattice stable over every table's range, then the
+** lower objective: a tie of the two types' laws (both tailed fits reach the same one) must not
+** hand the user the infeasible spring. */
 int cf_joint_better(const cf_joint_report *r)
 {
     int b = -1;
     for (int i = 0; i < r->nfits; i++) {
-        const int fi = r->fits[i].fit.feasible != 0, si = cf_joint_stable(&r->fits[i]);
-        const int fb = b >= 0 && r->fits[b].fit.feasible != 0, sb = b >= 0 && cf_joint_stable(&r->fits[b]);
-        if (b < 0 || (fi != fb   ? fi
+        const cf_joint_result *fi_ = &r->fits[i], *fb_ = b >= 0 ? &r->fits[b] : NULL;
+        const int ri = cf_joint_stable_at_rest(fi_), rb = fb_ && cf_joint_stable_at_rest(fb_);
+        const int fi = fi_->fit.feasible != 0, si = cf_joint_stable(fi_);
+        const int fb = fb_ && fb_->fit.feasible != 0, sb = fb_ && cf_joint_stable(fb_);
+        if (b < 0 || (ri != rb   ? ri
+                      : fi != fb ? fi
                       : si != sb ? si
-                                 : r->fits[i].objective < r->fits[b].objective))
+                                 : fi_->objective < fb_->objective))
             b = i;
     }
     return b;
@@ -169,9 +174,16 @@ static void pair_choice_text(FILE *o, const cf_joint_report *r)
                     law[l]->fit.feasible ? "" : " (infeasible)");
         if (pair->nested_objective > 0) {
             const unsigned v = pair->fit.nested_violated;
-            fprintf(o, "  %-16s two equal springs: the single-sided law's optimum the pair "
-                       "contains, since the pair its search ended on (objective %.4g) breaks "
-                       "the limit%s", "", pair->nested_objective, (v & (v - 1)) ? "s" : "");
+            if (!v)
+                fprintf(o, "  %-16s two equal springs: the single-sided law's optimum the pair "
+                           "contains, since the pair its search ended on (objective %.4g) ranks "
+                           "below it",
+                        "", pair->nested_objective);
+            else
+                fprintf(o, "  %-16s two equal springs: the single-sided law's optimum the pair "
+                           "contains, since the pair its search ended on (objective %.4g) breaks "
+                           "the limit%s",
+                        "", pair->nested_objective, (v & (v - 1)) ? "s" : "");
             for (int b = 0; b < CF_C_COUNT; b++)
                 if (v & (1u << b))
                     fprintf(o, " %s", cf_fit_constraint_name(1u << b));
@@ -209,6 +221,9 @@ static void value_se(char *buf, size_t cap, double v, double se, double scale, c
                  unit[0] ? " " : "", unit);
 }
 
+/* CF_JOINT_NU_MAX (joint.h) as the report states it */
+#define NU_MAX_TEXT "0.499"
+
 static const char *volume_how(cf_volume v)
 {
     switch (v) {
@@ -240,8 +255,16 @@ static void pair_volume_text(FILE *o, const cf_joint_result *j)
                  j->volume == CF_VOLUME_FIT ? j->volume_modulus_se : 0, 1e3, "kPa");
         if (j->volume != CF_VOLUME_FIT)
             snprintf(k, sizeof k, "%.6g kPa", j->volume_modulus_MPa * 1e3);
-        fprintf(o, " volume term (kappa/2)(J - 1)^2 per cell: kappa %s (%s)\n", k,
-                volume_how(j->volume));
+        if (!j->pair && j->volume == CF_VOLUME_FIT && j->volume_modulus_MPa == 0 &&
+            j->nested_objective > 0)
+            fprintf(o, " volume term: kappa 0, the law without it, which the fit contains, ranks "
+                       "above what its search ended on (objective %.4g)\n",
+                    j->nested_objective);
+        fprintf(o, " volume term (kappa/2)(J - 1)^2 per cell: kappa %s (%s%s)\n", k,
+                volume_how(j->volume),
+                j->volume == CF_VOLUME_FIT ? ", at most the kappa of small-strain nu " NU_MAX_TEXT
+                                             " in the compression spring's lattice"
+                                           : "");
     }
     if (j->pair || j->volume != CF_VOLUME_NONE)
         fprintf(o, " small strain, along an axis: compression E %.4g kPa, nu %.4f; extension E "
@@ -259,17 +282,30 @@ static void stability_text(FILE *o, const cf_joint_report *r, const cf_joint_res
         checked += jt->stability_checked;
         if (jt->stability_checked && !jt->stable_in_range) {
             all = 0;
-            fprintf(o, "  %s: the lattice loses stability at strain %.4g, inside the table\n",
-                    r->tables[k]->path, jt->stable_to);
+            if (jt->unstable_at_rest)
+                fprintf(o, "  %s: the lattice is unstable at rest (strain 0): it models no "
+                           "solid\n",
+                        r->tables[k]->path);
+            else
+                fprintf(o, "  %s: the lattice loses stability at strain %.4g, inside %.2fx the "
+                           "table's range\n",
+                        r->tables[k]->path, jt->stable_to, CF_JOINT_STABLE_MARGIN);
         }
     }
     if (checked == (int)r->ntables && all)
-        fprintf(o, "  stable over every table's range (the cell's incremental stiffness positive "
-                   "definite from 0 to each table's farthest strain; for a uniaxial table the "
-                   "full lattices of 2^3 and 3^3 cells too%s)\n",
-                j->volume_modulus_MPa > 0 ? ", with their cells' default hourglass control, "
-                                            "which a scene's lattice.hourglass 0 turns off"
+        fprintf(o, "  stable over every table's range with a margin (the cell's incremental "
+                   "stiffness positive definite and, for a uniaxial table, the full lattices of "
+                   "2^3 and 3^3 cells free of negative pivots, at 8 strains from 0 to %.2fx each "
+                   "table's farthest strain: the search's own check%s)\n",
+                CF_JOINT_STABLE_MARGIN,
+                j->volume_modulus_MPa > 0 ? "; the lattices with their cells' default hourglass "
+                                            "control, which a scene's lattice.hourglass 0 turns off"
                                           : "");
+    /* what the search tried */
+    fprintf(o, "  search: %d starts, %d stable end%s, %d restart%s kept to lattices stable to "
+               "%.2fx each table's farthest strain\n",
+            j->starts, j->stable_ends, j->stable_ends == 1 ? "" : "s", j->restarts,
+            j->restarts == 1 ? "" : "s", CF_JOINT_STABLE_MARGIN);
 }
 
 char *cf_joint_text(const cf_joint_report *r)
@@ -562,6 +598,10 @@ static json_t *joint_json(const cf_joint_report *r)
         json_object_set_new(f, "feasible", json_boolean(j->fit.feasible));
         json_object_set_new(f, "objective", num(j->objective));
         json_object_set_new(f, "evaluations", json_integer(j->evaluations));
+        json_object_set_new(f, "search",
+                            json_pack("{s:i, s:i, s:i, s:f}", "starts", j->starts, "stable_ends",
+                                      j->stable_ends, "stable_restarts", j->restarts,
+                                      "stability_margin", CF_JOINT_STABLE_MARGIN));
         json_object_set_new(f, "wall_time_s", num(r->with_timing ? j->wall_time_s : 0.0));
         json_object_set_new(f, "tables", tables_json(r, j));
         json_array_append_new(fits, f);

@@ -46,9 +46,9 @@ typedef struct cf_joint_report {
 /* Releases every fit's curves, the law not kept's too. Safe on a zeroed report. */
 void cf_joint_report_free(cf_joint_report *r);
 
-/* Index of the better fit (a feasible spring first, then one stable over every table's range
-** (cf_joint_stable), then the lower weighted objective), -1 when
-** none. */
+/* Index of the better fit (a lattice stable at rest first (cf_joint_stable_at_rest), then a
+** feasible spring, then one stable over every table's range (cf_joint_stable), then the lower
+** weighted objective), -1 when none. */
 int cf_joint_better(const cf_joint_report *r);
 
 /* The readable report (malloc'd; NULL when memory runs out). */

@@ -9,7 +9,10 @@
 **   - the statics force kernel (cf_lattice_forces, which every Newton iteration of a static run
 **     calls): odd law, pair, and each with the volume term (every cell's J from its eight nodes);
 **   - `conifit fit` of the brain cortex tension, compression and shear tables with --joint --law
-**     auto --volume fit as a child process (CPU from wait4), target under 5 s.
+**     auto --volume fit as a child process (CPU from wait4), target at most 20 s (issue 42: the
+**     search keeps to lattices stable to 1.05x each table's range, checked as the verification
+**     checks them; before that check, 7.8 s on the same machine, the kept lattice then buckling
+**     within 3 % past the tables' range).
 ** Node positions are displaced by a fixed pseudo-random 3 % of H, so that springs are compressed
 ** and stretched alike (both sides of the pair work); the step's h is 0, so the state stays put.
 */
@@ -209,16 +212,17 @@ void bench_section_pair(bench_ctx *ctx)
     fprintf(md, "\n`conifit fit` of the brain cortex tension, compression and shear tables with "
                 "`--joint --law auto --volume fit` (both spring types, the odd law, the conical "
                 "and the tailed pair and kappa fitted through the homogenised cell, kept to "
-                "stable full lattices, the uniaxial tables verified in the full lattice), as a "
+                "full lattices stable to 1.05x each table's range by the verification's own "
+                "check, the uniaxial tables verified in the full lattice), as a "
                 "child process, median of %d runs: ", runs);
     if (isfinite(cpu))
         fprintf(md, "**%.3g s CPU** (%.3g s wall).\n\n", cpu, wall);
     else
         fprintf(md, "not measured (%s).\n\n", why);
     static const char target[] = "joint fit of the three brain cortex tables with the pair and "
-                                 "kappa (--joint --law auto --volume fit) under 5 s CPU";
+                                 "kappa (--joint --law auto --volume fit) at most 20 s CPU";
     if (isfinite(cpu))
-        bench_target_add(ctx, target, cpu < 5.0, "%.3g s CPU", cpu);
+        bench_target_add(ctx, target, cpu <= 20.0, "%.3g s CPU", cpu);
     else
         bench_target_add(ctx, target, -1, "not measured: %s", why);
     cf_law_free(&lc);

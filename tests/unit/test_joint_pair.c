@@ -400,13 +400,15 @@ static void chicken_breast_pair_never_loses_to_the_odd_law(void **state)
         cf_table_free(&t[k]);
 }
 
-/* The corona radiata in tension and compression (issue 37): the telescoping pair's search ends on
-** an element whose extension spring breaks the least spring index (objective 0.0072) beside a
-** buildable odd law (0.579), so the pair (conical compression spring, cf_joint_fit_pair pair 1)
-** is that law's optimum as two equal springs, buildable, and the report says what the search
-** ended on. The pipeline (--law double-acting) also fits the pair with a tailed compression
-** spring, which is buildable here and far lower, and keeps it, naming the conical one. */
-static void coronaradiata_pair_infeasible_is_the_odd_law(void **state)
+/* The corona radiata in tension and compression (issues 37, 42): the telescoping pair (conical
+** compression spring, cf_joint_fit_pair pair 1) never ends above the buildable odd law (0.579)
+** it contains. Before issue 42 its search ended on an element whose extension spring breaks the
+** least spring index (0.0072), so the pair was that law's optimum as two equal springs (the
+** report then says what the search ended on); its restarts from every stable end now reach a
+** buildable pair stable to 1.05x the tables' range (0.00869). The pipeline (--law double-acting)
+** also fits the pair with a tailed compression spring, which never ends above the conical pair,
+** and names the one it does not keep. */
+static void coronaradiata_pair_never_above_the_odd_law(void **state)
 {
     (void)state;
     cf_table t[2];
@@ -435,13 +437,18 @@ static void coronaradiata_pair_infeasible_is_the_odd_law(void **state)
     lc->pair_ran = lc->chose_pair = 1;
     assert_true(pair->pair && odd->fit.feasible);
     assert_true(pair->fit.feasible && pair->ext.feasible);
-    close_rel("pair objective", pair->objective, odd->objective, 1e-9);
-    close_rel("extension D1", pair->ext.params.D1_mm, pair->fit.params.D1_mm, 1e-9);
-    assert_true(pair->nested_objective > 0 && pair->nested_objective < odd->objective);
-    assert_true(pair->fit.nested_violated & CF_C_INDEX_MIN);
+    assert_true(pair->objective <= odd->objective * (1 + 1e-9));
+    const int equal = pair->nested_objective > 0;
+    if (equal) { /* the odd law's optimum as two equal springs */
+        close_rel("pair objective", pair->objective, odd->objective, 1e-9);
+        close_rel("extension D1", pair->ext.params.D1_mm, pair->fit.params.D1_mm, 1e-9);
+    } else {
+        assert_true(cf_joint_stable(pair) && cf_joint_stable_at_rest(pair));
+    }
     char *text = cf_joint_text(&r);
     assert_non_null(text);
-    if (!strstr(text, "two equal springs: the single-sided law's optimum the pair contains"))
+    if (equal && !strstr(text, "two equal springs: the single-sided law's optimum the pair "
+                               "contains"))
         fail_msg("the report does not say what the pair's search ended on:\n%s", text);
     free(text);
     char dirt[] = "/tmp/conifit-jp-XXXXXX", json[256];
@@ -454,8 +461,8 @@ static void coronaradiata_pair_infeasible_is_the_odd_law(void **state)
     cf_output_free(jo);
     char *file = tu_slurp(json);
     assert_non_null(file);
-    assert_non_null(strstr(file, "\"equal_springs\""));
-    assert_non_null(strstr(file, "\"index_min\""));
+    if (equal)
+        assert_non_null(strstr(file, "\"equal_springs\""));
     free(file);
     const double conical_pair = pair->objective;
     cf_joint_report_free(&r);
@@ -464,16 +471,22 @@ static void coronaradiata_pair_infeasible_is_the_odd_law(void **state)
     if (cf_pipeline_fit_joint(tabs, 2, &po, &r, &err) != CF_OK)
         fail_msg("%s", err.msg);
     lc = &r.law_choice[0];
-    assert_true(lc->pair_ran && lc->chose_pair && lc->pair_tail_ran && lc->pair_tail_kept);
+    assert_true(lc->pair_ran && lc->chose_pair && lc->pair_tail_ran);
     pair = &r.fits[0];
-    assert_true(pair->pair && pair->fit.tail && pair->fit.params.n_tail > 0);
-    assert_true(pair->fit.feasible && pair->ext.feasible && cf_joint_stable(pair));
-    assert_true(pair->objective < 0.1 * conical_pair);
-    close_rel("the conical pair named", lc->alt_objective, conical_pair, 1e-9);
+    assert_true(pair->pair && pair->fit.feasible && pair->ext.feasible && cf_joint_stable(pair));
+    if (lc->pair_tail_kept) { /* the tailed pair, never above the conical one it contains */
+        assert_true(pair->fit.tail);
+        assert_true(pair->objective <= conical_pair * (1 + 1e-9));
+        close_rel("the conical pair named", lc->alt_objective, conical_pair, 1e-9);
+    } else {
+        close_rel("the conical pair kept", pair->objective, conical_pair, 1e-9);
+        assert_true(lc->alt_objective <= conical_pair * (1 + 1e-9) || !lc->alt_feasible ||
+                    !lc->alt_stable);
+    }
     text = cf_joint_text(&r);
     assert_non_null(text);
-    if (!strstr(text, "the pair's compression spring with a tail"))
-        fail_msg("the report does not name the tailed compression spring:\n%s", text);
+    if (!strstr(text, "the pair's compression spring"))
+        fail_msg("the report does not name the other compression spring:\n%s", text);
     free(text);
     jo = NULL;
     assert_int_equal(cf_output_new(&jo, &err), CF_OK);
@@ -483,7 +496,6 @@ static void coronaradiata_pair_infeasible_is_the_odd_law(void **state)
     file = tu_slurp(json);
     assert_non_null(file);
     assert_non_null(strstr(file, "\"pair_alternative\""));
-    assert_non_null(strstr(file, "\"n_tail\""));
     assert_non_null(strstr(file, "\"params_extension\""));
     free(file);
     remove(json);
@@ -502,7 +514,7 @@ int main(void)
         cmocka_unit_test(declared_nu_is_the_lattices),
         cmocka_unit_test(brain_cortex_stable_pair_below_half_of_ogden),
         cmocka_unit_test(chicken_breast_pair_never_loses_to_the_odd_law),
-        cmocka_unit_test(coronaradiata_pair_infeasible_is_the_odd_law),
+        cmocka_unit_test(coronaradiata_pair_never_above_the_odd_law),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
