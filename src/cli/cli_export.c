@@ -30,10 +30,14 @@ static const char export_help[] =
     "strain, and output requests) as a model that runs in the target as it is; conifit's own\n"
     "reaction at every step is written in its header. A SCENE.json with a body (calculix,\n"
     "febio; sofa without a volume term, poisson_ratio 0.25) writes the body: every edge a\n"
-    "spring with its own table, the volume term as tetrahedra of a purely volumetric material\n"
-    "(J per tetrahedron), the held nodes, and a flat punch along z as the prescribed motion of the\n"
-    "nodes under its face; conifit's probe force at every step in its header (a sphere probe\n"
-    "is refused: its contact set changes with depth). Row count and error go to stderr.\n"
+    "spring with its own table, the volume term per node as conifit takes it (calculix: a\n"
+    "grounded spring per node tied by *EQUATION to its volume change about conifit's solved\n"
+    "state at each step; febio: tet4 in a ut4 domain with alpha 0), the held nodes, and the\n"
+    "flat punch replayed as conifit ran it: its contact set at every step (calculix: conifit's\n"
+    "penalty springs against nodes of the punch's face, one *STEP per load step; febio, sofa:\n"
+    "each contact node moved along z as conifit solved it), with a warning that the contact\n"
+    "is replayed, not solved; conifit's probe force at every step in its header (a sphere\n"
+    "probe is refused). Row count and error go to stderr.\n"
     "Units: mm, N, s, tonne (stated inside each file).\n\n"
     "  FIT.json         '-' reads the fit file from standard input\n"
     "  --format F       one of the formats below (default: the format -o's extension names)\n"
@@ -402,6 +406,8 @@ int cf_cli_export(int argc, char **argv)
         return cf_cli_fail(&err);
     }
     free(buf);
+    if (q.ea.lattice && rep.warning[0])
+        cf_cli_printf_safe(stderr, "conifit export: warning: %s\n", rep.warning);
     const cf_export_format_info *fi = cf_export_format_get(opt.format);
     if (!q.quiet && fi->table)
         print_summary(fi, q.ea.lattice, &rep);
