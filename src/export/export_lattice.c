@@ -38,12 +38,7 @@ static cf_status time_protocol(const cf_scene *sc, const char *name, cf_export_l
     const char *kind = sc->kind == CF_PROTO_CYCLES ? "cycles"
                        : sc->kind == CF_PROTO_HOLD ? "hold"
                                                    : "history";
-    if (sc->drive != CF_DRIVE_DISPLACEMENT)
-        return cf_error_set(err, CF_E_DATA,
-                            "%s: key 'protocol.to_stress_kPa': protocol '%s' under a stress drive: "
-                            "the lattice export prescribes the top's displacement (use "
-                            "'to_strain')",
-                            name, kind);
+    lx->stress_drive = sc->drive != CF_DRIVE_DISPLACEMENT;
     const cf_msm_effects *e = &sc->effects;
     if (e->gravity_mm_per_s2 != 0)
         return cf_error_set(err, CF_E_DATA,
@@ -64,9 +59,13 @@ static cf_status time_protocol(const cf_scene *sc, const char *name, cf_export_l
         snprintf(left + n, sizeof left - n, "%sinertia", n ? ", " : "");
     snprintf(lx->note, sizeof lx->note,
              "protocol '%s' written as its quasi-static displacement history, one static "
-             "step per sample, of the elastic lattice%s%s; the reference reactions are conifit's "
-             "elastic run along the same path, not the scene's simulation",
-             kind, left[0] ? ": not carried: " : "", left);
+             "step per sample, of the elastic lattice%s%s%s; the reference reactions are "
+             "conifit's elastic run along the same path, not the scene's simulation",
+             kind,
+             lx->stress_drive ? " (its stress history turned into the strains of conifit's "
+                                "elastic lattice under it, force-driven)"
+                              : "",
+             left[0] ? ": not carried: " : "", left);
     return CF_OK;
 }
 
@@ -82,6 +81,7 @@ cf_status cf_export_lattice_from_scene(const cf_scene *sc, const char *name,
     if (timed) { /* the elastic lattice along the protocol's displacement history */
         cf_scene elastic = *sc;
         elastic.kind = CF_PROTO_RAMP;
+        elastic.drive = CF_DRIVE_DISPLACEMENT; /* a stress history: its strains, see above */
         memset(&elastic.effects, 0, sizeof elastic.effects);
         st = cf_validate_from_scene(&elastic, name, &v, err);
     } else
@@ -311,6 +311,42 @@ static cf_status refuse_loading(const cf_law *law, const cf_export_lattice *lx, 
                         where, lx->strain[unstable - 1], unstable, pivots, works);
 }
 
+/* A stress-driven loading (lx->stress_drive) as the strains conifit's elastic lattice takes
+** under it, force-driven, into *strained; lx itself otherwise. NULL, *st and err set, when the
+** run fails. */
+static const cf_export_lattice *strained_loading(cf_lattice *lat, const cf_export_lattice *lx,
+                                                 cf_export_lattice *strained, cf_status *st,
+                                                 cf_error *err)
+{
+    if (!lx->stress_drive)
+        return lx;
+    double t[CF_EXPORT_MAX_STEPS + 1], v[CF_EXPORT_MAX_STEPS + 1];
+    cf_msm_sample out[CF_EXPORT_MAX_STEPS];
+    t[0] = 0.0;
+    v[0] = 0.0;
+    for (size_t k = 0; k < lx->nsteps; k++) {
+        t[k + 1] = (double)(k + 1);
+        v[k + 1] = lx->strain[k];
+    }
+    const cf_msm_path path = {CF_DRIVE_FORCE, lx->nsteps + 1, t, v};
+    const cf_msm_effects none = {0};
+    cf_msm_stats stats = {0};
+    size_t done = 0;
+    cf_lattice_reset(lat);
+    cf_error e = {0};
+    *st = cf_msm_run(lat, &none, &lx->cfg, &path, t + 1, lx->nsteps, out, &done, &stats, &e);
+    cf_lattice_reset(lat);
+    if (*st != CF_OK) {
+        cf_error_set(err, *st, "the elastic lattice under the scene's stress history: %s", e.msg);
+        return NULL;
+    }
+    *strained = *lx;
+    strained->stress_drive = 0;
+    for (size_t k = 0; k < lx->nsteps; k++)
+        strained->strain[k] = out[k].strain;
+    return strained;
+}
+
 /* The loading to write: lx when conifit's lattice follows it (stably, within the tables), else
 ** its leading steps that it follows, in *part, with why the rest is cut at the end of note (after
 ** lx->note); conifit's reactions along it into ref. NULL, *st and err set, when not even the first
@@ -367,7 +403,7 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
     cf_xmodel m = {0};
     cf_export_report r = {0};
     char title[256], note[sizeof r.warning];
-    cf_export_lattice part;
+    cf_export_lattice part, strained;
     double ref[CF_EXPORT_MAX_STEPS];
     memset(&lat, 0, sizeof lat);
     memset(&ext, 0, sizeof ext);
@@ -391,7 +427,8 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
     if ((st = cf_export_table_for(&law, opt, &t, err)) != CF_OK ||
         (st = cf_lattice_create(&lat, &law, lx->method, &lc, err)) != CF_OK)
         goto done;
-    if (!(lx = loading_that_works(&lat, &law, &t, lx, &part, ref, note, sizeof note, &st, err)))
+    if (!(lx = strained_loading(&lat, lx, &strained, &st, err)) ||
+        !(lx = loading_that_works(&lat, &law, &t, lx, &part, ref, note, sizeof note, &st, err)))
         goto done;
     if (lattice_model(&m, &lat, &law, &t, lx, opt, title, sizeof title) != 0)
         goto oom;
