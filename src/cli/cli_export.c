@@ -234,7 +234,8 @@ static cf_status static_run_fits(const char *name, const cf_export_lattice *lx,
                                  const cf_scene_cost *cost, const cf_budget *b, cf_error *err)
 {
     const double each = cf_budget_solve_work(3.0 * (double)cost->nodes);
-    const double steps = (double)lx->nsteps;
+    /* a stress drive: a force-driven run first, for the strains (export_lattice.c) */
+    const double steps = (double)lx->nsteps * (lx->stress_drive ? 2.0 : 1.0);
     if (steps <= b->max_steps && steps * each <= b->max_work)
         return CF_OK;
     const double can = fmin(b->max_steps, floor(b->max_work / each));
