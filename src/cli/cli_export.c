@@ -28,12 +28,22 @@ static const char export_help[] =
     "built from the spring (every spring family with its weight and its own table, boundary\n"
     "conditions, the uniaxial loading of SCENE.json or, without it, 20 steps to half the solid\n"
     "strain, and output requests) as a model that runs in the target as it is; conifit's own\n"
-    "reaction at every step is written in its header. A SCENE.json with a body (calculix,\n"
-    "febio; sofa without a volume term, poisson_ratio 0.25) writes the body: every edge a\n"
-    "spring with its own table, the volume term as tetrahedra of a purely volumetric material\n"
-    "(J per tetrahedron), the held nodes, and a flat punch along z as the prescribed motion of the\n"
-    "nodes under its face; conifit's probe force at every step in its header (a sphere probe\n"
-    "is refused: its contact set changes with depth). Row count and error go to stderr.\n"
+    "reaction at every step is written in its header. A time protocol (hold, cycles, history)\n"
+    "is written as its quasi-static displacement history, one static step per sample, of the\n"
+    "elastic lattice (a stress drive through the strains conifit's elastic lattice takes under\n"
+    "it), a warning naming what is not carried (Prony terms, dashpots, inertia): the header's\n"
+    "reactions are conifit's elastic run along that path. A loading the lattice cannot follow\n"
+    "(unstable, past a table, no solution) is cut after its last step that works, with a\n"
+    "warning and a note in the header (refused only when its first step fails). A SCENE.json\n"
+    "with a body (calculix, febio; sofa without a volume term, poisson_ratio 0.25) writes the\n"
+    "body: every edge a spring with its own table, the volume term per node as conifit\n"
+    "takes it (calculix: a grounded spring per node tied by *EQUATION to its volume change\n"
+    "about conifit's solved state at each step; febio: tet4 in a ut4 domain with alpha 0),\n"
+    "the held nodes, and the flat punch replayed as conifit ran it: its contact set at every\n"
+    "step (calculix: conifit's penalty springs against nodes of the punch's face, one *STEP\n"
+    "per load step; febio, sofa: each contact node moved along z as conifit solved it), with\n"
+    "a warning that the contact is replayed, not solved; conifit's probe force at every step\n"
+    "in its header (a sphere probe is refused). Row count and error go to stderr.\n"
     "Units: mm, N, s, tonne (stated inside each file).\n\n"
     "  FIT.json         '-' reads the fit file from standard input\n"
     "  --format F       one of the formats below (default: the format -o's extension names)\n"
@@ -224,7 +234,8 @@ static cf_status static_run_fits(const char *name, const cf_export_lattice *lx,
                                  const cf_scene_cost *cost, const cf_budget *b, cf_error *err)
 {
     const double each = cf_budget_solve_work(3.0 * (double)cost->nodes);
-    const double steps = (double)lx->nsteps;
+    /* a stress drive: a force-driven run first, for the strains (export_lattice.c) */
+    const double steps = (double)lx->nsteps * (lx->stress_drive ? 2.0 : 1.0);
     if (steps <= b->max_steps && steps * each <= b->max_work)
         return CF_OK;
     const double can = fmin(b->max_steps, floor(b->max_work / each));
@@ -402,6 +413,8 @@ int cf_cli_export(int argc, char **argv)
         return cf_cli_fail(&err);
     }
     free(buf);
+    if (q.ea.lattice && rep.warning[0])
+        cf_cli_printf_safe(stderr, "conifit export: warning: %s\n", rep.warning);
     const cf_export_format_info *fi = cf_export_format_get(opt.format);
     if (!q.quiet && fi->table)
         print_summary(fi, q.ea.lattice, &rep);

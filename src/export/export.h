@@ -172,8 +172,10 @@ typedef struct cf_export_report {
     size_t springs;       /* lattice: springs */
     size_t nodes;         /* lattice: nodes */
     size_t steps;         /* lattice: load steps */
-    char warning[400];    /* "" or what the model does not do as conifit does (a body's probe
-                          ** replayed rather than solved as a contact) */
+    char warning[1024];   /* "" or what the model does not do as conifit does (a body's probe
+                          ** replayed rather than solved as a contact; a scene's time protocol
+                          ** written without its time effects; a loading cut where the lattice
+                          ** stops following it) */
 } cf_export_report;
 
 /* Writes the spring in the chosen format to out. Never writes NaN or Inf. */
@@ -190,6 +192,12 @@ typedef struct cf_export_lattice {
     cf_law_method method;       /* evaluator of conifit's own reference run */
     size_t nsteps;              /* load steps, <= CF_EXPORT_MAX_STEPS */
     double strain[CF_EXPORT_MAX_STEPS]; /* compressive strain at the end of each step, - */
+    int stress_drive;           /* 1: strain[] holds compressive nominal stresses (MPa) that
+                                ** conifit's elastic lattice, force-driven, turns into the strains
+                                ** written (a creep protocol) */
+    char note[400];             /* "" or, for a scene's time protocol written as its quasi-static
+                                ** displacement history, what the model does not carry (the
+                                ** file's header and the report's warning say it) */
 } cf_export_lattice;
 /* Default loading: CF_EXPORT_DEFAULT_STEPS equal steps to this fraction of the solid strain. */
 #define CF_EXPORT_DEFAULT_STEPS 20
@@ -199,9 +207,12 @@ typedef struct cf_export_lattice {
 ** half the solid strain of law. */
 cf_export_lattice cf_export_lattice_default(const cf_law *law);
 
-/* The lattice and loading of a scene, which must be a static uniaxial compression: protocol
-** "ramp" under a displacement drive to a compressive strain, no time effect; the steps are the
-** scene's samples after t = 0. CF_E_DATA naming the key otherwise. */
+/* The lattice and loading of a scene under a displacement drive: protocol "ramp" (a static
+** uniaxial compression, no time effect), or a time protocol ("hold", "cycles", "history") written
+** as its quasi-static displacement history of the elastic lattice, lx->note naming what is not
+** carried (the time effects: viscosity, damping, inertia), a stress drive through the strains
+** of conifit's elastic lattice under it; the steps are the scene's samples after t = 0.
+** CF_E_DATA naming the key otherwise (a ramp under a stress drive, gravity). */
 cf_status cf_export_lattice_from_scene(const cf_scene *sc, const char *name,
                                        cf_export_lattice *lx, cf_error *err);
 

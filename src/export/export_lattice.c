@@ -30,12 +30,62 @@ cf_export_lattice cf_export_lattice_default(const cf_law *law)
     return lx;
 }
 
+/* A scene's time protocol as its quasi-static displacement history: refused (CF_E_DATA) under a
+** stress drive or with gravity; what it leaves out into lx->note. */
+static cf_status time_protocol(const cf_scene *sc, const char *name, cf_export_lattice *lx,
+                               cf_error *err)
+{
+    const char *kind = sc->kind == CF_PROTO_CYCLES ? "cycles"
+                       : sc->kind == CF_PROTO_HOLD ? "hold"
+                                                   : "history";
+    lx->stress_drive = sc->drive != CF_DRIVE_DISPLACEMENT;
+    const cf_msm_effects *e = &sc->effects;
+    if (e->gravity_mm_per_s2 != 0)
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: key 'effects.gravity': the lattice export writes no body force",
+                            name);
+    char left[200] = "";
+    size_t n = 0;
+    if (e->prony_count > 0)
+        n += (size_t)snprintf(left + n, sizeof left - n, "%s%d Prony terms (viscosity)",
+                              n ? ", " : "", e->prony_count);
+    if (e->maxwell_E_MPa != 0 && n < sizeof left)
+        n += (size_t)snprintf(left + n, sizeof left - n, "%sthe Maxwell branch (viscosity)",
+                              n ? ", " : "");
+    if (e->eta_MPa_s != 0 && n < sizeof left)
+        n += (size_t)snprintf(left + n, sizeof left - n, "%sthe dashpots (damping)",
+                              n ? ", " : "");
+    if (e->inertia && n < sizeof left)
+        snprintf(left + n, sizeof left - n, "%sinertia", n ? ", " : "");
+    snprintf(lx->note, sizeof lx->note,
+             "protocol '%s' written as its quasi-static displacement history, one static "
+             "step per sample, of the elastic lattice%s%s%s; the reference reactions are "
+             "conifit's elastic run along the same path, not the scene's simulation",
+             kind,
+             lx->stress_drive ? " (its stress history turned into the strains of conifit's "
+                                "elastic lattice under it, force-driven)"
+                              : "",
+             left[0] ? ": not carried: " : "", left);
+    return CF_OK;
+}
+
 cf_status cf_export_lattice_from_scene(const cf_scene *sc, const char *name,
                                        cf_export_lattice *lx, cf_error *err)
 {
     memset(lx, 0, sizeof *lx);
     cf_validate_setup v;
-    cf_status st = cf_validate_from_scene(sc, name, &v, err);
+    const int timed = sc->kind != CF_PROTO_RAMP;
+    cf_status st = timed ? time_protocol(sc, name, lx, err) : CF_OK;
+    if (st != CF_OK)
+        return st;
+    if (timed) { /* the elastic lattice along the protocol's displacement history */
+        cf_scene elastic = *sc;
+        elastic.kind = CF_PROTO_RAMP;
+        elastic.drive = CF_DRIVE_DISPLACEMENT; /* a stress history: its strains, see above */
+        memset(&elastic.effects, 0, sizeof elastic.effects);
+        st = cf_validate_from_scene(&elastic, name, &v, err);
+    } else
+        st = cf_validate_from_scene(sc, name, &v, err);
     if (st != CF_OK)
         return st;
     lx->cfg = v.cfg;
@@ -59,7 +109,7 @@ cf_status cf_export_lattice_from_scene(const cf_scene *sc, const char *name,
                                 "%s: %zu samples: a lattice export takes at most %d load steps "
                                 "(use fewer samples_per_segment)",
                                 name, sc->nsamples, CF_EXPORT_MAX_STEPS);
-        if (e == 0.0)
+        if (e == 0.0 && !timed)
             continue;
         lx->strain[lx->nsteps++] = e;
     }
@@ -225,12 +275,11 @@ static int lattice_model(cf_xmodel *m, const cf_lattice *lat, const cf_law *law,
 
 /* Why the lattice cannot follow the loading (the reference run failed with run_err, was
 ** unstable from step `unstable` with `pivots` negative pivots, or compressed a spring to umax
-** past u_limit), with the largest strain that works: CF_E_DATA. */
-static cf_status refuse_loading(cf_lattice *lat, const cf_law *law, const cf_export_lattice *lx,
+** past u_limit), with the largest strain that works (its first ok steps): CF_E_DATA. */
+static cf_status refuse_loading(const cf_law *law, const cf_export_lattice *lx, size_t ok,
                                 cf_status run_st, const cf_error *run_err, double umax,
                                 double u_limit, size_t unstable, long pivots, cf_error *err)
 {
-    const size_t ok = steps_that_work(lat, lx, u_limit, lx->nsteps);
     char works[160];
     if (ok > 0)
         snprintf(works, sizeof works, "the loading works up to strain %.6g (step %zu)",
@@ -262,6 +311,85 @@ static cf_status refuse_loading(cf_lattice *lat, const cf_law *law, const cf_exp
                         where, lx->strain[unstable - 1], unstable, pivots, works);
 }
 
+/* A stress-driven loading (lx->stress_drive) as the strains conifit's elastic lattice takes
+** under it, force-driven, into *strained; lx itself otherwise. NULL, *st and err set, when the
+** run fails. */
+static const cf_export_lattice *strained_loading(cf_lattice *lat, const cf_export_lattice *lx,
+                                                 cf_export_lattice *strained, cf_status *st,
+                                                 cf_error *err)
+{
+    if (!lx->stress_drive)
+        return lx;
+    double t[CF_EXPORT_MAX_STEPS + 1], v[CF_EXPORT_MAX_STEPS + 1];
+    cf_msm_sample out[CF_EXPORT_MAX_STEPS];
+    t[0] = 0.0;
+    v[0] = 0.0;
+    for (size_t k = 0; k < lx->nsteps; k++) {
+        t[k + 1] = (double)(k + 1);
+        v[k + 1] = lx->strain[k];
+    }
+    const cf_msm_path path = {CF_DRIVE_FORCE, lx->nsteps + 1, t, v};
+    const cf_msm_effects none = {0};
+    cf_msm_stats stats = {0};
+    size_t done = 0;
+    cf_lattice_reset(lat);
+    cf_error e = {0};
+    *st = cf_msm_run(lat, &none, &lx->cfg, &path, t + 1, lx->nsteps, out, &done, &stats, &e);
+    cf_lattice_reset(lat);
+    if (*st != CF_OK) {
+        cf_error_set(err, *st, "the elastic lattice under the scene's stress history: %s", e.msg);
+        return NULL;
+    }
+    *strained = *lx;
+    strained->stress_drive = 0;
+    for (size_t k = 0; k < lx->nsteps; k++)
+        strained->strain[k] = out[k].strain;
+    return strained;
+}
+
+/* The loading to write: lx when conifit's lattice follows it (stably, within the tables), else
+** its leading steps that it follows, in *part, with why the rest is cut at the end of note (after
+** lx->note); conifit's reactions along it into ref. NULL, *st and err set, when not even the first
+** step works or memory runs out. */
+static const cf_export_lattice *loading_that_works(cf_lattice *lat, const cf_law *law,
+                                                   const cf_export_table *t,
+                                                   const cf_export_lattice *lx,
+                                                   cf_export_lattice *part, double *ref,
+                                                   char *note, size_t cap, cf_status *st,
+                                                   cf_error *err)
+{
+    double umax = 0.0;
+    size_t unstable = 0;
+    long pivots = 0;
+    cf_error run_err = {0};
+    snprintf(note, cap, "%s", lx->note);
+    cf_status rs = reference_run(lat, lx, ref, &umax, &unstable, &pivots, &run_err);
+    /* the table's ends against the largest compression (either side: max_u_over_travel is of
+    ** each spring's own side's travel) */
+    const double u_limit = fmin(t->u_hi_mm, -t->u_lo_mm);
+    if (rs == CF_OK && umax <= u_limit && !unstable)
+        return lx;
+    const size_t ok = steps_that_work(lat, lx, u_limit, lx->nsteps);
+    cf_error why = {0};
+    refuse_loading(law, lx, ok, rs, &run_err, umax, u_limit, unstable, pivots, &why);
+    if (ok == 0) {
+        *st = cf_error_set(err, CF_E_DATA, "%s", why.msg);
+        return NULL;
+    }
+    *part = *lx;
+    part->nsteps = ok;
+    if ((rs = reference_run(lat, part, ref, &umax, &unstable, &pivots, &run_err)) != CF_OK) {
+        *st = cf_error_set(err, rs, "%s", run_err.msg); /* it worked in the bisection */
+        return NULL;
+    }
+    const size_t n = strlen(note);
+    snprintf(note + n, cap - n,
+             "%sthe loading is cut after step %zu of %zu (strain %.6g), where conifit's lattice "
+             "stops following it: %s",
+             n ? "; " : "", ok, lx->nsteps, lx->strain[ok - 1], why.msg);
+    return part;
+}
+
 /* Builds the table and the lattice, runs conifit's reference along the loading (refusing a
 ** loading the lattice cannot follow), then writes the model. */
 cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
@@ -274,7 +402,9 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
     cf_export_table t = {0};
     cf_xmodel m = {0};
     cf_export_report r = {0};
-    char title[256];
+    char title[256], note[sizeof r.warning];
+    cf_export_lattice part, strained;
+    double ref[CF_EXPORT_MAX_STEPS];
     memset(&lat, 0, sizeof lat);
     memset(&ext, 0, sizeof ext);
     cf_status st = check_loading(opt, lx, err);
@@ -297,26 +427,19 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
     if ((st = cf_export_table_for(&law, opt, &t, err)) != CF_OK ||
         (st = cf_lattice_create(&lat, &law, lx->method, &lc, err)) != CF_OK)
         goto done;
+    if (!(lx = strained_loading(&lat, lx, &strained, &st, err)) ||
+        !(lx = loading_that_works(&lat, &law, &t, lx, &part, ref, note, sizeof note, &st, err)))
+        goto done;
     if (lattice_model(&m, &lat, &law, &t, lx, opt, title, sizeof title) != 0)
         goto oom;
+    m.note = note;
+    memcpy(m.ref_N, ref, m.nsteps * sizeof *m.ref_N);
     const char *no_volume = cf_xmodel_volume_refusal(&m, opt->format);
     if (no_volume) {
         st = cf_error_set(err, CF_E_DATA,
                           "the lattice has a volume term (kappa = %g MPa) that format %s cannot "
                           "carry: %s",
                           m.kappa_MPa, cf_export_format_name(opt->format), no_volume);
-        goto done;
-    }
-    double umax = 0.0;
-    size_t unstable = 0;
-    long pivots = 0;
-    cf_error run_err = {0};
-    st = reference_run(&lat, lx, m.ref_N, &umax, &unstable, &pivots, &run_err);
-    /* the table's ends against the largest compression (either side: max_u_over_travel is of
-    ** each spring's own side's travel) */
-    const double u_limit = fmin(t.u_hi_mm, -t.u_lo_mm);
-    if (st != CF_OK || umax > u_limit || unstable) {
-        st = refuse_loading(&lat, &law, lx, st, &run_err, umax, u_limit, unstable, pivots, err);
         goto done;
     }
     for (size_t k = 0; k < m.nsteps; k++)
@@ -332,6 +455,7 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
     r.springs = m.ns;
     r.nodes = m.nn;
     r.steps = m.nsteps;
+    snprintf(r.warning, sizeof r.warning, "%s", note);
     if (ferror(out))
         st = cf_error_set(err, CF_E_CANTWRITE, "cannot write the %s lattice export",
                           cf_export_format_name(opt->format));

@@ -245,6 +245,8 @@ void cf_xmodel_header(FILE *out, const char *lead, const char *tail, const cf_xm
                 "%sloading: the %zu top nodes move along z together (x, y free unless fixed); at "
                 "each step, conifit's compressive top reaction (N) for comparison:%s\n",
                 lead, m->ntop, tail);
+    if (m->note && m->note[0])
+        fprintf(out, "%snote: %s%s\n", lead, m->note, tail);
     fprintf(out,
             "%sreaction tolerance implied by the tables: %.6g N (tol F_C times the weights of "
             "the springs a horizontal plane cuts, projected on z)%s\n",

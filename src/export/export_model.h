@@ -74,6 +74,7 @@ typedef struct cf_xmodel {
     /* The lattice's volume term (cell.h): every cell stores (kappa/2)(J - 1)^2 of its rest volume;
     ** written as an eight-node hexahedron per cell with a purely volumetric material by the
     ** formats that can (CalculiX, Abaqus; cf_xmodel_volume_refusal). */
+    const char *note;       /* NULL or "": else a header line on what the loading leaves out */
     double kappa_MPa;       /* 0: no volume term (a body's or a lattice's) */
     size_t ncells;
     uint32_t *cell;         /* 8 nodes (0-based) per cell, corner di + 2 dj + 4 dk */

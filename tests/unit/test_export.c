@@ -1431,53 +1431,114 @@ static void the_output_extension_names_the_format(void **state)
     fclose(devnull);
 }
 
-static void an_unstable_lattice_loading_is_refused_with_the_strain_that_works(
-    void **state)
+static void an_unstable_lattice_loading_is_cut_where_it_stops_working(void **state)
 {
     (void)state;
     cf_law law;
     law_of(&law, &TEL);
-    /* deep compression: the lattice buckles (its tangent turns indefinite) before the end */
+    /* deep compression: the lattice buckles (its tangent turns indefinite) before the end; the
+    ** model holds the steps before, the header and a warning say where and why it is cut */
     write_scene("latbad.json", 0.9 * law.travel_mm / TEL.H_mm, 10);
     char err[2048], p[160];
-    struct stat st;
     snprintf(p, sizeof p, "%s/latbad.inp", dir);
     assert_int_equal(tu_run(NULL, 0, err, sizeof err,
                             "export %s/fit.json --lattice %s/latbad.json --format calculix -o %s",
                             dir, dir, p),
-                     65);
+                     0);
+    assert_non_null(strstr(err, "warning: the loading is cut after step "));
     assert_non_null(strstr(err, "loses stability"));
-    /* the limit it names is below the unstable step, and a loading just under it is accepted */
+    assert_non_null(strstr(err, "negative pivots"));
+    /* the limit it names is below the unstable step, and a loading just under it is whole */
     const char *lim = strstr(err, "stable up to strain ");
     assert_non_null(lim);
     const double limit = atof(lim + strlen("stable up to strain "));
     assert_true(limit > 0 && limit < 0.9 * law.travel_mm / TEL.H_mm);
+    const char *cut = strstr(err, "cut after step ");
+    const int kept = atoi(cut + strlen("cut after step "));
+    assert_true(kept >= 1 && kept < 10);
+    const double ok = atof(strstr(err, "works up to strain ") + strlen("works up to strain "));
+    assert_true(ok > 0 && ok <= limit);
+    char *x = tu_slurp(p);
+    assert_non_null(x);
+    assert_non_null(strstr(x, "** note: the loading is cut after step "));
+    int steps = 0;
+    for (const char *q = strstr(x, "*STEP"); q; q = strstr(q + 1, "*STEP"))
+        steps++;
+    assert_int_equal(steps, kept);
+    char last[64];
+    snprintf(last, sizeof last, "step %d: ", kept);
+    assert_non_null(strstr(x, last));
+    snprintf(last, sizeof last, "step %d: ", kept + 1);
+    assert_null(strstr(x, last));
+    free(x);
     write_scene("latlim.json", 0.99 * limit, 6);
     char largs[128];
     snprintf(largs, sizeof largs, "--lattice %s/latlim.json --format calculix", dir);
-    free(export_to("latlim.inp", largs));
-    assert_non_null(strstr(err, "negative pivots"));
-    assert_non_null(strstr(err, "the loading works up to strain"));
+    x = export_to("latlim.inp", largs);
+    assert_null(strstr(x, "note:")); /* nothing cut */
+    free(x);
+    /* not even the first step works: refused, nothing written */
+    struct stat st;
+    snprintf(p, sizeof p, "%s/latnone.inp", dir);
+    write_scene("latnone.json", 0.9 * law.travel_mm / TEL.H_mm, 1);
+    assert_int_equal(tu_run(NULL, 0, err, sizeof err,
+                            "export %s/fit.json --lattice %s/latnone.json --format calculix -o %s",
+                            dir, dir, p),
+                     65);
+    assert_non_null(strstr(err, "not even the first step"));
     assert_int_equal(stat(p, &st), -1);
-    /* and the strain it names does work */
-    const double ok = atof(strstr(err, "works up to strain ") + strlen("works up to strain "));
-    assert_true(ok > 0 && ok < law.travel_mm / TEL.H_mm);
-    write_scene("latok.json", ok, 10);
-    char args[128];
-    snprintf(args, sizeof args, "--lattice %s/latok.json --format calculix", dir);
-    free(export_to("latok.inp", args));
-    /* a scene that is not a static uniaxial ramp */
+}
+
+/* A scene's time protocol: load-unload cycles are written as the elastic lattice's displacement
+** history, one step per sample (back to the rest state in between), its header and a warning
+** naming the time effect it leaves out; a ramp under a stress drive is still refused. */
+static void a_time_protocol_is_written_as_its_displacement_history(void **state)
+{
+    (void)state;
+    char p[160], err[2048];
     snprintf(p, sizeof p, "%s/cyc.json", dir);
     FILE *f = fopen(p, "w");
     assert_non_null(f);
     fprintf(f, "{\"spring\": {\"params\": {\"D1_mm\": 10, \"D2_mm\": 30, \"n\": 4, \"d_mm\": 1, "
                "\"G_MPa\": 80000, \"H_mm\": 40}}, \"protocol\": {\"kind\": \"cycles\", "
-               "\"to_strain\": 0.2, \"period_s\": 1, \"count\": 2}}\n");
+               "\"to_strain\": 0.05, \"period_s\": 1, \"count\": 2}, \"samples_per_segment\": 2, "
+               "\"effects\": {\"viscosity\": {\"prony\": [{\"g\": 0.3, \"tau_s\": 2}]}}}\n");
+    fclose(f);
+    char out[160];
+    snprintf(out, sizeof out, "%s/cyc.inp", dir);
+    assert_int_equal(tu_run(NULL, 0, err, sizeof err,
+                            "export %s/fit.json --lattice %s --format calculix -o %s", dir, p, out),
+                     0);
+    assert_non_null(strstr(err, "warning: protocol 'cycles'"));
+    assert_non_null(strstr(err, "not carried: 1 Prony terms (viscosity)"));
+    assert_non_null(strstr(err, "8 load steps"));
+    char *x = tu_slurp(out);
+    assert_non_null(x);
+    assert_non_null(strstr(x, "** note: protocol 'cycles' written as its quasi-static"));
+    /* 0.025, 0.05, 0.025, 0, twice */
+    const double want[8] = {0.025, 0.05, 0.025, 0, 0.025, 0.05, 0.025, 0};
+    const char *q = x;
+    for (int k = 0; k < 8; k++) {
+        char key[48];
+        snprintf(key, sizeof key, "step %d: top z displacement ", k + 1);
+        q = strstr(q, key);
+        assert_non_null(q);
+        const char *s = strstr(q, "(strain ");
+        assert_non_null(s);
+        assert_close(atof(s + strlen("(strain ")), want[k], 1e-9);
+    }
+    free(x);
+    /* a ramp under a stress drive: validation's refusal, naming the key */
+    f = fopen(p, "w");
+    assert_non_null(f);
+    fprintf(f, "{\"spring\": {\"params\": {\"D1_mm\": 10, \"D2_mm\": 30, \"n\": 4, \"d_mm\": 1, "
+               "\"G_MPa\": 80000, \"H_mm\": 40}}, \"protocol\": {\"kind\": \"ramp\", "
+               "\"to_stress_kPa\": 1, \"duration_s\": 1}}\n");
     fclose(f);
     assert_int_equal(tu_run(NULL, 0, err, sizeof err,
                             "export %s/fit.json --lattice %s --format calculix", dir, p),
                      65);
-    assert_non_null(strstr(err, "protocol.kind"));
+    assert_non_null(strstr(err, "to_stress_kPa"));
 }
 
 /* A body (a block of 2 x 2 x 2 cells, no volume term) exported to SOFA by cf_export_write_body:
@@ -1605,7 +1666,8 @@ int main(void)
         cmocka_unit_test(every_format_has_a_runnable_example),
         cmocka_unit_test(the_format_registry_is_whole_and_drives_the_help),
         cmocka_unit_test(the_output_extension_names_the_format),
-        cmocka_unit_test(an_unstable_lattice_loading_is_refused_with_the_strain_that_works),
+        cmocka_unit_test(an_unstable_lattice_loading_is_cut_where_it_stops_working),
+        cmocka_unit_test(a_time_protocol_is_written_as_its_displacement_history),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
