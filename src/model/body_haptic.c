@@ -168,7 +168,7 @@ cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm
                               cf_error *err)
 {
     const size_t n = 3 * b->nn, nn = b->nn;
-    const double kp = penalty_N_per_mm > 0 ? penalty_N_per_mm : 1e4 * b->E_MPa * b->mean_edge_mm;
+    const double kp = penalty_N_per_mm > 0 ? penalty_N_per_mm : cf_body_penalty(b);
     double c[3];
     for (int k = 0; k < 3; k++)
         c[k] = probe->center_mm[k] + depth_mm * probe->dir[k];

@@ -65,7 +65,7 @@ size_t cf_body_contact_set(const cf_body *b, uint8_t *mark)
 
 double cf_body_penalty(const cf_body *b)
 {
-    return 1e4 * b->E_MPa * b->mean_edge_mm; /* as cf_body_solve's automatic penalty */
+    return 1e4 * b->E_MPa * b->mean_edge_mm; /* the static solve's and the haptic step's default */
 }
 
 /* A face of a tetrahedron as its three nodes in increasing order. */

@@ -207,7 +207,7 @@ static cf_status solve_cut(cf_body *b, body_work *w, const cf_probe *probe, cons
 cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
                         double penalty_N_per_mm, cf_body_step *out, cf_error *err)
 {
-    const double kp = penalty_N_per_mm > 0 ? penalty_N_per_mm : 1e4 * b->E_MPa * b->mean_edge_mm;
+    const double kp = penalty_N_per_mm > 0 ? penalty_N_per_mm : cf_body_penalty(b);
     double c[3];
     for (int k = 0; k < 3; k++)
         c[k] = probe->center_mm[k] + depth_mm * probe->dir[k];
