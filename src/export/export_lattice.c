@@ -390,6 +390,68 @@ static const cf_export_lattice *loading_that_works(cf_lattice *lat, const cf_law
     return part;
 }
 
+/* The reaction tolerance of a lattice with a volume term or hourglass control (N, before the
+** factor tol F_C): a table's force error dF (|dF| <= tol F_C, in a spring w dF) moves the
+** equilibrium, and the cells' stiffness turns that move into reaction. To first order (virtual
+** work with the symmetric tangent) a tension dT_s added to spring s changes the top reaction by
+** dT_s dL_s/dD, dL_s/dD the rate of the spring's length along conifit's equilibrium path per unit
+** top displacement D. So |dR| <= tol F_C sum_s w_s |dL_s/dD|, taken here at every step (the rates
+** by a difference of two equilibria 1e-6 of the height apart) and the largest kept; at least
+** `cut`. 0 and the springs' cut, when a run fails. */
+static double propagated_tol(cf_lattice *lat, const cf_export_lattice *lx, double cut)
+{
+    double t[CF_EXPORT_MAX_STEPS + 2], v[CF_EXPORT_MAX_STEPS + 2];
+    cf_msm_sample out[CF_EXPORT_MAX_STEPS + 1];
+    double *La = malloc(lat->ns * sizeof *La);
+    double worst = cut;
+    if (!La)
+        return cut;
+    t[0] = v[0] = 0.0;
+    for (size_t k = 0; k < lx->nsteps; k++) {
+        t[k + 1] = (double)(k + 1);
+        v[k + 1] = lx->strain[k];
+    }
+    const cf_msm_effects none = {0};
+    for (size_t k = 0; k < lx->nsteps; k++) {
+        const double e = lx->strain[k], h = 1e-6 * (e >= 0.0 ? 1.0 : -1.0);
+        double L[2] = {0, 0};
+        for (int pass = 0; pass < 2; pass++) { /* at e, then at e - h (toward rest) */
+            t[k + 2] = (double)(k + 2);
+            v[k + 2] = e - h;
+            const cf_msm_path path = {CF_DRIVE_DISPLACEMENT, k + 2 + (size_t)pass, t, v};
+            cf_msm_stats stats = {0};
+            size_t done = 0;
+            cf_error err = {0};
+            cf_lattice_reset(lat);
+            if (cf_msm_run(lat, &none, &lx->cfg, &path, t + 1, k + 1 + (size_t)pass, out, &done,
+                           &stats, &err) != CF_OK) {
+                cf_lattice_reset(lat);
+                free(La);
+                return cut;
+            }
+            double sum = 0.0;
+            for (size_t s = 0; s < lat->ns; s++) {
+                const size_t i = lat->si[s], j = lat->sj[s];
+                const double len = hypot(hypot(lat->x[j] - lat->x[i], lat->y[j] - lat->y[i]),
+                                         lat->z[j] - lat->z[i]);
+                if (pass == 0)
+                    La[s] = len;
+                else
+                    sum += lat->w[s] * fabs(len - La[s]);
+            }
+            L[pass] = sum;
+        }
+        t[k + 2] = (double)(k + 2); /* the next step back in place */
+        v[k + 2] = k + 1 < lx->nsteps ? lx->strain[k + 1] : 0.0;
+        const double rate = L[1] / (fabs(h) * lat->height_mm);
+        if (isfinite(rate) && rate > worst)
+            worst = rate;
+    }
+    cf_lattice_reset(lat);
+    free(La);
+    return worst;
+}
+
 /* Builds the table and the lattice, runs conifit's reference along the loading (refusing a
 ** loading the lattice cannot follow), then writes the model. */
 cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
@@ -434,6 +496,9 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
         goto oom;
     m.note = note;
     memcpy(m.ref_N, ref, m.nsteps * sizeof *m.ref_N);
+    if (m.ncells > 0) /* the cells' stiffness propagates the tables' error (propagated_tol) */
+        m.reaction_tol_N = t.tol * law.F_C_N *
+                           propagated_tol(&lat, lx, m.reaction_tol_N / (t.tol * law.F_C_N));
     const char *no_volume = cf_xmodel_volume_refusal(&m, opt->format);
     if (no_volume) {
         st = cf_error_set(err, CF_E_DATA,
