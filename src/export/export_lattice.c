@@ -390,6 +390,85 @@ static const cf_export_lattice *loading_that_works(cf_lattice *lat, const cf_law
     return part;
 }
 
+/* What propagated_tol gathers along its run: after every even sample (a step's equilibrium) the
+** springs' lengths, after every odd one (h back toward rest) the largest sum of w |dL| / dD. */
+typedef struct rate_walk {
+    cf_lattice *lat;
+    double *L_mm;        /* lengths at the last step's equilibrium */
+    const double *dD_mm; /* top displacement between a step and its neighbour, per step */
+    double worst;        /* the largest sum so far */
+} rate_walk;
+
+static void rate_sample(void *ctx, size_t done, size_t total, double t_s)
+{
+    (void)total;
+    (void)t_s;
+    rate_walk *r = ctx;
+    const cf_lattice *lat = r->lat;
+    double sum = 0.0;
+    for (size_t s = 0; s < lat->ns; s++) {
+        const size_t i = lat->si[s], j = lat->sj[s];
+        const double len =
+            hypot(hypot(lat->x[j] - lat->x[i], lat->y[j] - lat->y[i]), lat->z[j] - lat->z[i]);
+        if (done % 2 == 1)
+            r->L_mm[s] = len;
+        else
+            sum += lat->w[s] * fabs(len - r->L_mm[s]);
+    }
+    if (done % 2 == 0) {
+        const double rate = sum / r->dD_mm[done / 2 - 1];
+        if (isfinite(rate) && rate > r->worst)
+            r->worst = rate;
+    }
+}
+
+/* The reaction tolerance of a lattice with a volume term or hourglass control (N, before the
+** factor tol F_C): a table's force error dF (|dF| <= tol F_C, in a spring w dF) moves the
+** equilibrium, and the cells' stiffness turns that move into reaction. To first order (virtual
+** work with the symmetric tangent) a tension dT_s added to spring s changes the top reaction by
+** dT_s dL_s/dD, dL_s/dD the rate of the spring's length along conifit's equilibrium path per unit
+** top displacement D. So |dR| <= tol F_C sum_s w_s |dL_s/dD|, taken here at every step (the rates
+** by a difference of two equilibria 1e-6 of the height apart, one run along the loading that
+** steps back by that after every step) and the largest kept; at least `cut`, which is also the
+** answer when memory runs out or the run fails (it followed the same steps as the reference). */
+static double propagated_tol(cf_lattice *lat, const cf_export_lattice *lx, double cut)
+{
+    const size_t n = lx->nsteps, m = 2 * n;
+    double *t = malloc((m + 1) * sizeof *t), *v = malloc((m + 1) * sizeof *v);
+    double *dD = malloc(n * sizeof *dD), *L = malloc(lat->ns * sizeof *L);
+    cf_msm_sample *out = malloc(m * sizeof *out);
+    rate_walk r = {lat, L, dD, cut};
+    if (t && v && dD && L && out) {
+        t[0] = v[0] = 0.0;
+        for (size_t k = 0; k < n; k++) {
+            const double e = lx->strain[k], h = e >= 0.0 ? 1e-6 : -1e-6;
+            t[2 * k + 1] = (double)(2 * k + 1);
+            v[2 * k + 1] = e;
+            t[2 * k + 2] = (double)(2 * k + 2);
+            v[2 * k + 2] = e - h; /* toward rest */
+            dD[k] = 1e-6 * lat->height_mm;
+        }
+        const cf_msm_path path = {CF_DRIVE_DISPLACEMENT, m + 1, t, v};
+        const cf_msm_effects none = {0};
+        cf_msm_config cfg = lx->cfg;
+        cfg.progress = rate_sample;
+        cfg.progress_ctx = &r;
+        cf_msm_stats stats = {0};
+        size_t done = 0;
+        cf_error err = {0};
+        cf_lattice_reset(lat);
+        if (cf_msm_run(lat, &none, &cfg, &path, t + 1, m, out, &done, &stats, &err) != CF_OK)
+            r.worst = cut;
+        cf_lattice_reset(lat);
+    }
+    free(t);
+    free(v);
+    free(dD);
+    free(L);
+    free(out);
+    return r.worst;
+}
+
 /* Builds the table and the lattice, runs conifit's reference along the loading (refusing a
 ** loading the lattice cannot follow), then writes the model. */
 cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
@@ -434,6 +513,9 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
         goto oom;
     m.note = note;
     memcpy(m.ref_N, ref, m.nsteps * sizeof *m.ref_N);
+    if (m.ncells > 0) /* the cells' stiffness propagates the tables' error (propagated_tol) */
+        m.reaction_tol_N = t.tol * law.F_C_N *
+                           propagated_tol(&lat, lx, m.reaction_tol_N / (t.tol * law.F_C_N));
     const char *no_volume = cf_xmodel_volume_refusal(&m, opt->format);
     if (no_volume) {
         st = cf_error_set(err, CF_E_DATA,

@@ -247,10 +247,19 @@ void cf_xmodel_header(FILE *out, const char *lead, const char *tail, const cf_xm
                 lead, m->ntop, tail);
     if (m->note && m->note[0])
         fprintf(out, "%snote: %s%s\n", lead, m->note, tail);
-    fprintf(out,
-            "%sreaction tolerance implied by the tables: %.6g N (tol F_C times the weights of "
-            "the springs a horizontal plane cuts, projected on z)%s\n",
-            lead, m->reaction_tol_N, tail);
+    if (m->ncells > 0 && m->nt == 0) /* a lattice's cells: export_lattice.c, propagated_tol */
+        fprintf(out,
+                "%sreaction tolerance implied by the tables: %.6g N (tol F_C times the largest, "
+                "over the steps, sum of every spring's weight times the rate of its length per "
+                "unit top displacement along conifit's equilibrium path: the tables' error "
+                "carried through the equilibrium with the cells, to first order; at least that of "
+                "the springs a horizontal plane cuts)%s\n",
+                lead, m->reaction_tol_N, tail);
+    else
+        fprintf(out,
+                "%sreaction tolerance implied by the tables: %.6g N (tol F_C times the weights of "
+                "the springs a horizontal plane cuts, projected on z)%s\n",
+                lead, m->reaction_tol_N, tail);
     if (m->kappa_MPa > 0)
         fprintf(out,
                 "%svolume term: each of the %zu %s stores (kappa/2)(J - 1)^2 of its rest "

@@ -63,7 +63,9 @@ typedef struct cf_xmodel {
     double *ref_N;          /* conifit's compressive top reaction at each step, N */
     double *strain;         /* compressive nominal strain at each step, - */
     double reaction_tol_N;  /* what the tables allow in the top reaction: tol F_C times the
-                            ** weights of the springs a horizontal plane cuts, projected on z */
+                            ** weights of the springs a horizontal plane cuts, projected on z;
+                            ** a lattice with cells (volume term, hourglass control): the
+                            ** tables' error propagated through its equilibrium (at least that) */
     double area_mm2;        /* loaded area (lattice: nx ny H^2), mm^2 */
     double height_mm;       /* height along z, mm */
     /* a body's volume term: nt tetrahedra (4 node indices each, not owned); each node a stores
