@@ -156,6 +156,14 @@ int cf_joint_stable_at_rest(const cf_joint_result *r)
     return 1;
 }
 
+int cf_joint_elliptic(const cf_joint_result *r)
+{
+    for (size_t k = 0; k < r->ntables && k < CF_JOINT_MAX; k++)
+        if (r->tab[k].elliptic_checked && !r->tab[k].elliptic_in_range)
+            return 0;
+    return 1;
+}
+
 void cf_joint_free(cf_joint_result *r)
 {
     if (!r)

@@ -58,6 +58,15 @@ typedef struct cf_joint_table {
     /* 1: the lattice is unstable at rest already (stable_to under a thousandth of the range):
     ** never the better type nor the law kept over one that is not */
     int unstable_at_rest;
+    /* strong ellipticity of the homogenised cell (cell_elliptic.h) along the table's mode from 0
+    ** to the same CF_JOINT_STABLE_MARGIN x its farthest strain: elliptic_checked 1 where scanned,
+    ** elliptic_in_range 1 when the acoustic tensor stays positive definite in every direction
+    ** throughout; else elliptic_to the last strain where it does (table sign) and elliptic_n the
+    ** unit direction (reference configuration) where it is first lost (zero where the mode
+    ** cannot go on) */
+    int elliptic_checked, elliptic_in_range;
+    double elliptic_to;
+    double elliptic_n[3];
 } cf_joint_table;
 
 typedef struct cf_joint_result {
@@ -157,6 +166,9 @@ cf_status cf_joint_pair_determined(const cf_table *const *tables, size_t n, cf_e
 int cf_joint_stable(const cf_joint_result *r);
 /* 1 unless a table's check found the lattice unstable at rest (cf_joint_table.unstable_at_rest). */
 int cf_joint_stable_at_rest(const cf_joint_result *r);
+/* 1 unless a table's scan (cf_joint_table.elliptic_checked) found the homogenised cell losing
+** strong ellipticity inside that table's range (to CF_JOINT_STABLE_MARGIN x its farthest strain). */
+int cf_joint_elliptic(const cf_joint_result *r);
 
 /* The joint fit's one stability check, which its search applies to every point it keeps and its
 ** verification to the placed springs: the lattice of law (a pair through law's extension), family

@@ -43,10 +43,13 @@ int cf_joint_better(const cf_joint_report *r)
         const int ri = cf_joint_stable_at_rest(fi_), rb = fb_ && cf_joint_stable_at_rest(fb_);
         const int fi = fi_->fit.feasible != 0, si = cf_joint_stable(fi_);
         const int fb = fb_ && fb_->fit.feasible != 0, sb = fb_ && cf_joint_stable(fb_);
-        if (b < 0 || (ri != rb   ? ri
-                      : fi != fb ? fi
-                      : si != sb ? si
-                                 : fi_->objective < fb_->objective))
+        /* between buildable, stable lattices, a cell that stays strongly elliptic first */
+        const int ei = cf_joint_elliptic(fi_), eb = fb_ && cf_joint_elliptic(fb_);
+        if (b < 0 || (ri != rb                ? ri
+                      : fi != fb              ? fi
+                      : si != sb              ? si
+                      : fi && si && ei != eb ? ei
+                                              : fi_->objective < fb_->objective))
             b = i;
     }
     return b;
@@ -308,6 +311,31 @@ static void stability_text(FILE *o, const cf_joint_report *r, const cf_joint_res
             j->restarts == 1 ? "" : "s", CF_JOINT_STABLE_MARGIN);
 }
 
+/* Whether the homogenised cell stays strongly elliptic over each table's range. */
+static void elliptic_text(FILE *o, const cf_joint_report *r, const cf_joint_result *j)
+{
+    for (size_t k = 0; k < r->ntables; k++) {
+        const cf_joint_table *jt = &j->tab[k];
+        if (!jt->elliptic_checked)
+            continue;
+        if (jt->elliptic_in_range) {
+            fprintf(o, "  %s: strongly elliptic to %.2fx the table's range (the homogenised "
+                       "cell's acoustic tensor positive definite in every direction)\n",
+                    r->tables[k]->path, CF_JOINT_STABLE_MARGIN);
+        } else if (jt->elliptic_n[0] == 0 && jt->elliptic_n[1] == 0 && jt->elliptic_n[2] == 0) {
+            fprintf(o, "  %s: strong ellipticity checked to strain %.4g only (the mode goes no "
+                       "further)\n",
+                    r->tables[k]->path, jt->elliptic_to);
+        } else {
+            fprintf(o, "  %s: loses strong ellipticity at strain %.4g, inside %.2fx the table's "
+                       "range (acoustic tensor singular for direction n = (%.3f, %.3f, %.3f)): "
+                       "the bulk material may localise in bands there\n",
+                    r->tables[k]->path, jt->elliptic_to, CF_JOINT_STABLE_MARGIN,
+                    jt->elliptic_n[0], jt->elliptic_n[1], jt->elliptic_n[2]);
+        }
+    }
+}
+
 char *cf_joint_text(const cf_joint_report *r)
 {
     char *buf = NULL;
@@ -376,6 +404,7 @@ char *cf_joint_text(const cf_joint_report *r)
                     jt->points, a, b, c);
         }
         stability_text(o, r, j);
+        elliptic_text(o, r, j);
         fprintf(o, "  (* homogenised cell: the full lattice has no such boundary conditions; "
                    "%ld cell curves, %.3f s)\n",
                 j->evaluations, j->wall_time_s);
@@ -385,18 +414,23 @@ char *cf_joint_text(const cf_joint_report *r)
     int b = cf_joint_better(r);
     if (b >= 0) {
         /* the reason that decided: buildability when only one spring can be built */
-        int other_infeasible = 0, other_unstable = 0;
+        int other_infeasible = 0, other_unstable = 0, other_nonelliptic = 0;
         for (int i = 0; i < r->nfits; i++) {
-            other_infeasible |= i != b && !r->fits[i].fit.feasible && r->fits[b].fit.feasible;
-            other_unstable |= i != b && r->fits[i].fit.feasible && !cf_joint_stable(&r->fits[i]) &&
-                              cf_joint_stable(&r->fits[b]) &&
-                              r->fits[i].objective < r->fits[b].objective;
+            const cf_joint_result *fi = &r->fits[i], *fb = &r->fits[b];
+            other_infeasible |= i != b && !fi->fit.feasible && fb->fit.feasible;
+            other_unstable |= i != b && fi->fit.feasible && !cf_joint_stable(fi) &&
+                              cf_joint_stable(fb) && fi->objective < fb->objective;
+            other_nonelliptic |= i != b && fi->fit.feasible && cf_joint_stable(fi) &&
+                                 !cf_joint_elliptic(fi) && cf_joint_elliptic(fb) &&
+                                 fi->objective < fb->objective;
         }
         fprintf(o, "\nBetter type: %s (%s %.4g)\n", cf_spring_type_name(r->fits[b].fit.type),
                 other_infeasible ? "the other type's spring cannot be built; weighted objective"
                 : other_unstable ? "the other type's lattice loses stability inside a table's "
                                    "range; weighted objective"
-                                 : "lower weighted objective",
+                : other_nonelliptic ? "the other type's cell loses strong ellipticity inside a "
+                                      "table's range; weighted objective"
+                                    : "lower weighted objective",
                 r->fits[b].objective);
     }
     if (fclose(o) != 0) {
@@ -529,6 +563,14 @@ static json_t *tables_json(const cf_joint_report *r, const cf_joint_result *j)
         if (e && jt->stability_checked) {
             json_object_set_new(e, "stable_in_range", json_boolean(jt->stable_in_range));
             json_object_set_new(e, "stable_to_strain", num(jt->stable_to));
+        }
+        if (e && jt->elliptic_checked) {
+            json_object_set_new(e, "elliptic_in_range", json_boolean(jt->elliptic_in_range));
+            json_object_set_new(e, "elliptic_to_strain", num(jt->elliptic_to));
+            if (!jt->elliptic_in_range)
+                json_object_set_new(e, "elliptic_lost_direction",
+                                    json_pack("[o, o, o]", num(jt->elliptic_n[0]),
+                                              num(jt->elliptic_n[1]), num(jt->elliptic_n[2])));
         }
         json_array_append_new(per, e);
     }
