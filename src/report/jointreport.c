@@ -540,8 +540,8 @@ static void volume_json(json_t *lat, const cf_joint_result *j)
     json_object_set_new(lat, "modulus_extension_MPa", num(j->E_extension_MPa));
 }
 
-/* Fit j's numbers in each table: its RMSE in the cell and the lattice, AIC, and the stability
-** of its lattice over the table's range (uniaxial tables). */
+/* Fit j's numbers in each table: its RMSE in the cell and the lattice, AIC, the stability of
+** its lattice and the strong ellipticity of its cell over the table's range. */
 static json_t *tables_json(const cf_joint_report *r, const cf_joint_result *j)
 {
     json_t *per = json_array();
