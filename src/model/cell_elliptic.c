@@ -8,12 +8,12 @@
 #include <string.h>
 
 /* Steps of the scan from 0 to the reach, and bisections of a step where ellipticity is lost. */
-#define SCAN_STEPS 64
+#define SCAN_STEPS 32
 #define BISECTIONS 20
 /* Grid directions the pattern search starts from, and its first and last angular step, rad. */
-#define REFINE_STARTS 4
+#define REFINE_STARTS 2
 #define STEP_FIRST 0.1
-#define STEP_LAST 1e-8
+#define STEP_LAST 1e-7
 
 /* The smallest eigenvalue of the symmetric 3 x 3 matrix a (row-major; overwritten) by cyclic
 ** Jacobi rotations (Golub & Van Loan, Matrix Computations, 4th ed., sec. 8.5): accurate to
