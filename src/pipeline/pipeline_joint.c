@@ -10,17 +10,11 @@
 #include "fit/joint.h"
 #include "fit/lawkind.h"
 
-/* 1 when the joint fit r meets every target but ellipticity: a buildable element, a lattice
-** stable over every table's range. */
-static int within_targets(const cf_joint_result *r)
-{
-    return r->fit.feasible && cf_joint_stable(r) && cf_joint_stable_at_rest(r);
-}
-
 /* 1 when the joint fit b is kept over a (the one law choice, cf_law_pick): asked for, or
 ** feasible with a lower joint AIC and a lattice stable over every table's range unless a's is
 ** not either; between two fits that are both buildable and stable, the one whose cell stays
-** strongly elliptic over every range whatever the AIC. */
+** strongly elliptic over every range when its objective is within CF_JOINT_ELLIPTIC_SLACK of the
+** other's. */
 static int pick(const cf_joint_result *a, const cf_joint_result *b, int asked)
 {
     /* a lattice unstable at rest models no solid: never kept over one that is stable there */
@@ -29,10 +23,12 @@ static int pick(const cf_joint_result *a, const cf_joint_result *b, int asked)
     const cf_law_standing s[2] = {{a->fit.feasible, cf_joint_stable(a), a->aic},
                                   {b->fit.feasible, cf_joint_stable(b), b->aic}};
     /* between two buildable lattices stable over every range, the one whose cell stays strongly
-    ** elliptic there (cf_joint_elliptic) whatever the AIC; otherwise the ordinary choice */
-    if (!asked && within_targets(a) && within_targets(b) &&
-        cf_joint_elliptic(a) != cf_joint_elliptic(b))
-        return cf_joint_elliptic(b);
+    ** elliptic there at an objective close enough (cf_joint_elliptic_wins); otherwise the
+    ** ordinary choice */
+    if (!asked && cf_joint_elliptic_wins(b, a))
+        return 1;
+    if (!asked && cf_joint_elliptic_wins(a, b))
+        return 0;
     return cf_law_pick(s, 2, asked ? 1 : -1) == 1;
 }
 
@@ -74,8 +70,8 @@ static cf_status choose_law(const cf_table *const *tables, size_t n,
 }
 
 /* 1 when the pair a ranks above b: a buildable element first, then a lattice stable over every
-** table's range, then (between two such) a cell strongly elliptic over every range, then the
-** lower joint AIC. */
+** table's range, then (between two such, within CF_JOINT_ELLIPTIC_SLACK in objective) a cell
+** strongly elliptic over every range, then the lower joint AIC. */
 static int pair_ranks_above(const cf_joint_result *a, const cf_joint_result *b)
 {
     if (cf_joint_stable_at_rest(a) != cf_joint_stable_at_rest(b))
@@ -84,8 +80,8 @@ static int pair_ranks_above(const cf_joint_result *a, const cf_joint_result *b)
         return a->fit.feasible;
     if (cf_joint_stable(a) != cf_joint_stable(b))
         return cf_joint_stable(a);
-    if (within_targets(a) && cf_joint_elliptic(a) != cf_joint_elliptic(b))
-        return cf_joint_elliptic(a);
+    if (cf_joint_elliptic_wins(a, b) || cf_joint_elliptic_wins(b, a))
+        return cf_joint_elliptic_wins(a, b);
     return a->aic < b->aic;
 }
 

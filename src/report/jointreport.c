@@ -43,13 +43,15 @@ int cf_joint_better(const cf_joint_report *r)
         const int ri = cf_joint_stable_at_rest(fi_), rb = fb_ && cf_joint_stable_at_rest(fb_);
         const int fi = fi_->fit.feasible != 0, si = cf_joint_stable(fi_);
         const int fb = fb_ && fb_->fit.feasible != 0, sb = fb_ && cf_joint_stable(fb_);
-        /* between buildable, stable lattices, a cell that stays strongly elliptic first */
-        const int ei = cf_joint_elliptic(fi_), eb = fb_ && cf_joint_elliptic(fb_);
-        if (b < 0 || (ri != rb                ? ri
-                      : fi != fb              ? fi
-                      : si != sb              ? si
-                      : fi && si && ei != eb ? ei
-                                              : fi_->objective < fb_->objective))
+        /* between buildable, stable lattices, a cell that stays strongly elliptic first when
+        ** its objective is close enough (cf_joint_elliptic_wins) */
+        const int ei = fb_ && cf_joint_elliptic_wins(fi_, fb_);
+        const int eb = fb_ && cf_joint_elliptic_wins(fb_, fi_);
+        if (b < 0 || (ri != rb   ? ri
+                      : fi != fb ? fi
+                      : si != sb ? si
+                      : ei != eb ? ei
+                                 : fi_->objective < fb_->objective))
             b = i;
     }
     return b;
@@ -420,8 +422,7 @@ char *cf_joint_text(const cf_joint_report *r)
             other_infeasible |= i != b && !fi->fit.feasible && fb->fit.feasible;
             other_unstable |= i != b && fi->fit.feasible && !cf_joint_stable(fi) &&
                               cf_joint_stable(fb) && fi->objective < fb->objective;
-            other_nonelliptic |= i != b && fi->fit.feasible && cf_joint_stable(fi) &&
-                                 !cf_joint_elliptic(fi) && cf_joint_elliptic(fb) &&
+            other_nonelliptic |= i != b && cf_joint_elliptic_wins(fb, fi) &&
                                  fi->objective < fb->objective;
         }
         fprintf(o, "\nBetter type: %s (%s %.4g)\n", cf_spring_type_name(r->fits[b].fit.type),

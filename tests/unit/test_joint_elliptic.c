@@ -1,7 +1,8 @@
 /*
 ** Tests of the better type's choice with strong ellipticity (report/jointreport.c,
 ** cf_joint_better; fit/joint.c, cf_joint_elliptic): between two buildable lattices stable over
-** every range, the one whose cell stays strongly elliptic is kept even at a higher objective;
+** every range, the one whose cell stays strongly elliptic is kept even at a higher objective
+** within CF_JOINT_ELLIPTIC_SLACK (1.1x), not beyond;
 ** between two that are both elliptic or both not, the lower objective as before; a fit that is
 ** not buildable or not stable still loses to one that is, elliptic or not.
 */
@@ -44,17 +45,21 @@ static void elliptic_kept_between_fits_within_the_targets(void **state)
     assert_int_equal(cf_joint_elliptic(&j), 0);
     j.tab[0].elliptic_checked = 0; /* not scanned: no verdict against it */
     assert_int_equal(cf_joint_elliptic(&j), 1);
-    /* both buildable and stable: the elliptic one, whichever objective is lower */
-    assert_int_equal(better(1, 1, 0, 0.01, 1, 1, 1, 0.02), 1);
-    assert_int_equal(better(1, 1, 1, 0.02, 1, 1, 0, 0.01), 0);
+    /* both buildable and stable: the elliptic one at an objective within
+    ** CF_JOINT_ELLIPTIC_SLACK of the other's, whichever is lower */
+    assert_int_equal(better(1, 1, 0, 0.01, 1, 1, 1, 0.0105), 1);
+    assert_int_equal(better(1, 1, 1, 0.0105, 1, 1, 0, 0.01), 0);
+    /* further off, the lower objective (the report says where its cell loses ellipticity) */
+    assert_int_equal(better(1, 1, 0, 0.01, 1, 1, 1, 0.02), 0);
+    assert_int_equal(better(1, 1, 1, 0.02, 1, 1, 0, 0.01), 1);
     /* both elliptic, or both not: the lower objective, as before */
-    assert_int_equal(better(1, 1, 1, 0.02, 1, 1, 1, 0.01), 1);
-    assert_int_equal(better(1, 1, 0, 0.01, 1, 1, 0, 0.02), 0);
+    assert_int_equal(better(1, 1, 1, 0.0105, 1, 1, 1, 0.01), 1);
+    assert_int_equal(better(1, 1, 0, 0.01, 1, 1, 0, 0.0105), 0);
     /* buildable and stable come first */
-    assert_int_equal(better(1, 1, 0, 0.02, 0, 1, 1, 0.01), 0);
-    assert_int_equal(better(1, 1, 0, 0.02, 1, 0, 1, 0.01), 0);
+    assert_int_equal(better(1, 1, 0, 0.0105, 0, 1, 1, 0.01), 0);
+    assert_int_equal(better(1, 1, 0, 0.0105, 1, 0, 1, 0.01), 0);
     /* neither stable: ellipticity does not decide */
-    assert_int_equal(better(1, 0, 0, 0.01, 1, 0, 1, 0.02), 0);
+    assert_int_equal(better(1, 0, 0, 0.01, 1, 0, 1, 0.0105), 0);
 }
 
 int main(void)

@@ -307,9 +307,11 @@ static double acoustic_at(const cf_cell *cell, cf_mode m, double e, const double
 
 /* Every fit of r states for each table whether its cell stays strongly elliptic to 1.05x the
 ** range; where it does not, the acoustic tensor at the direction reported is positive definite
-** before the strain reported and not just past it (checked apart from the scan); the kept fit's
-** cell stays elliptic throughout (the cortex: measured so; the telescoping pair loses it in
-** tension at 5.6 %), and the report and the fit file (file, its text) say so. */
+** before the strain reported and not just past it (checked apart from the scan); no other type
+** is elliptic within CF_JOINT_ELLIPTIC_SLACK of the kept fit's objective where the kept one is
+** not (the cortex: the kept non-telescoping pair, 0.008504, loses it in tension at 5.6 %; the
+** telescoping one, elliptic, ends at 0.02987), and the report and the fit file (file, its text)
+** say so. */
 static void assert_elliptic_verdicts(const cf_joint_report *r, const char *file)
 {
     int lost = 0;
@@ -343,7 +345,9 @@ static void assert_elliptic_verdicts(const cf_joint_report *r, const char *file)
         cf_law_free(&law);
     }
     const int b = cf_joint_better(r);
-    assert_true(b >= 0 && cf_joint_elliptic(&r->fits[b]));
+    assert_true(b >= 0);
+    for (int i = 0; i < r->nfits; i++) /* no other type elliptic within the slack */
+        assert_false(cf_joint_elliptic_wins(&r->fits[i], &r->fits[b]));
     char *text = cf_joint_text(r);
     assert_non_null(text);
     assert_non_null(strstr(text, "strongly elliptic to 1.05x the table's range"));
