@@ -338,6 +338,32 @@ static void elliptic_text(FILE *o, const cf_joint_report *r, const cf_joint_resu
     }
 }
 
+/* The better type and the reason that decided it. */
+static void better_text(FILE *o, const cf_joint_report *r)
+{
+    const int b = cf_joint_better(r);
+    if (b >= 0) {
+        /* the reason that decided: buildability when only one spring can be built */
+        int other_infeasible = 0, other_unstable = 0, other_nonelliptic = 0;
+        for (int i = 0; i < r->nfits; i++) {
+            const cf_joint_result *fi = &r->fits[i], *fb = &r->fits[b];
+            other_infeasible |= i != b && !fi->fit.feasible && fb->fit.feasible;
+            other_unstable |= i != b && fi->fit.feasible && !cf_joint_stable(fi) &&
+                              cf_joint_stable(fb) && fi->objective < fb->objective;
+            other_nonelliptic |= i != b && cf_joint_elliptic_wins(fb, fi) &&
+                                 fi->objective < fb->objective;
+        }
+        fprintf(o, "\nBetter type: %s (%s %.4g)\n", cf_spring_type_name(r->fits[b].fit.type),
+                other_infeasible ? "the other type's spring cannot be built; weighted objective"
+                : other_unstable ? "the other type's lattice loses stability inside a table's "
+                                   "range; weighted objective"
+                : other_nonelliptic ? "the other type's cell loses strong ellipticity inside a "
+                                      "table's range; weighted objective"
+                                    : "lower weighted objective",
+                r->fits[b].objective);
+    }
+}
+
 char *cf_joint_text(const cf_joint_report *r)
 {
     char *buf = NULL;
@@ -413,27 +439,7 @@ char *cf_joint_text(const cf_joint_report *r)
     }
     law_choice_text(o, r);
     pair_choice_text(o, r);
-    int b = cf_joint_better(r);
-    if (b >= 0) {
-        /* the reason that decided: buildability when only one spring can be built */
-        int other_infeasible = 0, other_unstable = 0, other_nonelliptic = 0;
-        for (int i = 0; i < r->nfits; i++) {
-            const cf_joint_result *fi = &r->fits[i], *fb = &r->fits[b];
-            other_infeasible |= i != b && !fi->fit.feasible && fb->fit.feasible;
-            other_unstable |= i != b && fi->fit.feasible && !cf_joint_stable(fi) &&
-                              cf_joint_stable(fb) && fi->objective < fb->objective;
-            other_nonelliptic |= i != b && cf_joint_elliptic_wins(fb, fi) &&
-                                 fi->objective < fb->objective;
-        }
-        fprintf(o, "\nBetter type: %s (%s %.4g)\n", cf_spring_type_name(r->fits[b].fit.type),
-                other_infeasible ? "the other type's spring cannot be built; weighted objective"
-                : other_unstable ? "the other type's lattice loses stability inside a table's "
-                                   "range; weighted objective"
-                : other_nonelliptic ? "the other type's cell loses strong ellipticity inside a "
-                                      "table's range; weighted objective"
-                                    : "lower weighted objective",
-                r->fits[b].objective);
-    }
+    better_text(o, r);
     if (fclose(o) != 0) {
         free(buf);
         return NULL;
