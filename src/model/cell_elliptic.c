@@ -32,7 +32,8 @@ static double sym3_min_eigen(double a[9])
                 if (apq == 0)
                     continue;
                 const double theta = (a[3 * q + q] - a[3 * p + p]) / (2.0 * apq);
-                const double t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1));
+                const double t =
+                    (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1));
                 const double c = 1.0 / sqrt(t * t + 1), s = t * c;
                 for (int k = 0; k < 3; k++) { /* columns p, q of a J */
                     const double akp = a[3 * k + p], akq = a[3 * k + q];
@@ -166,8 +167,8 @@ cf_status cf_acoustic_min(const double A[81], double *q_min_MPa, double n[3], cf
         if (fabs(nb[a]) > fabs(nb[big]))
             big = a;
     const double sign = nb[big] < 0 ? -1.0 : 1.0;
-    for (int a = 0; a < 3; a++)
-        n[a] = sign * nb[a] + 0.0;
+    for (int a = 0; a < 3; a++) /* rounding-level components as zero (no "-0.000" printed) */
+        n[a] = fabs(nb[a]) < 1e-9 ? 0.0 : sign * nb[a];
     *q_min_MPa = qb;
     return CF_OK;
 }

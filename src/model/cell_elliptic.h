@@ -23,7 +23,8 @@
 
 /* The smallest eigenvalue (MPa) over unit n of Q(n)_ik = A[27 i + 9 j + 3 k + l] n_j n_l (A a
 ** first elasticity tensor as cf_cell_tangent gives it, major-symmetric), and the n where it is
-** reached (unit, its largest component positive; Q(n) = Q(-n)). CF_E_DATA when A is not finite. */
+** reached (unit, its largest component positive, components under 1e-9 zero; Q(n) = Q(-n)).
+** CF_E_DATA when A is not finite. */
 cf_status cf_acoustic_min(const double A[81], double *q_min_MPa, double n[3], cf_error *err);
 
 /* Follows mode m from strain 0 to `reach` (table sign, tension positive) and returns in *limit

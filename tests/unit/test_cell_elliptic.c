@@ -18,7 +18,8 @@ static void moduli(double lambda, double mu, double beta, const double m[3], dou
             for (int k = 0; k < 3; k++)
                 for (int l = 0; l < 3; l++)
                     A[27 * i + 9 * j + 3 * k + l] =
-                        lambda * (i == j) * (k == l) + mu * ((i == k) * (j == l) + (i == l) * (j == k)) +
+                        lambda * (i == j) * (k == l) +
+                        mu * ((i == k) * (j == l) + (i == l) * (j == k)) +
                         beta * m[i] * m[j] * m[k] * m[l];
 }
 

@@ -365,7 +365,8 @@ static void assert_elliptic_verdicts(const cf_joint_report *r, const char *file)
 ** control, a conical compression spring, whose optimum buckled without it; 0.01248 before, with a
 ** tailed one);
 ** every table's cell curve finite; the fit file holds params_extension, the tail and
-** lattice.volume_modulus_MPa; each table's strong-ellipticity verdict (assert_elliptic_verdicts). */
+** lattice.volume_modulus_MPa; each table's strong-ellipticity verdict
+** (assert_elliptic_verdicts). */
 static void brain_cortex_stable_pair_below_half_of_ogden(void **state)
 {
     (void)state;
