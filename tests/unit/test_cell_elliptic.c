@@ -3,8 +3,8 @@
 ** (src/model/cell_elliptic.c): an isotropic linear material, Q(n) = (lambda + 2 mu) n n +
 ** mu (I - n n), elliptic exactly when mu > 0 and lambda + 2 mu > 0; a material soft along one
 ** direction m, found there off the sampled grid; the isotropic cell at rest, where every
-** direction gives its shear modulus; and a scan's limit, where the smallest eigenvalue changes
-** sign.
+** direction gives its shear modulus; and the cortex's kept pair, stable in the lattice but not
+** elliptic in tension past 5.6 %, where the smallest eigenvalue changes sign.
 */
 #include "testutil.h"
 
@@ -93,12 +93,59 @@ static void isotropic_cell_at_rest(void **state)
     cf_law_free(&law);
 }
 
+/* The double-acting element and volume term the cortex joint fit keeps (its placed springs,
+** weights and kappa, written here so no data set is needed): stable in the lattice over the
+** tables' ranges, yet its cell loses strong ellipticity in uniaxial tension at strain 0.05584,
+** for a direction normal to the load; elliptic in compression and shear to 1.05x the tables'
+** ranges. Across the limit the smallest eigenvalue changes sign. */
+static void cortex_pair_loses_ellipticity_in_tension(void **state)
+{
+    (void)state;
+    const cf_spring sc = {0.46145949727262353, 2.1820760139457613, 5.592966167537142,
+                          0.15381983242420783, 23010.13512586006,  10.0,
+                          18.642809294715978,  8.094328817761534};
+    const cf_spring se = {1.752283017588974, 19.250008852901402, 14.97851003403528,
+                          0.5840943391379154, 7725.410265974434, 10.0};
+    cf_law law, ext;
+    assert_int_equal(cf_law_init(&law, &sc, NULL), CF_OK);
+    assert_int_equal(cf_law_init(&ext, &se, NULL), CF_OK);
+    assert_int_equal(cf_law_pair(&law, &ext, NULL), CF_OK);
+    const double w[3] = {0.6084898469281491, 0.27083625580635917, 0.27083625580635917};
+    cf_cell c;
+    assert_int_equal(cf_cell_init(&c, &law, CF_LAW_CLOSED, w, NULL), CF_OK);
+    c.volume_modulus_MPa = 0.012890005109405987;
+    double limit = 0, n[3];
+    int lost = 0;
+    assert_int_equal(cf_cell_elliptic_to(&c, CF_MODE_UNIAXIAL, 0.105, &limit, &lost, n, NULL),
+                     CF_OK);
+    assert_int_equal(lost, 1);
+    assert_true(fabs(limit - 0.05584) < 1e-4);
+    assert_true(fabs(n[2]) < 1e-6 && fabs(n[0] * n[0] + n[1] * n[1] - 1) < 1e-9);
+    for (int side = -1; side <= 1; side += 2) { /* the sign changes across the limit */
+        cf_cell_state s;
+        double A[81], q = 0, m[3];
+        assert_int_equal(cf_cell_mode(&c, CF_MODE_UNIAXIAL, limit * (1 + 0.01 * side), NULL, &s,
+                                      NULL),
+                         CF_OK);
+        assert_int_equal(cf_cell_tangent(&c, s.F, NULL, &s, A, NULL), CF_OK);
+        assert_int_equal(cf_acoustic_min(A, &q, m, NULL), CF_OK);
+        assert_true(side < 0 ? q > 0 : q < 0);
+    }
+    assert_int_equal(cf_cell_elliptic_to(&c, CF_MODE_UNIAXIAL, -0.105, &limit, &lost, n, NULL),
+                     CF_OK);
+    assert_int_equal(lost, 0);
+    assert_int_equal(cf_cell_elliptic_to(&c, CF_MODE_SHEAR, 0.21, &limit, &lost, n, NULL), CF_OK);
+    assert_int_equal(lost, 0);
+    cf_law_free(&law);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(isotropic_linear_material),
         cmocka_unit_test(soft_direction_found),
         cmocka_unit_test(isotropic_cell_at_rest),
+        cmocka_unit_test(cortex_pair_loses_ellipticity_in_tension),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
