@@ -32,8 +32,9 @@ void cf_joint_report_free(cf_joint_report *r)
 }
 
 /* A lattice stable at rest before one that is not (it models no solid at all), then a spring that
-** can be built before one that cannot, then a lattice stable over every table's range, then the
-** lower objective: a tie of the two types' laws (both tailed fits reach the same one) must not
+** can be built before one that cannot, then a lattice stable over every table's range, then a
+** cell strongly elliptic over every range within CF_JOINT_ELLIPTIC_SLACK of the objective
+** (cf_joint_elliptic_wins), then the lower objective: a tie of the two types' laws (both tailed fits reach the same one) must not
 ** hand the user the infeasible spring. */
 int cf_joint_better(const cf_joint_report *r)
 {
@@ -195,8 +196,12 @@ static void pair_choice_text(FILE *o, const cf_joint_report *r)
             fputc('\n', o);
         }
         const char *why = r->law == CF_KIND_DOUBLE ? "asked for (--law double-acting)"
-                          : lc->chose_pair           ? "lower joint AIC"
-                          : !pair->fit.feasible      ? "a spring of the pair is infeasible"
+                          : lc->chose_pair && cf_joint_elliptic_wins(pair, single)
+                              ? "its cell stays strongly elliptic, the single-sided law's not"
+                          : lc->chose_pair      ? "lower joint AIC"
+                          : !pair->fit.feasible ? "a spring of the pair is infeasible"
+                          : cf_joint_elliptic_wins(single, pair)
+                              ? "the pair's cell loses strong ellipticity inside a table's range"
                           : !cf_joint_stable(pair) && pair->aic < single->aic
                               ? "the pair's lattice loses stability inside a table's range"
                               : "the pair does not lower the joint AIC";
@@ -207,7 +212,8 @@ static void pair_choice_text(FILE *o, const cf_joint_report *r)
                        "%.4g, joint AIC %.2f, %d quantities%s%s)\n",
                     "", lc->pair_tail_kept ? "with a tail" : "conical",
                     lc->pair_tail_kept ? "kept (buildable first, then stable over every "
-                                         "table's range, then the lower joint AIC)"
+                                         "table's range, then strongly elliptic within 1.1x "
+                                         "the objective, then the lower joint AIC)"
                                        : "kept (the tailed one is not buildable, stable or "
                                          "lower in joint AIC before it)",
                     lc->pair_tail_kept ? "conical" : "tailed", lc->alt_objective, lc->alt_aic,
