@@ -156,6 +156,26 @@ int cf_joint_stable_at_rest(const cf_joint_result *r)
     return 1;
 }
 
+int cf_joint_elliptic(const cf_joint_result *r)
+{
+    for (size_t k = 0; k < r->ntables && k < CF_JOINT_MAX; k++)
+        if (r->tab[k].elliptic_checked && !r->tab[k].elliptic_in_range)
+            return 0;
+    return 1;
+}
+
+/* Buildable, stable at rest and over every table's range. */
+static int within_targets(const cf_joint_result *r)
+{
+    return r->fit.feasible && cf_joint_stable(r) && cf_joint_stable_at_rest(r);
+}
+
+int cf_joint_elliptic_wins(const cf_joint_result *r2, const cf_joint_result *r1)
+{
+    return within_targets(r1) && within_targets(r2) && cf_joint_elliptic(r2) &&
+           !cf_joint_elliptic(r1) && r2->objective <= CF_JOINT_ELLIPTIC_SLACK * r1->objective;
+}
+
 void cf_joint_free(cf_joint_result *r)
 {
     if (!r)

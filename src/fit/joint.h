@@ -30,6 +30,12 @@
 /* A joint fit's lattice must stay stable to this factor times each table's farthest strain: a
 ** simulator that presses a little further than the test did must not meet a buckled lattice. */
 #define CF_JOINT_STABLE_MARGIN 1.05
+/* Between two candidates both buildable and stable over every range, one whose cell stays strongly
+** elliptic (cf_joint_elliptic) is kept over one whose cell does not only when its weighted
+** objective is at most this factor times the other's: within the 1.1x of a reference solid's fit
+** the joint fit aims at, the elliptic one meets the same target; further off, the better fit is
+** kept and the report says where its cell loses ellipticity. */
+#define CF_JOINT_ELLIPTIC_SLACK 1.1
 /* A fitted volume modulus is a material's, not a free knob: at most the kappa that gives the
 ** lattice of the compression spring this small-strain Poisson's ratio along an axis
 ** (cf_cubic_kappa_of_nu); a stiffer term models no tissue and makes the lattice ill-conditioned. */
@@ -58,6 +64,15 @@ typedef struct cf_joint_table {
     /* 1: the lattice is unstable at rest already (stable_to under a thousandth of the range):
     ** never the better type nor the law kept over one that is not */
     int unstable_at_rest;
+    /* strong ellipticity of the homogenised cell (cell_elliptic.h) along the table's mode from 0
+    ** to the same CF_JOINT_STABLE_MARGIN x its farthest strain: elliptic_checked 1 where scanned,
+    ** elliptic_in_range 1 when the acoustic tensor stays positive definite in every direction
+    ** throughout; else elliptic_to the last strain where it does (table sign) and elliptic_n the
+    ** unit direction (reference configuration) where it is first lost (zero where the mode
+    ** cannot go on) */
+    int elliptic_checked, elliptic_in_range;
+    double elliptic_to;
+    double elliptic_n[3];
 } cf_joint_table;
 
 typedef struct cf_joint_result {
@@ -157,6 +172,12 @@ cf_status cf_joint_pair_determined(const cf_table *const *tables, size_t n, cf_e
 int cf_joint_stable(const cf_joint_result *r);
 /* 1 unless a table's check found the lattice unstable at rest (cf_joint_table.unstable_at_rest). */
 int cf_joint_stable_at_rest(const cf_joint_result *r);
+/* 1 unless a table's scan (cf_joint_table.elliptic_checked) found the homogenised cell losing
+** strong ellipticity inside that table's range (to CF_JOINT_STABLE_MARGIN x its farthest strain). */
+int cf_joint_elliptic(const cf_joint_result *r);
+/* 1 when the candidate r2's ellipticity decides against r1 (both buildable and stable, r2
+** elliptic, r1 not, r2's objective within CF_JOINT_ELLIPTIC_SLACK of r1's). */
+int cf_joint_elliptic_wins(const cf_joint_result *r2, const cf_joint_result *r1);
 
 /* The joint fit's one stability check, which its search applies to every point it keeps and its
 ** verification to the placed springs: the lattice of law (a pair through law's extension), family

@@ -8,6 +8,7 @@
 
 #include "fit/baseline.h"
 #include "model/cell.h"
+#include "model/cell_elliptic.h"
 #include "model/cell_stability.h"
 #include "model/family.h"
 #include "model/msm.h"
@@ -252,6 +253,22 @@ static cf_status table_verdict(const cf_cell *cell, const cf_msm_config *cfg, co
     return CF_OK;
 }
 
+/* Table t's strong-ellipticity verdict for the homogenised cell into jt (cf_cell_elliptic_to over
+** the stability check's range, CF_JOINT_STABLE_MARGIN x the farthest strain). */
+static void table_elliptic(const cf_cell *cell, const cf_table *t, cf_joint_table *jt)
+{
+    const double reach = table_reach(t) * CF_JOINT_STABLE_MARGIN;
+    if (reach == 0)
+        return;
+    double limit = reach;
+    int lost = 0;
+    if (cf_cell_elliptic_to(cell, t->mode, reach, &limit, &lost, jt->elliptic_n, NULL) != CF_OK)
+        return;
+    jt->elliptic_checked = 1;
+    jt->elliptic_in_range = !lost;
+    jt->elliptic_to = limit;
+}
+
 /* Each table in the lattice of the placed spring r->fit: the cell, and the full lattice when the
 ** mode is uniaxial (the verification). */
 cf_status cf_joint_verify_tables(const jctx *c, cf_joint_result *r, cf_error *err)
@@ -292,6 +309,7 @@ cf_status cf_joint_verify_tables(const jctx *c, cf_joint_result *r, cf_error *er
         jt->lattice_rmse = cf_lsq_quality_of(t, jt->lattice_MPa).rmse;
         if ((st = table_verdict(&cell, &full.cfg, t, jt, err)) != CF_OK)
             break;
+        table_elliptic(&cell, t, jt);
         double ss = 0;
         for (size_t i = 0; i < t->count; i++) {
             /* the law's stress at table strain x (tension positive): -F(-x H)/H^2, the odd

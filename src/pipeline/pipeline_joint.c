@@ -12,7 +12,9 @@
 
 /* 1 when the joint fit b is kept over a (the one law choice, cf_law_pick): asked for, or
 ** feasible with a lower joint AIC and a lattice stable over every table's range unless a's is
-** not either. */
+** not either; between two fits that are both buildable and stable, the one whose cell stays
+** strongly elliptic over every range when its objective is within CF_JOINT_ELLIPTIC_SLACK of the
+** other's. */
 static int pick(const cf_joint_result *a, const cf_joint_result *b, int asked)
 {
     /* a lattice unstable at rest models no solid: never kept over one that is stable there */
@@ -20,6 +22,13 @@ static int pick(const cf_joint_result *a, const cf_joint_result *b, int asked)
         return cf_joint_stable_at_rest(b);
     const cf_law_standing s[2] = {{a->fit.feasible, cf_joint_stable(a), a->aic},
                                   {b->fit.feasible, cf_joint_stable(b), b->aic}};
+    /* between two buildable lattices stable over every range, the one whose cell stays strongly
+    ** elliptic there at an objective close enough (cf_joint_elliptic_wins); otherwise the
+    ** ordinary choice */
+    if (!asked && cf_joint_elliptic_wins(b, a))
+        return 1;
+    if (!asked && cf_joint_elliptic_wins(a, b))
+        return 0;
     return cf_law_pick(s, 2, asked ? 1 : -1) == 1;
 }
 
@@ -61,7 +70,8 @@ static cf_status choose_law(const cf_table *const *tables, size_t n,
 }
 
 /* 1 when the pair a ranks above b: a buildable element first, then a lattice stable over every
-** table's range, then the lower joint AIC. */
+** table's range, then (between two such, within CF_JOINT_ELLIPTIC_SLACK in objective) a cell
+** strongly elliptic over every range, then the lower joint AIC. */
 static int pair_ranks_above(const cf_joint_result *a, const cf_joint_result *b)
 {
     if (cf_joint_stable_at_rest(a) != cf_joint_stable_at_rest(b))
@@ -70,6 +80,8 @@ static int pair_ranks_above(const cf_joint_result *a, const cf_joint_result *b)
         return a->fit.feasible;
     if (cf_joint_stable(a) != cf_joint_stable(b))
         return cf_joint_stable(a);
+    if (cf_joint_elliptic_wins(a, b) || cf_joint_elliptic_wins(b, a))
+        return cf_joint_elliptic_wins(a, b);
     return a->aic < b->aic;
 }
 

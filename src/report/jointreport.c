@@ -32,8 +32,9 @@ void cf_joint_report_free(cf_joint_report *r)
 }
 
 /* A lattice stable at rest before one that is not (it models no solid at all), then a spring that
-** can be built before one that cannot, then a lattice stable over every table's range, then the
-** lower objective: a tie of the two types' laws (both tailed fits reach the same one) must not
+** can be built before one that cannot, then a lattice stable over every table's range, then a
+** cell strongly elliptic over every range within CF_JOINT_ELLIPTIC_SLACK of the objective
+** (cf_joint_elliptic_wins), then the lower objective: a tie of the two types' laws (both tailed fits reach the same one) must not
 ** hand the user the infeasible spring. */
 int cf_joint_better(const cf_joint_report *r)
 {
@@ -43,9 +44,14 @@ int cf_joint_better(const cf_joint_report *r)
         const int ri = cf_joint_stable_at_rest(fi_), rb = fb_ && cf_joint_stable_at_rest(fb_);
         const int fi = fi_->fit.feasible != 0, si = cf_joint_stable(fi_);
         const int fb = fb_ && fb_->fit.feasible != 0, sb = fb_ && cf_joint_stable(fb_);
+        /* between buildable, stable lattices, a cell that stays strongly elliptic first when
+        ** its objective is close enough (cf_joint_elliptic_wins) */
+        const int ei = fb_ && cf_joint_elliptic_wins(fi_, fb_);
+        const int eb = fb_ && cf_joint_elliptic_wins(fb_, fi_);
         if (b < 0 || (ri != rb   ? ri
                       : fi != fb ? fi
                       : si != sb ? si
+                      : ei != eb ? ei
                                  : fi_->objective < fb_->objective))
             b = i;
     }
@@ -190,8 +196,12 @@ static void pair_choice_text(FILE *o, const cf_joint_report *r)
             fputc('\n', o);
         }
         const char *why = r->law == CF_KIND_DOUBLE ? "asked for (--law double-acting)"
-                          : lc->chose_pair           ? "lower joint AIC"
-                          : !pair->fit.feasible      ? "a spring of the pair is infeasible"
+                          : lc->chose_pair && cf_joint_elliptic_wins(pair, single)
+                              ? "its cell stays strongly elliptic, the single-sided law's not"
+                          : lc->chose_pair      ? "lower joint AIC"
+                          : !pair->fit.feasible ? "a spring of the pair is infeasible"
+                          : cf_joint_elliptic_wins(single, pair)
+                              ? "the pair's cell loses strong ellipticity inside a table's range"
                           : !cf_joint_stable(pair) && pair->aic < single->aic
                               ? "the pair's lattice loses stability inside a table's range"
                               : "the pair does not lower the joint AIC";
@@ -202,7 +212,8 @@ static void pair_choice_text(FILE *o, const cf_joint_report *r)
                        "%.4g, joint AIC %.2f, %d quantities%s%s)\n",
                     "", lc->pair_tail_kept ? "with a tail" : "conical",
                     lc->pair_tail_kept ? "kept (buildable first, then stable over every "
-                                         "table's range, then the lower joint AIC)"
+                                         "table's range, then strongly elliptic within 1.1x "
+                                         "the objective, then the lower joint AIC)"
                                        : "kept (the tailed one is not buildable, stable or "
                                          "lower in joint AIC before it)",
                     lc->pair_tail_kept ? "conical" : "tailed", lc->alt_objective, lc->alt_aic,
@@ -308,6 +319,57 @@ static void stability_text(FILE *o, const cf_joint_report *r, const cf_joint_res
             j->restarts == 1 ? "" : "s", CF_JOINT_STABLE_MARGIN);
 }
 
+/* Whether the homogenised cell stays strongly elliptic over each table's range. */
+static void elliptic_text(FILE *o, const cf_joint_report *r, const cf_joint_result *j)
+{
+    for (size_t k = 0; k < r->ntables; k++) {
+        const cf_joint_table *jt = &j->tab[k];
+        if (!jt->elliptic_checked)
+            continue;
+        if (jt->elliptic_in_range) {
+            fprintf(o, "  %s: strongly elliptic to %.2fx the table's range (the homogenised "
+                       "cell's acoustic tensor positive definite in every direction)\n",
+                    r->tables[k]->path, CF_JOINT_STABLE_MARGIN);
+        } else if (jt->elliptic_n[0] == 0 && jt->elliptic_n[1] == 0 && jt->elliptic_n[2] == 0) {
+            fprintf(o, "  %s: strong ellipticity checked to strain %.4g only (the mode goes no "
+                       "further)\n",
+                    r->tables[k]->path, jt->elliptic_to);
+        } else {
+            fprintf(o, "  %s: loses strong ellipticity at strain %.4g, inside %.2fx the table's "
+                       "range (acoustic tensor singular for direction n = (%.3f, %.3f, %.3f)): "
+                       "the bulk material may localise in bands there\n",
+                    r->tables[k]->path, jt->elliptic_to, CF_JOINT_STABLE_MARGIN,
+                    jt->elliptic_n[0], jt->elliptic_n[1], jt->elliptic_n[2]);
+        }
+    }
+}
+
+/* The better type and the reason that decided it. */
+static void better_text(FILE *o, const cf_joint_report *r)
+{
+    const int b = cf_joint_better(r);
+    if (b >= 0) {
+        /* the reason that decided: buildability when only one spring can be built */
+        int other_infeasible = 0, other_unstable = 0, other_nonelliptic = 0;
+        for (int i = 0; i < r->nfits; i++) {
+            const cf_joint_result *fi = &r->fits[i], *fb = &r->fits[b];
+            other_infeasible |= i != b && !fi->fit.feasible && fb->fit.feasible;
+            other_unstable |= i != b && fi->fit.feasible && !cf_joint_stable(fi) &&
+                              cf_joint_stable(fb) && fi->objective < fb->objective;
+            other_nonelliptic |= i != b && cf_joint_elliptic_wins(fb, fi) &&
+                                 fi->objective < fb->objective;
+        }
+        fprintf(o, "\nBetter type: %s (%s %.4g)\n", cf_spring_type_name(r->fits[b].fit.type),
+                other_infeasible ? "the other type's spring cannot be built; weighted objective"
+                : other_unstable ? "the other type's lattice loses stability inside a table's "
+                                   "range; weighted objective"
+                : other_nonelliptic ? "the other type's cell loses strong ellipticity inside a "
+                                      "table's range; weighted objective"
+                                    : "lower weighted objective",
+                r->fits[b].objective);
+    }
+}
+
 char *cf_joint_text(const cf_joint_report *r)
 {
     char *buf = NULL;
@@ -376,29 +438,14 @@ char *cf_joint_text(const cf_joint_report *r)
                     jt->points, a, b, c);
         }
         stability_text(o, r, j);
+        elliptic_text(o, r, j);
         fprintf(o, "  (* homogenised cell: the full lattice has no such boundary conditions; "
                    "%ld cell curves, %.3f s)\n",
                 j->evaluations, j->wall_time_s);
     }
     law_choice_text(o, r);
     pair_choice_text(o, r);
-    int b = cf_joint_better(r);
-    if (b >= 0) {
-        /* the reason that decided: buildability when only one spring can be built */
-        int other_infeasible = 0, other_unstable = 0;
-        for (int i = 0; i < r->nfits; i++) {
-            other_infeasible |= i != b && !r->fits[i].fit.feasible && r->fits[b].fit.feasible;
-            other_unstable |= i != b && r->fits[i].fit.feasible && !cf_joint_stable(&r->fits[i]) &&
-                              cf_joint_stable(&r->fits[b]) &&
-                              r->fits[i].objective < r->fits[b].objective;
-        }
-        fprintf(o, "\nBetter type: %s (%s %.4g)\n", cf_spring_type_name(r->fits[b].fit.type),
-                other_infeasible ? "the other type's spring cannot be built; weighted objective"
-                : other_unstable ? "the other type's lattice loses stability inside a table's "
-                                   "range; weighted objective"
-                                 : "lower weighted objective",
-                r->fits[b].objective);
-    }
+    better_text(o, r);
     if (fclose(o) != 0) {
         free(buf);
         return NULL;
@@ -506,8 +553,8 @@ static void volume_json(json_t *lat, const cf_joint_result *j)
     json_object_set_new(lat, "modulus_extension_MPa", num(j->E_extension_MPa));
 }
 
-/* Fit j's numbers in each table: its RMSE in the cell and the lattice, AIC, and the stability
-** of its lattice over the table's range (uniaxial tables). */
+/* Fit j's numbers in each table: its RMSE in the cell and the lattice, AIC, the stability of
+** its lattice and the strong ellipticity of its cell over the table's range. */
 static json_t *tables_json(const cf_joint_report *r, const cf_joint_result *j)
 {
     json_t *per = json_array();
@@ -529,6 +576,14 @@ static json_t *tables_json(const cf_joint_report *r, const cf_joint_result *j)
         if (e && jt->stability_checked) {
             json_object_set_new(e, "stable_in_range", json_boolean(jt->stable_in_range));
             json_object_set_new(e, "stable_to_strain", num(jt->stable_to));
+        }
+        if (e && jt->elliptic_checked) {
+            json_object_set_new(e, "elliptic_in_range", json_boolean(jt->elliptic_in_range));
+            json_object_set_new(e, "elliptic_to_strain", num(jt->elliptic_to));
+            if (!jt->elliptic_in_range)
+                json_object_set_new(e, "elliptic_lost_direction",
+                                    json_pack("[o, o, o]", num(jt->elliptic_n[0]),
+                                              num(jt->elliptic_n[1]), num(jt->elliptic_n[2])));
         }
         json_array_append_new(per, e);
     }

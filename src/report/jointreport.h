@@ -47,8 +47,9 @@ typedef struct cf_joint_report {
 void cf_joint_report_free(cf_joint_report *r);
 
 /* Index of the better fit (a lattice stable at rest first (cf_joint_stable_at_rest), then a
-** feasible spring, then one stable over every table's range (cf_joint_stable), then the lower
-** weighted objective), -1 when none. */
+** feasible spring, then one stable over every table's range (cf_joint_stable), then one whose
+** cell stays strongly elliptic within CF_JOINT_ELLIPTIC_SLACK of the other's objective
+** (cf_joint_elliptic_wins), then the lower weighted objective), -1 when none. */
 int cf_joint_better(const cf_joint_report *r);
 
 /* The readable report (malloc'd; NULL when memory runs out). */
