@@ -169,28 +169,37 @@ static int model_of_lattice(cf_xmodel *m, const cf_lattice *lat)
     return 0;
 }
 
-/* conifit's static run along the loading (the same solver as `conifit simulate`): compressive
-** top reaction (N) at each step into ref_N, the largest spring compression (mm), and the first
-** step whose equilibrium is unstable (negative pivots of the tangent; 0 when none is). */
-static cf_status reference_run(cf_lattice *lat, const cf_export_lattice *lx, double *ref_N,
-                               double *max_u_mm, size_t *unstable, long *pivots, cf_error *err)
+/* conifit's static run of the elastic lattice along lx's values (strains, or stresses when drive
+** is CF_DRIVE_FORCE), one sample per step into out, from and back to the lattice at rest. */
+static cf_status run_loading(cf_lattice *lat, const cf_export_lattice *lx, cf_msm_drive drive,
+                             cf_msm_sample *out, cf_msm_stats *stats, cf_error *err)
 {
     double t[CF_EXPORT_MAX_STEPS + 1], v[CF_EXPORT_MAX_STEPS + 1];
-    cf_msm_sample out[CF_EXPORT_MAX_STEPS];
     t[0] = 0.0;
     v[0] = 0.0;
     for (size_t k = 0; k < lx->nsteps; k++) {
         t[k + 1] = (double)(k + 1);
         v[k + 1] = lx->strain[k];
     }
-    const cf_msm_path path = {CF_DRIVE_DISPLACEMENT, lx->nsteps + 1, t, v};
+    const cf_msm_path path = {drive, lx->nsteps + 1, t, v};
     const cf_msm_effects none = {0};
-    cf_msm_stats stats = {0};
     size_t done = 0;
     cf_lattice_reset(lat);
-    cf_status st = cf_msm_run(lat, &none, &lx->cfg, &path, t + 1, lx->nsteps, out, &done, &stats,
+    cf_status st = cf_msm_run(lat, &none, &lx->cfg, &path, t + 1, lx->nsteps, out, &done, stats,
                               err);
     cf_lattice_reset(lat);
+    return st;
+}
+
+/* conifit's static run along the loading (the same solver as `conifit simulate`): compressive
+** top reaction (N) at each step into ref_N, the largest spring compression (mm), and the first
+** step whose equilibrium is unstable (negative pivots of the tangent; 0 when none is). */
+static cf_status reference_run(cf_lattice *lat, const cf_export_lattice *lx, double *ref_N,
+                               double *max_u_mm, size_t *unstable, long *pivots, cf_error *err)
+{
+    cf_msm_sample out[CF_EXPORT_MAX_STEPS];
+    cf_msm_stats stats = {0};
+    cf_status st = run_loading(lat, lx, CF_DRIVE_DISPLACEMENT, out, &stats, err);
     if (st != CF_OK)
         return st;
     *unstable = 0;
@@ -320,22 +329,10 @@ static const cf_export_lattice *strained_loading(cf_lattice *lat, const cf_expor
 {
     if (!lx->stress_drive)
         return lx;
-    double t[CF_EXPORT_MAX_STEPS + 1], v[CF_EXPORT_MAX_STEPS + 1];
     cf_msm_sample out[CF_EXPORT_MAX_STEPS];
-    t[0] = 0.0;
-    v[0] = 0.0;
-    for (size_t k = 0; k < lx->nsteps; k++) {
-        t[k + 1] = (double)(k + 1);
-        v[k + 1] = lx->strain[k];
-    }
-    const cf_msm_path path = {CF_DRIVE_FORCE, lx->nsteps + 1, t, v};
-    const cf_msm_effects none = {0};
     cf_msm_stats stats = {0};
-    size_t done = 0;
-    cf_lattice_reset(lat);
     cf_error e = {0};
-    *st = cf_msm_run(lat, &none, &lx->cfg, &path, t + 1, lx->nsteps, out, &done, &stats, &e);
-    cf_lattice_reset(lat);
+    *st = run_loading(lat, lx, CF_DRIVE_FORCE, out, &stats, &e);
     if (*st != CF_OK) {
         cf_error_set(err, *st, "the elastic lattice under the scene's stress history: %s", e.msg);
         return NULL;
