@@ -195,7 +195,7 @@ typedef struct cf_export_lattice {
     int stress_drive;           /* 1: strain[] holds compressive nominal stresses (MPa) that
                                 ** conifit's elastic lattice, force-driven, turns into the strains
                                 ** written (a creep protocol) */
-    char note[400];             /* "" or, for a scene's time protocol written as its quasi-static
+    char note[640];             /* "" or, for a scene's time protocol written as its quasi-static
                                 ** displacement history, what the model does not carry (the
                                 ** file's header and the report's warning say it) */
 } cf_export_lattice;
