@@ -100,7 +100,8 @@ cf_status cf_mesh_msh_nodes_once(const char *path, cf_error *err)
     fclose(f);
     if (nt < 0)
         return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory for the mesh", path);
-    qsort(t, (size_t)nt, sizeof *t, cmp_node_line);
+    if (nt > 1) /* (qsort of no nodes would take t NULL) */
+        qsort(t, (size_t)nt, sizeof *t, cmp_node_line);
     cf_status st = CF_OK;
     for (long i = 1; i < nt && st == CF_OK; i++)
         if (t[i].tag == t[i - 1].tag)
