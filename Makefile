@@ -18,7 +18,9 @@
 #                   variable CONIFIT_SIMD selects it), every other program once, at the first
 #                   (widest) level: 79 programs, 8 of them marked, make 95 runs on an AVX-512
 #                   processor instead of 237; SIMD="sse2" runs at the levels named only
-#   make sanitize   the same suite under AddressSanitizer + UndefinedBehaviorSanitizer
+#   make sanitize   the same suite under AddressSanitizer + UndefinedBehaviorSanitizer, every program
+#                   once with the SSE2 copies of the vector code (SIMD= names others; make test
+#                   runs the vector-level programs at every level)
 #   make fuzz       libFuzzer (clang, ASan + UBSan) on each parser for FUZZ_SECONDS (default 60) s
 #   make bench      the benchmark report into build/bench/report/ (optimised build, separate from
 #                   the tests); make bench-update copies it over the committed tests/bench/
@@ -281,7 +283,8 @@ figures: check-deps $(BUILD)/conifit
 # Leaks inside third-party libraries (Gmsh's surface classification) are suppressed by
 # tests/lsan.supp; every test program and every conifit it runs inherits the setting.
 sanitize:
-	@LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp $(MAKE) --no-print-directory test SANITIZE=1
+	@LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp $(MAKE) --no-print-directory test SANITIZE=1 \
+	  SIMD="$(or $(SIMD),sse2)"
 
 # Fuzzing (tests/fuzz/README.md): one libFuzzer harness per parser, the library built again with
 # clang and ASan + UBSan; seed corpora from data/ and fits/. `make test` replays the seeds and the
