@@ -103,7 +103,7 @@ static int write_outputs(const predict_args *a, const cf_predict_result *r,
 {
     cf_error err = {0};
     const int csv_stdout = a->out && cf_cli_is_stdio(a->out);
-    if (!csv_stdout && !a->quiet) {
+    if (!csv_stdout) { /* the report is the result: -q drops only the reader's notes */
         char *text = cf_predict_text(r);
         if (!text) {
             cf_error_set(&err, CF_E_INTERNAL, "out of memory for the report");
