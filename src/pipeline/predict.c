@@ -70,7 +70,9 @@ static cf_status check_table(const pmodel *pm, const cf_table *t, cf_error *err)
                             "force at a displacement is not a stress at a strain",
                             t->path, force ? "force-displacement" : "stress-strain",
                             pm->force ? "force-displacement" : "stress-strain");
-    if (pm->kind == CF_PREDICT_SPRING && !cf_mode_row_of(t->mode)->spring_curve)
+    /* a force-displacement table is one spring's curve whatever its '# mode:' (the fit does not
+    ** honour one either) */
+    if (pm->kind == CF_PREDICT_SPRING && !force && !cf_mode_row_of(t->mode)->spring_curve)
         return cf_error_set(err, CF_E_DATA,
                             "%s: a table in %s, and the fit is of the single spring's law "
                             "(target 'spring'), which is a uniaxial curve only: only a fit "

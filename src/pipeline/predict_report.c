@@ -40,6 +40,13 @@ static void model_words(const cf_predict_result *r, char *out, size_t cap)
              m->weight[0], m->weight[1], m->weight[2], kappa, cf_law_method_name(m->method));
 }
 
+/* The mode column of t: its test mode, or what a force-displacement table is (one spring's
+** curve, whatever its '# mode:'). */
+static const char *mode_word(const cf_table *t)
+{
+    return cf_table_is_force(t) ? "force-displacement" : cf_mode_name(t->mode);
+}
+
 /* The fit's own figures of a table it was fitted to, or "not fitted", into out. */
 static void fitted_cell(const cf_predict_table *pt, char *out, size_t cap)
 {
@@ -60,15 +67,15 @@ static void table_row(FILE *o, const cf_predict_table *pt, int width)
     snprintf(rows, sizeof rows, "%zu/%zu", pt->followed, t->count);
     fitted_cell(pt, fit, sizeof fit);
     if (!pt->ok) {
-        fprintf(o, "  %-*s %-12s %9s %16s %9s %16s %12s %7s  %s\n", width, t->path,
-                cf_mode_name(t->mode), rows, "-", "-", "-", "-", "-", fit);
+        fprintf(o, "  %-*s %-18s %9s %16s %9s %16s %12s %7s  %s\n", width, t->path,
+                mode_word(t), rows, "-", "-", "-", "-", "-", fit);
         return;
     }
     char rmse[48], rms[48];
     snprintf(rmse, sizeof rmse, "%.6g %s", pt->rmse * u, t->y_unit);
     snprintf(rms, sizeof rms, "%.6g %s", pt->rms * u, t->y_unit);
-    fprintf(o, "  %-*s %-12s %9s %16s %9.5f %16s %12.6g %6.1f%%  %s\n", width, t->path,
-            cf_mode_name(t->mode), rows, rmse, pt->r2, rms, pt->term, 100 * pt->share, fit);
+    fprintf(o, "  %-*s %-18s %9s %16s %9.5f %16s %12.6g %6.1f%%  %s\n", width, t->path,
+            mode_word(t), rows, rmse, pt->r2, rms, pt->term, 100 * pt->share, fit);
 }
 
 char *cf_predict_text(const cf_predict_result *r)
@@ -85,8 +92,9 @@ char *cf_predict_text(const cf_predict_result *r)
     int width = 5;
     for (size_t k = 0; k < r->n; k++)
         width = (int)fmax(width, (double)strlen(r->tab[k].table->path));
-    fprintf(o, "  %-*s %-12s %9s %16s %9s %16s %12s %7s  %s\n", width, "table", "mode", "rows",
-            "RMSE", "R^2", "RMS stress", "term", "share", "the fit's own RMSE");
+    fprintf(o, "  %-*s %-18s %9s %16s %9s %16s %12s %7s  %s\n", width, "table", "mode", "rows",
+            "RMSE", "R^2", r->fit.force_displacement ? "RMS force" : "RMS stress", "term", "share",
+            "the fit's own RMSE");
     for (size_t k = 0; k < r->n; k++)
         table_row(o, &r->tab[k], width);
     fprintf(o, "\n term: the table's part of the joint objective, (RMSE / RMS stress)^2 with every "
@@ -129,7 +137,7 @@ void cf_predict_write_csv(const cf_predict_result *r, FILE *f)
         char unit[40];
         cf_safe_text(unit, sizeof unit, t->y_unit, strlen(t->y_unit));
         for (size_t i = 0; i < t->count; i++) {
-            fprintf(f, "%zu,%s,%zu,%.12g,%s,%.12g,", k + 1, cf_mode_name(t->mode), i + 1,
+            fprintf(f, "%zu,%s,%zu,%.12g,%s,%.12g,", k + 1, mode_word(t), i + 1,
                     t->x[i], cf_table_is_force(t) ? "mm" : "-", t->y[i] * u);
             if (pt->follows[i])
                 fprintf(f, "%.12g,%.12g,", pt->model[i] * u, (pt->model[i] - t->y[i]) * u);

@@ -112,7 +112,34 @@ static void single_fit_reproduces_its_rmse(void **state)
     }
 }
 
-#define CORTEX(d, m) d "/brain_cortex_" m ".csv"
+/* A force-displacement fit (the thrombus table, whose '# mode:' a force table does not honour)
+** predicts its table: the fit file's RMSE in its force unit, whatever the mode comment says. */
+static void force_fit_reproduces_its_rmse(void **state)
+{
+    (void)state;
+    const char *d = tu_datasets();
+    if (!d) {
+        print_message("skipped: ../shared/datasets is absent (the thrombus table)\n");
+        skip();
+    }
+    char json[300], table[300];
+    snprintf(json, sizeof json, "%s/thrombus.json", dir);
+    snprintf(table, sizeof table, "%s/thrombus_pureshear_force_displacement.csv", d);
+    int rc = tu_run(out, sizeof out, errb, sizeof errb, "fit %s --type telescoping -q -o %s",
+                    table, json);
+    if (rc != 0)
+        fail_msg("fit exited %d: %s", rc, errb);
+    const char *paths[1] = {table};
+    cf_table t[1];
+    cf_predict_result r;
+    predict(json, paths, 1, t, &r);
+    assert_int_equal(r.model, CF_PREDICT_SPRING);
+    assert_true(cf_table_is_force(&t[0]));
+    assert_int_equal(r.tab[0].fitted, 1);
+    assert_rel(r.tab[0].rmse * t[0].y_to_file, fit_number(json, "rmse", 0), 1e-9);
+    release(t, 1, &r);
+}
+
 
 /* The joint fit of the cortex's tension and compression with a fitted volume term (json), made
 ** once; the test skips, saying why, when the published tables are absent. */
@@ -337,6 +364,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(single_fit_reproduces_its_rmse),
+        cmocka_unit_test(force_fit_reproduces_its_rmse),
         cmocka_unit_test(joint_fit_reproduces_its_terms),
         cmocka_unit_test(other_tissue_and_csv),
         cmocka_unit_test(pair_reaches_the_cell),
