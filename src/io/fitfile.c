@@ -382,7 +382,7 @@ static cf_status read_fitted_table(json_t *e, json_t *fit, const char *path, con
                     ? (size_t)json_integer_value(pts) : 0;
     t->scale = NAN;
     cf_status st = read_finite(joint ? e : fit, "rmse", path, at, &t->rmse, err);
-    if (st == CF_OK && joint)
+    if (st == CF_OK && joint && json_object_get(e, "scale")) /* absent: not recorded */
         st = read_finite(e, "scale", path, at, &t->scale, err);
     return st;
 }

@@ -98,7 +98,8 @@ typedef struct cf_fitfile_table {
     double rmse;     /* the fit's RMSE of the table (its target: the lattice's homogenised cell, or
                      ** the single spring's law), in unit */
     double scale;    /* its RMS stress, the joint objective's weight ("scale"), in unit; NAN when
-                     ** the file does not record it (a single fit) */
+                     ** the file does not record it (a single fit, a joint fit written before the
+                     ** key) */
 } cf_fitfile_table;
 
 /* A fit file's fit as a model to evaluate (cf_fitfile_load_model): the spring (and a double-acting
