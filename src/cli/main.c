@@ -13,6 +13,7 @@
 
 #include "base/atomic.h"
 #include "cli/cli.h"
+#include "cli/cli_predict.h"
 #include "cli/cli_shard.h"
 #include "model/simd.h"
 
@@ -27,6 +28,7 @@ static const command commands[] = {
     {"curve", cf_cli_curve, "CSV table of force and stiffness from full stretch to solid"},
     {"info", cf_cli_info, "derived quantities of a spring (type, travel, loads, k0, ...)"},
     {"fit", cf_cli_fit, "fit conical springs (both types) and baselines to measured tables"},
+    {"predict", cf_cli_predict, "a saved fit's RMSE and objective term at tables, without refitting"},
     {"export", cf_cli_export, "write a fitted spring for CalculiX, Abaqus, FEBio, LS-DYNA, SOFA"},
     {"synth", cf_cli_synth, "write the stress-strain table of a spring (example data)"},
     {"simulate", cf_cli_simulate, "run a scene on a mass-spring lattice of conical springs"},

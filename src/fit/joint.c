@@ -346,19 +346,13 @@ static cf_status joint_run(const cf_table *const *tables, size_t n, const cf_fit
             st = cf_error_set(err, CF_E_INTERNAL, "out of memory");
             goto out;
         }
-        double ss = 0;
-        for (size_t i = 0; i < t->count; i++)
-            ss += t->y[i] * t->y[i];
-        double s = sqrt(ss / (double)t->count);
-        if (!(s > 0)) {
+        if (cf_joint_table_weights(t, &r->tab[k].scale_MPa, c.sw[k]) != 0) {
             st = cf_error_set(err, CF_E_DATA, "%s: every stress is zero", t->path);
             goto out;
         }
-        r->tab[k].scale_MPa = s;
         r->tab[k].mode = t->mode;
         r->tab[k].points = t->count;
         for (size_t i = 0; i < t->count; i++) {
-            c.sw[k][i] = sqrt((t->w ? t->w[i] : 1.0) / (double)t->count) / s;
             all_sw[m] = c.sw[k][i];
             c.pr.ynorm += (all_sw[m] * t->y[i]) * (all_sw[m] * t->y[i]);
             reach_x[m] = copysign(cf_cell_spring_strain(t->mode, t->x[i]), t->x[i]);

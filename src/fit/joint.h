@@ -190,6 +190,13 @@ int cf_joint_lattice_stable(const cf_law *law, const double weight[CF_FAMILY_COU
                             double kappa_MPa, const cf_validate_setup *lat,
                             const cf_table *const *t, size_t n);
 
+/* The joint objective's weighting of table t, its one definition (the searches' and the
+** prediction's, pipeline/predict.h): the table's RMS stress s = sqrt(mean y^2) (MPa) into *scale
+** and each row's residual weight sqrt(w_i / n) / s into sw (t->count values; may be NULL), so that
+** the table's term of the objective is sum_i (sw_i (model_i - y_i))^2, (RMSE / s)^2 with unit
+** weights. Returns 0, or -1 when every stress is zero (no weight; *scale 0). */
+int cf_joint_table_weights(const cf_table *t, double *scale, double *sw);
+
 /* Releases the per-table curves. Safe on a zeroed result. */
 
 void cf_joint_free(cf_joint_result *r);

@@ -1,6 +1,7 @@
 /*
 ** What every joint search evaluates (joint_ctx.h): the tables' cell curves for a point of the
-** search, the cell's volume modulus for a law, and the family weights of a ratio. Below the
+** search, the cell's volume modulus for a law, the family weights of a ratio, and each table's
+** weights in the objective (joint.h). Below the
 ** searches (joint.c, joint_pair.c) and the stability checks (joint_stable.c), which all call it.
 */
 #include "fit/joint_ctx.h"
@@ -57,5 +58,19 @@ int cf_joint_curve(void *ctx, double rho, double B, double *out)
         if (cf_cell_curve(&cell, c->t[k]->mode, c->t[k]->x, c->t[k]->count, out + m, NULL) !=
             CF_OK)
             return 1;
+    return 0;
+}
+
+int cf_joint_table_weights(const cf_table *t, double *scale, double *sw)
+{
+    double ss = 0;
+    for (size_t i = 0; i < t->count; i++)
+        ss += t->y[i] * t->y[i];
+    const double s = sqrt(ss / (double)t->count);
+    *scale = s > 0 ? s : 0;
+    if (!(s > 0))
+        return -1;
+    for (size_t i = 0; sw && i < t->count; i++)
+        sw[i] = sqrt((t->w ? t->w[i] : 1.0) / (double)t->count) / s;
     return 0;
 }

@@ -290,20 +290,152 @@ static void read_provenance(json_t *root, json_t *fit, cf_fitted_spring *out)
                           (model && strcmp(model, "lattice") == 0);
 }
 
-static cf_status load(const char *path, const char *type_name, int allow_element,
-                      cf_fitted_spring *out, cf_error *err)
+/* load's steps with the document kept: *root (the caller releases it, also on failure), *fit
+** the fit read, *shown the file's name for messages and where the fit's key path. */
+static cf_status load_fit(const char *path, const char *type_name, int allow_element,
+                          cf_fitted_spring *out, json_t **root, json_t **fit, const char **shown,
+                          char where[64], cf_error *err)
 {
     memset(out, 0, sizeof *out);
     out->rmse = NAN;
-    json_t *root = NULL, *fit = NULL;
-    char where[64];
+    *root = NULL;
+    *fit = NULL;
     const char *want = (type_name && *type_name) ? type_name : NULL;
-    cf_status st = read_root(path, &path, &root, err);
-    if (st == CF_OK && (st = pick_fit(root, path, want, &fit, where, err)) == CF_OK &&
-        (st = read_spring(fit, path, where, out, err)) == CF_OK) {
-        read_provenance(root, fit, out);
-        if ((st = read_visco(fit, path, where, out, err)) == CF_OK)
-            st = read_element(fit, path, where, allow_element, out, err);
+    cf_status st = read_root(path, shown, root, err);
+    if (st == CF_OK && (st = pick_fit(*root, *shown, want, fit, where, err)) == CF_OK &&
+        (st = read_spring(*fit, *shown, where, out, err)) == CF_OK) {
+        read_provenance(*root, *fit, out);
+        if ((st = read_visco(*fit, *shown, where, out, err)) == CF_OK)
+            st = read_element(*fit, *shown, where, allow_element, out, err);
+    }
+    return st;
+}
+
+static cf_status load(const char *path, const char *type_name, int allow_element,
+                      cf_fitted_spring *out, cf_error *err)
+{
+    json_t *root, *fit;
+    char where[64];
+    cf_status st = load_fit(path, type_name, allow_element, out, &root, &fit, &path, where, err);
+    json_decref(root);
+    return st;
+}
+
+/* ---- a fit as a model to evaluate (cf_fitfile_load_model) ------------------------------------ */
+
+/* The finite number obj[key] (at `where`, for messages) into *v; CF_E_DATA naming it otherwise. */
+static cf_status read_finite(json_t *obj, const char *key, const char *path, const char *where,
+                             double *v, cf_error *err)
+{
+    json_t *j = json_object_get(obj, key);
+    if (json_is_number(j) && isfinite(json_number_value(j))) {
+        *v = json_number_value(j);
+        return CF_OK;
+    }
+    char *text = j ? json_dumps(j, JSON_ENCODE_ANY) : NULL;
+    cf_status st = cf_error_set(err, CF_E_DATA, "%s: %s.%s = %.40s is not a number", path, where,
+                                key, text ? text : "(missing)");
+    free(text);
+    return st;
+}
+
+/* The lattice a fit was evaluated in: its family weights (a joint fit's "lattice", a single fit's
+** "validation.lattice"; required when the fit's target is the lattice) and law method. */
+static cf_status read_lattice(json_t *fit, const char *path, const char *where,
+                              cf_fitted_model *out, cf_error *err)
+{
+    json_t *val = json_object_get(fit, "validation");
+    json_t *lat = out->joint ? json_object_get(fit, "lattice") : json_object_get(val, "lattice");
+    char at[96];
+    snprintf(at, sizeof at, "%s.%s.weights", where, out->joint ? "lattice" : "validation.lattice");
+    json_t *w = json_object_get(lat, "weights");
+    out->method = CF_LAW_CLOSED;
+    const char *m = out->joint ? NULL : json_string_value(json_object_get(val, "law_method"));
+    if (m && cf_law_method_parse(m, &out->method, NULL) != CF_OK)
+        return cf_error_set(err, CF_E_DATA, "%s: %s.validation.law_method = '%.40s' is not exact, "
+                                            "closed, closed+newton or table", path, where, m);
+    if (!w && !out->spring.target_lattice)
+        return CF_OK;
+    static const char *const key[3] = {"edge", "face", "body"};
+    for (int f = 0; f < 3; f++) {
+        cf_status st = read_finite(w, key[f], path, at, &out->weight[f], err);
+        if (st != CF_OK)
+            return st;
+    }
+    cf_error e = {0};
+    if (cf_calibration_check(out->weight, &e) != CF_OK)
+        return cf_error_set(err, CF_E_DATA, "%s: %s: %s", path, at, e.msg);
+    out->has_weight = 1;
+    return CF_OK;
+}
+
+/* One fitted table's record (the keys of a joint fit's "tables" entry, or a single fit's "data"
+** with the fit's rmse) into *t. */
+static cf_status read_fitted_table(json_t *e, json_t *fit, const char *path, const char *at,
+                                   int joint, cf_fitfile_table *t, cf_error *err)
+{
+    copy_string(e, "file", t->file, sizeof t->file);
+    copy_string(joint ? e : json_object_get(e, "measures"), "mode", t->mode, sizeof t->mode);
+    copy_string(e, joint ? "unit" : "y_unit", t->unit, sizeof t->unit);
+    json_t *pts = json_object_get(e, "points");
+    t->points = json_is_integer(pts) && json_integer_value(pts) > 0
+                    ? (size_t)json_integer_value(pts) : 0;
+    t->scale = NAN;
+    cf_status st = read_finite(joint ? e : fit, "rmse", path, at, &t->rmse, err);
+    if (st == CF_OK && joint && json_object_get(e, "scale")) /* absent: not recorded */
+        st = read_finite(e, "scale", path, at, &t->scale, err);
+    return st;
+}
+
+/* The tables the fit was fitted to and a joint fit's objective. */
+static cf_status read_fitted(json_t *root, json_t *fit, const char *path, const char *where,
+                             cf_fitted_model *out, cf_error *err)
+{
+    out->objective = NAN;
+    if (!out->joint) {
+        out->ntables = 1;
+        return read_fitted_table(json_object_get(root, "data"), fit, path, where, 0, &out->tab[0],
+                                 err);
+    }
+    cf_status st = read_finite(fit, "objective", path, where, &out->objective, err);
+    json_t *tabs = json_object_get(fit, "tables");
+    if (st == CF_OK && (!json_is_array(tabs) || json_array_size(tabs) == 0 ||
+                        json_array_size(tabs) > CF_FITFILE_TABLES))
+        return cf_error_set(err, CF_E_DATA, "%s: %s.tables is not a list of 1 to %d tables", path,
+                            where, CF_FITFILE_TABLES);
+    for (size_t k = 0; st == CF_OK && k < json_array_size(tabs); k++) {
+        char at[96];
+        snprintf(at, sizeof at, "%s.tables[%zu]", where, k);
+        st = read_fitted_table(json_array_get(tabs, k), fit, path, at, 1, &out->tab[k], err);
+        out->ntables = k + 1;
+    }
+    return st;
+}
+
+cf_status cf_fitfile_load_model(const char *path, const char *type_name, cf_fitted_model *out,
+                                cf_error *err)
+{
+    memset(out, 0, sizeof *out);
+    json_t *root, *fit;
+    char where[64];
+    const char *shown = path;
+    cf_status st = load_fit(path, type_name, 1, &out->spring, &root, &fit, &shown, where, err);
+    if (st == CF_OK && fit == root)
+        st = cf_error_set(err, CF_E_DATA, "%s: a single exported spring does not record the "
+                                          "lattice it was fitted in; give its fit file", shown);
+    else if (st == CF_OK && out->spring.viscoelastic)
+        st = cf_error_set(err, CF_E_DATA, "%s: %s is a time-series fit (key 'prony'): its "
+                                          "stress follows the strain history, not a curve",
+                          shown, where);
+    if (st == CF_OK) {
+        out->joint = json_is_true(json_object_get(root, "joint"));
+        const char *kind = json_string_value(json_object_get(json_object_get(root, "data"),
+                                                             "kind"));
+        out->force_displacement = kind && strcmp(kind, "force-displacement") == 0;
+        copy_string(json_object_get(fit, "target"), "mode", out->target_mode,
+                    sizeof out->target_mode);
+        if ((st = read_lattice(fit, shown, where, out, err)) == CF_OK)
+            st = read_fitted(root, fit, shown, where, out, err);
     }
     json_decref(root);
     return st;

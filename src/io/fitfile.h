@@ -86,6 +86,49 @@ cf_status cf_fitfile_load(const char *path, const char *type_name, cf_fitted_spr
 cf_status cf_fitfile_load_element(const char *path, const char *type_name,
                                   cf_fitted_spring *out, cf_error *err);
 
+/* Most tables a fit file's fit lists (a joint fit's; cf_fitted_model). */
+#define CF_FITFILE_TABLES 16
+
+/* A table the fit was fitted to, as its fit file records it. */
+typedef struct cf_fitfile_table {
+    char file[512];  /* the table's path as the fit named it */
+    char mode[24];   /* its test mode ("uniaxial", "shear", ...) */
+    size_t points;
+    char unit[32];   /* the unit of rmse and scale (the table's stress or force unit) */
+    double rmse;     /* the fit's RMSE of the table (its target: the lattice's homogenised cell, or
+                     ** the single spring's law), in unit */
+    double scale;    /* its RMS stress, the joint objective's weight ("scale"), in unit; NAN when
+                     ** the file does not record it (a single fit, a joint fit written before the
+                     ** key) */
+} cf_fitfile_table;
+
+/* A fit file's fit as a model to evaluate (cf_fitfile_load_model): the spring (and a double-acting
+** element's extension spring and the volume term, as cf_fitfile_load_element reads them) and the
+** lattice it was fitted through. */
+typedef struct cf_fitted_model {
+    cf_fitted_spring spring;
+    int joint;                 /* 1: a joint fit (root "joint": true) */
+    int force_displacement;    /* 1: fitted to a force-displacement table (data.kind) */
+    char target_mode[24];      /* the fit's target.mode ("" when absent, or a joint fit) */
+    double weight[3];          /* the lattice's family weights edge, face, body (the fit's
+                               ** "lattice.weights", or "validation.lattice.weights"); valid when
+                               ** has_weight */
+    int has_weight;
+    cf_law_method method;      /* "validation.law_method" (CF_LAW_CLOSED when absent; a joint fit's
+                               ** cells are evaluated closed) */
+    double objective;          /* a joint fit's weighted objective ("objective"); NAN otherwise */
+    size_t ntables;            /* the tables fitted (a joint fit's "tables", a single fit's "data") */
+    cf_fitfile_table tab[CF_FITFILE_TABLES];
+} cf_fitted_model;
+
+/* Loads the fit of the given type (as cf_fitfile_load chooses it) as a model: its spring as
+** cf_fitfile_load_element reads it, and what says how it was evaluated (above). Refuses, with
+** CF_E_DATA naming the file and key: a single exported spring (it does not record its lattice), a
+** time-series fit, a fit through the lattice without the lattice's weights, a weight, table entry
+** or objective that is not a finite number; CF_E_NOINPUT as cf_fitfile_load. */
+cf_status cf_fitfile_load_model(const char *path, const char *type_name, cf_fitted_model *out,
+                                cf_error *err);
+
 /* Splits "FILE.json:TYPE" into path and type (type NULL when there is no ":TYPE" suffix naming a
 ** spring type) and loads it. */
 cf_status cf_fitfile_load_spec(const char *spec, cf_fitted_spring *out, cf_error *err);

@@ -14,7 +14,7 @@
 static char out[1 << 16], err[1 << 14];
 
 static const char *const commands[] = {"force", "curve", "info", "fit", "export", "synth",
-                                       "simulate"};
+                                       "simulate", "predict"};
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 #define SPRING "--D1 8 --D2 20 --n 2.5 --d 1 --G 80000 --H 12"
 

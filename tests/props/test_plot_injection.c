@@ -2,8 +2,8 @@
 ** Input is data, never code: text from a table (column names, units, comments), from file names,
 ** scene strings and output names reaches gnuplot only as escaped string literals. Each payload below
 ** runs `touch PWNED...` when pasted into a gnuplot script the naive way (the control test proves
-** it); through every command that plots, none of them may run. The runs happen in a scratch folder
-** so that the markers are plain names there.
+** it); through every command that plots (fit, simulate, predict), none of them may run. The runs
+** happen in a scratch folder so that the markers are plain names there.
 */
 #include <fcntl.h>
 #include <limits.h>
@@ -295,6 +295,35 @@ static void fit_file_names(void **state)
     }
 }
 
+/* conifit predict --plot with payloads in the table's file name (a panel's title) and in the
+** plot's and the CSV's own names. */
+static void predict_file_names(void **state)
+{
+    (void)state;
+    if (!have_gnuplot())
+        skip();
+    char fit[PATH_MAX];
+    assert_non_null(realpath("fits/telescoping.json", fit));
+    for (size_t k = 0; k < NPAYLOADS; k++) {
+        char marker[32], p[256], name[300], png[300], csv[300];
+        snprintf(marker, sizeof marker, "PWNED%zu", k);
+        make_payload(p, sizeof p, k, marker);
+        snprintf(name, sizeof name, "p%s.csv", p);
+        snprintf(png, sizeof png, "q%s.png", p);
+        snprintf(csv, sizeof csv, "r%s.csv", p);
+        table_with_header(name, "strain,stress_kPa", NULL);
+        char *argv[] = {conifit_abs, "predict", fit, name, "-o", csv, "--plot", png, "--quiet",
+                        NULL};
+        int rc = run(NULL, argv);
+        if (rc != 0)
+            fail_msg("%s in predict's file names: exit %d: %s", payloads[k].name, rc,
+                     last_stderr());
+        assert_true(exists_in_scratch(png));
+        assert_true(exists_in_scratch(csv));
+        no_marker_left(payloads[k].name);
+    }
+}
+
 /* conifit fit --plot of a time series (its own figure: stress against time and strain) with
 ** payloads in the file name (the default title), the column names (axis labels) and --title. */
 static void fit_series_names(void **state)
@@ -434,6 +463,7 @@ int main(void)
         cmocka_unit_test(fit_file_names),
         cmocka_unit_test(gnuplot_init_file_is_not_read),
         cmocka_unit_test(fit_series_names),
+        cmocka_unit_test(predict_file_names),
         cmocka_unit_test(simulate_names),
         cmocka_unit_test(script_holds_no_live_text),
     };
