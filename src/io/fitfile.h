@@ -37,7 +37,7 @@
 #define CF_FITFILE_H
 
 #include "conifit/error.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "model/msm.h"
 
 /* The "schema" value of a single exported spring. */
