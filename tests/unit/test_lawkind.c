@@ -284,6 +284,19 @@ static void linear_kind_kept_on_a_line(void **state)
 /* ---- its law everywhere: the fit file, the lattice, the body, CalculiX ---- */
 
 static char dir[64];
+static cf_table line_t;
+static cf_fit_report line_r;
+static int line_done;
+
+/* The fit of the line (fit_line), made once for the tests below; the kind's fit is fits[0]. */
+static const cf_fit_report *line_fit(void)
+{
+    if (!line_done) {
+        fit_line(&line_t, &line_r);
+        line_done = 1;
+    }
+    return &line_r;
+}
 
 /* The fit of the line written as conifit fit -o writes it (the report's JSON) to dir/name. */
 static void write_fit_file(const cf_fit_report *r, const char *name, char *path, size_t cap)
@@ -301,13 +314,11 @@ static void write_fit_file(const cf_fit_report *r, const char *name, char *path,
 static void linear_kind_written_and_read_back(void **state)
 {
     (void)state;
-    cf_table t;
-    cf_fit_report r;
-    fit_line(&t, &r);
-    const cf_fit_result *f = &r.fits[0];
+    const cf_fit_report *r = line_fit();
+    const cf_fit_result *f = &r->fits[0];
     assert_string_equal(cf_law_kind_of(&f->law), "linear");
     char path[128];
-    write_fit_file(&r, "line.json", path, sizeof path);
+    write_fit_file(r, "line.json", path, sizeof path);
     cf_fitted_spring fs;
     cf_error err = {0};
     if (cf_fitfile_load(path, NULL, &fs, &err) != CF_OK)
@@ -353,8 +364,6 @@ static void linear_kind_written_and_read_back(void **state)
     impostor.name = "conical";
     assert_int_equal(cf_law_mech_register(&impostor, &err), CF_E_DATA);
     cf_law_free(&law);
-    cf_report_free(&r);
-    cf_table_free(&t);
 }
 
 /* The lattice of the kind's law: its uniaxial stress is the analytic linear lattice's (the
@@ -364,10 +373,7 @@ static void linear_kind_written_and_read_back(void **state)
 static void linear_kind_simulated_in_a_lattice(void **state)
 {
     (void)state;
-    cf_table t;
-    cf_fit_report r;
-    fit_line(&t, &r);
-    const cf_fit_result *f = &r.fits[0];
+    const cf_fit_result *f = &line_fit()->fits[0];
     const double E = f->q[0];
     cf_law cone;
     cf_error err = {0};
@@ -387,8 +393,6 @@ static void linear_kind_simulated_in_a_lattice(void **state)
     assert_close(sk[2], E * strain[2], 2e-3 * E * fabs(strain[2]));
     assert_close(sk[3], E * strain[3], 2e-3 * E * fabs(strain[3]));
     cf_law_free(&cone);
-    cf_report_free(&r);
-    cf_table_free(&t);
 }
 
 /* A Gmsh cube of 10 mm (elements of 1 mm, as test_body.c) compressed 1e-4 with lubricated faces: the reaction of the
@@ -435,10 +439,7 @@ static double block_reaction(const cf_law *law, double *E_ratio)
 static void linear_kind_simulated_in_a_body(void **state)
 {
     (void)state;
-    cf_table t;
-    cf_fit_report r;
-    fit_line(&t, &r);
-    const cf_fit_result *f = &r.fits[0];
+    const cf_fit_result *f = &line_fit()->fits[0];
     cf_law cone;
     assert_int_equal(cf_law_init(&cone, &f->params, NULL), CF_OK);
     double ek, ec;
@@ -449,8 +450,6 @@ static void linear_kind_simulated_in_a_body(void **state)
     assert_close(Fk, Fc, 1e-8 * Fc);
     assert_close(ek, 1, 0.05);
     cf_law_free(&cone);
-    cf_report_free(&r);
-    cf_table_free(&t);
 }
 
 /* The summed reactions of set NTOP at whole times 1, 2, ... of a ccx .dat. */
@@ -480,11 +479,8 @@ static void linear_kind_exported_to_calculix(void **state)
         print_message("skipped: ccx is not on PATH\n");
         skip();
     }
-    cf_table t;
-    cf_fit_report r;
-    fit_line(&t, &r);
     char path[128], inp[160];
-    write_fit_file(&r, "export.json", path, sizeof path);
+    write_fit_file(line_fit(), "export.json", path, sizeof path);
     cf_fitted_spring fs;
     cf_error err = {0};
     if (cf_fitfile_load(path, NULL, &fs, &err) != CF_OK)
@@ -529,8 +525,6 @@ static void linear_kind_exported_to_calculix(void **state)
     assert_true(steps >= 2 && steps == n);
     free(x);
     free(dat);
-    cf_report_free(&r);
-    cf_table_free(&t);
 }
 
 static int setup(void **state)
@@ -546,6 +540,10 @@ static int setup(void **state)
 static int teardown(void **state)
 {
     (void)state;
+    if (line_done) {
+        cf_report_free(&line_r);
+        cf_table_free(&line_t);
+    }
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
     return system(cmd) == 0 ? 0 : -1;
