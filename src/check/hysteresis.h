@@ -14,7 +14,7 @@
 
 #include "io/budget.h"
 #include "conifit/error.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "model/msm.h"
 #include "io/scene.h"
 

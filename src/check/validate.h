@@ -26,7 +26,7 @@
 #include "conifit/error.h"
 #include "fit/fit.h"
 #include "fit/lattice_fit.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "model/msm.h"
 #include "io/scene.h"
 

@@ -11,7 +11,7 @@
 
 #include "io/budget.h"
 #include "conifit/error.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "model/table.h"
 
 #include "conifit/version.h"

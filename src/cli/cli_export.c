@@ -292,7 +292,7 @@ static cf_status lattice_of(export_request *q, const cf_fitted_spring *fs,
         return st;
     }
     cf_law law;
-    if ((st = cf_law_init(&law, &fs->params, err)) != CF_OK)
+    if ((st = cf_fitted_law(fs, &law, err)) != CF_OK)
         return st;
     *lx = cf_export_lattice_default(&law);
     lx->cfg.lattice.volume_modulus_MPa = fs->volume_modulus_MPa;

@@ -559,7 +559,7 @@ cf_status cf_export_write(FILE *out, const cf_fitted_spring *fs, const cf_export
     cf_export_report r = {0};
     cf_xmodel m = {0};
     memset(&ext, 0, sizeof ext);
-    cf_status st = cf_law_init(&law, &fs->params, err);
+    cf_status st = cf_fitted_law(fs, &law, err);
     if (st != CF_OK)
         return st;
     if (fs->has_extension && ((st = cf_law_init(&ext, &fs->extension, err)) != CF_OK ||

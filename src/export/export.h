@@ -27,7 +27,7 @@
 
 #include "conifit/error.h"
 #include "io/fitfile.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "model/msm.h"
 #include "io/scene.h"
 

@@ -484,7 +484,7 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
     memset(&lat, 0, sizeof lat);
     memset(&ext, 0, sizeof ext);
     cf_status st = check_loading(opt, lx, err);
-    if (st != CF_OK || (st = cf_law_init(&law, &fs->params, err)) != CF_OK)
+    if (st != CF_OK || (st = cf_fitted_law(fs, &law, err)) != CF_OK)
         return st;
     /* the fit's whole element and volume term (a scene naming the fit file brings the same) */
     cf_lattice_config lc = lx->cfg.lattice;

@@ -12,7 +12,7 @@
 #include <stdio.h>
 
 #include "export/export.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "model/net.h"
 
 /* Springs of one rest length and one weight: their table in their own elongation and tension. */

@@ -54,6 +54,9 @@
 #define TABLE_MAX_INTERVALS 200000
 /* settle_half's answer when the next round would pass TABLE_MAX_INTERVALS. */
 #define TABLE_TOO_MANY ((size_t)-1)
+/* A law kind's rows on a side when its row gives no samples (and the first try's), evenly spaced;
+** doubled until the tolerance is met. */
+#define TABLE_KIND_SAMPLES 16
 
 /* ---- one half of the table (compression side, 0 <= u <= U) ----------------------------------- */
 
@@ -67,6 +70,36 @@ static double density(double t)
 {
     const double q = t * t, r = 1.0 + q;
     return 4.0 * sqrt(3.0) / (sqrt(r) * sqrt(4.0 + q * (6.0 + q * (4.0 + q))));
+}
+
+/* A law kind's half (lawmech.h): its row's samples over (0, U] on the side of sign when it gives
+** them and intervals is 0, else intervals + 1 rows evenly spaced over [0, U]; the values on the law
+** (h->F = sign F(sign u), which join mirrors back for the stretch side). 0, or -1 out of memory. */
+static int kind_place(const cf_law *law, double U, size_t intervals, double sign, half *h)
+{
+    free(h->u), free(h->F);
+    memset(h, 0, sizeof *h);
+    const size_t cap = (intervals ? intervals : TABLE_KIND_SAMPLES) + 1;
+    h->u = malloc(cap * sizeof *h->u);
+    h->F = malloc(cap * sizeof *h->F);
+    if (!h->u || !h->F)
+        return -1;
+    h->u[h->n++] = 0.0;
+    size_t m = 0;
+    if (!intervals && law->mech->samples)
+        m = law->mech->samples(law->q, law->p.H_mm, sign < 0 ? -1 : 1, U, cap - 1, h->u + 1);
+    for (size_t i = 0; i < m && i < cap - 1; i++)
+        if (h->u[i + 1] > h->u[h->n - 1] && h->u[i + 1] <= U)
+            h->u[h->n++] = h->u[i + 1];
+    if (h->n == 1 || h->u[h->n - 1] < U) { /* no samples, or not to U: evenly spaced */
+        const size_t N = intervals ? intervals : TABLE_KIND_SAMPLES;
+        h->n = 1;
+        for (size_t i = 1; i <= N; i++)
+            h->u[h->n++] = U * (double)i / (double)N;
+    }
+    for (size_t i = 0; i < h->n; i++)
+        h->F[i] = sign * cf_law_force(law, CF_LAW_EXACT, sign * h->u[i], NULL, NULL);
+    return 0;
 }
 
 /* Compression (mm) of the point of region 2 at r = 1 + t^2, written without cancellation near
@@ -229,6 +262,8 @@ static const cf_law *side_law(const cf_law *law, double sign)
 /* The stretch end of a table of law (the extension spring's end for a pair), mm, positive. */
 static double stretch_end(const cf_law *law, double tol)
 {
+    if (law->mech) /* a law kind's own stretch side */
+        return -cf_law_deflection(law, cf_law_solid_force(law, -1.0) * (1.0 - tol));
     return cf_export_table_end(side_law(law, -1.0), tol);
 }
 
@@ -290,6 +325,25 @@ static int join(const cf_law *law, const half *st, const half *co, cf_export_tab
     return 0;
 }
 
+/* settle_half for a law kind: its samples first, then evenly spaced rows doubled until the
+** half meets tol F_C (its solid force on the side). */
+static size_t settle_kind(const cf_law *law, double tol, double U, double sign, half *h,
+                          cf_export_table *scratch, double *err_N, double *where)
+{
+    const double goal = tol * fabs(cf_law_solid_force(law, sign));
+    half empty = {0}, one = {1, (double[]){0.0}, (double[]){0.0}};
+    for (size_t N = 0; N <= TABLE_MAX_INTERVALS; N = N ? 2 * N : TABLE_KIND_SAMPLES) {
+        if (kind_place(law, U, N, sign, h) != 0)
+            return 0;
+        const half *co = sign > 0 ? h : &empty, *st = sign > 0 ? &empty : h;
+        if (join(law, st->n ? st : &one, co->n ? co : &one, scratch) != 0)
+            return 0;
+        if ((*err_N = half_error(law, scratch, U, sign, where)) <= goal)
+            return h->n - 1;
+    }
+    return TABLE_TOO_MANY;
+}
+
 /* Places one half to the tolerance: returns its region-2 interval count, 0 on failure (memory),
 ** TABLE_TOO_MANY when the count would pass TABLE_MAX_INTERVALS (*err_N: the last error). */
 static size_t settle_half(const cf_law *law, double tol, double U, double sign, half *h,
@@ -298,6 +352,8 @@ static size_t settle_half(const cf_law *law, double tol, double U, double sign, 
     const double goal = tol * law->F_C_N;
     /* first guess from the integral of g: error per interval ~ (dG)^2 / 16 in units of F_C */
     double G = 0.0;
+    if (law->mech)
+        return settle_kind(law, tol, U, sign, h, scratch, err_N, where);
     if (U > law->u_T_mm && law->rho_inv_m1 > 0.0) {
         const double tT = sqrt(law->rho_inv_m1);
         const double tU = law->tail && U >= law->u_C_mm ? 0.0 : t_of_u(law, U);
@@ -345,7 +401,7 @@ static cf_status range_check(const cf_law *law, double tol, double u_lo_mm, doub
                             "range [%g, %g] mm must contain the rest state u = 0 and be wider "
                             "than a point",
                             u_lo_mm, u_hi_mm);
-    if (!law->extension && (u_hi_mm > u_end || -u_lo_mm > u_end))
+    if (!law->extension && !law->mech && (u_hi_mm > u_end || -u_lo_mm > u_end))
         return cf_error_set(err, CF_E_DATA,
                             "range [%g, %g] mm passes the end of the spring's travel: the table "
                             "reaches |u| <= %.10g mm (where the law carries F_C (1 - tol); solid "
@@ -358,7 +414,7 @@ static cf_status range_check(const cf_law *law, double tol, double u_lo_mm, doub
                             "(the extension spring), where each carries its F_C (1 - tol); solid "
                             "at %.10g and -%.10g mm",
                             u_lo_mm, u_hi_mm, u_end, s_end, law->travel_mm,
-                            law->extension->travel_mm);
+                            cf_law_travel(law, -1.0));
     return CF_OK;
 }
 
@@ -389,7 +445,7 @@ cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo
                 goto oom;
             if (Nst == TABLE_TOO_MANY)
                 goto too_many;
-        } else if (Ust == Uco) { /* the law is odd: the stretch half mirrors the compression half */
+        } else if (Ust == Uco && !law->mech) { /* the law is odd: the stretch half mirrors */
             st.n = co.n;
             st.u = malloc(co.n * sizeof *st.u);
             st.F = malloc(co.n * sizeof *st.F);
@@ -418,7 +474,9 @@ cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo
     eco = Uco > 0.0 ? half_error(law, t, Uco, +1.0, &wco) : 0.0;
     est = Ust > 0.0 ? half_error(law, t, Ust, -1.0, &wst) : 0.0;
     {   /* each side's error in its own spring's F_C (the same spring unless a pair) */
-        const double rco = eco / law->F_C_N, rst = est / side_law(law, -1.0)->F_C_N;
+        const double rco = eco / law->F_C_N,
+                     rst = est / (law->mech ? fabs(cf_law_solid_force(law, -1.0))
+                                            : side_law(law, -1.0)->F_C_N);
         t->max_err_N = fmax(eco, est);
         t->max_err_u_mm = rco >= rst ? wco : wst;
         t->max_err_rel = fmax(rco, rst);

@@ -27,7 +27,7 @@
 
 #include "conifit/error.h"
 #include "model/family.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "io/measure.h"
 
 /* Arrays of design parameters below are indexed by CF_P_D1 ... CF_P_H (spring.h). */

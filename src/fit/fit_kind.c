@@ -252,7 +252,11 @@ static void summarise(kfit *c, const cf_fit_options *opt, cf_spring_type type, c
     res->max_abs_error = ql.max_abs_error;
     res->r2 = ql.r2;
     res->params = c->row->member(res->q, c->fd, type);
-    cf_law_init(&res->law, &res->params, NULL);
+    /* the kind's own law where its row brings its mechanics (lawmech.h: quantities of a
+    ** stress-strain fit), else the conical law of its member */
+    if (!c->row->mech || c->fd ||
+        cf_law_init_kind(&res->law, c->row->mech, res->q, res->params.H_mm, NULL) != CF_OK)
+        cf_law_init(&res->law, &res->params, NULL);
     res->feasible = cf_fit_check(&res->params, type, c->t, opt, &res->active, &res->violated);
     const cf_ident fam = cf_ident_of_type(&res->params, type, c->fd);
     const double xmax = cf_lsq_xmax(c->t);

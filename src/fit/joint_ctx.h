@@ -12,7 +12,7 @@
 #include "model/cell.h"
 #include "model/family.h"
 #include "fit/joint.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "fit/cell_problem.h"
 
 /* BOBYQA's relative step tolerance (each curve a few tens of microseconds). */

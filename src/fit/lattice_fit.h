@@ -18,7 +18,7 @@
 #include "conifit/error.h"
 #include "model/family.h"
 #include "fit/fit.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "io/measure.h"
 #include "model/msm.h"
 

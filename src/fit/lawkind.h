@@ -62,6 +62,12 @@ typedef struct cf_law_row {
     double (*eval)(const double *q, int force, double x);
     void (*range)(const cf_table *t, double *start, double *lo, double *hi);
     cf_spring (*member)(const double *q, int force, cf_spring_type type);
+    /* Its mechanics (model/lawmech.h), so that its fitted law is its own in the lattice, the
+    ** body, the exports and the fit file: the fit of a stress-strain table makes the law of its
+    ** quantities (cf_law_init_kind, at its member's free length). NULL: its fit's law is the
+    ** conical law of its member (so too a force-displacement fit, whose quantities are not the
+    ** stress-strain family's). */
+    const cf_law_mech *mech;
 } cf_law_row;
 
 /* The library's rows: the conical law and the conical law with a tail. (The double-acting pair

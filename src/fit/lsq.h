@@ -9,7 +9,7 @@
 
 #include <stddef.h>
 
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "io/measure.h"
 
 /* Relative residuals divide by max(|y|, CF_LSQ_REL_FLOOR max|y|) so that the point at the origin

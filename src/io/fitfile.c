@@ -268,6 +268,47 @@ static cf_status read_spring(json_t *fit, const char *path, const char *where,
     return CF_OK;
 }
 
+/* A fit of a law kind that is not one of the library's (its "law" names another): the kind from the
+** registry (lawmech.h) and its quantities from "law_params", checked to make its law. */
+static cf_status read_kind(json_t *fit, const char *path, const char *where,
+                           cf_fitted_spring *out, cf_error *err)
+{
+    const char *name = json_string_value(json_object_get(fit, "law"));
+    static const char *const own[] = {"conical", "conical-tail", "double-acting"};
+    for (size_t i = 0; name && i < sizeof own / sizeof own[0]; i++)
+        if (strcmp(name, own[i]) == 0)
+            return CF_OK;
+    if (!name) /* a file written before kinds were recorded: the conical law */
+        return CF_OK;
+    if (!(out->mech = cf_law_mech_find(name)))
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: %s.law = '%s' is a law kind this program does not know (a kind "
+                            "a program defines is read once it registers it)",
+                            path, where, name);
+    json_t *q = json_object_get(fit, "law_params");
+    for (int k = 0; k < out->mech->nq; k++) {
+        json_t *v = json_object_get(q, out->mech->key[k]);
+        if (!json_is_number(v) || !isfinite(json_number_value(v)))
+            return cf_error_set(err, CF_E_DATA, "%s: %s.law_params.%s of law kind '%s' is %s",
+                                path, where, out->mech->key[k], name,
+                                v ? "not a finite number" : "missing");
+        out->q[k] = json_number_value(v);
+    }
+    cf_law law;
+    cf_error lerr = {0};
+    if (cf_law_init_kind(&law, out->mech, out->q, out->params.H_mm, &lerr) != CF_OK)
+        return cf_error_set(err, CF_E_DATA, "%s: %s.law_params: %s", path, where, lerr.msg);
+    cf_law_free(&law);
+    return CF_OK;
+}
+
+cf_status cf_fitted_law(const cf_fitted_spring *fs, cf_law *law, cf_error *err)
+{
+    if (fs->mech)
+        return cf_law_init_kind(law, fs->mech, fs->q, fs->params.H_mm, err);
+    return cf_law_init(law, &fs->params, err);
+}
+
 /* Where the fit came from: its RMSE, data file and unit, the version, whether it is a lattice's. */
 static void read_provenance(json_t *root, json_t *fit, cf_fitted_spring *out)
 {
@@ -303,7 +344,8 @@ static cf_status load_fit(const char *path, const char *type_name, int allow_ele
     const char *want = (type_name && *type_name) ? type_name : NULL;
     cf_status st = read_root(path, shown, root, err);
     if (st == CF_OK && (st = pick_fit(*root, *shown, want, fit, where, err)) == CF_OK &&
-        (st = read_spring(*fit, *shown, where, out, err)) == CF_OK) {
+        (st = read_spring(*fit, *shown, where, out, err)) == CF_OK &&
+        (st = read_kind(*fit, *shown, where, out, err)) == CF_OK) {
         read_provenance(*root, *fit, out);
         if ((st = read_visco(*fit, *shown, where, out, err)) == CF_OK)
             st = read_element(*fit, *shown, where, allow_element, out, err);
@@ -498,8 +540,16 @@ json_t *cf_fitfile_spring_json(const cf_law *law)
         json_decref(derived);
         return NULL;
     }
-    return json_pack("{s:s, s:o, s:o}", "type", cf_spring_type_name(law->type), "params", params,
-                     "derived", derived);
+    json_t *o = json_pack("{s:s, s:o, s:o}", "type", cf_spring_type_name(law->type), "params",
+                          params, "derived", derived);
+    if (o && law->mech) { /* a law kind's: its name and quantities, read back by read_kind */
+        json_t *q = json_object();
+        for (int k = 0; q && k < law->mech->nq; k++)
+            json_object_set_new(q, law->mech->key[k], cf_json_number(law->q[k]));
+        json_object_set_new(o, "law", json_string(law->mech->name));
+        json_object_set_new(o, "law_params", q);
+    }
+    return o;
 }
 
 /* Depth-first search for a null in v; path (capacity cap) receives its key path ("fits[0].rmse").

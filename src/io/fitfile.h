@@ -37,7 +37,7 @@
 #define CF_FITFILE_H
 
 #include "conifit/error.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "model/msm.h"
 
 /* The "schema" value of a single exported spring. */
@@ -66,7 +66,16 @@ typedef struct cf_fitted_spring {
     int has_extension;           /* 1: "params_extension" holds the extension spring */
     cf_spring extension;         /* its parameters (H the compression spring's) */
     double volume_modulus_MPa;   /* "lattice.volume_modulus_MPa", 0 when absent */
+    /* A fit of a law kind the library does not define (its "law" names a kind registered with
+    ** cf_law_mech_register, lawmech.h): its mechanics row and quantities ("law_params"); NULL for
+    ** the library's conical kinds. */
+    const cf_law_mech *mech;
+    double q[CF_LAW_Q_MAX];
 } cf_fitted_spring;
+
+/* The law of a fitted spring: its kind's (cf_law_init_kind) or the conical law of its params. The
+** extension spring of a pair is the caller's to join. Errors as those calls. */
+cf_status cf_fitted_law(const cf_fitted_spring *fs, cf_law *law, cf_error *err);
 
 /* Loads the spring of the given type from the fit file at path ("-":
 ** standard input); type_name NULL (or "") takes the

@@ -12,7 +12,7 @@
 #include <jansson.h>
 
 #include "conifit/error.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "conifit/output.h"
 
 /* A JSON number, or null for a value that is not finite; a document holding a null is never

@@ -12,7 +12,7 @@
 
 #include "model/body.h"
 #include "conifit/error.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "model/msm.h"
 
 typedef enum cf_protocol_kind {

@@ -37,7 +37,7 @@
 #include <stdint.h>
 
 #include "conifit/error.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 
 /* A tetrahedral mesh: nodes (mm) and elements of four node indices each, every element positively
 ** oriented (its signed volume (x1-x0).((x2-x0)x(x3-x0))/6 > 0). */

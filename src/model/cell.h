@@ -46,7 +46,7 @@
 
 #include "model/calibration.h"
 #include "conifit/error.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 
 typedef enum cf_mode {
     CF_MODE_UNIAXIAL = 0,

@@ -14,7 +14,7 @@
 #define CF_FAMILY_H
 
 #include "conifit/error.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "conifit/spring.h"
 
 /* Index of each quantity in cf_ident.v. */

@@ -483,6 +483,13 @@ static double law_work(const cf_law *law, cf_law_method m, double u,
 {
     if (u < 0 && law->extension) /* a pair's extension side: its own spring compressed by -u */
         law = law->extension, u = -u;
+    if (law->mech) { /* a law kind (lawmech.h): its force on the side of u, held past its travel */
+        law_at_ctx c = {law, m};
+        gsl_function f = {law_at, &c};
+        const double s = cf_law_travel_at(law, u), b = u < 0 ? fmax(u, -s) : fmin(u, s);
+        return gsl_integration_glfixed(&f, 0.0, b, gl) +
+               (u - b) * cf_law_force(law, m, b, NULL, NULL);
+    }
     double au = fabs(u), uT = law->u_T_mm, uC = law->u_C_mm, s = law->travel_mm;
     double e = 0.5 * law->k0_N_per_mm * fmin(au, uT) * fmin(au, uT);
     if (au > uT) {

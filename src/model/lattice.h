@@ -35,7 +35,7 @@
 
 #include "model/calibration.h"
 #include "conifit/error.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 
 typedef enum cf_bottom_bc {
     CF_BOTTOM_AXIAL = 0,  /* bottom nodes held in z, free to slide laterally (lubricated platen) */

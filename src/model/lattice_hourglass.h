@@ -21,7 +21,7 @@
 #define CF_MODEL_LATTICE_HOURGLASS_H
 
 #include "model/calibration.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 
 /* h_i(a) (+1 or -1) of mode i (0..3) at corner a (0..7, a = di + 2 dj + 4 dk). */
 int cf_hourglass_pattern(int i, int a);

@@ -21,7 +21,9 @@ cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const
     memset(st, 0, sizeof *st);
     st->lat = lat;
     cf_law_lanes_init(lat->law, &st->lanes);
-    if (lat->law->extension) { /* a double-acting element: both springs' lanes, side by side */
+    if (lat->law->mech) /* a law kind's row: the scalar law (its batch, law_kind.c) */
+        st->form = -1;
+    else if (lat->law->extension) { /* a double-acting element: both springs' lanes, side by side */
         const cf_law *e = lat->law->extension;
         cf_law_lanes_init(e, &st->ext_lanes);
         st->poly_error = NAN;

@@ -9,7 +9,7 @@
 **           relative accuracy of y, through c(y) = (3 + y^4)/(4y).
 ** The stiffness is dF/du = k_scale y^4/(1 - y^4) with 1 - y^4 = e (4 - 6e + 4e^2 - e^3).
 */
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "base/gslguard.h"
 #include "model/law_simd.h"
 
@@ -342,6 +342,8 @@ cf_status cf_law_table_build(cf_law *law, size_t intervals, cf_error *err)
     if (intervals < 2 || intervals > ((size_t)1 << 26))
         return cf_error_set(err, CF_E_DATA, "table size %zu must be between 2 and %zu", intervals,
                             (size_t)1 << 26);
+    if (law->mech) /* a law kind's row is evaluated as it is: no table */
+        return CF_OK;
     struct cf_law_table *t = calloc(1, sizeof *t);
     if (t) {
         t->y = malloc((intervals + 1) * sizeof *t->y);
@@ -550,6 +552,8 @@ cf_status cf_law_pair(cf_law *law, const cf_law *ext, cf_error *err)
 double cf_law_force(const cf_law *law, cf_law_method method, double u_mm, double *k_N_per_mm,
                     int *flags)
 {
+    if (law->mech)
+        return cf_law_kind_force(law, u_mm, k_N_per_mm, flags);
     int fl;
     const double F = law_eval(law, method, u_mm, k_N_per_mm, &fl);
     if (flags)
@@ -600,6 +604,10 @@ void cf_law_lanes_init(const cf_law *law, cf_law_lanes *lanes)
 void cf_law_force_scalar_many(const cf_law *law, cf_law_method method, size_t count,
                               const double *u_mm, double *F_N, double *k_N_per_mm)
 {
+    if (law->mech) {
+        cf_law_kind_force_many(law, count, u_mm, F_N, k_N_per_mm);
+        return;
+    }
     switch (method) { /* one branch per method so each loop body is specialised */
     case CF_LAW_EXACT:
         law_many(law, CF_LAW_EXACT, count, u_mm, F_N, k_N_per_mm);
@@ -619,6 +627,8 @@ void cf_law_force_scalar_many(const cf_law *law, cf_law_method method, size_t co
 
 double cf_law_deflection(const cf_law *law, double F_N)
 {
+    if (law->mech)
+        return cf_law_kind_deflection(law, F_N);
     if (F_N < 0 && law->extension)
         return -cf_law_deflection(law->extension, -F_N);
     const double a = fabs(F_N);

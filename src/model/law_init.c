@@ -3,10 +3,11 @@
 ** and the tail's derived quantities, every one of them checked representable; and the names of
 ** the evaluation methods. The evaluators themselves are in law.c.
 */
-#include "conifit/law.h"
+#include "model/law_internal.h"
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* ---- parameter checks and derived quantities ---------------------------------------------- */
@@ -216,3 +217,4 @@ const char *cf_law_method_name(cf_law_method method)
     }
     return "unknown";
 }
+

@@ -75,7 +75,7 @@ void cf_law_force_lanes(const cf_law_lanes *lanes, int form, size_t count, const
 void cf_law_force_many(const cf_law *law, cf_law_method method, size_t count, const double *u_mm,
                        double *F_N, double *k_N_per_mm)
 {
-    if (!k_N_per_mm && !law->tail && !law->extension &&
+    if (!k_N_per_mm && !law->tail && !law->extension && !law->mech &&
         (method == CF_LAW_CLOSED || (method == CF_LAW_TABLE && law->table))) {
         cf_law_lanes lanes;
         cf_law_lanes_init(law, &lanes);

@@ -47,7 +47,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "model/simd.h"
 
 #if defined(__GNUC__)

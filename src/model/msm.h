@@ -28,7 +28,7 @@
 
 #include "conifit/error.h"
 #include "model/lattice.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 
 /* Most Prony terms of a reduced relaxation function. */
 #define CF_PRONY_MAX 8

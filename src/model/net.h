@@ -20,7 +20,7 @@
 #include "model/body.h"
 #include "conifit/error.h"
 #include "model/lattice.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 
 /* The kinds of volume element: a row each in the table of net.c (its name and node count). */
 typedef enum cf_net_cell_kind {

@@ -24,7 +24,7 @@
 
 #include "conifit/error.h"
 #include "model/family.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "model/msm.h"
 
 /* The parameters of the time-dependent model. */

@@ -16,7 +16,7 @@
 #include "pipeline/simulate.h"
 #include "check/hysteresis.h"
 #include "model/lattice.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "io/measure.h"
 #include "model/msm.h"
 #include "pipeline/pipeline.h"

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 
 #include "bench.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 
 typedef struct variant {
     const char *name;

@@ -14,7 +14,7 @@
 #include "bench.h"
 #include "fit/baseline.h"
 #include "fit/fit.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "io/measure.h"
 
 /* Writes the table of the spring 8/20 mm, 2.5 coils, wire 2 mm, G 100 MPa, H 5 mm (telescoping,

@@ -25,7 +25,7 @@
 
 #include "bench.h"
 #include "model/lattice.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "model/lattice_step.h"
 
 static const cf_spring compression = {8, 20, 2.5, 2, 100, 5}; /* section 2's spring */

@@ -12,7 +12,7 @@
 
 #include "bench.h"
 #include "model/lattice.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "model/lattice_step.h"
 
 /* The export tests' telescoping spring, and the same cone in 30 mm with one tail coil in 10 mm

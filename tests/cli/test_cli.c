@@ -9,7 +9,7 @@
 
 #include <jansson.h>
 
-#include "conifit/law.h"
+#include "model/law_internal.h"
 
 static char out[1 << 16], err[1 << 14];
 

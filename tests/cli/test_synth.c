@@ -8,7 +8,7 @@
 
 #include "testutil.h"
 
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "io/measure.h"
 
 TU_SCRATCH_GROUP("synth")

@@ -13,9 +13,9 @@
 int main(int argc, char **argv)
 {
     cf_spring p = {.D1_mm = 4, .D2_mm = 12, .n = 5, .d_mm = 0.8, .G_MPa = 80000, .H_mm = 10};
-    cf_law law;
     cf_error err = {0};
-    if (cf_law_init(&law, &p, &err) != CF_OK) {
+    cf_law *law = cf_law_create(&p, &err);
+    if (!law) {
         fprintf(stderr, "law_example: %s\n", err.msg);
         return 1;
     }
@@ -26,13 +26,13 @@ int main(int argc, char **argv)
         return 1;
     for (int i = 0; i < n; i++) {
         u[i] = strtod(argv[i + 1], NULL);
-        printf("%s %.17g\n", argv[i + 1], cf_law_force(&law, CF_LAW_CLOSED, u[i], NULL, NULL));
+        printf("%s %.17g\n", argv[i + 1], cf_law_force(law, CF_LAW_CLOSED, u[i], NULL, NULL));
     }
-    cf_law_force_many(&law, CF_LAW_CLOSED, (size_t)n, u, F, NULL);
+    cf_law_force_many(law, CF_LAW_CLOSED, (size_t)n, u, F, NULL);
     for (int i = 0; i < n; i++)
         printf("many %s %.17g\n", argv[i + 1], F[i]);
     printf("version %s\n", CF_VERSION);
-    cf_law_free(&law);
+    cf_law_destroy(law);
     free(u);
     free(F);
     return 0;

@@ -11,7 +11,7 @@
 
 #include "testutil.h"
 
-#include "conifit/law.h"
+#include "model/law_internal.h"
 
 static char out[1 << 20], errb[1 << 14];
 

@@ -20,7 +20,7 @@
 #include "model/body.h"
 #include "export/export.h"
 #include "io/fitfile.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 
 /* ccx prints forces with 7 significant digits. */
 #define CCX_PRINT_REL 1e-6

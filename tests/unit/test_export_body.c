@@ -14,7 +14,7 @@
 
 #include "model/body.h"
 #include "export/export.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 
 static const cf_spring TEL = {10, 30, 4, 1, 80000, 40}; /* telescoping, s = 39 mm */
 

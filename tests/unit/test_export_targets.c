@@ -19,7 +19,7 @@
 #include <libxml/tree.h>
 
 #include "export/export.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "export/export_model.h"
 
 static char dir[] = "/tmp/conifit-xtargets-XXXXXX";

@@ -12,7 +12,7 @@
 
 #include "model/family.h"
 #include "fit/fit.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 
 static void named_and_indexed_views_agree(void **state)
 {

@@ -15,7 +15,7 @@
 
 #include "fit/baseline.h"
 #include "fit/fit.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "io/measure.h"
 
 /* ---- synthetic tables ------------------------------------------------------------------------ */

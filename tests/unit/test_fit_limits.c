@@ -14,7 +14,7 @@
 #include <jansson.h>
 
 #include "fit/fit.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "io/measure.h"
 
 static char out[1 << 16], errb[1 << 14];

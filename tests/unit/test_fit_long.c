@@ -17,7 +17,7 @@
 
 #include "fit/baseline.h"
 #include "fit/fit.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "io/measure.h"
 #include "fit/lsq.h"
 #include "fit/subsample.h"

@@ -12,7 +12,7 @@
 #include <jansson.h>
 
 #include "conifit/flat.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "io/measure.h"
 #include "pipeline/pipeline.h"
 

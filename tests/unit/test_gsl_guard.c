@@ -15,7 +15,7 @@
 #include <gsl/gsl_errno.h>
 
 #include "fit/fit.h"
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "conifit/output.h"
 #include "pipeline/pipeline.h"
 #include "report/report.h"

@@ -9,7 +9,7 @@
 
 #include "testutil.h"
 
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "model/law_simd.h"
 
 /* Error bounds (relative to |F| unless said otherwise). */

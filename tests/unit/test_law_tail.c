@@ -16,7 +16,7 @@
 
 #include <cmocka.h>
 
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "model/law_simd.h"
 #include "testutil.h"
 

@@ -9,7 +9,7 @@
 
 #include "testutil.h"
 
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "io/measure.h"
 
 /* Relative tolerance for values that went through one unit conversion (a product of doubles). */

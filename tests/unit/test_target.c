@@ -11,7 +11,7 @@
 
 #include <jansson.h>
 
-#include "conifit/law.h"
+#include "model/law_internal.h"
 #include "model/cell.h"
 
 static char out[1 << 16], errb[1 << 14];

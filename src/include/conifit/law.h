@@ -72,71 +72,37 @@ enum {
 
 struct cf_law_table; /* opaque; built by cf_law_table_build */
 
-/* A spring prepared for evaluation: its parameters and every derived quantity. Plain data apart
-** from the optional table; build with cf_law_init, release with cf_law_free. */
-typedef struct cf_law {
-    cf_spring p;
-    cf_spring_type type;
-    double rho;          /* D1/D2, dimensionless, in (0, 1] */
-    double rho_inv_m1;   /* 1/rho - 1 = (D2 - D1)/D1, formed without cancellation */
-    double index_c;      /* spring index D1/d, dimensionless */
-    double L_min_mm;     /* solid length, mm (the cone's and the tail's n_t d) */
-    double L_max_mm;     /* length at full stretch, 2H - L_min, mm */
-    double travel_mm;    /* compression to solid, H - L_min, mm (s + s_t with a tail) */
-    double F_T_N;        /* transition load (end of region 1), N */
-    double F_C_N;        /* load at which the cone is solid (the whole spring without a tail), N */
-    double k0_N_per_mm;  /* stiffness of region 1, N/mm (cone and tail in series) */
-    double u_T_mm;       /* compression at the transition, mm */
-    double inv_travel;   /* 1/s, 1/mm (s the cone's travel) */
-    double k_scale;      /* 4 F_C (1/rho - 1)/s, N/mm: region-2 stiffness is k_scale y^4/(1-y^4)
-                         ** (k_scale y^4/(1 - y^4 + 4 beta y^4) with a tail) */
-    double w_T;          /* sqrt((u_C - u_T)/s): where region 2 starts in the table variable */
-    /* the cylindrical tail: without one tail = 0, beta = tau = k_tail = 0, u_C = s and
-    ** F_solid = F_C */
-    int tail;              /* 1 when the spring has a tail */
-    double cone_travel_mm; /* s, the cone's travel: (H - H_tail) - its solid length, mm */
-    double k_tail_N_per_mm;/* tail stiffness G d^4/(8 n_t D1^3), N/mm */
-    double tau;            /* n_t/n = F_C/(k_tail s), dimensionless */
-    double beta;           /* (1/rho - 1) tau, dimensionless */
-    double u_C_mm;         /* compression at which the cone closes, s (1 + tau), mm */
-    double F_solid_N;      /* force when the whole spring is solid, k_tail s_t (F_C), N */
-    struct cf_law_table *table; /* NULL until cf_law_table_build */
-    /* The double-acting element (law kind double-acting): a cage of two springs sharing the free
-    ** length H, the compression spring (this law) for u >= 0 and the extension spring, which a
-    ** stretch compresses, for u < 0: F(u) = -F_e(-u) there, k(u) = k_e(-u). NULL (cf_law_init's
-    ** value) for the odd law F(-u) = -F(u). Not owned; its H must be this law's (cf_law_pair).
-    ** A pair of equal springs gives the odd law's values bit for bit. */
-    const struct cf_law *extension;
-} cf_law;
+/* A spring prepared for evaluation: its parameters and every derived quantity, or a law of another
+** kind (its kind's mechanics and quantities). Opaque: create with cf_law_create, release with
+** cf_law_destroy. */
+typedef struct cf_law cf_law;
 
-/* Validates p and fills law with the derived quantities (law->table = NULL). Refuses non-finite or
-** non-positive values, D1 > D2, n < 2 and a travel <= 0 with CF_E_DATA and a message naming the
-** parameter and its value. D1 == D2 (a cylindrical spring) is valid: linear up to solid. A tail
-** (n_tail > 0) must leave room for its solid length (H_tail > n_tail d) and the cone's (the cone's
-** travel > 0), and close after the cone: its gap per coil (H_tail - n_tail d)/n_tail exceeds the
-** cone's s/n; n_tail < 0, a non-finite tail value, or H_tail without n_tail is refused. */
-cf_status cf_law_init(cf_law *law, const cf_spring *p, cf_error *err);
+/* A new law of the conical spring p (with its tail when p has one): the checks of the library's
+** cf_law_init (non-finite or non-positive values, D1 > D2, n < 2, a travel <= 0 and a tail's room
+** refused with CF_E_DATA naming the parameter and its value). NULL on error (CF_E_INTERNAL when
+** memory runs out). */
+cf_law *cf_law_create(const cf_spring *p, cf_error *err);
 
-/* Joins the extension spring ext to law (law->extension = ext): CF_E_DATA when their free lengths
-** differ (the message gives both) or ext itself has an extension. */
+/* Releases law and its table. Safe on NULL. */
+void cf_law_destroy(cf_law *law);
+
+/* Joins the extension spring ext to law (a double-acting element: law for u >= 0, ext, which a
+** stretch compresses, for u < 0): CF_E_DATA when their free lengths differ (the message gives
+** both) or ext itself has an extension. ext is not owned and must outlive law's use. */
 cf_status cf_law_pair(cf_law *law, const cf_law *ext, cf_error *err);
 
-/* The travel to solid on the side of u: the extension spring's for u < 0 when there is one. */
-static inline double cf_law_travel_at(const cf_law *law, double u_mm)
-{
-    return u_mm < 0 && law->extension ? law->extension->travel_mm : law->travel_mm;
-}
+/* The travel to solid (mm, > 0) on the side of u: the extension spring's for u < 0 when there is
+** one, a law kind's own travel on that side. */
+double cf_law_travel(const cf_law *law, double u_mm);
 
-/* The smaller travel of the two sides (the law's own without an extension spring). */
-static inline double cf_law_travel_min(const cf_law *law)
-{
-    return law->extension && law->extension->travel_mm < law->travel_mm
-               ? law->extension->travel_mm
-               : law->travel_mm;
-}
+/* Force at full travel on the side of u (N, with the sign of u; its F_solid). */
+double cf_law_solid_force(const cf_law *law, double u_mm);
 
-/* Releases the table of law, if any. Safe on a zeroed law and on NULL. */
-void cf_law_free(cf_law *law);
+/* The spring of law: its design parameters (a law kind's buildable spring). */
+cf_spring cf_law_spring(const cf_law *law);
+
+/* The name of law's kind: "conical", "conical-tail", "double-acting" or a kind's own. */
+const char *cf_law_kind_of(const cf_law *law);
 
 /* Builds (or rebuilds) the table used by CF_LAW_TABLE with `intervals` intervals (>= 2) over
 ** region 2. CF_E_DATA for a bad size, CF_E_INTERNAL when memory runs out. */
