@@ -9,10 +9,12 @@
 
 #include "model/body_internal.h"
 
-static void pattern_free(pattern *P)
+void cf_body_pattern_free(pattern *P)
 {
-    free(P->colptr);
-    free(P->rowidx);
+    if (!P->borrowed) {
+        free(P->colptr);
+        free(P->rowidx);
+    }
     free(P->val);
     free(P->nbp);
     free(P->nb);
@@ -117,7 +119,7 @@ static int pattern_blocks(const cf_body *b, pattern *P, uint32_t *mark)
     return 1;
 }
 
-static int pattern_build(const cf_body *b, pattern *P)
+int cf_body_pattern_build(const cf_body *b, pattern *P)
 {
     memset(P, 0, sizeof *P);
     const size_t nn = b->nn, nt = b->nt;
@@ -185,8 +187,7 @@ static int pattern_build(const cf_body *b, pattern *P)
         goto fail;
     P->colptr = malloc((3 * nn + 1) * sizeof *P->colptr);
     P->rowidx = malloc(9 * nnb * sizeof *P->rowidx);
-    P->val = malloc(9 * nnb * sizeof *P->val);
-    if (!P->colptr || !P->rowidx || !P->val)
+    if (!P->colptr || !P->rowidx)
         goto fail;
     size_t nnz = 0;
     P->colptr[0] = 0;
@@ -204,7 +205,7 @@ static int pattern_build(const cf_body *b, pattern *P)
 fail:
     free(mark);
     free(list);
-    pattern_free(P);
+    cf_body_pattern_free(P);
     return 0;
 }
 
@@ -374,6 +375,8 @@ double cf_body_assemble(const cf_body *b, const double *x, const cf_probe *pr, c
     const cf_law *law = b->law;
     const double H = law->p.H_mm;
     memset(g, 0, 3 * b->nn * sizeof *g);
+    if (P && !P->val && !(P->val = malloc((size_t)P->colptr[P->n] * sizeof *P->val)))
+        return NAN; /* the haptic loop's first assembly */
     if (P)
         memset(P->val, 0, (size_t)P->colptr[P->n] * sizeof *P->val);
     for (size_t s = 0; s < b->ns; s++) {
@@ -525,56 +528,3 @@ int cf_body_admissible(const cf_body *b, const double *x)
     }
     return 1;
 }
-
-void cf_body_work_free(body_work *w)
-{
-    if (!w)
-        return;
-    cf_sparse_chol_free(w->ch);
-    cf_sparse_chol_free(w->hch);
-    free(w->hactive);
-    free(w->slot);
-    free(w->Z);
-    free(w->hy);
-    free(w->hrhs);
-    pattern_free(&w->P);
-    free(w->g);
-    free(w->dx);
-    free(w->xt);
-    free(w->active);
-    free(w->touch);
-    free(w->xs);
-    free(w);
-}
-
-cf_status cf_body_work_get(cf_body *b, body_work **out, cf_error *err)
-{
-    if (b->work) {
-        *out = b->work;
-        return CF_OK;
-    }
-    const size_t n = 3 * b->nn;
-    body_work *w = calloc(1, sizeof *w);
-    if (!w || !pattern_build(b, &w->P)) {
-        free(w);
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent of %zu nodes", b->nn);
-    }
-    w->g = malloc(n * sizeof *w->g);
-    w->dx = malloc(n * sizeof *w->dx);
-    w->xt = malloc(n * sizeof *w->xt);
-    w->active = malloc(b->nn);
-    w->touch = malloc(b->nn);
-    cf_status st = CF_OK;
-    if (!w->g || !w->dx || !w->xt || !w->active || !w->touch || !cf_body_touchable(b, w->touch))
-        st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent of %zu nodes", b->nn);
-    else
-        st = cf_sparse_chol_create(&w->ch, n, w->P.colptr, w->P.rowidx, err);
-    if (st != CF_OK) {
-        cf_body_work_free(w);
-        return st;
-    }
-    b->work = w;
-    *out = w;
-    return CF_OK;
-}
-
