@@ -57,6 +57,9 @@ typedef struct pattern {
     size_t n;              /* 3 nn */
     int *colptr, *rowidx;  /* the linear solver's copy (cf_linsolve_pattern) once it is made */
     int borrowed;          /* 1: colptr and rowidx are the linear solver's, not freed here */
+    int aug;               /* 1: the augmented form (n = 4 nn): a pressure unknown per node for the
+                              nodal volume term (volume_coupling in body_assemble.c), the
+                              neighbours of each node alone in the pattern */
     double *val;           /* the tangent's values for the haptic loop, made at its first
                               assembly (the static solve writes into the linear solver's) */
     size_t *nbp;           /* nn + 1 */
@@ -82,6 +85,7 @@ struct body_work;
 typedef struct body_sys {
     cf_body *b;
     struct body_work *w;
+    pattern *P;         /* the pattern of the linear systems: w->Pa with a volume term, else w->P */
     const cf_probe *probe;
     const double *c;
     double kp;
@@ -93,10 +97,12 @@ typedef struct body_sys {
 ** its linear solver (mech.h, linsolve.h: the analysed factorisation and the last factors, reused as
 ** chord steps while they converge fast enough), and work vectors. */
 typedef struct body_work {
-    pattern P;
+    pattern P;          /* the condensed tangent's (with a volume term the neighbours of
+                           neighbours): the haptic loop's */
+    pattern Pa;         /* with a volume term, the static solve's augmented form (pattern.aug) */
     body_sys sys;
     cf_mech mech;
-    double *g, *dx, *xt;
+    double *g, *dx, *xt; /* g and dx: 3 nn + the augmented form's nn */
     double *gt;         /* 3 nn: the gradient while the tangent is written */
     uint8_t *active;
     uint8_t *touch;     /* nn: 1 = a node on the body's surface, which a probe can touch */
@@ -104,6 +110,7 @@ typedef struct body_work {
     double c_last[3];   /* the probe's reference point at the last converged static solve */
     double depth_last;  /* and its depth, mm */
     int has_last;       /* 0 before the first */
+    long neg_last;      /* negative eigenvalues of the static solve's last fresh tangent, -1 none */
     int factored;       /* the linear solver holds the factors of a tangent of this body (the
                            haptic loop clears it) */
     /* the haptic loop (cf_body_haptic_step): the factors of the tangent without contact, taken
@@ -155,13 +162,15 @@ void cf_body_keep_reaction(const cf_body *b, const double *g);
 ** b->contact (when there is one), N. */
 void cf_body_keep_contact(const cf_body *b, const cf_probe *pr, const double *c, double kp,
                           const uint8_t *active);
-/* Zeroes the rows and columns of fixed components (diagonal 1) and their gradient entries. */
+/* Zeroes the rows and columns of fixed components (diagonal 1) and their gradient entries (g of
+** 3 nn entries; P's pressure columns, in the augmented form, lose their rows of fixed
+** components). */
 void cf_body_apply_fixed(const cf_body *b, pattern *P, double *g);
 /* 1 when positions x invert no tetrahedron and take no spring to solid. */
 int cf_body_admissible(const cf_body *b, const double *x);
 /* The tangent's pattern of b (colptr, rowidx and the block indices; val left NULL), and its
-** release. 0 when memory runs out. */
-int cf_body_pattern_build(const cf_body *b, pattern *P);
+** release. aug = 1 with a volume term: the augmented form (pattern.aug). 0 when memory runs out. */
+int cf_body_pattern_build(const cf_body *b, pattern *P, int aug);
 void cf_body_pattern_free(pattern *P);
 
 /* body_work.c */

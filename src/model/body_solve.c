@@ -28,6 +28,8 @@ static cf_status newton_in_set(body_work *w, const cf_probe *probe, const double
     cf_mech_result res;
     cf_status st = cf_mech_newton(&w->mech, w->g, w->dx, &res, err);
     w->factored = cf_linsolve_factored(w->mech.ls);
+    if (res.factorizations > 0)
+        w->neg_last = res.neg_pivots;
     *fresh = w->mech.fresh;
     *it += res.iters;
     *force = s->force;
@@ -108,6 +110,7 @@ static cf_status solve_at(cf_body *b, body_work *w, const cf_probe *probe, const
     out->force_N = force;
     out->contacts = contacts;
     out->newton_iters = it;
+    out->neg_pivots = w->neg_last;
     out->min_J = cf_body_measure(b, NULL, &out->max_u_over_travel);
 end:
     return st;

@@ -27,7 +27,7 @@ static cf_status sys_residual(void *ctx, double *r, cf_error *err)
 static void sys_tangent(void *ctx, double *v)
 {
     body_sys *s = ctx;
-    pattern *P = &s->w->P;
+    pattern *P = s->P;
     double *keep = P->val;
     P->val = v;
     /* the memory for the volume term's scratch ran out: the values are NaN, which the solver's
@@ -78,6 +78,7 @@ void cf_body_work_free(body_work *w)
     free(w->hy);
     free(w->hrhs);
     cf_body_pattern_free(&w->P);
+    cf_body_pattern_free(&w->Pa);
     free(w->g);
     free(w->dx);
     free(w->xt);
@@ -88,22 +89,28 @@ void cf_body_work_free(body_work *w)
     free(w);
 }
 
-/* The linear solver with the pattern, which then serves as the pattern's own (one copy). */
+/* The linear solver with the pattern of the static solve (the augmented form's with a volume
+** term, else the condensed one's), which then serves as that pattern's own (one copy). */
 static cf_status work_mech(cf_body *b, body_work *w, cf_error *err)
 {
+    const int aug = b->kappa_MPa > 0;
+    pattern *P = aug ? &w->Pa : &w->P;
+    if (aug && !cf_body_pattern_build(b, P, 1))
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent of %zu nodes", b->nn);
     w->sys.b = b;
     w->sys.w = w;
-    cf_status st = cf_mech_create(&w->mech, 3 * b->nn, &body_ops, &w->sys, w->P.colptr,
-                                  w->P.rowidx, err);
+    w->sys.P = P;
+    cf_status st = cf_mech_create(&w->mech, 3 * b->nn, aug ? b->nn : 0, &body_ops, &w->sys,
+                                  P->colptr, P->rowidx, err);
     if (st != CF_OK)
         return st;
     const int *colp, *rowi;
     cf_linsolve_pattern(w->mech.ls, &colp, &rowi);
-    free(w->P.colptr);
-    free(w->P.rowidx);
-    w->P.colptr = (int *)colp; /* read only, by the assembly and the haptic loop's factors */
-    w->P.rowidx = (int *)rowi;
-    w->P.borrowed = 1;
+    free(P->colptr);
+    free(P->rowidx);
+    P->colptr = (int *)colp; /* read only, by the assembly and the haptic loop's factors */
+    P->rowidx = (int *)rowi;
+    P->borrowed = 1;
     /* converged when the residual is below 1e-8 of the body's force scale, or a full step below
     ** rounding */
     w->mech.tol = 1e-8 * b->E_MPa * b->mean_edge_mm * b->mean_edge_mm;
@@ -117,18 +124,19 @@ cf_status cf_body_work_get(cf_body *b, body_work **out, cf_error *err)
         *out = b->work;
         return CF_OK;
     }
-    const size_t n = 3 * b->nn;
+    const size_t n = 3 * b->nn, na = n + (b->kappa_MPa > 0 ? b->nn : 0);
     body_work *w = calloc(1, sizeof *w);
-    if (!w || !cf_body_pattern_build(b, &w->P)) {
+    if (!w || !cf_body_pattern_build(b, &w->P, 0)) {
         free(w);
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent of %zu nodes", b->nn);
     }
-    w->g = malloc(n * sizeof *w->g);
-    w->dx = malloc(n * sizeof *w->dx);
+    w->g = malloc(na * sizeof *w->g);
+    w->dx = malloc(na * sizeof *w->dx);
     w->xt = malloc(n * sizeof *w->xt);
     w->gt = malloc(n * sizeof *w->gt);
     w->active = malloc(b->nn);
     w->touch = malloc(b->nn);
+    w->neg_last = -1;
     cf_status st = CF_OK;
     if (!w->g || !w->dx || !w->xt || !w->gt || !w->active || !w->touch ||
         !cf_body_touchable(b, w->touch))

@@ -34,7 +34,12 @@ typedef struct cf_mech_ops {
 
 /* The system and its solver settings. */
 typedef struct cf_mech {
-    size_t n;            /* unknowns */
+    size_t n;            /* unknowns of the state */
+    size_t n_aux;        /* auxiliary unknowns the linear systems hold beyond them (fields of a
+                            mixed form such as nodal pressures: their right-hand side is zero,
+                            their solution unused; their block must be negative definite, so that
+                            the inertia of the condensed tangent is the system's less n_aux
+                            negative eigenvalues, Haynsworth) */
     const cf_mech_ops *ops;
     void *ctx;
     cf_linsolve *ls;     /* made by cf_mech_create with the system's pattern and tangent */
@@ -56,16 +61,18 @@ typedef struct cf_mech_result {
     int inadmissible;    /* 1: ended because no step shorter than min_alpha was admissible */
     int iters;           /* steps taken */
     int factorizations;  /* tangents assembled and solved afresh */
-    long neg_pivots;     /* negative eigenvalues of the last fresh tangent, -1 unknown */
+    long neg_pivots;     /* negative eigenvalues of the last fresh tangent (its condensed form
+                            when there are auxiliary unknowns), -1 unknown */
     double rnorm;        /* the residual's largest component at the end */
 } cf_mech_result;
 
 /* Fills m's settings with the defaults (200 steps, chord rate 1/4, 40 halvings, min_alpha
-** 2^-20, fresh = 1) and makes its linear solver with the pattern colp[n + 1], rowi (linsolve.h:
-** both triangles, rows increasing in a column, every diagonal entry; copied). ops and ctx must
-** outlive m. CF_E_INTERNAL when memory runs out. */
-cf_status cf_mech_create(cf_mech *m, size_t n, const cf_mech_ops *ops, void *ctx, const int *colp,
-                         const int *rowi, cf_error *err);
+** 2^-20, fresh = 1) and makes its linear solver for n + n_aux unknowns with the pattern
+** colp[n + n_aux + 1], rowi (linsolve.h: both triangles, rows increasing in a column, every
+** diagonal entry; copied; the tangent writes every entry). ops and ctx must outlive m.
+** CF_E_INTERNAL when memory runs out. */
+cf_status cf_mech_create(cf_mech *m, size_t n, size_t n_aux, const cf_mech_ops *ops, void *ctx,
+                         const int *colp, const int *rowi, cf_error *err);
 void cf_mech_free(cf_mech *m);
 
 /* Newton's method from the current state: steps from the last factors while they converge at
@@ -73,6 +80,7 @@ void cf_mech_free(cf_mech *m);
 ** admissible. CF_OK with res->conv 0 when max_iter steps did not converge or no admissible step
 ** was found (res->inadmissible); an error of the linear solver (CF_E_NOCONV: singular, CF_E_INTERNAL:
 ** out of memory) or of the residual otherwise, the state then where the last step left it. */
+/* r and dx are work vectors of n + n_aux entries. */
 cf_status cf_mech_newton(cf_mech *m, double *r, double *dx, cf_mech_result *res, cf_error *err);
 
 #endif

@@ -8,11 +8,12 @@
 #include <math.h>
 #include <string.h>
 
-cf_status cf_mech_create(cf_mech *m, size_t n, const cf_mech_ops *ops, void *ctx, const int *colp,
-                         const int *rowi, cf_error *err)
+cf_status cf_mech_create(cf_mech *m, size_t n, size_t n_aux, const cf_mech_ops *ops, void *ctx,
+                         const int *colp, const int *rowi, cf_error *err)
 {
     memset(m, 0, sizeof *m);
     m->n = n;
+    m->n_aux = n_aux;
     m->ops = ops;
     m->ctx = ctx;
     m->tol = 0;
@@ -22,7 +23,7 @@ cf_status cf_mech_create(cf_mech *m, size_t n, const cf_mech_ops *ops, void *ctx
     m->max_halvings = 40;
     m->min_alpha = 0x1p-20;
     m->fresh = 1;
-    return cf_linsolve_create(&m->ls, n, colp, rowi, ops->tangent, ctx, 0, err);
+    return cf_linsolve_create(&m->ls, n + n_aux, colp, rowi, ops->tangent, ctx, 0, err);
 }
 
 void cf_mech_free(cf_mech *m)
@@ -59,7 +60,8 @@ static cf_status direction(cf_mech *m, const double *r, double *dx, int *fresh_u
         return st;
     *fresh_used = 1;
     res->factorizations++;
-    res->neg_pivots = cf_linsolve_neg_pivots(m->ls);
+    const long neg = cf_linsolve_neg_pivots(m->ls);
+    res->neg_pivots = neg >= (long)m->n_aux ? neg - (long)m->n_aux : -1;
     return CF_OK;
 }
 
@@ -93,6 +95,8 @@ cf_status cf_mech_newton(cf_mech *m, double *r, double *dx, cf_mech_result *res,
         }
         if (!m->fresh && !(rn <= m->chord_rate * rprev))
             m->fresh = 1; /* the old factors no longer converge fast: take the tangent here */
+        for (size_t i = m->n; i < m->n + m->n_aux; i++)
+            r[i] = 0; /* the auxiliary unknowns' equations hold at every state */
         int fresh_used;
         if ((st = direction(m, r, dx, &fresh_used, res, err)) != CF_OK)
             return st;

@@ -128,7 +128,7 @@ static cf_mech setup_mech(chain *c)
     pattern(p, rows);
     cf_mech m;
     cf_error err = {0};
-    assert_int_equal(cf_mech_create(&m, N, &ops, c, p, rows, &err), CF_OK);
+    assert_int_equal(cf_mech_create(&m, N, 0, &ops, c, p, rows, &err), CF_OK);
     m.tol = 1e-12;
     m.step_tol = 1e-15;
     return m;
