@@ -23,7 +23,10 @@ cf_status cf_mech_create(cf_mech *m, size_t n, size_t n_aux, const cf_mech_ops *
     m->max_halvings = 40;
     m->min_alpha = 0x1p-20;
     m->fresh = 1;
-    return cf_linsolve_create(&m->ls, n + n_aux, colp, rowi, ops->tangent, ctx, 0, err);
+    cf_status st = cf_linsolve_create(&m->ls, n + n_aux, colp, rowi, ops->tangent, ctx, 0, err);
+    if (st == CF_OK && n_aux > 0)
+        cf_linsolve_indefinite(m->ls); /* the auxiliary block is negative definite */
+    return st;
 }
 
 void cf_mech_free(cf_mech *m)
