@@ -98,7 +98,8 @@ typedef struct body_sys {
 ** chord steps while they converge fast enough), and work vectors. */
 typedef struct body_work {
     pattern P;          /* the condensed tangent's (with a volume term the neighbours of
-                           neighbours): the haptic loop's */
+                           neighbours): the haptic loop's, made by cf_body_work_get; without a
+                           volume term also the static solve's */
     pattern Pa;         /* with a volume term, the static solve's augmented form (pattern.aug) */
     body_sys sys;
     cf_mech mech;
@@ -174,8 +175,12 @@ int cf_body_pattern_build(const cf_body *b, pattern *P, int aug);
 void cf_body_pattern_free(pattern *P);
 
 /* body_work.c */
-/* The body's workspace (made at the first call: the pattern, the body as a mechanical system with
-** its linear solver), and its release. */
+/* The body's workspace (made at the first call: the body as a mechanical system with its linear
+** solver and the pattern of its systems): cf_body_work_static for the static and dynamic solves;
+** cf_body_work_get (the haptic loop's) also makes the condensed pattern w->P when there is a
+** volume term (the neighbours of neighbours: the augmented form's systems do without it). And its
+** release. */
+cf_status cf_body_work_static(cf_body *b, body_work **out, cf_error *err);
 cf_status cf_body_work_get(cf_body *b, body_work **out, cf_error *err);
 void cf_body_work_free(body_work *w);
 

@@ -178,7 +178,7 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
     for (int k = 0; k < 3; k++)
         c[k] = probe->center_mm[k] + depth_mm * probe->dir[k];
     body_work *w = NULL;
-    cf_status st = cf_body_work_get(b, &w, err);
+    cf_status st = cf_body_work_static(b, &w, err);
     if (st != CF_OK)
         return st;
     if ((st = solve_cut(b, w, probe, c, depth_mm, kp, out, err)) == CF_OK) {

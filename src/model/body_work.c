@@ -118,15 +118,13 @@ static cf_status work_mech(cf_body *b, body_work *w, cf_error *err)
     return CF_OK;
 }
 
-cf_status cf_body_work_get(cf_body *b, body_work **out, cf_error *err)
+/* The workspace without the condensed pattern (with a volume term the static solve needs only the
+** augmented one). */
+static cf_status work_make(cf_body *b, body_work **out, cf_error *err)
 {
-    if (b->work) {
-        *out = b->work;
-        return CF_OK;
-    }
     const size_t n = 3 * b->nn, na = n + (b->kappa_MPa > 0 ? b->nn : 0);
     body_work *w = calloc(1, sizeof *w);
-    if (!w || !cf_body_pattern_build(b, &w->P, 0)) {
+    if (!w || (!(b->kappa_MPa > 0) && !cf_body_pattern_build(b, &w->P, 0))) {
         free(w);
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent of %zu nodes", b->nn);
     }
@@ -149,5 +147,25 @@ cf_status cf_body_work_get(cf_body *b, body_work **out, cf_error *err)
     }
     b->work = w;
     *out = w;
+    return CF_OK;
+}
+
+cf_status cf_body_work_static(cf_body *b, body_work **out, cf_error *err)
+{
+    if (b->work) {
+        *out = b->work;
+        return CF_OK;
+    }
+    return work_make(b, out, err);
+}
+
+cf_status cf_body_work_get(cf_body *b, body_work **out, cf_error *err)
+{
+    cf_status st = cf_body_work_static(b, out, err);
+    if (st != CF_OK || (*out)->P.colptr)
+        return st;
+    /* the haptic loop's condensed pattern, made at its first call */
+    if (!cf_body_pattern_build(b, &(*out)->P, 0))
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent of %zu nodes", b->nn);
     return CF_OK;
 }
