@@ -30,14 +30,9 @@
 ** admissible; *stretched the springs in tension at the last step. */
 static void probe_block(const cf_law *law, double *force, size_t *stretched)
 {
-    double xs[7], zs[4];
-    for (int i = 0; i <= 6; i++)
-        xs[i] = 5.0 * i;
-    for (int i = 0; i <= 3; i++)
-        zs[i] = 5.0 * i;
     cf_mesh m;
     cf_error err = {0};
-    assert_int_equal(cf_mesh_block(&m, xs, 6, xs, 6, zs, 3, &err), CF_OK);
+    make_block(&m);
     cf_body b;
     const double kappa = cf_body_kappa_for_nu(cf_body_mu_of_law(law), 0.45);
     if (cf_body_create(&b, &m, law, CF_LAW_CLOSED, kappa, &err) != CF_OK)
