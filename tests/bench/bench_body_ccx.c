@@ -50,7 +50,7 @@ static void run_body(void *arg)
     cf_body_free(&b);
 }
 
-/* The CalculiX deck of mesh m (C3D4, E and nu) at dir/job.inp; 0 when it cannot be written. */
+/* The CalculiX deck of mesh m (C3D4, E and nu) at path; 0 when it cannot be written. */
 static int write_deck(const char *path, const cf_mesh *m, double E, double nu)
 {
     FILE *f = fopen(path, "w");
@@ -84,14 +84,16 @@ static int write_deck(const char *path, const cf_mesh *m, double E, double nu)
 /* ccx on the deck of m in a scratch folder: 0 and its wall time and peak RSS when it ran. */
 static int run_ccx(const cf_mesh *m, double E, double nu, double *wall, long *kb)
 {
-    char dir[] = "/tmp/conifit-bench-ccx-XXXXXX", path[80], job[80], cmd[160];
+    char dir[] = "/tmp/conifit-bench-ccx-XXXXXX", path[80], run[120], cmd[160];
     if (!mkdtemp(dir))
         return -1;
     snprintf(path, sizeof path, "%s/block.inp", dir);
-    snprintf(job, sizeof job, "%s/block", dir);
+    /* in the scratch folder: ccx writes its solver's files (spooles.out) where it runs; exec, so
+    ** that the resources are ccx's own */
+    snprintf(run, sizeof run, "cd '%s' && exec /usr/bin/ccx -i block", dir);
     int rc = -1;
     if (write_deck(path, m, E, nu)) {
-        char *argv[] = {"/usr/bin/ccx", "-i", job, NULL};
+        char *argv[] = {"/bin/sh", "-c", run, NULL};
         struct rusage ru;
         const double t0 = bench_now();
         rc = bench_exec(argv, &ru);
