@@ -31,16 +31,22 @@ static inline void write_msh(const char *path, cf_mesh *m)
     cf_mesh_free(m);
 }
 
-/* A block of 6 x 6 x 3 cells over 30 x 30 x 15 mm, as a Gmsh 2.2 file. */
-static inline void write_block(const char *path)
+/* The block of 6 x 6 x 3 cells over 30 x 30 x 15 mm (the block generator's) into m. */
+static inline void make_block(cf_mesh *m)
 {
     double xs[7], zs[4];
     for (int i = 0; i <= 6; i++)
         xs[i] = 5.0 * i;
     for (int i = 0; i <= 3; i++)
         zs[i] = 5.0 * i;
+    assert_int_equal(cf_mesh_block(m, xs, 6, xs, 6, zs, 3, NULL), CF_OK);
+}
+
+/* That block as a Gmsh 2.2 file. */
+static inline void write_block(const char *path)
+{
     cf_mesh m;
-    assert_int_equal(cf_mesh_block(&m, xs, 6, xs, 6, zs, 3, NULL), CF_OK);
+    make_block(&m);
     write_msh(path, &m);
 }
 

@@ -92,10 +92,10 @@ double cf_body_measure(const cf_body *b, cf_body_state *st, double *max_u_over_t
     for (size_t s = 0; s < b->ns; s++) {
         double n[3], u;
         double L = body_spring_geom(b, b->x, s, n, &u);
-        umax = fmax(umax, fabs(u) / b->law->travel_mm);
+        umax = fmax(umax, fabs(u) / cf_law_travel_at(b->law, u));
         if (st) {
             st->strain[s] = (L - b->L0[s]) / b->L0[s];
-            st->solid[s] = fabs(u) >= b->law->travel_mm;
+            st->solid[s] = fabs(u) >= cf_law_travel_at(b->law, u);
         }
     }
     for (size_t t = 0; t < b->nt; t++) {

@@ -210,6 +210,9 @@ typedef struct cf_body_step {
     int newton_iters;
     double min_J;
     double max_u_over_travel;
+    long neg_pivots;      /* negative eigenvalues of the last tangent the static solve factored
+                             (0: a stable equilibrium), -1 when none was factored or the count is
+                             unknown */
 } cf_body_step;
 
 /* Solves the static equilibrium of b with the probe at depth (probe->dir times depth from its

@@ -9,10 +9,12 @@
 
 #include "model/body_internal.h"
 
-static void pattern_free(pattern *P)
+void cf_body_pattern_free(pattern *P)
 {
-    free(P->colptr);
-    free(P->rowidx);
+    if (!P->borrowed) {
+        free(P->colptr);
+        free(P->rowidx);
+    }
     free(P->val);
     free(P->nbp);
     free(P->nb);
@@ -66,7 +68,7 @@ static int pattern_blocks(const cf_body *b, pattern *P, uint32_t *mark)
             for (int q = 0; q < 4; q++)
                 P->tblk[16 * t + 4 * (size_t)m + (size_t)q] =
                     (uint32_t)blk_of(P, b->tet[4 * t + q], b->tet[4 * t + m]);
-    if (!(b->kappa_MPa > 0))
+    if (!(b->kappa_MPa > 0) || P->aug)
         return 1;
     P->rp = malloc((nn + 1) * sizeof *P->rp);
     P->bp = malloc((nn + 1) * sizeof *P->bp);
@@ -117,12 +119,46 @@ static int pattern_blocks(const cf_body *b, pattern *P, uint32_t *mark)
     return 1;
 }
 
-static int pattern_build(const cf_body *b, pattern *P)
+/* The rows of the pattern's columns into colptr and rowidx (see pattern): node j's three columns
+** hold the blocks of its neighbours nb, and in the augmented form the pressure rows 3 nn + q of
+** the same neighbours; pressure column a the rows of a's neighbours and its own diagonal. */
+static int pattern_rows(pattern *P, size_t nn, size_t nnb)
+{
+    const size_t n = P->n, nnz = 9 * nnb + (P->aug ? 6 * nnb + nn : 0);
+    if (nnz > 2147483647u)
+        return 0;
+    P->colptr = malloc((n + 1) * sizeof *P->colptr);
+    P->rowidx = malloc(nnz * sizeof *P->rowidx);
+    if (!P->colptr || !P->rowidx)
+        return 0;
+    size_t k = 0;
+    P->colptr[0] = 0;
+    for (size_t j = 0; j < nn; j++)
+        for (int c = 0; c < 3; c++) {
+            for (size_t q = P->nbp[j]; q < P->nbp[j + 1]; q++)
+                for (int a = 0; a < 3; a++)
+                    P->rowidx[k++] = (int)(3 * P->nb[q] + (size_t)a);
+            for (size_t q = P->nbp[j]; P->aug && q < P->nbp[j + 1]; q++)
+                P->rowidx[k++] = (int)(3 * nn + P->nb[q]);
+            P->colptr[3 * j + c + 1] = (int)k;
+        }
+    for (size_t j = 0; P->aug && j < nn; j++) {
+        for (size_t q = P->nbp[j]; q < P->nbp[j + 1]; q++)
+            for (int a = 0; a < 3; a++)
+                P->rowidx[k++] = (int)(3 * P->nb[q] + (size_t)a);
+        P->rowidx[k++] = (int)(3 * nn + j);
+        P->colptr[3 * nn + j + 1] = (int)k;
+    }
+    return 1;
+}
+
+int cf_body_pattern_build(const cf_body *b, pattern *P, int aug)
 {
     memset(P, 0, sizeof *P);
     const size_t nn = b->nn, nt = b->nt;
-    const int two = b->kappa_MPa > 0;
-    P->n = 3 * nn;
+    P->aug = aug && b->kappa_MPa > 0;
+    const int two = b->kappa_MPa > 0 && !P->aug;
+    P->n = 3 * nn + (P->aug ? nn : 0);
     P->tp = calloc(nn + 1, sizeof *P->tp);
     P->tl = malloc(4 * nt * sizeof *P->tl);
     P->nbp = malloc((nn + 1) * sizeof *P->nbp);
@@ -181,22 +217,8 @@ static int pattern_build(const cf_body *b, pattern *P)
     }
     P->nb = list;
     list = NULL;
-    if (9 * nnb > 2147483647u)
+    if (!pattern_rows(P, nn, nnb))
         goto fail;
-    P->colptr = malloc((3 * nn + 1) * sizeof *P->colptr);
-    P->rowidx = malloc(9 * nnb * sizeof *P->rowidx);
-    P->val = malloc(9 * nnb * sizeof *P->val);
-    if (!P->colptr || !P->rowidx || !P->val)
-        goto fail;
-    size_t nnz = 0;
-    P->colptr[0] = 0;
-    for (size_t j = 0; j < nn; j++)
-        for (int c = 0; c < 3; c++) {
-            for (size_t k = P->nbp[j]; k < P->nbp[j + 1]; k++)
-                for (int a = 0; a < 3; a++)
-                    P->rowidx[nnz++] = (int)(3 * P->nb[k] + (size_t)a);
-            P->colptr[3 * j + c + 1] = (int)nnz;
-        }
     if (!pattern_blocks(b, P, mark))
         goto fail;
     free(mark);
@@ -204,7 +226,7 @@ static int pattern_build(const cf_body *b, pattern *P)
 fail:
     free(mark);
     free(list);
-    pattern_free(P);
+    cf_body_pattern_free(P);
     return 0;
 }
 
@@ -282,6 +304,36 @@ static void volume_hessian(const cf_body *b, const double *x, size_t t, double f
         }
 }
 
+/* The augmented form's volume coupling: node a's pressure unknown (row and column 3 nn + a) holds
+** w_a = dV_a/dx, the gradient of its volume, against the positions of its neighbours, and
+** -V0_a/kappa on its diagonal. Eliminating the pressures gives back the condensed tangent's
+** sum_a (kappa/V0_a) w_a w_a^T, so the positions' solution is the same, while the pattern keeps
+** only the neighbours of each node (the condensed one couples the neighbours of neighbours). */
+static void volume_coupling(const cf_body *b, const double *dVall, const double *V0n, pattern *P)
+{
+    const size_t nn = b->nn;
+    for (size_t a = 0; a < nn; a++) {
+        double *col = P->val + P->colptr[3 * nn + a];
+        const size_t nr = P->nbp[a + 1] - P->nbp[a];
+        memset(col, 0, 3 * nr * sizeof *col);
+        for (size_t k = P->tp[a]; k < P->tp[a + 1]; k++) {
+            const size_t t = P->tl[k];
+            for (int m = 0; m < 4; m++) {
+                const size_t q = blk_of(P, a, b->tet[4 * t + m]);
+                for (int c = 0; c < 3; c++)
+                    col[3 * q + (size_t)c] += dVall[12 * t + 3 * (size_t)m + (size_t)c] / 4;
+            }
+        }
+        col[3 * nr] = -V0n[a] / b->kappa_MPa;
+        for (size_t q = 0; q < nr; q++) { /* the same values in the rows of the pressure */
+            const size_t j = P->nb[P->nbp[a] + q];
+            const size_t off = 3 * (P->nbp[j + 1] - P->nbp[j]) + blk_of(P, j, a);
+            for (int c = 0; c < 3; c++)
+                P->val[(size_t)P->colptr[3 * j + (size_t)c] + off] = col[3 * q + (size_t)c];
+        }
+    }
+}
+
 /* The volume term, averaged over nodes: each node a owns a quarter of the volume of every
 ** tetrahedron around it, V_a and V0_a, and stores V0_a (kappa/2)(J_a - 1)^2 with J_a = V_a/V0_a
 ** (the average nodal pressure tetrahedron of Bonet & Burton 1998, Commun Numer Meth Engng
@@ -319,7 +371,9 @@ static int volume_term(const cf_body *b, const double *x, double *g, pattern *P)
         if (P && f != 0)
             volume_hessian(b, x, t, f, P);
     }
-    if (P) {
+    if (P && P->aug)
+        volume_coupling(b, dVall, V0n, P);
+    else if (P) {
         loc = malloc(nn * sizeof *loc);
         size_t maxring = 1;
         for (size_t a = 0; a < nn; a++)
@@ -374,6 +428,8 @@ double cf_body_assemble(const cf_body *b, const double *x, const cf_probe *pr, c
     const cf_law *law = b->law;
     const double H = law->p.H_mm;
     memset(g, 0, 3 * b->nn * sizeof *g);
+    if (P && !P->val && !(P->val = malloc((size_t)P->colptr[P->n] * sizeof *P->val)))
+        return NAN; /* the haptic loop's first assembly */
     if (P)
         memset(P->val, 0, (size_t)P->colptr[P->n] * sizeof *P->val);
     for (size_t s = 0; s < b->ns; s++) {
@@ -477,24 +533,20 @@ void cf_body_keep_contact(const cf_body *b, const cf_probe *pr, const double *c,
 /* Zeroes the rows and columns of fixed components (diagonal 1) and their gradient entries. */
 void cf_body_apply_fixed(const cf_body *b, pattern *P, double *g)
 {
-    for (size_t j = 0; j < b->nn; j++) {
-        for (int c = 0; c < 3; c++) {
-            if (!P) {
-                if ((b->fix[j] >> c) & 1)
-                    g[3 * j + c] = 0;
-                continue;
-            }
-            int *ri = P->rowidx + P->colptr[3 * j + c];
-            double *v = P->val + P->colptr[3 * j + c];
-            size_t len = (size_t)(P->colptr[3 * j + c + 1] - P->colptr[3 * j + c]);
-            const int colfix = (b->fix[j] >> c) & 1;
-            for (size_t k = 0; k < len; k++) {
-                size_t row = (size_t)ri[k];
-                if (colfix || ((b->fix[row / 3] >> (row % 3)) & 1))
-                    v[k] = (row == 3 * j + (size_t)c) ? 1 : 0;
-            }
-            if (colfix)
-                g[3 * j + c] = 0;
+    const size_t n3 = 3 * b->nn, ncol = P ? P->n : n3;
+    for (size_t col = 0; col < ncol; col++) {
+        const int colfix = col < n3 && ((b->fix[col / 3] >> (col % 3)) & 1);
+        if (colfix)
+            g[col] = 0;
+        if (!P)
+            continue;
+        const int *ri = P->rowidx + P->colptr[col];
+        double *v = P->val + P->colptr[col];
+        const size_t len = (size_t)(P->colptr[col + 1] - P->colptr[col]);
+        for (size_t k = 0; k < len; k++) {
+            const size_t row = (size_t)ri[k];
+            if (colfix || (row < n3 && ((b->fix[row / 3] >> (row % 3)) & 1)))
+                v[k] = row == col ? 1 : 0;
         }
     }
 }
@@ -515,7 +567,7 @@ int cf_body_admissible(const cf_body *b, const double *x)
     for (size_t s = 0; s < b->ns; s++) {
         double n[3], u;
         body_spring_geom(b, x, s, n, &u);
-        if (!(fabs(u) < b->law->travel_mm))
+        if (!(fabs(u) < cf_law_travel_at(b->law, u))) /* a pair: each side its own */
             return 0;
     }
     for (size_t t = 0; t < b->nt; t++) {
@@ -525,56 +577,3 @@ int cf_body_admissible(const cf_body *b, const double *x)
     }
     return 1;
 }
-
-void cf_body_work_free(body_work *w)
-{
-    if (!w)
-        return;
-    cf_sparse_chol_free(w->ch);
-    cf_sparse_chol_free(w->hch);
-    free(w->hactive);
-    free(w->slot);
-    free(w->Z);
-    free(w->hy);
-    free(w->hrhs);
-    pattern_free(&w->P);
-    free(w->g);
-    free(w->dx);
-    free(w->xt);
-    free(w->active);
-    free(w->touch);
-    free(w->xs);
-    free(w);
-}
-
-cf_status cf_body_work_get(cf_body *b, body_work **out, cf_error *err)
-{
-    if (b->work) {
-        *out = b->work;
-        return CF_OK;
-    }
-    const size_t n = 3 * b->nn;
-    body_work *w = calloc(1, sizeof *w);
-    if (!w || !pattern_build(b, &w->P)) {
-        free(w);
-        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent of %zu nodes", b->nn);
-    }
-    w->g = malloc(n * sizeof *w->g);
-    w->dx = malloc(n * sizeof *w->dx);
-    w->xt = malloc(n * sizeof *w->xt);
-    w->active = malloc(b->nn);
-    w->touch = malloc(b->nn);
-    cf_status st = CF_OK;
-    if (!w->g || !w->dx || !w->xt || !w->active || !w->touch || !cf_body_touchable(b, w->touch))
-        st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent of %zu nodes", b->nn);
-    else
-        st = cf_sparse_chol_create(&w->ch, n, w->P.colptr, w->P.rowidx, err);
-    if (st != CF_OK) {
-        cf_body_work_free(w);
-        return st;
-    }
-    b->work = w;
-    *out = w;
-    return CF_OK;
-}
-

@@ -62,7 +62,7 @@ cf_status cf_body_dynamic_step(cf_body *b, cf_body_motion *m, const cf_probe *pr
     if (!(dt_s > 0) || !isfinite(dt_s))
         return cf_error_set(err, CF_E_DATA, "body: time step %g s: must be finite and > 0", dt_s);
     body_work *w = NULL;
-    cf_status st = cf_body_work_get(b, &w, err);
+    cf_status st = cf_body_work_static(b, &w, err);
     if (st != CF_OK)
         return st;
     const size_t n = 3 * b->nn;

@@ -1,7 +1,8 @@
 /*
 ** What the files of the tissue body share (body.c: the springs, their calibration and the probe's
-** geometry; body_assemble.c: the tangent's pattern, the forces and tangent, the solver's workspace;
-** body_solve.c: the static probe solve; body_haptic.c: the probe loop at haptic rate). Private to
+** geometry; body_assemble.c: the tangent's pattern, the forces and tangent; body_work.c: the
+** solvers' workspace and the body as a mechanical system (mech.h); body_solve.c: the static probe
+** solve; body_haptic.c: the probe loop at haptic rate). Private to
 ** the model layer.
 */
 #ifndef CF_MODEL_BODY_INTERNAL_H
@@ -12,6 +13,7 @@
 #include <stdint.h>
 
 #include "model/body.h"
+#include "model/mech.h"
 #include "model/sparse_chol.h"
 
 /* Six times the signed volume of the tetrahedron a, b, c, d. */
@@ -53,8 +55,13 @@ static inline double body_norm_inf(const double *v, size_t n)
 ** nodal volume couples every pair of nodes around one node). */
 typedef struct pattern {
     size_t n;              /* 3 nn */
-    int *colptr, *rowidx;
-    double *val;
+    int *colptr, *rowidx;  /* the linear solver's copy (cf_linsolve_pattern) once it is made */
+    int borrowed;          /* 1: colptr and rowidx are the linear solver's, not freed here */
+    int aug;               /* 1: the augmented form (n = 4 nn): a pressure unknown per node for the
+                              nodal volume term (volume_coupling in body_assemble.c), the
+                              neighbours of each node alone in the pattern */
+    double *val;           /* the tangent's values for the haptic loop, made at its first
+                              assembly (the static solve writes into the linear solver's) */
     size_t *nbp;           /* nn + 1 */
     uint32_t *nb;
     size_t *tp;            /* tetrahedra around each node: tl[tp[a] .. tp[a + 1]) */
@@ -71,20 +78,42 @@ typedef struct pattern {
     uint32_t *rblk;
 } pattern;
 
-/* What the solves of a body keep between calls: the pattern and the analysed factorisation of its
-** tangent, the last factors (reused as chord steps while they converge fast enough), and work
-** vectors. */
+struct body_work;
+
+/* The body as a mechanical system (mech.h) for the static solve: the probe at c with penalty kp
+** on the contact set w->active, and what the last residual found. */
+typedef struct body_sys {
+    cf_body *b;
+    struct body_work *w;
+    pattern *P;         /* the pattern of the linear systems: w->Pa with a volume term, else w->P */
+    const cf_probe *probe;
+    const double *c;
+    double kp;
+    double force;       /* the reaction along the probe's direction, N */
+    int contacts;
+} body_sys;
+
+/* What the solves of a body keep between calls: the pattern, the body as a mechanical system with
+** its linear solver (mech.h, linsolve.h: the analysed factorisation and the last factors, reused as
+** chord steps while they converge fast enough), and work vectors. */
 typedef struct body_work {
-    pattern P;
-    cf_sparse_chol *ch;
-    double *g, *dx, *xt;
+    pattern P;          /* the condensed tangent's (with a volume term the neighbours of
+                           neighbours): the haptic loop's, made by cf_body_work_get; without a
+                           volume term also the static solve's */
+    pattern Pa;         /* with a volume term, the static solve's augmented form (pattern.aug) */
+    body_sys sys;
+    cf_mech mech;
+    double *g, *dx, *xt; /* g and dx: 3 nn + the augmented form's nn */
+    double *gt;         /* 3 nn: the gradient while the tangent is written */
     uint8_t *active;
     uint8_t *touch;     /* nn: 1 = a node on the body's surface, which a probe can touch */
     double *xs;         /* 3 nn: the body at the last converged part of a static solve's move */
     double c_last[3];   /* the probe's reference point at the last converged static solve */
     double depth_last;  /* and its depth, mm */
     int has_last;       /* 0 before the first */
-    int factored;       /* ch holds the factors of a tangent of this body */
+    long neg_last;      /* negative eigenvalues of the static solve's last fresh tangent, -1 none */
+    int factored;       /* the linear solver holds the factors of a tangent of this body (the
+                           haptic loop clears it) */
     /* the haptic loop (cf_body_haptic_step): the factors of the tangent without contact, taken
     ** once, and per node that has touched the probe the three columns of its inverse at that
     ** node (slot[i] + 1 indexes Z, 0 = none yet) */
@@ -134,11 +163,24 @@ void cf_body_keep_reaction(const cf_body *b, const double *g);
 ** b->contact (when there is one), N. */
 void cf_body_keep_contact(const cf_body *b, const cf_probe *pr, const double *c, double kp,
                           const uint8_t *active);
-/* Zeroes the rows and columns of fixed components (diagonal 1) and their gradient entries. */
+/* Zeroes the rows and columns of fixed components (diagonal 1) and their gradient entries (g of
+** 3 nn entries; P's pressure columns, in the augmented form, lose their rows of fixed
+** components). */
 void cf_body_apply_fixed(const cf_body *b, pattern *P, double *g);
 /* 1 when positions x invert no tetrahedron and take no spring to solid. */
 int cf_body_admissible(const cf_body *b, const double *x);
-/* The body's workspace (made at the first call), and its release. */
+/* The tangent's pattern of b (colptr, rowidx and the block indices; val left NULL), and its
+** release. aug = 1 with a volume term: the augmented form (pattern.aug). 0 when memory runs out. */
+int cf_body_pattern_build(const cf_body *b, pattern *P, int aug);
+void cf_body_pattern_free(pattern *P);
+
+/* body_work.c */
+/* The body's workspace (made at the first call: the body as a mechanical system with its linear
+** solver and the pattern of its systems): cf_body_work_static for the static and dynamic solves;
+** cf_body_work_get (the haptic loop's) also makes the condensed pattern w->P when there is a
+** volume term (the neighbours of neighbours: the augmented form's systems do without it). And its
+** release. */
+cf_status cf_body_work_static(cf_body *b, body_work **out, cf_error *err);
 cf_status cf_body_work_get(cf_body *b, body_work **out, cf_error *err);
 void cf_body_work_free(body_work *w);
 

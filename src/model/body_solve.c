@@ -9,74 +9,39 @@
 
 #include "model/body_internal.h"
 
-/* Newton's method with the contact set w->active held (each node of it pushed back by the
-** penalty kp in proportion to its signed depth), probe reference point at c: at most 200 steps,
-** chord steps on the last factors while each cuts the residual to a quarter (*fresh 0), the
-** tangent taken afresh otherwise. *conv 1 when the residual or the step fell below rounding;
-** *it counts the iterations, *force and *contacts are the last assembly's. */
-static cf_status newton_in_set(cf_body *b, body_work *w, const cf_probe *probe, const double c[3],
+/* Newton's method (the driver of mech.h over the body as a mechanical system, body_work.c) with
+** the contact set w->active held (each node of it pushed back by the penalty kp in proportion to
+** its signed depth), probe reference point at c: at most 200 steps, chord steps on the last
+** factors while each cuts the residual to a quarter, the tangent taken afresh otherwise (*fresh 1
+** asks for it at the first step). *conv 1 when the residual or the step fell below rounding; *it
+** counts the iterations, *force and *contacts are the last assembly's. */
+static cf_status newton_in_set(body_work *w, const cf_probe *probe, const double c[3],
                                double kp, double depth_mm, int *fresh, int *it, int *contacts,
                                double *force, int *conv, cf_error *err)
 {
-    const size_t n = 3 * b->nn;
-    const double fscale = b->E_MPa * b->mean_edge_mm * b->mean_edge_mm;
-    pattern *P = &w->P;
-    double *g = w->g, *dx = w->dx, *xt = w->xt;
-    const uint8_t *active = w->active;
-    cf_status st;
-    double rprev = INFINITY;
-    for (int k = 0; k < 200 && !*conv; k++, (*it)++) {
-        *force = cf_body_assemble(b, b->x, probe, c, kp, active, g, *fresh ? P : NULL, contacts);
-        if (isnan(*force))
-            return cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's tangent");
-        cf_body_add_inertia(b, w, b->x, g, *fresh ? P : NULL);
-        cf_body_apply_fixed(b, *fresh ? P : NULL, g);
-        double r = body_norm_inf(g, n);
-        if (r <= 1e-8 * fscale) {
-            *conv = 1;
-            break;
-        }
-        if (!*fresh && !(r <= 0.25 * rprev)) {
-            /* the old factors no longer converge fast: take the tangent here */
-            *fresh = 1;
-            rprev = INFINITY;
-            k--;
-            (*it)--;
-            continue;
-        }
-        if (*fresh) {
-            w->factored = 0;
-            if ((st = cf_sparse_chol_factor(w->ch, P->val, NULL, err)) != CF_OK)
-                return st;
-            w->factored = 1;
-        }
-        if ((st = cf_sparse_chol_solve(w->ch, g, dx, err)) != CF_OK)
-            return st;
-        for (size_t i = 0; i < b->nn; i++) /* held components never move (old factors */
-            for (int a = 0; a < 3; a++)    /* may have been made with other ones held) */
-                if ((b->fix[i] >> a) & 1)
-                    dx[3 * i + (size_t)a] = 0;
-        *fresh = 0;
-        rprev = r;
-        double alpha = 2;
-        int ok = 0;
-        for (int bt = 0; bt < 40 && !ok; bt++) {
-            alpha *= 0.5;
-            for (size_t i = 0; i < n; i++)
-                xt[i] = b->x[i] - alpha * dx[i];
-            ok = cf_body_admissible(b, xt);
-        }
-        if (!ok || alpha < 0x1p-20)
-            return cf_error_set(err, CF_E_NOCONV,
-                                "body: at probe depth %g mm every Newton step would invert a "
-                                "tetrahedron or take a spring to solid",
-                                depth_mm);
-        memcpy(b->x, xt, n * sizeof *xt);
-        if (alpha < 0.99)
-            *fresh = 1; /* a shortened step: take the tangent where it landed */
-        else if (body_norm_inf(dx, n) <= 1e-14 * b->mean_edge_mm)
-            *conv = 1; /* a full step below rounding (a cut one says nothing of convergence) */
-    }
+    body_sys *s = &w->sys;
+    s->probe = probe;
+    s->c = c;
+    s->kp = kp;
+    w->mech.fresh = *fresh || !w->factored;
+    w->factored = 0;
+    cf_mech_result res;
+    cf_status st = cf_mech_newton(&w->mech, w->g, w->dx, &res, err);
+    w->factored = cf_linsolve_factored(w->mech.ls);
+    if (res.factorizations > 0)
+        w->neg_last = res.neg_pivots;
+    *fresh = w->mech.fresh;
+    *it += res.iters;
+    *force = s->force;
+    *contacts = s->contacts;
+    *conv = res.conv;
+    if (st != CF_OK)
+        return st;
+    if (res.inadmissible)
+        return cf_error_set(err, CF_E_NOCONV,
+                            "body: at probe depth %g mm every Newton step would invert a "
+                            "tetrahedron or take a spring to solid",
+                            depth_mm);
     return CF_OK;
 }
 
@@ -107,7 +72,7 @@ static cf_status solve_at(cf_body *b, body_work *w, const cf_probe *probe, const
     fresh |= !w->factored;
     for (rounds = 0; rounds < 100; rounds++) {
         int conv = 0;
-        if ((st = newton_in_set(b, w, probe, c, kp, depth_mm, &fresh, &it, &contacts, &force,
+        if ((st = newton_in_set(w, probe, c, kp, depth_mm, &fresh, &it, &contacts, &force,
                                 &conv, err)) != CF_OK)
             goto end;
         if (!conv) {
@@ -145,6 +110,7 @@ static cf_status solve_at(cf_body *b, body_work *w, const cf_probe *probe, const
     out->force_N = force;
     out->contacts = contacts;
     out->newton_iters = it;
+    out->neg_pivots = w->neg_last;
     out->min_J = cf_body_measure(b, NULL, &out->max_u_over_travel);
 end:
     return st;
@@ -212,7 +178,7 @@ cf_status cf_body_solve(cf_body *b, const cf_probe *probe, double depth_mm,
     for (int k = 0; k < 3; k++)
         c[k] = probe->center_mm[k] + depth_mm * probe->dir[k];
     body_work *w = NULL;
-    cf_status st = cf_body_work_get(b, &w, err);
+    cf_status st = cf_body_work_static(b, &w, err);
     if (st != CF_OK)
         return st;
     if ((st = solve_cut(b, w, probe, c, depth_mm, kp, out, err)) == CF_OK) {

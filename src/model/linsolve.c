@@ -102,6 +102,11 @@ long cf_linsolve_neg_pivots(const cf_linsolve *s)
     return s->neg_pivots;
 }
 
+void cf_linsolve_indefinite(cf_linsolve *s)
+{
+    s->indefinite = 1;
+}
+
 int cf_linsolve_factored(const cf_linsolve *s)
 {
     return s->chol_ready;
@@ -134,6 +139,8 @@ static int chol_direction(cf_linsolve *s, const double *b, double *x, int *fatal
             s->chol_failed = 1;
             return 0;
         }
+        if (s->indefinite)
+            cf_sparse_chol_indefinite(s->chol);
     }
     cf_chol_info info;
     cf_status st = cf_sparse_chol_factor(s->chol, C->data, &info, &lerr);

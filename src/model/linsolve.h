@@ -48,6 +48,10 @@ void cf_linsolve_pattern(const cf_linsolve *ls, const int **colp, const int **ro
 cf_status cf_linsolve_direction(cf_linsolve *ls, const double *b, double *x, size_t *solves,
                                 cf_error *err);
 
+/* The matrices are indefinite by construction (a mixed form): the sparse factorisation goes to
+** L D L^T at once (cf_sparse_chol_indefinite). */
+void cf_linsolve_indefinite(cf_linsolve *ls);
+
 /* Negative pivots of the matrix of the last cf_linsolve_direction (its negative eigenvalues), -1
 ** when no factorisation reported them. */
 long cf_linsolve_neg_pivots(const cf_linsolve *ls);

@@ -23,6 +23,7 @@ struct cf_linsolve {
     gsl_matrix *AB;           /* banded LDL^T workspace, n x (band + 1); NULL until used */
     cf_sparse_chol *chol;     /* sparse factorisation of C (pattern analysed once); NULL until
                                  used */
+    int indefinite;           /* cf_linsolve_indefinite */
     int chol_failed;          /* 1: the sparse factorisation could not be set up; not retried */
     int chol_ready;           /* chol holds the factors of C, scaled by D, for a chord step */
     long neg_pivots;          /* negative pivots of the last factored matrix, -1 unknown */

@@ -45,6 +45,7 @@ struct cf_sparse_chol {
     const int *colptr, *rowidx;
     int last;              /* 0 none, 1 CHOLMOD, 2 MUMPS holds the last successful factorisation */
     int indefinite;        /* the last matrix was indefinite: start the next one with L D L^T */
+    int always_ldlt;       /* cf_sparse_chol_indefinite: every matrix is */
     /* MUMPS, set up at the first indefinite matrix */
     int mumps_on;
     int mumps_failed;      /* its analysis failed: not retried */
@@ -240,8 +241,14 @@ cf_status cf_sparse_chol_factor(cf_sparse_chol *ch, double *values, cf_chol_info
     in->ldlt = 1;
     cf_status st = mumps_factor(ch, values, in, err);
     if (st == CF_OK)
-        ch->indefinite = in->neg_pivots > 0;
+        ch->indefinite = in->neg_pivots > 0 || ch->always_ldlt;
     return st;
+}
+
+void cf_sparse_chol_indefinite(cf_sparse_chol *ch)
+{
+    ch->indefinite = 1;
+    ch->always_ldlt = 1;
 }
 
 cf_status cf_sparse_chol_solve(cf_sparse_chol *ch, const double *b, double *x, cf_error *err)

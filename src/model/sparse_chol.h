@@ -46,6 +46,11 @@ cf_status cf_sparse_chol_create(cf_sparse_chol **out, size_t n, int *colptr, int
 cf_status cf_sparse_chol_factor(cf_sparse_chol *ch, double *values, cf_chol_info *info,
                                 cf_error *err);
 
+/* Tells ch that its matrices are indefinite (a mixed form's, with a negative definite block): every
+** factorisation goes to the L D L^T at once, without the LL^T attempt, whose numeric factor would
+** stay allocated beside the L D L^T's (measured on a body of 4120 nodes: 61 MB of 201). */
+void cf_sparse_chol_indefinite(cf_sparse_chol *ch);
+
 /* Solves A x = b with the last factorisation (x and b may not alias). */
 cf_status cf_sparse_chol_solve(cf_sparse_chol *ch, const double *b, double *x, cf_error *err);
 

@@ -147,6 +147,7 @@ void bench_section_body(bench_ctx *ctx)
 {
     FILE *md = ctx->md;
     surface_crossings(ctx);
+    bench_section_body_ccx(ctx);
     fprintf(md, "## Tissue bodies: the probe loop at haptic rate\n\n");
     FILE *f = fopen("../shared/meshes/liver2.msh", "r");
     if (!f) {
