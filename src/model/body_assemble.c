@@ -537,7 +537,6 @@ void cf_body_work_free(body_work *w)
     free(w->Z);
     free(w->hy);
     free(w->hrhs);
-    free(w->hloc);
     pattern_free(&w->P);
     free(w->g);
     free(w->dx);

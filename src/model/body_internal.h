@@ -95,8 +95,6 @@ typedef struct body_work {
     double *Z;          /* 9 nn per slot: columns 3 nn each */
     size_t nslot, capslot;
     double *hy, *hrhs;
-    /* the haptic loop's region near the probe (body_haptic.c): one block, freed with free() */
-    struct haptic_loc *hloc;
     /* an implicit dynamic step (body_dynamic.c) while it solves: the inertia (and mass-
     ** proportional damping) of a Newmark step as a term mcoef m_i (x - xstar)
     ** in the residual and mcoef m_i on the tangent's diagonal; mcoef 0 = a static solve */
