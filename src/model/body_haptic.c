@@ -163,6 +163,20 @@ static int grow(size_t *cap, size_t **list, double **nv, double **M, double **rh
     return r2 ? 0 : -1;
 }
 
+/* The probe's force along its direction from the m nodes of list[] (penalty kp, reference point
+** c) at the body's positions: the contact term of cf_body_assemble's force alone, O(m). */
+static double contact_force(const cf_body *b, const cf_probe *probe, const double *c, double kp,
+                            const size_t *list, size_t m)
+{
+    double force = 0;
+    for (size_t k = 0; k < m; k++) {
+        double nrm[3];
+        const double d = cf_body_penetration(probe, c, b->x + 3 * list[k], nrm, 1);
+        force += kp * d * (nrm[0] * probe->dir[0] + nrm[1] * probe->dir[1] + nrm[2] * probe->dir[2]);
+    }
+    return force;
+}
+
 cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm,
                               double penalty_N_per_mm, int max_iters, cf_body_step *out,
                               cf_error *err)
@@ -247,6 +261,8 @@ cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm
         }
         memcpy(b->x, w->xt, n * sizeof *w->xt);
     }
+    if (it == max_iters) /* ended on a step: the contact force where the body now is */
+        force = contact_force(b, probe, c, kp, list, m);
     out->depth_mm = depth_mm;
     out->force_N = force;
     out->contacts = contacts;
