@@ -189,6 +189,7 @@ test: check-deps $(BUILD)/conifit $(LIB_SO) $(TESTS) $(REPLAYS)
 	@sh tests/check_layers.sh
 	@CC='$(CC)' sh tests/check_public.sh
 	@sh tests/check_cycles.sh $(LIB_OBJ)
+	@sh tests/check_includes.sh
 	@sh tests/check_size.sh
 	@sh tests/exports.sh check $(LIB_SO)
 	@sh tests/check_gsl_guard.sh $(BUILD)

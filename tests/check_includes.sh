@@ -8,13 +8,26 @@
 # Usage: tests/check_includes.sh (from anywhere; reads src/).
 cd "$(dirname "$0")/.." || exit 70
 
-# Includes that still close a circle, each "FILE HEADER", in files other work is changing at the
-# time of writing; they are reported, not failed on. Remove a line when its include goes.
+# Includes that still close a circle (issue 44, item 5), each "FILE HEADER": reported on every
+# run, not failed on; any other circle fails. The first four are in files other work was changing
+# when this list was written; the rest wait for their types to move out of the header of their
+# users. Remove a line when its include goes.
 known='
 src/model/law.c model/law_simd.h
 src/model/cell.c model/mode.h
 src/model/lattice.c model/lattice_step.h
 src/model/msm_tangent.c model/msm_internal.h
+src/io/scene_haptic.h io/scene.h
+src/io/columns.h io/measure.h
+src/io/measures.h io/measure.h
+src/io/measures.h io/columns.h
+src/io/reader.h io/measure.h
+src/io/surface.h io/mesh.h
+src/io/surface_geom.h io/surface.h
+src/fit/lattice_curve.h fit/lattice_fit.h
+src/report/report_baselines.h report/report.h
+src/report/report_words.h report/report.h
+src/export/export_model.h export/export.h
 '
 
 # One line per file ("F FILE"), then one per include ("I FILE HEADER"); awk maps each to modules.
@@ -53,7 +66,7 @@ files=$(find src -name '*.[ch]' | sort)
     for (i = 2; i <= n; i++) { x = order[i]; for (j = i - 1; j >= 1 && order[j] > x; j--) order[j + 1] = order[j]; order[j + 1] = x }
     for (i = 1; i <= n; i++) if (state[order[i]] == 0) visit(order[i], 0)
     for (i = 1; i <= nknown; i++) print "check_includes: known, to be removed: " kn[i]
-    if (!bad) print "check_includes: no include circle between modules (" n " modules)"
+    if (!bad) print "check_includes: no include circle between modules (" n " modules) but the " nknown " known"
     exit bad
   }
   function visit(x, depth,    m, a, k, w, j, msg) {

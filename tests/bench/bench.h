@@ -90,5 +90,6 @@ void bench_section_fastfit(bench_ctx *ctx);
 void bench_section_body(bench_ctx *ctx);
 void bench_section_output(bench_ctx *ctx);
 void bench_section_contact(bench_ctx *ctx);
+void bench_section_startup(bench_ctx *ctx);
 
 #endif
