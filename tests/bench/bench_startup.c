@@ -78,7 +78,7 @@ void bench_section_startup(bench_ctx *ctx)
     remove(out);
     fprintf(md, "\n");
     if (version_cpu >= 0)
-        bench_target_add(ctx, "start-up: `conifit --version` within 10 ms of CPU (21 ms with the "
-                              "sparse solvers linked)",
-                         version_cpu <= 10, "%.2f ms", version_cpu);
+        bench_target_add(ctx, "start-up: `conifit --version` within 15 ms of CPU (13-34 ms with the "
+                              "sparse solvers linked, by load: src/notes/performance.md)",
+                         version_cpu <= 15, "%.2f ms", version_cpu);
 }
