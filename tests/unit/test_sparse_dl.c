@@ -79,6 +79,27 @@ static double residual(const double *x, const double *b)
     return worst;
 }
 
+/* The factorisation of the matrix of laplacian(sigma), created (its libraries then loaded). */
+static cf_sparse_chol *created(double sigma)
+{
+    laplacian(sigma);
+    cf_sparse_chol *ch = NULL;
+    cf_error err = {0};
+    assert_int_equal(cf_sparse_chol_create(&ch, N, colp, rowi, &err), CF_OK);
+    return ch;
+}
+
+/* Solves with the last factors for b[r] = b0 + db r and checks the residual against tol. */
+static void solves(cf_sparse_chol *ch, double b0, double db, double tol)
+{
+    double b[N], x[N];
+    cf_error err = {0};
+    for (int r = 0; r < N; r++)
+        b[r] = b0 + db * r;
+    assert_int_equal(cf_sparse_chol_solve(ch, b, x, &err), CF_OK);
+    assert_true(residual(x, b) < tol);
+}
+
 static void nothing_heavy_is_loaded_before_a_factorisation(void **state)
 {
     (void)state;
@@ -118,19 +139,13 @@ static void cholmod_loads_at_its_first_use_and_mumps_stays_out(void **state)
 {
     (void)state;
     cf_sparse_dl_names(NULL, ABSENT_MUMPS); /* CHOLMOD tried again, by its default name */
-    laplacian(0.0);
-    cf_sparse_chol *ch = NULL;
-    cf_error err = {0};
-    assert_int_equal(cf_sparse_chol_create(&ch, N, colp, rowi, &err), CF_OK);
+    cf_sparse_chol *ch = created(0.0);
     cf_chol_info info;
+    cf_error err = {0};
     assert_int_equal(cf_sparse_chol_factor(ch, val, &info, &err), CF_OK);
     assert_int_equal(info.neg_pivots, 0);
     assert_int_equal(info.ldlt, 0);
-    double b[N], x[N];
-    for (int r = 0; r < N; r++)
-        b[r] = 1.0 + r;
-    assert_int_equal(cf_sparse_chol_solve(ch, b, x, &err), CF_OK);
-    assert_true(residual(x, b) < 1e-10);
+    solves(ch, 1.0, 1.0, 1e-10);
     cf_sparse_chol_free(ch);
     assert_true(mapped("cholmod"));
     assert_false(mapped("mumps"));
@@ -139,11 +154,9 @@ static void cholmod_loads_at_its_first_use_and_mumps_stays_out(void **state)
 static void a_missing_mumps_is_an_error_naming_it_at_the_first_indefinite_matrix(void **state)
 {
     (void)state;
-    laplacian(1.0); /* indefinite: eigenvalues below 1 become negative */
-    assert_true(eigenvalues_below(1.0) > 0);
-    cf_sparse_chol *ch = NULL;
+    assert_true(eigenvalues_below(1.0) > 0); /* indefinite: eigenvalues below 1 become negative */
+    cf_sparse_chol *ch = created(1.0);
     cf_error err = {0};
-    assert_int_equal(cf_sparse_chol_create(&ch, N, colp, rowi, &err), CF_OK);
     cf_chol_info info;
     assert_int_equal(cf_sparse_chol_factor(ch, val, &info, &err), CF_E_INTERNAL);
     assert_non_null(strstr(err.msg, "MUMPS"));
@@ -159,19 +172,13 @@ static void mumps_loads_at_the_first_indefinite_matrix(void **state)
 {
     (void)state;
     cf_sparse_dl_names(NULL, NULL);
-    laplacian(1.0);
-    cf_sparse_chol *ch = NULL;
+    cf_sparse_chol *ch = created(1.0);
     cf_error err = {0};
-    assert_int_equal(cf_sparse_chol_create(&ch, N, colp, rowi, &err), CF_OK);
     cf_chol_info info;
     assert_int_equal(cf_sparse_chol_factor(ch, val, &info, &err), CF_OK);
     assert_int_equal(info.ldlt, 1);
     assert_int_equal(info.neg_pivots, eigenvalues_below(1.0));
-    double b[N], x[N];
-    for (int r = 0; r < N; r++)
-        b[r] = 1.0 - 0.1 * r;
-    assert_int_equal(cf_sparse_chol_solve(ch, b, x, &err), CF_OK);
-    assert_true(residual(x, b) < 1e-9);
+    solves(ch, 1.0, -0.1, 1e-9);
     cf_sparse_chol_free(ch);
     assert_true(mapped("mumps"));
 }
