@@ -24,7 +24,6 @@ src/io/measures.h io/columns.h
 src/io/reader.h io/measure.h
 src/io/surface.h io/mesh.h
 src/io/surface_geom.h io/surface.h
-src/fit/lattice_curve.h fit/lattice_fit.h
 src/report/report_baselines.h report/report.h
 src/report/report_words.h report/report.h
 src/export/export_model.h export/export.h
