@@ -54,11 +54,17 @@ CPPFLAGS += -D_DEFAULT_SOURCE -Isrc/include -Isrc
 SPARSE_CFLAGS := $(shell pkg-config --cflags CHOLMOD 2>/dev/null || echo -I/usr/include/suitesparse)
 # MUMPS (sequential build: L D L^T of indefinite tangents) likewise has no pkg-config file.
 SPARSE_CFLAGS += -I/usr/include/mumps_seq
-SPARSE_LIBS   := $(shell pkg-config --libs CHOLMOD 2>/dev/null || echo -lcholmod) \
-                 -ldmumps_seq -lmumps_common_seq -lmpiseq_seq -lpord_seq
-# Gmsh (volume meshes of tissue bodies) is loaded with dlopen when a mesh is read (src/io/mesh.c):
-# only its header is needed to build.
-SPARSE_LIBS   += -ldl
+# CHOLMOD and MUMPS (with the BLAS, LAPACK and Fortran runtime they need) and Gmsh (volume meshes
+# of tissue bodies) are opened with dlopen at their first use (src/model/sparse_dl.c,
+# src/io/mesh.c), not linked: a command that does not use them does not load them. Only their
+# headers are needed to build; the run-time names of the solvers are the SONAMEs of the libraries
+# the linker would take for -lcholmod and -ldmumps_seq.
+soname = $(shell f=$$($(CC) -print-file-name=lib$(1).so) && objdump -p "$$f" 2>/dev/null | sed -n 's/^ *SONAME *//p')
+CHOLMOD_SONAME := $(call soname,cholmod)
+MUMPS_SONAME   := $(call soname,dmumps_seq)
+SPARSE_CFLAGS += $(if $(CHOLMOD_SONAME),-DCF_CHOLMOD_SONAME='"$(CHOLMOD_SONAME)"') \
+                 $(if $(MUMPS_SONAME),-DCF_MUMPS_SONAME='"$(MUMPS_SONAME)"')
+SPARSE_LIBS   := -ldl
 CFLAGS  += -std=c17 $(OPT) -fopenmp $(WARN) $(shell pkg-config --cflags $(PKGS) 2>/dev/null) $(SPARSE_CFLAGS)
 LDLIBS  += $(shell pkg-config --libs $(PKGS) 2>/dev/null) $(SPARSE_LIBS) -fopenmp -lm -lpthread
 
@@ -183,6 +189,7 @@ test: check-deps $(BUILD)/conifit $(LIB_SO) $(TESTS) $(REPLAYS)
 	@sh tests/check_layers.sh
 	@CC='$(CC)' sh tests/check_public.sh
 	@sh tests/check_cycles.sh $(LIB_OBJ)
+	@sh tests/check_includes.sh
 	@sh tests/check_size.sh
 	@sh tests/exports.sh check $(LIB_SO)
 	@sh tests/check_gsl_guard.sh $(BUILD)

@@ -28,7 +28,6 @@
 #include <stdio.h>
 
 #include "conifit/error.h"
-#include "conifit/output.h"
 
 /* The public cf_output (conifit/output.h) is this structure; inside the library it is used as a
 ** value (a job holds its outputs) under the name cf_atomic. */

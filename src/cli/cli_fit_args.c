@@ -293,28 +293,17 @@ static int columns_option(const char *optval, cf_measure_options *mo)
     return 0;
 }
 
-/* One option of fit: 0 to go on, else an exit status. Long only because fit has many options:
-** one case per option, each a few lines of checking. */
-static int fit_option_apply(void *ctx, int c, const char *optval)
+/* The options of fit by group: each applies an option of its group (0 to go on, else an exit
+** status) and returns NOT_MINE for any other. */
+#define NOT_MINE (-1)
+
+/* The design limits and held parameters (--fix, --index-max, --rho-min, --n-max,
+** --D2-max-H, --G-max). */
+static int limits_option(fit_args *a, int c, const char *optval)
 {
-    fit_args *a = ctx;
     cf_error err = {0};
     cf_fit_options *fo = &a->popt.fit;
-    long n;
     switch (c) {
-    case OPT_PLOT: a->plot = optval; return 0;
-    case OPT_TITLE: a->popt.title = optval; return 0;
-    case OPT_TYPE:
-        if (strcmp(optval, "both") == 0)
-            a->popt.types = CF_PIPELINE_BOTH;
-        else if (strcmp(optval, "telescoping") == 0)
-            a->popt.types = CF_PIPELINE_TELESCOPING;
-        else if (strcmp(optval, "non-telescoping") == 0)
-            a->popt.types = CF_PIPELINE_NON_TELESCOPING;
-        else
-            return cf_cli_usage_error("fit", "--type '%s': expected telescoping, "
-                                             "non-telescoping or both", optval);
-        return 0;
     case OPT_FIX: return fix_option(optval, a);
     case OPT_INDEX_MAX:
         if (cf_cli_parse_double("--index-max", optval, &fo->index_max, &err))
@@ -353,13 +342,29 @@ static int fit_option_apply(void *ctx, int c, const char *optval)
                                              "is stiffer in shear)",
                                       fo->upper[CF_P_G], CF_FIT_G_MAX_LIMIT);
         return 0;
+    default: return NOT_MINE;
+    }
+}
+
+/* The fit's search: the spring type, the law, the residuals, the optimiser, seed and starts. */
+static int search_option(fit_args *a, int c, const char *optval)
+{
+    cf_error err = {0};
+    cf_fit_options *fo = &a->popt.fit;
+    long n;
+    switch (c) {
+    case OPT_TYPE:
+        if (strcmp(optval, "both") == 0)
+            a->popt.types = CF_PIPELINE_BOTH;
+        else if (strcmp(optval, "telescoping") == 0)
+            a->popt.types = CF_PIPELINE_TELESCOPING;
+        else if (strcmp(optval, "non-telescoping") == 0)
+            a->popt.types = CF_PIPELINE_NON_TELESCOPING;
+        else
+            return cf_cli_usage_error("fit", "--type '%s': expected telescoping, "
+                                             "non-telescoping or both", optval);
+        return 0;
     case OPT_RELATIVE: fo->relative = 1; return 0;
-    case OPT_MAX_MEMORY:
-        return cf_cli_budget_option("fit", "--max-memory", optval, &a->popt.budget);
-    case OPT_MAX_STEPS:
-        return cf_cli_budget_option("fit", "--max-steps", optval, &a->popt.budget);
-    case OPT_MAX_WORK:
-        return cf_cli_budget_option("fit", "--max-work", optval, &a->popt.budget);
     case OPT_OPTIMIZER:
         if (cf_fit_optimizer_parse(optval, &fo->optimizer, &err) != CF_OK)
             return cf_cli_usage_error("fit", "option --optimizer: %s", err.msg);
@@ -374,6 +379,27 @@ static int fit_option_apply(void *ctx, int c, const char *optval)
             return cf_cli_usage_error("fit", "%s", err.msg);
         fo->multistart = (int)n;
         return 0;
+    case OPT_LAW:
+        if (cf_law_kind_parse(optval, &fo->law, &err) != CF_OK)
+            return cf_cli_usage_error("fit", "--law: %s", err.msg);
+        return 0;
+    default: return NOT_MINE;
+    }
+}
+
+/* The lattice: validation, the fit's target, the joint fit, the volume term, the
+** calibration, the validation's budget. */
+static int lattice_option(fit_args *a, int c, const char *optval)
+{
+    cf_error err = {0};
+    cf_fit_options *fo = &a->popt.fit;
+    switch (c) {
+    case OPT_MAX_MEMORY:
+        return cf_cli_budget_option("fit", "--max-memory", optval, &a->popt.budget);
+    case OPT_MAX_STEPS:
+        return cf_cli_budget_option("fit", "--max-steps", optval, &a->popt.budget);
+    case OPT_MAX_WORK:
+        return cf_cli_budget_option("fit", "--max-work", optval, &a->popt.budget);
     case OPT_VALIDATE:
     case OPT_THROUGH: validate_option(c, optval, a); return 0;
     case OPT_TARGET:
@@ -385,10 +411,6 @@ static int fit_option_apply(void *ctx, int c, const char *optval)
             return cf_cli_usage_error("fit", "--target '%s': expected lattice or spring", optval);
         return 0;
     case OPT_JOINT: a->joint = 1; return 0;
-    case OPT_LAW:
-        if (cf_law_kind_parse(optval, &fo->law, &err) != CF_OK)
-            return cf_cli_usage_error("fit", "--law: %s", err.msg);
-        return 0;
     case OPT_VOLUME:
         if (strcmp(optval, "fit") != 0)
             return cf_cli_usage_error("fit", "--volume '%s': expected fit (or declare kappa with "
@@ -429,6 +451,16 @@ static int fit_option_apply(void *ctx, int c, const char *optval)
         a->calibration_given = 1;
         return 0;
     }
+    default: return NOT_MINE;
+    }
+}
+
+/* The table's reading: mode, columns, header row, units, stretch, measures. */
+static int table_option(fit_args *a, int c, const char *optval)
+{
+    cf_error err = {0};
+    long n;
+    switch (c) {
     case OPT_MODE: {
         cf_mode md;
         if (cf_mode_parse(optval, &md, &err) != CF_OK)
@@ -448,6 +480,18 @@ static int fit_option_apply(void *ctx, int c, const char *optval)
     case OPT_FORCE_UNIT: a->mopt.force_unit = optval; return 0;
     case OPT_LENGTH_UNIT: a->mopt.length_unit = optval; return 0;
     case OPT_STRETCH: a->mopt.x_is_stretch = 1; return 0;
+    case OPT_STRESS_MEASURE:
+    case OPT_STRAIN_MEASURE: return measure_option(c, optval, &a->mopt);
+    default: return NOT_MINE;
+    }
+}
+
+/* Time series: Prony branches, dashpot, relaxation, the held elastic fit, evaluations. */
+static int series_option(fit_args *a, int c, const char *optval)
+{
+    cf_error err = {0};
+    long n;
+    switch (c) {
     case OPT_BRANCHES:
         if (cf_cli_parse_long("--branches", optval, 1, CF_PRONY_MAX, &n, &err) != CF_OK) {
             /* a branch count outside 1..8 is refused as bad data (65), as a bad table is */
@@ -483,14 +527,36 @@ static int fit_option_apply(void *ctx, int c, const char *optval)
         a->vopt.max_evaluations = n;
         a->series_only = 1;
         return 0;
-    case OPT_STRESS_MEASURE:
-    case OPT_STRAIN_MEASURE: return measure_option(c, optval, &a->mopt);
+    default: return NOT_MINE;
+    }
+}
+
+/* The plot and its title, the jobs. */
+static int output_option(fit_args *a, int c, const char *optval)
+{
+    cf_error err = {0};
+    switch (c) {
+    case OPT_PLOT: a->plot = optval; return 0;
+    case OPT_TITLE: a->popt.title = optval; return 0;
     case 'j':
         if (cf_cli_parse_long("-j", optval, 1, 256, &a->jobs, &err))
             return cf_cli_usage_error("fit", "%s", err.msg);
         return 0;
-    default: return cf_cli_usage_error("fit", "unexpected option");
+    default: return NOT_MINE;
     }
+}
+
+/* One option of fit: 0 to go on, else an exit status. */
+static int fit_option_apply(void *ctx, int c, const char *optval)
+{
+    static int (*const groups[])(fit_args *, int, const char *) = {
+        limits_option, search_option, lattice_option, table_option, series_option, output_option};
+    for (size_t k = 0; k < sizeof groups / sizeof groups[0]; k++) {
+        const int rc = groups[k](ctx, c, optval);
+        if (rc != NOT_MINE)
+            return rc;
+    }
+    return cf_cli_usage_error("fit", "unexpected option");
 }
 
 /* Appends the escaped word w (n bytes) to a->options, a blank before it unless first. */

@@ -50,12 +50,12 @@ cf_table cf_lattice_reach(const cf_table *d, double *spring_x)
 }
 
 void cf_lattice_take_quality(const cf_table *d, const double *g, const double *sw, double ynorm,
-                             cf_fit_result *res, cf_through_msm *t)
+                             cf_fit_result *res, double law[3])
 {
     const int uniaxial = cf_mode_row_of(d->mode)->spring_curve;
-    t->law_rmse = uniaxial ? res->rmse : NAN;
-    t->law_max_abs_error = uniaxial ? res->max_abs_error : NAN;
-    t->law_r2 = uniaxial ? res->r2 : NAN;
+    law[0] = uniaxial ? res->rmse : NAN;
+    law[1] = uniaxial ? res->max_abs_error : NAN;
+    law[2] = uniaxial ? res->r2 : NAN;
     cf_lsq_quality q = cf_lsq_quality_of(d, g);
     double wrss = 0;
     for (size_t i = 0; i < d->count; i++) {

@@ -5,7 +5,19 @@
 #ifndef CF_FIT_LATTICE_CURVE_H
 #define CF_FIT_LATTICE_CURVE_H
 
-#include "fit/lattice_fit.h"
+#include "conifit/error.h"
+#include "conifit/law.h"
+#include "conifit/spring.h"
+#include "fit/fit.h"
+#include "model/msm.h"
+
+/* Where the lattice comes from (the validation's lattice and the fits through it). */
+typedef struct cf_validate_setup {
+    cf_msm_config cfg;          /* lattice and Newton settings */
+    cf_law_method method;       /* law evaluator in the lattice */
+    size_t table_intervals;     /* table size when method is CF_LAW_TABLE */
+} cf_validate_setup;
+
 
 /* The curve of spring p at the strains of d in the table's mode: the full lattice (cf_msm_uniaxial)
 ** when full is set and the mode is uniaxial, else the homogenised cell (cell.h), which equals the
@@ -22,9 +34,9 @@ cf_table cf_lattice_reach(const cf_table *d, double *spring_x);
 
 /* The target's numbers of fit res once the cell's curve g of its spring at d's rows is known:
 ** res's quality (rss, rmse, max_abs_error, r2, and the weighted objective with weights sw and
-** zero-model norm ynorm) become the cell's, the single spring's own figures move to t->law_*
-** (a uniaxial table; NAN in the other modes). */
+** zero-model norm ynorm) become the cell's, the single spring's own figures move to law[0..2]
+** (its RMSE, largest |error| and R^2: a uniaxial table; NAN in the other modes). */
 void cf_lattice_take_quality(const cf_table *d, const double *g, const double *sw, double ynorm,
-                             cf_fit_result *res, cf_through_msm *t);
+                             cf_fit_result *res, double law[3]);
 
 #endif

@@ -103,7 +103,11 @@ static double bobyqa(tm_ctx *c, double *z, const double *lb, const double *ub)
 static cf_status take_target(tm_ctx *c, tm_ctx *search, cf_fit_result *res, cf_through_msm *t,
                              cf_error *err)
 {
-    cf_lattice_take_quality(c->d, c->pr.g, c->pr.sw, c->pr.ynorm, res, t);
+    double law[3]; /* the single spring's own RMSE, largest |error|, R^2 */
+    cf_lattice_take_quality(c->d, c->pr.g, c->pr.sw, c->pr.ynorm, res, law);
+    t->law_rmse = law[0];
+    t->law_max_abs_error = law[1];
+    t->law_r2 = law[2];
     res->ident = cf_ident_of(&res->params, 0);
     c->pr.ctx = c;
     search->pr.ctx = search;

@@ -21,13 +21,7 @@
 #include "model/law_internal.h"
 #include "io/measure.h"
 #include "model/msm.h"
-
-/* Where the lattice comes from (the validation's lattice and the fits through it). */
-typedef struct cf_validate_setup {
-    cf_msm_config cfg;          /* lattice and Newton settings */
-    cf_law_method method;       /* law evaluator in the lattice */
-    size_t table_intervals;     /* table size when method is CF_LAW_TABLE */
-} cf_validate_setup;
+#include "fit/lattice_curve.h"
 
 /* What the fit through the lattice did (the verification fields are filled by
 ** cf_validate_lattice_fit, validate.h). */

@@ -312,7 +312,11 @@ cf_status cf_lattice_fit_tail(const cf_table *d, const cf_fit_options *opt,
     /* the target's numbers: the cell's curve of the placed spring */
     if ((st = cf_lattice_curve(&res->params, s, d, 0, c.pr.g, NULL, NULL, NULL, err)) != CF_OK)
         goto out;
-    cf_lattice_take_quality(d, c.pr.g, c.pr.sw, c.pr.ynorm, res, t);
+    double law[3]; /* the single spring's own RMSE, largest |error|, R^2 */
+    cf_lattice_take_quality(d, c.pr.g, c.pr.sw, c.pr.ynorm, res, law);
+    t->law_rmse = law[0];
+    t->law_max_abs_error = law[1];
+    t->law_r2 = law[2];
     t->ident_after = res->ident;
     t->cell_rmse = res->rmse;
     t->improved = 1;

@@ -10,7 +10,7 @@
 #include "model/calibration.h"
 #include "model/linsolve.h"
 #include "model/msm_tangent.h"
-#include "model/net.h"
+#include "model/lattice.h"
 
 /* Bytes per node and per spring of the lattice and the solver state (positions, reference
 ** positions, forces, masses, velocities; spring ends, lengths, weights, tensions, law state), and

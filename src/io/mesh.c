@@ -10,6 +10,8 @@
 */
 #include "io/mesh.h"
 
+#include "base/dynlib.h"
+
 #include "io/isolate.h"
 #include "io/mesh_nodes.h"
 #include "io/surface.h"
@@ -24,7 +26,6 @@
 
 #include <stdint.h>
 
-#include <dlfcn.h>
 #include <gmshc.h>
 
 static int gmsh_ready;
@@ -65,23 +66,22 @@ static int gmsh_load(char *why, size_t cap)
     char soname[64];
     snprintf(soname, sizeof soname, "libgmsh.so.%d.%d", GMSH_API_VERSION_MAJOR,
              GMSH_API_VERSION_MINOR);
-    void *h = dlopen(soname, RTLD_NOW | RTLD_LOCAL);
-    if (!h)
-        h = dlopen("libgmsh.so", RTLD_NOW | RTLD_LOCAL);
-    if (!h) {
-        const char *e = dlerror();
-        snprintf(why, cap, "cannot load Gmsh's library (%s): %s", soname, e ? e : "not found");
-        return 0;
-    }
+    const char *names[] = {soname, "libgmsh.so", NULL};
+    cf_error err = {0};
+    void *h = cf_dynlib_open("Gmsh", names, &err);
 #define GMSH_BIND(f)                                                                               \
-    *(void **)(&gm.f) = dlsym(h, #f);                                                              \
-    if (!gm.f) {                                                                                   \
-        snprintf(why, cap, "Gmsh's library %s has no %s", soname, #f);                             \
-        dlclose(h);                                                                                \
-        return 0;                                                                                  \
+    if (h && !(*(void **)(&gm.f) = cf_dynlib_sym(h, soname, #f, &err))) {                          \
+        cf_dynlib_close(h);                                                                        \
+        h = NULL;                                                                                  \
     }
     GMSH_FUNCTIONS(GMSH_BIND)
 #undef GMSH_BIND
+    if (!h) { /* the message, cut to the caller's buffer */
+        const size_t m = strnlen(err.msg, cap - 1);
+        memcpy(why, err.msg, m);
+        why[m] = '\0';
+        return 0;
+    }
     gmsh_handle = h;
     return 1;
 }

@@ -38,6 +38,7 @@
 
 #include "conifit/error.h"
 #include "model/law_internal.h"
+#include "model/net.h"
 
 /* A tetrahedral mesh: nodes (mm) and elements of four node indices each, every element positively
 ** oriented (its signed volume (x1-x0).((x2-x0)x(x3-x0))/6 > 0). */
@@ -309,5 +310,18 @@ size_t cf_body_contact_set(const cf_body *b, uint8_t *mark);
 /* The penalty stiffness of a contact node that the solves take when given 0: 1e4 E times the mean
 ** edge (N/mm). */
 double cf_body_penalty(const cf_body *b);
+
+/* The body's spring network (net_mesh.c, body.c). */
+
+/* The net of the tetrahedral mesh m (checked by cf_mesh_check): its nodes, none held; its edges
+** as springs in the order of their end nodes, rest length the edge's, weight the calibration of
+** body.h for law (per tetrahedron the edge stiffnesses that best match an isotropic tensor, the
+** whole network scaled to the shear modulus cf_body_mu_of_law); its tetrahedra. CF_E_DATA when
+** the calibration finds no stiffness, CF_E_INTERNAL when memory runs out. */
+cf_status cf_net_mesh(cf_net *n, const cf_mesh *m, const cf_law *law, cf_error *err);
+
+/* A net that views b's arrays (nodes, fixity, springs, tetrahedra; nothing owned: not for
+** cf_net_free), for the exports. */
+cf_net cf_net_of_body(const cf_body *b);
 
 #endif

@@ -36,6 +36,8 @@
 #include "model/calibration.h"
 #include "conifit/error.h"
 #include "model/law_internal.h"
+#include "model/lattice_hourglass.h"
+#include "model/net.h"
 
 typedef enum cf_bottom_bc {
     CF_BOTTOM_AXIAL = 0,  /* bottom nodes held in z, free to slide laterally (lubricated platen) */
@@ -62,10 +64,9 @@ typedef struct cf_lattice_config {
                               ** volume term, 0 without */
 } cf_lattice_config;
 
-/* The hourglass fraction that means "the default with a volume term, none without", and that
-** default (lattice_hourglass.h). */
+/* The hourglass fraction that means "the default with a volume term, none without"; that default
+** is CF_HOURGLASS_DEFAULT (lattice_hourglass.h). */
 #define CF_HOURGLASS_AUTO (-1.0)
-#define CF_HOURGLASS_DEFAULT 0.5
 
 /* 3 x 3 x 3 cells, the isotropic calibration, density 1e-9 t/mm^3, bottom axial, no volume term,
 ** hourglass control automatic. */
@@ -165,5 +166,24 @@ double cf_lattice_lateral_stretch(const cf_lattice *lat);
 
 /* Mean z displacement of the top face (mm, compression positive) and nominal compressive strain. */
 double cf_lattice_top_strain(const cf_lattice *lat);
+
+/* The lattice's spring network (lattice_net.c). */
+
+/* The cubic lattice of cfg with cell edge H_mm (> 0): nodes at (i, j, k) H with index i + (nx + 1)
+** (j + (ny + 1) k); the springs of the families of non-zero weight from each node in that order
+** (the cell directions of cell.h), rest length H sqrt(1, 2 or 3) and weight the family's times the
+** share of the cells that hold the spring (cf_lattice_axis_share); the bottom face's fixity of
+** cfg->bottom (a sliding bottom also pins node (0,0,0) in x and y, node (nx,0,0) in y); every
+** cell as a hexahedron, x fastest. CF_E_DATA for cells out of range, CF_E_INTERNAL when memory
+** runs out (n is then empty). */
+cf_status cf_net_lattice(cf_net *n, const cf_lattice_config *cfg, double H_mm, cf_error *err);
+
+/* The cell counts of cfg: each between 1 and 10000, else CF_E_DATA naming the key
+** (lattice.nx ...). cf_net_lattice and the lattice's own check use it. */
+cf_status cf_net_lattice_check_cells(const cf_lattice_config *cfg, cf_error *err);
+
+/* The nodes and springs cf_net_lattice makes of cfg (cells >= 1 along each axis), counted without
+** making them (exact integers below 2^53), for the budgets of scenes. */
+void cf_net_lattice_size(const cf_lattice_config *cfg, double *nodes, double *springs);
 
 #endif

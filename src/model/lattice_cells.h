@@ -8,7 +8,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "model/lattice.h"
+/* The lattice (lattice.h) by its name alone: this header is lattice.c's, which includes it. */
+typedef struct cf_lattice cf_lattice;
 
 /* The eight corner nodes of cell c (corner di + 2 dj + 4 dk), as cf_lattice_cell_volume gives
 ** them. */

@@ -2,7 +2,6 @@
 ** Hourglass control of the lattice's cells (see lattice_hourglass.h).
 */
 #include "model/lattice_hourglass.h"
-#include "model/lattice.h"
 
 /* h_i(a) for corner a = di + 2 dj + 4 dk: xi eta, eta zeta, zeta xi, xi eta zeta. */
 #define pattern cf_hourglass_pattern

@@ -23,6 +23,10 @@
 #include "model/calibration.h"
 #include "model/law_internal.h"
 
+/* The hourglass fraction of a lattice with a volume term when none is given (lattice.h's
+** CF_HOURGLASS_AUTO). */
+#define CF_HOURGLASS_DEFAULT 0.5
+
 /* h_i(a) (+1 or -1) of mode i (0..3) at corner a (0..7, a = di + 2 dj + 4 dk). */
 int cf_hourglass_pattern(int i, int a);
 

@@ -9,13 +9,12 @@
 */
 #include "model/sparse_chol.h"
 
+#include "model/sparse_dl.h"
+
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include <cholmod.h>
-#include <dmumps_c.h>
 
 #define MUMPS_USE_COMM_WORLD (-987654) /* the sequential library's stand-in communicator */
 
@@ -29,14 +28,16 @@
 ** process-wide lock: threads still fit in parallel, their factorisations take turns. */
 static pthread_mutex_t sparse_lock = PTHREAD_MUTEX_INITIALIZER;
 
-static void mumps_call(DMUMPS_STRUC_C *mu)
+static void mumps_call(const cf_mumps_lib *ml, DMUMPS_STRUC_C *mu)
 {
     pthread_mutex_lock(&sparse_lock);
-    dmumps_c(mu);
+    ml->dmumps_c(mu);
     pthread_mutex_unlock(&sparse_lock);
 }
 
 struct cf_sparse_chol {
+    const cf_cholmod_lib *cl; /* the libraries' functions (sparse_dl.h): CHOLMOD from the start, */
+    const cf_mumps_lib *ml;   /* MUMPS from the first indefinite matrix */
     cholmod_common cm;
     cholmod_sparse A;      /* a header over the caller's arrays (lower triangle used) */
     cholmod_factor *LL;    /* supernodal LL^T */
@@ -66,7 +67,11 @@ cf_status cf_sparse_chol_create(cf_sparse_chol **out, size_t n, int *colptr, int
     cf_sparse_chol *ch = calloc(1, sizeof *ch);
     if (!ch)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the sparse factorisation");
-    if (!cholmod_start(&ch->cm)) {
+    if (!(ch->cl = cf_cholmod_lib_get(err))) {
+        free(ch);
+        return CF_E_INTERNAL;
+    }
+    if (!ch->cl->cholmod_start(&ch->cm)) {
         free(ch);
         return cf_error_set(err, CF_E_INTERNAL, "CHOLMOD could not start");
     }
@@ -92,7 +97,7 @@ cf_status cf_sparse_chol_create(cf_sparse_chol **out, size_t n, int *colptr, int
     A->dtype = CHOLMOD_DOUBLE;
     A->sorted = 0;
     A->packed = 1;
-    ch->LL = cholmod_analyze(A, &ch->cm);
+    ch->LL = ch->cl->cholmod_analyze(A, &ch->cm);
     if (!ch->LL || ch->cm.status < CHOLMOD_OK) {
         const int status = ch->cm.status;
         cf_sparse_chol_free(ch);
@@ -112,6 +117,10 @@ cf_status cf_sparse_chol_create(cf_sparse_chol **out, size_t n, int *colptr, int
 /* Analysis of the pattern for MUMPS (once), with the values of the first indefinite matrix. */
 static cf_status mumps_setup(cf_sparse_chol *ch, const double *values, cf_error *err)
 {
+    if (!(ch->ml = cf_mumps_lib_get(err))) {
+        ch->mumps_failed = 1; /* not retried */
+        return CF_E_INTERNAL;
+    }
     const size_t nz = ch->lower_nnz;
     ch->irn = malloc(nz * sizeof *ch->irn);
     ch->jcn = malloc(nz * sizeof *ch->jcn);
@@ -135,7 +144,7 @@ static cf_status mumps_setup(cf_sparse_chol *ch, const double *values, cf_error 
     mu->par = 1;
     mu->sym = 2; /* general symmetric: pivots may be negative or 2x2 */
     mu->comm_fortran = MUMPS_USE_COMM_WORLD;
-    mumps_call(mu);
+    mumps_call(ch->ml, mu);
     if (mu->info[0] < 0)
         return cf_error_set(err, CF_E_INTERNAL, "MUMPS could not start (INFO(1) = %d)",
                             (int)mu->info[0]);
@@ -155,7 +164,7 @@ static cf_status mumps_setup(cf_sparse_chol *ch, const double *values, cf_error 
     mu->jcn = ch->jcn;
     mu->a = ch->mval;
     mu->job = 1;
-    mumps_call(mu);
+    mumps_call(ch->ml, mu);
     if (mu->info[0] < 0) {
         ch->mumps_failed = 1;
         return cf_error_set(err, mu->info[0] == -7 ? CF_E_INTERNAL : CF_E_NOCONV,
@@ -180,7 +189,7 @@ static cf_status mumps_factor(cf_sparse_chol *ch, const double *values, cf_chol_
     DMUMPS_STRUC_C *mu = &ch->mu;
     for (int attempt = 0; attempt < 4; attempt++) {
         mu->job = 2;
-        mumps_call(mu);
+        mumps_call(ch->ml, mu);
         if (mu->info[0] != -8 && mu->info[0] != -9)
             break;
         mu->icntl[13] = mu->icntl[13] > 0 ? 2 * mu->icntl[13] : 40; /* more workspace, % */
@@ -225,7 +234,7 @@ cf_status cf_sparse_chol_factor(cf_sparse_chol *ch, double *values, cf_chol_info
     if (!ch->indefinite) {
         ch->A.x = values;
         pthread_mutex_lock(&sparse_lock);
-        cholmod_factorize(&ch->A, ch->LL, &ch->cm);
+        ch->cl->cholmod_factorize(&ch->A, ch->LL, &ch->cm);
         pthread_mutex_unlock(&sparse_lock);
         if (ch->cm.status == CHOLMOD_OUT_OF_MEMORY)
             return cf_error_set(err, CF_E_INTERNAL,
@@ -259,7 +268,7 @@ cf_status cf_sparse_chol_solve(cf_sparse_chol *ch, const double *b, double *x, c
         ch->mu.nrhs = 1;
         ch->mu.lrhs = (MUMPS_INT)ch->n;
         ch->mu.job = 3;
-        mumps_call(&ch->mu);
+        mumps_call(ch->ml, &ch->mu);
         if (ch->mu.info[0] < 0)
             return cf_error_set(err, CF_E_INTERNAL, "the indefinite solve failed (MUMPS INFO(1) "
                                 "= %d)", (int)ch->mu.info[0]);
@@ -278,13 +287,13 @@ cf_status cf_sparse_chol_solve(cf_sparse_chol *ch, const double *b, double *x, c
     B.xtype = CHOLMOD_REAL;
     B.dtype = CHOLMOD_DOUBLE;
     pthread_mutex_lock(&sparse_lock);
-    cholmod_dense *X = cholmod_solve(CHOLMOD_A, ch->LL, &B, &ch->cm);
+    cholmod_dense *X = ch->cl->cholmod_solve(CHOLMOD_A, ch->LL, &B, &ch->cm);
     pthread_mutex_unlock(&sparse_lock);
     if (!X)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory in the sparse solve (%zu unknowns)",
                             ch->n);
     memcpy(x, X->x, ch->n * sizeof(double));
-    cholmod_free_dense(&X, &ch->cm);
+    ch->cl->cholmod_free_dense(&X, &ch->cm);
     return CF_OK;
 }
 
@@ -300,11 +309,11 @@ void cf_sparse_chol_free(cf_sparse_chol *ch)
     if (!ch)
         return;
     if (ch->LL)
-        cholmod_free_factor(&ch->LL, &ch->cm);
-    cholmod_finish(&ch->cm);
+        ch->cl->cholmod_free_factor(&ch->LL, &ch->cm);
+    ch->cl->cholmod_finish(&ch->cm);
     if (ch->mumps_on) {
         ch->mu.job = -2;
-        mumps_call(&ch->mu);
+        mumps_call(ch->ml, &ch->mu);
     }
     free(ch->irn);
     free(ch->jcn);

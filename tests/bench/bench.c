@@ -172,7 +172,8 @@ int main(int argc, char **argv)
     static const struct {
         const char *what;
         void (*run)(bench_ctx *);
-    } sections[] = {{"memory of a fit", bench_memory_fit_early},
+    } sections[] = {{"start-up", bench_section_startup},
+                    {"memory of a fit", bench_memory_fit_early},
                     {"statics at scale (measured first: it forks)", bench_statics_early},
                     {"the force law", bench_section_law},
                     {"the spring with a cylindrical tail", bench_section_tail},

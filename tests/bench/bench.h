@@ -91,5 +91,6 @@ void bench_section_body(bench_ctx *ctx);
 void bench_section_body_ccx(bench_ctx *ctx); /* called by bench_section_body */
 void bench_section_output(bench_ctx *ctx);
 void bench_section_contact(bench_ctx *ctx);
+void bench_section_startup(bench_ctx *ctx);
 
 #endif
