@@ -1,0 +1,32 @@
+/*
+** What a biaxial or a fibre-frame table states beyond its columns (biaxial.c): the ratio of a
+** biaxial test's strains ('# ratio: A:B') and the plane of a test in the fibre frame
+** ('# plane: ij', or the caller's option planes). Used by the reader (measure.c).
+*/
+#ifndef CF_IO_BIAXIAL_H
+#define CF_IO_BIAXIAL_H
+
+#include <stddef.h>
+
+#include "conifit/error.h"
+#include "io/csv.h"
+#include "model/table.h"
+
+/* The '# ratio: A:B' comment (A, B > 0 finite; spaces allowed; text after B ignored) into
+** m->ratio and m->ratio_line. CF_E_DATA naming the file, line and column for a value that is not
+** two positive numbers, and naming the file when a biaxial table has no such comment. */
+cf_status cf_comment_ratio(const cf_csv_line *comments, size_t ncomments, const char *path,
+                           cf_table *m, cf_error *err);
+
+/* 0 when text (n bytes) is a plane "ij": two different letters of f, s, n; -1 otherwise. */
+int cf_plane_parse(const char *text, size_t n, char plane[3]);
+
+/* The plane of m: the entry of planes (the caller's option: "ij" for every table, or a comma
+** list of NAME=ij, NAME the table's file name without folder and extension) for m, else its
+** '# plane: ij' comment, else none. CF_E_DATA (naming the file and line, or the option) for a
+** plane that is not two of f, s, n, or a plane on a table whose mode is neither shear nor
+** biaxial. */
+cf_status cf_table_plane(const cf_csv_line *comments, size_t ncomments, const char *planes,
+                         cf_table *m, cf_error *err);
+
+#endif
