@@ -681,6 +681,9 @@ static json_t *joint_json(const cf_joint_report *r)
         json_array_append_new(tabs, e);
     }
     json_object_set_new(root, "tables", tabs);
+    json_t *ho = cf_report_ho_json(r); /* a set with a biaxial table only */
+    if (ho)
+        json_object_set_new(root, "holzapfel_ogden", ho);
     return root;
 }
 

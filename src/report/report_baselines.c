@@ -118,10 +118,10 @@ void cf_report_ho_text(FILE *o, const cf_joint_report *r)
     fprintf(o, ":\n");
     for (int c = 1; c >= 0; c--) {
         fprintf(o, "  biaxial tables' second direction along %s%s:\n", c ? "n" : "s",
-                c ? " (conifit's choice: the cross-fibre direction in the wall plane is the "
-                    "sheet-normal, as Sommer et al. 2015 cut their slabs and Martonova et al. "
-                    "2024 model them)"
-                  : "");
+                c ? " (conifit's choice: the cross-fibre direction of a slab cut in the wall "
+                    "plane is the sheet-normal, as the data's source models it)"
+                  : " (the sheet term then stiffens the cross-fibre direction, which the law "
+                    "has no term for along n)");
         for (int f = CF_HO_FULL; f <= CF_HO_TI; f++)
             ho_line(o, r, &r->ho[f][c]);
     }
