@@ -3,6 +3,9 @@
 */
 #include "io/biaxial.h"
 
+#include "io/columns.h"
+#include "io/measure.h"
+
 #include <ctype.h>
 #include <math.h>
 #include <stdio.h>
@@ -151,3 +154,91 @@ cf_status cf_table_plane(const cf_csv_line *comments, size_t ncomments, const ch
     }
     return CF_OK;
 }
+
+/* ---- the reader's biaxial passes ------------------------------------------------------------ */
+
+/* The second direction's strain and stress columns of a biaxial table, as "X,Y" (1-based numbers)
+** into pair: the first strain and the first stress column after the first direction's. */
+static cf_status second_pair(const reader *r, const layout *h, char *pair, size_t cap,
+                             cf_error *err)
+{
+    long xi = -1, yi = -1;
+    for (size_t i = 0; i < h->ncols; i++) {
+        const long k = (long)i;
+        if (k == h->xi || k == h->yi || k == h->wi || k == h->ti)
+            continue;
+        if (xi < 0 && k > h->xi && cf_column_is_x(r->cols[i].base))
+            xi = k;
+        else if (yi < 0 && k > h->yi && cf_column_is_y(r->cols[i].base))
+            yi = k;
+    }
+    if (xi < 0 || yi < 0)
+        return cf_csv_error(err, r->path, h->header_line, 1,
+                            "a biaxial table holds a strain and a stress column for each of its "
+                            "two directions (strain_f,strain_c,stress_f,stress_c): no second %s "
+                            "column after '%s' ('%s')", xi < 0 ? "strain" : "stress",
+                            r->cols[xi < 0 ? h->xi : h->yi].name, h->hq);
+    snprintf(pair, cap, "%ld,%ld", xi + 1, yi + 1);
+    return CF_OK;
+}
+
+/* What a first reading adds to the table from the comments: the plane, and a biaxial table's
+** ratio and second pair of columns (pair, "" for any other table). */
+cf_status cf_biaxial_frame(const reader *r, const layout *h, const cf_measure_options *opt,
+                           cf_table *m, char *pair, size_t cap, cf_error *err)
+{
+    cf_status st = cf_table_plane(r->comments, r->ncomments, opt->planes, m, err);
+    if (st != CF_OK || m->mode != CF_MODE_BIAXIAL)
+        return st;
+    if (strcmp(r->path, "(standard input)") == 0)
+        return cf_error_set(err, CF_E_DATA, "(standard input): a biaxial table is read in two "
+                            "passes, one per direction: give it as a file");
+    if ((st = cf_comment_ratio(r->comments, r->ncomments, r->path, m, err)) != CF_OK)
+        return st;
+    return second_pair(r, h, pair, cap, err);
+}
+
+/* Appends b's rows (the second direction, read with pair's columns; its rows' lines in lines)
+** to m's, after checking that they are the same load steps at m's ratio, in the same units and
+** measures. */
+cf_status cf_biaxial_stack(cf_table *m, const cf_table *b, const size_t *lines, const char *pair,
+                           cf_error *err)
+{
+    const size_t n = m->count, col = (size_t)strtoul(pair, NULL, 10);
+    if (b->count != n || b->y_to_file != m->y_to_file ||
+        b->measures.stress != m->measures.stress || b->measures.strain != m->measures.strain)
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: the biaxial table's second direction ('%s', '%s': %zu rows, "
+                            "%s, %s stress) differs from its first ('%s', '%s': %zu rows, %s, %s "
+                            "stress): both are read in one unit and measure, row by row",
+                            m->path, b->x_column, b->y_column, b->count, b->y_unit,
+                            cf_stress_measure_name(b->measures.stress), m->x_column, m->y_column,
+                            n, m->y_unit, cf_stress_measure_name(m->measures.stress));
+    const double a0 = m->ratio[0], a1 = m->ratio[1];
+    for (size_t i = 0; i < n; i++) {
+        const double u = b->x[i] * a0, v = m->x[i] * a1;
+        if (!(fabs(u - v) <= 1e-9 * fmax(fabs(u), fabs(v))))
+            return cf_csv_error(err, m->path, lines[i], col,
+                                "%s %.17g against %s %.17g is not the ratio %.17g:%.17g of the "
+                                "comment on line %zu (%s would be %.17g) ('%.17g')",
+                                b->x_column, b->x[i], m->x_column, m->x[i], a0, a1, m->ratio_line,
+                                b->x_column, m->x[i] * a1 / a0, b->x[i]);
+    }
+    double *p[4] = {m->x, m->y, m->w, m->t};
+    const double *q[4] = {b->x, b->y, b->w, b->t};
+    for (int k = 0; k < 4; k++) {
+        if (!p[k] || !q[k])
+            continue;
+        double *g = realloc(p[k], 2 * n * sizeof *g);
+        if (!g)
+            return cf_error_set(err, CF_E_INTERNAL, "%s: out of memory", m->path);
+        memcpy(g + n, q[k], n * sizeof *g);
+        *(k == 0 ? &m->x : k == 1 ? &m->y : k == 2 ? &m->w : &m->t) = g;
+    }
+    m->second = n;
+    m->count = 2 * n;
+    snprintf(m->x2_column, sizeof m->x2_column, "%s", b->x_column);
+    snprintf(m->y2_column, sizeof m->y2_column, "%s", b->y_column);
+    return CF_OK;
+}
+

@@ -10,6 +10,7 @@
 
 #include "conifit/error.h"
 #include "io/csv.h"
+#include "io/reader.h"
 #include "model/table.h"
 
 /* The '# ratio: A:B' comment (A, B > 0 finite; spaces allowed; text after B ignored) into
@@ -28,5 +29,20 @@ int cf_plane_parse(const char *text, size_t n, char plane[3]);
 ** biaxial. */
 cf_status cf_table_plane(const cf_csv_line *comments, size_t ncomments, const char *planes,
                          cf_table *m, cf_error *err);
+
+/* What a first reading of a table adds from its comments (the reader r and layout h alive): the
+** plane (cf_table_plane), and for a biaxial table its ratio (cf_comment_ratio) and its second
+** direction's columns as "X,Y" (1-based numbers) into pair: the first strain and the first stress
+** column after the first direction's. CF_E_DATA naming the file (and header line) for a biaxial
+** table on standard input (read twice) or without a second pair. pair "" for other tables. */
+cf_status cf_biaxial_frame(const reader *r, const layout *h, const cf_measure_options *opt,
+                           cf_table *m, char *pair, size_t cap, cf_error *err);
+
+/* Appends b's rows (the second direction, read with pair's columns; its rows' lines in lines) to
+** m's (table.h: m->second, m->count doubled, x2/y2 names), after checking that they are the same
+** load steps at m's ratio (1e-9 relative; CF_E_DATA naming the file, line and column), in the
+** same unit and measures. CF_E_INTERNAL when memory runs out. */
+cf_status cf_biaxial_stack(cf_table *m, const cf_table *b, const size_t *lines, const char *pair,
+                           cf_error *err);
 
 #endif

@@ -447,7 +447,7 @@ char *cf_joint_text(const cf_joint_report *r)
     law_choice_text(o, r);
     pair_choice_text(o, r);
     better_text(o, r);
-    cf_report_ho_text(o, r);
+    cf_report_ho_text(o, r, cf_joint_better(r));
     if (fclose(o) != 0) {
         free(buf);
         return NULL;

@@ -105,7 +105,7 @@ static void ho_line(FILE *o, const cf_joint_report *r, const cf_ho_fit *h)
     fprintf(o, "\n");
 }
 
-void cf_report_ho_text(FILE *o, const cf_joint_report *r)
+void cf_report_ho_text(FILE *o, const cf_joint_report *r, int b)
 {
     if (!r->ho_ran && !r->ho_why[0])
         return;
@@ -125,8 +125,7 @@ void cf_report_ho_text(FILE *o, const cf_joint_report *r)
         for (int f = CF_HO_FULL; f <= CF_HO_TI; f++)
             ho_line(o, r, &r->ho[f][c]);
     }
-    const int b = cf_joint_better(r);
-    if (b >= 0)
+    if (b >= 0 && b < r->nfits)
         fprintf(o, "  the isotropic lattice (%s): weighted objective %.4g\n",
                 cf_spring_type_name(r->fits[b].fit.type), r->fits[b].objective);
 }

@@ -24,8 +24,9 @@ void cf_report_baseline_coefficients(const cf_fit_report *r, int k, char *buf, s
 json_t *cf_report_baseline_json(const cf_fit_report *r, int k);
 
 /* The joint report's Holzapfel-Ogden baselines (r->ho, r->ho_why) as text into o, beside the
-** lattice's weighted objective (nothing when no table is biaxial). */
-void cf_report_ho_text(FILE *o, const cf_joint_report *r);
+** weighted objective of the lattice r->fits[better] (cf_joint_better; none when out of range);
+** nothing when no table is biaxial. */
+void cf_report_ho_text(FILE *o, const cf_joint_report *r, int better);
 
 /* The same as the fit file's object (NULL when they were not fitted or memory runs out). */
 json_t *cf_report_ho_json(const cf_joint_report *r);
