@@ -444,7 +444,7 @@ static int fit_option_apply(void *ctx, int c, const char *optval)
         a->mopt.mode = optval;
         return 0;
     }
-    case OPT_PLANE: a->mopt.planes = optval; return 0;
+    case OPT_PLANE: a->mopt.plane = optval; return 0;
     case OPT_X_COL: a->mopt.x_col = optval; return 0;
     case OPT_Y_COL: a->mopt.y_col = optval; return 0;
     case OPT_COLUMNS: return columns_option(optval, &a->mopt);

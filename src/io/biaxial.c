@@ -98,7 +98,7 @@ int cf_plane_parse(const char *text, size_t n, char plane[3])
     return 0;
 }
 
-/* The entry of the option planes for a table named name: *v, *n its plane text; 0 when none. */
+/* The entry of the option plane for a table named name: *v, *n its plane text; 0 when none. */
 static int plane_entry(const char *planes, const char *name, const char **v, size_t *n)
 {
     if (!strchr(planes, '=')) {
@@ -130,7 +130,7 @@ cf_status cf_table_plane(const cf_csv_line *comments, size_t ncomments, const ch
     if (planes && plane_entry(planes, name, &v, &n)) {
         if (cf_plane_parse(v, n, m->plane) != 0)
             return cf_error_set(err, CF_E_DATA,
-                                "%s: option planes: '%.*s' is not a plane: expected two "
+                                "%s: option plane: '%.*s' is not a plane: expected two "
                                 "different letters of f (fibre), s (sheet), n (normal), as fs",
                                 m->path, (int)(n > 40 ? 40 : n), v);
     } else if ((c = keyed_comment(comments, ncomments, "plane", &v, &end)) != NULL) {
@@ -143,6 +143,10 @@ cf_status cf_table_plane(const cf_csv_line *comments, size_t ncomments, const ch
         m->plane_line = c->line;
     } else
         return CF_OK;
+    if (m->mode != CF_MODE_SHEAR && m->mode != CF_MODE_BIAXIAL && !c && !strchr(planes, '=')) {
+        m->plane[0] = '\0'; /* one plane for every table: the shear and biaxial ones */
+        return CF_OK;
+    }
     if (m->mode != CF_MODE_SHEAR && m->mode != CF_MODE_BIAXIAL) {
         char where[48] = "";
         if (c)
@@ -187,7 +191,7 @@ static cf_status second_pair(const reader *r, const layout *h, char *pair, size_
 cf_status cf_biaxial_frame(const reader *r, const layout *h, const cf_measure_options *opt,
                            cf_table *m, char *pair, size_t cap, cf_error *err)
 {
-    cf_status st = cf_table_plane(r->comments, r->ncomments, opt->planes, m, err);
+    cf_status st = cf_table_plane(r->comments, r->ncomments, opt->plane, m, err);
     if (st != CF_OK || m->mode != CF_MODE_BIAXIAL)
         return st;
     if (strcmp(r->path, "(standard input)") == 0)

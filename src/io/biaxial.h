@@ -1,7 +1,7 @@
 /*
 ** What a biaxial or a fibre-frame table states beyond its columns (biaxial.c): the ratio of a
 ** biaxial test's strains ('# ratio: A:B') and the plane of a test in the fibre frame
-** ('# plane: ij', or the caller's option planes). Used by the reader (measure.c).
+** ('# plane: ij', or the caller's option plane). Used by the reader (measure.c).
 */
 #ifndef CF_IO_BIAXIAL_H
 #define CF_IO_BIAXIAL_H
@@ -24,8 +24,9 @@ int cf_plane_parse(const char *text, size_t n, char plane[3]);
 
 /* The plane of m: the entry of planes (the caller's option: "ij" for every table, or a comma
 ** list of NAME=ij, NAME the table's file name without folder and extension) for m, else its
-** '# plane: ij' comment, else none. CF_E_DATA (naming the file and line, or the option) for a
-** plane that is not two of f, s, n, or a plane on a table whose mode is neither shear nor
+** '# plane: ij' comment, else none. A plane for every table leaves the tables of other modes
+** alone. CF_E_DATA (naming the file and line, or the option) for a plane that is not two of f,
+** s, n, or a plane named for a table (NAME=ij, or its comment) whose mode is neither shear nor
 ** biaxial. */
 cf_status cf_table_plane(const cf_csv_line *comments, size_t ncomments, const char *planes,
                          cf_table *m, cf_error *err);

@@ -53,9 +53,9 @@ typedef struct cf_measure_options {
                              ** and is followed by rows of numbers */
     const char *columns;     /* "X,Y" or "X,Y,W": the x, y and weight columns by name or 1-based
                              ** number, and no others (no weight or time found by name); or NULL */
-    const char *planes;      /* the plane in the fibre frame (table.h) of shear and biaxial tables
+    const char *plane;       /* the plane in the fibre frame (table.h) of shear and biaxial tables
                              ** that state none or another in a '# plane:' comment: "ij" for
-                             ** every table, or a comma list of NAME=ij, NAME a table's file name
+                             ** every shear and biaxial table, or a comma list of NAME=ij, NAME a table's file name
                              ** without folder and extension; NULL: from the comment */
 } cf_measure_options;
 

@@ -2,7 +2,7 @@
 ** Biaxial tables at any ratio of strains (model/mode.c's biaxial row, io/measure.c, io/biaxial.c):
 **  - the reader stacks both directions of a '# mode: biaxial' table, checks its '# ratio:' row by
 **    row and refuses a mismatch, a missing or malformed ratio and a missing second pair of
-**    columns with the file, line and column; '# plane:' and the option planes name the plane;
+**    columns with the file, line and column; '# plane:' and the option plane name the plane;
 **  - the homogenised cell in the biaxial mode is the full lattice's homogeneous state: the
 **    lattice deformed by the cell's F (free stretch solved) has no force on any node off its x
 **    and y faces (the z faces traction-free), and its x and y faces carry the cell's nominal
@@ -68,7 +68,7 @@ static void refused(const char *name, const char *text, const char *opt_planes,
 {
     const char *p = write_table(name, text);
     cf_measure_options o = cf_measure_default_options();
-    o.planes = opt_planes;
+    o.plane = opt_planes;
     cf_table t;
     cf_error err = {0};
     assert_int_equal(cf_measure_load(p, &o, &t, &err), CF_E_DATA);
@@ -113,7 +113,7 @@ static void planes_come_from_the_comment_or_the_option(void **state)
     assert_string_equal(t.plane, "sf");
     assert_int_equal(t.plane_line, 1);
     cf_table_free(&t);
-    o.planes = "other=nf,shear_sf=fs"; /* the option wins, by the table's name */
+    o.plane = "other=nf,shear_sf=fs"; /* the option wins, by the table's name */
     assert_int_equal(cf_measure_load(p, &o, &t, &err), CF_OK);
     assert_string_equal(t.plane, "fs");
     cf_table_free(&t);
@@ -121,9 +121,17 @@ static void planes_come_from_the_comment_or_the_option(void **state)
     assert_int_equal(cf_measure_load(p, &o, &t, &err), CF_OK); /* not in the list: none */
     assert_string_equal(t.plane, "");
     cf_table_free(&t);
+    o.plane = "fs"; /* one plane for every table: a uniaxial one is left alone */
+    p = write_table("uniax.csv", "strain,stress_kPa\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n");
+    assert_int_equal(cf_measure_load(p, &o, &t, &err), CF_OK);
+    assert_string_equal(t.plane, "");
+    cf_table_free(&t);
+    const char *m0[] = {"uniax.csv: plane 'fs' given for a uniaxial table"};
+    refused("uniax.csv", "strain,stress_kPa\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n",
+            "uniax=fs", m0, 1);
     const char *m1[] = {"ff.csv:1:10:", "comment 'plane: ff'"};
     refused("ff.csv", "# plane: ff\n" SHEAR, NULL, m1, 2);
-    const char *m2[] = {"option planes", "'fx'"};
+    const char *m2[] = {"option plane", "'fx'"};
     refused("fx.csv", SHEAR, "fx", m2, 2);
     const char *m3[] = {"uni.csv:1:1:", "uniaxial table"};
     refused("uni.csv", "# plane: fs\nstrain,stress_kPa\n0,0\n0.1,1\n0.2,2\n0.3,3\n0.4,4\n0.5,5\n",

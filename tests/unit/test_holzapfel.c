@@ -164,7 +164,7 @@ static void joint_fit_on_the_shared_myocardium_set(void **state)
     const char *names[8] = {"biaxial_1to1", "biaxial_1to075", "biaxial_075to1", "biaxial_1to05",
                             "biaxial_05to1", "shear_fs", "shear_sf", "shear_nf"};
     cf_measure_options o = cf_measure_default_options();
-    o.planes = "heart_myocardium_shear_fs=fs,heart_myocardium_shear_sf=sf,"
+    o.plane = "heart_myocardium_shear_fs=fs,heart_myocardium_shear_sf=sf,"
                "heart_myocardium_shear_nf=nf";
     cf_table tab[8];
     const cf_table *t[8];
