@@ -118,7 +118,7 @@ int cf_ho_unfit(const cf_table *const *t, size_t n, char *buf, size_t cap)
             continue;
         if (t[k]->mode == CF_MODE_SHEAR)
             snprintf(buf, cap, "%.400s: a shear table states no plane in the fibre frame (a "
-                     "'# plane: ij' comment, or option plane)", t[k]->path);
+                     "'# plane: ij' comment, or the plane option: --plane)", t[k]->path);
         else
             snprintf(buf, cap, "%.400s: a %s table has no form of the law here (biaxial and "
                      "simple-shear tables only)", t[k]->path, cf_mode_name(t[k]->mode));

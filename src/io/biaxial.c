@@ -223,8 +223,8 @@ cf_status cf_biaxial_stack(cf_table *m, const cf_table *b, const size_t *lines, 
         const double u = b->x[i] * a0, v = m->x[i] * a1;
         if (!(fabs(u - v) <= 1e-9 * fmax(fabs(u), fabs(v))))
             return cf_csv_error(err, m->path, lines[i], col,
-                                "%s %.17g against %s %.17g is not the ratio %.17g:%.17g of the "
-                                "comment on line %zu (%s would be %.17g) ('%.17g')",
+                                "%s %.9g against %s %.9g is not the ratio %.9g:%.9g of the "
+                                "comment on line %zu (%s would be %.9g) ('%.9g')",
                                 b->x_column, b->x[i], m->x_column, m->x[i], a0, a1, m->ratio_line,
                                 b->x_column, m->x[i] * a1 / a0, b->x[i]);
     }
