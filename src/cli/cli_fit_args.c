@@ -70,8 +70,14 @@ static const char fit_help[] =
     "  --poisson NU            the lattice's small-strain nu declared, 0.25 <= NU < 0.5: kappa\n"
     "                          from it (with --joint; a double-acting element: its compression\n"
     "                          side)\n"
-    "  --mode M                the table's test mode: uniaxial, shear, planar, equibiaxial or\n"
-    "                          confined (wins over a '# mode:' comment; default uniaxial)\n"
+    "  --mode M                the table's test mode: uniaxial, shear, planar, equibiaxial,\n"
+    "                          confined or biaxial (wins over a '# mode:' comment; default\n"
+    "                          uniaxial; a biaxial table holds both directions' strain and\n"
+    "                          stress columns and a '# ratio: A:B' comment)\n"
+    "  --plane PLANE           where shear and biaxial tables lie in the fibre frame (f, s, n):\n"
+    "                          ij for every table, or NAME=ij,NAME=ij... by file name without\n"
+    "                          folder and extension (shear ij: i the normal of the sheared\n"
+    "                          face, j the direction of shear; wins over a '# plane:' comment)\n"
     "  --plot FILE.png|.svg|.pdf  draw data, fits, baselines and residuals with gnuplot\n"
     "                          (with several tables: a folder DIR/, one NAME.png per table)\n"
     "  --title TEXT            title of the plot (default: the table's file name without\n"
@@ -141,6 +147,7 @@ enum {
     OPT_THROUGH,
     OPT_TARGET,
     OPT_MODE,
+    OPT_PLANE,
     OPT_JOINT,
     OPT_CALIBRATION,
     OPT_X_COL,
@@ -192,6 +199,7 @@ static const struct option fit_options[] = {
     {"through-msm", optional_argument, NULL, OPT_THROUGH},
     {"target", required_argument, NULL, OPT_TARGET},
     {"mode", required_argument, NULL, OPT_MODE},
+    {"plane", required_argument, NULL, OPT_PLANE},
     {"joint", no_argument, NULL, OPT_JOINT},
     {"calibration", required_argument, NULL, OPT_CALIBRATION},
     {"x-col", required_argument, NULL, OPT_X_COL},
@@ -468,6 +476,7 @@ static int table_option(fit_args *a, int c, const char *optval)
         a->mopt.mode = optval;
         return 0;
     }
+    case OPT_PLANE: a->mopt.plane = optval; return 0;
     case OPT_X_COL: a->mopt.x_col = optval; return 0;
     case OPT_Y_COL: a->mopt.y_col = optval; return 0;
     case OPT_COLUMNS: return columns_option(optval, &a->mopt);

@@ -55,8 +55,7 @@ int cf_joint_curve(void *ctx, double rho, double B, double *out)
     if (c->kappa_mode != KAPPA_NONE)
         cell.volume_modulus_MPa = cf_joint_curve_kappa(c, &law);
     for (size_t k = 0, m = 0; k < c->n; m += c->t[k++]->count)
-        if (cf_cell_curve(&cell, c->t[k]->mode, c->t[k]->x, c->t[k]->count, out + m, NULL) !=
-            CF_OK)
+        if (cf_table_cell_curve(&cell, c->t[k], out + m, NULL) != CF_OK)
             return 1;
     return 0;
 }

@@ -107,16 +107,28 @@ static double table_reach(const cf_table *t)
     return reach;
 }
 
+/* The cell for scanning table t along its mode: a biaxial table's path with its larger strain
+** along x (k <= 1), so the scan to the table's farthest strain covers both directions' rows (the
+** cubic cell is the same along x and y); the cell itself for every other table. */
+static cf_cell scan_cell(const cf_cell *cell, const cf_table *t)
+{
+    cf_cell c = *cell;
+    const double k = cf_table_biaxial_k(t, 0);
+    c.biaxial_k = k <= 1 ? k : 1 / k;
+    return c;
+}
+
 /* The uniaxial states of table t at the check's strains e (the farthest first) and their lateral
 ** stretches lat; 0 when one cannot be reached. */
 static int check_states(const cf_cell *cell, const cf_table *t, double e[CHECK_STEPS],
                         double lat[CHECK_STEPS], double F[CHECK_STEPS][9])
 {
     const double reach = table_reach(t) * CF_JOINT_STABLE_MARGIN;
+    const cf_cell scan = scan_cell(cell, t);
     for (int j = 0; j < CHECK_STEPS; j++) {
         cf_cell_state st;
         e[j] = reach * (CHECK_STEPS - j) / CHECK_STEPS;
-        if (cf_cell_mode(cell, t->mode, e[j], NULL, &st, NULL) != CF_OK)
+        if (cf_cell_mode(&scan, t->mode, e[j], NULL, &st, NULL) != CF_OK)
             return 0;
         lat[j] = st.F[0];
         memcpy(F[j], st.F, sizeof F[j]);
@@ -238,7 +250,8 @@ static cf_status table_verdict(const cf_cell *cell, const cf_msm_config *cfg, co
         return CF_OK;
     double limit = reach;
     int lost = 0;
-    if (cf_cell_stable_to(cell, t->mode, reach, &limit, &lost, NULL) == CF_OK && lost)
+    const cf_cell scan = scan_cell(cell, t);
+    if (cf_cell_stable_to(&scan, t->mode, reach, &limit, &lost, NULL) == CF_OK && lost)
         jt->stable_to = limit;
     if (t->mode == CF_MODE_UNIAXIAL) {
         double llim = reach;
@@ -262,7 +275,8 @@ static void table_elliptic(const cf_cell *cell, const cf_table *t, cf_joint_tabl
         return;
     double limit = reach;
     int lost = 0;
-    if (cf_cell_elliptic_to(cell, t->mode, reach, &limit, &lost, jt->elliptic_n, NULL) != CF_OK)
+    const cf_cell scan = scan_cell(cell, t);
+    if (cf_cell_elliptic_to(&scan, t->mode, reach, &limit, &lost, jt->elliptic_n, NULL) != CF_OK)
         return;
     jt->elliptic_checked = 1;
     jt->elliptic_in_range = !lost;
@@ -290,7 +304,7 @@ cf_status cf_joint_verify_tables(const jctx *c, cf_joint_result *r, cf_error *er
     for (size_t k = 0; k < c->n && st == CF_OK; k++) {
         const cf_table *t = c->t[k];
         cf_joint_table *jt = &r->tab[k];
-        if ((st = cf_cell_curve(&cell, t->mode, t->x, t->count, c->curve[k], err)) != CF_OK)
+        if ((st = cf_table_cell_curve(&cell, t, c->curve[k], err)) != CF_OK)
             break;
         jt->cell_rmse = cf_lsq_quality_of(t, c->curve[k]).rmse;
         /* the table's own AIC at the joint law, in the table's unit as a single fit states it */

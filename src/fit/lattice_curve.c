@@ -32,7 +32,7 @@ cf_status cf_lattice_curve(const cf_spring *p, const cf_validate_setup *s, const
             memset(stats, 0, sizeof *stats);
         st = cf_cell_init(&c, &law, s->method, s->cfg.lattice.weight, err);
         if (st == CF_OK)
-            st = cf_cell_curve(&c, d->mode, d->x, d->count, out, err);
+            st = cf_table_cell_curve(&c, d, out, err);
     }
     for (size_t i = 0; st == CF_OK && law_out && i < d->count; i++)
         law_out[i] = cf_fit_model(&law, 0, d->x[i]);

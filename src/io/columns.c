@@ -2,6 +2,7 @@
 ** Column names and units of a measurement table (columns.h).
 */
 #include "io/columns.h"
+#include "model/mode.h"
 
 #include "io/measures.h"
 
@@ -309,8 +310,8 @@ cf_status cf_comment_mode(const cf_csv_line *comments, size_t ncomments, const c
         snprintf(name, sizeof name, "%.*s", (int)(s - w), w);
         if (cf_mode_parse(name, mode, NULL) != CF_OK)
             return cf_csv_error(err, path, comments[i].line, 1,
-                                "comment 'mode: %s': expected uniaxial, shear, planar, "
-                                "equibiaxial or confined ('%s')", name, name);
+                                "comment 'mode: %s': expected %s ('%s')", name, cf_mode_list(),
+                                name);
         *found = 1;
         return CF_OK;
     }

@@ -9,10 +9,12 @@
 #include "io/measure.h"
 
 #include "base/input.h"
+#include "io/biaxial.h"
 #include "io/columns.h"
 #include "io/csv.h"
 #include "io/measures.h"
 #include "io/reader.h"
+#include "model/mode.h"
 
 #include <errno.h>
 #include <math.h>
@@ -24,7 +26,7 @@
 
 cf_measure_options cf_measure_default_options(void)
 {
-    cf_measure_options o = {NULL, NULL, NULL, NULL, NULL, -1, NULL, -1, -1, 0, NULL};
+    cf_measure_options o = {NULL, NULL, NULL, NULL, NULL, -1, NULL, -1, -1, 0, NULL, NULL};
     return o;
 }
 
@@ -41,6 +43,7 @@ static void reader_free(reader *r)
     free(r->y);
     free(r->w);
     free(r->t);
+    free(r->row_line);
 }
 
 
@@ -387,10 +390,14 @@ static cf_status decide_units(const reader *r, const cf_measure_options *opt, co
 
 /* ---- rows ------------------------------------------------------------------------------------ */
 
-static int push_row(reader *r, double x, double y, double w, double t)
+static int push_row(reader *r, double x, double y, double w, double t, size_t line)
 {
     if (r->count == r->cap) {
         size_t cap = r->cap ? 2 * r->cap : 64;
+        size_t *rl = realloc(r->row_line, cap * sizeof *rl);
+        if (!rl)
+            return -1;
+        r->row_line = rl;
         double *a[4] = {r->x, r->y, r->w, r->t};
         for (int k = 0; k < 4; k++) {
             double *p = realloc(a[k], cap * sizeof *p);
@@ -412,6 +419,7 @@ static int push_row(reader *r, double x, double y, double w, double t)
     r->y[r->count] = y;
     r->w[r->count] = w;
     r->t[r->count] = t;
+    r->row_line[r->count] = line;
     r->count++;
     return 0;
 }
@@ -517,7 +525,7 @@ static cf_status read_row(reader *r, const cf_csv_line *l, size_t n, const layou
                             "%.17g s) ('%s')",
                             r->cols[h->ti].name, t, *tprev, cf_csv_field(&r->f, (size_t)h->ti));
     *tprev = t;
-    if (push_row(r, x, y, v[2], t) != 0)
+    if (push_row(r, x, y, v[2], t, l->line) != 0)
         return cf_reader_out_of_memory(err, path);
     return CF_OK;
 }
@@ -560,8 +568,8 @@ static cf_status decide_mode(const reader *r, const cf_measure_options *opt, cf_
         return cf_comment_mode(r->comments, r->ncomments, r->path, &m->mode, &m->mode_stated, err);
     cf_error me = {0};
     if (cf_mode_parse(opt->mode, &m->mode, &me) != CF_OK)
-        return cf_error_set(err, CF_E_DATA, "%s: --mode %s: expected uniaxial, shear, planar, "
-                            "equibiaxial or confined", r->path, opt->mode);
+        return cf_error_set(err, CF_E_DATA, "%s: --mode %s: expected %s", r->path, opt->mode,
+                            cf_mode_list());
     m->mode_stated = 1;
     return CF_OK;
 }
@@ -664,9 +672,11 @@ static void hand_over(reader *r, const layout *h, const scaling *u, cf_table *m)
 /* Reading a table is one pass through its stages in order: the text, the header, which columns,
 ** their units, the rows, the test mode; every stage reads what the ones before decided (in the
 ** reader, the layout and the scaling), and every refusal releases everything at one exit, so no
-** error path can leak or leave a half-filled table. */
-cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf_table *m,
-                          cf_error *err)
+** error path can leak or leave a half-filled table. A first reading (pair not NULL) also takes
+** the plane and, for a biaxial table, its ratio and its second pair of columns; a second reading
+** (lines not NULL) hands back the line of every row. */
+static cf_status load(const char *path, const cf_measure_options *opt_in, cf_table *m,
+                      char *pair, size_t cap, size_t **lines, cf_error *err)
 {
     cf_measure_options opt = opt_in ? *opt_in : cf_measure_default_options();
     reader r;
@@ -694,8 +704,44 @@ cf_status cf_measure_load(const char *path, const cf_measure_options *opt_in, cf
         return st;
     }
     hand_over(&r, &h, &u, m);
+    if (pair && (st = cf_biaxial_frame(&r, &h, &opt, m, pair, cap, err)) != CF_OK) {
+        reader_free(&r);
+        cf_table_free(m);
+        memset(m, 0, sizeof *m);
+        return st;
+    }
+    if (lines) {
+        *lines = r.row_line;
+        r.row_line = NULL;
+    }
     reader_free(&r);
     if ((st = cf_measures_convert(m, err)) != CF_OK) {
+        cf_table_free(m);
+        memset(m, 0, sizeof *m);
+        return st;
+    }
+    cf_error_clear(err);
+    return CF_OK;
+}
+
+cf_status cf_measure_load(const char *path, const cf_measure_options *opt, cf_table *m,
+                          cf_error *err)
+{
+    char pair[48] = "";
+    cf_status st = load(path, opt, m, pair, sizeof pair, NULL, err);
+    if (st != CF_OK || m->mode != CF_MODE_BIAXIAL)
+        return st;
+    cf_measure_options o = opt ? *opt : cf_measure_default_options();
+    o.columns = pair;
+    o.x_col = o.y_col = NULL;
+    o.mode = "biaxial";
+    cf_table b;
+    size_t *lines = NULL;
+    if ((st = load(path, &o, &b, NULL, 0, &lines, err)) == CF_OK)
+        st = cf_biaxial_stack(m, &b, lines, pair, err);
+    free(lines);
+    cf_table_free(&b);
+    if (st != CF_OK) {
         cf_table_free(m);
         memset(m, 0, sizeof *m);
         return st;

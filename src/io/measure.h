@@ -53,6 +53,10 @@ typedef struct cf_measure_options {
                              ** and is followed by rows of numbers */
     const char *columns;     /* "X,Y" or "X,Y,W": the x, y and weight columns by name or 1-based
                              ** number, and no others (no weight or time found by name); or NULL */
+    const char *plane;       /* the plane in the fibre frame (table.h) of shear and biaxial tables
+                             ** that state none or another in a '# plane:' comment: "ij" for
+                             ** every shear and biaxial table, or a comma list of NAME=ij, NAME a table's file name
+                             ** without folder and extension; NULL: from the comment */
 } cf_measure_options;
 
 /* Options with everything decided from the file. */
@@ -85,7 +89,12 @@ typedef enum cf_unit_class {
 ** NULL) the factor that converts a value in that unit to conifit's (MPa, N, mm, s, -). */
 cf_unit_class cf_measure_unit(const char *name, double *to_conifit);
 
-/* Reads the table at path ("-": standard input, named "(standard input)" in messages). Columns
+/* Reads the table at path ("-": standard input, named "(standard input)" in messages).
+** A biaxial table ('# mode: biaxial', or option mode) holds two directions: its first strain and
+** stress columns (by name, or option x_col and y_col) are the first direction, the next strain
+** and stress columns after them the second, read with the same units and measures; its
+** '# ratio: A:B' comment is checked against every row's two strains (1e-9 relative), and the
+** rows are stacked as table.h says. Columns
 ** are separated by ',' ';' TAB or, when the header has none of them, by blanks. A message that
 ** points at a setting of opt names it "option FIELD" (option stress_unit, option x_col), which a
 ** front end maps to its own spelling. Errors (nothing allocated is left behind):

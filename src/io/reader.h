@@ -24,6 +24,7 @@ typedef struct reader {
     size_t ncols;
     cf_csv_fields f;
     double *x, *y, *w, *t;
+    size_t *row_line;   /* each row's line in the file */
     size_t count, cap;
 } reader;
 

@@ -68,6 +68,7 @@ cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
     c->law_scale_strain = 0.0;
     c->stretch_hint = 0.0;
     c->linear_finish = 0;
+    c->biaxial_k = 1.0;
     c->volume_modulus_MPa = 0.0;
     memcpy(c->weight, weight, sizeof c->weight);
     return CF_OK;
@@ -333,8 +334,8 @@ static double guess(const cf_cell *c, cf_mode m, double e)
     cf_cubic_moduli cm = cf_cubic_moduli_of(c->weight);
     if (nf == 2)
         return 1 - cm.nu * e;
-    if (nf == 1)
-        return 1 - nl * cm.C12 / cm.C11 * e;
+    if (nf == 1) /* biaxial: the two loaded strains are e and k e */
+        return 1 - (m == CF_MODE_BIAXIAL ? 1 + c->biaxial_k : nl) * cm.C12 / cm.C11 * e;
     return 1;
 }
 
@@ -465,7 +466,7 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
     double F[9], kT[CF_CELL_DIRS];
     cf_status st;
     if (fm.zero < 0) {
-        cf_mode_place(m, e, 1, F);
+        cf_mode_place_k(m, e, 1, c->biaxial_k, F);
         if ((st = evaluate(c, F, extra, s, kT, err)) != CF_OK)
             return st;
         return settled(s, &fm, 1);
@@ -480,7 +481,7 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
     cf_error e1 = {0};
     double newton_before = 0; /* the Newton step that led to a, 0 when a came otherwise */
     for (int it = 0; it < MAX_ITER; it++) {
-        cf_mode_place(m, e, a, F);
+        cf_mode_place_k(m, e, a, c->biaxial_k, F);
         st = evaluate(c, F, extra, s, kT, &e1);
         if (st != CF_OK) {
             newton_before = 0;
@@ -503,7 +504,7 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
             if (an == a) /* the state just evaluated is the one it would place again */
                 return settled(s, &fm, a);
             a = an;
-            cf_mode_place(m, e, a, F);
+            cf_mode_place_k(m, e, a, c->biaxial_k, F);
             if ((st = evaluate(c, F, extra, s, kT, &e1)) != CF_OK)
                 break;
             return settled(s, &fm, a);

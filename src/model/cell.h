@@ -22,6 +22,10 @@
 **   planar       F = diag(1 + e, 1, c), c free with P_zz = 0 (pure shear); stress P_xx
 **   equibiaxial  F = diag(1 + e, 1 + e, c), c free with P_zz = 0; stress P_xx
 **   confined     F = diag(1, 1, 1 + e), lateral stretches held; stress P_zz
+**   biaxial      F = diag(1 + e, 1 + k e, c), c free with P_zz = 0; stress P_xx, k the cell's
+**                biaxial_k (the other in-plane strain per unit of this one; 1 is equibiaxial).
+**                The cubic cell is the same along x and y, so either direction of a biaxial
+**                test is its x: a table's rows of the second direction take k = 1 / ratio.
 ** Only uniaxial is a mode of the full lattice (cf_msm_uniaxial); the others are the cell's.
 **
 ** The volume term (Golec et al. 2020, The Visual Computer 36:809-825): with volume_modulus_MPa =
@@ -54,10 +58,11 @@ typedef enum cf_mode {
     CF_MODE_PLANAR = 2,
     CF_MODE_EQUIBIAXIAL = 3,
     CF_MODE_CONFINED = 4,
-    CF_MODE_COUNT = 5
+    CF_MODE_BIAXIAL = 5,
+    CF_MODE_COUNT = 6
 } cf_mode;
 
-/* "uniaxial", "shear", "planar", "equibiaxial", "confined"; the parser refuses anything else
+/* "uniaxial", "shear", "planar", "equibiaxial", "confined", "biaxial"; the parser refuses anything else
 ** with CF_E_DATA naming the value. */
 const char *cf_mode_name(cf_mode m);
 cf_status cf_mode_parse(const char *name, cf_mode *m, cf_error *err);
@@ -82,6 +87,8 @@ typedef struct cf_cell {
                                      ** from the small-strain constants); a history passes the
                                      ** last step's */
     double volume_modulus_MPa;       /* kappa of the volume term, MPa (0 by cf_cell_init: none) */
+    double biaxial_k;                /* the biaxial mode's strain along y per unit strain along x
+                                     ** (1 by cf_cell_init; other modes ignore it) */
     int linear_finish;               /* 1: a free-stretch solve whose last Newton step is too small
                                      ** for its second-order term to reach rounding takes that step
                                      ** by the cell's linearisation instead of evaluating the cell
@@ -89,7 +96,7 @@ typedef struct cf_cell {
 } cf_cell;
 
 /* Checks the weights (cf_calibration_check) and fills c (law_scale 1, law_scale_strain 0, stretch_hint 0,
-** linear_finish 0). */
+** linear_finish 0, biaxial_k 1). */
 cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
                        const double weight[CF_FAMILY_COUNT], cf_error *err);
 

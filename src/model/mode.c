@@ -62,6 +62,17 @@ static const cf_mode_row rows[CF_MODE_COUNT] = {
         .no_incompressible = "confined compression holds the lateral stretches, which an "
                              "incompressible solid cannot follow",
         .x_quantity = "engineering strain", .x_short = "strain"},
+    [CF_MODE_BIAXIAL] = {
+        .name = "biaxial",
+        .deformation = "stretched along x and y at a fixed ratio of strains, free along z",
+        .strain_mask = 3u, .free_mask = 4u, .shear_i = -1, .shear_j = -1,
+        .zero = 2, .si = 0, .sj = 0, .any_sign = 0, .spring_curve = 0,
+        .cauchy_over_stretch = 1,
+        .cauchy_words = "P = sigma / (1 + strain) along each direction, incompressible biaxial",
+        .q = 0.0,
+        .no_incompressible = "a biaxial test at a ratio other than 1:1 has two loaded stretches, "
+                             "which the one-stretch incompressible forms do not follow",
+        .x_quantity = "engineering strain", .x_short = "strain"},
 };
 
 const cf_mode_row *cf_mode_row_of(cf_mode m)
@@ -82,16 +93,22 @@ cf_status cf_mode_parse(const char *name, cf_mode *m, cf_error *err)
             *m = (cf_mode)k;
             return CF_OK;
         }
-    char list[128] = "";
-    for (int k = 0; k < CF_MODE_COUNT; k++) {
-        size_t n = strlen(list);
-        snprintf(list + n, sizeof list - n, "%s%s", k == 0 ? "" : k == CF_MODE_COUNT - 1 ? " or " : ", ",
-                 rows[k].name);
-    }
-    return cf_error_set(err, CF_E_DATA, "mode '%s': expected %s", name ? name : "(none)", list);
+    return cf_error_set(err, CF_E_DATA, "mode '%s': expected %s", name ? name : "(none)",
+                        cf_mode_list());
+}
+
+const char *cf_mode_list(void)
+{
+    /* the rows' names in order (tests/unit/test_cell.c checks it against the rows) */
+    return "uniaxial, shear, planar, equibiaxial, confined or biaxial";
 }
 
 void cf_mode_place(cf_mode m, double e, double a, double F[9])
+{
+    cf_mode_place_k(m, e, a, 1.0, F);
+}
+
+void cf_mode_place_k(cf_mode m, double e, double a, double k, double F[9])
 {
     memset(F, 0, 9 * sizeof(double));
     F[0] = F[4] = F[8] = 1;
@@ -106,4 +123,6 @@ void cf_mode_place(cf_mode m, double e, double a, double F[9])
     }
     if (r->shear_i >= 0)
         F[3 * r->shear_i + r->shear_j] = e;
+    if (m == CF_MODE_BIAXIAL)
+        F[4] = 1 + k * e;
 }

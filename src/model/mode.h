@@ -39,7 +39,14 @@ typedef struct cf_mode_row {
 /* The row of mode m; NULL when m is not a mode. */
 const cf_mode_row *cf_mode_row_of(cf_mode m);
 
-/* F (row-major 3x3) of mode m at strain e and free stretch a, as the row says. */
+/* F (row-major 3x3) of mode m at strain e and free stretch a, as the row says (biaxial: k = 1). */
 void cf_mode_place(cf_mode m, double e, double a, double F[9]);
+/* The same with the biaxial mode's strain along y per unit strain along x, F[1][1] = 1 + k e
+** (other modes ignore k). */
+void cf_mode_place_k(cf_mode m, double e, double a, double k, double F[9]);
+
+/* The mode names as a list for messages: "uniaxial, shear, planar, equibiaxial, confined or
+** biaxial". */
+const char *cf_mode_list(void);
 
 #endif

@@ -20,6 +20,29 @@ void cf_table_free(cf_table *m)
     m->count = 0;
 }
 
+double cf_table_biaxial_k(const cf_table *m, size_t i)
+{
+    if (m->mode != CF_MODE_BIAXIAL || !(m->ratio[0] > 0) || !(m->ratio[1] > 0))
+        return 1.0;
+    return i < m->second ? m->ratio[1] / m->ratio[0] : m->ratio[0] / m->ratio[1];
+}
+
+cf_status cf_table_cell_curve(const cf_cell *c, const cf_table *m, double *out, cf_error *err)
+{
+    if (m->mode != CF_MODE_BIAXIAL)
+        return cf_cell_curve(c, m->mode, m->x, m->count, out, err);
+    cf_cell k = *c;
+    cf_cell_state s;
+    for (size_t i = 0; i < m->count; i++) {
+        k.biaxial_k = cf_table_biaxial_k(m, i);
+        cf_status st = cf_cell_mode(&k, m->mode, m->x[i], NULL, &s, err);
+        if (st != CF_OK)
+            return st;
+        out[i] = s.stress_MPa;
+    }
+    return CF_OK;
+}
+
 int cf_table_is_force(const cf_table *m)
 {
     return m->kind == CF_TABLE_FORCE_DISPLACEMENT;

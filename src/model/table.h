@@ -78,6 +78,24 @@ typedef struct cf_table {
     cf_mode mode;          /* test mode (cell.h): the option, else a '# mode: NAME' comment, else
                            ** uniaxial */
     int mode_stated;       /* 1 when the option or the file named the mode */
+    /* A biaxial table (mode CF_MODE_BIAXIAL) holds both loaded directions as one table: rows
+    ** 0 .. second - 1 are the first direction (its strain in x, its stress in y), rows second ..
+    ** count - 1 the second direction at the same load steps (its own strain and stress), so
+    ** count = 2 * second; ratio[0]:ratio[1] is the ratio of the strains (first:second, as its
+    ** '# ratio:' comment states it, on line ratio_line), each row's strain along the other
+    ** direction being its own times ratio[1]/ratio[0] or ratio[0]/ratio[1]. second 0 and ratio
+    ** 0 for every other table. */
+    size_t second;
+    double ratio[2];
+    size_t ratio_line;
+    char x2_column[64];    /* header names of the second direction's strain and stress */
+    char y2_column[64];
+    /* Where the test lies in a fibre frame (f fibre, s sheet, n sheet-normal), from a
+    ** '# plane:' comment or the caller's option: a shear table's "ij" (i the normal of the
+    ** sheared face, j the direction of shear, as Sommer et al. 2015 name their modes), a biaxial
+    ** table's "ij" (the axes of its first and second direction); "" when not stated. */
+    char plane[3];
+    size_t plane_line;     /* the comment's line, 0 when from an option or not stated */
     cf_table_measures measures; /* stress and strain measures as read; x and y hold engineering
                            ** strain and nominal stress after conversion */
     char notes[768];       /* what the reader noticed and a front end should show: one note a
@@ -92,6 +110,16 @@ typedef struct cf_table {
 ** compression flag set as the reader sets it. CF_E_INTERNAL when memory runs out. */
 cf_status cf_table_from_arrays(cf_table_kind kind, size_t count, const double *x, const double *y,
                                const double *w, cf_table *m, cf_error *err);
+
+/* Row i of a biaxial table: the strain along the other in-plane direction per unit of the row's
+** own (ratio[1]/ratio[0] in the first direction, ratio[0]/ratio[1] in the second); 1 for every
+** row of any other table. */
+double cf_table_biaxial_k(const cf_table *m, size_t i);
+
+/* The homogenised cell's stress (MPa, table sign) at every row of m in m's mode: a biaxial
+** table's rows each along their own direction with the other at the ratio (cell.h: the cubic
+** cell's x stands for either direction). Stops at the first failure, as cf_cell_curve. */
+cf_status cf_table_cell_curve(const cf_cell *c, const cf_table *m, double *out, cf_error *err);
 
 /* 1 for a force-displacement table, 0 for stress-strain. */
 int cf_table_is_force(const cf_table *m);

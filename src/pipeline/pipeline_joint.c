@@ -188,6 +188,29 @@ static cf_status with_volume(const cf_table *const *tables, size_t n,
     return st;
 }
 
+/* The Holzapfel-Ogden baselines when a table is biaxial (jointreport.h): the transversely
+** isotropic form, then the full one from it, with a biaxial table's second direction along s and
+** along n. A set the law has no form for, or a fit that finds nothing, is said in r->ho_why. */
+static void ho_baselines(const cf_table *const *tables, size_t n, cf_joint_report *r)
+{
+    int biaxial = 0;
+    for (size_t k = 0; k < n; k++)
+        biaxial |= tables[k]->mode == CF_MODE_BIAXIAL;
+    if (!biaxial || cf_ho_unfit(tables, n, r->ho_why, sizeof r->ho_why))
+        return;
+    cf_error e = {0};
+    for (int c = 0; c < 2; c++) {
+        const char cross = c ? 'n' : 's';
+        if (cf_ho_fit_joint(tables, n, CF_HO_TI, cross, NULL, &r->ho[CF_HO_TI][c], &e) != CF_OK ||
+            cf_ho_fit_joint(tables, n, CF_HO_FULL, cross, &r->ho[CF_HO_TI][c],
+                            &r->ho[CF_HO_FULL][c], &e) != CF_OK) {
+            snprintf(r->ho_why, sizeof r->ho_why, "%s", e.msg);
+            return;
+        }
+    }
+    r->ho_ran = 1;
+}
+
 cf_status cf_pipeline_fit_joint(const cf_table *const *tables, size_t n,
                                 const cf_pipeline_options *opt, cf_joint_report *r,
                                 cf_error *err)
@@ -240,5 +263,6 @@ cf_status cf_pipeline_fit_joint(const cf_table *const *tables, size_t n,
             return st;
         }
     }
+    ho_baselines(tables, n, r);
     return CF_OK;
 }

@@ -16,6 +16,7 @@
 #include "io/fitfile_json.h"
 #include "fit/lawkind.h"
 #include "report/gnuplot.h"
+#include "report/report_baselines.h"
 #include "report/report_json.h"
 #include "report/report_notes.h"
 #include "report/report_words.h"
@@ -446,6 +447,7 @@ char *cf_joint_text(const cf_joint_report *r)
     law_choice_text(o, r);
     pair_choice_text(o, r);
     better_text(o, r);
+    cf_report_ho_text(o, r, cf_joint_better(r));
     if (fclose(o) != 0) {
         free(buf);
         return NULL;
@@ -679,6 +681,9 @@ static json_t *joint_json(const cf_joint_report *r)
         json_array_append_new(tabs, e);
     }
     json_object_set_new(root, "tables", tabs);
+    json_t *ho = cf_report_ho_json(r); /* a set with a biaxial table only */
+    if (ho)
+        json_object_set_new(root, "holzapfel_ogden", ho);
     return root;
 }
 

@@ -10,6 +10,7 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
+#include "fit/holzapfel.h"
 #include "fit/joint.h"
 #include "io/measure.h"
 #include "conifit/output.h"
@@ -41,6 +42,13 @@ typedef struct cf_joint_report {
     cf_joint_law_choice law_choice[2];
     cf_law_kind law;          /* the law asked for (--law) */
     int with_timing;            /* 0: wall times written as 0 */
+    /* The Holzapfel-Ogden baselines (holzapfel.h), fitted when a table is biaxial: ho_ran 1 and
+    ** ho[form][cross] (form CF_HO_FULL, CF_HO_TI; cross 0: a biaxial table's second direction
+    ** along s, 1: along n, where its plane does not say), or ho_why says why not ("" when no
+    ** table is biaxial: nothing is said) */
+    int ho_ran;
+    cf_ho_fit ho[2][2];
+    char ho_why[CF_ERROR_MSG_LEN];
 } cf_joint_report;
 
 /* Releases every fit's curves, the law not kept's too. Safe on a zeroed report. */

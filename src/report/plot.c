@@ -87,8 +87,9 @@ static int target_curve(const cf_fit_report *r, int k, const double *x, size_t c
         return 1;
     cf_cell cell;
     int bad = cf_cell_init(&cell, &law, su->method == CF_LAW_TABLE ? CF_LAW_CLOSED : su->method,
-                           su->cfg.lattice.weight, NULL) != CF_OK ||
-              cf_cell_curve(&cell, r->table->mode, x, count, out, NULL) != CF_OK;
+                           su->cfg.lattice.weight, NULL) != CF_OK;
+    cell.biaxial_k = cf_table_biaxial_k(r->table, 0); /* biaxial: the first direction's curve */
+    bad = bad || cf_cell_curve(&cell, r->table->mode, x, count, out, NULL) != CF_OK;
     cf_law_free(&law);
     return bad;
 }

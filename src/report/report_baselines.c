@@ -75,3 +75,88 @@ json_t *cf_report_baseline_json(const cf_fit_report *r, int k)
     json_object_set_new(o, "aic", cf_json_number(cf_report_baseline_aic(r, k)));
     return o;
 }
+
+/* ---- the Holzapfel-Ogden baselines of a joint fit -------------------------------------------- */
+
+static const char *const ho_names[CF_HO_NP] = {"a", "b", "a_f", "b_f", "a_s", "b_s", "a_fs",
+                                               "b_fs"};
+
+/* One fit's parameters (the a's in the first table's unit) and objective. */
+static void ho_line(FILE *o, const cf_joint_report *r, const cf_ho_fit *h)
+{
+    const cf_table *t0 = r->tables[0];
+    fprintf(o, "    %s (%d):", h->form == CF_HO_TI ? "transversely isotropic" : "full",
+            h->nparams);
+    for (int k = 0; k < CF_HO_NP; k++) {
+        if (h->form == CF_HO_TI && k >= 4)
+            break;
+        if (k % 2)
+            fprintf(o, " %s %.4g%s", ho_names[k], h->p[k], k + 1 < h->nparams ? "," : "");
+        else
+            fprintf(o, " %s %.4g %s,", ho_names[k], h->p[k] * t0->y_to_file, t0->y_unit);
+    }
+    fprintf(o, "; weighted objective %.4g\n      RMSE:", h->objective);
+    for (size_t k = 0; k < h->ntables; k++) {
+        char name[128];
+        cf_table_name(r->tables[k], name, sizeof name);
+        fprintf(o, "%s %s %.4g %s", k ? "," : "", name, h->rmse_MPa[k] * r->tables[k]->y_to_file,
+                r->tables[k]->y_unit);
+    }
+    fprintf(o, "\n");
+}
+
+void cf_report_ho_text(FILE *o, const cf_joint_report *r, int b)
+{
+    if (!r->ho_ran && !r->ho_why[0])
+        return;
+    fprintf(o, "\nHolzapfel-Ogden baselines (Holzapfel & Ogden 2009, incompressible, nominal "
+               "stress; fitted jointly with the lattice's weighted objective)");
+    if (!r->ho_ran) {
+        fprintf(o, ": not fitted: %s\n", r->ho_why);
+        return;
+    }
+    fprintf(o, ":\n");
+    for (int c = 1; c >= 0; c--) {
+        fprintf(o, "  biaxial tables' second direction along %s%s:\n", c ? "n" : "s",
+                c ? " (conifit's choice: the cross-fibre direction of a slab cut in the wall "
+                    "plane is the sheet-normal, as the data's source models it)"
+                  : " (the sheet term then stiffens the cross-fibre direction, which the law "
+                    "has no term for along n)");
+        for (int f = CF_HO_FULL; f <= CF_HO_TI; f++)
+            ho_line(o, r, &r->ho[f][c]);
+    }
+    if (b >= 0 && b < r->nfits)
+        fprintf(o, "  the isotropic lattice (%s): weighted objective %.4g\n",
+                cf_spring_type_name(r->fits[b].fit.type), r->fits[b].objective);
+}
+
+json_t *cf_report_ho_json(const cf_joint_report *r)
+{
+    if (!r->ho_ran)
+        return NULL;
+    json_t *a = json_array();
+    for (int c = 0; a && c < 2; c++)
+        for (int f = CF_HO_FULL; f <= CF_HO_TI; f++) {
+            const cf_ho_fit *h = &r->ho[f][c];
+            json_t *e = json_object(), *p = json_object(), *rm = json_array();
+            if (!e || !p || !rm || json_array_append_new(a, e) != 0) {
+                json_decref(e);
+                json_decref(p);
+                json_decref(rm);
+                json_decref(a);
+                return NULL;
+            }
+            for (int k = 0; k < h->nparams; k++)
+                json_object_set_new(p, k % 2 ? ho_names[k] : ho_names[k],
+                                    cf_json_number(k % 2 ? h->p[k] : h->p[k] * 1e3));
+            for (size_t k = 0; k < h->ntables; k++)
+                json_array_append_new(rm, cf_json_number(h->rmse_MPa[k] * 1e3));
+            json_object_set_new(e, "model", json_string(f == CF_HO_TI ? "holzapfel-ogden-ti"
+                                                                      : "holzapfel-ogden"));
+            json_object_set_new(e, "cross_axis", json_string(c ? "n" : "s"));
+            json_object_set_new(e, "parameters_a_kPa_b_dimensionless", p);
+            json_object_set_new(e, "objective", cf_json_number(h->objective));
+            json_object_set_new(e, "rmse_kPa", rm);
+        }
+    return a;
+}

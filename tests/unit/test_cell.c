@@ -94,7 +94,8 @@ static void small_strain_response_of_every_mode_follows_the_elastic_constants(vo
         cf_cubic_moduli m = cf_cubic_moduli_of(weights[k]);
         const double want[CF_MODE_COUNT] = {
             m.E, m.C44, m.C11 - m.C12 * m.C12 / m.C11,
-            m.C11 + m.C12 - 2 * m.C12 * m.C12 / m.C11, m.C11};
+            m.C11 + m.C12 - 2 * m.C12 * m.C12 / m.C11, m.C11,
+            m.C11 + m.C12 - 2 * m.C12 * m.C12 / m.C11}; /* biaxial at the cell's k = 1 */
         const double e = 1e-7;
         for (int md = 0; md < CF_MODE_COUNT; md++) {
             cf_cell_state s;
@@ -108,7 +109,7 @@ static void small_strain_response_of_every_mode_follows_the_elastic_constants(vo
                 assert_close(s.P_MPa[0][0], 0, 1e-14 * E0);
                 assert_close(s.P_MPa[1][1], 0, 1e-14 * E0);
             }
-            if (md == CF_MODE_PLANAR || md == CF_MODE_EQUIBIAXIAL)
+            if (md == CF_MODE_PLANAR || md == CF_MODE_EQUIBIAXIAL || md == CF_MODE_BIAXIAL)
                 assert_close(s.P_MPa[2][2], 0, 1e-14 * E0);
         }
         if (k == 0)
@@ -384,7 +385,16 @@ static void every_mode_is_one_consistent_row(void **state)
     cf_mode m;
     cf_error err = {0};
     assert_int_equal(cf_mode_parse("torsion", &m, &err), CF_E_DATA);
-    assert_non_null(strstr(err.msg, "expected uniaxial, shear, planar, equibiaxial or confined"));
+    assert_non_null(strstr(err.msg, "expected uniaxial, shear, planar, equibiaxial, confined or "
+                                    "biaxial"));
+    /* the list of the messages names every row, in order */
+    const char *list = cf_mode_list(), *at = list;
+    for (int k = 0; k < CF_MODE_COUNT; k++) {
+        const char *hit = strstr(at, cf_mode_name((cf_mode)k));
+        assert_non_null(hit);
+        at = hit + strlen(cf_mode_name((cf_mode)k));
+    }
+    assert_string_equal(at, "");
 }
 
 int main(void)

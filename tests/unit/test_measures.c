@@ -161,8 +161,11 @@ static void bad_declarations_are_refused_with_the_line(void **state)
     char text[512];
     snprintf(text, sizeof text, "# stress: piola2\nstrain,stress_kPa\n%s", rows);
     load_fails(table("b1.csv", text), &o, ":1:1: unknown stress measure");
+    snprintf(text, sizeof text, "# mode: torsion\nstrain,stress_kPa\n%s", rows);
+    load_fails(table("b2.csv", text), &o, ":1:1: comment 'mode: torsion'");
+    /* a biaxial table without its ratio (the reading itself: tests/unit/test_biaxial.c) */
     snprintf(text, sizeof text, "# mode: biaxial\nstrain,stress_kPa\n%s", rows);
-    load_fails(table("b2.csv", text), &o, "mode: biaxial");
+    load_fails(table("b2b.csv", text), &o, "'# ratio: A:B'");
     snprintf(text, sizeof text, "# stress: cauchy\n# stress: nominal\nstrain,stress_kPa\n%s", rows);
     load_fails(table("b3.csv", text), &o, ":2:1: stress measure declared twice");
     snprintf(text, sizeof text, "# stress: nominal\nstrain,true_stress_kPa\n%s", rows);

@@ -188,6 +188,9 @@ static long double ref_mode(const ref_cell *rc, cf_mode m, long double e)
     case CF_MODE_SHEAR: F[2] = e, si = 0; break;
     case CF_MODE_PLANAR: F[0] = 1 + e, free_i = 8, zero = 2, si = sj = 0; break;
     case CF_MODE_EQUIBIAXIAL: F[0] = F[4] = 1 + e, free_i = 8, zero = 2, si = sj = 0; break;
+    case CF_MODE_BIAXIAL: /* at the ratio the cell is given below, k = 0.6 */
+        F[0] = 1 + e, F[4] = 1 + 0.6L * e, free_i = 8, zero = 2, si = sj = 0;
+        break;
     default: F[8] = 1 + e; break;
     }
     if (free_i >= 0) {
@@ -234,12 +237,13 @@ static void cell_with_the_pair_and_the_volume_term_equals_an_independent_referen
                 cf_cell c;
                 assert_int_equal(cf_cell_init(&c, &comp, ms[mi], w, NULL), CF_OK);
                 c.volume_modulus_MPa = kappas[kk];
+                c.biaxial_k = 0.6;
                 for (int md = 0; md < CF_MODE_COUNT; md++) {
                     /* strains to 0.35 (0.7 of the compression spring's travel, 0.39 and 0.64
                     ** of the extension springs': both past their transitions, inside every
                     ** mode's reach); the points near zero strain are rounding, compared to 1e-2
                     ** of the curve's largest stress */
-                    const double reach = md == CF_MODE_EQUIBIAXIAL ? 0.2 : 0.35; /* its free
+                    const double reach = md == CF_MODE_EQUIBIAXIAL || md == CF_MODE_BIAXIAL ? 0.2 : 0.35; /* free
                     ** stretch grows twice as fast: 0.35 takes the nearly cylindrical extension
                     ** spring to solid */
                     double peak = 0, got[13];
