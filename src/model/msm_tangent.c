@@ -239,7 +239,9 @@ static cf_status build_tangent(solver *s, cf_error *err)
 
 /* The cells' tangent added into v: per cell, the volume term's kappa/H^3 g_a g_b^T + kappa (J - 1)
 ** d2V/dx_a dx_b (W = (kappa/2)(J - 1)^2 H^3, J = V/H^3, g = dV/dx) and the hourglass control's
-** constant k_h coef(a, b) I (lattice_hourglass.h). */
+** constant k_h coef(a, b) I (lattice_hourglass.h). In a homogeneous state (s->homogeneous) every
+** cell has the first one's J, g and d2V/dx2 (they depend on the differences of its corners only),
+** so those are computed once. */
 static void volume_tangent(solver *s, double *v)
 {
     const cf_lattice *lat = s->lat;
@@ -251,10 +253,11 @@ static void volume_tangent(solver *s, double *v)
     for (int a = 0; a < 8; a++)
         for (int b = 0; b < 8; b++)
             hg[a][b] = kh * cf_hourglass_coef(a, b);
+    double g[8][3] = {{0}}, J = 1.0;
     for (size_t c = 0; c < nc; c++) {
         uint32_t node[8];
-        double g[8][3];
-        const double J = kappa != 0 ? cf_lattice_cell_volume(lat, c, node, g, hess) : 1.0;
+        if (kappa != 0 && (c == 0 || !s->homogeneous))
+            J = cf_lattice_cell_volume(lat, c, node, g, hess);
         for (int a = 0; a < 8; a++)
             for (int b = 0; b < 8; b++)
                 for (int i = 0; i < 3; i++)
