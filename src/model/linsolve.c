@@ -196,7 +196,8 @@ int cf_linsolve_chord(cf_linsolve *s, const double *b, double *x, int *fatal, cf
 
 /* The scaled matrix is symmetric and often banded (a lattice's tangent, its nodes numbered layer
 ** by layer: half-bandwidth about 3 (nx + 1)(ny + 1)): a banded LDL^T (GSL) costs n b^2 instead of
-** n^3/3. It does
+** n^3/3; with banded_only (the stability checks' many small tangents) band_ldlt.c's, which gives
+** GSL's factors faster. It does
 ** not pivot, so the solve is accepted only when its residual is small; otherwise the caller falls
 ** back to dense LU or GMRES. Returns 1 when x holds the solution. */
 static int band_direction(cf_linsolve *s, const double *b, double *x)
