@@ -136,32 +136,36 @@ static int check_states(const cf_cell *cell, const cf_table *t, double e[CHECK_S
     return 1;
 }
 
-/* The part of the check for table t (check_states' e, lat and F): part 0 the 2^3 lattice, 1 the
-** cell, 2 the 3^3 lattice (the lattices for a uniaxial table only). 1 stable, 0 not, -1 out of
-** memory. */
-static int check_part(const cf_cell *cell, const cf_msm_config *cfg, const cf_table *t, int part,
-                      const double e[CHECK_STEPS], const double lat[CHECK_STEPS],
-                      double F[CHECK_STEPS][9])
+/* The cell's part of the check for table t (check_states' F): its incremental stiffness positive
+** definite at every strain. 1 stable, 0 not, -1 out of memory. */
+static int cell_part(const cf_cell *cell, double F[CHECK_STEPS][9])
 {
-    if (part == 1) {
-        for (int j = 0; j < CHECK_STEPS; j++) {
-            double lambda = 0;
-            cf_status s = cf_cell_min_stiffness(cell, F[j], &lambda, NULL);
-            if (s == CF_E_INTERNAL)
-                return -1;
-            if (s != CF_OK || !(lambda > 0))
-                return 0;
-        }
-        return 1;
+    for (int j = 0; j < CHECK_STEPS; j++) {
+        double lambda = 0;
+        cf_status s = cf_cell_min_stiffness(cell, F[j], &lambda, NULL);
+        if (s == CF_E_INTERNAL)
+            return -1;
+        if (s != CF_OK || !(lambda > 0))
+            return 0;
     }
-    if (t->mode != CF_MODE_UNIAXIAL)
+    return 1;
+}
+
+/* The lattice of n^3 cells (bottom sliding) at the count homogeneous states (e, lat): free of
+** negative pivots at every one. One lattice and one tangent pattern serve all the uniaxial tables'
+** strains (cf_msm_homogeneous_inertias stops at the first state with a negative pivot). 1 stable,
+** 0 not, -1 out of memory. */
+static int lattice_part(const cf_cell *cell, const cf_msm_config *cfg, int n, const double *e,
+                        const double *lat, size_t count)
+{
+    if (count == 0)
         return 1;
     cf_msm_config k = *cfg;
-    k.lattice.nx = k.lattice.ny = k.lattice.nz = part == 0 ? 2 : 3;
+    k.lattice.nx = k.lattice.ny = k.lattice.nz = n;
     k.lattice.bottom = CF_BOTTOM_AXIAL;
     long neg = -1;
-    cf_status s = cf_msm_homogeneous_inertias(cell->law, CF_LAW_CLOSED, &k, e, lat, CHECK_STEPS,
-                                              &neg, NULL);
+    cf_status s = cf_msm_homogeneous_inertias(cell->law, CF_LAW_CLOSED, &k, e, lat, count, &neg,
+                                              NULL);
     if (s == CF_E_INTERNAL)
         return -1;
     return s == CF_OK && neg == 0;
@@ -169,24 +173,31 @@ static int check_part(const cf_cell *cell, const cf_msm_config *cfg, const cf_ta
 
 /* The check on the n tables, part after part over all of them (the 2^3 lattice, the most slender
 ** and the first to buckle, then the cell, then the 3^3 lattice), so a point that fails usually
-** fails at the first part; the verdict is the same in any order. */
+** fails at the first part; the verdict is the same in any order. Each lattice part takes the
+** uniaxial tables' strains in table order, each table's farthest first. */
 static int tables_stable(const cf_cell *cell, const cf_msm_config *cfg, const cf_table *const *t,
                          size_t n)
 {
     double e[CF_JOINT_MAX][CHECK_STEPS], lat[CF_JOINT_MAX][CHECK_STEPS];
     double F[CF_JOINT_MAX][CHECK_STEPS][9];
-    for (size_t k = 0; k < n && k < CF_JOINT_MAX; k++)
-        if (table_reach(t[k]) != 0 && !check_states(cell, t[k], e[k], lat[k], F[k]))
+    double ue[CF_JOINT_MAX * CHECK_STEPS] = {0}, ulat[CF_JOINT_MAX * CHECK_STEPS] = {0};
+    size_t nu = 0;
+    for (size_t k = 0; k < n && k < CF_JOINT_MAX; k++) {
+        if (table_reach(t[k]) == 0)
+            continue;
+        if (!check_states(cell, t[k], e[k], lat[k], F[k]))
             return 0;
-    for (int part = 0; part < 3; part++)
-        for (size_t k = 0; k < n && k < CF_JOINT_MAX; k++) {
-            if (table_reach(t[k]) == 0)
-                continue;
-            const int r = check_part(cell, cfg, t[k], part, e[k], lat[k], F[k]);
-            if (r != 1)
-                return r;
-        }
-    return 1;
+        if (t[k]->mode != CF_MODE_UNIAXIAL)
+            continue;
+        memcpy(ue + nu, e[k], sizeof e[k]);
+        memcpy(ulat + nu, lat[k], sizeof lat[k]);
+        nu += CHECK_STEPS;
+    }
+    int r = lattice_part(cell, cfg, 2, ue, ulat, nu);
+    for (size_t k = 0; r == 1 && k < n && k < CF_JOINT_MAX; k++)
+        if (table_reach(t[k]) != 0)
+            r = cell_part(cell, F[k]);
+    return r == 1 ? lattice_part(cell, cfg, 3, ue, ulat, nu) : r;
 }
 
 static int table_stable(const cf_cell *cell, const cf_msm_config *cfg, const cf_table *t)

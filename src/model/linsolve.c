@@ -5,6 +5,8 @@
 */
 #include "model/linsolve_internal.h"
 
+#include "model/band_ldlt.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -201,7 +203,8 @@ int cf_linsolve_chord(cf_linsolve *s, const double *b, double *x, int *fatal, cf
 
 /* The scaled matrix is symmetric and often banded (a lattice's tangent, its nodes numbered layer
 ** by layer: half-bandwidth about 3 (nx + 1)(ny + 1)): a banded LDL^T (GSL) costs n b^2 instead of
-** n^3/3. It does
+** n^3/3; with banded_only (the stability checks' many small tangents) band_ldlt.c's, which gives
+** GSL's factors faster. It does
 ** not pivot, so the solve is accepted only when its residual is small; otherwise the caller falls
 ** back to dense LU or GMRES. Returns 1 when x holds the solution. */
 static int band_direction(cf_linsolve *s, const double *b, double *x)
@@ -212,24 +215,32 @@ static int band_direction(cf_linsolve *s, const double *b, double *x)
         return 0;
     if (!s->AB && !(s->AB = gsl_matrix_alloc(n, bw + 1)))
         return 0;
-    gsl_matrix_set_zero(s->AB);
+    double *ab = s->AB->data; /* AB(j, i - j) = A(i, j), rows of bw + 1 (band_ldlt.h) */
+    memset(ab, 0, n * (bw + 1) * sizeof(double));
     for (size_t col = 0; col < n; col++)
         for (int k = C->p[col]; k < C->p[col + 1]; k++) {
             size_t row = (size_t)C->i[k];
             if (row >= col)
-                gsl_matrix_set(s->AB, col, row - col, C->data[k]); /* AB(j, i - j) = A(i, j) */
+                ab[col * (bw + 1) + row - col] = C->data[k];
         }
     gsl_vector *rhs = gsl_vector_alloc(n), *xv = gsl_vector_alloc(n), *r = gsl_vector_alloc(n);
     int ok = rhs && xv && r;
+    long neg = 0; /* the inertia from D, the first column of the decomposed band */
     if (ok) {
         for (size_t e = 0; e < n; e++)
             gsl_vector_set(rhs, e, b[e] / s->D[e]);
-        ok = gsl_linalg_ldlt_band_decomp(s->AB) == GSL_SUCCESS &&
-             gsl_linalg_ldlt_band_solve(s->AB, rhs, xv) == GSL_SUCCESS;
+        if (s->banded_only) { /* the stability checks' many small tangents (band_ldlt.h) */
+            ok = cf_band_ldlt_factor(ab, n, bw, &neg) == 0;
+            gsl_vector_memcpy(xv, rhs);
+            if (ok)
+                cf_band_ldlt_solve(ab, n, bw, xv->data);
+        } else {
+            ok = gsl_linalg_ldlt_band_decomp(s->AB) == GSL_SUCCESS &&
+                 gsl_linalg_ldlt_band_solve(s->AB, rhs, xv) == GSL_SUCCESS;
+            for (size_t e = 0; ok && e < n; e++)
+                neg += ab[e * (bw + 1)] < 0;
+        }
     }
-    long neg = 0; /* the inertia from D, the first column of the decomposed band */
-    for (size_t e = 0; ok && e < n; e++)
-        neg += gsl_matrix_get(s->AB, e, 0) < 0;
     if (ok) { /* residual check: r = rhs - C x */
         gsl_vector_memcpy(r, rhs);
         ok = gsl_spblas_dgemv(CblasNoTrans, -1.0, C, xv, 1.0, r) == GSL_SUCCESS &&

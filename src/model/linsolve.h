@@ -33,7 +33,8 @@ typedef void cf_linsolve_fill(void *ctx, double *v);
 /* A solver for n x n symmetric matrices with the compressed-column pattern colp[n + 1],
 ** rowi[colp[n]] (both triangles present, the rows within a column increasing, every diagonal
 ** entry present); both arrays are copied. fill(ctx, v) assembles the matrix; ctx must outlive the
-** solver. banded_only skips the sparse factorisation. CF_E_INTERNAL when out of memory. */
+** solver. banded_only skips the sparse factorisation (the band's is then band_ldlt.h's).
+** CF_E_INTERNAL when out of memory. */
 cf_status cf_linsolve_create(cf_linsolve **out, size_t n, const int *colp, const int *rowi,
                              cf_linsolve_fill *fill, void *ctx, int banded_only, cf_error *err);
 void cf_linsolve_free(cf_linsolve *ls);

@@ -61,6 +61,8 @@ typedef struct solver {
     double *xprev, *xcur;
     double load;              /* current drive value: strain or stress, MPa */
     int extras;               /* quasi-static extras active */
+    int homogeneous;          /* every cell deformed alike (cf_msm_homogeneous_inertias): the
+                                 volume term's tangent is computed at the first cell only */
     cf_msm_stats *st;
 } solver;
 

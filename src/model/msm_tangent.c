@@ -239,7 +239,9 @@ static cf_status build_tangent(solver *s, cf_error *err)
 
 /* The cells' tangent added into v: per cell, the volume term's kappa/H^3 g_a g_b^T + kappa (J - 1)
 ** d2V/dx_a dx_b (W = (kappa/2)(J - 1)^2 H^3, J = V/H^3, g = dV/dx) and the hourglass control's
-** constant k_h coef(a, b) I (lattice_hourglass.h). */
+** constant k_h coef(a, b) I (lattice_hourglass.h). In a homogeneous state (s->homogeneous) every
+** cell has the first one's J, g and d2V/dx2 (they depend on the differences of its corners only),
+** so its block is computed once (the same operations, so the same values as each cell's own). */
 static void volume_tangent(solver *s, double *v)
 {
     const cf_lattice *lat = s->lat;
@@ -247,28 +249,34 @@ static void volume_tangent(solver *s, double *v)
     const double kh = lat->hg_k_N_per_mm;
     const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
     double hess[8][8][3][3]; /* 4.6 kB */
-    double hg[8][8];
+    double hg[8][8], blk[8][8][9];
     for (int a = 0; a < 8; a++)
         for (int b = 0; b < 8; b++)
             hg[a][b] = kh * cf_hourglass_coef(a, b);
+    double g[8][3] = {{0}}, J = 1.0;
     for (size_t c = 0; c < nc; c++) {
         uint32_t node[8];
-        double g[8][3];
-        const double J = kappa != 0 ? cf_lattice_cell_volume(lat, c, node, g, hess) : 1.0;
-        for (int a = 0; a < 8; a++)
+        const int fresh = c == 0 || !s->homogeneous;
+        if (kappa != 0 && fresh)
+            J = cf_lattice_cell_volume(lat, c, node, g, hess);
+        for (int a = 0; kappa != 0 && fresh && a < 8; a++)
             for (int b = 0; b < 8; b++)
                 for (int i = 0; i < 3; i++)
-                    for (int k = 0; k < 3; k++) {
-                        const int at =
-                            s->vmap[((c * 8 + (size_t)a) * 8 + (size_t)b) * 9 + (size_t)(i * 3 + k)];
-                        if (at < 0)
-                            continue;
-                        if (kappa != 0)
-                            v[at] += kappa / V0 * g[a][i] * g[b][k] +
-                                     kappa * (J - 1) * hess[a][b][i][k];
-                        if (i == k)
-                            v[at] += hg[a][b];
-                    }
+                    for (int k = 0; k < 3; k++)
+                        blk[a][b][i * 3 + k] = kappa / V0 * g[a][i] * g[b][k] +
+                                               kappa * (J - 1) * hess[a][b][i][k];
+        const int *vm = s->vmap + c * 8 * 8 * 9;
+        for (int a = 0; a < 8; a++)
+            for (int b = 0; b < 8; b++)
+                for (int e = 0; e < 9; e++) {
+                    const int at = vm[(a * 8 + b) * 9 + e];
+                    if (at < 0)
+                        continue;
+                    if (kappa != 0)
+                        v[at] += blk[a][b][e];
+                    if (e % 4 == 0) /* i == k */
+                        v[at] += hg[a][b];
+                }
     }
 }
 

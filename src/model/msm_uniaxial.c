@@ -235,6 +235,7 @@ cf_status cf_msm_homogeneous_inertias(const cf_law *law, cf_law_method m,
     cf_status rc = static_open(law, m, &cfg, &lat, &s, &st, err);
     if (rc != CF_OK)
         return rc;
+    s.homogeneous = 1;
     for (size_t q = 0; q < count && rc == CF_OK; q++) {
         const double strain = strains[q], lateral = laterals[q];
         /* F = diag(a, a, 1 + strain) about the pinned corner (the origin) */
