@@ -21,6 +21,7 @@
 
 typedef struct run {
     cf_law law;
+    cf_law ext;          /* a double-acting element's extension spring (law.extension) */
     cf_mesh mesh;
     cf_body body;
     size_t steps;
@@ -47,6 +48,7 @@ static void run_free(run *r)
     cf_body_free(&r->body);
     cf_mesh_free(&r->mesh);
     cf_law_free(&r->law);
+    cf_law_free(&r->ext);
     free(r->xs);
     free(r->step);
     free(r->presc);
@@ -62,14 +64,14 @@ static void run_free(run *r)
 }
 
 cf_status cf_cli_body_load(const cf_scene *sc, const cf_budget *budget, double node_bytes,
-                           cf_law *law, cf_mesh *mesh, cf_mesh_surface_info *surface,
-                           cf_error *err)
+                           cf_law *law, cf_law *ext, cf_mesh *mesh,
+                           cf_mesh_surface_info *surface, cf_error *err)
 {
     cf_status st;
     cf_mesh_surface_info unused;
-    if ((st = cf_law_init(law, &sc->spring, err)) != CF_OK ||
-        (sc->method == CF_LAW_TABLE &&
-         (st = cf_law_table_build(law, sc->table_intervals, err)) != CF_OK))
+    /* the law as a lattice scene's (with its table, and a double-acting element's extension
+    ** spring joined to it) */
+    if ((st = cf_scene_law(sc, law, ext, err)) != CF_OK)
         return st;
     cf_mesh_limits lim = cf_mesh_limits_default();
     lim.max_bytes = budget->max_memory_bytes;
@@ -269,8 +271,8 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
                        cf_error *err)
 {
     cf_status st;
-    if ((st = cf_cli_body_load(sc, budget, body_node_bytes(sc, r->keep_forces), &r->law, &r->mesh,
-                               &r->surface, err)) != CF_OK)
+    if ((st = cf_cli_body_load(sc, budget, body_node_bytes(sc, r->keep_forces), &r->law, &r->ext,
+                               &r->mesh, &r->surface, err)) != CF_OK)
         return st;
     const size_t steps = r->steps = (size_t)sc->body_steps;
     if (sc->body_dynamic && (st = dynamic_budget(sc, scene_path, budget, r->mesh.nn, err)))
@@ -495,6 +497,47 @@ static double total_mass(const run *r)
     return m;
 }
 
+/* A static run's stability: each step's equilibrium stable when the last stiffness matrix its
+** solve factored has no negative eigenvalue (cf_body_step.neg_pivots). A dynamic step's matrix
+** holds the masses, so it says nothing of the equilibrium: no line. */
+static void stability(FILE *o, const cf_scene *sc, const run *r)
+{
+    if (sc->body_dynamic)
+        return;
+    size_t stable = 0, unknown = 0, first = 0;
+    for (size_t k = 1; k <= r->steps; k++) {
+        const long neg = r->step[k].neg_pivots;
+        stable += neg == 0;
+        unknown += neg < 0;
+        if (neg > 0 && !first)
+            first = k;
+    }
+    fprintf(o, "stability: %zu of %zu steps a stable equilibrium (no negative eigenvalue of the "
+               "stiffness matrix)", stable, r->steps);
+    if (first)
+        fprintf(o, "; unstable from step %zu (%s %g%s): %ld negative eigenvalues, the body can "
+                   "buckle or snap through there",
+                first, sc->has_probe ? "depth" : "load factor", r->step[first].depth_mm,
+                sc->has_probe ? " mm" : "", r->step[first].neg_pivots);
+    if (unknown)
+        fprintf(o, "; %zu steps not checked (no stiffness matrix factored)", unknown);
+    fprintf(o, "\n");
+}
+
+/* A double-acting element: which spring each side takes, and the shear modulus the extension
+** spring gives (the body's E and nu are the compression spring's, cf_body_mu_of_law). */
+static void pair_line(FILE *o, const run *r)
+{
+    const cf_law *law = &r->law, *ext = law->extension;
+    if (!ext)
+        return;
+    fprintf(o, "double-acting element: edges in compression take the spring (k0 %.6g N/mm), "
+               "edges in extension the extension spring (k0 %.6g N/mm, shear modulus %.6g kPa "
+               "in extension; E and nu above are in compression)\n",
+            law->k0_N_per_mm, ext->k0_N_per_mm,
+            r->body.mu_MPa * ext->k0_N_per_mm / law->k0_N_per_mm * 1e3);
+}
+
 static void summary(FILE *o, const cf_scene *sc, const run *r)
 {
     const cf_body *b = &r->body;
@@ -511,6 +554,7 @@ static void summary(FILE *o, const cf_scene *sc, const run *r)
     fprintf(o, "body: E = %.6g kPa, nu = %.6g (shear modulus %.6g kPa from the spring, volume "
                "modulus %.6g kPa)\n",
             b->E_MPa * 1e3, b->nu, b->mu_MPa * 1e3, b->kappa_MPa * 1e3);
+    pair_line(o, r);
     if (sc->body_element_size_mm > 0) {
         const cf_mesh_surface_info *si = &r->surface;
         double V = 0;
@@ -644,8 +688,10 @@ int cf_cli_simulate_body(const cf_scene *sc, const char *scene_path, const char 
         rc = cf_cli_fail(&err);
         goto end;
     }
-    if (!quiet)
+    if (!quiet) {
         summary(csv.to_stdout ? stderr : stdout, sc, &r);
+        stability(csv.to_stdout ? stderr : stdout, sc, &r);
+    }
 end:
     cf_cli_out_abort(&csv);
     cf_atomic_abort(&plot);

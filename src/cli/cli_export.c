@@ -251,6 +251,34 @@ static cf_status static_run_fits(const char *name, const cf_export_lattice *lx,
                         name, steps, each, b->max_steps, b->max_work, fits);
 }
 
+/* A body scene's model into q->body_buf: the body solved with the fit file's element (a
+** double-acting one's extension spring too, never its compression spring alone) as simulate
+** solves it; a lattice's volume term is not a body's (scene_body.c). */
+static cf_status body_model(export_request *q, const cf_fitted_spring *fs, cf_scene *sc,
+                            cf_error *err)
+{
+    if (fs->volume_modulus_MPa > 0)
+        return cf_error_set(err, CF_E_DATA, "%s: a body's export: %s holds a lattice volume "
+                            "term (volume_modulus_MPa = %g, the cubic lattice's), which is not "
+                            "built for bodies; a body takes its volume term from 'body'",
+                            q->scene_path, q->fit_path, fs->volume_modulus_MPa);
+    sc->spring = fs->params;
+    sc->extension = fs->extension;
+    sc->has_extension = fs->has_extension;
+    FILE *mem = open_memstream(&q->body_buf, &q->body_len);
+    if (!mem)
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory");
+    cf_export_options opt = q->ea.opt;
+    opt.source = cf_cli_is_stdio(q->fit_path) ? "(standard input)" : q->fit_path;
+    opt.output = q->out_path && !cf_cli_is_stdio(q->out_path) ? q->out_path : NULL;
+    opt.auto_tol = !q->ea.tol_given;
+    cf_status st = cf_cli_body_export(sc, q->scene_path, &q->ea.budget, mem, &opt, &q->body_rep,
+                                      err);
+    if (fclose(mem) != 0 && st == CF_OK)
+        st = cf_error_set(err, CF_E_INTERNAL, "out of memory");
+    return st;
+}
+
 /* The lattice to export: the scene's (the fit file it names into q->scene_fit), or the
 ** validation's default for the spring. */
 static cf_status lattice_of(export_request *q, const cf_fitted_spring *fs,
@@ -264,22 +292,7 @@ static cf_status lattice_of(export_request *q, const cf_fitted_spring *fs,
             return st;
         snprintf(q->scene_fit, sizeof q->scene_fit, "%s", sc.fit_path);
         if (sc.has_body) {
-            /* a body: solved with the fit file's spring as simulate solves it, its model
-            ** rendered now */
-            sc.spring = fs->params;
-            FILE *mem = open_memstream(&q->body_buf, &q->body_len);
-            if (!mem)
-                st = cf_error_set(err, CF_E_INTERNAL, "out of memory");
-            else {
-                cf_export_options opt = q->ea.opt;
-                opt.source = cf_cli_is_stdio(q->fit_path) ? "(standard input)" : q->fit_path;
-                opt.output = q->out_path && !cf_cli_is_stdio(q->out_path) ? q->out_path : NULL;
-                opt.auto_tol = !q->ea.tol_given;
-                st = cf_cli_body_export(&sc, scene_path, &q->ea.budget, mem, &opt, &q->body_rep,
-                                        err);
-                if (fclose(mem) != 0 && st == CF_OK)
-                    st = cf_error_set(err, CF_E_INTERNAL, "out of memory");
-            }
+            st = body_model(q, fs, &sc, err);
             q->body = 1;
             cf_scene_free(&sc);
             return st;

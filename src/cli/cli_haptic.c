@@ -23,6 +23,7 @@
 
 typedef struct haptic_run {
     cf_law law;
+    cf_law ext; /* unused: the scene refuses a double-acting element with a haptic loop */
     cf_mesh mesh;
     cf_body body, still;  /* the haptic loop's body, and one solved statically for comparison */
     size_t nfixed;
@@ -39,6 +40,7 @@ static void haptic_free(haptic_run *r)
     cf_body_free(&r->still);
     cf_mesh_free(&r->mesh);
     cf_law_free(&r->law);
+    cf_law_free(&r->ext);
     free(r->t_ms);
     free(r->depth_mm);
     free(r->force_N);
@@ -120,7 +122,7 @@ static cf_status run(const cf_scene *sc, const char *scene_path, const cf_budget
                             scene_path, r->n, T, budget->max_steps);
     /* per node: two bodies as the static run counts one, and the kept columns (below) */
     if ((st = cf_cli_body_load(sc, budget, 2 * 3 * (81.0 * 16 * 8 + 40.0 * 81 * 8) + 9 * 1000 * 8,
-                               &r->law, &r->mesh, NULL, err)) != CF_OK)
+                               &r->law, &r->ext, &r->mesh, NULL, err)) != CF_OK)
         return st;
     /* memory: two bodies (the loop's and the static one) as the static run estimates one, the
     ** loop's kept columns of the inverse (9 nn per node that touches the probe, at most all of

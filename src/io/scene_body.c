@@ -446,12 +446,17 @@ cf_status cf_scene_body(ctx *c, json_t *root, cf_scene *sc)
                 json_object_get(root, "loaded") || json_object_get(root, "probe")))
         return cf_error_set(c->err, CF_E_DATA, "%s: keys 'fixed', 'displaced', 'loaded' and "
                             "'probe' need a 'body'", c->name);
-    if (bd && (sc->has_extension || (c->from_fit && c->fit.volume_modulus_MPa > 0)))
+    /* a double-acting element (the fit's or 'spring_extension') runs in a body: its edges close
+    ** under compression on the spring and under extension on the extension spring; the fit's
+    ** volume term is the cubic lattice's, calibrated on its cell, not a body's */
+    if (bd && c->from_fit && c->fit.volume_modulus_MPa > 0)
         return cf_error_set(c->err, CF_E_DATA,
-                            "%s: key 'body': a body's edges take one spring law and its volume "
-                            "term from 'body'; %s is not built for bodies",
-                            c->name, sc->has_extension ? "a double-acting element"
-                                                       : "the fit's lattice volume term");
+                            "%s: key 'body': 'spring.fit' = '%s' holds a lattice volume term "
+                            "(volume_modulus_MPa = %g, calibrated on the cubic lattice's cell), "
+                            "which is not built for bodies; a body takes its volume term from "
+                            "'body.poisson_ratio' or 'body.volume_modulus_MPa' (a fit without "
+                            "one: no --volume, --volume-modulus or --poisson)",
+                            c->name, sc->fit_path, c->fit.volume_modulus_MPa);
     return bd ? body_sections(c, root, bd, sc) : CF_OK;
 }
 
@@ -481,6 +486,12 @@ cf_status cf_scene_body_dynamics(ctx *c, json_t *root, cf_scene *sc)
     if ((st = body_effects_refused(c, root)))
         return st;
     sc->body_dynamic = sc->effects.inertia;
+    if (sc->has_extension && (sc->body_dynamic || sc->haptic_n))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s': a body with a double-acting "
+                            "element (an extension spring) runs static steps only (a probe or "
+                            "loaded regions); its %s is not built", c->name,
+                            sc->haptic_n ? "haptic" : "effects.inertia",
+                            sc->haptic_n ? "haptic loop" : "dynamic run");
     if (!sc->body_dynamic) {
         for (int k = 0; k < 4; k++)
             if (json_object_get(bd, dyn[k]))
