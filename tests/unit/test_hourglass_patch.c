@@ -10,7 +10,7 @@
 ** not a rigid punch; the rest of the top is free), ramped in 40 static steps to 2.394 N:
 **  - the control stiffens the patch: its force at 5 % of the height (mean indentation of the
 **    patch nodes) rises with the fraction, by 0.3 to 1.5 % at 0.1 and 2 to 5 % at 0.5 (measured
-**    0.66 % and 3.14 %);
+**    0.64 % and 3.10 % with these 40 steps);
 **  - without it the lattice loses stability inside the run (measured: from 10.9 % indentation,
 **    2.05 N; a spring reaches solid at 11.9 %), with the default 0.5 every step is stable.
 */
