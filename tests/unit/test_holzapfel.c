@@ -27,7 +27,7 @@ static const double p_true[CF_HO_NP] = {5e-4, 5, 2e-3, 20, 1e-3, 10, 5e-4, 8};
 ** its plane pl ("" for none), stresses from p (NULL: zero). */
 static cf_table biaxial(double r0, double r1, const char *pl, const double *p, size_t n)
 {
-    double x[64], y[64] = {0};
+    double x[64] = {0}, y[64] = {0};
     const double m = fmax(r0, r1);
     for (size_t i = 0; i < n; i++) {
         x[i] = 0.1 * r0 / m * (double)i / (double)(n - 1);
@@ -49,7 +49,7 @@ static cf_table biaxial(double r0, double r1, const char *pl, const double *p, s
 
 static cf_table shear(const char *pl, const double *p, size_t n)
 {
-    double x[64], y[64] = {0};
+    double x[64] = {0}, y[64] = {0};
     for (size_t i = 0; i < n; i++)
         x[i] = 0.5 * (double)i / (double)(n - 1);
     cf_table t;
