@@ -14,10 +14,6 @@ cd "$(dirname "$0")/.." || exit 70
 # users. Remove a line when its include goes.
 known='
 src/io/scene_haptic.h io/scene.h
-src/io/columns.h io/measure.h
-src/io/measures.h io/measure.h
-src/io/measures.h io/columns.h
-src/io/reader.h io/measure.h
 src/io/surface.h io/mesh.h
 src/io/surface_geom.h io/surface.h
 src/report/report_baselines.h report/report.h
