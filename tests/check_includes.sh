@@ -16,8 +16,6 @@ known='
 src/io/scene_haptic.h io/scene.h
 src/io/surface.h io/mesh.h
 src/io/surface_geom.h io/surface.h
-src/report/report_baselines.h report/report.h
-src/report/report_words.h report/report.h
 src/export/export_model.h export/export.h
 '
 
