@@ -8,35 +8,13 @@
 # Usage: tests/check_includes.sh (from anywhere; reads src/).
 cd "$(dirname "$0")/.." || exit 70
 
-# Includes that still close a circle (issue 44, item 5), each "FILE HEADER": reported on every
-# run, not failed on; any other circle fails. The first four are in files other work was changing
-# when this list was written; the rest wait for their types to move out of the header of their
-# users. Remove a line when its include goes.
-known='
-src/model/law.c model/law_simd.h
-src/model/cell.c model/mode.h
-src/model/lattice.c model/lattice_step.h
-src/model/msm_tangent.c model/msm_internal.h
-src/io/scene_haptic.h io/scene.h
-src/io/columns.h io/measure.h
-src/io/measures.h io/measure.h
-src/io/measures.h io/columns.h
-src/io/reader.h io/measure.h
-src/io/surface.h io/mesh.h
-src/io/surface_geom.h io/surface.h
-src/report/report_baselines.h report/report.h
-src/report/report_words.h report/report.h
-src/export/export_model.h export/export.h
-'
-
 # One line per file ("F FILE"), then one per include ("I FILE HEADER"); awk maps each to modules.
 files=$(find src -name '*.[ch]' | sort)
 {
   for f in $files; do echo "F $f"; done
   grep -H '^[[:space:]]*#[[:space:]]*include[[:space:]]*"' $files |
     sed -n 's/^\([^:]*\):[[:space:]]*#[[:space:]]*include[[:space:]]*"\([^"]*\)".*/I \1 \2/p'
-} | awk -v known="$known" '
-  BEGIN { nk = split(known, kl, "\n"); for (i = 1; i <= nk; i++) if (kl[i] != "") isknown[kl[i]] = 1 }
+} | awk '
   $1 == "F" { exists[$2] = 1; if ($2 ~ /\.c$/) { b = $2; sub(/^.*\//, "", b); csrc[b] = $2 } next }
   {
     f = $2; inc = $3
@@ -46,7 +24,6 @@ files=$(find src -name '*.[ch]' | sort)
     if (!(t in exists)) next # check_layers.sh reports it
     from = module(f); to = module(t)
     if (from == to) next
-    if ((f " " inc) in isknown) { nknown++; kn[nknown] = f " includes \"" inc "\" (" from " -> " to ")"; next }
     if (!((from, to) in edge)) { edge[from, to] = f " includes \"" inc "\""; adj[from] = adj[from] " " to; v[from]; v[to] }
   }
   function module(p,    n) {
@@ -64,8 +41,7 @@ files=$(find src -name '*.[ch]' | sort)
     for (x in v) order[++n] = x
     for (i = 2; i <= n; i++) { x = order[i]; for (j = i - 1; j >= 1 && order[j] > x; j--) order[j + 1] = order[j]; order[j + 1] = x }
     for (i = 1; i <= n; i++) if (state[order[i]] == 0) visit(order[i], 0)
-    for (i = 1; i <= nknown; i++) print "check_includes: known, to be removed: " kn[i]
-    if (!bad) print "check_includes: no include circle between modules (" n " modules) but the " nknown " known"
+    if (!bad) print "check_includes: no include circle between modules (" n " modules)"
     exit bad
   }
   function visit(x, depth,    m, a, k, w, j, msg) {

@@ -12,6 +12,7 @@
 #include "cli/cli_summary.h"
 #include "model/calibration.h"
 #include "fit/fit.h"
+#include "io/measures.h"
 #include "conifit/spring.h"
 #include "report/plot.h"
 

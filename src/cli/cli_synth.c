@@ -15,6 +15,7 @@
 
 #include "cli/cli.h"
 #include "io/measure.h"
+#include "io/columns.h"
 
 static const char synth_help[] =
     "usage: conifit synth SPRING [--strain-max E] [--points N] [--noise REL] [--seed S]\n"

@@ -16,7 +16,7 @@
 #include "conifit/version.h"
 #include "base/safetext.h"
 #include "io/fitfile_json.h"
-#include "export/export_model.h"
+#include "export/export_internal.h"
 
 cf_export_options cf_export_default_options(void)
 {

@@ -2,18 +2,7 @@
 ** Export of a fitted conical spring, or of the whole calibrated lattice it was validated in, to
 ** other simulators: the law as a force-displacement table, written in each target's own
 ** conventions and units, either as a block to paste into a model or as a model that runs as it is.
-**
-** The table (src/report/export_table.c). Rows run over a range of compressions u (mm), by default
-** from full stretch to just before solid, with rows always at 0, +-u_T and the two ends. The
-** tolerance is a fraction of the solid load: everywhere in the range
-**     |F_table(u) - F(u)| <= tol * F_C.
-** Nodes are placed by equidistributing the interpolation error (density ~ |F''|^(1/2)), interior
-** values are moved by half the local interpolation error (a best approximation rather than the
-** interpolant), and the achieved error is measured on a dense grid that knows nothing of the rows
-** (uniform in u, and uniform in sqrt(1 - |u|/s), which crowds towards solid). Near solid the
-** stiffness grows like (s - u)^(-1/2), so the full range stops at u_end, where the law carries
-** F_C (1 - tol): a simulator that holds the last force beyond it (CalculiX, FEBio CONSTANT) is
-** within tol F_C of the law up to solid.
+** The law's table is in export_table.h, the formats as a type in export_types.h.
 **
 ** Sign conventions: conifit's u > 0 compresses and F has the sign of u. CalculiX, Abaqus,
 ** FEBio, LS-DYNA and SOFA take tension positive, so their tables hold elongation = -u (mm) and
@@ -26,42 +15,12 @@
 #include <stdio.h>
 
 #include "conifit/error.h"
+#include "export/export_table.h"
+#include "export/export_types.h"
 #include "io/fitfile.h"
 #include "model/law_internal.h"
 #include "model/msm.h"
 #include "io/scene.h"
-
-/* Default tolerance of the table (fraction of F_C), and the range accepted. Below 1e-9 the rows
-** near solid would have to be closer than the spacing of doubles allows. */
-#define CF_EXPORT_TOL_DEFAULT 1e-4
-#define CF_EXPORT_TOL_MIN 1e-9
-#define CF_EXPORT_TOL_MAX 0.1
-/* CalculiX copies a nonlinear spring's curve into a fixed local array of 200 (elongation, force)
-** pairs with the pair count stored right after it (plconloc(802) in ccx's materialdata_sp.f);
-** a longer table is read without a message and corrupts that count, which perturbs the whole
-** curve. Exports for CalculiX (and Abaqus, so that the same file runs in both) keep to 200. */
-#define CF_EXPORT_CALCULIX_MAX_ROWS 200
-/* LS-DYNA rediscretizes every *DEFINE_CURVE to LCINT equally spaced points, 100 unless the
-** curve's LCINT says otherwise (LSTC FAQ "discretization of curves"; *DEFINE_CURVE, remark 1), so
-** its curves are written evenly spaced with LCINT = rows: the rediscretization then returns the
-** rows themselves. An even table cannot follow the law's stiffening near solid with few rows
-** (its curvature grows like (1 - F/F_C)^-3), so it has at most this many rows and its range stops
-** where they meet the tolerance. */
-#define CF_EXPORT_LSDYNA_MAX_ROWS 10000
-
-/* The export formats. What each is and what writes it is held in one registry (src/report/export.c):
-** a new format is a value here and an entry there; the command line builds its help, its
-** --format check and its messages from the registry. */
-typedef enum cf_export_format {
-    CF_EXPORT_JSON = 0,
-    CF_EXPORT_CSV,
-    CF_EXPORT_CALCULIX,
-    CF_EXPORT_ABAQUS,
-    CF_EXPORT_FEBIO,
-    CF_EXPORT_LSDYNA,
-    CF_EXPORT_SOFA,
-    CF_EXPORT_FORMAT_COUNT
-} cf_export_format;
 
 /* One entry of the registry, as callers see it. */
 typedef struct cf_export_format_info {
@@ -93,52 +52,6 @@ const char *cf_export_format_name(cf_export_format format);
 /* Writes the names of the formats (all, or only those that write models) into buf as an English
 ** list, "a, b or c"; returns buf (truncated to cap). */
 const char *cf_export_format_list(char *buf, size_t cap, int models_only);
-
-/* A force-displacement table of the law, rows ascending in u. */
-typedef struct cf_export_table {
-    size_t rows;
-    double *u_mm;        /* compression of each row, mm (ascending) */
-    double *F_N;         /* force of the table at u, N (within tol F_C of the law) */
-    double *k_N_per_mm;  /* tangent stiffness of the law at u, N/mm */
-    double tol;          /* requested tolerance, fraction of F_C */
-    double u_lo_mm;      /* first row (<= 0: the largest stretch), mm */
-    double u_hi_mm;      /* last row (>= 0: the largest compression), mm */
-    double max_err_rel;  /* achieved maximum |F_table - F| / F_C over [u_lo, u_hi] */
-    double max_err_N;    /* the same in N */
-    double max_err_u_mm; /* where it occurs, mm */
-    int even;            /* 1: rows evenly spaced in u (cf_export_table_build_even) */
-    double req_lo_mm, req_hi_mm; /* the range asked for, mm; an even table's [u_lo, u_hi] may be
-                         ** shorter (where its rows meet the tolerance) */
-} cf_export_table;
-
-/* Where the full-range table ends: the compression (mm) at which the law carries F_C (1 - tol);
-** with a cylindrical tail F_solid - tol F_C, in the tail's straight region 3. */
-double cf_export_table_end(const cf_law *law, double tol);
-
-/* Samples the law into t over [-u_end, u_end] (see the top of this file). CF_E_DATA for a
-** tolerance outside [CF_EXPORT_TOL_MIN, CF_EXPORT_TOL_MAX] or a spring whose table does not reach
-** the tolerance (the message gives the achieved error), CF_E_INTERNAL when memory runs out. */
-cf_status cf_export_table_build(const cf_law *law, double tol, cf_export_table *t, cf_error *err);
-
-/* The same over [u_lo, u_hi] (mm, u_lo <= 0 <= u_hi): CF_E_DATA naming the limit when the range
-** passes the end of the travel (|u| > u_end) or does not contain the rest state. */
-cf_status cf_export_table_build_range(const cf_law *law, double tol, double u_lo_mm,
-                                      double u_hi_mm, cf_export_table *t, cf_error *err);
-
-/* An evenly spaced table of the law (rows on the law) over [u_lo, u_hi], or over the part of it
-** where at most max_rows (>= 2) evenly spaced rows meet the tolerance: the fewest rows that meet
-** it over the whole range; else max_rows rows over the range cut at |u| <= U, the largest U for
-** which they do (the error measured on the check grid of the adaptive table). t->req_lo_mm and
-** t->req_hi_mm keep the range asked for. Errors as cf_export_table_build_range. */
-cf_status cf_export_table_build_even(const cf_law *law, double tol, double u_lo_mm,
-                                     double u_hi_mm, size_t max_rows, cf_export_table *t,
-                                     cf_error *err);
-
-/* Releases the rows of t; safe on a zeroed table. */
-void cf_export_table_free(cf_export_table *t);
-
-/* Linear interpolation of the table at u (mm), N; the end rows' forces outside the table. */
-double cf_export_table_eval(const cf_export_table *t, double u_mm);
 
 /* What to write. Build with cf_export_default_options, then change fields. */
 typedef struct cf_export_options {

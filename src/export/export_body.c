@@ -14,7 +14,7 @@
 #include "base/gslguard.h"
 #include "model/body.h"
 #include "model/lattice.h"
-#include "export/export_model.h"
+#include "export/export_internal.h"
 
 /* conifit's contact sets of run into m: top the nodes ever in contact (ascending), with their z
 ** displacement at every step, and each step's set with its nodes' z displacements. 0, -1 out of

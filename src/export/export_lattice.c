@@ -14,7 +14,7 @@
 #include "base/gslguard.h"
 #include "model/lattice.h"
 #include "check/validate.h"
-#include "export/export_model.h"
+#include "export/export_internal.h"
 
 cf_export_lattice cf_export_lattice_default(const cf_law *law)
 {

@@ -11,7 +11,8 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "export/export.h"
+#include "export/export_table.h"
+#include "export/export_types.h"
 #include "model/law_internal.h"
 #include "model/net.h"
 
@@ -106,20 +107,6 @@ void cf_xmodel_free(cf_xmodel *m);
 
 /* Fills the group tables from m->base (each group's L0 and weight set). 0, or -1 out of memory. */
 int cf_xmodel_tables(cf_xmodel *m);
-
-/* Writes m in format f through the format's model writer (export.c's registry): 0, or -1 for a
-** format without models or when memory runs out. */
-int cf_xmodel_write(FILE *out, const cf_xmodel *m, cf_export_format f);
-
-/* The table of the law for opt: its range and tolerance, kept to CalculiX's 200 pairs for
-** calculix and abaqus (loosening the tolerance when opt->auto_tol, else CF_E_DATA naming the
-** tolerance that fits). */
-cf_status cf_export_table_for(const cf_law *law, const cf_export_options *opt,
-                              cf_export_table *t, cf_error *err);
-
-/* The report of a table of law: its rows, tolerance, achieved error, range and force at its ends
-** (the rest zero). */
-cf_export_report cf_export_report_of_table(const cf_export_table *t, const cf_law *law);
 
 /* The writers of runnable models, one per target: 0, or -1 when memory runs out. */
 int cf_xmodel_write_calculix(FILE *out, const cf_xmodel *m);

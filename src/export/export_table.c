@@ -1,5 +1,5 @@
 /*
-** The export table (see export.h): the law as a piecewise-linear force-displacement table whose
+** The export table (see export_table.h): the law as a piecewise-linear force-displacement table whose
 ** nodes are placed where the interpolation error is, checked afterwards on a grid that knows
 ** nothing of the nodes.
 **
@@ -29,7 +29,7 @@
 ** added to the cone's deflection), ends at u_C where the cone closes (a row on the law), and the
 ** tail's region 3 beyond it is straight, one exact interval to the table's end.
 */
-#include "export/export.h"
+#include "export/export_table.h"
 
 #include <float.h>
 #include <math.h>

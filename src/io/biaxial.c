@@ -4,7 +4,8 @@
 #include "io/biaxial.h"
 
 #include "io/columns.h"
-#include "io/measure.h"
+#include "io/measures.h"
+#include "model/mode.h"
 
 #include <ctype.h>
 #include <math.h>

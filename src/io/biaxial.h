@@ -11,6 +11,7 @@
 #include "conifit/error.h"
 #include "io/csv.h"
 #include "io/reader.h"
+#include "io/table_types.h"
 #include "model/table.h"
 
 /* The '# ratio: A:B' comment (A, B > 0 finite; spaces allowed; text after B ignored) into

@@ -1,20 +1,18 @@
 /*
-** Column names and units, private to the table reader (io/measure.c): the catalogue of units, a
-** header name split into its name and its unit decoration, which names mark x, y, a weight or a
-** time, and what the file's '#' comments state (a column's unit, the test mode).
+** Column names and units, for the table reader (io/measure.c): the catalogue of units (a unit's
+** class and factor, cf_measure_unit, which the command line and the prediction use too), a header
+** name split into its name and its unit decoration, which names mark x, y, a weight or a time, and
+** what the file's '#' comments state (a column's unit, the test mode).
 */
 #ifndef CF_IO_COLUMNS_H
 #define CF_IO_COLUMNS_H
 
 #include <stddef.h>
 
-#include "model/cell.h"
 #include "conifit/error.h"
-#include "io/measure.h"
 #include "io/csv.h"
-
-/* Longest column name kept (longer names are an error: they are not column names). */
-#define CF_COLUMN_NAME_CAP 256
+#include "io/table_types.h"
+#include "model/mode.h"
 
 /* A unit as a file may spell it: its class and the factor to conifit's units. */
 typedef struct cf_unit_def {
@@ -24,13 +22,11 @@ typedef struct cf_unit_def {
     const char *canon; /* spelling used in reports */
 } cf_unit_def;
 
-/* A column of the header. */
-typedef struct cf_column {
-    char name[CF_COLUMN_NAME_CAP]; /* as in the header */
-    char base[CF_COLUMN_NAME_CAP]; /* without the unit decoration */
-    char unit[CF_COLUMN_NAME_CAP]; /* the decoration ("" when none), or the units row's */
-    int unit_from_row;             /* 1 when unit came from the units row under the header */
-} cf_column;
+/* Looks up a unit name ("kPa", "MPa", "N/mm2", "mN", "um", "%", "mm/mm", ...; letter case is
+** ignored except in a leading m or M, so "Mpa" is MPa and "mPa" is not a unit). Returns
+** CF_UNIT_UNKNOWN for a name it does not know; otherwise the class, and in *to_conifit (if not
+** NULL) the factor that converts a value in that unit to conifit's (MPa, N, mm, s, -). */
+cf_unit_class cf_measure_unit(const char *name, double *to_conifit);
 
 /* The unit spelled name, or NULL: letter case is ignored except for a leading m or M (milli or
 ** metre against mega), so "Mpa" and "kpa" are found and "mPa" is not MPa. */

@@ -3,6 +3,8 @@
 ** and which columns are x, y, a weight and a time.
 */
 #include "io/reader.h"
+#include "io/columns.h"
+#include "io/measure.h"
 
 #include <errno.h>
 #include <stdio.h>

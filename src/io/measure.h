@@ -19,45 +19,8 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
+#include "io/table_types.h"
 #include "model/table.h"
-
-/* Names of the measures a table records (table.h), as messages and reports spell them. */
-const char *cf_stress_measure_name(cf_stress_measure m); /* "nominal", "cauchy" */
-const char *cf_strain_measure_name(cf_strain_measure m); /* "engineering", "log", "stretch" */
-const char *cf_decl_source_name(cf_decl_source s);       /* "assumed", "comment", ... */
-
-/* Parse a measure word (case-insensitive; synonyms: true = cauchy, pk1/piola/engineering =
-** nominal for stress; true/hencky/logarithmic = log, lambda = stretch for strain). Return 0 and
-** set *m, or -1 for a word they do not know. */
-int cf_stress_measure_parse(const char *word, cf_stress_measure *m);
-int cf_strain_measure_parse(const char *word, cf_strain_measure *m);
-
-typedef struct cf_measure_options {
-    const char *x_col;       /* column name of x (with or without its unit decoration; a number
-                             ** from 1 when no column has that name), or NULL: the first column
-                             ** named strain/stretch/lambda/displacement/elongation/gamma/
-                             ** shear..., else the first column that is not y */
-    const char *y_col;       /* column name (or number) of y, or NULL: the first column named
-                             ** stress/force/load..., else the first remaining column */
-    const char *stress_unit; /* "Pa", "kPa", "MPa", "GPa", "N/mm2", "mmHg"...; NULL: from header */
-    const char *force_unit;  /* "N", "mN", "kN", "uN"; NULL: from header */
-    const char *length_unit; /* "m", "mm", "um", "cm"; NULL: from header */
-    int x_is_stretch;        /* -1: decide from the column name, 0: strain, 1: stretch */
-    const char *mode;        /* test mode ("uniaxial", "shear", ...), or NULL: from a '# mode:'
-                             ** comment of the file, else uniaxial */
-    int stress_measure;      /* -1: from the file (comment, column name; else nominal), or a
-                             ** cf_stress_measure that wins over the file */
-    int strain_measure;      /* -1: from the file, or a cf_strain_measure */
-    size_t header_row;       /* 1-based line of the header row, or 0: the first line with
-                             ** content, else the first after a preamble that names known columns
-                             ** and is followed by rows of numbers */
-    const char *columns;     /* "X,Y" or "X,Y,W": the x, y and weight columns by name or 1-based
-                             ** number, and no others (no weight or time found by name); or NULL */
-    const char *plane;       /* the plane in the fibre frame (table.h) of shear and biaxial tables
-                             ** that state none or another in a '# plane:' comment: "ij" for
-                             ** every shear and biaxial table, or a comma list of NAME=ij, NAME a table's file name
-                             ** without folder and extension; NULL: from the comment */
-} cf_measure_options;
 
 /* Options with everything decided from the file. */
 cf_measure_options cf_measure_default_options(void);
@@ -72,22 +35,6 @@ cf_measure_options cf_measure_default_options(void);
 #define CF_MEASURE_MAX_LINES 2000000          /* lines in all: rows, comments, blank lines */
 #define CF_MEASURE_MAX_BYTES ((size_t)256 << 20) /* file size, 256 MiB */
 #define CF_MEASURE_MAX_VALUE 1e100                /* |value| in MPa, N, mm, s or a weight */
-
-/* What a unit measures. */
-typedef enum cf_unit_class {
-    CF_UNIT_UNKNOWN = 0,
-    CF_UNIT_STRESS = 1, /* converted to MPa */
-    CF_UNIT_FORCE = 2,  /* converted to N */
-    CF_UNIT_LENGTH = 3, /* converted to mm */
-    CF_UNIT_TIME = 4,   /* converted to s */
-    CF_UNIT_STRAIN = 5  /* dimensionless: "-", "1" or "%" (converted to a plain fraction) */
-} cf_unit_class;
-
-/* Looks up a unit name ("kPa", "MPa", "N/mm2", "mN", "um", "%", "mm/mm", ...; letter case is
-** ignored except in a leading m or M, so "Mpa" is MPa and "mPa" is not a unit). Returns
-** CF_UNIT_UNKNOWN for a name it does not know; otherwise the class, and in *to_conifit (if not
-** NULL) the factor that converts a value in that unit to conifit's (MPa, N, mm, s, -). */
-cf_unit_class cf_measure_unit(const char *name, double *to_conifit);
 
 /* Reads the table at path ("-": standard input, named "(standard input)" in messages).
 ** A biaxial table ('# mode: biaxial', or option mode) holds two directions: its first strain and

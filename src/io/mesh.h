@@ -4,8 +4,9 @@
 #ifndef CF_MESH_H
 #define CF_MESH_H
 
-#include "model/body.h"
 #include "conifit/error.h"
+#include "io/surface_types.h"
+#include "model/body.h"
 
 /* What Gmsh may spend. Every use of Gmsh runs in a process of its own (io/isolate.h): a mesh
 ** that makes Gmsh loop, exhaust memory or crash ends in an error, never in a hang or an abort of
@@ -21,8 +22,6 @@ typedef struct cf_mesh_limits {
 
 #define CF_MESH_MAX_BYTES_DEFAULT (2.0 * 1024 * 1024 * 1024) /* 2 GiB */
 #define CF_MESH_MAX_SECONDS_DEFAULT 600.0
-/* The most tetrahedra a surface is filled with. */
-#define CF_MESH_MAX_FILL_TETS 5e6
 
 /* The default limits: 2 GiB, 600 s, no cost per node. */
 cf_mesh_limits cf_mesh_limits_default(void);
@@ -45,21 +44,6 @@ cf_status cf_mesh_read(const char *path, double unit_mm, cf_mesh *m, cf_error *e
 ** CF_E_DATA. */
 cf_status cf_mesh_read_refined(const char *path, double unit_mm, int refine,
                                const cf_mesh_limits *lim, cf_mesh *m, cf_error *err);
-
-/* What meshing a closed surface found and did (cf_mesh_from_surface). */
-typedef struct cf_mesh_surface_info {
-    size_t vertices, triangles;  /* of the surface as read */
-    double enclosed_mm3;         /* the volume it encloses (after any smoothing), mm^3 */
-    size_t crossings;            /* edges found crossing a triangle not their own (first round) */
-    size_t smoothed;             /* vertices moved to remove them (over all rounds) */
-    double max_move_mm;          /* the largest move, mm */
-    int reversed;                /* 1: the triangles were turned to face outward */
-    size_t shells;               /* closed shells: one, or a solid and its cavities */
-    size_t pair_tests;           /* edge-triangle tests the search for crossings made */
-    double estimated_tets;       /* the fill's tetrahedra, about (from the volume and size) */
-    double estimated_nodes;      /* and its nodes: an eighth of that, and the surface's at that
-                                 ** size (1.15 area / h^2); 1.2 to 1.4 times Gmsh's count */
-} cf_mesh_surface_info;
 
 /* Fills the closed surface at path (Wavefront .obj or .stl, read by conifit as data, never by
 ** Gmsh's script reader) with tetrahedra by Gmsh's library: the surface classified into patches

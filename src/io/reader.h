@@ -8,9 +8,8 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
-#include "io/measure.h"
-#include "io/columns.h"
 #include "io/csv.h"
+#include "io/table_types.h"
 
 typedef struct reader {
     const char *path;

@@ -1,13 +1,14 @@
 /*
-** The scene's "haptic" section (scene.h, src/notes/simulate.md, "Bodies"): the probe's path in
-** time for `simulate --haptic`. Private to the io module.
+** The scene's "haptic" section (scene_types.h, src/notes/simulate.md, "Bodies"): the probe's
+** path in time for `simulate --haptic`. Private to the io module.
 */
 #ifndef CF_IO_SCENE_HAPTIC_H
 #define CF_IO_SCENE_HAPTIC_H
 
 #include <jansson.h>
 
-#include "io/scene.h"
+#include "conifit/error.h"
+#include "io/scene_types.h"
 
 /* Most updates (milliseconds of simulated time) a haptic path may ask for; the run is further
 ** bounded by the budget's steps (budget.h). */

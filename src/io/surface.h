@@ -11,13 +11,10 @@
 #include <stdint.h>
 
 #include "conifit/error.h"
-#include "io/mesh.h"
+#include "io/surface_types.h"
 
-typedef struct cf_surface {
-    size_t nv, nf;
-    double *X;      /* 3 nv vertex coordinates, in the file's units */
-    uint32_t *tri;  /* 3 nf vertex indices */
-} cf_surface;
+/* The most tetrahedra a surface is filled with. */
+#define CF_MESH_MAX_FILL_TETS 5e6
 
 void cf_surface_free(cf_surface *s);
 

@@ -9,7 +9,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "io/surface.h"
+#include "conifit/error.h"
+#include "io/surface_types.h"
 
 static inline void sub3(const double *a, const double *b, double *c)
 {

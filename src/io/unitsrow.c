@@ -4,6 +4,7 @@
 ** columns whose header names no unit.
 */
 #include "io/reader.h"
+#include "io/columns.h"
 
 #include <stdio.h>
 #include <string.h>

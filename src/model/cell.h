@@ -51,21 +51,7 @@
 #include "model/calibration.h"
 #include "conifit/error.h"
 #include "model/law_internal.h"
-
-typedef enum cf_mode {
-    CF_MODE_UNIAXIAL = 0,
-    CF_MODE_SHEAR = 1,
-    CF_MODE_PLANAR = 2,
-    CF_MODE_EQUIBIAXIAL = 3,
-    CF_MODE_CONFINED = 4,
-    CF_MODE_BIAXIAL = 5,
-    CF_MODE_COUNT = 6
-} cf_mode;
-
-/* "uniaxial", "shear", "planar", "equibiaxial", "confined", "biaxial"; the parser refuses anything else
-** with CF_E_DATA naming the value. */
-const char *cf_mode_name(cf_mode m);
-cf_status cf_mode_parse(const char *name, cf_mode *m, cf_error *err);
+#include "model/mode.h"
 
 /* Spring directions of the cell. */
 #define CF_CELL_DIRS 13

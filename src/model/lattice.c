@@ -9,7 +9,6 @@
 
 #include "model/cell.h"
 #include "model/lattice_hourglass.h"
-#include "model/lattice_step.h"
 #include "model/net.h"
 
 #include <math.h>

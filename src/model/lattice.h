@@ -152,6 +152,17 @@ void cf_lattice_add_tensions(cf_lattice *lat, const double *Textra_N);
 double cf_lattice_cell_volume(const cf_lattice *lat, size_t c, uint32_t node[8], double g[8][3],
                               double (*hess)[8][3][3]);
 
+/* The cells' node forces, the volume term's -kappa (J - 1) dV/dx and the hourglass control's
+** (lattice_hourglass.h), of every cell, added to lat->fx, fy, fz (nothing when the lattice has
+** neither): the fused step's springs (lattice_step.h) do not include them. */
+void cf_lattice_add_volume_forces(cf_lattice *lat);
+
+/* A bound on the largest row sum of |d2W/dx2| of the cells' energies at the current positions,
+** over every node's three rows (N/mm): per cell kappa/H^3 g g^T + kappa (J - 1) d2V/dx2, summed
+** over the cells of each node, plus the hourglass control's 8 (3 k_h / 16) (Gershgorin, for the
+** explicit step's stability; 0 without either). */
+double cf_lattice_volume_row_bound(const cf_lattice *lat);
+
 /* Elastic energy stored in the springs and the cells at the current state, mJ = N mm (Gauss-
 ** Legendre quadrature of the law over each spring's compression, accurate to about 1e-10 relative
 ** away from solid; the volume term and the hourglass control exactly). */

@@ -89,15 +89,4 @@ void cf_lattice_stepper_advance(cf_lattice_stepper *st, double h, double *vx, do
 
 void cf_lattice_stepper_free(cf_lattice_stepper *st);
 
-/* The cells' node forces, the volume term's -kappa (J - 1) dV/dx and the hourglass control's
-** (lattice_hourglass.h), of every cell, added to lat->fx, fy, fz (nothing when the lattice has
-** neither): the fused step's springs do not include them (lattice.c). */
-void cf_lattice_add_volume_forces(cf_lattice *lat);
-
-/* A bound on the largest row sum of |d2W/dx2| of the cells' energies at the current positions,
-** over every node's three rows (N/mm): per cell kappa/H^3 g g^T + kappa (J - 1) d2V/dx2, summed
-** over the cells of each node, plus the hourglass control's 8 (3 k_h / 16) (Gershgorin, for the
-** explicit step's stability; 0 without either). */
-double cf_lattice_volume_row_bound(const cf_lattice *lat);
-
 #endif

@@ -11,7 +11,6 @@
 */
 #include "model/law_internal.h"
 #include "base/gslguard.h"
-#include "model/law_simd.h"
 
 #include <float.h>
 #include <math.h>
@@ -25,26 +24,6 @@
 
 /* Switch from the e-form to the y-form at y = 1/2, i.e. at delta(1/2) = 0.53125. */
 #define CF_DELTA_SWITCH 0.53125
-
-struct cf_law_table {
-    size_t intervals;  /* number of grid intervals */
-    double w_max;      /* grid spans w in [z0, w_max], w = sqrt((s - |u|)/s) (plain law) */
-    double inv_h;      /* intervals / (w_max - z0) */
-    double h;          /* (w_max - z0) / intervals */
-    double z0, kappa2; /* with a tail the grid variable is z = sqrt((u_C - |u|)/s + kappa^2) from
-                       ** z0 = kappa (0 and 0 without a tail). Phi has a minimum at e* < 0
-                       ** (y*^4 = 1/(1 - 4 beta)) whose value Phi(e*) ~ -3 beta^2/2 is a branch
-                       ** point of e(w) at distance ~ beta from the grid's end: e bends over
-                       ** w ~ beta. With kappa^2 = -Phi(e*) / r (r = 1/rho - 1) the branch point sits
-                       ** at z = 0 and e(z) is analytic on the grid (Morse's lemma). From
-                       ** beta = 0.2 on the minimum lies far away (y* > 1.49) and the grid
-                       ** keeps w (kappa = 0): a large kappa would make it uniform in Delta,
-                       ** too coarse where y is small */
-    double *y;         /* y at the nodes, intervals + 1 values */
-    double *dy;        /* dy/dw at the nodes, times h (scaled for the Hermite basis) */
-    double *coef;      /* per interval, the Hermite cubic as y0 + q (m0 + q (a + q b)): y0, m0,
-                          a, b (4 intervals values; law_simd.h evaluates it) */
-};
 
 void cf_law_free(cf_law *law)
 {
@@ -575,28 +554,6 @@ static inline void law_many(const cf_law *law, cf_law_method method, size_t coun
     else
         for (size_t i = 0; i < count; i++)
             F[i] = law_eval(law, method, u[i], NULL, &fl);
-}
-
-void cf_law_lanes_init(const cf_law *law, cf_law_lanes *lanes)
-{
-    memset(lanes, 0, sizeof *lanes);
-    lanes->u_T = law->u_T_mm;
-    lanes->s = law->travel_mm;
-    lanes->inv_s = law->inv_travel;
-    lanes->k0 = law->k0_N_per_mm;
-    lanes->F_C = law->F_C_N;
-    lanes->rim1 = law->rho_inv_m1;
-    lanes->coef = law->table ? law->table->coef : NULL;
-    lanes->inv_h = law->table ? law->table->inv_h : 0.0;
-    lanes->xmax = law->table ? (double)(law->table->intervals - 1) : 0.0;
-    lanes->law = law;
-    if (law->tail) { /* the polynomial only (law_simd.h); kappa2 and z0 come with its fit */
-        lanes->tail = 1;
-        lanes->u_C = law->u_C_mm;
-        lanes->k_t = law->k_tail_N_per_mm;
-        lanes->F_sol = law->F_solid_N;
-        lanes->b4 = 4.0 * law->beta;
-    }
 }
 
 /* The scalar law over many points (law_simd.h): the batch's path for the exact method, the

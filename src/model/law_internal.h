@@ -13,6 +13,28 @@
 
 #include "model/lawmech.h"
 
+/* The law's table of region 2 (cf_law_table_build, law.c), evaluated by law.c and by the lanes
+** (law_simd.h). */
+struct cf_law_table {
+    size_t intervals;  /* number of grid intervals */
+    double w_max;      /* grid spans w in [z0, w_max], w = sqrt((s - |u|)/s) (plain law) */
+    double inv_h;      /* intervals / (w_max - z0) */
+    double h;          /* (w_max - z0) / intervals */
+    double z0, kappa2; /* with a tail the grid variable is z = sqrt((u_C - |u|)/s + kappa^2) from
+                       ** z0 = kappa (0 and 0 without a tail). Phi has a minimum at e* < 0
+                       ** (y*^4 = 1/(1 - 4 beta)) whose value Phi(e*) ~ -3 beta^2/2 is a branch
+                       ** point of e(w) at distance ~ beta from the grid's end: e bends over
+                       ** w ~ beta. With kappa^2 = -Phi(e*) / r (r = 1/rho - 1) the branch point sits
+                       ** at z = 0 and e(z) is analytic on the grid (Morse's lemma). From
+                       ** beta = 0.2 on the minimum lies far away (y* > 1.49) and the grid
+                       ** keeps w (kappa = 0): a large kappa would make it uniform in Delta,
+                       ** too coarse where y is small */
+    double *y;         /* y at the nodes, intervals + 1 values */
+    double *dy;        /* dy/dw at the nodes, times h (scaled for the Hermite basis) */
+    double *coef;      /* per interval, the Hermite cubic as y0 + q (m0 + q (a + q b)): y0, m0,
+                          a, b (4 intervals values; law_simd.h evaluates it) */
+};
+
 /* A spring prepared for evaluation: its parameters and every derived quantity. Plain data apart
 ** from the optional table; build with cf_law_init, release with cf_law_free. */
 struct cf_law {
@@ -103,6 +125,15 @@ double cf_law_kind_force(const cf_law *law, double u_mm, double *k_N_per_mm, int
 void cf_law_kind_force_many(const cf_law *law, size_t count, const double *u_mm, double *F_N,
                             double *k_N_per_mm);
 double cf_law_kind_deflection(const cf_law *law, double F_N);
+
+/* e = 1 - y of region 2 at delta >= 0 from the exact solver (law.c); with a tail delta is the
+** tailed relation's Delta = (1/rho - 1)(u_C - |u|)/s. Used by the polynomial's fit (law_poly.c). */
+double cf_law_region2_e(const cf_law *law, double delta);
+
+/* The scalar law over many points with the method given (law.c): what cf_law_force_many runs for
+** the stiffness, the exact method and the laws the lanes do not carry (law_simd.h). */
+void cf_law_force_scalar_many(const cf_law *law, cf_law_method method, size_t count,
+                              const double *u_mm, double *F_N, double *k_N_per_mm);
 
 /* Releases the table of law, if any. Safe on a zeroed law and on NULL. */
 void cf_law_free(cf_law *law);

@@ -70,6 +70,29 @@ void cf_law_force_lanes(const cf_law_lanes *lanes, int form, size_t count, const
     CF_SIMD_CALL(force_lanes, (lanes, form, count, u, F));
 }
 
+/* The lanes of a law (law_simd.h): its fields, and its table's coefficients (law_internal.h). */
+void cf_law_lanes_init(const cf_law *law, cf_law_lanes *lanes)
+{
+    memset(lanes, 0, sizeof *lanes);
+    lanes->u_T = law->u_T_mm;
+    lanes->s = law->travel_mm;
+    lanes->inv_s = law->inv_travel;
+    lanes->k0 = law->k0_N_per_mm;
+    lanes->F_C = law->F_C_N;
+    lanes->rim1 = law->rho_inv_m1;
+    lanes->coef = law->table ? law->table->coef : NULL;
+    lanes->inv_h = law->table ? law->table->inv_h : 0.0;
+    lanes->xmax = law->table ? (double)(law->table->intervals - 1) : 0.0;
+    lanes->law = law;
+    if (law->tail) { /* the polynomial only (law_simd.h); kappa2 and z0 come with its fit */
+        lanes->tail = 1;
+        lanes->u_C = law->u_C_mm;
+        lanes->k_t = law->k_tail_N_per_mm;
+        lanes->F_sol = law->F_solid_N;
+        lanes->b4 = 4.0 * law->beta;
+    }
+}
+
 /* The law over many points (conifit/law.h): forces alone of a law the lanes carry go through
 ** them, everything else through the scalar law (law.c). */
 void cf_law_force_many(const cf_law *law, cf_law_method method, size_t count, const double *u_mm,

@@ -122,10 +122,6 @@ void cf_law_lanes_init(const cf_law *law, cf_law_lanes *lanes);
 ** error of the last fit tried, or NAN when nothing was fitted. */
 int cf_law_lanes_fit_poly(const cf_law *law, cf_law_lanes *lanes, double *worst);
 
-/* e = 1 - y of region 2 at delta >= 0 from the exact solver (law.c); with a tail delta is the
-** tailed relation's Delta = (1/rho - 1)(u_C - |u|)/s. */
-double cf_law_region2_e(const cf_law *law, double delta);
-
 /* The same force of one lane for any form: the caller has chosen it at compile time. */
 enum { CF_LANE_CLOSED = 0, CF_LANE_TABLE = 1, CF_LANE_POLY = 2 };
 
@@ -255,7 +251,7 @@ CF_LANE double cf_lane_poly(const cf_law_lanes *c, double u, int deg, int pieces
 ** step on the tailed relation Phi(e) = Delta (law.c) multiplied by 4 (1 - e) = 4 y,
 **   N(e) - 4 (1 - e)(Delta - Phi*) = 0,
 **   N(e) = e^2 (6 - 4e + e^2) + 4 beta e (1 - e)(3 - 3e + e^2) - 4 (1 - e) Phi*:
-** - CF_TAIL_NEAR (beta < 1/4): Phi's minimum e* < 0 (law.c, struct cf_law_table) is a double root
+** - CF_TAIL_NEAR (beta < 1/4): Phi's minimum e* < 0 (struct cf_law_table, law_internal.h) is a double root
 **   of N for Phi* = Phi(e*) = -r kappa^2, N = (e - e*)^2 Q(e) with Q quadratic; in
 **   z = sqrt(v + kappa^2), v = (u_C - |u|)/s, Delta - Phi* = r z^2, so e = e* + z P with P regular
 **   and h(P) = P^2 Q(e) - 4 r (1 - e) = 0: the plain law's relation (e* = 0, Q = 6 - 4e + e^2),
@@ -377,11 +373,6 @@ CF_LANE void cf_lanes_table(const cf_law_lanes *c, size_t count, const double *u
 ** polynomial (lanes->poly_fit): F[i] for u[i]. Vectorised, dispatched at run time. A form whose
 ** data lanes lacks runs the closed form; a spring with a tail has the polynomial only, and any
 ** other form (or no fitted polynomial) runs its scalar closed form. */
-/* The scalar law over many points with the method given (law.c): what cf_law_force_many runs for
-** the stiffness, the exact method and the laws the lanes do not carry. */
-void cf_law_force_scalar_many(const cf_law *law, cf_law_method method, size_t count,
-                              const double *u_mm, double *F_N, double *k_N_per_mm);
-
 void cf_law_force_lanes(const cf_law_lanes *lanes, int form, size_t count, const double *u,
                         double *F);
 

@@ -1,5 +1,5 @@
 /*
-** The test modes as a table (mode.c): one row per mode of model/cell.h's cf_mode, holding what
+** The test modes as a table (mode.c): one row per mode of cf_mode, holding what
 ** every layer needs to know of a mode -- its name, how it deforms a block (which stretches it sets,
 ** which it leaves free, which stress it reads), what its abscissa is, how a Cauchy stress becomes
 ** a nominal one, the incompressible forms of the hyperelastic baselines, and the words and labels
@@ -9,7 +9,22 @@
 #ifndef CF_MODEL_MODE_H
 #define CF_MODEL_MODE_H
 
-#include "model/cell.h"
+#include "conifit/error.h"
+
+typedef enum cf_mode {
+    CF_MODE_UNIAXIAL = 0,
+    CF_MODE_SHEAR = 1,
+    CF_MODE_PLANAR = 2,
+    CF_MODE_EQUIBIAXIAL = 3,
+    CF_MODE_CONFINED = 4,
+    CF_MODE_BIAXIAL = 5,
+    CF_MODE_COUNT = 6
+} cf_mode;
+
+/* "uniaxial", "shear", "planar", "equibiaxial", "confined", "biaxial"; the parser refuses anything else
+** with CF_E_DATA naming the value. */
+const char *cf_mode_name(cf_mode m);
+cf_status cf_mode_parse(const char *name, cf_mode *m, cf_error *err);
 
 typedef struct cf_mode_row {
     const char *name;          /* as in tables' "# mode:" and the fit file */

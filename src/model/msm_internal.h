@@ -12,7 +12,6 @@
 #include "model/msm.h"
 #include "model/lattice_step.h"
 #include "model/linsolve.h"
-#include "model/msm_tangent.h"
 
 /* Bisections of a load increment (or time step) before a solve is declared non-converged. */
 #define MAX_BISECT 12

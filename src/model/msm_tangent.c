@@ -4,6 +4,7 @@
 ** the Newton directions it gives through the linear solver (linsolve.h), which sees only the
 ** pattern and the values.
 */
+#include "model/msm_tangent.h"
 #include "model/msm_internal.h"
 #include "model/lattice_cells.h"
 #include "model/lattice_hourglass.h"

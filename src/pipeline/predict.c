@@ -14,6 +14,7 @@
 #include "fit/joint.h"
 #include "fit/lsq.h"
 #include "io/measure.h"
+#include "io/columns.h"
 #include "model/cell.h"
 #include "model/cell_stability.h"
 #include "model/mode.h"

@@ -10,46 +10,9 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
-#include "fit/holzapfel.h"
-#include "fit/joint.h"
-#include "io/measure.h"
 #include "conifit/output.h"
-
-/* Both laws of one type's joint fit (--law conical-tail or auto): the law not kept. */
-typedef struct cf_joint_law_choice {
-    int ran;                /* 1: the tailed law was fitted beside the conical one */
-    int chose_tail;         /* 1: fits[] holds the tailed law, other the conical one */
-    cf_joint_result other;  /* the other law's joint fit (its curves owned) */
-    int pair_ran;           /* 1: the double-acting element was fitted too (double-acting, auto) */
-    int chose_pair;         /* 1: fits[] holds the pair, pair_other the single-sided law it beat */
-    cf_joint_result pair_other; /* the pair when not kept, else the law it displaced (owned) */
-    char pair_refused[CF_ERROR_MSG_LEN]; /* auto: why the pair was not fitted ("" when it was,
-                                         ** or the reason is a declared nu) */
-    /* the pair with a tailed compression spring (cf_joint_fit_pair, pair 2) against the pair
-    ** with a conical one: the one kept is the pair above, the other summarised here */
-    int pair_tail_ran;          /* 1: the tailed pair was fitted (from the conical pair) */
-    int pair_tail_kept;         /* 1: the pair above has the tailed compression spring */
-    double alt_aic, alt_objective; /* the pair not kept: its joint AIC and weighted objective */
-    int alt_feasible, alt_stable, alt_nparams;
-} cf_joint_law_choice;
-
-/* One joint fit per spring type over the same tables. */
-typedef struct cf_joint_report {
-    const cf_table *const *tables;
-    size_t ntables;
-    int nfits;
-    cf_joint_result fits[2];
-    cf_joint_law_choice law_choice[2];
-    cf_law_kind law;          /* the law asked for (--law) */
-    int with_timing;            /* 0: wall times written as 0 */
-    /* The Holzapfel-Ogden baselines (holzapfel.h), fitted when a table is biaxial: ho_ran 1 and
-    ** ho[form][cross] (form CF_HO_FULL, CF_HO_TI; cross 0: a biaxial table's second direction
-    ** along s, 1: along n, where its plane does not say), or ho_why says why not ("" when no
-    ** table is biaxial: nothing is said) */
-    int ho_ran;
-    cf_ho_fit ho[2][2];
-    char ho_why[CF_ERROR_MSG_LEN];
-} cf_joint_report;
+#include "io/measure.h"
+#include "report/report_types.h"
 
 /* Releases every fit's curves, the law not kept's too. Safe on a zeroed report. */
 void cf_joint_report_free(cf_joint_report *r);

@@ -11,6 +11,7 @@
 
 #include "model/cell.h"
 #include "report/gnuplot.h"
+#include "io/measures.h"
 
 /* Points on each model curve. */
 #define CURVE_POINTS 400

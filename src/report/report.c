@@ -14,6 +14,7 @@
 
 #include "base/atomic.h"
 #include "io/fitfile_json.h"
+#include "io/measures.h"
 #include "report/report_baselines.h"
 #include "report/report_json.h"
 #include "report/report_notes.h"

@@ -1,7 +1,7 @@
 /*
 ** How a fit report states its baselines (baseline.h), in the text (report_text.c) and in the fit
-** file's baselines[] (report.c): the coefficients with their names and units. Private to
-** src/report/.
+** file's baselines[] (report.c): the coefficients with their names and units, and their AIC.
+** Private to src/report/ (and its tests).
 */
 #ifndef CF_REPORT_BASELINES_H
 #define CF_REPORT_BASELINES_H
@@ -11,12 +11,14 @@
 
 #include <jansson.h>
 
-#include "report/report.h"
-#include "report/jointreport.h"
+#include "report/report_types.h"
 
 /* Baseline k's coefficients as "C1 = 0.1, C2 = 2, C3 = -3 kPa" (values in the file's unit; the
 ** unit after each run of coefficients in it). */
 void cf_report_baseline_coefficients(const cf_fit_report *r, int k, char *buf, size_t cap);
+
+/* AIC of baseline k of r, with RSS in the file's unit (comparable with cf_report_fit_aic). */
+double cf_report_baseline_aic(const cf_fit_report *r, int k);
 
 /* Baseline k as the fit file's object: model, formula (the Yeoh and Ogden ones with their
 ** form, the table's mode), parameters and, when fitted, coefficients, rmse and aic; when not,

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "fit/lawkind.h"
+#include "io/measures.h"
 #include "report/report_baselines.h"
 #include "report/report_notes.h"
 #include "report/report_words.h"

@@ -5,6 +5,7 @@
 */
 #include "report/report_words.h"
 #include "fit/lawkind.h"
+#include "io/measures.h"
 #include "model/mode.h"
 
 #include <math.h>

@@ -7,7 +7,7 @@
 
 #include <stddef.h>
 
-#include "report/report.h"
+#include "report/report_types.h"
 
 /* Appends printf-formatted text to buf (capacity cap, *n bytes used), never past its end. */
 void cf_report_append(char *buf, size_t cap, size_t *n, const char *fmt, ...)

@@ -24,6 +24,7 @@
 #include "io/measure.h"
 #include "pipeline/pipeline.h"
 #include "report/report.h"
+#include "report/report_baselines.h"
 #include "fit/lawkind.h"
 #include "export/export.h"
 #include "io/fitfile.h"

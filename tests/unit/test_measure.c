@@ -11,6 +11,7 @@
 
 #include "model/law_internal.h"
 #include "io/measure.h"
+#include "io/columns.h"
 
 /* Relative tolerance for values that went through one unit conversion (a product of doubles). */
 #define CONV_TOL 1e-15
