@@ -61,4 +61,32 @@ static inline void write_cube(const char *path, double h)
     write_msh(path, &m);
 }
 
+/* Runs ccx on dir/job.inp (dir and job plain names the test made) and reads the probe force of
+** every step (minus the z total of the face nodes' reaction, set NFACE) into F[0 .. n); returns
+** how many steps it found. */
+static inline int bu_ccx_forces(const char *dir, const char *job, double *F, int n)
+{
+    char cmd[1600], dat[700];
+    snprintf(cmd, sizeof cmd, "cd %s && ccx -i %s > %s.log 2>&1", dir, job, job);
+    if (system(cmd) != 0)
+        fail_msg("ccx failed on %s/%s.inp", dir, job);
+    snprintf(dat, sizeof dat, "%s/%s.dat", dir, job);
+    char *text = tu_slurp(dat);
+    assert_non_null(text);
+    int found = 0;
+    for (const char *p = text; (p = strstr(p, "total force (fx,fy,fz) for set NFACE and time")); p++) {
+        double t, fx, fy, fz;
+        if (sscanf(p, "total force (fx,fy,fz) for set NFACE and time %lf %lf %lf %lf", &t, &fx,
+                   &fy, &fz) != 4)
+            continue;
+        const int k = (int)floor(t + 0.5);
+        if (fabs(t - k) > 1e-9 || k < 1 || k > n)
+            continue;
+        F[k - 1] = -fz;
+        found++;
+    }
+    free(text);
+    return found;
+}
+
 #endif

@@ -30,33 +30,6 @@ static void write_scene(const char *path, const char *body_extra, const char *fi
     fclose(f);
 }
 
-/* Runs ccx on dir/job.inp and reads the probe force of every step (minus the z total of the
-** face nodes' reaction, set NFACE) into F[0 .. n); returns how many steps it found. */
-static int ccx_forces(const char *job, double *F, int n)
-{
-    char cmd[1600], dat[700];
-    snprintf(cmd, sizeof cmd, "cd %s && ccx -i %s > %s.log 2>&1", dir, job, job);
-    if (system(cmd) != 0)
-        fail_msg("ccx failed on %s/%s.inp", dir, job);
-    snprintf(dat, sizeof dat, "%s/%s.dat", dir, job);
-    char *text = tu_slurp(dat);
-    assert_non_null(text);
-    int found = 0;
-    for (const char *p = text; (p = strstr(p, "total force (fx,fy,fz) for set NFACE and time")); p++) {
-        double t, fx, fy, fz;
-        if (sscanf(p, "total force (fx,fy,fz) for set NFACE and time %lf %lf %lf %lf", &t, &fx,
-                   &fy, &fz) != 4)
-            continue;
-        const int k = (int)floor(t + 0.5);
-        if (fabs(t - k) > 1e-9 || k < 1 || k > n)
-            continue;
-        F[k - 1] = -fz;
-        found++;
-    }
-    free(text);
-    return found;
-}
-
 static int exists(const char *path)
 {
     struct stat sb;
@@ -351,7 +324,7 @@ static void a_body_scene_exports_to_calculix_and_runs(void **state)
     fclose(c);
     assert_int_equal(n, 3);
     double G[2];
-    if (ccx_forces("punch", G, 2) != 2)
+    if (bu_ccx_forces(dir, "punch", G, 2) != 2)
         fail_msg("ccx: not every step in punch.dat");
     for (int k = 1; k <= 2; k++) {
         print_message("body export, step %d: ccx %.7g N, conifit simulate %.7g N\n", k, G[k - 1],
@@ -442,7 +415,7 @@ static void the_liver_probe_exports_and_runs_in_calculix(void **state)
                 n++;
         free(text);
         assert_int_equal(n, 16);
-        if (ccx_forces(job, got, 16) != 16)
+        if (bu_ccx_forces(dir, job, got, 16) != 16)
             fail_msg("ccx: not every step in %s.dat", job);
         double worst = 0;
         for (int k = 0; k < 16; k++) {

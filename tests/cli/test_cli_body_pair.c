@@ -188,33 +188,6 @@ static void what_is_not_built_is_refused(void **state)
     refused("kappa", spring, "", "volume_modulus_MPa = 0.01", "not built for bodies");
 }
 
-/* Runs ccx on dir/JOB.inp; the probe force of every step (minus the z total of set NFACE's
-** reaction) into F[0 .. n); returns how many steps it found. */
-static int ccx_forces(const char *job, double *F, int n)
-{
-    char cmd[1600], dat[700];
-    snprintf(cmd, sizeof cmd, "cd %s && ccx -i %s > %s.log 2>&1", dir, job, job);
-    if (system(cmd) != 0)
-        fail_msg("ccx failed on %s/%s.inp", dir, job);
-    snprintf(dat, sizeof dat, "%s/%s.dat", dir, job);
-    char *text = tu_slurp(dat);
-    assert_non_null(text);
-    int found = 0;
-    for (const char *p = text; (p = strstr(p, "total force (fx,fy,fz) for set NFACE and time")); p++) {
-        double t, fx, fy, fz;
-        if (sscanf(p, "total force (fx,fy,fz) for set NFACE and time %lf %lf %lf %lf", &t, &fx,
-                   &fy, &fz) != 4)
-            continue;
-        const int k = (int)floor(t + 0.5);
-        if (fabs(t - k) > 1e-9 || k < 1 || k > n)
-            continue;
-        F[k - 1] = -fz;
-        found++;
-    }
-    free(text);
-    return found;
-}
-
 static void the_pair_body_exports_to_calculix(void **state)
 {
     (void)state;
@@ -245,7 +218,7 @@ static void the_pair_body_exports_to_calculix(void **state)
         return;
     }
     double G[STEPS];
-    if (ccx_forces("xpair", G, STEPS) != STEPS)
+    if (bu_ccx_forces(dir, "xpair", G, STEPS) != STEPS)
         fail_msg("ccx: not every step in xpair.dat");
     for (int k = 1; k <= STEPS; k++) {
         print_message("pair body export, step %d: ccx %.7g N, conifit simulate %.7g N (%+.2e)\n",
