@@ -64,7 +64,8 @@ static int sys_trial(void *ctx, const double *dx, double alpha)
     return cf_body_admissible(s->b, s->b->x);
 }
 
-static const cf_mech_ops body_ops = {sys_residual, sys_tangent, sys_project, sys_save, sys_trial};
+static const cf_mech_ops body_ops = {sys_residual, sys_tangent, sys_project, sys_save, sys_trial,
+                                     NULL};
 
 void cf_body_work_free(body_work *w)
 {
@@ -101,7 +102,7 @@ static cf_status work_mech(cf_body *b, body_work *w, cf_error *err)
     w->sys.w = w;
     w->sys.P = P;
     cf_status st = cf_mech_create(&w->mech, 3 * b->nn, aug ? b->nn : 0, &body_ops, &w->sys,
-                                  P->colptr, P->rowidx, err);
+                                  P->colptr, P->rowidx, 0, err);
     if (st != CF_OK)
         return st;
     const int *colp, *rowi;

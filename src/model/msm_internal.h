@@ -1,7 +1,7 @@
 /*
 ** The workspace the lattice solvers share (msm.c, msm_newton.c, msm_tangent.c, msm_visco.c,
-** msm_dynamic.c, msm_uniaxial.c) and the functions they call in one another. Private to the model
-** layer.
+** msm_dynamic.c, msm_uniaxial.c) and the functions they call in one another. Private
+** to the model layer.
 */
 #ifndef CF_MODEL_MSM_INTERNAL_H
 #define CF_MODEL_MSM_INTERNAL_H
@@ -11,7 +11,7 @@
 
 #include "model/msm.h"
 #include "model/lattice_step.h"
-#include "model/linsolve.h"
+#include "model/mech.h"
 
 /* Bisections of a load increment (or time step) before a solve is declared non-converged. */
 #define MAX_BISECT 12
@@ -36,10 +36,10 @@ typedef struct solver {
     double qlv_scale;         /* step's law-force factor minus 1 (Prony terms; 0 when off) */
     double qlv_slope;         /* its growth per unit |strain| of the spring (0: quasi-linear) */
     double *tmp;              /* per-spring scratch */
-    /* the tangent (msm_tangent.c) and its linear solver, which holds the matrix, its scale and
-    ** its factorisations (linsolve.h) */
-    cf_linsolve *ls;          /* NULL until the first direction; it assembles through a pointer
-                                 to this struct, which must not move while it is there */
+    /* the lattice as a mechanical system (msm_newton.c) for the Newton driver (mech.h), whose
+    ** linear solver holds the tangent's pattern (msm_tangent.c), its scale and its factors */
+    cf_mech mech;             /* mech.ls NULL until the first solve; it assembles through a
+                                 pointer to this struct, which must not move while it is there */
     size_t nnz;               /* entries of the tangent's pattern */
     int *map;                 /* spring q's blocks ii, jj, ij, ji: entry (a, b) of block blk at
                                  index map[q * 36 + 9 * blk + 3 a + b] of the values, -1 fixed */
@@ -47,11 +47,15 @@ typedef struct solver {
                                  vmap[((c * 8 + a) * 8 + b) * 9 + i * 3 + k] (NULL without one) */
     long neg_pivots;          /* negative pivots of the last factored tangent, -1 unknown */
     int chord;                /* reuse factorisations across iterations and load steps (chord
-                                 steps, cf_msm_newton) */
-    int refactor;             /* the next direction needs a fresh tangent */
-    int krylov;               /* the factored tangent no longer gives chord steps that converge:
-                                 directions solve the current tangent by Krylov steps with those
-                                 factors as preconditioner (linsolve_krylov.c) until a refactor */
+                                 and Krylov steps, cf_msm_newton) */
+    int refactor;             /* the next solve starts with a fresh tangent (the driver keeps the
+                                 stage between solves otherwise: mech.fresh, mech.krylov) */
+    /* the last residual (cf_msm_residual): max |u|/travel, the residual's and the forces' largest
+    ** components; r_ready 1 when s->R holds it at the current positions, not yet handed to the
+    ** driver (msm_newton.c); the force floor of the current solve's tolerance */
+    double um, rn, fs;
+    int r_ready;
+    double floor_f;
     /* secant predictor of the static load steps (the uniaxial curve): the converged positions at
     ** the drive value before the current one (xprev, 3 nn as cf_msm_positions_get), vprev that
     ** value, prev_ok whether they are there; xcur scratch. NULL/0 unless secant is set. */
@@ -98,7 +102,7 @@ typedef struct dyn {
     cf_lattice_stepper step;  /* its state (when fused) */
 } dyn;
 
-/* msm_newton.c: the workspace, the residual and Newton's static equilibria */
+/* msm_newton.c: the workspace, the residual and the static load steps */
 cf_status cf_msm_solver_init(solver *s, cf_lattice *lat, const cf_msm_effects *fx,
                              const cf_msm_config *cfg, cf_msm_drive drive, cf_msm_stats *st,
                              cf_error *err);
@@ -109,7 +113,6 @@ cf_status cf_msm_solver_secant(solver *s, cf_error *err);
 void cf_msm_place_top(cf_lattice *lat, double e);
 void cf_msm_add_external(solver *s);
 double cf_msm_residual(solver *s, double *rnorm, double *fscale);
-cf_status cf_msm_newton(solver *s, cf_error *err);
 cf_status cf_msm_static_to(solver *s, double v, cf_error *err);
 double cf_msm_top_stress(const cf_lattice *lat);
 double cf_msm_reported_stress(solver *s);
@@ -117,17 +120,19 @@ double cf_msm_reported_stress(solver *s);
 void cf_msm_positions_get(const cf_lattice *lat, double *buf);
 void cf_msm_positions_set(cf_lattice *lat, const double *buf);
 
-/* msm_tangent.c: the tangent at the state of the last cf_msm_residual() and the Newton update
-** s->dx it gives for s->R. cf_msm_direction assembles and factors it (the pattern and the linear
-** solver built on first use), noting its inertia in s->neg_pivots and the statistics;
-** cf_msm_factored tells whether the factors of the last direction are there; cf_msm_chord solves
-** with them (a chord step), cf_msm_krylov solves the current tangent by GMRES preconditioned with
-** them (cf_linsolve_chord, cf_linsolve_krylov: 1 when s->dx holds the update, *fatal on an
-** out-of-memory no fallback would survive). */
+/* msm_tangent.c: the tangent K = -dR/dx at the state of the last cf_msm_residual(), written into
+** the values of its pattern (the system's tangent hook), and s->mech made with that pattern and
+** the hooks ops (CF_E_INTERNAL when memory runs out; s->mech.ls stays NULL). */
+void cf_msm_tangent_fill(void *ctx, double *v);
+cf_status cf_msm_tangent_build(solver *s, const cf_mech_ops *ops, cf_error *err);
+
+/* msm_newton.c: the lattice as a mechanical system and its solves on the Newton driver.
+** cf_msm_newton: Newton from the current positions (prescribed DOFs already placed); on failure
+** the positions are put back where they started. cf_msm_direction: the tangent at the state of
+** the last cf_msm_residual() factored afresh and the update s->dx it gives for s->R (a stability
+** check), its inertia in s->neg_pivots and the statistics. */
+cf_status cf_msm_newton(solver *s, cf_error *err);
 cf_status cf_msm_direction(solver *s, cf_error *err);
-int cf_msm_factored(const solver *s);
-int cf_msm_chord(solver *s, int *fatal, cf_error *err);
-int cf_msm_krylov(solver *s, double need, int *fatal, cf_error *err);
 
 /* msm_visco.c: implicit quasi-static steps with dashpots, Maxwell branches and Prony terms */
 cf_status cf_msm_relaxed_share_check(const solver *s, cf_error *err);

@@ -1,8 +1,11 @@
 /*
 ** The lattice solvers' workspace and static equilibria (see msm_internal.h): free DOFs, loads and
-** the residual; Newton with a line search that keeps every spring short of solid, chord and Krylov
-** steps for the uniaxial curve, a secant predictor of its load steps, and load increments halved
-** when a solve fails.
+** the residual; the lattice as a mechanical system (mech.h) and its Newton solves on the one
+** driver (mech_newton.c): steps accepted only where the residual drops and every spring stays
+** short of solid, the tolerance of the force scale, chord and Krylov steps on kept factors for the
+** uniaxial curve, a fresh tangent at every step otherwise (each state's inertia is reported); the
+** static load steps with a secant predictor of the uniaxial curve's steps, and load increments
+** halved when a solve fails.
 */
 #include "model/msm_internal.h"
 
@@ -21,9 +24,14 @@
 #define CHORD_RATE 0.25
 /* Halvings of a step from reused factors (chord or Krylov) before it counts as failed: a direction
 ** that needs more is not worth the residual evaluations, the next one does better (Krylov steps,
-** then a fresh tangent). A fresh tangent's step gets FRESH_HALVINGS. */
+** then a fresh tangent). A fresh tangent's step gets FRESH_HALVINGS; after ACCEPT_AFTER of them
+** it is taken wherever no spring passes the margin, whatever its residual. */
 #define REUSE_HALVINGS 4
 #define FRESH_HALVINGS 40
+#define ACCEPT_AFTER 30
+/* A step is accepted where the residual's largest component is below (1 - DECREASE alpha) of
+** its origin's. */
+#define DECREASE 1e-4
 
 /* ---- workspace, loads and residual ----------------------------------------------------------- */
 
@@ -44,7 +52,7 @@ void cf_msm_solver_free(solver *s)
     free(s->vmap);
     free(s->xprev);
     free(s->xcur);
-    cf_linsolve_free(s->ls);
+    cf_mech_free(&s->mech);
 }
 
 static int is_prescribed(const solver *s, size_t node, int axis)
@@ -162,12 +170,12 @@ double cf_msm_residual(solver *s, double *rnorm, double *fscale)
             s->R[e] = force(lat, a)[p];
             rn = fmax(rn, fabs(s->R[e]));
         }
-    *rnorm = rn;
-    *fscale = fs;
+    *rnorm = s->rn = rn;
+    *fscale = s->fs = fs;
+    s->um = um;
+    s->r_ready = 0; /* a residual the driver did not ask for */
     return um;
 }
-
-/* ---- Newton and static load steps ------------------------------------------------------------ */
 
 void cf_msm_positions_get(const cf_lattice *lat, double *buf)
 {
@@ -215,20 +223,104 @@ static double force_floor(const solver *s)
     return 1e-12 * FC * wmax + 1e-13 * dash + (vol != 0 ? 1e-12 * vol : 0.0);
 }
 
-/* A step from reused factors did not converge fast enough: chord steps give way to Krylov steps,
-** Krylov steps to a fresh tangent. */
-static void reuse_failed(solver *s)
+/* ---- the lattice as a mechanical system ------------------------------------------------------ */
+
+/* The residual (the out-of-balance forces on the free DOFs) at the current positions: the one a
+** trial evaluated there, else evaluated now. */
+static cf_status lat_residual(void *ctx, double *r, cf_error *err)
 {
-    if (s->krylov)
-        s->refactor = 1;
-    else
-        s->krylov = 1;
+    (void)err;
+    solver *s = ctx;
+    if (!s->r_ready) {
+        double rn, fs;
+        cf_msm_residual(s, &rn, &fs);
+    }
+    s->r_ready = 0;
+    if (r != s->R)
+        memcpy(r, s->R, s->ndof * sizeof *r);
+    return CF_OK;
 }
 
-/* Newton from the current positions (prescribed DOFs already placed). On failure the positions
-** are put back where they started. One function: the choice between a chord step and a fresh
-** tangent, the line search and the retry with a fresh tangent all read and update the same
-** iteration state (residual norms, the factorisation's age). */
+static void lat_save(void *ctx)
+{
+    solver *s = ctx;
+    cf_msm_positions_get(s->lat, s->xsave);
+}
+
+/* The free DOFs at the origin plus alpha dx (dx solves K dx = R with K = -dR/dx), admissible
+** when every spring stays short of the margin to solid: known from the forces, so the residual
+** is evaluated here. alpha 0 puts the origin back. */
+static int lat_trial(void *ctx, const double *dx, double alpha)
+{
+    solver *s = ctx;
+    cf_lattice *lat = s->lat;
+    if (alpha == 0) {
+        cf_msm_positions_set(lat, s->xsave);
+        s->r_ready = 0;
+        return 1;
+    }
+    for (size_t p = 0; p < lat->nn; p++)
+        for (int a = 0; a < 3; a++) {
+            long e = s->eq[3 * p + a];
+            if (e >= 0)
+                coord(lat, a)[p] = s->xsave[a * lat->nn + p] + alpha * dx[e];
+        }
+    double rn, fs;
+    const double um = cf_msm_residual(s, &rn, &fs);
+    s->r_ready = 1;
+    return um < SOLID_MARGIN;
+}
+
+/* Converged when the residual is below newton_rtol of the largest spring tension plus the force
+** floor, and no spring passes the margin. */
+static double lat_tolerance(void *ctx, int *may_end)
+{
+    const solver *s = ctx;
+    *may_end = s->um < SOLID_MARGIN;
+    return s->cfg->newton_rtol * s->fs + s->floor_f;
+}
+
+static const cf_mech_ops lattice_ops = {lat_residual, cf_msm_tangent_fill, NULL,
+                                        lat_save,     lat_trial,           lat_tolerance};
+
+/* The driver on the lattice's tangent, with the lattice's iteration, made at the first solve. */
+static cf_status lattice_mech(solver *s, cf_error *err)
+{
+    if (s->mech.ls)
+        return CF_OK;
+    cf_status st = cf_msm_tangent_build(s, &lattice_ops, err);
+    if (st != CF_OK)
+        return st;
+    cf_mech *m = &s->mech;
+    m->use_krylov = 1;
+    m->judge_fresh = 0;
+    m->decrease = DECREASE;
+    m->accept_after = ACCEPT_AFTER;
+    m->max_halvings = FRESH_HALVINGS;
+    m->reuse_halvings = REUSE_HALVINGS;
+    m->min_alpha = 0;
+    m->step_tol = 0;
+    return CF_OK;
+}
+
+/* Adds what the driver did to the statistics. */
+static void note(solver *s, const cf_mech_result *res)
+{
+    if (res->tangents > 0)
+        s->neg_pivots = res->neg_pivots;
+    cf_msm_stats *st = s->st;
+    if (!st)
+        return;
+    st->newton_iters += (size_t)res->iters;
+    st->chord_iters += (size_t)res->reused;
+    st->linear_iters += res->linear_solves;
+    st->indefinite_tangents += (size_t)res->indefinite;
+    if (res->neg_pivots_max > st->neg_pivots_max)
+        st->neg_pivots_max = res->neg_pivots_max;
+}
+
+/* ---- Newton on the driver -------------------------------------------------------------------- */
+
 cf_status cf_msm_newton(solver *s, cf_error *err)
 {
     cf_lattice *lat = s->lat;
@@ -238,94 +330,53 @@ cf_status cf_msm_newton(solver *s, cf_error *err)
     cf_msm_positions_get(lat, start);
     if (s->st)
         s->st->solves++;
-    double rn, fs;
-    double um = cf_msm_residual(s, &rn, &fs);
-    const double floor_f = force_floor(s);
-    cf_status st = CF_E_NOCONV;
-    for (int it = 0; it <= s->cfg->newton_max_iter; it++) {
-        const double target = s->cfg->newton_rtol * fs + floor_f;
-        if (um < SOLID_MARGIN && rn <= target) {
-            st = CF_OK;
-            break;
-        }
-        if (it == s->cfg->newton_max_iter)
-            break;
-        if (s->st)
-            s->st->newton_iters++;
-        cf_error lerr = {0};
-        /* a step from the last factored tangent while it still converges fast: a chord step, or
-        ** once chord steps stall, a Krylov solve of the current tangent preconditioned by it */
-        const int reuse = s->chord && cf_msm_factored(s) && !s->refactor;
-        if (reuse) {
-            int fatal = 0;
-            /* a Krylov solve only as accurate as this step needs */
-            const int got = s->krylov ? cf_msm_krylov(s, target / rn, &fatal, &lerr)
-                                      : cf_msm_chord(s, &fatal, &lerr);
-            if (!got) {
-                if (fatal) {
-                    cf_msm_positions_set(lat, start);
-                    free(start);
-                    return cf_error_set(err, CF_E_INTERNAL, "%s", lerr.msg);
-                }
-                reuse_failed(s);
-                continue;
-            }
-            if (s->st)
-                s->st->chord_iters++;
-        } else if (cf_msm_direction(s, &lerr) != CF_OK) {
-            if (lerr.status == CF_E_INTERNAL) { /* out of memory: not a matter of step size */
-                cf_msm_positions_set(lat, start);
-                free(start);
-                return cf_error_set(err, CF_E_INTERNAL, "%s", lerr.msg);
-            }
-            break;
-        } else {
-            s->refactor = 0;
-            s->krylov = 0;
-        }
-        cf_msm_positions_get(lat, s->xsave);
-        double alpha = 1, rn0 = rn;
-        int ok = 0;
-        const int halvings = reuse ? REUSE_HALVINGS : FRESH_HALVINGS;
-        for (int h = 0; h < halvings; h++) {
-            for (size_t p = 0; p < lat->nn; p++)
-                for (int a = 0; a < 3; a++) {
-                    long e = s->eq[3 * p + a];
-                    if (e >= 0)
-                        coord(lat, a)[p] = s->xsave[a * lat->nn + p] + alpha * s->dx[e];
-                }
-            um = cf_msm_residual(s, &rn, &fs);
-            if (um < SOLID_MARGIN && isfinite(rn) && (rn < (1 - 1e-4 * alpha) * rn0 || h >= 30)) {
-                ok = 1;
-                break;
-            }
-            alpha *= 0.5;
-        }
-        if (!ok) {
-            cf_msm_positions_set(lat, s->xsave);
-            if (!reuse)
-                break;
-            um = cf_msm_residual(s, &rn, &fs); /* stale factors: the next direction does better */
-            reuse_failed(s);
-            continue;
-        }
-        /* a slow step that ends the iteration is no reason for the next one to change */
-        if (reuse && (alpha < 1 || rn > CHORD_RATE * rn0) &&
-            !(um < SOLID_MARGIN && rn <= s->cfg->newton_rtol * fs + floor_f))
-            reuse_failed(s);
+    cf_error lerr = {0};
+    cf_status st = lattice_mech(s, &lerr);
+    cf_mech_result res = {0};
+    if (st == CF_OK) {
+        double rn, fs;
+        cf_msm_residual(s, &rn, &fs);
+        s->floor_f = force_floor(s); /* the rounding of the forces at the start */
+        s->r_ready = 1;
+        cf_mech *m = &s->mech;
+        m->chord_rate = s->chord ? CHORD_RATE : 0;
+        m->max_iter = s->cfg->newton_max_iter;
+        m->fresh |= s->refactor;
+        s->refactor = 0;
+        st = cf_mech_newton(m, s->R, s->dx, &res, &lerr);
+        note(s, &res);
     }
-    if (s->st && um > s->st->max_u_over_travel && st == CF_OK)
-        s->st->max_u_over_travel = um;
-    if (st != CF_OK) {
+    if (st == CF_E_INTERNAL || lerr.status == CF_E_INTERNAL) { /* not a matter of step size */
         cf_msm_positions_set(lat, start);
-        cf_error_set(err, CF_E_NOCONV,
-                     "lattice equilibrium not found at %s %.6g (residual %.3g N, max spring "
-                     "compression %.6g of travel)",
-                     s->drive == CF_DRIVE_DISPLACEMENT ? "strain" : "stress_MPa", s->load, rn, um);
+        free(start);
+        return cf_error_set(err, CF_E_INTERNAL, "%s", lerr.msg);
     }
+    if (st == CF_OK && res.conv) {
+        if (s->st && s->um > s->st->max_u_over_travel)
+            s->st->max_u_over_travel = s->um;
+        free(start);
+        return CF_OK;
+    }
+    cf_msm_positions_set(lat, start);
     free(start);
+    return cf_error_set(err, CF_E_NOCONV,
+                        "lattice equilibrium not found at %s %.6g (residual %.3g N, max spring "
+                        "compression %.6g of travel)",
+                        s->drive == CF_DRIVE_DISPLACEMENT ? "strain" : "stress_MPa", s->load,
+                        s->rn, s->um);
+}
+
+cf_status cf_msm_direction(solver *s, cf_error *err)
+{
+    if (lattice_mech(s, err) != CF_OK)
+        return CF_E_INTERNAL;
+    cf_mech_result res;
+    cf_status st = cf_mech_inertia(&s->mech, s->R, s->dx, &res, err);
+    note(s, &res);
     return st;
 }
+
+/* ---- static load steps ----------------------------------------------------------------------- */
 
 /* Moves the free z of every node by the affine part of a strain increment de (a predictor that
 ** puts the interior where a uniform lattice would be). */

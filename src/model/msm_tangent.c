@@ -1,8 +1,8 @@
 /*
 ** The tangent of the lattice solvers (see msm_internal.h): the sparsity pattern of K = -dR/dx over
-** the free DOFs, built once from the springs and the cells of the volume term, its assembly, and
-** the Newton directions it gives through the linear solver (linsolve.h), which sees only the
-** pattern and the values.
+** the free DOFs, built once from the springs and the cells of the volume term, with the Newton
+** driver (mech.h) made on it, and its assembly into the values of the driver's linear solver
+** (linsolve.h), which sees only the pattern and the values.
 */
 #include "model/msm_tangent.h"
 #include "model/msm_internal.h"
@@ -18,8 +18,6 @@
 typedef struct ccs {
     const int *p, *i;
 } ccs;
-
-static void fill(void *ctx, double *v);
 
 /* Index of entry (row, col) in the compressed-column pattern C, or -1. */
 static int ccs_index(const ccs *C, long row, long col)
@@ -193,10 +191,10 @@ static void block_map(solver *s, const ccs *C)
     }
 }
 
-/* The sparsity pattern of the tangent, built once, and the linear solver of that pattern; then
-** for every spring the positions in the values of its four 3 x 3 blocks (ii, jj, ij, ji), and the
-** volume term's, so that assembly is a pass of additions. */
-static cf_status build_tangent(solver *s, cf_error *err)
+/* The sparsity pattern of the tangent, built once, and the driver with the linear solver of that
+** pattern; then for every spring the positions in the values of its four 3 x 3 blocks (ii, jj,
+** ij, ji), and the volume term's, so that assembly is a pass of additions. */
+cf_status cf_msm_tangent_build(solver *s, const cf_mech_ops *ops, cf_error *err)
 {
     cf_lattice *lat = s->lat;
     const size_t n = s->ndof;
@@ -215,7 +213,7 @@ static cf_status build_tangent(solver *s, cf_error *err)
     free(adj);
     free(deg);
     s->nnz = (size_t)colp[n];
-    cf_status st = cf_linsolve_create(&s->ls, n, colp, rowi, fill, s, s->cfg->banded_only, err);
+    cf_status st = cf_mech_create(&s->mech, n, 0, ops, s, colp, rowi, s->cfg->banded_only, err);
     free(colp);
     free(rowi);
     if (st != CF_OK)
@@ -228,12 +226,11 @@ static cf_status build_tangent(solver *s, cf_error *err)
         free(s->map);
         free(s->vmap);
         s->map = s->vmap = NULL;
-        cf_linsolve_free(s->ls); /* built again on the next direction */
-        s->ls = NULL;
+        cf_mech_free(&s->mech); /* built again on the next solve */
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the tangent matrix");
     }
     ccs C;
-    cf_linsolve_pattern(s->ls, &C.p, &C.i);
+    cf_linsolve_pattern(s->mech.ls, &C.p, &C.i);
     block_map(s, &C);
     return CF_OK;
 }
@@ -282,8 +279,8 @@ static void volume_tangent(solver *s, double *v)
 }
 
 /* The tangent K = -dR/dx at the state of the last cf_msm_residual() into v (the pattern of
-** build_tangent), unscaled: the matrix of the linear solver (linsolve.h). */
-static void fill(void *ctx, double *v)
+** cf_msm_tangent_build), unscaled: the matrix of the linear solver (linsolve.h). */
+void cf_msm_tangent_fill(void *ctx, double *v)
 {
     solver *s = ctx;
     cf_lattice *lat = s->lat;
@@ -316,45 +313,4 @@ static void fill(void *ctx, double *v)
     }
     if (cf_lattice_has_cells(lat))
         volume_tangent(s, v);
-}
-/* ---- the directions ------------------------------------------------------------------------- */
-
-/* Adds the inertia of the tangent just solved (s->neg_pivots, -1 unknown) to the statistics. */
-static void note_inertia(solver *s)
-{
-    const long neg = s->neg_pivots;
-    if (!s->st || neg < 0)
-        return;
-    if (neg > 0)
-        s->st->indefinite_tangents++;
-    if (neg > s->st->neg_pivots_max)
-        s->st->neg_pivots_max = neg;
-}
-
-cf_status cf_msm_direction(solver *s, cf_error *err)
-{
-    if (!s->ls && build_tangent(s, err) != CF_OK)
-        return CF_E_INTERNAL;
-    cf_status st =
-        cf_linsolve_direction(s->ls, s->R, s->dx, s->st ? &s->st->linear_iters : NULL, err);
-    s->neg_pivots = cf_linsolve_neg_pivots(s->ls);
-    note_inertia(s);
-    return st;
-}
-
-int cf_msm_factored(const solver *s)
-{
-    return s->ls && cf_linsolve_factored(s->ls);
-}
-
-int cf_msm_chord(solver *s, int *fatal, cf_error *err)
-{
-    *fatal = 0;
-    return s->ls && cf_linsolve_chord(s->ls, s->R, s->dx, fatal, err);
-}
-
-int cf_msm_krylov(solver *s, double need, int *fatal, cf_error *err)
-{
-    *fatal = 0;
-    return s->ls && cf_linsolve_krylov(s->ls, s->R, s->dx, need, fatal, err);
 }

@@ -110,7 +110,7 @@ static int trial(void *ctx, const double *dx, double alpha)
     return admissible(c);
 }
 
-static const cf_mech_ops ops = {residual, tangent, project, save, trial};
+static const cf_mech_ops ops = {residual, tangent, project, save, trial, NULL};
 
 /* A chain with its equilibrium x*_i = 1 + 0.4 sin(i) (x*_0 = 0, held) and the loads that make it. */
 static void make(chain *c, double a, double b, double k)
@@ -128,7 +128,7 @@ static cf_mech setup_mech(chain *c)
     pattern(p, rows);
     cf_mech m;
     cf_error err = {0};
-    assert_int_equal(cf_mech_create(&m, N, 0, &ops, c, p, rows, &err), CF_OK);
+    assert_int_equal(cf_mech_create(&m, N, 0, &ops, c, p, rows, 0, &err), CF_OK);
     m.tol = 1e-12;
     m.step_tol = 1e-15;
     return m;
