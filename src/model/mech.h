@@ -69,9 +69,12 @@ typedef struct cf_mech {
                             step) */
     int use_krylov;      /* 1: chord steps that stall give way to Krylov steps before a fresh
                             tangent */
-    int judge_fresh;     /* 1: a step from a fresh tangent is held to chord_rate as well (missed:
-                            the next tangent fresh too); 0: the factors of a fresh tangent are
-                            always tried */
+    int judge_fresh;     /* 1: every step is judged: one from a fresh tangent is held to
+                            chord_rate as well (missed: the next tangent fresh too), and a
+                            shortened step takes the next tangent afresh even where the state it
+                            reached converged (the next call starts there); 0: the factors of a
+                            fresh tangent are always tried, and a step on kept factors is judged
+                            only when the iteration goes on */
     double decrease;     /* 0: a step is accepted at the first admissible state; > 0: where the
                             residual there (evaluated at each trial) is also below
                             (1 - decrease alpha) of the origin's, */

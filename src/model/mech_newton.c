@@ -209,6 +209,8 @@ static cf_status newton_step(cf_mech *m, double *r, double *dx, double *rn, doub
         return CF_OK;
     }
     *last = (last_step){stage != STAGE_FRESH || m->judge_fresh, stage, alpha, rn0};
+    if (alpha < 1 && m->judge_fresh)
+        m->fresh = 1; /* a shortened step: the tangent where it landed, converged there or not */
     if (!evaluated)
         return evaluate(m, r, rn, tol, may_end, res, err);
     *tol = gauge(m, may_end);
