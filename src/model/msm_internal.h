@@ -1,7 +1,7 @@
 /*
 ** The workspace the lattice solvers share (msm.c, msm_newton.c, msm_tangent.c, msm_visco.c,
-** msm_dynamic.c, msm_uniaxial.c) and the functions they call in one another. Private
-** to the model layer.
+** msm_dynamic.c, msm_uniaxial.c) and the functions they call in one another. Private to the model
+** layer.
 */
 #ifndef CF_MODEL_MSM_INTERNAL_H
 #define CF_MODEL_MSM_INTERNAL_H

@@ -13,8 +13,9 @@
 **    a Maxwell branch (its tau) and of a Prony term (its tau_i, amplitude g_i);
 **  - cf_msm_stability_limit: stable just below the limit, unstable just above;
 **  - cf_msm_stable_step: the step an explicit run reports, shortened by dashpots;
-**  - the steps on reused factors of the static solver (private: model/msm_tangent.c over
-**    model/linsolve_krylov.c, and the chord steps and secant predictor of model/msm_newton.c): a
+**  - the steps on reused factors of the static solver (private: the chord and Krylov stages of
+**    the Newton driver, model/mech_newton.c over model/linsolve_krylov.c, with the lattice's
+**    tangent of model/msm_tangent.c, and the secant predictor of model/msm_newton.c): a
 **    Krylov step solves the current tangent, and the uniaxial curve through those steps equals the one Newton finds with a fresh
 **    tangent at every iteration, past the stability limit, with a fraction of the factorisations.
 */
