@@ -70,16 +70,19 @@ static double run_ccx(const cf_body *b, const uint8_t *load, const double *uz, c
     for (size_t k = 0; k < ne; k++)
         mid[k] = b->nn + 1 + (size_t)((uint64_t *)bsearch(key + k, sorted, nm, sizeof *sorted,
                                                           cmp_u64) - sorted);
+    const int quad = !(getenv("STUDY_ELEM") && strcmp(getenv("STUDY_ELEM"), "C3D4") == 0);
+    if (!quad)
+        nm = 0;
     for (size_t k = 0; k < nm; k++) {
         const size_t a = sorted[k] >> 32, c = sorted[k] & 0xffffffffu;
         fprintf(f, "%zu, %.17g, %.17g, %.17g\n", b->nn + 1 + k, (b->X[3 * a] + b->X[3 * c]) / 2,
                 (b->X[3 * a + 1] + b->X[3 * c + 1]) / 2, (b->X[3 * a + 2] + b->X[3 * c + 2]) / 2);
     }
-    fprintf(f, "*ELEMENT, TYPE=C3D10, ELSET=BODY\n");
+    fprintf(f, "*ELEMENT, TYPE=%s, ELSET=BODY\n", quad ? "C3D10" : "C3D4");
     for (size_t t = 0; t < b->nt; t++) {
         fprintf(f, "%zu, %u, %u, %u, %u", t + 1, b->tet[4 * t] + 1, b->tet[4 * t + 1] + 1,
                 b->tet[4 * t + 2] + 1, b->tet[4 * t + 3] + 1);
-        for (int e = 0; e < 6; e++)
+        for (int e = 0; e < 6 * quad; e++)
             fprintf(f, ",%s %zu", e == 3 ? "\n" : "", mid[6 * t + e]);
         fprintf(f, "\n");
     }
@@ -178,6 +181,10 @@ int main(int argc, char **argv)
     if (cf_body_create(&b, &m, &law, CF_LAW_CLOSED,
                        cf_body_kappa_for_nu(cf_body_mu_of_law(&law), nu), &err) != CF_OK)
         return 70;
+    /* STUDY_SCALE: every spring's factor times this (the relaxed calibration's experiment) */
+    if ((env = getenv("STUDY_SCALE")))
+        for (size_t s = 0; s < b.ns; s++)
+            b.c[s] *= atof(env);
     for (size_t i = 0; i < b.nn; i++) {
         const double *X = b.X + 3 * i;
         b.fix[i] = (uint8_t)((X[0] < 1e-9) | (X[1] < 1e-9) << 1);
