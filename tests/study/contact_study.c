@@ -35,17 +35,69 @@ static int cmp_u64(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+
+/* CalculiX's own contact for the sphere (STUDY_CONTACT=1): the block's top faces within 3 contact
+** radii of the axis (C3D10 faces; corners 1-2-3, 1-4-2, 2-4-3, 3-4-1 are faces 1 to 4) as the
+** slave surface, and as master the lower face of a layer of hexahedra on the sphere's surface
+** z = R - sqrt(R^2 - x^2 - y^2) (0.5 mm thick, a little beyond the symmetry planes), every node
+** of it moved d down (a rigid sphere); face-to-face penalty contact, frictionless. Node numbers
+** from n0, elements from e0; the layer's nodes are the set IND. */
+static void write_indenter(FILE *f, const cf_body *b, double R, double d, double E, size_t n0,
+                           size_t e0)
+{
+    const double a = sqrt(R * d), lo = -0.1 * a, hi = 3 * a;
+    const int N = (int)ceil((hi - lo) / (0.08 * a));
+    fprintf(f, "*NODE, NSET=IND\n");
+    for (int l = 0; l < 2; l++)
+        for (int j = 0; j <= N; j++)
+            for (int i = 0; i <= N; i++) {
+                const double x = lo + (hi - lo) * i / N, y = lo + (hi - lo) * j / N;
+                fprintf(f, "%zu, %.12g, %.12g, %.12g\n", n0 + (size_t)(l * (N + 1) * (N + 1) + j * (N + 1) + i),
+                        x, y, R - sqrt(R * R - x * x - y * y) + 0.5 * l * a);
+            }
+    fprintf(f, "*ELEMENT, TYPE=C3D8, ELSET=IND\n");
+    size_t e = e0;
+    for (int j = 0; j < N; j++)
+        for (int i = 0; i < N; i++) {
+            size_t c[4] = {n0 + (size_t)(j * (N + 1) + i), n0 + (size_t)(j * (N + 1) + i + 1),
+                           n0 + (size_t)((j + 1) * (N + 1) + i + 1), n0 + (size_t)((j + 1) * (N + 1) + i)};
+            const size_t up = (size_t)((N + 1) * (N + 1));
+            fprintf(f, "%zu, %zu, %zu, %zu, %zu, %zu, %zu, %zu, %zu\n", e++, c[0], c[1], c[2], c[3],
+                    c[0] + up, c[1] + up, c[2] + up, c[3] + up);
+        }
+    fprintf(f, "*SURFACE, NAME=MASTER, TYPE=ELEMENT\nIND, S1\n*SURFACE, NAME=SLAVE, TYPE=ELEMENT\n");
+    static const int face[4][3] = {{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {2, 3, 0}};
+    for (size_t t = 0; t < b->nt; t++)
+        for (int k = 0; k < 4; k++) {
+            int top = 1;
+            for (int c = 0; c < 3; c++) {
+                const double *X = b->X + 3 * b->tet[4 * t + face[k][c]];
+                top &= X[2] > -1e-9 && X[0] * X[0] + X[1] * X[1] < 9 * a * a;
+            }
+            if (top)
+                fprintf(f, "%zu, S%d\n", t + 1, k + 1);
+        }
+    fprintf(f, "*MATERIAL, NAME=RIGID\n*ELASTIC\n%.17g, 0.3\n*SOLID SECTION, ELSET=IND, MATERIAL=RIGID\n"
+               "*SURFACE INTERACTION, NAME=SI\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n"
+               "%.10g, %.10g\n*CONTACT PAIR, INTERACTION=SI, TYPE=SURFACE TO SURFACE\nSLAVE, MASTER\n",
+            1e3 * E, 1e3 * E / a, 3e-5 * E);
+    (void)d;
+}
+
 /* Writes the C3D10 deck of body b (reference positions) with the held nodes of b->fix and node
 ** i moved by uz[i] along z where load[i]; runs ccx in dir and returns the summed z reaction of
 ** the loaded nodes (NAN when ccx did not run). */
 static double run_ccx(const cf_body *b, const uint8_t *load, const double *uz, const char *dir,
-                      const char *job)
+                      const char *job, const double *sph)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/%s.inp", dir, job);
     FILE *f = fopen(path, "w");
     if (!f)
         return NAN;
+    /* with contact the deck's modulus is 1000 MPa, its force scaled back (linear in E, the
+    ** penalty taken in proportion): CalculiX's convergence tests use absolute force levels */
+    const double Ew = sph ? 1000 : b->E_MPa;
     fprintf(f, "*NODE\n");
     for (size_t i = 0; i < b->nn; i++)
         fprintf(f, "%zu, %.17g, %.17g, %.17g\n", i + 1, b->X[3 * i], b->X[3 * i + 1],
@@ -102,7 +154,9 @@ static double run_ccx(const cf_body *b, const uint8_t *load, const double *uz, c
         if (!any)
             abort();
     }
-    fprintf(f, "*NSET, NSET=NTOP\n");
+    if (sph)
+        write_indenter(f, b, sph[0], sph[1], Ew, b->nn + nm + 1, b->nt + 1);
+    fprintf(f, "*NSET, NSET=NTOP%s\n", sph ? "\nIND" : "");
     for (size_t i = 0; i < b->nn; i++)
         if (load[i])
             fprintf(f, "%zu\n", i + 1);
@@ -110,9 +164,11 @@ static double run_ccx(const cf_body *b, const uint8_t *load, const double *uz, c
         if (load[sorted[k] >> 32] && load[sorted[k] & 0xffffffffu])
             fprintf(f, "%zu\n", b->nn + 1 + k);
     fprintf(f, "*MATERIAL, NAME=TISSUE\n*ELASTIC\n%.17g, %.17g\n"
-               "*SOLID SECTION, ELSET=BODY, MATERIAL=TISSUE\n*STEP\n*STATIC\n*BOUNDARY\n"
+               "*SOLID SECTION, ELSET=BODY, MATERIAL=TISSUE\n*STEP%s\n*STATIC\n%s*BOUNDARY\n"
                "FIX1, 1, 1\nFIX2, 2, 2\nFIX3, 3, 3\n",
-            b->E_MPa, b->nu);
+            Ew, b->nu, sph ? ", INC=200" : "", sph ? "1, 1\n" : "");
+    if (sph)
+        fprintf(f, "IND, 1, 2, 0\nIND, 3, 3, %.12g\n", -sph[1]);
     for (size_t i = 0; i < b->nn; i++)
         if (load[i])
             fprintf(f, "%zu, 3, 3, %.17g\n", i + 1, uz[i]);
@@ -148,7 +204,7 @@ static double run_ccx(const cf_body *b, const uint8_t *load, const double *uz, c
             next = 1;
     }
     fclose(f);
-    return F;
+    return F * b->E_MPa / Ew;
 }
 
 int main(int argc, char **argv)
@@ -230,7 +286,11 @@ int main(int argc, char **argv)
         snprintf(job, sizeof job, "%s_nu%02d_r%g", punch ? "punch" : "sphere",
                  (int)(nu * 100 + 0.5), r);
         const double t1 = cpu_s();
-        const double Fx = 4 * run_ccx(&b, load, uz, ccxdir, job);
+        const double sph[2] = {R, d};
+        const int own = !punch && getenv("STUDY_CONTACT") && atoi(getenv("STUDY_CONTACT"));
+        if (own)
+            memset(load, 0, b.nn);
+        const double Fx = 4 * fabs(run_ccx(&b, load, uz, ccxdir, job, own ? sph : NULL));
         struct rusage u;
         getrusage(RUSAGE_CHILDREN, &u);
         printf(", C3D10/theory %.4f, conifit/C3D10 %.4f (ccx %.1f s CPU)", Fx / theory, Fc / Fx,
