@@ -8,7 +8,10 @@
 **   contact_study sphere|punch NU REFINE [--ccx DIR]
 **
 ** Prints one line: nodes, contacts, conifit's force over theory, the CPU seconds of the solve
-** and, with --ccx, C3D10's force over theory and conifit's over C3D10's.
+** and, with --ccx, C3D10's force over theory and conifit's over C3D10's. STUDY_ELEM=C3D4 writes
+** linear tetrahedra instead; STUDY_CONTACT=1 (sphere) lets CalculiX find its own contact with a
+** rigid sphere instead of taking conifit's contact nodes; STUDY_SCALE=S multiplies every
+** spring's factor by S; STUDY_R, STUDY_D and STUDY_STEPS change the sphere and its steps.
 */
 #include <math.h>
 #include <stdint.h>
@@ -35,13 +38,13 @@ static int cmp_u64(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-
 /* CalculiX's own contact for the sphere (STUDY_CONTACT=1): the block's top faces within 3 contact
 ** radii of the axis (C3D10 faces; corners 1-2-3, 1-4-2, 2-4-3, 3-4-1 are faces 1 to 4) as the
 ** slave surface, and as master the lower face of a layer of hexahedra on the sphere's surface
-** z = R - sqrt(R^2 - x^2 - y^2) (0.5 mm thick, a little beyond the symmetry planes), every node
-** of it moved d down (a rigid sphere); face-to-face penalty contact, frictionless. Node numbers
-** from n0, elements from e0; the layer's nodes are the set IND. */
+** z = R - sqrt(R^2 - x^2 - y^2) (a = sqrt(R d) thick, 0.08 a apart, from -0.1 a to 3 a: a little
+** beyond the symmetry planes), every node of it moved d down (a rigid sphere); face-to-face
+** penalty contact of slope 1000 E/a, frictionless. Node numbers from n0, elements from e0; the
+** layer's nodes are the set IND. */
 static void write_indenter(FILE *f, const cf_body *b, double R, double d, double E, size_t n0,
                            size_t e0)
 {
@@ -52,20 +55,22 @@ static void write_indenter(FILE *f, const cf_body *b, double R, double d, double
         for (int j = 0; j <= N; j++)
             for (int i = 0; i <= N; i++) {
                 const double x = lo + (hi - lo) * i / N, y = lo + (hi - lo) * j / N;
-                fprintf(f, "%zu, %.12g, %.12g, %.12g\n", n0 + (size_t)(l * (N + 1) * (N + 1) + j * (N + 1) + i),
-                        x, y, R - sqrt(R * R - x * x - y * y) + 0.5 * l * a);
+                const size_t n = n0 + (size_t)((l * (N + 1) + j) * (N + 1) + i);
+                fprintf(f, "%zu, %.12g, %.12g, %.12g\n", n, x, y,
+                        R - sqrt(R * R - x * x - y * y) + 0.5 * l * a);
             }
     fprintf(f, "*ELEMENT, TYPE=C3D8, ELSET=IND\n");
     size_t e = e0;
     for (int j = 0; j < N; j++)
         for (int i = 0; i < N; i++) {
-            size_t c[4] = {n0 + (size_t)(j * (N + 1) + i), n0 + (size_t)(j * (N + 1) + i + 1),
-                           n0 + (size_t)((j + 1) * (N + 1) + i + 1), n0 + (size_t)((j + 1) * (N + 1) + i)};
+            const size_t c0 = n0 + (size_t)(j * (N + 1) + i), c2 = c0 + (size_t)(N + 1);
+            const size_t c[4] = {c0, c0 + 1, c2 + 1, c2};
             const size_t up = (size_t)((N + 1) * (N + 1));
             fprintf(f, "%zu, %zu, %zu, %zu, %zu, %zu, %zu, %zu, %zu\n", e++, c[0], c[1], c[2], c[3],
                     c[0] + up, c[1] + up, c[2] + up, c[3] + up);
         }
-    fprintf(f, "*SURFACE, NAME=MASTER, TYPE=ELEMENT\nIND, S1\n*SURFACE, NAME=SLAVE, TYPE=ELEMENT\n");
+    fprintf(f, "*SURFACE, NAME=MASTER, TYPE=ELEMENT\nIND, S1\n"
+               "*SURFACE, NAME=SLAVE, TYPE=ELEMENT\n");
     static const int face[4][3] = {{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {2, 3, 0}};
     for (size_t t = 0; t < b->nt; t++)
         for (int k = 0; k < 4; k++) {
@@ -77,11 +82,12 @@ static void write_indenter(FILE *f, const cf_body *b, double R, double d, double
             if (top)
                 fprintf(f, "%zu, S%d\n", t + 1, k + 1);
         }
-    fprintf(f, "*MATERIAL, NAME=RIGID\n*ELASTIC\n%.17g, 0.3\n*SOLID SECTION, ELSET=IND, MATERIAL=RIGID\n"
+    fprintf(f, "*MATERIAL, NAME=RIGID\n*ELASTIC\n%.10g, 0.3\n"
+               "*SOLID SECTION, ELSET=IND, MATERIAL=RIGID\n"
                "*SURFACE INTERACTION, NAME=SI\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n"
-               "%.10g, %.10g\n*CONTACT PAIR, INTERACTION=SI, TYPE=SURFACE TO SURFACE\nSLAVE, MASTER\n",
+               "%.10g, %.10g\n*CONTACT PAIR, INTERACTION=SI, TYPE=SURFACE TO SURFACE\n"
+               "SLAVE, MASTER\n",
             1e3 * E, 1e3 * E / a, 3e-5 * E);
-    (void)d;
 }
 
 /* Writes the C3D10 deck of body b (reference positions) with the held nodes of b->fix and node

@@ -91,7 +91,8 @@ static double relax_ratio(const cf_body *b, const cf_law *law, const double G[3]
         k[s] = b->c[s] * law->k0_N_per_mm * law->p.H_mm / b->L0[s];
     for (size_t i = 0; i < b->nn; i++)
         for (int a = 0; a < 3; a++)
-            u[3 * i + a] = G[a][0] * b->X[3 * i] + G[a][1] * b->X[3 * i + 1] + G[a][2] * b->X[3 * i + 2];
+            u[3 * i + a] =
+                G[a][0] * b->X[3 * i] + G[a][1] * b->X[3 * i + 1] + G[a][2] * b->X[3 * i + 2];
     double Wv = 0, V = 0, ee = 0;
     for (size_t s = 0; s < b->ns; s++) {
         double d = 0;
