@@ -299,7 +299,10 @@ int main(int argc, char **argv)
         const double Fx = 4 * fabs(run_ccx(&b, load, uz, ccxdir, job, own ? sph : NULL));
         struct rusage u;
         getrusage(RUSAGE_CHILDREN, &u);
-        printf(", C3D10/theory %.4f, conifit/C3D10 %.4f (ccx %.1f s CPU)", Fx / theory, Fc / Fx,
+        const char *el = (env = getenv("STUDY_ELEM")) && strcmp(env, "C3D4") == 0 ? "C3D4"
+                         : own                                                ? "C3D10-contact"
+                                                                              : "C3D10";
+        printf(", %s/theory %.4f, conifit/%s %.4f (ccx %.1f s CPU)", el, Fx / theory, el, Fc / Fx,
                (double)u.ru_utime.tv_sec + 1e-6 * (double)u.ru_utime.tv_usec + (cpu_s() - t1));
         free(load);
         free(uz);
