@@ -8,7 +8,10 @@
 **   contact_study sphere|punch NU REFINE [--ccx DIR]
 **
 ** Prints one line: nodes, contacts, conifit's force over theory, the CPU seconds of the solve
-** and, with --ccx, C3D10's force over theory and conifit's over C3D10's.
+** and, with --ccx, C3D10's force over theory and conifit's over C3D10's. STUDY_ELEM=C3D4 writes
+** linear tetrahedra instead; STUDY_CONTACT=1 (sphere) lets CalculiX find its own contact with a
+** rigid sphere instead of taking conifit's contact nodes; STUDY_SCALE=S multiplies every
+** spring's factor by S; STUDY_R, STUDY_D and STUDY_STEPS change the sphere and its steps.
 */
 #include <math.h>
 #include <stdint.h>
@@ -35,17 +38,72 @@ static int cmp_u64(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* CalculiX's own contact for the sphere (STUDY_CONTACT=1): the block's top faces within 3 contact
+** radii of the axis (C3D10 faces; corners 1-2-3, 1-4-2, 2-4-3, 3-4-1 are faces 1 to 4) as the
+** slave surface, and as master the lower face of a layer of hexahedra on the sphere's surface
+** z = R - sqrt(R^2 - x^2 - y^2) (a = sqrt(R d) thick, 0.08 a apart, from -0.1 a to 3 a: a little
+** beyond the symmetry planes), every node of it moved d down (a rigid sphere); face-to-face
+** penalty contact of slope 1000 E/a, frictionless. Node numbers from n0, elements from e0; the
+** layer's nodes are the set IND. */
+static void write_indenter(FILE *f, const cf_body *b, double R, double d, double E, size_t n0,
+                           size_t e0)
+{
+    const double a = sqrt(R * d), lo = -0.1 * a, hi = 3 * a;
+    const int N = (int)ceil((hi - lo) / (0.08 * a));
+    fprintf(f, "*NODE, NSET=IND\n");
+    for (int l = 0; l < 2; l++)
+        for (int j = 0; j <= N; j++)
+            for (int i = 0; i <= N; i++) {
+                const double x = lo + (hi - lo) * i / N, y = lo + (hi - lo) * j / N;
+                const size_t n = n0 + (size_t)((l * (N + 1) + j) * (N + 1) + i);
+                fprintf(f, "%zu, %.12g, %.12g, %.12g\n", n, x, y,
+                        R - sqrt(R * R - x * x - y * y) + 0.5 * l * a);
+            }
+    fprintf(f, "*ELEMENT, TYPE=C3D8, ELSET=IND\n");
+    size_t e = e0;
+    for (int j = 0; j < N; j++)
+        for (int i = 0; i < N; i++) {
+            const size_t c0 = n0 + (size_t)(j * (N + 1) + i), c2 = c0 + (size_t)(N + 1);
+            const size_t c[4] = {c0, c0 + 1, c2 + 1, c2};
+            const size_t up = (size_t)((N + 1) * (N + 1));
+            fprintf(f, "%zu, %zu, %zu, %zu, %zu, %zu, %zu, %zu, %zu\n", e++, c[0], c[1], c[2], c[3],
+                    c[0] + up, c[1] + up, c[2] + up, c[3] + up);
+        }
+    fprintf(f, "*SURFACE, NAME=MASTER, TYPE=ELEMENT\nIND, S1\n"
+               "*SURFACE, NAME=SLAVE, TYPE=ELEMENT\n");
+    static const int face[4][3] = {{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {2, 3, 0}};
+    for (size_t t = 0; t < b->nt; t++)
+        for (int k = 0; k < 4; k++) {
+            int top = 1;
+            for (int c = 0; c < 3; c++) {
+                const double *X = b->X + 3 * b->tet[4 * t + face[k][c]];
+                top &= X[2] > -1e-9 && X[0] * X[0] + X[1] * X[1] < 9 * a * a;
+            }
+            if (top)
+                fprintf(f, "%zu, S%d\n", t + 1, k + 1);
+        }
+    fprintf(f, "*MATERIAL, NAME=RIGID\n*ELASTIC\n%.10g, 0.3\n"
+               "*SOLID SECTION, ELSET=IND, MATERIAL=RIGID\n"
+               "*SURFACE INTERACTION, NAME=SI\n*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n"
+               "%.10g, %.10g\n*CONTACT PAIR, INTERACTION=SI, TYPE=SURFACE TO SURFACE\n"
+               "SLAVE, MASTER\n",
+            1e3 * E, 1e3 * E / a, 3e-5 * E);
+}
+
 /* Writes the C3D10 deck of body b (reference positions) with the held nodes of b->fix and node
 ** i moved by uz[i] along z where load[i]; runs ccx in dir and returns the summed z reaction of
 ** the loaded nodes (NAN when ccx did not run). */
 static double run_ccx(const cf_body *b, const uint8_t *load, const double *uz, const char *dir,
-                      const char *job)
+                      const char *job, const double *sph)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/%s.inp", dir, job);
     FILE *f = fopen(path, "w");
     if (!f)
         return NAN;
+    /* with contact the deck's modulus is 1000 MPa, its force scaled back (linear in E, the
+    ** penalty taken in proportion): CalculiX's convergence tests use absolute force levels */
+    const double Ew = sph ? 1000 : b->E_MPa;
     fprintf(f, "*NODE\n");
     for (size_t i = 0; i < b->nn; i++)
         fprintf(f, "%zu, %.17g, %.17g, %.17g\n", i + 1, b->X[3 * i], b->X[3 * i + 1],
@@ -70,16 +128,19 @@ static double run_ccx(const cf_body *b, const uint8_t *load, const double *uz, c
     for (size_t k = 0; k < ne; k++)
         mid[k] = b->nn + 1 + (size_t)((uint64_t *)bsearch(key + k, sorted, nm, sizeof *sorted,
                                                           cmp_u64) - sorted);
+    const int quad = !(getenv("STUDY_ELEM") && strcmp(getenv("STUDY_ELEM"), "C3D4") == 0);
+    if (!quad)
+        nm = 0;
     for (size_t k = 0; k < nm; k++) {
         const size_t a = sorted[k] >> 32, c = sorted[k] & 0xffffffffu;
         fprintf(f, "%zu, %.17g, %.17g, %.17g\n", b->nn + 1 + k, (b->X[3 * a] + b->X[3 * c]) / 2,
                 (b->X[3 * a + 1] + b->X[3 * c + 1]) / 2, (b->X[3 * a + 2] + b->X[3 * c + 2]) / 2);
     }
-    fprintf(f, "*ELEMENT, TYPE=C3D10, ELSET=BODY\n");
+    fprintf(f, "*ELEMENT, TYPE=%s, ELSET=BODY\n", quad ? "C3D10" : "C3D4");
     for (size_t t = 0; t < b->nt; t++) {
         fprintf(f, "%zu, %u, %u, %u, %u", t + 1, b->tet[4 * t] + 1, b->tet[4 * t + 1] + 1,
                 b->tet[4 * t + 2] + 1, b->tet[4 * t + 3] + 1);
-        for (int e = 0; e < 6; e++)
+        for (int e = 0; e < 6 * quad; e++)
             fprintf(f, ",%s %zu", e == 3 ? "\n" : "", mid[6 * t + e]);
         fprintf(f, "\n");
     }
@@ -99,7 +160,9 @@ static double run_ccx(const cf_body *b, const uint8_t *load, const double *uz, c
         if (!any)
             abort();
     }
-    fprintf(f, "*NSET, NSET=NTOP\n");
+    if (sph)
+        write_indenter(f, b, sph[0], sph[1], Ew, b->nn + nm + 1, b->nt + 1);
+    fprintf(f, "*NSET, NSET=NTOP%s\n", sph ? "\nIND" : "");
     for (size_t i = 0; i < b->nn; i++)
         if (load[i])
             fprintf(f, "%zu\n", i + 1);
@@ -107,9 +170,11 @@ static double run_ccx(const cf_body *b, const uint8_t *load, const double *uz, c
         if (load[sorted[k] >> 32] && load[sorted[k] & 0xffffffffu])
             fprintf(f, "%zu\n", b->nn + 1 + k);
     fprintf(f, "*MATERIAL, NAME=TISSUE\n*ELASTIC\n%.17g, %.17g\n"
-               "*SOLID SECTION, ELSET=BODY, MATERIAL=TISSUE\n*STEP\n*STATIC\n*BOUNDARY\n"
+               "*SOLID SECTION, ELSET=BODY, MATERIAL=TISSUE\n*STEP%s\n*STATIC\n%s*BOUNDARY\n"
                "FIX1, 1, 1\nFIX2, 2, 2\nFIX3, 3, 3\n",
-            b->E_MPa, b->nu);
+            Ew, b->nu, sph ? ", INC=200" : "", sph ? "1, 1\n" : "");
+    if (sph)
+        fprintf(f, "IND, 1, 2, 0\nIND, 3, 3, %.12g\n", -sph[1]);
     for (size_t i = 0; i < b->nn; i++)
         if (load[i])
             fprintf(f, "%zu, 3, 3, %.17g\n", i + 1, uz[i]);
@@ -145,7 +210,7 @@ static double run_ccx(const cf_body *b, const uint8_t *load, const double *uz, c
             next = 1;
     }
     fclose(f);
-    return F;
+    return F * b->E_MPa / Ew;
 }
 
 int main(int argc, char **argv)
@@ -178,6 +243,10 @@ int main(int argc, char **argv)
     if (cf_body_create(&b, &m, &law, CF_LAW_CLOSED,
                        cf_body_kappa_for_nu(cf_body_mu_of_law(&law), nu), &err) != CF_OK)
         return 70;
+    /* STUDY_SCALE: every spring's factor times this (the relaxed calibration's experiment) */
+    if ((env = getenv("STUDY_SCALE")))
+        for (size_t s = 0; s < b.ns; s++)
+            b.c[s] *= atof(env);
     for (size_t i = 0; i < b.nn; i++) {
         const double *X = b.X + 3 * i;
         b.fix[i] = (uint8_t)((X[0] < 1e-9) | (X[1] < 1e-9) << 1);
@@ -223,10 +292,17 @@ int main(int argc, char **argv)
         snprintf(job, sizeof job, "%s_nu%02d_r%g", punch ? "punch" : "sphere",
                  (int)(nu * 100 + 0.5), r);
         const double t1 = cpu_s();
-        const double Fx = 4 * run_ccx(&b, load, uz, ccxdir, job);
+        const double sph[2] = {R, d};
+        const int own = !punch && getenv("STUDY_CONTACT") && atoi(getenv("STUDY_CONTACT"));
+        if (own)
+            memset(load, 0, b.nn);
+        const double Fx = 4 * fabs(run_ccx(&b, load, uz, ccxdir, job, own ? sph : NULL));
         struct rusage u;
         getrusage(RUSAGE_CHILDREN, &u);
-        printf(", C3D10/theory %.4f, conifit/C3D10 %.4f (ccx %.1f s CPU)", Fx / theory, Fc / Fx,
+        const char *el = (env = getenv("STUDY_ELEM")) && strcmp(env, "C3D4") == 0 ? "C3D4"
+                         : own                                                ? "C3D10-contact"
+                                                                              : "C3D10";
+        printf(", %s/theory %.4f, conifit/%s %.4f (ccx %.1f s CPU)", el, Fx / theory, el, Fc / Fx,
                (double)u.ru_utime.tv_sec + 1e-6 * (double)u.ru_utime.tv_usec + (cpu_s() - t1));
         free(load);
         free(uz);

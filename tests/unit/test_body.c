@@ -12,6 +12,7 @@
 #include "export/export.h"
 #include "io/fitfile.h"
 #include "io/mesh.h"
+#include "study/relax.h"
 
 TU_SCRATCH_GROUP("body")
 
@@ -276,6 +277,52 @@ static void hertz_sphere_nu_045(void **state)
 {
     (void)state;
     hertz_on_three_meshes(0.45);
+}
+
+/* Why Hertz drifts under refinement (src/notes/contact-study.md, "Why the sphere drifts"): the
+** network is a linear-tetrahedron body whose elements' spring tensors scatter about the isotropic
+** one, and it relaxes below their average, the calibration's. On the study's middle mesh (2,830
+** nodes), an affine strain on the block's boundary and the inner nodes free: 0.9545 (uniaxial
+** strain), 0.9338 and 0.9385 (shears), 0.9271 (pure shear) of the calibrated energy, measured */
+static void the_network_relaxes_below_its_calibration(void **state)
+{
+    (void)state;
+    cf_law law = test_law();
+    const double W = 30, r = 3;
+    double lo[3] = {0, 0, -W}, hi[3] = {W, W, 0}, f[3] = {0, 0, 0};
+    cf_mesh m;
+    cf_error err = {0};
+    assert_int_equal(cf_mesh_box(lo, hi, f, 0.3 / r, 8 / r, 0.4 / r, &m, &err), CF_OK);
+    cf_body b;
+    assert_int_equal(cf_body_create(&b, &m, &law, CF_LAW_CLOSED, 0, &err), CF_OK);
+    uint8_t *fr = calloc(b.nn, 1);
+    assert_non_null(fr);
+    for (size_t i = 0; i < b.nn; i++) {
+        const double *X = b.X + 3 * i;
+        fr[i] = !(X[0] < 1e-9 || X[1] < 1e-9 || X[2] > -1e-9 || X[0] > W - 1e-9 ||
+                  X[1] > W - 1e-9 || X[2] < -W + 1e-9);
+    }
+    static const double G[4][3][3] = {{{0, 0, 0}, {0, 0, 0}, {0, 0, 1}},
+                                      {{0, 0, .5}, {0, 0, 0}, {.5, 0, 0}},
+                                      {{0, .5, 0}, {.5, 0, 0}, {0, 0, 0}},
+                                      {{.5, 0, 0}, {0, -.5, 0}, {0, 0, 0}}};
+    static const double measured[4] = {0.9545, 0.9338, 0.9385, 0.9271};
+    double mean = 0;
+    for (int mode = 0; mode < 4; mode++) {
+        double voigt;
+        const double rel = relax_ratio(&b, &law, G[mode], fr, &voigt);
+        print_message("mode %d: relaxed / calibrated %.4f, calibrated / isotropic %.4f\n", mode,
+                      rel, voigt);
+        assert_close(rel, measured[mode], 0.01);
+        mean += rel / 4;
+    }
+    /* 6 % softer than calibrated: the limit the sphere's force approaches as the linear
+    ** tetrahedron's own stiffness vanishes under refinement */
+    assert_true(mean > 0.92 && mean < 0.96);
+    free(fr);
+    cf_body_free(&b);
+    cf_mesh_free(&m);
+    cf_law_free(&law);
 }
 
 static void boussinesq_punch_nu_025(void **state)
@@ -814,6 +861,7 @@ int main(void)
         cmocka_unit_test(the_network_has_the_reported_small_strain_moduli),
         cmocka_unit_test(hertz_sphere_nu_025),
         cmocka_unit_test(hertz_sphere_nu_045),
+        cmocka_unit_test(the_network_relaxes_below_its_calibration),
         cmocka_unit_test(boussinesq_punch_nu_025),
         cmocka_unit_test(boussinesq_punch_nu_045),
         cmocka_unit_test(a_probe_inside_the_body_is_found),
