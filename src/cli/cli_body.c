@@ -99,7 +99,7 @@ cf_status cf_cli_body_create(const cf_scene *sc, const cf_law *law, const cf_mes
                              cf_body *b, cf_error *err)
 {
     double kappa = 0, mu = cf_body_mu_of_law(law);
-    if (sc->body_volume == 1)
+    if (sc->body_volume == 1 || sc->body_volume == 3) /* 3: the fit's lattice's, the same kappa */
         kappa = sc->body_volume_value;
     else if (sc->body_volume == 2)
         kappa = cf_body_kappa_for_nu(mu, sc->body_volume_value);
@@ -554,6 +554,11 @@ static void summary(FILE *o, const cf_scene *sc, const run *r)
     fprintf(o, "body: E = %.6g kPa, nu = %.6g (shear modulus %.6g kPa from the spring, volume "
                "modulus %.6g kPa)\n",
             b->E_MPa * 1e3, b->nu, b->mu_MPa * 1e3, b->kappa_MPa * 1e3);
+    if (sc->body_volume == 3)
+        fprintf(o, "volume term: the fit's lattice's, kappa = %.6g kPa taken whole (the isotropic "
+                   "lattice and the body share mu = k0/(2.5 H) and lambda = mu + kappa, so the "
+                   "body has the lattice's small-strain E = %.6g kPa and nu = %.6g)\n",
+                b->kappa_MPa * 1e3, b->E_MPa * 1e3, b->nu);
     pair_line(o, r);
     if (sc->body_element_size_mm > 0) {
         const cf_mesh_surface_info *si = &r->surface;

@@ -253,15 +253,13 @@ static cf_status static_run_fits(const char *name, const cf_export_lattice *lx,
 
 /* A body scene's model into q->body_buf: the body solved with the fit file's element (a
 ** double-acting one's extension spring too, never its compression spring alone) as simulate
-** solves it; a lattice's volume term is not a body's (scene_body.c). */
+** solves it; the fit's lattice volume term is the body's (cf_scene_body_fit_volume). */
 static cf_status body_model(export_request *q, const cf_fitted_spring *fs, cf_scene *sc,
                             cf_error *err)
 {
-    if (fs->volume_modulus_MPa > 0)
-        return cf_error_set(err, CF_E_DATA, "%s: a body's export: %s holds a lattice volume "
-                            "term (volume_modulus_MPa = %g, the cubic lattice's), which is not "
-                            "built for bodies; a body takes its volume term from 'body'",
-                            q->scene_path, q->fit_path, fs->volume_modulus_MPa);
+    cf_status st = cf_scene_body_fit_volume(sc, q->scene_path, q->fit_path, fs, err);
+    if (st != CF_OK)
+        return st;
     sc->spring = fs->params;
     sc->extension = fs->extension;
     sc->has_extension = fs->has_extension;
@@ -272,8 +270,7 @@ static cf_status body_model(export_request *q, const cf_fitted_spring *fs, cf_sc
     opt.source = cf_cli_is_stdio(q->fit_path) ? "(standard input)" : q->fit_path;
     opt.output = q->out_path && !cf_cli_is_stdio(q->out_path) ? q->out_path : NULL;
     opt.auto_tol = !q->ea.tol_given;
-    cf_status st = cf_cli_body_export(sc, q->scene_path, &q->ea.budget, mem, &opt, &q->body_rep,
-                                      err);
+    st = cf_cli_body_export(sc, q->scene_path, &q->ea.budget, mem, &opt, &q->body_rep, err);
     if (fclose(mem) != 0 && st == CF_OK)
         st = cf_error_set(err, CF_E_INTERNAL, "out of memory");
     return st;

@@ -35,6 +35,16 @@ cf_status cf_scene_law(const cf_scene *sc, cf_law *law, cf_law *ext, cf_error *e
 /* Releases the arrays of sc. Safe on a zeroed scene. */
 void cf_scene_free(cf_scene *sc);
 
+/* A body scene's volume term from the fit at fit_path (fs as cf_fitfile_load_element read it):
+** its lattice's kappa > 0 becomes the body's (body_volume 3; the isotropic lattice and the body
+** share mu and lambda = mu + kappa, scene_body.c), refused with CF_E_DATA beside the scene's own
+** 'body.poisson_ratio' or 'body.volume_modulus_MPa' and for a lattice of other than the isotropic
+** weights; a fit without one leaves the scene's own (and drops an earlier fit's). name: the
+** scene's, for messages. */
+struct cf_fitted_spring;
+cf_status cf_scene_body_fit_volume(cf_scene *sc, const char *name, const char *fit_path,
+                                   const struct cf_fitted_spring *fs, cf_error *err);
+
 /* The loading path of the scene, for cf_msm_run. */
 cf_msm_path cf_scene_path(const cf_scene *sc);
 

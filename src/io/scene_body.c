@@ -7,6 +7,7 @@
 #include <strings.h>
 
 #include "io/scene_internal.h"
+#include "model/calibration.h"
 
 /* A plane selector, "below" or "above": {"axis": "x"|"y"|"z", "value_mm": V} (the coordinate
 ** against V) or {"normal": [nx, ny, nz], "point_mm": [x, y, z]} (the side of the plane through the
@@ -436,6 +437,50 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
     return CF_OK;
 }
 
+/* The volume term of the fit's lattice as the body's (scene.h). The isotropic lattice
+** (calibration.h) and the body (body.h) are both central-spring networks calibrated to the shear
+** modulus mu = k0/(2.5 H) with lambda = mu (the Cauchy relation), and both volume terms store
+** (kappa/2)(J - 1)^2 per unit volume, which adds kappa to lambda and nothing to mu: the same kappa
+** gives the body the lattice's small-strain E and nu, nu = (mu + kappa)/(2 (2 mu + kappa)). A fit
+** through a lattice of other weights (its "lattice.weights" not the isotropic ones) has another
+** mu and a cubic material, which the body's isotropic network cannot take: refused. */
+cf_status cf_scene_body_fit_volume(cf_scene *sc, const char *name, const char *fit_path,
+                                   const struct cf_fitted_spring *fs, cf_error *err)
+{
+    if (!(fs->volume_modulus_MPa > 0)) {
+        if (sc->body_volume == 3) /* a scene's fit replaced by one without a volume term */
+            sc->body_volume = 0;
+        return CF_OK;
+    }
+    if (sc->body_volume == 1 || sc->body_volume == 2)
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: key 'body.%s': '%s' holds its lattice's volume term "
+                            "(volume_modulus_MPa = %g), which the body takes; give one or the "
+                            "other", name, sc->body_volume == 2 ? "poisson_ratio" : "volume_modulus_MPa",
+                            fit_path, fs->volume_modulus_MPa);
+    cf_fitted_model m;
+    cf_error e = {0};
+    double iso[CF_FAMILY_COUNT];
+    /* a file that does not record its lattice (an exported spring) is taken at the isotropic
+    ** calibration, a lattice scene's default */
+    if (cf_fitfile_load_model(fit_path, cf_spring_type_name(fs->type), &m, &e) != CF_OK)
+        m.has_weight = 0;
+    if (cf_calibration_weights(CF_CAL_ISOTROPIC, iso, &e) != CF_OK)
+        return cf_error_set(err, CF_E_INTERNAL, "%s", e.msg);
+    for (int f = 0; f < CF_FAMILY_COUNT && m.has_weight; f++)
+        if (!(fabs(m.weight[f] - iso[f]) <= 1e-9 * iso[f]))
+            return cf_error_set(err, CF_E_DATA,
+                                "%s: '%s': its volume term (volume_modulus_MPa = %g) was fitted "
+                                "in a lattice of %s weight %g, not the isotropic calibration's "
+                                "%g; a body (an isotropic network) takes the volume term of an "
+                                "isotropic lattice only",
+                                name, fit_path, fs->volume_modulus_MPa, cf_family_name(f),
+                                m.weight[f], iso[f]);
+    sc->body_volume = 3;
+    sc->body_volume_value = fs->volume_modulus_MPa;
+    return CF_OK;
+}
+
 cf_status cf_scene_body(ctx *c, json_t *root, cf_scene *sc)
 {
     cf_status st;
@@ -448,16 +493,11 @@ cf_status cf_scene_body(ctx *c, json_t *root, cf_scene *sc)
                             "'probe' need a 'body'", c->name);
     /* a double-acting element (the fit's or 'spring_extension') runs in a body: its edges close
     ** under compression on the spring and under extension on the extension spring; the fit's
-    ** volume term is the cubic lattice's, calibrated on its cell, not a body's */
-    if (bd && c->from_fit && c->fit.volume_modulus_MPa > 0)
-        return cf_error_set(c->err, CF_E_DATA,
-                            "%s: key 'body': 'spring.fit' = '%s' holds a lattice volume term "
-                            "(volume_modulus_MPa = %g, calibrated on the cubic lattice's cell), "
-                            "which is not built for bodies; a body takes its volume term from "
-                            "'body.poisson_ratio' or 'body.volume_modulus_MPa' (a fit without "
-                            "one: no --volume, --volume-modulus or --poisson)",
-                            c->name, sc->fit_path, c->fit.volume_modulus_MPa);
-    return bd ? body_sections(c, root, bd, sc) : CF_OK;
+    ** volume term (fitted in the isotropic lattice) is the body's, cf_scene_body_fit_volume */
+    if (bd && (st = body_sections(c, root, bd, sc)))
+        return st;
+    return bd && c->from_fit ? cf_scene_body_fit_volume(sc, c->name, sc->fit_path, &c->fit, c->err)
+                             : CF_OK;
 }
 
 /* The keys of the lattice's effects and integrator that a body does not take, refused by name

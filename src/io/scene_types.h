@@ -71,7 +71,10 @@ typedef struct cf_scene {
     double body_element_size_mm; /* body.element_size_mm: with a closed surface (.obj, .stl) for
                                     body.mesh, the target size of the tetrahedra filling it, mm;
                                     0 with a volume mesh */
-    int body_volume;            /* 0 no volume term, 1 body.volume_modulus_MPa, 2 body.poisson_ratio */
+    int body_volume;            /* 0 no volume term, 1 body.volume_modulus_MPa, 2 body.poisson_ratio,
+                                   3 the volume term of spring.fit's lattice (its kappa, taken as
+                                   the body's: src/notes/simulate.md, "The fitted lattice's
+                                   volume term in a body") */
     double body_volume_value;   /* kappa (MPa) or nu */
     int body_steps;             /* static steps of the run: probe.steps, or body.steps without a
                                    probe */

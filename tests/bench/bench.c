@@ -189,6 +189,7 @@ int main(int argc, char **argv)
                     {"long tables", bench_section_longfit},
                     {"fits at the cost of the law", bench_section_fastfit},
                     {"tissue bodies: the probe loop", bench_section_body},
+                    {"tissue bodies at organ scale (50,000 nodes)", bench_section_body_large},
                     {"output files: a --vtu series", bench_section_output},
                     {"tissue bodies: Hertz on the finest contact mesh", bench_section_contact}};
     const int nsec = (int)(sizeof sections / sizeof sections[0]);

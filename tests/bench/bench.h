@@ -89,6 +89,7 @@ void bench_section_longfit(bench_ctx *ctx);
 void bench_section_fastfit(bench_ctx *ctx);
 void bench_section_body(bench_ctx *ctx);
 void bench_section_body_ccx(bench_ctx *ctx); /* called by bench_section_body */
+void bench_section_body_large(bench_ctx *ctx); /* about 50,000 nodes against a minute of CPU */
 void bench_section_output(bench_ctx *ctx);
 void bench_section_contact(bench_ctx *ctx);
 void bench_section_startup(bench_ctx *ctx);
