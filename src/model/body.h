@@ -243,9 +243,11 @@ cf_status cf_body_solve_force(cf_body *b, const cf_probe *probe, double force_N,
 ** (a rank-one term per node, its three columns of the inverse computed once at its first contact),
 ** so that contact changes need no new factorisation. Stops early when the residual is below
 ** 1e-8 E h^2 (h the mean edge). The force is that of the positions returned: the last
-** assembly's when the residual stopped the update, else the contact force (penalty times depth
-** of the nodes in contact) where the last step left the body; repeated at one depth the updates
-** converge to cf_body_solve's equilibrium. The kept
+** assembly's when the residual stopped the update, else the body's internal forces at the nodes
+** in contact along the probe's direction where the last step left the body (an estimate of the
+** equilibrium force whose error scales with the body's stiffness, not the penalty's; those
+** forces are kept for the next update's residual); repeated at one depth the updates converge to
+** cf_body_solve's equilibrium. The kept
 ** columns grow by 9 nn numbers per node that has ever touched the probe (cf_body_free releases
 ** them). Same errors as cf_body_solve. */
 cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm,

@@ -123,8 +123,12 @@ static cf_status haptic_prepare(cf_body *b, body_work *w, cf_error *err)
         w->slot = calloc(nn, sizeof *w->slot);
         w->hy = malloc(n * sizeof *w->hy);
         w->hrhs = malloc(n * sizeof *w->hrhs);
-        if (!w->hactive || !w->slot || !w->hy || !w->hrhs)
+        w->hgi = malloc(n * sizeof *w->hgi);
+        w->hxg = malloc(n * sizeof *w->hxg);
+        if (!w->hactive || !w->slot || !w->hy || !w->hrhs || !w->hgi || !w->hxg)
             return cf_error_set(err, CF_E_INTERNAL, "out of memory for the haptic loop");
+        for (size_t i = 0; i < n; i++)
+            w->hxg[i] = NAN; /* no internal forces kept yet */
         if ((st = cf_sparse_chol_create(&w->hch, n, w->P.colptr, w->P.rowidx, err)) != CF_OK)
             return st;
     }
@@ -163,25 +167,117 @@ static int grow(size_t *cap, size_t **list, double **nv, double **M, double **rh
     return r2 ? 0 : -1;
 }
 
-/* The probe's force along its direction from the m nodes of list[] (penalty kp, reference point
-** c) at the body's positions: the contact term of cf_body_assemble's force alone, O(m). */
-static double contact_force(const cf_body *b, const cf_probe *probe, const double *c, double kp,
-                            const size_t *list, size_t m)
+/* Node i's contact normal (its held components zero) into nv[3]. */
+static void contact_normal(const cf_body *b, const cf_probe *probe, const double *c, size_t i,
+                           double *nv)
 {
-    double force = 0;
-    for (size_t k = 0; k < m; k++) {
+    cf_body_penetration(probe, c, b->x + 3 * i, nv, 1);
+    for (int a = 0; a < 3; a++)
+        if ((b->fix[i] >> a) & 1)
+            nv[a] = 0;
+}
+
+/* The contact set where the body is at the update's start (into list[*m], normals nv, flags
+** w->hactive): nodes inside the probe, and nodes of the last set still pushed. */
+static cf_status contact_set(cf_body *b, body_work *w, const cf_probe *probe, const double *c,
+                             size_t *cap, size_t **list, double **nv, double **M, double **rhs,
+                             size_t *m, cf_error *err)
+{
+    for (size_t i = 0; i < b->nn; i++) {
         double nrm[3];
-        const double d = cf_body_penetration(probe, c, b->x + 3 * list[k], nrm, 1);
+        uint8_t in = w->touch[i] && b->fix[i] != CF_BODY_FIX_ALL &&
+                     (cf_body_penetration(probe, c, b->x + 3 * i, nrm, 0) > 0 ||
+                      (w->hactive[i] && cf_body_penetration(probe, c, b->x + 3 * i, nrm, 1) > 0));
+        w->hactive[i] = in;
+        if (!in)
+            continue;
+        if (*m == *cap && grow(cap, list, nv, M, rhs) != 0)
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory for the haptic loop");
+        (*list)[*m] = i;
+        contact_normal(b, probe, c, i, *nv + 3 * *m);
+        (*m)++;
+    }
+    return CF_OK;
+}
+
+/* The residual w->g at the body's positions with the probe at c: the internal forces kept from the
+** end of the last update when the body has not moved since (w->hxg), else assembled, then the
+** contact of the nodes in w->hactive. Returns the contact force along the probe's direction (NAN
+** when memory runs out). */
+static double residual(cf_body *b, body_work *w, const cf_probe *probe, const double *c,
+                       double kp, int *contacts)
+{
+    const size_t n = 3 * b->nn;
+    if (memcmp(w->hxg, b->x, n * sizeof *b->x) != 0)
+        return cf_body_assemble(b, b->x, probe, c, kp, w->hactive, w->g, NULL, contacts);
+    memcpy(w->g, w->hgi, n * sizeof *w->g);
+    double force = 0;
+    int nc = 0;
+    for (size_t i = 0; i < b->nn; i++) {
+        if (!w->hactive[i])
+            continue;
+        double nrm[3], d = cf_body_penetration(probe, c, b->x + 3 * i, nrm, 1);
+        nc++;
+        for (int a = 0; a < 3; a++)
+            w->g[3 * i + (size_t)a] -= kp * d * nrm[a];
         force += kp * d * (nrm[0] * probe->dir[0] + nrm[1] * probe->dir[1] + nrm[2] * probe->dir[2]);
     }
+    *contacts = nc;
     return force;
+}
+
+/* After a step: the internal forces where the body now is (kept in w->hgi for the next iteration
+** or update), and the probe's force from the body's side, their sum along the probe's direction
+** over the m nodes of list[] (a held component takes the penalty's force instead). The body's
+** stiffness, not the penalty's, turns a position not yet at equilibrium into a force error, so
+** this estimate is far closer to the equilibrium force than penalty times depth. NAN when memory
+** runs out. */
+static double reaction(cf_body *b, body_work *w, const cf_probe *probe, const double *c, double kp,
+                       const size_t *list, size_t m)
+{
+    const size_t n = 3 * b->nn;
+    if (isnan(cf_body_assemble(b, b->x, NULL, NULL, 0, NULL, w->hgi, NULL, NULL)))
+        return NAN;
+    memcpy(w->hxg, b->x, n * sizeof *b->x);
+    double force = 0;
+    for (size_t k = 0; k < m; k++) {
+        const size_t i = list[k];
+        double nrm[3];
+        const double d = cf_body_penetration(probe, c, b->x + 3 * i, nrm, 1);
+        for (int a = 0; a < 3; a++)
+            force += (((b->fix[i] >> a) & 1) ? kp * d * nrm[a] : w->hgi[3 * i + (size_t)a]) *
+                     probe->dir[a];
+    }
+    return force;
+}
+
+/* A step -alpha dx from the body's positions, alpha halved from 1 until no tetrahedron inverts
+** and no spring goes solid; 0 when none of 40 does. */
+static int admissible_step(cf_body *b, body_work *w)
+{
+    const size_t n = 3 * b->nn;
+    for (size_t i = 0; i < b->nn; i++)
+        for (int a = 0; a < 3; a++)
+            if ((b->fix[i] >> a) & 1)
+                w->dx[3 * i + (size_t)a] = 0;
+    double alpha = 2;
+    for (int bt = 0; bt < 40; bt++) {
+        alpha *= 0.5;
+        for (size_t i = 0; i < n; i++)
+            w->xt[i] = b->x[i] - alpha * w->dx[i];
+        if (cf_body_admissible(b, w->xt)) {
+            memcpy(b->x, w->xt, n * sizeof *w->xt);
+            return 1;
+        }
+    }
+    return 0;
 }
 
 cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm,
                               double penalty_N_per_mm, int max_iters, cf_body_step *out,
                               cf_error *err)
 {
-    const size_t n = 3 * b->nn, nn = b->nn;
+    const size_t n = 3 * b->nn;
     const double kp = penalty_N_per_mm > 0 ? penalty_N_per_mm : cf_body_penalty(b);
     double c[3];
     for (int k = 0; k < 3; k++)
@@ -196,73 +292,42 @@ cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm
     double *nv = NULL, *M = NULL, *rhs = NULL;
     const double fscale = b->E_MPa * b->mean_edge_mm * b->mean_edge_mm;
     int it = 0, contacts = 0;
-    double force = 0, r = INFINITY;
+    double force = 0;
     size_t m = 0;
+    /* the contact set where the body is at the update's start, held through the update's
+    ** iterations (a node the step leaves just outside a curved probe, by its slip along the
+    ** surface, would otherwise drop out and spring back every other iteration), its normals
+    ** renewed */
+    if ((st = contact_set(b, w, probe, c, &cap, &list, &nv, &M, &rhs, &m, err)) != CF_OK)
+        goto end;
     for (it = 0; it < max_iters; it++) {
-        /* the contact set where the body is at the update's start: nodes inside the probe, and
-        ** nodes of the last set still pushed; held through the update's iterations (a node the
-        ** step leaves just outside a curved probe, by its slip along the surface, would otherwise
-        ** drop out and spring back every other iteration), its normals renewed */
-        for (size_t k = 0; it > 0 && k < m; k++) {
-            cf_body_penetration(probe, c, b->x + 3 * list[k], nv + 3 * k, 1);
-            for (int a = 0; a < 3; a++)
-                if ((b->fix[list[k]] >> a) & 1)
-                    nv[3 * k + (size_t)a] = 0;
-        }
-        for (size_t i = 0; it == 0 && i < nn; i++) {
-            double nrm[3];
-            uint8_t in = w->touch[i] && b->fix[i] != CF_BODY_FIX_ALL &&
-                         (cf_body_penetration(probe, c, b->x + 3 * i, nrm, 0) > 0 ||
-                          (w->hactive[i] && cf_body_penetration(probe, c, b->x + 3 * i, nrm, 1) > 0));
-            w->hactive[i] = in;
-            if (!in)
-                continue;
-            if (m == cap && grow(&cap, &list, &nv, &M, &rhs) != 0) {
-                st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the haptic loop");
-                goto end;
-            }
-            list[m] = i;
-            cf_body_penetration(probe, c, b->x + 3 * i, nv + 3 * m, 1);
-            for (int a = 0; a < 3; a++)
-                if ((b->fix[i] >> a) & 1)
-                    nv[3 * m + (size_t)a] = 0;
-            m++;
-        }
-        force = cf_body_assemble(b, b->x, probe, c, kp, w->hactive, w->g, NULL, &contacts);
+        for (size_t k = 0; it > 0 && k < m; k++)
+            contact_normal(b, probe, c, list[k], nv + 3 * k);
+        force = residual(b, w, probe, c, kp, &contacts);
         if (isnan(force)) {
             st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's forces");
             goto end;
         }
         cf_body_keep_reaction(b, w->g);
         cf_body_apply_fixed(b, NULL, w->g);
-        r = body_norm_inf(w->g, n);
-        if (r <= 1e-8 * fscale)
+        if (body_norm_inf(w->g, n) <= 1e-8 * fscale)
             break;
         if ((st = haptic_solve(b, w, kp, list, nv, m, M, rhs, w->dx, err)) != CF_OK)
             goto end;
-        for (size_t i = 0; i < nn; i++)
-            for (int a = 0; a < 3; a++)
-                if ((b->fix[i] >> a) & 1)
-                    w->dx[3 * i + (size_t)a] = 0;
-        double alpha = 2;
-        int ok = 0;
-        for (int bt = 0; bt < 40 && !ok; bt++) {
-            alpha *= 0.5;
-            for (size_t i = 0; i < n; i++)
-                w->xt[i] = b->x[i] - alpha * w->dx[i];
-            ok = cf_body_admissible(b, w->xt);
-        }
-        if (!ok) {
+        if (!admissible_step(b, w)) {
             st = cf_error_set(err, CF_E_NOCONV,
                               "body: at probe depth %g mm every haptic step would invert a "
                               "tetrahedron or take a spring to solid",
                               depth_mm);
             goto end;
         }
-        memcpy(b->x, w->xt, n * sizeof *w->xt);
+        /* the force where the step left the body, from the body's side; its internal forces
+        ** serve the next iteration's residual */
+        if (isnan(force = reaction(b, w, probe, c, kp, list, m))) {
+            st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's forces");
+            goto end;
+        }
     }
-    if (it == max_iters) /* ended on a step: the contact force where the body now is */
-        force = contact_force(b, probe, c, kp, list, m);
     out->depth_mm = depth_mm;
     out->force_N = force;
     out->contacts = contacts;

@@ -124,6 +124,9 @@ typedef struct body_work {
     double *Z;          /* 9 nn per slot: columns 3 nn each */
     size_t nslot, capslot;
     double *hy, *hrhs;
+    double *hgi, *hxg;  /* 3 nn: the internal forces (no contact) where the last update left the
+                           body, and those positions (the next update starts from them when the
+                           body has not moved since) */
     /* an implicit dynamic step (body_dynamic.c) while it solves: the inertia (and mass-
     ** proportional damping) of a Newmark step as a term mcoef m_i (x - xstar)
     ** in the residual and mcoef m_i on the tangent's diagonal; mcoef 0 = a static solve */

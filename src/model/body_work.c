@@ -77,6 +77,8 @@ void cf_body_work_free(body_work *w)
     free(w->slot);
     free(w->Z);
     free(w->hy);
+    free(w->hgi);
+    free(w->hxg);
     free(w->hrhs);
     cf_body_pattern_free(&w->P);
     cf_body_pattern_free(&w->Pa);
