@@ -21,7 +21,8 @@ cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const
     memset(st, 0, sizeof *st);
     st->lat = lat;
     cf_law_lanes_init(lat->law, &st->lanes);
-    if (lat->law->mech) /* a law kind's row: the scalar law (its batch, law_kind.c) */
+    if (lat->law->mech || lat->grouped) /* a law kind's row: the scalar law (its batch,
+                                         ** law_kind.c); a law per group: each group's */
         st->form = -1;
     else if (lat->law->extension) { /* a double-acting element: both springs' lanes, side by side */
         const cf_law *e = lat->law->extension;
@@ -77,6 +78,7 @@ cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const
         const int nzc = (off[0] != 0) + (off[1] != 0) + (off[2] != 0);
         sd->L0 = lat->H_mm * sqrt((double)nzc); /* as lattice.c forms them */
         sd->a = lat->H_mm / sd->L0;
+        sd->law = lat->glaw[fam];
         sd->wk[0] = 1.0;
         sd->wk[1] = cf_lattice_axis_share(0, off[2], nz); /* bottom and top layers */
         if (!(sd->wl = malloc(st->layer * sizeof(double))))
@@ -162,7 +164,7 @@ run_dir(const cf_lattice *lat, const cf_law_lanes *c, const cf_law_lanes *e, int
     else if (form == CF_LANE_CLOSED)
         cf_lanes_closed(c, n8, u, F);
     else /* the scalar law */
-        cf_law_force_many(lat->law, lat->method, n, u, F, NULL);
+        cf_law_force_many(sd->law, lat->method, n, u, F, NULL);
     /* the forces at p, then at p + D: two loops, since the runs overlap when D < n (each pointer
     ** is restrict in its own loop only) */
     {
