@@ -472,11 +472,16 @@ static double propagated_tol(cf_lattice *lat, const cf_export_lattice *lx, doubl
 }
 
 /* The laws of lx's spring groups into group[family] with their tables gt[family] (the others left
-** zeroed), and *glx a copy of *lx whose lattice points at them. */
-static cf_status group_laws(const cf_export_lattice *lx, const cf_export_options *opt,
-                            cf_law group[CF_FAMILY_COUNT], cf_export_table gt[CF_FAMILY_COUNT],
-                            cf_export_lattice *glx, cf_error *err)
+** zeroed), and *glx a copy of *lx whose lattice points at them; CF_E_DATA when the fit fs is a
+** double-acting element. */
+static cf_status group_laws(const cf_fitted_spring *fs, const cf_export_lattice *lx,
+                            const cf_export_options *opt, cf_law group[CF_FAMILY_COUNT],
+                            cf_export_table gt[CF_FAMILY_COUNT], cf_export_lattice *glx,
+                            cf_error *err)
 {
+    if (fs->has_extension)
+        return cf_error_set(err, CF_E_DATA, "spring groups do not combine with a double-acting "
+                                            "element (the fit holds one)");
     *glx = *lx;
     for (size_t k = 0; k < lx->ngroups; k++) {
         const int f = lx->group_family[k];
@@ -493,14 +498,16 @@ static cf_status group_laws(const cf_export_lattice *lx, const cf_export_options
 }
 
 /* The model's groups given their spring group's law and table (a group's family from its rest
-** length, H, sqrt 2 H or sqrt 3 H), and the largest tol F_C over the tables: the one law's
-** t->tol F_C without groups. */
+** length, H, sqrt 2 H or sqrt 3 H), and the largest tol F_C over the tables (the model's reaction
+** tolerance scaled to it): the one law's t->tol F_C without groups. */
 static double group_tables_of_model(cf_xmodel *m, const cf_lattice *lat, const cf_law *law,
                                     const cf_export_table *t, const cf_law group[CF_FAMILY_COUNT],
                                     const cf_export_table gt[CF_FAMILY_COUNT])
 {
     double tolF = t->tol * law->F_C_N;
-    for (size_t g = 0; lat->grouped && g < m->ng; g++) {
+    if (!lat->grouped)
+        return tolF;
+    for (size_t g = 0; g < m->ng; g++) {
         const double r = m->g[g].L0_mm / lat->H_mm;
         const long f = lround(r * r) - 1;
         if (f >= 0 && f < CF_FAMILY_COUNT && lat->cfg.group_law[f]) {
@@ -509,6 +516,7 @@ static double group_tables_of_model(cf_xmodel *m, const cf_lattice *lat, const c
             tolF = fmax(tolF, gt[f].tol * group[f].F_C_N);
         }
     }
+    m->reaction_tol_N *= tolF / (t->tol * law->F_C_N); /* the group whose table errs most */
     return tolF;
 }
 
@@ -537,12 +545,7 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
     if (st != CF_OK || (st = cf_fitted_law(fs, &law, err)) != CF_OK)
         return st;
     if (lx->ngroups > 0) { /* spring groups: each its law and table, the lattice pointing at them */
-        if (fs->has_extension) {
-            st = cf_error_set(err, CF_E_DATA, "spring groups do not combine with a double-acting "
-                                              "element (the fit holds one)");
-            goto done;
-        }
-        if ((st = group_laws(lx, opt, group, gt, &glx, err)) != CF_OK)
+        if ((st = group_laws(fs, lx, opt, group, gt, &glx, err)) != CF_OK)
             goto done;
         lx = &glx;
     }
@@ -568,10 +571,7 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
         goto done;
     if (lattice_model(&m, &lat, &law, &t, lx, opt, title, sizeof title) != 0)
         goto oom;
-    /* with groups, the tolerance is of the group whose table errs most in force */
     const double tolF = group_tables_of_model(&m, &lat, &law, &t, group, gt);
-    if (lat.grouped)
-        m.reaction_tol_N *= tolF / (t.tol * law.F_C_N);
     m.note = note;
     memcpy(m.ref_N, ref, m.nsteps * sizeof *m.ref_N);
     if (m.ncells > 0) /* the cells' stiffness propagates the tables' error (propagated_tol) */
