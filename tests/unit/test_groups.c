@@ -2,8 +2,8 @@
 ** Tests of spring groups (a law per family of the lattice: cf_lattice_config.group_law, and the
 ** homogenised cell's family_law): the cell equals the full lattice in uniaxial tension and
 ** compression with two groups of different laws to 1e-9; a group given the lattice's own law
-** (another copy) changes nothing; the explicit step's scalar path per group agrees with the
-** kernel; a group law of another free length is refused.
+** (another copy) changes nothing; the explicit step's lanes per group (and its scalar path with a
+** tailed group) agree with the kernel; a group law of another free length is refused.
 */
 #include "testutil.h"
 
@@ -130,7 +130,10 @@ static void explicit_step_takes_each_groups_law(void **state)
     memcpy(fz, lat.fz, lat.nn * sizeof *fz);
     cf_lattice_stepper st;
     assert_int_equal(cf_lattice_stepper_init(&st, &lat, NULL, NULL), CF_OK);
-    assert_int_equal(st.form, -1);
+    /* both plain cones: each group its own polynomial lanes (within CF_POLY_TOL of the closed
+    ** form the kernel evaluates) */
+    assert_int_equal(st.form, CF_LANE_POLY);
+    assert_true(st.poly_error <= CF_POLY_TOL);
     memset(lat.fx, 0, lat.nn * sizeof *lat.fx);
     memset(lat.fy, 0, lat.nn * sizeof *lat.fy);
     memset(lat.fz, 0, lat.nn * sizeof *lat.fz);
@@ -142,6 +145,23 @@ static void explicit_step_takes_each_groups_law(void **state)
     for (size_t p = 0; p < lat.nn; p++)
         assert_close(lat.fz[p], fz[p], 1e-12 * scale);
     cf_lattice_stepper_free(&st);
+    /* a tailed group: the scalar law of each group, the same forces */
+    cf_spring t = {5, 18, 3, 1.8, 200, 10, 1, 4};
+    cf_law tailed;
+    assert_int_equal(cf_law_init(&tailed, &t, NULL), CF_OK);
+    lat.glaw[CF_FAMILY_BODY] = &tailed;
+    cf_lattice_forces(&lat);
+    memcpy(fz, lat.fz, lat.nn * sizeof *fz);
+    assert_int_equal(cf_lattice_stepper_init(&st, &lat, NULL, NULL), CF_OK);
+    assert_int_equal(st.form, -1);
+    memset(lat.fx, 0, lat.nn * sizeof *lat.fx);
+    memset(lat.fy, 0, lat.nn * sizeof *lat.fy);
+    memset(lat.fz, 0, lat.nn * sizeof *lat.fz);
+    cf_lattice_stepper_forces(&st);
+    for (size_t p = 0; p < lat.nn; p++)
+        assert_close(lat.fz[p], fz[p], 1e-12 * scale);
+    cf_lattice_stepper_free(&st);
+    cf_law_free(&tailed);
     free(fz);
     cf_lattice_free(&lat);
     cf_law_free(&edge);
