@@ -103,7 +103,25 @@ cf_status cf_cli_body_create(const cf_scene *sc, const cf_law *law, const cf_mes
         kappa = sc->body_volume_value;
     else if (sc->body_volume == 2)
         kappa = cf_body_kappa_for_nu(mu, sc->body_volume_value);
-    return cf_body_create(b, mesh, law, sc->method, kappa, err);
+    cf_status st = cf_body_create(b, mesh, law, sc->method, kappa, err);
+    if (st != CF_OK || sc->ngroups == 0)
+        return st;
+    /* the scene's spring groups by region */
+    cf_select sel[CF_SCENE_MAX_GROUPS];
+    cf_spring spring[CF_SCENE_MAX_GROUPS];
+    char keys[CF_SCENE_MAX_GROUPS][32];
+    const char *key[CF_SCENE_MAX_GROUPS];
+    for (size_t g = 0; g < sc->ngroups; g++) {
+        sel[g] = sc->groups[g].sel;
+        spring[g] = sc->groups[g].spring;
+        snprintf(keys[g], sizeof keys[g], "groups[%zu]", g);
+        key[g] = keys[g];
+    }
+    cf_error e = {0};
+    if ((st = cf_body_set_groups(b, mesh, sc->ngroups, sel, spring, key, sc->table_intervals,
+                                 &e)) != CF_OK)
+        cf_error_set(err, st, "%s", e.msg);
+    return st;
 }
 
 cf_status cf_cli_body_probe_outside(const cf_scene *sc, const char *scene_path,
@@ -524,6 +542,22 @@ static void stability(FILE *o, const cf_scene *sc, const run *r)
     fprintf(o, "\n");
 }
 
+
+/* The body's spring groups (scene "groups"): each region's springs and the law they take (the
+** body's E and nu above are of the scene spring's law). */
+static void groups_line(FILE *o, const cf_scene *sc, const cf_body *b)
+{
+    for (size_t g = 0; g < sc->ngroups && b->group; g++) {
+        size_t n = 0;
+        for (size_t s = 0; s < b->ns; s++)
+            n += b->group[s] == g + 1;
+        fprintf(o, "group %zu (region '%s'): %zu springs take the law of spring %s (shear modulus "
+                   "%.6g kPa)\n",
+                g, cf_select_name(sc->groups[g].sel.kind), n, sc->groups[g].source,
+                cf_body_mu_of_law(b->glaw[g + 1]) * 1e3);
+    }
+}
+
 /* A double-acting element: which spring each side takes, and the shear modulus the extension
 ** spring gives (the body's E and nu are the compression spring's, cf_body_mu_of_law). */
 static void pair_line(FILE *o, const run *r)
@@ -559,6 +593,7 @@ static void summary(FILE *o, const cf_scene *sc, const run *r)
                    "lattice and the body share mu = k0/(2.5 H) and lambda = mu + kappa, so the "
                    "body has the lattice's small-strain E = %.6g kPa and nu = %.6g)\n",
                 b->kappa_MPa * 1e3, b->E_MPa * 1e3, b->nu);
+    groups_line(o, sc, b);
     pair_line(o, r);
     if (sc->body_element_size_mm > 0) {
         const cf_mesh_surface_info *si = &r->surface;

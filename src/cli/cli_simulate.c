@@ -129,6 +129,10 @@ static void summary(FILE *o, const cf_scene *sc, const cf_msm_sample *s, size_t 
            lc->weight[CF_FAMILY_EDGE], lc->weight[CF_FAMILY_FACE], lc->weight[CF_FAMILY_BODY],
            !timed ? "static equilibria"
            : sc->effects.inertia ? "explicit symplectic Euler" : "implicit quasi-static steps");
+    for (size_t g = 0; g < sc->ngroups; g++) /* the spring groups with a law of their own */
+        fprintf(o, "group %s: the %s springs take the law of spring %s\n",
+                cf_scene_group_name(sc->groups[g].family), cf_scene_group_name(sc->groups[g].family),
+                sc->groups[g].source);
     if (sc->has_extension || lc->volume_modulus_MPa > 0)
         fprintf(o, "element: %s; volume term: kappa %.6g MPa\n",
                 sc->has_extension ? "double-acting (its own extension spring)"

@@ -108,6 +108,11 @@ typedef struct cf_export_lattice {
     int stress_drive;           /* 1: strain[] holds compressive nominal stresses (MPa) that
                                 ** conifit's elastic lattice, force-driven, turns into the strains
                                 ** written (a creep protocol) */
+    size_t ngroups;             /* spring groups with a law of their own (a scene's "groups"):
+                                ** group k is the family group_family[k] (CF_FAMILY_*) with the
+                                ** law of group_spring[k] (the fit's free length H); 0: none */
+    int group_family[CF_FAMILY_COUNT];
+    cf_spring group_spring[CF_FAMILY_COUNT];
     char note[640];             /* "" or, for a scene's time protocol written as its quasi-static
                                 ** displacement history, what the model does not carry (the
                                 ** file's header and the report's warning say it) */

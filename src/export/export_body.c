@@ -104,11 +104,16 @@ static cf_status check_body(const cf_body *b, const cf_probe *pr, const cf_expor
 ** factor as the weight), its height and the reaction tolerance the tables imply. 0, or -1 out of
 ** memory. */
 static int fill_model(const cf_body *b, const cf_export_table *t, const cf_law *law,
-                      cf_xmodel *m)
+                      const cf_export_table *gt, cf_xmodel *m)
 {
     const cf_net net = cf_net_of_body(b);
     if (cf_xmodel_of_net(m, &net, CF_XGROUP_EACH) != 0)
         return -1;
+    for (size_t s = 0; b->group && s < b->ns; s++) /* spring s is model group s */
+        if (b->group[s]) {
+            m->g[s].law = b->glaw[b->group[s]];
+            m->g[s].table = &gt[b->group[s] - 1];
+        }
     double zlo = INFINITY, zhi = -INFINITY;
     for (size_t i = 0; i < b->nn; i++) {
         zlo = fmin(zlo, m->Z[i]);
@@ -122,7 +127,11 @@ static int fill_model(const cf_body *b, const cf_export_table *t, const cf_law *
     for (size_t s = 0; s < b->ns; s++) {
         const double zi = b->X[3 * b->si[s] + 2], zj = b->X[3 * b->sj[s] + 2];
         if ((zi - zmid) * (zj - zmid) < 0)
-            wcut += b->c[s] * fabs(zi - zj) / b->L0[s];
+            wcut += b->c[s] * fabs(zi - zj) / b->L0[s] *
+                    (b->group && b->group[s]
+                         ? gt[b->group[s] - 1].tol * b->glaw[b->group[s]]->F_C_N /
+                               (t->tol * law->F_C_N)
+                         : 1.0); /* a group's spring: its table's tol F_C */
     }
     m->reaction_tol_N = t->tol * law->F_C_N * wcut;
     return 0;
@@ -140,8 +149,13 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr,
     cf_export_table t = {0};
     cf_xmodel m = {0};
     cf_export_report r = {0};
+    cf_export_table gt[CF_BODY_MAX_GROUPS];
+    memset(gt, 0, sizeof gt);
     if ((st = cf_export_table_for(law, opt, &t, err)) != CF_OK)
         return st;
+    for (size_t g = 0; g < b->ngroups; g++) /* each spring group's law its table */
+        if ((st = cf_export_table_for(b->glaw[g + 1], opt, &gt[g], err)) != CF_OK)
+            goto done;
     char title[200];
     snprintf(title, sizeof title,
              "tissue body of %zu nodes, %zu edge springs and %zu tetrahedra (E = %.6g MPa, nu = "
@@ -165,7 +179,7 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr,
                           nsteps, run->depth_mm[nsteps - 1]);
         goto done;
     }
-    if (fill_model(b, &t, law, &m) != 0)
+    if (fill_model(b, &t, law, gt, &m) != 0)
         goto oom;
     for (size_t k = 0; k < nsteps; k++) {
         m.dz_mm[k] = run->depth_mm[k] * pr->dir[2];
@@ -204,5 +218,7 @@ done:
         *rep = r;
     cf_xmodel_free(&m);
     cf_export_table_free(&t);
+    for (size_t g = 0; g < CF_BODY_MAX_GROUPS; g++)
+        cf_export_table_free(&gt[g]);
     return st;
 }

@@ -90,6 +90,11 @@ cf_status cf_export_lattice_from_scene(const cf_scene *sc, const char *name,
         return st;
     lx->cfg = v.cfg;
     lx->cfg.progress = NULL;
+    lx->ngroups = sc->ngroups; /* the scene's spring groups, their laws made by the writer */
+    for (size_t k = 0; k < sc->ngroups; k++) {
+        lx->group_family[k] = sc->groups[k].family;
+        lx->group_spring[k] = sc->groups[k].spring;
+    }
     /* the reference run needs no table: the closed form is within 2.5e-15 of exact */
     lx->method = v.method == CF_LAW_TABLE ? CF_LAW_CLOSED : v.method;
     const cf_msm_path p = cf_scene_path(sc);
@@ -466,6 +471,55 @@ static double propagated_tol(cf_lattice *lat, const cf_export_lattice *lx, doubl
     return r.worst;
 }
 
+/* The laws of lx's spring groups into group[family] with their tables gt[family] (the others left
+** zeroed), and *glx a copy of *lx whose lattice points at them; CF_E_DATA when the fit fs is a
+** double-acting element. */
+static cf_status group_laws(const cf_fitted_spring *fs, const cf_export_lattice *lx,
+                            const cf_export_options *opt, cf_law group[CF_FAMILY_COUNT],
+                            cf_export_table gt[CF_FAMILY_COUNT], cf_export_lattice *glx,
+                            cf_error *err)
+{
+    if (fs->has_extension)
+        return cf_error_set(err, CF_E_DATA, "spring groups do not combine with a double-acting "
+                                            "element (the fit holds one)");
+    *glx = *lx;
+    for (size_t k = 0; k < lx->ngroups; k++) {
+        const int f = lx->group_family[k];
+        if (f < 0 || f >= CF_FAMILY_COUNT)
+            return cf_error_set(err, CF_E_DATA, "spring group %zu: family %d unknown", k, f);
+        cf_status st = cf_law_init(&group[f], &lx->group_spring[k], err);
+        if (st == CF_OK)
+            st = cf_export_table_for(&group[f], opt, &gt[f], err);
+        if (st != CF_OK)
+            return st;
+        glx->cfg.lattice.group_law[f] = &group[f];
+    }
+    return CF_OK;
+}
+
+/* The model's groups given their spring group's law and table (a group's family from its rest
+** length, H, sqrt 2 H or sqrt 3 H), and the largest tol F_C over the tables (the model's reaction
+** tolerance scaled to it): the one law's t->tol F_C without groups. */
+static double group_tables_of_model(cf_xmodel *m, const cf_lattice *lat, const cf_law *law,
+                                    const cf_export_table *t, const cf_law group[CF_FAMILY_COUNT],
+                                    const cf_export_table gt[CF_FAMILY_COUNT])
+{
+    double tolF = t->tol * law->F_C_N;
+    if (!lat->grouped)
+        return tolF;
+    for (size_t g = 0; g < m->ng; g++) {
+        const double r = m->g[g].L0_mm / lat->H_mm;
+        const long f = lround(r * r) - 1;
+        if (f >= 0 && f < CF_FAMILY_COUNT && lat->cfg.group_law[f]) {
+            m->g[g].law = &group[f];
+            m->g[g].table = &gt[f];
+            tolF = fmax(tolF, gt[f].tol * group[f].F_C_N);
+        }
+    }
+    m->reaction_tol_N *= tolF / (t->tol * law->F_C_N); /* the group whose table errs most */
+    return tolF;
+}
+
 /* Builds the table and the lattice, runs conifit's reference along the loading (refusing a
 ** loading the lattice cannot follow), then writes the model. */
 cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
@@ -479,13 +533,22 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
     cf_xmodel m = {0};
     cf_export_report r = {0};
     char title[256], note[sizeof r.warning];
-    cf_export_lattice part, strained;
+    cf_export_lattice part, strained, glx;
     double ref[CF_EXPORT_MAX_STEPS];
+    cf_law group[CF_FAMILY_COUNT];
+    cf_export_table gt[CF_FAMILY_COUNT];
+    memset(group, 0, sizeof group);
+    memset(gt, 0, sizeof gt);
     memset(&lat, 0, sizeof lat);
     memset(&ext, 0, sizeof ext);
     cf_status st = check_loading(opt, lx, err);
     if (st != CF_OK || (st = cf_fitted_law(fs, &law, err)) != CF_OK)
         return st;
+    if (lx->ngroups > 0) { /* spring groups: each its law and table, the lattice pointing at them */
+        if ((st = group_laws(fs, lx, opt, group, gt, &glx, err)) != CF_OK)
+            goto done;
+        lx = &glx;
+    }
     /* the fit's whole element and volume term (a scene naming the fit file brings the same) */
     cf_lattice_config lc = lx->cfg.lattice;
     if (!(lc.volume_modulus_MPa > 0))
@@ -508,11 +571,11 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
         goto done;
     if (lattice_model(&m, &lat, &law, &t, lx, opt, title, sizeof title) != 0)
         goto oom;
+    const double tolF = group_tables_of_model(&m, &lat, &law, &t, group, gt);
     m.note = note;
     memcpy(m.ref_N, ref, m.nsteps * sizeof *m.ref_N);
     if (m.ncells > 0) /* the cells' stiffness propagates the tables' error (propagated_tol) */
-        m.reaction_tol_N = t.tol * law.F_C_N *
-                           propagated_tol(&lat, lx, m.reaction_tol_N / (t.tol * law.F_C_N));
+        m.reaction_tol_N = tolF * propagated_tol(&lat, lx, m.reaction_tol_N / tolF);
     const char *no_volume = cf_xmodel_volume_refusal(&m, opt->format);
     if (no_volume) {
         st = cf_error_set(err, CF_E_DATA,
@@ -549,5 +612,9 @@ done:
     cf_export_table_free(&t);
     cf_law_free(&law);
     cf_law_free(&ext);
+    for (int f = 0; f < CF_FAMILY_COUNT; f++) {
+        cf_export_table_free(&gt[f]);
+        cf_law_free(&group[f]);
+    }
     return st;
 }

@@ -80,10 +80,10 @@ void cf_xmodel_free(cf_xmodel *m)
 
 int cf_xmodel_tables(cf_xmodel *m)
 {
-    const cf_export_table *t = m->base;
     const double H = m->law->p.H_mm;
     for (size_t g = 0; g < m->ng; g++) {
         cf_xgroup *G = &m->g[g];
+        const cf_export_table *t = G->table ? G->table : m->base;
         G->rows = t->rows;
         G->e_mm = malloc(t->rows * sizeof *G->e_mm);
         G->T_N = malloc(t->rows * sizeof *G->T_N);
@@ -104,6 +104,32 @@ int cf_xmodel_tables(cf_xmodel *m)
 }
 
 /* ---- comments shared by the writers ---------------------------------------------------------- */
+
+/* Most distinct group laws a header states (a body has at most CF_BODY_MAX_GROUPS, a lattice
+** three). */
+#define CF_XMODEL_LAWS_SAID 16
+
+/* Group G's (index g) own law and table at the first group taking it (said[k] the laws stated,
+** first[k] their groups), a reference to that group after. */
+static void comment_group_law(FILE *out, const char *lead, const char *tail, const cf_xgroup *G,
+                              size_t g, const cf_law *said[CF_XMODEL_LAWS_SAID],
+                              size_t first[CF_XMODEL_LAWS_SAID])
+{
+    int k = 0;
+    while (k < CF_XMODEL_LAWS_SAID && said[k] && said[k] != G->law)
+        k++;
+    if (k < CF_XMODEL_LAWS_SAID && said[k] == G->law) {
+        fprintf(out, "%s    group %zu: the law and table of group %zu%s\n", lead, g + 1,
+                first[k] + 1, tail);
+        return;
+    }
+    if (k < CF_XMODEL_LAWS_SAID)
+        said[k] = G->law, first[k] = g;
+    char gl[96];
+    snprintf(gl, sizeof gl, "%s    group %zu: ", lead, g + 1);
+    cf_export_comment_spring(out, gl, tail, G->law);
+    cf_export_comment_table(out, gl, tail, G->table, G->law);
+}
 
 void cf_export_comment_source(FILE *out, const char *lead, const char *tail, const char *source)
 {
@@ -229,9 +255,14 @@ void cf_xmodel_header(FILE *out, const char *lead, const char *tail, const cf_xm
             "%s%zu nodes, %zu springs in %zu groups; group k is the law at rest length L0 (in "
             "strain form u = -(L - L0) H/L0) times its weight:%s\n",
             lead, m->nn, m->ns, m->ng, tail);
-    for (size_t g = 0; g < m->ng; g++)
+    const cf_law *said[CF_XMODEL_LAWS_SAID] = {0}; /* group laws already stated */
+    size_t first[CF_XMODEL_LAWS_SAID] = {0};
+    for (size_t g = 0; g < m->ng; g++) {
         fprintf(out, "%s  group %zu: L0 = %.17g mm, weight = %.17g, %zu springs, %zu rows%s\n",
                 lead, g + 1, m->g[g].L0_mm, m->g[g].weight, m->g[g].count, m->g[g].rows, tail);
+        if (m->g[g].law) /* a spring group's own law and table (at the first group taking it) */
+            comment_group_law(out, lead, tail, &m->g[g], g, said, first);
+    }
     if (m->pp)
         fprintf(out,
                 "%sloading: conifit's probe replayed (a contact this format solves would not give "
@@ -260,6 +291,15 @@ void cf_xmodel_header(FILE *out, const char *lead, const char *tail, const cf_xm
                 "%sreaction tolerance implied by the tables: %.6g N (tol F_C times the weights of "
                 "the springs a horizontal plane cuts, projected on z)%s\n",
                 lead, m->reaction_tol_N, tail);
+    for (size_t g = 0; g < m->ng; g++)
+        if (m->g[g].law) { /* spring groups: the tolerance covers each */
+            fprintf(out,
+                    "%sspring groups: each group's table has its own law and tolerance; the tol "
+                    "F_C above is at least each spring's group's own, so the tolerance covers "
+                    "every group%s\n",
+                    lead, tail);
+            break;
+        }
     if (m->kappa_MPa > 0)
         fprintf(out,
                 "%svolume term: each of the %zu %s stores (kappa/2)(J - 1)^2 of its rest "

@@ -24,6 +24,8 @@ typedef struct cf_xgroup {
     size_t rows;        /* rows of the table */
     double *e_mm;       /* elongation L - L0 = -u L0/H, mm, ascending */
     double *T_N;        /* tension = -weight F(u), N */
+    const cf_law *law;  /* its spring group's law, NULL: the model's law */
+    const cf_export_table *table; /* that law's table, NULL: the model's base table */
 } cf_xgroup;
 
 typedef struct cf_xmodel {

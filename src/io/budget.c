@@ -24,6 +24,9 @@
 ** factor when it fits in CF_LINSOLVE_BAND_MAX_ENTRIES entries, else a dense LU up to
 ** CF_LINSOLVE_DENSE_MAX_DOF unknowns, else a GMRES basis of CF_LINSOLVE_GMRES_RESTART vectors. */
 #define TANGENT_ROW_BYTES (3.0 * CF_MSM_TANGENT_MAX_ADJ * 64.0)
+/* A lattice with spring groups (lattice.h): each spring's place in the groups' order and its
+** gathered compression, force and stiffness. */
+#define GROUP_SPRING_BYTES 28.0
 /* A law table: two values an end and four coefficients an interval (model/law.c). */
 #define LAW_TABLE_BYTES 48.0
 
@@ -97,14 +100,18 @@ static double lattice_bytes(const cf_scene *sc, double nx, double ny, double nz)
         solver = dof * TANGENT_ROW_BYTES + springs * 36 * 4 +
                  fmax(CF_BUDGET_FILL_BYTES * pow(dof, CF_BUDGET_FILL_EXPONENT), fallback);
     }
-    return CF_BUDGET_PROCESS_BYTES + nodes * NODE_BYTES + springs * SPRING_BYTES + solver;
+    const double grouped = sc->ngroups > 0 ? springs * GROUP_SPRING_BYTES : 0;
+    return CF_BUDGET_PROCESS_BYTES + nodes * NODE_BYTES + springs * SPRING_BYTES + solver + grouped;
 }
 
-/* The law table of `table_intervals` (model/law.c: values and slopes at the ends, four cubic
-** coefficients per interval), when the scene evaluates the law by table. */
+/* The law tables of `table_intervals` (model/law.c: values and slopes at the ends, four cubic
+** coefficients per interval), the scene spring's and each group's, when the scene evaluates the
+** law by table. */
 static double table_bytes(const cf_scene *sc)
 {
-    return sc->method == CF_LAW_TABLE ? LAW_TABLE_BYTES * ((double)sc->table_intervals + 1) : 0;
+    return sc->method == CF_LAW_TABLE ? LAW_TABLE_BYTES * ((double)sc->table_intervals + 1) *
+                                            (1.0 + (double)sc->ngroups) /* each group's law */
+                                      : 0;
 }
 
 /* The largest lattice of the scene's proportions whose bytes fit in `room` (its cell counts into

@@ -32,6 +32,15 @@ cf_status cf_scene_parse(const char *json_text, const char *name, cf_scene *sc, 
 ** cf_law_table_build. */
 cf_status cf_scene_law(const cf_scene *sc, cf_law *law, cf_law *ext, cf_error *err);
 
+/* The laws of the scene's spring groups (scene_groups.c) into group[family] (each with its table
+** for the table method; the others zeroed) and cfg->group_law pointed at them: group must outlive
+** cfg's use. Release each with cf_law_free (safe on the zeroed ones), whatever the status. */
+cf_status cf_scene_group_laws(const cf_scene *sc, cf_law group[CF_FAMILY_COUNT],
+                              cf_lattice_config *cfg, cf_error *err);
+
+/* A lattice group's name in scenes and reports: "edge", "face" or "body" (CF_FAMILY_*). */
+const char *cf_scene_group_name(int family);
+
 /* Releases the arrays of sc. Safe on a zeroed scene. */
 void cf_scene_free(cf_scene *sc);
 

@@ -126,22 +126,15 @@ static cf_status region_value(ctx *c, json_t *v, const char *key, cf_region_use 
     return CF_OK;
 }
 
-/* One region at key: exactly one selector (the table below), and the value its use takes. */
-static cf_status region(ctx *c, json_t *v, const char *key, cf_region_use use, cf_scene *sc)
+/* The selector of the region at key: exactly one of below, above, box, sphere and group, the
+** only other key allowed being other (NULL: none). */
+cf_status cf_scene_selector(ctx *c, json_t *v, const char *key, const char *other, cf_select *s)
 {
     static const char *const sel[] = {"below", "above", "box", "sphere", "group"};
-    static const char *const vkey[] = {NULL, "by_mm", "force_N"};
-    cf_status st;
-    if (sc->nregions == CF_SCENE_MAX_REGIONS)
-        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s': more than %d regions", c->name, key,
-                            CF_SCENE_MAX_REGIONS);
-    cf_scene_region *r = &sc->regions[sc->nregions];
-    memset(r, 0, sizeof *r);
-    r->use = use;
-    snprintf(r->key, sizeof r->key, "%s", key);
+    cf_status st = CF_OK;
     if (!json_is_object(v))
-        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be an object (a region) or an "
-                            "array of them", c->name, key);
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be an object (a region)",
+                            c->name, key);
     const char *k;
     json_t *x, *selv = NULL;
     int found = -1;
@@ -157,7 +150,7 @@ static cf_status region(ctx *c, json_t *v, const char *key, cf_region_use use, c
                                     "'%s': a region takes one", c->name, key, sel[found], k);
             found = kind;
             selv = x;
-        } else if (!vkey[use] || strcmp(k, vkey[use]) != 0)
+        } else if (!other || strcmp(k, other) != 0)
             return cf_error_set(c->err, CF_E_DATA, "%s: unknown key '%s.%s'", c->name, key, k);
     }
     if (found < 0)
@@ -165,25 +158,25 @@ static cf_status region(ctx *c, json_t *v, const char *key, cf_region_use use, c
                             "sphere or group", c->name, key);
     char where[96];
     snprintf(where, sizeof where, "%s.%s", key, sel[found]);
-    r->sel.kind = (cf_select_kind)found;
-    switch (r->sel.kind) {
+    s->kind = (cf_select_kind)found;
+    switch (s->kind) {
     case CF_SELECT_BELOW:
     case CF_SELECT_ABOVE:
-        st = plane(c, selv, where, &r->sel);
+        st = plane(c, selv, where, s);
         break;
     case CF_SELECT_BOX: {
         static const char *const ok[] = {"min_mm", "max_mm", NULL};
         if (!json_is_object(selv))
             return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be an object", c->name, where);
         if ((st = cf_scene_only_keys(c, selv, where, ok)) ||
-            (st = cf_scene_vec3(c, selv, where, "min_mm", r->sel.lo_mm)) ||
-            (st = cf_scene_vec3(c, selv, where, "max_mm", r->sel.hi_mm)))
+            (st = cf_scene_vec3(c, selv, where, "min_mm", s->lo_mm)) ||
+            (st = cf_scene_vec3(c, selv, where, "max_mm", s->hi_mm)))
             return st;
         for (int a = 0; a < 3; a++)
-            if (!(r->sel.hi_mm[a] >= r->sel.lo_mm[a]))
+            if (!(s->hi_mm[a] >= s->lo_mm[a]))
                 return cf_error_set(c->err, CF_E_DATA, "%s: key '%s': max_mm[%d] = %g is below "
-                                    "min_mm[%d] = %g", c->name, where, a, r->sel.hi_mm[a], a,
-                                    r->sel.lo_mm[a]);
+                                    "min_mm[%d] = %g", c->name, where, a, s->hi_mm[a], a,
+                                    s->lo_mm[a]);
         break;
     }
     case CF_SELECT_SPHERE: {
@@ -191,17 +184,35 @@ static cf_status region(ctx *c, json_t *v, const char *key, cf_region_use use, c
         if (!json_is_object(selv))
             return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be an object", c->name, where);
         if ((st = cf_scene_only_keys(c, selv, where, ok)) ||
-            (st = cf_scene_vec3(c, selv, where, "center_mm", r->sel.center_mm)) ||
+            (st = cf_scene_vec3(c, selv, where, "center_mm", s->center_mm)) ||
             (st = cf_scene_number(c, selv, where, "radius_mm", 1, 0, 0, 1, 1e12,
-                                  &r->sel.radius_mm)))
+                                  &s->radius_mm)))
             return st;
         break;
     }
     default:
-        st = group(c, selv, where, &r->sel);
+        st = group(c, selv, where, s);
         break;
     }
-    if (st)
+    return st;
+}
+
+/* One region at key: exactly one selector (the table below), and the value its use takes. */
+static cf_status region(ctx *c, json_t *v, const char *key, cf_region_use use, cf_scene *sc)
+{
+    static const char *const vkey[] = {NULL, "by_mm", "force_N"};
+    cf_status st;
+    if (sc->nregions == CF_SCENE_MAX_REGIONS)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s': more than %d regions", c->name, key,
+                            CF_SCENE_MAX_REGIONS);
+    cf_scene_region *r = &sc->regions[sc->nregions];
+    memset(r, 0, sizeof *r);
+    r->use = use;
+    snprintf(r->key, sizeof r->key, "%s", key);
+    if (!json_is_object(v))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be an object (a region) or an "
+                            "array of them", c->name, key);
+    if ((st = cf_scene_selector(c, v, key, vkey[use], &r->sel)))
         return st;
     if ((st = region_value(c, v, key, use, r)))
         return st;

@@ -45,4 +45,14 @@ cf_status cf_scene_body(ctx *c, json_t *root, cf_scene *sc);
 ** are read); the lattice's other effects refused for a body. */
 cf_status cf_scene_body_dynamics(ctx *c, json_t *root, cf_scene *sc);
 
+/* The selector of the region at key of a body's scene: exactly one of below, above, box, sphere
+** and group, the only other key allowed being other (NULL: none). */
+cf_status cf_scene_selector(ctx *c, json_t *v, const char *key, const char *other, cf_select *s);
+
+/* scene_groups.c: "groups" of root, a law per spring family of a lattice (after the lattice's
+** weights are read) or per region of a body: unknown families, a family named twice or of weight
+** 0, a double-acting element refused (a body's empty or overlapping regions are the body's to
+** find, cf_body_set_groups). */
+cf_status cf_scene_groups(ctx *c, json_t *root, cf_scene *sc);
+
 #endif

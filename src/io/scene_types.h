@@ -40,8 +40,21 @@ typedef struct cf_scene_region {
 /* Most points of a probe's path. */
 #define CF_SCENE_MAX_PATH 1000
 
+/* Most spring groups a scene may have (a lattice has CF_FAMILY_COUNT at most). */
+#define CF_SCENE_MAX_GROUPS 8
+
 /* Most regions a scene may have. */
 #define CF_SCENE_MAX_REGIONS 64
+
+/* A spring group of a scene ("groups", src/notes/simulate.md): in a lattice the springs of one
+** family (CF_FAMILY_EDGE, _FACE, _BODY), in a body those with both ends in a region, taking a
+** law of their own, that of spring. */
+typedef struct cf_scene_group {
+    int family;                 /* a lattice's: CF_FAMILY_*; a body's: -1 */
+    cf_select sel;              /* a body's: the region */
+    cf_spring spring;           /* its spring (the scene spring's free length H) */
+    char source[600];           /* "params" or the fit file (and type) it came from */
+} cf_scene_group;
 
 typedef struct cf_scene {
     cf_spring spring;           /* the spring of every lattice edge */
@@ -51,6 +64,9 @@ typedef struct cf_scene {
     char spring_source[600];    /* "params" or the fit file (and type) it came from */
     char fit_path[4096];        /* the fit file 'spring.fit' names, "" with 'spring.params': an
                                    input of the run like the scene itself */
+    size_t ngroups;             /* "groups": spring groups with a law of their own (0: every
+                                   spring the scene spring's) */
+    cf_scene_group groups[CF_SCENE_MAX_GROUPS];
     cf_law_method method;       /* law evaluator */
     size_t table_intervals;     /* for CF_LAW_TABLE */
     cf_msm_config cfg;          /* lattice and solver settings */

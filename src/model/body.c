@@ -92,10 +92,10 @@ double cf_body_measure(const cf_body *b, cf_body_state *st, double *max_u_over_t
     for (size_t s = 0; s < b->ns; s++) {
         double n[3], u;
         double L = body_spring_geom(b, b->x, s, n, &u);
-        umax = fmax(umax, fabs(u) / cf_law_travel_at(b->law, u));
+        umax = fmax(umax, fabs(u) / cf_law_travel_at(cf_body_spring_law(b, s), u));
         if (st) {
             st->strain[s] = (L - b->L0[s]) / b->L0[s];
-            st->solid[s] = fabs(u) >= cf_law_travel_at(b->law, u);
+            st->solid[s] = fabs(u) >= cf_law_travel_at(cf_body_spring_law(b, s), u);
         }
     }
     for (size_t t = 0; t < b->nt; t++) {
@@ -128,6 +128,10 @@ void cf_body_free(cf_body *b)
     free(b->f_ext);
     free(b->reaction);
     free(b->contact);
+    free(b->group);
+    for (size_t g = 0; b->gown && g < b->ngroups; g++)
+        cf_law_free(&b->gown[g]);
+    free(b->gown);
     memset(b, 0, sizeof *b);
 }
 

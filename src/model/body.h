@@ -123,6 +123,9 @@ typedef struct cf_probe {
                          ** the fields above in order still holds) */
 } cf_probe;
 
+/* Most spring groups of a body (cf_body_set_groups). */
+#define CF_BODY_MAX_GROUPS 8
+
 /* The body: the mesh's nodes and tetrahedra, its edges as springs. */
 typedef struct cf_body {
     const cf_law *law;     /* not owned */
@@ -150,7 +153,29 @@ typedef struct cf_body {
     void *work;            /* the solver's pattern, factors and vectors (NULL until the first
                            ** solve; cf_body_free releases them). Not thread-safe: one solve of a
                            ** body at a time */
+    /* spring groups (cf_body_set_groups): */
+    size_t ngroups;        /* groups with a law of their own (0: every spring takes law) */
+    uint8_t *group;        /* ns: the spring's group, 0 for law's, g for group g; NULL: none */
+    const cf_law *glaw[CF_BODY_MAX_GROUPS + 1]; /* glaw[0] = law, glaw[g] = gown + g - 1 */
+    cf_law *gown;          /* the groups' laws (owned) */
 } cf_body;
+
+/* The law of spring s (its group's). */
+static inline const cf_law *cf_body_spring_law(const cf_body *b, size_t s)
+{
+    return b->group ? b->glaw[b->group[s]] : b->law;
+}
+
+/* Gives the springs of n regions (n <= CF_BODY_MAX_GROUPS) laws of their own (body_groups.c):
+** group g (1..n) is every spring with both ends among the nodes sel[g - 1] selects in mesh m (the
+** body's), taking the law of spring[g - 1] (with its table, of table_intervals, for the table
+** method), of the body law's free length H to CF_GROUP_H_REL; the spring's calibration factor
+** is kept (it does not depend on the law), so the region's material has that law's modulus.
+** CF_E_DATA naming key[g - 1] for a group that holds no spring, for a spring two groups hold
+** (overlapping regions), for another H; CF_E_INTERNAL when memory runs out. */
+cf_status cf_body_set_groups(cf_body *b, const cf_mesh *m, size_t n, const cf_select *sel,
+                             const cf_spring *spring, const char *const *key,
+                             size_t table_intervals, cf_error *err);
 
 /* Every component of a node held. */
 #define CF_BODY_FIX_ALL 7

@@ -435,7 +435,7 @@ double cf_body_assemble(const cf_body *b, const double *x, const cf_probe *pr, c
     for (size_t s = 0; s < b->ns; s++) {
         double n[3], u, k;
         double L = body_spring_geom(b, x, s, n, &u);
-        double F = cf_law_force(law, b->method, u, &k, NULL);
+        double F = cf_law_force(b->group ? b->glaw[b->group[s]] : law, b->method, u, &k, NULL);
         double T = -b->c[s] * F; /* tension */
         size_t i = b->si[s], j = b->sj[s];
         for (int a = 0; a < 3; a++) {
@@ -567,7 +567,7 @@ int cf_body_admissible(const cf_body *b, const double *x)
     for (size_t s = 0; s < b->ns; s++) {
         double n[3], u;
         body_spring_geom(b, x, s, n, &u);
-        if (!(fabs(u) < cf_law_travel_at(b->law, u))) /* a pair: each side its own */
+        if (!(fabs(u) < cf_law_travel_at(cf_body_spring_law(b, s), u))) /* a pair: each side its own */
             return 0;
     }
     for (size_t t = 0; t < b->nt; t++) {

@@ -66,7 +66,7 @@ static void spring_forces(const cf_body *b, const double *x, cf_body_fields *f)
     for (size_t s = 0; s < b->ns; s++) {
         double n[3], u, k;
         body_spring_geom(b, x, s, n, &u);
-        f->force[s] = fin(-b->c[s] * cf_law_force(b->law, b->method, u, &k, NULL));
+        f->force[s] = fin(-b->c[s] * cf_law_force(cf_body_spring_law(b, s), b->method, u, &k, NULL));
     }
 }
 

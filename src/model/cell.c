@@ -70,8 +70,16 @@ cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
     c->linear_finish = 0;
     c->biaxial_k = 1.0;
     c->volume_modulus_MPa = 0.0;
+    for (int f = 0; f < CF_FAMILY_COUNT; f++)
+        c->family_law[f] = NULL;
     memcpy(c->weight, weight, sizeof c->weight);
     return CF_OK;
+}
+
+/* The law of family fam's springs. */
+static inline const cf_law *fam_law(const cf_cell *c, int fam)
+{
+    return c->family_law[fam] ? c->family_law[fam] : c->law;
 }
 
 /* 1 when spring d carries what the earlier spring e carries: the same squared length (so the
@@ -91,9 +99,9 @@ static cf_status spring_tension(const cf_cell *c, int d, double L, const cf_cell
                                 cf_cell_state *s, double kT[CF_CELL_DIRS], double *r,
                                 cf_error *err)
 {
-    const cf_law *law = c->law;
-    const double H = law->p.H_mm;
     const int *N = dirs[d], fam = dir_family[d];
+    const cf_law *law = fam_law(c, fam);
+    const double H = law->p.H_mm;
     double L0 = H * dir_len[d];
     double u = H * (L0 - L) / L0;
     const double travel = cf_law_travel_at(law, u); /* a pair: the side u loads */
@@ -395,7 +403,7 @@ static cf_status settle_linear(const cf_cell *c, const mode_form *fm,
         s->T_N[d] = Tn[d];
         const double L0 = H * dir_len[d];
         const double uu = H * (L0 - s->L_mm[d]) / L0;
-        const double ru = fabs(uu) / cf_law_travel_at(c->law, uu);
+        const double ru = fabs(uu) / cf_law_travel_at(fam_law(c, dir_family[d]), uu);
         umax = ru > umax ? ru : umax;
     }
     for (int m = 0; m < 3; m++) {
@@ -473,8 +481,9 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
     }
     /* Safeguarded Newton on r(a) = P[zero][zero], increasing in a: a bracket [lo, hi] with
     ** r(lo) < 0 < r(hi) is kept once known; a step that leaves it, or the domain, bisects. */
-    const double sH = c->law->travel_mm / c->law->p.H_mm; /* compression side */
-    const double sHe = cf_law_travel_at(c->law, -1) / c->law->p.H_mm; /* extension side */
+    const cf_law *edge = fam_law(c, CF_FAMILY_EDGE); /* the free axis's edge */
+    const double sH = edge->travel_mm / edge->p.H_mm; /* compression side */
+    const double sHe = cf_law_travel_at(edge, -1) / edge->p.H_mm; /* extension side */
     bracket b = {1 - sH, 1 + sHe, 0, 0}; /* the edge along a free axis reaches solid there */
     double a = c->stretch_hint > 0 ? c->stretch_hint : guess(c, m, e);
     a = fmin(fmax(a, b.lo + 1e-3 * sH), b.hi - 1e-3 * sHe);

@@ -34,6 +34,9 @@
 ** it adds kappa to Lame's lambda and nothing to mu: the isotropic lattice (lambda = mu) gets
 ** nu = (mu + kappa)/(2 (2 mu + kappa)). Simple shear keeps J = 1 and does not feel it. kappa = 0
 ** (cf_cell_init's value) leaves every result of the springs alone, bit for bit.
+** Spring groups: each family's directions may take a law of their own (family_law, the groups of
+** the lattice's cfg.group_law); the homogenised cell then equals the full lattice with those
+** groups as it does with one law.
 ** A double-acting law (law.h, law->extension) enters through the law alone: each spring's side
 ** (and the travel to solid on that side) follows the sign of its compression.
 **
@@ -75,6 +78,9 @@ typedef struct cf_cell {
     double volume_modulus_MPa;       /* kappa of the volume term, MPa (0 by cf_cell_init: none) */
     double biaxial_k;                /* the biaxial mode's strain along y per unit strain along x
                                      ** (1 by cf_cell_init; other modes ignore it) */
+    const cf_law *family_law[CF_FAMILY_COUNT]; /* a law per spring group (the family of each
+                                     ** direction, as the lattice's cfg.group_law), not owned; NULL
+                                     ** (cf_cell_init's): law. Same free length H as law */
     int linear_finish;               /* 1: a free-stretch solve whose last Newton step is too small
                                      ** for its second-order term to reach rounding takes that step
                                      ** by the cell's linearisation instead of evaluating the cell
@@ -82,7 +88,7 @@ typedef struct cf_cell {
 } cf_cell;
 
 /* Checks the weights (cf_calibration_check) and fills c (law_scale 1, law_scale_strain 0, stretch_hint 0,
-** linear_finish 0, biaxial_k 1). */
+** linear_finish 0, biaxial_k 1, every family with law). */
 cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
                        const double weight[CF_FAMILY_COUNT], cf_error *err);
 

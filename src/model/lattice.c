@@ -28,6 +28,8 @@ cf_lattice_config cf_lattice_default(void)
     c.bottom = CF_BOTTOM_AXIAL;
     c.volume_modulus_MPa = 0;
     c.hourglass = CF_HOURGLASS_AUTO;
+    for (int f = 0; f < CF_FAMILY_COUNT; f++)
+        c.group_law[f] = NULL;
     return c;
 }
 
@@ -45,6 +47,9 @@ void cf_lattice_free(cf_lattice *lat)
         free(*d[i]);
         *d[i] = NULL;
     }
+    free(lat->gidx), free(lat->gu), free(lat->gF), free(lat->gk);
+    lat->gidx = NULL;
+    lat->gu = lat->gF = lat->gk = NULL;
     free(lat->fix);
     free(lat->family);
     lat->family = NULL;
@@ -173,6 +178,71 @@ static void set_top(cf_lattice *lat)
         }
 }
 
+/* The groups' laws of cfg resolved into lat->glaw (the lattice's law where NULL): CF_E_DATA for a
+** group law of another free length. */
+static cf_status resolve_groups(cf_lattice *lat, const cf_law *law, const cf_lattice_config *cfg,
+                                cf_error *err)
+{
+    static const char *const names[CF_FAMILY_COUNT] = {"edge", "face", "body"};
+    lat->grouped = 0;
+    for (int f = 0; f < CF_FAMILY_COUNT; f++) {
+        const cf_law *g = cfg->group_law[f] ? cfg->group_law[f] : law;
+        if (!(fabs(g->p.H_mm - law->p.H_mm) <= CF_GROUP_H_REL * law->p.H_mm))
+            return cf_error_set(err, CF_E_DATA,
+                                "lattice group '%s': its law's free length H = %.10g mm differs "
+                                "from the lattice's %.10g mm (every group of a lattice shares H, "
+                                "to %g relative)",
+                                names[f], g->p.H_mm, law->p.H_mm, CF_GROUP_H_REL);
+        lat->glaw[f] = g;
+        if (g != law && cfg->weight[f] > 0)
+            lat->grouped = 1;
+    }
+    return CF_OK;
+}
+
+/* The grouped kernel's order of the springs (by group, each in spring order) and its buffers: 0,
+** or -1 when memory runs out. Nothing without groups. */
+static int group_index(cf_lattice *lat)
+{
+    if (!lat->grouped)
+        return 0;
+    const size_t ns = lat->ns ? lat->ns : 1;
+    lat->gidx = malloc(ns * sizeof *lat->gidx);
+    lat->gu = malloc(ns * sizeof *lat->gu);
+    lat->gF = malloc(ns * sizeof *lat->gF);
+    lat->gk = malloc(ns * sizeof *lat->gk);
+    if (!lat->gidx || !lat->gu || !lat->gF || !lat->gk)
+        return -1;
+    size_t n = 0;
+    for (int f = 0; f < CF_FAMILY_COUNT; f++) {
+        lat->gstart[f] = n;
+        for (size_t s = 0; s < lat->ns; s++)
+            if (lat->family[s] == f)
+                lat->gidx[n++] = (uint32_t)s;
+    }
+    lat->gstart[CF_FAMILY_COUNT] = n;
+    return 0;
+}
+
+double cf_lattice_travel_at(const cf_lattice *lat, double u)
+{
+    double t = cf_law_travel_at(lat->law, u);
+    for (int f = 0; lat->grouped && f < CF_FAMILY_COUNT; f++)
+        if (lat->cfg.weight[f] > 0)
+            t = fmin(t, cf_law_travel_at(lat->glaw[f], u));
+    return t;
+}
+
+/* The family weights the small-strain constants see (the hourglass stiffness): each group's
+** weight times its law's k0 over the lattice law's (the weights themselves without groups). */
+static void stiffness_weights(const cf_lattice *lat, double w[CF_FAMILY_COUNT])
+{
+    for (int f = 0; f < CF_FAMILY_COUNT; f++)
+        w[f] = lat->grouped ? lat->cfg.weight[f] * lat->glaw[f]->k0_N_per_mm /
+                                  lat->law->k0_N_per_mm
+                            : lat->cfg.weight[f];
+}
+
 cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method method,
                             const cf_lattice_config *cfg, cf_error *err)
 {
@@ -185,7 +255,12 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
     lat->method = method;
     lat->with_stiffness = 1;
     lat->H_mm = law->p.H_mm;
+    if ((st = resolve_groups(lat, law, cfg, err)) != CF_OK)
+        return st;
     lat->travel_mm = cf_law_travel_min(law); /* a pair: the side that closes first */
+    for (int f = 0; lat->grouped && f < CF_FAMILY_COUNT; f++)
+        if (cfg->weight[f] > 0)
+            lat->travel_mm = fmin(lat->travel_mm, cf_law_travel_min(lat->glaw[f]));
     /* the net of the lattice (its nodes, springs, weights and fixity), copied into the structures
     ** of arrays the kernels run on */
     cf_net net;
@@ -201,7 +276,7 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
     }
     copy_net(lat, &net);
     cf_net_free(&net);
-    if (set_max_degree(lat) != 0) {
+    if (set_max_degree(lat) != 0 || group_index(lat) != 0) {
         cf_lattice_free(lat);
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for a %d x %d x %d lattice",
                             cfg->nx, cfg->ny, cfg->nz);
@@ -209,8 +284,10 @@ cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method me
     set_top(lat);
     lat->area_mm2 = (double)cfg->nx * cfg->ny * lat->H_mm * lat->H_mm;
     lat->height_mm = cfg->nz * lat->H_mm;
+    double wk[CF_FAMILY_COUNT];
+    stiffness_weights(lat, wk);
     lat->hg_k_N_per_mm =
-        cf_hourglass_stiffness(cfg->weight, cfg->volume_modulus_MPa, cfg->hourglass, law);
+        cf_hourglass_stiffness(wk, cfg->volume_modulus_MPa, cfg->hourglass, law);
     return CF_OK;
 }
 
@@ -397,6 +474,34 @@ static void cell_forces(cf_lattice *lat)
     }
 }
 
+/* The grouped kernel's law: each group's springs gathered, its law's batch over them, the forces
+** and stiffnesses scattered back. Returns the largest |u| / travel over the springs, each group's
+** travel on its side. */
+static double group_forces(cf_lattice *lat)
+{
+    const int wk = lat->with_stiffness;
+    double r = 0;
+    for (int f = 0; f < CF_FAMILY_COUNT; f++) {
+        const size_t b = lat->gstart[f], n = lat->gstart[f + 1] - b;
+        const uint32_t *idx = lat->gidx + b;
+        const cf_law *g = lat->glaw[f];
+        for (size_t k = 0; k < n; k++) {
+            const double u = lat->u_mm[idx[k]];
+            lat->gu[b + k] = u;
+            r = fmax(r, fabs(u) / cf_law_travel_at(g, u));
+        }
+        if (n == 0)
+            continue;
+        cf_law_force_many(g, lat->method, n, lat->gu + b, lat->gF + b, wk ? lat->gk + b : NULL);
+        for (size_t k = 0; k < n; k++) {
+            lat->F_N[idx[k]] = lat->gF[b + k];
+            if (wk)
+                lat->k_N_per_mm[idx[k]] = lat->gk[b + k];
+        }
+    }
+    return r;
+}
+
 double cf_lattice_forces(cf_lattice *lat)
 {
     const size_t ns = lat->ns, nn = lat->nn;
@@ -416,9 +521,12 @@ double cf_lattice_forces(cf_lattice *lat)
         double au = fabs(u[s]);
         umax = au > umax ? au : umax;
     }
-    /* 2: the law, one dispatch for all springs. */
-    cf_law_force_many(lat->law, lat->method, ns, lat->u_mm, lat->F_N,
-                      lat->with_stiffness ? lat->k_N_per_mm : NULL);
+    /* 2: the law, one dispatch for all springs (or one per group). */
+    if (lat->grouped)
+        umax = group_forces(lat) * lat->travel_mm;
+    else
+        cf_law_force_many(lat->law, lat->method, ns, lat->u_mm, lat->F_N,
+                          lat->with_stiffness ? lat->k_N_per_mm : NULL);
     /* 3: tensions and equal and opposite node forces. */
     memset(fx, 0, nn * sizeof(double));
     memset(fy, 0, nn * sizeof(double));
@@ -525,7 +633,7 @@ double cf_lattice_elastic_energy(const cf_lattice *lat)
         double dy = lat->y[lat->sj[s]] - lat->y[lat->si[s]];
         double dz = lat->z[lat->sj[s]] - lat->z[lat->si[s]];
         double u = (lat->L0_mm[s] - sqrt(dx * dx + dy * dy + dz * dz)) * lat->a[s];
-        e += lat->w[s] / lat->a[s] * law_work(lat->law, lat->method, u, gl);
+        e += lat->w[s] / lat->a[s] * law_work(cf_lattice_spring_law(lat, s), lat->method, u, gl);
     }
     gsl_integration_glfixed_table_free(gl);
     const double kappa = lat->cfg.volume_modulus_MPa, H = lat->H_mm;

@@ -62,6 +62,10 @@ typedef struct cf_lattice_config {
                               ** the same node motion); 0 for none, at most 1000;
                               ** CF_HOURGLASS_AUTO (the default): CF_HOURGLASS_DEFAULT with a
                               ** volume term, 0 without */
+    const cf_law *group_law[CF_FAMILY_COUNT]; /* a law per spring group (a group is a family:
+                              ** CF_FAMILY_EDGE, _FACE, _BODY), not owned; NULL (the default):
+                              ** the lattice's law. A group's law has the lattice law's free
+                              ** length H, and with CF_LAW_TABLE its table built */
 } cf_lattice_config;
 
 /* The hourglass fraction that means "the default with a volume term, none without"; that default
@@ -69,7 +73,7 @@ typedef struct cf_lattice_config {
 #define CF_HOURGLASS_AUTO (-1.0)
 
 /* 3 x 3 x 3 cells, the isotropic calibration, density 1e-9 t/mm^3, bottom axial, no volume term,
-** hourglass control automatic. */
+** hourglass control automatic, every group with the lattice's law. */
 cf_lattice_config cf_lattice_default(void);
 
 /* DOF fixity bits per node. */
@@ -114,10 +118,29 @@ typedef struct cf_lattice {
     int max_degree;         /* most springs meeting at one node */
     double hg_k_N_per_mm;   /* the hourglass stiffness k_h of every cell (cfg.hourglass resolved
                             ** for this law), N/mm; 0: no hourglass control */
+    /* spring groups (cfg.group_law): */
+    const cf_law *glaw[CF_FAMILY_COUNT]; /* each group's law (the lattice's where cfg gives NULL) */
+    int grouped;            /* 1 when some group's law is not the lattice's: the kernel then
+                            ** evaluates each group's law over its springs (gathered by gidx) */
+    uint32_t *gidx;         /* grouped: the springs ordered by group, each in spring order */
+    size_t gstart[CF_FAMILY_COUNT + 1]; /* grouped: group g is gidx[gstart[g] .. gstart[g+1]) */
+    double *gu, *gF, *gk;   /* grouped: the gathered compressions, forces and stiffnesses */
 } cf_lattice;
 
+/* The law of spring s (its group's). */
+static inline const cf_law *cf_lattice_spring_law(const cf_lattice *lat, size_t s)
+{
+    return lat->glaw[lat->family[s]];
+}
+
+/* The travel to solid on the side of compression u (u < 0: extension) of the group that reaches
+** solid first on that side, mm: the lattice law's own with one group law. */
+double cf_lattice_travel_at(const cf_lattice *lat, double u);
+
+
 /* Builds the lattice at its reference (undeformed) state. CF_E_DATA with a message naming the
-** field for a bad configuration, CF_E_INTERNAL when memory runs out. The law must outlive the
+** field for a bad configuration (a group law of another free length among them), CF_E_INTERNAL
+** when memory runs out. The law must outlive the
 ** lattice; with CF_LAW_TABLE the caller builds the law's table first. */
 cf_status cf_lattice_create(cf_lattice *lat, const cf_law *law, cf_law_method method,
                             const cf_lattice_config *cfg, cf_error *err);

@@ -15,13 +15,48 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The form of a lattice with spring groups, every group's lanes in st->glanes: the polynomial
+** when each group's law has one within CF_POLY_TOL (st->poly_error the largest), else the closed
+** form or the table (every group's built); -1 (the scalar law of each group) for a kind, a pair
+** or a tailed spring among them. */
+static int group_form(cf_lattice_stepper *st, const cf_lattice *lat)
+{
+    const cf_law_method m = lat->method;
+    int poly = 1, table = 1;
+    st->poly_error = NAN;
+    for (int f = 0; f < CF_FAMILY_COUNT; f++) {
+        const cf_law *g = lat->glaw[f];
+        if (!(lat->cfg.weight[f] > 0))
+            continue;
+        if (g->mech || g->extension || g->tail || (m != CF_LAW_CLOSED && m != CF_LAW_TABLE))
+            return -1;
+        cf_law_lanes_init(g, &st->glanes[f]);
+        table = table && st->glanes[f].coef;
+    }
+    double worst = 0;
+    for (int f = 0; f < CF_FAMILY_COUNT && poly; f++) {
+        double pe;
+        if (lat->cfg.weight[f] > 0 && !cf_law_lanes_fit_poly(lat->glaw[f], &st->glanes[f], &pe))
+            poly = 0;
+        else if (lat->cfg.weight[f] > 0)
+            worst = fmax(worst, pe);
+    }
+    if (poly) {
+        st->poly_error = worst;
+        return CF_LANE_POLY;
+    }
+    return m == CF_LAW_CLOSED ? CF_LANE_CLOSED : table ? CF_LANE_TABLE : -1;
+}
+
 cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const long *eq,
                                   cf_error *err)
 {
     memset(st, 0, sizeof *st);
     st->lat = lat;
     cf_law_lanes_init(lat->law, &st->lanes);
-    if (lat->law->mech) /* a law kind's row: the scalar law (its batch, law_kind.c) */
+    if (lat->grouped) /* a law per group: each group's lanes in one form */
+        st->form = group_form(st, lat);
+    else if (lat->law->mech) /* a law kind's row: the scalar law (its batch, law_kind.c) */
         st->form = -1;
     else if (lat->law->extension) { /* a double-acting element: both springs' lanes, side by side */
         const cf_law *e = lat->law->extension;
@@ -54,7 +89,9 @@ cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const
         st->form = -1;
     /* closed form and table: the spring's polynomial when it is within CF_POLY_TOL of the closed
     ** form (more accurate than the table, cheaper than both) */
-    if (st->form >= 0 && !lat->law->extension && cf_law_lanes_fit_poly(lat->law, &st->lanes, &st->poly_error))
+    if (lat->grouped)
+        ; /* group_form chose */
+    else if (st->form >= 0 && !lat->law->extension && cf_law_lanes_fit_poly(lat->law, &st->lanes, &st->poly_error))
         st->form = CF_LANE_POLY;
     else if (st->form == CF_LANE_POLY)
         st->form = -1;
@@ -77,6 +114,8 @@ cf_status cf_lattice_stepper_init(cf_lattice_stepper *st, cf_lattice *lat, const
         const int nzc = (off[0] != 0) + (off[1] != 0) + (off[2] != 0);
         sd->L0 = lat->H_mm * sqrt((double)nzc); /* as lattice.c forms them */
         sd->a = lat->H_mm / sd->L0;
+        sd->law = lat->glaw[fam];
+        sd->lanes = lat->grouped && st->form >= 0 ? &st->glanes[fam] : NULL;
         sd->wk[0] = 1.0;
         sd->wk[1] = cf_lattice_axis_share(0, off[2], nz); /* bottom and top layers */
         if (!(sd->wl = malloc(st->layer * sizeof(double))))
@@ -162,7 +201,7 @@ run_dir(const cf_lattice *lat, const cf_law_lanes *c, const cf_law_lanes *e, int
     else if (form == CF_LANE_CLOSED)
         cf_lanes_closed(c, n8, u, F);
     else /* the scalar law */
-        cf_law_force_many(lat->law, lat->method, n, u, F, NULL);
+        cf_law_force_many(sd->law, lat->method, n, u, F, NULL);
     /* the forces at p, then at p + D: two loops, since the runs overlap when D < n (each pointer
     ** is restrict in its own loop only) */
     {
@@ -209,7 +248,8 @@ layer_springs(const cf_lattice_stepper *st, int form, size_t k)
             if (a >= b)
                 continue;
             const double um =
-                run_dir(lat, &c, &e, form, sd, sd->wk[edge], base + a, b - a, sd->wl + a);
+                run_dir(lat, sd->lanes ? sd->lanes : &c, &e, form, sd, sd->wk[edge], base + a,
+                        b - a, sd->wl + a);
             umax = um > umax ? um : umax;
         }
     }

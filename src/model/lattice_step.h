@@ -50,6 +50,8 @@ typedef struct cf_step_dir {
     double L0, a;        /* rest length, mm, and H/L0 */
     double wk[2];        /* layer factor: [0] inner layers, [1] the bottom and top layers */
     double *wl;          /* weight over the first nodes of a layer (0: no spring there) */
+    const cf_law *law;   /* the law of its group (the scalar form's; lattice.h, group_law) */
+    const cf_law_lanes *lanes; /* a lattice with groups: its group's lanes (NULL: the stepper's) */
 } cf_step_dir;
 
 /* The forms of a double-acting element's step (beside law_simd.h's CF_LANE_*): each spring of
@@ -61,8 +63,12 @@ typedef struct cf_lattice_stepper {
     cf_lattice *lat;       /* not owned */
     cf_law_lanes lanes;
     cf_law_lanes ext_lanes; /* a double-acting element's extension spring (its H the same) */
+    cf_law_lanes glanes[CF_FAMILY_COUNT]; /* a lattice with groups: each group's lanes */
     int form;              /* CF_LANE_POLY, CF_LANE_CLOSED, CF_LANE_TABLE, CF_STEP_PAIR_*, or -1:
-                              the scalar law per block */
+                              the scalar law per block (each direction its group's law). With
+                              groups, one form for every group (each its own lanes): the
+                              polynomial when every group's fits, else the closed form or the
+                              table; -1 when a group's law is a kind, a pair or tailed */
     double poly_error;     /* the polynomial's measured error (law_simd.h), NaN when not fitted */
     int ndir;              /* directions with springs (families of weight > 0) */
     cf_step_dir dir[CF_CELL_DIRS];

@@ -214,8 +214,18 @@ static double force_floor(const solver *s)
         for (size_t q = 0; q < lat->ns; q++)
             dash = fmax(dash, s->kx[q] * fmax(lat->L_mm[q], xmax));
     }
-    const double FC = lat->law->extension ? fmax(lat->law->F_C_N, lat->law->extension->F_C_N)
-                                          : lat->law->F_C_N;
+    /* with spring groups the scale is the largest weighted F_C over the springs (each its group's) */
+    double FC = lat->law->extension ? fmax(lat->law->F_C_N, lat->law->extension->F_C_N)
+                                    : lat->law->F_C_N;
+    if (lat->grouped) {
+        double wF = 0;
+        for (size_t q = 0; q < lat->ns; q++) {
+            const cf_law *g = cf_lattice_spring_law(lat, q);
+            wF = fmax(wF, lat->w[q] * (g->extension ? fmax(g->F_C_N, g->extension->F_C_N)
+                                                     : g->F_C_N));
+        }
+        FC = fmax(wF / wmax, FC / wmax);
+    }
     /* the volume term's forces scale with kappa H^2 as the springs' with F_C, the hourglass
     ** control's with k_h H */
     const double vol =

@@ -85,7 +85,7 @@ cf_status cf_msm_uniaxial(const cf_law *law, cf_law_method m, const cf_msm_confi
             }
             /* the loaded edge's spring on the table's side (a pair: tension closes the extension
             ** spring) */
-            const double side_travel = cf_law_travel_at(lat.law, -e);
+            const double side_travel = cf_lattice_travel_at(&lat, -e);
             if (fabs(e) * lat.H_mm >= side_travel) {
                 rc = cf_error_set(err, CF_E_DATA,
                                   "strain %.6g is at or beyond the spring's solid strain %.6g",
@@ -155,7 +155,7 @@ cf_status cf_msm_stability_limit(const cf_law *law, cf_law_method m, const cf_ms
     }
     /* compressive-positive drive: a table strain of sign `side` is -side times it */
     const double dir = side < 0 ? 1.0 : -1.0;
-    const double top = STABILITY_REACH * cf_law_travel_at(lat.law, -side) / lat.H_mm;
+    const double top = STABILITY_REACH * cf_lattice_travel_at(&lat, -side) / lat.H_mm;
     double stable = 0;
     s.load = 0;
     for (int k = 1; k <= STABILITY_STEPS; k++) {

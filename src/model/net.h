@@ -21,6 +21,11 @@
 #include "conifit/error.h"
 
 /* The kinds of volume element: a row each in the table of net.c (its name and node count). */
+/* How far a spring group's law may differ in free length from the net's law, relative (two fits
+** of one free length agree to rounding; the lattice's cell edge and the body's calibration are of
+** the net law's H). */
+#define CF_GROUP_H_REL 1e-9
+
 typedef enum cf_net_cell_kind {
     CF_NET_TET4 = 0, /* four corners, positively oriented (body.h) */
     CF_NET_HEX8 = 1  /* eight corners, corner di + 2 dj + 4 dk of the cell (the C3D8 / HEX8 order
