@@ -8,7 +8,11 @@
 **    mode (cf_cell_mode) to 1e-12 relative;
 **  - with fibres, each free stretch zeroes its stress (1e-12 of the loaded stress), biaxial rows
 **    of both directions and simple shear in all six planes of the fibre frame: in mode (fs) the
-**    fibre adds phi gamma to the shear stress, in (sf) nothing (the fibre keeps its length).
+**    fibre adds phi gamma to the shear stress, in (sf) nothing (the fibre keeps its length);
+**  - the full lattice with the same fibre groups (2 x 3 x 2 cells, volume term), placed at the
+**    cell's F of a biaxial row (either direction) or a simple shear in any of the six planes, with
+**    the frame on the lattice's axes and turned: no force on any node off its faces, and its
+**    nodal forces' moment -sum f X^T / V is the cell's nominal stress, 1e-9 relative.
 */
 #include "testutil.h"
 
@@ -18,6 +22,7 @@
 #include "model/cell.h"
 #include "model/family.h"
 #include "model/fibre.h"
+#include "model/lattice.h"
 
 typedef struct fixture {
     cf_law matrix, fib, sheet;
@@ -211,6 +216,83 @@ static void fibre_modes_in_every_plane(void **state)
         }
 }
 
+/* The lattice of x's laws and groups at the cell's state s: checks node by node. */
+static void lattice_is_the_cell(const fixture *x, const cf_cell_state *s, const char *what)
+{
+    cf_lattice_config lc = cf_lattice_default();
+    lc.nx = 2, lc.ny = 3, lc.nz = 2;
+    lc.volume_modulus_MPa = x->cell.volume_modulus_MPa;
+    lc.hourglass = 0;
+    memcpy(lc.weight, x->cell.weight, sizeof lc.weight);
+    lc.fibre = x->cell.fibre;
+    lc.nfibre = x->cell.nfibre;
+    cf_lattice lat;
+    cf_error err = {0};
+    if (cf_lattice_create(&lat, &x->matrix, CF_LAW_CLOSED, &lc, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    for (size_t p = 0; p < lat.nn; p++) {
+        const double X[3] = {lat.X[p], lat.Y[p], lat.Z[p]};
+        const double *F = s->F;
+        lat.x[p] = F[0] * X[0] + F[1] * X[1] + F[2] * X[2];
+        lat.y[p] = F[3] * X[0] + F[4] * X[1] + F[5] * X[2];
+        lat.z[p] = F[6] * X[0] + F[7] * X[1] + F[8] * X[2];
+    }
+    cf_lattice_forces(&lat);
+    const double H = x->matrix.p.H_mm, ext[3] = {lc.nx * H, lc.ny * H, lc.nz * H};
+    double big = 0, M[3][3] = {{0}}, pmax = 0;
+    for (size_t p = 0; p < lat.nn; p++)
+        big = fmax(big, fabs(lat.fx[p]) + fabs(lat.fy[p]) + fabs(lat.fz[p]));
+    for (size_t p = 0; p < lat.nn; p++) {
+        const double X[3] = {lat.X[p], lat.Y[p], lat.Z[p]}, f[3] = {lat.fx[p], lat.fy[p], lat.fz[p]};
+        int inside = 1;
+        for (int i = 0; i < 3; i++)
+            inside &= X[i] != 0 && X[i] != ext[i];
+        for (int i = 0; i < 3 && inside; i++)
+            if (!(fabs(f[i]) <= 1e-9 * big))
+                fail_msg("%s: inner node %zu carries %g N along %d (largest %g N)", what, p, f[i],
+                         i, big);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                M[i][j] -= f[i] * X[j] / (ext[0] * ext[1] * ext[2]);
+    }
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            pmax = fmax(pmax, fabs(s->P_MPa[i][j]));
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            if (!(fabs(M[i][j] - s->P_MPa[i][j]) <= 1e-9 * pmax))
+                fail_msg("%s: P[%d][%d] of the lattice %.17g, of the cell %.17g", what, i, j,
+                         M[i][j], s->P_MPa[i][j]);
+    cf_lattice_free(&lat);
+}
+
+static void cell_equals_the_full_lattice(void **state)
+{
+    (void)state;
+    for (int turn = 0; turn < 2; turn++) {
+        fixture x;
+        double R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+        if (turn)
+            turned(R);
+        setup_cell(&x, R, 2);
+        for (int p = 0; p < 3; p++)
+            for (int q = 0; q < 3; q++) {
+                if (p == q)
+                    continue;
+                char what[64];
+                cf_cell_state s;
+                const cf_cell_load bi = {CF_MODE_BIAXIAL, {p, q}, 0.75}, sh = {CF_MODE_SHEAR,
+                                                                              {p, q}, 0};
+                assert_int_equal(cf_cell_load_state(&x.cell, &bi, 0.08, &s, NULL), CF_OK);
+                snprintf(what, sizeof what, "biaxial %d%d, frame %d", p, q, turn);
+                lattice_is_the_cell(&x, &s, what);
+                assert_int_equal(cf_cell_load_state(&x.cell, &sh, 0.3, &s, NULL), CF_OK);
+                snprintf(what, sizeof what, "shear %d%d, frame %d", p, q, turn);
+                lattice_is_the_cell(&x, &s, what);
+            }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -218,6 +300,7 @@ int main(void)
         cmocka_unit_test(a_group_adds_its_closed_form),
         cmocka_unit_test(loads_without_fibres_are_the_cells_modes),
         cmocka_unit_test(fibre_modes_in_every_plane),
+        cmocka_unit_test(cell_equals_the_full_lattice),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
