@@ -129,7 +129,8 @@ static void fit_of(const ff_ctx *c, const double *th, cf_fibre_fit *f)
         q[k]->solid = logistic(x[1], k ? c->b_lo[k - 1] : c->b_lo_matrix, B_HI);
         q[k]->scale = exp(fmin(fmax(x[2], -40.0), 20.0));
     }
-    f->kappa_MPa = exp(fmin(fmax(th[3 * (f->ngroups + 1)], -40.0), 20.0));
+    /* kappa in (0, CF_KAPPA_MAX_MPA), the most a lattice takes (calibration.h) */
+    f->kappa_MPa = CF_KAPPA_MAX_MPA / (1 + exp(-fmax(th[3 * (f->ngroups + 1)], -700.0)));
 }
 
 static int residuals(const gsl_vector *x, void *arg, gsl_vector *r)
@@ -320,7 +321,7 @@ static void start(const ff_ctx *c, int s, double amp, double *th)
         x[1] = logit(fmax(s & 2 ? 0.25 : 0.14, 1.1 * c->b_lo[k]), c->b_lo[k], B_HI);
         x[2] = log((s & 4 ? 5.0 : 1.0) * amp * (k ? 0.3 : 1.0));
     }
-    th[c->np - 1] = log(10 * amp);
+    th[c->np - 1] = log(10 * amp / (CF_KAPPA_MAX_MPA - 10 * amp));
 }
 
 /* Each table's RMSE and term, the stability, into r (the model of r). */

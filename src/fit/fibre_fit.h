@@ -12,7 +12,9 @@
 ** strain and the third free, a shear row (ij) with the face of normal i moved along j.
 ** Objective: the joint fit's (each table (RMSE / RMS stress)^2, a biaxial table's two directions
 ** one table), the Holzapfel-Ogden fit's. Levenberg-Marquardt in bounded coordinates (logits of
-** rho and s/H, logs of the scales and kappa) from a grid of starts. Private to the library.
+** rho in (rho_min 0.05, 1), of s/H above the farthest strain each family's springs reach at
+** 1.05 x the tables' strains, of kappa in (0, CF_KAPPA_MAX_MPA); logs of the scales) from a grid
+** of eight starts. Private to the library.
 */
 #ifndef CF_FIT_FIBRE_FIT_H
 #define CF_FIT_FIBRE_FIT_H
