@@ -14,8 +14,9 @@ static void family_text(FILE *o, const cf_joint_report *r, const char *what, con
     const cf_table *t0 = r->tables[0];
     char sp[256];
     const cf_spring p = cf_ident_member(q);
-    fprintf(o, "      %s: rho %.4g, s/H %.4g, F_C/H^2 %.4g %s (member of H 1 mm: %s)\n", what,
-            q->rho, q->solid, q->scale * t0->y_to_file, t0->y_unit,
+    fprintf(o, "      %s: rho %.4g, s/H %.4g, F_C/H^2 %.4g %s (canonical member, not placed: "
+               "%s)\n",
+            what, q->rho, q->solid, q->scale * t0->y_to_file, t0->y_unit,
             cf_spring_text(&p, 4, 0, sp, sizeof sp));
 }
 
