@@ -62,6 +62,10 @@ static const char fit_help[] =
     "                          of work): a larger lattice or table is refused\n"
     "  --joint                 one lattice for every table (one or more), each in its own\n"
     "                          mode\n"
+    "  --fibres GROUPS         with --joint on biaxial and shear tables in a fibre frame (see\n"
+    "                          --plane): also fit a lattice with a tension-only conical spring\n"
+    "                          per cell along each named axis (f, s, n: e.g. f, fs, fn), beside\n"
+    "                          the Holzapfel-Ogden baselines, for either cross-fibre axis\n"
     "  --calibration C         isotropic (default), axial, or fitted (with --joint)\n"
     "  --volume fit            a volume term (kappa/2)(J - 1)^2 in every cell, kappa fitted\n"
     "                          (with --joint)\n"
@@ -150,6 +154,7 @@ enum {
     OPT_MODE,
     OPT_PLANE,
     OPT_JOINT,
+    OPT_FIBRES,
     OPT_CALIBRATION,
     OPT_X_COL,
     OPT_Y_COL,
@@ -202,6 +207,7 @@ static const struct option fit_options[] = {
     {"mode", required_argument, NULL, OPT_MODE},
     {"plane", required_argument, NULL, OPT_PLANE},
     {"joint", no_argument, NULL, OPT_JOINT},
+    {"fibres", required_argument, NULL, OPT_FIBRES},
     {"calibration", required_argument, NULL, OPT_CALIBRATION},
     {"x-col", required_argument, NULL, OPT_X_COL},
     {"y-col", required_argument, NULL, OPT_Y_COL},
@@ -420,6 +426,23 @@ static int lattice_option(fit_args *a, int c, const char *optval)
             return cf_cli_usage_error("fit", "--target '%s': expected lattice or spring", optval);
         return 0;
     case OPT_JOINT: a->joint = 1; return 0;
+    case OPT_FIBRES: {
+        const size_t n = strlen(optval);
+        int seen = 0;
+        for (size_t k = 0; k < n && n <= 3; k++) {
+            const char *at = strchr("fsn", optval[k]);
+            const int bit = at && optval[k] ? 1 << (at - "fsn") : 0;
+            seen = !bit || (seen & bit) ? -1 : seen | bit;
+            if (seen < 0)
+                break;
+        }
+        if (n < 1 || n > 3 || seen < 0)
+            return cf_cli_usage_error("fit", "--fibres '%s': one to three of the fibre-frame "
+                                             "axes f, s and n, each once (e.g. f, fs, fn)",
+                                      optval);
+        a->popt.fibres = optval;
+        return 0;
+    }
     case OPT_VOLUME:
         if (strcmp(optval, "fit") != 0)
             return cf_cli_usage_error("fit", "--volume '%s': expected fit (or declare kappa with "
@@ -682,6 +705,10 @@ int cf_cli_fit_parse(int argc, char **argv, fit_args *a)
         (!a->joint || a->nfiles < 2))
         return cf_cli_usage_error(cmd, "--calibration fitted: the family weights are fitted in a "
                                        "joint fit of several modes (--joint)");
+    if (a->popt.fibres && !a->joint)
+        return cf_cli_usage_error(cmd, "--fibres %s: the fibre-reinforced lattice is fitted "
+                                       "jointly to biaxial and shear tables (--joint)",
+                                  a->popt.fibres);
     if (a->joint && a->out && (cf_cli_is_stdio(a->out) || cf_cli_is_dir_target(a->out)))
         return cf_cli_usage_error(cmd, "--joint -o %s: a joint fit writes one fit file "
                                        "(-o FILE.json)", a->out);

@@ -72,6 +72,10 @@ cf_status cf_cell_init(cf_cell *c, const cf_law *law, cf_law_method method,
     c->volume_modulus_MPa = 0.0;
     for (int f = 0; f < CF_FAMILY_COUNT; f++)
         c->family_law[f] = NULL;
+    c->fibre = NULL;
+    c->nfibre = 0;
+    for (int i = 0; i < 9; i++)
+        c->frame[i] = i % 4 == 0;
     memcpy(c->weight, weight, sizeof c->weight);
     return CF_OK;
 }
@@ -221,6 +225,14 @@ static cf_status evaluate(const cf_cell *c, const double F[9], const cf_cell_ext
     }
     if (c->volume_modulus_MPa != 0)
         volume_stress(c->volume_modulus_MPa, F, P);
+    for (int g = 0; g < c->nfibre; g++) {
+        double T;
+        cf_status st = cf_fibre_add_stress(&c->fibre[g], c->law->p.H_mm, F, P, &T, &r, err);
+        umax = r > umax ? r : umax;
+        s->max_u_over_travel = umax;
+        if (st != CF_OK)
+            return st;
+    }
     memcpy(s->P_MPa, P, sizeof P);
     return CF_OK;
 }
@@ -267,6 +279,9 @@ cf_status cf_cell_tangent(const cf_cell *c, const double F[9], const cf_cell_ext
             A[i] += volume_tangent(c->volume_modulus_MPa, C, J, i / 27, (i / 9) % 3, (i / 3) % 3,
                                    i % 3);
     }
+    for (int g = 0; g < c->nfibre; g++)
+        if ((st = cf_fibre_add_tangent(&c->fibre[g], H, F, A, err)) != CF_OK)
+            return st;
     return CF_OK;
 }
 
@@ -460,6 +475,207 @@ static double next_stretch(bracket *b, double a, double r, double g)
     return an;
 }
 
+/* ---- modes on the axes of a frame (cf_cell_load_state; every mode of a cell with fibres) ---- */
+
+/* Where a load places F' (the frame's components): the base F' at free stretches 1, its free
+** diagonal entries, and the stress read. */
+typedef struct load_form {
+    double F0[9];
+    int nfree, fr[2];
+    int si, sj;
+} load_form;
+
+static cf_status load_form_of(const cf_cell_load *ld, double e, load_form *f, cf_error *err)
+{
+    const int p = ld->axis[0], q = ld->axis[1];
+    if (p < 0 || p > 2 || q < 0 || q > 2 || p == q)
+        return cf_error_set(err, CF_E_DATA, "load axes (%d, %d): two different axes of 0 .. 2",
+                            p, q);
+    if ((int)ld->mode < 0 || ld->mode >= CF_MODE_COUNT)
+        return cf_error_set(err, CF_E_DATA, "mode %d: unknown", (int)ld->mode);
+    const int any_sign = cf_mode_row_of(ld->mode)->any_sign;
+    if (!isfinite(e) || (!any_sign && !(e > -1)))
+        return cf_error_set(err, CF_E_DATA, "%s strain %g: must be finite%s",
+                            cf_mode_name(ld->mode), e, any_sign ? "" : " and > -1");
+    const int r = 3 - p - q;
+    for (int i = 0; i < 9; i++)
+        f->F0[i] = i % 4 == 0;
+    f->nfree = 0;
+    f->si = f->sj = p;
+    switch (ld->mode) {
+    case CF_MODE_SHEAR:
+        f->F0[3 * q + p] = e;
+        f->si = q;
+        break;
+    case CF_MODE_UNIAXIAL:
+        f->F0[4 * p] = 1 + e;
+        f->fr[f->nfree++] = q;
+        f->fr[f->nfree++] = r;
+        break;
+    case CF_MODE_CONFINED: f->F0[4 * p] = 1 + e; break;
+    default: /* planar, equibiaxial, biaxial: q at 1, 1 + e or 1 + k e; r free */
+        f->F0[4 * p] = 1 + e;
+        f->F0[4 * q] = ld->mode == CF_MODE_PLANAR        ? 1
+                       : ld->mode == CF_MODE_EQUIBIAXIAL ? 1 + e
+                                                         : 1 + ld->k * e;
+        f->fr[f->nfree++] = r;
+        break;
+    }
+    if (!isfinite(f->F0[4 * q]) || !(f->F0[4 * q] > 0))
+        return cf_error_set(err, CF_E_DATA, "biaxial strain %g at ratio %g: the other stretch "
+                            "%g is not positive", e, ld->k, f->F0[4 * q]);
+    return CF_OK;
+}
+
+/* F = R^T F' R (R's rows the frame's axes) with F' the form at free stretches v. */
+static void load_place(const double R[9], const load_form *f, const double v[2], double F[9])
+{
+    double Fp[9];
+    memcpy(Fp, f->F0, sizeof Fp);
+    for (int k = 0; k < f->nfree; k++)
+        Fp[4 * f->fr[k]] = v[k];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            double x = 0;
+            for (int a = 0; a < 3; a++)
+                for (int b = 0; b < 3; b++)
+                    x += R[3 * a + i] * Fp[3 * a + b] * R[3 * b + j];
+            F[3 * i + j] = x;
+        }
+}
+
+/* P'_ab = (R P R^T)_ab. */
+static double frame_stress(const double R[9], const double *P, int a, int b)
+{
+    double x = 0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            x += R[3 * a + i] * P[3 * i + j] * R[3 * b + j];
+    return x;
+}
+
+/* dP'_aa / dF'_bb from the lattice-frame tangent A. */
+static double frame_tangent(const double R[9], const double A[81], int a, int b)
+{
+    double x = 0;
+    for (int i = 0; i < 81; i++) {
+        const int ii = i / 27, jj = (i / 9) % 3, kk = (i / 3) % 3, ll = i % 3;
+        x += R[3 * a + ii] * R[3 * a + jj] * A[i] * R[3 * b + kk] * R[3 * b + ll];
+    }
+    return x;
+}
+
+/* Newton on the free stretches of f from v, each step halved while the state beyond it fails;
+** the state at the end into s. */
+static cf_status load_newton(const cf_cell *c, const double R[9], const load_form *f,
+                             const cf_cell_extra *x, double v[2], cf_cell_state *s, cf_error *err)
+{
+    double F[9], A[81];
+    load_place(R, f, v, F);
+    cf_status st = cf_cell_tangent(c, F, x, s, A, err);
+    for (int it = 0; st == CF_OK && it < MAX_ITER; it++) {
+        double r[2], J[2][2], dv[2];
+        for (int a = 0; a < f->nfree; a++) {
+            r[a] = frame_stress(R, &s->P_MPa[0][0], f->fr[a], f->fr[a]);
+            for (int b = 0; b < f->nfree; b++)
+                J[a][b] = frame_tangent(R, A, f->fr[a], f->fr[b]);
+        }
+        if (f->nfree == 1)
+            dv[0] = -r[0] / J[0][0];
+        else {
+            const double det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+            dv[0] = -(J[1][1] * r[0] - J[0][1] * r[1]) / det;
+            dv[1] = -(J[0][0] * r[1] - J[1][0] * r[0]) / det;
+        }
+        double step = 0;
+        for (int a = 0; a < f->nfree; a++)
+            step = fmax(step, fabs(dv[a]));
+        if (!isfinite(step))
+            return cf_error_set(err, CF_E_NOCONV, "the free stretches' tangent is singular at "
+                                "%.17g", v[0]);
+        double vn[2] = {v[0], v[1]};
+        for (int h = 0; h < 60; h++) {
+            for (int a = 0; a < f->nfree; a++)
+                vn[a] = v[a] + dv[a];
+            load_place(R, f, vn, F);
+            if (vn[0] > 0 && (f->nfree < 2 || vn[1] > 0) &&
+                (st = cf_cell_tangent(c, F, x, s, A, NULL)) == CF_OK)
+                break;
+            dv[0] *= 0.5, dv[1] *= 0.5;
+            st = CF_E_DATA;
+        }
+        if (st != CF_OK)
+            break;
+        v[0] = vn[0], v[1] = vn[1];
+        if (step <= 1e-15 * fmax(1.0, fabs(v[0])))
+            return CF_OK;
+    }
+    if (st != CF_OK)
+        return cf_error_set(err, CF_E_DATA, "no free stretch near %.6g reachable: a spring of "
+                            "the cell reaches solid", v[0]);
+    return cf_error_set(err, CF_E_NOCONV, "no free stretch gives zero lateral stress (last "
+                        "%.17g)", v[0]);
+}
+
+/* The state of ld at e on the axes of R (rows: unit axes in the lattice frame). */
+static cf_status load_solve(const cf_cell *c, const double R[9], const cf_cell_load *ld,
+                            double e, const cf_cell_extra *x, cf_cell_state *s, cf_error *err)
+{
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++) {
+            double d = 0;
+            for (int i = 0; i < 3; i++)
+                d += R[3 * a + i] * R[3 * b + i];
+            if (!(fabs(d - (a == b)) <= 1e-12))
+                return cf_error_set(err, CF_E_DATA, "fibre frame: axes %d and %d have dot "
+                                    "product %.17g (an orthonormal frame is needed)", a, b, d);
+        }
+    load_form f;
+    cf_status st = load_form_of(ld, e, &f, err);
+    if (st != CF_OK)
+        return st;
+    double v[2] = {1, 1}, F[9];
+    if (f.nfree == 0) {
+        load_place(R, &f, v, F);
+        st = cf_cell_stress(c, F, x, s, err);
+    } else {
+        cf_error e1 = {0};
+        const double lp = f.F0[4 * ld->axis[0]], lq = f.F0[4 * ld->axis[1]];
+        v[0] = v[1] = f.nfree == 2 ? 1 / sqrt(lp) : 1 / (lp * lq); /* an incompressible guess */
+        st = load_newton(c, R, &f, x, v, s, &e1);
+        if (st != CF_OK) { /* from the reference stretches instead */
+            v[0] = v[1] = 1;
+            st = load_newton(c, R, &f, x, v, s, &e1);
+        }
+        if (st != CF_OK)
+            return cf_error_set(err, st, "%s strain %g: %s", cf_mode_name(ld->mode), e, e1.msg);
+    }
+    if (st != CF_OK)
+        return st;
+    s->free_stretch = f.nfree ? v[0] : 1;
+    s->stress_MPa = frame_stress(R, &s->P_MPa[0][0], f.si, f.sj);
+    return CF_OK;
+}
+
+cf_status cf_cell_load_state(const cf_cell *c, const cf_cell_load *ld, double e,
+                             cf_cell_state *s, cf_error *err)
+{
+    return load_solve(c, c->frame, ld, e, NULL, s, err);
+}
+
+/* cf_cell_mode of a cell with fibres: the mode on the lattice's axes, as cf_cell_load places it. */
+static cf_status mode_with_fibres(const cf_cell *c, cf_mode m, double e, const cf_cell_extra *x,
+                                  cf_cell_state *s, cf_error *err)
+{
+    static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    cf_cell_load ld = {m, {0, 1}, c->biaxial_k};
+    if (m == CF_MODE_UNIAXIAL || m == CF_MODE_CONFINED)
+        ld.axis[0] = 2, ld.axis[1] = 0;
+    else if (m == CF_MODE_SHEAR)
+        ld.axis[0] = 2, ld.axis[1] = 0;
+    return load_solve(c, I, &ld, e, x, s, err);
+}
+
 cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extra *extra,
                        cf_cell_state *s, cf_error *err)
 {
@@ -470,6 +686,8 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
     if (!isfinite(e) || (!any_sign && !(e > -1)))
         return cf_error_set(err, CF_E_DATA, "%s strain %g: must be finite%s", cf_mode_name(m), e,
                             any_sign ? "" : " and > -1");
+    if (c->nfibre > 0)
+        return mode_with_fibres(c, m, e, extra, s, err);
     const mode_form fm = form_of(m);
     double F[9], kT[CF_CELL_DIRS];
     cf_status st;
@@ -540,70 +758,4 @@ cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extr
     return cf_error_set(err, CF_E_NOCONV,
                         "%s strain %g: no free stretch gives zero lateral stress (last %.17g)",
                         cf_mode_name(m), e, a);
-}
-
-double cf_cell_spring_strain(cf_mode m, double e)
-{
-    double F[9], r = 0;
-    cf_mode_place(m, e, 1, F);
-    for (int d = 0; d < CF_CELL_DIRS; d++) {
-        double X[3] = {dirs[d][0], dirs[d][1], dirs[d][2]}, L2 = 0, L02 = 0;
-        for (int i = 0; i < 3; i++) {
-            double xi = F[3 * i] * X[0] + F[3 * i + 1] * X[1] + F[3 * i + 2] * X[2];
-            L2 += xi * xi;
-            L02 += X[i] * X[i];
-        }
-        r = fmax(r, fabs(sqrt(L2 / L02) - 1));
-    }
-    return r;
-}
-
-cf_status cf_cell_curve(const cf_cell *c, cf_mode m, const double *strain, size_t count,
-                        double *stress_MPa, cf_error *err)
-{
-    cf_cell_state s;
-    for (size_t i = 0; i < count; i++) {
-        cf_status st = cf_cell_mode(c, m, strain[i], NULL, &s, err);
-        if (st != CF_OK)
-            return st;
-        stress_MPa[i] = s.stress_MPa;
-    }
-    return CF_OK;
-}
-
-/* 1 when mode m reaches table strain e (no spring at solid, the free stretch found). */
-static int reaches(const cf_cell *c, cf_mode m, double e)
-{
-    cf_cell_state s;
-    return cf_cell_mode(c, m, e, NULL, &s, NULL) == CF_OK;
-}
-
-cf_status cf_cell_solid_strain(const cf_cell *c, cf_mode m, int side, double *e_solid,
-                               cf_error *err)
-{
-    const double sg = side < 0 ? -1.0 : 1.0;
-    /* a bracket [good, bad] in |e|: the far end doubles until the mode cannot reach it (a
-    ** compression cannot pass -1 in a mode that stretches the loaded edge) */
-    double good = 0, bad = 0.1;
-    const int stretch = cf_mode_row_of(m) && !cf_mode_row_of(m)->any_sign;
-    while (reaches(c, m, sg * bad)) {
-        good = bad;
-        bad *= 2;
-        if (bad > 1e3 || (sg < 0 && stretch && bad >= 1))
-            break;
-    }
-    if (sg < 0 && stretch)
-        bad = fmin(bad, 1);
-    if (reaches(c, m, sg * bad))
-        return cf_error_set(err, CF_E_DATA, "%s strain %g: no spring of the cell reaches solid",
-                            cf_mode_name(m), sg * bad);
-    for (int k = 0; k < 200 && bad - good > 1e-12 * bad; k++) {
-        const double mid = 0.5 * (good + bad);
-        if (reaches(c, m, sg * mid))
-            good = mid;
-        else
-            bad = mid;
-    }
-    *e_solid = sg * good;
-    return CF_OK;
 }

@@ -52,6 +52,7 @@
 #include <stddef.h>
 
 #include "model/calibration.h"
+#include "model/fibre.h"
 #include "conifit/error.h"
 #include "model/law_internal.h"
 #include "model/mode.h"
@@ -81,6 +82,12 @@ typedef struct cf_cell {
     const cf_law *family_law[CF_FAMILY_COUNT]; /* a law per spring group (the family of each
                                      ** direction, as the lattice's cfg.group_law), not owned; NULL
                                      ** (cf_cell_init's): law. Same free length H as law */
+    const cf_fibre_group *fibre;     /* fibre groups (fibre.h), not owned; NULL by cf_cell_init */
+    int nfibre;                      /* their count, 0 .. CF_FIBRE_MAX (0 by cf_cell_init: the
+                                     ** cell of the node-to-node springs alone, bit for bit) */
+    double frame[9];                 /* the fibre frame, rows f, s, n as unit vectors in the
+                                     ** lattice frame (the identity by cf_cell_init): the axes of
+                                     ** cf_cell_load's modes */
     int linear_finish;               /* 1: a free-stretch solve whose last Newton step is too small
                                      ** for its second-order term to reach rounding takes that step
                                      ** by the cell's linearisation instead of evaluating the cell
@@ -127,6 +134,33 @@ cf_status cf_cell_tangent(const cf_cell *c, const double F[9], const cf_cell_ext
 ** cannot reach it (a spring at solid), CF_E_NOCONV when no free stretch gives zero stress. */
 cf_status cf_cell_mode(const cf_cell *c, cf_mode m, double e, const cf_cell_extra *extra,
                        cf_cell_state *s, cf_error *err);
+
+/* A test mode placed on the axes of the fibre frame (c->frame; 0 f, 1 s, 2 n), p = axis[0],
+** q = axis[1], r the third; the stretches of F in the fibre frame (F' = R F R^T, R the frame):
+**   uniaxial     F'_pp = 1 + e, F'_qq and F'_rr free (each zeroes its own P'), stress P'_pp
+**   planar       F'_pp = 1 + e, F'_qq = 1, F'_rr free; stress P'_pp
+**   equibiaxial  F'_pp = F'_qq = 1 + e, F'_rr free; stress P'_pp
+**   biaxial      F'_pp = 1 + e, F'_qq = 1 + k e, F'_rr free; stress P'_pp (a table's row of
+**                either direction: p its own axis, k the other's strain per unit of its own)
+**   confined     F'_pp = 1 + e, the others 1; stress P'_pp
+**   shear        F' = I + e e_q e_p^T (the face of normal p moved along q, Sommer et al. 2015's
+**                mode (pq)); stress P'_qp, the shear traction on that face
+** With fibres, cf_cell_mode places its mode this way on the lattice's own axes (the old modes'
+** axes: uniaxial and confined along z, planar, equibiaxial and biaxial along x with y second,
+** shear with z the normal and x the direction), each free stretch solved on its own. */
+typedef struct cf_cell_load {
+    cf_mode mode;
+    int axis[2];
+    double k;
+} cf_cell_load;
+
+/* The state of load ld at table strain e in the fibre frame (c->frame), every free stretch solved
+** (Newton on the analytic tangent, steps halved where a spring would reach solid) until it moves
+** by less than 1e-15; s->free_stretch is the first free stretch, s->F the lattice-frame F,
+** s->P_MPa the lattice-frame P. Failures as cf_cell_mode's; CF_E_DATA for axes that are not two
+** different axes of 0 .. 2. */
+cf_status cf_cell_load_state(const cf_cell *c, const cf_cell_load *ld, double e,
+                             cf_cell_state *s, cf_error *err);
 
 /* The largest |L/L0 - 1| over the cell's springs at table strain e of mode m with the free
 ** stretches held at 1: how far the springs travel (in strain) when the table reaches e. For

@@ -30,6 +30,8 @@ cf_lattice_config cf_lattice_default(void)
     c.hourglass = CF_HOURGLASS_AUTO;
     for (int f = 0; f < CF_FAMILY_COUNT; f++)
         c.group_law[f] = NULL;
+    c.fibre = NULL;
+    c.nfibre = 0;
     return c;
 }
 
@@ -87,6 +89,14 @@ static cf_status check_config(const cf_lattice_config *cfg, cf_error *err)
         return cf_error_set(err, CF_E_DATA, "lattice hourglass = %g: must be from 0 to 1000 (the "
                                             "fraction of the cell's shear stiffness)",
                             cfg->hourglass);
+    if (cfg->nfibre < 0 || cfg->nfibre > CF_FIBRE_MAX || (cfg->nfibre > 0 && !cfg->fibre))
+        return cf_error_set(err, CF_E_DATA, "lattice fibre groups: %d, must be 0 to %d (and "
+                            "given)", cfg->nfibre, CF_FIBRE_MAX);
+    for (int k = 0; k < cfg->nfibre; k++) {
+        cf_status sf = cf_fibre_check(&cfg->fibre[k], err);
+        if (sf != CF_OK)
+            return sf;
+    }
     return cf_calibration_check(cfg->weight, err);
 }
 
@@ -392,6 +402,7 @@ double cf_lattice_cell_volume(const cf_lattice *lat, size_t c, uint32_t node[8],
 /* The cells' node forces, the volume term's -kappa (J - 1) dV/dx and the hourglass control's,
 ** added to fx, fy, fz. */
 static void cell_forces(cf_lattice *lat);
+static double fibre_forces(cf_lattice *lat);
 
 int cf_lattice_has_cells(const cf_lattice *lat)
 {
@@ -402,6 +413,8 @@ void cf_lattice_add_volume_forces(cf_lattice *lat)
 {
     if (cf_lattice_has_cells(lat))
         cell_forces(lat);
+    if (lat->cfg.nfibre > 0)
+        fibre_forces(lat);
 }
 
 /* The corner positions of cell c into x (and its nodes into node). */
@@ -443,6 +456,44 @@ double cf_lattice_volume_row_bound(const cf_lattice *lat)
         worst = fmax(worst, row[q]);
     free(row);
     return worst + hg;
+}
+
+/* The fibre groups' forces of every cell: F = sum_a x_a g_a^T with g_a the mean gradient of
+** corner a's shape function, (2 xi_a - 1)/(4 H) per axis (xi_a in {0, 1}^3 its corner), and the
+** force -H^3 P g_a on corner a. Returns the largest compression over travel of a fibre spring
+** (a spring past solid gives no force and returns at least 1). */
+static double fibre_forces(cf_lattice *lat)
+{
+    const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
+    const double H = lat->H_mm, H3 = H * H * H;
+    double rmax = 0;
+    for (size_t c = 0; c < nc; c++) {
+        uint32_t node[8];
+        double x[8][3], g[8][3], F[9] = {0}, P[3][3] = {{0}};
+        cell_positions(lat, c, node, x);
+        for (int a = 0; a < 8; a++)
+            for (int j = 0; j < 3; j++)
+                g[a][j] = (2.0 * ((a >> j) & 1) - 1) / (4 * H);
+        for (int a = 0; a < 8; a++)
+            for (int i = 0; i < 3; i++)
+                for (int j = 0; j < 3; j++)
+                    F[3 * i + j] += x[a][i] * g[a][j];
+        for (int k = 0; k < lat->cfg.nfibre; k++) {
+            double T, r = 0;
+            if (cf_fibre_add_stress(&lat->cfg.fibre[k], H, F, P, &T, &r, NULL) != CF_OK)
+                r = fmax(r, 1.0);
+            rmax = fmax(rmax, r);
+        }
+        for (int a = 0; a < 8; a++) {
+            double f[3];
+            for (int i = 0; i < 3; i++)
+                f[i] = -H3 * (P[i][0] * g[a][0] + P[i][1] * g[a][1] + P[i][2] * g[a][2]);
+            lat->fx[node[a]] += f[0];
+            lat->fy[node[a]] += f[1];
+            lat->fz[node[a]] += f[2];
+        }
+    }
+    return rmax;
 }
 
 static void cell_forces(cf_lattice *lat)
@@ -546,6 +597,8 @@ double cf_lattice_forces(cf_lattice *lat)
     }
     if (cf_lattice_has_cells(lat))
         cell_forces(lat);
+    if (lat->cfg.nfibre > 0)
+        umax = fmax(umax, fibre_forces(lat) * lat->travel_mm);
     return umax / lat->travel_mm;
 }
 

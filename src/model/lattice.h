@@ -36,6 +36,7 @@
 #include "model/calibration.h"
 #include "conifit/error.h"
 #include "model/law_internal.h"
+#include "model/fibre.h"
 #include "model/lattice_hourglass.h"
 #include "model/net.h"
 
@@ -66,6 +67,14 @@ typedef struct cf_lattice_config {
                               ** CF_FAMILY_EDGE, _FACE, _BODY), not owned; NULL (the default):
                               ** the lattice's law. A group's law has the lattice law's free
                               ** length H, and with CF_LAW_TABLE its table built */
+    const cf_fibre_group *fibre; /* fibre groups (fibre.h), not owned, NULL (the default) for
+                              ** none: each cell carries one spring of each group, its stretch
+                              ** |F a| with F the cell's mean deformation gradient (that of its
+                              ** trilinear hexahedron averaged over the cell, exact for a
+                              ** homogeneous deformation), its nodal forces -H^3 P dF/dx; in the
+                              ** forces only: the solvers (cf_msm_run) refuse a lattice with
+                              ** fibres, their tangent does not carry them yet */
+    int nfibre;               /* their count, 0 .. CF_FIBRE_MAX */
 } cf_lattice_config;
 
 /* The hourglass fraction that means "the default with a volume term, none without"; that default

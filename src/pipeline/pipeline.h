@@ -53,6 +53,9 @@ typedef struct cf_pipeline_options {
     cf_budget budget;            /* limits of the validation's memory and static solves (budget.h,
                                  ** as for a scene; default cf_budget_default) */
     int with_timing;             /* 0: write wall times as 0 (reproducible fit files) */
+    const char *fibres;          /* a joint fit's fibre groups (fibre_fit.h: "f", "fs", "fn" ...;
+                                 ** NULL: none): a fibre-reinforced lattice fitted beside the
+                                 ** isotropic one when the tables lie in a fibre frame */
     const char *title;           /* the figure's title (NULL: the table's name; report.h) */
     cf_pipeline_progress progress; /* NULL: silent */
     void *progress_ctx;

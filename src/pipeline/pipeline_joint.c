@@ -6,6 +6,7 @@
 
 #include <stdio.h>
 #include <string.h>
+#include <time.h>
 
 #include "fit/joint.h"
 #include "fit/lawkind.h"
@@ -211,6 +212,26 @@ static void ho_baselines(const cf_table *const *tables, size_t n, cf_joint_repor
     r->ho_ran = 1;
 }
 
+/* The fibre-reinforced lattice with opt->fibres' groups, second directions along s and along n;
+** why not into r->fibre_why. */
+static void fibre_fits(const cf_table *const *tables, size_t n, const char *groups,
+                       cf_joint_report *r)
+{
+    snprintf(r->fibre_groups, sizeof r->fibre_groups, "%.*s", CF_FIBRE_MAX, groups);
+    if (cf_ho_unfit(tables, n, r->fibre_why, sizeof r->fibre_why))
+        return;
+    cf_error e = {0};
+    for (int c = 0; c < 2; c++) {
+        const clock_t t0 = clock();
+        if (cf_fibre_fit_joint(tables, n, groups, c ? 'n' : 's', &r->fibre[c], &e) != CF_OK) {
+            snprintf(r->fibre_why, sizeof r->fibre_why, "%s", e.msg);
+            return;
+        }
+        r->fibre_cpu_s[c] = r->with_timing ? (double)(clock() - t0) / CLOCKS_PER_SEC : 0;
+    }
+    r->fibre_ran = 1;
+}
+
 cf_status cf_pipeline_fit_joint(const cf_table *const *tables, size_t n,
                                 const cf_pipeline_options *opt, cf_joint_report *r,
                                 cf_error *err)
@@ -264,5 +285,7 @@ cf_status cf_pipeline_fit_joint(const cf_table *const *tables, size_t n,
         }
     }
     ho_baselines(tables, n, r);
+    if (opt->fibres && opt->fibres[0])
+        fibre_fits(tables, n, opt->fibres, r);
     return CF_OK;
 }

@@ -16,6 +16,7 @@
 #include "io/fitfile_json.h"
 #include "fit/lawkind.h"
 #include "report/gnuplot.h"
+#include "report/report_fibre.h"
 #include "report/report_baselines.h"
 #include "report/report_json.h"
 #include "report/report_notes.h"
@@ -448,6 +449,7 @@ char *cf_joint_text(const cf_joint_report *r)
     pair_choice_text(o, r);
     better_text(o, r);
     cf_report_ho_text(o, r, cf_joint_better(r));
+    cf_report_fibre_text(o, r);
     if (fclose(o) != 0) {
         free(buf);
         return NULL;
@@ -684,6 +686,9 @@ static json_t *joint_json(const cf_joint_report *r)
     json_t *ho = cf_report_ho_json(r); /* a set with a biaxial table only */
     if (ho)
         json_object_set_new(root, "holzapfel_ogden", ho);
+    json_t *fl = cf_report_fibre_json(r); /* when asked for (--fibres) */
+    if (fl)
+        json_object_set_new(root, "fibre_lattice", fl);
     return root;
 }
 

@@ -11,6 +11,7 @@
 #include "conifit/error.h"
 #include "fit/baseline.h"
 #include "fit/fit.h"
+#include "fit/fibre_fit.h"
 #include "fit/holzapfel.h"
 #include "fit/joint.h"
 #include "fit/softening.h"
@@ -92,6 +93,14 @@ typedef struct cf_joint_report {
     int ho_ran;
     cf_ho_fit ho[2][2];
     char ho_why[CF_ERROR_MSG_LEN];
+    /* The fibre-reinforced lattice (fibre_fit.h) when asked for (fibre_groups not ""): fibre_ran
+    ** 1 and fibre[cross] (0: a biaxial table's second direction along s, 1: along n) with the CPU
+    ** seconds of each fit, or fibre_why says why not */
+    char fibre_groups[CF_FIBRE_MAX + 1];
+    int fibre_ran;
+    cf_fibre_fit fibre[2];
+    double fibre_cpu_s[2];
+    char fibre_why[CF_ERROR_MSG_LEN];
 } cf_joint_report;
 
 #endif
