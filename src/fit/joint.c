@@ -570,6 +570,7 @@ static cf_status nest_pair(const cf_joint_result *plain, int pair, const cf_fit_
         nest.evaluations = r->evaluations;
         nest.wall_time_s = r->wall_time_s;
         nest.starts = r->starts, nest.stable_ends = r->stable_ends, nest.restarts = r->restarts;
+        nest.projected = r->projected;
         cf_joint_free(r);
     }
     *r = nest;

@@ -114,6 +114,9 @@ typedef struct cf_joint_result {
     ** passed the stability check, and the searches restarted under the check (from each stable
     ** end and from the nearest stable point towards the unconstrained optimum). */
     int starts, stable_ends, restarts;
+    /* the stable points found by projecting the unstable ends along stabilising directions (the
+    ** searches from the best of them count among the restarts) */
+    int projected;
 } cf_joint_result;
 
 /* Fits the n tables jointly with spring type `type` in the lattice of `lat` (its calibration:

@@ -91,5 +91,9 @@ double cf_joint_pair_polish(jctx *c, double v[PQ_COUNT], const int used[PQ_COUNT
 int cf_joint_pair_errors(jctx *c, const double v0[PQ_COUNT], const int used[PQ_COUNT],
                          double rss, double se[PQ_COUNT], double *cov_bt);
 void cf_joint_small_strain_moduli(jctx *c, const double v[PQ_COUNT], cf_joint_result *r);
+/* Both springs of the quantities v placed into r (the extension spring at the compression
+** spring's H; fit.feasible says whether both are buildable). */
+cf_status cf_joint_pair_place(const jctx *c, const cf_table *reach, const double v[PQ_COUNT],
+                              cf_joint_result *r, cf_error *err);
 
 #endif

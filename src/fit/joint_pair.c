@@ -26,6 +26,21 @@
 #define STABLE_SAME 1e-3
 #define STABLE_BISECT_SEGMENT 12
 #define STABLE_MAX_EVALS 500
+/* projections to stability: the best distinct unstable ends (within PROJ_WORSE of the best
+** objective, PROJ_SAME of the box apart) moved along each stabilising direction in steps of
+** PROJ_STEP0 doubling up to PROJ_DOUBLINGS times, the first stable step bisected PROJ_BISECT
+** times; the searches kept to stable lattices from the PROJ_RESTARTS best projected points */
+#define PROJ_ENDS 3
+#define PROJ_WORSE 2.0
+#define PROJ_SAME 0.05
+#define PROJ_STEP0 0.5
+#define PROJ_DOUBLINGS 5
+#define PROJ_BISECT 6
+#define PROJ_RESTARTS 3
+#define PROJ_MAX (PROJ_ENDS * 3)
+/* the last search's rounds (pair_last_search) */
+#define LAST_ROUNDS 4
+#define LAST_GAIN 1e-3
 /* the tailed compression spring's tau (its tail's coils over the cone's): the search's range, and
 ** the value held through the starts and the searches kept to stable lattices */
 #define TAU_LO 1e-3
@@ -97,6 +112,10 @@ typedef struct pair_search {
     double ends[MAX_PAIR_STARTS][8], fends[MAX_PAIR_STARTS];
     int nends;
     int starts, stable_ends, restarts; /* what the search tried (cf_joint_result) */
+    int projected;                     /* stable points found by projection (cf_joint_result) */
+    /* the last search's starting point and each round's end (pair_last_search) */
+    double hist[LAST_ROUNDS + 1][8], fhist[LAST_ROUNDS + 1];
+    int nhist;
     int tried[MAX_PAIR_STARTS], ntried; /* the ends restarted from */
 } pair_search;
 
@@ -247,7 +266,7 @@ static cf_status pair_starts(jctx *c, const cf_joint_result *plain, pair_search 
     s->best = CF_LSQ_HUGE_OBJ;
     memset(s->zb, 0, sizeof s->zb);
     s->nends = 0;
-    s->starts = s->stable_ends = s->restarts = s->ntried = 0;
+    s->starts = s->stable_ends = s->restarts = s->ntried = s->projected = 0;
     c->stab_on = 0;
     for (int gc = 0; gc < 2; gc++)
         for (int ge = 0; ge < nre; ge++)
@@ -312,6 +331,140 @@ static cf_status pair_starts(jctx *c, const cf_joint_result *plain, pair_search 
     return CF_OK;
 }
 
+/* z0 + t d, held inside the box, into z; 1 when it differs from prev (a step that ends on the
+** box's bounds in every direction d moves does not). */
+static int proj_point(const pvars *pv, const double *z0, const double *d, double t,
+                      const double *prev, double z[8])
+{
+    int moved = 0;
+    memset(z, 0, 8 * sizeof(double));
+    for (int j = 0; j < pv->n; j++) {
+        z[j] = fmin(fmax(z0[j] + t * d[j], pv->lb[j]), pv->ub[j]);
+        moved |= z[j] != prev[j];
+    }
+    return moved;
+}
+
+/* The stable point nearest z0 (whose lattice fails the check) along direction d: steps of
+** PROJ_STEP0 doubling until one passes the check, then bisected between it and the last that
+** failed. 1 with that point in zp; 0 when no step inside the box passes. */
+static int project_stable(jctx *c, const pvars *pv, const double *z0, const double *d,
+                          double zp[8])
+{
+    double z[8], prev[8], lo = 0, hi = -1;
+    memcpy(prev, z0, sizeof prev);
+    for (int k = 0; k <= PROJ_DOUBLINGS && hi < 0; k++) {
+        const double t = PROJ_STEP0 * (double)(1 << k);
+        if (!proj_point(pv, z0, d, t, prev, z))
+            break;
+        memcpy(prev, z, sizeof prev);
+        if (z_stable(c, pv, z))
+            hi = t;
+        else
+            lo = t;
+    }
+    if (hi < 0)
+        return 0;
+    for (int b = 0; b < PROJ_BISECT; b++) {
+        const double mid = 0.5 * (lo + hi);
+        proj_point(pv, z0, d, mid, z0, z);
+        if (z_stable(c, pv, z))
+            hi = mid;
+        else
+            lo = mid;
+    }
+    proj_point(pv, z0, d, hi, z0, zp);
+    return 1;
+}
+
+/* The next end to project: the lowest not yet looked at (seen), within PROJ_WORSE of the best
+** objective and PROJ_SAME of the box away from every end already projected; -1 when none. */
+static int next_proj_end(const pair_search *s, const double *fends, int *seen, const int *used,
+                         int nused)
+{
+    const pvars *pv = &s->pv;
+    for (;;) {
+        int pick = -1;
+        for (int i = 0; i < s->nends; i++)
+            if (!seen[i] && fends[i] <= PROJ_WORSE * s->best &&
+                (pick < 0 || fends[i] < fends[pick]))
+                pick = i;
+        if (pick < 0)
+            return -1;
+        seen[pick] = 1;
+        int same = 0;
+        for (int t = 0; t < nused && !same; t++) {
+            same = 1;
+            for (int j = 0; j < pv->n && same; j++)
+                same = fabs(s->ends[pick][j] - s->ends[used[t]][j]) <=
+                       PROJ_SAME * (pv->ub[j] - pv->lb[j]);
+        }
+        if (!same)
+            return pick;
+    }
+}
+
+/* Step 3a: the best distinct ends of the starts whose lattices fail the check, each projected to
+** stability along the directions that resist the lattice's node-scale modes (issue 42: a stiffer
+** extension spring in compression, a smaller kappa in tension): the extension spring's stress
+** scale up, kappa down, and both together; then the searches kept to stable lattices from the
+** PROJ_RESTARTS lowest projected points, the best end into *sb and zs. fends: the starts' ends'
+** objectives. */
+static cf_status pair_project(jctx *c, pair_search *s, const double *fends, double *sb,
+                              double zs[8], cf_error *err)
+{
+    const pvars *pv = &s->pv;
+    double dirs[3][8] = {{0}}, cand[PROJ_MAX][8], fc[PROJ_MAX];
+    int nd = 0, nc = 0, seen[MAX_PAIR_STARTS] = {0}, used[PROJ_ENDS], nused = 0;
+    if (pv->ie >= 0)
+        dirs[nd++][pv->ie + 2] = 1;
+    if (pv->ik >= 0)
+        dirs[nd++][pv->ik] = -1;
+    if (pv->ie >= 0 && pv->ik >= 0)
+        dirs[nd][pv->ie + 2] = 1, dirs[nd++][pv->ik] = -1;
+    c->stab_on = 0;
+    while (nd > 0 && nused < PROJ_ENDS) {
+        const int i = next_proj_end(s, fends, seen, used, nused);
+        if (i < 0)
+            break;
+        if (z_stable(c, pv, s->ends[i]))
+            continue; /* a stable end: the restarts below start from it */
+        used[nused++] = i;
+        for (int d = 0; d < nd; d++)
+            if (project_stable(c, pv, s->ends[i], dirs[d], cand[nc])) {
+                c->stab_on = 0;
+                fc[nc] = pair_objective((unsigned)pv->n, cand[nc], NULL, (void *)&s->o);
+                nc += fc[nc] < CF_LSQ_HUGE_OBJ;
+            }
+    }
+    s->projected = nc;
+    for (int r = 0; r < PROJ_RESTARTS; r++) {
+        int pick = -1;
+        for (int k = 0; k < nc; k++)
+            if (fc[k] < CF_LSQ_HUGE_OBJ && (pick < 0 || fc[k] < fc[pick]))
+                pick = k;
+        if (pick < 0)
+            break;
+        fc[pick] = CF_LSQ_HUGE_OBJ;
+        double step[8], f = CF_LSQ_HUGE_OBJ;
+        pair_steps(pv, 0, step);
+        c->stab_on = 1;
+        c->stab_best = CF_LSQ_HUGE_OBJ;
+        s->restarts++;
+        nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)pv->n, pv->lb,
+                                          pv->ub, step, XTOL_REL, STABLE_MAX_EVALS,
+                                          pair_objective, (void *)&s->o, cand[pick], &f);
+        if (c->pr.oom)
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory in the joint fit's "
+                                                    "optimiser (NLopt)");
+        if (search_ended(res) && f < *sb) {
+            *sb = f;
+            memcpy(zs, cand[pick], 8 * sizeof(double));
+        }
+    }
+    return CF_OK;
+}
+
 /* Step 3: an optimum whose lattice fails the joint fit's stability check (the verification's,
 ** cf_joint_lattice_stable): the search again, kept to stable lattices, from the stable point
 ** nearest the optimum on the segment to each starts' end that is stable, best first (ends within
@@ -328,7 +481,11 @@ static cf_status pair_keep_stable(jctx *c, pair_search *s, cf_error *err)
         c->stab_on = 1;
         return CF_OK;
     }
-    double sb = CF_LSQ_HUGE_OBJ, zs[8] = {0};
+    double sb = CF_LSQ_HUGE_OBJ, zs[8] = {0}, fe[MAX_PAIR_STARTS], ftried[STABLE_RESTARTS];
+    memcpy(fe, s->fends, sizeof fe);
+    cf_status st = pair_project(c, s, fe, &sb, zs, err);
+    if (st != CF_OK)
+        return st;
     for (int tries = 0; tries < STABLE_RESTARTS; tries++) {
         int pick = -1;
         for (int i = 0; i < s->nends; i++)
@@ -342,7 +499,16 @@ static cf_status pair_keep_stable(jctx *c, pair_search *s, cf_error *err)
             continue;
         }
         s->stable_ends++;
+        /* an end at the objective of one already restarted from (to 1e-6) is its basin again */
+        int twin = 0;
+        for (int t = 0; t < s->ntried && !twin; t++)
+            twin = fabs(fe[pick] - ftried[t]) <= 1e-6 * ftried[t];
+        if (twin) {
+            tries--;
+            continue;
+        }
         s->restarts++;
+        ftried[s->ntried] = fe[pick];
         s->tried[s->ntried++] = pick;
         /* from the stable point nearest the optimum on the segment to this end */
         double z[8], step[8], f = CF_LSQ_HUGE_OBJ, lo = 0, hi = 1;
@@ -380,22 +546,33 @@ static cf_status pair_keep_stable(jctx *c, pair_search *s, cf_error *err)
 }
 
 /* Step 4: a last, finer BOBYQA from the best point (under the stability check when step 3 kept
-** to stable lattices). */
+** to stable lattices), started again from its end while a round lowers the objective by more than
+** LAST_GAIN (under the stability check BOBYQA's model stalls on the wall of unstable points it
+** cannot see; a fresh start rebuilds it), at most LAST_ROUNDS rounds, the coarse steps and the
+** fine ones in turn. */
 static void pair_last_search(jctx *c, pair_search *s)
 {
     const pvars *pv = &s->pv;
-    if (!(s->best < CF_LSQ_HUGE_OBJ))
-        return;
-    double z[8], f = CF_LSQ_HUGE_OBJ, step[8];
-    memcpy(z, s->zb, sizeof z);
-    pair_steps(pv, 1, step);
-    c->stab_best = CF_LSQ_HUGE_OBJ;
-    nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)pv->n, pv->lb, pv->ub,
-                                      step, XTOL_REL * 1e-2, PAIR_MAX_EVALS, pair_objective,
-                                      (void *)&s->o, z, &f);
-    if (search_ended(res) && f < s->best) {
+    memcpy(s->hist[0], s->zb, sizeof s->hist[0]);
+    s->fhist[0] = s->best;
+    s->nhist = 1;
+    for (int round = 0; round < LAST_ROUNDS && s->best < CF_LSQ_HUGE_OBJ; round++) {
+        double z[8], f = CF_LSQ_HUGE_OBJ, step[8];
+        memcpy(z, s->zb, sizeof z);
+        pair_steps(pv, round % 2 == 0, step);
+        c->stab_best = CF_LSQ_HUGE_OBJ;
+        nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)pv->n, pv->lb,
+                                          pv->ub, step, XTOL_REL * 1e-2, PAIR_MAX_EVALS,
+                                          pair_objective, (void *)&s->o, z, &f);
+        if (!search_ended(res) || !(f < s->best))
+            return;
+        const int gain = f < s->best * (1 - LAST_GAIN);
         s->best = f;
         memcpy(s->zb, z, sizeof s->zb);
+        memcpy(s->hist[s->nhist], z, sizeof s->hist[0]);
+        s->fhist[s->nhist++] = f;
+        if (!gain || !c->stab_on)
+            return;
     }
 }
 
@@ -459,37 +636,43 @@ static double pair_quantities(jctx *c, pair_search *s, const int used[PQ_COUNT],
     return best;
 }
 
-/* Step 6: both springs of the quantities v placed (the extension spring at the compression
-** spring's H); the element is buildable when both are (fit.feasible says it for the pair). */
-static cf_status pair_place(jctx *c, const cf_table *reach, const double v[PQ_COUNT],
-                            cf_joint_result *r, cf_error *err)
+/* Steps 5 and 6 from the last search's latest point back (s->hist): the point's quantities
+** polished into v and both springs placed into r. The search does not see buildability, and its
+** rounds can walk past it: a point whose springs are not both buildable gives way to the one the
+** round before ended on; when none is buildable, the latest is kept. Returns the RSS of v as
+** pair_quantities does (-1 on an error, *st then set). */
+static double pair_finish(jctx *c, const cf_table *reach, pair_search *s,
+                          const int used[PQ_COUNT], double v[PQ_COUNT], double *A,
+                          cf_joint_result *r, cf_status *st, cf_error *err)
 {
-    r->ident.rho = v[PQ_RC], r->ident.solid = v[PQ_BC], r->ident.scale = v[PQ_AC];
-    cf_status st;
-    if (c->tail) { /* the tailed spring in closed form (tail.h); its errors follow the search */
-        const double vt[4] = {v[PQ_RC], v[PQ_BC], v[PQ_AC], v[PQ_T]}, se[4] = {-1, -1, -1, -1};
-        double corr[4][4];
-        for (int a = 0; a < 4; a++)
-            for (int b = 0; b < 4; b++)
-                corr[a][b] = NAN;
-        st = cf_tail_result(reach, c->opt, c->type, vt, se, corr, NAN, &r->fit, err);
-    } else {
-        st = cf_fit_place(reach, c->opt, c->type, &r->ident, &r->fit, err);
+    const int mode = c->kappa_mode, stab = c->stab_on;
+    const double kappa = c->kappa;
+    double best = CF_LSQ_HUGE_OBJ;
+    for (int h = s->nhist - 1, last = 0, tries = 0; h >= 0 && !last; h--, tries++) {
+        last = h == 0;
+        if (tries > 0) { /* the context as the search left it */
+            c->kappa_mode = mode, c->stab_on = stab, c->kappa = kappa;
+            c->pr.A_fixed = 0;
+        }
+        memcpy(s->zb, s->hist[h], sizeof s->zb);
+        s->best = s->fhist[h];
+        best = pair_quantities(c, s, used, v, A, err);
+        if (best < 0 || !(best < CF_LSQ_HUGE_OBJ)) {
+            *st = best < 0 ? CF_E_INTERNAL : CF_E_NOCONV;
+            return -1;
+        }
+        if ((*st = cf_joint_pair_place(c, reach, v, r, err)) != CF_OK)
+            return -1;
+        if (r->fit.feasible)
+            return best;
+        if (last && s->nhist > 1) { /* none buildable: the latest again */
+            const int k = s->nhist - 1;
+            memcpy(s->hist[0], s->hist[k], sizeof s->hist[0]);
+            s->fhist[0] = s->fhist[k];
+            h = 1, last = 0, s->nhist = 1;
+        }
     }
-    if (st != CF_OK)
-        return st;
-    r->fit.ident = r->ident;
-    if (c->pair) {
-        cf_fit_options oe = *c->opt;
-        oe.fixed[CF_P_H] = 1;
-        oe.fixed_value[CF_P_H] = r->fit.params.H_mm;
-        const cf_ident qe = {.rho = v[PQ_RE], .solid = v[PQ_BE], .scale = v[PQ_AE]};
-        if ((st = cf_fit_place(reach, &oe, c->type, &qe, &r->ext, err)) != CF_OK)
-            return st;
-        r->ext.ident = qe;
-        r->fit.feasible = r->fit.feasible && r->ext.feasible;
-    }
-    return CF_OK;
+    return best;
 }
 
 /* Step 7: the pair contains the single-sided law plain (two equal springs): a pair infeasible
@@ -571,20 +754,18 @@ cf_status cf_joint_search_pair(jctx *c, const cf_table *reach, double xmax,
     double v[PQ_COUNT], A = 0;
     const int was_fw = c->fit_weights;
     c->fit_weights = 0;
-    double best = pair_quantities(c, &s, used, v, &A, err);
+    double best = pair_finish(c, reach, &s, used, v, &A, r, &st, err);
     if (best < 0)
-        return CF_E_INTERNAL;
-    if (!(best < CF_LSQ_HUGE_OBJ))
-        return CF_E_NOCONV;
+        return st;
     r->objective = best;
     r->starts = s.starts, r->stable_ends = s.stable_ends, r->restarts = s.restarts;
+    r->projected = s.projected;
     r->pair = c->pair;
     r->volume = opt->volume;
     r->volume_modulus_MPa = v[PQ_K];
     r->volume_modulus_se = -1;
     r->nparams = 3 + (c->pair ? 3 : 0) + (opt->volume == CF_VOLUME_FIT ? 1 : 0) + c->tail;
-    if ((st = pair_place(c, reach, v, r, err)) != CF_OK ||
-        (st = pair_nest(c, reach, plain, &s, v, &best, r, err)) != CF_OK)
+    if ((st = pair_nest(c, reach, plain, &s, v, &best, r, err)) != CF_OK)
         return st;
     /* the small-strain moduli each side, from the cell of the quantities found: a bimodular
     ** lattice's uniaxial compression loads its axial springs' compression sides and its lateral

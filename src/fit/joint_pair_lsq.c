@@ -2,7 +2,7 @@
 ** The double-acting element's quantities as a least-squares problem (joint_ctx.h): the pair's cap
 ** on the compression stress scale, its residuals, the Levenberg-Marquardt polish of the search's
 ** optimum, the errors of every quantity, and the lattice's small-strain moduli in tension and in
-** compression. Below the search (joint_pair.c), which calls it.
+** compression; both springs placed. Below the search (joint_pair.c), which calls it.
 */
 #include <math.h>
 #include <stdlib.h>
@@ -18,6 +18,7 @@
 #include "fit/cell_problem.h"
 #include "fit/joint_ctx.h"
 #include "fit/lsq.h"
+#include "fit/tail.h"
 #include "fit/tail.h"
 #include "fit/tail_cell.h"
 
@@ -347,5 +348,35 @@ void cf_joint_small_strain_moduli(jctx *c, const double v[PQ_COUNT], cf_joint_re
     }
 }
 
-/* The search's state between its steps: the variables, the objective's data, the best point and
-** the starts' ends (for the searches kept to stable lattices). */
+/* Both springs of the quantities v placed (the extension spring at the compression
+** spring's H); the element is buildable when both are (fit.feasible says it for the pair). */
+cf_status cf_joint_pair_place(const jctx *c, const cf_table *reach, const double v[PQ_COUNT],
+                              cf_joint_result *r, cf_error *err)
+{
+    r->ident.rho = v[PQ_RC], r->ident.solid = v[PQ_BC], r->ident.scale = v[PQ_AC];
+    cf_status st;
+    if (c->tail) { /* the tailed spring in closed form (tail.h); its errors follow the search */
+        const double vt[4] = {v[PQ_RC], v[PQ_BC], v[PQ_AC], v[PQ_T]}, se[4] = {-1, -1, -1, -1};
+        double corr[4][4];
+        for (int a = 0; a < 4; a++)
+            for (int b = 0; b < 4; b++)
+                corr[a][b] = NAN;
+        st = cf_tail_result(reach, c->opt, c->type, vt, se, corr, NAN, &r->fit, err);
+    } else {
+        st = cf_fit_place(reach, c->opt, c->type, &r->ident, &r->fit, err);
+    }
+    if (st != CF_OK)
+        return st;
+    r->fit.ident = r->ident;
+    if (c->pair) {
+        cf_fit_options oe = *c->opt;
+        oe.fixed[CF_P_H] = 1;
+        oe.fixed_value[CF_P_H] = r->fit.params.H_mm;
+        const cf_ident qe = {.rho = v[PQ_RE], .solid = v[PQ_BE], .scale = v[PQ_AE]};
+        if ((st = cf_fit_place(reach, &oe, c->type, &qe, &r->ext, err)) != CF_OK)
+            return st;
+        r->ext.ident = qe;
+        r->fit.feasible = r->fit.feasible && r->ext.feasible;
+    }
+    return CF_OK;
+}

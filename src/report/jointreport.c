@@ -315,10 +315,12 @@ static void stability_text(FILE *o, const cf_joint_report *r, const cf_joint_res
                                             "control, which a scene's lattice.hourglass 0 turns off"
                                           : "");
     /* what the search tried */
-    fprintf(o, "  search: %d starts, %d stable end%s, %d restart%s kept to lattices stable to "
-               "%.2fx each table's farthest strain\n",
-            j->starts, j->stable_ends, j->stable_ends == 1 ? "" : "s", j->restarts,
-            j->restarts == 1 ? "" : "s", CF_JOINT_STABLE_MARGIN);
+    fprintf(o, "  search: %d starts, %d stable end%s, %d stable point%s projected from unstable "
+               "ends, %d restart%s kept to lattices stable to %.2fx each table's farthest "
+               "strain\n",
+            j->starts, j->stable_ends, j->stable_ends == 1 ? "" : "s", j->projected,
+            j->projected == 1 ? "" : "s", j->restarts, j->restarts == 1 ? "" : "s",
+            CF_JOINT_STABLE_MARGIN);
 }
 
 /* Whether the homogenised cell stays strongly elliptic over each table's range. */
@@ -658,9 +660,10 @@ static json_t *joint_json(const cf_joint_report *r)
         json_object_set_new(f, "objective", num(j->objective));
         json_object_set_new(f, "evaluations", json_integer(j->evaluations));
         json_object_set_new(f, "search",
-                            json_pack("{s:i, s:i, s:i, s:f}", "starts", j->starts, "stable_ends",
-                                      j->stable_ends, "stable_restarts", j->restarts,
-                                      "stability_margin", CF_JOINT_STABLE_MARGIN));
+                            json_pack("{s:i, s:i, s:i, s:i, s:f}", "starts", j->starts,
+                                      "stable_ends", j->stable_ends, "projected", j->projected,
+                                      "stable_restarts", j->restarts, "stability_margin",
+                                      CF_JOINT_STABLE_MARGIN));
         json_object_set_new(f, "wall_time_s", num(r->with_timing ? j->wall_time_s : 0.0));
         json_object_set_new(f, "tables", tables_json(r, j));
         json_array_append_new(fits, f);
