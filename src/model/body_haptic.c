@@ -1,6 +1,8 @@
 /*
 ** Tissue bodies (body.h): the probe loop at haptic rate, chord iterations on the factored
-** contact-free tangent corrected for the nodes in contact by Woodbury's identity.
+** contact-free tangent corrected for the nodes in contact by Woodbury's identity. The tangent is
+** factored and solved through the linear solver (linsolve.h), on its own solver object with the
+** condensed pattern.
 */
 #include <math.h>
 #include <stdlib.h>
@@ -31,7 +33,7 @@ static cf_status haptic_columns(body_work *w, size_t nn, size_t i, const double 
     for (int a = 0; a < 3; a++) {
         memset(w->hrhs, 0, n * sizeof *w->hrhs);
         w->hrhs[3 * i + (size_t)a] = 1;
-        if ((st = cf_sparse_chol_solve(w->hch, w->hrhs, col + (size_t)a * n, err)) != CF_OK)
+        if ((st = cf_linsolve_solve(w->hls, w->hrhs, col + (size_t)a * n, err)) != CF_OK)
             return st;
     }
     w->slot[i] = (uint32_t)++w->nslot;
@@ -47,7 +49,7 @@ static cf_status haptic_solve(cf_body *b, body_work *w, double kp, const size_t 
                               cf_error *err)
 {
     const size_t n = 3 * b->nn;
-    cf_status st = cf_sparse_chol_solve(w->hch, w->g, dx, err);
+    cf_status st = cf_linsolve_solve(w->hls, w->g, dx, err);
     if (st != CF_OK || m == 0)
         return st;
     const double sk = sqrt(kp);
@@ -112,13 +114,30 @@ static cf_status haptic_solve(cf_body *b, body_work *w, double kp, const size_t 
     return CF_OK;
 }
 
+/* The contact-free tangent where the body is now into v (the haptic solver's values, the condensed
+** pattern's order), its held components' rows and columns those of the identity. */
+static void haptic_tangent(void *ctx, double *v)
+{
+    body_work *w = ctx;
+    cf_body *b = w->sys.b;
+    pattern *P = &w->P;
+    double *keep = P->val;
+    P->val = v;
+    /* out of memory for the volume term's scratch: NaN values, which the factorisation refuses */
+    if (isnan(cf_body_assemble(b, b->x, NULL, NULL, 0, NULL, w->gt, P, NULL)))
+        for (size_t k = 0; k < (size_t)P->colptr[P->n]; k++)
+            v[k] = NAN;
+    cf_body_apply_fixed(b, P, w->gt);
+    P->val = keep;
+}
+
 /* The loop's workspace on first use, and the contact-free tangent where the body is now,
 ** factored once (until the body moves on without the loop). */
 static cf_status haptic_prepare(cf_body *b, body_work *w, cf_error *err)
 {
     const size_t n = 3 * b->nn, nn = b->nn;
     cf_status st;
-    if (!w->hch) {
+    if (!w->hls) {
         w->hactive = calloc(nn, 1);
         w->slot = calloc(nn, sizeof *w->slot);
         w->hy = malloc(n * sizeof *w->hy);
@@ -129,15 +148,13 @@ static cf_status haptic_prepare(cf_body *b, body_work *w, cf_error *err)
             return cf_error_set(err, CF_E_INTERNAL, "out of memory for the haptic loop");
         for (size_t i = 0; i < n; i++)
             w->hxg[i] = NAN; /* no internal forces kept yet */
-        if ((st = cf_sparse_chol_create(&w->hch, n, w->P.colptr, w->P.rowidx, err)) != CF_OK)
+        if ((st = cf_linsolve_create(&w->hls, n, w->P.colptr, w->P.rowidx, haptic_tangent, w,
+                                     0, err)) != CF_OK)
             return st;
     }
     if (!w->hfactored) {
         /* the contact-free tangent where the body is now, factored once */
-        if (isnan(cf_body_assemble(b, b->x, NULL, NULL, 0, NULL, w->g, &w->P, NULL)))
-            return cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's tangent");
-        cf_body_apply_fixed(b, &w->P, w->g);
-        if ((st = cf_sparse_chol_factor(w->hch, w->P.val, NULL, err)) != CF_OK)
+        if ((st = cf_linsolve_factor(w->hls, err)) != CF_OK)
             return st;
         w->factored = 0; /* the Newton solver's factors were of the same values: refactor */
         w->hfactored = 1;

@@ -14,7 +14,7 @@
 
 #include "model/body.h"
 #include "model/mech.h"
-#include "model/sparse_chol.h"
+#include "model/linsolve.h"
 
 /* Six times the signed volume of the tetrahedron a, b, c, d. */
 static inline double body_vol6(const double *a, const double *b, const double *c, const double *d)
@@ -114,10 +114,10 @@ typedef struct body_work {
     long neg_last;      /* negative eigenvalues of the static solve's last fresh tangent, -1 none */
     int factored;       /* the linear solver holds the factors of a tangent of this body (the
                            haptic loop clears it) */
-    /* the haptic loop (cf_body_haptic_step): the factors of the tangent without contact, taken
-    ** once, and per node that has touched the probe the three columns of its inverse at that
-    ** node (slot[i] + 1 indexes Z, 0 = none yet) */
-    cf_sparse_chol *hch;
+    /* the haptic loop (cf_body_haptic_step): a linear solver on the condensed pattern P holding
+    ** the factors of the tangent without contact, taken once, and per node that has touched the
+    ** probe the three columns of its inverse at that node (slot[i] + 1 indexes Z, 0 = none yet) */
+    cf_linsolve *hls;
     int hfactored;
     uint8_t *hactive;
     uint32_t *slot;

@@ -72,7 +72,7 @@ void cf_body_work_free(body_work *w)
     if (!w)
         return;
     cf_mech_free(&w->mech);
-    cf_sparse_chol_free(w->hch); /* the haptic loop's factors (body_haptic.c) */
+    cf_linsolve_free(w->hls); /* the haptic loop's solver (body_haptic.c) */
     free(w->hactive);
     free(w->slot);
     free(w->Z);

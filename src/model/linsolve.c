@@ -90,6 +90,7 @@ void cf_linsolve_free(cf_linsolve *s)
     free(s->D);
     free(s->kval);
     free(s->kbasis);
+    free(s->sb);
     free(s);
 }
 
@@ -199,6 +200,57 @@ int cf_linsolve_chord(cf_linsolve *s, const double *b, double *x, int *fatal, cf
     }
     free(rhs);
     return ok;
+}
+
+static void assemble(cf_linsolve *s);
+
+cf_status cf_linsolve_factor(cf_linsolve *s, cf_error *err)
+{
+    const size_t n = s->n;
+    cf_error lerr = {0};
+    s->chol_ready = 0;
+    s->neg_pivots = -1;
+    assemble(s);
+    if (n == 0)
+        return cf_error_set(err, CF_E_NOCONV, "linear solver: no unknowns to factor");
+    if (!s->sb && !(s->sb = malloc(n * sizeof *s->sb)))
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the linear solves");
+    cf_status st = CF_OK;
+    if (!s->chol) {
+        st = cf_sparse_chol_create(&s->chol, n, s->C->p, s->C->i, &lerr);
+        if (st != CF_OK)
+            return cf_error_set(err, st, "%s", lerr.msg);
+        if (s->indefinite)
+            cf_sparse_chol_indefinite(s->chol);
+    }
+    cf_chol_info info;
+    if ((st = cf_sparse_chol_factor(s->chol, s->C->data, &info, &lerr)) != CF_OK)
+        return cf_error_set(err, st, "%s", lerr.msg);
+    s->neg_pivots = info.neg_pivots;
+    s->chol_ready = 1;
+    return CF_OK;
+}
+
+cf_status cf_linsolve_solve(cf_linsolve *s, const double *b, double *x, cf_error *err)
+{
+    const size_t n = s->n;
+    if (!s->chol_ready)
+        return cf_error_set(err, CF_E_NOCONV, "linear solver: no factors kept to solve with");
+    /* (D^-1 A D^-1) (D x) = D^-1 b */
+    for (size_t e = 0; e < n; e++)
+        s->sb[e] = b[e] / s->D[e];
+    cf_error lerr = {0};
+    cf_status st = cf_sparse_chol_solve(s->chol, s->sb, x, &lerr);
+    if (st != CF_OK)
+        return cf_error_set(err, st, "%s", lerr.msg);
+    for (size_t e = 0; e < n; e++) {
+        x[e] /= s->D[e];
+        if (!isfinite(x[e]))
+            return cf_error_set(err, CF_E_NOCONV,
+                                "linear solver: the solve gave a value that is not finite (%g at "
+                                "unknown %zu)", x[e], e);
+    }
+    return CF_OK;
 }
 
 /* The scaled matrix is symmetric and often banded (a lattice's tangent, its nodes numbered layer

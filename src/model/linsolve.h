@@ -77,4 +77,18 @@ int cf_linsolve_chord(cf_linsolve *ls, const double *b, double *x, int *fatal, c
 int cf_linsolve_krylov(cf_linsolve *ls, const double *b, double *x, double need, int *fatal,
                        cf_error *err);
 
+/* Assembles the matrix (through fill), scales it as a direction does and factors it by the
+** sparse Cholesky, or L D L^T when it is not positive definite, without solving and without the
+** cascade's fallbacks: for a caller that solves many right-hand sides with one matrix
+** (cf_linsolve_solve). CF_E_NOCONV when the matrix cannot be factored (singular, not finite, or
+** the sparse solvers are missing), CF_E_INTERNAL when memory runs out. The factors then also
+** serve cf_linsolve_chord and cf_linsolve_krylov. */
+cf_status cf_linsolve_factor(cf_linsolve *ls, cf_error *err);
+
+/* x = A^-1 b from the factors of the last factored matrix (its scale applied to b and undone on
+** x), one forward and one back substitution: no residual check nor refinement (the caller's
+** iteration checks its own residual). b and x may not alias. CF_E_NOCONV when no factors are
+** kept or x comes out not finite. */
+cf_status cf_linsolve_solve(cf_linsolve *ls, const double *b, double *x, cf_error *err);
+
 #endif

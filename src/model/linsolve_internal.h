@@ -30,6 +30,8 @@ struct cf_linsolve {
     size_t iters;             /* linear solves of the current direction */
     double *kval;             /* the current matrix, C's pattern, scaled by D (Krylov steps) */
     double *kbasis;           /* their Krylov basis and preconditioned basis; NULL until used */
+    double *sb;               /* n: the scaled right-hand side of cf_linsolve_solve; NULL until
+                                 cf_linsolve_factor */
 };
 
 /* v <- D^-1 v D^-1 with the solver's D (v in C's pattern; linsolve.c). */
