@@ -6,7 +6,10 @@
 **    turned off), counts one linear solve, and reports the negative pivots that the known
 **    eigenvalues predict;
 **  - a chord step solves the matrix last factored, not the current one;
-**  - a Krylov step on those factors solves the current matrix.
+**  - a Krylov step on those factors solves the current matrix;
+**  - cf_linsolve_factor and cf_linsolve_solve: one assembly, then many right-hand sides solved with
+**    the kept factors (definite and indefinite), their inertia, and a clear refusal without
+**    factors.
 */
 #include "testutil.h"
 
@@ -183,12 +186,50 @@ static void chord_and_krylov_steps(void **state)
     free(pb);
 }
 
+/* Factors once, solves several right-hand sides with the kept factors (each solves the factored
+** matrix, no assembly between), for a definite and an indefinite shift; a solve before any
+** factorisation is refused. */
+static void factor_once_and_solve_many(void **state)
+{
+    (void)state;
+    problem *pb = malloc(sizeof *pb);
+    assert_non_null(pb);
+    const double sigmas[2] = {0.5, 3.1};
+    for (int t = 0; t < 2; t++) {
+        build(pb, sigmas[t]);
+        cf_linsolve *ls = NULL;
+        cf_error err = {0};
+        assert_int_equal(cf_linsolve_create(&ls, NU, pb->p, pb->i, fill, pb, 0, &err), CF_OK);
+        double b[NU], x[NU];
+        rhs(b);
+        assert_int_equal(cf_linsolve_solve(ls, b, x, &err), CF_E_NOCONV);
+        assert_non_null(strstr(err.msg, "no factors"));
+        if (cf_linsolve_factor(ls, &err) != CF_OK)
+            fail_msg("sigma %g: %s", sigmas[t], err.msg);
+        assert_int_equal(pb->fills, 1);
+        assert_true(cf_linsolve_factored(ls));
+        assert_int_equal(cf_linsolve_neg_pivots(ls), count_below(sigmas[t]));
+        for (int r = 0; r < 4; r++) {
+            for (int e = 0; e < NU; e++)
+                b[e] = r == 0 ? b[e] : cos(0.3 * (r + 1) * e) - 0.2 * r;
+            assert_int_equal(cf_linsolve_solve(ls, b, x, &err), CF_OK);
+            const double res = residual(pb, x, b);
+            if (!(res < 1e-10))
+                fail_msg("sigma %g, right-hand side %d: residual %g", sigmas[t], r, res);
+        }
+        assert_int_equal(pb->fills, 1); /* the solves assembled nothing */
+        cf_linsolve_free(ls);
+    }
+    free(pb);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(solves_definite_matrix),
         cmocka_unit_test(solves_indefinite_matrix_and_counts_its_inertia),
         cmocka_unit_test(chord_and_krylov_steps),
+        cmocka_unit_test(factor_once_and_solve_many),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
