@@ -89,4 +89,48 @@ static inline int bu_ccx_forces(const char *dir, const char *job, double *F, int
     return found;
 }
 
+/* Exports fit with the body scene (conifit export FIT --lattice SCENE --format calculix) to
+** dir/job.inp, checks that the deck's header states simulate's force F[1 .. steps] at every step
+** (1e-9) and, when ccx is installed, that ccx's probe force is within rel_tol of it; label names
+** the case in the printed lines. dir and job are plain names the test made. */
+static inline void bu_export_matches_simulate(const char *dir, const char *fit, const char *scene,
+                                              const char *job, const double *F, int steps,
+                                              const char *label, double rel_tol)
+{
+    char inp[700], out[8192], err[8192];
+    snprintf(inp, sizeof inp, "%s/%s.inp", dir, job);
+    if (tu_run(out, sizeof out, err, sizeof err, "export %s --lattice %s --format calculix -o %s",
+               fit, scene, inp) != 0)
+        fail_msg("export: %s", err);
+    char *deck = tu_slurp(inp);
+    assert_non_null(deck);
+    assert_non_null(strstr(deck, "extension spring"));
+    /* conifit's forces in the deck's header are simulate's */
+    int n = 0;
+    for (const char *q = deck; n < steps && (q = strstr(q, "conifit reaction ")); q++) {
+        double ref;
+        if (sscanf(q, "conifit reaction %lf", &ref) == 1) {
+            assert_true(fabs(ref - F[n + 1]) <= 1e-9 * fabs(F[n + 1]));
+            n++;
+        }
+    }
+    free(deck);
+    assert_int_equal(n, steps);
+    if (system("command -v ccx >/dev/null 2>&1") != 0) {
+        print_message("ccx not installed: the deck is checked, not run\n");
+        return;
+    }
+    double *G = calloc((size_t)steps, sizeof *G);
+    assert_non_null(G);
+    if (bu_ccx_forces(dir, job, G, steps) != steps)
+        fail_msg("ccx: not every step in %s.dat", job);
+    for (int k = 1; k <= steps; k++) {
+        print_message("%s export, step %d: ccx %.7g N, conifit simulate %.7g N (%+.2e)\n", label, k,
+                      G[k - 1], F[k], G[k - 1] / F[k] - 1);
+        if (!(fabs(G[k - 1] - F[k]) <= rel_tol * F[k]))
+            fail_msg("step %d: ccx %.7g N, conifit %.7g N: beyond %g", k, G[k - 1], F[k], rel_tol);
+    }
+    free(G);
+}
+
 #endif
