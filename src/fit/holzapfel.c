@@ -171,23 +171,9 @@ static int residuals(const gsl_vector *x, void *arg, gsl_vector *f)
 /* LM from th (np logs) to its end; the sum of squares there, th moved to it. */
 static double run_lm(ho_ctx *c, double *th)
 {
-    gsl_multifit_nlinear_fdf fdf = {residuals, NULL, NULL, c->rows, (size_t)c->np, c, 0, 0, 0};
-    gsl_multifit_nlinear_parameters fp = cf_lm_parameters();
-    fp.fdtype = GSL_MULTIFIT_NLINEAR_CTRDIFF;
-    int init = 0;
-    gsl_multifit_nlinear_workspace *w = cf_lm_start(&fp, &fdf, th, &init);
-    if (!w)
-        return INFINITY;
-    double ss = INFINITY;
-    if (init == GSL_SUCCESS) {
-        const cf_lm_stop stop = {.max_iter = 400, .xtol = 1e-15, .gtol = 1e-15, .ftol = 0,
-                                 .stall = 25, .stall_rel = 1e-14, .floor = 1e-28};
-        cf_lm_iterate(w, &stop);
-        gsl_blas_ddot(gsl_multifit_nlinear_residual(w), gsl_multifit_nlinear_residual(w), &ss);
-        memcpy(th, gsl_multifit_nlinear_position(w)->data, (size_t)c->np * sizeof *th);
-    }
-    gsl_multifit_nlinear_free(w);
-    return isfinite(ss) ? ss : INFINITY;
+    const cf_lm_stop stop = {.max_iter = 400, .xtol = 1e-15, .gtol = 1e-15, .ftol = 0,
+                             .stall = 25, .stall_rel = 1e-14, .floor = 1e-28};
+    return cf_lm_minimise(residuals, c, c->rows, (size_t)c->np, th, &stop);
 }
 
 /* The tables' axes and weights into c; CF_E_DATA naming a table without axes. */

@@ -4,6 +4,7 @@
 #include "fit/lm.h"
 
 #include <math.h>
+#include <string.h>
 
 #include <gsl/gsl_blas.h>
 #include <gsl/gsl_errno.h>
@@ -79,4 +80,24 @@ int cf_lm_iterate(gsl_multifit_nlinear_workspace *w, const cf_lm_stop *stop)
         }
     }
     return 0;
+}
+
+double cf_lm_minimise(int (*f)(const gsl_vector *x, void *params, gsl_vector *r), void *params,
+                      size_t n, size_t p, double *x, const cf_lm_stop *stop)
+{
+    gsl_multifit_nlinear_fdf fdf = {f, NULL, NULL, n, p, params, 0, 0, 0};
+    gsl_multifit_nlinear_parameters fp = cf_lm_parameters();
+    fp.fdtype = GSL_MULTIFIT_NLINEAR_CTRDIFF;
+    int init = 0;
+    gsl_multifit_nlinear_workspace *w = cf_lm_start(&fp, &fdf, x, &init);
+    if (!w)
+        return INFINITY;
+    double ss = INFINITY;
+    if (init == GSL_SUCCESS) {
+        cf_lm_iterate(w, stop);
+        gsl_blas_ddot(gsl_multifit_nlinear_residual(w), gsl_multifit_nlinear_residual(w), &ss);
+        memcpy(x, gsl_multifit_nlinear_position(w)->data, p * sizeof *x);
+    }
+    gsl_multifit_nlinear_free(w);
+    return isfinite(ss) ? ss : INFINITY;
 }

@@ -56,4 +56,11 @@ typedef struct cf_lm_stop {
 ** or -1 when an iteration ran out of memory (the position is then the last good one). */
 int cf_lm_iterate(gsl_multifit_nlinear_workspace *w, const cf_lm_stop *stop);
 
+/* Levenberg-Marquardt with central differences on the n residuals f (GSL's signature, params
+** its argument) of p parameters from x (moved to where the run ends), stopped by stop. Returns the
+** sum of squares there; INFINITY when the workspace cannot start or its first evaluation fails
+** (x unchanged) or when the sum at the end is not finite. */
+double cf_lm_minimise(int (*f)(const gsl_vector *x, void *params, gsl_vector *r), void *params,
+                      size_t n, size_t p, double *x, const cf_lm_stop *stop);
+
 #endif
