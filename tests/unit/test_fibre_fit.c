@@ -108,12 +108,6 @@ static int load_set(cf_table tab[8], const cf_table *t[8])
     return 1;
 }
 
-#if defined(__SANITIZE_ADDRESS__)
-#define TF_SANITIZED 1
-#else
-#define TF_SANITIZED 0
-#endif
-
 static void print_fit(const char *what, const cf_fibre_fit *f, double cpu)
 {
     printf("%s: objective %.4f (%.1f s CPU, %d starts), matrix rho %.4g s/H %.4g F_C/H^2 %.4g kPa, "
@@ -132,12 +126,9 @@ static void print_fit(const char *what, const cf_fibre_fit *f, double cpu)
 static void myocardium_set_at_or_below_holzapfel_ogden(void **state)
 {
     (void)state;
-    if (TF_SANITIZED) {
-        /* the recovery above runs the same fit's code under the sanitizers; this fit of the
-        ** eight tables takes over a minute of CPU unsanitised and several times that here */
-        print_message("the myocardium fit is asserted by make test, not under the sanitizers: skipped\n");
-        skip();
-    }
+    /* the recovery above runs the same fit's code under the sanitizers; this fit of the eight
+    ** tables takes over a minute of CPU unsanitised and several times that there */
+    TU_SKIP_SANITIZED("the myocardium fit");
     cf_table tab[8];
     const cf_table *t[8];
     if (!load_set(tab, t)) {

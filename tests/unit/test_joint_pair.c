@@ -370,6 +370,7 @@ static void assert_elliptic_verdicts(const cf_joint_report *r, const char *file)
 static void brain_cortex_stable_pair_below_ogden(void **state)
 {
     (void)state;
+    TU_SKIP_SANITIZED("brain_cortex_stable_pair_below_ogden");
     cf_table t[3];
     const cf_table *tabs[3];
     if (!tu_load_modes("brain_cortex", tu_tcs, 3, t, tabs))
@@ -446,6 +447,7 @@ static void brain_cortex_stable_pair_below_ogden(void **state)
 static void chicken_breast_pair_never_loses_to_the_odd_law(void **state)
 {
     (void)state;
+    TU_SKIP_SANITIZED("chicken_breast_pair_never_loses_to_the_odd_law");
     cf_table t[3];
     const cf_table *tabs[3];
     if (!tu_load_modes("chicken_breast", tu_tcs, 3, t, tabs))
@@ -498,6 +500,7 @@ static void chicken_breast_pair_never_loses_to_the_odd_law(void **state)
 static void coronaradiata_pair_never_above_the_odd_law(void **state)
 {
     (void)state;
+    TU_SKIP_SANITIZED("coronaradiata_pair_never_above_the_odd_law");
     cf_table t[2];
     const cf_table *tabs[2];
     static const char *const modes[2] = {"tension", "compression"};
