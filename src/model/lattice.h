@@ -72,8 +72,9 @@ typedef struct cf_lattice_config {
                               ** |F a| with F the cell's mean deformation gradient (that of its
                               ** trilinear hexahedron averaged over the cell, exact for a
                               ** homogeneous deformation), its nodal forces -H^3 P dF/dx; in the
-                              ** forces only: the solvers (cf_msm_run) refuse a lattice with
-                              ** fibres, their tangent does not carry them yet */
+                              ** forces and in the static solvers' tangent (msm_tangent.c);
+                              ** explicit dynamics (inertia) refuses fibres: its stable step
+                              ** does not count them yet */
     int nfibre;               /* their count, 0 .. CF_FIBRE_MAX */
 } cf_lattice_config;
 

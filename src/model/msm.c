@@ -146,9 +146,9 @@ cf_status cf_msm_run(cf_lattice *lat, const cf_msm_effects *fxin, const cf_msm_c
     memset(st, 0, sizeof *st);
     if (done)
         *done = 0;
-    if (lat->cfg.nfibre > 0)
-        return cf_error_set(err, CF_E_DATA, "a lattice with %d fibre group%s: its solvers do "
-                            "not carry fibres yet (their tangent); the homogenised cell does",
+    if (lat->cfg.nfibre > 0 && fx->inertia)
+        return cf_error_set(err, CF_E_DATA, "a lattice with %d fibre group%s: explicit dynamics "
+                            "does not carry fibres yet (its stable step); statics do",
                             lat->cfg.nfibre, lat->cfg.nfibre == 1 ? "" : "s");
     cf_status rc = check_run(fx, path, sample_t_s, nsamples, err);
     if (rc != CF_OK)

@@ -43,7 +43,8 @@ typedef struct solver {
     size_t nnz;               /* entries of the tangent's pattern */
     int *map;                 /* spring q's blocks ii, jj, ij, ji: entry (a, b) of block blk at
                                  index map[q * 36 + 9 * blk + 3 a + b] of the values, -1 fixed */
-    int *vmap;                /* the cells' blocks (volume term, hourglass): cell c's (a, b) entry (i, k) at
+    int *vmap;                /* the cells' blocks (volume term, hourglass, fibres): cell c's
+                                 (a, b) entry (i, k) at
                                  vmap[((c * 8 + a) * 8 + b) * 9 + i * 3 + k] (NULL without one) */
     long neg_pivots;          /* negative pivots of the last factored tangent, -1 unknown */
     int chord;                /* reuse factorisations across iterations and load steps (chord

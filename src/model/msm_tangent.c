@@ -60,6 +60,13 @@ static void ccs_index3(const ccs *C, const long rows[3], long col, int out[3])
     }
 }
 
+/* Whether the cells carry a tangent of their own: the volume term, the hourglass control or
+** fibre groups. */
+static int cells_couple(const cf_lattice *lat)
+{
+    return cf_lattice_has_cells(lat) || lat->cfg.nfibre > 0;
+}
+
 /* The pattern: each node couples with itself and the nodes it shares a spring or a cell with (at
 ** most 26), a 3 x 3 block each. */
 enum { MAXADJ = CF_MSM_TANGENT_MAX_ADJ };
@@ -91,10 +98,10 @@ static int node_adjacency(const cf_lattice *lat, uint32_t *adj, unsigned char *d
         for (int e = 0; e < 2 && !bad; e++)
             bad = adjacent(adj, deg, ends[e], ends[1 - e]);
     }
-    /* the volume term and the hourglass control couple every two nodes of a cell (a spring does
-    ** unless its family's weight is 0) */
+    /* the volume term, the hourglass control and the fibre groups couple every two nodes of a
+    ** cell (a spring does unless its family's weight is 0) */
     const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
-    for (size_t c = 0; cf_lattice_has_cells(lat) && c < nc && !bad; c++) {
+    for (size_t c = 0; cells_couple(lat) && c < nc && !bad; c++) {
         uint32_t node[8];
         cf_lattice_cell_nodes(lat, c, node);
         for (int a = 0; a < 8 && !bad; a++)
@@ -220,9 +227,9 @@ cf_status cf_msm_tangent_build(solver *s, const cf_mech_ops *ops, cf_error *err)
         return st;
     const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
     s->map = malloc((lat->ns ? lat->ns : 1) * 36 * sizeof(int));
-    if (cf_lattice_has_cells(lat))
+    if (cells_couple(lat))
         s->vmap = malloc(nc * 8 * 8 * 9 * sizeof(int));
-    if (!s->map || (cf_lattice_has_cells(lat) && !s->vmap)) {
+    if (!s->map || (cells_couple(lat) && !s->vmap)) {
         free(s->map);
         free(s->vmap);
         s->map = s->vmap = NULL;
@@ -235,16 +242,56 @@ cf_status cf_msm_tangent_build(solver *s, const cf_mech_ops *ops, cf_error *err)
     return CF_OK;
 }
 
+/* Adds cell c's fibre groups' tangent to blk: the cell's F = sum_a x_a g_a^T (g_a the mean
+** gradient of corner a's shape function, (2 xi_a - 1)/(4 H) per axis, as lattice.c's forces use),
+** its force on corner a -H^3 P g_a, so K_(a i)(b k) = H^3 sum_jl A_ijkl g_a,j g_b,l with A the
+** groups' dP/dF (fibre.h). A spring past solid adds nothing (the residual reports it). */
+static void fibre_block(const cf_lattice *lat, size_t c, double blk[8][8][9])
+{
+    const double H = lat->H_mm, H3 = H * H * H;
+    uint32_t node[8];
+    double g[8][3], F[9] = {0}, A[81] = {0};
+    cf_lattice_cell_nodes(lat, c, node);
+    for (int a = 0; a < 8; a++)
+        for (int j = 0; j < 3; j++)
+            g[a][j] = (2.0 * ((a >> j) & 1) - 1) / (4 * H);
+    for (int a = 0; a < 8; a++) {
+        const double x[3] = {lat->x[node[a]], lat->y[node[a]], lat->z[node[a]]};
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                F[3 * i + j] += x[i] * g[a][j];
+    }
+    for (int k = 0; k < lat->cfg.nfibre; k++)
+        (void)cf_fibre_add_tangent(&lat->cfg.fibre[k], H, F, A, NULL);
+    /* Ag[i][k][a][l] = sum_j A_ijkl g_a,j, then the blocks */
+    double Ag[3][3][8][3] = {{{{0}}}};
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 8; a++)
+                for (int l = 0; l < 3; l++)
+                    for (int j = 0; j < 3; j++)
+                        Ag[i][k][a][l] += A[27 * i + 9 * j + 3 * k + l] * g[a][j];
+    for (int a = 0; a < 8; a++)
+        for (int b = 0; b < 8; b++)
+            for (int i = 0; i < 3; i++)
+                for (int k = 0; k < 3; k++)
+                    blk[a][b][i * 3 + k] += H3 * (Ag[i][k][a][0] * g[b][0] +
+                                                  Ag[i][k][a][1] * g[b][1] +
+                                                  Ag[i][k][a][2] * g[b][2]);
+}
+
 /* The cells' tangent added into v: per cell, the volume term's kappa/H^3 g_a g_b^T + kappa (J - 1)
-** d2V/dx_a dx_b (W = (kappa/2)(J - 1)^2 H^3, J = V/H^3, g = dV/dx) and the hourglass control's
-** constant k_h coef(a, b) I (lattice_hourglass.h). In a homogeneous state (s->homogeneous) every
-** cell has the first one's J, g and d2V/dx2 (they depend on the differences of its corners only),
-** so its block is computed once (the same operations, so the same values as each cell's own). */
-static void volume_tangent(solver *s, double *v)
+** d2V/dx_a dx_b (W = (kappa/2)(J - 1)^2 H^3, J = V/H^3, g = dV/dx), the fibre groups'
+** (fibre_block) and the hourglass control's constant k_h coef(a, b) I (lattice_hourglass.h). In a
+** homogeneous state (s->homogeneous) every cell has the first one's J, g, d2V/dx2 and F (they
+** depend on the differences of its corners only), so its block is computed once (the same
+** operations, so the same values as each cell's own). */
+static void cell_tangent(solver *s, double *v)
 {
     const cf_lattice *lat = s->lat;
     const double kappa = lat->cfg.volume_modulus_MPa, H = lat->H_mm, V0 = H * H * H;
     const double kh = lat->hg_k_N_per_mm;
+    const int fib = lat->cfg.nfibre > 0;
     const size_t nc = (size_t)lat->cfg.nx * (size_t)lat->cfg.ny * (size_t)lat->cfg.nz;
     double hess[8][8][3][3]; /* 4.6 kB */
     double hg[8][8], blk[8][8][9];
@@ -257,12 +304,15 @@ static void volume_tangent(solver *s, double *v)
         const int fresh = c == 0 || !s->homogeneous;
         if (kappa != 0 && fresh)
             J = cf_lattice_cell_volume(lat, c, node, g, hess);
-        for (int a = 0; kappa != 0 && fresh && a < 8; a++)
+        for (int a = 0; (kappa != 0 || fib) && fresh && a < 8; a++)
             for (int b = 0; b < 8; b++)
                 for (int i = 0; i < 3; i++)
                     for (int k = 0; k < 3; k++)
-                        blk[a][b][i * 3 + k] = kappa / V0 * g[a][i] * g[b][k] +
-                                               kappa * (J - 1) * hess[a][b][i][k];
+                        blk[a][b][i * 3 + k] = kappa == 0 ? 0.0
+                                                          : kappa / V0 * g[a][i] * g[b][k] +
+                                                                kappa * (J - 1) * hess[a][b][i][k];
+        if (fib && fresh)
+            fibre_block(lat, c, blk);
         const int *vm = s->vmap + c * 8 * 8 * 9;
         for (int a = 0; a < 8; a++)
             for (int b = 0; b < 8; b++)
@@ -270,7 +320,7 @@ static void volume_tangent(solver *s, double *v)
                     const int at = vm[(a * 8 + b) * 9 + e];
                     if (at < 0)
                         continue;
-                    if (kappa != 0)
+                    if (kappa != 0 || fib)
                         v[at] += blk[a][b][e];
                     if (e % 4 == 0) /* i == k */
                         v[at] += hg[a][b];
@@ -311,6 +361,6 @@ void cf_msm_tangent_fill(void *ctx, double *v)
                     v[m[k + 27]] -= B;
             }
     }
-    if (cf_lattice_has_cells(lat))
-        volume_tangent(s, v);
+    if (cells_couple(lat))
+        cell_tangent(s, v);
 }

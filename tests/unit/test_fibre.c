@@ -12,17 +12,27 @@
 **  - the full lattice with the same fibre groups (2 x 3 x 2 cells, volume term), placed at the
 **    cell's F of a biaxial row (either direction) or a simple shear in any of the six planes, with
 **    the frame on the lattice's axes and turned: no force on any node off its faces, and its
-**    nodal forces' moment -sum f X^T / V is the cell's nominal stress, 1e-9 relative.
+**    nodal forces' moment -sum f X^T / V is the cell's nominal stress, 1e-9 relative;
+**  - the static solvers' tangent (msm_tangent.c) carries the fibre groups: at a perturbed state of
+**    a turned frame its Newton direction dx gives dR/dx dx = -R (central differences, 1e-6);
+**  - the solver itself (cf_msm_newton, the one of `conifit simulate`) takes a 3 x 3 x 3 lattice
+**    whose faces are held at the cell's F, its inner nodes displaced, back to the homogeneous
+**    state: inner nodes at F X and the nodal moment the cell's stress, 1e-9 relative, and the
+**    tangent there positive definite (no negative pivot), in biaxial and shear rows, frame on
+**    the axes and turned.
 */
 #include "testutil.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "model/cell.h"
 #include "model/family.h"
 #include "model/fibre.h"
 #include "model/lattice.h"
+#include "model/msm.h"
+#include "model/msm_internal.h"
 
 typedef struct fixture {
     cf_law matrix, fib, sheet;
@@ -216,27 +226,46 @@ static void fibre_modes_in_every_plane(void **state)
         }
 }
 
-/* The lattice of x's laws and groups at the cell's state s: checks node by node. */
-static void lattice_is_the_cell(const fixture *x, const cf_cell_state *s, const char *what)
+/* The lattice config of x's laws and groups: nx x ny x nz cells, no hourglass control. */
+static cf_lattice_config fibre_lattice(const fixture *x, int nx, int ny, int nz)
 {
     cf_lattice_config lc = cf_lattice_default();
-    lc.nx = 2, lc.ny = 3, lc.nz = 2;
+    lc.nx = nx, lc.ny = ny, lc.nz = nz;
     lc.volume_modulus_MPa = x->cell.volume_modulus_MPa;
     lc.hourglass = 0;
     memcpy(lc.weight, x->cell.weight, sizeof lc.weight);
     lc.fibre = x->cell.fibre;
     lc.nfibre = x->cell.nfibre;
+    return lc;
+}
+
+/* Every node p of lat at F X_p. */
+static void place_at(cf_lattice *lat, const double F[9])
+{
+    for (size_t p = 0; p < lat->nn; p++) {
+        const double X[3] = {lat->X[p], lat->Y[p], lat->Z[p]};
+        lat->x[p] = F[0] * X[0] + F[1] * X[1] + F[2] * X[2];
+        lat->y[p] = F[3] * X[0] + F[4] * X[1] + F[5] * X[2];
+        lat->z[p] = F[6] * X[0] + F[7] * X[1] + F[8] * X[2];
+    }
+}
+
+/* Deterministic numbers in [-1, 1]. */
+static double rnd(unsigned *s)
+{
+    *s = *s * 1103515245u + 12345u;
+    return ((*s >> 8) & 0xffff) / 32767.5 - 1.0;
+}
+
+/* The lattice of x's laws and groups at the cell's state s: checks node by node. */
+static void lattice_is_the_cell(const fixture *x, const cf_cell_state *s, const char *what)
+{
+    cf_lattice_config lc = fibre_lattice(x, 2, 3, 2);
     cf_lattice lat;
     cf_error err = {0};
     if (cf_lattice_create(&lat, &x->matrix, CF_LAW_CLOSED, &lc, &err) != CF_OK)
         fail_msg("%s", err.msg);
-    for (size_t p = 0; p < lat.nn; p++) {
-        const double X[3] = {lat.X[p], lat.Y[p], lat.Z[p]};
-        const double *F = s->F;
-        lat.x[p] = F[0] * X[0] + F[1] * X[1] + F[2] * X[2];
-        lat.y[p] = F[3] * X[0] + F[4] * X[1] + F[5] * X[2];
-        lat.z[p] = F[6] * X[0] + F[7] * X[1] + F[8] * X[2];
-    }
+    place_at(&lat, s->F);
     cf_lattice_forces(&lat);
     const double H = x->matrix.p.H_mm, ext[3] = {lc.nx * H, lc.ny * H, lc.nz * H};
     double big = 0, M[3][3] = {{0}}, pmax = 0;
@@ -293,6 +322,168 @@ static void cell_equals_the_full_lattice(void **state)
     }
 }
 
+/* The lattice solver's tangent with fibres: at a state off equilibrium (a biaxial row of a turned
+** frame, every free node moved), the Newton direction dx = K^-1 R satisfies dR/dx dx = -R. */
+static void lattice_tangent_carries_the_fibres(void **state)
+{
+    (void)state;
+    fixture x;
+    double R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    turned(R);
+    setup_cell(&x, R, 2);
+    cf_msm_config cfg = cf_msm_default();
+    cfg.lattice = fibre_lattice(&x, 2, 3, 2);
+    cf_lattice lat;
+    cf_error err = {0};
+    assert_int_equal(cf_lattice_create(&lat, &x.matrix, CF_LAW_CLOSED, &cfg.lattice, &err), CF_OK);
+    const cf_cell_load bi = {CF_MODE_BIAXIAL, {0, 1}, 0.75};
+    cf_cell_state cs;
+    assert_int_equal(cf_cell_load_state(&x.cell, &bi, 0.08, &cs, NULL), CF_OK);
+    solver s;
+    assert_int_equal(cf_msm_solver_init(&s, &lat, NULL, &cfg, CF_DRIVE_DISPLACEMENT, NULL, &err),
+                     CF_OK);
+    place_at(&lat, cs.F);
+    unsigned seed = 7;
+    double *co[3] = {lat.x, lat.y, lat.z};
+    const double H = lat.H_mm;
+    for (size_t p = 0; p < lat.nn; p++)
+        for (int a = 0; a < 3; a++)
+            if (s.eq[3 * p + a] >= 0)
+                co[a][p] += 0.01 * H * rnd(&seed);
+    double rn, fs;
+    cf_msm_residual(&s, &rn, &fs);
+    const size_t n = s.ndof;
+    double *R0 = malloc(n * sizeof *R0), *Rp = malloc(n * sizeof *Rp), *dx = malloc(n * sizeof *dx);
+    assert_non_null(R0);
+    assert_non_null(Rp);
+    assert_non_null(dx);
+    memcpy(R0, s.R, n * sizeof *R0);
+    if (cf_msm_direction(&s, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    memcpy(dx, s.dx, n * sizeof *dx);
+    double dmax = 0;
+    for (size_t e = 0; e < n; e++)
+        dmax = fmax(dmax, fabs(dx[e]));
+    const double eps = 1e-5 * H / dmax;
+    for (int sgn = 0; sgn < 2; sgn++) {
+        const double step = sgn ? -2 * eps : eps; /* +eps, then -eps */
+        for (size_t p = 0; p < lat.nn; p++)
+            for (int a = 0; a < 3; a++)
+                if (s.eq[3 * p + a] >= 0)
+                    co[a][p] += step * dx[s.eq[3 * p + a]];
+        cf_msm_residual(&s, &rn, &fs);
+        if (!sgn)
+            memcpy(Rp, s.R, n * sizeof *Rp);
+    }
+    double num = 0, den = 0;
+    for (size_t e = 0; e < n; e++) {
+        const double d = (Rp[e] - s.R[e]) / (2 * eps) + R0[e];
+        num += d * d;
+        den += R0[e] * R0[e];
+    }
+    if (!(sqrt(num / den) < 1e-6))
+        fail_msg("|dR/dx dx + R| / |R| = %.3g", sqrt(num / den));
+    free(R0);
+    free(Rp);
+    free(dx);
+    cf_msm_solver_free(&s);
+    cf_lattice_free(&lat);
+}
+
+/* One solve: the 3 x 3 x 3 lattice's faces held at the cell's F (state cs), its inner nodes moved
+** off F X, then Newton; the inner nodes come back to F X, the nodal moment is the cell's stress
+** (both 1e-9 relative) and the tangent there has no negative pivot. */
+static void solver_returns_to_the_cell(const fixture *x, const cf_cell_state *cs, const char *what)
+{
+    cf_msm_config cfg = cf_msm_default();
+    cfg.lattice = fibre_lattice(x, 3, 3, 3);
+    cfg.newton_rtol = 1e-13;
+    cf_lattice lat;
+    cf_error err = {0};
+    assert_int_equal(cf_lattice_create(&lat, &x->matrix, CF_LAW_CLOSED, &cfg.lattice, &err), CF_OK);
+    const double H = lat.H_mm, ext = 3 * H;
+    for (size_t p = 0; p < lat.nn; p++) {
+        const double X[3] = {lat.X[p], lat.Y[p], lat.Z[p]};
+        int inside = 1;
+        for (int i = 0; i < 3; i++)
+            inside &= X[i] != 0 && X[i] != ext;
+        lat.fix[p] = inside ? 0 : 7; /* every axis of a face node held */
+    }
+    place_at(&lat, cs->F);
+    solver s;
+    assert_int_equal(cf_msm_solver_init(&s, &lat, NULL, &cfg, CF_DRIVE_DISPLACEMENT, NULL, &err),
+                     CF_OK);
+    assert_int_equal(s.ndof, 24); /* the 8 inner nodes */
+    unsigned seed = 3;
+    double *co[3] = {lat.x, lat.y, lat.z};
+    for (size_t p = 0; p < lat.nn; p++)
+        for (int a = 0; a < 3; a++)
+            if (s.eq[3 * p + a] >= 0)
+                co[a][p] += 0.02 * H * rnd(&seed);
+    if (cf_msm_newton(&s, &err) != CF_OK)
+        fail_msg("%s: %s", what, err.msg);
+    double rn, fs;
+    cf_msm_residual(&s, &rn, &fs);
+    if (cf_msm_direction(&s, &err) != CF_OK)
+        fail_msg("%s: %s", what, err.msg);
+    if (s.neg_pivots != 0)
+        fail_msg("%s: %ld negative pivots", what, s.neg_pivots);
+    const double *F = cs->F;
+    for (size_t p = 0; p < lat.nn; p++) {
+        const double X[3] = {lat.X[p], lat.Y[p], lat.Z[p]}, xp[3] = {lat.x[p], lat.y[p], lat.z[p]};
+        for (int i = 0; i < 3; i++) {
+            const double want = F[3 * i] * X[0] + F[3 * i + 1] * X[1] + F[3 * i + 2] * X[2];
+            if (!(fabs(xp[i] - want) <= 1e-9 * H))
+                fail_msg("%s: node %zu axis %d at %.17g mm, F X %.17g mm", what, p, i, xp[i], want);
+        }
+    }
+    cf_lattice_forces(&lat);
+    double M[3][3] = {{0}}, pmax = 0;
+    for (size_t p = 0; p < lat.nn; p++) {
+        const double X[3] = {lat.X[p], lat.Y[p], lat.Z[p]}, f[3] = {lat.fx[p], lat.fy[p], lat.fz[p]};
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                M[i][j] -= f[i] * X[j] / (ext * ext * ext);
+    }
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            pmax = fmax(pmax, fabs(cs->P_MPa[i][j]));
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            if (!(fabs(M[i][j] - cs->P_MPa[i][j]) <= 1e-9 * pmax))
+                fail_msg("%s: P[%d][%d] of the solved lattice %.17g MPa, of the cell %.17g MPa", what,
+                         i, j, M[i][j], cs->P_MPa[i][j]);
+    cf_msm_solver_free(&s);
+    cf_lattice_free(&lat);
+}
+
+static void solver_reaches_the_cell_with_fibres(void **state)
+{
+    (void)state;
+    for (int turn = 0; turn < 2; turn++) {
+        fixture x;
+        double R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+        if (turn)
+            turned(R);
+        setup_cell(&x, R, 2);
+        for (int p = 0; p < 3; p++)
+            for (int q = 0; q < 3; q++) {
+                if (p == q)
+                    continue;
+                char what[64];
+                cf_cell_state cs;
+                const cf_cell_load bi = {CF_MODE_BIAXIAL, {p, q}, 0.75}, sh = {CF_MODE_SHEAR,
+                                                                              {p, q}, 0};
+                assert_int_equal(cf_cell_load_state(&x.cell, &bi, 0.08, &cs, NULL), CF_OK);
+                snprintf(what, sizeof what, "biaxial %d%d, frame %d", p, q, turn);
+                solver_returns_to_the_cell(&x, &cs, what);
+                assert_int_equal(cf_cell_load_state(&x.cell, &sh, 0.3, &cs, NULL), CF_OK);
+                snprintf(what, sizeof what, "shear %d%d, frame %d", p, q, turn);
+                solver_returns_to_the_cell(&x, &cs, what);
+            }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -301,6 +492,8 @@ int main(void)
         cmocka_unit_test(loads_without_fibres_are_the_cells_modes),
         cmocka_unit_test(fibre_modes_in_every_plane),
         cmocka_unit_test(cell_equals_the_full_lattice),
+        cmocka_unit_test(lattice_tangent_carries_the_fibres),
+        cmocka_unit_test(solver_reaches_the_cell_with_fibres),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
