@@ -36,6 +36,11 @@ cf_status cf_validate_from_scene(const cf_scene *sc, const char *name, cf_valida
         what = "viscosity";
     else if (sc->effects.gravity_mm_per_s2 != 0)
         what = "gravity";
+    if (sc->nfibres > 0)
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: key 'fibres': %zu fibre group%s; validation runs the fitted "
+                            "spring's own lattice in uniaxial compression, without fibres",
+                            name, sc->nfibres, sc->nfibres == 1 ? "" : "s");
     if (what)
         return cf_error_set(err, CF_E_DATA,
                             "%s: key 'effects' asks for %s: validation needs a static uniaxial "

@@ -133,6 +133,11 @@ static void summary(FILE *o, const cf_scene *sc, const cf_msm_sample *s, size_t 
         fprintf(o, "group %s: the %s springs take the law of spring %s\n",
                 cf_scene_group_name(sc->groups[g].family), cf_scene_group_name(sc->groups[g].family),
                 sc->groups[g].source);
+    for (size_t g = 0; g < sc->nfibres; g++) /* the fibre groups, tension only */
+        fprintf(o, "fibre group %zu: axis (%.6g, %.6g, %.6g), %.6g springs per cell of spring %s, "
+                "in tension only\n",
+                g, sc->fibres[g].axis[0], sc->fibres[g].axis[1], sc->fibres[g].axis[2],
+                sc->fibres[g].density, sc->fibres[g].source);
     if (sc->has_extension || lc->volume_modulus_MPa > 0)
         fprintf(o, "element: %s; volume term: kappa %.6g MPa\n",
                 sc->has_extension ? "double-acting (its own extension spring)"

@@ -73,6 +73,12 @@ cf_status cf_export_lattice_from_scene(const cf_scene *sc, const char *name,
                                        cf_export_lattice *lx, cf_error *err)
 {
     memset(lx, 0, sizeof *lx);
+    if (sc->nfibres > 0)
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: key 'fibres': a lattice with %zu fibre group%s; the lattice "
+                            "exports (CalculiX, FEBio, LS-DYNA, SOFA) do not write fibre groups "
+                            "yet",
+                            name, sc->nfibres, sc->nfibres == 1 ? "" : "s");
     cf_validate_setup v;
     const int timed = sc->kind != CF_PROTO_RAMP;
     cf_status st = timed ? time_protocol(sc, name, lx, err) : CF_OK;

@@ -38,6 +38,13 @@ cf_status cf_scene_law(const cf_scene *sc, cf_law *law, cf_law *ext, cf_error *e
 cf_status cf_scene_group_laws(const cf_scene *sc, cf_law group[CF_FAMILY_COUNT],
                               cf_lattice_config *cfg, cf_error *err);
 
+/* The laws of the scene's fibre groups ("fibres", scene_fibres.c) into law[k] (each with its table
+** for the table method), the groups into grp[k] and cfg->fibre, cfg->nfibre pointed at them: law
+** and grp must outlive cfg's use. Release each law with cf_law_free (law[] is zeroed first, so
+** that is safe whatever the status). */
+cf_status cf_scene_fibre_laws(const cf_scene *sc, cf_law law[CF_FIBRE_MAX],
+                              cf_fibre_group grp[CF_FIBRE_MAX], cf_lattice_config *cfg,
+                              cf_error *err);
 /* A lattice group's name in scenes and reports: "edge", "face" or "body" (CF_FAMILY_*). */
 const char *cf_scene_group_name(int family);
 

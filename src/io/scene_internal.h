@@ -54,5 +54,17 @@ cf_status cf_scene_selector(ctx *c, json_t *v, const char *key, const char *othe
 ** 0, a double-acting element refused (a body's empty or overlapping regions are the body's to
 ** find, cf_body_set_groups). */
 cf_status cf_scene_groups(ctx *c, json_t *root, cf_scene *sc);
+/* The spring of a group's entry at where (e.g. 'groups[i].spring'): {"fit": file} (a plain
+** conical or tailed spring's fit, "type" optional) or {"params": {...}}, into g->spring and
+** g->source; a double-acting fit refused. */
+cf_status cf_scene_group_spring(ctx *c, json_t *sp, const char *where, cf_scene_group *g);
+
+/* scene_fibres.c: one fibre group's entry e at where ({"axis": [ax, ay, az], "spring": as a
+** group's, "density": springs per cell}) into *f: the axis finite and not zero (normalised), the
+** density finite in (0, 1e6], the spring a valid law; every refusal names the key and the value.
+** Shared by the lattice's "fibres" and a body's. */
+cf_status cf_scene_fibre_entry(ctx *c, json_t *e, const char *where, cf_scene_fibre *f);
+/* "fibres" of a lattice scene's root (after "groups"): 1 to CF_FIBRE_MAX entries. */
+cf_status cf_scene_fibres(ctx *c, json_t *root, cf_scene *sc);
 
 #endif

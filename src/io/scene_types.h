@@ -56,6 +56,15 @@ typedef struct cf_scene_group {
     char source[600];           /* "params" or the fit file (and type) it came from */
 } cf_scene_group;
 
+/* A fibre group of a scene ("fibres", src/notes/simulate.md): one spring per lattice cell along
+** a material direction, acting in fibre tension only (model/fibre.h). */
+typedef struct cf_scene_fibre {
+    double axis[3];             /* its reference direction, unit length (the scene's normalised) */
+    double density;             /* springs per cell, > 0 */
+    cf_spring spring;           /* its spring (free length Hf, any) */
+    char source[600];           /* "params" or the fit file (and type) it came from */
+} cf_scene_fibre;
+
 typedef struct cf_scene {
     cf_spring spring;           /* the spring of every lattice edge */
     int has_extension;          /* 1: 'spring_extension' makes every element double-acting
@@ -67,6 +76,8 @@ typedef struct cf_scene {
     size_t ngroups;             /* "groups": spring groups with a law of their own (0: every
                                    spring the scene spring's) */
     cf_scene_group groups[CF_SCENE_MAX_GROUPS];
+    size_t nfibres;             /* "fibres": fibre groups of a lattice (0: none) */
+    cf_scene_fibre fibres[CF_FIBRE_MAX];
     cf_law_method method;       /* law evaluator */
     size_t table_intervals;     /* for CF_LAW_TABLE */
     cf_msm_config cfg;          /* lattice and solver settings */

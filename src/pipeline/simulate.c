@@ -52,14 +52,15 @@ cf_status cf_pipeline_simulate(const cf_scene *sc, const char *name, const cf_bu
                             name);
     if ((s = cf_scene_law(sc, &run->law, &run->ext, err)) != CF_OK)
         return s;
-    if (sc->ngroups == 0)
+    if (sc->ngroups == 0 && sc->nfibres == 0)
         return simulate_run(sc, name, budget, recovery, run, err);
-    /* spring groups: the scene with its groups' laws in the lattice's configuration */
+    /* spring and fibre groups: the scene with their laws in the lattice's configuration */
     cf_scene *g = malloc(sizeof *g);
     if (!g)
         return cf_error_set(err, CF_E_INTERNAL, "out of memory for the scene's groups");
     *g = *sc;
-    if ((s = cf_scene_group_laws(sc, run->group, &g->cfg.lattice, err)) == CF_OK)
+    if ((s = cf_scene_group_laws(sc, run->group, &g->cfg.lattice, err)) == CF_OK &&
+        (s = cf_scene_fibre_laws(sc, run->fibre_law, run->fibre, &g->cfg.lattice, err)) == CF_OK)
         s = simulate_run(g, name, budget, recovery, run, err);
     free(g);
     return s;
@@ -72,6 +73,8 @@ void cf_sim_run_free(cf_sim_run *run)
     cf_law_free(&run->ext);
     for (int f = 0; f < CF_FAMILY_COUNT; f++)
         cf_law_free(&run->group[f]);
+    for (int f = 0; f < CF_FIBRE_MAX; f++)
+        cf_law_free(&run->fibre_law[f]);
     free(run->samples);
     free(run->spring_MPa);
     memset(run, 0, sizeof *run);

@@ -16,6 +16,8 @@ typedef struct cf_sim_run {
     cf_law law, ext;          /* the scene's law (and a double-acting element's extension) */
     cf_law group[CF_FAMILY_COUNT]; /* the laws of the scene's spring groups (zeroed where the
                                  ** group takes the scene's law) */
+    cf_law fibre_law[CF_FIBRE_MAX]; /* the laws of the scene's fibre groups (zeroed beyond) */
+    cf_fibre_group fibre[CF_FIBRE_MAX]; /* those groups, the lattice's cfg.fibre */
     cf_lattice lat;           /* the lattice run */
     cf_msm_sample *samples;   /* one per scene sample */
     double *spring_MPa;       /* the law's own uniaxial stress at each sample's strain, MPa */
