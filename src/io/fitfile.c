@@ -626,3 +626,83 @@ cf_status cf_fitfile_prepare(const json_t *root, const char *path, const char *c
     free(s);
     return st;
 }
+
+/* One family of a "fibre_lattice" entry at where: rho, solid_strain, stress_scale_kPa. */
+static cf_status fibre_family(json_t *e, const char *path, const char *where, cf_ident *q,
+                              cf_error *err)
+{
+    static const char *const keys[] = {"rho", "solid_strain", "stress_scale_kPa"};
+    double v[3];
+    for (int k = 0; k < 3; k++) {
+        json_t *x = json_is_object(e) ? json_object_get(e, keys[k]) : NULL;
+        v[k] = json_is_number(x) ? json_number_value(x) : NAN;
+    }
+    if (!(v[0] > 0 && v[0] <= 1) || !(v[1] > 0 && v[1] < 1) || !(v[2] > 0) || !isfinite(v[2]))
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: key '%s': rho %g (0 to 1), solid_strain %g (0 to 1), "
+                            "stress_scale_kPa %g (> 0): not a fitted spring",
+                            path, where, v[0], v[1], v[2]);
+    q->rho = v[0], q->solid = v[1], q->scale = v[2] * 1e-3;
+    return CF_OK;
+}
+
+/* The entry e of "fibre_lattice" (at where) into out. */
+static cf_status fibre_entry(json_t *e, const char *path, const char *where, cf_fitted_fibre *out,
+                             cf_error *err)
+{
+    char w[96];
+    snprintf(w, sizeof w, "%s.matrix", where);
+    cf_status st = fibre_family(json_object_get(e, "matrix"), path, w, &out->matrix, err);
+    if (st != CF_OK)
+        return st;
+    json_t *gs = json_object_get(e, "fibre_groups"), *kv = json_object_get(e, "volume_modulus_kPa");
+    const size_t n = json_array_size(gs);
+    if (!json_is_array(gs) || n == 0 || n > CF_FIBRE_MAX)
+        return cf_error_set(err, CF_E_DATA, "%s: key '%s.fibre_groups' must hold 1 to %d groups",
+                            path, where, CF_FIBRE_MAX);
+    out->kappa_MPa = json_is_number(kv) ? json_number_value(kv) * 1e-3 : NAN;
+    if (!(out->kappa_MPa >= 0) || !isfinite(out->kappa_MPa))
+        return cf_error_set(err, CF_E_DATA, "%s: key '%s.volume_modulus_kPa' must be a finite "
+                            "number >= 0", path, where);
+    for (size_t k = 0; k < n; k++) {
+        json_t *g = json_array_get(gs, k);
+        const char *a = json_string_value(json_object_get(g, "axis"));
+        snprintf(w, sizeof w, "%s.fibre_groups[%zu]", where, k);
+        if (!a || strlen(a) != 1 || !strchr("fsn", a[0]) || memchr(out->axis, a[0], k))
+            return cf_error_set(err, CF_E_DATA, "%s: key '%s.axis' must be one of f, s, n, each "
+                                "once", path, w);
+        out->axis[k] = a[0];
+        if ((st = fibre_family(g, path, w, &out->group[k], err)) != CF_OK)
+            return st;
+    }
+    out->ngroups = (int)n;
+    return CF_OK;
+}
+
+cf_status cf_fitfile_load_fibre(const char *path, const char *cross, cf_fitted_fibre *out,
+                                cf_error *err)
+{
+    memset(out, 0, sizeof *out);
+    const char *shown;
+    json_t *root;
+    cf_status st = read_root(path, &shown, &root, err);
+    if (st != CF_OK)
+        return st;
+    json_t *fl = json_object_get(root, "fibre_lattice");
+    size_t k = 0;
+    for (; k < json_array_size(fl); k++) {
+        const char *c = json_string_value(json_object_get(json_array_get(fl, k), "cross_axis"));
+        if (c && strcmp(c, cross) == 0)
+            break;
+    }
+    char where[48];
+    snprintf(where, sizeof where, "fibre_lattice[%zu]", k);
+    if (k < json_array_size(fl))
+        st = fibre_entry(json_array_get(fl, k), shown, where, out, err);
+    else
+        st = cf_error_set(err, CF_E_DATA, "%s: no key 'fibre_lattice' with an entry of "
+                          "cross_axis '%s' (a joint fit with --fibres writes one per cross-fibre "
+                          "axis)", shown, cross);
+    json_decref(root);
+    return st;
+}

@@ -38,6 +38,7 @@
 
 #include "conifit/error.h"
 #include "model/law_internal.h"
+#include "model/family.h"
 #include "model/msm.h"
 
 /* The "schema" value of a single exported spring. */
@@ -136,6 +137,24 @@ typedef struct cf_fitted_model {
 ** time-series fit, a fit through the lattice without the lattice's weights, a weight, table entry
 ** or objective that is not a finite number; CF_E_NOINPUT as cf_fitfile_load. */
 cf_status cf_fitfile_load_model(const char *path, const char *type_name, cf_fitted_model *out,
+                                cf_error *err);
+
+/* The fibre-reinforced lattice of a joint fit file ("fibre_lattice", one entry per cross-fibre
+** axis): canonical members (family.h) of the matrix and of each group, the groups' axes of the
+** fibre frame ('f', 's', 'n'; the lattice's x, y, z) and the volume modulus. */
+typedef struct cf_fitted_fibre {
+    cf_ident matrix;
+    int ngroups;
+    char axis[CF_FIBRE_MAX];
+    cf_ident group[CF_FIBRE_MAX];
+    double kappa_MPa;
+} cf_fitted_fibre;
+
+/* Loads the entry of path's "fibre_lattice" whose cross_axis is cross ("s" or "n"). CF_E_DATA
+** naming the file and key: no "fibre_lattice", no entry of that cross axis, a quantity that is
+** missing or not finite (rho in (0, 1], solid_strain in (0, 1), stress scale and kappa > 0), an
+** axis other than f, s, n or twice; CF_E_NOINPUT as cf_fitfile_load. */
+cf_status cf_fitfile_load_fibre(const char *path, const char *cross, cf_fitted_fibre *out,
                                 cf_error *err);
 
 /* Splits "FILE.json:TYPE" into path and type (type NULL when there is no ":TYPE" suffix naming a

@@ -667,10 +667,10 @@ static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
     sc->cfg = cf_msm_default();
     sc->method = CF_LAW_CLOSED;
     sc->table_intervals = CF_LAW_TABLE_DEFAULT;
-    json_t *sp, *lt, *pr, *ef, *in;
-    if ((st = cf_scene_object(c, root, "spring", 1, &sp)) || (st = spring_section(c, sp, sc)))
+    json_t *sp, *lt, *pr, *ef, *in, *ex;
+    if ((st = cf_scene_fibre_fit(c, root, sc)) || (!sc->fibre_fit && ((st = cf_scene_object(
+            c, root, "spring", 1, &sp)) || (st = spring_section(c, sp, sc)))))
         return st;
-    json_t *ex;
     if ((st = cf_scene_object(c, root, "spring_extension", 0, &ex)) ||
         (ex && (st = extension_section(c, ex, sc))))
         return st;

@@ -8,7 +8,9 @@
 #include <math.h>
 #include <string.h>
 
+#include "base/safetext.h"
 #include "io/scene_internal.h"
+#include "model/calibration.h"
 
 /* Most springs per cell a fibre group may have (a stress scale, not a count to build). */
 #define MAX_DENSITY 1e6
@@ -56,9 +58,83 @@ cf_status cf_scene_fibre_entry(ctx *c, json_t *e, const char *where, cf_scene_fi
     return CF_OK;
 }
 
+cf_status cf_scene_fibre_fit(ctx *c, json_t *root, cf_scene *sc)
+{
+    static const char *const keys[] = {"fit", "cross_axis", NULL};
+    json_t *fs = json_object_get(root, "fibres");
+    sc->fibre_fit = 0;
+    if (!json_is_object(fs))
+        return CF_OK;
+    cf_status st = cf_scene_only_keys(c, fs, "fibres", keys);
+    if (st)
+        return st;
+    const char *path = json_string_value(json_object_get(fs, "fit"));
+    const char *cross = json_string_value(json_object_get(fs, "cross_axis"));
+    if (!path)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'fibres.fit' must name a fit file (or "
+                            "'fibres' be an array of groups)", c->name);
+    if (!cross || (strcmp(cross, "s") != 0 && strcmp(cross, "n") != 0))
+        return cf_error_set(c->err, CF_E_DATA, "%s: key 'fibres.cross_axis' must be \"s\" or "
+                            "\"n\" (the biaxial tables' second direction the fit took)", c->name);
+    const char *other = json_object_get(root, "spring")             ? "spring"
+                        : json_object_get(root, "spring_extension") ? "spring_extension"
+                                                                    : NULL;
+    if (other)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s': the fibre fit of 'fibres.fit' "
+                            "gives the lattice's spring; give one of them", c->name, other);
+    cf_fitted_fibre ff;
+    cf_error ferr = {0};
+    if ((st = cf_fitfile_load_fibre(path, cross, &ff, &ferr)))
+        return cf_error_set(c->err, st, "%s: key 'fibres.fit': %s", c->name, ferr.msg);
+    sc->spring = cf_ident_member(&ff.matrix);
+    char text[700];
+    snprintf(text, sizeof text, "%s (fibre lattice, cross axis %s): matrix", path, cross);
+    cf_safe_text(sc->spring_source, sizeof sc->spring_source, text, strlen(text));
+    for (int k = 0; k < ff.ngroups; k++) {
+        cf_scene_fibre *f = &sc->fibres[k];
+        memset(f, 0, sizeof *f);
+        const int a = ff.axis[k] == 'f' ? 0 : ff.axis[k] == 's' ? 1 : 2;
+        f->axis[a] = 1;
+        f->density = 1;
+        f->spring = cf_ident_member(&ff.group[k]);
+        snprintf(text, sizeof text, "%s: group %c", path, ff.axis[k]);
+        cf_safe_text(f->source, sizeof f->source, text, strlen(text));
+    }
+    sc->nfibres = (size_t)ff.ngroups;
+    sc->fibre_fit_kappa_MPa = ff.kappa_MPa;
+    sc->fibre_fit = 1;
+    return CF_OK;
+}
+
+/* After a fibre fit: the lattice's weights (the fit's cell: every family 1/E of the unit
+** weights, fibre_fit.c) and kappa, the lattice's own keys for them refused. */
+static cf_status fit_lattice(ctx *c, json_t *root, cf_scene *sc)
+{
+    static const char *const own[] = {"weights", "calibration", "diagonals", "diagonal_weight",
+                                      "volume_modulus_MPa", "poisson_ratio"};
+    json_t *lt = json_object_get(root, "lattice");
+    for (size_t k = 0; lt && k < sizeof own / sizeof own[0]; k++)
+        if (json_object_get(lt, own[k]))
+            return cf_error_set(c->err, CF_E_DATA, "%s: key 'lattice.%s': the fibre fit of "
+                                "'fibres.fit' gives the lattice's weights and volume term",
+                                c->name, own[k]);
+    const double u[CF_FAMILY_COUNT] = {1, 1, 1};
+    const double E = cf_cubic_moduli_of(u).E;
+    cf_lattice_config *L = &sc->cfg.lattice;
+    for (int k = 0; k < CF_FAMILY_COUNT; k++)
+        L->weight[k] = u[k] / E;
+    L->calibration = CF_CAL_CUSTOM;
+    L->volume_modulus_MPa = sc->fibre_fit_kappa_MPa;
+    return CF_OK;
+}
+
 cf_status cf_scene_fibres(ctx *c, json_t *root, cf_scene *sc)
 {
     json_t *fs = json_object_get(root, "fibres");
+    if (sc->fibre_fit)
+        return sc->has_body ? cf_error_set(c->err, CF_E_DATA, "%s: key 'fibres': a tissue body "
+                                           "does not take a fibre fit here", c->name)
+                            : fit_lattice(c, root, sc);
     sc->nfibres = 0;
     if (!fs)
         return CF_OK;

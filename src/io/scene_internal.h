@@ -64,7 +64,15 @@ cf_status cf_scene_group_spring(ctx *c, json_t *sp, const char *where, cf_scene_
 ** density finite in (0, 1e6], the spring a valid law; every refusal names the key and the value.
 ** Shared by the lattice's "fibres" and a body's. */
 cf_status cf_scene_fibre_entry(ctx *c, json_t *e, const char *where, cf_scene_fibre *f);
-/* "fibres" of a lattice scene's root (after "groups"): 1 to CF_FIBRE_MAX entries. */
+/* "fibres": {"fit": FILE, "cross_axis": "s" | "n"} of root (before the spring; nothing, and
+** sc->fibre_fit 0, when "fibres" is not an object): the fit file's fibre lattice of that cross
+** axis (cf_fitfile_load_fibre) gives the scene's spring (its matrix's canonical member) and its
+** fibre groups (density 1, along x, y, z for f, s, n); "spring" or "spring_extension" beside it
+** refused. */
+cf_status cf_scene_fibre_fit(ctx *c, json_t *root, cf_scene *sc);
+/* "fibres" of a lattice scene's root (after "groups"): 1 to CF_FIBRE_MAX entries; after a fibre
+** fit (cf_scene_fibre_fit) the lattice's weights and kappa, the fit's (the lattice's own weight
+** and volume keys refused beside it). */
 cf_status cf_scene_fibres(ctx *c, json_t *root, cf_scene *sc);
 
 #endif

@@ -78,6 +78,9 @@ typedef struct cf_scene {
     cf_scene_group groups[CF_SCENE_MAX_GROUPS];
     size_t nfibres;             /* "fibres": fibre groups of a lattice (0: none) */
     cf_scene_fibre fibres[CF_FIBRE_MAX];
+    int fibre_fit;              /* 1: "fibres" names a fibre fit file, whose matrix is the spring
+                                   and whose groups, weights and kappa the lattice's */
+    double fibre_fit_kappa_MPa; /* that fit's volume modulus, MPa */
     cf_law_method method;       /* law evaluator */
     size_t table_intervals;     /* for CF_LAW_TABLE */
     cf_msm_config cfg;          /* lattice and solver settings */

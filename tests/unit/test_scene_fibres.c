@@ -8,13 +8,19 @@
 **  - `conifit simulate`'s run (cf_pipeline_simulate) of a 3 x 3 x 3 lattice with a volume term and
 **    a fibre group along z, stretched along z by 10 %, reports at every sample the homogenised
 **    cell's uniaxial stress along z with the same group (1e-9 relative), and without the fibre
-**    group a stress at least 1.3 times smaller in magnitude; the run is stable throughout.
+**    group a stress at least 1.3 times smaller in magnitude; the run is stable throughout;
+**  - a scene naming a fibre fit file ("fibres": {"fit", "cross_axis"}) takes the fit's matrix
+**    spring, its groups (along x, y, z for f, s, n), weights and kappa: stretched 10 % along n it
+**    reports the fit's own homogenised cell (fibre_fit.c's model) to 1e-9 relative; the other
+**    cross axis, a missing fit file, a spring or lattice weight beside it are refused naming
+**    the key.
 */
 #include "testutil.h"
 
 #include <string.h>
 
 #include "export/export.h"
+#include "fit/fibre_fit.h"
 #include "io/scene.h"
 #include "model/cell.h"
 #include "pipeline/simulate.h"
@@ -52,7 +58,7 @@ static void bad_fibres_are_refused_naming_the_key(void **state)
          "'fibres[0].dir'"},
         {"[{\"axis\": [0, 0, 1], \"density\": 1, \"spring\": " FSPRING "}, 3]", "'fibres[1]'"},
         {"[]", "'fibres'"},
-        {"{\"axis\": [0, 0, 1]}", "'fibres'"},
+        {"{\"axis\": [0, 0, 1]}", "'fibres.axis'"}, /* an object is a fibre fit's */
         {"[{\"axis\": [0, 0, 1], \"density\": 1, \"spring\": " FSPRING "},"
          " {\"axis\": [0, 0, 1], \"density\": 1, \"spring\": " FSPRING "},"
          " {\"axis\": [0, 0, 1], \"density\": 1, \"spring\": " FSPRING "},"
@@ -164,12 +170,107 @@ static void stretched_along_the_fibre_the_lattice_is_the_cell(void **state)
     cf_scene_free(&bare);
 }
 
+TU_SCRATCH_GROUP("scenefibres")
+
+/* A joint fit file's fibre lattice of cross axis n only: matrix, f and n groups, kappa. */
+static const char *const fibre_fit_json =
+    "{\"fibre_lattice\": [{\"model\": \"fibre-lattice\", \"cross_axis\": \"n\",\n"
+    " \"matrix\": {\"rho\": 0.63, \"solid_strain\": 0.48, \"stress_scale_kPa\": 2.7},\n"
+    " \"fibre_groups\": [{\"axis\": \"f\", \"rho\": 0.3, \"solid_strain\": 0.2, "
+    "\"stress_scale_kPa\": 50},\n"
+    "  {\"axis\": \"n\", \"rho\": 0.35, \"solid_strain\": 0.22, \"stress_scale_kPa\": 30}],\n"
+    " \"volume_modulus_kPa\": 0.6}]}\n";
+
+/* Parses the scene text with "fibres" = fibres (and more root keys), path of the fit file in
+** place of FIT. Returns its status, the message in err. */
+static cf_status parse_fit_scene(const char *fibres, const char *more, cf_scene *sc,
+                                 cf_error *err)
+{
+    char json[2048];
+    snprintf(json, sizeof json,
+             "{\"lattice\": {\"nx\": 3, \"ny\": 3, \"nz\": 3}, " STRETCH ", \"fibres\": %s%s}",
+             fibres, more);
+    return cf_scene_parse(json, "s.json", sc, err);
+}
+
+static void a_fibre_fit_file_gives_the_whole_lattice(void **state)
+{
+    (void)state;
+    char fit[512], fibres[700];
+    snprintf(fit, sizeof fit, "%s/fibre.json", dir);
+    assert_int_equal(tu_write_bytes(fit, fibre_fit_json, strlen(fibre_fit_json)), 0);
+    snprintf(fibres, sizeof fibres, "{\"fit\": \"%s\", \"cross_axis\": \"n\"}", fit);
+    cf_scene sc;
+    cf_error err = {0};
+    if (parse_fit_scene(fibres, "", &sc, &err) != CF_OK)
+        fail_msg("%s", err.msg);
+    assert_int_equal(sc.nfibres, 2);
+    assert_true(sc.fibres[0].axis[0] == 1 && sc.fibres[1].axis[2] == 1);
+    assert_true(fabs(sc.cfg.lattice.volume_modulus_MPa - 0.6e-3) < 1e-18);
+    cf_sim_run run;
+    run_scene(&sc, &run);
+    /* the fit's own model */
+    cf_fibre_fit f = {.groups = "fn", .ngroups = 2, .cross = 'n', .kappa_MPa = 0.6e-3};
+    f.matrix = (cf_ident){.rho = 0.63, .solid = 0.48, .scale = 2.7e-3};
+    f.fibre[0] = (cf_ident){.rho = 0.3, .solid = 0.2, .scale = 50e-3};
+    f.fibre[1] = (cf_ident){.rho = 0.35, .solid = 0.22, .scale = 30e-3};
+    cf_fibre_model m;
+    assert_int_equal(cf_fibre_model_init(&m, &f, &err), CF_OK);
+    const cf_cell_load ld = {CF_MODE_UNIAXIAL, {2, 0}, 0};
+    for (size_t k = 1; k < run.count; k++) {
+        const cf_msm_sample *s = &run.samples[k];
+        cf_cell_state cs;
+        assert_true(s->neg_pivots == 0);
+        if (cf_cell_load_state(&m.cell, &ld, -s->strain, &cs, &err) != CF_OK)
+            fail_msg("%s", err.msg);
+        const double want = -cs.P_MPa[2][2];
+        if (!(fabs(s->stress_MPa - want) <= 1e-9 * fabs(want)))
+            fail_msg("sample %zu, strain %g: the scene's lattice %.17g MPa, the fit's cell %.17g "
+                     "MPa", k, s->strain, s->stress_MPa, want);
+    }
+    cf_fibre_model_free(&m);
+    cf_sim_run_free(&run);
+    cf_scene_free(&sc);
+    /* refusals, each naming its key */
+    struct {
+        const char *fibres, *more, *must;
+    } bad[] = {
+        {"{\"fit\": \"FIT\", \"cross_axis\": \"s\"}", "", "cross_axis 's'"},
+        {"{\"fit\": \"FIT\", \"cross_axis\": \"x\"}", "", "'fibres.cross_axis'"},
+        {"{\"fit\": \"FIT\"}", "", "'fibres.cross_axis'"},
+        {"{\"fit\": \"FIT\", \"cross_axis\": \"n\", \"kappa\": 1}", "", "'fibres.kappa'"},
+        {"{\"fit\": \"FIT\", \"cross_axis\": \"n\"}", ", " SPRING, "key 'spring'"},
+        {"{\"fit\": \"FIT.missing\", \"cross_axis\": \"n\"}", "", "'fibres.fit'"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        char fb[700];
+        const char *at = strstr(bad[i].fibres, "FIT");
+        snprintf(fb, sizeof fb, "%.*s%s%s", (int)(at - bad[i].fibres), bad[i].fibres, fit,
+                 at + 3);
+        cf_error e = {0};
+        cf_scene s2;
+        const cf_status st = parse_fit_scene(fb, bad[i].more, &s2, &e);
+        if (st == CF_OK)
+            cf_scene_free(&s2);
+        if (st == CF_OK || !strstr(e.msg, bad[i].must))
+            fail_msg("case %zu: status %d, '%s' (expected '%s')", i, (int)st, e.msg, bad[i].must);
+    }
+    /* a lattice weight beside the fit */
+    cf_error e = {0};
+    char json[1024];
+    snprintf(json, sizeof json, "{\"lattice\": {\"nx\": 3, \"poisson_ratio\": 0.3}, " STRETCH
+             ", \"fibres\": %s}", fibres);
+    assert_int_equal(cf_scene_parse(json, "s.json", &sc, &e), CF_E_DATA);
+    assert_non_null(strstr(e.msg, "'lattice.poisson_ratio'"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(bad_fibres_are_refused_naming_the_key),
         cmocka_unit_test(a_good_entry_is_kept_and_exports_refuse_it),
         cmocka_unit_test(stretched_along_the_fibre_the_lattice_is_the_cell),
+        cmocka_unit_test(a_fibre_fit_file_gives_the_whole_lattice),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return cmocka_run_group_tests(tests, setup, teardown);
 }
