@@ -269,13 +269,10 @@ static cf_status h_residual(void *ctx, double *r, cf_error *err)
     return CF_OK;
 }
 
+/* A direction's held components zeroed, as a residual's are. */
 static void h_project(void *ctx, double *dx)
 {
-    const cf_body *b = ((haptic_sys *)ctx)->b;
-    for (size_t i = 0; i < b->nn; i++)
-        for (int a = 0; a < 3; a++)
-            if ((b->fix[i] >> a) & 1)
-                dx[3 * i + (size_t)a] = 0;
+    cf_body_apply_fixed(((haptic_sys *)ctx)->b, NULL, dx);
 }
 
 static void h_save(void *ctx)
