@@ -1,8 +1,9 @@
 /*
 ** Tissue bodies (body.h): the probe loop at haptic rate, chord iterations on the factored
-** contact-free tangent corrected for the nodes in contact by Woodbury's identity. The tangent is
-** factored and solved through the linear solver (linsolve.h), on its own solver object with the
-** condensed pattern.
+** contact-free tangent corrected for the nodes in contact by Woodbury's identity. The body is a
+** mechanical system (mech.h) of its own hooks, iterated by the Newton driver in chord-only mode
+** for a fixed count; the tangent is factored and solved through the linear solver (linsolve.h),
+** the driver's, with the condensed pattern.
 */
 #include <math.h>
 #include <stdlib.h>
@@ -33,7 +34,7 @@ static cf_status haptic_columns(body_work *w, size_t nn, size_t i, const double 
     for (int a = 0; a < 3; a++) {
         memset(w->hrhs, 0, n * sizeof *w->hrhs);
         w->hrhs[3 * i + (size_t)a] = 1;
-        if ((st = cf_linsolve_solve(w->hls, w->hrhs, col + (size_t)a * n, err)) != CF_OK)
+        if ((st = cf_linsolve_solve(w->hmech.ls, w->hrhs, col + (size_t)a * n, err)) != CF_OK)
             return st;
     }
     w->slot[i] = (uint32_t)++w->nslot;
@@ -45,11 +46,11 @@ static cf_status haptic_columns(body_work *w, size_t nn, size_t i, const double 
 ** column sqrt(kp) n_i (at node i's components, held ones zero) per node in contact. m nodes in
 ** list[], their normals in nv[3 m]; M is m x m work space, rhs m. */
 static cf_status haptic_solve(cf_body *b, body_work *w, double kp, const size_t *list,
-                              const double *nv, size_t m, double *M, double *rhs, double *dx,
-                              cf_error *err)
+                              const double *nv, size_t m, double *M, double *rhs, const double *g,
+                              double *dx, cf_error *err)
 {
     const size_t n = 3 * b->nn;
-    cf_status st = cf_linsolve_solve(w->hls, w->g, dx, err);
+    cf_status st = cf_linsolve_solve(w->hmech.ls, g, dx, err);
     if (st != CF_OK || m == 0)
         return st;
     const double sk = sqrt(kp);
@@ -118,8 +119,9 @@ static cf_status haptic_solve(cf_body *b, body_work *w, double kp, const size_t 
 ** pattern's order), its held components' rows and columns those of the identity. */
 static void haptic_tangent(void *ctx, double *v)
 {
-    body_work *w = ctx;
-    cf_body *b = w->sys.b;
+    haptic_sys *h = ctx;
+    body_work *w = h->w;
+    cf_body *b = h->b;
     pattern *P = &w->P;
     double *keep = P->val;
     P->val = v;
@@ -129,39 +131,6 @@ static void haptic_tangent(void *ctx, double *v)
             v[k] = NAN;
     cf_body_apply_fixed(b, P, w->gt);
     P->val = keep;
-}
-
-/* The loop's workspace on first use, and the contact-free tangent where the body is now,
-** factored once (until the body moves on without the loop). */
-static cf_status haptic_prepare(cf_body *b, body_work *w, cf_error *err)
-{
-    const size_t n = 3 * b->nn, nn = b->nn;
-    cf_status st;
-    if (!w->hls) {
-        w->hactive = calloc(nn, 1);
-        w->slot = calloc(nn, sizeof *w->slot);
-        w->hy = malloc(n * sizeof *w->hy);
-        w->hrhs = malloc(n * sizeof *w->hrhs);
-        w->hgi = malloc(n * sizeof *w->hgi);
-        w->hxg = malloc(n * sizeof *w->hxg);
-        if (!w->hactive || !w->slot || !w->hy || !w->hrhs || !w->hgi || !w->hxg)
-            return cf_error_set(err, CF_E_INTERNAL, "out of memory for the haptic loop");
-        for (size_t i = 0; i < n; i++)
-            w->hxg[i] = NAN; /* no internal forces kept yet */
-        if ((st = cf_linsolve_create(&w->hls, n, w->P.colptr, w->P.rowidx, haptic_tangent, w,
-                                     0, err)) != CF_OK)
-            return st;
-    }
-    if (!w->hfactored) {
-        /* the contact-free tangent where the body is now, factored once */
-        if ((st = cf_linsolve_factor(w->hls, err)) != CF_OK)
-            return st;
-        w->factored = 0; /* the Newton solver's factors were of the same values: refactor */
-        w->hfactored = 1;
-        w->nslot = 0;
-        memset(w->slot, 0, nn * sizeof *w->slot);
-    }
-    return CF_OK;
 }
 
 /* Doubles the contact set's room (list, normals, the Schur matrix and its right side); -1 when
@@ -194,40 +163,39 @@ static void contact_normal(const cf_body *b, const cf_probe *probe, const double
             nv[a] = 0;
 }
 
-/* The contact set where the body is at the update's start (into list[*m], normals nv, flags
-** w->hactive): nodes inside the probe, and nodes of the last set still pushed. */
-static cf_status contact_set(cf_body *b, body_work *w, const cf_probe *probe, const double *c,
-                             size_t *cap, size_t **list, double **nv, double **M, double **rhs,
-                             size_t *m, cf_error *err)
+/* The contact set where the body is at the update's start (into h->list[h->m], normals h->nv,
+** flags w->hactive): nodes inside the probe, and nodes of the last set still pushed. */
+static cf_status contact_set(cf_body *b, body_work *w, haptic_sys *h, cf_error *err)
 {
     for (size_t i = 0; i < b->nn; i++) {
         double nrm[3];
         uint8_t in = w->touch[i] && b->fix[i] != CF_BODY_FIX_ALL &&
-                     (cf_body_penetration(probe, c, b->x + 3 * i, nrm, 0) > 0 ||
-                      (w->hactive[i] && cf_body_penetration(probe, c, b->x + 3 * i, nrm, 1) > 0));
+                     (cf_body_penetration(h->probe, h->c, b->x + 3 * i, nrm, 0) > 0 ||
+                      (w->hactive[i] &&
+                       cf_body_penetration(h->probe, h->c, b->x + 3 * i, nrm, 1) > 0));
         w->hactive[i] = in;
         if (!in)
             continue;
-        if (*m == *cap && grow(cap, list, nv, M, rhs) != 0)
+        if (h->m == h->cap && grow(&h->cap, &h->list, &h->nv, &h->M, &h->rhs) != 0)
             return cf_error_set(err, CF_E_INTERNAL, "out of memory for the haptic loop");
-        (*list)[*m] = i;
-        contact_normal(b, probe, c, i, *nv + 3 * *m);
-        (*m)++;
+        h->list[h->m] = i;
+        contact_normal(b, h->probe, h->c, i, h->nv + 3 * h->m);
+        h->m++;
     }
     return CF_OK;
 }
 
-/* The residual w->g at the body's positions with the probe at c: the internal forces kept from the
+/* The residual g at the body's positions with the probe at c: the internal forces kept from the
 ** end of the last update when the body has not moved since (w->hxg), else assembled, then the
 ** contact of the nodes in w->hactive. Returns the contact force along the probe's direction (NAN
 ** when memory runs out). */
 static double residual(cf_body *b, body_work *w, const cf_probe *probe, const double *c,
-                       double kp, int *contacts)
+                       double kp, double *g, int *contacts)
 {
     const size_t n = 3 * b->nn;
     if (memcmp(w->hxg, b->x, n * sizeof *b->x) != 0)
-        return cf_body_assemble(b, b->x, probe, c, kp, w->hactive, w->g, NULL, contacts);
-    memcpy(w->g, w->hgi, n * sizeof *w->g);
+        return cf_body_assemble(b, b->x, probe, c, kp, w->hactive, g, NULL, contacts);
+    memcpy(g, w->hgi, n * sizeof *g);
     double force = 0;
     int nc = 0;
     for (size_t i = 0; i < b->nn; i++) {
@@ -236,7 +204,7 @@ static double residual(cf_body *b, body_work *w, const cf_probe *probe, const do
         double nrm[3], d = cf_body_penetration(probe, c, b->x + 3 * i, nrm, 1);
         nc++;
         for (int a = 0; a < 3; a++)
-            w->g[3 * i + (size_t)a] -= kp * d * nrm[a];
+            g[3 * i + (size_t)a] -= kp * d * nrm[a];
         force += kp * d * (nrm[0] * probe->dir[0] + nrm[1] * probe->dir[1] + nrm[2] * probe->dir[2]);
     }
     *contacts = nc;
@@ -268,34 +236,127 @@ static double reaction(cf_body *b, body_work *w, const cf_probe *probe, const do
     return force;
 }
 
-/* A step -alpha dx from the body's positions, alpha halved from 1 until no tetrahedron inverts
-** and no spring goes solid; 0 when none of 40 does. */
-static int admissible_step(cf_body *b, body_work *w)
+/* The probe's force from the body's side where the last step left it (h->force), when a step was
+** taken since the last residual. */
+static cf_status read_reaction(haptic_sys *h, cf_error *err)
 {
+    if (!h->stepped)
+        return CF_OK;
+    h->stepped = 0;
+    h->force = reaction(h->b, h->w, h->probe, h->c, h->kp, h->list, h->m);
+    return isnan(h->force) ? cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's forces")
+                           : CF_OK;
+}
+
+/* The hooks of the haptic system (mech.h). The residual: first the force from the body's side
+** where the last step left it (its internal forces then serve this residual), then the contact
+** set's normals renewed (after the update's first residual), the residual with the contact's
+** force (h->force), the supports' reactions kept and the held components zeroed. */
+static cf_status h_residual(void *ctx, double *r, cf_error *err)
+{
+    haptic_sys *h = ctx;
+    cf_status st = read_reaction(h, err);
+    if (st != CF_OK)
+        return st;
+    for (size_t k = 0; h->evaluated && k < h->m; k++)
+        contact_normal(h->b, h->probe, h->c, h->list[k], h->nv + 3 * k);
+    h->evaluated = 1;
+    h->force = residual(h->b, h->w, h->probe, h->c, h->kp, r, &h->contacts);
+    if (isnan(h->force))
+        return cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's forces");
+    cf_body_keep_reaction(h->b, r);
+    cf_body_apply_fixed(h->b, NULL, r);
+    return CF_OK;
+}
+
+/* A direction's held components zeroed, as a residual's are. */
+static void h_project(void *ctx, double *dx)
+{
+    cf_body_apply_fixed(((haptic_sys *)ctx)->b, NULL, dx);
+}
+
+static void h_save(void *ctx)
+{
+    haptic_sys *h = ctx;
+    memcpy(h->w->xt, h->b->x, 3 * h->b->nn * sizeof *h->w->xt);
+}
+
+/* The state origin - alpha dx; admissible when no tetrahedron inverts and no spring goes solid
+** (the driver takes the first, halving alpha from 1). */
+static int h_trial(void *ctx, const double *dx, double alpha)
+{
+    haptic_sys *h = ctx;
+    cf_body *b = h->b;
     const size_t n = 3 * b->nn;
-    for (size_t i = 0; i < b->nn; i++)
-        for (int a = 0; a < 3; a++)
-            if ((b->fix[i] >> a) & 1)
-                w->dx[3 * i + (size_t)a] = 0;
-    double alpha = 2;
-    for (int bt = 0; bt < 40; bt++) {
-        alpha *= 0.5;
-        for (size_t i = 0; i < n; i++)
-            w->xt[i] = b->x[i] - alpha * w->dx[i];
-        if (cf_body_admissible(b, w->xt)) {
-            memcpy(b->x, w->xt, n * sizeof *w->xt);
-            return 1;
-        }
+    if (alpha == 0) {
+        memcpy(b->x, h->w->xt, n * sizeof *b->x);
+        return 1;
     }
-    return 0;
+    for (size_t i = 0; i < n; i++)
+        b->x[i] = h->w->xt[i] - alpha * dx[i];
+    const int ok = cf_body_admissible(b, b->x);
+    h->stepped |= ok;
+    return ok;
+}
+
+/* The direction: the contact-free tangent's factors, corrected for the contact set. */
+static cf_status h_chord(void *ctx, const double *r, double *dx, cf_error *err)
+{
+    haptic_sys *h = ctx;
+    return haptic_solve(h->b, h->w, h->kp, h->list, h->nv, h->m, h->M, h->rhs, r, dx, err);
+}
+
+static const cf_mech_ops haptic_ops = {h_residual, haptic_tangent, h_project, h_save,
+                                       h_trial,    NULL,           h_chord};
+
+/* The loop's workspace and system on first use, and the contact-free tangent where the body is
+** now, factored once (until the body moves on without the loop). */
+static cf_status haptic_prepare(cf_body *b, body_work *w, cf_error *err)
+{
+    const size_t n = 3 * b->nn, nn = b->nn;
+    cf_status st;
+    if (!w->hactive) {
+        w->hactive = calloc(nn, 1);
+        w->slot = calloc(nn, sizeof *w->slot);
+        w->hrhs = malloc(n * sizeof *w->hrhs);
+        w->hgi = malloc(n * sizeof *w->hgi);
+        w->hxg = malloc(n * sizeof *w->hxg);
+        if (!w->hactive || !w->slot || !w->hrhs || !w->hgi || !w->hxg)
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory for the haptic loop");
+        for (size_t i = 0; i < n; i++)
+            w->hxg[i] = NAN; /* no internal forces kept yet */
+    }
+    if (!w->hmech.ls) {
+        w->hsys.b = b;
+        w->hsys.w = w;
+        if ((st = cf_mech_create(&w->hmech, n, 0, &haptic_ops, &w->hsys, w->P.colptr,
+                                 w->P.rowidx, 0, err)) != CF_OK)
+            return st;
+        /* a fixed count of chord steps on the factors taken here, each halved from full length
+        ** until admissible (40 halvings), none judged, the last state read by the loop itself */
+        w->hmech.chord_only = 1;
+        w->hmech.last_unevaluated = 1;
+        w->hmech.step_tol = 0;
+        w->hmech.decrease = 0;
+        w->hmech.reuse_halvings = 40;
+        w->hmech.min_alpha = 0x1p-39;
+    }
+    if (!w->hfactored) {
+        /* the contact-free tangent where the body is now, factored once */
+        if ((st = cf_linsolve_factor(w->hmech.ls, err)) != CF_OK)
+            return st;
+        w->factored = 0; /* the Newton solver's factors were of the same values: refactor */
+        w->hfactored = 1;
+        w->nslot = 0;
+        memset(w->slot, 0, nn * sizeof *w->slot);
+    }
+    return CF_OK;
 }
 
 cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm,
                               double penalty_N_per_mm, int max_iters, cf_body_step *out,
                               cf_error *err)
 {
-    const size_t n = 3 * b->nn;
-    const double kp = penalty_N_per_mm > 0 ? penalty_N_per_mm : cf_body_penalty(b);
     double c[3];
     for (int k = 0; k < 3; k++)
         c[k] = probe->center_mm[k] + depth_mm * probe->dir[k];
@@ -305,55 +366,36 @@ cf_status cf_body_haptic_step(cf_body *b, const cf_probe *probe, double depth_mm
         return st;
     if ((st = haptic_prepare(b, w, err)) != CF_OK)
         return st;
-    size_t *list = NULL, cap = 0;
-    double *nv = NULL, *M = NULL, *rhs = NULL;
-    const double fscale = b->E_MPa * b->mean_edge_mm * b->mean_edge_mm;
-    int it = 0, contacts = 0;
-    double force = 0;
-    size_t m = 0;
+    haptic_sys *h = &w->hsys;
+    *h = (haptic_sys){b, w, probe, c, penalty_N_per_mm > 0 ? penalty_N_per_mm : cf_body_penalty(b),
+                      h->list, h->nv, h->M, h->rhs, 0, h->cap, 0, 0, 0, 0};
+    cf_mech_result res = {0};
     /* the contact set where the body is at the update's start, held through the update's
     ** iterations (a node the step leaves just outside a curved probe, by its slip along the
     ** surface, would otherwise drop out and spring back every other iteration), its normals
-    ** renewed */
-    if ((st = contact_set(b, w, probe, c, &cap, &list, &nv, &M, &rhs, &m, err)) != CF_OK)
-        goto end;
-    for (it = 0; it < max_iters; it++) {
-        for (size_t k = 0; it > 0 && k < m; k++)
-            contact_normal(b, probe, c, list[k], nv + 3 * k);
-        force = residual(b, w, probe, c, kp, &contacts);
-        if (isnan(force)) {
-            st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's forces");
-            goto end;
-        }
-        cf_body_keep_reaction(b, w->g);
-        cf_body_apply_fixed(b, NULL, w->g);
-        if (body_norm_inf(w->g, n) <= 1e-8 * fscale)
-            break;
-        if ((st = haptic_solve(b, w, kp, list, nv, m, M, rhs, w->dx, err)) != CF_OK)
-            goto end;
-        if (!admissible_step(b, w)) {
+    ** renewed; then max_iters directions on the kept factors, ending early where the residual
+    ** is below 1e-8 of the body's force scale */
+    if ((st = contact_set(b, w, h, err)) == CF_OK && max_iters > 0) {
+        const double fscale = b->E_MPa * b->mean_edge_mm * b->mean_edge_mm;
+        w->hmech.max_iter = max_iters;
+        w->hmech.tol = 1e-8 * fscale;
+        st = cf_mech_newton(&w->hmech, w->g, w->dx, &res, err);
+        if (st == CF_OK && res.inadmissible)
             st = cf_error_set(err, CF_E_NOCONV,
                               "body: at probe depth %g mm every haptic step would invert a "
                               "tetrahedron or take a spring to solid",
                               depth_mm);
-            goto end;
-        }
-        /* the force where the step left the body, from the body's side; its internal forces
-        ** serve the next iteration's residual */
-        if (isnan(force = reaction(b, w, probe, c, kp, list, m))) {
-            st = cf_error_set(err, CF_E_INTERNAL, "out of memory for the body's forces");
-            goto end;
-        }
+        if (st == CF_OK) /* the force where the last step left the body, from its side */
+            st = read_reaction(h, err);
     }
+    h->probe = NULL; /* c is this call's */
+    h->c = NULL;
+    if (st != CF_OK)
+        return st;
     out->depth_mm = depth_mm;
-    out->force_N = force;
-    out->contacts = contacts;
-    out->newton_iters = it;
+    out->force_N = h->force;
+    out->contacts = h->contacts;
+    out->newton_iters = res.iters;
     out->min_J = cf_body_measure(b, NULL, &out->max_u_over_travel);
-end:
-    free(list);
-    free(nv);
-    free(M);
-    free(rhs);
-    return st;
+    return CF_OK;
 }

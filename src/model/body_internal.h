@@ -93,6 +93,25 @@ typedef struct body_sys {
     int contacts;
 } body_sys;
 
+/* The body as the haptic loop's mechanical system (body_haptic.c) during one update: the probe at
+** c with penalty kp on the contact set held through the update (m nodes in list[], their normals
+** nv[3 m]; M and rhs the Woodbury system's room, all of cap entries, kept between updates), and
+** the force read last (from the residual's contact, or from the body's side after a step). */
+typedef struct haptic_sys {
+    cf_body *b;
+    struct body_work *w;
+    const cf_probe *probe;
+    const double *c;
+    double kp;
+    size_t *list;
+    double *nv, *M, *rhs;
+    size_t m, cap;
+    double force;       /* N, along the probe's direction */
+    int contacts;
+    int evaluated;      /* a residual evaluated in this update (the next renews the normals) */
+    int stepped;        /* a step taken since the last residual (its reaction not read yet) */
+} haptic_sys;
+
 /* What the solves of a body keep between calls: the pattern, the body as a mechanical system with
 ** its linear solver (mech.h, linsolve.h: the analysed factorisation and the last factors, reused as
 ** chord steps while they converge fast enough), and work vectors. */
@@ -114,16 +133,18 @@ typedef struct body_work {
     long neg_last;      /* negative eigenvalues of the static solve's last fresh tangent, -1 none */
     int factored;       /* the linear solver holds the factors of a tangent of this body (the
                            haptic loop clears it) */
-    /* the haptic loop (cf_body_haptic_step): a linear solver on the condensed pattern P holding
+    /* the haptic loop (cf_body_haptic_step): the body as its mechanical system, solved by the
+    ** Newton driver in chord-only mode on a linear solver with the condensed pattern P holding
     ** the factors of the tangent without contact, taken once, and per node that has touched the
     ** probe the three columns of its inverse at that node (slot[i] + 1 indexes Z, 0 = none yet) */
-    cf_linsolve *hls;
+    haptic_sys hsys;
+    cf_mech hmech;      /* hmech.ls: that linear solver (NULL before the loop's first use) */
     int hfactored;
     uint8_t *hactive;
     uint32_t *slot;
     double *Z;          /* 9 nn per slot: columns 3 nn each */
     size_t nslot, capslot;
-    double *hy, *hrhs;
+    double *hrhs;
     double *hgi, *hxg;  /* 3 nn: the internal forces (no contact) where the last update left the
                            body, and those positions (the next update starts from them when the
                            body has not moved since) */

@@ -65,18 +65,21 @@ static int sys_trial(void *ctx, const double *dx, double alpha)
 }
 
 static const cf_mech_ops body_ops = {sys_residual, sys_tangent, sys_project, sys_save, sys_trial,
-                                     NULL};
+                                     NULL, NULL};
 
 void cf_body_work_free(body_work *w)
 {
     if (!w)
         return;
     cf_mech_free(&w->mech);
-    cf_linsolve_free(w->hls); /* the haptic loop's solver (body_haptic.c) */
+    cf_mech_free(&w->hmech); /* the haptic loop's system (body_haptic.c) */
+    free(w->hsys.list);
+    free(w->hsys.nv);
+    free(w->hsys.M);
+    free(w->hsys.rhs);
     free(w->hactive);
     free(w->slot);
     free(w->Z);
-    free(w->hy);
     free(w->hgi);
     free(w->hxg);
     free(w->hrhs);

@@ -41,6 +41,11 @@ typedef struct cf_mech_ops {
     ** largest component at which that state is converged; *may_end (preset 1) set to 0 when the
     ** state may not end the iteration whatever its residual (a spring within rounding of solid). */
     double (*tolerance)(void *ctx, int *may_end);
+    /* A direction dx for r from factors the system keeps itself, corrected as it knows how (the
+    ** haptic loop: the contact-free tangent's factors, its contact set by Woodbury's identity);
+    ** NULL: the driver's chord step on its linear solver's last factors. Called only when the
+    ** settings say chord_only. An error ends the call. */
+    cf_status (*chord)(void *ctx, const double *r, double *dx, cf_error *err);
 } cf_mech_ops;
 
 /* The system and its solver settings. A direction comes from one of three stages: a fresh
@@ -83,6 +88,14 @@ typedef struct cf_mech {
     int max_halvings;    /* halvings of a fresh tangent's step looking for an acceptable state */
     int reuse_halvings;  /* halvings of a step from kept factors before it is given up */
     double min_alpha;    /* a step shortened below this fails */
+    int chord_only;      /* 1: every direction from kept factors (ops->chord when given), none
+                            judged, no tangent taken afresh: the factors the caller made stand
+                            for the tangent of the whole call; a step with no admissible state
+                            ends the call (res->inadmissible, the state at its origin) */
+    int last_unevaluated;/* 1: a fixed iteration count: the state the max_iter-th direction leads
+                            to is not evaluated (the caller reads there what it needs: the haptic
+                            loop's force from the body's side); res->rnorm then the residual's
+                            before that step */
     /* Between calls, the stage of the next direction: fresh 1 when it must take the tangent
     ** afresh (the caller sets it when the system changed, e.g. a contact set), krylov 1 when
     ** chord steps stalled on the kept factors; the driver keeps them as it ends. */
@@ -94,7 +107,8 @@ typedef struct cf_mech {
 typedef struct cf_mech_result {
     int conv;            /* 1: converged (residual within tolerance, or a full step within
                             step_tol) */
-    int inadmissible;    /* 1: ended because a fresh tangent's step found no acceptable state */
+    int inadmissible;    /* 1: ended because a fresh tangent's step (any step under chord_only)
+                            found no acceptable state */
     int iters;           /* directions sought (one refused by stale factors counts too) */
     int reused;          /* of them, directions from kept factors (chord and Krylov steps) */
     int tangents;        /* fresh tangents assembled and solved */

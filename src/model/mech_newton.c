@@ -78,6 +78,8 @@ static cf_status evaluate(const cf_mech *m, double *r, double *rn, double *tol, 
 /* The stage of the next direction. */
 static int stage_of(const cf_mech *m)
 {
+    if (m->chord_only)
+        return STAGE_CHORD;
     if (m->fresh || !(m->chord_rate > 0) || !cf_linsolve_factored(m->ls))
         return STAGE_FRESH;
     return m->krylov ? STAGE_KRYLOV : STAGE_CHORD;
@@ -113,6 +115,12 @@ static cf_status direction(cf_mech *m, int stage, const double *r, double *dx, d
                            int *got, cf_mech_result *res, cf_error *err)
 {
     *got = 0;
+    if (stage == STAGE_CHORD && m->ops->chord) {
+        cf_status st = m->ops->chord(m->ctx, r, dx, err);
+        *got = st == CF_OK;
+        res->reused += *got;
+        return st;
+    }
     if (stage != STAGE_FRESH) {
         int fatal = 0;
         const int ok = stage == STAGE_KRYLOV
@@ -195,7 +203,7 @@ static cf_status newton_step(cf_mech *m, double *r, double *dx, double *rn, doub
     if (st != CF_OK)
         return st;
     if (alpha == 0) {
-        if (stage == STAGE_FRESH) {
+        if (stage == STAGE_FRESH || m->chord_only) {
             res->inadmissible = 1;
             *done = 1;
             return CF_OK;
@@ -208,9 +216,14 @@ static cf_status newton_step(cf_mech *m, double *r, double *dx, double *rn, doub
         *done = 1;
         return CF_OK;
     }
-    *last = (last_step){stage != STAGE_FRESH || m->judge_fresh, stage, alpha, rn0};
-    if (alpha < 1 && m->judge_fresh)
+    *last = (last_step){(stage != STAGE_FRESH || m->judge_fresh) && !m->chord_only, stage, alpha,
+                        rn0};
+    if (alpha < 1 && m->judge_fresh && !m->chord_only)
         m->fresh = 1; /* a shortened step: the tangent where it landed, converged there or not */
+    if (m->last_unevaluated && res->iters == m->max_iter) {
+        *done = 1; /* the fixed count reached: the caller reads the state */
+        return CF_OK;
+    }
     if (!evaluated)
         return evaluate(m, r, rn, tol, may_end, res, err);
     *tol = gauge(m, may_end);

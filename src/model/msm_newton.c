@@ -290,8 +290,8 @@ static double lat_tolerance(void *ctx, int *may_end)
     return s->cfg->newton_rtol * s->fs + s->floor_f;
 }
 
-static const cf_mech_ops lattice_ops = {lat_residual, cf_msm_tangent_fill, NULL,
-                                        lat_save,     lat_trial,           lat_tolerance};
+static const cf_mech_ops lattice_ops = {lat_residual, cf_msm_tangent_fill, NULL, lat_save,
+                                        lat_trial,    lat_tolerance,       NULL};
 
 /* The driver on the lattice's tangent, with the lattice's iteration, made at the first solve. */
 static cf_status lattice_mech(solver *s, cf_error *err)

@@ -11,7 +11,11 @@
 **    limit and the limit lies between its last stable and first unstable sample;
 **  - a body probed by a sphere, statically and then in an implicit dynamic step, is solved by
 **    calls of the same entry on another system (other hooks), its Newton iterations the sum of
-**    the calls', and its supports carry the probe's force.
+**    the calls', and its supports carry the probe's force;
+**  - the haptic loop's updates on that body are calls of the same entry on a third system (the
+**    haptic hooks), one call per update, every direction from the kept factors (no tangent
+**    factored by the driver), their iterations the updates', and at rest the loop's force is the
+**    static solve's.
 */
 #include "testutil.h"
 
@@ -21,7 +25,7 @@
 
 /* What the wrapped entries saw since the last reset. */
 typedef struct seen {
-    size_t calls, conv, iters, linear, inertia;
+    size_t calls, conv, iters, reused, tangents, linear, inertia;
     const cf_mech_ops *ops; /* the hooks of the first call */
     int mixed;              /* 1: a later call had other hooks */
 } seen;
@@ -53,6 +57,8 @@ cf_status __wrap_cf_mech_newton(cf_mech *m, double *r, double *dx, cf_mech_resul
     S.calls++;
     S.conv += st == CF_OK && res->conv;
     S.iters += (size_t)res->iters;
+    S.reused += (size_t)res->reused;
+    S.tangents += (size_t)res->tangents;
     S.linear += res->linear_solves;
     return st;
 }
@@ -139,6 +145,43 @@ static void lattice_through_the_driver(const cf_mech_ops **ops)
     cf_law_free(&law);
 }
 
+/* The haptic loop on body b (probed by pr, last at 1.05 mm): 40 updates of at most 3 chord
+** iterations at 1.1 mm, each one call of the driver with the haptic hooks, then a static solve
+** there. */
+static void haptic_through_the_driver(cf_body *b, const cf_probe *pr, const cf_mech_ops *lattice_ops,
+                                      const cf_mech_ops *body_ops)
+{
+    enum { UPDATES = 40 };
+    cf_error err = {0};
+    cf_body_step st;
+    size_t iters = 0;
+    S = (seen){0};
+    for (int k = 0; k < UPDATES; k++) {
+        if (cf_body_haptic_step(b, pr, 1.1, 0, 3, &st, &err) != CF_OK)
+            fail_msg("haptic update %d: %s", k, err.msg);
+        iters += (size_t)st.newton_iters;
+    }
+    assert_int_equal(S.calls, UPDATES);
+    assert_true(S.ops != lattice_ops && S.ops != body_ops && !S.mixed);
+    assert_int_equal(S.iters, iters);
+    assert_int_equal(S.reused, iters); /* every direction from the kept factors */
+    assert_int_equal(S.tangents, 0);
+    assert_int_equal(S.linear, 0);
+    /* updates ended both ways: converged, and at the fixed count (the last state read by the
+    ** loop, not the driver) */
+    assert_true(iters > 0 && S.conv > 0 && S.conv < UPDATES && st.contacts > 0 && st.force_N > 0);
+    const double haptic = st.force_N;
+    const size_t conv = S.conv;
+    S = (seen){0};
+    if (cf_body_solve(b, pr, 1.1, 0, &st, &err) != CF_OK)
+        fail_msg("static solve: %s", err.msg);
+    assert_true(S.ops == body_ops);
+    print_message("haptic loop: %d updates, %zu chord iterations (%zu converged updates), force "
+                  "%.9g N at 1.1 mm, static %.9g N (%.2g relative)\n",
+                  UPDATES, iters, conv, haptic, st.force_N, fabs(haptic / st.force_N - 1));
+    assert_close(haptic, st.force_N, 2e-4 * st.force_N);
+}
+
 /* A block of 4 x 4 x 4 cells of 5 mm held at its base, a sphere of radius 10 mm pressed 1 mm into
 ** its top in four static steps and 0.05 mm more in an implicit dynamic step. */
 static void body_through_the_driver(const cf_mech_ops *lattice_ops)
@@ -192,6 +235,7 @@ static void body_through_the_driver(const cf_mech_ops *lattice_ops)
         fail_msg("dynamic step: %s", err.msg);
     assert_true(S.calls > before && S.ops == body_ops && !S.mixed && st.force_N > 0);
     cf_body_motion_free(&mo);
+    haptic_through_the_driver(&b, &pr, lattice_ops, body_ops);
     cf_body_free(&b);
     cf_mesh_free(&m);
     cf_law_free(&law);
