@@ -306,6 +306,8 @@ cf_status cf_predict(const char *fit_path, const char *type, const cf_table *con
     }
     for (size_t k = 0; st == CF_OK && k < n; k++)
         r->tab[k].share = r->sum_terms > 0 && r->tab[k].ok ? r->tab[k].term / r->sum_terms : 0.0;
+    if (st == CF_OK && r->fit.joint)
+        st = cf_pf_predict(fit_path, tables, n, &r->fibre, err);
     return st;
 }
 
@@ -319,5 +321,6 @@ void cf_predict_free(cf_predict_result *r)
     }
     free(r->tab);
     r->tab = NULL;
+    cf_pf_free(&r->fibre);
     r->n = 0;
 }
