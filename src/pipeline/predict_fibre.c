@@ -231,32 +231,48 @@ static const char *model_name(const cf_pf_model *m)
                                     : "Holzapfel-Ogden TI";
 }
 
+/* One cross axis's block: a row per table, a column per model of that axis. */
+static void cross_block(FILE *o, const cf_pf_result *r, const cf_table *const *tables, char cross)
+{
+    int idx[CF_PF_MAX], n = 0;
+    for (int j = 0; j < r->n; j++)
+        if (r->m[j].cross == cross)
+            idx[n++] = j;
+    if (n == 0)
+        return;
+    fprintf(o, "  biaxial second direction along %c:\n    %-36s", cross, "table");
+    for (int j = 0; j < n; j++)
+        fprintf(o, " %-26s", model_name(&r->m[idx[j]]));
+    for (size_t k = 0; k < r->ntables; k++) {
+        char name[128];
+        cf_table_name(tables[k], name, sizeof name);
+        fprintf(o, "\n    %-36s", name);
+        for (int j = 0; j < n; j++) {
+            const cf_pf_model *m = &r->m[idx[j]];
+            char cell[64] = "not in the fibre frame";
+            if (r->ok[k])
+                snprintf(cell, sizeof cell, "%.4g %s (%.4g)",
+                         m->rmse_MPa[k] * tables[k]->y_to_file, tables[k]->y_unit, m->term[k]);
+            fprintf(o, " %-26s", cell);
+        }
+    }
+    fprintf(o, "\n    %-36s", "sum of the terms (-)");
+    for (int j = 0; j < n; j++)
+        fprintf(o, " %-26.4g", r->m[idx[j]].sum_terms);
+    fprintf(o, "\n    %-36s", "the fit's own objective (-)");
+    for (int j = 0; j < n; j++)
+        fprintf(o, " %-26.4g", r->m[idx[j]].fit_objective);
+    fprintf(o, "\n");
+}
+
 void cf_pf_text(FILE *o, const cf_pf_result *r, const cf_table *const *tables)
 {
     if (r->n == 0)
         return;
-    fprintf(o, "\nFibre-frame models of the fit file (each model at its biaxial cross-fibre axis; "
-               "RMSE in the table's unit, term (RMSE / RMS stress)^2):\n");
-    for (int c = 1; c >= 0; c--) {
-        const char cross = c ? 'n' : 's';
-        fprintf(o, "  biaxial second direction along %c:\n", cross);
-        for (int j = 0; j < r->n; j++) {
-            const cf_pf_model *m = &r->m[j];
-            if (m->cross != cross)
-                continue;
-            fprintf(o, "    %-21s", model_name(m));
-            for (size_t k = 0; k < r->ntables; k++) {
-                char name[128];
-                cf_table_name(tables[k], name, sizeof name);
-                if (!r->ok[k]) {
-                    fprintf(o, "%s %s not in the fibre frame", k ? ";" : "", name);
-                    continue;
-                }
-                fprintf(o, "%s %s %.4g %s (%.4g)", k ? ";" : "", name,
-                        m->rmse_MPa[k] * tables[k]->y_to_file, tables[k]->y_unit, m->term[k]);
-            }
-            fprintf(o, "; sum of terms %.4g (-) (the fit's own objective %.4g on its tables)\n",
-                    m->sum_terms, m->fit_objective);
-        }
-    }
+    fprintf(o, "\nFibre-frame models of the fit file, without refitting (each at its biaxial "
+               "cross-fibre axis; per table the RMSE in the table's unit and, in brackets, its "
+               "term (RMSE / RMS stress)^2; the fit's own objective is over the tables it was "
+               "fitted to):\n");
+    cross_block(o, r, tables, 'n');
+    cross_block(o, r, tables, 's');
 }
