@@ -134,9 +134,10 @@ static cf_status eval_table(cf_pf_model *m, const cf_fibre_model *cell, const cf
     for (size_t i = 0; i < t->count; i++) {
         double y = 0;
         if (m->kind == CF_PF_LATTICE) {
-            cf_status st = cf_fibre_row_stress(cell, t, i, axes, &y, err);
-            if (st != CF_OK)
-                return st;
+            if (cf_fibre_row_stress(cell, t, i, axes, &y, NULL) != CF_OK) {
+                m->failed_row[k] = i + 1;
+                return CF_OK;
+            }
         } else {
             y = cf_ho_row_stress(m->ho, t, i, axes);
         }
@@ -161,7 +162,8 @@ static cf_status eval_all(cf_pf_result *r, const cf_table *const *t, size_t n, c
         cf_pf_model *m = &r->m[j];
         m->rmse_MPa = calloc(n + 1, sizeof(double));
         m->term = calloc(n + 1, sizeof(double));
-        if (!m->rmse_MPa || !m->term)
+        m->failed_row = calloc(n + 1, sizeof(size_t));
+        if (!m->rmse_MPa || !m->term || !m->failed_row)
             return cf_error_set(err, CF_E_INTERNAL, "out of memory");
         cf_fibre_model cell;
         memset(&cell, 0, sizeof cell);
@@ -218,6 +220,7 @@ void cf_pf_free(cf_pf_result *r)
     for (int j = 0; j < r->n; j++) {
         free(r->m[j].rmse_MPa);
         free(r->m[j].term);
+        free(r->m[j].failed_row);
     }
     free(r->ok);
     free(r->rms_MPa);
@@ -250,7 +253,9 @@ static void cross_block(FILE *o, const cf_pf_result *r, const cf_table *const *t
         for (int j = 0; j < n; j++) {
             const cf_pf_model *m = &r->m[idx[j]];
             char cell[64] = "not in the fibre frame";
-            if (r->ok[k])
+            if (r->ok[k] && m->failed_row[k])
+                snprintf(cell, sizeof cell, "no cell state at row %zu", m->failed_row[k]);
+            else if (r->ok[k])
                 snprintf(cell, sizeof cell, "%.4g %s (%.4g)",
                          m->rmse_MPa[k] * tables[k]->y_to_file, tables[k]->y_unit, m->term[k]);
             fprintf(o, " %-26s", cell);

@@ -33,6 +33,8 @@ typedef struct cf_pf_model {
     double fit_objective;     /* the objective the fit file records, - */
     double *rmse_MPa;         /* per table (owned); 0 where ok[k] is 0 */
     double *term;             /* per table (owned) */
+    size_t *failed_row;       /* per table: 1 + the first row whose state the lattice's cell
+                              ** does not reach (its figures then left out), 0 when none (owned) */
     double sum_terms;         /* over the tables it evaluates */
 } cf_pf_model;
 
@@ -48,7 +50,8 @@ typedef struct cf_pf_result {
 ** r->n 0 (and CF_OK) when the file has no "fibre_lattice" and no "holzapfel_ogden". CF_E_NOINPUT
 ** when the file cannot be opened; CF_E_DATA naming the key for an entry whose quantity is missing
 ** or not finite, or a cell the quantities do not build; a table without axes is left out
-** (ok[k] 0), never a failure. Release r with cf_pf_free in every case. */
+** (ok[k] 0), as is a table at a row of which the lattice's cell finds no state (failed_row),
+** never a failure. Release r with cf_pf_free in every case. */
 cf_status cf_pf_predict(const char *path, const cf_table *const *tables, size_t n,
                         cf_pf_result *r, cf_error *err);
 
