@@ -34,9 +34,15 @@ static const char predict_help[] =
     "                          (default: its better type)\n"
     "  --mode M                every table's test mode: uniaxial, shear, planar, equibiaxial or\n"
     "                          confined (wins over a '# mode:' comment; default uniaxial)\n"
-    "  --stress-unit U         unit of a stress column without one (Pa, kPa, MPa, ...)\n";
+    "  --stress-unit U         unit of a stress column without one (Pa, kPa, MPa, ...)\n"
+    "  --plane PLANE           where shear and biaxial tables lie in the fibre frame (f, s, n):\n"
+    "                          ij for every table or NAME=ij,... by file name, as conifit fit\n"
+    "                          takes it (wins over a '# plane:' comment). A joint fit file with a\n"
+    "                          fibre lattice (fit --fibres) or Holzapfel-Ogden baselines has them\n"
+    "                          predicted too, at every table in the fibre frame, beside the\n"
+    "                          isotropic lattice: each table's RMSE and term per model\n";
 
-enum { OPT_PLOT = CF_CLI_OPT_OWN, OPT_TYPE, OPT_MODE, OPT_STRESS_UNIT };
+enum { OPT_PLOT = CF_CLI_OPT_OWN, OPT_TYPE, OPT_MODE, OPT_STRESS_UNIT, OPT_PLANE };
 
 typedef struct predict_args {
     const char *plot;
@@ -72,6 +78,7 @@ static int predict_option(void *ctx, int c, const char *val)
         return 0;
     }
     case OPT_STRESS_UNIT: a->mopt.stress_unit = val; return 0;
+    case OPT_PLANE: a->mopt.plane = val; return 0;
     default: return cf_cli_usage_error("predict", "unexpected option");
     }
 }
@@ -83,6 +90,7 @@ static int parse(int argc, char **argv, predict_args *a)
                                         {"type", required_argument, NULL, OPT_TYPE},
                                         {"mode", required_argument, NULL, OPT_MODE},
                                         {"stress-unit", required_argument, NULL, OPT_STRESS_UNIT},
+                                        {"plane", required_argument, NULL, OPT_PLANE},
                                         {NULL, 0, NULL, 0}};
     memset(a, 0, sizeof *a);
     a->mopt = cf_measure_default_options();

@@ -87,6 +87,16 @@ static cf_status check_table(const pmodel *pm, const cf_table *t, cf_error *err)
 ** cell's mode reached), else 0. */
 static int eval_row(const pmodel *pm, const cf_table *t, size_t i, double *y)
 {
+    if (pm->kind == CF_PREDICT_CELL && t->mode == CF_MODE_BIAXIAL) {
+        /* the row along its own direction, the other at its ratio (cf_table_cell_curve) */
+        cf_cell k = pm->cell;
+        cf_cell_state s;
+        k.biaxial_k = cf_table_biaxial_k(t, i);
+        if (cf_cell_mode(&k, t->mode, t->x[i], NULL, &s, NULL) != CF_OK)
+            return 0;
+        *y = s.stress_MPa;
+        return isfinite(*y);
+    }
     if (pm->kind == CF_PREDICT_CELL)
         return cf_cell_curve(&pm->cell, t->mode, &t->x[i], 1, y, NULL) == CF_OK && isfinite(*y);
     /* cf_fit_model: the law at compression x H (x for a force-displacement table) */
@@ -306,6 +316,8 @@ cf_status cf_predict(const char *fit_path, const char *type, const cf_table *con
     }
     for (size_t k = 0; st == CF_OK && k < n; k++)
         r->tab[k].share = r->sum_terms > 0 && r->tab[k].ok ? r->tab[k].term / r->sum_terms : 0.0;
+    if (st == CF_OK && r->fit.joint)
+        st = cf_pf_predict(fit_path, tables, n, &r->fibre, err);
     return st;
 }
 
@@ -319,5 +331,6 @@ void cf_predict_free(cf_predict_result *r)
     }
     free(r->tab);
     r->tab = NULL;
+    cf_pf_free(&r->fibre);
     r->n = 0;
 }

@@ -24,6 +24,7 @@
 #include "conifit/error.h"
 #include "io/fitfile.h"
 #include "model/table.h"
+#include "pipeline/predict_fibre.h"
 
 /* What the fit's model is. */
 typedef enum cf_predict_model {
@@ -66,6 +67,9 @@ typedef struct cf_predict_result {
     cf_predict_table *tab;  /* n tables (owned) */
     double sum_terms;       /* the sum of the followed tables' terms */
     size_t fitted;          /* how many of the tables the fit was fitted to */
+    cf_pf_result fibre;     /* a joint fit's fibre-frame models (its "fibre_lattice" and
+                            ** "holzapfel_ogden"), at the tables in the fibre frame; n 0 when
+                            ** the file has none (predict_fibre.h) */
 } cf_predict_result;
 
 /* Loads the fit of type `type` (NULL: the file's better type) from the fit file at fit_path and
@@ -75,7 +79,8 @@ typedef struct cf_predict_result {
 ** uniaxial for the single spring's law (only a fit through the lattice has the other modes), a
 ** force-displacement table against a stress-strain fit or the other way round, a time series.
 ** Rows the model cannot follow (past a spring's solid length) leave the other rows' figures and a
-** note, never a failure. Release r with cf_predict_free in every case. */
+** note, never a failure. A joint fit file with fibre-frame models (--fibres, a biaxial table) has
+** them predicted too, into r->fibre (cf_pf_predict). Release r with cf_predict_free in every case. */
 cf_status cf_predict(const char *fit_path, const char *type, const cf_table *const *tables,
                      size_t n, cf_predict_result *r, cf_error *err);
 

@@ -112,6 +112,14 @@ char *cf_predict_text(const cf_predict_result *r)
         if (r->tab[k].note[0])
             fprintf(o, "%s %s: %s\n", notes++ ? "" : "\nnotes:\n", r->tab[k].table->path,
                     r->tab[k].note);
+    if (r->fibre.n) {
+        const cf_table **tp = malloc((r->n + 1) * sizeof *tp);
+        for (size_t k = 0; tp && k < r->n; k++)
+            tp[k] = r->tab[k].table;
+        if (tp)
+            cf_pf_text(o, &r->fibre, tp);
+        free(tp);
+    }
     if (fclose(o) != 0) {
         free(buf);
         return NULL;

@@ -6,7 +6,9 @@
 ** 1e-9 relative. Then tables the fit never saw (the cortex shear, another tissue) get finite
 ** figures; a double-acting element written into a fit file reaches the cell; rows past the
 ** springs' solid length are left out with a note, never NaN; bad inputs exit 66, 65 and 2 with a
-** message naming what is wrong. The joint fits here take the conical law (under a second each).
+** message naming what is wrong. A joint fit of two biaxial tables at unequal ratios reproduces
+** its lattice's RMSE and its Holzapfel-Ogden baselines' (fit file's holzapfel_ogden). The joint
+** fits here take the conical law (under a second each).
 */
 #include "testutil.h"
 
@@ -202,6 +204,49 @@ static void joint_fit_reproduces_its_terms(void **state)
     release(t, 3, &r);
 }
 
+/* A joint fit of two biaxial tables at ratios 1:0.5 and 0.5:1 (each row along its own direction,
+** the other at the ratio): predicting them reproduces the isotropic lattice's per-table RMSE and
+** objective (1e-9), and the fit file's Holzapfel-Ogden baselines (full and TI, cross-fibre s and
+** n), read back and evaluated at the same rows, reproduce the RMSE each records. */
+static void biaxial_joint_reproduces_lattice_and_baselines(void **state)
+{
+    (void)state;
+    const char *d = tu_datasets();
+    if (!d) {
+        print_message("skipped: ../shared/datasets is absent (the myocardium tables)\n");
+        skip();
+    }
+    char json[300], p0[256], p1[256];
+    snprintf(json, sizeof json, "%s/biaxial.json", dir);
+    snprintf(p0, sizeof p0, "%s/heart_myocardium_biaxial_1to05.csv", d);
+    snprintf(p1, sizeof p1, "%s/heart_myocardium_biaxial_05to1.csv", d);
+    int rc = tu_run(out, sizeof out, errb, sizeof errb,
+                    "fit %s %s --joint --law conical --type telescoping -q -o %s", p0, p1, json);
+    if (rc != 0)
+        fail_msg("joint fit exited %d: %s", rc, errb);
+    const char *paths[2] = {p0, p1};
+    cf_table t[2];
+    cf_predict_result r;
+    predict(json, paths, 2, t, &r);
+    for (size_t k = 0; k < 2; k++)
+        assert_rel(r.tab[k].rmse * t[k].y_to_file, fit_number(json, "table_rmse", k), 1e-9);
+    assert_rel(r.sum_terms, fit_number(json, "objective", 0), 1e-9);
+    assert_int_equal(r.fibre.n, 4);
+    json_error_t je;
+    json_t *root = json_load_file(json, 0, &je);
+    assert_non_null(root);
+    for (int j = 0; j < 4; j++) {
+        const json_t *rm = json_object_get(json_array_get(json_object_get(root, "holzapfel_ogden"),
+                                                          (size_t)j), "rmse_kPa");
+        assert_int_equal(r.fibre.m[j].kind, j % 2 ? CF_PF_HO_TI : CF_PF_HO);
+        for (size_t k = 0; k < 2; k++)
+            assert_rel(r.fibre.m[j].rmse_MPa[k] * 1e3,
+                       json_number_value(json_array_get(rm, k)), 1e-9);
+    }
+    json_decref(root);
+    release(t, 2, &r);
+}
+
 /* Another tissue from the cortex fit (chicken breast, every mode): finite figures, not fitted;
 ** the command's CSV holds every row and no NaN, its report the units. */
 static void other_tissue_and_csv(void **state)
@@ -366,6 +411,7 @@ int main(void)
         cmocka_unit_test(single_fit_reproduces_its_rmse),
         cmocka_unit_test(force_fit_reproduces_its_rmse),
         cmocka_unit_test(joint_fit_reproduces_its_terms),
+        cmocka_unit_test(biaxial_joint_reproduces_lattice_and_baselines),
         cmocka_unit_test(other_tissue_and_csv),
         cmocka_unit_test(pair_reaches_the_cell),
         cmocka_unit_test(rows_past_solid_are_noted),
