@@ -36,21 +36,18 @@ static int axis_of(char c)
     return c == 'f' ? 0 : c == 's' ? 1 : c == 'n' ? 2 : -1;
 }
 
-static cf_status member_law(cf_law *law, const cf_ident *q, cf_error *err)
-{
-    const cf_spring p = cf_ident_member(q);
-    return cf_law_init(law, &p, err);
-}
-
-cf_status cf_fibre_model_init(cf_fibre_model *m, const cf_fibre_fit *f, cf_error *err)
+/* The cell of f's families built of the springs sp (matrix first, then each group's), the
+** matrix's family weights and each group's density times count (one of each per family). */
+static cf_status model_build(cf_fibre_model *m, const cf_fibre_fit *f, const cf_spring *sp,
+                             const int *count, cf_error *err)
 {
     memset(m, 0, sizeof *m);
-    cf_status st = member_law(&m->matrix, &f->matrix, err);
+    cf_status st = cf_law_init(&m->matrix, &sp[0], err);
     if (st != CF_OK)
         return st;
     m->nlaws = 0;
     for (int k = 0; k < f->ngroups; k++) {
-        if ((st = member_law(&m->law[k], &f->fibre[k], err)) != CF_OK) {
+        if ((st = cf_law_init(&m->law[k], &sp[1 + k], err)) != CF_OK) {
             cf_fibre_model_free(m);
             return st;
         }
@@ -60,7 +57,7 @@ cf_status cf_fibre_model_init(cf_fibre_model *m, const cf_fibre_fit *f, cf_error
     double w[CF_FAMILY_COUNT];
     const double E = cf_cubic_moduli_of(u).E;
     for (int k = 0; k < CF_FAMILY_COUNT; k++)
-        w[k] = u[k] / E;
+        w[k] = count[0] * u[k] / E;
     if ((st = cf_cell_init(&m->cell, &m->matrix, CF_LAW_CLOSED, w, err)) != CF_OK) {
         cf_fibre_model_free(m);
         return st;
@@ -68,11 +65,38 @@ cf_status cf_fibre_model_init(cf_fibre_model *m, const cf_fibre_fit *f, cf_error
     m->cell.volume_modulus_MPa = f->kappa_MPa;
     for (int k = 0; k < f->ngroups; k++) {
         const int a = axis_of(f->groups[k]);
-        m->group[k] = (cf_fibre_group){&m->law[k], CF_LAW_CLOSED, {a == 0, a == 1, a == 2}, 1.0};
+        m->group[k] = (cf_fibre_group){&m->law[k], CF_LAW_CLOSED, {a == 0, a == 1, a == 2},
+                                       (double)count[1 + k]};
     }
     m->cell.fibre = m->group;
     m->cell.nfibre = f->ngroups;
     return CF_OK;
+}
+
+cf_status cf_fibre_model_init(cf_fibre_model *m, const cf_fibre_fit *f, cf_error *err)
+{
+    cf_spring sp[1 + CF_FIBRE_MAX];
+    int count[1 + CF_FIBRE_MAX];
+    sp[0] = cf_ident_member(&f->matrix);
+    count[0] = 1;
+    for (int k = 0; k < f->ngroups; k++) {
+        sp[1 + k] = cf_ident_member(&f->fibre[k]);
+        count[1 + k] = 1;
+    }
+    return model_build(m, f, sp, count, err);
+}
+
+cf_status cf_fibre_model_init_placed(cf_fibre_model *m, const cf_fibre_fit *f, cf_error *err)
+{
+    cf_spring sp[1 + CF_FIBRE_MAX];
+    int count[1 + CF_FIBRE_MAX];
+    sp[0] = f->matrix_spring.spring;
+    count[0] = f->matrix_spring.count;
+    for (int k = 0; k < f->ngroups; k++) {
+        sp[1 + k] = f->fibre_spring[k].spring;
+        count[1 + k] = f->fibre_spring[k].count;
+    }
+    return model_build(m, f, sp, count, err);
 }
 
 void cf_fibre_model_free(cf_fibre_model *m)
@@ -163,8 +187,8 @@ static double run_lm(ff_ctx *c, double *th)
     return cf_lm_minimise(residuals, c, c->rows, (size_t)c->np, th, &stop);
 }
 
-static double reach_of(const ff_ctx *c, int a);
-static double matrix_reach(const ff_ctx *c);
+static double reach_of(const ff_ctx *c, int a, double over);
+static double matrix_reach(const ff_ctx *c, double over);
 
 /* The tables' axes and weights and the groups into c; *amp the largest RMS stress. */
 static cf_status setup(ff_ctx *c, const cf_table *const *t, size_t n, const char *groups,
@@ -212,21 +236,21 @@ static cf_status setup(ff_ctx *c, const cf_table *const *t, size_t n, const char
         *amp = fmax(*amp, rms);
     }
     for (size_t k = 0; k < ng; k++)
-        c->b_lo[k] = fmax(B_LO, 1.001 * reach_of(c, axis_of(groups[k])));
-    c->b_lo_matrix = fmax(B_LO, 1.001 * matrix_reach(c));
+        c->b_lo[k] = fmax(B_LO, 1.001 * reach_of(c, axis_of(groups[k]), 1.05));
+    c->b_lo_matrix = fmax(B_LO, 1.001 * matrix_reach(c, 1.05));
     return CF_OK;
 }
 
-/* The farthest fibre strain lambda - 1 of a group along axis a over the tables at 1.05 x their
-** strains: a loaded biaxial axis stretches by its strain, the normal of a sheared face by
+/* The farthest fibre strain lambda - 1 of a group along axis a over the tables at `over` times
+** their strains: a loaded biaxial axis stretches by its strain, the normal of a sheared face by
 ** sqrt(1 + gamma^2) (the free axis of a biaxial row shortens and leaves the fibre slack). */
-static double reach_of(const ff_ctx *c, int a)
+static double reach_of(const ff_ctx *c, int a, double over)
 {
     double r = 0;
     for (size_t k = 0; k < c->n; k++) {
         const cf_table *t = c->t[k];
         for (size_t i = 0; i < t->count; i++) {
-            const double e = 1.05 * t->x[i];
+            const double e = over * t->x[i];
             if (t->mode == CF_MODE_SHEAR && c->axes[k][0] == a)
                 r = fmax(r, sqrt(1 + e * e) - 1);
             else if (t->mode == CF_MODE_BIAXIAL) {
@@ -241,17 +265,17 @@ static double reach_of(const ff_ctx *c, int a)
     return r;
 }
 
-/* The farthest strain |L/L0 - 1| of a matrix spring over the tables at 1.05 x their strains:
+/* The farthest strain |L/L0 - 1| of a matrix spring over the tables at `over` times their strains:
 ** simple shear's from the cell's geometry (cf_cell_spring_strain), a biaxial row's by the
 ** shortening of its free axis were the cell incompressible, 1 - 1 / ((1 + e)(1 + k e)), which
 ** the compressible cell does not exceed (its volume grows under tension). */
-static double matrix_reach(const ff_ctx *c)
+static double matrix_reach(const ff_ctx *c, double over)
 {
     double r = 0;
     for (size_t k = 0; k < c->n; k++) {
         const cf_table *t = c->t[k];
         for (size_t i = 0; i < t->count; i++) {
-            const double e = 1.05 * t->x[i];
+            const double e = over * t->x[i];
             if (t->mode == CF_MODE_SHEAR)
                 r = fmax(r, cf_cell_spring_strain(CF_MODE_SHEAR, e));
             else {
@@ -337,6 +361,60 @@ static void finish(const ff_ctx *c, cf_fibre_fit *r)
     cf_fibre_model_free(&m);
 }
 
+/* The largest difference between the placed lattice's stress and the fitted one's over every
+** row, relative to its table's largest |stress|; -1 when either does not run. */
+static double placed_error(const ff_ctx *c, const cf_fibre_fit *r)
+{
+    cf_fibre_model fitted, placed;
+    if (cf_fibre_model_init(&fitted, r, NULL) != CF_OK)
+        return -1;
+    if (cf_fibre_model_init_placed(&placed, r, NULL) != CF_OK) {
+        cf_fibre_model_free(&fitted);
+        return -1;
+    }
+    double worst = 0;
+    for (size_t k = 0; k < c->n && worst >= 0; k++) {
+        const cf_table *t = c->t[k];
+        double ymax = 0;
+        for (size_t i = 0; i < t->count; i++)
+            ymax = fmax(ymax, fabs(t->y[i]));
+        for (size_t i = 0; i < t->count && worst >= 0; i++) {
+            double a = 0, b = 0;
+            if (cf_fibre_row_stress(&fitted, t, i, c->axes[k], &a, NULL) != CF_OK ||
+                cf_fibre_row_stress(&placed, t, i, c->axes[k], &b, NULL) != CF_OK)
+                worst = -1;
+            else
+                worst = fmax(worst, fabs(a - b) / ymax);
+        }
+    }
+    cf_fibre_model_free(&fitted);
+    cf_fibre_model_free(&placed);
+    return worst;
+}
+
+/* Each family of r placed as buildable springs (cf_fibre_place, the spring fit's default design
+** limits), the groups at the matrix spring's free length, the cell's edge; their travel to the
+** tables' own farthest strains (a group no table stretches still gets a travel, 1e-3). */
+static cf_status place_all(const ff_ctx *c, cf_fibre_fit *r, cf_error *err)
+{
+    const cf_fit_options opt = cf_fit_default_options();
+    cf_status st = cf_fibre_place(&r->matrix, fmax(matrix_reach(c, 1.0), 1e-3), &opt, 0,
+                                  &r->matrix_spring, err);
+    if (st != CF_OK)
+        return st;
+    r->buildable = r->matrix_spring.buildable;
+    const double H = r->matrix_spring.spring.H_mm;
+    for (int k = 0; k < r->ngroups; k++) {
+        const double reach = fmax(reach_of(c, axis_of(r->groups[k]), 1.0), 1e-3);
+        if ((st = cf_fibre_place(&r->fibre[k], reach, &opt, H, &r->fibre_spring[k], err)) !=
+            CF_OK)
+            return st;
+        r->buildable = r->buildable && r->fibre_spring[k].buildable;
+    }
+    r->placed_error = placed_error(c, r);
+    return CF_OK;
+}
+
 cf_status cf_fibre_fit_joint(const cf_table *const *t, size_t n, const char *groups, char cross,
                              cf_fibre_fit *r, cf_error *err)
 {
@@ -365,5 +443,5 @@ cf_status cf_fibre_fit_joint(const cf_table *const *t, size_t n, const char *gro
     r->nparams = c.np;
     r->ntables = n;
     finish(&c, r);
-    return CF_OK;
+    return place_all(&c, r, err);
 }

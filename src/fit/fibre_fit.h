@@ -22,10 +22,29 @@
 #include <stddef.h>
 
 #include "conifit/error.h"
+#include "fit/fit.h"
 #include "fit/holzapfel.h"
 #include "model/family.h"
 #include "model/fibre.h"
 #include "model/table.h"
+
+/* A family of the fitted lattice placed as buildable springs (fibre_place.c): the spring fit's
+** placement (cf_fit_place, its default design limits) of the family with its stress scale shared
+** by `count` equal springs in parallel, each of F_C/H^2 = scale / count (the cell's stress of a
+** family is count x its spring's, so the lattice is the fitted one), every spring of the lattice
+** at the matrix spring's free length H, the cell's edge. */
+typedef struct cf_fibre_spring {
+    cf_spring spring;      /* one spring: D1, D2, n, d (mm), G (MPa), H (mm) */
+    cf_spring_type type;   /* its type */
+    int count;             /* springs in parallel: per cell along a group's axis, per lattice
+                           ** edge (each of the 13 node-to-node springs) for the matrix */
+    int buildable;         /* 1: the spring meets every design limit */
+    unsigned violated;     /* CF_C_* bits it breaks (0 when buildable) */
+    double reach;          /* the farthest strain its travel must take (the tables' own), - */
+} cf_fibre_spring;
+
+/* Most springs in parallel a placement gives a family before it calls it not buildable. */
+#define CF_FIBRE_COUNT_MAX 1000
 
 /* The fitted lattice. */
 typedef struct cf_fibre_fit {
@@ -43,6 +62,12 @@ typedef struct cf_fibre_fit {
     int stable;                    /* 1: the cell's incremental stiffness positive at every row
                                    ** and to 1.05 x each table's farthest strain */
     double min_stiffness_MPa;      /* its smallest eigenvalue over those states, MPa */
+    /* The lattice built: each family placed (cf_fibre_spring), buildable when all are, and the
+    ** largest difference between the placed lattice's stress and the fitted one's over every
+    ** row, relative to the row's table's largest |stress| (-1: the placed lattice did not run). */
+    cf_fibre_spring matrix_spring, fibre_spring[CF_FIBRE_MAX];
+    int buildable;
+    double placed_error;
 } cf_fibre_fit;
 
 /* The cell of a fitted lattice (laws owned here; free with cf_fibre_model_free). */
@@ -57,6 +82,22 @@ typedef struct cf_fibre_model {
 ** valid spring (its message). */
 cf_status cf_fibre_model_init(cf_fibre_model *m, const cf_fibre_fit *f, cf_error *err);
 void cf_fibre_model_free(cf_fibre_model *m);
+
+/* Builds the cell of f's placed springs (matrix_spring, fibre_spring): the matrix's law of its
+** spring with the family weights times its count, each group's law of its spring with density
+** its count. CF_E_DATA when a spring is not valid (its message). */
+cf_status cf_fibre_model_init_placed(cf_fibre_model *m, const cf_fibre_fit *f, cf_error *err);
+
+/* Places family q, whose springs must travel to strain reach, as buildable springs under the
+** design limits of opt: for each spring type where the family can be placed at all
+** (cf_fit_ident_limit), the fewest springs in parallel whose share of the stress scale lies
+** within the largest one spring of the type carries there, then cf_fit_place of that share;
+** the buildable placement with the fewest springs (non-telescoping first on a tie). H_mm > 0
+** scales the spring to that free length (its family unchanged) and checks it again. Where no
+** type places it, out is the non-telescoping placement of one spring, buildable 0, with the
+** limits it breaks. CF_E_INTERNAL when memory runs out. */
+cf_status cf_fibre_place(const cf_ident *q, double reach, const cf_fit_options *opt, double H_mm,
+                         cf_fibre_spring *out, cf_error *err);
 
 /* The nominal stress (MPa, table sign) of row i of t in the model's cell, axes from cf_ho_axes. */
 cf_status cf_fibre_row_stress(const cf_fibre_model *m, const cf_table *t, size_t i,
