@@ -14,7 +14,7 @@ static const char *const family_names[CF_FAMILY_COUNT] = {"edge", "face", "body"
 
 /* The spring of group entry where ('groups[i].spring'): {"fit": file} (a plain conical or tailed
 ** spring's fit, "type" optional) or {"params": {...}}. */
-static cf_status group_spring(ctx *c, json_t *sp, const char *where, cf_scene_group *g)
+cf_status cf_scene_group_spring(ctx *c, json_t *sp, const char *where, cf_scene_group *g)
 {
     static const char *const allowed[] = {"fit", "type", "params", NULL};
     const char *pkeys[CF_P_ALL + 1];
@@ -137,7 +137,7 @@ static cf_status group_entry(ctx *c, json_t *e, size_t i, cf_scene *sc)
     json_t *sp = json_object_get(e, "spring");
     if (!sp)
         return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' is required", c->name, sw);
-    if ((st = group_spring(c, sp, sw, g)))
+    if ((st = cf_scene_group_spring(c, sp, sw, g)))
         return st;
     cf_law law;
     cf_error lerr = {0};

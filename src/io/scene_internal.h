@@ -54,5 +54,12 @@ cf_status cf_scene_selector(ctx *c, json_t *v, const char *key, const char *othe
 ** 0, a double-acting element refused (a body's empty or overlapping regions are the body's to
 ** find, cf_body_set_groups). */
 cf_status cf_scene_groups(ctx *c, json_t *root, cf_scene *sc);
+/* The spring of a group entry at where: {"fit": file, "type"} (a plain conical or tailed spring's
+** fit) or {"params": {...}}, into g->spring and g->source. */
+cf_status cf_scene_group_spring(ctx *c, json_t *sp, const char *where, cf_scene_group *g);
+
+/* scene_body_fibres.c: a body's "fibres" of root (after "body"; refused without one): each entry's
+** helix rule, spring and density. */
+cf_status cf_scene_body_fibres(ctx *c, json_t *root, cf_scene *sc);
 
 #endif
