@@ -150,6 +150,28 @@ void cf_body_fibre_forces(const cf_body *b, const double *x, double *g, pattern 
     }
 }
 
+void cf_body_fibre_virial(const cf_body *b, const double *x, double *sn)
+{
+    const double H = b->law->p.H_mm;
+    static const int ij[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}};
+    for (size_t t = 0; t < b->nt; t++) {
+        double F[9], Pk[3][3] = {{0}};
+        tet_F(b, x, t, F);
+        for (size_t k = 0; k < b->nfibre; k++) {
+            const cf_fibre_group fg = group_at(b, k, t);
+            double T, r;
+            cf_fibre_add_stress(&fg, H, F, Pk, &T, &r, NULL);
+        }
+        for (int q = 0; q < 6; q++) { /* (F P^T)_ij = sum_l F_il P_jl */
+            const int i = ij[q][0], j = ij[q][1];
+            const double w = b->V0[t] * (F[3 * i] * Pk[j][0] + F[3 * i + 1] * Pk[j][1] +
+                                         F[3 * i + 2] * Pk[j][2]) / 4;
+            for (int m = 0; m < 4; m++)
+                sn[6 * b->tet[4 * t + (size_t)m] + (size_t)q] += w;
+        }
+    }
+}
+
 double cf_body_fibre_umax(const cf_body *b, const double *x)
 {
     double umax = 0;

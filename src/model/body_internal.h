@@ -93,6 +93,9 @@ static inline void body_add_block(pattern *P, size_t col, size_t blk, const doub
 ** their tangent (the blocks of each tetrahedron's corners, P->tblk). A fibre at solid adds
 ** nothing (cf_body_admissible refuses such positions). */
 void cf_body_fibre_forces(const cf_body *b, const double *x, double *g, pattern *P);
+/* Adds to the virial sn (6 nn, VTK's order) of each corner a quarter of each tetrahedron's fibre
+** virial V0 F P^T = V0 sum_groups phi (F a)(F a)^T (fibre.h; tension positive, N mm), at x. */
+void cf_body_fibre_virial(const cf_body *b, const double *x, double *sn);
 /* The largest compression over travel of the fibre springs at positions x (>= 1 at solid). */
 double cf_body_fibre_umax(const cf_body *b, const double *x);
 

@@ -2,7 +2,8 @@
 ** Fibre groups in a tissue body (body_fibres.c; src/notes/simulate.md, "Fibres in a body"):
 **  - under a homogeneous deformation (a stretch along the fibres, and a general F) the fibres'
 **    nodal forces vanish at every inner node and their moment -sum f X^T / V over the block is
-**    the closed form P = phi (F a) a^T / lambda, phi = density Hf T / H^3 (fibre.h), to 1e-9;
+**    the closed form P = phi (F a) a^T / lambda, phi = density Hf T / H^3 (fibre.h), and every
+**    node's dual-cell stress (the VTU's) gains the fibres' Cauchy stress F P^T / J, to 1e-9;
 **  - the assembled tangent with fibres of a helix field, at a non-affine state with the fibres in
 **    tension, is the central difference of the forces (1e-6 of its largest entry);
 **  - the helix rule turns the direction linearly through the thickness in the plane normal to the
@@ -61,7 +62,8 @@ static void fibre_part(cf_body *b, const double *x, double *f)
     free(g0);
 }
 
-static void homogeneous_case(const double F[9], double *worst_inner, double *worst_P)
+static void homogeneous_case(const double F[9], double *worst_inner, double *worst_P,
+                             double *worst_sigma)
 {
     cf_law law = law_of(&matrix_spring), fl = law_of(&fibre_spring);
     cf_mesh m;
@@ -108,6 +110,32 @@ static void homogeneous_case(const double F[9], double *worst_inner, double *wor
         }
     }
     *worst_inner /= fmaxv;
+    /* the fields: every node's dual-cell stress gains the fibres' Cauchy stress F P^T / J */
+    const double J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) +
+                     F[2] * (F[3] * F[7] - F[4] * F[6]);
+    const double sf[6] = {phi * Fa[0] * Fa[0] / J, phi * Fa[1] * Fa[1] / J, phi * Fa[2] * Fa[2] / J,
+                          phi * Fa[0] * Fa[1] / J, phi * Fa[1] * Fa[2] / J, phi * Fa[0] * Fa[2] / J};
+    double *ns[2];
+    for (int with = 0; with < 2; with++) {
+        cf_body_fields q = {malloc(6 * b.nn * sizeof(double)), malloc(6 * b.nt * sizeof(double)),
+                            malloc(b.nt * sizeof(double)), malloc(6 * b.nt * sizeof(double)),
+                            malloc(b.ns * sizeof(double))};
+        assert_true(q.node_stress && q.stress && q.mises && q.strain && q.force);
+        b.nfibre = (size_t)with;
+        assert_int_equal(cf_body_fields_at(&b, x, &q, &err), CF_OK);
+        ns[with] = q.node_stress;
+        free(q.stress);
+        free(q.mises);
+        free(q.strain);
+        free(q.force);
+    }
+    *worst_sigma = 0;
+    for (size_t n = 0; n < b.nn; n++)
+        for (int k = 0; k < 6; k++)
+            *worst_sigma = fmax(*worst_sigma, fabs(ns[1][6 * n + (size_t)k] - ns[0][6 * n + (size_t)k] -
+                                                  sf[k]) / (phi * lam * lam / J));
+    free(ns[0]);
+    free(ns[1]);
     *worst_P = 0;
     for (int i = 0; i < 9; i++)
         *worst_P = fmax(*worst_P, fabs(M[i] - phi * Fa[i / 3] * a[i % 3]) / Pmax);
@@ -127,16 +155,15 @@ static void a_homogeneous_block_carries_the_closed_form_fibre_stress(void **stat
     double Fu[9], Fg[9] = {1.05, 0.07, -0.03, 0.02, 0.97, 0.04, -0.05, 0.06, 1.09};
     for (int i = 0; i < 9; i++)
         Fu[i] = (i % 4 == 0) + e * a[i / 3] * a[i % 3]; /* stretch 1.08 along a */
-    double inner, dP;
-    homogeneous_case(Fu, &inner, &dP);
-    print_message("fibre stretch: inner-node force %.3g of the largest, moment vs P %.3g\n", inner,
-                  dP);
-    assert_true(inner <= 1e-9);
-    assert_true(dP <= 1e-9);
-    homogeneous_case(Fg, &inner, &dP);
-    print_message("general F: inner-node force %.3g of the largest, moment vs P %.3g\n", inner, dP);
-    assert_true(inner <= 1e-9);
-    assert_true(dP <= 1e-9);
+    double inner, dP, ds;
+    homogeneous_case(Fu, &inner, &dP, &ds);
+    print_message("fibre stretch: inner-node force %.3g of the largest, moment vs P %.3g, node "
+                  "stress vs F P^T/J %.3g\n", inner, dP, ds);
+    assert_true(inner <= 1e-9 && dP <= 1e-9 && ds <= 1e-9);
+    homogeneous_case(Fg, &inner, &dP, &ds);
+    print_message("general F: inner-node force %.3g of the largest, moment vs P %.3g, node "
+                  "stress vs F P^T/J %.3g\n", inner, dP, ds);
+    assert_true(inner <= 1e-9 && dP <= 1e-9 && ds <= 1e-9);
 }
 
 /* A slab with the helix field -60 to 60 degrees through z from x, fibres of density 3. */
