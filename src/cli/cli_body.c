@@ -104,7 +104,7 @@ cf_status cf_cli_body_create(const cf_scene *sc, const cf_law *law, const cf_mes
     else if (sc->body_volume == 2)
         kappa = cf_body_kappa_for_nu(mu, sc->body_volume_value);
     cf_status st = cf_body_create(b, mesh, law, sc->method, kappa, err);
-    if (st != CF_OK || sc->ngroups == 0)
+    if (st != CF_OK || (st = cf_cli_body_fibres(sc, b, err)) != CF_OK || sc->ngroups == 0)
         return st;
     /* the scene's spring groups by region */
     cf_select sel[CF_SCENE_MAX_GROUPS];
@@ -542,7 +542,6 @@ static void stability(FILE *o, const cf_scene *sc, const run *r)
     fprintf(o, "\n");
 }
 
-
 /* The body's spring groups (scene "groups"): each region's springs and the law they take (the
 ** body's E and nu above are of the scene spring's law). */
 static void groups_line(FILE *o, const cf_scene *sc, const cf_body *b)
@@ -594,6 +593,7 @@ static void summary(FILE *o, const cf_scene *sc, const run *r)
                    "body has the lattice's small-strain E = %.6g kPa and nu = %.6g)\n",
                 b->kappa_MPa * 1e3, b->E_MPa * 1e3, b->nu);
     groups_line(o, sc, b);
+    cf_cli_body_fibres_line(o, sc, b);
     pair_line(o, r);
     if (sc->body_element_size_mm > 0) {
         const cf_mesh_surface_info *si = &r->surface;

@@ -62,7 +62,7 @@ cf_status cf_scene_group_spring(ctx *c, json_t *sp, const char *where, cf_scene_
 /* scene_fibres.c: one fibre group's entry e at where ({"axis": [ax, ay, az], "spring": as a
 ** group's, "density": springs per cell}) into *f: the axis finite and not zero (normalised), the
 ** density finite in (0, 1e6], the spring a valid law; every refusal names the key and the value.
-** Shared by the lattice's "fibres" and a body's. */
+** The lattice's "fibres" (a body's entries take a helix rule instead: scene_body_fibres.c). */
 cf_status cf_scene_fibre_entry(ctx *c, json_t *e, const char *where, cf_scene_fibre *f);
 /* "fibres": {"fit": FILE, "cross_axis": "s" | "n"} of root (before the spring; nothing, and
 ** sc->fibre_fit 0, when "fibres" is not an object): the fit file's fibre lattice of that cross
@@ -74,5 +74,9 @@ cf_status cf_scene_fibre_fit(ctx *c, json_t *root, cf_scene *sc);
 ** fit (cf_scene_fibre_fit) the lattice's weights and kappa, the fit's (the lattice's own weight
 ** and volume keys refused beside it). */
 cf_status cf_scene_fibres(ctx *c, json_t *root, cf_scene *sc);
+
+/* scene_body_fibres.c: a body's "fibres" of root (after "body"; refused without one): each entry's
+** helix rule, spring and density. */
+cf_status cf_scene_body_fibres(ctx *c, json_t *root, cf_scene *sc);
 
 #endif

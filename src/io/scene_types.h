@@ -65,6 +65,16 @@ typedef struct cf_scene_fibre {
     char source[600];           /* "params" or the fit file (and type) it came from */
 } cf_scene_fibre;
 
+/* A fibre group of a body's scene ("fibres", src/notes/simulate.md, "Fibres in a body"): a
+** tension-only spring per tetrahedron along the direction of the helix rule (cf_body_helix_dirs). */
+typedef struct cf_scene_body_fibre {
+    double normal[3], reference[3]; /* helix.normal, helix.reference */
+    double from_deg, to_deg;        /* helix.from_deg, helix.to_deg */
+    cf_spring spring;               /* its spring (any free length) */
+    double density;                 /* springs per lattice cell of the scene spring's H */
+    char source[600];               /* "params" or the fit file (and type) it came from */
+} cf_scene_body_fibre;
+
 typedef struct cf_scene {
     cf_spring spring;           /* the spring of every lattice edge */
     int has_extension;          /* 1: 'spring_extension' makes every element double-acting
@@ -131,6 +141,8 @@ typedef struct cf_scene {
     size_t haptic_n;            /* vertices of the path (0: no "haptic") */
     double *haptic_t_ms, *haptic_depth_mm; /* [t_ms, depth_mm], t from 0 strictly increasing */
     int haptic_iterations;      /* chord iterations per update (cf_body_haptic_step), 1..100 */
+    size_t body_nfibres;        /* a body's "fibres": its fibre groups (0: none) */
+    cf_scene_body_fibre body_fibres[CF_FIBRE_MAX];
 } cf_scene;
 
 #endif

@@ -106,6 +106,8 @@ double cf_body_measure(const cf_body *b, cf_body_state *st, double *max_u_over_t
             st->J[t] = J;
         minJ = fmin(minJ, J);
     }
+    if (b->nfibre)
+        umax = fmax(umax, cf_body_fibre_umax(b, b->x));
     if (max_u_over_travel)
         *max_u_over_travel = umax;
     return minJ;
@@ -132,6 +134,11 @@ void cf_body_free(cf_body *b)
     for (size_t g = 0; b->gown && g < b->ngroups; g++)
         cf_law_free(&b->gown[g]);
     free(b->gown);
+    for (size_t k = 0; b->flaw && k < b->nfibre; k++)
+        cf_law_free(&b->flaw[k]);
+    free(b->flaw);
+    free(b->fdir);
+    free(b->fgrad);
     memset(b, 0, sizeof *b);
 }
 

@@ -37,6 +37,7 @@
 #include <stdint.h>
 
 #include "conifit/error.h"
+#include "model/fibre.h"
 #include "model/law_internal.h"
 #include "model/net.h"
 
@@ -158,6 +159,14 @@ typedef struct cf_body {
     uint8_t *group;        /* ns: the spring's group, 0 for law's, g for group g; NULL: none */
     const cf_law *glaw[CF_BODY_MAX_GROUPS + 1]; /* glaw[0] = law, glaw[g] = gown + g - 1 */
     cf_law *gown;          /* the groups' laws (owned) */
+    /* fibre groups (cf_body_add_fibres; src/notes/simulate.md, "Fibres in a body"): */
+    size_t nfibre;         /* 0: none */
+    cf_law *flaw;          /* CF_FIBRE_MAX laws (owned), group k's in flaw[k] */
+    double fdensity[CF_FIBRE_MAX]; /* springs per lattice cell of edge law->p.H_mm */
+    double *fdir;          /* 3 nt CF_FIBRE_MAX: group k's reference unit direction in
+                           ** tetrahedron t at fdir[3 (CF_FIBRE_MAX t + k)] */
+    double *fgrad;         /* 12 nt: each tetrahedron's reference shape-function gradients, its
+                           ** four corners' (1/mm) */
 } cf_body;
 
 /* The law of spring s (its group's). */
@@ -176,6 +185,28 @@ static inline const cf_law *cf_body_spring_law(const cf_body *b, size_t s)
 cf_status cf_body_set_groups(cf_body *b, const cf_mesh *m, size_t n, const cf_select *sel,
                              const cf_spring *spring, const char *const *key,
                              size_t table_intervals, cf_error *err);
+
+/* Adds a fibre group to b (at most CF_FIBRE_MAX; body_fibres.c): in every tetrahedron t a
+** tension-only spring along the reference unit direction dir[3 t .. 3 t + 2] (copied) with the
+** law of spring (its table built for the table method), density springs per cell of the lattice
+** of edge H = the body law's free length, whose energy per reference volume is that of the
+** homogenised cell's fibre group (fibre.h) at the tetrahedron's deformation gradient F (constant
+** in a linear tetrahedron): density E(|F a|)/H^3. Its forces and tangent enter every solve.
+** CF_E_DATA naming key for a bad direction (tetrahedron t), density or law, or a fifth group;
+** CF_E_INTERNAL when memory runs out. */
+cf_status cf_body_add_fibres(cf_body *b, const cf_spring *spring, double density,
+                             const double *dir, size_t table_intervals, const char *key,
+                             cf_error *err);
+
+/* The helix rule of a left-ventricular wall (Streeter et al. 1969, Circ Res 24:339-347): per
+** tetrahedron of b, into dir (3 nt), the unit direction in the plane normal to the unit normal n
+** at the angle from_deg + s (to_deg - from_deg) from reference's projection on that plane
+** (turning toward n x reference), s = (n . c - lo)/(hi - lo) the tetrahedron's centroid c's
+** position through the body's thickness along n (lo, hi the least and greatest n . X of its
+** nodes). CF_E_DATA when n is not finite and nonzero, reference is parallel to it, or the body
+** has no thickness along n. */
+cf_status cf_body_helix_dirs(const cf_body *b, const double normal[3], const double reference[3],
+                             double from_deg, double to_deg, double *dir, cf_error *err);
 
 /* Every component of a node held. */
 #define CF_BODY_FIX_ALL 7

@@ -230,16 +230,6 @@ fail:
     return 0;
 }
 
-/* Adds the 3 x 3 block B (row-major) to block `blk` of node col's columns. */
-static void add_block(pattern *P, size_t col, size_t blk, const double B[9])
-{
-    for (int c = 0; c < 3; c++) {
-        double *v = P->val + P->colptr[3 * col + c] + 3 * blk;
-        for (int a = 0; a < 3; a++)
-            v[a] += B[3 * a + c];
-    }
-}
-
 /* The volume of tetrahedron t at positions x and its gradient dV[4][3]. */
 static double tet_dV(const cf_body *b, const double *x, size_t t, double dV[4][3])
 {
@@ -300,7 +290,7 @@ static void volume_hessian(const cf_body *b, const double *x, size_t t, double f
             double B[9];
             for (int k = 0; k < 9; k++)
                 B[k] = f * Hx[m][q][k];
-            add_block(P, v[q], P->tblk[16 * t + 4 * (size_t)m + (size_t)q], B);
+            body_add_block(P, v[q], P->tblk[16 * t + 4 * (size_t)m + (size_t)q], B);
         }
 }
 
@@ -405,7 +395,7 @@ static int volume_term(const cf_body *b, const double *x, double *g, pattern *P)
                     for (int r = 0; r < 3; r++)
                         for (int c = 0; c < 3; c++)
                             B[3 * r + c] = kk * w[3 * rq + r] * w[3 * cq + c];
-                    add_block(P, ring[cq], blk[rq * nr + cq], B);
+                    body_add_block(P, ring[cq], blk[rq * nr + cq], B);
                 }
         }
     }
@@ -450,13 +440,15 @@ double cf_body_assemble(const cf_body *b, const double *x, const cf_probe *pr, c
                 B[3 * a + q] = (kax - geo) * n[a] * n[q] + (a == q ? geo : 0);
                 Bn[3 * a + q] = -B[3 * a + q];
             }
-        add_block(P, i, P->sblk[4 * s], B);
-        add_block(P, j, P->sblk[4 * s + 1], B);
-        add_block(P, j, P->sblk[4 * s + 2], Bn);
-        add_block(P, i, P->sblk[4 * s + 3], Bn);
+        body_add_block(P, i, P->sblk[4 * s], B);
+        body_add_block(P, j, P->sblk[4 * s + 1], B);
+        body_add_block(P, j, P->sblk[4 * s + 2], Bn);
+        body_add_block(P, i, P->sblk[4 * s + 3], Bn);
     }
     if (b->kappa_MPa > 0 && !volume_term(b, x, g, P))
         return NAN;
+    if (b->nfibre)
+        cf_body_fibre_forces(b, x, g, P);
     if (b->f_ext)
         for (size_t i = 0; i < 3 * b->nn; i++)
             g[i] -= b->f_ext[i];
@@ -479,7 +471,7 @@ double cf_body_assemble(const cf_body *b, const double *x, const cf_probe *pr, c
             for (int a = 0; a < 3; a++)
                 for (int q = 0; q < 3; q++)
                     B[3 * a + q] = kp * ((1 + curv) * nrm[a] * nrm[q] - (a == q ? curv : 0));
-            add_block(P, i, blk_of(P, i, i), B);
+            body_add_block(P, i, blk_of(P, i, i), B);
         }
     if (contacts)
         *contacts = nc;
@@ -497,7 +489,7 @@ void cf_body_add_inertia(const cf_body *b, const body_work *w, const double *x, 
             g[3 * i + (size_t)a] += k * (x[3 * i + (size_t)a] - w->xstar[3 * i + (size_t)a]);
         if (P) {
             const double B[9] = {k, 0, 0, 0, k, 0, 0, 0, k};
-            add_block(P, i, blk_of(P, i, i), B);
+            body_add_block(P, i, blk_of(P, i, i), B);
         }
     }
 }
@@ -575,5 +567,5 @@ int cf_body_admissible(const cf_body *b, const double *x)
         if (!(body_vol6(x + 3 * v[0], x + 3 * v[1], x + 3 * v[2], x + 3 * v[3]) > 0))
             return 0;
     }
-    return 1;
+    return !b->nfibre || cf_body_fibre_umax(b, x) < 1;
 }

@@ -78,6 +78,27 @@ typedef struct pattern {
     uint32_t *rblk;
 } pattern;
 
+/* Adds the 3 x 3 block B (row-major) to block `blk` of node col's columns. */
+static inline void body_add_block(pattern *P, size_t col, size_t blk, const double B[9])
+{
+    for (int c = 0; c < 3; c++) {
+        double *v = P->val + P->colptr[3 * col + c] + 3 * blk;
+        for (int a = 0; a < 3; a++)
+            v[a] += B[3 * a + c];
+    }
+}
+
+/* body_fibres.c */
+/* Adds the fibre groups' energy gradient at positions x to g (3 nn) and, when P is not NULL,
+** their tangent (the blocks of each tetrahedron's corners, P->tblk). A fibre at solid adds
+** nothing (cf_body_admissible refuses such positions). */
+void cf_body_fibre_forces(const cf_body *b, const double *x, double *g, pattern *P);
+/* Adds to the virial sn (6 nn, VTK's order) of each corner a quarter of each tetrahedron's fibre
+** virial V0 F P^T = V0 sum_groups phi (F a)(F a)^T (fibre.h; tension positive, N mm), at x. */
+void cf_body_fibre_virial(const cf_body *b, const double *x, double *sn);
+/* The largest compression over travel of the fibre springs at positions x (>= 1 at solid). */
+double cf_body_fibre_umax(const cf_body *b, const double *x);
+
 struct body_work;
 
 /* The body as a mechanical system (mech.h) for the static solve: the probe at c with penalty kp

@@ -5,6 +5,7 @@
 #include "report/vtu.h"
 
 #include <math.h>
+#include <stdio.h>
 
 static double fin(double v)
 {
@@ -70,6 +71,26 @@ static void cells(FILE *f, size_t count, int per, const uint32_t *conn, int vtk_
     fprintf(f, "</DataArray>\n</Cells>\n");
 }
 
+/* Each fibre group's reference direction per tetrahedron, "fibre_direction" (group 0) and
+** "fibre_direction_K" (group K > 0), unit vectors of 3 components; nothing without fibres. */
+static void fibre_arrays(FILE *f, const cf_body *b)
+{
+    for (size_t k = 0; k < b->nfibre; k++) {
+        char name[48];
+        if (k == 0)
+            snprintf(name, sizeof name, "fibre_direction");
+        else
+            snprintf(name, sizeof name, "fibre_direction_%zu", k);
+        fprintf(f, "<DataArray type=\"Float64\" Name=\"%s\" NumberOfComponents=\"3\" "
+                   "format=\"ascii\">\n", name);
+        for (size_t t = 0; t < b->nt; t++) {
+            const double *a = b->fdir + 3 * (CF_FIBRE_MAX * t + k);
+            fprintf(f, "%.10g %.10g %.10g\n", fin(a[0]), fin(a[1]), fin(a[2]));
+        }
+        fprintf(f, "</DataArray>\n");
+    }
+}
+
 static void footer(FILE *f)
 {
     fprintf(f, "</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
@@ -97,6 +118,7 @@ void cf_vtu_body(FILE *f, const cf_body *b, const cf_vtu_state *s)
     array(f, "von_mises_kPa", 1, b->nt, q->mises, 1e3);
     array(f, "strain_green_lagrange", 6, b->nt, q->strain, 1);
     array(f, "J", 1, b->nt, s->J, 1);
+    fibre_arrays(f, b);
     fprintf(f, "</CellData>\n");
     footer(f);
 }

@@ -9,7 +9,8 @@
 ** body_NNNN.vtu: point data "displacement" (mm, 3), "stress_kPa" (6, the node's dual cell),
 ** "contact_force_N" (3, the probe's force on the node), "reaction_N" (3, the supports' force at
 ** the held components); cell data "stress_kPa" (6), "von_mises_kPa", "strain_green_lagrange"
-** (6), "J". springs_NNNN.vtu: cell data "force_N" (tension positive), "strain" (engineering,
+** (6), "J", and with fibres "fibre_direction" (3, each tetrahedron's reference fibre direction;
+** "fibre_direction_K" for group K > 0). springs_NNNN.vtu: cell data "force_N" (tension positive), "strain" (engineering,
 ** tension positive), "solid" (1 where the law is at solid). Both carry field data "TimeValue"
 ** (the PVD's time), "step", and with a probe "probe_depth_mm" and "probe_force_N".
 */

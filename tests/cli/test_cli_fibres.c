@@ -1,0 +1,214 @@
+/*
+** A body scene with fibres (`"fibres"`, src/notes/simulate.md, "Fibres in a body"): the
+** left-ventricular slab, a Gmsh block of 20 x 20 x 5 mm whose fibre angle turns from -60 to +60
+** degrees through its thickness (z), held at its bottom and pressed by a flat punch:
+**  - `conifit simulate --vtu` runs it; the VTU's cell field "fibre_direction", read back with
+**    libxml2, is in every tetrahedron the helix rule's direction at its centroid (1e-9), and the
+**    summary names the fibres;
+**  - the punch's force exceeds that of the same slab without fibres (the fibres carry load);
+**  - bad "fibres" keys exit 65 naming the key and the value; the export refuses a body with
+**    fibres (65) instead of dropping them.
+*/
+#include "bodyutil.h"
+#include "testutil.h"
+
+#include <libxml/parser.h>
+#include <libxml/tree.h>
+
+TU_SCRATCH_GROUP("cli-fibres")
+
+#define PI 3.14159265358979323846
+
+#define FIBRES                                                                                     \
+    "\"fibres\": [{\"helix\": {\"normal\": [0, 0, 1], \"from_deg\": -60, \"to_deg\": 60, "      \
+    "\"reference\": [1, 0, 0]}, \"spring\": {\"params\": {\"D1_mm\": 10, \"D2_mm\": 30, "          \
+    "\"n\": 4, \"d_mm\": 1, \"G_MPa\": 80000, \"H_mm\": 30}}, \"density\": %s}],\n"
+
+static xmlNodePtr child(xmlNodePtr n, const char *name)
+{
+    for (xmlNodePtr c = n ? n->children : NULL; c; c = c->next)
+        if (c->type == XML_ELEMENT_NODE && strcmp((const char *)c->name, name) == 0)
+            return c;
+    return NULL;
+}
+
+/* The numbers of DataArray name under the piece's section, *n of them (new array). */
+static double *read_array(xmlDocPtr doc, const char *section, const char *name, size_t *n)
+{
+    xmlNodePtr sec = child(child(child(xmlDocGetRootElement(doc), "UnstructuredGrid"), "Piece"),
+                           section);
+    for (xmlNodePtr c = sec ? sec->children : NULL; c; c = c->next) {
+        xmlChar *nm = c->type == XML_ELEMENT_NODE ? xmlGetProp(c, (const xmlChar *)"Name") : NULL;
+        const int match = nm && (!name || strcmp((const char *)nm, name) == 0);
+        xmlFree(nm);
+        if (!match && !(name == NULL && c->type == XML_ELEMENT_NODE))
+            continue;
+        xmlChar *text = xmlNodeGetContent(c);
+        size_t cap = 4096, k = 0;
+        double *v = malloc(cap * sizeof *v);
+        assert_non_null(v);
+        const char *p = (const char *)text;
+        for (;;) {
+            char *e;
+            const double x = strtod(p, &e);
+            if (e == p)
+                break;
+            assert_true(isfinite(x));
+            if (k == cap)
+                assert_non_null(v = realloc(v, (cap *= 2) * sizeof *v));
+            v[k++] = x;
+            p = e;
+        }
+        xmlFree(text);
+        *n = k;
+        return v;
+    }
+    fail_msg("no %s %s", section, name ? name : "");
+    return NULL;
+}
+
+/* The slab meshed by Gmsh (element size 2.5 mm) and the scene (fibres of density dens, or none
+** when dens is NULL) at dir/name.json; the CSV's last force after `simulate`. */
+static double run_slab(const char *name, const char *dens, int vtu, char *out, size_t cap)
+{
+    char mesh[600], scene[600], csv[600], vdir[600], err[8192];
+    snprintf(mesh, sizeof mesh, "%s/slab.msh", dir);
+    snprintf(scene, sizeof scene, "%s/%s.json", dir, name);
+    snprintf(csv, sizeof csv, "%s/%s.csv", dir, name);
+    snprintf(vdir, sizeof vdir, "%s/%s", dir, name);
+    FILE *probe = fopen(mesh, "r");
+    if (!probe) {
+        const double lo[3] = {0, 0, 0}, hi[3] = {20, 20, 5}, f[3] = {10, 10, 5};
+        cf_mesh m;
+        cf_error e = {0};
+        if (cf_mesh_box(lo, hi, f, 2.5, 2.5, 0, &m, &e) != CF_OK)
+            fail_msg("%s", e.msg);
+        write_msh(mesh, &m);
+    } else
+        fclose(probe);
+    FILE *f = fopen(scene, "w");
+    assert_non_null(f);
+    fprintf(f, "{" SPRING ",\n \"body\": {\"mesh\": \"%s\", \"unit_mm\": 1, \"poisson_ratio\": "
+               "0.45},\n", mesh);
+    if (dens)
+        fprintf(f, FIBRES, dens);
+    fprintf(f, " \"fixed\": {\"below\": {\"axis\": \"z\", \"value_mm\": 0}},\n"
+               " \"probe\": {\"shape\": \"punch\", \"radius_mm\": 4, \"center_mm\": [10, 10, "
+               "5.001], \"direction\": [0, 0, -1], \"depth_mm\": 0.501, \"steps\": 3}}\n");
+    fclose(f);
+    if (tu_run(out, cap, err, sizeof err, "simulate %s -o %s%s%s", scene, csv,
+               vtu ? " --vtu " : "", vtu ? vdir : ""))
+        fail_msg("%s", err);
+    char *text = tu_slurp(csv);
+    assert_non_null(text);
+    const char *last = text + strlen(text) - 2;
+    while (last > text && *last != '\n')
+        last--;
+    double d, F;
+    assert_int_equal(sscanf(last + 1, "%lf,%lf", &d, &F), 2);
+    free(text);
+    return F;
+}
+
+static void the_fibre_slab_runs_and_shows_its_directions(void **state)
+{
+    (void)state;
+    char out[16384], path[700];
+    const double F0 = run_slab("plain", NULL, 0, out, sizeof out);
+    const double F1 = run_slab("helix", "2", 1, out, sizeof out);
+    print_message("punch 0.5 mm into the 20 x 20 x 5 mm slab: %.6g N without fibres, %.6g N with "
+                  "the -60..60 degree helix\n", F0, F1);
+    assert_true(F0 > 0 && F1 > 1.001 * F0);
+    assert_non_null(strstr(out, "fibres 0: helix from -60 to 60 degrees"));
+    snprintf(path, sizeof path, "%s/helix/body_0003.vtu", dir);
+    xmlDocPtr doc = xmlReadFile(path, NULL, XML_PARSE_NONET);
+    if (!doc)
+        fail_msg("libxml2 cannot parse %s", path);
+    size_t na, np, nc;
+    double *a = read_array(doc, "CellData", "fibre_direction", &na);
+    double *x = read_array(doc, "Points", NULL, &np);
+    double *u = read_array(doc, "PointData", "displacement", &np);
+    double *conn = read_array(doc, "Cells", "connectivity", &nc);
+    assert_int_equal(na, 3 * (nc / 4));
+    assert_true(nc > 400);
+    double worst = 0;
+    for (size_t t = 0; t < nc / 4; t++) {
+        double zc = 0; /* the reference centroid: current position less displacement */
+        for (int k = 0; k < 4; k++) {
+            const size_t v = (size_t)conn[4 * t + (size_t)k];
+            zc += (x[3 * v + 2] - u[3 * v + 2]) / 4;
+        }
+        const double th = (-60 + 120 * zc / 5) * PI / 180;
+        worst = fmax(worst, fabs(a[3 * t] - cos(th)) + fabs(a[3 * t + 1] - sin(th)) +
+                                fabs(a[3 * t + 2]));
+    }
+    print_message("%zu tetrahedra: fibre_direction within %.3g of the helix rule\n", nc / 4, worst);
+    assert_true(worst <= 1e-8); /* the file's 10 digits */
+    free(a);
+    free(x);
+    free(u);
+    free(conn);
+    xmlFreeDoc(doc);
+}
+
+/* A scene with FIBRES' entry replaced by entry; `simulate` must exit 65 with msg in its error. */
+static void refused(const char *entry, const char *msg)
+{
+    char scene[600], mesh[600], out[4096], err[4096];
+    snprintf(mesh, sizeof mesh, "%s/slab.msh", dir);
+    snprintf(scene, sizeof scene, "%s/bad.json", dir);
+    FILE *f = fopen(scene, "w");
+    assert_non_null(f);
+    fprintf(f, "{" SPRING ",\n \"body\": {\"mesh\": \"%s\", \"unit_mm\": 1},\n \"fibres\": [%s],\n"
+               " \"fixed\": {\"below\": {\"axis\": \"z\", \"value_mm\": 0}},\n"
+               " \"probe\": {\"shape\": \"punch\", \"radius_mm\": 4, \"center_mm\": [10, 10, "
+               "5.001], \"direction\": [0, 0, -1], \"depth_mm\": 0.5}}\n", mesh, entry);
+    fclose(f);
+    assert_int_equal(tu_run(out, sizeof out, err, sizeof err, "simulate %s -o -", scene), 65);
+    if (!strstr(err, msg))
+        fail_msg("expected '%s' in: %s", msg, err);
+}
+
+#define P_SPRING "\"spring\": {\"params\": {\"D1_mm\": 10, \"D2_mm\": 30, \"n\": 4, \"d_mm\": 1, " \
+                 "\"G_MPa\": 80000, \"H_mm\": 30}}"
+
+static void bad_fibres_are_refused_by_key_and_value(void **state)
+{
+    (void)state;
+    char out[4096];
+    run_slab("mesh", NULL, 0, out, sizeof out); /* writes the slab */
+    refused("{\"helix\": {\"normal\": [0, 0, 1], \"from_deg\": -60, \"to_deg\": 60, "
+            "\"reference\": [0, 0, 3]}, " P_SPRING "}",
+            "key 'fibres[0].helix.reference' = [0, 0, 3]");
+    refused("{\"helix\": {\"normal\": [0, 0, 0], \"from_deg\": -60, \"to_deg\": 60, "
+            "\"reference\": [1, 0, 0]}, " P_SPRING "}",
+            "key 'fibres[0].helix.normal' = [0, 0, 0]");
+    refused("{\"helix\": {\"normal\": [0, 0, 1], \"from_deg\": -60, \"to_deg\": 60, "
+            "\"reference\": [1, 0, 0]}, " P_SPRING ", \"density\": -1}",
+            "fibres[0]");
+    refused("{\"helix\": {\"normal\": [0, 0, 1], \"from_deg\": -60, \"to_deg\": 60, "
+            "\"reference\": [1, 0, 0], \"twist\": 1}, " P_SPRING "}",
+            "twist");
+    refused("{\"helix\": {\"normal\": [0, 0, 1], \"from_deg\": -60, \"to_deg\": 60, "
+            "\"reference\": [1, 0, 0]}}",
+            "key 'fibres[0].spring' is required");
+    /* the export refuses rather than dropping the fibres */
+    char scene[600], err[4096];
+    snprintf(scene, sizeof scene, "%s/helix.json", dir);
+    run_slab("helix", "1", 0, out, sizeof out);
+    const int st = tu_run(out, sizeof out, err, sizeof err, "export "
+                          "fits/series/muscle_compression_relaxation_fiber30.json --lattice %s "
+                          "--format calculix -o %s/x.inp", scene, dir);
+    print_message("export of the fibre slab: exit %d: %s", st, err);
+    assert_int_equal(st, 65);
+    assert_non_null(strstr(err, "fibres"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(the_fibre_slab_runs_and_shows_its_directions),
+        cmocka_unit_test(bad_fibres_are_refused_by_key_and_value),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
