@@ -49,6 +49,9 @@ typedef struct jctx {
     ** lattice is stable there (joint_stable_at); stab_on 0: no such check */
     int stab_on;
     double stab_best;
+    /* the springs' reach over every table, which the placement honours: with it set, the pair's
+    ** stability wall also asks both springs to be buildable (NULL: stability alone) */
+    const cf_table *reach;
     /* a fitted kappa's bound over the compression spring's k0/H (CF_JOINT_NU_MAX; 0: none) */
     double kappa_rel_max;
 } jctx;

@@ -76,11 +76,37 @@ static void pair_set(jctx *c, const pvars *pv, const double *z)
         c->tau = exp(z[pv->it]);
 }
 
-/* 1 when the search's point z (pair_set) has full lattices stable over the uniaxial tables. */
+/* 1 when both springs of the context's law at (rho, B) and compression stress scale A can be
+** built (cf_joint_pair_place over c->reach; 1 when the context has no reach). The search does not
+** see buildability otherwise, and its searches kept to stable lattices walked to springs that
+** cannot be built, the pair then falling back to the law it contains (issue 42). */
+static int point_buildable(const jctx *c, double rho, double B, double A)
+{
+    if (!c->reach)
+        return 1;
+    if (!(A > 0) || !isfinite(A))
+        return 0;
+    double v[PQ_COUNT] = {0};
+    v[PQ_RC] = rho, v[PQ_BC] = B, v[PQ_AC] = A;
+    if (c->tail)
+        v[PQ_T] = c->tau;
+    if (c->pair)
+        v[PQ_RE] = c->ext[0], v[PQ_BE] = c->ext[1], v[PQ_AE] = A * c->ext[2];
+    cf_joint_result r;
+    memset(&r, 0, sizeof r);
+    cf_error e = {0};
+    return cf_joint_pair_place(c, c->reach, v, &r, &e) == CF_OK && r.fit.feasible;
+}
+
+/* 1 when the search's point z (pair_set) has both springs buildable and full lattices stable over
+** the uniaxial tables. */
 static int z_stable(jctx *c, const pvars *pv, const double *z)
 {
     pair_set(c, pv, z);
-    return cf_joint_stable_at(c, exp(z[0]), z[1]);
+    double A = 0;
+    if (c->reach && !(cf_cell_rss(&c->pr, exp(z[0]), z[1], &A) < CF_LSQ_HUGE_OBJ))
+        return 0;
+    return point_buildable(c, exp(z[0]), z[1], A) && cf_joint_stable_at(c, exp(z[0]), z[1]);
 }
 
 typedef struct pair_obj {
@@ -98,7 +124,7 @@ static double pair_objective(unsigned nz, const double *z, double *grad, void *d
     double A;
     const double f = cf_cell_rss(&c->pr, exp(z[0]), z[1], &A);
     if (c->stab_on && f < c->stab_best) {
-        if (!cf_joint_stable_at(c, exp(z[0]), z[1]))
+        if (!point_buildable(c, exp(z[0]), z[1], A) || !cf_joint_stable_at(c, exp(z[0]), z[1]))
             return CF_LSQ_HUGE_OBJ;
         c->stab_best = f;
     }
@@ -739,6 +765,7 @@ cf_status cf_joint_search_pair(jctx *c, const cf_table *reach, double xmax,
         c->tau = TAU_HELD;
     }
     s.o = (pair_obj){c, &s.pv};
+    c->reach = reach;
     if ((st = pair_starts(c, plain, &s, err)) != CF_OK ||
         (st = pair_keep_stable(c, &s, err)) != CF_OK)
         return st;
