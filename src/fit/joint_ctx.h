@@ -98,5 +98,11 @@ void cf_joint_small_strain_moduli(jctx *c, const double v[PQ_COUNT], cf_joint_re
 ** spring's H; fit.feasible says whether both are buildable). */
 cf_status cf_joint_pair_place(const jctx *c, const cf_table *reach, const double v[PQ_COUNT],
                               cf_joint_result *r, cf_error *err);
+/* 1 when both springs of the context's law at (rho, B) and compression stress scale A can be
+** built (cf_joint_pair_place over c->reach; 1 when the context has no reach). */
+int cf_joint_pair_buildable(const jctx *c, double rho, double B, double A);
+/* The fitted kappa of a law a search contains over its compression spring's k0/H (KAPPA_REL);
+** 0 when it has none. */
+double cf_joint_nest_kappa_rel(const cf_joint_result *plain);
 
 #endif
