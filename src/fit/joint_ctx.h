@@ -49,6 +49,9 @@ typedef struct jctx {
     ** lattice is stable there (joint_stable_at); stab_on 0: no such check */
     int stab_on;
     double stab_best;
+    /* the springs' reach over every table, which the placement honours: with it set, the pair's
+    ** stability wall also asks both springs to be buildable (NULL: stability alone) */
+    const cf_table *reach;
     /* a fitted kappa's bound over the compression spring's k0/H (CF_JOINT_NU_MAX; 0: none) */
     double kappa_rel_max;
 } jctx;
@@ -95,5 +98,11 @@ void cf_joint_small_strain_moduli(jctx *c, const double v[PQ_COUNT], cf_joint_re
 ** spring's H; fit.feasible says whether both are buildable). */
 cf_status cf_joint_pair_place(const jctx *c, const cf_table *reach, const double v[PQ_COUNT],
                               cf_joint_result *r, cf_error *err);
+/* 1 when both springs of the context's law at (rho, B) and compression stress scale A can be
+** built (cf_joint_pair_place over c->reach; 1 when the context has no reach). */
+int cf_joint_pair_buildable(const jctx *c, double rho, double B, double A);
+/* The fitted kappa of a law a search contains over its compression spring's k0/H (KAPPA_REL);
+** 0 when it has none. */
+double cf_joint_nest_kappa_rel(const cf_joint_result *plain);
 
 #endif

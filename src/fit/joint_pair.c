@@ -76,11 +76,16 @@ static void pair_set(jctx *c, const pvars *pv, const double *z)
         c->tau = exp(z[pv->it]);
 }
 
-/* 1 when the search's point z (pair_set) has full lattices stable over the uniaxial tables. */
+/* 1 when the search's point z (pair_set) has both springs buildable and full lattices stable over
+** the uniaxial tables. */
 static int z_stable(jctx *c, const pvars *pv, const double *z)
 {
     pair_set(c, pv, z);
-    return cf_joint_stable_at(c, exp(z[0]), z[1]);
+    double A = 0;
+    if (c->reach && !(cf_cell_rss(&c->pr, exp(z[0]), z[1], &A) < CF_LSQ_HUGE_OBJ))
+        return 0;
+    return cf_joint_pair_buildable(c, exp(z[0]), z[1], A) &&
+           cf_joint_stable_at(c, exp(z[0]), z[1]);
 }
 
 typedef struct pair_obj {
@@ -98,7 +103,8 @@ static double pair_objective(unsigned nz, const double *z, double *grad, void *d
     double A;
     const double f = cf_cell_rss(&c->pr, exp(z[0]), z[1], &A);
     if (c->stab_on && f < c->stab_best) {
-        if (!cf_joint_stable_at(c, exp(z[0]), z[1]))
+        if (!cf_joint_pair_buildable(c, exp(z[0]), z[1], A) ||
+            !cf_joint_stable_at(c, exp(z[0]), z[1]))
             return CF_LSQ_HUGE_OBJ;
         c->stab_best = f;
     }
@@ -197,21 +203,6 @@ static cf_status pair_box(jctx *c, double xmax, pvars *pv, cf_error *err)
     return CF_OK;
 }
 
-/* The fitted kappa of the law a search contains (plain) over its compression spring's k0/H (the
-** search's variable, KAPPA_REL); 0 when it has none. */
-static double nest_kappa_rel(const cf_joint_result *plain)
-{
-    if (plain->volume != CF_VOLUME_FIT || !(plain->volume_modulus_MPa > 0) ||
-        !(plain->ident.scale > 0))
-        return 0;
-    const cf_ident q1 = {.rho = plain->ident.rho, .solid = plain->ident.solid, .scale = 1.0};
-    const cf_spring p1 = cf_ident_member(&q1);
-    cf_law l1;
-    if (cf_law_init(&l1, &p1, NULL) != CF_OK)
-        return 0;
-    return plain->volume_modulus_MPa / (plain->ident.scale * l1.k0_N_per_mm / l1.p.H_mm);
-}
-
 /* The tailed pair contains the conical pair plain (a tail of no coils): plain's optimum, its tail
 ** at the search's shortest, replaces the best point when it is lower (and, after a search kept
 ** to stable lattices, stable), so the last search starts from it. */
@@ -225,7 +216,7 @@ static void tail_nest_start(jctx *c, const cf_joint_result *plain, pair_search *
     z[pv->ie] = log(plain->ext.ident.rho), z[pv->ie + 1] = plain->ext.ident.solid;
     z[pv->ie + 2] = log(plain->ext.ident.scale / plain->ident.scale);
     if (pv->ik >= 0) {
-        const double k = nest_kappa_rel(plain);
+        const double k = cf_joint_nest_kappa_rel(plain);
         z[pv->ik] = log(k > 0 ? k : 1e-5);
     }
     if (pv->iA >= 0)
@@ -262,7 +253,7 @@ static cf_status pair_starts(jctx *c, const cf_joint_result *plain, pair_search 
     const int nest = plain && (c->tail ? plain->pair : !plain->pair);
     const int nre = c->pair ? (nest ? 4 : 3) : 1, nbe = c->pair ? 2 : 1,
               nk = pv->ik >= 0 ? 2 : 1;
-    const double k_nest = nest && pv->ik >= 0 ? nest_kappa_rel(plain) : 0;
+    const double k_nest = nest && pv->ik >= 0 ? cf_joint_nest_kappa_rel(plain) : 0;
     s->best = CF_LSQ_HUGE_OBJ;
     memset(s->zb, 0, sizeof s->zb);
     s->nends = 0;
@@ -562,7 +553,8 @@ static void pair_last_search(jctx *c, pair_search *s)
         pair_steps(pv, round % 2 == 0, step);
         c->stab_best = CF_LSQ_HUGE_OBJ;
         nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)pv->n, pv->lb,
-                                          pv->ub, step, XTOL_REL * 1e-2, PAIR_MAX_EVALS,
+                                          pv->ub, step, XTOL_REL * 1e-2,
+                                          round == 0 ? PAIR_MAX_EVALS : STABLE_MAX_EVALS,
                                           pair_objective, (void *)&s->o, z, &f);
         if (!search_ended(res) || !(f < s->best))
             return;
@@ -578,8 +570,8 @@ static void pair_last_search(jctx *c, pair_search *s)
 
 /* Step 5: the quantities of the search's best point into v (*A the compression stress scale),
 ** then Levenberg-Marquardt from them over the used quantities, the weights held, its point kept
-** when lower (and, after a search kept to stable lattices, stable). Returns the RSS of v,
-** CF_LSQ_HUGE_OBJ when the best point runs no table. */
+** when lower (and, after a search kept to stable lattices, stable and buildable). Returns the
+** RSS of v, CF_LSQ_HUGE_OBJ when the best point runs no table. */
 static double pair_quantities(jctx *c, pair_search *s, const int used[PQ_COUNT],
                               double v[PQ_COUNT], double *A, cf_error *err)
 {
@@ -617,7 +609,8 @@ static double pair_quantities(jctx *c, pair_search *s, const int used[PQ_COUNT],
             c->tau = vp[PQ_T];
         if (opt->volume != CF_VOLUME_POISSON)
             c->kappa_mode = KAPPA_UNIT, c->kappa = vp[PQ_K] / vp[PQ_AC];
-        if (!cf_joint_stable_at(c, vp[PQ_RC], vp[PQ_BC]))
+        if (!cf_joint_pair_buildable(c, vp[PQ_RC], vp[PQ_BC], vp[PQ_AC]) ||
+            !cf_joint_stable_at(c, vp[PQ_RC], vp[PQ_BC]))
             fp = CF_LSQ_HUGE_OBJ;
     }
     if (fp < best) {
@@ -637,9 +630,10 @@ static double pair_quantities(jctx *c, pair_search *s, const int used[PQ_COUNT],
 }
 
 /* Steps 5 and 6 from the last search's latest point back (s->hist): the point's quantities
-** polished into v and both springs placed into r. The search does not see buildability, and its
-** rounds can walk past it: a point whose springs are not both buildable gives way to the one the
-** round before ended on; when none is buildable, the latest is kept. Returns the RSS of v as
+** polished into v and both springs placed into r. A search kept to stable lattices keeps to
+** buildable springs too (cf_joint_pair_buildable); one that is not (no stable point found) can
+** walk past them: a point whose springs are not both buildable gives way to the one the round
+** before ended on; when none is buildable, the latest is kept. Returns the RSS of v as
 ** pair_quantities does (-1 on an error, *st then set). */
 static double pair_finish(jctx *c, const cf_table *reach, pair_search *s,
                           const int used[PQ_COUNT], double v[PQ_COUNT], double *A,
@@ -739,6 +733,7 @@ cf_status cf_joint_search_pair(jctx *c, const cf_table *reach, double xmax,
         c->tau = TAU_HELD;
     }
     s.o = (pair_obj){c, &s.pv};
+    c->reach = reach;
     if ((st = pair_starts(c, plain, &s, err)) != CF_OK ||
         (st = pair_keep_stable(c, &s, err)) != CF_OK)
         return st;

@@ -380,3 +380,40 @@ cf_status cf_joint_pair_place(const jctx *c, const cf_table *reach, const double
     }
     return CF_OK;
 }
+
+/* 1 when both springs of the context's law at (rho, B) and compression stress scale A can be
+** built (cf_joint_pair_place over c->reach; 1 when the context has no reach). The search does not
+** see buildability otherwise, and its searches kept to stable lattices walked to springs that
+** cannot be built, the pair then falling back to the law it contains (issue 42). */
+int cf_joint_pair_buildable(const jctx *c, double rho, double B, double A)
+{
+    if (!c->reach)
+        return 1;
+    if (!(A > 0) || !isfinite(A))
+        return 0;
+    double v[PQ_COUNT] = {0};
+    v[PQ_RC] = rho, v[PQ_BC] = B, v[PQ_AC] = A;
+    if (c->tail)
+        v[PQ_T] = c->tau;
+    if (c->pair)
+        v[PQ_RE] = c->ext[0], v[PQ_BE] = c->ext[1], v[PQ_AE] = A * c->ext[2];
+    cf_joint_result r;
+    memset(&r, 0, sizeof r);
+    cf_error e = {0};
+    return cf_joint_pair_place(c, c->reach, v, &r, &e) == CF_OK && r.fit.feasible;
+}
+
+/* The fitted kappa of the law a search contains (plain) over its compression spring's k0/H (the
+** search's variable, KAPPA_REL); 0 when it has none. */
+double cf_joint_nest_kappa_rel(const cf_joint_result *plain)
+{
+    if (plain->volume != CF_VOLUME_FIT || !(plain->volume_modulus_MPa > 0) ||
+        !(plain->ident.scale > 0))
+        return 0;
+    const cf_ident q1 = {.rho = plain->ident.rho, .solid = plain->ident.solid, .scale = 1.0};
+    const cf_spring p1 = cf_ident_member(&q1);
+    cf_law l1;
+    if (cf_law_init(&l1, &p1, NULL) != CF_OK)
+        return 0;
+    return plain->volume_modulus_MPa / (plain->ident.scale * l1.k0_N_per_mm / l1.p.H_mm);
+}

@@ -361,12 +361,14 @@ static void assert_elliptic_verdicts(const cf_joint_report *r, const char *file)
 /* The brain cortex (Budday et al. 2017) in tension, compression and shear, --joint --law auto
 ** --volume fit (issue 35's target): the kept element a buildable double-acting pair whose full
 ** lattice (2^3 and 3^3 cells) is stable over every table's range, its weighted objective at or
-** below 0.3 of one-term Ogden's 0.0343 (0.01029; 0.008504 measured with the lattice's hourglass
-** control and the search kept to stable lattices, a tailed compression spring; half Ogden's,
-** 0.01715, was the target before; 0.01248 before the hourglass control);
+** below CORTEX_MAX (0.00802 measured with the search kept to stable lattices and buildable springs,
+** a tailed compression spring; 0.008504 when the search saw stability alone: the bound holds
+** that the search no longer walks off to unbuildable springs; 0.3 of one-term Ogden's 0.0343,
+** 0.01029, before; 0.01248 before the hourglass control);
 ** every table's cell curve finite; the fit file holds params_extension, the tail and
 ** lattice.volume_modulus_MPa; each table's strong-ellipticity verdict
 ** (assert_elliptic_verdicts). */
+#define CORTEX_MAX 0.0083
 static void brain_cortex_stable_pair_below_ogden(void **state)
 {
     (void)state;
@@ -385,13 +387,14 @@ static void brain_cortex_stable_pair_below_ogden(void **state)
     const int b = cf_joint_better(&r);
     assert_true(b >= 0);
     const cf_joint_result *j = &r.fits[b];
-    if (!(j->objective <= 0.01029))
-        fail_msg("objective %.6g above 0.3 of one-term Ogden's 0.0343 (0.01029)", j->objective);
+    if (!(j->objective <= CORTEX_MAX))
+        fail_msg("objective %.6g above %g (one-term Ogden's: 0.0343)", j->objective, CORTEX_MAX);
     assert_true(j->pair && j->fit.feasible && j->ext.feasible);
     /* which compression spring: with the lattice's hourglass control (lattice_hourglass.h) the
-    ** conical pair's optimum, 0.01713, is stable, and the tailed pair's, 0.008504, stable and
-    ** buildable, is kept (its search's last rounds walk on to an unbuildable 0.007851, which gives
-    ** way to the round before); before the control, the tailed pair was kept at 0.01248 */
+    ** conical pair's optimum, 0.01713, is stable, and the tailed pair's, 0.00802, stable and
+    ** buildable, is kept (its search's last rounds, seeing stability alone, had walked on to an
+    ** unbuildable 0.007851 and given way to the round before, 0.008504); before the control, the
+    ** tailed pair was kept at 0.01248 */
     const int tail = r.law_choice[b].pair_tail_kept;
     assert_int_equal(j->fit.tail != 0, tail);
     if (tail)

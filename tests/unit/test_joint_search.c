@@ -360,10 +360,11 @@ static void brain_like_ogden_solids(void **state)
 /* The brain corona radiata in tension and compression (shared tables), --law auto --volume fit:
 ** every search's optimum buckles in the lattice, so the search keeps what it finds from stable
 ** points projected from its unstable ends (a stiffer extension spring, a smaller kappa). Kept:
-** at most CORONA_MAX (0.003686 measured; 0.007818 before the projection, src/notes/lattice-fit.md),
+** at most CORONA_MAX (0.003448 measured with the wall asking for buildable springs too; 0.003686
+** with stability alone, 0.007818 before the projection, src/notes/lattice-fit.md),
 ** buildable, stable over every table's range with the margin, the check the verification's; the
 ** projection found stable points in some search; nested laws never lose. */
-#define CORONA_MAX 0.0045
+#define CORONA_MAX 0.0036
 static void coronaradiata_projected_search(void **state)
 {
     (void)state;
