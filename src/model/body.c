@@ -132,6 +132,7 @@ void cf_body_free(cf_body *b)
     for (size_t g = 0; b->gown && g < b->ngroups; g++)
         cf_law_free(&b->gown[g]);
     free(b->gown);
+    free(b->elem);
     memset(b, 0, sizeof *b);
 }
 

@@ -158,6 +158,8 @@ typedef struct cf_body {
     uint8_t *group;        /* ns: the spring's group, 0 for law's, g for group g; NULL: none */
     const cf_law *glaw[CF_BODY_MAX_GROUPS + 1]; /* glaw[0] = law, glaw[g] = gown + g - 1 */
     cf_law *gown;          /* the groups' laws (owned) */
+    double *elem;          /* 36 nt, or NULL (none): per tetrahedron the element term's tensor in
+                           ** Voigt form (cf_body_match_elements), MPa. Released by cf_body_free */
 } cf_body;
 
 /* The law of spring s (its group's). */
@@ -186,6 +188,16 @@ cf_status cf_body_set_groups(cf_body *b, const cf_mesh *m, size_t n, const cf_se
 cf_status cf_body_create(cf_body *b, const cf_mesh *m, const cf_law *law, cf_law_method method,
                          double kappa_MPa, cf_error *err);
 void cf_body_free(cf_body *b);
+
+/* Gives every tetrahedron of b the element term that makes its small-strain tensor, with its
+** share of its six springs', the isotropic one of shear modulus mu and lambda = mu exactly (the
+** volume term adding kappa as before): the body becomes the linear tetrahedron of the
+** isotropic material, which converges to the continuum under refinement where the springs
+** alone relax below their calibration (src/notes/contact-study.md, "The element term"). At
+** finite strain the term is Saint Venant-Kirchhoff's in the Green-Lagrange strain. Not done by
+** cf_body_create: a body without it keeps its springs' response. CF_E_DATA for a body with
+** spring groups, CF_E_INTERNAL when memory runs out. */
+cf_status cf_body_match_elements(cf_body *b, cf_error *err);
 
 /* kappa of the volume term that gives the calibrated body (shear modulus mu) Poisson's ratio nu
 ** (0.25 <= nu < 0.5). */

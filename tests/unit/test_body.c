@@ -284,6 +284,78 @@ static void hertz_sphere_nu_045(void **state)
 ** one, and it relaxes below their average, the calibration's. On the study's middle mesh (2,830
 ** nodes), an affine strain on the block's boundary and the inner nodes free: 0.9545 (uniaxial
 ** strain), 0.9338 and 0.9385 (shears), 0.9271 (pure shear) of the calibrated energy, measured */
+/* The element term (cf_body_match_elements) passes the patch test the springs alone fail: an
+** affine small strain on every node of a graded Gmsh block (as the contact study's meshes are
+** graded) leaves no force on an inner node, and the top face carries the isotropic continuum's
+** stress (lambda + 2 mu) eps for uniaxial strain and mu gamma for shear (lambda = mu); without
+** the term the inner nodes carry out-of-balance forces (the heterogeneity that relaxes,
+** src/notes/contact-study.md). */
+static void patch_test(const cf_body *b, const double *G, double eps, double *inner,
+                       double top[3])
+{
+    cf_error err = {0};
+    double *g = malloc(3 * b->nn * sizeof *g);
+    assert_non_null(g);
+    cf_body *bb = (cf_body *)b;
+    for (size_t i = 0; i < b->nn; i++)
+        for (int a = 0; a < 3; a++) {
+            double u = 0;
+            for (int q = 0; q < 3; q++)
+                u += G[3 * a + q] * b->X[3 * i + q];
+            bb->x[3 * i + a] = b->X[3 * i + a] + eps * u;
+        }
+    assert_int_equal(cf_body_internal_force(b, g, &err), CF_OK);
+    *inner = 0;
+    top[0] = top[1] = top[2] = 0;
+    for (size_t i = 0; i < b->nn; i++) {
+        const double *X = b->X + 3 * i;
+        const int bnd = X[0] < 1e-9 || X[1] < 1e-9 || X[2] > -1e-9 || X[0] > 4 - 1e-9 ||
+                        X[1] > 4 - 1e-9 || X[2] < -4 + 1e-9;
+        for (int a = 0; a < 3; a++) {
+            if (!bnd)
+                *inner = fmax(*inner, fabs(g[3 * i + a]));
+            if (X[2] > -1e-9)
+                top[a] += g[3 * i + a];
+        }
+    }
+    memcpy(bb->x, b->X, 3 * b->nn * sizeof *b->x);
+    free(g);
+}
+
+static void the_element_term_passes_the_patch_test(void **state)
+{
+    (void)state;
+    cf_law law = test_law();
+    double lo[3] = {0, 0, -4}, hi[3] = {4, 4, 0}, f[3] = {0, 0, 0};
+    cf_mesh m;
+    cf_error err = {0};
+    assert_int_equal(cf_mesh_box(lo, hi, f, 0.1, 1, 0.3, &m, &err), CF_OK);
+    cf_body b;
+    assert_int_equal(cf_body_create(&b, &m, &law, CF_LAW_CLOSED, 0, &err), CF_OK);
+    const double mu = b.mu_MPa, eps = 1e-6, A = 16; /* top face 4 x 4 mm */
+    static const double UZ[9] = {0, 0, 0, 0, 0, 0, 0, 0, 1}, XZ[9] = {0, 0, 1, 0, 0, 0, 0, 0, 0};
+    double inner, top[3];
+    /* the springs alone: out of balance inside, the top's stress off the continuum's */
+    patch_test(&b, UZ, eps, &inner, top);
+    const double scale = 3 * mu * eps * A; /* the top face's force, N */
+    print_message("springs: %zu nodes, inner force %.3g of the top's, top %.4f of (lambda+2mu) eps A\n",
+                  b.nn, inner / scale, top[2] / scale);
+    assert_true(inner > 1e-3 * scale);
+    assert_int_equal(cf_body_match_elements(&b, &err), CF_OK);
+    patch_test(&b, UZ, eps, &inner, top);
+    print_message("element term: inner %.3g, top %.6f\n", inner / scale, top[2] / scale);
+    assert_true(inner < 1e-5 * scale);
+    assert_close(top[2] / scale, 1, 1e-5);
+    patch_test(&b, XZ, eps, &inner, top); /* u_x = eps z: shear gamma = eps, sigma_xz = mu eps */
+    print_message("element term, shear: inner %.3g, top x %.6f\n", inner / scale,
+                  top[0] / (mu * eps * A));
+    assert_true(inner < 1e-5 * scale);
+    assert_close(top[0] / (mu * eps * A), 1, 1e-5);
+    cf_body_free(&b);
+    cf_mesh_free(&m);
+    cf_law_free(&law);
+}
+
 static void the_network_relaxes_below_its_calibration(void **state)
 {
     (void)state;
@@ -871,6 +943,7 @@ int main(void)
         cmocka_unit_test(hertz_sphere_nu_025),
         cmocka_unit_test(hertz_sphere_nu_045),
         cmocka_unit_test(the_network_relaxes_below_its_calibration),
+        cmocka_unit_test(the_element_term_passes_the_patch_test),
         cmocka_unit_test(boussinesq_punch_nu_025),
         cmocka_unit_test(boussinesq_punch_nu_045),
         cmocka_unit_test(a_probe_inside_the_body_is_found),
