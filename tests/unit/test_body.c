@@ -284,6 +284,22 @@ static void hertz_sphere_nu_045(void **state)
 ** one, and it relaxes below their average, the calibration's. On the study's middle mesh (2,830
 ** nodes), an affine strain on the block's boundary and the inner nodes free: 0.9545 (uniaxial
 ** strain), 0.9338 and 0.9385 (shears), 0.9271 (pure shear) of the calibrated energy, measured */
+/* cf_mesh_box's size check counts a graded box's cells by its grading: a 90 mm block at 0.02 mm
+** under the contact, growing 0.3 mm per mm (730 nodes), meshes (main refused it: 0.02 mm against
+** the whole volume); a uniform 0.01 mm in it is still refused before Gmsh starts. */
+static void a_graded_box_is_budgeted_by_its_grading(void **state)
+{
+    (void)state;
+    double lo[3] = {0, 0, -90}, hi[3] = {90, 90, 0}, f[3] = {0, 0, 0};
+    cf_mesh m;
+    cf_error err = {0};
+    assert_int_equal(cf_mesh_box(lo, hi, f, 0.02, 20, 0.3, &m, &err), CF_OK);
+    assert_true(m.nn > 500 && m.nn < 2000);
+    cf_mesh_free(&m);
+    assert_int_equal(cf_mesh_box(lo, hi, f, 0.01, 0.01, 0, &m, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "too small for the box"));
+}
+
 /* The element term (cf_body_match_elements) passes the patch test the springs alone fail: an
 ** affine small strain on every node of a graded Gmsh block (as the contact study's meshes are
 ** graded) leaves no force on an inner node, and the top face carries the isotropic continuum's
@@ -944,6 +960,7 @@ int main(void)
         cmocka_unit_test(hertz_sphere_nu_045),
         cmocka_unit_test(the_network_relaxes_below_its_calibration),
         cmocka_unit_test(the_element_term_passes_the_patch_test),
+        cmocka_unit_test(a_graded_box_is_budgeted_by_its_grading),
         cmocka_unit_test(boussinesq_punch_nu_025),
         cmocka_unit_test(boussinesq_punch_nu_045),
         cmocka_unit_test(a_probe_inside_the_body_is_found),
