@@ -583,6 +583,31 @@ cf_status cf_mesh_read_refined(const char *path, double unit_mm, int refine,
     return st;
 }
 
+/* An upper bound on the number of element-sized cubes in the box lo..hi graded as cf_mesh_box
+** grades it (size h0 at focus, growing by g per mm, at most hf): the smaller of the box's volume
+** over h0^3 and, the graded part taken as the whole ball about focus that reaches the box's
+** farthest corner, the integral of 4 pi x^2 / (h0 + g x)^3 out to where the size reaches hf plus
+** the box's volume over hf^3. */
+static double box_cells(const double lo[3], const double hi[3], const double focus[3], double h0,
+                        double hf, double g)
+{
+    const double vol = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+    const double flat = vol / (h0 * h0 * h0);
+    if (!(g > 0))
+        return flat;
+    double r2 = 0;
+    for (int a = 0; a < 3; a++) {
+        const double e = fmax(fabs(hi[a] - focus[a]), fabs(focus[a] - lo[a]));
+        r2 += e * e;
+    }
+    /* with u = h0 + g x: (1/g^3) [ln u + 2 h0 / u - h0^2 / (2 u^2)] from h0 to u1 */
+    const double u1 = fmin(hf, h0 + g * sqrt(r2));
+    const double F1 = log(u1) + 2 * h0 / u1 - h0 * h0 / (2 * u1 * u1);
+    const double F0 = log(h0) + 2 - 0.5;
+    const double graded = 4 * M_PI * (F1 - F0) / (g * g * g) + vol / (hf * hf * hf);
+    return fmin(flat, graded);
+}
+
 cf_status cf_mesh_box(const double lo[3], const double hi[3], const double focus[3],
                       double size_near, double size_far, double growth, cf_mesh *m, cf_error *err)
 {
@@ -595,8 +620,7 @@ cf_status cf_mesh_box(const double lo[3], const double hi[3], const double focus
         return cf_error_set(err, CF_E_DATA, "box: element sizes %g, %g and growth %g: need "
                                             "0 < near <= far and growth >= 0",
                             size_near, size_far, growth);
-    double vol = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
-    if (vol / (size_near * size_near * size_near) > 1e8)
+    if (box_cells(lo, hi, focus, size_near, size_far, growth) > 1e8)
         return cf_error_set(err, CF_E_DATA, "box: element size %g mm too small for the box",
                             size_near);
     const double box[12] = {lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], focus[0], focus[1], focus[2],

@@ -139,6 +139,7 @@ void cf_body_free(cf_body *b)
     free(b->flaw);
     free(b->fdir);
     free(b->fgrad);
+    free(b->elem);
     memset(b, 0, sizeof *b);
 }
 

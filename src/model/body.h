@@ -167,6 +167,8 @@ typedef struct cf_body {
                            ** tetrahedron t at fdir[3 (CF_FIBRE_MAX t + k)] */
     double *fgrad;         /* 12 nt: each tetrahedron's reference shape-function gradients, its
                            ** four corners' (1/mm) */
+    double *elem;          /* 36 nt, or NULL (none): per tetrahedron the element term's tensor in
+                           ** Voigt form (cf_body_match_elements), MPa. Released by cf_body_free */
 } cf_body;
 
 /* The law of spring s (its group's). */
@@ -217,6 +219,16 @@ cf_status cf_body_helix_dirs(const cf_body *b, const double normal[3], const dou
 cf_status cf_body_create(cf_body *b, const cf_mesh *m, const cf_law *law, cf_law_method method,
                          double kappa_MPa, cf_error *err);
 void cf_body_free(cf_body *b);
+
+/* Gives every tetrahedron of b the element term that makes its small-strain tensor, with its
+** share of its six springs', the isotropic one of shear modulus mu and lambda = mu exactly (the
+** volume term adding kappa as before): the body becomes the linear tetrahedron of the
+** isotropic material, which converges to the continuum under refinement where the springs
+** alone relax below their calibration (src/notes/contact-study.md, "The element term"). At
+** finite strain the term is Saint Venant-Kirchhoff's in the Green-Lagrange strain. Not done by
+** cf_body_create: a body without it keeps its springs' response. CF_E_DATA for a body with
+** spring groups, CF_E_INTERNAL when memory runs out. */
+cf_status cf_body_match_elements(cf_body *b, cf_error *err);
 
 /* kappa of the volume term that gives the calibrated body (shear modulus mu) Poisson's ratio nu
 ** (0.25 <= nu < 0.5). */

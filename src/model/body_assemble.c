@@ -409,6 +409,32 @@ end:
     return ok;
 }
 
+/* The element term (cf_body_match_elements) of every tetrahedron into g and, when P is not NULL,
+** the tangent. Returns 0 for a flat tetrahedron. */
+static int elem_term(const cf_body *b, const double *x, double *g, pattern *P)
+{
+    double f[12], K[144];
+    for (size_t t = 0; t < b->nt; t++) {
+        if (!body_elem_tet(b, x, t, f, P ? K : NULL))
+            return 0;
+        const uint32_t *v = b->tet + 4 * t;
+        for (int m = 0; m < 4; m++)
+            for (int a = 0; a < 3; a++)
+                g[3 * v[m] + a] += f[3 * m + a];
+        if (!P)
+            continue;
+        for (int m = 0; m < 4; m++)
+            for (int q = 0; q < 4; q++) {
+                double B[9];
+                for (int a = 0; a < 3; a++)
+                    for (int c = 0; c < 3; c++)
+                        B[3 * a + c] = K[12 * (3 * m + a) + 3 * q + c];
+                add_block(P, v[q], P->tblk[16 * t + 4 * (size_t)m + (size_t)q], B);
+            }
+    }
+    return 1;
+}
+
 /* Energy gradient g (3 nn) and, when P is not NULL, the tangent at positions x; contact forces of
 ** the probe at c added (as -f to g) with their tangent. Returns the reaction along the probe's
 ** direction and the number of nodes in contact. */
@@ -449,6 +475,8 @@ double cf_body_assemble(const cf_body *b, const double *x, const cf_probe *pr, c
         return NAN;
     if (b->nfibre)
         cf_body_fibre_forces(b, x, g, P);
+    if (b->elem && !elem_term(b, x, g, P))
+        return NAN;
     if (b->f_ext)
         for (size_t i = 0; i < 3 * b->nn; i++)
             g[i] -= b->f_ext[i];

@@ -11,7 +11,8 @@
 ** and, with --ccx, C3D10's force over theory and conifit's over C3D10's. STUDY_ELEM=C3D4 writes
 ** linear tetrahedra instead; STUDY_CONTACT=1 (sphere) lets CalculiX find its own contact with a
 ** rigid sphere instead of taking conifit's contact nodes; STUDY_SCALE=S multiplies every
-** spring's factor by S; STUDY_R, STUDY_D and STUDY_STEPS change the sphere and its steps.
+** spring's factor by S (STUDY_MATCH=1 gives the body its element term first); STUDY_W sets the
+** block's side, STUDY_H0, STUDY_GROW, STUDY_HMAX its grading; STUDY_R, STUDY_D and STUDY_STEPS change the sphere and its steps.
 */
 #include <math.h>
 #include <stdint.h>
@@ -224,7 +225,7 @@ int main(int argc, char **argv)
     const char *ccxdir = argc > 5 && strcmp(argv[4], "--ccx") == 0 ? argv[5] : NULL;
     const char *env;
     /* the block and the probes: a contact radius of about 1 mm in both */
-    const double W = 30, D = 30;
+    const double W = (env = getenv("STUDY_W")) ? atof(env) : 30, D = W;
     const double R = punch ? 1 : ((env = getenv("STUDY_R")) ? atof(env) : 40);
     const double d = punch ? 0.01 : ((env = getenv("STUDY_D")) ? atof(env) : 0.025);
     const int steps = (env = getenv("STUDY_STEPS")) ? atoi(env) : 2;
@@ -235,7 +236,12 @@ int main(int argc, char **argv)
         return 70;
     double lo[3] = {0, 0, -D}, hi[3] = {W, W, 0}, focus[3] = {0, 0, 0};
     cf_mesh m;
-    if (cf_mesh_box(lo, hi, focus, 0.3 / r, 8 / r, 0.4 / r, &m, &err) != CF_OK) {
+    /* STUDY_H0, STUDY_GROW, STUDY_HMAX: the element size at the contact point (mm), its growth
+    ** (mm per mm) and its largest value (mm), each divided by REFINE; STUDY_W the block's side */
+    const double h0 = (env = getenv("STUDY_H0")) ? atof(env) : 0.3;
+    const double hg = (env = getenv("STUDY_GROW")) ? atof(env) : 0.4;
+    const double hm = (env = getenv("STUDY_HMAX")) ? atof(env) : 8;
+    if (cf_mesh_box(lo, hi, focus, h0 / r, hm / r, hg / r, &m, &err) != CF_OK) {
         fprintf(stderr, "%s\n", err.msg);
         return 70;
     }
@@ -243,6 +249,11 @@ int main(int argc, char **argv)
     if (cf_body_create(&b, &m, &law, CF_LAW_CLOSED,
                        cf_body_kappa_for_nu(cf_body_mu_of_law(&law), nu), &err) != CF_OK)
         return 70;
+    /* STUDY_MATCH=1: the element term (cf_body_match_elements) */
+    if ((env = getenv("STUDY_MATCH")) && atoi(env) && cf_body_match_elements(&b, &err) != CF_OK) {
+        fprintf(stderr, "%s\n", err.msg);
+        return 70;
+    }
     /* STUDY_SCALE: every spring's factor times this (the relaxed calibration's experiment) */
     if ((env = getenv("STUDY_SCALE")))
         for (size_t s = 0; s < b.ns; s++)
