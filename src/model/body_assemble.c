@@ -429,7 +429,7 @@ static int elem_term(const cf_body *b, const double *x, double *g, pattern *P)
                 for (int a = 0; a < 3; a++)
                     for (int c = 0; c < 3; c++)
                         B[3 * a + c] = K[12 * (3 * m + a) + 3 * q + c];
-                add_block(P, v[q], P->tblk[16 * t + 4 * (size_t)m + (size_t)q], B);
+                body_add_block(P, v[q], P->tblk[16 * t + 4 * (size_t)m + (size_t)q], B);
             }
     }
     return 1;
