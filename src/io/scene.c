@@ -677,9 +677,7 @@ static cf_status parse_root(ctx *c, json_t *root, cf_scene *sc)
     if ((st = cf_scene_body(c, root, sc)) || (st = haptic_key(c, root, sc)))
         return st;
     if ((st = cf_scene_object(c, root, "lattice", 0, &lt)) || (st = lattice_section(c, lt, sc)) ||
-        (st = cf_scene_groups(c, root, sc)) ||
-        (st = sc->has_body && !sc->fibre_fit ? cf_scene_body_fibres(c, root, sc)
-                                             : cf_scene_fibres(c, root, sc)))
+        (st = cf_scene_groups(c, root, sc)) || (st = cf_scene_fibres(c, root, sc)))
         return st;
     if ((st = cf_scene_number(c, root, "", "density_t_per_mm3", 0, 1e-9, 0, 1, 1, 
                      &sc->cfg.lattice.density_t_per_mm3)))

@@ -131,6 +131,8 @@ static cf_status fit_lattice(ctx *c, json_t *root, cf_scene *sc)
 cf_status cf_scene_fibres(ctx *c, json_t *root, cf_scene *sc)
 {
     json_t *fs = json_object_get(root, "fibres");
+    if (sc->has_body && !sc->fibre_fit)
+        return cf_scene_body_fibres(c, root, sc); /* a body's entries: helix rules */
     if (sc->fibre_fit)
         return sc->has_body ? cf_error_set(c->err, CF_E_DATA, "%s: key 'fibres': a tissue body "
                                            "does not take a fibre fit here", c->name)
@@ -138,9 +140,6 @@ cf_status cf_scene_fibres(ctx *c, json_t *root, cf_scene *sc)
     sc->nfibres = 0;
     if (!fs)
         return CF_OK;
-    if (sc->has_body)
-        return cf_error_set(c->err, CF_E_DATA, "%s: key 'fibres': a tissue body does not take "
-                            "fibre groups here (a lattice scene does)", c->name);
     if (!json_is_array(fs) || json_array_size(fs) == 0 || json_array_size(fs) > CF_FIBRE_MAX)
         return cf_error_set(c->err, CF_E_DATA,
                             "%s: key 'fibres' must be an array of 1 to %d {\"axis\", \"spring\", "

@@ -70,7 +70,8 @@ cf_status cf_scene_fibre_entry(ctx *c, json_t *e, const char *where, cf_scene_fi
 ** fibre groups (density 1, along x, y, z for f, s, n); "spring" or "spring_extension" beside it
 ** refused. */
 cf_status cf_scene_fibre_fit(ctx *c, json_t *root, cf_scene *sc);
-/* "fibres" of a lattice scene's root (after "groups"): 1 to CF_FIBRE_MAX entries; after a fibre
+/* "fibres" of a scene's root (after "groups"; a body's go to cf_scene_body_fibres): a lattice's
+** 1 to CF_FIBRE_MAX entries; after a fibre
 ** fit (cf_scene_fibre_fit) the lattice's weights and kappa, the fit's (the lattice's own weight
 ** and volume keys refused beside it). */
 cf_status cf_scene_fibres(ctx *c, json_t *root, cf_scene *sc);
