@@ -63,17 +63,8 @@ static cf_status fibre_entry(ctx *c, json_t *e, size_t i, cf_scene *sc)
     if ((st = helix(c, h, hw, f)) ||
         (st = cf_scene_number(c, e, where, "density", 0, 1, 0, 1, 1e6, &f->density)))
         return st;
-    cf_scene_group g;
-    memset(&g, 0, sizeof g);
-    if ((st = cf_scene_group_spring(c, sp, sw, &g)))
+    if ((st = cf_scene_fibre_spring(c, e, where, &f->spring, f->source)))
         return st;
-    cf_law law;
-    cf_error lerr = {0};
-    if (cf_law_init(&law, &g.spring, &lerr) != CF_OK)
-        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s': %s", c->name, sw, lerr.msg);
-    cf_law_free(&law);
-    f->spring = g.spring;
-    memcpy(f->source, g.source, sizeof f->source);
     sc->body_nfibres++;
     return CF_OK;
 }

@@ -39,6 +39,12 @@ cf_status cf_scene_fibre_entry(ctx *c, json_t *e, const char *where, cf_scene_fi
                             "cell)", c->name, where);
     if ((st = cf_scene_number(c, e, where, "density", 1, 0, 0, 1, MAX_DENSITY, &f->density)))
         return st;
+    return cf_scene_fibre_spring(c, e, where, &f->spring, f->source);
+}
+
+cf_status cf_scene_fibre_spring(ctx *c, json_t *e, const char *where, cf_spring *spring,
+                                char source[600])
+{
     char sw[96];
     snprintf(sw, sizeof sw, "%s.spring", where);
     json_t *sp = json_object_get(e, "spring");
@@ -46,15 +52,16 @@ cf_status cf_scene_fibre_entry(ctx *c, json_t *e, const char *where, cf_scene_fi
         return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' is required", c->name, sw);
     cf_scene_group g;
     memset(&g, 0, sizeof g);
-    if ((st = cf_scene_group_spring(c, sp, sw, &g)))
+    cf_status st = cf_scene_group_spring(c, sp, sw, &g);
+    if (st)
         return st;
     cf_law law;
     cf_error lerr = {0};
     if (cf_law_init(&law, &g.spring, &lerr) != CF_OK)
         return cf_error_set(c->err, CF_E_DATA, "%s: key '%s': %s", c->name, sw, lerr.msg);
     cf_law_free(&law);
-    f->spring = g.spring;
-    memcpy(f->source, g.source, sizeof f->source);
+    *spring = g.spring;
+    memcpy(source, g.source, 600);
     return CF_OK;
 }
 
