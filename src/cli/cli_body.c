@@ -63,8 +63,8 @@ static void run_free(run *r)
     cf_body_motion_free(&r->motion);
 }
 
-cf_status cf_cli_body_load(const cf_scene *sc, const cf_budget *budget, double node_bytes,
-                           cf_law *law, cf_law *ext, cf_mesh *mesh,
+cf_status cf_cli_body_load(const cf_scene *sc, const char *scene_path, const cf_budget *budget,
+                           double node_bytes, cf_law *law, cf_law *ext, cf_mesh *mesh,
                            cf_mesh_surface_info *surface, cf_error *err)
 {
     cf_status st;
@@ -73,8 +73,13 @@ cf_status cf_cli_body_load(const cf_scene *sc, const cf_budget *budget, double n
     ** spring joined to it) */
     if ((st = cf_scene_law(sc, law, ext, err)) != CF_OK)
         return st;
+    const double tables = cf_budget_law_tables_bytes(sc);
+    if (tables >= budget->max_memory_bytes)
+        return cf_error_set(err, CF_E_DATA, "%s: key 'table_intervals' = %zu: the law tables need "
+                            "%.3g bytes, over the limit %.3g (--max-memory)", scene_path,
+                            sc->table_intervals, tables, budget->max_memory_bytes);
     cf_mesh_limits lim = cf_mesh_limits_default();
-    lim.max_bytes = budget->max_memory_bytes;
+    lim.max_bytes = budget->max_memory_bytes - tables; /* what the mesh and its solve may take */
     lim.node_bytes = node_bytes;
     st = sc->body_element_size_mm > 0
              ? cf_mesh_from_surface(sc->body_mesh, sc->body_unit_mm, sc->body_element_size_mm,
@@ -86,13 +91,6 @@ cf_status cf_cli_body_load(const cf_scene *sc, const cf_budget *budget, double n
         snprintf(err->msg + n, sizeof err->msg - n, " (raise it with --max-memory)");
     }
     return st;
-}
-
-/* What a static or dynamic run spends per node (solve's estimate, below). */
-static double body_node_bytes(const cf_scene *sc, int keep_forces)
-{
-    return 3 * (81.0 * 16 * 8 + 40.0 * 81 * 8) +
-           (sc->body_steps + 1.0) * 3 * 8 * (keep_forces ? 3 : 1) + (double)sc->nregions;
 }
 
 cf_status cf_cli_body_create(const cf_scene *sc, const cf_law *law, const cf_mesh *mesh,
@@ -289,15 +287,15 @@ static cf_status solve(const cf_scene *sc, const char *scene_path, const cf_budg
                        cf_error *err)
 {
     cf_status st;
-    if ((st = cf_cli_body_load(sc, budget, body_node_bytes(sc, r->keep_forces), &r->law, &r->ext,
-                               &r->mesh, &r->surface, err)) != CF_OK)
+    if ((st = cf_cli_body_load(sc, scene_path, budget, cf_budget_body_node_bytes(sc, r->keep_forces),
+                               &r->law, &r->ext, &r->mesh, &r->surface, err)) != CF_OK)
         return st;
     const size_t steps = r->steps = (size_t)sc->body_steps;
     if (sc->body_dynamic && (st = dynamic_budget(sc, scene_path, budget, r->mesh.nn, err)))
         return st;
-    /* memory: the factor of the tangent (about 40 times its 3 x 3 blocks for meshes of organ
-    ** size), the matrix, and one copy of the positions per step */
-    double bytes = (double)r->mesh.nn * body_node_bytes(sc, r->keep_forces);
+    /* memory: per node (cf_budget_body_node_bytes) and the law tables */
+    double bytes = r->mesh.nn * cf_budget_body_node_bytes(sc, r->keep_forces) +
+                   cf_budget_law_tables_bytes(sc);
     if (bytes > budget->max_memory_bytes)
         return cf_error_set(err, CF_E_DATA, "%s: the body of %s (%zu nodes, %zu steps) needs "
                             "about %.3g bytes, over the limit %.3g (--max-memory)",

@@ -26,12 +26,14 @@ cf_status cf_cli_body_export(const cf_scene *sc, const char *scene_path, const c
 /* What every body command builds as simulate does (cli_haptic.c too): the scene's law (with its
 ** table; a double-acting element's extension spring into *ext, joined to *law: cf_scene_law; free
 ** both with cf_law_free) and mesh (read and refined, or filled from a closed surface; surface, which may be NULL,
-** receives what filling found) under the budget's memory, node_bytes being what the command
-** will spend per node (refused before Gmsh starts when the mesh's estimate passes the limit); the
+** receives what filling found) under the budget's memory less the law tables
+** (cf_budget_law_tables_bytes; CF_E_DATA naming scene_path and 'table_intervals' when they alone
+** pass it), node_bytes being what the command will spend per node (refused before Gmsh starts
+** when the mesh's estimate passes the limit); the
 ** body on them with the scene's volume term; the probe checked to start outside it (CF_E_DATA
 ** naming probe.center_mm and the node). */
-cf_status cf_cli_body_load(const cf_scene *sc, const cf_budget *budget, double node_bytes,
-                           cf_law *law, cf_law *ext, cf_mesh *mesh,
+cf_status cf_cli_body_load(const cf_scene *sc, const char *scene_path, const cf_budget *budget,
+                           double node_bytes, cf_law *law, cf_law *ext, cf_mesh *mesh,
                            cf_mesh_surface_info *surface, cf_error *err);
 cf_status cf_cli_body_create(const cf_scene *sc, const cf_law *law, const cf_mesh *mesh,
                              cf_body *b, cf_error *err);

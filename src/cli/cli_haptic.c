@@ -121,8 +121,9 @@ static cf_status run(const cf_scene *sc, const char *scene_path, const cf_budget
                             "ms to %g ms), over the limit %.3g (--max-steps)",
                             scene_path, r->n, T, budget->max_steps);
     /* per node: two bodies as the static run counts one, and the kept columns (below) */
-    if ((st = cf_cli_body_load(sc, budget, 2 * 3 * (81.0 * 16 * 8 + 40.0 * 81 * 8) + 9 * 1000 * 8,
-                               &r->law, &r->ext, &r->mesh, NULL, err)) != CF_OK)
+    const double node_bytes = 2 * 3 * (81.0 * 16 * 8 + 40.0 * 81 * 8) + 9 * 1000 * 8;
+    if ((st = cf_cli_body_load(sc, scene_path, budget, node_bytes, &r->law, &r->ext, &r->mesh,
+                               NULL, err)) != CF_OK)
         return st;
     /* memory: two bodies (the loop's and the static one) as the static run estimates one, the
     ** loop's kept columns of the inverse (9 nn per node that touches the probe, at most all of

@@ -104,13 +104,11 @@ static double lattice_bytes(const cf_scene *sc, double nx, double ny, double nz)
     return CF_BUDGET_PROCESS_BYTES + nodes * NODE_BYTES + springs * SPRING_BYTES + solver + grouped;
 }
 
-/* The law tables of `table_intervals` (model/law.c: values and slopes at the ends, four cubic
-** coefficients per interval), the scene spring's and each group's, when the scene evaluates the
-** law by table. */
-static double table_bytes(const cf_scene *sc)
+double cf_budget_law_tables_bytes(const cf_scene *sc)
 {
-    return sc->method == CF_LAW_TABLE ? LAW_TABLE_BYTES * ((double)sc->table_intervals + 1) *
-                                            (1.0 + (double)sc->ngroups) /* each group's law */
+    const double laws = 1.0 + (double)sc->ngroups + (double)sc->nfibres +
+                        (double)sc->body_nfibres; /* the scene's, each group's, each fibre's */
+    return sc->method == CF_LAW_TABLE ? LAW_TABLE_BYTES * ((double)sc->table_intervals + 1) * laws
                                       : 0;
 }
 
@@ -186,7 +184,7 @@ cf_status cf_budget_check_size(const cf_scene *sc, const char *name, const cf_bu
     c->samples = sc->nsamples;
     const double lattice = lattice_bytes(sc, nx, ny, nz);
     const double samples = (double)sc->nsamples * SAMPLE_BYTES;
-    const double table = table_bytes(sc);
+    const double table = cf_budget_law_tables_bytes(sc);
     c->memory_bytes = lattice + samples + table;
     if (c->memory_bytes > b->max_memory_bytes)
         return memory_refusal(sc, name, b, c, lattice, samples, table, err);
@@ -253,4 +251,13 @@ cf_status cf_budget_check_steps(const cf_scene *sc, const char *name, cf_lattice
                             "(raise it with --max-steps)",
                             name, key, c->steps, c->steps_kind, b->max_steps);
     return check_work(name, key, c, lat, b, fit, fit_what, err);
+}
+
+double cf_budget_body_node_bytes(const cf_scene *sc, int keep_forces)
+{
+    const double factor = 3 * (81.0 * 16 * 8 + 40.0 * 81 * 8); /* tangent and its fill */
+    const double groups = sc->ngroups ? 8.0 : 0;                /* a byte a spring, ~7 a node */
+    const double fibres = sc->body_nfibres ? 6 * 192.0 : 0;     /* 192 a tetrahedron, ~6 a node */
+    return factor + groups + fibres + (sc->body_steps + 1.0) * 3 * 8 * (keep_forces ? 3 : 1) +
+           (double)sc->nregions;
 }

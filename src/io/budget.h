@@ -76,4 +76,16 @@ cf_status cf_budget_check_steps(const cf_scene *sc, const char *name, cf_lattice
 /* Spring-steps of one static solve or implicit step of a lattice with this many unknowns. */
 double cf_budget_solve_work(double unknowns);
 
+/* The bytes of the scene's law tables when it evaluates its laws by table (`law_method` "table":
+** values and slopes at the ends, four cubic coefficients per interval of `table_intervals`): the
+** scene spring's, each spring group's and each fibre group's (lattice or body); 0 otherwise. */
+double cf_budget_law_tables_bytes(const cf_scene *sc);
+
+/* What a tissue body's static or dynamic run spends per node: the tangent and its factor's fill
+** (about 40 times its 3 x 3 blocks for meshes of organ size), one copy of the positions per step
+** (three with the forces kept), a byte a node per region, a spring group's index a spring and a
+** fibre group's directions and shape gradients per tetrahedron; the law tables come once on top
+** (cf_budget_law_tables_bytes). */
+double cf_budget_body_node_bytes(const cf_scene *sc, int keep_forces);
+
 #endif

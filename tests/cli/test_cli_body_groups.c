@@ -18,8 +18,9 @@ TU_SCRATCH_GROUP("body-groups")
 
 static char outb[1 << 14], errb[1 << 14];
 
-/* The punch scene with groups (a JSON array, "" for none) at dir/name. */
-static void write_scene(const char *name, const char *groups)
+/* The punch scene with groups (a JSON array, "" for none) and extra root keys (", ..." or "") at
+** dir/name. */
+static void write_scene(const char *name, const char *groups, const char *extra)
 {
     char path[600], mesh[600];
     snprintf(mesh, sizeof mesh, "%s/block.msh", dir);
@@ -31,8 +32,8 @@ static void write_scene(const char *name, const char *groups)
             "{\"spring\": {\"fit\": \"%s\"}, \"body\": {\"mesh\": \"%s\", \"unit_mm\": 1, "
             "\"poisson_ratio\": 0.25}, \"fixed\": {\"below\": {\"axis\": \"z\", \"value_mm\": 0}}, "
             "\"probe\": {\"shape\": \"punch\", \"radius_mm\": 6, \"center_mm\": [15, 15, 15], "
-            "\"direction\": [0, 0, -1], \"depth_mm\": 0.2, \"steps\": 2}%s%s}",
-            FIT, mesh, *groups ? ", \"groups\": " : "", groups);
+            "\"direction\": [0, 0, -1], \"depth_mm\": 0.2, \"steps\": 2}%s%s%s}",
+            FIT, mesh, *groups ? ", \"groups\": " : "", groups, extra);
     fclose(f);
 }
 
@@ -60,8 +61,8 @@ static void simulate(const char *name, double F[2])
 static void two_regions_simulate_and_run_in_ccx(void **state)
 {
     (void)state;
-    write_scene("one.json", "");
-    write_scene("two.json", "[" LOWER "]");
+    write_scene("one.json", "", "");
+    write_scene("two.json", "[" LOWER "]", "");
     double one[2], two[2];
     simulate("one.json", one);
     assert_null(strstr(outb, "group 0"));
@@ -107,23 +108,64 @@ static void overlapping_and_empty_regions_are_refused(void **state)
     (void)state;
     write_scene("overlap.json",
                 "[" LOWER ", {\"region\": {\"above\": {\"axis\": \"z\", \"value_mm\": 5}}, "
-                "\"spring\": {\"fit\": \"fits/telescoping.json\"}}]");
+                "\"spring\": {\"fit\": \"fits/telescoping.json\"}}]",
+                "");
     int rc = tu_run(outb, sizeof outb, errb, sizeof errb, "simulate %s/overlap.json -o %s/o.csv",
                     dir, dir);
     if (rc != 65 || !strstr(errb, "groups[1]: its region overlaps that of groups[0]"))
         fail_msg("overlap: exit %d, %s", rc, errb);
     write_scene("empty.json", "[{\"region\": {\"sphere\": {\"center_mm\": [100, 100, 100], "
-                              "\"radius_mm\": 1}}, \"spring\": {\"fit\": \"fits/telescoping.json\"}}]");
+                              "\"radius_mm\": 1}}, \"spring\": {\"fit\": \"fits/telescoping.json\"}}]",
+                "");
     rc = tu_run(outb, sizeof outb, errb, sizeof errb, "simulate %s/empty.json -o %s/e.csv", dir,
                 dir);
     if (rc != 65 || !strstr(errb, "groups[0]: the group is empty"))
         fail_msg("empty: exit %d, %s", rc, errb);
     write_scene("lattice_key.json", "[{\"springs\": \"face\", \"spring\": {\"fit\": "
-                                    "\"fits/telescoping.json\"}}]");
+                                    "\"fits/telescoping.json\"}}]",
+                "");
     rc = tu_run(outb, sizeof outb, errb, sizeof errb, "simulate %s/lattice_key.json -o %s/l.csv",
                 dir, dir);
     if (rc != 65 || !strstr(errb, "groups[0].springs"))
         fail_msg("a lattice's key in a body: exit %d, %s", rc, errb);
+}
+
+/* The body's estimate in bytes under --max-memory limit (exit 65, "needs about"). */
+static double body_estimate(const char *name, const char *limit)
+{
+    int rc = tu_run(outb, sizeof outb, errb, sizeof errb,
+                    "simulate %s/%s -o %s/b.csv --max-memory %s", dir, name, dir, limit);
+    const char *p = strstr(errb, "needs about ");
+    if (rc != 65 || !p)
+        fail_msg("%s under %s: exit %d, %s", name, limit, rc, errb);
+    return strtod(p + strlen("needs about "), NULL);
+}
+
+#define TABLE ", \"law_method\": \"table\", \"table_intervals\": 100000"
+
+/* A body's spring groups are in its memory estimate: with the law by table each group's law
+** carries a table of two values an end and four coefficients an interval (48 bytes), so a second
+** law raises the estimate by at least that, and the scene's own table stands in it too; tables
+** that alone pass the limit are refused before the mesh is read, naming the key. */
+static void groups_are_in_the_body_estimate(void **state)
+{
+    (void)state;
+    write_scene("t1.json", "", TABLE);
+    write_scene("t2.json", "[" LOWER "]", TABLE);
+    write_scene("e1.json", "", "");
+    const double table = 48.0 * (100000 + 1);
+    const double plain = body_estimate("e1.json", "12M"), one = body_estimate("t1.json", "12M"),
+                 two = body_estimate("t2.json", "12M");
+    print_message("estimates: exact law %.4g B, table %.4g B, table and a group %.4g B (a table "
+                  "%.4g B)\n", plain, one, two, table);
+    /* the estimates are printed to three digits: 1e5 B of rounding each */
+    if (!(fabs(one - plain - table) <= 1e5) || !(two - one >= table - 1e5))
+        fail_msg("estimates %.6g, %.6g, %.6g B: the tables (%.6g B each) not counted", plain,
+                 one, two, table);
+    int rc = tu_run(outb, sizeof outb, errb, sizeof errb,
+                    "simulate %s/t2.json -o %s/b.csv --max-memory 8M", dir, dir);
+    if (rc != 65 || !strstr(errb, "t2.json: key 'table_intervals' = 100000: the law tables need"))
+        fail_msg("tables over the limit: exit %d, %s", rc, errb);
 }
 
 int main(void)
@@ -131,6 +173,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(two_regions_simulate_and_run_in_ccx),
         cmocka_unit_test(overlapping_and_empty_regions_are_refused),
+        cmocka_unit_test(groups_are_in_the_body_estimate),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
