@@ -42,29 +42,6 @@ cf_status cf_scene_fibre_entry(ctx *c, json_t *e, const char *where, cf_scene_fi
     return cf_scene_fibre_spring(c, e, where, &f->spring, f->source);
 }
 
-cf_status cf_scene_fibre_spring(ctx *c, json_t *e, const char *where, cf_spring *spring,
-                                char source[600])
-{
-    char sw[96];
-    snprintf(sw, sizeof sw, "%s.spring", where);
-    json_t *sp = json_object_get(e, "spring");
-    if (!sp)
-        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' is required", c->name, sw);
-    cf_scene_group g;
-    memset(&g, 0, sizeof g);
-    cf_status st = cf_scene_group_spring(c, sp, sw, &g);
-    if (st)
-        return st;
-    cf_law law;
-    cf_error lerr = {0};
-    if (cf_law_init(&law, &g.spring, &lerr) != CF_OK)
-        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s': %s", c->name, sw, lerr.msg);
-    cf_law_free(&law);
-    *spring = g.spring;
-    memcpy(source, g.source, 600);
-    return CF_OK;
-}
-
 cf_status cf_scene_fibre_fit(ctx *c, json_t *root, cf_scene *sc)
 {
     static const char *const keys[] = {"fit", "cross_axis", NULL};

@@ -199,3 +199,26 @@ const char *cf_scene_group_name(int family)
 {
     return family >= 0 && family < CF_FAMILY_COUNT ? family_names[family] : "?";
 }
+
+cf_status cf_scene_fibre_spring(ctx *c, json_t *e, const char *where, cf_spring *spring,
+                                char source[600])
+{
+    char sw[96];
+    snprintf(sw, sizeof sw, "%s.spring", where);
+    json_t *sp = json_object_get(e, "spring");
+    if (!sp)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' is required", c->name, sw);
+    cf_scene_group g;
+    memset(&g, 0, sizeof g);
+    cf_status st = cf_scene_group_spring(c, sp, sw, &g);
+    if (st)
+        return st;
+    cf_law law;
+    cf_error lerr = {0};
+    if (cf_law_init(&law, &g.spring, &lerr) != CF_OK)
+        return cf_error_set(c->err, CF_E_DATA, "%s: key '%s': %s", c->name, sw, lerr.msg);
+    cf_law_free(&law);
+    *spring = g.spring;
+    memcpy(source, g.source, 600);
+    return CF_OK;
+}

@@ -64,8 +64,9 @@ cf_status cf_scene_group_spring(ctx *c, json_t *sp, const char *where, cf_scene_
 ** density finite in (0, 1e6], the spring a valid law; every refusal names the key and the value.
 ** The lattice's "fibres" (a body's entries take a helix rule instead: scene_body_fibres.c). */
 cf_status cf_scene_fibre_entry(ctx *c, json_t *e, const char *where, cf_scene_fibre *f);
-/* The "spring" of fibre entry e at where (required; as a group's, cf_scene_group_spring, and a
-** valid law) into *spring and source (600 bytes). Shared by the lattice's and a body's entries. */
+/* scene_groups.c: the "spring" of fibre entry e at where (required; as a group's,
+** cf_scene_group_spring, and a valid law) into *spring and source (600 bytes). Shared by the
+** lattice's and a body's entries. */
 cf_status cf_scene_fibre_spring(ctx *c, json_t *e, const char *where, cf_spring *spring,
                                 char source[600]);
 /* "fibres": {"fit": FILE, "cross_axis": "s" | "n"} of root (before the spring; nothing, and
