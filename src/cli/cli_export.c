@@ -288,15 +288,6 @@ static cf_status lattice_of(export_request *q, const cf_fitted_spring *fs,
         if ((st = cf_scene_load(scene_path, &sc, err)) != CF_OK)
             return st;
         snprintf(q->scene_fit, sizeof q->scene_fit, "%s", sc.fit_path);
-        if (sc.has_body && sc.body_nfibres) {
-            /* the exporters write a body's springs and volume term; its fibres are not yet
-            ** theirs (src/notes/export.md) */
-            st = cf_error_set(err, CF_E_DATA, "%s: key 'fibres': a body with fibres cannot be "
-                              "exported yet (the exports would drop the fibres' stiffness); "
-                              "simulate it with `conifit simulate`", scene_path);
-            cf_scene_free(&sc);
-            return st;
-        }
         if (sc.has_body) {
             st = body_model(q, fs, &sc, err);
             q->body = 1;

@@ -95,6 +95,7 @@ static void write_inp_probe_steps(FILE *out, const cf_xmodel *m, int abaqus)
     char kp[32];
     cf_export_inp_real(kp, m->kp_N_per_mm);
     fprintf(out, "*SPRING, ELSET=PROBE\n3, 3\n%s\n", kp);
+    cf_xmodel_inp_fibres(out, m, f0 + m->ntop, e0 + m->ntop);
     write_inp_held(out, m);
     for (size_t t = 0; t < m->ntop; t++)
         fprintf(out, "%zu, 1, 2\n", f0 + t + 1);
