@@ -22,6 +22,7 @@
 
 #include "export/export_internal.h"
 #include "model/body.h"
+#include "model/lattice.h"
 
 /* Index of the table of group k with weight w among m->fg[0 .. m->nfg) (fk the group of each),
 ** appended when new. */
@@ -109,6 +110,7 @@ int cf_xmodel_body_fibres(cf_xmodel *m, const cf_body *b, const cf_export_table 
     if (n == 0)
         return 0;
     const double H = b->law->p.H_mm;
+    m->fnc = 4;
     m->fcorner = malloc(4 * n * sizeof *m->fcorner);
     m->fgrp = malloc(n * sizeof *m->fgrp);
     m->fx_mm = malloc(6 * n * sizeof *m->fx_mm);
@@ -150,22 +152,23 @@ int cf_xmodel_body_fibres(cf_xmodel *m, const cf_body *b, const cf_export_table 
 }
 
 /* The equations of end e (0, 1) of fibre q, node number nd: u(nd) - sum_m N_m u(corner m) = 0
-** in each direction, terms of weight 0 left out. */
+** in each direction, terms of weight 0 left out, four terms a line. */
 static void write_equations(FILE *out, const cf_xmodel *m, size_t q, int e, size_t nd)
 {
-    const double *w = m->fwt + 8 * q + 4 * (size_t)e;
+    const size_t nc = m->fnc;
+    const double *w = m->fwt + 2 * nc * q + nc * (size_t)e;
     int terms = 1;
-    for (int c = 0; c < 4; c++)
+    for (size_t c = 0; c < nc; c++)
         terms += w[c] != 0;
     for (int d = 1; d <= 3; d++) {
         fprintf(out, "%d\n%zu, %d, -1.", terms, nd, d);
         int on_line = 1;
-        for (int c = 0; c < 4; c++) {
+        for (size_t c = 0; c < nc; c++) {
             if (w[c] == 0)
                 continue;
             char x[32];
             cf_export_inp_real(x, w[c]);
-            fprintf(out, "%s%u, %d, %s", on_line == 4 ? "\n" : ", ", m->fcorner[4 * q + (size_t)c] + 1,
+            fprintf(out, "%s%u, %d, %s", on_line == 4 ? "\n" : ", ", m->fcorner[nc * q + c] + 1,
                     d, x);
             on_line = on_line == 4 ? 1 : on_line + 1;
         }
@@ -177,14 +180,25 @@ void cf_xmodel_inp_fibres(FILE *out, const cf_xmodel *m, size_t node0, size_t el
 {
     if (m->nfib == 0)
         return;
-    fprintf(out, "** fibres: %zu embedded tension-only springs (one per tetrahedron and fibre "
-                 "group), each between two auxiliary nodes at the tetrahedron's centre -+ (Hf/2) "
-                 "a tied to its corners by *EQUATION (linear shape functions: the elongation is "
-                 "Hf (|F a| - 1) exactly); %zu tables; their share of the reaction tolerance "
-                 "%.6g N (tol F_C times the sum of each spring's weight times the rate of its "
-                 "elongation per unit probe travel along conifit's path, its largest over the "
-                 "steps)\n*NODE, NSET=NFIBRE\n",
-            m->nfib, m->nfg, m->fib_tol_N);
+    if (m->fnc == 4)
+        fprintf(out, "** fibres: %zu embedded tension-only springs (one per tetrahedron and fibre "
+                     "group), each between two auxiliary nodes at the tetrahedron's centre -+ "
+                     "(Hf/2) a tied to its corners by *EQUATION (linear shape functions: the "
+                     "elongation is Hf (|F a| - 1) exactly); %zu tables; their share of the "
+                     "reaction tolerance %.6g N (tol F_C times the sum of each spring's weight "
+                     "times the rate of its elongation per unit probe travel along conifit's "
+                     "path, its largest over the steps)\n", m->nfib, m->nfg, m->fib_tol_N);
+    else
+        fprintf(out, "** fibres: %zu embedded tension-only springs (one per cell and fibre group), "
+                     "each between two auxiliary nodes at the cell's centre -+ (Hf/2) a tied to "
+                     "its 8 nodes by *EQUATION (trilinear weights: the elongation is Hf (|F a| - "
+                     "1) with conifit's cell F exactly when a has a zero component or the cell "
+                     "deforms affinely; else the ends' separation adds (Hf^3 a1 a2 a3 / 4 H^3) "
+                     "times the cell's twist mode sum_a s1 s2 s3 x_a); %zu tables; their share of "
+                     "the reaction tolerance %.6g N (tol F_C times cells times density Hf / "
+                     "height: a fibre's stretch moves at most as fast as the strain)\n",
+                m->nfib, m->nfg, m->fib_tol_N);
+    fprintf(out, "*NODE, NSET=NFIBRE\n");
     for (size_t q = 0; q < 2 * m->nfib; q++) {
         char x[32], y[32], z[32];
         cf_export_inp_real(x, m->fx_mm[3 * q]);
@@ -203,11 +217,61 @@ void cf_xmodel_inp_fibres(FILE *out, const cf_xmodel *m, size_t node0, size_t el
             if (m->fgrp[q] == g)
                 fprintf(out, "%zu, %zu, %zu\n", elem0 + q + 1, node0 + 2 * q + 1,
                         node0 + 2 * q + 2);
-        fprintf(out, "** fibre table %zu: Hf = %.17g mm, weight %.17g (V0 density / H^3); "
+        fprintf(out, "** fibre table %zu: Hf = %.17g mm, weight %.17g (%s); "
                      "tension (N), elongation (mm), slack when shortened\n",
-                g + 1, G->L0_mm, G->weight);
+                g + 1, G->L0_mm, G->weight, m->fnc == 4 ? "V0 density / H^3" : "density");
         fprintf(out, "*SPRING, ELSET=F%zu, NONLINEAR\n\n", g + 1);
         for (size_t i = 0; i < G->rows; i++)
             cf_export_inp_pair(out, G->T_N[i], G->e_mm[i]);
     }
+}
+
+int cf_xmodel_lattice_fibres(cf_xmodel *m, const cf_lattice *lat, const cf_export_table *ft)
+{
+    const cf_lattice_config *lc = &lat->cfg;
+    const size_t nk = (size_t)lc->nfibre, n = m->ncells * nk;
+    if (n == 0)
+        return 0;
+    const double H = lat->H_mm;
+    m->fnc = 8;
+    m->fcorner = malloc(8 * n * sizeof *m->fcorner);
+    m->fgrp = malloc(n * sizeof *m->fgrp);
+    m->fx_mm = malloc(6 * n * sizeof *m->fx_mm);
+    m->fwt = malloc(16 * n * sizeof *m->fwt);
+    m->fg = calloc(nk, sizeof *m->fg);
+    if (!m->fcorner || !m->fgrp || !m->fx_mm || !m->fwt || !m->fg)
+        return -1;
+    m->nfg = nk;
+    for (size_t k = 0; k < nk; k++) {
+        const cf_fibre_group *g = &lc->fibre[k];
+        m->fg[k] = (cf_xgroup){.L0_mm = g->law->p.H_mm, .weight = g->density, .law = g->law,
+                               .table = &ft[k]};
+        if (fibre_rows(&m->fg[k]) != 0)
+            return -1;
+        m->fib_tol_N += (double)m->ncells * g->density * g->law->p.H_mm * ft[k].tol *
+                        g->law->F_C_N / m->height_mm;
+    }
+    for (size_t c = 0; c < m->ncells; c++)
+        for (size_t k = 0; k < nk; k++) {
+            const size_t q = m->nfib++;
+            const uint32_t *v = m->cell + 8 * c;
+            const double *a = lc->fibre[k].dir, Hf = lc->fibre[k].law->p.H_mm;
+            const double X0[3] = {m->X[v[0]], m->Y[v[0]], m->Z[v[0]]};
+            for (int e = 0; e < 2; e++) {
+                double s[3]; /* the end's coordinates in the cell, 0 .. 1 inside */
+                for (int i = 0; i < 3; i++) {
+                    const double p = X0[i] + H / 2 + (e ? 1 : -1) * Hf / 2 * a[i];
+                    m->fx_mm[6 * q + 3 * (size_t)e + (size_t)i] = p;
+                    s[i] = (p - X0[i]) / H;
+                }
+                for (int b = 0; b < 8; b++) /* corner b = di + 2 dj + 4 dk */
+                    m->fwt[16 * q + 8 * (size_t)e + (size_t)b] =
+                        ((b & 1) ? s[0] : 1 - s[0]) * ((b & 2) ? s[1] : 1 - s[1]) *
+                        ((b & 4) ? s[2] : 1 - s[2]);
+            }
+            memcpy(m->fcorner + 8 * q, v, 8 * sizeof *v);
+            m->fgrp[q] = (uint32_t)k;
+        }
+    m->reaction_tol_N += m->fib_tol_N;
+    return 0;
 }

@@ -9,6 +9,9 @@
 **  - its CalculiX export (each tetrahedron's fibre an embedded tension-only spring between two
 **    auxiliary nodes tied to the corners by *EQUATION) runs in ccx with the punch force at every
 **    step within the deck's stated tolerance and 1e-3 relative of simulate's;
+**  - a 3 x 3 x 3 lattice with a fibre along z per cell, pulled along z: its CalculiX export (the
+**    fibre tied to the cell's 8 nodes with trilinear weights, the top driven through stiff
+**    springs) runs in ccx within the deck's tolerance and 1e-3 of simulate at every step;
 **  - bad "fibres" keys exit 65 naming the key and the value; FEBio and SOFA exports refuse a body
 **    with fibres (65, naming the format) instead of dropping them.
 */
@@ -209,7 +212,7 @@ static void bad_fibres_are_refused_by_key_and_value(void **state)
         print_message("%s export of the fibre slab: exit %d: %s", formats[k], st, err);
         assert_int_equal(st, 65);
         char want[64];
-        snprintf(want, sizeof want, "%s: the body's 1 fibre group", formats[k]);
+        snprintf(want, sizeof want, "%s: key 'fibres': the body's fibre groups", formats[k]);
         if (!strstr(err, want))
             fail_msg("expected '%s' in: %s", want, err);
     }
@@ -275,12 +278,113 @@ static void the_fibre_slab_runs_in_ccx(void **state)
     }
 }
 
+/* A 3 x 3 x 3 isotropic lattice of the telescoping fit with fibres (density dens, or none when
+** dens is NULL) of that spring along z, pulled 10 % along z in 5 steps, at dir/name. */
+static void write_lattice(const char *name, const char *dens)
+{
+    char path[600];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f, "{\"spring\": {\"fit\": \"fits/telescoping.json\"},\n"
+               " \"lattice\": {\"nx\": 3, \"ny\": 3, \"nz\": 3, \"calibration\": "
+               "\"isotropic\"},\n");
+    if (dens)
+        fprintf(f, " \"fibres\": [{\"axis\": [0, 0, 1], \"spring\": {\"fit\": "
+                   "\"fits/telescoping.json\"}, \"density\": %s}],\n", dens);
+    fprintf(f, " \"protocol\": {\"kind\": \"ramp\", \"to_strain\": -0.1, \"duration_s\": 1},\n"
+               " \"samples_per_segment\": 5}\n");
+    fclose(f);
+}
+
+/* simulate's top reaction (N, compressive positive: stress times the 30 x 30 mm top) of
+** dir/name at its 5 samples after rest into R. */
+static void lattice_reactions(const char *name, double R[5])
+{
+    char out[8192], err[8192], csv[600], line[512];
+    snprintf(csv, sizeof csv, "%s/%s.csv", dir, name);
+    if (tu_run(out, sizeof out, err, sizeof err, "simulate %s/%s -o %s", dir, name, csv))
+        fail_msg("simulate %s: %s", name, err);
+    FILE *c = fopen(csv, "r");
+    assert_non_null(c);
+    int k = -1;
+    assert_non_null(fgets(line, sizeof line, c));
+    while (k < 5 && fgets(line, sizeof line, c)) {
+        double t, e, sk;
+        if (sscanf(line, "%lf,%lf,%lf", &t, &e, &sk) == 3) {
+            if (k >= 0)
+                R[k] = sk * 1e-3 * 900;
+            k++;
+        }
+    }
+    fclose(c);
+    assert_int_equal(k, 5);
+}
+
+static void a_lattice_fibre_runs_in_ccx(void **state)
+{
+    (void)state;
+    char out[8192], err[8192], path[700];
+    double R0[5], R[5];
+    write_lattice("lat0.json", NULL);
+    write_lattice("lat.json", "1");
+    lattice_reactions("lat0.json", R0);
+    lattice_reactions("lat.json", R);
+    print_message("3^3 lattice pulled 10 %% along z: %.6g N without fibres, %.6g N with a fibre "
+                  "along z per cell\n", R0[4], R[4]);
+    assert_true(R[4] < 1.5 * R0[4]); /* tension: negative; the fibres nearly double it */
+    const int st = tu_run(out, sizeof out, err, sizeof err, "export fits/telescoping.json "
+                          "--lattice %s/lat.json --format febio -o %s/lat.feb", dir, dir);
+    if (st != 65 || !strstr(err, "febio: the lattice's 1 fibre group"))
+        fail_msg("febio: exit %d, %s", st, err);
+    if (tu_run(out, sizeof out, err, sizeof err, "export fits/telescoping.json --lattice "
+               "%s/lat.json --format calculix -o %s/lat.inp", dir, dir))
+        fail_msg("export: %s", err);
+    snprintf(path, sizeof path, "%s/lat.inp", dir);
+    char *x = tu_slurp(path);
+    assert_non_null(x);
+    const char *key = "reaction tolerance implied by the tables: ";
+    const char *p = strstr(x, key);
+    assert_non_null(p);
+    const double tol = strtod(p + strlen(key), NULL);
+    assert_true(tol > 0);
+    assert_non_null(strstr(x, "27 embedded tension-only springs (one per cell"));
+    free(x);
+    if (system("command -v ccx >/dev/null 2>&1") != 0)
+        skip(); /* CI installs calculix-ccx (Makefile DEBS) */
+    char cmd[1600];
+    snprintf(cmd, sizeof cmd, "cd %s && ccx -i lat > lat.log 2>&1", dir);
+    if (system(cmd) != 0)
+        fail_msg("ccx failed on %s/lat.inp", dir);
+    snprintf(path, sizeof path, "%s/lat.dat", dir);
+    char *text = tu_slurp(path);
+    assert_non_null(text);
+    int n = 0;
+    const char *key2 = "total force (fx,fy,fz) for set NDRIVE and time";
+    for (const char *q = text; (q = strstr(q, key2)); q++) {
+        double t, fx, fy, fz;
+        if (sscanf(q, "total force (fx,fy,fz) for set NDRIVE and time %lf %lf %lf %lf", &t, &fx,
+                   &fy, &fz) != 4)
+            continue;
+        const int k = (int)floor(t + 0.5);
+        assert_true(k == n + 1);
+        print_message("fibre lattice, step %d: ccx %.7g N, conifit simulate %.7g N (%+.2e; "
+                      "tolerance %.3g N)\n", k, -fz, R[n], -fz / R[n] - 1, tol);
+        if (!(fabs(-fz - R[n]) <= tol) || !(fabs(-fz - R[n]) <= 1e-3 * fabs(R[n])))
+            fail_msg("step %d: beyond %.3g N or 1e-3", k, tol);
+        n++;
+    }
+    free(text);
+    assert_int_equal(n, 5);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(the_fibre_slab_runs_and_shows_its_directions),
         cmocka_unit_test(bad_fibres_are_refused_by_key_and_value),
         cmocka_unit_test(the_fibre_slab_runs_in_ccx),
+        cmocka_unit_test(a_lattice_fibre_runs_in_ccx),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
