@@ -257,6 +257,17 @@ static cf_status static_run_fits(const char *name, const cf_export_lattice *lx,
 static cf_status body_model(export_request *q, const cf_fitted_spring *fs, cf_scene *sc,
                             cf_error *err)
 {
+    /* before solving: what cf_export_write_body refuses whatever the run gives */
+    const cf_probe *pr = &sc->probe;
+    if (sc->has_probe && (pr->shape != CF_PROBE_PUNCH || fabs(pr->dir[0]) > 1e-12 ||
+                          fabs(pr->dir[1]) > 1e-12))
+        return cf_error_set(err, CF_E_DATA, "probe: a body's export takes a flat punch moving "
+                            "along z (its contact set replayed as prescribed z motions); a sphere "
+                            "pushes its nodes along their own normals (%s)", q->scene_path);
+    if (sc->body_nfibres > 0 && q->ea.opt.format != CF_EXPORT_CALCULIX)
+        return cf_error_set(err, CF_E_DATA, "%s: key 'fibres': the body's fibre groups have no "
+                            "form in this export; export it to calculix (%s)",
+                            cf_export_format_name(q->ea.opt.format), q->scene_path);
     cf_status st = cf_scene_body_fit_volume(sc, q->scene_path, q->fit_path, fs, err);
     if (st != CF_OK)
         return st;
@@ -288,15 +299,6 @@ static cf_status lattice_of(export_request *q, const cf_fitted_spring *fs,
         if ((st = cf_scene_load(scene_path, &sc, err)) != CF_OK)
             return st;
         snprintf(q->scene_fit, sizeof q->scene_fit, "%s", sc.fit_path);
-        if (sc.has_body && sc.body_nfibres) {
-            /* the exporters write a body's springs and volume term; its fibres are not yet
-            ** theirs (src/notes/export.md) */
-            st = cf_error_set(err, CF_E_DATA, "%s: key 'fibres': a body with fibres cannot be "
-                              "exported yet (the exports would drop the fibres' stiffness); "
-                              "simulate it with `conifit simulate`", scene_path);
-            cf_scene_free(&sc);
-            return st;
-        }
         if (sc.has_body) {
             st = body_model(q, fs, &sc, err);
             q->body = 1;

@@ -113,6 +113,12 @@ typedef struct cf_export_lattice {
                                 ** law of group_spring[k] (the fit's free length H); 0: none */
     int group_family[CF_FAMILY_COUNT];
     cf_spring group_spring[CF_FAMILY_COUNT];
+    size_t nfibre;              /* fibre groups (a scene's "fibres"; model/fibre.h): group k one
+                                ** spring of fibre_spring[k] per cell along the unit fibre_dir[k]
+                                ** (lattice frame), fibre_density[k] per cell; 0: none */
+    cf_spring fibre_spring[CF_FIBRE_MAX];
+    double fibre_dir[CF_FIBRE_MAX][3];
+    double fibre_density[CF_FIBRE_MAX];
     char note[640];             /* "" or, for a scene's time protocol written as its quasi-static
                                 ** displacement history, what the model does not carry (the
                                 ** file's header and the report's warning say it) */

@@ -75,6 +75,13 @@ static cf_status check_body(const cf_body *b, const cf_probe *pr, const cf_expor
         opt->format != CF_EXPORT_SOFA)
         return cf_error_set(err, CF_E_DATA, "a body is exported to calculix, febio or sofa, not %s",
                             cf_export_format_name(opt->format));
+    if (b->nfibre > 0 && opt->format != CF_EXPORT_CALCULIX)
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: the body's %zu fibre group%s (embedded tension-only springs tied "
+                            "to the tetrahedra by linear constraints) %s no form in this export; "
+                            "export it to calculix",
+                            cf_export_format_name(opt->format), b->nfibre,
+                            b->nfibre == 1 ? "" : "s", b->nfibre == 1 ? "has" : "have");
     if (opt->format == CF_EXPORT_SOFA && b->kappa_MPa > 0)
         return cf_error_set(err, CF_E_DATA,
                             "sofa: the body's volume term (kappa = %g MPa, nu = %g > 0.25) has no "
@@ -149,18 +156,25 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr,
     cf_export_table t = {0};
     cf_xmodel m = {0};
     cf_export_report r = {0};
-    cf_export_table gt[CF_BODY_MAX_GROUPS];
+    cf_export_table gt[CF_BODY_MAX_GROUPS], ft[CF_FIBRE_MAX];
     memset(gt, 0, sizeof gt);
+    memset(ft, 0, sizeof ft);
     if ((st = cf_export_table_for(law, opt, &t, err)) != CF_OK)
         return st;
     for (size_t g = 0; g < b->ngroups; g++) /* each spring group's law its table */
         if ((st = cf_export_table_for(b->glaw[g + 1], opt, &gt[g], err)) != CF_OK)
             goto done;
-    char title[200];
+    for (size_t k = 0; k < b->nfibre; k++) /* each fibre group's law its table */
+        if ((st = cf_export_table_for(&b->flaw[k], opt, &ft[k], err)) != CF_OK)
+            goto done;
+    char title[260];
     snprintf(title, sizeof title,
              "tissue body of %zu nodes, %zu edge springs and %zu tetrahedra (E = %.6g MPa, nu = "
              "%.6g), pressed by a flat punch of radius %.6g mm",
              b->nn, b->ns, b->nt, b->E_MPa, b->nu, pr->radius_mm);
+    if (b->nfibre > 0) /* a body without fibres keeps its title */
+        snprintf(title + strlen(title), sizeof title - strlen(title),
+                 ", with %zu fibre group%s", b->nfibre, b->nfibre == 1 ? "" : "s");
     m.title = title;
     m.source = opt->source;
     m.output = opt->output;
@@ -192,7 +206,8 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr,
         m.kappa_MPa = b->kappa_MPa;
         m.xk_mm = run->x_mm;
     }
-    if (cf_xmodel_tables(&m) != 0 || cf_xmodel_write(out, &m, opt->format) != 0)
+    if (cf_xmodel_tables(&m) != 0 || cf_xmodel_body_fibres(&m, b, ft) != 0 ||
+        cf_xmodel_write(out, &m, opt->format) != 0)
         goto oom;
     r = cf_export_report_of_table(&t, law);
     r.groups = m.ng;
@@ -220,5 +235,7 @@ done:
     cf_export_table_free(&t);
     for (size_t g = 0; g < CF_BODY_MAX_GROUPS; g++)
         cf_export_table_free(&gt[g]);
+    for (size_t k = 0; k < CF_FIBRE_MAX; k++)
+        cf_export_table_free(&ft[k]);
     return st;
 }

@@ -95,6 +95,7 @@ static void write_inp_probe_steps(FILE *out, const cf_xmodel *m, int abaqus)
     char kp[32];
     cf_export_inp_real(kp, m->kp_N_per_mm);
     fprintf(out, "*SPRING, ELSET=PROBE\n3, 3\n%s\n", kp);
+    cf_xmodel_inp_fibres(out, m, f0 + m->ntop, e0 + m->ntop);
     write_inp_held(out, m);
     for (size_t t = 0; t < m->ntop; t++)
         fprintf(out, "%zu, 1, 2\n", f0 + t + 1);
@@ -170,6 +171,54 @@ static void write_inp_hourglass(FILE *out, const cf_xmodel *m)
     }
 }
 
+/* A lattice with fibres: the fibres (after the hourglass nodes and springs), and the top driven
+** through stiff springs. ccx leaves the forces an *EQUATION carries to a node out of its RF, and
+** the fibres' equations reach the top nodes; so each top node is tied along z by a SPRING2 of
+** stiffness k_d to a driver node (set NDRIVE, x and y held) that the steps move, and the reaction
+** is summed over the drivers. k_d is 1e7 times the lattice's largest secant stiffness
+** max |R_k / dz_k|, so that a top node lags its driver by at most 1e-7 of the step's travel. */
+static void write_inp_lattice_fibres(FILE *out, const cf_xmodel *m, int abaqus)
+{
+    const size_t hg = m->hg_k_N_per_mm > 0 ? 4 * m->ncells : 0;
+    const size_t n0 = m->nn + hg + 2 * m->nfib;
+    const size_t e0 = m->ns + (m->kappa_MPa > 0 ? m->ncells : 0) + 3 * hg + m->nfib;
+    cf_xmodel_inp_fibres(out, m, m->nn + hg, e0 - m->nfib);
+    double kd = 0;
+    for (size_t k = 0; k < m->nsteps; k++)
+        if (m->dz_mm[k] != 0)
+            kd = fmax(kd, 1e7 * fabs(m->ref_N[k] / m->dz_mm[k]));
+    if (!(kd > 0))
+        kd = 1e7;
+    fprintf(out, "** the top driven through springs of %.6g N/mm along z (the fibres' equations "
+                 "reach the top nodes, and ccx leaves an equation's forces out of a node's RF): the "
+                 "reaction of a step is the z total of set NDRIVE ('total force ... for set "
+                 "NDRIVE' in NAME.dat)\n*NODE, NSET=NDRIVE\n", kd);
+    for (size_t t = 0; t < m->ntop; t++) {
+        char x[32], y[32], z[32];
+        cf_export_inp_real(x, m->X[m->top[t]]);
+        cf_export_inp_real(y, m->Y[m->top[t]]);
+        cf_export_inp_real(z, m->Z[m->top[t]]);
+        fprintf(out, "%zu, %s, %s, %s\n", n0 + t + 1, x, y, z);
+    }
+    fprintf(out, "*ELEMENT, TYPE=SPRING2, ELSET=DRIVE\n");
+    for (size_t t = 0; t < m->ntop; t++)
+        fprintf(out, "%zu, %u, %zu\n", e0 + t + 1, m->top[t] + 1, n0 + t + 1);
+    char k[32];
+    cf_export_inp_real(k, kd);
+    fprintf(out, "*SPRING, ELSET=DRIVE\n3, 3\n%s\n", k);
+    write_inp_held(out, m);
+    fprintf(out, "NDRIVE, 1, 2\n");
+    for (size_t s = 0; s < m->nsteps; s++) {
+        fprintf(out, "*STEP, NLGEOM%s, INC=1000\n*STATIC\n1., 1.\n", abaqus ? "=YES" : "");
+        fprintf(out, "*CONTROLS, PARAMETERS=FIELD%s\n%s", abaqus ? ", FIELD=DISPLACEMENT" : "",
+                inp_controls);
+        char dz[32];
+        cf_export_inp_real(dz, m->dz_mm[s]);
+        fprintf(out, "*BOUNDARY\nNDRIVE, 3, 3, %s\n", dz);
+        fprintf(out, "*NODE PRINT, NSET=NDRIVE, TOTALS=ONLY\nRF\n*END STEP\n");
+    }
+}
+
 static int write_inp(FILE *out, const cf_xmodel *m, int abaqus)
 {
     const char *target = abaqus ? "Abaqus/Standard" : "CalculiX (ccx)";
@@ -207,6 +256,10 @@ static int write_inp(FILE *out, const cf_xmodel *m, int abaqus)
         write_inp_volume(out, m);
     if (m->nt == 0 && m->hg_k_N_per_mm > 0)
         write_inp_hourglass(out, m);
+    if (m->nt == 0 && m->nfib > 0) { /* a lattice's fibres: after the hourglass nodes and springs */
+        write_inp_lattice_fibres(out, m, abaqus);
+        return 0;
+    }
     if (m->pp) {
         write_inp_probe_steps(out, m, abaqus);
         return 0;

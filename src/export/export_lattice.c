@@ -73,17 +73,26 @@ cf_status cf_export_lattice_from_scene(const cf_scene *sc, const char *name,
                                        cf_export_lattice *lx, cf_error *err)
 {
     memset(lx, 0, sizeof *lx);
-    if (sc->nfibres > 0)
+    if (sc->fibre_fit)
         return cf_error_set(err, CF_E_DATA,
-                            "%s: key 'fibres': a lattice with %zu fibre group%s; the lattice "
-                            "exports (CalculiX, FEBio, LS-DYNA, SOFA) do not write fibre groups "
-                            "yet",
-                            name, sc->nfibres, sc->nfibres == 1 ? "" : "s");
+                            "%s: key 'fibres': a fibre fit's lattice (its matrix, groups and "
+                            "weights from the fit file) is not exported; give its groups as "
+                            "'fibres' entries with an axis and a spring",
+                            name);
     cf_validate_setup v;
     const int timed = sc->kind != CF_PROTO_RAMP;
     cf_status st = timed ? time_protocol(sc, name, lx, err) : CF_OK;
     if (st != CF_OK)
         return st;
+    lx->nfibre = sc->nfibres; /* the validation's lattice takes none: they are the writer's */
+    for (size_t k = 0; k < sc->nfibres; k++) {
+        lx->fibre_spring[k] = sc->fibres[k].spring;
+        memcpy(lx->fibre_dir[k], sc->fibres[k].axis, sizeof lx->fibre_dir[k]);
+        lx->fibre_density[k] = sc->fibres[k].density;
+    }
+    cf_scene nofib = *sc;
+    nofib.nfibres = 0;
+    sc = &nofib;
     if (timed) { /* the elastic lattice along the protocol's displacement history */
         cf_scene elastic = *sc;
         elastic.kind = CF_PROTO_RAMP;
@@ -155,8 +164,8 @@ static int model_of_lattice(cf_xmodel *m, const cf_lattice *lat)
     m->height_mm = lat->height_mm;
     m->kappa_MPa = lat->cfg.volume_modulus_MPa;
     m->hg_k_N_per_mm = lat->hg_k_N_per_mm;
-    if (m->kappa_MPa > 0 || m->hg_k_N_per_mm > 0) { /* the net's cells, eight nodes each, corner
-                                                    ** di + 2 dj + 4 dk */
+    if (m->kappa_MPa > 0 || m->hg_k_N_per_mm > 0 || lat->cfg.nfibre > 0) {
+        /* the net's cells, eight nodes each, corner di + 2 dj + 4 dk */
         m->ncells = net.nc;
         m->cell = malloc(8 * m->ncells * sizeof *m->cell);
         if (m->cell)
@@ -503,6 +512,47 @@ static cf_status group_laws(const cf_fitted_spring *fs, const cf_export_lattice 
     return CF_OK;
 }
 
+/* A lattice's fibre groups as the writer builds them: laws, their tables, the groups. */
+typedef struct fibre_set {
+    cf_law law[CF_FIBRE_MAX];
+    cf_export_table t[CF_FIBRE_MAX];
+    cf_fibre_group grp[CF_FIBRE_MAX];
+} fibre_set;
+
+/* The laws of lx's fibre groups into f with their tables and groups, the lattice's configuration
+** lc pointing at them; CalculiX and Abaqus only (CF_E_DATA naming the format). */
+static cf_status fibre_laws(const cf_export_lattice *lx, const cf_export_options *opt,
+                            fibre_set *f, cf_lattice_config *lc, cf_error *err)
+{
+    cf_law *law = f->law;
+    cf_export_table *t = f->t;
+    cf_fibre_group *grp = f->grp;
+    if (opt->format != CF_EXPORT_CALCULIX && opt->format != CF_EXPORT_ABAQUS)
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: the lattice's %zu fibre group%s (embedded tension-only springs "
+                            "tied to the cells by linear constraints) %s no form in this export; "
+                            "export it to calculix",
+                            cf_export_format_name(opt->format), lx->nfibre,
+                            lx->nfibre == 1 ? "" : "s", lx->nfibre == 1 ? "has" : "have");
+    if (lx->nfibre > CF_FIBRE_MAX)
+        return cf_error_set(err, CF_E_DATA, "%zu fibre groups: at most %d", lx->nfibre,
+                            CF_FIBRE_MAX);
+    for (size_t k = 0; k < lx->nfibre; k++) {
+        cf_status st = cf_law_init(&law[k], &lx->fibre_spring[k], err);
+        if (st == CF_OK)
+            st = cf_export_table_for(&law[k], opt, &t[k], err);
+        if (st != CF_OK)
+            return st;
+        grp[k].law = &law[k];
+        grp[k].method = lx->method;
+        memcpy(grp[k].dir, lx->fibre_dir[k], sizeof grp[k].dir);
+        grp[k].density = lx->fibre_density[k];
+    }
+    lc->fibre = grp;
+    lc->nfibre = (int)lx->nfibre;
+    return CF_OK;
+}
+
 /* The model's groups given their spring group's law and table (a group's family from its rest
 ** length, H, sqrt 2 H or sqrt 3 H), and the largest tol F_C over the tables (the model's reaction
 ** tolerance scaled to it): the one law's t->tol F_C without groups. */
@@ -541,10 +591,9 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
     char title[256], note[sizeof r.warning];
     cf_export_lattice part, strained, glx;
     double ref[CF_EXPORT_MAX_STEPS];
-    cf_law group[CF_FAMILY_COUNT];
-    cf_export_table gt[CF_FAMILY_COUNT];
-    memset(group, 0, sizeof group);
-    memset(gt, 0, sizeof gt);
+    cf_law group[CF_FAMILY_COUNT] = {0};
+    cf_export_table gt[CF_FAMILY_COUNT] = {0};
+    fibre_set fib = {0};
     memset(&lat, 0, sizeof lat);
     memset(&ext, 0, sizeof ext);
     cf_status st = check_loading(opt, lx, err);
@@ -557,6 +606,8 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
     }
     /* the fit's whole element and volume term (a scene naming the fit file brings the same) */
     cf_lattice_config lc = lx->cfg.lattice;
+    if (lx->nfibre > 0 && (st = fibre_laws(lx, opt, &fib, &lc, err)) != CF_OK)
+        goto done;
     if (!(lc.volume_modulus_MPa > 0))
         lc.volume_modulus_MPa = fs->volume_modulus_MPa;
     /* the cells' hourglass control (lattice_hourglass.h) as CalculiX and Abaqus write it; the other
@@ -596,7 +647,8 @@ cf_status cf_export_write_lattice(FILE *out, const cf_fitted_spring *fs,
                               k + 1);
             goto done;
         }
-    if (cf_xmodel_tables(&m) != 0 || cf_xmodel_write(out, &m, opt->format) != 0)
+    if (cf_xmodel_tables(&m) != 0 || cf_xmodel_lattice_fibres(&m, &lat, fib.t) != 0 ||
+        cf_xmodel_write(out, &m, opt->format) != 0)
         goto oom;
     r = cf_export_report_of_table(&t, &law);
     r.groups = m.ng;
@@ -622,5 +674,7 @@ done:
         cf_export_table_free(&gt[f]);
         cf_law_free(&group[f]);
     }
+    for (int k = 0; k < CF_FIBRE_MAX; k++)
+        cf_export_table_free(&fib.t[k]), cf_law_free(&fib.law[k]);
     return st;
 }

@@ -75,6 +75,9 @@ void cf_xmodel_free(cf_xmodel *m)
     for (size_t g = 0; g < m->ng && m->g; g++)
         free(m->g[g].e_mm), free(m->g[g].T_N);
     free(m->g);
+    for (size_t g = 0; g < m->nfg && m->fg; g++)
+        free(m->fg[g].e_mm), free(m->fg[g].T_N);
+    free(m->fg), free(m->fcorner), free(m->fgrp), free(m->fx_mm), free(m->fwt);
     memset(m, 0, sizeof *m);
 }
 

@@ -89,6 +89,17 @@ typedef struct cf_xmodel {
     ** grounded SPRING1 of stiffness k_h. 0: none (the other formats' lattices are built
     ** without it, cf_xmodel_carries_hourglass). */
     double hg_k_N_per_mm;
+    /* Fibres (CalculiX, Abaqus; export_fibres.c): nfib embedded springs, fibre q between two
+    ** auxiliary nodes at fx_mm[6 q .. 6 q + 3) and [6 q + 3 .. 6 q + 6) (its element's centre
+    ** -+ (Hf/2) a), each end's displacement tied by *EQUATION to the element's fnc corners
+    ** fcorner[fnc q .. fnc (q + 1)) (4: a body's tetrahedron, 8: a lattice cell) with the
+    ** shape-function weights fwt[2 fnc q + fnc end + m] there; its tension-only table
+    ** fg[fgrp[q]] (elongation Hf (lambda - 1), tension). 0: none. */
+    size_t nfib, nfg, fnc;
+    double fib_tol_N;       /* the fibre tables' share of reaction_tol_N, N */
+    uint32_t *fcorner, *fgrp;
+    double *fx_mm, *fwt;
+    cf_xgroup *fg;
 } cf_xmodel;
 /* 1 when format f writes a lattice's hourglass control (CalculiX, Abaqus), else 0. */
 int cf_xmodel_carries_hourglass(cf_export_format f);
@@ -183,6 +194,11 @@ size_t cf_xmodel_inp_volume_nodes(const cf_xmodel *m);
 int cf_xmodel_inp_nodal_volume(FILE *out, const cf_xmodel *m);
 void cf_xmodel_inp_volume_held(FILE *out, const cf_xmodel *m);
 void cf_xmodel_inp_volume_step(FILE *out, const cf_xmodel *m, size_t k);
+
+/* The fibres of m for CalculiX and Abaqus (export_fibres.c): the auxiliary nodes (numbers from
+** node0 + 1), their equations and the SPRINGA elements with their tables (numbers from
+** elem0 + 1). */
+void cf_xmodel_inp_fibres(FILE *out, const cf_xmodel *m, size_t node0, size_t elem0);
 
 /* A real for CalculiX/Abaqus input: at most 20 characters, always with a decimal point
 ** (export_inp.c). */
