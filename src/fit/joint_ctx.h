@@ -105,4 +105,22 @@ int cf_joint_pair_buildable(const jctx *c, double rho, double B, double A);
 ** 0 when it has none. */
 double cf_joint_nest_kappa_rel(const cf_joint_result *plain);
 
+/* the tailed compression spring's tau (its tail's coils over the cone's): the search's range */
+#define TAU_LO 1e-3
+#define TAU_HI 30.0
+/* The pair's and the volume term's search variables, in order: ln rho, s/H of the compression
+** spring; with the pair ln rho, s/H of the extension spring and ln of its stress scale over the
+** compression one's; with kappa fitted ln (kappa/(k0/H)); with kappa declared ln of the stress
+** scale (held, kappa over it then known); with fitted weights ln q; with a tailed compression
+** spring ln tau, its tail's coils over the cone's. */
+typedef struct pvars {
+    int n;                         /* variables */
+    int ie, ik, iA, iq, it;        /* index of the extension's first, kappa's, A's, q's, tau's;
+                                   ** -1 none */
+    double lb[8], ub[8];
+} pvars;
+/* The search's variables and their box into pv and the context's problem (joint_pair_lsq.c);
+** xmax the tables' farthest strain. */
+cf_status cf_joint_pair_box(jctx *c, double xmax, pvars *pv, cf_error *err);
+
 #endif
