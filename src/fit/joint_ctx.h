@@ -46,7 +46,8 @@ typedef struct jctx {
                                     ** over its stress scale; KAPPA_NU: the declared nu */
     /* the pair's search keeps to lattices stable over the uniaxial tables' ranges: a point that
     ** would lower the best objective of the current start (stab_best) counts only when its full
-    ** lattice is stable there (joint_stable_at); stab_on 0: no such check */
+    ** lattice is stable there (joint_stable_at; the pair's search reports such a point mirrored
+    ** above stab_best, joint_pair.c); stab_on 0: no such check */
     int stab_on;
     double stab_best;
     /* the springs' reach over every table, which the placement honours: with it set, the pair's

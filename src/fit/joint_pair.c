@@ -80,6 +80,11 @@ typedef struct pair_obj {
     const pvars *pv;
 } pair_obj;
 
+/* The search's objective at z. Under the stability wall (c->stab_on) a point below the best stable
+** objective so far (stab_best) counts only when its springs are buildable and its lattice stable;
+** one that is not is reported mirrored above that best (2 stab_best - f): never lower than a
+** point the search keeps, yet close to it near the wall, so BOBYQA's quadratic model stays of the
+** objective's size (a wall of 1e30 wrecked the model and stalled the search on it). */
 static double pair_objective(unsigned nz, const double *z, double *grad, void *data)
 {
     (void)nz;
@@ -92,7 +97,7 @@ static double pair_objective(unsigned nz, const double *z, double *grad, void *d
     if (c->stab_on && f < c->stab_best) {
         if (!cf_joint_pair_buildable(c, exp(z[0]), z[1], A) ||
             !cf_joint_stable_at(c, exp(z[0]), z[1]))
-            return CF_LSQ_HUGE_OBJ;
+            return c->stab_best < CF_LSQ_HUGE_OBJ ? 2 * c->stab_best - f : CF_LSQ_HUGE_OBJ;
         c->stab_best = f;
     }
     return f;
