@@ -84,7 +84,7 @@ typedef struct pair_obj {
 ** objective so far (stab_best) counts only when its springs are buildable and its lattice stable;
 ** one that is not is reported mirrored above that best (2 stab_best - f): never lower than a
 ** point the search keeps, yet close to it near the wall, so BOBYQA's quadratic model stays of the
-** objective's size (a wall of 1e30 wrecked the model and stalled the search on it). */
+** objective's size (with a wall of 1e30 the searches stalled on it; src/notes/lattice-fit.md). */
 static double pair_objective(unsigned nz, const double *z, double *grad, void *data)
 {
     (void)nz;
