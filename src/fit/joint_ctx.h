@@ -46,7 +46,8 @@ typedef struct jctx {
                                     ** over its stress scale; KAPPA_NU: the declared nu */
     /* the pair's search keeps to lattices stable over the uniaxial tables' ranges: a point that
     ** would lower the best objective of the current start (stab_best) counts only when its full
-    ** lattice is stable there (joint_stable_at); stab_on 0: no such check */
+    ** lattice is stable there (joint_stable_at; the pair's search reports such a point mirrored
+    ** above stab_best, joint_pair.c); stab_on 0: no such check */
     int stab_on;
     double stab_best;
     /* the springs' reach over every table, which the placement honours: with it set, the pair's
@@ -104,5 +105,23 @@ int cf_joint_pair_buildable(const jctx *c, double rho, double B, double A);
 /* The fitted kappa of a law a search contains over its compression spring's k0/H (KAPPA_REL);
 ** 0 when it has none. */
 double cf_joint_nest_kappa_rel(const cf_joint_result *plain);
+
+/* the tailed compression spring's tau (its tail's coils over the cone's): the search's range */
+#define TAU_LO 1e-3
+#define TAU_HI 30.0
+/* The pair's and the volume term's search variables, in order: ln rho, s/H of the compression
+** spring; with the pair ln rho, s/H of the extension spring and ln of its stress scale over the
+** compression one's; with kappa fitted ln (kappa/(k0/H)); with kappa declared ln of the stress
+** scale (held, kappa over it then known); with fitted weights ln q; with a tailed compression
+** spring ln tau, its tail's coils over the cone's. */
+typedef struct pvars {
+    int n;                         /* variables */
+    int ie, ik, iA, iq, it;        /* index of the extension's first, kappa's, A's, q's, tau's;
+                                   ** -1 none */
+    double lb[8], ub[8];
+} pvars;
+/* The search's variables and their box into pv and the context's problem (joint_pair_lsq.c);
+** xmax the tables' farthest strain. */
+cf_status cf_joint_pair_box(jctx *c, double xmax, pvars *pv, cf_error *err);
 
 #endif

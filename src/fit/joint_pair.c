@@ -37,27 +37,14 @@
 #define PROJ_DOUBLINGS 5
 #define PROJ_BISECT 6
 #define PROJ_RESTARTS 3
+#define PROJ_ROUNDS 2
 #define PROJ_MAX (PROJ_ENDS * 3)
 /* the last search's rounds (pair_last_search) */
 #define LAST_ROUNDS 4
 #define LAST_GAIN 1e-3
-/* the tailed compression spring's tau (its tail's coils over the cone's): the search's range, and
-** the value held through the starts and the searches kept to stable lattices */
-#define TAU_LO 1e-3
-#define TAU_HI 30.0
+/* the tailed compression spring's tau (its tail's coils over the cone's) held through the starts
+** and the searches kept to stable lattices (its range: joint_ctx.h) */
 #define TAU_HELD 1.0
-
-/* The pair's and the volume term's search variables, in order: ln rho, s/H of the compression
-** spring; with the pair ln rho, s/H of the extension spring and ln of its stress scale over the
-** compression one's; with kappa fitted ln (kappa/(k0/H)); with kappa declared ln of the stress
-** scale (held, kappa over it then known); with fitted weights ln q; with a tailed compression
-** spring ln tau, its tail's coils over the cone's. */
-typedef struct pvars {
-    int n;                         /* variables */
-    int ie, ik, iA, iq, it;        /* index of the extension's first, kappa's, A's, q's, tau's;
-                                   ** -1 none */
-    double lb[8], ub[8];
-} pvars;
 
 /* The quantities the search's z stands for into the context (and the stress scale held, or 0). */
 static void pair_set(jctx *c, const pvars *pv, const double *z)
@@ -93,6 +80,11 @@ typedef struct pair_obj {
     const pvars *pv;
 } pair_obj;
 
+/* The search's objective at z. Under the stability wall (c->stab_on) a point below the best stable
+** objective so far (stab_best) counts only when its springs are buildable and its lattice stable;
+** one that is not is reported mirrored above that best (2 stab_best - f): never lower than a
+** point the search keeps, yet close to it near the wall, so BOBYQA's quadratic model stays of the
+** objective's size (with a wall of 1e30 the searches stalled on it; src/notes/lattice-fit.md). */
 static double pair_objective(unsigned nz, const double *z, double *grad, void *data)
 {
     (void)nz;
@@ -105,7 +97,7 @@ static double pair_objective(unsigned nz, const double *z, double *grad, void *d
     if (c->stab_on && f < c->stab_best) {
         if (!cf_joint_pair_buildable(c, exp(z[0]), z[1], A) ||
             !cf_joint_stable_at(c, exp(z[0]), z[1]))
-            return CF_LSQ_HUGE_OBJ;
+            return c->stab_best < CF_LSQ_HUGE_OBJ ? 2 * c->stab_best - f : CF_LSQ_HUGE_OBJ;
         c->stab_best = f;
     }
     return f;
@@ -153,54 +145,6 @@ static void pair_steps(const pvars *pv, int fine, double step[8])
     for (int j = 0; j < pv->n; j++)
         step[j] = j == 1 || j == pv->ie + 1 ? (fine ? 0.01 : 0.05) * (pv->ub[j] - pv->lb[j])
                                             : (fine ? 0.05 : 0.2);
-}
-
-/* Step 1: the search's variables and their box (pvars) into the context's problem; the volume
-** term's mode. */
-static cf_status pair_box(jctx *c, double xmax, pvars *pv, cf_error *err)
-{
-    const cf_fit_options *opt = c->opt;
-    *pv = (pvars){.n = 2, .ie = -1, .ik = -1, .iA = -1, .iq = -1, .it = -1};
-    pv->lb[0] = log(fmax(CF_IDENT_RHO_LO, opt->rho_min));
-    pv->ub[0] = log(cf_ident_rho_hi(c->type, opt->index_max));
-    pv->lb[1] = xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
-    pv->ub[1] = 1 - 1e-9;
-    if (!(pv->lb[1] < pv->ub[1]))
-        return cf_error_set(err, CF_E_DATA, "the springs must reach a strain of %g: no spring "
-                                            "does", xmax);
-    if (c->pair) {
-        pv->ie = pv->n;
-        pv->lb[pv->n] = pv->lb[0], pv->ub[pv->n++] = pv->ub[0];
-        pv->lb[pv->n] = pv->lb[1], pv->ub[pv->n++] = pv->ub[1];
-        pv->lb[pv->n] = log(1e-4), pv->ub[pv->n++] = log(1e4);
-    }
-    if (opt->volume == CF_VOLUME_FIT) {
-        pv->ik = pv->n;
-        /* kappa/(k0/H) at most the one of nu CF_JOINT_NU_MAX (the weights as they start) */
-        const double kmax = cf_cubic_kappa_of_nu(c->weight, 1.0, CF_JOINT_NU_MAX);
-        pv->lb[pv->n] = log(1e-5), pv->ub[pv->n++] = log(fmin(1e4, fmax(kmax, 1e-4)));
-        c->kappa_rel_max = exp(pv->ub[pv->n - 1]);
-        c->kappa_mode = KAPPA_REL;
-    } else if (opt->volume == CF_VOLUME_MODULUS) {
-        pv->iA = pv->n;
-        pv->lb[pv->n] = log(1e-12), pv->ub[pv->n++] = log(CF_MEASURE_MAX_VALUE);
-        c->kappa_mode = KAPPA_UNIT;
-    } else if (opt->volume == CF_VOLUME_POISSON) {
-        c->kappa_mode = KAPPA_NU;
-        c->kappa = opt->volume_value;
-    }
-    if (c->fit_weights) {
-        pv->iq = pv->n;
-        pv->lb[pv->n] = log(Q_LO), pv->ub[pv->n++] = log(Q_HI);
-    }
-    if (c->tail) {
-        pv->it = pv->n;
-        pv->lb[pv->n] = log(TAU_LO), pv->ub[pv->n++] = log(TAU_HI);
-    }
-    memcpy(c->pr.lb, pv->lb, sizeof c->pr.lb);
-    memcpy(c->pr.ub, pv->ub, sizeof c->pr.ub);
-    c->pr.A_max = cf_joint_pair_A_max;
-    return CF_OK;
 }
 
 /* The tailed pair contains the conical pair plain (a tail of no coils): plain's optimum, its tail
@@ -395,32 +339,41 @@ static int next_proj_end(const pair_search *s, const double *fends, int *seen, c
     }
 }
 
-/* Step 3a: the best distinct ends of the starts whose lattices fail the check, each projected to
-** stability along the directions that resist the lattice's node-scale modes (issue 42: a stiffer
-** extension spring in compression, a smaller kappa in tension): the extension spring's stress
-** scale up, kappa down, and both together; then the searches kept to stable lattices from the
-** PROJ_RESTARTS lowest projected points, the best end into *sb and zs. fends: the starts' ends'
-** objectives. */
-static cf_status pair_project(jctx *c, pair_search *s, const double *fends, double *sb,
-                              double zs[8], cf_error *err)
+/* BOBYQA kept to stable lattices (STABLE_MAX_EVALS curves) from z, its end into z and *f; 1 when
+** it ended on a point to keep, 0 when not, -1 out of memory. */
+static int stable_search(jctx *c, pair_search *s, double z[8], double *f)
 {
     const pvars *pv = &s->pv;
-    double dirs[3][8] = {{0}}, cand[PROJ_MAX][8], fc[PROJ_MAX];
-    int nd = 0, nc = 0, seen[MAX_PAIR_STARTS] = {0}, used[PROJ_ENDS], nused = 0;
-    if (pv->ie >= 0)
-        dirs[nd++][pv->ie + 2] = 1;
-    if (pv->ik >= 0)
-        dirs[nd++][pv->ik] = -1;
-    if (pv->ie >= 0 && pv->ik >= 0)
-        dirs[nd][pv->ie + 2] = 1, dirs[nd++][pv->ik] = -1;
+    double step[8];
+    pair_steps(pv, 0, step);
+    c->stab_on = 1;
+    c->stab_best = CF_LSQ_HUGE_OBJ;
+    s->restarts++;
+    *f = CF_LSQ_HUGE_OBJ;
+    nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)pv->n, pv->lb, pv->ub,
+                                      step, XTOL_REL, STABLE_MAX_EVALS, pair_objective,
+                                      (void *)&s->o, z, f);
+    return c->pr.oom ? -1 : search_ended(res);
+}
+
+/* One round of pair_project: the next PROJ_ENDS best distinct ends that fail the check (used,
+** *nused the ends projected so far), each moved to stability along the directions dirs[nd];
+** then the searches kept to stable lattices from the PROJ_RESTARTS lowest projected points, a
+** lower end into *sb and zs. Returns the points projected (0: no end left), -1 out of memory. */
+static int project_round(jctx *c, pair_search *s, const double *fends, double dirs[3][8],
+                         int nd, int *seen, int *used, int *nused, double *sb, double zs[8])
+{
+    const pvars *pv = &s->pv;
+    double cand[PROJ_MAX][8], fc[PROJ_MAX];
+    int nc = 0;
     c->stab_on = 0;
-    while (nd > 0 && nused < PROJ_ENDS) {
-        const int i = next_proj_end(s, fends, seen, used, nused);
+    for (int k = 0; nd > 0 && k < PROJ_ENDS;) {
+        const int i = next_proj_end(s, fends, seen, used, *nused);
         if (i < 0)
             break;
         if (z_stable(c, pv, s->ends[i]))
-            continue; /* a stable end: the restarts below start from it */
-        used[nused++] = i;
+            continue; /* a stable end: the restarts from stable ends start from it */
+        used[(*nused)++] = i, k++;
         for (int d = 0; d < nd; d++)
             if (project_stable(c, pv, s->ends[i], dirs[d], cand[nc])) {
                 c->stab_on = 0;
@@ -428,30 +381,54 @@ static cf_status pair_project(jctx *c, pair_search *s, const double *fends, doub
                 nc += fc[nc] < CF_LSQ_HUGE_OBJ;
             }
     }
-    s->projected = nc;
-    for (int r = 0; r < PROJ_RESTARTS; r++) {
+    for (int r = 0, n = nc; r < PROJ_RESTARTS; r++) {
         int pick = -1;
-        for (int k = 0; k < nc; k++)
+        for (int k = 0; k < n; k++)
             if (fc[k] < CF_LSQ_HUGE_OBJ && (pick < 0 || fc[k] < fc[pick]))
                 pick = k;
         if (pick < 0)
             break;
         fc[pick] = CF_LSQ_HUGE_OBJ;
-        double step[8], f = CF_LSQ_HUGE_OBJ;
-        pair_steps(pv, 0, step);
-        c->stab_on = 1;
-        c->stab_best = CF_LSQ_HUGE_OBJ;
-        s->restarts++;
-        nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)pv->n, pv->lb,
-                                          pv->ub, step, XTOL_REL, STABLE_MAX_EVALS,
-                                          pair_objective, (void *)&s->o, cand[pick], &f);
-        if (c->pr.oom)
-            return cf_error_set(err, CF_E_INTERNAL, "out of memory in the joint fit's "
-                                                    "optimiser (NLopt)");
-        if (search_ended(res) && f < *sb) {
+        double f;
+        const int ok = stable_search(c, s, cand[pick], &f);
+        if (ok < 0)
+            return -1;
+        if (ok && f < *sb) {
             *sb = f;
             memcpy(zs, cand[pick], 8 * sizeof(double));
         }
+    }
+    return nc;
+}
+
+/* Step 3a: the best distinct ends of the starts whose lattices fail the check, each projected to
+** stability along the directions that resist the lattice's node-scale modes (issue 42: a stiffer
+** extension spring in compression, a smaller kappa in tension): the extension spring's stress
+** scale up, kappa down, and both together; then the searches kept to stable lattices from the
+** lowest projected points, the best end into *sb and zs. In rounds of PROJ_ENDS ends: another
+** round while the last one lowered the best end by more than LAST_GAIN, at most PROJ_ROUNDS.
+** fends: the starts' ends' objectives. */
+static cf_status pair_project(jctx *c, pair_search *s, const double *fends, double *sb,
+                              double zs[8], cf_error *err)
+{
+    const pvars *pv = &s->pv;
+    double dirs[3][8] = {{0}};
+    int nd = 0, seen[MAX_PAIR_STARTS] = {0}, used[PROJ_ENDS * PROJ_ROUNDS], nused = 0;
+    if (pv->ie >= 0)
+        dirs[nd++][pv->ie + 2] = 1;
+    if (pv->ik >= 0)
+        dirs[nd++][pv->ik] = -1;
+    if (pv->ie >= 0 && pv->ik >= 0)
+        dirs[nd][pv->ie + 2] = 1, dirs[nd++][pv->ik] = -1;
+    for (int round = 0; round < PROJ_ROUNDS; round++) {
+        const double before = *sb;
+        const int nc = project_round(c, s, fends, dirs, nd, seen, used, &nused, sb, zs);
+        if (nc < 0)
+            return cf_error_set(err, CF_E_INTERNAL, "out of memory in the joint fit's "
+                                                    "optimiser (NLopt)");
+        s->projected += nc;
+        if (nc == 0 || !(*sb < before * (1 - LAST_GAIN)))
+            break;
     }
     return CF_OK;
 }
@@ -498,11 +475,10 @@ static cf_status pair_keep_stable(jctx *c, pair_search *s, cf_error *err)
             tries--;
             continue;
         }
-        s->restarts++;
         ftried[s->ntried] = fe[pick];
         s->tried[s->ntried++] = pick;
         /* from the stable point nearest the optimum on the segment to this end */
-        double z[8], step[8], f = CF_LSQ_HUGE_OBJ, lo = 0, hi = 1;
+        double z[8], f, lo = 0, hi = 1;
         for (int b = 0; b < STABLE_BISECT_SEGMENT; b++) {
             const double mid = 0.5 * (lo + hi);
             for (int j = 0; j < pv->n; j++)
@@ -514,16 +490,11 @@ static cf_status pair_keep_stable(jctx *c, pair_search *s, cf_error *err)
         }
         for (int j = 0; j < pv->n; j++)
             z[j] = s->zb[j] + hi * (s->ends[pick][j] - s->zb[j]);
-        pair_steps(pv, 0, step);
-        c->stab_on = 1;
-        c->stab_best = CF_LSQ_HUGE_OBJ;
-        nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)pv->n, pv->lb,
-                                          pv->ub, step, XTOL_REL, STABLE_MAX_EVALS,
-                                          pair_objective, (void *)&s->o, z, &f);
-        if (c->pr.oom)
+        const int ok = stable_search(c, s, z, &f);
+        if (ok < 0)
             return cf_error_set(err, CF_E_INTERNAL, "out of memory in the joint fit's "
                                                     "optimiser (NLopt)");
-        if (search_ended(res) && f < sb) {
+        if (ok && f < sb) {
             sb = f;
             memcpy(zs, z, sizeof zs);
         }
@@ -719,7 +690,7 @@ cf_status cf_joint_search_pair(jctx *c, const cf_table *reach, double xmax,
 {
     const cf_fit_options *opt = c->opt;
     pair_search s;
-    cf_status st = pair_box(c, xmax, &s.pv, err);
+    cf_status st = cf_joint_pair_box(c, xmax, &s.pv, err);
     if (st != CF_OK)
         return st;
     /* a tailed compression spring: the starts and the searches kept to stable lattices hold tau

@@ -417,3 +417,51 @@ double cf_joint_nest_kappa_rel(const cf_joint_result *plain)
         return 0;
     return plain->volume_modulus_MPa / (plain->ident.scale * l1.k0_N_per_mm / l1.p.H_mm);
 }
+
+/* Step 1 of the pair's search (joint_pair.c): its variables and their box (pvars) into the
+** context's problem; the volume term's mode. */
+cf_status cf_joint_pair_box(jctx *c, double xmax, pvars *pv, cf_error *err)
+{
+    const cf_fit_options *opt = c->opt;
+    *pv = (pvars){.n = 2, .ie = -1, .ik = -1, .iA = -1, .iq = -1, .it = -1};
+    pv->lb[0] = log(fmax(CF_IDENT_RHO_LO, opt->rho_min));
+    pv->ub[0] = log(cf_ident_rho_hi(c->type, opt->index_max));
+    pv->lb[1] = xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9);
+    pv->ub[1] = 1 - 1e-9;
+    if (!(pv->lb[1] < pv->ub[1]))
+        return cf_error_set(err, CF_E_DATA, "the springs must reach a strain of %g: no spring "
+                                            "does", xmax);
+    if (c->pair) {
+        pv->ie = pv->n;
+        pv->lb[pv->n] = pv->lb[0], pv->ub[pv->n++] = pv->ub[0];
+        pv->lb[pv->n] = pv->lb[1], pv->ub[pv->n++] = pv->ub[1];
+        pv->lb[pv->n] = log(1e-4), pv->ub[pv->n++] = log(1e4);
+    }
+    if (opt->volume == CF_VOLUME_FIT) {
+        pv->ik = pv->n;
+        /* kappa/(k0/H) at most the one of nu CF_JOINT_NU_MAX (the weights as they start) */
+        const double kmax = cf_cubic_kappa_of_nu(c->weight, 1.0, CF_JOINT_NU_MAX);
+        pv->lb[pv->n] = log(1e-5), pv->ub[pv->n++] = log(fmin(1e4, fmax(kmax, 1e-4)));
+        c->kappa_rel_max = exp(pv->ub[pv->n - 1]);
+        c->kappa_mode = KAPPA_REL;
+    } else if (opt->volume == CF_VOLUME_MODULUS) {
+        pv->iA = pv->n;
+        pv->lb[pv->n] = log(1e-12), pv->ub[pv->n++] = log(CF_MEASURE_MAX_VALUE);
+        c->kappa_mode = KAPPA_UNIT;
+    } else if (opt->volume == CF_VOLUME_POISSON) {
+        c->kappa_mode = KAPPA_NU;
+        c->kappa = opt->volume_value;
+    }
+    if (c->fit_weights) {
+        pv->iq = pv->n;
+        pv->lb[pv->n] = log(Q_LO), pv->ub[pv->n++] = log(Q_HI);
+    }
+    if (c->tail) {
+        pv->it = pv->n;
+        pv->lb[pv->n] = log(TAU_LO), pv->ub[pv->n++] = log(TAU_HI);
+    }
+    memcpy(c->pr.lb, pv->lb, sizeof c->pr.lb);
+    memcpy(c->pr.ub, pv->ub, sizeof c->pr.ub);
+    c->pr.A_max = cf_joint_pair_A_max;
+    return CF_OK;
+}
