@@ -207,6 +207,8 @@ static int write_inp(FILE *out, const cf_xmodel *m, int abaqus)
         write_inp_volume(out, m);
     if (m->nt == 0 && m->hg_k_N_per_mm > 0)
         write_inp_hourglass(out, m);
+    if (m->nt > 0 && m->elem) /* after the springs', the volume term's and the probe's elements */
+        cf_xmodel_inp_elem(out, m, m->ns + cf_xmodel_inp_volume_nodes(m) + m->ntop);
     if (m->pp) {
         write_inp_probe_steps(out, m, abaqus);
         return 0;

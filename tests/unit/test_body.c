@@ -380,6 +380,43 @@ static void patch_test(const cf_body *b, const double *G, double eps, double *in
     free(g);
 }
 
+/* The volume average of the nodes' stress (cf_body_fields_at, their dual cells' virial) of b
+** under the affine strain eps G, in VTK's order: over the whole body it is sum_i x_i (x) g_i / V,
+** which with the element term is the isotropic continuum's stress. */
+static void mean_node_stress(const cf_body *b, const double *G, double eps, double s[6])
+{
+    cf_body *bb = (cf_body *)b;
+    for (size_t i = 0; i < b->nn; i++)
+        for (int a = 0; a < 3; a++) {
+            double u = 0;
+            for (int q = 0; q < 3; q++)
+                u += G[3 * a + q] * b->X[3 * i + q];
+            bb->x[3 * i + a] = b->X[3 * i + a] + eps * u;
+        }
+    cf_body_fields f = {malloc(6 * b->nn * sizeof(double)), malloc(6 * b->nt * sizeof(double)),
+                        malloc(b->nt * sizeof(double)), malloc(6 * b->nt * sizeof(double)),
+                        malloc(b->ns * sizeof(double))};
+    double *Vn = calloc(b->nn, sizeof *Vn), V = 0;
+    assert_true(f.node_stress && f.stress && f.mises && f.strain && f.force && Vn);
+    cf_error err = {0};
+    assert_int_equal(cf_body_fields_at(b, b->x, &f, &err), CF_OK);
+    for (size_t t = 0; t < b->nt; t++) {
+        const uint32_t *v = b->tet + 4 * t;
+        const double *x = b->x;
+        const double Vt = body_vol6(x + 3 * v[0], x + 3 * v[1], x + 3 * v[2], x + 3 * v[3]) / 6;
+        for (int k = 0; k < 4; k++)
+            Vn[v[k]] += Vt / 4;
+        V += Vt;
+    }
+    for (int k = 0; k < 6; k++) {
+        s[k] = 0;
+        for (size_t i = 0; i < b->nn; i++)
+            s[k] += f.node_stress[6 * i + (size_t)k] * Vn[i] / V;
+    }
+    memcpy(bb->x, b->X, 3 * b->nn * sizeof *b->x);
+    free(f.node_stress), free(f.stress), free(f.mises), free(f.strain), free(f.force), free(Vn);
+}
+
 static void the_element_term_passes_the_patch_test(void **state)
 {
     (void)state;
@@ -409,6 +446,19 @@ static void the_element_term_passes_the_patch_test(void **state)
                   top[0] / (mu * eps * A));
     assert_true(inner < 1e-5 * scale);
     assert_close(top[0] / (mu * eps * A), 1, 1e-5);
+    /* the fields hold the element term's stress: their volume average is the continuum's,
+    ** (lambda + 2 mu) eps = 3 mu eps along z and lambda eps = mu eps across for uniaxial strain,
+    ** mu eps for the shear */
+    double s[6];
+    mean_node_stress(&b, UZ, eps, s);
+    print_message("element term, fields: mean stress zz %.7f, xx %.7f, yy %.7f of the continuum's\n",
+                  s[2] / (3 * mu * eps), s[0] / (mu * eps), s[1] / (mu * eps));
+    assert_close(s[2] / (3 * mu * eps), 1, 1e-5);
+    assert_close(s[0] / (mu * eps), 1, 1e-5);
+    assert_close(s[1] / (mu * eps), 1, 1e-5);
+    mean_node_stress(&b, XZ, eps, s);
+    print_message("element term, fields: mean stress xz %.7f of mu gamma\n", s[5] / (mu * eps));
+    assert_close(s[5] / (mu * eps), 1, 1e-5);
     cf_body_free(&b);
     cf_mesh_free(&m);
     cf_law_free(&law);
