@@ -95,14 +95,6 @@ static double body_node_bytes(const cf_scene *sc, int keep_forces)
            (sc->body_steps + 1.0) * 3 * 8 * (keep_forces ? 3 : 1) + (double)sc->nregions;
 }
 
-/* The body's element term (body.element_term), its error naming the key. */
-static cf_status element_term(cf_body *b, cf_error *err)
-{
-    cf_error e = {0};
-    const cf_status st = cf_body_match_elements(b, &e);
-    return st == CF_OK ? CF_OK : cf_error_set(err, st, "key 'body.element_term': %s", e.msg);
-}
-
 cf_status cf_cli_body_create(const cf_scene *sc, const cf_law *law, const cf_mesh *mesh,
                              cf_body *b, cf_error *err)
 {
@@ -112,14 +104,9 @@ cf_status cf_cli_body_create(const cf_scene *sc, const cf_law *law, const cf_mes
     else if (sc->body_volume == 2)
         kappa = cf_body_kappa_for_nu(mu, sc->body_volume_value);
     cf_status st = cf_body_create(b, mesh, law, sc->method, kappa, err);
-    if (st != CF_OK || (st = cf_cli_body_fibres(sc, b, err)) != CF_OK)
+    if (st != CF_OK || (st = cf_cli_body_fibres(sc, b, err)) != CF_OK ||
+        (st = cf_cli_body_element_term(sc, b, err)) != CF_OK || sc->ngroups == 0)
         return st;
-    if (sc->ngroups == 0)
-        return sc->body_element_term ? element_term(b, err) : CF_OK;
-    if (sc->body_element_term)
-        return cf_error_set(err, CF_E_DATA, "key 'body.element_term' = true: the element term "
-                            "takes one spring for the whole body, not the %zu groups of 'groups'",
-                            sc->ngroups);
     /* the scene's spring groups by region */
     cf_select sel[CF_SCENE_MAX_GROUPS];
     cf_spring spring[CF_SCENE_MAX_GROUPS];
@@ -606,10 +593,6 @@ static void summary(FILE *o, const cf_scene *sc, const run *r)
                    "lattice and the body share mu = k0/(2.5 H) and lambda = mu + kappa, so the "
                    "body has the lattice's small-strain E = %.6g kPa and nu = %.6g)\n",
                 b->kappa_MPa * 1e3, b->E_MPa * 1e3, b->nu);
-    if (b->elem)
-        fprintf(o, "element term: every tetrahedron carries the isotropic tensor (E = %.6g kPa, nu "
-                   "= %.6g) less its springs' share (body.element_term; src/notes/simulate.md)\n",
-                b->E_MPa * 1e3, b->nu);
     groups_line(o, sc, b);
     cf_cli_body_fibres_line(o, sc, b);
     pair_line(o, r);

@@ -227,7 +227,8 @@ void cf_body_free(cf_body *b);
 ** alone relax below their calibration (src/notes/contact-study.md, "The element term"). At
 ** finite strain the term is Saint Venant-Kirchhoff's in the Green-Lagrange strain. Not done by
 ** cf_body_create: a body without it keeps its springs' response. CF_E_DATA for a body with
-** spring groups, CF_E_INTERNAL when memory runs out. */
+** spring groups or a double-acting law (two stiffnesses at rest), CF_E_INTERNAL when memory
+** runs out. */
 cf_status cf_body_match_elements(cf_body *b, cf_error *err);
 
 /* kappa of the volume term that gives the calibrated body (shear modulus mu) Poisson's ratio nu

@@ -105,6 +105,12 @@ cf_status cf_body_match_elements(cf_body *b, cf_error *err)
         return cf_error_set(err, CF_E_DATA, "body: the element term needs one law for every "
                                             "spring (the body has %zu spring groups)",
                             b->ngroups);
+    if (b->law->extension)
+        return cf_error_set(err, CF_E_DATA, "body: the element term takes a spring of one "
+                            "stiffness at rest, not the double-acting element (k0 %g N/mm in "
+                            "compression, %g N/mm in extension): edges in extension would leave "
+                            "the isotropic tensor short",
+                            b->law->k0_N_per_mm, b->law->extension->k0_N_per_mm);
     size_t *ts = malloc((6 * b->nt + 1) * sizeof *ts);
     double *ks = calloc(b->ns + 1, sizeof *ks), *cnt = calloc(b->ns + 1, sizeof *cnt);
     double *D = malloc((36 * b->nt + 1) * sizeof *D);
