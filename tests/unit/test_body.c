@@ -288,6 +288,51 @@ static void hertz_sphere_nu_045(void **state)
 /* cf_mesh_box's size check counts a graded box's cells by its grading: a 90 mm block at 0.02 mm
 ** under the contact, growing 0.3 mm per mm (730 nodes), meshes (main refused it: 0.02 mm against
 ** the whole volume); a uniform 0.01 mm in it is still refused before Gmsh starts. */
+/* The mean edge (mm) of m's tetrahedra whose centroid lies within 0.25 mm of the point (rho, z)
+** in the (distance from the z axis, z) plane. */
+static double mean_edge_near(const cf_mesh *m, double rho, double z)
+{
+    double sum = 0;
+    size_t n = 0;
+    for (size_t t = 0; t < m->nt; t++) {
+        const uint32_t *v = m->tet + 4 * t;
+        double c[3] = {0, 0, 0};
+        for (int k = 0; k < 4; k++)
+            for (int a = 0; a < 3; a++)
+                c[a] += m->X[3 * v[k] + a] / 4;
+        if (hypot(hypot(c[0], c[1]) - rho, c[2] - z) > 0.25)
+            continue;
+        const double *p = m->X + 3 * v[0], *q = m->X + 3 * v[1];
+        sum += sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                    (p[2] - q[2]) * (p[2] - q[2]));
+        n++;
+    }
+    assert_true(n > 0);
+    return sum / (double)n;
+}
+
+/* cf_mesh_box_ring grades about the circle (a punch's rim), cf_mesh_box about its centre. */
+static void a_box_is_graded_about_a_ring(void **state)
+{
+    (void)state;
+    double lo[3] = {0, 0, -4}, hi[3] = {4, 4, 0}, f[3] = {0, 0, 0};
+    cf_mesh m;
+    cf_error err = {0};
+    assert_int_equal(cf_mesh_box_ring(lo, hi, f, 2, 0.05, 1, 0.5, &m, &err), CF_OK);
+    const double rim = mean_edge_near(&m, 2, -0.1), centre = mean_edge_near(&m, 0.2, -0.1);
+    print_message("ring: mean edge %.3g mm at the rim, %.3g mm at the centre (%zu nodes)\n", rim,
+                  centre, m.nn);
+    assert_true(rim < 0.6 * centre);
+    cf_mesh_free(&m);
+    assert_int_equal(cf_mesh_box(lo, hi, f, 0.05, 1, 0.5, &m, &err), CF_OK);
+    const double rim0 = mean_edge_near(&m, 2, -0.1), centre0 = mean_edge_near(&m, 0.2, -0.1);
+    print_message("point: mean edge %.3g mm at the rim, %.3g mm at the centre\n", rim0, centre0);
+    assert_true(centre0 < 0.6 * rim0);
+    cf_mesh_free(&m);
+    assert_int_equal(cf_mesh_box_ring(lo, hi, f, -1, 0.05, 1, 0.5, &m, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "ring radius -1 mm"));
+}
+
 static void a_graded_box_is_budgeted_by_its_grading(void **state)
 {
     (void)state;
@@ -1053,6 +1098,7 @@ int main(void)
         cmocka_unit_test(the_network_relaxes_below_its_calibration),
         cmocka_unit_test(the_element_term_passes_the_patch_test),
         cmocka_unit_test(a_graded_box_is_budgeted_by_its_grading),
+        cmocka_unit_test(a_box_is_graded_about_a_ring),
         cmocka_unit_test(the_element_terms_tangent_is_its_forces_derivative),
         cmocka_unit_test(boussinesq_punch_nu_025),
         cmocka_unit_test(boussinesq_punch_nu_045),
