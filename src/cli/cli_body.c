@@ -102,7 +102,8 @@ cf_status cf_cli_body_create(const cf_scene *sc, const cf_law *law, const cf_mes
     else if (sc->body_volume == 2)
         kappa = cf_body_kappa_for_nu(mu, sc->body_volume_value);
     cf_status st = cf_body_create(b, mesh, law, sc->method, kappa, err);
-    if (st != CF_OK || (st = cf_cli_body_fibres(sc, b, err)) != CF_OK || sc->ngroups == 0)
+    if (st != CF_OK || (st = cf_cli_body_fibres(sc, b, err)) != CF_OK ||
+        (st = cf_cli_body_element_term(sc, b, err)) != CF_OK || sc->ngroups == 0)
         return st;
     /* the scene's spring groups by region */
     cf_select sel[CF_SCENE_MAX_GROUPS];

@@ -38,9 +38,15 @@ cf_status cf_cli_body_load(const cf_scene *sc, const char *scene_path, const cf_
 cf_status cf_cli_body_create(const cf_scene *sc, const cf_law *law, const cf_mesh *mesh,
                              cf_body *b, cf_error *err);
 /* cli_body_fibres.c: the scene's fibre groups ("fibres") on b, each entry's helix directions,
-** spring and density (nothing without them); the summary's line per group. */
+** spring and density (nothing without them); the summary's line per group, then the element
+** term's (cf_cli_body_element_line). */
 cf_status cf_cli_body_fibres(const cf_scene *sc, cf_body *b, cf_error *err);
 void cf_cli_body_fibres_line(FILE *o, const cf_scene *sc, const cf_body *b);
+/* cli_body_fibres.c too: the element term (body.element_term, cf_body_match_elements) on b when
+** the scene asks for it, refused beside spring groups (CF_E_DATA naming the key); its summary
+** line (nothing without it). */
+cf_status cf_cli_body_element_term(const cf_scene *sc, cf_body *b, cf_error *err);
+void cf_cli_body_element_line(FILE *o, const cf_body *b);
 cf_status cf_cli_body_probe_outside(const cf_scene *sc, const char *scene_path,
                                     const cf_body *b, const cf_mesh *mesh, const cf_probe *probe,
                                     cf_error *err);

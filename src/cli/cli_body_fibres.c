@@ -1,6 +1,7 @@
 /*
 ** A body scene's fibre groups on the body (cli_body.h): each "fibres" entry's helix directions,
-** spring and density (cf_body_helix_dirs, cf_body_add_fibres), and their line in the summary.
+** spring and density (cf_body_helix_dirs, cf_body_add_fibres), and their line in the summary;
+** and the body's other added term, its element term (body.element_term), with its line.
 */
 #include "cli/cli_body.h"
 
@@ -44,4 +45,26 @@ void cf_cli_body_fibres_line(FILE *o, const cf_scene *sc, const cf_body *b)
                 f->reference[0], f->reference[1], f->reference[2], f->source, f->density,
                 b->law->p.H_mm);
     }
+    cf_cli_body_element_line(o, b);
+}
+
+cf_status cf_cli_body_element_term(const cf_scene *sc, cf_body *b, cf_error *err)
+{
+    if (!sc->body_element_term)
+        return CF_OK;
+    if (sc->ngroups)
+        return cf_error_set(err, CF_E_DATA, "key 'body.element_term' = true: the element term "
+                            "takes one spring for the whole body, not the %zu groups of 'groups'",
+                            sc->ngroups);
+    cf_error e = {0};
+    const cf_status st = cf_body_match_elements(b, &e);
+    return st == CF_OK ? CF_OK : cf_error_set(err, st, "key 'body.element_term': %s", e.msg);
+}
+
+void cf_cli_body_element_line(FILE *o, const cf_body *b)
+{
+    if (b->elem)
+        fprintf(o, "element term: every tetrahedron carries the isotropic tensor (E = %.6g kPa, "
+                   "nu = %.6g) less its springs' share (body.element_term)\n",
+                b->E_MPa * 1e3, b->nu);
 }

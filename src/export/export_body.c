@@ -4,7 +4,8 @@
 ** spring group (its rest length and its calibration factor as the weight, so its table is the law
 ** in strain form times that factor, as the lattice export writes its groups), the volume term as
 ** tetrahedra of a purely volumetric material, the held nodes, and a flat punch pressed along z as
-** the prescribed motion of the nodes under its face.
+** the prescribed motion of the nodes under its face; CalculiX also takes the element term
+** (body.element_term) as an anisotropic tetrahedron each (export_inp_elem.c).
 */
 #include <math.h>
 #include <stdlib.h>
@@ -88,6 +89,12 @@ static cf_status check_body(const cf_body *b, const cf_probe *pr, const cf_expor
                             "form among SOFA's springs; export it to calculix, or take "
                             "poisson_ratio 0.25",
                             b->kappa_MPa, b->nu);
+    if (b->elem && opt->format != CF_EXPORT_CALCULIX)
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: the body's element term (body.element_term, an anisotropic "
+                            "tensor per tetrahedron) has no form in this export; export it to "
+                            "calculix",
+                            cf_export_format_name(opt->format));
     if (pr->shape != CF_PROBE_PUNCH || fabs(pr->dir[0]) > 1e-12 || fabs(pr->dir[1]) > 1e-12)
         return cf_error_set(err, CF_E_DATA,
                             "probe: a body's export takes a flat punch moving along z (its contact "
@@ -205,6 +212,7 @@ cf_status cf_export_write_body(FILE *out, const cf_body *b, const cf_probe *pr,
         m.tet = b->tet;
         m.kappa_MPa = b->kappa_MPa;
         m.xk_mm = run->x_mm;
+        m.elem = b->elem;
     }
     if (cf_xmodel_tables(&m) != 0 || cf_xmodel_body_fibres(&m, b, ft) != 0 ||
         cf_xmodel_write(out, &m, opt->format) != 0)

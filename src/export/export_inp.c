@@ -256,6 +256,8 @@ static int write_inp(FILE *out, const cf_xmodel *m, int abaqus)
         write_inp_volume(out, m);
     if (m->nt == 0 && m->hg_k_N_per_mm > 0)
         write_inp_hourglass(out, m);
+    if (m->nt > 0 && m->elem) /* after the springs', the volume term's, the probe's and fibres' */
+        cf_xmodel_inp_elem(out, m, m->ns + cf_xmodel_inp_volume_nodes(m) + m->ntop + m->nfib);
     if (m->nt == 0 && m->nfib > 0) { /* a lattice's fibres: after the hourglass nodes and springs */
         write_inp_lattice_fibres(out, m, abaqus);
         return 0;

@@ -79,6 +79,9 @@ typedef struct cf_xmodel {
     /* The lattice's volume term (cell.h): every cell stores (kappa/2)(J - 1)^2 of its rest volume;
     ** written as an eight-node hexahedron per cell with a purely volumetric material by the
     ** formats that can (CalculiX, Abaqus; cf_xmodel_volume_refusal). */
+    /* a body's element term (cf_body_match_elements): nt tensors of 36 (Voigt, MPa; not owned),
+    ** written by CalculiX only; NULL: none */
+    const double *elem;
     const char *note;       /* NULL or "": else a header line on what the loading leaves out */
     double kappa_MPa;       /* 0: no volume term (a body's or a lattice's) */
     size_t ncells;
@@ -199,6 +202,9 @@ void cf_xmodel_inp_volume_step(FILE *out, const cf_xmodel *m, size_t k);
 ** node0 + 1), their equations and the SPRINGA elements with their tables (numbers from
 ** elem0 + 1). */
 void cf_xmodel_inp_fibres(FILE *out, const cf_xmodel *m, size_t node0, size_t elem0);
+/* A body's element term (m->elem) for CalculiX (export_inp_elem.c): each tetrahedron a C3D4 of
+** element number e0 + t + 1 with its own anisotropic material. */
+void cf_xmodel_inp_elem(FILE *out, const cf_xmodel *m, size_t e0);
 
 /* A real for CalculiX/Abaqus input: at most 20 characters, always with a decimal point
 ** (export_inp.c). */

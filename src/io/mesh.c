@@ -416,7 +416,7 @@ typedef struct gmsh_job {
     const cf_mesh_limits *lim;
     const cf_surface *surface; /* a surface to fill at size h (file units) */
     double h;
-    const double *box;         /* a box: lo[3], hi[3], focus[3], near, far, growth */
+    const double *box;         /* a box: lo[3], hi[3], focus[3], near, far, growth, ring */
 } gmsh_job;
 
 static int cmp_u64(const void *a, const void *b)
@@ -611,6 +611,13 @@ static double box_cells(const double lo[3], const double hi[3], const double foc
 cf_status cf_mesh_box(const double lo[3], const double hi[3], const double focus[3],
                       double size_near, double size_far, double growth, cf_mesh *m, cf_error *err)
 {
+    return cf_mesh_box_ring(lo, hi, focus, 0, size_near, size_far, growth, m, err);
+}
+
+cf_status cf_mesh_box_ring(const double lo[3], const double hi[3], const double focus[3],
+                           double ring_mm, double size_near, double size_far, double growth,
+                           cf_mesh *m, cf_error *err)
+{
     memset(m, 0, sizeof *m);
     for (int a = 0; a < 3; a++)
         if (!isfinite(lo[a]) || !isfinite(hi[a]) || !(hi[a] > lo[a]) || !isfinite(focus[a]))
@@ -620,11 +627,15 @@ cf_status cf_mesh_box(const double lo[3], const double hi[3], const double focus
         return cf_error_set(err, CF_E_DATA, "box: element sizes %g, %g and growth %g: need "
                                             "0 < near <= far and growth >= 0",
                             size_near, size_far, growth);
-    if (box_cells(lo, hi, focus, size_near, size_far, growth) > 1e8)
+    if (!(ring_mm >= 0) || !isfinite(ring_mm))
+        return cf_error_set(err, CF_E_DATA, "box: ring radius %g mm: need a finite value >= 0",
+                            ring_mm);
+    /* a ring: the ball's bound once per element length along it (a bound, not an estimate) */
+    if (box_cells(lo, hi, focus, size_near, size_far, growth) * (1 + 2 * M_PI * ring_mm / size_near) > 1e8)
         return cf_error_set(err, CF_E_DATA, "box: element size %g mm too small for the box",
                             size_near);
-    const double box[12] = {lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], focus[0], focus[1], focus[2],
-                            size_near, size_far, growth};
+    const double box[13] = {lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], focus[0], focus[1], focus[2],
+                            size_near, size_far, growth, ring_mm};
     const cf_mesh_limits dflt = cf_mesh_limits_default();
     const gmsh_job j = {"box", 1, 0, &dflt, NULL, 0, box};
     return gmsh_run(&j, m, err);
@@ -641,9 +652,14 @@ static cf_status box_job(const gmsh_job *j, cf_mesh *m, cf_error *err)
     gm.gmshModelOccAddBox(lo[0], lo[1], lo[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], -1, &ierr);
     gm.gmshModelOccSynchronize(&ierr);
     int fld = gm.gmshModelMeshFieldAdd("MathEval", -1, &ierr);
-    snprintf(expr, sizeof expr, "Min(%.17g, %.17g + %.17g * Sqrt((x - %.17g)^2 + (y - %.17g)^2 + "
-                                "(z - %.17g)^2))",
-             size_far, size_near, growth, focus[0], focus[1], focus[2]);
+    if (j->box[12] > 0) /* the distance from the ring about focus in the plane z = focus z */
+        snprintf(expr, sizeof expr, "Min(%.17g, %.17g + %.17g * Sqrt((Sqrt((x - %.17g)^2 + "
+                                    "(y - %.17g)^2) - %.17g)^2 + (z - %.17g)^2))",
+                 size_far, size_near, growth, focus[0], focus[1], j->box[12], focus[2]);
+    else
+        snprintf(expr, sizeof expr, "Min(%.17g, %.17g + %.17g * Sqrt((x - %.17g)^2 + (y - %.17g)^2 + "
+                                    "(z - %.17g)^2))",
+                 size_far, size_near, growth, focus[0], focus[1], focus[2]);
     gm.gmshModelMeshFieldSetString(fld, "F", expr, &ierr);
     gm.gmshModelMeshFieldSetAsBackgroundMesh(fld, &ierr);
     gm.gmshOptionSetNumber("Mesh.MeshSizeExtendFromBoundary", 0, &ierr);

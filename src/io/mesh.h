@@ -65,5 +65,11 @@ cf_status cf_mesh_from_surface(const char *path, double unit_mm, double size_mm,
 ** size_far. CF_E_DATA for a bad box or sizes. */
 cf_status cf_mesh_box(const double lo[3], const double hi[3], const double focus[3],
                       double size_near, double size_far, double growth, cf_mesh *m, cf_error *err);
+/* The same graded about a ring instead of a point: the circle of radius ring_mm about focus in the
+** plane z = focus z (a flat punch's rim), the size growing with the distance from it (ring_mm 0:
+** cf_mesh_box). CF_E_DATA for a negative or non-finite ring too. */
+cf_status cf_mesh_box_ring(const double lo[3], const double hi[3], const double focus[3],
+                           double ring_mm, double size_near, double size_far, double growth,
+                           cf_mesh *m, cf_error *err);
 
 #endif

@@ -358,7 +358,7 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
     static const char *const bk[] = {"mesh", "unit_mm", "refine", "poisson_ratio",
                                      "volume_modulus_MPa", "steps", "element_size_mm",
                                      "duration_s", "ramp_s", "damping_per_s", "newmark_gamma",
-                                     NULL};
+                                     "element_term", NULL};
     static const char *const pk[] = {"shape", "radius_mm", "center_mm", "direction", "depth_mm",
                                      "force_N", "path", "steps", NULL};
     cf_status st;
@@ -379,7 +379,8 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
         return cf_error_set(c->err, CF_E_DATA, "%s: key 'body.refine' = %g: must be a whole "
                             "number", c->name, refine);
     sc->body_refine = (int)refine;
-    if ((st = mesh_kind(c, bd, sc)))
+    if ((st = mesh_kind(c, bd, sc)) ||
+        (st = cf_scene_boolean(c, bd, "body", "element_term", &sc->body_element_term)))
         return st;
     json_t *pr = json_object_get(bd, "poisson_ratio"), *km = json_object_get(bd, "volume_modulus_MPa");
     if (pr && km)

@@ -116,6 +116,8 @@ typedef struct cf_scene {
                                    the body's: src/notes/simulate.md, "The fitted lattice's
                                    volume term in a body") */
     double body_volume_value;   /* kappa (MPa) or nu */
+    int body_element_term;      /* body.element_term: 1 gives every tetrahedron the isotropic
+                                   tensor less its springs' share (cf_body_match_elements) */
     int body_steps;             /* static steps of the run: probe.steps, or body.steps without a
                                    probe */
     int body_dynamic;           /* 1: 'effects.inertia' = true, a dynamic run (body_steps implicit

@@ -227,7 +227,8 @@ void cf_body_free(cf_body *b);
 ** alone relax below their calibration (src/notes/contact-study.md, "The element term"). At
 ** finite strain the term is Saint Venant-Kirchhoff's in the Green-Lagrange strain. Not done by
 ** cf_body_create: a body without it keeps its springs' response. CF_E_DATA for a body with
-** spring groups, CF_E_INTERNAL when memory runs out. */
+** spring groups or a double-acting law (two stiffnesses at rest), CF_E_INTERNAL when memory
+** runs out. */
 cf_status cf_body_match_elements(cf_body *b, cf_error *err);
 
 /* kappa of the volume term that gives the calibrated body (shear modulus mu) Poisson's ratio nu
@@ -254,7 +255,8 @@ double cf_body_measure(const cf_body *b, cf_body_state *st, double *max_u_over_t
 typedef struct cf_body_fields {
     double *node_stress; /* 6 nn: the virial of each node's dual cell (a quarter of every
                          ** tetrahedron around it, current volume): half of every spring at the
-                         ** node, T l n n, over the cell's volume, plus the volume term's
+                         ** node, T l n n, and a quarter of each tetrahedron's fibres and
+                         ** element term, over the cell's volume, plus the volume term's
                          ** pressure kappa (J_a - 1) of the node */
     double *stress;      /* 6 nt: each tetrahedron's, the mean of its four corners' (so that the
                          ** tetrahedra's stresses times their volumes sum to the nodes') */

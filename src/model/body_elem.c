@@ -105,6 +105,12 @@ cf_status cf_body_match_elements(cf_body *b, cf_error *err)
         return cf_error_set(err, CF_E_DATA, "body: the element term needs one law for every "
                                             "spring (the body has %zu spring groups)",
                             b->ngroups);
+    if (b->law->extension)
+        return cf_error_set(err, CF_E_DATA, "body: the element term takes a spring of one "
+                            "stiffness at rest, not the double-acting element (k0 %g N/mm in "
+                            "compression, %g N/mm in extension): edges in extension would leave "
+                            "the isotropic tensor short",
+                            b->law->k0_N_per_mm, b->law->extension->k0_N_per_mm);
     size_t *ts = malloc((6 * b->nt + 1) * sizeof *ts);
     double *ks = calloc(b->ns + 1, sizeof *ks), *cnt = calloc(b->ns + 1, sizeof *cnt);
     double *D = malloc((36 * b->nt + 1) * sizeof *D);
@@ -204,4 +210,41 @@ int body_elem_tet(const cf_body *b, const double *x, size_t t, double f[12], dou
                 }
         }
     return 1;
+}
+
+/* The element term's part of the nodal virial sn (6 per node, VTK's order xx yy zz xy yz xz; the
+** fields, body_fields.c): a quarter of each tetrahedron's V sigma = V0 F S F^T (J V0 = V, sigma =
+** F S F^T / J) at each of its corners. A flat tetrahedron adds nothing. */
+void body_elem_virial(const cf_body *b, const double *x, double *sn)
+{
+    for (size_t t = 0; b->elem && t < b->nt; t++) {
+        double G[4][3], F[3][3] = {{0}}, C[3][3], S6[6] = {0}, P[3][3], T[3][3];
+        if (!tet_grad(b, t, G))
+            continue;
+        const uint32_t *v = b->tet + 4 * t;
+        for (int m = 0; m < 4; m++)
+            for (int i = 0; i < 3; i++)
+                for (int J = 0; J < 3; J++)
+                    F[i][J] += x[3 * v[m] + i] * G[m][J];
+        for (int I = 0; I < 3; I++)
+            for (int J = 0; J < 3; J++)
+                C[I][J] = F[0][I] * F[0][J] + F[1][I] * F[1][J] + F[2][I] * F[2][J];
+        const double e[6] = {(C[0][0] - 1) / 2, (C[1][1] - 1) / 2, (C[2][2] - 1) / 2,
+                             C[1][2], C[0][2], C[0][1]};
+        const double *D = b->elem + 36 * t;
+        for (int i = 0; i < 6; i++)
+            for (int j = 0; j < 6; j++)
+                S6[i] += D[6 * i + j] * e[j];
+        const double S[3][3] = {{S6[0], S6[5], S6[4]}, {S6[5], S6[1], S6[3]}, {S6[4], S6[3], S6[2]}};
+        for (int i = 0; i < 3; i++) /* P = F S, T = P F^T */
+            for (int J = 0; J < 3; J++)
+                P[i][J] = F[i][0] * S[0][J] + F[i][1] * S[1][J] + F[i][2] * S[2][J];
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                T[i][j] = b->V0[t] / 4 * (P[i][0] * F[j][0] + P[i][1] * F[j][1] + P[i][2] * F[j][2]);
+        const double v6[6] = {T[0][0], T[1][1], T[2][2], T[0][1], T[1][2], T[0][2]};
+        for (int m = 0; m < 4; m++)
+            for (int k = 0; k < 6; k++)
+                sn[6 * v[m] + (size_t)k] += v6[k];
+    }
 }

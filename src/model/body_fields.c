@@ -1,7 +1,7 @@
 /*
 ** The stress and strain fields of a body (body.h, cf_body_fields_at): per node the Cauchy stress
-** of its dual cell (its halves of its springs, a quarter of the fibres of each tetrahedron around
-** it, and its volume term's pressure), per tetrahedron
+** of its dual cell (its halves of its springs, a quarter of the fibres and of the element term of
+** each tetrahedron around it, and its volume term's pressure), per tetrahedron
 ** the mean of its corners', its von Mises value and the Green-Lagrange strain of its deformation
 ** gradient; per spring its force. The derivation is in src/notes/simulate.md, "Fields".
 */
@@ -109,6 +109,7 @@ cf_status cf_body_fields_at(const cf_body *b, const double *x, cf_body_fields *f
     }
     if (b->nfibre) /* and a quarter of each tetrahedron's fibres */
         cf_body_fibre_virial(b, x, sn);
+    body_elem_virial(b, x, sn); /* and of its element term */
     for (size_t i = 0; i < nn; i++) {
         const double p = b->kappa_MPa > 0 && V0n[i] > 0 ? b->kappa_MPa * (Vn[i] / V0n[i] - 1) : 0;
         for (int k = 0; k < 6; k++)

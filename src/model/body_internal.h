@@ -45,6 +45,8 @@ static inline double body_spring_geom(const cf_body *b, const double *x, size_t 
 ** (node m, component i at 3 m + i) and, when K is not NULL, its Hessian K (row 3 m + i, column
 ** 3 q + j at 12 (3 m + i) + 3 q + j). Returns 0 for a flat reference tetrahedron. */
 int body_elem_tet(const cf_body *b, const double *x, size_t t, double f[12], double K[144]);
+/* Adds the element term's share of each node's virial (6 per node, VTK's order) to sn. */
+void body_elem_virial(const cf_body *b, const double *x, double *sn);
 
 static inline double body_norm_inf(const double *v, size_t n)
 {

@@ -12,7 +12,8 @@
 ** linear tetrahedra instead; STUDY_CONTACT=1 (sphere) lets CalculiX find its own contact with a
 ** rigid sphere instead of taking conifit's contact nodes; STUDY_SCALE=S multiplies every
 ** spring's factor by S (STUDY_MATCH=1 gives the body its element term first); STUDY_W sets the
-** block's side, STUDY_H0, STUDY_GROW, STUDY_HMAX its grading; STUDY_R, STUDY_D and STUDY_STEPS change the sphere and its steps.
+** block's side, STUDY_H0, STUDY_GROW, STUDY_HMAX its grading (STUDY_RIM=1: about the punch's
+** rim, not its centre); STUDY_R, STUDY_D and STUDY_STEPS change the sphere and its steps.
 */
 #include <math.h>
 #include <stdint.h>
@@ -241,7 +242,9 @@ int main(int argc, char **argv)
     const double h0 = (env = getenv("STUDY_H0")) ? atof(env) : 0.3;
     const double hg = (env = getenv("STUDY_GROW")) ? atof(env) : 0.4;
     const double hm = (env = getenv("STUDY_HMAX")) ? atof(env) : 8;
-    if (cf_mesh_box(lo, hi, focus, h0 / r, hm / r, hg / r, &m, &err) != CF_OK) {
+    /* STUDY_RIM=1 (punch): graded about the punch's rim instead of its centre */
+    const double ring = punch && (env = getenv("STUDY_RIM")) && atoi(env) ? R : 0;
+    if (cf_mesh_box_ring(lo, hi, focus, ring, h0 / r, hm / r, hg / r, &m, &err) != CF_OK) {
         fprintf(stderr, "%s\n", err.msg);
         return 70;
     }

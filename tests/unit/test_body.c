@@ -288,6 +288,51 @@ static void hertz_sphere_nu_045(void **state)
 /* cf_mesh_box's size check counts a graded box's cells by its grading: a 90 mm block at 0.02 mm
 ** under the contact, growing 0.3 mm per mm (730 nodes), meshes (main refused it: 0.02 mm against
 ** the whole volume); a uniform 0.01 mm in it is still refused before Gmsh starts. */
+/* The mean edge (mm) of m's tetrahedra whose centroid lies within 0.25 mm of the point (rho, z)
+** in the (distance from the z axis, z) plane. */
+static double mean_edge_near(const cf_mesh *m, double rho, double z)
+{
+    double sum = 0;
+    size_t n = 0;
+    for (size_t t = 0; t < m->nt; t++) {
+        const uint32_t *v = m->tet + 4 * t;
+        double c[3] = {0, 0, 0};
+        for (int k = 0; k < 4; k++)
+            for (int a = 0; a < 3; a++)
+                c[a] += m->X[3 * v[k] + a] / 4;
+        if (hypot(hypot(c[0], c[1]) - rho, c[2] - z) > 0.25)
+            continue;
+        const double *p = m->X + 3 * v[0], *q = m->X + 3 * v[1];
+        sum += sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                    (p[2] - q[2]) * (p[2] - q[2]));
+        n++;
+    }
+    assert_true(n > 0);
+    return sum / (double)n;
+}
+
+/* cf_mesh_box_ring grades about the circle (a punch's rim), cf_mesh_box about its centre. */
+static void a_box_is_graded_about_a_ring(void **state)
+{
+    (void)state;
+    double lo[3] = {0, 0, -4}, hi[3] = {4, 4, 0}, f[3] = {0, 0, 0};
+    cf_mesh m;
+    cf_error err = {0};
+    assert_int_equal(cf_mesh_box_ring(lo, hi, f, 2, 0.05, 1, 0.5, &m, &err), CF_OK);
+    const double rim = mean_edge_near(&m, 2, -0.1), centre = mean_edge_near(&m, 0.2, -0.1);
+    print_message("ring: mean edge %.3g mm at the rim, %.3g mm at the centre (%zu nodes)\n", rim,
+                  centre, m.nn);
+    assert_true(rim < 0.6 * centre);
+    cf_mesh_free(&m);
+    assert_int_equal(cf_mesh_box(lo, hi, f, 0.05, 1, 0.5, &m, &err), CF_OK);
+    const double rim0 = mean_edge_near(&m, 2, -0.1), centre0 = mean_edge_near(&m, 0.2, -0.1);
+    print_message("point: mean edge %.3g mm at the rim, %.3g mm at the centre\n", rim0, centre0);
+    assert_true(centre0 < 0.6 * rim0);
+    cf_mesh_free(&m);
+    assert_int_equal(cf_mesh_box_ring(lo, hi, f, -1, 0.05, 1, 0.5, &m, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "ring radius -1 mm"));
+}
+
 static void a_graded_box_is_budgeted_by_its_grading(void **state)
 {
     (void)state;
@@ -380,6 +425,43 @@ static void patch_test(const cf_body *b, const double *G, double eps, double *in
     free(g);
 }
 
+/* The volume average of the nodes' stress (cf_body_fields_at, their dual cells' virial) of b
+** under the affine strain eps G, in VTK's order: over the whole body it is sum_i x_i (x) g_i / V,
+** which with the element term is the isotropic continuum's stress. */
+static void mean_node_stress(const cf_body *b, const double *G, double eps, double s[6])
+{
+    cf_body *bb = (cf_body *)b;
+    for (size_t i = 0; i < b->nn; i++)
+        for (int a = 0; a < 3; a++) {
+            double u = 0;
+            for (int q = 0; q < 3; q++)
+                u += G[3 * a + q] * b->X[3 * i + q];
+            bb->x[3 * i + a] = b->X[3 * i + a] + eps * u;
+        }
+    cf_body_fields f = {malloc(6 * b->nn * sizeof(double)), malloc(6 * b->nt * sizeof(double)),
+                        malloc(b->nt * sizeof(double)), malloc(6 * b->nt * sizeof(double)),
+                        malloc(b->ns * sizeof(double))};
+    double *Vn = calloc(b->nn, sizeof *Vn), V = 0;
+    assert_true(f.node_stress && f.stress && f.mises && f.strain && f.force && Vn);
+    cf_error err = {0};
+    assert_int_equal(cf_body_fields_at(b, b->x, &f, &err), CF_OK);
+    for (size_t t = 0; t < b->nt; t++) {
+        const uint32_t *v = b->tet + 4 * t;
+        const double *x = b->x;
+        const double Vt = body_vol6(x + 3 * v[0], x + 3 * v[1], x + 3 * v[2], x + 3 * v[3]) / 6;
+        for (int k = 0; k < 4; k++)
+            Vn[v[k]] += Vt / 4;
+        V += Vt;
+    }
+    for (int k = 0; k < 6; k++) {
+        s[k] = 0;
+        for (size_t i = 0; i < b->nn; i++)
+            s[k] += f.node_stress[6 * i + (size_t)k] * Vn[i] / V;
+    }
+    memcpy(bb->x, b->X, 3 * b->nn * sizeof *b->x);
+    free(f.node_stress), free(f.stress), free(f.mises), free(f.strain), free(f.force), free(Vn);
+}
+
 static void the_element_term_passes_the_patch_test(void **state)
 {
     (void)state;
@@ -409,6 +491,19 @@ static void the_element_term_passes_the_patch_test(void **state)
                   top[0] / (mu * eps * A));
     assert_true(inner < 1e-5 * scale);
     assert_close(top[0] / (mu * eps * A), 1, 1e-5);
+    /* the fields hold the element term's stress: their volume average is the continuum's,
+    ** (lambda + 2 mu) eps = 3 mu eps along z and lambda eps = mu eps across for uniaxial strain,
+    ** mu eps for the shear */
+    double s[6];
+    mean_node_stress(&b, UZ, eps, s);
+    print_message("element term, fields: mean stress zz %.7f, xx %.7f, yy %.7f of the continuum's\n",
+                  s[2] / (3 * mu * eps), s[0] / (mu * eps), s[1] / (mu * eps));
+    assert_close(s[2] / (3 * mu * eps), 1, 1e-5);
+    assert_close(s[0] / (mu * eps), 1, 1e-5);
+    assert_close(s[1] / (mu * eps), 1, 1e-5);
+    mean_node_stress(&b, XZ, eps, s);
+    print_message("element term, fields: mean stress xz %.7f of mu gamma\n", s[5] / (mu * eps));
+    assert_close(s[5] / (mu * eps), 1, 1e-5);
     cf_body_free(&b);
     cf_mesh_free(&m);
     cf_law_free(&law);
@@ -1003,6 +1098,7 @@ int main(void)
         cmocka_unit_test(the_network_relaxes_below_its_calibration),
         cmocka_unit_test(the_element_term_passes_the_patch_test),
         cmocka_unit_test(a_graded_box_is_budgeted_by_its_grading),
+        cmocka_unit_test(a_box_is_graded_about_a_ring),
         cmocka_unit_test(the_element_terms_tangent_is_its_forces_derivative),
         cmocka_unit_test(boussinesq_punch_nu_025),
         cmocka_unit_test(boussinesq_punch_nu_045),
