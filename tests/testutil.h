@@ -224,6 +224,20 @@ static inline char *tu_slurp(const char *path)
     return buf;
 }
 
+/* The reaction tolerance (N) an exported deck's header states ("reaction tolerance implied by
+** the tables: "), failing the test when the header lacks it or it is not positive. */
+static inline double tu_deck_tolerance(const char *deck)
+{
+    const char *key = "reaction tolerance implied by the tables: ";
+    const char *p = strstr(deck, key);
+    if (!p)
+        fail_msg("the deck's header states no reaction tolerance");
+    const double tol = strtod(p + strlen(key), NULL);
+    if (!(tol > 0))
+        fail_msg("the deck's reaction tolerance %g is not positive", tol);
+    return tol;
+}
+
 /* Writes len bytes of text into a new file at path: 0, or -1. */
 static inline int tu_write_bytes(const char *path, const char *text, size_t len)
 {

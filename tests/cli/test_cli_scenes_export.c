@@ -102,14 +102,11 @@ static void runs_in_ccx(const char *scene, const char *job, int nsteps)
     snprintf(path, sizeof path, "%s/%s.inp", dir, job);
     char *x = tu_slurp(path);
     assert_non_null(x);
-    const char *key = "reaction tolerance implied by the tables: ";
-    const char *p = strstr(x, key);
-    assert_non_null(p);
-    const double tol = strtod(p + strlen(key), NULL);
-    assert_true(tol > 0);
+    const double tol = tu_deck_tolerance(x);
     double *ref = calloc((size_t)nsteps, sizeof *ref);
     assert_non_null(ref);
     int n = 0;
+    const char *p;
     for (p = strstr(x, "conifit reaction "); p && n < nsteps; p = strstr(p + 1, "conifit reaction "))
         ref[n++] = strtod(p + strlen("conifit reaction "), NULL);
     free(x);
