@@ -119,6 +119,7 @@ typedef struct cf_export_lattice {
     cf_spring fibre_spring[CF_FIBRE_MAX];
     double fibre_dir[CF_FIBRE_MAX][3];
     double fibre_density[CF_FIBRE_MAX];
+    double fibre_slack[CF_FIBRE_MAX]; /* group k's recruitment strain (model/fibre.h) */
     char note[640];             /* "" or, for a scene's time protocol written as its quasi-static
                                 ** displacement history, what the model does not carry (the
                                 ** file's header and the report's warning say it) */

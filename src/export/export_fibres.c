@@ -27,7 +27,7 @@
 /* Index of the table of group k with weight w among m->fg[0 .. m->nfg) (fk the group of each),
 ** appended when new. */
 static size_t table_of(cf_xmodel *m, uint32_t *fk, uint32_t k, double w, double Hf,
-                       const cf_law *law, const cf_export_table *t)
+                       double slack, const cf_law *law, const cf_export_table *t)
 {
     for (size_t g = 0; g < m->nfg; g++)
         if (fk[g] == k && m->fg[g].weight == w)
@@ -35,6 +35,7 @@ static size_t table_of(cf_xmodel *m, uint32_t *fk, uint32_t k, double w, double 
     cf_xgroup *G = &m->fg[m->nfg];
     memset(G, 0, sizeof *G);
     G->L0_mm = Hf;
+    G->slack_mm = slack * Hf;
     G->weight = w;
     G->law = law;
     G->table = t;
@@ -43,7 +44,8 @@ static size_t table_of(cf_xmodel *m, uint32_t *fk, uint32_t k, double w, double 
 }
 
 /* Group G's rows from its law's table: one slack row at e = -Hf, then the rows of u >= 0 (the
-** first of them at u = 0, force 0). 0, or -1 out of memory. */
+** first of them at u = 0, force 0) at e = u + the group's slack elongation (a recruited fibre is
+** slack up to it, fibre.h). 0, or -1 out of memory. */
 static int fibre_rows(cf_xgroup *G)
 {
     const cf_export_table *t = G->table;
@@ -58,14 +60,14 @@ static int fibre_rows(cf_xgroup *G)
     G->e_mm[0] = -G->L0_mm;
     G->T_N[0] = 0.0;
     for (size_t i = i0; i < t->rows; i++) {
-        G->e_mm[i - i0 + 1] = t->u_mm[i];
+        G->e_mm[i - i0 + 1] = t->u_mm[i] + G->slack_mm;
         G->T_N[i - i0 + 1] = t->u_mm[i] > 0 ? G->weight * t->F_N[i] : 0.0;
     }
     return 0;
 }
 
-/* Elongation Hf (|F a| - 1) of group k's fibre in tetrahedron t at positions x, F = sum_m x_m
-** (grad N_m)^T; 0 when it is slack. */
+/* Compression Hf (|F a| - 1 - slack) of group k's fibre spring in tetrahedron t at positions x,
+** F = sum_m x_m (grad N_m)^T; 0 when it is slack. */
 static double stretched(const cf_body *b, const double *x, size_t t, size_t k)
 {
     const uint32_t *v = b->tet + 4 * t;
@@ -76,7 +78,8 @@ static double stretched(const cf_body *b, const double *x, size_t t, size_t k)
         for (int i = 0; i < 3; i++)
             Fa[i] += x[3 * v[c4] + (size_t)i] * ga;
     }
-    const double e = b->flaw[k].p.H_mm * (sqrt(Fa[0] * Fa[0] + Fa[1] * Fa[1] + Fa[2] * Fa[2]) - 1);
+    const double e = b->flaw[k].p.H_mm *
+                     (sqrt(Fa[0] * Fa[0] + Fa[1] * Fa[1] + Fa[2] * Fa[2]) - 1 - b->fslack[k]);
     return e > 0 ? e : 0;
 }
 
@@ -140,7 +143,8 @@ int cf_xmodel_body_fibres(cf_xmodel *m, const cf_body *b, const cf_export_table 
                 m->fwt[8 * q + (size_t)c4] = 0.25 - Hf / 2 * ga;
                 m->fwt[8 * q + 4 + (size_t)c4] = 0.25 + Hf / 2 * ga;
             }
-            m->fgrp[q] = (uint32_t)table_of(m, fk, (uint32_t)k, w, Hf, &b->flaw[k], &ft[k]);
+            m->fgrp[q] = (uint32_t)table_of(m, fk, (uint32_t)k, w, Hf, b->fslack[k], &b->flaw[k],
+                                              &ft[k]);
         }
     free(fk);
     for (size_t g = 0; g < m->nfg; g++)
@@ -218,8 +222,9 @@ void cf_xmodel_inp_fibres(FILE *out, const cf_xmodel *m, size_t node0, size_t el
                 fprintf(out, "%zu, %zu, %zu\n", elem0 + q + 1, node0 + 2 * q + 1,
                         node0 + 2 * q + 2);
         fprintf(out, "** fibre table %zu: Hf = %.17g mm, weight %.17g (%s); "
-                     "tension (N), elongation (mm), slack when shortened\n",
-                g + 1, G->L0_mm, G->weight, m->fnc == 4 ? "V0 density / H^3" : "density");
+                     "tension (N), elongation (mm), slack below %.17g mm\n",
+                g + 1, G->L0_mm, G->weight, m->fnc == 4 ? "V0 density / H^3" : "density",
+                G->slack_mm);
         fprintf(out, "*SPRING, ELSET=F%zu, NONLINEAR\n\n", g + 1);
         for (size_t i = 0; i < G->rows; i++)
             cf_export_inp_pair(out, G->T_N[i], G->e_mm[i]);
@@ -244,7 +249,8 @@ int cf_xmodel_lattice_fibres(cf_xmodel *m, const cf_lattice *lat, const cf_expor
     m->nfg = nk;
     for (size_t k = 0; k < nk; k++) {
         const cf_fibre_group *g = &lc->fibre[k];
-        m->fg[k] = (cf_xgroup){.L0_mm = g->law->p.H_mm, .weight = g->density, .law = g->law,
+        m->fg[k] = (cf_xgroup){.L0_mm = g->law->p.H_mm, .weight = g->density,
+                               .slack_mm = g->slack * g->law->p.H_mm, .law = g->law,
                                .table = &ft[k]};
         if (fibre_rows(&m->fg[k]) != 0)
             return -1;

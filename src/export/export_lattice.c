@@ -89,6 +89,7 @@ cf_status cf_export_lattice_from_scene(const cf_scene *sc, const char *name,
         lx->fibre_spring[k] = sc->fibres[k].spring;
         memcpy(lx->fibre_dir[k], sc->fibres[k].axis, sizeof lx->fibre_dir[k]);
         lx->fibre_density[k] = sc->fibres[k].density;
+        lx->fibre_slack[k] = sc->fibres[k].slack;
     }
     cf_scene nofib = *sc;
     nofib.nfibres = 0;
@@ -547,6 +548,7 @@ static cf_status fibre_laws(const cf_export_lattice *lx, const cf_export_options
         grp[k].method = lx->method;
         memcpy(grp[k].dir, lx->fibre_dir[k], sizeof grp[k].dir);
         grp[k].density = lx->fibre_density[k];
+        grp[k].slack = lx->fibre_slack[k];
     }
     lc->fibre = grp;
     lc->nfibre = (int)lx->nfibre;

@@ -20,6 +20,8 @@
 typedef struct cf_xgroup {
     double L0_mm;       /* rest length, mm */
     double weight;      /* force factor on the law, - */
+    double slack_mm;    /* a fibre group's: elongation taken slack before the law (its
+                        ** recruitment strain times L0), mm; 0 otherwise */
     size_t count;       /* springs in the group */
     size_t rows;        /* rows of the table */
     double *e_mm;       /* elongation L - L0 = -u L0/H, mm, ascending */

@@ -10,6 +10,7 @@
 #include <gsl/gsl_errno.h>
 
 #include "fit/fit.h"
+#include "fit/joint.h"
 #include "fit/lm.h"
 #include "model/calibration.h"
 #include "model/cell_stability.h"
@@ -19,6 +20,8 @@
 #define RHO_LO CF_FIT_RHO_MIN_DEFAULT
 #define B_LO 0.02
 #define B_HI 0.99
+/* The largest recruitment strain a group is fitted with (fibre.h). */
+#define SLACK_HI 0.2
 
 static double logistic(double t, double lo, double hi)
 {
@@ -66,7 +69,7 @@ static cf_status model_build(cf_fibre_model *m, const cf_fibre_fit *f, const cf_
     for (int k = 0; k < f->ngroups; k++) {
         const int a = axis_of(f->groups[k]);
         m->group[k] = (cf_fibre_group){&m->law[k], CF_LAW_CLOSED, {a == 0, a == 1, a == 2},
-                                       (double)count[1 + k]};
+                                       (double)count[1 + k], f->slack[k]};
     }
     m->cell.fibre = m->group;
     m->cell.nfibre = f->ngroups;
@@ -140,7 +143,28 @@ typedef struct ff_ctx {
     int np;
 } ff_ctx;
 
-/* The lattice of the coordinates th: 3 for the matrix, 3 per group, 1 for kappa. */
+/* The largest kappa (MPa) of a matrix of member q: Poisson's ratio CF_JOINT_NU_MAX along an axis
+** of the lattice of equal family weights (model_build), at most CF_KAPPA_MAX_MPA; 0 when q is not
+** a spring. */
+static double kappa_max(const cf_ident *q)
+{
+    const double u[CF_FAMILY_COUNT] = {1, 1, 1};
+    double w[CF_FAMILY_COUNT];
+    const double E = cf_cubic_moduli_of(u).E;
+    for (int k = 0; k < CF_FAMILY_COUNT; k++)
+        w[k] = u[k] / E;
+    const cf_spring p = cf_ident_member(q);
+    cf_law law;
+    if (cf_law_init(&law, &p, NULL) != CF_OK)
+        return 0;
+    const double k0H = law.k0_N_per_mm / law.p.H_mm;
+    cf_law_free(&law);
+    const double k = cf_cubic_kappa_of_nu(w, k0H, CF_JOINT_NU_MAX);
+    return isfinite(k) && k > 0 ? fmin(k, CF_KAPPA_MAX_MPA) : 0;
+}
+
+/* The lattice of the coordinates th: 3 for the matrix, 3 per group, 1 for kappa, then 1 per
+** group for its recruitment strain. */
 static void fit_of(const ff_ctx *c, const double *th, cf_fibre_fit *f)
 {
     *f = c->shape;
@@ -153,8 +177,12 @@ static void fit_of(const ff_ctx *c, const double *th, cf_fibre_fit *f)
         q[k]->solid = logistic(x[1], k ? c->b_lo[k - 1] : c->b_lo_matrix, B_HI);
         q[k]->scale = exp(fmin(fmax(x[2], -40.0), 20.0));
     }
-    /* kappa in (0, CF_KAPPA_MAX_MPA), the most a lattice takes (calibration.h) */
-    f->kappa_MPa = CF_KAPPA_MAX_MPA / (1 + exp(-fmax(th[3 * (f->ngroups + 1)], -700.0)));
+    /* kappa in (0, kappa_max): at most the one of Poisson's ratio CF_JOINT_NU_MAX along an axis
+    ** of the matrix lattice (its weights, its springs' k0/H), as the joint fit's; within
+    ** CF_KAPPA_MAX_MPA, the most a lattice takes (calibration.h) */
+    f->kappa_MPa = kappa_max(&f->matrix) / (1 + exp(-fmax(th[3 * (f->ngroups + 1)], -700.0)));
+    for (int k = 0; k < f->ngroups; k++)
+        f->slack[k] = SLACK_HI / (1 + exp(-fmax(th[3 * (f->ngroups + 1) + 1 + k], -700.0)));
 }
 
 static int residuals(const gsl_vector *x, void *arg, gsl_vector *r)
@@ -216,7 +244,7 @@ static cf_status setup(ff_ctx *c, const cf_table *const *t, size_t n, const char
     memcpy(c->shape.groups, groups, ng);
     c->shape.ngroups = (int)ng;
     c->shape.cross = cross;
-    c->np = 3 * ((int)ng + 1) + 1;
+    c->np = 3 * ((int)ng + 1) + 1 + (int)ng;
     *amp = 0;
     for (size_t k = 0; k < n; k++) {
         char why[CF_ERROR_MSG_LEN];
@@ -319,7 +347,8 @@ static double min_stiffness(const ff_ctx *c, const cf_fibre_model *m)
 
 /* The start s of the grid: the matrix near the isotropic lattice of these scales, each group's
 ** rho, s/H and scale on a 2 x 2 x 2 grid (rho 0.3 or 0.8, s/H 0.14 or 0.25, scale 1 or 5 x amp;
-** the groups after the first at 0.3 of the first's scale), kappa 10 x amp. */
+** the groups after the first at 0.3 of the first's scale), kappa at 1 % of its bound, each
+** group recruited at strain 0.01. */
 static void start(const ff_ctx *c, int s, double amp, double *th)
 {
     th[0] = logit(0.6, RHO_LO, 1);
@@ -331,7 +360,10 @@ static void start(const ff_ctx *c, int s, double amp, double *th)
         x[1] = logit(fmax(s & 2 ? 0.25 : 0.14, 1.1 * c->b_lo[k]), c->b_lo[k], B_HI);
         x[2] = log((s & 4 ? 5.0 : 1.0) * amp * (k ? 0.3 : 1.0));
     }
-    th[c->np - 1] = log(10 * amp / (CF_KAPPA_MAX_MPA - 10 * amp));
+    const int nk = 3 * (c->shape.ngroups + 1);
+    th[nk] = log(0.01 / 0.99); /* kappa 1 % of its bound */
+    for (int k = 0; k < c->shape.ngroups; k++)
+        th[nk + 1 + k] = logit(0.01, 0, SLACK_HI);
 }
 
 /* Each table's RMSE and term, the stability, into r (the model of r). */
@@ -419,13 +451,13 @@ cf_status cf_fibre_fit_joint(const cf_table *const *t, size_t n, const char *gro
                              cf_fibre_fit *r, cf_error *err)
 {
     ff_ctx c;
-    double amp = 0, best = INFINITY, th_best[3 * (CF_FIBRE_MAX + 1) + 1] = {0};
+    double amp = 0, best = INFINITY, th_best[4 * CF_FIBRE_MAX + 4] = {0};
     cf_status st = setup(&c, t, n, groups, cross, &amp, err);
     if (st != CF_OK)
         return st;
     memset(r, 0, sizeof *r);
     for (int s = 0; s < 8; s++) {
-        double th[3 * (CF_FIBRE_MAX + 1) + 1];
+        double th[4 * CF_FIBRE_MAX + 4];
         start(&c, s, amp, th);
         const double ss = run_lm(&c, th);
         r->starts++;

@@ -4,8 +4,10 @@
 ** conical law (rho, s/H, F_C/H^2: the isotropic lattice of node-to-node springs, family weights
 ** equal, scaled so that its small-strain modulus along an axis is the law's k0/H), one fibre
 ** group per named axis of the frame (f, s or n), each a conical law acting in fibre tension only
-** (its own rho, s/H and F_C/H^2, one spring per cell of edge H = its free length), and the
-** volume modulus kappa. The frame is the lattice's own (f = x, s = y, n = z); a biaxial table's
+** (its own rho, s/H and F_C/H^2, one spring per cell of edge H = its free length) from its own
+** recruitment strain on (slack below it, model/fibre.h; fitted in (0, 0.2)), and the volume
+** modulus kappa (at most the one of Poisson's ratio CF_JOINT_NU_MAX along an axis of the
+** matrix). The frame is the lattice's own (f = x, s = y, n = z); a biaxial table's
 ** second direction is n or s (`cross`) where its plane does not say, as the Holzapfel-Ogden
 ** baseline reads it (holzapfel.h). Every row is the homogenised cell in its own mode
 ** (cf_cell_load_state): a biaxial row along its own axis with the other loaded at k times its
@@ -13,7 +15,8 @@
 ** Objective: the joint fit's (each table (RMSE / RMS stress)^2, a biaxial table's two directions
 ** one table), the Holzapfel-Ogden fit's. Levenberg-Marquardt in bounded coordinates (logits of
 ** rho in (rho_min 0.05, 1), of s/H above the farthest strain each family's springs reach at
-** 1.05 x the tables' strains, of kappa in (0, CF_KAPPA_MAX_MPA); logs of the scales) from a grid
+** 1.05 x the tables' strains, of kappa in (0, its bound), of each recruitment strain; logs of the
+** scales) from a grid
 ** of eight starts. Private to the library.
 */
 #ifndef CF_FIT_FIBRE_FIT_H
@@ -53,6 +56,7 @@ typedef struct cf_fibre_fit {
     char cross;                    /* 'n' or 's' (see above) */
     cf_ident matrix;               /* rho, s/H (-), F_C/H^2 (MPa) of the matrix springs */
     cf_ident fibre[CF_FIBRE_MAX];  /* the same of each group's spring */
+    double slack[CF_FIBRE_MAX];    /* each group's recruitment strain (fibre.h), - */
     double kappa_MPa;              /* volume modulus, MPa */
     double objective;              /* sum over tables of (RMSE / RMS stress)^2, - */
     size_t ntables;

@@ -674,6 +674,11 @@ static cf_status fibre_entry(json_t *e, const char *path, const char *where, cf_
         out->axis[k] = a[0];
         if ((st = fibre_family(g, path, w, &out->group[k], err)) != CF_OK)
             return st;
+        json_t *rs = json_object_get(g, "recruitment_strain"); /* files before it: taut */
+        out->slack[k] = rs ? (json_is_number(rs) ? json_number_value(rs) : NAN) : 0;
+        if (!(out->slack[k] >= 0 && out->slack[k] < 1))
+            return cf_error_set(err, CF_E_DATA, "%s: key '%s.recruitment_strain' = %g: must be "
+                                "a number in [0, 1)", path, w, out->slack[k]);
     }
     out->ngroups = (int)n;
     return CF_OK;

@@ -147,6 +147,7 @@ typedef struct cf_fitted_fibre {
     int ngroups;
     char axis[CF_FIBRE_MAX];
     cf_ident group[CF_FIBRE_MAX];
+    double slack[CF_FIBRE_MAX]; /* each group's recruitment strain (0 where the file has none) */
     double kappa_MPa;
 } cf_fitted_fibre;
 

@@ -42,7 +42,7 @@ static cf_status helix(ctx *c, json_t *h, const char *where, cf_scene_body_fibre
 /* Entry i of "fibres". */
 static cf_status fibre_entry(ctx *c, json_t *e, size_t i, cf_scene *sc)
 {
-    static const char *const ok[] = {"helix", "spring", "density", NULL};
+    static const char *const ok[] = {"helix", "spring", "density", "recruitment_strain", NULL};
     char where[48], hw[64], sw[64];
     snprintf(where, sizeof where, "fibres[%zu]", i);
     snprintf(hw, sizeof hw, "%s.helix", where);
@@ -61,7 +61,8 @@ static cf_status fibre_entry(ctx *c, json_t *e, size_t i, cf_scene *sc)
     if (!sp)
         return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' is required", c->name, sw);
     if ((st = helix(c, h, hw, f)) ||
-        (st = cf_scene_number(c, e, where, "density", 0, 1, 0, 1, 1e6, &f->density)))
+        (st = cf_scene_number(c, e, where, "density", 0, 1, 0, 1, 1e6, &f->density)) ||
+        (st = cf_scene_number(c, e, where, "recruitment_strain", 0, 0, 0, 0, 0.99, &f->slack)))
         return st;
     if ((st = cf_scene_fibre_spring(c, e, where, &f->spring, f->source)))
         return st;

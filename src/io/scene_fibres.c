@@ -14,10 +14,12 @@
 
 /* Most springs per cell a fibre group may have (a stress scale, not a count to build). */
 #define MAX_DENSITY 1e6
+/* Largest recruitment strain a fibre group takes (fibre.h: below 1). */
+#define MAX_SLACK 0.99
 
 cf_status cf_scene_fibre_entry(ctx *c, json_t *e, const char *where, cf_scene_fibre *f)
 {
-    static const char *const keys[] = {"axis", "spring", "density", NULL};
+    static const char *const keys[] = {"axis", "spring", "density", "recruitment_strain", NULL};
     cf_status st;
     if (!json_is_object(e))
         return cf_error_set(c->err, CF_E_DATA, "%s: key '%s' must be an object", c->name, where);
@@ -37,7 +39,9 @@ cf_status cf_scene_fibre_entry(ctx *c, json_t *e, const char *where, cf_scene_fi
     if (!json_object_get(e, "density"))
         return cf_error_set(c->err, CF_E_DATA, "%s: key '%s.density' is required (springs per "
                             "cell)", c->name, where);
-    if ((st = cf_scene_number(c, e, where, "density", 1, 0, 0, 1, MAX_DENSITY, &f->density)))
+    if ((st = cf_scene_number(c, e, where, "density", 1, 0, 0, 1, MAX_DENSITY, &f->density)) ||
+        (st = cf_scene_number(c, e, where, "recruitment_strain", 0, 0, 0, 0, MAX_SLACK,
+                              &f->slack)))
         return st;
     return cf_scene_fibre_spring(c, e, where, &f->spring, f->source);
 }
@@ -80,6 +84,7 @@ cf_status cf_scene_fibre_fit(ctx *c, json_t *root, cf_scene *sc)
         const int a = ff.axis[k] == 'f' ? 0 : ff.axis[k] == 's' ? 1 : 2;
         f->axis[a] = 1;
         f->density = 1;
+        f->slack = ff.slack[k];
         f->spring = cf_ident_member(&ff.group[k]);
         snprintf(text, sizeof text, "%s: group %c", path, ff.axis[k]);
         cf_safe_text(f->source, sizeof f->source, text, strlen(text));
@@ -156,6 +161,7 @@ cf_status cf_scene_fibre_laws(const cf_scene *sc, cf_law law[CF_FIBRE_MAX],
         grp[k].method = sc->method;
         memcpy(grp[k].dir, sc->fibres[k].axis, sizeof grp[k].dir);
         grp[k].density = sc->fibres[k].density;
+        grp[k].slack = sc->fibres[k].slack;
     }
     cfg->fibre = sc->nfibres ? grp : NULL;
     cfg->nfibre = (int)sc->nfibres;

@@ -61,6 +61,7 @@ typedef struct cf_scene_group {
 typedef struct cf_scene_fibre {
     double axis[3];             /* its reference direction, unit length (the scene's normalised) */
     double density;             /* springs per cell, > 0 */
+    double slack;               /* recruitment strain (fibre.h), [0, 1); 0: taut at rest */
     cf_spring spring;           /* its spring (free length Hf, any) */
     char source[600];           /* "params" or the fit file (and type) it came from */
 } cf_scene_fibre;
@@ -72,6 +73,7 @@ typedef struct cf_scene_body_fibre {
     double from_deg, to_deg;        /* helix.from_deg, helix.to_deg */
     cf_spring spring;               /* its spring (any free length) */
     double density;                 /* springs per lattice cell of the scene spring's H */
+    double slack;                   /* recruitment strain (fibre.h), [0, 1) */
     char source[600];               /* "params" or the fit file (and type) it came from */
 } cf_scene_body_fibre;
 

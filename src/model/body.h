@@ -163,6 +163,7 @@ typedef struct cf_body {
     size_t nfibre;         /* 0: none */
     cf_law *flaw;          /* CF_FIBRE_MAX laws (owned), group k's in flaw[k] */
     double fdensity[CF_FIBRE_MAX]; /* springs per lattice cell of edge law->p.H_mm */
+    double fslack[CF_FIBRE_MAX];   /* each group's recruitment strain (fibre.h), - */
     double *fdir;          /* 3 nt CF_FIBRE_MAX: group k's reference unit direction in
                            ** tetrahedron t at fdir[3 (CF_FIBRE_MAX t + k)] */
     double *fgrad;         /* 12 nt: each tetrahedron's reference shape-function gradients, its
@@ -196,7 +197,7 @@ cf_status cf_body_set_groups(cf_body *b, const cf_mesh *m, size_t n, const cf_se
 ** in a linear tetrahedron): density E(|F a|)/H^3. Its forces and tangent enter every solve.
 ** CF_E_DATA naming key for a bad direction (tetrahedron t), density or law, or a fifth group;
 ** CF_E_INTERNAL when memory runs out. */
-cf_status cf_body_add_fibres(cf_body *b, const cf_spring *spring, double density,
+cf_status cf_body_add_fibres(cf_body *b, const cf_spring *spring, double density, double slack,
                              const double *dir, size_t table_intervals, const char *key,
                              cf_error *err);
 

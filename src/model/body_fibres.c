@@ -43,7 +43,7 @@ static int shape_gradients(cf_body *b)
     return 1;
 }
 
-cf_status cf_body_add_fibres(cf_body *b, const cf_spring *spring, double density,
+cf_status cf_body_add_fibres(cf_body *b, const cf_spring *spring, double density, double slack,
                              const double *dir, size_t table_intervals, const char *key,
                              cf_error *err)
 {
@@ -53,6 +53,9 @@ cf_status cf_body_add_fibres(cf_body *b, const cf_spring *spring, double density
     if (!(isfinite(density) && density > 0))
         return cf_error_set(err, CF_E_DATA, "%s: density = %g springs per cell: must be finite and "
                             "> 0", key, density);
+    if (!(isfinite(slack) && slack >= 0 && slack < 1))
+        return cf_error_set(err, CF_E_DATA, "%s: recruitment_strain = %g: must be in [0, 1)", key,
+                            slack);
     for (size_t t = 0; t < b->nt; t++) {
         const double *a = dir + 3 * t, n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
         if (!(fabs(n - 1) <= 1e-12))
@@ -76,6 +79,7 @@ cf_status cf_body_add_fibres(cf_body *b, const cf_spring *spring, double density
     }
     const size_t k = b->nfibre++;
     b->fdensity[k] = density;
+    b->fslack[k] = slack;
     for (size_t t = 0; t < b->nt; t++)
         memcpy(b->fdir + 3 * (CF_FIBRE_MAX * t + k), dir + 3 * t, 3 * sizeof *dir);
     return CF_OK;
@@ -96,7 +100,7 @@ static void tet_F(const cf_body *b, const double *x, size_t t, double F[9])
 /* Group k of tetrahedron t as the cell's fibre group. */
 static cf_fibre_group group_at(const cf_body *b, size_t k, size_t t)
 {
-    cf_fibre_group fg = {&b->flaw[k], b->method, {0, 0, 0}, b->fdensity[k]};
+    cf_fibre_group fg = {&b->flaw[k], b->method, {0, 0, 0}, b->fdensity[k], b->fslack[k]};
     memcpy(fg.dir, b->fdir + 3 * (CF_FIBRE_MAX * t + k), sizeof fg.dir);
     return fg;
 }
@@ -181,12 +185,12 @@ double cf_body_fibre_umax(const cf_body *b, const double *x)
         for (size_t k = 0; k < b->nfibre; k++) {
             const cf_fibre_group fg = group_at(b, k, t);
             const double lambda = cf_fibre_stretch(&fg, F, Fa);
-            if (!(lambda > 1)) {
+            if (!(lambda > 1 + fg.slack)) {
                 if (!isfinite(lambda))
                     return INFINITY;
                 continue;
             }
-            const double u = fg.law->p.H_mm * (lambda - 1);
+            const double u = fg.law->p.H_mm * (lambda - 1 - fg.slack);
             umax = fmax(umax, u / cf_law_travel_at(fg.law, u));
         }
     }

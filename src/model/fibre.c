@@ -22,6 +22,9 @@ cf_status cf_fibre_check(const cf_fibre_group *g, cf_error *err)
     if (!(fabs(sqrt(n2) - 1) <= 1e-12))
         return cf_error_set(err, CF_E_DATA, "fibre direction (%g, %g, %g): length %.17g, not 1",
                             g->dir[0], g->dir[1], g->dir[2], sqrt(n2));
+    if (!(isfinite(g->slack) && g->slack >= 0 && g->slack < 1))
+        return cf_error_set(err, CF_E_DATA, "fibre recruitment strain %g: must be finite, in "
+                            "[0, 1)", g->slack);
     if (!(isfinite(g->density) && g->density > 0))
         return cf_error_set(err, CF_E_DATA, "fibre density %g springs per cell: must be finite "
                             "and > 0", g->density);
@@ -40,16 +43,16 @@ static cf_status tension(const cf_fibre_group *g, double lambda, double *T, doub
                          cf_error *err)
 {
     *T = 0, *k = 0, *r = 0;
-    if (!(lambda > 1))
+    if (!(lambda > 1 + g->slack))
         return CF_OK; /* slack */
-    const double Hf = g->law->p.H_mm, u = Hf * (lambda - 1);
+    const double Hf = g->law->p.H_mm, u = Hf * (lambda - 1 - g->slack);
     *r = u / cf_law_travel_at(g->law, u);
     if (!(*r < SOLID_MARGIN))
         return cf_error_set(err, CF_E_DATA,
                             "the fibre spring along (%.6g, %.6g, %.6g) reaches solid (stretch "
                             "%.6g, solid at %.6g)",
                             g->dir[0], g->dir[1], g->dir[2], lambda,
-                            1 + cf_law_travel_at(g->law, u) / Hf);
+                            1 + g->slack + cf_law_travel_at(g->law, u) / Hf);
     *T = cf_law_force(g->law, g->method, u, k, NULL);
     return CF_OK;
 }
@@ -76,7 +79,7 @@ cf_status cf_fibre_add_tangent(const cf_fibre_group *g, double H_mm, const doubl
     double Fa[3], T, k, r;
     const double lambda = cf_fibre_stretch(g, F, Fa);
     cf_status st = tension(g, lambda, &T, &k, &r, err);
-    if (st != CF_OK || !(lambda > 1))
+    if (st != CF_OK || !(lambda > 1 + g->slack))
         return st;
     const double Hf = g->law->p.H_mm, H3 = H_mm * H_mm * H_mm;
     const double phi = g->density * Hf * T / H3 / lambda;

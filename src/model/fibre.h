@@ -33,6 +33,8 @@ typedef struct cf_fibre_group {
     cf_law_method method;   /* its evaluator */
     double dir[3];          /* reference unit direction a, lattice frame */
     double density;         /* springs per cell, > 0 */
+    double slack;           /* recruitment strain, >= 0: the fibre is slack up to stretch
+                            ** 1 + slack (crimped collagen straightening), 0 for taut at rest */
 } cf_fibre_group;
 
 /* Checks g: a finite direction of unit length (1e-12), a finite density > 0, a law. CF_E_DATA

@@ -82,6 +82,12 @@ static cf_status lattice_entry(const json_t *e, size_t k, cf_pf_model *m, const 
         f->groups[g] = ax[0];
         f->ngroups = (int)g + 1;
         st = family(o, &f->fibre[g], path, gw, err);
+        f->slack[g] = 0; /* a fit file before recruitment: taut at rest */
+        if (st == CF_OK && json_object_get(o, "recruitment_strain"))
+            st = number(o, "recruitment_strain", 1.0, &f->slack[g], path, gw, err);
+        if (st == CF_OK && !(f->slack[g] >= 0 && f->slack[g] < 1))
+            st = cf_error_set(err, CF_E_DATA, "%s: %s.recruitment_strain = %g: not in [0, 1)",
+                              path, gw, f->slack[g]);
     }
     return st;
 }

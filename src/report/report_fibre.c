@@ -41,8 +41,9 @@ static void fit_text(FILE *o, const cf_joint_report *r, int c)
     fprintf(o, ", %d parameters, %.2f s CPU\n", f->nparams, r->fibre_cpu_s[c]);
     family_text(o, r, "matrix", &f->matrix, &f->matrix_spring, "lattice edge");
     for (int g = 0; g < f->ngroups; g++) {
-        char what[32];
-        snprintf(what, sizeof what, "group %c", f->groups[g]);
+        char what[64];
+        snprintf(what, sizeof what, "group %c (taut from strain %.4g)", f->groups[g],
+                 f->slack[g]);
         family_text(o, r, what, &f->fibre[g], &f->fibre_spring[g], "cell");
     }
     fprintf(o, "      lattice %s; the cell of these springs gives the fitted stress to %.2g of "
@@ -104,13 +105,15 @@ static json_t *spring_json(const cf_fibre_spring *s)
     return e;
 }
 
-static json_t *family_json(const cf_ident *q, const cf_fibre_spring *s, char axis)
+static json_t *family_json(const cf_ident *q, const cf_fibre_spring *s, char axis, double slack)
 {
     json_t *e = json_object();
     if (!e)
         return NULL;
-    if (axis)
+    if (axis) {
         json_object_set_new(e, "axis", json_stringn(&axis, 1));
+        json_object_set_new(e, "recruitment_strain", cf_json_number(slack));
+    }
     json_object_set_new(e, "rho", cf_json_number(q->rho));
     json_object_set_new(e, "solid_strain", cf_json_number(q->solid));
     json_object_set_new(e, "stress_scale_kPa", cf_json_number(q->scale * 1e3));
@@ -134,12 +137,13 @@ json_t *cf_report_fibre_json(const cf_joint_report *r)
             return NULL;
         }
         for (int g = 0; g < f->ngroups; g++)
-            json_array_append_new(gs, family_json(&f->fibre[g], &f->fibre_spring[g], f->groups[g]));
+            json_array_append_new(gs, family_json(&f->fibre[g], &f->fibre_spring[g], f->groups[g],
+                                                   f->slack[g]));
         for (size_t k = 0; k < f->ntables; k++)
             json_array_append_new(rm, cf_json_number(f->rmse_MPa[k] * 1e3));
         json_object_set_new(e, "model", json_string("fibre-lattice"));
         json_object_set_new(e, "cross_axis", json_string(c ? "n" : "s"));
-        json_object_set_new(e, "matrix", family_json(&f->matrix, &f->matrix_spring, 0));
+        json_object_set_new(e, "matrix", family_json(&f->matrix, &f->matrix_spring, 0, 0));
         json_object_set_new(e, "fibre_groups", gs);
         json_object_set_new(e, "volume_modulus_kPa", cf_json_number(f->kappa_MPa * 1e3));
         json_object_set_new(e, "objective", cf_json_number(f->objective));

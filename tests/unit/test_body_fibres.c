@@ -80,7 +80,7 @@ static void homogeneous_case(const double F[9], double *worst_inner, double *wor
     for (size_t t = 0; t < b.nt; t++)
         for (int i = 0; i < 3; i++)
             dir[3 * t + (size_t)i] = a[i];
-    assert_int_equal(cf_body_add_fibres(&b, &fibre_spring, density, dir, 0, "fibres[0]", &err),
+    assert_int_equal(cf_body_add_fibres(&b, &fibre_spring, density, 0, dir, 0, "fibres[0]", &err),
                      CF_OK);
     for (size_t n = 0; n < b.nn; n++)
         for (int i = 0; i < 3; i++)
@@ -193,7 +193,7 @@ static void helix_slab(cf_body *b, cf_mesh *m, cf_law *law, int nx, int nz, doub
     assert_non_null(dir);
     const double n[3] = {0, 0, 1}, ref[3] = {1, 0, 0};
     assert_int_equal(cf_body_helix_dirs(b, n, ref, -60, 60, dir, &err), CF_OK);
-    assert_int_equal(cf_body_add_fibres(b, &fibre_spring, 3, dir, 0, "fibres[0]", &err), CF_OK);
+    assert_int_equal(cf_body_add_fibres(b, &fibre_spring, 3, 0, dir, 0, "fibres[0]", &err), CF_OK);
     free(dir);
 }
 

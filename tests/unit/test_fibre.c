@@ -3,7 +3,9 @@
 **  - the cell's analytic tangent with two fibre groups along a turned frame is the central
 **    difference of its stress at a general F (1e-6 relative);
 **  - a fibre group adds exactly density Hf T(lambda) / (H^3 lambda) (F a) a^T, T the law's force at
-**    u = Hf (lambda - 1), and nothing while lambda <= 1 (slack);
+**    u = Hf (lambda - 1), and nothing while lambda <= 1 (slack); a group recruited at strain s
+**    nothing up to 1 + s, then the same with u = Hf (lambda - 1 - s), its tangent the stress's
+**    central difference; the other cases run with the sheet group recruited at 0.01;
 **  - without fibres, every mode placed on the frame's axes (cf_cell_load_state) is the cell's own
 **    mode (cf_cell_mode) to 1e-12 relative;
 **  - with fibres, each free stretch zeroes its stress (1e-12 of the loaded stress), biaxial rows
@@ -49,7 +51,8 @@ static void make_law(cf_law *law, double rho, double solid, double scale)
         fail_msg("%s", err.msg);
 }
 
-/* A matrix lattice with kappa, a fibre group along f and one along s of the frame R (rows). */
+/* A matrix lattice with kappa, a fibre group along f and one along s of the frame R (rows), the
+** second recruited at strain 0.01 (slack below stretch 1.01). */
 static void setup_cell(fixture *x, const double R[9], int nfibre)
 {
     const double w[CF_FAMILY_COUNT] = {1, 0.6, 0.6};
@@ -60,7 +63,7 @@ static void setup_cell(fixture *x, const double R[9], int nfibre)
     x->cell.volume_modulus_MPa = 5e-3;
     memcpy(x->cell.frame, R, sizeof x->cell.frame);
     x->g[0] = (cf_fibre_group){&x->fib, CF_LAW_CLOSED, {R[0], R[1], R[2]}, 1.0};
-    x->g[1] = (cf_fibre_group){&x->sheet, CF_LAW_CLOSED, {R[3], R[4], R[5]}, 0.5};
+    x->g[1] = (cf_fibre_group){&x->sheet, CF_LAW_CLOSED, {R[3], R[4], R[5]}, 0.5, 0.01};
     for (int k = 0; k < 2; k++)
         assert_int_equal(cf_fibre_check(&x->g[k], NULL), CF_OK);
     x->cell.fibre = x->g;
@@ -96,7 +99,7 @@ static void tangent_is_the_difference_of_the_stress(void **state)
         fail_msg("%s", err.msg);
     double Fa[3];
     assert_true(cf_fibre_stretch(&x.g[0], F, Fa) > 1.01); /* both groups taut */
-    assert_true(cf_fibre_stretch(&x.g[1], F, Fa) > 1.01);
+    assert_true(cf_fibre_stretch(&x.g[1], F, Fa) > 1.005 + x.g[1].slack);
     const double h = 1e-6;
     double amax = 0;
     for (int i = 0; i < 81; i++)
@@ -143,6 +146,57 @@ static void a_group_adds_its_closed_form(void **state)
                 assert_close(a.P_MPa[i][j] - b.P_MPa[i][j], want, 1e-13);
             }
     }
+}
+
+/* A group recruited at strain s adds nothing up to stretch 1 + s and then the closed form with
+** u = Hf (lambda - 1 - s); its tangent there is the difference of its stress. */
+static void a_recruited_group_is_slack_until_its_strain(void **state)
+{
+    (void)state;
+    fixture x;
+    const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    setup_cell(&x, I, 1);
+    x.g[0].slack = 0.03;
+    assert_int_equal(cf_fibre_check(&x.g[0], NULL), CF_OK);
+    cf_cell plain = x.cell;
+    plain.nfibre = 0;
+    const double lam[4] = {1.02, 1.0299, 1.04, 1.07}, Hf = x.fib.p.H_mm;
+    for (int c = 0; c < 4; c++) {
+        const double F[9] = {lam[c], 0.01, 0, 0, 0.99, 0, 0, 0, 1.0};
+        cf_cell_state a, b;
+        assert_int_equal(cf_cell_stress(&x.cell, F, NULL, &a, NULL), CF_OK);
+        assert_int_equal(cf_cell_stress(&plain, F, NULL, &b, NULL), CF_OK);
+        double Fa[3];
+        const double l = cf_fibre_stretch(&x.g[0], F, Fa);
+        const double T = l > 1.03 ? cf_law_force(&x.fib, CF_LAW_CLOSED, Hf * (l - 1.03), NULL,
+                                                 NULL)
+                                  : 0;
+        assert_true(c < 2 ? T == 0 : T > 0);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                assert_close(a.P_MPa[i][j] - b.P_MPa[i][j], Hf * T / (l * 1.0) * Fa[i] *
+                             x.g[0].dir[j], 1e-13);
+        if (c < 3)
+            continue;
+        double A[81] = {0};
+        assert_int_equal(cf_fibre_add_tangent(&x.g[0], 1.0, F, A, NULL), CF_OK);
+        for (int kl = 0; kl < 9; kl++) {
+            const double h = 1e-6;
+            double Fp[9], Fm[9], Pp[3][3] = {{0}}, Pm[3][3] = {{0}}, Tp, Tm, r;
+            memcpy(Fp, F, sizeof Fp);
+            memcpy(Fm, F, sizeof Fm);
+            Fp[kl] += h, Fm[kl] -= h;
+            assert_int_equal(cf_fibre_add_stress(&x.g[0], 1.0, Fp, Pp, &Tp, &r, NULL), CF_OK);
+            assert_int_equal(cf_fibre_add_stress(&x.g[0], 1.0, Fm, Pm, &Tm, &r, NULL), CF_OK);
+            for (int ij = 0; ij < 9; ij++)
+                assert_close(A[9 * ij + kl], (Pp[ij / 3][ij % 3] - Pm[ij / 3][ij % 3]) / (2 * h),
+                             1e-6 * fabs(A[0]));
+        }
+    }
+    x.g[0].slack = 1.0;
+    assert_int_equal(cf_fibre_check(&x.g[0], NULL), CF_E_DATA);
+    x.g[0].slack = -0.01;
+    assert_int_equal(cf_fibre_check(&x.g[0], NULL), CF_E_DATA);
 }
 
 static void loads_without_fibres_are_the_cells_modes(void **state)
@@ -215,12 +269,14 @@ static void fibre_modes_in_every_plane(void **state)
                 for (int k = 0; k < 2; k++) /* group k along axis k: stretched when p = k */
                     if (p == k) {
                         const double l = sqrt(1 + g * g), Hf = x.g[k].law->p.H_mm;
-                        const double T = cf_law_force(x.g[k].law, CF_LAW_CLOSED, Hf * (l - 1),
-                                                      NULL, NULL);
+                        const double u = Hf * (l - 1 - x.g[k].slack);
+                        const double T = u > 0 ? cf_law_force(x.g[k].law, CF_LAW_CLOSED, u, NULL,
+                                                              NULL)
+                                               : 0;
                         add += x.g[k].density * Hf * T / l * g;
                     }
                 assert_close(s.stress_MPa - t.stress_MPa, add, 1e-13);
-                if (p < 2)
+                if (p == 0 || (p == 1 && sqrt(1 + g * g) > 1 + x.g[1].slack))
                     assert_true(add > 0);
             }
         }
@@ -489,6 +545,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(tangent_is_the_difference_of_the_stress),
         cmocka_unit_test(a_group_adds_its_closed_form),
+        cmocka_unit_test(a_recruited_group_is_slack_until_its_strain),
         cmocka_unit_test(loads_without_fibres_are_the_cells_modes),
         cmocka_unit_test(fibre_modes_in_every_plane),
         cmocka_unit_test(cell_equals_the_full_lattice),
