@@ -22,6 +22,8 @@
 #define B_HI 0.99
 /* The largest recruitment strain a group is fitted with (fibre.h). */
 #define SLACK_HI 0.2
+/* The largest face or body family weight of the matrix, relative to the edge family's 1. */
+#define FAMILY_HI 20.0
 
 static double logistic(double t, double lo, double hi)
 {
@@ -37,6 +39,14 @@ static double logit(double v, double lo, double hi)
 static int axis_of(char c)
 {
     return c == 'f' ? 0 : c == 's' ? 1 : c == 'n' ? 2 : -1;
+}
+
+/* The matrix's relative family weights of f into u (1, 1, 1 when f has none). */
+static void family_of(const cf_fibre_fit *f, double u[CF_FAMILY_COUNT])
+{
+    const int none = !(f->family[0] > 0 || f->family[1] > 0 || f->family[2] > 0);
+    for (int k = 0; k < CF_FAMILY_COUNT; k++)
+        u[k] = none ? 1 : f->family[k];
 }
 
 /* The cell of f's families built of the springs sp (matrix first, then each group's), the
@@ -56,8 +66,8 @@ static cf_status model_build(cf_fibre_model *m, const cf_fibre_fit *f, const cf_
         }
         m->nlaws = k + 1;
     }
-    const double u[CF_FAMILY_COUNT] = {1, 1, 1};
-    double w[CF_FAMILY_COUNT];
+    double u[CF_FAMILY_COUNT], w[CF_FAMILY_COUNT];
+    family_of(f, u);
     const double E = cf_cubic_moduli_of(u).E;
     for (int k = 0; k < CF_FAMILY_COUNT; k++)
         w[k] = count[0] * u[k] / E;
@@ -146,10 +156,11 @@ typedef struct ff_ctx {
 /* The largest kappa (MPa) of a matrix of member q: Poisson's ratio CF_JOINT_NU_MAX along an axis
 ** of the lattice of equal family weights (model_build), at most CF_KAPPA_MAX_MPA; 0 when q is not
 ** a spring. */
-static double kappa_max(const cf_ident *q)
+static double kappa_max(const cf_fibre_fit *f)
 {
-    const double u[CF_FAMILY_COUNT] = {1, 1, 1};
-    double w[CF_FAMILY_COUNT];
+    const cf_ident *q = &f->matrix;
+    double u[CF_FAMILY_COUNT], w[CF_FAMILY_COUNT];
+    family_of(f, u);
     const double E = cf_cubic_moduli_of(u).E;
     for (int k = 0; k < CF_FAMILY_COUNT; k++)
         w[k] = u[k] / E;
@@ -163,8 +174,8 @@ static double kappa_max(const cf_ident *q)
     return isfinite(k) && k > 0 ? fmin(k, CF_KAPPA_MAX_MPA) : 0;
 }
 
-/* The lattice of the coordinates th: 3 for the matrix, 3 per group, 1 for kappa, then 1 per
-** group for its recruitment strain. */
+/* The lattice of the coordinates th: 3 for the matrix, 3 per group, 1 for kappa, 1 per group
+** for its recruitment strain, then the matrix's face and body family weights. */
 static void fit_of(const ff_ctx *c, const double *th, cf_fibre_fit *f)
 {
     *f = c->shape;
@@ -177,10 +188,15 @@ static void fit_of(const ff_ctx *c, const double *th, cf_fibre_fit *f)
         q[k]->solid = logistic(x[1], k ? c->b_lo[k - 1] : c->b_lo_matrix, B_HI);
         q[k]->scale = exp(fmin(fmax(x[2], -40.0), 20.0));
     }
+    /* the matrix's face and body family weights over the edge's, each in (0, FAMILY_HI) */
+    const double *x = th + 3 * (f->ngroups + 1) + 1 + f->ngroups;
+    f->family[0] = 1;
+    f->family[1] = logistic(x[0], 0, FAMILY_HI);
+    f->family[2] = logistic(x[1], 0, FAMILY_HI);
     /* kappa in (0, kappa_max): at most the one of Poisson's ratio CF_JOINT_NU_MAX along an axis
     ** of the matrix lattice (its weights, its springs' k0/H), as the joint fit's; within
     ** CF_KAPPA_MAX_MPA, the most a lattice takes (calibration.h) */
-    f->kappa_MPa = kappa_max(&f->matrix) / (1 + exp(-fmax(th[3 * (f->ngroups + 1)], -700.0)));
+    f->kappa_MPa = kappa_max(f) / (1 + exp(-fmax(th[3 * (f->ngroups + 1)], -700.0)));
     for (int k = 0; k < f->ngroups; k++)
         f->slack[k] = SLACK_HI / (1 + exp(-fmax(th[3 * (f->ngroups + 1) + 1 + k], -700.0)));
 }
@@ -244,7 +260,7 @@ static cf_status setup(ff_ctx *c, const cf_table *const *t, size_t n, const char
     memcpy(c->shape.groups, groups, ng);
     c->shape.ngroups = (int)ng;
     c->shape.cross = cross;
-    c->np = 3 * ((int)ng + 1) + 1 + (int)ng;
+    c->np = 3 * ((int)ng + 1) + 1 + (int)ng + 2;
     *amp = 0;
     for (size_t k = 0; k < n; k++) {
         char why[CF_ERROR_MSG_LEN];
@@ -364,6 +380,7 @@ static void start(const ff_ctx *c, int s, double amp, double *th)
     th[nk] = log(0.01 / 0.99); /* kappa 1 % of its bound */
     for (int k = 0; k < c->shape.ngroups; k++)
         th[nk + 1 + k] = logit(0.01, 0, SLACK_HI);
+    th[nk + 1 + c->shape.ngroups] = th[nk + 2 + c->shape.ngroups] = logit(1, 0, FAMILY_HI);
 }
 
 /* Each table's RMSE and term, the stability, into r (the model of r). */
@@ -451,13 +468,13 @@ cf_status cf_fibre_fit_joint(const cf_table *const *t, size_t n, const char *gro
                              cf_fibre_fit *r, cf_error *err)
 {
     ff_ctx c;
-    double amp = 0, best = INFINITY, th_best[4 * CF_FIBRE_MAX + 4] = {0};
+    double amp = 0, best = INFINITY, th_best[4 * CF_FIBRE_MAX + 6] = {0};
     cf_status st = setup(&c, t, n, groups, cross, &amp, err);
     if (st != CF_OK)
         return st;
     memset(r, 0, sizeof *r);
     for (int s = 0; s < 8; s++) {
-        double th[4 * CF_FIBRE_MAX + 4];
+        double th[4 * CF_FIBRE_MAX + 6];
         start(&c, s, amp, th);
         const double ss = run_lm(&c, th);
         r->starts++;

@@ -57,6 +57,9 @@ typedef struct cf_fibre_fit {
     cf_ident matrix;               /* rho, s/H (-), F_C/H^2 (MPa) of the matrix springs */
     cf_ident fibre[CF_FIBRE_MAX];  /* the same of each group's spring */
     double slack[CF_FIBRE_MAX];    /* each group's recruitment strain (fibre.h), - */
+    double family[CF_FAMILY_COUNT]; /* the matrix's relative family weights (edge 1, face and body
+                                    ** fitted in (0, 20); all 0: 1, 1, 1), each family's weight in
+                                    ** the cell that over the lattice's E of them */
     double kappa_MPa;              /* volume modulus, MPa */
     double objective;              /* sum over tables of (RMSE / RMS stress)^2, - */
     size_t ntables;

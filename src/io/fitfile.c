@@ -660,6 +660,16 @@ static cf_status fibre_entry(json_t *e, const char *path, const char *where, cf_
     if (!json_is_array(gs) || n == 0 || n > CF_FIBRE_MAX)
         return cf_error_set(err, CF_E_DATA, "%s: key '%s.fibre_groups' must hold 1 to %d groups",
                             path, where, CF_FIBRE_MAX);
+    json_t *fw = json_object_get(e, "family_weights"); /* files before it: equal weights */
+    for (int k = 0; k < CF_FAMILY_COUNT; k++) {
+        json_t *v = json_array_get(fw, (size_t)k);
+        out->family[k] = !fw ? 1 : json_is_number(v) ? json_number_value(v) : NAN;
+    }
+    if (fw && (!json_is_array(fw) || json_array_size(fw) != CF_FAMILY_COUNT ||
+               !(out->family[0] > 0 && out->family[0] <= 1e6 && out->family[1] >= 0 &&
+                 out->family[1] <= 1e6 && out->family[2] >= 0 && out->family[2] <= 1e6)))
+        return cf_error_set(err, CF_E_DATA, "%s: key '%s.family_weights' must be [edge, face, "
+                            "body]: edge > 0, face and body >= 0, each at most 1e6", path, where);
     out->kappa_MPa = json_is_number(kv) ? json_number_value(kv) * 1e-3 : NAN;
     if (!(out->kappa_MPa >= 0) || !isfinite(out->kappa_MPa))
         return cf_error_set(err, CF_E_DATA, "%s: key '%s.volume_modulus_kPa' must be a finite "

@@ -148,6 +148,8 @@ typedef struct cf_fitted_fibre {
     char axis[CF_FIBRE_MAX];
     cf_ident group[CF_FIBRE_MAX];
     double slack[CF_FIBRE_MAX]; /* each group's recruitment strain (0 where the file has none) */
+    double family[CF_FAMILY_COUNT]; /* the matrix's family weights, edge, face, body (1, 1, 1
+                                    ** where the file has none) */
     double kappa_MPa;
 } cf_fitted_fibre;
 

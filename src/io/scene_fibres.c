@@ -91,12 +91,13 @@ cf_status cf_scene_fibre_fit(ctx *c, json_t *root, cf_scene *sc)
     }
     sc->nfibres = (size_t)ff.ngroups;
     sc->fibre_fit_kappa_MPa = ff.kappa_MPa;
+    memcpy(sc->fibre_fit_family, ff.family, sizeof sc->fibre_fit_family);
     sc->fibre_fit = 1;
     return CF_OK;
 }
 
-/* After a fibre fit: the lattice's weights (the fit's cell: every family 1/E of the unit
-** weights, fibre_fit.c) and kappa, the lattice's own keys for them refused. */
+/* After a fibre fit: the lattice's weights (the fit's cell: each family its weight over the E of
+** the fit's family weights, fibre_fit.c) and kappa, the lattice's own keys for them refused. */
 static cf_status fit_lattice(ctx *c, json_t *root, cf_scene *sc)
 {
     static const char *const own[] = {"weights", "calibration", "diagonals", "diagonal_weight",
@@ -107,7 +108,7 @@ static cf_status fit_lattice(ctx *c, json_t *root, cf_scene *sc)
             return cf_error_set(c->err, CF_E_DATA, "%s: key 'lattice.%s': the fibre fit of "
                                 "'fibres.fit' gives the lattice's weights and volume term",
                                 c->name, own[k]);
-    const double u[CF_FAMILY_COUNT] = {1, 1, 1};
+    const double *u = sc->fibre_fit_family;
     const double E = cf_cubic_moduli_of(u).E;
     cf_lattice_config *L = &sc->cfg.lattice;
     for (int k = 0; k < CF_FAMILY_COUNT; k++)

@@ -93,6 +93,7 @@ typedef struct cf_scene {
     int fibre_fit;              /* 1: "fibres" names a fibre fit file, whose matrix is the spring
                                    and whose groups, weights and kappa the lattice's */
     double fibre_fit_kappa_MPa; /* that fit's volume modulus, MPa */
+    double fibre_fit_family[CF_FAMILY_COUNT]; /* its matrix's family weights (edge, face, body) */
     cf_law_method method;       /* law evaluator */
     size_t table_intervals;     /* for CF_LAW_TABLE */
     cf_msm_config cfg;          /* lattice and solver settings */

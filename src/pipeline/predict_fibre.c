@@ -67,6 +67,15 @@ static cf_status lattice_entry(const json_t *e, size_t k, cf_pf_model *m, const 
         st = number(e, "volume_modulus_kPa", 1e-3, &f->kappa_MPa, path, where, err);
     if (st == CF_OK)
         st = number(e, "objective", 1.0, &m->fit_objective, path, where, err);
+    const json_t *fw = json_object_get(e, "family_weights"); /* absent: equal (all 0 here) */
+    for (int q = 0; st == CF_OK && fw && q < CF_FAMILY_COUNT; q++) {
+        const json_t *v = json_array_get(fw, (size_t)q);
+        f->family[q] = json_is_number(v) ? json_number_value(v) : NAN;
+        if (!(f->family[q] >= (q ? 0 : 1e-300)) || !(f->family[q] <= 1e6) ||
+            json_array_size(fw) != CF_FAMILY_COUNT)
+            st = cf_error_set(err, CF_E_DATA, "%s: %s.family_weights: not [edge > 0, face >= 0, "
+                              "body >= 0], each at most 1e6", path, where);
+    }
     const json_t *gs = json_object_get(e, "fibre_groups");
     if (st == CF_OK && (!json_is_array(gs) || json_array_size(gs) > CF_FIBRE_MAX))
         return cf_error_set(err, CF_E_DATA, "%s: %s.fibre_groups: not an array of at most %d",

@@ -40,6 +40,8 @@ static void fit_text(FILE *o, const cf_joint_report *r, int c)
                 f->objective <= h->objective ? "at or below" : "above");
     fprintf(o, ", %d parameters, %.2f s CPU\n", f->nparams, r->fibre_cpu_s[c]);
     family_text(o, r, "matrix", &f->matrix, &f->matrix_spring, "lattice edge");
+    fprintf(o, "        family weights edge %.4g, face %.4g, body %.4g (each family's springs carry "
+               "its weight times the spring's force)\n", f->family[0], f->family[1], f->family[2]);
     for (int g = 0; g < f->ngroups; g++) {
         char what[64];
         snprintf(what, sizeof what, "group %c (taut from strain %.4g)", f->groups[g],
@@ -145,6 +147,10 @@ json_t *cf_report_fibre_json(const cf_joint_report *r)
         json_object_set_new(e, "cross_axis", json_string(c ? "n" : "s"));
         json_object_set_new(e, "matrix", family_json(&f->matrix, &f->matrix_spring, 0, 0));
         json_object_set_new(e, "fibre_groups", gs);
+        json_t *fw = json_array();
+        for (int k = 0; k < CF_FAMILY_COUNT && fw; k++)
+            json_array_append_new(fw, cf_json_number(f->family[k]));
+        json_object_set_new(e, "family_weights", fw);
         json_object_set_new(e, "volume_modulus_kPa", cf_json_number(f->kappa_MPa * 1e3));
         json_object_set_new(e, "objective", cf_json_number(f->objective));
         json_object_set_new(e, "stable", json_boolean(f->stable));

@@ -1,17 +1,17 @@
 /*
 ** The joint fit of a fibre-reinforced lattice (fit/fibre_fit.c):
-**  - a known lattice (matrix, a fibre group along f, one along n, each recruited at its own
-**    strain, kappa) is recovered from the
+**  - a known lattice (matrix of unequal family weights, a fibre group along f, one along n, each
+**    recruited at its own strain, kappa) is recovered from the
 **    noiseless tables of its own cell: five biaxial tables at Sommer's ratios (cross-fibre n) and
 **    shear fs, sf, nf, every quantity to 1e-6 relative, and every family placed as buildable
 **    springs (the spring fit's design limits, all at one free length, the cell of those springs
 **    the fitted cell to 1e-9);
 **  - a family stiffer than one spring is built of springs in parallel, each buildable; one below
 **    rho_min is flagged with that limit; one with s/H >= 1 is refused;
-**  - on the shared myocardium set the fit with f, s and n groups (biaxial cross-fibre n) has an
-**    objective at or below the Holzapfel-Ogden full fit's with the same weights (both fitted
-**    here; src/notes/lattice-fit.md records them), the lattice stable along every table to 1.05x
-**    and every family placed as buildable springs as above (skipped when ../shared is absent).
+**  - on the shared myocardium set the fit with f, s and n groups (biaxial cross-fibre s) has an
+**    objective at or below the better Holzapfel-Ogden full fit's with the same weights (either
+**    cross-fibre axis; all fitted here; src/notes/lattice-fit.md records them), kappa within
+**    its bound, the lattice stable along every table to 1.05x and every family placed as buildable springs as above (skipped when ../shared is absent).
 */
 #include "testutil.h"
 
@@ -89,6 +89,7 @@ static void known_lattice_is_recovered(void **state)
                                 .fibre = {{.rho = 0.4, .solid = 0.2, .scale = 1.5e-2},
                                           {.rho = 0.7, .solid = 0.15, .scale = 4e-3}},
                                 .slack = {0.012, 0.004},
+                                .family = {1, 0.5, 0.3},
                                 .kappa_MPa = 2e-2};
     cf_fibre_model m;
     assert_int_equal(cf_fibre_model_init(&m, &truth, NULL), CF_OK);
@@ -121,6 +122,9 @@ static void known_lattice_is_recovered(void **state)
                 fail_msg("family %d quantity %d: %.17g, made with %.17g", g, q, got[g][q],
                          want[g][q]);
     assert_close(f.kappa_MPa, truth.kappa_MPa, 1e-6 * truth.kappa_MPa);
+    for (int q = 1; q < 3; q++)
+        if (!(fabs(f.family[q] - truth.family[q]) <= 1e-6 * truth.family[q]))
+            fail_msg("family weight %d: %.17g, made with %.17g", q, f.family[q], truth.family[q]);
     for (int g = 0; g < 2; g++)
         if (!(fabs(f.slack[g] - truth.slack[g]) <= 1e-6 * truth.slack[g]))
             fail_msg("group %d recruitment strain %.17g, made with %.17g", g, f.slack[g],
@@ -216,24 +220,30 @@ static void myocardium_set_at_or_below_holzapfel_ogden(void **state)
         printf("skipped: ../shared/datasets is absent\n");
         skip();
     }
-    /* fibre, sheet and sheet-normal groups; the biaxial cross-fibre direction along n, as the
-    ** report's first choice; Holzapfel-Ogden full fitted with the same weights */
-    cf_ho_fit ti, ho;
-    assert_int_equal(cf_ho_fit_joint(t, 8, CF_HO_TI, 'n', NULL, &ti, NULL), CF_OK);
-    assert_int_equal(cf_ho_fit_joint(t, 8, CF_HO_FULL, 'n', &ti, &ho, NULL), CF_OK);
+    /* Holzapfel-Ogden full fitted with the same weights for either biaxial cross-fibre axis (the
+    ** better of the two, s, is the one to meet); the lattice's fibre, sheet and sheet-normal
+    ** groups with the cross-fibre direction along s */
+    cf_ho_fit ti, ho[2];
+    const char cross[2] = {'n', 's'};
+    for (int c = 0; c < 2; c++) {
+        assert_int_equal(cf_ho_fit_joint(t, 8, CF_HO_TI, cross[c], NULL, &ti, NULL), CF_OK);
+        assert_int_equal(cf_ho_fit_joint(t, 8, CF_HO_FULL, cross[c], &ti, &ho[c], NULL), CF_OK);
+        printf("Holzapfel-Ogden full (cross-fibre %c): %.4f\n", cross[c], ho[c].objective);
+    }
     cf_fibre_fit f;
     cf_error err = {0};
     const clock_t c0 = clock();
-    if (cf_fibre_fit_joint(t, 8, "fsn", 'n', &f, &err) != CF_OK)
+    if (cf_fibre_fit_joint(t, 8, "fsn", 's', &f, &err) != CF_OK)
         fail_msg("%s", err.msg);
-    print_fit("fsn, cross-fibre n", &f, (double)(clock() - c0) / CLOCKS_PER_SEC);
-    printf("Holzapfel-Ogden full (cross-fibre n): %.4f\n", ho.objective);
-    assert_true(f.objective <= ho.objective);
-    /* with taut groups (no recruitment strain) the same fit reached 0.4690; recruited 0.4238 */
-    assert_true(f.objective <= 0.43);
+    print_fit("fsn, cross-fibre s", &f, (double)(clock() - c0) / CLOCKS_PER_SEC);
+    printf("  family weights edge %.4g face %.4g body %.4g\n", f.family[0], f.family[1],
+           f.family[2]);
+    /* taut groups and equal weights reached 0.4562 (HO 0.3718); recruited 0.4112 */
+    assert_true(f.objective <= fmin(ho[0].objective, ho[1].objective));
     /* kappa within Poisson's ratio 0.499 of the matrix lattice (unbounded, the recruited fit ran
     ** it to the 1e6 MPa a lattice takes, 1e8 times the springs' stiffness) */
-    const double u[3] = {1, 1, 1}, E = cf_cubic_moduli_of(u).E, w[3] = {1 / E, 1 / E, 1 / E};
+    const double E = cf_cubic_moduli_of(f.family).E;
+    const double w[3] = {f.family[0] / E, f.family[1] / E, f.family[2] / E};
     const cf_spring pm = cf_ident_member(&f.matrix);
     cf_law lm;
     assert_int_equal(cf_law_init(&lm, &pm, NULL), CF_OK);

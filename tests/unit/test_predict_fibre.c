@@ -7,7 +7,7 @@
 **  - shear nf against an independent computation: the isotropic cell of the matrix spring
 **    alone (the old solver, no fibres) plus the n group's closed form, density Hf T(lambda)
 **    gamma / lambda / H^3 with lambda = sqrt(1 + gamma^2), T at Hf (lambda - 1 - 0.02) (the
-**    group recruited at strain 0.02, zero below) (the f and s groups are not stretched
+**    group recruited at strain 0.02, zero below; the matrix's family weights 1, 0.5, 0.25) (the f and s groups are not stretched
 **    in nf), and Holzapfel-Ogden's closed form a gamma e^(b gamma^2) (I4f = I4s = 1, I8fs = 0);
 **    RMSE to 1e-9 relative, the term (RMSE / RMS)^2 from the table's own RMS stress;
 **  - the biaxial table is in the fibre frame, the uniaxial one is not (left out, no failure);
@@ -44,6 +44,7 @@ static const char fit_json[] =
     "     {\"axis\": \"s\", \"rho\": 0.105, \"solid_strain\": 0.184, \"stress_scale_kPa\": 967},\n"
     "     {\"axis\": \"n\", \"rho\": 0.0702, \"solid_strain\": 0.181, \"stress_scale_kPa\": 1928,"
     "      \"recruitment_strain\": 0.02}],\n"
+    "   \"family_weights\": [1, 0.5, 0.25],\n"
     "   \"volume_modulus_kPa\": 0.61, \"objective\": 0.469, \"stable\": true}],\n"
     " \"holzapfel_ogden\": [{\"model\": \"holzapfel-ogden\", \"cross_axis\": \"n\",\n"
     "   \"parameters_a_kPa_b_dimensionless\": {\"a\": 2.782, \"b\": 2.23, \"a_f\": 1.444,"
@@ -71,16 +72,16 @@ static double lattice_nf(const cf_cell *matrix, const cf_law *ngroup, double g)
 
 static void check_nf(const cf_pf_result *r, const cf_table *t)
 {
-    /* the matrix alone, isotropic weights scaled as the fibre fit's (modulus k0/H) */
+    /* the matrix alone, the file's family weights scaled as the fibre fit's (modulus k0/H) */
     const cf_ident qm = {.rho = 0.631, .solid = 0.482, .scale = 2.70e-3};
     const cf_ident qn = {.rho = 0.0702, .solid = 0.181, .scale = 1.928};
     const cf_spring pm = cf_ident_member(&qm), pn = cf_ident_member(&qn);
     cf_law lm, ln;
     assert_int_equal(cf_law_init(&lm, &pm, NULL), CF_OK);
     assert_int_equal(cf_law_init(&ln, &pn, NULL), CF_OK);
-    const double u[3] = {1, 1, 1};
+    const double u[3] = {1, 0.5, 0.25};
     const double E = cf_cubic_moduli_of(u).E;
-    const double w[3] = {1 / E, 1 / E, 1 / E};
+    const double w[3] = {1 / E, 0.5 / E, 0.25 / E};
     cf_cell c;
     assert_int_equal(cf_cell_init(&c, &lm, CF_LAW_CLOSED, w, NULL), CF_OK);
     double ss = 0, sh = 0, sy = 0;
@@ -168,6 +169,14 @@ static void predicts_held_out_shared_tables(void **state)
     write_file(fit, bad);
     assert_int_equal(cf_pf_predict(fit, t, 3, &r, &err), CF_E_DATA);
     assert_non_null(strstr(err.msg, "fibre_lattice[0].volume_modulus_kPa: missing"));
+    cf_pf_free(&r);
+    /* a negative family weight: refused, naming the key */
+    snprintf(bad, sizeof bad, "%s", fit_json);
+    k = strstr(bad, "[1, 0.5, 0.25]");
+    memcpy(k, "[1, -0.5, 0.2]", 14);
+    write_file(fit, bad);
+    assert_int_equal(cf_pf_predict(fit, t, 3, &r, &err), CF_E_DATA);
+    assert_non_null(strstr(err.msg, "fibre_lattice[0].family_weights"));
     cf_pf_free(&r);
     for (int j = 0; j < 3; j++)
         cf_table_free(&tab[j]);

@@ -177,8 +177,8 @@ static void stretched_along_the_fibre_the_lattice_is_the_cell(void **state)
 
 TU_SCRATCH_GROUP("scenefibres")
 
-/* A joint fit file's fibre lattice of cross axis n only: matrix, f and n groups (n recruited at
-** strain 0.01), kappa. */
+/* A joint fit file's fibre lattice of cross axis n only: matrix (family weights 1, 0.4, 0.2), f
+** and n groups (n recruited at strain 0.01), kappa. */
 static const char *const fibre_fit_json =
     "{\"fibre_lattice\": [{\"model\": \"fibre-lattice\", \"cross_axis\": \"n\",\n"
     " \"matrix\": {\"rho\": 0.63, \"solid_strain\": 0.48, \"stress_scale_kPa\": 2.7},\n"
@@ -186,7 +186,7 @@ static const char *const fibre_fit_json =
     "\"stress_scale_kPa\": 50},\n"
     "  {\"axis\": \"n\", \"rho\": 0.35, \"solid_strain\": 0.22, \"stress_scale_kPa\": 30, "
     "\"recruitment_strain\": 0.01}],\n"
-    " \"volume_modulus_kPa\": 0.6}]}\n";
+    " \"family_weights\": [1, 0.4, 0.2], \"volume_modulus_kPa\": 0.6}]}\n";
 
 /* Parses the scene text with "fibres" = fibres (and more root keys), path of the fit file in
 ** place of FIT. Returns its status, the message in err. */
@@ -223,6 +223,7 @@ static void a_fibre_fit_file_gives_the_whole_lattice(void **state)
     f.fibre[0] = (cf_ident){.rho = 0.3, .solid = 0.2, .scale = 50e-3};
     f.fibre[1] = (cf_ident){.rho = 0.35, .solid = 0.22, .scale = 30e-3};
     f.slack[1] = 0.01;
+    f.family[0] = 1, f.family[1] = 0.4, f.family[2] = 0.2;
     cf_fibre_model m;
     assert_int_equal(cf_fibre_model_init(&m, &f, &err), CF_OK);
     const cf_cell_load ld = {CF_MODE_UNIAXIAL, {2, 0}, 0};
