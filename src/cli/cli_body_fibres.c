@@ -26,8 +26,8 @@ cf_status cf_cli_body_fibres(const cf_scene *sc, cf_body *b, cf_error *err)
             cf_error_set(err, st, "%s.helix: %s", key, e.msg);
             break;
         }
-        if ((st = cf_body_add_fibres(b, &f->spring, f->density, f->slack, dir, sc->table_intervals, key,
-                                     &e)) != CF_OK)
+        if ((st = cf_body_add_fibres(b, &f->spring, f->density, f->slack, dir,
+                                     sc->table_intervals, key, &e)) != CF_OK)
             cf_error_set(err, st, "%s", e.msg);
     }
     free(dir);

@@ -78,9 +78,8 @@ static double stretched(const cf_body *b, const double *x, size_t t, size_t k)
         for (int i = 0; i < 3; i++)
             Fa[i] += x[3 * v[c4] + (size_t)i] * ga;
     }
-    const double e = b->flaw[k].p.H_mm *
-                     (sqrt(Fa[0] * Fa[0] + Fa[1] * Fa[1] + Fa[2] * Fa[2]) - 1 - b->fslack[k]);
-    return e > 0 ? e : 0;
+    const cf_fibre_group g = {.law = &b->flaw[k], .slack = b->fslack[k]};
+    return cf_fibre_compression(&g, sqrt(Fa[0] * Fa[0] + Fa[1] * Fa[1] + Fa[2] * Fa[2]));
 }
 
 /* What the fibre tables allow in the probe force: the reaction is the derivative of the energy

@@ -41,12 +41,18 @@ static int axis_of(char c)
     return c == 'f' ? 0 : c == 's' ? 1 : c == 'n' ? 2 : -1;
 }
 
-/* The matrix's relative family weights of f into u (1, 1, 1 when f has none). */
-static void family_of(const cf_fibre_fit *f, double u[CF_FAMILY_COUNT])
+/* The matrix's family weights in the cell: each of f's relative weights (1, 1, 1 when f has
+** none) over the lattice's axial modulus E of them, so that the matrix's modulus along an axis is
+** its springs' k0/H. */
+static void matrix_weights(const cf_fibre_fit *f, double w[CF_FAMILY_COUNT])
 {
     const int none = !(f->family[0] > 0 || f->family[1] > 0 || f->family[2] > 0);
+    double u[CF_FAMILY_COUNT];
     for (int k = 0; k < CF_FAMILY_COUNT; k++)
         u[k] = none ? 1 : f->family[k];
+    const double E = cf_cubic_moduli_of(u).E;
+    for (int k = 0; k < CF_FAMILY_COUNT; k++)
+        w[k] = u[k] / E;
 }
 
 /* The cell of f's families built of the springs sp (matrix first, then each group's), the
@@ -66,11 +72,10 @@ static cf_status model_build(cf_fibre_model *m, const cf_fibre_fit *f, const cf_
         }
         m->nlaws = k + 1;
     }
-    double u[CF_FAMILY_COUNT], w[CF_FAMILY_COUNT];
-    family_of(f, u);
-    const double E = cf_cubic_moduli_of(u).E;
+    double w[CF_FAMILY_COUNT];
+    matrix_weights(f, w);
     for (int k = 0; k < CF_FAMILY_COUNT; k++)
-        w[k] = count[0] * u[k] / E;
+        w[k] *= count[0];
     if ((st = cf_cell_init(&m->cell, &m->matrix, CF_LAW_CLOSED, w, err)) != CF_OK) {
         cf_fibre_model_free(m);
         return st;
@@ -153,18 +158,14 @@ typedef struct ff_ctx {
     int np;
 } ff_ctx;
 
-/* The largest kappa (MPa) of a matrix of member q: Poisson's ratio CF_JOINT_NU_MAX along an axis
-** of the lattice of equal family weights (model_build), at most CF_KAPPA_MAX_MPA; 0 when q is not
+/* The largest kappa (MPa) of f's matrix: Poisson's ratio CF_JOINT_NU_MAX along an axis of its
+** lattice (matrix_weights, its springs' k0/H), at most CF_KAPPA_MAX_MPA; 0 when its member is not
 ** a spring. */
 static double kappa_max(const cf_fibre_fit *f)
 {
-    const cf_ident *q = &f->matrix;
-    double u[CF_FAMILY_COUNT], w[CF_FAMILY_COUNT];
-    family_of(f, u);
-    const double E = cf_cubic_moduli_of(u).E;
-    for (int k = 0; k < CF_FAMILY_COUNT; k++)
-        w[k] = u[k] / E;
-    const cf_spring p = cf_ident_member(q);
+    double w[CF_FAMILY_COUNT];
+    matrix_weights(f, w);
+    const cf_spring p = cf_ident_member(&f->matrix);
     cf_law law;
     if (cf_law_init(&law, &p, NULL) != CF_OK)
         return 0;

@@ -185,13 +185,11 @@ double cf_body_fibre_umax(const cf_body *b, const double *x)
         for (size_t k = 0; k < b->nfibre; k++) {
             const cf_fibre_group fg = group_at(b, k, t);
             const double lambda = cf_fibre_stretch(&fg, F, Fa);
-            if (!(lambda > 1 + fg.slack)) {
-                if (!isfinite(lambda))
-                    return INFINITY;
-                continue;
-            }
-            const double u = fg.law->p.H_mm * (lambda - 1 - fg.slack);
-            umax = fmax(umax, u / cf_law_travel_at(fg.law, u));
+            if (!isfinite(lambda))
+                return INFINITY;
+            const double u = cf_fibre_compression(&fg, lambda);
+            if (u > 0)
+                umax = fmax(umax, u / cf_law_travel_at(fg.law, u));
         }
     }
     return umax;

@@ -38,14 +38,19 @@ double cf_fibre_stretch(const cf_fibre_group *g, const double F[9], double Fa[3]
     return sqrt(Fa[0] * Fa[0] + Fa[1] * Fa[1] + Fa[2] * Fa[2]);
 }
 
+double cf_fibre_compression(const cf_fibre_group *g, double lambda)
+{
+    return lambda > 1 + g->slack ? g->law->p.H_mm * (lambda - 1 - g->slack) : 0;
+}
+
 /* Tension T (N) and dT/du k (N/mm) at stretch lambda; CF_E_DATA at solid. */
 static cf_status tension(const cf_fibre_group *g, double lambda, double *T, double *k, double *r,
                          cf_error *err)
 {
     *T = 0, *k = 0, *r = 0;
-    if (!(lambda > 1 + g->slack))
+    const double Hf = g->law->p.H_mm, u = cf_fibre_compression(g, lambda);
+    if (!(u > 0))
         return CF_OK; /* slack */
-    const double Hf = g->law->p.H_mm, u = Hf * (lambda - 1 - g->slack);
     *r = u / cf_law_travel_at(g->law, u);
     if (!(*r < SOLID_MARGIN))
         return cf_error_set(err, CF_E_DATA,
@@ -79,7 +84,7 @@ cf_status cf_fibre_add_tangent(const cf_fibre_group *g, double H_mm, const doubl
     double Fa[3], T, k, r;
     const double lambda = cf_fibre_stretch(g, F, Fa);
     cf_status st = tension(g, lambda, &T, &k, &r, err);
-    if (st != CF_OK || !(lambda > 1 + g->slack))
+    if (st != CF_OK || !(cf_fibre_compression(g, lambda) > 0))
         return st;
     const double Hf = g->law->p.H_mm, H3 = H_mm * H_mm * H_mm;
     const double phi = g->density * Hf * T / H3 / lambda;

@@ -44,6 +44,10 @@ cf_status cf_fibre_check(const cf_fibre_group *g, cf_error *err);
 /* The group's stretch lambda = |F a| at F (row-major), F a into Fa. */
 double cf_fibre_stretch(const cf_fibre_group *g, const double F[9], double Fa[3]);
 
+/* The compression u = Hf (lambda - 1 - slack) (mm) of the group's spring at stretch lambda; 0
+** while the fibre is slack (lambda <= 1 + slack, or lambda not a number). */
+double cf_fibre_compression(const cf_fibre_group *g, double lambda);
+
 /* Adds the group's nominal stress at F to P (MPa) in a cell of edge H_mm; *tension_N gets T and
 ** *r its compression over the travel. CF_E_DATA when the spring reaches solid (message: the
 ** direction and the stretch). */

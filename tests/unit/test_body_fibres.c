@@ -4,7 +4,10 @@
 **    nodal forces vanish at every inner node and their moment -sum f X^T / V over the block is
 **    the closed form P = phi (F a) a^T / lambda, phi = density Hf T / H^3 (fibre.h), and the
 **    homogenised cell's stress with the same group less its stress without it, and every
-**    node's dual-cell stress (the VTU's) gains the fibres' Cauchy stress F P^T / J, to 1e-9;
+**    node's dual-cell stress (the VTU's) gains the fibres' Cauchy stress F P^T / J, to 1e-9; the
+**    same with the group recruited at strain 0.03 (T at Hf (lambda - 1 - 0.03)), and the largest
+**    compression over travel (cf_body_fibre_umax) is the group's; a group stretched short of its
+**    recruitment strain adds no force;
 **  - the assembled tangent with fibres of a helix field, at a non-affine state with the fibres in
 **    tension, is the central difference of the forces (1e-6 of its largest entry);
 **  - the helix rule turns the direction linearly through the thickness in the plane normal to the
@@ -64,8 +67,8 @@ static void fibre_part(cf_body *b, const double *x, double *f)
     free(g0);
 }
 
-static void homogeneous_case(const double F[9], double *worst_inner, double *worst_P,
-                             double *worst_sigma)
+static void homogeneous_case(const double F[9], double slack, double *worst_inner,
+                             double *worst_P, double *worst_sigma)
 {
     cf_law law = law_of(&matrix_spring), fl = law_of(&fibre_spring);
     cf_mesh m;
@@ -80,7 +83,7 @@ static void homogeneous_case(const double F[9], double *worst_inner, double *wor
     for (size_t t = 0; t < b.nt; t++)
         for (int i = 0; i < 3; i++)
             dir[3 * t + (size_t)i] = a[i];
-    assert_int_equal(cf_body_add_fibres(&b, &fibre_spring, density, 0, dir, 0, "fibres[0]", &err),
+    assert_int_equal(cf_body_add_fibres(&b, &fibre_spring, density, slack, dir, 0, "fibres[0]", &err),
                      CF_OK);
     for (size_t n = 0; n < b.nn; n++)
         for (int i = 0; i < 3; i++)
@@ -92,8 +95,11 @@ static void homogeneous_case(const double F[9], double *worst_inner, double *wor
     for (int i = 0; i < 3; i++)
         Fa[i] = F[3 * i] * a[0] + F[3 * i + 1] * a[1] + F[3 * i + 2] * a[2];
     const double lam = sqrt(Fa[0] * Fa[0] + Fa[1] * Fa[1] + Fa[2] * Fa[2]), H = law.p.H_mm;
-    const double Hf = fl.p.H_mm, T = cf_law_force(&fl, CF_LAW_CLOSED, Hf * (lam - 1), NULL, NULL);
-    assert_true(lam > 1 && T > 0);
+    const double Hf = fl.p.H_mm, u = Hf * (lam - 1 - slack);
+    const double T = cf_law_force(&fl, CF_LAW_CLOSED, u, NULL, NULL);
+    assert_true(u > 0 && T > 0);
+    /* the largest compression over travel is the group's at this stretch */
+    assert_close(cf_body_fibre_umax(&b, x), u / cf_law_travel_at(&fl, u), 1e-12);
     const double phi = density * Hf * T / (H * H * H * lam);
     double M[9] = {0}, Pmax = 0, fmaxv = 0;
     for (int i = 0; i < 9; i++)
@@ -140,7 +146,7 @@ static void homogeneous_case(const double F[9], double *worst_inner, double *wor
     free(ns[1]);
     /* the homogenised cell with the same group: its stress with the group less without it */
     const double w[CF_FAMILY_COUNT] = {1, 0.6, 0.6};
-    const cf_fibre_group fg = {&fl, CF_LAW_CLOSED, {a[0], a[1], a[2]}, density};
+    const cf_fibre_group fg = {&fl, CF_LAW_CLOSED, {a[0], a[1], a[2]}, density, slack};
     cf_cell cell;
     cf_cell_state cs[2];
     assert_int_equal(cf_cell_init(&cell, &law, CF_LAW_CLOSED, w, &err), CF_OK);
@@ -172,14 +178,51 @@ static void a_homogeneous_block_carries_the_closed_form_fibre_stress(void **stat
     for (int i = 0; i < 9; i++)
         Fu[i] = (i % 4 == 0) + e * a[i / 3] * a[i % 3]; /* stretch 1.08 along a */
     double inner, dP, ds;
-    homogeneous_case(Fu, &inner, &dP, &ds);
+    homogeneous_case(Fu, 0, &inner, &dP, &ds);
     print_message("fibre stretch: inner-node force %.3g of the largest, moment vs P (closed form, cell) %.3g, node "
                   "stress vs F P^T/J %.3g\n", inner, dP, ds);
     assert_true(inner <= 1e-9 && dP <= 1e-9 && ds <= 1e-9);
-    homogeneous_case(Fg, &inner, &dP, &ds);
+    homogeneous_case(Fu, 0.03, &inner, &dP, &ds); /* recruited at 0.03: taut from 1.03 on */
+    print_message("fibre recruited at 0.03, stretch 1.08: %.3g, %.3g, %.3g\n", inner, dP, ds);
+    assert_true(inner <= 1e-9 && dP <= 1e-9 && ds <= 1e-9);
+    homogeneous_case(Fg, 0, &inner, &dP, &ds);
     print_message("general F: inner-node force %.3g of the largest, moment vs P (closed form, cell) %.3g, node "
                   "stress vs F P^T/J %.3g\n", inner, dP, ds);
     assert_true(inner <= 1e-9 && dP <= 1e-9 && ds <= 1e-9);
+}
+
+/* A block stretched 8 % along its fibres, recruited at 0.1: no fibre force, umax 0. */
+static void a_fibre_short_of_its_recruitment_adds_nothing(void **state)
+{
+    (void)state;
+    cf_law law = law_of(&matrix_spring);
+    cf_mesh m;
+    block(&m, 2, 2, 2, 8, 8, 8);
+    cf_body b;
+    cf_error err = {0};
+    assert_int_equal(cf_body_create(&b, &m, &law, CF_LAW_CLOSED, 0, &err), CF_OK);
+    double *dir = malloc(3 * b.nt * sizeof *dir), *f = malloc(3 * b.nn * sizeof *f);
+    double *x = malloc(3 * b.nn * sizeof *x);
+    assert_true(dir && f && x);
+    for (size_t t = 0; t < b.nt; t++)
+        dir[3 * t] = 1, dir[3 * t + 1] = dir[3 * t + 2] = 0;
+    assert_int_equal(cf_body_add_fibres(&b, &fibre_spring, 2, 0.1, dir, 0, "fibres[0]", &err),
+                     CF_OK);
+    for (size_t n = 0; n < 3 * b.nn; n++)
+        x[n] = b.X[n] * (n % 3 == 0 ? 1.08 : 1.0);
+    fibre_part(&b, x, f);
+    for (size_t n = 0; n < 3 * b.nn; n++)
+        assert_true(f[n] == 0);
+    assert_true(cf_body_fibre_umax(&b, x) == 0);
+    assert_int_equal(cf_body_add_fibres(&b, &fibre_spring, 2, 1.0, dir, 0, "fibres[1]", &err),
+                     CF_E_DATA);
+    assert_non_null(strstr(err.msg, "fibres[1]: recruitment_strain = 1"));
+    free(dir);
+    free(f);
+    free(x);
+    cf_body_free(&b);
+    cf_mesh_free(&m);
+    cf_law_free(&law);
 }
 
 /* A slab with the helix field -60 to 60 degrees through z from x, fibres of density 3. */
@@ -333,6 +376,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(a_homogeneous_block_carries_the_closed_form_fibre_stress),
+        cmocka_unit_test(a_fibre_short_of_its_recruitment_adds_nothing),
         cmocka_unit_test(the_tangent_with_fibres_is_the_difference_of_the_forces),
         cmocka_unit_test(the_helix_turns_through_the_thickness),
         cmocka_unit_test(a_pressed_fibre_slab_is_stiffer),

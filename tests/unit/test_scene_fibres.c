@@ -272,6 +272,26 @@ static void a_fibre_fit_file_gives_the_whole_lattice(void **state)
              ", \"fibres\": %s}", fibres);
     assert_int_equal(cf_scene_parse(json, "s.json", &sc, &e), CF_E_DATA);
     assert_non_null(strstr(e.msg, "'lattice.poisson_ratio'"));
+    /* a fit file with a recruitment strain or family weights out of range: refused, naming it */
+    static const char *const from[2] = {"\"recruitment_strain\": 0.01",
+                                        "\"family_weights\": [1, 0.4, 0.2]"};
+    static const char *const to[2] = {"\"recruitment_strain\": 1.50",
+                                      "\"family_weights\": [1, -4, 0.20]"};
+    static const char *const key[2] = {"fibre_groups[1].recruitment_strain",
+                                       "fibre_lattice[0].family_weights"};
+    for (int k = 0; k < 2; k++) {
+        char text[1024];
+        snprintf(text, sizeof text, "%s", fibre_fit_json);
+        char *at = strstr(text, from[k]);
+        assert_non_null(at);
+        memcpy(at, to[k], strlen(to[k]));
+        assert_int_equal(tu_write_bytes(fit, text, strlen(text)), 0);
+        cf_error fe = {0};
+        cf_scene s3;
+        assert_int_equal(parse_fit_scene(fibres, "", &s3, &fe), CF_E_DATA);
+        if (!strstr(fe.msg, key[k]))
+            fail_msg("expected '%s' in: %s", key[k], fe.msg);
+    }
 }
 
 int main(void)
