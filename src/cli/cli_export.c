@@ -317,6 +317,10 @@ static cf_status lattice_of(export_request *q, const cf_fitted_spring *fs,
         return st;
     *lx = cf_export_lattice_default(&law);
     lx->cfg.lattice.volume_modulus_MPa = fs->volume_modulus_MPa;
+    if (cf_fitted_own_weights(fs)) { /* a joint fit's fitted weights: its lattice */
+        memcpy(lx->cfg.lattice.weight, fs->weight, sizeof lx->cfg.lattice.weight);
+        lx->cfg.lattice.calibration = CF_CAL_FITTED;
+    }
     cf_law_free(&law);
     return CF_OK;
 }

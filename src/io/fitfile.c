@@ -101,6 +101,54 @@ static cf_status read_params6(json_t *fit, const char *name, const char *path, c
     return CF_OK;
 }
 
+static cf_status read_finite(json_t *obj, const char *key, const char *path, const char *where,
+                             double *v, cf_error *err);
+
+/* The family weights object w (at `at`, for messages) into weight: each finite, a lattice
+** cf_calibration_check accepts; CF_E_DATA naming the key otherwise. */
+static cf_status read_weights(json_t *w, const char *path, const char *at,
+                              double weight[CF_FAMILY_COUNT], cf_error *err)
+{
+    static const char *const key[CF_FAMILY_COUNT] = {"edge", "face", "body"};
+    for (int f = 0; f < CF_FAMILY_COUNT; f++) {
+        cf_status st = read_finite(w, key[f], path, at, &weight[f], err);
+        if (st != CF_OK)
+            return st;
+    }
+    cf_error e = {0};
+    if (cf_calibration_check(weight, &e) != CF_OK)
+        return cf_error_set(err, CF_E_DATA, "%s: %s: %s", path, at, e.msg);
+    return CF_OK;
+}
+
+/* A joint fit's family weights ("lattice.weights": its springs are the material only in a lattice
+** of those weights) into out->weight, has_weight 1; absent (a single fit, an exported spring):
+** has_weight 0. */
+static cf_status read_fit_weights(json_t *fit, const char *path, const char *where,
+                                  cf_fitted_spring *out, cf_error *err)
+{
+    json_t *w = json_object_get(json_object_get(fit, "lattice"), "weights");
+    out->has_weight = 0;
+    if (!w)
+        return CF_OK;
+    char at[96];
+    snprintf(at, sizeof at, "%s.lattice.weights", where);
+    cf_status st = read_weights(w, path, at, out->weight, err);
+    out->has_weight = st == CF_OK;
+    return st;
+}
+
+int cf_fitted_own_weights(const cf_fitted_spring *fs)
+{
+    double iso[CF_FAMILY_COUNT];
+    if (!fs->has_weight || cf_calibration_weights(CF_CAL_ISOTROPIC, iso, NULL) != CF_OK)
+        return 0;
+    for (int f = 0; f < CF_FAMILY_COUNT; f++)
+        if (!(fabs(fs->weight[f] - iso[f]) <= 1e-9 * iso[f]))
+            return 1;
+    return 0;
+}
+
 /* The double-acting element and the volume term of fit (see cf_fitfile_load_element), or their
 ** refusal when allow is 0. */
 static cf_status read_element(json_t *fit, const char *path, const char *where, int allow,
@@ -125,9 +173,10 @@ static cf_status read_element(json_t *fit, const char *path, const char *where, 
                                : "a lattice with a volume term (key "
                                  "'lattice.volume_modulus_MPa')");
     out->volume_modulus_MPa = kappa;
-    if (!pe)
-        return CF_OK;
-    cf_status st = read_params6(fit, "params_extension", path, where, &out->extension, err);
+    cf_status st = read_fit_weights(fit, path, where, out, err);
+    if (st != CF_OK || !pe)
+        return st;
+    st = read_params6(fit, "params_extension", path, where, &out->extension, err);
     if (st != CF_OK)
         return st;
     cf_law le;
@@ -398,17 +447,9 @@ static cf_status read_lattice(json_t *fit, const char *path, const char *where,
                                             "closed, closed+newton or table", path, where, m);
     if (!w && !out->spring.target_lattice)
         return CF_OK;
-    static const char *const key[3] = {"edge", "face", "body"};
-    for (int f = 0; f < 3; f++) {
-        cf_status st = read_finite(w, key[f], path, at, &out->weight[f], err);
-        if (st != CF_OK)
-            return st;
-    }
-    cf_error e = {0};
-    if (cf_calibration_check(out->weight, &e) != CF_OK)
-        return cf_error_set(err, CF_E_DATA, "%s: %s: %s", path, at, e.msg);
-    out->has_weight = 1;
-    return CF_OK;
+    cf_status st = read_weights(w, path, at, out->weight, err);
+    out->has_weight = st == CF_OK;
+    return st;
 }
 
 /* One fitted table's record (the keys of a joint fit's "tables" entry, or a single fit's "data"

@@ -67,12 +67,20 @@ typedef struct cf_fitted_spring {
     int has_extension;           /* 1: "params_extension" holds the extension spring */
     cf_spring extension;         /* its parameters (H the compression spring's) */
     double volume_modulus_MPa;   /* "lattice.volume_modulus_MPa", 0 when absent */
+    int has_weight;              /* 1: a joint fit's "lattice.weights", the family weights its
+                                 ** springs were fitted in (a scene and an export take them) */
+    double weight[CF_FAMILY_COUNT];
     /* A fit of a law kind the library does not define (its "law" names a kind registered with
     ** cf_law_mech_register, lawmech.h): its mechanics row and quantities ("law_params"); NULL for
     ** the library's conical kinds. */
     const cf_law_mech *mech;
     double q[CF_LAW_Q_MAX];
 } cf_fitted_spring;
+
+/* 1 when fs carries lattice weights other than the isotropic calibration's (a joint fit with
+** --calibration fitted): the lattice its springs are the material in; 0 otherwise (the
+** default lattice is the fit's). */
+int cf_fitted_own_weights(const cf_fitted_spring *fs);
 
 /* The law of a fitted spring: its kind's (cf_law_init_kind) or the conical law of its params. The
 ** extension spring of a pair is the caller's to join. Errors as those calls. */

@@ -234,10 +234,16 @@ static cf_status weights_section(ctx *c, json_t *lt, cf_lattice_config *L)
         if (L->calibration == CF_CAL_FITTED)
             return cf_error_set(c->err, CF_E_DATA,
                                 "%s: key 'lattice.calibration' = 'fitted': a scene takes fitted "
-                                "weights as 'lattice.weights' (from the fit file's "
-                                "'lattice.weights')",
+                                "weights from the joint fit its 'spring.fit' names (give no "
+                                "lattice weights), or as 'lattice.weights'",
                                 c->name);
         return cf_calibration_weights(L->calibration, L->weight, c->err);
+    }
+    if (!dg && !dw && c->from_fit && cf_fitted_own_weights(&c->fit)) {
+        /* a joint fit's springs are the material in the lattice of its fitted weights */
+        memcpy(L->weight, c->fit.weight, sizeof L->weight);
+        L->calibration = CF_CAL_FITTED;
+        return CF_OK;
     }
     if (!dg && !dw)
         return CF_OK; /* the default of cf_lattice_default(): isotropic */

@@ -84,8 +84,13 @@ static void fit_scene_is_the_element(const char *dir, const char *json)
     assert_int_equal(cf_law_init(&lc, &fs.params, NULL), CF_OK);
     assert_int_equal(cf_law_init(&le, &fs.extension, NULL), CF_OK);
     assert_int_equal(cf_law_pair(&lc, &le, NULL), CF_OK);
+    /* the lattice of the fit: its fitted weights when it has them, else the isotropic one */
     double w[3];
-    assert_int_equal(cf_calibration_weights(CF_CAL_ISOTROPIC, w, NULL), CF_OK);
+    assert_true(fs.has_weight);
+    if (cf_fitted_own_weights(&fs))
+        memcpy(w, fs.weight, sizeof w);
+    else
+        assert_int_equal(cf_calibration_weights(CF_CAL_ISOTROPIC, w, NULL), CF_OK);
     cf_cell c;
     assert_int_equal(cf_cell_init(&c, &lc, CF_LAW_CLOSED, w, NULL), CF_OK);
     c.volume_modulus_MPa = fs.volume_modulus_MPa;
@@ -105,6 +110,8 @@ static void fit_scene_is_the_element(const char *dir, const char *json)
         if (rc != 0)
             fail_msg("simulate of the fit's scene exited %d: %s", rc, errb);
         assert_non_null(strstr(out, "element: double-acting"));
+        assert_non_null(strstr(out, cf_fitted_own_weights(&fs) ? "calibration fitted"
+                                                               : "calibration isotropic"));
         double e, s, lat;
         last_row(csv, &e, &s, &lat);
         assert_close(e, strain[i], 1e-9);
@@ -332,6 +339,58 @@ static void brain_pair_fit_file_and_export(void **state)
     assert_non_null(strstr(errb, "volume term"));
     assert_false(exists(t));
     ccx_runs_the_brain_lattice(dir, json);
+    remove(json);
+    rmdir(dir);
+}
+
+/* The brain cortex, --joint --law auto --volume fit --calibration fitted: the lattice's weights
+** are fitted too. The fit file holds them, and a scene naming the fit runs the lattice of those
+** weights (its static runs equal the homogenised cell of the fit's pair, kappa and weights,
+** stable in 2^3 and 3^3 cells to 1.05x the tables' range), as the export's default lattice does
+** (its deck names them); the report states the weights' anisotropy. */
+static void brain_fitted_weights_reach_the_scene(void **state)
+{
+    (void)state;
+    const char *d = tu_datasets();
+    if (!d)
+        skip();
+    TU_SKIP_SANITIZED("a 20 s joint fit");
+    char dir[] = "/tmp/conifit-pairw-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char json[256];
+    snprintf(json, sizeof json, "%s/brainw.json", dir);
+    int rc = tu_run(out, sizeof out, errb, sizeof errb,
+                    "fit %s/brain_cortex_tension.csv %s/brain_cortex_compression.csv "
+                    "%s/brain_cortex_shear.csv --joint --law auto --volume fit --calibration "
+                    "fitted -o %s",
+                    d, d, d, json);
+    if (rc != 0)
+        fail_msg("exit %d: %s", rc, errb);
+    assert_non_null(strstr(out, "calibration fitted (weights edge"));
+    assert_non_null(strstr(out, "anisotropy 2 C44/(C11 - C12)"));
+    cf_fitted_spring fs;
+    cf_error err = {0};
+    assert_int_equal(cf_fitfile_load_element(json, NULL, &fs, &err), CF_OK);
+    if (!cf_fitted_own_weights(&fs))
+        fail_msg("the fit kept the isotropic weights (edge %g, face %g, body %g): nothing here "
+                 "tests that a scene takes fitted ones",
+                 fs.weight[0], fs.weight[1], fs.weight[2]);
+    fit_scene_is_the_element(dir, json);
+    kept_fit_stable_in_lattice(dir, json);
+    char t[300], want[96];
+    snprintf(t, sizeof t, "%s/lat.inp", dir);
+    rc = tu_run(out, sizeof out, errb, sizeof errb,
+                "export %s --lattice --format calculix -o %s", json, t);
+    if (rc != 0)
+        fail_msg("export of the fitted lattice exited %d: %s", rc, errb);
+    char *deck = tu_slurp(t);
+    assert_non_null(deck);
+    snprintf(want, sizeof want, "family weights: edge %g, face diagonal %g", fs.weight[0],
+             fs.weight[1]);
+    if (!strstr(deck, want))
+        fail_msg("the exported deck does not name the fit's weights ('%s')", want);
+    free(deck);
+    remove(t);
     remove(json);
     rmdir(dir);
 }
@@ -669,6 +728,7 @@ int main(void)
         cmocka_unit_test(single_table_pair_says_what_it_does_not_determine),
         cmocka_unit_test(brain_single_tables_and_the_pair),
         cmocka_unit_test(brain_pair_fit_file_and_export),
+        cmocka_unit_test(brain_fitted_weights_reach_the_scene),
         cmocka_unit_test(scene_poisson_ratio_and_pair),
         cmocka_unit_test(explicit_runs_carry_the_volume_term),
     };

@@ -5,6 +5,7 @@
 #include "testutil.h"
 
 #include "io/fitfile.h"
+#include "model/calibration.h"
 
 static char dir[64];
 static char path[128];
@@ -86,6 +87,45 @@ static void exported_spring_file_loads_and_checks_its_type(void **state)
 }
 
 /* Each malformed file: its text, and two pieces the message must contain (key and value). */
+/* TEL fitted in a lattice of weights edge E, face = body F (a joint fit's "lattice") */
+#define WEIGHTED(E, F)                                                                             \
+    "{\"type\":\"telescoping\",\"params\":{\"D1_mm\":10,\"D2_mm\":30,\"n\":4,\"d_mm\":1,"        \
+    "\"G_MPa\":80000,\"H_mm\":40},\"lattice\":{\"weights\":{\"edge\":" E ",\"face\":" F       \
+    ",\"body\":" F "}}}"
+
+/* A joint fit's lattice weights come with its spring: fitted ones are the fit's own lattice, the
+** isotropic calibration's are not (the default lattice is already theirs), a fit without them
+** has none. */
+static void a_joint_fits_weights_come_with_its_spring(void **state)
+{
+    (void)state;
+    double iso[3];
+    assert_int_equal(cf_calibration_weights(CF_CAL_ISOTROPIC, iso, NULL), CF_OK);
+    char e[32], f[32], text[1024];
+    cf_fitted_spring fs;
+    cf_error err = {0};
+    snprintf(text, sizeof text, HEAD "\"fits\":[" WEIGHTED("0.676", "0.2088") "]}");
+    assert_int_equal(cf_fitfile_load_element(write_file("w.json", text), NULL, &fs, &err), CF_OK);
+    assert_true(fs.has_weight);
+    assert_true(cf_fitted_own_weights(&fs));
+    assert_true(fs.weight[0] == 0.676 && fs.weight[1] == 0.2088 && fs.weight[2] == 0.2088);
+    snprintf(e, sizeof e, "%.17g", iso[0]);
+    snprintf(f, sizeof f, "%.17g", iso[1]);
+    snprintf(text, sizeof text,
+             HEAD "\"fits\":[{\"type\":\"telescoping\",\"params\":{\"D1_mm\":10,\"D2_mm\":30,"
+                  "\"n\":4,\"d_mm\":1,\"G_MPa\":80000,\"H_mm\":40},\"lattice\":{\"weights\":"
+                  "{\"edge\":%s,\"face\":%s,\"body\":%s}}}]}",
+             e, f, f);
+    assert_int_equal(cf_fitfile_load_element(write_file("w.json", text), NULL, &fs, &err), CF_OK);
+    assert_true(fs.has_weight);
+    assert_false(cf_fitted_own_weights(&fs));
+    assert_int_equal(
+        cf_fitfile_load_element(write_file("w.json", HEAD "\"fits\":[" TEL "]}"), NULL, &fs, &err),
+        CF_OK);
+    assert_false(fs.has_weight);
+    assert_false(cf_fitted_own_weights(&fs));
+}
+
 static void every_malformed_file_is_refused_naming_key_and_value(void **state)
 {
     (void)state;
@@ -120,6 +160,10 @@ static void every_malformed_file_is_refused_naming_key_and_value(void **state)
         {HEAD "\"fits\":[" TAILED("1", "0.5") "]}", NULL, "H_tail_mm = 0.5", "no room"},
         {HEAD "\"fits\":[" TAILED("1", "7") "]}", NULL, "H_tail_mm = 7", "before the cone"},
         {HEAD "\"fits\":[" TAILED("1", "39.5") "]}", NULL, "H_tail_mm = 39.5", "no travel"},
+        /* a joint fit's lattice weights: each a number, none negative */
+        {HEAD "\"fits\":[" WEIGHTED("\"x\"", "0.2") "]}", NULL, "fits[0].lattice.weights",
+         "\"x\""},
+        {HEAD "\"fits\":[" WEIGHTED("0.6", "-1") "]}", NULL, "lattice.weights.face", "-1"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         cf_fitted_spring fs;
@@ -204,6 +248,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(good_file_loads_both_types_and_provenance),
         cmocka_unit_test(exported_spring_file_loads_and_checks_its_type),
+        cmocka_unit_test(a_joint_fits_weights_come_with_its_spring),
         cmocka_unit_test(every_malformed_file_is_refused_naming_key_and_value),
         cmocka_unit_test(a_tailed_spring_round_trips_and_a_plain_file_has_no_tail_keys),
         cmocka_unit_test(missing_file_is_noinput),
