@@ -38,7 +38,8 @@
 #define PROJ_BISECT 6
 #define PROJ_RESTARTS 3
 #define PROJ_ROUNDS 2
-#define PROJ_MAX (PROJ_ENDS * 3)
+#define PROJ_DIRS 4
+#define PROJ_MAX (PROJ_ENDS * PROJ_DIRS)
 /* the last search's rounds (pair_last_search) */
 #define LAST_ROUNDS 4
 #define LAST_GAIN 1e-3
@@ -360,7 +361,7 @@ static int stable_search(jctx *c, pair_search *s, double z[8], double *f)
 ** *nused the ends projected so far), each moved to stability along the directions dirs[nd];
 ** then the searches kept to stable lattices from the PROJ_RESTARTS lowest projected points, a
 ** lower end into *sb and zs. Returns the points projected (0: no end left), -1 out of memory. */
-static int project_round(jctx *c, pair_search *s, const double *fends, double dirs[3][8],
+static int project_round(jctx *c, pair_search *s, const double *fends, double dirs[PROJ_DIRS][8],
                          int nd, int *seen, int *used, int *nused, double *sb, double zs[8])
 {
     const pvars *pv = &s->pv;
@@ -404,7 +405,9 @@ static int project_round(jctx *c, pair_search *s, const double *fends, double di
 /* Step 3a: the best distinct ends of the starts whose lattices fail the check, each projected to
 ** stability along the directions that resist the lattice's node-scale modes (issue 42: a stiffer
 ** extension spring in compression, a smaller kappa in tension): the extension spring's stress
-** scale up, kappa down, and both together; then the searches kept to stable lattices from the
+** scale up, kappa down, and both together; with fitted weights also the diagonals' weight up
+** (a lattice whose diagonals the search has thinned resists shear and lateral modes with little
+** else); then the searches kept to stable lattices from the
 ** lowest projected points, the best end into *sb and zs. In rounds of PROJ_ENDS ends: another
 ** round while the last one lowered the best end by more than LAST_GAIN, at most PROJ_ROUNDS.
 ** fends: the starts' ends' objectives. */
@@ -412,7 +415,7 @@ static cf_status pair_project(jctx *c, pair_search *s, const double *fends, doub
                               double zs[8], cf_error *err)
 {
     const pvars *pv = &s->pv;
-    double dirs[3][8] = {{0}};
+    double dirs[PROJ_DIRS][8] = {{0}};
     int nd = 0, seen[MAX_PAIR_STARTS] = {0}, used[PROJ_ENDS * PROJ_ROUNDS], nused = 0;
     if (pv->ie >= 0)
         dirs[nd++][pv->ie + 2] = 1;
@@ -420,6 +423,8 @@ static cf_status pair_project(jctx *c, pair_search *s, const double *fends, doub
         dirs[nd++][pv->ik] = -1;
     if (pv->ie >= 0 && pv->ik >= 0)
         dirs[nd][pv->ie + 2] = 1, dirs[nd++][pv->ik] = -1;
+    if (pv->iq >= 0) /* fitted weights: stiffer diagonals (the springs that resist shear) */
+        dirs[nd++][pv->iq] = 1;
     for (int round = 0; round < PROJ_ROUNDS; round++) {
         const double before = *sb;
         const int nc = project_round(c, s, fends, dirs, nd, seen, used, &nused, sb, zs);
