@@ -69,6 +69,9 @@ static const char fit_help[] =
     "                          of fitted family weights, beside the Holzapfel-Ogden baselines,\n"
     "                          for either cross-fibre axis\n"
     "  --calibration C         isotropic (default), axial, or fitted (with --joint)\n"
+    "  --anisotropy-max A      with --calibration fitted: the fitted weights keep the springs'\n"
+    "                          Zener ratio 2 C44/(C11 - C12) within [1 - A, 1 + A] (0.01..1;\n"
+    "                          default: any weights in the search's box)\n"
     "  --volume fit            a volume term (kappa/2)(J - 1)^2 in every cell, kappa fitted\n"
     "                          (with --joint)\n"
     "  --volume-modulus K      the volume term's kappa declared, in the first table's stress\n"
@@ -158,6 +161,7 @@ enum {
     OPT_JOINT,
     OPT_FIBRES,
     OPT_CALIBRATION,
+    OPT_ANISOTROPY_MAX,
     OPT_X_COL,
     OPT_Y_COL,
     OPT_COLUMNS,
@@ -211,6 +215,7 @@ static const struct option fit_options[] = {
     {"joint", no_argument, NULL, OPT_JOINT},
     {"fibres", required_argument, NULL, OPT_FIBRES},
     {"calibration", required_argument, NULL, OPT_CALIBRATION},
+    {"anisotropy-max", required_argument, NULL, OPT_ANISOTROPY_MAX},
     {"x-col", required_argument, NULL, OPT_X_COL},
     {"y-col", required_argument, NULL, OPT_Y_COL},
     {"columns", required_argument, NULL, OPT_COLUMNS},
@@ -476,6 +481,17 @@ static int lattice_option(fit_args *a, int c, const char *optval)
         fo->volume_value = v;
         return 0;
     }
+    case OPT_ANISOTROPY_MAX: {
+        double v;
+        if (cf_cli_parse_double("--anisotropy-max", optval, &v, &err))
+            return cf_cli_usage_error("fit", "%s", err.msg);
+        if (!(v >= 0.01 && v <= 1))
+            return cf_cli_usage_error("fit", "--anisotropy-max %s: the Zener ratio's allowed "
+                                             "departure from 1 must lie in [0.01, 1]",
+                                      optval);
+        fo->anisotropy_max = v;
+        return 0;
+    }
     case OPT_CALIBRATION: {
         cf_lattice_config *lc = &a->popt.lattice.cfg.lattice;
         if (cf_calibration_parse(optval, &lc->calibration, &err) != CF_OK)
@@ -703,10 +719,14 @@ int cf_cli_fit_parse(int argc, char **argv, fit_args *a)
     if (a->joint && a->popt.fit.law == CF_KIND_TAIL && a->popt.fit.volume != CF_VOLUME_NONE)
         return cf_cli_usage_error(cmd, "--law conical-tail has no volume term yet (use conical, "
                                        "double-acting or auto)");
-    if (a->calibration_given && a->popt.lattice.cfg.lattice.calibration == CF_CAL_FITTED &&
-        (!a->joint || a->nfiles < 2))
+    const int fitted =
+        a->calibration_given && a->popt.lattice.cfg.lattice.calibration == CF_CAL_FITTED;
+    if (fitted && (!a->joint || a->nfiles < 2))
         return cf_cli_usage_error(cmd, "--calibration fitted: the family weights are fitted in a "
                                        "joint fit of several modes (--joint)");
+    if (a->popt.fit.anisotropy_max > 0 && !fitted)
+        return cf_cli_usage_error(cmd, "--anisotropy-max %g: it bounds fitted weights (add "
+                                       "--calibration fitted)", a->popt.fit.anisotropy_max);
     if (a->popt.fibres && !a->joint)
         return cf_cli_usage_error(cmd, "--fibres %s: the fibre-reinforced lattice is fitted "
                                        "jointly to biaxial and shear tables (--joint)",

@@ -131,6 +131,9 @@ typedef struct cf_fit_options {
     int nkinds;
     cf_volume volume;               /* the volume term of a joint fit (default none) */
     double volume_value;            /* its declared kappa (MPa) or nu (-) */
+    double anisotropy_max;          /* a joint fit's fitted weights: their Zener ratio
+                                    ** 2 C44/(C11 - C12) held within [1 - a, 1 + a]; 0: the
+                                    ** weights' whole box (calibration.h) */
 } cf_fit_options;
 
 /* Tables up to this many rows are searched on every row; a longer one on its subsample of as many

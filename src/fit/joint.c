@@ -42,6 +42,25 @@ static double profile(jctx *c, const double *z, double *A_out)
     return cf_cell_rss(&c->pr, exp(z[0]), z[1], A_out);
 }
 
+void cf_joint_q_box(const cf_fit_options *opt, double *lb, double *ub)
+{
+    double lo = Q_LO, hi = Q_HI;
+    if (opt->anisotropy_max > 0) {
+        const double a = cf_cubic_q_of_zener(1 - opt->anisotropy_max),
+                     b = cf_cubic_q_of_zener(1 + opt->anisotropy_max);
+        if (a > lo)
+            lo = a;
+        if (b < hi) /* NAN (beyond the ratio's limit): the box's end */
+            hi = b;
+    }
+    *lb = log(lo), *ub = log(hi);
+}
+
+double cf_joint_q_step(double lb, double ub, int fine)
+{
+    return fmin(fine ? 0.05 : 0.2, 0.4 * (ub - lb));
+}
+
 /* The conical search's objective; with the context's stab_on a point that would lower the best
 ** objective of the current search (stab_best) counts only when its full lattice is stable over
 ** the uniaxial tables (cf_joint_stable_at), as in the pair's search. */
@@ -122,7 +141,7 @@ static void conical_keep_stable(jctx *c, int nz, const double *lb, const double 
         }
         for (int j = 0; j < nz; j++)
             z[j] = zb[j] + hi * (ends[pick][j] - zb[j]);
-        double step[3] = {0.1, 0.05 * (ub[1] - lb[1]), 0.2};
+        double step[3] = {0.1, 0.05 * (ub[1] - lb[1]), cf_joint_q_step(lb[2], ub[2], 0)};
         c->stab_on = 1;
         c->stab_best = CF_LSQ_HUGE_OBJ;
         nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)nz, lb, ub, step,
@@ -194,8 +213,9 @@ static cf_status search_conical(jctx *c, const cf_table *reach, double xmax, cf_
     const cf_fit_options *opt = c->opt;
     const int nz = c->fit_weights ? 3 : 2;
     double lb[3] = {log(fmax(CF_IDENT_RHO_LO, opt->rho_min)),
-                    xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9), log(Q_LO)};
-    double ub[3] = {log(cf_ident_rho_hi(c->type, opt->index_max)), 1 - 1e-9, log(Q_HI)};
+                    xmax * (1 + CF_FIT_TRAVEL_MARGIN) * (1 + 1e-9), 0};
+    double ub[3] = {log(cf_ident_rho_hi(c->type, opt->index_max)), 1 - 1e-9, 0};
+    cf_joint_q_box(opt, &lb[2], &ub[2]);
     if (!(lb[1] < ub[1]))
         return cf_error_set(err, CF_E_DATA, "the springs must reach a strain of %g: no spring "
                                             "does", xmax);
@@ -212,7 +232,8 @@ static cf_status search_conical(jctx *c, const cf_table *reach, double xmax, cf_
                            log(grid_q[gq])};
             for (int j = 0; j < nz; j++)
                 z[j] = fmin(fmax(z[j], lb[j]), ub[j]);
-            double step[3] = {0.1, 0.05 * (ub[1] - lb[1]), 0.2}, f = CF_LSQ_HUGE_OBJ;
+            double step[3] = {0.1, 0.05 * (ub[1] - lb[1]), cf_joint_q_step(lb[2], ub[2], 0)},
+                   f = CF_LSQ_HUGE_OBJ;
             nlopt_result res = cf_cell_search(&c->pr, NLOPT_LN_BOBYQA, (unsigned)nz, lb, ub,
                                               step, XTOL_REL, MAX_EVALS, objective, c, z, &f);
             if (c->pr.oom)
@@ -385,6 +406,7 @@ static cf_status joint_run(const cf_table *const *tables, size_t n, const cf_fit
         goto out;
     memcpy(r->weight, c.weight, sizeof r->weight);
     r->calibration = lat->cfg.lattice.calibration;
+    r->anisotropy_max = r->calibration == CF_CAL_FITTED ? opt->anisotropy_max : 0;
     if (!r->nparams)
         r->nparams = r->fit.tail ? 4 : 3;
     r->aic = cf_baseline_aic(total, r->objective, r->nparams, 1.0);

@@ -80,6 +80,8 @@ typedef struct cf_joint_result {
     cf_ident ident;                 /* rho, s/H, F_C/H^2 [MPa] the search found (family.h) */
     double weight[CF_FAMILY_COUNT]; /* the lattice's family weights */
     cf_calibration calibration;     /* isotropic, axial or fitted */
+    double anisotropy_max;          /* fitted weights: the bound on |Zener ratio - 1| asked (0:
+                                    ** none; cf_fit_options.anisotropy_max) */
     size_t ntables;
     cf_joint_table tab[CF_JOINT_MAX];
     double objective;               /* the weighted objective at the optimum, - */

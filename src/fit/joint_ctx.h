@@ -20,6 +20,10 @@
 /* Diagonal-to-edge weight ratio searched when the weights are fitted. */
 #define Q_LO 0.02
 #define Q_HI 5.0
+/* The box of ln q: [ln Q_LO, ln Q_HI], within opt->anisotropy_max's Zener ratios when given. */
+void cf_joint_q_box(const cf_fit_options *opt, double *lb, double *ub);
+/* BOBYQA's initial step in ln q: 0.2 (fine 0.05), at most 0.4 of the box. */
+double cf_joint_q_step(double lb, double ub, int fine);
 /* relative step of the tailed law's errors' central differences, as its single fit through the
 ** lattice takes (lattice_tail.c); the pair's errors take it too */
 #define TAIL_FD_STEP 1e-4

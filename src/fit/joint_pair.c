@@ -145,6 +145,7 @@ static void pair_steps(const pvars *pv, int fine, double step[8])
 {
     for (int j = 0; j < pv->n; j++)
         step[j] = j == 1 || j == pv->ie + 1 ? (fine ? 0.01 : 0.05) * (pv->ub[j] - pv->lb[j])
+                  : j == pv->iq             ? cf_joint_q_step(pv->lb[j], pv->ub[j], fine)
                                             : (fine ? 0.05 : 0.2);
 }
 

@@ -454,7 +454,8 @@ cf_status cf_joint_pair_box(jctx *c, double xmax, pvars *pv, cf_error *err)
     }
     if (c->fit_weights) {
         pv->iq = pv->n;
-        pv->lb[pv->n] = log(Q_LO), pv->ub[pv->n++] = log(Q_HI);
+        cf_joint_q_box(opt, &pv->lb[pv->n], &pv->ub[pv->n]);
+        pv->n++;
     }
     if (c->tail) {
         pv->it = pv->n;

@@ -190,90 +190,6 @@ static cf_status volume_keys(ctx *c, json_t *lt, cf_scene *sc)
     return CF_OK;
 }
 
-/* The family weights: exactly one of 'weights' {edge, face, body}, 'calibration' (isotropic,
-** axial), or the shorthands 'diagonals' / 'diagonal_weight' (edges 1, the named diagonals the
-** given weight: the uncalibrated lattice); none of them: isotropic. */
-static cf_status weights_section(ctx *c, json_t *lt, cf_lattice_config *L)
-{
-    static const char *const wkeys[] = {"edge", "face", "body", NULL};
-    json_t *w = lt ? json_object_get(lt, "weights") : NULL;
-    json_t *cal = lt ? json_object_get(lt, "calibration") : NULL;
-    json_t *dg = lt ? json_object_get(lt, "diagonals") : NULL;
-    json_t *dw = lt ? json_object_get(lt, "diagonal_weight") : NULL;
-    int given = (w != NULL) + (cal != NULL) + (dg != NULL || dw != NULL);
-    if (given > 1)
-        return cf_error_set(c->err, CF_E_DATA,
-                            "%s: key 'lattice.%s': give one of 'lattice.weights', "
-                            "'lattice.calibration' or the shorthands 'lattice.diagonals' / "
-                            "'lattice.diagonal_weight'",
-                            c->name, w && cal ? "calibration" : dg ? "diagonals" : "diagonal_weight");
-    cf_status st;
-    cf_error e = {0};
-    if (w) {
-        if (!json_is_object(w))
-            return cf_error_set(c->err, CF_E_DATA,
-                                "%s: key 'lattice.weights' must be an object {\"edge\": ..., "
-                                "\"face\": ..., \"body\": ...}",
-                                c->name);
-        if ((st = cf_scene_only_keys(c, w, "lattice.weights", wkeys)))
-            return st;
-        for (int f = 0; f < CF_FAMILY_COUNT; f++)
-            if ((st = cf_scene_number(c, w, "lattice.weights", wkeys[f], 1, 0, 0, 0, 1e6, &L->weight[f])))
-                return st;
-        if (cf_calibration_check(L->weight, &e) != CF_OK)
-            return cf_error_set(c->err, CF_E_DATA, "%s: key %s", c->name, e.msg);
-        L->calibration = CF_CAL_CUSTOM;
-        return CF_OK;
-    }
-    if (cal) {
-        const char *name = json_string_value(cal);
-        if (cf_calibration_parse(name, &L->calibration, &e) != CF_OK)
-            return cf_error_set(c->err, CF_E_DATA, "%s: key 'lattice.calibration' = '%s': "
-                                "expected isotropic, axial or fitted", c->name,
-                                name ? name : "(not a string)");
-        if (L->calibration == CF_CAL_FITTED)
-            return cf_error_set(c->err, CF_E_DATA,
-                                "%s: key 'lattice.calibration' = 'fitted': a scene takes fitted "
-                                "weights from the joint fit its 'spring.fit' names (give no "
-                                "lattice weights), or as 'lattice.weights'",
-                                c->name);
-        return cf_calibration_weights(L->calibration, L->weight, c->err);
-    }
-    if (!dg && !dw && c->from_fit && cf_fitted_own_weights(&c->fit)) {
-        /* a joint fit's springs are the material in the lattice of its fitted weights */
-        memcpy(L->weight, c->fit.weight, sizeof L->weight);
-        L->calibration = CF_CAL_FITTED;
-        return CF_OK;
-    }
-    if (!dg && !dw)
-        return CF_OK; /* the default of cf_lattice_default(): isotropic */
-    double wd = 1;
-    if ((st = cf_scene_number(c, lt, "lattice", "diagonal_weight", 0, 1, 0, 0, 1e6, &wd)))
-        return st;
-    unsigned fam = 3; /* bit 0 face, bit 1 body */
-    if (dg) {
-        const char *s = json_string_value(dg);
-        if (s && strcmp(s, "none") == 0)
-            fam = 0;
-        else if (s && strcmp(s, "face") == 0)
-            fam = 1;
-        else if (s && strcmp(s, "body") == 0)
-            fam = 2;
-        else if (s && strcmp(s, "face+body") == 0)
-            fam = 3;
-        else
-            return cf_error_set(c->err, CF_E_DATA,
-                                "%s: key 'lattice.diagonals' = '%s': expected none, face, body or "
-                                "face+body",
-                                c->name, s ? s : "(not a string)");
-    }
-    L->weight[CF_FAMILY_EDGE] = 1;
-    L->weight[CF_FAMILY_FACE] = (fam & 1) ? wd : 0;
-    L->weight[CF_FAMILY_BODY] = (fam & 2) ? wd : 0;
-    L->calibration = CF_CAL_CUSTOM;
-    return CF_OK;
-}
-
 static cf_status lattice_section(ctx *c, json_t *lt, cf_scene *sc)
 {
     static const char *const allowed[] = {"nx", "ny", "nz", "weights", "calibration", "diagonals",
@@ -294,7 +210,7 @@ static cf_status lattice_section(ctx *c, json_t *lt, cf_scene *sc)
                                 "number", c->name, dn[k], v);
         *dv[k] = (int)v;
     }
-    if ((st = weights_section(c, lt, L)))
+    if ((st = cf_scene_weights(c, lt, L)))
         return st;
     json_t *b = lt ? json_object_get(lt, "bottom") : NULL;
     const char *bs = b ? json_string_value(b) : NULL;

@@ -19,6 +19,10 @@ typedef struct ctx {
 } ctx;
 
 /* scene_keys.c: every message names the file (c->name) and the key, 'where.key'. */
+/* The lattice's family weights into L: exactly one of 'weights' {edge, face, body},
+** 'calibration' (isotropic, axial) or the shorthands 'diagonals' / 'diagonal_weight'; none:
+** isotropic, or the fitted weights of the joint fit the scene's spring names. */
+cf_status cf_scene_weights(ctx *c, json_t *lt, cf_lattice_config *L);
 /* Refuses keys of obj that are not in the NULL-terminated list. */
 cf_status cf_scene_only_keys(ctx *c, json_t *obj, const char *where, const char *const *allowed);
 /* A number at obj[key]: required or default; checked finite and within [lo, hi] (or (lo, hi]

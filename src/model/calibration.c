@@ -28,6 +28,16 @@ cf_cubic_moduli cf_cubic_moduli_of(const double w[CF_FAMILY_COUNT])
     return m;
 }
 
+double cf_cubic_q_of_zener(double zener)
+{
+    /* weights {1, q, q}: ke = 1, kf = q/sqrt 2, kb = q/sqrt 3, so with C11 - C12 = ke + kf and
+    ** C44 = kf + 4 kb/3 the ratio is a q/(1 + q/sqrt 2), a = 2 (1/sqrt 2 + 4/(3 sqrt 3)) */
+    double ke, kf, kb;
+    family_stiffness((const double[CF_FAMILY_COUNT]){1, 1, 1}, &ke, &kf, &kb);
+    const double a = 2 * (kf + 4 * kb / 3), q = zener * ke / (a - zener * kf);
+    return zener > 0 && q > 0 && isfinite(q) ? q : NAN;
+}
+
 cf_status cf_calibration_weights(cf_calibration c, double w[CF_FAMILY_COUNT], cf_error *err)
 {
     if (c == CF_CAL_ISOTROPIC) {

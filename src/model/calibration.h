@@ -55,6 +55,11 @@ typedef struct cf_cubic_moduli {
 /* The moduli of a lattice with family weights w (each finite and >= 0). */
 cf_cubic_moduli cf_cubic_moduli_of(const double w[CF_FAMILY_COUNT]);
 
+/* The diagonal-to-edge weight ratio q of a lattice of weights {1, q, q} (face = body) whose Zener
+** ratio 2 C44/(C11 - C12) is zener (> 0, below 2 sqrt 2 (1/sqrt 2 + 4/(3 sqrt 3)), the ratio's
+** limit as q grows); the ratio rises with q, 1 at the isotropic calibration's. NAN out of range. */
+double cf_cubic_q_of_zener(double zener);
+
 /* The volume term (cell.h) adds kappa to C11 and C12 (Lame's lambda), nothing to C44: the
 ** volume modulus kappa (MPa) that gives a lattice of weights w and small-strain modulus scale
 ** k0/H (MPa) the Poisson's ratio nu along an axis, kappa = (nu (C11 + C12) - C12)/(1 - 2 nu) k0/H

@@ -406,9 +406,12 @@ char *cf_joint_text(const cf_joint_report *r)
         cf_report_ident_cell(&j->fit, 2, 1e3, "kPa", q[2], sizeof q[2]);
         fprintf(o, " lattice: rho %s, solid strain s/H %s, stress scale F_C/H^2 %s; "
                    "calibration %s (weights edge %.4g, face %.4g, body %.4g; nu %.3f; "
-                   "springs' anisotropy 2 C44/(C11 - C12) %.3f, 1 isotropic)\n",
+                   "springs' anisotropy 2 C44/(C11 - C12) %.3f, 1 isotropic",
                 q[0], q[1], q[2], cf_calibration_name(j->calibration), j->weight[0],
                 j->weight[1], j->weight[2], cm.nu, cm.zener);
+        if (j->anisotropy_max > 0)
+            fprintf(o, ", held within 1 +- %g", j->anisotropy_max);
+        fputs(")\n", o);
         const cf_law_row *row = cf_fit_kind_of(&j->fit);
         for (int k = 0; k < row->nq; k++)
             if (j->fit.interval_ok[k]) {
@@ -655,6 +658,8 @@ static json_t *joint_json(const cf_joint_report *r)
                       cf_calibration_name(j->calibration), "weights", "edge", num(j->weight[0]),
                       "face", num(j->weight[1]), "body", num(j->weight[2]), "modulus_ratio",
                       num(cm.E), "poisson_ratio", num(cm.nu), "zener_ratio", num(cm.zener)));
+        if (j->anisotropy_max > 0) /* the bound asked */
+            json_object_set_new(json_object_get(f, "lattice"), "anisotropy_max", num(j->anisotropy_max));
         if (j->pair || j->volume != CF_VOLUME_NONE)
             volume_json(json_object_get(f, "lattice"), j);
         json_object_set_new(f, "feasible", json_boolean(j->fit.feasible));

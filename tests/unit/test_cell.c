@@ -119,6 +119,27 @@ static void small_strain_response_of_every_mode_follows_the_elastic_constants(vo
 
 /* Deep in the nonlinear range the free stretch still leaves no lateral stress, and the uniaxial
 ** stress is continuous and increasing from compression to tension. */
+/* cf_cubic_q_of_zener inverts the Zener ratio of weights {1, q, q}: q of ratio z gives back z
+** (1e-12), the isotropic calibration's ratio q is that of z = 1, and a ratio past the limit or not
+** positive has none (NAN). */
+static void the_weight_ratio_of_a_zener_ratio(void **state)
+{
+    (void)state;
+    const double z[] = {0.05, 0.5, 0.9, 1.0, 1.1, 2.0, 3.5};
+    for (size_t k = 0; k < sizeof z / sizeof z[0]; k++) {
+        const double q = cf_cubic_q_of_zener(z[k]);
+        assert_true(q > 0);
+        const double w[CF_FAMILY_COUNT] = {1, q, q};
+        assert_close(cf_cubic_moduli_of(w).zener, z[k], 1e-12 * z[k]);
+    }
+    double iso[CF_FAMILY_COUNT];
+    assert_int_equal(cf_calibration_weights(CF_CAL_ISOTROPIC, iso, NULL), CF_OK);
+    assert_close(cf_cubic_q_of_zener(1.0), iso[CF_FAMILY_FACE] / iso[CF_FAMILY_EDGE], 1e-12);
+    assert_true(isnan(cf_cubic_q_of_zener(0)));
+    assert_true(isnan(cf_cubic_q_of_zener(-1)));
+    assert_true(isnan(cf_cubic_q_of_zener(5.0))); /* the limit is 2 sqrt 2 (...) = 4.18 */
+}
+
 static void uniaxial_curve_is_monotonic_with_zero_lateral_stress(void **state)
 {
     (void)state;
@@ -402,6 +423,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(cell_equals_the_full_lattice_in_uniaxial_tension_and_compression),
         cmocka_unit_test(small_strain_response_of_every_mode_follows_the_elastic_constants),
+        cmocka_unit_test(the_weight_ratio_of_a_zener_ratio),
         cmocka_unit_test(uniaxial_curve_is_monotonic_with_zero_lateral_stress),
         cmocka_unit_test(stress_is_frame_indifferent),
         cmocka_unit_test(extra_tensions_act_as_spring_forces),
