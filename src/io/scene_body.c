@@ -455,10 +455,17 @@ static cf_status body_sections(ctx *c, json_t *root, json_t *bd, cf_scene *sc)
 ** (kappa/2)(J - 1)^2 per unit volume, which adds kappa to lambda and nothing to mu: the same kappa
 ** gives the body the lattice's small-strain E and nu, nu = (mu + kappa)/(2 (2 mu + kappa)). A fit
 ** through a lattice of other weights (its "lattice.weights" not the isotropic ones) has another
-** mu and a cubic material, which the body's isotropic network cannot take: refused. */
+** mu and a cubic material, which the body's isotropic network cannot take: refused, with a
+** volume term or without (a joint fit's fitted weights). */
 cf_status cf_scene_body_fit_volume(cf_scene *sc, const char *name, const char *fit_path,
                                    const struct cf_fitted_spring *fs, cf_error *err)
 {
+    if (!(fs->volume_modulus_MPa > 0) && cf_fitted_own_weights(fs))
+        return cf_error_set(err, CF_E_DATA,
+                            "%s: '%s': its springs were fitted in a lattice of fitted weights "
+                            "(edge %g, face %g, body %g), a cubic material; a body (an isotropic "
+                            "network) takes a fit through the isotropic lattice only",
+                            name, fit_path, fs->weight[0], fs->weight[1], fs->weight[2]);
     if (!(fs->volume_modulus_MPa > 0)) {
         if (sc->body_volume == 3) /* a scene's fit replaced by one without a volume term */
             sc->body_volume = 0;

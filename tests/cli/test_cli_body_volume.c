@@ -62,10 +62,12 @@ static void write_scene(char *scene, size_t cap, const char *name, const char *f
     fclose(f);
 }
 
-/* A copy of FIT at dir/NAME.json with the text from replaced by to (which must occur). */
-static void fit_copy(char *path, size_t cap, const char *name, const char *from, const char *to)
+/* A copy of src (FIT or an earlier copy) at dir/NAME.json with the text from replaced by to (which
+** must occur). */
+static void fit_copy_of(const char *src, char *path, size_t cap, const char *name,
+                        const char *from, const char *to)
 {
-    char *text = tu_slurp(FIT);
+    char *text = tu_slurp(src);
     assert_non_null(text);
     char *v = strstr(text, from);
     assert_non_null(v);
@@ -75,6 +77,11 @@ static void fit_copy(char *path, size_t cap, const char *name, const char *from,
     fprintf(f, "%.*s%s%s", (int)(v - text), text, to, v + strlen(from));
     fclose(f);
     free(text);
+}
+
+static void fit_copy(char *path, size_t cap, const char *name, const char *from, const char *to)
+{
+    fit_copy_of(FIT, path, cap, name, from, to);
 }
 
 /* Runs the scene into dir/NAME.csv, its forces (STEPS + 1 rows) into F and the summary into out;
@@ -202,6 +209,13 @@ static void a_second_volume_term_or_another_lattice_is_refused(void **state)
     char fit[600];
     fit_copy(fit, sizeof fit, "axial_fit", "\"edge\": 0.60848984692814911", "\"edge\": 0.5");
     refused("axial", fit, "", "edge weight 0.5", "isotropic lattice only");
+    /* a joint fit's fitted weights, without a volume term too: another material */
+    char fit2[600];
+    fit_copy(fit, sizeof fit, "fitted_w", "\"edge\": 0.60848984692814911",
+             "\"edge\": 0.676");
+    fit_copy_of(fit, fit2, sizeof fit2, "fitted_w0", "\"volume_modulus_MPa\": 0.0029634644827944115",
+                "\"volume_modulus_MPa\": 0");
+    refused("fittedw", fit2, "", "fitted weights (edge 0.676", "isotropic lattice only");
 }
 
 static void the_body_exports_to_calculix(void **state)
