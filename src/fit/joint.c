@@ -42,25 +42,6 @@ static double profile(jctx *c, const double *z, double *A_out)
     return cf_cell_rss(&c->pr, exp(z[0]), z[1], A_out);
 }
 
-void cf_joint_q_box(const cf_fit_options *opt, double *lb, double *ub)
-{
-    double lo = Q_LO, hi = Q_HI;
-    if (opt->anisotropy_max > 0) {
-        const double a = cf_cubic_q_of_zener(1 - opt->anisotropy_max),
-                     b = cf_cubic_q_of_zener(1 + opt->anisotropy_max);
-        if (a > lo)
-            lo = a;
-        if (b < hi) /* NAN (beyond the ratio's limit): the box's end */
-            hi = b;
-    }
-    *lb = log(lo), *ub = log(hi);
-}
-
-double cf_joint_q_step(double lb, double ub, int fine)
-{
-    return fmin(fine ? 0.05 : 0.2, 0.4 * (ub - lb));
-}
-
 /* The conical search's objective; with the context's stab_on a point that would lower the best
 ** objective of the current search (stab_best) counts only when its full lattice is stable over
 ** the uniaxial tables (cf_joint_stable_at), as in the pair's search. */

@@ -73,3 +73,22 @@ int cf_joint_table_weights(const cf_table *t, double *scale, double *sw)
         sw[i] = sqrt((t->w ? t->w[i] : 1.0) / (double)t->count) / s;
     return 0;
 }
+
+void cf_joint_q_box(const cf_fit_options *opt, double *lb, double *ub)
+{
+    double lo = Q_LO, hi = Q_HI;
+    if (opt->anisotropy_max > 0) {
+        const double a = cf_cubic_q_of_zener(1 - opt->anisotropy_max),
+                     b = cf_cubic_q_of_zener(1 + opt->anisotropy_max);
+        if (a > lo)
+            lo = a;
+        if (b < hi) /* NAN (beyond the ratio's limit): the box's end */
+            hi = b;
+    }
+    *lb = log(lo), *ub = log(hi);
+}
+
+double cf_joint_q_step(double lb, double ub, int fine)
+{
+    return fmin(fine ? 0.05 : 0.2, 0.4 * (ub - lb));
+}
