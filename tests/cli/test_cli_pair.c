@@ -284,6 +284,24 @@ static void kept_fit_stable_in_lattice(const char *dir, const char *json)
     remove(scene);
 }
 
+/* The joint report's better type: its verdict stable over every table's range, in the full
+** lattice too. */
+static void better_type_stable(const char *report)
+{
+    const char *better = strstr(report, "Better type: ");
+    assert_non_null(better);
+    const char *type = strncmp(better + 13, "telescoping", 11) == 0 ? "\ntelescoping spring:"
+                                                                     : "non-telescoping spring:";
+    const char *block = strstr(report, type);
+    assert_non_null(block);
+    const char *end = strstr(block + 1, "\n\n");
+    char *text = strndup(block, end ? (size_t)(end - block) : strlen(block));
+    assert_non_null(text);
+    if (!strstr(text, "\n  stable over every table's range") || strstr(text, "loses stability"))
+        fail_msg("the kept fit's verdict is not stable over every table's range:\n%s", text);
+    free(text);
+}
+
 /* The brain cortex, --joint --law auto --volume fit: the fit file holds the pair and kappa, and
 ** export refuses it with 65 naming the key, writing nothing. */
 static void brain_pair_fit_file_and_export(void **state)
@@ -304,20 +322,7 @@ static void brain_pair_fit_file_and_export(void **state)
         fail_msg("exit %d: %s", rc, errb);
     assert_non_null(strstr(out, "double-acting element"));
     assert_non_null(strstr(out, "volume term"));
-    /* the better type's verdict: stable over every table's range, in the full lattice too */
-    const char *better = strstr(out, "Better type: ");
-    assert_non_null(better);
-    const char *type = strncmp(better + 13, "telescoping", 11) == 0 ? "telescoping spring:"
-                                                                     : "non-telescoping spring:";
-    const char *block = strstr(out, type);
-    assert_non_null(block);
-    const char *end = strstr(block, "\n\n");
-    const size_t len = end ? (size_t)(end - block) : strlen(block);
-    char *text = strndup(block, len);
-    assert_non_null(text);
-    if (!strstr(text, "\n  stable over every table's range") || strstr(text, "loses stability"))
-        fail_msg("the kept fit's verdict is not stable over every table's range:\n%s", text);
-    free(text);
+    better_type_stable(out);
     char *file = tu_slurp(json);
     assert_non_null(file);
     assert_non_null(strstr(file, "\"params_extension\""));
@@ -427,18 +432,7 @@ static void fitted_weights_keep_a_stable_lattice_without_shear(void **state)
                                      "brain_coronaradiata_compression.csv", NULL};
     char dir[] = "/tmp/conifit-pairc-XXXXXX", json[256];
     brain_joint_fit(dir, json, sizeof json, cr, "--calibration fitted");
-    const char *better = strstr(out, "Better type: ");
-    assert_non_null(better);
-    const char *type = strncmp(better + 13, "telescoping", 11) == 0 ? "\ntelescoping spring:"
-                                                                     : "non-telescoping spring:";
-    const char *block = strstr(out, type);
-    assert_non_null(block);
-    const char *end = strstr(block + 1, "\n\n");
-    char *text = strndup(block, end ? (size_t)(end - block) : strlen(block));
-    assert_non_null(text);
-    if (!strstr(text, "\n  stable over every table's range") || strstr(text, "loses stability"))
-        fail_msg("the kept fit is not stable over every table's range:\n%s", text);
-    free(text);
+    better_type_stable(out);
     remove(json);
     rmdir(dir);
 }
